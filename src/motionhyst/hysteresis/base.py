@@ -1,0 +1,111 @@
+"""The interface every hysteresis model of a dynamic link implements.
+
+A hysteresis element maps the displacement ``x`` of the stage (the position
+``y1`` of the actuated mass in the paper's Fig. 2) to the disturbance force
+``w`` it exerts on the stage.  The analyses in :mod:`motionhyst` use only the
+methods defined here, so every model is accepted by the quasi-linear analysis,
+the periodic steady state and the time simulation.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+from control import DescribingFunctionNonlinearity
+from numpy.typing import ArrayLike, NDArray
+
+
+class Hysteresis(DescribingFunctionNonlinearity, ABC):
+    """Base class of hysteresis elements (displacement in, force out).
+
+    Subclasses implement :meth:`describing_function` (paper eq. 7), the
+    exact sampled response :meth:`response` and :meth:`to_dict`.  Instances
+    are also python-control nonlinearities: calling one with a scalar
+    displacement advances an internal state, so
+    :func:`control.describing_function` and
+    :func:`control.describing_function_response` accept them and use the
+    closed form through :meth:`describing_function`.
+
+    Attributes
+    ----------
+    rate_independent : bool
+        True if the output depends only on the path of ``x``, not on its
+        speed; the describing function then depends on amplitude only.
+    """
+
+    rate_independent: bool = True
+    name: str = "hysteresis"
+
+    @property
+    @abstractmethod
+    def initial_stiffness(self) -> float:
+        """Stiffness of the element for small motions [N/m] (upper bound of ``|D|``)."""
+
+    @abstractmethod
+    def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
+        """Describing function ``D = (b1 + j a1) / A`` (paper eq. 7) [N/m].
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) of the input ``x = A sin(omega t)`` [m].
+        omega : array_like, optional
+            Angular frequency [rad/s]; ignored by rate-independent elements.
+
+        Returns
+        -------
+        complex or ndarray of complex
+            Same shape as `A`; phase relative to ``sin(omega t)``, positive
+            phase is lead (dissipation).
+        """
+
+    @abstractmethod
+    def response(self, x: ArrayLike, w0: float = 0.0) -> NDArray[np.float64]:
+        """Force ``w`` for a sampled displacement ``x`` starting from force `w0`.
+
+        The displacement is taken as monotone between samples.
+        """
+
+    @abstractmethod
+    def to_dict(self) -> dict:
+        """Parameters as a JSON-ready dictionary, with key ``model``."""
+
+    def reset(self, w: float = 0.0) -> None:
+        """Reset the state used by :meth:`__call__` (force `w`, last input unknown)."""
+        self._w = float(w)
+        self._x = None
+
+    def __call__(self, x: float) -> float:
+        """Advance the element by one displacement sample (python-control interface)."""
+        x = float(np.squeeze(x))
+        if getattr(self, "_x", None) is None:
+            self._w = getattr(self, "_w", 0.0)
+            self._x = x
+            return self._w
+        out = self.response(np.array([self._x, x]), w0=self._w)
+        self._w = float(out[-1])
+        self._x = x
+        return self._w
+
+    def _isstatic(self) -> bool:
+        return False
+
+
+def check_positive(name: str, value: float) -> float:
+    """Return `value` as float, raising ``ValueError`` unless finite and > 0."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
+    return v
+
+
+def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
+    """Return amplitudes as a float array, raising ``ValueError`` unless finite and >= 0."""
+    a = np.asarray(A, dtype=float)
+    if not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise ValueError("amplitude must be finite and >= 0")
+    return a

@@ -1,0 +1,219 @@
+"""The motion control loop of the paper's Fig. 3 and its linear closed-loop transfers.
+
+The loop is ``u = C e + u_ff``, ``e = r - y2``, ``y1 = P1 (u - w)``,
+``y2 = P2 (u - w)`` with the hysteresis force ``w = phi(y1)`` and the
+rigid-body feedforward ``u_ff = M r''`` (``C_ff = P_r^-1 = M s^2``).
+Solving the linear part for the two inputs ``r`` and ``w`` gives::
+
+    e  = (1 - P2 C_ff) / (1 + C P2) r  +  P2 / (1 + C P2) w
+    y1 = P1 (C + C_ff) / (1 + C P2) r  -  P1 / (1 + C P2) w
+
+Only the second terms involve the hysteresis, and they are of the size of the
+tracking error, so every analysis computes them directly rather than by
+subtracting positions.  For LTI systems the transfers are formed as
+polynomial ratios with common factors ``s^n`` cancelled, so ``s = 0`` (DC) is
+exact: a controller without integrator gives ``P2 / (1 + C P2) -> 1 / C(0)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.hysteresis.base import Hysteresis
+from motionhyst.systems import MeasuredPlant, TwoMassStage, bandwidth, freqresp
+
+TRANSFERS = ("r->e", "r->y1", "w->e", "w->y1")
+
+
+def _tf_poly(sys) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Numerator and denominator coefficients of a SISO LTI system."""
+    if isinstance(sys, control.StateSpace):
+        sys = control.ss2tf(sys)
+    if not isinstance(sys, control.TransferFunction):
+        raise TypeError(f"expected an LTI system, got {type(sys).__name__}")
+    if sys.ninputs != 1 or sys.noutputs != 1:
+        raise ValueError("plant and controller must be single-input single-output")
+    return np.atleast_1d(np.asarray(sys.num[0][0], float)), np.atleast_1d(
+        np.asarray(sys.den[0][0], float))
+
+
+def _trim(p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Drop leading coefficients that are exactly zero."""
+    p = np.atleast_1d(np.asarray(p, dtype=float))
+    nz = np.nonzero(p != 0.0)[0]
+    return p[nz[0]:] if nz.size else np.zeros(1)
+
+
+def _polysub_exact(a, b, rtol: float = 1e-12):
+    """``a - b`` with coefficients that cancel to round-off set to exactly zero."""
+    n = max(len(a), len(b))
+    a = np.pad(np.asarray(a, float), (n - len(a), 0))
+    b = np.pad(np.asarray(b, float), (n - len(b), 0))
+    d = a - b
+    d[np.abs(d) <= rtol * np.maximum(np.abs(a), np.abs(b))] = 0.0
+    return d
+
+
+def _cancel_s(num, den):
+    """Cancel common factors ``s`` (trailing zero coefficients) of a ratio."""
+    num, den = _trim(num), _trim(den)
+    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
+        num, den = num[:-1], den[:-1]
+    return num, den
+
+
+@dataclass(frozen=True)
+class PolyTF:
+    """A SISO transfer function as coefficient arrays (highest power first)."""
+
+    num: NDArray[np.float64]
+    den: NDArray[np.float64]
+
+    def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
+        s = 1j * np.asarray(omega, dtype=float)
+        return np.polyval(self.num, s) / np.polyval(self.den, s)
+
+    def tf(self) -> control.TransferFunction:
+        """As a python-control transfer function."""
+        return control.tf(self.num, self.den)
+
+
+class Loop:
+    """Plant, controller, hysteresis and feedforward of the paper's Fig. 3.
+
+    Parameters
+    ----------
+    plant : TwoMassStage or MeasuredPlant or tuple
+        The stage: a :class:`~motionhyst.systems.TwoMassStage`, a measured
+        plant, or a tuple ``(P1, P2)`` of python-control LTI systems (then
+        `mass` is required for the feedforward).
+    controller : python-control LTI system
+        Feedback controller ``C``.
+    hysteresis : Hysteresis, optional
+        The dynamic link ``phi`` acting at ``y1``; None for none.
+    feedforward : {"rigid-body", None}
+        ``C_ff = M s^2`` (the paper's feedforward) or no feedforward.
+    mass : float, optional
+        Rigid-body mass ``M`` for the feedforward [kg]; defaults to the plant's.
+    hysteresis_feedforward : Hysteresis, optional
+        A model ``phi_hat`` driven by the reference and added to the
+        feedforward force: ``u_ff = M r'' + phi_hat(r)``.
+    """
+
+    def __init__(self, plant, controller, hysteresis: Hysteresis | None = None,
+                 feedforward: str | None = "rigid-body", mass: float | None = None,
+                 hysteresis_feedforward: Hysteresis | None = None) -> None:
+        if isinstance(plant, TwoMassStage | MeasuredPlant):
+            P1, P2 = plant.P1, plant.P2
+            mass = plant.M if mass is None else mass
+        else:
+            try:
+                P1, P2 = plant
+            except (TypeError, ValueError):
+                raise TypeError("plant must be a TwoMassStage, a MeasuredPlant or a tuple "
+                                "(P1, P2)") from None
+        if feedforward not in ("rigid-body", None):
+            raise ValueError(f"unknown feedforward {feedforward!r}; use 'rigid-body' or None")
+        if feedforward == "rigid-body" and (mass is None or not mass > 0):
+            raise ValueError("rigid-body feedforward needs the mass M > 0")
+        self.plant = plant
+        self.P1, self.P2 = P1, P2
+        self.controller = controller
+        self.hysteresis = hysteresis
+        self.feedforward = feedforward
+        self.M = float(mass) if mass is not None else None
+        self.hysteresis_feedforward = hysteresis_feedforward
+        self.is_lti = not any(isinstance(s, control.FrequencyResponseData)
+                              for s in (P1, P2, controller))
+        self._poly = self._closed_loop_polys() if self.is_lti else None
+
+    @property
+    def Pr(self) -> control.TransferFunction:
+        """Rigid-body model ``1 / (M s^2)``."""
+        if self.M is None:
+            raise ValueError("the loop has no rigid-body mass")
+        return control.tf([1.0], [self.M, 0.0, 0.0])
+
+    def _closed_loop_polys(self) -> dict[str, PolyTF]:
+        n1, d1 = _tf_poly(self.P1)
+        n2, d2 = _tf_poly(self.P2)
+        nc, dc = _tf_poly(self.controller)
+        char = np.polyadd(np.polymul(d2, dc), np.polymul(n2, nc))  # (1 + C P2) d2 dc
+        if self.feedforward == "rigid-body":
+            # 1 - P2 M s^2 = (d2 - M s^2 n2) / d2; C + C_ff = (nc + M s^2 dc) / dc
+            ff_num = _polysub_exact(d2, np.polymul(n2, [self.M, 0.0, 0.0]))
+            cff = np.polyadd(nc, np.polymul(dc, [self.M, 0.0, 0.0]))
+        else:
+            ff_num, cff = d2, nc
+        out = {
+            "r->e": _cancel_s(np.polymul(ff_num, dc), char),
+            "r->y1": _cancel_s(np.polymul(np.polymul(n1, d2), cff), np.polymul(d1, char)),
+            "w->e": _cancel_s(np.polymul(n2, dc), char),
+            "w->y1": _cancel_s(-np.polymul(np.polymul(n1, d2), dc), np.polymul(d1, char)),
+        }
+        return {k: PolyTF(*v) for k, v in out.items()}
+
+    def transfer(self, name: str, omega: ArrayLike) -> NDArray[np.complex128]:
+        """Frequency response of a closed-loop transfer at `omega` [rad/s].
+
+        Parameters
+        ----------
+        name : {"r->e", "r->y1", "w->e", "w->y1"}
+            From reference or hysteresis force to tracking error or ``y1``.
+        omega : array_like
+            Angular frequencies [rad/s]; 0 is allowed for LTI loops.
+        """
+        if name not in TRANSFERS:
+            raise ValueError(f"unknown transfer {name!r}; one of {', '.join(TRANSFERS)}")
+        w = np.asarray(omega, dtype=float)
+        if self._poly is not None:
+            return self._poly[name](w)
+        P1, P2 = freqresp(self.P1, w), freqresp(self.P2, w)
+        C = freqresp(self.controller, w)
+        Cff = self.M * (1j * w) ** 2 if self.feedforward == "rigid-body" else 0.0
+        sens = 1.0 / (1.0 + C * P2)
+        return {"r->e": (1.0 - P2 * Cff) * sens, "r->y1": P1 * (C + Cff) * sens,
+                "w->e": P2 * sens, "w->y1": -P1 * sens}[name]
+
+    def transfer_tf(self, name: str) -> control.TransferFunction:
+        """A closed-loop transfer as a python-control transfer function (LTI loops only)."""
+        if self._poly is None:
+            raise ValueError("closed-loop transfer functions need LTI plant and controller")
+        if name not in TRANSFERS:
+            raise ValueError(f"unknown transfer {name!r}; one of {', '.join(TRANSFERS)}")
+        return self._poly[name].tf()
+
+    def closed_loop_poles(self) -> NDArray[np.complex128]:
+        """Poles of ``1 + C P2`` (LTI loops only)."""
+        return np.roots(self._poly["w->e"].den)
+
+    def check_stable(self) -> None:
+        """Raise ``ValueError`` unless the linear loop is stable.
+
+        Checked without the dynamic link and with it stuck (a spring of the
+        hysteresis's initial stiffness at ``y1``), the two linear extremes of
+        the element.  Only LTI loops can be checked.
+        """
+        if self._poly is None:
+            return
+        cases = [("", self._poly["w->e"].den)]
+        if self.hysteresis is not None:
+            # stuck link: w = kJ y1, characteristic polynomial of 1 - kJ T_w->y1
+            t = self._poly["w->y1"]
+            kj = self.hysteresis.initial_stiffness
+            cases.append((" with the dynamic link stuck", np.polysub(t.den, kj * np.asarray(
+                np.pad(t.num, (len(t.den) - len(t.num), 0))))))
+        for what, den in cases:
+            p = np.roots(_trim(den))
+            if p.size and np.max(p.real) >= 0:
+                worst = p[np.argmax(p.real)]
+                raise ValueError(f"the controller does not stabilise the loop{what} "
+                                 f"(closed-loop pole at {worst.real:.4g}{worst.imag:+.4g}j rad/s)")
+
+    def bandwidth_hz(self) -> float:
+        """First 0 dB crossing of ``C P2`` [Hz]."""
+        return bandwidth(self.controller, self.P2)

@@ -1,0 +1,277 @@
+"""Quasi-linear (describing-function) analysis of the loop, paper sections III-C and IV.
+
+The hysteresis ``phi`` is replaced by its describing function ``D`` (eq. 10),
+which turns the loop into a linear one whose frequency responses show where
+the dynamic link spoils tracking: the quasi-linear plant ``P^phi`` (eq. 12),
+the sensitivity ``S1^phi`` (eq. 15), the feedforward mismatch ``E`` (eq. 18)
+and its low-frequency asymptote (eq. 20), with the characteristic frequencies
+``f*`` (eq. 13) and the crossover of eq. (21).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import brentq
+
+from motionhyst.loop import Loop
+from motionhyst.systems import TWO_PI, TwoMassStage, freqresp
+
+
+def quasi_linear_plant(P1: ArrayLike, P2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
+    """Quasi-linear plant ``P^phi = P2 / (1 + D P1)`` from ``u`` to ``y2``, paper eq. (12)."""
+    return np.asarray(P2) / (1.0 + np.asarray(D) * np.asarray(P1))
+
+
+def sensitivity_s1(P1: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
+    """Sensitivity ``S1^phi = (1 + D P1)^-1`` from ``u`` to ``u - w``, paper eq. (15)."""
+    return 1.0 / (1.0 + np.asarray(D) * np.asarray(P1))
+
+
+def mismatch(C: ArrayLike, P1: ArrayLike, P2: ArrayLike, Pr: ArrayLike, Pf2: ArrayLike,
+             D: ArrayLike) -> NDArray[np.complex128]:
+    """Feedforward mismatch ``E = e / e_hat`` due to hysteresis, paper eq. (18).
+
+    ``E = (C P2 + 1)(Pr - P2 S1) / (Pf2 (C P2 S1 + 1))``: the quasi-linear
+    tracking error with the dynamic link over the error without it, both with
+    the rigid-body feedforward ``Pr^-1``.  ``Pr - P2 S1`` is evaluated as
+    ``Pf2 + P2 D P1 S1``, which avoids the cancellation of ``Pr`` and ``P2`` at
+    low frequency.
+
+    Parameters
+    ----------
+    C, P1, P2, Pr, Pf2 : array_like
+        Frequency responses of the controller and the plant's parts (eqs. 1-2).
+    D : array_like
+        Describing function of the hysteresis [N/m].
+    """
+    C, P1, P2, Pr, Pf2, D = (np.asarray(x) for x in (C, P1, P2, Pr, Pf2, D))
+    S1 = sensitivity_s1(P1, D)
+    return (C * P2 + 1.0) * (Pf2 + P2 * D * P1 * S1) / (Pf2 * (C * P2 * S1 + 1.0))
+
+
+def mismatch_asymptote(Pr: ArrayLike, Pf2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
+    """Low-frequency asymptote ``E~ = Pr^2 D / Pf2`` of the mismatch, paper eq. (20)."""
+    return np.asarray(Pr) ** 2 * np.asarray(D) / np.asarray(Pf2)
+
+
+def f_star(k: float, M: float) -> float:
+    """Frequency above which ``P^phi`` tends to ``P2``, ``sqrt(k/M) / (2 pi)`` [Hz], eq. (13)."""
+    return float(np.sqrt(k / M) / TWO_PI)
+
+
+def mismatch_crossover_estimate(k: float, m1: float, m2: float, D_abs: float) -> float:
+    """Crossover ``|E~| = 1`` of the asymptote, ``(k |D| / (m1 m2))^(1/4) / (2 pi)`` [Hz], eq. (21).
+
+    `k` is the stage's internal stiffness, not the link's.
+    """
+    return float((k * D_abs / (m1 * m2)) ** 0.25 / TWO_PI)
+
+
+@dataclass
+class MismatchPoint:
+    """The mismatch at one frequency."""
+
+    frequency_hz: float
+    value: complex
+    asymptote: complex
+    zeta: float
+    y1_amplitude: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (magnitudes and phases in degrees)."""
+        return {"frequency_hz": self.frequency_hz, "abs": abs(self.value),
+                "phase_deg": float(np.degrees(np.angle(self.value))),
+                "asymptote_abs": abs(self.asymptote), "zeta": self.zeta,
+                "y1_amplitude": self.y1_amplitude}
+
+
+@dataclass
+class QuasiLinearAnalysis:
+    """Result of :func:`analyze`: the paper's quasi-linear numbers for one scenario.
+
+    Attributes
+    ----------
+    amplitude : float
+        Reference amplitude ``A_r`` [m].
+    zeta : float
+        ``fc / (k A_r)`` (eq. 4), with ``A_y1 = A_r`` as in the paper.
+    D : complex
+        Describing function at ``A_r`` [N/m] (eq. 10).
+    k_link : float
+        Initial stiffness of the dynamic link [N/m].
+    f_star_hz : float
+        Eq. (13) [Hz].
+    bandwidth_hz : float
+        First 0 dB crossing of ``C P2`` [Hz].
+    crossover_hz : float
+        Eq. (21) [Hz] (nan without a two-mass model).
+    crossover_exact_hz : float
+        Lowest frequency where ``|E - 1|`` of eq. (18) falls to 1 [Hz]
+        (see :func:`mismatch_crossover`).
+    points : list of MismatchPoint
+        The mismatch at the requested frequencies.
+    amplitude_mode : str
+        ``"reference"`` or ``"self-consistent"``.
+    """
+
+    amplitude: float
+    zeta: float
+    D: complex
+    k_link: float
+    f_star_hz: float
+    bandwidth_hz: float
+    crossover_hz: float
+    crossover_exact_hz: float
+    points: list[MismatchPoint] = field(default_factory=list)
+    amplitude_mode: str = "reference"
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (the ``analyze --json`` schema)."""
+        return {
+            "amplitude": self.amplitude,
+            "amplitude_mode": self.amplitude_mode,
+            "zeta": self.zeta,
+            "df_re": self.D.real,
+            "df_im": self.D.imag,
+            "df_abs_over_k": abs(self.D) / self.k_link,
+            "df_phase_deg": float(np.degrees(np.angle(self.D))),
+            "f_star_hz": self.f_star_hz,
+            "bandwidth_hz": self.bandwidth_hz,
+            "mismatch_crossover_hz": self.crossover_hz,
+            "mismatch_crossover_exact_hz": self.crossover_exact_hz,
+            "mismatch": [p.to_dict() for p in self.points],
+        }
+
+
+def _parts(loop: Loop, omega: NDArray[np.float64]):
+    """Frequency responses C, P1, P2, Pr, Pf2 of the loop at `omega`."""
+    C = freqresp(loop.controller, omega)
+    P1 = freqresp(loop.P1, omega)
+    P2 = freqresp(loop.P2, omega)
+    Pr = 1.0 / (loop.M * (1j * omega) ** 2)
+    if isinstance(loop.plant, TwoMassStage):
+        Pf2 = freqresp(loop.plant.Pf2, omega)
+    else:
+        Pf2 = Pr - P2
+    return C, P1, P2, Pr, Pf2
+
+
+def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayLike
+                  ) -> NDArray[np.complex128]:
+    """Mismatch ``E`` of eq. (18) for `loop` at the given frequencies [Hz].
+
+    `amplitude` is the amplitude of ``y1`` that sets ``D``: a scalar, or one
+    per frequency.  Rate-dependent elements get ``D(A, omega)``.
+    """
+    f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
+    omega = TWO_PI * f
+    D = loop.hysteresis.describing_function(np.broadcast_to(amplitude, f.shape), omega)
+    return mismatch(*_parts(loop, omega), D)
+
+
+def self_consistent_amplitude(loop: Loop, frequency_hz: float, amplitude: float,
+                              tol: float = 1e-12, max_iter: int = 200) -> float:
+    """Amplitude of ``y1`` in the quasi-linear loop, solved with ``w = D(A_y1) y1``.
+
+    ``y1 = T_ry1 / (1 - T_wy1 D) r``; iterated on ``A_y1`` starting at ``A_r``.
+    """
+    omega = TWO_PI * float(frequency_hz)
+    t_r = complex(loop.transfer("r->y1", np.array([omega]))[0])
+    t_w = complex(loop.transfer("w->y1", np.array([omega]))[0])
+    a = amplitude
+    for _ in range(max_iter):
+        D = complex(np.asarray(loop.hysteresis.describing_function(a, omega)).ravel()[0])
+        a_new = abs(t_r / (1.0 - t_w * D)) * amplitude
+        if abs(a_new - a) <= tol * a_new:
+            return float(a_new)
+        a = a_new
+    raise RuntimeError(f"self-consistent amplitude did not converge at {frequency_hz} Hz")
+
+
+def mismatch_crossover(loop: Loop, amplitude: float, f_min: float = 1e-2,
+                       f_max: float = 1e4) -> float:
+    """Exact counterpart of the crossover of eq. (21) [Hz]: lowest f where ``|E - 1| = 1``.
+
+    ``E - 1 = (e - e_hat) / e_hat`` is the error that the hysteresis adds,
+    relative to the error without it; eq. (20) is its low-frequency
+    asymptote, and eq. (21) solves ``|E~| = 1``.  This solves the same
+    condition on eq. (18) itself, with ``D`` at the given amplitude.  (``|E|``
+    itself tends to 1 from above as frequency grows and does not cross 1 in
+    any meaningful place.)  Returns nan if there is no crossing in the range.
+    """
+    lo, hi = getattr(loop.plant, "frequency_range_hz", (f_min, f_max))
+    f_min, f_max = max(f_min, lo), min(f_max, hi)
+    f = np.geomspace(f_min, f_max, 3000)
+
+    def g(x):
+        return np.log(np.abs(loop_mismatch(loop, x, amplitude) - 1.0))
+
+    v = g(f)
+    idx = np.nonzero((v[:-1] > 0) & (v[1:] <= 0))[0]
+    if idx.size == 0:
+        return float("nan")
+    i = idx[0]
+    return float(brentq(lambda x: float(g(np.array([x]))[0]), f[i], f[i + 1], xtol=1e-12))
+
+
+def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
+            amplitude_mode: str = "reference") -> QuasiLinearAnalysis:
+    """The paper's quasi-linear analysis of `loop` for ``r = A sin(2 pi f t)``.
+
+    Parameters
+    ----------
+    loop : Loop
+        Loop with a hysteresis element and rigid-body feedforward.
+    amplitude : float
+        Reference amplitude ``A_r`` [m].
+    frequencies_hz : array_like
+        Frequencies at which to report the mismatch [Hz].
+    amplitude_mode : {"reference", "self-consistent"}
+        ``"reference"`` takes ``A_y1 = A_r`` as the paper does; ``"self-consistent"``
+        solves the amplitude of ``y1`` in the quasi-linear loop per frequency.
+
+    Returns
+    -------
+    QuasiLinearAnalysis
+    """
+    if loop.hysteresis is None:
+        raise ValueError("the loop has no hysteresis element")
+    if loop.feedforward != "rigid-body":
+        raise ValueError("the mismatch of eq. (18) is defined for rigid-body feedforward")
+    if amplitude_mode not in ("reference", "self-consistent"):
+        raise ValueError("amplitude_mode must be 'reference' or 'self-consistent'")
+    if not (np.isfinite(amplitude) and amplitude > 0):
+        raise ValueError("amplitude must be finite and > 0")
+    f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    if not np.all(np.isfinite(f)) or np.any(f <= 0):
+        raise ValueError("frequencies must be finite and > 0")
+    hyst = loop.hysteresis
+    k_link = hyst.initial_stiffness
+    omega = TWO_PI * f
+    if amplitude_mode == "reference":
+        amps = np.full(f.shape, float(amplitude))
+    else:
+        amps = np.array([self_consistent_amplitude(loop, fi, amplitude) for fi in f])
+    D_pts = np.asarray(hyst.describing_function(amps, omega), dtype=complex)
+    C, P1, P2, Pr, Pf2 = _parts(loop, omega)
+    E = mismatch(C, P1, P2, Pr, Pf2, D_pts)
+    Et = mismatch_asymptote(Pr, Pf2, D_pts)
+    zetas = np.asarray(hyst.zeta(amps)) if hasattr(hyst, "zeta") else np.full(f.shape, np.nan)
+    D_ref = complex(np.asarray(hyst.describing_function(amplitude)).ravel()[0])
+    zeta_ref = float(hyst.zeta(amplitude)) if hasattr(hyst, "zeta") else float("nan")
+    if isinstance(loop.plant, TwoMassStage):
+        st = loop.plant
+        crossover = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D_ref))
+    else:
+        crossover = float("nan")
+    points = [MismatchPoint(float(fi), complex(e), complex(et), float(z), float(a))
+              for fi, e, et, z, a in zip(f, E, Et, np.broadcast_to(zetas, f.shape), amps,
+                                         strict=True)]
+    return QuasiLinearAnalysis(
+        amplitude=float(amplitude), zeta=zeta_ref, D=D_ref, k_link=k_link,
+        f_star_hz=f_star(k_link, loop.M), bandwidth_hz=loop.bandwidth_hz(),
+        crossover_hz=crossover, crossover_exact_hz=mismatch_crossover(loop, amplitude),
+        points=points, amplitude_mode=amplitude_mode)
