@@ -1,4 +1,4 @@
-"""Linear parts of the loop: the two-mass stage (eqs. 1-2), the controller of eq. (23), measured plants.
+"""Linear parts of the loop: two-mass stage (eqs. 1-2), controller (eq. 23), measured plants.
 
 All objects are python-control systems, so any other python-control LTI
 plant or controller can take their place, and a plant may also be given as
@@ -132,7 +132,8 @@ class TwoMassStage:
 class LeadLagLowpass(control.TransferFunction):
     """Feedback controller of eq. (23): lead-lag filter times second-order low-pass.
 
-    ``C(s) = K (f2/f1) (s + 2 pi f1)/(s + 2 pi f2) (2 pi flp)^2 / (s^2 + 4 beta pi flp s + (2 pi flp)^2)``
+    ``C(s) = K (f2/f1) (s + 2 pi f1) / (s + 2 pi f2)
+    * (2 pi flp)^2 / (s^2 + 4 beta pi flp s + (2 pi flp)^2)``
 
     A python-control transfer function; the parameters are kept as attributes.
 

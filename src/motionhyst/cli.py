@@ -1,0 +1,185 @@
+"""Command-line interface: ``motionhyst df | analyze | simulate | reproduce``.
+
+A thin layer: it parses arguments, calls the library and prints tables or
+JSON.  Every user error ends in one line on stderr and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+
+EXIT_USAGE = 2
+
+
+class UsageError(Exception):
+    """A user error: reported as one line, exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line (no usage block)."""
+
+    def error(self, message: str):  # noqa: D102
+        raise UsageError(f"{self.prog}: {message}")
+
+
+def _number(text: str, what: str, positive: bool) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{what} must be a number, got {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"{what} must be finite, got {text!r}")
+    if positive and v <= 0:
+        raise argparse.ArgumentTypeError(f"{what} must be > 0, got {text!r}")
+    if not positive and v < 0:
+        raise argparse.ArgumentTypeError(f"{what} must be >= 0, got {text!r}")
+    return v
+
+
+def positive(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    return _number(text, "value", True)
+
+
+def nonnegative(text: str) -> float:
+    """argparse type: a finite number >= 0."""
+    return _number(text, "value", False)
+
+
+def _jsonable(obj):
+    """Replace non-finite floats by None (JSON has no inf or nan)."""
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, float | np.floating) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def _print_json(obj) -> None:
+    print(json.dumps(_jsonable(obj), indent=2, allow_nan=False))
+
+
+def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
+              for i, h in enumerate(headers)]
+    line = "  ".join(h.rjust(w) for h, w in zip(headers, widths, strict=True))
+    out = [line, "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+    return "\n".join(out)
+
+
+def _g(x: float, digits: int = 4) -> str:
+    return "nan" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}g}"
+
+
+# ---------------------------------------------------------------------------- df
+def cmd_df(args: argparse.Namespace) -> int:
+    """Describing function of a hysteresis element at given amplitudes."""
+    from motionhyst.hysteresis import Jenkins
+
+    el = Jenkins(args.k, args.fc)
+    A = np.asarray(args.amplitude, dtype=float)
+    D = np.atleast_1d(el.describing_function(A))
+    zeta = np.atleast_1d(el.zeta(A))
+    points = [{"amplitude": float(a), "zeta": float(z), "re": float(d.real),
+               "im": float(d.imag), "abs": float(abs(d)),
+               "phase_deg": float(np.degrees(np.angle(d)))}
+              for a, z, d in zip(A, zeta, D, strict=True)]
+    result = {**el.to_dict(), "points": points}
+    if args.json:
+        _print_json(result)
+        return 0
+    print(f"Describing function of the Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N "
+          f"(paper eq. 10)")
+    rows = [[_g(p["amplitude"]), _g(p["zeta"]), _g(p["re"]), _g(p["im"]), _g(p["abs"]),
+             _g(p["abs"] / el.k), f"{p['phase_deg']:.2f}"] for p in points]
+    print(_table(["A [m]", "zeta [-]", "Re D [N/m]", "Im D [N/m]", "|D| [N/m]", "|D|/k [-]",
+                  "angle D [deg]"], rows))
+    return 0
+
+
+# ----------------------------------------------------------------------- analyze
+def cmd_analyze(args: argparse.Namespace) -> int:
+    """Quasi-linear analysis of a scenario (paper eqs. 12-21)."""
+    from motionhyst.quasilinear import analyze
+    from motionhyst.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    freqs = args.frequency or sc.frequencies
+    amplitude = args.amplitude or sc.amplitude
+    mode = "self-consistent" if args.self_consistent else "reference"
+    res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
+    d = res.to_dict()
+    if args.json:
+        _print_json(d)
+        return 0
+    print(f"Quasi-linear analysis of {sc.source}")
+    print(f"  reference amplitude A_r        {amplitude:g} m")
+    print(f"  zeta = fc/(k A)  (eq. 4)       {_g(d['zeta'])}")
+    print(f"  |D|/k, angle D  (eq. 10)       {_g(d['df_abs_over_k'])}, "
+          f"{d['df_phase_deg']:.2f} deg")
+    print(f"  f*  (eq. 13)                   {_g(d['f_star_hz'])} Hz")
+    print(f"  bandwidth (|C P2| = 1)         {_g(d['bandwidth_hz'])} Hz")
+    print(f"  mismatch crossover (eq. 21)    {_g(d['mismatch_crossover_hz'])} Hz")
+    print(f"  exact crossover |E - 1| = 1    {_g(d['mismatch_crossover_exact_hz'])} Hz")
+    print()
+    rows = [[_g(p["frequency_hz"]), _g(p["abs"]), f"{20 * math.log10(p['abs']):.2f}",
+             f"{p['phase_deg']:.2f}", _g(p["asymptote_abs"]), _g(p["y1_amplitude"])]
+            for p in d["mismatch"]]
+    print(_table(["f [Hz]", "|E| [-]", "|E| [dB]", "angle E [deg]", "|E~| (eq. 20)",
+                  "A_y1 [m]"], rows))
+    return 0
+
+
+# --------------------------------------------------------------------------- main
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``motionhyst`` command."""
+    p = _Parser(prog="motionhyst", description="Hysteresis of dynamic links in motion control "
+                "loops: describing functions, quasi-linear analysis, exact steady state.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    q = sub.add_parser("df", help="describing function of a hysteresis element")
+    q.add_argument("--k", type=positive, required=True, help="spring stiffness k_J [N/m]")
+    q.add_argument("--fc", type=positive, required=True, help="slip force f_c [N]")
+    q.add_argument("--amplitude", type=nonnegative, nargs="+", required=True,
+                   help="input amplitude(s) A [m]")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=cmd_df)
+
+    q = sub.add_parser("analyze", help="quasi-linear analysis of a scenario (eqs. 12-21)")
+    q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
+    q.add_argument("--frequency", type=positive, nargs="+", help="frequencies [Hz]")
+    q.add_argument("--amplitude", type=positive, help="reference amplitude [m]")
+    q.add_argument("--self-consistent", action="store_true",
+                   help="solve the amplitude of y1 in the quasi-linear loop instead of A_y1 = A_r")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=cmd_analyze)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``motionhyst`` command; returns the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return args.func(args)
+    except UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+    except (ValueError, OSError) as exc:
+        print(f"motionhyst: error: {exc}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("motionhyst: interrupted", file=sys.stderr)
+        return 130
+    return EXIT_USAGE
+
+
+if __name__ == "__main__":
+    sys.exit(main())

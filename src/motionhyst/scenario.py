@@ -1,0 +1,269 @@
+"""Scenario files (TOML): the one place where user input about a loop is validated.
+
+A scenario names the stage (or a measured plant), the hysteresis, the
+controller, the feedforward and the reference.  The paper's Table I ships as
+``examples/paper.toml`` and is the default everywhere (:func:`default_scenario`).
+Every problem in a file is reported as a :class:`ScenarioError` with one line
+naming the file, the key and the problem.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Literal
+
+import control
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from motionhyst.hysteresis import Hysteresis, Jenkins
+from motionhyst.loop import Loop
+from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
+
+
+class ScenarioError(ValueError):
+    """A scenario file that cannot be used; the message is one line."""
+
+
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False, strict=False)]
+NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+
+
+class _Section(BaseModel):
+    # strict: no strings for numbers; integers are accepted where floats are expected
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_booleans(cls, data):
+        if isinstance(data, dict):
+            for key, value in data.items():
+                if isinstance(value, bool):
+                    raise ValueError(f"{key}: expected a number, got a boolean")
+        return data
+
+
+class StageSection(_Section):
+    """``[stage]``: the two-mass stage of eqs. (1)-(2)."""
+
+    m1: PositiveFloat
+    m2: PositiveFloat
+    b: NonNegativeFloat
+    k: PositiveFloat
+
+
+class PlantSection(_Section):
+    """``[plant]``: a measured plant (CSV of P1 and P2, see :func:`load_frd_plant`)."""
+
+    type: Literal["frd"] = "frd"
+    file: str
+    mass: PositiveFloat | None = None
+
+
+class JenkinsSection(_Section):
+    """``[hysteresis] model = "jenkins"``: eq. (3)."""
+
+    model: Literal["jenkins"]
+    k: PositiveFloat
+    fc: PositiveFloat
+
+
+class LeadLagSection(_Section):
+    """``[controller] type = "leadlag-lowpass"``: eq. (23)."""
+
+    type: Literal["leadlag-lowpass"]
+    K: PositiveFloat
+    f1: PositiveFloat
+    f2: PositiveFloat
+    flp: PositiveFloat
+    beta: PositiveFloat
+
+
+class TransferFunctionSection(_Section):
+    """``[controller] type = "tf"``: any controller as polynomial coefficients in s."""
+
+    type: Literal["tf"]
+    num: list[Annotated[float, Field(allow_inf_nan=False)]]
+    den: list[Annotated[float, Field(allow_inf_nan=False)]]
+
+
+    @model_validator(mode="after")
+    def _proper(self):
+        if not self.den or all(c == 0 for c in self.den):
+            raise ValueError("den must have a non-zero coefficient")
+        if not self.num or all(c == 0 for c in self.num):
+            raise ValueError("num must have a non-zero coefficient")
+        strip = lambda p: p[next(i for i, c in enumerate(p) if c != 0):]  # noqa: E731
+        if len(strip(self.num)) > len(strip(self.den)):
+            raise ValueError("controller must be proper (deg num <= deg den)")
+        return self
+
+
+class FeedforwardSection(_Section):
+    """``[feedforward]``: rigid-body ``M r''`` or none."""
+
+    type: Literal["rigid-body", "none"] = "rigid-body"
+
+
+class ReferenceSection(_Section):
+    """``[reference]``: the sinusoidal reference ``r = A sin(2 pi f t)``."""
+
+    amplitude: PositiveFloat
+    frequencies: Annotated[list[PositiveFloat], Field(min_length=1)]
+
+
+
+class ScenarioModel(_Section):
+    """The whole file."""
+
+    stage: StageSection | None = None
+    plant: PlantSection | None = None
+    hysteresis: JenkinsSection
+    controller: Annotated[LeadLagSection | TransferFunctionSection,
+                          Field(discriminator="type")]
+    feedforward: FeedforwardSection = FeedforwardSection()
+    reference: ReferenceSection
+
+    @model_validator(mode="after")
+    def _one_plant(self):
+        if (self.stage is None) == (self.plant is None):
+            raise ValueError("give exactly one of [stage] and [plant]")
+        return self
+
+
+_UNION_TAGS = {"leadlag-lowpass", "tf", "jenkins"}
+
+
+def _format_error(source: str, err: ValidationError) -> str:
+    """One line naming the file, the section and key, and the problem."""
+    e = err.errors()[0]
+    loc = [p for p in e["loc"] if not (isinstance(p, str) and p in _UNION_TAGS)]
+    key = ""
+    for p in loc[1:]:
+        key += f"[{p}]" if isinstance(p, int) else (f".{p}" if key else str(p))
+    where = (f"[{loc[0]}] {key}" if key else f"[{loc[0]}]") if loc else ""
+    kind = e["type"]
+    if kind == "extra_forbidden":
+        msg = "unknown key" if key else "unknown section"
+    elif kind == "missing":
+        msg = "missing"
+    elif kind == "union_tag_invalid":
+        msg = f"unknown {e['ctx']['discriminator'].strip(chr(39))} {e['ctx']['tag']!r}; " \
+              f"expected one of {e['ctx']['expected_tags']}"
+    elif kind == "union_tag_not_found":
+        msg = f"missing key {e['ctx']['discriminator']}"
+    else:
+        msg = e["msg"].removeprefix("Value error, ")
+        if "input" in e and not isinstance(e["input"], dict | list):
+            msg += f" (got {e['input']!r})"
+    return f"{source}: {where}: {msg}" if where else f"{source}: {msg}"
+
+
+class Scenario:
+    """A validated scenario; builds the loop and holds the reference.
+
+    Use :meth:`from_file`, :meth:`from_dict` or :func:`default_scenario`.
+    """
+
+    def __init__(self, model: ScenarioModel, source: str = "<dict>",
+                 base_dir: Path | None = None) -> None:
+        self.model = model
+        self.source = source
+        self.base_dir = base_dir or Path.cwd()
+        self._loop: Loop | None = None
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str = "<dict>",
+                  base_dir: Path | None = None) -> Scenario:
+        """Validate a parsed scenario; raises :class:`ScenarioError`."""
+        try:
+            model = ScenarioModel.model_validate(data)
+        except ValidationError as err:
+            raise ScenarioError(_format_error(source, err)) from None
+        sc = cls(model, source, base_dir)
+        sc.loop()  # builds and checks stability
+        return sc
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Scenario:
+        """Read and validate a TOML scenario; raises :class:`ScenarioError`."""
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise ScenarioError(f"{path}: cannot read ({exc.strerror})") from None
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ScenarioError(f"{path}: TOML syntax error: {exc}") from None
+        return cls.from_dict(data, str(path), path.parent)
+
+    @property
+    def amplitude(self) -> float:
+        """Reference amplitude [m]."""
+        return self.model.reference.amplitude
+
+    @property
+    def frequencies(self) -> list[float]:
+        """Reference frequencies [Hz]."""
+        return list(self.model.reference.frequencies)
+
+    def plant(self) -> TwoMassStage | MeasuredPlant:
+        """The stage model or measured plant."""
+        m = self.model
+        if m.stage is not None:
+            return TwoMassStage(m.stage.m1, m.stage.m2, m.stage.b, m.stage.k)
+        f = Path(m.plant.file)
+        if not f.is_absolute():
+            f = self.base_dir / f
+        try:
+            return load_frd_plant(f, m.plant.mass)
+        except ValueError as exc:
+            raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
+
+    def hysteresis(self) -> Hysteresis:
+        """The dynamic link's hysteresis model."""
+        h = self.model.hysteresis
+        return Jenkins(h.k, h.fc)
+
+    def controller(self) -> control.TransferFunction:
+        """The feedback controller."""
+        c = self.model.controller
+        if c.type == "leadlag-lowpass":
+            return LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta)
+        return control.tf(c.num, c.den)
+
+    def loop(self) -> Loop:
+        """The loop (built once, checked for stability)."""
+        if self._loop is None:
+            ff = None if self.model.feedforward.type == "none" else "rigid-body"
+            loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff)
+            try:
+                loop.check_stable()
+            except ValueError as exc:
+                raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
+            self._loop = loop
+        return self._loop
+
+    def to_dict(self) -> dict:
+        """The validated scenario as a dictionary."""
+        return self.model.model_dump(exclude_none=True)
+
+
+def default_scenario_path() -> Path:
+    """Path of the shipped Table I scenario."""
+    return Path(str(resources.files("motionhyst") / "data" / "paper.toml"))
+
+
+def default_scenario() -> Scenario:
+    """The paper's Table I scenario."""
+    sc = Scenario.from_file(default_scenario_path())
+    sc.source = "paper.toml (Table I, built in)"
+    return sc
+
+
+def load_scenario(path: str | Path | None) -> Scenario:
+    """The scenario at `path`, or the default (Table I) when `path` is None."""
+    return default_scenario() if path is None else Scenario.from_file(path)
+
