@@ -24,7 +24,7 @@ class UsageError(Exception):
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line (no usage block)."""
 
-    def error(self, message: str):  # noqa: D102
+    def error(self, message: str):
         raise UsageError(f"{self.prog}: {message}")
 
 

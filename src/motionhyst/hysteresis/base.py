@@ -71,6 +71,34 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary, with key ``model``."""
 
+    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int
+                           ) -> NDArray[np.complex128]:
+        """Harmonics of the periodic output for a periodic input.
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement over one period,
+            ``x(theta) = X_0 + 2 Re sum X_m exp(j m theta)`` (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+
+        Returns
+        -------
+        ndarray of complex, shape (H + 1,)
+            Output harmonics in the same scaling.  This default samples the
+            period finely and runs the element to its periodic state; elements
+            with an exact method override it.
+        """
+        H = int(n_harmonics)
+        N = max(8 * H, 8 * (len(X) - 1), 8192)
+        spec = np.zeros(N // 2 + 1, dtype=complex)
+        spec[: min(len(X), N // 2)] = X[: N // 2]
+        x = np.fft.irfft(spec * N, n=N)
+        xs = np.concatenate([x, x, x, x[:1]])
+        w = self.response(xs)[2 * N: 3 * N]
+        return (np.fft.rfft(w) / N)[: H + 1]
+
     def reset(self, w: float = 0.0) -> None:
         """Reset the state used by :meth:`__call__` (force `w`, last input unknown)."""
         self._w = float(w)

@@ -156,6 +156,13 @@ class Jenkins(Hysteresis):
             raise ValueError(f"|w0| must be <= fc = {self.fc}, got {w0}")
         return stop_response(xs, self.k, self.fc, float(w0))
 
+    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int
+                           ) -> NDArray[np.complex128]:
+        """Exact harmonics of the periodic output (see :mod:`motionhyst.hysteresis.periodic`)."""
+        from motionhyst.hysteresis.periodic import stop_periodic_harmonics
+
+        return stop_periodic_harmonics(np.asarray(X, dtype=complex), self.k, self.fc, n_harmonics)
+
     def ode_rhs(self, w: ArrayLike, xdot: ArrayLike):
         """Right-hand side ``dw/dt`` of the differential form, paper eq. (3).
 
