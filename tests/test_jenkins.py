@@ -72,7 +72,7 @@ def reference_describing_function(k: float, fc: float, A: float) -> complex:
         0.5 * math.pi: (math.cos, lambda u: -math.sin(u)),
         1.5 * math.pi: (lambda u: -math.cos(u), math.sin),
     }
-    # tolerance far below the 1e-9 asserted (|D| A pi >= pi fc min(1, 4 (1 - zeta)) ~ fc)
+    # far below the 1e-9 asserted: |D| >= k zeta on (0, 1], so |D| A pi >= pi fc
     opts = {"epsabs": 1e-12 * fc, "epsrel": 1e-13, "limit": 200}
     a1 = b1 = 0.0
     for theta0, lo, hi, fun in steady_loop_pieces(k, fc, A):
@@ -84,7 +84,7 @@ def reference_describing_function(k: float, fc: float, A: float) -> complex:
     return complex(b1, a1) / (math.pi * A)
 
 
-ZETAS = [1e-6, 1e-4, 1e-3, 0.01, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 0.999, 1 - 1e-9, 1.0]
+ZETAS = [1e-12, 1e-6, 1e-4, 1e-3, 0.01, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 0.999, 1 - 1e-9, 1.0]
 
 
 @pytest.mark.filterwarnings("error")
@@ -167,6 +167,8 @@ def test_describing_function_bounds_on_grid():
     assert np.all(np.abs(D) <= 3.0 * (1 + 1e-12))
     assert np.all(D.imag >= 0)
     assert np.all(D.real >= 0)
+    inside = (zeta > 0) & (zeta <= 1)
+    assert np.all(np.abs(D[inside]) >= 3.0 * zeta[inside] * (1 - 1e-12))
     # |D| grows and the phase falls monotonically with zeta (paper Fig. 8)
     assert np.all(np.diff(np.abs(D)) >= -1e-12)
     assert np.all(np.diff(np.angle(D[1:])) <= 1e-12)

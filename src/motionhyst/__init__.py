@@ -1,0 +1,21 @@
+"""motionhyst: hysteresis of dynamic links in high-precision motion control.
+
+Model the hysteresis (:class:`Jenkins`), predict its effect on tracking with
+describing functions (:func:`analyze`), and check the prediction against the
+exact periodic steady state of the nonlinear loop (:func:`periodic_steady_state`).
+"""
+
+from motionhyst.hysteresis import Hysteresis, Jenkins
+from motionhyst.loop import Loop
+from motionhyst.quasilinear import QuasiLinearAnalysis, analyze
+from motionhyst.scenario import Scenario, ScenarioError, default_scenario, load_scenario
+from motionhyst.steady import SteadyState, periodic_steady_state, steady_state_sweep
+from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "MeasuredPlant", "QuasiLinearAnalysis",
+    "Scenario", "ScenarioError", "SteadyState", "TwoMassStage", "analyze", "default_scenario",
+    "load_frd_plant", "load_scenario", "periodic_steady_state", "steady_state_sweep",
+]
