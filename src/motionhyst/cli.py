@@ -168,6 +168,19 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+# --------------------------------------------------------------------- reproduce
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    """The paper's figures and numbers for a scenario, as a report."""
+    from motionhyst.report import reproduce
+    from motionhyst.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None)
+    if not args.quiet:
+        print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf)")
+    return 0
+
+
 # --------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``motionhyst`` command."""
@@ -198,6 +211,12 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--amplitude", type=positive, help="reference amplitude [m]")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=cmd_simulate)
+
+    q = sub.add_parser("reproduce", help="the paper's figures and numbers, as a report")
+    q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
+    q.add_argument("--out", default="out", help="output folder (default: ./out)")
+    q.add_argument("--quiet", action="store_true", help="no progress bar or summary line")
+    q.set_defaults(func=cmd_reproduce)
     return p
 
 

@@ -1,0 +1,207 @@
+"""Figures of the paper (Figs. 5-11), drawn from motionhyst's results.
+
+One style for all figures; each function returns a matplotlib Figure and
+attaches the plotted data as ``fig.motionhyst_data`` (a dict of arrays), so
+callers and tests can check what is shown without reading pixels.
+"""
+
+from __future__ import annotations
+
+import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+from motionhyst.hysteresis import Jenkins
+from motionhyst.loop import Loop
+from motionhyst.quasilinear import QuasiLinearAnalysis, loop_mismatch, mismatch_asymptote
+from motionhyst.steady import SteadyState
+from motionhyst.systems import TWO_PI, freqresp
+
+STYLE = {
+    "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
+    "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False, "font.size": 9,
+    "legend.fontsize": 8, "legend.frameon": False, "lines.linewidth": 1.4,
+}
+MODE2_COLOR, MODE3_COLOR, LINEAR_COLOR = "0.15", "tab:red", "tab:blue"
+
+
+def _figure(nrows: int = 1, sharex: bool = True):
+    with matplotlib.rc_context(STYLE):
+        fig = Figure(figsize=(6.4, 4.2 if nrows == 1 else 5.6), layout="constrained")
+        axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False)
+    for ax in axes.ravel():
+        ax.grid(True, which="both", alpha=0.3)
+    fig.motionhyst_data = {}
+    return fig, axes[:, 0]
+
+
+def _sine_loop(el: Jenkins, A: float, n: int = 2000):
+    theta = np.linspace(0.0, TWO_PI, n + 1)
+    x = A * np.sin(np.concatenate([theta, TWO_PI + theta[1:]]))
+    w = el.response(x)[n:]
+    return x[n:], w
+
+
+def fig5_loops(el: Jenkins, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25)):
+    """Fig. 5: displacement-force loops of the element for sinusoids at several zeta."""
+    fig, (ax,) = _figure()
+    for z in zetas:
+        A = el.fc / (el.k * z)
+        x, w = _sine_loop(el, A)
+        ax.plot(x * 1e3, w, label=f"zeta = {z:g} (A = {A * 1e3:.3g} mm)")
+        fig.motionhyst_data[f"zeta={z:g}"] = np.vstack([x, w])
+    ax.axhline(el.fc, color="0.5", ls=":", lw=0.8)
+    ax.axhline(-el.fc, color="0.5", ls=":", lw=0.8)
+    ax.set_xlabel("displacement x [mm]")
+    ax.set_ylabel("force w [N]")
+    ax.set_title(f"Fig. 5: Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N")
+    ax.legend()
+    return fig
+
+
+def fig6_modes(el: Jenkins, zeta_mode2: float = 0.4, zeta_mode3: float = 0.7):
+    """Fig. 6: the two nonlinear modes: stick-to-slip at x w <= 0 (mode 2) and x w > 0 (mode 3)."""
+    fig, (ax,) = _figure()
+    for z, color, mode in ((zeta_mode2, MODE2_COLOR, 2), (zeta_mode3, MODE3_COLOR, 3)):
+        A = el.fc / (el.k * z)
+        x, w = _sine_loop(el, A)
+        slip = np.isclose(np.abs(w), el.fc)
+        onset = np.nonzero(slip & ~np.roll(slip, 1))[0]
+        ax.plot(x * 1e3, w, color=color, label=f"mode {mode}: zeta = {z:g}")
+        ax.plot(x[onset] * 1e3, w[onset], "o", color="tab:blue", ms=5)
+        fig.motionhyst_data[f"mode{mode}"] = np.vstack([x, w])
+        fig.motionhyst_data[f"mode{mode}_onsets"] = np.vstack([x[onset], w[onset]])
+    ax.axvline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("displacement x [mm]")
+    ax.set_ylabel("force w [N]")
+    ax.set_title("Fig. 6: modes 2 and 3 of the element (dots: stick to slip)")
+    ax.legend()
+    return fig
+
+
+def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
+    """Fig. 7: w(t) over a period, slip intervals shaded, and its first harmonic."""
+    fig, (ax,) = _figure()
+    x, w = _sine_loop(el, A)
+    t = np.linspace(0.0, 1.0 / frequency_hz, len(x))
+    D = el.describing_function(A)
+    w1 = A * np.abs(D) * np.sin(TWO_PI * frequency_hz * t + np.angle(D))
+    slip = np.isclose(np.abs(w), el.fc)
+    ax.fill_between(t, -el.fc * 1.1, el.fc * 1.1, where=slip, color="0.85", step="mid",
+                    label="slipping")
+    ax.plot(t, w, color="k", label="w(t), exact")
+    ax.plot(t, w1, "--", color="tab:red", label="first harmonic (describing function)")
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("force w [N]")
+    ax.set_title(f"Fig. 7: element output for x = A sin(2 pi f t), zeta = {el.zeta(A):.3g}")
+    ax.legend(loc="lower left")
+    fig.motionhyst_data.update(t=t, w=w, w_first_harmonic=w1, slip=slip)
+    return fig
+
+
+def fig8_describing_function(el: Jenkins, zeta_range=(1e-3, 10.0)):
+    """Fig. 8: |D|/k and angle of D against zeta (eq. 10), mode regions shaded."""
+    fig, (ax1, ax2) = _figure(2)
+    z = np.geomspace(*zeta_range, 800)
+    D = el.describing_function(el.fc / (el.k * z))
+    for ax in (ax1, ax2):
+        ax.axvspan(zeta_range[0], 0.5, color="tab:red", alpha=0.08, label="mode 2")
+        ax.axvspan(0.5, 1.0, color="0.5", alpha=0.12, label="mode 3")
+        ax.axvspan(1.0, zeta_range[1], color=LINEAR_COLOR, alpha=0.06, label="linear (no slip)")
+    ax1.semilogx(z, np.abs(D) / el.k, color="k")
+    ax2.semilogx(z, np.degrees(np.angle(D)), color="k")
+    ax1.set_ylabel("|D| / k [-]")
+    ax2.set_ylabel("angle D [deg]")
+    ax2.set_xlabel("zeta = fc / (k A) [-]")
+    ax1.set_title("Fig. 8: describing function of the Jenkins element, eq. (10)")
+    ax1.legend(loc="upper left")
+    fig.motionhyst_data.update(zeta=z, abs_over_k=np.abs(D) / el.k,
+                               phase_deg=np.degrees(np.angle(D)))
+    return fig
+
+
+def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5, 0.75, 1.0),
+                           f_range=(0.01, 100.0), f_star_hz: float | None = None):
+    """Fig. 9: Bode plot of the quasi-linear plant ``P^phi`` (eq. 12) for zeta in (0, 1]."""
+    el = loop.hysteresis
+    fig, (ax1, ax2) = _figure(2)
+    f = np.geomspace(*f_range, 600)
+    w = TWO_PI * f
+    P1, P2 = freqresp(loop.P1, w), freqresp(loop.P2, w)
+    cmap = matplotlib.colormaps["viridis"]
+    for i, z in enumerate(zetas):
+        D = el.describing_function(el.fc / (el.k * z))
+        Pphi = P2 / (1.0 + D * P1)
+        c = cmap(i / max(1, len(zetas) - 1))
+        ax1.semilogx(f, 20 * np.log10(np.abs(Pphi)), color=c, label=f"zeta = {z:g}")
+        ax2.semilogx(f, np.degrees(np.unwrap(np.angle(Pphi))), color=c)
+        fig.motionhyst_data[f"zeta={z:g}"] = Pphi
+    ax1.semilogx(f, 20 * np.log10(np.abs(P2)), "k--", label="P2 (no link)")
+    ax2.semilogx(f, np.degrees(np.unwrap(np.angle(P2))), "k--")
+    if f_star_hz:
+        for ax in (ax1, ax2):
+            ax.axvline(f_star_hz, color="tab:red", ls=":", lw=1)
+        ax1.annotate(f"f* = {f_star_hz:.3g} Hz", (f_star_hz, ax1.get_ylim()[0]),
+                     xytext=(4, 8), textcoords="offset points", color="tab:red")
+    ax1.set_ylabel("|P^phi| [dB re 1 m/N]")
+    ax2.set_ylabel("angle P^phi [deg]")
+    ax2.set_xlabel("frequency [Hz]")
+    ax1.set_title("Fig. 9: quasi-linear plant, eq. (12)")
+    ax1.legend(ncol=2)
+    fig.motionhyst_data.update(f=f, P2=P2)
+    return fig
+
+
+def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
+                   exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
+    """Fig. 10: mismatch |E| (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
+    fig, (ax,) = _figure()
+    f = np.geomspace(*f_range, 800)
+    E = loop_mismatch(loop, f, analysis.amplitude)
+    w = TWO_PI * f
+    Pr = 1.0 / (loop.M * (1j * w) ** 2)
+    Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - freqresp(loop.P2, w)
+    Et = mismatch_asymptote(Pr, Pf2, analysis.D)
+    ax.loglog(f, np.abs(E), color="k", label="|E|, eq. (18)")
+    ax.loglog(f, np.abs(Et), "--", color="tab:red", label="asymptote, eq. (20)")
+    if exact:
+        fe = np.array([s.frequency_hz for s in exact])
+        Ee = np.array([abs(s.mismatch) for s in exact])
+        ax.loglog(fe, Ee, "o", mfc="none", color="tab:blue",
+                  label="exact steady state (nonlinear loop)")
+        fig.motionhyst_data.update(f_exact=fe, E_exact=Ee)
+    ax.axhline(1.0, color="0.5", lw=0.8)
+    for fx, lab, ls in ((analysis.crossover_hz, "eq. (21)", ":"),
+                        (analysis.crossover_exact_hz, "|E - 1| = 1", "-.")):
+        if np.isfinite(fx):
+            ax.axvline(fx, color="tab:green", ls=ls, lw=1, label=f"crossover {lab}: {fx:.3g} Hz")
+    ax.set_ylim(0.5, max(10.0, float(np.abs(E).max()) * 2))
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("|E| [-]")
+    ax.set_title(f"Fig. 10: feedforward mismatch, zeta = {analysis.zeta:.3g}")
+    ax.legend(loc="upper right")
+    fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
+    return fig
+
+
+def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike):
+    """Fig. 11: steady-state error over a period, with and without hysteresis, and the DF."""
+    fig, axes = _figure(len(states), sharex=False)
+    for ax, ss, E in zip(axes, states, np.atleast_1d(mismatch_df), strict=True):
+        ts = ss.time_series()
+        theta = TWO_PI * ss.frequency_hz * ts["t"]
+        e_df = np.abs(E * ss.e_linear[1]) * np.sin(theta + np.angle(E * ss.e_linear[1]))
+        t_ms = ts["t"] * 1e3
+        ax.plot(t_ms, ts["e"] * 1e9, color="k", label="with hysteresis (exact)")
+        ax.plot(t_ms, ts["e_linear"] * 1e9, color=LINEAR_COLOR, label="without hysteresis")
+        ax.plot(t_ms, e_df * 1e9, "--", color="tab:red", label="describing function")
+        ax.set_ylabel("e [nm]")
+        ax.set_title(f"f = {ss.frequency_hz:g} Hz", fontsize=9, loc="left")
+        fig.motionhyst_data[f"f={ss.frequency_hz:g}"] = np.vstack(
+            [ts["t"], ts["e"], ts["e_linear"], e_df])
+    axes[-1].set_xlabel("time [ms]")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=3)
+    fig.suptitle("Fig. 11: steady-state tracking error", fontsize=10)
+    return fig

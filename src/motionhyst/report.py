@@ -1,0 +1,167 @@
+"""``motionhyst reproduce``: the paper's figures and numbers for a scenario, as a report.
+
+Writes Figs. 5-11 (PNG and PDF), ``summary.json`` (the analyze and simulate
+results) and ``report.md`` into an output folder.  Everything is written to
+a fresh folder first and moved into place at the end, so a run that fails
+leaves the previous output as it was.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from motionhyst import plots
+from motionhyst.quasilinear import analyze, loop_mismatch
+from motionhyst.scenario import Scenario
+from motionhyst.steady import periodic_steady_state
+from motionhyst.systems import TwoMassStage
+
+# Numbers the paper states for Table I (section V and Fig. 8).
+PAPER_VALUES = {
+    "zeta": ("0.25", "zeta"),
+    "df_abs_over_k": ("~0.3", "\\|D\\| / k"),
+    "df_phase_deg": ("~50 deg", "angle D"),
+    "f_star_hz": ("0.15 Hz", "f* (eq. 13)"),
+    "mismatch_crossover_hz": ("7.6 Hz", "crossover (eq. 21)"),
+    "bandwidth_hz": ("120 Hz", "bandwidth"),
+}
+
+FIGURE_NOTES = {
+    "fig5": "Displacement-force loops of the Jenkins element for sinusoids at several zeta: "
+            "a spring while it sticks, flat at +-fc while it slips; zeta >= 1 never slips.",
+    "fig6": "The two nonlinear modes: for zeta <= 0.5 the element starts to slip where x w <= 0, "
+            "for 0.5 < zeta < 1 where x w > 0 (dots).",
+    "fig7": "The force over one period with the slip intervals shaded, and its first harmonic: "
+            "what the describing function keeps.",
+    "fig8": "Magnitude and phase of the describing function against zeta (eq. 10): a small "
+            "lead-dominated force for small zeta, the spring k for zeta >= 1.",
+    "fig9": "The quasi-linear plant (eq. 12) departs from the floating mass P2 only below f*.",
+    "fig10": "The feedforward mismatch (eq. 18) and its asymptote (eq. 20); the circles are the "
+             "exact periodic steady state of the nonlinear loop.",
+    "fig11": "Steady-state error over a period with and without the dynamic link, and the "
+             "describing-function estimate of its first harmonic.",
+}
+
+
+def _fmt(x) -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "n/a"
+    return f"{x:.4g}"
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, float | np.floating):
+        return float(obj) if math.isfinite(obj) else None
+    return obj
+
+
+def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
+                  is_paper: bool, notes: list[str]) -> None:
+    a = summary["analyze"]
+    lines = [f"# motionhyst report: {sc.source}", ""]
+    lines += ["## Paper vs computed" if is_paper else "## Key numbers", ""]
+    head = "| quantity | paper | computed |" if is_paper else "| quantity | computed |"
+    lines += [head, "|---|---|---|" if is_paper else "|---|---|"]
+    units = {"f_star_hz": " Hz", "mismatch_crossover_hz": " Hz", "bandwidth_hz": " Hz",
+             "df_phase_deg": " deg"}
+    for key, (paper, label) in PAPER_VALUES.items():
+        val = _fmt(a[key]) + units.get(key, "")
+        lines.append(f"| {label} | {paper} | {val} |" if is_paper else f"| {label} | {val} |")
+    exact = _fmt(a["mismatch_crossover_exact_hz"]) + " Hz"
+    lines.append(f"| exact crossover, \\|E - 1\\| = 1 | - | {exact} |" if is_paper
+                 else f"| exact crossover, \\|E - 1\\| = 1 | {exact} |")
+    lines += ["", "Mismatch at the reference frequencies: describing function (eq. 18) against "
+              "the exact periodic steady state of the nonlinear loop.", "",
+              "| f [Hz] | \\|E\\| eq. (18) | angle [deg] | \\|E\\| exact | angle [deg] | "
+              "\\|e1\\| [m] | \\|e3\\| [m] | peak e [m] |", "|---|---|---|---|---|---|---|---|"]
+    for p in summary["simulate"]["points"]:
+        h = {x["n"]: x["abs"] for x in p["error_harmonics"]}
+        lines.append(f"| {_fmt(p['frequency_hz'])} | {_fmt(p['mismatch_df_abs'])} | "
+                     f"{p['mismatch_df_phase_deg']:.2f} | {_fmt(p['mismatch_simulated_abs'])} | "
+                     f"{p['mismatch_simulated_phase_deg']:.2f} | {_fmt(h.get(1))} | "
+                     f"{_fmt(h.get(3))} | {_fmt(p['error_peak'])} |")
+    lines += ["", "## Figures", ""]
+    for name in figures:
+        lines += [f"### {name}", "", FIGURE_NOTES[name], "", f"![{name}]({name}.png)", ""]
+    if notes:
+        lines += ["## Notes", ""] + [f"- {n}" for n in notes] + [""]
+    path.write_text("\n".join(lines))
+
+
+def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
+              is_paper: bool = False) -> dict:
+    """Write the figures, ``summary.json`` and ``report.md`` for scenario `sc` into `out_dir`.
+
+    Returns the summary dictionary.
+    """
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    loop = sc.loop()
+    el = loop.hysteresis
+    A, freqs = sc.amplitude, sc.frequencies
+    show = not quiet and sys.stderr.isatty()
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    notes: list[str] = []
+    try:
+        steps = tqdm(total=10, desc="reproduce", disable=not show, file=sys.stderr, leave=False)
+        analysis = analyze(loop, A, freqs)
+        steps.update()
+        states = [periodic_steady_state(loop, A, f) for f in freqs]
+        E_df = loop_mismatch(loop, freqs, A)
+        steps.update()
+        f_exact = np.unique(np.concatenate([np.geomspace(1.0, 100.0, 13), freqs]))
+        exact = [periodic_steady_state(loop, A, f) for f in f_exact]
+        steps.update()
+        summary = {
+            "scenario": sc.to_dict(),
+            "analyze": analysis.to_dict(),
+            "simulate": {"points": [s.to_dict(mismatch_df=complex(e))
+                                    for s, e in zip(states, E_df, strict=True)]},
+        }
+        figs = {
+            "fig5": lambda: plots.fig5_loops(el),
+            "fig6": lambda: plots.fig6_modes(el),
+            "fig7": lambda: plots.fig7_time(el, A, freqs[0]),
+            "fig8": lambda: plots.fig8_describing_function(el),
+            "fig9": lambda: plots.fig9_quasilinear_plant(loop, f_star_hz=analysis.f_star_hz),
+            "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
+            "fig11": lambda: plots.fig11_errors(states, E_df),
+        }
+        if not isinstance(loop.plant, TwoMassStage):
+            notes.append("The plant is measured frequency-response data: eq. (21) needs the "
+                         "two-mass model and is not computed.")
+        written = []
+        for name, make in figs.items():
+            fig = make()
+            stem = f"{name}"
+            fig.savefig(tmp / f"{stem}.png")
+            fig.savefig(tmp / f"{stem}.pdf")
+            written.append(name)
+            steps.update()
+        (tmp / "summary.json").write_text(json.dumps(_jsonable(summary), indent=2,
+                                                     allow_nan=False))
+        _write_report(tmp / "report.md", sc, summary, written, is_paper, notes)
+        steps.close()
+        old = None
+        if out_dir.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
+            out_dir.rename(old / out_dir.name)
+        tmp.rename(out_dir)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return summary
