@@ -17,7 +17,7 @@ reproduce: $(STAMP)
 	$(BIN)/motionhyst reproduce --out out
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks examples
+	$(BIN)/ruff check .
 
 test: lint
 	$(BIN)/python -m pytest

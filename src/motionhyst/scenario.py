@@ -26,7 +26,7 @@ class ScenarioError(ValueError):
     """A scenario file that cannot be used; the message is one line."""
 
 
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False, strict=False)]
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 
 

@@ -1,0 +1,194 @@
+"""Reference trajectories for time simulation: position and acceleration on any time grid.
+
+The rigid-body feedforward needs the acceleration ``r''``; every reference
+therefore gives both, exactly where it is known in closed form (sine,
+point-to-point profile) and from a quintic interpolating spline for sampled
+data.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import make_interp_spline
+
+from motionhyst.systems import TWO_PI
+
+
+@dataclass(frozen=True)
+class SineReference:
+    """``r = amplitude sin(2 pi frequency_hz t)``."""
+
+    amplitude: float
+    frequency_hz: float
+
+    def __post_init__(self):
+        for name in ("amplitude", "frequency_hz"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+
+    @property
+    def max_frequency_hz(self) -> float:
+        """Highest frequency in the reference [Hz]."""
+        return self.frequency_hz
+
+    def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Position [m] and acceleration [m/s^2] at times `t` [s]."""
+        th = TWO_PI * self.frequency_hz * np.asarray(t, dtype=float)
+        r = self.amplitude * np.sin(th)
+        return r, -((TWO_PI * self.frequency_hz) ** 2) * r
+
+
+@dataclass(frozen=True)
+class PointToPoint:
+    """Jerk-limited point-to-point move (third-order profile), a stage's usual set-point.
+
+    Parameters
+    ----------
+    distance : float
+        Length of the move [m] (sign gives direction).
+    v_max, a_max, j_max : float
+        Velocity [m/s], acceleration [m/s^2] and jerk [m/s^3] limits, > 0.
+    start : float
+        Time at which the move starts [s].
+    """
+
+    distance: float
+    v_max: float
+    a_max: float
+    j_max: float
+    start: float = 0.0
+
+    def __post_init__(self):
+        if not np.isfinite(self.distance) or self.distance == 0:
+            raise ValueError("distance must be finite and non-zero")
+        for name in ("v_max", "a_max", "j_max"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        if not (np.isfinite(self.start) and self.start >= 0):
+            raise ValueError("start must be finite and >= 0")
+
+    def _phases(self) -> tuple[float, float, float]:
+        """Durations of the jerk phase, the constant-acceleration phase and the cruise."""
+        d, v, a, j = abs(self.distance), self.v_max, self.a_max, self.j_max
+        tj = min(a / j, np.sqrt(v / j))
+        ta = max(v / (j * tj) - tj, 0.0) if tj > 0 else 0.0
+        # distance covered while accelerating to the peak speed and back to rest
+        vp = j * tj * (tj + ta)
+        d_acc = vp * (2 * tj + ta)
+        if d_acc <= d:
+            return tj, ta, (d - d_acc) / vp
+        # too short to reach v_max: shrink the peak speed (bisection on the profile length)
+        lo, hi = 0.0, vp
+        for _ in range(200):
+            vm = 0.5 * (lo + hi)
+            tj = min(a / j, np.sqrt(vm / j))
+            ta = max(vm / (j * tj) - tj, 0.0)
+            if vm * (2 * tj + ta) > d:
+                hi = vm
+            else:
+                lo = vm
+        tj = min(a / j, np.sqrt(lo / j))
+        ta = max(lo / (j * tj) - tj, 0.0)
+        return tj, ta, 0.0
+
+    @property
+    def duration(self) -> float:
+        """Duration of the move [s]."""
+        tj, ta, tv = self._phases()
+        return 2 * (2 * tj + ta) + tv
+
+    @property
+    def max_frequency_hz(self) -> float:
+        """A frequency that the profile's jerk switching resolves to [Hz]."""
+        tj, ta, _ = self._phases()
+        return 1.0 / max(min(tj, ta) if ta > 0 else tj, 1e-9)
+
+    def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Position [m] and acceleration [m/s^2] at times `t` [s]."""
+        tj, ta, tv = self._phases()
+        jerks = np.array([1, 0, -1, 0, -1, 0, 1], dtype=float) * self.j_max
+        durs = np.array([tj, ta, tj, tv, tj, ta, tj])
+        edges = np.concatenate([[0.0], np.cumsum(durs)])
+        # state (position, velocity, acceleration) at each edge
+        p, v, a = [0.0], [0.0], [0.0]
+        for jk, d in zip(jerks, durs, strict=True):
+            p.append(p[-1] + v[-1] * d + a[-1] * d**2 / 2 + jk * d**3 / 6)
+            v.append(v[-1] + a[-1] * d + jk * d**2 / 2)
+            a.append(a[-1] + jk * d)
+        tt = np.asarray(t, dtype=float) - self.start
+        idx = np.clip(np.searchsorted(edges, tt, side="right") - 1, 0, 6)
+        tau = np.clip(tt - edges[idx], 0.0, None)
+        tau = np.where(tt >= edges[-1], 0.0, tau)
+        idx = np.where(tt >= edges[-1], 6, idx)
+        p0, v0, a0 = np.array(p)[idx], np.array(v)[idx], np.array(a)[idx]
+        jk = jerks[idx]
+        pos = p0 + v0 * tau + a0 * tau**2 / 2 + jk * tau**3 / 6
+        acc = a0 + jk * tau
+        pos = np.where(tt >= edges[-1], p[-1], np.where(tt < 0, 0.0, pos))
+        acc = np.where((tt >= edges[-1]) | (tt < 0), 0.0, acc)
+        sgn = np.sign(self.distance)
+        return sgn * pos, sgn * acc
+
+
+@dataclass(frozen=True)
+class SampledReference:
+    """A reference given by samples, interpolated by a quintic spline (acceleration from it)."""
+
+    t: NDArray[np.float64]
+    r: NDArray[np.float64]
+
+    def __post_init__(self):
+        t, r = np.asarray(self.t, float), np.asarray(self.r, float)
+        if t.ndim != 1 or t.shape != r.shape:
+            raise ValueError("time and position must be one-dimensional and of equal length")
+        if t.size < 6:
+            raise ValueError("a sampled reference needs at least 6 samples")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(r))):
+            raise ValueError("the reference has non-finite values")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError("reference time must be strictly increasing")
+        object.__setattr__(self, "_spline", make_interp_spline(t, r, k=5))
+
+    @property
+    def max_frequency_hz(self) -> float:
+        """Nyquist frequency of the samples [Hz]."""
+        return 0.5 / float(np.min(np.diff(self.t)))
+
+    @property
+    def duration(self) -> float:
+        """Time of the last sample [s]."""
+        return float(self.t[-1])
+
+    def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Position [m] and acceleration [m/s^2]; held constant outside the samples."""
+        tt = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
+        inside = (np.asarray(t) >= self.t[0]) & (np.asarray(t) <= self.t[-1])
+        return self._spline(tt), np.where(inside, self._spline(tt, 2), 0.0)
+
+
+def load_reference_csv(path: str | Path) -> SampledReference:
+    """Read a reference from CSV with a header and columns ``time,position`` (SI units)."""
+    path = Path(path)
+    try:
+        with path.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as exc:
+        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
+    if not rows or not {"time", "position"} <= set(rows[0]):
+        raise ValueError(f"{path}: need a header with columns time,position")
+    try:
+        t = np.array([float(r["time"]) for r in rows])
+        r = np.array([float(r["position"]) for r in rows])
+    except (TypeError, ValueError):
+        raise ValueError(f"{path}: non-numeric value in data") from None
+    try:
+        return SampledReference(t, r)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
