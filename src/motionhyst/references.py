@@ -37,6 +37,11 @@ class SineReference:
         """Highest frequency in the reference [Hz]."""
         return self.frequency_hz
 
+    @property
+    def initial_velocity(self) -> float:
+        """Velocity at ``t = 0`` [m/s]: the reference starts from rest with this jump."""
+        return TWO_PI * self.frequency_hz * self.amplitude
+
     def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Position [m] and acceleration [m/s^2] at times `t` [s]."""
         th = TWO_PI * self.frequency_hz * np.asarray(t, dtype=float)
@@ -155,6 +160,11 @@ class SampledReference:
         if np.any(np.diff(t) <= 0):
             raise ValueError("reference time must be strictly increasing")
         object.__setattr__(self, "_spline", make_interp_spline(t, r, k=5))
+
+    @property
+    def initial_velocity(self) -> float:
+        """Velocity of the first sample [m/s], a jump when the loop starts from rest."""
+        return float(self._spline(self.t[0], 1))
 
     @property
     def max_frequency_hz(self) -> float:

@@ -112,11 +112,11 @@ def _block_system(loop: Loop, omega0: float):
 
 
 @njit(cache=True)
-def _run(Ad, Bd, Cd, Dd, r, a, k, fc):  # pragma: no cover - compiled
+def _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0):  # pragma: no cover - compiled
     n_t = r.shape[0]
     n_x = Ad.shape[0]
     m = k.shape[0]
-    x = np.zeros(n_x)
+    x = x0.copy()
     e = np.empty(n_t)
     y1 = np.empty(n_t)
     w = np.empty(n_t)
@@ -218,13 +218,17 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
     omega0 = float(np.max(np.abs(loop.closed_loop_poles())))
     A, B, C, D = _block_system(loop, omega0)
     Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), omega0 * step, method="foh")
+    # a reference that starts with a velocity v0 has r'' = v0 delta(t) + ...: the impulse
+    # sets the initial state (delta(t) = omega0 delta(tau) in scaled time)
+    v0 = float(getattr(reference, "initial_velocity", 0.0))
+    x0 = B[:, 0] * v0 * omega0
     k, fc = _stop_parameters(loop)
     if loop.hysteresis is None:
         k = np.zeros(1)
-    e, y1, w = _run(Ad, Bd, Cd, Dd, r, a, k, fc)
-    e_lin, _, _ = _run(Ad, Bd, Cd, Dd, r, a, np.zeros(1), np.ones(1))
+    e, y1, w = _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0)
+    e_lin, _, _ = _run(Ad, Bd, Cd, Dd, r, a, np.zeros(1), np.ones(1), x0)
     y2 = r - e
     u = control.forced_response(loop.controller, t, e).outputs
     if loop.feedforward == "rigid-body":
-        u = u + loop.M * a
+        u = u + loop.M * a  # the impulse M v0 delta(t) at t = 0 is not representable
     return Simulation(t=t, r=r, e=e, y1=y1, y2=y2, u=np.asarray(u), w=w, e_linear=e_lin)
