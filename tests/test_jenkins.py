@@ -195,7 +195,8 @@ def test_no_nan_or_warning_at_extremes():
         z0 = el.zeta(0.0)
     assert d0 == 20.0 + 0j
     assert z0 == np.inf
-    assert np.isfinite(d_huge) and abs(d_huge) <= 1e-298
+    assert d_huge.imag == pytest.approx(4 / np.pi * 20.0 * el.zeta(1e300), rel=1e-12)
+    assert 0.0 <= d_huge.real <= 1e-12 * d_huge.imag
     assert_array_equal(dz, [0.0, 20.0])
 
 
@@ -241,13 +242,16 @@ def test_control_numerical_describing_function(A):
 
 
 def test_control_describing_function_response_runs(link):
-    H = control.tf([4e4], [1, 4, 6, 4, 1])  # 4e4 / (s + 1)^4, stable
-    amps = np.geomspace(1e-3, 1.0, 40)
+    H = control.tf([8.0], [1, 3, 3, 1])  # 8 / (s + 1)^3, stable, phase to -270 deg
+    amps = np.geomspace(1e-3, 10.0, 60)
     resp = control.describing_function_response(H, link, amps, warn_nyquist=False)
     assert_allclose(resp.N_vals, -1.0 / link.describing_function(amps), rtol=1e-14)
-    # every reported intersection predicts a limit cycle: H(j omega) D(A) = -1
-    for a, omega in resp.intersections:
-        assert abs(1.0 + complex(H(1j * omega)) * link.describing_function(a)) < 1e-3
+    # -1/D runs through the second quadrant, where H passes: one predicted limit cycle,
+    # at which H(j omega) D(A) = -1
+    assert len(resp.intersections) == 1
+    a, omega = resp.intersections[0]
+    assert 1e-3 < a < 10.0
+    assert abs(1.0 + complex(H(1j * omega)) * link.describing_function(a)) < 1e-4
 
 
 # ---------------------------------------------------------------------------
@@ -272,8 +276,8 @@ def test_ode_rhs_modes():
 def test_ode_euler_tracks_exact_response():
     """Explicit Euler on eq. (3) chatters around +-fc but stays within k |xdot| dt of exact."""
     el = Jenkins(k=20.0, fc=0.05)
-    A, omega, dt = 0.01, 2 * np.pi, 1e-5
-    t = np.arange(int(2.0 / dt) + 1) * dt
+    A, omega, dt = 0.01, 2 * np.pi, 2e-5
+    t = np.arange(int(1.25 / dt) + 1) * dt  # from rest: slip up, down and up again
     x = A * np.sin(omega * t)
     xdot = A * omega * np.cos(omega * t)
     w = np.empty_like(t)
@@ -316,14 +320,11 @@ def test_response_rejects_bad_input(link):
         link.response(np.zeros((2, 2)))
 
 
-@pytest.mark.xfail(strict=True, reason="bug: Jenkins.response accepts w0=nan and returns all NaN")
 def test_response_rejects_nan_initial_force(link):
     with pytest.raises(ValueError):
         link.response([0.0, 0.01], w0=np.nan)
 
 
-@pytest.mark.xfail(strict=True, reason="bug: fc / (k A) overflows with a RuntimeWarning for "
-                   "subnormal A (only divide-by-zero is silenced)")
 def test_no_warning_for_subnormal_amplitude(link):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -379,12 +380,14 @@ def test_property_dissipated_energy_is_loop_area(k, fc, A):
 @given(
     k=positive,
     fc=positive,
-    x=st.lists(st.floats(min_value=-1e3, max_value=1e3), min_size=1, max_size=60),
+    steps=st.lists(st.floats(min_value=-3.0, max_value=3.0), min_size=0, max_size=60),
+    offset=st.floats(min_value=-1e3, max_value=1e3),
     frac=st.floats(min_value=-1.0, max_value=1.0),
 )
-def test_property_response_bounded_and_rate_independent(k, fc, x, frac):
+def test_property_response_bounded_and_rate_independent(k, fc, steps, offset, frac):
+    """Steps of up to 3 slip displacements fc / k mix stick and slip."""
     el = Jenkins(k=k, fc=fc)
-    x = np.array(x)
+    x = offset + fc / k * np.concatenate([[0.0], np.cumsum(steps)])
     w = el.response(x, w0=frac * fc)
     assert w[0] == frac * fc
     assert np.all(np.abs(w) <= fc)
@@ -393,4 +396,10 @@ def test_property_response_bounded_and_rate_independent(k, fc, x, frac):
     xm[0::2] = x
     xm[1::2] = 0.5 * (x[:-1] + x[1:])
     wm = el.response(xm, w0=frac * fc)
-    assert_allclose(wm[0::2], w, rtol=0, atol=1e-9 * (fc + k * np.max(np.abs(x))))
+    # to round-off: of the force, and of displacement differences times the stiffness
+    assert_allclose(wm[0::2], w, rtol=0, atol=1e-12 * (fc + k * np.max(np.abs(x))))
+    # in stick (no clipping on the way) the force is the spring law exactly
+    stick = np.all(np.abs(frac * fc + k * (x - x[0])) < fc)
+    if stick:
+        assert_allclose(w, frac * fc + k * (x - x[0]), rtol=0,
+                        atol=1e-12 * (fc + k * np.max(np.abs(x))))

@@ -113,7 +113,7 @@ class Loop:
         else:
             try:
                 P1, P2 = plant
-            except (TypeError, ValueError):
+            except Exception:
                 raise TypeError("plant must be a TwoMassStage, a MeasuredPlant or a tuple "
                                 "(P1, P2)") from None
         if feedforward not in ("rigid-body", None):
@@ -202,11 +202,18 @@ class Loop:
             return
         cases = [("", self._poly["w->e"].den)]
         if self.hysteresis is not None:
-            # stuck link: w = kJ y1, characteristic polynomial of 1 - kJ T_w->y1
-            t = self._poly["w->y1"]
+            # stuck link, w = kJ y1: characteristic polynomial of 1 + kJ P1 + C P2, over a
+            # common denominator of P1 and P2 (shared by both for a two-mass stage)
+            n1, d1 = _tf_poly(self.P1)
+            n2, d2 = _tf_poly(self.P2)
+            nc, dc = _tf_poly(self.controller)
             kj = self.hysteresis.initial_stiffness
-            cases.append((" with the dynamic link stuck", np.polysub(t.den, kj * np.asarray(
-                np.pad(t.num, (len(t.den) - len(t.num), 0))))))
+            if d1.shape == d2.shape and np.array_equal(d1, d2):
+                n1c, n2c, d = n1, n2, d1
+            else:
+                n1c, n2c, d = np.polymul(n1, d2), np.polymul(n2, d1), np.polymul(d1, d2)
+            stuck = np.polyadd(np.polymul(np.polyadd(d, kj * n1c), dc), np.polymul(n2c, nc))
+            cases.append((" with the dynamic link stuck", stuck))
         for what, den in cases:
             p = np.roots(_trim(den))
             if p.size and np.max(p.real) >= 0:

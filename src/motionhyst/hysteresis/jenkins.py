@@ -109,7 +109,7 @@ class Jenkins(Hysteresis):
         ``A = 0`` gives ``inf`` (the element does not slip).
         """
         a = check_amplitudes(A)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", over="ignore"):
             z = self.fc / (self.k * a)
         return float(z) if z.ndim == 0 else z
 
@@ -120,7 +120,7 @@ class Jenkins(Hysteresis):
         is rate-independent.  Returns a complex scalar for scalar `A`.
         """
         a = check_amplitudes(A)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", over="ignore"):
             z = self.fc / (self.k * a)
         d = jenkins_describing_function(self.k, z)
         if omega is not None:
@@ -152,7 +152,7 @@ class Jenkins(Hysteresis):
             raise ValueError("x must be one-dimensional")
         if not np.all(np.isfinite(xs)):
             raise ValueError("x must be finite")
-        if abs(w0) > self.fc:
+        if not abs(w0) <= self.fc:
             raise ValueError(f"|w0| must be <= fc = {self.fc}, got {w0}")
         return stop_response(xs, self.k, self.fc, float(w0))
 
