@@ -8,7 +8,6 @@ data.
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import make_interp_spline
 
+from motionhyst.csvdata import read_columns
 from motionhyst.systems import TWO_PI
 
 
@@ -186,18 +186,8 @@ class SampledReference:
 def load_reference_csv(path: str | Path) -> SampledReference:
     """Read a reference from CSV with a header and columns ``time,position`` (SI units)."""
     path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
-    if not rows or not {"time", "position"} <= set(rows[0]):
-        raise ValueError(f"{path}: need a header with columns time,position")
-    try:
-        t = np.array([float(r["time"]) for r in rows])
-        r = np.array([float(r["position"]) for r in rows])
-    except (TypeError, ValueError):
-        raise ValueError(f"{path}: non-numeric value in data") from None
+    data = read_columns(path, ("time", "position"))
+    t, r = data[:, 0], data[:, 1]
     try:
         return SampledReference(t, r)
     except ValueError as exc:

@@ -7,7 +7,6 @@ measured frequency-response data (:func:`load_frd_plant`).
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
+from motionhyst.csvdata import read_columns, read_header
 from motionhyst.hysteresis.base import check_positive
 
 TWO_PI = 2.0 * np.pi
@@ -255,25 +255,14 @@ def load_frd_plant(path: str | Path, mass: float | None = None) -> MeasuredPlant
     MeasuredPlant
     """
     path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
-    if not rows:
-        raise ValueError(f"{path}: no data rows")
-    header = set(rows[0])
+    header = set(read_header(path))
     if "frequency_hz" not in header:
         raise ValueError(f"{path}: missing column 'frequency_hz'")
     kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
     if kind is None:
         raise ValueError(f"{path}: need columns {', '.join(_FRD_COLUMNS['reim'])} or "
                          f"{', '.join(_FRD_COLUMNS['absphase'])}")
-    cols = ("frequency_hz", *_FRD_COLUMNS[kind])
-    try:
-        data = np.array([[float(r[c]) for c in cols] for r in rows])
-    except (TypeError, ValueError):
-        raise ValueError(f"{path}: non-numeric value in data") from None
+    data = read_columns(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
     if not np.all(np.isfinite(data)):
         raise ValueError(f"{path}: non-finite value in data")
     f = data[:, 0]
