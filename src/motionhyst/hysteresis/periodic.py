@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
+from scipy.fft import next_fast_len
 from scipy.signal import fftconvolve
 
 TWO_PI = 2.0 * np.pi
@@ -68,7 +69,7 @@ def _grid(X: NDArray[np.complex128]) -> tuple[NDArray[np.float64], NDArray[np.fl
                                               NDArray[np.float64]]:
     """Angles, x and dx/dtheta on a grid fine enough to separate the roots."""
     M = len(X) - 1
-    n = max(512, 16 * M)
+    n = next_fast_len(max(1024, 4 * M), real=True)
     th = np.arange(n) * (TWO_PI / n)
     x = np.fft.irfft(X * n, n=n)
     d = np.fft.irfft(1j * np.arange(M + 1) * X * n, n=n)
