@@ -36,6 +36,18 @@ def _figure(nrows: int = 1, sharex: bool = True):
     return fig, axes[:, 0]
 
 
+def _phase_deg(P) -> np.ndarray:
+    """Unwrapped phase in degrees, starting in (-360, 0]."""
+    ph = np.degrees(np.unwrap(np.angle(P)))
+    return ph - 360.0 * np.ceil(ph[0] / 360.0)
+
+
+def _frequency_range(loop: Loop, f_range):
+    """`f_range` clipped to the measured range of a measured plant."""
+    lo, hi = getattr(loop.plant, "frequency_range_hz", f_range)
+    return max(f_range[0], lo), min(f_range[1], hi)
+
+
 def _sine_loop(el: Jenkins, A: float, n: int = 2000):
     theta = np.linspace(0.0, TWO_PI, n + 1)
     x = A * np.sin(np.concatenate([theta, TWO_PI + theta[1:]]))
@@ -126,7 +138,7 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     """Fig. 9: Bode plot of the quasi-linear plant ``P^phi`` (eq. 12) for zeta in (0, 1]."""
     el = loop.hysteresis
     fig, (ax1, ax2) = _figure(2)
-    f = np.geomspace(*f_range, 600)
+    f = np.geomspace(*_frequency_range(loop, f_range), 600)
     w = TWO_PI * f
     P1, P2 = freqresp(loop.P1, w), freqresp(loop.P2, w)
     cmap = matplotlib.colormaps["viridis"]
@@ -135,20 +147,20 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
         Pphi = P2 / (1.0 + D * P1)
         c = cmap(i / max(1, len(zetas) - 1))
         ax1.semilogx(f, 20 * np.log10(np.abs(Pphi)), color=c, label=f"zeta = {z:g}")
-        ax2.semilogx(f, np.degrees(np.unwrap(np.angle(Pphi))), color=c)
+        ax2.semilogx(f, _phase_deg(Pphi), color=c)
         fig.motionhyst_data[f"zeta={z:g}"] = Pphi
     ax1.semilogx(f, 20 * np.log10(np.abs(P2)), "k--", label="P2 (no link)")
-    ax2.semilogx(f, np.degrees(np.unwrap(np.angle(P2))), "k--")
+    ax2.semilogx(f, _phase_deg(P2), "k--")
     if f_star_hz:
         for ax in (ax1, ax2):
             ax.axvline(f_star_hz, color="tab:red", ls=":", lw=1)
-        ax1.annotate(f"f* = {f_star_hz:.3g} Hz", (f_star_hz, ax1.get_ylim()[0]),
-                     xytext=(4, 8), textcoords="offset points", color="tab:red")
+        ax1.annotate(f"f* = {f_star_hz:.3g} Hz", (f_star_hz, ax1.get_ylim()[1]),
+                     xytext=(4, -12), textcoords="offset points", color="tab:red")
     ax1.set_ylabel("|P^phi| [dB re 1 m/N]")
     ax2.set_ylabel("angle P^phi [deg]")
     ax2.set_xlabel("frequency [Hz]")
     ax1.set_title("Fig. 9: quasi-linear plant, eq. (12)")
-    ax1.legend(ncol=2)
+    ax1.legend(ncol=2, loc="lower left")
     fig.motionhyst_data.update(f=f, P2=P2)
     return fig
 
@@ -157,7 +169,7 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
     """Fig. 10: mismatch |E| (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
     fig, (ax,) = _figure()
-    f = np.geomspace(*f_range, 800)
+    f = np.geomspace(*_frequency_range(loop, f_range), 800)
     E = loop_mismatch(loop, f, analysis.amplitude)
     w = TWO_PI * f
     Pr = 1.0 / (loop.M * (1j * w) ** 2)

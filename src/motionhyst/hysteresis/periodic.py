@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 from scipy.fft import next_fast_len
+from scipy.optimize import brentq
 from scipy.signal import fftconvolve
 
 TWO_PI = 2.0 * np.pi
