@@ -51,18 +51,22 @@ def _root(X: NDArray[np.complex128], deriv: int, level: float, a: float, b: floa
     Newton from the linear interpolant (the bracket is one grid cell, so two
     or three steps reach round-off), with a bisection safeguard.
     """
-    t = a + (b - a) * fa / (fa - fb)
+    t = a + (b - a) * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
+    # a root on a grid point may lie a round-off outside [a, b]: allow half a cell either side
+    lo, hi = a - 0.5 * (b - a), b + 0.5 * (b - a)
     for _ in range(8):
         f = float(trig_eval(X, t, deriv)) - level
         step = f / float(trig_eval(X, t, deriv + 1))
         t_new = t - step
-        if not a <= t_new <= b:
-            return brentq(lambda u: float(trig_eval(X, u, deriv)) - level, a, b,
-                          xtol=1e-15, rtol=1e-15)
+        if not lo <= t_new <= hi:
+            break
         if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
             return t_new
         t = t_new
-    return t
+    else:
+        return t
+    return brentq(lambda u: float(trig_eval(X, u, deriv)) - level, lo, hi,
+                  xtol=1e-15, rtol=1e-15)
 
 
 def _grid(X: NDArray[np.complex128]) -> tuple[NDArray[np.float64], NDArray[np.float64],

@@ -1,0 +1,177 @@
+"""Tests of the exact periodic harmonics of the stop operator (hysteresis/periodic.py).
+
+Conventions: a periodic signal is given by its ``rfft / N`` harmonics ``X_0 .. X_M``,
+``x(theta) = X_0 + 2 Re sum_m X_m exp(j m theta)``.  For ``x = A sin(theta + phase)``
+this is ``X_1 = A exp(j phase) / (2 j)``, and the describing function (paper eq. 7) of
+the element is ``D = 2 j W_1 / (A exp(j phase))``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from motionhyst.hysteresis.jenkins import Jenkins
+from motionhyst.hysteresis.periodic import (
+    significant_harmonics,
+    stop_periodic_harmonics,
+    trig_eval,
+)
+
+K, FC = 20.0, 0.05  # Table I link
+N_SAMPLED = 2**18  # samples a period of the independent sampled computation
+H_OUT = 15
+
+ZETAS = [1e-3, 0.01, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 0.99, 0.999, 1.0 - 1e-6]
+PHASES = [0.0, 0.3, 1.234, -2.1, np.pi, 2.9]
+
+
+@pytest.fixture(scope="module")
+def el() -> Jenkins:
+    return Jenkins(k=K, fc=FC)
+
+
+def sine_harmonics(A: float, phase: float = 0.0) -> np.ndarray:
+    X = np.zeros(2, dtype=complex)
+    X[1] = A * np.exp(1j * phase) / 2j
+    return X
+
+
+def sampled_harmonics(el: Jenkins, x_of_theta, n_harmonics: int) -> np.ndarray:
+    """Independent reference: run the exact sampled element over two periods, FFT the second."""
+    theta = np.arange(2 * N_SAMPLED) * (2 * np.pi / N_SAMPLED)
+    w = el.response(x_of_theta(theta))[N_SAMPLED:]
+    return (np.fft.rfft(w) / N_SAMPLED)[: n_harmonics + 1]
+
+
+def df_from_harmonics(W: np.ndarray, A: float, phase: float) -> complex:
+    return complex(2j * W[1] / (A * np.exp(1j * phase)))
+
+
+# --------------------------------------------------------------------------- sine input
+
+
+@pytest.mark.parametrize("phase", PHASES)
+@pytest.mark.parametrize("zeta", ZETAS)
+def test_sine_reproduces_closed_form_describing_function(el, zeta, phase):
+    A = FC / (K * zeta)
+    W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 9)
+    D_closed = el.describing_function(A)
+    assert abs(df_from_harmonics(W, A, phase) - D_closed) <= 1e-12 * abs(D_closed)
+
+
+@pytest.mark.parametrize("zeta", [1e-6, 1e-5, 1e-4])
+def test_small_zeta_accuracy_is_limited_only_by_conditioning(el, zeta):
+    """For small zeta the stick pieces k x (size fc / zeta) cancel to a force of size fc."""
+    A = FC / (K * zeta)
+    D_closed = el.describing_function(A)
+    assert D_closed.imag == pytest.approx(4 / np.pi * K * zeta, rel=2 * zeta)  # eq. (11)
+    for phase in (0.0, 0.3, -2.1):
+        W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 3)
+        err = abs(df_from_harmonics(W, A, phase) - D_closed) / abs(D_closed)
+        assert err <= 1e-15 / zeta
+
+
+@pytest.mark.parametrize("phase", [0.0, 0.7, -2.3])
+@pytest.mark.parametrize("zeta", [0.1, 0.25, 0.5, 0.75])
+def test_symmetric_input_has_no_mean_and_no_even_harmonics(zeta, phase):
+    A = FC / (K * zeta)
+    W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 20)
+    assert W.shape == (21,)
+    assert np.max(np.abs(W[0::2])) <= 1e-13 * abs(W[1])
+
+
+@pytest.mark.parametrize(("zeta", "phase"), [(0.1, 0.0), (0.25, 0.3), (0.5, -1.1), (0.8, 2.5)])
+def test_sine_harmonics_match_sampled_fft(el, zeta, phase):
+    A = FC / (K * zeta)
+    W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, H_OUT)
+    W_ref = sampled_harmonics(el, lambda th: A * np.sin(th + phase), H_OUT)
+    assert_allclose(W[1::2], W_ref[1::2], rtol=0, atol=1e-6 * abs(W[1]))
+    # the higher odd harmonics are really there (not a trivially zero comparison)
+    assert abs(W[3]) > 1e-2 * abs(W[1])
+
+
+@pytest.mark.parametrize("A", [1e-3, 2.4e-3, 2.4999e-3])
+def test_no_slip_amplitude_is_a_spring(A):
+    """Below the slip displacement fc / k = 2.5 mm the output is W = k X (zero mean)."""
+    phase = 0.4
+    X = sine_harmonics(A, phase)
+    W = stop_periodic_harmonics(X, K, FC, 7)
+    assert W[1] == pytest.approx(K * X[1], rel=1e-13)
+    assert np.max(np.abs(np.delete(W, 1))) <= 1e-13 * abs(W[1])
+
+
+def test_no_slip_with_offset_returns_symmetric_solution():
+    """Without slip the periodic output is defined up to a constant: the symmetric one."""
+    X = sine_harmonics(1e-3, 0.2)
+    X[0] = 0.37  # a mean displacement does not change the force
+    W = stop_periodic_harmonics(X, K, FC, 5)
+    assert abs(W[0]) <= 1e-15
+    assert W[1] == pytest.approx(K * X[1], rel=1e-13)
+
+
+def test_mean_displacement_does_not_change_slipping_output():
+    A, phase = 0.01, 0.3
+    W0 = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 9)
+    X = sine_harmonics(A, phase)
+    X[0] = -0.2
+    W = stop_periodic_harmonics(X, K, FC, 9)
+    assert_allclose(W, W0, rtol=0, atol=1e-14 * abs(W0[1]))
+
+
+def test_zero_and_constant_input_give_zero_output():
+    assert np.all(stop_periodic_harmonics(np.zeros(4, complex), K, FC, 5) == 0)
+    assert np.all(stop_periodic_harmonics(np.array([0.3 + 0j, 0, 0]), K, FC, 5) == 0)
+
+
+def test_scaling_with_k_and_fc():
+    """W / fc depends only on zeta: scale fc and k together with A."""
+    A, phase = 0.01, 0.5
+    W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 9)
+    W2 = stop_periodic_harmonics(sine_harmonics(A, phase), 10 * K, 10 * FC, 9)
+    assert_allclose(W2, 10 * W, rtol=0, atol=1e-14 * abs(W2[1]))
+    W3 = stop_periodic_harmonics(sine_harmonics(A / 4, phase), 4 * K, FC, 9)
+    assert_allclose(W3, W, rtol=0, atol=1e-14 * abs(W[1]))
+
+
+@pytest.mark.parametrize("zeta", [0.25, 0.5])
+def test_reversal_on_grid_point(el, zeta):
+    """x = A sin(theta + pi/4) reverses at theta = pi/4, grid point 128 of 1024."""
+    A, phase = FC / (K * zeta), np.pi / 4
+    W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 5)
+    assert abs(df_from_harmonics(W, A, phase) - el.describing_function(A)) <= (
+        1e-12 * abs(el.describing_function(A)))
+
+
+# --------------------------------------------------------------------- two-harmonic input
+
+
+@pytest.mark.parametrize("A", [0.01, 0.004, 0.003])
+def test_two_harmonic_input_with_minor_loops_matches_sampled_fft(el, A):
+    """x = A sin(theta) + 0.3 A sin(3 theta + 0.4) reverses six times a period (minor loops)."""
+    phase3 = 0.4
+    X = np.zeros(4, dtype=complex)
+    X[1] = A / 2j
+    X[3] = 0.3 * A * np.exp(1j * phase3) / 2j
+
+    def x_of_theta(th):
+        return A * np.sin(th) + 0.3 * A * np.sin(3 * th + phase3)
+
+    # the input has minor loops: six reversals a period
+    th = np.arange(4096) * (2 * np.pi / 4096)
+    dx = np.diff(x_of_theta(np.append(th, 2 * np.pi)))
+    assert np.count_nonzero(np.sign(dx) != np.sign(np.roll(dx, 1))) == 6
+    assert_allclose(trig_eval(X, th), x_of_theta(th), rtol=0, atol=1e-15)
+
+    W = stop_periodic_harmonics(X, K, FC, H_OUT)
+    W_ref = sampled_harmonics(el, x_of_theta, H_OUT)
+    assert_allclose(W, W_ref, rtol=0, atol=1e-5 * abs(W[1]))
+    # half-wave symmetric input: even harmonics vanish
+    assert np.max(np.abs(W[0::2])) <= 1e-12 * abs(W[1])
+
+
+def test_significant_harmonics():
+    X = np.array([5.0, 1.0, 0.0, 0.5, 1e-20, 0.0], dtype=complex)
+    assert significant_harmonics(X) == 3
+    assert significant_harmonics(np.array([1.0, 0.0, 0.0], dtype=complex)) == 0
