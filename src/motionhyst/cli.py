@@ -7,7 +7,6 @@ JSON.  Every user error ends in one line on stderr and exit code 2.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import sys
@@ -16,6 +15,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+
+from motionhyst.jsonio import dumps
 
 EXIT_USAGE = 2
 
@@ -55,19 +56,8 @@ def nonnegative(text: str) -> float:
     return _number(text, "value", False)
 
 
-def _jsonable(obj):
-    """Replace non-finite floats by None (JSON has no inf or nan)."""
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, float | np.floating) and not math.isfinite(obj):
-        return None
-    return obj
-
-
 def _print_json(obj) -> None:
-    print(json.dumps(_jsonable(obj), indent=2, allow_nan=False))
+    print(dumps(obj))
 
 
 def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

@@ -8,7 +8,6 @@ leaves the previous output as it was.
 
 from __future__ import annotations
 
-import json
 import math
 import shutil
 import sys
@@ -19,6 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from motionhyst import plots
+from motionhyst.jsonio import dumps
 from motionhyst.quasilinear import analyze, loop_mismatch
 from motionhyst.scenario import Scenario
 from motionhyst.steady import periodic_steady_state
@@ -55,16 +55,6 @@ def _fmt(x) -> str:
     if x is None or (isinstance(x, float) and not math.isfinite(x)):
         return "n/a"
     return f"{x:.4g}"
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
 
 
 def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
@@ -153,8 +143,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             fig.savefig(tmp / f"{stem}.pdf")
             written.append(name)
             steps.update()
-        (tmp / "summary.json").write_text(json.dumps(_jsonable(summary), indent=2,
-                                                     allow_nan=False))
+        (tmp / "summary.json").write_text(dumps(summary))
         _write_report(tmp / "report.md", sc, summary, written, is_paper, notes)
         steps.close()
         old = None
