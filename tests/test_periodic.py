@@ -144,6 +144,29 @@ def test_reversal_on_grid_point(el, zeta):
         1e-12 * abs(el.describing_function(A)))
 
 
+def test_reversals_on_every_grid_point(el):
+    """Phases that put the reversals of x on each point of the 1024-point root grid."""
+    A = FC / (K * 0.25)
+    D = el.describing_function(A)
+    worst = 0.0
+    for j in range(1024):
+        phase = np.pi / 2 - 2 * np.pi * j / 1024
+        W = stop_periodic_harmonics(sine_harmonics(A, phase), K, FC, 4)
+        worst = max(worst, abs(df_from_harmonics(W, A, phase) - D) / abs(D),
+                    float(np.max(np.abs(W[0::2])) / abs(W[1])))
+    assert worst <= 1e-12
+
+
+@pytest.mark.parametrize("zeta", [1.0 - 1e-13, 1.0 - 1e-15])
+def test_closed_form_near_zeta_one(el, zeta):
+    A = FC / (K * zeta)
+    W = stop_periodic_harmonics(sine_harmonics(A), K, FC, 3)
+    D_exact = df_from_harmonics(W, A, 0.0)
+    # the exact harmonics are right: D -> k with Im D = (4 / pi) k zeta (1 - zeta) -> 0
+    assert abs(D_exact - K) <= 1e-12 * K
+    assert abs(el.describing_function(A) - D_exact) <= 1e-12 * abs(D_exact)
+
+
 # --------------------------------------------------------------------- two-harmonic input
 
 

@@ -150,7 +150,13 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         if out_dir.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
             out_dir.rename(old / out_dir.name)
-        tmp.rename(out_dir)
+        try:
+            tmp.rename(out_dir)
+        except BaseException:
+            if old is not None:  # put the previous output back
+                (old / out_dir.name).rename(out_dir)
+                shutil.rmtree(old, ignore_errors=True)
+            raise
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
     except BaseException:

@@ -24,7 +24,8 @@ def _real_part_bracket(zeta: NDArray[np.float64]) -> NDArray[np.float64]:
     `zeta` its terms cancel, so a series is used there.
     """
     s = np.sqrt(zeta)
-    direct = np.arcsin(s) - s * (1.0 - 2.0 * zeta) * np.sqrt(1.0 - zeta)
+    c = np.sqrt(1.0 - zeta)
+    direct = np.arctan2(s, c) - s * (1.0 - 2.0 * zeta) * c  # arctan2: well conditioned at 1
     series = s**3 * np.polynomial.polynomial.polyval(zeta, _SMALL_ZETA_SERIES)
     return np.where(zeta < _SMALL_ZETA, series, direct)
 

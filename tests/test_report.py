@@ -1,0 +1,302 @@
+"""Tests of ``motionhyst reproduce`` (report.py) and the paper's figures (plots.py)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+from numpy.testing import assert_allclose
+
+from motionhyst import plots, report
+from motionhyst.quasilinear import analyze, loop_mismatch, mismatch_asymptote
+from motionhyst.scenario import default_scenario
+from motionhyst.steady import periodic_steady_state
+from motionhyst.systems import freqresp
+
+FIGURES = [f"fig{i}" for i in range(5, 12)]
+A_REF = 0.01
+FREQS = [5.0, 10.0, 15.0]
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return default_scenario()
+
+
+@pytest.fixture(scope="module")
+def loop(scenario):
+    return scenario.loop()
+
+
+@pytest.fixture(scope="module")
+def el(loop):
+    return loop.hysteresis
+
+
+@pytest.fixture(scope="module")
+def states(loop):
+    return [periodic_steady_state(loop, A_REF, f) for f in FREQS]
+
+
+@pytest.fixture(scope="module")
+def analysis(loop):
+    return analyze(loop, A_REF, FREQS)
+
+
+@pytest.fixture(scope="module")
+def reproduced(tmp_path_factory):
+    out = tmp_path_factory.mktemp("reproduce") / "out"
+    out.mkdir()
+    (out / "stale.txt").write_text("from an earlier run")  # replaced as a whole
+    summary = report.reproduce(default_scenario(), out, quiet=True, is_paper=True)
+    return out, summary
+
+
+# ------------------------------------------------------------------------------ reproduce
+
+
+def test_reproduce_writes_all_files(reproduced):
+    out, _ = reproduced
+    expected = {f"{n}.{ext}" for n in FIGURES for ext in ("png", "pdf")}
+    expected |= {"summary.json", "report.md"}
+    assert {p.name for p in out.iterdir()} == expected
+    for name in expected:
+        assert (out / name).stat().st_size > 0
+    for n in FIGURES:
+        assert (out / f"{n}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert (out / f"{n}.pdf").read_bytes()[:5] == b"%PDF-"
+    # nothing left behind next to the output
+    assert [p.name for p in out.parent.iterdir()] == ["out"]
+
+
+def test_summary_json(reproduced, loop, states):
+    out, summary = reproduced
+    data = json.loads((out / "summary.json").read_text())
+    assert set(data) >= {"scenario", "analyze", "simulate"}
+    assert data == json.loads(json.dumps(summary))
+    a = data["analyze"]
+    assert a["zeta"] == pytest.approx(0.25, rel=1e-12)
+    assert a["df_abs_over_k"] == pytest.approx(0.3086, abs=5e-5)
+    assert a["df_phase_deg"] == pytest.approx(50.69, abs=0.01)
+    assert a["f_star_hz"] == pytest.approx(0.150, abs=5e-4)
+    assert a["mismatch_crossover_hz"] == pytest.approx(7.6, abs=0.01)
+    assert a["bandwidth_hz"] == pytest.approx(120.0, rel=0.01)
+    assert [m["frequency_hz"] for m in a["mismatch"]] == FREQS
+    points = data["simulate"]["points"]
+    assert [p["frequency_hz"] for p in points] == FREQS
+    E_df = loop_mismatch(loop, FREQS, A_REF)
+    for p, ss, e in zip(points, states, E_df, strict=True):
+        assert p["mismatch_df_abs"] == pytest.approx(abs(e), rel=1e-12)
+        assert p["mismatch_df_phase_deg"] == pytest.approx(np.degrees(np.angle(e)), abs=1e-9)
+        assert p["mismatch_simulated_abs"] == pytest.approx(abs(ss.mismatch), rel=1e-10)
+        # the paper's claim: describing function within 1 % and 1 deg of the exact result
+        assert p["mismatch_simulated_abs"] == pytest.approx(p["mismatch_df_abs"], rel=0.01)
+        assert p["mismatch_simulated_phase_deg"] == pytest.approx(p["mismatch_df_phase_deg"],
+                                                                  abs=1.0)
+        assert p["error_harmonics"][0]["abs"] == pytest.approx(abs(ss.e[1]), rel=1e-10)
+        assert p["error_rms"] == pytest.approx(ss.error_rms, rel=1e-10)
+        assert p["y1_amplitude"] == pytest.approx(abs(ss.y1[1]), rel=1e-10)
+
+
+def test_report_markdown(reproduced):
+    out, _ = reproduced
+    text = (out / "report.md").read_text()
+    assert "## Paper vs computed" in text
+    lines = text.splitlines()
+    zeta_row = next(ln for ln in lines if ln.startswith("| zeta |"))
+    assert zeta_row.split("|")[2:4] == [" 0.25 ", " 0.25 "]
+    cross_row = next(ln for ln in lines if ln.startswith("| crossover (eq. 21) |"))
+    assert "7.6 Hz" in cross_row and "7.607 Hz" in cross_row
+    assert "| 0.3086 |" in text
+    for n in FIGURES:
+        assert f"![{n}]({n}.png)" in text
+    # one row per reference frequency in the mismatch table
+    assert sum(ln.startswith(("| 5 |", "| 10 |", "| 15 |")) for ln in lines) == 3
+
+
+def test_reproduce_replaced_previous_output(reproduced):
+    out, _ = reproduced
+    assert not (out / "stale.txt").exists()
+
+
+def test_report_without_paper_column(reproduced, scenario, tmp_path):
+    _, summary = reproduced
+    path = tmp_path / "report.md"
+    report._write_report(path, scenario, summary, ["fig5"], is_paper=False, notes=["a note"])
+    text = path.read_text()
+    assert "## Key numbers" in text and "Paper vs computed" not in text
+    assert "| quantity | computed |" in text
+    assert "- a note" in text
+
+
+def test_reproduce_failure_leaves_previous_output(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "marker.txt").write_text("previous run")
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("fig9 failed")
+
+    monkeypatch.setattr(plots, "fig9_quasilinear_plant", broken)
+    sc = default_scenario()
+    sc.model.reference.frequencies = [10.0]
+    with pytest.raises(RuntimeError, match="fig9 failed"):
+        report.reproduce(sc, out, quiet=True)
+    assert [p.name for p in out.iterdir()] == ["marker.txt"]
+    assert (out / "marker.txt").read_text() == "previous run"
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no temporary folders remain
+
+
+def test_reproduce_failure_in_final_move_leaves_previous_output(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "marker.txt").write_text("previous run")
+    for name in FIGURES:  # figures are not the point here: draw empty ones
+        attr = next(a for a in dir(plots) if a.startswith(f"{name}_"))
+        monkeypatch.setattr(plots, attr, lambda *args, **kwargs: Figure())
+    rename = Path.rename
+
+    def failing_rename(self, target):
+        # only the move of the new output (the ".out.*" temporary folder) fails
+        if Path(target) == out and self.name.startswith(".out.") and \
+                not self.name.startswith(".out.old"):
+            raise OSError(28, "No space left on device")
+        return rename(self, target)
+
+    monkeypatch.setattr(Path, "rename", failing_rename)
+    sc = default_scenario()
+    sc.model.reference.frequencies = [10.0]
+    with pytest.raises(OSError, match="No space"):
+        report.reproduce(sc, out, quiet=True)
+    monkeypatch.undo()
+    assert (out / "marker.txt").read_text() == "previous run"
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+# -------------------------------------------------------------------------------- figures
+
+
+def test_fig5_loops_bounded_by_fc(el):
+    fig = plots.fig5_loops(el)
+    assert isinstance(fig, Figure)
+    data = fig.motionhyst_data
+    assert set(data) == {"zeta=0.25", "zeta=0.5", "zeta=0.75", "zeta=1.25"}
+    for key, xw in data.items():
+        zeta = float(key.split("=")[1])
+        x, w = xw
+        assert np.max(np.abs(w)) <= el.fc
+        assert np.max(np.abs(x)) == pytest.approx(el.fc / (el.k * zeta), rel=1e-6)
+        if zeta < 1:
+            assert np.max(np.abs(w)) == pytest.approx(el.fc)  # slips
+        else:
+            assert_allclose(w, el.k * x, rtol=0, atol=1e-15)  # a spring, never slips
+
+
+def test_fig6_modes(el):
+    data = plots.fig6_modes(el).motionhyst_data
+    # stick-to-slip onsets: x w <= 0 in mode 2, x w > 0 in mode 3 (paper section III-A)
+    x2, w2 = data["mode2_onsets"]
+    x3, w3 = data["mode3_onsets"]
+    assert len(x2) == len(x3) == 2
+    assert np.all(x2 * w2 <= 0)
+    assert np.all(x3 * w3 > 0)
+    assert_allclose(np.abs(w2), el.fc)
+
+
+def test_fig7_first_harmonic(el):
+    fig = plots.fig7_time(el, A_REF, 5.0)
+    data = fig.motionhyst_data
+    t, w, w1 = data["t"], data["w"], data["w_first_harmonic"]
+    assert t[-1] == pytest.approx(0.2)
+    D = el.describing_function(A_REF)
+    assert np.max(np.abs(w1)) == pytest.approx(A_REF * abs(D), rel=1e-5)
+    # w1 is the first Fourier harmonic of w (one period, endpoint repeated)
+    n = len(t) - 1
+    c1 = 2 * np.fft.rfft(w[:-1])[1] / n
+    assert abs(1j * c1) == pytest.approx(A_REF * abs(D), rel=1e-3)
+    assert np.all(np.abs(w[data["slip"]]) == pytest.approx(el.fc))
+
+
+def test_fig8_describing_function(el):
+    data = plots.fig8_describing_function(el).motionhyst_data
+    z = data["zeta"]
+    assert z[0] == pytest.approx(1e-3) and z[-1] == pytest.approx(10.0)
+    assert np.interp(np.log(0.25), np.log(z), data["abs_over_k"]) == pytest.approx(0.3086,
+                                                                                   abs=2e-4)
+    assert np.interp(np.log(0.25), np.log(z), data["phase_deg"]) == pytest.approx(50.69,
+                                                                                  abs=0.05)
+    # exact values on a grid through zeta = 0.25
+    exact = plots.fig8_describing_function(el, zeta_range=(0.25, 4.0)).motionhyst_data
+    assert exact["zeta"][0] == 0.25
+    assert exact["abs_over_k"][0] == pytest.approx(0.30857, abs=1e-5)
+    assert np.all(data["abs_over_k"] <= 1 + 1e-15)  # |D| <= k
+    assert_allclose(data["abs_over_k"][z >= 1], 1.0, rtol=1e-15)
+    assert_allclose(data["phase_deg"][z >= 1], 0.0, atol=1e-12)
+    # eq. (11): the phase tends to 90 deg; for small zeta Re D / Im D = (4 / 3) sqrt(zeta)
+    assert data["phase_deg"][0] == pytest.approx(
+        90.0 - np.degrees(np.arctan(4 / 3 * np.sqrt(1e-3))), abs=0.01)
+
+
+def test_fig9_quasilinear_plant(loop, el):
+    fig = plots.fig9_quasilinear_plant(loop, f_star_hz=0.15)
+    data = fig.motionhyst_data
+    f = data["f"]
+    w = 2 * np.pi * f
+    P1, P2 = freqresp(loop.P1, w), freqresp(loop.P2, w)
+    assert_allclose(data["P2"], P2, rtol=1e-12)
+    for z in (0.01, 0.25, 1.0):
+        D = el.describing_function(el.fc / (el.k * z))
+        assert_allclose(data[f"zeta={z:g}"], P2 / (1 + D * P1), rtol=1e-12)
+    # above f* the quasi-linear plant is the floating mass P2 (Remark 1)
+    hi = f > 10 * 0.15
+    assert_allclose(np.abs(data["zeta=1"][hi]), np.abs(P2[hi]), rtol=0.02)
+
+
+def test_fig10_mismatch(loop, analysis, states):
+    fig = plots.fig10_mismatch(loop, analysis, states)
+    data = fig.motionhyst_data
+    f = data["f"]
+    assert_allclose(data["E"], loop_mismatch(loop, f, A_REF), rtol=1e-12)
+    w = 2 * np.pi * f
+    Pr = 1.0 / (loop.M * (1j * w) ** 2)
+    Et = mismatch_asymptote(Pr, freqresp(loop.plant.Pf2, w), analysis.D)
+    assert_allclose(data["asymptote"], Et, rtol=1e-12)
+    assert_allclose(data["f_exact"], FREQS)
+    assert_allclose(data["E_exact"], [abs(s.mismatch) for s in states], rtol=1e-14)
+    # the asymptote crosses 1 at eq. (21)
+    i = np.argmin(np.abs(np.log(np.abs(Et))))
+    assert f[i] == pytest.approx(analysis.crossover_hz, rel=0.01)
+    # without exact points no markers
+    assert "E_exact" not in plots.fig10_mismatch(loop, analysis).motionhyst_data
+
+
+def test_fig11_errors(loop, states):
+    E_df = loop_mismatch(loop, FREQS, A_REF)
+    fig = plots.fig11_errors(states, E_df)
+    assert len(fig.axes) == len(states)
+    data = fig.motionhyst_data
+    for ss, E in zip(states, E_df, strict=True):
+        t, e, e_lin, e_df = data[f"f={ss.frequency_hz:g}"]
+        ts = ss.time_series()
+        assert_allclose(t, ts["t"], rtol=0, atol=0)
+        assert_allclose(e, ts["e"], rtol=0, atol=0)
+        assert_allclose(e_lin, ts["e_linear"], rtol=0, atol=0)
+        e1 = E * ss.e_linear[1]
+        assert_allclose(e_df, abs(e1) * np.sin(2 * np.pi * ss.frequency_hz * t + np.angle(e1)),
+                        rtol=0, atol=1e-12 * abs(e1))
+        # the describing-function estimate is close to the exact first harmonic
+        assert abs(e1 - ss.e[1]) < 0.01 * abs(ss.e[1])
+
+
+def test_figures_from_reproduce_match_functions(reproduced, loop, el, analysis, states):
+    """reproduce draws each figure once: the functions it calls return Figures."""
+    makers = [plots.fig5_loops(el), plots.fig6_modes(el), plots.fig7_time(el, A_REF, 5.0),
+              plots.fig8_describing_function(el), plots.fig9_quasilinear_plant(loop),
+              plots.fig10_mismatch(loop, analysis, states),
+              plots.fig11_errors(states, loop_mismatch(loop, FREQS, A_REF))]
+    for fig in makers:
+        assert isinstance(fig, Figure)
+        assert fig.motionhyst_data
