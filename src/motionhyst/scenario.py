@@ -17,7 +17,7 @@ from typing import Annotated, Literal
 import control
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from motionhyst.hysteresis import Hysteresis, Jenkins
+from motionhyst.hysteresis import Hysteresis, Jenkins, MaxwellSlip
 from motionhyst.loop import Loop
 from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
 
@@ -67,6 +67,24 @@ class JenkinsSection(_Section):
     model: Literal["jenkins"]
     k: PositiveFloat
     fc: PositiveFloat
+
+
+class MaxwellSlipSection(_Section):
+    """``[hysteresis] model = "maxwell-slip"``: parallel Jenkins elements."""
+
+    model: Literal["maxwell-slip"]
+    k: Annotated[list[PositiveFloat], Field(min_length=1)]
+    fc: Annotated[list[PositiveFloat], Field(min_length=1)]
+
+    @model_validator(mode="after")
+    def _same_length(self):
+        if len(self.k) != len(self.fc):
+            raise ValueError(f"k and fc must have the same length ({len(self.k)} != "
+                             f"{len(self.fc)})")
+        return self
+
+
+HysteresisSection = Annotated[JenkinsSection | MaxwellSlipSection, Field(discriminator="model")]
 
 
 class LeadLagSection(_Section):
@@ -119,7 +137,7 @@ class ScenarioModel(_Section):
 
     stage: StageSection | None = None
     plant: PlantSection | None = None
-    hysteresis: JenkinsSection
+    hysteresis: HysteresisSection
     controller: Annotated[LeadLagSection | TransferFunctionSection,
                           Field(discriminator="type")]
     feedforward: FeedforwardSection = FeedforwardSection()
@@ -132,7 +150,14 @@ class ScenarioModel(_Section):
         return self
 
 
-_UNION_TAGS = {"leadlag-lowpass", "tf", "jenkins"}
+_UNION_TAGS = {"leadlag-lowpass", "tf", "jenkins", "maxwell-slip"}
+
+
+def build_hysteresis(section) -> Hysteresis:
+    """The hysteresis model a validated ``[hysteresis]`` section describes."""
+    if section.model == "jenkins":
+        return Jenkins(section.k, section.fc)
+    return MaxwellSlip(section.k, section.fc)
 
 
 def _format_error(source: str, err: ValidationError) -> str:
@@ -224,8 +249,7 @@ class Scenario:
 
     def hysteresis(self) -> Hysteresis:
         """The dynamic link's hysteresis model."""
-        h = self.model.hysteresis
-        return Jenkins(h.k, h.fc)
+        return build_hysteresis(self.model.hysteresis)
 
     def controller(self) -> control.TransferFunction:
         """The feedback controller."""

@@ -2,5 +2,6 @@
 
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.hysteresis.jenkins import Jenkins, jenkins_describing_function
+from motionhyst.hysteresis.maxwell import MaxwellSlip
 
-__all__ = ["Hysteresis", "Jenkins", "jenkins_describing_function"]
+__all__ = ["Hysteresis", "Jenkins", "MaxwellSlip", "jenkins_describing_function"]

@@ -71,8 +71,8 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary, with key ``model``."""
 
-    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int
-                           ) -> NDArray[np.complex128]:
+    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
+                           omega: float | None = None) -> NDArray[np.complex128]:
         """Harmonics of the periodic output for a periodic input.
 
         Parameters
@@ -82,6 +82,8 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
             ``x(theta) = X_0 + 2 Re sum X_m exp(j m theta)`` (``rfft / N`` scaling).
         n_harmonics : int
             Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency of the period [rad/s]; used by rate-dependent elements.
 
         Returns
         -------
@@ -98,6 +100,42 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
         xs = np.concatenate([x, x, x, x[:1]])
         w = self.response(xs)[2 * N: 3 * N]
         return (np.fft.rfft(w) / N)[: H + 1]
+
+    def hosidf(self, A: ArrayLike, n_max: int, omega: float | None = None
+               ) -> NDArray[np.complex128]:
+        """Higher-order sinusoidal-input describing functions ``H_n(A) = Y_n / A``.
+
+        ``Y_n`` is the complex amplitude of the output's n-th harmonic relative
+        to ``sin(n omega t)`` for the input ``x = A sin(omega t)``; ``H_1`` is
+        the describing function.  Computed from the exact periodic output.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], > 0.
+        n_max : int
+            Highest harmonic, >= 1.
+        omega : float, optional
+            Angular frequency [rad/s] for rate-dependent elements.
+
+        Returns
+        -------
+        ndarray of complex, shape ``A.shape + (n_max,)``
+            ``H_1 .. H_n_max`` [N/m].
+        """
+        a = check_amplitudes(A)
+        n_max = int(n_max)
+        if n_max < 1:
+            raise ValueError("n_max must be >= 1")
+        out = np.empty((*a.shape, n_max), dtype=complex)
+        for idx, amp in np.ndenumerate(a):
+            if amp == 0:
+                out[idx] = 0.0
+                out[(*idx, 0)] = self.initial_stiffness
+                continue
+            W = self.periodic_harmonics(np.array([0.0, amp / 2j]), n_max, omega)
+            out[idx] = 2j * W[1:] / amp
+        return out
 
     def reset(self, w: float = 0.0) -> None:
         """Reset the state used by :meth:`__call__` (force `w`, last input unknown)."""

@@ -157,12 +157,56 @@ class Jenkins(Hysteresis):
             raise ValueError(f"|w0| must be <= fc = {self.fc}, got {w0}")
         return stop_response(xs, self.k, self.fc, float(w0))
 
-    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int
-                           ) -> NDArray[np.complex128]:
+    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
+                           omega: float | None = None) -> NDArray[np.complex128]:
         """Exact harmonics of the periodic output (see :mod:`motionhyst.hysteresis.periodic`)."""
         from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 
         return stop_periodic_harmonics(np.asarray(X, dtype=complex), self.k, self.fc, n_harmonics)
+
+    def hosidf_closed_form(self, A: ArrayLike, n_max: int) -> NDArray[np.complex128]:
+        """Higher-order describing functions ``H_n(A)``, n = 1 .. n_max, in closed form.
+
+        For ``x = A sin(theta)`` and ``zeta < 1`` the periodic output is, from
+        the maximum at ``theta = pi/2``: a spring ``fc - k A (1 - sin theta)``
+        until ``theta_1 = pi - arcsin(1 - 2 zeta)`` (eq. 6), slip at ``-fc``
+        until ``3 pi / 2``, a spring ``-fc + k A (1 + sin theta)`` until
+        ``theta_3 = 2 pi - arcsin(1 - 2 zeta)``, and slip at ``+fc``.  Each piece
+        is integrated against ``exp(-j n theta)`` exactly; ``H_1`` is eq. (10).
+        Even harmonics are zero (half-wave symmetry); ``zeta >= 1`` gives
+        ``H_1 = k`` only.
+
+        Returns
+        -------
+        ndarray of complex, shape ``A.shape + (n_max,)`` [N/m]
+        """
+        a = check_amplitudes(A)
+        n = np.arange(1, int(n_max) + 1)
+        if n.size == 0:
+            raise ValueError("n_max must be >= 1")
+        with np.errstate(divide="ignore", over="ignore"):
+            zeta = self.fc / (self.k * a)
+        z = np.clip(zeta, 0.0, 1.0)[..., None]
+        kA = (self.k * a)[..., None]
+        asn = np.arcsin(np.clip(1.0 - 2.0 * z, -1.0, 1.0))
+        t0, t1, t2 = np.pi / 2, np.pi - asn, 1.5 * np.pi
+        t3, t4 = 2 * np.pi - asn, 2.5 * np.pi
+
+        def E(q, lo, hi):  # int_lo^hi exp(-j q theta) d theta, q integer
+            q = np.broadcast_to(q, np.broadcast_shapes(np.shape(q), np.shape(lo)))
+            safe = np.where(q == 0, 1, q)
+            val = (np.exp(-1j * safe * lo) - np.exp(-1j * safe * hi)) / (1j * safe)
+            return np.where(q == 0, hi - lo, val)
+
+        def S(lo, hi):  # int sin(theta) exp(-j n theta)
+            return (E(n - 1, lo, hi) - E(n + 1, lo, hi)) / 2j
+
+        fc = self.fc
+        total = ((fc - kA) * E(n, t0, t1) + kA * S(t0, t1) - fc * E(n, t1, t2)
+                 + (kA - fc) * E(n, t2, t3) + kA * S(t2, t3) + fc * E(n, t3, t4))
+        H = 1j * total / (np.pi * a[..., None])
+        linear = np.where(n == 1, self.k + 0j, 0j)
+        return np.where((zeta >= 1.0)[..., None], linear, H)
 
     def ode_rhs(self, w: ArrayLike, xdot: ArrayLike):
         """Right-hand side ``dw/dt`` of the differential form, paper eq. (3).

@@ -1,0 +1,118 @@
+"""Maxwell-slip element: Jenkins elements in parallel (a Prandtl-Ishlinskii structure).
+
+A cable slab slips in many places at different forces; parallel Jenkins
+elements ``(k_i, fc_i)`` capture that.  Every property is the sum of the
+elements': the force, the describing function (eq. 10 per element), the
+higher-order describing functions and the exact periodic output.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
+from motionhyst.hysteresis.jenkins import Jenkins, jenkins_describing_function
+
+
+class MaxwellSlip(Hysteresis):
+    """Parallel Jenkins elements with stiffnesses `k` and slip forces `fc`.
+
+    Parameters
+    ----------
+    k : array_like
+        Spring stiffnesses ``k_i`` [N/m], each > 0.
+    fc : array_like
+        Slip forces ``fc_i`` [N], each > 0, same length as `k`.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import MaxwellSlip
+    >>> link = MaxwellSlip(k=[1.0, 2.0], fc=[1.0, 0.5])
+    >>> link.initial_stiffness
+    3.0
+    """
+
+    name = "maxwell-slip"
+    rate_independent = True
+
+    def __init__(self, k: ArrayLike, fc: ArrayLike) -> None:
+        super().__init__()
+        k_arr = np.atleast_1d(np.asarray(k, dtype=float))
+        fc_arr = np.atleast_1d(np.asarray(fc, dtype=float))
+        if k_arr.ndim != 1 or k_arr.size == 0:
+            raise ValueError("k must be a non-empty list")
+        if k_arr.shape != fc_arr.shape:
+            raise ValueError(f"k and fc must have the same length ({k_arr.size} != "
+                             f"{fc_arr.size})")
+        for i, (ki, fi) in enumerate(zip(k_arr, fc_arr, strict=True)):
+            check_positive(f"k[{i}]", ki)
+            check_positive(f"fc[{i}]", fi)
+        self.k = k_arr
+        self.fc = fc_arr
+        self.elements = [Jenkins(ki, fi) for ki, fi in zip(k_arr, fc_arr, strict=True)]
+        self.reset()
+
+    def __repr__(self) -> str:
+        return f"MaxwellSlip(k={self.k.tolist()!r}, fc={self.fc.tolist()!r})"
+
+    @property
+    def initial_stiffness(self) -> float:
+        """Sum of the spring stiffnesses [N/m]."""
+        return float(self.k.sum())
+
+    @property
+    def slip_force(self) -> float:
+        """Force when every element slips, ``sum fc_i`` [N]."""
+        return float(self.fc.sum())
+
+    def stop_parameters(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Stiffnesses and slip forces of the parallel stop operators."""
+        return self.k.copy(), self.fc.copy()
+
+    def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
+        """Sum of the elements' closed-form describing functions (eq. 10) [N/m]."""
+        a = check_amplitudes(A)
+        with np.errstate(divide="ignore", over="ignore"):
+            zeta = self.fc / (self.k * a[..., None])
+        d = jenkins_describing_function(1.0, zeta) @ self.k.astype(complex)
+        if omega is not None:
+            d = np.broadcast_to(d, np.broadcast_shapes(d.shape, np.shape(omega))).copy()
+        return complex(d) if d.ndim == 0 else d
+
+    def hosidf_closed_form(self, A: ArrayLike, n_max: int) -> NDArray[np.complex128]:
+        """Sum of the elements' closed-form higher-order describing functions [N/m]."""
+        return sum(el.hosidf_closed_form(A, n_max) for el in self.elements)
+
+    def response(self, x: ArrayLike, w0: ArrayLike = 0.0) -> NDArray[np.float64]:
+        """Total force for a sampled displacement; `w0` is the initial force per element."""
+        from motionhyst.hysteresis._kernels import maxwell_response
+
+        xs = np.ascontiguousarray(x, dtype=float)
+        if xs.ndim != 1:
+            raise ValueError("x must be one-dimensional")
+        if not np.all(np.isfinite(xs)):
+            raise ValueError("x must be finite")
+        w0s = np.broadcast_to(np.asarray(w0, dtype=float), self.k.shape).copy()
+        if not np.all(np.abs(w0s) <= self.fc):
+            raise ValueError("each initial force must satisfy |w0_i| <= fc_i")
+        return maxwell_response(xs, self.k, self.fc, w0s).sum(axis=1)
+
+    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
+                           omega: float | None = None) -> NDArray[np.complex128]:
+        """Exact harmonics of the periodic output: the sum of the elements'."""
+        return sum(el.periodic_harmonics(X, n_harmonics) for el in self.elements)
+
+    def __call__(self, x: float) -> float:
+        """Advance every element by one displacement sample (python-control interface)."""
+        return float(sum(el(x) for el in self.elements))
+
+    def reset(self, w: float = 0.0) -> None:
+        """Reset the elements' state (the force `w` is shared in proportion to fc)."""
+        share = np.asarray(self.fc) / np.sum(self.fc)
+        for el, s in zip(getattr(self, "elements", []), share, strict=False):
+            el.reset(w * s)
+
+    def to_dict(self) -> dict:
+        """Parameters as a JSON-ready dictionary."""
+        return {"model": self.name, "k": self.k.tolist(), "fc": self.fc.tolist()}
