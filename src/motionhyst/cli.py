@@ -56,6 +56,17 @@ def nonnegative(text: str) -> float:
     return _number(text, "value", False)
 
 
+def _harmonic_count(text: str) -> int:
+    """argparse type: a whole number of harmonics from 1 to 1000."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 1 <= n <= 1000:
+        raise argparse.ArgumentTypeError(f"must be from 1 to 1000, got {text!r}")
+    return n
+
+
 def _print_json(obj) -> None:
     print(dumps(obj))
 
@@ -74,28 +85,69 @@ def _g(x: float, digits: int = 4) -> str:
 
 
 # ---------------------------------------------------------------------------- df
-def cmd_df(args: argparse.Namespace) -> int:
-    """Describing function of a hysteresis element at given amplitudes."""
-    from motionhyst.hysteresis import Jenkins
+def _element_from_args(args: argparse.Namespace):
+    """The hysteresis element named by ``--model`` and its parameter options."""
+    from motionhyst.scenario import ScenarioError, hysteresis_from_dict
 
-    el = Jenkins(args.k, args.fc)
+    params: dict = {"model": args.model}
+    for name in ("k", "fc"):
+        values = getattr(args, name)
+        if values is None:
+            raise UsageError(f"motionhyst df: --{name} is required for --model {args.model}")
+        if args.model == "jenkins":
+            if len(values) != 1:
+                raise UsageError(f"motionhyst df: --{name} takes one value for --model jenkins "
+                                 f"(use --model maxwell-slip for several)")
+            params[name] = values[0]
+        else:
+            params[name] = list(values)
+    try:
+        return hysteresis_from_dict(params, source="motionhyst df")
+    except ScenarioError as exc:
+        msg = str(exc).replace("[hysteresis]: ", "").replace("[hysteresis] ", "--")
+        raise UsageError(msg) from None
+
+
+def cmd_df(args: argparse.Namespace) -> int:
+    """Describing function (and higher harmonics) of a hysteresis element."""
+    el = _element_from_args(args)
     A = np.asarray(args.amplitude, dtype=float)
     D = np.atleast_1d(el.describing_function(A))
-    zeta = np.atleast_1d(el.zeta(A))
+    zeta = np.atleast_1d(el.zeta(A)) if hasattr(el, "zeta") else np.full(A.shape, np.nan)
     points = [{"amplitude": float(a), "zeta": float(z), "re": float(d.real),
                "im": float(d.imag), "abs": float(abs(d)),
                "phase_deg": float(np.degrees(np.angle(d)))}
               for a, z, d in zip(A, zeta, D, strict=True)]
+    if args.harmonics:
+        H = el.hosidf(A, args.harmonics)
+        for p, h in zip(points, H, strict=True):
+            p["harmonics"] = [{"n": n, "re": float(c.real), "im": float(c.imag),
+                               "abs_over_amplitude": float(abs(c)),
+                               "phase_deg": float(np.degrees(np.angle(c)))}
+                              for n, c in enumerate(h, start=1)]
     result = {**el.to_dict(), "points": points}
     if args.json:
         _print_json(result)
         return 0
-    print(f"Describing function of the Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N "
-          f"(paper eq. 10)")
+    k0 = el.initial_stiffness
+    units = {"k": "N/m", "fc": "N"}
+
+    def show(v):
+        return ", ".join(f"{x:g}" for x in v) if isinstance(v, list) else f"{v:g}"
+
+    params = ", ".join(f"{k} = {show(v)} {units.get(k, '')}".rstrip()
+                       for k, v in el.to_dict().items() if k != "model")
+    print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 10)")
     rows = [[_g(p["amplitude"]), _g(p["zeta"]), _g(p["re"]), _g(p["im"]), _g(p["abs"]),
-             _g(p["abs"] / el.k), f"{p['phase_deg']:.2f}"] for p in points]
+             _g(p["abs"] / k0), f"{p['phase_deg']:.2f}"] for p in points]
     print(_table(["A [m]", "zeta [-]", "Re D [N/m]", "Im D [N/m]", "|D| [N/m]", "|D|/k [-]",
                   "angle D [deg]"], rows))
+    if args.harmonics:
+        print()
+        print("Higher-order describing functions H_n = Y_n / A [N/m], relative to sin(n w t)")
+        rows = [[_g(p["amplitude"]), str(h["n"]), _g(h["abs_over_amplitude"]),
+                 f"{h['phase_deg']:.2f}"] for p in points for h in p["harmonics"]]
+        print(_table(["A [m]", "n", "|H_n| [N/m]", "angle H_n [deg]"], rows))
     return 0
 
 
@@ -229,10 +281,16 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     q = sub.add_parser("df", help="describing function of a hysteresis element")
-    q.add_argument("--k", type=positive, required=True, help="spring stiffness k_J [N/m]")
-    q.add_argument("--fc", type=positive, required=True, help="slip force f_c [N]")
+    q.add_argument("--model", choices=["jenkins", "maxwell-slip"], default="jenkins",
+                   help="hysteresis model (default: jenkins)")
+    q.add_argument("--k", type=positive, nargs="+",
+                   help="spring stiffness k_J [N/m] (one per element for maxwell-slip)")
+    q.add_argument("--fc", type=positive, nargs="+",
+                   help="slip force f_c [N] (one per element for maxwell-slip)")
     q.add_argument("--amplitude", type=nonnegative, nargs="+", required=True,
                    help="input amplitude(s) A [m]")
+    q.add_argument("--harmonics", type=_harmonic_count, metavar="N",
+                   help="also the higher-order describing functions H_1 .. H_N")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=cmd_df)
 
@@ -276,6 +334,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         return args.func(args)
+    except BrokenPipeError:  # output piped into head, say: not an error
+        sys.stdout = open(os.devnull, "w")
+        return 0
     except UsageError as exc:
         print(f"error: {exc}", file=sys.stderr)
     except (ValueError, OSError, RuntimeError) as exc:

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import control
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
 from motionhyst.hysteresis import Hysteresis, Jenkins, MaxwellSlip
 from motionhyst.loop import Loop
@@ -160,10 +160,22 @@ def build_hysteresis(section) -> Hysteresis:
     return MaxwellSlip(section.k, section.fc)
 
 
-def _format_error(source: str, err: ValidationError) -> str:
+_HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection)
+
+
+def hysteresis_from_dict(data: dict, source: str = "<dict>") -> Hysteresis:
+    """Validate a ``[hysteresis]`` table and build the model; raises :class:`ScenarioError`."""
+    try:
+        section = _HYSTERESIS_ADAPTER.validate_python(data)
+    except ValidationError as err:
+        raise ScenarioError(_format_error(source, err, prefix=("hysteresis",))) from None
+    return build_hysteresis(section)
+
+
+def _format_error(source: str, err: ValidationError, prefix: tuple = ()) -> str:
     """One line naming the file, the section and key, and the problem."""
     e = err.errors()[0]
-    loc = [p for p in e["loc"] if not (isinstance(p, str) and p in _UNION_TAGS)]
+    loc = [p for p in (*prefix, *e["loc"]) if not (isinstance(p, str) and p in _UNION_TAGS)]
     key = ""
     for p in loc[1:]:
         key += f"[{p}]" if isinstance(p, int) else (f".{p}" if key else str(p))

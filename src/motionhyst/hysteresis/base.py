@@ -134,7 +134,9 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
                 out[(*idx, 0)] = self.initial_stiffness
                 continue
             W = self.periodic_harmonics(np.array([0.0, amp / 2j]), n_max, omega)
-            out[idx] = 2j * W[1:] / amp
+            h = 2j * W[1:] / amp
+            h[np.abs(h) <= 1e-13 * np.max(np.abs(h))] = 0.0  # round-off, e.g. even harmonics
+            out[idx] = h
         return out
 
     def reset(self, w: float = 0.0) -> None:
