@@ -203,13 +203,16 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     rows = []
     for p in points:
         h = {x["n"]: x for x in p["error_harmonics"]}
+        hd = {x["n"]: x for x in p["error_harmonics_df"]}
         rows.append([_g(p["frequency_hz"]), _g(h[1]["abs"]), f"{h[1]['phase_deg']:.1f}",
-                     _g(h[3]["abs"]) if 3 in h else "-", _g(h[5]["abs"]) if 5 in h else "-",
+                     _g(h[3]["abs"]) if 3 in h else "-", _g(hd[3]["abs"]) if 3 in hd else "-",
+                     _g(h[5]["abs"]) if 5 in h else "-", _g(hd[5]["abs"]) if 5 in hd else "-",
                      _g(p["error_linear_abs"]), _g(p["mismatch_simulated_abs"]),
                      f"{p['mismatch_simulated_phase_deg']:.2f}", _g(p["mismatch_df_abs"]),
                      f"{p['mismatch_df_phase_deg']:.2f}", _g(p["error_peak"]),
                      _g(p["error_hysteresis_rms"])])
-    print(_table(["f [Hz]", "|e1| [m]", "angle e1 [deg]", "|e3| [m]", "|e5| [m]",
+    print(_table(["f [Hz]", "|e1| [m]", "angle e1 [deg]", "|e3| [m]", "|e3| HOSIDF",
+                  "|e5| [m]", "|e5| HOSIDF",
                   "|e1 lin| [m]", "|E sim|", "angle E sim", "|E df| (18)", "angle E df",
                   "peak e [m]", "rms e-e_lin [m]"], rows))
     return 0

@@ -197,10 +197,16 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     return fig
 
 
-def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike):
-    """Fig. 11: steady-state error over a period, with and without hysteresis, and the DF."""
+def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike,
+                 harmonics_df: list[ArrayLike] | None = None):
+    """Fig. 11: steady-state error over a period, with and without hysteresis, and the DF.
+
+    `harmonics_df`, per state, the predicted error harmonics 1, 2, ... from the
+    higher-order describing functions, adds their sum as a dotted line.
+    """
     fig, axes = _figure(len(states), sharex=False)
-    for ax, ss, E in zip(axes, states, np.atleast_1d(mismatch_df), strict=True):
+    hdf = harmonics_df if harmonics_df is not None else [None] * len(states)
+    for ax, ss, E, h in zip(axes, states, np.atleast_1d(mismatch_df), hdf, strict=True):
         ts = ss.time_series()
         theta = TWO_PI * ss.frequency_hz * ts["t"]
         e_df = np.abs(E * ss.e_linear[1]) * np.sin(theta + np.angle(E * ss.e_linear[1]))
@@ -208,12 +214,19 @@ def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike):
         ax.plot(t_ms, ts["e"] * 1e9, color="k", label="with hysteresis (exact)")
         ax.plot(t_ms, ts["e_linear"] * 1e9, color=LINEAR_COLOR, label="without hysteresis")
         ax.plot(t_ms, e_df * 1e9, "--", color="tab:red", label="describing function")
+        if h is not None:
+            h = np.asarray(h)
+            n = np.arange(1, len(h) + 1)
+            e_hdf = np.imag(np.exp(1j * np.outer(theta, n)) @ h)
+            ax.plot(t_ms, e_hdf * 1e9, ":", color="tab:green",
+                    label=f"higher-order DFs, n <= {len(h)}")
+            fig.motionhyst_data[f"f={ss.frequency_hz:g} hosidf"] = e_hdf
         ax.set_ylabel("e [nm]")
         ax.set_title(f"f = {ss.frequency_hz:g} Hz", fontsize=9, loc="left")
         fig.motionhyst_data[f"f={ss.frequency_hz:g}"] = np.vstack(
             [ts["t"], ts["e"], ts["e_linear"], e_df])
     axes[-1].set_xlabel("time [ms]")
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3)
+    fig.legend(handles, labels, loc="outside lower center", ncol=2)
     fig.suptitle("Fig. 11: steady-state tracking error", fontsize=10)
     return fig

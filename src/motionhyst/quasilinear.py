@@ -172,6 +172,31 @@ def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayL
     return mismatch(*_parts(loop, omega), D)
 
 
+def error_harmonics_df(loop: Loop, amplitude: float, frequency_hz: float, n_max: int = 5,
+                       amplitude_mode: str = "reference") -> NDArray[np.complex128]:
+    """Quasi-linear prediction of the error's harmonics 1 .. n_max [m], relative to sin(n w t).
+
+    The first harmonic is ``E e_hat`` (eq. 18 times the linear error); harmonic
+    ``n >= 2`` is the n-th harmonic of the hysteresis force for
+    ``y1 = A_y1 sin(omega t + phi)``, from the higher-order describing function
+    ``H_n(A_y1)``, passed through ``P2 / (1 + C P2)`` at ``n omega``.  ``phi`` is
+    the phase of the linear loop's ``y1``; ``A_y1 = A_r`` (``"reference"``) or
+    the quasi-linear loop's solution (``"self-consistent"``).
+    """
+    omega = TWO_PI * float(frequency_hz)
+    n = np.arange(1, int(n_max) + 1)
+    t_ry1 = complex(loop.transfer("r->y1", np.array([omega]))[0])
+    a_y1 = (amplitude if amplitude_mode == "reference"
+            else self_consistent_amplitude(loop, frequency_hz, amplitude))
+    phi = np.angle(t_ry1)
+    H = np.asarray(loop.hysteresis.hosidf(a_y1, int(n_max), omega)).ravel()
+    w_n = H * a_y1 * np.exp(1j * n * phi)
+    e = loop.transfer("w->e", n * omega) * w_n
+    e_hat = complex(loop.transfer("r->e", np.array([omega]))[0]) * amplitude
+    e[0] = complex(loop_mismatch(loop, [frequency_hz], a_y1)[0]) * e_hat
+    return e
+
+
 def self_consistent_amplitude(loop: Loop, frequency_hz: float, amplitude: float,
                               tol: float = 1e-12, max_iter: int = 200) -> float:
     """Amplitude of ``y1`` in the quasi-linear loop, solved with ``w = D(A_y1) y1``.

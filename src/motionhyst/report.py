@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from motionhyst import plots
 from motionhyst.jsonio import dumps
-from motionhyst.quasilinear import analyze, loop_mismatch
+from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
 from motionhyst.scenario import Scenario
 from motionhyst.steady import periodic_steady_state
 from motionhyst.systems import TwoMassStage
@@ -46,8 +46,9 @@ FIGURE_NOTES = {
     "fig9": "The quasi-linear plant (eq. 12) departs from the floating mass P2 only below f*.",
     "fig10": "The feedforward mismatch (eq. 18) and its asymptote (eq. 20); the circles are the "
              "exact periodic steady state of the nonlinear loop.",
-    "fig11": "Steady-state error over a period with and without the dynamic link, and the "
-             "describing-function estimate of its first harmonic.",
+    "fig11": "Steady-state error over a period with and without the dynamic link, the "
+             "describing-function estimate of its first harmonic, and the sum of harmonics "
+             "1-7 predicted by the higher-order describing functions.",
 }
 
 
@@ -110,6 +111,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         steps.update()
         states = [periodic_steady_state(loop, A, f) for f in freqs]
         E_df = loop_mismatch(loop, freqs, A)
+        H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
         steps.update()
         lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
         f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
@@ -119,8 +121,8 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         summary = {
             "scenario": sc.to_dict(),
             "analyze": analysis.to_dict(),
-            "simulate": {"points": [s.to_dict(mismatch_df=complex(e))
-                                    for s, e in zip(states, E_df, strict=True)]},
+            "simulate": {"points": [s.to_dict(mismatch_df=complex(e), error_harmonics_df=h)
+                                    for s, e, h in zip(states, E_df, H_df, strict=True)]},
         }
         figs = {
             "fig5": lambda: plots.fig5_loops(el),
@@ -129,7 +131,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             "fig8": lambda: plots.fig8_describing_function(el),
             "fig9": lambda: plots.fig9_quasilinear_plant(loop, f_star_hz=analysis.f_star_hz),
             "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
-            "fig11": lambda: plots.fig11_errors(states, E_df),
+            "fig11": lambda: plots.fig11_errors(states, E_df, H_df),
         }
         if not isinstance(loop.plant, TwoMassStage):
             notes.append("The plant is measured frequency-response data: eq. (21) needs the "

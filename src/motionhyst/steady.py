@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.loop import Loop
-from motionhyst.quasilinear import loop_mismatch
+from motionhyst.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.systems import TWO_PI
 
 MIN_HARMONICS = 32
@@ -129,7 +129,8 @@ class SteadyState:
         return float(np.max(np.abs(self.time_series()["e"])))
 
     def to_dict(self, harmonics: tuple[int, ...] = (1, 3, 5),
-                mismatch_df: complex | None = None) -> dict:
+                mismatch_df: complex | None = None,
+                error_harmonics_df: ArrayLike | None = None) -> dict:
         """JSON-ready dictionary (one point of the ``simulate --json`` schema)."""
         eh = [{"n": n, "abs": float(abs(self.e[n])),
                "phase_deg": float(np.degrees(np.angle(self.e[n])))}
@@ -146,6 +147,12 @@ class SteadyState:
         if mismatch_df is not None:
             out["mismatch_df_abs"] = abs(mismatch_df)
             out["mismatch_df_phase_deg"] = float(np.degrees(np.angle(mismatch_df)))
+        if error_harmonics_df is not None:
+            edf = np.asarray(error_harmonics_df)
+            out["error_harmonics_df"] = [
+                {"n": n, "abs": float(abs(edf[n - 1])),
+                 "phase_deg": float(np.degrees(np.angle(edf[n - 1])))}
+                for n in harmonics if n <= len(edf)]
         out.update({
             "error_peak": self.error_peak,
             "error_rms": self.error_rms,
@@ -248,5 +255,6 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     """Exact steady state next to the describing-function mismatch of eq. (18), per frequency."""
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     E_df = loop_mismatch(loop, f, amplitude)
-    return [ss.to_dict(mismatch_df=complex(ed))
+    return [ss.to_dict(mismatch_df=complex(ed),
+                       error_harmonics_df=error_harmonics_df(loop, amplitude, ss.frequency_hz))
             for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)]
