@@ -135,18 +135,26 @@ def fig8_describing_function(el: Jenkins, zeta_range=(1e-3, 10.0)):
 
 def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5, 0.75, 1.0),
                            f_range=(0.01, 100.0), f_star_hz: float | None = None):
-    """Fig. 9: Bode plot of the quasi-linear plant ``P^phi`` (eq. 12) for zeta in (0, 1]."""
+    """Fig. 9: Bode plot of the quasi-linear plant ``P^phi`` (eq. 12) for zeta in (0, 1].
+
+    For a Jenkins element the curves are labelled by zeta (eq. 4); for other
+    models by the amplitude ``fc_total / (k_total zeta)`` they correspond to.
+    """
     el = loop.hysteresis
     fig, (ax1, ax2) = _figure(2)
     f = np.geomspace(*_frequency_range(loop, f_range), 600)
     w = TWO_PI * f
     P1, P2 = freqresp(loop.P1, w), freqresp(loop.P2, w)
     cmap = matplotlib.colormaps["viridis"]
+    jenkins = isinstance(el, Jenkins)
+    fc_total = float(np.sum(el.fc)) if hasattr(el, "fc") else 1.0
     for i, z in enumerate(zetas):
-        D = el.describing_function(el.fc / (el.k * z))
+        A = fc_total / (el.initial_stiffness * z)
+        D = el.describing_function(A, w if not el.rate_independent else None)
         Pphi = P2 / (1.0 + D * P1)
         c = cmap(i / max(1, len(zetas) - 1))
-        ax1.semilogx(f, 20 * np.log10(np.abs(Pphi)), color=c, label=f"zeta = {z:g}")
+        label = f"zeta = {z:g}" if jenkins else f"A = {A:.3g} m"
+        ax1.semilogx(f, 20 * np.log10(np.abs(Pphi)), color=c, label=label)
         ax2.semilogx(f, _phase_deg(Pphi), color=c)
         fig.motionhyst_data[f"zeta={z:g}"] = Pphi
     ax1.semilogx(f, 20 * np.log10(np.abs(P2)), "k--", label="P2 (no link)")

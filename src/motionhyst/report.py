@@ -18,6 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from motionhyst import plots
+from motionhyst.hysteresis import Jenkins
 from motionhyst.jsonio import dumps
 from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
 from motionhyst.scenario import Scenario
@@ -133,6 +134,11 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
             "fig11": lambda: plots.fig11_errors(states, E_df, H_df),
         }
+        if not isinstance(el, Jenkins):
+            for name in ("fig5", "fig6", "fig7", "fig8"):
+                del figs[name]
+            notes.append(f"Figs. 5-8 describe the single Jenkins element of the paper; the "
+                         f"scenario's link is a {el.name} model, so they are not drawn.")
         if not isinstance(loop.plant, TwoMassStage):
             notes.append("The plant is measured frequency-response data: eq. (21) needs the "
                          "two-mass model and is not computed; frequency plots are limited to "
