@@ -5,7 +5,7 @@ describing functions (:func:`analyze`), and check the prediction against the
 exact periodic steady state of the nonlinear loop (:func:`periodic_steady_state`).
 """
 
-from motionhyst.hysteresis import Hysteresis, Jenkins
+from motionhyst.hysteresis import Hysteresis, Jenkins, MaxwellSlip
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import QuasiLinearAnalysis, analyze
 from motionhyst.scenario import Scenario, ScenarioError, default_scenario, load_scenario
@@ -15,7 +15,8 @@ from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load
 __version__ = "0.1.0"
 
 __all__ = [
-    "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "MeasuredPlant", "QuasiLinearAnalysis",
-    "Scenario", "ScenarioError", "SteadyState", "TwoMassStage", "analyze", "default_scenario",
-    "load_frd_plant", "load_scenario", "periodic_steady_state", "steady_state_sweep",
+    "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "MaxwellSlip", "MeasuredPlant",
+    "QuasiLinearAnalysis", "Scenario", "ScenarioError", "SteadyState", "TwoMassStage", "analyze",
+    "default_scenario", "load_frd_plant", "load_scenario", "periodic_steady_state",
+    "steady_state_sweep",
 ]

@@ -169,7 +169,28 @@ def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayL
     f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
     omega = TWO_PI * f
     D = loop.hysteresis.describing_function(np.broadcast_to(amplitude, f.shape), omega)
-    return mismatch(*_parts(loop, omega), D)
+    if loop.hysteresis_feedforward is None:
+        return mismatch(*_parts(loop, omega), D)
+    return residual_mismatch(loop, omega, D, loop.hysteresis_feedforward.describing_function(
+        np.broadcast_to(amplitude, f.shape), omega))
+
+
+def residual_mismatch(loop: Loop, omega: ArrayLike, D: ArrayLike, D_ff: ArrayLike
+                      ) -> NDArray[np.complex128]:
+    """Mismatch ``e / e_hat`` left with hysteresis feedforward ``u_ff = M r'' + phi_hat(r)``.
+
+    Quasi-linear: ``w = D y1`` and ``phi_hat(r) = D_ff r``, so
+    ``y1 = (T_ry1 - T_wy1 D_ff) / (1 - T_wy1 D) r`` and
+    ``e = T_re r + T_we (D y1 - D_ff r)``; ``e_hat = T_re r`` is the error
+    without hysteresis and without its feedforward.  With ``D_ff = 0`` this is
+    eq. (18).
+    """
+    w = np.asarray(omega, dtype=float)
+    t_re, t_ry1 = loop.transfer("r->e", w), loop.transfer("r->y1", w)
+    t_we, t_wy1 = loop.transfer("w->e", w), loop.transfer("w->y1", w)
+    D, D_ff = np.asarray(D), np.asarray(D_ff)
+    y1 = (t_ry1 - t_wy1 * D_ff) / (1.0 - t_wy1 * D)
+    return 1.0 + t_we * (D * y1 - D_ff) / t_re
 
 
 def error_harmonics_df(loop: Loop, amplitude: float, frequency_hz: float, n_max: int = 5,
@@ -282,7 +303,11 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         amps = np.array([self_consistent_amplitude(loop, fi, amplitude) for fi in f])
     D_pts = np.asarray(hyst.describing_function(amps, omega), dtype=complex)
     C, P1, P2, Pr, Pf2 = _parts(loop, omega)
-    E = mismatch(C, P1, P2, Pr, Pf2, D_pts)
+    if loop.hysteresis_feedforward is None:
+        E = mismatch(C, P1, P2, Pr, Pf2, D_pts)
+    else:
+        D_ff = loop.hysteresis_feedforward.describing_function(amplitude, omega)
+        E = residual_mismatch(loop, omega, D_pts, D_ff)
     Et = mismatch_asymptote(Pr, Pf2, D_pts)
     zetas = np.asarray(hyst.zeta(amps)) if hasattr(hyst, "zeta") else np.full(f.shape, np.nan)
     D_ref = complex(np.asarray(hyst.describing_function(amplitude)).ravel()[0])

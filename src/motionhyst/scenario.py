@@ -87,6 +87,17 @@ class MaxwellSlipSection(_Section):
 HysteresisSection = Annotated[JenkinsSection | MaxwellSlipSection, Field(discriminator="model")]
 
 
+class FeedforwardSection(_Section):
+    """``[feedforward]``: rigid-body ``M r''`` or none, plus an optional hysteresis model.
+
+    ``hysteresis = { model = "maxwell-slip", k = [...], fc = [...] }`` adds
+    ``phi_hat(r)`` to the feedforward force (identified by ``motionhyst identify``).
+    """
+
+    type: Literal["rigid-body", "none"] = "rigid-body"
+    hysteresis: HysteresisSection | None = None
+
+
 class LeadLagSection(_Section):
     """``[controller] type = "leadlag-lowpass"``: eq. (23)."""
 
@@ -118,10 +129,6 @@ class TransferFunctionSection(_Section):
         return self
 
 
-class FeedforwardSection(_Section):
-    """``[feedforward]``: rigid-body ``M r''`` or none."""
-
-    type: Literal["rigid-body", "none"] = "rigid-body"
 
 
 class ReferenceSection(_Section):
@@ -274,7 +281,9 @@ class Scenario:
         """The loop (built once, checked for stability)."""
         if self._loop is None:
             ff = None if self.model.feedforward.type == "none" else "rigid-body"
-            loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff)
+            hff = self.model.feedforward.hysteresis
+            loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff,
+                        hysteresis_feedforward=None if hff is None else build_hysteresis(hff))
             try:
                 loop.check_stable()
             except ValueError as exc:

@@ -47,7 +47,8 @@ class Simulation:
     w : ndarray
         Hysteresis force [N].
     e_linear : ndarray
-        Error of the same loop without hysteresis [m].
+        Error of the same loop without hysteresis and without hysteresis
+        feedforward [m].
     """
 
     t: NDArray[np.float64]
@@ -112,7 +113,7 @@ def _block_system(loop: Loop, omega0: float):
 
 
 @njit(cache=True)
-def _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0):  # pragma: no cover - compiled
+def _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0, uh):  # pragma: no cover - compiled
     n_t = r.shape[0]
     n_x = Ad.shape[0]
     m = k.shape[0]
@@ -134,7 +135,7 @@ def _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0):  # pragma: no cover - compiled
             wt += we[j]
         w_new = we.copy()
         for _ in range(4):
-            yi = r[i] + base_y + Dd[1, 1] * wt
+            yi = r[i] + base_y + Dd[1, 1] * (wt - uh[i])
             dx = yi - y1_prev
             wt = 0.0
             for j in range(m):
@@ -145,16 +146,16 @@ def _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0):  # pragma: no cover - compiled
                     v = -fc[j]
                 w_new[j] = v
                 wt += v
-        yi = r[i] + base_y + Dd[1, 1] * wt
+        yi = r[i] + base_y + Dd[1, 1] * (wt - uh[i])
         for j in range(m):
             we[j] = w_new[j]
         y1_prev = yi
-        e[i] = base_e + Dd[0, 1] * wt
+        e[i] = base_e + Dd[0, 1] * (wt - uh[i])
         y1[i] = yi
         w[i] = wt
         xn = np.zeros(n_x)
         for j in range(n_x):
-            s = Bd[j, 0] * a[i] + Bd[j, 1] * wt
+            s = Bd[j, 0] * a[i] + Bd[j, 1] * (wt - uh[i])
             for q in range(n_x):
                 s += Ad[j, q] * x[q]
             xn[j] = s
@@ -202,8 +203,6 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
     if loop.feedforward != "rigid-body" and loop.feedforward is not None:
         raise ValueError("unknown feedforward")
-    if loop.hysteresis_feedforward is not None:
-        raise ValueError("time simulation with hysteresis feedforward is not supported yet")
     f_ref = getattr(reference, "max_frequency_hz", 1.0)
     step = default_step(loop, f_ref) if dt is None else float(dt)
     if not (np.isfinite(step) and step > 0):
@@ -225,10 +224,14 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
     k, fc = _stop_parameters(loop)
     if loop.hysteresis is None:
         k = np.zeros(1)
-    e, y1, w = _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0)
-    e_lin, _, _ = _run(Ad, Bd, Cd, Dd, r, a, np.zeros(1), np.ones(1), x0)
+    # hysteresis feedforward u_h = phi_hat(r) acts like -w on the loop
+    hff = loop.hysteresis_feedforward
+    uh = hff.response(r) if hff is not None else np.zeros_like(r)
+    e, y1, w = _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0, uh)
+    e_lin, _, _ = _run(Ad, Bd, Cd, Dd, r, a, np.zeros(1), np.ones(1), x0, np.zeros_like(r))
     y2 = r - e
     u = control.forced_response(loop.controller, t, e).outputs
     if loop.feedforward == "rigid-body":
         u = u + loop.M * a  # the impulse M v0 delta(t) at t = 0 is not representable
+    u = u + uh
     return Simulation(t=t, r=r, e=e, y1=y1, y2=y2, u=np.asarray(u), w=w, e_linear=e_lin)
