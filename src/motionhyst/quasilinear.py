@@ -159,20 +159,23 @@ def _parts(loop: Loop, omega: NDArray[np.float64]):
     return C, P1, P2, Pr, Pf2
 
 
-def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayLike
-                  ) -> NDArray[np.complex128]:
+def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayLike,
+                  reference_amplitude: float | None = None) -> NDArray[np.complex128]:
     """Mismatch ``E`` of eq. (18) for `loop` at the given frequencies [Hz].
 
     `amplitude` is the amplitude of ``y1`` that sets ``D``: a scalar, or one
-    per frequency.  Rate-dependent elements get ``D(A, omega)``.
+    per frequency.  Rate-dependent elements get ``D(A, omega)``.  With
+    hysteresis feedforward the residual mismatch is returned, its model driven
+    by the reference of amplitude `reference_amplitude` (default `amplitude`).
     """
     f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
     omega = TWO_PI * f
     D = loop.hysteresis.describing_function(np.broadcast_to(amplitude, f.shape), omega)
     if loop.hysteresis_feedforward is None:
         return mismatch(*_parts(loop, omega), D)
-    return residual_mismatch(loop, omega, D, loop.hysteresis_feedforward.describing_function(
-        np.broadcast_to(amplitude, f.shape), omega))
+    a_ref = amplitude if reference_amplitude is None else reference_amplitude
+    D_ff = loop.hysteresis_feedforward.describing_function(np.broadcast_to(a_ref, f.shape), omega)
+    return residual_mismatch(loop, omega, D, D_ff)
 
 
 def residual_mismatch(loop: Loop, omega: ArrayLike, D: ArrayLike, D_ff: ArrayLike
@@ -212,9 +215,12 @@ def error_harmonics_df(loop: Loop, amplitude: float, frequency_hz: float, n_max:
     phi = np.angle(t_ry1)
     H = np.asarray(loop.hysteresis.hosidf(a_y1, int(n_max), omega)).ravel()
     w_n = H * a_y1 * np.exp(1j * n * phi)
+    hff = loop.hysteresis_feedforward
+    if hff is not None:  # phi_hat(r), r = A_r sin(omega t)
+        w_n = w_n - np.asarray(hff.hosidf(amplitude, int(n_max), omega)).ravel() * amplitude
     e = loop.transfer("w->e", n * omega) * w_n
     e_hat = complex(loop.transfer("r->e", np.array([omega]))[0]) * amplitude
-    e[0] = complex(loop_mismatch(loop, [frequency_hz], a_y1)[0]) * e_hat
+    e[0] = complex(loop_mismatch(loop, [frequency_hz], a_y1, amplitude)[0]) * e_hat
     return e
 
 
@@ -222,15 +228,19 @@ def self_consistent_amplitude(loop: Loop, frequency_hz: float, amplitude: float,
                               tol: float = 1e-12, max_iter: int = 200) -> float:
     """Amplitude of ``y1`` in the quasi-linear loop, solved with ``w = D(A_y1) y1``.
 
-    ``y1 = T_ry1 / (1 - T_wy1 D) r``; iterated on ``A_y1`` starting at ``A_r``.
+    ``y1 = (T_ry1 - T_wy1 D_ff) / (1 - T_wy1 D) r`` (``D_ff`` of a hysteresis
+    feedforward, else 0); iterated on ``A_y1`` starting at ``A_r``.
     """
     omega = TWO_PI * float(frequency_hz)
     t_r = complex(loop.transfer("r->y1", np.array([omega]))[0])
     t_w = complex(loop.transfer("w->y1", np.array([omega]))[0])
+    hff = loop.hysteresis_feedforward
+    D_ff = 0.0 if hff is None else complex(
+        np.asarray(hff.describing_function(amplitude, omega)).ravel()[0])
     a = amplitude
     for _ in range(max_iter):
         D = complex(np.asarray(loop.hysteresis.describing_function(a, omega)).ravel()[0])
-        a_new = abs(t_r / (1.0 - t_w * D)) * amplitude
+        a_new = abs((t_r - t_w * D_ff) / (1.0 - t_w * D)) * amplitude
         if abs(a_new - a) <= tol * a_new:
             return float(a_new)
         a = a_new

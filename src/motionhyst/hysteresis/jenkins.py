@@ -174,7 +174,8 @@ class Jenkins(Hysteresis):
         ``theta_3 = 2 pi - arcsin(1 - 2 zeta)``, and slip at ``+fc``.  Each piece
         is integrated against ``exp(-j n theta)`` exactly; ``H_1`` is eq. (10).
         Even harmonics are zero (half-wave symmetry); ``zeta >= 1`` gives
-        ``H_1 = k`` only.
+        ``H_1 = k`` only.  Terms of size ``k A`` cancel for small ``zeta``: the
+        absolute accuracy is about ``1e-16 / zeta`` of ``|H_1|``.
 
         Returns
         -------
@@ -204,7 +205,8 @@ class Jenkins(Hysteresis):
         fc = self.fc
         total = ((fc - kA) * E(n, t0, t1) + kA * S(t0, t1) - fc * E(n, t1, t2)
                  + (kA - fc) * E(n, t2, t3) + kA * S(t2, t3) + fc * E(n, t3, t4))
-        H = 1j * total / (np.pi * a[..., None])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            H = 1j * total / (np.pi * a[..., None])
         linear = np.where(n == 1, self.k + 0j, 0j)
         return np.where((zeta >= 1.0)[..., None], linear, H)
 

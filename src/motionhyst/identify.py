@@ -1,0 +1,951 @@
+"""Identification of Jenkins / Maxwell-slip hysteresis from measured records.
+
+The paper (sec. VI) leaves "identification of hysteresis models for
+feedforward purposes" as future work; this module identifies the parallel
+Jenkins elements ``(k_i, fc_i)`` of a :class:`~motionhyst.hysteresis.MaxwellSlip`
+model (paper eq. 3 per element) from
+
+(a) force-displacement records ``(x, w)`` (:func:`identify_maxwell_slip`), and
+(b) closed-loop records ``(y1, u)`` of a two-mass stage, where the link force
+    is ``w = u - P1^-1 y1`` (paper eq. 1, :func:`infer_link_force`,
+    :func:`identify_closed_loop`).
+
+Method
+------
+With slip displacements ``d_i = fc_i / k_i`` fixed, the Maxwell-slip force is
+linear in the stiffnesses: ``w = sum_i k_i s(x; d_i) + c`` with ``s(x; d)`` the
+unit-stiffness stop operator of threshold ``d`` and ``c`` a force offset.
+
+1. Regressor: unit stop operators on a log-spaced grid of thresholds from
+   ``1e-3 h`` to ``h`` (``h`` the half-range of ``x``), each started relaxed.
+2. Non-negative least squares (:func:`scipy.optimize.nnls`) for the weights;
+   the offset is removed by centring.  Adjacent non-zero weights are merged
+   into one element; elements carrying less than 0.5 % of the total slip
+   force are pruned.
+3. Joint refinement of all ``k_i, fc_i``, the offset and (by default) each
+   element's initial force ``w_i(0) = alpha_i fc_i, |alpha_i| <= 1`` with
+   bounded :func:`scipy.optimize.least_squares` and the exact (almost
+   everywhere) Jacobian of the stop operator.
+4. Model order: fits for ``N`` = 1 ... (merging the adjacent pair that costs
+   least, splitting the strongest element) are compared; the default
+   criterion picks the smallest ``N`` whose RMS residual is within 1 % of the
+   best RMS over all orders tried (``criterion="rms"``); ``criterion="bic"``
+   minimises ``n log(RSS / n) + p log n`` instead.
+5. Uncertainty: ``sigma^2 (J^T J)^-1`` at the optimum with
+   ``sigma^2 = RSS / (n - p)``; parameters the data cannot determine (e.g. the
+   slip force of an element that never slips) get an infinite standard
+   deviation.  The formula assumes white residuals; with coloured noise or
+   model error it is optimistic.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import control
+import numpy as np
+from numba import njit
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import solve
+from scipy.optimize import least_squares, nnls
+from scipy.signal import butter, cont2discrete, zpk2ss
+
+from motionhyst.csvdata import read_columns
+from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.hysteresis._kernels import maxwell_response, stop_response
+from motionhyst.systems import TWO_PI
+
+MIN_SAMPLES = 50
+"""Fewest samples accepted in a record."""
+N_GRID = 40
+"""Candidate slip displacements in the NNLS stage."""
+GRID_SPAN = 1e-3
+"""Smallest candidate slip displacement relative to the half-range of x."""
+PRUNE = 0.005
+"""Elements of the NNLS stage with less than this share of the total slip force are dropped."""
+MAX_ELEMENTS = 8
+"""Largest number of elements tried when the order is chosen automatically."""
+MAX_ROWS = 50_000
+"""Most samples used in the residual (the operators always run on the full record)."""
+REVERSAL_BAND = 0.01
+"""A reversal is a retreat of more than this fraction of the range from a running extreme."""
+SETTLE_PERIODS = 8.0
+"""Start-up transient of the closed-loop prefilter, in units of ``1 / cutoff_hz``."""
+UNIFORM_RTOL = 0.01
+"""Allowed relative deviation of the closed-loop sampling interval from its median."""
+
+Criterion = Literal["rms", "bic"]
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+@njit(cache=True)
+def _count_reversals(x, band):  # pragma: no cover - compiled
+    """Direction changes of `x` that retreat more than `band` from a running extreme."""
+    n_rev = 0
+    direction = 0
+    hi = x[0]
+    lo = x[0]
+    ext = x[0]
+    for i in range(1, x.shape[0]):
+        v = x[i]
+        if direction == 0:
+            hi = max(hi, v)
+            lo = min(lo, v)
+            if v - lo > band:
+                direction = 1
+                ext = v
+            elif hi - v > band:
+                direction = -1
+                ext = v
+        elif direction == 1:
+            if v > ext:
+                ext = v
+            elif ext - v > band:
+                n_rev += 1
+                direction = -1
+                ext = v
+        else:
+            if v < ext:
+                ext = v
+            elif v - ext > band:
+                n_rev += 1
+                direction = 1
+                ext = v
+    return n_rev
+
+
+def count_reversals(x: ArrayLike, band: float | None = None) -> int:
+    """Number of direction reversals of a sampled signal.
+
+    Parameters
+    ----------
+    x : array_like
+        Samples.
+    band : float, optional
+        Excursions smaller than this are ignored (noise); by default
+        ``REVERSAL_BAND`` times the range of `x`.
+
+    Returns
+    -------
+    int
+        How often `x` turns back by more than `band` from its running extreme.
+    """
+    xs = np.ascontiguousarray(x, dtype=float)
+    if xs.size < 2:
+        return 0
+    if band is None:
+        band = REVERSAL_BAND * float(np.ptp(xs))
+    return int(_count_reversals(xs, float(band)))
+
+
+def _check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
+                   xname: str = "displacement") -> None:
+    """``ValueError`` (one line, no file) for records that cannot be identified from."""
+    arrays = {xname: x, **named}
+    if t is not None:
+        arrays = {"time": t, **arrays}
+    lengths = {k: v.shape for k, v in arrays.items()}
+    if any(v.ndim != 1 for v in arrays.values()) or len(set(lengths.values())) != 1:
+        raise ValueError("inconsistent lengths: " + ", ".join(
+            f"{k} {v.size}" for k, v in arrays.items()))
+    if x.size < MIN_SAMPLES:
+        raise ValueError(f"too short: {x.size} samples, need at least {MIN_SAMPLES}")
+    for k, v in arrays.items():
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"non-finite value in {k} (sample {int(np.argmin(np.isfinite(v)))})")
+    if t is not None and np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0))
+        raise ValueError(f"time must be strictly increasing (sample {i + 1})")
+    if not np.ptp(x) > 0:
+        raise ValueError(f"constant {xname}: nothing to identify from")
+    if count_reversals(x) < 1:
+        raise ValueError(f"no reversal: the {xname} must move back and forth at least once")
+
+
+@njit(cache=True)
+def _dss_filter(Ad, Bd, Cd, Dd, U, X0):  # pragma: no cover - compiled
+    """Run a SISO discrete state-space filter over each column of `U` from states `X0`."""
+    n, m = U.shape
+    nx = Ad.shape[0]
+    Y = np.empty((n, m))
+    for j in range(m):
+        x = X0[:, j].copy()
+        xn = np.empty(nx)
+        for i in range(n):
+            u = U[i, j]
+            y = Dd * u
+            for a in range(nx):
+                y += Cd[a] * x[a]
+            Y[i, j] = y
+            for a in range(nx):
+                s = Bd[a] * u
+                for b in range(nx):
+                    s += Ad[a, b] * x[b]
+                xn[a] = s
+            for a in range(nx):
+                x[a] = xn[a]
+    return Y
+
+
+class HoldFilter:
+    """A proper SISO LTI filter applied to sampled signals, exact for piecewise-linear inputs.
+
+    The filter is discretised with a first-order hold (``cont2discrete(...,
+    method="foh")``) in time scaled by `omega0`, so the discrete filter is the
+    continuous one applied to the samples' linear interpolation.  Every
+    signal is taken as constant at its first value before the record (the
+    filter state starts in steady state), which removes start-up transients
+    from position offsets.
+
+    Parameters
+    ----------
+    zeros, poles : array_like
+        Zeros and poles [rad/s] (conjugate pairs complete); ``len(zeros) <= len(poles)``.
+    gain : float
+        Gain of the zero-pole-gain form.
+    dt : float
+        Sampling interval [s].
+    omega0 : float
+        Time scale [rad/s] used for conditioning (e.g. the cut-off).
+    """
+
+    def __init__(self, zeros: ArrayLike, poles: ArrayLike, gain: float, dt: float,
+                 omega0: float) -> None:
+        z = np.asarray(zeros, dtype=complex) / omega0
+        p = np.asarray(poles, dtype=complex) / omega0
+        if z.size > p.size:
+            raise ValueError("the filter must be proper")
+        g = float(gain) * omega0 ** (z.size - p.size)
+        A, B, C, D = zpk2ss(z, p, g)
+        Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), omega0 * dt, method="foh")
+        self.Ad = np.ascontiguousarray(Ad, dtype=float)
+        self.Bd = np.ascontiguousarray(np.ravel(Bd), dtype=float)
+        self.Cd = np.ascontiguousarray(np.ravel(Cd), dtype=float)
+        self.Dd = float(np.ravel(Dd)[0])
+        # steady state for a unit constant input: x = Ad x + Bd
+        self._x_unit = solve(np.eye(self.Ad.shape[0]) - self.Ad, self.Bd)
+        self.dc_gain = float(self.Dd + self.Cd @ self._x_unit)
+
+    def __call__(self, u: ArrayLike) -> NDArray[np.float64]:
+        """Filter a signal (1-D) or each column of a 2-D array (time along axis 0)."""
+        U = np.asarray(u, dtype=float)
+        one = U.ndim == 1
+        U2 = np.ascontiguousarray(U[:, None] if one else U)
+        X0 = np.ascontiguousarray(np.outer(self._x_unit, U2[0]))
+        Y = _dss_filter(self.Ad, self.Bd, self.Cd, self.Dd, U2, X0)
+        return Y[:, 0] if one else Y
+
+
+# --------------------------------------------------------------------------- the model fit
+
+
+@dataclass
+class _Problem:
+    """Data of one fit: operators run on `x`; residual on `rows` of `target`."""
+
+    x: NDArray[np.float64]
+    target: NDArray[np.float64]
+    rows: NDArray[np.intp]
+    filt: HoldFilter | None
+    fit_initial: bool
+    grid_d: NDArray[np.float64] | None = None
+    grid_A: NDArray[np.float64] | None = None  # unit stop columns / d at the rows
+
+    @property
+    def y(self) -> NDArray[np.float64]:
+        return self.target[self.rows]
+
+
+@dataclass
+class _Fit:
+    k: NDArray[np.float64]
+    fc: NDArray[np.float64]
+    alpha: NDArray[np.float64]
+    c: float
+    rss: float
+    J: NDArray[np.float64] = field(repr=False)
+    resid: NDArray[np.float64] = field(repr=False)
+
+    @property
+    def n(self) -> int:
+        return int(self.k.size)
+
+
+def _pack(k, fc, alpha, c, fit_initial: bool) -> NDArray[np.float64]:
+    parts = [k, fc] + ([alpha] if fit_initial else []) + [[c]]
+    return np.concatenate([np.asarray(p, dtype=float) for p in parts])
+
+
+def _unpack(theta, n: int, fit_initial: bool):
+    k, fc = theta[:n], theta[n:2 * n]
+    alpha = theta[2 * n:3 * n] if fit_initial else np.zeros(n)
+    return k, fc, alpha, float(theta[-1])
+
+
+def _evaluate(prob: _Problem, theta, n: int, jac: bool):
+    """Residual (model - target) at the rows and, optionally, its Jacobian."""
+    k, fc, alpha, c = _unpack(theta, n, prob.fit_initial)
+    k = np.ascontiguousarray(k)
+    fc = np.ascontiguousarray(fc)
+    W = maxwell_response(prob.x, k, fc, np.ascontiguousarray(alpha * fc))
+    cols = [W.sum(axis=1)[:, None]]
+    if jac:
+        # d w_i / d fc_i = sigma_i: the sign of the last saturation (alpha_i before the first);
+        # d w_i / d k_i = (w_i - fc_i sigma_i) / k_i; d w_i / d alpha_i = fc_i before the first.
+        sat = np.abs(W) >= fc
+        idx = np.where(sat, np.arange(W.shape[0])[:, None], -1)
+        last = np.maximum.accumulate(idx, axis=0)
+        before = last < 0
+        sign = np.sign(np.take_along_axis(W, np.maximum(last, 0), axis=0))
+        sigma = np.where(before, alpha, sign)
+        cols += [(W - fc * sigma) / k, sigma]
+        if prob.fit_initial:
+            cols.append(before * fc)
+    M = np.concatenate(cols, axis=1)
+    if prob.filt is not None:
+        M = prob.filt(M)
+    M = M[prob.rows]
+    # a constant offset passes the prefilter with its DC gain (1 by construction)
+    r = M[:, 0] + c - prob.y
+    if not jac:
+        return r, None
+    J = np.column_stack([M[:, 1:], np.ones(r.size)])
+    return r, J
+
+
+def _refine(prob: _Problem, k, fc, alpha, c) -> _Fit:
+    """Joint bounded least-squares refinement of all parameters."""
+    n = len(k)
+    theta0 = _pack(k, fc, np.clip(alpha, -0.999, 0.999), c, prob.fit_initial)
+    k_lo = 1e-9 * float(np.sum(k))
+    fc_lo = 1e-9 * float(np.sum(fc))
+    lo = _pack(np.full(n, k_lo), np.full(n, fc_lo), -np.ones(n), -np.inf, prob.fit_initial)
+    hi = _pack(np.full(n, np.inf), np.full(n, np.inf), np.ones(n), np.inf, prob.fit_initial)
+    theta0[:n] = np.maximum(theta0[:n], 2 * k_lo)
+    theta0[n:2 * n] = np.maximum(theta0[n:2 * n], 2 * fc_lo)
+    cache: dict = {}
+
+    def fun(th):
+        r, J = _evaluate(prob, th, n, True)
+        cache["th"], cache["J"] = th.copy(), J
+        return r
+
+    def jacobian(th):
+        if "th" in cache and np.array_equal(cache["th"], th):
+            return cache["J"]
+        return _evaluate(prob, th, n, True)[1]
+
+    sol = least_squares(fun, theta0, jac=jacobian, bounds=(lo, hi), x_scale="jac",
+                        method="trf", tr_solver="lsmr", ftol=1e-12, xtol=1e-12, gtol=1e-12,
+                        max_nfev=200)
+    k, fc, alpha, c = _unpack(sol.x, n, prob.fit_initial)
+    r, J = _evaluate(prob, sol.x, n, True)
+    return _Fit(k=k.copy(), fc=fc.copy(), alpha=alpha.copy(), c=c, rss=float(r @ r), J=J,
+                resid=r)
+
+
+def _rss_only(prob: _Problem, k, fc, alpha, c) -> float:
+    r, _ = _evaluate(prob, _pack(k, fc, alpha, c, prob.fit_initial), len(k), False)
+    return float(r @ r)
+
+
+def _nnls_start(prob: _Problem) -> tuple[NDArray, NDArray, float]:
+    """Stage 1-2: stop-operator regressor on a threshold grid, NNLS, merge and prune."""
+    h = 0.5 * float(np.ptp(prob.x))
+    d = np.geomspace(GRID_SPAN * h, h, N_GRID)
+    S = np.column_stack([stop_response(prob.x, 1.0, dj, 0.0) / dj for dj in d])
+    if prob.filt is not None:
+        S = prob.filt(S)
+    A = S[prob.rows]
+    prob.grid_d, prob.grid_A = d, A
+    y = prob.y
+    a_mean, y_mean = A.mean(axis=0), float(y.mean())
+    R = np.linalg.qr(np.column_stack([A - a_mean, y - y_mean]), mode="r")
+    f, _ = nnls(R[:N_GRID, :N_GRID], R[:N_GRID, N_GRID], maxiter=50 * N_GRID)
+    c = y_mean - float(a_mean @ f)
+    on = f > 1e-12 * max(float(f.max()), 1e-300)
+    ks, fcs = [], []
+    j = 0
+    while j < N_GRID:
+        if not on[j]:
+            j += 1
+            continue
+        run = slice(j, j + int(np.argmin(np.append(on[j:], False))))
+        fcs.append(float(f[run].sum()))
+        ks.append(float((f[run] / d[run]).sum()))
+        j = run.stop
+    ks_a, fcs_a = np.array(ks), np.array(fcs)
+    if ks_a.size == 0:
+        raise ValueError("no hysteresis found: the force does not follow any stop operator "
+                         "of the displacement")
+    keep = fcs_a >= PRUNE * fcs_a.sum()
+    return ks_a[keep], fcs_a[keep], c
+
+
+def _sorted(k, fc, alpha):
+    order = np.argsort(fc / k)
+    return k[order], fc[order], alpha[order]
+
+
+def _merge(k, fc, alpha, i):
+    """Merge elements i and i + 1 (sorted by slip displacement); keep the initial force."""
+    fcm = fc[i] + fc[i + 1]
+    am = (alpha[i] * fc[i] + alpha[i + 1] * fc[i + 1]) / fcm
+    k2 = np.concatenate([k[:i], [k[i] + k[i + 1]], k[i + 2:]])
+    fc2 = np.concatenate([fc[:i], [fcm], fc[i + 2:]])
+    a2 = np.concatenate([alpha[:i], [am], alpha[i + 2:]])
+    return k2, fc2, a2
+
+
+def _best_merge(prob, k, fc, alpha, c):
+    """The merge of two adjacent elements that increases the residual least."""
+    k, fc, alpha = _sorted(k, fc, alpha)
+    options = [_merge(k, fc, alpha, i) for i in range(len(k) - 1)]
+    costs = [_rss_only(prob, *o, c) for o in options]
+    return options[int(np.argmin(costs))]
+
+
+def _grow(prob: _Problem, fit: _Fit):
+    """Add the grid element that best explains the residual (greedy, non-negative)."""
+    A = prob.grid_A - prob.grid_A.mean(axis=0)
+    e = -(fit.resid - fit.resid.mean())
+    num = A.T @ e
+    den = np.einsum("ij,ij->j", A, A)
+    score = np.where(num > 0, num**2 / np.maximum(den, 1e-300), -np.inf)
+    j = int(np.argmax(score))
+    f = num[j] / den[j] if np.isfinite(score[j]) else 0.01 * float(fit.fc.sum())
+    d = prob.grid_d[j]
+    return _sorted(np.append(fit.k, f / d), np.append(fit.fc, f), np.append(fit.alpha, 0.0))
+
+
+def _clean(prob: _Problem, fit: _Fit) -> _Fit:
+    """Drop elements that collapsed onto their bounds and refit."""
+    keep = (fit.fc > 1e-6 * fit.fc.sum()) & (fit.k > 1e-6 * fit.k.sum())
+    if keep.all() or not keep.any():
+        return fit
+    return _refine(prob, fit.k[keep], fit.fc[keep], fit.alpha[keep], fit.c)
+
+
+def _bic(rss: float, n_rows: int, n_params: int) -> float:
+    return float(n_rows * np.log(max(rss, 1e-300) / n_rows) + n_params * np.log(n_rows))
+
+
+def _n_params(n_el: int, fit_initial: bool) -> int:
+    return (3 if fit_initial else 2) * n_el + 1
+
+
+def _covariance_std(fit: _Fit, n_rows: int) -> NDArray[np.float64]:
+    """Standard deviations ``sqrt(diag(sigma^2 (J^T J)^-1))``; inf where not identifiable."""
+    J = fit.J
+    p = J.shape[1]
+    sigma2 = fit.rss / max(n_rows - p, 1)
+    scale = np.linalg.norm(J, axis=0)
+    scale[scale == 0] = 1.0
+    _, s, Vt = np.linalg.svd(J / scale, full_matrices=False)
+    good = s > max(s[0], 1e-300) * 1e-9
+    inv = (Vt[good].T / s[good] ** 2) @ Vt[good]
+    std = np.sqrt(np.clip(np.diag(inv), 0.0, None) * sigma2) / scale
+    if (~good).any():
+        weak = np.linalg.norm(Vt[~good], axis=0) > 1e-6
+        std[weak] = np.inf
+    return std
+
+
+def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol: float,
+              max_elements: int, signal_name: str) -> Identification:
+    """Stages 1-5 of the module docstring on a prepared problem."""
+    if criterion not in ("rms", "bic"):
+        raise ValueError(f"unknown criterion {criterion!r}; use 'rms' or 'bic'")
+    if n_elements is not None and (int(n_elements) != n_elements or n_elements < 1):
+        raise ValueError(f"n_elements must be a positive integer, got {n_elements!r}")
+    if not (np.isfinite(rtol) and rtol >= 0):
+        raise ValueError(f"rtol must be finite and >= 0, got {rtol!r}")
+    n_rows = prob.rows.size
+    k, fc, c = _nnls_start(prob)
+    alpha = np.zeros(k.size)
+    k, fc, alpha = _sorted(k, fc, alpha)
+    cap = int(n_elements) if n_elements is not None else max(1, int(max_elements))
+    while k.size > cap:
+        k, fc, alpha = _best_merge(prob, k, fc, alpha, c)
+
+    fits: dict[int, _Fit] = {}
+
+    def add(fit: _Fit) -> _Fit:
+        fit = _clean(prob, fit)
+        if fit.n not in fits or fit.rss < fits[fit.n].rss:
+            fits[fit.n] = fit
+        return fit
+
+    first = add(_refine(prob, k, fc, alpha, c))
+    if n_elements is not None:
+        cur = first
+        while cur.n < n_elements:
+            new = add(_refine(prob, *_grow(prob, cur), cur.c))
+            if new.n <= cur.n:  # the split collapsed: the data hold no more elements
+                break
+            cur = new
+        cur = fits[max(fits)]
+        while cur.n > n_elements:
+            new = add(_refine(prob, *_best_merge(prob, cur.k, cur.fc, cur.alpha, cur.c), cur.c))
+            if new.n >= cur.n:
+                break
+            cur = new
+        chosen = fits[min(fits, key=lambda m: (abs(m - int(n_elements)), m))]
+        how = f"fixed: {int(n_elements)} element(s) requested"
+    else:
+        cur = first
+        while cur.n > 1:
+            prev = cur.n
+            cur = add(_refine(prob, *_best_merge(prob, cur.k, cur.fc, cur.alpha, cur.c), cur.c))
+            if cur.n >= prev:
+                break
+        cur = fits[max(fits)]
+        while cur.n < max_elements:
+            new = add(_refine(prob, *_grow(prob, cur), cur.c))
+            if new.n <= cur.n or new.rss > (1.0 - rtol) ** 2 * cur.rss:
+                break
+            cur = new
+        orders = sorted(fits)
+        if criterion == "rms":
+            best = min(fits[n].rss for n in orders)
+            floor = (1e-6 * float(np.std(prob.y))) ** 2 * n_rows
+            limit = max((1.0 + rtol) ** 2 * best, floor)
+            chosen = fits[next(n for n in orders if fits[n].rss <= limit)]
+            how = (f"rms: smallest N with RMS residual within {100 * rtol:g} % of the best "
+                   f"(N tried: {', '.join(map(str, orders))})")
+        else:
+            bics = {n: _bic(fits[n].rss, n_rows, _n_params(n, prob.fit_initial)) for n in orders}
+            chosen = fits[min(bics, key=bics.get)]
+            how = f"bic: smallest BIC (N tried: {', '.join(map(str, orders))})"
+
+    std = _covariance_std(chosen, n_rows)
+    n = chosen.n
+    order = np.argsort(chosen.fc / chosen.k)
+    k_std, fc_std = std[:n], std[n:2 * n]
+    elements = [{"k": float(chosen.k[i]), "fc": float(chosen.fc[i]),
+                 "k_std": float(k_std[i]), "fc_std": float(fc_std[i])} for i in order]
+    y = prob.y
+    tss = float(np.sum((y - y.mean()) ** 2))
+    rms = float(np.sqrt(chosen.rss / n_rows))
+    ref_rms = float(np.sqrt(tss / n_rows))
+    candidates = [{"n_elements": m, "fit_rms": float(np.sqrt(fits[m].rss / n_rows)),
+                   "bic": _bic(fits[m].rss, n_rows, _n_params(m, prob.fit_initial))}
+                  for m in sorted(fits)]
+    return Identification(
+        model=MaxwellSlip(chosen.k[order], chosen.fc[order]),
+        elements=elements,
+        offset=chosen.c,
+        offset_std=float(std[-1]),
+        initial_forces=(chosen.alpha * chosen.fc)[order],
+        fit_rms=rms,
+        fit_nrms=rms / ref_rms if ref_rms > 0 else float("inf"),
+        r2=1.0 - chosen.rss / tss if tss > 0 else float("nan"),
+        n_samples=int(n_rows),
+        criterion=how,
+        candidates=candidates,
+        signal=signal_name,
+    )
+
+
+# --------------------------------------------------------------------------- results
+
+
+def _fmt(v: float) -> str:
+    """A float as a TOML float literal with 7 significant digits."""
+    s = repr(float(f"{float(v):.7g}"))
+    return s if ("." in s or "e" in s or "inf" in s or "nan" in s) else s + ".0"
+
+
+@dataclass
+class Identification:
+    """Identified Maxwell-slip (parallel Jenkins) hysteresis and the quality of the fit.
+
+    Attributes
+    ----------
+    model : MaxwellSlip
+        The identified elements, ordered by slip displacement ``fc / k``.
+    elements : list of dict
+        Per element ``{"k", "fc", "k_std", "fc_std"}`` [N/m, N]; ``*_std`` are
+        standard errors (``inf`` where the data do not determine the value).
+    offset : float
+        Constant force offset ``c`` of the record [N] (sensor bias).
+    offset_std : float
+        Its standard error [N].
+    initial_forces : ndarray
+        Each element's force at the first sample [N] (zero when started relaxed).
+    fit_rms : float
+        RMS of the residual [N].
+    fit_nrms : float
+        ``fit_rms`` over the RMS of the force about its mean [-].
+    r2 : float
+        Coefficient of determination ``1 - RSS / TSS`` [-].
+    n_samples : int
+        Samples in the residual.
+    criterion : str
+        How the number of elements was chosen.
+    candidates : list of dict
+        Every order tried: ``{"n_elements", "fit_rms", "bic"}``.
+    signal : str
+        What was fitted: ``"force"`` or, for closed-loop records,
+        ``"prefiltered force"`` (the residual is in the prefiltered domain).
+    """
+
+    model: MaxwellSlip
+    elements: list[dict[str, float]]
+    offset: float
+    offset_std: float
+    initial_forces: NDArray[np.float64]
+    fit_rms: float
+    fit_nrms: float
+    r2: float
+    n_samples: int
+    criterion: str
+    candidates: list[dict] = field(default_factory=list)
+    signal: str = "force"
+
+    @property
+    def n_elements(self) -> int:
+        """Number of Jenkins elements."""
+        return len(self.elements)
+
+    def predict(self, x: ArrayLike, w0: ArrayLike = 0.0) -> NDArray[np.float64]:
+        """Force of the identified model for displacement `x`, plus the offset [N].
+
+        Parameters
+        ----------
+        x : array_like
+            Displacement samples [m].
+        w0 : float or array_like
+            Initial force per element [N] (default: relaxed).
+        """
+        return self.model.response(x, w0) + self.offset
+
+    def to_dict(self) -> dict:
+        """Result as a JSON-ready dictionary."""
+        return {"model": "maxwell-slip", "elements": [dict(e) for e in self.elements],
+                "fit_rms": self.fit_rms, "fit_nrms": self.fit_nrms, "r2": self.r2,
+                "n_samples": self.n_samples, "offset": self.offset,
+                "criterion": self.criterion, "signal": self.signal,
+                "candidates": [dict(c) for c in self.candidates]}
+
+    def scenario_fragment(self) -> str:
+        """A ``[hysteresis]`` section of a scenario file (TOML), ready to paste.
+
+        One element is written as ``model = "jenkins"`` with scalars, more as
+        ``model = "maxwell-slip"`` with lists.
+        """
+        k, fc = self.model.k, self.model.fc
+        head = (f"# identified from {self.n_samples} samples: fit NRMS "
+                f"{100 * self.fit_nrms:.3g} %, R^2 {self.r2:.6f}\n[hysteresis]\n")
+        if k.size == 1:
+            return (head + 'model = "jenkins"\n'
+                    f"k = {_fmt(k[0])}      # spring stiffness k_J [N/m]\n"
+                    f"fc = {_fmt(fc[0])}     # slip force f_c [N]\n")
+        return (head + 'model = "maxwell-slip"\n'
+                f"k = [{', '.join(_fmt(v) for v in k)}]      # spring stiffnesses [N/m]\n"
+                f"fc = [{', '.join(_fmt(v) for v in fc)}]     # slip forces [N]\n")
+
+
+# --------------------------------------------------------------------------- public API
+
+
+def _rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
+    stride = max(1, int(np.ceil((n - start) / max(int(max_rows), 1))))
+    return np.arange(start, n, stride)
+
+
+def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = None, *,
+                          t: ArrayLike | None = None, criterion: Criterion = "rms",
+                          rtol: float = 0.01, initial_state: Literal["fit", "relaxed"] = "fit",
+                          max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS
+                          ) -> Identification:
+    """Identify Maxwell-slip (parallel Jenkins, eq. 3) parameters from a force-displacement record.
+
+    Parameters
+    ----------
+    x : array_like
+        Displacement samples [m], taken as monotone between samples; it must
+        reverse at least once.
+    w : array_like
+        Force samples [N], same length; may contain a constant offset.
+    n_elements : int, optional
+        Number of Jenkins elements; chosen by `criterion` if omitted.
+    t : array_like, optional
+        Sample times [s]; only checked (strictly increasing): the element is
+        rate-independent.
+    criterion : {"rms", "bic"}
+        Order selection: ``"rms"`` takes the smallest number of elements whose
+        RMS residual is within `rtol` of the best over all orders tried;
+        ``"bic"`` minimises the Bayesian information criterion.
+    rtol : float
+        Relative RMS tolerance of the ``"rms"`` criterion (and the smallest
+        improvement for which another element is tried).
+    initial_state : {"fit", "relaxed"}
+        ``"fit"`` estimates each element's force at the first sample (records
+        that start in an unknown state); ``"relaxed"`` takes every element as
+        unstressed there (a system started from rest, as :func:`motionhyst.simulate.simulate`).
+    max_elements : int
+        Most elements tried when `n_elements` is omitted.
+    max_rows : int
+        Most samples used in the residual (evenly strided); the stop operators
+        always run on every sample.
+
+    Returns
+    -------
+    Identification
+
+    Raises
+    ------
+    ValueError
+        For records that are too short, non-finite, of inconsistent lengths,
+        with constant displacement, without a reversal, or with non-increasing
+        time.
+
+    Notes
+    -----
+    See the module docstring for the method (grid of stop operators, NNLS,
+    bounded least-squares refinement, order criterion, covariance).
+    """
+    xs = np.ascontiguousarray(np.asarray(x, dtype=float))
+    ws = np.asarray(w, dtype=float)
+    ts = None if t is None else np.asarray(t, dtype=float)
+    _check_signals(xs, {"force": ws}, ts)
+    if initial_state not in ("fit", "relaxed"):
+        raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
+    prob = _Problem(x=xs, target=ws, rows=_rows(0, xs.size, max_rows), filt=None,
+                    fit_initial=initial_state == "fit")
+    return _identify(prob, n_elements, criterion, rtol, max_elements, "force")
+
+
+def _poly(sys) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    if isinstance(sys, control.StateSpace):
+        sys = control.ss2tf(sys)
+    if not isinstance(sys, control.TransferFunction):
+        raise TypeError("closed-loop identification needs an LTI model of P1 (a TwoMassStage "
+                        f"or a python-control system), got {type(sys).__name__}")
+    num = np.trim_zeros(np.atleast_1d(np.asarray(sys.num[0][0], float)), "f")
+    den = np.trim_zeros(np.atleast_1d(np.asarray(sys.den[0][0], float)), "f")
+    return num, den
+
+
+@dataclass
+class LinkForce:
+    """Link force inferred from a closed-loop record, in the prefiltered domain.
+
+    Attributes
+    ----------
+    t, y1 : ndarray
+        Time [s] and position of the actuated mass [m].
+    w : ndarray
+        ``L w = L u - (L / P1) y1`` [N]: the link force through the prefilter ``L``.
+    lowpass : HoldFilter
+        The prefilter ``L``; apply it to a model's force to compare with `w`.
+    cutoff_hz : float
+        Cut-off of the Butterworth part of ``L`` [Hz].
+    settle_index : int
+        First sample after the prefilter's start-up transient.
+    """
+
+    t: NDArray[np.float64]
+    y1: NDArray[np.float64]
+    w: NDArray[np.float64]
+    lowpass: HoldFilter
+    cutoff_hz: float
+    settle_index: int
+
+
+def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
+                     cutoff_hz: float | None = None) -> LinkForce:
+    """Infer the link force ``w = u - P1^-1 y1`` from a closed-loop record (paper eq. 1).
+
+    ``P1^-1`` is improper (for the two-mass stage ``s^2 (m1 m2 s^2 + b M s +
+    k M) / (m2 s^2 + b s + k)``), so both sides are filtered with the same
+    proper filter
+
+    ``L(s) = B(s) n1(s) / n1(0)``,  hence ``L / P1 = B(s) d1(s) / n1(0)``,
+
+    where ``P1 = n1 / d1`` and ``B`` is a Butterworth low-pass of order
+    ``deg d1`` (unit DC gain).  ``L`` contains ``P1``'s zeros, so the inverse
+    has no poles from them (for the stage: no lightly damped
+    anti-resonance that would ring); both filters have only ``B``'s
+    well-damped poles.  They are discretised with a first-order hold, i.e.
+    applied exactly to the linear interpolation of the samples: the
+    interpolation error is then common to ``u`` and ``y1`` and cancels up to
+    ``O(dt^2)`` times ``w`` itself, not times the much larger ``u`` (rigid-body
+    forces).  The result is ``L w`` (not ``w``): identify in that domain with
+    :func:`identify_closed_loop`, which filters the model in the same way.
+
+    Parameters
+    ----------
+    t : array_like
+        Uniformly sampled time [s].
+    y1 : array_like
+        Position of the actuated mass (where the link acts) [m].
+    u : array_like
+        Actuator force (feedback plus feedforward) [N].
+    stage : TwoMassStage or python-control LTI system
+        The stage (its ``P1``) or ``P1 = y1 / (u - w)`` itself.
+    cutoff_hz : float, optional
+        Cut-off of ``B`` [Hz].  Default: 20 times the record's fundamental
+        frequency (estimated from the number of reversals of `y1`), at most a
+        twentieth of the sampling rate.
+
+    Returns
+    -------
+    LinkForce
+    """
+    ts = np.asarray(t, dtype=float)
+    ys = np.ascontiguousarray(np.asarray(y1, dtype=float))
+    us = np.asarray(u, dtype=float)
+    _check_signals(ys, {"u": us}, ts, xname="y1")
+    dts = np.diff(ts)
+    dt = float(np.median(dts))
+    if np.max(np.abs(dts - dt)) > UNIFORM_RTOL * dt:
+        raise ValueError("closed-loop records must be uniformly sampled; resample first")
+    num, den = _poly(getattr(stage, "P1", stage))
+    if num.size > den.size:
+        raise ValueError("P1 must be proper")
+    if num[-1] == 0:
+        raise ValueError("P1 must not have a zero at s = 0")
+    fs = 1.0 / dt
+    if cutoff_hz is None:
+        duration = float(ts[-1] - ts[0])
+        f0 = (count_reversals(ys) + 1) / (2.0 * duration)
+        cutoff_hz = min(20.0 * f0, fs / 20.0)
+    cutoff_hz = float(cutoff_hz)
+    if not (np.isfinite(cutoff_hz) and 0 < cutoff_hz < fs / 2):
+        raise ValueError(f"cutoff_hz must be in (0, {fs / 2:g}) Hz, got {cutoff_hz!r}")
+    wl = TWO_PI * cutoff_hz
+    order = den.size - 1
+    zb, pb, kb = butter(order, wl, analog=True, output="zpk")
+    n0 = float(num[-1])
+    L = HoldFilter(np.concatenate([zb, np.roots(num)]), pb, kb * num[0] / n0, dt, wl)
+    L_over_P1 = HoldFilter(np.concatenate([zb, np.roots(den)]), pb, kb * den[0] / n0, dt, wl)
+    # y1 enters through s^k factors: removing its first value keeps the filter well scaled
+    w_f = L(us) - L_over_P1(ys - ys[0])
+    settle = int(np.searchsorted(ts - ts[0], SETTLE_PERIODS / cutoff_hz))
+    if ts.size - settle < MIN_SAMPLES:
+        raise ValueError(f"too short: the prefilter settles in {SETTLE_PERIODS / cutoff_hz:.3g} "
+                         f"s, leaving {max(ts.size - settle, 0)} samples; record longer or "
+                         "raise cutoff_hz")
+    return LinkForce(t=ts, y1=ys, w=w_f, lowpass=L, cutoff_hz=cutoff_hz, settle_index=settle)
+
+
+def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
+                         n_elements: int | None = None, *, cutoff_hz: float | None = None,
+                         criterion: Criterion = "rms", rtol: float = 0.01,
+                         initial_state: Literal["fit", "relaxed"] = "fit",
+                         max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS
+                         ) -> Identification:
+    """Identify Maxwell-slip parameters from a closed-loop record ``(t, y1, u)`` of a stage.
+
+    The link force is inferred with :func:`infer_link_force` as ``L w``; the
+    model is fitted in the same domain, ``L[phi(y1)] + c`` against ``L w``
+    after the prefilter's start-up transient, so the prefilter's smoothing
+    and phase lag cause no bias.  Fit quality (``fit_rms`` etc.) refers to
+    the prefiltered force.
+
+    Parameters
+    ----------
+    t, y1, u, stage, cutoff_hz
+        As :func:`infer_link_force`.
+    n_elements, criterion, rtol, initial_state, max_elements, max_rows
+        As :func:`identify_maxwell_slip`.
+
+    Returns
+    -------
+    Identification
+    """
+    lf = infer_link_force(t, y1, u, stage, cutoff_hz)
+    if initial_state not in ("fit", "relaxed"):
+        raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
+    prob = _Problem(x=lf.y1, target=lf.w, rows=_rows(lf.settle_index, lf.y1.size, max_rows),
+                    filt=lf.lowpass, fit_initial=initial_state == "fit")
+    return _identify(prob, n_elements, criterion, rtol, max_elements, "prefiltered force")
+
+
+# --------------------------------------------------------------------------- CSV
+
+
+def _read_record(path: str | Path, names: tuple[str, ...]) -> NDArray[np.float64]:
+    """Named columns of a CSV file, with a clear error for rows of the wrong length."""
+    path = Path(path)
+    try:
+        with path.open(newline="") as fh:
+            reader = csv.reader(fh)
+            header = next(reader, None)
+            if not header:
+                raise ValueError(f"{path}: empty file, no header")
+            for row in reader:
+                if row and len(row) != len(header):
+                    raise ValueError(f"{path}: inconsistent lengths: line {reader.line_num} has "
+                                     f"{len(row)} fields, the header {len(header)}")
+    except OSError as exc:
+        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
+    return read_columns(path, names)
+
+
+def _load(path: str | Path, names: tuple[str, str, str], xname: str):
+    path = Path(path)
+    data = _read_record(path, names)
+    t, x, v = data[:, 0], data[:, 1], data[:, 2]
+    try:
+        _check_signals(x, {names[2]: v}, t, xname=xname)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+    return t, x, v
+
+
+def load_force_displacement_csv(path: str | Path
+                                ) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                           NDArray[np.float64]]:
+    """Read a force-displacement record from CSV.
+
+    The file has a header and the columns ``time,displacement,force``
+    (s, m, N; other columns are ignored).
+
+    Returns
+    -------
+    t, x, w : ndarray
+        Time [s], displacement [m], force [N].
+
+    Raises
+    ------
+    ValueError
+        With one line naming the file: unreadable, missing column, non-numeric
+        or non-finite value, rows of inconsistent length, fewer than
+        ``MIN_SAMPLES`` samples, time not strictly increasing, constant
+        displacement, or no reversal of the displacement.
+    """
+    return _load(path, ("time", "displacement", "force"), "displacement")
+
+
+def load_closed_loop_csv(path: str | Path
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                    NDArray[np.float64]]:
+    """Read a closed-loop record from CSV: header and columns ``time,y1,u`` (s, m, N).
+
+    Returns
+    -------
+    t, y1, u : ndarray
+        Time [s], position of the actuated mass [m], actuator force [N].
+
+    Raises
+    ------
+    ValueError
+        As :func:`load_force_displacement_csv` (with ``y1`` in place of the
+        displacement).
+    """
+    return _load(path, ("time", "y1", "u"), "y1")
+
+
+__all__ = [
+    "HoldFilter", "Identification", "LinkForce", "count_reversals", "identify_closed_loop",
+    "identify_maxwell_slip", "infer_link_force", "load_closed_loop_csv",
+    "load_force_displacement_csv",
+]
