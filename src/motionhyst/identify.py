@@ -26,16 +26,28 @@ unit-stiffness stop operator of threshold ``d`` and ``c`` a force offset.
    element's initial force ``w_i(0) = alpha_i fc_i, |alpha_i| <= 1`` with
    bounded :func:`scipy.optimize.least_squares` and the exact (almost
    everywhere) Jacobian of the stop operator.
-4. Model order: fits for ``N`` = 1 ... (merging the adjacent pair that costs
-   least, splitting the strongest element) are compared; the default
-   criterion picks the smallest ``N`` whose RMS residual is within 1 % of the
-   best RMS over all orders tried (``criterion="rms"``); ``criterion="bic"``
-   minimises ``n log(RSS / n) + p log n`` instead.
+4. Model order: fits for ``N`` = 1, 2, ... are compared (fewer elements by
+   merging the adjacent pair that costs least, more by adding the grid element
+   that best explains the residual, each refined).  The default criterion
+   (``criterion="rms"``) picks the smallest ``N`` whose RMS residual exceeds
+   the best over all orders tried by at most 1 % of that best or 0.1 % of the
+   force's RMS, whichever is larger; ``criterion="bic"`` minimises
+   ``n log(RSS / n) + p log n`` instead (prone to extra elements when the
+   residual is not white).
 5. Uncertainty: ``sigma^2 (J^T J)^-1`` at the optimum with
-   ``sigma^2 = RSS / (n - p)``; parameters the data cannot determine (e.g. the
-   slip force of an element that never slips) get an infinite standard
-   deviation.  The formula assumes white residuals; with coloured noise or
-   model error it is optimistic.
+   ``sigma^2 = RSS / (n - p)``; parameters the data cannot determine get an
+   infinite standard deviation.  An element that never slips is a spring: its
+   ``fc`` is only bounded below by its largest spring force (its standard
+   error is then infinite or merely local).  The formula assumes white residuals; with
+   coloured noise or model error (closed-loop records) it is optimistic.
+
+Closed-loop records
+-------------------
+``P1^-1`` is improper, so ``u`` and ``y1`` are passed through one proper
+prefilter ``L`` (a Butterworth low-pass times ``P1``'s numerator, see
+:func:`infer_link_force`), giving ``L w = L u - (L / P1) y1`` without ever
+forming ``P1^-1``.  The model is fitted in that filtered domain
+(``L[phi(y1)] + c`` against ``L w``), so the prefilter causes no bias.
 """
 
 from __future__ import annotations
@@ -72,7 +84,11 @@ MAX_ROWS = 50_000
 """Most samples used in the residual (the operators always run on the full record)."""
 REVERSAL_BAND = 0.01
 """A reversal is a retreat of more than this fraction of the range from a running extreme."""
-SETTLE_PERIODS = 8.0
+EXTRA_ORDER = 2
+"""Order of the prefilter beyond ``deg d1``: ``L / P1`` then rolls off at high frequency."""
+DECIMATED_RATE = 40.0
+"""Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""
+SETTLE_PERIODS = 10.0
 """Start-up transient of the closed-loop prefilter, in units of ``1 / cutoff_hz``."""
 UNIFORM_RTOL = 0.01
 """Allowed relative deviation of the closed-loop sampling interval from its median."""
@@ -216,8 +232,13 @@ class HoldFilter:
 
     def __init__(self, zeros: ArrayLike, poles: ArrayLike, gain: float, dt: float,
                  omega0: float) -> None:
-        z = np.asarray(zeros, dtype=complex) / omega0
-        p = np.asarray(poles, dtype=complex) / omega0
+        self.zeros = np.asarray(zeros, dtype=complex)
+        self.poles = np.asarray(poles, dtype=complex)
+        self.gain = float(gain)
+        self.dt = float(dt)
+        self.omega0 = float(omega0)
+        z = self.zeros / omega0
+        p = self.poles / omega0
         if z.size > p.size:
             raise ValueError("the filter must be proper")
         g = float(gain) * omega0 ** (z.size - p.size)
@@ -230,6 +251,10 @@ class HoldFilter:
         # steady state for a unit constant input: x = Ad x + Bd
         self._x_unit = solve(np.eye(self.Ad.shape[0]) - self.Ad, self.Bd)
         self.dc_gain = float(self.Dd + self.Cd @ self._x_unit)
+
+    def with_step(self, dt: float) -> HoldFilter:
+        """The same continuous filter discretised for sampling interval `dt` [s]."""
+        return HoldFilter(self.zeros, self.poles, self.gain, dt, self.omega0)
 
     def __call__(self, u: ArrayLike) -> NDArray[np.float64]:
         """Filter a signal (1-D) or each column of a 2-D array (time along axis 0)."""
@@ -341,8 +366,8 @@ def _refine(prob: _Problem, k, fc, alpha, c) -> _Fit:
         return _evaluate(prob, th, n, True)[1]
 
     sol = least_squares(fun, theta0, jac=jacobian, bounds=(lo, hi), x_scale="jac",
-                        method="trf", tr_solver="lsmr", ftol=1e-12, xtol=1e-12, gtol=1e-12,
-                        max_nfev=200)
+                        method="trf", tr_solver="lsmr", ftol=1e-10, xtol=1e-10, gtol=1e-10,
+                        max_nfev=100)
     k, fc, alpha, c = _unpack(sol.x, n, prob.fit_initial)
     r, J = _evaluate(prob, sol.x, n, True)
     return _Fit(k=k.copy(), fc=fc.copy(), alpha=alpha.copy(), c=c, rss=float(r @ r), J=J,
@@ -423,6 +448,17 @@ def _grow(prob: _Problem, fit: _Fit):
     return _sorted(np.append(fit.k, f / d), np.append(fit.fc, f), np.append(fit.alpha, 0.0))
 
 
+def _polish(prob: _Problem, fits: dict[int, _Fit], add, n_max: int) -> None:
+    """Second start for every order: grow the best fit with one element fewer.
+
+    Each order then has the better of two refinements (from the NNLS / merge
+    path and from the forward path), which guards against local minima.
+    """
+    for n in range(2, n_max + 1):
+        if n - 1 in fits:
+            add(_refine(prob, *_grow(prob, fits[n - 1]), fits[n - 1].c))
+
+
 def _clean(prob: _Problem, fit: _Fit) -> _Fit:
     """Drop elements that collapsed onto their bounds and refit."""
     keep = (fit.fc > 1e-6 * fit.fc.sum()) & (fit.k > 1e-6 * fit.k.sum())
@@ -457,15 +493,24 @@ def _covariance_std(fit: _Fit, n_rows: int) -> NDArray[np.float64]:
 
 
 def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol: float,
-              max_elements: int, signal_name: str) -> Identification:
+              atol: float, max_elements: int, signal_name: str) -> Identification:
     """Stages 1-5 of the module docstring on a prepared problem."""
     if criterion not in ("rms", "bic"):
         raise ValueError(f"unknown criterion {criterion!r}; use 'rms' or 'bic'")
     if n_elements is not None and (int(n_elements) != n_elements or n_elements < 1):
         raise ValueError(f"n_elements must be a positive integer, got {n_elements!r}")
-    if not (np.isfinite(rtol) and rtol >= 0):
-        raise ValueError(f"rtol must be finite and >= 0, got {rtol!r}")
+    for name, v in (("rtol", rtol), ("atol", atol)):
+        if not (np.isfinite(v) and v >= 0):
+            raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
     n_rows = prob.rows.size
+    w_rms = float(np.std(prob.y))
+
+    def rms(fit: _Fit) -> float:
+        return float(np.sqrt(fit.rss / n_rows))
+
+    def margin(r: float) -> float:  # an RMS change smaller than this is not significant
+        return max(rtol * r, atol * w_rms)
+
     k, fc, c = _nnls_start(prob)
     alpha = np.zeros(k.size)
     k, fc, alpha = _sorted(k, fc, alpha)
@@ -481,43 +526,32 @@ def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol
             fits[fit.n] = fit
         return fit
 
-    first = add(_refine(prob, k, fc, alpha, c))
+    cur = add(_refine(prob, k, fc, alpha, c))
+    while cur.n > 1:  # fewer elements: merge the adjacent pair that costs least
+        new = add(_refine(prob, *_best_merge(prob, cur.k, cur.fc, cur.alpha, cur.c), cur.c))
+        if new.n >= cur.n:
+            break
+        cur = new
+    n_top = int(n_elements) if n_elements is not None else int(max_elements)
+    cur = fits[max(fits)]
+    while cur.n < n_top:  # more elements: add the one that best explains the residual
+        new = add(_refine(prob, *_grow(prob, cur), cur.c))
+        if new.n <= cur.n:  # collapsed: the data hold no more elements
+            break
+        if n_elements is None and rms(new) > rms(cur) - margin(rms(cur)):
+            break
+        cur = new
+    _polish(prob, fits, add, n_top if n_elements is not None else max(fits))
     if n_elements is not None:
-        cur = first
-        while cur.n < n_elements:
-            new = add(_refine(prob, *_grow(prob, cur), cur.c))
-            if new.n <= cur.n:  # the split collapsed: the data hold no more elements
-                break
-            cur = new
-        cur = fits[max(fits)]
-        while cur.n > n_elements:
-            new = add(_refine(prob, *_best_merge(prob, cur.k, cur.fc, cur.alpha, cur.c), cur.c))
-            if new.n >= cur.n:
-                break
-            cur = new
         chosen = fits[min(fits, key=lambda m: (abs(m - int(n_elements)), m))]
         how = f"fixed: {int(n_elements)} element(s) requested"
     else:
-        cur = first
-        while cur.n > 1:
-            prev = cur.n
-            cur = add(_refine(prob, *_best_merge(prob, cur.k, cur.fc, cur.alpha, cur.c), cur.c))
-            if cur.n >= prev:
-                break
-        cur = fits[max(fits)]
-        while cur.n < max_elements:
-            new = add(_refine(prob, *_grow(prob, cur), cur.c))
-            if new.n <= cur.n or new.rss > (1.0 - rtol) ** 2 * cur.rss:
-                break
-            cur = new
         orders = sorted(fits)
         if criterion == "rms":
-            best = min(fits[n].rss for n in orders)
-            floor = (1e-6 * float(np.std(prob.y))) ** 2 * n_rows
-            limit = max((1.0 + rtol) ** 2 * best, floor)
-            chosen = fits[next(n for n in orders if fits[n].rss <= limit)]
-            how = (f"rms: smallest N with RMS residual within {100 * rtol:g} % of the best "
-                   f"(N tried: {', '.join(map(str, orders))})")
+            best = min(rms(fits[n]) for n in orders)
+            chosen = fits[next(n for n in orders if rms(fits[n]) <= best + margin(best))]
+            how = (f"rms: smallest N with RMS residual within {100 * rtol:g} % of the best or "
+                   f"{100 * atol:g} % of the force RMS (N tried: {', '.join(map(str, orders))})")
         else:
             bics = {n: _bic(fits[n].rss, n_rows, _n_params(n, prob.fit_initial)) for n in orders}
             chosen = fits[min(bics, key=bics.get)]
@@ -531,9 +565,9 @@ def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol
                  "k_std": float(k_std[i]), "fc_std": float(fc_std[i])} for i in order]
     y = prob.y
     tss = float(np.sum((y - y.mean()) ** 2))
-    rms = float(np.sqrt(chosen.rss / n_rows))
+    fit_rms = rms(chosen)
     ref_rms = float(np.sqrt(tss / n_rows))
-    candidates = [{"n_elements": m, "fit_rms": float(np.sqrt(fits[m].rss / n_rows)),
+    candidates = [{"n_elements": m, "fit_rms": rms(fits[m]),
                    "bic": _bic(fits[m].rss, n_rows, _n_params(m, prob.fit_initial))}
                   for m in sorted(fits)]
     return Identification(
@@ -542,8 +576,8 @@ def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol
         offset=chosen.c,
         offset_std=float(std[-1]),
         initial_forces=(chosen.alpha * chosen.fc)[order],
-        fit_rms=rms,
-        fit_nrms=rms / ref_rms if ref_rms > 0 else float("inf"),
+        fit_rms=fit_rms,
+        fit_nrms=fit_rms / ref_rms if ref_rms > 0 else float("inf"),
         r2=1.0 - chosen.rss / tss if tss > 0 else float("nan"),
         n_samples=int(n_rows),
         criterion=how,
@@ -661,7 +695,8 @@ def _rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
 
 def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = None, *,
                           t: ArrayLike | None = None, criterion: Criterion = "rms",
-                          rtol: float = 0.01, initial_state: Literal["fit", "relaxed"] = "fit",
+                          rtol: float = 0.01, atol: float = 1e-3,
+                          initial_state: Literal["fit", "relaxed"] = "fit",
                           max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS
                           ) -> Identification:
     """Identify Maxwell-slip (parallel Jenkins, eq. 3) parameters from a force-displacement record.
@@ -680,11 +715,15 @@ def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = N
         rate-independent.
     criterion : {"rms", "bic"}
         Order selection: ``"rms"`` takes the smallest number of elements whose
-        RMS residual is within `rtol` of the best over all orders tried;
-        ``"bic"`` minimises the Bayesian information criterion.
-    rtol : float
-        Relative RMS tolerance of the ``"rms"`` criterion (and the smallest
-        improvement for which another element is tried).
+        RMS residual exceeds the best over all orders tried by no more than
+        ``max(rtol * best, atol * RMS(w - mean w))``; ``"bic"`` minimises the
+        Bayesian information criterion ``n log(RSS / n) + p log n``.
+    rtol, atol : float
+        Relative and absolute (as a fraction of the force's RMS) tolerances of
+        the ``"rms"`` criterion; another element is tried only while it
+        improves the RMS residual by more than this margin.  `atol` keeps
+        elements that explain less than 0.1 % of the force out of nearly
+        noise-free fits.
     initial_state : {"fit", "relaxed"}
         ``"fit"`` estimates each element's force at the first sample (records
         that start in an unknown state); ``"relaxed"`` takes every element as
@@ -719,7 +758,7 @@ def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = N
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
     prob = _Problem(x=xs, target=ws, rows=_rows(0, xs.size, max_rows), filt=None,
                     fit_initial=initial_state == "fit")
-    return _identify(prob, n_elements, criterion, rtol, max_elements, "force")
+    return _identify(prob, n_elements, criterion, rtol, atol, max_elements, "force")
 
 
 def _poly(sys) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -770,15 +809,20 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     ``L(s) = B(s) n1(s) / n1(0)``,  hence ``L / P1 = B(s) d1(s) / n1(0)``,
 
     where ``P1 = n1 / d1`` and ``B`` is a Butterworth low-pass of order
-    ``deg d1`` (unit DC gain).  ``L`` contains ``P1``'s zeros, so the inverse
-    has no poles from them (for the stage: no lightly damped
+    ``deg d1 + 2`` (unit DC gain).  ``L`` contains ``P1``'s zeros, so the
+    inverse has no poles from them (for the stage: no lightly damped
     anti-resonance that would ring); both filters have only ``B``'s
-    well-damped poles.  They are discretised with a first-order hold, i.e.
-    applied exactly to the linear interpolation of the samples: the
-    interpolation error is then common to ``u`` and ``y1`` and cancels up to
-    ``O(dt^2)`` times ``w`` itself, not times the much larger ``u`` (rigid-body
-    forces).  The result is ``L w`` (not ``w``): identify in that domain with
-    :func:`identify_closed_loop`, which filters the model in the same way.
+    well-damped poles.  The two extra orders make ``L / P1`` roll off above
+    the cut-off.  Both filters are discretised with a first-order hold, i.e.
+    applied exactly to the linear interpolation of the samples: at low
+    frequencies the interpolation error is then common to ``u`` and ``y1``
+    and cancels up to ``O(dt^2)`` times ``w`` itself, not times the much
+    larger ``u`` (rigid-body forces); the interpolation's images near the
+    sampling rate are suppressed by the roll-off.  Keep the cut-off well
+    below the sampling rate (the image error grows like ``(cutoff * dt)^2``
+    relative to the rigid-body force).  The result is ``L w`` (not ``w``):
+    identify in that domain with :func:`identify_closed_loop`, which filters
+    the model in the same way.
 
     Parameters
     ----------
@@ -821,7 +865,7 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     if not (np.isfinite(cutoff_hz) and 0 < cutoff_hz < fs / 2):
         raise ValueError(f"cutoff_hz must be in (0, {fs / 2:g}) Hz, got {cutoff_hz!r}")
     wl = TWO_PI * cutoff_hz
-    order = den.size - 1
+    order = den.size - 1 + EXTRA_ORDER
     zb, pb, kb = butter(order, wl, analog=True, output="zpk")
     n0 = float(num[-1])
     L = HoldFilter(np.concatenate([zb, np.roots(num)]), pb, kb * num[0] / n0, dt, wl)
@@ -838,7 +882,7 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
 
 def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
                          n_elements: int | None = None, *, cutoff_hz: float | None = None,
-                         criterion: Criterion = "rms", rtol: float = 0.01,
+                         criterion: Criterion = "rms", rtol: float = 0.01, atol: float = 1e-3,
                          initial_state: Literal["fit", "relaxed"] = "fit",
                          max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS
                          ) -> Identification:
@@ -854,7 +898,7 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     ----------
     t, y1, u, stage, cutoff_hz
         As :func:`infer_link_force`.
-    n_elements, criterion, rtol, initial_state, max_elements, max_rows
+    n_elements, criterion, rtol, atol, initial_state, max_elements, max_rows
         As :func:`identify_maxwell_slip`.
 
     Returns
@@ -864,9 +908,16 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     lf = infer_link_force(t, y1, u, stage, cutoff_hz)
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
-    prob = _Problem(x=lf.y1, target=lf.w, rows=_rows(lf.settle_index, lf.y1.size, max_rows),
-                    filt=lf.lowpass, fit_initial=initial_state == "fit")
-    return _identify(prob, n_elements, criterion, rtol, max_elements, "prefiltered force")
+    # L w is band-limited: fit on every q-th sample (the model's prefilter re-discretised)
+    dt = lf.lowpass.dt
+    q = max(1, int(1.0 / (dt * DECIMATED_RATE * lf.cutoff_hz)))
+    sel = np.arange(0, lf.y1.size, q)
+    start = int(np.searchsorted(sel, lf.settle_index))
+    prob = _Problem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],
+                    rows=_rows(start, sel.size, max_rows), filt=lf.lowpass.with_step(q * dt),
+                    fit_initial=initial_state == "fit")
+    return _identify(prob, n_elements, criterion, rtol, atol, max_elements,
+                     "prefiltered force")
 
 
 # --------------------------------------------------------------------------- CSV
