@@ -1,4 +1,4 @@
-"""Command-line interface: ``motionhyst df | analyze | simulate | reproduce``.
+"""Command-line interface: ``motionhyst df | analyze | simulate | identify | reproduce``.
 
 A thin layer: it parses arguments, calls the library and prints tables or
 JSON.  Every user error ends in one line on stderr and exit code 2.
@@ -263,6 +263,143 @@ def _time_series(args: argparse.Namespace, sc, amplitude: float, frequency: floa
     return 0
 
 
+# ---------------------------------------------------------------------- identify
+RECORD_KINDS = {"force-displacement": ("time", "displacement", "force"),
+                "closed-loop": ("time", "y1", "u")}
+"""CSV columns that identify a record's kind (``motionhyst identify``)."""
+
+
+def _element_count(text: str) -> int:
+    """argparse type: a whole number of Jenkins elements from 1 to 20."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 1 <= n <= 20:
+        raise argparse.ArgumentTypeError(f"must be from 1 to 20, got {text!r}")
+    return n
+
+
+def record_kind(path: str | Path) -> str:
+    """The kind of a measured record from its CSV header.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file with a header row.
+
+    Returns
+    -------
+    str
+        ``"force-displacement"`` (columns ``time,displacement,force``) or
+        ``"closed-loop"`` (columns ``time,y1,u``); the first when both fit.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file: unreadable, empty, or a header of neither kind.
+    """
+    from motionhyst.csvdata import read_header
+
+    header = set(read_header(path))
+    for kind, names in RECORD_KINDS.items():
+        if header.issuperset(names):
+            return kind
+    expected = " or ".join(f"{','.join(n)} ({k})" for k, n in RECORD_KINDS.items())
+    raise ValueError(f"{path}: unknown record header {','.join(read_header(path))!r}; "
+                     f"expected {expected}")
+
+
+def _toml_float(v: float) -> str:
+    """A float as a TOML float literal with 7 significant digits."""
+    s = repr(float(f"{float(v):.7g}"))
+    return s if any(c in s for c in ".en") else s + ".0"
+
+
+def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
+    """A ``[feedforward]`` section with the identified hysteresis, ready to paste (TOML).
+
+    One element is written as ``model = "jenkins"`` with scalars, more as
+    ``model = "maxwell-slip"`` with lists (as
+    :meth:`motionhyst.identify.Identification.scenario_fragment`).
+    """
+    if len(k) == 1:
+        table = (f'{{ model = "jenkins", k = {_toml_float(k[0])}, '
+                 f"fc = {_toml_float(fc[0])} }}")
+    else:
+        table = (f'{{ model = "maxwell-slip", k = [{", ".join(map(_toml_float, k))}], '
+                 f'fc = [{", ".join(map(_toml_float, fc))}] }}')
+    return ('[feedforward]\ntype = "rigid-body"   # u_ff = M r\'\' + phi_hat(r)\n'
+            f"hysteresis = {table}\n")
+
+
+def _std_text(value: float, std: float) -> str:
+    if not math.isfinite(std):
+        return "not determined"
+    return f"{std:.2g} ({100 * std / value:.2g} %)"
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    """Identify Maxwell-slip hysteresis from a measured record (CSV)."""
+    from motionhyst.identify import (
+        identify_closed_loop,
+        identify_maxwell_slip,
+        load_closed_loop_csv,
+        load_force_displacement_csv,
+    )
+    from motionhyst.scenario import load_scenario
+    from motionhyst.systems import TwoMassStage
+
+    path = Path(args.data)
+    kind = record_kind(path)
+    if kind == "force-displacement" and args.scenario is not None:
+        raise UsageError("motionhyst identify: --scenario applies to closed-loop records "
+                         f"(time,y1,u) only; {path} is a force-displacement record")
+    options = {"n_elements": args.elements, "criterion": args.criterion}
+    extra: dict = {"record": kind, "data": str(path)}
+    if kind == "force-displacement":
+        t, x, w = load_force_displacement_csv(path)
+        what = "force-displacement record"
+        try:
+            ident = identify_maxwell_slip(x, w, t=t, **options)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+    else:
+        sc = load_scenario(args.scenario)
+        plant = sc.plant()
+        if not isinstance(plant, TwoMassStage):
+            raise UsageError(f"motionhyst identify: closed-loop records need a [stage] in the "
+                             f"scenario (P1 as a model); {sc.source} has a measured [plant]")
+        t, y1, u = load_closed_loop_csv(path)
+        what = f"closed-loop record, plant of {sc.source}"
+        extra["scenario"] = sc.source
+        try:
+            ident = identify_closed_loop(t, y1, u, plant, **options)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+    k = [e["k"] for e in ident.elements]
+    fc = [e["fc"] for e in ident.elements]
+    if args.json:
+        _print_json({**ident.to_dict(), **extra})
+        return 0
+    print(f"Maxwell-slip hysteresis identified from {path} ({what}, {ident.n_samples} samples)")
+    print(f"  elements: {ident.n_elements}   ({ident.criterion})")
+    print(f"  fit RMS {_g(ident.fit_rms)} N = {100 * ident.fit_nrms:.3g} % of the "
+          f"{ident.signal} RMS, R^2 = {ident.r2:.6f}, offset {_g(ident.offset)} N")
+    print()
+    rows = [[str(i), _g(e["k"], 6), _std_text(e["k"], e["k_std"]), _g(e["fc"], 6),
+             _std_text(e["fc"], e["fc_std"]), _g(e["fc"] / e["k"] * 1e3)]
+            for i, e in enumerate(ident.elements, start=1)]
+    print(_table(["i", "k [N/m]", "std k [N/m]", "fc [N]", "std fc [N]", "fc/k [mm]"], rows))
+    print()
+    print(f"  total stiffness {_g(sum(k), 6)} N/m, total slip force {_g(sum(fc), 6)} N")
+    print()
+    print("# hysteresis feedforward, to paste into a scenario (replaces its [feedforward];")
+    print("# the same inline table is a valid [hysteresis] section to model the link):")
+    print(feedforward_fragment(k, fc), end="")
+    return 0
+
+
 # --------------------------------------------------------------------- reproduce
 def cmd_reproduce(args: argparse.Namespace) -> int:
     """The paper's figures and numbers for a scenario, as a report."""
@@ -322,6 +459,21 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--j-max", type=positive, default=1000.0, help="jerk limit [m/s^3] (1000)")
     q.add_argument("--duration", type=positive, help="simulated time [s]")
     q.set_defaults(func=cmd_simulate)
+
+    q = sub.add_parser("identify", help="identify Maxwell-slip hysteresis from a measured "
+                       "record (CSV)")
+    q.add_argument("data", metavar="DATA.csv",
+                   help="record with a header: time,displacement,force (force-displacement) or "
+                        "time,y1,u (closed-loop) [SI units]")
+    q.add_argument("--elements", type=_element_count, metavar="N",
+                   help="number of Jenkins elements (default: chosen by --criterion)")
+    q.add_argument("--criterion", choices=["rms", "bic"], default="rms",
+                   help="model-order criterion when --elements is not given (default: rms)")
+    q.add_argument("--scenario", metavar="FILE",
+                   help="scenario TOML whose [stage] gives P1 for closed-loop records "
+                        "(default: the paper's Table I)")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=cmd_identify)
 
     q = sub.add_parser("reproduce", help="the paper's figures and numbers, as a report")
     q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
