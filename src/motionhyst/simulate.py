@@ -16,15 +16,24 @@ tune it.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import control
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
+from scipy.linalg import expm
 from scipy.signal import cont2discrete
 
-from motionhyst.hysteresis import Jenkins
+from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
+from motionhyst.hysteresis._ode_kernels import (
+    GL_T,
+    GL_W,
+    bouc_wen_advance,
+    dahl_advance,
+    lugre_g,
+)
 from motionhyst.loop import Loop, _cancel_s, _polysub_exact
 from motionhyst.systems import TWO_PI
 
@@ -84,8 +93,26 @@ def _realize(num, den, omega0: float):
     return sys.A, sys.B, sys.C, sys.D
 
 
-def _block_system(loop: Loop, omega0: float):
-    """Stacked realisation, inputs (r'', w), outputs (e, y1 - r)."""
+def _stack(mats):
+    """Block-diagonal stack of single-input realisations sharing that input, one output each."""
+    n = sum(a.shape[0] for a, _, _, _ in mats)
+    A = np.zeros((n, n))
+    B = np.zeros((n, 1))
+    C = np.zeros((len(mats), n))
+    D = np.zeros((len(mats), 1))
+    k = 0
+    for o, (a, b, c, d) in enumerate(mats):
+        m = a.shape[0]
+        A[k:k + m, k:k + m] = a
+        B[k:k + m, 0] = b[:, 0]
+        C[o, k:k + m] = c[0]
+        D[o, 0] = d[0, 0]
+        k += m
+    return A, B, C, D
+
+
+def _block_systems(loop: Loop, omega0: float):
+    """Realisations in scaled time of ``r'' -> (e, y1 - r)`` and ``w -> (e, y1 - r)``."""
     P = loop._poly
     if P is None:
         raise ValueError("time simulation needs LTI plant and controller")
@@ -93,85 +120,294 @@ def _block_system(loop: Loop, omega0: float):
     n_ae = _divide_s2(P["r->e"].num, P["r->e"].den, "the error response to the reference")
     n_ay = _divide_s2(_polysub_exact(ry1.num, ry1.den), ry1.den,
                       "the response of y1 - r to the reference")
-    blocks = [(n_ae, 0, 0), ((P["w->e"].num, P["w->e"].den), 1, 0),
-              (n_ay, 0, 1), ((P["w->y1"].num, P["w->y1"].den), 1, 1)]
-    mats = [(_realize(num, den, omega0), i, o) for (num, den), i, o in blocks]
-    n = sum(m[0][0].shape[0] for m in mats)
-    A = np.zeros((n, n))
-    B = np.zeros((n, 2))
-    C = np.zeros((2, n))
-    D = np.zeros((2, 2))
-    k = 0
-    for (a, b, c, d), i, o in mats:
-        m = a.shape[0]
-        A[k:k + m, k:k + m] = a
-        B[k:k + m, i] = b[:, 0]
-        C[o, k:k + m] = c[0]
-        D[o, i] += d[0, 0]
-        k += m
-    return A, B, C, D
+    sys_a = _stack([_realize(num, den, omega0) for num, den in (n_ae, n_ay)])
+    sys_w = _stack([_realize(P[name].num, P[name].den, omega0) for name in ("w->e", "w->y1")])
+    return sys_a, sys_w
+
+
+def _discretize(sys, h: float):
+    """First-order-hold (input linear between samples) discretisation with step `h`."""
+    Ad, Bd, Cd, Dd, _ = cont2discrete(sys, h, method="foh")
+    return (np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), np.ascontiguousarray(Cd),
+            np.ascontiguousarray(Dd))
+
+
+# element kinds of the compiled loop (one row of parameters each)
+_STOP, _DAHL, _BOUC_WEN, _LUGRE = 0, 1, 2, 3
+_N_PARAMS = 6
+MAX_FIXED_POINT_ITERATIONS = 50
 
 
 @njit(cache=True)
-def _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0, uh):  # pragma: no cover - compiled
+def _advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no cover
+    """New state and force of one element after a displacement `dx` over a time `h`.
+
+    ``code``/``p`` as built by :func:`_elements`; the displacement is taken as
+    linear in time over the step (monotone for the rate-independent kinds).
+    `s_prev` and `dx_prev` are the state and the displacement one step earlier,
+    used by LuGre only and ignored on the `first` step.
+    """
+    if code == _STOP:  # p = (k, fc); state w: exact stop operator
+        v = s + p[0] * dx
+        if v > p[1]:
+            v = p[1]
+        elif v < -p[1]:
+            v = -p[1]
+        return v, v
+    if code == _DAHL:  # p = (k / fc, fc, alpha); state w / fc
+        du = p[0] * dx
+        if du > 0.0:
+            s = dahl_advance(s, du, p[2])
+        elif du < 0.0:
+            s = -dahl_advance(-s, -du, p[2])
+        return s, p[1] * s
+    if code == _BOUC_WEN:  # p = (k / fc, fc, n, beta + gamma, beta - gamma, hmax); state w / fc
+        du = p[0] * dx
+        if du > 0.0:
+            s = bouc_wen_advance(s, du, p[2], p[3], p[4], p[5], glt, glw)
+        elif du < 0.0:
+            s = -bouc_wen_advance(-s, -du, p[2], p[3], p[4], p[5], glt, glw)
+        return s, p[1] * s
+    # LuGre, p = (sigma0, sigma1, sigma2, fc, fs, vs); state z.  As in lugre_response, z
+    # relaxes exactly to q for the step's constant velocity (g constant).  The rates in
+    # the force are taken at the sample by the second-order backward difference,
+    # v = (3 dx - dx_prev) / (2 h) and z' likewise from z: the step's mean velocity is half
+    # a step late (first order), and z' from the state equation at the sample would
+    # amplify the error of z by h / tau when the bristles relax within a step (tau =
+    # g / (sigma0 |v|) < h, stiff bristles).
+    sigma0 = p[0]
+    if h <= 0.0:
+        return s, sigma0 * s
+    z0 = s
+    if dx != 0.0:
+        g = lugre_g(dx / h, p[3], p[4], p[5])
+        q = g / sigma0 if dx > 0.0 else -g / sigma0
+        s = q + (s - q) * math.exp(-sigma0 * abs(dx) / g)
+    if first:
+        v = dx / h
+        zdot = (s - z0) / h
+    else:
+        v = (1.5 * dx - 0.5 * dx_prev) / h
+        zdot = (1.5 * (s - z0) - 0.5 * (z0 - s_prev)) / h
+    return s, sigma0 * s + p[1] * zdot + p[2] * v
+
+
+@njit(cache=True)
+def _open_loop(codes, params, s0, x, h, glt, glw):  # pragma: no cover - compiled
+    """Force of the elements for the displacement samples `x` (step `h`), from rest at ``x[0]``."""
+    n_t = x.shape[0]
+    s = s0.copy()
+    s_prev = s0.copy()
+    w = np.empty(n_t)
+    dx_prev = 0.0
+    for i in range(n_t):
+        dx = x[i] - x[i - 1] if i > 0 else 0.0
+        wt = 0.0
+        for j in range(codes.shape[0]):
+            sj, f = _advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
+                             h if i > 0 else 0.0, i == 1, glt, glw)
+            s_prev[j] = s[j]
+            s[j] = sj
+            wt += f
+        w[i] = wt
+        dx_prev = dx
+    return w
+
+
+@njit(cache=True)
+def _lsim(Ad, Bd, Cd, Dd, u, x0):  # pragma: no cover - compiled
+    """Outputs ``(n_t, p)`` of the discrete system ``x+ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
+    n_t = u.shape[0]
+    n_x = Ad.shape[0]
+    n_y = Cd.shape[0]
+    x = x0.copy()
+    xn = np.empty(n_x)
+    y = np.empty((n_t, n_y))
+    for i in range(n_t):
+        ui = u[i]
+        for o in range(n_y):
+            acc = Dd[o, 0] * ui
+            for j in range(n_x):
+                acc += Cd[o, j] * x[j]
+            y[i, o] = acc
+        for j in range(n_x):
+            acc = Bd[j, 0] * ui
+            for q in range(n_x):
+                acc += Ad[j, q] * x[q]
+            xn[j] = acc
+        x, xn = xn, x
+    return y
+
+
+@njit(cache=True)
+def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, ftol,
+         max_iter):  # pragma: no cover - compiled
+    """The loop driven by the hysteresis force, around the linear response to ``r''``.
+
+    ``Ad .. Dd`` realise ``w - u_h -> (e, y1 - r)`` (first-order hold);
+    ``e_lin``, ``dev_lin`` are the responses to ``r''``.  Each step is implicit
+    in ``w`` through the feedthrough ``Dd``: a fixed-point iteration, stopped
+    when ``w`` changes by at most `ftol`.  Returns ``e``, ``y1 - r``, ``w`` and
+    the largest number of iterations used (``max_iter + 1`` if one step failed
+    to converge; the run stops there).
+    """
     n_t = r.shape[0]
     n_x = Ad.shape[0]
-    m = k.shape[0]
-    x = x0.copy()
-    e = np.empty(n_t)
-    y1 = np.empty(n_t)
-    w = np.empty(n_t)
-    we = np.zeros(m)
-    y1_prev = r[0]
+    m = codes.shape[0]
+    x = np.zeros(n_x)
+    xn = np.zeros(n_x)
+    s = s0.copy()
+    s_new = s0.copy()
+    s_prev = s0.copy()
+    e = np.zeros(n_t)
+    dev = np.zeros(n_t)
+    w = np.zeros(n_t)
+    worst = 0
+    r_prev = r[0]
+    dev_prev = 0.0  # the element starts at rest at y1 = r(0)
+    w_prev = 0.0
+    dx_prev = 0.0
+    for j in range(m):
+        w_prev += _advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
     for i in range(n_t):
-        base_e = Dd[0, 0] * a[i]
-        base_y = Dd[1, 0] * a[i]
+        base_e = e_lin[i]
+        base_y = dev_lin[i]
         for j in range(n_x):
             base_e += Cd[0, j] * x[j]
             base_y += Cd[1, j] * x[j]
-        # implicit in w through the hold's feedthrough (|k Dd| << 1): fixed point
-        wt = 0.0
-        for j in range(m):
-            wt += we[j]
-        w_new = we.copy()
-        for _ in range(4):
-            yi = r[i] + base_y + Dd[1, 1] * (wt - uh[i])
-            dx = yi - y1_prev
-            wt = 0.0
+        hi = h if i > 0 else 0.0
+        dr = r[i] - r_prev
+        wt = w_prev
+        d = base_y + Dd[1, 0] * (wt - uh[i])
+        it = 0
+        step_prev = np.inf
+        while True:
+            it += 1
+            dx = dr + (d - dev_prev)
+            wn = 0.0
             for j in range(m):
-                v = we[j] + k[j] * dx
-                if v > fc[j]:
-                    v = fc[j]
-                elif v < -fc[j]:
-                    v = -fc[j]
-                w_new[j] = v
-                wt += v
-        yi = r[i] + base_y + Dd[1, 1] * (wt - uh[i])
-        for j in range(m):
-            we[j] = w_new[j]
-        y1_prev = yi
-        e[i] = base_e + Dd[0, 1] * (wt - uh[i])
-        y1[i] = yi
+                s_new[j], f = _advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, hi,
+                                       i == 1, glt, glw)
+                wn += f
+            d_next = base_y + Dd[1, 0] * (wn - uh[i])
+            # converged when w settles or y1 - r changes by a few ulps only; or at the
+            # round-off floor: no longer contracting while y1 - r moves by < 1e-12 of itself
+            # (a steep element, e.g. LuGre's sigma1 z' / dt, amplifies the round-off of z)
+            step_w = abs(wn - wt)
+            step_d = abs(d_next - d)
+            scale_d = abs(d) + abs(dx)
+            done = (step_w <= ftol or step_d <= 1e-15 * scale_d
+                    or (it >= 3 and step_w >= 0.5 * step_prev and step_d <= 1e-12 * scale_d))
+            step_prev = step_w
+            wt = wn
+            if done or m == 0:
+                break  # d: the y1 - r the element was advanced with
+            d = d_next
+            if it > max_iter:
+                return e[:i], dev[:i], w[:i], it
+        if it > worst:
+            worst = it
+        s_prev, s, s_new = s, s_new, s_prev
+        e[i] = base_e + Dd[0, 0] * (wt - uh[i])
+        dev[i] = d
         w[i] = wt
-        xn = np.zeros(n_x)
+        dx_prev = dr + (d - dev_prev)
+        r_prev = r[i]
+        dev_prev = d
+        w_prev = wt
         for j in range(n_x):
-            s = Bd[j, 0] * a[i] + Bd[j, 1] * (wt - uh[i])
+            acc = Bd[j, 0] * (wt - uh[i])
             for q in range(n_x):
-                s += Ad[j, q] * x[q]
-            xn[j] = s
-        x = xn
-    return e, y1, w
+                acc += Ad[j, q] * x[q]
+            xn[j] = acc
+        x, xn = xn, x
+    return e, dev, w, worst
 
 
-def _stop_parameters(loop: Loop) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    h = loop.hysteresis
+@njit(cache=True)
+def _foh_states(Ad, Bd0, Bd1, C, D, u):  # pragma: no cover - compiled
+    """Output of ``x_i = Ad x_{i-1} + Bd0 u_{i-1} + Bd1 u_i``, ``y = C x + D u`` from rest."""
+    n_t = u.shape[0]
+    n_x = Ad.shape[0]
+    x = np.zeros(n_x)
+    xn = np.zeros(n_x)
+    y = np.empty(n_t)
+    for i in range(n_t):
+        if i > 0:
+            for j in range(n_x):
+                acc = 0.0
+                for q in range(n_x):
+                    acc += Ad[j, q] * x[q]
+                xn[j] = acc + Bd0[j] * u[i - 1] + Bd1[j] * u[i]
+            x, xn = xn, x
+        acc = 0.0
+        for j in range(n_x):
+            acc += C[j] * x[j]
+        y[i] = acc + D * u[i]
+    return y
+
+
+def _filter_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Response from rest of the SISO LTI `sys` to `u`, linear between the uniform samples `t`.
+
+    The algorithm and realisation of :func:`control.forced_response` (exact for
+    an input linear between samples), with the time loop compiled.
+    """
+    ss = control.ss(sys)
+    A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
+    C, D = np.asarray(ss.C, float), np.asarray(ss.D, float)
+    n = A.shape[0]
+    if n == 0:
+        return D[0, 0] * u
+    h = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
+    M = np.zeros((n + 2, n + 2))
+    M[:n, :n] = A * h
+    M[:n, n] = B[:, 0] * h
+    M[n, n + 1] = 1.0
+    E = expm(M)
+    Ad = np.ascontiguousarray(E[:n, :n])
+    Bd1 = np.ascontiguousarray(E[:n, n + 1])
+    Bd0 = np.ascontiguousarray(E[:n, n] - Bd1)
+    return _foh_states(Ad, Bd0, Bd1, np.ascontiguousarray(C[0]), float(D[0, 0]), u)
+
+
+def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float64],
+                                             NDArray[np.float64], float]:
+    """Kinds, parameters, initial states (at rest) and a force scale [N] of the link's elements.
+
+    Raises
+    ------
+    ValueError
+        For a model the compiled loop has no exact update for.
+    """
     if h is None:
-        return np.zeros(1), np.ones(1)
-    if isinstance(h, Jenkins):
-        return np.array([h.k]), np.array([h.fc])
-    if hasattr(h, "stop_parameters"):
-        return h.stop_parameters()
-    raise ValueError(f"time simulation does not support the {h.name} model yet")
+        return np.zeros(0, np.int64), np.zeros((0, _N_PARAMS)), np.zeros(0), 1.0
+    if isinstance(h, Dahl):
+        rows = [(_DAHL, (h.k / h.fc, h.fc, h.alpha))]
+        scale = h.fc
+    elif isinstance(h, BoucWen):
+        rows = [(_BOUC_WEN, (h.k / h.fc, h.fc, h.n, h.beta + h.gamma, h.beta - h.gamma,
+                             h._step()))]
+        scale = h.saturation_force
+    elif isinstance(h, LuGre):
+        rows = [(_LUGRE, (h.sigma0, h.sigma1, h.sigma2, h.fc, h.fs, h.vs))]
+        scale = max(h.fc, h.fs)
+    elif isinstance(h, Jenkins):
+        rows = [(_STOP, (h.k, h.fc))]
+        scale = h.fc
+    elif isinstance(h, MaxwellSlip):
+        k, fc = h.stop_parameters()
+        rows = [(_STOP, (float(kj), float(fj))) for kj, fj in zip(k, fc, strict=True)]
+        scale = float(np.sum(fc))
+    else:
+        raise ValueError(f"time simulation does not support the {h.name!r} model "
+                         f"({type(h).__name__}); supported: Jenkins, MaxwellSlip, Dahl, "
+                         "BoucWen, LuGre")
+    codes = np.array([c for c, _ in rows], dtype=np.int64)
+    params = np.zeros((len(rows), _N_PARAMS))
+    for j, (_, p) in enumerate(rows):
+        params[j, :len(p)] = p
+    return codes, params, np.zeros(len(rows)), float(scale)
 
 
 def default_step(loop: Loop, max_frequency_hz: float) -> float:
@@ -184,10 +420,22 @@ def default_step(loop: Loop, max_frequency_hz: float) -> float:
 def simulate(loop: Loop, reference, duration: float, dt: float | None = None) -> Simulation:
     """Simulate the nonlinear loop from rest.
 
+    The linear part is discretised exactly for inputs linear between samples
+    (first-order hold); the link is advanced between samples by its exact
+    update for a displacement linear in time: the stop operator (Jenkins,
+    Maxwell-slip), the closed-form Dahl and Bouc-Wen (``n = 1``) solutions or
+    converged RK4 sub-steps (Bouc-Wen, other ``n``), and the exponential LuGre
+    update for the step's constant velocity (force ``sigma0 z + sigma1 z' +
+    sigma2 v`` with the velocity of the step ending at the sample, as in
+    :meth:`~motionhyst.hysteresis.LuGre.response`).  Each step is implicit in
+    ``w`` through the hold's feedthrough and solved by fixed-point iteration.
+
     Parameters
     ----------
     loop : Loop
-        An LTI loop whose plant has a rigid-body double integrator.
+        An LTI loop whose plant has a rigid-body double integrator; its link
+        and hysteresis feedforward (if any) one of Jenkins, MaxwellSlip, Dahl,
+        BoucWen, LuGre.
     reference : callable
         ``reference(t) -> (r, r'')``, e.g. the classes of :mod:`motionhyst.references`.
     duration : float
@@ -198,11 +446,23 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
     Returns
     -------
     Simulation
+
+    Raises
+    ------
+    ValueError
+        For invalid arguments, a loop that is not LTI or a link model without
+        a time-domain update.
+    RuntimeError
+        If the implicit step does not converge (a link too stiff for the step).
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
     if loop.feedforward != "rigid-body" and loop.feedforward is not None:
         raise ValueError("unknown feedforward")
+    codes, params, s0, f_scale = _elements(loop.hysteresis)
+    hff = loop.hysteresis_feedforward
+    if hff is not None:
+        _elements(hff)  # the same models are supported as feedforward
     f_ref = getattr(reference, "max_frequency_hz", 1.0)
     step = default_step(loop, f_ref) if dt is None else float(dt)
     if not (np.isfinite(step) and step > 0):
@@ -214,24 +474,36 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
     r, a = reference(t)
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(a))):
         raise ValueError("the reference has non-finite values")
+    r = np.ascontiguousarray(r, dtype=float)
+    a = np.ascontiguousarray(a, dtype=float)
     omega0 = float(np.max(np.abs(loop.closed_loop_poles())))
-    A, B, C, D = _block_system(loop, omega0)
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), omega0 * step, method="foh")
+    sys_a, sys_w = _block_systems(loop, omega0)
     # a reference that starts with a velocity v0 has r'' = v0 delta(t) + ...: the impulse
     # sets the initial state (delta(t) = omega0 delta(tau) in scaled time)
     v0 = float(getattr(reference, "initial_velocity", 0.0))
-    x0 = B[:, 0] * v0 * omega0
-    k, fc = _stop_parameters(loop)
-    if loop.hysteresis is None:
-        k = np.zeros(1)
+    x0 = sys_a[1][:, 0] * v0 * omega0
+    lin = _lsim(*_discretize(sys_a, omega0 * step), a, x0)
+    e_lin = np.ascontiguousarray(lin[:, 0])
     # hysteresis feedforward u_h = phi_hat(r) acts like -w on the loop
-    hff = loop.hysteresis_feedforward
-    uh = hff.response(r) if hff is not None else np.zeros_like(r)
-    e, y1, w = _run(Ad, Bd, Cd, Dd, r, a, k, fc, x0, uh)
-    e_lin, _, _ = _run(Ad, Bd, Cd, Dd, r, a, np.zeros(1), np.ones(1), x0, np.zeros_like(r))
+    if hff is None:
+        uh = np.zeros_like(r)
+    elif hff.rate_independent:
+        uh = hff.response(r)
+    else:  # as the link in the loop: force with the velocity at the sample
+        uh = _open_loop(*_elements(hff)[:3], r, step, GL_T, GL_W)
+    e, dev, w, iters = _run(*_discretize(sys_w, omega0 * step), r, e_lin,
+                            np.ascontiguousarray(lin[:, 1]), uh, step, codes, params, s0,
+                            GL_T, GL_W, 1e-14 * f_scale, MAX_FIXED_POINT_ITERATIONS)
+    if iters > MAX_FIXED_POINT_ITERATIONS:
+        raise RuntimeError(
+            f"the implicit step at t = {len(e) * step:.6g} s did not converge in "
+            f"{MAX_FIXED_POINT_ITERATIONS} iterations: the link is too stiff (or too "
+            "strongly damped) for dt; use a smaller dt")
+    y1 = r + dev
     y2 = r - e
-    u = control.forced_response(loop.controller, t, e).outputs
+    # feedback force C e, with the input linear between samples (as control.forced_response)
+    u = _filter_foh(loop.controller, t, e)
     if loop.feedforward == "rigid-body":
         u = u + loop.M * a  # the impulse M v0 delta(t) at t = 0 is not representable
     u = u + uh
-    return Simulation(t=t, r=r, e=e, y1=y1, y2=y2, u=np.asarray(u), w=w, e_linear=e_lin)
+    return Simulation(t=t, r=r, e=e, y1=y1, y2=y2, u=u, w=w, e_linear=e_lin)
