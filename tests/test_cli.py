@@ -299,7 +299,7 @@ def test_missing_scenario_file_with_json(capsys, tmp_path):
 
 @pytest.mark.parametrize(("edits", "fragment"), [
     pytest.param({"stage": {"m1": "-5.0"}}, "m1", id="negative-mass"),
-    pytest.param({"hysteresis": {"model": '"bouc-wen"'}}, "bouc-wen", id="unknown-model"),
+    pytest.param({"hysteresis": {"model": '"preisach"'}}, "preisach", id="unknown-model"),
     pytest.param({"controller": {"K": "6.2e9"}}, "stabilise", id="unstable"),
     pytest.param({"reference": {"frequencies": "[5.0, nan]"}}, "frequencies", id="nan-frequency"),
 ])

@@ -280,7 +280,7 @@ def test_feedforward_section_without_hysteresis_has_none():
         ({"model": "jenkins", "k": "20", "fc": 0.05}, "k"),
         ({"model": "jenkins", "k": 0, "fc": 0.05}, "k"),
         ({"model": "jenkins", "k": 20, "fc": 0.05, "extra": 1}, "extra: unknown key"),
-        ({"model": "bouc-wen", "k": 20, "fc": 0.05}, "bouc-wen"),
+        ({"model": "preisach", "k": 20, "fc": 0.05}, "preisach"),
         ({"k": 20, "fc": 0.05}, "model"),
         ("jenkins", ""),
     ],

@@ -317,7 +317,7 @@ ERROR_CASES = [
     pytest.param(_drop("controller", "type"), ("[controller]", "type"),
                  id="missing-controller-type"),
     # unknown models and types
-    pytest.param(_set("hysteresis", "model", "bouc-wen"), ("[hysteresis]", "model", "bouc-wen"),
+    pytest.param(_set("hysteresis", "model", "preisach"), ("[hysteresis]", "model", "preisach"),
                  id="unknown-hysteresis-model"),
     pytest.param(_set("controller", "type", "pid"), ("[controller]", "type", "pid"),
                  id="unknown-controller-type"),

@@ -79,13 +79,14 @@ class MismatchPoint:
     asymptote: complex
     zeta: float
     y1_amplitude: float
+    D: complex = complex("nan")
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (magnitudes and phases in degrees)."""
         return {"frequency_hz": self.frequency_hz, "abs": abs(self.value),
                 "phase_deg": float(np.degrees(np.angle(self.value))),
                 "asymptote_abs": abs(self.asymptote), "zeta": self.zeta,
-                "y1_amplitude": self.y1_amplitude}
+                "y1_amplitude": self.y1_amplitude, "df_re": self.D.real, "df_im": self.D.imag}
 
 
 @dataclass
@@ -99,7 +100,8 @@ class QuasiLinearAnalysis:
     zeta : float
         ``fc / (k A_r)`` (eq. 4), with ``A_y1 = A_r`` as in the paper.
     D : complex
-        Describing function at ``A_r`` [N/m] (eq. 10).
+        Describing function at ``A_r`` [N/m] (eq. 10); for a rate-dependent
+        element, at the lowest requested frequency (`df_frequency_hz`).
     k_link : float
         Initial stiffness of the dynamic link [N/m].
     f_star_hz : float
@@ -115,6 +117,8 @@ class QuasiLinearAnalysis:
         The mismatch at the requested frequencies.
     amplitude_mode : str
         ``"reference"`` or ``"self-consistent"``.
+    df_frequency_hz : float or None
+        Frequency at which `D` is evaluated [Hz]; None for a rate-independent element.
     """
 
     amplitude: float
@@ -127,6 +131,7 @@ class QuasiLinearAnalysis:
     crossover_exact_hz: float
     points: list[MismatchPoint] = field(default_factory=list)
     amplitude_mode: str = "reference"
+    df_frequency_hz: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``analyze --json`` schema)."""
@@ -138,6 +143,7 @@ class QuasiLinearAnalysis:
             "df_im": self.D.imag,
             "df_abs_over_k": abs(self.D) / self.k_link,
             "df_phase_deg": float(np.degrees(np.angle(self.D))),
+            "df_frequency_hz": self.df_frequency_hz,
             "f_star_hz": self.f_star_hz,
             "bandwidth_hz": self.bandwidth_hz,
             "mismatch_crossover_hz": self.crossover_hz,
@@ -320,18 +326,33 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         E = residual_mismatch(loop, omega, D_pts, D_ff)
     Et = mismatch_asymptote(Pr, Pf2, D_pts)
     zetas = np.asarray(hyst.zeta(amps)) if hasattr(hyst, "zeta") else np.full(f.shape, np.nan)
-    D_ref = complex(np.asarray(hyst.describing_function(amplitude)).ravel()[0])
+    f_df = None if hyst.rate_independent else float(np.min(f))
+    D_ref = complex(np.asarray(hyst.describing_function(
+        amplitude, None if f_df is None else TWO_PI * f_df)).ravel()[0])
     zeta_ref = float(hyst.zeta(amplitude)) if hasattr(hyst, "zeta") else float("nan")
     if isinstance(loop.plant, TwoMassStage):
-        st = loop.plant
-        crossover = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D_ref))
+        crossover = _crossover_estimate(loop.plant, hyst, amplitude, D_ref)
     else:
         crossover = float("nan")
-    points = [MismatchPoint(float(fi), complex(e), complex(et), float(z), float(a))
-              for fi, e, et, z, a in zip(f, E, Et, np.broadcast_to(zetas, f.shape), amps,
-                                         strict=True)]
+    points = [MismatchPoint(float(fi), complex(e), complex(et), float(z), float(a), complex(d))
+              for fi, e, et, z, a, d in zip(f, E, Et, np.broadcast_to(zetas, f.shape), amps,
+                                            np.broadcast_to(D_pts, f.shape), strict=True)]
     return QuasiLinearAnalysis(
         amplitude=float(amplitude), zeta=zeta_ref, D=D_ref, k_link=k_link,
         f_star_hz=f_star(k_link, loop.M), bandwidth_hz=loop.bandwidth_hz(),
         crossover_hz=crossover, crossover_exact_hz=mismatch_crossover(loop, amplitude),
-        points=points, amplitude_mode=amplitude_mode)
+        points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df)
+
+
+def _crossover_estimate(st: TwoMassStage, hyst, amplitude: float, D: complex) -> float:
+    """Eq. (21); for a rate-dependent element solved with ``D`` at the crossover itself."""
+    fc = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D))
+    if hyst.rate_independent:
+        return fc
+    for _ in range(50):
+        D = complex(np.asarray(hyst.describing_function(amplitude, TWO_PI * fc)).ravel()[0])
+        f_new = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D))
+        if abs(f_new - fc) <= 1e-12 * f_new:
+            return f_new
+        fc = f_new
+    return float("nan")

@@ -17,7 +17,7 @@ from typing import Annotated, Literal
 import control
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
-from motionhyst.hysteresis import Hysteresis, Jenkins, MaxwellSlip
+from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
 from motionhyst.loop import Loop
 from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
 
@@ -84,7 +84,49 @@ class MaxwellSlipSection(_Section):
         return self
 
 
-HysteresisSection = Annotated[JenkinsSection | MaxwellSlipSection, Field(discriminator="model")]
+class BoucWenSection(_Section):
+    """``[hysteresis] model = "bouc-wen"``: normalised, rate-independent Bouc-Wen."""
+
+    model: Literal["bouc-wen"]
+    k: PositiveFloat
+    fc: PositiveFloat
+    n: Annotated[float, Field(ge=1, allow_inf_nan=False)] = 1.0
+    beta: Annotated[float, Field(allow_inf_nan=False)] = 0.5
+    gamma: Annotated[float, Field(allow_inf_nan=False)] = 0.5
+
+    @model_validator(mode="after")
+    def _bounded_dissipative(self):
+        if not self.beta + self.gamma > 0:
+            raise ValueError("beta + gamma must be > 0 (bounded hysteresis)")
+        if not self.beta >= self.gamma:
+            raise ValueError("beta must be >= gamma (dissipative loops)")
+        return self
+
+
+class DahlSection(_Section):
+    """``[hysteresis] model = "dahl"``: Dahl's solid friction."""
+
+    model: Literal["dahl"]
+    k: PositiveFloat
+    fc: PositiveFloat
+    alpha: PositiveFloat = 1.0
+
+
+class LuGreSection(_Section):
+    """``[hysteresis] model = "lugre"``: LuGre friction (rate-dependent)."""
+
+    model: Literal["lugre"]
+    sigma0: PositiveFloat
+    sigma1: NonNegativeFloat = 0.0
+    sigma2: NonNegativeFloat = 0.0
+    fc: PositiveFloat
+    fs: PositiveFloat
+    vs: PositiveFloat
+
+
+HysteresisSection = Annotated[
+    JenkinsSection | MaxwellSlipSection | BoucWenSection | DahlSection | LuGreSection,
+    Field(discriminator="model")]
 
 
 class FeedforwardSection(_Section):
@@ -157,14 +199,20 @@ class ScenarioModel(_Section):
         return self
 
 
-_UNION_TAGS = {"leadlag-lowpass", "tf", "jenkins", "maxwell-slip"}
+_UNION_TAGS = {"leadlag-lowpass", "tf", "jenkins", "maxwell-slip", "bouc-wen", "dahl", "lugre"}
+
+_MODELS: dict[str, type[Hysteresis]] = {
+    "jenkins": Jenkins, "maxwell-slip": MaxwellSlip, "bouc-wen": BoucWen, "dahl": Dahl,
+    "lugre": LuGre}
+
+#: Names accepted by ``[hysteresis] model = ...``
+HYSTERESIS_MODELS = tuple(_MODELS)
 
 
 def build_hysteresis(section) -> Hysteresis:
     """The hysteresis model a validated ``[hysteresis]`` section describes."""
-    if section.model == "jenkins":
-        return Jenkins(section.k, section.fc)
-    return MaxwellSlip(section.k, section.fc)
+    params = section.model_dump(exclude={"model"})
+    return _MODELS[section.model](**params)
 
 
 _HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection)

@@ -210,7 +210,8 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     y1_lin = loop.transfer("r->y1", wn) * R
     e_lin[0] = y1_lin[0] = 0.0
     hyst, hff = loop.hysteresis, loop.hysteresis_feedforward
-    U_h = np.zeros(H + 1, dtype=complex) if hff is None else hff.periodic_harmonics(R, H)
+    U_h = (np.zeros(H + 1, dtype=complex) if hff is None
+           else hff.periodic_harmonics(R, H, omega))
     if hyst is None and hff is None:
         z = np.zeros(H + 1, dtype=complex)
         return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e_lin),
@@ -223,7 +224,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     if hyst is not None:
         previous = np.inf
         for it in range(1, max_iter + 1):
-            W_new = hyst.periodic_harmonics(X, H)
+            W_new = hyst.periodic_harmonics(X, H, omega)
             change = float(np.max(np.abs(W_new - W)))
             residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
             W = W_new
