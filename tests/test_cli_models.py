@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from motionhyst.cli import main
-from motionhyst.hysteresis import Jenkins, MaxwellSlip
+from motionhyst.hysteresis import BoucWen, Dahl, Jenkins, LuGre, MaxwellSlip
 from motionhyst.scenario import default_scenario_path
 
 HARMONIC_KEYS = {"n", "re", "im", "abs_over_amplitude", "phase_deg"}
@@ -125,6 +125,46 @@ def test_df_text_output_without_harmonics_has_one_table(capsys):
     assert "Higher-order" not in out
 
 
+@pytest.mark.parametrize(("args", "element"), [
+    (("--model", "bouc-wen", "--k", "20", "--fc", "0.05", "--n", "2", "--beta", "0.7",
+      "--gamma", "0.3"), BoucWen(20.0, 0.05, n=2.0, beta=0.7, gamma=0.3)),
+    (("--model", "bouc-wen", "--k", "20", "--fc", "0.05"), BoucWen(20.0, 0.05)),
+    (("--model", "dahl", "--k", "20", "--fc", "0.05", "--alpha", "2"),
+     Dahl(20.0, 0.05, alpha=2.0)),
+], ids=["bouc-wen", "bouc-wen-defaults", "dahl"])
+def test_df_rate_independent_models_json(capsys, args, element):
+    amps = [0.0, 0.001, 0.01]
+    d = run_json(capsys, "df", *args, "--amplitude", *map(str, amps), "--harmonics", "3",
+                 "--json")
+    assert d == {**element.to_dict(), "points": d["points"]}
+    assert [p["amplitude"] for p in d["points"]] == amps
+    assert all("frequency_hz" not in p for p in d["points"])
+    H = element.hosidf(np.array(amps), 3)
+    for p, a, h in zip(d["points"], amps, H, strict=True):
+        D = complex(element.describing_function(a))
+        assert complex(p["re"], p["im"]) == pytest.approx(D, rel=1e-12)
+        got = [complex(x["re"], x["im"]) for x in p["harmonics"]]
+        np.testing.assert_allclose(got, h, rtol=0, atol=1e-12 * abs(D))
+    assert d["points"][0]["re"] == pytest.approx(20.0, rel=1e-12)  # A = 0: stuck, k
+
+
+def test_df_lugre_needs_frequency_and_gives_every_pair(capsys):
+    args = ("df", "--model", "lugre", "--sigma0", "20", "--sigma1", "0.1", "--sigma2", "0.01",
+            "--fc", "0.05", "--fs", "0.06", "--vs", "0.01", "--amplitude", "0.001", "0.01")
+    d = run_json(capsys, *args, "--frequency", "1", "10", "--json")
+    el = LuGre(20.0, 0.1, 0.01, 0.05, 0.06, 0.01)
+    assert d == {**el.to_dict(), "points": d["points"]}
+    pairs = [(p["amplitude"], p["frequency_hz"]) for p in d["points"]]
+    assert pairs == [(0.001, 1.0), (0.01, 1.0), (0.001, 10.0), (0.01, 10.0)]
+    for p in d["points"]:
+        D = el.describing_function(p["amplitude"], 2 * np.pi * p["frequency_hz"])
+        assert complex(p["re"], p["im"]) == pytest.approx(D, rel=1e-12)
+    # rate-dependent: the same amplitude at another frequency gives another D
+    assert abs(d["points"][0]["im"] - d["points"][2]["im"]) > 0.1 * abs(d["points"][0]["im"])
+    rc, out, _ = run(capsys, *args, "--frequency", "1")
+    assert rc == 0 and "f [Hz]" in out and "sigma1 = 0.1 N s/m" in out
+
+
 @pytest.mark.parametrize(
     ("args", "fragments"),
     [
@@ -147,6 +187,29 @@ def test_df_text_output_without_harmonics_has_one_table(capsys):
          ("--model", "preisach")),
         (("df", "--model", "maxwell-slip", "--k", "1", "-2", "--fc", "1", "1",
           "--amplitude", "3"), ("--k",)),
+        (("df", "--model", "lugre", "--sigma0", "20", "--fc", "0.05", "--fs", "0.06",
+          "--vs", "0.01", "--amplitude", "3"), ("--frequency", "required", "lugre")),
+        (("df", "--model", "lugre", "--sigma0", "20", "--fc", "0.05", "--vs", "0.01",
+          "--amplitude", "3", "--frequency", "1"), ("--fs", "required")),
+        (("df", "--model", "dahl", "--k", "1", "--fc", "1", "--amplitude", "3",
+          "--frequency", "1"), ("--frequency", "rate-independent")),
+        (("df", "--model", "dahl", "--k", "1", "--fc", "1", "--beta", "1", "--amplitude", "3"),
+         ("--beta", "does not apply", "dahl")),
+        (("df", "--k", "1", "--fc", "1", "--sigma0", "1", "--amplitude", "3"),
+         ("--sigma0", "does not apply", "jenkins")),
+        (("df", "--model", "bouc-wen", "--k", "1", "--fc", "1", "--beta", "0.1", "--gamma",
+          "0.3", "--amplitude", "3"), ("beta", "gamma")),
+        (("df", "--model", "bouc-wen", "--k", "1", "--fc", "1", "--n", "0.5",
+          "--amplitude", "3"), ("--n", "1")),
+        (("df", "--model", "bouc-wen", "--k", "1", "--fc", "1", "--beta", "nan",
+          "--amplitude", "3"), ("--beta", "finite")),
+        (("df", "--model", "dahl", "--k", "1", "--fc", "1", "--alpha", "0",
+          "--amplitude", "3"), ("--alpha", "> 0")),
+        (("df", "--model", "lugre", "--sigma0", "20", "--sigma1", "-1", "--fc", "0.05",
+          "--fs", "0.06", "--vs", "0.01", "--amplitude", "3", "--frequency", "1"),
+         ("--sigma1",)),
+        (("df", "--model", "dahl", "--k", "1", "2", "--fc", "1", "--amplitude", "3"),
+         ("--k", "one value")),
     ],
 )
 def test_df_usage_errors_are_one_line(capsys, args, fragments):

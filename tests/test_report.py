@@ -11,8 +11,9 @@ from matplotlib.figure import Figure
 from numpy.testing import assert_allclose
 
 from motionhyst import plots, report
+from motionhyst.hysteresis import BoucWen, Dahl, LuGre, MaxwellSlip
 from motionhyst.quasilinear import analyze, loop_mismatch, mismatch_asymptote
-from motionhyst.scenario import default_scenario
+from motionhyst.scenario import Scenario, default_scenario
 from motionhyst.steady import periodic_steady_state
 from motionhyst.systems import freqresp
 
@@ -300,3 +301,56 @@ def test_figures_from_reproduce_match_functions(reproduced, loop, el, analysis, 
     for fig in makers:
         assert isinstance(fig, Figure)
         assert fig.motionhyst_data
+
+
+# ------------------------------------------------------------------ other link models
+@pytest.mark.parametrize("other", [
+    BoucWen(20.0, 0.05, n=2.0), Dahl(20.0, 0.05), MaxwellSlip([12.0, 8.0], [0.02, 0.03])],
+    ids=["bouc-wen", "dahl", "maxwell-slip"])
+def test_fig5_and_fig8_of_other_models_show_their_periodic_loops(other):
+    fc = float(np.sum(other.fc))
+    data = plots.fig5_loops(other, zetas=(0.25, 2.0)).motionhyst_data
+    for zeta in (0.25, 2.0):
+        x, w = data[f"zeta={zeta:g}"]
+        A = fc / (other.initial_stiffness * zeta)
+        assert np.max(np.abs(x)) == pytest.approx(A, rel=1e-6)
+        assert np.max(np.abs(w)) <= fc * (1 + 1e-12)
+        # the periodic loop: closed, and odd symmetric (w(-x) = -w(x) half a period on)
+        assert (x[0], w[0]) == pytest.approx((x[-1], w[-1]), abs=1e-12 * fc)
+        assert np.max(w) == pytest.approx(-np.min(w), rel=1e-6)
+        # its area is the energy per cycle, pi A^2 Im D (paper eq. 7)
+        area = abs(np.sum(0.5 * (w[1:] + w[:-1]) * np.diff(x)))
+        assert area == pytest.approx(np.pi * A**2 * other.describing_function(A).imag,
+                                     rel=1e-3)
+    d8 = plots.fig8_describing_function(other, zeta_range=(0.1, 10.0)).motionhyst_data
+    A = fc / (other.initial_stiffness * d8["zeta"])
+    D = other.describing_function(A)
+    assert_allclose(d8["abs_over_k"], np.abs(D) / other.initial_stiffness, rtol=1e-14)
+    assert_allclose(d8["phase_deg"], np.degrees(np.angle(D)), rtol=1e-14)
+
+
+def test_rate_dependent_figures_need_a_frequency():
+    lugre = LuGre(20.0, 0.0, 0.0, 0.05, 0.05, 0.01)
+    with pytest.raises(ValueError, match="frequency_hz"):
+        plots.fig5_loops(lugre)
+    data = plots.fig8_describing_function(lugre, zeta_range=(0.5, 2.0), frequency_hz=5.0)
+    z = data.motionhyst_data["zeta"]
+    D = lugre.describing_function(0.05 / (20.0 * z), 2 * np.pi * 5.0)
+    assert_allclose(data.motionhyst_data["abs_over_k"], np.abs(D) / 20.0, rtol=1e-14)
+
+
+def test_reproduce_with_another_model_draws_its_figures(tmp_path):
+    sc = default_scenario()
+    data = sc.to_dict()
+    data["hysteresis"] = {"model": "dahl", "k": 20.0, "fc": 0.05}
+    other = Scenario.from_dict(data, source="dahl.toml")
+    out = tmp_path / "out"
+    summary = report.reproduce(other, out, quiet=True)
+    written = sorted(p.stem for p in out.glob("*.png"))
+    assert written == ["fig10", "fig11", "fig5", "fig8", "fig9"]
+    text = (out / "report.md").read_text()
+    assert "dahl model" in text and "Jenkins element for sinusoids" not in text
+    assert summary["scenario"]["hysteresis"]["model"] == "dahl"
+    # the mismatch of a Dahl link at 5 Hz: exact steady state against eq. (18) within 1 %
+    p = summary["simulate"]["points"][0]
+    assert p["mismatch_simulated_abs"] == pytest.approx(p["mismatch_df_abs"], rel=0.01)

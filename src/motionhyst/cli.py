@@ -32,7 +32,7 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(f"{self.prog}: {message}")
 
 
-def _number(text: str, what: str, positive: bool) -> float:
+def _number(text: str, what: str, positive: bool | None) -> float:
     try:
         v = float(text)
     except ValueError:
@@ -41,7 +41,7 @@ def _number(text: str, what: str, positive: bool) -> float:
         raise argparse.ArgumentTypeError(f"{what} must be finite, got {text!r}")
     if positive and v <= 0:
         raise argparse.ArgumentTypeError(f"{what} must be > 0, got {text!r}")
-    if not positive and v < 0:
+    if positive is False and v < 0:
         raise argparse.ArgumentTypeError(f"{what} must be >= 0, got {text!r}")
     return v
 
@@ -49,6 +49,11 @@ def _number(text: str, what: str, positive: bool) -> float:
 def positive(text: str) -> float:
     """argparse type: a finite number > 0."""
     return _number(text, "value", True)
+
+
+def _finite(text: str) -> float:
+    """argparse type: a finite number."""
+    return _number(text, "value", None)
 
 
 def nonnegative(text: str) -> float:
@@ -85,22 +90,47 @@ def _g(x: float, digits: int = 4) -> str:
 
 
 # ---------------------------------------------------------------------------- df
+#: Parameter options of ``motionhyst df`` per model: (option, list allowed, required).
+_DF_PARAMETERS: dict[str, tuple[tuple[str, bool, bool], ...]] = {
+    "jenkins": (("k", False, True), ("fc", False, True)),
+    "maxwell-slip": (("k", True, True), ("fc", True, True)),
+    "bouc-wen": (("k", False, True), ("fc", False, True), ("n", False, False),
+                 ("beta", False, False), ("gamma", False, False)),
+    "dahl": (("k", False, True), ("fc", False, True), ("alpha", False, False)),
+    "lugre": (("sigma0", False, True), ("sigma1", False, False), ("sigma2", False, False),
+              ("fc", False, True), ("fs", False, True), ("vs", False, True)),
+}
+_DF_OPTIONS = ("k", "fc", "n", "beta", "gamma", "alpha", "sigma0", "sigma1", "sigma2",
+               "fs", "vs")
+_UNITS = {"k": "N/m", "fc": "N", "sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m",
+          "fs": "N", "vs": "m/s"}
+
+
 def _element_from_args(args: argparse.Namespace):
     """The hysteresis element named by ``--model`` and its parameter options."""
     from motionhyst.scenario import ScenarioError, hysteresis_from_dict
 
-    params: dict = {"model": args.model}
-    for name in ("k", "fc"):
+    model = args.model
+    spec = {name: (many, required) for name, many, required in _DF_PARAMETERS[model]}
+    for name in _DF_OPTIONS:
+        if getattr(args, name) is not None and name not in spec:
+            raise UsageError(f"motionhyst df: --{name} does not apply to --model {model} "
+                             f"(its parameters: {', '.join('--' + n for n in spec)})")
+    params: dict = {"model": model}
+    for name, (many, required) in spec.items():
         values = getattr(args, name)
         if values is None:
-            raise UsageError(f"motionhyst df: --{name} is required for --model {args.model}")
-        if args.model == "jenkins":
-            if len(values) != 1:
-                raise UsageError(f"motionhyst df: --{name} takes one value for --model jenkins "
-                                 f"(use --model maxwell-slip for several)")
-            params[name] = values[0]
-        else:
+            if required:
+                raise UsageError(f"motionhyst df: --{name} is required for --model {model}")
+            continue
+        if many:
             params[name] = list(values)
+        elif len(values) != 1:
+            hint = " (use --model maxwell-slip for several)" if name in ("k", "fc") else ""
+            raise UsageError(f"motionhyst df: --{name} takes one value for --model {model}"
+                             f"{hint}")
+        else:
+            params[name] = values[0]
     try:
         return hysteresis_from_dict(params, source="motionhyst df")
     except ScenarioError as exc:
@@ -108,46 +138,79 @@ def _element_from_args(args: argparse.Namespace):
         raise UsageError(msg) from None
 
 
+def _df_frequencies(args: argparse.Namespace, el) -> list[float | None]:
+    """The frequencies [Hz] of ``df``: required for rate-dependent elements, else none."""
+    if el.rate_independent:
+        if args.frequency is not None:
+            raise UsageError(f"motionhyst df: --frequency does not apply to --model "
+                             f"{args.model}: the element is rate-independent, its describing "
+                             f"function depends on the amplitude only")
+        return [None]
+    if args.frequency is None:
+        raise UsageError(f"motionhyst df: --frequency is required for --model {args.model} "
+                         f"(rate-dependent: D depends on amplitude and frequency)")
+    return list(args.frequency)
+
+
+def _df_point(el, amplitude: float, zeta: float, D: complex, frequency_hz: float | None) -> dict:
+    point = {"amplitude": float(amplitude)}
+    if frequency_hz is not None:
+        point["frequency_hz"] = float(frequency_hz)
+    point.update({"zeta": float(zeta), "re": float(D.real), "im": float(D.imag),
+                  "abs": float(abs(D)), "phase_deg": float(np.degrees(np.angle(D)))})
+    return point
+
+
 def cmd_df(args: argparse.Namespace) -> int:
     """Describing function (and higher harmonics) of a hysteresis element."""
     el = _element_from_args(args)
+    freqs = _df_frequencies(args, el)
     A = np.asarray(args.amplitude, dtype=float)
-    D = np.atleast_1d(el.describing_function(A))
     zeta = np.atleast_1d(el.zeta(A)) if hasattr(el, "zeta") else np.full(A.shape, np.nan)
-    points = [{"amplitude": float(a), "zeta": float(z), "re": float(d.real),
-               "im": float(d.imag), "abs": float(abs(d)),
-               "phase_deg": float(np.degrees(np.angle(d)))}
-              for a, z, d in zip(A, zeta, D, strict=True)]
-    if args.harmonics:
-        H = el.hosidf(A, args.harmonics)
-        for p, h in zip(points, H, strict=True):
-            p["harmonics"] = [{"n": n, "re": float(c.real), "im": float(c.imag),
-                               "abs_over_amplitude": float(abs(c)),
-                               "phase_deg": float(np.degrees(np.angle(c)))}
-                              for n, c in enumerate(h, start=1)]
+    points = []
+    for f in freqs:
+        omega = None if f is None else 2.0 * math.pi * f
+        D = np.atleast_1d(el.describing_function(A, omega))
+        pts = [_df_point(el, a, z, d, f) for a, z, d in zip(A, zeta, D, strict=True)]
+        if args.harmonics:
+            H = el.hosidf(A, args.harmonics, omega)
+            for p, h in zip(pts, H, strict=True):
+                p["harmonics"] = [{"n": n, "re": float(c.real), "im": float(c.imag),
+                                   "abs_over_amplitude": float(abs(c)),
+                                   "phase_deg": float(np.degrees(np.angle(c)))}
+                                  for n, c in enumerate(h, start=1)]
+        points += pts
     result = {**el.to_dict(), "points": points}
     if args.json:
         _print_json(result)
         return 0
     k0 = el.initial_stiffness
-    units = {"k": "N/m", "fc": "N"}
 
     def show(v):
         return ", ".join(f"{x:g}" for x in v) if isinstance(v, list) else f"{v:g}"
 
-    params = ", ".join(f"{k} = {show(v)} {units.get(k, '')}".rstrip()
+    params = ", ".join(f"{k} = {show(v)} {_UNITS.get(k, '')}".rstrip()
                        for k, v in el.to_dict().items() if k != "model")
-    print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 10)")
-    rows = [[_g(p["amplitude"]), _g(p["zeta"]), _g(p["re"]), _g(p["im"]), _g(p["abs"]),
-             _g(p["abs"] / k0), f"{p['phase_deg']:.2f}"] for p in points]
-    print(_table(["A [m]", "zeta [-]", "Re D [N/m]", "Im D [N/m]", "|D| [N/m]", "|D|/k [-]",
-                  "angle D [deg]"], rows))
+    print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 7)")
+    rate = el.rate_independent
+    head = ["A [m]"] if rate else ["A [m]", "f [Hz]"]
+
+    def lead(p):
+        return [_g(p["amplitude"])] + ([] if rate else [_g(p["frequency_hz"])])
+
+    has_zeta = any(not math.isnan(p["zeta"]) for p in points)
+    rows = [[*lead(p), *([_g(p["zeta"])] if has_zeta else []), _g(p["re"]), _g(p["im"]),
+             _g(p["abs"]), _g(p["abs"] / k0), f"{p['phase_deg']:.2f}"] for p in points]
+    print(_table([*head, *(["zeta [-]"] if has_zeta else []), "Re D [N/m]", "Im D [N/m]",
+                  "|D| [N/m]", "|D|/k0 [-]", "angle D [deg]"], rows))
+    print(f"k0 = {k0:g} N/m, the initial stiffness"
+          + (" (|D| -> k0 as A -> 0)" if rate else ""))
     if args.harmonics:
         print()
         print("Higher-order describing functions H_n = Y_n / A [N/m], relative to sin(n w t)")
-        rows = [[_g(p["amplitude"]), str(h["n"]), _g(h["abs_over_amplitude"]),
+        rows = [[*lead(p), str(h["n"]), _g(h["abs_over_amplitude"]),
                  f"{h['phase_deg']:.2f}"] for p in points for h in p["harmonics"]]
-        print(_table(["A [m]", "n", "|H_n| [N/m]", "angle H_n [deg]"], rows))
+        print(_table([*head, "n", "|H_n| [N/m]", "angle H_n [deg]"], rows))
     return 0
 
 
@@ -168,9 +231,11 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         return 0
     print(f"Quasi-linear analysis of {sc.source}")
     print(f"  reference amplitude A_r        {amplitude:g} m")
-    print(f"  zeta = fc/(k A)  (eq. 4)       {_g(d['zeta'])}")
+    if d["zeta"] is not None and not math.isnan(d["zeta"]):
+        print(f"  zeta = fc/(k A)  (eq. 4)       {_g(d['zeta'])}")
+    at = "" if d["df_frequency_hz"] is None else f" at {_g(d['df_frequency_hz'])} Hz"
     print(f"  |D|/k, angle D  (eq. 10)       {_g(d['df_abs_over_k'])}, "
-          f"{d['df_phase_deg']:.2f} deg")
+          f"{d['df_phase_deg']:.2f} deg{at}")
     print(f"  f*  (eq. 13)                   {_g(d['f_star_hz'])} Hz")
     print(f"  bandwidth (|C P2| = 1)         {_g(d['bandwidth_hz'])} Hz")
     print(f"  mismatch crossover (eq. 21)    {_g(d['mismatch_crossover_hz'])} Hz")
@@ -421,12 +486,27 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     q = sub.add_parser("df", help="describing function of a hysteresis element")
-    q.add_argument("--model", choices=["jenkins", "maxwell-slip"], default="jenkins",
+    q.add_argument("--model", choices=list(_DF_PARAMETERS), default="jenkins",
                    help="hysteresis model (default: jenkins)")
     q.add_argument("--k", type=positive, nargs="+",
-                   help="spring stiffness k_J [N/m] (one per element for maxwell-slip)")
+                   help="spring stiffness k [N/m] (one per element for maxwell-slip); "
+                        "jenkins, maxwell-slip, bouc-wen, dahl")
     q.add_argument("--fc", type=positive, nargs="+",
-                   help="slip force f_c [N] (one per element for maxwell-slip)")
+                   help="slip (Coulomb) force f_c [N] (one per element for maxwell-slip); "
+                        "all models")
+    q.add_argument("--n", type=positive, nargs=1, help="bouc-wen: sharpness n >= 1 (1)")
+    q.add_argument("--beta", type=_finite, nargs=1, help="bouc-wen: beta (0.5)")
+    q.add_argument("--gamma", type=_finite, nargs=1, help="bouc-wen: gamma, <= beta (0.5)")
+    q.add_argument("--alpha", type=positive, nargs=1, help="dahl: shape exponent alpha (1)")
+    q.add_argument("--sigma0", type=positive, nargs=1, help="lugre: bristle stiffness [N/m]")
+    q.add_argument("--sigma1", type=nonnegative, nargs=1,
+                   help="lugre: bristle damping [N s/m] (0)")
+    q.add_argument("--sigma2", type=nonnegative, nargs=1,
+                   help="lugre: viscous friction [N s/m] (0)")
+    q.add_argument("--fs", type=positive, nargs=1, help="lugre: static (Stribeck) force [N]")
+    q.add_argument("--vs", type=positive, nargs=1, help="lugre: Stribeck velocity [m/s]")
+    q.add_argument("--frequency", type=positive, nargs="+",
+                   help="frequency(ies) [Hz]; required for the rate-dependent lugre")
     q.add_argument("--amplitude", type=nonnegative, nargs="+", required=True,
                    help="input amplitude(s) A [m]")
     q.add_argument("--harmonics", type=_harmonic_count, metavar="N",

@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from motionhyst.hysteresis import Jenkins
+from motionhyst.hysteresis import Hysteresis, Jenkins
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import QuasiLinearAnalysis, loop_mismatch, mismatch_asymptote
 from motionhyst.steady import SteadyState
@@ -48,26 +48,59 @@ def _frequency_range(loop: Loop, f_range):
     return max(f_range[0], lo), min(f_range[1], hi)
 
 
-def _sine_loop(el: Jenkins, A: float, n: int = 2000):
+def _sine_loop(el: Hysteresis, A: float, n: int = 2000, frequency_hz: float | None = None):
+    """One period of the periodic response to ``x = A sin(theta)``: ``x, w``."""
+    if hasattr(el, "steady_loop"):  # the periodic loop of an element with a fading memory
+        args = () if el.rate_independent else (TWO_PI * frequency_hz,)
+        _, x, w = el.steady_loop(A, *args)
+        return np.append(x, x[0]), np.append(w, w[0])
     theta = np.linspace(0.0, TWO_PI, n + 1)
     x = A * np.sin(np.concatenate([theta, TWO_PI + theta[1:]]))
     w = el.response(x)[n:]
     return x[n:], w
 
 
-def fig5_loops(el: Jenkins, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25)):
-    """Fig. 5: displacement-force loops of the element for sinusoids at several zeta."""
+def _force_scale(el: Hysteresis) -> float:
+    """Total slip (Coulomb) force of the element [N]: the scale of its loops."""
+    return float(np.sum(el.fc))
+
+
+def _describe(el: Hysteresis, frequency_hz: float | None) -> str:
+    params = ", ".join(f"{k} = {v:g}" for k, v in el.to_dict().items()
+                       if k != "model" and not isinstance(v, list))
+    at = "" if el.rate_independent else f", f = {frequency_hz:g} Hz"
+    return f"{el.name} element{', ' if params else ''}{params}{at}"
+
+
+def _check_frequency(el: Hysteresis, frequency_hz: float | None) -> None:
+    if not el.rate_independent and frequency_hz is None:
+        raise ValueError(f"the {el.name} element is rate-dependent: give frequency_hz")
+
+
+def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
+               frequency_hz: float | None = None):
+    """Fig. 5: displacement-force loops of the element for sinusoids at several zeta.
+
+    ``zeta = fc / (k A)`` (eq. 4); for other models ``fc`` is the total slip
+    force and ``k`` the initial stiffness, and a rate-dependent element needs
+    `frequency_hz`.
+    """
+    _check_frequency(el, frequency_hz)
     fig, (ax,) = _figure()
+    fc = _force_scale(el)
     for z in zetas:
-        A = el.fc / (el.k * z)
-        x, w = _sine_loop(el, A)
+        A = fc / (el.initial_stiffness * z)
+        x, w = _sine_loop(el, A, frequency_hz=frequency_hz)
         ax.plot(x * 1e3, w, label=f"zeta = {z:g} (A = {A * 1e3:.3g} mm)")
         fig.motionhyst_data[f"zeta={z:g}"] = np.vstack([x, w])
-    ax.axhline(el.fc, color="0.5", ls=":", lw=0.8)
-    ax.axhline(-el.fc, color="0.5", ls=":", lw=0.8)
+    ax.axhline(fc, color="0.5", ls=":", lw=0.8)
+    ax.axhline(-fc, color="0.5", ls=":", lw=0.8)
     ax.set_xlabel("displacement x [mm]")
     ax.set_ylabel("force w [N]")
-    ax.set_title(f"Fig. 5: Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N")
+    if isinstance(el, Jenkins):
+        ax.set_title(f"Fig. 5: Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N")
+    else:
+        ax.set_title(f"Fig. 5: {_describe(el, frequency_hz)}", fontsize=8)
     ax.legend()
     return fig
 
@@ -112,23 +145,40 @@ def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
     return fig
 
 
-def fig8_describing_function(el: Jenkins, zeta_range=(1e-3, 10.0)):
-    """Fig. 8: |D|/k and angle of D against zeta (eq. 10), mode regions shaded."""
+def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
+                              frequency_hz: float | None = None):
+    """Fig. 8: |D|/k and angle of D against zeta (eq. 10), mode regions shaded.
+
+    For other models than Jenkins, ``zeta = fc / (k A)`` with the total slip
+    force and the initial stiffness, without the Jenkins element's modes; a
+    rate-dependent element is drawn at `frequency_hz`.
+    """
+    _check_frequency(el, frequency_hz)
     fig, (ax1, ax2) = _figure(2)
-    z = np.geomspace(*zeta_range, 800)
-    D = el.describing_function(el.fc / (el.k * z))
-    for ax in (ax1, ax2):
-        ax.axvspan(zeta_range[0], 0.5, color="tab:red", alpha=0.08, label="mode 2")
-        ax.axvspan(0.5, 1.0, color="0.5", alpha=0.12, label="mode 3")
-        ax.axvspan(1.0, zeta_range[1], color=LINEAR_COLOR, alpha=0.06, label="linear (no slip)")
-    ax1.semilogx(z, np.abs(D) / el.k, color="k")
+    jenkins = isinstance(el, Jenkins)
+    z = np.geomspace(*zeta_range, 800 if jenkins else 200)
+    k0 = el.initial_stiffness
+    omega = None if el.rate_independent else TWO_PI * frequency_hz
+    D = el.describing_function(_force_scale(el) / (k0 * z), omega)
+    if jenkins:
+        for ax in (ax1, ax2):
+            ax.axvspan(zeta_range[0], 0.5, color="tab:red", alpha=0.08, label="mode 2")
+            ax.axvspan(0.5, 1.0, color="0.5", alpha=0.12, label="mode 3")
+            ax.axvspan(1.0, zeta_range[1], color=LINEAR_COLOR, alpha=0.06,
+                       label="linear (no slip)")
+    ax1.semilogx(z, np.abs(D) / k0, color="k")
     ax2.semilogx(z, np.degrees(np.angle(D)), color="k")
     ax1.set_ylabel("|D| / k [-]")
     ax2.set_ylabel("angle D [deg]")
-    ax2.set_xlabel("zeta = fc / (k A) [-]")
-    ax1.set_title("Fig. 8: describing function of the Jenkins element, eq. (10)")
-    ax1.legend(loc="upper left")
-    fig.motionhyst_data.update(zeta=z, abs_over_k=np.abs(D) / el.k,
+    if jenkins:
+        ax2.set_xlabel("zeta = fc / (k A) [-]")
+        ax1.set_title("Fig. 8: describing function of the Jenkins element, eq. (10)")
+        ax1.legend(loc="upper left")
+    else:
+        ax2.set_xlabel("zeta = fc / (k A) [-], k the initial stiffness")
+        ax1.set_title(f"Fig. 8: describing function, {_describe(el, frequency_hz)}",
+                      fontsize=8)
+    fig.motionhyst_data.update(zeta=z, abs_over_k=np.abs(D) / k0,
                                phase_deg=np.degrees(np.angle(D)))
     return fig
 

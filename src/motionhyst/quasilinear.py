@@ -266,17 +266,25 @@ def mismatch_crossover(loop: Loop, amplitude: float, f_min: float = 1e-2,
     """
     lo, hi = getattr(loop.plant, "frequency_range_hz", (f_min, f_max))
     f_min, f_max = max(f_min, lo), min(f_max, hi)
-    f = np.geomspace(f_min, f_max, 3000)
+    # a fine grid for closed-form D; a coarser one where each D is a periodic solve,
+    # scanned upwards so that frequencies above the first crossing are never evaluated
+    per_decade = 500 if loop.hysteresis.rate_independent else 40
+    n = max(2, int(np.ceil(per_decade * np.log10(f_max / f_min))) + 1)
+    f = np.geomspace(f_min, f_max, n)
 
     def g(x):
         return np.log(np.abs(loop_mismatch(loop, x, amplitude) - 1.0))
 
-    v = g(f)
-    idx = np.nonzero((v[:-1] > 0) & (v[1:] <= 0))[0]
-    if idx.size == 0:
-        return float("nan")
-    i = idx[0]
-    return float(brentq(lambda x: float(g(np.array([x]))[0]), f[i], f[i + 1], xtol=1e-12))
+    chunk = 64
+    for start in range(0, n - 1, chunk):
+        fs = f[start:start + chunk + 1]
+        v = g(fs)
+        idx = np.nonzero((v[:-1] > 0) & (v[1:] <= 0))[0]
+        if idx.size:
+            i = idx[0]
+            return float(brentq(lambda x: float(g(np.array([x]))[0]), fs[i], fs[i + 1],
+                                xtol=1e-12))
+    return float("nan")
 
 
 def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,

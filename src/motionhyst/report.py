@@ -44,6 +44,11 @@ FIGURE_NOTES = {
             "what the describing function keeps.",
     "fig8": "Magnitude and phase of the describing function against zeta (eq. 10): a small "
             "lead-dominated force for small zeta, the spring k for zeta >= 1.",
+    "fig5-other": "Displacement-force loops of the scenario's link for sinusoids at several "
+                  "zeta = fc / (k A) (total slip force over initial stiffness times amplitude).",
+    "fig8-other": "Magnitude and phase of the scenario's link's describing function against "
+                  "zeta = fc / (k A): from the initial stiffness for small amplitudes to a "
+                  "lead-dominated force for large ones.",
     "fig9": "The quasi-linear plant (eq. 12) departs from the floating mass P2 only below f*.",
     "fig10": "The feedforward mismatch (eq. 18) and its asymptote (eq. 20); the circles are the "
              "exact periodic steady state of the nonlinear loop.",
@@ -62,6 +67,7 @@ def _fmt(x) -> str:
 def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
                   is_paper: bool, notes: list[str]) -> None:
     a = summary["analyze"]
+    jenkins = summary["scenario"]["hysteresis"]["model"] == "jenkins"
     lines = [f"# motionhyst report: {sc.source}", ""]
     lines += ["## Paper vs computed" if is_paper else "## Key numbers", ""]
     head = "| quantity | paper | computed |" if is_paper else "| quantity | computed |"
@@ -86,7 +92,8 @@ def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
                      f"{_fmt(h.get(3))} | {_fmt(p['error_peak'])} |")
     lines += ["", "## Figures", ""]
     for name in figures:
-        lines += [f"### {name}", "", FIGURE_NOTES[name], "", f"![{name}]({name}.png)", ""]
+        note = FIGURE_NOTES.get(name if jenkins else f"{name}-other", FIGURE_NOTES[name])
+        lines += [f"### {name}", "", note, "", f"![{name}]({name}.png)", ""]
     if notes:
         lines += ["## Notes", ""] + [f"- {n}" for n in notes] + [""]
     path.write_text("\n".join(lines))
@@ -126,19 +133,22 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                                     for s, e, h in zip(states, E_df, H_df, strict=True)]},
         }
         figs = {
-            "fig5": lambda: plots.fig5_loops(el),
+            "fig5": lambda: plots.fig5_loops(el, frequency_hz=freqs[0]),
             "fig6": lambda: plots.fig6_modes(el),
             "fig7": lambda: plots.fig7_time(el, A, freqs[0]),
-            "fig8": lambda: plots.fig8_describing_function(el),
+            "fig8": lambda: plots.fig8_describing_function(el, frequency_hz=freqs[0]),
             "fig9": lambda: plots.fig9_quasilinear_plant(loop, f_star_hz=analysis.f_star_hz),
             "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
             "fig11": lambda: plots.fig11_errors(states, E_df, H_df),
         }
         if not isinstance(el, Jenkins):
-            for name in ("fig5", "fig6", "fig7", "fig8"):
+            for name in ("fig6", "fig7"):
                 del figs[name]
-            notes.append(f"Figs. 5-8 describe the single Jenkins element of the paper; the "
-                         f"scenario's link is a {el.name} model, so they are not drawn.")
+            at = "" if el.rate_independent else f" at {freqs[0]:g} Hz"
+            notes.append(f"Figs. 6-7 show the slip modes of the paper's single Jenkins element; "
+                         f"the scenario's link is a {el.name} model, so they are not drawn. "
+                         f"Figs. 5 and 8 show its loops and describing function{at}, with "
+                         f"zeta = fc / (k A) from its total slip force and initial stiffness.")
         if not isinstance(loop.plant, TwoMassStage):
             notes.append("The plant is measured frequency-response data: eq. (21) needs the "
                          "two-mass model and is not computed; frequency plots are limited to "
