@@ -75,7 +75,9 @@ class LuGre(Hysteresis):
     For a given motion the state equation is linear in ``z``:
     ``dz/dtheta = x' - lambda(theta) z`` with ``lambda = sigma0 |x'| / g``, so the
     periodic state follows from one pass over the period (the period map is
-    affine), integrated by an exponential scheme exact for constant ``g``
+    affine), integrated by an exponential scheme exact for constant ``g``,
+    with substeps where the Stribeck curve varies (``|v| < 6 vs``, near the
+    reversals), so the grid does not grow with ``omega A / vs``
     (see :func:`~motionhyst.hysteresis._ode_kernels.lugre_steps`).
 
     Parameters
@@ -156,18 +158,26 @@ class LuGre(Hysteresis):
 
         At least 8 samples per input harmonic and 4 per output harmonic, 12
         across the width ``sqrt(2 g / (sigma0 A))`` [rad] of the transition
-        after a reversal, 12 across the Stribeck window ``vs / (omega A)`` [rad]
-        (if ``fs != fc``) and ``1100 (sigma0 A / fc)^(1/3)`` for the aliasing of
+        after a reversal and ``1100 (sigma0 A / fc)^(1/3)`` for the aliasing of
         the corners at reversals.  The first harmonic's error falls as ``N^-4``
         and is about 1e-10 relative or less at this size.
+
+        The size does not depend on `omega` (accepted for a uniform
+        signature): the Stribeck window ``|v| < 6 vs``, only
+        ``~ 6 vs / (omega A)`` rad wide around a reversal at high
+        ``omega A / vs``, is resolved by substeps inside
+        :func:`~motionhyst.hysteresis._ode_kernels.lugre_steps`, not by the grid.
+        The window leaves a narrow change in ``z`` whose effect on ``D`` falls
+        as ``(vs / (omega A))^2``; sampling it on a grid coarser than the window
+        costs nothing measurable (measured: ``D`` agrees with an adaptive ODE
+        reference to about 1e-11 relative or better for ``omega A / vs`` from 0.06
+        to 6e5 and ``sigma0 A / fc`` from 0.4 to 1000).
         """
         X = truncate_harmonics(X)
         amp = 2.0 * float(np.sum(np.abs(X[1:])))
         r = self.sigma0 * amp / min(self.fc, self.fs)
         need = [8 * (len(X) - 1), 4 * (int(n_harmonics) + 1),
                 1100.0 * max(r, 1.0) ** (1.0 / 3.0), 12.0 * TWO_PI / np.sqrt(2.0 / max(r, 1e-300))]
-        if self.fs != self.fc and omega > 0 and amp > 0:
-            need.append(12.0 * TWO_PI * omega * amp / self.vs)
         return pow2_at_least(max(need))
 
     def _periodic_state(self, X: NDArray[np.complex128], omega: float, N: int
