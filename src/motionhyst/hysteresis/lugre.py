@@ -338,8 +338,11 @@ class LuGre(Hysteresis):
         """Force for displacement samples `x` at times `t`, linear in between.
 
         With constant velocity on each interval the state equation is solved
-        exactly (``g`` is then constant), so the result converges as the
-        samples get finer at the rate of the linear interpolation of ``x``.
+        exactly (``g`` is then constant), so the bristle force ``sigma0 z``
+        converges at the second-order rate of the linear interpolation of
+        ``x``; the damping and viscous terms (``sigma1``, ``sigma2`` > 0) use the
+        velocity of the interval ending at the sample and converge at first
+        order in the step.
 
         Parameters
         ----------
