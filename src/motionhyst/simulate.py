@@ -16,7 +16,6 @@ tune it.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import control
@@ -32,7 +31,7 @@ from motionhyst.hysteresis._ode_kernels import (
     GL_W,
     bouc_wen_advance,
     dahl_advance,
-    lugre_g,
+    lugre_relax,
 )
 from motionhyst.loop import Loop, _cancel_s, _polysub_exact
 from motionhyst.systems import TWO_PI
@@ -169,7 +168,7 @@ def _advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no
             s = -bouc_wen_advance(-s, -du, p[2], p[3], p[4], p[5], glt, glw)
         return s, p[1] * s
     # LuGre, p = (sigma0, sigma1, sigma2, fc, fs, vs); state z.  As in lugre_response, z
-    # relaxes exactly to q for the step's constant velocity (g constant).  The rates in
+    # relaxes exactly for the step's constant velocity (lugre_relax).  The rates in
     # the force are taken at the sample by the second-order backward difference,
     # v = (3 dx - dx_prev) / (2 h) and z' likewise from z: the step's mean velocity is half
     # a step late (first order), and z' from the state equation at the sample would
@@ -179,10 +178,7 @@ def _advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no
     if h <= 0.0:
         return s, sigma0 * s
     z0 = s
-    if dx != 0.0:
-        g = lugre_g(dx / h, p[3], p[4], p[5])
-        q = g / sigma0 if dx > 0.0 else -g / sigma0
-        s = q + (s - q) * math.exp(-sigma0 * abs(dx) / g)
+    s = lugre_relax(s, dx, h, sigma0, p[3], p[4], p[5])
     if first:
         v = dx / h
         zdot = (s - z0) / h

@@ -433,12 +433,27 @@ def lugre_steps(xa, xm, xb, h, omega, sigma0, fc, fs, vs):  # pragma: no cover -
 
 
 @njit(cache=True)
+def lugre_relax(z, dx, h, sigma0, fc, fs, vs):  # pragma: no cover - compiled
+    """Bristle state after a displacement `dx` at constant velocity over a time `h` > 0.
+
+    ``g(v)`` is constant for ``v = dx / h``, and ``z`` relaxes exactly to the
+    quasi-static state ``q = sign(v) g / sigma0``:
+    ``z <- q + (z - q) exp(-sigma0 |dx| / g)``.
+    """
+    if dx == 0.0:
+        return z
+    g = lugre_g(dx / h, fc, fs, vs)
+    q = g / sigma0 if dx > 0.0 else -g / sigma0
+    return q + (z - q) * math.exp(-sigma0 * abs(dx) / g)
+
+
+@njit(cache=True)
 def lugre_response(x, t, sigma0, sigma1, sigma2, fc, fs, vs, z0):  # pragma: no cover
     """LuGre state and force for displacement samples `x` at times `t`, linear in between.
 
-    With constant velocity ``v`` on an interval, ``g(v)`` is constant and the
-    state relaxes exactly: ``z <- q + (z - q) exp(-sigma0 |dx| / g)``, ``q = sign(v) g / sigma0``.
-    The force at a sample uses the velocity of the interval ending there.
+    With constant velocity on an interval the state relaxes exactly
+    (:func:`lugre_relax`).  The force at a sample uses the velocity of the
+    interval ending there.
     """
     n = x.shape[0]
     w = np.empty(n)
@@ -450,11 +465,8 @@ def lugre_response(x, t, sigma0, sigma1, sigma2, fc, fs, vs, z0):  # pragma: no 
         dt = t[i] - t[i - 1]
         dx = x[i] - x[i - 1]
         v = dx / dt
-        g = lugre_g(v, fc, fs, vs)
-        if dx != 0.0:
-            q = g / sigma0 if dx > 0.0 else -g / sigma0
-            z = q + (z - q) * math.exp(-sigma0 * abs(dx) / g)
-        zdot = v - sigma0 * abs(v) * z / g
+        z = lugre_relax(z, dx, dt, sigma0, fc, fs, vs)
+        zdot = v - sigma0 * abs(v) * z / lugre_g(v, fc, fs, vs)
         w[i] = sigma0 * z + sigma1 * zdot + sigma2 * v
     return w
 
