@@ -69,7 +69,7 @@ def _describe(el: Hysteresis, frequency_hz: float | None) -> str:
     params = ", ".join(f"{k} = {v:g}" for k, v in el.to_dict().items()
                        if k != "model" and not isinstance(v, list))
     at = "" if el.rate_independent else f", f = {frequency_hz:g} Hz"
-    return f"{el.name} element{', ' if params else ''}{params}{at}"
+    return f"{el.name} element\n{params}{at}"
 
 
 def _check_frequency(el: Hysteresis, frequency_hz: float | None) -> None:
@@ -100,7 +100,7 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
     if isinstance(el, Jenkins):
         ax.set_title(f"Fig. 5: Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N")
     else:
-        ax.set_title(f"Fig. 5: {_describe(el, frequency_hz)}", fontsize=8)
+        ax.set_title(f"Fig. 5: {_describe(el, frequency_hz)}", fontsize=9)
     ax.legend()
     return fig
 
@@ -177,7 +177,7 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
     else:
         ax2.set_xlabel("zeta = fc / (k A) [-], k the initial stiffness")
         ax1.set_title(f"Fig. 8: describing function, {_describe(el, frequency_hz)}",
-                      fontsize=8)
+                      fontsize=9)
     fig.motionhyst_data.update(zeta=z, abs_over_k=np.abs(D) / k0,
                                phase_deg=np.degrees(np.angle(D)))
     return fig
@@ -249,7 +249,9 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     ax.set_ylim(0.5, max(10.0, float(np.abs(E).max()) * 2))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("|E| [-]")
-    ax.set_title(f"Fig. 10: feedforward mismatch, zeta = {analysis.zeta:.3g}")
+    at = (f"zeta = {analysis.zeta:.3g}" if np.isfinite(analysis.zeta)
+          else f"A = {analysis.amplitude:.3g} m")
+    ax.set_title(f"Fig. 10: feedforward mismatch, {at}")
     ax.legend(loc="upper right")
     fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
     return fig
