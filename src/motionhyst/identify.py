@@ -25,21 +25,34 @@ unit-stiffness stop operator of threshold ``d`` and ``c`` a force offset.
 3. Joint refinement of all ``k_i, fc_i``, the offset and (by default) each
    element's initial force ``w_i(0) = alpha_i fc_i, |alpha_i| <= 1`` with
    bounded :func:`scipy.optimize.least_squares` and the exact (almost
-   everywhere) Jacobian of the stop operator.
-4. Model order: fits for ``N`` = 1, 2, ... are compared (fewer elements by
-   merging the adjacent pair that costs least, more by adding the grid element
-   that best explains the residual, each refined).  The default criterion
-   (``criterion="rms"``) picks the smallest ``N`` whose RMS residual exceeds
-   the best over all orders tried by at most 1 % of that best or 0.1 % of the
-   force's RMS, whichever is larger; ``criterion="bic"`` minimises
-   ``n log(RSS / n) + p log n`` instead (prone to extra elements when the
-   residual is not white).
+   everywhere) Jacobian of the stop operator.  The objective has a kink
+   wherever a slip onset moves from one sample to the next, hence many local
+   minima (far apart on short records); every order is therefore refined
+   from several starts: the NNLS elements merged down to ``N`` (the adjacent
+   pair that costs least, before any refinement) and the best ``N - 1``
+   element fit plus the grid element that best explains its residual.  The
+   best of these is then moved across kinks by a derivative-free scan of each
+   slip displacement (stiffnesses and offset re-solved linearly) and refined
+   again, while that lowers the residual sum of squares by more than the
+   noise variance.
+4. Model order: every ``N`` up to the number of NNLS elements is fitted as
+   in 3, then more while another element still helps.  An ``N``-element fit
+   depends only on the data and the fits of lower order, so it is the same
+   whether ``N`` was requested (`n_elements`) or chosen.  The order is chosen
+   after refinement: the default criterion (``criterion="rms"``) picks the
+   smallest ``N`` whose RMS residual exceeds the best over all orders tried by
+   at most 1 % of that best or 0.1 % of the force's RMS, whichever is larger;
+   ``criterion="bic"`` minimises ``n log(RSS / n) + p log n`` instead (prone
+   to extra elements when the residual is not white).
 5. Uncertainty: ``sigma^2 (J^T J)^-1`` at the optimum with
    ``sigma^2 = RSS / (n - p)``; parameters the data cannot determine get an
-   infinite standard deviation.  An element that never slips is a spring: its
+   infinite standard deviation.  For white noise this matches the scatter of
+   the estimates over noise realisations (the tests check it within a factor
+   of two on a short record).  An element that never slips is a spring: its
    ``fc`` is only bounded below by its largest spring force (its standard
-   error is then infinite or merely local).  The formula assumes white residuals; with
-   coloured noise or model error (closed-loop records) it is optimistic.
+   error is then infinite or merely local).  The formula assumes white
+   residuals; with coloured noise or model error (closed-loop records, or a
+   refinement stuck in a wrong local minimum) it is optimistic.
 
 Closed-loop records
 -------------------
@@ -80,6 +93,16 @@ PRUNE = 0.005
 """Elements of the NNLS stage with less than this share of the total slip force are dropped."""
 MAX_ELEMENTS = 8
 """Largest number of elements tried when the order is chosen automatically."""
+SCAN_SPAN = 0.3
+"""The scan covers ``1 / (1 + SCAN_SPAN)`` to ``1 + SCAN_SPAN`` times each slip displacement."""
+SCAN_POINTS = 61
+"""Values per slip displacement in the derivative-free scan (denser near the current one)."""
+HOPS = 3
+"""Most scan-and-refine rounds per model order."""
+MAX_NFEV = 100
+"""Most residual evaluations of one refinement."""
+SCREEN_NFEV = 15
+"""Residual evaluations after which the starts of one order are compared (the best goes on)."""
 MAX_ROWS = 50_000
 """Most samples used in the residual (the operators always run on the full record)."""
 REVERSAL_BAND = 0.01
@@ -343,7 +366,7 @@ def _evaluate(prob: _Problem, theta, n: int, jac: bool):
     return r, J
 
 
-def _refine(prob: _Problem, k, fc, alpha, c) -> _Fit:
+def _refine(prob: _Problem, k, fc, alpha, c, max_nfev: int = MAX_NFEV) -> _Fit:
     """Joint bounded least-squares refinement of all parameters."""
     n = len(k)
     theta0 = _pack(k, fc, np.clip(alpha, -0.999, 0.999), c, prob.fit_initial)
@@ -367,7 +390,7 @@ def _refine(prob: _Problem, k, fc, alpha, c) -> _Fit:
 
     sol = least_squares(fun, theta0, jac=jacobian, bounds=(lo, hi), x_scale="jac",
                         method="trf", tr_solver="lsmr", ftol=1e-10, xtol=1e-10, gtol=1e-10,
-                        max_nfev=100)
+                        max_nfev=max_nfev)
     k, fc, alpha, c = _unpack(sol.x, n, prob.fit_initial)
     r, J = _evaluate(prob, sol.x, n, True)
     return _Fit(k=k.copy(), fc=fc.copy(), alpha=alpha.copy(), c=c, rss=float(r @ r), J=J,
@@ -448,23 +471,148 @@ def _grow(prob: _Problem, fit: _Fit):
     return _sorted(np.append(fit.k, f / d), np.append(fit.fc, f), np.append(fit.alpha, 0.0))
 
 
-def _polish(prob: _Problem, fits: dict[int, _Fit], add, n_max: int) -> None:
-    """Second start for every order: grow the best fit with one element fewer.
+def _collapsed(fit: _Fit) -> bool:
+    """An element fell onto its lower bound: the fit has in effect fewer elements."""
+    return bool(np.any(fit.fc <= 1e-6 * fit.fc.sum()) or np.any(fit.k <= 1e-6 * fit.k.sum()))
 
-    Each order then has the better of two refinements (from the NNLS / merge
-    path and from the forward path), which guards against local minima.
+
+def _unit_columns(prob: _Problem, d, w0) -> NDArray[np.float64]:
+    """Unit-stiffness stop operators of thresholds `d` started at `w0`, at the rows."""
+    S = np.column_stack([stop_response(prob.x, 1.0, float(di), float(wi))
+                         for di, wi in zip(d, w0, strict=True)])
+    if prob.filt is not None:
+        S = prob.filt(S)
+    return S[prob.rows]
+
+
+def _scan_thresholds(prob: _Problem, fit: _Fit):
+    """A start across the kinks next to a refined fit, or ``None`` if there is none better.
+
+    With the slip displacements ``d_i = fc_i / k_i`` (and the initial states
+    ``alpha_i``) fixed, the force is linear in the stiffnesses and the offset.
+    Each ``d_i`` in turn is scanned over ``SCAN_POINTS`` values within a
+    factor ``1 + SCAN_SPAN`` of its value (0.03 % apart near it, 1.7 % at the
+    ends), the stiffnesses and offset re-solved by non-negative least squares
+    (variable projection; the other elements' columns are factored once per
+    ``d_i``), and the best kept.  The objective has a kink wherever a slip
+    onset moves from one sample to the next (``2 d_i`` equal to the travel
+    from a reversal to a sample), hence many local minima; the gradient-based
+    refinement stops in one, this search steps over kinks.  A start is
+    returned only if it lowers the residual sum of squares by more than the
+    noise variance ``RSS / (n - p)``: a smaller gain moves the estimate by
+    less than about one standard error.
     """
-    for n in range(2, n_max + 1):
-        if n - 1 in fits:
-            add(_refine(prob, *_grow(prob, fits[n - 1]), fits[n - 1].c))
+    n = fit.n
+    y = prob.y
+    yc = y - y.mean()
+    yy = float(yc @ yc)
+    d = fit.fc / fit.k
+    A = _unit_columns(prob, d, fit.alpha * d)
+    a_mean = A.mean(axis=0)
+    Ac = A - a_mean
+    k, rnorm = nnls(Ac, yc)
+    best = min(float(rnorm**2), fit.rss)
+    ref = best
+    found = False
+    t = np.linspace(-1.0, 1.0, SCAN_POINTS)
+    factors = (1.0 + SCAN_SPAN) ** (t * np.abs(t))  # dense near 1: the kinks are close
+    for i in range(n):
+        trial = d[i] * factors
+        T = _unit_columns(prob, trial, fit.alpha[i] * trial)
+        t_mean = T.mean(axis=0)
+        # split every trial column and y into parts in and orthogonal to the other columns:
+        # ||O k_o + T_j k_i - y||^2 = ||R0 k_o + P_j k_i - P_y||^2 + ||E_j k_i - E_y||^2
+        others = np.delete(Ac, i, axis=1)
+        if n > 1:
+            Q0, R0 = np.linalg.qr(others)
+        else:
+            Q0, R0 = np.zeros((y.size, 0)), np.zeros((0, 0))
+        B = np.column_stack([T - t_mean, yc])
+        P = Q0.T @ B
+        E = B - Q0 @ P
+        e_jj = np.einsum("ij,ij->j", E[:, :-1], E[:, :-1])
+        e_jy = E[:, :-1].T @ E[:, -1]
+        e_yy = float(E[:, -1] @ E[:, -1])
+        jbest = -1
+        for j in np.flatnonzero(e_jj > 0):
+            sj = np.sqrt(e_jj[j])
+            small = np.zeros((n, n))
+            small[:n - 1, :n - 1] = R0
+            small[:n - 1, -1] = P[:, j]
+            small[-1, -1] = sj
+            kj, _ = nnls(small, np.append(P[:, -1], e_jy[j] / sj))
+            if not np.all(kj > 0):  # a zero stiffness drops an element
+                continue
+            top = float(np.sum((small[:n - 1] @ kj - P[:, -1]) ** 2))
+            ki = kj[-1]
+            if top + (e_jj[j] * ki - 2.0 * e_jy[j]) * ki + e_yy > best + 1e-12 * yy:
+                continue  # not better (the expanded square is exact to rounding of y^T y)
+            rss = top + float(np.sum((E[:, j] * ki - E[:, -1]) ** 2))
+            if rss < best:
+                best, jbest = rss, j
+                k = np.insert(kj[:n - 1], i, kj[-1])
+        if jbest >= 0:
+            found = True
+            d[i] = trial[jbest]
+            Ac[:, i] = T[:, jbest] - t_mean[jbest]
+            a_mean[i] = t_mean[jbest]
+    sigma2 = fit.rss / max(prob.rows.size - fit.J.shape[1], 1)
+    if not found or best > ref - sigma2:
+        return None
+    return (*_sorted(k, k * d, fit.alpha.copy()), float(y.mean() - a_mean @ k))
 
 
-def _clean(prob: _Problem, fit: _Fit) -> _Fit:
-    """Drop elements that collapsed onto their bounds and refit."""
-    keep = (fit.fc > 1e-6 * fit.fc.sum()) & (fit.k > 1e-6 * fit.k.sum())
-    if keep.all() or not keep.any():
-        return fit
-    return _refine(prob, fit.k[keep], fit.fc[keep], fit.alpha[keep], fit.c)
+def _merge_chain(prob: _Problem, k, fc, c) -> dict[int, tuple]:
+    """Starts ``(k, fc, alpha, c)`` per order: the NNLS elements merged pairwise down to 1.
+
+    Each step merges the adjacent pair (by slip displacement) whose merge
+    raises the residual least, without refinement.
+    """
+    kk, ff, aa = _sorted(k, fc, np.zeros(k.size))
+    chain = {kk.size: (kk, ff, aa, c)}
+    while kk.size > 1:
+        kk, ff, aa = _best_merge(prob, kk, ff, aa, c)
+        chain[kk.size] = (kk, ff, aa, c)
+    return chain
+
+
+def _fit_order(prob: _Problem, n: int, chain: dict[int, tuple],
+               fits: dict[int, _Fit]) -> _Fit | None:
+    """Best refined ``n``-element fit over several starts; ``None`` if every start collapses.
+
+    Starts: (a) the NNLS elements merged down to ``n`` (`chain`), (b) the
+    best ``n - 1`` element fit plus the grid element that best explains its
+    residual; each is refined for ``SCREEN_NFEV`` evaluations and the best
+    one to convergence.  That fit is then moved across kinks of the
+    objective by :func:`_scan_thresholds` and refined again, at most ``HOPS``
+    times, while that helps.  The starts depend only on the data and on the
+    fits of lower order, so the ``n``-element fit is the same whether ``n``
+    was requested or reached by the automatic order search.
+    """
+    starts = [chain[n]] if n in chain else []
+    if n - 1 in fits:
+        prev = fits[n - 1]
+        starts.append((*_grow(prob, prev), prev.c))
+    # screen the starts with a few evaluations each, then refine the best to convergence
+    # (the next best if that collapses)
+    screen = SCREEN_NFEV if len(starts) > 1 else MAX_NFEV
+    tried = [_refine(prob, *start, max_nfev=screen) for start in starts]
+    best = None
+    for fit in sorted((f for f in tried if not _collapsed(f)), key=lambda f: f.rss):
+        if screen < MAX_NFEV:
+            fit = _refine(prob, fit.k, fit.fc, fit.alpha, fit.c)
+        if not _collapsed(fit):
+            best = fit
+            break
+    for _ in range(HOPS if best is not None else 0):
+        start = _scan_thresholds(prob, best)
+        if start is None:
+            break
+        fit = _refine(prob, *start)
+        if _collapsed(fit) or fit.rss >= best.rss:
+            break
+        best = fit
+    return best
 
 
 def _bic(rss: float, n_rows: int, n_params: int) -> float:
@@ -511,37 +659,19 @@ def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol
     def margin(r: float) -> float:  # an RMS change smaller than this is not significant
         return max(rtol * r, atol * w_rms)
 
-    k, fc, c = _nnls_start(prob)
-    alpha = np.zeros(k.size)
-    k, fc, alpha = _sorted(k, fc, alpha)
-    cap = int(n_elements) if n_elements is not None else max(1, int(max_elements))
-    while k.size > cap:
-        k, fc, alpha = _best_merge(prob, k, fc, alpha, c)
-
+    chain = _merge_chain(prob, *_nnls_start(prob))
     fits: dict[int, _Fit] = {}
-
-    def add(fit: _Fit) -> _Fit:
-        fit = _clean(prob, fit)
-        if fit.n not in fits or fit.rss < fits[fit.n].rss:
-            fits[fit.n] = fit
-        return fit
-
-    cur = add(_refine(prob, k, fc, alpha, c))
-    while cur.n > 1:  # fewer elements: merge the adjacent pair that costs least
-        new = add(_refine(prob, *_best_merge(prob, cur.k, cur.fc, cur.alpha, cur.c), cur.c))
-        if new.n >= cur.n:
+    # automatic: every order up to the NNLS stage's, then on while an element still helps
+    n_top = int(n_elements) if n_elements is not None else max(1, int(max_elements))
+    n_nnls = min(max(chain), n_top)
+    for n in range(1, n_top + 1):
+        fit = _fit_order(prob, n, chain, fits)
+        if fit is None:  # every start collapsed: the data hold no more elements
             break
-        cur = new
-    n_top = int(n_elements) if n_elements is not None else int(max_elements)
-    cur = fits[max(fits)]
-    while cur.n < n_top:  # more elements: add the one that best explains the residual
-        new = add(_refine(prob, *_grow(prob, cur), cur.c))
-        if new.n <= cur.n:  # collapsed: the data hold no more elements
+        fits[n] = fit
+        if (n_elements is None and n >= max(n_nnls, 2)
+                and rms(fit) > rms(fits[n - 1]) - margin(rms(fits[n - 1]))):
             break
-        if n_elements is None and rms(new) > rms(cur) - margin(rms(cur)):
-            break
-        cur = new
-    _polish(prob, fits, add, n_top if n_elements is not None else max(fits))
     if n_elements is not None:
         chosen = fits[min(fits, key=lambda m: (abs(m - int(n_elements)), m))]
         how = f"fixed: {int(n_elements)} element(s) requested"
