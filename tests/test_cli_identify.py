@@ -262,6 +262,8 @@ def _record_text(kind: str) -> str:
         lines[10] = "0.009,0.001"
     elif kind == "empty":
         lines = []
+    elif kind == "both":
+        lines = [lines[0] + ",y1,u"] + [ln + ",0.0,0.0" for ln in lines[1:]]
     return "\n".join(lines) + "\n"
 
 
@@ -279,6 +281,11 @@ def _record_text(kind: str) -> str:
     ("ok", ["--elements", "2.5"], "--elements: must be a whole number"),
     ("ok", ["--criterion", "aic"], "--criterion: invalid choice"),
     ("ok", ["--scenario", "x.toml"], "--scenario applies to closed-loop records"),
+    ("both", [], "columns of both a force-displacement and a closed-loop record; choose one "
+                 "with --record"),
+    ("ok", ["--record", "closed-loop"], "a closed-loop record needs the columns time,y1,u; "
+                                        "the header is 'time,displacement,force'"),
+    ("ok", ["--record", "hysteresis"], "--record: invalid choice"),
 ])
 def test_bad_input_is_one_line_exit_2(capsys, tmp_path, kind, args, match):
     path = tmp_path / "rec.csv"
@@ -291,6 +298,15 @@ def test_bad_input_is_one_line_exit_2(capsys, tmp_path, kind, args, match):
     assert err.count("\n") == 1 and "Traceback" not in err
     if kind not in ("ok",):
         assert "rec.csv" in err
+
+
+def test_record_kind_chosen_where_the_header_has_both(capsys, tmp_path, record, identified):
+    lines = record.read_text().splitlines()
+    both = tmp_path / "both.csv"
+    both.write_text("\n".join([lines[0] + ",y1,u"] + [ln + ",0,0" for ln in lines[1:]]) + "\n")
+    d = run_json(capsys, "identify", str(both), "--record", "force-displacement")
+    assert d["record"] == "force-displacement"
+    assert d["elements"] == identified["elements"]
 
 
 def test_missing_argument(capsys):

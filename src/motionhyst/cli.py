@@ -345,34 +345,45 @@ def _element_count(text: str) -> int:
     return n
 
 
-def record_kind(path: str | Path) -> str:
+def record_kind(path: str | Path, kind: str | None = None) -> str:
     """The kind of a measured record from its CSV header.
 
     Parameters
     ----------
     path : str or Path
         CSV file with a header row.
+    kind : str, optional
+        The kind the user asked for (``--record``); checked against the header.
 
     Returns
     -------
     str
         ``"force-displacement"`` (columns ``time,displacement,force``) or
-        ``"closed-loop"`` (columns ``time,y1,u``); the first when both fit.
+        ``"closed-loop"`` (columns ``time,y1,u``).
 
     Raises
     ------
     ValueError
-        One line naming the file: unreadable, empty, or a header of neither kind.
+        One line naming the file: unreadable, empty, a header of neither kind,
+        of both kinds without `kind`, or without the columns of `kind`.
     """
     from motionhyst.csvdata import read_header
 
-    header = set(read_header(path))
-    for kind, names in RECORD_KINDS.items():
-        if header.issuperset(names):
-            return kind
+    names = read_header(path)
+    header = set(names)
+    fits = [k for k, cols in RECORD_KINDS.items() if header.issuperset(cols)]
+    if kind is not None:
+        if kind not in fits:
+            raise ValueError(f"{path}: a {kind} record needs the columns "
+                             f"{','.join(RECORD_KINDS[kind])}; the header is {','.join(names)!r}")
+        return kind
+    if len(fits) == 1:
+        return fits[0]
+    if fits:
+        raise ValueError(f"{path}: the header {','.join(names)!r} has the columns of both a "
+                         f"force-displacement and a closed-loop record; choose one with --record")
     expected = " or ".join(f"{','.join(n)} ({k})" for k, n in RECORD_KINDS.items())
-    raise ValueError(f"{path}: unknown record header {','.join(read_header(path))!r}; "
-                     f"expected {expected}")
+    raise ValueError(f"{path}: unknown record header {','.join(names)!r}; expected {expected}")
 
 
 def _toml_float(v: float) -> str:
@@ -416,7 +427,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     from motionhyst.systems import TwoMassStage
 
     path = Path(args.data)
-    kind = record_kind(path)
+    kind = record_kind(path, args.record)
     if kind == "force-displacement" and args.scenario is not None:
         raise UsageError("motionhyst identify: --scenario applies to closed-loop records "
                          f"(time,y1,u) only; {path} is a force-displacement record")
@@ -547,6 +558,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "time,y1,u (closed-loop) [SI units]")
     q.add_argument("--elements", type=_element_count, metavar="N",
                    help="number of Jenkins elements (default: chosen by --criterion)")
+    q.add_argument("--record", choices=list(RECORD_KINDS),
+                   help="the record's kind, where its header has the columns of both "
+                        "(default: from the header)")
     q.add_argument("--criterion", choices=["rms", "bic"], default="rms",
                    help="model-order criterion when --elements is not given (default: rms)")
     q.add_argument("--scenario", metavar="FILE",
