@@ -208,7 +208,9 @@ def test_closed_loop_record(capsys, closed_loop_case):
     assert d["record"] == "closed-loop"
     assert d["scenario"] == str(scenario)
     assert d["signal"] == "prefiltered force"
-    assert set(d) == IDENTIFY_KEYS | {"scenario"}
+    assert set(d) == IDENTIFY_KEYS | {"scenario", "cutoff_hz"}
+    # 20 times the fundamental as estimated from the reversals: (4 + 1) / (2 * 1 s) = 2.5 Hz
+    assert d["cutoff_hz"] == pytest.approx(50.0, rel=1e-3)
     assert len(d["elements"]) == 3
     # noise-free simulation: measured errors at most 3.1e-4 (prefilter, sampling)
     np.testing.assert_allclose([e["k"] for e in d["elements"]], K_TRUE, rtol=2e-3)
@@ -218,6 +220,19 @@ def test_closed_loop_record(capsys, closed_loop_case):
     rc, out, err = run(capsys, "identify", str(csv))
     assert rc == 0, err
     assert "closed-loop record, plant of paper.toml (Table I, built in)" in out
+
+
+def test_closed_loop_prefilter_cutoff(capsys, closed_loop_case):
+    scenario, csv = closed_loop_case
+    capsys.readouterr()
+    d = run_json(capsys, "identify", str(csv), "--scenario", str(scenario), "--cutoff", "25")
+    assert d["cutoff_hz"] == 25.0
+    # the model is fitted through the same prefilter, so a lower cut-off costs no bias
+    np.testing.assert_allclose([e["k"] for e in d["elements"]], K_TRUE, rtol=2e-3)
+    np.testing.assert_allclose([e["fc"] for e in d["elements"]], FC_TRUE, rtol=2e-3)
+    rc, out, err = run(capsys, "identify", str(csv), "--cutoff", "1e6")
+    assert rc == 2 and out == "" and err.count("\n") == 1
+    assert "cutoff_hz must be in (0, " in err and str(csv) in err
 
 
 def test_closed_loop_needs_a_stage_model(capsys, tmp_path, closed_loop_case):
@@ -281,6 +296,8 @@ def _record_text(kind: str) -> str:
     ("ok", ["--elements", "2.5"], "--elements: must be a whole number"),
     ("ok", ["--criterion", "aic"], "--criterion: invalid choice"),
     ("ok", ["--scenario", "x.toml"], "--scenario applies to closed-loop records"),
+    ("ok", ["--cutoff", "10"], "--cutoff applies to closed-loop records"),
+    ("ok", ["--cutoff", "-1"], "--cutoff: value must be > 0"),
     ("both", [], "columns of both a force-displacement and a closed-loop record; choose one "
                  "with --record"),
     ("ok", ["--record", "closed-loop"], "a closed-loop record needs the columns time,y1,u; "

@@ -428,9 +428,12 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     path = Path(args.data)
     kind = record_kind(path, args.record)
-    if kind == "force-displacement" and args.scenario is not None:
-        raise UsageError("motionhyst identify: --scenario applies to closed-loop records "
-                         f"(time,y1,u) only; {path} is a force-displacement record")
+    if kind == "force-displacement":
+        for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
+            if value is not None:
+                raise UsageError(f"motionhyst identify: {option} applies to closed-loop "
+                                 f"records (time,y1,u) only; {path} is a force-displacement "
+                                 f"record")
     options = {"n_elements": args.elements, "criterion": args.criterion}
     extra: dict = {"record": kind, "data": str(path)}
     if kind == "force-displacement":
@@ -447,12 +450,13 @@ def cmd_identify(args: argparse.Namespace) -> int:
             raise UsageError(f"motionhyst identify: closed-loop records need a [stage] in the "
                              f"scenario (P1 as a model); {sc.source} has a measured [plant]")
         t, y1, u = load_closed_loop_csv(path)
-        what = f"closed-loop record, plant of {sc.source}"
         extra["scenario"] = sc.source
         try:
-            ident = identify_closed_loop(t, y1, u, plant, **options)
+            ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+        what = (f"closed-loop record, plant of {sc.source}, prefilter cut-off "
+                f"{_g(ident.cutoff_hz)} Hz")
     k = [e["k"] for e in ident.elements]
     fc = [e["fc"] for e in ident.elements]
     if args.json:
@@ -558,6 +562,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "time,y1,u (closed-loop) [SI units]")
     q.add_argument("--elements", type=_element_count, metavar="N",
                    help="number of Jenkins elements (default: chosen by --criterion)")
+    q.add_argument("--cutoff", type=positive, metavar="HZ",
+                   help="closed-loop records: cut-off of the prefilter through which the link "
+                        "force is inferred [Hz] (default: 20 times the record's fundamental, "
+                        "at most a twentieth of the sampling rate)")
     q.add_argument("--record", choices=list(RECORD_KINDS),
                    help="the record's kind, where its header has the columns of both "
                         "(default: from the header)")

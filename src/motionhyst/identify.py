@@ -757,6 +757,9 @@ class Identification:
     signal : str
         What was fitted: ``"force"`` or, for closed-loop records,
         ``"prefiltered force"`` (the residual is in the prefiltered domain).
+    cutoff_hz : float or None
+        Cut-off of the prefilter of a closed-loop record [Hz]; None for a
+        force-displacement record.
     """
 
     model: MaxwellSlip
@@ -771,6 +774,7 @@ class Identification:
     criterion: str
     candidates: list[dict] = field(default_factory=list)
     signal: str = "force"
+    cutoff_hz: float | None = None
 
     @property
     def n_elements(self) -> int:
@@ -795,7 +799,8 @@ class Identification:
                 "fit_rms": self.fit_rms, "fit_nrms": self.fit_nrms, "r2": self.r2,
                 "n_samples": self.n_samples, "offset": self.offset,
                 "criterion": self.criterion, "signal": self.signal,
-                "candidates": [dict(c) for c in self.candidates]}
+                "candidates": [dict(c) for c in self.candidates],
+                **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz})}
 
     def scenario_fragment(self) -> str:
         """A ``[hysteresis]`` section of a scenario file (TOML), ready to paste.
@@ -1046,8 +1051,10 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     prob = _Problem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],
                     rows=_rows(start, sel.size, max_rows), filt=lf.lowpass.with_step(q * dt),
                     fit_initial=initial_state == "fit")
-    return _identify(prob, n_elements, criterion, rtol, atol, max_elements,
-                     "prefiltered force")
+    ident = _identify(prob, n_elements, criterion, rtol, atol, max_elements,
+                      "prefiltered force")
+    ident.cutoff_hz = lf.cutoff_hz
+    return ident
 
 
 # --------------------------------------------------------------------------- CSV
