@@ -115,6 +115,12 @@ def test_closed_loop_poles(loop, stage, controller):
     assert np.all(got.real < 0)
 
 
+def test_closed_loop_poles_are_computed_once_and_returned_as_a_copy(loop):
+    p = loop.closed_loop_poles()
+    p[:] = 0.0
+    assert np.all(loop.closed_loop_poles() != 0.0)
+
+
 def test_check_stable_table1(loop):
     loop.check_stable()
 

@@ -8,9 +8,13 @@ the element is ``D = 2 j W_1 / (A exp(j phase))``.
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from scipy.integrate import quad
+from scipy.optimize import brentq
 
 from motionhyst.hysteresis.jenkins import Jenkins
 from motionhyst.hysteresis.periodic import (
@@ -198,3 +202,86 @@ def test_significant_harmonics():
     X = np.array([5.0, 1.0, 0.0, 0.5, 1e-20, 0.0], dtype=complex)
     assert significant_harmonics(X) == 3
     assert significant_harmonics(np.array([1.0, 0.0, 0.0], dtype=complex)) == 0
+
+
+# ------------------------------------------------- independent reference at round-off
+
+
+def quadrature_harmonics(X: np.ndarray, k: float, fc: float, n_harmonics: int) -> np.ndarray:
+    """Independent reference: ``W_n`` by adaptive quadrature of the exact periodic force.
+
+    Reversals (roots of ``x'``) and slip onsets are found by ``brentq`` from sign changes
+    on a fine grid, the element is run twice round the reversals from the global maximum
+    (from ``k (x - mid-range)``, the symmetric solution where it never slips), and
+    ``w(theta) exp(-j n theta)`` is integrated by ``quad`` between its corners.
+    """
+    m = np.arange(1, len(X))
+
+    def x(t):
+        return X[0].real + 2 * np.real(np.sum(X[1:] * np.exp(1j * m * t)))
+
+    def dx(t):
+        return 2 * np.real(np.sum(1j * m * X[1:] * np.exp(1j * m * t)))
+
+    grid = np.linspace(0.0, 2 * np.pi, 4097)
+    dv = [dx(t) for t in grid]
+    rev = [brentq(dx, grid[i], grid[i + 1], xtol=1e-15) for i in range(4096)
+           if np.sign(dv[i]) != np.sign(dv[i + 1])]
+    i0 = int(np.argmax([x(t) for t in rev]))
+    rev = rev[i0:] + [t + 2 * np.pi for t in rev[:i0]] + [rev[i0] + 2 * np.pi]
+    xs = [x(t) for t in rev]
+    w = min(max(k * (xs[0] - 0.5 * (max(xs) + min(xs))), -fc), fc)  # symmetric if no slip
+    for _ in range(2):
+        ws = [w]
+        for a, b in pairwise(xs):
+            w = min(max(w + k * (b - a), -fc), fc)
+            ws.append(w)
+    W = np.zeros(n_harmonics + 1, dtype=complex)
+    for i in range(len(rev) - 1):
+        d = 1.0 if xs[i + 1] > xs[i] else -1.0
+        level = xs[i] + (d * fc - ws[i]) / k
+        corners = [rev[i], rev[i + 1]]
+        if d * (xs[i + 1] - level) > 0:
+            corners.insert(1, brentq(lambda t, lv=level: x(t) - lv, rev[i], rev[i + 1],
+                                     xtol=1e-15))
+
+        def force(t, i=i):
+            return min(max(ws[i] + k * (x(t) - xs[i]), -fc), fc)
+
+        for a, b in pairwise(corners):
+            for n in range(n_harmonics + 1):
+                re = quad(lambda t, n=n: force(t) * np.cos(n * t), a, b, epsabs=1e-18,
+                          epsrel=1e-15, limit=200)[0]
+                im = quad(lambda t, n=n: -force(t) * np.sin(n * t), a, b, epsabs=1e-18,
+                          epsrel=1e-15, limit=200)[0]
+                W[n] += re + 1j * im
+    return W / (2 * np.pi)
+
+
+def rich_input(A: float) -> np.ndarray:
+    """A mean, a second and a third harmonic: six reversals a period (minor loops)."""
+    return np.array([0.001, A / 2j, 0.1 * A * np.exp(0.7j) / 2j, 0.3 * A * np.exp(0.4j) / 2j])
+
+
+@pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
+def test_rich_input_matches_quadrature_to_round_off():
+    X = rich_input(0.004)
+    W = stop_periodic_harmonics(X, K, FC, 6)
+    assert_allclose(W, quadrature_harmonics(X, K, FC, 6), rtol=0, atol=5e-15 * abs(W[1]))
+
+
+@pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
+def test_parallel_elements_are_the_sum_of_single_elements():
+    """Maxwell-slip in one pass: elements that slip, slip in minor loops, or never slip."""
+    k, fc = np.array([8.0, 6.0, 4.0]), np.array([0.01, 0.03, 0.06])
+    X = rich_input(0.01)
+    W = stop_periodic_harmonics(X, k, fc, 9)
+    singles = [stop_periodic_harmonics(X, ki, fi, 9) for ki, fi in zip(k, fc, strict=True)]
+    assert_allclose(W, sum(singles), rtol=0, atol=1e-15 * abs(W[1]))
+    W_quad = sum(quadrature_harmonics(X, ki, fi, 4) for ki, fi in zip(k, fc, strict=True))
+    assert_allclose(W[:5], W_quad, rtol=0, atol=5e-15 * abs(W[1]))
+
+
+def test_mismatched_parallel_parameters_raise():
+    with pytest.raises(ValueError, match="equal length"):
+        stop_periodic_harmonics(sine_harmonics(0.01), [1.0, 2.0], [0.1], 3)

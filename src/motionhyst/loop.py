@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import control
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.base import Hysteresis
@@ -66,6 +67,22 @@ def _cancel_s(num, den):
     return num, den
 
 
+@njit(cache=True)
+def _polyratio(num, den, omega):  # pragma: no cover - compiled
+    """``num(j omega) / den(j omega)`` at each of `omega`, both by Horner's rule."""
+    out = np.empty(omega.shape[0], dtype=np.complex128)
+    for i in range(omega.shape[0]):
+        s = 1j * omega[i]
+        p = 0j
+        for c in num:
+            p = p * s + c
+        q = 0j
+        for c in den:
+            q = q * s + c
+        out[i] = p / q
+    return out
+
+
 @dataclass(frozen=True)
 class PolyTF:
     """A SISO transfer function as coefficient arrays (highest power first)."""
@@ -74,8 +91,8 @@ class PolyTF:
     den: NDArray[np.float64]
 
     def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
-        s = 1j * np.asarray(omega, dtype=float)
-        return np.polyval(self.num, s) / np.polyval(self.den, s)
+        w = np.asarray(omega, dtype=float)
+        return _polyratio(self.num, self.den, w.ravel()).reshape(w.shape)
 
     def tf(self) -> control.TransferFunction:
         """As a python-control transfer function."""
@@ -130,6 +147,7 @@ class Loop:
         self.is_lti = not any(isinstance(s, control.FrequencyResponseData)
                               for s in (P1, P2, controller))
         self._poly = self._closed_loop_polys() if self.is_lti else None
+        self._poles: NDArray[np.complex128] | None = None
 
     @property
     def Pr(self) -> control.TransferFunction:
@@ -189,7 +207,9 @@ class Loop:
 
     def closed_loop_poles(self) -> NDArray[np.complex128]:
         """Poles of ``1 + C P2`` (LTI loops only)."""
-        return np.roots(self._poly["w->e"].den)
+        if self._poles is None:
+            self._poles = np.roots(self._poly["w->e"].den)
+        return self._poles.copy()
 
     def check_stable(self) -> None:
         """Raise ``ValueError`` unless the linear loop is stable.

@@ -206,9 +206,11 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     wn = omega * np.arange(H + 1)
     R = np.zeros(H + 1, dtype=complex)
     R[1] = -0.5j * amplitude  # r = A sin(theta)
-    e_lin = loop.transfer("r->e", wn) * R
-    y1_lin = loop.transfer("r->y1", wn) * R
-    e_lin[0] = y1_lin[0] = 0.0
+    # the reference has one harmonic, so the linear loop answers with that one only
+    e_lin = np.zeros(H + 1, dtype=complex)
+    y1_lin = np.zeros(H + 1, dtype=complex)
+    e_lin[1] = loop.transfer("r->e", wn[1:2])[0] * R[1]
+    y1_lin[1] = loop.transfer("r->y1", wn[1:2])[0] * R[1]
     hyst, hff = loop.hysteresis, loop.hysteresis_feedforward
     U_h = (np.zeros(H + 1, dtype=complex) if hff is None
            else hff.periodic_harmonics(R, H, omega))
@@ -216,7 +218,6 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
         z = np.zeros(H + 1, dtype=complex)
         return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e_lin),
                            _to_sin_amplitudes(y1_lin), z, _to_sin_amplitudes(e_lin), 0, 0.0)
-    G_e = loop.transfer("w->e", wn)
     G_1 = loop.transfer("w->y1", wn)
     X = y1_lin - G_1 * U_h
     W = np.zeros(H + 1, dtype=complex)
@@ -238,6 +239,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
                 f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+    G_e = loop.transfer("w->e", wn)
     e = e_lin + G_e * (W - U_h)
     return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e),
                        _to_sin_amplitudes(X), _to_sin_amplitudes(W),

@@ -1,4 +1,10 @@
-"""Compiled inner loops of the rate-independent elements (numba)."""
+"""Compiled inner loops of the rate-independent elements (numba).
+
+The sampled response of the stop operator (Jenkins) and of parallel stop
+operators (Maxwell-slip), and the steps of their exact periodic output
+(:mod:`motionhyst.hysteresis.periodic`): roots of trigonometric polynomials,
+the elements' pieces between reversals, and Fourier sums over jumps.
+"""
 
 from __future__ import annotations
 
@@ -45,3 +51,243 @@ def maxwell_response(x, k, fc, w0):  # pragma: no cover - compiled
                 wi = -fc[j]
             w[i, j] = wi
     return w
+
+
+# ---------------------------------------------------------------------------
+# Exact periodic output of parallel stop operators (see periodic.py)
+# ---------------------------------------------------------------------------
+
+_TWO_PI = 2.0 * np.pi
+_ANCHOR = 4  # phasor powers are recomputed directly every _ANCHOR steps
+
+
+@njit(cache=True)
+def _trig2(A, B, theta):  # pragma: no cover - compiled
+    """``2 Re sum_m A_m z^m`` and ``2 Re sum_m B_m z^m`` (m >= 1, ``z = exp(j theta)``), Horner."""
+    z = complex(np.cos(theta), np.sin(theta))
+    pa = 0j
+    pb = 0j
+    for m in range(A.shape[0] - 1, 0, -1):
+        pa = (pa + A[m]) * z
+        pb = (pb + B[m]) * z
+    return 2.0 * pa.real, 2.0 * pb.real
+
+
+@njit(cache=True)
+def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
+    """Root of ``2 Re sum_m A_m exp(j m theta) = level`` in the grid cell [a, b].
+
+    `B` holds the derivative's coefficients (``j m A_m``) and `fa`, `fb` the
+    function minus `level` at the cell's ends (opposite signs or zero).
+    Newton from the linear interpolant (two or three steps reach round-off);
+    a root on a grid point may lie a round-off outside the cell, so half a
+    cell either side is allowed.  Bisection if Newton leaves that range.
+    """
+    h = b - a
+    lo = a - 0.5 * h
+    hi = b + 0.5 * h
+    t = a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
+    converged = True
+    for _ in range(8):
+        f, fp = _trig2(A, B, t)
+        if fp == 0.0:
+            converged = False
+            break
+        t_new = t - (f - level) / fp
+        if not (lo <= t_new <= hi):
+            converged = False
+            break
+        if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
+            return t_new
+        t = t_new
+    if converged:
+        return t
+    # bisection on the widest bracket with a sign change
+    flo = _trig2(A, B, lo)[0] - level
+    fhi = _trig2(A, B, hi)[0] - level
+    if flo * fhi > 0.0:
+        lo, hi = a, b
+        flo = _trig2(A, B, lo)[0] - level
+        fhi = _trig2(A, B, hi)[0] - level
+        if flo * fhi > 0.0:
+            return a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if hi - lo <= 1e-15 + 1e-15 * abs(mid) or mid == lo or mid == hi:
+            break
+        fm = _trig2(A, B, mid)[0] - level
+        if fm == 0.0:
+            return mid
+        if (fm > 0.0) == (flo > 0.0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def reversal_points(X, C1, C2, d):  # pragma: no cover - compiled
+    """Angles in [0, 2 pi) where ``x`` changes direction, sorted, and ``x`` there.
+
+    `X` are the harmonics of ``x``, ``C1 = j m X`` and ``C2 = -m^2 X`` those of
+    its first two derivatives, `d` holds ``x'`` on the grid ``2 pi i / n``.
+    """
+    n = d.shape[0]
+    h = _TWO_PI / n
+    count = 0
+    for i in range(n):
+        if (d[i] > 0.0) != (d[(i + 1) % n] > 0.0):
+            count += 1
+    rev = np.empty(count)
+    q = 0
+    for i in range(n):
+        j = (i + 1) % n
+        if (d[i] > 0.0) != (d[j] > 0.0):
+            a = i * h
+            rev[q] = trig_root(C1, C2, 0.0, a, a + h, d[i], d[j]) % _TWO_PI
+            q += 1
+    rev.sort()
+    xr = np.empty(count)
+    for q in range(count):
+        xr[q] = X[0].real + _trig2(X, C1, rev[q])[0]
+    return rev, xr
+
+
+@njit(cache=True)
+def _crossing(X, C1, x, level, a, b):  # pragma: no cover - compiled
+    """Angle in [a, b] (b may exceed 2 pi) where the monotone ``x`` passes `level`.
+
+    The first grid cell with a sign change of ``x - level`` brackets the root.
+    """
+    n = x.shape[0]
+    h = _TWO_PI / n
+    i0 = int(np.floor(a / h))
+    i1 = int(np.ceil(b / h))
+    t_prev = a
+    g_prev = X[0].real + _trig2(X, C1, a)[0] - level
+    t_first, g_first = a, g_prev
+    for i in range(i0 + 1, i1 + 1):
+        if i == i1:
+            t = b
+            g = X[0].real + _trig2(X, C1, b)[0] - level
+        else:
+            t = i * h
+            g = x[i % n] - level
+        if i == i0 + 1:
+            t_first, g_first = t, g
+        if np.sign(g_prev) * np.sign(g) <= 0.0:
+            return trig_root(X, C1, level - X[0].real, t_prev, t, g_prev, g)
+        t_prev, g_prev = t, g
+    # no sign change (the level is a round-off outside [x(a), x(b)]): the first cell
+    return trig_root(X, C1, level - X[0].real, a, t_first,
+                     X[0].real + _trig2(X, C1, a)[0] - level, g_first)
+
+
+@njit(cache=True)
+def stop_pieces(X, C1, x, rev, xr, k, fc):  # pragma: no cover - compiled
+    """Pieces of the periodic output of parallel stop operators, as jumps.
+
+    Over one period each element ``(k_i, fc_i)`` sticks (``w = w_j + k_i (x -
+    x_j)``) or slips (``w = +-fc_i``) between the reversal points `rev` (values
+    `xr`).  The output is ``w = g + s x`` with ``g`` piecewise constant and
+    ``s`` the sum of the stiffnesses of the sticking elements.  Returns the
+    angles where ``g`` or ``s`` jump, the jumps of ``g`` and ``s``, and their
+    means over the period.  The periodic state is found by running the
+    elements twice round the reversal points from the global maximum; where
+    an element never slips, the symmetric solution (about mid-range) is used.
+    """
+    nr = rev.shape[0]
+    m = k.shape[0]
+    i0 = 0
+    for i in range(nr):
+        if xr[i] > xr[i0]:
+            i0 = i
+    th = np.empty(nr + 1)
+    xs = np.empty(nr + 1)
+    for i in range(nr):
+        j = (i0 + i) % nr
+        th[i] = rev[j] if rev[j] >= rev[i0] else rev[j] + _TWO_PI
+        xs[i] = xr[j]
+    th[nr] = th[0] + _TWO_PI
+    xs[nr] = xs[0]
+    mid = 0.5 * (np.max(xr) + np.min(xr))
+    t_b = np.empty(2 * nr * m)  # at most a stick and a slip piece per element and interval
+    jg = np.empty(2 * nr * m)
+    js = np.empty(2 * nr * m)
+    nb = 0
+    g_mean = 0.0
+    s_mean = 0.0
+    ws = np.empty(nr + 1)
+    for e in range(m):
+        ke, fe = k[e], fc[e]
+        w = min(max(ke * (xs[0] - mid), -fe), fe)
+        for _ in range(2):  # the second pass starts from the periodic state
+            ws[0] = w
+            for i in range(nr):
+                w = min(max(w + ke * (xs[i + 1] - xs[i]), -fe), fe)
+                ws[i + 1] = w
+        first = nb
+        for i in range(nr):
+            a, b = th[i], th[i + 1]
+            wi, xi, x_end = ws[i], xs[i], xs[i + 1]
+            d = 1.0 if x_end > xi else -1.0
+            slip_level = xi + (d * fe - wi) / ke  # x where the spring reaches +-fc
+            s = b
+            if d * (x_end - slip_level) > 0.0:
+                s = min(max(_crossing(X, C1, x, slip_level, a, b), a), b)
+            # pieces of non-zero length: stick (g = w_i - k x_i, s = k) on [a, s),
+            # slip (g = +-fc, s = 0) on [s, b); jumps are filled in below
+            if s > a:
+                t_b[nb], jg[nb], js[nb] = a, wi - ke * xi, ke
+                nb += 1
+                g_mean += (wi - ke * xi) * (s - a)
+                s_mean += ke * (s - a)
+            if b > s:
+                t_b[nb], jg[nb], js[nb] = s, d * fe, 0.0
+                nb += 1
+                g_mean += d * fe * (b - s)
+        # values -> jumps, cyclically within this element's pieces
+        g_last, s_last = jg[nb - 1], js[nb - 1]
+        for p in range(nb - 1, first, -1):
+            jg[p] -= jg[p - 1]
+            js[p] -= js[p - 1]
+        jg[first] -= g_last
+        js[first] -= s_last
+    return t_b[:nb], jg[:nb], js[:nb], g_mean / _TWO_PI, s_mean / _TWO_PI
+
+
+@njit(cache=True)
+def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
+    """Fourier coefficients of two piecewise-constant periodic functions from their jumps.
+
+    Functions with jumps `jg` (`js`) at the angles `t_b` have the coefficients
+    ``int_0^{2 pi} f exp(-j q theta) d theta / 2 pi = sum_b J_b exp(-j q t_b) /
+    (2 pi j q)`` for ``q != 0``.  Returns them for ``q = 0 .. n_g`` (`jg`) and
+    ``q = 0 .. n_s`` (`js`); ``q = 0`` (the means) is left 0.  The powers of
+    ``exp(-j t_b)`` are multiplied up and recomputed directly every
+    ``_ANCHOR`` steps, which keeps them as accurate as direct evaluation.
+    """
+    nq = max(n_g, n_s) + 1
+    G = np.zeros(n_g + 1, dtype=np.complex128)
+    S = np.zeros(n_s + 1, dtype=np.complex128)
+    for b in range(t_b.shape[0]):
+        if jg[b] == 0.0 and js[b] == 0.0:
+            continue
+        t = t_b[b]
+        u = complex(np.cos(t), -np.sin(t))
+        z = 0j
+        for q in range(nq):
+            if q % _ANCHOR == 0:
+                z = complex(np.cos(q * t), -np.sin(q * t))
+            if q <= n_g:
+                G[q] += jg[b] * z
+            if q <= n_s:
+                S[q] += js[b] * z
+            z *= u
+    G[0] = 0.0
+    S[0] = 0.0
+    for q in range(1, n_g + 1):
+        G[q] *= -1j / (_TWO_PI * q)
+    for q in range(1, n_s + 1):
+        S[q] *= -1j / (_TWO_PI * q)
+    return G, S

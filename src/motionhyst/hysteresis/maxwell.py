@@ -100,8 +100,15 @@ class MaxwellSlip(Hysteresis):
 
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:
-        """Exact harmonics of the periodic output: the sum of the elements'."""
-        return sum(el.periodic_harmonics(X, n_harmonics) for el in self.elements)
+        """Exact harmonics of the periodic output: the sum of the elements'.
+
+        The elements share the reversal points of `X` and one convolution
+        (see :mod:`motionhyst.hysteresis.periodic`).
+        """
+        from motionhyst.hysteresis.periodic import stop_periodic_harmonics
+
+        return stop_periodic_harmonics(np.asarray(X, dtype=complex), self.k, self.fc,
+                                       n_harmonics)
 
     def __call__(self, x: float) -> float:
         """Advance every element by one displacement sample (python-control interface)."""
