@@ -672,3 +672,20 @@ def test_valid_sections_build_the_model(model):
 def test_section_defaults(section, expected):
     el = hysteresis_from_dict(section)
     assert type(el) is type(expected) and el.to_dict() == expected.to_dict()
+
+
+@pytest.mark.parametrize("A", [1e-8, 1e-9, 1e-10])
+def test_dahl_keeps_its_accuracy_at_nanometre_amplitudes(A):
+    """Im D = 4 fc / (pi A) (1 - tanh r / r), r = k A / fc, whose series is r^2/3 - 2 r^4/15.
+
+    The loop's area is a part in 1e7..1e9 of the stored energy here: a step formed as
+    ``1 - (1 - zeta) exp(-v)`` loses it to cancellation (it was 33x too large at 1e-10 m).
+    """
+    k, fc = 20.0, 0.05
+    r = k * A / fc
+    D = Dahl(k, fc).describing_function(A)
+    assert D.imag == pytest.approx(4 * fc / (np.pi * A) * (r**2 / 3 - 2 * r**4 / 15), rel=1e-5)
+    assert D.real <= k * (1 + 1e-15)
+    # LuGre with fs = fc and no damping is the same model, computed by another kernel
+    assert D == pytest.approx(LuGre(k, 0.0, 0.0, fc, fc, 0.01).describing_function(A, 10.0),
+                              rel=1e-14)

@@ -40,20 +40,23 @@ MAX_SAMPLES = 2**22
 
 @njit(cache=True)
 def dahl_advance(zeta, v, alpha):  # pragma: no cover - compiled
-    """Exact solution of ``dzeta/dv = (1 - zeta)^alpha`` after a distance ``v >= 0``."""
+    """Exact solution of ``dzeta/dv = (1 - zeta)^alpha`` after a distance ``v >= 0``.
+
+    ``1 - zeta`` shrinks by the factor ``exp(-v)`` (``alpha = 1``) or
+    ``(1 + (alpha - 1) v (1 - zeta)^(alpha - 1))^(-1 / (alpha - 1))``; the step is
+    formed as ``zeta - (1 - zeta) expm1(...)`` so that it keeps its relative
+    accuracy for tiny ``v`` (nanometre motions).
+    """
     y = 1.0 - zeta
     if y <= 0.0 or v == 0.0:
         return zeta
     eps = alpha - 1.0
     if eps == 0.0:
-        y = y * math.exp(-v)
-    else:
-        q = v * y**eps
-        arg = eps * q
-        if arg <= -1.0:
-            return 1.0  # alpha < 1: saturates at a finite distance
-        y = y * math.exp(-math.log1p(arg) / eps)
-    return 1.0 - y
+        return zeta - y * math.expm1(-v)
+    arg = eps * v * y**eps
+    if arg <= -1.0:
+        return 1.0  # alpha < 1: saturates at a finite distance
+    return zeta - y * math.expm1(-math.log1p(arg) / eps)
 
 
 @njit(cache=True)
