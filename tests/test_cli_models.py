@@ -200,7 +200,7 @@ def test_df_lugre_needs_frequency_and_gives_every_pair(capsys):
         (("df", "--model", "bouc-wen", "--k", "1", "--fc", "1", "--beta", "0.1", "--gamma",
           "0.3", "--amplitude", "3"), ("beta", "gamma")),
         (("df", "--model", "bouc-wen", "--k", "1", "--fc", "1", "--n", "0.5",
-          "--amplitude", "3"), ("--n", "1")),
+          "--amplitude", "3"), ("n must be >= 1, got 0.5",)),
         (("df", "--model", "bouc-wen", "--k", "1", "--fc", "1", "--beta", "nan",
           "--amplitude", "3"), ("--beta", "finite")),
         (("df", "--model", "dahl", "--k", "1", "--fc", "1", "--alpha", "0",

@@ -309,7 +309,12 @@ def test_figures_from_reproduce_match_functions(reproduced, loop, el, analysis, 
     ids=["bouc-wen", "dahl", "maxwell-slip"])
 def test_fig5_and_fig8_of_other_models_show_their_periodic_loops(other):
     fc = float(np.sum(other.fc))
-    data = plots.fig5_loops(other, zetas=(0.25, 2.0)).motionhyst_data
+    fig = plots.fig5_loops(other, zetas=(0.25, 2.0))
+    title = fig.axes[0].get_title()
+    assert all(f"{key} = " in title for key in other.to_dict() if key != "model")
+    if isinstance(other, MaxwellSlip):
+        assert "k = [12, 8], fc = [0.02, 0.03]" in title
+    data = fig.motionhyst_data
     for zeta in (0.25, 2.0):
         x, w = data[f"zeta={zeta:g}"]
         A = fc / (other.initial_stiffness * zeta)

@@ -1,11 +1,12 @@
 """motionhyst: hysteresis of dynamic links in high-precision motion control.
 
-Model the hysteresis (:class:`Jenkins`), predict its effect on tracking with
+Model the hysteresis (:class:`Jenkins`, :class:`MaxwellSlip`, :class:`BoucWen`,
+:class:`Dahl`, :class:`LuGre`), predict its effect on tracking with
 describing functions (:func:`analyze`), and check the prediction against the
 exact periodic steady state of the nonlinear loop (:func:`periodic_steady_state`).
 """
 
-from motionhyst.hysteresis import Hysteresis, Jenkins, MaxwellSlip
+from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import QuasiLinearAnalysis, analyze
 from motionhyst.scenario import Scenario, ScenarioError, default_scenario, load_scenario
@@ -15,7 +16,8 @@ from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load
 __version__ = "0.1.0"
 
 __all__ = [
-    "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "MaxwellSlip", "MeasuredPlant",
+    "BoucWen", "Dahl", "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "LuGre", "MaxwellSlip",
+    "MeasuredPlant",
     "QuasiLinearAnalysis", "Scenario", "ScenarioError", "SteadyState", "TwoMassStage", "analyze",
     "default_scenario", "load_frd_plant", "load_scenario", "periodic_steady_state",
     "steady_state_sweep",

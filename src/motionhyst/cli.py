@@ -11,6 +11,7 @@ import math
 import os
 import sys
 import tempfile
+import typing
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -90,29 +91,27 @@ def _g(x: float, digits: int = 4) -> str:
 
 
 # ---------------------------------------------------------------------------- df
-#: Parameter options of ``motionhyst df`` per model: (option, list allowed, required).
-_DF_PARAMETERS: dict[str, tuple[tuple[str, bool, bool], ...]] = {
-    "jenkins": (("k", False, True), ("fc", False, True)),
-    "maxwell-slip": (("k", True, True), ("fc", True, True)),
-    "bouc-wen": (("k", False, True), ("fc", False, True), ("n", False, False),
-                 ("beta", False, False), ("gamma", False, False)),
-    "dahl": (("k", False, True), ("fc", False, True), ("alpha", False, False)),
-    "lugre": (("sigma0", False, True), ("sigma1", False, False), ("sigma2", False, False),
-              ("fc", False, True), ("fs", False, True), ("vs", False, True)),
-}
-_DF_OPTIONS = ("k", "fc", "n", "beta", "gamma", "alpha", "sigma0", "sigma1", "sigma2",
-               "fs", "vs")
 _UNITS = {"k": "N/m", "fc": "N", "sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m",
           "fs": "N", "vs": "m/s"}
 
 
+def _df_parameters(model: str) -> dict[str, tuple[bool, bool]]:
+    """``{option: (takes a list, required)}`` of a model, from its scenario section."""
+    from motionhyst.scenario import LINK_SECTIONS
+
+    fields = LINK_SECTIONS[model].model_fields
+    return {name: (typing.get_origin(f.annotation) is list, f.is_required())
+            for name, f in fields.items() if name != "model"}
+
+
 def _element_from_args(args: argparse.Namespace):
     """The hysteresis element named by ``--model`` and its parameter options."""
-    from motionhyst.scenario import ScenarioError, hysteresis_from_dict
+    from motionhyst.scenario import LINK_SECTIONS, ScenarioError, hysteresis_from_dict
 
     model = args.model
-    spec = {name: (many, required) for name, many, required in _DF_PARAMETERS[model]}
-    for name in _DF_OPTIONS:
+    spec = _df_parameters(model)
+    options = dict.fromkeys(n for m in LINK_SECTIONS for n in _df_parameters(m))
+    for name in options:
         if getattr(args, name) is not None and name not in spec:
             raise UsageError(f"motionhyst df: --{name} does not apply to --model {model} "
                              f"(its parameters: {', '.join('--' + n for n in spec)})")
@@ -152,7 +151,7 @@ def _df_frequencies(args: argparse.Namespace, el) -> list[float | None]:
     return list(args.frequency)
 
 
-def _df_point(el, amplitude: float, zeta: float, D: complex, frequency_hz: float | None) -> dict:
+def _df_point(amplitude: float, zeta: float, D: complex, frequency_hz: float | None) -> dict:
     point = {"amplitude": float(amplitude)}
     if frequency_hz is not None:
         point["frequency_hz"] = float(frequency_hz)
@@ -171,7 +170,7 @@ def cmd_df(args: argparse.Namespace) -> int:
     for f in freqs:
         omega = None if f is None else 2.0 * math.pi * f
         D = np.atleast_1d(el.describing_function(A, omega))
-        pts = [_df_point(el, a, z, d, f) for a, z, d in zip(A, zeta, D, strict=True)]
+        pts = [_df_point(a, z, d, f) for a, z, d in zip(A, zeta, D, strict=True)]
         if args.harmonics:
             H = el.hosidf(A, args.harmonics, omega)
             for p, h in zip(pts, H, strict=True):
@@ -234,7 +233,9 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     if d["zeta"] is not None and not math.isnan(d["zeta"]):
         print(f"  zeta = fc/(k A)  (eq. 4)       {_g(d['zeta'])}")
     at = "" if d["df_frequency_hz"] is None else f" at {_g(d['df_frequency_hz'])} Hz"
-    print(f"  |D|/k, angle D  (eq. 10)       {_g(d['df_abs_over_k'])}, "
+    eq = "eq. 10" if d["zeta"] is not None and not math.isnan(d["zeta"]) else "eq. 7"
+    label = f"|D|/k, angle D  ({eq})"
+    print(f"  {label:<31}{_g(d['df_abs_over_k'])}, "
           f"{d['df_phase_deg']:.2f} deg{at}")
     print(f"  f*  (eq. 13)                   {_g(d['f_star_hz'])} Hz")
     print(f"  bandwidth (|C P2| = 1)         {_g(d['bandwidth_hz'])} Hz")
@@ -496,12 +497,14 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``motionhyst`` command."""
+    from motionhyst.scenario import LINK_SECTIONS
+
     p = _Parser(prog="motionhyst", description="Hysteresis of dynamic links in motion control "
                 "loops: describing functions, quasi-linear analysis, exact steady state.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     q = sub.add_parser("df", help="describing function of a hysteresis element")
-    q.add_argument("--model", choices=list(_DF_PARAMETERS), default="jenkins",
+    q.add_argument("--model", choices=list(LINK_SECTIONS), default="jenkins",
                    help="hysteresis model (default: jenkins)")
     q.add_argument("--k", type=positive, nargs="+",
                    help="spring stiffness k [N/m] (one per element for maxwell-slip); "

@@ -66,8 +66,10 @@ def _force_scale(el: Hysteresis) -> float:
 
 
 def _describe(el: Hysteresis, frequency_hz: float | None) -> str:
-    params = ", ".join(f"{k} = {v:g}" for k, v in el.to_dict().items()
-                       if k != "model" and not isinstance(v, list))
+    def show(v):
+        return "[" + ", ".join(f"{x:g}" for x in v) + "]" if isinstance(v, list) else f"{v:g}"
+
+    params = ", ".join(f"{k} = {show(v)}" for k, v in el.to_dict().items() if k != "model")
     at = "" if el.rate_independent else f", f = {frequency_hz:g} Hz"
     return f"{el.name} element\n{params}{at}"
 

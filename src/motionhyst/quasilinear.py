@@ -352,15 +352,21 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df)
 
 
+#: Fixed-point iterations of eq. (21) for a rate-dependent element (each one evaluation of D).
+CROSSOVER_MAX_ITERATIONS = 50
+
+
 def _crossover_estimate(st: TwoMassStage, hyst, amplitude: float, D: complex) -> float:
     """Eq. (21); for a rate-dependent element solved with ``D`` at the crossover itself."""
     fc = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D))
     if hyst.rate_independent:
         return fc
-    for _ in range(50):
+    for _ in range(CROSSOVER_MAX_ITERATIONS):
         D = complex(np.asarray(hyst.describing_function(amplitude, TWO_PI * fc)).ravel()[0])
         f_new = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D))
         if abs(f_new - fc) <= 1e-12 * f_new:
             return f_new
-        fc = f_new
-    return float("nan")
+        change, fc = abs(f_new - fc), f_new
+    raise RuntimeError(f"eq. (21) with D(A, omega) at the crossover did not converge in "
+                       f"{CROSSOVER_MAX_ITERATIONS} iterations: last estimate {fc:.6g} Hz, "
+                       f"last change {change:.3g} Hz")

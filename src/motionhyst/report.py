@@ -74,8 +74,9 @@ def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
     lines += [head, "|---|---|---|" if is_paper else "|---|---|"]
     units = {"f_star_hz": " Hz", "mismatch_crossover_hz": " Hz", "bandwidth_hz": " Hz",
              "df_phase_deg": " deg"}
+    at = "" if a.get("df_frequency_hz") is None else f" (at {_fmt(a['df_frequency_hz'])} Hz)"
     for key, (paper, label) in PAPER_VALUES.items():
-        val = _fmt(a[key]) + units.get(key, "")
+        val = _fmt(a[key]) + units.get(key, "") + (at if key.startswith("df_") else "")
         lines.append(f"| {label} | {paper} | {val} |" if is_paper else f"| {label} | {val} |")
     exact = _fmt(a["mismatch_crossover_exact_hz"]) + " Hz"
     lines.append(f"| exact crossover, \\|E - 1\\| = 1 | - | {exact} |" if is_paper

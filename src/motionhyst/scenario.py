@@ -61,7 +61,21 @@ class PlantSection(_Section):
     mass: PositiveFloat | None = None
 
 
-class JenkinsSection(_Section):
+class _LinkSection(_Section):
+    """A ``[hysteresis]`` section: field types here, the model's own rules in its class.
+
+    After the fields are validated the model is built once, so that its
+    constructor's checks (``beta >= gamma``, equal lengths, ...) are the only
+    statement of them; their messages become validation errors.
+    """
+
+    @model_validator(mode="after")
+    def _model_accepts(self):
+        _MODELS[self.model](**self.model_dump(exclude={"model"}))
+        return self
+
+
+class JenkinsSection(_LinkSection):
     """``[hysteresis] model = "jenkins"``: eq. (3)."""
 
     model: Literal["jenkins"]
@@ -69,41 +83,26 @@ class JenkinsSection(_Section):
     fc: PositiveFloat
 
 
-class MaxwellSlipSection(_Section):
+class MaxwellSlipSection(_LinkSection):
     """``[hysteresis] model = "maxwell-slip"``: parallel Jenkins elements."""
 
     model: Literal["maxwell-slip"]
     k: Annotated[list[PositiveFloat], Field(min_length=1)]
     fc: Annotated[list[PositiveFloat], Field(min_length=1)]
 
-    @model_validator(mode="after")
-    def _same_length(self):
-        if len(self.k) != len(self.fc):
-            raise ValueError(f"k and fc must have the same length ({len(self.k)} != "
-                             f"{len(self.fc)})")
-        return self
 
-
-class BoucWenSection(_Section):
+class BoucWenSection(_LinkSection):
     """``[hysteresis] model = "bouc-wen"``: normalised, rate-independent Bouc-Wen."""
 
     model: Literal["bouc-wen"]
     k: PositiveFloat
     fc: PositiveFloat
-    n: Annotated[float, Field(ge=1, allow_inf_nan=False)] = 1.0
+    n: Annotated[float, Field(allow_inf_nan=False)] = 1.0
     beta: Annotated[float, Field(allow_inf_nan=False)] = 0.5
     gamma: Annotated[float, Field(allow_inf_nan=False)] = 0.5
 
-    @model_validator(mode="after")
-    def _bounded_dissipative(self):
-        if not self.beta + self.gamma > 0:
-            raise ValueError("beta + gamma must be > 0 (bounded hysteresis)")
-        if not self.beta >= self.gamma:
-            raise ValueError("beta must be >= gamma (dissipative loops)")
-        return self
 
-
-class DahlSection(_Section):
+class DahlSection(_LinkSection):
     """``[hysteresis] model = "dahl"``: Dahl's solid friction."""
 
     model: Literal["dahl"]
@@ -112,7 +111,7 @@ class DahlSection(_Section):
     alpha: PositiveFloat = 1.0
 
 
-class LuGreSection(_Section):
+class LuGreSection(_LinkSection):
     """``[hysteresis] model = "lugre"``: LuGre friction (rate-dependent)."""
 
     model: Literal["lugre"]
@@ -123,6 +122,11 @@ class LuGreSection(_Section):
     fs: PositiveFloat
     vs: PositiveFloat
 
+
+#: The section of each ``[hysteresis] model = ...``.
+LINK_SECTIONS: dict[str, type[_LinkSection]] = {
+    "jenkins": JenkinsSection, "maxwell-slip": MaxwellSlipSection, "bouc-wen": BoucWenSection,
+    "dahl": DahlSection, "lugre": LuGreSection}
 
 HysteresisSection = Annotated[
     JenkinsSection | MaxwellSlipSection | BoucWenSection | DahlSection | LuGreSection,
@@ -199,14 +203,12 @@ class ScenarioModel(_Section):
         return self
 
 
-_UNION_TAGS = {"leadlag-lowpass", "tf", "jenkins", "maxwell-slip", "bouc-wen", "dahl", "lugre"}
-
 _MODELS: dict[str, type[Hysteresis]] = {
     "jenkins": Jenkins, "maxwell-slip": MaxwellSlip, "bouc-wen": BoucWen, "dahl": Dahl,
     "lugre": LuGre}
 
-#: Names accepted by ``[hysteresis] model = ...``
-HYSTERESIS_MODELS = tuple(_MODELS)
+# tags of the discriminated unions, left out of the key named in an error message
+_UNION_TAGS = {"leadlag-lowpass", "tf", *_MODELS}
 
 
 def build_hysteresis(section) -> Hysteresis:
