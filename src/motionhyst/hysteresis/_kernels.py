@@ -3,7 +3,9 @@
 The sampled response of the stop operator (Jenkins) and of parallel stop
 operators (Maxwell-slip), and the steps of their exact periodic output
 (:mod:`motionhyst.hysteresis.periodic`): roots of trigonometric polynomials,
-the elements' pieces between reversals, and Fourier sums over jumps.
+the elements' pieces between reversals, and Fourier sums over jumps.  The
+reversal points of a periodic input (:func:`reversal_roots`) also serve the
+smooth models (:func:`motionhyst.hysteresis._ode_kernels.reversal_angles`).
 """
 
 from __future__ import annotations
@@ -78,15 +80,45 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
     """Root of ``2 Re sum_m A_m exp(j m theta) = level`` in the grid cell [a, b].
 
     `B` holds the derivative's coefficients (``j m A_m``) and `fa`, `fb` the
-    function minus `level` at the cell's ends (opposite signs or zero).
-    Newton from the linear interpolant (two or three steps reach round-off);
-    a root on a grid point may lie a round-off outside the cell, so half a
-    cell either side is allowed.  Bisection if Newton leaves that range.
+    function minus `level` at the cell's ends (from the grid samples).
+    Newton from the linear interpolant; two or three steps reach round-off.
+
+    Where `fa` and `fb` bracket a root (opposite signs, or one of them zero)
+    the bracket is narrowed at each iterate, and a Newton step that would
+    leave it becomes a bisection step: the root found is the one in the cell,
+    also when a second root lies just beyond its end (two reversals close
+    together).  A root on a grid point, where the samples and the polynomial
+    may disagree by round-off about its side, comes out within round-off of
+    the grid point.  Without a bracket (`_crossing` with a level a round-off
+    beyond the values in the cell) Newton may go half a cell either side,
+    with bisection on the widest bracket with a sign change if it leaves
+    that range.
     """
     h = b - a
+    t = a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
+    if fa != fb and (fa <= 0.0 <= fb or fb <= 0.0 <= fa):
+        lo, hi = a, b
+        rising = fb > fa
+        for _ in range(100):
+            f, fp = _trig2(A, B, t)
+            f -= level
+            if f == 0.0:
+                return t
+            if (f > 0.0) == rising:
+                hi = t
+            else:
+                lo = t
+            t_new = t - f / fp if fp != 0.0 else 0.5 * (lo + hi)
+            if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
+                return t_new
+            if not (lo <= t_new <= hi):
+                t_new = 0.5 * (lo + hi)
+            if hi - lo <= 4e-16 * max(1.0, abs(t_new)):
+                return t_new
+            t = t_new
+        return t
     lo = a - 0.5 * h
     hi = b + 0.5 * h
-    t = a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
     converged = True
     for _ in range(8):
         f, fp = _trig2(A, B, t)
@@ -126,11 +158,24 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def reversal_points(X, C1, C2, d):  # pragma: no cover - compiled
-    """Angles in [0, 2 pi) where ``x`` changes direction, sorted, and ``x`` there.
+def reversal_roots(C1, C2, d):  # pragma: no cover - compiled
+    """Roots of ``x'`` bracketed by the grid ``theta_i = 2 pi i / n``, one per grid cell.
 
-    `X` are the harmonics of ``x``, ``C1 = j m X`` and ``C2 = -m^2 X`` those of
-    its first two derivatives, `d` holds ``x'`` on the grid ``2 pi i / n``.
+    `C1` are the harmonics of ``x'`` (``j m X_m``), `C2` those of ``x''``
+    (``-m^2 X_m``) and `d` holds ``x'`` on the grid.  A cell ``i`` (from
+    ``theta_i`` to ``theta_{i+1}``, cyclically) brackets a root where ``d > 0``
+    holds at one of its ends and not at the other; the root is refined by
+    :func:`trig_root`.  A double root (tangency) or two roots inside one cell
+    give no sign change and are not reported; a constant ``x`` has none.
+
+    Returns
+    -------
+    cells : ndarray of int64
+        The cells ``i`` with a sign change, ascending.
+    roots : ndarray
+        The root in each cell: in ``[theta_i, theta_{i+1}]`` up to round-off
+        (a root on a grid point may lie a round-off outside), not wrapped
+        into ``[0, 2 pi)`` (the last cell ends at ``2 pi``).
     """
     n = d.shape[0]
     h = _TWO_PI / n
@@ -138,17 +183,31 @@ def reversal_points(X, C1, C2, d):  # pragma: no cover - compiled
     for i in range(n):
         if (d[i] > 0.0) != (d[(i + 1) % n] > 0.0):
             count += 1
-    rev = np.empty(count)
+    cells = np.empty(count, dtype=np.int64)
+    roots = np.empty(count)
     q = 0
     for i in range(n):
         j = (i + 1) % n
         if (d[i] > 0.0) != (d[j] > 0.0):
             a = i * h
-            rev[q] = trig_root(C1, C2, 0.0, a, a + h, d[i], d[j]) % _TWO_PI
+            cells[q] = i
+            roots[q] = trig_root(C1, C2, 0.0, a, a + h, d[i], d[j])
             q += 1
+    return cells, roots
+
+
+@njit(cache=True)
+def reversal_points(X, C1, C2, d):  # pragma: no cover - compiled
+    """Angles in [0, 2 pi) where ``x`` changes direction, sorted, and ``x`` there.
+
+    `X` are the harmonics of ``x``, ``C1 = j m X`` and ``C2 = -m^2 X`` those of
+    its first two derivatives, `d` holds ``x'`` on the grid ``2 pi i / n``.
+    The roots are those of :func:`reversal_roots`, wrapped into [0, 2 pi).
+    """
+    rev = reversal_roots(C1, C2, d)[1] % _TWO_PI
     rev.sort()
-    xr = np.empty(count)
-    for q in range(count):
+    xr = np.empty(rev.shape[0])
+    for q in range(rev.shape[0]):
         xr[q] = X[0].real + _trig2(X, C1, rev[q])[0]
     return rev, xr
 

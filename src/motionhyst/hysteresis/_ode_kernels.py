@@ -26,8 +26,9 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.hysteresis._kernels import reversal_roots
 from motionhyst.hysteresis.base import check_positive
-from motionhyst.hysteresis.periodic import significant_harmonics, trig_eval
+from motionhyst.hysteresis.periodic import sample_period, significant_harmonics, trig_eval
 
 TWO_PI = 2.0 * np.pi
 MIN_SAMPLES = 4096
@@ -495,53 +496,37 @@ def pow2_at_least(n: float) -> int:
     return int(2 ** math.ceil(math.log2(n)))
 
 
-def sample_period(X: NDArray[np.complex128], N: int, deriv: int = 0) -> NDArray[np.float64]:
-    """Samples of ``x^(deriv)(theta)`` at ``theta = 2 pi i / N``, i = 0 .. N-1."""
-    M = len(X) - 1
-    if N // 2 <= M:
-        raise ValueError(f"{N} samples cannot represent {M} harmonics")
-    spec = np.zeros(N // 2 + 1, dtype=complex)
-    spec[: M + 1] = X * (1j * np.arange(M + 1)) ** deriv
-    if deriv:
-        spec[0] = 0.0
-    return np.fft.irfft(spec * N, n=N)
-
-
 def reversal_angles(X: NDArray[np.complex128], d: NDArray[np.float64]
                     ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Reversal points of ``x``: cells ``i`` (between samples i and i+1) and angles.
+    """Reversal points of ``x``: the grid cells that hold them and their angles.
 
-    `d` holds ``dx/dtheta`` on the uniform grid.  Each sign change of `d`
-    between neighbouring samples brackets a root of ``x'``, refined by Newton
-    steps on the trigonometric polynomial with a bisection safeguard.
+    Each sign change of `d` between neighbouring samples (cyclically) brackets
+    a root of ``x'``, refined on the trigonometric polynomial by the compiled
+    root finder shared with the stop operator
+    (:func:`~motionhyst.hysteresis._kernels.reversal_roots`).
+
+    Parameters
+    ----------
+    X : ndarray of complex
+        Harmonics ``X_0 .. X_M`` of ``x`` (``rfft / N`` scaling).
+    d : ndarray, shape (N,)
+        ``dx/dtheta`` on the grid ``theta_i = 2 pi i / N``.
+
+    Returns
+    -------
+    cells : ndarray of int64
+        Cells ``i`` (between samples ``i`` and ``i + 1``, the last one ending at
+        ``2 pi``), ascending, one per sign change of `d` (``d > 0`` against
+        ``d <= 0``); empty for a constant ``x``.  Tangencies and two roots in
+        one cell give no sign change.
+    angles : ndarray
+        The root in each cell [rad], clamped to ``[theta_i, theta_{i+1}]``.
     """
-    N = d.size
-    hgrid = TWO_PI / N
-    pos = d > 0
-    cells = np.nonzero(pos != np.roll(pos, -1))[0]
-    angles = np.empty(cells.size)
-    for q, i in enumerate(cells):
-        a, b = i * hgrid, (i + 1) * hgrid
-        fa, fb = d[i], d[(i + 1) % N]
-        th = a + (b - a) * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
-        for _ in range(50):
-            f = float(trig_eval(X, th, 1))
-            if f == 0.0:
-                break
-            if (f > 0) == (fa > 0):
-                a = th
-            else:
-                b = th
-            fp = float(trig_eval(X, th, 2))
-            t_new = th - f / fp if fp != 0.0 else 0.5 * (a + b)
-            if not a <= t_new <= b:
-                t_new = 0.5 * (a + b)
-            if abs(t_new - th) <= 1e-15 * max(1.0, th):
-                th = t_new
-                break
-            th = t_new
-        angles[q] = min(max(th, i * hgrid), (i + 1) * hgrid)
-    return cells, angles
+    X = np.asarray(X, dtype=complex)
+    m = np.arange(X.size)
+    cells, roots = reversal_roots(1j * m * X, -(m**2) * X, np.ascontiguousarray(d, dtype=float))
+    hgrid = TWO_PI / d.size
+    return cells, np.clip(roots, cells * hgrid, (cells + 1) * hgrid)
 
 
 def rate_independent_path(X: NDArray[np.complex128], N: int

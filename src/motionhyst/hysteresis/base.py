@@ -15,6 +15,8 @@ import numpy as np
 from control import DescribingFunctionNonlinearity
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.hysteresis.periodic import sample_period
+
 
 class Hysteresis(DescribingFunctionNonlinearity, ABC):
     """Base class of hysteresis elements (displacement in, force out).
@@ -94,9 +96,7 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
         """
         H = int(n_harmonics)
         N = max(8 * H, 8 * (len(X) - 1), 8192)
-        spec = np.zeros(N // 2 + 1, dtype=complex)
-        spec[: min(len(X), N // 2)] = X[: N // 2]
-        x = np.fft.irfft(spec * N, n=N)
+        x = sample_period(X, N)
         xs = np.concatenate([x, x, x, x[:1]])
         w = self.response(xs)[2 * N: 3 * N]
         return (np.fft.rfft(w) / N)[: H + 1]

@@ -21,10 +21,10 @@ from motionhyst.hysteresis._ode_kernels import (
     lugre_step_arrays,
     lugre_steps,
     pow2_at_least,
-    sample_period,
     truncate_harmonics,
 )
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
+from motionhyst.hysteresis.periodic import sample_period
 
 
 def _check_nonnegative(name: str, value: float) -> float:

@@ -48,6 +48,46 @@ def trig_eval(X: NDArray[np.complex128], theta, deriv: int = 0):
     return val
 
 
+def sample_period(X: NDArray[np.complex128], N: int, deriv: int = 0) -> NDArray[np.float64]:
+    """Samples of a trigonometric polynomial or its derivative on the uniform grid of a period.
+
+    Parameters
+    ----------
+    X : ndarray of complex
+        Harmonics ``X_0 .. X_M`` (``rfft / N`` scaling) of
+        ``x(theta) = X_0 + 2 Re sum_m X_m exp(j m theta)``.
+    N : int
+        Number of samples; ``N > 2 M`` (the highest harmonic lies below the
+        Nyquist frequency).
+    deriv : int, optional
+        Order of the derivative in ``theta`` (0: ``x`` itself).
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        ``x^(deriv)(theta_i)`` at ``theta_i = 2 pi i / N``, ``i = 0 .. N - 1``,
+        by an inverse real FFT.
+
+    Raises
+    ------
+    ValueError
+        If `N` samples cannot represent `M` harmonics.
+    """
+    X = np.asarray(X, dtype=complex)
+    M = X.size - 1
+    if 2 * M >= N:
+        raise ValueError(f"{N} samples cannot represent {M} harmonics")
+    if M < 0:
+        return np.zeros(N)
+    if deriv:
+        jm = 1j * np.arange(M + 1)
+        spec = X * (jm if deriv == 1 else jm**deriv) * N
+        spec[0] = 0.0
+    else:
+        spec = X * N
+    return np.fft.irfft(spec, n=N)  # zero-padded to N // 2 + 1 bins
+
+
 def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLike,
                             n_harmonics: int) -> NDArray[np.complex128]:
     """Harmonics ``W_0 .. W_H`` (``rfft`` scaling) of a Jenkins element's periodic output.
@@ -96,16 +136,11 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     # the grid brackets the roots (at least 1024 cells, 4 per harmonic) and carries the
     # product s x without aliasing (2 (H + M) + 1 samples)
     n = next_fast_len(max(1024, 4 * M, 2 * (H + M) + 1), real=True)
-    spec = np.zeros(n // 2 + 1, dtype=complex)
-    spec[: M + 1] = n * X
-    x = np.fft.irfft(spec, n=n)
-    spec[: M + 1] = n * C1
-    rev, xr = reversal_points(X, C1, -(m**2) * X, np.fft.irfft(spec, n=n))
+    x = sample_period(X, n)
+    rev, xr = reversal_points(X, C1, -(m**2) * X, sample_period(C1, n))
     if rev.size < 2:
         return W
     t_b, jg, js, g_mean, s_mean = stop_pieces(X, C1, x, rev, xr, k_arr, fc_arr)
     G, S = jump_series(t_b, jg, js, H, H + M)
     G[0], S[0] = g_mean, s_mean
-    spec[:] = 0.0
-    spec[: H + M + 1] = n * S
-    return G + np.fft.rfft(x * np.fft.irfft(spec, n=n))[: H + 1] / n
+    return G + np.fft.rfft(x * sample_period(S, n))[: H + 1] / n
