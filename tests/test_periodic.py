@@ -285,3 +285,26 @@ def test_parallel_elements_are_the_sum_of_single_elements():
 def test_mismatched_parallel_parameters_raise():
     with pytest.raises(ValueError, match="equal length"):
         stop_periodic_harmonics(sine_harmonics(0.01), [1.0, 2.0], [0.1], 3)
+
+
+@pytest.mark.parametrize("b", [0.11112, 0.1112])
+def test_close_reversals_rotate_with_the_input(b):
+    """A time shift of the input rotates every harmonic: W_q -> W_q exp(j q phase).
+
+    ``x = A (sin theta + b sin 3 theta)`` has two reversals 0.012 rad (b = 0.11112,
+    about two grid cells) and 0.05 rad apart near theta = pi/2; the shifts move them
+    across the grid on which the roots are bracketed.
+    """
+    el = Jenkins(20.0, 0.05)
+    X = np.zeros(4, dtype=complex)
+    X[1], X[3] = 0.01 / 2j, b * 0.01 / 2j
+    W0 = el.periodic_harmonics(X, 7)
+    q = np.arange(8)
+    for phase in np.linspace(0.0, 2 * np.pi, 60, endpoint=False):
+        W = el.periodic_harmonics(X * np.exp(1j * np.arange(4) * phase), 7)
+        assert_allclose(W * np.exp(-1j * q * phase), W0, rtol=0, atol=1e-13 * abs(W0[1]))
+
+
+def test_negative_harmonic_count_raises():
+    with pytest.raises(ValueError, match="n_harmonics must be >= 0"):
+        Jenkins(20.0, 0.05).periodic_harmonics(np.array([0.0, 0.01 / 2j]), -1)

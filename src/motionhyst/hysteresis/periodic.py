@@ -121,6 +121,8 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     """
     M = significant_harmonics(X)
     H = int(n_harmonics)
+    if H < 0:
+        raise ValueError("n_harmonics must be >= 0")
     k_arr = np.atleast_1d(np.asarray(k, dtype=float))
     fc_arr = np.atleast_1d(np.asarray(fc, dtype=float))
     if k_arr.ndim != 1 or k_arr.shape != fc_arr.shape:
