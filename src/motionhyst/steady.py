@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.systems import TWO_PI
@@ -112,12 +113,10 @@ class SteadyState:
         N = n_samples or max(4096, 8 * self.n_harmonics)
         t = np.arange(N) / (N * self.frequency_hz)
 
-        def synth(c):
-            X = np.zeros(N // 2 + 1, dtype=complex)
-            m = min(len(c), N // 2)
-            X[:m] = c[:m] / 2j
+        def synth(c):  # sin-referenced amplitudes -> rfft scaling, below Nyquist
+            X = np.asarray(c[: N // 2], dtype=complex) / 2j
             X[0] = c[0].real
-            return np.fft.irfft(X * N, n=N) if m > 1 else np.full(N, c[0].real)
+            return sample_period(X, N)
 
         r = self.amplitude * np.sin(TWO_PI * self.frequency_hz * t)
         return {"t": t, "r": r, "e": synth(self.e), "e_linear": synth(self.e_linear),
