@@ -1,0 +1,54 @@
+"""Command-line interface: ``motionhyst df | analyze | simulate | identify | reproduce``.
+
+A thin layer: it parses arguments, calls the library and prints tables or
+JSON.  Every user error ends in one line on stderr and exit code 2.  Each
+command is one module of this package with ``add_parser(sub)`` and
+``run(args) -> int``; a new command is a new module listed in
+:data:`COMMANDS`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+from collections.abc import Sequence
+
+from motionhyst.cli._common import EXIT_USAGE, Parser, UsageError
+from motionhyst.cli.identify import feedforward_fragment, record_kind
+
+COMMANDS = ("df", "analyze", "simulate", "identify", "reproduce")
+"""The commands, in the order ``motionhyst --help`` lists them (module names)."""
+
+__all__ = ["COMMANDS", "EXIT_USAGE", "UsageError", "build_parser", "feedforward_fragment",
+           "main", "record_kind"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``motionhyst`` command."""
+    p = Parser(prog="motionhyst", description="Hysteresis of dynamic links in motion control "
+               "loops: describing functions, quasi-linear analysis, exact steady state.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for name in COMMANDS:
+        importlib.import_module(f"motionhyst.cli.{name}").add_parser(sub)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``motionhyst`` command; returns the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return args.func(args)
+    except BrokenPipeError:  # output piped into head, say: not an error
+        sys.stdout = open(os.devnull, "w")
+        return 0
+    except UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+    except (ValueError, OSError, RuntimeError) as exc:
+        print(f"motionhyst: error: {exc}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("motionhyst: interrupted", file=sys.stderr)
+        return 130
+    return EXIT_USAGE

@@ -1,0 +1,178 @@
+"""``motionhyst df``: the describing function (and higher harmonics) of one link element.
+
+Paper eq. (7); for the Jenkins element eq. (10).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import typing
+
+import numpy as np
+
+from motionhyst.cli._common import (
+    UsageError,
+    finite,
+    g,
+    harmonic_count,
+    nonnegative,
+    positive,
+    print_json,
+    table,
+)
+
+_UNITS = {"k": "N/m", "fc": "N", "sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m",
+          "fs": "N", "vs": "m/s"}
+
+
+def _df_parameters(model: str) -> dict[str, tuple[bool, bool]]:
+    """``{option: (takes a list, required)}`` of a model, from its scenario section."""
+    from motionhyst.scenario import LINK_SECTIONS
+
+    fields = LINK_SECTIONS[model].model_fields
+    return {name: (typing.get_origin(f.annotation) is list, f.is_required())
+            for name, f in fields.items() if name != "model"}
+
+
+def _element_from_args(args: argparse.Namespace):
+    """The hysteresis element named by ``--model`` and its parameter options."""
+    from motionhyst.scenario import LINK_SECTIONS, ScenarioError, hysteresis_from_dict
+
+    model = args.model
+    spec = _df_parameters(model)
+    options = dict.fromkeys(n for m in LINK_SECTIONS for n in _df_parameters(m))
+    for name in options:
+        if getattr(args, name) is not None and name not in spec:
+            raise UsageError(f"motionhyst df: --{name} does not apply to --model {model} "
+                             f"(its parameters: {', '.join('--' + n for n in spec)})")
+    params: dict = {"model": model}
+    for name, (many, required) in spec.items():
+        values = getattr(args, name)
+        if values is None:
+            if required:
+                raise UsageError(f"motionhyst df: --{name} is required for --model {model}")
+            continue
+        if many:
+            params[name] = list(values)
+        elif len(values) != 1:
+            hint = " (use --model maxwell-slip for several)" if name in ("k", "fc") else ""
+            raise UsageError(f"motionhyst df: --{name} takes one value for --model {model}"
+                             f"{hint}")
+        else:
+            params[name] = values[0]
+    try:
+        return hysteresis_from_dict(params, source="motionhyst df")
+    except ScenarioError as exc:
+        msg = str(exc).replace("[hysteresis]: ", "").replace("[hysteresis] ", "--")
+        raise UsageError(msg) from None
+
+
+def _df_frequencies(args: argparse.Namespace, el) -> list[float | None]:
+    """The frequencies [Hz] of ``df``: required for rate-dependent elements, else none."""
+    if el.rate_independent:
+        if args.frequency is not None:
+            raise UsageError(f"motionhyst df: --frequency does not apply to --model "
+                             f"{args.model}: the element is rate-independent, its describing "
+                             f"function depends on the amplitude only")
+        return [None]
+    if args.frequency is None:
+        raise UsageError(f"motionhyst df: --frequency is required for --model {args.model} "
+                         f"(rate-dependent: D depends on amplitude and frequency)")
+    return list(args.frequency)
+
+
+def _df_point(amplitude: float, zeta: float, D: complex, frequency_hz: float | None) -> dict:
+    point = {"amplitude": float(amplitude)}
+    if frequency_hz is not None:
+        point["frequency_hz"] = float(frequency_hz)
+    point.update({"zeta": float(zeta), "re": float(D.real), "im": float(D.imag),
+                  "abs": float(abs(D)), "phase_deg": float(np.degrees(np.angle(D)))})
+    return point
+
+
+def run(args: argparse.Namespace) -> int:
+    """Describing function (and higher harmonics) of a hysteresis element."""
+    el = _element_from_args(args)
+    freqs = _df_frequencies(args, el)
+    A = np.asarray(args.amplitude, dtype=float)
+    zeta = np.atleast_1d(el.zeta(A)) if hasattr(el, "zeta") else np.full(A.shape, np.nan)
+    points = []
+    for f in freqs:
+        omega = None if f is None else 2.0 * math.pi * f
+        D = np.atleast_1d(el.describing_function(A, omega))
+        pts = [_df_point(a, z, d, f) for a, z, d in zip(A, zeta, D, strict=True)]
+        if args.harmonics:
+            H = el.hosidf(A, args.harmonics, omega)
+            for p, h in zip(pts, H, strict=True):
+                p["harmonics"] = [{"n": n, "re": float(c.real), "im": float(c.imag),
+                                   "abs_over_amplitude": float(abs(c)),
+                                   "phase_deg": float(np.degrees(np.angle(c)))}
+                                  for n, c in enumerate(h, start=1)]
+        points += pts
+    result = {**el.to_dict(), "points": points}
+    if args.json:
+        print_json(result)
+        return 0
+    k0 = el.initial_stiffness
+
+    def show(v):
+        return ", ".join(f"{x:g}" for x in v) if isinstance(v, list) else f"{v:g}"
+
+    params = ", ".join(f"{k} = {show(v)} {_UNITS.get(k, '')}".rstrip()
+                       for k, v in el.to_dict().items() if k != "model")
+    print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 7)")
+    rate = el.rate_independent
+    head = ["A [m]"] if rate else ["A [m]", "f [Hz]"]
+
+    def lead(p):
+        return [g(p["amplitude"])] + ([] if rate else [g(p["frequency_hz"])])
+
+    has_zeta = any(not math.isnan(p["zeta"]) for p in points)
+    rows = [[*lead(p), *([g(p["zeta"])] if has_zeta else []), g(p["re"]), g(p["im"]),
+             g(p["abs"]), g(p["abs"] / k0), f"{p['phase_deg']:.2f}"] for p in points]
+    print(table([*head, *(["zeta [-]"] if has_zeta else []), "Re D [N/m]", "Im D [N/m]",
+                  "|D| [N/m]", "|D|/k0 [-]", "angle D [deg]"], rows))
+    print(f"k0 = {k0:g} N/m, the initial stiffness"
+          + (" (|D| -> k0 as A -> 0)" if rate else ""))
+    if args.harmonics:
+        print()
+        print("Higher-order describing functions H_n = Y_n / A [N/m], relative to sin(n w t)")
+        rows = [[*lead(p), str(h["n"]), g(h["abs_over_amplitude"]),
+                 f"{h['phase_deg']:.2f}"] for p in points for h in p["harmonics"]]
+        print(table([*head, "n", "|H_n| [N/m]", "angle H_n [deg]"], rows))
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add the ``df`` command to the subparsers `sub`."""
+    from motionhyst.scenario import LINK_SECTIONS
+
+    q = sub.add_parser("df", help="describing function of a hysteresis element")
+    q.add_argument("--model", choices=list(LINK_SECTIONS), default="jenkins",
+                   help="hysteresis model (default: jenkins)")
+    q.add_argument("--k", type=positive, nargs="+",
+                   help="spring stiffness k [N/m] (one per element for maxwell-slip); "
+                        "jenkins, maxwell-slip, bouc-wen, dahl")
+    q.add_argument("--fc", type=positive, nargs="+",
+                   help="slip (Coulomb) force f_c [N] (one per element for maxwell-slip); "
+                        "all models")
+    q.add_argument("--n", type=positive, nargs=1, help="bouc-wen: sharpness n >= 1 (1)")
+    q.add_argument("--beta", type=finite, nargs=1, help="bouc-wen: beta (0.5)")
+    q.add_argument("--gamma", type=finite, nargs=1, help="bouc-wen: gamma, <= beta (0.5)")
+    q.add_argument("--alpha", type=positive, nargs=1, help="dahl: shape exponent alpha (1)")
+    q.add_argument("--sigma0", type=positive, nargs=1, help="lugre: bristle stiffness [N/m]")
+    q.add_argument("--sigma1", type=nonnegative, nargs=1,
+                   help="lugre: bristle damping [N s/m] (0)")
+    q.add_argument("--sigma2", type=nonnegative, nargs=1,
+                   help="lugre: viscous friction [N s/m] (0)")
+    q.add_argument("--fs", type=positive, nargs=1, help="lugre: static (Stribeck) force [N]")
+    q.add_argument("--vs", type=positive, nargs=1, help="lugre: Stribeck velocity [m/s]")
+    q.add_argument("--frequency", type=positive, nargs="+",
+                   help="frequency(ies) [Hz]; required for the rate-dependent lugre")
+    q.add_argument("--amplitude", type=nonnegative, nargs="+", required=True,
+                   help="input amplitude(s) A [m]")
+    q.add_argument("--harmonics", type=harmonic_count, metavar="N",
+                   help="also the higher-order describing functions H_1 .. H_N")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=run)

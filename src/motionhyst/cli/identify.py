@@ -1,0 +1,185 @@
+"""``motionhyst identify``: Maxwell-slip hysteresis from a measured record (CSV)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+from motionhyst.cli._common import UsageError, g, positive, print_json, table
+
+RECORD_KINDS = {"force-displacement": ("time", "displacement", "force"),
+                "closed-loop": ("time", "y1", "u")}
+"""CSV columns that identify a record's kind (``motionhyst identify``)."""
+
+
+def _element_count(text: str) -> int:
+    """argparse type: a whole number of Jenkins elements from 1 to 20."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 1 <= n <= 20:
+        raise argparse.ArgumentTypeError(f"must be from 1 to 20, got {text!r}")
+    return n
+
+
+def record_kind(path: str | Path, kind: str | None = None) -> str:
+    """The kind of a measured record from its CSV header.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file with a header row.
+    kind : str, optional
+        The kind the user asked for (``--record``); checked against the header.
+
+    Returns
+    -------
+    str
+        ``"force-displacement"`` (columns ``time,displacement,force``) or
+        ``"closed-loop"`` (columns ``time,y1,u``).
+
+    Raises
+    ------
+    ValueError
+        One line naming the file: unreadable, empty, a header of neither kind,
+        of both kinds without `kind`, or without the columns of `kind`.
+    """
+    from motionhyst.csvdata import read_header
+
+    names = read_header(path)
+    header = set(names)
+    fits = [k for k, cols in RECORD_KINDS.items() if header.issuperset(cols)]
+    if kind is not None:
+        if kind not in fits:
+            raise ValueError(f"{path}: a {kind} record needs the columns "
+                             f"{','.join(RECORD_KINDS[kind])}; the header is {','.join(names)!r}")
+        return kind
+    if len(fits) == 1:
+        return fits[0]
+    if fits:
+        raise ValueError(f"{path}: the header {','.join(names)!r} has the columns of both a "
+                         f"force-displacement and a closed-loop record; choose one with --record")
+    expected = " or ".join(f"{','.join(n)} ({k})" for k, n in RECORD_KINDS.items())
+    raise ValueError(f"{path}: unknown record header {','.join(names)!r}; expected {expected}")
+
+
+def _toml_float(v: float) -> str:
+    """A float as a TOML float literal with 7 significant digits."""
+    s = repr(float(f"{float(v):.7g}"))
+    return s if any(c in s for c in ".en") else s + ".0"
+
+
+def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
+    """A ``[feedforward]`` section with the identified hysteresis, ready to paste (TOML).
+
+    One element is written as ``model = "jenkins"`` with scalars, more as
+    ``model = "maxwell-slip"`` with lists (as
+    :meth:`motionhyst.identify.Identification.scenario_fragment`).
+    """
+    if len(k) == 1:
+        table = (f'{{ model = "jenkins", k = {_toml_float(k[0])}, '
+                 f"fc = {_toml_float(fc[0])} }}")
+    else:
+        table = (f'{{ model = "maxwell-slip", k = [{", ".join(map(_toml_float, k))}], '
+                 f'fc = [{", ".join(map(_toml_float, fc))}] }}')
+    return ('[feedforward]\ntype = "rigid-body"   # u_ff = M r\'\' + phi_hat(r)\n'
+            f"hysteresis = {table}\n")
+
+
+def _std_text(value: float, std: float) -> str:
+    if not math.isfinite(std):
+        return "not determined"
+    return f"{std:.2g} ({100 * std / value:.2g} %)"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Identify Maxwell-slip hysteresis from a measured record (CSV)."""
+    from motionhyst.identify import (
+        identify_closed_loop,
+        identify_maxwell_slip,
+        load_closed_loop_csv,
+        load_force_displacement_csv,
+    )
+    from motionhyst.scenario import load_scenario
+    from motionhyst.systems import TwoMassStage
+
+    path = Path(args.data)
+    kind = record_kind(path, args.record)
+    if kind == "force-displacement":
+        for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
+            if value is not None:
+                raise UsageError(f"motionhyst identify: {option} applies to closed-loop "
+                                 f"records (time,y1,u) only; {path} is a force-displacement "
+                                 f"record")
+    options = {"n_elements": args.elements, "criterion": args.criterion}
+    extra: dict = {"record": kind, "data": str(path)}
+    if kind == "force-displacement":
+        t, x, w = load_force_displacement_csv(path)
+        what = "force-displacement record"
+        try:
+            ident = identify_maxwell_slip(x, w, t=t, **options)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+    else:
+        sc = load_scenario(args.scenario)
+        plant = sc.plant()
+        if not isinstance(plant, TwoMassStage):
+            raise UsageError(f"motionhyst identify: closed-loop records need a [stage] in the "
+                             f"scenario (P1 as a model); {sc.source} has a measured [plant]")
+        t, y1, u = load_closed_loop_csv(path)
+        extra["scenario"] = sc.source
+        try:
+            ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff, **options)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+        what = (f"closed-loop record, plant of {sc.source}, prefilter cut-off "
+                f"{g(ident.cutoff_hz)} Hz")
+    k = [e["k"] for e in ident.elements]
+    fc = [e["fc"] for e in ident.elements]
+    if args.json:
+        print_json({**ident.to_dict(), **extra})
+        return 0
+    print(f"Maxwell-slip hysteresis identified from {path} ({what}, {ident.n_samples} samples)")
+    print(f"  elements: {ident.n_elements}   ({ident.criterion})")
+    print(f"  fit RMS {g(ident.fit_rms)} N = {100 * ident.fit_nrms:.3g} % of the "
+          f"{ident.signal} RMS, R^2 = {ident.r2:.6f}, offset {g(ident.offset)} N")
+    print()
+    rows = [[str(i), g(e["k"], 6), _std_text(e["k"], e["k_std"]), g(e["fc"], 6),
+             _std_text(e["fc"], e["fc_std"]), g(e["fc"] / e["k"] * 1e3)]
+            for i, e in enumerate(ident.elements, start=1)]
+    print(table(["i", "k [N/m]", "std k [N/m]", "fc [N]", "std fc [N]", "fc/k [mm]"], rows))
+    print()
+    print(f"  total stiffness {g(sum(k), 6)} N/m, total slip force {g(sum(fc), 6)} N")
+    print()
+    print("# hysteresis feedforward, to paste into a scenario (replaces its [feedforward];")
+    print("# the same inline table is a valid [hysteresis] section to model the link):")
+    print(feedforward_fragment(k, fc), end="")
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add the ``identify`` command to the subparsers `sub`."""
+    q = sub.add_parser("identify", help="identify Maxwell-slip hysteresis from a measured "
+                       "record (CSV)")
+    q.add_argument("data", metavar="DATA.csv",
+                   help="record with a header: time,displacement,force (force-displacement) or "
+                        "time,y1,u (closed-loop) [SI units]")
+    q.add_argument("--elements", type=_element_count, metavar="N",
+                   help="number of Jenkins elements (default: chosen by --criterion)")
+    q.add_argument("--cutoff", type=positive, metavar="HZ",
+                   help="closed-loop records: cut-off of the prefilter through which the link "
+                        "force is inferred [Hz] (default: 20 times the record's fundamental, "
+                        "at most a twentieth of the sampling rate)")
+    q.add_argument("--record", choices=list(RECORD_KINDS),
+                   help="the record's kind, where its header has the columns of both "
+                        "(default: from the header)")
+    q.add_argument("--criterion", choices=["rms", "bic"], default="rms",
+                   help="model-order criterion when --elements is not given (default: rms)")
+    q.add_argument("--scenario", metavar="FILE",
+                   help="scenario TOML whose [stage] gives P1 for closed-loop records "
+                        "(default: the paper's Table I)")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=run)

@@ -1,0 +1,26 @@
+"""``motionhyst reproduce``: the paper's figures and numbers for a scenario, as a report."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def run(args: argparse.Namespace) -> int:
+    """The paper's figures and numbers for a scenario, as a report."""
+    from motionhyst.report import reproduce
+    from motionhyst.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None)
+    if not args.quiet:
+        print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf)")
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add the ``reproduce`` command to the subparsers `sub`."""
+    q = sub.add_parser("reproduce", help="the paper's figures and numbers, as a report")
+    q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
+    q.add_argument("--out", default="out", help="output folder (default: ./out)")
+    q.add_argument("--quiet", action="store_true", help="no progress bar or summary line")
+    q.set_defaults(func=run)
