@@ -48,16 +48,9 @@ def _frequency_range(loop: Loop, f_range):
     return max(f_range[0], lo), min(f_range[1], hi)
 
 
-def _sine_loop(el: Hysteresis, A: float, n: int = 2000, frequency_hz: float | None = None):
+def _sine_loop(el: Hysteresis, A: float, frequency_hz: float | None = None):
     """One period of the periodic response to ``x = A sin(theta)``: ``x, w``."""
-    if hasattr(el, "steady_loop"):  # the periodic loop of an element with a fading memory
-        args = () if el.rate_independent else (TWO_PI * frequency_hz,)
-        _, x, w = el.steady_loop(A, *args)
-        return np.append(x, x[0]), np.append(w, w[0])
-    theta = np.linspace(0.0, TWO_PI, n + 1)
-    x = A * np.sin(np.concatenate([theta, TWO_PI + theta[1:]]))
-    w = el.response(x)[n:]
-    return x[n:], w
+    return el.sine_loop(A, None if el.rate_independent else TWO_PI * frequency_hz)
 
 
 def _force_scale(el: Hysteresis) -> float:
@@ -99,7 +92,7 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
     ax.axhline(-fc, color="0.5", ls=":", lw=0.8)
     ax.set_xlabel("displacement x [mm]")
     ax.set_ylabel("force w [N]")
-    if isinstance(el, Jenkins):
+    if el.defines_zeta:
         ax.set_title(f"Fig. 5: Jenkins element, k = {el.k:g} N/m, fc = {el.fc:g} N")
     else:
         ax.set_title(f"Fig. 5: {_describe(el, frequency_hz)}", fontsize=9)
@@ -157,7 +150,7 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
     """
     _check_frequency(el, frequency_hz)
     fig, (ax1, ax2) = _figure(2)
-    jenkins = isinstance(el, Jenkins)
+    jenkins = el.defines_zeta  # the paper's Jenkins element: slip modes by zeta (eq. 4)
     z = np.geomspace(*zeta_range, 800 if jenkins else 200)
     k0 = el.initial_stiffness
     omega = None if el.rate_independent else TWO_PI * frequency_hz
@@ -198,8 +191,8 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     w = TWO_PI * f
     P1, P2 = freqresp(loop.P1, w), freqresp(loop.P2, w)
     cmap = matplotlib.colormaps["viridis"]
-    jenkins = isinstance(el, Jenkins)
-    fc_total = float(np.sum(el.fc)) if hasattr(el, "fc") else 1.0
+    jenkins = el.defines_zeta  # the paper's Jenkins element: slip modes by zeta (eq. 4)
+    fc_total = _force_scale(el)
     for i, z in enumerate(zetas):
         A = fc_total / (el.initial_stiffness * z)
         D = el.describing_function(A, w if not el.rate_independent else None)

@@ -333,11 +333,11 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         D_ff = loop.hysteresis_feedforward.describing_function(amplitude, omega)
         E = residual_mismatch(loop, omega, D_pts, D_ff)
     Et = mismatch_asymptote(Pr, Pf2, D_pts)
-    zetas = np.asarray(hyst.zeta(amps)) if hasattr(hyst, "zeta") else np.full(f.shape, np.nan)
+    zetas = np.asarray(hyst.zeta(amps)) if hyst.defines_zeta else np.full(f.shape, np.nan)
     f_df = None if hyst.rate_independent else float(np.min(f))
     D_ref = complex(np.asarray(hyst.describing_function(
         amplitude, None if f_df is None else TWO_PI * f_df)).ravel()[0])
-    zeta_ref = float(hyst.zeta(amplitude)) if hasattr(hyst, "zeta") else float("nan")
+    zeta_ref = float(hyst.zeta(amplitude)) if hyst.defines_zeta else float("nan")
     if isinstance(loop.plant, TwoMassStage):
         crossover = _crossover_estimate(loop.plant, hyst, amplitude, D_ref)
     else:

@@ -18,7 +18,6 @@ import numpy as np
 from tqdm import tqdm
 
 from motionhyst import plots
-from motionhyst.hysteresis import Jenkins
 from motionhyst.jsonio import dumps
 from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
 from motionhyst.scenario import Scenario
@@ -142,7 +141,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
             "fig11": lambda: plots.fig11_errors(states, E_df, H_df),
         }
-        if not isinstance(el, Jenkins):
+        if not el.defines_zeta:
             for name in ("fig6", "fig7"):
                 del figs[name]
             at = "" if el.rate_independent else f" at {freqs[0]:g} Hz"

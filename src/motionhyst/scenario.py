@@ -12,12 +12,20 @@ from __future__ import annotations
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Literal, Union
 
 import control
-from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    TypeAdapter,
+    ValidationError,
+    create_model,
+    model_validator,
+)
 
-from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
+from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.loop import Loop
 from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
 
@@ -71,66 +79,33 @@ class _LinkSection(_Section):
 
     @model_validator(mode="after")
     def _model_accepts(self):
-        _MODELS[self.model](**self.model_dump(exclude={"model"}))
+        model_class(self.model)(**self.model_dump(exclude={"model"}))
         return self
 
 
-class JenkinsSection(_LinkSection):
-    """``[hysteresis] model = "jenkins"``: eq. (3)."""
-
-    model: Literal["jenkins"]
-    k: PositiveFloat
-    fc: PositiveFloat
+_FIELD_TYPES = {"positive": PositiveFloat, "nonnegative": NonNegativeFloat,
+                "finite": Annotated[float, Field(allow_inf_nan=False)]}
 
 
-class MaxwellSlipSection(_LinkSection):
-    """``[hysteresis] model = "maxwell-slip"``: parallel Jenkins elements."""
-
-    model: Literal["maxwell-slip"]
-    k: Annotated[list[PositiveFloat], Field(min_length=1)]
-    fc: Annotated[list[PositiveFloat], Field(min_length=1)]
-
-
-class BoucWenSection(_LinkSection):
-    """``[hysteresis] model = "bouc-wen"``: normalised, rate-independent Bouc-Wen."""
-
-    model: Literal["bouc-wen"]
-    k: PositiveFloat
-    fc: PositiveFloat
-    n: Annotated[float, Field(allow_inf_nan=False)] = 1.0
-    beta: Annotated[float, Field(allow_inf_nan=False)] = 0.5
-    gamma: Annotated[float, Field(allow_inf_nan=False)] = 0.5
+def _link_section(name: str, cls: type[Hysteresis]) -> type[_LinkSection]:
+    """The ``[hysteresis] model = name`` section, from the model's declared parameters."""
+    fields: dict = {"model": (Literal[name], ...)}
+    for p in cls.parameters:
+        t = _FIELD_TYPES[p.kind]
+        if p.many:
+            t = Annotated[list[t], Field(min_length=1)]
+        fields[p.name] = (t, ... if p.required else p.default)
+    section = create_model(f"{cls.__name__}Section", __base__=_LinkSection, **fields)
+    section.__doc__ = f"``[hysteresis] model = \"{name}\"``: the {cls.__name__} model."
+    return section
 
 
-class DahlSection(_LinkSection):
-    """``[hysteresis] model = "dahl"``: Dahl's solid friction."""
-
-    model: Literal["dahl"]
-    k: PositiveFloat
-    fc: PositiveFloat
-    alpha: PositiveFloat = 1.0
-
-
-class LuGreSection(_LinkSection):
-    """``[hysteresis] model = "lugre"``: LuGre friction (rate-dependent)."""
-
-    model: Literal["lugre"]
-    sigma0: PositiveFloat
-    sigma1: NonNegativeFloat = 0.0
-    sigma2: NonNegativeFloat = 0.0
-    fc: PositiveFloat
-    fs: PositiveFloat
-    vs: PositiveFloat
-
-
-#: The section of each ``[hysteresis] model = ...``.
+#: The section of each ``[hysteresis] model = ...``, one per registered link model.
 LINK_SECTIONS: dict[str, type[_LinkSection]] = {
-    "jenkins": JenkinsSection, "maxwell-slip": MaxwellSlipSection, "bouc-wen": BoucWenSection,
-    "dahl": DahlSection, "lugre": LuGreSection}
+    name: _link_section(name, cls) for name, cls in MODELS.items()}
 
-HysteresisSection = Annotated[
-    JenkinsSection | MaxwellSlipSection | BoucWenSection | DahlSection | LuGreSection,
-    Field(discriminator="model")]
+HysteresisSection = Annotated[Union[tuple(LINK_SECTIONS.values())],  # noqa: UP007
+                              Field(discriminator="model")]
 
 
 class FeedforwardSection(_Section):
@@ -203,18 +178,14 @@ class ScenarioModel(_Section):
         return self
 
 
-_MODELS: dict[str, type[Hysteresis]] = {
-    "jenkins": Jenkins, "maxwell-slip": MaxwellSlip, "bouc-wen": BoucWen, "dahl": Dahl,
-    "lugre": LuGre}
-
 # tags of the discriminated unions, left out of the key named in an error message
-_UNION_TAGS = {"leadlag-lowpass", "tf", *_MODELS}
+_UNION_TAGS = {"leadlag-lowpass", "tf", *MODELS}
 
 
 def build_hysteresis(section) -> Hysteresis:
     """The hysteresis model a validated ``[hysteresis]`` section describes."""
     params = section.model_dump(exclude={"model"})
-    return _MODELS[section.model](**params)
+    return model_class(section.model)(**params)
 
 
 _HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection)

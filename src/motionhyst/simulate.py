@@ -25,14 +25,9 @@ from numpy.typing import NDArray
 from scipy.linalg import expm
 from scipy.signal import cont2discrete
 
-from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
-from motionhyst.hysteresis._ode_kernels import (
-    GL_T,
-    GL_W,
-    bouc_wen_advance,
-    dahl_advance,
-    lugre_relax,
-)
+from motionhyst.hysteresis import Hysteresis
+from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
+from motionhyst.hysteresis.stepping import Stepping, advance, open_loop
 from motionhyst.loop import Loop, _cancel_s, _polysub_exact
 from motionhyst.systems import TWO_PI
 
@@ -132,82 +127,7 @@ def _discretize(sys, h: float):
 
 
 # element kinds of the compiled loop (one row of parameters each)
-_STOP, _DAHL, _BOUC_WEN, _LUGRE = 0, 1, 2, 3
-_N_PARAMS = 6
 MAX_FIXED_POINT_ITERATIONS = 50
-
-
-@njit(cache=True)
-def _advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no cover
-    """New state and force of one element after a displacement `dx` over a time `h`.
-
-    ``code``/``p`` as built by :func:`_elements`; the displacement is taken as
-    linear in time over the step (monotone for the rate-independent kinds).
-    `s_prev` and `dx_prev` are the state and the displacement one step earlier,
-    used by LuGre only and ignored on the `first` step.
-    """
-    if code == _STOP:  # p = (k, fc); state w: exact stop operator
-        v = s + p[0] * dx
-        if v > p[1]:
-            v = p[1]
-        elif v < -p[1]:
-            v = -p[1]
-        return v, v
-    if code == _DAHL:  # p = (k / fc, fc, alpha); state w / fc
-        du = p[0] * dx
-        if du > 0.0:
-            s = dahl_advance(s, du, p[2])
-        elif du < 0.0:
-            s = -dahl_advance(-s, -du, p[2])
-        return s, p[1] * s
-    if code == _BOUC_WEN:  # p = (k / fc, fc, n, beta + gamma, beta - gamma, hmax); state w / fc
-        du = p[0] * dx
-        if du > 0.0:
-            s = bouc_wen_advance(s, du, p[2], p[3], p[4], p[5], glt, glw)
-        elif du < 0.0:
-            s = -bouc_wen_advance(-s, -du, p[2], p[3], p[4], p[5], glt, glw)
-        return s, p[1] * s
-    # LuGre, p = (sigma0, sigma1, sigma2, fc, fs, vs); state z.  As in lugre_response, z
-    # relaxes exactly for the step's constant velocity (lugre_relax).  The rates in
-    # the force are taken at the sample by the second-order backward difference,
-    # v = (3 dx - dx_prev) / (2 h) and z' likewise from z: the step's mean velocity is half
-    # a step late (first order), and z' from the state equation at the sample would
-    # amplify the error of z by h / tau when the bristles relax within a step (tau =
-    # g / (sigma0 |v|) < h, stiff bristles).
-    sigma0 = p[0]
-    if h <= 0.0:
-        return s, sigma0 * s
-    z0 = s
-    s = lugre_relax(s, dx, h, sigma0, p[3], p[4], p[5])
-    if first:
-        v = dx / h
-        zdot = (s - z0) / h
-    else:
-        v = (1.5 * dx - 0.5 * dx_prev) / h
-        zdot = (1.5 * (s - z0) - 0.5 * (z0 - s_prev)) / h
-    return s, sigma0 * s + p[1] * zdot + p[2] * v
-
-
-@njit(cache=True)
-def _open_loop(codes, params, s0, x, h, glt, glw):  # pragma: no cover - compiled
-    """Force of the elements for the displacement samples `x` (step `h`), from rest at ``x[0]``."""
-    n_t = x.shape[0]
-    s = s0.copy()
-    s_prev = s0.copy()
-    w = np.empty(n_t)
-    dx_prev = 0.0
-    for i in range(n_t):
-        dx = x[i] - x[i - 1] if i > 0 else 0.0
-        wt = 0.0
-        for j in range(codes.shape[0]):
-            sj, f = _advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
-                             h if i > 0 else 0.0, i == 1, glt, glw)
-            s_prev[j] = s[j]
-            s[j] = sj
-            wt += f
-        w[i] = wt
-        dx_prev = dx
-    return w
 
 
 @njit(cache=True)
@@ -264,7 +184,7 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, 
     w_prev = 0.0
     dx_prev = 0.0
     for j in range(m):
-        w_prev += _advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
+        w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
     for i in range(n_t):
         base_e = e_lin[i]
         base_y = dev_lin[i]
@@ -282,7 +202,7 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, 
             dx = dr + (d - dev_prev)
             wn = 0.0
             for j in range(m):
-                s_new[j], f = _advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, hi,
+                s_new[j], f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, hi,
                                        i == 1, glt, glw)
                 wn += f
             d_next = base_y + Dd[1, 0] * (wn - uh[i])
@@ -376,34 +296,8 @@ def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float
     ValueError
         For a model the compiled loop has no exact update for.
     """
-    if h is None:
-        return np.zeros(0, np.int64), np.zeros((0, _N_PARAMS)), np.zeros(0), 1.0
-    if isinstance(h, Dahl):
-        rows = [(_DAHL, (h.k / h.fc, h.fc, h.alpha))]
-        scale = h.fc
-    elif isinstance(h, BoucWen):
-        rows = [(_BOUC_WEN, (h.k / h.fc, h.fc, h.n, h.beta + h.gamma, h.beta - h.gamma,
-                             h._step()))]
-        scale = h.saturation_force
-    elif isinstance(h, LuGre):
-        rows = [(_LUGRE, (h.sigma0, h.sigma1, h.sigma2, h.fc, h.fs, h.vs))]
-        scale = max(h.fc, h.fs)
-    elif isinstance(h, Jenkins):
-        rows = [(_STOP, (h.k, h.fc))]
-        scale = h.fc
-    elif isinstance(h, MaxwellSlip):
-        k, fc = h.stop_parameters()
-        rows = [(_STOP, (float(kj), float(fj))) for kj, fj in zip(k, fc, strict=True)]
-        scale = float(np.sum(fc))
-    else:
-        raise ValueError(f"time simulation does not support the {h.name!r} model "
-                         f"({type(h).__name__}); supported: Jenkins, MaxwellSlip, Dahl, "
-                         "BoucWen, LuGre")
-    codes = np.array([c for c, _ in rows], dtype=np.int64)
-    params = np.zeros((len(rows), _N_PARAMS))
-    for j, (_, p) in enumerate(rows):
-        params[j, :len(p)] = p
-    return codes, params, np.zeros(len(rows)), float(scale)
+    st = Stepping.empty() if h is None else h.time_stepping()
+    return st.codes, st.params, st.state0, st.scale
 
 
 def default_step(loop: Loop, max_frequency_hz: float) -> float:
@@ -486,7 +380,7 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
     elif hff.rate_independent:
         uh = hff.response(r)
     else:  # as the link in the loop: force with the velocity at the sample
-        uh = _open_loop(*_elements(hff)[:3], r, step, GL_T, GL_W)
+        uh = open_loop(*_elements(hff)[:3], r, step, GL_T, GL_W)
     e, dev, w, iters = _run(*_discretize(sys_w, omega0 * step), r, e_lin,
                             np.ascontiguousarray(lin[:, 1]), uh, step, codes, params, s0,
                             GL_T, GL_W, 1e-14 * f_scale, MAX_FIXED_POINT_ITERATIONS)

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import typing
 
 import numpy as np
 
@@ -22,26 +21,22 @@ from motionhyst.cli._common import (
     table,
 )
 
-_UNITS = {"k": "N/m", "fc": "N", "sigma0": "N/m", "sigma1": "N s/m", "sigma2": "N s/m",
-          "fs": "N", "vs": "m/s"}
-
 
 def _df_parameters(model: str) -> dict[str, tuple[bool, bool]]:
-    """``{option: (takes a list, required)}`` of a model, from its scenario section."""
-    from motionhyst.scenario import LINK_SECTIONS
+    """``{option: (takes a list, required)}`` of a model, from its declared parameters."""
+    from motionhyst.hysteresis import model_class
 
-    fields = LINK_SECTIONS[model].model_fields
-    return {name: (typing.get_origin(f.annotation) is list, f.is_required())
-            for name, f in fields.items() if name != "model"}
+    return {p.name: (p.many, p.required) for p in model_class(model).parameters}
 
 
 def _element_from_args(args: argparse.Namespace):
     """The hysteresis element named by ``--model`` and its parameter options."""
-    from motionhyst.scenario import LINK_SECTIONS, ScenarioError, hysteresis_from_dict
+    from motionhyst.hysteresis import MODELS
+    from motionhyst.scenario import ScenarioError, hysteresis_from_dict
 
     model = args.model
     spec = _df_parameters(model)
-    options = dict.fromkeys(n for m in LINK_SECTIONS for n in _df_parameters(m))
+    options = dict.fromkeys(n for m in MODELS for n in _df_parameters(m))
     for name in options:
         if getattr(args, name) is not None and name not in spec:
             raise UsageError(f"motionhyst df: --{name} does not apply to --model {model} "
@@ -96,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     el = _element_from_args(args)
     freqs = _df_frequencies(args, el)
     A = np.asarray(args.amplitude, dtype=float)
-    zeta = np.atleast_1d(el.zeta(A)) if hasattr(el, "zeta") else np.full(A.shape, np.nan)
+    zeta = np.atleast_1d(el.zeta(A)) if el.defines_zeta else np.full(A.shape, np.nan)
     points = []
     for f in freqs:
         omega = None if f is None else 2.0 * math.pi * f
@@ -119,7 +114,8 @@ def run(args: argparse.Namespace) -> int:
     def show(v):
         return ", ".join(f"{x:g}" for x in v) if isinstance(v, list) else f"{v:g}"
 
-    params = ", ".join(f"{k} = {show(v)} {_UNITS.get(k, '')}".rstrip()
+    units = {p.name: p.unit for p in el.parameters}
+    params = ", ".join(f"{k} = {show(v)} {units.get(k, '')}".rstrip()
                        for k, v in el.to_dict().items() if k != "model")
     print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 7)")
     rate = el.rate_independent
@@ -146,30 +142,28 @@ def run(args: argparse.Namespace) -> int:
 
 def add_parser(sub) -> None:
     """Add the ``df`` command to the subparsers `sub`."""
-    from motionhyst.scenario import LINK_SECTIONS
+    from motionhyst.hysteresis import MODELS
 
     q = sub.add_parser("df", help="describing function of a hysteresis element")
-    q.add_argument("--model", choices=list(LINK_SECTIONS), default="jenkins",
+    q.add_argument("--model", choices=list(MODELS), default="jenkins",
                    help="hysteresis model (default: jenkins)")
-    q.add_argument("--k", type=positive, nargs="+",
-                   help="spring stiffness k [N/m] (one per element for maxwell-slip); "
-                        "jenkins, maxwell-slip, bouc-wen, dahl")
-    q.add_argument("--fc", type=positive, nargs="+",
-                   help="slip (Coulomb) force f_c [N] (one per element for maxwell-slip); "
-                        "all models")
-    q.add_argument("--n", type=positive, nargs=1, help="bouc-wen: sharpness n >= 1 (1)")
-    q.add_argument("--beta", type=finite, nargs=1, help="bouc-wen: beta (0.5)")
-    q.add_argument("--gamma", type=finite, nargs=1, help="bouc-wen: gamma, <= beta (0.5)")
-    q.add_argument("--alpha", type=positive, nargs=1, help="dahl: shape exponent alpha (1)")
-    q.add_argument("--sigma0", type=positive, nargs=1, help="lugre: bristle stiffness [N/m]")
-    q.add_argument("--sigma1", type=nonnegative, nargs=1,
-                   help="lugre: bristle damping [N s/m] (0)")
-    q.add_argument("--sigma2", type=nonnegative, nargs=1,
-                   help="lugre: viscous friction [N s/m] (0)")
-    q.add_argument("--fs", type=positive, nargs=1, help="lugre: static (Stribeck) force [N]")
-    q.add_argument("--vs", type=positive, nargs=1, help="lugre: Stribeck velocity [m/s]")
+    types = {"positive": positive, "nonnegative": nonnegative, "finite": finite}
+    declared: dict[str, list] = {}
+    for name, cls in MODELS.items():
+        for p in cls.parameters:
+            declared.setdefault(p.name, []).append((name, p))
+    for option, uses in declared.items():
+        p = uses[0][1]
+        unit = f" [{p.unit}]" if p.unit else ""
+        default = "" if p.required else f" ({p.default:g})"
+        many = [m for m, pm in uses if pm.many]
+        several = f" (one per element for {', '.join(many)})" if many else ""
+        models = "all models" if len(uses) == len(MODELS) else ", ".join(m for m, _ in uses)
+        q.add_argument(f"--{option}", type=types[p.kind], nargs="+" if many else 1,
+                       help=f"{p.help}{unit}{default}{several}; {models}")
     q.add_argument("--frequency", type=positive, nargs="+",
-                   help="frequency(ies) [Hz]; required for the rate-dependent lugre")
+                   help="frequency(ies) [Hz]; required for the rate-dependent "
+                        + ", ".join(m for m, c in MODELS.items() if not c.rate_independent))
     q.add_argument("--amplitude", type=nonnegative, nargs="+", required=True,
                    help="input amplitude(s) A [m]")
     q.add_argument("--harmonics", type=harmonic_count, metavar="N",

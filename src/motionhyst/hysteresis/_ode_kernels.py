@@ -744,6 +744,12 @@ class NormalisedRateIndependent:
             d = np.broadcast_to(d, np.broadcast_shapes(d.shape, np.shape(omega))).copy()
         return complex(d) if d.ndim == 0 else d
 
+    def sine_loop(self, A: float, omega: float | None = None, n_samples: int | None = None
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """One closed period of the exact periodic response (see :meth:`Hysteresis.sine_loop`)."""
+        _, x, w = self.steady_loop(A, n_samples=n_samples)
+        return np.append(x, x[0]), np.append(w, w[0])
+
     def steady_loop(self, A: float, n_samples: int | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """One period of the periodic response to ``x = A sin(theta)``.

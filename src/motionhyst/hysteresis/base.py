@@ -10,12 +10,17 @@ the periodic steady state and the time simulation.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from control import DescribingFunctionNonlinearity
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.periodic import sample_period
+
+if TYPE_CHECKING:
+    from motionhyst.hysteresis.registry import Parameter
+    from motionhyst.hysteresis.stepping import Stepping
 
 
 class Hysteresis(DescribingFunctionNonlinearity, ABC):
@@ -31,13 +36,23 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
 
     Attributes
     ----------
+    name : str
+        The model's name in scenarios and the CLI (its key in
+        :data:`~motionhyst.hysteresis.registry.MODELS`).
     rate_independent : bool
         True if the output depends only on the path of ``x``, not on its
         speed; the describing function then depends on amplitude only.
+    parameters : tuple of Parameter
+        The constructor's parameters as scenarios and ``motionhyst df`` spell them.
+    defines_zeta : bool
+        True if the model defines the paper's ``zeta = fc / (k A)`` (eq. 4)
+        through :meth:`zeta`.
     """
 
-    rate_independent: bool = True
-    name: str = "hysteresis"
+    name: ClassVar[str] = "hysteresis"
+    rate_independent: ClassVar[bool] = True
+    parameters: ClassVar[tuple[Parameter, ...]] = ()
+    defines_zeta: ClassVar[bool] = False
 
     @property
     @abstractmethod
@@ -72,6 +87,52 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
     @abstractmethod
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary, with key ``model``."""
+
+    def sine_loop(self, A: float, omega: float | None = None, n_samples: int | None = None
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """One closed period of the periodic response to ``x = A sin(omega t)``.
+
+        Parameters
+        ----------
+        A : float
+            Amplitude [m], > 0.
+        omega : float, optional
+            Angular frequency [rad/s], for rate-dependent elements.
+        n_samples : int, optional
+            Samples per period (default 2000 here; models with an exact periodic
+            path choose their own).
+
+        Returns
+        -------
+        x, w : ndarray
+            Displacement [m] and force [N]; the first sample repeated at the end.
+        """
+        n = 2000 if n_samples is None else int(n_samples)
+        theta = np.linspace(0.0, 2.0 * np.pi, n + 1)
+        x = A * np.sin(np.concatenate([theta, 2.0 * np.pi + theta[1:]]))
+        w = self.response(x)[n:]
+        return x[n:], w
+
+    def zeta(self, A: ArrayLike):
+        """The paper's ``zeta = fc / (k A)`` (eq. 4), for models with ``defines_zeta``.
+
+        Raises
+        ------
+        ValueError
+            For a model that does not define it.
+        """
+        raise ValueError(f"zeta (eq. 4) is not defined for the {self.name} model")
+
+    def time_stepping(self) -> Stepping:
+        """The elements as the compiled time step advances them (:mod:`.stepping`).
+
+        Raises
+        ------
+        ValueError
+            For a model the compiled time step has no update for.
+        """
+        raise ValueError(f"time simulation does not support the {self.name!r} model "
+                         f"({type(self).__name__})")
 
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:

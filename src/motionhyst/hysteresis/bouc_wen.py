@@ -22,6 +22,8 @@ from motionhyst.hysteresis._ode_kernels import (
     bouc_wen_path,
 )
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
+from motionhyst.hysteresis.registry import Parameter, register
+from motionhyst.hysteresis.stepping import BOUC_WEN, Stepping
 
 
 def _check_finite(name: str, value: float) -> float:
@@ -34,6 +36,7 @@ def _check_finite(name: str, value: float) -> float:
     return v
 
 
+@register
 class BoucWen(NormalisedRateIndependent, Hysteresis):
     """Bouc-Wen hysteresis (Bouc 1967, Wen 1976), normalised, rate-independent.
 
@@ -87,6 +90,11 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
 
     name = "bouc-wen"
     rate_independent = True
+    parameters = (Parameter("k", "N/m", "spring stiffness k"),
+                  Parameter("fc", "N", "slip (Coulomb) force f_c"),
+                  Parameter("n", "", "sharpness n >= 1", 1.0, "finite"),
+                  Parameter("beta", "", "beta", 0.5, "finite"),
+                  Parameter("gamma", "", "gamma, <= beta", 0.5, "finite"))
     #: RK4 step in ``k x / fc`` for ``n != 1``, divided by ``max(1, n (beta + gamma)^(1/n))``
     rk4_step = 0.02
 
@@ -188,6 +196,12 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         range) and the samples are transformed by an FFT.  `omega` is ignored.
         """
         return self._harmonics(X, n_harmonics, n_samples)
+
+    def time_stepping(self) -> Stepping:
+        """The elements as the compiled time step advances them (:mod:`.stepping`)."""
+        p = (self.k / self.fc, self.fc, self.n, self.beta + self.gamma, self.beta - self.gamma,
+             self._step())
+        return Stepping.from_rows([(BOUC_WEN, p)], self.saturation_force)
 
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""

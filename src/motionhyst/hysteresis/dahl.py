@@ -13,8 +13,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis._ode_kernels import NormalisedRateIndependent, dahl_path
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
+from motionhyst.hysteresis.registry import Parameter, register
+from motionhyst.hysteresis.stepping import DAHL, Stepping
 
 
+@register
 class Dahl(NormalisedRateIndependent, Hysteresis):
     """Dahl friction element (Dahl 1968), displacement ``x`` in, force ``w`` out.
 
@@ -59,6 +62,9 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
 
     name = "dahl"
     rate_independent = True
+    parameters = (Parameter("k", "N/m", "spring stiffness k"),
+                  Parameter("fc", "N", "slip (Coulomb) force f_c"),
+                  Parameter("alpha", "", "shape exponent alpha", 1.0))
 
     def __init__(self, k: float, fc: float, alpha: float = 1.0) -> None:
         super().__init__()
@@ -132,6 +138,10 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
         ignored (rate-independent).
         """
         return self._harmonics(X, n_harmonics, n_samples)
+
+    def time_stepping(self) -> Stepping:
+        """The elements as the compiled time step advances them (:mod:`.stepping`)."""
+        return Stepping.from_rows([(DAHL, (self.k / self.fc, self.fc, self.alpha))], self.fc)
 
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""

@@ -9,6 +9,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
+from motionhyst.hysteresis.registry import Parameter, register
+from motionhyst.hysteresis.stepping import STOP, Stepping
 
 # Taylor coefficients of asin(s) - s (1 - 2 s^2) sqrt(1 - s^2) in odd powers s^3, s^5, ...
 _SMALL_ZETA_SERIES = np.array(
@@ -55,6 +57,7 @@ def jenkins_describing_function(k: float, zeta: ArrayLike) -> NDArray[np.complex
     return np.where(z >= 1.0, k + 0j, re + 1j * im)
 
 
+@register
 class Jenkins(Hysteresis):
     """Elasto-plastic (Jenkins) element, paper eq. (3).
 
@@ -84,6 +87,9 @@ class Jenkins(Hysteresis):
 
     name = "jenkins"
     rate_independent = True
+    defines_zeta = True
+    parameters = (Parameter("k", "N/m", "spring stiffness k"),
+                  Parameter("fc", "N", "slip (Coulomb) force f_c"))
 
     def __init__(self, k: float, fc: float) -> None:
         super().__init__()
@@ -221,6 +227,10 @@ class Jenkins(Hysteresis):
         xdot = np.asarray(xdot, dtype=float)
         s = np.sign(w**2 - self.fc**2)
         return 0.5 * self.k * xdot * (1.0 - s - np.sign(xdot * w) * (1.0 + s))
+
+    def time_stepping(self) -> Stepping:
+        """The elements as the compiled time step advances them (:mod:`.stepping`)."""
+        return Stepping.from_rows([(STOP, (self.k, self.fc))], self.fc)
 
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""

@@ -25,6 +25,8 @@ from motionhyst.hysteresis._ode_kernels import (
 )
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.periodic import sample_period
+from motionhyst.hysteresis.registry import Parameter, register
+from motionhyst.hysteresis.stepping import LUGRE, Stepping
 
 
 def _check_nonnegative(name: str, value: float) -> float:
@@ -50,6 +52,7 @@ def _check_omega(omega) -> float:
     return om
 
 
+@register
 class LuGre(Hysteresis):
     """LuGre friction (Canudas de Wit et al. 1995), displacement ``x`` in, force ``w`` out.
 
@@ -113,6 +116,12 @@ class LuGre(Hysteresis):
 
     name = "lugre"
     rate_independent = False
+    parameters = (Parameter("sigma0", "N/m", "bristle stiffness sigma0"),
+                  Parameter("sigma1", "N s/m", "bristle damping sigma1", 0.0, "nonnegative"),
+                  Parameter("sigma2", "N s/m", "viscous friction sigma2", 0.0, "nonnegative"),
+                  Parameter("fc", "N", "Coulomb force f_c"),
+                  Parameter("fs", "N", "static (Stribeck) force f_s"),
+                  Parameter("vs", "m/s", "Stribeck velocity v_s"))
     _CACHE_SIZE = 8192
 
     def __init__(self, sigma0: float, sigma1: float, sigma2: float, fc: float, fs: float,
@@ -318,6 +327,12 @@ class LuGre(Hysteresis):
         out[(a == 0), 0] = complex(self.small_amplitude_limit(om))
         return out
 
+    def sine_loop(self, A: float, omega: float | None = None, n_samples: int | None = None
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """One closed period of the exact periodic response (see :meth:`Hysteresis.sine_loop`)."""
+        _, x, w = self.steady_loop(A, omega, n_samples)
+        return np.append(x, x[0]), np.append(w, w[0])
+
     def steady_loop(self, A: float, omega: float, n_samples: int | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """One period of the periodic response to ``x = A sin(theta)``, ``theta = omega t``.
@@ -382,6 +397,11 @@ class LuGre(Hysteresis):
         raise TypeError("the LuGre model is rate-dependent: it cannot be advanced by a "
                         "displacement alone; use response(x, t=...) or describing_function(A, "
                         "omega)")
+
+    def time_stepping(self) -> Stepping:
+        """The elements as the compiled time step advances them (:mod:`.stepping`)."""
+        p = (self.sigma0, self.sigma1, self.sigma2, self.fc, self.fs, self.vs)
+        return Stepping.from_rows([(LUGRE, p)], max(self.fc, self.fs))
 
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""

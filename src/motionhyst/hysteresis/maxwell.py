@@ -13,8 +13,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.jenkins import Jenkins, jenkins_describing_function
+from motionhyst.hysteresis.registry import Parameter, register
+from motionhyst.hysteresis.stepping import STOP, Stepping
 
 
+@register
 class MaxwellSlip(Hysteresis):
     """Parallel Jenkins elements with stiffnesses `k` and slip forces `fc`.
 
@@ -35,6 +38,8 @@ class MaxwellSlip(Hysteresis):
 
     name = "maxwell-slip"
     rate_independent = True
+    parameters = (Parameter("k", "N/m", "spring stiffness k of each element", many=True),
+                  Parameter("fc", "N", "slip force f_c of each element", many=True))
 
     def __init__(self, k: ArrayLike, fc: ArrayLike) -> None:
         super().__init__()
@@ -119,6 +124,12 @@ class MaxwellSlip(Hysteresis):
         share = np.asarray(self.fc) / np.sum(self.fc)
         for el, s in zip(getattr(self, "elements", []), share, strict=False):
             el.reset(w * s)
+
+    def time_stepping(self) -> Stepping:
+        """The elements as the compiled time step advances them (:mod:`.stepping`)."""
+        k, fc = self.stop_parameters()
+        rows = [(STOP, (float(kj), float(fj))) for kj, fj in zip(k, fc, strict=True)]
+        return Stepping.from_rows(rows, float(np.sum(fc)))
 
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""

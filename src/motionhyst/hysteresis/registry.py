@@ -1,0 +1,98 @@
+"""The registry of link models: every model, keyed by the name a scenario uses.
+
+A link model is one file of :mod:`motionhyst.hysteresis`: a subclass of
+:class:`~motionhyst.hysteresis.base.Hysteresis` that declares its ``name``, its
+:class:`Parameter` list and how the compiled time simulation steps it
+(:meth:`~motionhyst.hysteresis.base.Hysteresis.time_stepping`).  Registering
+the class (the :func:`register` decorator) is all that makes it known to the
+scenario schema (``[hysteresis] model = ...``), ``motionhyst df --model``, the
+report and the figures: they take their model lists from :data:`MODELS`.
+
+Examples
+--------
+>>> from motionhyst.hysteresis.registry import MODELS, model_class
+>>> list(MODELS)[:2]
+['jenkins', 'maxwell-slip']
+>>> model_class("jenkins").parameters[0].name
+'k'
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal, TypeVar
+
+if TYPE_CHECKING:
+    from motionhyst.hysteresis.base import Hysteresis
+
+ParameterKind = Literal["positive", "nonnegative", "finite"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of a link model, as scenarios and the CLI spell it.
+
+    Parameters
+    ----------
+    name : str
+        Keyword of the model's constructor, key in the scenario's
+        ``[hysteresis]`` table and ``--name`` option of ``motionhyst df``.
+    unit : str
+        SI unit (``""`` for a pure number).
+    help : str
+        One line for ``--help`` and the documentation.
+    default : float, optional
+        Value when not given; ``None`` makes the parameter required.
+    kind : {"positive", "nonnegative", "finite"}
+        The range a single value must lie in (the model's constructor states
+        any further rule).
+    many : bool
+        A list of values (one per element of a parallel model).
+    """
+
+    name: str
+    unit: str
+    help: str
+    default: float | None = None
+    kind: ParameterKind = "positive"
+    many: bool = False
+
+    @property
+    def required(self) -> bool:
+        """True if the parameter has no default."""
+        return self.default is None
+
+
+MODELS: dict[str, type[Hysteresis]] = {}
+"""Every registered link model, keyed by its ``name`` (in registration order)."""
+
+_H = TypeVar("_H")
+
+
+def register(cls: _H) -> _H:
+    """Class decorator: add a link model to :data:`MODELS` under its ``name``.
+
+    Raises
+    ------
+    ValueError
+        If another class is registered under the same name.
+    """
+    name = cls.name  # type: ignore[attr-defined]
+    if MODELS.get(name, cls) is not cls:
+        raise ValueError(f"a link model named {name!r} is already registered")
+    MODELS[name] = cls  # type: ignore[assignment]
+    return cls
+
+
+def model_class(name: str) -> type[Hysteresis]:
+    """The registered model class of a scenario's ``model = name``.
+
+    Raises
+    ------
+    ValueError
+        One line naming the known models.
+    """
+    try:
+        return MODELS[name]
+    except KeyError:
+        raise ValueError(f"unknown link model {name!r}; known: {', '.join(MODELS)}") from None
