@@ -307,7 +307,8 @@ def default_step(loop: Loop, max_frequency_hz: float) -> float:
                      1.0 / (STEPS_PER_REFERENCE_PERIOD * max_frequency_hz)))
 
 
-def simulate(loop: Loop, reference, duration: float, dt: float | None = None) -> Simulation:
+def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
+             force=None) -> Simulation:
     """Simulate the nonlinear loop from rest.
 
     The linear part is discretised exactly for inputs linear between samples
@@ -332,6 +333,10 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
         Simulated time [s], > 0.
     dt : float, optional
         Output and integration step [s]; by default from :func:`default_step`.
+    force : callable, optional
+        An additional feedforward force [N], ``force(t) -> array`` on the time
+        grid (e.g. one learned by :mod:`motionhyst.ilc`); it is added to the
+        actuator force like the hysteresis feedforward, linear between samples.
 
     Returns
     -------
@@ -381,6 +386,11 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None) ->
         uh = hff.response(r)
     else:  # as the link in the loop: force with the velocity at the sample
         uh = open_loop(*_elements(hff)[:3], r, step, GL_T, GL_W)
+    if force is not None:
+        uf = np.asarray(force(t), dtype=float)
+        if uf.shape != t.shape or not np.all(np.isfinite(uf)):
+            raise ValueError("the feedforward force must give one finite value per time")
+        uh = np.ascontiguousarray(uh + uf)
     e, dev, w, iters = _run(*_discretize(sys_w, omega0 * step), r, e_lin,
                             np.ascontiguousarray(lin[:, 1]), uh, step, codes, params, s0,
                             GL_T, GL_W, 1e-14 * f_scale, MAX_FIXED_POINT_ITERATIONS)

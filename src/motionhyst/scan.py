@@ -1,0 +1,432 @@
+"""Scan metrics of the exact time simulation and compensation compared.
+
+A lithographic scanner grades the servo error of a stage during the
+constant-velocity scan by two moving statistics over the exposure window
+``W`` (slit width / scan speed): the moving average ``MA(t)``, which shifts
+the image (overlay), and the moving standard deviation ``MSD(t)``, which blurs
+it (fading).  Here both are taken on the simulation's output grid over the
+centred window ``|t_k - t| <= W / 2`` (population standard deviation)::
+
+    MA(t)  = mean_k e(t_k),   MSD(t) = sqrt(mean_k (e(t_k) - MA(t))^2)
+
+Their maxima are taken over the constant-velocity phases, at the centres
+whose whole window lies inside the phase (the points a scan exposes).
+
+:func:`run_scan` simulates a setpoint profile (:mod:`motionhyst.profiles`)
+from rest with the loop's dynamic link and compares compensations: ``none``
+(rigid-body feedforward only), ``model`` (the loop's hysteresis feedforward
+``phi_hat(r)``, driven by the setpoint) and ``ilc`` (a force learned over
+trials, :mod:`motionhyst.ilc`); and, on another setpoint, whether the learned
+force and the model carry over.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.ilc import ILCFilters, ILCResult, learn
+from motionhyst.loop import Loop
+from motionhyst.profiles import PHASE_COLORS, Profile, shade_phases
+from motionhyst.simulate import default_step, simulate
+
+COMPENSATIONS = ("none", "model", "ilc")
+"""The compensations :func:`run_scan` compares."""
+
+DEFAULT_SETTLE_TOLERANCE = 1e-9
+"""Error band for the settling time [m]."""
+
+COLORS = {"none": "tab:red", "model": "tab:blue", "ilc": "tab:green"}
+
+
+@njit(cache=True)
+def _window_stats(e, lo, hi):  # pragma: no cover - compiled
+    """Mean and population standard deviation of ``e[lo[k]:hi[k]]`` for each k (two passes)."""
+    n = e.shape[0]
+    ma = np.empty(n)
+    msd = np.empty(n)
+    for k in range(n):
+        s = 0.0
+        for i in range(lo[k], hi[k]):
+            s += e[i]
+        m = hi[k] - lo[k]
+        mean = s / m
+        q = 0.0
+        for i in range(lo[k], hi[k]):
+            d = e[i] - mean
+            q += d * d
+        ma[k] = mean
+        msd[k] = math.sqrt(q / m)
+    return ma, msd
+
+
+def _window_bounds(t: NDArray[np.float64], window: float):
+    """Index ranges ``[lo, hi)`` of the samples with ``|t_k - t| <= window / 2``."""
+    half = 0.5 * window
+    slack = 1e-9 * (t[-1] - t[0]) / max(len(t) - 1, 1)  # a sample exactly at the edge counts
+    lo = np.searchsorted(t, t - half - slack, side="left")
+    hi = np.searchsorted(t, t + half + slack, side="right")
+    return lo.astype(np.int64), hi.astype(np.int64)
+
+
+def moving_statistics(t: ArrayLike, e: ArrayLike,
+                      window: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Moving average and moving standard deviation of `e` over a centred `window`.
+
+    Parameters
+    ----------
+    t : array_like
+        Increasing sample times [s].
+    e : array_like
+        The signal (the tracking error) [m].
+    window : float
+        Window length ``W`` [s], > 0: each value uses the samples with
+        ``|t_k - t| <= W / 2`` (fewer at the ends of the record).
+
+    Returns
+    -------
+    ma, msd : ndarray
+        Mean and population standard deviation at each sample time.
+
+    Examples
+    --------
+    >>> t = [0.0, 1.0, 2.0, 3.0, 4.0]
+    >>> ma, msd = moving_statistics(t, [0.0, 0.0, 3.0, 0.0, 0.0], window=2.0)
+    >>> ma.tolist(), [round(float(x), 4) for x in msd]
+    ([0.0, 1.0, 1.0, 1.0, 0.0], [0.0, 1.4142, 1.4142, 1.4142, 0.0])
+    """
+    t = np.asarray(t, dtype=float)
+    e = np.ascontiguousarray(e, dtype=float)
+    if t.ndim != 1 or t.shape != e.shape or t.size == 0:
+        raise ValueError("time and signal must be one-dimensional and of equal length")
+    if not (math.isfinite(window) and window > 0):
+        raise ValueError(f"window must be finite and > 0 s, got {window!r}")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("time must be strictly increasing")
+    lo, hi = _window_bounds(t, window)
+    return _window_stats(e, lo, hi)
+
+
+def settling_time(t: NDArray[np.float64], e: NDArray[np.float64], start: float, end: float,
+                  tolerance: float) -> float | None:
+    """Time from `start` after which ``|e| <= tolerance`` until `end` [s]; None if never.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 1.0, 11)
+    >>> settling_time(t, np.exp(-5 * t), 0.0, 1.0, 0.1)
+    0.5
+    """
+    sel = (t >= start) & (t <= end)
+    tt, out = t[sel], np.abs(e[sel]) > tolerance
+    if tt.size == 0 or out[-1]:
+        return None
+    if not out.any():
+        return 0.0
+    return float(tt[np.nonzero(out)[0][-1] + 1] - start)
+
+
+@dataclass
+class ScanRun:
+    """The error of one run and its scan metrics.
+
+    Attributes
+    ----------
+    compensation : str
+        ``"none"``, ``"model"`` or ``"ilc"`` (``"without link"`` for the loop
+        without its dynamic link).
+    t, e, ma, msd : ndarray
+        Time [s], error, its moving average and moving standard deviation [m].
+    ma_max, msd_max : float or None
+        Largest ``|MA|`` and ``MSD`` over the constant-velocity phases [m]
+        (None when no window fits in one).
+    peak_error : float
+        Largest ``|e|`` over the run [m].
+    settling_time_s : float or None
+        For a scan, the longest time from the start of a constant-velocity
+        phase until ``|e|`` stays within the tolerance to its end; for a
+        point-to-point move, from the end of the move to the end of the run.
+        None if the error does not settle.
+    """
+
+    compensation: str
+    t: NDArray[np.float64] = field(repr=False)
+    e: NDArray[np.float64] = field(repr=False)
+    ma: NDArray[np.float64] = field(repr=False)
+    msd: NDArray[np.float64] = field(repr=False)
+    ma_max: float | None
+    msd_max: float | None
+    peak_error: float
+    settling_time_s: float | None
+
+    def to_dict(self) -> dict:
+        """The run's metrics (JSON keys spelled here)."""
+        return {"compensation": self.compensation, "ma_max": self.ma_max,
+                "msd_max": self.msd_max, "peak_error": self.peak_error,
+                "settling_time_s": self.settling_time_s}
+
+
+def scan_metrics(t: NDArray[np.float64], e: NDArray[np.float64], profile: Profile,
+                 window: float, compensation: str = "none",
+                 settle_tolerance: float = DEFAULT_SETTLE_TOLERANCE) -> ScanRun:
+    """MA, MSD, their maxima over the constant-velocity phases, peak error, settling time.
+
+    See :class:`ScanRun` for the definitions.
+    """
+    t = np.asarray(t, dtype=float)
+    e = np.asarray(e, dtype=float)
+    ma, msd = moving_statistics(t, e, window)
+    inside = np.zeros(t.shape, dtype=bool)
+    for ph in profile.constant_velocity_phases():
+        inside |= (t - 0.5 * window >= ph.start - 1e-12) & (t + 0.5 * window <= ph.end + 1e-12)
+    ma_max = float(np.max(np.abs(ma[inside]))) if inside.any() else None
+    msd_max = float(np.max(msd[inside])) if inside.any() else None
+    if profile.kind == "scan":
+        times = [settling_time(t, e, ph.start, ph.end, settle_tolerance)
+                 for ph in profile.constant_velocity_phases()]
+        settle = None if any(x is None for x in times) else max(times)
+    else:
+        settle = settling_time(t, e, profile.end, t[-1], settle_tolerance)
+    return ScanRun(compensation, t, e, ma, msd, ma_max, msd_max, float(np.max(np.abs(e))),
+                   settle)
+
+
+@dataclass
+class ScanResult:
+    """Result of :func:`run_scan`: the runs of each compensation on one setpoint.
+
+    Attributes
+    ----------
+    profile : Profile
+        The setpoint.
+    window : float
+        Exposure window ``W`` [s].
+    settle_tolerance : float
+        Error band of the settling time [m].
+    r : ndarray
+        The setpoint on the runs' time grid [m].
+    runs : list of ScanRun
+        One per compensation, in the order asked.
+    without_link : ScanRun
+        The loop without its dynamic link (and without hysteresis feedforward).
+    ilc : ILCResult or None
+        The learning's trials, if ``ilc`` was asked.
+    carry_over : ScanResult or None
+        Another setpoint with the model and the force learned on this one.
+    """
+
+    profile: Profile
+    window: float
+    settle_tolerance: float
+    r: NDArray[np.float64] = field(repr=False)
+    runs: list[ScanRun]
+    without_link: ScanRun
+    ilc: ILCResult | None = None
+    carry_over: ScanResult | None = None
+
+    @property
+    def t(self) -> NDArray[np.float64]:
+        """Time grid [s]."""
+        return self.without_link.t
+
+    def run(self, compensation: str) -> ScanRun:
+        """The run of one compensation."""
+        for r in self.runs:
+            if r.compensation == compensation:
+                return r
+        raise KeyError(compensation)
+
+    def to_dict(self) -> dict:
+        """Window, profile, results, without link, ILC trials, carry-over (JSON keys here)."""
+        d = {"window_s": self.window, "settle_tolerance": self.settle_tolerance,
+             "profile": self.profile.to_dict(), "results": [r.to_dict() for r in self.runs],
+             "without_link": {k: v for k, v in self.without_link.to_dict().items()
+                              if k != "compensation"}}
+        if self.ilc is not None:
+            d["ilc"] = self.ilc.to_dict()
+        if self.carry_over is not None:
+            c = self.carry_over
+            d["carry_over"] = {"profile": c.profile.to_dict(),
+                               "results": [r.to_dict() for r in c.runs]}
+        return d
+
+    def columns(self) -> dict[str, NDArray[np.float64]]:
+        """Time series by CSV column: ``time, r, scan``, then ``e_c, ma_c, msd_c`` per run."""
+        t = self.t
+        in_scan = np.zeros(t.shape)
+        for ph in self.profile.constant_velocity_phases():
+            in_scan[(t >= ph.start) & (t <= ph.end)] = 1.0
+        cols = {"time": t, "r": self.r, "scan": in_scan}
+        for run in self.runs:
+            cols.update({f"e_{run.compensation}": run.e, f"ma_{run.compensation}": run.ma,
+                         f"msd_{run.compensation}": run.msd})
+        return cols
+
+    def _table(self) -> list[str]:
+        def fmt(x, scale=1.0):
+            return "-" if x is None else f"{x * scale:.4g}"
+
+        head = (f"  {'compensation':<14}{'max |MA| [m]':>14}{'max MSD [m]':>14}"
+                f"{'peak |e| [m]':>14}{'settling [s]':>14}")
+        lines = [head]
+        for r in [*self.runs, self.without_link]:
+            lines.append(f"  {r.compensation:<14}{fmt(r.ma_max):>14}{fmt(r.msd_max):>14}"
+                         f"{fmt(r.peak_error):>14}{fmt(r.settling_time_s):>14}")
+        return lines
+
+    def __str__(self) -> str:
+        out = [f"{self.profile}", f"exposure window {self.window:g} s, settling band "
+               f"{self.settle_tolerance:g} m", *self._table()]
+        if self.ilc is not None:
+            out.append(str(self.ilc))
+        if self.carry_over is not None:
+            out += ["carried over to another setpoint (model and learned force unchanged):",
+                    f"{self.carry_over.profile}", *self.carry_over._table()[:-1]]
+        return "\n".join(out)
+
+    def plot(self, unit: float = 1e-9, unit_name: str = "nm"):
+        """Figure of ``e``, ``MA`` and ``MSD`` against time, the profile's phases shaded."""
+        from matplotlib.figure import Figure
+        from matplotlib.patches import Patch
+
+        fig = Figure(figsize=(7.2, 6.4), layout="constrained")
+        axes = fig.subplots(3, 1, sharex=True)
+        for ax, name in zip(axes, ("e", "ma", "msd"), strict=True):
+            ref = getattr(self.without_link, name)
+            ax.plot(self.t, ref / unit, color="0.5", lw=0.9, ls="--", label="without link")
+            for r in self.runs:
+                ax.plot(r.t, getattr(r, name) / unit, color=COLORS.get(r.compensation),
+                        lw=1.1, label=f"link, {r.compensation}")
+            shade_phases(ax, self.profile)
+            ax.grid(True, alpha=0.3)
+        axes[0].set_ylabel(f"error e [{unit_name}]")
+        axes[1].set_ylabel(f"MA [{unit_name}]")
+        axes[2].set_ylabel(f"MSD [{unit_name}]")
+        axes[2].set_xlabel("time [s]")
+        handles, labels = axes[0].get_legend_handles_labels()
+        handles += [Patch(color=c, alpha=0.15) for c in PHASE_COLORS.values()]
+        labels += list(PHASE_COLORS)
+        axes[0].legend(handles, labels, ncol=4, fontsize=7, loc="upper right")
+        axes[0].set_title(f"{self.profile}\nexposure window W = {self.window * 1e3:g} ms",
+                          fontsize=8)
+        return fig
+
+
+def _without_hysteresis_feedforward(loop: Loop) -> Loop:
+    if loop.hysteresis_feedforward is None:
+        return loop
+    return Loop(loop.plant, loop.controller, loop.hysteresis, feedforward=loop.feedforward,
+                mass=loop.M)
+
+
+def run_scan(loop: Loop, profile: Profile, window: float,
+             compensations: tuple[str, ...] | list[str] = ("none",), ilc_trials: int = 10,
+             ilc_filters: ILCFilters | None = None, other_profile: Profile | None = None,
+             settle_tolerance: float = DEFAULT_SETTLE_TOLERANCE, tail: float = 0.05,
+             dt: float | None = None) -> ScanResult:
+    """Simulate `profile` from rest with each compensation and grade the scans.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its dynamic link; for ``model`` its
+        ``hysteresis_feedforward`` (a scenario's ``[feedforward] hysteresis``).
+    profile : Profile
+        The setpoint.
+    window : float
+        Exposure window ``W`` [s] of MA and MSD.
+    compensations : sequence of {"none", "model", "ilc"}
+        Which to run, in this order.
+    ilc_trials : int
+        Trials of the learning (the last is the ``ilc`` run).
+    ilc_filters : ILCFilters, optional
+        Learning and robustness filters.
+    other_profile : Profile, optional
+        Another setpoint: run without compensation, with the model (if asked)
+        and with the force learned on `profile` (if ``ilc`` was asked),
+        unchanged.
+    settle_tolerance : float
+        Error band of the settling time [m].
+    tail : float
+        Time simulated after the end of the profile [s].
+    dt : float, optional
+        Time step [s]; by default the simulation's own.
+
+    Returns
+    -------
+    ScanResult
+
+    Raises
+    ------
+    ValueError
+        For an unknown or repeated compensation, ``model`` on a loop without
+        hysteresis feedforward, or a scan whose constant-velocity phases are
+        all shorter than the window.
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage
+    >>> from motionhyst.profiles import scan
+    >>> loop = Loop(TwoMassStage(5.0, 17.5, 90.0, 7.4e7), LeadLagLowpass(6.2e6, 60, 240, 700, 0.6),
+    ...             Jenkins(20.0, 0.05))
+    >>> p = scan(0.01, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)
+    >>> res = run_scan(loop, p, window=0.02, tail=0.0)
+    >>> round(res.run("none").ma_max / (0.05 / 6.2e6), 2)   # slipping link: e = fc / C(0)
+    1.0
+    """
+    comps = list(compensations)
+    for c in comps:
+        if c not in COMPENSATIONS:
+            raise ValueError(f"unknown compensation {c!r}; use {', '.join(COMPENSATIONS)}")
+    if len(set(comps)) != len(comps) or not comps:
+        raise ValueError("give each compensation once, at least one")
+    if "model" in comps and loop.hysteresis_feedforward is None:
+        raise ValueError("compensation 'model' needs a hysteresis feedforward model "
+                         "(a scenario's [feedforward] hysteresis)")
+    if not (math.isfinite(window) and window > 0):
+        raise ValueError(f"window must be finite and > 0 s, got {window!r}")
+    if not (math.isfinite(settle_tolerance) and settle_tolerance > 0):
+        raise ValueError(f"settling tolerance must be finite and > 0 m, got {settle_tolerance!r}")
+    if not (math.isfinite(tail) and tail >= 0):
+        raise ValueError(f"tail must be finite and >= 0 s, got {tail!r}")
+    for p in (profile, other_profile):
+        if p is not None and p.kind == "scan" and not any(
+                ph.duration >= window for ph in p.constant_velocity_phases()):
+            raise ValueError(f"the exposure window ({window:g} s) is longer than the scan "
+                             f"({p.constant_velocity_phases()[0].duration:g} s at constant "
+                             "velocity)")
+    bare = _without_hysteresis_feedforward(loop)
+    result = _runs(loop, bare, profile, window, comps, ilc_trials, ilc_filters,
+                   settle_tolerance, tail, dt, None)
+    if other_profile is not None:
+        learned = result.ilc.force_function() if result.ilc is not None else None
+        result.carry_over = _runs(loop, bare, other_profile, window,
+                                  [c for c in comps if c != "ilc" or learned is not None],
+                                  ilc_trials, ilc_filters, settle_tolerance, tail, None, learned)
+    return result
+
+
+def _runs(loop, bare, profile, window, comps, ilc_trials, ilc_filters, tol, tail, dt,
+          learned) -> ScanResult:
+    """The runs of one setpoint; with `learned` the ``ilc`` run replays that force."""
+    duration = profile.end + tail
+    step = default_step(loop, profile.max_frequency_hz) if dt is None else dt
+    none = simulate(bare, profile, duration, step)
+    runs, ilc = [], None
+    for c in comps:
+        if c == "none":
+            sim = none
+        elif c == "model":
+            sim = simulate(loop, profile, duration, step)
+        elif learned is not None:
+            sim = simulate(bare, profile, duration, step, force=learned)
+        else:
+            ilc = learn(bare, profile, duration, ilc_trials, ilc_filters, step, first=none)
+            sim = ilc.last
+        runs.append(scan_metrics(sim.t, sim.e, profile, window, c, tol))
+    without = scan_metrics(none.t, none.e_linear, profile, window, "without link", tol)
+    return ScanResult(profile, window, tol, none.r, runs, without, ilc)

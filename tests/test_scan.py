@@ -1,0 +1,164 @@
+"""Tests of the scan metrics and the compensations compared (scan.py)."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+from conftest import FC_LINK, K_LINK
+from numpy.testing import assert_allclose
+
+from motionhyst.hysteresis import Jenkins
+from motionhyst.loop import Loop
+from motionhyst.profiles import point_to_point, scan
+from motionhyst.scan import moving_statistics, run_scan, scan_metrics, settling_time
+
+# a gentle scan whose error the link dominates: the link slips during the acceleration
+# (3 mm > fc / kJ = 2.5 mm) and takes 5 mm to reverse, within the return scan
+GENTLE = dict(speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3)
+
+
+def brute(t, e, window):
+    ma, msd = np.empty_like(e), np.empty_like(e)
+    for k, tk in enumerate(t):
+        sel = np.abs(t - tk) <= window / 2 * (1 + 1e-12)
+        ma[k], msd[k] = np.mean(e[sel]), np.std(e[sel])  # population std (ddof = 0)
+    return ma, msd
+
+
+@pytest.mark.parametrize("uniform", [True, False])
+def test_moving_statistics_are_centred_window_mean_and_population_std(uniform):
+    rng = np.random.default_rng(4)
+    t = np.linspace(0, 1, 501) if uniform else np.sort(rng.uniform(0, 1, 400))
+    e = 1e-8 * (1 + rng.standard_normal(t.size))  # a large mean: the two-pass std is exact
+    ma, msd = moving_statistics(t, e, 0.05)
+    ma_b, msd_b = brute(t, e, 0.05)
+    assert_allclose(ma, ma_b, rtol=1e-13)
+    assert_allclose(msd, msd_b, rtol=1e-12)
+    # a constant signal has zero MSD, exactly
+    assert np.max(moving_statistics(t, np.full(t.size, 3e-9), 0.1)[1]) < 1e-14 * 3e-9
+
+
+def test_moving_statistics_window_includes_samples_on_its_edges():
+    t = np.arange(7) * 0.1
+    ma, _ = moving_statistics(t, [0, 0, 0, 7.0, 0, 0, 0], 0.2)  # 3 samples each
+    assert_allclose(ma, [0, 0, 7 / 3, 7 / 3, 7 / 3, 0, 0], rtol=1e-15)
+
+
+@pytest.mark.parametrize(("t", "e", "w"), [([0, 1], [0.0], 1.0), ([0, 1], [0, 1], 0.0),
+                                           ([0, 1], [0, 1], np.nan), ([1, 0], [0, 1], 1.0)])
+def test_moving_statistics_invalid(t, e, w):
+    with pytest.raises(ValueError):
+        moving_statistics(t, e, w)
+
+
+def test_settling_time():
+    t = np.linspace(0, 1, 101)
+    e = np.where(t < 0.3, 1.0, 0.0)
+    assert settling_time(t, e, 0.1, 1.0, 0.5) == pytest.approx(0.2)
+    assert settling_time(t, e, 0.5, 1.0, 0.5) == 0.0
+    assert settling_time(t, np.ones_like(t), 0.0, 1.0, 0.5) is None
+
+
+def test_slipping_link_at_constant_velocity_leaves_fc_over_c0(loop):
+    # paper eq. (3): a slipping Jenkins element is a constant force +-fc; at constant
+    # velocity the rigid-body feedforward is exact and the loop's DC gain from w to e is
+    # P2 / (1 + C P2) -> 1 / C(0) (no integrator), so e = fc / C(0), and -fc / C(0) back
+    p = scan(0.02, back_and_forth=True, start=0.01, **GENTLE)
+    res = run_scan(loop, p, window=0.05, tail=0.0)
+    e_slip = FC_LINK / control.dcgain(loop.controller)
+    run = res.run("none")
+    for ph, sign in zip(p.constant_velocity_phases(), (1, -1), strict=True):
+        late = (run.t > ph.end - 0.1) & (run.t <= ph.end)
+        assert_allclose(run.e[late], sign * e_slip, rtol=1e-6)
+        assert np.max(np.abs(res.without_link.e[late])) < 1e-6 * e_slip
+    assert run.ma_max == pytest.approx(e_slip, rel=1e-3)
+    # the return scan starts with the link stuck: its force ramps through 2 fc over
+    # 2 fc / kJ = 5 mm, part of it in the scan, and the MSD shows it
+    assert 2 * FC_LINK / K_LINK == pytest.approx(0.005)
+    assert run.msd_max > 50 * res.without_link.msd_max
+    assert run.peak_error >= run.ma_max and run.settling_time_s is None
+
+
+def test_exact_model_removes_the_link_and_a_mis_estimated_one_most_of_it(stage, controller):
+    def loop_with(model):
+        return Loop(stage, controller, Jenkins(K_LINK, FC_LINK), hysteresis_feedforward=model)
+
+    p = scan(0.02, back_and_forth=True, start=0.01, **GENTLE)
+    exact = run_scan(loop_with(Jenkins(K_LINK, FC_LINK)), p, 0.05, ("none", "model"), tail=0.0)
+    model, lin = exact.run("model"), exact.without_link
+    # phi_hat(r) against phi(y1): equal but for y1 - r (nm), so the error is the linear one
+    assert np.max(np.abs(model.e - lin.e)) < 1e-4 * exact.run("none").peak_error
+    # 4 % too large a force (k and fc): 4 % of the link's error is left, 25x less
+    off = run_scan(loop_with(Jenkins(1.04 * K_LINK, 1.04 * FC_LINK)), p, 0.05,
+                   ("none", "model"), tail=0.0)
+    none, model = off.run("none"), off.run("model")
+    assert none.ma_max / model.ma_max == pytest.approx(25, rel=0.05)
+    assert none.msd_max / model.msd_max > 15
+
+
+def test_carry_over_to_another_speed(stage, controller):
+    loop = Loop(stage, controller, Jenkins(K_LINK, FC_LINK),
+                hysteresis_feedforward=Jenkins(K_LINK, FC_LINK))
+    p = point_to_point(0.01, 0.05, 2.0, 50.0, 1e3, start=0.01)
+    other = point_to_point(0.01, 0.035, 2.0, 50.0, 1e3, start=0.01)
+    res = run_scan(loop, p, 0.02, ("none", "model", "ilc"), ilc_trials=3, other_profile=other)
+    co = res.carry_over
+    assert [r.compensation for r in co.runs] == ["none", "model", "ilc"]
+    # the learned force, a function of time, fits its own setpoint only; the model
+    # (a function of position) fits both
+    def link_part(r, run):  # the error the link causes: what the loop without it lacks
+        return np.max(np.abs(r.run(run).e - r.without_link.e))
+
+    assert res.run("ilc").peak_error < res.run("none").peak_error / 10
+    assert link_part(co, "model") < 1e-3 * link_part(co, "none")
+    # measured: the replayed force leaves 23 % of the link's error, 100x its own setpoint's
+    assert link_part(co, "ilc") > 0.1 * link_part(co, "none")
+    assert co.run("ilc").peak_error > 10 * res.run("ilc").peak_error
+    d = res.to_dict()
+    assert [r["compensation"] for r in d["carry_over"]["results"]] == ["none", "model", "ilc"]
+    assert d["carry_over"]["profile"]["v_max"] == 0.035
+
+
+def test_result_outputs(loop):
+    p = scan(0.005, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)
+    res = run_scan(loop, p, 0.02, ("none", "ilc"), ilc_trials=2, tail=0.01)
+    d = res.to_dict()
+    assert set(d) == {"window_s", "settle_tolerance", "profile", "results", "without_link",
+                      "ilc"}
+    assert d["window_s"] == 0.02 and len(d["ilc"]["trials"]) == 2
+    for r in d["results"]:
+        assert set(r) == {"compensation", "ma_max", "msd_max", "peak_error", "settling_time_s"}
+    cols = res.columns()
+    assert list(cols) == ["time", "r", "scan", "e_none", "ma_none", "msd_none", "e_ilc",
+                          "ma_ilc", "msd_ilc"]
+    cv = p.constant_velocity_phases()[0]
+    assert np.all(cols["scan"][(cols["time"] > cv.start) & (cols["time"] < cv.end)] == 1)
+    assert np.all(cols["scan"][cols["time"] < cv.start - 1e-9] == 0)
+    text = str(res)
+    assert "ilc" in text and "without link" in text and "ILC, 2 trials" in text
+    fig = res.plot()
+    assert len(fig.axes) == 3
+
+
+def test_metrics_of_a_point_to_point_move_settle_after_the_move(loop):
+    p = point_to_point(0.01, 0.05, 2.0, 50.0, 1e3, start=0.01)
+    sim_t = np.linspace(0, p.end + 0.1, 2001)
+    e = np.where(sim_t < p.end + 0.02, 1e-8, 1e-10)
+    run = scan_metrics(sim_t, e, p, 0.02, "none", settle_tolerance=1e-9)
+    assert run.settling_time_s == pytest.approx(0.02, abs=sim_t[1] - sim_t[0])
+    assert run.ma_max == pytest.approx(1e-8)
+
+
+def test_invalid_requests(loop):
+    p = scan(0.005, start=0.0, **GENTLE)
+    with pytest.raises(ValueError, match="model"):
+        run_scan(loop, p, 0.02, ("none", "model"))
+    with pytest.raises(ValueError, match="unknown compensation"):
+        run_scan(loop, p, 0.02, ("feedback",))
+    with pytest.raises(ValueError, match="once"):
+        run_scan(loop, p, 0.02, ("none", "none"))
+    with pytest.raises(ValueError, match="window"):
+        run_scan(loop, p, 0.2)
+    with pytest.raises(ValueError, match="tolerance"):
+        run_scan(loop, p, 0.02, settle_tolerance=0.0)
