@@ -228,7 +228,7 @@ def test_df_usage_errors_are_one_line(capsys, args, fragments):
 def simulate_points():
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
-        rc = main(["simulate", "--json"])
+        rc = main(["steady", "--json"])
     assert rc == 0
     return json.loads(buf.getvalue(), parse_constant=_reject_constant)["points"]
 
@@ -249,8 +249,15 @@ def test_simulate_json_has_error_harmonics_df(simulate_points):
                                              rel=1e-9)
 
 
-def test_simulate_text_shows_hosidf_columns(capsys):
-    rc, out, err = run(capsys, "simulate", "--frequency", "5")
+def test_simulate_without_time_series_is_steady_and_says_so(capsys):
+    rc, out, err = run(capsys, "simulate", "--frequency", "5", "--json")
+    rc2, out2, err2 = run(capsys, "steady", "--frequency", "5", "--json")
+    assert rc == rc2 == 0 and out == out2 and err2 == ""
+    assert err.count("\n") == 1 and "motionhyst steady" in err
+
+
+def test_steady_text_shows_hosidf_columns(capsys):
+    rc, out, err = run(capsys, "steady", "--frequency", "5")
     assert rc == 0 and err == ""
     assert "|e3| HOSIDF" in out and "|e5| HOSIDF" in out
 
@@ -264,10 +271,10 @@ def test_simulate_maxwell_scenario_with_feedforward(capsys, tmp_path):
                                     'fc = [0.01, 0.03, 0.06] }\n\n[reference]'))
     path = tmp_path / "maxwell_ff.toml"
     path.write_text(text)
-    with_ff = run_json(capsys, "simulate", str(path), "--frequency", "5", "--json")["points"][0]
+    with_ff = run_json(capsys, "steady", str(path), "--frequency", "5", "--json")["points"][0]
     path.write_text(text.replace('hysteresis = { model = "maxwell-slip", k = [8, 6, 4], '
                                  'fc = [0.01, 0.03, 0.06] }', ""))
-    without = run_json(capsys, "simulate", str(path), "--frequency", "5", "--json")["points"][0]
+    without = run_json(capsys, "steady", str(path), "--frequency", "5", "--json")["points"][0]
     assert without["error_hysteresis_rms"] / with_ff["error_hysteresis_rms"] > 1000
     assert with_ff["mismatch_simulated_abs"] == pytest.approx(1.0, abs=2e-3)
     assert with_ff["mismatch_df_abs"] == pytest.approx(1.0, abs=5e-3)
@@ -304,7 +311,7 @@ def test_analyze_and_simulate_accept_every_link_model(capsys, tmp_path, name):
     assert 7.0 < a["mismatch_crossover_hz"] < 8.2
     assert a["mismatch_crossover_exact_hz"] == pytest.approx(a["mismatch_crossover_hz"],
                                                              rel=0.01)
-    s = run_json(capsys, "simulate", str(path), "--frequency", "5", "10", "--json")
+    s = run_json(capsys, "steady", str(path), "--frequency", "5", "10", "--json")
     for p, q in zip(s["points"], a["mismatch"], strict=True):
         # the describing function's claim (paper section V) holds for these links too
         assert p["mismatch_simulated_abs"] == pytest.approx(p["mismatch_df_abs"], rel=0.01)

@@ -11,11 +11,12 @@ import warnings
 import numpy as np
 import pytest
 
+from motionhyst.comparison import compare_with_describing_function
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import error_harmonics_df
 from motionhyst.scenario import default_scenario
-from motionhyst.steady import compare_with_describing_function, periodic_steady_state
+from motionhyst.steady import periodic_steady_state
 
 K_J, FC = 20.0, 0.05  # Table I
 N_MAX = 15
@@ -222,7 +223,7 @@ def test_even_error_harmonics(exact_and_df, f):
 
 
 def test_steady_to_dict_reports_error_harmonics_df(table1_loop, exact_and_df):
-    points = compare_with_describing_function(table1_loop, A_REF, [5.0])
+    points = compare_with_describing_function(table1_loop, A_REF, [5.0]).to_dict()["points"]
     p = points[0]
     edf = exact_and_df[5.0][1]
     assert [h["n"] for h in p["error_harmonics_df"]] == [1, 3, 5]

@@ -269,7 +269,7 @@ def test_fig10_mismatch(loop, analysis, states):
     assert_allclose(data["E_exact"], [abs(s.mismatch) for s in states], rtol=1e-14)
     # the asymptote crosses 1 at eq. (21)
     i = np.argmin(np.abs(np.log(np.abs(Et))))
-    assert f[i] == pytest.approx(analysis.crossover_hz, rel=0.01)
+    assert f[i] == pytest.approx(analysis.mismatch_crossover_hz, rel=0.01)
     # without exact points no markers
     assert "E_exact" not in plots.fig10_mismatch(loop, analysis).motionhyst_data
 

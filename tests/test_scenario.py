@@ -147,7 +147,7 @@ def test_default_scenario_analysis_numbers():
     assert abs(res.D) / res.k_link == pytest.approx(0.309, abs=5e-4)
     assert math.degrees(np.angle(res.D)) == pytest.approx(50.7, abs=0.05)
     assert res.f_star_hz == pytest.approx(0.150, abs=5e-4)
-    assert res.crossover_hz == pytest.approx(7.6, abs=0.05)
+    assert res.mismatch_crossover_hz == pytest.approx(7.6, abs=0.05)
     assert res.bandwidth_hz == pytest.approx(120.6, abs=0.1)
     assert [p.frequency_hz for p in res.points] == [5.0, 10.0, 15.0]
 
@@ -471,9 +471,9 @@ def test_frd_plant_loads_relative_to_toml_folder(tmp_path, monkeypatch, two_mass
     assert res.zeta == pytest.approx(0.25)
     assert res.f_star_hz == pytest.approx(two_mass_analysis.f_star_hz, rel=1e-6)
     assert res.bandwidth_hz == pytest.approx(two_mass_analysis.bandwidth_hz, rel=1e-6)
-    assert res.crossover_exact_hz == pytest.approx(two_mass_analysis.crossover_exact_hz,
-                                                   rel=1e-3)
-    assert math.isnan(res.crossover_hz)  # eq. (21) needs the two-mass parameters
+    assert res.mismatch_crossover_exact_hz == pytest.approx(
+        two_mass_analysis.mismatch_crossover_exact_hz, rel=1e-3)
+    assert math.isnan(res.mismatch_crossover_hz)  # eq. (21) needs the two-mass parameters
     for p, q in zip(res.points, two_mass_analysis.points, strict=True):
         assert abs(p.value - q.value) <= 1e-2 * abs(q.value), p.frequency_hz
 

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from motionhyst.comparison import compare_with_describing_function
 from motionhyst.hysteresis.jenkins import Jenkins
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import loop_mismatch
 from motionhyst.scenario import default_scenario
 from motionhyst.steady import (
-    compare_with_describing_function,
     default_harmonics,
     periodic_steady_state,
     steady_state_sweep,
@@ -240,7 +240,7 @@ def test_sweep_and_compare(loop, states):
     sweep = steady_state_sweep(loop, A_REF, list(FREQS))
     for ss in sweep:
         assert ss.e[1] == pytest.approx(states[ss.frequency_hz].e[1], rel=1e-14)
-    rows = compare_with_describing_function(loop, A_REF, FREQS)
+    rows = compare_with_describing_function(loop, A_REF, FREQS).to_dict()["points"]
     E_df = loop_mismatch(loop, np.array(FREQS), A_REF)
     assert [r["frequency_hz"] for r in rows] == list(FREQS)
     for row, e in zip(rows, E_df, strict=True):

@@ -10,6 +10,7 @@ and its low-frequency asymptote (eq. 20), with the characteristic frequencies
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,6 +19,7 @@ from scipy.optimize import brentq
 
 from motionhyst.loop import Loop
 from motionhyst.systems import TWO_PI, TwoMassStage, freqresp
+from motionhyst.textfmt import g, table
 
 
 def quasi_linear_plant(P1: ArrayLike, P2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
@@ -62,7 +64,7 @@ def f_star(k: float, M: float) -> float:
     return float(np.sqrt(k / M) / TWO_PI)
 
 
-def mismatch_crossover_estimate(k: float, m1: float, m2: float, D_abs: float) -> float:
+def mismatch_crossover(k: float, m1: float, m2: float, D_abs: float) -> float:
     """Crossover ``|E~| = 1`` of the asymptote, ``(k |D| / (m1 m2))^(1/4) / (2 pi)`` [Hz], eq. (21).
 
     `k` is the stage's internal stiffness, not the link's.
@@ -108,11 +110,11 @@ class QuasiLinearAnalysis:
         Eq. (13) [Hz].
     bandwidth_hz : float
         First 0 dB crossing of ``C P2`` [Hz].
-    crossover_hz : float
+    mismatch_crossover_hz : float
         Eq. (21) [Hz] (nan without a two-mass model).
-    crossover_exact_hz : float
+    mismatch_crossover_exact_hz : float
         Lowest frequency where ``|E - 1|`` of eq. (18) falls to 1 [Hz]
-        (see :func:`mismatch_crossover`).
+        (see :func:`mismatch_crossover_exact`).
     points : list of MismatchPoint
         The mismatch at the requested frequencies.
     amplitude_mode : str
@@ -127,8 +129,8 @@ class QuasiLinearAnalysis:
     k_link: float
     f_star_hz: float
     bandwidth_hz: float
-    crossover_hz: float
-    crossover_exact_hz: float
+    mismatch_crossover_hz: float
+    mismatch_crossover_exact_hz: float
     points: list[MismatchPoint] = field(default_factory=list)
     amplitude_mode: str = "reference"
     df_frequency_hz: float | None = None
@@ -146,10 +148,43 @@ class QuasiLinearAnalysis:
             "df_frequency_hz": self.df_frequency_hz,
             "f_star_hz": self.f_star_hz,
             "bandwidth_hz": self.bandwidth_hz,
-            "mismatch_crossover_hz": self.crossover_hz,
-            "mismatch_crossover_exact_hz": self.crossover_exact_hz,
+            "mismatch_crossover_hz": self.mismatch_crossover_hz,
+            "mismatch_crossover_exact_hz": self.mismatch_crossover_exact_hz,
             "mismatch": [p.to_dict() for p in self.points],
         }
+
+    def __str__(self) -> str:
+        d = self.to_dict()
+        has_zeta = self.zeta is not None and math.isfinite(self.zeta)
+        lines = [f"  reference amplitude A_r        {g(self.amplitude)} m"]
+        if has_zeta:
+            lines.append(f"  zeta = fc/(k A)  (eq. 4)       {g(self.zeta)}")
+        at = "" if self.df_frequency_hz is None else f" at {g(self.df_frequency_hz)} Hz"
+        label = f"|D|/k, angle D  ({'eq. 10' if has_zeta else 'eq. 7'})"
+        lines += [f"  {label:<31}{g(d['df_abs_over_k'])}, {d['df_phase_deg']:.2f} deg{at}",
+                  f"  f*  (eq. 13)                   {g(self.f_star_hz)} Hz",
+                  f"  bandwidth (|C P2| = 1)         {g(self.bandwidth_hz)} Hz",
+                  f"  mismatch crossover (eq. 21)    {g(self.mismatch_crossover_hz)} Hz",
+                  f"  exact crossover |E - 1| = 1    {g(self.mismatch_crossover_exact_hz)} Hz",
+                  ""]
+        rows = [[g(p["frequency_hz"]), g(p["abs"]), f"{20 * math.log10(p['abs']):.2f}",
+                 f"{p['phase_deg']:.2f}", g(p["asymptote_abs"]), g(p["y1_amplitude"])]
+                for p in d["mismatch"]]
+        lines.append(table(["f [Hz]", "|E| [-]", "|E| [dB]", "angle E [deg]", "|E~| (eq. 20)",
+                            "A_y1 [m]"], rows))
+        return "\n".join(lines)
+
+    def plot(self):
+        """The mismatch ``|E|`` (eq. 18) and its asymptote (eq. 20) at the analysed
+        frequencies, with the crossovers (:func:`motionhyst.plots.plot_analysis`).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.plots import plot_analysis
+
+        return plot_analysis(self)
 
 
 def _parts(loop: Loop, omega: NDArray[np.float64]):
@@ -253,7 +288,7 @@ def self_consistent_amplitude(loop: Loop, frequency_hz: float, amplitude: float,
     raise RuntimeError(f"self-consistent amplitude did not converge at {frequency_hz} Hz")
 
 
-def mismatch_crossover(loop: Loop, amplitude: float, f_min: float = 1e-2,
+def mismatch_crossover_exact(loop: Loop, amplitude: float, f_min: float = 1e-2,
                        f_max: float = 1e4) -> float:
     """Exact counterpart of the crossover of eq. (21) [Hz]: lowest f where ``|E - 1| = 1``.
 
@@ -348,7 +383,8 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     return QuasiLinearAnalysis(
         amplitude=float(amplitude), zeta=zeta_ref, D=D_ref, k_link=k_link,
         f_star_hz=f_star(k_link, loop.M), bandwidth_hz=loop.bandwidth_hz(),
-        crossover_hz=crossover, crossover_exact_hz=mismatch_crossover(loop, amplitude),
+        mismatch_crossover_hz=crossover,
+        mismatch_crossover_exact_hz=mismatch_crossover_exact(loop, amplitude),
         points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df)
 
 
@@ -358,12 +394,12 @@ CROSSOVER_MAX_ITERATIONS = 50
 
 def _crossover_estimate(st: TwoMassStage, hyst, amplitude: float, D: complex) -> float:
     """Eq. (21); for a rate-dependent element solved with ``D`` at the crossover itself."""
-    fc = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D))
+    fc = mismatch_crossover(st.k, st.m1, st.m2, abs(D))
     if hyst.rate_independent:
         return fc
     for _ in range(CROSSOVER_MAX_ITERATIONS):
         D = complex(np.asarray(hyst.describing_function(amplitude, TWO_PI * fc)).ravel()[0])
-        f_new = mismatch_crossover_estimate(st.k, st.m1, st.m2, abs(D))
+        f_new = mismatch_crossover(st.k, st.m1, st.m2, abs(D))
         if abs(f_new - fc) <= 1e-12 * f_new:
             return f_new
         change, fc = abs(f_new - fc), f_new

@@ -25,8 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
-from motionhyst.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.systems import TWO_PI
+from motionhyst.textfmt import g, table
 
 MIN_HARMONICS = 32
 MAX_HARMONICS = 4096
@@ -126,6 +126,29 @@ class SteadyState:
     def error_peak(self) -> float:
         """Largest ``|e|`` over a period [m] (finely sampled)."""
         return float(np.max(np.abs(self.time_series()["e"])))
+
+    def __str__(self) -> str:
+        rows = [[str(n), g(abs(self.e[n])), f"{np.degrees(np.angle(self.e[n])):.2f}",
+                 g(abs(self.w[n]))] for n in range(1, min(self.n_harmonics, 5) + 1)]
+        return "\n".join([
+            f"Periodic steady state, r = {g(self.amplitude)} m sin(2 pi {g(self.frequency_hz)} t)"
+            f": {self.n_harmonics} harmonics, {self.iterations} iterations",
+            f"  |E| = |e1 / e1_linear| = {g(abs(self.mismatch))}, "
+            f"angle {np.degrees(np.angle(self.mismatch)):.2f} deg",
+            f"  error RMS {g(self.error_rms)} m (without hysteresis {g(self.error_linear_rms)} m)",
+            table(["n", "|e_n| [m]", "angle e_n [deg]", "|w_n| [N]"], rows)])
+
+    def plot(self):
+        """One period of the error, with and without hysteresis
+        (:func:`motionhyst.plots.plot_steady_state`).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.plots import plot_steady_state
+
+        return plot_steady_state(self)
 
     def to_dict(self, harmonics: tuple[int, ...] = (1, 3, 5),
                 mismatch_df: complex | None = None,
@@ -250,13 +273,3 @@ def steady_state_sweep(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     """:func:`periodic_steady_state` at each frequency [Hz]."""
     return [periodic_steady_state(loop, amplitude, float(f), **kwargs)
             for f in np.atleast_1d(frequencies_hz)]
-
-
-def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike
-                                     ) -> list[dict]:
-    """Exact steady state next to the describing-function mismatch of eq. (18), per frequency."""
-    f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
-    E_df = loop_mismatch(loop, f, amplitude)
-    return [ss.to_dict(mismatch_df=complex(ed),
-                       error_harmonics_df=error_harmonics_df(loop, amplitude, ss.frequency_hz))
-            for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)]

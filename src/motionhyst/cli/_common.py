@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Sequence
 
 from motionhyst.jsonio import dumps
+from motionhyst.textfmt import g, table
+
+__all__ = ["EXIT_USAGE", "Parser", "UsageError", "finite", "g", "harmonic_count",
+           "nonnegative", "positive", "print_json", "table"]
 
 EXIT_USAGE = 2
 """Exit code of every user error."""
@@ -67,19 +70,3 @@ def harmonic_count(text: str) -> int:
 def print_json(obj) -> None:
     """Print `obj` as JSON (NumPy values converted, NaN as null)."""
     print(dumps(obj))
-
-
-def table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    """A plain-text table: right-aligned columns under a ruled header."""
-    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
-              for i, h in enumerate(headers)]
-    line = "  ".join(h.rjust(w) for h, w in zip(headers, widths, strict=True))
-    out = [line, "  ".join("-" * w for w in widths)]
-    out += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
-    return "\n".join(out)
-
-
-def g(x: float, digits: int = 4) -> str:
-    """`x` with `digits` significant digits; ``nan`` for None or NaN."""
-    return "nan" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}g}"
-

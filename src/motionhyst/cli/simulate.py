@@ -1,50 +1,34 @@
-"""``motionhyst simulate``: the exact periodic steady state of the nonlinear loop,
-or a transient run from rest (``--time-series``).
+"""``motionhyst simulate``: a transient run of the nonlinear loop from rest (``--time-series``).
+
+Without ``--time-series`` it is the old spelling of ``motionhyst steady``.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from motionhyst.cli._common import UsageError, g, positive, print_json, table
+from motionhyst.cli._common import UsageError, positive, print_json
 
 
 def run(args: argparse.Namespace) -> int:
-    """Exact periodic steady state of the nonlinear loop, next to the describing function."""
+    """A transient run from rest (``--time-series``); without it, the old spelling of ``steady``."""
+    from motionhyst.cli import steady
     from motionhyst.scenario import load_scenario
-    from motionhyst.steady import compare_with_describing_function
 
+    if not args.time_series:
+        print("motionhyst simulate: without --time-series this computes the periodic steady "
+              "state; the command for that is now `motionhyst steady`", file=sys.stderr)
+        return steady.run(args)
     sc = load_scenario(args.scenario)
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
-    if args.time_series:
-        return _time_series(args, sc, amplitude, freqs[0])
-    points = compare_with_describing_function(sc.loop(), amplitude, freqs)
-    if args.json:
-        print_json({"points": points})
-        return 0
-    print(f"Exact periodic steady state of {sc.source}, r = {amplitude:g} m sin(2 pi f t)")
-    rows = []
-    for p in points:
-        h = {x["n"]: x for x in p["error_harmonics"]}
-        hd = {x["n"]: x for x in p["error_harmonics_df"]}
-        rows.append([g(p["frequency_hz"]), g(h[1]["abs"]), f"{h[1]['phase_deg']:.1f}",
-                     g(h[3]["abs"]) if 3 in h else "-", g(hd[3]["abs"]) if 3 in hd else "-",
-                     g(h[5]["abs"]) if 5 in h else "-", g(hd[5]["abs"]) if 5 in hd else "-",
-                     g(p["error_linear_abs"]), g(p["mismatch_simulated_abs"]),
-                     f"{p['mismatch_simulated_phase_deg']:.2f}", g(p["mismatch_df_abs"]),
-                     f"{p['mismatch_df_phase_deg']:.2f}", g(p["error_peak"]),
-                     g(p["error_hysteresis_rms"])])
-    print(table(["f [Hz]", "|e1| [m]", "angle e1 [deg]", "|e3| [m]", "|e3| HOSIDF",
-                  "|e5| [m]", "|e5| HOSIDF",
-                  "|e1 lin| [m]", "|E sim|", "angle E sim", "|E df| (18)", "angle E df",
-                  "peak e [m]", "rms e-e_lin [m]"], rows))
-    return 0
+    return _time_series(args, sc, amplitude, freqs[0])
 
 
 def _time_series(args: argparse.Namespace, sc, amplitude: float, frequency: float) -> int:
@@ -94,7 +78,8 @@ def _time_series(args: argparse.Namespace, sc, amplitude: float, frequency: floa
 
 def add_parser(sub) -> None:
     """Add the ``simulate`` command to the subparsers `sub`."""
-    q = sub.add_parser("simulate", help="exact periodic steady state of the nonlinear loop")
+    q = sub.add_parser("simulate", help="transient run of the nonlinear loop from rest, "
+                       "written to CSV (--time-series)")
     q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
     q.add_argument("--frequency", type=positive, nargs="+", help="frequencies [Hz]")
     q.add_argument("--amplitude", type=positive, help="reference amplitude [m]")

@@ -1,0 +1,37 @@
+"""``motionhyst steady``: the exact periodic steady state of the nonlinear loop,
+next to the describing function's prediction (paper section V, eq. 18).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from motionhyst.cli._common import positive, print_json
+
+
+def run(args: argparse.Namespace) -> int:
+    """Exact periodic steady state of the nonlinear loop, next to the describing function."""
+    from motionhyst.comparison import compare_with_describing_function
+    from motionhyst.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    freqs = args.frequency or sc.frequencies
+    amplitude = args.amplitude or sc.amplitude
+    result = compare_with_describing_function(sc.loop(), amplitude, freqs)
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    print(f"Exact periodic steady state of {sc.source}, r = {amplitude:g} m sin(2 pi f t)")
+    print(result)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add the ``steady`` command to the subparsers `sub`."""
+    q = sub.add_parser("steady", help="exact periodic steady state of the nonlinear loop, "
+                       "next to the describing function")
+    q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
+    q.add_argument("--frequency", type=positive, nargs="+", help="frequencies [Hz]")
+    q.add_argument("--amplitude", type=positive, help="reference amplitude [m]")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=run)

@@ -1,0 +1,118 @@
+"""The describing function's prediction next to the exact periodic steady state.
+
+Paper section V: the quasi-linear mismatch of eq. (18) and the error
+harmonics predicted by the higher-order describing functions, compared per
+frequency with the exact steady state of the nonlinear loop
+(:func:`~motionhyst.steady.periodic_steady_state`).  This is the one module
+that needs both analyses; neither of them imports the other.
+
+Examples
+--------
+>>> from motionhyst import default_scenario
+>>> cmp = compare_with_describing_function(default_scenario().loop(), 0.01, [5.0])
+>>> p = cmp.points[0]
+>>> round(abs(p.state.mismatch), 2), round(abs(p.mismatch_df), 2)
+(6.04, 6.04)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.loop import Loop
+from motionhyst.quasilinear import error_harmonics_df, loop_mismatch
+from motionhyst.steady import SteadyState, steady_state_sweep
+from motionhyst.textfmt import g, table
+
+
+@dataclass
+class ComparisonPoint:
+    """Exact steady state and describing-function prediction at one frequency.
+
+    Attributes
+    ----------
+    state : SteadyState
+        The exact periodic steady state.
+    mismatch_df : complex
+        Eq. (18) at the reference amplitude.
+    error_harmonics_df : ndarray of complex
+        Predicted error harmonics ``1 .. n`` [m] (higher-order describing functions).
+    """
+
+    state: SteadyState
+    mismatch_df: complex
+    error_harmonics_df: NDArray[np.complex128]
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary: one point of the ``steady --json`` schema."""
+        return self.state.to_dict(mismatch_df=self.mismatch_df,
+                                  error_harmonics_df=self.error_harmonics_df)
+
+
+@dataclass
+class DescribingFunctionComparison:
+    """Result of :func:`compare_with_describing_function`, one point per frequency."""
+
+    amplitude: float
+    points: list[ComparisonPoint] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary: ``{"points": [...]}``."""
+        return {"points": [p.to_dict() for p in self.points]}
+
+    def __str__(self) -> str:
+        rows = []
+        for p in (q.to_dict() for q in self.points):
+            h = {x["n"]: x for x in p["error_harmonics"]}
+            hd = {x["n"]: x for x in p["error_harmonics_df"]}
+            rows.append([g(p["frequency_hz"]), g(h[1]["abs"]), f"{h[1]['phase_deg']:.1f}",
+                         g(h[3]["abs"]) if 3 in h else "-", g(hd[3]["abs"]) if 3 in hd else "-",
+                         g(h[5]["abs"]) if 5 in h else "-", g(hd[5]["abs"]) if 5 in hd else "-",
+                         g(p["error_linear_abs"]), g(p["mismatch_simulated_abs"]),
+                         f"{p['mismatch_simulated_phase_deg']:.2f}", g(p["mismatch_df_abs"]),
+                         f"{p['mismatch_df_phase_deg']:.2f}", g(p["error_peak"]),
+                         g(p["error_hysteresis_rms"])])
+        return table(["f [Hz]", "|e1| [m]", "angle e1 [deg]", "|e3| [m]", "|e3| HOSIDF",
+                      "|e5| [m]", "|e5| HOSIDF",
+                      "|e1 lin| [m]", "|E sim|", "angle E sim", "|E df| (18)", "angle E df",
+                      "peak e [m]", "rms e-e_lin [m]"], rows)
+
+    def plot(self):
+        """Fig. 11: the error over a period, exact, without hysteresis and predicted.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.plots import fig11_errors
+
+        return fig11_errors([p.state for p in self.points],
+                            [p.mismatch_df for p in self.points],
+                            [p.error_harmonics_df for p in self.points])
+
+
+def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike
+                                     ) -> DescribingFunctionComparison:
+    """Exact steady state next to the mismatch of eq. (18) and the HOSIDF error harmonics.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    amplitude : float
+        Reference amplitude ``A_r`` [m] of ``r = A_r sin(2 pi f t)``.
+    frequencies_hz : array_like
+        Frequencies [Hz].
+
+    Returns
+    -------
+    DescribingFunctionComparison
+    """
+    f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    E_df = loop_mismatch(loop, f, amplitude)
+    return DescribingFunctionComparison(float(amplitude), [
+        ComparisonPoint(ss, complex(ed), error_harmonics_df(loop, amplitude, ss.frequency_hz))
+        for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)])
