@@ -18,7 +18,9 @@ import control
 from pydantic import (
     BaseModel,
     ConfigDict,
+    Discriminator,
     Field,
+    Tag,
     TypeAdapter,
     ValidationError,
     create_model,
@@ -26,6 +28,7 @@ from pydantic import (
 )
 
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
+from motionhyst.hysteresis.registry import Form
 from motionhyst.loop import Loop
 from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
 
@@ -74,38 +77,101 @@ class _LinkSection(_Section):
 
     After the fields are validated the model is built once, so that its
     constructor's checks (``beta >= gamma``, equal lengths, ...) are the only
-    statement of them; their messages become validation errors.
+    statement of them; their messages become validation errors.  A section of
+    another :class:`~motionhyst.hysteresis.registry.Form` of a model builds it
+    with the form's constructor and rejects the keys of the model's own
+    spelling that the form lacks.
     """
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_spelling(cls, data):
+        form = _SECTION_FORMS.get(cls)
+        if form is not None and isinstance(data, dict):
+            own = {p.name for p in form.parameters}
+            mixed = sorted(k for k in data if k != "model" and k not in own)
+            if mixed:
+                theirs = sorted(own - {p.name for p in model_class(data["model"]).parameters})
+                raise ValueError(f"{', '.join(mixed)} (not of the {form.name} form) and "
+                                 f"{', '.join(theirs)} ({form.name} form) cannot be mixed in "
+                                 f"one {data['model']} table")
+        return data
 
     @model_validator(mode="after")
     def _model_accepts(self):
-        model_class(self.model)(**self.model_dump(exclude={"model"}))
+        self.build()
         return self
+
+    def build(self) -> Hysteresis:
+        """The model the section describes."""
+        cls = model_class(self.model)
+        form = _SECTION_FORMS.get(type(self))
+        make = cls if form is None else getattr(cls, form.constructor)
+        return make(**self.model_dump(exclude={"model"}))
 
 
 _FIELD_TYPES = {"positive": PositiveFloat, "nonnegative": NonNegativeFloat,
                 "finite": Annotated[float, Field(allow_inf_nan=False)]}
 
 
-def _link_section(name: str, cls: type[Hysteresis]) -> type[_LinkSection]:
-    """The ``[hysteresis] model = name`` section, from the model's declared parameters."""
+def _link_section(name: str, cls: type[Hysteresis], form: Form | None = None
+                  ) -> type[_LinkSection]:
+    """The ``[hysteresis] model = name`` section, from the model's declared parameters
+    (or those of one of its other forms)."""
     fields: dict = {"model": (Literal[name], ...)}
-    for p in cls.parameters:
+    for p in cls.parameters if form is None else form.parameters:
         t = _FIELD_TYPES[p.kind]
         if p.many:
             t = Annotated[list[t], Field(min_length=1)]
         fields[p.name] = (t, ... if p.required else p.default)
-    section = create_model(f"{cls.__name__}Section", __base__=_LinkSection, **fields)
-    section.__doc__ = f"``[hysteresis] model = \"{name}\"``: the {cls.__name__} model."
+    suffix = "" if form is None else form.name.capitalize()
+    section = create_model(f"{cls.__name__}{suffix}Section", __base__=_LinkSection, **fields)
+    what = f"the {cls.__name__} model" + ("" if form is None else f" in its {form.name} form")
+    section.__doc__ = f"``[hysteresis] model = \"{name}\"``: {what}."
+    if form is not None:
+        _SECTION_FORMS[section] = form
     return section
 
+
+def _form_tag(name: str, form: Form) -> str:
+    return f"{name} ({form.name} form)"
+
+
+#: the other forms of the models, by section
+_SECTION_FORMS: dict[type, Form] = {}
 
 #: The section of each ``[hysteresis] model = ...``, one per registered link model.
 LINK_SECTIONS: dict[str, type[_LinkSection]] = {
     name: _link_section(name, cls) for name, cls in MODELS.items()}
 
-HysteresisSection = Annotated[Union[tuple(LINK_SECTIONS.values())],  # noqa: UP007
-                              Field(discriminator="model")]
+#: Sections of the models' other forms (:class:`~motionhyst.hysteresis.registry.Form`), by tag.
+FORM_SECTIONS: dict[str, type[_LinkSection]] = {
+    _form_tag(name, form): _link_section(name, cls, form)
+    for name, cls in MODELS.items() for form in getattr(cls, "forms", ())}
+
+
+def _link_tag(data) -> str | None:
+    """Tag of a ``[hysteresis]`` table: its model, or one of the model's other forms when
+    the table has a key of that form that the model's own parameters lack."""
+    if not isinstance(data, dict):
+        section = _SECTION_FORMS.get(type(data))
+        model = getattr(data, "model", None)
+        return model if section is None else _form_tag(model, section)
+    model = data.get("model")
+    if not isinstance(model, str):
+        return None
+    cls = MODELS.get(model)
+    for form in getattr(cls, "forms", ()):
+        own = {p.name for p in cls.parameters}
+        if any(p.name in data and p.name not in own for p in form.parameters):
+            return _form_tag(model, form)
+    return model
+
+
+HysteresisSection = Annotated[
+    Union[tuple(Annotated[section, Tag(tag)]  # noqa: UP007
+                for tag, section in {**LINK_SECTIONS, **FORM_SECTIONS}.items())],
+    Discriminator(_link_tag)]
 
 
 class FeedforwardSection(_Section):
@@ -179,13 +245,12 @@ class ScenarioModel(_Section):
 
 
 # tags of the discriminated unions, left out of the key named in an error message
-_UNION_TAGS = {"leadlag-lowpass", "tf", *MODELS}
+_UNION_TAGS = {"leadlag-lowpass", "tf", *MODELS, *FORM_SECTIONS}
 
 
 def build_hysteresis(section) -> Hysteresis:
     """The hysteresis model a validated ``[hysteresis]`` section describes."""
-    params = section.model_dump(exclude={"model"})
-    return model_class(section.model)(**params)
+    return section.build()
 
 
 _HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection)
@@ -198,6 +263,12 @@ def hysteresis_from_dict(data: dict, source: str = "<dict>") -> Hysteresis:
     except ValidationError as err:
         raise ScenarioError(_format_error(source, err, prefix=("hysteresis",))) from None
     return build_hysteresis(section)
+
+
+def _discriminator(e: dict) -> str:
+    """The key a discriminated union is chosen by (``model`` for the link's callable one)."""
+    name = e["ctx"]["discriminator"].strip("'")
+    return "model" if name == f"{_link_tag.__name__}()" else name
 
 
 def _format_error(source: str, err: ValidationError, prefix: tuple = ()) -> str:
@@ -214,10 +285,12 @@ def _format_error(source: str, err: ValidationError, prefix: tuple = ()) -> str:
     elif kind == "missing":
         msg = "missing"
     elif kind == "union_tag_invalid":
-        msg = f"unknown {e['ctx']['discriminator'].strip(chr(39))} {e['ctx']['tag']!r}; " \
-              f"expected one of {e['ctx']['expected_tags']}"
+        tags = e["ctx"]["expected_tags"]
+        for tag in FORM_SECTIONS:
+            tags = tags.replace(f", {tag!r}", "")
+        msg = f"unknown {_discriminator(e)} {e['ctx']['tag']!r}; expected one of {tags}"
     elif kind == "union_tag_not_found":
-        msg = f"missing key {e['ctx']['discriminator']}"
+        msg = f"missing key '{_discriminator(e)}'"
     else:
         msg = e["msg"].removeprefix("Value error, ")
         if "input" in e and not isinstance(e["input"], dict | list):

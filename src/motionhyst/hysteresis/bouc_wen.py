@@ -12,6 +12,8 @@ bounded, thermodynamically admissible parameter classes).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -20,10 +22,34 @@ from motionhyst.hysteresis._ode_kernels import (
     GL_W,
     NormalisedRateIndependent,
     bouc_wen_path,
+    periodic_fixed_point,
+    rate_independent_path,
+    truncate_harmonics,
 )
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
-from motionhyst.hysteresis.registry import Parameter, register
+from motionhyst.hysteresis.registry import Form, Parameter, register
 from motionhyst.hysteresis.stepping import BOUC_WEN, Stepping
+
+
+def _check_shape(n: float, beta: float, gamma: float, names: tuple[str, str, str]) -> None:
+    """The accepted set of the normalised ``(n, beta, gamma)`` (see :class:`BoucWen`).
+
+    `names` are the parameters' names in the caller's spelling (normalised
+    ``n, beta, gamma`` or general ``nu, gamma, delta``).
+    """
+    nn, bn, gn = names
+    got = f"got {bn}={beta!r}, {gn}={gamma!r}"
+    if not beta - gamma >= 0:
+        raise ValueError(f"{bn} must be >= {gn} (dissipative loops), {got}")
+    if beta + gamma > 0:
+        return
+    if n != 1.0:
+        raise ValueError(f"{bn} + {gn} must be > 0 unless {nn} = 1 (without an ultimate force "
+                         f"the force escapes to infinity within a finite displacement), {got}, "
+                         f"{nn}={n!r}")
+    if beta < 0:
+        raise ValueError(f"{bn} must be >= 0 when {bn} + {gn} <= 0 (small cycles would raise "
+                         f"the force without bound), {got}")
 
 
 def _check_finite(name: str, value: float) -> float:
@@ -38,45 +64,82 @@ def _check_finite(name: str, value: float) -> float:
 
 @register
 class BoucWen(NormalisedRateIndependent, Hysteresis):
-    """Bouc-Wen hysteresis (Bouc 1967, Wen 1976), normalised, rate-independent.
+    r"""Bouc-Wen hysteresis (Bouc 1967, Wen 1976), rate-independent, in two spellings.
+
+    The benchmark's general form (Noel and Schoukens 2016; Ismail et al. 2009,
+    eq. 1, with ``beta`` factored out), force ``z`` [N] of the displacement
+    ``x`` [m]:
 
     .. math::
 
-        w = f_c z, \\qquad
-        \\frac{dz}{dx} = \\frac{k}{f_c}\\left[1 - \\left(\\beta\\,
-        \\mathrm{sign}(\\dot x z) + \\gamma\\right) |z|^n\\right].
+        \dot z = \alpha \dot x - \beta\left(\gamma |\dot x| |z|^{\nu-1} z
+                  + \delta \dot x |z|^\nu\right)                  \qquad (1)
 
-    This is the classical ``z' = A x' - beta |x'| |z|^(n-1) z - gamma x' |z|^n``
-    (Ismail et al. 2009, eq. 1, without the parallel linear spring) with
-    ``A = k / fc``, ``beta_c = beta k / fc``, ``gamma_c = gamma k / fc`` and the
-    force ``fc z``, so that
+    and the normalised form ``w = fc zeta`` with
+
+    .. math::
+
+        \frac{d\zeta}{dx} = \frac{k}{f_c}\left[1 - \left(\beta_n\,
+        \mathrm{sign}(\dot x \zeta) + \gamma_n\right) |\zeta|^n\right]   \qquad (2)
+
+    are one model: (1) is (2) with
+
+    .. math::
+
+        k = \alpha, \quad f_c = (\alpha / \beta)^{1/\nu}, \quad n = \nu, \quad
+        \beta_n = \gamma, \quad \gamma_n = \delta                          \qquad (3)
+
+    (substitute ``z = fc zeta`` in (1) and divide by ``fc``: ``beta fc^nu / alpha = 1``).
+    Conversely (2) is (1) with ``alpha = k``, ``beta = k / fc^n``, ``gamma = beta_n``,
+    ``delta = gamma_n``, ``nu = n``.  The constructor takes the normalised
+    parameters, :meth:`from_general` the general ones; :attr:`general`
+    gives (1)'s parameters of either, and :meth:`to_dict` returns the spelling
+    the element was made with, so that it round-trips exactly.
+
+    In the normalised form
 
     * the stiffness at ``w = 0`` (the initial stiffness) is ``k``;
-    * in a long monotone motion ``|z|`` tends to ``z_u = (beta + gamma)^(-1/n)``,
-      i.e. the force saturates at ``fc`` when ``beta + gamma = 1``;
-    * ``n`` sets the sharpness of the transition (``n -> inf`` with
-      ``beta = gamma = 1/2`` gives the Jenkins element of paper eq. 3);
-    * the loading stiffness is ``k (1 - (beta + gamma) |z|^n)``, the unloading
-      stiffness ``k (1 + (beta - gamma) |z|^n)`` (``= k`` for ``beta = gamma``).
+    * the loading stiffness is ``k (1 - (beta_n + gamma_n) |zeta|^n)``, the
+      unloading stiffness ``k (1 + (beta_n - gamma_n) |zeta|^n)`` (``= k`` for
+      ``beta_n = gamma_n``);
+    * with ``beta_n + gamma_n > 0`` a long monotone motion takes ``|zeta|`` to
+      ``z_u = (beta_n + gamma_n)^(-1/n)``: the force saturates at
+      ``fc z_u`` (``= fc`` when ``beta_n + gamma_n = 1``; ``n -> inf`` with
+      ``beta_n = gamma_n = 1/2`` gives the Jenkins element of paper eq. 3);
+    * with ``beta_n + gamma_n <= 0`` (the benchmark: ``gamma + delta = -0.3``)
+      there is no ultimate force: the loading branch stiffens.
 
-    The parameters must satisfy ``beta + gamma > 0`` and ``beta - gamma >= 0``
-    (class I of Ikhouane and Rodellar 2007: bounded and dissipative); then
-    ``D`` has ``Im D >= 0``.  The element is rate-independent, integrated in
-    ``x``: exactly (piecewise exponentials) for ``n = 1``, by RK4 sub-steps of
-    at most ``0.02 / max(1, n (beta + gamma)^(1/n))`` in ``k x / fc`` otherwise,
-    with the crossing of ``z = 0`` (a kink of the right-hand side) located by
-    Gauss-Legendre quadrature.
+    Accepted parameters (the response stays bounded for every bounded
+    motion; Ikhouane and Rodellar 2007, ch. 2): ``k, fc > 0``, ``n >= 1``,
+    ``beta_n >= gamma_n`` (dissipative loops, ``Im D >= 0``), and either
+    ``beta_n + gamma_n > 0`` or (no ultimate force) ``n = 1`` and
+    ``beta_n >= 0``.  Rejected: ``beta_n + gamma_n <= 0`` with ``n > 1``, where
+    the loading branch ``d zeta / du = 1 + |beta_n + gamma_n| zeta^n`` escapes
+    to infinity within a finite displacement, and ``beta_n < 0``, where small
+    cycles at a large force multiply it by ``exp(-2 beta_n du)`` each, without
+    bound.  In the general form: ``alpha, beta > 0``, ``nu >= 1``,
+    ``delta <= gamma``, and ``gamma + delta > 0`` or (``nu = 1`` and
+    ``gamma >= 0``).
+
+    The element is integrated in ``x``: exactly (piecewise exponentials) for
+    ``n = 1``, by RK4 sub-steps of at most ``0.02 / max(1, n (beta_n +
+    gamma_n)^(1/n))`` in ``k x / fc`` otherwise, with the crossing of
+    ``zeta = 0`` (a kink of the right-hand side) located by Gauss-Legendre
+    quadrature.  The compiled step,
+    :func:`~motionhyst.hysteresis._ode_kernels.bouc_wen_step`, serves the
+    time simulations.
 
     Parameters
     ----------
     k : float
-        Initial stiffness [N/m], > 0.
+        Initial stiffness [N/m], > 0 (``alpha``).
     fc : float
         Force scale [N], > 0: the saturation force when ``beta + gamma = 1``.
     n : float
-        Smoothness exponent [-], >= 1.
+        Smoothness exponent [-], >= 1 (``nu``).
     beta, gamma : float
-        Shape parameters [-]; ``beta + gamma > 0`` and ``beta >= gamma``.
+        Normalised shape parameters ``beta_n``, ``gamma_n`` [-] (the general
+        form's ``gamma`` and ``delta``), within the accepted set above.
 
     Examples
     --------
@@ -84,8 +147,18 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
     >>> el = BoucWen(k=20.0, fc=0.05)
     >>> el.saturation_force
     0.05
-    >>> round(abs(el.describing_function(1e-7)) / el.k, 6)
+    >>> round(abs(el.describing_function(1e-10)) / el.k, 6)
     1.0
+
+    The benchmark's element, in its own names:
+
+    >>> bw = BoucWen.from_general(alpha=5e4, beta=1e3, gamma=0.8, delta=-1.1, nu=1.0)
+    >>> bw.k, bw.fc, bw.n, bw.beta, bw.gamma
+    (50000.0, 50.0, 1.0, 0.8, -1.1)
+    >>> bw.saturation_force
+    inf
+    >>> bw.to_dict()
+    {'model': 'bouc-wen', 'alpha': 50000.0, 'beta': 1000.0, 'gamma': 0.8, 'delta': -1.1, 'nu': 1.0}
     """
 
     name = "bouc-wen"
@@ -95,8 +168,17 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
                   Parameter("n", "", "sharpness n >= 1", 1.0, "finite"),
                   Parameter("beta", "", "beta", 0.5, "finite"),
                   Parameter("gamma", "", "gamma, <= beta", 0.5, "finite"))
+    #: the benchmark's general form, eq. (1), read by :meth:`from_general`
+    forms = (Form("general", "from_general", (
+        Parameter("alpha", "N/m", "initial stiffness alpha"),
+        Parameter("beta", "N^-nu", "scale beta of the nonlinear terms"),
+        Parameter("gamma", "", "gamma", None, "finite"),
+        Parameter("delta", "", "delta, <= gamma", None, "finite"),
+        Parameter("nu", "", "smoothness nu >= 1", 1.0, "finite"))),)
     #: RK4 step in ``k x / fc`` for ``n != 1``, divided by ``max(1, n (beta + gamma)^(1/n))``
     rk4_step = 0.02
+    #: names of the general form's parameters, eq. (1)
+    GENERAL_KEYS = ("alpha", "beta", "gamma", "delta", "nu")
 
     def __init__(self, k: float, fc: float, n: float = 1.0, beta: float = 0.5,
                  gamma: float = 0.5) -> None:
@@ -108,17 +190,95 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
             raise ValueError(f"n must be >= 1, got {n!r}")
         self.beta = _check_finite("beta", beta)
         self.gamma = _check_finite("gamma", gamma)
-        if not self.beta + self.gamma > 0:
-            raise ValueError(f"beta + gamma must be > 0 (bounded hysteresis), got "
-                             f"beta={beta!r}, gamma={gamma!r}")
-        if not self.beta - self.gamma >= 0:
-            raise ValueError(f"beta must be >= gamma (dissipative loops), got "
-                             f"beta={beta!r}, gamma={gamma!r}")
+        _check_shape(self.n, self.beta, self.gamma, ("n", "beta", "gamma"))
+        self._general: dict | None = None
         self.reset()
 
+    @classmethod
+    def from_general(cls, alpha: float, beta: float, gamma: float, delta: float,
+                     nu: float = 1.0) -> BoucWen:
+        """The element of the benchmark's general form, eq. (1), mapped by eq. (3).
+
+        Parameters
+        ----------
+        alpha : float
+            Initial stiffness [N/m], > 0.
+        beta : float
+            Scale of the nonlinear terms [N^-nu], > 0 ([1/m] for ``nu = 1``
+            with ``alpha`` in N/m).
+        gamma, delta : float
+            Shape parameters [-]; ``delta <= gamma``, and ``gamma + delta > 0``
+            or (``nu = 1`` and ``gamma >= 0``).
+        nu : float
+            Smoothness exponent [-], >= 1.
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import BoucWen
+        >>> bw = BoucWen.from_general(alpha=20.0, beta=400.0, gamma=0.5, delta=0.5)
+        >>> bw.to_dict() == BoucWen.from_dict(bw.to_dict()).to_dict()
+        True
+        >>> bw.describing_function(0.01) == BoucWen(20.0, 0.05).describing_function(0.01)
+        True
+        """
+        a = check_positive("alpha", alpha)
+        b = check_positive("beta", beta)
+        nu_ = _check_finite("nu", nu)
+        if nu_ < 1.0:
+            raise ValueError(f"nu must be >= 1, got {nu!r}")
+        g = _check_finite("gamma", gamma)
+        d = _check_finite("delta", delta)
+        _check_shape(nu_, g, d, ("nu", "gamma", "delta"))
+        fc = a / b if nu_ == 1.0 else (a / b) ** (1.0 / nu_)
+        if not (np.isfinite(fc) and fc > 0.0):
+            raise ValueError(f"alpha / beta must give a finite force scale (alpha / beta)^(1/nu) "
+                             f"> 0, got alpha={alpha!r}, beta={beta!r}")
+        el = cls(a, fc, nu_, g, d)
+        el._general = {"alpha": a, "beta": b, "gamma": g, "delta": d, "nu": nu_}
+        return el
+
+    @classmethod
+    def from_dict(cls, params: dict) -> BoucWen:
+        """The element of either spelling of :meth:`to_dict` (the key ``model`` is ignored).
+
+        Raises
+        ------
+        ValueError
+            For keys of both spellings, or of neither.
+        """
+        keys = {key for key in params if key != "model"}
+        general = bool(keys & {"alpha", "delta", "nu"})
+        allowed, required = ((cls.GENERAL_KEYS, ("alpha", "beta", "gamma", "delta")) if general
+                             else (("k", "fc", "n", "beta", "gamma"), ("k", "fc")))
+        form = "general" if general else "normalised"
+        for key in sorted(keys - set(allowed)):
+            raise ValueError(f"{key}: not a parameter of the {form} form ({', '.join(allowed)})")
+        for key in required:
+            if key not in keys:
+                raise ValueError(f"{key}: missing (a parameter of the {form} form)")
+        args = {key: params[key] for key in keys}
+        return cls.from_general(**args) if general else cls(**args)
+
     def __repr__(self) -> str:
+        if self._general is not None:
+            g = self._general
+            return (f"BoucWen.from_general(alpha={g['alpha']!r}, beta={g['beta']!r}, "
+                    f"gamma={g['gamma']!r}, delta={g['delta']!r}, nu={g['nu']!r})")
         return (f"BoucWen(k={self.k!r}, fc={self.fc!r}, n={self.n!r}, beta={self.beta!r}, "
                 f"gamma={self.gamma!r})")
+
+    @property
+    def general(self) -> dict[str, float]:
+        """Parameters ``alpha, beta, gamma, delta, nu`` of the general form, eq. (1).
+
+        Those given to :meth:`from_general`, or from the normalised ones by
+        ``alpha = k``, ``beta = k / fc^n``, ``gamma = beta_n``, ``delta = gamma_n``,
+        ``nu = n``.
+        """
+        if self._general is not None:
+            return dict(self._general)
+        return {"alpha": self.k, "beta": self.k / self.fc**self.n, "gamma": self.beta,
+                "delta": self.gamma, "nu": self.n}
 
     @property
     def initial_stiffness(self) -> float:
@@ -127,12 +287,14 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
 
     @property
     def z_max(self) -> float:
-        """Bound ``z_u = (beta + gamma)^(-1/n)`` of the normalised state [-]."""
-        return float((self.beta + self.gamma) ** (-1.0 / self.n))
+        """Bound ``z_u = (beta + gamma)^(-1/n)`` of the normalised state [-] (inf if
+        ``beta + gamma <= 0``: no ultimate force)."""
+        ap = self.beta + self.gamma
+        return float(ap ** (-1.0 / self.n)) if ap > 0.0 else math.inf
 
     @property
     def saturation_force(self) -> float:
-        """Force approached in a long monotone motion, ``fc z_u`` [N]."""
+        """Force approached in a long monotone motion, ``fc z_u`` [N] (inf: no ultimate force)."""
         return self.fc * self.z_max
 
     def _step(self) -> float:
@@ -143,9 +305,53 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         return bouc_wen_path(u, float(s0), self.n, self.beta + self.gamma,
                              self.beta - self.gamma, self._step(), GL_T, GL_W)
 
-    def _state_bounds(self) -> tuple[float, float]:
+    def _state_bounds(self, u_range: float = math.inf) -> tuple[float, float]:
+        """An interval holding every periodic state for a path of range `u_range` in ``u``.
+
+        ``[-z_u, z_u]`` with an ultimate force.  Without one (``n = 1``,
+        ``beta + gamma = -b <= 0``), a monotone motion from ``zeta = 0`` over
+        the path's whole range reaches ``expm1(b u_range) / b``, and smaller
+        cycles never raise it (``beta >= 0``); twice that is returned.
+        """
         z = self.z_max
-        return -z, z
+        if math.isfinite(z):
+            return -z, z
+        b = -(self.beta + self.gamma)
+        reach = u_range if b == 0.0 else math.expm1(b * u_range) / b
+        bound = 2.0 * reach + 1.0
+        if not math.isfinite(bound):
+            raise ValueError(f"the motion is too large for an element without an ultimate "
+                             f"force: k x / fc spans {u_range:.3g}, the force would exceed "
+                             "1e300 fc")
+        return -bound, bound
+
+    def periodic_samples(self, X: ArrayLike, n_samples: int | None = None
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Displacement and force on the grid ``theta = 2 pi i / N`` of the periodic state.
+
+        Parameters
+        ----------
+        X : array_like of complex
+            Harmonics of the displacement (``rfft / N`` scaling).
+        n_samples : int, optional
+            Grid size ``N`` (even); by default :meth:`default_samples`.
+
+        Returns
+        -------
+        x, w : ndarray, shape (N,)
+            Displacement [m] and force [N] over one period of the periodic state.
+        """
+        X = truncate_harmonics(np.asarray(X, dtype=complex))
+        N = self.default_samples(X) if n_samples is None else int(n_samples)
+        if N < 8 or N % 2:
+            raise ValueError(f"n_samples must be an even number >= 8, got {n_samples!r}")
+        if len(X) == 1:  # constant displacement: the (non-unique) periodic state w = 0
+            return np.full(N, X[0].real), np.zeros(N)
+        x, path, grid_index = rate_independent_path(X, N)
+        u = (self.k / self.fc) * (path - path[0])
+        lo, hi = self._state_bounds(float(np.max(u) - np.min(u)))
+        traj = periodic_fixed_point(lambda s: self._path(u, s), 0.0, lo, hi)
+        return x, self.fc * traj[grid_index]
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
         """Describing function ``D = (b1 + j a1) / A`` (paper eq. 7) at amplitude(s) `A` [N/m].
@@ -177,7 +383,7 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         """
         xs = self._validated_path(x)
         w_max = self.saturation_force
-        if not abs(w0) <= w_max * (1.0 + 1e-12):
+        if not (math.isfinite(w0) and abs(w0) <= w_max * (1.0 + 1e-12)):
             raise ValueError(f"|w0| must be <= the saturation force {w_max}, got {w0}")
         if xs.size == 0:
             return np.empty(0)
@@ -201,10 +407,13 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         """The elements as the compiled time step advances them (:mod:`.stepping`)."""
         p = (self.k / self.fc, self.fc, self.n, self.beta + self.gamma, self.beta - self.gamma,
              self._step())
-        return Stepping.from_rows([(BOUC_WEN, p)], self.saturation_force)
+        scale = self.saturation_force if math.isfinite(self.saturation_force) else self.fc
+        return Stepping.from_rows([(BOUC_WEN, p)], scale)
 
     def to_dict(self) -> dict:
-        """Parameters as a JSON-ready dictionary."""
+        """Parameters as a JSON-ready dictionary, in the spelling the element was made with."""
+        if self._general is not None:
+            return {"model": self.name, **self._general}
         return {"model": self.name, "k": self.k, "fc": self.fc, "n": self.n,
                 "beta": self.beta, "gamma": self.gamma}
 

@@ -63,6 +63,29 @@ class Parameter:
         return self.default is None
 
 
+@dataclass(frozen=True)
+class Form:
+    """Another spelling of a link model's parameters, with its own constructor.
+
+    A scenario's ``[hysteresis]`` table with ``model = name`` is read in this
+    form when it has one of the form's keys that the model's own
+    ``parameters`` lack (e.g. Bouc-Wen's ``alpha``, ``delta``, ``nu``).
+
+    Parameters
+    ----------
+    name : str
+        The form's name in messages (``"general"``).
+    constructor : str
+        Name of the class method that builds the model from these parameters.
+    parameters : tuple of Parameter
+        The form's parameters.
+    """
+
+    name: str
+    constructor: str
+    parameters: tuple[Parameter, ...]
+
+
 MODELS: dict[str, type[Hysteresis]] = {}
 """Every registered link model, keyed by its ``name`` (in registration order)."""
 

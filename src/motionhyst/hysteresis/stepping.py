@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from motionhyst.hysteresis._ode_kernels import (
     GL_T,
     GL_W,
-    bouc_wen_advance,
+    bouc_wen_step,
     dahl_advance,
     lugre_relax,
 )
@@ -101,11 +101,7 @@ def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no 
             s = -dahl_advance(-s, -du, p[2])
         return s, p[1] * s
     if code == BOUC_WEN:  # p = (k / fc, fc, n, beta + gamma, beta - gamma, hmax); state w / fc
-        du = p[0] * dx
-        if du > 0.0:
-            s = bouc_wen_advance(s, du, p[2], p[3], p[4], p[5], glt, glw)
-        elif du < 0.0:
-            s = -bouc_wen_advance(-s, -du, p[2], p[3], p[4], p[5], glt, glw)
+        s = bouc_wen_step(s, p[0] * dx, p[2], p[3], p[4], p[5], glt, glw)
         return s, p[1] * s
     # LuGre, p = (sigma0, sigma1, sigma2, fc, fs, vs); state z.  As in lugre_response, z
     # relaxes exactly for the step's constant velocity (lugre_relax).  The rates in
