@@ -1,46 +1,360 @@
-"""Reading measured data from CSV files with a header row (one error line per problem)."""
+"""One reader for every tabular input: CSV files as engineers have them, arrays and DataFrames.
+
+Every CSV the package reads (measured records, references, measured plants)
+goes through :func:`read_columns` and :func:`read_header`, built on
+:func:`pandas.read_csv`.  They accept what spreadsheets and measurement
+software write:
+
+- UTF-8 with or without a byte-order mark (UTF-16 with a BOM too), LF or CRLF
+  line ends;
+- comma, semicolon or tab as separator, spaces after it; with semicolons, a
+  decimal comma (``1,5;2,25``) where the data rows use one;
+- column names matched case-insensitively with surrounding spaces trimmed
+  (``" Time "`` is ``time``); extra columns are ignored.
+
+Errors are :class:`CSVError` (a ``ValueError``) with one line naming the
+source: a missing file, an empty file, a header without the expected columns
+(the message names them), a row with too many fields, a cell that is not a
+number (by line and column).  Where a path is accepted, a numpy array (its
+columns in the order asked for) or a pandas DataFrame (columns by name, matched
+as in a CSV header) is accepted too.  Floats are parsed by pandas' C parser
+straight into float64 columns, so a million-row file costs its numbers, not
+Python objects.
+"""
 
 from __future__ import annotations
 
-import csv
+import codecs
+import os
+import re
+import typing
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import pandas as pd
 from numpy.typing import NDArray
 
+Source = str | os.PathLike | np.ndarray | pd.DataFrame | Mapping
+"""What the readers accept: a CSV path, a 2-D array or a DataFrame (or a mapping of columns)."""
 
-def read_columns(path: str | Path, names: tuple[str, ...]) -> NDArray[np.float64]:
-    """The named columns of a CSV file as a float array of shape (rows, len(names)).
+_SEPARATORS = (",", ";", "\t")
+_SNIFF_BYTES = 64 * 1024
 
-    Raises ``ValueError`` with one line naming the file for an unreadable
-    file, no data rows, a missing column or a non-numeric value.
+
+class CSVError(ValueError):
+    """A tabular input that cannot be used: one line naming the source and the problem."""
+
+
+def normalize_name(name: Any) -> str:
+    """A column name as matched: trimmed, lower case, byte-order mark and quotes removed.
+
+    Examples
+    --------
+    >>> normalize_name('\\ufeff Time ')
+    'time'
     """
-    path = Path(path)
+    return str(name).replace("\ufeff", "").strip().strip('"').strip().lower()
+
+
+def describe(source: Source) -> str:
+    """How messages name a source: its path, or the kind of in-memory table.
+
+    Examples
+    --------
+    >>> describe("data/rec.csv")
+    'data/rec.csv'
+    >>> import numpy as np
+    >>> describe(np.zeros((3, 2)))
+    'the array'
+    """
+    if isinstance(source, pd.DataFrame):
+        return "the DataFrame"
+    if isinstance(source, np.ndarray):
+        return "the array"
+    if isinstance(source, Mapping):
+        return "the table"
+    return str(source)
+
+
+def _is_path(source: Source) -> bool:
+    return isinstance(source, str | os.PathLike)
+
+
+class _Dialect(typing.NamedTuple):
+    encoding: str
+    sep: str
+    decimal: str
+    header_line: int  # 1-based line of the header (blank lines before it are skipped)
+
+
+def _dialect(path: Path) -> _Dialect:
+    """Encoding, separator, decimal mark and header line of a CSV file, from its first bytes."""
     try:
-        with path.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
+        with path.open("rb") as fh:
+            head = fh.read(_SNIFF_BYTES)
+    except IsADirectoryError:
+        raise CSVError(f"cannot read {path}: it is a folder") from None
     except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
-    if not rows:
-        raise ValueError(f"{path}: no data rows")
-    missing = [n for n in names if n not in rows[0]]
+        raise CSVError(f"cannot read {path}: {exc.strerror}") from None
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        encoding = "utf-16"
+    else:
+        encoding = "utf-8-sig"
+    text = head.decode(encoding, errors="replace")
+    physical = text.split("\n")
+    first = next((i for i, ln in enumerate(physical) if ln.strip()), None)
+    if first is None:
+        raise CSVError(f"{path}: empty file: no header, no data rows")
+    header = physical[first]
+    counts = {s: header.count(s) for s in _SEPARATORS}
+    sep = max(_SEPARATORS, key=lambda s: counts[s])
+    if counts[sep] == 0:
+        sep = ","
+    data = next((ln for ln in physical[first + 1:] if ln.strip()), "")
+    decimal = "," if sep == ";" and "," in data and "." not in data else "."
+    return _Dialect(encoding, sep, decimal, first + 1)
+
+
+def _parser_message(text: str, sep: str) -> str:
+    """pandas' tokenizer error as one line: ``inconsistent lengths: line N has F fields ...``."""
+    m = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", text)
+    if m:
+        want, line, saw = m.groups()
+        return f"inconsistent lengths: line {line} has {saw} fields, the line before {want}"
+    return "cannot parse: " + " ".join(text.split())
+
+
+def _read_csv(path: Path, d: _Dialect, empty: str = "empty file: no header, no data rows",
+              **options) -> pd.DataFrame:
+    """The file through pandas' C parser, with one-line errors naming it."""
+    try:
+        return pd.read_csv(path, sep=d.sep, skipinitialspace=True, encoding=d.encoding,
+                           encoding_errors="replace", decimal=d.decimal, engine="c",
+                           skip_blank_lines=True, **options)
+    except pd.errors.EmptyDataError:
+        raise CSVError(f"{path}: {empty}") from None
+    except pd.errors.ParserError as exc:
+        raise CSVError(f"{path}: {_parser_message(str(exc), d.sep)}") from None
+    except (OSError, UnicodeError) as exc:
+        raise CSVError(f"cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None
+
+
+def _file_header(path: Path, d: _Dialect) -> list[str]:
+    """Normalised names of the header line (an unnamed column is ``""``)."""
+    head = _read_csv(path, d, nrows=0, skiprows=d.header_line - 1, header=0,
+                     index_col=False)
+    return ["" if str(c).startswith("Unnamed: ") else normalize_name(c) for c in head.columns]
+
+
+def read_header(source: Source) -> list[str]:
+    """The column names of a CSV file or DataFrame, normalised (see :func:`normalize_name`).
+
+    Parameters
+    ----------
+    source : str, Path or DataFrame
+        CSV file with a header row, or a DataFrame.
+
+    Returns
+    -------
+    list of str
+        Column names, trimmed and in lower case, in file order (an unnamed
+        column, as after a trailing separator, is ``""``).
+
+    Raises
+    ------
+    CSVError
+        One line naming the file: unreadable, empty, or a name given twice.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> read_header(pd.DataFrame({" Time": [0.0], "Position ": [1.0]}))
+    ['time', 'position']
+    """
+    if isinstance(source, np.ndarray):
+        raise CSVError("an array has no column names; give a CSV file or a DataFrame")
+    if isinstance(source, pd.DataFrame):
+        names = [normalize_name(c) for c in source.columns]
+    elif isinstance(source, Mapping):
+        names = [normalize_name(c) for c in source]
+    else:
+        path = Path(source)
+        names = _file_header(path, _dialect(path))
+    _check_unique(names, describe(source))
+    return names
+
+
+def _check_unique(names: Sequence[str], where: str) -> None:
+    seen = set()
+    for n in names:
+        if n and n in seen:
+            raise CSVError(f"{where}: column {n!r} appears twice in the header "
+                           f"(names are matched ignoring case and spaces)")
+        seen.add(n)
+
+
+def _line_of_row(path: Path, row: int) -> int | None:
+    """File line (1-based) of data row `row` (0-based), blank lines skipped as pandas does."""
+    d = _dialect(path)
+    with path.open(encoding=d.encoding, errors="replace", newline="") as fh:
+        seen = -1  # the header is row -1
+        for number, line in enumerate(fh, start=1):
+            if number < d.header_line or not line.strip():
+                continue
+            if seen == row:
+                return number
+            seen += 1
+    return None
+
+
+def _where(source: Source, row: int) -> str:
+    """``line N`` of a file for data row `row` (0-based), else ``row N`` (1-based)."""
+    if _is_path(source):
+        line = _line_of_row(Path(source), row)
+        if line is not None:
+            return f"line {line}"
+    return f"row {row + 1}"
+
+
+def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
+    """The columns `names` of a CSV file (floats where they parse), rows checked for length."""
+    d = _dialect(path)
+    header = _file_header(path, d)
+    _check_unique(header, str(path))
+    missing = [n for n in names if n not in header]
     if missing:
-        raise ValueError(f"{path}: missing column(s) {', '.join(missing)}; "
-                         f"need a header with {','.join(names)}")
-    try:
-        return np.array([[float(r[n]) for n in names] for r in rows])
-    except (TypeError, ValueError):
-        raise ValueError(f"{path}: non-numeric value in data") from None
+        found = ",".join(header) or "none"
+        raise CSVError(f"{path}: missing column(s) {', '.join(missing)}; need a header with "
+                       f"{','.join(names)} (found {found})")
+    frame = _read_csv(path, d, "no data rows", header=None, skiprows=d.header_line)
+    width = len(header)
+    if frame.shape[1] > width:  # more fields than names: allowed only if empty (trailing sep)
+        used = frame.iloc[:, width:].notna().to_numpy().any(axis=1)
+        if used.any():
+            i = int(np.argmax(used))
+            fields = int(frame.iloc[i].notna().sum())
+            raise CSVError(f"{path}: inconsistent lengths: {_where(path, i)} has {fields} "
+                           f"fields, the header {width}")
+        frame = frame.iloc[:, :width]
+    frame.columns = header[:frame.shape[1]]
+    if frame.shape[1] < width and len(frame):  # every row short
+        raise CSVError(f"{path}: inconsistent lengths: {_where(path, 0)} has "
+                       f"{frame.shape[1]} fields, the header {width}")
+    return frame[list(names)]
 
 
-def read_header(path: str | Path) -> list[str]:
-    """Column names of a CSV file (``ValueError`` if it cannot be read or is empty)."""
-    path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            header = next(csv.reader(fh), [])
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
-    if not header:
-        raise ValueError(f"{path}: empty file, no data rows")
-    return header
+def _bad_cell(frame: pd.DataFrame, names: Sequence[str], source: Source) -> str | None:
+    """A message for the first cell that is not a number, or None if all are numbers."""
+    where = describe(source)
+    for name in names:
+        col = frame[name]
+        if pd.api.types.is_numeric_dtype(col.dtype):
+            continue
+        values = pd.to_numeric(col, errors="coerce")
+        bad = (values.isna() & col.notna()).to_numpy()
+        if bad.any():
+            i = int(np.argmax(bad))
+            return (f"{where}: non-numeric value {str(col.iloc[i]).strip()!r} at "
+                    f"{_where(source, i)}, column {name!r}")
+    if not _is_path(source):
+        return None  # NaN in memory is the caller's value, checked as non-finite
+    blank = frame[list(names)].isna().to_numpy().any(axis=1)
+    if not blank.any():
+        return None
+    # NaN from the file: the text nan (kept), an empty cell or a short row (errors)
+    path = Path(source)
+    d = _dialect(path)
+    width = len(_file_header(path, d))
+    raw = _read_csv(path, d, header=None, skiprows=d.header_line, dtype=str,
+                    keep_default_na=False, na_values=[])
+    raw = raw.iloc[:, :width]
+    raw.columns = _file_header(path, d)[:raw.shape[1]]
+    empty = (raw[list(names)].apply(lambda c: c.str.strip()) == "").to_numpy()
+    rows = np.flatnonzero(empty.any(axis=1))
+    if rows.size == 0:
+        return None
+    i = int(rows[0])
+    line = _line_of_row(path, i)
+    if line is not None:
+        one = _read_csv(path, d, header=None, skiprows=line - 1, nrows=1, dtype=str,
+                        keep_default_na=False, na_values=[])
+        if one.shape[1] < width:
+            return (f"{where}: inconsistent lengths: line {line} has {one.shape[1]} fields, "
+                    f"the header {width}")
+    name = names[int(np.argmax(empty[i]))]
+    return f"{where}: an empty cell at {_where(source, i)}, column {name!r}"
+
+
+def read_columns(source: Source, names: Sequence[str]) -> NDArray[np.float64]:
+    """The named columns of a table as a float array of shape ``(rows, len(names))``.
+
+    Parameters
+    ----------
+    source : str, Path, ndarray, DataFrame or mapping
+        A CSV file with a header row (see the module docstring for the
+        dialects read), a DataFrame or mapping whose column names are matched
+        like a CSV header, or a 2-D array whose columns are `names` in order.
+    names : sequence of str
+        Columns wanted, lower case (matched ignoring case and surrounding spaces).
+
+    Returns
+    -------
+    ndarray
+        Float64, C-contiguous, one column per name.  Cells ``nan`` or ``inf``
+        written as such are kept (callers check finiteness in their own terms).
+
+    Raises
+    ------
+    CSVError
+        One line naming the source: unreadable or empty, no data rows, a
+        missing column (the message lists the columns expected and those
+        found), a row with more fields than the header, an empty or
+        non-numeric cell (by line and column).
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> read_columns(pd.DataFrame({"Time": [0.0, 0.1], "position": [0.0, 1e-3]}),
+    ...              ("time", "position"))
+    array([[0.   , 0.   ],
+           [0.1  , 0.001]])
+    >>> read_columns(np.array([[0.0, 1.0], [0.5, 2.0]]), ("time", "position"))[:, 1]
+    array([1., 2.])
+    """
+    names = tuple(names)
+    where = describe(source)
+    if isinstance(source, np.ndarray):
+        data = np.asarray(source)
+        if data.ndim != 2 or data.shape[1] != len(names):
+            raise CSVError(f"{where}: need shape (rows, {len(names)}) with the columns "
+                           f"{','.join(names)}; got shape {data.shape}")
+        try:
+            data = np.ascontiguousarray(data, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise CSVError(f"{where}: non-numeric values") from None
+        if data.shape[0] == 0:
+            raise CSVError(f"{where}: no data rows")
+        return data
+    if isinstance(source, pd.DataFrame | Mapping):
+        frame = source if isinstance(source, pd.DataFrame) else pd.DataFrame(dict(source))
+        frame = frame.rename(columns=normalize_name)
+        _check_unique(list(frame.columns), where)
+        missing = [n for n in names if n not in frame.columns]
+        if missing:
+            raise CSVError(f"{where}: missing column(s) {', '.join(missing)}; need the "
+                           f"columns {','.join(names)} (found "
+                           f"{','.join(map(str, frame.columns)) or 'none'})")
+        frame = frame[list(names)]
+    else:
+        frame = _file_columns(Path(source), names)
+    if len(frame) == 0:
+        raise CSVError(f"{where}: no data rows")
+    msg = _bad_cell(frame, names, source)
+    if msg is not None:
+        raise CSVError(msg)
+    return np.ascontiguousarray(frame.to_numpy(dtype=np.float64))
+
+
+__all__ = ["CSVError", "describe", "normalize_name", "read_columns", "read_header"]

@@ -65,9 +65,7 @@ forming ``P1^-1``.  The model is fitted in that filtered domain
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Literal
 
 import control
@@ -78,7 +76,7 @@ from scipy.linalg import solve
 from scipy.optimize import least_squares, nnls
 from scipy.signal import butter, cont2discrete, zpk2ss
 
-from motionhyst.csvdata import read_columns
+from motionhyst.csvdata import Source, describe, read_columns
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.hysteresis._kernels import maxwell_response, stop_response
 from motionhyst.systems import TWO_PI
@@ -1067,42 +1065,25 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
 # --------------------------------------------------------------------------- CSV
 
 
-def _read_record(path: str | Path, names: tuple[str, ...]) -> NDArray[np.float64]:
-    """Named columns of a CSV file, with a clear error for rows of the wrong length."""
-    path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            reader = csv.reader(fh)
-            header = next(reader, None)
-            if not header:
-                raise ValueError(f"{path}: empty file, no header")
-            for row in reader:
-                if row and len(row) != len(header):
-                    raise ValueError(f"{path}: inconsistent lengths: line {reader.line_num} has "
-                                     f"{len(row)} fields, the header {len(header)}")
-    except OSError as exc:
-        raise ValueError(f"cannot read {path}: {exc.strerror}") from None
-    return read_columns(path, names)
-
-
-def _load(path: str | Path, names: tuple[str, str, str], xname: str):
-    path = Path(path)
-    data = _read_record(path, names)
+def _load(source: Source, names: tuple[str, str, str], xname: str):
+    data = read_columns(source, names)
     t, x, v = data[:, 0], data[:, 1], data[:, 2]
     try:
         _check_signals(x, {names[2]: v}, t, xname=xname)
     except ValueError as exc:
-        raise ValueError(f"{path}: {exc}") from None
+        raise ValueError(f"{describe(source)}: {exc}") from None
     return t, x, v
 
 
-def load_force_displacement_csv(path: str | Path
+def load_force_displacement_csv(source: Source
                                 ) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                            NDArray[np.float64]]:
-    """Read a force-displacement record from CSV.
+    """Read a force-displacement record from CSV (or an array or DataFrame).
 
     The file has a header and the columns ``time,displacement,force``
-    (s, m, N; other columns are ignored).
+    (s, m, N; other columns are ignored; the dialects of
+    :mod:`motionhyst.csvdata`: BOM, comma or semicolon, names in any case).
+    A DataFrame has those columns by name, an array those three columns in order.
 
     Returns
     -------
@@ -1117,13 +1098,15 @@ def load_force_displacement_csv(path: str | Path
         ``MIN_SAMPLES`` samples, time not strictly increasing, constant
         displacement, or no reversal of the displacement.
     """
-    return _load(path, ("time", "displacement", "force"), "displacement")
+    return _load(source, ("time", "displacement", "force"), "displacement")
 
 
-def load_closed_loop_csv(path: str | Path
+def load_closed_loop_csv(source: Source
                          ) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                     NDArray[np.float64]]:
     """Read a closed-loop record from CSV: header and columns ``time,y1,u`` (s, m, N).
+
+    An array (those columns in order) or a DataFrame is accepted as well.
 
     Returns
     -------
@@ -1136,7 +1119,7 @@ def load_closed_loop_csv(path: str | Path
         As :func:`load_force_displacement_csv` (with ``y1`` in place of the
         displacement).
     """
-    return _load(path, ("time", "y1", "u"), "y1")
+    return _load(source, ("time", "y1", "u"), "y1")
 
 
 __all__ = [

@@ -9,13 +9,12 @@ data.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import make_interp_spline
 
-from motionhyst.csvdata import read_columns
+from motionhyst.csvdata import Source, describe, read_columns
 from motionhyst.systems import TWO_PI
 
 
@@ -183,12 +182,35 @@ class SampledReference:
         return self._spline(tt), np.where(inside, self._spline(tt, 2), 0.0)
 
 
-def load_reference_csv(path: str | Path) -> SampledReference:
-    """Read a reference from CSV with a header and columns ``time,position`` (SI units)."""
-    path = Path(path)
-    data = read_columns(path, ("time", "position"))
+def load_reference_csv(source: Source) -> SampledReference:
+    """Read a reference: CSV with a header and columns ``time,position`` (SI units).
+
+    Parameters
+    ----------
+    source : str, Path, ndarray or DataFrame
+        A CSV file (read by :func:`motionhyst.csvdata.read_columns`: BOM,
+        comma or semicolon, names in any case), a DataFrame with those
+        columns, or an array of shape ``(n, 2)``.
+
+    Returns
+    -------
+    SampledReference
+
+    Raises
+    ------
+    ValueError
+        One line naming the source.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.linspace(0.0, 0.5, 6)
+    >>> load_reference_csv(np.column_stack([t, 1e-3 * t])).duration
+    0.5
+    """
+    data = read_columns(source, ("time", "position"))
     t, r = data[:, 0], data[:, 1]
     try:
         return SampledReference(t, r)
     except ValueError as exc:
-        raise ValueError(f"{path}: {exc}") from None
+        raise ValueError(f"{describe(source)}: {exc}") from None

@@ -8,14 +8,13 @@ measured frequency-response data (:func:`load_frd_plant`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from motionhyst.csvdata import read_columns, read_header
+from motionhyst.csvdata import Source, describe, read_columns, read_header
 from motionhyst.hysteresis.base import check_positive
 
 TWO_PI = 2.0 * np.pi
@@ -235,8 +234,8 @@ _FRD_COLUMNS = {
 }
 
 
-def load_frd_plant(path: str | Path, mass: float | None = None) -> MeasuredPlant:
-    """Read a measured plant from CSV.
+def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
+    """Read a measured plant from CSV (or a DataFrame with the same columns).
 
     The file has a header and a column ``frequency_hz``, plus either
     ``p1_re, p1_im, p2_re, p2_im`` or ``p1_abs, p1_phase_deg, p2_abs,
@@ -244,8 +243,9 @@ def load_frd_plant(path: str | Path, mass: float | None = None) -> MeasuredPlant
 
     Parameters
     ----------
-    path : str or Path
-        CSV file.
+    path : str, Path or DataFrame
+        CSV file (read by :func:`motionhyst.csvdata.read_columns`: BOM, comma
+        or semicolon, names in any case), or a DataFrame with those columns.
     mass : float, optional
         Rigid-body mass [kg]; if omitted, estimated from the lowest measured
         decade as the median of ``-1 / (omega^2 Re P2)``.
@@ -254,22 +254,24 @@ def load_frd_plant(path: str | Path, mass: float | None = None) -> MeasuredPlant
     -------
     MeasuredPlant
     """
-    path = Path(path)
-    header = set(read_header(path))
+    where = describe(path)
+    names = read_header(path)
+    header = set(names)
+    expected = (f"{', '.join(_FRD_COLUMNS['reim'])} or {', '.join(_FRD_COLUMNS['absphase'])}"
+                f" next to frequency_hz (found {','.join(names) or 'none'})")
     if "frequency_hz" not in header:
-        raise ValueError(f"{path}: missing column 'frequency_hz'")
+        raise ValueError(f"{where}: missing column 'frequency_hz'; need columns {expected}")
     kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
     if kind is None:
-        raise ValueError(f"{path}: need columns {', '.join(_FRD_COLUMNS['reim'])} or "
-                         f"{', '.join(_FRD_COLUMNS['absphase'])}")
+        raise ValueError(f"{where}: need columns {expected}")
     data = read_columns(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
     if not np.all(np.isfinite(data)):
-        raise ValueError(f"{path}: non-finite value in data")
+        raise ValueError(f"{where}: non-finite value in data")
     f = data[:, 0]
     if np.any(f <= 0) or np.any(np.diff(f) <= 0):
-        raise ValueError(f"{path}: frequency_hz must be positive and increasing")
+        raise ValueError(f"{where}: frequency_hz must be positive and increasing")
     if len(f) < 2:
-        raise ValueError(f"{path}: need at least two frequencies")
+        raise ValueError(f"{where}: need at least two frequencies")
     if kind == "reim":
         p1 = data[:, 1] + 1j * data[:, 2]
         p2 = data[:, 3] + 1j * data[:, 4]
@@ -281,8 +283,8 @@ def load_frd_plant(path: str | Path, mass: float | None = None) -> MeasuredPlant
         low = f <= f[0] * 10
         mass = float(np.median(-1.0 / (omega[low] ** 2 * p2[low].real)))
         if not np.isfinite(mass) or mass <= 0:
-            raise ValueError(f"{path}: cannot estimate the rigid-body mass; give it explicitly")
+            raise ValueError(f"{where}: cannot estimate the rigid-body mass; give it explicitly")
     mass = check_positive("mass", mass)
     P1 = control.frd(p1, omega, smooth=len(f) > 3)
     P2 = control.frd(p2, omega, smooth=len(f) > 3)
-    return MeasuredPlant(P1=P1, P2=P2, M=mass, source=str(path))
+    return MeasuredPlant(P1=P1, P2=P2, M=mass, source=where)
