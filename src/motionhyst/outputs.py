@@ -1,0 +1,452 @@
+"""Every file the command line writes goes through here: atomic, asked for, never an input.
+
+Rules (issue 10, checked by tests/test_outputs.py and tests/test_bad_inputs.py):
+
+- A file is written to a temporary file in the target's own folder, flushed
+  and ``fsync``-ed, then moved over the target with :func:`os.replace`: a
+  reader sees the old file or the new one, never half of one.
+- An existing target is replaced only when the user asked (``force=True``,
+  the ``--force`` option); otherwise :class:`OutputError` names it.  A target
+  that is an input of the same command (the same file by
+  :func:`os.path.samefile`, hard links and symbolic links included) is refused
+  even with ``force``.
+- A replaced file keeps its permission bits; a new file gets ``0666`` and a
+  new folder ``0777``, both less the process umask (``0644`` / ``0755`` under
+  ``022``), as ``open`` and ``mkdir`` would give them.
+- SIGINT or SIGTERM while a file is written leave the old file as it was and
+  remove the temporary file; the process then ends with the usual
+  ``KeyboardInterrupt``.  Messages name the target, never a temporary path.
+
+:class:`OutputFolder` applies the same rules to a folder of results
+(``motionhyst reproduce --out DIR``): it writes a manifest,
+:data:`MANIFEST`, listing the files the tool wrote there; a later run
+replaces those files and no others, and never deletes anything it did not
+write.
+
+Examples
+--------
+>>> import os, tempfile
+>>> folder = tempfile.mkdtemp()
+>>> target = OutputFile(os.path.join(folder, "run.csv"))
+>>> with target.open() as fh:
+...     _ = fh.write("time,error\\n0,0\\n")
+>>> open(target.path).read()
+'time,error\\n0,0\\n'
+>>> try:
+...     OutputFile(target.path)
+... except OutputError as exc:
+...     print(str(exc).endswith("run.csv exists; give --force to replace it"))
+True
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import signal
+import stat
+import tempfile
+import threading
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import IO
+
+MANIFEST = "motionhyst-manifest.json"
+"""Name of the manifest :class:`OutputFolder` writes into a results folder."""
+
+_MANIFEST_KIND = "motionhyst output folder"
+
+
+class OutputError(ValueError):
+    """An output that must not be written as asked: one line naming the path (exit 2)."""
+
+
+def umask() -> int:
+    """The process umask (read without changing it for longer than one call).
+
+    Examples
+    --------
+    >>> 0 <= umask() <= 0o777
+    True
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    old = os.umask(0o022)
+    os.umask(old)
+    return old
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+def _inputs(inputs: Iterable[str | os.PathLike | None]) -> list[Path]:
+    return [Path(p) for p in inputs if p is not None and isinstance(p, str | os.PathLike)]
+
+
+def check_not_input(path: str | os.PathLike, inputs: Iterable[str | os.PathLike | None],
+                    option: str | None = None) -> None:
+    """Raise :class:`OutputError` if `path` is one of `inputs` (same file or same resolved path).
+
+    Examples
+    --------
+    >>> check_not_input("a.csv", ["b.toml"])
+    >>> check_not_input("a.csv", ["./a.csv"], "--time-series")
+    Traceback (most recent call last):
+    ...
+    motionhyst.outputs.OutputError: --time-series a.csv: it is an input of this command; \
+choose another output file
+    """
+    path = Path(path)
+    for src in _inputs(inputs):
+        if _same_file(path, src):
+            raise OutputError(f"{_label(path, option)}: it is an input of this command; "
+                              f"choose another output file")
+
+
+def _label(path: Path, option: str | None) -> str:
+    return f"{option} {path}" if option else str(path)
+
+
+def _check_parents(path: Path, label: str) -> None:
+    """The nearest existing folder above `path` is a folder we may write in."""
+    for parent in path.parents:
+        if parent.exists() or parent.is_symlink():
+            if not parent.is_dir():
+                raise OutputError(f"{label}: {parent} is not a folder")
+            if not os.access(parent, os.W_OK | os.X_OK):
+                raise OutputError(f"{label}: no permission to write in {parent}")
+            return
+
+
+def _missing_parents(folder: Path) -> list[Path]:
+    """Folders that must be created for `folder` to exist, outermost first."""
+    missing = []
+    while not folder.exists() and not folder.is_symlink():
+        missing.append(folder)
+        if folder.parent == folder:
+            break
+        folder = folder.parent
+    return missing[::-1]
+
+
+@contextlib.contextmanager
+def _signals_raise() -> Iterator[None]:
+    """SIGINT and SIGTERM raise ``KeyboardInterrupt`` inside the block (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):
+        raise KeyboardInterrupt(signal.Signals(signum).name)
+
+    saved = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            saved[sig] = signal.signal(sig, handler)
+        except (ValueError, OSError):  # pragma: no cover - not the main interpreter
+            pass
+    try:
+        yield
+    finally:
+        for sig, old in saved.items():
+            signal.signal(sig, old)
+
+
+class OutputFile:
+    """A file the CLI will write, checked when created (before any computation).
+
+    Parameters
+    ----------
+    path : str or Path
+        The target.  A symbolic link is followed: the file it points to is
+        replaced and the link kept.
+    force : bool
+        Replace an existing file (``--force``).
+    inputs : iterable of paths
+        Files the command reads; the target may be none of them, even with `force`.
+    option : str, optional
+        The option that named the target (``"--time-series"``), for messages.
+
+    Raises
+    ------
+    OutputError
+        One line: the target exists and `force` is false, is an input, is a
+        folder or not a regular file, or its folder is a file.
+    """
+
+    def __init__(self, path: str | os.PathLike, force: bool = False,
+                 inputs: Iterable[str | os.PathLike | None] = (), option: str | None = None):
+        self.path = Path(path)
+        self.option = option
+        self.force = force
+        label = _label(self.path, option)
+        if str(path) == "" or self.path.name in ("", ".", ".."):
+            raise OutputError(f"{label}: not a file name")
+        check_not_input(self.path, inputs, option)
+        self.target = Path(os.path.realpath(self.path)) if self.path.is_symlink() else self.path
+        if self.target.is_dir():
+            raise OutputError(f"{label}: it is a folder; give a file name")
+        if self.target.exists():
+            if not self.target.is_file():
+                raise OutputError(f"{label}: not a regular file; refusing to replace it")
+            if not force:
+                raise OutputError(f"{label} exists; give --force to replace it")
+        elif self.path.is_symlink():
+            raise OutputError(f"{label}: a symbolic link to a missing file; "
+                              f"remove it or choose another name")
+        _check_parents(self.target, label)
+
+    def _mode(self) -> int:
+        try:
+            return stat.S_IMODE(os.stat(self.target).st_mode)
+        except FileNotFoundError:
+            return 0o666 & ~umask()
+
+    @contextlib.contextmanager
+    def open(self, mode: str = "w", encoding: str | None = "utf-8",
+             newline: str | None = None) -> Iterator[IO]:
+        """Write the file through a temporary file in its folder; replace the target at the end.
+
+        Parameters
+        ----------
+        mode : {"w", "wb"}
+            Text or binary.
+        encoding, newline : str, optional
+            As :func:`open` (text mode only).
+
+        Yields
+        ------
+        file object
+            Write to it; the target is replaced when the block ends without
+            an exception (or interruption).  Otherwise the target is as it
+            was and the temporary file is gone.
+        """
+        if mode not in ("w", "wb"):
+            raise ValueError("mode must be 'w' or 'wb'")
+        label = _label(self.path, self.option)
+        created = []
+        tmp = None
+        with _signals_raise():
+            try:
+                for folder in _missing_parents(self.target.parent):
+                    folder.mkdir()
+                    created.append(folder)
+                if (self.target.exists() and not self.force):  # appeared meanwhile
+                    raise OutputError(f"{label} exists; give --force to replace it")
+                fd, tmp = tempfile.mkstemp(prefix=f".{self.target.name}.", suffix=".part",
+                                           dir=self.target.parent)
+                os.fchmod(fd, self._mode())
+                kw = {} if mode == "wb" else {"encoding": encoding, "newline": newline}
+                with os.fdopen(fd, mode, **kw) as fh:
+                    yield fh
+                    fh.flush()
+                    os.fsync(fh.fileno())
+                os.replace(tmp, self.target)
+                tmp = None
+                _fsync_dir(self.target.parent)
+            except OSError as exc:
+                raise OutputError(f"cannot write {label}: "
+                                  f"{exc.strerror or exc.__class__.__name__}") from None
+            finally:
+                if tmp is not None:
+                    with contextlib.suppress(OSError):
+                        os.unlink(tmp)
+                    for folder in reversed(created):
+                        with contextlib.suppress(OSError):
+                            folder.rmdir()
+
+    def write_bytes(self, data: bytes) -> None:
+        """Write `data` atomically (see :meth:`open`)."""
+        with self.open("wb") as fh:
+            fh.write(data)
+
+    def write_text(self, text: str) -> None:
+        """Write `text` (UTF-8) atomically (see :meth:`open`)."""
+        with self.open("w") as fh:
+            fh.write(text)
+
+
+def _fsync_dir(folder: Path) -> None:
+    """Make a rename in `folder` durable (best effort)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:  # pragma: no cover - e.g. platforms without directory fds
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover
+        pass
+    finally:
+        os.close(fd)
+
+
+class OutputFolder:
+    """A results folder (``reproduce --out DIR``) shared with the user's own files.
+
+    The folder may hold anything; the tool writes only the names it is asked
+    to write, records them in :data:`MANIFEST`, and on a later run replaces
+    only files that manifest lists (others of the same name need `force`).
+    Files of an earlier run that this run does not write again are removed
+    only if the manifest lists them.  Each file is written atomically by
+    :class:`OutputFile`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The folder; created (with missing parents) if absent.  ``"."`` is fine.
+    names : iterable of str
+        Every file name this run may write (plain names, no folders).
+    force : bool
+        Also replace files of those names that the tool did not write.
+    inputs : iterable of paths
+        Files the command reads (never replaced).
+    option : str
+        The option naming the folder, for messages.
+
+    Raises
+    ------
+    OutputError
+        The path is a regular file, a symbolic link or not a folder, or a file
+        to be written exists, was not written by the tool and `force` is false.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> folder = tempfile.mkdtemp()
+    >>> open(os.path.join(folder, "notes.txt"), "w").write("mine")
+    4
+    >>> out = OutputFolder(folder, ["report.md"])
+    >>> out.write_text("report.md", "# report")
+    >>> out.finish()  # the names of files of an earlier run that were removed
+    []
+    >>> sorted(os.listdir(folder))
+    ['motionhyst-manifest.json', 'notes.txt', 'report.md']
+    """
+
+    def __init__(self, path: str | os.PathLike, names: Iterable[str], force: bool = False,
+                 inputs: Iterable[str | os.PathLike | None] = (), option: str = "--out"):
+        self.path = Path(path)
+        self.option = option
+        self.force = force
+        self.inputs = _inputs(inputs)
+        self.names = list(dict.fromkeys(names))
+        label = f"{option} {self.path}"
+        for name in self.names:
+            if Path(name).name != name or name in ("", ".", "..", MANIFEST):
+                raise ValueError(f"not a plain file name: {name!r}")
+        if self.path.is_symlink():
+            raise OutputError(f"{label} is a symbolic link; give the folder it points to "
+                              f"or another name")
+        if self.path.exists() and not self.path.is_dir():
+            kind = "a file" if self.path.is_file() else "not a folder"
+            raise OutputError(f"{label} is {kind}; give a folder (it is left untouched)")
+        _check_parents(self.path, label)
+        self.previous = self._read_manifest()
+        for name in self.names:
+            target = self.path / name
+            if target.is_symlink() or target.exists():
+                if target.is_dir() and not target.is_symlink():
+                    raise OutputError(f"{label}: {target} is a folder; the tool writes a file "
+                                      f"of that name (move it away)")
+                if name not in self.previous and not force:
+                    raise OutputError(f"{label}: {target} exists and was not written by "
+                                      f"motionhyst (not in {MANIFEST}); give --force to "
+                                      f"replace it")
+            check_not_input(target, self.inputs, option)
+        self.written: list[str] = []
+        self._created: list[Path] = []
+
+    def _read_manifest(self) -> set[str]:
+        """Names an earlier run recorded; a manifest that is not ours is ignored."""
+        path = self.path / MANIFEST
+        if not path.is_file() or path.is_symlink():
+            return set()
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return set()
+        if not isinstance(data, dict) or data.get("kind") != _MANIFEST_KIND:
+            return set()
+        files = data.get("files", [])
+        if not isinstance(files, list):
+            return set()
+        # only plain names: a manifest never authorises a path outside the folder
+        return {f for f in files if isinstance(f, str) and Path(f).name == f
+                and f not in ("", ".", "..", MANIFEST)}
+
+    def _ensure_folder(self) -> None:
+        if not self.path.exists():
+            for folder in _missing_parents(self.path):
+                try:
+                    folder.mkdir()
+                except OSError as exc:
+                    raise OutputError(f"cannot create {self.option} {folder}: "
+                                      f"{exc.strerror}") from None
+                self._created.append(folder)
+
+    def _manifest(self, names: Iterable[str]) -> None:
+        text = json.dumps({"kind": _MANIFEST_KIND,
+                           "note": "files written by motionhyst; a later run replaces "
+                                   "these and nothing else in this folder",
+                           "files": sorted(set(names))}, indent=2) + "\n"
+        OutputFile(self.path / MANIFEST, force=True).write_text(text)
+
+    def _file(self, name: str) -> OutputFile:
+        if name not in self.names:
+            raise ValueError(f"{name!r} is not among the names given to OutputFolder")
+        self._ensure_folder()
+        if not self.written:
+            # record first what may appear, so an interrupted run's files are still ours
+            self._manifest(self.previous | set(self.names))
+        return OutputFile(self.path / name, force=True, inputs=self.inputs, option=self.option)
+
+    def write_bytes(self, name: str, data: bytes) -> None:
+        """Write the file `name` of the folder atomically."""
+        self._file(name).write_bytes(data)
+        self.written.append(name)
+
+    def write_text(self, name: str, text: str) -> None:
+        """Write the text file `name` of the folder atomically (UTF-8)."""
+        self._file(name).write_text(text)
+        self.written.append(name)
+
+    def finish(self) -> list[str]:
+        """Record the files of this run and remove files of earlier runs not written again.
+
+        Returns
+        -------
+        list of str
+            Names of the removed files.
+        """
+        self._ensure_folder()
+        removed = []
+        for name in sorted(self.previous - set(self.written)):
+            target = self.path / name
+            if target.is_file() and not target.is_symlink():
+                with contextlib.suppress(OSError):
+                    target.unlink()
+                    removed.append(name)
+        self._manifest(self.written)
+        return removed
+
+    def abandon(self) -> None:
+        """After a failure: remove the folders this run created if they are still empty."""
+        for folder in reversed(self._created):
+            with contextlib.suppress(OSError):
+                if {p.name for p in folder.iterdir()} <= {MANIFEST}:
+                    (folder / MANIFEST).unlink(missing_ok=True)
+                folder.rmdir()
+
+
+__all__ = ["MANIFEST", "OutputError", "OutputFile", "OutputFolder", "check_not_input",
+           "umask"]

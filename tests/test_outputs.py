@@ -1,0 +1,264 @@
+"""motionhyst.outputs: atomic writes, --force, inputs never overwritten, modes, signals."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from motionhyst.outputs import MANIFEST, OutputError, OutputFile, OutputFolder
+
+
+@pytest.fixture
+def umask022():
+    old = os.umask(0o022)
+    yield
+    os.umask(old)
+
+
+def _mode(path) -> int:
+    return stat.S_IMODE(os.stat(path).st_mode)
+
+
+def _listing(folder) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): (p.read_bytes() if p.is_file() else b"<dir>")
+            for p in sorted(folder.rglob("*"))}
+
+
+def test_new_file_and_folders_follow_the_umask(tmp_path, umask022):
+    out = OutputFile(tmp_path / "a" / "b" / "run.csv")
+    out.write_text("x\n")
+    assert (tmp_path / "a" / "b" / "run.csv").read_text() == "x\n"
+    assert _mode(tmp_path / "a" / "b" / "run.csv") == 0o644
+    assert _mode(tmp_path / "a") == 0o755 and _mode(tmp_path / "a" / "b") == 0o755
+    os.umask(0o077)
+    OutputFile(tmp_path / "private.csv").write_text("y")
+    assert _mode(tmp_path / "private.csv") == 0o600
+
+
+def test_existing_file_needs_force_and_keeps_its_mode(tmp_path, umask022):
+    path = tmp_path / "run.csv"
+    path.write_text("old")
+    os.chmod(path, 0o640)
+    with pytest.raises(OutputError, match=r"--time-series .*run\.csv exists; give --force"):
+        OutputFile(path, option="--time-series")
+    assert path.read_text() == "old"
+    OutputFile(path, force=True).write_text("new")
+    assert path.read_text() == "new" and _mode(path) == 0o640
+    assert sorted(os.listdir(tmp_path)) == ["run.csv"]
+
+
+def test_an_input_is_never_overwritten_even_with_force(tmp_path, monkeypatch):
+    src = tmp_path / "scenario.toml"
+    src.write_text("input")
+    (tmp_path / "hard.toml").hardlink_to(src)
+    (tmp_path / "soft.toml").symlink_to(src)
+    monkeypatch.chdir(tmp_path)
+    for target in (src, tmp_path / "hard.toml", tmp_path / "soft.toml", "scenario.toml",
+                   tmp_path / "sub" / ".." / "scenario.toml"):
+        with pytest.raises(OutputError, match="it is an input of this command"):
+            OutputFile(target, force=True, inputs=[None, src])
+    assert src.read_text() == "input"
+
+
+def test_symlink_target_is_followed_and_kept(tmp_path):
+    real = tmp_path / "real.csv"
+    real.write_text("old")
+    link = tmp_path / "link.csv"
+    link.symlink_to(real)
+    with pytest.raises(OutputError, match="exists"):
+        OutputFile(link)
+    OutputFile(link, force=True).write_text("new")
+    assert link.is_symlink() and real.read_text() == "new"
+    dangling = tmp_path / "dangling.csv"
+    dangling.symlink_to(tmp_path / "nowhere.csv")
+    with pytest.raises(OutputError, match="symbolic link to a missing file"):
+        OutputFile(dangling)
+
+
+@pytest.mark.parametrize("make", ["folder", "parent-file", "empty", "dot"])
+def test_targets_that_are_not_files(tmp_path, make):
+    if make == "folder":
+        (tmp_path / "x").mkdir()
+        target, match = tmp_path / "x", "it is a folder"
+    elif make == "parent-file":
+        (tmp_path / "f").write_text("mine")
+        target, match = tmp_path / "f" / "run.csv", "is not a folder"
+    elif make == "empty":
+        target, match = "", "not a file name"
+    else:
+        target, match = tmp_path / ".", "it is a folder"
+    before = _listing(tmp_path)
+    with pytest.raises(OutputError, match=match):
+        OutputFile(target, force=True)
+    assert _listing(tmp_path) == before
+
+
+def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
+    path = tmp_path / "run.csv"
+    path.write_text("old")
+    out = OutputFile(path, force=True)
+    with pytest.raises(RuntimeError), out.open() as fh:
+        fh.write("half")
+        raise RuntimeError("simulation failed")
+    assert path.read_text() == "old" and os.listdir(tmp_path) == ["run.csv"]
+    created = OutputFile(tmp_path / "new" / "deep" / "run.csv")
+    with pytest.raises(KeyboardInterrupt), created.open() as fh:
+        raise KeyboardInterrupt
+    assert os.listdir(tmp_path) == ["run.csv"]  # the folders it made are gone too
+
+
+def test_errors_name_the_target_not_a_temporary(tmp_path):
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    os.chmod(folder, 0o555)
+    try:
+        if os.access(folder, os.W_OK):
+            pytest.skip("running as a user who can write anywhere")
+        with pytest.raises(OutputError) as info:
+            OutputFile(folder / "run.csv")
+        assert str(info.value) == f"{folder / 'run.csv'}: no permission to write in {folder}"
+    finally:
+        os.chmod(folder, 0o755)
+
+
+_WRITER = textwrap.dedent("""
+    import sys, time
+    from motionhyst.outputs import OutputFile
+    out = OutputFile(sys.argv[1], force=True)
+    with out.open() as fh:
+        fh.write("new,partial\\n" * 1000)
+        fh.flush()
+        print("writing", flush=True)
+        time.sleep(60)
+""")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_mid_write_leaves_the_old_file_and_no_temporary(tmp_path, sig):
+    path = tmp_path / "run.csv"
+    path.write_text("old\n")
+    proc = subprocess.Popen([sys.executable, "-c", _WRITER, str(path)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "writing"
+    assert any(p.name.endswith(".part") for p in tmp_path.iterdir())  # the write is under way
+    proc.send_signal(sig)
+    deadline = time.monotonic() + 30
+    while proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is not None and proc.returncode != 0
+    assert "KeyboardInterrupt" in proc.stderr.read()
+    assert path.read_text() == "old\n"
+    assert os.listdir(tmp_path) == ["run.csv"]
+
+
+# ------------------------------------------------------------------------- folders
+NAMES = ["report.md", "summary.json", "fig5.png"]
+
+
+def _run(folder, names=NAMES, force=False, content="v1"):
+    out = OutputFolder(folder, names, force=force)
+    for name in names:
+        out.write_text(name, f"{content} {name}")
+    out.finish()
+    return out
+
+
+def test_folder_keeps_everything_it_did_not_write(tmp_path, umask022):
+    out = tmp_path / "out"
+    (out / "sub").mkdir(parents=True)
+    (out / "notes.txt").write_text("mine")
+    (out / "sub" / "data.csv").write_text("1,2")
+    _run(out)
+    _run(out, content="v2")  # a second run replaces its own files without --force
+    assert (out / "report.md").read_text() == "v2 report.md"
+    assert (out / "notes.txt").read_text() == "mine"
+    assert (out / "sub" / "data.csv").read_text() == "1,2"
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert manifest["files"] == sorted(NAMES)
+    assert _mode(out / "report.md") == 0o644
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_folder_refuses_a_file_of_the_same_name_it_did_not_write(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "report.md").write_text("my own report")
+    before = _listing(tmp_path)
+    with pytest.raises(OutputError, match=r"report\.md exists and was not written by motionhyst"):
+        _run(out)
+    assert _listing(tmp_path) == before
+    _run(out, force=True)
+    assert (out / "report.md").read_text() == "v1 report.md"
+
+
+def test_folder_removes_only_its_own_stale_files(tmp_path):
+    out = tmp_path / "out"
+    _run(out, names=["fig6.png", *NAMES])
+    (out / "fig7.png").write_text("the user's")
+    _run(out, names=NAMES)
+    assert not (out / "fig6.png").exists()
+    assert (out / "fig7.png").read_text() == "the user's"
+
+
+def test_a_forged_manifest_authorises_nothing_outside_the_names(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (tmp_path / "precious.txt").write_text("keep")
+    (out / "keep.txt").write_text("keep")
+    (out / MANIFEST).write_text(json.dumps({"kind": "motionhyst output folder",
+                                            "files": ["../precious.txt", "keep.txt"]}))
+    _run(out)
+    assert (tmp_path / "precious.txt").read_text() == "keep"
+    assert not (out / "keep.txt").exists()  # listed as ours: removed as stale
+    (out / "other.txt").write_text("keep")
+    (out / MANIFEST).write_text("not json")
+    (out / "report.md").write_text("mine now")
+    with pytest.raises(OutputError, match="was not written by motionhyst"):
+        _run(out)
+
+
+@pytest.mark.parametrize("kind", ["file", "symlink-to-folder", "symlink-to-file", "dangling"])
+def test_folder_named_by_a_file_or_link_is_left_untouched(tmp_path, kind):
+    target = tmp_path / "out"
+    (tmp_path / "real").mkdir()
+    (tmp_path / "real.txt").write_text("x")
+    if kind == "file":
+        target.write_text("my data")
+    elif kind == "symlink-to-folder":
+        target.symlink_to(tmp_path / "real")
+    elif kind == "symlink-to-file":
+        target.symlink_to(tmp_path / "real.txt")
+    else:
+        target.symlink_to(tmp_path / "nowhere")
+    before = _listing(tmp_path)
+    with pytest.raises(OutputError, match=r"--out .*out is (a file|a symbolic link)"):
+        _run(target)
+    assert _listing(tmp_path) == before
+
+
+def test_folder_dot_is_the_current_folder(tmp_path, monkeypatch):
+    (tmp_path / "mine.txt").write_text("x")
+    monkeypatch.chdir(tmp_path)
+    _run(".")
+    assert sorted(os.listdir(tmp_path)) == sorted([*NAMES, MANIFEST, "mine.txt"])
+
+
+def test_folder_failure_leaves_no_hidden_files_and_removes_a_new_empty_folder(tmp_path):
+    target = tmp_path / "new" / "out"
+    out = OutputFolder(target, NAMES)
+    out.abandon()
+    assert os.listdir(tmp_path) == []
+    out = OutputFolder(target, NAMES)
+    out.write_text("report.md", "x")
+    with pytest.raises(ValueError, match="not among the names"):
+        out.write_text("other.md", "x")
+    assert sorted(os.listdir(target)) == [MANIFEST, "report.md"]
+    assert "report.md" in json.loads((target / MANIFEST).read_text())["files"]
