@@ -68,17 +68,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-import control
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import solve
 from scipy.optimize import least_squares, nnls
-from scipy.signal import butter, cont2discrete, zpk2ss
+from scipy.signal import butter
 
 from motionhyst.csvdata import Source, describe, read_columns
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.hysteresis._kernels import maxwell_response, stop_response
+from motionhyst.lti import HoldFilter, tf_poly
 from motionhyst.systems import TWO_PI
 
 MIN_SAMPLES = 50
@@ -202,89 +201,6 @@ def _check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
         raise ValueError(f"constant {xname}: nothing to identify from")
     if count_reversals(x) < 1:
         raise ValueError(f"no reversal: the {xname} must move back and forth at least once")
-
-
-@njit(cache=True)
-def _dss_filter(Ad, Bd, Cd, Dd, U, X0):  # pragma: no cover - compiled
-    """Run a SISO discrete state-space filter over each column of `U` from states `X0`."""
-    n, m = U.shape
-    nx = Ad.shape[0]
-    Y = np.empty((n, m))
-    for j in range(m):
-        x = X0[:, j].copy()
-        xn = np.empty(nx)
-        for i in range(n):
-            u = U[i, j]
-            y = Dd * u
-            for a in range(nx):
-                y += Cd[a] * x[a]
-            Y[i, j] = y
-            for a in range(nx):
-                s = Bd[a] * u
-                for b in range(nx):
-                    s += Ad[a, b] * x[b]
-                xn[a] = s
-            for a in range(nx):
-                x[a] = xn[a]
-    return Y
-
-
-class HoldFilter:
-    """A proper SISO LTI filter applied to sampled signals, exact for piecewise-linear inputs.
-
-    The filter is discretised with a first-order hold (``cont2discrete(...,
-    method="foh")``) in time scaled by `omega0`, so the discrete filter is the
-    continuous one applied to the samples' linear interpolation.  Every
-    signal is taken as constant at its first value before the record (the
-    filter state starts in steady state), which removes start-up transients
-    from position offsets.
-
-    Parameters
-    ----------
-    zeros, poles : array_like
-        Zeros and poles [rad/s] (conjugate pairs complete); ``len(zeros) <= len(poles)``.
-    gain : float
-        Gain of the zero-pole-gain form.
-    dt : float
-        Sampling interval [s].
-    omega0 : float
-        Time scale [rad/s] used for conditioning (e.g. the cut-off).
-    """
-
-    def __init__(self, zeros: ArrayLike, poles: ArrayLike, gain: float, dt: float,
-                 omega0: float) -> None:
-        self.zeros = np.asarray(zeros, dtype=complex)
-        self.poles = np.asarray(poles, dtype=complex)
-        self.gain = float(gain)
-        self.dt = float(dt)
-        self.omega0 = float(omega0)
-        z = self.zeros / omega0
-        p = self.poles / omega0
-        if z.size > p.size:
-            raise ValueError("the filter must be proper")
-        g = float(gain) * omega0 ** (z.size - p.size)
-        A, B, C, D = zpk2ss(z, p, g)
-        Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), omega0 * dt, method="foh")
-        self.Ad = np.ascontiguousarray(Ad, dtype=float)
-        self.Bd = np.ascontiguousarray(np.ravel(Bd), dtype=float)
-        self.Cd = np.ascontiguousarray(np.ravel(Cd), dtype=float)
-        self.Dd = float(np.ravel(Dd)[0])
-        # steady state for a unit constant input: x = Ad x + Bd
-        self._x_unit = solve(np.eye(self.Ad.shape[0]) - self.Ad, self.Bd)
-        self.dc_gain = float(self.Dd + self.Cd @ self._x_unit)
-
-    def with_step(self, dt: float) -> HoldFilter:
-        """The same continuous filter discretised for sampling interval `dt` [s]."""
-        return HoldFilter(self.zeros, self.poles, self.gain, dt, self.omega0)
-
-    def __call__(self, u: ArrayLike) -> NDArray[np.float64]:
-        """Filter a signal (1-D) or each column of a 2-D array (time along axis 0)."""
-        U = np.asarray(u, dtype=float)
-        one = U.ndim == 1
-        U2 = np.ascontiguousarray(U[:, None] if one else U)
-        X0 = np.ascontiguousarray(np.outer(self._x_unit, U2[0]))
-        Y = _dss_filter(self.Ad, self.Bd, self.Cd, self.Dd, U2, X0)
-        return Y[:, 0] if one else Y
 
 
 # --------------------------------------------------------------------------- the model fit
@@ -903,15 +819,14 @@ def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = N
     return _identify(prob, n_elements, criterion, rtol, atol, max_elements, "force")
 
 
-def _poly(sys) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    if isinstance(sys, control.StateSpace):
-        sys = control.ss2tf(sys)
-    if not isinstance(sys, control.TransferFunction):
+def _p1_poly(stage) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Coefficients of ``P1`` of a stage (or of an LTI ``P1`` itself), leading zeros dropped."""
+    try:
+        num, den = tf_poly(getattr(stage, "P1", stage), "P1")
+    except TypeError:
         raise TypeError("closed-loop identification needs an LTI model of P1 (a TwoMassStage "
-                        f"or a python-control system), got {type(sys).__name__}")
-    num = np.trim_zeros(np.atleast_1d(np.asarray(sys.num[0][0], float)), "f")
-    den = np.trim_zeros(np.atleast_1d(np.asarray(sys.den[0][0], float)), "f")
-    return num, den
+                        f"or a python-control system), got {type(stage).__name__}") from None
+    return np.trim_zeros(num, "f"), np.trim_zeros(den, "f")
 
 
 @dataclass
@@ -993,7 +908,7 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     dt = float(np.median(dts))
     if np.max(np.abs(dts - dt)) > UNIFORM_RTOL * dt:
         raise ValueError("closed-loop records must be uniformly sampled; resample first")
-    num, den = _poly(getattr(stage, "P1", stage))
+    num, den = _p1_poly(stage)
     if num.size > den.size:
         raise ValueError("P1 must be proper")
     if num[-1] == 0:

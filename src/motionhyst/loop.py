@@ -17,86 +17,15 @@ exact: a controller without integrator gives ``P2 / (1 + C P2) -> 1 / C(0)``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import control
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.base import Hysteresis
+from motionhyst.lti import PolyTF, cancel_s, polysub_exact, tf_poly, trim
 from motionhyst.systems import MeasuredPlant, TwoMassStage, bandwidth, freqresp
 
 TRANSFERS = ("r->e", "r->y1", "w->e", "w->y1")
-
-
-def _tf_poly(sys) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Numerator and denominator coefficients of a SISO LTI system."""
-    if isinstance(sys, control.StateSpace):
-        sys = control.ss2tf(sys)
-    if not isinstance(sys, control.TransferFunction):
-        raise TypeError(f"expected an LTI system, got {type(sys).__name__}")
-    if sys.ninputs != 1 or sys.noutputs != 1:
-        raise ValueError("plant and controller must be single-input single-output")
-    return np.atleast_1d(np.asarray(sys.num[0][0], float)), np.atleast_1d(
-        np.asarray(sys.den[0][0], float))
-
-
-def _trim(p: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Drop leading coefficients that are exactly zero."""
-    p = np.atleast_1d(np.asarray(p, dtype=float))
-    nz = np.nonzero(p != 0.0)[0]
-    return p[nz[0]:] if nz.size else np.zeros(1)
-
-
-def _polysub_exact(a, b, rtol: float = 1e-12):
-    """``a - b`` with coefficients that cancel to round-off set to exactly zero."""
-    n = max(len(a), len(b))
-    a = np.pad(np.asarray(a, float), (n - len(a), 0))
-    b = np.pad(np.asarray(b, float), (n - len(b), 0))
-    d = a - b
-    d[np.abs(d) <= rtol * np.maximum(np.abs(a), np.abs(b))] = 0.0
-    return d
-
-
-def _cancel_s(num, den):
-    """Cancel common factors ``s`` (trailing zero coefficients) of a ratio."""
-    num, den = _trim(num), _trim(den)
-    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
-        num, den = num[:-1], den[:-1]
-    return num, den
-
-
-@njit(cache=True)
-def _polyratio(num, den, omega):  # pragma: no cover - compiled
-    """``num(j omega) / den(j omega)`` at each of `omega`, both by Horner's rule."""
-    out = np.empty(omega.shape[0], dtype=np.complex128)
-    for i in range(omega.shape[0]):
-        s = 1j * omega[i]
-        p = 0j
-        for c in num:
-            p = p * s + c
-        q = 0j
-        for c in den:
-            q = q * s + c
-        out[i] = p / q
-    return out
-
-
-@dataclass(frozen=True)
-class PolyTF:
-    """A SISO transfer function as coefficient arrays (highest power first)."""
-
-    num: NDArray[np.float64]
-    den: NDArray[np.float64]
-
-    def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
-        w = np.asarray(omega, dtype=float)
-        return _polyratio(self.num, self.den, w.ravel()).reshape(w.shape)
-
-    def tf(self) -> control.TransferFunction:
-        """As a python-control transfer function."""
-        return control.tf(self.num, self.den)
 
 
 class Loop:
@@ -157,21 +86,21 @@ class Loop:
         return control.tf([1.0], [self.M, 0.0, 0.0])
 
     def _closed_loop_polys(self) -> dict[str, PolyTF]:
-        n1, d1 = _tf_poly(self.P1)
-        n2, d2 = _tf_poly(self.P2)
-        nc, dc = _tf_poly(self.controller)
+        n1, d1 = tf_poly(self.P1)
+        n2, d2 = tf_poly(self.P2)
+        nc, dc = tf_poly(self.controller)
         char = np.polyadd(np.polymul(d2, dc), np.polymul(n2, nc))  # (1 + C P2) d2 dc
         if self.feedforward == "rigid-body":
             # 1 - P2 M s^2 = (d2 - M s^2 n2) / d2; C + C_ff = (nc + M s^2 dc) / dc
-            ff_num = _polysub_exact(d2, np.polymul(n2, [self.M, 0.0, 0.0]))
+            ff_num = polysub_exact(d2, np.polymul(n2, [self.M, 0.0, 0.0]))
             cff = np.polyadd(nc, np.polymul(dc, [self.M, 0.0, 0.0]))
         else:
             ff_num, cff = d2, nc
         out = {
-            "r->e": _cancel_s(np.polymul(ff_num, dc), char),
-            "r->y1": _cancel_s(np.polymul(np.polymul(n1, d2), cff), np.polymul(d1, char)),
-            "w->e": _cancel_s(np.polymul(n2, dc), char),
-            "w->y1": _cancel_s(-np.polymul(np.polymul(n1, d2), dc), np.polymul(d1, char)),
+            "r->e": cancel_s(np.polymul(ff_num, dc), char),
+            "r->y1": cancel_s(np.polymul(np.polymul(n1, d2), cff), np.polymul(d1, char)),
+            "w->e": cancel_s(np.polymul(n2, dc), char),
+            "w->y1": cancel_s(-np.polymul(np.polymul(n1, d2), dc), np.polymul(d1, char)),
         }
         return {k: PolyTF(*v) for k, v in out.items()}
 
@@ -224,9 +153,9 @@ class Loop:
         if self.hysteresis is not None:
             # stuck link, w = kJ y1: characteristic polynomial of 1 + kJ P1 + C P2, over a
             # common denominator of P1 and P2 (shared by both for a two-mass stage)
-            n1, d1 = _tf_poly(self.P1)
-            n2, d2 = _tf_poly(self.P2)
-            nc, dc = _tf_poly(self.controller)
+            n1, d1 = tf_poly(self.P1)
+            n2, d2 = tf_poly(self.P2)
+            nc, dc = tf_poly(self.controller)
             kj = self.hysteresis.initial_stiffness
             if d1.shape == d2.shape and np.array_equal(d1, d2):
                 n1c, n2c, d = n1, n2, d1
@@ -235,7 +164,7 @@ class Loop:
             stuck = np.polyadd(np.polymul(np.polyadd(d, kj * n1c), dc), np.polymul(n2c, nc))
             cases.append((" with the dynamic link stuck", stuck))
         for what, den in cases:
-            p = np.roots(_trim(den))
+            p = np.roots(trim(den))
             if p.size and np.max(p.real) >= 0:
                 worst = p[np.argmax(p.real)]
                 raise ValueError(f"the controller does not stabilise the loop{what} "

@@ -18,17 +18,23 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import control
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
-from scipy.linalg import expm
-from scipy.signal import cont2discrete
 
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
 from motionhyst.hysteresis.stepping import Stepping, advance, open_loop
-from motionhyst.loop import Loop, _cancel_s, _polysub_exact
+from motionhyst.loop import Loop
+from motionhyst.lti import (
+    discretize_foh,
+    divide_s2,
+    dss_filter,
+    forced_response_foh,
+    polysub_exact,
+    realize_scaled,
+    stack,
+)
 from motionhyst.systems import TWO_PI
 
 STEPS_PER_POLE_PERIOD = 40
@@ -69,90 +75,21 @@ class Simulation:
                 "y2": self.y2, "u": self.u, "w": self.w, "error_linear": self.e_linear}
 
 
-def _divide_s2(num, den, what: str):
-    num, den = _cancel_s(num, np.polymul(den, [1.0, 0.0, 0.0]))
-    if den[-1] == 0.0 and len(den) > 1 and den[-2] == 0.0:
-        raise ValueError(f"time simulation needs {what} to vanish like s^2 at DC "
-                         "(a plant with a rigid-body double integrator)")
-    return num, den
-
-
-def _realize(num, den, omega0: float):
-    """Balanced state-space realisation in scaled time ``omega0 t``."""
-    n = len(den) - 1
-    # substitute s = omega0 * s_hat, then divide numerator and denominator by omega0^n
-    num_h = np.asarray(num) * omega0 ** (np.arange(len(num) - 1, -1, -1.0) - n)
-    den_h = np.asarray(den) * omega0 ** (np.arange(n, -1, -1.0) - n)
-    sys = control.tf2ss(control.tf(num_h / den_h[0], den_h / den_h[0]))
-    return sys.A, sys.B, sys.C, sys.D
-
-
-def _stack(mats):
-    """Block-diagonal stack of single-input realisations sharing that input, one output each."""
-    n = sum(a.shape[0] for a, _, _, _ in mats)
-    A = np.zeros((n, n))
-    B = np.zeros((n, 1))
-    C = np.zeros((len(mats), n))
-    D = np.zeros((len(mats), 1))
-    k = 0
-    for o, (a, b, c, d) in enumerate(mats):
-        m = a.shape[0]
-        A[k:k + m, k:k + m] = a
-        B[k:k + m, 0] = b[:, 0]
-        C[o, k:k + m] = c[0]
-        D[o, 0] = d[0, 0]
-        k += m
-    return A, B, C, D
-
-
 def _block_systems(loop: Loop, omega0: float):
     """Realisations in scaled time of ``r'' -> (e, y1 - r)`` and ``w -> (e, y1 - r)``."""
     P = loop._poly
     if P is None:
         raise ValueError("time simulation needs LTI plant and controller")
     ry1 = P["r->y1"]
-    n_ae = _divide_s2(P["r->e"].num, P["r->e"].den, "the error response to the reference")
-    n_ay = _divide_s2(_polysub_exact(ry1.num, ry1.den), ry1.den,
+    n_ae = divide_s2(P["r->e"].num, P["r->e"].den, "the error response to the reference")
+    n_ay = divide_s2(polysub_exact(ry1.num, ry1.den), ry1.den,
                       "the response of y1 - r to the reference")
-    sys_a = _stack([_realize(num, den, omega0) for num, den in (n_ae, n_ay)])
-    sys_w = _stack([_realize(P[name].num, P[name].den, omega0) for name in ("w->e", "w->y1")])
+    sys_a = stack([realize_scaled(num, den, omega0) for num, den in (n_ae, n_ay)])
+    sys_w = stack([realize_scaled(P[name].num, P[name].den, omega0) for name in ("w->e", "w->y1")])
     return sys_a, sys_w
 
 
-def _discretize(sys, h: float):
-    """First-order-hold (input linear between samples) discretisation with step `h`."""
-    Ad, Bd, Cd, Dd, _ = cont2discrete(sys, h, method="foh")
-    return (np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), np.ascontiguousarray(Cd),
-            np.ascontiguousarray(Dd))
-
-
-# element kinds of the compiled loop (one row of parameters each)
 MAX_FIXED_POINT_ITERATIONS = 50
-
-
-@njit(cache=True)
-def _lsim(Ad, Bd, Cd, Dd, u, x0):  # pragma: no cover - compiled
-    """Outputs ``(n_t, p)`` of the discrete system ``x+ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
-    n_t = u.shape[0]
-    n_x = Ad.shape[0]
-    n_y = Cd.shape[0]
-    x = x0.copy()
-    xn = np.empty(n_x)
-    y = np.empty((n_t, n_y))
-    for i in range(n_t):
-        ui = u[i]
-        for o in range(n_y):
-            acc = Dd[o, 0] * ui
-            for j in range(n_x):
-                acc += Cd[o, j] * x[j]
-            y[i, o] = acc
-        for j in range(n_x):
-            acc = Bd[j, 0] * ui
-            for q in range(n_x):
-                acc += Ad[j, q] * x[q]
-            xn[j] = acc
-        x, xn = xn, x
-    return y
 
 
 @njit(cache=True)
@@ -238,53 +175,6 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, 
             xn[j] = acc
         x, xn = xn, x
     return e, dev, w, worst
-
-
-@njit(cache=True)
-def _foh_states(Ad, Bd0, Bd1, C, D, u):  # pragma: no cover - compiled
-    """Output of ``x_i = Ad x_{i-1} + Bd0 u_{i-1} + Bd1 u_i``, ``y = C x + D u`` from rest."""
-    n_t = u.shape[0]
-    n_x = Ad.shape[0]
-    x = np.zeros(n_x)
-    xn = np.zeros(n_x)
-    y = np.empty(n_t)
-    for i in range(n_t):
-        if i > 0:
-            for j in range(n_x):
-                acc = 0.0
-                for q in range(n_x):
-                    acc += Ad[j, q] * x[q]
-                xn[j] = acc + Bd0[j] * u[i - 1] + Bd1[j] * u[i]
-            x, xn = xn, x
-        acc = 0.0
-        for j in range(n_x):
-            acc += C[j] * x[j]
-        y[i] = acc + D * u[i]
-    return y
-
-
-def _filter_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Response from rest of the SISO LTI `sys` to `u`, linear between the uniform samples `t`.
-
-    The algorithm and realisation of :func:`control.forced_response` (exact for
-    an input linear between samples), with the time loop compiled.
-    """
-    ss = control.ss(sys)
-    A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
-    C, D = np.asarray(ss.C, float), np.asarray(ss.D, float)
-    n = A.shape[0]
-    if n == 0:
-        return D[0, 0] * u
-    h = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
-    M = np.zeros((n + 2, n + 2))
-    M[:n, :n] = A * h
-    M[:n, n] = B[:, 0] * h
-    M[n, n + 1] = 1.0
-    E = expm(M)
-    Ad = np.ascontiguousarray(E[:n, :n])
-    Bd1 = np.ascontiguousarray(E[:n, n + 1])
-    Bd0 = np.ascontiguousarray(E[:n, n] - Bd1)
-    return _foh_states(Ad, Bd0, Bd1, np.ascontiguousarray(C[0]), float(D[0, 0]), u)
 
 
 def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float64],
@@ -377,7 +267,9 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     # sets the initial state (delta(t) = omega0 delta(tau) in scaled time)
     v0 = float(getattr(reference, "initial_velocity", 0.0))
     x0 = sys_a[1][:, 0] * v0 * omega0
-    lin = _lsim(*_discretize(sys_a, omega0 * step), a, x0)
+    Ad, Bd, Cd, Dd = discretize_foh(sys_a, omega0 * step)
+    lin = dss_filter(Ad, np.ascontiguousarray(Bd[:, 0]), Cd, np.ascontiguousarray(Dd[:, 0]),
+                     a[:, None], x0[:, None])[:, :, 0]
     e_lin = np.ascontiguousarray(lin[:, 0])
     # hysteresis feedforward u_h = phi_hat(r) acts like -w on the loop
     if hff is None:
@@ -391,7 +283,7 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
         if uf.shape != t.shape or not np.all(np.isfinite(uf)):
             raise ValueError("the feedforward force must give one finite value per time")
         uh = np.ascontiguousarray(uh + uf)
-    e, dev, w, iters = _run(*_discretize(sys_w, omega0 * step), r, e_lin,
+    e, dev, w, iters = _run(*discretize_foh(sys_w, omega0 * step), r, e_lin,
                             np.ascontiguousarray(lin[:, 1]), uh, step, codes, params, s0,
                             GL_T, GL_W, 1e-14 * f_scale, MAX_FIXED_POINT_ITERATIONS)
     if iters > MAX_FIXED_POINT_ITERATIONS:
@@ -402,7 +294,7 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     y1 = r + dev
     y2 = r - e
     # feedback force C e, with the input linear between samples (as control.forced_response)
-    u = _filter_foh(loop.controller, t, e)
+    u = forced_response_foh(loop.controller, t, e)
     if loop.feedforward == "rigid-body":
         u = u + loop.M * a  # the impulse M v0 delta(t) at t = 0 is not representable
     u = u + uh

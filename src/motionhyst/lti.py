@@ -1,0 +1,322 @@
+"""Linear time-invariant helpers shared by the loop, the simulation and identification.
+
+Transfer functions as polynomial coefficient arrays (highest power first)
+with exact cancellation of common factors ``s`` (so ``s = 0`` is exact), the
+exact first-order-hold discretisation (the input taken as linear between
+samples, as :func:`control.forced_response` does) and one compiled
+discrete state-space filter.
+
+Examples
+--------
+>>> import numpy as np
+>>> num, den = cancel_s([1.0, 0.0], [1.0, 2.0, 0.0])        # s / (s^2 + 2 s)
+>>> num.tolist(), den.tolist()
+([1.0], [1.0, 2.0])
+>>> f = HoldFilter([], [-1.0], 1.0, dt=0.01, omega0=1.0)     # 1 / (s + 1)
+>>> round(float(f(np.ones(1001))[-1]), 12)                   # starts in steady state
+1.0
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+from numba import njit
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import expm, solve
+from scipy.signal import cont2discrete, zpk2ss
+
+__all__ = ["HoldFilter", "PolyTF", "cancel_s", "discretize_foh", "divide_s2", "dss_filter",
+           "forced_response_foh", "polyratio", "polysub_exact", "realize_scaled", "stack",
+           "tf_poly", "trim"]
+
+
+# ------------------------------------------------------------------ polynomials
+def tf_poly(sys, what: str = "plant and controller"
+            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Numerator and denominator coefficients of a SISO LTI system.
+
+    Raises
+    ------
+    TypeError
+        If `sys` is not a python-control LTI system.
+    ValueError
+        If it is not single-input single-output (`what` names it).
+    """
+    if isinstance(sys, control.StateSpace):
+        sys = control.ss2tf(sys)
+    if not isinstance(sys, control.TransferFunction):
+        raise TypeError(f"expected an LTI system, got {type(sys).__name__}")
+    if sys.ninputs != 1 or sys.noutputs != 1:
+        raise ValueError(f"{what} must be single-input single-output")
+    return np.atleast_1d(np.asarray(sys.num[0][0], float)), np.atleast_1d(
+        np.asarray(sys.den[0][0], float))
+
+
+def trim(p: ArrayLike) -> NDArray[np.float64]:
+    """Drop leading coefficients that are exactly zero."""
+    p = np.atleast_1d(np.asarray(p, dtype=float))
+    nz = np.nonzero(p != 0.0)[0]
+    return p[nz[0]:] if nz.size else np.zeros(1)
+
+
+def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np.float64]:
+    """``a - b`` with coefficients that cancel to round-off set to exactly zero."""
+    a = np.asarray(a, float)
+    b = np.asarray(b, float)
+    n = max(len(a), len(b))
+    a = np.pad(a, (n - len(a), 0))
+    b = np.pad(b, (n - len(b), 0))
+    d = a - b
+    d[np.abs(d) <= rtol * np.maximum(np.abs(a), np.abs(b))] = 0.0
+    return d
+
+
+def cancel_s(num: ArrayLike, den: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Cancel common factors ``s`` (trailing zero coefficients) of a ratio."""
+    num, den = trim(num), trim(den)
+    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
+        num, den = num[:-1], den[:-1]
+    return num, den
+
+
+def divide_s2(num: ArrayLike, den: ArrayLike, what: str
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``num / (den s^2)`` with common factors ``s`` cancelled.
+
+    Raises
+    ------
+    ValueError
+        If the result keeps a double pole at ``s = 0`` (`what` names the transfer).
+    """
+    num, den = cancel_s(num, np.polymul(den, [1.0, 0.0, 0.0]))
+    if den[-1] == 0.0 and len(den) > 1 and den[-2] == 0.0:
+        raise ValueError(f"time simulation needs {what} to vanish like s^2 at DC "
+                         "(a plant with a rigid-body double integrator)")
+    return num, den
+
+
+@njit(cache=True)
+def polyratio(num, den, omega):  # pragma: no cover - compiled
+    """``num(j omega) / den(j omega)`` at each of `omega`, both by Horner's rule."""
+    out = np.empty(omega.shape[0], dtype=np.complex128)
+    for i in range(omega.shape[0]):
+        s = 1j * omega[i]
+        p = 0j
+        for c in num:
+            p = p * s + c
+        q = 0j
+        for c in den:
+            q = q * s + c
+        out[i] = p / q
+    return out
+
+
+@dataclass(frozen=True)
+class PolyTF:
+    """A SISO transfer function as coefficient arrays (highest power first)."""
+
+    num: NDArray[np.float64]
+    den: NDArray[np.float64]
+
+    def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
+        """Frequency response at the angular frequencies `omega` [rad/s]."""
+        w = np.asarray(omega, dtype=float)
+        return polyratio(self.num, self.den, w.ravel()).reshape(w.shape)
+
+    def tf(self) -> control.TransferFunction:
+        """As a python-control transfer function."""
+        return control.tf(self.num, self.den)
+
+
+# ------------------------------------------------------------------ state space
+def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
+    """State-space realisation ``(A, B, C, D)`` in scaled time ``omega0 t`` (conditioning)."""
+    n = len(den) - 1
+    # substitute s = omega0 * s_hat, then divide numerator and denominator by omega0^n
+    num_h = np.asarray(num) * omega0 ** (np.arange(len(num) - 1, -1, -1.0) - n)
+    den_h = np.asarray(den) * omega0 ** (np.arange(n, -1, -1.0) - n)
+    sys = control.tf2ss(control.tf(num_h / den_h[0], den_h / den_h[0]))
+    return sys.A, sys.B, sys.C, sys.D
+
+
+def stack(mats):
+    """Block-diagonal stack of single-input realisations sharing that input, one output each."""
+    n = sum(a.shape[0] for a, _, _, _ in mats)
+    A = np.zeros((n, n))
+    B = np.zeros((n, 1))
+    C = np.zeros((len(mats), n))
+    D = np.zeros((len(mats), 1))
+    k = 0
+    for o, (a, b, c, d) in enumerate(mats):
+        m = a.shape[0]
+        A[k:k + m, k:k + m] = a
+        B[k:k + m, 0] = b[:, 0]
+        C[o, k:k + m] = c[0]
+        D[o, 0] = d[0, 0]
+        k += m
+    return A, B, C, D
+
+
+def discretize_foh(sys, h: float):
+    """First-order-hold discretisation (input linear between samples) with step `h`.
+
+    Returns contiguous ``Ad, Bd, Cd, Dd`` (2-D, as :func:`scipy.signal.cont2discrete`).
+    """
+    Ad, Bd, Cd, Dd, _ = cont2discrete(sys, h, method="foh")
+    return (np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), np.ascontiguousarray(Cd),
+            np.ascontiguousarray(Dd))
+
+
+@njit(cache=True)
+def dss_filter(Ad, Bd, Cd, Dd, U, X0):  # pragma: no cover - compiled
+    """The discrete system ``x+ = Ad x + Bd u``, ``y = Cd x + Dd u`` over each column of `U`.
+
+    Parameters
+    ----------
+    Ad : ndarray, shape (n, n)
+    Bd : ndarray, shape (n,)
+    Cd : ndarray, shape (p, n)
+    Dd : ndarray, shape (p,)
+    U : ndarray, shape (n_t, m)
+        Inputs, one signal per column, filtered independently.
+    X0 : ndarray, shape (n, m)
+        Initial state of each column.
+
+    Returns
+    -------
+    ndarray, shape (n_t, p, m)
+    """
+    n_t, m = U.shape
+    nx = Ad.shape[0]
+    p = Cd.shape[0]
+    Y = np.empty((n_t, p, m))
+    x = np.empty(nx)
+    xn = np.empty(nx)
+    for j in range(m):
+        for a in range(nx):
+            x[a] = X0[a, j]
+        for i in range(n_t):
+            u = U[i, j]
+            for o in range(p):
+                y = Dd[o] * u
+                for a in range(nx):
+                    y += Cd[o, a] * x[a]
+                Y[i, o, j] = y
+            for a in range(nx):
+                s = Bd[a] * u
+                for b in range(nx):
+                    s += Ad[a, b] * x[b]
+                xn[a] = s
+            for a in range(nx):
+                x[a] = xn[a]
+    return Y
+
+
+@njit(cache=True)
+def _foh_states(Ad, Bd0, Bd1, C, D, u):  # pragma: no cover - compiled
+    """Output of ``x_i = Ad x_{i-1} + Bd0 u_{i-1} + Bd1 u_i``, ``y = C x + D u`` from rest."""
+    n_t = u.shape[0]
+    n_x = Ad.shape[0]
+    x = np.zeros(n_x)
+    xn = np.zeros(n_x)
+    y = np.empty(n_t)
+    for i in range(n_t):
+        if i > 0:
+            for j in range(n_x):
+                acc = 0.0
+                for q in range(n_x):
+                    acc += Ad[j, q] * x[q]
+                xn[j] = acc + Bd0[j] * u[i - 1] + Bd1[j] * u[i]
+            x, xn = xn, x
+        acc = 0.0
+        for j in range(n_x):
+            acc += C[j] * x[j]
+        y[i] = acc + D * u[i]
+    return y
+
+
+def forced_response_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Response from rest of the SISO LTI `sys` to `u`, linear between the uniform samples `t`.
+
+    The algorithm and realisation of :func:`control.forced_response` (exact for
+    an input linear between samples), with the time loop compiled, so that it
+    agrees with python-control to round-off; :class:`HoldFilter` is the
+    filter for records (conditioned by a time scale, started in steady state).
+    """
+    ss = control.ss(sys)
+    A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
+    C, D = np.asarray(ss.C, float), np.asarray(ss.D, float)
+    n = A.shape[0]
+    if n == 0:
+        return D[0, 0] * u
+    h = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
+    M = np.zeros((n + 2, n + 2))
+    M[:n, :n] = A * h
+    M[:n, n] = B[:, 0] * h
+    M[n, n + 1] = 1.0
+    E = expm(M)
+    Ad = np.ascontiguousarray(E[:n, :n])
+    Bd1 = np.ascontiguousarray(E[:n, n + 1])
+    Bd0 = np.ascontiguousarray(E[:n, n] - Bd1)
+    return _foh_states(Ad, Bd0, Bd1, np.ascontiguousarray(C[0]), float(D[0, 0]), u)
+
+
+class HoldFilter:
+    """A proper SISO LTI filter applied to sampled signals, exact for piecewise-linear inputs.
+
+    The filter is discretised with a first-order hold (``cont2discrete(...,
+    method="foh")``) in time scaled by `omega0`, so the discrete filter is the
+    continuous one applied to the samples' linear interpolation.  By default
+    every signal is taken as constant at its first value before the record
+    (the filter state starts in steady state), which removes start-up
+    transients from position offsets.
+
+    Parameters
+    ----------
+    zeros, poles : array_like
+        Zeros and poles [rad/s] (conjugate pairs complete); ``len(zeros) <= len(poles)``.
+    gain : float
+        Gain of the zero-pole-gain form.
+    dt : float
+        Sampling interval [s].
+    omega0 : float
+        Time scale [rad/s] used for conditioning (e.g. the cut-off).
+    """
+
+    def __init__(self, zeros: ArrayLike, poles: ArrayLike, gain: float, dt: float,
+                 omega0: float) -> None:
+        self.zeros = np.asarray(zeros, dtype=complex)
+        self.poles = np.asarray(poles, dtype=complex)
+        self.gain = float(gain)
+        self.dt = float(dt)
+        self.omega0 = float(omega0)
+        z = self.zeros / omega0
+        p = self.poles / omega0
+        if z.size > p.size:
+            raise ValueError("the filter must be proper")
+        g = float(gain) * omega0 ** (z.size - p.size)
+        A, B, C, D = zpk2ss(z, p, g)
+        Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), omega0 * dt, method="foh")
+        self.Ad = np.ascontiguousarray(Ad, dtype=float)
+        self.Bd = np.ascontiguousarray(np.ravel(Bd), dtype=float)
+        self.Cd = np.ascontiguousarray(np.ravel(Cd), dtype=float)
+        self.Dd = float(np.ravel(Dd)[0])
+        # steady state for a unit constant input: x = Ad x + Bd
+        self._x_unit = solve(np.eye(self.Ad.shape[0]) - self.Ad, self.Bd)
+        self.dc_gain = float(self.Dd + self.Cd @ self._x_unit)
+
+    def with_step(self, dt: float) -> HoldFilter:
+        """The same continuous filter discretised for sampling interval `dt` [s]."""
+        return HoldFilter(self.zeros, self.poles, self.gain, dt, self.omega0)
+
+    def __call__(self, u: ArrayLike) -> NDArray[np.float64]:
+        """Filter a signal (1-D) or each column of a 2-D array (time along axis 0)."""
+        U = np.asarray(u, dtype=float)
+        one = U.ndim == 1
+        U2 = np.ascontiguousarray(U[:, None] if one else U)
+        X0 = np.ascontiguousarray(np.outer(self._x_unit, U2[0]))
+        Y = dss_filter(self.Ad, self.Bd, self.Cd[None, :], np.array([self.Dd]), U2, X0)[:, 0, :]
+        return Y[:, 0] if one else Y
