@@ -234,8 +234,8 @@ def test_analyze_measured_plant_gives_null_crossover(capsys, tmp_path):
             for fi, a, b in zip(f, p1, p2, strict=True)]
     (tmp_path / "p.csv").write_text("frequency_hz,p1_re,p1_im,p2_re,p2_im\n" + "\n".join(rows))
     text = default_scenario_path().read_text()
-    text = text[:text.index("[stage]")] + '[plant]\nfile = "p.csv"\nmass = 22.5\n\n' + \
-        text[text.index("[hysteresis]"):]
+    text = (text[:text.index("[stage]")] + '[plant]\nfile = "p.csv"\nmass = 22.5\n'
+            'use = "data"\n\n' + text[text.index("[hysteresis]"):])
     (tmp_path / "frd.toml").write_text(text)
     rc, out, err = run(capsys, "analyze", str(tmp_path / "frd.toml"), "--json")
     assert rc == 0, err

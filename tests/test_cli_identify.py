@@ -245,8 +245,8 @@ def test_closed_loop_needs_a_stage_model(capsys, tmp_path, closed_loop_case):
     write_csv(tmp_path / "p.csv", "frequency_hz,p1_re,p1_im,p2_re,p2_im",
               (f, p1.real, p1.imag, p2.real, p2.imag))
     text = default_scenario_path().read_text()
-    text = text[:text.index("[stage]")] + '[plant]\nfile = "p.csv"\nmass = 22.5\n\n' + \
-        text[text.index("[hysteresis]"):]
+    text = (text[:text.index("[stage]")] + '[plant]\nfile = "p.csv"\nmass = 22.5\n'
+            'use = "data"\n\n' + text[text.index("[hysteresis]"):])
     (tmp_path / "frd.toml").write_text(text)
     rc, out, err = run(capsys, "identify", str(csv), "--scenario", str(tmp_path / "frd.toml"))
     assert rc == 2 and out == ""

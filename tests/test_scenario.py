@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from motionhyst.frf_fit import ModalPlant
 from motionhyst.hysteresis import Jenkins
 from motionhyst.quasilinear import analyze
 from motionhyst.scenario import (
@@ -433,13 +434,16 @@ def write_frd_csv(path: Path, f_hz: np.ndarray) -> Path:
     return path
 
 
-def frd_scenario(tmp_path: Path, f_hz: np.ndarray, mass: float | None = None) -> Path:
+def frd_scenario(tmp_path: Path, f_hz: np.ndarray, mass: float | None = None,
+                 use: str | None = "data") -> Path:
     """A scenario in tmp_path/case whose [plant] CSV is in a subfolder, given relatively."""
     folder = tmp_path / "case"
     write_frd_csv(folder / "data" / "stage.csv", f_hz)
     d = paper_dict()
     del d["stage"]
     d["plant"] = {"type": "frd", "file": "data/stage.csv"}
+    if use is not None:
+        d["plant"]["use"] = use
     if mass is not None:
         d["plant"]["mass"] = mass
     path = folder / "frd.toml"
@@ -492,11 +496,62 @@ def test_frd_plant_absolute_path(tmp_path):
     csv_path = write_frd_csv(tmp_path / "abs" / "stage.csv", LOG_GRID)
     d = paper_dict()
     del d["stage"]
-    d["plant"] = {"file": str(csv_path), "mass": 22.5}  # type defaults to "frd"
+    d["plant"] = {"file": str(csv_path), "mass": 22.5, "use": "data"}  # type defaults to "frd"
     path = tmp_path / "other" / "s.toml"
     path.parent.mkdir()
     path.write_text(dump_toml(d))
     assert isinstance(Scenario.from_file(path).plant(), MeasuredPlant)
+
+
+def test_frd_plant_is_fitted_by_default(tmp_path, two_mass_analysis):
+    """Without ``use``, the measured plant is fitted and every number comes from the model."""
+    sc = Scenario.from_file(frd_scenario(tmp_path, np.geomspace(1.0, 3000.0, 60), use=None))
+    plant = sc.plant()
+    assert isinstance(plant, ModalPlant) and sc.plant_fit().plant is plant
+    assert len(plant.modes) == 1
+    assert plant.modes[0].frequency_hz == pytest.approx(STAGE.resonance_hz, rel=1e-9)
+    res = analyze(sc.loop(), sc.amplitude, sc.frequencies)
+    assert res.mismatch_crossover_hz == pytest.approx(
+        two_mass_analysis.mismatch_crossover_hz, rel=1e-8)
+    for p, q in zip(res.points, two_mass_analysis.points, strict=True):
+        assert abs(p.value - q.value) <= 1e-7 * abs(q.value), p.frequency_hz
+
+
+def test_frd_plant_modes_given(tmp_path):
+    path = frd_scenario(tmp_path, np.geomspace(1.0, 3000.0, 60), use="fit")
+    text = path.read_text().replace('use = "fit"', 'use = "fit"\nmodes = 2')
+    path.write_text(text)
+    sc = Scenario.from_file(path)
+    assert len(sc.plant().modes) == 2 and sc.plant_fit().criterion == "modes given"
+
+
+@pytest.mark.parametrize(("plant", "fragment"), [
+    ({"use": "model"}, "use"),
+    ({"use": "data", "modes": 1}, "modes applies to use"),
+    ({"modes": -1}, "modes"),
+    ({"modes": 1.5}, "modes"),
+    ({"modes": True}, "modes"),
+    ({"modes": 21}, "modes"),
+])
+def test_bad_plant_fit_options(tmp_path, plant, fragment):
+    write_frd_csv(tmp_path / "p.csv", np.geomspace(1.0, 3000.0, 60))
+    d = paper_dict()
+    del d["stage"]
+    d["plant"] = {"file": "p.csv", **plant}
+    path = tmp_path / "s.toml"
+    path.write_text(dump_toml(d))
+    assert_one_line(load_error(path), path, "[plant]", fragment)
+
+
+def test_frd_plant_that_cannot_be_fitted_gives_one_line_error(tmp_path):
+    # 2 lines (8 real values) cannot determine a mass and a mode (5 parameters)
+    write_frd_csv(tmp_path / "p.csv", [1.0, 2.0])
+    d = paper_dict()
+    del d["stage"]
+    d["plant"] = {"file": "p.csv", "modes": 1}
+    path = tmp_path / "s.toml"
+    path.write_text(dump_toml(d))
+    assert_one_line(load_error(path), path, "[plant] file", "cannot determine 1 modes")
 
 
 _HEADER = "frequency_hz,p1_re,p1_im,p2_re,p2_im\n"

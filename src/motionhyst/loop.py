@@ -33,10 +33,12 @@ class Loop:
 
     Parameters
     ----------
-    plant : TwoMassStage or MeasuredPlant or tuple
-        The stage: a :class:`~motionhyst.systems.TwoMassStage`, a measured
-        plant, or a tuple ``(P1, P2)`` of python-control LTI systems (then
-        `mass` is required for the feedforward).
+    plant : TwoMassStage or ModalPlant or MeasuredPlant or tuple
+        The stage: a :class:`~motionhyst.systems.TwoMassStage`, a plant fitted
+        to a measured FRF (:class:`~motionhyst.frf_fit.ModalPlant`), the raw
+        measured plant, or a tuple ``(P1, P2)`` of python-control LTI systems
+        (then `mass` is required for the feedforward).  Any object with
+        attributes ``P1``, ``P2`` and ``M`` is taken as a plant.
     controller : python-control LTI system
         Feedback controller ``C``.
     hysteresis : Hysteresis, optional
@@ -53,15 +55,16 @@ class Loop:
     def __init__(self, plant, controller, hysteresis: Hysteresis | None = None,
                  feedforward: str | None = "rigid-body", mass: float | None = None,
                  hysteresis_feedforward: Hysteresis | None = None) -> None:
-        if isinstance(plant, TwoMassStage | MeasuredPlant):
+        if isinstance(plant, TwoMassStage | MeasuredPlant) or all(
+                hasattr(plant, a) for a in ("P1", "P2", "M")):
             P1, P2 = plant.P1, plant.P2
             mass = plant.M if mass is None else mass
         else:
             try:
                 P1, P2 = plant
             except Exception:
-                raise TypeError("plant must be a TwoMassStage, a MeasuredPlant or a tuple "
-                                "(P1, P2)") from None
+                raise TypeError("plant must be a TwoMassStage, a ModalPlant, a MeasuredPlant "
+                                "or a tuple (P1, P2)") from None
         if feedforward not in ("rigid-body", None):
             raise ValueError(f"unknown feedforward {feedforward!r}; use 'rigid-body' or None")
         if feedforward == "rigid-body" and (mass is None or not mass > 0):

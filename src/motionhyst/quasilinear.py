@@ -193,7 +193,7 @@ def _parts(loop: Loop, omega: NDArray[np.float64]):
     P1 = freqresp(loop.P1, omega)
     P2 = freqresp(loop.P2, omega)
     Pr = 1.0 / (loop.M * (1j * omega) ** 2)
-    if isinstance(loop.plant, TwoMassStage):
+    if hasattr(loop.plant, "Pf2"):  # a model: Pf2 from its own terms, not Pr - P2
         Pf2 = freqresp(loop.plant.Pf2, omega)
     else:
         Pf2 = Pr - P2
@@ -373,10 +373,9 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     D_ref = complex(np.asarray(hyst.describing_function(
         amplitude, None if f_df is None else TWO_PI * f_df)).ravel()[0])
     zeta_ref = float(hyst.zeta(amplitude)) if hyst.defines_zeta else float("nan")
-    if isinstance(loop.plant, TwoMassStage):
-        crossover = _crossover_estimate(loop.plant, hyst, amplitude, D_ref)
-    else:
-        crossover = float("nan")
+    q = _stiffness_over_masses(loop.plant)
+    crossover = (float("nan") if q is None
+                 else _crossover_estimate(q, hyst, amplitude, D_ref))
     points = [MismatchPoint(float(fi), complex(e), complex(et), float(z), float(a), complex(d))
               for fi, e, et, z, a, d in zip(f, E, Et, np.broadcast_to(zetas, f.shape), amps,
                                             np.broadcast_to(D_pts, f.shape), strict=True)]
@@ -392,14 +391,28 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
 CROSSOVER_MAX_ITERATIONS = 50
 
 
-def _crossover_estimate(st: TwoMassStage, hyst, amplitude: float, D: complex) -> float:
-    """Eq. (21); for a rate-dependent element solved with ``D`` at the crossover itself."""
-    fc = mismatch_crossover(st.k, st.m1, st.m2, abs(D))
+def _stiffness_over_masses(plant) -> float | None:
+    """``k / (m1 m2)`` of eq. (21): for a modal model ``1 / (M^2 Pf2(0))``; None for data.
+
+    Eq. (21) solves ``|Pr^2 D / Pf2| = 1`` with ``Pf2`` at its static value;
+    for the two-mass stage ``M^2 Pf2(0) = m1 m2 / k``.
+    """
+    if isinstance(plant, TwoMassStage):
+        return plant.k / (plant.m1 * plant.m2)
+    pf2 = getattr(plant, "pf2_static", None)
+    if pf2 is None or not pf2 > 0:
+        return None
+    return 1.0 / (plant.M**2 * pf2)
+
+
+def _crossover_estimate(q: float, hyst, amplitude: float, D: complex) -> float:
+    """Eq. (21) with ``q = k / (m1 m2)``; rate-dependent elements take ``D`` at the crossover."""
+    fc = mismatch_crossover(q, 1.0, 1.0, abs(D))
     if hyst.rate_independent:
         return fc
     for _ in range(CROSSOVER_MAX_ITERATIONS):
         D = complex(np.asarray(hyst.describing_function(amplitude, TWO_PI * fc)).ravel()[0])
-        f_new = mismatch_crossover(st.k, st.m1, st.m2, abs(D))
+        f_new = mismatch_crossover(q, 1.0, 1.0, abs(D))
         if abs(f_new - fc) <= 1e-12 * f_new:
             return f_new
         change, fc = abs(f_new - fc), f_new

@@ -27,6 +27,7 @@ from pydantic import (
     model_validator,
 )
 
+from motionhyst.frf_fit import FrfFit, ModalPlant, fit_measured_plant
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.hysteresis.registry import Form
 from motionhyst.loop import Loop
@@ -65,11 +66,26 @@ class StageSection(_Section):
 
 
 class PlantSection(_Section):
-    """``[plant]``: a measured plant (CSV of P1 and P2, see :func:`load_frd_plant`)."""
+    """``[plant]``: a measured plant (CSV of P1 and P2, see :func:`load_frd_plant`).
+
+    ``use = "fit"`` (default) fits the data to a rigid body plus ``modes``
+    flexible modes (:func:`motionhyst.frf_fit.fit_frf`; the number chosen by
+    the BIC when ``modes`` is omitted) and analyses the fitted model;
+    ``use = "data"`` keeps the raw data: only measured frequencies are
+    evaluated.  ``mass`` fixes the rigid-body mass [kg].
+    """
 
     type: Literal["frd"] = "frd"
     file: str
     mass: PositiveFloat | None = None
+    use: Literal["fit", "data"] = "fit"
+    modes: Annotated[int, Field(ge=0, le=20)] | None = None
+
+    @model_validator(mode="after")
+    def _modes_need_fit(self):
+        if self.use == "data" and self.modes is not None:
+            raise ValueError('modes applies to use = "fit" only')
+        return self
 
 
 class _LinkSection(_Section):
@@ -310,6 +326,8 @@ class Scenario:
         self.source = source
         self.base_dir = base_dir or Path.cwd()
         self._loop: Loop | None = None
+        self._plant = None
+        self._fit: FrfFit | None = None
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "<dict>",
@@ -347,18 +365,36 @@ class Scenario:
         """Reference frequencies [Hz]."""
         return list(self.model.reference.frequencies)
 
-    def plant(self) -> TwoMassStage | MeasuredPlant:
-        """The stage model or measured plant."""
+    def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant:
+        """The stage model, the model fitted to a measured plant, or the raw measured plant."""
+        if self._plant is not None:
+            return self._plant
         m = self.model
         if m.stage is not None:
-            return TwoMassStage(m.stage.m1, m.stage.m2, m.stage.b, m.stage.k)
+            self._plant = TwoMassStage(m.stage.m1, m.stage.m2, m.stage.b, m.stage.k)
+            return self._plant
         f = Path(m.plant.file)
         if not f.is_absolute():
             f = self.base_dir / f
         try:
-            return load_frd_plant(f, m.plant.mass)
+            data = load_frd_plant(f, m.plant.mass)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
+        if m.plant.use == "data":
+            self._plant = data
+            return data
+        try:
+            self._fit = fit_measured_plant(data, modes=m.plant.modes, mass=m.plant.mass)
+        except ValueError as exc:
+            raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body "
+                                f"plus modes: {exc}") from None
+        self._plant = self._fit.plant
+        return self._plant
+
+    def plant_fit(self) -> FrfFit | None:
+        """The fit of a measured plant (``[plant] use = "fit"``), else None."""
+        self.plant()
+        return self._fit
 
     def hysteresis(self) -> Hysteresis:
         """The dynamic link's hysteresis model."""

@@ -17,9 +17,16 @@ def run(args: argparse.Namespace) -> int:
     amplitude = args.amplitude or sc.amplitude
     mode = "self-consistent" if args.self_consistent else "reference"
     res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
+    fit = sc.plant_fit()
     if args.json:
-        print_json(res.to_dict())
+        d = res.to_dict()
+        if fit is not None:
+            d["plant_fit"] = fit.to_dict()
+        print_json(d)
         return 0
+    if fit is not None:
+        print(fit)
+        print()
     print(f"Quasi-linear analysis of {sc.source}")
     print(res)
     return 0

@@ -104,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
         load_force_displacement_csv,
     )
     from motionhyst.scenario import load_scenario
-    from motionhyst.systems import TwoMassStage
+    from motionhyst.systems import MeasuredPlant
 
     path = Path(args.data)
     kind = record_kind(path, args.record)
@@ -126,9 +126,10 @@ def run(args: argparse.Namespace) -> int:
     else:
         sc = load_scenario(args.scenario)
         plant = sc.plant()
-        if not isinstance(plant, TwoMassStage):
-            raise UsageError(f"motionhyst identify: closed-loop records need a [stage] in the "
-                             f"scenario (P1 as a model); {sc.source} has a measured [plant]")
+        if isinstance(plant, MeasuredPlant):
+            raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "
+                             f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
+                             f"has a measured [plant] with use = \"data\"")
         t, y1, u = load_closed_loop_csv(path)
         extra["scenario"] = sc.source
         try:

@@ -1,0 +1,673 @@
+"""A measured frequency response fitted to a rigid body plus flexible modes (paper eqs. 1-2).
+
+The paper's plant is ``P1 = Pr + Pf1`` and ``P2 = Pr - Pf2`` with the rigid
+body ``Pr = 1 / (M s^2)`` (eq. 1).  A measured stage is fitted to the modal
+form motion-control engineers use for it: the same rigid body and ``n``
+flexible modes that the collocated ``P1`` and the non-collocated ``P2``
+share::
+
+    P1(s) = 1 / (M s^2) + sum_i r1_i / (s^2 + 2 z_i w_i s + w_i^2)
+    P2(s) = 1 / (M s^2) - sum_i r2_i / (s^2 + 2 z_i w_i s + w_i^2)
+
+with real residues (modal damping).  The two-mass stage of eq. (2) is the
+case of one mode with ``r1 = m2 / (M m1)``, ``r2 = 1 / M``,
+``w^2 = k M / (m1 m2)`` and ``2 z w = b M / (m1 m2)``.
+
+Why a model: the mismatch of eq. (18) divides by ``Pf2 = Pr - P2``, which at
+1 Hz is about 2e-6 of ``P2`` for Table I, far below the resolution of any
+measurement.  The modes are seen where they are large (around and above
+the resonances); the model carries ``Pf2`` down to low frequencies, where
+``Pf2(0) = sum_i r2_i / w_i^2``.
+
+Method
+------
+Weighted nonlinear least squares (:func:`scipy.optimize.least_squares`,
+analytic Jacobian) of the relative complex error ``(P_model - P_data) /
+|P_data|`` of ``P1`` and ``P2`` together, which is the maximum-likelihood
+criterion for noise proportional to the response.  It starts from a
+separable search: given the poles, the rigid body ``1/M`` and the residues
+enter linearly, so each mode is added in turn by scanning its frequency
+(50 per decade, from half the lowest to three times the highest measured
+frequency) and damping (0.1 % to 20 %) with the other poles fixed and the
+linear parameters solved exactly; then all parameters are refined together.
+The scan finds a lightly damped mode that falls between measured lines,
+where peak picking cannot.  (Vector fitting libraries on PyPI fit complex
+pole-residue models of network parameters; they neither fix the double
+pole at the origin nor keep modal residues real and shared between two
+transfers, so the start is done here.)
+
+The number of modes is given, or chosen as the first minimum of the
+Bayesian information criterion ``BIC = N ln(RSS / N) + p ln N`` over
+``n = 0, 1, 2, ...`` (``N`` real residuals, ``p`` parameters).
+Uncertainties are one standard deviation from the Jacobian at the
+solution, ``cov = s^2 (J^T J)^-1`` with ``s^2 = RSS / (N - p)``.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
+
+from motionhyst.systems import TWO_PI, MeasuredPlant
+
+#: Largest number of modes the automatic choice tries.
+MAX_MODES = 6
+#: Damping ratios and frequency density of the start's scan.
+_SCAN_DAMPING = (0.001, 0.003, 0.01, 0.03, 0.1, 0.2)
+_SCAN_PER_DECADE = 50
+#: Bounds of a fitted mode: damping ratio, and frequency relative to the measured range.
+DAMPING_BOUNDS = (1e-5, 1.0)
+_FREQ_BOUNDS = (0.5, 10.0)
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One flexible mode of a :class:`ModalPlant` (its uncertainties are in :class:`FrfFit`).
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Undamped natural frequency ``w / (2 pi)`` [Hz].
+    damping : float
+        Damping ratio ``z`` [-].
+    r1, r2 : float
+        Residues of the collocated and non-collocated transfers [1/kg].
+    """
+
+    frequency_hz: float
+    damping: float
+    r1: float
+    r2: float
+
+
+def _modal_polys(M: float, modes: tuple[Mode, ...]):
+    """Numerators and denominators of ``P1``, ``P2``, ``Pf1``, ``Pf2`` (highest power first)."""
+    qs = [np.array([1.0, 2.0 * m.damping * TWO_PI * m.frequency_hz, (TWO_PI * m.frequency_hz) ** 2])
+          for m in modes]
+    q_all = np.array([1.0])
+    for q in qs:
+        q_all = np.polymul(q_all, q)
+    others = []
+    for i in range(len(qs)):
+        p = np.array([1.0])
+        for j, q in enumerate(qs):
+            if j != i:
+                p = np.polymul(p, q)
+        others.append(p)
+    nf1 = sum((m.r1 * p for m, p in zip(modes, others, strict=True)), np.zeros(1))
+    nf2 = sum((m.r2 * p for m, p in zip(modes, others, strict=True)), np.zeros(1))
+    s2 = np.array([1.0, 0.0, 0.0])
+    den = np.polymul(s2, q_all)
+    n1 = np.polyadd(q_all / M, np.polymul(s2, nf1))
+    n2 = np.polysub(q_all / M, np.polymul(s2, nf2))
+    return n1, n2, den, nf1, nf2, q_all
+
+
+class ModalPlant:
+    """Rigid body plus flexible modes shared by ``P1`` and ``P2`` (paper eqs. 1-2, modal form).
+
+    ``P1 = 1/(M s^2) + sum r1_i / (s^2 + 2 z_i w_i s + w_i^2)``,
+    ``P2 = 1/(M s^2) - sum r2_i / (s^2 + 2 z_i w_i s + w_i^2)``.  It offers
+    what :class:`~motionhyst.systems.TwoMassStage` offers (``P1``, ``P2``,
+    ``Pr``, ``Pf1``, ``Pf2`` as python-control transfer functions, ``M``), so
+    a :class:`~motionhyst.loop.Loop` and every analysis take it.
+
+    Parameters
+    ----------
+    M : float
+        Rigid-body mass [kg], > 0.
+    modes : sequence of Mode
+        Flexible modes (may be empty: a pure rigid body).
+    source : str
+        Where the plant came from.
+
+    Examples
+    --------
+    >>> from motionhyst.frf_fit import ModalPlant
+    >>> from motionhyst.systems import TwoMassStage
+    >>> p = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    >>> round(p.modes[0].frequency_hz, 2), round(p.modes[0].damping, 5)
+    (694.26, 0.00265)
+    >>> f"{p.pf2_static:.4e}"  # Pf2(0) = m1 m2 / (k M^2) [m/N]
+    '2.3357e-09'
+    """
+
+    def __init__(self, M: float, modes=(), source: str = "") -> None:
+        M = float(M)
+        if not (np.isfinite(M) and M > 0):
+            raise ValueError(f"M must be finite and > 0, got {M!r}")
+        self.M = M
+        self.modes = tuple(sorted((Mode(float(m.frequency_hz), float(m.damping), float(m.r1),
+                                        float(m.r2)) for m in modes),
+                                  key=lambda m: m.frequency_hz))
+        for m in self.modes:
+            if not (m.frequency_hz > 0 and m.damping > 0 and np.isfinite(m.r1)
+                    and np.isfinite(m.r2)):
+                raise ValueError(f"invalid mode {m}")
+        self.source = source
+        n1, n2, den, nf1, nf2, q = _modal_polys(self.M, self.modes)
+        self._tf = {"P1": (n1, den), "P2": (n2, den), "Pf1": (nf1, q), "Pf2": (nf2, q)}
+
+    @classmethod
+    def from_two_mass(cls, stage) -> ModalPlant:
+        """The modal form of a :class:`~motionhyst.systems.TwoMassStage` (eq. 2)."""
+        m1, m2, M = stage.m1, stage.m2, stage.M
+        w = np.sqrt(stage.k * M / (m1 * m2))
+        mode = Mode(frequency_hz=w / TWO_PI, damping=stage.b * M / (m1 * m2) / (2 * w),
+                    r1=m2 / (M * m1), r2=1.0 / M)
+        return cls(M, (mode,), source=repr(stage))
+
+    def __repr__(self) -> str:
+        return f"ModalPlant(M={self.M:.6g}, modes={list(self.modes)})"
+
+    def _get(self, name: str) -> control.TransferFunction:
+        num, den = self._tf[name]
+        return control.tf(num, den)
+
+    @property
+    def P1(self) -> control.TransferFunction:
+        """Collocated transfer ``y1 / (u - w) = Pr + Pf1``, eq. (1)."""
+        return self._get("P1")
+
+    @property
+    def P2(self) -> control.TransferFunction:
+        """Non-collocated transfer ``y2 / (u - w) = Pr - Pf2``, eq. (1)."""
+        return self._get("P2")
+
+    @property
+    def Pf1(self) -> control.TransferFunction:
+        """Flexible part of ``P1`` (sum of the modes' ``r1`` terms)."""
+        return self._get("Pf1")
+
+    @property
+    def Pf2(self) -> control.TransferFunction:
+        """Flexible part of ``P2``, ``Pr - P2`` (sum of the modes' ``r2`` terms)."""
+        return self._get("Pf2")
+
+    @property
+    def Pr(self) -> control.TransferFunction:
+        """Rigid-body dynamics ``1 / (M s^2)``, eq. (1)."""
+        return control.tf([1.0], [self.M, 0.0, 0.0])
+
+    @property
+    def pf2_static(self) -> float:
+        """``Pf2(0) = sum r2_i / w_i^2`` [m/N]: the flexible compliance that eq. (20) divides by."""
+        return float(sum(m.r2 / (TWO_PI * m.frequency_hz) ** 2 for m in self.modes))
+
+    @property
+    def resonance_hz(self) -> float:
+        """Frequency of the lowest mode [Hz] (nan without modes)."""
+        return self.modes[0].frequency_hz if self.modes else float("nan")
+
+    def response(self, omega: ArrayLike) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """``P1(j omega)`` and ``P2(j omega)`` evaluated term by term [m/N]."""
+        w = np.asarray(omega, dtype=float)
+        s = 1j * w
+        with np.errstate(divide="ignore"):
+            pr = 1.0 / (self.M * s**2)
+        f1 = np.zeros(w.shape, complex)
+        f2 = np.zeros(w.shape, complex)
+        for m in self.modes:
+            wn = TWO_PI * m.frequency_hz
+            g = 1.0 / (s**2 + 2 * m.damping * wn * s + wn**2)
+            f1 += m.r1 * g
+            f2 += m.r2 * g
+        return pr + f1, pr - f2
+
+    def to_dict(self) -> dict:
+        """Parameters as a JSON-ready dictionary."""
+        return {"type": "modal", "M": self.M,
+                "modes": [{"frequency_hz": m.frequency_hz, "damping": m.damping, "r1": m.r1,
+                           "r2": m.r2} for m in self.modes]}
+
+
+# ------------------------------------------------------------------------------------ fitting
+def _unpack(x: NDArray[np.float64], n: int, mass: float | None):
+    k = 0
+    if mass is None:
+        M, k = float(np.exp(x[0])), 1
+    else:
+        M = mass
+    p = x[k:].reshape(n, 4) if n else np.zeros((0, 4))
+    return M, np.exp(p[:, 0]), np.exp(p[:, 1]), p[:, 2], p[:, 3]
+
+
+class _Problem:
+    """Relative complex residuals of P1 and P2 and their Jacobian (real and imaginary parts)."""
+
+    def __init__(self, f, p1, p2, mass):
+        self.f = f
+        self.s = 1j * TWO_PI * f
+        self.p1, self.p2 = p1, p2
+        self.w1, self.w2 = 1.0 / np.abs(p1), 1.0 / np.abs(p2)
+        self.mass = mass
+
+    def model(self, x, n):
+        M, wn, z, r1, r2 = _unpack(x, n, self.mass)
+        s = self.s[:, None]
+        g = 1.0 / (s**2 + 2 * z * wn * s + wn**2)
+        pr = 1.0 / (M * self.s**2)
+        return pr + g @ r1, pr - g @ r2, g, M, wn, z, r1, r2
+
+    def residuals(self, x, n):
+        m1, m2, *_ = self.model(x, n)
+        c = np.concatenate([(m1 - self.p1) * self.w1, (m2 - self.p2) * self.w2])
+        return np.concatenate([c.real, c.imag])
+
+    def jacobian(self, x, n):
+        _, _, g, M, wn, z, r1, r2 = self.model(x, n)
+        s = self.s[:, None]
+        nf = self.f.size
+        cols = []
+        zero = np.zeros(nf, complex)
+        if self.mass is None:
+            dpr = -1.0 / (M * self.s**2)  # d/d ln M
+            cols.append(np.concatenate([dpr * self.w1, dpr * self.w2]))
+        dg_dlnw = -(2 * z * wn * s + 2 * wn**2) * g**2
+        dg_dlnz = -(2 * z * wn * s) * g**2
+        for i in range(n):
+            cols.append(np.concatenate([r1[i] * dg_dlnw[:, i] * self.w1,
+                                        -r2[i] * dg_dlnw[:, i] * self.w2]))
+            cols.append(np.concatenate([r1[i] * dg_dlnz[:, i] * self.w1,
+                                        -r2[i] * dg_dlnz[:, i] * self.w2]))
+            cols.append(np.concatenate([g[:, i] * self.w1, zero]))
+            cols.append(np.concatenate([zero, -g[:, i] * self.w2]))
+        J = np.array(cols).T
+        return np.vstack([J.real, J.imag])
+
+    def linear_start(self, wn, z, extra=None):
+        """Solve ``1/M`` and the residues for fixed poles; with `extra` candidate poles scanned.
+
+        Returns ``(rss, a, r1, r2)`` for the fixed poles alone, or the index of the
+        best candidate and its solution when `extra = (wn_c, z_c)` arrays are given.
+        """
+        s = self.s[:, None]
+        nf = self.f.size
+        fixed = []
+        if self.mass is None:
+            fixed.append(np.concatenate([self.w1 / self.s**2, self.w2 / self.s**2]))
+        g = 1.0 / (s**2 + 2 * z * wn * s + wn**2)
+        zero = np.zeros(nf, complex)
+        for i in range(wn.size):
+            fixed.append(np.concatenate([g[:, i] * self.w1, zero]))
+            fixed.append(np.concatenate([zero, -g[:, i] * self.w2]))
+        y = np.concatenate([self.p1 * self.w1, self.p2 * self.w2])
+        if self.mass is not None:
+            pr = 1.0 / (self.mass * self.s**2)
+            y = y - np.concatenate([self.w1 * pr, self.w2 * pr])
+        yr = np.concatenate([y.real, y.imag])
+        F = np.array(fixed).T if fixed else np.zeros((2 * nf, 0), complex)
+        Fr = np.vstack([F.real, F.imag])
+        if Fr.shape[1]:
+            Q, _ = np.linalg.qr(Fr)
+        else:
+            Q = np.zeros((yr.size, 0))
+        y_perp = yr - Q @ (Q.T @ yr)
+        if extra is None:
+            coef = np.linalg.lstsq(Fr, yr, rcond=None)[0] if Fr.shape[1] else np.zeros(0)
+            return float(y_perp @ y_perp), coef
+        wc, zc = extra
+        gc = 1.0 / (s**2 + 2 * zc * wc * s + wc**2)  # (nf, ncand)
+        g1, g2 = gc * self.w1[:, None], -gc * self.w2[:, None]
+        zr = np.zeros_like(g1.real)
+        G1 = np.concatenate([g1.real, zr, g1.imag, zr])  # rows ordered as yr
+        G2 = np.concatenate([zr, g2.real, zr, g2.imag])
+        if Q.shape[1]:
+            # einsum, not BLAS: thin products, where BLAS threads only add overhead
+            G1 -= np.einsum("rk,kc->rc", Q, np.einsum("rk,rc->kc", Q, G1))
+            G2 -= np.einsum("rk,kc->rc", Q, np.einsum("rk,rc->kc", Q, G2))
+        a11 = np.einsum("rc,rc->c", G1, G1)
+        a22 = np.einsum("rc,rc->c", G2, G2)
+        a12 = np.einsum("rc,rc->c", G1, G2)
+        b1, b2 = y_perp @ G1, y_perp @ G2
+        det = a11 * a22 - a12**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gain = (a22 * b1**2 - 2 * a12 * b1 * b2 + a11 * b2**2) / det
+        gain[~np.isfinite(gain)] = -np.inf
+        best = int(np.argmax(gain))
+        return best, float(y_perp @ y_perp - gain[best])
+
+
+def _pack(M, wn, z, r1, r2, mass):
+    head = [np.log(M)] if mass is None else []
+    body = np.column_stack([np.log(wn), np.log(z), r1, r2]).ravel() if len(wn) else []
+    return np.concatenate([head, body])
+
+
+def _start(prob: _Problem, x_prev, n_prev):
+    """Add one mode to the solution `x_prev` with `n_prev` modes by the separable scan."""
+    _, wn, z, _, _ = _unpack(x_prev, n_prev, prob.mass)
+    f = prob.f
+    lo, hi = f.min() * _FREQ_BOUNDS[0], f.max() * 3.0
+    n_grid = int(np.ceil(_SCAN_PER_DECADE * np.log10(hi / lo))) + 1
+    wc = TWO_PI * np.geomspace(lo, hi, n_grid)
+    zc = np.asarray(_SCAN_DAMPING)
+    W, Z = (a.ravel() for a in np.meshgrid(wc, zc))
+    best, _ = prob.linear_start(wn, z, (W, Z))
+    wn2, z2 = np.append(wn, W[best]), np.append(z, Z[best])
+    _, coef = prob.linear_start(wn2, z2)
+    k = 0
+    if prob.mass is None:
+        a, k = coef[0], 1
+        M = 1.0 / a if a > 0 else _unpack(x_prev, n_prev, None)[0]
+    else:
+        M = prob.mass
+    r = coef[k:].reshape(-1, 2)
+    return _pack(M, wn2, z2, r[:, 0], r[:, 1], prob.mass)
+
+
+def _bounds(prob: _Problem, n: int):
+    w_lo = TWO_PI * prob.f.min() * _FREQ_BOUNDS[0]
+    w_hi = TWO_PI * prob.f.max() * _FREQ_BOUNDS[1]
+    lo = [-np.inf] if prob.mass is None else []
+    hi = [np.inf] if prob.mass is None else []
+    for _ in range(n):
+        lo += [np.log(w_lo), np.log(DAMPING_BOUNDS[0]), -np.inf, -np.inf]
+        hi += [np.log(w_hi), np.log(DAMPING_BOUNDS[1]), np.inf, np.inf]
+    return np.array(lo), np.array(hi)
+
+
+def _solve(prob: _Problem, x0, n):
+    lo, hi = _bounds(prob, n)
+    x0 = np.clip(x0, np.nextafter(lo, hi), np.nextafter(hi, lo))
+    if x0.size == 0:
+        return x0, prob.residuals(x0, n)
+    sol = least_squares(prob.residuals, x0, jac=prob.jacobian, bounds=(lo, hi), args=(n,),
+                        x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500)
+    return sol.x, sol.fun
+
+
+@dataclass
+class FrfFit:
+    """Result of :func:`fit_frf`: the fitted :class:`ModalPlant`, its data and its quality.
+
+    Attributes
+    ----------
+    plant : ModalPlant
+        The fitted rigid body and modes.
+    frequency_hz : ndarray
+        Measured frequencies [Hz].
+    P1_data, P2_data : ndarray of complex
+        Measured responses [m/N].
+    M_std : float
+        Standard deviation of ``M`` [kg] (0 when the mass was given).
+    mode_std : list of dict
+        Per mode, standard deviations of ``frequency_hz``, ``damping``, ``r1``, ``r2``.
+    pf2_static_std : float
+        Standard deviation of ``Pf2(0)`` [m/N].
+    criterion : str
+        How the number of modes was chosen.
+    bic : dict
+        ``{number of modes: BIC}`` of the fits tried.
+    rms_relative_error : float
+        RMS of ``|P_model - P_data| / |P_data|`` over both transfers.
+    mass_given : bool
+        True when ``M`` was fixed by the user.
+    """
+
+    plant: ModalPlant
+    frequency_hz: NDArray[np.float64]
+    P1_data: NDArray[np.complex128]
+    P2_data: NDArray[np.complex128]
+    M_std: float
+    mode_std: list[dict]
+    pf2_static_std: float
+    criterion: str
+    bic: dict = field(default_factory=dict)
+    rms_relative_error: float = float("nan")
+    mass_given: bool = False
+
+    def relative_errors(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``|P_model - P_data| / |P_data|`` of ``P1`` and ``P2`` at each measured frequency."""
+        m1, m2 = self.plant.response(TWO_PI * self.frequency_hz)
+        return (np.abs(m1 - self.P1_data) / np.abs(self.P1_data),
+                np.abs(m2 - self.P2_data) / np.abs(self.P2_data))
+
+    def bands(self) -> list[dict]:
+        """Fit quality per decade band of the measured range.
+
+        Returns
+        -------
+        list of dict
+            ``f_lo_hz``, ``f_hi_hz``, ``lines`` (measured frequencies in the
+            band), and the RMS and largest relative error of ``P1`` and ``P2``.
+        """
+        e1, e2 = self.relative_errors()
+        f = self.frequency_hz
+        edges = 10.0 ** np.arange(np.floor(np.log10(f.min())), np.ceil(np.log10(f.max())) + 1)
+        out = []
+        for lo, hi in itertools.pairwise(edges):
+            sel = (f >= lo) & (f < hi) if hi < edges[-1] else (f >= lo) & (f <= hi)
+            if not sel.any():
+                continue
+            out.append({"f_lo_hz": float(max(lo, f[sel].min())), "f_hi_hz": float(f[sel].max()),
+                        "lines": int(sel.sum()),
+                        "p1_rms_rel": float(np.sqrt(np.mean(e1[sel] ** 2))),
+                        "p1_max_rel": float(e1[sel].max()),
+                        "p2_rms_rel": float(np.sqrt(np.mean(e2[sel] ** 2))),
+                        "p2_max_rel": float(e2[sel].max())})
+        return out
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (the ``plant_fit`` block of ``analyze --json``)."""
+        p = self.plant
+        return {
+            "model": "rigid body + modes (modal form, shared poles)",
+            "M": p.M, "M_std": self.M_std, "mass_given": self.mass_given,
+            "modes": [{"frequency_hz": m.frequency_hz, "frequency_hz_std": s["frequency_hz"],
+                       "damping": m.damping, "damping_std": s["damping"],
+                       "r1": m.r1, "r1_std": s["r1"], "r2": m.r2, "r2_std": s["r2"]}
+                      for m, s in zip(p.modes, self.mode_std, strict=True)],
+            "pf2_static": p.pf2_static, "pf2_static_std": self.pf2_static_std,
+            "criterion": self.criterion,
+            "bic": {str(k): v for k, v in self.bic.items()},
+            "lines": int(self.frequency_hz.size),
+            "frequency_range_hz": [float(self.frequency_hz.min()),
+                                   float(self.frequency_hz.max())],
+            "rms_relative_error": self.rms_relative_error,
+            "bands": self.bands(),
+        }
+
+    def __str__(self) -> str:
+        p = self.plant
+        f = self.frequency_hz
+        lines = [f"Fit of {p.source or 'measured FRF'}: rigid body + {len(p.modes)} mode(s), "
+                 f"{f.size} lines {_num(f.min())}-{_num(f.max())} Hz ({self.criterion})",
+                 f"  M = {_pm(p.M, self.M_std)} kg" + (" (given)" if self.mass_given else "")]
+        for i, (m, s) in enumerate(zip(p.modes, self.mode_std, strict=True), start=1):
+            lines.append(f"  mode {i}: f = {_pm(m.frequency_hz, s['frequency_hz'])} Hz, "
+                         f"damping = {_pm(m.damping, s['damping'])}, "
+                         f"r1 = {_pm(m.r1, s['r1'])} 1/kg, r2 = {_pm(m.r2, s['r2'])} 1/kg")
+        lines.append(f"  Pf2(0) = {_pm(p.pf2_static, self.pf2_static_std)} m/N "
+                     f"(flexible compliance at P2; sets eqs. 18-21 at low frequency)")
+        lines.append("  relative error |P_fit - P_data|/|P_data|: RMS "
+                     f"{_num(self.rms_relative_error)} over both transfers; per band:")
+        for b in self.bands():
+            lines.append(f"    {_num(b['f_lo_hz']):>6}-{_num(b['f_hi_hz']):<6} Hz "
+                         f"{b['lines']:>3} lines  P1 RMS {_num(b['p1_rms_rel'])} "
+                         f"(max {_num(b['p1_max_rel'])}), P2 RMS {_num(b['p2_rms_rel'])} "
+                         f"(max {_num(b['p2_max_rel'])})")
+        return "\n".join(lines)
+
+    def plot(self, f_range: tuple[float, float] | None = None):
+        """Bode figure of the measured ``P1``, ``P2`` (markers) and the fit (lines).
+
+        Returns a matplotlib Figure (see :func:`motionhyst.plots.fig_frf_fit`).
+        """
+        from motionhyst.plots import fig_frf_fit
+
+        return fig_frf_fit(self, f_range)
+
+
+def _num(x: float) -> str:
+    return "nan" if not np.isfinite(x) else f"{x:.4g}"
+
+
+def _pm(v: float, s: float) -> str:
+    if s == 0:
+        return _num(v)
+    if not np.isfinite(s):
+        return f"{_num(v)} +- (not determined)"
+    return f"{_num(v)} +- {s:.2g}"
+
+
+#: Relative error below which a fit counts as exact (the BIC does not reward fitting round-off).
+EXACT_RELATIVE_ERROR = 1e-9
+
+
+def _bic(rss: float, n_res: int, n_par: int) -> float:
+    mse = max(rss / n_res, EXACT_RELATIVE_ERROR**2)
+    return float(n_res * np.log(mse) + n_par * np.log(n_res))
+
+
+def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | None = None,
+            mass: float | None = None, max_modes: int = MAX_MODES, source: str = "") -> FrfFit:
+    """Fit measured ``P1``, ``P2`` to a rigid body plus flexible modes (eqs. 1-2, modal form).
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Measured frequencies [Hz], positive and increasing.
+    P1, P2 : array_like of complex
+        Measured collocated and non-collocated responses [m/N].
+    modes : int, optional
+        Number of flexible modes; default: chosen by the BIC (module docstring).
+    mass : float, optional
+        Rigid-body mass [kg]; fixed when given, else fitted.
+    max_modes : int
+        Largest number of modes the automatic choice tries.
+    source : str
+        Where the data came from (for the report).
+
+    Returns
+    -------
+    FrfFit
+
+    Raises
+    ------
+    ValueError
+        Too few lines for the number of parameters, non-finite or zero data,
+        or data that are not a rigid body at low frequency.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.frf_fit import ModalPlant, fit_frf
+    >>> from motionhyst.systems import TwoMassStage
+    >>> exact = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    >>> f = np.geomspace(1.0, 3000.0, 60)
+    >>> p1, p2 = exact.response(2 * np.pi * f)
+    >>> fit = fit_frf(f, p1, p2)
+    >>> len(fit.plant.modes), round(fit.plant.M, 6), round(fit.plant.modes[0].frequency_hz, 3)
+    (1, 22.5, 694.262)
+    """
+    f = np.asarray(frequency_hz, dtype=float).ravel()
+    p1 = np.asarray(P1, dtype=complex).ravel()
+    p2 = np.asarray(P2, dtype=complex).ravel()
+    if not (f.size == p1.size == p2.size):
+        raise ValueError("frequency_hz, P1 and P2 must have the same length")
+    if not (np.all(np.isfinite(f)) and np.all(np.isfinite(p1)) and np.all(np.isfinite(p2))):
+        raise ValueError("non-finite value in the frequency response")
+    if np.any(f <= 0) or np.any(np.diff(f) <= 0):
+        raise ValueError("frequency_hz must be positive and increasing")
+    if np.any(p1 == 0) or np.any(p2 == 0):
+        raise ValueError("a measured response is exactly zero")
+    if mass is not None and not (np.isfinite(mass) and mass > 0):
+        raise ValueError(f"mass must be finite and > 0, got {mass!r}")
+    n_res = 4 * f.size
+    n_fixed = 0 if mass is not None else 1
+    if modes is not None:
+        if int(modes) != modes or modes < 0:
+            raise ValueError(f"modes must be a whole number >= 0, got {modes!r}")
+        modes = int(modes)
+        if 2 * (n_fixed + 4 * modes) > n_res:
+            raise ValueError(f"{f.size} measured lines cannot determine {modes} modes "
+                             f"({n_fixed + 4 * modes} parameters from {n_res} real values; "
+                             f"at least twice as many values as parameters are needed)")
+    prob = _Problem(f, p1, p2, mass)
+    if mass is None:
+        # start: the rigid body of the lowest decade, -1 / (omega^2 Re P), both transfers
+        low = f <= f[0] * 10.0
+        w2 = (TWO_PI * f[low]) ** 2
+        a0 = float(np.median(np.concatenate([-w2 * p1[low].real, -w2 * p2[low].real])))
+        if not a0 > 0:
+            raise ValueError("the data do not look like a rigid body 1/(M s^2) at the lowest "
+                             "measured frequencies (Re P > 0); give the mass or check the data")
+        x = np.array([np.log(1.0 / a0)])
+    else:
+        x = np.zeros(0)
+    x, r = _solve(prob, x, 0)
+    fits = {0: (x, float(r @ r))}
+    bic = {0: _bic(fits[0][1], n_res, n_fixed)}
+    target = modes if modes is not None else max_modes
+    for n in range(1, target + 1):
+        if 2 * (n_fixed + 4 * n) > n_res:
+            break
+        x0 = _start(prob, fits[n - 1][0], n - 1)
+        x, r = _solve(prob, x0, n)
+        fits[n] = (x, float(r @ r))
+        bic[n] = _bic(fits[n][1], n_res, n_fixed + 4 * n)
+        if modes is None and bic[n] >= bic[n - 1]:
+            break
+    if modes is None:
+        n_best = min(bic, key=lambda k: (bic[k], k))
+        criterion = (f"modes chosen by the BIC, first minimum over n = 0..{max(bic)}")
+    else:
+        n_best = modes
+        criterion = "modes given"
+    x, rss = fits[n_best]
+    return _result(prob, x, n_best, rss, criterion, bic, source)
+
+
+def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
+    M, wn, z, r1, r2 = _unpack(x, n, prob.mass)
+    n_res = 4 * prob.f.size
+    n_par = x.size
+    if n_par:
+        J = prob.jacobian(x, n)
+        s2 = rss / max(n_res - n_par, 1)
+        cov = s2 * np.linalg.pinv(J.T @ J)
+        std_x = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    else:
+        cov = np.zeros((0, 0))
+        std_x = np.zeros(0)
+    k = 0 if prob.mass is not None else 1
+    M_std = float(M * std_x[0]) if prob.mass is None else 0.0
+    sx = std_x[k:].reshape(n, 4) if n else np.zeros((0, 4))
+    mode_std = [{"frequency_hz": float(wn[i] / TWO_PI * sx[i, 0]),
+                 "damping": float(z[i] * sx[i, 1]), "r1": float(sx[i, 2]),
+                 "r2": float(sx[i, 3])} for i in range(n)]
+    # Pf2(0) = sum r2_i / w_i^2: gradient in (ln w_i, r2_i)
+    grad = np.zeros(n_par)
+    for i in range(n):
+        grad[k + 4 * i] = -2.0 * r2[i] / wn[i] ** 2
+        grad[k + 4 * i + 3] = 1.0 / wn[i] ** 2
+    pf2_std = float(np.sqrt(max(grad @ cov @ grad, 0.0))) if n_par else 0.0
+    modes = [Mode(float(wn[i] / TWO_PI), float(z[i]), float(r1[i]), float(r2[i]))
+             for i in range(n)]
+    order = np.argsort([m.frequency_hz for m in modes])
+    plant = ModalPlant(M, [modes[i] for i in order], source=source)
+    fit = FrfFit(plant=plant, frequency_hz=prob.f, P1_data=prob.p1, P2_data=prob.p2,
+                 M_std=M_std, mode_std=[mode_std[i] for i in order], pf2_static_std=pf2_std,
+                 criterion=criterion, bic=bic, mass_given=prob.mass is not None)
+    e1, e2 = fit.relative_errors()
+    fit.rms_relative_error = float(np.sqrt(np.mean(np.concatenate([e1, e2]) ** 2)))
+    return fit
+
+
+def fit_measured_plant(plant: MeasuredPlant, modes: int | None = None,
+                       mass: float | None = None) -> FrfFit:
+    """Fit a :class:`~motionhyst.systems.MeasuredPlant` (see :func:`fit_frf`).
+
+    `mass` fixes ``M``; by default it is fitted (the plant's own estimate of
+    ``M`` from its lowest decade is not used).
+    """
+    f = plant.P2.omega / TWO_PI
+    p1 = np.asarray(plant.P1.frdata, dtype=complex).ravel()
+    p2 = np.asarray(plant.P2.frdata, dtype=complex).ravel()
+    return fit_frf(f, p1, p2, modes=modes, mass=mass, source=plant.source)

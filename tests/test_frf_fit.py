@@ -1,0 +1,307 @@
+"""Tests of motionhyst.frf_fit: a measured FRF fitted to a rigid body plus modes (eqs. 1-2)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from motionhyst.frf_fit import FrfFit, ModalPlant, Mode, fit_frf
+from motionhyst.loop import Loop
+from motionhyst.quasilinear import analyze
+from motionhyst.references import SineReference
+from motionhyst.simulate import simulate
+from motionhyst.steady import periodic_steady_state
+from motionhyst.systems import TwoMassStage, freqresp
+
+TABLE_I = TwoMassStage(5.0, 17.5, 90.0, 7.4e7)
+LINES = np.geomspace(1.0, 3000.0, 60)  # the issue's measurement: 60 log-spaced lines
+NOISE = 0.005  # 0.5 % complex noise, relative to the response
+
+
+def measure(plant: ModalPlant, f=LINES, noise=NOISE, seed=0):
+    """P1, P2 of `plant` at `f` with relative complex Gaussian noise of RMS `noise`."""
+    p1, p2 = plant.response(2 * np.pi * f)
+    rng = np.random.default_rng(seed)
+
+    def noisy(p):
+        n = rng.standard_normal(p.shape) + 1j * rng.standard_normal(p.shape)
+        return p * (1.0 + noise * n / np.sqrt(2.0))
+
+    return (noisy(p1), noisy(p2)) if noise else (p1, p2)
+
+
+@pytest.fixture(scope="module")
+def exact() -> ModalPlant:
+    return ModalPlant.from_two_mass(TABLE_I)
+
+
+@pytest.fixture(scope="module")
+def noisy_fit(exact) -> FrfFit:
+    return fit_frf(LINES, *measure(exact, seed=0), source="table-I.csv")
+
+
+# ---------------------------------------------------------------- the modal plant
+def test_modal_form_of_two_mass_stage_is_eq_1_2(exact):
+    omega = 2 * np.pi * np.array([0.01, 1.0, 100.0, 327.0, 694.27, 2000.0])
+    for name in ("P1", "P2", "Pr", "Pf1", "Pf2"):
+        assert_allclose(freqresp(getattr(exact, name), omega),
+                        freqresp(getattr(TABLE_I, name), omega), rtol=1e-10, err_msg=name)
+    p1, p2 = exact.response(omega)
+    assert_allclose(p1, freqresp(TABLE_I.P1, omega), rtol=1e-10)
+    assert_allclose(p2, freqresp(TABLE_I.P2, omega), rtol=1e-10)
+    # Pf2(0) = m1 m2 / (k M^2)
+    assert exact.pf2_static == pytest.approx(5.0 * 17.5 / (7.4e7 * 22.5**2), rel=1e-12)
+    assert exact.resonance_hz == pytest.approx(TABLE_I.resonance_hz, rel=1e-12)
+
+
+def test_loop_on_modal_plant_equals_loop_on_stage(exact, controller, link):
+    a = analyze(Loop(exact, controller, link), 0.01, [1.0, 5.0, 10.0, 15.0])
+    b = analyze(Loop(TABLE_I, controller, link), 0.01, [1.0, 5.0, 10.0, 15.0])
+    for p, q in zip(a.points, b.points, strict=True):
+        assert abs(p.value - q.value) <= 1e-8 * abs(q.value)
+    # eq. (21) from M^2 Pf2(0) = m1 m2 / k
+    assert a.mismatch_crossover_hz == pytest.approx(b.mismatch_crossover_hz, rel=1e-10)
+    assert a.mismatch_crossover_hz == pytest.approx(7.6, abs=0.05)
+
+
+def test_modal_plant_rejects_bad_parameters():
+    with pytest.raises(ValueError, match="M must be"):
+        ModalPlant(0.0)
+    with pytest.raises(ValueError, match="invalid mode"):
+        ModalPlant(1.0, [Mode(100.0, -0.01, 0.1, 0.1)])
+
+
+# ------------------------------------------------------------------ the fit
+def test_noise_free_fit_recovers_table_I(exact):
+    fit = fit_frf(LINES, *measure(exact, noise=0.0))
+    assert len(fit.plant.modes) == 1
+    m, e = fit.plant.modes[0], exact.modes[0]
+    assert fit.plant.M == pytest.approx(22.5, rel=1e-8)
+    assert m.frequency_hz == pytest.approx(e.frequency_hz, rel=1e-8)
+    assert m.damping == pytest.approx(e.damping, rel=1e-6)
+    assert m.r1 == pytest.approx(e.r1, rel=1e-8)
+    assert m.r2 == pytest.approx(e.r2, rel=1e-8)
+    assert fit.rms_relative_error < 1e-8
+
+
+def test_noisy_table_I_fit_parameters_within_their_uncertainty(noisy_fit, exact):
+    fit = noisy_fit
+    assert len(fit.plant.modes) == 1
+    assert "BIC" in fit.criterion
+    # the BIC has its first minimum at one mode
+    assert fit.bic[1] < fit.bic[0] and fit.bic[1] < fit.bic[2]
+    m, e, s = fit.plant.modes[0], exact.modes[0], fit.mode_std[0]
+    for value, truth, std in ((fit.plant.M, 22.5, fit.M_std),
+                              (m.frequency_hz, e.frequency_hz, s["frequency_hz"]),
+                              (m.damping, e.damping, s["damping"]), (m.r1, e.r1, s["r1"]),
+                              (m.r2, e.r2, s["r2"]),
+                              (fit.plant.pf2_static, exact.pf2_static, fit.pf2_static_std)):
+        assert 0 < std < 0.05 * abs(truth)
+        assert abs(value - truth) < 4 * std, (value, truth, std)
+    # the residuals are the noise: RMS of |relative error| is NOISE (complex, RMS 1)
+    assert fit.rms_relative_error == pytest.approx(NOISE, rel=0.2)
+
+
+def test_uncertainties_match_the_scatter_over_noise_draws(exact):
+    """The reported standard deviations are the spread of the estimates over noise draws."""
+    draws = [fit_frf(LINES, *measure(exact, seed=s), modes=1) for s in range(1, 13)]
+    for get, get_std in ((lambda f: f.plant.modes[0].frequency_hz,
+                          lambda f: f.mode_std[0]["frequency_hz"]),
+                         (lambda f: f.plant.pf2_static, lambda f: f.pf2_static_std),
+                         (lambda f: f.plant.M, lambda f: f.M_std)):
+        values = np.array([get(f) for f in draws])
+        stds = np.array([get_std(f) for f in draws])
+        ratio = np.std(values, ddof=1) / np.mean(stds)
+        assert 0.5 < ratio < 1.8, ratio
+
+
+def test_fitted_table_I_meets_the_issue_targets(noisy_fit, controller, link):
+    """|E| at 1, 5, 10 Hz and the steady state's first harmonic within 2 % of the exact stage."""
+    fitted = Loop(noisy_fit.plant, controller, link)
+    fitted.check_stable()
+    exact_loop = Loop(TABLE_I, controller, link)
+    freqs = [1.0, 5.0, 10.0]
+    a, b = analyze(fitted, 0.01, freqs), analyze(exact_loop, 0.01, freqs)
+    for p, q in zip(a.points, b.points, strict=True):
+        assert abs(abs(p.value) / abs(q.value) - 1) < 0.02, p.frequency_hz
+        assert abs(p.value - q.value) < 0.02 * abs(q.value), p.frequency_hz
+    assert abs(b.points[0].value) == pytest.approx(3349, rel=0.01)  # the issue's exact value
+    assert a.mismatch_crossover_hz == pytest.approx(b.mismatch_crossover_hz, rel=0.01)
+    for f in (5.0, 10.0):
+        s, t = periodic_steady_state(fitted, 0.01, f), periodic_steady_state(exact_loop, 0.01, f)
+        assert abs(s.e[1] - t.e[1]) < 0.02 * abs(t.e[1]), f
+
+
+def test_time_simulation_runs_on_the_fitted_plant(noisy_fit, controller, link):
+    fitted = Loop(noisy_fit.plant, controller, link)
+    exact_loop = Loop(TABLE_I, controller, link)
+    ref = SineReference(0.01, 10.0)
+    a, b = simulate(fitted, ref, 0.3), simulate(exact_loop, ref, 0.3)
+    assert np.all(np.isfinite(a.e))
+    peak_a, peak_b = np.max(np.abs(a.e[a.t > 0.2])), np.max(np.abs(b.e[b.t > 0.2]))
+    assert peak_a == pytest.approx(peak_b, rel=0.02)
+
+
+@pytest.mark.parametrize("damping", [0.001, 0.01])
+def test_resonance_between_measured_lines(damping):
+    """A lightly damped mode half-way (log) between two lines is found by the scan."""
+    f_mode = float(np.sqrt(LINES[47] * LINES[48]))  # 630 Hz, lines at 589 and 674 Hz
+    m1, m2, M = 5.0, 17.5, 22.5
+    w = 2 * np.pi * f_mode
+    stage = TwoMassStage(m1, m2, 2 * damping * w * m1 * m2 / M, w**2 * m1 * m2 / M)
+    exact = ModalPlant.from_two_mass(stage)
+    # the measured peak is far below the true one: the lines miss the resonance
+    p1, _ = exact.response(2 * np.pi * LINES)
+    peak = abs(exact.response(np.array([w]))[0][0])
+    assert np.max(np.abs(p1[LINES > 300])) < 0.2 * peak
+    fit = fit_frf(LINES, *measure(exact, seed=3))
+    assert len(fit.plant.modes) == 1
+    m, s = fit.plant.modes[0], fit.mode_std[0]
+    assert abs(m.frequency_hz - f_mode) < max(4 * s["frequency_hz"], 1e-3 * f_mode)
+    assert m.frequency_hz == pytest.approx(f_mode, rel=2e-3)
+    assert m.damping == pytest.approx(damping, rel=0.2)
+    assert fit.plant.pf2_static == pytest.approx(exact.pf2_static, rel=5e-3)
+
+
+def test_two_modes_chosen_and_recovered():
+    truth = ModalPlant(22.5, [Mode(694.0, 0.003, 0.1555, 0.0444),
+                              Mode(1800.0, 0.01, 0.05, -0.02)])
+    fit = fit_frf(LINES, *measure(truth, seed=5))
+    assert len(fit.plant.modes) == 2
+    for m, t in zip(fit.plant.modes, truth.modes, strict=True):
+        assert m.frequency_hz == pytest.approx(t.frequency_hz, rel=1e-3)
+        assert m.r2 == pytest.approx(t.r2, rel=0.01)
+    assert fit.plant.pf2_static == pytest.approx(truth.pf2_static, rel=0.01)
+    # one mode is not enough: the fit with one mode leaves errors far above the noise
+    one = fit_frf(LINES, *measure(truth, seed=5), modes=1)
+    assert one.rms_relative_error > 5 * fit.rms_relative_error
+    assert one.criterion == "modes given"
+
+
+def test_given_mass_is_kept(exact):
+    fit = fit_frf(LINES, *measure(exact, seed=2), mass=22.0)
+    assert fit.plant.M == 22.0 and fit.M_std == 0.0 and fit.mass_given
+
+
+def test_result_reports_bands_dict_text_and_figure(noisy_fit):
+    bands = noisy_fit.bands()
+    assert [b["lines"] for b in bands] == [17, 17, 17, 9]
+    assert sum(b["lines"] for b in bands) == LINES.size
+    assert bands[0]["f_lo_hz"] == pytest.approx(1.0) and bands[-1]["f_hi_hz"] == 3000.0
+    for b in bands:
+        assert b["p1_rms_rel"] < 3 * NOISE and b["p2_rms_rel"] < 3 * NOISE
+    d = noisy_fit.to_dict()
+    assert d["modes"][0]["frequency_hz"] == pytest.approx(694.27, abs=0.5)
+    assert d["lines"] == 60 and d["bands"] == bands
+    text = str(noisy_fit)
+    assert "1 mode(s)" in text and "mode 1: f = 694" in text and "Pf2(0)" in text
+    assert text.count(" lines  P1 RMS") == 4
+    fig = noisy_fit.plot()
+    data = fig.motionhyst_data
+    assert_allclose(data["P1_data"], noisy_fit.P1_data)
+    # the dense fit curve passes through the resonance
+    assert noisy_fit.plant.modes[0].frequency_hz in data["f"]
+
+
+# ------------------------------------------------------------------ errors
+@pytest.mark.parametrize(("kwargs", "fragment"), [
+    ({"modes": 20}, "cannot determine 20 modes"),
+    ({"modes": -1}, "whole number"),
+    ({"modes": 1.5}, "whole number"),
+    ({"mass": -1.0}, "mass must be"),
+    ({"mass": math.nan}, "mass must be"),
+])
+def test_bad_options(exact, kwargs, fragment):
+    f = LINES[:40]
+    p1, p2 = exact.response(2 * np.pi * f)
+    with pytest.raises(ValueError, match=fragment):
+        fit_frf(f, p1, p2, **kwargs)
+
+
+def test_bad_data(exact):
+    p1, p2 = exact.response(2 * np.pi * LINES)
+    with pytest.raises(ValueError, match="same length"):
+        fit_frf(LINES[:-1], p1, p2)
+    with pytest.raises(ValueError, match="increasing"):
+        fit_frf(LINES[::-1], p1, p2)
+    bad = p1.copy()
+    bad[3] = np.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        fit_frf(LINES, bad, p2)
+    bad[3] = 0.0
+    with pytest.raises(ValueError, match="zero"):
+        fit_frf(LINES, bad, p2)
+    with pytest.raises(ValueError, match="rigid body"):  # a spring, not a floating mass
+        fit_frf(LINES, -p1, -p2)
+
+
+# ------------------------------------------------------------------ CLI
+def write_frd(path, f, p1, p2):
+    rows = [",".join(repr(float(x)) for x in (fi, a.real, a.imag, b.real, b.imag))
+            for fi, a, b in zip(f, p1, p2, strict=True)]
+    path.write_text("frequency_hz,p1_re,p1_im,p2_re,p2_im\n" + "\n".join(rows) + "\n")
+
+
+def frd_toml(tmp_path, plant_lines: str) -> str:
+    from motionhyst.scenario import default_scenario_path
+
+    text = default_scenario_path().read_text()
+    text = (text[:text.index("[stage]")] + f'[plant]\nfile = "p.csv"\n{plant_lines}\n\n'
+            + text[text.index("[hysteresis]"):])
+    path = tmp_path / "frd.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_cli_analyze_fits_a_measured_plant(capsys, tmp_path, exact):
+    from motionhyst.cli import main
+
+    write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
+    toml = frd_toml(tmp_path, "")
+    assert main(["analyze", toml, "--frequency", "1", "5", "10", "--json"]) == 0
+    out = capsys.readouterr().out
+    import json
+
+    d = json.loads(out)
+    fit = d["plant_fit"]
+    assert len(fit["modes"]) == 1 and fit["lines"] == 60
+    assert fit["modes"][0]["frequency_hz"] == pytest.approx(694.26, abs=4 * fit["modes"][0][
+        "frequency_hz_std"])
+    exact_E = {1.0: 3349.0, 5.0: 6.04}  # the issue's values for the exact stage
+    for p in d["mismatch"]:
+        if p["frequency_hz"] in exact_E:
+            assert p["abs"] == pytest.approx(exact_E[p["frequency_hz"]], rel=0.02)
+    assert d["mismatch_crossover_hz"] == pytest.approx(7.6, abs=0.05)
+    assert main(["analyze", toml]) == 0
+    text = capsys.readouterr().out
+    assert "rigid body + 1 mode(s)" in text and "per band" in text
+
+
+def test_cli_identify_closed_loop_runs_on_the_fitted_plant(capsys, tmp_path, exact):
+    """The closed-loop identification needs P1 as a model: the fitted one serves."""
+    from motionhyst.cli import main
+    from motionhyst.hysteresis import Jenkins
+    from motionhyst.systems import LeadLagLowpass
+
+    write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
+    toml = frd_toml(tmp_path, "")
+    loop = Loop(TABLE_I, LeadLagLowpass(6.2e6, 60.0, 240.0, 700.0, 0.6), Jenkins(20.0, 0.05))
+    sim = simulate(loop, SineReference(0.01, 2.0), 1.5)
+    rows = "\n".join(f"{t:.17g},{y:.17g},{u:.17g}"
+                     for t, y, u in zip(sim.t, sim.y1, sim.u, strict=True))
+    (tmp_path / "rec.csv").write_text("time,y1,u\n" + rows + "\n")
+    assert main(["identify", str(tmp_path / "rec.csv"), "--scenario", toml, "--elements", "1",
+                 "--json"]) == 0
+    import json
+
+    d = json.loads(capsys.readouterr().out)
+    el = d["elements"][0]
+    assert el["k"] == pytest.approx(20.0, rel=0.05) and el["fc"] == pytest.approx(0.05, rel=0.05)
+    # with use = "data" there is no model of P1: a one-line error
+    toml = frd_toml(tmp_path, 'use = "data"')
+    assert main(["identify", str(tmp_path / "rec.csv"), "--scenario", toml]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and 'use = "data"' in err
