@@ -3,7 +3,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: reproduce test bench lint clean
+.PHONY: reproduce test bench benchmark lint clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +25,11 @@ test: lint
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run.py
 	$(BIN)/python benchmarks/models.py
+
+# the Bouc-Wen hysteretic benchmark end to end (about a minute; kept out of make test)
+BENCHMARK_DATA ?= ../shared/benchmarks/bouc-wen
+benchmark: $(STAMP)
+	$(BIN)/motionhyst benchmark bouc-wen --data $(BENCHMARK_DATA)
 
 clean:
 	rm -rf $(VENV) out

@@ -395,3 +395,86 @@ def load_test_set(directory: str | Path, name: str) -> Record:
         raise ValueError(f"{directory}: {TEST_SETS[name][0]} and {TEST_SETS[name][1]} differ in "
                          f"length ({u.size} and {y.size})")
     return Record(np.arange(u.size) / FS, u, y)
+
+
+def default_data_dir() -> Path | None:
+    """``../shared/benchmarks/bouc-wen`` (relative to the working folder) if it exists."""
+    d = Path("..") / "shared" / "benchmarks" / "bouc-wen"
+    return d if d.is_dir() else None
+
+
+def generator_check(directory: str | Path) -> float:
+    """RMS difference [m] between the generator's output and the official multisine test output.
+
+    The official test input (one period) is upsampled by zero-padding its
+    spectrum (it is a multisine below 150 Hz: exact), simulated for three
+    periods from rest and the middle period compared.  Only the test's input
+    and output are used, nothing is estimated.
+    """
+    test = load_test_set(directory, "multisine")
+    n = test.u.size
+    spec = np.zeros(n * UPSAMPLE // 2 + 1, dtype=complex)
+    spec[: n // 2] = np.fft.rfft(test.u)[: n // 2]
+    u_fine = np.fft.irfft(spec, n * UPSAMPLE) * UPSAMPLE
+    y = benchmark_output(np.tile(u_fine, 3))
+    return float(np.sqrt(np.mean((y[n:2 * n] - test.y) ** 2)))
+
+
+def run_benchmark(directory: str | Path, *, seed: int = 0, n_experiments: int = 2,
+                  n_periods: int = 5, models: tuple[str, ...] = ("bouc-wen",),
+                  progress=None) -> dict:
+    """The Bouc-Wen benchmark end to end: training data, identification, test RMSE.
+
+    Training: `n_experiments` experiments of `n_periods` periods made by the
+    benchmark's procedure (:func:`training_record`, fresh multisines and noise
+    from `seed`).  Each model in `models` is identified from them alone
+    (:func:`motionhyst.identify_io.identify_io`, from rest), then simulated from
+    the official test inputs (the multisine as its periodic steady state, the
+    sine sweep from rest) and scored by the RMS of the simulation error over
+    each whole test set.
+
+    Returns
+    -------
+    dict
+        ``{"training", "generator_check_rms", "models": [{"model", "multisine_rmse",
+        "sinesweep_rmse", "identification_s", "simulation_s", "fit_rms",
+        "identification"}], "published"}``.
+    """
+    import time
+
+    from motionhyst.identify_io import IORecord, identify_io
+
+    tests = {name: load_test_set(directory, name) for name in TEST_SETS}
+    say = progress or (lambda msg: None)
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    records = []
+    for i in range(n_experiments):
+        rec = training_record(rng, n_periods)
+        records.append(IORecord(rec.t, rec.u, rec.y, f"experiment {i + 1}"))
+    gen_s = time.perf_counter() - t0
+    say(f"training data: {n_experiments} x {n_periods} periods of {PERIOD} samples "
+        f"({gen_s:.1f} s)")
+    out_models = []
+    for model in models:
+        t0 = time.perf_counter()
+        fit = identify_io(records, model)
+        ident_s = time.perf_counter() - t0
+        say(f"{model}: identified in {ident_s:.1f} s, fit RMS {fit.fit_rms:.3g} m")
+        system = fit.system()
+        row = {"model": model, "identification_s": ident_s, "fit_rms": fit.fit_rms,
+               "identification": fit.to_dict()}
+        t0 = time.perf_counter()
+        for name, test in tests.items():
+            y = system.simulate(test.t, test.u, periodic=(name == "multisine")).displacement
+            row[f"{name}_rmse"] = float(np.sqrt(np.mean((y - test.y) ** 2)))
+        row["simulation_s"] = time.perf_counter() - t0
+        say(f"{model}: test RMSE multisine {row['multisine_rmse']:.3g} m, sine sweep "
+            f"{row['sinesweep_rmse']:.3g} m")
+        out_models.append(row)
+    return {"training": {"experiments": n_experiments, "periods": n_periods,
+                         "samples_per_period": PERIOD, "noise_rms": NOISE_RMS, "seed": seed,
+                         "generation_s": gen_s},
+            "generator_check_rms": generator_check(directory),
+            "models": out_models,
+            "published": [{"method": m, "multisine_rmse": v} for m, v in PUBLISHED_MULTISINE]}

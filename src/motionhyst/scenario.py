@@ -31,6 +31,7 @@ from motionhyst.frf_fit import FrfFit, ModalPlant, fit_measured_plant
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.hysteresis.registry import Form
 from motionhyst.loop import Loop
+from motionhyst.openloop import MassSpringDamper, OpenLoop
 from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
 
 
@@ -57,12 +58,40 @@ class _Section(BaseModel):
 
 
 class StageSection(_Section):
-    """``[stage]``: the two-mass stage of eqs. (1)-(2)."""
+    """``[stage]``: the two-mass stage of eqs. (1)-(2) (``type = "two-mass"``, the default)."""
 
+    type: Annotated[Literal["two-mass"], Field(exclude=True)] = "two-mass"  # the default
     m1: PositiveFloat
     m2: PositiveFloat
     b: NonNegativeFloat
     k: PositiveFloat
+
+
+class MassSpringDamperSection(_Section):
+    """``[stage] type = "mass-spring-damper"``: one mass on a spring and damper, open loop.
+
+    ``m y'' + c y' + k y + w = u`` with the link force ``w`` on the position
+    (:class:`~motionhyst.openloop.MassSpringDamper`); force in, position out,
+    no ``[controller]``, ``[feedforward]`` or ``[reference]``.
+    """
+
+    type: Literal["mass-spring-damper"]
+    m: PositiveFloat
+    c: NonNegativeFloat
+    k: NonNegativeFloat
+
+
+def _stage_tag(data) -> str | None:
+    """Tag of a ``[stage]`` table: its ``type``, ``"two-mass"`` when absent."""
+    if isinstance(data, dict):
+        return data.get("type", "two-mass")
+    return getattr(data, "type", None)
+
+
+StageUnion = Annotated[
+    Union[Annotated[StageSection, Tag("two-mass")],  # noqa: UP007
+          Annotated[MassSpringDamperSection, Tag("mass-spring-damper")]],
+    Discriminator(_stage_tag)]
 
 
 class PlantSection(_Section):
@@ -245,23 +274,40 @@ class ReferenceSection(_Section):
 class ScenarioModel(_Section):
     """The whole file."""
 
-    stage: StageSection | None = None
+    stage: StageUnion | None = None
     plant: PlantSection | None = None
     hysteresis: HysteresisSection
     controller: Annotated[LeadLagSection | TransferFunctionSection,
-                          Field(discriminator="type")]
-    feedforward: FeedforwardSection = FeedforwardSection()
-    reference: ReferenceSection
+                          Field(discriminator="type")] | None = None
+    feedforward: FeedforwardSection | None = None
+    reference: ReferenceSection | None = None
 
     @model_validator(mode="after")
     def _one_plant(self):
         if (self.stage is None) == (self.plant is None):
             raise ValueError("give exactly one of [stage] and [plant]")
+        if isinstance(self.stage, MassSpringDamperSection):
+            for name in ("controller", "feedforward", "reference"):
+                if getattr(self, name) is not None:
+                    raise ValueError(f"[{name}] does not apply to a mass-spring-damper [stage] "
+                                     f"(an open-loop system, force in, position out)")
+            return self
+        for name in ("controller", "reference"):
+            if getattr(self, name) is None:
+                raise ValueError(f"[{name}]: missing")
+        if self.feedforward is None:
+            self.feedforward = FeedforwardSection()
         return self
+
+    @property
+    def open_loop(self) -> bool:
+        """True for a mass-spring-damper stage (no controller)."""
+        return isinstance(self.stage, MassSpringDamperSection)
 
 
 # tags of the discriminated unions, left out of the key named in an error message
-_UNION_TAGS = {"leadlag-lowpass", "tf", *MODELS, *FORM_SECTIONS}
+_UNION_TAGS = {"leadlag-lowpass", "tf", "two-mass", "mass-spring-damper", *MODELS,
+               *FORM_SECTIONS}
 
 
 def build_hysteresis(section) -> Hysteresis:
@@ -284,6 +330,8 @@ def hysteresis_from_dict(data: dict, source: str = "<dict>") -> Hysteresis:
 def _discriminator(e: dict) -> str:
     """The key a discriminated union is chosen by (``model`` for the link's callable one)."""
     name = e["ctx"]["discriminator"].strip("'")
+    if name == f"{_stage_tag.__name__}()":
+        return "type"
     return "model" if name == f"{_link_tag.__name__}()" else name
 
 
@@ -338,7 +386,8 @@ class Scenario:
         except ValidationError as err:
             raise ScenarioError(_format_error(source, err)) from None
         sc = cls(model, source, base_dir)
-        sc.loop()  # builds and checks stability
+        if not model.open_loop:
+            sc.loop()  # builds and checks stability
         return sc
 
     @classmethod
@@ -356,20 +405,43 @@ class Scenario:
         return cls.from_dict(data, str(path), path.parent)
 
     @property
+    def is_open_loop(self) -> bool:
+        """True for a mass-spring-damper stage: force in, position out, no controller."""
+        return self.model.open_loop
+
+    def _closed(self, what: str) -> None:
+        if self.model.open_loop:
+            raise ScenarioError(f"{self.source}: [stage] is a mass-spring-damper (an open-loop "
+                                f"system without [controller] or [reference]); {what} needs a "
+                                f"closed loop (use motionhyst predict for open-loop systems)")
+
+    @property
     def amplitude(self) -> float:
         """Reference amplitude [m]."""
+        self._closed("the reference")
         return self.model.reference.amplitude
 
     @property
     def frequencies(self) -> list[float]:
         """Reference frequencies [Hz]."""
+        self._closed("the reference")
         return list(self.model.reference.frequencies)
 
-    def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant:
+    def open_loop(self) -> OpenLoop:
+        """The open-loop system of a mass-spring-damper stage and its link."""
+        if not self.model.open_loop:
+            raise ScenarioError(f"{self.source}: [stage] is not a mass-spring-damper; an "
+                                f"open-loop system needs [stage] type = \"mass-spring-damper\"")
+        st = self.model.stage
+        return OpenLoop(MassSpringDamper(st.m, st.c, st.k), self.hysteresis())
+
+    def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant | MassSpringDamper:
         """The stage model, the model fitted to a measured plant, or the raw measured plant."""
         if self._plant is not None:
             return self._plant
         m = self.model
+        if m.open_loop:
+            return MassSpringDamper(m.stage.m, m.stage.c, m.stage.k)
         if m.stage is not None:
             self._plant = TwoMassStage(m.stage.m1, m.stage.m2, m.stage.b, m.stage.k)
             return self._plant
@@ -402,6 +474,7 @@ class Scenario:
 
     def controller(self) -> control.TransferFunction:
         """The feedback controller."""
+        self._closed("a controller")
         c = self.model.controller
         if c.type == "leadlag-lowpass":
             return LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta)
@@ -409,6 +482,7 @@ class Scenario:
 
     def loop(self) -> Loop:
         """The loop (built once, checked for stability)."""
+        self._closed("this")
         if self._loop is None:
             ff = None if self.model.feedforward.type == "none" else "rigid-body"
             hff = self.model.feedforward.hysteresis

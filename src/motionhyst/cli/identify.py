@@ -8,6 +8,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from motionhyst.cli._common import UsageError, g, positive, print_json, table
+from motionhyst.cli._identify_io import (
+    add_input_output_arguments,
+    check_not_input_output,
+    run_input_output,
+)
 
 RECORD_KINDS = {"force-displacement": ("time", "displacement", "force"),
                 "closed-loop": ("time", "y1", "u")}
@@ -106,7 +111,13 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.scenario import load_scenario
     from motionhyst.systems import MeasuredPlant
 
-    path = Path(args.data)
+    if args.record == "input-output":
+        return run_input_output(args)
+    check_not_input_output(args)
+    if len(args.data) > 1:
+        raise UsageError("motionhyst identify: several records are read with --record "
+                         "input-output only")
+    path = Path(args.data[0])
     kind = record_kind(path, args.record)
     if kind == "force-displacement":
         for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
@@ -165,18 +176,21 @@ def add_parser(sub) -> None:
     """Add the ``identify`` command to the subparsers `sub`."""
     q = sub.add_parser("identify", help="identify Maxwell-slip hysteresis from a measured "
                        "record (CSV)")
-    q.add_argument("data", metavar="DATA.csv",
+    q.add_argument("data", metavar="DATA.csv", nargs="+",
                    help="record with a header: time,displacement,force (force-displacement) or "
-                        "time,y1,u (closed-loop) [SI units]")
+                        "time,y1,u (closed-loop) [SI units]; with --record input-output one or "
+                        "more records time,force,displacement (force in, position out)")
     q.add_argument("--elements", type=_element_count, metavar="N",
                    help="number of Jenkins elements (default: chosen by --criterion)")
     q.add_argument("--cutoff", type=positive, metavar="HZ",
                    help="closed-loop records: cut-off of the prefilter through which the link "
                         "force is inferred [Hz] (default: 20 times the record's fundamental, "
                         "at most a twentieth of the sampling rate)")
-    q.add_argument("--record", choices=list(RECORD_KINDS),
+    q.add_argument("--record", choices=[*RECORD_KINDS, "input-output"],
                    help="the record's kind, where its header has the columns of both "
-                        "(default: from the header)")
+                        "(default: from the header); input-output: identify the stage and its "
+                        "link jointly from force and position (grey box, simulation error)")
+    add_input_output_arguments(q)
     q.add_argument("--criterion", choices=["rms", "bic"], default="rms",
                    help="model-order criterion when --elements is not given (default: rms)")
     q.add_argument("--scenario", metavar="FILE",

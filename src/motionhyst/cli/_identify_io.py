@@ -1,0 +1,125 @@
+"""``motionhyst identify --record input-output``: the stage and its link from force and position."""
+
+from __future__ import annotations
+
+import argparse
+
+from motionhyst.cli._common import UsageError, g, print_json, table
+from motionhyst.cli._write import write_text
+
+PLANTS = ("mass-spring-damper", "two-mass")
+IO_MODELS = ("bouc-wen", "maxwell-slip", "jenkins", "dahl", "lugre")
+
+
+def _nu(text: str) -> float | str:
+    """argparse type: a Bouc-Wen exponent >= 1, or ``free`` to estimate it."""
+    if text == "free":
+        return text
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number >= 1 or 'free', got {text!r}") from None
+    if not v >= 1.0 or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a number >= 1 or 'free', got {text!r}")
+    return v
+
+
+def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
+    """The options of input-output identification."""
+    q.add_argument("--plant", choices=PLANTS,
+                   help="input-output records: the stage's model (default mass-spring-damper)")
+    q.add_argument("--model", choices=IO_MODELS,
+                   help="input-output records: the link's model (default bouc-wen)")
+    q.add_argument("--periodic", action="store_true",
+                   help="input-output records: each record holds whole periods of a periodic "
+                        "steady state (default: each is an experiment from rest)")
+    q.add_argument("--nu", type=_nu, metavar="NU|free",
+                   help="input-output records, Bouc-Wen: the exponent nu, fixed (default 1) or "
+                        "'free' to estimate it")
+    q.add_argument("--save", metavar="MODEL.toml",
+                   help="input-output records: write the identified system as a scenario "
+                        "(read by motionhyst predict)")
+    q.add_argument("--force", action="store_true", help="replace the --save file if it exists")
+
+
+def check_not_input_output(args: argparse.Namespace) -> None:
+    """One-line error for input-output options given with another record kind."""
+    for option, value in (("--plant", args.plant), ("--model", args.model),
+                          ("--periodic", args.periodic or None), ("--nu", args.nu),
+                          ("--save", args.save)):
+        if value is not None:
+            raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
+                             f"only")
+
+
+def run_input_output(args: argparse.Namespace) -> int:
+    """Identify the stage and its link from input-output records; print, optionally save."""
+    from motionhyst.identify_io import identify_io, load_io_csv
+
+    for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff),
+                          ("--elements", args.elements)):
+        if value is not None:
+            raise UsageError(f"motionhyst identify: {option} does not apply to --record "
+                             f"input-output")
+    plant = args.plant or "mass-spring-damper"
+    model = args.model or "bouc-wen"
+    if plant == "two-mass":
+        raise UsageError("motionhyst identify: --plant two-mass is not available for "
+                         "input-output records yet; use --plant mass-spring-damper")
+    if model not in ("bouc-wen",):
+        raise UsageError(f"motionhyst identify: --model {model} is not available for "
+                         f"input-output records yet; use --model bouc-wen")
+    if args.nu is not None and model != "bouc-wen":
+        raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
+    if args.save is not None:  # refuse before the work, not after
+        write_check(args.save, args.force, args.data)
+    records = [load_io_csv(path) for path in args.data]
+    nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
+    fit = identify_io(records, model, periodic=args.periodic, nu=nu)
+    result = {**fit.to_dict(), "records": fit.records}
+    if args.save is not None:
+        write_text(args.save, fit.scenario_text(), force=args.force, inputs=args.data,
+                   option="--save")
+        result["saved"] = args.save
+    if args.json:
+        print_json(result)
+        return 0
+    kind = "periodic steady state" if fit.periodic else "from rest"
+    print(f"Stage and {model} link identified from {len(records)} input-output record(s) "
+          f"({kind}) by simulation error in {fit.seconds:.3g} s")
+    print(f"  fit RMS {g(fit.fit_rms)} m; {fit.stopping}")
+    rows = []
+    for name, value in fit.estimates.items():
+        s = fit.std.get(name)
+        rows.append([name, g(value, 8), "not identifiable" if s is None else g(s, 2),
+                     "" if s is None or value == 0 else f"{100 * s / abs(value):.2g} %"])
+    print()
+    print(table(["parameter", "estimate", "std", "std/|value|"], rows))
+    if fit.not_identifiable:
+        print()
+        for name, why in fit.not_identifiable.items():
+            print(f"  {name}: {why}")
+    print()
+    print(table(["record", "samples", "fit RMS [m]", "output RMS [m]"],
+                [[r["name"], str(r["samples"]), g(r["fit_rms"]), g(r["output_rms"])]
+                 for r in fit.records]))
+    if args.save is not None:
+        print(f"\nwrote {args.save}")
+    else:
+        print("\n# the identified system, a scenario for motionhyst predict (or give --save):")
+        print(fit.scenario_text(), end="")
+    return 0
+
+
+def write_check(path: str, force: bool, inputs) -> None:
+    """Refuse an output that exists (without --force) or is an input, before any work."""
+    import os
+    from pathlib import Path
+
+    target = Path(path)
+    for inp in inputs:
+        if target.exists() and Path(inp).exists() and os.path.samefile(target, inp):
+            raise ValueError(f"--save {target}: is an input of this command; refusing to "
+                             f"overwrite it")
+    if target.exists() and not force:
+        raise ValueError(f"--save {target} exists; give --force to replace it")

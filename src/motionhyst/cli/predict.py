@@ -1,0 +1,67 @@
+"""``motionhyst predict``: the displacement of an open-loop system for a force record."""
+
+from __future__ import annotations
+
+import argparse
+import io
+
+import numpy as np
+
+from motionhyst.cli._common import UsageError, print_json
+from motionhyst.cli._write import write_text
+
+
+def add_parser(sub) -> None:
+    """Add the ``predict`` command to the subparsers `sub`."""
+    q = sub.add_parser("predict", help="displacement of an open-loop system (mass-spring-damper "
+                       "scenario) for a force record (CSV)")
+    q.add_argument("scenario", metavar="MODEL.toml",
+                   help='scenario with [stage] type = "mass-spring-damper" and [hysteresis] '
+                        "(as written by motionhyst identify --save)")
+    q.add_argument("data", metavar="INPUT.csv", help="force record with a header: time,force "
+                   "[s, N], uniform time steps")
+    q.add_argument("--periodic", action="store_true",
+                   help="the record is one period (or whole periods) of a periodic force: "
+                        "output the periodic steady state (default: from rest)")
+    q.add_argument("--out", required=True, metavar="OUT.csv",
+                   help="output CSV: time,displacement [s, m] on the input's time grid")
+    q.add_argument("--substeps", type=int, metavar="N",
+                   help="integration steps per sample (default: >= 20 and >= 400 per period "
+                        "of the stage's mode)")
+    q.add_argument("--force", action="store_true", help="replace OUT.csv if it exists")
+    q.add_argument("--json", action="store_true", help="print a JSON summary")
+    q.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Simulate the scenario's open-loop system for the force record and write the output."""
+    from motionhyst.csvdata import read_columns
+    from motionhyst.scenario import Scenario
+
+    if args.substeps is not None and not 1 <= args.substeps <= 10000:
+        raise UsageError(f"motionhyst predict: --substeps must be from 1 to 10000, got "
+                         f"{args.substeps}")
+    sc = Scenario.from_file(args.scenario)
+    system = sc.open_loop()
+    data = read_columns(args.data, ("time", "force"))
+    t, u = data[:, 0], data[:, 1]
+    try:
+        out = system.simulate(t, u, periodic=args.periodic, substeps=args.substeps)
+    except ValueError as exc:
+        raise ValueError(f"{args.data}: {exc}") from None
+    buf = io.StringIO()
+    buf.write("time,displacement\n")
+    np.savetxt(buf, np.column_stack([out.t, out.displacement]), delimiter=",", fmt="%.17g")
+    write_text(args.out, buf.getvalue(), force=args.force, inputs=[args.scenario, args.data],
+               option="--out")
+    summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
+               "displacement_rms": float(np.sqrt(np.mean(out.displacement ** 2))),
+               "displacement_peak": float(np.max(np.abs(out.displacement)))}
+    if args.json:
+        print_json(summary)
+    else:
+        what = "periodic steady state" if args.periodic else "from rest"
+        print(f"Predicted {t.size} samples of {sc.source} ({what}) for {args.data} -> {args.out}")
+        print(f"  displacement RMS {summary['displacement_rms']:.4g} m, peak "
+              f"{summary['displacement_peak']:.4g} m")
+    return 0

@@ -1,0 +1,158 @@
+"""Grey-box identification from input-output records (motionhyst.identify_io) and its CLI."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from motionhyst.cli import main
+from motionhyst.hysteresis import BoucWen
+from motionhyst.identify_io import IORecord, best_linear_approximation, identify_io
+from motionhyst.openloop import MassSpringDamper, OpenLoop
+
+FS = 750.0
+TRUE = {"m": 2.0, "c": 10.0, "k": 5e4, "alpha": 5e4, "beta*gamma": 800.0,
+        "beta*delta": -1100.0}
+SYSTEM = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4),
+                  BoucWen.from_general(5e4, 1e3, 0.8, -1.1, 1.0))
+SUBSTEPS = 20
+
+
+def _multisine(n: int, seed: int, rms: float = 50.0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    spec = np.zeros(n // 2 + 1, dtype=complex)
+    lines = np.arange(int(5 / (FS / n)), int(150 / (FS / n)) + 1)
+    spec[lines] = np.exp(2j * np.pi * rng.random(lines.size))
+    u = np.fft.irfft(spec, n)
+    return u * rms / np.std(u)
+
+
+def _record(n: int, seed: int, noise: float = 0.0, periodic: bool = False) -> IORecord:
+    u = _multisine(n, seed)
+    t = np.arange(n) / FS
+    y = SYSTEM.simulate(t, u, periodic=periodic, substeps=SUBSTEPS).displacement
+    y = y + noise * np.random.default_rng(seed + 100).standard_normal(n)
+    return IORecord(t, u, y, f"record {seed}")
+
+
+@pytest.fixture(scope="module")
+def exact_fit():
+    return identify_io([_record(1536, 1)], substeps=SUBSTEPS)
+
+
+def test_noise_free_records_give_the_parameters(exact_fit):
+    for name, value in TRUE.items():
+        assert exact_fit.estimates[name] == pytest.approx(value, rel=1e-6), name
+    assert exact_fit.fit_rms < 1e-12
+    # beta alone is not identifiable; the identifiable products are the estimates
+    assert "beta" in exact_fit.not_identifiable
+    g = exact_fit.hysteresis.general
+    assert abs(g["gamma"]) + abs(g["delta"]) == pytest.approx(1.0)
+    assert g["beta"] * g["gamma"] == pytest.approx(800.0, rel=1e-6)
+    d = exact_fit.to_dict()
+    assert {"plant", "hysteresis", "std", "fit_rms", "records", "seconds"} <= set(d)
+    assert d["plant"] == {"type": "mass-spring-damper", "m": pytest.approx(2.0, rel=1e-6),
+                          "c": pytest.approx(10.0, rel=1e-6), "k": pytest.approx(5e4, rel=1e-6)}
+
+
+def test_noisy_records_within_three_standard_errors():
+    noise = 8e-6  # the benchmark's noise, about 1 % of the output RMS
+    fit = identify_io([_record(1536, 2, noise), _record(1536, 3, noise)], substeps=SUBSTEPS)
+    for name, value in TRUE.items():
+        std = fit.std[name]
+        assert std is not None and 0 < std < 0.01 * abs(value), name
+        assert abs(fit.estimates[name] - value) <= 3 * std, name
+    assert fit.fit_rms == pytest.approx(noise, rel=0.1)
+
+
+def test_periodic_records():
+    fit = identify_io([_record(1024, 4, periodic=True)], periodic=True, substeps=SUBSTEPS)
+    for name, value in TRUE.items():
+        assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
+
+
+def test_best_linear_approximation_of_a_linear_stage():
+    t = np.arange(2048) / FS
+    u = _multisine(2048, 5)
+    plant = MassSpringDamper(1.5, 4.0, 2e4)
+    y = OpenLoop(plant).simulate(t, u, periodic=True).displacement
+    bla = best_linear_approximation([IORecord(t, u, y)])
+    assert (bla.m, bla.c, bla.k) == (pytest.approx(1.5, rel=1e-6), pytest.approx(4.0, rel=1e-5),
+                                     pytest.approx(2e4, rel=1e-6))
+
+
+def test_record_errors():
+    t = np.arange(200) / FS
+    u = np.sin(2 * np.pi * 10 * t)
+    with pytest.raises(ValueError, match="too short"):
+        identify_io([IORecord(t[:10], u[:10], u[:10], "a.csv")])
+    with pytest.raises(ValueError, match=r"a\.csv: displacement is not finite"):
+        identify_io([IORecord(t, u, np.where(t > 0.1, np.nan, 0.0), "a.csv")])
+    with pytest.raises(ValueError, match=r"a\.csv: the force is constant"):
+        identify_io([IORecord(t, np.ones_like(t), u, "a.csv")])
+    with pytest.raises(ValueError, match=r"b\.csv: sampled at 375 Hz"):
+        identify_io([IORecord(t, u, u, "a.csv"), IORecord(2 * t, u, u, "b.csv")])
+    with pytest.raises(ValueError, match="differ in length"):
+        identify_io([IORecord(t, u, u[:-1], "a.csv")])
+    with pytest.raises(ValueError, match="unknown link model"):
+        identify_io([IORecord(t, u, u)], "preisach")
+
+
+def _write_csv(path, rec: IORecord) -> None:
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+
+
+def test_cli_identify_save_and_predict(tmp_path, capsys):
+    rec = _record(1536, 1)
+    data = tmp_path / "rec.csv"
+    _write_csv(data, rec)
+    model = tmp_path / "model.toml"
+    assert main(["identify", str(data), "--record", "input-output", "--save", str(model),
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert {"plant", "hysteresis", "std", "fit_rms", "records", "seconds"} <= set(out)
+    assert out["hysteresis"]["model"] == "bouc-wen"
+    assert out["plant"]["m"] == pytest.approx(2.0, rel=1e-4)
+    # predict reads the saved scenario; the periodic prediction of one period is the
+    # model's steady state
+    t = np.arange(512) / FS
+    u = _multisine(512, 9)
+    inp = tmp_path / "force.csv"
+    np.savetxt(inp, np.column_stack([t, u]), delimiter=",", header="time,force", comments="",
+               fmt="%.17g")
+    pred = tmp_path / "pred.csv"
+    assert main(["predict", str(model), str(inp), "--periodic", "--out", str(pred)]) == 0
+    got = np.loadtxt(pred, delimiter=",", skiprows=1)
+    np.testing.assert_allclose(got[:, 0], t, rtol=0, atol=1e-15)
+    ref = SYSTEM.simulate(t, u, periodic=True).displacement
+    assert np.max(np.abs(got[:, 1] - ref)) < 1e-4 * np.max(np.abs(ref))
+    # existing output: refused without --force, replaced with it; an input is never replaced
+    assert main(["predict", str(model), str(inp), "--out", str(pred)]) == 2
+    assert "exists; give --force" in capsys.readouterr().err
+    assert main(["predict", str(model), str(inp), "--out", str(pred), "--force"]) == 0
+    assert main(["predict", str(model), str(inp), "--out", str(inp), "--force"]) == 2
+    assert "input" in capsys.readouterr().err
+    assert np.loadtxt(inp, delimiter=",", skiprows=1).shape == (512, 2)
+
+
+def test_cli_errors(tmp_path, capsys):
+    t = np.arange(100) / FS
+    bad = tmp_path / "const.csv"
+    _write_csv(bad, IORecord(t, np.ones_like(t), np.sin(t), ""))
+    assert main(["identify", str(bad), "--record", "input-output"]) == 2
+    err = capsys.readouterr().err
+    assert "const.csv: the force is constant" in err and len(err.strip().splitlines()) == 1
+    assert main(["identify", str(bad), "--model", "bouc-wen"]) == 2
+    assert "--model applies to --record input-output only" in capsys.readouterr().err
+    assert main(["identify", str(bad), "--record", "input-output", "--plant", "two-mass"]) == 2
+    assert "two-mass is not available" in capsys.readouterr().err
+    closed = tmp_path / "closed.toml"
+    closed.write_text('[stage]\nm1 = 5.0\nm2 = 17.5\nb = 90.0\nk = 7.4e7\n'
+                      '[hysteresis]\nmodel = "jenkins"\nk = 20.0\nfc = 0.05\n'
+                      '[controller]\ntype = "tf"\nnum = [1e6, 1e8]\nden = [1.0, 1e3]\n'
+                      '[reference]\namplitude = 0.01\nfrequencies = [1.0]\n')
+    assert main(["predict", str(closed), str(bad), "--out", str(tmp_path / "o.csv")]) == 2
+    assert "not a mass-spring-damper" in capsys.readouterr().err
