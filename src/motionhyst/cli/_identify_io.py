@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 
 from motionhyst.cli._common import UsageError, g, print_json, table
-from motionhyst.cli._write import write_text
 
 PLANTS = ("mass-spring-damper", "two-mass")
 IO_MODELS = ("bouc-wen", "maxwell-slip", "jenkins", "dahl", "lugre")
@@ -71,15 +70,17 @@ def run_input_output(args: argparse.Namespace) -> int:
                          f"input-output records yet; use --model bouc-wen")
     if args.nu is not None and model != "bouc-wen":
         raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
-    if args.save is not None:  # refuse before the work, not after
-        write_check(args.save, args.force, args.data)
+    target = None
+    if args.save is not None:  # refused before the work, not after
+        from motionhyst.outputs import OutputFile
+
+        target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
     records = [load_io_csv(path) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     fit = identify_io(records, model, periodic=args.periodic, nu=nu)
     result = {**fit.to_dict(), "records": fit.records}
-    if args.save is not None:
-        write_text(args.save, fit.scenario_text(), force=args.force, inputs=args.data,
-                   option="--save")
+    if target is not None:
+        target.write_text(fit.scenario_text())
         result["saved"] = args.save
     if args.json:
         print_json(result)
@@ -109,17 +110,3 @@ def run_input_output(args: argparse.Namespace) -> int:
         print("\n# the identified system, a scenario for motionhyst predict (or give --save):")
         print(fit.scenario_text(), end="")
     return 0
-
-
-def write_check(path: str, force: bool, inputs) -> None:
-    """Refuse an output that exists (without --force) or is an input, before any work."""
-    import os
-    from pathlib import Path
-
-    target = Path(path)
-    for inp in inputs:
-        if target.exists() and Path(inp).exists() and os.path.samefile(target, inp):
-            raise ValueError(f"--save {target}: is an input of this command; refusing to "
-                             f"overwrite it")
-    if target.exists() and not force:
-        raise ValueError(f"--save {target} exists; give --force to replace it")

@@ -8,7 +8,6 @@ import io
 import numpy as np
 
 from motionhyst.cli._common import UsageError, print_json
-from motionhyst.cli._write import write_text
 
 
 def add_parser(sub) -> None:
@@ -41,6 +40,10 @@ def run(args: argparse.Namespace) -> int:
     if args.substeps is not None and not 1 <= args.substeps <= 10000:
         raise UsageError(f"motionhyst predict: --substeps must be from 1 to 10000, got "
                          f"{args.substeps}")
+    from motionhyst.outputs import OutputFile
+
+    target = OutputFile(args.out, force=args.force, inputs=[args.scenario, args.data],
+                        option="--out")  # refused before any work
     sc = Scenario.from_file(args.scenario)
     system = sc.open_loop()
     data = read_columns(args.data, ("time", "force"))
@@ -52,8 +55,7 @@ def run(args: argparse.Namespace) -> int:
     buf = io.StringIO()
     buf.write("time,displacement\n")
     np.savetxt(buf, np.column_stack([out.t, out.displacement]), delimiter=",", fmt="%.17g")
-    write_text(args.out, buf.getvalue(), force=args.force, inputs=[args.scenario, args.data],
-               option="--out")
+    target.write_text(buf.getvalue())
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "displacement_rms": float(np.sqrt(np.mean(out.displacement ** 2))),
                "displacement_peak": float(np.max(np.abs(out.displacement)))}
