@@ -143,7 +143,7 @@ def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
 
 def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
                               frequency_hz: float | None = None):
-    """Fig. 8: |D|/k and angle of D against zeta (eq. 10), mode regions shaded.
+    """Fig. 8: ``|D| / k`` and angle of ``D`` against zeta (eq. 10), mode regions shaded.
 
     For other models than Jenkins, ``zeta = fc / (k A)`` with the total slip
     force and the initial stiffness, without the Jenkins element's modes; a
@@ -221,7 +221,7 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
 
 def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
-    """Fig. 10: mismatch |E| (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
+    """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
     fig, (ax,) = _figure()
     f = np.geomspace(*_frequency_range(loop, f_range), 800)
     E = loop_mismatch(loop, f, analysis.amplitude)

@@ -81,7 +81,7 @@ class Jenkins(Hysteresis):
     >>> el.zeta(0.01)
     0.25
     >>> D = control.describing_function(el, 0.01)
-    >>> round(abs(D) / el.k, 3)
+    >>> print(round(abs(D) / el.k, 3))
     0.309
     """
 

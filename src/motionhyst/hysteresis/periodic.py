@@ -90,7 +90,7 @@ def sample_period(X: NDArray[np.complex128], N: int, deriv: int = 0) -> NDArray[
 
 def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLike,
                             n_harmonics: int) -> NDArray[np.complex128]:
-    """Harmonics ``W_0 .. W_H`` (``rfft`` scaling) of a Jenkins element's periodic output.
+    """Harmonics ``W_0`` to ``W_H`` (``rfft`` scaling) of a Jenkins element's periodic output.
 
     Parameters
     ----------
