@@ -13,6 +13,7 @@ import argparse
 import importlib
 import inspect
 import pkgutil
+import shutil
 import subprocess
 import sys
 from collections.abc import Callable
@@ -80,9 +81,14 @@ def public_api() -> dict[str, list[str]]:
     return api
 
 
-def _first_line(module: ModuleType) -> str:
-    doc = inspect.getdoc(module) or ""
-    return doc.strip().splitlines()[0].rstrip(".") if doc.strip() else ""
+def _shadowed(mod_name: str) -> bool:
+    """Whether the package attribute of a module's name is another object.
+
+    ``motionhyst.simulate`` is the function ``simulate``, defined in the module of the
+    same name; the function's page owns the name.
+    """
+    parent, _, last = mod_name.rpartition(".")
+    return getattr(importlib.import_module(parent), last) is not importlib.import_module(mod_name)
 
 
 def write_api(dest: Path) -> int:
@@ -110,8 +116,10 @@ def write_api(dest: Path) -> int:
     for mod_name in sorted(api):
         module = importlib.import_module(mod_name)
         title = f"``{mod_name}``"
-        lines += [title, "-" * len(title), "", f".. automodule:: {mod_name}", "   :no-members:",
-                  ""]
+        lines += [title, "-" * len(title), "", f".. automodule:: {mod_name}", "   :no-members:"]
+        if _shadowed(mod_name):  # the name is the function's: the module gets no target
+            lines.append("   :no-index:")
+        lines.append("")
         names = api[mod_name]
         if names:
             # relative to the package, so that the table reads Jenkins, quasilinear.mismatch
@@ -123,6 +131,7 @@ def write_api(dest: Path) -> int:
         elif module_public_names(module):
             lines += ["Its public names are documented above under their shorter spelling.", ""]
     dest.mkdir(parents=True, exist_ok=True)
+    shutil.rmtree(dest / "generated", ignore_errors=True)  # stubs of names since removed
     _write_if_changed(dest / "index.rst", "\n".join(lines) + "\n")
     return count
 
