@@ -50,6 +50,25 @@ class Loop:
     hysteresis_feedforward : Hysteresis, optional
         A model ``phi_hat`` driven by the reference and added to the
         feedforward force: ``u_ff = M r'' + phi_hat(r)``.
+
+    Examples
+    --------
+    The paper's Table I loop, its closed-loop transfers and bandwidth:
+
+    >>> import numpy as np
+    >>> from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> C = LeadLagLowpass(K=6.2e6, f1=60.0, f2=240.0, flp=700.0, beta=0.6)
+    >>> loop = Loop(stage, C, Jenkins(k=20.0, fc=0.05))    # rigid-body feedforward M s^2
+    >>> loop.M
+    22.5
+    >>> print(f"{loop.bandwidth_hz():.1f} Hz")
+    120.6 Hz
+    >>> bool(np.all(loop.closed_loop_poles().real < 0))
+    True
+    >>> e_over_r = loop.transfer("r->e", 2 * np.pi * np.array([5.0, 10.0]))
+    >>> print(np.abs(e_over_r))                            # the linear loop's tracking error
+    [1.858e-07 2.976e-06]
     """
 
     def __init__(self, plant, controller, hysteresis: Hysteresis | None = None,

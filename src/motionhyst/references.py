@@ -20,7 +20,17 @@ from motionhyst.systems import TWO_PI
 
 @dataclass(frozen=True)
 class SineReference:
-    """``r = amplitude sin(2 pi frequency_hz t)``."""
+    """``r = amplitude sin(2 pi frequency_hz t)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import SineReference
+    >>> ref = SineReference(0.01, 5.0)                     # 10 mm at 5 Hz
+    >>> r, a = ref(np.array([0.05]))                       # a quarter period: the crest
+    >>> print(r, a)                                        # a = -(2 pi 5)^2 r
+    [0.01] [-9.8696044]
+    """
 
     amplitude: float
     frequency_hz: float
@@ -60,6 +70,20 @@ class PointToPoint:
         Velocity [m/s], acceleration [m/s^2] and jerk [m/s^3] limits, > 0.
     start : float
         Time at which the move starts [s].
+
+    Examples
+    --------
+    A 20 mm move at 0.5 m/s, 10 m/s^2, 1000 m/s^3; a reference gives position and
+    acceleration (for the feedforward ``M r''``) at any times:
+
+    >>> import numpy as np
+    >>> from motionhyst import PointToPoint
+    >>> move = PointToPoint(0.02, 0.5, 10.0, 1000.0)
+    >>> print(f"{move.duration:.3f} s")
+    0.100 s
+    >>> r, a = move(np.array([0.0, move.duration / 2, move.duration + 0.1]))
+    >>> print(r)
+    [0.   0.01 0.02]
     """
 
     distance: float
@@ -143,7 +167,20 @@ class PointToPoint:
 
 @dataclass(frozen=True)
 class SampledReference:
-    """A reference given by samples, interpolated by a quintic spline (acceleration from it)."""
+    """A reference given by samples, interpolated by a quintic spline (acceleration from it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import SampledReference
+    >>> t = np.linspace(0.0, 0.5, 501)
+    >>> ref = SampledReference(t, 0.01 * np.sin(2 * np.pi * 4.0 * t))
+    >>> ref.duration
+    0.5
+    >>> r, a = ref(np.array([1 / 16]))                     # the crest of the 4 Hz sine
+    >>> print(f"r = {r[0]:.6f} m, a = {a[0]:.3f} m/s^2")   # exact: 0.01, -6.317
+    r = 0.010000 m, a = -6.317 m/s^2
+    """
 
     t: NDArray[np.float64]
     r: NDArray[np.float64]
@@ -207,6 +244,18 @@ def load_reference_csv(source: Source) -> SampledReference:
     >>> t = np.linspace(0.0, 0.5, 6)
     >>> load_reference_csv(np.column_stack([t, 1e-3 * t])).duration
     0.5
+
+    From a file:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> t = np.linspace(0.0, 0.5, 501)
+    >>> path = Path(tempfile.mkdtemp()) / "setpoint.csv"
+    >>> np.savetxt(path, np.column_stack([t, 0.01 * np.sin(2 * np.pi * 4.0 * t)]),
+    ...            delimiter=",", header="time,position", comments="")
+    >>> ref = load_reference_csv(path)
+    >>> ref.duration, round(ref.max_frequency_hz)
+    (0.5, 500)
     """
     data = read_columns(source, ("time", "position"))
     t, r = data[:, 0], data[:, 1]

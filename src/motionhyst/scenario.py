@@ -36,7 +36,20 @@ from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load
 
 
 class ScenarioError(ValueError):
-    """A scenario file that cannot be used; the message is one line."""
+    """A scenario file that cannot be used; the message is one line.
+
+    Examples
+    --------
+    >>> from motionhyst import Scenario, ScenarioError
+    >>> try:
+    ...     Scenario.from_dict({"stage": {"m1": -5.0, "m2": 17.5, "b": 90.0, "k": 7.4e7},
+    ...                         "hysteresis": {"model": "jenkins", "k": 20.0, "fc": 0.05},
+    ...                         "controller": {"type": "tf", "num": [1.0], "den": [1.0]},
+    ...                         "reference": {"amplitude": 0.01, "frequencies": [5.0]}})
+    ... except ScenarioError as err:
+    ...     print(err)
+    <dict>: [stage] m1: Input should be greater than 0 (got -5.0)
+    """
 
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -366,6 +379,21 @@ class Scenario:
     """A validated scenario; builds the loop and holds the reference.
 
     Use :meth:`from_file`, :meth:`from_dict` or :func:`default_scenario`.
+
+    Examples
+    --------
+    A scenario from a dictionary (the layout of a TOML file):
+
+    >>> from motionhyst import Scenario
+    >>> sc = Scenario.from_dict({
+    ...     "stage": {"m1": 5.0, "m2": 17.5, "b": 90.0, "k": 7.4e7},
+    ...     "hysteresis": {"model": "jenkins", "k": 20.0, "fc": 0.05},
+    ...     "controller": {"type": "leadlag-lowpass", "K": 6.2e6, "f1": 60.0, "f2": 240.0,
+    ...                    "flp": 700.0, "beta": 0.6},
+    ...     "reference": {"amplitude": 0.01, "frequencies": [5.0, 10.0]}})
+    >>> sc.hysteresis(), sc.frequencies
+    (Jenkins(k=20.0, fc=0.05), [5.0, 10.0])
+    >>> loop = sc.loop()                                   # a motionhyst.Loop
     """
 
     def __init__(self, model: ScenarioModel, source: str = "<dict>",
@@ -506,13 +534,56 @@ def default_scenario_path() -> Path:
 
 
 def default_scenario() -> Scenario:
-    """The paper's Table I scenario."""
+    """The paper's Table I scenario.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> sc = default_scenario()
+    >>> sc.amplitude, sc.frequencies
+    (0.01, [5.0, 10.0, 15.0])
+    >>> sc.loop().hysteresis
+    Jenkins(k=20.0, fc=0.05)
+    """
     sc = Scenario.from_file(default_scenario_path())
     sc.source = "paper.toml (Table I, built in)"
     return sc
 
 
 def load_scenario(path: str | Path | None) -> Scenario:
-    """The scenario at `path`, or the default (Table I) when `path` is None."""
+    """The scenario at `path`, or the default (Table I) when `path` is None.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from motionhyst import load_scenario
+    >>> load_scenario(None).source                         # no file: the paper's Table I
+    'paper.toml (Table I, built in)'
+    >>> path = Path(tempfile.mkdtemp()) / "slab.toml"
+    >>> _ = path.write_text('''
+    ... [stage]
+    ... m1 = 5.0
+    ... m2 = 17.5
+    ... b = 90.0
+    ... k = 7.4e7
+    ... [hysteresis]
+    ... model = "maxwell-slip"
+    ... k = [10.0, 6.0, 4.0]
+    ... fc = [0.01, 0.02, 0.03]
+    ... [controller]
+    ... type = "leadlag-lowpass"
+    ... K = 6.2e6
+    ... f1 = 60.0
+    ... f2 = 240.0
+    ... flp = 700.0
+    ... beta = 0.6
+    ... [reference]
+    ... amplitude = 0.01
+    ... frequencies = [5.0]
+    ... ''')
+    >>> load_scenario(path).hysteresis()
+    MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.01, 0.02, 0.03])
+    """
     return default_scenario() if path is None else Scenario.from_file(path)
 

@@ -58,6 +58,15 @@ class Simulation:
     e_linear : ndarray
         Error of the same loop without hysteresis and without hysteresis
         feedforward [m].
+
+    Examples
+    --------
+    >>> from motionhyst import SineReference, default_scenario, simulate
+    >>> sim = simulate(default_scenario().loop(), SineReference(0.01, 5.0), 0.2)
+    >>> list(sim.columns())                                # the CSV of ``simulate --time-series``
+    ['time', 'reference', 'error', 'y1', 'y2', 'u', 'w', 'error_linear']
+    >>> bool(abs(sim.w).max() <= 0.05)                      # the Jenkins link's force, |w| <= fc
+    True
     """
 
     t: NDArray[np.float64]
@@ -239,6 +248,21 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
         a time-domain update.
     RuntimeError
         If the implicit step does not converge (a link too stiff for the step).
+
+    Examples
+    --------
+    The Table I loop running a 20 mm point-to-point move from rest:
+
+    >>> import numpy as np
+    >>> from motionhyst import PointToPoint, default_scenario, simulate
+    >>> loop = default_scenario().loop()
+    >>> move = PointToPoint(0.02, 0.5, 10.0, 1000.0)
+    >>> sim = simulate(loop, move, move.duration + 0.2)
+    >>> print(f"{sim.t[-1]:.1f} s in {sim.t.size} samples")
+    0.3 s in 12001 samples
+    >>> print(f"peak error {np.abs(sim.e_linear).max():.2e} m without the link, "
+    ...       f"the link adds {np.abs(sim.e - sim.e_linear).max():.2e} m")
+    peak error 8.32e-08 m without the link, the link adds 8.28e-09 m
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
