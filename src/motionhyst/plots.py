@@ -10,31 +10,14 @@ from __future__ import annotations
 import matplotlib
 import matplotlib.ticker
 import numpy as np
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
+from motionhyst.figures import LINEAR_COLOR, MODE2_COLOR, MODE3_COLOR, _figure
 from motionhyst.hysteresis import Hysteresis, Jenkins
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import QuasiLinearAnalysis, loop_mismatch, mismatch_asymptote
 from motionhyst.steady import SteadyState
 from motionhyst.systems import TWO_PI, freqresp
-
-STYLE = {
-    "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
-    "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False, "font.size": 9,
-    "legend.fontsize": 8, "legend.frameon": False, "lines.linewidth": 1.4,
-}
-MODE2_COLOR, MODE3_COLOR, LINEAR_COLOR = "0.15", "tab:red", "tab:blue"
-
-
-def _figure(nrows: int = 1, sharex: bool = True):
-    with matplotlib.rc_context(STYLE):
-        fig = Figure(figsize=(6.4, 4.2 if nrows == 1 else 5.6), layout="constrained")
-        axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False)
-    for ax in axes.ravel():
-        ax.grid(True, which="both", alpha=0.3)
-    fig.motionhyst_data = {}
-    return fig, axes[:, 0]
 
 
 def _phase_deg(P) -> np.ndarray:
@@ -285,50 +268,6 @@ def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike,
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=2)
     fig.suptitle("Fig. 11: steady-state tracking error", fontsize=10)
-    return fig
-
-
-def plot_analysis(analysis: QuasiLinearAnalysis):
-    """The mismatch of a :class:`~motionhyst.quasilinear.QuasiLinearAnalysis` at its frequencies.
-
-    ``|E|`` (eq. 18) and the asymptote ``|E~|`` (eq. 20) at the analysed
-    frequencies, the crossover of eq. (21) and the exact crossover
-    ``|E - 1| = 1``.  (:func:`fig10_mismatch` draws the same on a dense grid
-    from the loop.)
-    """
-    fig, (ax,) = _figure()
-    f = np.array([p.frequency_hz for p in analysis.points])
-    E = np.array([p.value for p in analysis.points])
-    Et = np.array([p.asymptote for p in analysis.points])
-    ax.loglog(f, np.abs(E), "o-", color="k", label="|E|, eq. (18)")
-    ax.loglog(f, np.abs(Et), "s--", color="tab:red", mfc="none", label="|E~|, eq. (20)")
-    ax.axhline(1.0, color="0.5", lw=0.8)
-    for fx, lab, ls in ((analysis.mismatch_crossover_hz, "eq. (21)", ":"),
-                        (analysis.mismatch_crossover_exact_hz, "|E - 1| = 1", "-.")):
-        if np.isfinite(fx):
-            ax.axvline(fx, color="tab:green", ls=ls, lw=1, label=f"crossover {lab}: {fx:.3g} Hz")
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("|E| [-]")
-    ax.set_title(f"Feedforward mismatch, A_r = {analysis.amplitude:.3g} m")
-    ax.legend(loc="upper right")
-    fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
-    return fig
-
-
-def plot_steady_state(state: SteadyState):
-    """One period of a :class:`~motionhyst.steady.SteadyState`: the error with and without
-    hysteresis."""
-    fig, (ax,) = _figure()
-    ts = state.time_series()
-    t_ms = ts["t"] * 1e3
-    ax.plot(t_ms, ts["e"] * 1e9, color="k", label="with hysteresis (exact)")
-    ax.plot(t_ms, ts["e_linear"] * 1e9, color=LINEAR_COLOR, label="without hysteresis")
-    ax.set_xlabel("time [ms]")
-    ax.set_ylabel("e [nm]")
-    ax.set_title(f"Periodic steady state, r = {state.amplitude:g} m sin(2 pi "
-                 f"{state.frequency_hz:g} Hz t)")
-    ax.legend()
-    fig.motionhyst_data.update(t=ts["t"], e=ts["e"], e_linear=ts["e_linear"])
     return fig
 
 

@@ -190,13 +190,13 @@ class QuasiLinearAnalysis:
 
     def plot(self):
         """The mismatch ``|E|`` (eq. 18) and its asymptote (eq. 20) at the analysed
-        frequencies, with the crossovers (:func:`motionhyst.plots.plot_analysis`).
+        frequencies, with the crossovers (:func:`motionhyst.figures.plot_analysis`).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.plots import plot_analysis
+        from motionhyst.figures import plot_analysis
 
         return plot_analysis(self)
 

@@ -152,13 +152,13 @@ class SteadyState:
 
     def plot(self):
         """One period of the error, with and without hysteresis
-        (:func:`motionhyst.plots.plot_steady_state`).
+        (:func:`motionhyst.figures.plot_steady_state`).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.plots import plot_steady_state
+        from motionhyst.figures import plot_steady_state
 
         return plot_steady_state(self)
 

@@ -27,8 +27,8 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis._kernels import reversal_roots
-from motionhyst.hysteresis.base import check_positive
 from motionhyst.hysteresis.periodic import sample_period, significant_harmonics, trig_eval
+from motionhyst.validation import check_positive
 
 TWO_PI = 2.0 * np.pi
 MIN_SAMPLES = 4096

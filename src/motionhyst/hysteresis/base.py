@@ -17,6 +17,9 @@ from control import DescribingFunctionNonlinearity
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.periodic import sample_period
+from motionhyst.validation import check_amplitudes, check_positive
+
+__all__ = ["Hysteresis", "check_amplitudes", "check_positive"]
 
 if TYPE_CHECKING:
     from motionhyst.hysteresis.registry import Parameter
@@ -219,22 +222,3 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
 
     def _isstatic(self) -> bool:
         return False
-
-
-def check_positive(name: str, value: float) -> float:
-    """Return `value` as float, raising ``ValueError`` unless finite and > 0."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return v
-
-
-def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
-    """Return amplitudes as a float array, raising ``ValueError`` unless finite and >= 0."""
-    a = np.asarray(A, dtype=float)
-    if not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise ValueError("amplitude must be finite and >= 0")
-    return a

@@ -29,6 +29,7 @@ from motionhyst.hysteresis._ode_kernels import (
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.registry import Form, Parameter, register
 from motionhyst.hysteresis.stepping import BOUC_WEN, Stepping
+from motionhyst.validation import check_finite
 
 
 def _check_shape(n: float, beta: float, gamma: float, names: tuple[str, str, str]) -> None:
@@ -50,16 +51,6 @@ def _check_shape(n: float, beta: float, gamma: float, names: tuple[str, str, str
     if beta < 0:
         raise ValueError(f"{bn} must be >= 0 when {bn} + {gn} <= 0 (small cycles would raise "
                          f"the force without bound), {got}")
-
-
-def _check_finite(name: str, value: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
 
 
 @register
@@ -185,11 +176,11 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         super().__init__()
         self.k = check_positive("k", k)
         self.fc = check_positive("fc", fc)
-        self.n = _check_finite("n", n)
+        self.n = check_finite("n", n)
         if self.n < 1.0:
             raise ValueError(f"n must be >= 1, got {n!r}")
-        self.beta = _check_finite("beta", beta)
-        self.gamma = _check_finite("gamma", gamma)
+        self.beta = check_finite("beta", beta)
+        self.gamma = check_finite("gamma", gamma)
         _check_shape(self.n, self.beta, self.gamma, ("n", "beta", "gamma"))
         self._general: dict | None = None
         self.reset()
@@ -223,11 +214,11 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         """
         a = check_positive("alpha", alpha)
         b = check_positive("beta", beta)
-        nu_ = _check_finite("nu", nu)
+        nu_ = check_finite("nu", nu)
         if nu_ < 1.0:
             raise ValueError(f"nu must be >= 1, got {nu!r}")
-        g = _check_finite("gamma", gamma)
-        d = _check_finite("delta", delta)
+        g = check_finite("gamma", gamma)
+        d = check_finite("delta", delta)
         _check_shape(nu_, g, d, ("nu", "gamma", "delta"))
         fc = a / b if nu_ == 1.0 else (a / b) ** (1.0 / nu_)
         if not (np.isfinite(fc) and fc > 0.0):

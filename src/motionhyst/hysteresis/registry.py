@@ -20,10 +20,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, TypeVar
-
-if TYPE_CHECKING:
-    from motionhyst.hysteresis.base import Hysteresis
+from typing import Any, Literal, TypeVar
 
 ParameterKind = Literal["positive", "nonnegative", "finite"]
 
@@ -86,8 +83,9 @@ class Form:
     parameters: tuple[Parameter, ...]
 
 
-MODELS: dict[str, type[Hysteresis]] = {}
-"""Every registered link model, keyed by its ``name`` (in registration order)."""
+MODELS: dict[str, Any] = {}
+"""Every registered link model (a :class:`~motionhyst.hysteresis.base.Hysteresis` subclass),
+keyed by its ``name``, in registration order."""
 
 _H = TypeVar("_H")
 
@@ -107,7 +105,7 @@ def register(cls: _H) -> _H:
     return cls
 
 
-def model_class(name: str) -> type[Hysteresis]:
+def model_class(name: str) -> Any:
     """The registered model class of a scenario's ``model = name``.
 
     Raises

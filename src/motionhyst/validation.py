@@ -1,0 +1,49 @@
+"""Checks of user-given numbers, shared by every model and system: one-line ``ValueError``s
+naming the parameter.
+
+Examples
+--------
+>>> check_positive("k", 1e4)
+10000.0
+>>> check_positive("fc", -1)
+Traceback (most recent call last):
+...
+ValueError: fc must be finite and > 0, got -1
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["check_amplitudes", "check_finite", "check_positive"]
+
+
+def check_finite(name: str, value: float) -> float:
+    """Return `value` as float, raising ``ValueError`` unless it is a finite number."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def check_positive(name: str, value: float) -> float:
+    """Return `value` as float, raising ``ValueError`` unless finite and > 0."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
+    return v
+
+
+def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
+    """Return amplitudes as a float array, raising ``ValueError`` unless finite and >= 0."""
+    a = np.asarray(A, dtype=float)
+    if not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise ValueError("amplitude must be finite and >= 0")
+    return a
