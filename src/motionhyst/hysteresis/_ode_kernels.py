@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.hysteresis._kernels import reversal_roots
+from motionhyst.hysteresis._kernels import _trig2, reversal_roots, trig_root
 from motionhyst.hysteresis.periodic import sample_period, significant_harmonics, trig_eval
 from motionhyst.validation import check_positive
 
@@ -90,10 +90,17 @@ GL_W = 0.5 * _GL_W
 
 
 @njit(cache=True)
+def _bw_pow(a, n):  # pragma: no cover - compiled
+    """``a^n`` for ``a >= 0``, without a call to pow for n = 1, 2."""
+    return a if n == 1.0 else (a * a if n == 2.0 else a**n)
+
+
+@njit(cache=True)
 def _bw_rhs(zeta, n, ap, am):  # pragma: no cover - compiled
+    p = _bw_pow(abs(zeta), n)
     if zeta >= 0.0:
-        return 1.0 - ap * zeta**n
-    return 1.0 + am * (-zeta) ** n
+        return 1.0 - ap * p
+    return 1.0 + am * p
 
 
 @njit(cache=True)
@@ -124,22 +131,16 @@ def _bw_invert(za, h, n, ap, am, t, wq):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def bouc_wen_advance(zeta, v, n, ap, am, hmax, t, wq):  # pragma: no cover - compiled
-    """Solution of the normalised Bouc-Wen ODE after a distance ``v >= 0``.
-
-    ``ap = beta + gamma`` applies for ``zeta > 0`` (loading), ``am = beta - gamma``
-    for ``zeta < 0`` (unloading).  Exact for ``n = 1``; RK4 sub-steps of at most
-    `hmax` otherwise, with the crossing of ``zeta = 0`` (where the right-hand
-    side has a kink) located by quadrature.
-    """
-    if v <= 0.0:
-        return zeta
-    if n == 1.0:
-        if zeta < 0.0:
+def _bw_exact(zeta, v, n, ap, am):  # pragma: no cover - compiled
+    """Exact state of the normalised ODE after a distance ``v > 0``, for ``n = 1`` or 2."""
+    if n == 2.0:
+        if zeta < 0.0:  # dzeta/dv = 1 + am zeta^2 up to zeta = 0
             if am > 0.0:
-                vstar = math.log1p(-am * zeta) / am
+                sq = math.sqrt(am)
+                vstar = math.atan(-sq * zeta) / sq
                 if v < vstar:
-                    return zeta * math.exp(-am * v) - math.expm1(-am * v) / am
+                    tv = math.tan(sq * v)
+                    return zeta + (tv / sq) * (1.0 + am * zeta * zeta) / (1.0 - sq * zeta * tv)
             else:
                 vstar = -zeta
                 if v < vstar:
@@ -148,7 +149,41 @@ def bouc_wen_advance(zeta, v, n, ap, am, hmax, t, wq):  # pragma: no cover - com
             zeta = 0.0
         if ap == 0.0:
             return zeta + v
-        return zeta * math.exp(-ap * v) - math.expm1(-ap * v) / ap
+        c = math.sqrt(ap)  # dzeta/dv = 1 - ap zeta^2 (ap > 0 for n = 2)
+        tv = math.tanh(c * v)
+        return zeta + (tv / c) * ((1.0 - c * zeta) * (1.0 + c * zeta)) / (1.0 + c * zeta * tv)
+    # n = 1
+    if zeta < 0.0:
+        if am > 0.0:
+            vstar = math.log1p(-am * zeta) / am
+            if v < vstar:
+                return zeta * math.exp(-am * v) - math.expm1(-am * v) / am
+        else:
+            vstar = -zeta
+            if v < vstar:
+                return zeta + v
+        v -= vstar
+        zeta = 0.0
+    if ap == 0.0:
+        return zeta + v
+    return zeta * math.exp(-ap * v) - math.expm1(-ap * v) / ap
+
+
+@njit(cache=True)
+def bouc_wen_advance(zeta, v, n, ap, am, hmax, t, wq):  # pragma: no cover - compiled
+    """Solution of the normalised Bouc-Wen ODE after a distance ``v >= 0``.
+
+    ``ap = beta + gamma`` applies for ``zeta > 0`` (loading), ``am = beta - gamma``
+    for ``zeta < 0`` (unloading).  Exact for ``n = 1`` (piecewise exponentials)
+    and ``n = 2`` (``tan`` while ``zeta < 0``, ``tanh`` after, each as an addition
+    formula that keeps the increment's relative accuracy for small `v`); RK4
+    sub-steps of at most `hmax` otherwise, with the crossing of ``zeta = 0``
+    (where the right-hand side has a kink) located by quadrature.
+    """
+    if v <= 0.0:
+        return zeta
+    if n == 1.0 or n == 2.0:
+        return _bw_exact(zeta, v, n, ap, am)
     smooth = n == math.floor(n)  # |zeta|^n is then smooth on each side of 0
     near0 = 0.0 if smooth else 0.1  # otherwise step by quadrature while |zeta| < near0
     while v > 0.0:
@@ -210,6 +245,234 @@ def bouc_wen_step(z, du, n, ap, am, hmax, t, wq):  # pragma: no cover - compiled
     if du < 0.0:
         return -bouc_wen_advance(-z, -du, n, ap, am, hmax, t, wq)
     return z
+
+
+@njit(cache=True)
+def _bw_crossing(z, sg, xa, xb, tha, thb, X, C1, C2, kf, n, am):  # pragma: no cover - compiled
+    """Angle, ``x'`` and ``x''`` where the state crosses 0 in a step from ``(tha, xa)`` to
+    ``(thb, xb)`` (``n`` = 1 or 2, direction `sg`, state `z` at its start)."""
+    zeta = -sg * z  # distance in u to zeta = 0
+    if am <= 0.0:
+        vstar = zeta
+    elif n == 1.0:
+        vstar = math.log1p(am * zeta) / am
+    else:
+        sq = math.sqrt(am)
+        vstar = math.atan(sq * zeta) / sq
+    level = xa + sg * vstar / kf
+    th = trig_root(X, C1, level - X[0].real, tha, thb, xa - level, xb - level)
+    d1, d2 = _trig2(C1, C2, th)
+    return th, d1, d2
+
+
+@njit(cache=True)
+def _bw_period(s0, X, C1, C2, C3, x, cells, roots, xr, kf, n, ap, am, hmax, t, wq, out,
+               dout, jt, jv, jo):  # pragma: no cover - compiled
+    """One period of the normalised state from `s0` at ``x[0]``, written to `out` at the grid
+    (and its derivative with respect to `s0` to `dout`).
+
+    The path visits the grid samples `x` in order with the reversals (angles
+    `roots`, values `xr`) inserted after the samples ``cells`` and ends at
+    ``x[0]``.  Returns the final state, its derivative with respect to `s0`
+    (for an autonomous scalar ODE a monotone step maps ``z`` to ``z'`` with
+    slope ``f(z') / f(z)``, so the period's slope is the product over its
+    steps) and the number of jumps recorded in `jt` (angle), `jv` (size) and
+    `jo` (order ``p`` of the derivative ``z^(p) = d^p z / d theta^p`` that jumps).
+    With ``z' = kf x' g(z, s)``, ``g = 1 - (beta sign(s z) + gamma) |z|^n`` (``s``
+    the direction of motion; ``beta``, ``gamma`` the normalised parameters):
+
+    * at a reversal ``g`` jumps by ``Dg = -2 beta sign(x'' z) |z|^n``, so ``z^(2)``
+      by ``kf x^(2) Dg`` and ``z^(3)`` by ``kf x^(3) Dg``;
+    * where ``z`` crosses 0, for ``n = 1`` ``g_z`` jumps by ``-2 gamma s`` and
+      ``g_z^2`` by ``ap^2 - am^2``: ``z^(2)`` by ``-2 gamma s kf^2 x'^2`` and ``z^(3)``
+      by ``3 kf^2 x' x'' (-2 gamma s) + kf^3 x'^3 (ap^2 - am^2)``; for ``n = 2``
+      ``g_zz`` jumps by ``-4 beta``: ``z^(3)`` by ``-4 beta kf^3 x'^3``.
+    """
+    m = x.shape[0]
+    h = 2.0 * np.pi / m
+    exact = n == 1.0 or n == 2.0
+    z = s0
+    slope = 1.0
+    q = 0
+    nq = cells.shape[0]
+    nj = 0
+    xp = x[0]
+    thp = 0.0
+    i = 0  # the next grid sample to record is i; the step ends at a reversal or at i + 1
+    out[0] = z
+    dout[0] = 1.0
+    while i < m:
+        rev = q < nq and cells[q] == i
+        if rev:
+            xn = xr[q]
+            thn = roots[q]
+        else:
+            xn = x[i + 1] if i + 1 < m else x[0]
+            thn = (i + 1) * h
+        du = kf * (xn - xp)
+        if du != 0.0:
+            sg = 1.0 if du > 0.0 else -1.0
+            if exact:
+                zn = sg * _bw_exact(sg * z, sg * du, n, ap, am)
+            else:
+                zn = bouc_wen_step(z, du, n, ap, am, hmax, t, wq)
+            fa = _bw_rhs(sg * z, n, ap, am)
+            slope = slope * (_bw_rhs(sg * zn, n, ap, am) / fa) if fa > 0.0 else 0.0
+            if exact and sg * z < 0.0 < sg * zn:
+                th, d1, d2 = _bw_crossing(z, sg, xp, xn, thp, thn, X, C1, C2, kf, n, am)
+                if n == 1.0:
+                    dgz = -(ap - am) * sg  # -2 gamma s
+                    jt[nj] = th
+                    jv[nj] = dgz * kf * kf * d1 * d1
+                    jo[nj] = 2
+                    jt[nj + 1] = th
+                    jv[nj + 1] = (3.0 * kf * kf * d1 * d2 * dgz
+                                  + kf**3 * d1**3 * (ap * ap - am * am))
+                    jo[nj + 1] = 3
+                    nj += 2
+                else:
+                    jt[nj] = th
+                    jv[nj] = -2.0 * (ap + am) * kf**3 * d1**3  # -4 beta kf^3 x'^3
+                    jo[nj] = 3
+                    nj += 1
+            z = zn
+        xp = xn
+        thp = thn
+        if rev:
+            d2, d3 = _trig2(C2, C3, thn)
+            sz = 1.0 if z > 0.0 else (-1.0 if z < 0.0 else 0.0)
+            s2 = 1.0 if d2 > 0.0 else -1.0
+            dg = -(ap + am) * s2 * sz * _bw_pow(abs(z), n)  # -2 beta sign(x'' z) |z|^n
+            jt[nj] = thn
+            jv[nj] = kf * d2 * dg
+            jo[nj] = 2
+            jt[nj + 1] = thn
+            jv[nj + 1] = kf * d3 * dg
+            jo[nj + 1] = 3
+            nj += 2
+            q += 1
+        else:
+            i += 1
+            if i < m:
+                out[i] = z
+                dout[i] = slope
+    return z, slope, nj
+
+
+@njit(cache=True)
+def bouc_wen_periodic(X, C1, C2, C3, x, d, kf, n, ap, am, hmax, lo, hi, t,
+                      wq):  # pragma: no cover - compiled
+    """Normalised periodic Bouc-Wen state on the grid ``theta_i = 2 pi i / N``, compiled end to end.
+
+    `X`, ``C1 = j m X``, ``C2 = -m^2 X``, ``C3 = -j m^3 X`` are the harmonics of ``x``
+    and its first three derivatives, `x` and `d` its samples and those of ``x'`` on the
+    grid, ``kf = k / fc``.  The reversals of ``x`` are found on the
+    trigonometric polynomial (:func:`~motionhyst.hysteresis._kernels.reversal_roots`)
+    and inserted in the path; the state that repeats after one period is the
+    root of ``g(s) = P(s) - s`` for the period map ``P``, found by Newton steps
+    with the exact slope ``P'`` (:func:`_bw_period`) kept inside the bracket
+    ``[lo, hi]`` (bisection otherwise).  A pass is accepted when ``g`` is below
+    1e-14 of the state's range, or when the Newton correction ``delta`` moves
+    no sample by more than 1e-8 of it: the samples are then corrected to first
+    order, ``z_i + delta dz_i/ds`` (the neglected second order is ~1e-16), which
+    saves the pass that would only confirm them.
+
+    Returns
+    -------
+    z : ndarray, shape (N,)
+        The state ``w / fc`` at the grid samples.
+    jt, jv, jo : ndarray
+        Angles, sizes and orders ``p`` of the jumps of ``d^p z / d theta^p``
+        over the period (:func:`_bw_period`).
+    ok : bool
+        False if the fixed point was not found to 1e-10 of the range.
+    """
+    m = x.shape[0]
+    cells, roots = reversal_roots(C1, C2, d)
+    h = 2.0 * np.pi / m
+    nq = cells.shape[0]
+    xr = np.empty(nq)
+    for q in range(nq):
+        roots[q] = min(max(roots[q], cells[q] * h), (cells[q] + 1) * h)
+        xr[q] = X[0].real + _trig2(X, C1, roots[q])[0]
+    out = np.empty(m)
+    dout = np.empty(m)
+    jt = np.empty(4 * nq + 4)
+    jv = np.empty(4 * nq + 4)
+    jo = np.empty(4 * nq + 4, dtype=np.int64)
+    s = 0.0
+    best = np.inf
+    for _ in range(60):
+        zend, slope, nj = _bw_period(s, X, C1, C2, C3, x, cells, roots, xr, kf, n, ap, am,
+                                     hmax, t, wq, out, dout, jt, jv, jo)
+        g = zend - s
+        scale = max(out.max() - out.min(), 1e-300)
+        if abs(g) <= 1e-14 * scale or g == 0.0:
+            return out, jt[:nj], jv[:nj], jo[:nj], True
+        if slope < 1.0:
+            delta = g / (1.0 - slope)
+            if abs(delta) * max(np.abs(dout).max(), 1.0) <= 1e-8 * scale:
+                for i in range(m):
+                    out[i] += delta * dout[i]
+                return out, jt[:nj], jv[:nj], jo[:nj], True
+        best = min(best, abs(g) / scale)
+        if g > 0.0:
+            lo = max(lo, s)
+        else:
+            hi = min(hi, s)
+        s_new = s - g / (slope - 1.0) if slope != 1.0 else 0.5 * (lo + hi)
+        if not lo <= s_new <= hi:
+            s_new = 0.5 * (lo + hi)
+        if s_new == s:
+            return out, jt[:nj], jv[:nj], jo[:nj], True
+        s = s_new
+    return out, jt[:nj], jv[:nj], jo[:nj], best <= 1e-10
+
+
+#: aliases summed on each side in :func:`alias_of_jumps`: the rest is at most 0.4 % of the
+#: correction of a jump of the second derivative (``~ 1 / ALIAS_TERMS^2``), the corrections
+#: being below ~1e-8 of ``|W_1|`` where they are used
+ALIAS_TERMS = 16
+
+
+@njit(cache=True)
+def alias_of_jumps(jt, jv, jo, N, H):  # pragma: no cover - compiled
+    """Aliasing error of the sampled FFT (``rfft / N``) from jumps of a function's derivatives.
+
+    A jump ``J`` of the ``p``-th derivative at ``theta_j`` (`jt`, `jv`, `jo`)
+    gives the function the Fourier coefficients ``c_k ~ J exp(-j k theta_j) /
+    (2 pi (j k)^(p+1))``; the FFT of ``N`` samples returns ``sum_l c_{m + l N}``, so
+    its error at harmonic ``m`` is the sum over ``l != 0`` (``|l| <=``
+    :data:`ALIAS_TERMS`), returned for ``m = 0 .. H``: ``O(N^-(p+1))`` off the grid.
+    """
+    E = np.zeros(H + 1, dtype=np.complex128)
+    rot = np.empty(ALIAS_TERMS, dtype=np.complex128)
+    for j in range(jt.shape[0]):
+        p = jo[j]  # 2 or 3
+        amp = jv[j] / (2.0 * np.pi) / (1j) ** (p + 1)
+        step = complex(math.cos(N * jt[j]), -math.sin(N * jt[j]))  # exp(-j N theta_j)
+        r = 1.0 + 0j
+        for li in range(ALIAS_TERMS):
+            r *= step
+            rot[li] = r  # exp(-j (li + 1) N theta_j)
+        turn = complex(math.cos(jt[j]), -math.sin(jt[j]))  # exp(-j theta_j)
+        base = 1.0 + 0j
+        for mm in range(H + 1):
+            if mm % 64 == 0:  # exp(-j m theta_j), recomputed now and then against drift
+                base = complex(math.cos(mm * jt[j]), -math.sin(mm * jt[j]))
+            acc = 0j
+            for li in range(ALIAS_TERMS):
+                ip = 1.0 / (mm + (li + 1) * N)
+                im = 1.0 / (mm - (li + 1) * N)
+                wp = ip * ip * ip
+                wm = im * im * im
+                if p == 3:
+                    wp *= ip
+                    wm *= im
+                acc += rot[li] * wp + rot[li].conjugate() * wm
+            E[mm] += amp * base * acc
+            base *= turn
+    return E
 
 
 @njit(cache=True)
