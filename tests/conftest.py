@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import pytest
 
+from motionhyst._jit import quiet_compilation
 from motionhyst.hysteresis.jenkins import Jenkins
 from motionhyst.loop import Loop
 from motionhyst.systems import LeadLagLowpass, TwoMassStage
+
+# the tests check the commands' stderr: no notice of the first compilation in this session
+# (tests/test_startup.py checks the notice in fresh processes)
+quiet_compilation()
 
 # Table I of the paper
 M1, M2, B, K_STAGE = 5.0, 17.5, 90.0, 7.4e7

@@ -39,9 +39,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, lfilter
+
+from motionhyst._jit import njit
 
 #: The benchmark's true system (SI units).
 TRUE_PARAMETERS: dict[str, float] = {

@@ -69,11 +69,11 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares, nnls
 from scipy.signal import butter
 
+from motionhyst._jit import njit
 from motionhyst.csvdata import Source, describe, read_columns
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.hysteresis._kernels import maxwell_response, stop_response

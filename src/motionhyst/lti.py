@@ -23,10 +23,11 @@ from dataclasses import dataclass
 
 import control
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm, solve
 from scipy.signal import cont2discrete, zpk2ss
+
+from motionhyst._jit import njit
 
 __all__ = ["HoldFilter", "PolyTF", "cancel_s", "discretize_foh", "divide_s2", "dss_filter",
            "forced_response_foh", "polyratio", "polysub_exact", "realize_scaled", "stack",

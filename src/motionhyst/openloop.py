@@ -39,10 +39,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, resample_poly
 
+from motionhyst._jit import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, advance
 from motionhyst.simulate import MAX_FIXED_POINT_ITERATIONS

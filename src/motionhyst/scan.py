@@ -26,9 +26,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst._jit import njit
 from motionhyst.ilc import ILCFilters, ILCResult, learn
 from motionhyst.loop import Loop
 from motionhyst.profiles import PHASE_COLORS, Profile, shade_phases

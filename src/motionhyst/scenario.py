@@ -12,9 +12,8 @@ from __future__ import annotations
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal, Union
+from typing import TYPE_CHECKING, Annotated, Literal, Union
 
-import control
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -27,12 +26,16 @@ from pydantic import (
     model_validator,
 )
 
-from motionhyst.frf_fit import FrfFit, ModalPlant, fit_measured_plant
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.hysteresis.registry import Form
-from motionhyst.loop import Loop
-from motionhyst.openloop import MassSpringDamper, OpenLoop
-from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
+
+if TYPE_CHECKING:  # imported where used: validating a file needs neither python-control nor scipy
+    import control
+
+    from motionhyst.frf_fit import FrfFit, ModalPlant
+    from motionhyst.loop import Loop
+    from motionhyst.openloop import MassSpringDamper, OpenLoop
+    from motionhyst.systems import MeasuredPlant, TwoMassStage
 
 
 class ScenarioError(ValueError):
@@ -57,8 +60,9 @@ NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 
 
 class _Section(BaseModel):
-    # strict: no strings for numbers; integers are accepted where floats are expected
-    model_config = ConfigDict(extra="forbid", strict=True)
+    # strict: no strings for numbers; integers are accepted where floats are expected;
+    # validators are built at the first validation, not at import (command start-up)
+    model_config = ConfigDict(extra="forbid", strict=True, defer_build=True)
 
     @model_validator(mode="before")
     @classmethod
@@ -328,7 +332,7 @@ def build_hysteresis(section) -> Hysteresis:
     return section.build()
 
 
-_HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection)
+_HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection, config=ConfigDict(defer_build=True))
 
 
 def hysteresis_from_dict(data: dict, source: str = "<dict>") -> Hysteresis:
@@ -461,12 +465,18 @@ class Scenario:
             raise ScenarioError(f"{self.source}: [stage] is not a mass-spring-damper; an "
                                 f"open-loop system needs [stage] type = \"mass-spring-damper\"")
         st = self.model.stage
+        from motionhyst.openloop import MassSpringDamper, OpenLoop
+
         return OpenLoop(MassSpringDamper(st.m, st.c, st.k), self.hysteresis())
 
     def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant | MassSpringDamper:
         """The stage model, the model fitted to a measured plant, or the raw measured plant."""
         if self._plant is not None:
             return self._plant
+        from motionhyst.frf_fit import fit_measured_plant
+        from motionhyst.openloop import MassSpringDamper
+        from motionhyst.systems import TwoMassStage, load_frd_plant
+
         m = self.model
         if m.open_loop:
             return MassSpringDamper(m.stage.m, m.stage.c, m.stage.k)
@@ -503,6 +513,10 @@ class Scenario:
     def controller(self) -> control.TransferFunction:
         """The feedback controller."""
         self._closed("a controller")
+        import control
+
+        from motionhyst.systems import LeadLagLowpass
+
         c = self.model.controller
         if c.type == "leadlag-lowpass":
             return LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta)
@@ -512,6 +526,8 @@ class Scenario:
         """The loop (built once, checked for stability)."""
         self._closed("this")
         if self._loop is None:
+            from motionhyst.loop import Loop
+
             ff = None if self.model.feedforward.type == "none" else "rigid-body"
             hff = self.model.feedforward.hysteresis
             loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff,

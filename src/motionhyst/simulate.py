@@ -19,9 +19,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from motionhyst._jit import njit
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
 from motionhyst.hysteresis.stepping import Stepping, advance, open_loop

@@ -11,7 +11,8 @@ smooth models (:func:`motionhyst.hysteresis._ode_kernels.reversal_angles`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from motionhyst._jit import njit
 
 
 @njit(cache=True)

@@ -23,9 +23,9 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst._jit import njit
 from motionhyst.hysteresis._kernels import _trig2, reversal_roots, trig_root
 from motionhyst.hysteresis.periodic import sample_period, significant_harmonics, trig_eval
 from motionhyst.validation import check_positive

@@ -13,10 +13,8 @@ from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
-from control import DescribingFunctionNonlinearity
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.validation import check_amplitudes, check_positive
 
 __all__ = ["Hysteresis", "check_amplitudes", "check_positive"]
@@ -26,16 +24,17 @@ if TYPE_CHECKING:
     from motionhyst.hysteresis.stepping import Stepping
 
 
-class Hysteresis(DescribingFunctionNonlinearity, ABC):
+class Hysteresis(ABC):
     """Base class of hysteresis elements (displacement in, force out).
 
     Subclasses implement :meth:`describing_function` (paper eq. 7), the
     exact sampled response :meth:`response` and :meth:`to_dict`.  Instances
-    are also python-control nonlinearities: calling one with a scalar
-    displacement advances an internal state, so
-    :func:`control.describing_function` and
-    :func:`control.describing_function_response` accept them and use the
-    closed form through :meth:`describing_function`.
+    are also python-control nonlinearities without deriving from its
+    ``DescribingFunctionNonlinearity`` (so that python-control is not
+    imported with the models): calling one with a scalar displacement
+    advances an internal state, and :func:`control.describing_function` and
+    :func:`control.describing_function_response` use the closed form through
+    :meth:`describing_function`, which they look up by name.
 
     Attributes
     ----------
@@ -158,6 +157,8 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
             period finely and runs the element to its periodic state; elements
             with an exact method override it.
         """
+        from motionhyst.hysteresis.periodic import sample_period
+
         H = int(n_harmonics)
         N = max(8 * H, 8 * (len(X) - 1), 8192)
         x = sample_period(X, N)
@@ -221,4 +222,5 @@ class Hysteresis(DescribingFunctionNonlinearity, ABC):
         return self._w
 
     def _isstatic(self) -> bool:
+        """False: calls advance a state (python-control's test for static nonlinearities)."""
         return False

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.fft import next_fast_len
 
 from motionhyst.hysteresis._kernels import jump_series, reversal_points, stop_pieces
 
@@ -137,6 +136,8 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     C1 = 1j * m * X  # harmonics of x'
     # the grid brackets the roots (at least 1024 cells, 4 per harmonic) and carries the
     # product s x without aliasing (2 (H + M) + 1 samples)
+    from scipy.fft import next_fast_len  # here: scipy.fft takes longer to import than df to run
+
     n = next_fast_len(max(1024, 4 * M, 2 * (H + M) + 1), real=True)
     x = sample_period(X, n)
     rev, xr = reversal_points(X, C1, -(m**2) * X, sample_period(C1, n))

@@ -1,0 +1,173 @@
+"""Compiled kernels (numba), set up at their first call.
+
+Every compiled loop of :mod:`motionhyst` is declared with :func:`njit` from
+this module instead of numba's.  The kernel stays a plain Python object until
+it is first called, so importing :mod:`motionhyst` (and commands that never
+run a kernel, such as ``motionhyst --help`` or ``motionhyst df`` for a
+Jenkins element) does not import numba.  At the first call, once per process:
+
+* numba is imported and the cache is chosen: compiled machine code is kept
+  beside the package (``__pycache__``), or, where the package is read-only,
+  in the user's cache folder (numba's own locators, or ``NUMBA_CACHE_DIR``
+  when set); where neither is writable the kernels are compiled in memory for
+  the process instead of failing;
+* the first compilation announces itself with one line on stderr (it takes
+  seconds; later runs load the cache).
+
+Kernels calling other kernels work as in numba: a kernel passes for its numba
+dispatcher inside compiled code.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from collections.abc import Callable
+from typing import Any
+
+_LOCK = threading.RLock()
+_STATE: dict[str, Any] = {"cache": None, "announced": False, "numba": None}
+_PACKAGE = __name__.rpartition(".")[0]
+
+
+def _probe() -> None:
+    """A function of this package's files: where numba would cache it decides for all."""
+
+
+def _can_cache(py_func: Callable = _probe) -> bool:
+    """True if numba finds a writable cache folder for `py_func`."""
+    from numba.core.caching import FunctionCache
+
+    try:
+        FunctionCache(py_func)
+    except RuntimeError:  # "cannot cache function ...: no locator available"
+        return False
+    return True
+
+
+def _announce(dispatcher) -> None:
+    """One line on stderr before the first compilation of a motionhyst kernel."""
+    if _STATE["announced"]:
+        return
+    module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+    if not module.startswith(_PACKAGE + "."):
+        return
+    _STATE["announced"] = True
+    where = ("cached for later runs" if _STATE["cache"]
+             else "no writable cache folder: compiled for this run only")
+    print(f"motionhyst: compiling numerical kernels on first use ({where}) ...",
+          file=sys.stderr, flush=True)
+
+
+def _numba():
+    """numba, imported and set up once (cache decision, compile announcement)."""
+    numba = _STATE["numba"]
+    if numba is None:
+        import numba
+        from numba.core import event
+
+        class _Listener(event.Listener):
+            def on_start(self, ev):
+                _announce(ev.data.get("dispatcher"))
+
+            def on_end(self, ev):
+                pass
+
+        event.register("numba:compile", _Listener())
+        _STATE["numba"] = numba
+    return numba
+
+
+class Kernel:
+    """A function compiled by numba at its first call (see the module docstring).
+
+    Parameters
+    ----------
+    py_func : callable
+        The Python function, in numba's nopython subset.
+    options : dict
+        Options for ``numba.njit`` other than ``cache``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst._jit import njit
+    >>> @njit
+    ... def total(x):
+    ...     s = 0.0
+    ...     for v in x:
+    ...         s += v
+    ...     return s
+    >>> total(np.arange(4.0))
+    6.0
+    """
+
+    def __init__(self, py_func: Callable, options: dict) -> None:
+        self.py_func = py_func
+        self._options = options
+        self._dispatcher = None
+        self.__name__ = py_func.__name__
+        self.__qualname__ = py_func.__qualname__
+        self.__module__ = py_func.__module__
+        self.__doc__ = py_func.__doc__
+        self.__wrapped__ = py_func
+
+    def dispatcher(self):
+        """The numba dispatcher (created at the first call)."""
+        d = self._dispatcher
+        if d is None:
+            with _LOCK:
+                d = self._dispatcher
+                if d is None:
+                    numba = _numba()
+                    if _STATE["cache"] is None:
+                        _STATE["cache"] = _can_cache()
+                    # a function without a source file (a doctest, the REPL) is never cached
+                    cache = _STATE["cache"] and _can_cache(self.py_func)
+                    d = numba.njit(cache=cache, **self._options)(self.py_func)
+                    self._dispatcher = d
+        return d
+
+    @property
+    def _numba_type_(self):
+        # how numba types a global holding this object inside another kernel
+        return self.dispatcher()._numba_type_
+
+    def __call__(self, *args):
+        d = self._dispatcher
+        if d is None:
+            d = self.dispatcher()
+        return d(*args)
+
+    def __repr__(self) -> str:
+        return f"<compiled kernel {self.__module__}.{self.__qualname__}>"
+
+
+def njit(func: Callable | None = None, **options) -> Kernel | Callable[[Callable], Kernel]:
+    """Declare a numba kernel compiled at its first call (``@njit`` or ``@njit(...)``).
+
+    ``cache`` is accepted for symmetry with numba and ignored: the cache is
+    chosen once per process (see the module docstring).
+    """
+    options.pop("cache", None)
+    if func is None:
+        return lambda f: Kernel(f, options)
+    return Kernel(func, options)
+
+
+def quiet_compilation(quiet: bool = True) -> None:
+    """Leave out (or restore) the one-line notice of the first compilation.
+
+    For callers whose stderr must stay clean, e.g. a test session that checks
+    the commands' error output.
+    """
+    _STATE["announced"] = bool(quiet)
+
+
+def compiled_in_memory() -> bool | None:
+    """Whether kernels are compiled without a disk cache (None before the first kernel call)."""
+    c = _STATE["cache"]
+    return None if c is None else not c
+
+
+__all__ = ["Kernel", "compiled_in_memory", "njit", "quiet_compilation"]

@@ -1,0 +1,159 @@
+"""Start-up and compilation: what the commands import, and where compiled kernels go.
+
+Each case runs in a fresh interpreter (a subprocess), the only way to see
+what a command imports and what the first compilation does.  Nothing here
+is timed (start-up times are measured by ``make bench``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import motionhyst
+
+HEAVY = ("control", "scipy.signal", "matplotlib", "numba")
+PACKAGE = Path(motionhyst.__file__).parent
+
+_PROBE = """
+import contextlib, io, json, sys
+from motionhyst.cli import main
+err = io.StringIO()
+with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+    try:
+        rc = main(sys.argv[1:])
+    except SystemExit as exc:
+        rc = exc.code
+heavy = sorted({m for m in sys.modules for h in HEAVY if m == h or m.startswith(h + ".")})
+print(json.dumps({"rc": rc, "heavy": heavy, "err": err.getvalue()}))
+""".replace("HEAVY", repr(HEAVY))
+
+
+def _run(code: str, *args: str, env: dict | None = None, cwd: Path | None = None
+         ) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          env=env, cwd=cwd, timeout=600, check=False)
+
+
+def _probe(*argv: str) -> dict:
+    proc = _run(_PROBE, *argv)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
+
+
+@pytest.mark.parametrize("argv, rc", [
+    (["--help"], 0),
+    (["df", "--help"], 0),
+    (["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"], 0),
+    (["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01", "0.02", "--json"], 0),
+    (["df", "--model", "maxwell-slip", "--k", "20", "10", "--fc", "0.05", "0.02",
+      "--amplitude", "0.01"], 0),
+    (["df", "--model", "lugre", "--sigma0", "1", "--amplitude", "0.01"], 2),  # missing --fc
+    (["df", "--model", "dahl", "--k", "20", "--fc", "-1", "--amplitude", "0.01"], 2),
+    (["df", "--k", "20", "--fc", "0.05"], 2),                                  # no --amplitude
+    (["analyze", "--frequency", "ten"], 2),
+    (["simulate", "--amplitude", "-1"], 2),
+    (["identify"], 2),
+    (["reproduce", "--bogus"], 2),
+    (["no-such-command"], 2),
+])
+def test_help_df_and_argument_errors_import_nothing_heavy(argv, rc):
+    out = _probe(*argv)
+    assert out["rc"] == rc, out["err"]
+    assert out["heavy"] == [], f"motionhyst {' '.join(argv)} imported {out['heavy']}"
+    if rc == 2:
+        assert out["err"].count("\n") == 1 and "error" in out["err"]
+
+
+def test_import_motionhyst_is_light_and_exports_every_name():
+    code = """
+import json, sys
+import motionhyst
+light = sorted(m for m in sys.modules if m.split(".")[0] in ("control", "scipy", "matplotlib",
+                                                             "numba", "pydantic"))
+from motionhyst import *  # noqa
+from motionhyst import Loop, periodic_steady_state
+import motionhyst.loop, motionhyst.steady
+same = (Loop is motionhyst.loop.Loop
+        and periodic_steady_state is motionhyst.steady.periodic_steady_state)
+print(json.dumps({"light": light, "same": same, "all": sorted(motionhyst.__all__),
+                  "dir": all(n in dir(motionhyst) for n in motionhyst.__all__),
+                  "resolved": all(getattr(motionhyst, n) is not None for n in motionhyst.__all__)}))
+"""
+    proc = _run(code)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert out["light"] == []
+    assert out["same"] and out["dir"] and out["resolved"]
+    assert {"Loop", "analyze", "simulate", "periodic_steady_state"} <= set(out["all"])
+    with pytest.raises(AttributeError, match="no attribute 'nothing_here'"):
+        motionhyst.nothing_here  # noqa: B018
+
+
+def _readonly_copy(tmp_path: Path) -> Path:
+    """A copy of the package in which no ``__pycache__`` folder can be created."""
+    root = tmp_path / "site"
+    shutil.copytree(PACKAGE, root / "motionhyst",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    for folder in [root / "motionhyst", *(p for p in (root / "motionhyst").rglob("*")
+                                          if p.is_dir())]:
+        (folder / "__pycache__").write_text("")  # a file where the cache folder would go
+    for path in root.rglob("*"):
+        path.chmod(0o444 if path.is_file() else 0o555)
+    return root
+
+
+_KERNEL = """
+import json
+import numpy as np
+from motionhyst import Jenkins
+from motionhyst._jit import compiled_in_memory
+w = Jenkins(k=20.0, fc=0.05).response(np.array([0.0, 0.01, -0.01, 0.0]))
+print(json.dumps({"w": w.tolist(), "in_memory": compiled_in_memory()}))
+"""
+
+
+def _env(root: Path, cache_home: Path) -> dict:
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("HOME", "XDG_CACHE_HOME", "NUMBA_CACHE_DIR", "PYTHONPATH")}
+    env.update(PYTHONPATH=str(root), XDG_CACHE_HOME=str(cache_home),
+               PYTHONDONTWRITEBYTECODE="1")
+    return env
+
+
+def test_read_only_install_without_cache_folder_compiles_in_memory(tmp_path):
+    root = _readonly_copy(tmp_path)
+    blocked = tmp_path / "not-a-folder"
+    blocked.write_text("")  # neither the user cache nor HOME can hold a folder
+    env = _env(root, blocked)
+    env["HOME"] = str(blocked)
+    proc = _run(_KERNEL, env=env, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert out == {"w": [0.0, 0.05, -0.05, 0.05], "in_memory": True}
+    assert proc.stderr.count("motionhyst: compiling") == 1
+    assert "this run only" in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_read_only_install_caches_in_the_user_folder(tmp_path):
+    root = _readonly_copy(tmp_path)
+    cache = tmp_path / "cache"
+    env = _env(root, cache)
+    env.pop("HOME", None)
+    first = _run(_KERNEL, env=env, cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    assert json.loads(first.stdout) == {"w": [0.0, 0.05, -0.05, 0.05], "in_memory": False}
+    assert first.stderr.count("motionhyst: compiling") == 1
+    assert "cached for later runs" in first.stderr
+    assert list(cache.rglob("*.nbi")), "no numba index in the user cache folder"
+    second = _run(_KERNEL, env=env, cwd=tmp_path)
+    assert second.returncode == 0, second.stderr
+    assert second.stdout == first.stdout
+    assert "compiling" not in second.stderr  # loaded from the cache, nothing announced
