@@ -76,7 +76,6 @@ from scipy.signal import butter
 from motionhyst._jit import njit
 from motionhyst.csvdata import Source, describe, read_columns
 from motionhyst.hysteresis import MaxwellSlip
-from motionhyst.hysteresis._kernels import maxwell_response, stop_response
 from motionhyst.lti import HoldFilter, tf_poly
 from motionhyst.systems import TWO_PI
 
@@ -249,29 +248,99 @@ def _unpack(theta, n: int, fit_initial: bool):
     return k, fc, alpha, float(theta[-1])
 
 
+@njit(cache=True)
+def _maxwell_at(x, k, fc, w0, rows):  # pragma: no cover - compiled
+    """Parallel stop operators run over every sample of `x`, kept only at `rows` (ascending).
+
+    Returns the element forces ``W``, the sign of each element's force at its
+    latest saturation (``|w_i| >= fc_i``) and whether it has not saturated
+    yet, all of shape ``(rows.size, k.size)``; the recursion is that of
+    :func:`~motionhyst.hysteresis._kernels.maxwell_response`.
+    """
+    n = x.shape[0]
+    m = k.shape[0]
+    r = rows.shape[0]
+    W = np.empty((r, m))
+    sign = np.zeros((r, m))
+    before = np.ones((r, m), dtype=np.bool_)
+    w = w0.copy()
+    last = np.zeros(m)
+    seen = np.zeros(m, dtype=np.bool_)
+    q = 0
+    for i in range(n):
+        if i > 0:
+            dx = x[i] - x[i - 1]
+            for j in range(m):
+                wi = w[j] + k[j] * dx
+                if wi > fc[j]:
+                    wi = fc[j]
+                elif wi < -fc[j]:
+                    wi = -fc[j]
+                w[j] = wi
+        for j in range(m):
+            if abs(w[j]) >= fc[j]:
+                seen[j] = True
+                last[j] = 1.0 if w[j] > 0 else (-1.0 if w[j] < 0 else 0.0)
+        while q < r and rows[q] == i:
+            for j in range(m):
+                W[q, j] = w[j]
+                sign[q, j] = last[j]
+                before[q, j] = not seen[j]
+            q += 1
+    return W, sign, before
+
+
+@njit(cache=True)
+def _stops_at(x, d, w0, rows, per_slip_force):  # pragma: no cover - compiled
+    """Unit-stiffness stop operators of thresholds `d` from `w0`, kept only at `rows`.
+
+    The recursion of :func:`~motionhyst.hysteresis._kernels.stop_response`
+    with ``k = 1``; with `per_slip_force` each column is divided by its ``d``.
+    """
+    n = x.shape[0]
+    m = d.shape[0]
+    r = rows.shape[0]
+    S = np.empty((r, m))
+    for j in range(m):
+        fc = d[j]
+        wi = w0[j]
+        q = 0
+        for i in range(n):
+            if i > 0:
+                wi = wi + 1.0 * (x[i] - x[i - 1])
+                if wi > fc:
+                    wi = fc
+                elif wi < -fc:
+                    wi = -fc
+            while q < r and rows[q] == i:
+                S[q, j] = wi / fc if per_slip_force else wi
+                q += 1
+    return S
+
+
 def _evaluate(prob: _Problem, theta, n: int, jac: bool):
-    """Residual (model - target) at the rows and, optionally, its Jacobian."""
+    """Residual (model - target) at the rows and, optionally, its Jacobian.
+
+    Without a prefilter the operators keep only the rows (memory and time
+    per evaluation linear in the record, not in the record times the
+    parameters); with one they keep every sample, which the filter needs.
+    """
     k, fc, alpha, c = _unpack(theta, n, prob.fit_initial)
     k = np.ascontiguousarray(k)
     fc = np.ascontiguousarray(fc)
-    W = maxwell_response(prob.x, k, fc, np.ascontiguousarray(alpha * fc))
+    keep = prob.rows if prob.filt is None else np.arange(prob.x.size)
+    W, sign, before = _maxwell_at(prob.x, k, fc, np.ascontiguousarray(alpha * fc), keep)
     cols = [W.sum(axis=1)[:, None]]
     if jac:
         # d w_i / d fc_i = sigma_i: the sign of the last saturation (alpha_i before the first);
         # d w_i / d k_i = (w_i - fc_i sigma_i) / k_i; d w_i / d alpha_i = fc_i before the first.
-        sat = np.abs(W) >= fc
-        idx = np.where(sat, np.arange(W.shape[0])[:, None], -1)
-        last = np.maximum.accumulate(idx, axis=0)
-        before = last < 0
-        sign = np.sign(np.take_along_axis(W, np.maximum(last, 0), axis=0))
         sigma = np.where(before, alpha, sign)
         cols += [(W - fc * sigma) / k, sigma]
         if prob.fit_initial:
             cols.append(before * fc)
     M = np.concatenate(cols, axis=1)
     if prob.filt is not None:
-        M = prob.filt(M)
-    M = M[prob.rows]
+        M = prob.filt(M)[prob.rows]
     # a constant offset passes the prefilter with its DC gain (1 by construction)
     r = M[:, 0] + c - prob.y
     if not jac:
@@ -325,13 +394,17 @@ def _unit_columns(prob: _Problem, d, w0, per_slip_force: bool = False
     change the closed-loop fits at round-off level, enough to move the
     refinement to a neighbouring local minimum.
     """
-    S = np.column_stack([stop_response(prob.x, 1.0, float(di), float(wi))
-                         for di, wi in zip(d, w0, strict=True)])
-    if per_slip_force:
-        S = S / d
-    if prob.filt is not None:
-        S = prob.filt(S)
-    return S[prob.rows]
+    d = np.ascontiguousarray(d, dtype=float)
+    w0 = np.ascontiguousarray(w0, dtype=float)
+    if prob.filt is None:
+        return _stops_at(prob.x, d, w0, prob.rows, per_slip_force)
+    # the prefilter needs every sample: one column at a time keeps memory to a few records
+    every = np.arange(prob.x.size)
+    S = np.empty((prob.rows.size, d.size))
+    for j in range(d.size):
+        col = _stops_at(prob.x, d[j:j + 1], w0[j:j + 1], every, per_slip_force)
+        S[:, j] = prob.filt(col)[prob.rows, 0]
+    return S
 
 
 def _nnls_start(prob: _Problem) -> tuple[NDArray, NDArray, float]:
