@@ -108,7 +108,10 @@ def reference_df(make, p: dict, A: float, omega: float, z_bound: float) -> compl
     def period_map(z0: float) -> float:
         return solve_ivp(rhs, (0.0, T), [z0], **kw).y[0, -1] - z0
 
-    z0 = brentq(period_map, -z_bound, z_bound, xtol=1e-15 * z_bound)
+    # the state decays towards the bound from beyond it, so the period map changes sign over
+    # +-1.5 bound; at the bound itself it is zero up to the integrator's round-off (1e-13 at
+    # large amplitudes), of either sign
+    z0 = brentq(period_map, -1.5 * z_bound, 1.5 * z_bound, xtol=1e-15 * z_bound)
 
     def with_projection(t, s):  # the Fourier integrals as two more states, no sampling error
         w = force(t, s)
