@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
 from motionhyst.loop import Loop
+from motionhyst.margins import LoopMargins, loop_margins
 from motionhyst.systems import TWO_PI, TwoMassStage, freqresp
 from motionhyst.textfmt import g, table
 
@@ -121,6 +122,9 @@ class QuasiLinearAnalysis:
         ``"reference"`` or ``"self-consistent"``.
     df_frequency_hz : float or None
         Frequency at which `D` is evaluated [Hz]; None for a rate-independent element.
+    margins : LoopMargins or None
+        Gain, phase and modulus margins of the linear loop ``C P2``
+        (:func:`motionhyst.margins.loop_margins`).
 
     Examples
     --------
@@ -148,6 +152,7 @@ class QuasiLinearAnalysis:
     points: list[MismatchPoint] = field(default_factory=list)
     amplitude_mode: str = "reference"
     df_frequency_hz: float | None = None
+    margins: LoopMargins | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``analyze --json`` schema)."""
@@ -162,6 +167,8 @@ class QuasiLinearAnalysis:
             "df_frequency_hz": self.df_frequency_hz,
             "f_star_hz": self.f_star_hz,
             "bandwidth_hz": self.bandwidth_hz,
+            **({} if self.margins is None else
+               {k: v for k, v in self.margins.to_dict().items() if k != "bandwidth_hz"}),
             "mismatch_crossover_hz": self.mismatch_crossover_hz,
             "mismatch_crossover_exact_hz": self.mismatch_crossover_exact_hz,
             "mismatch": [p.to_dict() for p in self.points],
@@ -177,9 +184,13 @@ class QuasiLinearAnalysis:
         label = f"|D|/k, angle D  ({'eq. 10' if has_zeta else 'eq. 7'})"
         lines += [f"  {label:<31}{g(d['df_abs_over_k'])}, {d['df_phase_deg']:.2f} deg{at}",
                   f"  f*  (eq. 13)                   {g(self.f_star_hz)} Hz",
-                  f"  bandwidth (|C P2| = 1)         {g(self.bandwidth_hz)} Hz",
+                  f"  bandwidth (first |C P2| = 1)   {g(self.bandwidth_hz)} Hz (the crossover "
+                  "frequency, where |C P2| falls through 0 dB)",
+                  *([] if self.margins is None else str(self.margins).splitlines()[:3]),
                   f"  mismatch crossover (eq. 21)    {g(self.mismatch_crossover_hz)} Hz",
-                  f"  exact crossover |E - 1| = 1    {g(self.mismatch_crossover_exact_hz)} Hz",
+                  f"  exact crossover |E - 1| = 1    {g(self.mismatch_crossover_exact_hz)} Hz "
+                  "(eq. 18: where the error the link adds equals the error without it; "
+                  "eq. 21 estimates it from the asymptote, eq. 20)",
                   ""]
         rows = [[g(p["frequency_hz"]), g(p["abs"]), f"{20 * math.log10(p['abs']):.2f}",
                  f"{p['phase_deg']:.2f}", g(p["asymptote_abs"]), g(p["y1_amplitude"])]
@@ -412,6 +423,7 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     return QuasiLinearAnalysis(
         amplitude=float(amplitude), zeta=zeta_ref, D=D_ref, k_link=k_link,
         f_star_hz=f_star(k_link, loop.M), bandwidth_hz=loop.bandwidth_hz(),
+        margins=loop_margins(loop.controller, loop.P2),
         mismatch_crossover_hz=crossover,
         mismatch_crossover_exact_hz=mismatch_crossover_exact(loop, amplitude),
         points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df)

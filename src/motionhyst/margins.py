@@ -1,0 +1,213 @@
+"""Stability margins of the linear loop ``L = C P2`` (without the dynamic link).
+
+The classical margins of the open loop ``L(j omega) = C(j omega) P2(j omega)``
+of the paper's Fig. 3 with ``phi = 0``, with the definitions of
+:func:`control.stability_margins`:
+
+- gain margin ``1 / |L|`` where ``L`` crosses the negative real axis (phase
+  -180 deg mod 360); of several crossings the one nearest 0 dB;
+- phase margin ``angle L + 180 deg`` where ``|L| = 1``; of several the
+  smallest in magnitude;
+- modulus margin ``min |1 + L| = 1 / max |S|``, ``S = 1 / (1 + L)``, the
+  distance of the Nyquist curve to -1.
+
+The bandwidth is the crossover frequency: the first (lowest) frequency where
+``|L|`` falls through 1 (0 dB), as the paper's ``f_bw = 120 Hz`` for Table I.
+
+For LTI systems ``L`` is scanned on a dense logarithmic grid and each
+crossing and the minimum of ``|1 + L|`` is refined by root finding, so a
+margin is found wherever the grid brackets it.  For measured data only the
+measured lines are evaluated: crossings are interpolated linearly in
+``log f`` between the two lines that bracket them and the modulus margin is
+the smallest ``|1 + L|`` on the lines (an upper bound of the true one).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq, minimize_scalar
+
+from motionhyst.systems import TWO_PI, freqresp
+
+BANDWIDTH_DEFINITION = ("crossover frequency: the lowest frequency where |L| = |C P2| falls "
+                        "through 1 (0 dB)")
+#: Grid density of the scan of an LTI loop [points per decade].
+POINTS_PER_DECADE = 400
+
+
+@dataclass(frozen=True)
+class LoopMargins:
+    """Margins of ``L = C P2`` (see the module docstring for the definitions).
+
+    Attributes
+    ----------
+    gain_margin : float
+        ``1 / |L|`` at the phase crossover [-] (inf without a crossing).
+    gain_margin_hz : float
+        Its frequency [Hz] (nan without a crossing).
+    phase_margin_deg : float
+        ``angle L + 180`` at the gain crossover [deg] (inf without a crossing).
+    phase_margin_hz : float
+        Its frequency [Hz].
+    modulus_margin : float
+        ``min |1 + L| = 1 / max |S|`` [-].
+    modulus_margin_hz : float
+        Frequency of ``max |S|`` [Hz].
+    bandwidth_hz : float
+        Lowest frequency where ``|L|`` falls through 1 [Hz].
+    evaluated_on : str
+        ``"model"`` (dense grid, refined) or ``"measured lines"``.
+    """
+
+    gain_margin: float
+    gain_margin_hz: float
+    phase_margin_deg: float
+    phase_margin_hz: float
+    modulus_margin: float
+    modulus_margin_hz: float
+    bandwidth_hz: float
+    evaluated_on: str = "model"
+
+    @property
+    def gain_margin_db(self) -> float:
+        """Gain margin in dB, ``20 log10(gain_margin)``."""
+        return 20.0 * math.log10(self.gain_margin) if self.gain_margin > 0 else -math.inf
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (keys of ``analyze --json``)."""
+        return {"gain_margin_db": self.gain_margin_db, "gain_margin_hz": self.gain_margin_hz,
+                "phase_margin_deg": self.phase_margin_deg,
+                "phase_margin_hz": self.phase_margin_hz,
+                "modulus_margin": self.modulus_margin,
+                "modulus_margin_hz": self.modulus_margin_hz,
+                "bandwidth_hz": self.bandwidth_hz,
+                "bandwidth_definition": BANDWIDTH_DEFINITION,
+                "margins_evaluated_on": self.evaluated_on}
+
+    def __str__(self) -> str:
+        def at(f):
+            return "" if not math.isfinite(f) else f" at {f:.4g} Hz"
+
+        gm = self.gain_margin_db
+        return "\n".join([
+            f"  gain margin                    {gm:.4g} dB{at(self.gain_margin_hz)}",
+            f"  phase margin                   {self.phase_margin_deg:.4g} deg"
+            f"{at(self.phase_margin_hz)}",
+            f"  modulus margin 1/max|S|        {self.modulus_margin:.4g}"
+            f"{at(self.modulus_margin_hz)}"
+            f" (max|S| = {20 * math.log10(1 / self.modulus_margin):.4g} dB)",
+            f"  bandwidth                      {self.bandwidth_hz:.4g} Hz ({BANDWIDTH_DEFINITION})"
+            + ("" if self.evaluated_on == "model" else
+               f"; evaluated on the {self.evaluated_on} only")])
+
+
+def _grid_hz(controller, plant) -> NDArray[np.float64]:
+    """Frequencies spanning every pole and zero of ``C`` and ``P2`` by two decades."""
+    corners = []
+    for sys in (controller, plant):
+        for roots in (control.poles(sys), control.zeros(sys)):
+            r = np.abs(np.asarray(roots))
+            corners += list(r[r > 0] / TWO_PI)
+    lo = min([*corners, 1.0]) / 100.0
+    hi = max([*corners, 1.0]) * 100.0
+    n = int(np.ceil(POINTS_PER_DECADE * np.log10(hi / lo))) + 1
+    return np.geomspace(lo, hi, n)
+
+
+def loop_margins(controller, plant) -> LoopMargins:
+    """Gain, phase and modulus margins and the bandwidth of ``L = C P2``.
+
+    Parameters
+    ----------
+    controller : python-control LTI system
+        Feedback controller ``C``.
+    plant : python-control LTI system or FrequencyResponseData
+        Non-collocated plant ``P2``; measured data are evaluated at the
+        measured lines only.
+
+    Returns
+    -------
+    LoopMargins
+
+    Examples
+    --------
+    >>> from motionhyst.margins import loop_margins
+    >>> from motionhyst.systems import LeadLagLowpass, TwoMassStage
+    >>> m = loop_margins(LeadLagLowpass(6.2e6, 60.0, 240.0, 700.0, 0.6),
+    ...                  TwoMassStage(5.0, 17.5, 90.0, 7.4e7).P2)
+    >>> round(m.bandwidth_hz, 1), round(m.phase_margin_deg, 1), round(m.modulus_margin, 3)
+    (120.6, 24.8, 0.396)
+    """
+    data = isinstance(plant, control.FrequencyResponseData)
+    if data:
+        w = np.asarray(plant.omega, dtype=float)
+        f = w / TWO_PI
+        L = freqresp(controller, w) * np.asarray(plant.frdata, dtype=complex).ravel()
+    else:
+        f = _grid_hz(controller, plant)
+        L = freqresp(controller, TWO_PI * f) * freqresp(plant, TWO_PI * f)
+
+    def loop_at(x: float) -> complex:
+        w1 = np.array([TWO_PI * x])
+        return complex(freqresp(controller, w1)[0] * freqresp(plant, w1)[0])
+
+    def refine(fun, i: int) -> float:
+        """Root of `fun` between grid points i and i + 1 (log-linear for data)."""
+        a, b = fun(f[i]), fun(f[i + 1])
+        if data:
+            t = a / (a - b)
+            return float(np.exp(np.log(f[i]) + t * np.log(f[i + 1] / f[i])))
+        return float(brentq(fun, f[i], f[i + 1], xtol=1e-13 * f[i], rtol=1e-14))
+
+    def at_lines(values):
+        table = dict(zip(f.tolist(), values, strict=True))
+        return lambda x: table[x]
+
+    # phase crossovers: Im L changes sign where Re L < 0
+    im = L.imag
+    im_fun = at_lines(im) if data else (lambda x: loop_at(x).imag)
+    idx = np.nonzero((np.sign(im[:-1]) != np.sign(im[1:])) & (L.real[:-1] + L.real[1:] < 0))[0]
+    f180 = [refine(im_fun, i) for i in idx]
+    if data:
+        mag180 = [float(np.exp(np.interp(np.log(x), np.log(f), np.log(np.abs(L)))))
+                  for x in f180]
+    else:
+        mag180 = [abs(loop_at(x)) for x in f180]
+    gms = [(1.0 / m, x) for m, x in zip(mag180, f180, strict=True) if m > 0]
+    gm, f_gm = (min(gms, key=lambda v: abs(math.log(v[0]))) if gms
+                else (math.inf, math.nan))
+
+    # gain crossovers: log|L| changes sign
+    lm = np.log(np.abs(L))
+    lm_fun = at_lines(lm) if data else (lambda x: math.log(abs(loop_at(x))))
+    idx = np.nonzero(np.sign(lm[:-1]) != np.sign(lm[1:]))[0]
+    fc = [refine(lm_fun, i) for i in idx]
+    if data:
+        ph = np.unwrap(np.angle(L))
+        pms = [(float(np.remainder(np.degrees(np.interp(np.log(x), np.log(f), ph)), 360.0)
+                      - 180.0), x) for x in fc]
+    else:
+        pms = [(float(np.remainder(np.degrees(np.angle(loop_at(x))), 360.0) - 180.0), x)
+               for x in fc]
+    pm, f_pm = min(pms, key=lambda v: abs(v[0])) if pms else (math.inf, math.nan)
+    falling = [x for i, x in zip(idx, fc, strict=True) if lm[i] > 0]
+    bw = min(falling) if falling else math.nan
+
+    # modulus margin: min |1 + L|
+    d = np.abs(1.0 + L)
+    i = int(np.argmin(d))
+    if data or i in (0, d.size - 1):
+        mm, f_mm = float(d[i]), float(f[i])
+    else:
+        res = minimize_scalar(lambda x: abs(1.0 + loop_at(x)), bounds=(f[i - 1], f[i + 1]),
+                              method="bounded", options={"xatol": 1e-10 * f[i]})
+        mm, f_mm = float(res.fun), float(res.x)
+    return LoopMargins(gain_margin=float(gm), gain_margin_hz=float(f_gm),
+                       phase_margin_deg=float(pm), phase_margin_hz=float(f_pm),
+                       modulus_margin=mm, modulus_margin_hz=f_mm, bandwidth_hz=float(bw),
+                       evaluated_on="measured lines" if data else "model")
