@@ -359,3 +359,93 @@ def test_reproduce_with_another_model_draws_its_figures(tmp_path):
     # the mismatch of a Dahl link at 5 Hz: exact steady state against eq. (18) within 1 %
     p = summary["simulate"]["points"][0]
     assert p["mismatch_simulated_abs"] == pytest.approx(p["mismatch_df_abs"], rel=0.01)
+
+
+# ------------------------------------------------ figures as printed (issue 13)
+def test_fig7_input_and_switching_instants(el):
+    data = plots.fig7_time(el, A_REF, 5.0).motionhyst_data
+    t, x = data["t"], data["x"]
+    assert np.max(x) == pytest.approx(A_REF, rel=1e-6)  # A
+    assert t[-1] == pytest.approx(1 / 5.0)  # f
+    # eq. (6): gamma = arcsin(2 zeta - 1); stick at x reversals, slip at pi + gamma, 2 pi + gamma
+    gamma = np.arcsin(2 * 0.25 - 1)
+    expected = np.sort(np.remainder([np.pi / 2, np.pi + gamma, 3 * np.pi / 2, 2 * np.pi + gamma],
+                                    2 * np.pi)) / (2 * np.pi * 5.0)
+    assert_allclose(data["tau"], expected, rtol=1e-12)
+    # the switching instants are where the sampled force changes between slipping and sticking
+    slip = data["slip"]
+    changes = t[1:][slip[1:] != slip[:-1]]
+    for tau in data["tau"]:
+        assert np.min(np.abs(changes - tau)) < 2 * (t[1] - t[0])
+    # no switching without slip (zeta >= 1)
+    assert plots.switching_instants(el, el.fc / el.k, 5.0).size == 0
+
+
+def test_fig8_marks_the_operating_point(el):
+    data = plots.fig8_describing_function(el, zeta_op=0.25).motionhyst_data
+    assert data["zeta_op"] == 0.25
+    D = data["D_op"]
+    assert abs(D) / el.k == pytest.approx(0.3086, abs=5e-5)  # the paper: ~0.3 k
+    assert np.degrees(np.angle(D)) == pytest.approx(50.69, abs=0.01)  # the paper: ~50 deg
+
+
+def test_fig9_paper_parameters_beside_the_scenario(loop):
+    from motionhyst.hysteresis import Jenkins
+
+    fig = plots.fig9_quasilinear_plant(loop, f_star_hz=0.15)
+    data = fig.motionhyst_data
+    paper = Jenkins(k=1e4, fc=100.0)  # the paper's section III-C for Fig. 9
+    f = data["paper_f"]
+    w = 2 * np.pi * f
+    stage = loop.plant
+    P1, P2 = freqresp(stage.P1, w), freqresp(stage.P2, w)
+    for z in (0.01, 0.25, 1.0):
+        D = paper.describing_function(paper.fc / (paper.k * z))
+        assert_allclose(data[f"paper_zeta={z:g}"], P2 / (1 + D * P1), rtol=1e-12)
+    # f* = sqrt(kJ / M) / (2 pi) = 3.36 Hz: above it the paper's curves are P2 (Remark 1)
+    hi = f > 10 * np.sqrt(1e4 / 22.5) / (2 * np.pi)
+    assert_allclose(np.abs(data["paper_zeta=1"][hi]), np.abs(P2[hi]), rtol=0.02)
+    titles = " ".join(ax.get_title() for ax in fig.axes)
+    assert "kJ = 1e4 N/m, fc = 100 N" in titles and "this scenario" in titles
+    assert len(fig.axes) == 4
+
+
+def test_report_defines_margins_and_exact_crossover(reproduced):
+    out, summary = reproduced
+    text = (out / "report.md").read_text()
+    a = summary["analyze"]
+    for label in ("| gain margin |", "| phase margin |", "| modulus margin 1 / max \\|S\\| |"):
+        assert label in text
+    assert "not a quantity of the paper" in text and "crossover frequency" in text
+    assert a["phase_margin_deg"] == pytest.approx(24.83, abs=0.01)
+    for name in ("fig7", "fig9", "fig10"):
+        assert name in text
+    assert "tau_i" in report.FIGURE_NOTES["fig7"]
+    assert "kJ = 1e4 N/m, fc = 100 N" in report.FIGURE_NOTES["fig9"]
+    for line in ("Black", "Dashed red", "Circles", "Grey", "Dotted green", "Dash-dotted green"):
+        assert line in report.FIGURE_NOTES["fig10"]
+
+
+def test_report_of_a_fitted_measured_plant(tmp_path):
+    from motionhyst.frf_fit import ModalPlant
+    from motionhyst.scenario import Scenario, default_scenario_path
+    from motionhyst.systems import TwoMassStage
+
+    exact = ModalPlant.from_two_mass(TwoMassStage(5.0, 17.5, 90.0, 7.4e7))
+    f = np.geomspace(1.0, 3000.0, 60)
+    p1, p2 = exact.response(2 * np.pi * f)
+    rows = [",".join(f"{v:.17g}" for v in (fi, a.real, a.imag, b.real, b.imag))
+            for fi, a, b in zip(f, p1, p2, strict=True)]
+    (tmp_path / "p.csv").write_text("frequency_hz,p1_re,p1_im,p2_re,p2_im\n" + "\n".join(rows))
+    text = default_scenario_path().read_text()
+    text = (text[:text.index("[stage]")] + '[plant]\nfile = "p.csv"\n\n'
+            + text[text.index("[hysteresis]"):].replace("[5.0, 10.0, 15.0]", "[5.0]"))
+    (tmp_path / "s.toml").write_text(text)
+    sc = Scenario.from_file(tmp_path / "s.toml")
+    summary = report.reproduce(sc, tmp_path / "out", quiet=True)
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert "## Measured plant" in md and "rigid body + 1 mode(s)" in md
+    assert "![plant_fit](plant_fit.png)" in md
+    assert (tmp_path / "out" / "plant_fit.png").stat().st_size > 0
+    assert summary["plant_fit"]["modes"][0]["frequency_hz"] == pytest.approx(694.26, abs=0.01)
+    assert summary["analyze"]["mismatch_crossover_hz"] == pytest.approx(7.607, abs=0.001)

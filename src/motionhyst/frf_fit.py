@@ -53,6 +53,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
+from motionhyst.lti import polysub_exact, trim
 from motionhyst.systems import TWO_PI, MeasuredPlant
 
 #: Largest number of modes the automatic choice tries.
@@ -103,8 +104,10 @@ def _modal_polys(M: float, modes: tuple[Mode, ...]):
     nf2 = sum((m.r2 * p for m, p in zip(modes, others, strict=True)), np.zeros(1))
     s2 = np.array([1.0, 0.0, 0.0])
     den = np.polymul(s2, q_all)
-    n1 = np.polyadd(q_all / M, np.polymul(s2, nf1))
-    n2 = np.polysub(q_all / M, np.polymul(s2, nf2))
+    # coefficients that cancel to round-off are exactly zero (for the two-mass stage the
+    # leading ones of P2: 1/M - r2 = 0), so the transfer functions keep their true degree
+    n1 = trim(polysub_exact(q_all / M, -np.polymul(s2, nf1)))
+    n2 = trim(polysub_exact(q_all / M, np.polymul(s2, nf2)))
     return n1, n2, den, nf1, nf2, q_all
 
 
@@ -497,11 +500,11 @@ class FrfFit:
     def plot(self, f_range: tuple[float, float] | None = None):
         """Bode figure of the measured ``P1``, ``P2`` (markers) and the fit (lines).
 
-        Returns a matplotlib Figure (see :func:`motionhyst.plots.fig_frf_fit`).
+        Returns a matplotlib Figure (see :func:`motionhyst.figures.plot_frf_fit`).
         """
-        from motionhyst.plots import fig_frf_fit
+        from motionhyst.figures import plot_frf_fit
 
-        return fig_frf_fit(self, f_range)
+        return plot_frf_fit(self, f_range)
 
 
 def _num(x: float) -> str:

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq, minimize_scalar
 
+from motionhyst.lti import tf_poly, trim
 from motionhyst.systems import TWO_PI, freqresp
 
 BANDWIDTH_DEFINITION = ("crossover frequency: the lowest frequency where |L| = |C P2| falls "
@@ -110,8 +111,8 @@ def _grid_hz(controller, plant) -> NDArray[np.float64]:
     """Frequencies spanning every pole and zero of ``C`` and ``P2`` by two decades."""
     corners = []
     for sys in (controller, plant):
-        for roots in (control.poles(sys), control.zeros(sys)):
-            r = np.abs(np.asarray(roots))
+        for poly in tf_poly(sys):
+            r = np.abs(np.roots(trim(poly)))
             corners += list(r[r > 0] / TWO_PI)
     lo = min([*corners, 1.0]) / 100.0
     hi = max([*corners, 1.0]) * 100.0

@@ -8,11 +8,11 @@ callers and tests can check what is shown without reading pixels.
 from __future__ import annotations
 
 import matplotlib
-import matplotlib.ticker
 import numpy as np
+from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from motionhyst.figures import LINEAR_COLOR, MODE2_COLOR, MODE3_COLOR, _figure
+from motionhyst.figures import LINEAR_COLOR, MODE2_COLOR, MODE3_COLOR, STYLE, _figure
 from motionhyst.hysteresis import Hysteresis, Jenkins
 from motionhyst.loop import Loop
 from motionhyst.quasilinear import QuasiLinearAnalysis, loop_mismatch, mismatch_asymptote
@@ -104,33 +104,74 @@ def fig6_modes(el: Jenkins, zeta_mode2: float = 0.4, zeta_mode3: float = 0.7):
     return fig
 
 
+def switching_instants(el: Jenkins, A: float, frequency_hz: float) -> np.ndarray:
+    """Switching instants ``tau_i`` of the Jenkins element for ``x = A sin(2 pi f t)`` [s].
+
+    Within one period ``[0, 1/f)``: stick begins where ``x`` reverses
+    (``omega t = pi/2, 3 pi/2``) and slip begins where the stuck spring
+    reaches ``-+fc`` (``omega t = pi + gamma, 2 pi + gamma``, ``gamma`` of
+    eq. 6).  Sorted; empty for ``zeta >= 1`` (no slip).
+    """
+    z = float(el.zeta(A))
+    if z >= 1.0:
+        return np.zeros(0)
+    gamma = np.arcsin(2.0 * z - 1.0)
+    theta = np.remainder([np.pi / 2, np.pi + gamma, 3 * np.pi / 2, 2 * np.pi + gamma], TWO_PI)
+    return np.sort(theta) / (TWO_PI * frequency_hz)
+
+
 def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
-    """Fig. 7: w(t) over a period, slip intervals shaded, and its first harmonic."""
-    fig, (ax,) = _figure()
+    """Fig. 7: input x(t) and output w(t) over a period, switching instants, first harmonic.
+
+    Upper panel the input ``x = A sin(2 pi f t)``; lower panel the force
+    ``w(t)`` (eq. 5) with the slip intervals shaded, the switching instants
+    ``tau_i`` (eq. 6) marked, and the first harmonic kept by the describing
+    function (eq. 7).
+    """
+    fig, (ax_x, ax) = _figure(2)
     x, w = _sine_loop(el, A)
     t = np.linspace(0.0, 1.0 / frequency_hz, len(x))
     D = el.describing_function(A)
     w1 = A * np.abs(D) * np.sin(TWO_PI * frequency_hz * t + np.angle(D))
     slip = np.isclose(np.abs(w), el.fc)
+    taus = switching_instants(el, A, frequency_hz)
+    ax_x.plot(t, x * 1e3, color="tab:blue", label="x(t) = A sin(2 pi f t)")
+    ax_x.axhline(A * 1e3, color="0.5", ls=":", lw=0.8)
+    ax_x.axhline(-A * 1e3, color="0.5", ls=":", lw=0.8)
+    ax_x.annotate(f"A = {A * 1e3:.4g} mm", (t[-1], A * 1e3), xytext=(-4, -12),
+                  textcoords="offset points", ha="right", fontsize=8, color="0.3")
+    ax_x.set_ylabel("input x [mm]")
     ax.fill_between(t, -el.fc * 1.1, el.fc * 1.1, where=slip, color="0.85", step="mid",
-                    label="slipping")
-    ax.plot(t, w, color="k", label="w(t), exact")
-    ax.plot(t, w1, "--", color="tab:red", label="first harmonic (describing function)")
+                    label="slipping (|w| = fc)")
+    ax.plot(t, w, color="k", label="w(t), exact (eq. 5)")
+    ax.plot(t, w1, "--", color="tab:red", label="first harmonic (describing function, eq. 7)")
+    for i, tau in enumerate(taus, start=1):
+        for a in (ax_x, ax):
+            a.axvline(tau, color="tab:green", ls="-.", lw=0.8)
+        ax.annotate(f"tau{i}", (tau, 1.0), xycoords=("data", "axes fraction"),
+                    xytext=(2, -10), textcoords="offset points", fontsize=8,
+                    color="tab:green")
     ax.set_xlabel("time t [s]")
     ax.set_ylabel("force w [N]")
-    ax.set_title(f"Fig. 7: element output for x = A sin(2 pi f t), zeta = {el.zeta(A):.3g}")
-    ax.legend(loc="lower left")
-    fig.motionhyst_data.update(t=t, w=w, w_first_harmonic=w1, slip=slip)
+    ax_x.set_title(f"Fig. 7: Jenkins element (k = {el.k:g} N/m, fc = {el.fc:g} N) for "
+                   f"x = A sin(2 pi f t),\nA = {A * 1e3:.4g} mm, f = {frequency_hz:g} Hz, "
+                   f"zeta = {el.zeta(A):.3g}; tau_i: switching instants (eq. 6)", fontsize=9)
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=7)
+    fig.motionhyst_data.update(t=t, x=x, w=w, w_first_harmonic=w1, slip=slip, tau=taus)
     return fig
 
 
 def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
-                              frequency_hz: float | None = None):
+                              frequency_hz: float | None = None,
+                              zeta_op: float | None = None):
     """Fig. 8: ``|D| / k`` and angle of ``D`` against zeta (eq. 10), mode regions shaded.
 
     For other models than Jenkins, ``zeta = fc / (k A)`` with the total slip
     force and the initial stiffness, without the Jenkins element's modes; a
-    rate-dependent element is drawn at `frequency_hz`.
+    rate-dependent element is drawn at `frequency_hz`.  `zeta_op` marks an
+    operating point (the paper's section V: zeta = 0.25, ``|D| ~ 0.3 k``,
+    angle ~50 deg) with its values.
     """
     _check_frequency(el, frequency_hz)
     fig, (ax1, ax2) = _figure(2)
@@ -147,12 +188,25 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
                        label="linear (no slip)")
     ax1.semilogx(z, np.abs(D) / k0, color="k")
     ax2.semilogx(z, np.degrees(np.angle(D)), color="k")
+    if zeta_op is not None and np.isfinite(zeta_op):
+        D_op = complex(np.asarray(el.describing_function(
+            _force_scale(el) / (k0 * zeta_op), omega)).ravel()[0])
+        mag, ph = abs(D_op) / k0, float(np.degrees(np.angle(D_op)))
+        # text where the curve is not: upper left of the rising |D|, upper right of the phase
+        for ax, v, text, dx, ha in ((ax1, mag, f"|D|/k = {mag:.3g}", -6, "right"),
+                                    (ax2, ph, f"angle D = {ph:.3g} deg", 6, "left")):
+            ax.axvline(zeta_op, color="tab:orange", ls="--", lw=1)
+            ax.plot([zeta_op], [v], "o", color="tab:orange", ms=5,
+                    label=f"operating point zeta = {zeta_op:.3g}" if ax is ax1 else None)
+            ax.annotate(text, (zeta_op, v), xytext=(dx, 6), textcoords="offset points",
+                        fontsize=8, color="tab:orange", ha=ha)
+        fig.motionhyst_data.update(zeta_op=zeta_op, D_op=D_op)
     ax1.set_ylabel("|D| / k [-]")
     ax2.set_ylabel("angle D [deg]")
     if jenkins:
         ax2.set_xlabel("zeta = fc / (k A) [-]")
         ax1.set_title("Fig. 8: describing function of the Jenkins element, eq. (10)")
-        ax1.legend(loc="upper left")
+        ax1.legend(loc="center left")
     else:
         ax2.set_xlabel("zeta = fc / (k A) [-], k the initial stiffness")
         ax1.set_title(f"Fig. 8: describing function, {_describe(el, frequency_hz)}",
@@ -162,18 +216,14 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
     return fig
 
 
-def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5, 0.75, 1.0),
-                           f_range=(0.01, 100.0), f_star_hz: float | None = None):
-    """Fig. 9: Bode plot of the quasi-linear plant ``P^phi`` (eq. 12) for zeta in (0, 1].
+#: The link and stage the paper states for its Fig. 9 (section III-C): kJ = 1e4 N/m, fc = 100 N.
+FIG9_PAPER_LINK = {"k": 1e4, "fc": 100.0}
+FIG9_PAPER_STAGE = {"m1": 5.0, "m2": 17.5, "b": 90.0, "k": 7.4e7}
 
-    For a Jenkins element the curves are labelled by zeta (eq. 4); for other
-    models by the amplitude ``fc_total / (k_total zeta)`` they correspond to.
-    """
-    el = loop.hysteresis
-    fig, (ax1, ax2) = _figure(2)
-    f = np.geomspace(*_frequency_range(loop, f_range), 600)
+
+def _fig9_panel(ax1, ax2, P1, P2, el, zetas, f, f_star_hz, data, prefix=""):
+    """Curves of eq. (12) for each zeta on one column of Fig. 9."""
     w = TWO_PI * f
-    P1, P2 = freqresp(loop.P1, w), freqresp(loop.P2, w)
     cmap = matplotlib.colormaps["viridis"]
     jenkins = el.defines_zeta  # the paper's Jenkins element: slip modes by zeta (eq. 4)
     fc_total = _force_scale(el)
@@ -182,23 +232,74 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
         D = el.describing_function(A, w if not el.rate_independent else None)
         Pphi = P2 / (1.0 + D * P1)
         c = cmap(i / max(1, len(zetas) - 1))
-        label = f"zeta = {z:g}" if jenkins else f"A = {A:.3g} m"
+        label = (f"zeta = {z:g} (A = {A * 1e3:.4g} mm)" if jenkins
+                 else f"A = {A * 1e3:.4g} mm")
         ax1.semilogx(f, 20 * np.log10(np.abs(Pphi)), color=c, label=label)
         ax2.semilogx(f, _phase_deg(Pphi), color=c)
-        fig.motionhyst_data[f"zeta={z:g}"] = Pphi
+        data[f"{prefix}zeta={z:g}"] = Pphi
     ax1.semilogx(f, 20 * np.log10(np.abs(P2)), "k--", label="P2 (no link)")
     ax2.semilogx(f, _phase_deg(P2), "k--")
     if f_star_hz:
         for ax in (ax1, ax2):
             ax.axvline(f_star_hz, color="tab:red", ls=":", lw=1)
-        ax1.annotate(f"f* = {f_star_hz:.3g} Hz", (f_star_hz, ax1.get_ylim()[1]),
-                     xytext=(4, -12), textcoords="offset points", color="tab:red")
+        ax1.annotate(f"f* = {f_star_hz:.3g} Hz (eq. 13)", (f_star_hz, 1.0),
+                     xycoords=("data", "axes fraction"), xytext=(4, -12),
+                     textcoords="offset points", color="tab:red", fontsize=8)
     ax1.set_ylabel("|P^phi| [dB re 1 m/N]")
     ax2.set_ylabel("angle P^phi [deg]")
     ax2.set_xlabel("frequency [Hz]")
-    ax1.set_title("Fig. 9: quasi-linear plant, eq. (12)")
-    ax1.legend(ncol=2, loc="lower left")
-    fig.motionhyst_data.update(f=f, P2=P2)
+    ax1.legend(loc="lower left", fontsize=7)
+    data[f"{prefix}f"] = f
+    data[f"{prefix}P2"] = P2
+
+
+def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5, 0.75, 1.0),
+                           f_range=(0.01, 100.0), f_star_hz: float | None = None,
+                           paper: bool = True, paper_f_range=(0.1, 100.0)):
+    """Fig. 9: Bode plot of the quasi-linear plant ``P^phi`` (eq. 12) for zeta in (0, 1].
+
+    With `paper` (default) two columns: on the left the figure as the paper
+    states it (section III-C: the Table I stage with a Jenkins link of
+    ``kJ = 1e4 N/m``, ``fc = 100 N``, so ``f* = 3.4 Hz``), on the right the
+    scenario's own loop (`loop`'s plant and link, ``f*`` = `f_star_hz`).
+    For a Jenkins element the curves are labelled by zeta (eq. 4) and the
+    amplitude; for other models by the amplitude ``fc_total / (k_total zeta)``.
+    ``fig.motionhyst_data`` holds the scenario's curves (``f``, ``P2``,
+    ``zeta=...``) and the paper's with the prefix ``paper_``.
+    """
+    from motionhyst.hysteresis import Jenkins as _Jenkins
+    from motionhyst.quasilinear import f_star
+    from motionhyst.systems import TwoMassStage
+
+    el = loop.hysteresis
+    with matplotlib.rc_context(STYLE):
+        ncol = 2 if paper else 1
+        fig = Figure(figsize=(11.0 if paper else 6.4, 5.6), layout="constrained")
+        axes = fig.subplots(2, ncol, sharex="col", squeeze=False)
+    for ax in axes.ravel():
+        ax.grid(True, which="both", alpha=0.3)
+    fig.motionhyst_data = {}
+    if paper:
+        stage = TwoMassStage(**FIG9_PAPER_STAGE)
+        link = _Jenkins(**FIG9_PAPER_LINK)
+        f = np.geomspace(*paper_f_range, 600)
+        w = TWO_PI * f
+        _fig9_panel(axes[0, 0], axes[1, 0], freqresp(stage.P1, w), freqresp(stage.P2, w), link,
+                    zetas, f, f_star(link.k, stage.M), fig.motionhyst_data, prefix="paper_")
+        axes[0, 0].set_title("as in the paper: Table I stage, Jenkins kJ = 1e4 N/m, fc = 100 N",
+                             fontsize=9)
+    f = np.geomspace(*_frequency_range(loop, f_range), 600)
+    w = TWO_PI * f
+    _fig9_panel(axes[0, -1], axes[1, -1], freqresp(loop.P1, w), freqresp(loop.P2, w), el, zetas,
+                f, f_star_hz, fig.motionhyst_data)
+    units = {"k": " N/m", "fc": " N", "sigma0": " N/m", "sigma1": " N s/m", "sigma2": " N s/m",
+             "fs": " N", "vs": " m/s"}
+    params = ", ".join(f"{k} = {v:g}{units.get(k, '')}" if not isinstance(v, list) else
+                       f"{k} = [{', '.join(f'{x:g}' for x in v)}]{units.get(k, '')}"
+                       for k, v in el.to_dict().items() if k != "model")
+    axes[0, -1].set_title(f"this scenario: {el.name} link, {params}", fontsize=9)
+    fig.suptitle("Fig. 9: quasi-linear plant P^phi = P2 / (1 + D P1), eq. (12); "
+                 "0 dB = 1 m/N", fontsize=10)
     return fig
 
 
@@ -212,26 +313,28 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     Pr = 1.0 / (loop.M * (1j * w) ** 2)
     Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - freqresp(loop.P2, w)
     Et = mismatch_asymptote(Pr, Pf2, analysis.D)
-    ax.loglog(f, np.abs(E), color="k", label="|E|, eq. (18)")
-    ax.loglog(f, np.abs(Et), "--", color="tab:red", label="asymptote, eq. (20)")
+    ax.loglog(f, np.abs(E), color="k", label="|E| = |e / e_hat|, eq. (18): quasi-linear mismatch")
+    ax.loglog(f, np.abs(Et), "--", color="tab:red",
+              label="|E~| = |Pr^2 D / Pf2|, eq. (20): low-frequency asymptote")
     if exact:
         fe = np.array([s.frequency_hz for s in exact])
         Ee = np.array([abs(s.mismatch) for s in exact])
         ax.loglog(fe, Ee, "o", mfc="none", color="tab:blue",
-                  label="exact steady state (nonlinear loop)")
+                  label="|e1 / e_hat1| of the exact periodic steady state (nonlinear loop)")
         fig.motionhyst_data.update(f_exact=fe, E_exact=Ee)
-    ax.axhline(1.0, color="0.5", lw=0.8)
-    for fx, lab, ls in ((analysis.mismatch_crossover_hz, "eq. (21)", ":"),
-                        (analysis.mismatch_crossover_exact_hz, "|E - 1| = 1", "-.")):
+    ax.axhline(1.0, color="0.5", lw=0.8, label="|E| = 1: no mismatch (eq. 22)")
+    for fx, lab, ls in ((analysis.mismatch_crossover_hz, "eq. (21), |E~| = 1", ":"),
+                        (analysis.mismatch_crossover_exact_hz,
+                         "|E - 1| = 1 on eq. (18): added error = error without link", "-.")):
         if np.isfinite(fx):
-            ax.axvline(fx, color="tab:green", ls=ls, lw=1, label=f"crossover {lab}: {fx:.3g} Hz")
+            ax.axvline(fx, color="tab:green", ls=ls, lw=1, label=f"{lab}: {fx:.4g} Hz")
     ax.set_ylim(0.5, max(10.0, float(np.abs(E).max()) * 2))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("|E| [-]")
     at = (f"zeta = {analysis.zeta:.3g}" if np.isfinite(analysis.zeta)
           else f"A = {analysis.amplitude:.3g} m")
     ax.set_title(f"Fig. 10: feedforward mismatch, {at}")
-    ax.legend(loc="upper right")
+    ax.legend(loc="upper right", fontsize=7)
     fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
     return fig
 
@@ -268,48 +371,4 @@ def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike,
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=2)
     fig.suptitle("Fig. 11: steady-state tracking error", fontsize=10)
-    return fig
-
-
-def fig_frf_fit(fit, f_range: tuple[float, float] | None = None):
-    """Bode figure of a measured plant (markers) and its rigid-body + modes fit (lines).
-
-    `fit` is a :class:`motionhyst.frf_fit.FrfFit`.  The fitted ``P1`` and
-    ``P2`` are drawn densely (so a resonance between measured lines shows),
-    with the fitted modes' frequencies marked.
-    """
-    f_data = fit.frequency_hz
-    lo, hi = f_range if f_range is not None else (f_data.min() / 1.5, f_data.max() * 1.5)
-    f = np.geomspace(lo, hi, 2000)
-    if fit.plant.modes:
-        f = np.union1d(f, [m.frequency_hz for m in fit.plant.modes if lo <= m.frequency_hz <= hi])
-    m1, m2 = fit.plant.response(TWO_PI * f)
-    fig, (ax1, ax2) = _figure(2)
-    for P, D, color, name in ((m1, fit.P1_data, "tab:blue", "P1 (collocated)"),
-                              (m2, fit.P2_data, "tab:red", "P2 (non-collocated)")):
-        ax1.semilogx(f, 20 * np.log10(np.abs(P)), color=color, label=f"{name}, fit")
-        ax1.semilogx(f_data, 20 * np.log10(np.abs(D)), "o", ms=3, mfc="none", color=color,
-                     label=f"{name}, measured")
-        ph = _phase_deg(P)
-        # the data on the fit's branch of the phase
-        at_data = fit.plant.response(TWO_PI * f_data)[0 if P is m1 else 1]
-        ph_data = np.interp(f_data, f, ph) + np.degrees(np.angle(D / at_data))
-        ax2.semilogx(f, ph, color=color)
-        ax2.semilogx(f_data, ph_data, "o", ms=3, mfc="none", color=color)
-    for i, m in enumerate(fit.plant.modes):
-        for ax in (ax1, ax2):
-            ax.axvline(m.frequency_hz, color="0.5", ls=":", lw=0.8)
-        ax1.annotate(f"mode {i + 1}: {m.frequency_hz:.4g} Hz", (m.frequency_hz, 1.0),
-                     xycoords=("data", "axes fraction"), xytext=(3, -10),
-                     textcoords="offset points", fontsize=7, color="0.3")
-    ax2.yaxis.set_major_locator(matplotlib.ticker.MultipleLocator(90))
-    ax1.set_ylabel("magnitude [dB re 1 m/N]")
-    ax2.set_ylabel("phase [deg]")
-    ax2.set_xlabel("frequency [Hz]")
-    ax1.set_title(f"Measured plant and fit: rigid body M = {fit.plant.M:.4g} kg + "
-                  f"{len(fit.plant.modes)} mode(s), RMS relative error "
-                  f"{fit.rms_relative_error:.2g}", fontsize=9)
-    ax1.legend(loc="lower left")
-    fig.motionhyst_data.update(f=f, P1_fit=m1, P2_fit=m2, f_data=f_data, P1_data=fit.P1_data,
-                               P2_data=fit.P2_data)
     return fig

@@ -22,7 +22,7 @@ from motionhyst.jsonio import dumps
 from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
 from motionhyst.scenario import Scenario
 from motionhyst.steady import periodic_steady_state
-from motionhyst.systems import TwoMassStage
+from motionhyst.systems import MeasuredPlant
 
 # Numbers the paper states for Table I (section V and Fig. 8).
 PAPER_VALUES = {
@@ -31,26 +31,62 @@ PAPER_VALUES = {
     "df_phase_deg": ("~50 deg", "angle D"),
     "f_star_hz": ("0.15 Hz", "f* (eq. 13)"),
     "mismatch_crossover_hz": ("7.6 Hz", "crossover (eq. 21)"),
-    "bandwidth_hz": ("120 Hz", "bandwidth"),
+    "bandwidth_hz": ("120 Hz", "bandwidth (crossover: first \\|C P2\\| = 1)"),
 }
+
+# Loop margins of C P2 (not stated in the paper): key, label, unit.
+MARGIN_ROWS = (
+    ("gain_margin_db", "gain margin", " dB", "gain_margin_hz"),
+    ("phase_margin_deg", "phase margin", " deg", "phase_margin_hz"),
+    ("modulus_margin", "modulus margin 1 / max \\|S\\|", "", "modulus_margin_hz"),
+)
+
+#: The exact crossover and what it is (it is not a quantity of the paper).
+EXACT_CROSSOVER_LABEL = "exact crossover, \\|E - 1\\| = 1 on eq. (18)"
+EXACT_CROSSOVER_NOTE = ("Exact crossover: where \\|E - 1\\| = 1 on eq. (18), i.e. the error "
+                        "that the link adds equals the error without it. It is not a quantity of "
+                        "the paper: eq. (21) estimates the same frequency from the asymptote of "
+                        "eq. (20). The bandwidth is the crossover frequency of the open loop, the "
+                        "lowest frequency where \\|C P2\\| falls through 1; the margins are "
+                        "those of C P2 without the link (as control.stability_margins defines "
+                        "them).")
 
 FIGURE_NOTES = {
     "fig5": "Displacement-force loops of the Jenkins element for sinusoids at several zeta: "
             "a spring while it sticks, flat at +-fc while it slips; zeta >= 1 never slips.",
     "fig6": "The two nonlinear modes: for zeta <= 0.5 the element starts to slip where x w <= 0, "
             "for 0.5 < zeta < 1 where x w > 0 (dots).",
-    "fig7": "The force over one period with the slip intervals shaded, and its first harmonic: "
-            "what the describing function keeps.",
+    "fig7": "Upper panel: the input x(t) = A sin(2 pi f t) with its amplitude A. Lower panel: "
+            "the element's force w(t) over one period (eq. 5, black), the slip intervals "
+            "|w| = fc shaded, the switching instants tau_i between sticking and slipping "
+            "(dash-dotted, from eq. 6) and the first harmonic that the describing function "
+            "keeps (eq. 7, dashed red).",
     "fig8": "Magnitude and phase of the describing function against zeta (eq. 10): a small "
-            "lead-dominated force for small zeta, the spring k for zeta >= 1.",
+            "lead-dominated force for small zeta, the spring k for zeta >= 1; shaded the modes "
+            "of operation (2: zeta <= 0.5, 3: 0.5 < zeta < 1, linear: zeta >= 1); the orange "
+            "point marks the operating point of section V (zeta = 0.25 for Table I: "
+            "|D| ~ 0.3 k, angle ~50 deg).",
     "fig5-other": "Displacement-force loops of the scenario's link for sinusoids at several "
                   "zeta = fc / (k A) (total slip force over initial stiffness times amplitude).",
     "fig8-other": "Magnitude and phase of the scenario's link's describing function against "
                   "zeta = fc / (k A): from the initial stiffness for small amplitudes to a "
                   "lead-dominated force for large ones.",
-    "fig9": "The quasi-linear plant (eq. 12) departs from the floating mass P2 only below f*.",
-    "fig10": "The feedforward mismatch (eq. 18) and its asymptote (eq. 20); the circles are the "
-             "exact periodic steady state of the nonlinear loop.",
+    "fig9": "The quasi-linear plant P^phi = P2 / (1 + D P1) (eq. 12) for zeta from 0.01 to 1 "
+            "(colours, with the amplitude A = fc / (k zeta) each stands for) and the floating "
+            "mass P2 without link (black dashed); the dotted red line is f* (eq. 13), above "
+            "which P^phi is P2. Left: the figure as the paper states it (Table I stage, "
+            "Jenkins kJ = 1e4 N/m, fc = 100 N, f* = 3.4 Hz); right: this scenario's stage and "
+            "link.",
+    "fig10": "Black: |E| of eq. (18), the quasi-linear error with the link over the error "
+             "without it. Dashed red: its low-frequency asymptote |E~| of eq. (20). Circles: "
+             "the same ratio from the exact periodic steady state of the nonlinear loop (first "
+             "harmonics). Grey: |E| = 1, no mismatch (eq. 22). Dotted green: eq. (21), where "
+             "|E~| = 1. Dash-dotted green: where |E - 1| = 1 on eq. (18), i.e. the error the "
+             "link adds equals the error without it; this exact counterpart of eq. (21) is not "
+             "a quantity of the paper.",
+    "plant_fit": "Measured P1 (collocated) and P2 (non-collocated) as circles and the fitted "
+                 "rigid body plus modes as lines, drawn densely so that a resonance between "
+                 "measured lines shows; dotted: the fitted modes' frequencies.",
     "fig11": "Steady-state error over a period with and without the dynamic link, the "
              "describing-function estimate of its first harmonic, and the sum of harmonics "
              "1-7 predicted by the higher-order describing functions.",
@@ -78,8 +114,21 @@ def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
         val = _fmt(a[key]) + units.get(key, "") + (at if key.startswith("df_") else "")
         lines.append(f"| {label} | {paper} | {val} |" if is_paper else f"| {label} | {val} |")
     exact = _fmt(a["mismatch_crossover_exact_hz"]) + " Hz"
-    lines.append(f"| exact crossover, \\|E - 1\\| = 1 | - | {exact} |" if is_paper
-                 else f"| exact crossover, \\|E - 1\\| = 1 | {exact} |")
+    lines.append(f"| {EXACT_CROSSOVER_LABEL} | - | {exact} |" if is_paper
+                 else f"| {EXACT_CROSSOVER_LABEL} | {exact} |")
+    for key, label, unit, fkey in MARGIN_ROWS:
+        if key in a:
+            val = f"{_fmt(a[key])}{unit} at {_fmt(a[fkey])} Hz"
+            lines.append(f"| {label} | - | {val} |" if is_paper else f"| {label} | {val} |")
+    lines += ["", EXACT_CROSSOVER_NOTE]
+    if a.get("margins_evaluated_on", "model") != "model":
+        lines += ["", f"Margins and bandwidth evaluated on the {a['margins_evaluated_on']} only."]
+    fit = summary.get("plant_fit")
+    if fit is not None:
+        lines += ["", "## Measured plant", "",
+                  "The measured plant is fitted to a rigid body plus flexible modes "
+                  "(`motionhyst.frf_fit`); every number and figure of this report comes from "
+                  "the fitted model.", "", "```", str(sc.plant_fit()), "```"]
     lines += ["", "Mismatch at the reference frequencies: describing function (eq. 18) against "
               "the exact periodic steady state of the nonlinear loop.", "",
               "| f [Hz] | \\|E\\| eq. (18) | angle [deg] | \\|E\\| exact | angle [deg] | "
@@ -136,11 +185,16 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             "fig5": lambda: plots.fig5_loops(el, frequency_hz=freqs[0]),
             "fig6": lambda: plots.fig6_modes(el),
             "fig7": lambda: plots.fig7_time(el, A, freqs[0]),
-            "fig8": lambda: plots.fig8_describing_function(el, frequency_hz=freqs[0]),
+            "fig8": lambda: plots.fig8_describing_function(el, frequency_hz=freqs[0],
+                                                           zeta_op=analysis.zeta),
             "fig9": lambda: plots.fig9_quasilinear_plant(loop, f_star_hz=analysis.f_star_hz),
             "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
             "fig11": lambda: plots.fig11_errors(states, E_df, H_df),
         }
+        fit = sc.plant_fit()
+        if fit is not None:
+            summary["plant_fit"] = fit.to_dict()
+            figs["plant_fit"] = fit.plot
         if not el.defines_zeta:
             for name in ("fig6", "fig7"):
                 del figs[name]
@@ -149,10 +203,10 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                          f"the scenario's link is a {el.name} model, so they are not drawn. "
                          f"Figs. 5 and 8 show its loops and describing function{at}, with "
                          f"zeta = fc / (k A) from its total slip force and initial stiffness.")
-        if not isinstance(loop.plant, TwoMassStage):
-            notes.append("The plant is measured frequency-response data: eq. (21) needs the "
-                         "two-mass model and is not computed; frequency plots are limited to "
-                         "the measured range.")
+        if isinstance(loop.plant, MeasuredPlant):
+            notes.append("The plant is measured frequency-response data (use = \"data\"): "
+                         "eq. (21) needs a model and is not computed; frequency plots are "
+                         "limited to the measured range.")
         written = []
         for name, make in figs.items():
             fig = make()
