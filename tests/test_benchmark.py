@@ -138,3 +138,24 @@ def test_training_record_is_periodic_after_the_transient():
     assert np.max(np.abs(rec.y[2 * n:] - rec.y[n:2 * n])) < 2e-3 * np.max(np.abs(rec.y))
     noisy = training_record(np.random.default_rng(4), 3, period=2048)
     assert np.std(noisy.y - rec.y) == pytest.approx(8e-6, rel=0.05)
+
+
+@needs_shared
+def test_benchmark_on_one_training_period_meets_the_multisine_target():
+    from motionhyst.benchmark import run_benchmark
+
+    res = run_benchmark(SHARED, n_experiments=1, n_periods=1, models=("bouc-wen",))
+    row = res["models"][0]
+    assert row["multisine_rmse"] <= 1e-6  # the target, from 8192 noisy samples only
+    assert row["sinesweep_rmse"] <= 5e-6
+    assert res["generator_check_rms"] < 1e-12
+
+
+def test_benchmark_command_without_test_sets(tmp_path, capsys, monkeypatch):
+    from motionhyst.cli import main
+
+    monkeypatch.chdir(tmp_path)  # no ../shared here
+    assert main(["benchmark", "bouc-wen"]) == 2
+    assert "give --data DIR" in capsys.readouterr().err
+    assert main(["benchmark", "bouc-wen", "--data", str(tmp_path)]) == 2
+    assert "uval_multisine.mat: cannot read" in capsys.readouterr().err

@@ -156,3 +156,19 @@ def test_cli_errors(tmp_path, capsys):
                       '[reference]\namplitude = 0.01\nfrequencies = [1.0]\n')
     assert main(["predict", str(closed), str(bad), "--out", str(tmp_path / "o.csv")]) == 2
     assert "not a mass-spring-damper" in capsys.readouterr().err
+
+
+def test_maxwell_slip_link_recovered_from_noise_free_records():
+    from motionhyst.hysteresis import MaxwellSlip
+
+    true = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), MaxwellSlip(k=[2e4, 3e4], fc=[4.0, 15.0]))
+    n = 1536
+    u = _multisine(n, 1)
+    t = np.arange(n) / FS
+    y = true.simulate(t, u, substeps=10).displacement
+    fit = identify_io([IORecord(t, u, y)], "maxwell-slip", n_elements=2, substeps=10)
+    expected = {"m": 2.0, "c": 10.0, "k": 5e4, "k[0]": 2e4, "k[1]": 3e4, "fc[0]": 4.0,
+                "fc[1]": 15.0}
+    for name, value in expected.items():
+        assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
+    assert fit.hysteresis.to_dict()["model"] == "maxwell-slip"

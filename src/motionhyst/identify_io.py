@@ -67,7 +67,7 @@ from motionhyst.openloop import (
 )
 
 MIN_SAMPLES = 64
-MODELS = ("bouc-wen",)
+MODELS = ("bouc-wen", "maxwell-slip", "jenkins", "dahl")
 SINGULAR_RTOL = 1e-8
 
 
@@ -351,7 +351,8 @@ def _uncertainty(J: NDArray[np.float64], rss: float, n_rows: int
 
 def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
                 nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
-                max_nfev: int = 60) -> IOIdentification:
+                max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None
+                ) -> IOIdentification:
     """Identify a mass-spring-damper stage and its link from input-output records.
 
     Parameters
@@ -359,13 +360,18 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     records : list of IORecord
         Force in, displacement out; each from rest (``y = y' = 0``, link relaxed
         at the first sample) or, with `periodic`, whole periods of a steady state.
-    model : {"bouc-wen"}
+    model : {"bouc-wen", "maxwell-slip", "jenkins", "dahl"}
         The link's model.
     periodic : bool
         Records are steady-state periods (each record one period or several
         whole periods of its force).
     nu : float or None
         Bouc-Wen exponent: fixed at this value, or estimated when None.
+    n_elements : int
+        Maxwell-slip: number of Jenkins elements.
+    start_nfev : int, optional
+        Links other than Bouc-Wen: evaluations of each start's refinement on the
+        short part of the records (default ``15 p``, ``p`` parameters).
     substeps : int, optional
         Integration steps per sample (default: the model's
         :meth:`~motionhyst.openloop.OpenLoop.default_substeps` at the start).
@@ -403,6 +409,9 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
             if rec_period is None and abs(rec.u[0] - rec.u[-1]) > 0.5 * np.ptp(rec.u):
                 raise ValueError(f"{rec.name}: periodic records must hold whole periods of "
                                  f"the force; its ends do not join")
+    if model != "bouc-wen":
+        return _identify_elements(records, model, periodic, substeps, tol, max_nfev,
+                                  n_elements, t_start, start_nfev)
     bla = best_linear_approximation(records)
     fs = records[0].fs
     r = substeps or OpenLoop(bla).default_substeps(fs)
@@ -498,3 +507,109 @@ def _bouc_wen_link(alpha: float, bg: float, bd: float, nu: float) -> Hysteresis:
         raise ValueError(f"the identified Bouc-Wen parameters (alpha={alpha:.6g}, "
                          f"beta*gamma={bg:.6g}, beta*delta={bd:.6g}, nu={nu:.6g}) are outside "
                          f"the model's accepted set: {exc}") from None
+
+
+# ----------------------------------------------------------------- other links (finite differences)
+def _link_from(model: str, v: NDArray[np.float64], n: int) -> Hysteresis:
+    from motionhyst.hysteresis import Dahl, Jenkins, MaxwellSlip
+
+    if model == "maxwell-slip":
+        return MaxwellSlip(k=v[:n], fc=v[n:2 * n])
+    if model == "jenkins":
+        return Jenkins(k=v[0], fc=v[1])
+    return Dahl(k=v[0], fc=v[1], alpha=v[2])
+
+
+def _link_names(model: str, n: int) -> list[str]:
+    if model == "maxwell-slip":
+        return [f"k[{i}]" for i in range(n)] + [f"fc[{i}]" for i in range(n)]
+    return ["k", "fc"] if model == "jenkins" else ["k", "fc", "alpha"]
+
+
+def _link_start(model: str, k_link: float, y_scale: float, n: int) -> NDArray[np.float64]:
+    """Link parameters of stiffness `k_link` slipping across the record's displacement range."""
+    if model == "maxwell-slip":
+        d = y_scale * np.geomspace(0.05, 2.0, n)
+        k = np.full(n, k_link / n)
+        return np.concatenate([k, k * d])
+    v = [k_link, k_link * 0.5 * y_scale]
+    return np.array(v if model == "jenkins" else [*v, 1.0])
+
+
+class _ElementProblem:
+    """Simulation residuals of the stage with a link of exact-update elements (log parameters)."""
+
+    def __init__(self, records, periodic, substeps, model, n, y_scale):
+        self.records, self.periodic, self.r = records, periodic, substeps
+        self.model, self.n, self.y_scale = model, n, y_scale
+        self.n_eval = 0
+
+    def residuals(self, logp: NDArray[np.float64]) -> NDArray[np.float64]:
+        self.n_eval += 1
+        v = np.exp(logp)
+        try:
+            sys = OpenLoop(MassSpringDamper(v[0], v[1], v[2]), _link_from(self.model, v[3:],
+                                                                           self.n))
+
+            def one(rec):
+                return sys.simulate(rec.t, rec.u, periodic=self.periodic,
+                                    substeps=self.r).displacement - rec.y
+
+            if len(self.records) > 1:
+                with ThreadPoolExecutor(max_workers=min(len(self.records),
+                                                        os.cpu_count() or 1)) as pool:
+                    res = list(pool.map(one, self.records))
+            else:
+                res = [one(self.records[0])]
+            r = np.concatenate(res) / self.y_scale
+        except ValueError:
+            r = np.full(sum(rec.y.size for rec in self.records), np.nan)
+        return np.where(np.isfinite(r), r, 1e3)
+
+
+def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_start,
+                       start_nfev) -> IOIdentification:
+    """Stage and a Jenkins, Maxwell-slip or Dahl link by simulation error (finite differences)."""
+    if model != "maxwell-slip":
+        n = 1
+    bla = best_linear_approximation(records)
+    r = substeps or OpenLoop(bla).default_substeps(records[0].fs)
+    y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2)))
+    short = _short_records(records, periodic)
+    n_eval = 0
+    best = None
+    for share in (0.3, 0.6):
+        p0 = np.concatenate([[bla.m, bla.c, (1 - share) * bla.k],
+                             _link_start(model, share * bla.k, y_scale, n)])
+        prob = _ElementProblem(short, periodic, r, model, n, y_scale)
+        sol = least_squares(prob.residuals, np.log(p0), method="trf", ftol=1e-6, xtol=1e-6,
+                            gtol=1e-6, max_nfev=start_nfev or 15 * p0.size, diff_step=1e-6)
+        n_eval += prob.n_eval
+        if best is None or sol.cost < best.cost:
+            best = sol
+    prob = _ElementProblem(records, periodic, r, model, n, y_scale)
+    sol = least_squares(prob.residuals, best.x, method="trf", ftol=tol, xtol=tol, gtol=tol,
+                        max_nfev=max_nfev, diff_step=1e-6)
+    n_eval += prob.n_eval
+    v = np.exp(sol.x)
+    res = prob.residuals(sol.x) * y_scale
+    rss = float(res @ res)
+    J = sol.jac * y_scale / v  # d residual / d parameter
+    std_v, undetermined = _uncertainty(J, rss, res.size)
+    names = ["m", "c", "k", *_link_names(model, n)]
+    estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
+    std: dict[str, float | None] = {}
+    not_ident: dict[str, str] = {}
+    for nm, sd, bad in zip(names, std_v, undetermined, strict=True):
+        std[nm] = None if bad or not math.isfinite(sd) else float(sd)
+        if bad:
+            not_ident[nm] = ("not determined by these records (a direction of the Jacobian "
+                             "with a singular value below 1e-8 of the largest)")
+    return IOIdentification(
+        plant=MassSpringDamper(v[0], v[1], v[2]), hysteresis=_link_from(model, v[3:], n),
+        estimates=estimates, std=std, not_identifiable=not_ident,
+        fit_rms=float(np.sqrt(rss / res.size)), records=_per_record(records, res),
+        seconds=time.perf_counter() - t_start, periodic=periodic,
+        stopping=f"{sol.message} (finite-difference Jacobian; ftol = xtol = gtol = {tol:g}, "
+                 f"at most {max_nfev} evaluations; {sol.nfev} used)",
+        n_evaluations=n_eval, substeps=r)

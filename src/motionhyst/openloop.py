@@ -321,7 +321,7 @@ def _rk4_run(uf, h, r, p, x0, s0, sens):  # pragma: no cover - compiled
 
 
 # ----------------------------------------------------------------- other links: FOH + exact update
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _foh_link_run(Ad, B0, B1, uf, r, codes, params, glt, glw, h, ftol, max_iter, x0, s0
                   ):  # pragma: no cover - compiled
     """Stage (FOH, state (y, v)), link elements advanced exactly; outputs every r steps."""

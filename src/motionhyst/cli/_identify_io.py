@@ -55,8 +55,7 @@ def run_input_output(args: argparse.Namespace) -> int:
     """Identify the stage and its link from input-output records; print, optionally save."""
     from motionhyst.identify_io import identify_io, load_io_csv
 
-    for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff),
-                          ("--elements", args.elements)):
+    for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} does not apply to --record "
                              f"input-output")
@@ -65,9 +64,11 @@ def run_input_output(args: argparse.Namespace) -> int:
     if plant == "two-mass":
         raise UsageError("motionhyst identify: --plant two-mass is not available for "
                          "input-output records yet; use --plant mass-spring-damper")
-    if model not in ("bouc-wen",):
-        raise UsageError(f"motionhyst identify: --model {model} is not available for "
-                         f"input-output records yet; use --model bouc-wen")
+    if model == "lugre":
+        raise UsageError("motionhyst identify: --model lugre is not available for "
+                         "input-output records yet; use bouc-wen, maxwell-slip, jenkins or dahl")
+    if args.elements is not None and model != "maxwell-slip":
+        raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     if args.nu is not None and model != "bouc-wen":
         raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
     target = None
@@ -77,7 +78,8 @@ def run_input_output(args: argparse.Namespace) -> int:
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
     records = [load_io_csv(path) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
-    fit = identify_io(records, model, periodic=args.periodic, nu=nu)
+    fit = identify_io(records, model, periodic=args.periodic, nu=nu,
+                      n_elements=args.elements or 3)
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         target.write_text(fit.scenario_text())
