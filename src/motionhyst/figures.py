@@ -16,12 +16,17 @@ Examples
 
 from __future__ import annotations
 
+import multiprocessing
+import os
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
 import matplotlib
 import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["STYLE", "plot_analysis", "plot_frf_fit", "plot_steady_state"]
+__all__ = ["STYLE", "plot_analysis", "plot_frf_fit", "plot_steady_state", "save_figures"]
 
 STYLE = {
     "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
@@ -129,3 +134,98 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
     fig.motionhyst_data.update(f=f, P1_fit=m1, P2_fit=m2, f_data=f_data, P1_data=fit.P1_data,
                                P2_data=fit.P2_data)
     return fig
+
+
+# ---------------------------------------------------------------------------- saving
+FigureMaker = Callable[[], Figure]
+_PENDING: dict[str, FigureMaker] = {}  # the figures a forked worker draws (inherited, not sent)
+
+
+def _draw_and_save(job: tuple[str, Path, tuple[str, ...]]) -> str:
+    """Draw figure `name` and save it in every format (in a worker or in-process)."""
+    name, folder, formats = job
+    fig = _PENDING[name]()
+    for fmt in formats:
+        fig.savefig(folder / f"{name}.{fmt}")
+        # the constrained layout found for the first file holds for the others (same size in
+        # inches, same text): keep it instead of solving it again (~15 % of the saving time)
+        fig.set_layout_engine("none")
+    return name
+
+
+def _workers(n_jobs: int) -> int:
+    """Processes to draw `n_jobs` figures with: the usable cores, 1 without ``fork``."""
+    if "fork" not in multiprocessing.get_all_start_methods():
+        return 1
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - platforms without affinity
+        cores = os.cpu_count() or 1
+    return max(1, min(cores, n_jobs))
+
+
+def save_figures(makers: dict[str, FigureMaker], folder: str | Path,
+                 formats: Sequence[str] = ("png", "pdf"),
+                 done: Callable[[str], None] | None = None,
+                 workers: int | None = None) -> list[str]:
+    """Draw figures and save each as ``folder/<name>.<format>``, several at a time.
+
+    Laying out and rendering a figure (constrained layout, tick labels on log
+    axes, PNG and PDF backends) is pure Python in matplotlib and takes far
+    longer than computing its data, so the figures are drawn in parallel by
+    forked worker processes (one per usable core); each worker draws a figure
+    from its maker, inherited through ``fork`` (nothing is pickled but the
+    name), and writes every format.  Without ``fork`` (Windows, or one core)
+    they are drawn in this process, one after the other.
+
+    Parameters
+    ----------
+    makers : dict
+        Figure name -> function returning the :class:`~matplotlib.figure.Figure`.
+    folder : str or Path
+        Existing folder the files are written into.
+    formats : sequence of str
+        File formats (extensions), each written for every figure.
+    done : callable, optional
+        Called with each figure's name once its files are written (progress).
+    workers : int, optional
+        Processes to use; by default the usable cores, at most one per figure.
+
+    Returns
+    -------
+    list of str
+        The names, in the order of `makers`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.figures import save_figures
+    >>> from motionhyst.plots import fig5_loops, fig8_describing_function
+    >>> el = Jenkins(k=20.0, fc=0.05)
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> save_figures({"fig5": lambda: fig5_loops(el), "fig8": lambda: fig8_describing_function(el)},
+    ...              folder)
+    ['fig5', 'fig8']
+    >>> sorted(p.name for p in folder.iterdir())
+    ['fig5.pdf', 'fig5.png', 'fig8.pdf', 'fig8.png']
+    """
+    global _PENDING
+    names = list(makers)
+    jobs = [(name, Path(folder), tuple(formats)) for name in names]
+    n = _workers(len(jobs)) if workers is None else max(1, min(int(workers), len(jobs)))
+    _PENDING = dict(makers)
+    try:
+        if n == 1:
+            for name in map(_draw_and_save, jobs):
+                if done is not None:
+                    done(name)
+        else:
+            with multiprocessing.get_context("fork").Pool(n) as pool:
+                for name in pool.imap_unordered(_draw_and_save, jobs):
+                    if done is not None:
+                        done(name)
+    finally:
+        _PENDING = {}
+    return names

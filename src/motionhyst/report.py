@@ -18,6 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from motionhyst import plots
+from motionhyst.figures import save_figures
 from motionhyst.jsonio import dumps
 from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
 from motionhyst.scenario import Scenario
@@ -207,14 +208,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             notes.append("The plant is measured frequency-response data (use = \"data\"): "
                          "eq. (21) needs a model and is not computed; frequency plots are "
                          "limited to the measured range.")
-        written = []
-        for name, make in figs.items():
-            fig = make()
-            stem = f"{name}"
-            fig.savefig(tmp / f"{stem}.png")
-            fig.savefig(tmp / f"{stem}.pdf")
-            written.append(name)
-            steps.update()
+        written = save_figures(figs, tmp, ("png", "pdf"), done=lambda _: steps.update())
         (tmp / "summary.json").write_text(dumps(summary))
         _write_report(tmp / "report.md", sc, summary, written, is_paper, notes)
         steps.close()
