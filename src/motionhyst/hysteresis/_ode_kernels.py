@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst._jit import njit
 from motionhyst.hysteresis._kernels import _trig2, reversal_roots, trig_root
-from motionhyst.hysteresis.periodic import sample_period, significant_harmonics, trig_eval
+from motionhyst.hysteresis.periodic import sample_period, significant_harmonics
 from motionhyst.validation import check_positive
 
 TWO_PI = 2.0 * np.pi
@@ -829,14 +829,36 @@ def rate_independent_path(X: NDArray[np.complex128], N: int
     grid_index : ndarray, shape (N,)
         Position of each grid sample in `path`.
     """
+    X = np.asarray(X, dtype=complex)
     x = sample_period(X, N)
     d = sample_period(X, N, 1)
-    cells, angles = reversal_angles(X, d)
-    xr = trig_eval(X, angles) if cells.size else np.empty(0)
-    base = np.append(x, x[0])
-    path = np.insert(base, cells + 1, xr)
-    grid_index = np.arange(N) + np.searchsorted(cells + 1, np.arange(N), side="right")
+    m = np.arange(X.size)
+    path, grid_index = _path_with_reversals(x, d, X, 1j * m * X, -(m**2) * X)
     return x, path, grid_index
+
+
+@njit(cache=True)
+def _path_with_reversals(x, d, X, C1, C2):  # pragma: no cover - compiled
+    """``x`` on the grid with the reversal values inserted (see :func:`rate_independent_path`)."""
+    n = x.shape[0]
+    hgrid = TWO_PI / n
+    cells, roots = reversal_roots(C1, C2, d)
+    nc = cells.shape[0]
+    path = np.empty(n + 1 + nc)
+    grid_index = np.empty(n, dtype=np.int64)
+    q = 0
+    k = 0
+    for i in range(n):
+        grid_index[i] = k
+        path[k] = x[i]
+        k += 1
+        if q < nc and cells[q] == i:
+            r = min(max(roots[q], i * hgrid), (i + 1) * hgrid)
+            path[k] = X[0].real + _trig2(X, X, r)[0]
+            k += 1
+            q += 1
+    path[k] = x[0]
+    return path, grid_index
 
 
 def periodic_fixed_point(period: Callable[[float], NDArray[np.float64]], s0: float,
@@ -893,35 +915,43 @@ def lugre_step_arrays(X: NDArray[np.complex128], N: int
     middle and end of each step and its length) and the index of each grid
     sample among the step boundaries.
     """
+    X = np.asarray(X, dtype=complex)
     d2 = sample_period(X, 2 * N, 1)
-    xa = d2[0::2]
-    xm = d2[1::2]
-    xb = np.roll(xa, -1)
-    h = np.full(N, TWO_PI / N)
-    cells, angles = reversal_angles(X, xa)
-    grid_index = np.arange(N) + np.searchsorted(cells + 1, np.arange(N), side="right")
-    if cells.size == 0:
-        return xa, xm, xb, h, grid_index
-    hgrid = TWO_PI / N
-    # split each reversal cell into its pieces (a cell may hold several reversals)
-    new_a, new_m, new_b, new_h = [], [], [], []
-    for i in np.unique(cells):
-        cuts = np.concatenate([[i * hgrid], np.sort(angles[cells == i]), [(i + 1) * hgrid]])
-        lo, hi = cuts[:-1], cuts[1:]
-        new_a.append(np.concatenate([[xa[i]], np.zeros(lo.size - 1)]))
-        new_b.append(np.concatenate([np.zeros(lo.size - 1), [xb[i]]]))
-        new_m.append(trig_eval(X, 0.5 * (lo + hi), 1))
-        new_h.append(hi - lo)
-    keep = np.setdiff1d(np.arange(N), cells)
-    order = np.concatenate([keep, np.repeat(np.unique(cells), [len(v) for v in new_h])])
-    sub = np.concatenate([np.zeros(keep.size), np.concatenate(
-        [np.arange(len(v)) for v in new_h])])
-    A = np.concatenate([xa[keep], *new_a])
-    Mx = np.concatenate([xm[keep], *new_m])
-    B = np.concatenate([xb[keep], *new_b])
-    H = np.concatenate([h[keep], *new_h])
-    idx = np.lexsort((sub, order))
-    return A[idx], Mx[idx], B[idx], H[idx], grid_index
+    m = np.arange(X.size)
+    return _lugre_steps_with_reversals(np.ascontiguousarray(d2[0::2]),
+                                       np.ascontiguousarray(d2[1::2]), 1j * m * X, -(m**2) * X)
+
+
+@njit(cache=True)
+def _lugre_steps_with_reversals(xa, xm, C1, C2):  # pragma: no cover - compiled
+    """The steps of :func:`lugre_step_arrays` from ``x'`` at the grid points and mid-cells."""
+    n = xa.shape[0]
+    hgrid = TWO_PI / n
+    cells, roots = reversal_roots(C1, C2, xa)  # at most one reversal per cell
+    nc = cells.shape[0]
+    A = np.empty(n + nc)
+    M = np.empty(n + nc)
+    B = np.empty(n + nc)
+    H = np.empty(n + nc)
+    grid_index = np.empty(n, dtype=np.int64)
+    q = 0
+    k = 0
+    for i in range(n):
+        grid_index[i] = i + q
+        xb = xa[(i + 1) % n]
+        if q < nc and cells[q] == i:  # split at the reversal: x' = 0 there
+            lo = i * hgrid
+            hi = (i + 1) * hgrid
+            r = min(max(roots[q], lo), hi)
+            A[k], M[k], B[k], H[k] = xa[i], _trig2(C1, C1, 0.5 * (lo + r))[0], 0.0, r - lo
+            A[k + 1], M[k + 1], B[k + 1], H[k + 1] = (0.0, _trig2(C1, C1, 0.5 * (r + hi))[0],
+                                                      xb, hi - r)
+            k += 2
+            q += 1
+        else:
+            A[k], M[k], B[k], H[k] = xa[i], xm[i], xb, hgrid
+            k += 1
+    return A, M, B, H, grid_index
 
 
 def describing_function_from_harmonics(W1: complex, A: float) -> complex:
