@@ -309,7 +309,7 @@ def half_half_reference(r):
 def test_half_half_describing_function_within_1e_10(r):
     """The hold-out case (``n = 1``, ``beta = gamma = 1/2``) was 1.5e-9 off at ``r = 400``:
     the jump of ``w''`` where the state crosses 0, between samples, aliased as ``N^-3``.
-    The jumps are now corrected (measured <= 5e-13 here).  The reference's quadrature
+    The jumps are now corrected (measured <= 2.1e-13 here).  The reference's quadrature
     may warn of round-off at its target, far below the tolerance."""
     k, fc = 20.0, 0.05
     ref = half_half_reference(r)
@@ -317,7 +317,7 @@ def test_half_half_describing_function_within_1e_10(r):
     assert abs(D - ref) <= 1e-10 * abs(ref), abs(D - ref) / abs(ref)
 
 
-# measured errors: 1.6e-11, 1.7e-12, 2.8e-11, 1.8e-11 of |W_1| (1.8e-8 to 5.7e-8 without the
+# measured errors: 1.2e-11, 8e-13, 2.8e-11, 1.5e-11 of |W_1| (1.8e-8 to 5.7e-8 without the
 # correction at the same sample count); for n = 1.5, whose |z|^1.5 at z = 0 is not corrected,
 # 1.4e-10 (3.6e-9 with the count and method before the correction)
 @pytest.mark.parametrize(("p", "r", "rtol"), [((1.0, 0.5, 0.5), 50.0, 1e-10),

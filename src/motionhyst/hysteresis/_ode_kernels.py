@@ -429,10 +429,11 @@ def bouc_wen_periodic(X, C1, C2, C3, x, d, kf, n, ap, am, hmax, lo, hi, t,
     return out, jt[:nj], jv[:nj], jo[:nj], best <= 1e-10
 
 
-#: aliases summed on each side in :func:`alias_of_jumps`: the rest is at most 0.4 % of the
-#: correction of a jump of the second derivative (``~ 1 / ALIAS_TERMS^2``), the corrections
-#: being below ~1e-8 of ``|W_1|`` where they are used
-ALIAS_TERMS = 16
+#: aliases summed on each side in :func:`alias_of_jumps` (the rest: below 1e-5 of the correction)
+ALIAS_TERMS = 256
+#: most terms of the expansion in ``m / N`` (``<= 1/2``) in :func:`alias_of_jumps`; fewer
+#: are used where ``H / N`` is small enough for the rest to fall below 1e-9 of the first
+ALIAS_ORDERS = 40
 
 
 @njit(cache=True)
@@ -441,37 +442,64 @@ def alias_of_jumps(jt, jv, jo, N, H):  # pragma: no cover - compiled
 
     A jump ``J`` of the ``p``-th derivative at ``theta_j`` (`jt`, `jv`, `jo`)
     gives the function the Fourier coefficients ``c_k ~ J exp(-j k theta_j) /
-    (2 pi (j k)^(p+1))``; the FFT of ``N`` samples returns ``sum_l c_{m + l N}``, so
-    its error at harmonic ``m`` is the sum over ``l != 0`` (``|l| <=``
-    :data:`ALIAS_TERMS`), returned for ``m = 0 .. H``: ``O(N^-(p+1))`` off the grid.
+    (2 pi (j k)^q)``, ``q = p + 1``; the FFT of ``N`` samples returns
+    ``sum_l c_{m + l N}``, so its error at harmonic ``m`` is the sum over ``l != 0``,
+    returned for ``m = 0 .. H`` (``O(N^-q)`` off the grid).  With
+    ``(m + l N)^-q = (l N)^-q sum_s binom(-q, s) (m / (l N))^s`` (``|m / N| <= 1/2``)
+    it is ``N^-q sum_s binom(-q, s) (m / N)^s T_{q+s}`` with the lattice sums
+    ``T_n = sum_{l != 0} exp(-j l N theta_j) l^-n``, computed once per jump
+    (:data:`ALIAS_TERMS` values of ``l`` each side, :data:`ALIAS_ORDERS` values of ``s``).
+    The sum is taken directly here rather than by subtracting the jumps'
+    Bernoulli polynomials from the samples, which would lose the precision of
+    ``w`` to their size (``~ (k A / fc)^3`` at sharp crossings).
     """
     E = np.zeros(H + 1, dtype=np.complex128)
-    rot = np.empty(ALIAS_TERMS, dtype=np.complex128)
-    for j in range(jt.shape[0]):
-        p = jo[j]  # 2 or 3
-        amp = jv[j] / (2.0 * np.pi) / (1j) ** (p + 1)
-        step = complex(math.cos(N * jt[j]), -math.sin(N * jt[j]))  # exp(-j N theta_j)
-        r = 1.0 + 0j
-        for li in range(ALIAS_TERMS):
-            r *= step
-            rot[li] = r  # exp(-j (li + 1) N theta_j)
+    B = np.zeros(ALIAS_ORDERS, dtype=np.complex128)  # the polynomial in m / N at one angle
+    Tc = np.empty(ALIAS_ORDERS)
+    Ts = np.empty(ALIAS_ORDERS)
+    rmax = min(H / N, 0.5)
+    nj = jt.shape[0]
+    top = 0  # orders in B
+    for j in range(nj):
+        q = jo[j] + 1
+        orders = 1
+        bound = 1.0  # |binom(-q, s)| rmax^s
+        while orders < ALIAS_ORDERS and bound > 1e-9:
+            bound *= (q + orders - 1) / orders * rmax
+            orders += 1
+        phi = (N * jt[j]) % (2.0 * np.pi)
+        Tc[:orders] = 0.0
+        Ts[:orders] = 0.0
+        for li in range(1, ALIAS_TERMS + 1):
+            c = math.cos(li * phi)
+            sn = math.sin(li * phi)
+            w = 1.0 / float(li) ** q
+            inv = 1.0 / li
+            for s in range(orders):
+                Tc[s] += c * w
+                Ts[s] += sn * w
+                w *= inv
+        amp = jv[j] / (2.0 * np.pi) / (1j) ** q / float(N) ** q
+        coef = 1.0  # binom(-q, s)
+        for s in range(orders):
+            B[s] += amp * coef * (2.0 * Tc[s] if (q + s) % 2 == 0 else -2.0j * Ts[s])
+            coef *= -(q + s) / (s + 1.0)
+        top = max(top, orders)
+        if j + 1 < nj and jt[j + 1] == jt[j]:
+            continue  # jumps of several derivatives at one angle share the sum over m
         turn = complex(math.cos(jt[j]), -math.sin(jt[j]))  # exp(-j theta_j)
         base = 1.0 + 0j
         for mm in range(H + 1):
             if mm % 64 == 0:  # exp(-j m theta_j), recomputed now and then against drift
                 base = complex(math.cos(mm * jt[j]), -math.sin(mm * jt[j]))
-            acc = 0j
-            for li in range(ALIAS_TERMS):
-                ip = 1.0 / (mm + (li + 1) * N)
-                im = 1.0 / (mm - (li + 1) * N)
-                wp = ip * ip * ip
-                wm = im * im * im
-                if p == 3:
-                    wp *= ip
-                    wm *= im
-                acc += rot[li] * wp + rot[li].conjugate() * wm
-            E[mm] += amp * base * acc
+            ratio = mm / N
+            acc = B[top - 1]
+            for s in range(top - 2, -1, -1):
+                acc = acc * ratio + B[s]
+            E[mm] += base * acc
             base *= turn
+        B[:top] = 0.0
+        top = 0
     return E
 
 

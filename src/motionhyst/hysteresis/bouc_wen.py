@@ -326,11 +326,12 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         """Samples per period used by :meth:`periodic_harmonics` for the input `X`.
 
         An even FFT-friendly size (:func:`scipy.fft.next_fast_len`) with at
-        least 8 samples per input harmonic, 4 per output harmonic, 2048, and
-        ``700 (k A / fc)^(1/3)``: with the jumps of ``w''`` corrected
+        least 4 samples per input harmonic (as the stop operator's exact
+        harmonics), 4 per output harmonic, 2048, and ``700 (k A / fc)^(1/3)``:
+        with the aliasing of the jumps of ``w''`` and ``w'''`` subtracted
         (:func:`~motionhyst.hysteresis._ode_kernels.alias_of_jumps`) the
         harmonics' remaining error is that of the jumps of higher derivatives,
-        ``~ N^-4``, below 1e-10 of ``|W_1|`` there.  For a non-integer ``n`` the
+        ``~ N^-5``, below 1e-10 of ``|W_1|`` there.  For a non-integer ``n`` the
         crossing of ``z = 0`` (``|z|^n``) is not corrected and the count of
         :meth:`NormalisedRateIndependent.default_samples` applies.
         """
@@ -339,7 +340,7 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         X = truncate_harmonics(X)
         amp = float(np.sum(np.abs(X[1:]))) * 2.0  # bound on the half range of x
         r = self.k * amp / self.fc
-        target = max(8 * (len(X) - 1), 4 * (int(n_harmonics) + 1), MIN_SAMPLES_CORRECTED,
+        target = max(4 * (len(X) - 1), 4 * (int(n_harmonics) + 1), MIN_SAMPLES_CORRECTED,
                      700.0 * max(r, 1.0) ** (1.0 / 3.0))
         n = next_fast_len(math.ceil(min(target, MAX_SAMPLES)), real=True)
         while n % 2:
