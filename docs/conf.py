@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import os
 import sys
 from pathlib import Path
@@ -66,8 +67,19 @@ def _equation_links_resolve(app, env, node, contnode):
             location=node)
 
 
+def _no_type_docstring_for_data(app, what, name, obj, options, lines):
+    """A module constant without a doc comment shows no docstring (not its type's: ndarray's)."""
+    if what not in ("data", "attribute") or not lines or isinstance(obj, str):
+        return
+    type_doc = (inspect.getdoc(type(obj)) or "").strip().splitlines()
+    first = lines[0].strip()
+    if first.startswith(type(obj).__name__ + "(") or (type_doc and first == type_doc[0]):
+        lines.clear()
+
+
 def setup(app):
     app.connect("missing-reference", _equation_links_resolve)
+    app.connect("autodoc-process-docstring", _no_type_docstring_for_data, priority=400)
 
 
 # Pages written from the package itself at every build (see apigen.py).
