@@ -169,6 +169,14 @@ def count_reversals(x: ArrayLike, band: float | None = None) -> int:
     -------
     int
         How often `x` turns back by more than `band` from its running extreme.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.identify import count_reversals
+    >>> t = np.linspace(0.0, 2.0, 2001)
+    >>> count_reversals(np.sin(2 * np.pi * 2.0 * t))        # 2 Hz for 2 s: 8 extrema
+    8
     """
     xs = np.ascontiguousarray(x, dtype=float)
     if xs.size < 2:
@@ -756,6 +764,24 @@ class Identification:
     cutoff_hz : float or None
         Cut-off of the prefilter of a closed-loop record [Hz]; None for a
         force-displacement record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import MaxwellSlip
+    >>> from motionhyst.identify import identify_maxwell_slip
+    >>> t = np.linspace(0.0, 4.0, 4001)
+    >>> x = 0.01 * np.exp(-t / 2) * np.sin(2 * np.pi * 2.0 * t)
+    >>> ident = identify_maxwell_slip(x, MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).response(x))
+    >>> print(f"R^2 = {ident.r2:.6f}, {ident.n_samples} samples")
+    R^2 = 1.000000, 4001 samples
+    >>> w = ident.predict(0.005 * np.sin(np.linspace(0.0, 4 * np.pi, 200)))   # any displacement
+    >>> print(ident.scenario_fragment())                   # doctest: +ELLIPSIS
+    # identified from 4001 samples: ...
+    [hysteresis]
+    model = "maxwell-slip"
+    k = [10.0, 6.0]      # spring stiffnesses [N/m]
+    fc = [0.01, 0.03]     # slip forces [N]
     """
 
     model: MaxwellSlip
@@ -880,6 +906,22 @@ def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = N
     -----
     See the module docstring for the method (grid of stop operators, NNLS,
     bounded least-squares refinement, order criterion, covariance).
+
+    Examples
+    --------
+    A two-element cable slab measured under a decaying sine:
+
+    >>> import numpy as np
+    >>> from motionhyst import MaxwellSlip
+    >>> from motionhyst.identify import identify_maxwell_slip
+    >>> t = np.linspace(0.0, 4.0, 4001)
+    >>> x = 0.01 * np.exp(-t / 2) * np.sin(2 * np.pi * 2.0 * t)
+    >>> w = MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).response(x)
+    >>> ident = identify_maxwell_slip(x, w, t=t)
+    >>> ident.n_elements                                   # chosen by the RMS criterion
+    2
+    >>> print(np.round(ident.model.k, 4), np.round(ident.model.fc, 5))
+    [10.  6.] [0.01 0.03]
     """
     xs = np.ascontiguousarray(np.asarray(x, dtype=float))
     ws = np.asarray(w, dtype=float)
@@ -918,6 +960,17 @@ class LinkForce:
         Cut-off of the Butterworth part of ``L`` [Hz].
     settle_index : int
         First sample after the prefilter's start-up transient.
+
+    Examples
+    --------
+    >>> from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+    >>> from motionhyst.identify import infer_link_force
+    >>> sc = default_scenario()
+    >>> loop = Loop(sc.plant(), sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    >>> sim = simulate(loop, SineReference(0.01, 2.0), 1.5, dt=2e-4)
+    >>> lf = infer_link_force(sim.t, sim.y1, sim.u, sc.plant())
+    >>> print(f"cut-off {lf.cutoff_hz:.1f} Hz, settled after {lf.t[lf.settle_index]:.3f} s")
+    cut-off 46.7 Hz, settled after 0.214 s
     """
 
     t: NDArray[np.float64]
@@ -972,6 +1025,24 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     Returns
     -------
     LinkForce
+
+    Examples
+    --------
+    A closed-loop record of the Table I stage with a two-element link, simulated; the link
+    force inferred from ``y1`` and ``u`` matches the simulated one through the prefilter:
+
+    >>> import numpy as np
+    >>> from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+    >>> from motionhyst.identify import infer_link_force
+    >>> sc = default_scenario()
+    >>> stage = sc.plant()
+    >>> loop = Loop(stage, sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    >>> sim = simulate(loop, SineReference(0.01, 2.0), 1.5, dt=2e-4)
+    >>> lf = infer_link_force(sim.t, sim.y1, sim.u, stage)
+    >>> i = lf.settle_index
+    >>> error = np.abs(lf.w[i:] - lf.lowpass(sim.w)[i:]).max()
+    >>> bool(error < 5e-3 * np.abs(sim.w).max())             # measured: 0.1 % of the force
+    True
     """
     ts = np.asarray(t, dtype=float)
     ys = np.ascontiguousarray(np.asarray(y1, dtype=float))
@@ -1034,6 +1105,18 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     Returns
     -------
     Identification
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+    >>> from motionhyst.identify import identify_closed_loop
+    >>> sc = default_scenario()
+    >>> loop = Loop(sc.plant(), sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    >>> sim = simulate(loop, SineReference(0.01, 2.0), 1.5, dt=2e-4)   # the "measurement"
+    >>> ident = identify_closed_loop(sim.t, sim.y1, sim.u, sc.plant())
+    >>> print(np.round(ident.model.k, 2), np.round(ident.model.fc, 4), ident.signal)
+    [10.  6.] [0.01 0.03] prefiltered force
     """
     lf = infer_link_force(t, y1, u, stage, cutoff_hz)
     if initial_state not in ("fit", "relaxed"):
@@ -1085,6 +1168,22 @@ def load_force_displacement_csv(source: Source
         or non-finite value, rows of inconsistent length, fewer than
         ``MIN_SAMPLES`` samples, time not strictly increasing, constant
         displacement, or no reversal of the displacement.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from motionhyst import Jenkins
+    >>> from motionhyst.identify import load_force_displacement_csv
+    >>> t = np.linspace(0.0, 1.0, 1001)
+    >>> x = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+    >>> path = Path(tempfile.mkdtemp()) / "record.csv"
+    >>> np.savetxt(path, np.column_stack([t, x, Jenkins(k=20.0, fc=0.05).response(x)]),
+    ...            delimiter=",", header="time,displacement,force", comments="")
+    >>> t, x, w = load_force_displacement_csv(path)
+    >>> t.size, float(w.max())
+    (1001, 0.05)
     """
     return _load(source, ("time", "displacement", "force"), "displacement")
 
@@ -1106,6 +1205,16 @@ def load_closed_loop_csv(source: Source
     ValueError
         As :func:`load_force_displacement_csv` (with ``y1`` in place of the
         displacement).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.identify import load_closed_loop_csv
+    >>> t = np.linspace(0.0, 1.0, 1001)
+    >>> record = np.column_stack([t, 0.01 * np.sin(2 * np.pi * 2.0 * t), np.cos(2 * np.pi * t)])
+    >>> t, y1, u = load_closed_loop_csv(record)           # columns time, y1, u (or a CSV file)
+    >>> y1.shape
+    (1001,)
     """
     return _load(source, ("time", "y1", "u"), "y1")
 

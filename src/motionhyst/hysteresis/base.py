@@ -49,6 +49,21 @@ class Hysteresis(ABC):
     defines_zeta : bool
         True if the model defines the paper's ``zeta = fc / (k A)`` (eq. 4)
         through :meth:`zeta`.
+
+    Examples
+    --------
+    Every link model is a ``Hysteresis``; the analyses use only this interface:
+
+    >>> import numpy as np
+    >>> from motionhyst import Dahl, Hysteresis, Jenkins
+    >>> links = [Jenkins(k=20.0, fc=0.05), Dahl(k=20.0, fc=0.05)]
+    >>> all(isinstance(link, Hysteresis) for link in links)
+    True
+    >>> for link in links:
+    ...     D = complex(np.ravel(link.describing_function(0.01))[0])   # eq. (7) at A = 10 mm
+    ...     print(f"{link.name:8s} |D| = {abs(D):.3f} N/m, k = {link.initial_stiffness} N/m")
+    jenkins  |D| = 6.171 N/m, k = 20.0 N/m
+    dahl     |D| = 5.965 N/m, k = 20.0 N/m
     """
 
     name: ClassVar[str] = "hysteresis"
