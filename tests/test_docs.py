@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import inspect
 import re
 import subprocess
 import sys
@@ -76,6 +77,29 @@ def test_every_public_name_is_in_the_api_reference(tmp_path):
     # the top-level names are documented under their top-level spelling
     for name in motionhyst.__all__:
         assert f"motionhyst.{name}" in listed, name
+
+
+def _has_examples(obj: object) -> bool:
+    doc = inspect.getdoc(obj) or ""
+    m = re.search(r"^Examples\n-{8,}\n(.*?)(?=^\S[^\n]*\n-{3,}\n|\Z)", doc, re.M | re.S)
+    return bool(m) and ">>>" in m.group(1)
+
+
+def _functions_and_classes() -> list[tuple[str, object]]:
+    seen: set[int] = set()
+    out = []
+    for name, obj in PUBLIC:
+        if (inspect.isclass(obj) or inspect.isfunction(obj)) and id(obj) not in seen:
+            seen.add(id(obj))
+            out.append((name, obj))
+    return out
+
+
+@pytest.mark.parametrize("name, obj", _functions_and_classes(),
+                         ids=lambda v: v if isinstance(v, str) else "")
+def test_public_function_or_class_has_an_examples_section(name, obj):
+    """Run by ``--doctest-modules``; a name without one fails here."""
+    assert _has_examples(obj), f"{name}: no numpydoc Examples section with >>> lines"
 
 
 def _resolve(dotted: str) -> object:

@@ -44,7 +44,18 @@ _SNIFF_BYTES = 64 * 1024
 
 
 class CSVError(ValueError):
-    """A tabular input that cannot be used: one line naming the source and the problem."""
+    """A tabular input that cannot be used: one line naming the source and the problem.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.csvdata import CSVError, read_columns
+    >>> try:
+    ...     read_columns(np.zeros((3, 1)), ("time", "position"))
+    ... except CSVError as err:
+    ...     print("CSVError:", err)                         # doctest: +ELLIPSIS
+    CSVError: ...
+    """
 
 
 def normalize_name(name: Any) -> str:

@@ -45,6 +45,13 @@ def tf_poly(sys, what: str = "plant and controller"
         If `sys` is not a python-control LTI system.
     ValueError
         If it is not single-input single-output (`what` names it).
+
+    Examples
+    --------
+    >>> import control
+    >>> from motionhyst.lti import tf_poly
+    >>> tf_poly(control.tf([1.0], [1.0, 2.0]))
+    (array([1.]), array([1., 2.]))
     """
     if isinstance(sys, control.StateSpace):
         sys = control.ss2tf(sys)
@@ -57,14 +64,28 @@ def tf_poly(sys, what: str = "plant and controller"
 
 
 def trim(p: ArrayLike) -> NDArray[np.float64]:
-    """Drop leading coefficients that are exactly zero."""
+    """Drop leading coefficients that are exactly zero.
+
+    Examples
+    --------
+    >>> from motionhyst.lti import trim
+    >>> trim([0.0, 0.0, 1.0, 2.0])
+    array([1., 2.])
+    """
     p = np.atleast_1d(np.asarray(p, dtype=float))
     nz = np.nonzero(p != 0.0)[0]
     return p[nz[0]:] if nz.size else np.zeros(1)
 
 
 def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np.float64]:
-    """``a - b`` with coefficients that cancel to round-off set to exactly zero."""
+    """``a - b`` with coefficients that cancel to round-off set to exactly zero.
+
+    Examples
+    --------
+    >>> from motionhyst.lti import polysub_exact
+    >>> polysub_exact([1.0, 0.1 + 0.2, 1.0], [1.0, 0.3, 0.0])   # 0.1 + 0.2 - 0.3 is 5.6e-17
+    array([0., 0., 1.])
+    """
     a = np.asarray(a, float)
     b = np.asarray(b, float)
     n = max(len(a), len(b))
@@ -76,7 +97,14 @@ def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np
 
 
 def cancel_s(num: ArrayLike, den: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Cancel common factors ``s`` (trailing zero coefficients) of a ratio."""
+    """Cancel common factors ``s`` (trailing zero coefficients) of a ratio.
+
+    Examples
+    --------
+    >>> from motionhyst.lti import cancel_s
+    >>> cancel_s([1.0, 0.0], [1.0, 2.0, 0.0])               # s / (s^2 + 2 s) = 1 / (s + 2)
+    (array([1.]), array([1., 2.]))
+    """
     num, den = trim(num), trim(den)
     while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
         num, den = num[:-1], den[:-1]
@@ -91,6 +119,12 @@ def divide_s2(num: ArrayLike, den: ArrayLike, what: str
     ------
     ValueError
         If the result keeps a double pole at ``s = 0`` (`what` names the transfer).
+
+    Examples
+    --------
+    >>> from motionhyst.lti import divide_s2
+    >>> divide_s2([1.0, 0.0, 0.0], [1.0, 1.0], "r->e")      # s^2 / ((s + 1) s^2)
+    (array([1.]), array([1., 1.]))
     """
     num, den = cancel_s(num, np.polymul(den, [1.0, 0.0, 0.0]))
     if den[-1] == 0.0 and len(den) > 1 and den[-2] == 0.0:
@@ -117,7 +151,16 @@ def polyratio(num, den, omega):  # pragma: no cover - compiled
 
 @dataclass(frozen=True)
 class PolyTF:
-    """A SISO transfer function as coefficient arrays (highest power first)."""
+    """A SISO transfer function as coefficient arrays (highest power first).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.lti import PolyTF
+    >>> lowpass = PolyTF(np.array([1.0]), np.array([1.0, 1.0]))   # 1 / (s + 1)
+    >>> lowpass(np.array([0.0, 1.0]))
+    array([1. +0.j , 0.5-0.5j])
+    """
 
     num: NDArray[np.float64]
     den: NDArray[np.float64]
@@ -134,7 +177,15 @@ class PolyTF:
 
 # ------------------------------------------------------------------ state space
 def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
-    """State-space realisation ``(A, B, C, D)`` in scaled time ``omega0 t`` (conditioning)."""
+    """State-space realisation ``(A, B, C, D)`` in scaled time ``omega0 t`` (conditioning).
+
+    Examples
+    --------
+    >>> from motionhyst.lti import realize_scaled
+    >>> A, B, C, D = realize_scaled([1.0], [1.0, 100.0], 100.0)   # 1 / (s + 100), time 100 t
+    >>> float(A[0, 0]), float(B[0, 0] * C[0, 0])
+    (-1.0, 0.01)
+    """
     n = len(den) - 1
     # substitute s = omega0 * s_hat, then divide numerator and denominator by omega0^n
     num_h = np.asarray(num) * omega0 ** (np.arange(len(num) - 1, -1, -1.0) - n)
@@ -144,7 +195,16 @@ def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
 
 
 def stack(mats):
-    """Block-diagonal stack of single-input realisations sharing that input, one output each."""
+    """Block-diagonal stack of single-input realisations sharing that input, one output each.
+
+    Examples
+    --------
+    >>> from motionhyst.lti import realize_scaled, stack
+    >>> A, B, C, D = stack([realize_scaled([1.0], [1.0, 1.0], 1.0),
+    ...                     realize_scaled([2.0], [1.0, 2.0], 1.0)])   # one input, two outputs
+    >>> A.shape, B.shape, C.shape, D.shape
+    ((2, 2), (2, 1), (2, 2), (2, 1))
+    """
     n = sum(a.shape[0] for a, _, _, _ in mats)
     A = np.zeros((n, n))
     B = np.zeros((n, 1))
@@ -165,6 +225,15 @@ def discretize_foh(sys, h: float):
     """First-order-hold discretisation (input linear between samples) with step `h`.
 
     Returns contiguous ``Ad, Bd, Cd, Dd`` (2-D, as :func:`scipy.signal.cont2discrete`).
+
+    Examples
+    --------
+    >>> import control
+    >>> from motionhyst.lti import discretize_foh
+    >>> sys = control.ss(control.tf([1.0], [1.0, 1.0]))
+    >>> Ad, Bd, Cd, Dd = discretize_foh((sys.A, sys.B, sys.C, sys.D), 0.1)
+    >>> round(float(Ad[0, 0]), 6)                          # exp(-0.1)
+    0.904837
     """
     Ad, Bd, Cd, Dd, _ = cont2discrete(sys, h, method="foh")
     return (np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), np.ascontiguousarray(Cd),
@@ -246,6 +315,19 @@ def forced_response_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> 
     an input linear between samples), with the time loop compiled, so that it
     agrees with python-control to round-off; :class:`HoldFilter` is the
     filter for records (conditioned by a time scale, started in steady state).
+
+    Examples
+    --------
+    >>> import control
+    >>> import numpy as np
+    >>> from motionhyst.lti import forced_response_foh
+    >>> sys = control.tf([1.0], [1.0, 1.0])
+    >>> t = np.linspace(0.0, 5.0, 501)
+    >>> y = forced_response_foh(sys, t, np.ones_like(t))   # step response from rest
+    >>> bool(np.allclose(y, 1.0 - np.exp(-t), rtol=0, atol=1e-12))
+    True
+    >>> bool(np.allclose(y, control.forced_response(sys, t, np.ones_like(t)).outputs, atol=1e-14))
+    True
     """
     ss = control.ss(sys)
     A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
@@ -285,6 +367,19 @@ class HoldFilter:
         Sampling interval [s].
     omega0 : float
         Time scale [rad/s] used for conditioning (e.g. the cut-off).
+
+    Examples
+    --------
+    A 10 Hz first-order low-pass sampled at 1 kHz:
+
+    >>> import numpy as np
+    >>> from motionhyst.lti import HoldFilter
+    >>> wc = 2 * np.pi * 10.0
+    >>> lowpass = HoldFilter(zeros=[], poles=[-wc], gain=wc, dt=1e-3, omega0=wc)
+    >>> round(lowpass.dc_gain, 12)
+    1.0
+    >>> lowpass(np.full(5, 2.0))                           # starts in steady state: no transient
+    array([2., 2., 2., 2., 2.])
     """
 
     def __init__(self, zeros: ArrayLike, poles: ArrayLike, gain: float, dt: float,

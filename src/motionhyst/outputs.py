@@ -59,7 +59,21 @@ _MANIFEST_KIND = "motionhyst output folder"
 
 
 class OutputError(ValueError):
-    """An output that must not be written as asked: one line naming the path (exit 2)."""
+    """An output that must not be written as asked: one line naming the path (exit 2).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from motionhyst.outputs import OutputError, OutputFile
+    >>> path = Path(tempfile.mkdtemp()) / "run.csv"
+    >>> _ = path.write_text("time\\n")
+    >>> try:
+    ...     OutputFile(path)                               # exists, and no force=True
+    ... except OutputError as err:
+    ...     print(str(err).replace(str(path.parent), "DIR"))
+    DIR/run.csv exists; give --force to replace it
+    """
 
 
 def umask() -> int:
@@ -182,6 +196,19 @@ class OutputFile:
     OutputError
         One line: the target exists and `force` is false, is an input, is a
         folder or not a regular file, or its folder is a file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from motionhyst.outputs import OutputFile
+    >>> path = Path(tempfile.mkdtemp()) / "summary.txt"
+    >>> OutputFile(path).write_text("written atomically\\n")
+    >>> path.read_text()
+    'written atomically\\n'
+    >>> OutputFile(path, force=True).write_text("replaced\\n")   # an existing file needs force
+    >>> path.read_text()
+    'replaced\\n'
     """
 
     def __init__(self, path: str | os.PathLike, force: bool = False,

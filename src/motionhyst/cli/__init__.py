@@ -28,7 +28,15 @@ __all__ = ["COMMANDS", "EXIT_USAGE", "UsageError", "build_parser", "feedforward_
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``motionhyst`` command."""
+    """The argument parser of the ``motionhyst`` command.
+
+    Examples
+    --------
+    >>> from motionhyst.cli import build_parser
+    >>> args = build_parser().parse_args(["analyze", "--frequency", "5", "10"])
+    >>> args.command, args.frequency
+    ('analyze', [5.0, 10.0])
+    """
     p = Parser(prog="motionhyst", description="Hysteresis of dynamic links in motion control "
                "loops: describing functions, quasi-linear analysis, exact steady state.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -38,7 +46,23 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``motionhyst`` command; returns the exit code."""
+    """Entry point of the ``motionhyst`` command; returns the exit code.
+
+    Examples
+    --------
+    The ``motionhyst`` command, called from Python (the exit code is returned):
+
+    >>> from motionhyst.cli import main
+    >>> main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"])   # doctest: +ELLIPSIS
+    Describing function of the jenkins element, k = 20 N/m, fc = 0.05 N ...
+    A [m]  zeta [-]  Re D [N/m]  Im D [N/m]  |D| [N/m]  |D|/k0 [-]  angle D [deg]
+    -----  --------  ----------  ----------  ---------  ----------  -------------
+     0.01      0.25        3.91       4.775      6.171      0.3086          50.69
+    ...
+    0
+    >>> main(["df", "--k", "-20", "--fc", "0.05", "--amplitude", "0.01"])  # one line on stderr
+    2
+    """
     parser = build_parser()
     try:
         args = parser.parse_args(argv)

@@ -17,7 +17,16 @@ EXIT_USAGE = 2
 
 
 class UsageError(Exception):
-    """A user error: reported as one line, exit code 2."""
+    """A user error: reported as one line, exit code 2.
+
+    Examples
+    --------
+    >>> from motionhyst.cli import UsageError, main
+    >>> issubclass(UsageError, Exception)
+    True
+    >>> main(["identify", "no-such-record.csv"])           # reported as one line, exit code 2
+    2
+    """
 
 
 class Parser(argparse.ArgumentParser):

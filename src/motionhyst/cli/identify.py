@@ -51,6 +51,16 @@ def record_kind(path: str | Path, kind: str | None = None) -> str:
     ValueError
         One line naming the file: unreadable, empty, a header of neither kind,
         of both kinds without `kind`, or without the columns of `kind`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from motionhyst.cli import record_kind
+    >>> path = Path(tempfile.mkdtemp()) / "record.csv"
+    >>> _ = path.write_text("time,y1,u\\n0.0,0.0,0.0\\n")
+    >>> record_kind(path)
+    'closed-loop'
     """
     from motionhyst.csvdata import read_header
 
@@ -83,6 +93,15 @@ def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
     One element is written as ``model = "jenkins"`` with scalars, more as
     ``model = "maxwell-slip"`` with lists (as
     :meth:`motionhyst.identify.Identification.scenario_fragment`).
+
+    Examples
+    --------
+    >>> from motionhyst.cli import feedforward_fragment
+    >>> print(feedforward_fragment([10.0, 6.0], [0.01, 0.03]))
+    [feedforward]
+    type = "rigid-body"   # u_ff = M r'' + phi_hat(r)
+    hysteresis = { model = "maxwell-slip", k = [10.0, 6.0], fc = [0.01, 0.03] }
+    <BLANKLINE>
     """
     if len(k) == 1:
         table = (f'{{ model = "jenkins", k = {_toml_float(k[0])}, '

@@ -45,6 +45,12 @@ class Parameter:
         any further rule).
     many : bool
         A list of values (one per element of a parallel model).
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins
+    >>> [(p.name, p.unit, p.default) for p in Jenkins.parameters]
+    [('k', 'N/m', None), ('fc', 'N', None)]
     """
 
     name: str
@@ -97,6 +103,16 @@ def register(cls: _H) -> _H:
     ------
     ValueError
         If another class is registered under the same name.
+
+    Examples
+    --------
+    The registry that scenarios and the command line take their models from:
+
+    >>> from motionhyst.hysteresis import MODELS, Jenkins, register
+    >>> list(MODELS)[:2]
+    ['jenkins', 'maxwell-slip']
+    >>> register(Jenkins) is Jenkins                       # registering again is harmless
+    True
     """
     name = cls.name  # type: ignore[attr-defined]
     if MODELS.get(name, cls) is not cls:
@@ -112,6 +128,16 @@ def model_class(name: str) -> Any:
     ------
     ValueError
         One line naming the known models.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import model_class
+    >>> model_class("maxwell-slip")(k=[10.0, 6.0], fc=[0.01, 0.03])
+    MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03])
+    >>> model_class("coulomb")                             # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown link model 'coulomb'; known: jenkins, maxwell-slip, ...
     """
     try:
         return MODELS[name]

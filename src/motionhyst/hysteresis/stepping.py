@@ -54,6 +54,14 @@ class Stepping:
         States at rest.
     scale : float
         A force scale [N] of the link (its slip or saturation force), for tolerances.
+
+    Examples
+    --------
+    >>> from motionhyst import MaxwellSlip
+    >>> from motionhyst.hysteresis.stepping import STOP
+    >>> s = MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).time_stepping()
+    >>> bool((s.codes == STOP).all()), s.scale                # two stop operators, total slip force
+    (True, 0.04)
     """
 
     codes: NDArray[np.int64]
