@@ -54,6 +54,14 @@ def plot_analysis(analysis) -> Figure:
     frequencies, the crossover of eq. (21) and the exact crossover
     ``|E - 1| = 1``.  (:func:`motionhyst.plots.fig10_mismatch` draws the same on a dense grid
     from the loop.)
+
+    Examples
+    --------
+    >>> from motionhyst import analyze, default_scenario
+    >>> from motionhyst.figures import plot_analysis
+    >>> fig = plot_analysis(analyze(default_scenario().loop(), 0.01, [5.0, 10.0, 15.0]))
+    >>> type(fig).__name__                                 # save it with fig.savefig(...)
+    'Figure'
     """
     fig, (ax,) = _figure()
     f = np.array([p.frequency_hz for p in analysis.points])
@@ -76,7 +84,16 @@ def plot_analysis(analysis) -> Figure:
 
 def plot_steady_state(state) -> Figure:
     """One period of a :class:`~motionhyst.steady.SteadyState`: the error with and without
-    hysteresis."""
+    hysteresis.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario, periodic_steady_state
+    >>> from motionhyst.figures import plot_steady_state
+    >>> fig = plot_steady_state(periodic_steady_state(default_scenario().loop(), 0.01, 5.0))
+    >>> len(fig.axes) >= 1
+    True
+    """
     fig, (ax,) = _figure()
     ts = state.time_series()
     t_ms = ts["t"] * 1e3
@@ -97,6 +114,18 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
     `fit` is a :class:`motionhyst.frf_fit.FrfFit`.  The fitted ``P1`` and
     ``P2`` are drawn densely (so a resonance between measured lines shows),
     with the fitted modes' frequencies marked.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.figures import plot_frf_fit
+    >>> from motionhyst.frf_fit import ModalPlant, fit_frf
+    >>> from motionhyst.systems import TwoMassStage
+    >>> exact = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    >>> f = np.geomspace(1.0, 3000.0, 60)
+    >>> fig = plot_frf_fit(fit_frf(f, *exact.response(2 * np.pi * f)))
+    >>> len(fig.axes) >= 2                                 # magnitude and phase
+    True
     """
     f_data = fit.frequency_hz
     lo, hi = f_range if f_range is not None else (f_data.min() / 1.5, f_data.max() * 1.5)

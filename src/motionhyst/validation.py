@@ -20,7 +20,18 @@ __all__ = ["check_amplitudes", "check_finite", "check_positive"]
 
 
 def check_finite(name: str, value: float) -> float:
-    """Return `value` as float, raising ``ValueError`` unless it is a finite number."""
+    """Return `value` as float, raising ``ValueError`` unless it is a finite number.
+
+    Examples
+    --------
+    >>> from motionhyst.validation import check_finite
+    >>> check_finite("beta", "0.5")
+    0.5
+    >>> check_finite("beta", float("nan"))
+    Traceback (most recent call last):
+    ...
+    ValueError: beta must be finite, got nan
+    """
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -31,7 +42,18 @@ def check_finite(name: str, value: float) -> float:
 
 
 def check_positive(name: str, value: float) -> float:
-    """Return `value` as float, raising ``ValueError`` unless finite and > 0."""
+    """Return `value` as float, raising ``ValueError`` unless finite and > 0.
+
+    Examples
+    --------
+    >>> from motionhyst.validation import check_positive
+    >>> check_positive("k", 20)
+    20.0
+    >>> check_positive("k", -1.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: k must be finite and > 0, got -1.0
+    """
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -42,7 +64,14 @@ def check_positive(name: str, value: float) -> float:
 
 
 def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
-    """Return amplitudes as a float array, raising ``ValueError`` unless finite and >= 0."""
+    """Return amplitudes as a float array, raising ``ValueError`` unless finite and >= 0.
+
+    Examples
+    --------
+    >>> from motionhyst.validation import check_amplitudes
+    >>> check_amplitudes([0.0, 0.01])
+    array([0.  , 0.01])
+    """
     a = np.asarray(A, dtype=float)
     if not np.all(np.isfinite(a)) or np.any(a < 0):
         raise ValueError("amplitude must be finite and >= 0")
