@@ -172,3 +172,13 @@ def test_maxwell_slip_link_recovered_from_noise_free_records():
     for name, value in expected.items():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
     assert fit.hysteresis.to_dict()["model"] == "maxwell-slip"
+
+
+def test_free_exponent_of_the_benchmark_link_is_fixed_at_one():
+    # no ultimate force (beta*(gamma + delta) < 0) is admitted for nu = 1 only; the data
+    # cannot tell nu from 1, so it is fixed there and the rest refined again
+    fit = identify_io([_record(1536, 1)], nu=None, substeps=SUBSTEPS)
+    assert "nu" not in fit.estimates and fit.hysteresis.general["nu"] == 1.0
+    assert fit.not_identifiable["nu"].startswith("not distinguishable from 1")
+    for name, value in TRUE.items():
+        assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
