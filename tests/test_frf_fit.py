@@ -305,3 +305,76 @@ def test_cli_identify_closed_loop_runs_on_the_fitted_plant(capsys, tmp_path, exa
     assert main(["identify", str(tmp_path / "rec.csv"), "--scenario", toml]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and 'use = "data"' in err
+
+
+# ------------------------------------------------------------- use = "data"
+def test_raw_data_say_what_they_cannot_resolve(capsys, tmp_path, exact):
+    """use = "data": measured lines only; Pf2 below the noise is reported, not computed."""
+    import json
+
+    from motionhyst.cli import main
+    from motionhyst.scenario import Scenario
+    from motionhyst.systems import MeasuredPlant
+
+    write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
+    toml = frd_toml(tmp_path, 'use = "data"')
+    sc = Scenario.from_file(toml)
+    plant = sc.plant()
+    assert isinstance(plant, MeasuredPlant) and sc.plant_fit() is None
+    assert plant.resolution == pytest.approx(NOISE, rel=0.2)  # the data's scatter
+    high = float(LINES[45])  # 453 Hz: Pf2 / P2 = 0.6, resolved
+    res = analyze(sc.loop(), 0.01, [LINES[0], 5.0, high])
+    at_1hz, at_5hz, at_high = res.points
+    # 1 Hz is a line, but Pf2 / P2 = 2e-6 there: far below the 0.5 % noise
+    assert math.isnan(abs(at_1hz.value))
+    assert any("at 1 Hz: Pf2 = Pr - P2" in u and "resolution" in u for u in res.unresolved)
+    assert math.isnan(abs(at_5hz.value))
+    assert any("at 5 Hz: not a measured frequency" in u for u in res.unresolved)
+    # where the data resolve Pf2 they give E close to the exact stage's
+    ref = analyze(Loop(TABLE_I, sc.controller(), sc.hysteresis()), 0.01, [high]).points[0]
+    assert at_high.value == pytest.approx(ref.value, rel=0.05)
+    assert math.isnan(res.mismatch_crossover_hz) and math.isnan(res.mismatch_crossover_exact_hz)
+    assert res.margins.evaluated_on == "measured lines"
+    # JSON and text carry the list; steady state and time simulation refuse in one line
+    assert main(["analyze", toml, "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["unresolved"] and "plant_fit" not in d
+    assert main(["analyze", toml]) == 0
+    assert "Not resolved from the raw measured data" in capsys.readouterr().out
+    assert main(["steady", toml]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and 'use = \\"fit\\"' not in err and 'use = "fit"' in err
+    out = tmp_path / "run.csv"
+    assert main(["simulate", toml, "--time-series", str(out)]) == 2
+    assert capsys.readouterr().err.count("\n") == 1 and not out.exists()
+    with pytest.raises(ValueError, match="use = \"fit\""):
+        periodic_steady_state(sc.loop(), 0.01, 5.0)
+
+
+def test_noise_free_raw_data_resolve_everything_on_the_lines(tmp_path, exact):
+    from motionhyst.scenario import Scenario
+
+    write_frd(tmp_path / "p.csv", LINES, *measure(exact, noise=0.0))
+    sc = Scenario.from_file(frd_toml(tmp_path, 'use = "data"\nmass = 22.5'))
+    assert sc.plant().resolution < 1e-10
+    f = [float(LINES[0]), float(LINES[10]), float(LINES[20])]
+    res = analyze(sc.loop(), 0.01, f)
+    ref = analyze(Loop(TABLE_I, sc.controller(), sc.hysteresis()), 0.01, f)
+    assert [u for u in res.unresolved if u.startswith("E and")] == []
+    for p, q in zip(res.points, ref.points, strict=True):
+        assert abs(p.value - q.value) < 1e-6 * abs(q.value)
+
+
+def test_report_of_raw_data_lists_what_it_cannot_resolve(tmp_path, exact):
+    from motionhyst.report import reproduce
+    from motionhyst.scenario import Scenario
+
+    write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
+    sc = Scenario.from_file(frd_toml(tmp_path, 'use = "data"'))
+    summary = reproduce(sc, tmp_path / "out", quiet=True)
+    names = {p.name for p in (tmp_path / "out").iterdir()}
+    assert "fig10.png" in names and "fig11.png" not in names and "plant_fit.png" not in names
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert "raw measured frequency-response data" in md
+    assert "not a measured frequency" in md and "| crossover (eq. 21) | n/a |" in md
+    assert summary["simulate"]["points"] == []

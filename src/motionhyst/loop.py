@@ -157,7 +157,11 @@ class Loop:
         return self._poly[name].tf()
 
     def closed_loop_poles(self) -> NDArray[np.complex128]:
-        """Poles of ``1 + C P2`` (LTI loops only)."""
+        """Poles of ``1 + C P2`` (LTI loops only; ValueError for measured data)."""
+        if self._poly is None:
+            raise ValueError("closed-loop poles, the time simulation and the steady state need "
+                             "LTI plant and controller; a raw measured plant has none: fit it "
+                             '([plant] use = "fit")')
         if self._poles is None:
             self._poles = np.roots(self._poly["w->e"].den)
         return self._poles.copy()

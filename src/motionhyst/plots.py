@@ -15,15 +15,28 @@ from numpy.typing import ArrayLike
 from motionhyst.figures import LINEAR_COLOR, MODE2_COLOR, MODE3_COLOR, STYLE, _figure
 from motionhyst.hysteresis import Hysteresis, Jenkins
 from motionhyst.loop import Loop
-from motionhyst.quasilinear import QuasiLinearAnalysis, loop_mismatch, mismatch_asymptote
+from motionhyst.quasilinear import (
+    QuasiLinearAnalysis,
+    _resolved,
+    loop_mismatch,
+    mismatch_asymptote,
+)
 from motionhyst.steady import SteadyState
-from motionhyst.systems import TWO_PI, freqresp
+from motionhyst.systems import TWO_PI, MeasuredPlant, freqresp
 
 
 def _phase_deg(P) -> np.ndarray:
     """Unwrapped phase in degrees, starting in (-360, 0]."""
     ph = np.degrees(np.unwrap(np.angle(P)))
     return ph - 360.0 * np.ceil(ph[0] / 360.0)
+
+
+def _grid(loop: Loop, f_range, n: int) -> np.ndarray:
+    """`n` log-spaced frequencies in `f_range` [Hz]; for raw measured data its lines there."""
+    if isinstance(loop.plant, MeasuredPlant):
+        f = loop.plant.frequency_hz
+        return f[(f >= f_range[0]) & (f <= f_range[1])]
+    return np.geomspace(*_frequency_range(loop, f_range), n)
 
 
 def _frequency_range(loop: Loop, f_range):
@@ -288,7 +301,7 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
                     zetas, f, f_star(link.k, stage.M), fig.motionhyst_data, prefix="paper_")
         axes[0, 0].set_title("as in the paper: Table I stage, Jenkins kJ = 1e4 N/m, fc = 100 N",
                              fontsize=9)
-    f = np.geomspace(*_frequency_range(loop, f_range), 600)
+    f = _grid(loop, f_range, 600)
     w = TWO_PI * f
     _fig9_panel(axes[0, -1], axes[1, -1], freqresp(loop.P1, w), freqresp(loop.P2, w), el, zetas,
                 f, f_star_hz, fig.motionhyst_data)
@@ -307,13 +320,21 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
     """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
     fig, (ax,) = _figure()
-    f = np.geomspace(*_frequency_range(loop, f_range), 800)
+    f = _grid(loop, f_range, 800)
     E = loop_mismatch(loop, f, analysis.amplitude)
     w = TWO_PI * f
     Pr = 1.0 / (loop.M * (1j * w) ** 2)
-    Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - freqresp(loop.P2, w)
+    P2 = freqresp(loop.P2, w)
+    Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - P2
     Et = mismatch_asymptote(Pr, Pf2, analysis.D)
-    ax.loglog(f, np.abs(E), color="k", label="|E| = |e / e_hat|, eq. (18): quasi-linear mismatch")
+    if isinstance(loop.plant, MeasuredPlant):  # raw data: only the lines that resolve Pf2
+        ok = _resolved(loop.plant, P2, Pf2)
+        ax.loglog(f[~ok], np.abs(E[~ok]), "x", color="0.6", ms=4,
+                  label="measured lines where Pf2 = Pr - P2 is not resolved (noise)")
+        E, Et = np.where(ok, E, np.nan), np.where(ok, Et, np.nan)
+    style = "-o" if isinstance(loop.plant, MeasuredPlant) else "-"  # data: the measured lines
+    ax.loglog(f, np.abs(E), style, ms=2, color="k",
+              label="|E| = |e / e_hat|, eq. (18): quasi-linear mismatch")
     ax.loglog(f, np.abs(Et), "--", color="tab:red",
               label="|E~| = |Pr^2 D / Pf2|, eq. (20): low-frequency asymptote")
     if exact:

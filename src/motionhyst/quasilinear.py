@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 
 from motionhyst.loop import Loop
 from motionhyst.margins import LoopMargins, loop_margins
-from motionhyst.systems import TWO_PI, TwoMassStage, freqresp
+from motionhyst.systems import TWO_PI, MeasuredPlant, TwoMassStage, freqresp
 from motionhyst.textfmt import g, table
 
 
@@ -125,6 +125,11 @@ class QuasiLinearAnalysis:
     margins : LoopMargins or None
         Gain, phase and modulus margins of the linear loop ``C P2``
         (:func:`motionhyst.margins.loop_margins`).
+    unresolved : list of str
+        For raw measured data (``use = "data"``), the quantities the data
+        cannot give and why (they are nan): frequencies that are not measured
+        lines, lines where ``Pf2 = Pr - P2`` is below the data's resolution,
+        eq. (21).  Empty for a model.
 
     Examples
     --------
@@ -153,6 +158,7 @@ class QuasiLinearAnalysis:
     amplitude_mode: str = "reference"
     df_frequency_hz: float | None = None
     margins: LoopMargins | None = None
+    unresolved: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``analyze --json`` schema)."""
@@ -172,6 +178,7 @@ class QuasiLinearAnalysis:
             "mismatch_crossover_hz": self.mismatch_crossover_hz,
             "mismatch_crossover_exact_hz": self.mismatch_crossover_exact_hz,
             "mismatch": [p.to_dict() for p in self.points],
+            "unresolved": list(self.unresolved),
         }
 
     def __str__(self) -> str:
@@ -197,6 +204,10 @@ class QuasiLinearAnalysis:
                 for p in d["mismatch"]]
         lines.append(table(["f [Hz]", "|E| [-]", "|E| [dB]", "angle E [deg]", "|E~| (eq. 20)",
                             "A_y1 [m]"], rows))
+        if self.unresolved:
+            lines += ["", "Not resolved from the raw measured data (nan above; fit the data "
+                      'with [plant] use = "fit" to get them):']
+            lines += [f"  - {u}" for u in self.unresolved]
         return "\n".join(lines)
 
     def plot(self):
@@ -417,16 +428,78 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     q = _stiffness_over_masses(loop.plant)
     crossover = (float("nan") if q is None
                  else _crossover_estimate(q, hyst, amplitude, D_ref))
+    margins = loop_margins(loop.controller, loop.P2)
+    unresolved: list[str] = []
+    if isinstance(loop.plant, MeasuredPlant):
+        E, Et, amps = E.copy(), Et.copy(), amps.copy()
+        unresolved = _measured_limits(loop.plant, f, P2, Pf2, E, Et, amps)
+        crossover_exact, why = _crossover_exact_on_lines(loop, amplitude)
+        unresolved += [why] if why else []
+        unresolved.append("eq. (21): needs Pf2(0) from a model of the plant "
+                          '([plant] use = "fit")')
+        bandwidth_hz = margins.bandwidth_hz
+    else:
+        crossover_exact = mismatch_crossover_exact(loop, amplitude)
+        bandwidth_hz = loop.bandwidth_hz()
     points = [MismatchPoint(float(fi), complex(e), complex(et), float(z), float(a), complex(d))
               for fi, e, et, z, a, d in zip(f, E, Et, np.broadcast_to(zetas, f.shape), amps,
                                             np.broadcast_to(D_pts, f.shape), strict=True)]
     return QuasiLinearAnalysis(
         amplitude=float(amplitude), zeta=zeta_ref, D=D_ref, k_link=k_link,
-        f_star_hz=f_star(k_link, loop.M), bandwidth_hz=loop.bandwidth_hz(),
-        margins=loop_margins(loop.controller, loop.P2),
-        mismatch_crossover_hz=crossover,
-        mismatch_crossover_exact_hz=mismatch_crossover_exact(loop, amplitude),
-        points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df)
+        f_star_hz=f_star(k_link, loop.M), bandwidth_hz=bandwidth_hz, margins=margins,
+        mismatch_crossover_hz=crossover, mismatch_crossover_exact_hz=crossover_exact,
+        points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df,
+        unresolved=unresolved)
+
+
+#: ``Pf2 = Pr - P2`` counts as resolved by data where ``|Pf2| / |P2|`` exceeds this many times
+#: the data's relative scatter (three standard deviations).
+RESOLUTION_FACTOR = 3.0
+
+
+def _resolved(plant: MeasuredPlant, P2, Pf2) -> NDArray[np.bool_]:
+    """Where ``|Pf2| / |P2|`` exceeds 3 x the data's resolution (everywhere if it is unknown)."""
+    ratio = np.abs(Pf2) / np.abs(P2)
+    if plant.resolution is None:
+        return np.ones_like(ratio, bool)
+    return ratio > RESOLUTION_FACTOR * plant.resolution
+
+
+def _measured_limits(plant: MeasuredPlant, f, P2, Pf2, E, Et, amps) -> list[str]:
+    """Blank (nan) the mismatch where raw data cannot give it; say why, per frequency."""
+    out = []
+    ok = _resolved(plant, P2, Pf2)
+    lines = plant.frequency_hz
+    for i, fi in enumerate(f):
+        if plant.measured_line(fi) is None:
+            near = lines[np.argmin(np.abs(lines - fi))]
+            out.append(f"E and E~ at {fi:g} Hz: not a measured frequency (nearest line "
+                       f"{near:.4g} Hz); raw data are evaluated at the measured lines only")
+        elif not ok[i]:
+            out.append(f"E and E~ at {fi:g} Hz: Pf2 = Pr - P2 is {abs(Pf2[i] / P2[i]):.2g} of "
+                       f"P2, not above 3 x the data's resolution {plant.resolution:.2g}")
+        else:
+            continue
+        E[i] = Et[i] = amps[i] = np.nan
+    return out
+
+
+def _crossover_exact_on_lines(loop: Loop, amplitude: float) -> tuple[float, str]:
+    """``|E - 1| = 1`` from the measured lines (log-linear between the two that bracket it)."""
+    plant = loop.plant
+    f = plant.frequency_hz
+    g = np.log(np.abs(loop_mismatch(loop, f, amplitude) - 1.0))
+    idx = np.nonzero((g[:-1] > 0) & (g[1:] <= 0))[0]
+    if idx.size == 0:
+        return float("nan"), ""
+    i = int(idx[0])
+    _, _, P2, _, Pf2 = _parts(loop, TWO_PI * f[i:i + 2])
+    if not np.all(_resolved(plant, P2, Pf2)):
+        return float("nan"), (f"exact crossover |E - 1| = 1: between the lines {f[i]:.4g} and "
+                              f"{f[i + 1]:.4g} Hz Pf2 = Pr - P2 is not above 3 x the data's "
+                              f"resolution {plant.resolution:.2g}")
+    t = g[i] / (g[i] - g[i + 1])
+    return float(np.exp(np.log(f[i]) + t * np.log(f[i + 1] / f[i]))), ""
 
 
 #: Fixed-point iterations of eq. (21) for a rate-dependent element (each one evaluation of D).

@@ -112,9 +112,11 @@ def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
              "df_phase_deg": " deg"}
     at = "" if a.get("df_frequency_hz") is None else f" (at {_fmt(a['df_frequency_hz'])} Hz)"
     for key, (paper, label) in PAPER_VALUES.items():
-        val = _fmt(a[key]) + units.get(key, "") + (at if key.startswith("df_") else "")
+        val = _fmt(a[key])
+        val += "" if val == "n/a" else units.get(key, "") + (at if key.startswith("df_") else "")
         lines.append(f"| {label} | {paper} | {val} |" if is_paper else f"| {label} | {val} |")
-    exact = _fmt(a["mismatch_crossover_exact_hz"]) + " Hz"
+    exact = _fmt(a["mismatch_crossover_exact_hz"])
+    exact += "" if exact == "n/a" else " Hz"
     lines.append(f"| {EXACT_CROSSOVER_LABEL} | - | {exact} |" if is_paper
                  else f"| {EXACT_CROSSOVER_LABEL} | {exact} |")
     for key, label, unit, fkey in MARGIN_ROWS:
@@ -130,10 +132,11 @@ def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
                   "The measured plant is fitted to a rigid body plus flexible modes "
                   "(`motionhyst.frf_fit`); every number and figure of this report comes from "
                   "the fitted model.", "", "```", str(sc.plant_fit()), "```"]
-    lines += ["", "Mismatch at the reference frequencies: describing function (eq. 18) against "
-              "the exact periodic steady state of the nonlinear loop.", "",
-              "| f [Hz] | \\|E\\| eq. (18) | angle [deg] | \\|E\\| exact | angle [deg] | "
-              "\\|e1\\| [m] | \\|e3\\| [m] | peak e [m] |", "|---|---|---|---|---|---|---|---|"]
+    if summary["simulate"]["points"]:
+        lines += ["", "Mismatch at the reference frequencies: describing function (eq. 18) "
+                  "against the exact periodic steady state of the nonlinear loop.", "",
+                  "| f [Hz] | \\|E\\| eq. (18) | angle [deg] | \\|E\\| exact | angle [deg] | "
+                  "\\|e1\\| [m] | \\|e3\\| [m] | peak e [m] |", "|---|---|---|---|---|---|---|---|"]
     for p in summary["simulate"]["points"]:
         h = {x["n"]: x["abs"] for x in p["error_harmonics"]}
         lines.append(f"| {_fmt(p['frequency_hz'])} | {_fmt(p['mismatch_df_abs'])} | "
@@ -167,14 +170,18 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         steps = tqdm(total=10, desc="reproduce", disable=not show, file=sys.stderr, leave=False)
         analysis = analyze(loop, A, freqs)
         steps.update()
-        states = [periodic_steady_state(loop, A, f) for f in freqs]
-        E_df = loop_mismatch(loop, freqs, A)
-        H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
-        steps.update()
-        lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
-        f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
-        f_exact = np.unique(np.concatenate([f_exact, freqs]))
-        exact = [periodic_steady_state(loop, A, f) for f in f_exact]
+        raw_data = isinstance(loop.plant, MeasuredPlant)
+        if raw_data:  # the steady state needs the plant at every harmonic: no exact results
+            states, E_df, H_df, exact = [], [], [], []
+        else:
+            states = [periodic_steady_state(loop, A, f) for f in freqs]
+            E_df = loop_mismatch(loop, freqs, A)
+            H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
+            steps.update()
+            lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
+            f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
+            f_exact = np.unique(np.concatenate([f_exact, freqs]))
+            exact = [periodic_steady_state(loop, A, f) for f in f_exact]
         steps.update()
         summary = {
             "scenario": sc.to_dict(),
@@ -204,10 +211,14 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                          f"the scenario's link is a {el.name} model, so they are not drawn. "
                          f"Figs. 5 and 8 show its loops and describing function{at}, with "
                          f"zeta = fc / (k A) from its total slip force and initial stiffness.")
-        if isinstance(loop.plant, MeasuredPlant):
-            notes.append("The plant is measured frequency-response data (use = \"data\"): "
-                         "eq. (21) needs a model and is not computed; frequency plots are "
-                         "limited to the measured range.")
+        if raw_data:
+            del figs["fig11"]
+            notes.append("The plant is raw measured frequency-response data (use = \"data\"): "
+                         "only the measured lines are evaluated; eq. (21) and the exact steady "
+                         "state (the mismatch table's exact columns, Fig. 10's circles, Fig. 11) "
+                         "need a model and are not computed. Quantities the data cannot resolve "
+                         "are listed below and are n/a.")
+            notes += analysis.unresolved
         written = save_figures(figs, tmp, ("png", "pdf"), done=lambda _: steps.update())
         (tmp / "summary.json").write_text(dumps(summary))
         _write_report(tmp / "report.md", sc, summary, written, is_paper, notes)

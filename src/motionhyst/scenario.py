@@ -9,6 +9,7 @@ naming the file, the key and the problem.
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -491,8 +492,13 @@ class Scenario:
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
         if m.plant.use == "data":
-            self._plant = data
-            return data
+            # the data's resolution: their scatter around the rigid body + modes fit
+            try:
+                scatter = fit_measured_plant(data, mass=m.plant.mass).rms_relative_error
+            except ValueError:
+                scatter = None
+            self._plant = dataclasses.replace(data, resolution=scatter)
+            return self._plant
         try:
             self._fit = fit_measured_plant(data, modes=m.plant.modes, mass=m.plant.mass)
         except ValueError as exc:

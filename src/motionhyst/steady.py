@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
-from motionhyst.systems import TWO_PI
+from motionhyst.systems import TWO_PI, MeasuredPlant
 from motionhyst.textfmt import g, table
 
 MIN_HARMONICS = 32
@@ -226,7 +226,9 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     Raises
     ------
     ValueError
-        For a non-positive or non-finite amplitude or frequency.
+        For a non-positive or non-finite amplitude or frequency, or a raw
+        measured plant (``[plant] use = "data"``): the steady state needs the
+        plant at every harmonic ``n f``, which measured lines do not give.
     RuntimeError
         If the fixed point does not converge (a link too stiff for the loop).
 
@@ -245,6 +247,9 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     for name, v in (("amplitude", amplitude), ("frequency", frequency_hz)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+    if isinstance(loop.plant, MeasuredPlant):
+        raise ValueError("the steady state needs the plant at every harmonic n f, which raw "
+                         "measured lines do not give; fit the data ([plant] use = \"fit\")")
     H = int(n_harmonics) if n_harmonics is not None else default_harmonics(loop, frequency_hz)
     if H < 1:
         raise ValueError("n_harmonics must be >= 1")

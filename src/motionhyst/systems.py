@@ -233,6 +233,10 @@ class MeasuredPlant:
         Rigid-body mass [kg] of the feedforward ``M s^2``.
     source : str
         Where the data came from.
+    resolution : float or None
+        Relative scatter of the data (RMS of ``|P - P_smooth| / |P|``), the
+        smallest relative difference the data resolve; None if unknown.
+        ``Pf2 = Pr - P2`` is resolved only where ``|Pf2| / |P2|`` exceeds it.
 
     Examples
     --------
@@ -251,6 +255,18 @@ class MeasuredPlant:
     P2: control.FrequencyResponseData
     M: float
     source: str = ""
+    resolution: float | None = None
+
+    @property
+    def frequency_hz(self) -> NDArray[np.float64]:
+        """The measured frequencies [Hz]."""
+        return np.asarray(self.P2.omega, dtype=float) / TWO_PI
+
+    def measured_line(self, frequency_hz: float, rtol: float = 1e-9) -> float | None:
+        """The measured frequency equal to `frequency_hz` (to `rtol`), else None."""
+        f = self.frequency_hz
+        i = int(np.argmin(np.abs(f - frequency_hz)))
+        return float(f[i]) if abs(f[i] - frequency_hz) <= rtol * frequency_hz else None
 
     @property
     def Pr(self) -> control.TransferFunction:
