@@ -167,8 +167,8 @@ def test_maxwell_slip_link_recovered_from_noise_free_records():
     t = np.arange(n) / FS
     y = true.simulate(t, u, substeps=10).displacement
     fit = identify_io([IORecord(t, u, y)], "maxwell-slip", n_elements=2, substeps=10)
-    expected = {"m": 2.0, "c": 10.0, "k": 5e4, "k[0]": 2e4, "k[1]": 3e4, "fc[0]": 4.0,
-                "fc[1]": 15.0}
+    expected = {"m": 2.0, "c": 10.0, "k": 5e4, "link.k[0]": 2e4, "link.k[1]": 3e4,
+                "link.fc[0]": 4.0, "link.fc[1]": 15.0}
     for name, value in expected.items():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
     assert fit.hysteresis.to_dict()["model"] == "maxwell-slip"
@@ -182,3 +182,19 @@ def test_free_exponent_of_the_benchmark_link_is_fixed_at_one():
     assert fit.not_identifiable["nu"].startswith("not distinguishable from 1")
     for name, value in TRUE.items():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
+
+
+def test_inseparable_parameters_are_reported_not_given_huge_errors():
+    from motionhyst.identify_io import _uncertainty, _undetermined_notes
+
+    rng = np.random.default_rng(8)
+    a, b = rng.standard_normal(200), rng.standard_normal(200)
+    J = np.column_stack([a, b, 3.0 * b, np.zeros(200)])  # b, 3b: only b + 3c counts
+    std, groups = _uncertainty(J, rss=2.0, n_rows=200)
+    assert sorted(map(sorted, groups)) == [[1, 2], [3]]
+    assert np.isfinite(std[0]) and np.all(np.isnan(std[1:]))
+    notes = _undetermined_notes(["m", "k", "link.k", "fc"], groups, 1e-8)
+    assert notes["k"].startswith("not determined by these records: only a combination with "
+                                 "link.k is")
+    assert "no effect on the output" in notes["fc"]
+    assert "m" not in notes

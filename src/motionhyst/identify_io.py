@@ -32,9 +32,10 @@ Method
    evaluations.
 4. Standard errors ``sqrt(diag(sigma^2 (J^T J)^-1))``, ``sigma^2 = RSS/(N - p)``,
    from the scaled Jacobian's singular values: a direction whose singular
-   value is below ``1e-8`` of the largest is not determined by the data; its
-   parameters are reported as not identifiable (never as a huge standard
-   error) and the rest from the pseudo-inverse.
+   value is below ``1e-8`` of the largest (``1e-5`` for a finite-difference
+   Jacobian) is not determined by the data; its parameters are reported as
+   not identifiable, with the others they combine with (never as a huge
+   standard error), and the rest from the pseudo-inverse.
 
 The benchmark's Bouc-Wen parameters ``beta, gamma, delta`` enter the model only
 as ``beta*gamma`` and ``beta*delta`` (``z`` is not measured and ``beta`` always
@@ -69,6 +70,7 @@ from motionhyst.openloop import (
 MIN_SAMPLES = 64
 MODELS = ("bouc-wen", "maxwell-slip", "jenkins", "dahl")
 SINGULAR_RTOL = 1e-8
+FD_SINGULAR_RTOL = 1e-5  # finite-difference Jacobians (step 1e-6) are no more exact than this
 
 
 @dataclass
@@ -335,23 +337,45 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
     return sol
 
 
-def _uncertainty(J: NDArray[np.float64], rss: float, n_rows: int
-                 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Standard errors of the (scaled) parameters and a mask of the undetermined ones."""
+def _uncertainty(J: NDArray[np.float64], rss: float, n_rows: int,
+                 rtol: float = SINGULAR_RTOL
+                 ) -> tuple[NDArray[np.float64], list[list[int]]]:
+    """Standard errors of the parameters and the groups the data cannot separate.
+
+    The columns of `J` are normalised; a right singular vector whose singular
+    value is below `rtol` of the largest is a direction the data do not
+    determine, and the parameters with a component above 1e-3 in it form a
+    group (only other combinations of them are determined).  Their standard
+    errors are NaN; the others come from the pseudo-inverse.
+    """
     norms = np.linalg.norm(J, axis=0)
     norms[norms == 0] = 1.0
     Jn = J / norms
     _, sv, vt = np.linalg.svd(Jn, full_matrices=False)
     p = J.shape[1]
     sigma2 = rss / max(n_rows - p, 1)
-    good = sv > SINGULAR_RTOL * sv[0]
-    undetermined = np.zeros(p, dtype=bool)
-    for i in np.nonzero(~good)[0]:
-        undetermined |= np.abs(vt[i]) > 1e-3
+    good = sv > rtol * sv[0]
+    groups = [list(np.nonzero(np.abs(vt[i]) > 1e-3)[0]) for i in np.nonzero(~good)[0]]
     cov = (vt[good].T / sv[good] ** 2) @ vt[good]
     std = np.sqrt(sigma2 * np.diag(cov)) / norms
-    std[undetermined] = np.nan
-    return std, undetermined
+    for g in groups:
+        std[g] = np.nan
+    return std, groups
+
+
+def _undetermined_notes(names: list[str], groups: list[list[int]], rtol: float
+                        ) -> dict[str, str]:
+    notes: dict[str, str] = {}
+    for g in groups:
+        members = [names[i] for i in g]
+        for i in g:
+            others = [m for m in members if m != names[i]]
+            what = (f"only a combination with {', '.join(others)} is" if others
+                    else "it has no effect on the output")
+            notes[names[i]] = (f"not determined by these records: {what} (a direction of "
+                               f"the Jacobian with a singular value below {rtol:g} of the "
+                               f"largest)")
+    return notes
 
 
 def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
@@ -466,7 +490,7 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         res *= y_scale
         J = jac[:, free] * y_scale
         rss = float(res @ res)
-        std_q, undetermined = _uncertainty(J, rss, res.size)
+        std_q, groups = _uncertainty(J, rss, res.size)
         if not free[6] or p[4] + p[5] >= 0.0:
             break
         # no ultimate force (beta*(gamma + delta) < 0) is admitted for nu = 1 only: when
@@ -487,11 +511,9 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     not_ident = {"beta": "only the products beta*gamma and beta*delta enter the model "
                          "(z is not measured); beta is fixed by |gamma| + |delta| = 1",
                  "gamma": "see beta", "delta": "see beta", **notes}
-    for n, s, bad in zip(free_names, std_q, undetermined, strict=True):
-        std[n] = None if bad or not math.isfinite(s) else float(s)
-        if bad:
-            not_ident[n] = "not determined by these records (a direction of the Jacobian " \
-                           "with a singular value below 1e-8 of the largest)"
+    for n, s in zip(free_names, std_q, strict=True):
+        std[n] = float(s) if math.isfinite(s) else None
+    not_ident.update(_undetermined_notes(free_names, groups, SINGULAR_RTOL))
     plant = MassSpringDamper(p[0], max(p[1], 0.0), max(p[2], 0.0))
     link = _bouc_wen_link(p[3], p[4], p[5], p[6])
     per_record = _per_record(records, res)
@@ -549,9 +571,12 @@ def _link_from(model: str, v: NDArray[np.float64], n: int) -> Hysteresis:
 
 
 def _link_names(model: str, n: int) -> list[str]:
+    """Names of the link's estimates, ``link.`` before the model's parameter names."""
     if model == "maxwell-slip":
-        return [f"k[{i}]" for i in range(n)] + [f"fc[{i}]" for i in range(n)]
-    return ["k", "fc"] if model == "jenkins" else ["k", "fc", "alpha"]
+        names = [f"k[{i}]" for i in range(n)] + [f"fc[{i}]" for i in range(n)]
+    else:
+        names = ["k", "fc"] if model == "jenkins" else ["k", "fc", "alpha"]
+    return [f"link.{name}" for name in names]
 
 
 def _link_start(model: str, k_link: float, y_scale: float, n: int) -> NDArray[np.float64]:
@@ -623,16 +648,14 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)
     J = sol.jac * y_scale / v  # d residual / d parameter
-    std_v, undetermined = _uncertainty(J, rss, res.size)
+    std_v, groups = _uncertainty(J, rss, res.size, FD_SINGULAR_RTOL)
     names = ["m", "c", "k", *_link_names(model, n)]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
     not_ident: dict[str, str] = {}
-    for nm, sd, bad in zip(names, std_v, undetermined, strict=True):
-        std[nm] = None if bad or not math.isfinite(sd) else float(sd)
-        if bad:
-            not_ident[nm] = ("not determined by these records (a direction of the Jacobian "
-                             "with a singular value below 1e-8 of the largest)")
+    for nm, sd in zip(names, std_v, strict=True):
+        std[nm] = float(sd) if math.isfinite(sd) else None
+    not_ident.update(_undetermined_notes(names, groups, FD_SINGULAR_RTOL))
     return IOIdentification(
         plant=MassSpringDamper(v[0], v[1], v[2]), hysteresis=_link_from(model, v[3:], n),
         estimates=estimates, std=std, not_identifiable=not_ident,
