@@ -26,7 +26,9 @@ from typing import TYPE_CHECKING
 __version__ = "0.1.0"
 
 _EXPORTS = {
+    "motionhyst.frf_fit": ("FrfFit", "ModalPlant", "fit_frf"),
     "motionhyst.hysteresis": ("BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellSlip"),
+    "motionhyst.margins": ("LoopMargins", "loop_margins"),
     "motionhyst.loop": ("Loop",),
     "motionhyst.quasilinear": ("QuasiLinearAnalysis", "analyze"),
     "motionhyst.references": ("PointToPoint", "SampledReference", "SineReference",
@@ -39,17 +41,20 @@ _EXPORTS = {
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = [
-    "BoucWen", "Dahl", "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "LuGre", "MaxwellSlip",
-    "MeasuredPlant", "PointToPoint",
+    "BoucWen", "Dahl", "FrfFit", "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "LoopMargins",
+    "LuGre", "MaxwellSlip", "MeasuredPlant", "ModalPlant", "PointToPoint",
     "QuasiLinearAnalysis", "SampledReference", "Scenario", "ScenarioError", "Simulation",
     "SineReference", "SteadyState", "TwoMassStage", "analyze",
-    "default_scenario", "load_frd_plant", "load_reference_csv", "load_scenario",
+    "default_scenario", "fit_frf", "load_frd_plant", "load_reference_csv", "load_scenario",
+    "loop_margins",
     "periodic_steady_state", "simulate", "steady_state_sweep",
 ]
 
 if TYPE_CHECKING:
+    from motionhyst.frf_fit import FrfFit, ModalPlant, fit_frf
     from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
     from motionhyst.loop import Loop
+    from motionhyst.margins import LoopMargins, loop_margins
     from motionhyst.quasilinear import QuasiLinearAnalysis, analyze
     from motionhyst.references import (
         PointToPoint,

@@ -411,6 +411,20 @@ class FrfFit:
         RMS of ``|P_model - P_data| / |P_data|`` over both transfers.
     mass_given : bool
         True when ``M`` was fixed by the user.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import ModalPlant, TwoMassStage, fit_frf
+    >>> stage = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    >>> f = np.geomspace(1.0, 3000.0, 60)
+    >>> fit = fit_frf(f, *stage.response(2 * np.pi * f), source="stage.csv")
+    >>> [b["lines"] for b in fit.bands()]                  # lines per decade band
+    [17, 17, 17, 9]
+    >>> print(str(fit).splitlines()[0])
+    Fit of stage.csv: rigid body + 1 mode(s), 60 lines 1-3000 Hz (modes chosen by the BIC, ...)
+    >>> sorted(fit.to_dict())[:3]
+    ['M', 'M_std', 'bands']
     """
 
     plant: ModalPlant

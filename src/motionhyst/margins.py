@@ -63,6 +63,16 @@ class LoopMargins:
         Lowest frequency where ``|L|`` falls through 1 [Hz].
     evaluated_on : str
         ``"model"`` (dense grid, refined) or ``"measured lines"``.
+
+    Examples
+    --------
+    >>> from motionhyst import LeadLagLowpass, TwoMassStage, loop_margins
+    >>> m = loop_margins(LeadLagLowpass(6.2e6, 60.0, 240.0, 700.0, 0.6),
+    ...                  TwoMassStage(5.0, 17.5, 90.0, 7.4e7).P2)
+    >>> round(m.gain_margin_db, 2), round(m.gain_margin_hz, 1)
+    (9.07, 273.0)
+    >>> print(str(m).splitlines()[1])
+      phase margin                   24.83 deg at 120.6 Hz
     """
 
     gain_margin: float
