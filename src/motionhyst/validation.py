@@ -1,4 +1,4 @@
-"""Checks of user-given numbers, shared by every model and system: one-line ``ValueError``s
+"""Checks of user-given numbers, shared by every model and system: one-line ``ValueError`` messages
 naming the parameter.
 
 Examples
