@@ -54,6 +54,7 @@ html_theme_options = {
     "show_toc_level": 2,
 }
 html_static_path: list[str] = []
+html_sidebars = {"equations": [], "index": [], "examples/index": []}  # pages without sections
 
 
 
