@@ -378,3 +378,16 @@ def test_report_of_raw_data_lists_what_it_cannot_resolve(tmp_path, exact):
     assert "raw measured frequency-response data" in md
     assert "not a measured frequency" in md and "| crossover (eq. 21) | n/a |" in md
     assert summary["simulate"]["points"] == []
+
+
+def test_scan_runs_on_the_fitted_plant(noisy_fit, controller, link):
+    """The scan metrics (MA of a slipping link) on the fitted stage equal the exact stage's."""
+    from motionhyst.profiles import scan
+    from motionhyst.scan import run_scan
+
+    p = scan(0.01, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)
+    fitted = run_scan(Loop(noisy_fit.plant, controller, link), p, window=0.02, tail=0.0)
+    exact = run_scan(Loop(TABLE_I, controller, link), p, window=0.02, tail=0.0)
+    a, b = fitted.run("none"), exact.run("none")
+    assert a.ma_max == pytest.approx(b.ma_max, rel=0.02)
+    assert a.ma_max == pytest.approx(0.05 / 6.2e6, rel=0.02)  # e = fc / C(0) while slipping
