@@ -317,7 +317,7 @@ def test_half_half_describing_function_within_1e_10(r):
     assert abs(D - ref) <= 1e-10 * abs(ref), abs(D - ref) / abs(ref)
 
 
-# measured errors: 1.2e-11, 8e-13, 2.8e-11, 1.5e-11 of |W_1| (1.8e-8 to 5.7e-8 without the
+# measured errors: 1.2e-11, 5e-11, 2.8e-11, 1.5e-11 of |W_1| (1.8e-8 to 8e-8 without the
 # correction at the same sample count); for n = 1.5, whose |z|^1.5 at z = 0 is not corrected,
 # 1.4e-10 (3.6e-9 with the count and method before the correction)
 @pytest.mark.parametrize(("p", "r", "rtol"), [((1.0, 0.5, 0.5), 50.0, 1e-10),

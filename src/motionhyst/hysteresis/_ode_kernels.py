@@ -236,7 +236,7 @@ def bouc_wen_step(z, du, n, ap, am, hmax, t, wq):  # pragma: no cover - compiled
     :class:`~motionhyst.hysteresis.BoucWen`), `hmax` the RK4 sub-step
     (``BoucWen._step()``, unused for ``n = 1``) and ``t, wq`` the
     Gauss-Legendre rule :data:`GL_T`, :data:`GL_W`.  Exact for ``n = 1``
-    (``ap`` of any sign), RK4 to about 1e-10 otherwise.  The derivative of
+    (``ap`` of any sign) and ``n = 2``, RK4 to about 1e-10 otherwise.  The derivative of
     the new state with respect to `du` is the right-hand side at the new state,
     ``1 - (beta sign(du z) + gamma) |z|^n``.
     """

@@ -35,7 +35,7 @@ from motionhyst.hysteresis.stepping import BOUC_WEN, Stepping
 from motionhyst.validation import check_finite
 
 #: least samples per period of the corrected periodic output (:meth:`BoucWen.default_samples`)
-MIN_SAMPLES_CORRECTED = 2048
+MIN_SAMPLES_CORRECTED = 1024
 
 
 def _check_shape(n: float, beta: float, gamma: float, names: tuple[str, str, str]) -> None:
@@ -327,7 +327,7 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
 
         An even FFT-friendly size (:func:`scipy.fft.next_fast_len`) with at
         least 4 samples per input harmonic (as the stop operator's exact
-        harmonics), 4 per output harmonic, 2048, and ``700 (k A / fc)^(1/3)``:
+        harmonics), 4 per output harmonic, 1024, and ``700 (k A / fc)^(1/3)``:
         with the aliasing of the jumps of ``w''`` and ``w'''`` subtracted
         (:func:`~motionhyst.hysteresis._ode_kernels.alias_of_jumps`) the
         harmonics' remaining error is that of the jumps of higher derivatives,
