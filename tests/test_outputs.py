@@ -66,6 +66,8 @@ def test_an_input_is_never_overwritten_even_with_force(tmp_path, monkeypatch):
         with pytest.raises(OutputError, match="it is an input of this command"):
             OutputFile(target, force=True, inputs=[None, src])
     assert src.read_text() == "input"
+    with pytest.raises(OutputError, match="it is an input"):  # one path, not a list
+        OutputFile(tmp_path / "hard.toml", force=True, inputs=str(src))
 
 
 def test_symlink_target_is_followed_and_kept(tmp_path):
@@ -164,10 +166,9 @@ NAMES = ["report.md", "summary.json", "fig5.png"]
 
 
 def _run(folder, names=NAMES, force=False, content="v1"):
-    out = OutputFolder(folder, names, force=force)
-    for name in names:
-        out.write_text(name, f"{content} {name}")
-    out.finish()
+    with OutputFolder(folder, names, force=force) as out:
+        for name in names:
+            out.write_text(name, f"{content} {name}")
     return out
 
 
@@ -256,9 +257,27 @@ def test_folder_failure_leaves_no_hidden_files_and_removes_a_new_empty_folder(tm
     out = OutputFolder(target, NAMES)
     out.abandon()
     assert os.listdir(tmp_path) == []
-    out = OutputFolder(target, NAMES)
-    out.write_text("report.md", "x")
-    with pytest.raises(ValueError, match="not among the names"):
+    with pytest.raises(ValueError, match="not among the names"), \
+            OutputFolder(target, NAMES) as out:
+        out.write_text("report.md", "x")
         out.write_text("other.md", "x")
-    assert sorted(os.listdir(target)) == [MANIFEST, "report.md"]
-    assert "report.md" in json.loads((target / MANIFEST).read_text())["files"]
+    assert os.listdir(tmp_path) == []  # the staged file and the new folders are gone
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "report.md").write_text("v0")
+    with pytest.raises(OutputError, match="No space left"), \
+            OutputFolder(tmp_path / "out", NAMES, force=True) as out:
+        out.write_text("report.md", "v1")
+        raise OutputError("cannot write summary.json: No space left on device")
+    assert os.listdir(tmp_path / "out") == ["report.md"]
+    assert (tmp_path / "out" / "report.md").read_text() == "v0"
+
+
+def test_folder_moves_nothing_until_everything_is_staged(tmp_path):
+    out = tmp_path / "out"
+    _run(out, content="v1")
+    folder = OutputFolder(out, NAMES)
+    folder.write_text("report.md", "v2 report.md")
+    assert (out / "report.md").read_text() == "v1 report.md"
+    assert any(p.name.endswith(".part") for p in out.iterdir())
+    folder.abandon()
+    assert sorted(os.listdir(out)) == sorted([*NAMES, MANIFEST])

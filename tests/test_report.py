@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,7 @@ from numpy.testing import assert_allclose
 
 from motionhyst import plots, report
 from motionhyst.hysteresis import BoucWen, Dahl, LuGre, MaxwellSlip
+from motionhyst.outputs import MANIFEST
 from motionhyst.quasilinear import analyze, loop_mismatch, mismatch_asymptote
 from motionhyst.scenario import Scenario, default_scenario
 from motionhyst.steady import periodic_steady_state
@@ -51,7 +53,7 @@ def analysis(loop):
 def reproduced(tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce") / "out"
     out.mkdir()
-    (out / "stale.txt").write_text("from an earlier run")  # replaced as a whole
+    (out / "notes.txt").write_text("the user's own file")  # never touched (issue 10)
     summary = report.reproduce(default_scenario(), out, quiet=True, is_paper=True)
     return out, summary
 
@@ -63,7 +65,8 @@ def test_reproduce_writes_all_files(reproduced):
     out, _ = reproduced
     expected = {f"{n}.{ext}" for n in FIGURES for ext in ("png", "pdf")}
     expected |= {"summary.json", "report.md"}
-    assert {p.name for p in out.iterdir()} == expected
+    assert {p.name for p in out.iterdir()} == expected | {"notes.txt", MANIFEST}
+    assert set(json.loads((out / MANIFEST).read_text())["files"]) == expected
     for name in expected:
         assert (out / name).stat().st_size > 0
     for n in FIGURES:
@@ -118,16 +121,14 @@ def test_report_markdown(reproduced):
     assert sum(ln.startswith(("| 5 |", "| 10 |", "| 15 |")) for ln in lines) == 3
 
 
-def test_reproduce_replaced_previous_output(reproduced):
+def test_reproduce_keeps_the_users_files(reproduced):
     out, _ = reproduced
-    assert not (out / "stale.txt").exists()
+    assert (out / "notes.txt").read_text() == "the user's own file"
 
 
 def test_report_without_paper_column(reproduced, scenario, tmp_path):
     _, summary = reproduced
-    path = tmp_path / "report.md"
-    report._write_report(path, scenario, summary, ["fig5"], is_paper=False, notes=["a note"])
-    text = path.read_text()
+    text = report._report_text(scenario, summary, ["fig5"], is_paper=False, notes=["a note"])
     assert "## Key numbers" in text and "Paper vs computed" not in text
     assert "| quantity | computed |" in text
     assert "- a note" in text
@@ -158,22 +159,25 @@ def test_reproduce_failure_in_final_move_leaves_previous_output(tmp_path, monkey
     for name in FIGURES:  # figures are not the point here: draw empty ones
         attr = next(a for a in dir(plots) if a.startswith(f"{name}_"))
         monkeypatch.setattr(plots, attr, lambda *args, **kwargs: Figure())
-    rename = Path.rename
-
-    def failing_rename(self, target):
-        # only the move of the new output (the ".out.*" temporary folder) fails
-        if Path(target) == out and self.name.startswith(".out.") and \
-                not self.name.startswith(".out.old"):
-            raise OSError(28, "No space left on device")
-        return rename(self, target)
-
-    monkeypatch.setattr(Path, "rename", failing_rename)
     sc = default_scenario()
     sc.model.reference.frequencies = [10.0]
-    with pytest.raises(OSError, match="No space"):
+    report.reproduce(sc, out, quiet=True)
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    replace = os.replace
+
+    def failing_replace(src, dst):
+        # the move of a staged figure fails, after others have been moved
+        if Path(dst).name == "fig9.png":
+            raise OSError(28, "No space left on device")
+        return replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", failing_replace)
+    with pytest.raises(ValueError, match=r"cannot write .*fig9\.png: No space"):
         report.reproduce(sc, out, quiet=True)
     monkeypatch.undo()
     assert (out / "marker.txt").read_text() == "previous run"
+    after = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert set(after) == set(before)  # no temporary file is left
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 

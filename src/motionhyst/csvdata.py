@@ -123,8 +123,9 @@ def _dialect(path: Path) -> _Dialect:
     sep = max(_SEPARATORS, key=lambda s: counts[s])
     if counts[sep] == 0:
         sep = ","
-    data = next((ln for ln in physical[first + 1:] if ln.strip()), "")
-    decimal = "," if sep == ";" and "," in data and "." not in data else "."
+    data = [ln for ln in physical[first + 1:] if ln.strip()]
+    decimal = ("," if sep == ";" and any("," in ln for ln in data)
+               and not any("." in ln for ln in data) else ".")
     return _Dialect(encoding, sep, decimal, first + 1)
 
 

@@ -253,7 +253,8 @@ def dss_filter(Ad, Bd, Cd, Dd, U, X0):  # pragma: no cover - compiled
     U : ndarray, shape (n_t, m)
         Inputs, one signal per column, filtered independently.
     X0 : ndarray, shape (n, m)
-        Initial state of each column.
+        Initial state of each column; overwritten with the final state, so
+        that a signal filtered in pieces continues where the last piece ended.
 
     Returns
     -------
@@ -282,30 +283,81 @@ def dss_filter(Ad, Bd, Cd, Dd, U, X0):  # pragma: no cover - compiled
                 xn[a] = s
             for a in range(nx):
                 x[a] = xn[a]
+        for a in range(nx):
+            X0[a, j] = x[a]
     return Y
 
 
 @njit(cache=True)
-def _foh_states(Ad, Bd0, Bd1, C, D, u):  # pragma: no cover - compiled
-    """Output of ``x_i = Ad x_{i-1} + Bd0 u_{i-1} + Bd1 u_i``, ``y = C x + D u`` from rest."""
+def _foh_states(Ad, Bd0, Bd1, C, D, u, state, u_prev, first):  # pragma: no cover - compiled
+    """Output of ``x_i = Ad x_{i-1} + Bd0 u_{i-1} + Bd1 u_i``, ``y = C x + D u``.
+
+    From rest if `first`, else from `state` after the input `u_prev`; the
+    final state is left in `state` (a signal filtered in pieces).
+    """
     n_t = u.shape[0]
     n_x = Ad.shape[0]
-    x = np.zeros(n_x)
+    x = np.zeros(n_x) if first else state.copy()
     xn = np.zeros(n_x)
     y = np.empty(n_t)
     for i in range(n_t):
-        if i > 0:
+        if i > 0 or not first:
+            up = u[i - 1] if i > 0 else u_prev
             for j in range(n_x):
                 acc = 0.0
                 for q in range(n_x):
                     acc += Ad[j, q] * x[q]
-                xn[j] = acc + Bd0[j] * u[i - 1] + Bd1[j] * u[i]
+                xn[j] = acc + Bd0[j] * up + Bd1[j] * u[i]
             x, xn = xn, x
         acc = 0.0
         for j in range(n_x):
             acc += C[j] * x[j]
         y[i] = acc + D * u[i]
+    state[:] = x
     return y
+
+
+class FohResponse:
+    """The SISO LTI `sys` from rest, driven by an input linear between samples `h` apart.
+
+    The algorithm and realisation of :func:`control.forced_response` (exact for
+    an input linear between samples), with the time loop compiled; called on
+    consecutive pieces of a signal, it carries its state from one to the next.
+    """
+
+    def __init__(self, sys, h: float):
+        ss = control.ss(sys)
+        A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
+        C, D = np.asarray(ss.C, float), np.asarray(ss.D, float)
+        n = A.shape[0]
+        self.D = float(D[0, 0])
+        self.n = n
+        if n == 0:
+            return
+        M = np.zeros((n + 2, n + 2))
+        M[:n, :n] = A * h
+        M[:n, n] = B[:, 0] * h
+        M[n, n + 1] = 1.0
+        E = expm(M)
+        self.Ad = np.ascontiguousarray(E[:n, :n])
+        self.Bd1 = np.ascontiguousarray(E[:n, n + 1])
+        self.Bd0 = np.ascontiguousarray(E[:n, n] - self.Bd1)
+        self.C = np.ascontiguousarray(C[0])
+        self.state = np.zeros(n)
+        self.u_prev = 0.0
+        self.first = True
+
+    def __call__(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The output for the next piece `u` of the input."""
+        u = np.ascontiguousarray(u, dtype=float)
+        if self.n == 0:
+            return self.D * u
+        y = _foh_states(self.Ad, self.Bd0, self.Bd1, self.C, self.D, u, self.state,
+                        self.u_prev, self.first)
+        if len(u):
+            self.first = False
+            self.u_prev = float(u[-1])
+        return y
 
 
 def forced_response_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -329,22 +381,8 @@ def forced_response_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> 
     >>> bool(np.allclose(y, control.forced_response(sys, t, np.ones_like(t)).outputs, atol=1e-14))
     True
     """
-    ss = control.ss(sys)
-    A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
-    C, D = np.asarray(ss.C, float), np.asarray(ss.D, float)
-    n = A.shape[0]
-    if n == 0:
-        return D[0, 0] * u
     h = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
-    M = np.zeros((n + 2, n + 2))
-    M[:n, :n] = A * h
-    M[:n, n] = B[:, 0] * h
-    M[n, n + 1] = 1.0
-    E = expm(M)
-    Ad = np.ascontiguousarray(E[:n, :n])
-    Bd1 = np.ascontiguousarray(E[:n, n + 1])
-    Bd0 = np.ascontiguousarray(E[:n, n] - Bd1)
-    return _foh_states(Ad, Bd0, Bd1, np.ascontiguousarray(C[0]), float(D[0, 0]), u)
+    return FohResponse(sys, h)(u)
 
 
 class HoldFilter:

@@ -103,7 +103,12 @@ def _same_file(a: Path, b: Path) -> bool:
         return os.path.realpath(a) == os.path.realpath(b)
 
 
-def _inputs(inputs: Iterable[str | os.PathLike | None]) -> list[Path]:
+def _inputs(inputs) -> list[Path]:
+    """The input paths: one path or an iterable of paths (None entries skipped)."""
+    if inputs is None:
+        return []
+    if isinstance(inputs, str | os.PathLike):
+        inputs = [inputs]
     return [Path(p) for p in inputs if p is not None and isinstance(p, str | os.PathLike)]
 
 
@@ -324,8 +329,12 @@ class OutputFolder:
     to write, records them in :data:`MANIFEST`, and on a later run replaces
     only files that manifest lists (others of the same name need `force`).
     Files of an earlier run that this run does not write again are removed
-    only if the manifest lists them.  Each file is written atomically by
-    :class:`OutputFile`.
+    only if the manifest lists them.  Files are first staged as temporary
+    files in the folder (:meth:`write_bytes`), then moved into place together
+    (:meth:`finish`): a failure while writing leaves the earlier files as they
+    were and no temporary file.  Used as a context manager, it finishes at the
+    end of the block, abandons on an exception, and turns SIGINT and SIGTERM
+    into ``KeyboardInterrupt`` meanwhile.
 
     Parameters
     ----------
@@ -352,10 +361,8 @@ class OutputFolder:
     >>> folder = tempfile.mkdtemp()
     >>> open(os.path.join(folder, "notes.txt"), "w").write("mine")
     4
-    >>> out = OutputFolder(folder, ["report.md"])
-    >>> out.write_text("report.md", "# report")
-    >>> out.finish()  # the names of files of an earlier run that were removed
-    []
+    >>> with OutputFolder(folder, ["report.md"]) as out:
+    ...     out.write_text("report.md", "# report")
     >>> sorted(os.listdir(folder))
     ['motionhyst-manifest.json', 'notes.txt', 'report.md']
     """
@@ -390,7 +397,8 @@ class OutputFolder:
                                       f"motionhyst (not in {MANIFEST}); give --force to "
                                       f"replace it")
             check_not_input(target, self.inputs, option)
-        self.written: list[str] = []
+        self._staged: list[tuple[str, str]] = []
+        self._done: list[str] = []
         self._created: list[Path] = []
 
     def _read_manifest(self) -> set[str]:
@@ -428,27 +436,43 @@ class OutputFolder:
                            "files": sorted(set(names))}, indent=2) + "\n"
         OutputFile(self.path / MANIFEST, force=True).write_text(text)
 
-    def _file(self, name: str) -> OutputFile:
+    def write_bytes(self, name: str, data: bytes) -> None:
+        """Stage the file `name`: a temporary file in the folder, moved by :meth:`finish`."""
         if name not in self.names:
             raise ValueError(f"{name!r} is not among the names given to OutputFolder")
         self._ensure_folder()
-        if not self.written:
-            # record first what may appear, so an interrupted run's files are still ours
-            self._manifest(self.previous | set(self.names))
-        return OutputFile(self.path / name, force=True, inputs=self.inputs, option=self.option)
-
-    def write_bytes(self, name: str, data: bytes) -> None:
-        """Write the file `name` of the folder atomically."""
-        self._file(name).write_bytes(data)
-        self.written.append(name)
+        target = self.path / name
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".part", dir=self.path)
+        except OSError as exc:
+            raise OutputError(f"cannot write {target}: {exc.strerror}") from None
+        self._staged.append((name, tmp))
+        try:
+            os.fchmod(fd, OutputFile(target, force=True)._mode())
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            raise OutputError(f"cannot write {target}: {exc.strerror}") from None
 
     def write_text(self, name: str, text: str) -> None:
-        """Write the text file `name` of the folder atomically (UTF-8)."""
-        self._file(name).write_text(text)
-        self.written.append(name)
+        """Stage the text file `name` (UTF-8), as :meth:`write_bytes`."""
+        self.write_bytes(name, text.encode("utf-8"))
+
+    @property
+    def written(self) -> list[str]:
+        """Names staged so far."""
+        return [name for name, _ in self._staged]
 
     def finish(self) -> list[str]:
-        """Record the files of this run and remove files of earlier runs not written again.
+        """Move the staged files into place, record them, remove this tool's stale files.
+
+        The manifest first lists the earlier and the new names (so a run cut
+        short between the moves leaves only files the tool knows as its own),
+        then the staged files replace their targets, files of the earlier run
+        not written again are removed, and the manifest is rewritten with the
+        names of this run.
 
         Returns
         -------
@@ -456,23 +480,57 @@ class OutputFolder:
             Names of the removed files.
         """
         self._ensure_folder()
+        with _signals_raise():
+            try:
+                self._manifest(self.previous | set(self.written))
+                while self._staged:
+                    name, tmp = self._staged[0]
+                    try:
+                        os.replace(tmp, self.path / name)
+                    except OSError as exc:
+                        raise OutputError(f"cannot write {self.path / name}: "
+                                          f"{exc.strerror}") from None
+                    self._done.append(name)
+                    self._staged.pop(0)
+            except BaseException:
+                self.abandon()
+                raise
+        _fsync_dir(self.path)
         removed = []
-        for name in sorted(self.previous - set(self.written)):
+        for name in sorted(self.previous - set(self._done)):
             target = self.path / name
             if target.is_file() and not target.is_symlink():
                 with contextlib.suppress(OSError):
                     target.unlink()
                     removed.append(name)
-        self._manifest(self.written)
+        self._manifest(self._done)
         return removed
 
     def abandon(self) -> None:
-        """After a failure: remove the folders this run created if they are still empty."""
+        """After a failure: remove the staged files, and folders this run created if empty."""
+        for _, tmp in self._staged:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        self._staged.clear()
         for folder in reversed(self._created):
             with contextlib.suppress(OSError):
                 if {p.name for p in folder.iterdir()} <= {MANIFEST}:
                     (folder / MANIFEST).unlink(missing_ok=True)
                 folder.rmdir()
+
+    def __enter__(self) -> OutputFolder:
+        self._signals = _signals_raise()
+        self._signals.__enter__()
+        return self
+
+    def __exit__(self, kind, value, tb) -> None:
+        try:
+            if kind is None:
+                self.finish()
+            else:
+                self.abandon()
+        finally:
+            self._signals.__exit__(None, None, None)
 
 
 __all__ = ["MANIFEST", "OutputError", "OutputFile", "OutputFolder", "check_not_input",

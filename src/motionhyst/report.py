@@ -1,17 +1,19 @@
 """``motionhyst reproduce``: the paper's figures and numbers for a scenario, as a report.
 
 Writes Figs. 5-11 (PNG and PDF), ``summary.json`` (the analyze and simulate
-results) and ``report.md`` into an output folder.  Everything is written to
-a fresh folder first and moved into place at the end, so a run that fails
-leaves the previous output as it was.
+results) and ``report.md`` into an output folder, through
+:class:`motionhyst.outputs.OutputFolder`: everything is computed first, then
+each file is staged in the folder and all are moved into place together and
+listed in the folder's manifest; the user's own files in the folder are never
+touched.
 """
 
 from __future__ import annotations
 
 import math
-import shutil
 import sys
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +22,7 @@ from tqdm import tqdm
 from motionhyst import plots
 from motionhyst.figures import save_figures
 from motionhyst.jsonio import dumps
+from motionhyst.outputs import OutputFolder
 from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
 from motionhyst.scenario import Scenario
 from motionhyst.steady import periodic_steady_state
@@ -100,8 +103,8 @@ def _fmt(x) -> str:
     return f"{x:.4g}"
 
 
-def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
-                  is_paper: bool, notes: list[str]) -> None:
+def _report_text(sc: Scenario, summary: dict, figures: list[str], is_paper: bool,
+                 notes: list[str]) -> str:
     a = summary["analyze"]
     jenkins = summary["scenario"]["hysteresis"]["model"] == "jenkins"
     lines = [f"# motionhyst report: {sc.source}", ""]
@@ -149,22 +152,61 @@ def _write_report(path: Path, sc: Scenario, summary: dict, figures: list[str],
         lines += [f"### {name}", "", note, "", f"![{name}]({name}.png)", ""]
     if notes:
         lines += ["## Notes", ""] + [f"- {n}" for n in notes] + [""]
-    path.write_text("\n".join(lines))
+    return "\n".join(lines)
+
+
+FIGURES = ("fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "plant_fit")
+"""Figures the report may hold (Figs. 6-7 only for a link with zeta = fc / (k A), plant_fit
+only for a measured plant that is fitted)."""
+
+OUTPUT_NAMES = (*(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf")), "summary.json",
+                "report.md")
+"""Every file :func:`reproduce` may write into its folder (besides the manifest)."""
 
 
 def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
-              is_paper: bool = False) -> dict:
+              is_paper: bool = False, force: bool = False,
+              inputs: Iterable[str | Path | None] = ()) -> dict:
     """Write the figures, ``summary.json`` and ``report.md`` for scenario `sc` into `out_dir`.
 
-    Returns the summary dictionary.
+    The folder is an :class:`~motionhyst.outputs.OutputFolder`: it may hold
+    the user's own files, which are never touched; the report's files are
+    listed in its manifest and replaced by a later run; the files are staged
+    once everything has been computed and moved into place together, so a run
+    that fails leaves the previous report as it was.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The scenario.
+    out_dir : str or Path
+        Output folder, created if absent (``"."`` is the current folder).
+    quiet : bool
+        No progress bar.
+    is_paper : bool
+        Compare with the numbers the paper states (Table I scenario).
+    force : bool
+        Also replace files of the report's names that motionhyst did not write.
+    inputs : iterable of paths
+        Files the command read (the scenario): never replaced.
+
+    Returns
+    -------
+    dict
+        The summary (also written as ``summary.json``).
+
+    Raises
+    ------
+    motionhyst.outputs.OutputError
+        Before any computation, if `out_dir` is a file or a symbolic link, or
+        holds a file of the report's names that motionhyst did not write and
+        `force` is false.
     """
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    folder = OutputFolder(out_dir, OUTPUT_NAMES, force=force, inputs=inputs)
     loop = sc.loop()
     el = loop.hysteresis
     A, freqs = sc.amplitude, sc.frequencies
     show = not quiet and sys.stderr.isatty()
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     notes: list[str] = []
     try:
         steps = tqdm(total=10, desc="reproduce", disable=not show, file=sys.stderr, leave=False)
@@ -219,24 +261,21 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                          "need a model and are not computed. Quantities the data cannot resolve "
                          "are listed below and are n/a.")
             notes += analysis.unresolved
-        written = save_figures(figs, tmp, ("png", "pdf"), done=lambda _: steps.update())
-        (tmp / "summary.json").write_text(dumps(summary))
-        _write_report(tmp / "report.md", sc, summary, written, is_paper, notes)
+        files: dict[str, bytes] = {}
+        # the figures are drawn in parallel into a scratch folder outside the user's folder
+        with tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch:
+            written = save_figures(figs, scratch, ("png", "pdf"),
+                                   done=lambda _: steps.update())
+            for name in written:
+                for ext in ("png", "pdf"):
+                    files[f"{name}.{ext}"] = (Path(scratch) / f"{name}.{ext}").read_bytes()
+        files["summary.json"] = dumps(summary).encode()
+        files["report.md"] = _report_text(sc, summary, written, is_paper, notes).encode()
         steps.close()
-        old = None
-        if out_dir.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
-            out_dir.rename(old / out_dir.name)
-        try:
-            tmp.rename(out_dir)
-        except BaseException:
-            if old is not None:  # put the previous output back
-                (old / out_dir.name).rename(out_dir)
-                shutil.rmtree(old, ignore_errors=True)
-            raise
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
+        with folder:  # staged, then moved into place together; SIGTERM cleans up
+            for name, data in files.items():
+                folder.write_bytes(name, data)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        folder.abandon()
         raise
     return summary

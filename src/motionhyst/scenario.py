@@ -431,6 +431,8 @@ class Scenario:
             text = path.read_text()
         except OSError as exc:
             raise ScenarioError(f"{path}: cannot read ({exc.strerror})") from None
+        except UnicodeDecodeError:
+            raise ScenarioError(f"{path}: not a text file (TOML must be UTF-8)") from None
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
@@ -447,6 +449,18 @@ class Scenario:
             raise ScenarioError(f"{self.source}: [stage] is a mass-spring-damper (an open-loop "
                                 f"system without [controller] or [reference]); {what} needs a "
                                 f"closed loop (use motionhyst predict for open-loop systems)")
+
+    @property
+    def files(self) -> list[Path]:
+        """The files the scenario was read from: its TOML and a measured plant's CSV.
+
+        A command never writes over these (:mod:`motionhyst.outputs`).
+        """
+        files = [Path(self.source)] if Path(self.source).is_file() else []
+        if self.model.stage is None and self.model.plant is not None:
+            f = Path(self.model.plant.file)
+            files.append(f if f.is_absolute() else self.base_dir / f)
+        return files
 
     @property
     def amplitude(self) -> float:

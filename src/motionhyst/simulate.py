@@ -16,6 +16,7 @@ tune it.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,13 +25,13 @@ from numpy.typing import NDArray
 from motionhyst._jit import njit
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
-from motionhyst.hysteresis.stepping import Stepping, advance, open_loop
+from motionhyst.hysteresis.stepping import Stepping, advance
 from motionhyst.loop import Loop
 from motionhyst.lti import (
+    FohResponse,
     discretize_foh,
     divide_s2,
     dss_filter,
-    forced_response_foh,
     polysub_exact,
     realize_scaled,
     stack,
@@ -102,8 +103,8 @@ MAX_FIXED_POINT_ITERATIONS = 50
 
 
 @njit(cache=True)
-def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, ftol,
-         max_iter):  # pragma: no cover - compiled
+def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, st_x, st_s, st_sprev,
+         st_scalars, i0, glt, glw, ftol, max_iter):  # pragma: no cover - compiled
     """The loop driven by the hysteresis force, around the linear response to ``r''``.
 
     ``Ad .. Dd`` realise ``w - u_h -> (e, y1 - r)`` (first-order hold);
@@ -112,35 +113,49 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, 
     when ``w`` changes by at most `ftol`.  Returns ``e``, ``y1 - r``, ``w`` and
     the largest number of iterations used (``max_iter + 1`` if one step failed
     to converge; the run stops there).
+
+    The samples are those from index `i0` of the whole run; the state of the
+    linear part `st_x`, of the elements `st_s` (and one step earlier,
+    `st_sprev`) and ``st_scalars = (r, y1 - r, w, dx)`` of the previous sample
+    are read at the start (ignored for ``i0 = 0``, except the elements' rest
+    state `st_s`) and updated at the end, so a run in chunks equals one run.
     """
     n_t = r.shape[0]
     n_x = Ad.shape[0]
     m = codes.shape[0]
-    x = np.zeros(n_x)
+    x = st_x.copy()
     xn = np.zeros(n_x)
-    s = s0.copy()
-    s_new = s0.copy()
-    s_prev = s0.copy()
+    s = st_s.copy()
+    s_new = st_s.copy()
+    s_prev = st_sprev.copy()
     e = np.zeros(n_t)
     dev = np.zeros(n_t)
     w = np.zeros(n_t)
     worst = 0
-    r_prev = r[0]
-    dev_prev = 0.0  # the element starts at rest at y1 = r(0)
-    w_prev = 0.0
-    dx_prev = 0.0
-    for j in range(m):
-        w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
-    for i in range(n_t):
-        base_e = e_lin[i]
-        base_y = dev_lin[i]
+    if i0 == 0:
+        x[:] = 0.0
+        s_prev[:] = s
+        r_prev = r[0]
+        dev_prev = 0.0  # the element starts at rest at y1 = r(0)
+        w_prev = 0.0
+        dx_prev = 0.0
+        for j in range(m):
+            w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt,
+                              glw)[1]
+    else:
+        r_prev, dev_prev, w_prev, dx_prev = (st_scalars[0], st_scalars[1], st_scalars[2],
+                                             st_scalars[3])
+    for k in range(n_t):
+        i = i0 + k
+        base_e = e_lin[k]
+        base_y = dev_lin[k]
         for j in range(n_x):
             base_e += Cd[0, j] * x[j]
             base_y += Cd[1, j] * x[j]
         hi = h if i > 0 else 0.0
-        dr = r[i] - r_prev
+        dr = r[k] - r_prev
         wt = w_prev
-        d = base_y + Dd[1, 0] * (wt - uh[i])
+        d = base_y + Dd[1, 0] * (wt - uh[k])
         it = 0
         step_prev = np.inf
         while True:
@@ -151,7 +166,7 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, 
                 s_new[j], f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, hi,
                                        i == 1, glt, glw)
                 wn += f
-            d_next = base_y + Dd[1, 0] * (wn - uh[i])
+            d_next = base_y + Dd[1, 0] * (wn - uh[k])
             # converged when w settles or y1 - r changes by a few ulps only; or at the
             # round-off floor: no longer contracting while y1 - r moves by < 1e-12 of itself
             # (a steep element, e.g. LuGre's sigma1 z' / dt, amplifies the round-off of z)
@@ -166,24 +181,74 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, s0, glt, glw, 
                 break  # d: the y1 - r the element was advanced with
             d = d_next
             if it > max_iter:
-                return e[:i], dev[:i], w[:i], it
+                return e[:k], dev[:k], w[:k], it
         if it > worst:
             worst = it
         s_prev, s, s_new = s, s_new, s_prev
-        e[i] = base_e + Dd[0, 0] * (wt - uh[i])
-        dev[i] = d
-        w[i] = wt
+        e[k] = base_e + Dd[0, 0] * (wt - uh[k])
+        dev[k] = d
+        w[k] = wt
         dx_prev = dr + (d - dev_prev)
-        r_prev = r[i]
+        r_prev = r[k]
         dev_prev = d
         w_prev = wt
         for j in range(n_x):
-            acc = Bd[j, 0] * (wt - uh[i])
+            acc = Bd[j, 0] * (wt - uh[k])
             for q in range(n_x):
                 acc += Ad[j, q] * x[q]
             xn[j] = acc
         x, xn = xn, x
+    st_x[:] = x
+    st_s[:] = s
+    st_sprev[:] = s_prev
+    st_scalars[0] = r_prev
+    st_scalars[1] = dev_prev
+    st_scalars[2] = w_prev
+    st_scalars[3] = dx_prev
+    st_x[:] = x
+    st_s[:] = s
+    st_sprev[:] = s_prev
+    st_scalars[0] = r_prev
+    st_scalars[1] = dev_prev
+    st_scalars[2] = w_prev
+    st_scalars[3] = dx_prev
     return e, dev, w, worst
+
+
+@njit(cache=True)
+def _open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt,
+                     glw):  # pragma: no cover - compiled
+    """:func:`~motionhyst.hysteresis.stepping.open_loop` for samples from index `i0` on.
+
+    ``s``, ``s_prev`` (element states now and one step earlier) and
+    ``scalars = (x, dx)`` of the previous sample are read (for ``i0 > 0``) and
+    updated, so that a run in chunks equals one run.
+    """
+    n_t = x.shape[0]
+    w = np.empty(n_t)
+    if i0 == 0:
+        s_prev[:] = s
+        x_prev = x[0] if n_t else 0.0
+        dx_prev = 0.0
+    else:
+        x_prev = scalars[0]
+        dx_prev = scalars[1]
+    for k in range(n_t):
+        i = i0 + k
+        dx = x[k] - x_prev if i > 0 else 0.0
+        wt = 0.0
+        for j in range(codes.shape[0]):
+            sj, f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
+                            h if i > 0 else 0.0, i == 1, glt, glw)
+            s_prev[j] = s[j]
+            s[j] = sj
+            wt += f
+        w[k] = wt
+        dx_prev = dx
+        x_prev = x[k]
+    scalars[0] = x_prev
+    scalars[1] = dx_prev
+    return w
 
 
 def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float64],
@@ -266,60 +331,164 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
-    if loop.feedforward != "rigid-body" and loop.feedforward is not None:
-        raise ValueError("unknown feedforward")
-    codes, params, s0, f_scale = _elements(loop.hysteresis)
-    hff = loop.hysteresis_feedforward
-    if hff is not None:
-        _elements(hff)  # the same models are supported as feedforward
-    f_ref = getattr(reference, "max_frequency_hz", 1.0)
-    step = default_step(loop, f_ref) if dt is None else float(dt)
-    if not (np.isfinite(step) and step > 0):
-        raise ValueError("dt must be finite and > 0")
-    n = int(np.ceil(duration / step)) + 1
+    engine = _Engine(loop, reference, dt, force)
+    n = int(np.ceil(duration / engine.step)) + 1
     if n > 50_000_000:
         raise ValueError(f"{n} time steps: too many; shorten the duration")
-    t = np.arange(n) * step
-    r, a = reference(t)
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(a))):
-        raise ValueError("the reference has non-finite values")
-    r = np.ascontiguousarray(r, dtype=float)
-    a = np.ascontiguousarray(a, dtype=float)
-    omega0 = float(np.max(np.abs(loop.closed_loop_poles())))
-    sys_a, sys_w = _block_systems(loop, omega0)
-    # a reference that starts with a velocity v0 has r'' = v0 delta(t) + ...: the impulse
-    # sets the initial state (delta(t) = omega0 delta(tau) in scaled time)
-    v0 = float(getattr(reference, "initial_velocity", 0.0))
-    x0 = sys_a[1][:, 0] * v0 * omega0
-    Ad, Bd, Cd, Dd = discretize_foh(sys_a, omega0 * step)
-    lin = dss_filter(Ad, np.ascontiguousarray(Bd[:, 0]), Cd, np.ascontiguousarray(Dd[:, 0]),
-                     a[:, None], x0[:, None])[:, :, 0]
-    e_lin = np.ascontiguousarray(lin[:, 0])
-    # hysteresis feedforward u_h = phi_hat(r) acts like -w on the loop
-    if hff is None:
-        uh = np.zeros_like(r)
-    elif hff.rate_independent:
-        uh = hff.response(r)
-    else:  # as the link in the loop: force with the velocity at the sample
-        uh = open_loop(*_elements(hff)[:3], r, step, GL_T, GL_W)
-    if force is not None:
-        uf = np.asarray(force(t), dtype=float)
-        if uf.shape != t.shape or not np.all(np.isfinite(uf)):
-            raise ValueError("the feedforward force must give one finite value per time")
-        uh = np.ascontiguousarray(uh + uf)
-    e, dev, w, iters = _run(*discretize_foh(sys_w, omega0 * step), r, e_lin,
-                            np.ascontiguousarray(lin[:, 1]), uh, step, codes, params, s0,
-                            GL_T, GL_W, 1e-14 * f_scale, MAX_FIXED_POINT_ITERATIONS)
-    if iters > MAX_FIXED_POINT_ITERATIONS:
-        raise RuntimeError(
-            f"the implicit step at t = {len(e) * step:.6g} s did not converge in "
-            f"{MAX_FIXED_POINT_ITERATIONS} iterations: the link is too stiff (or too "
-            "strongly damped) for dt; use a smaller dt")
-    y1 = r + dev
-    y2 = r - e
-    # feedback force C e, with the input linear between samples (as control.forced_response)
-    u = forced_response_foh(loop.controller, t, e)
-    if loop.feedforward == "rigid-body":
-        u = u + loop.M * a  # the impulse M v0 delta(t) at t = 0 is not representable
-    u = u + uh
-    return Simulation(t=t, r=r, e=e, y1=y1, y2=y2, u=u, w=w, e_linear=e_lin)
+    t = np.arange(n) * engine.step
+    h_foh = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
+    return engine.run(t, 0, h_foh)
+
+
+def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = None,
+                    force=None, chunk: int = 1 << 16) -> Iterator[Simulation]:
+    """:func:`simulate` in consecutive pieces of at most `chunk` samples, for long runs.
+
+    Memory stays bounded by the chunk, whatever the duration; the pieces,
+    joined, are the samples of :func:`simulate` (the same integration, its
+    state carried from piece to piece).
+
+    Parameters
+    ----------
+    loop, reference, duration, dt, force
+        As :func:`simulate`; `duration` may give any number of steps.
+    chunk : int
+        Samples per piece, >= 1.
+
+    Yields
+    ------
+    Simulation
+        The samples of one piece, ``t`` continuing where the previous ended.
+
+    Examples
+    --------
+    >>> from motionhyst.scenario import default_scenario
+    >>> from motionhyst.references import SineReference
+    >>> loop = default_scenario().loop()
+    >>> ref = SineReference(0.01, 5.0)
+    >>> pieces = list(simulate_chunks(loop, ref, 0.01, chunk=100))
+    >>> whole = simulate(loop, ref, 0.01)
+    >>> bool(np.allclose(np.concatenate([p.e for p in pieces]), whole.e, rtol=0, atol=1e-15))
+    True
+    """
+    if not (np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be finite and > 0, got {duration!r}")
+    if int(chunk) < 1:
+        raise ValueError("chunk must be >= 1")
+    engine = _Engine(loop, reference, dt, force)
+    n = int(np.ceil(duration / engine.step)) + 1
+    for i0 in range(0, n, int(chunk)):
+        t = np.arange(i0, min(n, i0 + int(chunk))) * engine.step
+        yield engine.run(t, i0, engine.step)
+
+
+class _Engine:
+    """The discretised loop of :func:`simulate`, run chunk by chunk with its state carried."""
+
+    def __init__(self, loop: Loop, reference, dt: float | None, force):
+        if loop.feedforward != "rigid-body" and loop.feedforward is not None:
+            raise ValueError("unknown feedforward")
+        self.loop = loop
+        self.reference = reference
+        self.force = force
+        self.codes, self.params, s0, self.f_scale = _elements(loop.hysteresis)
+        self.hff = loop.hysteresis_feedforward
+        if self.hff is not None:
+            _elements(self.hff)  # the same models are supported as feedforward
+        f_ref = getattr(reference, "max_frequency_hz", 1.0)
+        step = default_step(loop, f_ref) if dt is None else float(dt)
+        if not (np.isfinite(step) and step > 0):
+            raise ValueError("dt must be finite and > 0")
+        self.step = step
+        omega0 = float(np.max(np.abs(loop.closed_loop_poles())))
+        sys_a, sys_w = _block_systems(loop, omega0)
+        # a reference that starts with a velocity v0 has r'' = v0 delta(t) + ...: the impulse
+        # sets the initial state (delta(t) = omega0 delta(tau) in scaled time)
+        v0 = float(getattr(reference, "initial_velocity", 0.0))
+        self.x_a = np.ascontiguousarray(sys_a[1][:, 0] * v0 * omega0, dtype=float)
+        Ad, Bd, Cd, Dd = discretize_foh(sys_a, omega0 * step)
+        self.disc_a = (Ad, np.ascontiguousarray(Bd[:, 0]), Cd, np.ascontiguousarray(Dd[:, 0]))
+        self.x_a = np.ascontiguousarray(self.x_a[:, None])
+        self.disc_w = discretize_foh(sys_w, omega0 * step)
+        self.x_w = np.zeros(self.disc_w[0].shape[0])
+        self.s = np.ascontiguousarray(s0, dtype=float).copy()
+        self.s_prev = self.s.copy()
+        self.scalars = np.zeros(4)
+        self.hff_history = np.empty(0)
+        if self.hff is not None and not self.hff.rate_independent:
+            self.hff_codes, self.hff_params, hs0, _ = _elements(self.hff)
+            self.hff_s = np.ascontiguousarray(hs0, dtype=float).copy()
+            self.hff_s_prev = self.hff_s.copy()
+            self.hff_scalars = np.zeros(2)
+        self.feedback = None
+
+    def run(self, t: NDArray[np.float64], i0: int, h_foh: float) -> Simulation:
+        """The samples at times `t` (indices from `i0`), continuing the previous call."""
+        loop, step = self.loop, self.step
+        r, a = self.reference(t)
+        if not (np.all(np.isfinite(r)) and np.all(np.isfinite(a))):
+            raise ValueError("the reference has non-finite values")
+        r = np.ascontiguousarray(r, dtype=float)
+        a = np.ascontiguousarray(a, dtype=float)
+        lin = dss_filter(*self.disc_a, a[:, None], self.x_a)[:, :, 0]
+        e_lin = np.ascontiguousarray(lin[:, 0])
+        # hysteresis feedforward u_h = phi_hat(r) acts like -w on the loop
+        hff = self.hff
+        if hff is None:
+            uh = np.zeros_like(r)
+        elif hff.rate_independent:
+            uh = self._rate_independent_feedforward(r)
+        else:  # as the link in the loop: force with the velocity at the sample
+            uh = _open_loop_chunk(self.hff_codes, self.hff_params, self.hff_s,
+                                  self.hff_s_prev, self.hff_scalars, r, step, i0, GL_T, GL_W)
+        if self.force is not None:
+            uf = np.asarray(self.force(t), dtype=float)
+            if uf.shape != t.shape or not np.all(np.isfinite(uf)):
+                raise ValueError("the feedforward force must give one finite value per time")
+            uh = np.ascontiguousarray(uh + uf)
+        e, dev, w, iters = _run(*self.disc_w, r, e_lin, np.ascontiguousarray(lin[:, 1]), uh,
+                                step, self.codes, self.params, self.x_w, self.s, self.s_prev,
+                                self.scalars, i0, GL_T, GL_W, 1e-14 * self.f_scale,
+                                MAX_FIXED_POINT_ITERATIONS)
+        if iters > MAX_FIXED_POINT_ITERATIONS:
+            raise RuntimeError(
+                f"the implicit step at t = {(i0 + len(e)) * step:.6g} s did not converge in "
+                f"{MAX_FIXED_POINT_ITERATIONS} iterations: the link is too stiff (or too "
+                "strongly damped) for dt; use a smaller dt")
+        y1 = r + dev
+        y2 = r - e
+        # feedback force C e, the input linear between samples (as control.forced_response)
+        if self.feedback is None:
+            self.feedback = FohResponse(loop.controller, h_foh)
+        u = self.feedback(e)
+        if loop.feedforward == "rigid-body":
+            u = u + loop.M * a  # the impulse M v0 delta(t) at t = 0 is not representable
+        u = u + uh
+        return Simulation(t=t, r=r, e=e, y1=y1, y2=y2, u=u, w=w, e_linear=e_lin)
+
+    def _rate_independent_feedforward(self, r: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``phi_hat(r)`` of a rate-independent feedforward, continued from the previous chunk.
+
+        A rate-independent element's state after a monotone stretch depends on
+        its end point only: the first sample and the reversals seen so far
+        replay the state exactly before the new samples.
+        """
+        hist = self.hff_history
+        x = np.concatenate([hist, r]) if len(hist) else r
+        out = self.hff.response(x)[len(hist):]
+        self.hff_history = _turning_points(x)
+        return np.ascontiguousarray(out, dtype=float)
+
+
+def _turning_points(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The first sample, the reversals and the last sample of `x`: enough to replay its path."""
+    if len(x) < 3:
+        return x.copy()
+    d = np.diff(x)
+    nz = np.flatnonzero(d != 0)
+    if nz.size == 0:
+        return x[[0, -1]].copy()
+    sgn = np.sign(d[nz])
+    turns = nz[np.flatnonzero(sgn[1:] != sgn[:-1]) + 1]  # first step of a new direction
+    keep = np.unique(np.concatenate([[0], turns, [len(x) - 1]]))
+    return x[keep].copy()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Sequence
 
 from motionhyst.jsonio import dumps
 from motionhyst.textfmt import g, table
@@ -79,3 +80,105 @@ def harmonic_count(text: str) -> int:
 def print_json(obj) -> None:
     """Print `obj` as JSON (NumPy values converted, NaN as null)."""
     print(dumps(obj))
+
+
+# ------------------------------------------------------------------ outputs and options
+def add_force_option(q: argparse.ArgumentParser) -> None:
+    """Add ``--force`` to a command that writes files (see :func:`output_file`)."""
+    q.add_argument("--force", action="store_true",
+                   help="replace an existing output file (never one of the command's inputs)")
+
+
+def output_file(path: str, args: argparse.Namespace, option: str, inputs=()):
+    """The :class:`~motionhyst.outputs.OutputFile` a command writes, checked now.
+
+    Every command that writes a file calls this before it computes anything:
+    the file must not exist unless ``--force`` was given (``args.force``), and
+    is never one of `inputs` (the scenario, records, references, plant files
+    the command reads).  Write it with ``with out.open() as fh: ...``: atomic,
+    mode kept or from the umask, SIGINT/SIGTERM leave the old file.
+
+    Raises
+    ------
+    motionhyst.outputs.OutputError
+        One line naming `option` and the path (exit 2).
+    """
+    from motionhyst.outputs import OutputFile
+
+    return OutputFile(path, force=bool(getattr(args, "force", False)), inputs=inputs,
+                      option=option)
+
+
+def refuse_unused(args: argparse.Namespace, options: Sequence[str], reason: str,
+                  defaults: dict | None = None) -> None:
+    """Exit 2 if any of `options` was given although it has no effect (`reason` says why).
+
+    `options` are the command-line spellings (``"--profile"``); an option
+    counts as given when its value differs from ``defaults`` (``None`` or
+    ``False`` unless stated).
+    """
+    defaults = defaults or {}
+    for option in options:
+        dest = option.lstrip("-").replace("-", "_")
+        value = getattr(args, dest, None)
+        if value is not None and value is not False and value != defaults.get(option):
+            raise UsageError(f"motionhyst {args.command}: {option} has no effect {reason}")
+
+
+def distinct(values: Sequence[float] | None, option: str, command: str):
+    """`values` of a list option, refused if one is given twice (exit 2).
+
+    Examples
+    --------
+    >>> distinct([5.0, 10.0], "--frequency", "analyze")
+    [5.0, 10.0]
+    """
+    if values is None:
+        return None
+    seen = set()
+    for v in values:
+        if v in seen:
+            raise UsageError(f"motionhyst {command}: {option} {v:g} is given twice")
+        seen.add(v)
+    return list(values)
+
+
+# ----------------------------------------------------------------- plausibility warnings
+def warn(message: str) -> None:
+    """A plausibility warning: one line on stderr; the command still succeeds (exit 0)."""
+    import sys
+
+    print(f"motionhyst: warning: {message}", file=sys.stderr)
+
+
+def check_plausible(loop, amplitude: float, frequencies, command: str) -> None:
+    """Warn where a sine of `amplitude` at `frequencies` leaves the model's meaning.
+
+    - a frequency below f* (eq. 13): the quasi-linear plant no longer tends to
+      the floating mass P2, so eq. (20) and the crossover of eq. (21) do not apply;
+    - a frequency outside a measured plant's data (the fit or data are extrapolated);
+    - an amplitude at which the element never slips (``zeta = fc / (k A) >= 1``):
+      it is a linear spring at every frequency asked, no hysteresis to see.
+    """
+    from motionhyst.quasilinear import f_star
+
+    el = loop.hysteresis
+    freqs = [float(f) for f in frequencies]
+    if el is not None:
+        fs = f_star(el.initial_stiffness, loop.M)
+        low = [f for f in freqs if f < fs]
+        if low:
+            warn(f"{command}: {', '.join(f'{f:g}' for f in low)} Hz below f* = {fs:.3g} Hz "
+                 f"(eq. 13): the link shapes the plant there, the asymptote of eq. (20) and "
+                 f"the crossover of eq. (21) do not apply")
+        if el.defines_zeta and float(el.zeta(amplitude)) >= 1.0:
+            warn(f"{command}: at amplitude {amplitude:g} m the element never slips "
+                 f"(zeta = fc / (k A) = {float(el.zeta(amplitude)):.3g} >= 1): it is a linear "
+                 f"spring at every frequency asked, there is no hysteresis to see")
+    data = getattr(loop.plant, "frequency_range_hz", None)
+    if data is not None:
+        lo, hi = data
+        out = [f for f in freqs if f < lo or f > hi]
+        if out:
+            warn(f"{command}: {', '.join(f'{f:g}' for f in out)} Hz outside the measured "
+                 f"plant's data ({lo:g}-{hi:g} Hz): the plant there is extrapolated")

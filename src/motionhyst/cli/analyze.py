@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import positive, print_json
+from motionhyst.cli._common import check_plausible, distinct, positive, print_json
 
 
 def run(args: argparse.Namespace) -> int:
@@ -12,9 +12,11 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.quasilinear import analyze
     from motionhyst.scenario import load_scenario
 
+    args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario)
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
+    check_plausible(sc.loop(), amplitude, freqs, args.command)
     mode = "self-consistent" if args.self_consistent else "reference"
     res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
     fit = sc.plant_fit()

@@ -12,6 +12,7 @@ import numpy as np
 
 from motionhyst.cli._common import (
     UsageError,
+    distinct,
     finite,
     g,
     harmonic_count,
@@ -88,6 +89,7 @@ def _df_point(amplitude: float, zeta: float, D: complex, frequency_hz: float | N
 
 def run(args: argparse.Namespace) -> int:
     """Describing function (and higher harmonics) of a hysteresis element."""
+    args.frequency = distinct(args.frequency, "--frequency", "df")
     el = _element_from_args(args)
     freqs = _df_frequencies(args, el)
     A = np.asarray(args.amplitude, dtype=float)

@@ -4,16 +4,21 @@ from __future__ import annotations
 
 import argparse
 
+from motionhyst.cli._common import add_force_option
+
 
 def run(args: argparse.Namespace) -> int:
     """The paper's figures and numbers for a scenario, as a report."""
+    from motionhyst.outputs import MANIFEST
     from motionhyst.report import reproduce
     from motionhyst.scenario import load_scenario
 
     sc = load_scenario(args.scenario)
-    reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None)
+    reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None, force=args.force,
+              inputs=sc.files)
     if not args.quiet:
-        print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf)")
+        print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf), listed in "
+              f"{MANIFEST}")
     return 0
 
 
@@ -21,6 +26,9 @@ def add_parser(sub) -> None:
     """Add the ``reproduce`` command to the subparsers `sub`."""
     q = sub.add_parser("reproduce", help="the paper's figures and numbers, as a report")
     q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
-    q.add_argument("--out", default="out", help="output folder (default: ./out)")
+    q.add_argument("--out", default="out",
+                   help="output folder (default: ./out); other files in it are left alone, the "
+                        "report's files are listed in its motionhyst-manifest.json")
     q.add_argument("--quiet", action="store_true", help="no progress bar or summary line")
+    add_force_option(q)
     q.set_defaults(func=run)

@@ -6,14 +6,26 @@ Without ``--time-series`` it is the old spelling of ``motionhyst steady``.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
-from pathlib import Path
 
-import numpy as np
+from motionhyst.cli._common import (
+    UsageError,
+    add_force_option,
+    check_plausible,
+    distinct,
+    output_file,
+    positive,
+    print_json,
+    refuse_unused,
+    warn,
+)
 
-from motionhyst.cli._common import UsageError, positive, print_json
+TIME_SERIES_ONLY = ("--reference-csv", "--profile", "--distance", "--v-max", "--a-max",
+                    "--j-max", "--duration", "--output-rate", "--settle-band", "--force")
+"""Options that only shape a ``--time-series`` run."""
+
+PROFILE_DEFAULTS = {"distance": 0.01, "v_max": 0.5, "a_max": 10.0, "j_max": 1000.0}
+"""Limits of the built-in point-to-point profile unless given [m, m/s, m/s^2, m/s^3]."""
 
 
 def run(args: argparse.Namespace) -> int:
@@ -21,58 +33,104 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.cli import steady
     from motionhyst.scenario import load_scenario
 
+    args.frequency = distinct(args.frequency, "--frequency", "simulate")
     if not args.time_series:
+        refuse_unused(args, TIME_SERIES_ONLY, "without --time-series (it shapes the transient "
+                      "run written to CSV)")
         print("motionhyst simulate: without --time-series this computes the periodic steady "
               "state; the command for that is now `motionhyst steady`", file=sys.stderr)
         return steady.run(args)
-    sc = load_scenario(args.scenario)
-    freqs = args.frequency or sc.frequencies
-    amplitude = args.amplitude or sc.amplitude
-    return _time_series(args, sc, amplitude, freqs[0])
+    return _time_series(args, load_scenario(args.scenario))
 
 
-def _time_series(args: argparse.Namespace, sc, amplitude: float, frequency: float) -> int:
-    """Transient run from rest, written to CSV atomically."""
+def _reference(args: argparse.Namespace, sc):
+    """The reference of a ``--time-series`` run, its default duration and a description."""
     from motionhyst.references import PointToPoint, SineReference, load_reference_csv
-    from motionhyst.simulate import simulate
 
     if args.reference_csv and args.profile:
         raise UsageError("motionhyst simulate: give --reference-csv or --profile, not both")
+    if not args.profile:
+        refuse_unused(args, ("--distance", "--v-max", "--a-max", "--j-max", "--settle-band"),
+                      "without --profile point-to-point")
+    if args.reference_csv or args.profile:
+        given = "--reference-csv" if args.reference_csv else "--profile"
+        refuse_unused(args, ("--frequency", "--amplitude"),
+                      f"with {given} (the reference is the "
+                      f"{'file' if args.reference_csv else 'profile'}, not a sine)")
     if args.reference_csv:
         ref = load_reference_csv(args.reference_csv)
-        duration = args.duration or ref.duration
-        what = f"reference from {args.reference_csv}"
-    elif args.profile:
-        ref = PointToPoint(args.distance, args.v_max, args.a_max, args.j_max)
-        duration = args.duration or ref.duration + 0.2
-        what = f"point-to-point move of {args.distance:g} m"
-    else:
-        ref = SineReference(amplitude, frequency)
-        duration = args.duration or 1.0
-        what = f"r = {amplitude:g} m sin(2 pi {frequency:g} t)"
-    sim = simulate(sc.loop(), ref, duration)
-    cols = sim.columns()
-    out = Path(args.time_series)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(",".join(cols) + "\n")
-            np.savetxt(fh, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12e")
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    summary = {"time_series": str(out), "samples": len(sim.t), "duration_s": float(sim.t[-1]),
-               "dt_s": float(sim.t[1] - sim.t[0]), "error_peak": float(np.max(np.abs(sim.e))),
-               "error_linear_peak": float(np.max(np.abs(sim.e_linear)))}
+        return ref, ref.duration, f"reference from {args.reference_csv}"
+    if args.profile:
+        limits = {k: (getattr(args, k) if getattr(args, k) is not None else v)
+                  for k, v in PROFILE_DEFAULTS.items()}
+        if limits["distance"] == 0:
+            raise UsageError("motionhyst simulate: --distance must be non-zero")
+        ref = PointToPoint(**limits)
+        return (ref, ref.duration + 0.2,
+                f"point-to-point move of {limits['distance']:g} m")
+    freqs = args.frequency or sc.frequencies
+    if len(freqs) > 1:
+        where = "--frequency" if args.frequency else f"the scenario's {len(freqs)} frequencies"
+        raise UsageError(f"motionhyst simulate: --time-series runs one sine; {where} gives "
+                         f"{len(freqs)} (give one --frequency)")
+    amplitude = args.amplitude or sc.amplitude
+    return (SineReference(amplitude, freqs[0]), 1.0,
+            f"r = {amplitude:g} m sin(2 pi {freqs[0]:g} t)")
+
+
+def _time_series(args: argparse.Namespace, sc) -> int:
+    """Transient run from rest, streamed to CSV atomically, with its summary."""
+    from motionhyst.references import SineReference
+    from motionhyst.systems import MeasuredPlant
+    from motionhyst.timeseries import run_time_series
+
+    if isinstance(sc.plant(), MeasuredPlant):
+        raise UsageError(f"motionhyst simulate: --time-series needs a plant model; {sc.source} "
+                         f"uses its measured [plant] as raw data (use = \"data\"), which has no "
+                         f"time-domain model; use = \"fit\" fits one")
+    ref, default_duration, what = _reference(args, sc)
+    inputs = [*sc.files, args.reference_csv]
+    out = output_file(args.time_series, args, "--time-series", inputs)
+    duration = args.duration or default_duration
+    if isinstance(ref, SineReference):
+        check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz], "simulate")
+        if 1.0 / ref.frequency_hz > duration:
+            warn(f"simulate: the period 1/{ref.frequency_hz:g} Hz = {1 / ref.frequency_hz:.3g} s "
+                 f"exceeds --duration {duration:g} s: no full period, the run is start-up only")
+    options = {"output_rate_hz": args.output_rate}
+    if args.settle_band is not None:
+        options["settle_band"] = args.settle_band
+    with out.open(newline="") as fh:
+        s = run_time_series(sc.loop(), ref, duration, fh, **options)
+    s = {"time_series": str(out.path), **s}
     if args.json:
-        print_json(summary)
-    else:
-        print(f"Simulated {summary['duration_s']:.4g} s of {sc.source}, {what}: "
-              f"{summary['samples']} samples (dt = {summary['dt_s']:.3g} s) -> {out}")
-        print(f"  peak |e| = {summary['error_peak']:.4g} m "
-              f"(without hysteresis {summary['error_linear_peak']:.4g} m)")
+        print_json(s)
+        return 0
+    print(f"Simulated {s['duration_s']:.4g} s of {sc.source}, {what}: {s['steps']} steps of "
+          f"{s['dt_s']:.3g} s, {s['samples']} rows at {s['output_rate_hz']:g} Hz -> {out.path}")
+    print(f"  whole run from rest: peak |e| = {s['error_peak']:.4g} m (without hysteresis "
+          f"{s['error_linear_peak']:.4g} m), start-up transient included")
+    if "last_period" in s:
+        lp = s["last_period"]
+        if lp is None:
+            print("  last full period: none (the run is shorter than one period)")
+        else:
+            print(f"  last full period ({lp['start_s']:.4g}-{lp['end_s']:.4g} s): peak |e| = "
+                  f"{lp['error_peak']:.4g} m, RMS {lp['error_rms']:.4g} m; without hysteresis "
+                  f"peak {lp['error_linear_peak']:.4g} m, RMS {lp['error_linear_rms']:.4g} m")
+    if "move" in s:
+        mv = s["move"]
+
+        def settle(v):
+            return "not within the run" if v is None else f"{v * 1e3:.4g} ms"
+
+        print(f"  while moving ({mv['start_s']:.4g}-{mv['end_s']:.4g} s): peak |e| = "
+              f"{mv['error_peak']:.4g} m (without hysteresis {mv['error_linear_peak']:.4g} m)")
+        print(f"  settling into +-{mv['settle_band']:.3g} m after the move: "
+              f"{settle(mv['settling_time_s'])} (without hysteresis "
+              f"{settle(mv['settling_time_linear_s'])})")
+    print(f"  final error {s['error_final']:.4g} m (without hysteresis "
+          f"{s['error_linear_final']:.4g} m)")
     return 0
 
 
@@ -85,13 +143,22 @@ def add_parser(sub) -> None:
     q.add_argument("--amplitude", type=positive, help="reference amplitude [m]")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.add_argument("--time-series", metavar="OUT.csv",
-                   help="write a transient run from rest to CSV (sine of the first frequency, "
-                        "or --reference-csv / --profile)")
-    q.add_argument("--reference-csv", metavar="FILE", help="reference CSV: time,position [s, m]")
+                   help="write a transient run from rest to CSV (sine of one frequency, "
+                        "or --reference-csv / --profile); an existing file needs --force")
+    q.add_argument("--reference-csv", metavar="FILE",
+                   help="reference CSV: time,position [s, m] (comma or semicolon, any case)")
     q.add_argument("--profile", choices=["point-to-point"], help="built-in reference profile")
-    q.add_argument("--distance", type=float, default=0.01, help="move length [m] (0.01)")
-    q.add_argument("--v-max", type=positive, default=0.5, help="velocity limit [m/s] (0.5)")
-    q.add_argument("--a-max", type=positive, default=10.0, help="acceleration limit [m/s^2] (10)")
-    q.add_argument("--j-max", type=positive, default=1000.0, help="jerk limit [m/s^3] (1000)")
-    q.add_argument("--duration", type=positive, help="simulated time [s]")
+    q.add_argument("--distance", type=float, help="move length [m] (0.01)")
+    q.add_argument("--v-max", type=positive, help="velocity limit [m/s] (0.5)")
+    q.add_argument("--a-max", type=positive, help="acceleration limit [m/s^2] (10)")
+    q.add_argument("--j-max", type=positive, help="jerk limit [m/s^3] (1000)")
+    q.add_argument("--duration", type=positive,
+                   help="simulated time [s] (sine 1, profile its length + 0.2, file its length)")
+    q.add_argument("--output-rate", type=positive, metavar="HZ",
+                   help="rows per second of the CSV (default: the reference file's own rate, "
+                        "10 kHz for sines and profiles); the integration step follows the "
+                        "loop's dynamics")
+    q.add_argument("--settle-band", type=positive, metavar="M",
+                   help="point-to-point: half-width of the settling band [m] (1e-8 = 10 nm)")
+    add_force_option(q)
     q.set_defaults(func=run)

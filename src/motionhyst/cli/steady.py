@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import positive, print_json
+from motionhyst.cli._common import check_plausible, distinct, positive, print_json
 
 
 def run(args: argparse.Namespace) -> int:
@@ -14,9 +14,11 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.comparison import compare_with_describing_function
     from motionhyst.scenario import load_scenario
 
+    args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario)
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
+    check_plausible(sc.loop(), amplitude, freqs, args.command)
     result = compare_with_describing_function(sc.loop(), amplitude, freqs)
     if args.json:
         print_json(result.to_dict())

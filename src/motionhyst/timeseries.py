@@ -1,0 +1,269 @@
+"""Long transient runs written as they are computed, and summaries that separate the start-up.
+
+:func:`run_time_series` drives :func:`motionhyst.simulate.simulate_chunks`:
+the integration step follows the loop's dynamics (and a built-in reference's
+own time scale), never the sample rate of a reference file; rows are written
+at the output rate only, chunk by chunk, so memory stays bounded whatever the
+duration.  The summary answers what the run is for:
+
+- a sine: peak and RMS error over the last full period, with and without
+  hysteresis (the start-up transient of a run from rest is excluded; the
+  paper's steady-state comparison, section V);
+- a point-to-point move: peak error while moving, settling time into a band
+  after the move ends, and the final error, with and without hysteresis;
+- any reference: the peak error over the whole run and the final error.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import IO
+
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.loop import Loop
+from motionhyst.references import PointToPoint, SampledReference, SineReference
+from motionhyst.simulate import (
+    STEPS_PER_POLE_PERIOD,
+    STEPS_PER_REFERENCE_PERIOD,
+    Simulation,
+    simulate_chunks,
+)
+from motionhyst.systems import TWO_PI
+
+DEFAULT_OUTPUT_RATE_HZ = 10_000.0
+"""Output rate of built-in references (sines, profiles) unless one is asked for [Hz]."""
+
+DEFAULT_SETTLE_BAND = 10e-9
+"""Half-width of the settling band of a point-to-point move [m] (10 nm)."""
+
+MAX_ROWS = 100_000_000
+"""Most rows a run writes (about 10 GB of CSV)."""
+
+MAX_STEPS = 2_000_000_000
+"""Most integration steps of a run."""
+
+ROWS_PER_CHUNK = 8192
+"""Output rows computed and written at a time."""
+
+COLUMNS = ("time", "reference", "error", "y1", "y2", "u", "w", "error_linear")
+"""Columns of the CSV, in order (as :meth:`motionhyst.simulate.Simulation.columns`)."""
+
+
+def dynamics_step(loop: Loop, reference) -> float:
+    """Integration step [s] from the loop's fastest pole and a built-in reference's time scale.
+
+    A sampled reference (a file) is interpolated between its samples and does
+    not set the step: a 10 kHz file does not force 400 steps per sample.
+
+    Examples
+    --------
+    >>> from motionhyst.scenario import default_scenario
+    >>> from motionhyst.references import SineReference
+    >>> loop = default_scenario().loop()
+    >>> h = dynamics_step(loop, SineReference(0.01, 5.0))
+    >>> 1e-6 < h < 1e-4
+    True
+    """
+    p = float(np.max(np.abs(loop.closed_loop_poles())))
+    h = TWO_PI / (STEPS_PER_POLE_PERIOD * p)
+    if not isinstance(reference, SampledReference):
+        f = float(getattr(reference, "max_frequency_hz", 0.0) or 0.0)
+        if f > 0:
+            h = min(h, 1.0 / (STEPS_PER_REFERENCE_PERIOD * f))
+    return h
+
+
+def reference_rate_hz(reference: SampledReference) -> float:
+    """The sample rate of a sampled reference [Hz]: one over its median sample spacing."""
+    return 1.0 / float(np.median(np.diff(reference.t)))
+
+
+@dataclass
+class _Extreme:
+    """Peak |x|, sum of squares and count of a signal over a window, accumulated by chunks."""
+
+    peak: float = 0.0
+    sum2: float = 0.0
+    count: int = 0
+
+    def add(self, x: NDArray[np.float64]) -> None:
+        if x.size:
+            self.peak = max(self.peak, float(np.max(np.abs(x))))
+            self.sum2 += float(np.dot(x, x))
+            self.count += int(x.size)
+
+    @property
+    def rms(self) -> float:
+        return math.sqrt(self.sum2 / self.count) if self.count else math.nan
+
+
+@dataclass
+class _Settling:
+    """Last time a signal was outside a band, accumulated by chunks."""
+
+    band: float
+    last_out: float = -math.inf
+    final: float = math.nan
+
+    def add(self, t: NDArray[np.float64], x: NDArray[np.float64]) -> None:
+        if x.size:
+            out = np.flatnonzero(np.abs(x) > self.band)
+            if out.size:
+                self.last_out = float(t[out[-1]])
+            self.final = float(x[-1])
+
+
+@dataclass
+class _Signals:
+    """The summaries of one error signal (with or without hysteresis)."""
+
+    whole: _Extreme = field(default_factory=_Extreme)
+    window: _Extreme = field(default_factory=_Extreme)
+    settling: _Settling | None = None
+
+
+def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None = None,
+                    output_rate_hz: float | None = None,
+                    settle_band: float = DEFAULT_SETTLE_BAND) -> dict:
+    """Simulate from rest, write rows at the output rate to `out`, and summarise.
+
+    Parameters
+    ----------
+    loop : Loop
+        An LTI loop (see :func:`motionhyst.simulate.simulate`).
+    reference : SineReference, PointToPoint, SampledReference or callable
+        The reference; a sine or a point-to-point move gets its own summary.
+    duration : float
+        Simulated time [s], > 0.
+    out : text file, optional
+        Where the CSV rows go (header first); nothing is written if None.
+    output_rate_hz : float, optional
+        Rows per second.  Default: a sampled reference's own rate, else
+        :data:`DEFAULT_OUTPUT_RATE_HZ`.  The integration step divides the
+        output period, so every row is an integration sample.
+    settle_band : float
+        Half-width of the settling band of a point-to-point move [m].
+
+    Returns
+    -------
+    dict
+        ``samples`` (rows), ``steps`` (integration samples), ``dt_s``
+        (integration step), ``output_rate_hz``, ``duration_s``,
+        ``error_peak`` / ``error_linear_peak`` (whole run, start-up
+        included), ``error_final`` / ``error_linear_final``, and per kind:
+        ``last_period`` (sine: ``start_s``, ``end_s``, ``error_peak``,
+        ``error_rms``, ``error_linear_peak``, ``error_linear_rms``; None if
+        the run is shorter than a period) or ``move`` (point-to-point:
+        ``start_s``, ``end_s``, ``error_peak``, ``error_linear_peak``,
+        ``settle_band``, ``settling_time_s``, ``settling_time_linear_s``,
+        None where the error is still outside the band at the end).
+
+    Examples
+    --------
+    >>> import io
+    >>> from motionhyst.scenario import default_scenario
+    >>> from motionhyst.references import SineReference
+    >>> buf = io.StringIO()
+    >>> s = run_time_series(default_scenario().loop(), SineReference(0.01, 10.0), 0.2, buf,
+    ...                     output_rate_hz=1000.0)
+    >>> s["samples"], buf.getvalue().splitlines()[0]
+    (201, 'time,reference,error,y1,y2,u,w,error_linear')
+    >>> s["last_period"]["error_peak"] < s["error_peak"]  # the start-up is excluded
+    True
+    """
+    if not (np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be finite and > 0, got {duration!r}")
+    if output_rate_hz is None:
+        output_rate_hz = (reference_rate_hz(reference) if isinstance(reference, SampledReference)
+                          else DEFAULT_OUTPUT_RATE_HZ)
+    if not (np.isfinite(output_rate_hz) and output_rate_hz > 0):
+        raise ValueError(f"output rate must be finite and > 0, got {output_rate_hz!r}")
+    if not (np.isfinite(settle_band) and settle_band > 0):
+        raise ValueError(f"settle band must be finite and > 0, got {settle_band!r}")
+    period_out = 1.0 / output_rate_hz
+    if period_out > duration:
+        raise ValueError(f"the output period 1/{output_rate_hz:g} Hz is longer than the "
+                         f"duration {duration:g} s")
+    per_row = max(1, math.ceil(period_out / dynamics_step(loop, reference) * (1 - 1e-12)))
+    step = period_out / per_row
+    n_rows = math.floor(duration / period_out * (1 + 1e-12)) + 1
+    end = (n_rows - 1) * period_out
+    if n_rows > MAX_ROWS or n_rows * per_row > MAX_STEPS:
+        raise ValueError(f"{n_rows} rows of {per_row} steps each: too many; lower the output "
+                         f"rate or the duration (at most {MAX_ROWS:.0e} rows, "
+                         f"{MAX_STEPS:.0e} steps)")
+    window = move = None
+    if isinstance(reference, SineReference):
+        period = 1.0 / reference.frequency_hz
+        if period <= end:
+            window = (end - period, end)
+    elif isinstance(reference, PointToPoint):
+        move = (reference.start, reference.start + reference.duration)
+    sig = {name: _Signals(settling=_Settling(settle_band)) for name in ("e", "e_linear")}
+    if out is not None:
+        out.write(",".join(COLUMNS) + "\n")
+    rows = 0
+    steps = 0
+    chunk = per_row * ROWS_PER_CHUNK
+    for piece in simulate_chunks(loop, reference, end, dt=step, chunk=chunk):
+        t = piece.t
+        steps += len(t)
+        for name, x in (("e", piece.e), ("e_linear", piece.e_linear)):
+            s = sig[name]
+            s.whole.add(x)
+            s.settling.add(t, x)
+            span = window or move
+            if span is not None:
+                inside = (t >= span[0] - 0.5 * step) & (t < span[1] - 0.5 * step) \
+                    if window else (t >= span[0]) & (t <= span[1])
+                s.window.add(x[inside])
+        rows += _write_rows(out, piece, per_row, rows, period_out)
+    summary: dict = {"samples": rows, "steps": steps, "dt_s": step,
+                     "output_rate_hz": output_rate_hz, "duration_s": end,
+                     "error_peak": sig["e"].whole.peak,
+                     "error_linear_peak": sig["e_linear"].whole.peak,
+                     "error_final": sig["e"].settling.final,
+                     "error_linear_final": sig["e_linear"].settling.final}
+    if isinstance(reference, SineReference):
+        summary["last_period"] = None if window is None else {
+            "start_s": window[0], "end_s": window[1],
+            "error_peak": sig["e"].window.peak, "error_rms": sig["e"].window.rms,
+            "error_linear_peak": sig["e_linear"].window.peak,
+            "error_linear_rms": sig["e_linear"].window.rms}
+    if move is not None:
+        def settling(s: _Signals):
+            if abs(s.settling.final) > settle_band:
+                return None  # still outside the band at the end of the run
+            return max(0.0, s.settling.last_out + step - move[1])
+
+        summary["move"] = {"start_s": move[0], "end_s": move[1],
+                           "error_peak": sig["e"].window.peak,
+                           "error_linear_peak": sig["e_linear"].window.peak,
+                           "settle_band": settle_band,
+                           "settling_time_s": settling(sig["e"]),
+                           "settling_time_linear_s": settling(sig["e_linear"])}
+    return summary
+
+
+def _write_rows(out: IO[str] | None, piece: Simulation, per_row: int, first_row: int,
+                period_out: float) -> int:
+    """Write every `per_row`-th sample of `piece` as CSV rows; their number.
+
+    Pieces start at a multiple of `per_row` samples, so their first sample is a
+    row; the time column is the row's time ``row * period_out`` (the samples'
+    times up to round-off), so a reference's own time stamps come back exactly.
+    """
+    cols = piece.columns()
+    n = len(cols["time"][::per_row])
+    block = np.column_stack([(first_row + np.arange(n)) * period_out if c == "time"
+                             else cols[c][::per_row] for c in COLUMNS])
+    if out is not None and n:
+        np.savetxt(out, block, delimiter=",", fmt="%.12e")
+    return n
+
+
+__all__ = ["COLUMNS", "DEFAULT_OUTPUT_RATE_HZ", "DEFAULT_SETTLE_BAND", "dynamics_step",
+           "reference_rate_hz", "run_time_series"]
