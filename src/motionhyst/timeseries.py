@@ -77,7 +77,18 @@ def dynamics_step(loop: Loop, reference) -> float:
 
 
 def reference_rate_hz(reference: SampledReference) -> float:
-    """The sample rate of a sampled reference [Hz]: one over its median sample spacing."""
+    """The sample rate of a sampled reference [Hz]: one over its median sample spacing.
+
+    The output grid of :func:`run_time_series` is uniform at this rate, so a
+    file sampled uniformly gets its own time stamps back.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(11) * 1e-4
+    >>> round(reference_rate_hz(SampledReference(t, 1e-3 * t)))
+    10000
+    """
     return 1.0 / float(np.median(np.diff(reference.t)))
 
 
