@@ -53,7 +53,8 @@ html_theme_options = {
     "navigation_with_keys": False,
     "show_toc_level": 2,
 }
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["custom.css"]
 html_sidebars = {"equations": [], "index": [], "examples/index": []}  # pages without sections
 
 
