@@ -184,9 +184,11 @@ def _link_section(name: str, cls: type[Hysteresis], form: Form | None = None
     fields: dict = {"model": (Literal[name], ...)}
     for p in cls.parameters if form is None else form.parameters:
         t = _FIELD_TYPES[p.kind]
-        if p.many:
-            t = Annotated[list[t], Field(min_length=1)]
-        fields[p.name] = (t, ... if p.required else p.default)
+        default = ... if p.required else p.default
+        if p.many:  # a list; one with a default (a tuple) may be empty
+            t = Annotated[list[t], Field(min_length=1 if p.required else 0)]
+            default = default if p.required else list(default)
+        fields[p.name] = (t, default)
     suffix = "" if form is None else form.name.capitalize()
     section = create_model(f"{cls.__name__}{suffix}Section", __base__=_LinkSection, **fields)
     what = f"the {cls.__name__} model" + ("" if form is None else f" in its {form.name} form")

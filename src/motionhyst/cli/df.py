@@ -30,6 +30,11 @@ def _df_parameters(model: str) -> dict[str, tuple[bool, bool]]:
     return {p.name: (p.many, p.required) for p in model_class(model).parameters}
 
 
+def _option(name: str) -> str:
+    """The ``df`` option of a model parameter: ``--name`` with dashes for underscores."""
+    return "--" + name.replace("_", "-")
+
+
 def _element_from_args(args: argparse.Namespace):
     """The hysteresis element named by ``--model`` and its parameter options."""
     from motionhyst.hysteresis import MODELS
@@ -40,21 +45,22 @@ def _element_from_args(args: argparse.Namespace):
     options = dict.fromkeys(n for m in MODELS for n in _df_parameters(m))
     for name in options:
         if getattr(args, name) is not None and name not in spec:
-            raise UsageError(f"motionhyst df: --{name} does not apply to --model {model} "
-                             f"(its parameters: {', '.join('--' + n for n in spec)})")
+            raise UsageError(f"motionhyst df: {_option(name)} does not apply to --model "
+                             f"{model} (its parameters: {', '.join(map(_option, spec))})")
     params: dict = {"model": model}
     for name, (many, required) in spec.items():
         values = getattr(args, name)
         if values is None:
             if required:
-                raise UsageError(f"motionhyst df: --{name} is required for --model {model}")
+                raise UsageError(f"motionhyst df: {_option(name)} is required for --model "
+                                 f"{model}")
             continue
         if many:
             params[name] = list(values)
         elif len(values) != 1:
             hint = " (use --model maxwell-slip for several)" if name in ("k", "fc") else ""
-            raise UsageError(f"motionhyst df: --{name} takes one value for --model {model}"
-                             f"{hint}")
+            raise UsageError(f"motionhyst df: {_option(name)} takes one value for --model "
+                             f"{model}{hint}")
         else:
             params[name] = values[0]
     try:
@@ -111,13 +117,15 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result)
         return 0
-    k0 = el.initial_stiffness
+    k_init = el.initial_stiffness  # not "k0": a model may have a parameter of that name
 
-    def show(v):
-        return ", ".join(f"{x:g}" for x in v) if isinstance(v, list) else f"{v:g}"
+    def show(v, unit):
+        if isinstance(v, list):
+            return f"{', '.join(f'{x:g}' for x in v)} {unit}".rstrip() if v else "none"
+        return f"{v:g} {unit}".rstrip()
 
     units = {p.name: p.unit for p in el.parameters}
-    params = ", ".join(f"{k} = {show(v)} {units.get(k, '')}".rstrip()
+    params = ", ".join(f"{k} = {show(v, units.get(k, ''))}"
                        for k, v in el.to_dict().items() if k != "model")
     print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 7)")
     rate = el.rate_independent
@@ -128,11 +136,11 @@ def run(args: argparse.Namespace) -> int:
 
     has_zeta = any(not math.isnan(p["zeta"]) for p in points)
     rows = [[*lead(p), *([g(p["zeta"])] if has_zeta else []), g(p["re"]), g(p["im"]),
-             g(p["abs"]), g(p["abs"] / k0), f"{p['phase_deg']:.2f}"] for p in points]
+             g(p["abs"]), g(p["abs"] / k_init), f"{p['phase_deg']:.2f}"] for p in points]
     print(table([*head, *(["zeta [-]"] if has_zeta else []), "Re D [N/m]", "Im D [N/m]",
-                  "|D| [N/m]", "|D|/k0 [-]", "angle D [deg]"], rows))
-    print(f"k0 = {k0:g} N/m, the initial stiffness"
-          + (" (|D| -> k0 as A -> 0)" if rate else ""))
+                  "|D| [N/m]", "|D|/k_init [-]", "angle D [deg]"], rows))
+    print(f"k_init = {k_init:g} N/m, the initial stiffness"
+          + (" (|D| -> k_init as A -> 0)" if rate else ""))
     if args.harmonics:
         print()
         print("Higher-order describing functions H_n = Y_n / A [N/m], relative to sin(n w t)")
@@ -157,11 +165,16 @@ def add_parser(sub) -> None:
     for option, uses in declared.items():
         p = uses[0][1]
         unit = f" [{p.unit}]" if p.unit else ""
-        default = "" if p.required else f" ({p.default:g})"
+        if p.required:
+            default = ""
+        elif p.many:  # a list parameter's default is a tuple
+            default = f" ({', '.join(f'{v:g}' for v in p.default) or 'none'})"
+        else:
+            default = f" ({p.default:g})"
         many = [m for m, pm in uses if pm.many]
         several = f" (one per element for {', '.join(many)})" if many else ""
         models = "all models" if len(uses) == len(MODELS) else ", ".join(m for m, _ in uses)
-        q.add_argument(f"--{option}", type=types[p.kind], nargs="+" if many else 1,
+        q.add_argument(_option(option), type=types[p.kind], nargs="+" if many else 1,
                        help=f"{p.help}{unit}{default}{several}; {models}")
     q.add_argument("--frequency", type=positive, nargs="+",
                    help="frequency(ies) [Hz]; required for the rate-dependent "

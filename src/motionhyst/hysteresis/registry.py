@@ -33,13 +33,15 @@ class Parameter:
     ----------
     name : str
         Keyword of the model's constructor, key in the scenario's
-        ``[hysteresis]`` table and ``--name`` option of ``motionhyst df``.
+        ``[hysteresis]`` table and ``--name`` option of ``motionhyst df``
+        (underscores written as dashes there).
     unit : str
         SI unit (``""`` for a pure number).
     help : str
         One line for ``--help`` and the documentation.
-    default : float, optional
-        Value when not given; ``None`` makes the parameter required.
+    default : float or tuple of float, optional
+        Value when not given (a tuple for a list parameter, ``()`` for none);
+        ``None`` makes the parameter required.
     kind : {"positive", "nonnegative", "finite"}
         The range a single value must lie in (the model's constructor states
         any further rule).
@@ -56,7 +58,7 @@ class Parameter:
     name: str
     unit: str
     help: str
-    default: float | None = None
+    default: float | tuple[float, ...] | None = None
     kind: ParameterKind = "positive"
     many: bool = False
 

@@ -2,7 +2,7 @@
 
 A link model states how it is stepped (:meth:`Hysteresis.time_stepping`) as a
 :class:`Stepping`: one row per element, each a primitive kind of this module
-(``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``) with its parameters.  The time
+(``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``, ``MAXWELL``) with its parameters.  The time
 simulation and the open-loop force of a feedforward model advance the rows
 with :func:`advance`, so they never need to know which model they run.
 
@@ -33,10 +33,10 @@ from motionhyst.hysteresis._ode_kernels import (
     lugre_relax,
 )
 
-__all__ = ["BOUC_WEN", "DAHL", "GL_T", "GL_W", "LUGRE", "N_PARAMS", "STOP", "Stepping",
-           "advance", "open_loop"]
+__all__ = ["BOUC_WEN", "DAHL", "GL_T", "GL_W", "LUGRE", "MAXWELL", "N_PARAMS", "STOP",
+           "Stepping", "advance", "open_loop"]
 
-STOP, DAHL, BOUC_WEN, LUGRE = 0, 1, 2, 3
+STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL = 0, 1, 2, 3, 4
 N_PARAMS = 6
 
 
@@ -47,7 +47,8 @@ class Stepping:
     Attributes
     ----------
     codes : ndarray of int64, shape (n,)
-        Primitive kind of each element (``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``).
+        Primitive kind of each element (``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``,
+        ``MAXWELL``).
     params : ndarray, shape (n, N_PARAMS)
         Each element's parameters, in the order :func:`advance` reads them.
     state0 : ndarray, shape (n,)
@@ -111,6 +112,15 @@ def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no 
     if code == BOUC_WEN:  # p = (k / fc, fc, n, beta + gamma, beta - gamma, hmax); state w / fc
         s = bouc_wen_step(s, p[0] * dx, p[2], p[3], p[4], p[5], glt, glw)
         return s, p[1] * s
+    if code == MAXWELL:  # p = (kv, cv): a spring kv in series with a damper cv; state f
+        # exact for dx linear in time: f+ = f e^-a + cv (dx / h) (1 - e^-a), a = h kv / cv,
+        # written as kv dx (1 - e^-a) / a (a spring kv for h = 0)
+        a = h * p[0] / p[1]
+        if a > 0.0:
+            s = s * np.exp(-a) - p[0] * dx * np.expm1(-a) / a
+        else:
+            s = s + p[0] * dx
+        return s, s
     # LuGre, p = (sigma0, sigma1, sigma2, fc, fs, vs); state z.  As in lugre_response, z
     # relaxes exactly for the step's constant velocity (lugre_relax).  The rates in
     # the force are taken at the sample by the second-order backward difference,
