@@ -345,7 +345,7 @@ def test_analyze_and_steady_state_of_a_scenario(tmp_path):
     assert rc == 0, err
     a = json.loads(out)
     assert a["df_frequency_hz"] == 5.0  # rate-dependent: D at the first frequency
-    rc, out, err = run_cli("simulate", str(path), "--frequency", "10", "--json")
+    rc, out, err = run_cli("steady", str(path), "--frequency", "10", "--json")
     assert rc == 0, err
     (p,) = json.loads(out)["points"]
     # the describing function's prediction of the error is close to the exact steady state
