@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from motionhyst import plots
 from motionhyst.cli import main
 from motionhyst.hysteresis import MODELS, Jenkins, MaxwellIwan, jenkins_describing_function
 from motionhyst.hysteresis.maxwell_iwan import iwan_describing_function
@@ -350,6 +351,21 @@ def test_analyze_and_steady_state_of_a_scenario(tmp_path):
     (p,) = json.loads(out)["points"]
     # the describing function's prediction of the error is close to the exact steady state
     assert p["mismatch_simulated_abs"] == pytest.approx(p["mismatch_df_abs"], rel=0.02)
+
+
+def test_figures_of_the_link(link):
+    """Figs. 5 and 8 draw this link (reproduce with a maxwell-iwan scenario): the loops are the
+    exact ones at zeta = fc / (k A) with fc = ki mean(d), the total slip force."""
+    assert link.fc == pytest.approx(30.0 * 2.05e-3, rel=1e-15)
+    data = plots.fig5_loops(link, frequency_hz=5.0).motionhyst_data
+    A = link.fc / (link.initial_stiffness * 0.5)
+    x, w = link.sine_loop(A, TWO_PI * 5.0)
+    np.testing.assert_allclose(data["zeta=0.5"], np.vstack([x, w]), rtol=1e-12)
+    d8 = plots.fig8_describing_function(link, frequency_hz=5.0).motionhyst_data
+    assert np.all(d8["abs_over_k"] <= 1.0)
+    assert d8["abs_over_k"][-1] == pytest.approx(
+        abs(link.describing_function(0.1 * link.fc / link.initial_stiffness, TWO_PI * 5.0))
+        / link.initial_stiffness, rel=1e-12)
 
 
 # ------------------------------------------------------------------ errors

@@ -217,7 +217,7 @@ class MaxwellIwan(Hysteresis):
     branches (``rate_independent = False``); the Iwan part alone is
     rate-independent and obeys the Masing rules.  For small motions the link
     is a spring ``k0 + ki`` plus the branches; for ``A >> d_max`` the Iwan part
-    slips at the force ``ki mean(d)``.
+    slips at the force ``fc = ki mean(d)``.
 
     Parameters
     ----------
@@ -261,6 +261,7 @@ class MaxwellIwan(Hysteresis):
                   kind="nonnegative"),
         Parameter("d_max", "m", "largest slip displacement fc/k of the Iwan element"))
     N_STOPS = 256
+    MAX_CUTS = 4096
 
     def __init__(self, k0: float, ki: float, d_min: float, d_max: float,
                  kv: ArrayLike = (), cv: ArrayLike = (), *, n_stops: int = N_STOPS) -> None:
@@ -293,8 +294,12 @@ class MaxwellIwan(Hysteresis):
         return float(self.k0 + self.kv.sum() + self.ki)
 
     @property
-    def slip_force(self) -> float:
-        """Force of the Iwan element when all its elements slip, ``ki (d_min + d_max) / 2`` [N]."""
+    def fc(self) -> float:
+        """Total slip force of the Iwan element, ``ki (d_min + d_max) / 2`` [N].
+
+        The force it carries once all its elements slip (the sum of their
+        ``fc``): the scale of the loops, as the figures take it (:mod:`motionhyst.plots`).
+        """
         return 0.5 * self.ki * (self.d_min + self.d_max)
 
     # ------------------------------------------------------------------ linear part
@@ -348,13 +353,17 @@ class MaxwellIwan(Hysteresis):
         A Gauss rule in the slip displacement ``d`` (:func:`_cosine_nodes`, `n`
         nodes per interval) on ``[d_min, d_max]`` cut at the `breaks` inside it.
         Exact for integrands smooth between the breaks (to the rule's spectral
-        convergence); ``d_min = d_max`` gives the one Jenkins element.
+        convergence); ``d_min = d_max`` gives the one Jenkins element.  Beyond
+        ``MAX_CUTS`` breaks (an input with more than ~90 reversals per period)
+        the cuts are their quantiles and the convergence at the others algebraic.
         """
         if self.d_max == self.d_min:
             return np.array([self.ki]), np.array([self.ki * self.d_max])
         b = np.asarray(breaks, dtype=float)
-        b = b[(b > self.d_min) & (b < self.d_max)]
-        cuts = np.unique(np.concatenate([[self.d_min, self.d_max], b]))
+        b = np.unique(b[(b > self.d_min) & (b < self.d_max)])
+        if b.size > self.MAX_CUTS:  # many reversals: cut at the quantiles of the breaks
+            b = np.unique(np.quantile(b, np.linspace(0.0, 1.0, self.MAX_CUTS)))
+        cuts = np.concatenate([[self.d_min], b, [self.d_max]])
         d, w = _cosine_nodes(cuts, n)
         k = w * (self.ki / (self.d_max - self.d_min))
         return k, k * d
@@ -493,7 +502,7 @@ class MaxwellIwan(Hysteresis):
         d = self.d_min + (np.arange(n) + 0.5) * ((self.d_max - self.d_min) / n)
         kj = self.ki / n
         rows += [(STOP, (kj, kj * float(dj))) for dj in d]
-        return Stepping.from_rows(rows, self.slip_force)
+        return Stepping.from_rows(rows, self.fc)
 
     def response(self, x: ArrayLike, w0: float = 0.0, t: ArrayLike | None = None
                  ) -> NDArray[np.float64]:
