@@ -5,6 +5,8 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -232,6 +234,21 @@ def test_response_to_a_sine_approaches_the_exact_loop(n_stops):
             assert err > 0.5 * bound
 
 
+def test_single_slip_displacement_steps_as_the_jenkins_element():
+    """d_min = d_max: one stop operator in the time step, the Jenkins element's exact response;
+    its periodic output is the Jenkins element's too."""
+    one = MaxwellIwan(k0=0.0, ki=30.0, d_min=1e-3, d_max=1e-3)
+    st = one.time_stepping()
+    assert st.codes.size == 1 and st.scale == pytest.approx(0.03)
+    t = np.linspace(0.0, 1.0, 3001)
+    x = 3e-3 * np.sin(TWO_PI * 2.0 * t) * np.exp(-t)
+    jenkins = Jenkins(k=30.0, fc=0.03)
+    assert np.max(np.abs(one.response(x, t=t) - jenkins.response(x))) < 1e-15
+    X = np.array([0.0, 2e-3 / 2j, 0.0, 5e-4 / 2j])
+    assert np.max(np.abs(one.periodic_harmonics(X, 7, 1.0)
+                         - jenkins.periodic_harmonics(X, 7))) < 1e-15
+
+
 def test_loop_simulation_matches_exact_steady_state():
     """The Table I loop with this link: after settling, the simulated error's harmonics are
     those of the exact periodic steady state (64 stop operators: measured 4.6e-6 in e1 and
@@ -347,6 +364,23 @@ def test_df_missing_and_foreign_options_name_the_dashed_option():
     rc, _, err = run_cli("df", "--model", "jenkins", "--k", "20", "--fc", "0.05", "--d-min",
                          "1e-3", "--amplitude", "1e-3")
     assert rc == 2 and "--d-min does not apply to --model jenkins" in err
+
+
+def test_df_imports_nothing_heavy():
+    """The closed-form describing function needs no compiled kernel: ``df`` for this link
+    imports neither numba, python-control nor matplotlib (a fresh interpreter)."""
+    code = ("import contextlib, io, json, sys\n"
+            "from motionhyst.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    rc = main(sys.argv[1:])\n"
+            "heavy = sorted(m for m in sys.modules if m.split('.')[0] in "
+            "('numba', 'control', 'matplotlib'))\n"
+            "print(json.dumps([rc, heavy]))\n")
+    proc = subprocess.run([sys.executable, "-c", code, *DF_ARGS, "--amplitude", "1e-3",
+                           "--frequency", "10"], capture_output=True, text=True, timeout=600,
+                          check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == [0, []]
 
 
 def test_analyze_and_steady_state_of_a_scenario(tmp_path):

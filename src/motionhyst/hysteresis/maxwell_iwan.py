@@ -35,9 +35,9 @@ from fractions import Fraction
 from math import comb
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst._jit import njit
 from motionhyst.hysteresis._kernels import reversal_points
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.jenkins import jenkins_describing_function
