@@ -55,9 +55,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     >>> from motionhyst.cli import main
     >>> main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"])   # doctest: +ELLIPSIS
     Describing function of the jenkins element, k = 20 N/m, fc = 0.05 N ...
-    A [m]  zeta [-]  Re D [N/m]  Im D [N/m]  |D| [N/m]  |D|/k0 [-]  angle D [deg]
-    -----  --------  ----------  ----------  ---------  ----------  -------------
-     0.01      0.25        3.91       4.775      6.171      0.3086          50.69
+    A [m]  zeta [-]  Re D [N/m]  Im D [N/m]  |D| [N/m]  |D|/k_init [-]  angle D [deg]
+    -----  --------  ----------  ----------  ---------  --------------  -------------
+     0.01      0.25        3.91       4.775      6.171          0.3086          50.69
     ...
     0
     >>> main(["df", "--k", "-20", "--fc", "0.05", "--amplitude", "0.01"])  # one line on stderr
