@@ -217,8 +217,12 @@ def _run_example(script: Path, out: Path) -> str:
 
 
 def run_reproduce(out: Path) -> None:
-    """``motionhyst reproduce --out OUT --quiet``: the report and figures the outputs page shows."""
-    out.mkdir(parents=True, exist_ok=True)
+    """``motionhyst reproduce --out OUT --quiet``: the report and figures the outputs page shows.
+
+    `out` is the build's own folder: emptied first, so every build shows a fresh run.
+    """
+    shutil.rmtree(out, ignore_errors=True)
+    out.mkdir(parents=True)
     code = "import sys; from motionhyst.cli import main; sys.exit(main(sys.argv[1:]))"
     proc = subprocess.run([sys.executable, "-c", code, "reproduce", "--out", str(out), "--quiet"],
                           capture_output=True, text=True, env=_env(), check=False, timeout=600)
