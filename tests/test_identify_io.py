@@ -1,4 +1,4 @@
-"""Grey-box identification from input-output records (motionhyst.identify_io) and its CLI."""
+"""Grey-box identification from input-output records (identify.input_output) and its CLI."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from motionhyst.cli import main
 from motionhyst.hysteresis import BoucWen
-from motionhyst.identify_io import IORecord, best_linear_approximation, identify_io
+from motionhyst.identify.input_output import IORecord, best_linear_approximation, identify_io
 from motionhyst.openloop import MassSpringDamper, OpenLoop
 
 FS = 750.0
@@ -185,7 +185,7 @@ def test_free_exponent_of_the_benchmark_link_is_fixed_at_one():
 
 
 def test_inseparable_parameters_are_reported_not_given_huge_errors():
-    from motionhyst.identify_io import _uncertainty, _undetermined_notes
+    from motionhyst.identify.input_output import _uncertainty, _undetermined_notes
 
     rng = np.random.default_rng(8)
     a, b = rng.standard_normal(200), rng.standard_normal(200)

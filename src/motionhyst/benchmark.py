@@ -73,7 +73,7 @@ TEST_SETS: dict[str, tuple[str, str]] = {
     "sinesweep": ("uval_sinesweep.mat", "yval_sinesweep.mat"),
 }
 
-#: Options of :func:`motionhyst.identify_io.identify_io` for the comparison models.
+#: Options of :func:`motionhyst.identify.input_output.identify_io` for the comparison models.
 COMPARISON_OPTIONS: dict[str, dict] = {
     "maxwell-slip": {"n_elements": 3, "substeps": 5, "max_nfev": 3, "start_nfev": 20}}
 
@@ -433,7 +433,7 @@ def run_benchmark(directory: str | Path, *, seed: int = 0, n_experiments: int = 
     Training: `n_experiments` experiments of `n_periods` periods made by the
     benchmark's procedure (:func:`training_record`, fresh multisines and noise
     from `seed`).  Each model in `models` is identified from them alone
-    (:func:`motionhyst.identify_io.identify_io`, from rest), then simulated from
+    (:func:`motionhyst.identify.input_output.identify_io`, from rest), then simulated from
     the official test inputs (the multisine as its periodic steady state, the
     sine sweep from rest) and scored by the RMS of the simulation error over
     each whole test set.  The Maxwell-slip comparison (3 elements) is
@@ -451,7 +451,7 @@ def run_benchmark(directory: str | Path, *, seed: int = 0, n_experiments: int = 
     """
     import time
 
-    from motionhyst.identify_io import IORecord, identify_io
+    from motionhyst.identify.input_output import IORecord, identify_io
 
     tests = {name: load_test_set(directory, name) for name in TEST_SETS}
     say = progress or (lambda msg: None)

@@ -26,7 +26,7 @@ system is then integrated with a fine fixed step, ``substeps`` per sample
   ``z' = alpha y' - beta (gamma |y'| |z|^(nu-1) z + delta y' |z|^nu)``) and the
   linear stage: classical fourth-order Runge-Kutta on ``(y, y', z)``, with the
   forward sensitivities of ``y`` to ``m, c, k, alpha, beta*gamma, beta*delta, nu``
-  when asked (they are what :mod:`motionhyst.identify_io` fits with);
+  when asked (they are what :mod:`motionhyst.identify.input_output` fits with);
 * the other links: the stage discretised exactly for a force linear between
   fine steps (first-order hold) and the link advanced by its exact update
   (as :func:`motionhyst.simulate.simulate`), implicit in ``w`` and solved by a

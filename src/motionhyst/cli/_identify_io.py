@@ -53,7 +53,7 @@ def check_not_input_output(args: argparse.Namespace) -> None:
 
 def run_input_output(args: argparse.Namespace) -> int:
     """Identify the stage and its link from input-output records; print, optionally save."""
-    from motionhyst.identify_io import identify_io, load_io_csv
+    from motionhyst.identify.input_output import identify_io, load_io_csv
 
     for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
         if value is not None:

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from motionhyst.cli._common import UsageError, g, positive, print_json, table
+from motionhyst.cli._common import UsageError, g, positive, print_json
 from motionhyst.cli._identify_io import (
     add_input_output_arguments,
     check_not_input_output,
@@ -113,12 +112,6 @@ def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
             f"hysteresis = {table}\n")
 
 
-def _std_text(value: float, std: float) -> str:
-    if not math.isfinite(std):
-        return "not determined"
-    return f"{std:.2g} ({100 * std / value:.2g} %)"
-
-
 def run(args: argparse.Namespace) -> int:
     """Identify Maxwell-slip hysteresis from a measured record (CSV)."""
     from motionhyst.identify import (
@@ -174,16 +167,7 @@ def run(args: argparse.Namespace) -> int:
         print_json({**ident.to_dict(), **extra})
         return 0
     print(f"Maxwell-slip hysteresis identified from {path} ({what}, {ident.n_samples} samples)")
-    print(f"  elements: {ident.n_elements}   ({ident.criterion})")
-    print(f"  fit RMS {g(ident.fit_rms)} N = {100 * ident.fit_nrms:.3g} % of the "
-          f"{ident.signal} RMS, R^2 = {ident.r2:.6f}, offset {g(ident.offset)} N")
-    print()
-    rows = [[str(i), g(e["k"], 6), _std_text(e["k"], e["k_std"]), g(e["fc"], 6),
-             _std_text(e["fc"], e["fc_std"]), g(e["fc"] / e["k"] * 1e3)]
-            for i, e in enumerate(ident.elements, start=1)]
-    print(table(["i", "k [N/m]", "std k [N/m]", "fc [N]", "std fc [N]", "fc/k [mm]"], rows))
-    print()
-    print(f"  total stiffness {g(sum(k), 6)} N/m, total slip force {g(sum(fc), 6)} N")
+    print(ident)
     print()
     print("# hysteresis feedforward, to paste into a scenario (replaces its [feedforward];")
     print("# the same inline table is a valid [hysteresis] section to model the link):")

@@ -1,0 +1,192 @@
+"""Measured records for identification: reading them (CSV, arrays, DataFrames) and checking
+that they can be identified from (length, finite values, increasing time, reversals)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst._jit import njit
+from motionhyst.csvdata import Source, describe, read_columns
+
+MIN_SAMPLES = 50
+"""Fewest samples accepted in a record."""
+
+
+REVERSAL_BAND = 0.01
+"""A reversal is a retreat of more than this fraction of the range from a running extreme."""
+
+
+@njit(cache=True)
+def _count_reversals(x, band):  # pragma: no cover - compiled
+    """Direction changes of `x` that retreat more than `band` from a running extreme."""
+    n_rev = 0
+    direction = 0
+    hi = x[0]
+    lo = x[0]
+    ext = x[0]
+    for i in range(1, x.shape[0]):
+        v = x[i]
+        if direction == 0:
+            hi = max(hi, v)
+            lo = min(lo, v)
+            if v - lo > band:
+                direction = 1
+                ext = v
+            elif hi - v > band:
+                direction = -1
+                ext = v
+        elif direction == 1:
+            if v > ext:
+                ext = v
+            elif ext - v > band:
+                n_rev += 1
+                direction = -1
+                ext = v
+        else:
+            if v < ext:
+                ext = v
+            elif v - ext > band:
+                n_rev += 1
+                direction = 1
+                ext = v
+    return n_rev
+
+
+def count_reversals(x: ArrayLike, band: float | None = None) -> int:
+    """Number of direction reversals of a sampled signal.
+
+    Parameters
+    ----------
+    x : array_like
+        Samples.
+    band : float, optional
+        Excursions smaller than this are ignored (noise); by default
+        ``REVERSAL_BAND`` times the range of `x`.
+
+    Returns
+    -------
+    int
+        How often `x` turns back by more than `band` from its running extreme.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.identify import count_reversals
+    >>> t = np.linspace(0.0, 2.0, 2001)
+    >>> count_reversals(np.sin(2 * np.pi * 2.0 * t))        # 2 Hz for 2 s: 8 extrema
+    8
+    """
+    xs = np.ascontiguousarray(x, dtype=float)
+    if xs.size < 2:
+        return 0
+    if band is None:
+        band = REVERSAL_BAND * float(np.ptp(xs))
+    return int(_count_reversals(xs, float(band)))
+
+
+def _check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
+                   xname: str = "displacement") -> None:
+    """``ValueError`` (one line, no file) for records that cannot be identified from."""
+    arrays = {xname: x, **named}
+    if t is not None:
+        arrays = {"time": t, **arrays}
+    lengths = {k: v.shape for k, v in arrays.items()}
+    if any(v.ndim != 1 for v in arrays.values()) or len(set(lengths.values())) != 1:
+        raise ValueError("inconsistent lengths: " + ", ".join(
+            f"{k} {v.size}" for k, v in arrays.items()))
+    if x.size < MIN_SAMPLES:
+        raise ValueError(f"too short: {x.size} samples, need at least {MIN_SAMPLES}")
+    for k, v in arrays.items():
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"non-finite value in {k} (sample {int(np.argmin(np.isfinite(v)))})")
+    if t is not None and np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0))
+        raise ValueError(f"time must be strictly increasing (sample {i + 1})")
+    if not np.ptp(x) > 0:
+        raise ValueError(f"constant {xname}: nothing to identify from")
+    if count_reversals(x) < 1:
+        raise ValueError(f"no reversal: the {xname} must move back and forth at least once")
+
+
+def _load(source: Source, names: tuple[str, str, str], xname: str):
+    data = read_columns(source, names)
+    t, x, v = data[:, 0], data[:, 1], data[:, 2]
+    try:
+        _check_signals(x, {names[2]: v}, t, xname=xname)
+    except ValueError as exc:
+        raise ValueError(f"{describe(source)}: {exc}") from None
+    return t, x, v
+
+
+def load_force_displacement_csv(source: Source
+                                ) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                           NDArray[np.float64]]:
+    """Read a force-displacement record from CSV (or an array or DataFrame).
+
+    The file has a header and the columns ``time,displacement,force``
+    (s, m, N; other columns are ignored; the dialects of
+    :mod:`motionhyst.csvdata`: BOM, comma or semicolon, names in any case).
+    A DataFrame has those columns by name, an array those three columns in order.
+
+    Returns
+    -------
+    t, x, w : ndarray
+        Time [s], displacement [m], force [N].
+
+    Raises
+    ------
+    ValueError
+        With one line naming the file: unreadable, missing column, non-numeric
+        or non-finite value, rows of inconsistent length, fewer than
+        ``MIN_SAMPLES`` samples, time not strictly increasing, constant
+        displacement, or no reversal of the displacement.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from motionhyst import Jenkins
+    >>> from motionhyst.identify import load_force_displacement_csv
+    >>> t = np.linspace(0.0, 1.0, 1001)
+    >>> x = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+    >>> path = Path(tempfile.mkdtemp()) / "record.csv"
+    >>> np.savetxt(path, np.column_stack([t, x, Jenkins(k=20.0, fc=0.05).response(x)]),
+    ...            delimiter=",", header="time,displacement,force", comments="")
+    >>> t, x, w = load_force_displacement_csv(path)
+    >>> t.size, float(w.max())
+    (1001, 0.05)
+    """
+    return _load(source, ("time", "displacement", "force"), "displacement")
+
+
+def load_closed_loop_csv(source: Source
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                    NDArray[np.float64]]:
+    """Read a closed-loop record from CSV: header and columns ``time,y1,u`` (s, m, N).
+
+    An array (those columns in order) or a DataFrame is accepted as well.
+
+    Returns
+    -------
+    t, y1, u : ndarray
+        Time [s], position of the actuated mass [m], actuator force [N].
+
+    Raises
+    ------
+    ValueError
+        As :func:`load_force_displacement_csv` (with ``y1`` in place of the
+        displacement).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.identify import load_closed_loop_csv
+    >>> t = np.linspace(0.0, 1.0, 1001)
+    >>> record = np.column_stack([t, 0.01 * np.sin(2 * np.pi * 2.0 * t), np.cos(2 * np.pi * t)])
+    >>> t, y1, u = load_closed_loop_csv(record)           # columns time, y1, u (or a CSV file)
+    >>> y1.shape
+    (1001,)
+    """
+    return _load(source, ("time", "y1", "u"), "y1")

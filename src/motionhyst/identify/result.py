@@ -1,0 +1,162 @@
+"""The result of an identification: :class:`Identification`."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.textfmt import g, table
+
+
+def _fmt(v: float) -> str:
+    """A float as a TOML float literal with 7 significant digits."""
+    s = repr(float(f"{float(v):.7g}"))
+    return s if ("." in s or "e" in s or "inf" in s or "nan" in s) else s + ".0"
+
+
+@dataclass
+class Identification:
+    """Identified Maxwell-slip (parallel Jenkins) hysteresis and the quality of the fit.
+
+    Attributes
+    ----------
+    model : MaxwellSlip
+        The identified elements, ordered by slip displacement ``fc / k``.
+    elements : list of dict
+        Per element ``{"k", "fc", "k_std", "fc_std"}`` [N/m, N]; ``*_std`` are
+        standard errors (``inf`` where the data do not determine the value).
+    offset : float
+        Constant force offset ``c`` of the record [N] (sensor bias).
+    offset_std : float
+        Its standard error [N].
+    initial_forces : ndarray
+        Each element's force at the first sample [N] (zero when started relaxed).
+    fit_rms : float
+        RMS of the residual [N].
+    fit_nrms : float
+        ``fit_rms`` over the RMS of the force about its mean [-].
+    r2 : float
+        Coefficient of determination ``1 - RSS / TSS`` [-].
+    n_samples : int
+        Samples in the residual.
+    criterion : str
+        How the number of elements was chosen.
+    candidates : list of dict
+        Every order tried: ``{"n_elements", "fit_rms", "bic"}``.
+    signal : str
+        What was fitted: ``"force"`` or, for closed-loop records,
+        ``"prefiltered force"`` (the residual is in the prefiltered domain).
+    cutoff_hz : float or None
+        Cut-off of the prefilter of a closed-loop record [Hz]; None for a
+        force-displacement record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import MaxwellSlip
+    >>> from motionhyst.identify import identify_maxwell_slip
+    >>> t = np.linspace(0.0, 4.0, 4001)
+    >>> x = 0.01 * np.exp(-t / 2) * np.sin(2 * np.pi * 2.0 * t)
+    >>> ident = identify_maxwell_slip(x, MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).response(x))
+    >>> print(f"R^2 = {ident.r2:.6f}, {ident.n_samples} samples")
+    R^2 = 1.000000, 4001 samples
+    >>> w = ident.predict(0.005 * np.sin(np.linspace(0.0, 4 * np.pi, 200)))   # any displacement
+    >>> print(ident.scenario_fragment())                   # doctest: +ELLIPSIS
+    # identified from 4001 samples: ...
+    [hysteresis]
+    model = "maxwell-slip"
+    k = [10.0, 6.0]      # spring stiffnesses [N/m]
+    fc = [0.01, 0.03]     # slip forces [N]
+    """
+
+    model: MaxwellSlip
+    elements: list[dict[str, float]]
+    offset: float
+    offset_std: float
+    initial_forces: NDArray[np.float64]
+    fit_rms: float
+    fit_nrms: float
+    r2: float
+    n_samples: int
+    criterion: str
+    candidates: list[dict] = field(default_factory=list)
+    signal: str = "force"
+    cutoff_hz: float | None = None
+
+    @property
+    def n_elements(self) -> int:
+        """Number of Jenkins elements."""
+        return len(self.elements)
+
+    def predict(self, x: ArrayLike, w0: ArrayLike = 0.0) -> NDArray[np.float64]:
+        """Force of the identified model for displacement `x`, plus the offset [N].
+
+        Parameters
+        ----------
+        x : array_like
+            Displacement samples [m].
+        w0 : float or array_like
+            Initial force per element [N] (default: relaxed).
+        """
+        return self.model.response(x, w0) + self.offset
+
+    def to_dict(self) -> dict:
+        """Result as a JSON-ready dictionary."""
+        return {"model": "maxwell-slip", "elements": [dict(e) for e in self.elements],
+                "fit_rms": self.fit_rms, "fit_nrms": self.fit_nrms, "r2": self.r2,
+                "n_samples": self.n_samples, "offset": self.offset,
+                "criterion": self.criterion, "signal": self.signal,
+                "candidates": [dict(c) for c in self.candidates],
+                **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz})}
+
+    def __str__(self) -> str:
+        def std_text(value: float, std: float) -> str:
+            return "not determined" if not math.isfinite(std) else \
+                f"{std:.2g} ({100 * std / value:.2g} %)"
+
+        rows = [[str(i), g(e["k"], 6), std_text(e["k"], e["k_std"]), g(e["fc"], 6),
+                 std_text(e["fc"], e["fc_std"]), g(e["fc"] / e["k"] * 1e3)]
+                for i, e in enumerate(self.elements, start=1)]
+        k = sum(e["k"] for e in self.elements)
+        fc = sum(e["fc"] for e in self.elements)
+        return "\n".join([
+            f"  elements: {self.n_elements}   ({self.criterion})",
+            f"  fit RMS {g(self.fit_rms)} N = {100 * self.fit_nrms:.3g} % of the "
+            f"{self.signal} RMS, R^2 = {self.r2:.6f}, offset {g(self.offset)} N",
+            "",
+            table(["i", "k [N/m]", "std k [N/m]", "fc [N]", "std fc [N]", "fc/k [mm]"], rows),
+            "",
+            f"  total stiffness {g(k, 6)} N/m, total slip force {g(fc, 6)} N"])
+
+    def plot(self):
+        """The identified link's force-displacement loops (:func:`motionhyst.figures.plot_link`).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.figures import plot_link
+
+        return plot_link(self.model, title=f"Identified Maxwell-slip link, "
+                         f"{self.n_elements} element(s)")
+
+    def scenario_fragment(self) -> str:
+        """A ``[hysteresis]`` section of a scenario file (TOML), ready to paste.
+
+        One element is written as ``model = "jenkins"`` with scalars, more as
+        ``model = "maxwell-slip"`` with lists.
+        """
+        k, fc = self.model.k, self.model.fc
+        head = (f"# identified from {self.n_samples} samples: fit NRMS "
+                f"{100 * self.fit_nrms:.3g} %, R^2 {self.r2:.6f}\n[hysteresis]\n")
+        if k.size == 1:
+            return (head + 'model = "jenkins"\n'
+                    f"k = {_fmt(k[0])}      # spring stiffness k_J [N/m]\n"
+                    f"fc = {_fmt(fc[0])}     # slip force f_c [N]\n")
+        return (head + 'model = "maxwell-slip"\n'
+                f"k = [{', '.join(_fmt(v) for v in k)}]      # spring stiffnesses [N/m]\n"
+                f"fc = [{', '.join(_fmt(v) for v in fc)}]     # slip forces [N]\n")
