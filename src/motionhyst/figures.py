@@ -295,3 +295,27 @@ def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:
     ax.set_title(title or f"{link.name} link")
     ax.legend()
     return fig
+
+
+def plot_simulation(sim) -> Figure:
+    """A :class:`~motionhyst.simulate.Simulation`: the error with and without the link, and
+    the link force, against time.
+
+    Examples
+    --------
+    >>> from motionhyst import SineReference, default_scenario, simulate
+    >>> fig = plot_simulation(simulate(default_scenario().loop(), SineReference(0.01, 5.0), 0.1))
+    >>> sorted(fig.motionhyst_data)
+    ['e', 'e_linear', 't', 'w']
+    """
+    fig, (ax1, ax2) = _figure(2)
+    ax1.plot(sim.t, sim.e * 1e9, color="k", label="with the link")
+    ax1.plot(sim.t, sim.e_linear * 1e9, color=LINEAR_COLOR, label="without the link")
+    ax1.set_ylabel("e [nm]")
+    ax1.set_title("Time simulation from rest")
+    ax1.legend()
+    ax2.plot(sim.t, sim.w, color="tab:red")
+    ax2.set_ylabel("link force w [N]")
+    ax2.set_xlabel("time [s]")
+    fig.motionhyst_data.update(t=sim.t, e=sim.e, e_linear=sim.e_linear, w=sim.w)
+    return fig

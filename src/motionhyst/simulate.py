@@ -37,6 +37,7 @@ from motionhyst.lti import (
     stack,
 )
 from motionhyst.systems import TWO_PI
+from motionhyst.textfmt import g, table
 
 STEPS_PER_POLE_PERIOD = 40
 STEPS_PER_REFERENCE_PERIOD = 400
@@ -68,6 +69,8 @@ class Simulation:
     ['time', 'reference', 'error', 'y1', 'y2', 'u', 'w', 'error_linear']
     >>> bool(abs(sim.w).max() <= 0.05)                      # the Jenkins link's force, |w| <= fc
     True
+    >>> sim.to_dict()["samples"] == sim.t.size
+    True
     """
 
     t: NDArray[np.float64]
@@ -83,6 +86,43 @@ class Simulation:
         """The signals by name, in CSV column order."""
         return {"time": self.t, "reference": self.r, "error": self.e, "y1": self.y1,
                 "y2": self.y2, "u": self.u, "w": self.w, "error_linear": self.e_linear}
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary: samples, step, and peak and RMS errors with and without the link.
+
+        The signals themselves are in :meth:`columns` (CSV, not JSON).
+        """
+        def rms(x: NDArray[np.float64]) -> float:
+            return float(np.sqrt(np.mean(x ** 2)))
+
+        return {"samples": int(self.t.size), "duration_s": float(self.t[-1] - self.t[0]),
+                "dt_s": float(self.t[1] - self.t[0]) if self.t.size > 1 else None,
+                "error_peak": float(np.max(np.abs(self.e))), "error_rms": rms(self.e),
+                "error_linear_peak": float(np.max(np.abs(self.e_linear))),
+                "error_linear_rms": rms(self.e_linear),
+                "link_force_peak": float(np.max(np.abs(self.w)))}
+
+    def __str__(self) -> str:
+        d = self.to_dict()
+        return "\n".join([
+            f"Time simulation from rest: {d['samples']} samples over {g(d['duration_s'])} s "
+            f"(dt = {g(d['dt_s'])} s)",
+            table(["", "peak |e| [m]", "rms e [m]"],
+                  [["with the link", g(d["error_peak"]), g(d["error_rms"])],
+                   ["without", g(d["error_linear_peak"]), g(d["error_linear_rms"])]]),
+            f"  peak link force {g(d['link_force_peak'])} N"])
+
+    def plot(self):
+        """The error with and without the link, and the link force, against time
+        (:func:`motionhyst.figures.plot_simulation`).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.figures import plot_simulation
+
+        return plot_simulation(self)
 
 
 def _block_systems(loop: Loop, omega0: float):
