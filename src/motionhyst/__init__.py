@@ -1,7 +1,7 @@
 """motionhyst: hysteresis of dynamic links in high-precision motion control.
 
 Model the hysteresis (:class:`Jenkins`, :class:`MaxwellSlip`, :class:`BoucWen`,
-:class:`Dahl`, :class:`LuGre`), predict its effect on tracking with
+:class:`Dahl`, :class:`LuGre`, :class:`MaxwellIwan`), predict its effect on tracking with
 describing functions (:func:`analyze`), and check the prediction against the
 exact periodic steady state of the nonlinear loop (:func:`periodic_steady_state`).
 
@@ -27,7 +27,9 @@ __version__ = "0.1.0"
 
 _EXPORTS = {
     "motionhyst.frf_fit": ("FrfFit", "ModalPlant", "fit_frf"),
-    "motionhyst.hysteresis": ("BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellSlip"),
+    "motionhyst.comparison": ("DescribingFunctionComparison", "compare_with_describing_function"),
+    "motionhyst.hysteresis": ("BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellIwan",
+                              "MaxwellSlip"),
     "motionhyst.margins": ("LoopMargins", "loop_margins"),
     "motionhyst.loop": ("Loop",),
     "motionhyst.quasilinear": ("QuasiLinearAnalysis", "analyze"),
@@ -41,18 +43,28 @@ _EXPORTS = {
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = [
-    "BoucWen", "Dahl", "FrfFit", "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "LoopMargins",
-    "LuGre", "MaxwellSlip", "MeasuredPlant", "ModalPlant", "PointToPoint",
+    "BoucWen", "Dahl", "DescribingFunctionComparison", "FrfFit", "Hysteresis", "Jenkins",
+    "LeadLagLowpass", "Loop", "LoopMargins", "LuGre", "MaxwellIwan", "MaxwellSlip",
+    "MeasuredPlant", "ModalPlant", "PointToPoint",
     "QuasiLinearAnalysis", "SampledReference", "Scenario", "ScenarioError", "Simulation",
-    "SineReference", "SteadyState", "TwoMassStage", "analyze",
+    "SineReference", "SteadyState", "TwoMassStage", "analyze", "compare_with_describing_function",
     "default_scenario", "fit_frf", "load_frd_plant", "load_reference_csv", "load_scenario",
     "loop_margins",
     "periodic_steady_state", "simulate", "steady_state_sweep",
 ]
 
 if TYPE_CHECKING:
+    from motionhyst.comparison import DescribingFunctionComparison, compare_with_describing_function
     from motionhyst.frf_fit import FrfFit, ModalPlant, fit_frf
-    from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, Jenkins, LuGre, MaxwellSlip
+    from motionhyst.hysteresis import (
+        BoucWen,
+        Dahl,
+        Hysteresis,
+        Jenkins,
+        LuGre,
+        MaxwellIwan,
+        MaxwellSlip,
+    )
     from motionhyst.loop import Loop
     from motionhyst.margins import LoopMargins, loop_margins
     from motionhyst.quasilinear import QuasiLinearAnalysis, analyze
