@@ -18,7 +18,9 @@ import pytest
 
 import motionhyst
 
-HEAVY = ("control", "scipy.signal", "matplotlib", "numba")
+# python-control, scipy (scipy.signal, scipy.fft, ...), matplotlib, numba and pandas each take
+# longer to import than these commands take to run
+HEAVY = ("control", "scipy", "matplotlib", "numba", "pandas")
 PACKAGE = Path(motionhyst.__file__).parent
 
 _PROBE = """

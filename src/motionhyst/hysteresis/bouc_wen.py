@@ -16,7 +16,6 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.fft import next_fast_len
 
 from motionhyst.hysteresis._ode_kernels import (
     GL_T,
@@ -337,6 +336,8 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         """
         if self.n != math.floor(self.n):
             return super().default_samples(X, n_harmonics)
+        from scipy.fft import next_fast_len  # here: importing scipy.fft delays every command
+
         X = truncate_harmonics(X)
         amp = float(np.sum(np.abs(X[1:]))) * 2.0  # bound on the half range of x
         r = self.k * amp / self.fc
