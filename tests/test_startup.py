@@ -159,3 +159,23 @@ def test_read_only_install_caches_in_the_user_folder(tmp_path):
     assert second.returncode == 0, second.stderr
     assert second.stdout == first.stdout
     assert "compiling" not in second.stderr  # loaded from the cache, nothing announced
+
+
+def test_cache_folder_is_keyed_by_the_sources(tmp_path):
+    """numba checks a cached kernel against its own file only: after any source changes (an
+    upgrade, an edit of a kernel another one calls), the cache folder must be a new one."""
+    root = tmp_path / "src"
+    shutil.copytree(Path(motionhyst.__file__).parent, root / "motionhyst",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    code = "from motionhyst._jit import _cache_folder; print(_cache_folder().name)"
+
+    def folder() -> str:
+        out = subprocess.run([sys.executable, "-c", code], env=_env(root, tmp_path / "cache"),
+                             capture_output=True, text=True, check=True)
+        return out.stdout.strip()
+
+    before = folder()
+    assert before.startswith("numba-") and folder() == before  # stable while nothing changes
+    kernels = root / "motionhyst" / "hysteresis" / "_kernels.py"
+    kernels.write_text(kernels.read_text() + "\n# edited\n")
+    assert folder() != before

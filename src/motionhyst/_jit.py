@@ -7,10 +7,13 @@ run a kernel, such as ``motionhyst --help`` or ``motionhyst df`` for a
 Jenkins element) does not import numba.  At the first call, once per process:
 
 * numba is imported and the cache is chosen: compiled machine code is kept
-  beside the package (``__pycache__``), or, where the package is read-only,
-  in the user's cache folder (numba's own locators, or ``NUMBA_CACHE_DIR``
-  when set); where neither is writable the kernels are compiled in memory for
-  the process instead of failing;
+  beside the package (``__pycache__/numba-<key>``), or, where the package is
+  read-only, in the user's cache folder (``$XDG_CACHE_HOME/motionhyst`` or
+  ``~/.cache/motionhyst``; ``NUMBA_CACHE_DIR`` when set); where neither is
+  writable the kernels are compiled in memory for the process instead of
+  failing.  ``<key>`` is a hash of the package's sources: numba checks a
+  cached kernel only against its own file, so a kernel whose callee in another
+  file changed (an upgrade, an edit) would otherwise run stale machine code;
 * the first compilation announces itself with one line on stderr (it takes
   seconds; later runs load the cache).
 
@@ -20,9 +23,13 @@ dispatcher inside compiled code.
 
 from __future__ import annotations
 
+import hashlib
+import os
 import sys
+import tempfile
 import threading
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 _LOCK = threading.RLock()
@@ -32,6 +39,44 @@ _PACKAGE = __name__.rpartition(".")[0]
 
 def _probe() -> None:
     """A function of this package's files: where numba would cache it decides for all."""
+
+
+def _source_key() -> str:
+    """A short hash of every source file of the package (the cache folder's name)."""
+    root = Path(__file__).resolve().parent
+    h = hashlib.sha1()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _writable_folder(folder: Path) -> bool:
+    """True if `folder` exists or can be made, and a file can be written in it."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def _cache_folder() -> Path | None:
+    """The folder for compiled kernels, keyed by the sources; None if none is writable."""
+    name = f"numba-{_source_key()}"
+    user = os.environ.get("NUMBA_CACHE_DIR")
+    if user:
+        candidates = [Path(user) / "motionhyst" / name]
+    else:
+        xdg = os.environ.get("XDG_CACHE_HOME")
+        home = os.environ.get("HOME")
+        candidates = [Path(__file__).resolve().parent / "__pycache__" / name]
+        if xdg:
+            candidates.append(Path(xdg) / "motionhyst" / name)
+        elif home:
+            candidates.append(Path(home) / ".cache" / "motionhyst" / name)
+    return next((c for c in candidates if _writable_folder(c)), None)
 
 
 def _can_cache(py_func: Callable = _probe) -> bool:
@@ -121,7 +166,10 @@ class Kernel:
                 if d is None:
                     numba = _numba()
                     if _STATE["cache"] is None:
-                        _STATE["cache"] = _can_cache()
+                        folder = _cache_folder()
+                        if folder is not None:  # numba's locator for a user-given folder
+                            numba.config.CACHE_DIR = str(folder)
+                        _STATE["cache"] = folder is not None and _can_cache()
                     # a function without a source file (a doctest, the REPL) is never cached
                     cache = _STATE["cache"] and _can_cache(self.py_func)
                     d = numba.njit(cache=cache, **self._options)(self.py_func)
