@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
 from conftest import FC_LINK, K_LINK
 from numpy.testing import assert_allclose
 
+from motionhyst.cli import main as cli_main
 from motionhyst.hysteresis import Jenkins
 from motionhyst.loop import Loop
 from motionhyst.profiles import point_to_point, scan
@@ -162,3 +166,62 @@ def test_invalid_requests(loop):
         run_scan(loop, p, 0.2)
     with pytest.raises(ValueError, match="tolerance"):
         run_scan(loop, p, 0.02, settle_tolerance=0.0)
+
+
+# ----------------------------------------------------------------------------------- CLI
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+SHORT = ["--length", "0.005", "--speed", "0.05", "--a-max", "2", "--j-max", "50",
+         "--s-max", "1000", "--window", "0.02", "--tail", "0.01"]
+
+
+def test_cli_scan_json_and_time_series(tmp_path, capsys):
+    out = tmp_path / "ts.csv"
+    argv = ["scan", str(EXAMPLES / "scan.toml"), *SHORT, "--compensation", "none", "model",
+            "ilc", "--ilc-trials", "2", "--time-series", str(out), "--json"]
+    assert cli_main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["window_s"] == 0.02 and d["profile"]["kind"] == "scan"
+    assert [r["compensation"] for r in d["results"]] == ["none", "model", "ilc"]
+    assert len(d["ilc"]["trials"]) == 2 and d["ilc"]["robustness_cutoff_hz"] == 300.0
+    assert d["carry_over"]["profile"]["v_max"] == 0.025  # half the speed by default
+    none, model = d["results"][0], d["results"][1]
+    # 4 % too large a model leaves 4 % of the slipping link's MA, fc / C(0) = 8.06 nm
+    assert none["ma_max"] == pytest.approx(FC_LINK / 6.2e6, rel=5e-3)
+    assert model["ma_max"] == pytest.approx(0.04 * none["ma_max"], rel=0.1)
+    header = out.read_text().splitlines()[0]
+    assert header == ("time,r,scan,e_none,ma_none,msd_none,e_model,ma_model,msd_model,"
+                      "e_ilc,ma_ilc,msd_ilc")
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert set(np.unique(data[:, 2])) == {0.0, 1.0}
+    assert data[-1, 1] == pytest.approx(0.005 + 2 * 0.05 * 0.0584, rel=0.1)  # scan + ramps
+    # the text summary, and an existing file is kept without --force
+    assert cli_main(["scan", *SHORT, "--compensation", "none"]) == 0
+    text = capsys.readouterr().out
+    assert "max |MA| [m]" in text and "without link" in text
+    before = out.read_bytes()
+    assert cli_main(["scan", *SHORT, "--compensation", "none", "--time-series", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err and out.read_bytes() == before
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--compensation", "model"], "has none"),
+    (["--compensation", "none", "none"], "twice"),
+    (["--ilc-gain", "2"], "(0, 2)"),
+    (["--window", "0.5"], "window"),
+    (["--point-to-point", "--back-and-forth"], "--back-and-forth"),
+    (["--ilc-trials", "0"], "--ilc-trials"),
+    (["--speed", "-1"], "--speed"),
+])
+def test_cli_scan_errors_are_one_line_exit_2(extra, message, capsys):
+    assert cli_main(["scan", *SHORT, *extra]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_scan_never_writes_over_its_scenario(tmp_path, capsys):
+    sc = tmp_path / "s.toml"
+    sc.write_text((EXAMPLES / "scan.toml").read_text())
+    before = sc.read_bytes()
+    assert cli_main(["scan", str(sc), *SHORT, "--compensation", "none", "--time-series",
+                     str(sc), "--force"]) == 2
+    assert "scenario" in capsys.readouterr().err and sc.read_bytes() == before

@@ -33,6 +33,7 @@ from motionhyst.ilc import ILCFilters, ILCResult, learn
 from motionhyst.loop import Loop
 from motionhyst.profiles import PHASE_COLORS, Profile, shade_phases
 from motionhyst.simulate import default_step, simulate
+from motionhyst.textfmt import g, table
 
 COMPENSATIONS = ("none", "model", "ilc")
 """The compensations :func:`run_scan` compares."""
@@ -266,26 +267,24 @@ class ScanResult:
                          f"msd_{run.compensation}": run.msd})
         return cols
 
-    def _table(self) -> list[str]:
-        def fmt(x, scale=1.0):
-            return "-" if x is None else f"{x * scale:.4g}"
+    def _table(self, without_link: bool = True) -> str:
+        def fmt(x):
+            return "-" if x is None else g(x)
 
-        head = (f"  {'compensation':<14}{'max |MA| [m]':>14}{'max MSD [m]':>14}"
-                f"{'peak |e| [m]':>14}{'settling [s]':>14}")
-        lines = [head]
-        for r in [*self.runs, self.without_link]:
-            lines.append(f"  {r.compensation:<14}{fmt(r.ma_max):>14}{fmt(r.msd_max):>14}"
-                         f"{fmt(r.peak_error):>14}{fmt(r.settling_time_s):>14}")
-        return lines
+        runs = [*self.runs, self.without_link] if without_link else self.runs
+        return table(["compensation", "max |MA| [m]", "max MSD [m]", "peak |e| [m]",
+                      "settling [s]"],
+                     [[r.compensation, fmt(r.ma_max), fmt(r.msd_max), fmt(r.peak_error),
+                       fmt(r.settling_time_s)] for r in runs])
 
     def __str__(self) -> str:
         out = [f"{self.profile}", f"exposure window {self.window:g} s, settling band "
-               f"{self.settle_tolerance:g} m", *self._table()]
+               f"{self.settle_tolerance:g} m", self._table()]
         if self.ilc is not None:
             out.append(str(self.ilc))
         if self.carry_over is not None:
             out += ["carried over to another setpoint (model and learned force unchanged):",
-                    f"{self.carry_over.profile}", *self.carry_over._table()[:-1]]
+                    f"{self.carry_over.profile}", self.carry_over._table(without_link=False)]
         return "\n".join(out)
 
     def plot(self, unit: float = 1e-9, unit_name: str = "nm"):
@@ -310,9 +309,10 @@ class ScanResult:
         handles, labels = axes[0].get_legend_handles_labels()
         handles += [Patch(color=c, alpha=0.15) for c in PHASE_COLORS.values()]
         labels += list(PHASE_COLORS)
-        axes[0].legend(handles, labels, ncol=4, fontsize=7, loc="upper right")
         axes[0].set_title(f"{self.profile}\nexposure window W = {self.window * 1e3:g} ms",
                           fontsize=8)
+        fig.legend(handles, labels, ncol=4, fontsize=7, loc="outside lower center",
+                   frameon=False)
         return fig
 
 

@@ -1,5 +1,5 @@
-"""Command-line interface: ``motionhyst df | analyze | steady | simulate | identify | predict |
-benchmark | reproduce``.
+"""Command-line interface: ``motionhyst df | analyze | steady | simulate | scan | identify |
+predict | benchmark | reproduce``.
 
 A thin layer: it parses arguments, calls the library and prints tables or
 JSON.  Every user error ends in one line on stderr and exit code 2.  Each
@@ -19,8 +19,8 @@ from collections.abc import Sequence
 from motionhyst.cli._common import EXIT_USAGE, Parser, UsageError
 from motionhyst.cli.identify import feedforward_fragment, record_kind
 
-COMMANDS = ("df", "analyze", "steady", "simulate", "identify", "predict", "benchmark",
-            "reproduce")
+COMMANDS = ("df", "analyze", "steady", "simulate", "scan", "identify", "predict",
+            "benchmark", "reproduce")
 """The commands, in the order ``motionhyst --help`` lists them (module names)."""
 
 __all__ = ["COMMANDS", "EXIT_USAGE", "UsageError", "build_parser", "feedforward_fragment",

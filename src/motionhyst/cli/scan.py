@@ -1,0 +1,162 @@
+"""``motionhyst scan``: a fourth-order setpoint through the loop, graded by the moving
+average and moving standard deviation of the error over the exposure window, with the
+compensations compared (none, the scenario's hysteresis model, learning control).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from motionhyst.cli._common import UsageError, nonnegative, positive, print_json
+
+PROG = "motionhyst scan"
+LEAD_IN = 0.01
+"""Rest before the setpoint starts [s]: room for the learned force to act ahead of it."""
+
+
+def _count(text: str) -> int:
+    """argparse type: a whole number of trials from 1 to 1000."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 1 <= n <= 1000:
+        raise argparse.ArgumentTypeError(f"must be from 1 to 1000, got {text!r}")
+    return n
+
+
+def add_parser(sub) -> None:
+    """Register ``scan`` on the subcommand parsers `sub`."""
+    q = sub.add_parser("scan", help="scan or point-to-point setpoint: MA/MSD of the error, "
+                       "compensation by the hysteresis model and by learning control")
+    q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
+    q.add_argument("--length", type=positive, required=True,
+                   help="scan length at constant velocity (point-to-point: move length) [m]")
+    q.add_argument("--speed", type=positive, required=True,
+                   help="scan speed (point-to-point: velocity limit) [m/s]")
+    q.add_argument("--a-max", type=positive, required=True, help="acceleration limit [m/s^2]")
+    q.add_argument("--j-max", type=positive, required=True, help="jerk limit [m/s^3]")
+    q.add_argument("--s-max", type=positive, required=True, help="snap limit [m/s^4]")
+    q.add_argument("--point-to-point", action="store_true",
+                   help="a point-to-point move of --length instead of a scan")
+    q.add_argument("--back-and-forth", action="store_true",
+                   help="scan, then scan back to the start")
+    q.add_argument("--dwell", type=nonnegative, default=0.0,
+                   help="rest between a scan and its return [s] (0)")
+    q.add_argument("--rate", type=positive, metavar="HZ",
+                   help="controller rate: switching instants on its samples [Hz]")
+    q.add_argument("--window", type=positive, default=0.01, metavar="W",
+                   help="exposure window of MA and MSD, slit width / scan speed [s] (0.01)")
+    q.add_argument("--compensation", nargs="+", choices=["none", "model", "ilc"],
+                   help="compensations to compare (default: none, model if the scenario has "
+                        "a [feedforward] hysteresis model, ilc)")
+    q.add_argument("--ilc-trials", type=_count, default=10, metavar="N",
+                   help="learning trials; the last is the ilc result (10)")
+    q.add_argument("--ilc-gain", type=positive, default=1.0,
+                   help="learning gain in (0, 2): L = gain / PS, PS = P2 / (1 + C P2) (1)")
+    q.add_argument("--ilc-cutoff", type=positive, default=300.0, metavar="HZ",
+                   help="corner of the zero-phase Butterworth robustness filter Q [Hz] (300)")
+    q.add_argument("--ilc-order", type=_count, default=2,
+                   help="order of the Butterworth filter whose squared magnitude is Q (2)")
+    q.add_argument("--other-length", type=positive, metavar="L",
+                   help="carry-over setpoint: length [m] (default: --length)")
+    q.add_argument("--other-speed", type=positive, metavar="V",
+                   help="carry-over setpoint: speed [m/s] (default: half of --speed)")
+    q.add_argument("--settle-tol", type=positive, default=1e-9, metavar="M",
+                   help="error band of the settling time [m] (1e-9)")
+    q.add_argument("--tail", type=nonnegative, default=0.05,
+                   help="time simulated after the setpoint ends [s] (0.05)")
+    q.add_argument("--time-series", metavar="OUT.csv",
+                   help="write time, r, scan and e_c, ma_c, msd_c per compensation to CSV")
+    q.add_argument("--force", action="store_true", help="overwrite an existing --time-series")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=run)
+
+
+def _profile(args, length: float, speed: float):
+    from motionhyst.profiles import point_to_point, scan
+
+    if args.point_to_point:
+        if args.back_and_forth or args.dwell:
+            raise UsageError(f"{PROG}: --back-and-forth and --dwell apply to scans, not to "
+                             "--point-to-point")
+        return point_to_point(length, speed, args.a_max, args.j_max, args.s_max,
+                              rate_hz=args.rate, start=LEAD_IN)
+    return scan(length, speed, args.a_max, args.j_max, args.s_max,
+                back_and_forth=args.back_and_forth, dwell=args.dwell, rate_hz=args.rate,
+                start=LEAD_IN)
+
+
+def _output_path(args, sc) -> Path | None:
+    if not args.time_series:
+        return None
+    out = Path(args.time_series)
+    if args.scenario and out.resolve() == Path(args.scenario).resolve():
+        raise UsageError(f"{PROG}: --time-series {out} is the scenario file; choose another")
+    if out.is_dir():
+        raise UsageError(f"{PROG}: --time-series {out} is a folder")
+    if out.exists() and not args.force:
+        raise UsageError(f"{PROG}: --time-series {out} exists; use --force to overwrite it")
+    return out
+
+
+def _write_csv(out: Path, cols: dict) -> None:
+    """Write the columns to `out` atomically (a temporary file renamed into place)."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(",".join(cols) + "\n")
+            np.savetxt(fh, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12e")
+        os.replace(tmp, out)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def run(args: argparse.Namespace) -> int:
+    """Simulate the setpoint with each compensation and print the scan metrics."""
+    from motionhyst.ilc import ILCFilters
+    from motionhyst.scan import run_scan
+    from motionhyst.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    loop = sc.loop()
+    has_model = loop.hysteresis_feedforward is not None
+    comps = args.compensation or (["none", "model", "ilc"] if has_model else ["none", "ilc"])
+    if len(set(comps)) != len(comps):
+        raise UsageError(f"{PROG}: --compensation lists one twice")
+    if "model" in comps and not has_model:
+        raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
+                         f"model, and {sc.source} has none")
+    if not 0 < args.ilc_gain < 2:
+        raise UsageError(f"{PROG}: --ilc-gain must be in (0, 2), got {args.ilc_gain:g}")
+    out = _output_path(args, sc)
+    try:
+        profile = _profile(args, args.length, args.speed)
+        other = None
+        if "ilc" in comps:
+            other = _profile(args, args.other_length or args.length,
+                             args.other_speed or 0.5 * args.speed)
+    except ValueError as exc:
+        raise UsageError(f"{PROG}: {exc}") from None
+    filters = ILCFilters(args.ilc_gain, args.ilc_cutoff, args.ilc_order)
+    res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
+                   args.settle_tol, args.tail)
+    if out is not None:
+        _write_csv(out, res.columns())
+    if args.json:
+        d = {"scenario": sc.source, **res.to_dict()}
+        if out is not None:
+            d["time_series"] = str(out)
+        print_json(d)
+        return 0
+    print(f"{sc.source}: {res}")
+    if out is not None:
+        print(f"time series ({len(res.t)} samples) -> {out}")
+    return 0
