@@ -224,4 +224,4 @@ def test_cli_scan_never_writes_over_its_scenario(tmp_path, capsys):
     before = sc.read_bytes()
     assert cli_main(["scan", str(sc), *SHORT, "--compensation", "none", "--time-series",
                      str(sc), "--force"]) == 2
-    assert "scenario" in capsys.readouterr().err and sc.read_bytes() == before
+    assert "input" in capsys.readouterr().err and sc.read_bytes() == before

@@ -6,9 +6,6 @@ compensations compared (none, the scenario's hysteresis model, learning control)
 from __future__ import annotations
 
 import argparse
-import os
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
@@ -92,31 +89,21 @@ def _profile(args, length: float, speed: float):
                 start=LEAD_IN)
 
 
-def _output_path(args, sc) -> Path | None:
+def _output(args):
+    """The ``--time-series`` target, checked before any computation (None without it)."""
+    from motionhyst.outputs import OutputFile
+
     if not args.time_series:
         return None
-    out = Path(args.time_series)
-    if args.scenario and out.resolve() == Path(args.scenario).resolve():
-        raise UsageError(f"{PROG}: --time-series {out} is the scenario file; choose another")
-    if out.is_dir():
-        raise UsageError(f"{PROG}: --time-series {out} is a folder")
-    if out.exists() and not args.force:
-        raise UsageError(f"{PROG}: --time-series {out} exists; use --force to overwrite it")
-    return out
+    return OutputFile(args.time_series, force=args.force, inputs=[args.scenario],
+                      option="--time-series")
 
 
-def _write_csv(out: Path, cols: dict) -> None:
-    """Write the columns to `out` atomically (a temporary file renamed into place)."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(",".join(cols) + "\n")
-            np.savetxt(fh, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12e")
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+def _write_csv(out, cols: dict) -> None:
+    """Write the columns to the checked target `out` (atomically)."""
+    with out.open() as fh:
+        fh.write(",".join(cols) + "\n")
+        np.savetxt(fh, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12e")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -136,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
                          f"model, and {sc.source} has none")
     if not 0 < args.ilc_gain < 2:
         raise UsageError(f"{PROG}: --ilc-gain must be in (0, 2), got {args.ilc_gain:g}")
-    out = _output_path(args, sc)
+    out = _output(args)
     try:
         profile = _profile(args, args.length, args.speed)
         other = None
@@ -153,10 +140,10 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         d = {"scenario": sc.source, **res.to_dict()}
         if out is not None:
-            d["time_series"] = str(out)
+            d["time_series"] = str(out.path)
         print_json(d)
         return 0
     print(f"{sc.source}: {res}")
     if out is not None:
-        print(f"time series ({len(res.t)} samples) -> {out}")
+        print(f"time series ({len(res.t)} samples) -> {out.path}")
     return 0
