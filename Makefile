@@ -36,6 +36,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/run.py
 	$(BIN)/python benchmarks/models.py
 	$(BIN)/python benchmarks/speed.py
+	$(BIN)/python benchmarks/scan.py
 
 # the Bouc-Wen hysteretic benchmark end to end (about a minute; kept out of make test)
 BENCHMARK_DATA ?= ../shared/benchmarks/bouc-wen
