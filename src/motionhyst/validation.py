@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["check_amplitudes", "check_finite", "check_positive"]
+__all__ = ["check_amplitudes", "check_finite", "check_omega", "check_positive"]
 
 
 def check_finite(name: str, value: float) -> float:
@@ -76,3 +76,28 @@ def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
     if not np.all(np.isfinite(a)) or np.any(a < 0):
         raise ValueError("amplitude must be finite and >= 0")
     return a
+
+
+def check_omega(omega, model: str) -> float:
+    """The angular frequency [rad/s] a rate-dependent `model` needs, as a float >= 0.
+
+    Raises
+    ------
+    ValueError
+        One line: missing (None), not a number, negative or not finite.
+
+    Examples
+    --------
+    >>> check_omega(10.0, "lugre")
+    10.0
+    """
+    if omega is None:
+        raise ValueError(f"the {model} model is rate-dependent: give the angular frequency "
+                         "omega [rad/s]")
+    try:
+        om = float(omega)
+    except (TypeError, ValueError):
+        raise ValueError(f"omega must be a number, got {omega!r}") from None
+    if not np.isfinite(om) or om < 0:
+        raise ValueError(f"omega must be finite and >= 0, got {omega!r}")
+    return om

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from motionhyst.jsonio import dumps
 from motionhyst.textfmt import g, table
 
 __all__ = ["EXIT_USAGE", "Parser", "UsageError", "finite", "g", "harmonic_count",
-           "nonnegative", "positive", "print_json", "table"]
+           "nonnegative", "positive", "print_json", "table", "whole_number"]
 
 EXIT_USAGE = 2
 """Exit code of every user error."""
@@ -66,15 +66,29 @@ def nonnegative(text: str) -> float:
     return _number(text, "value", False)
 
 
-def harmonic_count(text: str) -> int:
-    """argparse type: a whole number of harmonics from 1 to 1000."""
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if not 1 <= n <= 1000:
-        raise argparse.ArgumentTypeError(f"must be from 1 to 1000, got {text!r}")
-    return n
+def whole_number(lo: int, hi: int, what: str) -> Callable[[str], int]:
+    """argparse type: a whole number of `what` from `lo` to `hi`.
+
+    Examples
+    --------
+    >>> whole_number(1, 20, "elements")("3")
+    3
+    """
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+        if not lo <= n <= hi:
+            raise argparse.ArgumentTypeError(f"must be from {lo} to {hi}, got {text!r}")
+        return n
+
+    parse.__doc__ = f"argparse type: a whole number of {what} from {lo} to {hi}."
+    return parse
+
+
+harmonic_count = whole_number(1, 1000, "harmonics")
+"""argparse type: a whole number of harmonics from 1 to 1000."""
 
 
 def print_json(obj) -> None:

@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
-from motionhyst.cli._common import UsageError, g, positive, print_json
+from motionhyst.cli._common import UsageError, g, positive, print_json, whole_number
 from motionhyst.cli._identify_io import (
     add_input_output_arguments,
     check_not_input_output,
@@ -18,15 +18,7 @@ RECORD_KINDS = {"force-displacement": ("time", "displacement", "force"),
 """CSV columns that identify a record's kind (``motionhyst identify``)."""
 
 
-def _element_count(text: str) -> int:
-    """argparse type: a whole number of Jenkins elements from 1 to 20."""
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if not 1 <= n <= 20:
-        raise argparse.ArgumentTypeError(f"must be from 1 to 20, got {text!r}")
-    return n
+_element_count = whole_number(1, 20, "Jenkins elements")
 
 
 def record_kind(path: str | Path, kind: str | None = None) -> str:

@@ -9,22 +9,14 @@ import argparse
 
 import numpy as np
 
-from motionhyst.cli._common import UsageError, nonnegative, positive, print_json
+from motionhyst.cli._common import UsageError, nonnegative, positive, print_json, whole_number
 
 PROG = "motionhyst scan"
 LEAD_IN = 0.01
 """Rest before the setpoint starts [s]: room for the learned force to act ahead of it."""
 
 
-def _count(text: str) -> int:
-    """argparse type: a whole number of trials from 1 to 1000."""
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if not 1 <= n <= 1000:
-        raise argparse.ArgumentTypeError(f"must be from 1 to 1000, got {text!r}")
-    return n
+_count = whole_number(1, 1000, "trials")
 
 
 def add_parser(sub) -> None:

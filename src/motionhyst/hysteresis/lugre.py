@@ -27,6 +27,7 @@ from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_posit
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import LUGRE, Stepping
+from motionhyst.validation import check_omega
 
 
 def _check_nonnegative(name: str, value: float) -> float:
@@ -37,19 +38,6 @@ def _check_nonnegative(name: str, value: float) -> float:
     if not np.isfinite(v) or v < 0:
         raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
     return v
-
-
-def _check_omega(omega) -> float:
-    if omega is None:
-        raise ValueError("the LuGre model is rate-dependent: give the angular frequency "
-                         "omega [rad/s]")
-    try:
-        om = float(omega)
-    except (TypeError, ValueError):
-        raise ValueError(f"omega must be a number, got {omega!r}") from None
-    if not np.isfinite(om) or om < 0:
-        raise ValueError(f"omega must be finite and >= 0, got {omega!r}")
-    return om
 
 
 @register
@@ -214,7 +202,7 @@ class LuGre(Hysteresis):
         n_samples : int, optional
             Grid size ``N`` (even); by default :meth:`default_samples`.
         """
-        om = _check_omega(omega)
+        om = check_omega(omega, "LuGre")
         X = truncate_harmonics(np.asarray(X, dtype=complex))
         N = self.default_samples(X, om) if n_samples is None else int(n_samples)
         if N < 8 or N % 2:
@@ -253,7 +241,7 @@ class LuGre(Hysteresis):
         ValueError
             If `omega` is None, negative or not finite.
         """
-        om = _check_omega(omega)
+        om = check_omega(omega, "LuGre")
         H = int(n_harmonics)
         if H < 0:
             raise ValueError("n_harmonics must be >= 0")
@@ -305,7 +293,7 @@ class LuGre(Hysteresis):
             ``A = 0`` gives :meth:`small_amplitude_limit`.
         """
         if omega is None:
-            _check_omega(None)
+            check_omega(None, "LuGre")
         a = check_amplitudes(A)
         om = np.asarray(omega, dtype=float)
         if not np.all(np.isfinite(om)) or np.any(om < 0):
@@ -321,7 +309,7 @@ class LuGre(Hysteresis):
     def hosidf(self, A: ArrayLike, n_max: int, omega: float | None = None
                ) -> NDArray[np.complex128]:
         """Higher-order describing functions ``H_1 .. H_n_max`` at `omega` (required) [N/m]."""
-        om = _check_omega(omega)
+        om = check_omega(omega, "LuGre")
         out = super().hosidf(A, n_max, om)
         a = check_amplitudes(A)
         out[(a == 0), 0] = complex(self.small_amplitude_limit(om))

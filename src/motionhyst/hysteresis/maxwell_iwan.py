@@ -49,6 +49,7 @@ from motionhyst.hysteresis.periodic import (
 )
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import GL_T, GL_W, MAXWELL, STOP, Stepping, advance
+from motionhyst.validation import check_omega
 
 __all__ = ["MaxwellIwan", "iwan_describing_function"]
 
@@ -193,19 +194,6 @@ def _run_rows(codes, params, s0, x, t, glt, glw):  # pragma: no cover - compiled
     return w
 
 
-def _check_omega(omega) -> float:
-    if omega is None:
-        raise ValueError("the maxwell-iwan model is rate-dependent: give the angular "
-                         "frequency omega [rad/s]")
-    try:
-        om = float(omega)
-    except (TypeError, ValueError):
-        raise ValueError(f"omega must be a number, got {omega!r}") from None
-    if not np.isfinite(om) or om < 0:
-        raise ValueError(f"omega must be finite and >= 0, got {omega!r}")
-    return om
-
-
 @register
 class MaxwellIwan(Hysteresis):
     """A spring, Maxwell branches and a uniform Iwan element in parallel (cable-slab model).
@@ -336,7 +324,7 @@ class MaxwellIwan(Hysteresis):
             limit ``linear_gain(omega) + ki``.
         """
         if omega is None:
-            _check_omega(None)
+            check_omega(None, "maxwell-iwan")
         a = check_amplitudes(A)
         om = np.asarray(omega, dtype=float)
         if not np.all(np.isfinite(om)) or np.any(om < 0):
@@ -396,7 +384,7 @@ class MaxwellIwan(Hysteresis):
         omega : float
             Angular frequency of the period [rad/s]; required (rate-dependent).
         """
-        om = _check_omega(omega)
+        om = check_omega(omega, "maxwell-iwan")
         H = int(n_harmonics)
         if H < 0:
             raise ValueError("n_harmonics must be >= 0")
@@ -435,7 +423,7 @@ class MaxwellIwan(Hysteresis):
 
         From :meth:`periodic_harmonics`; the linear parts give ``H_1`` only.
         """
-        om = _check_omega(omega)
+        om = check_omega(omega, "maxwell-iwan")
         out = super().hosidf(A, n_max, om)
         a = check_amplitudes(A)
         out[(a == 0), 0] = complex(self.describing_function(0.0, om))
@@ -479,7 +467,7 @@ class MaxwellIwan(Hysteresis):
             sample repeated at the end.
         """
         amp = check_positive("A", A)
-        om = _check_omega(omega)
+        om = check_omega(omega, "maxwell-iwan")
         n = 2000 if n_samples is None else int(n_samples)
         theta = np.linspace(0.0, TWO_PI, n + 1)
         x = amp * np.sin(theta)
