@@ -5,7 +5,7 @@ operators (Maxwell-slip), and the steps of their exact periodic output
 (:mod:`motionhyst.hysteresis.periodic`): roots of trigonometric polynomials,
 the elements' pieces between reversals, and Fourier sums over jumps.  The
 reversal points of a periodic input (:func:`reversal_roots`) also serve the
-smooth models (:func:`motionhyst.hysteresis._ode_kernels.reversal_angles`).
+smooth models (:func:`motionhyst.hysteresis._ode_periodic.reversal_angles`).
 """
 
 from __future__ import annotations

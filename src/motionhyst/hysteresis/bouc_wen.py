@@ -21,12 +21,11 @@ from motionhyst.hysteresis._ode_kernels import (
     GL_T,
     GL_W,
     MAX_SAMPLES,
-    NormalisedRateIndependent,
     alias_of_jumps,
     bouc_wen_path,
     bouc_wen_periodic,
-    truncate_harmonics,
 )
+from motionhyst.hysteresis._ode_periodic import NormalisedRateIndependent, truncate_harmonics
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.hysteresis.registry import Form, Parameter, register

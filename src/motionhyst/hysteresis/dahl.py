@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.hysteresis._ode_kernels import NormalisedRateIndependent, dahl_path
+from motionhyst.hysteresis._ode_kernels import dahl_path
+from motionhyst.hysteresis._ode_periodic import NormalisedRateIndependent
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import DAHL, Stepping

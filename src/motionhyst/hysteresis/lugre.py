@@ -13,13 +13,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.hysteresis._ode_kernels import (
-    TWO_PI,
+from motionhyst.hysteresis._ode_kernels import TWO_PI, lugre_g, lugre_response, lugre_steps
+from motionhyst.hysteresis._ode_periodic import (
     describing_function_from_harmonics,
-    lugre_g,
-    lugre_response,
     lugre_step_arrays,
-    lugre_steps,
     pow2_at_least,
     truncate_harmonics,
 )
