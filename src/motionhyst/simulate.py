@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from motionhyst._jit import njit
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
-from motionhyst.hysteresis.stepping import Stepping, advance
+from motionhyst.hysteresis.stepping import Stepping, advance, open_loop_chunk
 from motionhyst.loop import Loop
 from motionhyst.lti import (
     FohResponse,
@@ -255,42 +255,6 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, st_x, st_s, st
     return e, dev, w, worst
 
 
-@njit(cache=True)
-def _open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt,
-                     glw):  # pragma: no cover - compiled
-    """:func:`~motionhyst.hysteresis.stepping.open_loop` for samples from index `i0` on.
-
-    ``s``, ``s_prev`` (element states now and one step earlier) and
-    ``scalars = (x, dx)`` of the previous sample are read (for ``i0 > 0``) and
-    updated, so that a run in chunks equals one run.
-    """
-    n_t = x.shape[0]
-    w = np.empty(n_t)
-    if i0 == 0:
-        s_prev[:] = s
-        x_prev = x[0] if n_t else 0.0
-        dx_prev = 0.0
-    else:
-        x_prev = scalars[0]
-        dx_prev = scalars[1]
-    for k in range(n_t):
-        i = i0 + k
-        dx = x[k] - x_prev if i > 0 else 0.0
-        wt = 0.0
-        for j in range(codes.shape[0]):
-            sj, f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
-                            h if i > 0 else 0.0, i == 1, glt, glw)
-            s_prev[j] = s[j]
-            s[j] = sj
-            wt += f
-        w[k] = wt
-        dx_prev = dx
-        x_prev = x[k]
-    scalars[0] = x_prev
-    scalars[1] = dx_prev
-    return w
-
-
 def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float64],
                                              NDArray[np.float64], float]:
     """Kinds, parameters, initial states (at rest) and a force scale [N] of the link's elements.
@@ -479,7 +443,7 @@ class _Engine:
         elif hff.rate_independent:
             uh = self._rate_independent_feedforward(r)
         else:  # as the link in the loop: force with the velocity at the sample
-            uh = _open_loop_chunk(self.hff_codes, self.hff_params, self.hff_s,
+            uh = open_loop_chunk(self.hff_codes, self.hff_params, self.hff_s,
                                   self.hff_s_prev, self.hff_scalars, r, step, i0, GL_T, GL_W)
         if self.force is not None:
             uf = np.asarray(self.force(t), dtype=float)

@@ -192,6 +192,14 @@ class NormalisedRateIndependent:
         return pow2_at_least(max(8 * (len(X) - 1), 4 * (int(n_harmonics) + 1),
                                  1100.0 * max(r, 1.0) ** (1.0 / 3.0)))
 
+    def _grid(self, X: ArrayLike, n_samples: int | None) -> tuple[NDArray[np.complex128], int]:
+        """The harmonics without negligible ones, and the checked grid size ``N``."""
+        X = truncate_harmonics(np.asarray(X, dtype=complex))
+        N = self.default_samples(X) if n_samples is None else int(n_samples)
+        if N < 8 or N % 2:
+            raise ValueError(f"n_samples must be an even number >= 8, got {n_samples!r}")
+        return X, N
+
     def periodic_samples(self, X: ArrayLike, n_samples: int | None = None
                          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Displacement and force on the grid ``theta = 2 pi i / N`` of the periodic state.
@@ -208,10 +216,7 @@ class NormalisedRateIndependent:
         x, w : ndarray, shape (N,)
             Displacement [m] and force [N] over one period of the periodic state.
         """
-        X = truncate_harmonics(np.asarray(X, dtype=complex))
-        N = self.default_samples(X) if n_samples is None else int(n_samples)
-        if N < 8 or N % 2:
-            raise ValueError(f"n_samples must be an even number >= 8, got {n_samples!r}")
+        X, N = self._grid(X, n_samples)
         if len(X) == 1:  # constant displacement: the (non-unique) periodic state w = 0
             return np.full(N, X[0].real), np.zeros(N)
         x, path, grid_index = rate_independent_path(X, N)

@@ -378,10 +378,7 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         x, w : ndarray, shape (N,)
             Displacement [m] and force [N] over one period of the periodic state.
         """
-        X = truncate_harmonics(np.asarray(X, dtype=complex))
-        N = self.default_samples(X) if n_samples is None else int(n_samples)
-        if N < 8 or N % 2:
-            raise ValueError(f"n_samples must be an even number >= 8, got {n_samples!r}")
+        X, N = self._grid(X, n_samples)
         if len(X) == 1:  # constant displacement: the (non-unique) periodic state w = 0
             return np.full(N, X[0].real), np.zeros(N)
         x, z, _ = self._periodic_state(X, N)

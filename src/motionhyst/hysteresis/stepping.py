@@ -34,7 +34,7 @@ from motionhyst.hysteresis._ode_kernels import (
 )
 
 __all__ = ["BOUC_WEN", "DAHL", "GL_T", "GL_W", "LUGRE", "MAXWELL", "N_PARAMS", "STOP",
-           "Stepping", "advance", "open_loop"]
+           "Stepping", "advance", "open_loop", "open_loop_chunk"]
 
 STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL = 0, 1, 2, 3, 4
 N_PARAMS = 6
@@ -143,22 +143,54 @@ def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no 
 
 
 @njit(cache=True)
-def open_loop(codes, params, s0, x, h, glt, glw):  # pragma: no cover - compiled
-    """Force of the elements for the displacement samples `x` (step `h`), from rest at ``x[0]``."""
+def open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt,
+                     glw):  # pragma: no cover - compiled
+    """:func:`open_loop` for samples from index `i0` on.
+
+    ``s``, ``s_prev`` (element states now and one step earlier) and
+    ``scalars = (x, dx)`` of the previous sample are read (for ``i0 > 0``) and
+    updated, so that a run in chunks equals one run.
+    """
     n_t = x.shape[0]
-    s = s0.copy()
-    s_prev = s0.copy()
     w = np.empty(n_t)
-    dx_prev = 0.0
-    for i in range(n_t):
-        dx = x[i] - x[i - 1] if i > 0 else 0.0
+    if i0 == 0:
+        s_prev[:] = s
+        x_prev = x[0] if n_t else 0.0
+        dx_prev = 0.0
+    else:
+        x_prev = scalars[0]
+        dx_prev = scalars[1]
+    for k in range(n_t):
+        i = i0 + k
+        dx = x[k] - x_prev if i > 0 else 0.0
         wt = 0.0
         for j in range(codes.shape[0]):
             sj, f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
-                             h if i > 0 else 0.0, i == 1, glt, glw)
+                            h if i > 0 else 0.0, i == 1, glt, glw)
             s_prev[j] = s[j]
             s[j] = sj
             wt += f
-        w[i] = wt
+        w[k] = wt
         dx_prev = dx
+        x_prev = x[k]
+    scalars[0] = x_prev
+    scalars[1] = dx_prev
     return w
+
+
+def open_loop(codes, params, s0, x, h, glt, glw):
+    """Force of the elements for the displacement samples `x` (step `h`), from rest at ``x[0]``.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import Dahl
+    >>> st = Dahl(k=1e4, fc=5.0).time_stepping()
+    >>> w = open_loop(st.codes, st.params, st.state0, np.linspace(0.0, 0.01, 101), 1e-3,
+    ...               GL_T, GL_W)
+    >>> bool(0.0 < w[-1] < 5.0)                  # approaches the slip force fc from below
+    True
+    """
+    s = np.array(s0, dtype=float)
+    return open_loop_chunk(codes, params, s, s.copy(), np.zeros(2),
+                           np.ascontiguousarray(x, dtype=float), h, 0, glt, glw)
+
