@@ -31,6 +31,7 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
     "numpydoc",
+    "linkmodels",  # docs/linkmodels.py: the link models' tables from the registry
 ]
 
 exclude_patterns = ["_build", "_generated/**/*.md"]

@@ -221,3 +221,41 @@ def test_docstrings_are_valid_restructuredtext():
                     and 'Unknown directive type' not in ln]
         problems += [f"{name}: {m}" for m in messages]
     assert not problems, "\n".join(problems)
+
+
+def _linkmodels(monkeypatch) -> ModuleType:
+    monkeypatch.syspath_prepend(str(DOCS))  # it imports docs/apigen.py as Sphinx does
+    spec = importlib.util.spec_from_file_location("linkmodels", DOCS / "linkmodels.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_model_tables_come_from_the_registry(monkeypatch):
+    """The models page lists every registered model and each of its parameters, a model
+    registered later included, with the class under its documented name."""
+    from motionhyst.hysteresis import MODELS, Jenkins
+    from motionhyst.hysteresis.registry import Parameter
+
+    class Spring(Jenkins):
+        """A linear spring, registered for this test only."""
+
+        name = "spring-only"
+        parameters = (Parameter("k_lin", "N/m", "stiffness of the spring"),)
+
+    monkeypatch.setitem(MODELS, Spring.name, Spring)
+    gen = _linkmodels(monkeypatch)
+    table = "\n".join(gen.summary_table())
+    sections = "\n".join(gen.parameter_sections())
+    rows = re.findall(r"^   \* - ``([\w-]+)``$", table, re.M)
+    assert rows == list(MODELS)
+    for name, cls in MODELS.items():
+        section = sections.split(f"``{name}``\n")[1].split("\n~~~")[0]
+        for p in cls.parameters:
+            assert f"``{p.name}" in section and p.help in section, (name, p.name)
+        for form in getattr(cls, "forms", ()):
+            assert all(f"``{p.name}``" in section for p in form.parameters), name
+    assert "``--k-lin``" in sections and "stiffness of the spring" in sections
+    assert ":class:`motionhyst.Jenkins`" in table  # the top-level spelling the API uses
+    assert ":class:`motionhyst.MaxwellIwan`" in gen.substitutions()
+    assert "Closed-form describing function" in table

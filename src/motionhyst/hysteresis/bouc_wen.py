@@ -403,7 +403,7 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         return W
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
-        """Describing function ``D = (b1 + j a1) / A`` (paper eq. 7) at amplitude(s) `A` [N/m].
+        """Numerical describing function ``D = (b1 + j a1) / A`` (eq. 7) at amplitude(s) `A` [N/m].
 
         From the periodic output (:meth:`periodic_harmonics`); within 1e-10
         relative (measured <= 5e-13 for ``n = 1`` and 3e-12 for ``n = 2`` up to

@@ -94,7 +94,7 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
         return -1.0, 1.0
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
-        """Describing function ``D = (b1 + j a1) / A`` (paper eq. 7) at amplitude(s) `A` [N/m].
+        """Numerical describing function ``D = (b1 + j a1) / A`` (eq. 7) at amplitude(s) `A` [N/m].
 
         Computed from the exact periodic output (:meth:`periodic_harmonics`),
         about 1e-10 relative; values are cached per amplitude.  `omega` is

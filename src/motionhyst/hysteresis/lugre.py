@@ -274,7 +274,7 @@ class LuGre(Hysteresis):
         return d
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
-        """Describing function ``D(A, omega) = (b1 + j a1) / A`` (paper eq. 7) [N/m].
+        """Numerical describing function ``D(A, omega) = (b1 + j a1) / A`` (paper eq. 7) [N/m].
 
         Parameters
         ----------
