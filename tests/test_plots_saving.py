@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import matplotlib.image
+import numpy as np
 import pytest
 
 from motionhyst import plots
-from motionhyst.figures import save_figures
+from motionhyst.figures import _lay_out_once, save_figures
 from motionhyst.hysteresis import Jenkins
 
 EL = Jenkins(k=20.0, fc=0.05)
@@ -50,3 +52,24 @@ def test_an_error_in_a_figure_reaches_the_caller(tmp_path, workers):
 
     with pytest.raises(ValueError, match="no data for fig9"):
         save_figures({**MAKERS, "fig9": broken}, tmp_path, ("png",), workers=workers)
+
+
+@pytest.mark.parametrize("make", [lambda: plots.fig8_describing_function(EL, zeta_op=0.25),
+                                  lambda: plots.fig7_time(EL, 0.01)])
+def test_the_layout_solved_once_is_the_one_savefig_solves(tmp_path, make):
+    # savefig lays a figure out for its first file (then kept for the others, as the report
+    # always did); _lay_out_once solves it once beforehand: the same axes, pixels and PDF
+    plain, once = make(), make()
+    plain.savefig(tmp_path / "plain.png")
+    plain.set_layout_engine("none")
+    plain.savefig(tmp_path / "plain.pdf", metadata={"CreationDate": None})
+    _lay_out_once(once)
+    assert once.get_layout_engine() is None
+    assert [ax.get_position().bounds for ax in once.axes] == \
+        [ax.get_position().bounds for ax in plain.axes]
+    once.savefig(tmp_path / "once.png")
+    once.savefig(tmp_path / "once.pdf", metadata={"CreationDate": None})
+    a = matplotlib.image.imread(tmp_path / "plain.png")
+    b = matplotlib.image.imread(tmp_path / "once.png")
+    assert a.shape == b.shape and np.array_equal(a, b)
+    assert (tmp_path / "plain.pdf").read_bytes() == (tmp_path / "once.pdf").read_bytes()

@@ -174,12 +174,31 @@ def _draw_and_save(job: tuple[str, Path, tuple[str, ...]]) -> str:
     """Draw figure `name` and save it in every format (in a worker or in-process)."""
     name, folder, formats = job
     fig = _PENDING[name]()
+    _lay_out_once(fig)
     for fmt in formats:
         fig.savefig(folder / f"{name}.{fmt}")
-        # the constrained layout found for the first file holds for the others (same size in
-        # inches, same text): keep it instead of solving it again (~15 % of the saving time)
-        fig.set_layout_engine("none")
     return name
+
+
+def _lay_out_once(fig: Figure) -> None:
+    """Solve `fig`'s layout now, as the first ``savefig`` would, and keep it for every file.
+
+    With a layout engine, every ``savefig`` draws the figure once without
+    rendering to solve the layout and then once more to render it.  The
+    layout found at the figure's own dpi (what ``savefig`` solves it at) holds
+    for every format (same size in inches, same text), so it is solved here
+    once, on an Agg canvas, and the engine is removed: each file is then drawn
+    once, the same files in a quarter less time.
+    """
+    engine = fig.get_layout_engine()
+    if engine is None:
+        return
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    if not isinstance(fig.canvas, FigureCanvasAgg):
+        FigureCanvasAgg(fig)
+    engine.execute(fig)
+    fig.set_layout_engine(None)
 
 
 def _workers(n_jobs: int) -> int:
