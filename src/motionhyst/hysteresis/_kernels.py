@@ -182,13 +182,13 @@ def reversal_roots(C1, C2, d):  # pragma: no cover - compiled
     h = _TWO_PI / n
     count = 0
     for i in range(n):
-        if (d[i] > 0.0) != (d[(i + 1) % n] > 0.0):
+        if (d[i] > 0.0) != (d[i + 1 if i + 1 < n else 0] > 0.0):
             count += 1
     cells = np.empty(count, dtype=np.int64)
     roots = np.empty(count)
     q = 0
     for i in range(n):
-        j = (i + 1) % n
+        j = i + 1 if i + 1 < n else 0
         if (d[i] > 0.0) != (d[j] > 0.0):
             a = i * h
             cells[q] = i

@@ -16,7 +16,6 @@ from motionhyst.hysteresis._ode_kernels import (
     MAX_SAMPLES,
     MIN_SAMPLES,
     TWO_PI,
-    lugre_steps_with_reversals,
     path_with_reversals,
 )
 from motionhyst.hysteresis.periodic import sample_period, significant_harmonics
@@ -137,22 +136,6 @@ def periodic_fixed_point(period: Callable[[float], NDArray[np.float64]], s0: flo
     if best[0] <= 1e-10 * max(scale, 1e-300):
         return best[1]
     raise RuntimeError("periodic state not found (period map did not converge)")
-
-
-def lugre_step_arrays(X: NDArray[np.complex128], N: int
-                      ) -> tuple[NDArray[np.float64], ...]:
-    """Integration steps over one period for the LuGre kernel.
-
-    The steps are the grid cells, split at reversal points so that ``x'`` has
-    one sign inside each step.  Returns ``xa, xm, xb, h`` (``x'`` at the start,
-    middle and end of each step and its length) and the index of each grid
-    sample among the step boundaries.
-    """
-    X = np.asarray(X, dtype=complex)
-    d2 = sample_period(X, 2 * N, 1)
-    m = np.arange(X.size)
-    return lugre_steps_with_reversals(np.ascontiguousarray(d2[0::2]),
-                                       np.ascontiguousarray(d2[1::2]), 1j * m * X, -(m**2) * X)
 
 
 def describing_function_from_harmonics(W1: complex, A: float) -> complex:
