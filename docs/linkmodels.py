@@ -128,7 +128,7 @@ def _parameter_table(parameters: tuple, df_options: bool = True) -> list[str]:
     for p in parameters:
         option = "--" + p.name.replace("_", "-") + (" ..." if p.many else "")
         rng = RANGES[p.kind] + (", each" if p.many else "")
-        cells = [_key(p), f"``{option}``", p.unit or "1", _default(p), rng, p.help]
+        cells = [_key(p), f"``{option}``", p.unit or "-", _default(p), rng, p.help]
         if not df_options:
             del cells[1]
         lines += [f"   * - {cells[0]}", *(f"     - {c}" for c in cells[1:])]
@@ -154,8 +154,6 @@ def parameter_sections() -> list[str]:
                       f"this form; in Python "
                       f":meth:`{documented_name(cls)}.{form.constructor}`.", ""]
             lines += [*_parameter_table(form.parameters, df_options=False), ""]
-        lines += ["Rules the constructor adds to these ranges are in the class's "
-                  f"documentation, :class:`{documented_name(cls)}`.", ""]
     return lines
 
 
