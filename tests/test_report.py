@@ -126,12 +126,19 @@ def test_reproduce_keeps_the_users_files(reproduced):
     assert (out / "notes.txt").read_text() == "the user's own file"
 
 
-def test_report_without_paper_column(reproduced, scenario, tmp_path):
-    _, summary = reproduced
-    text = report._report_text(scenario, summary, ["fig5"], is_paper=False, notes=["a note"])
+def test_report_without_paper_column(scenario, el, analysis, states):
+    E_df = [p.value for p in analysis.points]
+    text = report._report_text(scenario, el, analysis, states, E_df, None, ["fig5"],
+                               is_paper=False, notes=["a note"])
     assert "## Key numbers" in text and "Paper vs computed" not in text
     assert "| quantity | computed |" in text
     assert "- a note" in text
+    # the mismatch rows carry the results' own numbers: eq. (18) and the exact steady state
+    for f, E, st in zip(FREQS, E_df, states, strict=True):
+        row = next(ln for ln in text.splitlines() if ln.startswith(f"| {f:g} |"))
+        assert row.split("|")[2:6] == [f" {abs(E):.4g} ", f" {np.degrees(np.angle(E)):.2f} ",
+                                       f" {abs(st.mismatch):.4g} ",
+                                       f" {np.degrees(np.angle(st.mismatch)):.2f} "]
 
 
 def test_reproduce_failure_leaves_previous_output(tmp_path, monkeypatch):

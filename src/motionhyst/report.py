@@ -15,6 +15,7 @@ import sys
 import tempfile
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm import tqdm
@@ -23,10 +24,19 @@ from motionhyst import plots
 from motionhyst.figures import save_figures
 from motionhyst.jsonio import dumps
 from motionhyst.outputs import OutputFolder
-from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
+from motionhyst.quasilinear import (
+    QuasiLinearAnalysis,
+    analyze,
+    error_harmonics_df,
+    loop_mismatch,
+)
 from motionhyst.scenario import Scenario
-from motionhyst.steady import periodic_steady_state
+from motionhyst.steady import SteadyState, periodic_steady_state
 from motionhyst.systems import MeasuredPlant
+
+if TYPE_CHECKING:
+    from motionhyst.frf_fit import FrfFit
+    from motionhyst.hysteresis import Hysteresis
 
 # Numbers the paper states for Table I (section V and Fig. 8).
 PAPER_VALUES = {
@@ -103,49 +113,62 @@ def _fmt(x) -> str:
     return f"{x:.4g}"
 
 
-def _report_text(sc: Scenario, summary: dict, figures: list[str], is_paper: bool,
-                 notes: list[str]) -> str:
-    a = summary["analyze"]
-    jenkins = summary["scenario"]["hysteresis"]["model"] == "jenkins"
+def _computed(analysis: QuasiLinearAnalysis, key: str) -> float | None:
+    """A number of :data:`PAPER_VALUES` from the analysis (the describing function's as
+    ``|D| / k`` and its angle in degrees)."""
+    if key == "df_abs_over_k":
+        return abs(analysis.D) / analysis.k_link
+    if key == "df_phase_deg":
+        return float(np.degrees(np.angle(analysis.D)))
+    return getattr(analysis, key)
+
+
+def _report_text(sc: Scenario, link: Hysteresis, analysis: QuasiLinearAnalysis,
+                 states: list[SteadyState], E_df: Iterable[complex], fit: FrfFit | None,
+                 figures: list[str], is_paper: bool, notes: list[str]) -> str:
+    """``report.md`` from the results: the analysis, the steady states with the describing
+    function's mismatch at their frequencies, the plant's fit, the figures drawn."""
+    jenkins = link.name == "jenkins"
     lines = [f"# motionhyst report: {sc.source}", ""]
     lines += ["## Paper vs computed" if is_paper else "## Key numbers", ""]
     head = "| quantity | paper | computed |" if is_paper else "| quantity | computed |"
     lines += [head, "|---|---|---|" if is_paper else "|---|---|"]
     units = {"f_star_hz": " Hz", "mismatch_crossover_hz": " Hz", "bandwidth_hz": " Hz",
              "df_phase_deg": " deg"}
-    at = "" if a.get("df_frequency_hz") is None else f" (at {_fmt(a['df_frequency_hz'])} Hz)"
+    df_f = analysis.df_frequency_hz
+    at = "" if df_f is None else f" (at {_fmt(df_f)} Hz)"
     for key, (paper, label) in PAPER_VALUES.items():
-        val = _fmt(a[key])
+        val = _fmt(_computed(analysis, key))
         val += "" if val == "n/a" else units.get(key, "") + (at if key.startswith("df_") else "")
         lines.append(f"| {label} | {paper} | {val} |" if is_paper else f"| {label} | {val} |")
-    exact = _fmt(a["mismatch_crossover_exact_hz"])
+    exact = _fmt(analysis.mismatch_crossover_exact_hz)
     exact += "" if exact == "n/a" else " Hz"
     lines.append(f"| {EXACT_CROSSOVER_LABEL} | - | {exact} |" if is_paper
                  else f"| {EXACT_CROSSOVER_LABEL} | {exact} |")
-    for key, label, unit, fkey in MARGIN_ROWS:
-        if key in a:
-            val = f"{_fmt(a[key])}{unit} at {_fmt(a[fkey])} Hz"
+    margins = analysis.margins
+    if margins is not None:
+        for key, label, unit, fkey in MARGIN_ROWS:
+            val = f"{_fmt(getattr(margins, key))}{unit} at {_fmt(getattr(margins, fkey))} Hz"
             lines.append(f"| {label} | - | {val} |" if is_paper else f"| {label} | {val} |")
     lines += ["", EXACT_CROSSOVER_NOTE]
-    if a.get("margins_evaluated_on", "model") != "model":
-        lines += ["", f"Margins and bandwidth evaluated on the {a['margins_evaluated_on']} only."]
-    fit = summary.get("plant_fit")
+    if margins is not None and margins.evaluated_on != "model":
+        lines += ["", f"Margins and bandwidth evaluated on the {margins.evaluated_on} only."]
     if fit is not None:
         lines += ["", "## Measured plant", "",
                   "The measured plant is fitted to a rigid body plus flexible modes "
                   "(`motionhyst.frf_fit`); every number and figure of this report comes from "
-                  "the fitted model.", "", "```", str(sc.plant_fit()), "```"]
-    if summary["simulate"]["points"]:
+                  "the fitted model.", "", "```", str(fit), "```"]
+    if states:
         lines += ["", "Mismatch at the reference frequencies: describing function (eq. 18) "
                   "against the exact periodic steady state of the nonlinear loop.", "",
                   "| f [Hz] | \\|E\\| eq. (18) | angle [deg] | \\|E\\| exact | angle [deg] | "
                   "\\|e1\\| [m] | \\|e3\\| [m] | peak e [m] |", "|---|---|---|---|---|---|---|---|"]
-    for p in summary["simulate"]["points"]:
-        h = {x["n"]: x["abs"] for x in p["error_harmonics"]}
-        lines.append(f"| {_fmt(p['frequency_hz'])} | {_fmt(p['mismatch_df_abs'])} | "
-                     f"{p['mismatch_df_phase_deg']:.2f} | {_fmt(p['mismatch_simulated_abs'])} | "
-                     f"{p['mismatch_simulated_phase_deg']:.2f} | {_fmt(h.get(1))} | "
-                     f"{_fmt(h.get(3))} | {_fmt(p['error_peak'])} |")
+    for st, E in zip(states, E_df, strict=True):
+        e3 = float(abs(st.e[3])) if st.n_harmonics >= 3 else None
+        lines.append(f"| {_fmt(st.frequency_hz)} | {_fmt(abs(E))} | "
+                     f"{np.degrees(np.angle(E)):.2f} | {_fmt(abs(st.mismatch))} | "
+                     f"{np.degrees(np.angle(st.mismatch)):.2f} | {_fmt(float(abs(st.e[1])))} | "
+                     f"{_fmt(e3)} | {_fmt(st.error_peak)} |")
     lines += ["", "## Figures", ""]
     for name in figures:
         note = FIGURE_NOTES.get(name if jenkins else f"{name}-other", FIGURE_NOTES[name])
@@ -270,7 +293,8 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 for ext in ("png", "pdf"):
                     files[f"{name}.{ext}"] = (Path(scratch) / f"{name}.{ext}").read_bytes()
         files["summary.json"] = dumps(summary).encode()
-        files["report.md"] = _report_text(sc, summary, written, is_paper, notes).encode()
+        files["report.md"] = _report_text(sc, el, analysis, states, E_df, fit, written,
+                                          is_paper, notes).encode()
         steps.close()
         with folder:  # staged, then moved into place together; SIGTERM cleans up
             for name, data in files.items():
