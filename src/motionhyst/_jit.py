@@ -18,7 +18,11 @@ Jenkins element) does not import numba.  At the first call, once per process:
   seconds; later runs load the cache).
 
 Kernels calling other kernels work as in numba: a kernel passes for its numba
-dispatcher inside compiled code.
+dispatcher inside compiled code.  A kernel declared with a signature
+(``@njit("(float64, int64)")``) is compiled for that one signature when first
+needed, and arguments of other types are converted to it: a kernel that
+would otherwise be compiled once more for a constant argument (numba types
+``f(x, 1)`` with the literal ``1``) or another dtype costs one compilation.
 """
 
 from __future__ import annotations
@@ -132,6 +136,9 @@ class Kernel:
         The Python function, in numba's nopython subset.
     options : dict
         Options for ``numba.njit`` other than ``cache``.
+    signature : str, optional
+        The one signature to compile (numba's syntax, e.g. ``"(float64, int64)"``);
+        by default one per combination of argument types seen.
 
     Examples
     --------
@@ -145,11 +152,17 @@ class Kernel:
     ...     return s
     >>> total(np.arange(4.0))
     6.0
+    >>> @njit("(float64, int64)")
+    ... def scaled(x, n):
+    ...     return x * n
+    >>> scaled(1.5, 2), scaled(2, 3)   # one compiled version; 2 is converted to 2.0
+    (3.0, 6.0)
     """
 
-    def __init__(self, py_func: Callable, options: dict) -> None:
+    def __init__(self, py_func: Callable, options: dict, signature: str | None = None) -> None:
         self.py_func = py_func
         self._options = options
+        self._signature = signature
         self._dispatcher = None
         self.__name__ = py_func.__name__
         self.__qualname__ = py_func.__qualname__
@@ -172,7 +185,9 @@ class Kernel:
                         _STATE["cache"] = folder is not None and _can_cache()
                     # a function without a source file (a doctest, the REPL) is never cached
                     cache = _STATE["cache"] and _can_cache(self.py_func)
-                    d = numba.njit(cache=cache, **self._options)(self.py_func)
+                    jit = (numba.njit(cache=cache, **self._options) if self._signature is None
+                           else numba.njit(self._signature, cache=cache, **self._options))
+                    d = jit(self.py_func)
                     self._dispatcher = d
         return d
 
@@ -191,15 +206,17 @@ class Kernel:
         return f"<compiled kernel {self.__module__}.{self.__qualname__}>"
 
 
-def njit(func: Callable | None = None, **options) -> Kernel | Callable[[Callable], Kernel]:
-    """Declare a numba kernel compiled at its first call (``@njit`` or ``@njit(...)``).
+def njit(func: Callable | str | None = None, **options
+         ) -> Kernel | Callable[[Callable], Kernel]:
+    """Declare a numba kernel compiled at its first call (``@njit``, ``@njit(...)`` or
+    ``@njit(signature, ...)`` with the one signature to compile, see :class:`Kernel`).
 
     ``cache`` is accepted for symmetry with numba and ignored: the cache is
     chosen once per process (see the module docstring).
     """
     options.pop("cache", None)
-    if func is None:
-        return lambda f: Kernel(f, options)
+    if func is None or isinstance(func, str):
+        return lambda f: Kernel(f, options, func)
     return Kernel(func, options)
 
 

@@ -313,7 +313,8 @@ def _foh_states(Ad, Bd0, Bd1, C, D, u, state, u_prev, first):  # pragma: no cove
         for j in range(n_x):
             acc += C[j] * x[j]
         y[i] = acc + D * u[i]
-    state[:] = x
+    for j in range(n_x):  # element-wise: a slice assigned an array compiles an error message
+        state[j] = x[j]
     return y
 
 

@@ -174,7 +174,8 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, st_x, st_s, st
     worst = 0
     if i0 == 0:
         x[:] = 0.0
-        s_prev[:] = s
+        for j in range(m):
+            s_prev[j] = s[j]
         r_prev = r[0]
         dev_prev = 0.0  # the element starts at rest at y1 = r(0)
         w_prev = 0.0
@@ -238,16 +239,13 @@ def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, st_x, st_s, st
                 acc += Ad[j, q] * x[q]
             xn[j] = acc
         x, xn = xn, x
-    st_x[:] = x
-    st_s[:] = s
-    st_sprev[:] = s_prev
-    st_scalars[0] = r_prev
-    st_scalars[1] = dev_prev
-    st_scalars[2] = w_prev
-    st_scalars[3] = dx_prev
-    st_x[:] = x
-    st_s[:] = s
-    st_sprev[:] = s_prev
+    # element-wise copies: an array assigned to a slice compiles numba's shape-mismatch error
+    # message (seconds of the first compilation)
+    for j in range(n_x):
+        st_x[j] = x[j]
+    for j in range(m):
+        st_s[j] = s[j]
+        st_sprev[j] = s_prev[j]
     st_scalars[0] = r_prev
     st_scalars[1] = dev_prev
     st_scalars[2] = w_prev

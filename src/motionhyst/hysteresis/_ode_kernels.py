@@ -402,12 +402,18 @@ def bouc_wen_periodic(X, C1, C2, C3, x, d, kf, n, ap, am, hmax, lo, hi, t,
         zend, slope, nj = _bw_period(s, X, C1, C2, C3, x, cells, roots, xr, kf, n, ap, am,
                                      hmax, t, wq, out, dout, jt, jv, jo)
         g = zend - s
-        scale = max(out.max() - out.min(), 1e-300)
+        lo_out = hi_out = out[0]
+        dmax = 1.0
+        for i in range(m):
+            lo_out = min(lo_out, out[i])
+            hi_out = max(hi_out, out[i])
+            dmax = max(dmax, abs(dout[i]))
+        scale = max(hi_out - lo_out, 1e-300)
         if abs(g) <= 1e-14 * scale or g == 0.0:
             return out, jt[:nj], jv[:nj], jo[:nj], True
         if slope < 1.0:
             delta = g / (1.0 - slope)
-            if abs(delta) * max(np.abs(dout).max(), 1.0) <= 1e-8 * scale:
+            if abs(delta) * dmax <= 1e-8 * scale:
                 for i in range(m):
                     out[i] += delta * dout[i]
                 return out, jt[:nj], jv[:nj], jo[:nj], True
@@ -622,7 +628,8 @@ def _quad_level(b0, b1, b2, t0, t1, level):  # pragma: no cover - compiled
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
+@njit("(float64, float64, float64, float64, float64, float64, float64, float64, float64, "
+      "float64, float64, float64, float64, int64)")
 def _lugre_piece(zi, b0, b1, b2, t0, t1, h, sg, omega, sigma0, fc, fs, vs,
                  m):  # pragma: no cover - compiled
     """`m` equal substeps of ``[t0, t1]`` (fractions of a step of angle `h`) with ``x'``

@@ -86,7 +86,8 @@ class Stepping:
 
 
 
-@njit(cache=True)
+@njit("(int64, float64[::1], float64, float64, float64, float64, float64, boolean, "
+      "float64[::1], float64[::1])")
 def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no cover
     """New state and force of one element after a displacement `dx` over a time `h`.
 
@@ -154,7 +155,9 @@ def open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt,
     n_t = x.shape[0]
     w = np.empty(n_t)
     if i0 == 0:
-        s_prev[:] = s
+        for j in range(codes.shape[0]):  # element-wise: a slice assigned an array compiles
+            # numba's shape-mismatch error message (seconds of the first compilation)
+            s_prev[j] = s[j]
         x_prev = x[0] if n_t else 0.0
         dx_prev = 0.0
     else:
