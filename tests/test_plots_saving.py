@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import multiprocessing
+import time
+
 import matplotlib.image
 import numpy as np
 import pytest
 
 from motionhyst import plots
-from motionhyst.figures import _lay_out_once, save_figures
+from motionhyst.figures import FigureWriter, _lay_out_once, save_figures
 from motionhyst.hysteresis import Jenkins
 
 EL = Jenkins(k=20.0, fc=0.05)
@@ -73,3 +76,46 @@ def test_the_layout_solved_once_is_the_one_savefig_solves(tmp_path, make):
     b = matplotlib.image.imread(tmp_path / "once.png")
     assert a.shape == b.shape and np.array_equal(a, b)
     assert (tmp_path / "plain.pdf").read_bytes() == (tmp_path / "once.pdf").read_bytes()
+
+
+@pytest.mark.parametrize("parallel", [False, True])
+def test_writer_draws_each_batch_while_the_caller_goes_on(tmp_path, parallel):
+    done = []
+    with FigureWriter(tmp_path, ("png", "pdf"), done=done.append, parallel=parallel) as writer:
+        writer.submit({"fig8": MAKERS["fig8"]})
+        # data made after the first batch was submitted reach the workers forked after it
+        el2 = Jenkins(k=40.0, fc=0.05)
+        writer.submit({"fig5": lambda: plots.fig5_loops(el2), "fig6": MAKERS["fig6"]})
+        assert writer.wait() == ["fig8", "fig5", "fig6"]
+    assert sorted(done) == ["fig5", "fig6", "fig8"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        f"{n}.{ext}" for n in ("fig5", "fig6", "fig8") for ext in ("png", "pdf"))
+    assert multiprocessing.active_children() == []
+
+
+def test_writer_stops_its_workers_when_the_caller_fails(tmp_path):
+    def slow():
+        time.sleep(60)
+        return plots.fig6_modes(EL)
+
+    t0 = time.monotonic()
+    with pytest.raises(KeyError, match="no such data"), \
+            FigureWriter(tmp_path, ("png",), parallel=True) as writer:
+        writer.submit({"fig6": slow})
+        raise KeyError("no such data")  # the caller's computation fails meanwhile
+    assert time.monotonic() - t0 < 30  # the worker was stopped, not waited for
+    assert multiprocessing.active_children() == []
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_writer_reports_the_first_error_with_the_workers_traceback(tmp_path):
+    def broken():
+        raise ValueError("no data for fig9")
+
+    with FigureWriter(tmp_path, ("png",), parallel=True) as writer:
+        writer.submit({"fig5": MAKERS["fig5"]})
+        writer.submit({"fig9": broken})
+        with pytest.raises(ValueError, match="no data for fig9") as err:
+            writer.wait()
+    assert "in broken" in str(err.value.__cause__)  # where it failed, in the worker
+    assert multiprocessing.active_children() == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 from pathlib import Path
 
@@ -15,7 +16,7 @@ from motionhyst import plots, report
 from motionhyst.hysteresis import BoucWen, Dahl, LuGre, MaxwellSlip
 from motionhyst.outputs import MANIFEST
 from motionhyst.quasilinear import analyze, loop_mismatch, mismatch_asymptote
-from motionhyst.scenario import Scenario, default_scenario
+from motionhyst.scenario import Scenario, default_scenario, default_scenario_path
 from motionhyst.steady import periodic_steady_state
 from motionhyst.systems import freqresp
 
@@ -157,6 +158,25 @@ def test_reproduce_failure_leaves_previous_output(tmp_path, monkeypatch):
     assert [p.name for p in out.iterdir()] == ["marker.txt"]
     assert (out / "marker.txt").read_text() == "previous run"
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no temporary folders remain
+
+
+def test_reproduce_of_an_unstable_scenario_writes_nothing(tmp_path, capsys):
+    # the loop is built and checked inside the command, while the link's figures are drawn
+    from motionhyst.cli import main
+
+    text = default_scenario_path().read_text()
+    assert "\nK = 6.2e6 " in text
+    scenario = tmp_path / "unstable.toml"
+    scenario.write_text(text.replace("\nK = 6.2e6 ", "\nK = 6.2e9 "))  # 1000 x: unstable
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "marker.txt").write_text("previous run")
+    assert main(["reproduce", str(scenario), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "[controller]" in err and "stabilise" in err
+    assert [p.name for p in out.iterdir()] == ["marker.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "unstable.toml"]
+    assert multiprocessing.active_children() == []  # the figure workers were stopped
 
 
 def test_reproduce_failure_in_final_move_leaves_previous_output(tmp_path, monkeypatch):

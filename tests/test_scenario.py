@@ -371,6 +371,19 @@ def test_invalid_dict_names_its_source(edit, fragments):
     assert_one_line(info.value, "from-a-dict", *fragments)
 
 
+def test_unchecked_scenario_gives_the_same_error_at_its_loop(write):
+    # check=False (reproduce draws the link's figures meanwhile): the loop's error at loop()
+    d = paper_dict()
+    d["controller"]["K"] = 6.2e9  # 1000 x Table I: unstable
+    path = write(d)
+    sc = Scenario.from_file(path, check=False)
+    assert sc.hysteresis().k == 20.0
+    with pytest.raises(ScenarioError) as info:
+        sc.loop()
+    assert str(info.value) == str(load_error(path))
+    assert_one_line(info.value, path, "[controller]", "stabilise")
+
+
 def test_tf_with_negative_gain_is_unstable_independently():
     roots = char_poly_roots(TwoMassStage(5.0, 17.5, 90.0, 7.4e7), [-1.0], [1.0])
     assert np.max(roots.real) > 0

@@ -16,9 +16,14 @@ Examples
 
 from __future__ import annotations
 
+import gc
+import io
 import multiprocessing
 import os
+import traceback
 from collections.abc import Callable, Sequence
+from multiprocessing.connection import Connection
+from multiprocessing.connection import wait as wait_connections
 from pathlib import Path
 
 import matplotlib
@@ -26,7 +31,8 @@ import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["STYLE", "plot_analysis", "plot_frf_fit", "plot_steady_state", "save_figures"]
+__all__ = ["STYLE", "FigureWriter", "plot_analysis", "plot_frf_fit", "plot_steady_state",
+           "save_figures"]
 
 STYLE = {
     "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
@@ -167,17 +173,14 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
 
 # ---------------------------------------------------------------------------- saving
 FigureMaker = Callable[[], Figure]
-_PENDING: dict[str, FigureMaker] = {}  # the figures a forked worker draws (inherited, not sent)
 
 
-def _draw_and_save(job: tuple[str, Path, tuple[str, ...]]) -> str:
-    """Draw figure `name` and save it in every format (in a worker or in-process)."""
-    name, folder, formats = job
-    fig = _PENDING[name]()
+def _draw_and_save(name: str, make: FigureMaker, folder: Path, formats: Sequence[str]) -> None:
+    """Draw figure `name` with `make` and save it as ``folder/<name>.<format>`` in every format."""
+    fig = make()
     _lay_out_once(fig)
     for fmt in formats:
         fig.savefig(folder / f"{name}.{fmt}")
-    return name
 
 
 def _lay_out_once(fig: Figure) -> None:
@@ -201,15 +204,196 @@ def _lay_out_once(fig: Figure) -> None:
     fig.set_layout_engine(None)
 
 
-def _workers(n_jobs: int) -> int:
-    """Processes to draw `n_jobs` figures with: the usable cores, 1 without ``fork``."""
-    if "fork" not in multiprocessing.get_all_start_methods():
-        return 1
+def _usable_cores() -> int:
     try:
-        cores = len(os.sched_getaffinity(0))
+        return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - platforms without affinity
-        cores = os.cpu_count() or 1
-    return max(1, min(cores, n_jobs))
+        return os.cpu_count() or 1
+
+
+def _can_fork() -> bool:
+    """Whether figures are drawn by forked workers: ``fork`` exists and more than one core."""
+    return "fork" in multiprocessing.get_all_start_methods() and _usable_cores() > 1
+
+
+def _warm_up(formats: Sequence[str]) -> None:
+    """Load once what drawing any figure loads at its first use, for workers forked later.
+
+    The formats' backends, the font and the math-text parser (tick labels of
+    log axes): a worker forked after this inherits them instead of loading
+    its own.
+    """
+    from matplotlib.backend_bases import get_registered_canvas_class
+
+    for fmt in formats:
+        get_registered_canvas_class(fmt)
+    fig, (ax,) = _figure()
+    ax.loglog([1.0, 100.0], [1.0, 10.0])
+    fig.savefig(io.BytesIO(), format="png")
+
+
+class _WorkerTraceback(Exception):
+    """The traceback of an error in a figure worker (the cause of the error re-raised)."""
+
+
+def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[str],
+                conn) -> None:
+    """A worker's job: draw `makers` in order, sending each name (or the error) on `conn`.
+
+    A kernel compiled here is not announced on stderr: the caller announces its own.
+    """
+    from motionhyst._jit import quiet_compilation
+
+    quiet_compilation()
+    try:
+        for name, make in makers.items():
+            _draw_and_save(name, make, folder, formats)
+            conn.send(("done", name))
+    except BaseException as exc:  # every error, interruptions included, goes to the caller
+        tb = traceback.format_exc()
+        try:
+            conn.send(("error", exc, tb))
+        except Exception:  # an error that does not pickle: its text
+            conn.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}"), tb))
+    finally:
+        conn.close()
+
+
+class FigureWriter:
+    """Draws and saves figures in forked worker processes while the caller goes on computing.
+
+    Laying out and rendering a figure (constrained layout, tick labels of log
+    axes, the PNG and PDF backends) is pure Python in matplotlib and takes far
+    longer than computing its data.  Each :meth:`submit` forks a worker that
+    draws its figures one after the other and saves each as
+    ``folder/<name>.<format>`` in every format, while the caller computes the
+    data of the next ones; the worker inherits the figure makers and their
+    data through ``fork`` (nothing is pickled but the names and errors sent
+    back).  Without ``fork`` (Windows) or with one usable core, :meth:`submit`
+    draws the figures in this process before it returns.
+
+    Used as a context manager: leaving it, on success or on an error, stops
+    the workers still drawing (their files are then incomplete: write into a
+    scratch folder and move the files once :meth:`wait` has returned).
+
+    Parameters
+    ----------
+    folder : str or Path
+        Existing folder the files are written into.
+    formats : sequence of str
+        File formats (extensions), each written for every figure.
+    done : callable, optional
+        Called with each figure's name once its files are written (progress;
+        for the workers' figures, while :meth:`wait` waits).
+    parallel : bool, optional
+        Draw in forked workers; by default when ``fork`` exists and more than
+        one core is usable.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from motionhyst.figures import FigureWriter
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.plots import fig5_loops, fig8_describing_function
+    >>> el = Jenkins(k=20.0, fc=0.05)
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> with FigureWriter(folder, ("png", "pdf")) as figures:
+    ...     figures.submit({"fig5": lambda: fig5_loops(el)})  # drawn while fig8's data is made
+    ...     figures.submit({"fig8": lambda: fig8_describing_function(el)})
+    ...     figures.wait()
+    ['fig5', 'fig8']
+    >>> sorted(p.name for p in folder.iterdir())
+    ['fig5.pdf', 'fig5.png', 'fig8.pdf', 'fig8.png']
+    """
+
+    def __init__(self, folder: str | Path, formats: Sequence[str] = ("png", "pdf"),
+                 done: Callable[[str], None] | None = None,
+                 parallel: bool | None = None) -> None:
+        self.folder = Path(folder)
+        self.formats = tuple(formats)
+        self.done = done
+        self.parallel = _can_fork() if parallel is None else bool(parallel)
+        self._names: list[str] = []
+        self._workers: list[tuple[multiprocessing.process.BaseProcess, Connection]] = []
+        self._warm = False
+
+    def __enter__(self) -> FigureWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def submit(self, makers: dict[str, FigureMaker]) -> None:
+        """Draw and save `makers` (name -> function returning the figure) in a new worker."""
+        self._names += list(makers)
+        if not self.parallel:
+            for name, make in makers.items():
+                _draw_and_save(name, make, self.folder, self.formats)
+                self._done(name)
+            return
+        ctx = multiprocessing.get_context("fork")
+        receive, send = ctx.Pipe(duplex=False)
+        worker = ctx.Process(target=_draw_batch, daemon=True,
+                             args=(dict(makers), self.folder, self.formats, send))
+        # the worker's garbage collections leave alone the objects it inherits (all of this
+        # process's): without, each goes through them all and copies their memory pages, a
+        # quarter of a figure's drawing time
+        gc.freeze()
+        try:
+            worker.start()
+        finally:
+            gc.unfreeze()
+        send.close()
+        self._workers.append((worker, receive))
+        if not self._warm:  # while the first worker draws: for the workers forked later
+            _warm_up(self.formats)
+            self._warm = True
+
+    def wait(self) -> list[str]:
+        """Wait until every figure submitted is saved; their names, in the order submitted.
+
+        Raises the first error a worker met (its traceback as the cause), after
+        stopping the other workers.
+        """
+        try:
+            while self._workers:
+                for conn in wait_connections([c for _, c in self._workers]):
+                    try:
+                        message = conn.recv()
+                    except EOFError:  # the worker has finished
+                        worker = self._finished(conn)
+                        if worker.exitcode != 0:
+                            raise RuntimeError(f"a figure worker ended with exit code "
+                                               f"{worker.exitcode}") from None
+                        continue
+                    if message[0] == "done":
+                        self._done(message[1])
+                    else:
+                        raise message[1] from _WorkerTraceback(message[2])
+        finally:
+            self.close()
+        return list(self._names)
+
+    def close(self) -> None:
+        """Stop the workers still drawing (nothing to do once :meth:`wait` has returned)."""
+        while self._workers:
+            worker, conn = self._workers.pop()
+            if worker.is_alive():
+                worker.terminate()
+            worker.join()
+            conn.close()
+
+    def _finished(self, conn: Connection) -> multiprocessing.process.BaseProcess:
+        i = next(i for i, (_, c) in enumerate(self._workers) if c is conn)
+        worker, _ = self._workers.pop(i)
+        worker.join()
+        conn.close()
+        return worker
+
+    def _done(self, name: str) -> None:
+        if self.done is not None:
+            self.done(name)
 
 
 def save_figures(makers: dict[str, FigureMaker], folder: str | Path,
@@ -218,13 +402,11 @@ def save_figures(makers: dict[str, FigureMaker], folder: str | Path,
                  workers: int | None = None) -> list[str]:
     """Draw figures and save each as ``folder/<name>.<format>``, several at a time.
 
-    Laying out and rendering a figure (constrained layout, tick labels on log
-    axes, PNG and PDF backends) is pure Python in matplotlib and takes far
-    longer than computing its data, so the figures are drawn in parallel by
-    forked worker processes (one per usable core); each worker draws a figure
-    from its maker, inherited through ``fork`` (nothing is pickled but the
-    name), and writes every format.  Without ``fork`` (Windows, or one core)
-    they are drawn in this process, one after the other.
+    The figures are shared out among `workers` forked worker processes (one
+    per usable core by default, at most one per figure), each drawing its
+    share one after the other through a :class:`FigureWriter`; without
+    ``fork`` (Windows, or one core) they are drawn in this process, one after
+    the other.
 
     Parameters
     ----------
@@ -259,24 +441,16 @@ def save_figures(makers: dict[str, FigureMaker], folder: str | Path,
     >>> sorted(p.name for p in folder.iterdir())
     ['fig5.pdf', 'fig5.png', 'fig8.pdf', 'fig8.png']
     """
-    global _PENDING
-    names = list(makers)
-    jobs = [(name, Path(folder), tuple(formats)) for name in names]
-    n = _workers(len(jobs)) if workers is None else max(1, min(int(workers), len(jobs)))
-    _PENDING = dict(makers)
-    try:
-        if n == 1:
-            for name in map(_draw_and_save, jobs):
-                if done is not None:
-                    done(name)
-        else:
-            with multiprocessing.get_context("fork").Pool(n) as pool:
-                for name in pool.imap_unordered(_draw_and_save, jobs):
-                    if done is not None:
-                        done(name)
-    finally:
-        _PENDING = {}
-    return names
+    items = list(makers.items())
+    if workers is None:
+        n = min(_usable_cores(), len(items)) if _can_fork() else 1
+    else:
+        n = max(1, min(int(workers), len(items)))
+    with FigureWriter(folder, formats, done=done, parallel=n > 1) as writer:
+        for i in range(n):  # figure i to worker i mod n
+            writer.submit(dict(items[i::n]))
+        writer.wait()
+    return [name for name, _ in items]
 
 
 def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:

@@ -7,6 +7,8 @@ callers and tests can check what is shown without reading pixels.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
@@ -14,15 +16,12 @@ from numpy.typing import ArrayLike
 
 from motionhyst.figures import LINEAR_COLOR, MODE2_COLOR, MODE3_COLOR, STYLE, _figure
 from motionhyst.hysteresis import Hysteresis, Jenkins
-from motionhyst.loop import Loop
-from motionhyst.quasilinear import (
-    QuasiLinearAnalysis,
-    _resolved,
-    loop_mismatch,
-    mismatch_asymptote,
-)
-from motionhyst.steady import SteadyState
-from motionhyst.systems import TWO_PI, MeasuredPlant, freqresp
+from motionhyst.hysteresis.periodic import TWO_PI
+
+if TYPE_CHECKING:
+    from motionhyst.loop import Loop
+    from motionhyst.quasilinear import QuasiLinearAnalysis
+    from motionhyst.steady import SteadyState
 
 
 def _phase_deg(P) -> np.ndarray:
@@ -33,6 +32,8 @@ def _phase_deg(P) -> np.ndarray:
 
 def _grid(loop: Loop, f_range, n: int) -> np.ndarray:
     """`n` log-spaced frequencies in `f_range` [Hz]; for raw measured data its lines there."""
+    from motionhyst.systems import MeasuredPlant
+
     if isinstance(loop.plant, MeasuredPlant):
         f = loop.plant.frequency_hz
         return f[(f >= f_range[0]) & (f <= f_range[1])]
@@ -282,7 +283,7 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     """
     from motionhyst.hysteresis import Jenkins as _Jenkins
     from motionhyst.quasilinear import f_star
-    from motionhyst.systems import TwoMassStage
+    from motionhyst.systems import TwoMassStage, freqresp
 
     el = loop.hysteresis
     with matplotlib.rc_context(STYLE):
@@ -319,6 +320,9 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
 def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
     """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
+    from motionhyst.quasilinear import _resolved, loop_mismatch, mismatch_asymptote
+    from motionhyst.systems import MeasuredPlant, freqresp
+
     fig, (ax,) = _figure()
     f = _grid(loop, f_range, 800)
     E = loop_mismatch(loop, f, analysis.amplitude)

@@ -21,22 +21,16 @@ import numpy as np
 from tqdm import tqdm
 
 from motionhyst import plots
-from motionhyst.figures import save_figures
+from motionhyst.figures import FigureWriter
 from motionhyst.jsonio import dumps
 from motionhyst.outputs import OutputFolder
-from motionhyst.quasilinear import (
-    QuasiLinearAnalysis,
-    analyze,
-    error_harmonics_df,
-    loop_mismatch,
-)
 from motionhyst.scenario import Scenario
-from motionhyst.steady import SteadyState, periodic_steady_state
-from motionhyst.systems import MeasuredPlant
 
 if TYPE_CHECKING:
     from motionhyst.frf_fit import FrfFit
     from motionhyst.hysteresis import Hysteresis
+    from motionhyst.quasilinear import QuasiLinearAnalysis
+    from motionhyst.steady import SteadyState
 
 # Numbers the paper states for Table I (section V and Fig. 8).
 PAPER_VALUES = {
@@ -187,6 +181,26 @@ OUTPUT_NAMES = (*(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf")), "sum
 """Every file :func:`reproduce` may write into its folder (besides the manifest)."""
 
 
+def _link_figures(el: Hysteresis, A: float, freqs: list[float]) -> dict:
+    """The figures of the link alone (Figs. 5-8): they need neither the loop nor its analysis.
+
+    Fig. 8 marks the operating point ``zeta = fc / (k A)`` of the reference
+    amplitude (eq. 4), the zeta :func:`~motionhyst.quasilinear.analyze`
+    reports; Figs. 6-7 only for a link with the Jenkins element's slip modes.
+    """
+    zeta_op = float(el.zeta(A)) if el.defines_zeta else None
+    figs = {
+        "fig5": lambda: plots.fig5_loops(el, frequency_hz=freqs[0]),
+        "fig6": lambda: plots.fig6_modes(el),
+        "fig7": lambda: plots.fig7_time(el, A, freqs[0]),
+        "fig8": lambda: plots.fig8_describing_function(el, frequency_hz=freqs[0],
+                                                       zeta_op=zeta_op),
+    }
+    if not el.defines_zeta:
+        del figs["fig6"], figs["fig7"]
+    return figs
+
+
 def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
               is_paper: bool = False, force: bool = False,
               inputs: Iterable[str | Path | None] = ()) -> dict:
@@ -226,69 +240,70 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         `force` is false.
     """
     folder = OutputFolder(out_dir, OUTPUT_NAMES, force=force, inputs=inputs)
-    loop = sc.loop()
-    el = loop.hysteresis
     A, freqs = sc.amplitude, sc.frequencies
+    el = sc.hysteresis()
     show = not quiet and sys.stderr.isatty()
     notes: list[str] = []
     try:
         steps = tqdm(total=10, desc="reproduce", disable=not show, file=sys.stderr, leave=False)
-        analysis = analyze(loop, A, freqs)
-        steps.update()
-        raw_data = isinstance(loop.plant, MeasuredPlant)
-        if raw_data:  # the steady state needs the plant at every harmonic: no exact results
-            states, E_df, H_df, exact = [], [], [], []
-        else:
-            states = [periodic_steady_state(loop, A, f) for f in freqs]
-            E_df = loop_mismatch(loop, freqs, A)
-            H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
+        # the figures are drawn by worker processes into a scratch folder outside the user's
+        # folder, each as soon as its data is computed, while the next data is computed
+        with (tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch,
+              FigureWriter(scratch, ("png", "pdf"), done=lambda _: steps.update()) as figures):
+            figures.submit(_link_figures(el, A, freqs))  # need no loop: drawn while it is built
+            # the analysis (python-control, the compiled kernels) is imported only now
+            from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
+            from motionhyst.steady import periodic_steady_state
+            from motionhyst.systems import MeasuredPlant
+
+            loop = sc.loop()
+            analysis = analyze(loop, A, freqs)
             steps.update()
-            lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
-            f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
-            f_exact = np.unique(np.concatenate([f_exact, freqs]))
-            exact = [periodic_steady_state(loop, A, f) for f in f_exact]
-        steps.update()
-        summary = {
-            "scenario": sc.to_dict(),
-            "analyze": analysis.to_dict(),
-            "simulate": {"points": [s.to_dict(mismatch_df=complex(e), error_harmonics_df=h)
-                                    for s, e, h in zip(states, E_df, H_df, strict=True)]},
-        }
-        figs = {
-            "fig5": lambda: plots.fig5_loops(el, frequency_hz=freqs[0]),
-            "fig6": lambda: plots.fig6_modes(el),
-            "fig7": lambda: plots.fig7_time(el, A, freqs[0]),
-            "fig8": lambda: plots.fig8_describing_function(el, frequency_hz=freqs[0],
-                                                           zeta_op=analysis.zeta),
-            "fig9": lambda: plots.fig9_quasilinear_plant(loop, f_star_hz=analysis.f_star_hz),
-            "fig10": lambda: plots.fig10_mismatch(loop, analysis, exact),
-            "fig11": lambda: plots.fig11_errors(states, E_df, H_df),
-        }
-        fit = sc.plant_fit()
-        if fit is not None:
-            summary["plant_fit"] = fit.to_dict()
-            figs["plant_fit"] = fit.plot
-        if not el.defines_zeta:
-            for name in ("fig6", "fig7"):
-                del figs[name]
-            at = "" if el.rate_independent else f" at {freqs[0]:g} Hz"
-            notes.append(f"Figs. 6-7 show the slip modes of the paper's single Jenkins element; "
-                         f"the scenario's link is a {el.name} model, so they are not drawn. "
-                         f"Figs. 5 and 8 show its loops and describing function{at}, with "
-                         f"zeta = fc / (k A) from its total slip force and initial stiffness.")
-        if raw_data:
-            del figs["fig11"]
-            notes.append("The plant is raw measured frequency-response data (use = \"data\"): "
-                         "only the measured lines are evaluated; eq. (21) and the exact steady "
-                         "state (the mismatch table's exact columns, Fig. 10's circles, Fig. 11) "
-                         "need a model and are not computed. Quantities the data cannot resolve "
-                         "are listed below and are n/a.")
-            notes += analysis.unresolved
-        files: dict[str, bytes] = {}
-        # the figures are drawn in parallel into a scratch folder outside the user's folder
-        with tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch:
-            written = save_figures(figs, scratch, ("png", "pdf"),
-                                   done=lambda _: steps.update())
+            figures.submit({"fig9": lambda: plots.fig9_quasilinear_plant(
+                loop, f_star_hz=analysis.f_star_hz)})
+            fit = sc.plant_fit()
+            if fit is not None:
+                figures.submit({"plant_fit": fit.plot})
+            raw_data = isinstance(loop.plant, MeasuredPlant)
+            if raw_data:  # the steady state needs the plant at every harmonic: no exact results
+                states, E_df, H_df, exact = [], [], [], []
+            else:
+                states = [periodic_steady_state(loop, A, f) for f in freqs]
+                E_df = loop_mismatch(loop, freqs, A)
+                H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
+                figures.submit({"fig11": lambda: plots.fig11_errors(states, E_df, H_df)})
+                steps.update()
+                lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
+                f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
+                f_exact = np.unique(np.concatenate([f_exact, freqs]))
+                exact = [periodic_steady_state(loop, A, f) for f in f_exact]
+            figures.submit({"fig10": lambda: plots.fig10_mismatch(loop, analysis, exact)})
+            steps.update()
+            summary = {
+                "scenario": sc.to_dict(),
+                "analyze": analysis.to_dict(),
+                "simulate": {"points": [s.to_dict(mismatch_df=complex(e), error_harmonics_df=h)
+                                        for s, e, h in zip(states, E_df, H_df, strict=True)]},
+            }
+            if fit is not None:
+                summary["plant_fit"] = fit.to_dict()
+            if not el.defines_zeta:
+                at = "" if el.rate_independent else f" at {freqs[0]:g} Hz"
+                notes.append(f"Figs. 6-7 show the slip modes of the paper's single Jenkins "
+                             f"element; the scenario's link is a {el.name} model, so they are not "
+                             f"drawn. Figs. 5 and 8 show its loops and describing function{at}, "
+                             f"with zeta = fc / (k A) from its total slip force and initial "
+                             f"stiffness.")
+            if raw_data:
+                notes.append("The plant is raw measured frequency-response data (use = "
+                             "\"data\"): only the measured lines are evaluated; eq. (21) and the "
+                             "exact steady state (the mismatch table's exact columns, Fig. 10's "
+                             "circles, Fig. 11) need a model and are not computed. Quantities "
+                             "the data cannot resolve are listed below and are n/a.")
+                notes += analysis.unresolved
+            drawn = set(figures.wait())
+            written = [name for name in FIGURES if name in drawn]
+            files: dict[str, bytes] = {}
             for name in written:
                 for ext in ("png", "pdf"):
                     files[f"{name}.{ext}"] = (Path(scratch) / f"{name}.{ext}").read_bytes()

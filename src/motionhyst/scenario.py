@@ -414,20 +414,28 @@ class Scenario:
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "<dict>",
-                  base_dir: Path | None = None) -> Scenario:
-        """Validate a parsed scenario; raises :class:`ScenarioError`."""
+                  base_dir: Path | None = None, check: bool = True) -> Scenario:
+        """Validate a parsed scenario; raises :class:`ScenarioError`.
+
+        With `check` (the default) the loop is also built and checked for
+        stability now; without, at the first :meth:`loop`, which raises the
+        same :class:`ScenarioError` (a command that can do other work first).
+        """
         try:
             model = ScenarioModel.model_validate(data)
         except ValidationError as err:
             raise ScenarioError(_format_error(source, err)) from None
         sc = cls(model, source, base_dir)
-        if not model.open_loop:
+        if check and not model.open_loop:
             sc.loop()  # builds and checks stability
         return sc
 
     @classmethod
-    def from_file(cls, path: str | Path) -> Scenario:
-        """Read and validate a TOML scenario; raises :class:`ScenarioError`."""
+    def from_file(cls, path: str | Path, check: bool = True) -> Scenario:
+        """Read and validate a TOML scenario; raises :class:`ScenarioError`.
+
+        `check` as for :meth:`from_dict`.
+        """
         path = Path(path)
         try:
             text = path.read_text()
@@ -439,7 +447,7 @@ class Scenario:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ScenarioError(f"{path}: TOML syntax error: {exc}") from None
-        return cls.from_dict(data, str(path), path.parent)
+        return cls.from_dict(data, str(path), path.parent, check=check)
 
     @property
     def is_open_loop(self) -> bool:
@@ -571,8 +579,8 @@ def default_scenario_path() -> Path:
     return Path(str(resources.files("motionhyst") / "data" / "paper.toml"))
 
 
-def default_scenario() -> Scenario:
-    """The paper's Table I scenario.
+def default_scenario(check: bool = True) -> Scenario:
+    """The paper's Table I scenario (`check` as for :meth:`Scenario.from_dict`).
 
     Examples
     --------
@@ -583,13 +591,16 @@ def default_scenario() -> Scenario:
     >>> sc.loop().hysteresis
     Jenkins(k=20.0, fc=0.05)
     """
-    sc = Scenario.from_file(default_scenario_path())
+    sc = Scenario.from_file(default_scenario_path(), check=check)
     sc.source = "paper.toml (Table I, built in)"
     return sc
 
 
-def load_scenario(path: str | Path | None) -> Scenario:
+def load_scenario(path: str | Path | None, check: bool = True) -> Scenario:
     """The scenario at `path`, or the default (Table I) when `path` is None.
+
+    `check` as for :meth:`Scenario.from_dict`: without it the loop is built
+    and checked at the first :meth:`Scenario.loop`.
 
     Examples
     --------
@@ -622,6 +633,10 @@ def load_scenario(path: str | Path | None) -> Scenario:
     ... ''')
     >>> load_scenario(path).hysteresis()
     MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.01, 0.02, 0.03])
+    >>> sc = load_scenario(path, check=False)              # the loop is built at sc.loop()
+    >>> sc.hysteresis(), sc.loop().hysteresis
+    (MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.01, 0.02, 0.03]), MaxwellSlip(k=[10.0, 6.0, 4.0], \
+fc=[0.01, 0.02, 0.03]))
     """
-    return default_scenario() if path is None else Scenario.from_file(path)
+    return default_scenario(check) if path is None else Scenario.from_file(path, check)
 

@@ -13,7 +13,8 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.report import reproduce
     from motionhyst.scenario import load_scenario
 
-    sc = load_scenario(args.scenario)
+    # the loop is built (and checked) inside reproduce, while the first figures are drawn
+    sc = load_scenario(args.scenario, check=False)
     reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None, force=args.force,
               inputs=sc.files)
     if not args.quiet:
