@@ -7,7 +7,6 @@ import argparse
 from motionhyst.cli._common import UsageError, g, print_json, table
 
 PLANTS = ("mass-spring-damper", "two-mass")
-IO_MODELS = ("bouc-wen", "maxwell-slip", "jenkins", "dahl", "lugre")
 
 
 def _nu(text: str) -> float | str:
@@ -25,9 +24,11 @@ def _nu(text: str) -> float | str:
 
 def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     """The options of input-output identification."""
+    from motionhyst.hysteresis import MODELS
+
     q.add_argument("--plant", choices=PLANTS,
                    help="input-output records: the stage's model (default mass-spring-damper)")
-    q.add_argument("--model", choices=IO_MODELS,
+    q.add_argument("--model", choices=list(MODELS),
                    help="input-output records: the link's model (default bouc-wen)")
     q.add_argument("--periodic", action="store_true",
                    help="input-output records: each record holds whole periods of a periodic "
@@ -64,9 +65,6 @@ def run_input_output(args: argparse.Namespace) -> int:
     if plant == "two-mass":
         raise UsageError("motionhyst identify: --plant two-mass is not available for "
                          "input-output records yet; use --plant mass-spring-damper")
-    if model == "lugre":
-        raise UsageError("motionhyst identify: --model lugre is not available for "
-                         "input-output records yet; use bouc-wen, maxwell-slip, jenkins or dahl")
     if args.elements is not None and model != "maxwell-slip":
         raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     if args.nu is not None and model != "bouc-wen":

@@ -107,7 +107,8 @@ class LuGre(Hysteresis):
     rate_independent = False
     parameters = (Parameter("sigma0", "N/m", "bristle stiffness sigma0"),
                   Parameter("sigma1", "N s/m", "bristle damping sigma1", 0.0, "nonnegative"),
-                  Parameter("sigma2", "N s/m", "viscous friction sigma2", 0.0, "nonnegative"),
+                  Parameter("sigma2", "N s/m", "viscous friction sigma2", 0.0, "nonnegative",
+                            parallel="damper"),
                   Parameter("fc", "N", "Coulomb force f_c"),
                   Parameter("fs", "N", "static (Stribeck) force f_s"),
                   Parameter("vs", "m/s", "Stribeck velocity v_s"))

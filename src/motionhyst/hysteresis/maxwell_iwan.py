@@ -242,7 +242,8 @@ class MaxwellIwan(Hysteresis):
     name = "maxwell-iwan"
     rate_independent = False
     parameters = (
-        Parameter("k0", "N/m", "stiffness k0 of the parallel spring", kind="nonnegative"),
+        Parameter("k0", "N/m", "stiffness k0 of the parallel spring", kind="nonnegative",
+                  parallel="spring"),
         Parameter("kv", "N/m", "spring stiffness kv of each Maxwell branch", (), many=True),
         Parameter("cv", "N s/m", "damping cv of each Maxwell branch", (), many=True),
         Parameter("ki", "N/m", "total stiffness ki of the Iwan element"),

@@ -47,6 +47,11 @@ class Parameter:
         any further rule).
     many : bool
         A list of values (one per element of a parallel model).
+    parallel : {"", "spring", "damper"}
+        ``"spring"`` (``"damper"``) if the parameter only adds a linear spring
+        ``p x`` (damper ``p dx/dt``) in parallel with the rest of the link:
+        on a stage with its own spring and damper its effect cannot be told
+        from the stage's (input-output identification fixes it at 0).
 
     Examples
     --------
@@ -61,6 +66,7 @@ class Parameter:
     default: float | tuple[float, ...] | None = None
     kind: ParameterKind = "positive"
     many: bool = False
+    parallel: Literal["", "spring", "damper"] = ""
 
     @property
     def required(self) -> bool:

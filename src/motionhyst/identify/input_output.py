@@ -19,15 +19,16 @@ Method
    carrying input power (weighted by ``|G|``, i.e. the relative output error).
 2. Start, link: the linear fit by simulation error; then the link's force is
    introduced by splitting the best linear stiffness ``k`` between the stage
-   and the link (Bouc-Wen: ``alpha``, with ``beta*gamma = beta*delta = 0``;
-   Maxwell-slip: elements whose slip displacements span the record's
-   displacement range).  Several splits are refined on a short part of the
-   records and the best continues.
+   and the link (Bouc-Wen: ``alpha``, with ``beta*gamma = beta*delta = 0``; the
+   other links, from the model registry: parameters started by their units,
+   the link slipping within the records or hardly at all, a rate scale such
+   as LuGre's ``vs`` held on a grid, see :func:`_identify_elements`).  Several
+   starts are refined on a short part of the records and the best continues.
 3. Refinement: :func:`scipy.optimize.least_squares` (trust-region reflective)
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
    from forward sensitivities integrated with the model (RK4); other links: a
-   finite-difference Jacobian.  Stopping rule: the first of a relative cost
-   reduction below ``ftol``, a relative step below ``xtol`` or a scaled
+   finite-difference Jacobian (columns in parallel threads).  Stopping rule:
+   the first of a relative cost reduction below ``ftol``, a relative step below ``xtol`` or a scaled
    gradient below ``gtol`` (all ``1e-12`` by default), or ``max_nfev``
    evaluations.
 4. Standard errors ``sqrt(diag(sigma^2 (J^T J)^-1))``, ``sigma^2 = RSS/(N - p)``,
@@ -35,7 +36,12 @@ Method
    value is below ``1e-8`` of the largest (``1e-5`` for a finite-difference
    Jacobian) is not determined by the data; its parameters are reported as
    not identifiable, with the others they combine with (never as a huge
-   standard error), and the rest from the pseudo-inverse.
+   standard error), and the rest from the pseudo-inverse.  Other links also
+   report a parameter whose standard error exceeds its value (with the
+   parameters its estimate is correlated with), a rate scale whose profile is
+   flat (95 % likelihood ratio), and a parameter that only adds a spring or
+   damper in parallel with the stage's (``Parameter.parallel``, e.g. LuGre's
+   ``sigma2``: only ``c + sigma2`` enters the output; fixed at 0).
 
 The benchmark's Bouc-Wen parameters ``beta, gamma, delta`` enter the model only
 as ``beta*gamma`` and ``beta*delta`` (``z`` is not measured and ``beta`` always
@@ -57,7 +63,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from motionhyst.hysteresis import BoucWen, Hysteresis
+from motionhyst.hysteresis import MODELS as REGISTERED
+from motionhyst.hysteresis import BoucWen, Hysteresis, Parameter
 from motionhyst.openloop import (
     MassSpringDamper,
     OpenLoop,
@@ -68,7 +75,12 @@ from motionhyst.openloop import (
 )
 
 MIN_SAMPLES = 64
-MODELS = ("bouc-wen", "maxwell-slip", "jenkins", "dahl")
+#: Link models for input-output records: Bouc-Wen (exact sensitivities) and every other
+#: registered model (its parameters taken from the registry)
+#: registered model (its parameters taken from the registry); not maxwell-iwan, whose Iwan
+#: element of 256 stop operators makes a simulation too slow for a search
+MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
+                                                                      "maxwell-iwan")))
 SINGULAR_RTOL = 1e-8
 FD_SINGULAR_RTOL = 1e-5  # finite-difference Jacobians (step 1e-6) are no more exact than this
 
@@ -378,6 +390,46 @@ def _undetermined_notes(names: list[str], groups: list[list[int]], rtol: float
     return notes
 
 
+def _correlation(J: NDArray[np.float64], rtol: float) -> NDArray[np.float64]:
+    """Correlation matrix of the estimates, ``(J^T J)^+`` over the determined directions."""
+    norms = np.linalg.norm(J, axis=0)
+    norms[norms == 0] = 1.0
+    _, sv, vt = np.linalg.svd(J / norms, full_matrices=False)
+    good = sv > rtol * sv[0]
+    cov = (vt[good].T / sv[good] ** 2) @ vt[good]
+    d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
+    return cov / np.outer(d, d)
+
+
+def _weak_notes(names: list[str], values: NDArray[np.float64], std: NDArray[np.float64],
+                J: NDArray[np.float64], rtol: float, may_be_zero: NDArray[np.bool_]
+                ) -> dict[str, str]:
+    """Parameters whose standard error exceeds their value: not determined by the records.
+
+    A parameter that must be positive is then reported with the parameters its
+    estimate is correlated with (``|r| > 0.99``: only that combination is
+    determined), or as having almost no effect at the records' noise; one that
+    may be zero as not distinguishable from 0.
+    """
+    corr = _correlation(J, rtol)
+    notes: dict[str, str] = {}
+    for i, name in enumerate(names):
+        s = std[i]
+        if not (math.isfinite(s) and s > abs(values[i])):
+            continue
+        if may_be_zero[i]:
+            notes[name] = (f"not distinguishable from 0 by these records (estimate "
+                           f"{values[i]:.4g} +- {s:.2g})")
+            continue
+        partners = [f"{names[j]} (r = {corr[i, j]:+.4f})" for j in range(len(names))
+                    if j != i and abs(corr[i, j]) > 0.99]
+        what = (f"only a combination with {', '.join(partners)} is" if partners else
+                "it has almost no effect on the output at the records' noise")
+        notes[name] = (f"not determined by these records: its standard error {s:.2g} exceeds "
+                       f"the estimate {values[i]:.4g}; {what}")
+    return notes
+
+
 def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
                 nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
                 max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None
@@ -389,8 +441,11 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     records : list of IORecord
         Force in, displacement out; each from rest (``y = y' = 0``, link relaxed
         at the first sample) or, with `periodic`, whole periods of a steady state.
-    model : {"bouc-wen", "maxwell-slip", "jenkins", "dahl"}
-        The link's model.
+    model : str
+        The link's model, one of :data:`MODELS` (``"bouc-wen"``, ``"jenkins"``,
+        ``"maxwell-slip"``, ``"dahl"``, ``"lugre"``): Bouc-Wen with exact
+        sensitivities, the others from the model registry (LuGre's viscous
+        ``sigma2`` is not estimated: it adds to ``c``).
     periodic : bool
         Records are steady-state periods (each record one period or several
         whole periods of its force).
@@ -560,107 +615,327 @@ def _bouc_wen_link(alpha: float, bg: float, bd: float, nu: float) -> Hysteresis:
 
 
 # ----------------------------------------------------------------- other links (finite differences)
-def _link_from(model: str, v: NDArray[np.float64], n: int) -> Hysteresis:
-    from motionhyst.hysteresis import Dahl, Jenkins, MaxwellSlip
-
-    if model == "maxwell-slip":
-        return MaxwellSlip(k=v[:n], fc=v[n:2 * n])
-    if model == "jenkins":
-        return Jenkins(k=v[0], fc=v[1])
-    return Dahl(k=v[0], fc=v[1], alpha=v[2])
+# start values and search scales by the parameter's unit (registry.Parameter.unit)
+_STIFFNESS, _FORCE, _DAMPING, _VELOCITY, _LENGTH = "N/m", "N", "N s/m", "m/s", "m"
 
 
-def _link_names(model: str, n: int) -> list[str]:
-    """Names of the link's estimates, ``link.`` before the model's parameter names."""
-    if model == "maxwell-slip":
-        names = [f"k[{i}]" for i in range(n)] + [f"fc[{i}]" for i in range(n)]
-    else:
-        names = ["k", "fc"] if model == "jenkins" else ["k", "fc", "alpha"]
-    return [f"link.{name}" for name in names]
+@dataclass
+class _LinkLayout:
+    """How a registered link model's parameters enter the search.
 
+    Built from the model's :class:`~motionhyst.hysteresis.registry.Parameter`
+    list alone, so a newly registered model needs no edit here: each value
+    (a list parameter gives `n` values) is estimated, as a logarithm when it
+    must be positive, linearly (scaled, bounded below by 0) when it may be 0;
+    a parameter that only adds a spring or damper in parallel (``parallel``)
+    is fixed at 0, since the stage's ``k`` or ``c`` holds the sum.
+    """
 
-def _link_start(model: str, k_link: float, y_scale: float, n: int) -> NDArray[np.float64]:
-    """Link parameters of stiffness `k_link` slipping across the record's displacement range."""
-    if model == "maxwell-slip":
-        d = y_scale * np.geomspace(0.05, 2.0, n)
-        k = np.full(n, k_link / n)
-        return np.concatenate([k, k * d])
-    v = [k_link, k_link * 0.5 * y_scale]
-    return np.array(v if model == "jenkins" else [*v, 1.0])
+    model: str
+    cls: type
+    entries: list[tuple[Parameter, int]]  # (parameter, number of values; -1: a scalar)
+    fixed: dict[str, float]
+
+    @classmethod
+    def of(cls, model: str, n: int) -> _LinkLayout:
+        from motionhyst.hysteresis import model_class
+
+        klass = model_class(model)
+        entries, fixed = [], {}
+        for par in klass.parameters:
+            if par.parallel:
+                fixed[par.name] = 0.0
+            elif par.many:  # a list: n values (none if the model's default is no element)
+                entries.append((par, 0 if par.default == () else n))
+            else:
+                entries.append((par, -1))
+        return cls(model, klass, entries, fixed)
+
+    def _values(self):
+        for par, count in self.entries:
+            if count < 0:
+                yield par, None
+            else:
+                for i in range(count):
+                    yield par, i
+
+    @property
+    def names(self) -> list[str]:
+        """Names of the estimates, ``link.`` before the model's parameter names."""
+        return [f"link.{par.name}" if i is None else f"link.{par.name}[{i}]"
+                for par, i in self._values()]
+
+    @property
+    def logarithmic(self) -> NDArray[np.bool_]:
+        """True for the values searched as logarithms (those that must be positive)."""
+        return np.array([par.kind == "positive" for par, _ in self._values()], dtype=bool)
+
+    def build(self, v: NDArray[np.float64]) -> Hysteresis:
+        """The link of the values `v` (in the order of :attr:`names`)."""
+        kwargs: dict = dict(self.fixed)
+        j = 0
+        for par, count in self.entries:
+            if count < 0:
+                kwargs[par.name] = float(v[j])
+                j += 1
+            else:
+                kwargs[par.name] = [float(x) for x in v[j:j + count]]
+                j += count
+        return self.cls(**kwargs)
+
+    def scales(self, k: float, c: float, y_scale: float, v_scale: float
+               ) -> NDArray[np.float64]:
+        """Typical magnitude of each value, by its unit (for the linear ones' search)."""
+        unit = {_STIFFNESS: k, _FORCE: k * y_scale, _DAMPING: c, _VELOCITY: v_scale,
+                _LENGTH: y_scale}
+        return np.array([unit.get(par.unit, 1.0) for par, _ in self._values()])
+
+    def start(self, k_link: float, y_scale: float, v_scale: float, c: float,
+              slip: float = 1.0) -> NDArray[np.float64]:
+        """Start values: stiffness `k_link` slipping across the record's displacement range.
+
+        The stiffness values share `k_link`; element ``i`` of a list slips at a
+        displacement from ``0.05`` to ``2`` times `y_scale` (geometric), a
+        scalar force at ``0.5 y_scale`` times the link's stiffness (a second
+        force half as large again), all times `slip`; a velocity is ``0.1`` of
+        `v_scale`, a damping `c`; a parameter with a default starts there.
+        """
+        values = list(self._values())
+        n_stiff = sum(1 for par, _ in values if par.unit == _STIFFNESS)
+        k_each = k_link / max(n_stiff, 1)
+        n_list = max([count for _, count in self.entries] + [1])
+        y_scale = y_scale * slip
+        d_list = y_scale * np.geomspace(0.05, 2.0, n_list)
+        n_len = sum(1 for par, i in values if par.unit == _LENGTH and i is None)
+        d_len = y_scale * np.geomspace(0.05, 2.0, max(n_len, 1))
+        out, n_force, j_len = [], 0, 0
+        for par, i in values:
+            if par.default not in (None, ()) and not par.many:
+                out.append(float(par.default))  # type: ignore[arg-type]
+            elif par.unit == _STIFFNESS:
+                out.append(k_each)
+            elif par.unit == _FORCE:
+                if i is not None:
+                    out.append(k_each * d_list[i])
+                else:
+                    out.append(k_link * 0.5 * y_scale * 1.5 ** n_force)
+                    n_force += 1
+            elif par.unit == _LENGTH:
+                out.append(d_list[i] if i is not None else d_len[j_len])
+                j_len += i is None
+            elif par.unit == _VELOCITY:
+                out.append(0.1 * v_scale)
+            elif par.unit == _DAMPING:
+                out.append(c)
+            else:
+                out.append(1.0)
+        return np.array(out)
 
 
 class _ElementProblem:
-    """Simulation residuals of the stage with a link of exact-update elements (log parameters)."""
+    """Simulation residuals of the stage with a link of exact-update elements.
 
-    def __init__(self, records, periodic, substeps, model, n, y_scale):
+    The search variables are ``log m, log c, log k`` and the link's values,
+    each as a logarithm or scaled (see :class:`_LinkLayout`); those not in
+    `free` stay at their values in `fixed`.  The Jacobian is by forward
+    differences (relative step ``1e-6``), its columns computed in parallel.
+    """
+
+    def __init__(self, records, periodic, substeps, layout: _LinkLayout, y_scale,
+                 scale: NDArray[np.float64], free: NDArray[np.bool_] | None = None,
+                 fixed: NDArray[np.float64] | None = None):
         self.records, self.periodic, self.r = records, periodic, substeps
-        self.model, self.n, self.y_scale = model, n, y_scale
+        self.layout, self.y_scale = layout, y_scale
+        self.log = np.concatenate([[True, True, True], layout.logarithmic])
+        self.scale = scale
+        self.free = np.ones(self.log.size, bool) if free is None else free
+        self.fixed = np.zeros(self.log.size) if fixed is None else fixed
+        self.fine = [fine_input(rec.u, substeps, periodic) for rec in records]
         self.n_eval = 0
+        self._last: tuple[bytes, NDArray[np.float64]] | None = None
 
-    def residuals(self, logp: NDArray[np.float64]) -> NDArray[np.float64]:
-        self.n_eval += 1
-        v = np.exp(logp)
+    def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Parameters ``m, c, k, link...`` of the (whole) search vector `q`."""
+        return np.where(self.log, np.exp(np.where(self.log, q, 0.0)), q * self.scale)
+
+    def variables(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The whole search vector of the parameters `v`."""
+        return np.where(self.log, np.log(np.where(self.log, v, 1.0)), v / self.scale)
+
+    def derivative(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``d v / d q`` of each parameter."""
+        return np.where(self.log, v, self.scale)
+
+    def whole(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The whole search vector: `q_free` where free, the fixed values elsewhere."""
+        q = self.fixed.copy()
+        q[self.free] = q_free
+        return q
+
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Lower bound 0 on the linearly searched values, none on the logarithms."""
+        lower = np.where(self.log, -np.inf, 0.0)[self.free]
+        return lower, np.full(lower.size, np.inf)
+
+    def _run(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+        v = self.values(self.whole(q_free))
         try:
-            sys = OpenLoop(MassSpringDamper(v[0], v[1], v[2]), _link_from(self.model, v[3:],
-                                                                           self.n))
-
-            def one(rec):
-                return sys.simulate(rec.t, rec.u, periodic=self.periodic,
-                                    substeps=self.r).displacement - rec.y
-
-            if len(self.records) > 1:
-                with ThreadPoolExecutor(max_workers=min(len(self.records),
-                                                        os.cpu_count() or 1)) as pool:
-                    res = list(pool.map(one, self.records))
-            else:
-                res = [one(self.records[0])]
+            sys = OpenLoop(MassSpringDamper(v[0], v[1], v[2]), self.layout.build(v[3:]))
+            res = [sys._simulate_elements(rec.u, rec.fs, self.r, self.periodic, fine) - rec.y
+                   for rec, fine in zip(self.records, self.fine, strict=True)]
             r = np.concatenate(res) / self.y_scale
         except ValueError:
             r = np.full(sum(rec.y.size for rec in self.records), np.nan)
         return np.where(np.isfinite(r), r, 1e3)
 
+    def residuals(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Output errors in units of the output's RMS."""
+        self.n_eval += 1
+        r = self._run(q_free)
+        self._last = (q_free.tobytes(), r)
+        return r
+
+    def jacobian(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Forward differences, one column per free variable, in parallel threads."""
+        if self._last is not None and self._last[0] == q_free.tobytes():
+            r0 = self._last[1]
+        else:
+            r0 = self.residuals(q_free)
+        steps = 1e-6 * np.maximum(1.0, np.abs(q_free))
+
+        def column(j):
+            q = q_free.copy()
+            q[j] += steps[j]
+            return (self._run(q) - r0) / steps[j]
+
+        self.n_eval += q_free.size
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+            cols = list(pool.map(column, range(q_free.size)))
+        return np.column_stack(cols)
+
+    def solve(self, q0_free: NDArray[np.float64], tol: float, max_nfev: int):
+        """Trust-region refinement of the free variables from `q0_free`."""
+        return least_squares(self.residuals, q0_free, jac=self.jacobian, method="trf",
+                             ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev,
+                             bounds=self.bounds())
+
+
+#: The rate scales (velocity parameters, e.g. LuGre's vs) are held at each of these
+#: fractions of the records' RMS velocity in turn, the rest refined; the best continues
+RATE_GRID = (0.1, 0.01, 0.03, 0.3, 1.0, 3.0)
+#: Starts of the link: (share of the best linear stiffness, slip displacements in units of
+#: those spanning the records): slipping within the records, or hardly at all
+STARTS = ((0.3, 1.0), (0.6, 1.0), (0.5, 10.0))
+
 
 def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_start,
                        start_nfev) -> IOIdentification:
-    """Stage and a Jenkins, Maxwell-slip or Dahl link by simulation error (finite differences)."""
-    if model != "maxwell-slip":
-        n = 1
+    """Stage and a link of exact-update elements by simulation error (finite differences).
+
+    Starts (on a short part of the records): for the splits of the best linear
+    stiffness between stage and link and the slip displacements of
+    :data:`STARTS`, the link's values are refined with its
+    rate scales (velocities) held at the first of :data:`RATE_GRID`; from the
+    better, with the rate scales held at each other value of the grid (a
+    profile: the rate scale and the force it shapes form a long valley when
+    searched together); the best is refined with everything free on all
+    records.
+    """
+    layout = _LinkLayout.of(model, n)
     bla = best_linear_approximation(records)
     r = substeps or OpenLoop(bla).default_substeps(records[0].fs)
-    y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2)))
+    y_all = np.concatenate([rec.y for rec in records])
+    y_scale = float(np.sqrt(np.mean(y_all ** 2)))
+    v_scale = float(np.sqrt(np.mean(np.concatenate(
+        [np.gradient(rec.y, rec.t) for rec in records]) ** 2)))
+    c_scale = max(bla.c, 1e-3 * bla.m * 2 * np.pi * records[0].fs)
+    scale = np.concatenate([[bla.m, c_scale, bla.k],
+                            layout.scales(bla.k, c_scale, y_scale, v_scale)])
+    rate = np.concatenate([[False] * 3, [par.unit == _VELOCITY for par, _ in layout._values()]])
     short = _short_records(records, periodic)
     n_eval = 0
+    n_start = start_nfev or 15 * scale.size
+
+    def held(p0: NDArray[np.float64], nfev: int):
+        prob = _ElementProblem(short, periodic, r, layout, y_scale, scale, ~rate)
+        prob.fixed = prob.variables(p0)
+        sol = prob.solve(prob.fixed[~rate], 1e-6, nfev)
+        return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
+
     best = None
-    for share in (0.3, 0.6):
+    for share, slip in STARTS:
         p0 = np.concatenate([[bla.m, bla.c, (1 - share) * bla.k],
-                             _link_start(model, share * bla.k, y_scale, n)])
-        prob = _ElementProblem(short, periodic, r, model, n, y_scale)
-        sol = least_squares(prob.residuals, np.log(p0), method="trf", ftol=1e-6, xtol=1e-6,
-                            gtol=1e-6, max_nfev=start_nfev or 15 * p0.size, diff_step=1e-6)
-        n_eval += prob.n_eval
-        if best is None or sol.cost < best.cost:
-            best = sol
-    prob = _ElementProblem(records, periodic, r, model, n, y_scale)
-    sol = least_squares(prob.residuals, best.x, method="trf", ftol=tol, xtol=tol, gtol=tol,
-                        max_nfev=max_nfev, diff_step=1e-6)
-    n_eval += prob.n_eval
-    v = np.exp(sol.x)
+                             layout.start(share * bla.k, y_scale, v_scale, bla.c, slip)])
+        p0[rate] = RATE_GRID[0] * v_scale
+        cost, p, used = held(p0, n_start)
+        n_eval += used
+        if best is None or cost < best[0]:
+            best = (cost, p)
+    profile = [best[0]]
+    if rate.any():
+        p_rest = best[1]
+        for fraction in RATE_GRID[1:]:
+            p0 = p_rest.copy()
+            p0[rate] = fraction * v_scale
+            cost, p, used = held(p0, n_start)
+            n_eval += used
+            profile.append(cost)
+            if cost < best[0]:
+                best = (cost, p)
+    prob = _ElementProblem(records, periodic, r, layout, y_scale, scale)
+    sol = prob.solve(prob.variables(best[1]), tol, max_nfev)
+    v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)
-    J = sol.jac * y_scale / v  # d residual / d parameter
+    J = prob.jacobian(sol.x) * y_scale / prob.derivative(v)  # d residual / d parameter
+    n_eval += prob.n_eval
     std_v, groups = _uncertainty(J, rss, res.size, FD_SINGULAR_RTOL)
-    names = ["m", "c", "k", *_link_names(model, n)]
+    names = ["m", "c", "k", *layout.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
-    not_ident: dict[str, str] = {}
     for nm, sd in zip(names, std_v, strict=True):
         std[nm] = float(sd) if math.isfinite(sd) else None
+    not_ident = {f"link.{name}": _parallel_note(layout, name) for name in layout.fixed}
     not_ident.update(_undetermined_notes(names, groups, FD_SINGULAR_RTOL))
+    weak = _weak_notes(names, v, std_v, J, FD_SINGULAR_RTOL, ~prob.log)
+    n_short = sum(rec.y.size for rec in short)
+    if rate.any() and _flat_profile(profile, n_short - scale.size):
+        lo, hi = min(RATE_GRID) * v_scale, max(RATE_GRID) * v_scale
+        for name in np.array(names)[rate]:
+            weak[name] = (f"not determined by these records: held anywhere from {lo:.3g} to "
+                          f"{hi:.3g} m/s, the other parameters fit the first record as well "
+                          f"(likelihood ratio below {PROFILE_CHI2:g}, 95 %): the rate-dependent "
+                          f"term is not seen, and the link's forces are its level at the "
+                          f"records' velocities")
+    for name, why in weak.items():
+        if name not in not_ident:
+            not_ident[name] = why
+            std[name] = None
     return IOIdentification(
-        plant=MassSpringDamper(v[0], v[1], v[2]), hysteresis=_link_from(model, v[3:], n),
+        plant=MassSpringDamper(v[0], v[1], v[2]), hysteresis=layout.build(v[3:]),
         estimates=estimates, std=std, not_identifiable=not_ident,
         fit_rms=float(np.sqrt(rss / res.size)), records=_per_record(records, res),
         seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} (finite-difference Jacobian; ftol = xtol = gtol = {tol:g}, "
                  f"at most {max_nfev} evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r)
+
+
+#: 95 % point of the chi-square distribution with one degree of freedom
+PROFILE_CHI2 = 3.84
+
+
+def _flat_profile(costs: list[float], dof: int) -> bool:
+    """True if no cost of a profile exceeds the least by the 95 % likelihood-ratio bound.
+
+    ``(RSS_i - RSS_min) / sigma^2 < 3.84`` for every point, ``sigma^2 = RSS_min / dof``.
+    """
+    least = min(costs)
+    return bool(least > 0 and (max(costs) - least) / least * max(dof, 1) < PROFILE_CHI2)
+
+
+def _parallel_note(layout: _LinkLayout, name: str) -> str:
+    par = next(p for p in layout.cls.parameters if p.name == name)
+    what, stage = ("a spring", "k") if par.parallel == "spring" else ("a damper", "c")
+    return (f"{what} in parallel with the stage's: only the sum {stage} + {name} enters the "
+            f"output; fixed at 0, the stage's {stage} holds the sum")
