@@ -282,3 +282,43 @@ def test_cli_lugre_below_sliding_reports_what_the_records_cannot_determine(tmp_p
                    ).simulate(t, _multisine(256, 9, 0.5)).displacement
     np.testing.assert_allclose(np.loadtxt(pred, delimiter=",", skiprows=1)[:, 1], ref,
                                rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def _bouc_wen_nu_system(nu: float) -> tuple[OpenLoop, dict[str, float]]:
+    """The test stage with a Bouc-Wen link of exponent nu and a 30 N ultimate force."""
+    alpha, gamma, delta = 5e4, 0.8, -0.3
+    beta = alpha / 30.0 ** nu / (gamma + delta)
+    true = {"m": 2.0, "c": 10.0, "k": 5e4, "alpha": alpha, "beta*gamma": beta * gamma,
+            "beta*delta": beta * delta, "nu": nu}
+    return OpenLoop(MassSpringDamper(2.0, 10.0, 5e4),
+                    BoucWen.from_general(alpha, beta, gamma, delta, nu)), true
+
+
+@pytest.mark.parametrize("nu", [1.5, 2.0, 3.0])
+def test_free_exponent_recovered_from_noise_free_records(nu):
+    system, true = _bouc_wen_nu_system(nu)
+    t = np.arange(1024) / FS
+    u = _multisine(1024, 1)
+    y = system.simulate(t, u, substeps=SUBSTEPS).displacement
+    fit = identify_io([IORecord(t, u, y)], nu=None, substeps=SUBSTEPS)
+    for name, value in true.items():
+        assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
+    assert fit.fit_rms < 1e-12
+    assert fit.hysteresis.general["nu"] == pytest.approx(nu, rel=1e-6)
+
+
+def test_free_exponent_noisy_records_within_three_standard_errors():
+    system, true = _bouc_wen_nu_system(2.0)
+    noise = 8e-6
+    records = []
+    for seed in (2, 3):
+        t = np.arange(1536) / FS
+        u = _multisine(1536, seed)
+        y = system.simulate(t, u, substeps=SUBSTEPS).displacement
+        records.append(IORecord(t, u, y + noise * np.random.default_rng(seed).standard_normal(
+            t.size)))
+    fit = identify_io(records, nu=None, substeps=SUBSTEPS)
+    for name, value in true.items():
+        std = fit.std[name]
+        assert std is not None and 0 < std < 0.05 * abs(value), name
+        assert abs(fit.estimates[name] - value) <= 3 * std, name

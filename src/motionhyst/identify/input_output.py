@@ -277,8 +277,12 @@ class _BoucWenProblem:
     """Simulation residuals of the stage with a general Bouc-Wen link, and their Jacobian."""
 
     def __init__(self, records: list[IORecord], periodic: bool, substeps: int,
-                 free: NDArray[np.bool_], fixed: NDArray[np.float64], y_scale: float):
+                 free: NDArray[np.bool_], fixed: NDArray[np.float64], y_scale: float,
+                 force_scale: float = 1.0):
         self.y_scale = y_scale  # residuals in units of the output's RMS
+        # with nu free the products are searched as beta*gamma F^(nu - 1) (and delta): the
+        # size of beta*gamma |z|^nu at |z| ~ F, which then does not move with nu
+        self.force_scale = force_scale if free[6] else 1.0
         self.records = records
         self.periodic = periodic
         self.r = substeps
@@ -288,9 +292,30 @@ class _BoucWenProblem:
         self.n_eval = 0
 
     def full(self, q_free: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray:
+        """Parameters ``m, c, k, alpha, beta*gamma, beta*delta, nu`` of the search variables."""
         p = self.fixed.copy()
         p[self.free] = q_free * scale[self.free]
+        if self.force_scale != 1.0:
+            p[4:6] *= self.force_scale ** (1.0 - p[6])
         return p
+
+    def variables(self, p: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray:
+        """The search variables of the parameters `p` (inverse of :meth:`full`)."""
+        q = p / scale
+        if self.force_scale != 1.0:
+            q[4:6] /= self.force_scale ** (1.0 - p[6])
+        return q[self.free]
+
+    def jacobian(self, dy_dp: NDArray[np.float64], p: NDArray[np.float64],
+                 scale: NDArray[np.float64]) -> NDArray:
+        """Derivatives in the search variables from those in the parameters (chain rule)."""
+        J = dy_dp * scale
+        if self.force_scale != 1.0:
+            f = self.force_scale ** (1.0 - p[6])
+            J[:, 6] -= math.log(self.force_scale) * scale[6] * (dy_dp[:, 4] * p[4]
+                                                                 + dy_dp[:, 5] * p[5])
+            J[:, 4:6] *= f
+        return J[:, self.free]
 
     def run(self, p: NDArray[np.float64], jac: bool):
         self.n_eval += 1
@@ -328,18 +353,20 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
         hit = cache.get(key)
         if hit is not None:
             return hit
-        r, s = prob.run(prob.full(q, scale), True)
+        p = prob.full(q, scale)
+        r, s = prob.run(p, True)
         cache.clear()
-        cache[key] = (r, s)
-        return r, s
+        cache[key] = (r, s, p)
+        return r, s, p
 
     def fun(q):
         return evaluate(q)[0]
 
     def jacobian(q):
-        return evaluate(q)[1][:, prob.free] * scale[prob.free]
+        _, s, p = evaluate(q)
+        return prob.jacobian(s, p, scale)
 
-    q0 = p0[prob.free] / scale[prob.free]
+    q0 = prob.variables(p0, scale)
     lower = np.full(q0.size, -np.inf)
     if prob.free[6]:
         lower[-1] = 1.0 / scale[6]
@@ -347,6 +374,15 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
     sol = least_squares(fun, q0, jac=jacobian, method="trf", x_scale=1.0, ftol=tol, xtol=tol,
                         gtol=tol, max_nfev=max_nfev, bounds=(lower, np.inf))
     return sol
+
+
+def _force_scale(p: NDArray[np.float64], y_scale: float) -> float:
+    """A typical link force ``|z|`` [N]: ``alpha y_scale``, or the ultimate force if smaller."""
+    alpha, b, nu = p[3], p[4] + p[5], p[6]
+    f = abs(alpha) * y_scale
+    if b > 0.0 and alpha > 0.0:
+        f = min(f, (alpha / b) ** (1.0 / nu))
+    return f if math.isfinite(f) and f > 0.0 else 1.0
 
 
 def _uncertainty(J: NDArray[np.float64], rss: float, n_rows: int,
@@ -452,9 +488,13 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     nu : float or None
         Bouc-Wen exponent: fixed at this value, or estimated (``nu >= 1``) when
         None, starting from 1.  With ``nu`` free the products ``beta*gamma`` and
-        ``beta*delta`` change units with it; the search can then crawl along a
-        long valley (seen with ``nu = 2``: 200 evaluations, not converged), so
-        fixing ``nu`` is the robust choice.
+        ``beta*delta`` change units with it (``N^(1-nu)/m``), and searched as they
+        are they crawl along a long valley with ``nu``; the search therefore takes
+        ``beta*gamma F^(nu-1)`` and ``beta*delta F^(nu-1)`` (the size of the
+        nonlinear terms at a typical link force ``F``: ``alpha`` times the
+        output's RMS, or the ultimate force if smaller), which do not move with
+        ``nu``; the sensitivities follow by the chain rule.  The estimates are
+        still ``beta*gamma`` and ``beta*delta`` at the estimated ``nu``.
     n_elements : int
         Maxwell-slip: number of Jenkins elements.
     start_nfev : int, optional
@@ -537,7 +577,8 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     p = best[1]
     notes: dict[str, str] = {}
     while True:
-        prob = _BoucWenProblem(records, periodic, r, free, p, y_scale)
+        prob = _BoucWenProblem(records, periodic, r, free, p, y_scale,
+                               _force_scale(p, y_scale))
         sol = _solve(prob, p, scale, tol, max_nfev)
         n_eval += prob.n_eval
         p = prob.full(sol.x, scale)
