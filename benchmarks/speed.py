@@ -26,7 +26,8 @@ Commands run as fresh processes are timed by wall clock (the targets) and by
 CPU time (user + system, worker processes included), which a machine shared
 with other jobs inflates less.
 
-Run with ``make bench`` or ``python benchmarks/speed.py [--json] [--quick]``.
+Run with ``make bench`` or ``python benchmarks/speed.py [--json] [--quick] [--only SECTION ...]``
+(``--only steady`` measures the link models alone).
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ STEADY_POINTS = 40
 REPORT_REPEATS = 3
 IDENTIFY_SIZES = (100_000, 1_000_000)
 
+SECTIONS = ("startup", "steady", "identify", "report")
 TARGETS = {"help": 3.0, "df": 5.0, "steady": 3.0, "identify_time": 4.0, "identify_mb": 700.0,
            "reproduce": 2.0}
 
@@ -193,42 +195,47 @@ def print_results(res: dict) -> None:
     m = res["machine"]
     print(f"motionhyst speed benchmark ({m['platform']}, {m['cores']} cores, "
           f"Python {m['python']}); every ratio from one run")
-    s = res["startup"]
-    print()
-    print("Start-up (median of fresh processes, interleaved): wall time, ratio; CPU ratio")
-    print(f"  python -c 'import numpy'                {s['numpy'] * 1e3:8.0f} ms   1.00x")
-    print(f"  motionhyst --help                       {s['help'] * 1e3:8.0f} ms "
-          f"{s['help_ratio']:6.2f}x; CPU {s['help_cpu_ratio']:.2f}x  (target <= "
-          f"{TARGETS['help']:g}x: {_verdict(s['help_ratio'], TARGETS['help'])})")
-    print(f"  motionhyst df --k 20 --fc 0.05 --amplitude 0.01 {s['df'] * 1e3:5.0f} ms "
-          f"{s['df_ratio']:6.2f}x; CPU {s['df_cpu_ratio']:.2f}x  (target <= "
-          f"{TARGETS['df']:g}x: {_verdict(s['df_ratio'], TARGETS['df'])})")
-    print()
-    print("One steady-state point of the Table I loop (median CPU time, interleaved), "
-          "against Jenkins")
-    for name, v in res["steady"].items():
-        target = "" if name.startswith("Jenkins") else (
-            f"  (target <= {TARGETS['steady']:g}x: {_verdict(v['ratio'], TARGETS['steady'])})")
-        print(f"  {name:<30} {v['seconds'] * 1e3:8.2f} ms {v['ratio']:6.2f}x{target}")
-    i = res["identify"]
-    print()
-    print("motionhyst identify on a force-displacement record (CSV)")
-    for r in i["runs"]:
-        print(f"  {r['samples']:>9,} samples  {r['seconds']:7.2f} s  peak {r['peak_mb']:6.0f} MB"
-              f"  k = {', '.join(f'{v:.4g}' for v in r['k'])}")
-    peak = max(r["peak_mb"] for r in i["runs"])
-    print(f"  time ratio {i['time_ratio']:.2f}x for {i['length_ratio']:.0f}x the samples "
-          f"(target <= {TARGETS['identify_time']:g}x: "
-          f"{_verdict(i['time_ratio'], TARGETS['identify_time'])}); peak {peak:.0f} MB "
-          f"(target < {TARGETS['identify_mb']:g} MB: {_verdict(peak, TARGETS['identify_mb'])})")
-    r = res["report"]
-    print()
-    print("Figures (median of fresh processes, interleaved): wall time, ratio; CPU time, ratio")
-    print(f"  motionhyst analyze                      {r['analyze']:8.2f} s    1.00x; "
-          f"CPU {r['analyze_cpu']:.2f} s")
-    print(f"  motionhyst reproduce (figures in PNG and PDF) {r['reproduce']:6.2f} s "
-          f"{r['ratio']:6.2f}x; CPU {r['reproduce_cpu']:.2f} s, {r['cpu_ratio']:.2f}x  "
-          f"(target <= {TARGETS['reproduce']:g}x: {_verdict(r['ratio'], TARGETS['reproduce'])})")
+    if "startup" in res:
+        s = res["startup"]
+        print()
+        print("Start-up (median of fresh processes, interleaved): wall time, ratio; CPU ratio")
+        print(f"  python -c 'import numpy'                {s['numpy'] * 1e3:8.0f} ms   1.00x")
+        print(f"  motionhyst --help                       {s['help'] * 1e3:8.0f} ms "
+              f"{s['help_ratio']:6.2f}x; CPU {s['help_cpu_ratio']:.2f}x  (target <= "
+              f"{TARGETS['help']:g}x: {_verdict(s['help_ratio'], TARGETS['help'])})")
+        print(f"  motionhyst df --k 20 --fc 0.05 --amplitude 0.01 {s['df'] * 1e3:5.0f} ms "
+              f"{s['df_ratio']:6.2f}x; CPU {s['df_cpu_ratio']:.2f}x  (target <= "
+              f"{TARGETS['df']:g}x: {_verdict(s['df_ratio'], TARGETS['df'])})")
+    if "steady" in res:
+        print()
+        print("One steady-state point of the Table I loop (median CPU time, interleaved), "
+              "against Jenkins")
+        for name, v in res["steady"].items():
+            target = "" if name.startswith("Jenkins") else (
+                f"  (target <= {TARGETS['steady']:g}x: {_verdict(v['ratio'], TARGETS['steady'])})")
+            print(f"  {name:<30} {v['seconds'] * 1e3:8.2f} ms {v['ratio']:6.2f}x{target}")
+    if "identify" in res:
+        i = res["identify"]
+        print()
+        print("motionhyst identify on a force-displacement record (CSV)")
+        for r in i["runs"]:
+            print(f"  {r['samples']:>9,} samples  {r['seconds']:7.2f} s  "
+                  f"peak {r['peak_mb']:6.0f} MB  k = {', '.join(f'{v:.4g}' for v in r['k'])}")
+        peak = max(r["peak_mb"] for r in i["runs"])
+        print(f"  time ratio {i['time_ratio']:.2f}x for {i['length_ratio']:.0f}x the samples "
+              f"(target <= {TARGETS['identify_time']:g}x: "
+              f"{_verdict(i['time_ratio'], TARGETS['identify_time'])}); peak {peak:.0f} MB "
+              f"(target < {TARGETS['identify_mb']:g} MB: {_verdict(peak, TARGETS['identify_mb'])})")
+    if "report" in res:
+        r = res["report"]
+        print()
+        print("Figures (median of fresh processes, interleaved): wall time, ratio; CPU time, ratio")
+        print(f"  motionhyst analyze                      {r['analyze']:8.2f} s    1.00x; "
+              f"CPU {r['analyze_cpu']:.2f} s")
+        print(f"  motionhyst reproduce (figures in PNG and PDF) {r['reproduce']:6.2f} s "
+              f"{r['ratio']:6.2f}x; CPU {r['reproduce_cpu']:.2f} s, {r['cpu_ratio']:.2f}x  "
+              f"(target <= {TARGETS['reproduce']:g}x: "
+              f"{_verdict(r['ratio'], TARGETS['reproduce'])})")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -236,6 +243,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", action="store_true", help="print JSON instead of the tables")
     parser.add_argument("--quick", action="store_true",
                         help="fewer repeats and 1e4/1e5 samples (a smoke run, not for the README)")
+    parser.add_argument("--only", nargs="+", choices=SECTIONS, metavar="SECTION",
+                        help=f"run only these sections ({', '.join(SECTIONS)}); default: all")
     args = parser.parse_args(argv)
     quick = args.quick
     res = {"machine": {"platform": platform.platform(terse=True), "cores": os.cpu_count(),
@@ -246,6 +255,8 @@ def main(argv: list[str] | None = None) -> int:
             ("identify", "identification",
              lambda: identification((10_000, 100_000) if quick else IDENTIFY_SIZES)),
             ("report", "reproduce vs analyze", lambda: report(1 if quick else REPORT_REPEATS))):
+        if args.only and key not in args.only:
+            continue
         print(f"running {what} ...", file=sys.stderr, flush=True)
         res[key] = run()
     if args.json:
