@@ -32,6 +32,7 @@ import os
 import sys
 import tempfile
 import threading
+import types
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -185,9 +186,14 @@ class Kernel:
                         _STATE["cache"] = folder is not None and _can_cache()
                     # a function without a source file (a doctest, the REPL) is never cached
                     cache = _STATE["cache"] and _can_cache(self.py_func)
+                    _BUILDING.add(self)
+                    try:
+                        func = _with_callee_dispatchers(self)
+                    finally:
+                        _BUILDING.discard(self)
                     jit = (numba.njit(cache=cache, **self._options) if self._signature is None
                            else numba.njit(self._signature, cache=cache, **self._options))
-                    d = jit(self.py_func)
+                    d = jit(func)
                     self._dispatcher = d
         return d
 
@@ -204,6 +210,37 @@ class Kernel:
 
     def __repr__(self) -> str:
         return f"<compiled kernel {self.__module__}.{self.__qualname__}>"
+
+
+def _with_callee_dispatchers(kernel: Kernel) -> Callable:
+    """`kernel`'s function, seeing the numba dispatchers of the kernels it calls by name.
+
+    numba inlines a callee declared ``inline="always"`` only when the global it
+    finds is the callee's dispatcher, not a :class:`Kernel` standing for it
+    (a call it cannot inline costs the hot loops of :mod:`motionhyst.openloop`
+    a factor 2 to 4).  The module keeps its :class:`Kernel` objects: the
+    function is a copy whose globals hold the dispatchers (each callee does
+    the same for its own callees; a kernel calling itself is left as it is).
+    """
+    f = kernel.py_func
+    names = f.__globals__
+    swap = {}
+    for name in f.__code__.co_names:
+        g = names.get(name)
+        if isinstance(g, Kernel) and g is not kernel and g not in _BUILDING:
+            swap[name] = g.dispatcher()
+    if not swap:
+        return f
+    copy = types.FunctionType(f.__code__, {**names, **swap}, f.__name__, f.__defaults__,
+                              f.__closure__)
+    copy.__qualname__ = f.__qualname__
+    copy.__module__ = f.__module__
+    copy.__doc__ = f.__doc__
+    copy.__kwdefaults__ = f.__kwdefaults__
+    return copy
+
+
+_BUILDING: set[Kernel] = set()
 
 
 def njit(func: Callable | str | None = None, **options

@@ -1,16 +1,28 @@
-"""Open-loop systems: a mass on a spring and damper with a dynamic link, force in, position out.
+"""Open-loop systems: a stage with a dynamic link, force in, a position out.
 
-The stage of the Bouc-Wen benchmark (Noel and Schoukens 2016) and of any
-single-mass test rig without feedback,
+Two plants, both a linear mechanical plant with lumped masses
+(:class:`Mechanics`: ``M q'' + C q' + K q = e (u - w)``, in state-space form
+``x = (q, q')``), the force ``u`` and the link force ``w`` acting on the
+first mass, ``w`` the force of a hysteresis model (any model of
+:mod:`motionhyst.hysteresis`) of that mass's position:
 
-.. math::
+* :class:`MassSpringDamper`, the stage of the Bouc-Wen benchmark (Noel and
+  Schoukens 2016) and of any single-mass test rig without feedback,
+  ``m y'' + c y' + k y + w = u``, output ``y``;
+* :class:`TwoMass`, the floating two-mass stage of the paper's eqs. (1)-(2)
+  without its controller: ``m1`` actuated (position ``y1``, where the link
+  acts), ``m2`` the point of control (``y2``), spring ``k`` and damper ``b``
+  between them; output ``y2`` (default) or ``y1``.
 
-    m \\ddot y + c \\dot y + k y + w = u,
-
-with ``w`` the force of a hysteresis model acting on the position ``y``
-(any model of :mod:`motionhyst.hysteresis`).  :class:`OpenLoop` simulates the
-response to a sampled force record from rest, or the periodic steady state
-when the record is one period of a periodic force.
+:class:`OpenLoop` simulates the response to a sampled force record from rest,
+or the periodic steady state when the record is one period of a periodic
+force.  Only the link holds a floating stage (the two-mass stage, or
+``k = 0``) in place: from rest, a force the link cannot hold makes it run
+away (the simulation says so by its numbers); a periodic steady state exists
+only if the position repeats too, is then defined up to a constant and
+returned with zero mean, and a stage that moves on by the same distance
+every period (a slipping element, a Bouc-Wen link ratcheting under an
+unsymmetric force) is reported as having none.
 
 Accuracy
 --------
@@ -24,8 +36,10 @@ system is then integrated with a fine fixed step, ``substeps`` per sample
 * Bouc-Wen links (every parameter set, :class:`~motionhyst.hysteresis.BoucWen`'s
   normalised form mapped exactly onto the general one
   ``z' = alpha y' - beta (gamma |y'| |z|^(nu-1) z + delta y' |z|^nu)``) and the
-  linear stage: classical fourth-order Runge-Kutta on ``(y, y', z)``, with the
-  forward sensitivities of ``y`` to ``m, c, k, alpha, beta*gamma, beta*delta, nu``
+  linear stage: classical fourth-order Runge-Kutta on ``(q, q', z)``, one
+  compiled integrator for both plants (compiled for the plant's size), with
+  the forward sensitivities of the output to the plant's parameters
+  (``m, c, k`` or ``m1, m2, b, k``) and ``alpha, beta*gamma, beta*delta, nu``
   when asked (they are what :mod:`motionhyst.identify.input_output` fits with);
 * the other links: the stage discretised exactly for a force linear between
   fine steps (first-order hold) and the link advanced by its exact update
@@ -56,6 +70,129 @@ SINC_HALF_WIDTH = 64
 MAX_PERIODIC_DECAYS = 60.0  # periodic runs stop after this many time constants of the mode
 
 
+class Mechanics:
+    """A linear mechanical plant with lumped masses: ``M q'' + C q' + K q = e_l (u - w)``.
+
+    The state-space form of an open-loop plant, ``x = (q, q')``,
+    ``x' = A x + B (u - w)`` with ``A = [[0, I], [-M^-1 K, -M^-1 C]]`` and
+    ``B = [0; M^-1 e_l]``: the force ``u`` and the link force ``w`` act on the
+    coordinate ``q[link]`` (the link's displacement), the output is
+    ``q[output]``.  The plant's parameters enter ``M``, ``C`` and ``K``
+    linearly; their derivatives are what the forward sensitivities need.
+
+    Parameters
+    ----------
+    mass : array_like, shape (n,)
+        Diagonal of ``M`` [kg].
+    C, K : array_like, shape (n, n)
+        Damping [N s/m] and stiffness [N/m] matrices.
+    dmass, dC, dK : array_like, shapes (p, n), (p, n, n), (p, n, n)
+        Their derivatives in the plant's `p` parameters.
+    link, output : int
+        Coordinate of the force and link, and of the output.
+
+    Examples
+    --------
+    >>> mech = TwoMass(m1=2.0, m2=3.0, b=20.0, k=2e5).mechanics()
+    >>> A, B = mech.state_space()
+    >>> A.shape, B.tolist(), mech.link, mech.output
+    ((4, 4), [0.0, 0.0, 0.5, 0.0], 0, 1)
+    """
+
+    def __init__(self, mass, C, K, dmass, dC, dK, link: int, output: int) -> None:
+        self.mass = np.ascontiguousarray(mass, dtype=float)
+        self.C = np.ascontiguousarray(C, dtype=float)
+        self.K = np.ascontiguousarray(K, dtype=float)
+        self.dmass = np.ascontiguousarray(dmass, dtype=float)
+        self.dC = np.ascontiguousarray(dC, dtype=float)
+        self.dK = np.ascontiguousarray(dK, dtype=float)
+        self.link = int(link)
+        self.output = int(output)
+
+    @property
+    def n(self) -> int:
+        """Number of coordinates ``q``."""
+        return self.mass.size
+
+    @property
+    def floating(self) -> bool:
+        """True if no spring holds the plant to the ground (``K`` times ones is zero)."""
+        return bool(np.all(self.K.sum(axis=1) == 0.0))
+
+    def state_space(self, k_link: float = 0.0, c_link: float = 0.0
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``A`` and ``B`` (``x = (q, q')``), the link taken as a spring `k_link` and
+        damper `c_link` to the ground (0: the link left out)."""
+        n = self.n
+        K = self.K.copy()
+        C = self.C.copy()
+        K[self.link, self.link] += k_link
+        C[self.link, self.link] += c_link
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -K / self.mass[:, None]
+        A[n:, n:] = -C / self.mass[:, None]
+        B = np.zeros(2 * n)
+        B[n + self.link] = 1.0 / self.mass[self.link]
+        return A, B
+
+    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
+                           ) -> NDArray[np.complex128]:
+        """``q[output] / u`` at `f_hz`, the link a spring `k_link` and damper `c_link`."""
+        s = 2j * np.pi * np.atleast_1d(np.asarray(f_hz, dtype=float))
+        K = self.K.astype(complex)
+        C = self.C.astype(complex)
+        K[self.link, self.link] += k_link
+        C[self.link, self.link] += c_link
+        Z = (np.diag(self.mass)[None] * s[:, None, None] ** 2 + C[None] * s[:, None, None]
+             + K[None])
+        e = np.zeros(self.n, dtype=complex)
+        e[self.link] = 1.0
+        x = np.linalg.solve(Z, np.broadcast_to(e, (s.size, self.n))[..., None])[..., 0]
+        return x[:, self.output]
+
+    def linear_periodic_state(self, u: NDArray[np.float64], fs: float, k_link: float
+                              ) -> NDArray[np.float64]:
+        """``x = (q, q')`` at the start of the periodic steady state for the period `u`, the
+        link a spring `k_link` to the ground (from the spectrum of `u`)."""
+        U = np.fft.rfft(u)
+        f = np.fft.rfftfreq(u.size, 1.0 / fs)
+        x = np.zeros(2 * self.n)
+        K = self.K.copy()
+        K[self.link, self.link] += k_link
+        s = 2j * np.pi * f
+        Z = np.diag(self.mass)[None] * s[:, None, None] ** 2 + self.C[None] * s[:, None, None] + K
+        if np.linalg.cond(Z[0]) > 1e12:  # no spring to the ground: the mean left out
+            Z[0] = np.eye(self.n)
+            U = U.copy()
+            U[0] = 0.0
+        e = np.zeros(self.n)
+        e[self.link] = 1.0
+        H = np.linalg.solve(Z, np.broadcast_to(e, (f.size, self.n))[..., None].astype(complex))
+        for i in range(self.n):
+            Q = H[:, i, 0] * U
+            x[i] = np.fft.irfft(Q, u.size)[0]
+            x[self.n + i] = np.fft.irfft(s * Q, u.size)[0]
+        return x
+
+    def natural_frequency_hz(self, k_link: float = 0.0) -> float:
+        """Highest undamped natural frequency, the link a spring `k_link` to the ground [Hz]."""
+        K = self.K.copy()
+        K[self.link, self.link] += k_link
+        w2 = np.linalg.eigvals(K / self.mass[:, None]).real
+        return math.sqrt(max(float(np.max(w2)), 0.0)) / (2 * math.pi)
+
+    def decay_time(self, k_link: float = 0.0) -> float:
+        """Slowest decay time of the modes, the link a spring `k_link` [s] (inf: undamped)."""
+        A, _ = self.state_space(max(k_link, 0.0))
+        lam = np.linalg.eigvals(A)
+        rate = -lam.real
+        if not np.all(np.isfinite(lam)) or np.min(rate) <= 1e-12 * max(np.max(np.abs(lam)),
+                                                                        1e-300):
+            return math.inf
+        return float(1.0 / np.min(rate))
+
+
 class MassSpringDamper:
     """A single mass on a linear spring and damper: ``m y'' + c y' + k y = u - w``.
 
@@ -77,6 +214,9 @@ class MassSpringDamper:
     2e-05
     """
 
+    #: Names of the parameters, in the order of :meth:`parameters`.
+    PARAMETERS = ("m", "c", "k")
+
     def __init__(self, m: float, c: float, k: float) -> None:
         self.m = _check(m, "m", positive=True)
         self.c = _check(c, "c", positive=False)
@@ -95,15 +235,141 @@ class MassSpringDamper:
         """``c / (2 sqrt(k m))`` [-] (inf for ``k = 0``)."""
         return self.c / (2 * math.sqrt(self.k * self.m)) if self.k > 0 else math.inf
 
+    @property
+    def output(self) -> str:
+        """The measured position: ``"y"``, the mass's."""
+        return "y"
+
     def frequency_response(self, f_hz: ArrayLike) -> NDArray[np.complex128] | complex:
         """``Y / U = 1 / (m s^2 + c s + k)`` at ``s = 2 pi j f`` [m/N]."""
         s = 2j * np.pi * np.asarray(f_hz, dtype=float)
         out = 1.0 / (self.m * s * s + self.c * s + self.k)
         return complex(out) if np.ndim(out) == 0 else out
 
+    def parameters(self) -> NDArray[np.float64]:
+        """``(m, c, k)`` (:attr:`PARAMETERS`)."""
+        return np.array([self.m, self.c, self.k])
+
+    def with_parameters(self, values: ArrayLike) -> MassSpringDamper:
+        """The same kind of plant with the parameters `values` (checked)."""
+        m, c, k = (float(v) for v in values)
+        return MassSpringDamper(m, c, k)
+
+    def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
+        """The plant (or the unchecked parameter `values`) as :class:`Mechanics`."""
+        m, c, k = self.parameters() if values is None else np.asarray(values, dtype=float)
+        return Mechanics([m], [[c]], [[k]], [[1.0], [0.0], [0.0]],
+                         [[[0.0]], [[1.0]], [[0.0]]], [[[0.0]], [[0.0]], [[1.0]]], 0, 0)
+
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary (the ``[stage]`` table of a scenario)."""
         return {"type": "mass-spring-damper", "m": self.m, "c": self.c, "k": self.k}
+
+
+class TwoMass:
+    """The floating two-mass stage of eqs. (1)-(2) as an open-loop plant, force in.
+
+    .. math::
+
+        m_1 \\ddot y_1 + b (\\dot y_1 - \\dot y_2) + k (y_1 - y_2) = u - w, \\qquad
+        m_2 \\ddot y_2 + b (\\dot y_2 - \\dot y_1) + k (y_2 - y_1) = 0,
+
+    the force ``u`` on the actuated mass ``m1``, where the link acts (its
+    force ``w`` a function of ``y1``), the output the position `output` of
+    the point of control ``y2`` (default) or of ``m1``.  The same stage as
+    :class:`motionhyst.systems.TwoMassStage` without a controller.
+
+    No spring holds the stage to the ground except the link: with a link that
+    has no stiffness (or none, ``w = 0``) a force with a nonzero mean makes the
+    stage run away, and a periodic steady state is defined up to a constant
+    position (:meth:`OpenLoop.simulate` returns it with zero mean).
+
+    Parameters
+    ----------
+    m1, m2 : float
+        Masses [kg], > 0.
+    b : float
+        Damper between the masses [N s/m], >= 0.
+    k : float
+        Spring between the masses [N/m], > 0.
+    output : {"y2", "y1"}
+        The measured position.
+
+    Examples
+    --------
+    >>> p = TwoMass(m1=5.0, m2=17.5, b=90.0, k=7.4e7)     # Table I
+    >>> round(p.resonance_hz, 1), p.output
+    (694.3, 'y2')
+    >>> G = p.frequency_response([10.0], k_link=0.0)     # y2 / u: nearly 1 / (M s^2)
+    >>> round(float(abs(G[0]) * p.M * (2 * np.pi * 10.0) ** 2), 4)
+    1.0002
+    """
+
+    #: Names of the parameters, in the order of :meth:`parameters`.
+    PARAMETERS = ("m1", "m2", "b", "k")
+    OUTPUTS = ("y2", "y1")
+
+    def __init__(self, m1: float, m2: float, b: float, k: float, output: str = "y2") -> None:
+        self.m1 = _check(m1, "m1", positive=True)
+        self.m2 = _check(m2, "m2", positive=True)
+        self.b = _check(b, "b", positive=False)
+        self.k = _check(k, "k", positive=True)
+        if output not in self.OUTPUTS:
+            raise ValueError(f"output must be 'y2' or 'y1', got {output!r}")
+        self.output = output
+
+    def __repr__(self) -> str:
+        return (f"TwoMass(m1={self.m1!r}, m2={self.m2!r}, b={self.b!r}, k={self.k!r}, "
+                f"output={self.output!r})")
+
+    @property
+    def M(self) -> float:
+        """Total mass ``m1 + m2`` [kg]."""
+        return self.m1 + self.m2
+
+    @property
+    def resonance_hz(self) -> float:
+        """The internal mode, ``sqrt(k M / (m1 m2)) / (2 pi)`` [Hz]."""
+        return math.sqrt(self.k * self.M / (self.m1 * self.m2)) / (2 * math.pi)
+
+    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
+                           ) -> NDArray[np.complex128]:
+        """The output over the force at `f_hz` [m/N], the link a spring `k_link` and damper
+        `c_link` on ``y1`` (both 0: eq. (1), ``P2`` or ``P1``)."""
+        return self.mechanics().frequency_response(f_hz, k_link, c_link)
+
+    def parameters(self) -> NDArray[np.float64]:
+        """``(m1, m2, b, k)`` (:attr:`PARAMETERS`)."""
+        return np.array([self.m1, self.m2, self.b, self.k])
+
+    def with_parameters(self, values: ArrayLike) -> TwoMass:
+        """The same kind of plant (same output) with the parameters `values` (checked)."""
+        m1, m2, b, k = (float(v) for v in values)
+        return TwoMass(m1, m2, b, k, self.output)
+
+    def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
+        """The plant (or the unchecked parameter `values`) as :class:`Mechanics`."""
+        m1, m2, b, k = self.parameters() if values is None else np.asarray(values, dtype=float)
+        D = np.array([[1.0, -1.0], [-1.0, 1.0]])
+        Z = np.zeros((2, 2))
+        return Mechanics([m1, m2], b * D, k * D, [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0],
+                                                 [0.0, 0.0]],
+                         [Z, Z, D, Z], [Z, Z, Z, D], 0, 0 if self.output == "y1" else 1)
+
+    def stage(self):
+        """The same stage for the closed loop (:class:`motionhyst.systems.TwoMassStage`)."""
+        from motionhyst.systems import TwoMassStage
+
+        return TwoMassStage(self.m1, self.m2, self.b, self.k)
+
+    def to_dict(self) -> dict:
+        """Parameters as a JSON-ready dictionary (the ``[stage]`` table of a scenario)."""
+        return {"type": "two-mass", "m1": self.m1, "m2": self.m2, "b": self.b, "k": self.k,
+                "output": self.output}
+
+
+Plant = MassSpringDamper | TwoMass
+"""An open-loop plant: force in, the link on its (first) mass, a position out."""
 
 
 def _check(value, name: str, positive: bool) -> float:
@@ -226,129 +492,177 @@ def _rate(v, z, alpha, bg, bd, nu, sens):  # pragma: no cover - compiled
     f_v = alpha - bg * sv * pn1 * z - bd * pn
     f_z = -nu * pn1 * (bg * av + bd * v * sz)
     f_nu = 0.0
-    if sens and az > 0.0:
+    if sens is not None and az > 0.0:
         f_nu = -(bg * g + bd * d) * math.log(az)
     return f, f_v, f_z, f_nu, g, d
 
 
 @njit(cache=True, inline="always")
-def _deriv(uu, x, s, p, dx, ds, sens):  # pragma: no cover - compiled
-    m, c, k, alpha, bg, bd, nu = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
-    y, v, z = x[0], x[1], x[2]
-    a = (uu - c * v - k * y - z) / m
-    f, f_v, f_z, f_nu, g, d = _rate(v, z, alpha, bg, bd, nu, sens)
-    dx[0] = v
-    dx[1] = a
-    dx[2] = f
-    if sens:
-        for j in range(7):
-            sy, sv, sz = s[0, j], s[1, j], s[2, j]
-            ds[0, j] = sv
-            ds[1, j] = (-c * sv - k * sy - sz) / m
-            ds[2, j] = f_v * sv + f_z * sz
-        ds[1, 0] -= a / m
-        ds[1, 1] -= v / m
-        ds[1, 2] -= y / m
-        ds[2, 3] += v
-        ds[2, 4] -= g
-        ds[2, 5] -= d
-        ds[2, 6] += f_nu
+def _deriv(uu, x, s, mass, C, K, dmass, dC, dK, li, lp, acc, dx, ds, sens
+           ):  # pragma: no cover - compiled
+    """Rates of the state ``(q, q', z)`` of ``M q'' + C q' + K q = e_li (u - z)`` and of
+    its sensitivities (columns: the plant's parameters, then alpha, beta*gamma,
+    beta*delta, nu; ``lp`` holds those four)."""
+    n = len(mass)
+    z = x[2 * n]
+    for i in range(n):
+        f = uu if i == li else 0.0
+        for j in range(n):
+            f -= C[i, j] * x[n + j]
+        for j in range(n):
+            f -= K[i, j] * x[j]
+        if i == li:
+            f -= z
+        acc[i] = f / mass[i]
+    rf, f_v, f_z, f_nu, g, d = _rate(x[n + li], z, lp[0], lp[1], lp[2], lp[3], sens)
+    for i in range(n):
+        dx[i] = x[n + i]
+        dx[n + i] = acc[i]
+    dx[2 * n] = rf
+    if sens is not None:
+        n_plant = len(dmass)
+        nc = len(dmass) + 4
+        for i in range(n):
+            for col in range(nc):
+                ds[i, col] = s[n + i, col]
+            for col in range(nc):
+                ds[n + i, col] = 0.0
+            for j in range(n):
+                cij = C[i, j]
+                for col in range(nc):
+                    ds[n + i, col] -= cij * s[n + j, col]
+            for j in range(n):
+                kij = K[i, j]
+                for col in range(nc):
+                    ds[n + i, col] -= kij * s[j, col]
+            if i == li:
+                for col in range(nc):
+                    ds[n + i, col] -= s[2 * n, col]
+            mi = mass[i]
+            for col in range(nc):
+                ds[n + i, col] = ds[n + i, col] / mi
+        for col in range(nc):
+            ds[2 * n, col] = f_v * s[n + li, col] + f_z * s[2 * n, col]
+        for col in range(n_plant):
+            for i in range(n):
+                t = dmass[col][i] * acc[i]
+                for j in range(n):
+                    t += dC[col, i, j] * x[n + j]
+                for j in range(n):
+                    t += dK[col, i, j] * x[j]
+                ds[n + i, col] -= t / mass[i]
+        ds[2 * n, n_plant] += x[n + li]
+        ds[2 * n, n_plant + 1] -= g
+        ds[2 * n, n_plant + 2] -= d
+        ds[2 * n, n_plant + 3] += f_nu
 
 
 @njit(cache=True, nogil=True)
-def _rk4_run(uf, h, r, p, x0, s0, sens):  # pragma: no cover - compiled
+def _rk4_run(uf, h, r, mass, C, K, dmass, dC, dK, li, lo, lp, x0, s0, sens
+             ):  # pragma: no cover - compiled
     """RK4 with step `h` over ``uf`` (input at half steps); outputs every `r` steps.
 
-    Returns the output ``y`` and its sensitivities at the record samples
-    (the first at the initial state) and the final state and sensitivities.
+    Returns the output ``q[lo]`` and its sensitivities at the record samples
+    (the first at the initial state) and the final state and sensitivities
+    (``sens``: True, or None for none).  ``mass`` (the diagonal of ``M``) and
+    ``dmass`` are tuples, so that the run is compiled for the plant's size.
     """
     n_steps = (uf.shape[0] - 1) // 2
     n_out = n_steps // r + 1
+    ns = 2 * len(mass) + 1
+    nc = len(dmass) + 4
     y = np.empty(n_out)
-    sy = np.zeros((n_out, 7))
+    sy = np.zeros((n_out, nc))
     x = x0.copy()
     s = s0.copy()
-    k1 = np.empty(3)
-    k2 = np.empty(3)
-    k3 = np.empty(3)
-    k4 = np.empty(3)
-    q1 = np.zeros((3, 7))
-    q2 = np.zeros((3, 7))
-    q3 = np.zeros((3, 7))
-    q4 = np.zeros((3, 7))
-    xt = np.empty(3)
-    st = np.zeros((3, 7))
-    y[0] = x[0]
-    if sens:
-        for j in range(7):
-            sy[0, j] = s[0, j]
+    acc = np.empty(len(mass))
+    k1 = np.empty(ns)
+    k2 = np.empty(ns)
+    k3 = np.empty(ns)
+    k4 = np.empty(ns)
+    q1 = np.zeros((ns, nc))
+    q2 = np.zeros((ns, nc))
+    q3 = np.zeros((ns, nc))
+    q4 = np.zeros((ns, nc))
+    xt = np.empty(ns)
+    st = np.zeros((ns, nc))
+    y[0] = x[lo]
+    if sens is not None:
+        for j in range(nc):
+            sy[0, j] = s[lo, j]
     for i in range(n_steps):
-        _deriv(uf[2 * i], x, s, p, k1, q1, sens)
-        for a in range(3):
+        _deriv(uf[2 * i], x, s, mass, C, K, dmass, dC, dK, li, lp, acc, k1, q1, sens)
+        for a in range(ns):
             xt[a] = x[a] + 0.5 * h * k1[a]
-        if sens:
-            for a in range(3):
-                for j in range(7):
+        if sens is not None:
+            for a in range(ns):
+                for j in range(nc):
                     st[a, j] = s[a, j] + 0.5 * h * q1[a, j]
-        _deriv(uf[2 * i + 1], xt, st, p, k2, q2, sens)
-        for a in range(3):
+        _deriv(uf[2 * i + 1], xt, st, mass, C, K, dmass, dC, dK, li, lp, acc, k2, q2, sens)
+        for a in range(ns):
             xt[a] = x[a] + 0.5 * h * k2[a]
-        if sens:
-            for a in range(3):
-                for j in range(7):
+        if sens is not None:
+            for a in range(ns):
+                for j in range(nc):
                     st[a, j] = s[a, j] + 0.5 * h * q2[a, j]
-        _deriv(uf[2 * i + 1], xt, st, p, k3, q3, sens)
-        for a in range(3):
+        _deriv(uf[2 * i + 1], xt, st, mass, C, K, dmass, dC, dK, li, lp, acc, k3, q3, sens)
+        for a in range(ns):
             xt[a] = x[a] + h * k3[a]
-        if sens:
-            for a in range(3):
-                for j in range(7):
+        if sens is not None:
+            for a in range(ns):
+                for j in range(nc):
                     st[a, j] = s[a, j] + h * q3[a, j]
-        _deriv(uf[2 * i + 2], xt, st, p, k4, q4, sens)
-        for a in range(3):
+        _deriv(uf[2 * i + 2], xt, st, mass, C, K, dmass, dC, dK, li, lp, acc, k4, q4, sens)
+        for a in range(ns):
             x[a] += h / 6.0 * (k1[a] + 2.0 * k2[a] + 2.0 * k3[a] + k4[a])
-        if sens:
-            for a in range(3):
-                for j in range(7):
+        if sens is not None:
+            for a in range(ns):
+                for j in range(nc):
                     s[a, j] += h / 6.0 * (q1[a, j] + 2.0 * q2[a, j] + 2.0 * q3[a, j] + q4[a, j])
         if (i + 1) % r == 0:
             o = (i + 1) // r
-            y[o] = x[0]
-            if sens:
-                for j in range(7):
-                    sy[o, j] = s[0, j]
+            y[o] = x[lo]
+            if sens is not None:
+                for j in range(nc):
+                    sy[o, j] = s[lo, j]
     return y, sy, x, s
 
 
 # ----------------------------------------------------------------- other links: FOH + exact update
 @njit(cache=True, nogil=True)
-def _foh_link_run(Ad, B0, B1, uf, r, codes, params, glt, glw, h, ftol, max_iter, x0, s0
+def _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, glt, glw, h, ftol, max_iter, x0, s0
                   ):  # pragma: no cover - compiled
-    """Stage (FOH, state (y, v)), link elements advanced exactly; outputs every r steps."""
+    """Stage (FOH, state ``(q, q')``, force and link on ``q[li]``), link elements advanced
+    exactly; outputs ``q[lo]`` every r steps."""
     n_steps = uf.shape[0] - 1
     n_out = n_steps // r + 1
     m = codes.shape[0]
+    ns = x0.shape[0]
     y = np.empty(n_out)
     x = x0.copy()
+    xn = x0.copy()
     s = s0.copy()
     s_prev = s0.copy()
     s_new = s0.copy()
     w_prev = 0.0
     for j in range(m):
         w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
-    y[0] = x[0]
+    y[0] = x[lo]
     dx_prev = 0.0
     worst = 0
     for i in range(n_steps):
-        # y_{i+1} = base + B1[0] * (-w_{i+1})
+        # q_li at the step's end = base + B1[li] * (-w_{i+1})
         f0 = uf[i] - w_prev
-        base_y = Ad[0, 0] * x[0] + Ad[0, 1] * x[1] + B0[0] * f0 + B1[0] * uf[i + 1]
+        base_y = Ad[li, 0] * x[0]
+        for b in range(1, ns):
+            base_y += Ad[li, b] * x[b]
+        base_y = base_y + B0[li] * f0 + B1[li] * uf[i + 1]
         wt = w_prev
         it = 0
         change = math.inf
         while True:
             it += 1
-            dx = base_y - B1[0] * wt - x[0]
+            dx = base_y - B1[li] * wt - x[li]
             wn = 0.0
             for j in range(m):
                 s_new[j], fj = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, h,
@@ -365,19 +679,22 @@ def _foh_link_run(Ad, B0, B1, uf, r, codes, params, glt, glw, h, ftol, max_iter,
                 break
         if it > worst:
             worst = it
-        dx = base_y - B1[0] * wt - x[0]
+        dx = base_y - B1[li] * wt - x[li]
         f1 = uf[i + 1] - wt
-        x0n = Ad[0, 0] * x[0] + Ad[0, 1] * x[1] + B0[0] * f0 + B1[0] * f1
-        x1n = Ad[1, 0] * x[0] + Ad[1, 1] * x[1] + B0[1] * f0 + B1[1] * f1
-        x[0] = x0n
-        x[1] = x1n
+        for a in range(ns):
+            acc = Ad[a, 0] * x[0]
+            for b in range(1, ns):
+                acc += Ad[a, b] * x[b]
+            xn[a] = acc + B0[a] * f0 + B1[a] * f1
+        for a in range(ns):
+            x[a] = xn[a]
         for j in range(m):
             s_prev[j] = s[j]
             s[j] = s_new[j]
         w_prev = wt
         dx_prev = dx
         if (i + 1) % r == 0:
-            y[(i + 1) // r] = x[0]
+            y[(i + 1) // r] = x[lo]
     return y, x, s, w_prev, worst
 
 
@@ -405,7 +722,7 @@ class OpenLoopResponse:
     force : ndarray
         Input force [N].
     displacement : ndarray
-        Position ``y`` [m].
+        The plant's output position [m] (``y``; ``y2`` or ``y1`` of a two-mass stage).
     periodic : bool
         True for a periodic steady state, False for a run from rest.
     """
@@ -421,12 +738,12 @@ class OpenLoopResponse:
 
 
 class OpenLoop:
-    """A :class:`MassSpringDamper` with a hysteresis link on its position, force in.
+    """An open-loop plant with a hysteresis link, force in, a position out.
 
     Parameters
     ----------
-    plant : MassSpringDamper
-        The stage.
+    plant : MassSpringDamper or TwoMass
+        The stage; the force and the link act on its (first) mass.
     hysteresis : Hysteresis or None
         The link's model (None: the linear stage alone).
 
@@ -439,33 +756,44 @@ class OpenLoop:
     >>> out = sys.simulate(t, 20 * np.sin(2 * np.pi * 3 * t), periodic=True)
     >>> round(float(np.max(out.displacement)) * 1e4, 2)   # between 20 N/(k + kJ) and 20 N/k
     4.63
+
+    A two-mass stage held by a Bouc-Wen link, ``y2`` measured:
+
+    >>> from motionhyst.hysteresis import BoucWen
+    >>> sys = OpenLoop(TwoMass(2.0, 3.0, 20.0, 2e5), BoucWen(k=5e4, fc=20.0, beta=0.6,
+    ...                                                        gamma=0.2))
+    >>> out = sys.simulate(t, 20 * np.sin(2 * np.pi * 3 * t))   # from rest
+    >>> round(float(np.max(np.abs(out.displacement))) * 1e4, 1)
+    11.3
     """
 
-    def __init__(self, plant: MassSpringDamper, hysteresis: Hysteresis | None = None) -> None:
+    def __init__(self, plant: Plant, hysteresis: Hysteresis | None = None) -> None:
         self.plant = plant
         self.hysteresis = hysteresis
 
     def __repr__(self) -> str:
         return f"OpenLoop({self.plant!r}, {self.hysteresis!r})"
 
+    def _k_link(self) -> float:
+        return self.hysteresis.initial_stiffness if self.hysteresis is not None else 0.0
+
     def default_substeps(self, fs: float) -> int:
-        """Integration steps per record sample: >= 20 and >= 400 per period of the mode."""
-        k_total = self.plant.k + (self.hysteresis.initial_stiffness
-                                  if self.hysteresis is not None else 0.0)
-        f_n = math.sqrt(max(k_total, 0.0) / self.plant.m) / (2 * math.pi)
+        """Integration steps per record sample: >= 20 and >= 400 per period of the fastest
+        mode (the link taken as its initial stiffness)."""
+        f_n = self.plant.mechanics().natural_frequency_hz(self._k_link())
         return max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
 
     def _bw_parameters(self) -> NDArray[np.float64] | None:
         h = self.hysteresis
         if h is None:
-            return np.array([self.plant.m, self.plant.c, self.plant.k, 0.0, 0.0, 0.0, 1.0])
+            return np.array([*self.plant.parameters(), 0.0, 0.0, 0.0, 1.0])
         if isinstance(h, BoucWen):
-            return np.array([self.plant.m, self.plant.c, self.plant.k, *bouc_wen_general(h)])
+            return np.array([*self.plant.parameters(), *bouc_wen_general(h)])
         return None
 
     def simulate(self, t: ArrayLike, force: ArrayLike, *, periodic: bool = False,
                  substeps: int | None = None) -> OpenLoopResponse:
-        """Displacement for a force record, from rest or as the periodic steady state.
+        """The output position for a force record, from rest or as the periodic steady state.
 
         Parameters
         ----------
@@ -474,11 +802,14 @@ class OpenLoop:
         force : array_like
             Force at the instants `t` [N].
         periodic : bool
-            False: from rest (``y = y' = 0``, link relaxed) at ``t[0]``.  True:
+            False: from rest (``q = q' = 0``, link relaxed) at ``t[0]``.  True:
             `force` is one period (or whole periods) of a periodic force; the
             response is the periodic steady state, reached by repeating the
             period until the output changes by less than ``1e-12`` of its
-            amplitude from one period to the next.
+            amplitude from one period to the next.  A floating plant (no spring
+            to the ground: the two-mass stage, or ``k = 0``) has such a state
+            only if the link carries the force's mean, and then at any constant
+            offset: it is returned with zero mean.
         substeps : int, optional
             Integration steps per sample (default :meth:`default_substeps`).
 
@@ -490,8 +821,11 @@ class OpenLoop:
         fs = 1.0 / (tt[1] - tt[0])
         r = substeps or self.default_substeps(fs)
         p = self._bw_parameters()
-        if p is not None:
-            y, _ = simulate_bouc_wen(p, u, fs, r, periodic=periodic, sensitivities=False)
+        if periodic and self.hysteresis is None and self.plant.mechanics().floating:
+            y = _floating_linear_periodic(self.plant.mechanics(), u, fs)
+        elif p is not None:
+            y, _ = simulate_bouc_wen(p, u, fs, r, periodic=periodic, sensitivities=False,
+                                     plant=self.plant)
         else:
             y = self._simulate_elements(u, fs, r, periodic)
         return OpenLoopResponse(tt, u, y, periodic)
@@ -502,39 +836,91 @@ class OpenLoop:
         st = Stepping.empty() if self.hysteresis is None else self.hysteresis.time_stepping()
         codes, params, s0, scale = st.codes, st.params, st.state0, st.scale
         h = 1.0 / (fs * r)
-        pl = self.plant
-        A = np.array([[0.0, 1.0], [-pl.k / pl.m, -pl.c / pl.m]])
-        B = np.array([[0.0], [1.0 / pl.m]])
+        mech = self.plant.mechanics()
+        A, B = mech.state_space()
+        ns = A.shape[0]
         # first-order hold, split into the weights of the step's two end samples
-        M = np.zeros((4, 4))
-        M[:2, :2] = A * h
-        M[:2, 2] = B[:, 0] * h
-        M[2, 3] = 1.0
+        M = np.zeros((ns + 2, ns + 2))
+        M[:ns, :ns] = A * h
+        M[:ns, ns] = B * h
+        M[ns, ns + 1] = 1.0
         from scipy.linalg import expm
 
         E = expm(M)
-        B1 = np.ascontiguousarray(E[:2, 3])
-        B0 = np.ascontiguousarray(E[:2, 2] - B1)
-        Ad = np.ascontiguousarray(E[:2, :2])
+        B1 = np.ascontiguousarray(E[:ns, ns + 1])
+        B0 = np.ascontiguousarray(E[:ns, ns] - B1)
+        Ad = np.ascontiguousarray(E[:ns, :ns])
         ftol = 1e-13 * scale
         uf = upsampled if upsampled is not None else fine_input(u, r, periodic)
+        li, lo = mech.link, mech.output
         if not periodic:
-            y, _, _, _, worst = _foh_link_run(Ad, B0, B1, uf, r, codes, params, GL_T, GL_W, h,
-                                              ftol, MAX_FIXED_POINT_ITERATIONS, np.zeros(2), s0)
+            y, _, _, _, worst = _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, GL_T,
+                                              GL_W, h, ftol, MAX_FIXED_POINT_ITERATIONS,
+                                              np.zeros(ns), s0)
             _check_converged(worst)
             return y
-        x, s = np.zeros(2), s0
+        x, s = np.zeros(ns), s0
         prev = None
-        for _ in range(_max_periods(pl, u.size / fs)):
-            y, x, s, _, worst = _foh_link_run(Ad, B0, B1, uf, r, codes, params, GL_T, GL_W, h,
-                                              ftol, MAX_FIXED_POINT_ITERATIONS, x, s)
+        step: list[float] = []
+        for _ in range(_max_periods(mech, self._k_link(), u.size / fs)):
+            y, x, s, _, worst = _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, GL_T,
+                                              GL_W, h, ftol, MAX_FIXED_POINT_ITERATIONS, x, s)
             _check_converged(worst)
             y = y[:-1]
-            if prev is not None and np.max(np.abs(y - prev)) <= PERIODIC_RTOL * np.max(np.abs(y)):
-                return y
+            if prev is not None and _settled(y, prev, mech.floating, step):
+                return y - np.mean(y) if mech.floating else y
             prev = y
-        raise ValueError("the periodic steady state was not reached (the response does not "
-                         "settle from one period to the next)")
+        raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))
+
+
+def _floating_linear_periodic(mech: Mechanics, u: NDArray[np.float64], fs: float
+                              ) -> NDArray[np.float64]:
+    """Periodic steady state of a floating plant without a link, from the record's spectrum.
+
+    Nothing damps its rigid-body motion, so repeating the period never forgets
+    the start; the steady state is ``G(f) U(f)`` line by line (exact for a
+    band-limited period), with zero mean.  A force with a nonzero mean has none.
+    """
+    U = np.fft.rfft(u)
+    if abs(U[0]) > 1e-9 * max(float(np.max(np.abs(U))), 1e-300):
+        raise ValueError("the force has a nonzero mean: a floating stage without a link "
+                         "runs away and has no periodic steady state")
+    f = np.fft.rfftfreq(u.size, 1.0 / fs)
+    Y = np.zeros_like(U)
+    Y[1:] = mech.frequency_response(f[1:]) * U[1:]
+    if u.size % 2 == 0:
+        Y[-1] = Y[-1].real  # the Nyquist line of a real signal
+    return np.fft.irfft(Y, u.size)
+
+
+_NO_STEADY_STATE = ("the periodic steady state was not reached (the response does not settle "
+                    "from one period to the next)")
+_FLOATING_HINT = ("; the stage floats and the link does not hold it in place: it drifts")
+
+
+def _settled(y: NDArray[np.float64], prev: NDArray[np.float64], floating: bool,
+             last_step: list[float]) -> bool:
+    """True if a period's output `y` repeats the previous one to :data:`PERIODIC_RTOL`.
+
+    A floating stage whose link lets it move on by the same distance every
+    period (a Bouc-Wen link ratchets under an unsymmetric force; a slipping
+    element does not hold the stage) has no periodic steady state: raised as
+    such, with the drift, once the motion repeats and its position moves on by
+    the same step twice (`last_step` keeps the previous step).
+    """
+    if not floating:
+        return bool(np.max(np.abs(y - prev)) <= PERIODIC_RTOL * np.max(np.abs(y)))
+    tol = PERIODIC_RTOL * np.ptp(y)
+    if np.max(np.abs(y - prev)) <= tol:
+        return True
+    step = float(np.mean(y) - np.mean(prev))
+    if (np.max(np.abs(y - prev - step)) <= tol and abs(step) > 10 * tol and last_step
+            and abs(step - last_step[0]) <= 1e-6 * abs(step)):
+        raise ValueError(f"no periodic steady state: the stage floats and the link does not "
+                         f"hold it in place; it drifts {step:.3g} m per period (only a run "
+                         f"from rest describes this force)")
+    last_step[:] = [step]
+    return False
 
 
 def _check_converged(worst: int) -> None:
@@ -542,8 +928,10 @@ def _check_converged(worst: int) -> None:
         raise ValueError("the link's implicit step did not converge; use more substeps")
 
 
-def _max_periods(plant: MassSpringDamper, period_s: float) -> int:
-    tau = 2.0 * plant.m / plant.c if plant.c > 0 else math.inf
+def _max_periods(mech: Mechanics, k_link: float, period_s: float) -> int:
+    """Periods a periodic run may take: until the slowest mode has decayed
+    :data:`MAX_PERIODIC_DECAYS` times (at most 1000, at least 4)."""
+    tau = mech.decay_time(k_link)
     if not math.isfinite(tau):
         return 1000
     return int(min(1000, max(4, math.ceil(MAX_PERIODIC_DECAYS * tau / period_s) + 2)))
@@ -569,14 +957,17 @@ def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], N
 
 
 def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float, r: int, *,
-                      periodic: bool, sensitivities: bool, upsampled: NDArray | None = None
+                      periodic: bool, sensitivities: bool, upsampled: NDArray | None = None,
+                      plant: Plant | None = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Output of the stage with a general Bouc-Wen link and its sensitivities (RK4).
+    """Output of a plant with a general Bouc-Wen link and its sensitivities (RK4).
 
     Parameters
     ----------
     p : ndarray
-        ``m, c, k, alpha, beta*gamma, beta*delta, nu`` (:data:`BW_PARAMETERS`).
+        The plant's parameters (:attr:`MassSpringDamper.PARAMETERS`,
+        :attr:`TwoMass.PARAMETERS`), then ``alpha, beta*gamma, beta*delta, nu``
+        (for the mass-spring-damper: :data:`BW_PARAMETERS`).
     u : ndarray
         Force record at `fs` [N].
     fs : float
@@ -584,41 +975,80 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
     r : int
         RK4 steps per sample.
     periodic : bool
-        From rest (False) or the periodic steady state of the period `u` (True).
+        From rest (False) or the periodic steady state of the period `u` (True;
+        with zero mean for a floating plant, as :meth:`OpenLoop.simulate`).
     sensitivities : bool
         Also return ``dy/dp`` (else an empty array).
     upsampled : ndarray, optional
         ``fine_input(u, 2 r, periodic)``, if already computed (it depends on `u` only).
+    plant : MassSpringDamper or TwoMass, optional
+        The kind of plant (and its output) the first entries of `p` are the
+        parameters of; its own values are not used.  Default: a mass-spring-damper.
 
     Returns
     -------
     y : ndarray
-        Displacement at the record samples [m].
-    dy_dp : ndarray, shape ``(len(u), 7)``
+        Output position at the record samples [m].
+    dy_dp : ndarray, shape ``(len(u), len(p))``
         Its derivatives in ``p``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u = 30 * np.sin(2 * np.pi * 5 * np.arange(300) / 750)
+    >>> p = np.array([2.0, 3.0, 20.0, 2e5, 5e4, 800.0, -1100.0, 1.0])
+    >>> y, dy = simulate_bouc_wen(p, u, 750.0, 20, periodic=False, sensitivities=True,
+    ...                           plant=TwoMass(1.0, 1.0, 0.0, 1.0))
+    >>> y.shape, dy.shape
+    ((300,), (300, 8))
     """
+    structure = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
+    n_plant = len(structure.PARAMETERS)
+    p = np.ascontiguousarray(p, dtype=float)
+    if p.size != n_plant + 4:
+        raise ValueError(f"expected {n_plant + 4} parameters, got {p.size}")
+    mech = structure.mechanics(p[:n_plant])
+    lp = np.ascontiguousarray(p[n_plant:])
     h = 1.0 / (fs * r)
     uf = upsampled if upsampled is not None else fine_input(u, 2 * r, periodic)
-    p = np.ascontiguousarray(p, dtype=float)
-    x0 = np.zeros(3)
-    s0 = np.zeros((3, 7))
+    ns = 2 * mech.n + 1
+    x0 = np.zeros(ns)
+    s0 = np.zeros((ns, p.size))
+
+    def run(x0, s0):
+        # the masses and parameter count as tuples: compiled for their sizes (unrolled loops);
+        # no sensitivities: None, which removes their code from the compiled run
+        return _rk4_run(uf, h, r, tuple(mech.mass), mech.C, mech.K,
+                        tuple(tuple(row) for row in mech.dmass), mech.dC, mech.dK, mech.link,
+                        mech.output, lp, x0, s0, True if sensitivities else None)
+
     if not periodic:
-        y, sy, _, _ = _rk4_run(uf, h, r, p, x0, s0, sensitivities)
+        y, sy, _, _ = run(x0, s0)
         return y, sy
-    plant = MassSpringDamper(p[0], max(p[1], 0.0), max(p[2], 0.0))
+    if isinstance(structure, MassSpringDamper):  # as ever: a negative c or k taken as 0
+        mech_tau = structure.mechanics([p[0], max(p[1], 0.0), max(p[2], 0.0)])
+    else:
+        mech_tau = mech
+    if mech.floating and lp[0] > 0.0:
+        # the lightly damped mode of the stage on its link would take long to forget a start
+        # from rest: start from the steady state with the link a spring alpha
+        x0[:-1] = mech.linear_periodic_state(u, fs, lp[0])
+        x0[-1] = lp[0] * x0[mech.link]
     prev = None
-    for _ in range(_max_periods(plant, u.size / fs)):
-        y, sy, x0, s0 = _rk4_run(uf, h, r, p, x0, s0, sensitivities)
+    step: list[float] = []
+    for _ in range(_max_periods(mech_tau, lp[0], u.size / fs)):
+        y, sy, x0, s0 = run(x0, s0)
         y, sy = y[:-1], sy[:-1]
         if prev is not None:
-            ok = np.max(np.abs(y - prev[0])) <= PERIODIC_RTOL * np.max(np.abs(y))
+            ok = _settled(y, prev[0], mech.floating, step)
             if sensitivities:
                 ok &= bool(np.all(np.max(np.abs(sy - prev[1]), axis=0)
                                   <= 1e-8 * (np.max(np.abs(sy), axis=0) + 1e-300)))
             if ok:
+                if mech.floating:  # defined up to a constant: zero mean
+                    return y - np.mean(y), sy - np.mean(sy, axis=0)
                 return y, sy
         if not np.all(np.isfinite(x0)):
             break
         prev = (y, sy)
-    raise ValueError("the periodic steady state was not reached (the response does not "
-                     "settle from one period to the next)")
+    raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))

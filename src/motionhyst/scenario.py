@@ -35,7 +35,7 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
 
     from motionhyst.frf_fit import FrfFit, ModalPlant
     from motionhyst.loop import Loop
-    from motionhyst.openloop import MassSpringDamper, OpenLoop
+    from motionhyst.openloop import MassSpringDamper, OpenLoop, TwoMass
     from motionhyst.systems import MeasuredPlant, TwoMassStage
 
 
@@ -76,13 +76,21 @@ class _Section(BaseModel):
 
 
 class StageSection(_Section):
-    """``[stage]``: the two-mass stage of eqs. (1)-(2) (``type = "two-mass"``, the default)."""
+    """``[stage]``: the two-mass stage of eqs. (1)-(2) (``type = "two-mass"``, the default).
+
+    ``output = "y2"`` or ``"y1"`` makes it an open-loop system
+    (:class:`~motionhyst.openloop.TwoMass`: force on ``m1``, the link on ``y1``,
+    that position out, as :func:`motionhyst.identify.identify_io` writes it), with
+    no ``[controller]``, ``[feedforward]`` or ``[reference]``; without it the
+    stage is the plant of the closed loop.
+    """
 
     type: Annotated[Literal["two-mass"], Field(exclude=True)] = "two-mass"  # the default
     m1: PositiveFloat
     m2: PositiveFloat
     b: NonNegativeFloat
     k: PositiveFloat
+    output: Literal["y2", "y1"] | None = None
 
 
 class MassSpringDamperSection(_Section):
@@ -306,23 +314,32 @@ class ScenarioModel(_Section):
     def _one_plant(self):
         if (self.stage is None) == (self.plant is None):
             raise ValueError("give exactly one of [stage] and [plant]")
-        if isinstance(self.stage, MassSpringDamperSection):
+        if self.open_loop:
+            what = ("a mass-spring-damper [stage]"
+                    if isinstance(self.stage, MassSpringDamperSection)
+                    else f'a [stage] with output = "{self.stage.output}"')
             for name in ("controller", "feedforward", "reference"):
                 if getattr(self, name) is not None:
-                    raise ValueError(f"[{name}] does not apply to a mass-spring-damper [stage] "
-                                     f"(an open-loop system, force in, position out)")
+                    raise ValueError(f"[{name}] does not apply to {what} (an open-loop system, "
+                                     f"force in, position out)")
             return self
         for name in ("controller", "reference"):
             if getattr(self, name) is None:
-                raise ValueError(f"[{name}]: missing")
+                hint = ""
+                if (isinstance(self.stage, StageSection) and self.controller is None
+                        and self.reference is None):
+                    hint = ' (or give [stage] output = "y2" or "y1" for an open-loop system)'
+                raise ValueError(f"[{name}]: missing{hint}")
         if self.feedforward is None:
             self.feedforward = FeedforwardSection()
         return self
 
     @property
     def open_loop(self) -> bool:
-        """True for a mass-spring-damper stage (no controller)."""
-        return isinstance(self.stage, MassSpringDamperSection)
+        """True for a mass-spring-damper stage or a two-mass one with an ``output`` (no
+        controller)."""
+        return isinstance(self.stage, MassSpringDamperSection) or (
+            isinstance(self.stage, StageSection) and self.stage.output is not None)
 
 
 # tags of the discriminated unions, left out of the key named in an error message
@@ -451,14 +468,18 @@ class Scenario:
 
     @property
     def is_open_loop(self) -> bool:
-        """True for a mass-spring-damper stage: force in, position out, no controller."""
+        """True for an open-loop system (a mass-spring-damper stage, or a two-mass stage with
+        an ``output``): force in, position out, no controller."""
         return self.model.open_loop
 
     def _closed(self, what: str) -> None:
         if self.model.open_loop:
-            raise ScenarioError(f"{self.source}: [stage] is a mass-spring-damper (an open-loop "
-                                f"system without [controller] or [reference]); {what} needs a "
-                                f"closed loop (use motionhyst predict for open-loop systems)")
+            kind = ("a mass-spring-damper" if isinstance(self.model.stage,
+                                                         MassSpringDamperSection)
+                    else f'a two-mass stage with output = "{self.model.stage.output}"')
+            raise ScenarioError(f"{self.source}: [stage] is {kind} (an open-loop system "
+                                f"without [controller] or [reference]); {what} needs a closed "
+                                f"loop (use motionhyst predict for open-loop systems)")
 
     @property
     def files(self) -> list[Path]:
@@ -485,26 +506,32 @@ class Scenario:
         return list(self.model.reference.frequencies)
 
     def open_loop(self) -> OpenLoop:
-        """The open-loop system of a mass-spring-damper stage and its link."""
+        """The open-loop system of the stage and its link (force in, a position out)."""
         if not self.model.open_loop:
-            raise ScenarioError(f"{self.source}: [stage] is not a mass-spring-damper; an "
-                                f"open-loop system needs [stage] type = \"mass-spring-damper\"")
-        st = self.model.stage
-        from motionhyst.openloop import MassSpringDamper, OpenLoop
+            raise ScenarioError(f"{self.source}: [stage] is not a mass-spring-damper nor a "
+                                f"two-mass stage with an output; an open-loop system needs "
+                                f"[stage] type = \"mass-spring-damper\", or output = \"y2\" "
+                                f"or \"y1\" in a two-mass [stage] (and no [controller])")
+        from motionhyst.openloop import OpenLoop
 
-        return OpenLoop(MassSpringDamper(st.m, st.c, st.k), self.hysteresis())
+        return OpenLoop(self.plant(), self.hysteresis())
 
-    def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant | MassSpringDamper:
-        """The stage model, the model fitted to a measured plant, or the raw measured plant."""
+    def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant | MassSpringDamper | TwoMass:
+        """The stage model, the model fitted to a measured plant, or the raw measured plant
+        (an open-loop system's: :class:`~motionhyst.openloop.MassSpringDamper` or
+        :class:`~motionhyst.openloop.TwoMass`)."""
         if self._plant is not None:
             return self._plant
         from motionhyst.frf_fit import fit_measured_plant
-        from motionhyst.openloop import MassSpringDamper
+        from motionhyst.openloop import MassSpringDamper, TwoMass
         from motionhyst.systems import TwoMassStage, load_frd_plant
 
         m = self.model
         if m.open_loop:
-            return MassSpringDamper(m.stage.m, m.stage.c, m.stage.k)
+            st = m.stage
+            if isinstance(st, MassSpringDamperSection):
+                return MassSpringDamper(st.m, st.c, st.k)
+            return TwoMass(st.m1, st.m2, st.b, st.k, st.output)
         if m.stage is not None:
             self._plant = TwoMassStage(m.stage.m1, m.stage.m2, m.stage.b, m.stage.k)
             return self._plant

@@ -140,6 +140,11 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"{path}: {exc}") from None
     else:
         sc = load_scenario(args.scenario)
+        if sc.is_open_loop:
+            raise UsageError(f"motionhyst identify: closed-loop records need the plant of a "
+                             f"closed loop; {sc.source} is an open-loop system (no "
+                             f"[controller]); give a scenario with a two-mass [stage] without "
+                             f"output, or identify with --record input-output")
         plant = sc.plant()
         if isinstance(plant, MeasuredPlant):
             raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "

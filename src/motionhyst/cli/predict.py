@@ -13,20 +13,23 @@ from motionhyst.cli._common import UsageError, print_json
 def add_parser(sub) -> None:
     """Add the ``predict`` command to the subparsers `sub`."""
     q = sub.add_parser("predict", help="displacement of an open-loop system (mass-spring-damper "
-                       "scenario) for a force record (CSV)")
+                       "or two-mass scenario without controller) for a force record (CSV)")
     q.add_argument("scenario", metavar="MODEL.toml",
-                   help='scenario with [stage] type = "mass-spring-damper" and [hysteresis] '
-                        "(as written by motionhyst identify --save)")
+                   help='open-loop scenario: [stage] type = "mass-spring-damper", or a two-mass '
+                        '[stage] with output = "y2" or "y1" (the position written), and '
+                        "[hysteresis] (as written by motionhyst identify --save)")
     q.add_argument("data", metavar="INPUT.csv", help="force record with a header: time,force "
                    "[s, N], uniform time steps")
     q.add_argument("--periodic", action="store_true",
                    help="the record is one period (or whole periods) of a periodic force: "
-                        "output the periodic steady state (default: from rest)")
+                        "output the periodic steady state (default: from rest; a floating "
+                        "two-mass stage: with zero mean, an error if it drifts)")
     q.add_argument("--out", required=True, metavar="OUT.csv",
-                   help="output CSV: time,displacement [s, m] on the input's time grid")
+                   help="output CSV: time,displacement [s, m] on the input's time grid (a "
+                        "two-mass stage: the position its [stage] output names)")
     q.add_argument("--substeps", type=int, metavar="N",
                    help="integration steps per sample (default: >= 20 and >= 400 per period "
-                        "of the stage's mode)")
+                        "of the stage's fastest mode)")
     q.add_argument("--force", action="store_true", help="replace OUT.csv if it exists")
     q.add_argument("--json", action="store_true", help="print a JSON summary")
     q.set_defaults(func=run)
