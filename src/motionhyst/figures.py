@@ -217,11 +217,10 @@ def _can_fork() -> bool:
 
 
 def _warm_up(formats: Sequence[str]) -> None:
-    """Load once what drawing any figure loads at its first use, for workers forked later.
+    """Load what drawing any figure loads at its first use, once, before forking workers.
 
     The formats' backends, the font and the math-text parser (tick labels of
-    log axes): a worker forked after this inherits them instead of loading
-    its own.
+    log axes): each worker inherits them instead of loading its own.
     """
     from matplotlib.backend_bases import get_registered_canvas_class
 
@@ -332,6 +331,9 @@ class FigureWriter:
                 _draw_and_save(name, make, self.folder, self.formats)
                 self._done(name)
             return
+        if not self._warm:  # once, here, rather than in every worker
+            _warm_up(self.formats)
+            self._warm = True
         ctx = multiprocessing.get_context("fork")
         receive, send = ctx.Pipe(duplex=False)
         worker = ctx.Process(target=_draw_batch, daemon=True,
@@ -346,9 +348,6 @@ class FigureWriter:
             gc.unfreeze()
         send.close()
         self._workers.append((worker, receive))
-        if not self._warm:  # while the first worker draws: for the workers forked later
-            _warm_up(self.formats)
-            self._warm = True
 
     def wait(self) -> list[str]:
         """Wait until every figure submitted is saved; their names, in the order submitted.

@@ -22,6 +22,7 @@ from tqdm import tqdm
 
 from motionhyst import plots
 from motionhyst.figures import FigureWriter
+from motionhyst.hysteresis.periodic import TWO_PI
 from motionhyst.jsonio import dumps
 from motionhyst.outputs import OutputFolder
 from motionhyst.scenario import Scenario
@@ -250,6 +251,9 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         # folder, each as soon as its data is computed, while the next data is computed
         with (tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch,
               FigureWriter(scratch, ("png", "pdf"), done=lambda _: steps.update()) as figures):
+            # the link's compiled kernels (numba), loaded here once: the steady states need them
+            # and the workers forked from now on inherit them instead of loading their own
+            el.sine_loop(A, None if el.rate_independent else TWO_PI * freqs[0])
             figures.submit(_link_figures(el, A, freqs))  # need no loop: drawn while it is built
             # the analysis (python-control, the compiled kernels) is imported only now
             from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
