@@ -343,7 +343,7 @@ class _BoucWenProblem:
 
 def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.float64],
            tol: float, max_nfev: int):
-    """Trust-region refinement of the free parameters (``nu >= 1`` when free)."""
+    """Trust-region refinement of the free parameters (``m > 0``; ``c, k, alpha >= 0``; ``nu >= 1``)."""
     cache: dict = {}
 
     # the sensitivities cost ~40 % of a run and are needed at every accepted point:
@@ -367,10 +367,10 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
         return prob.jacobian(s, p, scale)
 
     q0 = prob.variables(p0, scale)
-    lower = np.full(q0.size, -np.inf)
-    if prob.free[6]:
-        lower[-1] = 1.0 / scale[6]
-        q0[-1] = max(q0[-1], lower[-1] * (1 + 1e-9))
+    # m > 0 and c, k, alpha >= 0 (a stage and link that exist), nu >= 1
+    low = np.array([1e-6, 0.0, 0.0, 0.0, -np.inf, -np.inf, 1.0 / scale[6]])
+    lower = low[prob.free]
+    q0 = np.where(np.isfinite(lower), np.maximum(q0, lower + 1e-9 * np.abs(q0) + 1e-12), q0)
     sol = least_squares(fun, q0, jac=jacobian, method="trf", x_scale=1.0, ftol=tol, xtol=tol,
                         gtol=tol, max_nfev=max_nfev, bounds=(lower, np.inf))
     return sol
@@ -559,47 +559,43 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     lin = prob.full(sol.x, scale)
     n_eval = prob.n_eval
 
-    # 2. starts: the stiffness split between stage and link, refined on the short part
-    # (with nu at its start value; a free nu joins in the refinement)
+    # 2. starts (nu at its start value; a free nu joins in the refinement): each simulated
+    # once on the short part of the records; the basic ones and the best others refined there
     free_start = free.copy()
     free_start[6] = False
-    best = None
-    for share in (0.25, 0.5, 0.75):
-        for lam in (0.5, 2.0):
-            p0 = np.array([lin[0], lin[1], (1 - share) * lin[2], share * lin[2],
-                           lam / y_scale, -lam / y_scale, nu0])
-            sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale)
-            s = _solve(sp, p0, scale, 1e-6, 12)
-            n_eval += sp.n_eval
-            if best is None or s.cost < best[0]:
-                best = (s.cost, sp.full(s.x, scale))
-    # 3. refinement on all records
-    p = best[1]
-    notes: dict[str, str] = {}
-    while True:
-        prob = _BoucWenProblem(records, periodic, r, free, p, y_scale,
-                               _force_scale(p, y_scale))
-        sol = _solve(prob, p, scale, tol, max_nfev)
-        n_eval += prob.n_eval
-        p = prob.full(sol.x, scale)
-        res, jac = prob.run(p, True)
-        res *= y_scale
-        J = jac[:, free] * y_scale
-        rss = float(res @ res)
-        std_q, groups = _uncertainty(J, rss, res.size)
-        if not free[6] or p[4] + p[5] >= 0.0:
-            break
-        # no ultimate force (beta*(gamma + delta) < 0) is admitted for nu = 1 only: when
-        # the data cannot tell nu from 1, nu is fixed at 1 and the rest refined again
-        nu_std = std_q[-1]
-        if not abs(p[6] - 1.0) <= max(3.0 * nu_std, 1e-9):
-            break
-        notes["nu"] = (f"not distinguishable from 1 (estimate {p[6]:.9g} +- {nu_std:.2g}); "
-                       f"fixed at 1, as the link has no ultimate force "
-                       f"(beta*(gamma + delta) < 0), admitted for nu = 1 only")
-        free = free.copy()
-        free[6] = False
-        p[6] = 1.0
+    sp = _BoucWenProblem(short, periodic, r, free_start, lin, y_scale)
+    screened = []
+    for i, p0 in enumerate(_bouc_wen_starts(lin, y_scale, nu0)):
+        res, _ = sp.run(p0, False)
+        screened.append((float(res @ res), i, p0))
+    n_eval += sp.n_eval
+    screened.sort(key=lambda c: c[:2])
+    chosen = [c for c in screened if c[1] < len(BASIC_STARTS)]
+    chosen += [c for c in screened if c[1] >= len(BASIC_STARTS)][:START_REFINED]
+    refined = []
+    for _, _, p0 in chosen:
+        sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale)
+        s = _solve(sp, p0, scale, 1e-6, 12)
+        n_eval += sp.n_eval
+        refined.append((float(s.cost), len(refined), sp.full(s.x, scale)))
+    refined.sort(key=lambda c: c[:2])
+    # 3. refinement on all records, from the best start whose result is a valid system
+    error = None
+    for _, _, p_start in refined[:FINAL_ATTEMPTS]:
+        p, free_used, sol, res, std_q, groups, notes, n = _refine(
+            records, periodic, r, free, p_start, y_scale, scale, tol, max_nfev)
+        n_eval += n
+        try:
+            link = _bouc_wen_link(p[3], p[4], p[5], p[6])
+            plant = MassSpringDamper(p[0], p[1], p[2])
+        except ValueError as exc:
+            error = error or exc
+            continue
+        break
+    else:
+        raise error
+    free = free_used
+    rss = float(res @ res)
     names = ["m", "c", "k", "alpha", "beta*gamma", "beta*delta", "nu"]
     free_names = [n for n, f in zip(names, free, strict=True) if f]
     estimates = {n: float(v) for n, v in zip(names, p, strict=True) if n in free_names}
@@ -610,8 +606,6 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     for n, s in zip(free_names, std_q, strict=True):
         std[n] = float(s) if math.isfinite(s) else None
     not_ident.update(_undetermined_notes(free_names, groups, SINGULAR_RTOL))
-    plant = MassSpringDamper(p[0], max(p[1], 0.0), max(p[2], 0.0))
-    link = _bouc_wen_link(p[3], p[4], p[5], p[6])
     per_record = _per_record(records, res)
     return IOIdentification(
         plant=plant, hysteresis=link, estimates=estimates, std=std,
@@ -620,6 +614,67 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r)
+
+
+#: Starts of the Bouc-Wen link, screened by one simulation each: the link's initial
+#: stiffness ``alpha`` as a share of the linear model's stiffness ``k``, taken from the
+#: stage's (``split``) or added to it (a link that saturates early hardly shows in ``k``);
+#: ``beta*gamma`` in units of 1/output-RMS; ``delta/gamma``: no ultimate force on loading
+#: (-1), an ultimate force ``alpha/(beta*gamma)`` (0), or an in-between (-0.5)
+START_SHARES = (0.25, 0.5, 0.75)
+START_PRODUCTS = (0.5, 2.0, 8.0, 32.0)
+START_RATIOS = (-1.0, -0.5, 0.0)
+#: The starts always refined on the short part of the records (share, beta*gamma in units
+#: of 1/output-RMS, delta/gamma = -1), and how many of the other screened starts join them
+BASIC_STARTS = tuple((share, lam) for share in START_SHARES for lam in (0.5, 2.0))
+START_REFINED = 2
+#: Refinements on all records tried, best start first, until one gives a valid link
+FINAL_ATTEMPTS = 3
+
+
+def _bouc_wen_starts(lin: NDArray[np.float64], y_scale: float, nu: float
+                     ) -> list[NDArray[np.float64]]:
+    """Start parameters ``m, c, k, alpha, beta*gamma, beta*delta, nu`` around the linear fit."""
+    starts = [np.array([lin[0], lin[1], (1.0 - share) * lin[2], share * lin[2], lam / y_scale,
+                        -lam / y_scale, nu]) for share, lam in BASIC_STARTS]
+    for share in START_SHARES:
+        for split in (True, False):
+            k = (1.0 - share) * lin[2] if split else lin[2]
+            for lam in START_PRODUCTS:
+                for ratio in START_RATIOS:
+                    if split and ratio == -1.0 and lam in (0.5, 2.0):
+                        continue  # a basic start
+                    starts.append(np.array([lin[0], lin[1], k, share * lin[2], lam / y_scale,
+                                            ratio * lam / y_scale, nu]))
+    return starts
+
+
+def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev):
+    """Refinement on all records; with ``nu`` free and no ultimate force, ``nu = 1`` if the
+    data cannot tell it from 1 (the only ``nu`` such links are admitted for)."""
+    notes: dict[str, str] = {}
+    n_eval = 0
+    while True:
+        prob = _BoucWenProblem(records, periodic, r, free, p, y_scale,
+                               _force_scale(p, y_scale))
+        sol = _solve(prob, p, scale, tol, max_nfev)
+        n_eval += prob.n_eval
+        p = prob.full(sol.x, scale)
+        res, jac = prob.run(p, True)
+        res *= y_scale
+        std_q, groups = _uncertainty(jac[:, free] * y_scale, float(res @ res), res.size)
+        if not free[6] or p[4] + p[5] >= 0.0:
+            break
+        nu_std = std_q[-1]
+        if not abs(p[6] - 1.0) <= max(3.0 * nu_std, 1e-9):
+            break
+        notes["nu"] = (f"not distinguishable from 1 (estimate {p[6]:.9g} +- {nu_std:.2g}); "
+                       f"fixed at 1, as the link has no ultimate force "
+                       f"(beta*(gamma + delta) < 0), admitted for nu = 1 only")
+        free = free.copy()
+        free[6] = False
+        p[6] = 1.0
+    return p, free, sol, res, std_q, groups, notes, n_eval
 
 
 def _per_record(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:
