@@ -19,7 +19,11 @@ Method
    carrying input power (weighted by ``|G|``, i.e. the relative output error).
 2. Start, link: the linear fit by simulation error; then the link's force is
    introduced by splitting the best linear stiffness ``k`` between the stage
-   and the link (Bouc-Wen: ``alpha``, with ``beta*gamma = beta*delta = 0``; the
+   and the link (Bouc-Wen: ``alpha`` split from ``k`` or added to it, a grid
+   of ``beta*gamma`` and ``delta/gamma``, each start screened by one
+   simulation, see :func:`_bouc_wen_starts`; the full refinement runs from
+   the best start, or the next when it ends outside the model's accepted
+   set; the
    other links, from the model registry: parameters started by their units,
    the link slipping within the records or hardly at all, a rate scale such
    as LuGre's ``vs`` held on a grid, see :func:`_identify_elements`).  Several
