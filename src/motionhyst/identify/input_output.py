@@ -347,7 +347,7 @@ class _BoucWenProblem:
 
 def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.float64],
            tol: float, max_nfev: int):
-    """Trust-region refinement of the free parameters (``m > 0``; ``c, k, alpha >= 0``; ``nu >= 1``)."""
+    """Trust-region refinement of the free parameters (m > 0; c, k, alpha >= 0; nu >= 1)."""
     cache: dict = {}
 
     # the sensitivities cost ~40 % of a run and are needed at every accepted point:
