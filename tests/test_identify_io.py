@@ -346,3 +346,13 @@ def test_free_exponent_noisy_records_within_three_standard_errors():
         std = fit.std[name]
         assert std is not None and 0 < std < 0.05 * abs(value), name
         assert abs(fit.estimates[name] - value) <= 3 * std, name
+
+
+def test_cli_model_without_input_output_identification(tmp_path, capsys):
+    data = tmp_path / "rec.csv"
+    _write_csv(data, _record(256, 1))
+    assert main(["identify", str(data), "--record", "input-output", "--model",
+                 "maxwell-iwan"]) == 2
+    err = capsys.readouterr().err
+    assert "--model maxwell-iwan is not available for input-output records; use bouc-wen" in err
+    assert len(err.strip().splitlines()) == 1

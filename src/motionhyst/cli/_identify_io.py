@@ -65,6 +65,11 @@ def run_input_output(args: argparse.Namespace) -> int:
     if plant == "two-mass":
         raise UsageError("motionhyst identify: --plant two-mass is not available for "
                          "input-output records yet; use --plant mass-spring-damper")
+    from motionhyst.identify.input_output import MODELS
+
+    if model not in MODELS:
+        raise UsageError(f"motionhyst identify: --model {model} is not available for "
+                         f"input-output records; use {', '.join(MODELS)}")
     if args.elements is not None and model != "maxwell-slip":
         raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     if args.nu is not None and model != "bouc-wen":

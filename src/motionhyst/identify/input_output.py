@@ -30,8 +30,10 @@ Method
    starts are refined on a short part of the records and the best continues.
 3. Refinement: :func:`scipy.optimize.least_squares` (trust-region reflective)
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
-   from forward sensitivities integrated with the model (RK4); other links: a
-   finite-difference Jacobian (columns in parallel threads).  Stopping rule:
+   from forward sensitivities integrated with the model (RK4); other links:
+   the exact Jacobian from the forward sensitivities of their simulation
+   (:mod:`~motionhyst.identify._element_sensitivities`; finite differences,
+   columns in parallel threads, for an element kind without them).  Stopping rule:
    the first of a relative cost reduction below ``ftol``, a relative step below ``xtol`` or a scaled
    gradient below ``gtol`` (all ``1e-12`` by default), or ``max_nfev``
    evaluations.
@@ -837,13 +839,17 @@ class _ElementProblem:
 
     The search variables are ``log m, log c, log k`` and the link's values,
     each as a logarithm or scaled (see :class:`_LinkLayout`); those not in
-    `free` stay at their values in `fixed`.  The Jacobian is by forward
-    differences (relative step ``1e-6``), its columns computed in parallel.
+    `free` stay at their values in `fixed`.  The Jacobian is exact, from the
+    forward sensitivities of the simulation
+    (:mod:`~motionhyst.identify._element_sensitivities`, computed with the
+    residuals), or, for an element kind without them or with `exact` False,
+    by forward differences (relative step ``1e-6``), its columns computed in
+    parallel.
     """
 
     def __init__(self, records, periodic, substeps, layout: _LinkLayout, y_scale,
                  scale: NDArray[np.float64], free: NDArray[np.bool_] | None = None,
-                 fixed: NDArray[np.float64] | None = None):
+                 fixed: NDArray[np.float64] | None = None, exact: bool = True):
         self.records, self.periodic, self.r = records, periodic, substeps
         self.layout, self.y_scale = layout, y_scale
         self.log = np.concatenate([[True, True, True], layout.logarithmic])
@@ -852,7 +858,8 @@ class _ElementProblem:
         self.fixed = np.zeros(self.log.size) if fixed is None else fixed
         self.fine = [fine_input(rec.u, substeps, periodic) for rec in records]
         self.n_eval = 0
-        self._last: tuple[bytes, NDArray[np.float64]] | None = None
+        self.exact: bool | None = None if exact else False  # sensitivities (None: untried)
+        self._last: tuple | None = None
 
     def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """Parameters ``m, c, k, link...`` of the (whole) search vector `q`."""
@@ -888,19 +895,70 @@ class _ElementProblem:
             r = np.full(sum(rec.y.size for rec in self.records), np.nan)
         return np.where(np.isfinite(r), r, 1e3)
 
+    def _run_exact(self, q_free: NDArray[np.float64]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """Residuals and their exact Jacobian in the free variables (forward sensitivities);
+        None if the link has an element kind without them."""
+        from motionhyst.identify._element_sensitivities import (
+            row_derivatives,
+            simulate_with_sensitivities,
+        )
+
+        v = self.values(self.whole(q_free))
+        n_rows = sum(rec.y.size for rec in self.records)
+        try:
+            dparams = row_derivatives(self.layout.build, v[3:])
+            if dparams is None:
+                return None
+            link = self.layout.build(v[3:])
+            stepping = link.time_stepping()
+
+            def one(i):
+                rec = self.records[i]
+                return simulate_with_sensitivities(v[0], v[1], v[2], stepping, dparams, rec.u,
+                                                   rec.fs, self.r, self.periodic, self.fine[i],
+                                                   link.initial_stiffness)
+
+            if len(self.records) > 1:  # the compiled runs release the GIL
+                with ThreadPoolExecutor(max_workers=min(len(self.records),
+                                                        os.cpu_count() or 1)) as pool:
+                    outs = list(pool.map(one, range(len(self.records))))
+            else:
+                outs = [one(0)]
+            r = np.concatenate([y - rec.y for (y, _), rec in zip(outs, self.records,
+                                                                 strict=True)])
+            J = np.concatenate([sy for _, sy in outs]) * self.derivative(v)
+        except ValueError:
+            return np.full(n_rows, 1e3), np.zeros((n_rows, int(self.free.sum())))
+        r = r / self.y_scale
+        if not np.all(np.isfinite(r)) or not np.all(np.isfinite(J)):
+            return np.full(n_rows, 1e3), np.zeros((n_rows, int(self.free.sum())))
+        return r, J[:, self.free] / self.y_scale
+
     def residuals(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Output errors in units of the output's RMS."""
         self.n_eval += 1
+        if self.exact is not False:
+            out = self._run_exact(q_free)
+            if out is not None:
+                self.exact = True
+                self._last = (q_free.tobytes(), *out)
+                return out[0]
+            self.exact = False
         r = self._run(q_free)
-        self._last = (q_free.tobytes(), r)
+        self._last = (q_free.tobytes(), r, None)
         return r
 
     def jacobian(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Forward differences, one column per free variable, in parallel threads."""
+        """Exact (forward sensitivities, computed with the residuals), else forward
+        differences, one column per free variable, in parallel threads."""
         if self._last is not None and self._last[0] == q_free.tobytes():
-            r0 = self._last[1]
+            r0, J = self._last[1], self._last[2]
         else:
             r0 = self.residuals(q_free)
+            J = self._last[2]
+        if J is not None:
+            return J
         steps = 1e-6 * np.maximum(1.0, np.abs(q_free))
 
         def column(j):
@@ -923,17 +981,19 @@ class _ElementProblem:
 #: The rate scales (velocity parameters, e.g. LuGre's vs) are held at each of these
 #: fractions of the records' RMS velocity in turn, the rest refined; the best continues
 RATE_GRID = (0.1, 0.01, 0.03, 0.3, 1.0, 3.0)
-#: Starts of the link: (share of the best linear stiffness, slip displacements in units of
-#: those spanning the records): slipping within the records, or hardly at all
-STARTS = ((0.3, 1.0), (0.6, 1.0), (0.5, 10.0))
+#: Starts: (stage's and link's stiffness as shares of the best linear one, the link's slip
+#: displacements in units of those spanning the records): the link slipping within the
+#: records, hardly at all, or early (a stiff link that slips most of the time adds little
+#: to the best linear stiffness)
+STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 
 def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_start,
                        start_nfev) -> IOIdentification:
-    """Stage and a link of exact-update elements by simulation error (finite differences).
+    """Stage and a link of exact-update elements by simulation error.
 
-    Starts (on a short part of the records): for the splits of the best linear
-    stiffness between stage and link and the slip displacements of
+    Starts (on a short part of the records): for the shares of the best linear
+    stiffness of stage and link and the slip displacements of
     :data:`STARTS`, the link's values are refined with its
     rate scales (velocities) held at the first of :data:`RATE_GRID`; from the
     better, with the rate scales held at each other value of the grid (a
@@ -963,8 +1023,8 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
     best = None
-    for share, slip in STARTS:
-        p0 = np.concatenate([[bla.m, bla.c, (1 - share) * bla.k],
+    for stage, share, slip in STARTS:
+        p0 = np.concatenate([[bla.m, bla.c, stage * bla.k],
                              layout.start(share * bla.k, y_scale, v_scale, bla.c, slip)])
         p0[rate] = RATE_GRID[0] * v_scale
         cost, p, used = held(p0, n_start)
@@ -989,15 +1049,16 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     rss = float(res @ res)
     J = prob.jacobian(sol.x) * y_scale / prob.derivative(v)  # d residual / d parameter
     n_eval += prob.n_eval
-    std_v, groups = _uncertainty(J, rss, res.size, FD_SINGULAR_RTOL)
+    rtol = SINGULAR_RTOL if prob.exact else FD_SINGULAR_RTOL
+    std_v, groups = _uncertainty(J, rss, res.size, rtol)
     names = ["m", "c", "k", *layout.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
     for nm, sd in zip(names, std_v, strict=True):
         std[nm] = float(sd) if math.isfinite(sd) else None
     not_ident = {f"link.{name}": _parallel_note(layout, name) for name in layout.fixed}
-    not_ident.update(_undetermined_notes(names, groups, FD_SINGULAR_RTOL))
-    weak = _weak_notes(names, v, std_v, J, FD_SINGULAR_RTOL, ~prob.log)
+    not_ident.update(_undetermined_notes(names, groups, rtol))
+    weak = _weak_notes(names, v, std_v, J, rtol, ~prob.log)
     n_short = sum(rec.y.size for rec in short)
     if rate.any() and _flat_profile(profile, n_short - scale.size):
         lo, hi = min(RATE_GRID) * v_scale, max(RATE_GRID) * v_scale
@@ -1016,7 +1077,8 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
         estimates=estimates, std=std, not_identifiable=not_ident,
         fit_rms=float(np.sqrt(rss / res.size)), records=_per_record(records, res),
         seconds=time.perf_counter() - t_start, periodic=periodic,
-        stopping=f"{sol.message} (finite-difference Jacobian; ftol = xtol = gtol = {tol:g}, "
+        stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
+                 f"Jacobian; ftol = xtol = gtol = {tol:g}, "
                  f"at most {max_nfev} evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r)
 
