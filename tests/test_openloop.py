@@ -331,3 +331,16 @@ def test_predict_two_mass_periodic_and_from_rest(tmp_path, capsys):
                comments="", fmt="%.17g")
     assert main(["identify", str(closed), "--scenario", str(scenario)]) == 2
     assert "is an open-loop system" in capsys.readouterr().err
+
+
+def test_stamps_rounded_when_written_are_the_same_record():
+    sys = OpenLoop(PLANT, LINK)
+    t = np.arange(3000) / 750
+    u = 20 * np.sin(2 * np.pi * 3 * t) + 5 * np.sin(2 * np.pi * 41 * t)
+    exact = sys.simulate(t, u).displacement
+    rounded = sys.simulate(np.round(t, 4), u).displacement   # 4 decimals: 3.75 % of a step
+    assert np.max(np.abs(rounded - exact)) < 1e-6 * np.max(np.abs(exact))
+    jittered = t.copy()
+    jittered[1234] += 0.1 / 750
+    with pytest.raises(ValueError, match=r"stamp 1\.64\d* s is 0\.1 sampling intervals off"):
+        sys.simulate(jittered, u)

@@ -818,7 +818,7 @@ class OpenLoop:
         OpenLoopResponse
         """
         tt, u = check_record(t, force)
-        fs = 1.0 / (tt[1] - tt[0])
+        fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
         p = self._bw_parameters()
         if periodic and self.hysteresis is None and self.plant.mechanics().floating:
@@ -937,10 +937,30 @@ def _max_periods(mech: Mechanics, k_link: float, period_s: float) -> int:
     return int(min(1000, max(4, math.ceil(MAX_PERIODIC_DECAYS * tau / period_s) + 2)))
 
 
+#: Largest distance of a time stamp from the record's uniform grid, in sampling intervals
+#: (time columns written with few digits, e.g. 12.3457 s at 750 Hz, are off by up to 4 %)
+STAMP_TOLERANCE = 0.05
+
+
 def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A uniform time grid and a finite force of the same length, as float arrays.
 
-    Raises ``ValueError`` (one line) otherwise.
+    The grid is the uniform one nearest to `t` (:func:`sampling_rate`);
+    stamps rounded when written are accepted within :data:`STAMP_TOLERANCE` of
+    a sampling interval.  Raises ``ValueError`` (one line) otherwise.
+
+    Examples
+    --------
+    >>> t = np.round(np.arange(3000) / 750, 4)   # stamps written with 4 decimals
+    >>> tt, u = check_record(t, np.zeros(3000))
+    >>> print(f"{sampling_rate(tt):.4f}")
+    750.0000
+    >>> try:
+    ...     check_record([0.0, 0.1, 0.3], [1.0, 2.0, 3.0])
+    ... except ValueError as exc:
+    ...     print(exc)
+    time must increase in uniform steps (the stamp 0.1 s is 0.22 sampling intervals off the
+    uniform grid)
     """
     tt = np.asarray(t, dtype=float)
     u = np.asarray(force, dtype=float)
@@ -950,10 +970,32 @@ def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], N
         raise ValueError("a record needs at least 2 samples")
     if not (np.all(np.isfinite(tt)) and np.all(np.isfinite(u))):
         raise ValueError("time and force must be finite")
-    dt = np.diff(tt)
-    if not np.all(dt > 0) or np.max(np.abs(dt - dt.mean())) > 1e-6 * dt.mean():
-        raise ValueError("time must increase in uniform steps")
+    if not np.all(np.diff(tt) > 0):
+        raise ValueError("time must increase")
+    t0, dt = _uniform_grid(tt)
+    off = np.abs(tt - (t0 + dt * np.arange(tt.size))) / dt
+    worst = int(np.argmax(off))
+    if off[worst] > STAMP_TOLERANCE:
+        raise ValueError(f"time must increase in uniform steps (the stamp {tt[worst]:.9g} s is "
+                         f"{off[worst]:.2g} sampling intervals off the uniform grid)")
     return tt, u
+
+
+def _uniform_grid(t: NDArray[np.float64]) -> tuple[float, float]:
+    """Start and step of the uniform grid nearest to `t` (least squares)."""
+    i = np.arange(t.size, dtype=float) - 0.5 * (t.size - 1)
+    tc = t - t.mean()
+    dt = float(i @ tc / (i @ i))
+    return float(t.mean() - 0.5 * (t.size - 1) * dt), dt
+
+
+def sampling_rate(t: NDArray[np.float64]) -> float:
+    """Rate of a record's uniform grid [Hz]: the step fitted to all its stamps.
+
+    Exact for exact stamps; for stamps rounded when written, far more exact
+    than the difference of two of them.
+    """
+    return 1.0 / _uniform_grid(np.asarray(t, dtype=float))[1]
 
 
 def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float, r: int, *,

@@ -77,12 +77,12 @@ from motionhyst.openloop import (
     check_record,
     fine_input,
     is_periodic_record,
+    sampling_rate,
     simulate_bouc_wen,
 )
 
 MIN_SAMPLES = 64
 #: Link models for input-output records: Bouc-Wen (exact sensitivities) and every other
-#: registered model (its parameters taken from the registry)
 #: registered model (its parameters taken from the registry); not maxwell-iwan, whose Iwan
 #: element of 256 stop operators makes a simulation too slow for a search
 MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
@@ -103,7 +103,7 @@ class IORecord:
     @property
     def fs(self) -> float:
         """Sampling frequency [Hz]."""
-        return 1.0 / (self.t[1] - self.t[0])
+        return sampling_rate(self.t)
 
 
 def load_io_csv(path: str | Path) -> IORecord:
