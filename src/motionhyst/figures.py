@@ -20,6 +20,7 @@ import gc
 import io
 import multiprocessing
 import os
+import signal
 import traceback
 from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection
@@ -244,6 +245,10 @@ def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[
     from motionhyst._jit import quiet_compilation
 
     quiet_compilation()
+    # the caller ends its workers (FigureWriter.close, with SIGTERM), whatever handlers it has:
+    # a worker dies at SIGTERM and leaves Ctrl-C to the caller
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         for name, make in makers.items():
             _draw_and_save(name, make, folder, formats)

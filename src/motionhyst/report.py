@@ -248,14 +248,21 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
     try:
         steps = tqdm(total=10, desc="reproduce", disable=not show, file=sys.stderr, leave=False)
         # the figures are drawn by worker processes into a scratch folder outside the user's
-        # folder, each as soon as its data is computed, while the next data is computed
-        with (tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch,
-              FigureWriter(scratch, ("png", "pdf"), done=lambda _: steps.update()) as figures):
+        # folder, each as soon as its data is computed, while the next data is computed; each
+        # figure's files are staged in the output folder as soon as they are written (and all
+        # are moved into place together at the end; SIGTERM cleans up)
+        def stage(name: str) -> None:
+            for ext in ("png", "pdf"):
+                folder.write_bytes(f"{name}.{ext}", (Path(scratch) / f"{name}.{ext}").read_bytes())
+            steps.update()
+
+        with (folder, tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch,
+              FigureWriter(scratch, ("png", "pdf"), done=stage) as figures):
             # the link's compiled kernels (numba), loaded here once: the steady states need them
             # and the workers forked from now on inherit them instead of loading their own
             el.sine_loop(A, None if el.rate_independent else TWO_PI * freqs[0])
             figures.submit(_link_figures(el, A, freqs))  # need no loop: drawn while it is built
-            # the analysis (python-control, the compiled kernels) is imported only now
+            # the analysis (python-control) is imported only now, while the worker draws
             from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
             from motionhyst.steady import periodic_steady_state
             from motionhyst.systems import MeasuredPlant
@@ -307,17 +314,10 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 notes += analysis.unresolved
             drawn = set(figures.wait())
             written = [name for name in FIGURES if name in drawn]
-            files: dict[str, bytes] = {}
-            for name in written:
-                for ext in ("png", "pdf"):
-                    files[f"{name}.{ext}"] = (Path(scratch) / f"{name}.{ext}").read_bytes()
-        files["summary.json"] = dumps(summary).encode()
-        files["report.md"] = _report_text(sc, el, analysis, states, E_df, fit, written,
-                                          is_paper, notes).encode()
-        steps.close()
-        with folder:  # staged, then moved into place together; SIGTERM cleans up
-            for name, data in files.items():
-                folder.write_bytes(name, data)
+            folder.write_bytes("summary.json", dumps(summary).encode())
+            folder.write_bytes("report.md", _report_text(sc, el, analysis, states, E_df, fit,
+                                                         written, is_paper, notes).encode())
+            steps.close()
     except BaseException:
         folder.abandon()
         raise
