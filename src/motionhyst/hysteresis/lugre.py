@@ -172,11 +172,15 @@ class LuGre(Hysteresis):
         reference to about 1e-11 relative or better for ``omega A / vs`` from 0.06
         to 6e5 and ``sigma0 A / fc`` from 0.4 to 1000).
         """
-        X = truncate_harmonics(X)
+        return self._samples(truncate_harmonics(X), n_harmonics)
+
+    def _samples(self, X: NDArray[np.complex128], n_harmonics: int = 1) -> int:
+        """:meth:`default_samples` for harmonics `X` already truncated."""
         amp = 2.0 * float(np.sum(np.abs(X[1:])))
         r = self.sigma0 * amp / min(self.fc, self.fs)
         need = [8 * (len(X) - 1), 4 * (int(n_harmonics) + 1),
-                1100.0 * max(r, 1.0) ** (1.0 / 3.0), 12.0 * TWO_PI / np.sqrt(2.0 / max(r, 1e-300))]
+                1100.0 * max(r, 1.0) ** (1.0 / 3.0),
+                12.0 * TWO_PI / np.sqrt(2.0 / max(r, 1e-300))]
         return pow2_at_least(max(need))
 
     def _periodic_state(self, X: NDArray[np.complex128], omega: float, N: int
@@ -204,7 +208,7 @@ class LuGre(Hysteresis):
         """
         om = check_omega(omega, "LuGre")
         X = truncate_harmonics(np.asarray(X, dtype=complex))
-        N = self.default_samples(X, om) if n_samples is None else int(n_samples)
+        N = self._samples(X) if n_samples is None else int(n_samples)
         if N < 8 or N % 2:
             raise ValueError(f"n_samples must be an even number >= 8, got {n_samples!r}")
         x = sample_period(X, N)
@@ -250,7 +254,7 @@ class LuGre(Hysteresis):
         W = np.zeros(H + 1, dtype=complex)
         if len(X) == 1:
             return W
-        N = self.default_samples(X, om, H) if n_samples is None else int(n_samples)
+        N = self._samples(X, H) if n_samples is None else int(n_samples)
         if N < 8 or N % 2:
             raise ValueError(f"n_samples must be an even number >= 8, got {n_samples!r}")
         z, _ = self._periodic_state(X, om, N)
