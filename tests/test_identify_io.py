@@ -147,8 +147,10 @@ def test_cli_errors(tmp_path, capsys):
     assert "const.csv: the force is constant" in err and len(err.strip().splitlines()) == 1
     assert main(["identify", str(bad), "--model", "bouc-wen"]) == 2
     assert "--model applies to --record input-output only" in capsys.readouterr().err
-    assert main(["identify", str(bad), "--record", "input-output", "--plant", "two-mass"]) == 2
-    assert "two-mass is not available" in capsys.readouterr().err
+    assert main(["identify", str(bad), "--record", "input-output", "--output", "y1"]) == 2
+    assert "--output applies to --plant two-mass only" in capsys.readouterr().err
+    assert main(["identify", str(bad), "--output", "y1"]) == 2
+    assert "--output applies to --record input-output only" in capsys.readouterr().err
     closed = tmp_path / "closed.toml"
     closed.write_text('[stage]\nm1 = 5.0\nm2 = 17.5\nb = 90.0\nk = 7.4e7\n'
                       '[hysteresis]\nmodel = "jenkins"\nk = 20.0\nfc = 0.05\n'

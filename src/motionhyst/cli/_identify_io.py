@@ -27,7 +27,11 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     from motionhyst.hysteresis import MODELS
 
     q.add_argument("--plant", choices=PLANTS,
-                   help="input-output records: the stage's model (default mass-spring-damper)")
+                   help="input-output records: the stage's model (default mass-spring-damper; "
+                        "two-mass: the floating stage of eqs. 1-2, force and link on m1)")
+    q.add_argument("--output", choices=("y2", "y1"),
+                   help="input-output records, --plant two-mass: the measured position, y2 "
+                        "(the point of control, default) or y1 (the actuated mass)")
     q.add_argument("--model", choices=list(MODELS),
                    help="input-output records: the link's model (default bouc-wen)")
     q.add_argument("--periodic", action="store_true",
@@ -46,7 +50,7 @@ def check_not_input_output(args: argparse.Namespace) -> None:
     """One-line error for input-output options given with another record kind."""
     for option, value in (("--plant", args.plant), ("--model", args.model),
                           ("--periodic", args.periodic or None), ("--nu", args.nu),
-                          ("--save", args.save)):
+                          ("--save", args.save), ("--output", args.output)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
                              f"only")
@@ -62,9 +66,9 @@ def run_input_output(args: argparse.Namespace) -> int:
                              f"input-output")
     plant = args.plant or "mass-spring-damper"
     model = args.model or "bouc-wen"
-    if plant == "two-mass":
-        raise UsageError("motionhyst identify: --plant two-mass is not available for "
-                         "input-output records yet; use --plant mass-spring-damper")
+    if args.output is not None and plant != "two-mass":
+        raise UsageError("motionhyst identify: --output applies to --plant two-mass only (a "
+                         "mass-spring-damper has one position)")
     from motionhyst.identify.input_output import MODELS
 
     if model not in MODELS:
@@ -82,7 +86,7 @@ def run_input_output(args: argparse.Namespace) -> int:
     records = [load_io_csv(path) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     fit = identify_io(records, model, periodic=args.periodic, nu=nu,
-                      n_elements=args.elements or 3)
+                      n_elements=args.elements or 3, plant=plant, output=args.output or "y2")
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         target.write_text(fit.scenario_text())
@@ -91,7 +95,9 @@ def run_input_output(args: argparse.Namespace) -> int:
         print_json(result)
         return 0
     kind = "periodic steady state" if fit.periodic else "from rest"
-    print(f"Stage and {model} link identified from {len(records)} input-output record(s) "
+    stage = (f"Two-mass stage ({args.output or 'y2'} measured)" if plant == "two-mass"
+             else "Stage")
+    print(f"{stage} and {model} link identified from {len(records)} input-output record(s) "
           f"({kind}) by simulation error in {fit.seconds:.3g} s")
     print(f"  fit RMS {g(fit.fit_rms)} m; {fit.stopping}")
     rows = []

@@ -2,8 +2,10 @@
 
 The records are force ``u`` in, position ``y`` out (the link force is not
 measured), each an experiment from rest or, with ``periodic=True``, whole
-periods of a periodic steady state.  The plant (a :class:`MassSpringDamper`)
-and the link are estimated jointly by minimising the *simulation* error
+periods of a periodic steady state.  The plant (a :class:`MassSpringDamper`,
+or the floating two-mass stage of eqs. (1)-(2), :class:`~motionhyst.openloop.TwoMass`,
+with ``y2`` or ``y1`` measured) and the link are estimated jointly by
+minimising the *simulation* error
 
 .. math::
 
@@ -28,6 +30,12 @@ Method
    the link slipping within the records or hardly at all, a rate scale such
    as LuGre's ``vs`` held on a grid, see :func:`_identify_elements`).  Several
    starts are refined on a short part of the records and the best continues.
+   The two-mass stage: :func:`best_linear_approximation_two_mass` (the link a
+   spring and damper to the ground; from rest, the frequency response of an
+   ARX model of the records), then the link's initial stiffness 1, 3 and 9
+   times that spring with mild to strong nonlinearity, then three splits of
+   the mass at the same internal mode (see :func:`_two_mass_start`); its
+   element links by finite differences.
 3. Refinement: :func:`scipy.optimize.least_squares` (trust-region reflective)
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
    from forward sensitivities integrated with the model (RK4); other links:
@@ -72,8 +80,11 @@ from scipy.optimize import least_squares
 from motionhyst.hysteresis import MODELS as REGISTERED
 from motionhyst.hysteresis import BoucWen, Hysteresis, Parameter
 from motionhyst.openloop import (
+    MIN_SUBSTEPS,
+    STEPS_PER_MODE_PERIOD,
     MassSpringDamper,
     OpenLoop,
+    TwoMass,
     check_record,
     fine_input,
     is_periodic_record,
@@ -87,6 +98,8 @@ MIN_SAMPLES = 64
 #: element of 256 stop operators makes a simulation too slow for a search
 MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
                                                                       "maxwell-iwan")))
+PLANTS = ("mass-spring-damper", "two-mass")
+BLA_STARTS = 6  # two-mass: grid points refined
 SINGULAR_RTOL = 1e-8
 FD_SINGULAR_RTOL = 1e-5  # finite-difference Jacobians (step 1e-6) are no more exact than this
 
@@ -167,20 +180,8 @@ def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
     >>> round(p.m, 3), round(p.c, 2), round(p.k)
     (2.0, 10.0, 50000)
     """
-    n_max = max(r.u.size for r in records)
-    freqs = np.fft.rfftfreq(n_max, 1.0 / records[0].fs)
-    suy = np.zeros(freqs.size, dtype=complex)
-    suu = np.zeros(freqs.size)
-    for r in records:
-        f = np.fft.rfftfreq(r.u.size, 1.0 / r.fs)
-        U = np.fft.rfft(r.u - r.u.mean())
-        Y = np.fft.rfft(r.y - r.y.mean())
-        idx = np.clip(np.searchsorted(freqs, f), 0, freqs.size - 1)
-        np.add.at(suy, idx, Y * np.conj(U))
-        np.add.at(suu, idx, np.abs(U) ** 2)
-    sel = (suu >= 1e-3 * suu.max()) & (freqs > 0)
-    G = suy[sel] / suu[sel]
-    w = 2 * np.pi * freqs[sel]
+    f, G = _spectral_response(records)
+    w = 2 * np.pi * f
     wt = np.abs(G)
     inv = 1.0 / G
     # rows: Re(1/G) = k - m w^2 ; Im(1/G) = c w
@@ -195,6 +196,155 @@ def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
     return MassSpringDamper(m, max(c, 1e-6 * m * w.min()), max(k, 1e-6 * m * w.min() ** 2))
 
 
+def _spectral_response(records: list[IORecord]
+                       ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
+    """``G(f) = sum Y U* / sum |U|^2`` over the records (each transformed whole), at the
+    lines whose input power is at least ``1e-3`` of the largest."""
+    n_max = max(r.u.size for r in records)
+    freqs = np.fft.rfftfreq(n_max, 1.0 / records[0].fs)
+    suy = np.zeros(freqs.size, dtype=complex)
+    suu = np.zeros(freqs.size)
+    for r in records:
+        f = np.fft.rfftfreq(r.u.size, 1.0 / r.fs)
+        U = np.fft.rfft(r.u - r.u.mean())
+        Y = np.fft.rfft(r.y - r.y.mean())
+        idx = np.clip(np.searchsorted(freqs, f), 0, freqs.size - 1)
+        np.add.at(suy, idx, Y * np.conj(U))
+        np.add.at(suu, idx, np.abs(U) ** 2)
+    sel = (suu >= 1e-3 * suu.max()) & (freqs > 0)
+    return freqs[sel], suy[sel] / suu[sel]
+
+
+def _arx_response(records: list[IORecord], f_hz: NDArray[np.float64], na: int = 4,
+                  nb: int = 6) -> NDArray[np.complex128]:
+    """Frequency response at `f_hz` of an ARX model fitted to records from rest.
+
+    ``y[n] + a_1 y[n-1] + ... + a_na y[n-na] = b_0 u[n] + ... + b_(nb-1) u[n-nb+1]``
+    by least squares over every record (zero before the first sample: from
+    rest).  The records' spectra would see the free ringing of a lightly damped
+    mode started by the record's start as a response to the force; the
+    recursion carries it.
+    """
+    rows, rhs = [], []
+    for rec in records:
+        n = rec.y.size
+        yp = np.concatenate([np.zeros(na), rec.y])
+        up = np.concatenate([np.zeros(nb), rec.u])
+        cols = [-yp[na - i:na - i + n] for i in range(1, na + 1)]
+        cols += [up[nb - i:nb - i + n] for i in range(nb)]
+        rows.append(np.column_stack(cols))
+        rhs.append(rec.y)
+    A = np.concatenate(rows)
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    theta = np.linalg.lstsq(A / scale, np.concatenate(rhs), rcond=None)[0] / scale
+    z1 = np.exp(-2j * np.pi * f_hz / records[0].fs)
+    den = 1.0 + sum(theta[i - 1] * z1 ** i for i in range(1, na + 1))
+    num = sum(theta[na + i] * z1 ** i for i in range(nb))
+    return num / den
+
+
+def two_mass_response(theta: NDArray[np.float64], f_hz: NDArray[np.float64], output: str
+                      ) -> NDArray[np.complex128]:
+    """``y2 / u`` or ``y1 / u`` of the two-mass stage (eqs. 1-2) held by a spring ``kl``
+    and damper ``cl`` on ``y1``; ``theta = (m1, m2, b, k, kl, cl)``.
+
+    With ``D = (m1 s^2 + (b + cl) s + k + kl)(m2 s^2 + b s + k) - (b s + k)^2``:
+    ``y2 / u = (b s + k) / D`` and ``y1 / u = (m2 s^2 + b s + k) / D``.
+    """
+    m1, m2, b, k, kl, cl = theta
+    s = 2j * np.pi * f_hz
+    inner = b * s + k
+    D = (m1 * s * s + (b + cl) * s + k + kl) * (m2 * s * s + inner) - inner * inner
+    return (inner if output == "y2" else m2 * s * s + inner) / D
+
+
+def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y2",
+                                       periodic: bool = True) -> tuple[TwoMass, float, float]:
+    """The two-mass stage and a spring and damper for its link fitted to the records'
+    frequency response.
+
+    The link is linearised as a spring ``kl`` and damper ``cl`` from ``y1`` to
+    the ground (:func:`two_mass_response`).  The impedance at ``y1`` is
+
+    .. math::
+
+        Z_1 = \\frac{1}{G_1} = m_1 s^2 + c_l s + k_l + m_2 s^2 H(s), \\qquad
+        H = \\frac{y_2}{y_1} = \\frac{2 \\zeta \\omega s + \\omega^2}
+        {s^2 + 2 \\zeta \\omega s + \\omega^2},
+
+    with ``omega^2 = k / m2`` and ``2 zeta omega = b / m2`` (and ``1/G2 = Z1 / H``
+    when ``y2`` is measured), linear in ``(m1, cl, kl, m2)`` for given
+    ``(omega, zeta)``: those four are solved by weighted linear least squares
+    (relative error) on a grid of ``omega`` across and beyond the excited band
+    and of ``zeta`` from 0.005 to 0.3, and the best point is refined in all six
+    parameters (``log`` of each) by nonlinear least squares on the relative
+    error of ``G`` (:func:`_spectral_response`).  A start for the simulation-error
+    fit, not a result.
+
+    Returns
+    -------
+    plant : TwoMass
+    k_link, c_link : float
+        The link's linear stiffness [N/m] and damping [N s/m].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.openloop import OpenLoop, TwoMass
+    >>> from motionhyst.hysteresis import BoucWen
+    >>> t = np.arange(4096) / 750
+    >>> u = np.random.default_rng(0).standard_normal(4096)
+    >>> spring = BoucWen.from_general(5e4, 1.0, 0.0, 0.0, 1.0)   # beta = 0: a spring
+    >>> y = OpenLoop(TwoMass(2.0, 3.0, 20.0, 2e5), spring).simulate(t, u, periodic=True)
+    >>> p, kl, cl = best_linear_approximation_two_mass([IORecord(t, u, y.displacement)])
+    >>> round(p.m1, 3), round(p.m2, 3), round(p.b, 2), round(p.k), round(kl), round(cl, 6)
+    (2.0, 3.0, 20.0, 200000, 50000, 0.0)
+    """
+    f, G = _spectral_response(records)
+    keep = f < 0.5 * records[0].fs * (1 - 1e-9)  # the Nyquist line is ambiguous
+    f, G = f[keep], G[keep]
+    if not periodic:
+        G = _arx_response(records, f)
+    s = 2j * np.pi * f
+    grid = []
+    for om in 2 * np.pi * np.geomspace(0.5 * f[0], 10 * f[-1], 80):
+        for zeta in np.geomspace(0.002, 0.5, 12):
+            H = (2 * zeta * om * s + om * om) / (s * s + 2 * zeta * om * s + om * om)
+            Z = 1.0 / G if output == "y1" else H / G
+            A = np.column_stack([s * s, s, np.ones_like(s), s * s * H]) / np.abs(Z)[:, None]
+            rhs = Z / np.abs(Z)
+            x = np.linalg.lstsq(np.concatenate([A.real, A.imag]),
+                                np.concatenate([rhs.real, rhs.imag]), rcond=None)[0]
+            m1, cl, kl, m2 = x
+            if m1 > 0 and m2 > 0 and kl > 0:
+                cost = float(np.sum(np.abs(A @ x - rhs) ** 2))
+                grid.append((cost, m1, m2, 2 * zeta * om * m2, om * om * m2, kl, max(cl, 0.0)))
+    if not grid:
+        raise ValueError("the records' frequency response does not fit a two-mass stage on "
+                         "a spring (no positive masses and stiffness)")
+    mag = np.abs(G)
+
+    def residual(logt):
+        with np.errstate(all="ignore"):
+            e = (two_mass_response(np.exp(logt), f, output) - G) / mag
+        r = np.concatenate([e.real, e.imag])
+        return np.where(np.isfinite(r), r, 1e6)
+
+    best = None
+    for start in sorted(grid)[:BLA_STARTS]:  # the best grid points, refined in all six
+        v = np.array(start[1:])
+        v[-1] = max(v[-1], 1e-6 * math.sqrt(v[4] * (v[0] + v[1])))
+        x0 = np.log(v)
+        sol = least_squares(residual, x0, method="trf", xtol=1e-14, ftol=1e-14, gtol=1e-14,
+                            max_nfev=200, bounds=(x0 - 30.0, x0 + 30.0))
+        if best is None or sol.cost < best.cost:
+            best = sol
+    sol = best
+    m1, m2, b, k, kl, cl = np.exp(sol.x)
+    return TwoMass(m1, m2, b, k, output), float(kl), float(cl)
+
+
 # ----------------------------------------------------------------- result
 @dataclass
 class IOIdentification:
@@ -202,7 +352,7 @@ class IOIdentification:
 
     Attributes
     ----------
-    plant : MassSpringDamper
+    plant : MassSpringDamper or TwoMass
     hysteresis : Hysteresis
         The link model (Bouc-Wen in the general form, normalised so that
         ``|gamma| + |delta| = 1``; or Maxwell-slip).
@@ -257,10 +407,10 @@ class IOIdentification:
     def scenario_text(self) -> str:
         """A scenario file (TOML) of the identified system: ``[stage]`` and ``[hysteresis]``."""
         lines = [f"# identified from {len(self.records)} input-output record(s) by simulation "
-                 f"error: fit RMS {self.fit_rms:.4g} m", "[stage]",
-                 'type = "mass-spring-damper"']
-        for key in ("m", "c", "k"):
-            lines.append(f"{key} = {_toml(getattr(self.plant, key))}")
+                 f"error: fit RMS {self.fit_rms:.4g} m", "[stage]"]
+        for key, value in self.plant.to_dict().items():
+            lines.append(f'{key} = "{value}"' if isinstance(value, str)
+                         else f"{key} = {_toml(value)}")
         lines.append("")
         lines.append("[hysteresis]")
         for key, value in self.hysteresis.to_dict().items():
@@ -280,12 +430,24 @@ def _toml(v: float) -> str:
 
 # ----------------------------------------------------------------- Bouc-Wen problem
 class _BoucWenProblem:
-    """Simulation residuals of the stage with a general Bouc-Wen link, and their Jacobian."""
+    """Simulation residuals of the stage with a general Bouc-Wen link, and their Jacobian.
+
+    The parameter vector: the plant's first three parameters, ``alpha,
+    beta*gamma, beta*delta, nu``, then the plant's others (a two-mass stage's
+    ``k``), so that the link's always sit at 3-6.  `plant` gives the kind of
+    plant (default: a mass-spring-damper).
+    """
 
     def __init__(self, records: list[IORecord], periodic: bool, substeps: int,
                  free: NDArray[np.bool_], fixed: NDArray[np.float64], y_scale: float,
-                 force_scale: float = 1.0):
+                 force_scale: float = 1.0, plant: MassSpringDamper | TwoMass | None = None):
         self.y_scale = y_scale  # residuals in units of the output's RMS
+        self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
+        n_plant = len(self.plant.PARAMETERS)
+        # problem order -> simulation order (the plant's parameters, then the link's)
+        self.order = np.r_[0:3, 7:4 + n_plant, 3:7]
+        # a floating stage's periodic output is known up to a constant: compared without means
+        self.centre = periodic and isinstance(self.plant, TwoMass)
         # with nu free the products are searched as beta*gamma F^(nu - 1) (and delta): the
         # size of beta*gamma |z|^nu at |z| ~ F, which then does not move with nu
         self.force_scale = force_scale if free[6] else 1.0
@@ -298,7 +460,8 @@ class _BoucWenProblem:
         self.n_eval = 0
 
     def full(self, q_free: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray:
-        """Parameters ``m, c, k, alpha, beta*gamma, beta*delta, nu`` of the search variables."""
+        """Parameters ``m, c, k, alpha, beta*gamma, beta*delta, nu`` (and a two-mass stage's
+        ``k``) of the search variables."""
         p = self.fixed.copy()
         p[self.free] = q_free * scale[self.free]
         if self.force_scale != 1.0:
@@ -328,10 +491,16 @@ class _BoucWenProblem:
         def one(i):
             rec = self.records[i]
             try:
-                return simulate_bouc_wen(p, rec.u, rec.fs, self.r, periodic=self.periodic,
-                                         sensitivities=jac, upsampled=self.fine[i])
+                y, s = simulate_bouc_wen(p[self.order], rec.u, rec.fs, self.r,
+                                         periodic=self.periodic, sensitivities=jac,
+                                         upsampled=self.fine[i], plant=self.plant)
             except ValueError:  # no periodic steady state: a point the search must leave
-                return np.full(rec.u.size, np.nan), np.zeros((rec.u.size, 7))
+                return np.full(rec.u.size, np.nan), np.zeros((rec.u.size, p.size))
+            if jac:
+                s_problem = np.empty_like(s)
+                s_problem[:, self.order] = s
+                s = s_problem
+            return y, s
 
         if len(self.records) > 1:  # the compiled runs release the GIL: one thread per record
             with ThreadPoolExecutor(max_workers=min(len(self.records), os.cpu_count() or 1)
@@ -339,7 +508,8 @@ class _BoucWenProblem:
                 outs = list(pool.map(one, range(len(self.records))))
         else:
             outs = [one(0)]
-        res = [y - rec.y for (y, _), rec in zip(outs, self.records, strict=True)]
+        res = [y - (rec.y - np.mean(rec.y) if self.centre else rec.y)
+               for (y, _), rec in zip(outs, self.records, strict=True)]
         rows = [s for _, s in outs]
         r = np.concatenate(res) / self.y_scale
         if not np.all(np.isfinite(r)):
@@ -375,6 +545,8 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
     q0 = prob.variables(p0, scale)
     # m > 0 and c, k, alpha >= 0 (a stage and link that exist), nu >= 1
     low = np.array([1e-6, 0.0, 0.0, 0.0, -np.inf, -np.inf, 1.0 / scale[6]])
+    if prob.fixed.size > 7:  # a two-mass stage (m1, m2, b, ..., k): m1, m2, k > 0, b >= 0
+        low = np.array([1e-6, 1e-6, 0.0, 0.0, -np.inf, -np.inf, 1.0 / scale[6], 1e-6])
     lower = low[prob.free]
     q0 = np.where(np.isfinite(lower), np.maximum(q0, lower + 1e-9 * np.abs(q0) + 1e-12), q0)
     sol = least_squares(fun, q0, jac=jacobian, method="trf", x_scale=1.0, ftol=tol, xtol=tol,
@@ -474,9 +646,9 @@ def _weak_notes(names: list[str], values: NDArray[np.float64], std: NDArray[np.f
 
 def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
                 nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
-                max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None
-                ) -> IOIdentification:
-    """Identify a mass-spring-damper stage and its link from input-output records.
+                max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None,
+                plant: str = "mass-spring-damper", output: str = "y2") -> IOIdentification:
+    """Identify a stage and its link from input-output records.
 
     Parameters
     ----------
@@ -490,7 +662,17 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         ``sigma2`` is not estimated: it adds to ``c``).
     periodic : bool
         Records are steady-state periods (each record one period or several
-        whole periods of its force).
+        whole periods of its force).  A floating stage's (the two-mass one) is
+        known up to a constant position: records and model are compared with
+        their means removed.
+    plant : {"mass-spring-damper", "two-mass"}
+        The stage: :class:`~motionhyst.openloop.MassSpringDamper` (``m, c, k``)
+        or the floating :class:`~motionhyst.openloop.TwoMass` of eqs. (1)-(2)
+        (``m1, m2, b, k``; the force and the link on ``m1``, no spring to the
+        ground but the link's).
+    output : {"y2", "y1"}
+        Two-mass stage: the measured position (``y2``, the point of control, or
+        ``y1``, the actuated mass).
     nu : float or None
         Bouc-Wen exponent: fixed at this value, or estimated (``nu >= 1``) when
         None, starting from 1.  With ``nu`` free the products ``beta*gamma`` and
@@ -543,9 +725,17 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
             if rec_period is None and abs(rec.u[0] - rec.u[-1]) > 0.5 * np.ptp(rec.u):
                 raise ValueError(f"{rec.name}: periodic records must hold whole periods of "
                                  f"the force; its ends do not join")
+    if plant not in PLANTS:
+        raise ValueError(f"unknown plant {plant!r} for input-output records; expected one of "
+                         f"{', '.join(PLANTS)}")
+    if output not in TwoMass.OUTPUTS:
+        raise ValueError(f"unknown output {output!r}; expected y2 or y1")
     if model != "bouc-wen":
         return _identify_elements(records, model, periodic, substeps, tol, max_nfev,
-                                  n_elements, t_start, start_nfev)
+                                  n_elements, t_start, start_nfev, plant, output)
+    if plant == "two-mass":
+        return _identify_two_mass(records, periodic, nu, substeps, tol, max_nfev, output,
+                                  t_start)
     bla = best_linear_approximation(records)
     fs = records[0].fs
     r = substeps or OpenLoop(bla).default_substeps(fs)
@@ -655,14 +845,14 @@ def _bouc_wen_starts(lin: NDArray[np.float64], y_scale: float, nu: float
     return starts
 
 
-def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev):
+def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=None):
     """Refinement on all records; with ``nu`` free and no ultimate force, ``nu = 1`` if the
     data cannot tell it from 1 (the only ``nu`` such links are admitted for)."""
     notes: dict[str, str] = {}
     n_eval = 0
     while True:
         prob = _BoucWenProblem(records, periodic, r, free, p, y_scale,
-                               _force_scale(p, y_scale))
+                               _force_scale(p, y_scale), plant=plant)
         sol = _solve(prob, p, scale, tol, max_nfev)
         n_eval += prob.n_eval
         p = prob.full(sol.x, scale)
@@ -671,7 +861,7 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev):
         std_q, groups = _uncertainty(jac[:, free] * y_scale, float(res @ res), res.size)
         if not free[6] or p[4] + p[5] >= 0.0:
             break
-        nu_std = std_q[-1]
+        nu_std = std_q[int(np.count_nonzero(free[:6]))]
         if not abs(p[6] - 1.0) <= max(3.0 * nu_std, 1e-9):
             break
         notes["nu"] = (f"not distinguishable from 1 (estimate {p[6]:.9g} +- {nu_std:.2g}); "
@@ -681,6 +871,102 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev):
         free[6] = False
         p[6] = 1.0
     return p, free, sol, res, std_q, groups, notes, n_eval
+
+
+def _identify_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start
+                       ) -> IOIdentification:
+    """The two-mass stage and a Bouc-Wen link: :func:`_two_mass_start`, then :func:`_refine`
+    on all records (problem order ``m1, m2, b, alpha, beta*gamma, beta*delta, nu, k``)."""
+    structure, r, y_scale, scale, free, p, n_eval = _two_mass_start(records, periodic, nu,
+                                                                   substeps, output)
+    p, free, sol, res, std_q, groups, notes, n = _refine(
+        records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=structure)
+    n_eval += n
+    link = _bouc_wen_link(p[3], p[4], p[5], p[6])
+    stage = _two_mass_result(p[0], p[1], p[2], p[7], output)
+    rss = float(res @ res)
+    names = ["m1", "m2", "b", "alpha", "beta*gamma", "beta*delta", "nu", "k"]
+    free_names = [n for n, f in zip(names, free, strict=True) if f]
+    values = dict(zip(names, p, strict=True))
+    std_of = dict(zip(free_names, std_q, strict=True))
+    # the plant's parameters first, then the link's
+    order = ["m1", "m2", "b", "k", "alpha", "beta*gamma", "beta*delta", "nu"]
+    estimates = {n: float(values[n]) for n in order if n in free_names}
+    std: dict[str, float | None] = {n: float(std_of[n]) if math.isfinite(std_of[n]) else None
+                                    for n in estimates}
+    not_ident = {"beta": "only the products beta*gamma and beta*delta enter the model "
+                         "(z is not measured); beta is fixed by |gamma| + |delta| = 1",
+                 "gamma": "see beta", "delta": "see beta", **notes}
+    not_ident.update(_undetermined_notes(free_names, groups, SINGULAR_RTOL))
+    return IOIdentification(
+        plant=stage, hysteresis=link, estimates=estimates, std=std,
+        not_identifiable=not_ident, fit_rms=float(np.sqrt(rss / res.size)),
+        records=_per_record(records, res), seconds=time.perf_counter() - t_start,
+        periodic=periodic,
+        stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
+                 f"evaluations; {sol.nfev} used)",
+        n_evaluations=n_eval, substeps=r)
+
+
+def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
+                    substeps: int | None, output: str):
+    """Steps 1-2 for the two-mass stage (problem order ``m1, m2, b, alpha, beta*gamma,
+    beta*delta, nu, k``): the linear model with the link a spring ``alpha`` (its only
+    hold), then starts with the link's nonlinearity, refined on a short part."""
+    bla, k_link, _ = best_linear_approximation_two_mass(records, output, periodic)
+    structure = TwoMass(1.0, 1.0, 0.0, 1.0, output)
+    fs = records[0].fs
+    f_n = bla.mechanics().natural_frequency_hz(k_link)
+    r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
+    y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y - (np.mean(rec.y) if periodic else 0.0)
+                                                    for rec in records]) ** 2)))
+    mu = bla.m1 * bla.m2 / bla.M
+    scale = np.array([bla.m1, bla.m2, max(bla.b, 1e-3 * math.sqrt(bla.k * mu)), k_link,
+                      1.0 / y_scale, 1.0 / y_scale, 1.0, bla.k])
+    free = np.array([True] * 6 + [nu is None, True])
+    nu0 = 1.0 if nu is None else float(nu)
+    short = _short_records(records, periodic)
+    free_start = free.copy()
+    free_start[6] = False
+    n_eval = 0
+    best = None
+    # the link's initial stiffness is above the linear (secant) one, up to an order of
+    # magnitude for a link driven into saturation; its nonlinearity neither hardening nor
+    # softening (gamma + delta = 0), or softening (delta = 0), mild to strong
+    for stiffer in (1.0, 3.0, 9.0):
+        for lam_g, lam_d in ((0.5, -0.5), (2.0, -2.0), (8.0, -8.0), (1.0, 0.0), (4.0, 0.0)):
+            p0 = np.array([bla.m1, bla.m2, bla.b, stiffer * k_link, lam_g / y_scale,
+                           lam_d / y_scale, nu0, bla.k])
+            sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale,
+                                 plant=structure)
+            s = _solve(sp, p0, scale, 1e-6, 12)
+            n_eval += sp.n_eval
+            if best is None or s.cost < best[0]:
+                best = (s.cost, sp.full(s.x, scale))
+    # the split of the mass is what a linear fit of y2 sees least (and the link's
+    # nonlinearity biases): from the best, other splits with the same total mass and
+    # internal mode
+    m_total = best[1][0] + best[1][1]
+    omega2 = best[1][7] * m_total / (best[1][0] * best[1][1])
+    for share in (0.25, 0.5, 0.75):
+        p0 = best[1].copy()
+        p0[0], p0[1] = share * m_total, (1 - share) * m_total
+        p0[7] = omega2 * p0[0] * p0[1] / m_total
+        sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale, plant=structure)
+        s = _solve(sp, p0, scale, 1e-6, 12)
+        n_eval += sp.n_eval
+        if s.cost < best[0]:
+            best = (s.cost, sp.full(s.x, scale))
+    return structure, r, y_scale, scale, free, best[1], n_eval
+
+
+def _two_mass_result(m1: float, m2: float, b: float, k: float, output: str) -> TwoMass:
+    """The identified two-mass stage (one-line ``ValueError`` for a non-physical one)."""
+    try:
+        return TwoMass(m1, m2, max(b, 0.0), k, output)
+    except ValueError as exc:
+        raise ValueError(f"the identified two-mass stage (m1={m1:.6g}, m2={m2:.6g}, b={b:.6g}, "
+                         f"k={k:.6g}) is not physical: {exc}") from None
 
 
 def _per_record(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:
@@ -837,22 +1123,31 @@ class _LinkLayout:
 class _ElementProblem:
     """Simulation residuals of the stage with a link of exact-update elements.
 
-    The search variables are ``log m, log c, log k`` and the link's values,
-    each as a logarithm or scaled (see :class:`_LinkLayout`); those not in
-    `free` stay at their values in `fixed`.  The Jacobian is exact, from the
+    The search variables are the logarithms of the plant's parameters
+    (``m, c, k`` or, with `plant` a :class:`~motionhyst.openloop.TwoMass`,
+    ``m1, m2, b, k``) and the link's values, each as a logarithm or scaled
+    (see :class:`_LinkLayout`); those not in `free` stay at their values in
+    `fixed`.  The Jacobian is exact, from the
     forward sensitivities of the simulation
     (:mod:`~motionhyst.identify._element_sensitivities`, computed with the
     residuals), or, for an element kind without them or with `exact` False,
     by forward differences (relative step ``1e-6``), its columns computed in
-    parallel.
+    parallel (the two-mass stage's: forward differences).
     """
 
     def __init__(self, records, periodic, substeps, layout: _LinkLayout, y_scale,
                  scale: NDArray[np.float64], free: NDArray[np.bool_] | None = None,
-                 fixed: NDArray[np.float64] | None = None, exact: bool = True):
+                 fixed: NDArray[np.float64] | None = None, exact: bool = True,
+                 plant: MassSpringDamper | TwoMass | None = None):
         self.records, self.periodic, self.r = records, periodic, substeps
         self.layout, self.y_scale = layout, y_scale
-        self.log = np.concatenate([[True, True, True], layout.logarithmic])
+        self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
+        self.n_plant = len(self.plant.PARAMETERS)
+        # a floating stage's periodic output is known up to a constant: compared without means
+        self.centre = periodic and isinstance(self.plant, TwoMass)
+        if isinstance(self.plant, TwoMass):
+            exact = False  # the element sensitivities are the mass-spring-damper's
+        self.log = np.concatenate([[True] * self.n_plant, layout.logarithmic])
         self.scale = scale
         self.free = np.ones(self.log.size, bool) if free is None else free
         self.fixed = np.zeros(self.log.size) if fixed is None else fixed
@@ -887,8 +1182,10 @@ class _ElementProblem:
     def _run(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         v = self.values(self.whole(q_free))
         try:
-            sys = OpenLoop(MassSpringDamper(v[0], v[1], v[2]), self.layout.build(v[3:]))
-            res = [sys._simulate_elements(rec.u, rec.fs, self.r, self.periodic, fine) - rec.y
+            k = self.n_plant
+            sys = OpenLoop(self.plant.with_parameters(v[:k]), self.layout.build(v[k:]))
+            res = [sys._simulate_elements(rec.u, rec.fs, self.r, self.periodic, fine)
+                   - (rec.y - np.mean(rec.y) if self.centre else rec.y)
                    for rec, fine in zip(self.records, self.fine, strict=True)]
             r = np.concatenate(res) / self.y_scale
         except ValueError:
@@ -989,7 +1286,8 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 
 def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_start,
-                       start_nfev) -> IOIdentification:
+                       start_nfev, plant="mass-spring-damper", output="y2"
+                       ) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -1000,32 +1298,65 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     profile: the rate scale and the force it shapes form a long valley when
     searched together); the best is refined with everything free on all
     records.
+
+    A two-mass stage (floating: the link is its only hold) starts from
+    :func:`best_linear_approximation_two_mass`, the link's stiffness 1, 4 and
+    16 times the linear one (its initial stiffness is above that secant one),
+    its forces together 0.3, 1 or 3 times the records' force RMS; a parameter
+    that adds a spring or damper in parallel is fixed at 0 (the stage has none
+    to the ground to hold it), and the Jacobian is by forward differences.
     """
     layout = _LinkLayout.of(model, n)
-    bla = best_linear_approximation(records)
-    r = substeps or OpenLoop(bla).default_substeps(records[0].fs)
-    y_all = np.concatenate([rec.y for rec in records])
+    y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and plant == "two-mass"
+                                     else 0.0) for rec in records])
     y_scale = float(np.sqrt(np.mean(y_all ** 2)))
     v_scale = float(np.sqrt(np.mean(np.concatenate(
         [np.gradient(rec.y, rec.t) for rec in records]) ** 2)))
-    c_scale = max(bla.c, 1e-3 * bla.m * 2 * np.pi * records[0].fs)
-    scale = np.concatenate([[bla.m, c_scale, bla.k],
-                            layout.scales(bla.k, c_scale, y_scale, v_scale)])
-    rate = np.concatenate([[False] * 3, [par.unit == _VELOCITY for par, _ in layout._values()]])
+    force = np.array([par.unit == _FORCE for par, _ in layout._values()], dtype=bool)
+    if plant == "two-mass":
+        bla, k_link, c_link = best_linear_approximation_two_mass(records, output, periodic)
+        structure: MassSpringDamper | TwoMass | None = bla
+        f_n = bla.mechanics().natural_frequency_hz(16.0 * k_link)
+        r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n
+                                                    / records[0].fs))
+        mu = bla.m1 * bla.m2 / bla.M
+        c_scale = max(c_link, 1e-3 * bla.M * 2 * np.pi * records[0].fs)
+        stage0 = [bla.m1, bla.m2, max(bla.b, 1e-3 * math.sqrt(bla.k * mu)), bla.k]
+        scale = np.concatenate([stage0, layout.scales(k_link, c_scale, y_scale, v_scale)])
+        u_rms = float(np.sqrt(np.mean(np.concatenate([rec.u for rec in records]) ** 2)))
+        starts = []
+        for stiffer in (1.0, 4.0, 16.0):
+            for held_force in (0.3, 1.0, 3.0):
+                link0 = layout.start(stiffer * k_link, y_scale, v_scale, c_link)
+                if force.any():
+                    link0[force] *= held_force * u_rms / np.sum(link0[force])
+                starts.append(np.concatenate([stage0, link0]))
+    else:
+        bla = best_linear_approximation(records)
+        structure = None
+        r = substeps or OpenLoop(bla).default_substeps(records[0].fs)
+        c_scale = max(bla.c, 1e-3 * bla.m * 2 * np.pi * records[0].fs)
+        scale = np.concatenate([[bla.m, c_scale, bla.k],
+                                layout.scales(bla.k, c_scale, y_scale, v_scale)])
+        starts = [np.concatenate([[bla.m, bla.c, stage * bla.k],
+                                  layout.start(share * bla.k, y_scale, v_scale, bla.c, slip)])
+                  for stage, share, slip in STARTS]
+    n_plant = len((structure or MassSpringDamper).PARAMETERS)
+    rate = np.concatenate([[False] * n_plant,
+                           [par.unit == _VELOCITY for par, _ in layout._values()]])
     short = _short_records(records, periodic)
     n_eval = 0
     n_start = start_nfev or 15 * scale.size
 
     def held(p0: NDArray[np.float64], nfev: int):
-        prob = _ElementProblem(short, periodic, r, layout, y_scale, scale, ~rate)
+        prob = _ElementProblem(short, periodic, r, layout, y_scale, scale, ~rate,
+                               plant=structure)
         prob.fixed = prob.variables(p0)
         sol = prob.solve(prob.fixed[~rate], 1e-6, nfev)
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
     best = None
-    for stage, share, slip in STARTS:
-        p0 = np.concatenate([[bla.m, bla.c, stage * bla.k],
-                             layout.start(share * bla.k, y_scale, v_scale, bla.c, slip)])
+    for p0 in starts:
         p0[rate] = RATE_GRID[0] * v_scale
         cost, p, used = held(p0, n_start)
         n_eval += used
@@ -1042,7 +1373,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
             profile.append(cost)
             if cost < best[0]:
                 best = (cost, p)
-    prob = _ElementProblem(records, periodic, r, layout, y_scale, scale)
+    prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure)
     sol = prob.solve(prob.variables(best[1]), tol, max_nfev)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
@@ -1051,12 +1382,13 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     n_eval += prob.n_eval
     rtol = SINGULAR_RTOL if prob.exact else FD_SINGULAR_RTOL
     std_v, groups = _uncertainty(J, rss, res.size, rtol)
-    names = ["m", "c", "k", *layout.names]
+    names = [*prob.plant.PARAMETERS, *layout.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
     for nm, sd in zip(names, std_v, strict=True):
         std[nm] = float(sd) if math.isfinite(sd) else None
-    not_ident = {f"link.{name}": _parallel_note(layout, name) for name in layout.fixed}
+    not_ident = {f"link.{name}": _parallel_note(layout, name, structure)
+                 for name in layout.fixed}
     not_ident.update(_undetermined_notes(names, groups, rtol))
     weak = _weak_notes(names, v, std_v, J, rtol, ~prob.log)
     n_short = sum(rec.y.size for rec in short)
@@ -1073,7 +1405,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
             not_ident[name] = why
             std[name] = None
     return IOIdentification(
-        plant=MassSpringDamper(v[0], v[1], v[2]), hysteresis=layout.build(v[3:]),
+        plant=prob.plant.with_parameters(v[:n_plant]), hysteresis=layout.build(v[n_plant:]),
         estimates=estimates, std=std, not_identifiable=not_ident,
         fit_rms=float(np.sqrt(rss / res.size)), records=_per_record(records, res),
         seconds=time.perf_counter() - t_start, periodic=periodic,
@@ -1096,8 +1428,11 @@ def _flat_profile(costs: list[float], dof: int) -> bool:
     return bool(least > 0 and (max(costs) - least) / least * max(dof, 1) < PROFILE_CHI2)
 
 
-def _parallel_note(layout: _LinkLayout, name: str) -> str:
+def _parallel_note(layout: _LinkLayout, name: str, plant=None) -> str:
     par = next(p for p in layout.cls.parameters if p.name == name)
     what, stage = ("a spring", "k") if par.parallel == "spring" else ("a damper", "c")
+    if isinstance(plant, TwoMass):
+        return (f"{what} to the ground in parallel with the link; not estimated with a "
+                f"two-mass stage (which has none to the ground): fixed at 0")
     return (f"{what} in parallel with the stage's: only the sum {stage} + {name} enters the "
             f"output; fixed at 0, the stage's {stage} holds the sum")
