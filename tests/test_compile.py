@@ -1,0 +1,75 @@
+"""Each compiled kernel is compiled for one signature.
+
+A numba kernel is compiled once per combination of argument types it is
+called with, and a constant argument of a call between kernels counts as a
+type of its own (``f(x, True)`` compiles ``f`` for ``Literal[bool](True)``
+besides ``bool``).  Each extra version costs its whole compilation again on
+a user's first run (``advance``, called with a literal ``True`` on a
+simulation's first sample, was compiled twice before it was declared with
+its one signature).  The test runs the periodic steady state with every link
+model, time simulations with the time-stepped ones and the sampled
+responses, then reads the signatures cached for every kernel: the cache
+folder is keyed by the package's sources, so its index holds every version
+compiled for these sources (in a ``make test`` session, those of every test;
+a kernel loaded from the cache is not compiled again in the process, so the
+dispatchers alone would miss callees).
+"""
+
+from __future__ import annotations
+
+import gc
+
+import numpy as np
+import pytest
+
+from motionhyst._jit import Kernel, compiled_in_memory
+from motionhyst.hysteresis import BoucWen, Dahl, Jenkins, LuGre, MaxwellIwan, MaxwellSlip
+from motionhyst.loop import Loop
+from motionhyst.references import SineReference
+from motionhyst.scenario import default_scenario
+from motionhyst.simulate import simulate
+from motionhyst.steady import periodic_steady_state
+
+LINKS = [Jenkins(20.0, 0.05), MaxwellSlip([12.0, 5.0, 3.0], [0.02, 0.02, 0.01]),
+         BoucWen(k=20.0, fc=0.05, n=2.0, beta=0.7, gamma=0.3),
+         BoucWen(k=20.0, fc=0.05, n=1.5, beta=0.7, gamma=0.3), Dahl(20.0, 0.05),
+         LuGre(sigma0=20.0, sigma1=0.01, sigma2=0.001, fc=0.05, fs=0.06, vs=0.01),
+         MaxwellIwan(k0=5.0, kv=[8.0, 3.0], cv=[0.4, 0.02], ki=30.0, d_min=1e-4,
+                     d_max=4e-3)]
+
+
+# kernels specialised on purpose, one version per kind of call
+SPECIALISED = {
+    # per plant size (the masses as a tuple) and with or without the sensitivities (None)
+    "motionhyst.openloop._rk4_run",
+}
+
+
+def cached_signatures(kernel: Kernel) -> list:
+    """The signatures in the cache index of `kernel` (numba's own reader)."""
+    from numba.core.caching import FunctionCache
+
+    return [key[0] for key in FunctionCache(kernel.py_func)._cache_file._load_index()]
+
+
+def test_each_kernel_is_compiled_for_one_signature():
+    base = default_scenario().loop()
+    for link in LINKS:
+        loop = Loop(base.plant, base.controller, link)
+        assert periodic_steady_state(loop, 0.01, 10.0).iterations >= 1
+        if not isinstance(link, MaxwellIwan):
+            sim = simulate(loop, SineReference(0.01, 10.0), 0.05)
+            assert np.all(np.isfinite(sim.e))
+    t = np.linspace(0.0, 0.1, 201)
+    x = 0.01 * np.sin(2 * np.pi * 10.0 * t)
+    for link in LINKS:
+        w = link.response(x, t=t) if isinstance(link, LuGre | MaxwellIwan) else link.response(x)
+        assert np.all(np.isfinite(w))
+    if compiled_in_memory():
+        pytest.skip("no writable cache folder: the compiled versions are not recorded")
+    kernels = [k for k in gc.get_objects() if isinstance(k, Kernel)]
+    cached = {f"{k.__module__}.{k.__qualname__}": cached_signatures(k) for k in kernels}
+    assert sum(1 for v in cached.values() if v) >= 30  # the paths above compiled many kernels
+    several = {name: sigs for name, sigs in cached.items()
+               if len(sigs) > 1 and name not in SPECIALISED}
+    assert not several, several
