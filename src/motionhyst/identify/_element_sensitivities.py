@@ -74,7 +74,8 @@ def _dahl_general(zeta, y, v, eps):  # pragma: no cover - compiled
     return zeta - y * math.expm1(lg), d_zeta, d_v, -yn * dlog
 
 
-@njit(cache=True)
+@njit("(int64, float64[::1], float64, float64, float64, float64, float64, boolean, "
+      "float64[::1], float64[::1])")
 def advance_partials(code, p, s, s_prev, dx, dx_prev, h, first, ds, df
                      ):  # pragma: no cover - compiled
     """:func:`~motionhyst.hysteresis.stepping.advance` with its partial derivatives.
