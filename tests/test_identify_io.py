@@ -358,3 +358,17 @@ def test_cli_model_without_input_output_identification(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--model maxwell-iwan is not available for input-output records; use bouc-wen" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_lugre_link_recovered_from_a_periodic_record():
+    # the periodic steady state and its sensitivities, carried from period to period
+    from motionhyst.hysteresis import LuGre
+
+    link = LuGre(sigma0=2e4, sigma1=30.0, sigma2=0.0, fc=5.0, fs=8.0, vs=0.02)
+    t = np.arange(512) / FS
+    u = _multisine(512, 4)
+    y = OpenLoop(LUGRE_STAGE, link).simulate(t, u, periodic=True, substeps=10).displacement
+    fit = identify_io([IORecord(t, u, y)], "lugre", periodic=True, substeps=10)
+    for name, value in LUGRE_TRUE.items():
+        assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
+    assert fit.periodic and "exact Jacobian" in fit.stopping
