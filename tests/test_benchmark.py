@@ -66,6 +66,9 @@ def test_test_sets_load():
 
 
 def test_missing_test_set_is_a_one_line_error(tmp_path):
+    with pytest.raises(ValueError, match=r"uval_multisine\.mat: no such file"):
+        load_test_set(tmp_path, "multisine")
+    (tmp_path / "uval_multisine.mat").write_text("not a MATLAB file")
     with pytest.raises(ValueError, match=r"uval_multisine\.mat: cannot read"):
         load_test_set(tmp_path, "multisine")
     with pytest.raises(ValueError, match="unknown test set"):
@@ -158,4 +161,4 @@ def test_benchmark_command_without_test_sets(tmp_path, capsys, monkeypatch):
     assert main(["benchmark", "bouc-wen"]) == 2
     assert "give --data DIR" in capsys.readouterr().err
     assert main(["benchmark", "bouc-wen", "--data", str(tmp_path)]) == 2
-    assert "uval_multisine.mat: cannot read" in capsys.readouterr().err
+    assert "uval_multisine.mat: no such file" in capsys.readouterr().err

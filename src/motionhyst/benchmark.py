@@ -378,15 +378,19 @@ def load_test_set(directory: str | Path, name: str) -> Record:
     or unreadable or the two do not match.
     """
     from scipy.io import loadmat
+    from scipy.io.matlab import MatReadError
 
     if name not in TEST_SETS:
         raise ValueError(f"unknown test set {name!r}; expected one of {sorted(TEST_SETS)}")
     arrays = []
     for fname in TEST_SETS[name]:
         path = Path(directory) / fname
+        if not path.is_file():
+            raise ValueError(f"{path}: no such file (the benchmark's test sets are "
+                             f"{', '.join(f for pair in TEST_SETS.values() for f in pair)})")
         try:
             data = loadmat(path)
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, MatReadError) as exc:
             raise ValueError(f"{path}: cannot read ({exc})") from None
         key = fname.removesuffix(".mat")
         if key not in data:
