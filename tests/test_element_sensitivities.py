@@ -8,12 +8,12 @@ from scipy.linalg import expm
 
 from motionhyst.hysteresis import Dahl, Jenkins, LuGre, MaxwellSlip
 from motionhyst.identify._element_sensitivities import (
-    expm_small,
     row_derivatives,
     simulate_with_sensitivities,
     stage_matrices,
 )
 from motionhyst.identify.input_output import _LinkLayout
+from motionhyst.lti import expm_small
 from motionhyst.openloop import MassSpringDamper, OpenLoop, fine_input
 
 FS = 750.0

@@ -59,6 +59,7 @@ from scipy.signal import firwin, resample_poly
 from motionhyst._jit import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, advance
+from motionhyst.lti import expm_small
 from motionhyst.simulate import MAX_FIXED_POINT_ITERATIONS
 
 #: Names of the general Bouc-Wen parameters the compiled integrator carries (sensitivity order).
@@ -844,9 +845,7 @@ class OpenLoop:
         M[:ns, :ns] = A * h
         M[:ns, ns] = B * h
         M[ns, ns + 1] = 1.0
-        from scipy.linalg import expm
-
-        E = expm(M)
+        E = expm_small(M)
         B1 = np.ascontiguousarray(E[:ns, ns + 1])
         B0 = np.ascontiguousarray(E[:ns, ns] - B1)
         Ad = np.ascontiguousarray(E[:ns, :ns])

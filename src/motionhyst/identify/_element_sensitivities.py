@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from motionhyst._jit import njit
 from motionhyst.hysteresis.stepping import DAHL, LUGRE, MAXWELL, N_PARAMS, STOP
+from motionhyst.lti import expm_small
 
 #: Element kinds whose update is differentiated here (the others fall back to differences)
 SUPPORTED = (STOP, DAHL, LUGRE, MAXWELL)
@@ -340,44 +341,6 @@ def foh_link_sensitivities(Ad, B0, B1, dAd, dB0, dB1, uf, r, codes, params, dpar
             for b in range(P):
                 sy[o, b] = sx[0, b]
     return y, sy, x, s, sx, ss, worst
-
-
-@njit(cache=True)
-def expm_small(M):  # pragma: no cover - compiled
-    """``exp(M)`` of a small matrix: scaling and squaring of a 20-term Taylor series.
-
-    Compiled loops without BLAS: for the 4x4 and 8x8 matrices of a stage step
-    this is microseconds, where a threaded BLAS can spend milliseconds
-    synchronising its threads on a busy machine.  The series is summed for
-    ``M / 2^s`` with norm at most 1/2, where its remainder is below 1e-19.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> E = expm_small(np.array([[0.0, 1.0], [-1.0, 0.0]]))   # a rotation by 1 rad
-    >>> bool(np.allclose(E, [[np.cos(1), np.sin(1)], [-np.sin(1), np.cos(1)]], atol=1e-15))
-    True
-    """
-    n = M.shape[0]
-    norm = 0.0
-    for i in range(n):
-        row = 0.0
-        for j in range(n):
-            row += abs(M[i, j])
-        norm = max(norm, row)
-    sq = 0
-    while norm > 0.5:
-        norm *= 0.5
-        sq += 1
-    A = M / 2.0 ** sq
-    E = np.eye(n)
-    T = np.eye(n)
-    for kk in range(1, 21):
-        T = (T @ A) / kk
-        E = E + T
-    for _ in range(sq):
-        E = E @ E
-    return E
 
 
 def stage_matrices(m: float, c: float, k: float, h: float):
