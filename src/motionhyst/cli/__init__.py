@@ -11,6 +11,8 @@ command is one module of this package with ``add_parser(sub)`` and
 from __future__ import annotations
 
 import argparse
+import atexit
+import gc
 import importlib
 import os
 import sys
@@ -48,6 +50,18 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``motionhyst`` command; returns the exit code.
 
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments; by default the command line (``sys.argv[1:]``).
+
+    Notes
+    -----
+    Run as the command (`argv` None), it also skips the interpreter's last
+    garbage collections at exit: they would go through every object of the
+    libraries imported (0.2-0.4 s, a sixth of a command's time) only to free
+    memory the operating system takes back anyway.
+
     Examples
     --------
     The ``motionhyst`` command, called from Python (the exit code is returned):
@@ -63,6 +77,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     >>> main(["df", "--k", "-20", "--fc", "0.05", "--amplitude", "0.01"])  # one line on stderr
     2
     """
+    if argv is None:
+        # every atexit handler still runs and every object freed by reference counting still
+        # is (files and temporary folders are closed by the command itself); only unreachable
+        # cycles are left to the operating system
+        atexit.register(gc.freeze)
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
