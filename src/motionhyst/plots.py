@@ -14,7 +14,14 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from motionhyst.figures import LINEAR_COLOR, MODE2_COLOR, MODE3_COLOR, STYLE, _figure
+from motionhyst.figures import (
+    LINEAR_COLOR,
+    MODE2_COLOR,
+    MODE3_COLOR,
+    STYLE,
+    _figure,
+    _minor_log_ticks,
+)
 from motionhyst.hysteresis import Hysteresis, Jenkins
 from motionhyst.hysteresis.periodic import TWO_PI
 
@@ -225,6 +232,7 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
         ax2.set_xlabel("zeta = fc / (k A) [-], k the initial stiffness")
         ax1.set_title(f"Fig. 8: describing function, {_describe(el, frequency_hz)}",
                       fontsize=9)
+    _minor_log_ticks(fig)
     fig.motionhyst_data.update(zeta=z, abs_over_k=np.abs(D) / k0,
                                phase_deg=np.degrees(np.angle(D)))
     return fig
@@ -314,6 +322,7 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     axes[0, -1].set_title(f"this scenario: {el.name} link, {params}", fontsize=9)
     fig.suptitle("Fig. 9: quasi-linear plant P^phi = P2 / (1 + D P1), eq. (12); "
                  "0 dB = 1 m/N", fontsize=10)
+    _minor_log_ticks(fig)
     return fig
 
 
@@ -360,6 +369,7 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
           else f"A = {analysis.amplitude:.3g} m")
     ax.set_title(f"Fig. 10: feedforward mismatch, {at}")
     ax.legend(loc="upper right", fontsize=7)
+    _minor_log_ticks(fig)
     fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
     return fig
 
