@@ -1,8 +1,12 @@
-"""figures.save_figures: every figure in every format, drawn by worker processes or in-process."""
+"""figure_writer: every figure in every format, drawn by worker processes or in-process."""
 
 from __future__ import annotations
 
 import multiprocessing
+import os
+import subprocess
+import sys
+import textwrap
 import time
 
 import matplotlib.image
@@ -10,7 +14,7 @@ import numpy as np
 import pytest
 
 from motionhyst import plots
-from motionhyst.figures import FigureWriter, _lay_out_once, save_figures
+from motionhyst.figure_writer import FigureWriter, _lay_out_once, save_figures
 from motionhyst.hysteresis import Jenkins
 
 EL = Jenkins(k=20.0, fc=0.05)
@@ -119,3 +123,45 @@ def test_writer_reports_the_first_error_with_the_workers_traceback(tmp_path):
             writer.wait()
     assert "in broken" in str(err.value.__cause__)  # where it failed, in the worker
     assert multiprocessing.active_children() == []
+
+
+def test_figures_module_still_offers_the_writer():
+    from motionhyst import figures
+
+    assert figures.FigureWriter is FigureWriter and figures.save_figures is save_figures
+
+
+def test_workers_run_at_a_lower_priority_than_the_caller(tmp_path):
+    def fig5_and_priority():
+        (tmp_path / "nice.txt").write_text(str(os.nice(0)))
+        return MAKERS["fig5"]()
+
+    with FigureWriter(tmp_path, ("png",), parallel=True, nice=3) as writer:
+        writer.submit({"fig5": fig5_and_priority})
+        writer.wait()
+    assert int((tmp_path / "nice.txt").read_text()) == min(os.nice(0) + 3, 19)
+
+
+def test_a_caller_without_matplotlib_leaves_loading_it_to_the_worker(tmp_path):
+    # the caller forks its first worker before importing matplotlib: the worker loads it (and
+    # the backends) and draws; the caller never imports it
+    script = textwrap.dedent(f"""
+        import sys
+        from motionhyst.figure_writer import FigureWriter
+        from motionhyst.hysteresis import Jenkins
+
+        def fig5():
+            from motionhyst.plots import fig5_loops
+            return fig5_loops(Jenkins(k=20.0, fc=0.05))
+
+        with FigureWriter({str(tmp_path)!r}, ("png", "pdf"), parallel=True) as writer:
+            writer.submit({{"fig5": fig5}})
+            assert writer.wait() == ["fig5"]
+        print("matplotlib" in sys.modules)
+    """)
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300, check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "False"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig5.pdf", "fig5.png"]
+    assert matplotlib.image.imread(tmp_path / "fig5.png").shape[0] > 100

@@ -20,8 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm import tqdm
 
-from motionhyst import plots
-from motionhyst.figures import FigureWriter
+from motionhyst.figure_writer import FigureWriter
 from motionhyst.hysteresis.periodic import TWO_PI
 from motionhyst.jsonio import dumps
 from motionhyst.outputs import OutputFolder
@@ -182,6 +181,13 @@ OUTPUT_NAMES = (*(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf")), "sum
 """Every file :func:`reproduce` may write into its folder (besides the manifest)."""
 
 
+def _plots():
+    """:mod:`motionhyst.plots`, imported where a figure is drawn (it imports matplotlib)."""
+    from motionhyst import plots
+
+    return plots
+
+
 def _link_figures(el: Hysteresis, A: float, freqs: list[float]) -> dict:
     """The figures of the link alone (Figs. 5-8): they need neither the loop nor its analysis.
 
@@ -191,11 +197,11 @@ def _link_figures(el: Hysteresis, A: float, freqs: list[float]) -> dict:
     """
     zeta_op = float(el.zeta(A)) if el.defines_zeta else None
     figs = {
-        "fig5": lambda: plots.fig5_loops(el, frequency_hz=freqs[0]),
-        "fig6": lambda: plots.fig6_modes(el),
-        "fig7": lambda: plots.fig7_time(el, A, freqs[0]),
-        "fig8": lambda: plots.fig8_describing_function(el, frequency_hz=freqs[0],
-                                                       zeta_op=zeta_op),
+        "fig5": lambda: _plots().fig5_loops(el, frequency_hz=freqs[0]),
+        "fig6": lambda: _plots().fig6_modes(el),
+        "fig7": lambda: _plots().fig7_time(el, A, freqs[0]),
+        "fig8": lambda: _plots().fig8_describing_function(el, frequency_hz=freqs[0],
+                                                          zeta_op=zeta_op),
     }
     if not el.defines_zeta:
         del figs["fig6"], figs["fig7"]
@@ -261,8 +267,10 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             # the link's compiled kernels (numba), loaded here once: the steady states need them
             # and the workers forked from now on inherit them instead of loading their own
             el.sine_loop(A, None if el.rate_independent else TWO_PI * freqs[0])
-            figures.submit(_link_figures(el, A, freqs))  # need no loop: drawn while it is built
-            # the analysis (python-control) is imported only now, while the worker draws
+            # Figs. 5-8 need no loop: a worker loads matplotlib and draws them while this process
+            # imports the analysis (python-control) and builds the loop; the later workers
+            # inherit matplotlib from this process (python-control imports it)
+            figures.submit(_link_figures(el, A, freqs))
             from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
             from motionhyst.steady import periodic_steady_state
             from motionhyst.systems import MeasuredPlant
@@ -270,7 +278,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             loop = sc.loop()
             analysis = analyze(loop, A, freqs)
             steps.update()
-            figures.submit({"fig9": lambda: plots.fig9_quasilinear_plant(
+            figures.submit({"fig9": lambda: _plots().fig9_quasilinear_plant(
                 loop, f_star_hz=analysis.f_star_hz)})
             fit = sc.plant_fit()
             if fit is not None:
@@ -282,13 +290,13 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 states = [periodic_steady_state(loop, A, f) for f in freqs]
                 E_df = loop_mismatch(loop, freqs, A)
                 H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
-                figures.submit({"fig11": lambda: plots.fig11_errors(states, E_df, H_df)})
+                figures.submit({"fig11": lambda: _plots().fig11_errors(states, E_df, H_df)})
                 steps.update()
                 lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
                 f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
                 f_exact = np.unique(np.concatenate([f_exact, freqs]))
                 exact = [periodic_steady_state(loop, A, f) for f in f_exact]
-            figures.submit({"fig10": lambda: plots.fig10_mismatch(loop, analysis, exact)})
+            figures.submit({"fig10": lambda: _plots().fig10_mismatch(loop, analysis, exact)})
             steps.update()
             summary = {
                 "scenario": sc.to_dict(),
