@@ -375,6 +375,66 @@ def test_rate_dependent_figures_need_a_frequency():
     assert_allclose(data.motionhyst_data["abs_over_k"], np.abs(D) / 20.0, rtol=1e-14)
 
 
+LUGRE = LuGre(sigma0=20.0, sigma1=0.1, sigma2=0.01, fc=0.05, fs=0.06, vs=0.01)
+
+
+class _Counted:
+    """A link whose describing function counts the frequencies it is computed at."""
+
+    def __init__(self, el):
+        self.el, self.rate_independent, self.computed = el, el.rate_independent, 0
+
+    def describing_function(self, A, omega=None):
+        self.computed += np.size(omega)
+        return self.el.describing_function(A, omega)
+
+
+@pytest.mark.parametrize("A", [2.5e-1, 1e-2, 2.5e-3, 1e-5])  # zeta 0.01 to 1, and far below
+def test_describing_function_curve_of_lugre_is_exact_from_a_sixth_of_the_points(A):
+    w = 2 * np.pi * np.geomspace(0.01, 100.0, 600)  # Fig. 9's grid
+    counted = _Counted(LUGRE)
+    D = plots.describing_function_curve(counted, A, w)
+    exact = LUGRE.describing_function(A, w)
+    assert np.max(np.abs(D - exact) / np.abs(exact)) < 1e-5
+    assert counted.computed <= 600 // 6 + 2
+
+
+class _Notch:
+    """A rate-dependent describing function with a notch narrower than the coarse grid."""
+
+    rate_independent = False
+
+    def __init__(self, omega0):
+        self.omega0 = omega0
+
+    def describing_function(self, A, omega=None):
+        u = np.log(np.asarray(omega) / self.omega0) / 2e-3
+        return (1.0 + 0.5j) * (1.0 - 0.5 / (1.0 + u**2)) * np.ones_like(u)
+
+
+def test_describing_function_curve_computes_each_point_where_the_spline_misses():
+    w = 2 * np.pi * np.geomspace(0.01, 100.0, 600)
+    notch = _Notch(w[305])  # between two points of the coarse grid (every 12th)
+    D = plots.describing_function_curve(notch, 0.01, w)
+    assert_allclose(D, notch.describing_function(0.01, w), rtol=1e-4)
+
+
+def test_figures_of_a_lugre_loop_draw_its_exact_curves(loop):
+    from motionhyst.loop import Loop
+
+    lugre_loop = Loop(loop.plant, loop.controller, LUGRE, feedforward="rigid-body")
+    f = np.geomspace(0.01, 100.0, 600)
+    w = 2 * np.pi * f
+    data = plots.fig9_quasilinear_plant(lugre_loop, paper=False).motionhyst_data
+    P1, P2 = freqresp(lugre_loop.P1, w), freqresp(lugre_loop.P2, w)
+    A = 0.05 / (20.0 * 0.25)
+    exact = P2 / (1 + LUGRE.describing_function(A, w) * P1)
+    assert_allclose(data["zeta=0.25"], exact, rtol=1e-5)
+    analysis = analyze(lugre_loop, 0.01, [5.0])
+    d10 = plots.fig10_mismatch(lugre_loop, analysis).motionhyst_data
+    assert_allclose(d10["E"], loop_mismatch(lugre_loop, d10["f"], 0.01), rtol=1e-5)
+
+
 def test_reproduce_with_another_model_draws_its_figures(tmp_path):
     sc = default_scenario()
     data = sc.to_dict()

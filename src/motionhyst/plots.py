@@ -53,6 +53,76 @@ def _frequency_range(loop: Loop, f_range):
     return max(f_range[0], lo), min(f_range[1], hi)
 
 
+def describing_function_curve(el: Hysteresis, A: float, omega: ArrayLike, stride: int = 12,
+                              rtol: float = 1e-4) -> np.ndarray:
+    """``D(A, omega)`` (eq. 7) of `el` along a dense frequency grid, for a figure's curve.
+
+    A rate-independent link has one value.  For a rate-dependent one (LuGre),
+    each value is a periodic steady state; along a smooth curve of hundreds
+    of frequencies most of them can be interpolated: ``D`` is computed on
+    every `stride`-th frequency and at the last, and interpolated in
+    between by a cubic spline in ``log omega``; it is also computed at the
+    middle of each interval, and wherever the spline is off there by more
+    than `rtol` times ``|D|`` every frequency of the interval is computed.
+    The rest is interpolated through the coarse grid and the middles.
+
+    Parameters
+    ----------
+    el : Hysteresis
+        The link model.
+    A : float
+        Amplitude [m].
+    omega : array_like
+        Increasing angular frequencies [rad/s], > 0.
+    stride : int
+        Frequencies per interval of the first, coarse grid.
+    rtol : float
+        Largest relative error of the interpolation at the intervals' middles.
+
+    Returns
+    -------
+    ndarray of complex
+        ``D`` at `omega` [N/m].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import LuGre
+    >>> from motionhyst.plots import describing_function_curve
+    >>> el = LuGre(sigma0=20.0, sigma1=0.1, sigma2=0.01, fc=0.05, fs=0.06, vs=0.01)
+    >>> w = 2 * np.pi * np.geomspace(0.1, 100.0, 200)
+    >>> D = describing_function_curve(el, 0.01, w)
+    >>> exact = el.describing_function(0.01, w)
+    >>> bool(np.max(np.abs(D - exact) / np.abs(exact)) < 1e-4)
+    True
+    """
+    w = np.asarray(omega, dtype=float)
+    if el.rate_independent:
+        return np.full(w.shape, complex(el.describing_function(A)))
+    n = len(w)
+    if n < 4 * stride or np.any(w <= 0) or np.any(np.diff(w) <= 0):
+        return np.asarray(el.describing_function(A, w), dtype=complex)
+    from scipy.interpolate import CubicSpline
+
+    x = np.log(w)
+    D = np.full(n, np.nan, dtype=complex)
+    coarse = np.unique(np.r_[np.arange(0, n, stride), n - 1])
+    D[coarse] = el.describing_function(A, w[coarse])
+    middle = (coarse[:-1] + coarse[1:]) // 2
+    D[middle] = el.describing_function(A, w[middle])
+    guess = CubicSpline(x[coarse], D[coarse])(x[middle])
+    missed = np.abs(guess - D[middle]) > rtol * np.abs(D[middle])
+    for i in np.nonzero(missed)[0]:
+        todo = np.arange(coarse[i] + 1, coarse[i + 1])
+        D[todo] = el.describing_function(A, w[todo])
+    # the rest from the coarse grid and the middles of the smooth intervals only: a sharp
+    # turn computed point by point would make a spline through it ring into its neighbours
+    knots = np.union1d(coarse, middle[~missed])
+    rest = np.isnan(D)
+    D[rest] = CubicSpline(x[knots], D[knots])(x[rest])
+    return D
+
+
 def _sine_loop(el: Hysteresis, A: float, frequency_hz: float | None = None):
     """One period of the periodic response to ``x = A sin(theta)``: ``x, w``."""
     return el.sine_loop(A, None if el.rate_independent else TWO_PI * frequency_hz)
@@ -251,7 +321,7 @@ def _fig9_panel(ax1, ax2, P1, P2, el, zetas, f, f_star_hz, data, prefix=""):
     fc_total = _force_scale(el)
     for i, z in enumerate(zetas):
         A = fc_total / (el.initial_stiffness * z)
-        D = el.describing_function(A, w if not el.rate_independent else None)
+        D = describing_function_curve(el, A, w)
         Pphi = P2 / (1.0 + D * P1)
         c = cmap(i / max(1, len(zetas) - 1))
         label = (f"zeta = {z:g} (A = {A * 1e3:.4g} mm)" if jenkins
@@ -334,8 +404,9 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
 
     fig, (ax,) = _figure()
     f = _grid(loop, f_range, 800)
-    E = loop_mismatch(loop, f, analysis.amplitude)
     w = TWO_PI * f
+    E = loop_mismatch(loop, f, analysis.amplitude, describing_function=describing_function_curve(
+        loop.hysteresis, analysis.amplitude, w))
     Pr = 1.0 / (loop.M * (1j * w) ** 2)
     P2 = freqresp(loop.P2, w)
     Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - P2

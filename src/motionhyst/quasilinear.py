@@ -237,17 +237,22 @@ def _parts(loop: Loop, omega: NDArray[np.float64]):
 
 
 def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayLike,
-                  reference_amplitude: float | None = None) -> NDArray[np.complex128]:
+                  reference_amplitude: float | None = None,
+                  describing_function: ArrayLike | None = None) -> NDArray[np.complex128]:
     """Mismatch ``E`` of eq. (18) for `loop` at the given frequencies [Hz].
 
     `amplitude` is the amplitude of ``y1`` that sets ``D``: a scalar, or one
-    per frequency.  Rate-dependent elements get ``D(A, omega)``.  With
+    per frequency.  Rate-dependent elements get ``D(A, omega)``; a `describing_function`
+    given (one value per frequency, already computed) is used instead.  With
     hysteresis feedforward the residual mismatch is returned, its model driven
     by the reference of amplitude `reference_amplitude` (default `amplitude`).
     """
     f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
     omega = TWO_PI * f
-    D = loop.hysteresis.describing_function(np.broadcast_to(amplitude, f.shape), omega)
+    if describing_function is not None:
+        D = np.broadcast_to(np.asarray(describing_function, dtype=complex), f.shape)
+    else:
+        D = loop.hysteresis.describing_function(np.broadcast_to(amplitude, f.shape), omega)
     if loop.hysteresis_feedforward is None:
         return mismatch(*_parts(loop, omega), D)
     a_ref = amplitude if reference_amplitude is None else reference_amplitude
