@@ -19,8 +19,9 @@
    run in increasing order, so the figure of the larger is its own), and the
    ratio of the times.
 4. Figures: ``motionhyst reproduce`` (figures, report) against
-   ``motionhyst analyze`` (numbers only) on Table I (fresh processes,
-   interleaved, median of ``REPORT_REPEATS``).
+   ``motionhyst analyze`` (numbers only) on Table I, and on Table I with a
+   LuGre link (:data:`LUGRE_LINK`) (fresh processes, interleaved, median of
+   ``REPORT_REPEATS``).
 
 Commands run as fresh processes are timed by wall clock (the targets) and by
 CPU time (user + system, worker processes included), which a machine shared
@@ -48,7 +49,7 @@ import numpy as np
 
 STARTUP_REPEATS = 15
 STEADY_POINTS = 40
-REPORT_REPEATS = 3
+REPORT_REPEATS = 5
 IDENTIFY_SIZES = (100_000, 1_000_000)
 
 SECTIONS = ("startup", "steady", "identify", "report")
@@ -178,13 +179,37 @@ def identification(sizes: tuple[int, ...]) -> dict:
             "length_ratio": runs[-1]["samples"] / runs[0]["samples"]}
 
 
+#: The Table I scenario with a LuGre link instead of the Jenkins element (a rate-dependent link:
+#: its figures need periodic steady states for their describing functions).
+LUGRE_LINK = ("[hysteresis]\nmodel = \"lugre\"\nsigma0 = 20.0\nsigma1 = 0.1\nsigma2 = 0.01\n"
+              "fc = 0.05\nfs = 0.06\nvs = 0.01\n")
+
+
+def _lugre_scenario(folder: str) -> str:
+    """The Table I scenario file with :data:`LUGRE_LINK` as its link, written into `folder`."""
+    from motionhyst.scenario import default_scenario_path
+
+    text = default_scenario_path().read_text()
+    start = text.index("[hysteresis]")
+    end = text.index("\n[", start) + 1  # the next section
+    path = Path(folder) / "lugre.toml"
+    path.write_text(text[:start] + LUGRE_LINK + "\n" + text[end:])
+    return str(path)
+
+
 def report(repeats: int) -> dict:
     with tempfile.TemporaryDirectory() as d:
+        lugre = _lugre_scenario(d)
         t = _interleaved({"analyze": _command("analyze"),
-                          "reproduce": _command("reproduce", "--out", "out", "--quiet")},
+                          "reproduce": _command("reproduce", "--out", "out", "--quiet"),
+                          "analyze_lugre": _command("analyze", lugre),
+                          "reproduce_lugre": _command("reproduce", lugre, "--out", "out-lugre",
+                                                      "--quiet")},
                          repeats, cwd=d)
     return {**t, "ratio": t["reproduce"] / t["analyze"],
-            "cpu_ratio": t["reproduce_cpu"] / t["analyze_cpu"]}
+            "cpu_ratio": t["reproduce_cpu"] / t["analyze_cpu"],
+            "ratio_lugre": t["reproduce_lugre"] / t["analyze_lugre"],
+            "cpu_ratio_lugre": t["reproduce_lugre_cpu"] / t["analyze_lugre_cpu"]}
 
 
 def _verdict(value: float, target: float) -> str:
@@ -236,6 +261,12 @@ def print_results(res: dict) -> None:
               f"{r['ratio']:6.2f}x; CPU {r['reproduce_cpu']:.2f} s, {r['cpu_ratio']:.2f}x  "
               f"(target <= {TARGETS['reproduce']:g}x: "
               f"{_verdict(r['ratio'], TARGETS['reproduce'])})")
+        print("  the same scenario with a LuGre link:")
+        print(f"  motionhyst analyze lugre.toml           {r['analyze_lugre']:8.2f} s    1.00x; "
+              f"CPU {r['analyze_lugre_cpu']:.2f} s")
+        print(f"  motionhyst reproduce lugre.toml         {r['reproduce_lugre']:8.2f} s "
+              f"{r['ratio_lugre']:6.2f}x; CPU {r['reproduce_lugre_cpu']:.2f} s, "
+              f"{r['cpu_ratio_lugre']:.2f}x")
 
 
 def main(argv: list[str] | None = None) -> int:
