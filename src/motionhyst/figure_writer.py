@@ -78,10 +78,11 @@ _warm_formats: set[str] = set()
 
 
 def _warm_up(formats: Sequence[str]) -> None:
-    """Load what drawing any figure loads at its first use, once per process.
+    """Load what drawing any figure loads at its first use, once, before forking workers.
 
     The formats' backends, the font and the math-text parser (tick labels of
-    log axes); workers forked afterwards inherit them.
+    log axes): each worker forked afterwards inherits them instead of loading
+    its own.
     """
     todo = [fmt for fmt in formats if fmt not in _warm_formats]
     if not todo:
@@ -106,8 +107,7 @@ def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[
                 conn, nice: int) -> None:
     """A worker's job: draw `makers` in order, sending each name (or the error) on `conn`.
 
-    The worker lowers its priority by `nice` and loads matplotlib's backends
-    if the caller had not (:func:`_warm_up`).  A kernel compiled here is not
+    The worker lowers its priority by `nice`.  A kernel compiled here is not
     announced on stderr: the caller announces its own.
     """
     from motionhyst._jit import quiet_compilation
@@ -120,7 +120,6 @@ def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[
     try:
         if nice > 0:
             os.nice(nice)
-        _warm_up(formats)
         for name, make in makers.items():
             _draw_and_save(name, make, folder, formats)
             conn.send(("done", name))
@@ -174,7 +173,7 @@ class FigureWriter:
     second to load at their first use.  If the caller has imported
     matplotlib, :meth:`submit` loads them once in the caller and every worker
     inherits them; if not (a caller forking its first worker straight away),
-    each worker loads them itself, so the caller goes on at once.
+    the worker loads what its figures need, and the caller goes on at once.
 
     Examples
     --------
