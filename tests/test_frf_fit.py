@@ -21,9 +21,13 @@ LINES = np.geomspace(1.0, 3000.0, 60)  # the issue's measurement: 60 log-spaced 
 NOISE = 0.005  # 0.5 % complex noise, relative to the response
 
 
-def measure(plant: ModalPlant, f=LINES, noise=NOISE, seed=0):
-    """P1, P2 of `plant` at `f` with relative complex Gaussian noise of RMS `noise`."""
+def measure(plant: ModalPlant, f=LINES, noise=NOISE, seed=0, delay=0.0):
+    """P1, P2 of `plant` at `f` with relative complex Gaussian noise of RMS `noise`, delayed by
+    `delay` [s] (a measurement chain's e^{-s tau} on both)."""
     p1, p2 = plant.response(2 * np.pi * f)
+    if delay:
+        lag = np.exp(-2j * np.pi * f * delay)
+        p1, p2 = p1 * lag, p2 * lag
     rng = np.random.default_rng(seed)
 
     def noisy(p):
@@ -206,6 +210,151 @@ def test_result_reports_bands_dict_text_and_figure(noisy_fit):
     assert noisy_fit.plant.modes[0].frequency_hz in data["f"]
 
 
+# ------------------------------------------------------------------ a delay in the measurement
+DELAY = 50e-6  # 50 us: about one sample of a 20 kHz controller
+
+
+@pytest.fixture(scope="module")
+def delayed_fit(exact) -> FrfFit:
+    return fit_frf(LINES, *measure(exact, seed=0, delay=DELAY), source="delayed.csv")
+
+
+def test_delay_is_estimated_and_the_modes_are_those_without_it(delayed_fit, noisy_fit, exact):
+    """Table I measured through 50 us: one mode, M and the mode within their uncertainty, and
+    the delay within its own (about 0.1 us).  Without the delay in the model the same data
+    gave five spurious modes and Pf2(0) five times off."""
+    fit = delayed_fit
+    assert len(fit.plant.modes) == 1 and fit.warnings == []
+    assert 0 < fit.delay_std_s < 1e-6
+    assert abs(fit.delay_s - DELAY) < 4 * fit.delay_std_s
+    m, e, s = fit.plant.modes[0], exact.modes[0], fit.mode_std[0]
+    for value, truth, std in ((fit.plant.M, 22.5, fit.M_std),
+                              (m.frequency_hz, e.frequency_hz, s["frequency_hz"]),
+                              (m.damping, e.damping, s["damping"]), (m.r1, e.r1, s["r1"]),
+                              (m.r2, e.r2, s["r2"]),
+                              (fit.plant.pf2_static, exact.pf2_static, fit.pf2_static_std)):
+        assert 0 < std < 0.05 * abs(truth)
+        assert abs(value - truth) < 4 * std, (value, truth, std)
+    # the uncertainties are those of the fit without a delay, within 10 %
+    assert fit.pf2_static_std == pytest.approx(noisy_fit.pf2_static_std, rel=0.1)
+    # the delay is divided out of the data the plant is compared with: errors are the noise
+    assert fit.rms_relative_error == pytest.approx(NOISE, rel=0.2)
+    lag = np.exp(-2j * np.pi * LINES * fit.delay_s)
+    assert_allclose(fit.P1_data * lag, measure(exact, seed=0, delay=DELAY)[0], rtol=1e-12)
+    # the BIC of the fits without a delay is far higher: they are kept for the record
+    assert min(fit.bic_other.values()) > min(fit.bic.values()) + 100
+    d = fit.to_dict()
+    assert d["delay_s"] == fit.delay_s and d["warnings"] == [] and not d["delay_given"]
+    assert "delay = 50" in str(fit) and " us (e^(-s tau)" in str(fit)
+
+
+def test_delayed_table_I_gives_the_mismatch_of_the_stage(delayed_fit, noisy_fit, controller,
+                                                        link):
+    """|E| at 1, 5, 10 Hz from the delayed data as from the data without delay (0.1 %) and
+    as for the exact stage (2 %, the issue's target); without the delay in the model |E| at
+    1 Hz was 5 times too small."""
+    freqs = [1.0, 5.0, 10.0]
+    a = analyze(Loop(delayed_fit.plant, controller, link), 0.01, freqs)
+    b = analyze(Loop(noisy_fit.plant, controller, link), 0.01, freqs)
+    c = analyze(Loop(TABLE_I, controller, link), 0.01, freqs)
+    for p, q, r in zip(a.points, b.points, c.points, strict=True):
+        assert abs(p.value - q.value) < 1e-3 * abs(q.value), p.frequency_hz
+        assert abs(p.value - r.value) < 0.02 * abs(r.value), p.frequency_hz
+    assert a.mismatch_crossover_hz == pytest.approx(c.mismatch_crossover_hz, rel=0.01)
+
+
+def test_noise_free_delayed_data_are_recovered_exactly(exact):
+    for delay in (10e-6, 200e-6):  # 200 us: 3.8 rad of phase at the highest line
+        fit = fit_frf(LINES, *measure(exact, noise=0.0, delay=delay))
+        assert fit.delay_s == pytest.approx(delay, rel=1e-8)
+        assert fit.plant.M == pytest.approx(22.5, rel=1e-8)
+        assert fit.plant.pf2_static == pytest.approx(exact.pf2_static, rel=1e-7)
+        assert fit.rms_relative_error < 1e-8 and fit.warnings == []
+
+
+def test_two_modes_through_a_delay():
+    truth = ModalPlant(22.5, [Mode(694.0, 0.003, 0.1555, 0.0444),
+                              Mode(1800.0, 0.01, 0.05, -0.02)])
+    fit = fit_frf(LINES, *measure(truth, seed=5, delay=DELAY))
+    assert len(fit.plant.modes) == 2 and fit.warnings == []
+    assert abs(fit.delay_s - DELAY) < 4 * fit.delay_std_s
+    for m, t in zip(fit.plant.modes, truth.modes, strict=True):
+        assert m.frequency_hz == pytest.approx(t.frequency_hz, rel=1e-3)
+        assert m.r2 == pytest.approx(t.r2, rel=0.01)
+    assert fit.plant.pf2_static == pytest.approx(truth.pf2_static, rel=0.01)
+
+
+def test_no_delay_is_found_in_data_without_one(exact):
+    """0 when there is none: a delay must lower the BIC by more than its one parameter costs,
+    which the noise alone does not (12 draws), and the fit is then the fit without delay."""
+    for seed in range(12):
+        data = measure(exact, seed=seed)
+        fit = fit_frf(LINES, *data, modes=1)
+        assert fit.delay_s == 0.0 and fit.delay_std_s == 0.0 and fit.warnings == [], seed
+        assert_allclose(fit.P1_data, data[0], rtol=0, atol=0)
+        assert set(fit.bic_other) == {0, 1}  # the fits with a delay were tried
+    assert "delay = 0 (a delay" in str(fit)
+
+
+def test_given_delay_is_divided_out(exact, noisy_fit):
+    """A known delay is divided out before the fit: the fit of the data without it."""
+    fit = fit_frf(LINES, *measure(exact, seed=0, delay=DELAY), delay=DELAY)
+    assert fit.delay_given and fit.delay_s == DELAY and fit.delay_std_s == 0.0
+    assert fit.bic_other == {}
+    assert fit.plant.M == pytest.approx(noisy_fit.plant.M, rel=1e-9)
+    assert fit.plant.pf2_static == pytest.approx(noisy_fit.plant.pf2_static, rel=1e-7)
+    assert "delay = 50 us (given" in str(fit)
+
+
+# ------------------------------------------------------------------ what the model cannot describe
+def two_mass_held(f, k_ground, m1=5.0, m2=17.5, b=90.0, k=7.4e7):
+    """P1, P2 of Table I with a spring `k_ground` from m1 to the ground (a link that sticks)."""
+    s = 2j * np.pi * np.asarray(f)
+    z11, z22, z12 = m1 * s**2 + b * s + k + k_ground, m2 * s**2 + b * s + k, -(b * s + k)
+    det = z11 * z22 - z12**2
+    return z22 / det, -z12 / det
+
+
+def noisy(p, seed):
+    rng = np.random.default_rng(seed)
+    return p * (1.0 + NOISE * (rng.standard_normal(p.shape)
+                               + 1j * rng.standard_normal(p.shape)) / np.sqrt(2.0))
+
+
+def test_stuck_link_is_reported_not_fitted_silently(controller, link):
+    """Table I's link stuck (k_J = 20 N/m to the ground at m1): the automatic choice chases
+    it with a mode below the lowest line and a negative Pf2(0), and |E| at 1 Hz is 1000
+    times off; the fit says so in one line."""
+    p1, p2 = two_mass_held(LINES, 20.0)
+    fit = fit_frf(LINES, noisy(p1, 0), noisy(p2, 1))
+    assert fit.plant.pf2_static < 0 and fit.plant.modes[0].frequency_hz < LINES[0]
+    (warning,) = fit.warnings
+    assert "\n" not in warning and "not a floating rigid body" in warning
+    assert "Pf2(0) = -" in warning and "below the lowest line 1 Hz" in warning
+    assert "stiffness to ground" in warning and "sticking link" in warning
+    assert f"  warning: {warning}" in str(fit).splitlines()
+    assert fit.to_dict()["warnings"] == [warning]
+    E = analyze(Loop(fit.plant, controller, link), 0.01, [1.0]).points[0].value
+    E_exact = analyze(Loop(TABLE_I, controller, link), 0.01, [1.0]).points[0].value
+    assert abs(E) < 0.01 * abs(E_exact)  # what the warning is about
+
+
+def test_errors_far_above_the_noise_are_reported():
+    """A stiffness to ground the modes are not allowed to chase (modes given), and a sensor
+    low-pass that is no pure delay: the errors stand far above their line-to-line scatter."""
+    p1, p2 = two_mass_held(LINES, 200.0)
+    fit = fit_frf(LINES, noisy(p1, 0), noisy(p2, 1), modes=1)
+    (warning,) = fit.warnings
+    assert "errors far above the data's noise" in warning and "at 1-8.769 Hz (RMS 0.07" in warning
+    exact = ModalPlant.from_two_mass(TABLE_I)
+    lowpass = 1.0 / (1.0 + 1j * LINES / 2000.0)
+    p1, p2 = exact.response(2 * np.pi * LINES)
+    fit = fit_frf(LINES, noisy(p1 * lowpass, 0), noisy(p2 * lowpass, 1), modes=1)
+    assert any("errors far above the data's noise" in w for w in fit.warnings)
+    # the same data with the low-pass divided out: no warning
+    assert fit_frf(LINES, noisy(p1, 0), noisy(p2, 1), modes=1).warnings == []
+
+
 # ------------------------------------------------------------------ errors
 @pytest.mark.parametrize(("kwargs", "fragment"), [
     ({"modes": 20}, "cannot determine 20 modes"),
@@ -213,6 +362,8 @@ def test_result_reports_bands_dict_text_and_figure(noisy_fit):
     ({"modes": 1.5}, "whole number"),
     ({"mass": -1.0}, "mass must be"),
     ({"mass": math.nan}, "mass must be"),
+    ({"delay": -1e-6}, "delay must be"),
+    ({"delay": math.inf}, "delay must be"),
 ])
 def test_bad_options(exact, kwargs, fragment):
     f = LINES[:40]
@@ -305,6 +456,50 @@ def test_cli_identify_closed_loop_runs_on_the_fitted_plant(capsys, tmp_path, exa
     assert main(["identify", str(tmp_path / "rec.csv"), "--scenario", toml]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and 'use = "data"' in err
+
+
+def test_cli_warns_of_a_plant_the_model_cannot_describe(capsys, tmp_path):
+    """A stuck link in the measurement: every command on the fitted plant says so on stderr
+    (one line, exit 0), analyze also in the fit it prints and in its JSON."""
+    import json
+
+    from motionhyst.cli import main
+
+    p1, p2 = two_mass_held(LINES, 20.0)
+    write_frd(tmp_path / "p.csv", LINES, noisy(p1, 0), noisy(p2, 1))
+    toml = frd_toml(tmp_path, "")
+    assert main(["analyze", toml, "--frequency", "5"]) == 0
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        "motionhyst: warning: analyze: measured plant: the lowest lines are not a floating "
+        "rigid body (Pf2(0) = -")
+    assert "  warning: measured plant: the lowest lines" in out
+    assert main(["analyze", toml, "--frequency", "5", "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["plant_fit"]["warnings"] == [lines[0].split("analyze: ", 1)[1]]
+    assert err.splitlines() == lines
+    assert main(["steady", toml, "--frequency", "5"]) == 0
+    assert capsys.readouterr().err.splitlines() == [lines[0].replace("analyze", "steady", 1)]
+
+
+def test_cli_analyze_of_delayed_data_and_a_given_delay(capsys, tmp_path, exact):
+    import json
+
+    from motionhyst.cli import main
+
+    write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0, delay=DELAY))
+    for extra in ("", "delay = 5e-5"):
+        toml = frd_toml(tmp_path, extra)
+        assert main(["analyze", toml, "--frequency", "1", "5", "--json"]) == 0
+        out, err = capsys.readouterr()
+        d = json.loads(out)
+        assert err == "" and d["plant_fit"]["warnings"] == []
+        assert d["plant_fit"]["delay_given"] == bool(extra)
+        assert d["plant_fit"]["delay_s"] == pytest.approx(DELAY, rel=0.01)
+        assert len(d["plant_fit"]["modes"]) == 1
+        for p, exact_abs in zip(d["mismatch"], (3349.0, 6.04), strict=True):
+            assert p["abs"] == pytest.approx(exact_abs, rel=0.02)
 
 
 # ------------------------------------------------------------- use = "data"

@@ -551,6 +551,8 @@ def test_frd_plant_modes_given(tmp_path):
     ({"modes": 1.5}, "modes"),
     ({"modes": True}, "modes"),
     ({"modes": 21}, "modes"),
+    ({"delay": -1e-6}, "delay"),
+    ({"use": "data", "delay": 5e-5}, "delay applies to use"),
 ])
 def test_bad_plant_fit_options(tmp_path, plant, fragment):
     write_frd_csv(tmp_path / "p.csv", np.geomspace(1.0, 3000.0, 60))

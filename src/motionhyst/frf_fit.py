@@ -230,40 +230,67 @@ class ModalPlant:
 
 
 # ------------------------------------------------------------------------------------ fitting
-def _unpack(x: NDArray[np.float64], n: int, mass: float | None):
-    k = 0
-    if mass is None:
-        M, k = float(np.exp(x[0])), 1
-    else:
-        M = mass
-    p = x[k:].reshape(n, 4) if n else np.zeros((0, 4))
-    return M, np.exp(p[:, 0]), np.exp(p[:, 1]), p[:, 2], p[:, 3]
-
-
 class _Problem:
-    """Relative complex residuals of P1 and P2 and their Jacobian (real and imaginary parts)."""
+    """Relative complex residuals of P1 and P2 and their Jacobian (real and imaginary parts).
 
-    def __init__(self, f, p1, p2, mass):
+    The parameters are ``ln M`` (unless the mass is given), the delay ``tau``
+    [s] (when it is fitted) and ``ln w, ln z, r1, r2`` of each mode.  The
+    delay is divided out of the data, ``(P_model - P_data e^{s tau}) /
+    |P_data|``, which has the modulus of ``(P_model e^{-s tau} - P_data) /
+    |P_data|``: the model itself stays the mechanics.
+    """
+
+    def __init__(self, f, p1, p2, mass, fit_delay: bool = False):
         self.f = f
         self.s = 1j * TWO_PI * f
         self.p1, self.p2 = p1, p2
         self.w1, self.w2 = 1.0 / np.abs(p1), 1.0 / np.abs(p2)
         self.mass = mass
+        self.fit_delay = fit_delay
+        self.n_head = int(mass is None) + int(fit_delay)
+
+    def unpack(self, x: NDArray[np.float64], n: int):
+        """``M, tau, w, z, r1, r2`` from the parameter vector `x` of `n` modes."""
+        k = 0
+        if self.mass is None:
+            M, k = float(np.exp(x[0])), 1
+        else:
+            M = self.mass
+        tau = 0.0
+        if self.fit_delay:
+            tau, k = float(x[k]), k + 1
+        p = x[k:].reshape(n, 4) if n else np.zeros((0, 4))
+        return M, tau, np.exp(p[:, 0]), np.exp(p[:, 1]), p[:, 2], p[:, 3]
+
+    def pack(self, M, tau, wn, z, r1, r2) -> NDArray[np.float64]:
+        """The parameter vector of :meth:`unpack`."""
+        head = [np.log(M)] if self.mass is None else []
+        head += [tau] if self.fit_delay else []
+        body = np.column_stack([np.log(wn), np.log(z), r1, r2]).ravel() if len(wn) else []
+        return np.concatenate([head, body])
+
+    def data(self, tau: float):
+        """The measured ``P1``, ``P2`` with the delay `tau` divided out, ``P e^{s tau}``."""
+        if tau == 0.0:
+            return self.p1, self.p2
+        rot = np.exp(self.s * tau)
+        return self.p1 * rot, self.p2 * rot
 
     def model(self, x, n):
-        M, wn, z, r1, r2 = _unpack(x, n, self.mass)
+        M, tau, wn, z, r1, r2 = self.unpack(x, n)
         s = self.s[:, None]
         g = 1.0 / (s**2 + 2 * z * wn * s + wn**2)
         pr = 1.0 / (M * self.s**2)
-        return pr + g @ r1, pr - g @ r2, g, M, wn, z, r1, r2
+        return pr + g @ r1, pr - g @ r2, g, M, tau, wn, z, r1, r2
 
     def residuals(self, x, n):
-        m1, m2, *_ = self.model(x, n)
-        c = np.concatenate([(m1 - self.p1) * self.w1, (m2 - self.p2) * self.w2])
+        m1, m2, _, _, tau, *_ = self.model(x, n)
+        d1, d2 = self.data(tau)
+        c = np.concatenate([(m1 - d1) * self.w1, (m2 - d2) * self.w2])
         return np.concatenate([c.real, c.imag])
 
     def jacobian(self, x, n):
-        _, _, g, M, wn, z, r1, r2 = self.model(x, n)
+        _, _, g, M, tau, wn, z, r1, r2 = self.model(x, n)
         s = self.s[:, None]
         nf = self.f.size
         cols = []
@@ -271,6 +298,9 @@ class _Problem:
         if self.mass is None:
             dpr = -1.0 / (M * self.s**2)  # d/d ln M
             cols.append(np.concatenate([dpr * self.w1, dpr * self.w2]))
+        if self.fit_delay:
+            d1, d2 = self.data(tau)  # d/d tau of -P_data e^{s tau}
+            cols.append(np.concatenate([-self.s * d1 * self.w1, -self.s * d2 * self.w2]))
         dg_dlnw = -(2 * z * wn * s + 2 * wn**2) * g**2
         dg_dlnz = -(2 * z * wn * s) * g**2
         for i in range(n):
@@ -283,12 +313,8 @@ class _Problem:
         J = np.array(cols).T
         return np.vstack([J.real, J.imag])
 
-    def linear_start(self, wn, z, extra=None):
-        """Solve ``1/M`` and the residues for fixed poles; with `extra` candidate poles scanned.
-
-        Returns ``(rss, a, r1, r2)`` for the fixed poles alone, or the index of the
-        best candidate and its solution when `extra = (wn_c, z_c)` arrays are given.
-        """
+    def _fixed(self, wn, z, taus):
+        """Columns of the linear parameters for fixed poles, and the data (one column per delay)."""
         s = self.s[:, None]
         nf = self.f.size
         fixed = []
@@ -299,26 +325,49 @@ class _Problem:
         for i in range(wn.size):
             fixed.append(np.concatenate([g[:, i] * self.w1, zero]))
             fixed.append(np.concatenate([zero, -g[:, i] * self.w2]))
-        y = np.concatenate([self.p1 * self.w1, self.p2 * self.w2])
-        if self.mass is not None:
-            pr = 1.0 / (self.mass * self.s**2)
-            y = y - np.concatenate([self.w1 * pr, self.w2 * pr])
-        yr = np.concatenate([y.real, y.imag])
+        ys = []
+        for tau in taus:
+            d1, d2 = self.data(tau)
+            y = np.concatenate([d1 * self.w1, d2 * self.w2])
+            if self.mass is not None:
+                pr = 1.0 / (self.mass * self.s**2)
+                y = y - np.concatenate([self.w1 * pr, self.w2 * pr])
+            ys.append(np.concatenate([y.real, y.imag]))
         F = np.array(fixed).T if fixed else np.zeros((2 * nf, 0), complex)
-        Fr = np.vstack([F.real, F.imag])
+        return np.vstack([F.real, F.imag]), np.array(ys).T
+
+    def linear_start(self, wn, z, extra=None, tau: float = 0.0):
+        """Solve ``1/M`` and the residues for fixed poles; with `extra` candidate poles scanned.
+
+        Returns ``(rss, a, r1, r2)`` for the fixed poles alone, or the index of the
+        best candidate and its solution when `extra = (wn_c, z_c)` arrays are given.
+        The data are taken with the delay `tau` divided out.
+        """
+        best, rss, coef = self._scan(wn, z, extra, (tau,))
+        return (float(rss[0]), coef) if extra is None else (int(best[0]), float(rss[0]))
+
+    def _scan(self, wn, z, extra, taus):
+        """:meth:`linear_start` for every delay in `taus` at once: best candidates and RSS."""
+        Fr, Y = self._fixed(wn, z, taus)
         if Fr.shape[1]:
             Q, _ = np.linalg.qr(Fr)
         else:
-            Q = np.zeros((yr.size, 0))
-        y_perp = yr - Q @ (Q.T @ yr)
+            Q = np.zeros((Y.shape[0], 0))
+        if Y.shape[1] == 1:
+            y = Y[:, 0]
+            y_perp = (y - Q @ (Q.T @ y))[:, None]
+        else:
+            y_perp = Y - Q @ (Q.T @ Y)
+        rss0 = np.einsum("rt,rt->t", y_perp, y_perp)
         if extra is None:
-            coef = np.linalg.lstsq(Fr, yr, rcond=None)[0] if Fr.shape[1] else np.zeros(0)
-            return float(y_perp @ y_perp), coef
+            coef = np.linalg.lstsq(Fr, Y[:, 0], rcond=None)[0] if Fr.shape[1] else np.zeros(0)
+            return None, rss0, coef
+        s = self.s[:, None]
         wc, zc = extra
         gc = 1.0 / (s**2 + 2 * zc * wc * s + wc**2)  # (nf, ncand)
         g1, g2 = gc * self.w1[:, None], -gc * self.w2[:, None]
         zr = np.zeros_like(g1.real)
-        G1 = np.concatenate([g1.real, zr, g1.imag, zr])  # rows ordered as yr
+        G1 = np.concatenate([g1.real, zr, g1.imag, zr])  # rows ordered as the data
         G2 = np.concatenate([zr, g2.real, zr, g2.imag])
         if Q.shape[1]:
             # einsum, not BLAS: thin products, where BLAS threads only add overhead
@@ -327,41 +376,66 @@ class _Problem:
         a11 = np.einsum("rc,rc->c", G1, G1)
         a22 = np.einsum("rc,rc->c", G2, G2)
         a12 = np.einsum("rc,rc->c", G1, G2)
-        b1, b2 = y_perp @ G1, y_perp @ G2
+        if Y.shape[1] == 1:
+            b1, b2 = (y_perp[:, 0] @ G1)[None, :], (y_perp[:, 0] @ G2)[None, :]
+        else:
+            b1, b2 = y_perp.T @ G1, y_perp.T @ G2  # (ntau, ncand)
         det = a11 * a22 - a12**2
         with np.errstate(divide="ignore", invalid="ignore"):
             gain = (a22 * b1**2 - 2 * a12 * b1 * b2 + a11 * b2**2) / det
         gain[~np.isfinite(gain)] = -np.inf
-        best = int(np.argmax(gain))
-        return best, float(y_perp @ y_perp - gain[best])
+        best = np.argmax(gain, axis=1)
+        return best, rss0 - gain[np.arange(best.size), best], None
 
 
-def _pack(M, wn, z, r1, r2, mass):
-    head = [np.log(M)] if mass is None else []
-    body = np.column_stack([np.log(wn), np.log(z), r1, r2]).ravel() if len(wn) else []
-    return np.concatenate([head, body])
-
-
-def _start(prob: _Problem, x_prev, n_prev):
-    """Add one mode to the solution `x_prev` with `n_prev` modes by the separable scan."""
-    _, wn, z, _, _ = _unpack(x_prev, n_prev, prob.mass)
-    f = prob.f
+def _candidates(f: NDArray[np.float64]):
+    """Poles of the start's scan: frequencies and damping ratios (flattened grid)."""
     lo, hi = f.min() * _FREQ_BOUNDS[0], f.max() * 3.0
     n_grid = int(np.ceil(_SCAN_PER_DECADE * np.log10(hi / lo))) + 1
     wc = TWO_PI * np.geomspace(lo, hi, n_grid)
     zc = np.asarray(_SCAN_DAMPING)
     W, Z = (a.ravel() for a in np.meshgrid(wc, zc))
-    best, _ = prob.linear_start(wn, z, (W, Z))
+    return W, Z
+
+
+def _start(prob: _Problem, x_prev, n_prev, tau: float | None = None):
+    """Add one mode to the solution `x_prev` with `n_prev` modes by the separable scan.
+
+    The data are taken with the delay of `x_prev` divided out, or with `tau` when given.
+    """
+    _, tau_prev, wn, z, _, _ = prob.unpack(x_prev, n_prev)
+    tau = tau_prev if tau is None else tau
+    W, Z = _candidates(prob.f)
+    best, _ = prob.linear_start(wn, z, (W, Z), tau=tau)
     wn2, z2 = np.append(wn, W[best]), np.append(z, Z[best])
-    _, coef = prob.linear_start(wn2, z2)
+    _, coef = prob.linear_start(wn2, z2, tau=tau)
     k = 0
     if prob.mass is None:
         a, k = coef[0], 1
-        M = 1.0 / a if a > 0 else _unpack(x_prev, n_prev, None)[0]
+        M = 1.0 / a if a > 0 else prob.unpack(x_prev, n_prev)[0]
     else:
         M = prob.mass
     r = coef[k:].reshape(-1, 2)
-    return _pack(M, wn2, z2, r[:, 0], r[:, 1], prob.mass)
+    return prob.pack(M, tau, wn2, z2, r[:, 0], r[:, 1])
+
+
+#: Delays the start tries: steps of 0.1 rad of phase at the highest line, up to three turns.
+_DELAY_STEP_RAD = 0.1
+_DELAY_SCAN_TURNS = 3.0
+
+
+def _delay_start(prob: _Problem) -> float:
+    """The delay [s] at which a rigid body plus one mode (the scan of :func:`_start`) fits best.
+
+    Every delay of a grid (phase steps of 0.1 rad at the highest measured line,
+    up to three turns) divides the data; the best single mode of the scan is
+    found for each.  A delay is told apart from the phase of the modes only
+    with them: the non-collocated ``P2`` loses 180 deg above each mode.
+    """
+    w_max = TWO_PI * prob.f.max()
+    taus = np.arange(0.0, _DELAY_SCAN_TURNS * TWO_PI, _DELAY_STEP_RAD) / w_max
+    _, rss, _ = prob._scan(np.zeros(0), np.zeros(0), _candidates(prob.f), taus)
+    return float(taus[int(np.argmin(rss))])
 
 
 def _bounds(prob: _Problem, n: int):
@@ -369,6 +443,9 @@ def _bounds(prob: _Problem, n: int):
     w_hi = TWO_PI * prob.f.max() * _FREQ_BOUNDS[1]
     lo = [-np.inf] if prob.mass is None else []
     hi = [np.inf] if prob.mass is None else []
+    if prob.fit_delay:
+        lo.append(0.0)
+        hi.append(np.inf)
     for _ in range(n):
         lo += [np.log(w_lo), np.log(DAMPING_BOUNDS[0]), -np.inf, -np.inf]
         hi += [np.log(w_hi), np.log(DAMPING_BOUNDS[1]), np.inf, np.inf]
@@ -396,7 +473,8 @@ class FrfFit:
     frequency_hz : ndarray
         Measured frequencies [Hz].
     P1_data, P2_data : ndarray of complex
-        Measured responses [m/N].
+        Measured responses [m/N] with the delay divided out, ``P e^{s tau}``
+        (the measurement itself when ``delay_s`` is 0): what the plant is fitted to.
     M_std : float
         Standard deviation of ``M`` [kg] (0 when the mass was given).
     mode_std : list of dict
@@ -411,6 +489,21 @@ class FrfFit:
         RMS of ``|P_model - P_data| / |P_data|`` over both transfers.
     mass_given : bool
         True when ``M`` was fixed by the user.
+    delay_s, delay_std_s : float
+        Input-output delay ``tau`` [s] of ``e^{-s tau}``, common to ``P1`` and
+        ``P2``, and its standard deviation; 0 when the fit without a delay has
+        the lower BIC.  Not part of :attr:`plant`.
+    delay_given : bool
+        True when the delay was fixed by the user.
+    bic_other : dict
+        ``{number of modes: BIC}`` of the fits of the other kind: with a
+        delay when the fit has none and the other way round (empty when the
+        delay was given).
+    warnings : list of str
+        One line each where the data are not what the model describes: a
+        stiffness to ground (a negative ``Pf2(0)``, a mode below the lowest
+        line), a mode a passive stage does not have, errors far above the
+        noise in a decade band.  Empty for a fit to trust.
 
     Examples
     --------
@@ -438,12 +531,25 @@ class FrfFit:
     bic: dict = field(default_factory=dict)
     rms_relative_error: float = float("nan")
     mass_given: bool = False
+    delay_s: float = 0.0
+    delay_std_s: float = 0.0
+    delay_given: bool = False
+    bic_other: dict = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+    def _complex_errors(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """``(P_model - P_data) / |P_data|`` of ``P1`` and ``P2`` at each measured frequency."""
+        m1, m2 = self.plant.response(TWO_PI * self.frequency_hz)
+        return ((m1 - self.P1_data) / np.abs(self.P1_data),
+                (m2 - self.P2_data) / np.abs(self.P2_data))
 
     def relative_errors(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """``|P_model - P_data| / |P_data|`` of ``P1`` and ``P2`` at each measured frequency."""
-        m1, m2 = self.plant.response(TWO_PI * self.frequency_hz)
-        return (np.abs(m1 - self.P1_data) / np.abs(self.P1_data),
-                np.abs(m2 - self.P2_data) / np.abs(self.P2_data))
+        """``|P_model - P_data| / |P_data|`` of ``P1`` and ``P2`` at each measured frequency.
+
+        The same as ``|P_model e^{-s tau} - P_measured| / |P_measured|``.
+        """
+        c1, c2 = self._complex_errors()
+        return np.abs(c1), np.abs(c2)
 
     def bands(self) -> list[dict]:
         """Fit quality per decade band of the measured range.
@@ -488,6 +594,10 @@ class FrfFit:
                                    float(self.frequency_hz.max())],
             "rms_relative_error": self.rms_relative_error,
             "bands": self.bands(),
+            "delay_s": self.delay_s, "delay_std_s": self.delay_std_s,
+            "delay_given": self.delay_given,
+            "bic_other": {str(k): v for k, v in self.bic_other.items()},
+            "warnings": list(self.warnings),
         }
 
     def __str__(self) -> str:
@@ -502,6 +612,15 @@ class FrfFit:
                          f"r1 = {_pm(m.r1, s['r1'])} 1/kg, r2 = {_pm(m.r2, s['r2'])} 1/kg")
         lines.append(f"  Pf2(0) = {_pm(p.pf2_static, self.pf2_static_std)} m/N "
                      f"(flexible compliance at P2; sets eqs. 18-21 at low frequency)")
+        if self.delay_given:
+            lines.append(f"  delay = {_num(self.delay_s * 1e6)} us (given; divided out of the "
+                         f"data)")
+        elif self.delay_s > 0:
+            lines.append(f"  delay = {_pm(self.delay_s * 1e6, self.delay_std_s * 1e6)} us "
+                         f"(e^(-s tau) of the measurement chain on P1 and P2, divided out of "
+                         f"the data: the plant is without it)")
+        else:
+            lines.append("  delay = 0 (a delay e^(-s tau) on P1 and P2 does not lower the BIC)")
         lines.append("  relative error |P_fit - P_data|/|P_data|: RMS "
                      f"{_num(self.rms_relative_error)} over both transfers; per band:")
         for b in self.bands():
@@ -509,6 +628,7 @@ class FrfFit:
                          f"{b['lines']:>3} lines  P1 RMS {_num(b['p1_rms_rel'])} "
                          f"(max {_num(b['p1_max_rel'])}), P2 RMS {_num(b['p2_rms_rel'])} "
                          f"(max {_num(b['p2_max_rel'])})")
+        lines += [f"  warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
     def plot(self, f_range: tuple[float, float] | None = None):
@@ -543,8 +663,15 @@ def _bic(rss: float, n_res: int, n_par: int) -> float:
 
 
 def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | None = None,
-            mass: float | None = None, max_modes: int = MAX_MODES, source: str = "") -> FrfFit:
+            mass: float | None = None, max_modes: int = MAX_MODES, source: str = "",
+            delay: float | None = None) -> FrfFit:
     """Fit measured ``P1``, ``P2`` to a rigid body plus flexible modes (eqs. 1-2, modal form).
+
+    The data may lag the mechanics by a pure delay ``e^{-s tau}`` common to
+    ``P1`` and ``P2`` (sample-and-hold, computation, the measurement chain):
+    it is estimated with the modes and kept when it lowers the BIC (module
+    docstring), and divided out of the data; the fitted plant is the
+    mechanics without it.
 
     Parameters
     ----------
@@ -560,16 +687,21 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
         Largest number of modes the automatic choice tries.
     source : str
         Where the data came from (for the report).
+    delay : float, optional
+        Input-output delay ``tau`` [s], >= 0, divided out of the data; default:
+        estimated (0 when the data show none).
 
     Returns
     -------
     FrfFit
+        With :attr:`FrfFit.warnings` when the data are not what the model
+        describes (a stiffness to ground, errors far above the noise).
 
     Raises
     ------
     ValueError
         Too few lines for the number of parameters, non-finite or zero data,
-        or data that are not a rigid body at low frequency.
+        a negative delay, or data that are not a rigid body at low frequency.
 
     Examples
     --------
@@ -582,6 +714,15 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     >>> fit = fit_frf(f, p1, p2)
     >>> len(fit.plant.modes), round(fit.plant.M, 6), round(fit.plant.modes[0].frequency_hz, 3)
     (1, 22.5, 694.262)
+    >>> fit.delay_s, fit.warnings
+    (0.0, [])
+
+    The same stage measured through a chain that delays it by 50 us:
+
+    >>> lag = np.exp(-2j * np.pi * f * 50e-6)
+    >>> fit = fit_frf(f, p1 * lag, p2 * lag)
+    >>> len(fit.plant.modes), round(fit.delay_s * 1e6, 3), round(fit.plant.M, 6)
+    (1, 50.0, 22.5)
     """
     f = np.asarray(frequency_hz, dtype=float).ravel()
     p1 = np.asarray(P1, dtype=complex).ravel()
@@ -596,6 +737,13 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
         raise ValueError("a measured response is exactly zero")
     if mass is not None and not (np.isfinite(mass) and mass > 0):
         raise ValueError(f"mass must be finite and > 0, got {mass!r}")
+    if delay is not None:
+        if not (np.isfinite(delay) and delay >= 0):
+            raise ValueError(f"delay must be finite and >= 0, got {delay!r}")
+        delay = float(delay)
+        if delay > 0:  # divided out: the fit is that of the mechanics
+            rot = np.exp(1j * TWO_PI * f * delay)
+            p1, p2 = p1 * rot, p2 * rot
     n_res = 4 * f.size
     n_fixed = 0 if mass is not None else 1
     if modes is not None:
@@ -618,31 +766,63 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
         x = np.array([np.log(1.0 / a0)])
     else:
         x = np.zeros(0)
-    x, r = _solve(prob, x, 0)
-    fits = {0: (x, float(r @ r))}
-    bic = {0: _bic(fits[0][1], n_res, n_fixed)}
-    target = modes if modes is not None else max_modes
-    for n in range(1, target + 1):
-        if 2 * (n_fixed + 4 * n) > n_res:
-            break
-        x0 = _start(prob, fits[n - 1][0], n - 1)
-        x, r = _solve(prob, x0, n)
-        fits[n] = (x, float(r @ r))
-        bic[n] = _bic(fits[n][1], n_res, n_fixed + 4 * n)
-        if modes is None and bic[n] >= bic[n - 1]:
-            break
+    fits, bic = _chain(prob, x, n_res, modes, max_modes)
+    n_best = _choose(bic, modes)
+    chosen, other = (prob, fits, bic, n_best), {}
+    if delay is None:
+        probd = _Problem(f, p1, p2, mass, fit_delay=True)
+        tau0 = _delay_start(probd)
+        fits_d, bic_d = _chain(probd, np.append(x, tau0), n_res, modes, max_modes, tau0)
+        other = bic_d
+        if modes is None or modes in fits_d:
+            nd = _choose(bic_d, modes)
+            if probd.unpack(fits_d[nd][0], nd)[1] > 0 and bic_d[nd] < bic[n_best]:
+                chosen, other = (probd, fits_d, bic_d, nd), bic
+    prob, fits, bic, n_best = chosen
     if modes is None:
-        n_best = min(bic, key=lambda k: (bic[k], k))
         criterion = (f"modes chosen by the BIC, first minimum over n = 0..{max(bic)}")
     else:
-        n_best = modes
         criterion = "modes given"
     x, rss = fits[n_best]
-    return _result(prob, x, n_best, rss, criterion, bic, source)
+    fit = _result(prob, x, n_best, rss, criterion, bic, source)
+    fit.bic_other = other
+    if delay is not None:
+        fit.delay_s, fit.delay_given = delay, True
+    fit.warnings = _diagnose(fit)
+    return fit
+
+
+def _chain(prob: _Problem, x0, n_res: int, modes: int | None, max_modes: int,
+           tau_first: float | None = None):
+    """Fits with 0, 1, 2, ... modes, each started from the one before (module docstring).
+
+    Up to `modes`, or to the first minimum of the BIC.  `tau_first`: the delay
+    the scan for the first mode divides out (default: that of the fit without modes).
+    Returns ``{n: (x, rss)}`` and ``{n: BIC}``.
+    """
+    x, r = _solve(prob, x0, 0)
+    fits = {0: (x, float(r @ r))}
+    bic = {0: _bic(fits[0][1], n_res, prob.n_head)}
+    target = modes if modes is not None else max_modes
+    for n in range(1, target + 1):
+        if 2 * (prob.n_head + 4 * n) > n_res:
+            break
+        x0 = _start(prob, fits[n - 1][0], n - 1, tau_first if n == 1 else None)
+        x, r = _solve(prob, x0, n)
+        fits[n] = (x, float(r @ r))
+        bic[n] = _bic(fits[n][1], n_res, prob.n_head + 4 * n)
+        if modes is None and bic[n] >= bic[n - 1]:
+            break
+    return fits, bic
+
+
+def _choose(bic: dict, modes: int | None) -> int:
+    """The number of modes: given, or that of the lowest BIC."""
+    return modes if modes is not None else min(bic, key=lambda k: (bic[k], k))
 
 
 def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
-    M, wn, z, r1, r2 = _unpack(x, n, prob.mass)
+    M, tau, wn, z, r1, r2 = prob.unpack(x, n)
     n_res = 4 * prob.f.size
     n_par = x.size
     if n_par:
@@ -653,8 +833,9 @@ def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
     else:
         cov = np.zeros((0, 0))
         std_x = np.zeros(0)
-    k = 0 if prob.mass is not None else 1
+    k = prob.n_head
     M_std = float(M * std_x[0]) if prob.mass is None else 0.0
+    tau_std = float(std_x[k - 1]) if prob.fit_delay else 0.0
     sx = std_x[k:].reshape(n, 4) if n else np.zeros((0, 4))
     mode_std = [{"frequency_hz": float(wn[i] / TWO_PI * sx[i, 0]),
                  "damping": float(z[i] * sx[i, 1]), "r1": float(sx[i, 2]),
@@ -669,22 +850,92 @@ def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
              for i in range(n)]
     order = np.argsort([m.frequency_hz for m in modes])
     plant = ModalPlant(M, [modes[i] for i in order], source=source)
-    fit = FrfFit(plant=plant, frequency_hz=prob.f, P1_data=prob.p1, P2_data=prob.p2,
+    d1, d2 = prob.data(tau)
+    fit = FrfFit(plant=plant, frequency_hz=prob.f, P1_data=d1, P2_data=d2,
                  M_std=M_std, mode_std=[mode_std[i] for i in order], pf2_static_std=pf2_std,
-                 criterion=criterion, bic=bic, mass_given=prob.mass is not None)
+                 criterion=criterion, bic=bic, mass_given=prob.mass is not None,
+                 delay_s=tau, delay_std_s=tau_std)
     e1, e2 = fit.relative_errors()
     fit.rms_relative_error = float(np.sqrt(np.mean(np.concatenate([e1, e2]) ** 2)))
     return fit
 
 
+#: A band's RMS error this many times the line-to-line scatter of its errors is far above
+#: the noise (for noise alone the ratio is 1, within about 0.2 for a band of 9 lines).
+RESIDUAL_NOISE_RATIO = 2.0
+#: Fewest lines of a band checked for errors above its noise.
+_RESIDUAL_MIN_LINES = 5
+#: Relative errors below this are far below any measurement's noise: never warned about.
+_RESIDUAL_FLOOR = 1e-6
+
+
+def _diagnose(fit: FrfFit) -> list[str]:
+    """One-line warnings where the data are not what the model describes (:attr:`FrfFit.warnings`).
+
+    - a stiffness to ground: a negative ``Pf2(0)`` or a mode below the lowest
+      line (the lowest lines are then not a floating rigid body);
+    - modes a passive stage does not have: a negative collocated residue
+      ``r1`` (by more than 3 standard deviations) or a damping ratio at its bound;
+    - errors far above the noise: in a decade band, the RMS of the complex
+      relative error more than :data:`RESIDUAL_NOISE_RATIO` times its
+      line-to-line scatter ``sqrt(mean |e_i+1 - e_i|^2 / 2)``, which noise
+      alone makes equal to the RMS while an error the model leaves varies
+      slowly from line to line.
+    """
+    p, f = fit.plant, fit.frequency_hz
+    out = []
+    low = [m for m in p.modes if m.frequency_hz < f.min()]
+    if p.pf2_static < 0 or low:
+        what = ([f"Pf2(0) = {p.pf2_static:.3g} m/N < 0"] if p.pf2_static < 0 else []) + [
+            f"a mode at {_num(m.frequency_hz)} Hz below the lowest line {_num(f.min())} Hz"
+            for m in low]
+        out.append(f"measured plant: the lowest lines are not a floating rigid body "
+                   f"({', '.join(what)}): a stiffness to ground, such as a sticking link, that "
+                   f"the stage of eqs. 1-2 lacks; |E| at low frequencies is wrong; measure with "
+                   f"the link sliding or detached")
+    odd = []
+    for i, (m, s) in enumerate(zip(p.modes, fit.mode_std, strict=True), start=1):
+        why = []
+        if m.r1 < -3 * s["r1"]:
+            why.append(f"r1 = {_num(m.r1)} 1/kg < 0")
+        if m.damping <= DAMPING_BOUNDS[0] * 1.001 or m.damping >= DAMPING_BOUNDS[1] * 0.999:
+            why.append(f"damping at its bound {_num(m.damping)}")
+        if why and m not in low:  # those are in the warning above
+            odd.append(f"mode {i} at {_num(m.frequency_hz)} Hz ({', '.join(why)})")
+    if odd:
+        out.append(f"measured plant: {'; '.join(odd)}: not a mode of a passive stage (positive "
+                   f"collocated residue, resonant); the fit uses it for something the model "
+                   f"lacks")
+    c1, c2 = fit._complex_errors()
+    high = []
+    for b in fit.bands():
+        sel = np.nonzero((f >= b["f_lo_hz"]) & (f <= b["f_hi_hz"]))[0]
+        if sel.size < _RESIDUAL_MIN_LINES:
+            continue
+        e = np.concatenate([c1[sel], c2[sel]])
+        d = np.concatenate([np.diff(c1[sel]), np.diff(c2[sel])])
+        rms, scatter = np.sqrt(np.mean(np.abs(e) ** 2)), np.sqrt(np.mean(np.abs(d) ** 2) / 2)
+        if rms > _RESIDUAL_FLOOR and rms > RESIDUAL_NOISE_RATIO * scatter:
+            high.append((b["f_lo_hz"], b["f_hi_hz"], rms, rms / max(scatter, 1e-300)))
+    if high:
+        where = ", ".join(f"{_num(lo)}-{_num(hi)} Hz (RMS {_num(r)}, {q:.2g} x)"
+                          for lo, hi, r, q in high)
+        out.append(f"measured plant: fit errors far above the data's noise (their line-to-line "
+                   f"scatter) at {where}: the data hold something a rigid body plus modes and a "
+                   f"pure delay does not describe (a stiffness to ground, amplifier or sensor "
+                   f"dynamics, a missing mode)")
+    return out
+
+
 def fit_measured_plant(plant: MeasuredPlant, modes: int | None = None,
-                       mass: float | None = None) -> FrfFit:
+                       mass: float | None = None, delay: float | None = None) -> FrfFit:
     """Fit a :class:`~motionhyst.systems.MeasuredPlant` (see :func:`fit_frf`).
 
     `mass` fixes ``M``; by default it is fitted (the plant's own estimate of
-    ``M`` from its lowest decade is not used).
+    ``M`` from its lowest decade is not used).  `delay` fixes the delay [s];
+    by default it is estimated.
     """
     f = plant.P2.omega / TWO_PI
     p1 = np.asarray(plant.P1.frdata, dtype=complex).ravel()
     p2 = np.asarray(plant.P2.frdata, dtype=complex).ravel()
-    return fit_frf(f, p1, p2, modes=modes, mass=mass, source=plant.source)
+    return fit_frf(f, p1, p2, modes=modes, mass=mass, source=plant.source, delay=delay)

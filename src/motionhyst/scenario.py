@@ -127,7 +127,8 @@ class PlantSection(_Section):
     flexible modes (:func:`motionhyst.frf_fit.fit_frf`; the number chosen by
     the BIC when ``modes`` is omitted) and analyses the fitted model;
     ``use = "data"`` keeps the raw data: only measured frequencies are
-    evaluated.  ``mass`` fixes the rigid-body mass [kg].
+    evaluated.  ``mass`` fixes the rigid-body mass [kg]; ``delay`` fixes the
+    input-output delay of the measurement [s] (default: estimated by the fit).
     """
 
     type: Literal["frd"] = "frd"
@@ -135,11 +136,13 @@ class PlantSection(_Section):
     mass: PositiveFloat | None = None
     use: Literal["fit", "data"] = "fit"
     modes: Annotated[int, Field(ge=0, le=20)] | None = None
+    delay: NonNegativeFloat | None = None
 
     @model_validator(mode="after")
     def _modes_need_fit(self):
-        if self.use == "data" and self.modes is not None:
-            raise ValueError('modes applies to use = "fit" only')
+        for key in ("modes", "delay"):
+            if self.use == "data" and getattr(self, key) is not None:
+                raise ValueError(f'{key} applies to use = "fit" only')
         return self
 
 
@@ -551,7 +554,8 @@ class Scenario:
             self._plant = dataclasses.replace(data, resolution=scatter)
             return self._plant
         try:
-            self._fit = fit_measured_plant(data, modes=m.plant.modes, mass=m.plant.mass)
+            self._fit = fit_measured_plant(data, modes=m.plant.modes, mass=m.plant.mass,
+                                           delay=m.plant.delay)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body "
                                 f"plus modes: {exc}") from None

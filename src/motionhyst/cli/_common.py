@@ -165,6 +165,18 @@ def warn(message: str) -> None:
     print(f"motionhyst: warning: {message}", file=sys.stderr)
 
 
+def warn_plant_fit(sc, command: str) -> None:
+    """The warnings of a measured plant's fit (:attr:`motionhyst.FrfFit.warnings`) on stderr.
+
+    One line each: the data are not what a rigid body plus modes describes
+    (a stiffness to ground, errors far above the noise), so every number
+    computed on the fitted plant is in doubt.  Nothing for a modelled stage.
+    """
+    fit = sc.plant_fit()
+    for message in fit.warnings if fit is not None else ():
+        warn(f"{command}: {message}")
+
+
 def check_plausible(loop, amplitude: float, frequencies, command: str) -> None:
     """Warn where a sine of `amplitude` at `frequencies` leaves the model's meaning.
 

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import check_plausible, distinct, positive, print_json
+from motionhyst.cli._common import (
+    check_plausible,
+    distinct,
+    positive,
+    print_json,
+    warn_plant_fit,
+)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -20,6 +26,7 @@ def run(args: argparse.Namespace) -> int:
     mode = "self-consistent" if args.self_consistent else "reference"
     res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
     fit = sc.plant_fit()
+    warn_plant_fit(sc, args.command)
     if args.json:
         d = res.to_dict()
         if fit is not None:

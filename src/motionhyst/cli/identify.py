@@ -6,7 +6,14 @@ import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
-from motionhyst.cli._common import UsageError, g, positive, print_json, whole_number
+from motionhyst.cli._common import (
+    UsageError,
+    g,
+    positive,
+    print_json,
+    warn_plant_fit,
+    whole_number,
+)
 from motionhyst.cli._identify_io import (
     add_input_output_arguments,
     check_not_input_output,
@@ -150,6 +157,7 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "
                              f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
                              f"has a measured [plant] with use = \"data\"")
+        warn_plant_fit(sc, "identify")
         t, y1, u = load_closed_loop_csv(path)
         extra["scenario"] = sc.source
         try:

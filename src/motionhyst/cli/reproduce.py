@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import add_force_option
+from motionhyst.cli._common import add_force_option, warn_plant_fit
 
 
 def run(args: argparse.Namespace) -> int:
@@ -17,6 +17,7 @@ def run(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario, check=False)
     reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None, force=args.force,
               inputs=sc.files)
+    warn_plant_fit(sc, "reproduce")
     if not args.quiet:
         print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf), listed in "
               f"{MANIFEST}")

@@ -9,7 +9,14 @@ import argparse
 
 import numpy as np
 
-from motionhyst.cli._common import UsageError, nonnegative, positive, print_json, whole_number
+from motionhyst.cli._common import (
+    UsageError,
+    nonnegative,
+    positive,
+    print_json,
+    warn_plant_fit,
+    whole_number,
+)
 
 PROG = "motionhyst scan"
 LEAD_IN = 0.01
@@ -106,6 +113,7 @@ def run(args: argparse.Namespace) -> int:
 
     sc = load_scenario(args.scenario)
     loop = sc.loop()
+    warn_plant_fit(sc, "scan")
     has_model = loop.hysteresis_feedforward is not None
     comps = args.compensation or (["none", "model", "ilc"] if has_model else ["none", "ilc"])
     if len(set(comps)) != len(comps):

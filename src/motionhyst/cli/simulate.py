@@ -18,6 +18,7 @@ from motionhyst.cli._common import (
     print_json,
     refuse_unused,
     warn,
+    warn_plant_fit,
 )
 
 TIME_SERIES_ONLY = ("--reference-csv", "--profile", "--distance", "--v-max", "--a-max",
@@ -88,6 +89,7 @@ def _time_series(args: argparse.Namespace, sc) -> int:
         raise UsageError(f"motionhyst simulate: --time-series needs a plant model; {sc.source} "
                          f"uses its measured [plant] as raw data (use = \"data\"), which has no "
                          f"time-domain model; use = \"fit\" fits one")
+    warn_plant_fit(sc, "simulate")
     ref, default_duration, what = _reference(args, sc)
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)

@@ -6,7 +6,13 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import check_plausible, distinct, positive, print_json
+from motionhyst.cli._common import (
+    check_plausible,
+    distinct,
+    positive,
+    print_json,
+    warn_plant_fit,
+)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -19,6 +25,7 @@ def run(args: argparse.Namespace) -> int:
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
     check_plausible(sc.loop(), amplitude, freqs, args.command)
+    warn_plant_fit(sc, args.command)
     result = compare_with_describing_function(sc.loop(), amplitude, freqs)
     if args.json:
         print_json(result.to_dict())
