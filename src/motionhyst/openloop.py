@@ -44,7 +44,9 @@ system is then integrated with a fine fixed step, ``substeps`` per sample
 * the other links: the stage discretised exactly for a force linear between
   fine steps (first-order hold) and the link advanced by its exact update
   (as :func:`motionhyst.simulate.simulate`), implicit in ``w`` and solved by a
-  fixed-point iteration; second order in the step.
+  fixed-point iteration; second order in the step.  One compiled run
+  (:func:`simulate_elements`) for both plants, with the forward sensitivities
+  of the output to the plant's and the link's parameters when asked.
 """
 
 from __future__ import annotations
@@ -58,7 +60,16 @@ from scipy.signal import firwin, resample_poly
 
 from motionhyst._jit import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
-from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, advance
+from motionhyst.hysteresis.stepping import (
+    DIFFERENTIATED,
+    GL_T,
+    GL_W,
+    N_PARAMS,
+    N_PARTIALS,
+    Stepping,
+    advance,
+    advance_partials,
+)
 from motionhyst.lti import expm_small
 from motionhyst.simulate import MAX_FIXED_POINT_ITERATIONS
 
@@ -136,6 +147,74 @@ class Mechanics:
         B = np.zeros(2 * n)
         B[n + self.link] = 1.0 / self.mass[self.link]
         return A, B
+
+    def foh(self, h: float, derivatives: bool = False) -> tuple[NDArray[np.float64], ...]:
+        """The plant over a step `h` for a force linear over the step (first-order hold).
+
+        ``x(t + h) = Ad x(t) + B0 f(t) + B1 f(t + h)`` exactly for ``f = u - w``
+        linear over the step, from the exponential of ``[[A h, B h, 0], [0, 0, 1],
+        [0, 0, 0]]`` (:func:`~motionhyst.lti.expm_small`; the link left out).
+
+        Parameters
+        ----------
+        h : float
+            Step [s].
+        derivatives : bool
+            Also the derivatives of ``Ad, B0, B1`` in the plant's `p` parameters
+            (the rows of ``dmass, dC, dK``): Frechet derivatives of the
+            exponential, each the corner of the exponential of a block matrix
+            ``[[M, dM], [0, M]]``.
+
+        Returns
+        -------
+        Ad, B0, B1 : ndarray, shapes (2n, 2n), (2n,), (2n,)
+        dAd, dB0, dB1 : ndarray, shapes (p, 2n, 2n), (p, 2n), (p, 2n)
+            Their derivatives (``p = 0``, empty, without `derivatives`).
+
+        Examples
+        --------
+        >>> mech = MassSpringDamper(2.0, 10.0, 5e4).mechanics()
+        >>> Ad, B0, B1, dAd, dB0, dB1 = mech.foh(1e-4, derivatives=True)
+        >>> eps = 1e-6   # d Ad / d k against a central difference
+        >>> hi = MassSpringDamper(2.0, 10.0, 5e4 * (1 + eps)).mechanics().foh(1e-4)[0]
+        >>> lo = MassSpringDamper(2.0, 10.0, 5e4 * (1 - eps)).mechanics().foh(1e-4)[0]
+        >>> fd = (hi - lo) / (2 * 5e4 * eps)
+        >>> bool(np.allclose(dAd[2], fd, rtol=1e-6, atol=1e-6 * np.max(np.abs(fd))))
+        True
+        >>> mech.foh(1e-4)[3].shape
+        (0, 2, 2)
+        """
+        A, B = self.state_space()
+        ns = A.shape[0]
+        n = self.n
+        M = np.zeros((ns + 2, ns + 2))
+        M[:ns, :ns] = A * h
+        M[:ns, ns] = B * h
+        M[ns, ns + 1] = 1.0
+        E = expm_small(M)
+        B1 = np.ascontiguousarray(E[:ns, ns + 1])
+        B0 = np.ascontiguousarray(E[:ns, ns] - B1)
+        Ad = np.ascontiguousarray(E[:ns, :ns])
+        p = self.dmass.shape[0] if derivatives else 0
+        dAd = np.zeros((p, ns, ns))
+        dB0 = np.zeros((p, ns))
+        dB1 = np.zeros((p, ns))
+        big = np.zeros((2 * ns + 4, 2 * ns + 4))
+        big[:ns + 2, :ns + 2] = M
+        big[ns + 2:, ns + 2:] = M
+        for a in range(p):
+            # d(-M^-1 K) = -M^-1 (dK - dM M^-1 K), likewise C; d(M^-1 e_l) = -M^-2 dM e_l
+            rel = (self.dmass[a] / self.mass)[:, None]
+            dM = np.zeros((ns + 2, ns + 2))
+            dM[n:ns, :n] = -(self.dK[a] - rel * self.K) / self.mass[:, None] * h
+            dM[n:ns, n:ns] = -(self.dC[a] - rel * self.C) / self.mass[:, None] * h
+            dM[n + self.link, ns] = -self.dmass[a, self.link] / self.mass[self.link] ** 2 * h
+            big[:ns + 2, ns + 2:] = dM
+            dE = expm_small(big)[:ns + 2, ns + 2:]
+            dAd[a] = dE[:ns, :ns]
+            dB1[a] = dE[:ns, ns + 1]
+            dB0[a] = dE[:ns, ns] - dE[:ns, ns + 1]
+        return Ad, B0, B1, dAd, dB0, dB1
 
     def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
                            ) -> NDArray[np.complex128]:
@@ -630,25 +709,70 @@ def _rk4_run(uf, h, r, mass, C, K, dmass, dC, dK, li, lo, lp, x0, s0, sens
 
 
 # ----------------------------------------------------------------- other links: FOH + exact update
-@njit(cache=True, nogil=True)
-def _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, glt, glw, h, ftol, max_iter, x0, s0
-                  ):  # pragma: no cover - compiled
-    """Stage (FOH, state ``(q, q')``, force and link on ``q[li]``), link elements advanced
-    exactly; outputs ``q[lo]`` every r steps."""
+@njit("(float64[:, ::1], float64[::1], float64[::1], float64[:, :, ::1], float64[:, ::1], "
+      "float64[:, ::1], int64, int64, float64[::1], int64, int64[::1], float64[:, ::1], "
+      "float64[:, :, ::1], float64[::1], float64[::1], float64, float64, int64, float64[::1], "
+      "float64[::1], float64[:, ::1], float64[:, ::1])", nogil=True)
+def _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, li, lo, uf, r, codes, params, dparams, glt, glw,
+                  h, ftol, max_iter, x0, s0, sx0, ss0):  # pragma: no cover - compiled
+    """The plant over the fine steps (FOH, state ``x = (q, q')``, force and link on
+    ``q[li]``), the link's elements advanced exactly; outputs ``q[lo]`` every `r` steps.
+
+    The step's link force is the fixed point ``w = W(dx(w))``, ``dx = base - B1[li] w -
+    q[li]``.  Forward sensitivities in ``P = sx0.shape[1]`` parameters, the plant's
+    first (``dAd, dB0, dB1``: ``Mechanics.foh``'s derivatives in them), then the link's
+    (``dparams[j, l, b]``: element ``j``'s row entry ``l`` in the link's parameter ``b``),
+    are carried only for ``P > 0`` (``P = 0``: empty ``sx0, ss0`` and derivative arrays,
+    the simulation alone).  Each step's are those of the element updates (then advanced
+    by :func:`~motionhyst.hysteresis.stepping.advance_partials`: the states and forces
+    of ``advance``, bit for bit, and their partials, taken at the fixed point's last
+    pass) and of the implicit link force, ``dw = (dW_rest + W_dx dbase) / (1 + W_dx
+    B1[li])``.
+
+    Returns the output and its sensitivities at the samples, the final states ``x, s``
+    and sensitivities ``sx`` (2n, P), ``ss`` (elements, P), and the largest number of
+    fixed-point passes of a step.
+    """
     n_steps = uf.shape[0] - 1
     n_out = n_steps // r + 1
     m = codes.shape[0]
     ns = x0.shape[0]
+    P = sx0.shape[1]
+    npl = dAd.shape[0]
+    sens = P > 0
     y = np.empty(n_out)
+    sy = np.zeros((n_out, P))
     x = x0.copy()
     xn = x0.copy()
     s = s0.copy()
     s_prev = s0.copy()
     s_new = s0.copy()
+    sx = sx0.copy()
+    sxn = sx0.copy()
+    ss = ss0.copy()
+    ss_prev = ss0.copy()
+    ss_new = ss0.copy()
+    dw_prev = np.zeros(P)
+    ddx_prev = np.zeros(P)
+    dw = np.zeros(P)
+    ddx = np.zeros(P)
+    pds = np.zeros((m, N_PARTIALS))
+    pdf = np.zeros((m, N_PARTIALS))
     w_prev = 0.0
     for j in range(m):
-        w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
+        if not sens:
+            w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
+        else:
+            w_prev += advance_partials(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True,
+                                       pds[j], pdf[j])[1]
+            for b in range(P):
+                dw_prev[b] += (pdf[j, 0] + pdf[j, 1]) * ss[j, b]
+            for b in range(npl, P):
+                for lp in range(N_PARAMS):
+                    dw_prev[b] += pdf[j, 4 + lp] * dparams[j, lp, b - npl]
     y[0] = x[lo]
+    for b in range(P):
+        sy[0, b] = sx[lo, b]
     dx_prev = 0.0
     worst = 0
     for i in range(n_steps):
@@ -665,10 +789,16 @@ def _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, glt, glw, h, ftol, m
             it += 1
             dx = base_y - B1[li] * wt - x[li]
             wn = 0.0
-            for j in range(m):
-                s_new[j], fj = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, h,
-                                        i == 0, glt, glw)
-                wn += fj
+            if not sens:
+                for j in range(m):
+                    s_new[j], fj = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
+                                            h, i == 0, glt, glw)
+                    wn += fj
+            else:  # the same states and forces, and their partials
+                for j in range(m):
+                    s_new[j], fj = advance_partials(codes[j], params[j], s[j], s_prev[j], dx,
+                                                    dx_prev, h, i == 0, pds[j], pdf[j])
+                    wn += fj
             # converged, or stalled at the rounding floor (a contraction's changes stop
             # falling only there: rate terms such as LuGre's sigma1 z' amplify the rounding
             # of dx by ~ sigma1 / h)
@@ -682,6 +812,64 @@ def _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, glt, glw, h, ftol, m
             worst = it
         dx = base_y - B1[li] * wt - x[li]
         f1 = uf[i + 1] - wt
+        if sens:  # the partials of the last pass (at the converged point to rounding)
+            w_dx = 0.0
+            for j in range(m):
+                w_dx += pdf[j, 2]
+            # the plant's step in the sensitivities but for this step's link force:
+            # Ad sx - B0 dw_prev, and dAd x + dB0 f0 + dB1 f1 in the plant's parameters
+            for a in range(ns):
+                for b in range(P):
+                    sxn[a, b] = -B0[a] * dw_prev[b]
+                for c in range(ns):
+                    adc = Ad[a, c]
+                    for b in range(P):
+                        sxn[a, b] += adc * sx[c, b]
+                for b in range(npl):
+                    t = dB0[b, a] * f0 + dB1[b, a] * f1
+                    for c in range(ns):
+                        t += dAd[b, a, c] * x[c]
+                    sxn[a, b] += t
+            # the link force's change: the elements' partials in their states, their
+            # previous displacement and their parameters, then through dx (implicit)
+            for b in range(P):
+                dw[b] = 0.0
+            for j in range(m):
+                c0, c1, c3 = pdf[j, 0], pdf[j, 1], pdf[j, 3]
+                for b in range(P):
+                    dw[b] += c0 * ss[j, b] + c1 * ss_prev[j, b] + c3 * ddx_prev[b]
+                for lp in range(N_PARAMS):
+                    cp = pdf[j, 4 + lp]
+                    if cp != 0.0:
+                        for b in range(npl, P):
+                            dw[b] += cp * dparams[j, lp, b - npl]
+            for b in range(P):
+                dbase = sxn[li, b] - sx[li, b]  # of dx = base - B1[li] w - q[li]
+                dw[b] = (dw[b] + w_dx * dbase) / (1.0 + w_dx * B1[li])
+                ddx[b] = dbase - B1[li] * dw[b]
+            for a in range(ns):
+                for b in range(P):
+                    sxn[a, b] -= B1[a] * dw[b]
+            for j in range(m):
+                c0, c1, c2, c3 = pds[j, 0], pds[j, 1], pds[j, 2], pds[j, 3]
+                for b in range(P):
+                    ss_new[j, b] = (c0 * ss[j, b] + c1 * ss_prev[j, b] + c2 * ddx[b]
+                                    + c3 * ddx_prev[b])
+                for lp in range(N_PARAMS):
+                    cp = pds[j, 4 + lp]
+                    if cp != 0.0:
+                        for b in range(npl, P):
+                            ss_new[j, b] += cp * dparams[j, lp, b - npl]
+            for a in range(ns):
+                for b in range(P):
+                    sx[a, b] = sxn[a, b]
+            for j in range(m):
+                for b in range(P):
+                    ss_prev[j, b] = ss[j, b]
+                    ss[j, b] = ss_new[j, b]
+            for b in range(P):
+                dw_prev[b] = dw[b]
+                ddx_prev[b] = ddx[b]
         for a in range(ns):
             acc = Ad[a, 0] * x[0]
             for b in range(1, ns):
@@ -695,8 +883,11 @@ def _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, glt, glw, h, ftol, m
         w_prev = wt
         dx_prev = dx
         if (i + 1) % r == 0:
-            y[(i + 1) // r] = x[lo]
-    return y, x, s, w_prev, worst
+            o = (i + 1) // r
+            y[o] = x[lo]
+            for b in range(P):
+                sy[o, b] = sx[lo, b]
+    return y, sy, x, s, sx, ss, worst
 
 
 # ----------------------------------------------------------------- the system
@@ -835,41 +1026,9 @@ class OpenLoop:
         """Displacement of a link of exact-update elements (`upsampled`: ``fine_input(u, r,
         periodic)`` if already computed)."""
         st = Stepping.empty() if self.hysteresis is None else self.hysteresis.time_stepping()
-        codes, params, s0, scale = st.codes, st.params, st.state0, st.scale
-        h = 1.0 / (fs * r)
-        mech = self.plant.mechanics()
-        A, B = mech.state_space()
-        ns = A.shape[0]
-        # first-order hold, split into the weights of the step's two end samples
-        M = np.zeros((ns + 2, ns + 2))
-        M[:ns, :ns] = A * h
-        M[:ns, ns] = B * h
-        M[ns, ns + 1] = 1.0
-        E = expm_small(M)
-        B1 = np.ascontiguousarray(E[:ns, ns + 1])
-        B0 = np.ascontiguousarray(E[:ns, ns] - B1)
-        Ad = np.ascontiguousarray(E[:ns, :ns])
-        ftol = 1e-13 * scale
-        uf = upsampled if upsampled is not None else fine_input(u, r, periodic)
-        li, lo = mech.link, mech.output
-        if not periodic:
-            y, _, _, _, worst = _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, GL_T,
-                                              GL_W, h, ftol, MAX_FIXED_POINT_ITERATIONS,
-                                              np.zeros(ns), s0)
-            _check_converged(worst)
-            return y
-        x, s = np.zeros(ns), s0
-        prev = None
-        step: list[float] = []
-        for _ in range(_max_periods(mech, self._k_link(), u.size / fs)):
-            y, x, s, _, worst = _foh_link_run(Ad, B0, B1, li, lo, uf, r, codes, params, GL_T,
-                                              GL_W, h, ftol, MAX_FIXED_POINT_ITERATIONS, x, s)
-            _check_converged(worst)
-            y = y[:-1]
-            if prev is not None and _settled(y, prev, mech.floating, step):
-                return y - np.mean(y) if mech.floating else y
-            prev = y
-        raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))
+        y, _ = simulate_elements(self.plant.mechanics(), st, u, fs, r, periodic=periodic,
+                                 k_link=self._k_link(), upsampled=upsampled)
+        return y
 
 
 def _floating_linear_periodic(mech: Mechanics, u: NDArray[np.float64], fs: float
@@ -1091,5 +1250,124 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
                 return y, sy
         if not np.all(np.isfinite(x0)):
             break
+        prev = (y, sy)
+    raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))
+
+
+def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64], fs: float,
+                      r: int, *, periodic: bool, k_link: float = 0.0,
+                      upsampled: NDArray[np.float64] | None = None,
+                      dparams: NDArray[np.float64] | None = None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Output of a plant with a link of exact-update elements, and its sensitivities (FOH).
+
+    The plant is discretised exactly for a force linear over each of the `r`
+    fine steps per sample (:meth:`Mechanics.foh`), the elements advanced by
+    their exact update (:func:`~motionhyst.hysteresis.stepping.advance`), the
+    step's link force solved by a fixed-point iteration; with `dparams`, the
+    forward sensitivities of the output are carried along in the same compiled
+    run (the partials of each element's update,
+    :func:`~motionhyst.hysteresis.stepping.advance_partials`, and of the
+    implicit link force).  What :meth:`OpenLoop.simulate` runs for such a link,
+    and the exact Jacobian of :mod:`motionhyst.identify.input_output`; the
+    output is the same with or without the sensitivities, bit for bit.
+
+    Parameters
+    ----------
+    mech : Mechanics
+        The plant.
+    stepping : Stepping
+        The link's rows (:meth:`Hysteresis.time_stepping`; empty: no link).
+    u : ndarray
+        Force record [N] at `fs` [Hz].
+    r : int
+        Fine steps per sample.
+    periodic : bool
+        From rest (False) or the periodic steady state of the period `u`
+        (True: periods repeated until the output changes by less than
+        :data:`PERIODIC_RTOL` of its amplitude and, with `dparams`, the
+        sensitivities by less than 1e-8 of theirs; returned with zero mean for
+        a floating plant, as :meth:`OpenLoop.simulate`).
+    k_link : float
+        The link's initial stiffness [N/m] (bounds the periods a periodic run may take).
+    upsampled : ndarray, optional
+        ``fine_input(u, r, periodic)``, if already computed.
+    dparams : ndarray, shape (elements, N_PARAMS, P_link), optional
+        The derivatives of the rows' parameters in the link's `P_link`
+        parameters (every element of a kind in
+        :data:`~motionhyst.hysteresis.stepping.DIFFERENTIATED`); None: no
+        sensitivities.
+
+    Returns
+    -------
+    y : ndarray
+        Output position at the samples [m].
+    dy : ndarray, shape (len(u), p + P_link)
+        Its derivatives in the plant's `p` parameters (the rows of
+        ``mech.dmass``), then the link's; ``(len(u), 0)`` without `dparams`.
+
+    Examples
+    --------
+    A Jenkins link ``(k, fc)``: its row ``(k, fc)`` moves one for one with them.
+
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> link = Jenkins(k=2e4, fc=10.0)
+    >>> t = np.arange(256) / 750
+    >>> u = 40 * np.sin(2 * np.pi * 8 * t)
+    >>> dparams = np.zeros((1, N_PARAMS, 2))
+    >>> dparams[0, 0, 0] = dparams[0, 1, 1] = 1.0
+    >>> plant = MassSpringDamper(2.0, 10.0, 5e4)
+    >>> y, dy = simulate_elements(plant.mechanics(), link.time_stepping(), u, 750.0, 10,
+    ...                           periodic=False, dparams=dparams)
+    >>> ref = OpenLoop(plant, link).simulate(t, u, substeps=10)
+    >>> bool(np.array_equal(y, ref.displacement)), dy.shape    # m, c, k, link k, fc
+    (True, (256, 5))
+    """
+    h = 1.0 / (fs * r)
+    sens = dparams is not None
+    Ad, B0, B1, dAd, dB0, dB1 = mech.foh(h, derivatives=sens)
+    ns = Ad.shape[0]
+    n_el = stepping.codes.size
+    if sens:
+        if not np.all(np.isin(stepping.codes, DIFFERENTIATED)):
+            raise ValueError("sensitivities need elements of the kinds advance_partials "
+                             "differentiates (stop, Dahl, LuGre, Maxwell)")
+        dp = np.ascontiguousarray(dparams, dtype=float)
+        n_sens = dAd.shape[0] + dp.shape[2]
+    else:
+        dp = np.zeros((n_el, N_PARAMS, 0))
+        n_sens = 0
+    uf = np.ascontiguousarray(upsampled if upsampled is not None
+                              else fine_input(u, r, periodic), dtype=float)
+    codes = np.ascontiguousarray(stepping.codes, dtype=np.int64)
+    params = np.ascontiguousarray(stepping.params, dtype=float)
+    ftol = 1e-13 * stepping.scale
+
+    def run(x, s, sx, ss):
+        *out, worst = _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, mech.link, mech.output, uf, r,
+                                    codes, params, dp, GL_T, GL_W, h, ftol,
+                                    MAX_FIXED_POINT_ITERATIONS, x, s, sx, ss)
+        _check_converged(worst)
+        return out
+
+    x, s = np.zeros(ns), np.array(stepping.state0, dtype=float)
+    sx, ss = np.zeros((ns, n_sens)), np.zeros((n_el, n_sens))
+    if not periodic:
+        y, sy, *_ = run(x, s, sx, ss)
+        return y, sy
+    prev = None
+    step: list[float] = []
+    for _ in range(_max_periods(mech, k_link, u.size / fs)):
+        y, sy, x, s, sx, ss = run(x, s, sx, ss)
+        y, sy = y[:-1], sy[:-1]
+        if prev is not None:
+            ok = _settled(y, prev[0], mech.floating, step)
+            if sens:
+                ok &= bool(np.all(np.max(np.abs(sy - prev[1]), axis=0)
+                                  <= 1e-8 * (np.max(np.abs(sy), axis=0) + 1e-300)))
+            if ok:
+                if mech.floating:  # defined up to a constant: zero mean
+                    return y - np.mean(y), sy - np.mean(sy, axis=0)
+                return y, sy
         prev = (y, sy)
     raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))

@@ -40,7 +40,7 @@ Method
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
    from forward sensitivities integrated with the model (RK4); other links:
    the exact Jacobian from the forward sensitivities of their simulation
-   (:mod:`~motionhyst.identify._element_sensitivities`; finite differences,
+   (:func:`~motionhyst.openloop.simulate_elements`; finite differences,
    columns in parallel threads, for an element kind without them).  Stopping rule:
    the first of a relative cost reduction below ``ftol``, a relative step below ``xtol`` or a scaled
    gradient below ``gtol`` (all ``1e-12`` by default), or ``max_nfev``
@@ -90,6 +90,7 @@ from motionhyst.openloop import (
     is_periodic_record,
     sampling_rate,
     simulate_bouc_wen,
+    simulate_elements,
 )
 
 MIN_SAMPLES = 64
@@ -1129,7 +1130,7 @@ class _ElementProblem:
     (see :class:`_LinkLayout`); those not in `free` stay at their values in
     `fixed`.  The Jacobian is exact, from the
     forward sensitivities of the simulation
-    (:mod:`~motionhyst.identify._element_sensitivities`, computed with the
+    (:func:`~motionhyst.openloop.simulate_elements`, computed with the
     residuals), or, for an element kind without them or with `exact` False,
     by forward differences (relative step ``1e-6``), its columns computed in
     parallel (the two-mass stage's: forward differences).
@@ -1196,25 +1197,24 @@ class _ElementProblem:
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
         """Residuals and their exact Jacobian in the free variables (forward sensitivities);
         None if the link has an element kind without them."""
-        from motionhyst.identify._element_sensitivities import (
-            row_derivatives,
-            simulate_with_sensitivities,
-        )
+        from motionhyst.identify._element_sensitivities import row_derivatives
 
         v = self.values(self.whole(q_free))
         n_rows = sum(rec.y.size for rec in self.records)
+        k = self.n_plant
         try:
-            dparams = row_derivatives(self.layout.build, v[3:])
+            dparams = row_derivatives(self.layout.build, v[k:])
             if dparams is None:
                 return None
-            link = self.layout.build(v[3:])
+            link = self.layout.build(v[k:])
             stepping = link.time_stepping()
+            mech = self.plant.mechanics(v[:k])
 
             def one(i):
                 rec = self.records[i]
-                return simulate_with_sensitivities(v[0], v[1], v[2], stepping, dparams, rec.u,
-                                                   rec.fs, self.r, self.periodic, self.fine[i],
-                                                   link.initial_stiffness)
+                return simulate_elements(mech, stepping, rec.u, rec.fs, self.r,
+                                         periodic=self.periodic, k_link=link.initial_stiffness,
+                                         upsampled=self.fine[i], dparams=dparams)
 
             if len(self.records) > 1:  # the compiled runs release the GIL
                 with ThreadPoolExecutor(max_workers=min(len(self.records),
