@@ -15,14 +15,23 @@ resonance at 694 Hz falls between two lines).  The example
 4. analyses the Table I loop on the fitted plant and on the exact stage: the
    mismatch ``|E|`` of eq. (18) at 1, 5 and 10 Hz, and the margins of ``C P2``.
 
-Run ``python examples/measured_plant.py [OUT_DIR]`` (default ``out/measured_plant``);
-then ``motionhyst analyze OUT_DIR/measured.toml`` gives the same fit and analysis
-from the command line.
+Two measurements that go wrong in practice can be made instead:
+
+- ``--delay-us 50``: the chain delays both transfers by 50 us (``e^{-s tau}``, a
+  sample-and-hold and a computation step); the fit estimates the delay, divides it out
+  and finds the same stage;
+- ``--k-ground 20``: the link sticks during the measurement and holds ``m1`` to the
+  ground with its stiffness ``k_J = 20 N/m`` (eq. 13); no rigid body plus modes
+  describes that, and the fit says so in a warning.
+
+Run ``python examples/measured_plant.py [OUT_DIR] [--delay-us US] [--k-ground K]``
+(default ``out/measured_plant``); then ``motionhyst analyze OUT_DIR/measured.toml`` gives
+the same fit and analysis from the command line.
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 from pathlib import Path
 
 import matplotlib
@@ -41,9 +50,31 @@ FREQUENCIES_HZ = (1.0, 5.0, 10.0)
 TABLE_I = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
 
 
-def measure(seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """``P1``, ``P2`` of Table I at :data:`LINES_HZ` with relative complex noise."""
-    p1, p2 = ModalPlant.from_two_mass(TABLE_I).response(2 * np.pi * LINES_HZ)
+def held_response(k_ground: float) -> tuple[np.ndarray, np.ndarray]:
+    """``P1``, ``P2`` of Table I at :data:`LINES_HZ` with ``m1`` held to the ground by a
+    spring `k_ground` [N/m] (a link that sticks)."""
+    s = 2j * np.pi * LINES_HZ
+    st = TABLE_I
+    z11 = st.m1 * s**2 + st.b * s + st.k + k_ground
+    z22, z12 = st.m2 * s**2 + st.b * s + st.k, -(st.b * s + st.k)
+    det = z11 * z22 - z12**2
+    return z22 / det, -z12 / det
+
+
+def measure(seed: int = 0, delay_s: float = 0.0,
+            k_ground: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``P1``, ``P2`` of Table I at :data:`LINES_HZ` with relative complex noise.
+
+    `delay_s` [s] delays both (``e^{-s tau}``); `k_ground` [N/m] holds ``m1`` to the
+    ground (:func:`held_response`).
+    """
+    if k_ground:
+        p1, p2 = held_response(k_ground)
+    else:
+        p1, p2 = ModalPlant.from_two_mass(TABLE_I).response(2 * np.pi * LINES_HZ)
+    if delay_s:
+        lag = np.exp(-2j * np.pi * LINES_HZ * delay_s)
+        p1, p2 = p1 * lag, p2 * lag
     rng = np.random.default_rng(seed)
 
     def noisy(p: np.ndarray) -> np.ndarray:
@@ -71,8 +102,8 @@ def scenario_text() -> str:
     return text[:start] + plant + text[end:]
 
 
-def main(out_dir: str | Path = "out/measured_plant", seed: int = 0,
-         quiet: bool = False) -> dict:
+def main(out_dir: str | Path = "out/measured_plant", seed: int = 0, quiet: bool = False,
+         delay_s: float = 0.0, k_ground: float = 0.0) -> dict:
     """Write the measurement and scenario, fit, draw and analyse; return the numbers.
 
     Parameters
@@ -83,16 +114,21 @@ def main(out_dir: str | Path = "out/measured_plant", seed: int = 0,
         Seed of the measurement noise.
     quiet : bool
         Print nothing.
+    delay_s : float
+        Delay of the measurement chain [s] (:func:`measure`).
+    k_ground : float
+        Stiffness holding ``m1`` to the ground during the measurement [N/m].
 
     Returns
     -------
     dict
         ``fit`` (:meth:`motionhyst.FrfFit.to_dict`), ``mismatch_fit`` and
         ``mismatch_exact`` (``|E|`` at :data:`FREQUENCIES_HZ`), ``margins_fit``,
-        ``margins_exact`` and the paths written.
+        ``margins_exact``, ``warnings`` (:attr:`motionhyst.FrfFit.warnings`) and the
+        paths written.
     """
     out = Path(out_dir)
-    p1, p2 = measure(seed)
+    p1, p2 = measure(seed, delay_s, k_ground)
     OutputFile(out / "frf.csv", force=True).write_text(frf_csv(p1, p2))
     OutputFile(out / "measured.toml", force=True).write_text(scenario_text())
 
@@ -116,6 +152,7 @@ def main(out_dir: str | Path = "out/measured_plant", seed: int = 0,
         "mismatch_exact": [abs(p.value) for p in on_exact.points],
         "margins_fit": {k: on_fit.to_dict()[k] for k in margin_keys},
         "margins_exact": {k: on_exact.to_dict()[k] for k in margin_keys},
+        "warnings": list(fit.warnings),
         "files": [str(out / "frf.csv"), str(out / "measured.toml"), str(figure)],
     }
     if not quiet:
@@ -133,4 +170,11 @@ def main(out_dir: str | Path = "out/measured_plant", seed: int = 0,
 
 if __name__ == "__main__":
     matplotlib.use("Agg")
-    main(sys.argv[1] if len(sys.argv) > 1 else "out/measured_plant")
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out_dir", nargs="?", default="out/measured_plant")
+    parser.add_argument("--delay-us", type=float, default=0.0,
+                        help="delay of the measurement chain [us]")
+    parser.add_argument("--k-ground", type=float, default=0.0,
+                        help="stiffness holding m1 to the ground (a stuck link) [N/m]")
+    args = parser.parse_args()
+    main(args.out_dir, delay_s=args.delay_us * 1e-6, k_ground=args.k_ground)

@@ -126,6 +126,22 @@ def test_measured_plant_fit_recovers_table_I(measured):
         assert measured["margins_fit"][key] == pytest.approx(exact, rel=5e-3), key
 
 
+def test_measured_plant_through_a_delay_and_with_the_link_stuck(tmp_path):
+    """--delay-us 50: the delay found (50.1 +- 0.07 us) and |E| as without it (measured:
+    3349 / 6.039 / 1.239); --k-ground 20: the fit is |E| = 1.049 at 1 Hz and says it is
+    wrong in one warning."""
+    example = load_example("measured_plant")
+    delayed = example.main(tmp_path / "delay", quiet=True, delay_s=50e-6)
+    fit = delayed["fit"]
+    assert abs(fit["delay_s"] - 50e-6) < 4 * fit["delay_std_s"] and len(fit["modes"]) == 1
+    assert delayed["warnings"] == []
+    np.testing.assert_allclose(delayed["mismatch_fit"], delayed["mismatch_exact"], rtol=2e-3)
+    stuck = example.main(tmp_path / "stuck", quiet=True, k_ground=20.0)
+    (warning,) = stuck["warnings"]
+    assert "not a floating rigid body" in warning
+    assert stuck["mismatch_fit"][0] < 0.01 * stuck["mismatch_exact"][0]
+
+
 def test_measured_plant_files_give_the_same_fit_on_the_command_line(measured, capsys):
     csv_path, toml_path, figure = (Path(p) for p in measured["files"])
     assert csv_path.read_text().splitlines()[0] == \

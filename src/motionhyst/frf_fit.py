@@ -41,6 +41,29 @@ Bayesian information criterion ``BIC = N ln(RSS / N) + p ln N`` over
 ``n = 0, 1, 2, ...`` (``N`` real residuals, ``p`` parameters).
 Uncertainties are one standard deviation from the Jacobian at the
 solution, ``cov = s^2 (J^T J)^-1`` with ``s^2 = RSS / (N - p)``.
+
+Delay
+-----
+A measurement chain delays both transfers by the same ``e^{-s tau}``
+(sample-and-hold, computation, transport).  The fit is made a second time
+with ``tau >= 0`` as one more parameter and the delay divided out of the
+data, ``(P_model - P_data e^{s tau}) / |P_data|``, which has the modulus of
+the error of the delayed model.  It starts from the delay at which the
+separable scan's best rigid body plus one mode fits best, over a grid of
+0.1 rad steps of phase at the highest line up to three turns (the 180 deg a
+non-collocated ``P2`` loses above a mode is told apart from a delay only
+with the mode); modes are then added as without a delay, the delay refined
+with them.  Of the two, the fit with the lower BIC is kept (the delay costs
+``ln N``), so data without a delay keep the fit without one.
+
+Warnings
+--------
+:attr:`FrfFit.warnings` says, one line each, where the data are not what
+the model describes: a negative ``Pf2(0)`` or a mode below the lowest line
+(a stiffness to ground, such as a link that sticks), a mode no passive
+stage has, and a decade band whose RMS error is more than
+:data:`RESIDUAL_NOISE_RATIO` times the line-to-line scatter of its errors
+(the noise; an error the model leaves changes slowly from line to line).
 """
 
 from __future__ import annotations
