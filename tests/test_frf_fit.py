@@ -272,6 +272,18 @@ def test_noise_free_delayed_data_are_recovered_exactly(exact):
         assert fit.rms_relative_error < 1e-8 and fit.warnings == []
 
 
+def test_delay_below_the_modes_and_a_mode_beyond_the_lines(exact):
+    """Lines 1-51 Hz only: the delay's phase is 0.9 deg at the highest line, and the mode
+    at 694 Hz is beyond the lines.  The delay is still found (within its uncertainty, a few
+    us); Pf2(0), and with it |E| at low frequencies, is not determined, which is said."""
+    lines = LINES[:30]
+    for seed in range(4):
+        fit = fit_frf(lines, *measure(exact, f=lines, seed=seed, delay=DELAY))
+        assert fit.delay_std_s < 1e-5 and abs(fit.delay_s - DELAY) < 4 * fit.delay_std_s
+        assert fit.pf2_static_std > 0.2 * exact.pf2_static
+        assert any("is not determined to 10% by the data" in w for w in fit.warnings)
+
+
 def test_two_modes_through_a_delay():
     truth = ModalPlant(22.5, [Mode(694.0, 0.003, 0.1555, 0.0444),
                               Mode(1800.0, 0.01, 0.05, -0.02)])

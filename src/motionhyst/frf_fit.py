@@ -60,7 +60,8 @@ Warnings
 --------
 :attr:`FrfFit.warnings` says, one line each, where the data are not what
 the model describes: a negative ``Pf2(0)`` or a mode below the lowest line
-(a stiffness to ground, such as a link that sticks), a mode no passive
+(a stiffness to ground, such as a link that sticks), a ``Pf2(0)`` the data
+do not determine to :data:`PF2_RELATIVE_STD`, a mode no passive
 stage has, and a decade band whose RMS error is more than
 :data:`RESIDUAL_NOISE_RATIO` times the line-to-line scatter of its errors
 (the noise; an error the model leaves changes slowly from line to line).
@@ -819,8 +820,9 @@ def _chain(prob: _Problem, x0, n_res: int, modes: int | None, max_modes: int,
            tau_first: float | None = None):
     """Fits with 0, 1, 2, ... modes, each started from the one before (module docstring).
 
-    Up to `modes`, or to the first minimum of the BIC.  `tau_first`: the delay
-    the scan for the first mode divides out (default: that of the fit without modes).
+    Up to `modes`, or to the first minimum of the BIC.  `tau_first`: a delay
+    the scan for the first mode also divides out, besides that of the fit
+    without modes (which a mode's phase can pull away); the better fit is kept.
     Returns ``{n: (x, rss)}`` and ``{n: BIC}``.
     """
     x, r = _solve(prob, x0, 0)
@@ -830,9 +832,15 @@ def _chain(prob: _Problem, x0, n_res: int, modes: int | None, max_modes: int,
     for n in range(1, target + 1):
         if 2 * (prob.n_head + 4 * n) > n_res:
             break
-        x0 = _start(prob, fits[n - 1][0], n - 1, tau_first if n == 1 else None)
-        x, r = _solve(prob, x0, n)
-        fits[n] = (x, float(r @ r))
+        taus = [None]
+        if n == 1 and tau_first is not None and tau_first != prob.unpack(fits[0][0], 0)[1]:
+            taus.append(tau_first)
+        tries = []
+        for tau in taus:
+            x, r = _solve(prob, _start(prob, fits[n - 1][0], n - 1, tau), n)
+            tries.append((float(r @ r), len(tries), x))
+        rss, _, x = min(tries)
+        fits[n] = (x, rss)
         bic[n] = _bic(fits[n][1], n_res, prob.n_head + 4 * n)
         if modes is None and bic[n] >= bic[n - 1]:
             break
@@ -886,6 +894,8 @@ def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
 #: A band's RMS error this many times the line-to-line scatter of its errors is far above
 #: the noise (for noise alone the ratio is 1, within about 0.2 for a band of 9 lines).
 RESIDUAL_NOISE_RATIO = 2.0
+#: Relative standard deviation of Pf2(0) above which it is not determined by the data.
+PF2_RELATIVE_STD = 0.1
 #: Fewest lines of a band checked for errors above its noise.
 _RESIDUAL_MIN_LINES = 5
 #: Relative errors below this are far below any measurement's noise: never warned about.
@@ -897,6 +907,8 @@ def _diagnose(fit: FrfFit) -> list[str]:
 
     - a stiffness to ground: a negative ``Pf2(0)`` or a mode below the lowest
       line (the lowest lines are then not a floating rigid body);
+    - ``Pf2(0)`` not determined: its standard deviation above
+      :data:`PF2_RELATIVE_STD` of it (the modes lie beyond the measured lines);
     - modes a passive stage does not have: a negative collocated residue
       ``r1`` (by more than 3 standard deviations) or a damping ratio at its bound;
     - errors far above the noise: in a decade band, the RMS of the complex
@@ -916,6 +928,10 @@ def _diagnose(fit: FrfFit) -> list[str]:
                    f"({', '.join(what)}): a stiffness to ground, such as a sticking link, that "
                    f"the stage of eqs. 1-2 lacks; |E| at low frequencies is wrong; measure with "
                    f"the link sliding or detached")
+    elif p.modes and not fit.pf2_static_std <= PF2_RELATIVE_STD * p.pf2_static:
+        out.append(f"measured plant: Pf2(0) = {_pm(p.pf2_static, fit.pf2_static_std)} m/N is not "
+                   f"determined to {PF2_RELATIVE_STD:.0%} by the data, nor is |E| at low "
+                   f"frequencies (eq. 20 divides by it); measure up to and beyond the first mode")
     odd = []
     for i, (m, s) in enumerate(zip(p.modes, fit.mode_std, strict=True), start=1):
         why = []
