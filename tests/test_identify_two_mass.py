@@ -11,6 +11,8 @@ from motionhyst.cli import main
 from motionhyst.hysteresis import BoucWen, Dahl, Jenkins
 from motionhyst.identify.input_output import (
     IORecord,
+    _ElementProblem,
+    _LinkLayout,
     best_linear_approximation_two_mass,
     identify_io,
 )
@@ -88,6 +90,31 @@ def test_element_links_recovered_from_noise_free_records(model, link, expected):
     for name, value in {**STAGE, **expected}.items():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
     assert fit.hysteresis.to_dict()["model"] == model
+    assert "(exact Jacobian" in fit.stopping  # the two-mass stage's element sensitivities
+
+
+def test_the_exact_jacobian_of_a_periodic_floating_stage():
+    """Element links on the two-mass stage's periodic steady state (defined up to a constant:
+    the output, its sensitivities and the record compared without their means): residuals
+    at the truth vanish, the exact Jacobian is the residuals' central differences."""
+    # slipping at 20 N of a 20 N RMS force with odd harmonics: no drift, every column alive
+    rec = _record(512, 4, periodic=True, rms=20.0, link=Jenkins(k=5e4, fc=20.0), substeps=10)
+    rec = IORecord(rec.t, rec.u, rec.y + 3e-3, rec.name)  # the stage's offset is arbitrary
+    layout = _LinkLayout.of("jenkins", 1)
+    values = np.array([*STAGE.values(), 5e4, 20.0])
+    prob = _ElementProblem([rec], True, 10, layout, float(np.std(rec.y)), values,
+                           plant=TwoMass(**STAGE))
+    q = prob.variables(values)
+    r = prob.residuals(q)
+    J = prob.jacobian(q)
+    assert prob.exact
+    assert np.max(np.abs(r)) < 1e-9  # in units of the output's RMS
+    for b in range(q.size):
+        hi, lo = q.copy(), q.copy()
+        hi[b] += 1e-5
+        lo[b] -= 1e-5
+        fd = (prob._run(hi) - prob._run(lo)) / 2e-5
+        assert np.max(np.abs(J[:, b] - fd)) < 2e-6 * np.max(np.abs(fd)), b
 
 
 def test_best_linear_approximation_with_the_link_a_spring():

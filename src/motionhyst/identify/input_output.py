@@ -35,12 +35,13 @@ Method
    ARX model of the records), then the link's initial stiffness 1, 3 and 9
    times that spring with mild to strong nonlinearity, then three splits of
    the mass at the same internal mode (see :func:`_two_mass_start`); its
-   element links by finite differences.
+   element links from 1, 4 and 16 times that spring and forces of 0.3 to 3
+   times the force's RMS (see :func:`_identify_elements`).
 3. Refinement: :func:`scipy.optimize.least_squares` (trust-region reflective)
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
    from forward sensitivities integrated with the model (RK4); other links:
-   the exact Jacobian from the forward sensitivities of their simulation
-   (:func:`~motionhyst.openloop.simulate_elements`; finite differences,
+   the exact Jacobian from the forward sensitivities of their simulation, on
+   either plant (:func:`~motionhyst.openloop.simulate_elements`; finite differences,
    columns in parallel threads, for an element kind without them).  Stopping rule:
    the first of a relative cost reduction below ``ftol``, a relative step below ``xtol`` or a scaled
    gradient below ``gtol`` (all ``1e-12`` by default), or ``max_nfev``
@@ -1133,7 +1134,7 @@ class _ElementProblem:
     (:func:`~motionhyst.openloop.simulate_elements`, computed with the
     residuals), or, for an element kind without them or with `exact` False,
     by forward differences (relative step ``1e-6``), its columns computed in
-    parallel (the two-mass stage's: forward differences).
+    parallel.
     """
 
     def __init__(self, records, periodic, substeps, layout: _LinkLayout, y_scale,
@@ -1146,8 +1147,6 @@ class _ElementProblem:
         self.n_plant = len(self.plant.PARAMETERS)
         # a floating stage's periodic output is known up to a constant: compared without means
         self.centre = periodic and isinstance(self.plant, TwoMass)
-        if isinstance(self.plant, TwoMass):
-            exact = False  # the element sensitivities are the mass-spring-damper's
         self.log = np.concatenate([[True] * self.n_plant, layout.logarithmic])
         self.scale = scale
         self.free = np.ones(self.log.size, bool) if free is None else free
@@ -1222,8 +1221,8 @@ class _ElementProblem:
                     outs = list(pool.map(one, range(len(self.records))))
             else:
                 outs = [one(0)]
-            r = np.concatenate([y - rec.y for (y, _), rec in zip(outs, self.records,
-                                                                 strict=True)])
+            r = np.concatenate([y - (rec.y - np.mean(rec.y) if self.centre else rec.y)
+                                for (y, _), rec in zip(outs, self.records, strict=True)])
             J = np.concatenate([sy for _, sy in outs]) * self.derivative(v)
         except ValueError:
             return np.full(n_rows, 1e3), np.zeros((n_rows, int(self.free.sum())))
@@ -1304,7 +1303,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     16 times the linear one (its initial stiffness is above that secant one),
     its forces together 0.3, 1 or 3 times the records' force RMS; a parameter
     that adds a spring or damper in parallel is fixed at 0 (the stage has none
-    to the ground to hold it), and the Jacobian is by forward differences.
+    to the ground to hold it).
     """
     layout = _LinkLayout.of(model, n)
     y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and plant == "two-mass"
