@@ -25,13 +25,16 @@ from matplotlib.figure import Figure
 
 from motionhyst.figure_writer import FigureWriter, save_figures
 
-__all__ = ["STYLE", "FigureWriter", "MinorLogLocator", "plot_analysis", "plot_frf_fit",
-           "plot_steady_state", "save_figures"]
+__all__ = ["STYLE", "DecadeFormatter", "FigureWriter", "MinorLogLocator", "plot_analysis",
+           "plot_frf_fit", "plot_steady_state", "save_figures"]
 
 STYLE = {
     "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
     "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False, "font.size": 9,
     "legend.fontsize": 8, "legend.frameon": False, "lines.linewidth": 1.4,
+    # titles just above their axes (nothing is drawn above an axes but its title): matplotlib
+    # would otherwise look for a place clear of the axes' tick labels at every draw
+    "axes.titley": 1.0,
 }
 MODE2_COLOR, MODE3_COLOR, LINEAR_COLOR = "0.15", "tab:red", "tab:blue"
 
@@ -69,8 +72,37 @@ class MinorLogLocator(matplotlib.ticker.LogLocator):
         return super().tick_values(vmin, vmax)
 
 
+_SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076"
+                                            "\u2077\u2078\u2079")
+
+
+class DecadeFormatter(matplotlib.ticker.LogFormatterSciNotation):
+    """Labels of a log axis with its decades as plain text: ``10⁻¹``, ``10⁰``, ``10³``.
+
+    Other labels as :class:`matplotlib.ticker.LogFormatterSciNotation` gives
+    them.  Plain text with Unicode superscripts looks like matplotlib's math
+    text and needs no math-text layout at each draw.
+
+    Examples
+    --------
+    >>> from motionhyst.figures import DecadeFormatter
+    >>> DecadeFormatter()(0.01), DecadeFormatter()(1000.0)
+    ('10⁻²', '10³')
+    """
+
+    def __call__(self, x: float, pos: int | None = None) -> str:
+        """The label of the tick at `x`."""
+        label = super().__call__(x, pos)
+        if label and x > 0:
+            exponent = round(float(np.log10(x)))
+            if np.isclose(x, 10.0**exponent, rtol=1e-9, atol=0.0):
+                return "10" + str(exponent).translate(_SUPERSCRIPT)
+        return label
+
+
 def _minor_log_ticks(fig: Figure) -> None:
-    """Give every log axis of `fig` the 1-2-5 minor ticks of :class:`MinorLogLocator`.
+    """Give every log axis of `fig` the 1-2-5 minor ticks of :class:`MinorLogLocator` and the
+    labels of :class:`DecadeFormatter`.
 
     Called once the data is plotted (setting a log scale resets an axis's locators).
     """
@@ -78,6 +110,7 @@ def _minor_log_ticks(fig: Figure) -> None:
         for axis in (ax.xaxis, ax.yaxis):
             if axis.get_scale() == "log":
                 axis.set_minor_locator(MinorLogLocator())
+                axis.set_major_formatter(DecadeFormatter())
 
 
 def _figure(nrows: int = 1, sharex: bool = True):

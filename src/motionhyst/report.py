@@ -264,12 +264,10 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
 
         with (folder, tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch,
               FigureWriter(scratch, ("png", "pdf"), done=stage) as figures):
-            # the link's compiled kernels (numba), loaded here once: the steady states need them
-            # and the workers forked from now on inherit them instead of loading their own
-            el.sine_loop(A, None if el.rate_independent else TWO_PI * freqs[0])
-            # Figs. 5-8 need no loop: a worker loads matplotlib and draws them while this process
-            # imports the analysis (python-control) and builds the loop; the later workers
-            # inherit matplotlib from this process (python-control imports it)
+            # Figs. 5-8 need no loop: at once, a worker loads the link's compiled kernels (numba)
+            # and matplotlib and draws them while this process imports the analysis
+            # (python-control) and builds the loop; the later workers inherit both from this
+            # process (python-control imports matplotlib)
             figures.submit(_link_figures(el, A, freqs))
             from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
             from motionhyst.steady import periodic_steady_state
@@ -283,6 +281,9 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             fit = sc.plant_fit()
             if fit is not None:
                 figures.submit({"plant_fit": fit.plot})
+            # the link's kernels, loaded only now (Fig. 9 needs none for a rate-independent
+            # link): the steady states need them, and the later workers inherit them
+            el.sine_loop(A, None if el.rate_independent else TWO_PI * freqs[0])
             raw_data = isinstance(loop.plant, MeasuredPlant)
             if raw_data:  # the steady state needs the plant at every harmonic: no exact results
                 states, E_df, H_df, exact = [], [], [], []
