@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import multiprocessing
-import os
 import subprocess
 import sys
 import textwrap
@@ -129,17 +128,6 @@ def test_figures_module_still_offers_the_writer():
     from motionhyst import figures
 
     assert figures.FigureWriter is FigureWriter and figures.save_figures is save_figures
-
-
-def test_workers_run_at_a_lower_priority_than_the_caller(tmp_path):
-    def fig5_and_priority():
-        (tmp_path / "nice.txt").write_text(str(os.nice(0)))
-        return MAKERS["fig5"]()
-
-    with FigureWriter(tmp_path, ("png",), parallel=True, nice=3) as writer:
-        writer.submit({"fig5": fig5_and_priority})
-        writer.wait()
-    assert int((tmp_path / "nice.txt").read_text()) == min(os.nice(0) + 3, 19)
 
 
 def test_a_caller_without_matplotlib_leaves_loading_it_to_the_worker(tmp_path):

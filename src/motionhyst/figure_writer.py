@@ -104,11 +104,10 @@ class _WorkerTraceback(Exception):
 
 
 def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[str],
-                conn, nice: int) -> None:
+                conn) -> None:
     """A worker's job: draw `makers` in order, sending each name (or the error) on `conn`.
 
-    The worker lowers its priority by `nice`.  A kernel compiled here is not
-    announced on stderr: the caller announces its own.
+    A kernel compiled here is not announced on stderr: the caller announces its own.
     """
     from motionhyst._jit import quiet_compilation
 
@@ -118,8 +117,6 @@ def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        if nice > 0:
-            os.nice(nice)
         for name, make in makers.items():
             _draw_and_save(name, make, folder, formats)
             conn.send(("done", name))
@@ -162,10 +159,6 @@ class FigureWriter:
     parallel : bool, optional
         Draw in forked workers; by default when ``fork`` exists and more than
         one core is usable.
-    nice : int, optional
-        How much lower the workers' scheduling priority is than the caller's
-        (``os.nice``; 0 keeps it): while workers draw, the caller, computing
-        the data of the next figures, keeps a core to itself.
 
     Notes
     -----
@@ -195,12 +188,11 @@ class FigureWriter:
 
     def __init__(self, folder: str | Path, formats: Sequence[str] = ("png", "pdf"),
                  done: Callable[[str], None] | None = None,
-                 parallel: bool | None = None, nice: int = 5) -> None:
+                 parallel: bool | None = None) -> None:
         self.folder = Path(folder)
         self.formats = tuple(formats)
         self.done = done
         self.parallel = _can_fork() if parallel is None else bool(parallel)
-        self.nice = int(nice)
         self._names: list[str] = []
         self._workers: list[tuple[multiprocessing.process.BaseProcess, Connection]] = []
 
@@ -223,7 +215,7 @@ class FigureWriter:
         ctx = multiprocessing.get_context("fork")
         receive, send = ctx.Pipe(duplex=False)
         worker = ctx.Process(target=_draw_batch, daemon=True,
-                             args=(dict(makers), self.folder, self.formats, send, self.nice))
+                             args=(dict(makers), self.folder, self.formats, send))
         # the worker's garbage collections leave alone the objects it inherits (all of this
         # process's): without, each goes through them all and copies their memory pages, a
         # quarter of a figure's drawing time
