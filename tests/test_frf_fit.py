@@ -272,6 +272,19 @@ def test_noise_free_delayed_data_are_recovered_exactly(exact):
         assert fit.rms_relative_error < 1e-8 and fit.warnings == []
 
 
+def test_the_fit_figure_says_the_delay_was_divided_out(exact):
+    from motionhyst.figures import plot_frf_fit
+
+    delayed = plot_frf_fit(fit_frf(LINES, *measure(exact, noise=0.0, delay=50e-6)))
+    assert "delay 50 us" in delayed.axes[0].get_title()
+    labels = [t.get_text() for t in delayed.axes[0].get_legend().get_texts()]
+    assert "P1 (collocated), measured (delay divided out)" in labels
+    plain = plot_frf_fit(fit_frf(LINES, *measure(exact, noise=0.0)))
+    assert "delay" not in plain.axes[0].get_title()
+    assert "P1 (collocated), measured" in [t.get_text() for t in
+                                           plain.axes[0].get_legend().get_texts()]
+
+
 def test_delay_below_the_modes_and_a_mode_beyond_the_lines(exact):
     """Lines 1-51 Hz only: the delay's phase is 0.9 deg at the highest line, and the mode
     at 694 Hz is beyond the lines.  The delay is still found (within its uncertainty, a few

@@ -212,11 +212,12 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
         f = np.union1d(f, [m.frequency_hz for m in fit.plant.modes if lo <= m.frequency_hz <= hi])
     m1, m2 = fit.plant.response(2 * np.pi * f)
     fig, (ax1, ax2) = _figure(2)
+    delayed = " (delay divided out)" if fit.delay_s > 0 else ""
     for P, D, color, name in ((m1, fit.P1_data, "tab:blue", "P1 (collocated)"),
                               (m2, fit.P2_data, "tab:red", "P2 (non-collocated)")):
         ax1.semilogx(f, 20 * np.log10(np.abs(P)), color=color, label=f"{name}, fit")
         ax1.semilogx(f_data, 20 * np.log10(np.abs(D)), "o", ms=3, mfc="none", color=color,
-                     label=f"{name}, measured")
+                     label=f"{name}, measured{delayed}")
         ph = np.degrees(np.unwrap(np.angle(P)))
         ph -= 360.0 * np.ceil(ph[0] / 360.0)  # starting in (-360, 0]
         # the data on the fit's branch of the phase
@@ -234,8 +235,9 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
     ax1.set_ylabel("magnitude [dB re 1 m/N]")
     ax2.set_ylabel("phase [deg]")
     ax2.set_xlabel("frequency [Hz]")
+    delay = f", delay {fit.delay_s * 1e6:.3g} us" if fit.delay_s > 0 else ""
     ax1.set_title(f"Measured plant and fit: rigid body M = {fit.plant.M:.4g} kg + "
-                  f"{len(fit.plant.modes)} mode(s), RMS relative error "
+                  f"{len(fit.plant.modes)} mode(s){delay},\nRMS relative error "
                   f"{fit.rms_relative_error:.2g}", fontsize=9)
     ax1.legend(loc="lower left")
     _minor_log_ticks(fig)
