@@ -88,7 +88,7 @@ def main(out_dir: str | Path = "out/identify_input_output", seed: int = 0,
     Returns
     -------
     dict
-        ``identified`` (:meth:`motionhyst.identify.input_output.IOIdentification.to_dict`),
+        ``identified`` (:meth:`motionhyst.identify.io_results.IOIdentification.to_dict`),
         ``true`` (the benchmark's parameters), ``fit_rms`` [m], ``test_rmse`` and
         ``test_output_rms`` [m] of the held-out prediction, and the paths written.
     """

@@ -8,7 +8,7 @@ from scipy.linalg import expm
 
 from motionhyst.hysteresis import Dahl, Jenkins, LuGre, MaxwellSlip
 from motionhyst.identify._element_sensitivities import row_derivatives
-from motionhyst.identify.input_output import _LinkLayout
+from motionhyst.identify.io_elements import _LinkLayout
 from motionhyst.lti import expm_small
 from motionhyst.openloop import (
     MassSpringDamper,

@@ -211,7 +211,7 @@ def test_free_exponent_of_the_benchmark_link_is_fixed_at_one():
 
 
 def test_inseparable_parameters_are_reported_not_given_huge_errors():
-    from motionhyst.identify.input_output import _uncertainty, _undetermined_notes
+    from motionhyst.identify.io_uncertainty import _uncertainty, _undetermined_notes
 
     rng = np.random.default_rng(8)
     a, b = rng.standard_normal(200), rng.standard_normal(200)

@@ -11,11 +11,10 @@ from motionhyst.cli import main
 from motionhyst.hysteresis import BoucWen, Dahl, Jenkins
 from motionhyst.identify.input_output import (
     IORecord,
-    _ElementProblem,
-    _LinkLayout,
     best_linear_approximation_two_mass,
     identify_io,
 )
+from motionhyst.identify.io_elements import _ElementProblem, _LinkLayout
 from motionhyst.openloop import OpenLoop, TwoMass
 
 FS = 750.0

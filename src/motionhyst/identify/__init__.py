@@ -75,7 +75,11 @@ fit
 closed_loop
     The link force inferred from closed-loop records, and its fit.
 input_output
-    Grey-box identification of stage and link from input-output records.
+    Grey-box identification of stage and link from input-output records, the
+    entry point of its parts: io_records (the records), io_start (the best
+    linear approximations), io_bouc_wen (the Bouc-Wen link), io_elements (the
+    registry's other links), io_uncertainty (standard errors, what the records
+    do not determine) and io_results (:class:`~motionhyst.identify.io_results.IOIdentification`).
 result
     :class:`Identification`, the result of (a) and (b).
 """

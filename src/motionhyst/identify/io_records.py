@@ -1,0 +1,85 @@
+"""Input-output records: force in, displacement out, one sampling rate.
+
+What :func:`motionhyst.identify.input_output.identify_io` takes: an
+:class:`IORecord` per experiment (read from CSV by :func:`load_io_csv`), checked
+by :func:`check_records`; the refinements' starts are tried on the short part
+of the records :func:`_short_records` cuts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.openloop import check_record, sampling_rate
+
+MIN_SAMPLES = 64
+
+
+@dataclass
+class IORecord:
+    """One input-output record: time [s], force [N], displacement [m] and a name."""
+
+    t: NDArray[np.float64]
+    u: NDArray[np.float64]
+    y: NDArray[np.float64]
+    name: str = "record"
+
+    @property
+    def fs(self) -> float:
+        """Sampling frequency [Hz]."""
+        return sampling_rate(self.t)
+
+
+def load_io_csv(path: str | Path) -> IORecord:
+    """Read a record with columns ``time,force,displacement`` (one-line ``ValueError``)."""
+    from motionhyst.csvdata import read_columns
+
+    data = read_columns(path, ("time", "force", "displacement"))
+    return IORecord(data[:, 0], data[:, 1], data[:, 2], str(path))
+
+
+def check_records(records: list[IORecord], periodic: bool) -> list[IORecord]:
+    """Validate records; raises ``ValueError`` with one line naming the record."""
+    if not records:
+        raise ValueError("no records")
+    out = []
+    for rec in records:
+        t = np.asarray(rec.t, dtype=float)
+        u = np.asarray(rec.u, dtype=float)
+        y = np.asarray(rec.y, dtype=float)
+        if not (t.shape == u.shape == y.shape) or t.ndim != 1:
+            raise ValueError(f"{rec.name}: time, force and displacement differ in length")
+        if t.size < MIN_SAMPLES:
+            raise ValueError(f"{rec.name}: too short ({t.size} samples; need at least "
+                             f"{MIN_SAMPLES})")
+        if not np.all(np.isfinite(y)):
+            raise ValueError(f"{rec.name}: displacement is not finite everywhere")
+        try:
+            check_record(t, u)
+        except ValueError as exc:
+            raise ValueError(f"{rec.name}: {exc}") from None
+        if np.ptp(u) <= 1e-12 * max(1.0, float(np.max(np.abs(u)))):
+            raise ValueError(f"{rec.name}: the force is constant; it excites nothing")
+        if np.ptp(y) == 0.0:
+            raise ValueError(f"{rec.name}: the displacement is constant")
+        out.append(IORecord(t, u, y, rec.name))
+    fs = out[0].fs
+    for rec in out[1:]:
+        if abs(rec.fs - fs) > 1e-9 * fs:
+            raise ValueError(f"{rec.name}: sampled at {rec.fs:.6g} Hz, {out[0].name} at "
+                             f"{fs:.6g} Hz; records must share one sampling rate")
+    return out
+
+
+
+def _short_records(records: list[IORecord], periodic: bool, n_max: int = 4096
+                   ) -> list[IORecord]:
+    """The first record, or its first `n_max` samples from rest (whole for periodic records)."""
+    rec = records[0]
+    if periodic or rec.y.size <= n_max:
+        return [rec]
+    return [IORecord(rec.t[:n_max], rec.u[:n_max], rec.y[:n_max], rec.name)]

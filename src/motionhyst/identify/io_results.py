@@ -1,0 +1,105 @@
+"""The result of an input-output identification: :class:`IOIdentification`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.hysteresis import Hysteresis
+from motionhyst.identify.io_records import IORecord
+from motionhyst.openloop import MassSpringDamper, OpenLoop
+
+
+@dataclass
+class IOIdentification:
+    """A plant and link identified from input-output records by simulation error.
+
+    Attributes
+    ----------
+    plant : MassSpringDamper or TwoMass
+    hysteresis : Hysteresis
+        The link model (Bouc-Wen in the general form, normalised so that
+        ``|gamma| + |delta| = 1``; or Maxwell-slip).
+    estimates : dict
+        Every estimated parameter (identifiable quantities only) by name.
+    std : dict
+        Standard error of each estimate (same keys); ``None`` where the data
+        do not determine it (then listed in `not_identifiable`).
+    not_identifiable : dict
+        Parameter name -> why it is not identifiable and what is.
+    fit_rms : float
+        RMS simulation error over all records [m].
+    records : list of dict
+        Per record: ``{"name", "samples", "fit_rms", "output_rms"}``.
+    seconds : float
+        Wall time of the identification [s].
+    periodic : bool
+        Records taken as steady-state periods (True) or from rest (False).
+    stopping : str
+        Why the refinement stopped (scipy's message) and its tolerances.
+    n_evaluations : int
+        Model evaluations of the refinement.
+    """
+
+    plant: MassSpringDamper
+    hysteresis: Hysteresis
+    estimates: dict[str, float]
+    std: dict[str, float | None]
+    not_identifiable: dict[str, str]
+    fit_rms: float
+    records: list[dict]
+    seconds: float
+    periodic: bool
+    stopping: str
+    n_evaluations: int
+    substeps: int = 0
+    extra: dict = field(default_factory=dict)
+
+    def system(self) -> OpenLoop:
+        """The identified open-loop system."""
+        return OpenLoop(self.plant, self.hysteresis)
+
+    def to_dict(self) -> dict:
+        """JSON-ready: ``plant``, ``hysteresis``, ``std``, ``fit_rms``, ``records``, ``seconds``."""
+        return {"plant": self.plant.to_dict(), "hysteresis": self.hysteresis.to_dict(),
+                "estimates": dict(self.estimates), "std": dict(self.std),
+                "not_identifiable": dict(self.not_identifiable), "fit_rms": self.fit_rms,
+                "records": [dict(r) for r in self.records], "seconds": self.seconds,
+                "periodic": self.periodic, "stopping": self.stopping,
+                "evaluations": self.n_evaluations, "substeps": self.substeps}
+
+    def scenario_text(self) -> str:
+        """A scenario file (TOML) of the identified system: ``[stage]`` and ``[hysteresis]``."""
+        lines = [f"# identified from {len(self.records)} input-output record(s) by simulation "
+                 f"error: fit RMS {self.fit_rms:.4g} m", "[stage]"]
+        for key, value in self.plant.to_dict().items():
+            lines.append(f'{key} = "{value}"' if isinstance(value, str)
+                         else f"{key} = {_toml(value)}")
+        lines.append("")
+        lines.append("[hysteresis]")
+        for key, value in self.hysteresis.to_dict().items():
+            if isinstance(value, str):
+                lines.append(f'{key} = "{value}"')
+            elif isinstance(value, list | tuple | np.ndarray):
+                lines.append(f"{key} = [{', '.join(_toml(v) for v in value)}]")
+            else:
+                lines.append(f"{key} = {_toml(value)}")
+        return "\n".join(lines) + "\n"
+
+
+def _toml(v: float) -> str:
+    s = repr(float(v))
+    return s if any(ch in s for ch in ".en") else s + ".0"
+
+
+def _per_record(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:
+    out, i = [], 0
+    for rec in records:
+        e = res[i:i + rec.y.size]
+        i += rec.y.size
+        out.append({"name": rec.name, "samples": int(rec.y.size),
+                    "fit_rms": float(np.sqrt(np.mean(e ** 2))),
+                    "output_rms": float(np.sqrt(np.mean(rec.y ** 2)))})
+    return out

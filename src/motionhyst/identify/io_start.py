@@ -1,0 +1,206 @@
+"""The linear start of an input-output identification: the best linear approximation.
+
+The mass-spring-damper ``1 / (m s^2 + c s + k)`` (:func:`best_linear_approximation`)
+and the floating two-mass stage of eqs. (1)-(2) held by a spring and damper in
+place of its link (:func:`best_linear_approximation_two_mass`, its response
+:func:`two_mass_response`), fitted to the records' frequency response, or, for
+records from rest, to that of an ARX model of them.  Starts for the
+simulation-error fits, not results.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from motionhyst.identify.io_records import IORecord
+from motionhyst.openloop import MassSpringDamper, TwoMass
+
+BLA_STARTS = 6  # two-mass: grid points refined
+
+
+def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
+    """``m, c, k`` of ``1 / (m s^2 + c s + k)`` fitted to the records' frequency response.
+
+    ``G(f) = sum Y U* / sum |U|^2`` over the records (each transformed whole),
+    at the lines whose input power is at least ``1e-3`` of the largest; the
+    fit minimises ``sum |G| ^2 |1/G - (k - m w^2 + j c w)|^2``.  Negative
+    estimates are clipped to small positive values (a start, not a result).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.openloop import MassSpringDamper, OpenLoop
+    >>> t = np.arange(4096) / 750
+    >>> u = np.random.default_rng(0).standard_normal(4096)
+    >>> y = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4)).simulate(t, u, periodic=True).displacement
+    >>> p = best_linear_approximation([IORecord(t, u, y)])
+    >>> round(p.m, 3), round(p.c, 2), round(p.k)
+    (2.0, 10.0, 50000)
+    """
+    f, G = _spectral_response(records)
+    w = 2 * np.pi * f
+    wt = np.abs(G)
+    inv = 1.0 / G
+    # rows: Re(1/G) = k - m w^2 ; Im(1/G) = c w
+    A = np.zeros((2 * w.size, 3))
+    b = np.concatenate([inv.real, inv.imag])
+    A[: w.size, 0] = -w ** 2
+    A[: w.size, 2] = 1.0
+    A[w.size:, 1] = w
+    ww = np.concatenate([wt, wt])
+    m, c, k = np.linalg.lstsq(A * ww[:, None], b * ww, rcond=None)[0]
+    m = abs(m) if m != 0 else 1.0
+    return MassSpringDamper(m, max(c, 1e-6 * m * w.min()), max(k, 1e-6 * m * w.min() ** 2))
+
+
+def _spectral_response(records: list[IORecord]
+                       ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
+    """``G(f) = sum Y U* / sum |U|^2`` over the records (each transformed whole), at the
+    lines whose input power is at least ``1e-3`` of the largest."""
+    n_max = max(r.u.size for r in records)
+    freqs = np.fft.rfftfreq(n_max, 1.0 / records[0].fs)
+    suy = np.zeros(freqs.size, dtype=complex)
+    suu = np.zeros(freqs.size)
+    for r in records:
+        f = np.fft.rfftfreq(r.u.size, 1.0 / r.fs)
+        U = np.fft.rfft(r.u - r.u.mean())
+        Y = np.fft.rfft(r.y - r.y.mean())
+        idx = np.clip(np.searchsorted(freqs, f), 0, freqs.size - 1)
+        np.add.at(suy, idx, Y * np.conj(U))
+        np.add.at(suu, idx, np.abs(U) ** 2)
+    sel = (suu >= 1e-3 * suu.max()) & (freqs > 0)
+    return freqs[sel], suy[sel] / suu[sel]
+
+
+def _arx_response(records: list[IORecord], f_hz: NDArray[np.float64], na: int = 4,
+                  nb: int = 6) -> NDArray[np.complex128]:
+    """Frequency response at `f_hz` of an ARX model fitted to records from rest.
+
+    ``y[n] + a_1 y[n-1] + ... + a_na y[n-na] = b_0 u[n] + ... + b_(nb-1) u[n-nb+1]``
+    by least squares over every record (zero before the first sample: from
+    rest).  The records' spectra would see the free ringing of a lightly damped
+    mode started by the record's start as a response to the force; the
+    recursion carries it.
+    """
+    rows, rhs = [], []
+    for rec in records:
+        n = rec.y.size
+        yp = np.concatenate([np.zeros(na), rec.y])
+        up = np.concatenate([np.zeros(nb), rec.u])
+        cols = [-yp[na - i:na - i + n] for i in range(1, na + 1)]
+        cols += [up[nb - i:nb - i + n] for i in range(nb)]
+        rows.append(np.column_stack(cols))
+        rhs.append(rec.y)
+    A = np.concatenate(rows)
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    theta = np.linalg.lstsq(A / scale, np.concatenate(rhs), rcond=None)[0] / scale
+    z1 = np.exp(-2j * np.pi * f_hz / records[0].fs)
+    den = 1.0 + sum(theta[i - 1] * z1 ** i for i in range(1, na + 1))
+    num = sum(theta[na + i] * z1 ** i for i in range(nb))
+    return num / den
+
+
+def two_mass_response(theta: NDArray[np.float64], f_hz: NDArray[np.float64], output: str
+                      ) -> NDArray[np.complex128]:
+    """``y2 / u`` or ``y1 / u`` of the two-mass stage (eqs. 1-2) held by a spring ``kl``
+    and damper ``cl`` on ``y1``; ``theta = (m1, m2, b, k, kl, cl)``.
+
+    With ``D = (m1 s^2 + (b + cl) s + k + kl)(m2 s^2 + b s + k) - (b s + k)^2``:
+    ``y2 / u = (b s + k) / D`` and ``y1 / u = (m2 s^2 + b s + k) / D``.
+    """
+    m1, m2, b, k, kl, cl = theta
+    s = 2j * np.pi * f_hz
+    inner = b * s + k
+    D = (m1 * s * s + (b + cl) * s + k + kl) * (m2 * s * s + inner) - inner * inner
+    return (inner if output == "y2" else m2 * s * s + inner) / D
+
+
+def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y2",
+                                       periodic: bool = True) -> tuple[TwoMass, float, float]:
+    """The two-mass stage and a spring and damper for its link fitted to the records'
+    frequency response.
+
+    The link is linearised as a spring ``kl`` and damper ``cl`` from ``y1`` to
+    the ground (:func:`two_mass_response`).  The impedance at ``y1`` is
+
+    .. math::
+
+        Z_1 = \\frac{1}{G_1} = m_1 s^2 + c_l s + k_l + m_2 s^2 H(s), \\qquad
+        H = \\frac{y_2}{y_1} = \\frac{2 \\zeta \\omega s + \\omega^2}
+        {s^2 + 2 \\zeta \\omega s + \\omega^2},
+
+    with ``omega^2 = k / m2`` and ``2 zeta omega = b / m2`` (and ``1/G2 = Z1 / H``
+    when ``y2`` is measured), linear in ``(m1, cl, kl, m2)`` for given
+    ``(omega, zeta)``: those four are solved by weighted linear least squares
+    (relative error) on a grid of ``omega`` across and beyond the excited band
+    and of ``zeta`` from 0.005 to 0.3, and the best point is refined in all six
+    parameters (``log`` of each) by nonlinear least squares on the relative
+    error of ``G`` (:func:`_spectral_response`).  A start for the simulation-error
+    fit, not a result.
+
+    Returns
+    -------
+    plant : TwoMass
+    k_link, c_link : float
+        The link's linear stiffness [N/m] and damping [N s/m].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.openloop import OpenLoop, TwoMass
+    >>> from motionhyst.hysteresis import BoucWen
+    >>> t = np.arange(4096) / 750
+    >>> u = np.random.default_rng(0).standard_normal(4096)
+    >>> spring = BoucWen.from_general(5e4, 1.0, 0.0, 0.0, 1.0)   # beta = 0: a spring
+    >>> y = OpenLoop(TwoMass(2.0, 3.0, 20.0, 2e5), spring).simulate(t, u, periodic=True)
+    >>> p, kl, cl = best_linear_approximation_two_mass([IORecord(t, u, y.displacement)])
+    >>> round(p.m1, 3), round(p.m2, 3), round(p.b, 2), round(p.k), round(kl), round(cl, 6)
+    (2.0, 3.0, 20.0, 200000, 50000, 0.0)
+    """
+    f, G = _spectral_response(records)
+    keep = f < 0.5 * records[0].fs * (1 - 1e-9)  # the Nyquist line is ambiguous
+    f, G = f[keep], G[keep]
+    if not periodic:
+        G = _arx_response(records, f)
+    s = 2j * np.pi * f
+    grid = []
+    for om in 2 * np.pi * np.geomspace(0.5 * f[0], 10 * f[-1], 80):
+        for zeta in np.geomspace(0.002, 0.5, 12):
+            H = (2 * zeta * om * s + om * om) / (s * s + 2 * zeta * om * s + om * om)
+            Z = 1.0 / G if output == "y1" else H / G
+            A = np.column_stack([s * s, s, np.ones_like(s), s * s * H]) / np.abs(Z)[:, None]
+            rhs = Z / np.abs(Z)
+            x = np.linalg.lstsq(np.concatenate([A.real, A.imag]),
+                                np.concatenate([rhs.real, rhs.imag]), rcond=None)[0]
+            m1, cl, kl, m2 = x
+            if m1 > 0 and m2 > 0 and kl > 0:
+                cost = float(np.sum(np.abs(A @ x - rhs) ** 2))
+                grid.append((cost, m1, m2, 2 * zeta * om * m2, om * om * m2, kl, max(cl, 0.0)))
+    if not grid:
+        raise ValueError("the records' frequency response does not fit a two-mass stage on "
+                         "a spring (no positive masses and stiffness)")
+    mag = np.abs(G)
+
+    def residual(logt):
+        with np.errstate(all="ignore"):
+            e = (two_mass_response(np.exp(logt), f, output) - G) / mag
+        r = np.concatenate([e.real, e.imag])
+        return np.where(np.isfinite(r), r, 1e6)
+
+    best = None
+    for start in sorted(grid)[:BLA_STARTS]:  # the best grid points, refined in all six
+        v = np.array(start[1:])
+        v[-1] = max(v[-1], 1e-6 * math.sqrt(v[4] * (v[0] + v[1])))
+        x0 = np.log(v)
+        sol = least_squares(residual, x0, method="trf", xtol=1e-14, ftol=1e-14, gtol=1e-14,
+                            max_nfev=200, bounds=(x0 - 30.0, x0 + 30.0))
+        if best is None or sol.cost < best.cost:
+            best = sol
+    sol = best
+    m1, m2, b, k, kl, cl = np.exp(sol.x)
+    return TwoMass(m1, m2, b, k, output), float(kl), float(cl)
