@@ -88,12 +88,13 @@ def _warm_up(formats: Sequence[str]) -> None:
     if not todo:
         return
     from matplotlib.backend_bases import get_registered_canvas_class
-
-    from motionhyst.figures import _figure
+    from matplotlib.figure import Figure
 
     for fmt in todo:
         get_registered_canvas_class(fmt)
-    fig, (ax,) = _figure()
+    fig = Figure(layout="constrained")
+    ax = fig.subplots()
+    ax.set_title("warm-up")
     ax.loglog([1.0, 100.0], [1.0, 10.0])
     fig.savefig(io.BytesIO(), format="png")
     _warm_formats.update(todo)
