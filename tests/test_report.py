@@ -435,6 +435,19 @@ def test_figures_of_a_lugre_loop_draw_its_exact_curves(loop):
     assert_allclose(d10["E"], loop_mismatch(lugre_loop, d10["f"], 0.01), rtol=1e-5)
 
 
+def test_fig9_wraps_a_long_parameter_list_between_parameters(loop):
+    from motionhyst.loop import Loop
+
+    lugre_loop = Loop(loop.plant, loop.controller, LUGRE, feedforward="rigid-body")
+    title = plots.fig9_quasilinear_plant(lugre_loop).axes[1].get_title()
+    lines = title.split("\n")
+    assert len(lines) == 2 and all(len(line) <= 70 for line in lines)
+    # every parameter whole on one line, as the model states it
+    for key, value in LUGRE.to_dict().items():
+        if key != "model":
+            assert any(f"{key} = {value:g}" in line for line in lines), key
+
+
 def test_reproduce_with_another_model_draws_its_figures(tmp_path):
     sc = default_scenario()
     data = sc.to_dict()

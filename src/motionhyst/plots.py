@@ -7,6 +7,7 @@ callers and tests can check what is shown without reading pixels.
 
 from __future__ import annotations
 
+import textwrap
 from typing import TYPE_CHECKING
 
 import matplotlib
@@ -386,10 +387,14 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
                 f, f_star_hz, fig.motionhyst_data)
     units = {"k": " N/m", "fc": " N", "sigma0": " N/m", "sigma1": " N s/m", "sigma2": " N s/m",
              "fs": " N", "vs": " m/s"}
-    params = ", ".join(f"{k} = {v:g}{units.get(k, '')}" if not isinstance(v, list) else
-                       f"{k} = [{', '.join(f'{x:g}' for x in v)}]{units.get(k, '')}"
-                       for k, v in el.to_dict().items() if k != "model")
-    axes[0, -1].set_title(f"this scenario: {el.name} link, {params}", fontsize=9)
+    params = [f"{k} = {v:g}{units.get(k, '')}" if not isinstance(v, list) else
+              f"{k} = [{', '.join(f'{x:g}' for x in v)}]{units.get(k, '')}"
+              for k, v in el.to_dict().items() if k != "model"]
+    title = f"this scenario: {el.name} link, " + ", ".join(
+        p.replace(" ", "\u00a0") for p in params)  # lines break between parameters only
+    # a column is about 70 characters wide at this size: a longer title wraps
+    title = textwrap.fill(title, 70 if paper else 120, break_long_words=False)
+    axes[0, -1].set_title(title.replace("\u00a0", " "), fontsize=9)
     fig.suptitle("Fig. 9: quasi-linear plant P^phi = P2 / (1 + D P1), eq. (12); "
                  "0 dB = 1 m/N", fontsize=10)
     _minor_log_ticks(fig)
