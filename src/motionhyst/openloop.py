@@ -1095,6 +1095,37 @@ def _max_periods(mech: Mechanics, k_link: float, period_s: float) -> int:
     return int(min(1000, max(4, math.ceil(MAX_PERIODIC_DECAYS * tau / period_s) + 2)))
 
 
+def _periodic_output(next_period, periods: int, floating: bool, sensitivities: bool
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Run periods until the output (and its sensitivities) repeat: the last period's.
+
+    `next_period()` runs one more period from the state the previous one left
+    and returns its output and sensitivities, one sample longer than the
+    period, and whether the state is still finite.  The output repeats as
+    :func:`_settled` judges, the sensitivities to 1e-8 of their largest
+    values; a floating stage's output is returned with zero mean (it is
+    defined up to a constant).  Raises if `periods` do not settle.
+    """
+    prev = None
+    step: list[float] = []
+    for _ in range(periods):
+        y, sy, finite = next_period()
+        y, sy = y[:-1], sy[:-1]
+        if prev is not None:
+            ok = _settled(y, prev[0], floating, step)
+            if sensitivities:
+                ok &= bool(np.all(np.max(np.abs(sy - prev[1]), axis=0)
+                                  <= 1e-8 * (np.max(np.abs(sy), axis=0) + 1e-300)))
+            if ok:
+                if floating:  # defined up to a constant: zero mean
+                    return y - np.mean(y), sy - np.mean(sy, axis=0)
+                return y, sy
+        if not finite:
+            break
+        prev = (y, sy)
+    raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if floating else ""))
+
+
 #: Largest distance of a time stamp from the record's uniform grid, in sampling intervals
 #: (time columns written with few digits, e.g. 12.3457 s at 750 Hz, are off by up to 4 %)
 STAMP_TOLERANCE = 0.05
@@ -1234,24 +1265,14 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
         # from rest: start from the steady state with the link a spring alpha
         x0[:-1] = mech.linear_periodic_state(u, fs, lp[0])
         x0[-1] = lp[0] * x0[mech.link]
-    prev = None
-    step: list[float] = []
-    for _ in range(_max_periods(mech_tau, lp[0], u.size / fs)):
-        y, sy, x0, s0 = run(x0, s0)
-        y, sy = y[:-1], sy[:-1]
-        if prev is not None:
-            ok = _settled(y, prev[0], mech.floating, step)
-            if sensitivities:
-                ok &= bool(np.all(np.max(np.abs(sy - prev[1]), axis=0)
-                                  <= 1e-8 * (np.max(np.abs(sy), axis=0) + 1e-300)))
-            if ok:
-                if mech.floating:  # defined up to a constant: zero mean
-                    return y - np.mean(y), sy - np.mean(sy, axis=0)
-                return y, sy
-        if not np.all(np.isfinite(x0)):
-            break
-        prev = (y, sy)
-    raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))
+    state = [x0, s0]
+
+    def next_period():
+        y, sy, state[0], state[1] = run(*state)
+        return y, sy, bool(np.all(np.isfinite(state[0])))
+
+    return _periodic_output(next_period, _max_periods(mech_tau, lp[0], u.size / fs),
+                            mech.floating, bool(sensitivities))
 
 
 def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64], fs: float,
@@ -1355,19 +1376,11 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     if not periodic:
         y, sy, *_ = run(x, s, sx, ss)
         return y, sy
-    prev = None
-    step: list[float] = []
-    for _ in range(_max_periods(mech, k_link, u.size / fs)):
-        y, sy, x, s, sx, ss = run(x, s, sx, ss)
-        y, sy = y[:-1], sy[:-1]
-        if prev is not None:
-            ok = _settled(y, prev[0], mech.floating, step)
-            if sens:
-                ok &= bool(np.all(np.max(np.abs(sy - prev[1]), axis=0)
-                                  <= 1e-8 * (np.max(np.abs(sy), axis=0) + 1e-300)))
-            if ok:
-                if mech.floating:  # defined up to a constant: zero mean
-                    return y - np.mean(y), sy - np.mean(sy, axis=0)
-                return y, sy
-        prev = (y, sy)
-    raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if mech.floating else ""))
+    state = [x, s, sx, ss]
+
+    def next_period():
+        y, sy, *state[:] = run(*state)
+        return y, sy, bool(np.all(np.isfinite(state[0])))
+
+    return _periodic_output(next_period, _max_periods(mech, k_link, u.size / fs),
+                            mech.floating, sens)
