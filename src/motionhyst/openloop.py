@@ -61,6 +61,7 @@ from scipy.signal import firwin, resample_poly
 from motionhyst._jit import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.hysteresis.stepping import (
+    COULOMB,
     DIFFERENTIATED,
     GL_T,
     GL_W,
@@ -69,6 +70,7 @@ from motionhyst.hysteresis.stepping import (
     Stepping,
     advance,
     advance_partials,
+    coulomb_implicit,
 )
 from motionhyst.lti import expm_small
 from motionhyst.simulate import MAX_FIXED_POINT_ITERATIONS
@@ -775,6 +777,8 @@ def _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, li, lo, uf, r, codes, params, dpara
         sy[0, b] = sx[lo, b]
     dx_prev = 0.0
     worst = 0
+    rigid = m == 1 and codes[0] == COULOMB  # a lone rigid slider: the step in closed form
+    iv = ns // 2 + li  # its velocity's index in x
     for i in range(n_steps):
         # q_li at the step's end = base + B1[li] * (-w_{i+1})
         f0 = uf[i] - w_prev
@@ -785,7 +789,16 @@ def _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, li, lo, uf, r, codes, params, dpara
         wt = w_prev
         it = 0
         change = math.inf
-        while True:
+        v_end = 0.0
+        if rigid:  # the velocity at the step's end without the link force, then with it
+            a_v = Ad[iv, 0] * x[0]
+            for b in range(1, ns):
+                a_v += Ad[iv, b] * x[b]
+            a_v = a_v + B0[iv] * f0 + B1[iv] * uf[i + 1]
+            wt, v_end = coulomb_implicit(params[0], a_v, B1[iv])
+            s_new[0] = wt
+            it = 1
+        while not rigid:
             it += 1
             dx = base_y - B1[li] * wt - x[li]
             wn = 0.0
@@ -845,7 +858,19 @@ def _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, li, lo, uf, r, codes, params, dpara
                             dw[b] += cp * dparams[j, lp, b - npl]
             for b in range(P):
                 dbase = sxn[li, b] - sx[li, b]  # of dx = base - B1[li] w - q[li]
-                dw[b] = (dw[b] + w_dx * dbase) / (1.0 + w_dx * B1[li])
+                if rigid:  # from v_end = a - B1[iv] w (the velocity's own step)
+                    da = sxn[iv, b]
+                    if v_end == 0.0:  # stuck: v_end = 0 whatever the parameters
+                        dw[b] = da / B1[iv]
+                    else:
+                        lp, cv = (0, params[0, 2]) if v_end > 0.0 else (1, params[0, 3])
+                        dpar = 0.0
+                        if b >= npl:
+                            dpar = (dparams[0, lp, b - npl] * (1.0 if lp == 0 else -1.0)
+                                    + dparams[0, lp + 2, b - npl] * v_end)
+                        dw[b] = (dpar + cv * da) / (1.0 + cv * B1[iv])
+                else:
+                    dw[b] = (dw[b] + w_dx * dbase) / (1.0 + w_dx * B1[li])
                 ddx[b] = dbase - B1[li] * dw[b]
             for a in range(ns):
                 for b in range(P):

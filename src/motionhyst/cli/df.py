@@ -136,11 +136,13 @@ def run(args: argparse.Namespace) -> int:
 
     has_zeta = any(not math.isnan(p["zeta"]) for p in points)
     rows = [[*lead(p), *([g(p["zeta"])] if has_zeta else []), g(p["re"]), g(p["im"]),
-             g(p["abs"]), g(p["abs"] / k_init), f"{p['phase_deg']:.2f}"] for p in points]
+             g(p["abs"]), g(p["abs"] / k_init) if k_init > 0 else "-",
+             f"{p['phase_deg']:.2f}"] for p in points]
     print(table([*head, *(["zeta [-]"] if has_zeta else []), "Re D [N/m]", "Im D [N/m]",
                   "|D| [N/m]", "|D|/k_init [-]", "angle D [deg]"], rows))
     print(f"k_init = {k_init:g} N/m, the initial stiffness"
-          + (" (|D| -> k_init as A -> 0)" if rate else ""))
+          + (" (|D| -> k_init as A -> 0)" if rate else "")
+          + (" (none: the element has no elastic range)" if k_init == 0 else ""))
     if args.harmonics:
         print()
         print("Higher-order describing functions H_n = Y_n / A [N/m], relative to sin(n w t)")

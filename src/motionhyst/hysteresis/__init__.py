@@ -15,8 +15,9 @@ from motionhyst.hysteresis.bouc_wen import BoucWen
 from motionhyst.hysteresis.dahl import Dahl
 from motionhyst.hysteresis.lugre import LuGre
 from motionhyst.hysteresis.maxwell_iwan import MaxwellIwan
+from motionhyst.hysteresis.coulomb import Coulomb
 # isort: on
 from motionhyst.hysteresis.registry import MODELS, Parameter, model_class, register
 
-__all__ = ["MODELS", "BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellIwan",
+__all__ = ["MODELS", "BoucWen", "Coulomb", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellIwan",
            "MaxwellSlip", "Parameter", "jenkins_describing_function", "model_class", "register"]

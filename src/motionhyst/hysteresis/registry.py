@@ -142,10 +142,10 @@ def model_class(name: str) -> Any:
     >>> from motionhyst.hysteresis import model_class
     >>> model_class("maxwell-slip")(k=[10.0, 6.0], fc=[0.01, 0.03])
     MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03])
-    >>> model_class("coulomb")                             # doctest: +ELLIPSIS
+    >>> model_class("preisach")                            # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: unknown link model 'coulomb'; known: jenkins, maxwell-slip, ...
+    ValueError: unknown link model 'preisach'; known: jenkins, maxwell-slip, ...
     """
     try:
         return MODELS[name]

@@ -2,8 +2,8 @@
 
 A link model states how it is stepped (:meth:`Hysteresis.time_stepping`) as a
 :class:`Stepping`: one row per element, each a primitive kind of this module
-(``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``, ``MAXWELL``) with its parameters.  The time
-simulation and the open-loop force of a feedforward model advance the rows
+(``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``, ``MAXWELL``, ``COULOMB``) with its
+parameters.  The time simulation and the open-loop force of a feedforward model advance the rows
 with :func:`advance`, so they never need to know which model they run;
 :func:`advance_partials` differentiates the step of the kinds in
 :data:`DIFFERENTIATED` (the open loop's sensitivities for identification).
@@ -36,11 +36,11 @@ from motionhyst.hysteresis._ode_kernels import (
     lugre_relax,
 )
 
-__all__ = ["BOUC_WEN", "DAHL", "DIFFERENTIATED", "GL_T", "GL_W", "LUGRE", "MAXWELL", "N_PARAMS",
-           "N_PARTIALS", "STOP", "Stepping", "advance", "advance_partials", "open_loop",
-           "open_loop_chunk"]
+__all__ = ["BOUC_WEN", "COULOMB", "DAHL", "DIFFERENTIATED", "GL_T", "GL_W", "LUGRE", "MAXWELL",
+           "N_PARAMS", "N_PARTIALS", "STOP", "Stepping", "advance", "advance_partials",
+           "coulomb_implicit", "open_loop", "open_loop_chunk"]
 
-STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL = 0, 1, 2, 3, 4
+STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL, COULOMB = 0, 1, 2, 3, 4, 5
 N_PARAMS = 6
 
 
@@ -52,7 +52,7 @@ class Stepping:
     ----------
     codes : ndarray of int64, shape (n,)
         Primitive kind of each element (``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``,
-        ``MAXWELL``).
+        ``MAXWELL``, ``COULOMB``).
     params : ndarray, shape (n, N_PARAMS)
         Each element's parameters, in the order :func:`advance` reads them.
     state0 : ndarray, shape (n,)
@@ -117,6 +117,17 @@ def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no 
     if code == BOUC_WEN:  # p = (k / fc, fc, n, beta + gamma, beta - gamma, hmax); state w / fc
         s = bouc_wen_step(s, p[0] * dx, p[2], p[3], p[4], p[5], glt, glw)
         return s, p[1] * s
+    if code == COULOMB:  # p = (fc_pos, fc_neg, c_pos, c_neg): a rigid slider; state w
+        # the rigid limit of a stop operator: moving, the slip force and the viscous force of
+        # the step's mean velocity; not moving, the force it held (a time step that solves for
+        # the stick force, as the open loop's does, sets the state itself)
+        if dx > 0.0:
+            v = p[0] + (p[2] * dx / h if h > 0.0 else 0.0)
+        elif dx < 0.0:
+            v = -p[1] + (p[3] * dx / h if h > 0.0 else 0.0)
+        else:
+            v = s
+        return v, v
     if code == MAXWELL:  # p = (kv, cv): a spring kv in series with a damper cv; state f
         # exact for dx linear in time: f+ = f e^-a + cv (dx / h) (1 - e^-a), a = h kv / cv,
         # written as kv dx (1 - e^-a) / a (a spring kv for h = 0)
@@ -147,8 +158,38 @@ def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no 
     return s, sigma0 * s + p[1] * zdot + p[2] * v
 
 
+@njit("UniTuple(float64, 2)(float64[::1], float64, float64)", nogil=True)
+def coulomb_implicit(p, a, b):  # pragma: no cover - compiled
+    """Force and end velocity of a lone rigid slider (``COULOMB``) over an implicit step.
+
+    The velocity at the step's end is ``v = a - b w`` (``b > 0``: the plant's
+    response to the link force ``w``).  The slider slides forward if it must,
+    ``w = fc_pos + c_pos v`` with ``v > 0``, which happens if ``a > b fc_pos``;
+    backward likewise; else it sticks: ``v = 0`` and ``w = a / b`` (within
+    ``-fc_neg .. fc_pos``).  The rigid limit of the stop operator, sticking
+    included, solved exactly with no iteration; a stuck stage stays at rest
+    to rounding (a step that held only its position would let the velocity grow).
+
+    Examples
+    --------
+    >>> p = np.array([2.0, 3.0, 0.0, 0.0, 0.0, 0.0])
+    >>> coulomb_implicit(p, 1e-6, 1e-6)            # held: 1 N of the 2 N it can hold
+    (1.0, 0.0)
+    >>> w, v = coulomb_implicit(p, 5e-6, 1e-6)     # slides forward at 2 N
+    >>> float(w), round(float(v) * 1e6, 12)
+    (2.0, 3.0)
+    """
+    if a > b * p[0]:
+        v = (a - b * p[0]) / (1.0 + b * p[2])
+        return p[0] + p[2] * v, v
+    if a < -b * p[1]:
+        v = (a + b * p[1]) / (1.0 + b * p[3])
+        return -p[1] + p[3] * v, v
+    return a / b, 0.0
+
+
 #: Element kinds :func:`advance_partials` differentiates (not ``BOUC_WEN``)
-DIFFERENTIATED = (STOP, DAHL, LUGRE, MAXWELL)
+DIFFERENTIATED = (STOP, DAHL, LUGRE, MAXWELL, COULOMB)
 #: Length of :func:`advance_partials`' derivative vectors: in ``s, s_prev, dx, dx_prev``, then
 #: the element's ``N_PARAMS`` parameters
 N_PARTIALS = 4 + N_PARAMS
@@ -257,6 +298,27 @@ def advance_partials(code, p, s, s_prev, dx, dx_prev, h, first, ds, df
             df[i] = p[1] * ds[i]
         df[5] = sn
         return sn, p[1] * sn
+    if code == COULOMB:  # p = (fc_pos, fc_neg, c_pos, c_neg); state w (stuck: see advance)
+        if dx > 0.0:
+            v = p[0]
+            df[4] = 1.0
+            if h > 0.0:
+                v += p[2] * dx / h
+                df[2] = p[2] / h
+                df[6] = dx / h
+        elif dx < 0.0:
+            v = -p[1]
+            df[5] = -1.0
+            if h > 0.0:
+                v += p[3] * dx / h
+                df[2] = p[3] / h
+                df[7] = dx / h
+        else:
+            v = s
+            df[0] = 1.0
+        for i in range(N_PARTIALS):
+            ds[i] = df[i]
+        return v, v
     if code == MAXWELL:  # p = (kv, cv); state f
         a = h * p[0] / p[1]
         if a > 0.0:
