@@ -1,0 +1,2 @@
+"""Inputs and outputs: scenario files, CSV records, safe file writing.
+"""

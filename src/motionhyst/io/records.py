@@ -1,0 +1,546 @@
+"""Measured records as engineers have them: CSV or MATLAB ``.mat`` files, columns mapped and scaled.
+
+Every command that reads a record (``identify``, ``predict``, ``simulate``'s
+reference, a measured plant's frequency response) reads it through
+:func:`read_record`, which takes
+
+- a CSV file with a header row (the dialects of :mod:`motionhyst.csvdata`:
+  byte-order marks, comma, semicolon or tab, decimal commas, names in any case);
+- a MATLAB ``.mat`` file: level 4 and 5 (MATLAB's ``-v4``, ``-v6``, ``-v7``)
+  through :func:`scipy.io.loadmat`, version 7.3 (HDF5) through :mod:`h5py`.
+  Each column is a numeric vector variable (``n x 1`` or ``1 x n``; any real
+  numeric class), a field of a structure written ``name.field``; names match
+  exactly, else ignoring case when that is unambiguous.  The file's kind is
+  found from its content, not only its name: a text file named ``.mat`` is an
+  error, a ``.mat`` file named otherwise is read;
+- a numpy array (the columns in the order asked for), a pandas DataFrame or a
+  mapping of columns (names matched as in a CSV header).
+
+Files name their signals as their software does (the EMPS benchmark's
+``DATA_EMPS.mat``: ``t``, ``qm``, ``vir``).  A column map (``--columns
+time=t,force=vir,displacement=qm`` on the command line,
+:func:`parse_columns`) says which of the file's columns is which quantity
+the command needs, and a scale (``--scale force=35.15065``,
+:func:`parse_scale`) multiplies a quantity by a gain, here the drive's
+35.15065 N/V that turns the controller's output in volts into the force
+in newtons.
+
+Time stamps written by a data logger jitter (EMPS: 2e-5 of the step).
+Where a command needs a uniform grid (``identify --record input-output``,
+``predict``), it fits the nearest one to all the stamps and accepts every
+stamp within 0.05 of a sampling interval of it
+(:data:`motionhyst.openloop.STAMP_TOLERANCE`, :func:`motionhyst.openloop.check_record`);
+a record whose stamps stray further (a dropped or repeated sample) is refused,
+naming the worst stamp.
+
+Every problem is a :class:`RecordError` (a ``ValueError``) with one line
+naming the file: not a CSV or ``.mat`` file, a missing column or variable
+(the message lists those found), a variable that is not a numeric vector,
+columns of different lengths, a column map or scale naming a quantity the
+command does not read.
+"""
+
+from __future__ import annotations
+
+import codecs
+import math
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.csvdata import CSVError, Source, describe, normalize_name, read_columns, read_header
+
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+_MAT_TEXT_HEADER = b"MATLAB"
+_MAT_CLASSES = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
+                "int64", "uint64", "logical"}
+_CLASS_WORDS = {"cell": "a cell array", "char": "text (char)", "struct": "a structure",
+                "function_handle": "a function handle"}
+
+
+class RecordError(CSVError):
+    """A record that cannot be read as asked: one line naming the file and the problem.
+
+    Examples
+    --------
+    >>> from motionhyst.io.records import RecordError, parse_columns
+    >>> try:
+    ...     parse_columns("time")
+    ... except RecordError as err:
+    ...     print("RecordError:", err)
+    RecordError: --columns: 'time' is not NAME=COLUMN (for example time=t,force=vir,...)
+    """
+
+
+# ------------------------------------------------------------------ the command-line options
+def _pairs(text: str, option: str, example: str) -> list[tuple[str, str]]:
+    pairs = []
+    for item in str(text).split(","):
+        if not item.strip():
+            continue
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise RecordError(f"{option}: {item.strip()!r} is not NAME=COLUMN (for example "
+                              f"{example})" if option == "--columns" else
+                              f"{option}: {item.strip()!r} is not NAME=GAIN (for example "
+                              f"{example})")
+        pairs.append((normalize_name(name), value.strip()))
+    if not pairs:
+        raise RecordError(f"{option}: empty; give NAME=VALUE pairs (for example {example})")
+    seen: set[str] = set()
+    for name, _ in pairs:
+        if name in seen:
+            raise RecordError(f"{option}: {name!r} is given twice")
+        seen.add(name)
+    return pairs
+
+
+def parse_columns(text: str) -> dict[str, str]:
+    """The column map of ``--columns``: quantity -> the file's name for it.
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=COLUMN`` pairs separated by commas; NAME is a quantity the
+        command reads (``time``, ``force``, ``displacement``, ...), COLUMN the
+        CSV column or MATLAB variable (``data.qm`` for a structure's field).
+
+    Returns
+    -------
+    dict
+        Quantity (lower case) -> column name as given.
+
+    Raises
+    ------
+    RecordError
+        A pair without ``=``, an empty side, a quantity given twice.
+
+    Examples
+    --------
+    >>> parse_columns("time=t,force=vir,displacement=qm")
+    {'time': 't', 'force': 'vir', 'displacement': 'qm'}
+    """
+    return dict(_pairs(text, "--columns", "time=t,force=vir,..."))
+
+
+def parse_scale(text: str) -> dict[str, float]:
+    """The gains of ``--scale``: quantity -> the factor its column is multiplied by.
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=GAIN`` pairs separated by commas; GAIN a finite non-zero number
+        (negative to flip a sign).
+
+    Returns
+    -------
+    dict
+        Quantity (lower case) -> gain.
+
+    Raises
+    ------
+    RecordError
+        A pair that is not ``NAME=GAIN``, a gain that is not a finite non-zero
+        number, a quantity given twice.
+
+    Examples
+    --------
+    >>> parse_scale("force=35.15065")
+    {'force': 35.15065}
+    """
+    out = {}
+    for name, value in _pairs(text, "--scale", "force=35.15065"):
+        try:
+            gain = float(value)
+        except ValueError:
+            raise RecordError(f"--scale: {name}={value}: the gain must be a number") from None
+        if not math.isfinite(gain) or gain == 0.0:
+            raise RecordError(f"--scale: {name}={value}: the gain must be finite and non-zero")
+        out[name] = gain
+    return out
+
+
+def _check_keys(given: Mapping | None, names: Sequence[str], option: str, where: str) -> None:
+    for key in given or {}:
+        if key not in names:
+            raise RecordError(f"{where}: {option} names {key!r}, which is not read here; this "
+                              f"record's columns are {','.join(names)}")
+
+
+# ------------------------------------------------------------------ the file's kind
+def _is_path(source: Source) -> bool:
+    return isinstance(source, str | os.PathLike)
+
+
+def _head(path: Path, n: int = 128) -> bytes:
+    try:
+        with path.open("rb") as fh:
+            return fh.read(n)
+    except FileNotFoundError:
+        raise RecordError(f"cannot read {path}: no such file") from None
+    except IsADirectoryError:
+        raise RecordError(f"cannot read {path}: it is a folder") from None
+    except OSError as exc:
+        raise RecordError(f"cannot read {path}: {exc.strerror or exc}") from None
+
+
+def is_mat_file(source: Source) -> bool:
+    """Whether `source` is read as a MATLAB file: its content says so, or its name ends ``.mat``.
+
+    Examples
+    --------
+    >>> is_mat_file("DATA_EMPS.mat"), is_mat_file("record.csv")
+    (True, False)
+    """
+    if not _is_path(source):
+        return False
+    path = Path(source)
+    if path.suffix.lower() == ".mat":
+        return True
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(520)
+    except OSError:
+        return False
+    return head.startswith(_MAT_TEXT_HEADER) or _HDF5_SIGNATURE in (head[:8], head[512:520])
+
+
+def _mat_kind(path: Path) -> str:
+    """``"hdf5"`` (MATLAB 7.3) or ``"scipy"`` (levels 4 and 5); RecordError for anything else."""
+    head = _head(path, 520)
+    if not head:
+        raise RecordError(f"{path}: empty file, not a MATLAB .mat file")
+    if _HDF5_SIGNATURE in (head[:8], head[512:520]):
+        return "hdf5"
+    if head.startswith(_MAT_TEXT_HEADER):
+        return "scipy"
+    from scipy.io.matlab import matfile_version
+
+    try:
+        major, _ = matfile_version(str(path))
+    except Exception:  # scipy raises several kinds for a file that is not MATLAB's
+        major = None
+    if major == 0 and not _looks_like_text(head):  # level 4: no text header
+        return "scipy"
+    what = "a text file" if _looks_like_text(head) else "an unknown format"
+    raise RecordError(f"{path}: not a MATLAB .mat file ({what}); a CSV record must be named .csv")
+
+
+def _check_text(source: Source) -> None:
+    """A CSV path must hold text: a binary file is refused before its bytes reach a message."""
+    if not _is_path(source) or Path(source).is_dir():
+        return
+    path = Path(source)
+    if not path.exists():
+        return  # the CSV reader says so
+    head = _head(path, 4096)
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return
+    if b"\0" in head:
+        raise RecordError(f"{path}: not a CSV file (binary data, and not a MATLAB .mat file)")
+
+
+def _looks_like_text(head: bytes) -> bool:
+    try:
+        text = head.decode("utf-8")
+    except UnicodeDecodeError:
+        try:
+            text = head.decode("utf-16")
+        except UnicodeDecodeError:
+            return False
+    return all(c.isprintable() or c in "\r\n\t\ufeff" for c in text)
+
+
+# ------------------------------------------------------------------ MATLAB files
+def _resolve(name: str, available: Sequence[str], path: Path, what: str = "variable") -> str:
+    """`name` among `available`: exactly, else the one equal ignoring case."""
+    if name in available:
+        return name
+    folded = [a for a in available if a.lower() == name.lower()]
+    if len(folded) == 1:
+        return folded[0]
+    shown = ", ".join(available) if available else "none"
+    if folded:
+        raise RecordError(f"{path}: {what} {name!r} is ambiguous ignoring case "
+                          f"({', '.join(folded)})")
+    err = RecordError(f"{path}: no {what} {name!r} (the file has: {shown})")
+    err.missing = name
+    raise err
+
+
+def _vector(path: Path, name: str, value, matlab_class: str | None) -> NDArray[np.float64]:
+    """A MATLAB variable as a float vector, or a one-line error saying what it is."""
+    if matlab_class is not None and matlab_class not in _MAT_CLASSES:
+        what = _CLASS_WORDS.get(matlab_class, f"of class {matlab_class}")
+        raise RecordError(f"{path}: variable {name!r} is {what}, not a numeric vector")
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "biuf":
+        kind = "complex" if arr.dtype.kind == "c" else "non-numeric"
+        raise RecordError(f"{path}: variable {name!r} is {kind}, not a real numeric vector")
+    shape = "x".join(str(s) for s in arr.shape) or "1x1"
+    if arr.size == 0:
+        raise RecordError(f"{path}: variable {name!r} is empty")
+    if sum(s > 1 for s in arr.shape) > 1:
+        raise RecordError(f"{path}: variable {name!r} is a {shape} matrix; each column must be "
+                          f"a vector (n x 1 or 1 x n)")
+    return np.asarray(arr, dtype=np.float64).ravel()
+
+
+def _read_scipy(path: Path, wanted: Sequence[str]) -> list[NDArray[np.float64]]:
+    from scipy.io import loadmat, whosmat
+
+    try:
+        info = {n: cls for n, _, cls in whosmat(str(path))}
+        try:
+            tops = list(dict.fromkeys(_resolve(w.split(".")[0], list(info), path)
+                                      for w in wanted))
+        except RecordError:
+            loadmat(str(path))  # a file cut short lists only its first variables: say so
+            raise
+        data = loadmat(str(path), variable_names=tops, simplify_cells=True)
+    except RecordError:
+        raise
+    except Exception as exc:  # scipy's many ways to fail on a damaged file
+        raise RecordError(f"{path}: cannot read as a MATLAB file ({_one_line(exc)})") from None
+    out = []
+    for w in wanted:
+        top, *fields = w.split(".")
+        top = _resolve(top, list(info), path)
+        value, cls, name = data[top], info[top], top
+        for field in fields:
+            if not isinstance(value, dict):
+                raise RecordError(f"{path}: variable {name!r} is not a structure (no field "
+                                  f"{field!r})")
+            key = _resolve(field, list(value), path, f"field of {name!r}:")
+            value, cls, name = value[key], None, f"{name}.{key}"
+        if isinstance(value, dict):
+            raise RecordError(f"{path}: variable {name!r} is a structure; name one of its fields "
+                              f"({', '.join(value)}) as {name}.FIELD")
+        if isinstance(value, str):
+            raise RecordError(f"{path}: variable {name!r} is text, not a numeric vector")
+        if isinstance(value, list):
+            raise RecordError(f"{path}: variable {name!r} is a cell array, not a numeric vector")
+        out.append(_vector(path, name, value, cls))
+    return out
+
+
+def _matlab_class(obj) -> str | None:
+    cls = obj.attrs.get("MATLAB_class")
+    if cls is None:
+        return None
+    return cls.decode() if isinstance(cls, bytes) else str(cls)
+
+
+def _read_hdf5(path: Path, wanted: Sequence[str]) -> list[NDArray[np.float64]]:
+    import h5py
+
+    try:
+        fh = h5py.File(path, "r")
+    except Exception as exc:  # h5py raises OSError subclasses with long texts
+        raise RecordError(f"{path}: cannot read as a MATLAB 7.3 file ({_one_line(exc)})") from None
+    with fh:
+        out = []
+        for w in wanted:
+            group, name = fh, ""
+            parts = w.split(".")
+            for i, part in enumerate(parts):
+                names = [k for k in group if not k.startswith("#")]
+                what = "variable" if i == 0 else f"field of {name!r}:"
+                key = _resolve(part, names, path, what)
+                name = f"{name}.{key}" if name else key
+                obj = group[key]
+                if i < len(parts) - 1:
+                    if not isinstance(obj, h5py.Group):
+                        raise RecordError(f"{path}: variable {name!r} is not a structure (no "
+                                          f"field {parts[i + 1]!r})")
+                    group = obj
+            if isinstance(obj, h5py.Group):
+                fields = ", ".join(k for k in obj if not k.startswith("#"))
+                raise RecordError(f"{path}: variable {name!r} is a structure; name one of its "
+                                  f"fields ({fields}) as {name}.FIELD")
+            cls = _matlab_class(obj)
+            if obj.attrs.get("MATLAB_empty"):
+                raise RecordError(f"{path}: variable {name!r} is empty")
+            if cls is not None and cls not in _MAT_CLASSES:
+                what = _CLASS_WORDS.get(cls, f"of class {cls}")
+                raise RecordError(f"{path}: variable {name!r} is {what}, not a numeric vector")
+            try:
+                value = obj[()]
+            except Exception as exc:
+                raise RecordError(f"{path}: cannot read variable {name!r} "
+                                  f"({_one_line(exc)})") from None
+            if value.dtype.names:  # MATLAB stores complex numbers as a compound (real, imag)
+                raise RecordError(f"{path}: variable {name!r} is complex, not a real numeric "
+                                  f"vector")
+            out.append(_vector(path, name, np.asarray(value).T, cls))  # MATLAB's shape
+    return out
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def _mat_names(path: Path) -> list[str]:
+    """The variables of a MATLAB file (a structure's fields as ``name.field``)."""
+    if _mat_kind(path) == "hdf5":
+        import h5py
+
+        try:
+            with h5py.File(path, "r") as fh:
+                names = []
+                for k in fh:
+                    if k.startswith("#"):
+                        continue
+                    if isinstance(fh[k], h5py.Group):
+                        names += [f"{k}.{f}" for f in fh[k] if not f.startswith("#")]
+                    else:
+                        names.append(k)
+                return names
+        except Exception as exc:
+            raise RecordError(f"{path}: cannot read as a MATLAB 7.3 file "
+                              f"({_one_line(exc)})") from None
+    from scipy.io import whosmat
+
+    try:
+        return [n for n, _, _ in whosmat(str(path))]
+    except Exception as exc:
+        raise RecordError(f"{path}: cannot read as a MATLAB file ({_one_line(exc)})") from None
+
+
+def _read_mat(path: Path, wanted: Sequence[str]) -> NDArray[np.float64]:
+    reader = _read_hdf5 if _mat_kind(path) == "hdf5" else _read_scipy
+    columns = reader(path, wanted)
+    lengths = {w: c.size for w, c in zip(wanted, columns, strict=True)}
+    if len(set(lengths.values())) > 1:
+        raise RecordError(f"{path}: the variables differ in length (" + ", ".join(
+            f"{w} {n}" for w, n in lengths.items()) + ")")
+    return np.ascontiguousarray(np.column_stack(columns), dtype=np.float64)
+
+
+# ------------------------------------------------------------------ the readers
+def record_columns(source: Source, columns: Mapping[str, str] | None = None) -> list[str]:
+    """The quantities a record offers: its column (or variable) names, mapped by `columns`.
+
+    A name `columns` maps to is reported as the quantity (``t`` as ``time``
+    with ``columns={"time": "t"}``); other names normalised as a CSV header's
+    (lower case, see :func:`motionhyst.csvdata.normalize_name`).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> record_columns(pd.DataFrame({"t": [0.0], "qm": [0.0], "vir": [0.0]}),
+    ...                {"time": "t", "displacement": "qm"})
+    ['time', 'displacement', 'vir']
+    """
+    if _is_path(source) and is_mat_file(source):
+        names = _mat_names(Path(source))
+        back = {}
+        for quantity, col in (columns or {}).items():
+            try:
+                back[_resolve(col, names, Path(source))] = quantity
+            except RecordError:
+                pass
+        return [back.get(n, normalize_name(n)) for n in names]
+    _check_text(source)
+    try:
+        names = read_header(source)
+    except CSVError as exc:
+        raise RecordError(str(exc)) from None
+    back = {normalize_name(col): quantity for quantity, col in (columns or {}).items()}
+    return [back.get(n, n) for n in names]
+
+
+def read_record(source: Source, names: Sequence[str], *,
+                columns: Mapping[str, str] | None = None,
+                scale: Mapping[str, float] | None = None) -> NDArray[np.float64]:
+    """The quantities `names` of a record, as a float array of shape ``(rows, len(names))``.
+
+    Parameters
+    ----------
+    source : str, Path, ndarray, DataFrame or mapping
+        A CSV or MATLAB ``.mat`` file (see the module docstring), a DataFrame
+        or mapping of columns, or a 2-D array whose columns are `names` in order.
+    names : sequence of str
+        The quantities wanted, lower case (``("time", "force", "displacement")``).
+    columns : mapping, optional
+        Quantity -> the file's name for it (:func:`parse_columns`); a quantity
+        not mapped is read under its own name.  Each key must be in `names`.
+    scale : mapping, optional
+        Quantity -> gain its column is multiplied by (:func:`parse_scale`);
+        each key must be in `names`.
+
+    Returns
+    -------
+    ndarray
+        Float64, C-contiguous, one column per name.  Non-finite values are
+        kept as read; callers check them in their own terms.
+
+    Raises
+    ------
+    RecordError
+        One line naming the source (see the module docstring).
+
+    Examples
+    --------
+    A MATLAB file written as the EMPS benchmark's, read with its names mapped
+    and the controller's output in volts scaled to newtons:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from scipy.io import savemat
+    >>> path = Path(tempfile.mkdtemp()) / "axis.mat"
+    >>> t = np.arange(4) * 1e-3
+    >>> savemat(path, {"t": t[:, None], "vir": np.array([[0.1], [0.2], [0.0], [-0.1]]),
+    ...                "qm": np.zeros((4, 1))})
+    >>> data = read_record(path, ("time", "force", "displacement"),
+    ...                    columns={"time": "t", "force": "vir", "displacement": "qm"},
+    ...                    scale={"force": 35.15065})
+    >>> data[:, 1]
+    array([ 3.515065,  7.03013 ,  0.      , -3.515065])
+    """
+    names = tuple(names)
+    where = describe(source)
+    _check_keys(columns, names, "--columns", where)
+    _check_keys(scale, names, "--scale", where)
+    columns = dict(columns or {})
+    wanted = [columns.get(n, n) for n in names]
+    if len(set(map(str.lower, wanted))) < len(wanted):
+        raise RecordError(f"{where}: --columns reads one column as two quantities ("
+                          + ", ".join(f"{n}={w}" for n, w in zip(names, wanted, strict=True))
+                          + ")")
+    unmapped = [n for n in names if n not in columns]
+    if _is_path(source) and is_mat_file(source):
+        try:
+            data = _read_mat(Path(source), wanted)
+        except RecordError as exc:
+            missing = getattr(exc, "missing", None)
+            if missing in unmapped:
+                raise RecordError(f"{exc}; map the file's name for it with --columns "
+                                  f"{missing}=NAME") from None
+            raise
+    else:
+        if columns and isinstance(source, np.ndarray):
+            raise RecordError(f"{where}: --columns maps names, and an array has none; give its "
+                              f"columns in the order {','.join(names)}")
+        _check_text(source)
+        try:
+            data = read_columns(source, [normalize_name(w) for w in wanted])
+        except RecordError:
+            raise
+        except CSVError as exc:
+            hint = ("; map the file's names with --columns NAME=COLUMN,..." if unmapped
+                    and "missing column" in str(exc) and _is_path(source) else "")
+            raise RecordError(f"{exc}{hint}") from None
+    for i, n in enumerate(names):
+        gain = (scale or {}).get(n)
+        if gain is not None:
+            data[:, i] *= gain
+    return data
+
+
+__all__ = ["RecordError", "is_mat_file", "parse_columns",
+           "parse_scale", "read_record", "record_columns"]
