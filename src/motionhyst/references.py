@@ -14,7 +14,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import make_interp_spline
 
-from motionhyst.csvdata import Source, describe, read_columns
+from motionhyst.csvdata import Source, describe
+from motionhyst.io.records import read_record
 from motionhyst.systems import TWO_PI
 
 
@@ -219,15 +220,21 @@ class SampledReference:
         return self._spline(tt), np.where(inside, self._spline(tt, 2), 0.0)
 
 
-def load_reference_csv(source: Source) -> SampledReference:
-    """Read a reference: CSV with a header and columns ``time,position`` (SI units).
+def load_reference_csv(source: Source, *, columns: dict[str, str] | None = None,
+                       scale: dict[str, float] | None = None) -> SampledReference:
+    """Read a reference: columns ``time,position`` (SI units) of a CSV or MATLAB ``.mat`` file.
 
     Parameters
     ----------
     source : str, Path, ndarray or DataFrame
-        A CSV file (read by :func:`motionhyst.csvdata.read_columns`: BOM,
-        comma or semicolon, names in any case), a DataFrame with those
-        columns, or an array of shape ``(n, 2)``.
+        A CSV file (BOM, comma or semicolon, names in any case) or a MATLAB
+        file (levels 4 to 7.3), read by :func:`motionhyst.io.records.read_record`;
+        a DataFrame with those columns, or an array of shape ``(n, 2)``.
+    columns : dict, optional
+        The file's names of ``time`` and ``position`` (the EMPS benchmark's
+        reference: ``{"time": "t", "position": "qg"}``).
+    scale : dict, optional
+        Gains the columns are multiplied by (``{"position": 1e-3}`` for mm).
 
     Returns
     -------
@@ -257,7 +264,7 @@ def load_reference_csv(source: Source) -> SampledReference:
     >>> ref.duration, round(ref.max_frequency_hz)
     (0.5, 500)
     """
-    data = read_columns(source, ("time", "position"))
+    data = read_record(source, ("time", "position"), columns=columns, scale=scale)
     t, r = data[:, 0], data[:, 1]
     try:
         return SampledReference(t, r)

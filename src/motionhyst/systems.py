@@ -14,8 +14,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from motionhyst.csvdata import Source, describe, read_columns, read_header
+from motionhyst.csvdata import Source, describe
 from motionhyst.hysteresis.base import check_positive
+from motionhyst.io.records import read_record, record_columns
 
 TWO_PI = 2.0 * np.pi
 
@@ -287,17 +288,18 @@ _FRD_COLUMNS = {
 
 
 def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
-    """Read a measured plant from CSV (or a DataFrame with the same columns).
+    """Read a measured plant from CSV or MATLAB ``.mat`` (or a DataFrame with the same columns).
 
-    The file has a header and a column ``frequency_hz``, plus either
+    The file has a column (a MATLAB file: a vector variable) ``frequency_hz``, plus either
     ``p1_re, p1_im, p2_re, p2_im`` or ``p1_abs, p1_phase_deg, p2_abs,
     p2_phase_deg`` (magnitudes in m/N, phases in degrees).
 
     Parameters
     ----------
     path : str, Path or DataFrame
-        CSV file (read by :func:`motionhyst.csvdata.read_columns`: BOM, comma
-        or semicolon, names in any case), or a DataFrame with those columns.
+        CSV file (BOM, comma or semicolon, names in any case) or MATLAB file
+        (levels 4 to 7.3), read by :func:`motionhyst.io.records.read_record`;
+        or a DataFrame with those columns.
     mass : float, optional
         Rigid-body mass [kg]; if omitted, estimated from the lowest measured
         decade as the median of ``-1 / (omega^2 Re P2)``.
@@ -327,7 +329,7 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     (1.0, 2000.0...)
     """
     where = describe(path)
-    names = read_header(path)
+    names = record_columns(path)
     header = set(names)
     expected = (f"{', '.join(_FRD_COLUMNS['reim'])} or {', '.join(_FRD_COLUMNS['absphase'])}"
                 f" next to frequency_hz (found {','.join(names) or 'none'})")
@@ -336,7 +338,7 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
     if kind is None:
         raise ValueError(f"{where}: need columns {expected}")
-    data = read_columns(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
+    data = read_record(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
     if not np.all(np.isfinite(data)):
         raise ValueError(f"{where}: non-finite value in data")
     f = data[:, 0]

@@ -10,8 +10,8 @@ from collections.abc import Callable, Sequence
 from motionhyst.jsonio import dumps
 from motionhyst.textfmt import g, table
 
-__all__ = ["EXIT_USAGE", "Parser", "UsageError", "finite", "g", "harmonic_count",
-           "nonnegative", "positive", "print_json", "table", "whole_number"]
+__all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
+           "harmonic_count", "nonnegative", "positive", "print_json", "table", "whole_number"]
 
 EXIT_USAGE = 2
 """Exit code of every user error."""
@@ -94,6 +94,39 @@ harmonic_count = whole_number(1, 1000, "harmonics")
 def print_json(obj) -> None:
     """Print `obj` as JSON (NumPy values converted, NaN as null)."""
     print(dumps(obj))
+
+
+# ------------------------------------------------------------------ records
+def _columns(text: str) -> dict[str, str]:
+    from motionhyst.io.records import RecordError, parse_columns
+
+    try:
+        return parse_columns(text)
+    except RecordError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--columns: ")) from None
+
+
+def _scale(text: str) -> dict[str, float]:
+    from motionhyst.io.records import RecordError, parse_scale
+
+    try:
+        return parse_scale(text)
+    except RecordError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--scale: ")) from None
+
+
+def add_record_options(q: argparse.ArgumentParser, quantities: str, example: str) -> None:
+    """Add ``--columns`` and ``--scale`` (:mod:`motionhyst.io.records`) to a record reader.
+
+    `quantities` names the columns the command reads, `example` is a column map.
+    """
+    q.add_argument("--columns", type=_columns, metavar="NAME=COLUMN,...",
+                   help=f"the record's own names (CSV columns or MATLAB variables, "
+                        f"STRUCT.FIELD for a structure's field) of {quantities} (e.g. "
+                        f"{example}; default: those names)")
+    q.add_argument("--scale", type=_scale, metavar="NAME=GAIN,...",
+                   help="multiply a column by a gain after reading it (e.g. force=35.15065: "
+                        "a drive's volts to newtons)")
 
 
 # ------------------------------------------------------------------ outputs and options

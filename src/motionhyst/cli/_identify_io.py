@@ -83,7 +83,7 @@ def run_input_output(args: argparse.Namespace) -> int:
         from motionhyst.outputs import OutputFile
 
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
-    records = [load_io_csv(path) for path in args.data]
+    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     fit = identify_io(records, model, periodic=args.periodic, nu=nu,
                       n_elements=args.elements or 3, plant=plant, output=args.output or "y2")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from motionhyst.cli._common import (
     UsageError,
+    add_record_options,
     g,
     positive,
     print_json,
@@ -28,15 +29,19 @@ RECORD_KINDS = {"force-displacement": ("time", "displacement", "force"),
 _element_count = whole_number(1, 20, "Jenkins elements")
 
 
-def record_kind(path: str | Path, kind: str | None = None) -> str:
-    """The kind of a measured record from its CSV header.
+def record_kind(path: str | Path, kind: str | None = None,
+                columns: dict[str, str] | None = None) -> str:
+    """The kind of a measured record from its columns (a CSV header, a MATLAB file's variables).
 
     Parameters
     ----------
     path : str or Path
-        CSV file with a header row.
+        CSV file with a header row, or MATLAB ``.mat`` file.
     kind : str, optional
         The kind the user asked for (``--record``); checked against the header.
+    columns : dict, optional
+        The file's names of the columns (``--columns``), as
+        :func:`motionhyst.io.records.record_columns` maps them.
 
     Returns
     -------
@@ -60,9 +65,9 @@ def record_kind(path: str | Path, kind: str | None = None) -> str:
     >>> record_kind(path)
     'closed-loop'
     """
-    from motionhyst.csvdata import read_header
+    from motionhyst.io.records import record_columns
 
-    names = read_header(path)
+    names = record_columns(path, columns)
     header = set(names)
     fits = [k for k, cols in RECORD_KINDS.items() if header.issuperset(cols)]
     if kind is not None:
@@ -76,7 +81,9 @@ def record_kind(path: str | Path, kind: str | None = None) -> str:
         raise ValueError(f"{path}: the header {','.join(names)!r} has the columns of both a "
                          f"force-displacement and a closed-loop record; choose one with --record")
     expected = " or ".join(f"{','.join(n)} ({k})" for k, n in RECORD_KINDS.items())
-    raise ValueError(f"{path}: unknown record header {','.join(names)!r}; expected {expected}")
+    hint = "" if columns else "; map the file's names with --columns NAME=COLUMN,..."
+    raise ValueError(f"{path}: unknown record header {','.join(names)!r}; expected "
+                     f"{expected}{hint}")
 
 
 def _toml_float(v: float) -> str:
@@ -129,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("motionhyst identify: several records are read with --record "
                          "input-output only")
     path = Path(args.data[0])
-    kind = record_kind(path, args.record)
+    kind = record_kind(path, args.record, args.columns)
     if kind == "force-displacement":
         for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
             if value is not None:
@@ -139,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     options = {"n_elements": args.elements, "criterion": args.criterion}
     extra: dict = {"record": kind, "data": str(path)}
     if kind == "force-displacement":
-        t, x, w = load_force_displacement_csv(path)
+        t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         what = "force-displacement record"
         try:
             ident = identify_maxwell_slip(x, w, t=t, **options)
@@ -158,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
                              f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
                              f"has a measured [plant] with use = \"data\"")
         warn_plant_fit(sc, "identify")
-        t, y1, u = load_closed_loop_csv(path)
+        t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         extra["scenario"] = sc.source
         try:
             ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff, **options)
@@ -185,9 +192,12 @@ def add_parser(sub) -> None:
     q = sub.add_parser("identify", help="identify Maxwell-slip hysteresis from a measured "
                        "record (CSV)")
     q.add_argument("data", metavar="DATA.csv", nargs="+",
-                   help="record with a header: time,displacement,force (force-displacement) or "
-                        "time,y1,u (closed-loop) [SI units]; with --record input-output one or "
-                        "more records time,force,displacement (force in, position out)")
+                   help="record, CSV with a header or MATLAB .mat: time,displacement,force "
+                        "(force-displacement) or time,y1,u (closed-loop) [SI units]; with "
+                        "--record input-output one or more records time,force,displacement "
+                        "(force in, position out; time stamps within 0.05 of a step of a "
+                        "uniform grid)")
+    add_record_options(q, "the record's columns", "time=t,force=vir,displacement=qm")
     q.add_argument("--elements", type=_element_count, metavar="N",
                    help="number of Jenkins elements (default: chosen by --criterion)")
     q.add_argument("--cutoff", type=positive, metavar="HZ",

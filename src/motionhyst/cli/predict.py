@@ -7,7 +7,7 @@ import io
 
 import numpy as np
 
-from motionhyst.cli._common import UsageError, print_json
+from motionhyst.cli._common import UsageError, add_record_options, print_json
 
 
 def add_parser(sub) -> None:
@@ -18,8 +18,10 @@ def add_parser(sub) -> None:
                    help='open-loop scenario: [stage] type = "mass-spring-damper", or a two-mass '
                         '[stage] with output = "y2" or "y1" (the position written), and '
                         "[hysteresis] (as written by motionhyst identify --save)")
-    q.add_argument("data", metavar="INPUT.csv", help="force record with a header: time,force "
-                   "[s, N], uniform time steps")
+    q.add_argument("data", metavar="INPUT.csv", help="force record: time,force [s, N], uniform "
+                   "time steps (stamps within 0.05 of a step of a uniform grid); CSV with a "
+                   "header or MATLAB .mat")
+    add_record_options(q, "time,force", "time=t,force=vir")
     q.add_argument("--periodic", action="store_true",
                    help="the record is one period (or whole periods) of a periodic force: "
                         "output the periodic steady state (default: from rest; a floating "
@@ -37,7 +39,7 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Simulate the scenario's open-loop system for the force record and write the output."""
-    from motionhyst.csvdata import read_columns
+    from motionhyst.io.records import read_record
     from motionhyst.scenario import Scenario
 
     if args.substeps is not None and not 1 <= args.substeps <= 10000:
@@ -49,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
                         option="--out")  # refused before any work
     sc = Scenario.from_file(args.scenario)
     system = sc.open_loop()
-    data = read_columns(args.data, ("time", "force"))
+    data = read_record(args.data, ("time", "force"), columns=args.columns, scale=args.scale)
     t, u = data[:, 0], data[:, 1]
     try:
         out = system.simulate(t, u, periodic=args.periodic, substeps=args.substeps)

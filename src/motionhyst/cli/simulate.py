@@ -11,6 +11,7 @@ import sys
 from motionhyst.cli._common import (
     UsageError,
     add_force_option,
+    add_record_options,
     check_plausible,
     distinct,
     output_file,
@@ -21,8 +22,9 @@ from motionhyst.cli._common import (
     warn_plant_fit,
 )
 
-TIME_SERIES_ONLY = ("--reference-csv", "--profile", "--distance", "--v-max", "--a-max",
-                    "--j-max", "--duration", "--output-rate", "--settle-band", "--force")
+TIME_SERIES_ONLY = ("--reference-csv", "--columns", "--scale", "--profile", "--distance",
+                    "--v-max", "--a-max", "--j-max", "--duration", "--output-rate",
+                    "--settle-band", "--force")
 """Options that only shape a ``--time-series`` run."""
 
 PROFILE_DEFAULTS = {"distance": 0.01, "v_max": 0.5, "a_max": 10.0, "j_max": 1000.0}
@@ -58,8 +60,11 @@ def _reference(args: argparse.Namespace, sc):
         refuse_unused(args, ("--frequency", "--amplitude"),
                       f"with {given} (the reference is the "
                       f"{'file' if args.reference_csv else 'profile'}, not a sine)")
+    if not args.reference_csv:
+        refuse_unused(args, ("--columns", "--scale"), "without --reference-csv (they map and "
+                      "scale its columns)")
     if args.reference_csv:
-        ref = load_reference_csv(args.reference_csv)
+        ref = load_reference_csv(args.reference_csv, columns=args.columns, scale=args.scale)
         return ref, ref.duration, f"reference from {args.reference_csv}"
     if args.profile:
         limits = {k: (getattr(args, k) if getattr(args, k) is not None else v)
@@ -148,7 +153,9 @@ def add_parser(sub) -> None:
                    help="write a transient run from rest to CSV (sine of one frequency, "
                         "or --reference-csv / --profile); an existing file needs --force")
     q.add_argument("--reference-csv", metavar="FILE",
-                   help="reference CSV: time,position [s, m] (comma or semicolon, any case)")
+                   help="reference record: time,position [s, m]; CSV (comma or semicolon, "
+                        "any case) or MATLAB .mat")
+    add_record_options(q, "time,position (--reference-csv)", "time=t,position=qg")
     q.add_argument("--profile", choices=["point-to-point"], help="built-in reference profile")
     q.add_argument("--distance", type=float, help="move length [m] (0.01)")
     q.add_argument("--v-max", type=positive, help="velocity limit [m/s] (0.5)")

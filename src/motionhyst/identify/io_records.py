@@ -34,11 +34,16 @@ class IORecord:
         return sampling_rate(self.t)
 
 
-def load_io_csv(path: str | Path) -> IORecord:
-    """Read a record with columns ``time,force,displacement`` (one-line ``ValueError``)."""
-    from motionhyst.csvdata import read_columns
+def load_io_csv(path: str | Path, *, columns: dict[str, str] | None = None,
+                scale: dict[str, float] | None = None) -> IORecord:
+    """Read a record with columns ``time,force,displacement``, CSV or MATLAB ``.mat``.
 
-    data = read_columns(path, ("time", "force", "displacement"))
+    The file's own names are mapped by `columns` and scaled by `scale`
+    (:func:`motionhyst.io.records.read_record`); errors are one-line ``ValueError``.
+    """
+    from motionhyst.io.records import read_record
+
+    data = read_record(path, ("time", "force", "displacement"), columns=columns, scale=scale)
     return IORecord(data[:, 0], data[:, 1], data[:, 2], str(path))
 
 

@@ -7,7 +7,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst._jit import njit
-from motionhyst.csvdata import Source, describe, read_columns
+from motionhyst.csvdata import Source, describe
+from motionhyst.io.records import read_record
 
 MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
@@ -109,8 +110,8 @@ def _check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
         raise ValueError(f"no reversal: the {xname} must move back and forth at least once")
 
 
-def _load(source: Source, names: tuple[str, str, str], xname: str):
-    data = read_columns(source, names)
+def _load(source: Source, names: tuple[str, str, str], xname: str, columns=None, scale=None):
+    data = read_record(source, names, columns=columns, scale=scale)
     t, x, v = data[:, 0], data[:, 1], data[:, 2]
     try:
         _check_signals(x, {names[2]: v}, t, xname=xname)
@@ -119,15 +120,17 @@ def _load(source: Source, names: tuple[str, str, str], xname: str):
     return t, x, v
 
 
-def load_force_displacement_csv(source: Source
+def load_force_displacement_csv(source: Source, *, columns: dict[str, str] | None = None,
+                                scale: dict[str, float] | None = None
                                 ) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                            NDArray[np.float64]]:
-    """Read a force-displacement record from CSV (or an array or DataFrame).
+    """Read a force-displacement record from CSV or MATLAB ``.mat`` (or an array or DataFrame).
 
-    The file has a header and the columns ``time,displacement,force``
-    (s, m, N; other columns are ignored; the dialects of
-    :mod:`motionhyst.csvdata`: BOM, comma or semicolon, names in any case).
-    A DataFrame has those columns by name, an array those three columns in order.
+    The record has the columns ``time,displacement,force`` (s, m, N; other
+    columns are ignored), under those names or under the file's own mapped by
+    `columns`, scaled by `scale` (read by :func:`motionhyst.io.records.read_record`:
+    CSV dialects, MATLAB levels 4 to 7.3).  A DataFrame has those columns by
+    name, an array those three columns in order.
 
     Returns
     -------
@@ -158,15 +161,18 @@ def load_force_displacement_csv(source: Source
     >>> t.size, float(w.max())
     (1001, 0.05)
     """
-    return _load(source, ("time", "displacement", "force"), "displacement")
+    return _load(source, ("time", "displacement", "force"), "displacement", columns, scale)
 
 
-def load_closed_loop_csv(source: Source
+def load_closed_loop_csv(source: Source, *, columns: dict[str, str] | None = None,
+                         scale: dict[str, float] | None = None
                          ) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                     NDArray[np.float64]]:
-    """Read a closed-loop record from CSV: header and columns ``time,y1,u`` (s, m, N).
+    """Read a closed-loop record: columns ``time,y1,u`` (s, m, N), CSV or MATLAB ``.mat``.
 
-    An array (those columns in order) or a DataFrame is accepted as well.
+    The file's own names are mapped by `columns` and scaled by `scale` (as
+    :func:`load_force_displacement_csv`); an array (those columns in order) or
+    a DataFrame is accepted as well.
 
     Returns
     -------
@@ -189,4 +195,4 @@ def load_closed_loop_csv(source: Source
     >>> y1.shape
     (1001,)
     """
-    return _load(source, ("time", "y1", "u"), "y1")
+    return _load(source, ("time", "y1", "u"), "y1", columns, scale)
