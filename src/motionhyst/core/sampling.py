@@ -1,0 +1,231 @@
+"""A continuous plant seen by a digital controller: zero-order hold, delay, sampling.
+
+The controller's output ``u_k``, computed from the samples at ``t_k = k T``, is
+applied from ``t_k + d T`` on and held until the next update (``d`` samples of
+delay, fractional allowed).  The held force has the Fourier transform of the
+samples' times the hold's response::
+
+    H(s) = e^{-s d T} (1 - e^{-s T}) / (s T)            (H(0) = 1)
+
+and the plant's output sampled at ``t_k`` answers the samples ``u_k`` with the
+pulse transfer function of the plant behind the hold (the modified z-transform
+for a fractional delay)::
+
+    G_d(e^{s T}) = sum_k P(s + j k w_s) H(s + j k w_s),     w_s = 2 pi / T
+
+which for an integer ``d`` is ``c2d(P, T, "zoh") z^-d``.  :class:`ZohEquivalent`
+evaluates it in closed form, exactly: with ``d = D + phi`` (``0 <= phi < 1``)
+the state over one period is ``x_{k+1} = Phi x_k + Gamma_a u_{k-D-1} +
+Gamma_b u_{k-D}``, the older sample acting for ``phi T`` first.  The plant's
+rigid-body part (its poles at ``s = 0``) is taken apart and evaluated with
+``z - 1 = expm1(j w T)``, so that ``G_d`` keeps its relative accuracy at low
+frequency, where ``(zI - Phi)^-1`` of a double integrator would lose
+``(w T)^-2`` of it.
+
+Examples
+--------
+>>> import numpy as np
+>>> import control
+>>> P = control.tf([1.0], [2.0, 0.0, 0.0])                 # 1 / (2 s^2)
+>>> G = ZohEquivalent(P, period=1e-3)
+>>> Gd = control.c2d(P, 1e-3, "zoh")
+>>> w = np.array([10.0, 1000.0])
+>>> bool(np.allclose(G(w), Gd(np.exp(1j * w * 1e-3)), rtol=1e-9))
+True
+>>> complex(hold_response(0.0, 1e-3, 1.5))                 # passes DC unchanged
+(1+0j)
+"""
+
+from __future__ import annotations
+
+import math
+
+import control
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import expm
+
+__all__ = ["ZohEquivalent", "hold_response", "unit_circle_minus_one"]
+
+
+def unit_circle_minus_one(theta: ArrayLike) -> NDArray[np.complex128]:
+    """``e^{j theta} - 1`` to full relative accuracy near ``theta = 0``.
+
+    Parameters
+    ----------
+    theta : array_like
+        Angles [rad].
+
+    Examples
+    --------
+    >>> from motionhyst.core.sampling import unit_circle_minus_one
+    >>> complex(unit_circle_minus_one(1e-9))               # not 1e-9j plus round-off
+    (-5e-19+1e-09j)
+    """
+    th = np.asarray(theta, dtype=float)
+    return -2.0 * np.sin(0.5 * th) ** 2 + 1j * np.sin(th)
+
+
+def hold_response(omega: ArrayLike, period: float, delay_samples: float = 0.0
+                  ) -> NDArray[np.complex128]:
+    """Zero-order hold with delay, ``H(j w) = e^{-j w d T} (1 - e^{-j w T}) / (j w T)``.
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequencies [rad/s]; 0 gives 1.
+    period : float
+        Sampling period ``T`` [s].
+    delay_samples : float
+        Delay ``d`` of the held output, in samples (fractional allowed).
+
+    Returns
+    -------
+    ndarray of complex
+        The hold's response relative to a sample sequence of unit spectrum
+        (``H -> 1`` as ``T -> 0``).
+
+    Examples
+    --------
+    >>> from motionhyst.core.sampling import hold_response
+    >>> h = complex(hold_response(2 * 3.141592653589793 * 500.0, 1e-3))   # at Nyquist
+    >>> round(abs(h), 4), round(float(np.degrees(np.angle(h))), 1)        # 2 / pi, -90 deg
+    (0.6366, -90.0)
+    """
+    w = np.asarray(omega, dtype=float)
+    th = w * period
+    with np.errstate(divide="ignore", invalid="ignore"):
+        zoh = np.where(th == 0.0, 1.0 + 0j, -np.conj(unit_circle_minus_one(th))
+                       / np.where(th == 0.0, 1.0, 1j * th))
+    return zoh * np.exp(-1j * th * delay_samples)
+
+
+def _rigid_split(num: NDArray[np.float64], den: NDArray[np.float64]):
+    """``num / den = a2 / s^2 + a1 / s + rest``: the coefficients and the rest's polynomials."""
+    num = np.trim_zeros(np.asarray(num, float), "f")
+    den = np.trim_zeros(np.asarray(den, float), "f")
+    m = 0
+    while den.size > 1 and den[-1] == 0.0:
+        den, m = den[:-1], m + 1
+    while m > 0 and num.size > 1 and num[-1] == 0.0:
+        num, m = num[:-1], m - 1
+    if m > 2:
+        raise ValueError("a plant with more than two integrators cannot be sampled here")
+    # Taylor coefficients of num / den0 at s = 0: c0, c1
+    n0 = num[-1]
+    n1 = num[-2] if num.size > 1 else 0.0
+    d0, d1 = den[-1], (den[-2] if den.size > 1 else 0.0)
+    c0 = n0 / d0
+    c1 = (n1 - c0 * d1) / d0
+    a = {2: (c0, c1), 1: (0.0, c0), 0: (0.0, 0.0)}[m]
+    # rest = num / (s^m den0) - a2 / s^2 - a1 / s, over s^m den0; the low coefficients vanish
+    sub = np.zeros(1)
+    if m == 2:
+        sub = np.polyadd(np.polymul([a[1], a[0]], den), np.zeros(1))
+    elif m == 1:
+        sub = a[1] * den
+    rest_num = np.polysub(num, sub)
+    if m:
+        rest_num = rest_num[:-m] if rest_num.size > m else np.zeros(1)
+    return a[0], a[1], rest_num, den
+
+
+class ZohEquivalent:
+    """Pulse transfer function ``G_d(z)`` of a plant behind a delayed zero-order hold.
+
+    Parameters
+    ----------
+    plant : python-control LTI system
+        Strictly proper SISO continuous plant ``P`` (at most two poles at ``s = 0``).
+    period : float
+        Sampling period ``T`` [s].
+    delay_samples : float
+        Delay ``d >= 0`` of the held input in samples (fractional allowed).
+
+    Attributes
+    ----------
+    a2, a1 : float
+        Rigid-body part ``a2 / s^2 + a1 / s`` of ``P``.
+
+    Examples
+    --------
+    The ZOH equivalent with one and a half samples of delay lies between those of one
+    and two samples:
+
+    >>> import numpy as np
+    >>> import control
+    >>> from motionhyst.core.sampling import ZohEquivalent
+    >>> P = control.tf([1.0], [1.0, 1.0, 0.0])             # 1 / (s (s + 1))
+    >>> w = np.array([1.0])
+    >>> g = [abs(np.angle(ZohEquivalent(P, 0.1, d)(w)[0])) for d in (1.0, 1.5, 2.0)]
+    >>> bool(g[0] < g[1] < g[2])
+    True
+    """
+
+    def __init__(self, plant, period: float, delay_samples: float = 0.0) -> None:
+        if not (math.isfinite(period) and period > 0):
+            raise ValueError(f"the sampling period must be finite and > 0, got {period!r}")
+        if not (math.isfinite(delay_samples) and delay_samples >= 0):
+            raise ValueError(f"delay_samples must be finite and >= 0, got {delay_samples!r}")
+        if isinstance(plant, control.StateSpace):
+            plant = control.ss2tf(plant)
+        if not isinstance(plant, control.TransferFunction) or plant.isdtime(strict=True):
+            raise TypeError("the plant behind the hold must be a continuous python-control "
+                            "LTI system (measured frequency data have no response above the "
+                            "measured lines, which the samples alias)")
+        num = np.asarray(plant.num[0][0], float)
+        den = np.asarray(plant.den[0][0], float)
+        if np.trim_zeros(num, "f").size >= np.trim_zeros(den, "f").size:
+            raise ValueError("the plant behind the hold must be strictly proper")
+        self.period = float(period)
+        self.delay_samples = float(delay_samples)
+        self.whole = math.floor(self.delay_samples)
+        self.phi = self.delay_samples - self.whole
+        self.a2, self.a1, rest_num, rest_den = _rigid_split(num, den)
+        self._rest = None
+        if np.any(rest_num != 0.0):
+            sys = control.tf2ss(control.tf(rest_num, rest_den))
+            A, B, C = np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C)
+            n = A.shape[0]
+            T, phi = self.period, self.phi
+
+            def integral(tau):  # exp(A tau) and int_0^tau exp(A s) ds B
+                M = np.zeros((n + 1, n + 1))
+                M[:n, :n], M[:n, n:] = A * tau, B * tau
+                E = expm(M)
+                return E[:n, :n], E[:n, n]
+
+            Phi, _ = integral(T)
+            Eb, gb = integral((1.0 - phi) * T)
+            _, ga = integral(phi * T)
+            self._rest = (Phi, Eb @ ga, gb, C[0])
+
+    def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
+        """``G_d(e^{j w T})``, the delay included.
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular frequencies [rad/s] (> 0 for a plant with integrators).
+        """
+        w = np.asarray(omega, dtype=float)
+        th = w.ravel() * self.period
+        zm1 = unit_circle_minus_one(th)              # z - 1
+        z = 1.0 + zm1
+        zinv = np.exp(-1j * th)
+        T, phi = self.period, self.phi
+        out = np.zeros(th.shape, dtype=complex)
+        if self.a2 or self.a1:
+            tb = (1.0 - phi) * T
+            g1 = (phi * T) ** 2 / 2.0 + tb * phi * T        # Gamma_a of 1/s^2, position
+            g1 = g1 * zinv + tb**2 / 2.0
+            g2 = phi * T * zinv + tb                          # velocity
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out += self.a2 * (g1 * zm1 + T * g2) / zm1**2 + self.a1 * g2 / zm1
+        if self._rest is not None:
+            Phi, ga, gb, C = self._rest
+            n = Phi.shape[0]
+            M = z[:, None, None] * np.eye(n) - Phi
+            g = ga[None, :] * zinv[:, None] + gb[None, :]
+            out += np.linalg.solve(M, g[..., None])[..., 0] @ C
+        return (out * zinv**self.whole).reshape(w.shape)
