@@ -15,7 +15,7 @@ FREQS_HZ = np.array([1.0, 5.0, 10.0, 50.0, 120.0, 500.0, 694.0, 2000.0])
 
 
 def docstring_transfers(P1, P2, C, M, omega):
-    """The four transfers of loop.py's module docstring from the parts' frequency responses."""
+    """The transfers of loop.py's module docstring from the parts' frequency responses."""
     p1, p2, c = freqresp(P1, omega), freqresp(P2, omega), freqresp(C, omega)
     cff = M * (1j * omega) ** 2
     return {
@@ -23,6 +23,8 @@ def docstring_transfers(P1, P2, C, M, omega):
         "r->y1": p1 * (c + cff) / (1 + c * p2),
         "w->e": p2 / (1 + c * p2),
         "w->y1": -p1 / (1 + c * p2),
+        "f->e": -p2 / (1 + c * p2),
+        "f->y1": p1 / (1 + c * p2),
     }
 
 

@@ -14,6 +14,15 @@ of the paper's Fig. 3 with ``phi = 0``, with the definitions of
 The bandwidth is the crossover frequency: the first (lowest) frequency where
 ``|L|`` falls through 1 (0 dB), as the paper's ``f_bw = 120 Hz`` for Table I.
 
+With a sampled controller (:class:`~motionhyst.controllers.sampled.SampledController`)
+the loop is ``L = Y(z) G_d(z)`` at ``z = e^{j w T}``, ``Y`` the feedback path and
+``G_d`` the plant behind the delayed hold (:class:`~motionhyst.core.sampling.ZohEquivalent`),
+scanned up to the Nyquist frequency: for a whole number ``d`` of samples of delay
+the margins are those :func:`control.stability_margins` gives for
+``c2d(P2, T, "zoh") C_d(z) z^-d``.  The delay margin is the extra delay that
+brings the loop to the edge of stability, ``PM / w_c`` at each gain crossover
+(the smallest), in seconds and, for a sampled loop, in samples.
+
 For LTI systems ``L`` is scanned on a dense logarithmic grid and each
 crossing and the minimum of ``|1 + L|`` is refined by root finding, so a
 margin is found wherever the grid brackets it.  For measured data only the
@@ -32,6 +41,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq, minimize_scalar
 
+from motionhyst.controllers.sampled import SampledController
+from motionhyst.core.sampling import ZohEquivalent
 from motionhyst.lti import tf_poly, trim
 from motionhyst.systems import TWO_PI, freqresp
 
@@ -63,6 +74,10 @@ class LoopMargins:
         Lowest frequency where ``|L|`` falls through 1 [Hz].
     evaluated_on : str
         ``"model"`` (dense grid, refined) or ``"measured lines"``.
+    delay_margin_s : float
+        Smallest ``PM / w_c`` over the gain crossovers [s] (inf without one).
+    sample_rate_hz : float or None
+        The sampled controller's rate; None for a continuous loop.
 
     Examples
     --------
@@ -83,6 +98,13 @@ class LoopMargins:
     modulus_margin_hz: float
     bandwidth_hz: float
     evaluated_on: str = "model"
+    delay_margin_s: float = math.inf
+    sample_rate_hz: float | None = None
+
+    @property
+    def delay_margin_samples(self) -> float | None:
+        """The delay margin in samples of a sampled controller (None for a continuous one)."""
+        return None if self.sample_rate_hz is None else self.delay_margin_s * self.sample_rate_hz
 
     @property
     def gain_margin_db(self) -> float:
@@ -98,7 +120,11 @@ class LoopMargins:
                 "modulus_margin_hz": self.modulus_margin_hz,
                 "bandwidth_hz": self.bandwidth_hz,
                 "bandwidth_definition": BANDWIDTH_DEFINITION,
-                "margins_evaluated_on": self.evaluated_on}
+                "margins_evaluated_on": self.evaluated_on,
+                "delay_margin_s": self.delay_margin_s,
+                **({} if self.sample_rate_hz is None else
+                   {"sample_rate_hz": self.sample_rate_hz,
+                    "delay_margin_samples": self.delay_margin_samples})}
 
     def __str__(self) -> str:
         def at(f):
@@ -112,6 +138,9 @@ class LoopMargins:
             f"  modulus margin 1/max|S|        {self.modulus_margin:.4g}"
             f"{at(self.modulus_margin_hz)}"
             f" (max|S| = {20 * math.log10(1 / self.modulus_margin):.4g} dB)",
+            f"  delay margin                   {self.delay_margin_s:.4g} s"
+            + ("" if self.sample_rate_hz is None else
+               f" ({self.delay_margin_samples:.4g} samples at {self.sample_rate_hz:g} Hz)"),
             f"  bandwidth                      {self.bandwidth_hz:.4g} Hz ({BANDWIDTH_DEFINITION})"
             + ("" if self.evaluated_on == "model" else
                f"; evaluated on the {self.evaluated_on} only")])
@@ -121,6 +150,8 @@ def _grid_hz(controller, plant) -> NDArray[np.float64]:
     """Frequencies spanning every pole and zero of ``C`` and ``P2`` by two decades."""
     corners = []
     for sys in (controller, plant):
+        if sys is None:
+            continue
         for poly in tf_poly(sys):
             r = np.abs(np.roots(trim(poly)))
             corners += list(r[r > 0] / TWO_PI)
@@ -135,11 +166,12 @@ def loop_margins(controller, plant) -> LoopMargins:
 
     Parameters
     ----------
-    controller : python-control LTI system
-        Feedback controller ``C``.
+    controller : python-control LTI system or SampledController
+        Feedback controller ``C`` (a sampled one: its feedback path ``Y(z)``,
+        behind its hold and delay).
     plant : python-control LTI system or FrequencyResponseData
         Non-collocated plant ``P2``; measured data are evaluated at the
-        measured lines only.
+        measured lines only (not with a sampled controller).
 
     Returns
     -------
@@ -155,7 +187,22 @@ def loop_margins(controller, plant) -> LoopMargins:
     (120.6, 24.8, 0.396)
     """
     data = isinstance(plant, control.FrequencyResponseData)
-    if data:
+    sampled = isinstance(controller, SampledController)
+    if sampled:
+        G = ZohEquivalent(plant, controller.period, controller.delay_samples)
+        nyq = controller.nyquist_hz
+        corners = [x for x in _grid_hz(None, plant)[[0, -1]]]
+        lo = min(corners[0], nyq * 1e-6)
+        n = int(np.ceil(POINTS_PER_DECADE * np.log10(nyq / lo))) + 1
+        f = np.geomspace(lo, nyq, n)
+        f[-1] = nyq * (1.0 - 1e-12)   # z = -1 itself: L is real there, its phase ambiguous
+
+        def response(x):
+            w = TWO_PI * np.asarray(x, dtype=float)
+            return controller.feedback_response(w) * G(w)
+
+        L = response(f)
+    elif data:
         w = np.asarray(plant.omega, dtype=float)
         f = w / TWO_PI
         L = freqresp(controller, w) * np.asarray(plant.frdata, dtype=complex).ravel()
@@ -164,6 +211,8 @@ def loop_margins(controller, plant) -> LoopMargins:
         L = freqresp(controller, TWO_PI * f) * freqresp(plant, TWO_PI * f)
 
     def loop_at(x: float) -> complex:
+        if sampled:
+            return complex(response(np.array([x]))[0])
         w1 = np.array([TWO_PI * x])
         return complex(freqresp(controller, w1)[0] * freqresp(plant, w1)[0])
 
@@ -206,6 +255,9 @@ def loop_margins(controller, plant) -> LoopMargins:
         pms = [(float(np.remainder(np.degrees(np.angle(loop_at(x))), 360.0) - 180.0), x)
                for x in fc]
     pm, f_pm = min(pms, key=lambda v: abs(v[0])) if pms else (math.inf, math.nan)
+    # delay margin: the extra delay that turns a gain crossover's phase margin to zero
+    dms = [float(np.remainder(p, 360.0)) / 360.0 / x for p, x in pms if x > 0]
+    dm = min(dms) if dms else math.inf
     falling = [x for i, x in zip(idx, fc, strict=True) if lm[i] > 0]
     bw = min(falling) if falling else math.nan
 
@@ -221,4 +273,6 @@ def loop_margins(controller, plant) -> LoopMargins:
     return LoopMargins(gain_margin=float(gm), gain_margin_hz=float(f_gm),
                        phase_margin_deg=float(pm), phase_margin_hz=float(f_pm),
                        modulus_margin=mm, modulus_margin_hz=f_mm, bandwidth_hz=float(bw),
-                       evaluated_on="measured lines" if data else "model")
+                       evaluated_on="measured lines" if data else "model",
+                       delay_margin_s=float(dm),
+                       sample_rate_hz=controller.sample_rate_hz if sampled else None)

@@ -6,6 +6,20 @@ the dynamic link spoils tracking: the quasi-linear plant ``P^phi`` (eq. 12),
 the sensitivity ``S1^phi`` (eq. 15), the feedforward mismatch ``E`` (eq. 18)
 and its low-frequency asymptote (eq. 20), with the characteristic frequencies
 ``f*`` (eq. 13) and the crossover of eq. (21).
+
+With a sampled controller the analysis is that of the sampled-data loop:
+the controller and the hold are evaluated at ``z = e^{j w T}``, the plant and the
+link act in continuous time, and eq. (18) is the ratio of the fundamentals of
+the error with and without the link (:meth:`motionhyst.loop.Loop.transfer`).
+What is approximated, besides the describing function itself: the link
+acts on the fundamental of ``y1`` only.  The held force also has images at
+``w + k F`` (``k != 0``, all above the Nyquist frequency ``F / 2`` for ``f < F / 2``);
+they move ``y1`` by ``|P1 H|`` at those frequencies and the link's response to
+them is left out, as are the harmonics it generates.  Their aliases at the
+samples are kept exactly (``G_d`` sums them in closed form).  For ``f`` above the
+Nyquist frequency the same holds (the fundamental is exact for the linear loop),
+except at multiples of ``F / 2``, where a sinusoid and its image coincide at the
+samples: there the analysis refuses.
 """
 
 from __future__ import annotations
@@ -130,6 +144,9 @@ class QuasiLinearAnalysis:
         cannot give and why (they are nan): frequencies that are not measured
         lines, lines where ``Pf2 = Pr - P2`` is below the data's resolution,
         eq. (21).  Empty for a model.
+    sampling : str or None
+        For a sampled controller: its rate, delay and feedforward advance, and
+        what the analysis approximates above the Nyquist frequency.
 
     Examples
     --------
@@ -159,6 +176,7 @@ class QuasiLinearAnalysis:
     df_frequency_hz: float | None = None
     margins: LoopMargins | None = None
     unresolved: list[str] = field(default_factory=list)
+    sampling: str | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``analyze --json`` schema)."""
@@ -179,12 +197,15 @@ class QuasiLinearAnalysis:
             "mismatch_crossover_exact_hz": self.mismatch_crossover_exact_hz,
             "mismatch": [p.to_dict() for p in self.points],
             "unresolved": list(self.unresolved),
+            **({} if self.sampling is None else {"sampling": self.sampling}),
         }
 
     def __str__(self) -> str:
         d = self.to_dict()
         has_zeta = self.zeta is not None and math.isfinite(self.zeta)
         lines = [f"  reference amplitude A_r        {g(self.amplitude)} m"]
+        if self.sampling is not None:
+            lines.insert(0, f"  {self.sampling}")
         if has_zeta:
             lines.append(f"  zeta = fc/(k A)  (eq. 4)       {g(self.zeta)}")
         at = "" if self.df_frequency_hz is None else f" at {g(self.df_frequency_hz)} Hz"
@@ -193,7 +214,8 @@ class QuasiLinearAnalysis:
                   f"  f*  (eq. 13)                   {g(self.f_star_hz)} Hz",
                   f"  bandwidth (first |C P2| = 1)   {g(self.bandwidth_hz)} Hz (the crossover "
                   "frequency, where |C P2| falls through 0 dB)",
-                  *([] if self.margins is None else str(self.margins).splitlines()[:3]),
+                  *([] if self.margins is None else str(self.margins).splitlines()[
+                      :3 if self.sampling is None else 4]),
                   f"  mismatch crossover (eq. 21)    {g(self.mismatch_crossover_hz)} Hz",
                   f"  exact crossover |E - 1| = 1    {g(self.mismatch_crossover_exact_hz)} Hz "
                   "(eq. 18: where the error the link adds equals the error without it; "
@@ -224,8 +246,9 @@ class QuasiLinearAnalysis:
 
 
 def _parts(loop: Loop, omega: NDArray[np.float64]):
-    """Frequency responses C, P1, P2, Pr, Pf2 of the loop at `omega`."""
-    C = freqresp(loop.controller, omega)
+    """Frequency responses C, P1, P2, Pr, Pf2 of the loop at `omega` (C: ``Y(z)`` if sampled)."""
+    C = (freqresp(loop.controller, omega) if loop.sampled is None
+         else loop.sampled.feedback_response(omega))
     P1 = freqresp(loop.P1, omega)
     P2 = freqresp(loop.P2, omega)
     Pr = 1.0 / (loop.M * (1j * omega) ** 2)
@@ -253,11 +276,29 @@ def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayL
         D = np.broadcast_to(np.asarray(describing_function, dtype=complex), f.shape)
     else:
         D = loop.hysteresis.describing_function(np.broadcast_to(amplitude, f.shape), omega)
-    if loop.hysteresis_feedforward is None:
-        return mismatch(*_parts(loop, omega), D)
     a_ref = amplitude if reference_amplitude is None else reference_amplitude
-    D_ff = loop.hysteresis_feedforward.describing_function(np.broadcast_to(a_ref, f.shape), omega)
-    return residual_mismatch(loop, omega, D, D_ff)
+    if _paper_loop(loop):
+        return mismatch(*_parts(loop, omega), D)
+    return residual_mismatch(loop, omega, D, _feedforward_df(loop, a_ref, omega))
+
+
+def _paper_loop(loop: Loop) -> bool:
+    """A continuous loop with the paper's feedforward ``M s^2`` alone: eq. (18) as written."""
+    ff = loop.ff
+    return (loop.sampled is None and loop.hysteresis_feedforward is None and ff is not None
+            and ff.mass == loop.M and not ff.viscous and not ff.coulomb)
+
+
+def _feedforward_df(loop: Loop, amplitude, omega) -> NDArray[np.complex128] | float:
+    """The feedforward's nonlinear force per unit reference: ``phi_hat``'s DF and Coulomb's."""
+    out = 0.0
+    hff = loop.hysteresis_feedforward
+    if hff is not None:
+        out = out + np.asarray(hff.describing_function(
+            np.broadcast_to(amplitude, np.shape(omega)), omega))
+    if loop.ff is not None and loop.ff.coulomb:   # eq. (10)'s counterpart: 4j fc / (pi A)
+        out = out + 4j * loop.ff.coulomb / (np.pi * np.asarray(amplitude, dtype=float))
+    return out
 
 
 def residual_mismatch(loop: Loop, omega: ArrayLike, D: ArrayLike, D_ff: ArrayLike
@@ -265,17 +306,23 @@ def residual_mismatch(loop: Loop, omega: ArrayLike, D: ArrayLike, D_ff: ArrayLik
     """Mismatch ``e / e_hat`` left with hysteresis feedforward ``u_ff = M r'' + phi_hat(r)``.
 
     Quasi-linear: ``w = D y1`` and ``phi_hat(r) = D_ff r``, so
-    ``y1 = (T_ry1 - T_wy1 D_ff) / (1 - T_wy1 D) r`` and
-    ``e = T_re r + T_we (D y1 - D_ff r)``; ``e_hat = T_re r`` is the error
-    without hysteresis and without its feedforward.  With ``D_ff = 0`` this is
-    eq. (18).
+    ``y1 = (T_ry1 + T_fy1 D_ff) / (1 - T_wy1 D) r`` and
+    ``e = T_re r + T_we D y1 + T_fe D_ff r``; ``e_hat = T_re r`` is the error
+    without hysteresis and without its feedforward.  ``T_f`` is the path of a
+    force added to the controller's output (``T_f = -T_w`` for a continuous
+    controller; sampled, advanced and held with it for a sampled one).  With
+    ``D_ff = 0`` this is eq. (18).
     """
     w = np.asarray(omega, dtype=float)
     t_re, t_ry1 = loop.transfer("r->e", w), loop.transfer("r->y1", w)
     t_we, t_wy1 = loop.transfer("w->e", w), loop.transfer("w->y1", w)
     D, D_ff = np.asarray(D), np.asarray(D_ff)
-    y1 = (t_ry1 - t_wy1 * D_ff) / (1.0 - t_wy1 * D)
-    return 1.0 + t_we * (D * y1 - D_ff) / t_re
+    if loop.sampled is None:
+        y1 = (t_ry1 - t_wy1 * D_ff) / (1.0 - t_wy1 * D)
+        return 1.0 + t_we * (D * y1 - D_ff) / t_re
+    t_fe, t_fy1 = loop.transfer("f->e", w), loop.transfer("f->y1", w)
+    y1 = (t_ry1 + t_fy1 * D_ff) / (1.0 - t_wy1 * D)
+    return 1.0 + (t_we * D * y1 + t_fe * D_ff) / t_re
 
 
 def error_harmonics_df(loop: Loop, amplitude: float, frequency_hz: float, n_max: int = 5,
@@ -310,19 +357,19 @@ def self_consistent_amplitude(loop: Loop, frequency_hz: float, amplitude: float,
                               tol: float = 1e-12, max_iter: int = 200) -> float:
     """Amplitude of ``y1`` in the quasi-linear loop, solved with ``w = D(A_y1) y1``.
 
-    ``y1 = (T_ry1 - T_wy1 D_ff) / (1 - T_wy1 D) r`` (``D_ff`` of a hysteresis
-    feedforward, else 0); iterated on ``A_y1`` starting at ``A_r``.
+    ``y1 = (T_ry1 + T_fy1 D_ff) / (1 - T_wy1 D) r`` (``D_ff`` of a hysteresis or
+    Coulomb feedforward, else 0; ``T_fy1 = -T_wy1`` for a continuous controller);
+    iterated on ``A_y1`` starting at ``A_r``.
     """
     omega = TWO_PI * float(frequency_hz)
     t_r = complex(loop.transfer("r->y1", np.array([omega]))[0])
     t_w = complex(loop.transfer("w->y1", np.array([omega]))[0])
-    hff = loop.hysteresis_feedforward
-    D_ff = 0.0 if hff is None else complex(
-        np.asarray(hff.describing_function(amplitude, omega)).ravel()[0])
+    t_f = complex(loop.transfer("f->y1", np.array([omega]))[0])
+    D_ff = complex(np.asarray(_feedforward_df(loop, amplitude, omega)).ravel()[0])
     a = amplitude
     for _ in range(max_iter):
         D = complex(np.asarray(loop.hysteresis.describing_function(a, omega)).ravel()[0])
-        a_new = abs((t_r - t_w * D_ff) / (1.0 - t_w * D)) * amplitude
+        a_new = abs((t_r + t_f * D_ff) / (1.0 - t_w * D)) * amplitude
         if abs(a_new - a) <= tol * a_new:
             return float(a_new)
         a = a_new
@@ -342,6 +389,8 @@ def mismatch_crossover_exact(loop: Loop, amplitude: float, f_min: float = 1e-2,
     """
     lo, hi = getattr(loop.plant, "frequency_range_hz", (f_min, f_max))
     f_min, f_max = max(f_min, lo), min(f_max, hi)
+    if loop.sampled is not None:  # below the Nyquist frequency (the sampled loop repeats above)
+        f_max = min(f_max, loop.sampled.nyquist_hz * (1.0 - 1e-9))
     # a fine grid for closed-form D; a coarser one where each D is a periodic solve,
     # scanned upwards so that frequencies above the first crossing are never evaluated
     per_decade = 500 if loop.hysteresis.rate_independent else 40
@@ -410,6 +459,7 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0")
+    sampling = None if loop.sampled is None else _sampling_note(loop, f)
     hyst = loop.hysteresis
     k_link = hyst.initial_stiffness
     omega = TWO_PI * f
@@ -419,11 +469,10 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         amps = np.array([self_consistent_amplitude(loop, fi, amplitude) for fi in f])
     D_pts = np.asarray(hyst.describing_function(amps, omega), dtype=complex)
     C, P1, P2, Pr, Pf2 = _parts(loop, omega)
-    if loop.hysteresis_feedforward is None:
+    if _paper_loop(loop):
         E = mismatch(C, P1, P2, Pr, Pf2, D_pts)
     else:
-        D_ff = loop.hysteresis_feedforward.describing_function(amplitude, omega)
-        E = residual_mismatch(loop, omega, D_pts, D_ff)
+        E = residual_mismatch(loop, omega, D_pts, _feedforward_df(loop, amplitude, omega))
     Et = mismatch_asymptote(Pr, Pf2, D_pts)
     zetas = np.asarray(hyst.zeta(amps)) if hyst.defines_zeta else np.full(f.shape, np.nan)
     f_df = None if hyst.rate_independent else float(np.min(f))
@@ -454,7 +503,27 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         f_star_hz=f_star(k_link, loop.M), bandwidth_hz=bandwidth_hz, margins=margins,
         mismatch_crossover_hz=crossover, mismatch_crossover_exact_hz=crossover_exact,
         points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df,
-        unresolved=unresolved)
+        unresolved=unresolved, sampling=sampling)
+
+
+def _sampling_note(loop: Loop, f: NDArray[np.float64]) -> str:
+    """What the analysis of a sampled loop is of, and what it approximates (module docstring)."""
+    c = loop.sampled
+    nyq = c.nyquist_hz
+    k = f / nyq
+    on = np.abs(k - np.round(k)) <= 1e-9 * np.maximum(k, 1.0)
+    if np.any(on):
+        raise ValueError(f"{f[on][0]:g} Hz is a multiple of the Nyquist frequency {nyq:g} Hz "
+                         f"of the controller sampled at {c.sample_rate_hz:g} Hz: a sinusoid and "
+                         "its image have the same samples there; take another frequency")
+    adv = 0.0 if loop.ff is None else loop.ff.advance_samples
+    above = ("" if np.all(f < nyq) else
+             f"; {int(np.sum(f > nyq))} frequencies above the Nyquist frequency: their "
+             "fundamental only")
+    return (f"sampled at {c.sample_rate_hz:g} Hz, {c.delay_samples:g} samples of delay, "
+            f"feedforward advanced {adv:g} samples: controller and hold at z = e^(jwT), plant and "
+            f"link continuous; the link acts on the fundamental of y1 only (the held force's "
+            f"images at f + k {c.sample_rate_hz:g} Hz reach the plant without it){above}")
 
 
 #: ``Pf2 = Pr - P2`` counts as resolved by data where ``|Pf2| / |P2|`` exceeds this many times

@@ -14,6 +14,19 @@ formed by subtracting positions.
 
 Complex amplitudes are reported relative to ``sin(n omega t)``:
 a signal is ``c_0 + sum_n |c_n| sin(n omega t + angle c_n)``.
+
+With a sampled controller the loop is hybrid: the link and the plant move
+continuously, the controller sees the samples ``y2(t_k)`` and acts through a
+delayed hold.  When the reference period is a whole number ``N`` of samples
+(``f = F / N``) the loop's steady state is periodic with the reference, and
+it is computed exactly in the same way: the samples' spectrum at
+``z_m = e^{j 2 pi m / N}`` gathers every harmonic ``n = m mod N`` of the plant's
+output (aliasing), the controller acts on it, and the hold spreads its output
+over all those harmonics again (``H(j n w)``); the plant's response to the held
+force is summed in closed form (:class:`~motionhyst.core.sampling.ZohEquivalent`),
+the link's force is kept to ``H`` harmonics as in the continuous loop.  For
+another frequency the loop has no steady state of the reference's period, and
+:func:`periodic_steady_state` names the nearest frequency that has one.
 """
 
 from __future__ import annotations
@@ -23,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.sampling import hold_response
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
 from motionhyst.systems import TWO_PI, MeasuredPlant
@@ -66,11 +80,14 @@ class SteadyState:
         displacement [m] and the hysteresis force [N], relative to
         ``sin(n omega t)`` (``[0]`` is the mean).
     e_linear : ndarray of complex
-        Harmonics of the error without hysteresis (only ``n = 1`` is non-zero).
+        Harmonics of the error without hysteresis (only ``n = 1`` is non-zero,
+        and its images ``n = k N +- 1`` for a sampled controller).
     iterations : int
         Fixed-point iterations used.
     residual : float
         Relative change of the first harmonic of ``w`` in the last iteration.
+    samples_per_period : int or None
+        ``N`` for a sampled controller (``f = F / N``); None for a continuous one.
 
     Examples
     --------
@@ -93,6 +110,7 @@ class SteadyState:
     e_linear: NDArray[np.complex128]
     iterations: int
     residual: float
+    samples_per_period: int | None = None
 
     @property
     def n_harmonics(self) -> int:
@@ -142,9 +160,11 @@ class SteadyState:
     def __str__(self) -> str:
         rows = [[str(n), g(abs(self.e[n])), f"{np.degrees(np.angle(self.e[n])):.2f}",
                  g(abs(self.w[n]))] for n in range(1, min(self.n_harmonics, 5) + 1)]
+        sampled = ("" if self.samples_per_period is None else
+                   f", sampled: {self.samples_per_period} samples a period")
         return "\n".join([
             f"Periodic steady state, r = {g(self.amplitude)} m sin(2 pi {g(self.frequency_hz)} t)"
-            f": {self.n_harmonics} harmonics, {self.iterations} iterations",
+            f": {self.n_harmonics} harmonics, {self.iterations} iterations{sampled}",
             f"  |E| = |e1 / e1_linear| = {g(abs(self.mismatch))}, "
             f"angle {np.degrees(np.angle(self.mismatch)):.2f} deg",
             f"  error RMS {g(self.error_rms)} m (without hysteresis {g(self.error_linear_rms)} m)",
@@ -195,6 +215,8 @@ class SteadyState:
             "harmonics_kept": self.n_harmonics,
             "iterations": self.iterations,
         })
+        if self.samples_per_period is not None:
+            out["samples_per_period"] = self.samples_per_period
         return out
 
 
@@ -250,6 +272,14 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     if isinstance(loop.plant, MeasuredPlant):
         raise ValueError("the steady state needs the plant at every harmonic n f, which raw "
                          "measured lines do not give; fit the data ([plant] use = \"fit\")")
+    if loop.sampled is not None:
+        N = samples_per_period(loop.sampled.sample_rate_hz, frequency_hz)
+        H = (int(n_harmonics) if n_harmonics is not None
+             else max(default_harmonics(loop, frequency_hz), min(N + 1, MAX_HARMONICS)))
+        if H < 1:
+            raise ValueError("n_harmonics must be >= 1")
+        return _sampled_steady_state(loop, float(amplitude), float(frequency_hz), N, H,
+                                     tol, max_iter)
     H = int(n_harmonics) if n_harmonics is not None else default_harmonics(loop, frequency_hz)
     if H < 1:
         raise ValueError("n_harmonics must be >= 1")
@@ -265,6 +295,13 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     hyst, hff = loop.hysteresis, loop.hysteresis_feedforward
     U_h = (np.zeros(H + 1, dtype=complex) if hff is None
            else hff.periodic_harmonics(R, H, omega))
+    if loop.ff is not None and loop.ff.coulomb:
+        # fc sign(r') = fc sign(cos theta): a square wave, odd harmonics 4 fc / (pi n) cos(n theta)
+        n = np.arange(H + 1)
+        odd = n % 2 == 1
+        U_h = U_h.copy()
+        U_h[odd] += loop.ff.coulomb * 2.0 / (np.pi * n[odd]) * (-1.0) ** ((n[odd] - 1) // 2)
+        hff = hff if hff is not None else loop.ff
     if hyst is None and hff is None:
         z = np.zeros(H + 1, dtype=complex)
         return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e_lin),
@@ -295,6 +332,152 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e),
                        _to_sin_amplitudes(X), _to_sin_amplitudes(W),
                        _to_sin_amplitudes(e_lin), it, residual)
+
+
+def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:
+    """``N = F / f`` when it is a whole number >= 3; else ValueError naming the nearest such f.
+
+    Parameters
+    ----------
+    sample_rate_hz : float
+        The controller's rate ``F`` [Hz].
+    frequency_hz : float
+        The reference's frequency ``f`` [Hz].
+
+    Examples
+    --------
+    >>> from motionhyst.steady import samples_per_period
+    >>> samples_per_period(10e3, 5.0)
+    2000
+    >>> try:
+    ...     samples_per_period(10e3, 7.0)
+    ... except ValueError as err:
+    ...     print(err)
+    the steady state of a loop sampled at 10000 Hz needs a whole number of samples per \
+period: 7 Hz has 1428.57; the nearest frequency that has one is 6.997900629811 Hz (1429 samples)
+    """
+    ratio = float(sample_rate_hz) / float(frequency_hz)
+    N = max(3, round(ratio))
+    if abs(ratio - N) > 1e-9 * ratio:
+        raise ValueError(
+            f"the steady state of a loop sampled at {sample_rate_hz:g} Hz needs a whole number "
+            f"of samples per period: {frequency_hz:g} Hz has {ratio:.6g}; the nearest frequency "
+            f"that has one is {sample_rate_hz / N:.13g} Hz ({N} samples)")
+    return int(N)
+
+
+def _feedforward_samples(loop: Loop, amplitude: float, omega: float, N: int
+                         ) -> NDArray[np.complex128]:
+    """DFT / N of the feedforward's nonlinear terms at the samples (Coulomb, phi_hat(r))."""
+    T = loop.sampled.period
+    a = 0.0 if loop.ff is None else loop.ff.advance_samples
+    th = omega * (np.arange(N) + a) * T
+    f = np.zeros(N)
+    if loop.ff is not None and loop.ff.coulomb:
+        c = np.cos(th)
+        f += loop.ff.coulomb * np.where(np.abs(c) < 1e-12, 0.0, np.sign(c))
+    hff = loop.hysteresis_feedforward
+    if hff is not None:
+        if not hff.rate_independent:
+            raise ValueError("the sampled loop's steady state takes a rate-independent "
+                             "hysteresis feedforward only")
+        # three periods through the sample instants and the reference's turning points
+        pts = np.concatenate([np.mod(th, 2 * np.pi), [0.5 * np.pi, 1.5 * np.pi]])
+        grid = np.unique(np.concatenate([pts + 2 * np.pi * k for k in range(3)]))
+        out = hff.response(amplitude * np.sin(grid))
+        last = grid >= 4 * np.pi
+        lookup = dict(zip(np.round(grid[last] - 4 * np.pi, 12), out[last], strict=True))
+        f += np.array([lookup[x] for x in np.round(np.mod(th, 2 * np.pi), 12)])
+    return np.fft.fft(f) / N
+
+
+def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: int, H: int,
+                          tol: float, max_iter: int) -> SteadyState:
+    """The hybrid loop's periodic steady state (module docstring), ``f = F / N``."""
+    c = loop.sampled
+    T, d = c.period, c.delay_samples
+    omega = TWO_PI * frequency_hz
+    n = np.arange(-H, H + 1)                      # two-sided harmonics of the period
+    wn = n * omega
+    m_of_n = np.mod(n, N)
+    wm = TWO_PI * np.arange(N) / (N * T)          # a representative frequency of each z_m
+    parts = loop.sampled_parts
+    integrating = parts.zoh.a2 != 0.0 or parts.zoh.a1 != 0.0
+    w_dc = np.where(n == 0, 1.0, wn) if integrating else wn   # P(0) is not used then
+    P1 = np.asarray(parts.P1(w_dc))
+    P2 = np.asarray(parts.P2(w_dc))
+    Hn = hold_response(wn, T, d)
+    Rm, Ym = c.response(wm)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Gm = parts.zoh(wm)
+    den = 1.0 + Ym * Gm
+    # the linear loop: the fundamental (its careful error) and its images k N +- 1
+    R1 = -0.5j * amplitude
+    ff = loop.ff
+    F1 = 0.0 if ff is None else complex(ff.linear_response(omega)) * np.exp(
+        1j * omega * T * ff.advance_samples)
+    ud1 = (Rm[1] + F1) * R1 / den[1]
+    E_lin = np.zeros(n.size, dtype=complex)
+    Y1_lin = np.zeros(n.size, dtype=complex)
+    for sign, ud in ((1, ud1), (-1, np.conj(ud1))):
+        img = m_of_n == (sign % N)
+        E_lin[img] = -P2[img] * Hn[img] * ud
+        Y1_lin[img] = P1[img] * Hn[img] * ud
+    i1 = H + 1
+    E_lin[i1] = loop.transfer("r->e", np.array([omega]))[0] * R1
+    E_lin[H - 1] = np.conj(E_lin[i1])
+    FF = _feedforward_samples(loop, amplitude, omega, N)
+    hyst = loop.hysteresis
+    W = np.zeros(H + 1, dtype=complex)
+
+    def respond(W_pos):
+        """Y1 and E (two-sided) of the loop with the link's force W and the feedforward's."""
+        Wn = np.concatenate([np.conj(W_pos[:0:-1]), W_pos])
+        wd2 = np.zeros(N, dtype=complex)
+        np.add.at(wd2, m_of_n, np.where(n == 0, 0.0, P2 * Wn))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ud = (FF + Ym * wd2) / den
+        if integrating:
+            ud[0] = Wn[H]                          # no net static force on a free plant
+        else:
+            ud[0] = (FF[0] + Ym[0] * (wd2[0] + P2[H] * Wn[H])) / den[0]
+        U = Hn * ud[m_of_n]
+        Y1 = Y1_lin + np.where(n == 0, 0.0, P1 * (U - Wn))
+        E = E_lin - np.where(n == 0, 0.0, P2 * (U - Wn))
+        # the mean: the controller's static balance at the samples
+        static = np.nonzero((m_of_n == 0) & (n != 0))[0]
+        y2_images = np.sum(P2[static] * (U[static] - Wn[static]))
+        y0 = Ym[0]
+        if integrating:
+            y2d0 = (FF[0] - Wn[H]) / y0 if np.isfinite(y0) and y0 != 0 else 0.0
+            E[H] = -(y2d0 - y2_images)
+            Y1[H] = -E[H]     # no net static force: the plant is not deflected, y1 = y2 on mean
+        else:
+            E[H] = -P2[H] * (U[H] - Wn[H])
+            Y1[H] = P1[H] * (U[H] - Wn[H])
+        return Y1, E
+
+    Y1, E = respond(W)
+    residual, it = 0.0, 0
+    if hyst is not None:
+        previous = np.inf
+        for it in range(1, max_iter + 1):
+            W_new = hyst.periodic_harmonics(Y1[H:], H, omega)
+            change = float(np.max(np.abs(W_new - W)))
+            residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
+            W = W_new
+            Y1, E = respond(W)
+            rho = residual / previous if it > 2 and previous > 0 else 1.0
+            previous = residual
+            if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
+                break
+        else:
+            raise RuntimeError(
+                f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
+                f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+    return SteadyState(frequency_hz, amplitude, _to_sin_amplitudes(E[H:]),
+                       _to_sin_amplitudes(Y1[H:]), _to_sin_amplitudes(W),
+                       _to_sin_amplitudes(E_lin[H:]), it, residual, samples_per_period=N)
 
 
 def steady_state_sweep(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,

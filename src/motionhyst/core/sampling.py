@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
-__all__ = ["ZohEquivalent", "hold_response", "unit_circle_minus_one"]
+__all__ = ["ZohEquivalent", "hold_mismatch", "hold_response", "unit_circle_minus_one"]
 
 
 def unit_circle_minus_one(theta: ArrayLike) -> NDArray[np.complex128]:
@@ -98,6 +98,44 @@ def hold_response(omega: ArrayLike, period: float, delay_samples: float = 0.0
         zoh = np.where(th == 0.0, 1.0 + 0j, -np.conj(unit_circle_minus_one(th))
                        / np.where(th == 0.0, 1.0, 1j * th))
     return zoh * np.exp(-1j * th * delay_samples)
+
+
+def hold_mismatch(omega: ArrayLike, period: float, lag_samples: float = 0.0
+                  ) -> NDArray[np.complex128]:
+    """``1 - H(j w)`` for a hold lagging `lag_samples`, to full accuracy at low frequency.
+
+    ``H = e^{-j w l T} (1 - e^{-j w T}) / (j w T)``: the part of a sampled,
+    held and delayed feedforward that does not arrive as computed.  With
+    ``l = -1/2`` (the feedforward advanced by the delay and half a sample) it
+    is of second order in ``w T``, of first order otherwise.
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequencies [rad/s].
+    period : float
+        Sampling period ``T`` [s].
+    lag_samples : float
+        ``l``: the delay minus the feedforward's advance, in samples (may be negative).
+
+    Examples
+    --------
+    >>> from motionhyst.core.sampling import hold_mismatch
+    >>> w, T = 2 * np.pi * 5.0, 1e-4
+    >>> round(abs(complex(hold_mismatch(w, T, -0.5))) / (w * T) ** 2, 6)   # (w T)^2 / 24
+    0.041667
+    """
+    th = np.asarray(omega, dtype=float) * period
+    small = np.abs(th) < 0.05
+    ts = np.where(small, th, 0.0)
+    # 1 - q, q = (1 - e^{-j th}) / (j th): j (th - sin th) / (j th) - 2 sin^2(th / 2) / (j th)
+    series = ts**2 / 6.0 - ts**4 / 120.0 + ts**6 / 5040.0 - ts**8 / 362880.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        direct = (th - np.sin(th)) / np.where(small, 1.0, th)
+        sin2 = np.where(th == 0.0, 0.0, 2.0 * np.sin(0.5 * th) ** 2 / np.where(th == 0, 1.0, th))
+    one_minus_q = np.where(small, series, direct) + 1j * sin2
+    q = 1.0 - one_minus_q
+    return one_minus_q - q * unit_circle_minus_one(-th * lag_samples)
 
 
 def _rigid_split(num: NDArray[np.float64], den: NDArray[np.float64]):
@@ -199,6 +237,43 @@ class ZohEquivalent:
             Eb, gb = integral((1.0 - phi) * T)
             _, ga = integral(phi * T)
             self._rest = (Phi, Eb @ ga, gb, C[0])
+
+    def state_space(self) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                   NDArray[np.float64], NDArray[np.float64]]:
+        """``(Phi, Gamma_a, Gamma_b, C)`` of the sampled plant.
+
+        ``x_{k+1} = Phi x_k + Gamma_a u_{k-D-1} + Gamma_b u_{k-D}``, ``y_k = C x_k``,
+        ``D`` = :attr:`whole` samples; the rigid-body states first.
+
+        Examples
+        --------
+        >>> import control
+        >>> from motionhyst.core.sampling import ZohEquivalent
+        >>> Phi, ga, gb, C = ZohEquivalent(control.tf([1.0], [1.0, 0.0]), 0.1, 0.25).state_space()
+        >>> Phi.tolist(), ga.tolist(), gb.tolist(), C.tolist()      # 1 / s
+        ([[1.0]], [0.025], [0.075], [1.0])
+        """
+        T, phi = self.period, self.phi
+        tb = (1.0 - phi) * T
+        blocks = []
+        if self.a2 or self.a1:
+            rigid = (np.array([[1.0, T], [0.0, 1.0]]),
+                     np.array([(phi * T) ** 2 / 2.0 + tb * phi * T, phi * T]),
+                     np.array([tb**2 / 2.0, tb]), np.array([self.a2, self.a1]))
+            if not self.a2:  # 1 / s alone: the velocity state
+                rigid = tuple(np.atleast_2d(x[1:, 1:]) if x.ndim == 2 else x[1:]
+                              for x in rigid)
+            blocks.append(rigid)
+        if self._rest is not None:
+            blocks.append(self._rest)
+        n = sum(b[0].shape[0] for b in blocks)
+        Phi, ga, gb, C = np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n)
+        i = 0
+        for P, a, b, c in blocks:
+            k = P.shape[0]
+            Phi[i:i + k, i:i + k], ga[i:i + k], gb[i:i + k], C[i:i + k] = P, a, b, c
+            i += k
+        return Phi, ga, gb, C
 
     def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
         """``G_d(e^{j w T})``, the delay included.
