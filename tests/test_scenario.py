@@ -320,7 +320,7 @@ ERROR_CASES = [
     # unknown models and types
     pytest.param(_set("hysteresis", "model", "preisach"), ("[hysteresis]", "model", "preisach"),
                  id="unknown-hysteresis-model"),
-    pytest.param(_set("controller", "type", "pid"), ("[controller]", "type", "pid"),
+    pytest.param(_set("controller", "type", "lqr"), ("[controller]", "type", "lqr"),
                  id="unknown-controller-type"),
     pytest.param(_set("feedforward", "type", "magic"), ("[feedforward]", "type", "magic"),
                  id="unknown-feedforward"),

@@ -33,6 +33,7 @@ from motionhyst.hysteresis.registry import Form
 if TYPE_CHECKING:  # imported where used: validating a file needs neither python-control nor scipy
     import control
 
+    from motionhyst.controllers.sampled import SampledController
     from motionhyst.frf_fit import FrfFit, ModalPlant
     from motionhyst.loop import Loop
     from motionhyst.openloop import MassSpringDamper, OpenLoop, TwoMass
@@ -251,17 +252,71 @@ HysteresisSection = Annotated[
 
 
 class FeedforwardSection(_Section):
-    """``[feedforward]``: rigid-body ``M r''`` or none, plus an optional hysteresis model.
+    """``[feedforward]``: rigid-body ``M r''`` or none, plus friction terms and a hysteresis model.
 
     ``hysteresis = { model = "maxwell-slip", k = [...], fc = [...] }`` adds
-    ``phi_hat(r)`` to the feedforward force (identified by ``motionhyst identify``).
+    ``phi_hat(r)`` to the feedforward force (identified by ``motionhyst identify``);
+    ``acceleration = m`` [kg] replaces the plant's mass in ``m r''``, ``viscous = c``
+    [N s/m] adds ``c r'``, ``coulomb = fc`` [N] adds ``fc sign(r')``
+    (:class:`~motionhyst.controllers.feedforward.Feedforward`); ``advance_samples = a``
+    reads the setpoint ``a`` samples ahead for a sampled controller.
     """
 
     type: Literal["rigid-body", "none"] = "rigid-body"
     hysteresis: HysteresisSection | None = None
+    acceleration: NonNegativeFloat | None = None
+    viscous: NonNegativeFloat | None = None   # None: 0, and not written back by to_dict
+    coulomb: NonNegativeFloat | None = None
+    advance_samples: NonNegativeFloat | None = None
+
+    @model_validator(mode="after")
+    def _terms_need_a_feedforward(self):
+        if self.type == "none":
+            given = [k for k in ("acceleration", "viscous", "coulomb", "advance_samples")
+                     if getattr(self, k)]
+            if given:
+                raise ValueError(f"{', '.join(given)} cannot go with type = \"none\" (no "
+                                 f"feedforward)")
+        return self
 
 
-class LeadLagSection(_Section):
+class _Sampling(_Section):
+    """Keys every ``[controller]`` has: the sampling of a real-time computer."""
+
+    sample_rate_hz: PositiveFloat | None = None
+    delay_samples: NonNegativeFloat | None = None   # None: 0
+    u_max: PositiveFloat | None = None
+
+    @model_validator(mode="after")
+    def _sampling_keys_need_a_rate(self):
+        if self.sample_rate_hz is None:
+            given = [k for k in ("delay_samples", "u_max", "discretization", "prewarp_hz")
+                     if getattr(self, k, None)]
+            if given:
+                raise ValueError(f"{', '.join(given)} needs sample_rate_hz (a sampled "
+                                 f"controller)")
+        return self
+
+
+class _Continuous(_Sampling):
+    """A continuous controller, sampled when ``sample_rate_hz`` is given."""
+
+    discretization: Literal["tustin", "tustin-prewarp", "zoh", "matched"] | None = None
+    prewarp_hz: PositiveFloat | None = None
+
+    @model_validator(mode="after")
+    def _prewarp(self):
+        if (self.prewarp_hz is not None) != (self.discretization == "tustin-prewarp"):
+            raise ValueError('prewarp_hz goes with discretization = "tustin-prewarp" (the '
+                             'frequency it maps exactly), and only with it')
+        if self.prewarp_hz is not None and self.sample_rate_hz is not None and \
+                self.prewarp_hz >= self.sample_rate_hz / 2:
+            raise ValueError(f"prewarp_hz = {self.prewarp_hz:g} Hz must lie below the Nyquist "
+                             f"frequency {self.sample_rate_hz / 2:g} Hz")
+        return self
+
+
+class LeadLagSection(_Continuous):
     """``[controller] type = "leadlag-lowpass"``: eq. (23)."""
 
     type: Literal["leadlag-lowpass"]
@@ -272,7 +327,7 @@ class LeadLagSection(_Section):
     beta: PositiveFloat
 
 
-class TransferFunctionSection(_Section):
+class TransferFunctionSection(_Continuous):
     """``[controller] type = "tf"``: any controller as polynomial coefficients in s."""
 
     type: Literal["tf"]
@@ -292,6 +347,82 @@ class TransferFunctionSection(_Section):
         return self
 
 
+class NotchSection(_Section):
+    """A notch of a PID: ``frequency_hz``, ``zeta_zero`` (0.01), ``zeta_pole`` (0.5)."""
+
+    frequency_hz: PositiveFloat
+    zeta_zero: NonNegativeFloat = 0.01
+    zeta_pole: PositiveFloat = 0.5
+
+
+class PidSection(_Continuous):
+    """``[controller] type = "pid"``: ``kp + ki / s + kd s / (1 + s / w_d)`` with notches
+    (:class:`~motionhyst.controllers.pid.Pid`); without ``derivative_filter_hz`` a pure
+    derivative, which needs ``sample_rate_hz`` (a backward difference)."""
+
+    type: Literal["pid"]
+    kp: NonNegativeFloat
+    ki: NonNegativeFloat = 0.0
+    kd: NonNegativeFloat = 0.0
+    derivative_filter_hz: PositiveFloat | None = None
+    notches: list[NotchSection] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _realisable(self):
+        if self.kp == self.ki == self.kd == 0:
+            raise ValueError("a PID needs a non-zero gain (kp, ki or kd)")
+        if self.kd and self.derivative_filter_hz is None and self.sample_rate_hz is None:
+            raise ValueError("a continuous PID with kd needs derivative_filter_hz (a pure "
+                             "derivative is improper); give it, or sample_rate_hz")
+        return self
+
+
+_ZCoef = Annotated[list[Annotated[float, Field(allow_inf_nan=False)]], Field(min_length=1)]
+
+
+def _check_z(name: str, num: list[float], den: list[float]) -> None:
+    if den[0] == 0:
+        raise ValueError(f"{name}den[0] (the coefficient of u_k) must not be 0: the controller "
+                         "would not be causal")
+    if not any(num):
+        raise ValueError(f"{name}num must have a non-zero coefficient")
+
+
+class DiscreteTfSection(_Sampling):
+    """``[controller] type = "tf-z"``: ``C(z)``, ``num`` and ``den`` in ascending powers of
+    ``z^-1``, run at ``sample_rate_hz`` on ``e_k = r_k - y_k``."""
+
+    type: Literal["tf-z"]
+    num: _ZCoef
+    den: _ZCoef
+
+    @model_validator(mode="after")
+    def _causal(self):
+        if self.sample_rate_hz is None:
+            raise ValueError('type = "tf-z" needs sample_rate_hz')
+        _check_z("", self.num, self.den)
+        return self
+
+
+class TwoDofSection(_Sampling):
+    """``[controller] type = "two-dof-z"``: ``u = R(z) r - Y(z) y``, polynomials in ascending
+    powers of ``z^-1`` (the EMPS cascade: ``R = g kv kp``, ``Y = g kv ((kp + F) - F z^-1)``)."""
+
+    type: Literal["two-dof-z"]
+    r_num: _ZCoef
+    r_den: _ZCoef
+    y_num: _ZCoef
+    y_den: _ZCoef
+
+    @model_validator(mode="after")
+    def _causal(self):
+        if self.sample_rate_hz is None:
+            raise ValueError('type = "two-dof-z" needs sample_rate_hz')
+        _check_z("r_", self.r_num, self.r_den)
+        _check_z("y_", self.y_num, self.y_den)
+        return self
+
+
 
 
 class ReferenceSection(_Section):
@@ -308,7 +439,8 @@ class ScenarioModel(_Section):
     stage: StageUnion | None = None
     plant: PlantSection | None = None
     hysteresis: HysteresisSection
-    controller: Annotated[LeadLagSection | TransferFunctionSection,
+    controller: Annotated[LeadLagSection | TransferFunctionSection | PidSection
+                          | DiscreteTfSection | TwoDofSection,
                           Field(discriminator="type")] | None = None
     feedforward: FeedforwardSection | None = None
     reference: ReferenceSection | None = None
@@ -335,6 +467,9 @@ class ScenarioModel(_Section):
                 raise ValueError(f"[{name}]: missing{hint}")
         if self.feedforward is None:
             self.feedforward = FeedforwardSection()
+        if self.feedforward.advance_samples and self.controller.sample_rate_hz is None:
+            raise ValueError("[feedforward] advance_samples needs a sampled controller "
+                             "([controller] sample_rate_hz)")
         return self
 
     @property
@@ -346,8 +481,8 @@ class ScenarioModel(_Section):
 
 
 # tags of the discriminated unions, left out of the key named in an error message
-_UNION_TAGS = {"leadlag-lowpass", "tf", "two-mass", "mass-spring-damper", *MODELS,
-               *FORM_SECTIONS}
+_UNION_TAGS = {"leadlag-lowpass", "tf", "pid", "tf-z", "two-dof-z", "two-mass",
+               "mass-spring-damper", *MODELS, *FORM_SECTIONS}
 
 
 def build_hysteresis(section) -> Hysteresis:
@@ -571,17 +706,37 @@ class Scenario:
         """The dynamic link's hysteresis model."""
         return build_hysteresis(self.model.hysteresis)
 
-    def controller(self) -> control.TransferFunction:
-        """The feedback controller."""
+    def controller(self) -> control.TransferFunction | SampledController:
+        """The feedback controller: continuous, or sampled with ``sample_rate_hz``."""
         self._closed("a controller")
         import control
 
+        from motionhyst.controllers.pid import Notch, Pid
+        from motionhyst.controllers.sampled import SampledController
         from motionhyst.systems import LeadLagLowpass
 
         c = self.model.controller
-        if c.type == "leadlag-lowpass":
-            return LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta)
-        return control.tf(c.num, c.den)
+        delay = c.delay_samples or 0.0
+        if c.type == "tf-z":
+            return SampledController(c.num, c.den, sample_rate_hz=c.sample_rate_hz,
+                                     delay_samples=delay, u_max=c.u_max)
+        if c.type == "two-dof-z":
+            return SampledController(c.r_num, c.r_den, c.y_num, c.y_den,
+                                     sample_rate_hz=c.sample_rate_hz,
+                                     delay_samples=delay, u_max=c.u_max)
+        method = c.discretization or "tustin"
+        if c.type == "pid":
+            pid = Pid(c.kp, c.ki, c.kd, c.derivative_filter_hz,
+                      tuple(Notch(n.frequency_hz, n.zeta_zero, n.zeta_pole) for n in c.notches))
+            if c.sample_rate_hz is None:
+                return pid.tf()
+            return pid.sampled(c.sample_rate_hz, method, c.prewarp_hz, delay, c.u_max)
+        cont = (LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta) if c.type == "leadlag-lowpass"
+                else control.tf(c.num, c.den))
+        if c.sample_rate_hz is None:
+            return cont
+        return SampledController.discretize(cont, c.sample_rate_hz, method, c.prewarp_hz,
+                                            delay, c.u_max)
 
     def loop(self) -> Loop:
         """The loop (built once, checked for stability)."""
@@ -589,10 +744,21 @@ class Scenario:
         if self._loop is None:
             from motionhyst.loop import Loop
 
-            ff = None if self.model.feedforward.type == "none" else "rigid-body"
-            hff = self.model.feedforward.hysteresis
-            loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff,
-                        hysteresis_feedforward=None if hff is None else build_hysteresis(hff))
+            sec = self.model.feedforward
+            ff = None if sec.type == "none" else "rigid-body"
+            if sec.type != "none" and (sec.acceleration is not None or sec.viscous
+                                       or sec.coulomb or sec.advance_samples):
+                from motionhyst.controllers.feedforward import Feedforward
+
+                ff = Feedforward(mass=sec.acceleration, viscous=sec.viscous or 0.0,
+                                 coulomb=sec.coulomb or 0.0,
+                                 advance_samples=sec.advance_samples or 0.0)
+            hff = sec.hysteresis
+            try:
+                loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff,
+                            hysteresis_feedforward=None if hff is None else build_hysteresis(hff))
+            except ValueError as exc:
+                raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
             try:
                 loop.check_stable()
             except ValueError as exc:
