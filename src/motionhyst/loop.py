@@ -318,6 +318,7 @@ class SampledParts:
         self.d = c.delay_samples
         self.zoh = ZohEquivalent(loop.P2, self.T, self.d)
         self.a = 0.0 if loop.ff is None else loop.ff.advance_samples
+        self._last = None
         n2, d2 = tf_poly(loop.P2)
         self.P2 = PolyTF(n2, d2)
         n1, d1 = tf_poly(loop.P1)
@@ -330,12 +331,17 @@ class SampledParts:
             self._y_minus_r = (num, np.convolve(c.y_den, c.r_den))
 
     def _parts(self, w):
+        w = np.asarray(w, dtype=float)
+        key = (w.shape, w.tobytes())
+        if self._last is not None and self._last[0] == key:  # the transfers of one analysis
+            return self._last[1]
         zinv = np.exp(-1j * w * self.T)
         R, Y = self.c.response(w)
         P2 = self.P2(w)
         H = hold_response(w, self.T, self.d)
         Gd = self.zoh(w)
-        return zinv, R, Y, P2, H, Gd
+        self._last = (key, (zinv, R, Y, P2, H, Gd))
+        return self._last[1]
 
     def open_loop(self, w: ArrayLike) -> NDArray[np.complex128]:
         """``L = Y G_d`` at `w` [rad/s].

@@ -161,7 +161,7 @@ def _grid_hz(controller, plant) -> NDArray[np.float64]:
     return np.geomspace(lo, hi, n)
 
 
-def loop_margins(controller, plant) -> LoopMargins:
+def loop_margins(controller, plant, zoh: ZohEquivalent | None = None) -> LoopMargins:
     """Gain, phase and modulus margins and the bandwidth of ``L = C P2``.
 
     Parameters
@@ -172,6 +172,8 @@ def loop_margins(controller, plant) -> LoopMargins:
     plant : python-control LTI system or FrequencyResponseData
         Non-collocated plant ``P2``; measured data are evaluated at the
         measured lines only (not with a sampled controller).
+    zoh : ZohEquivalent, optional
+        ``G_d`` of `plant` behind a sampled controller's hold, when already built.
 
     Returns
     -------
@@ -189,7 +191,7 @@ def loop_margins(controller, plant) -> LoopMargins:
     data = isinstance(plant, control.FrequencyResponseData)
     sampled = isinstance(controller, SampledController)
     if sampled:
-        G = ZohEquivalent(plant, controller.period, controller.delay_samples)
+        G = zoh or ZohEquivalent(plant, controller.period, controller.delay_samples)
         nyq = controller.nyquist_hz
         corners = [x for x in _grid_hz(None, plant)[[0, -1]]]
         lo = min(corners[0], nyq * 1e-6)

@@ -482,7 +482,8 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     q = _stiffness_over_masses(loop.plant)
     crossover = (float("nan") if q is None
                  else _crossover_estimate(q, hyst, amplitude, D_ref))
-    margins = loop_margins(loop.controller, loop.P2)
+    margins = loop_margins(loop.controller, loop.P2,
+                           None if loop.sampled is None else loop.sampled_parts.zoh)
     unresolved: list[str] = []
     if isinstance(loop.plant, MeasuredPlant):
         E, Et, amps = E.copy(), Et.copy(), amps.copy()

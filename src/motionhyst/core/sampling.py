@@ -43,7 +43,8 @@ import math
 import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import expm
+
+from motionhyst.lti import expm_small
 
 __all__ = ["ZohEquivalent", "hold_mismatch", "hold_response", "unit_circle_minus_one"]
 
@@ -230,13 +231,19 @@ class ZohEquivalent:
             def integral(tau):  # exp(A tau) and int_0^tau exp(A s) ds B
                 M = np.zeros((n + 1, n + 1))
                 M[:n, :n], M[:n, n:] = A * tau, B * tau
-                E = expm(M)
+                E = expm_small(M)
                 return E[:n, :n], E[:n, n]
 
             Phi, _ = integral(T)
             Eb, gb = integral((1.0 - phi) * T)
             _, ga = integral(phi * T)
             self._rest = (Phi, Eb @ ga, gb, C[0])
+            # partial fractions over Phi's eigenvalues: sum (ra z^-1 + rb) / (z - lambda)
+            lam, V = np.linalg.eig(Phi)
+            self._modal = None
+            if np.linalg.cond(V) < 1e8:
+                cv = C[0] @ V
+                self._modal = (lam, cv * np.linalg.solve(V, Eb @ ga), cv * np.linalg.solve(V, gb))
 
     def state_space(self) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                    NDArray[np.float64], NDArray[np.float64]]:
@@ -297,7 +304,10 @@ class ZohEquivalent:
             g2 = phi * T * zinv + tb                          # velocity
             with np.errstate(divide="ignore", invalid="ignore"):
                 out += self.a2 * (g1 * zm1 + T * g2) / zm1**2 + self.a1 * g2 / zm1
-        if self._rest is not None:
+        if self._rest is not None and self._modal is not None:
+            lam, ra, rb = self._modal
+            out += np.sum((ra * zinv[:, None] + rb) / (z[:, None] - lam), axis=1)
+        elif self._rest is not None:
             Phi, ga, gb, C = self._rest
             n = Phi.shape[0]
             M = z[:, None, None] * np.eye(n) - Phi
