@@ -162,3 +162,22 @@ def test_two_dof_cascade_loop():
     G = pc_loop(z)
     R, Y = c.response(np.array([2 * np.pi]))
     assert e1 == pytest.approx(0.1 * abs(1 - G * R[0] / (1 + Y[0] * G)), rel=1e-6)
+
+
+def test_digital_comparison_of_table_i():
+    from motionhyst.analysis.digital import compare_digital
+
+    cmp = compare_digital(Loop(STAGE, C, LINK), 0.01, [10.0, 15.0])
+    cont, late, advanced = cmp.variants
+    # issue 22: the feedforward sampled and delayed with the feedback leaves about 1e-6 m RMS
+    # at 10 Hz, over 100 times the error the link causes; advanced by the delay it does not
+    assert 1e-6 < late.points[0].error_linear_rms < 2e-6
+    assert late.points[0].error_linear_rms > 100 * late.points[0].error_link_rms
+    assert advanced.points[0].error_linear_rms == pytest.approx(
+        cont.points[0].error_linear_rms, rel=0.05)
+    assert advanced.points[0].error_link_rms == pytest.approx(
+        cont.points[0].error_link_rms, rel=0.01)
+    assert late.margins.phase_margin_deg < cont.margins.phase_margin_deg - 8
+    # 15 Hz is not a whole number of samples at 10 kHz: no exact steady state, eq. (18) only
+    assert np.isnan(late.points[1].error_linear_rms) and np.isfinite(late.points[1].mismatch_df)
+    assert "n/a" in str(cmp) and cmp.to_dict()["variants"][2]["name"].endswith("advanced")

@@ -27,6 +27,7 @@ from motionhyst.outputs import OutputFolder
 from motionhyst.scenario import Scenario
 
 if TYPE_CHECKING:
+    from motionhyst.analysis.digital import DigitalComparison
     from motionhyst.frf_fit import FrfFit
     from motionhyst.hysteresis import Hysteresis
     from motionhyst.quasilinear import QuasiLinearAnalysis
@@ -119,9 +120,11 @@ def _computed(analysis: QuasiLinearAnalysis, key: str) -> float | None:
 
 def _report_text(sc: Scenario, link: Hysteresis, analysis: QuasiLinearAnalysis,
                  states: list[SteadyState], E_df: Iterable[complex], fit: FrfFit | None,
-                 figures: list[str], is_paper: bool, notes: list[str]) -> str:
+                 figures: list[str], is_paper: bool, notes: list[str],
+                 digital: DigitalComparison | None = None) -> str:
     """``report.md`` from the results: the analysis, the steady states with the describing
-    function's mismatch at their frequencies, the plant's fit, the figures drawn."""
+    function's mismatch at their frequencies, the digital loop beside the continuous one,
+    the plant's fit, the figures drawn."""
     jenkins = link.name == "jenkins"
     lines = [f"# motionhyst report: {sc.source}", ""]
     lines += ["## Paper vs computed" if is_paper else "## Key numbers", ""]
@@ -163,6 +166,19 @@ def _report_text(sc: Scenario, link: Hysteresis, analysis: QuasiLinearAnalysis,
                      f"{np.degrees(np.angle(E)):.2f} | {_fmt(abs(st.mismatch))} | "
                      f"{np.degrees(np.angle(st.mismatch)):.2f} | {_fmt(float(abs(st.e[1])))} | "
                      f"{_fmt(e3)} | {_fmt(st.error_peak)} |")
+    if digital is not None:
+        lines += ["", "## The loop as a real-time computer runs it", "",
+                  f"The {'paper' if is_paper else 'scenario'}'s loop with its controller "
+                  f"discretised (Tustin) at {digital.sample_rate_hz:g} Hz, the force applied "
+                  f"{digital.delay_samples:g} samples after the position is sampled and held "
+                  "(zero-order hold), against the continuous loop the analysis above is of; in "
+                  "the last column the rigid-body feedforward reads the reference "
+                  f"{digital.advance_samples:g} samples ahead (the delay and the hold's half "
+                  "sample), as machines do. Exact: the periodic steady state of the hybrid "
+                  "loop (n/a where the period is not a whole number of samples).", ""]
+        head, rows = digital.rows()
+        lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in rows]
     lines += ["", "## Figures", ""]
     for name in figures:
         note = FIGURE_NOTES.get(name if jenkins else f"{name}-other", FIGURE_NOTES[name])
@@ -297,6 +313,11 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
                 f_exact = np.unique(np.concatenate([f_exact, freqs]))
                 exact = [periodic_steady_state(loop, A, f) for f in f_exact]
+            digital = None
+            if not raw_data and loop.sampled is None and loop.hysteresis is not None:
+                from motionhyst.analysis.digital import compare_digital
+
+                digital = compare_digital(loop, A, freqs)
             figures.submit({"fig10": lambda: _plots().fig10_mismatch(loop, analysis, exact)})
             steps.update()
             summary = {
@@ -307,6 +328,8 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             }
             if fit is not None:
                 summary["plant_fit"] = fit.to_dict()
+            if digital is not None:
+                summary["digital"] = digital.to_dict()
             if not el.defines_zeta:
                 at = "" if el.rate_independent else f" at {freqs[0]:g} Hz"
                 notes.append(f"Figs. 6-7 show the slip modes of the paper's single Jenkins "
@@ -325,7 +348,8 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             written = [name for name in FIGURES if name in drawn]
             folder.write_bytes("summary.json", dumps(summary).encode())
             folder.write_bytes("report.md", _report_text(sc, el, analysis, states, E_df, fit,
-                                                         written, is_paper, notes).encode())
+                                                         written, is_paper, notes,
+                                                         digital).encode())
             steps.close()
     except BaseException:
         folder.abandon()
