@@ -30,6 +30,7 @@ import numpy as np
 
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.sampled import SampledController
+from motionhyst.jsonio import jsonable
 from motionhyst.loop import Loop
 from motionhyst.margins import LoopMargins, loop_margins
 from motionhyst.quasilinear import loop_mismatch
@@ -65,11 +66,12 @@ class DigitalPoint:
     error_link_rms: float
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary."""
-        return {"frequency_hz": self.frequency_hz, "mismatch_df_abs": abs(self.mismatch_df),
-                "mismatch_exact_abs": abs(self.mismatch_exact),
-                "error_linear_rms": self.error_linear_rms,
-                "error_link_rms": self.error_link_rms}
+        """JSON-ready dictionary (None where there is no exact steady state)."""
+        return jsonable({"frequency_hz": self.frequency_hz,
+                         "mismatch_df_abs": abs(self.mismatch_df),
+                         "mismatch_exact_abs": abs(self.mismatch_exact),
+                         "error_linear_rms": self.error_linear_rms,
+                         "error_link_rms": self.error_link_rms})
 
 
 @dataclass(frozen=True)
@@ -92,7 +94,7 @@ class DigitalVariant:
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
-        return {"name": self.name, "margins": self.margins.to_dict(),
+        return {"name": self.name, "margins": jsonable(self.margins.to_dict()),
                 "points": [p.to_dict() for p in self.points]}
 
 

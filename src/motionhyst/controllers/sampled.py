@@ -44,10 +44,12 @@ array([1.     , 1.00029])
 from __future__ import annotations
 
 import math
+import warnings
 
 import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.signal import BadCoefficients
 
 __all__ = ["DISCRETIZATIONS", "SampledController", "ascending", "discretize", "polyval_zinv"]
 
@@ -169,7 +171,9 @@ def discretize(controller, sample_rate_hz: float, method: str = "tustin",
         kwargs["prewarp_frequency"] = 2.0 * math.pi * f
     pc_method = {"tustin": "tustin", "tustin-prewarp": "tustin", "zoh": "zoh",
                  "matched": "matched"}[method]
-    sysd = control.c2d(control.tf(num, den), T, pc_method, **kwargs)
+    with warnings.catch_warnings():  # scipy's note on wide-ranging coefficients
+        warnings.simplefilter("ignore", BadCoefficients)
+        sysd = control.c2d(control.tf(num, den), T, pc_method, **kwargs)
     return ascending(sysd)
 
 

@@ -39,10 +39,12 @@ True
 from __future__ import annotations
 
 import math
+import warnings
 
 import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.signal import BadCoefficients
 
 from motionhyst.lti import expm_small
 
@@ -223,7 +225,9 @@ class ZohEquivalent:
         self.a2, self.a1, rest_num, rest_den = _rigid_split(num, den)
         self._rest = None
         if np.any(rest_num != 0.0):
-            sys = control.tf2ss(control.tf(rest_num, rest_den))
+            with warnings.catch_warnings():  # scipy's note on wide-ranging coefficients
+                warnings.simplefilter("ignore", BadCoefficients)
+                sys = control.tf2ss(control.tf(rest_num, rest_den))
             A, B, C = np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C)
             n = A.shape[0]
             T, phi = self.period, self.phi
