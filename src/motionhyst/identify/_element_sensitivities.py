@@ -3,7 +3,7 @@
 :func:`motionhyst.openloop.simulate_elements` runs the open loop with a link
 of exact-update elements and, when asked, the forward sensitivities of its
 output: the derivatives of the stage's discrete matrices in its parameters
-(:meth:`~motionhyst.openloop.Mechanics.foh`, Frechet derivatives of the matrix
+(:meth:`~motionhyst.plants.mechanics.Mechanics.foh`, Frechet derivatives of the matrix
 exponential), the partial derivatives of each element's update in its state,
 its displacement and its parameters
 (:func:`~motionhyst.hysteresis.stepping.advance_partials`), and the implicit

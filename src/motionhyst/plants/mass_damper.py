@@ -1,0 +1,168 @@
+"""A positioning axis: one mass with viscous friction to the ground and no spring.
+
+``m y'' + c y' = u + f0 - w``: the carriage of a ball-screw or linear-motor
+axis, the force ``u`` of the drive (with a constant offset ``f0``), the link
+force ``w`` (friction) on the carriage's position ``y``, which is measured.
+The rigid-body mass ``M = m`` is that of the feedforward ``M s^2``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.plants.mechanics import Mechanics
+from motionhyst.plants.registry import FORCE_OFFSET, PlantParameter, register
+
+__all__ = ["MassDamper"]
+
+
+@register
+class MassDamper:
+    """One mass with viscous friction to the ground, no spring: ``m y'' + c y' = u + f0 - w``.
+
+    ``P1 = P2 = 1 / (m s^2 + c s)``: the axis floats (only the link holds it).
+
+    Parameters
+    ----------
+    m : float
+        Mass [kg], > 0.
+    c : float
+        Viscous damping to the ground [N s/m], >= 0.
+    force_offset : float
+        Constant force ``f0`` added to the force on the mass [N].
+
+    Examples
+    --------
+    The EMPS axis's published values:
+
+    >>> import numpy as np
+    >>> from motionhyst.plants import MassDamper
+    >>> axis = MassDamper(m=95.1, c=203.5, force_offset=3.16)
+    >>> axis
+    MassDamper(m=95.1, c=203.5, force_offset=3.16)
+    >>> round(axis.corner_hz, 4)                           # c / (2 pi m): friction vs inertia
+    0.3406
+    >>> G = axis.frequency_response([10.0])[0]             # at 10 Hz nearly 1 / (m s^2)
+    >>> print(f"{abs(G) * axis.M * (2 * np.pi * 10.0) ** 2:.4f}")
+    0.9994
+    """
+
+    name: ClassVar[str] = "mass-damper"
+    parameters: ClassVar[tuple[PlantParameter, ...]] = (
+        PlantParameter("m", "kg", "moving mass"),
+        PlantParameter("c", "N s/m", "viscous damping to the ground", "nonnegative"),
+        FORCE_OFFSET,
+    )
+    PARAMETERS: ClassVar[tuple[str, ...]] = ("m", "c")
+    outputs: ClassVar[tuple[str, ...]] = ("y",)
+    is_lti: ClassVar[bool] = True
+    has_inertia: ClassVar[bool] = True
+    output: str = "y"
+    frequency_range_hz: ClassVar[None] = None
+    pf2_static: ClassVar[None] = None  # no flexible compliance: eq. (21) does not apply
+
+    def __init__(self, m: float, c: float, force_offset: float = 0.0) -> None:
+        spec = dict((p.name, p) for p in self.parameters)
+        self.m = spec["m"].check(m)
+        self.c = spec["c"].check(c)
+        self.force_offset = spec["force_offset"].check(force_offset)
+
+    def __repr__(self) -> str:
+        extra = f", force_offset={self.force_offset!r}" if self.force_offset else ""
+        return f"MassDamper(m={self.m!r}, c={self.c!r}{extra})"
+
+    @property
+    def M(self) -> float:
+        """Rigid-body mass ``m`` [kg]."""
+        return self.m
+
+    @property
+    def corner_hz(self) -> float:
+        """``c / (2 pi m)`` [Hz]: below it friction dominates the response, above it inertia."""
+        return self.c / (2 * np.pi * self.m)
+
+    @property
+    def P1(self) -> Any:
+        """``y / (u - w) = 1 / (m s^2 + c s)`` (the link acts on the measured mass)."""
+        import control
+
+        return control.tf([1.0], [self.m, self.c, 0.0])
+
+    @property
+    def P2(self) -> Any:
+        """The same as :attr:`P1`: one mass."""
+        return self.P1
+
+    @property
+    def Pf2(self) -> Any:
+        """``Pr - P2 = c / (m s^2 (m s + c))``: the viscous part, not a flexible mode."""
+        import control
+
+        return control.tf([self.c], [self.m * self.m, self.m * self.c, 0.0, 0.0])
+
+    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
+                           ) -> NDArray[np.complex128] | complex:
+        """``y / u = 1 / (m s^2 + (c + c_link) s + k_link)`` at ``s = 2 pi j f`` [m/N].
+
+        Parameters
+        ----------
+        f_hz : array_like
+            Frequencies [Hz].
+        k_link, c_link : float
+            The link taken as a spring [N/m] and damper [N s/m] to the ground.
+
+        Returns
+        -------
+        complex or ndarray of complex
+            Same shape as `f_hz`.
+        """
+        s = 2j * np.pi * np.asarray(f_hz, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = 1.0 / (self.m * s * s + (self.c + c_link) * s + k_link)
+        return complex(out) if np.ndim(out) == 0 else out
+
+    def values(self) -> NDArray[np.float64]:
+        """``(m, c)`` (:attr:`PARAMETERS`)."""
+        return np.array([self.m, self.c])
+
+    def with_parameters(self, values: ArrayLike) -> MassDamper:
+        """The same axis (same force offset) with ``(m, c) = values`` (checked).
+
+        Parameters
+        ----------
+        values : array_like
+            ``m, c``.
+
+        Returns
+        -------
+        MassDamper
+        """
+        m, c = (float(v) for v in values)
+        return MassDamper(m, c, self.force_offset)
+
+    def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
+        """The axis (or the unchecked ``(m, c) = values``) as :class:`Mechanics`.
+
+        Parameters
+        ----------
+        values : array_like, optional
+            ``m, c`` instead of the axis's own.
+
+        Returns
+        -------
+        Mechanics
+            One coordinate, no stiffness (floating), derivatives in ``m, c``.
+        """
+        m, c = self.values() if values is None else np.asarray(values, dtype=float)
+        return Mechanics([m], [[c]], [[0.0]], [[1.0], [0.0]], [[[0.0]], [[1.0]]],
+                         [[[0.0]], [[0.0]]], 0, 0, force_offset=self.force_offset)
+
+    def to_dict(self) -> dict:
+        """The scenario's ``[stage]`` table (``force_offset`` only when not 0)."""
+        out = {"type": self.name, "m": self.m, "c": self.c}
+        if self.force_offset:
+            out["force_offset"] = self.force_offset
+        return out
