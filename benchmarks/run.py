@@ -48,9 +48,9 @@ from motionhyst import (
     periodic_steady_state,
     steady_state_sweep,
 )
-from motionhyst.references import SineReference
-from motionhyst.simulate import default_step, simulate
-from motionhyst.steady import default_harmonics
+from motionhyst.analysis.steady import default_harmonics
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import default_step, simulate
 
 # Table I
 M1, M2, B, K = 5.0, 17.5, 90.0, 7.4e7

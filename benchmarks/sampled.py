@@ -25,9 +25,9 @@ import time
 import numpy as np
 
 from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage, analyze
+from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.sampled import SampledController
-from motionhyst.steady import periodic_steady_state
 
 REPEATS = 21
 TARGETS = {"analysis": 2.0}

@@ -3,7 +3,7 @@
 One run measures, on the Table I loop with a link model 4 % off (``examples/scan.toml``)
 and the scan of ``examples/scan_compensation.py`` (15 mm at 50 mm/s and back, 1.07 s):
 
-1. motionhyst: :func:`motionhyst.scan.run_scan` with ``none``, ``model`` and ``ilc``
+1. motionhyst: :func:`motionhyst.scan.scanning.run_scan` with ``none``, ``model`` and ``ilc``
    (10 trials) and the carry-over at half the speed, 14 simulations in all (median of
    3 after a warm-up), and the whole command ``motionhyst scan ...`` as a new process
    (imports included);
@@ -31,10 +31,10 @@ from pathlib import Path
 import control as ct
 import numpy as np
 
-from motionhyst.profiles import scan
-from motionhyst.scan import run_scan
+from motionhyst.scan.profiles import scan
+from motionhyst.scan.scanning import run_scan
 from motionhyst.scenario import Scenario
-from motionhyst.simulate import default_step
+from motionhyst.time.simulation import default_step
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO = ROOT / "examples" / "scan.toml"

@@ -84,8 +84,8 @@ def public_api() -> dict[str, list[str]]:
 def _shadowed(mod_name: str) -> bool:
     """Whether the package attribute of a module's name is another object.
 
-    ``motionhyst.simulate`` is the function ``simulate``, defined in the module of the
-    same name; the function's page owns the name.
+    An old module path that moved (``motionhyst.simulate``, see ``motionhyst._MOVED``) may be
+    shadowed by an exported function of the same name; the function's page owns the name.
     """
     parent, _, last = mod_name.rpartition(".")
     return getattr(importlib.import_module(parent), last) is not importlib.import_module(mod_name)

@@ -20,7 +20,7 @@ End-to-end example of issue 6, in four steps:
    three-element link, without and with the identified model as hysteresis
    feedforward ``u_ff = M r'' + phi_hat(r)``; the hysteresis-induced error
    ``e - e_linear`` of the exact periodic steady state at 5 Hz, 10 mm
-   (:func:`motionhyst.steady.periodic_steady_state`), its RMS before and after,
+   (:func:`motionhyst.analysis.steady.periodic_steady_state`), its RMS before and after,
    and a figure of it over one period.
 
 Run ``python examples/identify_and_compensate.py [OUT_DIR]`` (default
@@ -42,11 +42,11 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from motionhyst.analysis.steady import SteadyState, periodic_steady_state
+from motionhyst.core.jsonio import dumps
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.identify import Identification, identify_maxwell_slip
-from motionhyst.jsonio import dumps
 from motionhyst.scenario import Scenario, default_scenario
-from motionhyst.steady import SteadyState, periodic_steady_state
 
 K_TRUE = (10.0, 6.0, 4.0)
 """Stiffnesses of the simulated cable slab's elements [N/m] (sum: Table I's k_J = 20 N/m)."""

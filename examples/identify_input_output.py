@@ -4,7 +4,7 @@ The system is the Bouc-Wen benchmark's (Noel and Schoukens 2016): a mass
 ``m = 2 kg`` on a spring ``k = 5e4 N/m`` and damper ``c = 10 N s/m`` with a
 Bouc-Wen link (``alpha = 5e4 N/m``, ``beta = 1e3``, ``gamma = 0.8``,
 ``delta = -1.1``, ``nu = 1``), force in, position out, sampled at 750 Hz.  The
-records are made by the benchmark's own procedure (:mod:`motionhyst.benchmark`:
+records are made by the benchmark's own procedure (:mod:`motionhyst.identify.benchmark`:
 random-phase multisines of 50 N RMS from 5 to 150 Hz, its Newmark integration and
 decimation), shorter than the benchmark's so that the example runs in seconds.
 The example
@@ -36,9 +36,9 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
-from motionhyst.benchmark import NOISE_RMS, TRUE_PARAMETERS, Record, training_record
+from motionhyst.identify.benchmark import NOISE_RMS, TRUE_PARAMETERS, Record, training_record
 from motionhyst.identify.input_output import identify_io, load_io_csv
-from motionhyst.outputs import OutputFile
+from motionhyst.io.outputs import OutputFile
 from motionhyst.scenario import Scenario
 
 PERIOD = 2048

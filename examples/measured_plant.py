@@ -38,7 +38,7 @@ import matplotlib
 import numpy as np
 
 from motionhyst import ModalPlant, TwoMassStage, analyze, load_scenario
-from motionhyst.outputs import OutputFile
+from motionhyst.io.outputs import OutputFile
 from motionhyst.scenario import default_scenario_path
 
 LINES_HZ = np.geomspace(1.0, 3000.0, 60)

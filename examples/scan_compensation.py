@@ -5,12 +5,12 @@ End-to-end example of issue 14, on the paper's Table I loop with its Jenkins lin
 whose model is 4 % off):
 
 1. Setpoint: a fourth-order scan of 15 mm at 50 mm/s and back
-   (:func:`motionhyst.profiles.scan`); its acceleration covers 2.9 mm, more than
+   (:func:`motionhyst.scan.profiles.scan`); its acceleration covers 2.9 mm, more than
    the link's slip displacement f_c / k_J = 2.5 mm and less than the 5 mm the link
    takes to reverse, so the return scan starts with the link stuck.
 2. Metrics: the error's moving average (MA) and moving standard deviation (MSD)
    over a 50 ms exposure window, maximal over the constant-velocity phases
-   (:func:`motionhyst.scan.run_scan`), for three compensations: ``none``
+   (:func:`motionhyst.scan.scanning.run_scan`), for three compensations: ``none``
    (rigid-body feedforward only), ``model`` (the 4 %-off link model driven by the
    setpoint) and ``ilc`` (10 trials of frequency-domain learning control).
 3. Carry-over: the model and the learned force, unchanged, on the same scan at
@@ -33,10 +33,10 @@ from typing import IO
 
 import matplotlib
 
-from motionhyst.ilc import ILCFilters
-from motionhyst.jsonio import dumps
-from motionhyst.profiles import scan
-from motionhyst.scan import ScanResult, run_scan
+from motionhyst.core.jsonio import dumps
+from motionhyst.scan.ilc import ILCFilters
+from motionhyst.scan.profiles import scan
+from motionhyst.scan.scanning import ScanResult, run_scan
 from motionhyst.scenario import Scenario
 
 SCENARIO = Path(__file__).resolve().parent / "scan.toml"

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from motionhyst._jit import quiet_compilation
+from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.core.compiled import quiet_compilation
 from motionhyst.hysteresis.jenkins import Jenkins
 from motionhyst.loop import Loop
-from motionhyst.systems import LeadLagLowpass, TwoMassStage
+from motionhyst.plants.two_mass import TwoMassStage
 
 # the tests check the commands' stderr: no notice of the first compilation in this session
 # (tests/test_startup.py checks the notice in fresh processes)

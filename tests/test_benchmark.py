@@ -1,4 +1,4 @@
-"""The Bouc-Wen benchmark's data generator (motionhyst.benchmark) and its test sets."""
+"""The Bouc-Wen benchmark's data generator (motionhyst.identify.benchmark) and its test sets."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from motionhyst.benchmark import (
+from motionhyst.identify.benchmark import (
     FS,
     TRUE_PARAMETERS,
     UPSAMPLE,
@@ -145,7 +145,7 @@ def test_training_record_is_periodic_after_the_transient():
 
 @needs_shared
 def test_benchmark_on_one_training_period_meets_the_multisine_target():
-    from motionhyst.benchmark import run_benchmark
+    from motionhyst.identify.benchmark import run_benchmark
 
     res = run_benchmark(SHARED, n_experiments=1, n_periods=1, models=("bouc-wen",))
     row = res["models"][0]

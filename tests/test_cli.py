@@ -225,7 +225,8 @@ def test_analyze_measured_plant_gives_null_crossover(capsys, tmp_path):
     """eq. (21) is nan for a measured plant: it is printed as JSON null, never NaN."""
     import numpy as np
 
-    from motionhyst.systems import TwoMassStage, freqresp
+    from motionhyst.core.lti import freqresp
+    from motionhyst.plants.two_mass import TwoMassStage
 
     stage = TwoMassStage(5.0, 17.5, 90.0, 7.4e7)
     f = np.geomspace(0.05, 5000.0, 200)

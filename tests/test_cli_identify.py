@@ -236,7 +236,8 @@ def test_closed_loop_prefilter_cutoff(capsys, closed_loop_case):
 
 
 def test_closed_loop_needs_a_stage_model(capsys, tmp_path, closed_loop_case):
-    from motionhyst.systems import TwoMassStage, freqresp
+    from motionhyst.core.lti import freqresp
+    from motionhyst.plants.two_mass import TwoMassStage
 
     _, csv = closed_loop_case
     stage = TwoMassStage(5.0, 17.5, 90.0, 7.4e7)

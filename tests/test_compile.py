@@ -22,13 +22,13 @@ import gc
 import numpy as np
 import pytest
 
-from motionhyst._jit import Kernel, compiled_in_memory
+from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.core.compiled import Kernel, compiled_in_memory
 from motionhyst.hysteresis import BoucWen, Dahl, Jenkins, LuGre, MaxwellIwan, MaxwellSlip
 from motionhyst.loop import Loop
-from motionhyst.references import SineReference
 from motionhyst.scenario import default_scenario
-from motionhyst.simulate import simulate
-from motionhyst.steady import periodic_steady_state
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 LINKS = [Jenkins(20.0, 0.05), MaxwellSlip([12.0, 5.0, 3.0], [0.02, 0.02, 0.01]),
          BoucWen(k=20.0, fc=0.05, n=2.0, beta=0.7, gamma=0.3),
@@ -41,7 +41,7 @@ LINKS = [Jenkins(20.0, 0.05), MaxwellSlip([12.0, 5.0, 3.0], [0.02, 0.02, 0.01]),
 # kernels specialised on purpose, one version per kind of call
 SPECIALISED = {
     # per plant size (the masses as a tuple) and with or without the sensitivities (None)
-    "motionhyst.openloop._rk4_run",
+    "motionhyst.time.openloop._rk4_run",
 }
 
 

@@ -7,8 +7,8 @@ import pytest
 
 from motionhyst.hysteresis import Coulomb, Jenkins
 from motionhyst.hysteresis.stepping import N_PARAMS
-from motionhyst.openloop import MassSpringDamper, OpenLoop, simulate_elements
 from motionhyst.scenario import ScenarioError, hysteresis_from_dict
+from motionhyst.time.openloop import MassSpringDamper, OpenLoop, simulate_elements
 
 FS = 1000.0
 AXIS = MassSpringDamper(95.0, 200.0, 0.0)  # a positioning axis: a mass and a damper

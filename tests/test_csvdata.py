@@ -8,10 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from motionhyst.csvdata import CSVError, read_columns, read_header
 from motionhyst.identify import load_force_displacement_csv
-from motionhyst.references import load_reference_csv
-from motionhyst.systems import load_frd_plant
+from motionhyst.io.csvdata import CSVError, read_columns, read_header
+from motionhyst.plants.measured import load_frd_plant
+from motionhyst.time.references import load_reference_csv
 
 T = np.linspace(0.0, 0.5, 6)
 R = np.array([0.0, 1.5e-3, 2.25e-3, -3.125e-4, 4e-3, 5.5e-3])

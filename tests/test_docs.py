@@ -107,8 +107,8 @@ def _resolve(dotted: str) -> object:
     """The object a dotted name stands for, found as autosummary finds it.
 
     The longest importable module prefix first, then attributes: so
-    ``motionhyst.simulate`` is the function and ``motionhyst.simulate.Simulation`` the
-    class in the module of the same name.  A dataclass field, which is no class
+    ``motionhyst.simulate`` is the function and ``motionhyst.time.simulation.Simulation`` the
+    class in its module.  A dataclass field, which is no class
     attribute, resolves to its class.
     """
     parts = dotted.split(".")
@@ -163,8 +163,8 @@ def test_readme_python_runs_as_written(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("first", [
     "pass",
-    "import motionhyst.simulate",
-    "from motionhyst.simulate import Simulation",
+    "import motionhyst.time.simulation",
+    "from motionhyst.time.simulation import Simulation",
     "import motionhyst.cli",
 ])
 def test_top_level_simulate_is_the_function_in_any_import_order(first):

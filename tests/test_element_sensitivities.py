@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
+from motionhyst.core.lti import expm_small
 from motionhyst.hysteresis import Dahl, Jenkins, LuGre, MaxwellSlip
 from motionhyst.identify._element_sensitivities import row_derivatives
 from motionhyst.identify.io_elements import _LinkLayout
-from motionhyst.lti import expm_small
-from motionhyst.openloop import (
+from motionhyst.time.openloop import (
     MassSpringDamper,
     OpenLoop,
     TwoMass,

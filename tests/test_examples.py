@@ -165,7 +165,7 @@ def test_identify_input_output_recovers_the_benchmark_system(io_result):
     """Two short benchmark experiments with 8e-6 m noise: the fit leaves the noise, every
     identifiable parameter lies within 4 standard errors of the truth (measured: within
     2.6), and the held-out prediction is far below the noise (measured 1.45e-7 m)."""
-    from motionhyst.benchmark import NOISE_RMS, TRUE_PARAMETERS
+    from motionhyst.identify.benchmark import NOISE_RMS, TRUE_PARAMETERS
 
     p = TRUE_PARAMETERS
     ident = io_result["identified"]

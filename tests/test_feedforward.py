@@ -10,20 +10,20 @@ import control
 import numpy as np
 import pytest
 
-from motionhyst.hysteresis import Jenkins, MaxwellSlip
-from motionhyst.loop import Loop
-from motionhyst.quasilinear import (
+from motionhyst.analysis.quasilinear import (
     analyze,
     error_harmonics_df,
     loop_mismatch,
     mismatch,
     residual_mismatch,
 )
-from motionhyst.references import SineReference
+from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.core.lti import TWO_PI, freqresp
+from motionhyst.hysteresis import Jenkins, MaxwellSlip
+from motionhyst.loop import Loop
 from motionhyst.scenario import Scenario, ScenarioError, default_scenario_path
-from motionhyst.simulate import simulate
-from motionhyst.steady import periodic_steady_state
-from motionhyst.systems import TWO_PI, freqresp
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 K3, FC3 = [8.0, 6.0, 4.0], [0.01, 0.03, 0.06]
 # the same link with every parameter off by 2 %, alternately up and down

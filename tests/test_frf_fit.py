@@ -1,4 +1,4 @@
-"""Tests of motionhyst.frf_fit: a measured FRF fitted to a rigid body plus modes (eqs. 1-2)."""
+"""Tests of motionhyst.plants.frf_fit: an FRF fitted to a rigid body plus modes (eqs. 1-2)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from motionhyst.frf_fit import FrfFit, ModalPlant, Mode, fit_frf
+from motionhyst.analysis.quasilinear import analyze
+from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.core.lti import freqresp
 from motionhyst.loop import Loop
-from motionhyst.quasilinear import analyze
-from motionhyst.references import SineReference
-from motionhyst.simulate import simulate
-from motionhyst.steady import periodic_steady_state
-from motionhyst.systems import TwoMassStage, freqresp
+from motionhyst.plants.frf_fit import FrfFit, ModalPlant, Mode, fit_frf
+from motionhyst.plants.two_mass import TwoMassStage
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 TABLE_I = TwoMassStage(5.0, 17.5, 90.0, 7.4e7)
 LINES = np.geomspace(1.0, 3000.0, 60)  # the issue's measurement: 60 log-spaced lines
@@ -273,7 +274,7 @@ def test_noise_free_delayed_data_are_recovered_exactly(exact):
 
 
 def test_the_fit_figure_says_the_delay_was_divided_out(exact):
-    from motionhyst.figures import plot_frf_fit
+    from motionhyst.present.figures import plot_frf_fit
 
     delayed = plot_frf_fit(fit_frf(LINES, *measure(exact, noise=0.0, delay=50e-6)))
     assert "delay 50 us" in delayed.axes[0].get_title()
@@ -459,8 +460,8 @@ def test_cli_analyze_fits_a_measured_plant(capsys, tmp_path, exact):
 def test_cli_identify_closed_loop_runs_on_the_fitted_plant(capsys, tmp_path, exact):
     """The closed-loop identification needs P1 as a model: the fitted one serves."""
     from motionhyst.cli import main
+    from motionhyst.controllers.leadlag import LeadLagLowpass
     from motionhyst.hysteresis import Jenkins
-    from motionhyst.systems import LeadLagLowpass
 
     write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
     toml = frd_toml(tmp_path, "")
@@ -533,8 +534,8 @@ def test_raw_data_say_what_they_cannot_resolve(capsys, tmp_path, exact):
     import json
 
     from motionhyst.cli import main
+    from motionhyst.plants.measured import MeasuredPlant
     from motionhyst.scenario import Scenario
-    from motionhyst.systems import MeasuredPlant
 
     write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
     toml = frd_toml(tmp_path, 'use = "data"')
@@ -586,7 +587,7 @@ def test_noise_free_raw_data_resolve_everything_on_the_lines(tmp_path, exact):
 
 
 def test_report_of_raw_data_lists_what_it_cannot_resolve(tmp_path, exact):
-    from motionhyst.report import reproduce
+    from motionhyst.present.report import reproduce
     from motionhyst.scenario import Scenario
 
     write_frd(tmp_path / "p.csv", LINES, *measure(exact, seed=0))
@@ -602,8 +603,8 @@ def test_report_of_raw_data_lists_what_it_cannot_resolve(tmp_path, exact):
 
 def test_scan_runs_on_the_fitted_plant(noisy_fit, controller, link):
     """The scan metrics (MA of a slipping link) on the fitted stage equal the exact stage's."""
-    from motionhyst.profiles import scan
-    from motionhyst.scan import run_scan
+    from motionhyst.scan.profiles import scan
+    from motionhyst.scan.scanning import run_scan
 
     p = scan(0.01, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)
     fitted = run_scan(Loop(noisy_fit.plant, controller, link), p, window=0.02, tail=0.0)

@@ -11,12 +11,12 @@ import warnings
 import numpy as np
 import pytest
 
-from motionhyst.comparison import compare_with_describing_function
+from motionhyst.analysis.comparison import compare_with_describing_function
+from motionhyst.analysis.quasilinear import error_harmonics_df
+from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
 from motionhyst.loop import Loop
-from motionhyst.quasilinear import error_harmonics_df
 from motionhyst.scenario import default_scenario
-from motionhyst.steady import periodic_steady_state
 
 K_J, FC = 20.0, 0.05  # Table I
 N_MAX = 15

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
+from motionhyst.controllers.leadlag import LeadLagLowpass
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
 from motionhyst.identify import (
     Identification,
@@ -20,9 +21,9 @@ from motionhyst.identify import (
     load_force_displacement_csv,
 )
 from motionhyst.loop import Loop
+from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.scenario import hysteresis_from_dict
-from motionhyst.simulate import simulate
-from motionhyst.systems import LeadLagLowpass, TwoMassStage
+from motionhyst.time.simulation import simulate
 
 K_TRUE = np.array([8.0, 6.0, 4.0])  # N/m
 FC_TRUE = np.array([0.01, 0.03, 0.06])  # N; slip displacements 1.25, 5 and 15 mm

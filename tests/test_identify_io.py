@@ -10,7 +10,7 @@ import pytest
 from motionhyst.cli import main
 from motionhyst.hysteresis import BoucWen
 from motionhyst.identify.input_output import IORecord, best_linear_approximation, identify_io
-from motionhyst.openloop import MassSpringDamper, OpenLoop
+from motionhyst.time.openloop import MassSpringDamper, OpenLoop
 
 FS = 750.0
 TRUE = {"m": 2.0, "c": 10.0, "k": 5e4, "alpha": 5e4, "beta*gamma": 800.0,

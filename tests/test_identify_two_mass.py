@@ -15,7 +15,7 @@ from motionhyst.identify.input_output import (
     identify_io,
 )
 from motionhyst.identify.io_elements import _ElementProblem, _LinkLayout
-from motionhyst.openloop import OpenLoop, TwoMass
+from motionhyst.time.openloop import OpenLoop, TwoMass
 
 FS = 750.0
 SUBSTEPS = 20

@@ -7,10 +7,10 @@ import pytest
 from conftest import FC_LINK
 from numpy.testing import assert_allclose
 
-from motionhyst.ilc import ILCFilters, learn
 from motionhyst.loop import Loop
-from motionhyst.profiles import point_to_point, scan
-from motionhyst.simulate import simulate
+from motionhyst.scan.ilc import ILCFilters, learn
+from motionhyst.scan.profiles import point_to_point, scan
+from motionhyst.time.simulation import simulate
 
 
 def test_filters_as_stated(loop):

@@ -7,9 +7,12 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.core.lti import freqresp
 from motionhyst.hysteresis.jenkins import Jenkins
 from motionhyst.loop import TRANSFERS, Loop
-from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, freqresp
+from motionhyst.plants.measured import MeasuredPlant
+from motionhyst.plants.two_mass import TwoMassStage
 
 FREQS_HZ = np.array([1.0, 5.0, 10.0, 50.0, 120.0, 500.0, 694.0, 2000.0])
 

@@ -1,4 +1,4 @@
-"""The small-matrix exponential of :mod:`motionhyst.lti` against :func:`scipy.linalg.expm`."""
+"""The small-matrix exponential of :mod:`motionhyst.core.lti` against :func:`scipy.linalg.expm`."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
+from motionhyst.core.lti import expm_small
 from motionhyst.hysteresis import Jenkins
-from motionhyst.lti import expm_small
-from motionhyst.openloop import MassSpringDamper, OpenLoop, TwoMass
+from motionhyst.time.openloop import MassSpringDamper, OpenLoop, TwoMass
 
 FS = 750.0
 PLANTS = {

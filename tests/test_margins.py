@@ -1,4 +1,4 @@
-"""Tests of motionhyst.margins: gain, phase and modulus margins of L = C P2 vs python-control."""
+"""Tests of motionhyst.analysis.margins: gain, phase, modulus margins of C P2 vs python-control."""
 
 from __future__ import annotations
 
@@ -8,11 +8,14 @@ import control
 import numpy as np
 import pytest
 
-from motionhyst.frf_fit import ModalPlant, Mode
+from motionhyst.analysis.margins import BANDWIDTH_DEFINITION, loop_margins
+from motionhyst.analysis.quasilinear import analyze
+from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.core.lti import freqresp
 from motionhyst.loop import Loop
-from motionhyst.margins import BANDWIDTH_DEFINITION, loop_margins
-from motionhyst.quasilinear import analyze
-from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, freqresp
+from motionhyst.plants.frf_fit import ModalPlant, Mode
+from motionhyst.plants.measured import MeasuredPlant
+from motionhyst.plants.two_mass import TwoMassStage
 
 TABLE_I = TwoMassStage(5.0, 17.5, 90.0, 7.4e7)
 

@@ -12,22 +12,22 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from motionhyst import plots
+from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.cli import main
 from motionhyst.hysteresis import MODELS, Jenkins, MaxwellIwan, jenkins_describing_function
 from motionhyst.hysteresis.maxwell_iwan import iwan_describing_function
 from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 from motionhyst.hysteresis.stepping import GL_T, GL_W, MAXWELL, Stepping, open_loop
 from motionhyst.loop import Loop
-from motionhyst.references import SineReference
+from motionhyst.present import plots
 from motionhyst.scenario import (
     ScenarioError,
     default_scenario,
     default_scenario_path,
     hysteresis_from_dict,
 )
-from motionhyst.simulate import simulate
-from motionhyst.steady import periodic_steady_state
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 TWO_PI = 2.0 * np.pi
 # the example: k0 = 5 N/m, two Maxwell branches, an Iwan element of 30 N/m slipping

@@ -1,13 +1,14 @@
-"""Open-loop systems (motionhyst.openloop) and their scenarios."""
+"""Open-loop systems (motionhyst.time.openloop) and their scenarios."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from motionhyst.benchmark import TRUE_PARAMETERS, newmark_bouc_wen
 from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
-from motionhyst.openloop import (
+from motionhyst.identify.benchmark import TRUE_PARAMETERS, newmark_bouc_wen
+from motionhyst.scenario import Scenario, ScenarioError
+from motionhyst.time.openloop import (
     MassSpringDamper,
     OpenLoop,
     TwoMass,
@@ -15,7 +16,6 @@ from motionhyst.openloop import (
     simulate_bouc_wen,
     upsample,
 )
-from motionhyst.scenario import Scenario, ScenarioError
 
 P = TRUE_PARAMETERS
 PLANT = MassSpringDamper(P["m"], P["c"], P["k"])

@@ -1,4 +1,4 @@
-"""motionhyst.outputs: atomic writes, --force, inputs never overwritten, modes, signals."""
+"""motionhyst.io.outputs: atomic writes, --force, inputs never overwritten, modes, signals."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import time
 
 import pytest
 
-from motionhyst.outputs import MANIFEST, OutputError, OutputFile, OutputFolder
+from motionhyst.io.outputs import MANIFEST, OutputError, OutputFile, OutputFolder
 
 
 @pytest.fixture
@@ -133,7 +133,7 @@ def test_errors_name_the_target_not_a_temporary(tmp_path):
 
 _WRITER = textwrap.dedent("""
     import sys, time
-    from motionhyst.outputs import OutputFile
+    from motionhyst.io.outputs import OutputFile
     out = OutputFile(sys.argv[1], force=True)
     with out.open() as fh:
         fh.write("new,partial\\n" * 1000)

@@ -36,7 +36,7 @@ F = np.array([0.5, 3.0, 40.0, 700.0])
 
 
 def _freqresp(sys, f):
-    from motionhyst.systems import freqresp
+    from motionhyst.core.lti import freqresp
 
     return freqresp(sys, 2 * np.pi * np.asarray(f, dtype=float))
 
@@ -162,8 +162,8 @@ def test_mass_damper_runs_in_the_time_engine_with_its_force_offset():
     """From rest under a constant force F: y = F/c (t - m/c (1 - exp(-c t / m))); the force
     offset is that force."""
     from motionhyst.hysteresis import Jenkins
-    from motionhyst.openloop import OpenLoop
     from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.time.openloop import OpenLoop
 
     m, c, F = 2.0, 10.0, 5.0
     t = np.arange(400) / 1000.0

@@ -12,9 +12,9 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from motionhyst import plots
-from motionhyst.figure_writer import FigureWriter, _lay_out_once, save_figures
 from motionhyst.hysteresis import Jenkins
+from motionhyst.present import plots
+from motionhyst.present.figure_writer import FigureWriter, _lay_out_once, save_figures
 
 EL = Jenkins(k=20.0, fc=0.05)
 MAKERS = {
@@ -125,7 +125,7 @@ def test_writer_reports_the_first_error_with_the_workers_traceback(tmp_path):
 
 
 def test_figures_module_still_offers_the_writer():
-    from motionhyst import figures
+    from motionhyst.present import figures
 
     assert figures.FigureWriter is FigureWriter and figures.save_figures is save_figures
 
@@ -135,11 +135,11 @@ def test_a_caller_without_matplotlib_leaves_loading_it_to_the_worker(tmp_path):
     # the backends) and draws; the caller never imports it
     script = textwrap.dedent(f"""
         import sys
-        from motionhyst.figure_writer import FigureWriter
+        from motionhyst.present.figure_writer import FigureWriter
         from motionhyst.hysteresis import Jenkins
 
         def fig5():
-            from motionhyst.plots import fig5_loops
+            from motionhyst.present.plots import fig5_loops
             return fig5_loops(Jenkins(k=20.0, fc=0.05))
 
         with FigureWriter({str(tmp_path)!r}, ("png", "pdf"), parallel=True) as writer:

@@ -9,7 +9,7 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.integrate import cumulative_trapezoid
 
-from motionhyst.profiles import point_to_point, scan
+from motionhyst.scan.profiles import point_to_point, scan
 
 # (length, v, a, j, s): every limit reached; short moves that reach only some of them
 FULL = [(0.1, 0.5, 10.0, 500.0, 5e4), (-0.3, 1.0, 30.0, 3000.0, 1e6)]

@@ -7,9 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from motionhyst.hysteresis.jenkins import Jenkins
-from motionhyst.loop import Loop
-from motionhyst.quasilinear import (
+from motionhyst.analysis.quasilinear import (
     analyze,
     f_star,
     loop_mismatch,
@@ -21,7 +19,9 @@ from motionhyst.quasilinear import (
     self_consistent_amplitude,
     sensitivity_s1,
 )
-from motionhyst.systems import freqresp
+from motionhyst.core.lti import freqresp
+from motionhyst.hysteresis.jenkins import Jenkins
+from motionhyst.loop import Loop
 
 A_REF = 0.01
 

@@ -17,7 +17,7 @@ from motionhyst.io.records import (
     read_record,
     record_columns,
 )
-from motionhyst.openloop import STAMP_TOLERANCE, check_record, sampling_rate
+from motionhyst.time.openloop import STAMP_TOLERANCE, check_record, sampling_rate
 
 EMPS = Path(__file__).resolve().parents[2] / "shared" / "benchmarks" / "emps" / "DATA_EMPS.mat"
 NAMES = ("time", "force", "displacement")
@@ -224,8 +224,9 @@ def test_commands_read_mat_files_with_mapped_scaled_columns(tmp_path, capsys):
     layout) with the file's own names gives what the same record as CSV gives."""
     from motionhyst.cli import main
     from motionhyst.hysteresis import MaxwellSlip
-    from motionhyst.references import load_reference_csv
-    from motionhyst.systems import TwoMassStage, load_frd_plant
+    from motionhyst.plants.measured import load_frd_plant
+    from motionhyst.plants.two_mass import TwoMassStage
+    from motionhyst.time.references import load_reference_csv
 
     n = 800
     t = np.arange(n) * 1e-3

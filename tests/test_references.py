@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from motionhyst.references import (
+from motionhyst.time.references import (
     PointToPoint,
     SampledReference,
     SineReference,

@@ -12,13 +12,13 @@ import pytest
 from matplotlib.figure import Figure
 from numpy.testing import assert_allclose
 
-from motionhyst import plots, report
+from motionhyst.analysis.quasilinear import analyze, loop_mismatch, mismatch_asymptote
+from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.core.lti import freqresp
 from motionhyst.hysteresis import BoucWen, Dahl, LuGre, MaxwellSlip
-from motionhyst.outputs import MANIFEST
-from motionhyst.quasilinear import analyze, loop_mismatch, mismatch_asymptote
+from motionhyst.io.outputs import MANIFEST
+from motionhyst.present import plots, report
 from motionhyst.scenario import Scenario, default_scenario, default_scenario_path
-from motionhyst.steady import periodic_steady_state
-from motionhyst.systems import freqresp
 
 FIGURES = [f"fig{i}" for i in range(5, 12)]
 A_REF = 0.01
@@ -531,9 +531,9 @@ def test_report_defines_margins_and_exact_crossover(reproduced):
 
 
 def test_report_of_a_fitted_measured_plant(tmp_path):
-    from motionhyst.frf_fit import ModalPlant
+    from motionhyst.plants.frf_fit import ModalPlant
+    from motionhyst.plants.two_mass import TwoMassStage
     from motionhyst.scenario import Scenario, default_scenario_path
-    from motionhyst.systems import TwoMassStage
 
     exact = ModalPlant.from_two_mass(TwoMassStage(5.0, 17.5, 90.0, 7.4e7))
     f = np.geomspace(1.0, 3000.0, 60)

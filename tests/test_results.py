@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from motionhyst import SineReference, analyze, default_scenario, periodic_steady_state, simulate
-from motionhyst.comparison import compare_with_describing_function
+from motionhyst.analysis.comparison import compare_with_describing_function
+from motionhyst.core.textfmt import g
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.identify import identify_maxwell_slip
-from motionhyst.textfmt import g
 
 
 @pytest.fixture(scope="module")

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage, analyze, loop_margins
+from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.sampled import SampledController
 from motionhyst.controllers.two_dof import position_velocity_cascade
-from motionhyst.steady import periodic_steady_state
 
 STAGE = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
 C = LeadLagLowpass(K=6.2e6, f1=60.0, f2=240.0, flp=700.0, beta=0.6)

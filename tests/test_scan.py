@@ -14,8 +14,8 @@ from numpy.testing import assert_allclose
 from motionhyst.cli import main as cli_main
 from motionhyst.hysteresis import Jenkins
 from motionhyst.loop import Loop
-from motionhyst.profiles import point_to_point, scan
-from motionhyst.scan import moving_statistics, run_scan, scan_metrics, settling_time
+from motionhyst.scan.profiles import point_to_point, scan
+from motionhyst.scan.scanning import moving_statistics, run_scan, scan_metrics, settling_time
 
 # a gentle scan whose error the link dominates: the link slips during the acceleration
 # (3 mm > fc / kJ = 2.5 mm) and takes 5 mm to reverse, within the return scan

@@ -11,9 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from motionhyst.frf_fit import ModalPlant
+from motionhyst.analysis.quasilinear import analyze
+from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.core.lti import freqresp
 from motionhyst.hysteresis import Jenkins
-from motionhyst.quasilinear import analyze
+from motionhyst.plants.frf_fit import ModalPlant
+from motionhyst.plants.measured import MeasuredPlant
+from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.scenario import (
     Scenario,
     ScenarioError,
@@ -21,7 +25,6 @@ from motionhyst.scenario import (
     default_scenario_path,
     load_scenario,
 )
-from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, freqresp
 
 REPO = Path(__file__).parents[1]
 EXAMPLE = REPO / "examples" / "paper.toml"

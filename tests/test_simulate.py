@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
+from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, LuGre
 from motionhyst.loop import Loop
-from motionhyst.references import PointToPoint, SampledReference, SineReference
 from motionhyst.scenario import default_scenario
-from motionhyst.simulate import Simulation, default_step, simulate
-from motionhyst.steady import periodic_steady_state
+from motionhyst.time.references import PointToPoint, SampledReference, SineReference
+from motionhyst.time.simulation import Simulation, default_step, simulate
 
 A_REF, F_REF = 0.01, 10.0
 DURATION = 2.5  # s: transients of the Table I loop have died out long before

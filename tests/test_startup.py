@@ -81,9 +81,9 @@ light = sorted(m for m in sys.modules if m.split(".")[0] in ("control", "scipy",
                                                              "numba", "pydantic"))
 from motionhyst import *  # noqa
 from motionhyst import Loop, periodic_steady_state
-import motionhyst.loop, motionhyst.steady
+import motionhyst.loop, motionhyst.analysis.steady
 same = (Loop is motionhyst.loop.Loop
-        and periodic_steady_state is motionhyst.steady.periodic_steady_state)
+        and periodic_steady_state is motionhyst.analysis.steady.periodic_steady_state)
 print(json.dumps({"light": light, "same": same, "all": sorted(motionhyst.__all__),
                   "dir": all(n in dir(motionhyst) for n in motionhyst.__all__),
                   "resolved": all(getattr(motionhyst, n) is not None for n in motionhyst.__all__)}))
@@ -115,7 +115,7 @@ _KERNEL = """
 import json
 import numpy as np
 from motionhyst import Jenkins
-from motionhyst._jit import compiled_in_memory
+from motionhyst.core.compiled import compiled_in_memory
 w = Jenkins(k=20.0, fc=0.05).response(np.array([0.0, 0.01, -0.01, 0.0]))
 print(json.dumps({"w": w.tolist(), "in_memory": compiled_in_memory()}))
 """
@@ -167,7 +167,7 @@ def test_cache_folder_is_keyed_by_the_sources(tmp_path):
     root = tmp_path / "src"
     shutil.copytree(Path(motionhyst.__file__).parent, root / "motionhyst",
                     ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-    code = "from motionhyst._jit import _cache_folder; print(_cache_folder().name)"
+    code = "from motionhyst.core.compiled import _cache_folder; print(_cache_folder().name)"
 
     def folder() -> str:
         out = subprocess.run([sys.executable, "-c", code], env=_env(root, tmp_path / "cache"),

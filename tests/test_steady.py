@@ -8,16 +8,16 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from motionhyst.comparison import compare_with_describing_function
-from motionhyst.hysteresis.jenkins import Jenkins
-from motionhyst.loop import Loop
-from motionhyst.quasilinear import loop_mismatch
-from motionhyst.scenario import default_scenario
-from motionhyst.steady import (
+from motionhyst.analysis.comparison import compare_with_describing_function
+from motionhyst.analysis.quasilinear import loop_mismatch
+from motionhyst.analysis.steady import (
     default_harmonics,
     periodic_steady_state,
     steady_state_sweep,
 )
+from motionhyst.hysteresis.jenkins import Jenkins
+from motionhyst.loop import Loop
+from motionhyst.scenario import default_scenario
 
 A_REF = 0.01  # section V: r = 10 mm sin(2 pi f t)
 FREQS = (5.0, 10.0, 15.0)  # Fig. 11

@@ -9,14 +9,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from motionhyst.systems import (
-    LeadLagLowpass,
-    MeasuredPlant,
-    TwoMassStage,
-    bandwidth,
-    freqresp,
-    load_frd_plant,
-)
+from motionhyst.controllers.leadlag import LeadLagLowpass, bandwidth
+from motionhyst.core.lti import freqresp
+from motionhyst.plants.measured import MeasuredPlant, load_frd_plant
+from motionhyst.plants.two_mass import TwoMassStage
 
 FREQS_HZ = np.array([0.01, 0.1, 1.0, 10.0, 100.0, 500.0, 694.0, 1000.0, 5000.0])
 

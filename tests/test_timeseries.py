@@ -10,9 +10,9 @@ import pytest
 
 from motionhyst.hysteresis import BoucWen, LuGre, MaxwellSlip
 from motionhyst.loop import Loop
-from motionhyst.references import PointToPoint, SampledReference, SineReference
-from motionhyst.simulate import default_step, simulate, simulate_chunks
-from motionhyst.timeseries import COLUMNS, dynamics_step, run_time_series
+from motionhyst.time.references import PointToPoint, SampledReference, SineReference
+from motionhyst.time.simulation import default_step, simulate, simulate_chunks
+from motionhyst.time.timeseries import COLUMNS, dynamics_step, run_time_series
 
 A_REF = 0.01  # reference amplitude of section V [m]
 

@@ -19,26 +19,32 @@ Examples
 from __future__ import annotations
 
 import importlib
+import importlib.abc
+import importlib.machinery
 import sys
 import types
+import warnings
 from typing import TYPE_CHECKING
 
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "motionhyst.frf_fit": ("FrfFit", "ModalPlant", "fit_frf"),
-    "motionhyst.comparison": ("DescribingFunctionComparison", "compare_with_describing_function"),
+    "motionhyst.plants.frf_fit": ("FrfFit", "ModalPlant", "fit_frf"),
+    "motionhyst.analysis.comparison": ("DescribingFunctionComparison",
+                                       "compare_with_describing_function"),
     "motionhyst.hysteresis": ("BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellIwan",
                               "MaxwellSlip"),
-    "motionhyst.margins": ("LoopMargins", "loop_margins"),
+    "motionhyst.analysis.margins": ("LoopMargins", "loop_margins"),
     "motionhyst.loop": ("Loop",),
-    "motionhyst.quasilinear": ("QuasiLinearAnalysis", "analyze"),
-    "motionhyst.references": ("PointToPoint", "SampledReference", "SineReference",
+    "motionhyst.analysis.quasilinear": ("QuasiLinearAnalysis", "analyze"),
+    "motionhyst.time.references": ("PointToPoint", "SampledReference", "SineReference",
                               "load_reference_csv"),
     "motionhyst.scenario": ("Scenario", "ScenarioError", "default_scenario", "load_scenario"),
-    "motionhyst.simulate": ("Simulation", "simulate"),
-    "motionhyst.steady": ("SteadyState", "periodic_steady_state", "steady_state_sweep"),
-    "motionhyst.systems": ("LeadLagLowpass", "MeasuredPlant", "TwoMassStage", "load_frd_plant"),
+    "motionhyst.time.simulation": ("Simulation", "simulate"),
+    "motionhyst.analysis.steady": ("SteadyState", "periodic_steady_state", "steady_state_sweep"),
+    "motionhyst.controllers.leadlag": ("LeadLagLowpass",),
+    "motionhyst.plants.measured": ("MeasuredPlant", "load_frd_plant"),
+    "motionhyst.plants.two_mass": ("TwoMassStage",),
 }
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
@@ -54,8 +60,14 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:
-    from motionhyst.comparison import DescribingFunctionComparison, compare_with_describing_function
-    from motionhyst.frf_fit import FrfFit, ModalPlant, fit_frf
+    from motionhyst.analysis.comparison import (
+        DescribingFunctionComparison,
+        compare_with_describing_function,
+    )
+    from motionhyst.analysis.margins import LoopMargins, loop_margins
+    from motionhyst.analysis.quasilinear import QuasiLinearAnalysis, analyze
+    from motionhyst.analysis.steady import SteadyState, periodic_steady_state, steady_state_sweep
+    from motionhyst.controllers.leadlag import LeadLagLowpass
     from motionhyst.hysteresis import (
         BoucWen,
         Dahl,
@@ -66,18 +78,17 @@ if TYPE_CHECKING:
         MaxwellSlip,
     )
     from motionhyst.loop import Loop
-    from motionhyst.margins import LoopMargins, loop_margins
-    from motionhyst.quasilinear import QuasiLinearAnalysis, analyze
-    from motionhyst.references import (
+    from motionhyst.plants.frf_fit import FrfFit, ModalPlant, fit_frf
+    from motionhyst.plants.measured import MeasuredPlant, load_frd_plant
+    from motionhyst.plants.two_mass import TwoMassStage
+    from motionhyst.scenario import Scenario, ScenarioError, default_scenario, load_scenario
+    from motionhyst.time.references import (
         PointToPoint,
         SampledReference,
         SineReference,
         load_reference_csv,
     )
-    from motionhyst.scenario import Scenario, ScenarioError, default_scenario, load_scenario
-    from motionhyst.simulate import Simulation, simulate
-    from motionhyst.steady import SteadyState, periodic_steady_state, steady_state_sweep
-    from motionhyst.systems import LeadLagLowpass, MeasuredPlant, TwoMassStage, load_frd_plant
+    from motionhyst.time.simulation import Simulation, simulate
 
 
 def __getattr__(name: str):
@@ -94,18 +105,78 @@ def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
 
 
-class _Package(types.ModuleType):
-    """The package's module type: an export named like its own submodule stays the export.
+# Modules that moved in 0.2 (one subpackage per part of the architecture). Their old
+# dotted paths still import, with a DeprecationWarning, until the next release.
+_MOVED = {
+    "motionhyst._jit": ("motionhyst.core.compiled",),
+    "motionhyst.validation": ("motionhyst.core.validation",),
+    "motionhyst.lti": ("motionhyst.core.lti",),
+    "motionhyst.textfmt": ("motionhyst.core.textfmt",),
+    "motionhyst.jsonio": ("motionhyst.core.jsonio",),
+    "motionhyst.systems": ("motionhyst.plants.two_mass", "motionhyst.plants.measured",
+                           "motionhyst.controllers.leadlag", "motionhyst.core.lti"),
+    "motionhyst.frf_fit": ("motionhyst.plants.frf_fit",),
+    "motionhyst.quasilinear": ("motionhyst.analysis.quasilinear",),
+    "motionhyst.margins": ("motionhyst.analysis.margins",),
+    "motionhyst.steady": ("motionhyst.analysis.steady",),
+    "motionhyst.comparison": ("motionhyst.analysis.comparison",),
+    "motionhyst.simulate": ("motionhyst.time.simulation",),
+    "motionhyst.openloop": ("motionhyst.time.openloop",),
+    "motionhyst.timeseries": ("motionhyst.time.timeseries",),
+    "motionhyst.references": ("motionhyst.time.references",),
+    "motionhyst.ilc": ("motionhyst.scan.ilc",),
+    "motionhyst.profiles": ("motionhyst.scan.profiles",),
+    "motionhyst.benchmark": ("motionhyst.identify.benchmark",),
+    "motionhyst.csvdata": ("motionhyst.io.csvdata",),
+    "motionhyst.outputs": ("motionhyst.io.outputs",),
+    "motionhyst.figures": ("motionhyst.present.figures",),
+    "motionhyst.figure_writer": ("motionhyst.present.figure_writer",),
+    "motionhyst.plots": ("motionhyst.present.plots",),
+    "motionhyst.report": ("motionhyst.present.report",),
+}
 
-    Importing ``motionhyst.simulate`` (the module) sets the package attribute
-    ``simulate``; here it is set to the function ``simulate.simulate`` the
-    package exports instead, in whatever order the two are imported.
-    """
 
-    def __setattr__(self, name: str, value) -> None:
-        if isinstance(value, types.ModuleType) and _WHERE.get(name) == value.__name__:
-            value = getattr(value, name)
-        super().__setattr__(name, value)
+class _MovedModule(types.ModuleType):
+    """An old module path: its names are looked up in the module(s) it moved to."""
+
+    def __getattr__(self, name: str):
+        for target in _MOVED[self.__name__]:
+            module = importlib.import_module(target)
+            if hasattr(module, name):
+                return getattr(module, name)
+        raise AttributeError(f"module {self.__name__!r} has no attribute {name!r}")
+
+    def __call__(self, *args, **kwargs):
+        # importing an old path sets the package attribute of its name to the module: where
+        # the package exports a function of that name (``simulate``), the call still works
+        name = self.__name__.rpartition(".")[2]
+        if name not in _WHERE:
+            raise TypeError(f"module {self.__name__!r} is not callable")
+        return getattr(importlib.import_module(_WHERE[name]), name)(*args, **kwargs)
+
+    def __dir__(self) -> list[str]:
+        return sorted({name for target in _MOVED[self.__name__]
+                       for name in dir(importlib.import_module(target))})
 
 
-sys.modules[__name__].__class__ = _Package
+class _MovedFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Imports an old module path of :data:`_MOVED` with a DeprecationWarning."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname not in _MOVED:
+            return None
+        return importlib.machinery.ModuleSpec(fullname, self)
+
+    def create_module(self, spec):
+        new = _MOVED[spec.name]
+        warnings.warn(f"{spec.name} moved to {' and '.join(new)}; the old path will be removed "
+                      "in the next release", DeprecationWarning, stacklevel=4)
+        return _MovedModule(spec.name)
+
+    def exec_module(self, module) -> None:
+        module.__all__ = [n for target in _MOVED[module.__name__]
+                          for n in getattr(importlib.import_module(target), "__all__", ())]
+
+
+if not any(isinstance(f, _MovedFinder) for f in sys.meta_path):
+    sys.meta_path.append(_MovedFinder())

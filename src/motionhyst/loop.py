@@ -41,11 +41,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.controllers.feedforward import Feedforward
+from motionhyst.controllers.leadlag import bandwidth
 from motionhyst.controllers.sampled import SampledController, polyval_zinv
+from motionhyst.core.lti import PolyTF, cancel_s, freqresp, polysub_exact, tf_poly, trim
 from motionhyst.core.sampling import ZohEquivalent, hold_mismatch, hold_response
 from motionhyst.hysteresis.base import Hysteresis
-from motionhyst.lti import PolyTF, cancel_s, polysub_exact, tf_poly, trim
-from motionhyst.systems import MeasuredPlant, TwoMassStage, bandwidth, freqresp
+from motionhyst.plants.measured import MeasuredPlant
+from motionhyst.plants.two_mass import TwoMassStage
 
 __all__ = ["TRANSFERS", "Loop"]
 
@@ -58,8 +60,8 @@ class Loop:
     Parameters
     ----------
     plant : TwoMassStage or ModalPlant or MeasuredPlant or tuple
-        The stage: a :class:`~motionhyst.systems.TwoMassStage`, a plant fitted
-        to a measured FRF (:class:`~motionhyst.frf_fit.ModalPlant`), the raw
+        The stage: a :class:`~motionhyst.plants.two_mass.TwoMassStage`, a plant fitted
+        to a measured FRF (:class:`~motionhyst.plants.frf_fit.ModalPlant`), the raw
         measured plant, or a tuple ``(P1, P2)`` of python-control LTI systems
         (then `mass` is required for the feedforward).  Any object with
         attributes ``P1``, ``P2`` and ``M`` is taken as a plant.

@@ -7,7 +7,7 @@ and delayed with the feedback and once read ``delay + 1/2`` samples ahead (the
 delay and the hold's half sample), as machines do.  For each: the margins
 (gain, phase, modulus, delay), the mismatch of eq. (18) and, where the
 reference's period is a whole number of samples, the exact periodic steady
-state (:func:`motionhyst.steady.periodic_steady_state`): its ``|E|``, the
+state (:func:`motionhyst.analysis.steady.periodic_steady_state`): its ``|E|``, the
 error's RMS without the link and the RMS the link adds.
 
 Examples
@@ -28,14 +28,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from motionhyst.analysis.margins import LoopMargins, loop_margins
+from motionhyst.analysis.quasilinear import loop_mismatch
+from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.sampled import SampledController
-from motionhyst.jsonio import jsonable
+from motionhyst.core.jsonio import jsonable
+from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
-from motionhyst.margins import LoopMargins, loop_margins
-from motionhyst.quasilinear import loop_mismatch
-from motionhyst.steady import periodic_steady_state
-from motionhyst.textfmt import g, table
 
 __all__ = ["DigitalComparison", "DigitalPoint", "DigitalVariant", "compare_digital"]
 

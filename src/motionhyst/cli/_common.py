@@ -7,8 +7,8 @@ import argparse
 import math
 from collections.abc import Callable, Sequence
 
-from motionhyst.jsonio import dumps
-from motionhyst.textfmt import g, table
+from motionhyst.core.jsonio import dumps
+from motionhyst.core.textfmt import g, table
 
 __all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
            "harmonic_count", "nonnegative", "positive", "print_json", "table", "whole_number"]
@@ -137,7 +137,7 @@ def add_force_option(q: argparse.ArgumentParser) -> None:
 
 
 def output_file(path: str, args: argparse.Namespace, option: str, inputs=()):
-    """The :class:`~motionhyst.outputs.OutputFile` a command writes, checked now.
+    """The :class:`~motionhyst.io.outputs.OutputFile` a command writes, checked now.
 
     Every command that writes a file calls this before it computes anything:
     the file must not exist unless ``--force`` was given (``args.force``), and
@@ -147,10 +147,10 @@ def output_file(path: str, args: argparse.Namespace, option: str, inputs=()):
 
     Raises
     ------
-    motionhyst.outputs.OutputError
+    motionhyst.io.outputs.OutputError
         One line naming `option` and the path (exit 2).
     """
-    from motionhyst.outputs import OutputFile
+    from motionhyst.io.outputs import OutputFile
 
     return OutputFile(path, force=bool(getattr(args, "force", False)), inputs=inputs,
                       option=option)
@@ -219,7 +219,7 @@ def check_plausible(loop, amplitude: float, frequencies, command: str) -> None:
     - an amplitude at which the element never slips (``zeta = fc / (k A) >= 1``):
       it is a linear spring at every frequency asked, no hysteresis to see.
     """
-    from motionhyst.quasilinear import f_star
+    from motionhyst.analysis.quasilinear import f_star
 
     el = loop.hysteresis
     freqs = [float(f) for f in frequencies]

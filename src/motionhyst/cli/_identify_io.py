@@ -80,7 +80,7 @@ def run_input_output(args: argparse.Namespace) -> int:
         raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
     target = None
     if args.save is not None:  # refused before the work, not after
-        from motionhyst.outputs import OutputFile
+        from motionhyst.io.outputs import OutputFile
 
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]

@@ -15,7 +15,7 @@ from motionhyst.cli._common import (
 
 def run(args: argparse.Namespace) -> int:
     """Quasi-linear analysis of a scenario (paper eqs. 12-21)."""
-    from motionhyst.quasilinear import analyze
+    from motionhyst.analysis.quasilinear import analyze
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)

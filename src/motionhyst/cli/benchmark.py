@@ -25,7 +25,7 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Make training data, identify, score on the official test sets, print the table."""
-    from motionhyst.benchmark import default_data_dir, run_benchmark
+    from motionhyst.identify.benchmark import default_data_dir, run_benchmark
 
     data = args.data if args.data is not None else default_data_dir()
     if data is None:

@@ -126,8 +126,8 @@ def run(args: argparse.Namespace) -> int:
         load_closed_loop_csv,
         load_force_displacement_csv,
     )
+    from motionhyst.plants.measured import MeasuredPlant
     from motionhyst.scenario import load_scenario
-    from motionhyst.systems import MeasuredPlant
 
     if args.record == "input-output":
         return run_input_output(args)

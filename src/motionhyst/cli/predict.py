@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     if args.substeps is not None and not 1 <= args.substeps <= 10000:
         raise UsageError(f"motionhyst predict: --substeps must be from 1 to 10000, got "
                          f"{args.substeps}")
-    from motionhyst.outputs import OutputFile
+    from motionhyst.io.outputs import OutputFile
 
     target = OutputFile(args.out, force=args.force, inputs=[args.scenario, args.data],
                         option="--out")  # refused before any work

@@ -9,8 +9,8 @@ from motionhyst.cli._common import add_force_option, warn_plant_fit
 
 def run(args: argparse.Namespace) -> int:
     """The paper's figures and numbers for a scenario, as a report."""
-    from motionhyst.outputs import MANIFEST
-    from motionhyst.report import reproduce
+    from motionhyst.io.outputs import MANIFEST
+    from motionhyst.present.report import reproduce
     from motionhyst.scenario import load_scenario
 
     # the loop is built (and checked) inside reproduce, while the first figures are drawn

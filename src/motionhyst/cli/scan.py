@@ -75,7 +75,7 @@ def add_parser(sub) -> None:
 
 
 def _profile(args, length: float, speed: float):
-    from motionhyst.profiles import point_to_point, scan
+    from motionhyst.scan.profiles import point_to_point, scan
 
     if args.point_to_point:
         if args.back_and_forth or args.dwell:
@@ -90,7 +90,7 @@ def _profile(args, length: float, speed: float):
 
 def _output(args):
     """The ``--time-series`` target, checked before any computation (None without it)."""
-    from motionhyst.outputs import OutputFile
+    from motionhyst.io.outputs import OutputFile
 
     if not args.time_series:
         return None
@@ -107,8 +107,8 @@ def _write_csv(out, cols: dict) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
-    from motionhyst.ilc import ILCFilters
-    from motionhyst.scan import run_scan
+    from motionhyst.scan.ilc import ILCFilters
+    from motionhyst.scan.scanning import run_scan
     from motionhyst.scenario import load_scenario
 
     sc = load_scenario(args.scenario)

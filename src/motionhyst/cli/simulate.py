@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _reference(args: argparse.Namespace, sc):
     """The reference of a ``--time-series`` run, its default duration and a description."""
-    from motionhyst.references import PointToPoint, SineReference, load_reference_csv
+    from motionhyst.time.references import PointToPoint, SineReference, load_reference_csv
 
     if args.reference_csv and args.profile:
         raise UsageError("motionhyst simulate: give --reference-csv or --profile, not both")
@@ -86,9 +86,9 @@ def _reference(args: argparse.Namespace, sc):
 
 def _time_series(args: argparse.Namespace, sc) -> int:
     """Transient run from rest, streamed to CSV atomically, with its summary."""
-    from motionhyst.references import SineReference
-    from motionhyst.systems import MeasuredPlant
-    from motionhyst.timeseries import run_time_series
+    from motionhyst.plants.measured import MeasuredPlant
+    from motionhyst.time.references import SineReference
+    from motionhyst.time.timeseries import run_time_series
 
     if isinstance(sc.plant(), MeasuredPlant):
         raise UsageError(f"motionhyst simulate: --time-series needs a plant model; {sc.source} "

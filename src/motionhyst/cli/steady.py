@@ -17,7 +17,7 @@ from motionhyst.cli._common import (
 
 def run(args: argparse.Namespace) -> int:
     """Exact periodic steady state of the nonlinear loop, next to the describing function."""
-    from motionhyst.comparison import compare_with_describing_function
+    from motionhyst.analysis.comparison import compare_with_describing_function
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import BadCoefficients
 
-from motionhyst.lti import expm_small
+from motionhyst.core.lti import expm_small
 
 __all__ = ["ZohEquivalent", "hold_mismatch", "hold_response", "unit_circle_minus_one"]
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
 
 
 @njit(cache=True)

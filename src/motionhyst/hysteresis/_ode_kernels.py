@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
 from motionhyst.hysteresis._kernels import _trig2, reversal_roots, trig_root
 
 TWO_PI = 2.0 * np.pi

@@ -11,6 +11,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.validation import check_positive
 from motionhyst.hysteresis._kernels import reversal_roots
 from motionhyst.hysteresis._ode_kernels import (
     MAX_SAMPLES,
@@ -19,7 +20,6 @@ from motionhyst.hysteresis._ode_kernels import (
     path_with_reversals,
 )
 from motionhyst.hysteresis.periodic import sample_period, significant_harmonics
-from motionhyst.validation import check_positive
 
 
 def truncate_harmonics(X: NDArray[np.complex128]) -> NDArray[np.complex128]:

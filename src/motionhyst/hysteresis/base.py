@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.validation import check_amplitudes, check_positive
+from motionhyst.core.validation import check_amplitudes, check_positive
 
 __all__ = ["Hysteresis", "check_amplitudes", "check_positive"]
 

@@ -17,6 +17,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.validation import check_finite
 from motionhyst.hysteresis._ode_kernels import (
     GL_T,
     GL_W,
@@ -30,7 +31,6 @@ from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_posit
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.hysteresis.registry import Form, Parameter, register
 from motionhyst.hysteresis.stepping import BOUC_WEN, Stepping
-from motionhyst.validation import check_finite
 
 #: least samples per period of the corrected periodic output (:meth:`BoucWen.default_samples`)
 MIN_SAMPLES_CORRECTED = 1024

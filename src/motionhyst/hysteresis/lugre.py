@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis._ode_kernels import (
     TWO_PI,
     lugre_g,
@@ -28,7 +29,6 @@ from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_posit
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import LUGRE, Stepping
-from motionhyst.validation import check_omega
 
 
 def _check_nonnegative(name: str, value: float) -> float:

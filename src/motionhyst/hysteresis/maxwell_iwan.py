@@ -37,7 +37,8 @@ from math import comb
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
+from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis._kernels import reversal_points
 from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_positive
 from motionhyst.hysteresis.jenkins import jenkins_describing_function
@@ -49,7 +50,6 @@ from motionhyst.hysteresis.periodic import (
 )
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import GL_T, GL_W, MAXWELL, STOP, Stepping, advance
-from motionhyst.validation import check_omega
 
 __all__ = ["MaxwellIwan", "iwan_describing_function"]
 
@@ -288,7 +288,7 @@ class MaxwellIwan(Hysteresis):
         """Total slip force of the Iwan element, ``ki (d_min + d_max) / 2`` [N].
 
         The force it carries once all its elements slip (the sum of their
-        ``fc``): the scale of the loops, as the figures take it (:mod:`motionhyst.plots`).
+        ``fc``): the scale of the loops, as the figures take it (:mod:`motionhyst.present.plots`).
         """
         return 0.5 * self.ki * (self.d_min + self.d_max)
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
 from motionhyst.hysteresis._ode_kernels import (
     GL_T,
     GL_W,

@@ -84,6 +84,7 @@ result
     :class:`Identification`, the result of (a) and (b).
 """
 
+from motionhyst.core.lti import HoldFilter
 from motionhyst.identify.closed_loop import LinkForce, identify_closed_loop, infer_link_force
 from motionhyst.identify.fit import identify_maxwell_slip
 from motionhyst.identify.records import (
@@ -92,7 +93,6 @@ from motionhyst.identify.records import (
     load_force_displacement_csv,
 )
 from motionhyst.identify.result import Identification
-from motionhyst.lti import HoldFilter
 
 __all__ = [
     "HoldFilter", "Identification", "LinkForce", "count_reversals", "identify_closed_loop",

@@ -1,6 +1,6 @@
 """The derivatives an element link's sensitivities need in the link's own parameters.
 
-:func:`motionhyst.openloop.simulate_elements` runs the open loop with a link
+:func:`motionhyst.time.openloop.simulate_elements` runs the open loop with a link
 of exact-update elements and, when asked, the forward sensitivities of its
 output: the derivatives of the stage's discrete matrices in its parameters
 (:meth:`~motionhyst.plants.mechanics.Mechanics.foh`, Frechet derivatives of the matrix

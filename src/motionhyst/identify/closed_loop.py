@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import butter
 
+from motionhyst.core.lti import TWO_PI, HoldFilter, tf_poly
 from motionhyst.identify.fit import (
     EXTRA_ORDER,
     MAX_ELEMENTS,
@@ -21,8 +22,6 @@ from motionhyst.identify.fit import (
 )
 from motionhyst.identify.records import MIN_SAMPLES, _check_signals, count_reversals
 from motionhyst.identify.result import Identification
-from motionhyst.lti import HoldFilter, tf_poly
-from motionhyst.systems import TWO_PI
 
 DECIMATED_RATE = 40.0
 """Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""

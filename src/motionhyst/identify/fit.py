@@ -13,11 +13,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares, nnls
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
+from motionhyst.core.lti import HoldFilter
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.identify.records import _check_signals
 from motionhyst.identify.result import Identification
-from motionhyst.lti import HoldFilter
 
 N_GRID = 40
 """Candidate slip displacements in the NNLS stage."""
@@ -612,7 +612,8 @@ def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = N
     initial_state : {"fit", "relaxed"}
         ``"fit"`` estimates each element's force at the first sample (records
         that start in an unknown state); ``"relaxed"`` takes every element as
-        unstressed there (a system started from rest, as :func:`motionhyst.simulate.simulate`).
+        unstressed there (a system started from rest, as
+        :func:`motionhyst.time.simulation.simulate`).
     max_elements : int
         Most elements tried when `n_elements` is omitted.
     max_rows : int

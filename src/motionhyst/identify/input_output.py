@@ -3,7 +3,7 @@
 The records are force ``u`` in, position ``y`` out (the link force is not
 measured), each an experiment from rest or, with ``periodic=True``, whole
 periods of a periodic steady state.  The plant (a :class:`MassSpringDamper`,
-or the floating two-mass stage of eqs. (1)-(2), :class:`~motionhyst.openloop.TwoMass`,
+or the floating two-mass stage of eqs. (1)-(2), :class:`~motionhyst.time.openloop.TwoMass`,
 with ``y2`` or ``y1`` measured) and the link are estimated jointly by
 minimising the *simulation* error
 
@@ -11,7 +11,7 @@ minimising the *simulation* error
 
     V(\\theta) = \\sum_{records} \\sum_i \\left(\\hat y_i(\\theta; u) - y_i\\right)^2,
 
-the model being run from the input alone (:class:`~motionhyst.openloop.OpenLoop`),
+the model being run from the input alone (:class:`~motionhyst.time.openloop.OpenLoop`),
 as the Bouc-Wen benchmark scores it (Noel and Schoukens 2016).
 
 Method
@@ -43,7 +43,7 @@ Method
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
    from forward sensitivities integrated with the model (RK4); other links:
    the exact Jacobian from the forward sensitivities of their simulation, on
-   either plant (:func:`~motionhyst.openloop.simulate_elements`; finite differences,
+   either plant (:func:`~motionhyst.time.openloop.simulate_elements`; finite differences,
    columns in parallel threads, for an element kind without them).  Stopping rule:
    the first of a relative cost reduction below ``ftol``, a relative step below ``xtol`` or a scaled
    gradient below ``gtol`` (all ``1e-12`` by default), or ``max_nfev``
@@ -112,7 +112,7 @@ from motionhyst.identify.io_start import (
 from motionhyst.identify.io_start import two_mass_response as two_mass_response
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
-from motionhyst.openloop import TwoMass, is_periodic_record
+from motionhyst.time.openloop import TwoMass, is_periodic_record
 
 #: Link models for input-output records: Bouc-Wen (exact sensitivities) and every other
 #: registered model (its parameters taken from the registry); not maxwell-iwan, whose Iwan
@@ -144,8 +144,8 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         known up to a constant position: records and model are compared with
         their means removed.
     plant : {"mass-spring-damper", "two-mass"}
-        The stage: :class:`~motionhyst.openloop.MassSpringDamper` (``m, c, k``)
-        or the floating :class:`~motionhyst.openloop.TwoMass` of eqs. (1)-(2)
+        The stage: :class:`~motionhyst.time.openloop.MassSpringDamper` (``m, c, k``)
+        or the floating :class:`~motionhyst.time.openloop.TwoMass` of eqs. (1)-(2)
         (``m1, m2, b, k``; the force and the link on ``m1``, no spring to the
         ground but the link's).
     output : {"y2", "y1"}
@@ -168,7 +168,7 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         short part of the records (default ``15 p``, ``p`` parameters).
     substeps : int, optional
         Integration steps per sample (default: the model's
-        :meth:`~motionhyst.openloop.OpenLoop.default_substeps` at the start).
+        :meth:`~motionhyst.time.openloop.OpenLoop.default_substeps` at the start).
     tol : float
         ``ftol = xtol = gtol`` of the refinement.
     max_nfev : int
@@ -181,7 +181,7 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.openloop import MassSpringDamper, OpenLoop
+    >>> from motionhyst.time.openloop import MassSpringDamper, OpenLoop
     >>> from motionhyst.hysteresis import BoucWen
     >>> true = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), BoucWen(k=5e4, fc=20.0, beta=0.6,
     ...                                                            gamma=0.2))

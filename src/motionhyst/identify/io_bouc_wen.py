@@ -5,7 +5,7 @@ The link of the benchmark (Noel and Schoukens 2016) in the general form,
 mass-spring-damper (:func:`_identify_bouc_wen`) or on the floating two-mass stage
 of eqs. (1)-(2) (:func:`_identify_two_mass`, its starts :func:`_two_mass_start`).
 The simulation residuals and their exact Jacobian, from forward sensitivities
-integrated with the model (:func:`~motionhyst.openloop.simulate_bouc_wen`), are
+integrated with the model (:func:`~motionhyst.time.openloop.simulate_bouc_wen`), are
 :class:`_BoucWenProblem`'s; the trust-region refinement is :func:`_solve`.
 
 ``beta`` only enters as ``beta*gamma`` and ``beta*delta``, so those products are
@@ -36,7 +36,7 @@ from motionhyst.identify.io_uncertainty import (
     _uncertainty,
     _undetermined_notes,
 )
-from motionhyst.openloop import (
+from motionhyst.time.openloop import (
     MIN_SUBSTEPS,
     STEPS_PER_MODE_PERIOD,
     MassSpringDamper,

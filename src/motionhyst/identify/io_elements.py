@@ -6,7 +6,7 @@ the registry's :class:`~motionhyst.hysteresis.registry.Parameter` list
 (:class:`_LinkLayout`), on a mass-spring-damper or the floating two-mass stage
 of eqs. (1)-(2) (:func:`_identify_elements`).  The simulation residuals and
 their Jacobian (exact, from the forward sensitivities of
-:func:`~motionhyst.openloop.simulate_elements`, or by finite differences for
+:func:`~motionhyst.time.openloop.simulate_elements`, or by finite differences for
 an element kind without them) are :class:`_ElementProblem`'s.
 """
 
@@ -36,7 +36,7 @@ from motionhyst.identify.io_uncertainty import (
     _undetermined_notes,
     _weak_notes,
 )
-from motionhyst.openloop import (
+from motionhyst.time.openloop import (
     MIN_SUBSTEPS,
     STEPS_PER_MODE_PERIOD,
     MassSpringDamper,
@@ -167,12 +167,12 @@ class _ElementProblem:
     """Simulation residuals of the stage with a link of exact-update elements.
 
     The search variables are the logarithms of the plant's parameters
-    (``m, c, k`` or, with `plant` a :class:`~motionhyst.openloop.TwoMass`,
+    (``m, c, k`` or, with `plant` a :class:`~motionhyst.time.openloop.TwoMass`,
     ``m1, m2, b, k``) and the link's values, each as a logarithm or scaled
     (see :class:`_LinkLayout`); those not in `free` stay at their values in
     `fixed`.  The Jacobian is exact, from the
     forward sensitivities of the simulation
-    (:func:`~motionhyst.openloop.simulate_elements`, computed with the
+    (:func:`~motionhyst.time.openloop.simulate_elements`, computed with the
     residuals), or, for an element kind without them or with `exact` False,
     by forward differences (relative step ``1e-6``), its columns computed in
     parallel.

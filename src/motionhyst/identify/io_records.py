@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.openloop import check_record, sampling_rate
+from motionhyst.time.openloop import check_record, sampling_rate
 
 MIN_SAMPLES = 64
 

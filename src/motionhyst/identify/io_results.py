@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.identify.io_records import IORecord
-from motionhyst.openloop import MassSpringDamper, OpenLoop
+from motionhyst.time.openloop import MassSpringDamper, OpenLoop
 
 
 @dataclass

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.identify.io_records import IORecord
-from motionhyst.openloop import MassSpringDamper, TwoMass
+from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
 BLA_STARTS = 6  # two-mass: grid points refined
 
@@ -33,7 +33,7 @@ def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.openloop import MassSpringDamper, OpenLoop
+    >>> from motionhyst.time.openloop import MassSpringDamper, OpenLoop
     >>> t = np.arange(4096) / 750
     >>> u = np.random.default_rng(0).standard_normal(4096)
     >>> y = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4)).simulate(t, u, periodic=True).displacement
@@ -152,7 +152,7 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.openloop import OpenLoop, TwoMass
+    >>> from motionhyst.time.openloop import OpenLoop, TwoMass
     >>> from motionhyst.hysteresis import BoucWen
     >>> t = np.arange(4096) / 750
     >>> u = np.random.default_rng(0).standard_normal(4096)

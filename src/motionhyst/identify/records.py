@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst._jit import njit
-from motionhyst.csvdata import Source, describe
+from motionhyst.core.compiled import njit
+from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
 MIN_SAMPLES = 50

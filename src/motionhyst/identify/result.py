@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import MaxwellSlip
-from motionhyst.textfmt import g, table
 
 
 def _fmt(v: float) -> str:
@@ -133,13 +133,15 @@ class Identification:
             f"  total stiffness {g(k, 6)} N/m, total slip force {g(fc, 6)} N"])
 
     def plot(self):
-        """The identified link's force-displacement loops (:func:`motionhyst.figures.plot_link`).
+        """The identified link's force-displacement loops.
+
+        Drawn by :func:`~motionhyst.present.figures.plot_link`.
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.figures import plot_link
+        from motionhyst.present.figures import plot_link
 
         return plot_link(self.model, title=f"Identified Maxwell-slip link, "
                          f"{self.n_elements} element(s)")

@@ -1,2 +1,2 @@
-"""Inputs and outputs: scenario files, CSV records, safe file writing.
+"""Files in and out: measured records (CSV and MATLAB), CSV tables, safe file writing.
 """

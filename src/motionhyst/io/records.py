@@ -4,7 +4,7 @@ Every command that reads a record (``identify``, ``predict``, ``simulate``'s
 reference, a measured plant's frequency response) reads it through
 :func:`read_record`, which takes
 
-- a CSV file with a header row (the dialects of :mod:`motionhyst.csvdata`:
+- a CSV file with a header row (the dialects of :mod:`motionhyst.io.csvdata`:
   byte-order marks, comma, semicolon or tab, decimal commas, names in any case);
 - a MATLAB ``.mat`` file: level 4 and 5 (MATLAB's ``-v4``, ``-v6``, ``-v7``)
   through :func:`scipy.io.loadmat`, version 7.3 (HDF5) through :mod:`h5py`.
@@ -29,7 +29,7 @@ Time stamps written by a data logger jitter (EMPS: 2e-5 of the step).
 Where a command needs a uniform grid (``identify --record input-output``,
 ``predict``), it fits the nearest one to all the stamps and accepts every
 stamp within 0.05 of a sampling interval of it
-(:data:`motionhyst.openloop.STAMP_TOLERANCE`, :func:`motionhyst.openloop.check_record`);
+(:data:`motionhyst.time.openloop.STAMP_TOLERANCE`, :func:`motionhyst.time.openloop.check_record`);
 a record whose stamps stray further (a dropped or repeated sample) is refused,
 naming the worst stamp.
 
@@ -51,7 +51,14 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.csvdata import CSVError, Source, describe, normalize_name, read_columns, read_header
+from motionhyst.io.csvdata import (
+    CSVError,
+    Source,
+    describe,
+    normalize_name,
+    read_columns,
+    read_header,
+)
 
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _MAT_TEXT_HEADER = b"MATLAB"
@@ -426,7 +433,7 @@ def record_columns(source: Source, columns: Mapping[str, str] | None = None) -> 
 
     A name `columns` maps to is reported as the quantity (``t`` as ``time``
     with ``columns={"time": "t"}``); other names normalised as a CSV header's
-    (lower case, see :func:`motionhyst.csvdata.normalize_name`).
+    (lower case, see :func:`motionhyst.io.csvdata.normalize_name`).
 
     Examples
     --------

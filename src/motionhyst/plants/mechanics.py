@@ -46,7 +46,7 @@ class Mechanics:
 
     Examples
     --------
-    >>> from motionhyst.openloop import TwoMass
+    >>> from motionhyst.time.openloop import TwoMass
     >>> mech = TwoMass(m1=2.0, m2=3.0, b=20.0, k=2e5).mechanics()
     >>> A, B = mech.state_space()
     >>> A.shape, B.tolist(), mech.link, mech.output
@@ -97,7 +97,7 @@ class Mechanics:
 
         ``x(t + h) = Ad x(t) + B0 f(t) + B1 f(t + h)`` exactly for ``f = u - w``
         linear over the step, from the exponential of ``[[A h, B h, 0], [0, 0, 1],
-        [0, 0, 0]]`` (:func:`~motionhyst.lti.expm_small`; the link left out).
+        [0, 0, 0]]`` (:func:`~motionhyst.core.lti.expm_small`; the link left out).
 
         Parameters
         ----------
@@ -118,7 +118,7 @@ class Mechanics:
 
         Examples
         --------
-        >>> from motionhyst.openloop import MassSpringDamper
+        >>> from motionhyst.time.openloop import MassSpringDamper
         >>> mech = MassSpringDamper(2.0, 10.0, 5e4).mechanics()
         >>> Ad, B0, B1, dAd, dB0, dB1 = mech.foh(1e-4, derivatives=True)
         >>> eps = 1e-6   # d Ad / d k against a central difference
@@ -130,7 +130,7 @@ class Mechanics:
         >>> mech.foh(1e-4)[3].shape
         (0, 2, 2)
         """
-        from motionhyst.lti import expm_small  # scipy: imported when a run needs it
+        from motionhyst.core.lti import expm_small  # scipy: imported when a run needs it
 
         A, B = self.state_space()
         ns = A.shape[0]

@@ -22,12 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst._jit import njit
-from motionhyst.hysteresis import Hysteresis
-from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
-from motionhyst.hysteresis.stepping import Stepping, advance, open_loop_chunk
-from motionhyst.loop import Loop
-from motionhyst.lti import (
+from motionhyst.core.compiled import njit
+from motionhyst.core.lti import (
+    TWO_PI,
     FohResponse,
     discretize_foh,
     divide_s2,
@@ -36,8 +33,11 @@ from motionhyst.lti import (
     realize_scaled,
     stack,
 )
-from motionhyst.systems import TWO_PI
-from motionhyst.textfmt import g, table
+from motionhyst.core.textfmt import g, table
+from motionhyst.hysteresis import Hysteresis
+from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
+from motionhyst.hysteresis.stepping import Stepping, advance, open_loop_chunk
+from motionhyst.loop import Loop
 
 STEPS_PER_POLE_PERIOD = 40
 STEPS_PER_REFERENCE_PERIOD = 400
@@ -114,13 +114,13 @@ class Simulation:
 
     def plot(self):
         """The error with and without the link, and the link force, against time
-        (:func:`motionhyst.figures.plot_simulation`).
+        (:func:`motionhyst.present.figures.plot_simulation`).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.figures import plot_simulation
+        from motionhyst.present.figures import plot_simulation
 
         return plot_simulation(self)
 
@@ -294,14 +294,14 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
         and hysteresis feedforward (if any) one of Jenkins, MaxwellSlip, Dahl,
         BoucWen, LuGre.
     reference : callable
-        ``reference(t) -> (r, r'')``, e.g. the classes of :mod:`motionhyst.references`.
+        ``reference(t) -> (r, r'')``, e.g. the classes of :mod:`motionhyst.time.references`.
     duration : float
         Simulated time [s], > 0.
     dt : float, optional
         Output and integration step [s]; by default from :func:`default_step`.
     force : callable, optional
         An additional feedforward force [N], ``force(t) -> array`` on the time
-        grid (e.g. one learned by :mod:`motionhyst.ilc`); it is added to the
+        grid (e.g. one learned by :mod:`motionhyst.scan.ilc`); it is added to the
         actuator force like the hysteresis feedforward, linear between samples.
 
     Returns
@@ -365,7 +365,7 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
     Examples
     --------
     >>> from motionhyst.scenario import default_scenario
-    >>> from motionhyst.references import SineReference
+    >>> from motionhyst.time.references import SineReference
     >>> loop = default_scenario().loop()
     >>> ref = SineReference(0.01, 5.0)
     >>> pieces = list(simulate_chunks(loop, ref, 0.01, chunk=100))

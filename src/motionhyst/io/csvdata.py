@@ -49,7 +49,7 @@ class CSVError(ValueError):
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.csvdata import CSVError, read_columns
+    >>> from motionhyst.io.csvdata import CSVError, read_columns
     >>> try:
     ...     read_columns(np.zeros((3, 1)), ("time", "position"))
     ... except CSVError as err:

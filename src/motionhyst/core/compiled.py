@@ -39,7 +39,7 @@ from typing import Any
 
 _LOCK = threading.RLock()
 _STATE: dict[str, Any] = {"cache": None, "announced": False, "numba": None}
-_PACKAGE = __name__.rpartition(".")[0]
+_PACKAGE = __name__.partition(".")[0]
 
 
 def _probe() -> None:
@@ -48,7 +48,7 @@ def _probe() -> None:
 
 def _source_key() -> str:
     """A short hash of every source file of the package (the cache folder's name)."""
-    root = Path(__file__).resolve().parent
+    root = Path(__file__).resolve().parent.parent
     h = hashlib.sha1()
     for f in sorted(root.rglob("*.py")):
         h.update(str(f.relative_to(root)).encode())
@@ -76,7 +76,7 @@ def _cache_folder() -> Path | None:
     else:
         xdg = os.environ.get("XDG_CACHE_HOME")
         home = os.environ.get("HOME")
-        candidates = [Path(__file__).resolve().parent / "__pycache__" / name]
+        candidates = [Path(__file__).resolve().parent.parent / "__pycache__" / name]
         if xdg:
             candidates.append(Path(xdg) / "motionhyst" / name)
         elif home:
@@ -144,7 +144,7 @@ class Kernel:
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst._jit import njit
+    >>> from motionhyst.core.compiled import njit
     >>> @njit
     ... def total(x):
     ...     s = 0.0
@@ -217,7 +217,7 @@ def _with_callee_dispatchers(kernel: Kernel) -> Callable:
 
     numba inlines a callee declared ``inline="always"`` only when the global it
     finds is the callee's dispatcher, not a :class:`Kernel` standing for it
-    (a call it cannot inline costs the hot loops of :mod:`motionhyst.openloop`
+    (a call it cannot inline costs the hot loops of :mod:`motionhyst.time.openloop`
     a factor 2 to 4).  The module keeps its :class:`Kernel` objects: the
     function is a copy whose globals hold the dispatchers (each callee does
     the same for its own callees; a kernel calling itself is left as it is).
@@ -250,6 +250,14 @@ def njit(func: Callable | str | None = None, **options
 
     ``cache`` is accepted for symmetry with numba and ignored: the cache is
     chosen once per process (see the module docstring).
+
+    Examples
+    --------
+    >>> @njit("(float64, float64)")
+    ... def clip_add(w, dx):
+    ...     return min(max(w + dx, -1.0), 1.0)
+    >>> clip_add(0.5, 0.75)
+    1.0
     """
     options.pop("cache", None)
     if func is None or isinstance(func, str):
@@ -262,12 +270,22 @@ def quiet_compilation(quiet: bool = True) -> None:
 
     For callers whose stderr must stay clean, e.g. a test session that checks
     the commands' error output.
+
+    Examples
+    --------
+    >>> quiet_compilation()         # no notice before the next first compilation
     """
     _STATE["announced"] = bool(quiet)
 
 
 def compiled_in_memory() -> bool | None:
-    """Whether kernels are compiled without a disk cache (None before the first kernel call)."""
+    """Whether kernels are compiled without a disk cache (None before the first kernel call).
+
+    Examples
+    --------
+    >>> compiled_in_memory() in (None, True, False)
+    True
+    """
     c = _STATE["cache"]
     return None if c is None else not c
 

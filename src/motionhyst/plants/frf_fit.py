@@ -77,8 +77,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from motionhyst.lti import polysub_exact, trim
-from motionhyst.systems import TWO_PI, MeasuredPlant
+from motionhyst.core.lti import TWO_PI, polysub_exact, trim
+from motionhyst.plants.measured import MeasuredPlant
 
 #: Largest number of modes the automatic choice tries.
 MAX_MODES = 6
@@ -140,7 +140,7 @@ class ModalPlant:
 
     ``P1 = 1/(M s^2) + sum r1_i / (s^2 + 2 z_i w_i s + w_i^2)``,
     ``P2 = 1/(M s^2) - sum r2_i / (s^2 + 2 z_i w_i s + w_i^2)``.  It offers
-    what :class:`~motionhyst.systems.TwoMassStage` offers (``P1``, ``P2``,
+    what :class:`~motionhyst.plants.two_mass.TwoMassStage` offers (``P1``, ``P2``,
     ``Pr``, ``Pf1``, ``Pf2`` as python-control transfer functions, ``M``), so
     a :class:`~motionhyst.loop.Loop` and every analysis take it.
 
@@ -155,8 +155,8 @@ class ModalPlant:
 
     Examples
     --------
-    >>> from motionhyst.frf_fit import ModalPlant
-    >>> from motionhyst.systems import TwoMassStage
+    >>> from motionhyst.plants.frf_fit import ModalPlant
+    >>> from motionhyst.plants.two_mass import TwoMassStage
     >>> p = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
     >>> round(p.modes[0].frequency_hz, 2), round(p.modes[0].damping, 5)
     (694.26, 0.00265)
@@ -182,7 +182,7 @@ class ModalPlant:
 
     @classmethod
     def from_two_mass(cls, stage) -> ModalPlant:
-        """The modal form of a :class:`~motionhyst.systems.TwoMassStage` (eq. 2)."""
+        """The modal form of a :class:`~motionhyst.plants.two_mass.TwoMassStage` (eq. 2)."""
         m1, m2, M = stage.m1, stage.m2, stage.M
         w = np.sqrt(stage.k * M / (m1 * m2))
         mode = Mode(frequency_hz=w / TWO_PI, damping=stage.b * M / (m1 * m2) / (2 * w),
@@ -658,9 +658,9 @@ class FrfFit:
     def plot(self, f_range: tuple[float, float] | None = None):
         """Bode figure of the measured ``P1``, ``P2`` (markers) and the fit (lines).
 
-        Returns a matplotlib Figure (see :func:`motionhyst.figures.plot_frf_fit`).
+        Returns a matplotlib Figure (see :func:`motionhyst.present.figures.plot_frf_fit`).
         """
-        from motionhyst.figures import plot_frf_fit
+        from motionhyst.present.figures import plot_frf_fit
 
         return plot_frf_fit(self, f_range)
 
@@ -730,8 +730,8 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.frf_fit import ModalPlant, fit_frf
-    >>> from motionhyst.systems import TwoMassStage
+    >>> from motionhyst.plants.frf_fit import ModalPlant, fit_frf
+    >>> from motionhyst.plants.two_mass import TwoMassStage
     >>> exact = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
     >>> f = np.geomspace(1.0, 3000.0, 60)
     >>> p1, p2 = exact.response(2 * np.pi * f)
@@ -968,7 +968,7 @@ def _diagnose(fit: FrfFit) -> list[str]:
 
 def fit_measured_plant(plant: MeasuredPlant, modes: int | None = None,
                        mass: float | None = None, delay: float | None = None) -> FrfFit:
-    """Fit a :class:`~motionhyst.systems.MeasuredPlant` (see :func:`fit_frf`).
+    """Fit a :class:`~motionhyst.plants.measured.MeasuredPlant` (see :func:`fit_frf`).
 
     `mass` fixes ``M``; by default it is fitted (the plant's own estimate of
     ``M`` from its lowest decade is not used).  `delay` fixes the delay [s];

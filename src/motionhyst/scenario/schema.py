@@ -34,10 +34,11 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
     import control
 
     from motionhyst.controllers.sampled import SampledController
-    from motionhyst.frf_fit import FrfFit, ModalPlant
     from motionhyst.loop import Loop
-    from motionhyst.openloop import MassSpringDamper, OpenLoop, TwoMass
-    from motionhyst.systems import MeasuredPlant, TwoMassStage
+    from motionhyst.plants.frf_fit import FrfFit, ModalPlant
+    from motionhyst.plants.measured import MeasuredPlant
+    from motionhyst.plants.two_mass import TwoMassStage
+    from motionhyst.time.openloop import MassSpringDamper, OpenLoop, TwoMass
 
 
 class ScenarioError(ValueError):
@@ -80,7 +81,7 @@ class StageSection(_Section):
     """``[stage]``: the two-mass stage of eqs. (1)-(2) (``type = "two-mass"``, the default).
 
     ``output = "y2"`` or ``"y1"`` makes it an open-loop system
-    (:class:`~motionhyst.openloop.TwoMass`: force on ``m1``, the link on ``y1``,
+    (:class:`~motionhyst.time.openloop.TwoMass`: force on ``m1``, the link on ``y1``,
     that position out, as :func:`motionhyst.identify.identify_io` writes it), with
     no ``[controller]``, ``[feedforward]`` or ``[reference]``; without it the
     stage is the plant of the closed loop.
@@ -98,7 +99,7 @@ class MassSpringDamperSection(_Section):
     """``[stage] type = "mass-spring-damper"``: one mass on a spring and damper, open loop.
 
     ``m y'' + c y' + k y + w = u`` with the link force ``w`` on the position
-    (:class:`~motionhyst.openloop.MassSpringDamper`); force in, position out,
+    (:class:`~motionhyst.time.openloop.MassSpringDamper`); force in, position out,
     no ``[controller]``, ``[feedforward]`` or ``[reference]``.
     """
 
@@ -125,7 +126,7 @@ class PlantSection(_Section):
     """``[plant]``: a measured plant (CSV of P1 and P2, see :func:`load_frd_plant`).
 
     ``use = "fit"`` (default) fits the data to a rigid body plus ``modes``
-    flexible modes (:func:`motionhyst.frf_fit.fit_frf`; the number chosen by
+    flexible modes (:func:`motionhyst.plants.frf_fit.fit_frf`; the number chosen by
     the BIC when ``modes`` is omitted) and analyses the fitted model;
     ``use = "data"`` keeps the raw data: only measured frequencies are
     evaluated.  ``mass`` fixes the rigid-body mass [kg]; ``delay`` fixes the
@@ -494,7 +495,25 @@ _HYSTERESIS_ADAPTER = TypeAdapter(HysteresisSection, config=ConfigDict(defer_bui
 
 
 def hysteresis_from_dict(data: dict, source: str = "<dict>") -> Hysteresis:
-    """Validate a ``[hysteresis]`` table and build the model; raises :class:`ScenarioError`."""
+    """Validate a ``[hysteresis]`` table and build the model; raises :class:`ScenarioError`.
+
+    Parameters
+    ----------
+    data : dict
+        The table's keys and values, as read from TOML (``model`` and the model's parameters).
+    source : str
+        Where the table comes from, named in error messages.
+
+    Returns
+    -------
+    Hysteresis
+        The link model.
+
+    Examples
+    --------
+    >>> hysteresis_from_dict({"model": "jenkins", "k": 20.0, "fc": 0.05})
+    Jenkins(k=20.0, fc=0.05)
+    """
     try:
         section = _HYSTERESIS_ADAPTER.validate_python(data)
     except ValidationError as err:
@@ -623,7 +642,7 @@ class Scenario:
     def files(self) -> list[Path]:
         """The files the scenario was read from: its TOML and a measured plant's CSV.
 
-        A command never writes over these (:mod:`motionhyst.outputs`).
+        A command never writes over these (:mod:`motionhyst.io.outputs`).
         """
         files = [Path(self.source)] if Path(self.source).is_file() else []
         if self.model.stage is None and self.model.plant is not None:
@@ -650,19 +669,20 @@ class Scenario:
                                 f"two-mass stage with an output; an open-loop system needs "
                                 f"[stage] type = \"mass-spring-damper\", or output = \"y2\" "
                                 f"or \"y1\" in a two-mass [stage] (and no [controller])")
-        from motionhyst.openloop import OpenLoop
+        from motionhyst.time.openloop import OpenLoop
 
         return OpenLoop(self.plant(), self.hysteresis())
 
     def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant | MassSpringDamper | TwoMass:
         """The stage model, the model fitted to a measured plant, or the raw measured plant
-        (an open-loop system's: :class:`~motionhyst.openloop.MassSpringDamper` or
-        :class:`~motionhyst.openloop.TwoMass`)."""
+        (an open-loop system's: :class:`~motionhyst.time.openloop.MassSpringDamper` or
+        :class:`~motionhyst.time.openloop.TwoMass`)."""
         if self._plant is not None:
             return self._plant
-        from motionhyst.frf_fit import fit_measured_plant
-        from motionhyst.openloop import MassSpringDamper, TwoMass
-        from motionhyst.systems import TwoMassStage, load_frd_plant
+        from motionhyst.plants.frf_fit import fit_measured_plant
+        from motionhyst.plants.measured import load_frd_plant
+        from motionhyst.plants.two_mass import TwoMassStage
+        from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
         m = self.model
         if m.open_loop:
@@ -711,9 +731,9 @@ class Scenario:
         self._closed("a controller")
         import control
 
+        from motionhyst.controllers.leadlag import LeadLagLowpass
         from motionhyst.controllers.pid import Notch, Pid
         from motionhyst.controllers.sampled import SampledController
-        from motionhyst.systems import LeadLagLowpass
 
         c = self.model.controller
         delay = c.delay_samples or 0.0
@@ -772,8 +792,14 @@ class Scenario:
 
 
 def default_scenario_path() -> Path:
-    """Path of the shipped Table I scenario."""
-    return Path(str(resources.files("motionhyst") / "data" / "paper.toml"))
+    """Path of the shipped Table I scenario (``data/paper.toml`` in this package).
+
+    Examples
+    --------
+    >>> default_scenario_path().name
+    'paper.toml'
+    """
+    return Path(str(resources.files("motionhyst.scenario") / "data" / "paper.toml"))
 
 
 def default_scenario(check: bool = True) -> Scenario:

@@ -42,7 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, lfilter
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
 
 #: The benchmark's true system (SI units).
 TRUE_PARAMETERS: dict[str, float] = {

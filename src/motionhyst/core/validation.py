@@ -24,7 +24,7 @@ def check_finite(name: str, value: float) -> float:
 
     Examples
     --------
-    >>> from motionhyst.validation import check_finite
+    >>> from motionhyst.core.validation import check_finite
     >>> check_finite("beta", "0.5")
     0.5
     >>> check_finite("beta", float("nan"))
@@ -46,7 +46,7 @@ def check_positive(name: str, value: float) -> float:
 
     Examples
     --------
-    >>> from motionhyst.validation import check_positive
+    >>> from motionhyst.core.validation import check_positive
     >>> check_positive("k", 20)
     20.0
     >>> check_positive("k", -1.0)
@@ -68,7 +68,7 @@ def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
 
     Examples
     --------
-    >>> from motionhyst.validation import check_amplitudes
+    >>> from motionhyst.core.validation import check_amplitudes
     >>> check_amplitudes([0.0, 0.01])
     array([0.  , 0.01])
     """

@@ -14,9 +14,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import make_interp_spline
 
-from motionhyst.csvdata import Source, describe
+from motionhyst.core.lti import TWO_PI
+from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
-from motionhyst.systems import TWO_PI
 
 
 @dataclass(frozen=True)

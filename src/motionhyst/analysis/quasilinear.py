@@ -31,10 +31,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
+from motionhyst.analysis.margins import LoopMargins, loop_margins
+from motionhyst.core.lti import TWO_PI, freqresp
+from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
-from motionhyst.margins import LoopMargins, loop_margins
-from motionhyst.systems import TWO_PI, MeasuredPlant, TwoMassStage, freqresp
-from motionhyst.textfmt import g, table
+from motionhyst.plants.measured import MeasuredPlant
+from motionhyst.plants.two_mass import TwoMassStage
 
 
 def quasi_linear_plant(P1: ArrayLike, P2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
@@ -138,7 +140,7 @@ class QuasiLinearAnalysis:
         Frequency at which `D` is evaluated [Hz]; None for a rate-independent element.
     margins : LoopMargins or None
         Gain, phase and modulus margins of the linear loop ``C P2``
-        (:func:`motionhyst.margins.loop_margins`).
+        (:func:`motionhyst.analysis.margins.loop_margins`).
     unresolved : list of str
         For raw measured data (``use = "data"``), the quantities the data
         cannot give and why (they are nan): frequencies that are not measured
@@ -234,13 +236,13 @@ class QuasiLinearAnalysis:
 
     def plot(self):
         """The mismatch ``|E|`` (eq. 18) and its asymptote (eq. 20) at the analysed
-        frequencies, with the crossovers (:func:`motionhyst.figures.plot_analysis`).
+        frequencies, with the crossovers (:func:`motionhyst.present.figures.plot_analysis`).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.figures import plot_analysis
+        from motionhyst.present.figures import plot_analysis
 
         return plot_analysis(self)
 

@@ -173,8 +173,8 @@ class Profile:
     """A fourth-order setpoint: rest-to-rest moves, evaluated exactly.
 
     Build one with :func:`point_to_point` or :func:`scan`.  Calling it gives
-    position and acceleration, the interface of :mod:`motionhyst.references`
-    (and of :func:`motionhyst.simulate.simulate`).
+    position and acceleration, the interface of :mod:`motionhyst.time.references`
+    (and of :func:`motionhyst.time.simulation.simulate`).
 
     Attributes
     ----------

@@ -2,7 +2,7 @@
 
 Writes Figs. 5-11 (PNG and PDF), ``summary.json`` (the analyze and simulate
 results) and ``report.md`` into an output folder, through
-:class:`motionhyst.outputs.OutputFolder`: everything is computed first, then
+:class:`motionhyst.io.outputs.OutputFolder`: everything is computed first, then
 each file is staged in the folder and all are moved into place together and
 listed in the folder's manifest; the user's own files in the folder are never
 touched.
@@ -20,18 +20,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm import tqdm
 
-from motionhyst.figure_writer import FigureWriter
+from motionhyst.core.jsonio import dumps
 from motionhyst.hysteresis.periodic import TWO_PI
-from motionhyst.jsonio import dumps
-from motionhyst.outputs import OutputFolder
+from motionhyst.io.outputs import OutputFolder
+from motionhyst.present.figure_writer import FigureWriter
 from motionhyst.scenario import Scenario
 
 if TYPE_CHECKING:
     from motionhyst.analysis.digital import DigitalComparison
-    from motionhyst.frf_fit import FrfFit
+    from motionhyst.analysis.quasilinear import QuasiLinearAnalysis
+    from motionhyst.analysis.steady import SteadyState
     from motionhyst.hysteresis import Hysteresis
-    from motionhyst.quasilinear import QuasiLinearAnalysis
-    from motionhyst.steady import SteadyState
+    from motionhyst.plants.frf_fit import FrfFit
 
 # Numbers the paper states for Table I (section V and Fig. 8).
 PAPER_VALUES = {
@@ -153,8 +153,8 @@ def _report_text(sc: Scenario, link: Hysteresis, analysis: QuasiLinearAnalysis,
     if fit is not None:
         lines += ["", "## Measured plant", "",
                   "The measured plant is fitted to a rigid body plus flexible modes "
-                  "(`motionhyst.frf_fit`); every number and figure of this report comes from "
-                  "the fitted model.", "", "```", str(fit), "```"]
+                  "(`motionhyst.plants.frf_fit`); every number and figure of this report comes "
+                  "from the fitted model.", "", "```", str(fit), "```"]
     if states:
         lines += ["", "Mismatch at the reference frequencies: describing function (eq. 18) "
                   "against the exact periodic steady state of the nonlinear loop.", "",
@@ -198,8 +198,8 @@ OUTPUT_NAMES = (*(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf")), "sum
 
 
 def _plots():
-    """:mod:`motionhyst.plots`, imported where a figure is drawn (it imports matplotlib)."""
-    from motionhyst import plots
+    """:mod:`motionhyst.present.plots`, imported where a figure is drawn (it imports matplotlib)."""
+    from motionhyst.present import plots
 
     return plots
 
@@ -208,7 +208,7 @@ def _link_figures(el: Hysteresis, A: float, freqs: list[float]) -> dict:
     """The figures of the link alone (Figs. 5-8): they need neither the loop nor its analysis.
 
     Fig. 8 marks the operating point ``zeta = fc / (k A)`` of the reference
-    amplitude (eq. 4), the zeta :func:`~motionhyst.quasilinear.analyze`
+    amplitude (eq. 4), the zeta :func:`~motionhyst.analysis.quasilinear.analyze`
     reports; Figs. 6-7 only for a link with the Jenkins element's slip modes.
     """
     zeta_op = float(el.zeta(A)) if el.defines_zeta else None
@@ -229,7 +229,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
               inputs: Iterable[str | Path | None] = ()) -> dict:
     """Write the figures, ``summary.json`` and ``report.md`` for scenario `sc` into `out_dir`.
 
-    The folder is an :class:`~motionhyst.outputs.OutputFolder`: it may hold
+    The folder is an :class:`~motionhyst.io.outputs.OutputFolder`: it may hold
     the user's own files, which are never touched; the report's files are
     listed in its manifest and replaced by a later run; the files are staged
     once everything has been computed and moved into place together, so a run
@@ -257,7 +257,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
 
     Raises
     ------
-    motionhyst.outputs.OutputError
+    motionhyst.io.outputs.OutputError
         Before any computation, if `out_dir` is a file or a symbolic link, or
         holds a file of the report's names that motionhyst did not write and
         `force` is false.
@@ -285,9 +285,9 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             # (python-control) and builds the loop; the later workers inherit both from this
             # process (python-control imports matplotlib)
             figures.submit(_link_figures(el, A, freqs))
-            from motionhyst.quasilinear import analyze, error_harmonics_df, loop_mismatch
-            from motionhyst.steady import periodic_steady_state
-            from motionhyst.systems import MeasuredPlant
+            from motionhyst.analysis.quasilinear import analyze, error_harmonics_df, loop_mismatch
+            from motionhyst.analysis.steady import periodic_steady_state
+            from motionhyst.plants.measured import MeasuredPlant
 
             loop = sc.loop()
             analysis = analyze(loop, A, freqs)

@@ -15,7 +15,9 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from motionhyst.figures import (
+from motionhyst.hysteresis import Hysteresis, Jenkins
+from motionhyst.hysteresis.periodic import TWO_PI
+from motionhyst.present.figures import (
     LINEAR_COLOR,
     MODE2_COLOR,
     MODE3_COLOR,
@@ -23,13 +25,11 @@ from motionhyst.figures import (
     _figure,
     _minor_log_ticks,
 )
-from motionhyst.hysteresis import Hysteresis, Jenkins
-from motionhyst.hysteresis.periodic import TWO_PI
 
 if TYPE_CHECKING:
+    from motionhyst.analysis.quasilinear import QuasiLinearAnalysis
+    from motionhyst.analysis.steady import SteadyState
     from motionhyst.loop import Loop
-    from motionhyst.quasilinear import QuasiLinearAnalysis
-    from motionhyst.steady import SteadyState
 
 
 def _phase_deg(P) -> np.ndarray:
@@ -40,7 +40,7 @@ def _phase_deg(P) -> np.ndarray:
 
 def _grid(loop: Loop, f_range, n: int) -> np.ndarray:
     """`n` log-spaced frequencies in `f_range` [Hz]; for raw measured data its lines there."""
-    from motionhyst.systems import MeasuredPlant
+    from motionhyst.plants.measured import MeasuredPlant
 
     if isinstance(loop.plant, MeasuredPlant):
         f = loop.plant.frequency_hz
@@ -89,7 +89,7 @@ def describing_function_curve(el: Hysteresis, A: float, omega: ArrayLike, stride
     --------
     >>> import numpy as np
     >>> from motionhyst import LuGre
-    >>> from motionhyst.plots import describing_function_curve
+    >>> from motionhyst.present.plots import describing_function_curve
     >>> el = LuGre(sigma0=20.0, sigma1=0.1, sigma2=0.01, fc=0.05, fs=0.06, vs=0.01)
     >>> w = 2 * np.pi * np.geomspace(0.1, 100.0, 200)
     >>> D = describing_function_curve(el, 0.01, w)
@@ -360,9 +360,10 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     ``fig.motionhyst_data`` holds the scenario's curves (``f``, ``P2``,
     ``zeta=...``) and the paper's with the prefix ``paper_``.
     """
+    from motionhyst.analysis.quasilinear import f_star
+    from motionhyst.core.lti import freqresp
     from motionhyst.hysteresis import Jenkins as _Jenkins
-    from motionhyst.quasilinear import f_star
-    from motionhyst.systems import TwoMassStage, freqresp
+    from motionhyst.plants.two_mass import TwoMassStage
 
     el = loop.hysteresis
     with matplotlib.rc_context(STYLE):
@@ -404,8 +405,9 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
 def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
     """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
-    from motionhyst.quasilinear import _resolved, loop_mismatch, mismatch_asymptote
-    from motionhyst.systems import MeasuredPlant, freqresp
+    from motionhyst.analysis.quasilinear import _resolved, loop_mismatch, mismatch_asymptote
+    from motionhyst.core.lti import freqresp
+    from motionhyst.plants.measured import MeasuredPlant
 
     fig, (ax,) = _figure()
     f = _grid(loop, f_range, 800)

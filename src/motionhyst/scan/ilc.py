@@ -29,9 +29,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
 
+from motionhyst.core.lti import TWO_PI
 from motionhyst.loop import Loop
-from motionhyst.simulate import Simulation, default_step, simulate
-from motionhyst.systems import TWO_PI
+from motionhyst.time.simulation import Simulation, default_step, simulate
 
 
 @dataclass(frozen=True)
@@ -193,7 +193,7 @@ def learn(loop: Loop, reference, duration: float, trials: int = 10,
     loop : Loop
         The loop (its link included); any hysteresis feedforward in it stays on.
     reference : callable
-        The setpoint, ``reference(t) -> (r, r'')`` (e.g. a :mod:`motionhyst.profiles` profile).
+        The setpoint, ``reference(t) -> (r, r'')`` (e.g. a :mod:`motionhyst.scan.profiles` profile).
     duration : float
         Length of a trial [s].
     trials : int
@@ -201,7 +201,7 @@ def learn(loop: Loop, reference, duration: float, trials: int = 10,
     filters : ILCFilters, optional
         Learning and robustness filters (default ``ILCFilters()``).
     dt : float, optional
-        Time step [s]; by default :func:`~motionhyst.simulate.default_step`.
+        Time step [s]; by default :func:`~motionhyst.time.simulation.default_step`.
     first : Simulation, optional
         The first trial if already simulated (same loop, reference, grid).
 
@@ -212,7 +212,7 @@ def learn(loop: Loop, reference, duration: float, trials: int = 10,
     Examples
     --------
     >>> from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage
-    >>> from motionhyst.profiles import point_to_point
+    >>> from motionhyst.scan.profiles import point_to_point
     >>> loop = Loop(TwoMassStage(5.0, 17.5, 90.0, 7.4e7), LeadLagLowpass(6.2e6, 60, 240, 700, 0.6),
     ...             Jenkins(20.0, 0.05))
     >>> p = point_to_point(0.005, 0.2, 20.0, 2000.0, 1e6, start=0.005)

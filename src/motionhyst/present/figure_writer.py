@@ -110,7 +110,7 @@ def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[
 
     A kernel compiled here is not announced on stderr: the caller announces its own.
     """
-    from motionhyst._jit import quiet_compilation
+    from motionhyst.core.compiled import quiet_compilation
 
     quiet_compilation()
     # the caller ends its workers (FigureWriter.close, with SIGTERM), whatever handlers it has:
@@ -173,9 +173,9 @@ class FigureWriter:
     --------
     >>> import tempfile
     >>> from pathlib import Path
-    >>> from motionhyst.figure_writer import FigureWriter
+    >>> from motionhyst.present.figure_writer import FigureWriter
     >>> from motionhyst.hysteresis import Jenkins
-    >>> from motionhyst.plots import fig5_loops, fig8_describing_function
+    >>> from motionhyst.present.plots import fig5_loops, fig8_describing_function
     >>> el = Jenkins(k=20.0, fc=0.05)
     >>> folder = Path(tempfile.mkdtemp())
     >>> with FigureWriter(folder, ("png", "pdf")) as figures:
@@ -309,8 +309,8 @@ def save_figures(makers: dict[str, FigureMaker], folder: str | Path,
     >>> import tempfile
     >>> from pathlib import Path
     >>> from motionhyst.hysteresis import Jenkins
-    >>> from motionhyst.figure_writer import save_figures
-    >>> from motionhyst.plots import fig5_loops, fig8_describing_function
+    >>> from motionhyst.present.figure_writer import save_figures
+    >>> from motionhyst.present.plots import fig5_loops, fig8_describing_function
     >>> el = Jenkins(k=20.0, fc=0.05)
     >>> folder = Path(tempfile.mkdtemp())
     >>> save_figures({"fig5": lambda: fig5_loops(el), "fig8": lambda: fig8_describing_function(el)},

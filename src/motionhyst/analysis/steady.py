@@ -36,11 +36,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.lti import TWO_PI
 from motionhyst.core.sampling import hold_response
+from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
-from motionhyst.systems import TWO_PI, MeasuredPlant
-from motionhyst.textfmt import g, table
+from motionhyst.plants.measured import MeasuredPlant
 
 MIN_HARMONICS = 32
 MAX_HARMONICS = 4096
@@ -172,13 +173,13 @@ class SteadyState:
 
     def plot(self):
         """One period of the error, with and without hysteresis
-        (:func:`motionhyst.figures.plot_steady_state`).
+        (:func:`motionhyst.present.figures.plot_steady_state`).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.figures import plot_steady_state
+        from motionhyst.present.figures import plot_steady_state
 
         return plot_steady_state(self)
 
@@ -346,7 +347,7 @@ def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:
 
     Examples
     --------
-    >>> from motionhyst.steady import samples_per_period
+    >>> from motionhyst.analysis.steady import samples_per_period
     >>> samples_per_period(10e3, 5.0)
     2000
     >>> try:

@@ -3,9 +3,9 @@
 Each function returns a matplotlib :class:`~matplotlib.figure.Figure` (not
 attached to pyplot, so nothing is shown or kept open) and attaches the
 plotted data as ``fig.motionhyst_data``.  The paper's figures are in
-:mod:`motionhyst.plots`, in the same style.  This module imports no analysis:
+:mod:`motionhyst.present.plots`, in the same style.  This module imports no analysis:
 the results call it (lazily) from their ``plot()`` methods.  Figures are
-saved several at a time by :mod:`motionhyst.figure_writer` (its
+saved several at a time by :mod:`motionhyst.present.figure_writer` (its
 :class:`FigureWriter` and :func:`save_figures` are also importable from here).
 
 Examples
@@ -23,7 +23,7 @@ import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
-from motionhyst.figure_writer import FigureWriter, save_figures
+from motionhyst.present.figure_writer import FigureWriter, save_figures
 
 __all__ = ["STYLE", "DecadeFormatter", "FigureWriter", "MinorLogLocator", "plot_analysis",
            "plot_frf_fit", "plot_steady_state", "save_figures"]
@@ -54,7 +54,7 @@ class MinorLogLocator(matplotlib.ticker.LogLocator):
 
     Examples
     --------
-    >>> from motionhyst.figures import MinorLogLocator
+    >>> from motionhyst.present.figures import MinorLogLocator
     >>> MinorLogLocator().tick_values(1.0, 100.0).tolist()
     [0.2, 0.5, 2.0, 5.0, 20.0, 50.0, 200.0, 500.0]
     >>> MinorLogLocator(max_decades=6).tick_values(1e-1, 1e7).tolist()
@@ -85,7 +85,7 @@ class DecadeFormatter(matplotlib.ticker.LogFormatterSciNotation):
 
     Examples
     --------
-    >>> from motionhyst.figures import DecadeFormatter
+    >>> from motionhyst.present.figures import DecadeFormatter
     >>> DecadeFormatter()(0.01), DecadeFormatter()(1000.0)
     ('10⁻²', '10³')
     """
@@ -125,17 +125,19 @@ def _figure(nrows: int = 1, sharex: bool = True):
 
 
 def plot_analysis(analysis) -> Figure:
-    """The mismatch of a :class:`~motionhyst.quasilinear.QuasiLinearAnalysis` at its frequencies.
+    """The mismatch of a quasi-linear analysis at its frequencies.
+
+    `analysis` is a :class:`~motionhyst.analysis.quasilinear.QuasiLinearAnalysis`.
 
     ``|E|`` (eq. 18) and the asymptote ``|E~|`` (eq. 20) at the analysed
     frequencies, the crossover of eq. (21) and the exact crossover
-    ``|E - 1| = 1``.  (:func:`motionhyst.plots.fig10_mismatch` draws the same on a dense grid
+    ``|E - 1| = 1``.  (:func:`~motionhyst.present.plots.fig10_mismatch` draws it on a dense grid
     from the loop.)
 
     Examples
     --------
     >>> from motionhyst import analyze, default_scenario
-    >>> from motionhyst.figures import plot_analysis
+    >>> from motionhyst.present.figures import plot_analysis
     >>> fig = plot_analysis(analyze(default_scenario().loop(), 0.01, [5.0, 10.0, 15.0]))
     >>> type(fig).__name__                                 # save it with fig.savefig(...)
     'Figure'
@@ -161,13 +163,13 @@ def plot_analysis(analysis) -> Figure:
 
 
 def plot_steady_state(state) -> Figure:
-    """One period of a :class:`~motionhyst.steady.SteadyState`: the error with and without
+    """One period of a :class:`~motionhyst.analysis.steady.SteadyState`: the error with and without
     hysteresis.
 
     Examples
     --------
     >>> from motionhyst import default_scenario, periodic_steady_state
-    >>> from motionhyst.figures import plot_steady_state
+    >>> from motionhyst.present.figures import plot_steady_state
     >>> fig = plot_steady_state(periodic_steady_state(default_scenario().loop(), 0.01, 5.0))
     >>> len(fig.axes) >= 1
     True
@@ -189,16 +191,16 @@ def plot_steady_state(state) -> Figure:
 def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
     """Bode figure of a measured plant (markers) and its rigid-body + modes fit (lines).
 
-    `fit` is a :class:`motionhyst.frf_fit.FrfFit`.  The fitted ``P1`` and
+    `fit` is a :class:`motionhyst.plants.frf_fit.FrfFit`.  The fitted ``P1`` and
     ``P2`` are drawn densely (so a resonance between measured lines shows),
     with the fitted modes' frequencies marked.
 
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.figures import plot_frf_fit
-    >>> from motionhyst.frf_fit import ModalPlant, fit_frf
-    >>> from motionhyst.systems import TwoMassStage
+    >>> from motionhyst.present.figures import plot_frf_fit
+    >>> from motionhyst.plants.frf_fit import ModalPlant, fit_frf
+    >>> from motionhyst.plants.two_mass import TwoMassStage
     >>> exact = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
     >>> f = np.geomspace(1.0, 3000.0, 60)
     >>> fig = plot_frf_fit(fit_frf(f, *exact.response(2 * np.pi * f)))
@@ -285,7 +287,7 @@ def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:
 
 
 def plot_simulation(sim) -> Figure:
-    """A :class:`~motionhyst.simulate.Simulation`: the error with and without the link, and
+    """A :class:`~motionhyst.time.simulation.Simulation`: the error with and without the link, and
     the link force, against time.
 
     Examples

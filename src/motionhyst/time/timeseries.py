@@ -1,6 +1,6 @@
 """Long transient runs written as they are computed, and summaries that separate the start-up.
 
-:func:`run_time_series` drives :func:`motionhyst.simulate.simulate_chunks`:
+:func:`run_time_series` drives :func:`motionhyst.time.simulation.simulate_chunks`:
 the integration step follows the loop's dynamics (and a built-in reference's
 own time scale), never the sample rate of a reference file; rows are written
 at the output rate only, chunk by chunk, so memory stays bounded whatever the
@@ -23,15 +23,15 @@ from typing import IO
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.lti import TWO_PI
 from motionhyst.loop import Loop
-from motionhyst.references import PointToPoint, SampledReference, SineReference
-from motionhyst.simulate import (
+from motionhyst.time.references import PointToPoint, SampledReference, SineReference
+from motionhyst.time.simulation import (
     STEPS_PER_POLE_PERIOD,
     STEPS_PER_REFERENCE_PERIOD,
     Simulation,
     simulate_chunks,
 )
-from motionhyst.systems import TWO_PI
 
 DEFAULT_OUTPUT_RATE_HZ = 10_000.0
 """Output rate of built-in references (sines, profiles) unless one is asked for [Hz]."""
@@ -49,7 +49,7 @@ ROWS_PER_CHUNK = 8192
 """Output rows computed and written at a time."""
 
 COLUMNS = ("time", "reference", "error", "y1", "y2", "u", "w", "error_linear")
-"""Columns of the CSV, in order (as :meth:`motionhyst.simulate.Simulation.columns`)."""
+"""Columns of the CSV, in order (as :meth:`motionhyst.time.simulation.Simulation.columns`)."""
 
 
 def dynamics_step(loop: Loop, reference) -> float:
@@ -61,7 +61,7 @@ def dynamics_step(loop: Loop, reference) -> float:
     Examples
     --------
     >>> from motionhyst.scenario import default_scenario
-    >>> from motionhyst.references import SineReference
+    >>> from motionhyst.time.references import SineReference
     >>> loop = default_scenario().loop()
     >>> h = dynamics_step(loop, SineReference(0.01, 5.0))
     >>> 1e-6 < h < 1e-4
@@ -144,7 +144,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     Parameters
     ----------
     loop : Loop
-        An LTI loop (see :func:`motionhyst.simulate.simulate`).
+        An LTI loop (see :func:`motionhyst.time.simulation.simulate`).
     reference : SineReference, PointToPoint, SampledReference or callable
         The reference; a sine or a point-to-point move gets its own summary.
     duration : float
@@ -176,7 +176,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     --------
     >>> import io
     >>> from motionhyst.scenario import default_scenario
-    >>> from motionhyst.references import SineReference
+    >>> from motionhyst.time.references import SineReference
     >>> buf = io.StringIO()
     >>> s = run_time_series(default_scenario().loop(), SineReference(0.01, 10.0), 0.2, buf,
     ...                     output_rate_hz=1000.0)

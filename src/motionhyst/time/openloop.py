@@ -43,7 +43,7 @@ system is then integrated with a fine fixed step, ``substeps`` per sample
   when asked (they are what :mod:`motionhyst.identify.input_output` fits with);
 * the other links: the stage discretised exactly for a force linear between
   fine steps (first-order hold) and the link advanced by its exact update
-  (as :func:`motionhyst.simulate.simulate`), implicit in ``w`` and solved by a
+  (as :func:`motionhyst.time.simulation.simulate`), implicit in ``w`` and solved by a
   fixed-point iteration; second order in the step.  One compiled run
   (:func:`simulate_elements`) for both plants, with the forward sensitivities
   of the output to the plant's and the link's parameters when asked.
@@ -58,7 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, resample_poly
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.hysteresis.stepping import (
     COULOMB,
@@ -73,7 +73,7 @@ from motionhyst.hysteresis.stepping import (
     coulomb_implicit,
 )
 from motionhyst.plants.mechanics import Mechanics
-from motionhyst.simulate import MAX_FIXED_POINT_ITERATIONS
+from motionhyst.time.simulation import MAX_FIXED_POINT_ITERATIONS
 
 #: Names of the general Bouc-Wen parameters the compiled integrator carries (sensitivity order).
 BW_PARAMETERS = ("m", "c", "k", "alpha", "beta_gamma", "beta_delta", "nu")
@@ -168,7 +168,7 @@ class TwoMass:
     the force ``u`` on the actuated mass ``m1``, where the link acts (its
     force ``w`` a function of ``y1``), the output the position `output` of
     the point of control ``y2`` (default) or of ``m1``.  The same stage as
-    :class:`motionhyst.systems.TwoMassStage` without a controller.
+    :class:`motionhyst.plants.two_mass.TwoMassStage` without a controller.
 
     No spring holds the stage to the ground except the link: with a link that
     has no stiffness (or none, ``w = 0``) a force with a nonzero mean makes the
@@ -248,8 +248,8 @@ class TwoMass:
                          [Z, Z, D, Z], [Z, Z, Z, D], 0, 0 if self.output == "y1" else 1)
 
     def stage(self):
-        """The same stage for the closed loop (:class:`motionhyst.systems.TwoMassStage`)."""
-        from motionhyst.systems import TwoMassStage
+        """The same stage for the closed loop (:class:`motionhyst.plants.two_mass.TwoMassStage`)."""
+        from motionhyst.plants.two_mass import TwoMassStage
 
         return TwoMassStage(self.m1, self.m2, self.b, self.k)
 

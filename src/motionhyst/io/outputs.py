@@ -65,7 +65,7 @@ class OutputError(ValueError):
     --------
     >>> import tempfile
     >>> from pathlib import Path
-    >>> from motionhyst.outputs import OutputError, OutputFile
+    >>> from motionhyst.io.outputs import OutputError, OutputFile
     >>> path = Path(tempfile.mkdtemp()) / "run.csv"
     >>> _ = path.write_text("time\\n")
     >>> try:
@@ -122,7 +122,7 @@ def check_not_input(path: str | os.PathLike, inputs: Iterable[str | os.PathLike 
     >>> check_not_input("a.csv", ["./a.csv"], "--time-series")
     Traceback (most recent call last):
     ...
-    motionhyst.outputs.OutputError: --time-series a.csv: it is an input of this command; \
+    motionhyst.io.outputs.OutputError: --time-series a.csv: it is an input of this command; \
 choose another output file
     """
     path = Path(path)
@@ -206,7 +206,7 @@ class OutputFile:
     --------
     >>> import tempfile
     >>> from pathlib import Path
-    >>> from motionhyst.outputs import OutputFile
+    >>> from motionhyst.io.outputs import OutputFile
     >>> path = Path(tempfile.mkdtemp()) / "summary.txt"
     >>> OutputFile(path).write_text("written atomically\\n")
     >>> path.read_text()

@@ -3,7 +3,7 @@
 Paper section V: the quasi-linear mismatch of eq. (18) and the error
 harmonics predicted by the higher-order describing functions, compared per
 frequency with the exact steady state of the nonlinear loop
-(:func:`~motionhyst.steady.periodic_steady_state`).  This is the one module
+(:func:`~motionhyst.analysis.steady.periodic_steady_state`).  This is the one module
 that needs both analyses; neither of them imports the other.
 
 Examples
@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
+from motionhyst.analysis.steady import SteadyState, steady_state_sweep
+from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
-from motionhyst.quasilinear import error_harmonics_df, loop_mismatch
-from motionhyst.steady import SteadyState, steady_state_sweep
-from motionhyst.textfmt import g, table
 
 
 @dataclass
@@ -104,7 +104,7 @@ class DescribingFunctionComparison:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.plots import fig11_errors
+        from motionhyst.present.plots import fig11_errors
 
         return fig11_errors([p.state for p in self.points],
                             [p.mismatch_df for p in self.points],

@@ -12,11 +12,11 @@ centred window ``|t_k - t| <= W / 2`` (population standard deviation)::
 Their maxima are taken over the constant-velocity phases, at the centres
 whose whole window lies inside the phase (the points a scan exposes).
 
-:func:`run_scan` simulates a setpoint profile (:mod:`motionhyst.profiles`)
+:func:`run_scan` simulates a setpoint profile (:mod:`motionhyst.scan.profiles`)
 from rest with the loop's dynamic link and compares compensations: ``none``
 (rigid-body feedforward only), ``model`` (the loop's hysteresis feedforward
 ``phi_hat(r)``, driven by the setpoint) and ``ilc`` (a force learned over
-trials, :mod:`motionhyst.ilc`); and, on another setpoint, whether the learned
+trials, :mod:`motionhyst.scan.ilc`); and, on another setpoint, whether the learned
 force and the model carry over.
 """
 
@@ -28,12 +28,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst._jit import njit
-from motionhyst.ilc import ILCFilters, ILCResult, learn
+from motionhyst.core.compiled import njit
+from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
-from motionhyst.profiles import PHASE_COLORS, Profile, shade_phases
-from motionhyst.simulate import default_step, simulate
-from motionhyst.textfmt import g, table
+from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
+from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
+from motionhyst.time.simulation import default_step, simulate
 
 COMPENSATIONS = ("none", "model", "ilc")
 """The compensations :func:`run_scan` compares."""
@@ -370,7 +370,7 @@ def run_scan(loop: Loop, profile: Profile, window: float,
     Examples
     --------
     >>> from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage
-    >>> from motionhyst.profiles import scan
+    >>> from motionhyst.scan.profiles import scan
     >>> loop = Loop(TwoMassStage(5.0, 17.5, 90.0, 7.4e7), LeadLagLowpass(6.2e6, 60, 240, 700, 0.6),
     ...             Jenkins(20.0, 0.05))
     >>> p = scan(0.01, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)

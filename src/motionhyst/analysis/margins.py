@@ -42,9 +42,8 @@ from numpy.typing import NDArray
 from scipy.optimize import brentq, minimize_scalar
 
 from motionhyst.controllers.sampled import SampledController
+from motionhyst.core.lti import TWO_PI, freqresp, tf_poly, trim
 from motionhyst.core.sampling import ZohEquivalent
-from motionhyst.lti import tf_poly, trim
-from motionhyst.systems import TWO_PI, freqresp
 
 BANDWIDTH_DEFINITION = ("crossover frequency: the lowest frequency where |L| = |C P2| falls "
                         "through 1 (0 dB)")
@@ -181,8 +180,9 @@ def loop_margins(controller, plant, zoh: ZohEquivalent | None = None) -> LoopMar
 
     Examples
     --------
-    >>> from motionhyst.margins import loop_margins
-    >>> from motionhyst.systems import LeadLagLowpass, TwoMassStage
+    >>> from motionhyst.analysis.margins import loop_margins
+    >>> from motionhyst.controllers.leadlag import LeadLagLowpass
+    >>> from motionhyst.plants.two_mass import TwoMassStage
     >>> m = loop_margins(LeadLagLowpass(6.2e6, 60.0, 240.0, 700.0, 0.6),
     ...                  TwoMassStage(5.0, 17.5, 90.0, 7.4e7).P2)
     >>> round(m.bandwidth_hz, 1), round(m.phase_margin_deg, 1), round(m.modulus_margin, 3)

@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm, solve
 from scipy.signal import cont2discrete, zpk2ss
 
-from motionhyst._jit import njit
+from motionhyst.core.compiled import njit
 
 __all__ = ["HoldFilter", "PolyTF", "cancel_s", "discretize_foh", "divide_s2", "dss_filter",
            "expm_small", "forced_response_foh", "polyratio", "polysub_exact", "realize_scaled",
@@ -50,7 +50,7 @@ def tf_poly(sys, what: str = "plant and controller"
     Examples
     --------
     >>> import control
-    >>> from motionhyst.lti import tf_poly
+    >>> from motionhyst.core.lti import tf_poly
     >>> tf_poly(control.tf([1.0], [1.0, 2.0]))
     (array([1.]), array([1., 2.]))
     """
@@ -63,13 +63,38 @@ def tf_poly(sys, what: str = "plant and controller"
     return np.atleast_1d(np.asarray(sys.num[0][0], float)), np.atleast_1d(
         np.asarray(sys.den[0][0], float))
 
+TWO_PI = 2.0 * np.pi
+
+
+def freqresp(sys, omega: ArrayLike) -> NDArray[np.complex128]:
+    """Complex frequency response of a SISO python-control system at `omega` [rad/s].
+
+    Works for transfer functions, state-space systems and frequency-response
+    data (interpolated between measured points).
+    """
+    w = np.atleast_1d(np.asarray(omega, dtype=float))
+    if isinstance(sys, control.FrequencyResponseData):
+        return np.asarray(sys.eval(w, squeeze=True), dtype=complex).reshape(w.shape)
+    if isinstance(sys, control.StateSpace):
+        sys = control.ss2tf(sys)
+    if isinstance(sys, control.TransferFunction):
+        num = np.asarray(sys.num_array[0, 0], dtype=float) if hasattr(sys, "num_array") else \
+            np.asarray(sys.num[0][0], dtype=float)
+        den = np.asarray(sys.den_array[0, 0], dtype=float) if hasattr(sys, "den_array") else \
+            np.asarray(sys.den[0][0], dtype=float)
+        s = 1j * w
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.polyval(num, s) / np.polyval(den, s)
+    raise TypeError(f"unsupported system type {type(sys).__name__}")
+
+
 
 def trim(p: ArrayLike) -> NDArray[np.float64]:
     """Drop leading coefficients that are exactly zero.
 
     Examples
     --------
-    >>> from motionhyst.lti import trim
+    >>> from motionhyst.core.lti import trim
     >>> trim([0.0, 0.0, 1.0, 2.0])
     array([1., 2.])
     """
@@ -83,7 +108,7 @@ def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np
 
     Examples
     --------
-    >>> from motionhyst.lti import polysub_exact
+    >>> from motionhyst.core.lti import polysub_exact
     >>> polysub_exact([1.0, 0.1 + 0.2, 1.0], [1.0, 0.3, 0.0])   # 0.1 + 0.2 - 0.3 is 5.6e-17
     array([0., 0., 1.])
     """
@@ -102,7 +127,7 @@ def cancel_s(num: ArrayLike, den: ArrayLike) -> tuple[NDArray[np.float64], NDArr
 
     Examples
     --------
-    >>> from motionhyst.lti import cancel_s
+    >>> from motionhyst.core.lti import cancel_s
     >>> cancel_s([1.0, 0.0], [1.0, 2.0, 0.0])               # s / (s^2 + 2 s) = 1 / (s + 2)
     (array([1.]), array([1., 2.]))
     """
@@ -123,7 +148,7 @@ def divide_s2(num: ArrayLike, den: ArrayLike, what: str
 
     Examples
     --------
-    >>> from motionhyst.lti import divide_s2
+    >>> from motionhyst.core.lti import divide_s2
     >>> divide_s2([1.0, 0.0, 0.0], [1.0, 1.0], "r->e")      # s^2 / ((s + 1) s^2)
     (array([1.]), array([1., 1.]))
     """
@@ -157,7 +182,7 @@ class PolyTF:
     Examples
     --------
     >>> import numpy as np
-    >>> from motionhyst.lti import PolyTF
+    >>> from motionhyst.core.lti import PolyTF
     >>> lowpass = PolyTF(np.array([1.0]), np.array([1.0, 1.0]))   # 1 / (s + 1)
     >>> lowpass(np.array([0.0, 1.0]))
     array([1. +0.j , 0.5-0.5j])
@@ -182,7 +207,7 @@ def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
 
     Examples
     --------
-    >>> from motionhyst.lti import realize_scaled
+    >>> from motionhyst.core.lti import realize_scaled
     >>> A, B, C, D = realize_scaled([1.0], [1.0, 100.0], 100.0)   # 1 / (s + 100), time 100 t
     >>> float(A[0, 0]), float(B[0, 0] * C[0, 0])
     (-1.0, 0.01)
@@ -200,7 +225,7 @@ def stack(mats):
 
     Examples
     --------
-    >>> from motionhyst.lti import realize_scaled, stack
+    >>> from motionhyst.core.lti import realize_scaled, stack
     >>> A, B, C, D = stack([realize_scaled([1.0], [1.0, 1.0], 1.0),
     ...                     realize_scaled([2.0], [1.0, 2.0], 1.0)])   # one input, two outputs
     >>> A.shape, B.shape, C.shape, D.shape
@@ -326,7 +351,7 @@ def discretize_foh(sys, h: float):
     Examples
     --------
     >>> import control
-    >>> from motionhyst.lti import discretize_foh
+    >>> from motionhyst.core.lti import discretize_foh
     >>> sys = control.ss(control.tf([1.0], [1.0, 1.0]))
     >>> Ad, Bd, Cd, Dd = discretize_foh((sys.A, sys.B, sys.C, sys.D), 0.1)
     >>> round(float(Ad[0, 0]), 6)                          # exp(-0.1)
@@ -470,7 +495,7 @@ def forced_response_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> 
     --------
     >>> import control
     >>> import numpy as np
-    >>> from motionhyst.lti import forced_response_foh
+    >>> from motionhyst.core.lti import forced_response_foh
     >>> sys = control.tf([1.0], [1.0, 1.0])
     >>> t = np.linspace(0.0, 5.0, 501)
     >>> y = forced_response_foh(sys, t, np.ones_like(t))   # step response from rest
@@ -509,7 +534,7 @@ class HoldFilter:
     A 10 Hz first-order low-pass sampled at 1 kHz:
 
     >>> import numpy as np
-    >>> from motionhyst.lti import HoldFilter
+    >>> from motionhyst.core.lti import HoldFilter
     >>> wc = 2 * np.pi * 10.0
     >>> lowpass = HoldFilter(zeros=[], poles=[-wc], gain=wc, dt=1e-3, omega0=wc)
     >>> round(lowpass.dc_gain, 12)

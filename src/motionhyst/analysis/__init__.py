@@ -1,0 +1,3 @@
+"""Frequency-domain and periodic analyses of the loop: quasi-linear analysis, margins, exact
+periodic steady state, their comparison.
+"""

@@ -1,0 +1,156 @@
+"""Plants known only by measured frequency responses of ``P1`` and ``P2``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.core.lti import TWO_PI
+from motionhyst.hysteresis.base import check_positive
+from motionhyst.io.csvdata import Source, describe
+from motionhyst.io.records import read_record, record_columns
+
+
+@dataclass(frozen=True)
+class MeasuredPlant:
+    """A plant known only by measured frequency responses of ``P1`` and ``P2``.
+
+    Attributes
+    ----------
+    P1, P2 : control.FrequencyResponseData
+        Collocated and non-collocated transfers [m/N].
+    M : float
+        Rigid-body mass [kg] of the feedforward ``M s^2``.
+    source : str
+        Where the data came from.
+    resolution : float or None
+        Relative scatter of the data (RMS of ``|P - P_smooth| / |P|``), the
+        smallest relative difference the data resolve; None if unknown.
+        ``Pf2 = Pr - P2`` is resolved only where ``|Pf2| / |P2|`` exceeds it.
+
+    Examples
+    --------
+    >>> import control
+    >>> import numpy as np
+    >>> from motionhyst import MeasuredPlant, TwoMassStage
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> omega = 2 * np.pi * np.geomspace(1.0, 1000.0, 100)
+    >>> plant = MeasuredPlant(P1=control.frd(stage.P1, omega), P2=control.frd(stage.P2, omega),
+    ...                       M=stage.M, source="Table I, sampled")
+    >>> plant.frequency_range_hz
+    (1.0, 1000.0...)
+    """
+
+    P1: control.FrequencyResponseData
+    P2: control.FrequencyResponseData
+    M: float
+    source: str = ""
+    resolution: float | None = None
+
+    @property
+    def frequency_hz(self) -> NDArray[np.float64]:
+        """The measured frequencies [Hz]."""
+        return np.asarray(self.P2.omega, dtype=float) / TWO_PI
+
+    def measured_line(self, frequency_hz: float, rtol: float = 1e-9) -> float | None:
+        """The measured frequency equal to `frequency_hz` (to `rtol`), else None."""
+        f = self.frequency_hz
+        i = int(np.argmin(np.abs(f - frequency_hz)))
+        return float(f[i]) if abs(f[i] - frequency_hz) <= rtol * frequency_hz else None
+
+    @property
+    def Pr(self) -> control.TransferFunction:
+        """Rigid-body model ``1 / (M s^2)``."""
+        return control.tf([1.0], [self.M, 0.0, 0.0])
+
+    @property
+    def frequency_range_hz(self) -> tuple[float, float]:
+        """Lowest and highest measured frequency [Hz]."""
+        w = self.P2.omega
+        return float(w.min() / TWO_PI), float(w.max() / TWO_PI)
+
+
+_FRD_COLUMNS = {
+    "reim": ("p1_re", "p1_im", "p2_re", "p2_im"),
+    "absphase": ("p1_abs", "p1_phase_deg", "p2_abs", "p2_phase_deg"),
+}
+
+
+def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
+    """Read a measured plant from CSV or MATLAB ``.mat`` (or a DataFrame with the same columns).
+
+    The file has a column (a MATLAB file: a vector variable) ``frequency_hz``, plus either
+    ``p1_re, p1_im, p2_re, p2_im`` or ``p1_abs, p1_phase_deg, p2_abs,
+    p2_phase_deg`` (magnitudes in m/N, phases in degrees).
+
+    Parameters
+    ----------
+    path : str, Path or DataFrame
+        CSV file (BOM, comma or semicolon, names in any case) or MATLAB file
+        (levels 4 to 7.3), read by :func:`motionhyst.io.records.read_record`;
+        or a DataFrame with those columns.
+    mass : float, optional
+        Rigid-body mass [kg]; if omitted, estimated from the lowest measured
+        decade as the median of ``-1 / (omega^2 Re P2)``.
+
+    Returns
+    -------
+    MeasuredPlant
+
+    Examples
+    --------
+    Write the Table I stage's responses as a measurement would give them, and read them back:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from motionhyst import TwoMassStage, load_frd_plant
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> f = np.geomspace(1.0, 2000.0, 300)
+    >>> p1, p2 = stage.P1(2j * np.pi * f), stage.P2(2j * np.pi * f)
+    >>> path = Path(tempfile.mkdtemp()) / "plant.csv"
+    >>> np.savetxt(path, np.column_stack([f, p1.real, p1.imag, p2.real, p2.imag]),
+    ...            delimiter=",", header="frequency_hz,p1_re,p1_im,p2_re,p2_im", comments="")
+    >>> plant = load_frd_plant(path)
+    >>> print(f"M = {plant.M:.3f} kg")                    # estimated from the lowest decade
+    M = 22.500 kg
+    >>> plant.frequency_range_hz
+    (1.0, 2000.0...)
+    """
+    where = describe(path)
+    names = record_columns(path)
+    header = set(names)
+    expected = (f"{', '.join(_FRD_COLUMNS['reim'])} or {', '.join(_FRD_COLUMNS['absphase'])}"
+                f" next to frequency_hz (found {','.join(names) or 'none'})")
+    if "frequency_hz" not in header:
+        raise ValueError(f"{where}: missing column 'frequency_hz'; need columns {expected}")
+    kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
+    if kind is None:
+        raise ValueError(f"{where}: need columns {expected}")
+    data = read_record(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
+    if not np.all(np.isfinite(data)):
+        raise ValueError(f"{where}: non-finite value in data")
+    f = data[:, 0]
+    if np.any(f <= 0) or np.any(np.diff(f) <= 0):
+        raise ValueError(f"{where}: frequency_hz must be positive and increasing")
+    if len(f) < 2:
+        raise ValueError(f"{where}: need at least two frequencies")
+    if kind == "reim":
+        p1 = data[:, 1] + 1j * data[:, 2]
+        p2 = data[:, 3] + 1j * data[:, 4]
+    else:
+        p1 = data[:, 1] * np.exp(1j * np.deg2rad(data[:, 2]))
+        p2 = data[:, 3] * np.exp(1j * np.deg2rad(data[:, 4]))
+    omega = TWO_PI * f
+    if mass is None:
+        low = f <= f[0] * 10
+        mass = float(np.median(-1.0 / (omega[low] ** 2 * p2[low].real)))
+        if not np.isfinite(mass) or mass <= 0:
+            raise ValueError(f"{where}: cannot estimate the rigid-body mass; give it explicitly")
+    mass = check_positive("mass", mass)
+    P1 = control.frd(p1, omega, smooth=len(f) > 3)
+    P2 = control.frd(p2, omega, smooth=len(f) > 3)
+    return MeasuredPlant(P1=P1, P2=P2, M=mass, source=where)

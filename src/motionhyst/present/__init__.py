@@ -1,0 +1,2 @@
+"""Presentation of results: figures, plots, the report.
+"""

@@ -1,0 +1,2 @@
+"""Scans: setpoint profiles, MA/MSD metrics, model feedforward and learning control.
+"""

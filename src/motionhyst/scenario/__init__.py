@@ -1,0 +1,23 @@
+"""Scenario files: the TOML description of a loop or an open-loop system, read into model objects.
+
+The schema and its reader are in :mod:`motionhyst.scenario.schema`; the paper's Table I is
+``data/paper.toml`` here and the default everywhere (:func:`default_scenario`).
+"""
+
+from motionhyst.scenario.schema import (
+    Scenario,
+    ScenarioError,
+    default_scenario,
+    default_scenario_path,
+    hysteresis_from_dict,
+    load_scenario,
+)
+
+__all__ = [
+    "Scenario",
+    "ScenarioError",
+    "default_scenario",
+    "default_scenario_path",
+    "hysteresis_from_dict",
+    "load_scenario",
+]

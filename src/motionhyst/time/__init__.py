@@ -1,0 +1,2 @@
+"""The loop in time: simulation, open-loop systems, long time series, references.
+"""
