@@ -48,7 +48,8 @@ from scipy.signal import BadCoefficients
 
 from motionhyst.core.lti import expm_small
 
-__all__ = ["ZohEquivalent", "hold_mismatch", "hold_response", "unit_circle_minus_one"]
+__all__ = ["HeldInputFilter", "ZohEquivalent", "hold_mismatch", "hold_response",
+           "unit_circle_minus_one"]
 
 
 def unit_circle_minus_one(theta: ArrayLike) -> NDArray[np.complex128]:
@@ -318,3 +319,82 @@ class ZohEquivalent:
             g = ga[None, :] * zinv[:, None] + gb[None, :]
             out += np.linalg.solve(M, g[..., None])[..., 0] @ C
         return (out * zinv**self.whole).reshape(w.shape)
+
+
+class HeldInputFilter:
+    """A strictly proper filter applied exactly to samples held from ``t_k + d T`` on.
+
+    A controller's output ``u_k`` acts on the plant as a staircase, held
+    ``d`` samples late; filtering the staircase exactly is filtering the
+    samples with the filter's pulse transfer function behind the delayed hold
+    (:class:`ZohEquivalent`), evaluated here in time scaled by `omega0` for
+    conditioning.  The output is the filtered staircase at ``t_k``; the filter
+    starts in steady state for the first sample held since ``-inf``.
+
+    Parameters
+    ----------
+    zeros, poles : array_like
+        Zeros and poles [rad/s] (conjugate pairs complete), fewer zeros than poles, no
+        pole at 0.
+    gain : float
+        Gain of the zero-pole-gain form.
+    period : float
+        Sampling period ``T`` [s].
+    delay_samples : float
+        ``d >= 0`` [samples].
+    omega0 : float
+        Time scale [rad/s] (e.g. the filter's cut-off).
+
+    Examples
+    --------
+    A 10 Hz low-pass seeing a step that a controller at 1 kHz applies one sample late:
+
+    >>> import numpy as np
+    >>> from motionhyst.core.sampling import HeldInputFilter
+    >>> wc = 2 * np.pi * 10.0
+    >>> f = HeldInputFilter([], [-wc], wc, 1e-3, 1.0, wc)
+    >>> y = f(np.r_[0.0, np.ones(3)])                 # the step computed at t_1, applied at t_2
+    >>> np.round(y, 6).tolist()                       # 1 - exp(-wc (t - t_2)) for t >= t_2
+    [0.0, 0.0, 0.0, 0.060899]
+    """
+
+    def __init__(self, zeros: ArrayLike, poles: ArrayLike, gain: float, period: float,
+                 delay_samples: float, omega0: float) -> None:
+        z = np.asarray(zeros, dtype=complex) / omega0
+        p = np.asarray(poles, dtype=complex) / omega0
+        if z.size >= p.size:
+            raise ValueError("the filter must be strictly proper")
+        if np.any(p == 0):
+            raise ValueError("the filter must not have a pole at s = 0")
+        g = float(gain) * omega0 ** (z.size - p.size)
+        num = np.real(np.poly(z)) * g if z.size else np.array([g])
+        den = np.real(np.poly(p))
+        self.zoh = ZohEquivalent(control.tf(num, den), omega0 * float(period),
+                                 float(delay_samples))
+        Phi, ga, gb, C = self.zoh.state_space()
+        self._mats = (Phi, ga, gb, C)
+        n = Phi.shape[0]
+        # steady state for a unit input held forever: x = Phi x + ga + gb
+        self._x_unit = np.linalg.solve(np.eye(n) - Phi, ga + gb)
+
+    def __call__(self, u: ArrayLike) -> NDArray[np.float64]:
+        """The filtered staircase at the sampling instants.
+
+        Parameters
+        ----------
+        u : array_like
+            The samples ``u_k`` (1-D).
+        """
+        Phi, ga, gb, C = self._mats
+        uu = np.asarray(u, dtype=float)
+        D = self.zoh.whole
+        pad = np.concatenate([np.full(D + 1, uu[0]), uu])
+        new = pad[1:uu.size + 1]                      # u_{k-D}
+        old = pad[:uu.size]                           # u_{k-D-1}
+        x = self._x_unit * uu[0]
+        out = np.empty(uu.size)
+        drive = np.outer(old, ga) + np.outer(new, gb)
+        for k in range(uu.size):
+            out[k] = C @ x
+            x = Phi @ x + drive[k]
+        return out

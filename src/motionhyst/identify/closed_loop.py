@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.signal import butter
 
 from motionhyst.core.lti import TWO_PI, HoldFilter, tf_poly
+from motionhyst.core.sampling import HeldInputFilter
 from motionhyst.identify.fit import (
     EXTRA_ORDER,
     MAX_ELEMENTS,
@@ -83,7 +84,7 @@ class LinkForce:
 
 
 def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
-                     cutoff_hz: float | None = None) -> LinkForce:
+                     cutoff_hz: float | None = None, controller=None) -> LinkForce:
     """Infer the link force ``w = u - P1^-1 y1`` from a closed-loop record (paper eq. 1).
 
     ``P1^-1`` is improper (for the two-mass stage ``s^2 (m1 m2 s^2 + b M s +
@@ -122,6 +123,12 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         Cut-off of ``B`` [Hz].  Default: 20 times the record's fundamental
         frequency (estimated from the number of reversals of `y1`), at most a
         twentieth of the sampling rate.
+    controller : SampledController, optional
+        The known discrete controller that produced `u`, the record taken at its
+        samples: ``u_k`` acted on the stage held from ``t_k + d T`` on, so ``L u``
+        is the exact response of ``L`` to that staircase
+        (:class:`~motionhyst.core.sampling.HeldInputFilter`) instead of to the
+        samples' linear interpolation.
 
     Returns
     -------
@@ -173,7 +180,16 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     L = HoldFilter(np.concatenate([zb, np.roots(num)]), pb, kb * num[0] / n0, dt, wl)
     L_over_P1 = HoldFilter(np.concatenate([zb, np.roots(den)]), pb, kb * den[0] / n0, dt, wl)
     # y1 enters through s^k factors: removing its first value keeps the filter well scaled
-    w_f = L(us) - L_over_P1(ys - ys[0])
+    if controller is not None:
+        if abs(dt - controller.period) > UNIFORM_RTOL * controller.period:
+            raise ValueError(f"the record's sampling interval {dt:g} s is not the controller's "
+                             f"period {controller.period:g} s")
+        held = HeldInputFilter(np.concatenate([zb, np.roots(num)]), pb, kb * num[0] / n0,
+                               controller.period, controller.delay_samples, wl)
+        Lu = held(us)
+    else:
+        Lu = L(us)
+    w_f = Lu - L_over_P1(ys - ys[0])
     settle = int(np.searchsorted(ts - ts[0], SETTLE_PERIODS / cutoff_hz))
     if ts.size - settle < MIN_SAMPLES:
         raise ValueError(f"too short: the prefilter settles in {SETTLE_PERIODS / cutoff_hz:.3g} "
@@ -186,8 +202,8 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
                          n_elements: int | None = None, *, cutoff_hz: float | None = None,
                          criterion: Criterion = "rms", rtol: float = 0.01, atol: float = 1e-3,
                          initial_state: Literal["fit", "relaxed"] = "fit",
-                         max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS
-                         ) -> Identification:
+                         max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS,
+                         controller=None) -> Identification:
     """Identify Maxwell-slip parameters from a closed-loop record ``(t, y1, u)`` of a stage.
 
     The link force is inferred with :func:`infer_link_force` as ``L w``; the
@@ -198,8 +214,9 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
 
     Parameters
     ----------
-    t, y1, u, stage, cutoff_hz
-        As :func:`infer_link_force`.
+    t, y1, u, stage, cutoff_hz, controller
+        As :func:`infer_link_force` (`controller`: a known sampled controller that
+        produced `u`, the record at its samples).
     n_elements, criterion, rtol, atol, initial_state, max_elements, max_rows
         As :func:`identify_maxwell_slip`.
 
@@ -219,7 +236,7 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     >>> print(np.round(ident.model.k, 2), np.round(ident.model.fc, 4), ident.signal)
     [10.  6.] [0.01 0.03] prefiltered force
     """
-    lf = infer_link_force(t, y1, u, stage, cutoff_hz)
+    lf = infer_link_force(t, y1, u, stage, cutoff_hz, controller)
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
     # L w is band-limited: fit on every q-th sample (the model's prefilter re-discretised)
