@@ -167,12 +167,17 @@ def run(args: argparse.Namespace) -> int:
         warn_plant_fit(sc, "identify")
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         extra["scenario"] = sc.source
+        # a sampled controller: the record is at its samples, u_k acted held and delayed
+        ctrl = sc.loop().sampled
         try:
-            ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff, **options)
+            ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff,
+                                         controller=ctrl, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         what = (f"closed-loop record, plant of {sc.source}, prefilter cut-off "
-                f"{g(ident.cutoff_hz)} Hz")
+                f"{g(ident.cutoff_hz)} Hz"
+                + ("" if ctrl is None else f", the force held by the controller at "
+                   f"{g(ctrl.sample_rate_hz)} Hz, {g(ctrl.delay_samples)} samples late"))
     k = [e["k"] for e in ident.elements]
     fc = [e["fc"] for e in ident.elements]
     if args.json:
