@@ -118,3 +118,11 @@ def test_cli_one_line_errors(tmp_path):
     assert len(errors) == 1 and "6.997900629811 Hz (1429 samples)" in errors[0]
     assert "Traceback" not in out.stderr
     assert bad.read_bytes() == before
+
+
+def test_continuous_simulation_refuses_feedforward_terms_it_cannot_run():
+    from motionhyst import SineReference, simulate
+
+    loop = scenario(None, {"viscous": 3.0}).loop()
+    with pytest.raises(ValueError, match="rigid-body feedforward M r'' alone"):
+        simulate(loop, SineReference(0.01, 5.0), 0.01)

@@ -333,6 +333,7 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
+    _check_feedforward(loop)
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     if n > 50_000_000:
@@ -340,6 +341,16 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     t = np.arange(n) * engine.step
     h_foh = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
     return engine.run(t, 0, h_foh)
+
+
+def _check_feedforward(loop: Loop) -> None:
+    """The continuous run takes the rigid-body feedforward ``M r''`` alone; say so otherwise."""
+    ff = loop.ff
+    if ff is not None and (ff.viscous or ff.coulomb or ff.mass != loop.M):
+        raise ValueError("the continuous loop's time simulation takes the rigid-body "
+                         "feedforward M r'' alone; [feedforward] acceleration, viscous and "
+                         "coulomb are run with a sampled controller ([controller] "
+                         "sample_rate_hz), and analysed either way")
 
 
 def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = None,
@@ -377,6 +388,7 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
     if int(chunk) < 1:
         raise ValueError("chunk must be >= 1")
+    _check_feedforward(loop)
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     for i0 in range(0, n, int(chunk)):
