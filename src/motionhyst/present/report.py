@@ -311,6 +311,9 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 steps.update()
                 lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
                 f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
+                if loop.sampled is not None:  # the hybrid loop's: whole samples per period
+                    rate = loop.sampled.sample_rate_hz
+                    f_exact = rate / np.maximum(3, np.round(rate / f_exact))
                 f_exact = np.unique(np.concatenate([f_exact, freqs]))
                 exact = [periodic_steady_state(loop, A, f) for f in f_exact]
             digital = None
