@@ -384,11 +384,12 @@ def _feedforward_samples(loop: Loop, amplitude: float, omega: float, N: int
                              "hysteresis feedforward only")
         # three periods through the sample instants and the reference's turning points
         pts = np.concatenate([np.mod(th, 2 * np.pi), [0.5 * np.pi, 1.5 * np.pi]])
-        grid = np.unique(np.concatenate([pts + 2 * np.pi * k for k in range(3)]))
-        out = hff.response(amplitude * np.sin(grid))
-        last = grid >= 4 * np.pi
-        lookup = dict(zip(np.round(grid[last] - 4 * np.pi, 12), out[last], strict=True))
-        f += np.array([lookup[x] for x in np.round(np.mod(th, 2 * np.pi), 12)])
+        order = np.argsort(pts, kind="stable")
+        grid = np.concatenate([pts[order] + 2 * np.pi * k for k in range(3)])
+        out = hff.response(amplitude * np.sin(grid))[2 * pts.size:]
+        vals = np.empty(pts.size)
+        vals[order] = out                          # the third period, at each sample
+        f += vals[:N]
     return np.fft.fft(f) / N
 
 
