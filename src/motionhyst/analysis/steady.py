@@ -369,7 +369,11 @@ period: 7 Hz has 1428.57; the nearest frequency that has one is 6.997900629811 H
 
 def _feedforward_samples(loop: Loop, amplitude: float, omega: float, N: int
                          ) -> NDArray[np.complex128]:
-    """DFT / N of the feedforward's nonlinear terms at the samples (Coulomb, phi_hat(r))."""
+    """DFT / N of the feedforward's nonlinear terms at the samples (Coulomb, phi_hat(r)).
+
+    ``phi_hat`` is evaluated on the setpoint's samples, as the controller does (it does
+    not see the setpoint's reversals between samples).
+    """
     T = loop.sampled.period
     a = 0.0 if loop.ff is None else loop.ff.advance_samples
     th = omega * (np.arange(N) + a) * T
@@ -382,14 +386,10 @@ def _feedforward_samples(loop: Loop, amplitude: float, omega: float, N: int
         if not hff.rate_independent:
             raise ValueError("the sampled loop's steady state takes a rate-independent "
                              "hysteresis feedforward only")
-        # three periods through the sample instants and the reference's turning points
-        pts = np.concatenate([np.mod(th, 2 * np.pi), [0.5 * np.pi, 1.5 * np.pi]])
-        order = np.argsort(pts, kind="stable")
-        grid = np.concatenate([pts[order] + 2 * np.pi * k for k in range(3)])
-        out = hff.response(amplitude * np.sin(grid))[2 * pts.size:]
-        vals = np.empty(pts.size)
-        vals[order] = out                          # the third period, at each sample
-        f += vals[:N]
+        # evaluated on the setpoint's samples, as the controller does: three periods of
+        # them, the last one kept (a rate-independent model forgets its start by then)
+        r_k = amplitude * np.sin(th)
+        f += hff.response(np.concatenate([r_k, r_k, r_k]))[2 * N:]
     return np.fft.fft(f) / N
 
 
