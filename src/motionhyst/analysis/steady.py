@@ -379,8 +379,7 @@ def _feedforward_samples(loop: Loop, amplitude: float, omega: float, N: int
     th = omega * (np.arange(N) + a) * T
     f = np.zeros(N)
     if loop.ff is not None and loop.ff.coulomb:
-        c = np.cos(th)
-        f += loop.ff.coulomb * np.where(np.abs(c) < 1e-12, 0.0, np.sign(c))
+        f += loop.ff.coulomb_force(amplitude * omega * np.cos(th))
     hff = loop.hysteresis_feedforward
     if hff is not None:
         if not hff.rate_independent:

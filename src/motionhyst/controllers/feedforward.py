@@ -33,7 +33,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["Feedforward"]
+__all__ = ["STANDSTILL", "Feedforward"]
+
+#: A setpoint velocity at most this [m/s] is a standstill for the Coulomb term (sign 0): a
+#: sample that falls on a reversal gives no force, whatever the velocity's round-off.
+STANDSTILL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -99,7 +103,18 @@ class Feedforward:
         v = np.asarray(velocity, dtype=float)
         m = 0.0 if self.mass is None else self.mass
         return m * np.asarray(acceleration, dtype=float) + self.viscous * v + \
-            self.coulomb * np.sign(v)
+            self.coulomb_force(v)
+
+    def coulomb_force(self, velocity: ArrayLike) -> NDArray[np.float64]:
+        """``fc sign(r')`` [N], 0 at a standstill (``|r'| <=`` :data:`STANDSTILL`).
+
+        Parameters
+        ----------
+        velocity : array_like
+            ``r'`` [m/s].
+        """
+        v = np.asarray(velocity, dtype=float)
+        return self.coulomb * np.where(np.abs(v) <= STANDSTILL, 0.0, np.sign(v))
 
     def linear_response(self, omega: ArrayLike) -> NDArray[np.complex128]:
         """``m (j w)^2 + c j w``: the linear terms' force per unit setpoint at `omega` [rad/s].
