@@ -70,19 +70,47 @@ def test_an_input_is_never_overwritten_even_with_force(tmp_path, monkeypatch):
         OutputFile(tmp_path / "hard.toml", force=True, inputs=str(src))
 
 
-def test_symlink_target_is_followed_and_kept(tmp_path):
-    real = tmp_path / "real.csv"
+def test_a_symlink_needs_force_and_is_replaced_itself_never_its_target(tmp_path):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    real = outside / "real.csv"
     real.write_text("old")
-    link = tmp_path / "link.csv"
+    os.chmod(real, 0o600)
+    folder = tmp_path / "work"
+    folder.mkdir()
+    link = folder / "link.csv"
     link.symlink_to(real)
-    with pytest.raises(OutputError, match="exists"):
+    with pytest.raises(OutputError, match="a symbolic link; give --force to replace the link"):
         OutputFile(link)
     OutputFile(link, force=True).write_text("new")
-    assert link.is_symlink() and real.read_text() == "new"
-    dangling = tmp_path / "dangling.csv"
+    assert not link.is_symlink() and link.read_text() == "new"
+    assert real.read_text() == "old" and _mode(real) == 0o600
+    assert sorted(os.listdir(folder)) == ["link.csv"] and os.listdir(outside) == ["real.csv"]
+    dangling = folder / "dangling.csv"
     dangling.symlink_to(tmp_path / "nowhere.csv")
     with pytest.raises(OutputError, match="symbolic link to a missing file"):
         OutputFile(dangling)
+    OutputFile(dangling, force=True).write_text("x")
+    assert dangling.read_text() == "x" and not (tmp_path / "nowhere.csv").exists()
+
+
+def test_a_killed_writer_leaves_no_temporary_and_the_next_writer_cleans_any(tmp_path):
+    path = tmp_path / "run.csv"
+    path.write_text("old\n")
+    proc = subprocess.Popen([sys.executable, "-c", _WRITER, str(path)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "writing"
+    proc.kill()
+    proc.wait()
+    # a file named only for the instant before the move, left by a writer that died then
+    stale = tmp_path / f".run.csv.motionhyst-{proc.pid}-0a1b.part"
+    stale.write_text("half")
+    mine = tmp_path / ".notes.part"  # not a name the tool gives: never touched
+    mine.write_text("mine")
+    assert path.read_text() == "old\n"
+    OutputFile(tmp_path / "other.csv").write_text("y")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".notes.part", "other.csv",
+                                                          "run.csv"]
 
 
 @pytest.mark.parametrize("make", ["folder", "parent-file", "empty", "dot"])
@@ -131,6 +159,19 @@ def test_errors_name_the_target_not_a_temporary(tmp_path):
         os.chmod(folder, 0o755)
 
 
+def test_a_results_folder_that_cannot_be_written_is_refused_before_the_work(tmp_path):
+    folder = tmp_path / "out"
+    folder.mkdir()
+    os.chmod(folder, 0o555)
+    try:
+        if os.access(folder, os.W_OK):
+            pytest.skip("running as a user who can write anywhere")
+        with pytest.raises(OutputError, match="no permission to write in"):
+            OutputFolder(folder, ["report.md"])
+    finally:
+        os.chmod(folder, 0o755)
+
+
 _WRITER = textwrap.dedent("""
     import sys, time
     from motionhyst.io.outputs import OutputFile
@@ -149,8 +190,7 @@ def test_a_signal_mid_write_leaves_the_old_file_and_no_temporary(tmp_path, sig):
     path.write_text("old\n")
     proc = subprocess.Popen([sys.executable, "-c", _WRITER, str(path)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    assert proc.stdout.readline().strip() == "writing"
-    assert any(p.name.endswith(".part") for p in tmp_path.iterdir())  # the write is under way
+    assert proc.stdout.readline().strip() == "writing"  # the write is under way
     proc.send_signal(sig)
     deadline = time.monotonic() + 30
     while proc.poll() is None and time.monotonic() < deadline:
@@ -278,6 +318,6 @@ def test_folder_moves_nothing_until_everything_is_staged(tmp_path):
     folder = OutputFolder(out, NAMES)
     folder.write_text("report.md", "v2 report.md")
     assert (out / "report.md").read_text() == "v1 report.md"
-    assert any(p.name.endswith(".part") for p in out.iterdir())
+    assert folder.written == ["report.md"]  # staged, unnamed until finish
     folder.abandon()
     assert sorted(os.listdir(out)) == sorted([*NAMES, MANIFEST])

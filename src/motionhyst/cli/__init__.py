@@ -18,8 +18,9 @@ import os
 import sys
 from collections.abc import Sequence
 
-from motionhyst.cli._common import EXIT_USAGE, Parser, UsageError
+from motionhyst.cli._common import EXIT_USAGE, Parser, UsageError, memory_size, one_line
 from motionhyst.cli.identify import feedforward_fragment, record_kind
+from motionhyst.core.budget import set_max_memory
 
 COMMANDS = ("df", "analyze", "steady", "simulate", "scan", "identify", "predict",
             "benchmark", "reproduce")
@@ -44,6 +45,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     for name in COMMANDS:
         importlib.import_module(f"motionhyst.cli.{name}").add_parser(sub)
+        sub.choices[name].add_argument(
+            "--max-memory", type=memory_size, metavar="SIZE",
+            help="memory one computation may take, such as 4G or 500M (default: half of the "
+                 "memory available; a larger one is refused before it starts)")
     return p
 
 
@@ -85,15 +90,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
+        set_max_memory(args.max_memory)
         return args.func(args)
     except BrokenPipeError:  # output piped into head, say: not an error
         sys.stdout = open(os.devnull, "w")
         return 0
     except UsageError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {one_line(str(exc))}", file=sys.stderr)
     except (ValueError, OSError, RuntimeError) as exc:
-        print(f"motionhyst: error: {exc}", file=sys.stderr)
+        print(f"motionhyst: error: {one_line(str(exc))}", file=sys.stderr)
     except KeyboardInterrupt:
         print("motionhyst: interrupted", file=sys.stderr)
         return 130
+    except MemoryError:  # an estimate missed: still one line, and the remedy
+        print("motionhyst: error: out of memory; give a smaller problem (or a larger "
+              "--max-memory, if the machine has it)", file=sys.stderr)
+    finally:
+        set_max_memory(None)
     return EXIT_USAGE

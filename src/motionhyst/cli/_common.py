@@ -11,7 +11,8 @@ from motionhyst.core.jsonio import dumps
 from motionhyst.core.textfmt import g, table
 
 __all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
-           "harmonic_count", "nonnegative", "positive", "print_json", "table", "whole_number"]
+           "harmonic_count", "memory_size", "nonnegative", "one_line", "positive", "print_json",
+           "table", "whole_number"]
 
 EXIT_USAGE = 2
 """Exit code of every user error."""
@@ -87,8 +88,54 @@ def whole_number(lo: int, hi: int, what: str) -> Callable[[str], int]:
     return parse
 
 
+def memory_size(text: str) -> int:
+    """argparse type: a memory size such as ``4G`` or ``500M`` (bytes).
+
+    Examples
+    --------
+    >>> memory_size("4G")
+    4294967296
+    """
+    from motionhyst.core.budget import parse_size
+
+    try:
+        return parse_size(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 harmonic_count = whole_number(1, 1000, "harmonics")
 """argparse type: a whole number of harmonics from 1 to 1000."""
+
+
+MAX_MESSAGE = 1000
+"""Most characters of a message on stderr (a file's header it quotes may be a whole file)."""
+
+
+def one_line(text: str) -> str:
+    """`text` as one line of plain text: line breaks joined, control characters escaped, cut.
+
+    A message may quote what a user's file holds (a header, a cell); bytes of
+    a binary file never reach the terminal as they are.
+
+    Parameters
+    ----------
+    text : str
+        The message.
+
+    Returns
+    -------
+    str
+        One printable line of at most :data:`MAX_MESSAGE` characters.
+
+    Examples
+    --------
+    >>> print(one_line("bad header 'ti\\x1b[2Jme'\\nexpected time"))
+    bad header 'ti\\x1b[2Jme'; expected time
+    """
+    text = "; ".join(part.strip() for part in text.strip().splitlines() if part.strip())
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    return text if len(text) <= MAX_MESSAGE else text[:MAX_MESSAGE - 3] + "..."
 
 
 def print_json(obj) -> None:
@@ -195,7 +242,7 @@ def warn(message: str) -> None:
     """A plausibility warning: one line on stderr; the command still succeeds (exit 0)."""
     import sys
 
-    print(f"motionhyst: warning: {message}", file=sys.stderr)
+    print(f"motionhyst: warning: {one_line(message)}", file=sys.stderr)
 
 
 def warn_plant_fit(sc, command: str) -> None:

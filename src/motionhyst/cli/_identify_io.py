@@ -60,7 +60,8 @@ def run_input_output(args: argparse.Namespace) -> int:
     """Identify the stage and its link from input-output records; print, optionally save."""
     from motionhyst.identify.input_output import identify_io, load_io_csv
 
-    for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
+    for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff),
+                          ("--criterion", args.criterion)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} does not apply to --record "
                              f"input-output")

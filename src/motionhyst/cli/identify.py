@@ -143,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
                 raise UsageError(f"motionhyst identify: {option} applies to closed-loop "
                                  f"records (time,y1,u) only; {path} is a force-displacement "
                                  f"record")
-    options = {"n_elements": args.elements, "criterion": args.criterion}
+    options = {"n_elements": args.elements, "criterion": args.criterion or "rms"}
     extra: dict = {"record": kind, "data": str(path)}
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
@@ -214,8 +214,9 @@ def add_parser(sub) -> None:
                         "(default: from the header); input-output: identify the stage and its "
                         "link jointly from force and position (grey box, simulation error)")
     add_input_output_arguments(q)
-    q.add_argument("--criterion", choices=["rms", "bic"], default="rms",
-                   help="model-order criterion when --elements is not given (default: rms)")
+    q.add_argument("--criterion", choices=["rms", "bic"],
+                   help="force-displacement and closed-loop records: model-order criterion "
+                        "when --elements is not given (default: rms)")
     q.add_argument("--scenario", metavar="FILE",
                    help="scenario TOML whose [stage] gives P1 for closed-loop records "
                         "(default: the paper's Table I)")

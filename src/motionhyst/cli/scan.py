@@ -14,6 +14,7 @@ from motionhyst.cli._common import (
     nonnegative,
     positive,
     print_json,
+    refuse_unused,
     warn_plant_fit,
     whole_number,
 )
@@ -24,6 +25,9 @@ LEAD_IN = 0.01
 
 
 _count = whole_number(1, 1000, "trials")
+
+ILC_DEFAULTS = {"ilc_trials": 10, "ilc_gain": 1.0, "ilc_cutoff": 300.0, "ilc_order": 2}
+"""Learning control's options unless given (they apply with ``--compensation ilc`` only)."""
 
 
 def add_parser(sub) -> None:
@@ -51,13 +55,13 @@ def add_parser(sub) -> None:
     q.add_argument("--compensation", nargs="+", choices=["none", "model", "ilc"],
                    help="compensations to compare (default: none, model if the scenario has "
                         "a [feedforward] hysteresis model, ilc)")
-    q.add_argument("--ilc-trials", type=_count, default=10, metavar="N",
+    q.add_argument("--ilc-trials", type=_count, metavar="N",
                    help="learning trials; the last is the ilc result (10)")
-    q.add_argument("--ilc-gain", type=positive, default=1.0,
+    q.add_argument("--ilc-gain", type=positive,
                    help="learning gain in (0, 2): L = gain / PS, PS = P2 / (1 + C P2) (1)")
-    q.add_argument("--ilc-cutoff", type=positive, default=300.0, metavar="HZ",
+    q.add_argument("--ilc-cutoff", type=positive, metavar="HZ",
                    help="corner of the zero-phase Butterworth robustness filter Q [Hz] (300)")
-    q.add_argument("--ilc-order", type=_count, default=2,
+    q.add_argument("--ilc-order", type=_count,
                    help="order of the Butterworth filter whose squared magnitude is Q (2)")
     q.add_argument("--other-length", type=positive, metavar="L",
                    help="carry-over setpoint: length [m] (default: --length)")
@@ -121,6 +125,13 @@ def run(args: argparse.Namespace) -> int:
     if "model" in comps and not has_model:
         raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
                          f"model, and {sc.source} has none")
+    if "ilc" not in comps:
+        refuse_unused(args, ("--ilc-trials", "--ilc-gain", "--ilc-cutoff", "--ilc-order",
+                             "--other-length", "--other-speed"),
+                      "without --compensation ilc (it shapes learning control only)")
+    for name, value in ILC_DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
     if not 0 < args.ilc_gain < 2:
         raise UsageError(f"{PROG}: --ilc-gain must be in (0, 2), got {args.ilc_gain:g}")
     out = _output(args)

@@ -122,6 +122,60 @@ MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
 PLANTS = ("mass-spring-damper", "two-mass")
 
 
+STEADY_RATIO = 1.5
+"""A periodic record's first period may differ from its last by this many times the scatter
+between its last two (the noise); more is a transient: the record is not a steady state.
+(Noise alone gives 1 within a few per cent for periods of 50 samples or more.)"""
+
+
+def check_steady_state(rec: IORecord, period: int) -> None:
+    """Refuse a record of three or more periods of its force whose output is not periodic.
+
+    In a periodic steady state every period of the output is the same up to the
+    noise: the first differs from the last as much as the last two differ.  A
+    record from rest carries a transient in its first periods, which a fit under
+    ``periodic`` would take for the system (biased estimates, a fit error far
+    above the noise).
+
+    Parameters
+    ----------
+    rec : IORecord
+        The record.
+    period : int
+        Samples per period of its force.
+
+    Raises
+    ------
+    ValueError
+        One line: how far the first period is from the last, and what to do.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(300) / 750
+    >>> u = np.sin(2 * np.pi * 7.5 * t)
+    >>> check_steady_state(IORecord(t, u, 1e-5 * u, name="steady.csv"), 100)
+    >>> try:
+    ...     check_steady_state(IORecord(t, u, 1e-5 * u * (1 - np.exp(-t / 0.05)),
+    ...                                 name="from-rest.csv"), 100)
+    ... except ValueError as exc:
+    ...     print(str(exc)[:42])
+    from-rest.csv: not a periodic steady state
+    """
+    n = rec.y.size // period
+    if n < 3 or period < 50:
+        return
+    y = rec.y[: n * period].reshape(n, period)
+    first = float(np.sqrt(np.mean((y[0] - y[-1]) ** 2)))
+    last = float(np.sqrt(np.mean((y[-2] - y[-1]) ** 2)))
+    scale = float(np.sqrt(np.mean(rec.y ** 2)))
+    if first > 1e-3 * scale and first > STEADY_RATIO * last:
+        raise ValueError(f"{rec.name}: not a periodic steady state: its first period differs "
+                         f"from its last by {first:.3g} m RMS, {first / max(last, 1e-300):.3g} "
+                         f"times the scatter of its last two; a record from rest? identify "
+                         f"without --periodic, or drop the periods before the steady state")
+
+
 def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
                 nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
                 max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None,
@@ -203,6 +257,8 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
             if rec_period is None and abs(rec.u[0] - rec.u[-1]) > 0.5 * np.ptp(rec.u):
                 raise ValueError(f"{rec.name}: periodic records must hold whole periods of "
                                  f"the force; its ends do not join")
+            if rec_period is not None:
+                check_steady_state(rec, rec_period)
     if plant not in PLANTS:
         raise ValueError(f"unknown plant {plant!r} for input-output records; expected one of "
                          f"{', '.join(PLANTS)}")

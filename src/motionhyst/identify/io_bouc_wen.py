@@ -30,6 +30,7 @@ from motionhyst.identify.io_results import IOIdentification, _per_record
 from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
+    check_substeps,
 )
 from motionhyst.identify.io_uncertainty import (
     SINGULAR_RTOL,
@@ -371,6 +372,7 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
     fs = records[0].fs
     f_n = bla.mechanics().natural_frequency_hz(k_link)
     r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
+    check_substeps(records, r, f_n, 2)
     y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y - (np.mean(rec.y) if periodic else 0.0)
                                                     for rec in records]) ** 2)))
     mu = bla.m1 * bla.m2 / bla.M

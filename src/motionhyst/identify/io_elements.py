@@ -28,6 +28,7 @@ from motionhyst.identify.io_results import IOIdentification, _per_record
 from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
+    check_substeps,
 )
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
@@ -359,6 +360,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
         f_n = bla.mechanics().natural_frequency_hz(16.0 * k_link)
         r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n
                                                     / records[0].fs))
+        check_substeps(records, r, f_n)
         mu = bla.m1 * bla.m2 / bla.M
         c_scale = max(c_link, 1e-3 * bla.M * 2 * np.pi * records[0].fs)
         stage0 = [bla.m1, bla.m2, max(bla.b, 1e-3 * math.sqrt(bla.k * mu)), bla.k]

@@ -204,3 +204,55 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     sol = best
     m1, m2, b, k, kl, cl = np.exp(sol.x)
     return TwoMass(m1, m2, b, k, output), float(kl), float(cl)
+
+
+MAX_FINE_SAMPLES = 50_000_000
+"""Most integration steps of one simulation of the records (the work budget of a fit)."""
+
+
+def check_substeps(records: list[IORecord], substeps: int, f_n: float, factor: int = 1) -> None:
+    """Refuse a fit whose records need too many integration steps, before it starts.
+
+    The integration takes `substeps` steps per sample (``factor`` times as
+    many input samples) to follow the stage's fastest mode `f_n`; a start
+    whose mode lies far above the sample rate (a two-mass stage fitted to a
+    record of one mass puts its second mass at any frequency) would
+    otherwise ask for terabytes and hours.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records.
+    substeps : int
+        Integration steps per sample.
+    f_n : float
+        The fastest mode of the start [Hz].
+    factor : int
+        Input samples per integration step (2: the midpoints too).
+
+    Raises
+    ------
+    ValueError
+        One line: the steps, the mode, the remedy.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rec = IORecord(np.arange(100) / 750, np.zeros(100), np.zeros(100))
+    >>> check_substeps([rec], 20, 700.0)
+    >>> try:
+    ...     check_substeps([rec], 10**7, 4e8)
+    ... except ValueError as exc:
+    ...     print(str(exc)[:43])
+    the start's fastest mode, 4e+08 Hz, needs 1
+    """
+    from motionhyst.core.budget import check_memory
+
+    n = sum(rec.u.size for rec in records) * int(substeps)
+    what = (f"the start's fastest mode, {f_n:.3g} Hz, needs {substeps} integration steps per "
+            f"sample of {records[0].fs:.3g} Hz ({n:.3g} in all)")
+    remedy = ("the records may not show that stage (a single mass fitted as two masses: try "
+              "--plant mass-spring-damper)")
+    if n > MAX_FINE_SAMPLES:
+        raise ValueError(f"{what}: more than {MAX_FINE_SAMPLES:.0e}; {remedy}")
+    check_memory(8.0 * factor * n * 4, what, remedy)

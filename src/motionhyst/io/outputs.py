@@ -13,6 +13,15 @@ Rules (issue 10, checked by tests/test_outputs.py and tests/test_bad_inputs.py):
 - A replaced file keeps its permission bits; a new file gets ``0666`` and a
   new folder ``0777``, both less the process umask (``0644`` / ``0755`` under
   ``022``), as ``open`` and ``mkdir`` would give them.
+- A target that is a symbolic link is refused without ``force``; with it, the
+  link itself is replaced by the new file and the file it points to is left
+  as it was (a link never makes the tool write outside the folder named).
+- The temporary file has no name while it is written (``O_TMPFILE``, where
+  the system has it): a process killed meanwhile leaves nothing behind.  It
+  gets a name, ``.NAME.motionhyst-PID-XXXX.part``, only for the instant
+  before it replaces the target (and throughout, where ``O_TMPFILE`` is
+  missing); such a file of a process that no longer runs is removed by the
+  next writer in that folder (:func:`clean_stale`).
 - SIGINT or SIGTERM while a file is written leave the old file as it was and
   remove the temporary file; the process then ends with the usual
   ``KeyboardInterrupt``.  Messages name the target, never a temporary path.
@@ -44,6 +53,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import signal
 import stat
 import tempfile
@@ -158,6 +168,120 @@ def _missing_parents(folder: Path) -> list[Path]:
     return missing[::-1]
 
 
+_STALE = re.compile(r"\..+\.motionhyst-(\d+)-[A-Za-z0-9_]+\.part")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process, say: alive
+        return True
+    return True
+
+
+def clean_stale(folder: str | os.PathLike) -> list[str]:
+    """Remove the temporary files of writers in `folder` whose process no longer runs.
+
+    Only names this module gives its temporary files
+    (``.NAME.motionhyst-PID-XXXX.part``) whose process ``PID`` has ended:
+    what a writer killed (``SIGKILL``, a power cut) between naming its file
+    and moving it into place left behind.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The folder.
+
+    Returns
+    -------
+    list of str
+        The names removed.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> folder = tempfile.mkdtemp()
+    >>> open(os.path.join(folder, ".run.csv.motionhyst-999999999-ab12.part"), "w").close()
+    >>> clean_stale(folder), os.listdir(folder)
+    (['.run.csv.motionhyst-999999999-ab12.part'], [])
+    """
+    removed = []
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return removed
+    for name in names:
+        m = _STALE.fullmatch(name)
+        if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
+            with contextlib.suppress(OSError):
+                os.unlink(os.path.join(folder, name))
+                removed.append(name)
+    return removed
+
+
+class _Temporary:
+    """A temporary file in `folder` for `name`: unnamed (``O_TMPFILE``) until :meth:`commit`."""
+
+    def __init__(self, folder: Path, name: str, mode: int):
+        self.folder, self.name, self.path, self.mode = folder, name, None, mode
+        try:
+            self.fd = os.open(folder, os.O_TMPFILE | os.O_RDWR | os.O_CLOEXEC, mode)
+        except (AttributeError, OSError):  # no O_TMPFILE here: a named file from the start
+            self.fd, self.path = self._named()
+        os.fchmod(self.fd, mode)
+
+    def _named(self) -> tuple[int, str]:
+        fd, path = tempfile.mkstemp(prefix=f".{self.name}.motionhyst-{os.getpid()}-",
+                                    suffix=".part", dir=self.folder)
+        os.fchmod(fd, self.mode)
+        return fd, path
+
+    def commit(self, target: Path) -> None:
+        """Move the (flushed) file over `target` atomically."""
+        if self.path is None:
+            for _ in range(100):
+                path = self.folder / (f".{self.name}.motionhyst-{os.getpid()}-"
+                                      f"{os.urandom(4).hex()}.part")
+                try:  # linkat(AT_SYMLINK_FOLLOW) of the descriptor: a dir_fd makes it linkat
+                    dir_fd = os.open(self.folder, os.O_RDONLY | os.O_DIRECTORY)
+                    try:
+                        os.link(f"/proc/self/fd/{self.fd}", path.name, dst_dir_fd=dir_fd,
+                                follow_symlinks=True)
+                    finally:
+                        os.close(dir_fd)
+                except FileExistsError:
+                    continue
+                except OSError:  # no /proc: copy into a named file
+                    fd, name = self._named()
+                    self.path = name
+                    with open(fd, "wb", closefd=True) as out:
+                        os.lseek(self.fd, 0, os.SEEK_SET)
+                        while chunk := os.read(self.fd, 1 << 20):
+                            out.write(chunk)
+                        out.flush()
+                        os.fsync(out.fileno())
+                    break
+                self.path = str(path)
+                break
+            else:  # pragma: no cover
+                raise FileExistsError(f"no free temporary name for {target}")
+        os.replace(self.path, target)
+        self.path = None
+
+    def discard(self) -> None:
+        """Remove the file (a named one) and close it."""
+        if self.path is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(self.path)
+            self.path = None
+        if self.fd is not None:
+            with contextlib.suppress(OSError):
+                os.close(self.fd)
+            self.fd = None
+
+
 @contextlib.contextmanager
 def _signals_raise() -> Iterator[None]:
     """SIGINT and SIGTERM raise ``KeyboardInterrupt`` inside the block (main thread only)."""
@@ -187,10 +311,10 @@ class OutputFile:
     Parameters
     ----------
     path : str or Path
-        The target.  A symbolic link is followed: the file it points to is
-        replaced and the link kept.
+        The target.  A symbolic link needs `force` and is then replaced
+        itself: the file it points to is never written.
     force : bool
-        Replace an existing file (``--force``).
+        Replace an existing file or symbolic link (``--force``).
     inputs : iterable of paths
         Files the command reads; the target may be none of them, even with `force`.
     option : str, optional
@@ -225,24 +349,28 @@ class OutputFile:
         if str(path) == "" or self.path.name in ("", ".", ".."):
             raise OutputError(f"{label}: not a file name")
         check_not_input(self.path, inputs, option)
-        self.target = Path(os.path.realpath(self.path)) if self.path.is_symlink() else self.path
-        if self.target.is_dir():
+        self.target = self.path
+        if self.path.is_symlink():
+            if not force:
+                what = "a symbolic link" if self.path.exists() else ("a symbolic link to a "
+                                                                     "missing file")
+                raise OutputError(f"{label}: {what}; give --force to replace the link itself "
+                                  f"(never the file it points to) or choose another name")
+        elif self.target.is_dir():
             raise OutputError(f"{label}: it is a folder; give a file name")
-        if self.target.exists():
+        elif self.target.exists():
             if not self.target.is_file():
                 raise OutputError(f"{label}: not a regular file; refusing to replace it")
             if not force:
                 raise OutputError(f"{label} exists; give --force to replace it")
-        elif self.path.is_symlink():
-            raise OutputError(f"{label}: a symbolic link to a missing file; "
-                              f"remove it or choose another name")
         _check_parents(self.target, label)
 
     def _mode(self) -> int:
         try:
-            return stat.S_IMODE(os.stat(self.target).st_mode)
+            st = os.lstat(self.target)
         except FileNotFoundError:
             return 0o666 & ~umask()
+        return stat.S_IMODE(st.st_mode) if stat.S_ISREG(st.st_mode) else 0o666 & ~umask()
 
     @contextlib.contextmanager
     def open(self, mode: str = "w", encoding: str | None = "utf-8",
@@ -268,31 +396,35 @@ class OutputFile:
         label = _label(self.path, self.option)
         created = []
         tmp = None
+        done = False
         with _signals_raise():
             try:
                 for folder in _missing_parents(self.target.parent):
                     folder.mkdir()
                     created.append(folder)
-                if (self.target.exists() and not self.force):  # appeared meanwhile
+                if ((self.target.exists() or self.target.is_symlink())
+                        and not self.force):  # appeared meanwhile
                     raise OutputError(f"{label} exists; give --force to replace it")
-                fd, tmp = tempfile.mkstemp(prefix=f".{self.target.name}.", suffix=".part",
-                                           dir=self.target.parent)
-                os.fchmod(fd, self._mode())
+                clean_stale(self.target.parent)
+                tmp = _Temporary(self.target.parent, self.target.name, self._mode())
                 kw = {} if mode == "wb" else {"encoding": encoding, "newline": newline}
-                with os.fdopen(fd, mode, **kw) as fh:
+                fh = os.fdopen(os.dup(tmp.fd), mode, **kw)
+                try:
                     yield fh
                     fh.flush()
                     os.fsync(fh.fileno())
-                os.replace(tmp, self.target)
-                tmp = None
+                finally:
+                    fh.close()
+                tmp.commit(self.target)
+                done = True
                 _fsync_dir(self.target.parent)
             except OSError as exc:
                 raise OutputError(f"cannot write {label}: "
                                   f"{exc.strerror or exc.__class__.__name__}") from None
             finally:
                 if tmp is not None:
-                    with contextlib.suppress(OSError):
-                        os.unlink(tmp)
+                    tmp.discard()
+                if not done:
                     for folder in reversed(created):
                         with contextlib.suppress(OSError):
                             folder.rmdir()
@@ -385,6 +517,8 @@ class OutputFolder:
             kind = "a file" if self.path.is_file() else "not a folder"
             raise OutputError(f"{label} is {kind}; give a folder (it is left untouched)")
         _check_parents(self.path, label)
+        if self.path.is_dir() and not os.access(self.path, os.W_OK | os.X_OK):
+            raise OutputError(f"{label}: no permission to write in {self.path}")
         self.previous = self._read_manifest()
         for name in self.names:
             target = self.path / name
@@ -397,7 +531,7 @@ class OutputFolder:
                                       f"motionhyst (not in {MANIFEST}); give --force to "
                                       f"replace it")
             check_not_input(target, self.inputs, option)
-        self._staged: list[tuple[str, str]] = []
+        self._staged: list[tuple[str, _Temporary]] = []
         self._done: list[str] = []
         self._created: list[Path] = []
 
@@ -442,17 +576,19 @@ class OutputFolder:
             raise ValueError(f"{name!r} is not among the names given to OutputFolder")
         self._ensure_folder()
         target = self.path / name
+        mode = OutputFile(target, force=True)._mode()
         try:
-            fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".part", dir=self.path)
+            if not self._staged:
+                clean_stale(self.path)
+            tmp = _Temporary(self.path, name, mode)
         except OSError as exc:
             raise OutputError(f"cannot write {target}: {exc.strerror}") from None
         self._staged.append((name, tmp))
         try:
-            os.fchmod(fd, OutputFile(target, force=True)._mode())
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
+            view = memoryview(data)
+            while view:
+                view = view[os.write(tmp.fd, view):]
+            os.fsync(tmp.fd)
         except OSError as exc:
             raise OutputError(f"cannot write {target}: {exc.strerror}") from None
 
@@ -486,10 +622,11 @@ class OutputFolder:
                 while self._staged:
                     name, tmp = self._staged[0]
                     try:
-                        os.replace(tmp, self.path / name)
+                        tmp.commit(self.path / name)
                     except OSError as exc:
                         raise OutputError(f"cannot write {self.path / name}: "
                                           f"{exc.strerror}") from None
+                    tmp.discard()
                     self._done.append(name)
                     self._staged.pop(0)
             except BaseException:
@@ -509,8 +646,7 @@ class OutputFolder:
     def abandon(self) -> None:
         """After a failure: remove the staged files, and folders this run created if empty."""
         for _, tmp in self._staged:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
+            tmp.discard()
         self._staged.clear()
         for folder in reversed(self._created):
             with contextlib.suppress(OSError):
@@ -534,4 +670,4 @@ class OutputFolder:
 
 
 __all__ = ["MANIFEST", "OutputError", "OutputFile", "OutputFolder", "check_not_input",
-           "umask"]
+           "clean_stale", "umask"]

@@ -77,6 +77,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
+from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import TWO_PI, polysub_exact, trim
 from motionhyst.plants.measured import MeasuredPlant
 
@@ -85,6 +86,12 @@ MAX_MODES = 6
 #: Damping ratios and frequency density of the start's scan.
 _SCAN_DAMPING = (0.001, 0.003, 0.01, 0.03, 0.1, 0.2)
 _SCAN_PER_DECADE = 50
+#: Rigid-body masses of motion stages [kg]: a fitted mass outside is a warning (a unit slip).
+PLAUSIBLE_MASS_KG = (1e-3, 1e4)
+#: Most measured lines a fit uses: a denser response is thinned (:func:`thin_lines`).
+MAX_FIT_LINES = 1000
+#: Bytes the start's scan holds per line and candidate mode (its complex and real arrays).
+_SCAN_BYTES = 136
 #: Bounds of a fitted mode: damping ratio, and frequency relative to the measured range.
 DAMPING_BOUNDS = (1e-5, 1.0)
 _FREQ_BOUNDS = (0.5, 10.0)
@@ -388,6 +395,8 @@ class _Problem:
             return None, rss0, coef
         s = self.s[:, None]
         wc, zc = extra
+        check_memory(_SCAN_BYTES * s.size * np.size(wc), f"the scan of {np.size(wc)} candidate "
+                     f"modes over {s.size} lines", "thin the measured lines")
         gc = 1.0 / (s**2 + 2 * zc * wc * s + wc**2)  # (nf, ncand)
         g1, g2 = gc * self.w1[:, None], -gc * self.w2[:, None]
         zr = np.zeros_like(g1.real)
@@ -410,6 +419,53 @@ class _Problem:
         gain[~np.isfinite(gain)] = -np.inf
         best = np.argmax(gain, axis=1)
         return best, rss0 - gain[np.arange(best.size), best], None
+
+
+def thin_lines(f: NDArray[np.float64], p1: NDArray[np.complex128], p2: NDArray[np.complex128],
+               n_max: int = MAX_FIT_LINES) -> NDArray[np.intp]:
+    """Indices of at most about `n_max` lines of a dense response: log-spaced, peaks kept.
+
+    A measured response of more lines than a fit needs (a swept sine logged at
+    every sample, 1e6 lines) is thinned to lines evenly spaced in log frequency,
+    plus the three lines around each of the largest peaks of ``|P| w^2`` (the
+    response relative to a rigid body), where a lightly damped mode is narrow.
+
+    Parameters
+    ----------
+    f : ndarray
+        Frequencies [Hz], increasing.
+    p1, p2 : ndarray of complex
+        Responses at `f`.
+    n_max : int
+        Lines to keep, about (at least 20).
+
+    Returns
+    -------
+    ndarray of int
+        Increasing indices into `f`; all of them when ``f.size <= n_max``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.linspace(1.0, 1000.0, 100_000)
+    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2) * (1 + 0.5 * (np.abs(f - 700.0) < 0.02))
+    >>> keep = thin_lines(f, p, p, 200)
+    >>> len(keep) <= 200, bool(np.any(np.abs(f[keep] - 700.0) < 0.02))
+    (True, True)
+    """
+    n_max = max(int(n_max), 20)
+    if f.size <= n_max:
+        return np.arange(f.size)
+    n_peaks = 8
+    grid = np.geomspace(f[0], f[-1], n_max - 2 * 3 * n_peaks)
+    keep = [np.clip(np.searchsorted(f, grid), 0, f.size - 1), [0, f.size - 1]]
+    w2 = f**2
+    for p in (p1, p2):
+        a = np.abs(p) * w2
+        peaks = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
+        top = peaks[np.argsort(a[peaks])[-n_peaks:]]
+        keep.append(np.clip(np.concatenate([top - 1, top, top + 1]), 0, f.size - 1))
+    return np.unique(np.concatenate(keep))
 
 
 def _candidates(f: NDArray[np.float64]):
@@ -768,6 +824,10 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
         if delay > 0:  # divided out: the fit is that of the mechanics
             rot = np.exp(1j * TWO_PI * f * delay)
             p1, p2 = p1 * rot, p2 * rot
+    n_measured = f.size
+    if f.size > MAX_FIT_LINES:  # a dense response: the fit's size bounded, not the data's
+        keep = thin_lines(f, p1, p2)
+        f, p1, p2 = f[keep], p1[keep], p2[keep]
     n_res = 4 * f.size
     n_fixed = 0 if mass is not None else 1
     if modes is not None:
@@ -807,6 +867,9 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
         criterion = (f"modes chosen by the BIC, first minimum over n = 0..{max(bic)}")
     else:
         criterion = "modes given"
+    if f.size < n_measured:
+        criterion += (f"; fitted to {f.size} of the {n_measured} measured lines, log-spaced "
+                      f"with the peaks kept")
     x, rss = fits[n_best]
     fit = _result(prob, x, n_best, rss, criterion, bic, source)
     fit.bic_other = other
@@ -911,6 +974,7 @@ def _diagnose(fit: FrfFit) -> list[str]:
       :data:`PF2_RELATIVE_STD` of it (the modes lie beyond the measured lines);
     - modes a passive stage does not have: a negative collocated residue
       ``r1`` (by more than 3 standard deviations) or a damping ratio at its bound;
+    - a rigid-body mass outside :data:`PLAUSIBLE_MASS_KG` (a unit slip: kHz for Hz);
     - errors far above the noise: in a decade band, the RMS of the complex
       relative error more than :data:`RESIDUAL_NOISE_RATIO` times its
       line-to-line scatter ``sqrt(mean |e_i+1 - e_i|^2 / 2)``, which noise
@@ -919,6 +983,11 @@ def _diagnose(fit: FrfFit) -> list[str]:
     """
     p, f = fit.plant, fit.frequency_hz
     out = []
+    if not fit.mass_given and not PLAUSIBLE_MASS_KG[0] <= p.M <= PLAUSIBLE_MASS_KG[1]:
+        out.append(f"measured plant: M = {p.M:.3g} kg, outside the {PLAUSIBLE_MASS_KG[0]:g}-"
+                   f"{PLAUSIBLE_MASS_KG[1]:g} kg of motion stages: check the units (frequency_hz "
+                   f"in kHz makes M 1e6 times too large, a response in um/N or mm/N 1e6 or 1e3 "
+                   f"times too small)")
     low = [m for m in p.modes if m.frequency_hz < f.min()]
     if p.pf2_static < 0 or low:
         what = ([f"Pf2(0) = {p.pf2_static:.3g} m/N < 0"] if p.pf2_static < 0 else []) + [

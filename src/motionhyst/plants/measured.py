@@ -142,6 +142,12 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
         p1 = data[:, 1] + 1j * data[:, 2]
         p2 = data[:, 3] + 1j * data[:, 4]
     else:
+        for col, name in ((1, "p1_abs"), (3, "p2_abs")):
+            bad = np.flatnonzero(data[:, col] <= 0)
+            if bad.size:
+                raise ValueError(f"{where}: {name} must be > 0 (a magnitude; a sign belongs in "
+                                 f"the phase), got {data[bad[0], col]:g} at "
+                                 f"{f[bad[0]]:g} Hz")
         p1 = data[:, 1] * np.exp(1j * np.deg2rad(data[:, 2]))
         p2 = data[:, 3] * np.exp(1j * np.deg2rad(data[:, 4]))
     omega = TWO_PI * f

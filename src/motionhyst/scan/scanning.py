@@ -28,12 +28,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
 from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
-from motionhyst.time.simulation import default_step, simulate
+from motionhyst.time.simulation import BYTES_PER_SAMPLE, default_step, simulate
 
 COMPENSATIONS = ("none", "model", "ilc")
 """The compensations :func:`run_scan` compares."""
@@ -415,6 +416,12 @@ def _runs(loop, bare, profile, window, comps, ilc_trials, ilc_filters, tol, tail
     """The runs of one setpoint; with `learned` the ``ilc`` run replays that force."""
     duration = profile.end + tail
     step = default_step(loop, profile.max_frequency_hz) if dt is None else dt
+    n = int(np.ceil(duration / step)) + 1  # each run keeps its signals: checked before any
+    remedy = "shorten the setpoint (its length, dwell) or the tail after it, or raise the speed"
+    if n > 50_000_000:
+        raise ValueError(f"{n} time steps of {step:.3g} s: too many; {remedy}")
+    check_memory(n * BYTES_PER_SAMPLE * (len(comps) + 2),
+                 f"a scan of {len(comps)} runs of {n:.3g} time steps each", remedy)
     none = simulate(bare, profile, duration, step)
     runs, ilc = [], None
     for c in comps:

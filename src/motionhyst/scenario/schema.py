@@ -432,6 +432,15 @@ class ReferenceSection(_Section):
     amplitude: PositiveFloat
     frequencies: Annotated[list[PositiveFloat], Field(min_length=1)]
 
+    @model_validator(mode="after")
+    def _distinct(self):
+        seen = set()
+        for f in self.frequencies:
+            if f in seen:
+                raise ValueError(f"frequencies: {f:g} is given twice")
+            seen.add(f)
+        return self
+
 
 
 class ScenarioModel(_Section):
@@ -714,6 +723,16 @@ class Scenario:
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body "
                                 f"plus modes: {exc}") from None
+        if not self._fit.plant.modes:  # Pf2 = 0: eqs. (18)-(21) divide by it
+            n = len(self._fit.frequency_hz)
+            why = ("modes = 0 leaves" if m.plant.modes == 0 else
+                   f"{n} measured lines cannot determine a mode (4 parameters more), which "
+                   f"leaves" if 4 * n < 2 * (4 + (m.plant.mass is None)) else
+                   "the data show no flexible mode (the BIC keeps a rigid body alone), which "
+                   "leaves")
+            raise ScenarioError(f"{self.source}: [plant] file: {f}: {why} a rigid body alone, "
+                                f"with Pf2 = 0 and no link between P1 and P2 to analyse; "
+                                f"give data up to above the first resonance (or modes >= 1)")
         self._plant = self._fit.plant
         return self._plant
 
@@ -782,6 +801,13 @@ class Scenario:
             try:
                 loop.check_stable()
             except ValueError as exc:
+                if self._fit is not None and self._fit.warnings:  # the fit, not the controller
+                    raise ScenarioError(
+                        f"{self.source}: [plant] file: the loop with the plant fitted to "
+                        f"{self.model.plant.file} is unstable"
+                        f"{str(exc).replace('the controller does not stabilise the loop', '')}"
+                        f", and the fit is in doubt: "
+                        f"{self._fit.warnings[0].removeprefix('measured plant: ')}") from None
                 raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
             self._loop = loop
         return self._loop

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import (
     TWO_PI,
@@ -41,6 +42,8 @@ from motionhyst.loop import Loop
 
 STEPS_PER_POLE_PERIOD = 40
 STEPS_PER_REFERENCE_PERIOD = 400
+BYTES_PER_SAMPLE = 160
+"""Memory of one time sample of a run: its signals and the loop's intermediate arrays [bytes]."""
 
 
 @dataclass
@@ -337,7 +340,9 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     if n > 50_000_000:
-        raise ValueError(f"{n} time steps: too many; shorten the duration")
+        raise ValueError(f"{n} time steps: too many; shorten the run or lower its frequencies")
+    check_memory(n * BYTES_PER_SAMPLE, f"a run of {n:.3g} time steps",
+                 "shorten the run or lower its frequencies")
     t = np.arange(n) * engine.step
     h_foh = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
     return engine.run(t, 0, h_foh)

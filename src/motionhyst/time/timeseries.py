@@ -42,11 +42,14 @@ DEFAULT_SETTLE_BAND = 10e-9
 MAX_ROWS = 100_000_000
 """Most rows a run writes (about 10 GB of CSV)."""
 
-MAX_STEPS = 2_000_000_000
-"""Most integration steps of a run."""
+MAX_STEPS = 200_000_000
+"""Most integration steps of a run (the work budget: some minutes at about 1.5 us a step)."""
 
 ROWS_PER_CHUNK = 8192
 """Output rows computed and written at a time."""
+
+MAX_CHUNK = 1 << 18
+"""Most integration samples computed at a time (about 30 MB), however many a row holds."""
 
 COLUMNS = ("time", "reference", "error", "y1", "y2", "u", "w", "error_linear")
 """Columns of the CSV, in order (as :meth:`motionhyst.time.simulation.Simulation.columns`)."""
@@ -203,9 +206,11 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     n_rows = math.floor(duration / period_out * (1 + 1e-12)) + 1
     end = (n_rows - 1) * period_out
     if n_rows > MAX_ROWS or n_rows * per_row > MAX_STEPS:
-        raise ValueError(f"{n_rows} rows of {per_row} steps each: too many; lower the output "
-                         f"rate or the duration (at most {MAX_ROWS:.0e} rows, "
-                         f"{MAX_STEPS:.0e} steps)")
+        fast = "" if per_row < 1000 else (f" (a step of {step:.3g} s follows the "
+                                          f"reference's frequency)")
+        raise ValueError(f"{n_rows} rows of {per_row} steps each: too many time steps{fast}; "
+                         f"lower the frequency, the output rate or the duration (at most "
+                         f"{MAX_ROWS:.0e} rows, {MAX_STEPS:.0e} steps)")
     window = move = None
     if isinstance(reference, SineReference):
         period = 1.0 / reference.frequency_hz
@@ -218,7 +223,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
         out.write(",".join(COLUMNS) + "\n")
     rows = 0
     steps = 0
-    chunk = per_row * ROWS_PER_CHUNK
+    chunk = min(per_row * ROWS_PER_CHUNK, MAX_CHUNK)  # memory bounded, whatever per_row
     for piece in simulate_chunks(loop, reference, end, dt=step, chunk=chunk):
         t = piece.t
         steps += len(t)
@@ -231,7 +236,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
                 inside = (t >= span[0] - 0.5 * step) & (t < span[1] - 0.5 * step) \
                     if window else (t >= span[0]) & (t <= span[1])
                 s.window.add(x[inside])
-        rows += _write_rows(out, piece, per_row, rows, period_out)
+        rows += _write_rows(out, piece, per_row, steps - len(t), period_out)
     summary: dict = {"samples": rows, "steps": steps, "dt_s": step,
                      "output_rate_hz": output_rate_hz, "duration_s": end,
                      "error_peak": sig["e"].whole.peak,
@@ -259,18 +264,21 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     return summary
 
 
-def _write_rows(out: IO[str] | None, piece: Simulation, per_row: int, first_row: int,
+def _write_rows(out: IO[str] | None, piece: Simulation, per_row: int, first_sample: int,
                 period_out: float) -> int:
     """Write every `per_row`-th sample of `piece` as CSV rows; their number.
 
-    Pieces start at a multiple of `per_row` samples, so their first sample is a
-    row; the time column is the row's time ``row * period_out`` (the samples'
+    The piece's first sample is sample `first_sample` of the run; rows are the
+    samples whose index is a multiple of `per_row` (a piece may hold no row).
+    The time column is the row's time ``row * period_out`` (the samples'
     times up to round-off), so a reference's own time stamps come back exactly.
     """
     cols = piece.columns()
-    n = len(cols["time"][::per_row])
+    skip = -first_sample % per_row
+    n = len(cols["time"][skip::per_row])
+    first_row = (first_sample + skip) // per_row
     block = np.column_stack([(first_row + np.arange(n)) * period_out if c == "time"
-                             else cols[c][::per_row] for c in COLUMNS])
+                             else cols[c][skip::per_row] for c in COLUMNS])
     if out is not None and n:
         np.savetxt(out, block, delimiter=",", fmt="%.12e")
     return n

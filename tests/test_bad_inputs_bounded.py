@@ -1,0 +1,330 @@
+"""Bounded and honest on every input (issue 26): memory, links, temporary files, no answer
+from nothing, no option ignored.
+
+Every case runs the command line in a child process whose address space is
+limited (``RLIMIT_AS``), in a folder holding the user's files and a folder
+beside it that a symbolic link may point into.  It asserts the exit code, one
+line on stderr for a refusal (plain text, no traceback), and that every file
+that was there before is byte-identical afterwards, apart from the outputs the
+command owns, with no file added (no temporary file, no half-written output).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from motionhyst.plants.frf_fit import ModalPlant
+from motionhyst.plants.two_mass import TwoMassStage
+from motionhyst.scenario import default_scenario_path
+
+PAPER = default_scenario_path().read_text()
+LIMIT = 3 << 30
+"""Address space of a case's process [bytes]: an estimate that misses is a MemoryError."""
+
+_MAIN = ("import sys\n"
+         "from motionhyst.core.compiled import quiet_compilation\n"
+         "quiet_compilation()\n"
+         "from motionhyst.cli import main\n"
+         "sys.exit(main(sys.argv[1:]))\n")
+
+
+def _limit() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (LIMIT, LIMIT))
+
+
+def _popen(argv, cwd) -> subprocess.Popen:
+    env = {k: v for k, v in os.environ.items() if k != "MOTIONHYST_MAX_MEMORY"}
+    return subprocess.Popen([sys.executable, "-c", _MAIN, *argv], cwd=cwd, env=env,
+                            preexec_fn=_limit, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def _frd(f, scale_f: float = 1.0, noise: float = 0.0, magphase: bool = False) -> str:
+    """A measured two-mass stage (Table I) at `f` [Hz], written with `f` times `scale_f`."""
+    stage = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    p1, p2 = stage.response(2 * np.pi * f)
+    if noise:
+        rng = np.random.default_rng(0)
+        p1 = p1 * (1 + noise * rng.standard_normal(f.size))
+        p2 = p2 * (1 + noise * rng.standard_normal(f.size))
+    if magphase:
+        cols = [f * scale_f, np.abs(p1), np.angle(p1, deg=True), np.abs(p2),
+                np.angle(p2, deg=True)]
+        head = "frequency_hz,p1_abs,p1_phase_deg,p2_abs,p2_phase_deg\n"
+    else:
+        cols = [f * scale_f, p1.real, p1.imag, p2.real, p2.imag]
+        head = "frequency_hz,p1_re,p1_im,p2_re,p2_im\n"
+    rows = np.column_stack(cols)
+    return head + "\n".join(",".join(f"{v:.10e}" for v in row) for row in rows) + "\n"
+
+
+def _with_plant(extra: str = "", text: str = PAPER) -> str:
+    """The Table I scenario with a measured [plant] ``plant.csv`` in place of its [stage]."""
+    return (text[:text.index("[stage]")] + f'[plant]\nfile = "plant.csv"\n{extra}\n'
+            + text[text.index("[hysteresis]"):])
+
+
+def _io_record() -> str:
+    """A short input-output record (time,force,displacement) of a mass on a spring."""
+    t = np.arange(600) / 750.0
+    u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
+    y = u / 5e4
+    return "time,force,displacement\n" + "".join(
+        f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), u.tolist(), y.tolist(),
+                                                 strict=True))
+
+
+def _from_rest() -> str:
+    """Three periods of a sine force on a mass-spring-damper, from rest: not a steady state."""
+    from motionhyst.time.openloop import MassSpringDamper, OpenLoop
+
+    t = np.arange(750) / 750.0
+    u = 50.0 * np.sin(2 * np.pi * 3.0 * t)
+    y = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4)).simulate(t, u).displacement
+    y = y + 1e-5 * np.random.default_rng(1).standard_normal(y.size)  # 1.4 % of its RMS
+    return "time,force,displacement\n" + "".join(
+        f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), u.tolist(), y.tolist(),
+                                                 strict=True))
+
+
+LOG = np.geomspace(1.0, 3000.0, 200)
+
+
+def _negative_magnitude() -> str:
+    """Magnitude and phase, the first line's ``p1_abs`` negative (a sign slipped in)."""
+    rows = _frd(LOG, magphase=True).splitlines()
+    cells = rows[1].split(",")
+    cells[1] = "-" + cells[1]
+    return "\n".join([rows[0], ",".join(cells), *rows[2:]]) + "\n"
+SCAN = ["scan", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+        "--s-max", "1e6"]
+
+BASE = {"s.toml": PAPER, "notes.txt": "my notes", "old.csv": "time,error\n0,0\n",
+        "io.csv": _io_record(), "../outside/target.csv": "not yours\n"}
+
+# (id, extra files, argv, exit code, words of the one line on stderr (None: stderr free),
+#  outputs the command owns (created or replaced))
+CASES = [
+    # ------------------------------------------------------------------------ memory and work
+    ("simulate-1MHz-sine", {}, ["simulate", "s.toml", "--time-series", "t.csv", "--frequency",
+                                "1e6"], 2, ["too many time steps", "lower the frequency"], []),
+    ("scan-long-tail", {}, [*SCAN, "--tail", "1e5"], 2, ["too many", "tail"], []),
+    ("scan-above-max-memory", {}, [*SCAN, "--tail", "10", "--max-memory", "50M"], 2,
+     ["memory budget of 52.4 MB", "--max-memory"], []),
+    ("frf-fit-above-max-memory", {"p.toml": _with_plant(), "plant.csv": _frd(LOG)},
+     ["analyze", "p.toml", "--max-memory", "10M"], 2, ["candidate modes", "memory budget"],
+     []),
+    ("max-memory-not-a-size", {}, ["analyze", "--max-memory", "lots"], 2,
+     ["--max-memory", "not a size"], []),
+    ("frf-dense-200k-lines", {"p.toml": _with_plant(),
+                              "plant.csv": _frd(np.linspace(1.0, 3000.0, 200_000),
+                                                noise=0.01)},
+     ["analyze", "p.toml"], 0, None, []),
+    ("io-two-mass-on-one-mass", {}, ["identify", "io.csv", "--record", "input-output",
+                                     "--plant", "two-mass"], 2,
+     ["integration steps per sample", "--plant mass-spring-damper"], []),
+    # ----------------------------------------------------------------- no answer from nothing
+    ("frf-two-lines", {"p.toml": _with_plant(), "plant.csv": _frd(np.array([10.0, 100.0]))},
+     ["analyze", "p.toml"], 2, ["2 measured lines cannot determine a mode", "Pf2 = 0"], []),
+    ("frf-modes-0", {"p.toml": _with_plant("modes = 0"), "plant.csv": _frd(LOG)},
+     ["steady", "p.toml"], 2, ["modes = 0", "Pf2 = 0"], []),
+    ("frf-negative-magnitude", {"p.toml": _with_plant(), "plant.csv": _negative_magnitude()},
+     ["analyze", "p.toml"], 2, ["p1_abs must be > 0", "phase", "at 1 Hz"], []),
+    ("frf-in-khz", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, scale_f=1e-3)},
+     ["analyze", "p.toml"], 0, ["warning", "M = 2.25e+07 kg", "kHz"], []),
+    ("frf-poor-fit-unstable", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, noise=0.01)},
+     ["analyze", "p.toml"], 2, ["plant fitted to plant.csv is unstable", "fit is in doubt"],
+     []),
+    ("periodic-record-from-rest", {"rest.csv": _from_rest()},
+     ["identify", "rest.csv", "--record", "input-output", "--periodic"], 2,
+     ["rest.csv: not a periodic steady state", "without --periodic"], []),
+    ("scenario-duplicate-frequency", {"d.toml": PAPER.replace(
+        "frequencies = [5.0, 10.0, 15.0]", "frequencies = [5.0, 10.0, 5.0]")},
+     ["analyze", "d.toml"], 2, ["frequencies: 5 is given twice"], []),
+    # ------------------------------------------------------------------- options not ignored
+    ("criterion-with-input-output", {}, ["identify", "io.csv", "--record", "input-output",
+                                         "--criterion", "bic"], 2,
+     ["--criterion", "input-output"], []),
+    ("scan-ilc-trials-without-ilc", {}, [*SCAN, "--compensation", "none", "--ilc-trials", "3"],
+     2, ["--ilc-trials has no effect without --compensation ilc"], []),
+    ("scan-other-speed-without-ilc", {}, [*SCAN, "--compensation", "none", "--other-speed",
+                                          "0.2"], 2, ["--other-speed has no effect"], []),
+    # --------------------------------------------------------------------- outputs and links
+    ("time-series-link-out-of-folder", {"@symlink:link.csv": "../outside/target.csv"},
+     ["simulate", "--time-series", "link.csv", "--frequency", "5", "--duration", "0.05"], 2,
+     ["link.csv: a symbolic link", "--force", "never the file it points to"], []),
+    ("time-series-link-forced", {"@symlink:link.csv": "../outside/target.csv"},
+     ["simulate", "--time-series", "link.csv", "--frequency", "5", "--duration", "0.3",
+      "--force"], 0, None, ["link.csv"]),
+    ("predict-out-link-forced", {"@symlink:pred.csv": "../outside/target.csv",
+                                 "model.toml": "[stage]\ntype = \"mass-spring-damper\"\n"
+                                 "m = 2.0\nc = 10.0\nk = 5e4\n\n[hysteresis]\n"
+                                 "model = \"jenkins\"\nk = 100.0\nfc = 1.0\n",
+                                 "f.csv": "time,force\n" + "".join(
+                                     f"{i / 750!r},{np.sin(i / 10):.6f}\n" for i in range(300))},
+     ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--force"], 0, None,
+     ["pred.csv"]),
+    ("reproduce-out-link-to-folder", {"@symlink:out": "../outside"},
+     ["reproduce", "--out", "out", "--force"], 2, ["symbolic link"], []),
+]
+
+
+def _populate(root: Path, files: dict) -> None:
+    for name, content in {**BASE, **files}.items():
+        if name.startswith("@"):
+            (root / name.split(":")[1]).symlink_to(content)
+            continue
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+
+
+def _snapshot(top: Path) -> dict[str, str]:
+    """Every entry under `top`: links by target, files by hash, folders as such."""
+    snap = {}
+    for dirpath, dirnames, filenames in os.walk(top):
+        for name in dirnames + filenames:
+            path = Path(dirpath) / name
+            rel = str(path.relative_to(top))
+            if path.is_symlink():
+                snap[rel] = "link:" + os.readlink(path)
+            elif path.is_dir():
+                snap[rel] = "dir"
+            else:
+                snap[rel] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return snap
+
+
+def _one_line(err: bytes) -> str:
+    text = err.decode("utf-8", errors="replace")
+    lines = text.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in text, text
+    assert lines[0].isprintable(), lines[0]
+    return lines[0]
+
+
+def test_the_cases_are_distinct():
+    assert len({c[0] for c in CASES}) == len(CASES)
+
+
+@pytest.mark.parametrize(("files", "argv", "code", "words", "owned"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_bounded_honest_and_touching_nothing_it_does_not_own(tmp_path, files, argv, code,
+                                                             words, owned):
+    root = tmp_path / "user"
+    root.mkdir()
+    _populate(root, files)
+    before = _snapshot(tmp_path)
+    start = time.monotonic()
+    proc = _popen(argv, root)
+    out, err = proc.communicate(timeout=600)
+    took = time.monotonic() - start
+    assert proc.returncode == code, (proc.returncode, err.decode(errors="replace")[-3000:])
+    if words is None:
+        assert err.decode(errors="replace").strip() == "", err
+    else:
+        line = _one_line(err)
+        for word in words:
+            assert word in line, (word, line)
+        if code != 0:
+            assert out == b""
+            assert took < 60, took  # refused before the work, not after it
+    after = _snapshot(tmp_path)
+    for name in owned:  # the command's own outputs: a regular file now, links replaced
+        assert not (root / name).is_symlink() and (root / name).is_file()
+        after.pop(f"user/{name}")
+        before.pop(f"user/{name}", None)
+    assert after == before  # nothing else changed, nothing added (no temporary file)
+
+
+def test_a_dense_frf_is_fitted_to_a_thinned_set_of_its_lines():
+    from motionhyst.plants.frf_fit import MAX_FIT_LINES, fit_frf
+
+    f = np.linspace(1.0, 3000.0, 50_000)
+    stage = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    fit = fit_frf(f, *stage.response(2 * np.pi * f))
+    assert len(fit.frequency_hz) <= MAX_FIT_LINES
+    assert "of the 50000 measured lines" in fit.criterion
+    assert len(fit.plant.modes) == 1
+    assert fit.plant.M == pytest.approx(22.5, rel=1e-6)
+    assert fit.plant.modes[0].frequency_hz == pytest.approx(694.262, rel=1e-5)
+
+
+def test_a_time_series_is_the_same_in_pieces_that_split_its_rows(monkeypatch):
+    """A row of more integration steps than a piece holds: memory bounded, rows the same."""
+    import io
+
+    from motionhyst.scenario import default_scenario
+    from motionhyst.time import timeseries
+    from motionhyst.time.references import SineReference
+
+    loop = default_scenario().loop()
+    ref = SineReference(0.01, 50.0)
+
+    def run():
+        buf = io.StringIO()
+        s = timeseries.run_time_series(loop, ref, 0.02, buf, output_rate_hz=500.0)
+        return s, buf.getvalue()
+
+    s_whole, whole = run()
+    assert s_whole["steps"] // s_whole["samples"] > 7  # several steps per row
+    monkeypatch.setattr(timeseries, "MAX_CHUNK", 7)  # pieces of 7 steps: rows split across
+    _, split = run()
+    assert split.splitlines()[0] == whole.splitlines()[0]
+    a = np.loadtxt(whole.splitlines()[1:], delimiter=",")
+    b = np.loadtxt(split.splitlines()[1:], delimiter=",")
+    assert a.shape == b.shape == (s_whole["samples"], len(timeseries.COLUMNS))
+    np.testing.assert_allclose(b, a, rtol=1e-9, atol=1e-15)
+
+
+def _writing(proc: subprocess.Popen, path: Path, timeout: float = 60.0) -> None:
+    """Wait until `proc` has started its run (its output file is open), or fail."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            pytest.fail(f"ended early: {proc.stderr.read().decode(errors='replace')}")
+        fds = Path(f"/proc/{proc.pid}/fd")
+        try:
+            if any("(deleted)" in os.readlink(fd) or str(path.parent) in os.readlink(fd)
+                   for fd in fds.iterdir()):
+                return
+        except OSError:
+            pass
+        time.sleep(0.05)
+    pytest.fail("the run did not start writing")
+
+
+LONG_RUN = ["simulate", "--time-series", "old.csv", "--frequency", "5", "--duration", "60",
+            "--force"]
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="needs /proc")
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL])
+def test_interrupted_or_killed_mid_write_leaves_the_old_file_and_nothing_else(tmp_path, sig):
+    root = tmp_path / "user"
+    root.mkdir()
+    _populate(root, {})
+    before = _snapshot(tmp_path)
+    proc = _popen(LONG_RUN, root)
+    _writing(proc, root / "old.csv")
+    time.sleep(0.5)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    if sig == signal.SIGINT:
+        assert proc.returncode == 130
+        assert _one_line(err) == "motionhyst: interrupted"
+    else:
+        assert proc.returncode == -signal.SIGKILL
+    assert _snapshot(tmp_path) == before  # the old file, and no temporary file
