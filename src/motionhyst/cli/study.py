@@ -1,0 +1,124 @@
+"""``motionhyst study``: a scenario swept over axes and Monte-Carlo samples, computed on every
+local core (or a dask cluster) into a resumable zarr store; ``--summary`` reads a store.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from motionhyst.cli._common import UsageError, output_file, print_json, whole_number
+
+
+def _summary(args: argparse.Namespace) -> int:
+    from motionhyst.study import StudyError, open_results, summarize
+
+    for opt, given in (("--out", args.out), ("--estimate", args.estimate),
+                       ("--scheduler", args.scheduler), ("--workers", args.workers is not None)):
+        if given:
+            raise UsageError(f"study --summary: {opt} is for running a study")
+    if args.study is not None:
+        raise UsageError("study --summary STORE: give the store alone, not a study file")
+    try:
+        ds = open_results(args.summary)
+    except StudyError as exc:
+        raise UsageError(f"study --summary: {exc}") from None
+    _exports(ds, args)
+    s = summarize(ds)
+    if args.json:
+        print_json(s.to_dict())
+    else:
+        print(f"Study {ds.attrs.get('study')} on {ds.attrs.get('scenario')} "
+              f"(motionhyst {ds.attrs.get('version')}, seed {ds.attrs.get('seed')})")
+        print(s)
+    return 0
+
+
+def _exports(ds, args: argparse.Namespace) -> None:
+    from motionhyst.study.export import to_netcdf_bytes, to_table
+
+    if args.table_file is not None:
+        args.table_file.write_text(to_table(ds))
+    if args.netcdf_file is not None:
+        args.netcdf_file.write_bytes(to_netcdf_bytes(ds))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run a study (or resume it), or summarize a store."""
+    args.table_file = (None if args.table is None
+                       else output_file(args.table, args, "--table", [args.study]))
+    args.netcdf_file = (None if args.netcdf is None
+                        else output_file(args.netcdf, args, "--netcdf", [args.study]))
+    if args.summary is not None:
+        return _summary(args)
+    from motionhyst.study import Study, StudyError, estimate_study, open_results, run_study
+
+    if args.study is None:
+        raise UsageError("study: give a study file (or --summary STORE)")
+    try:
+        study = Study.from_file(args.study)
+    except StudyError as exc:
+        raise UsageError(f"study: {exc}") from None
+    if args.estimate:
+        est = estimate_study(study, args.workers or 1, args.out)
+        if args.json:
+            print_json(est.to_dict())
+        else:
+            print(f"Study {args.study}: estimate")
+            print(est)
+        return 0
+    if args.out is None:
+        raise UsageError("study: give --out STORE (a zarr store, resumed if it holds this study)")
+    client = None
+    if args.scheduler is not None:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise UsageError("study --scheduler: needs dask.distributed (pip install "
+                             "'motionhyst[distributed]')") from None
+        try:
+            client = Client(args.scheduler, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise UsageError(f"study --scheduler {args.scheduler}: cannot connect ({exc})"
+                             ) from None
+    try:
+        report = run_study(study, args.out, workers=args.workers, client=client,
+                           force=args.force, progress=not args.json and sys.stderr.isatty())
+    except StudyError as exc:
+        raise UsageError(f"study: {exc}") from None
+    finally:
+        if client is not None:
+            client.close()
+    _exports(open_results(args.out), args)
+    if args.json:
+        print_json(report.to_dict())
+    else:
+        print(report)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add the ``study`` command to the subparsers `sub`."""
+    q = sub.add_parser(
+        "study", help="a scenario over axes and Monte-Carlo samples, on every core or a "
+        "dask cluster, into a resumable zarr store",
+        description="Compute every point of a study file (a scenario, axes over its keys, "
+        "amplitude and frequency_hz, Monte-Carlo [samples], outputs) into a zarr store; the "
+        "same command after an interruption computes only the missing points.")
+    q.add_argument("study", nargs="?", help="study TOML")
+    q.add_argument("--out", metavar="STORE", help="zarr store (a folder) of the results")
+    q.add_argument("--workers", type=whole_number(0, 4096, "--workers"),
+                   help="local worker processes (default: every core; 0: this process)")
+    q.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786")
+    q.add_argument("--estimate", action="store_true",
+                   help="state points, time, core-hours, disk and memory; compute nothing")
+    q.add_argument("--table", metavar="OUT.csv", help="also write the results as CSV, a row a "
+                   "point")
+    q.add_argument("--netcdf", metavar="OUT.nc", help="also write the results as netCDF")
+    q.add_argument("--summary", metavar="STORE", help="summarize a store: worst case per axis, "
+                   "Monte-Carlo band")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.add_argument("--force", action="store_true",
+                   help="replace a store holding another study, or an existing --table/--netcdf")
+    q.set_defaults(func=run)

@@ -1,0 +1,219 @@
+"""Run a study into its store, resuming what an earlier run left; estimate it first.
+
+:func:`run_study` opens or creates the store, computes the points whose status is still
+missing in batches of at least :data:`~motionhyst.study.engine.BATCH_SECONDS` of work, and
+writes each batch as it comes back.  A point that fails is recorded as failed and counted;
+Ctrl-C, SIGKILL or a lost worker lose at most the batches in flight, which the same call
+computes again.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from motionhyst.core.textfmt import g
+from motionhyst.study.engine import batch_size, run_batches, seconds_per_point, split
+from motionhyst.study.outputs import fields_of
+from motionhyst.study.spec import Study, StudyError
+from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
+
+__all__ = ["Estimate", "RunReport", "estimate_study", "run_study"]
+
+
+@dataclass
+class RunReport:
+    """What one run did: ``points`` in the study, ``computed`` by this run, ``failed`` in the
+    store (points that did not converge or whose loop could not be built), ``seconds``.
+
+    Examples
+    --------
+    >>> r = RunReport(points=400, computed=100, failed=2, seconds=4.0)
+    >>> print(r)
+    400 points: 100 computed in 4.0 s (25 points/s), 2 failed
+    >>> sorted(r.to_dict())                                # the ``study --json`` schema
+    ['computed', 'failed', 'points', 'seconds']
+    """
+
+    points: int
+    computed: int
+    failed: int
+    seconds: float
+
+    def to_dict(self) -> dict:
+        """The ``study --json`` schema."""
+        return {"points": self.points, "computed": self.computed, "failed": self.failed,
+                "seconds": self.seconds}
+
+    def __str__(self) -> str:
+        rate = self.computed / self.seconds if self.seconds > 0 else float("nan")
+        return (f"{self.points} points: {self.computed} computed in {self.seconds:.1f} s "
+                f"({rate:.0f} points/s), {self.failed} failed")
+
+
+@dataclass
+class Estimate:
+    """What a study costs before it runs (:func:`estimate_study`).
+
+    Examples
+    --------
+    >>> e = Estimate(points=1_000_000, missing=1_000_000, seconds_per_point=5e-4, workers=2,
+    ...              disk_bytes=17_000_000, memory_bytes=10_000_000)
+    >>> print(f"{e.core_hours:.3f} core-hours")
+    0.139 core-hours
+    """
+
+    points: int
+    missing: int
+    seconds_per_point: float
+    workers: int
+    disk_bytes: int
+    memory_bytes: int
+
+    @property
+    def core_hours(self) -> float:
+        """Core-hours of the points still to compute."""
+        return self.missing * self.seconds_per_point / 3600.0
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {"points": self.points, "missing": self.missing,
+                "seconds_per_point": self.seconds_per_point, "core_hours": self.core_hours,
+                "workers": self.workers,
+                "wall_seconds": self.missing * self.seconds_per_point / max(self.workers, 1),
+                "disk_bytes": self.disk_bytes, "memory_bytes": self.memory_bytes}
+
+    def __str__(self) -> str:
+        wall = self.missing * self.seconds_per_point / max(self.workers, 1)
+        return "\n".join([
+            f"  points                 {self.points} ({self.missing} to compute)",
+            f"  one point              {g(self.seconds_per_point * 1e3)} ms (measured here)",
+            f"  work                   {g(self.core_hours)} core-hours, about {wall:.0f} s on "
+            f"{self.workers} worker(s)",
+            f"  store on disk          at most {g(self.disk_bytes / 1e6)} MB",
+            f"  memory of this process about {g(self.memory_bytes / 1e6)} MB"])
+
+
+def _bytes_per_point(study: Study) -> int:
+    return 1 + sum(16 if k == "complex" else 8 for k in fields_of(study.outputs).values())
+
+
+def estimate_study(study: Study, workers: int = 1, store: str | Path | None = None) -> Estimate:
+    """Points, time per point (measured on a few points), core-hours, disk and memory.
+
+    Examples
+    --------
+    >>> import tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    ...                      scenario=base)
+    >>> est = estimate_study(st)
+    >>> est.points, est.missing, est.seconds_per_point > 0
+    (2, 2, True)
+    """
+    missing = study.n_points
+    if store is not None and is_study_store(store):
+        st = StudyStore.open(store)
+        if st.matches(study):
+            missing = len(st.missing())
+    per = seconds_per_point(study)
+    bpp = _bytes_per_point(study)
+    return Estimate(points=study.n_points, missing=missing, seconds_per_point=per,
+                    workers=max(workers, 1), disk_bytes=study.n_points * bpp,
+                    memory_bytes=study.n_points * (8 + 1) + 65536 * bpp * 4)
+
+
+def _open_store(study: Study, path: Path, force: bool, version: str) -> StudyStore:
+    if path.exists() or path.is_symlink():
+        if not is_study_store(path):
+            raise StudyError(f"--out {path}: exists and is not a study's store; refusing to "
+                             f"replace it")
+        store = StudyStore.open(path)
+        if store.matches(study):
+            return store
+        if not force:
+            raise StudyError(f"--out {path}: holds another study (other scenario, axes, "
+                             f"samples or outputs); give --force to replace it")
+        remove_store(path)
+    elif not path.parent.is_dir():
+        raise StudyError(f"--out {path}: folder {path.parent} does not exist")
+    return StudyStore.create(path, study, version)
+
+
+def run_study(study: Study, store: str | Path, workers: int | None = None, client=None,
+              force: bool = False, batch: int | None = None, progress: bool = False
+              ) -> RunReport:
+    """Compute the points of `study` missing from `store` (created if need be).
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    store : path
+        A zarr store (a folder): new, or holding the same study (then only the missing
+        points are computed), or another study's with `force`.
+    workers : int, optional
+        Local worker processes (default: every core); 0 computes in this process.
+    client : distributed.Client, optional
+        Run the batches on this dask cluster instead.
+    force : bool
+        Replace a store holding another study.
+    batch : int, optional
+        Points a batch (default: at least 0.1 s of work, measured).
+    progress : bool
+        Points per second and the time left on stderr.
+
+    Returns
+    -------
+    RunReport
+
+    Examples
+    --------
+    >>> import tempfile, tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["error_rms"],
+    ...                       "axes": {"frequency_hz": [5.0, 10.0], "controller.K": [6.2e6, 1e12]}},
+    ...                      scenario=base)
+    >>> store = Path(tempfile.mkdtemp()) / "s.zarr"
+    >>> r = run_study(st, store, workers=0)                # K = 1e12: an unstable loop
+    >>> r.points, r.computed, r.failed
+    (4, 4, 2)
+    >>> run_study(st, store, workers=0).computed           # nothing missing: nothing computed
+    0
+    """
+    from motionhyst import __version__
+
+    t0 = time.perf_counter()
+    path = Path(store)
+    st = _open_store(study, path, force, __version__)
+    todo = st.missing(study.order())
+    if workers is None:
+        workers = os.cpu_count() or 1
+    computed = 0
+    if len(todo):
+        size = batch or batch_size(seconds_per_point(study, 2), len(todo), workers)
+        batches = split(todo, size)
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(todo), unit="point", file=sys.stderr, smoothing=0.1,
+                       desc="study")
+        try:
+            for indices, status, values in run_batches(study, batches, workers, client):
+                st.write(indices, status, values)
+                computed += len(indices)
+                if bar is not None:
+                    bar.update(len(indices))
+        finally:
+            if bar is not None:
+                bar.close()
+    failed = int(np.count_nonzero(st.status() == FAILED))
+    return RunReport(study.n_points, computed, failed, time.perf_counter() - t0)

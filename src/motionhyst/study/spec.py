@@ -1,0 +1,390 @@
+"""A study: a scenario, axes over its keys and the reference, Monte-Carlo samples, outputs.
+
+A study file (TOML) names its scenario (a path relative to the file), its outputs and its
+axes; each axis is a list of values or ``{ geomspace = [a, b, n] }`` /
+``{ linspace = [a, b, n] }``.  An optional ``[samples]`` table draws ``n`` Monte-Carlo
+samples of scenario keys from stated distributions, seeded::
+
+    scenario = "paper.toml"
+    outputs = ["e1", "mismatch", "error_rms"]
+    [axes]
+    amplitude = [0.001, 0.01]
+    frequency_hz = { geomspace = [1.0, 100.0, 200] }
+    "hysteresis.fc" = [0.03, 0.05]
+    [samples]
+    n = 100
+    seed = 0
+    "hysteresis.k" = { lognormal = [20.0, 0.1] }
+
+The points are the cross product of the axes and the samples (a dimension ``sample``); an axis
+``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.study.outputs import OUTPUTS
+
+__all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "Study", "StudyError", "set_key"]
+
+REFERENCE_AXES = ("amplitude", "frequency_hz")
+"""Axes over the reference ``r = amplitude sin(2 pi frequency_hz t)`` (not scenario keys)."""
+
+DISTRIBUTIONS = {
+    "lognormal": "[median, sigma of the logarithm]",
+    "normal": "[mean, standard deviation]",
+    "uniform": "[low, high]",
+}
+"""Distributions of Monte-Carlo samples and the meaning of their two parameters."""
+
+MAX_POINTS = 100_000_000
+
+
+class StudyError(ValueError):
+    """A study file or study definition that cannot be run (one line, naming the key).
+
+    Examples
+    --------
+    >>> try:
+    ...     Study.from_dict({"outputs": ["e7"]}, scenario={})
+    ... except StudyError as exc:
+    ...     print(exc)                                     # doctest: +ELLIPSIS
+    'outputs': unknown output 'e7' (known: e1, harmonics, ...)
+    """
+
+
+def set_key(data: dict, key: str, value: float) -> None:
+    """Set the dotted scenario `key` (``"hysteresis.k"``) of the nested `data` to `value`.
+
+    Examples
+    --------
+    >>> d = {"hysteresis": {"model": "jenkins", "k": 20.0}}
+    >>> set_key(d, "hysteresis.k", 25.0)
+    >>> d
+    {'hysteresis': {'model': 'jenkins', 'k': 25.0}}
+    """
+    *path, last = key.split(".")
+    node = data
+    for part in path:
+        nxt = node.get(part)
+        if not isinstance(nxt, dict):
+            raise StudyError(f"{key!r}: the scenario has no table [{part}]")
+        node = nxt
+    node[last] = value
+
+
+def _axis_values(key: str, spec, where: str) -> NDArray[np.float64]:
+    if isinstance(spec, dict):
+        if len(spec) != 1 or next(iter(spec)) not in ("geomspace", "linspace"):
+            raise StudyError(f"{where}{key!r}: give a list or {{ geomspace = [a, b, n] }} or "
+                             f"{{ linspace = [a, b, n] }}")
+        kind, args = next(iter(spec.items()))
+        if (not isinstance(args, list) or len(args) != 3
+                or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in args)
+                or not isinstance(args[2], int) or args[2] < 1):
+            raise StudyError(f"{where}{key!r}: {kind} needs [a, b, n] with numbers a, b and a "
+                             f"whole number n >= 1")
+        a, b, n = args
+        if kind == "geomspace" and (a <= 0 or b <= 0):
+            raise StudyError(f"{where}{key!r}: geomspace needs a, b > 0")
+        values = (np.geomspace if kind == "geomspace" else np.linspace)(float(a), float(b), n)
+    elif isinstance(spec, list):
+        if not spec or not all(isinstance(v, int | float) and not isinstance(v, bool)
+                               for v in spec):
+            raise StudyError(f"{where}{key!r}: give a non-empty list of numbers")
+        values = np.asarray(spec, dtype=float)
+    else:
+        raise StudyError(f"{where}{key!r}: give a list or {{ geomspace = [a, b, n] }} or "
+                         f"{{ linspace = [a, b, n] }}")
+    if not np.all(np.isfinite(values)):
+        raise StudyError(f"{where}{key!r}: values must be finite")
+    if len(np.unique(values)) != len(values):
+        raise StudyError(f"{where}{key!r}: values repeat")
+    if key in REFERENCE_AXES and np.any(values <= 0):
+        raise StudyError(f"{where}{key!r}: values must be > 0")
+    return values
+
+
+def _distribution(key: str, spec) -> tuple[str, float, float]:
+    if not isinstance(spec, dict) or len(spec) != 1 or next(iter(spec)) not in DISTRIBUTIONS:
+        names = ", ".join(f"{{ {k} = {v} }}" for k, v in DISTRIBUTIONS.items())
+        raise StudyError(f"[samples] {key!r}: give one of {names}")
+    kind, args = next(iter(spec.items()))
+    if (not isinstance(args, list) or len(args) != 2
+            or not all(isinstance(a, int | float) and not isinstance(a, bool)
+                       and math.isfinite(a) for a in args)):
+        raise StudyError(f"[samples] {key!r}: {kind} needs two finite numbers "
+                         f"{DISTRIBUTIONS[kind]}")
+    a, b = float(args[0]), float(args[1])
+    if kind == "lognormal" and (a <= 0 or b < 0):
+        raise StudyError(f"[samples] {key!r}: lognormal needs a median > 0 and a sigma >= 0")
+    if kind == "normal" and b < 0:
+        raise StudyError(f"[samples] {key!r}: normal needs a standard deviation >= 0")
+    if kind == "uniform" and not a < b:
+        raise StudyError(f"[samples] {key!r}: uniform needs low < high")
+    return kind, a, b
+
+
+@dataclass
+class Study:
+    """A scenario, axes, Monte-Carlo samples and outputs: every point of the cross product.
+
+    Parameters
+    ----------
+    scenario : dict
+        The scenario as a dictionary (the layout of a scenario TOML file).
+    axes : dict of str to array
+        Axis name (``amplitude``, ``frequency_hz`` or a dotted scenario key) to its values.
+    outputs : list of str
+        Names in :data:`motionhyst.study.outputs.OUTPUTS`.
+    samples : dict of str to (kind, a, b)
+        Monte-Carlo distributions of scenario keys (:data:`DISTRIBUTIONS`); may be empty.
+    n_samples, seed : int
+        Number of samples and the seed of their generator.
+    source, scenario_source : str
+        The study file and the scenario file (attributes of the results).
+
+    Examples
+    --------
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> import tomllib
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["mismatch"],
+    ...                       "axes": {"frequency_hz": [5.0, 10.0], "hysteresis.fc": [0.03, 0.05]},
+    ...                       "samples": {"n": 3, "seed": 1,
+    ...                                   "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
+    ...                      scenario=base)
+    >>> st.dims, st.shape, st.n_points
+    (('frequency_hz', 'hysteresis.fc', 'amplitude', 'sample'), (2, 2, 1, 3), 12)
+    >>> st.point(11)                                  # the axes' and samples' values of point 11
+    {'frequency_hz': 10.0, 'hysteresis.fc': 0.05, 'amplitude': 0.01, 'hysteresis.k': 20.67...}
+    """
+
+    scenario: dict
+    axes: dict[str, NDArray[np.float64]]
+    outputs: list[str]
+    samples: dict[str, tuple[str, float, float]] = field(default_factory=dict)
+    n_samples: int = 0
+    seed: int = 0
+    source: str = "<dict>"
+    scenario_source: str = "<dict>"
+    base_dir: Path | None = None
+
+    def __post_init__(self) -> None:
+        self.sample_values = self._draw()
+
+    # ---------------------------------------------------------------- reading
+    @classmethod
+    def from_file(cls, path: str | Path) -> Study:
+        """Read a study file; raises :class:`StudyError` (one line naming the key)."""
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise StudyError(f"{path}: cannot read ({exc.strerror})") from None
+        except UnicodeDecodeError:
+            raise StudyError(f"{path}: not a text file (TOML must be UTF-8)") from None
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise StudyError(f"{path}: TOML syntax error: {exc}") from None
+        try:
+            return cls.from_dict(data, source=str(path), base_dir=path.parent)
+        except StudyError as exc:
+            raise StudyError(f"{path}: {exc}") from None
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str = "<dict>", base_dir: Path | None = None,
+                  scenario: dict | None = None) -> Study:
+        """A study from the layout of a study file; `scenario` given replaces its ``scenario``.
+
+        Raises :class:`StudyError` naming the key at fault.
+        """
+        unknown = sorted(set(data) - {"scenario", "outputs", "axes", "samples"})
+        if unknown:
+            raise StudyError(f"unknown key {unknown[0]!r} (a study has scenario, outputs, "
+                             f"[axes] and [samples])")
+        scenario_source = "<dict>"
+        if scenario is None:
+            name = data.get("scenario")
+            if not isinstance(name, str) or not name:
+                raise StudyError("'scenario': give the scenario file, relative to the study file")
+            spath = Path(name)
+            if not spath.is_absolute():
+                spath = (base_dir or Path.cwd()) / spath
+            try:
+                scenario = tomllib.loads(spath.read_text())
+            except OSError as exc:
+                raise StudyError(f"'scenario': {spath}: cannot read ({exc.strerror})") from None
+            except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+                raise StudyError(f"'scenario': {spath}: not a TOML file ({exc})") from None
+            scenario_source = name
+        outputs = data.get("outputs")
+        if (not isinstance(outputs, list) or not outputs
+                or not all(isinstance(o, str) for o in outputs)):
+            raise StudyError(f"'outputs': give a list of names among {', '.join(OUTPUTS)}")
+        for o in outputs:
+            if o not in OUTPUTS:
+                raise StudyError(f"'outputs': unknown output {o!r} (known: "
+                                 f"{', '.join(OUTPUTS)})")
+        if len(set(outputs)) != len(outputs):
+            raise StudyError("'outputs': a name repeats")
+        axes_spec = data.get("axes", {})
+        if not isinstance(axes_spec, dict):
+            raise StudyError("'axes': give a table [axes]")
+        axes = {key: _axis_values(key, spec, "[axes] ") for key, spec in axes_spec.items()}
+        ref = scenario.get("reference") if isinstance(scenario.get("reference"), dict) else {}
+        for key, default in (("amplitude", ref.get("amplitude")),
+                             ("frequency_hz", ref.get("frequencies"))):
+            if key not in axes:
+                if default is None:
+                    raise StudyError(f"[axes]: give {key} (the scenario has no [reference] "
+                                     f"{'amplitude' if key == 'amplitude' else 'frequencies'})")
+                if key == "amplitude":
+                    default = [default]
+                axes[key] = _axis_values(key, default, "[reference] ")
+        samples: dict[str, tuple[str, float, float]] = {}
+        n, seed = 0, 0
+        if "samples" in data:
+            s = dict(data["samples"]) if isinstance(data["samples"], dict) else None
+            if s is None:
+                raise StudyError("'samples': give a table [samples]")
+            n, seed = s.pop("n", None), s.pop("seed", None)
+            if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+                raise StudyError("[samples] 'n': give a whole number of samples >= 1")
+            if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+                raise StudyError("[samples] 'seed': give a whole number >= 0 (the samples are "
+                                 "drawn from it, reproducibly)")
+            if not s:
+                raise StudyError("[samples]: name at least one scenario key and its "
+                                 "distribution")
+            for key, spec in s.items():
+                if key in REFERENCE_AXES or key in axes:
+                    raise StudyError(f"[samples] {key!r}: already an axis")
+                samples[key] = _distribution(key, spec)
+        study = cls(scenario=scenario, axes=axes, outputs=list(outputs), samples=samples,
+                    n_samples=n, seed=seed, source=source, scenario_source=scenario_source,
+                    base_dir=base_dir)
+        study.check()
+        return study
+
+    def check(self) -> None:
+        """Validate the scenario with the first value of each axis and sample; a key the
+        scenario does not accept raises :class:`StudyError` naming it."""
+        from motionhyst.scenario import Scenario, ScenarioError
+
+        if self.n_points > MAX_POINTS:
+            raise StudyError(f"{self.n_points} points: more than {MAX_POINTS}; split the study")
+        first = self.point(0)
+        for key, value in first.items():
+            if key in REFERENCE_AXES:
+                continue
+            data = copy.deepcopy(self.scenario)
+            where = "[samples]" if key in self.samples else "[axes]"
+            try:
+                set_key(data, key, value)
+                Scenario.from_dict(data, source=f"{where} {key!r}", base_dir=self.base_dir,
+                                   check=False)
+            except (StudyError, ScenarioError) as exc:
+                raise StudyError(f"{where} {key!r}: not a key of the scenario ({exc})") from None
+        try:
+            sc = Scenario.from_dict(self.scenario_at(first), source="the scenario",
+                                    base_dir=self.base_dir, check=False)
+        except ScenarioError as exc:
+            raise StudyError(str(exc)) from None
+        if sc.is_open_loop:
+            raise StudyError("the scenario is an open-loop system; a study needs a closed loop")
+
+    # ---------------------------------------------------------------- points
+    def _draw(self) -> NDArray[np.float64]:
+        """The Monte-Carlo samples, one column per sampled key (in file order)."""
+        rng = np.random.default_rng(self.seed)
+        cols = []
+        for kind, a, b in self.samples.values():
+            if kind == "lognormal":
+                cols.append(a * np.exp(b * rng.standard_normal(self.n_samples)))
+            elif kind == "normal":
+                cols.append(a + b * rng.standard_normal(self.n_samples))
+            else:
+                cols.append(rng.uniform(a, b, self.n_samples))
+        return np.array(cols, dtype=float).T.reshape(self.n_samples, len(self.samples))
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        """The results' dimensions: the axes in file order, then ``sample``."""
+        return tuple(self.axes) + (("sample",) if self.samples else ())
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Number of values along each of :attr:`dims`."""
+        return tuple(len(v) for v in self.axes.values()) + (
+            (self.n_samples,) if self.samples else ())
+
+    @property
+    def n_points(self) -> int:
+        """Number of points (the product of :attr:`shape`)."""
+        return math.prod(self.shape)
+
+    def point(self, index: int) -> dict[str, float]:
+        """The axes' and samples' values at the flat (C-order) `index` of :attr:`shape`."""
+        idx = np.unravel_index(int(index), self.shape)
+        out = {k: float(v[i]) for (k, v), i in zip(self.axes.items(), idx, strict=False)}
+        if self.samples:
+            row = self.sample_values[idx[-1]]
+            out.update({k: float(x) for k, x in zip(self.samples, row, strict=True)})
+        return out
+
+    def scenario_at(self, values: dict[str, float]) -> dict:
+        """The scenario dictionary with the scenario keys of `values` set."""
+        data = copy.deepcopy(self.scenario)
+        for key, value in values.items():
+            if key not in REFERENCE_AXES:
+                set_key(data, key, value)
+        return data
+
+    def order(self) -> NDArray[np.int64]:
+        """Flat indices in the order points are computed: the reference axes vary fastest,
+        so consecutive points share one loop."""
+        dims = self.dims
+        inner = [i for i, d in enumerate(dims) if d in REFERENCE_AXES]
+        outer = [i for i, d in enumerate(dims) if d not in REFERENCE_AXES]
+        grid = np.arange(self.n_points, dtype=np.int64).reshape(self.shape)
+        return grid.transpose(outer + inner).ravel()
+
+    def fingerprint(self) -> str:
+        """A digest of everything that sets the results (a store holds one study)."""
+        d = {"scenario": self.scenario, "axes": {k: v.tolist() for k, v in self.axes.items()},
+             "outputs": self.outputs, "samples": self.samples, "n": self.n_samples,
+             "seed": self.seed}
+        return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
+
+    def to_dict(self) -> dict:
+        """Plain parameters (what a worker needs to compute any point)."""
+        return {"scenario": self.scenario, "axes": {k: v.tolist() for k, v in self.axes.items()},
+                "outputs": self.outputs,
+                "samples": {k: list(v) for k, v in self.samples.items()},
+                "n_samples": self.n_samples, "seed": self.seed, "source": self.source,
+                "scenario_source": self.scenario_source,
+                "base_dir": None if self.base_dir is None else str(self.base_dir)}
+
+    @classmethod
+    def from_plain(cls, d: dict) -> Study:
+        """The inverse of :meth:`to_dict` (no file read, no check)."""
+        return cls(scenario=d["scenario"],
+                   axes={k: np.asarray(v, dtype=float) for k, v in d["axes"].items()},
+                   outputs=list(d["outputs"]),
+                   samples={k: (v[0], float(v[1]), float(v[2]))
+                            for k, v in d["samples"].items()},
+                   n_samples=d["n_samples"], seed=d["seed"], source=d["source"],
+                   scenario_source=d["scenario_source"],
+                   base_dir=None if d["base_dir"] is None else Path(d["base_dir"]))

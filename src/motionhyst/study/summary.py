@@ -1,0 +1,132 @@
+"""The closing summary of a study: worst case per axis and, with Monte-Carlo samples, the band
+of each output's worst case over the samples (the spread of a fleet of machines)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from motionhyst.core.textfmt import g, table
+from motionhyst.study.store import FAILED, OK, field_names
+
+__all__ = ["BAND", "StudySummary", "summarize"]
+
+BAND = (5.0, 50.0, 95.0)
+"""Percentiles of the Monte-Carlo band [%]."""
+
+
+@dataclass
+class StudySummary:
+    """Per output field (magnitudes for complex fields): the worst case over the study and where,
+    the worst case along each axis, and the Monte-Carlo band.
+
+    Attributes
+    ----------
+    points, computed, failed : int
+        Points of the study, computed (converged), failed.
+    worst : dict
+        Field to ``{"value": .., "at": {axis: value}}``: the largest magnitude.
+    per_axis : dict
+        Field to axis to ``{"values": [...], "worst": [...]}``: along each axis, the largest
+        magnitude over all other axes.
+    band : dict
+        Field to ``{"5": .., "50": .., "95": ..}``: percentiles over the samples of each
+        sample's worst case (empty without samples).
+
+    Examples
+    --------
+    >>> s = StudySummary(points=10, computed=9, failed=1)
+    >>> print(s)
+    10 points: 9 computed, 1 failed, 0 not computed yet
+    """
+
+    points: int
+    computed: int
+    failed: int
+    worst: dict = field(default_factory=dict)
+    per_axis: dict = field(default_factory=dict)
+    band: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (the ``study --summary --json`` schema)."""
+        return {"points": self.points, "computed": self.computed, "failed": self.failed,
+                "worst": self.worst, "per_axis": self.per_axis, "band": self.band}
+
+    def __str__(self) -> str:
+        lines = [f"{self.points} points: {self.computed} computed, {self.failed} failed, "
+                 f"{self.points - self.computed - self.failed} not computed yet"]
+        for name, w in self.worst.items():
+            at = ", ".join(f"{k} = {g(v)}" for k, v in w["at"].items())
+            lines.append(f"{name}: worst |{name}| = {g(w['value'])} at {at}")
+            rows = []
+            for axis, d in self.per_axis[name].items():
+                i = int(np.nanargmax(d["worst"])) if np.any(np.isfinite(d["worst"])) else 0
+                rows.append([axis, g(d["values"][i]), g(d["worst"][i]),
+                             g(float(np.nanmin(d["worst"])))])
+            lines.append(table(["axis", "worst at", "worst", "best of the worst"], rows))
+            if name in self.band:
+                b = self.band[name]
+                lines.append("  Monte Carlo, each sample's worst case: " + ", ".join(
+                    f"{k} % {g(v)}" for k, v in b.items()))
+        return "\n".join(lines)
+
+    def plot(self, ax=None):
+        """The worst case of each field along the first reference axis (a line per field)."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots()
+        for name, axes in self.per_axis.items():
+            axis = "frequency_hz" if "frequency_hz" in axes else next(iter(axes))
+            ax.loglog(axes[axis]["values"], axes[axis]["worst"], label=name)
+            ax.set_xlabel(axis)
+        ax.legend()
+        return ax.figure
+
+
+def summarize(ds) -> StudySummary:
+    """The summary of a study's results (:func:`motionhyst.study.open_results`).
+
+    Examples
+    --------
+    >>> import tempfile, tomllib
+    >>> from pathlib import Path
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> from motionhyst.study import Study, open_results, run_study
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["error_rms"],
+    ...                       "axes": {"frequency_hz": [5.0, 10.0, 15.0]}}, scenario=base)
+    >>> path = Path(tempfile.mkdtemp()) / "s.zarr"
+    >>> _ = run_study(st, path, workers=0)
+    >>> s = summarize(open_results(path))
+    >>> s.worst["error_rms"]["at"]
+    {'frequency_hz': 15.0, 'amplitude': 0.01}
+    """
+    status = ds["status"].values
+    dims = list(ds["status"].dims)
+    ok = status == OK
+    out = StudySummary(points=int(status.size), computed=int(np.count_nonzero(ok)),
+                       failed=int(np.count_nonzero(status == FAILED)))
+    for name in field_names(ds):
+        mag = np.where(ok, np.abs(ds[name].values), np.nan)
+        if not np.any(np.isfinite(mag)):
+            continue
+        flat = int(np.nanargmax(mag))
+        idx = np.unravel_index(flat, mag.shape)
+        at = {d: float(ds[d].values[i]) for d, i in zip(dims, idx, strict=True)}
+        out.worst[name] = {"value": float(mag[idx]), "at": at}
+        out.per_axis[name] = {}
+        for k, d in enumerate(dims):
+            others = tuple(j for j in range(len(dims)) if j != k)
+            with np.errstate(all="ignore"):
+                worst = np.nanmax(np.where(np.isfinite(mag), mag, -np.inf), axis=others)
+            worst = np.where(np.isfinite(worst), worst, np.nan)
+            out.per_axis[name][d] = {"values": ds[d].values.astype(float).tolist(),
+                                     "worst": worst.tolist()}
+        if "sample" in dims:
+            per_sample = np.array(out.per_axis[name]["sample"]["worst"], dtype=float)
+            per_sample = per_sample[np.isfinite(per_sample)]
+            if per_sample.size:
+                out.band[name] = {f"{p:g}": float(np.percentile(per_sample, p)) for p in BAND}
+    return out

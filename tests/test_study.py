@@ -1,0 +1,268 @@
+"""Studies: the study file, the points, the store, resume after SIGKILL, the local pool."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from motionhyst.analysis.quasilinear import loop_mismatch
+from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.cli import main
+from motionhyst.scenario import Scenario, default_scenario_path
+from motionhyst.study import Study, StudyError, open_results, run_study, summarize
+from motionhyst.study.export import to_netcdf_bytes, to_table
+from motionhyst.study.store import FAILED, OK
+
+BASE = tomllib.loads(default_scenario_path().read_text())
+
+STUDY_TOML = """\
+scenario = "paper.toml"
+outputs = ["e1", "mismatch", "error_rms", "E"]
+[axes]
+amplitude = [0.001, 0.01]
+frequency_hz = { geomspace = [2.0, 50.0, 4] }
+"hysteresis.fc" = [0.03, 0.05]
+[samples]
+n = 2
+seed = 7
+"hysteresis.k" = { lognormal = [20.0, 0.1] }
+"""
+
+
+@pytest.fixture
+def study_file(tmp_path: Path) -> Path:
+    shutil.copy(default_scenario_path(), tmp_path / "paper.toml")
+    path = tmp_path / "study.toml"
+    path.write_text(STUDY_TOML)
+    return path
+
+
+def _values(ds) -> dict[str, np.ndarray]:
+    return {name: ds[name].values for name in ds.data_vars}
+
+
+def test_study_file_points_and_samples(study_file):
+    st = Study.from_file(study_file)
+    assert st.dims == ("amplitude", "frequency_hz", "hysteresis.fc", "sample")
+    assert st.shape == (2, 4, 2, 2) and st.n_points == 32
+    np.testing.assert_allclose(st.axes["frequency_hz"], [2.0, 2.0 * 25 ** (1 / 3),
+                                                         2.0 * 25 ** (2 / 3), 50.0])
+    # the samples come from the seed, the same every time, and change with it
+    again = Study.from_file(study_file)
+    np.testing.assert_array_equal(st.sample_values, again.sample_values)
+    other = Study.from_dict({**tomllib.loads(STUDY_TOML),
+                             "samples": {"n": 2, "seed": 8,
+                                         "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
+                            base_dir=study_file.parent)
+    assert not np.array_equal(st.sample_values, other.sample_values)
+    p = st.point(31)
+    assert p["amplitude"] == 0.01 and p["frequency_hz"] == 50.0 and p["hysteresis.fc"] == 0.05
+    assert p["hysteresis.k"] == st.sample_values[1, 0]
+    # computed with the reference axes fastest, every point once
+    order = st.order()
+    assert sorted(order.tolist()) == list(range(32))
+    assert [st.point(i)["hysteresis.fc"] for i in order[:8]] == [0.03] * 8
+
+
+def test_distributions_have_their_stated_parameters():
+    data = {"outputs": ["E"], "axes": {"frequency_hz": [5.0]},
+            "samples": {"n": 4000, "seed": 0, "hysteresis.k": {"lognormal": [20.0, 0.1]},
+                        "hysteresis.fc": {"uniform": [0.03, 0.05]},
+                        "stage.m2": {"normal": [17.5, 0.2]}}}
+    s = Study.from_dict(data, scenario=BASE).sample_values
+    # 4000 draws: the median within 4 standard errors (0.1 * 1.25 / sqrt(4000) relative)
+    assert abs(np.median(s[:, 0]) / 20.0 - 1) < 4 * 0.1 * 1.25 / np.sqrt(4000)
+    assert abs(np.std(np.log(s[:, 0])) - 0.1) < 0.005
+    assert s[:, 1].min() >= 0.03 and s[:, 1].max() <= 0.05
+    assert abs(np.mean(s[:, 2]) - 17.5) < 4 * 0.2 / np.sqrt(4000)
+
+
+def test_points_are_the_library_functions(tmp_path):
+    """A study's point is periodic_steady_state and loop_mismatch of the scenario with the
+    point's keys set."""
+    st = Study.from_dict({"outputs": ["e1", "mismatch", "error_rms", "harmonics", "E"],
+                          "axes": {"frequency_hz": [3.0, 12.0], "stage.m2": [17.5, 30.0]}},
+                         scenario=BASE)
+    run_study(st, tmp_path / "s.zarr", workers=0)
+    ds = open_results(tmp_path / "s.zarr")
+    assert ds["e1"].dtype == complex and ds["status"].values.tolist() == [[[OK]] * 2] * 2
+    assert ds.attrs["seed"] == 0 and ds.attrs["version"]
+    for m2 in (17.5, 30.0):
+        data = json.loads(json.dumps(BASE))
+        data["stage"]["m2"] = m2
+        loop = Scenario.from_dict(data).loop()
+        for f in (3.0, 12.0):
+            ss = periodic_steady_state(loop, 0.01, f)
+            at = ds.sel(frequency_hz=f, **{"stage.m2": m2}, amplitude=0.01)
+            assert complex(at["e1"]) == complex(ss.e[1])
+            assert complex(at["e3"]) == complex(ss.e[3])
+            assert complex(at["mismatch"]) == ss.mismatch
+            assert float(at["error_rms"]) == ss.error_rms
+            assert complex(at["E"]) == complex(loop_mismatch(loop, f, 0.01)[0])
+
+
+def test_a_point_that_fails_is_counted_and_the_study_goes_on(tmp_path):
+    st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0],
+                                                      "controller.K": [6.2e6, 1e12]}},
+                         scenario=BASE)
+    rep = run_study(st, tmp_path / "s.zarr", workers=0)
+    assert (rep.points, rep.computed, rep.failed) == (4, 4, 2)
+    ds = open_results(tmp_path / "s.zarr")
+    status = ds["status"].sel({"controller.K": 1e12}).values
+    assert np.all(status == FAILED)
+    assert np.all(np.isnan(ds["e1"].sel({"controller.K": 1e12}).values))
+    assert np.all(ds["status"].sel({"controller.K": 6.2e6}).values == OK)
+    assert summarize(ds).failed == 2
+
+
+def test_local_pool_gives_the_numbers_of_this_process(tmp_path, study_file):
+    """Two worker processes, batches of 3 points, equal to one process bit for bit."""
+    st = Study.from_file(study_file)
+    run_study(st, tmp_path / "one.zarr", workers=0)
+    rep = run_study(st, tmp_path / "pool.zarr", workers=2, batch=3)
+    assert (rep.points, rep.computed, rep.failed) == (32, 32, 0)
+    one, pool = open_results(tmp_path / "one.zarr"), open_results(tmp_path / "pool.zarr")
+    for name, v in _values(one).items():
+        np.testing.assert_array_equal(v, pool[name].values, err_msg=name)
+    # run again: nothing missing, nothing computed
+    assert run_study(st, tmp_path / "pool.zarr", workers=2).computed == 0
+    s = summarize(one)
+    assert s.computed == 32 and set(s.band) == {"e1", "mismatch", "error_rms", "E"}
+    lo, mid, hi = s.band["error_rms"].values()
+    assert lo <= mid <= hi
+    worst = s.worst["error_rms"]
+    assert worst["value"] == pytest.approx(float(np.nanmax(one["error_rms"].values)))
+
+
+def test_exports(tmp_path, study_file):
+    st = Study.from_file(study_file)
+    run_study(st, tmp_path / "s.zarr", workers=0)
+    ds = open_results(tmp_path / "s.zarr")
+    lines = to_table(ds).splitlines()
+    assert lines[0] == ("amplitude,frequency_hz,hysteresis.fc,sample,hysteresis.k,e1_abs,e1_deg,"
+                        "mismatch_abs,mismatch_deg,error_rms,E_abs,E_deg,status")
+    assert len(lines) == 33
+    row = dict(zip(lines[0].split(","), lines[-1].split(","), strict=True))
+    at = ds.isel(amplitude=-1, frequency_hz=-1, sample=-1).sel({"hysteresis.fc": 0.05})
+    assert float(row["e1_abs"]) == abs(complex(at["e1"]))
+    assert float(row["hysteresis.k"]) == float(at["hysteresis.k"])
+    import xarray as xr
+
+    (tmp_path / "s.nc").write_bytes(to_netcdf_bytes(ds))
+    nc = xr.open_dataset(tmp_path / "s.nc", engine="scipy")
+    np.testing.assert_array_equal(nc["e1_real"].values, ds["e1"].values.real)
+    np.testing.assert_array_equal(nc["e1_imag"].values, ds["e1"].values.imag)
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('outputs = ["e1"]\n[axes]\nfrequency_hz = [5.0]\n', "'scenario'"),
+    ('scenario = "paper.toml"\noutputs = ["e7"]\n', "unknown output 'e7'"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\nfrequency_hz = { geomspace = [0.0, 1.0,'
+     ' 3] }\n', "'frequency_hz': geomspace needs a, b > 0"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\n"hysteresis.kk" = [1.0]\n',
+     "[axes] 'hysteresis.kk': not a key of the scenario"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\n"plant.k" = [1.0]\n',
+     "'plant.k': not a key of the scenario"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[samples]\nn = 5\nseed = 0\n'
+     '"hysteresis.k" = { gamma = [1.0, 2.0] }\n', "[samples] 'hysteresis.k': give one of"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[samples]\nn = 5\n'
+     '"hysteresis.k" = { normal = [1.0, 2.0] }\n', "[samples] 'seed'"),
+    ('scenario = "missing.toml"\noutputs = ["e1"]\n', "missing.toml: cannot read"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\namplitude = [0.01, 0.01]\n',
+     "'amplitude': values repeat"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\nextra = 1\n', "unknown key 'extra'"),
+])
+def test_bad_study_files_are_one_line_naming_the_key(tmp_path, study_file, capsys, text,
+                                                     message):
+    study_file.write_text(text)
+    assert main(["study", str(study_file), "--out", str(tmp_path / "s.zarr")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err
+    assert not (tmp_path / "s.zarr").exists()
+
+
+def test_store_of_another_study_needs_force(tmp_path, study_file, capsys):
+    out = tmp_path / "s.zarr"
+    assert main(["study", str(study_file), "--out", str(out), "--workers", "0", "--json"]) == 0
+    capsys.readouterr()
+    study_file.write_text(STUDY_TOML.replace("seed = 7", "seed = 8"))
+    assert main(["study", str(study_file), "--out", str(out), "--workers", "0"]) == 2
+    assert "holds another study" in capsys.readouterr().err
+    assert main(["study", str(study_file), "--out", str(out), "--workers", "0", "--json",
+                 "--force"]) == 0
+    assert json.loads(capsys.readouterr().out)["computed"] == 32
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "folder" / "keep.txt").write_text("mine")
+    assert main(["study", str(study_file), "--out", str(tmp_path / "folder"), "--force"]) == 2
+    assert "not a study's store" in capsys.readouterr().err
+    assert (tmp_path / "folder" / "keep.txt").read_text() == "mine"
+
+
+def test_resume_after_sigkill_computes_only_what_is_missing(tmp_path, study_file):
+    """The command killed with SIGKILL mid-study; the same command computes the rest, and the
+    results are those of one uninterrupted run."""
+    study_file.write_text(STUDY_TOML.replace("n = 2", "n = 12")
+                          .replace('outputs = ["e1", "mismatch", "error_rms", "E"]',
+                                   'outputs = ["e1", "error_peak"]'))
+    out = tmp_path / "s.zarr"
+    cmd = [sys.executable, "-m", "motionhyst.cli", "study", str(study_file), "--out", str(out),
+           "--workers", "0", "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    done = 0
+    try:
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline and proc.poll() is None:
+            try:
+                done = int(np.count_nonzero(open_results(out)["status"].values == OK))
+            except (StudyError, OSError, ValueError, KeyError):
+                done = 0
+            if done:
+                break
+            time.sleep(0.05)
+        assert proc.poll() is None, proc.communicate()[1].decode()
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait()
+    assert proc.returncode == -signal.SIGKILL
+    before = open_results(out)["status"].values
+    n_done = int(np.count_nonzero(before == OK))
+    assert 0 < n_done < 192
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    report = json.loads(res.stdout)
+    assert report["points"] == 192 and report["failed"] == 0
+    assert report["computed"] == 192 - n_done
+    resumed = open_results(out)
+    run_study(Study.from_file(study_file), tmp_path / "whole.zarr", workers=0)
+    whole = open_results(tmp_path / "whole.zarr")
+    for name, v in _values(whole).items():
+        np.testing.assert_array_equal(v, resumed[name].values, err_msg=name)
+
+
+def test_cli_summary_table_and_estimate(tmp_path, study_file, capsys):
+    out = tmp_path / "s.zarr"
+    assert main(["study", str(study_file), "--estimate", "--json"]) == 0
+    est = json.loads(capsys.readouterr().out)
+    assert est["points"] == 32 and est["missing"] == 32 and est["seconds_per_point"] > 0
+    assert main(["study", str(study_file), "--out", str(out), "--workers", "0",
+                 "--table", str(tmp_path / "t.csv")]) == 0
+    assert "32 points: 32 computed" in capsys.readouterr().out
+    assert len((tmp_path / "t.csv").read_text().splitlines()) == 33
+    assert main(["study", "--summary", str(out), "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["computed"] == 32 and s["failed"] == 0
+    assert s["worst"]["error_rms"]["at"]["amplitude"] == 0.01
+    assert main(["study", "--summary", str(tmp_path)]) == 2
+    assert "not a store of motionhyst study" in capsys.readouterr().err
+    assert main(["study", str(study_file)]) == 2
+    assert "--out" in capsys.readouterr().err
