@@ -1,0 +1,143 @@
+"""The dask engine of studies on a real cluster: a scheduler and two workers started as
+separate processes on localhost, the same numbers as the local pool, a worker killed
+mid-study."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from motionhyst.cli import main
+from motionhyst.scenario import default_scenario_path
+from motionhyst.study import Study, open_results, run_study
+from motionhyst.study.store import OK
+
+distributed = pytest.importorskip("distributed")
+
+STUDY_TOML = """\
+scenario = "paper.toml"
+outputs = ["e1", "error_peak"]
+[axes]
+amplitude = [0.001, 0.01]
+frequency_hz = { geomspace = [2.0, 50.0, 5] }
+[samples]
+n = 6
+seed = 3
+"hysteresis.k" = { lognormal = [20.0, 0.1] }
+"hysteresis.fc" = { uniform = [0.03, 0.05] }
+"""
+POINTS = 60
+
+
+def _start(args: list[str], log: Path) -> subprocess.Popen:
+    with open(log, "w") as fh:
+        return subprocess.Popen([sys.executable, "-m", "dask", *args], stdout=fh,
+                                stderr=subprocess.STDOUT, start_new_session=True)
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    """``dask scheduler`` and two ``dask worker`` processes (one thread each, no nanny: a
+    killed worker stays dead) on 127.0.0.1."""
+    sched_file = tmp_path / "scheduler.json"
+    procs = [_start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                     "--scheduler-file", str(sched_file)], tmp_path / "scheduler.log")]
+    try:
+        deadline = time.monotonic() + 120
+        while not sched_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert sched_file.exists(), (tmp_path / "scheduler.log").read_text()
+        for i in range(2):
+            procs.append(_start(["worker", "--scheduler-file", str(sched_file), "--nthreads",
+                                 "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1",
+                                 "--local-directory", str(tmp_path / f"worker{i}")],
+                                tmp_path / f"worker{i}.log"))
+        client = distributed.Client(scheduler_file=str(sched_file), timeout="60s")
+        try:
+            client.wait_for_workers(2, timeout=120)
+            yield client, procs[1:]
+        finally:
+            client.close()
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGTERM)
+        for p in procs:
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+
+
+@pytest.fixture
+def study_file(tmp_path: Path) -> Path:
+    shutil.copy(default_scenario_path(), tmp_path / "paper.toml")
+    path = tmp_path / "study.toml"
+    path.write_text(STUDY_TOML)
+    return path
+
+
+def _done(store: Path) -> int:
+    try:
+        return int(np.count_nonzero(open_results(store)["status"].values == OK))
+    except (OSError, ValueError, KeyError):
+        return 0
+
+
+def test_cluster_gives_the_local_pools_numbers_with_a_worker_killed(cluster, tmp_path,
+                                                                    study_file):
+    client, workers = cluster
+    st = Study.from_file(study_file)
+    assert st.n_points == POINTS
+    run_study(st, tmp_path / "local.zarr", workers=2, batch=4)
+    local = open_results(tmp_path / "local.zarr")
+
+    # batches of one point; the first worker killed (SIGKILL) once points came back
+    out = tmp_path / "dask.zarr"
+    result = {}
+    runner = threading.Thread(target=lambda: result.update(
+        report=run_study(st, out, client=client, batch=1)))
+    runner.start()
+    deadline = time.monotonic() + 300
+    done = 0
+    while runner.is_alive() and time.monotonic() < deadline:
+        done = _done(out)
+        if done:
+            break
+        time.sleep(0.02)
+    os.kill(workers[0].pid, signal.SIGKILL)
+    runner.join(timeout=600)
+    assert not runner.is_alive()
+    assert 0 < done < POINTS, "the worker was not killed mid-study"
+    assert workers[0].wait(timeout=30) == -signal.SIGKILL
+    report = result["report"]
+    assert (report.points, report.computed, report.failed) == (POINTS, POINTS, 0)
+    remote = open_results(out)
+    for name in ("e1", "error_peak", "status", "hysteresis.k", "hysteresis.fc"):
+        np.testing.assert_array_equal(local[name].values, remote[name].values, err_msg=name)
+
+    # the command line on the same (now one-worker) cluster, by its address
+    address = client.scheduler.address
+    store = tmp_path / "cli.zarr"
+    assert main(["study", str(study_file), "--out", str(store), "--scheduler", address,
+                 "--json"]) == 0
+    cli = open_results(store)
+    np.testing.assert_array_equal(local["e1"].values, cli["e1"].values)
+
+
+def test_unreachable_scheduler_is_one_line(tmp_path, study_file, capsys):
+    assert main(["study", str(study_file), "--out", str(tmp_path / "s.zarr"), "--scheduler",
+                 "tcp://127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot connect" in err, err
+    assert not (tmp_path / "s.zarr").exists()
