@@ -5,6 +5,7 @@ local core (or a dask cluster) into a resumable zarr store; ``--summary`` reads 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from motionhyst.cli._common import UsageError, output_file, print_json, whole_number
@@ -60,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
     except StudyError as exc:
         raise UsageError(f"study: {exc}") from None
     if args.estimate:
-        est = estimate_study(study, args.workers or 1, args.out)
+        workers = args.workers if args.workers is not None else os.cpu_count() or 1
+        est = estimate_study(study, workers, args.out)
         if args.json:
             print_json(est.to_dict())
         else:

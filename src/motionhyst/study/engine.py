@@ -162,8 +162,11 @@ class _Pool:
 
         pending = list(range(len(batches)))
         restarts = 0
+        # forked workers start with this process's modules and compiled kernels (a spawned
+        # one imports and loads them again: seconds on a loaded machine)
+        method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
         while pending:
-            ctx = mp.get_context("spawn")
+            ctx = mp.get_context(method)
             pool = ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_init_worker,
                                        initargs=(self.key, self.plain))
             try:

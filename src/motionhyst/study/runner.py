@@ -9,9 +9,12 @@ computes again.
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import os
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +26,10 @@ from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import Study, StudyError
 from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
 
-__all__ = ["Estimate", "RunReport", "estimate_study", "run_study"]
+__all__ = ["LOCK_NAME", "Estimate", "RunReport", "estimate_study", "run_lock", "run_study"]
+
+LOCK_NAME = "zarr.json"
+"""The store's file that a run holds locked (:func:`fcntl.flock`; never rewritten by a run)."""
 
 
 @dataclass
@@ -193,6 +199,47 @@ def run_study(study: Study, store: str | Path, workers: int | None = None, clien
     t0 = time.perf_counter()
     path = Path(store)
     st = _open_store(study, path, force, __version__)
+    with run_lock(path):
+        computed = _compute(study, st, workers, client, batch, progress)
+    failed = int(np.count_nonzero(st.status() == FAILED))
+    return RunReport(study.n_points, computed, failed, time.perf_counter() - t0)
+
+
+@contextlib.contextmanager
+def run_lock(path: Path) -> Iterator[None]:
+    """Hold the lock of the store at `path` (a second run is refused while it is held): two
+    runs writing one store at once would undo each other's chunks.
+
+    Examples
+    --------
+    >>> import tempfile, tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0]}}, scenario=base)
+    >>> path = Path(tempfile.mkdtemp()) / "s.zarr"
+    >>> _ = StudyStore.create(path, st)
+    >>> with run_lock(path):
+    ...     try:
+    ...         run_study(st, path, workers=0)
+    ...     except StudyError as exc:
+    ...         print(str(exc).endswith("another run is writing to this store; wait for it "
+    ...                                 "or stop it"))
+    True
+    """
+    with open(path / LOCK_NAME, "rb") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise StudyError(f"--out {path}: another run is writing to this store; wait for "
+                             f"it or stop it") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _compute(study: Study, st: StudyStore, workers: int | None, client, batch: int | None,
+             progress: bool) -> int:
     todo = st.missing(study.order())
     if workers is None:
         workers = os.cpu_count() or 1
@@ -215,5 +262,4 @@ def run_study(study: Study, store: str | Path, workers: int | None = None, clien
         finally:
             if bar is not None:
                 bar.close()
-    failed = int(np.count_nonzero(st.status() == FAILED))
-    return RunReport(study.n_points, computed, failed, time.perf_counter() - t0)
+    return computed

@@ -141,9 +141,13 @@ class StudyStore:
     def write(self, indices, status: NDArray[np.int8], values: dict[str, NDArray]) -> None:
         """Write one batch: the fields of the points at the flat `indices`, then their status."""
         idx = np.unravel_index(np.asarray(indices, dtype=np.int64), self.shape)
-        for name in self.fields:
-            self.group[name].vindex[idx] = values[name]
-        self.group["status"].vindex[idx] = np.asarray(status, dtype=np.int8)
+        try:
+            for name in self.fields:
+                self.group[name].vindex[idx] = values[name]
+            self.group["status"].vindex[idx] = np.asarray(status, dtype=np.int8)
+        except KeyError as exc:
+            raise StudyError(f"{self.path}: the store lost its array {exc} while the study ran "
+                             f"(removed by another program?)") from None
 
 
 def is_study_store(path: str | Path) -> bool:

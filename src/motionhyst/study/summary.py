@@ -3,6 +3,7 @@ of each output's worst case over the samples (the spread of a fleet of machines)
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +34,10 @@ class StudySummary:
     band : dict
         Field to ``{"5": .., "50": .., "95": ..}``: percentiles over the samples of each
         sample's worst case (empty without samples).
+    widest : dict
+        Field to ``{"at": {axis: value}, "5": .., "50": .., "95": ..}``: the percentiles over
+        the samples at the point of the axes where they spread most, relative to the median
+        (where the machines of a fleet differ most).
 
     Examples
     --------
@@ -47,11 +52,13 @@ class StudySummary:
     worst: dict = field(default_factory=dict)
     per_axis: dict = field(default_factory=dict)
     band: dict = field(default_factory=dict)
+    widest: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``study --summary --json`` schema)."""
         return {"points": self.points, "computed": self.computed, "failed": self.failed,
-                "worst": self.worst, "per_axis": self.per_axis, "band": self.band}
+                "worst": self.worst, "per_axis": self.per_axis, "band": self.band,
+                "widest": self.widest}
 
     def __str__(self) -> str:
         lines = [f"{self.points} points: {self.computed} computed, {self.failed} failed, "
@@ -69,6 +76,11 @@ class StudySummary:
                 b = self.band[name]
                 lines.append("  Monte Carlo, each sample's worst case: " + ", ".join(
                     f"{k} % {g(v)}" for k, v in b.items()))
+            if name in self.widest:
+                w = dict(self.widest[name])
+                at = ", ".join(f"{k} = {g(v)}" for k, v in w.pop("at").items())
+                lines.append(f"  Monte Carlo, widest band at {at}: " + ", ".join(
+                    f"{k} % {g(v)}" for k, v in w.items()))
         return "\n".join(lines)
 
     def plot(self, ax=None):
@@ -129,4 +141,15 @@ def summarize(ds) -> StudySummary:
             per_sample = per_sample[np.isfinite(per_sample)]
             if per_sample.size:
                 out.band[name] = {f"{p:g}": float(np.percentile(per_sample, p)) for p in BAND}
+            k = dims.index("sample")
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                q = np.nanpercentile(mag, BAND, axis=k)
+                spread = (q[2] - q[0]) / np.abs(q[1])
+            if np.any(np.isfinite(spread)):
+                j = np.unravel_index(int(np.nanargmax(spread)), spread.shape)
+                grid = [d for d in dims if d != "sample"]
+                out.widest[name] = {
+                    "at": {d: float(ds[d].values[i]) for d, i in zip(grid, j, strict=True)},
+                    **{f"{p:g}": float(q[(n, *j)]) for n, p in enumerate(BAND)}}
     return out
