@@ -271,6 +271,14 @@ def test_cli_summary_table_and_estimate(tmp_path, study_file, capsys):
     s = json.loads(capsys.readouterr().out)
     assert s["computed"] == 32 and s["failed"] == 0
     assert s["worst"]["error_rms"]["at"]["amplitude"] == 0.01
+    fig = tmp_path / "band.png"
+    assert main(["study", "--summary", str(out), "--figure", str(fig)]) == 0
+    capsys.readouterr()
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["study", "--summary", str(out), "--figure", str(tmp_path / "band.txt")]) == 2
+    assert ".png, .pdf or .svg" in capsys.readouterr().err
+    assert main(["study", "--summary", str(out), "--figure", str(fig)]) == 2   # exists
+    assert "--force" in capsys.readouterr().err
     assert main(["study", "--summary", str(tmp_path)]) == 2
     assert "not a store of motionhyst study" in capsys.readouterr().err
     assert main(["study", str(study_file)]) == 2

@@ -42,6 +42,18 @@ def _exports(ds, args: argparse.Namespace) -> None:
         args.table_file.write_text(to_table(ds))
     if args.netcdf_file is not None:
         args.netcdf_file.write_bytes(to_netcdf_bytes(ds))
+    if args.figure_file is not None:
+        import io
+
+        from motionhyst.study.summary import plot_band
+
+        try:
+            fig = plot_band(ds)
+        except ValueError as exc:
+            raise UsageError(f"study --figure: {exc}") from None
+        buf = io.BytesIO()
+        fig.savefig(buf, format=args.figure_file.path.suffix.lstrip(".") or "png", dpi=150)
+        args.figure_file.write_bytes(buf.getvalue())
 
 
 def run(args: argparse.Namespace) -> int:
@@ -50,6 +62,11 @@ def run(args: argparse.Namespace) -> int:
                        else output_file(args.table, args, "--table", [args.study]))
     args.netcdf_file = (None if args.netcdf is None
                         else output_file(args.netcdf, args, "--netcdf", [args.study]))
+    args.figure_file = (None if args.figure is None
+                        else output_file(args.figure, args, "--figure", [args.study]))
+    if args.figure_file is not None and args.figure_file.path.suffix.lower() not in (
+            ".png", ".pdf", ".svg"):
+        raise UsageError("study --figure: give a .png, .pdf or .svg file")
     if args.summary is not None:
         return _summary(args)
     from motionhyst.study import Study, StudyError, estimate_study, open_results, run_study
@@ -118,6 +135,8 @@ def add_parser(sub) -> None:
     q.add_argument("--table", metavar="OUT.csv", help="also write the results as CSV, a row a "
                    "point")
     q.add_argument("--netcdf", metavar="OUT.nc", help="also write the results as netCDF")
+    q.add_argument("--figure", metavar="OUT.png", help="also draw |E| (or the first output) "
+                   "over frequency with its Monte-Carlo band (.png, .pdf or .svg)")
     q.add_argument("--summary", metavar="STORE", help="summarize a store: worst case per axis, "
                    "Monte-Carlo band")
     q.add_argument("--json", action="store_true", help="print JSON")

@@ -11,7 +11,7 @@ import numpy as np
 from motionhyst.core.textfmt import g, table
 from motionhyst.study.store import FAILED, OK, field_names
 
-__all__ = ["BAND", "StudySummary", "summarize"]
+__all__ = ["BAND", "StudySummary", "plot_band", "summarize"]
 
 BAND = (5.0, 50.0, 95.0)
 """Percentiles of the Monte-Carlo band [%]."""
@@ -84,7 +84,12 @@ class StudySummary:
         return "\n".join(lines)
 
     def plot(self, ax=None):
-        """The worst case of each field along the first reference axis (a line per field)."""
+        """The worst case of each field along ``frequency_hz`` (a line per field).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -95,6 +100,72 @@ class StudySummary:
             ax.set_xlabel(axis)
         ax.legend()
         return ax.figure
+
+
+def plot_band(ds, name: str | None = None, ax=None):
+    """``|name|`` over frequency, a line per amplitude: the median over the Monte-Carlo samples
+    and the band from 5 to 95 % (the worst case over any other axis).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A study's results (:func:`motionhyst.study.open_results`) with a ``frequency_hz`` axis.
+    name : str, optional
+        The output field; by default ``E`` if the study has it, else its first field.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; a new figure by default.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr
+    >>> f = [1.0, 10.0, 100.0]
+    >>> ds = xr.Dataset({"E": (("frequency_hz", "sample"), np.ones((3, 4)) * (1 + 1j)),
+    ...                  "status": (("frequency_hz", "sample"), np.ones((3, 4), np.int8))},
+    ...                 coords={"frequency_hz": f, "sample": np.arange(4)})
+    >>> fig = plot_band(ds)
+    >>> fig.axes[0].get_ylabel()
+    '|E|'
+    """
+    import matplotlib.pyplot as plt
+
+    names = field_names(ds)
+    name = name or ("E" if "E" in names else names[0])
+    if name not in names:
+        raise ValueError(f"no output {name!r} in the study (it has {', '.join(names)})")
+    if "frequency_hz" not in ds["status"].dims:
+        raise ValueError("the figure needs a frequency_hz axis")
+    mag = abs(ds[name]).where(ds["status"] == OK)
+    others = [d for d in mag.dims if d not in ("frequency_hz", "amplitude", "sample")]
+    if others:
+        mag = mag.max(others)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
+    amps = mag["amplitude"].values if "amplitude" in mag.dims else [None]
+    f = mag["frequency_hz"].values
+    for a in amps:
+        m = mag if a is None else mag.sel(amplitude=a)
+        label = "" if a is None else f"A = {g(float(a))} m"
+        if "sample" in m.dims:
+            q = m.quantile([BAND[0] / 100, BAND[1] / 100, BAND[2] / 100], dim="sample")
+            (line,) = ax.plot(f, q.isel(quantile=1).transpose("frequency_hz").values,
+                              label=f"{label} median".strip())
+            ax.fill_between(f, q.isel(quantile=0).transpose("frequency_hz").values,
+                            q.isel(quantile=2).transpose("frequency_hz").values,
+                            color=line.get_color(), alpha=0.25,
+                            label=f"{label} {BAND[0]:g}-{BAND[2]:g} %".strip())
+        else:
+            ax.plot(f, m.transpose("frequency_hz").values, label=label or name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"|{name}|")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    return ax.figure
 
 
 def summarize(ds) -> StudySummary:
