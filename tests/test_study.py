@@ -184,6 +184,9 @@ def test_exports(tmp_path, study_file):
     ('scenario = "paper.toml"\noutputs = ["e1"]\n[samples]\nn = 5\n'
      '"hysteresis.k" = { normal = [1.0, 2.0] }\n', "[samples] 'seed'"),
     ('scenario = "missing.toml"\noutputs = ["e1"]\n', "missing.toml: cannot read"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\n"hysteresis.k" = [-1.0, 20.0]\n',
+     "[axes] 'hysteresis.k' = -1: refused by the scenario: [hysteresis] k: Input should be "
+     "greater than 0"),
     ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\namplitude = [0.01, 0.01]\n',
      "'amplitude': values repeat"),
     ('scenario = "paper.toml"\noutputs = ["e1"]\nextra = 1\n', "unknown key 'extra'"),

@@ -293,10 +293,15 @@ class Study:
             where = "[samples]" if key in self.samples else "[axes]"
             try:
                 set_key(data, key, value)
-                Scenario.from_dict(data, source=f"{where} {key!r}", base_dir=self.base_dir,
+                Scenario.from_dict(data, source="the scenario", base_dir=self.base_dir,
                                    check=False)
-            except (StudyError, ScenarioError) as exc:
+            except StudyError as exc:
                 raise StudyError(f"{where} {key!r}: not a key of the scenario ({exc})") from None
+            except ScenarioError as exc:
+                if str(exc).endswith("unknown key") or "Extra inputs" in str(exc):
+                    raise StudyError(f"{where} {key!r}: not a key of the scenario ({exc})"
+                                     ) from None
+                raise StudyError(f"{where} {key!r} = {value:g}: refused by {exc}") from None
         try:
             sc = Scenario.from_dict(self.scenario_at(first), source="the scenario",
                                     base_dir=self.base_dir, check=False)
