@@ -261,6 +261,47 @@ def test_resume_after_sigkill_computes_only_what_is_missing(tmp_path, study_file
         np.testing.assert_array_equal(v, resumed[name].values, err_msg=name)
 
 
+def test_ctrl_c_stops_the_command_and_its_workers(tmp_path, study_file):
+    """SIGINT to the process group (Ctrl-C in a terminal): exit 130 with one line, the local
+    workers gone with the command, the store resumable."""
+    study_file.write_text(STUDY_TOML.replace("n = 2", "n = 24")
+                          .replace('outputs = ["e1", "mismatch", "error_rms", "E"]',
+                                   'outputs = ["e1", "error_peak"]'))
+    out = tmp_path / "s.zarr"
+    cmd = [sys.executable, "-m", "motionhyst.cli", "study", str(study_file), "--out", str(out),
+           "--workers", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline and proc.poll() is None:
+            try:
+                if np.any(zarr.open_array(out / "status", mode="r")[...] == OK):
+                    break
+            except (OSError, ValueError, KeyError):
+                pass
+            time.sleep(0.005)
+        assert proc.poll() is None, proc.communicate()[1].decode()
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130
+    assert err.decode().splitlines()[-1] == "motionhyst: interrupted"
+    assert "Traceback" not in err.decode()
+    # no process of the group is left (the workers were forked into it)
+    with pytest.raises(ProcessLookupError):
+        for _ in range(100):
+            os.killpg(proc.pid, 0)
+            time.sleep(0.05)
+    res = subprocess.run([*cmd, "--json"], capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    assert json.loads(res.stdout)["failed"] == 0
+    assert np.all(open_results(out)["status"].values == OK)
+
+
 def test_cli_summary_table_and_estimate(tmp_path, study_file, capsys):
     out = tmp_path / "s.zarr"
     assert main(["study", str(study_file), "--estimate", "--json"]) == 0

@@ -10,6 +10,7 @@ fastest).  A point's numbers do not depend on its batch, its worker or the engin
 from __future__ import annotations
 
 import math
+import signal
 import threading
 import time
 from collections.abc import Iterator
@@ -133,6 +134,8 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
 
 
 def _init_worker(key: str, plain: dict) -> None:
+    # Ctrl-C reaches the whole process group: the command stops its workers itself
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _evaluator(key, plain)
 
 
@@ -182,6 +185,12 @@ class _Pool:
                 if restarts > 3:
                     raise RuntimeError("the local workers died four times; giving up (the "
                                        "store keeps what was computed)") from None
+            except BaseException:
+                # Ctrl-C or the caller stopped: no batch in the workers' hands is worth waiting
+                procs = getattr(pool, "_processes", None) or {}
+                for proc in list(procs.values()):
+                    proc.terminate()
+                raise
             finally:
                 pool.shutdown(wait=False, cancel_futures=True)
 

@@ -254,11 +254,13 @@ def _compute(study: Study, st: StudyStore, workers: int | None, client, batch: i
             bar = tqdm(total=len(todo), unit="point", file=sys.stderr, smoothing=0.1,
                        desc="study")
         try:
-            for indices, status, values in run_batches(study, batches, workers, client):
-                st.write(indices, status, values)
-                computed += len(indices)
-                if bar is not None:
-                    bar.update(len(indices))
+            # closed at once on any exception (Ctrl-C): the workers stop with the command
+            with contextlib.closing(run_batches(study, batches, workers, client)) as results:
+                for indices, status, values in results:
+                    st.write(indices, status, values)
+                    computed += len(indices)
+                    if bar is not None:
+                        bar.update(len(indices))
         finally:
             if bar is not None:
                 bar.close()
