@@ -99,6 +99,18 @@ class Hysteresis(ABC):
         """Force ``w`` for a sampled displacement ``x`` starting from force `w0`.
 
         The displacement is taken as monotone between samples.
+
+        Parameters
+        ----------
+        x : array_like
+            Displacement samples [m].
+        w0 : float
+            Force at the first sample [N].
+
+        Returns
+        -------
+        ndarray
+            Force at each sample [N].
         """
 
     @abstractmethod
@@ -132,6 +144,11 @@ class Hysteresis(ABC):
 
     def zeta(self, A: ArrayLike):
         """The paper's ``zeta = fc / (k A)`` (eq. 4), for models with ``defines_zeta``.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], > 0.
 
         Raises
         ------
@@ -220,7 +237,13 @@ class Hysteresis(ABC):
         return out
 
     def reset(self, w: float = 0.0) -> None:
-        """Reset the state used by :meth:`__call__` (force `w`, last input unknown)."""
+        """Reset the state used by :meth:`__call__` (force `w`, last input unknown).
+
+        Parameters
+        ----------
+        w : float
+            Force to start from [N].
+        """
         self._w = float(w)
         self._x = None
 

@@ -332,6 +332,18 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         ``~ N^-5``, below 1e-10 of ``|W_1|`` there.  For a non-integer ``n`` the
         crossing of ``z = 0`` (``|z|^n``) is not corrected and the count of
         :meth:`NormalisedRateIndependent.default_samples` applies.
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the input over one period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic wanted.
+
+        Returns
+        -------
+        int
+            Samples per period.
         """
         if self.n != math.floor(self.n):
             return super().default_samples(X, n_harmonics)
@@ -410,6 +422,13 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         ``k A / fc = 3000``), cached per amplitude.  `omega` is ignored
         (rate-independent); the result is broadcast against it.  ``A = 0``
         gives ``k``.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        omega : array_like, optional
+            Angular frequency [rad/s]; ignored.
         """
         return self._describing_function(check_amplitudes(A), omega)
 
@@ -456,6 +475,22 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         for ``n = 1, 2``, where ``w`` crosses 0) is subtracted in closed form
         (:func:`~motionhyst.hysteresis._ode_kernels.alias_of_jumps`), so that
         for ``n = 1, 2`` the error falls as ``N^-5``.  `omega` is ignored.
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the input over one period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency [rad/s]; ignored.
+        n_samples : int, optional
+            Samples per period (default :meth:`default_samples`).
+
+        Returns
+        -------
+        ndarray of complex, shape (H + 1,)
+            ``W_0 .. W_H``.
         """
         return self._harmonics(X, n_harmonics, n_samples)
 

@@ -100,6 +100,14 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
         about 1e-10 relative; values are cached per amplitude.  `omega` is
         accepted for the common interface and ignored (rate-independent); the
         result is broadcast against it.  ``A = 0`` gives ``k``.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        omega : array_like, optional
+            Angular frequency [rad/s]; ignored (rate-independent), the result is broadcast against
+            it.
         """
         return self._describing_function(check_amplitudes(A), omega)
 
@@ -137,6 +145,17 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
         period (a scalar fixed point, found by secant steps to 1e-14 of the
         loop's range), and the samples are transformed by an FFT.  `omega` is
         ignored (rate-independent).
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement over one period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency of the period [rad/s]; ignored (rate-independent).
+        n_samples : int, optional
+            Samples per period (default :meth:`default_samples`).
         """
         return self._harmonics(X, n_harmonics, n_samples)
 

@@ -125,6 +125,11 @@ class Jenkins(Hysteresis):
         """Dimensionless coefficient ``zeta = fc / (k A)``, paper eq. (4).
 
         ``A = 0`` gives ``inf`` (the element does not slip).
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
         """
         a = check_amplitudes(A)
         with np.errstate(divide="ignore", over="ignore"):
@@ -136,6 +141,14 @@ class Jenkins(Hysteresis):
 
         `omega` is accepted for the common interface and ignored: the element
         is rate-independent.  Returns a complex scalar for scalar `A`.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        omega : array_like, optional
+            Angular frequency [rad/s]; ignored (rate-independent), the result is broadcast against
+            it.
         """
         a = check_amplitudes(A)
         with np.errstate(divide="ignore", over="ignore"):
@@ -176,7 +189,17 @@ class Jenkins(Hysteresis):
 
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:
-        """Exact harmonics of the periodic output (see :mod:`motionhyst.hysteresis.periodic`)."""
+        """Exact harmonics of the periodic output (see :mod:`motionhyst.hysteresis.periodic`).
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement over one period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency of the period [rad/s]; ignored (rate-independent).
+        """
         from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 
         return stop_periodic_harmonics(np.asarray(X, dtype=complex), self.k, self.fc, n_harmonics)
@@ -193,6 +216,13 @@ class Jenkins(Hysteresis):
         Even harmonics are zero (half-wave symmetry); ``zeta >= 1`` gives
         ``H_1 = k`` only.  Terms of size ``k A`` cancel for small ``zeta``: the
         absolute accuracy is about ``1e-16 / zeta`` of ``|H_1|``.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        n_max : int
+            Highest harmonic, >= 1.
 
         Returns
         -------
@@ -233,6 +263,13 @@ class Jenkins(Hysteresis):
         ``dw/dt = k xdot / 2 {1 - sign(w^2 - fc^2) - sign(xdot w) (1 + sign(w^2 - fc^2))}``.
         Discontinuous at ``|w| = fc``: general ODE solvers chatter on it, so
         motionhyst itself uses :meth:`response`.  Provided for comparison.
+
+        Parameters
+        ----------
+        w : array_like
+            Force of the element [N].
+        xdot : array_like
+            Velocity of the displacement [m/s].
         """
         w = np.asarray(w, dtype=float)
         xdot = np.asarray(xdot, dtype=float)

@@ -136,17 +136,35 @@ class LuGre(Hysteresis):
         return self.sigma0
 
     def stribeck(self, v: ArrayLike) -> NDArray[np.float64]:
-        """Stribeck curve ``g(v)`` [N] at velocity(ies) `v` [m/s]."""
+        """Stribeck curve ``g(v)`` [N] at velocity(ies) `v` [m/s].
+
+        Parameters
+        ----------
+        v : array_like
+            Sliding velocity(ies) [m/s].
+        """
         r = np.asarray(v, dtype=float) / self.vs
         return self.fc + (self.fs - self.fc) * np.exp(-r * r)
 
     def steady_sliding_force(self, v: ArrayLike) -> NDArray[np.float64]:
-        """Friction in steady sliding, ``g(v) sign(v) + sigma2 v`` [N]."""
+        """Friction in steady sliding, ``g(v) sign(v) + sigma2 v`` [N].
+
+        Parameters
+        ----------
+        v : array_like
+            Sliding velocity(ies) [m/s].
+        """
         v = np.asarray(v, dtype=float)
         return self.stribeck(v) * np.sign(v) + self.sigma2 * v
 
     def small_amplitude_limit(self, omega: ArrayLike) -> NDArray[np.complex128]:
-        """``D`` for vanishing amplitude, ``sigma0 + j omega (sigma1 + sigma2)`` [N/m]."""
+        """``D`` for vanishing amplitude, ``sigma0 + j omega (sigma1 + sigma2)`` [N/m].
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular frequency(ies) [rad/s].
+        """
         return self.sigma0 + 1j * np.asarray(omega, dtype=float) * (self.sigma1 + self.sigma2)
 
     # ------------------------------------------------------------------ periodic state
@@ -171,6 +189,15 @@ class LuGre(Hysteresis):
         costs nothing measurable (measured: ``D`` agrees with an adaptive ODE
         reference to about 1e-11 relative or better for ``omega A / vs`` from 0.06
         to 6e5 and ``sigma0 A / fc`` from 0.4 to 1000).
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement over one period (``rfft / N`` scaling).
+        omega : float
+            Angular frequency [rad/s] (does not change the size, see above).
+        n_harmonics : int
+            Highest output harmonic wanted.
         """
         return self._samples(truncate_harmonics(X), n_harmonics)
 
@@ -313,7 +340,17 @@ class LuGre(Hysteresis):
 
     def hosidf(self, A: ArrayLike, n_max: int, omega: float | None = None
                ) -> NDArray[np.complex128]:
-        """Higher-order describing functions ``H_1 .. H_n_max`` at `omega` (required) [N/m]."""
+        """Higher-order describing functions ``H_1 .. H_n_max`` at `omega` (required) [N/m].
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        n_max : int
+            Highest harmonic, >= 1.
+        omega : float
+            Angular frequency [rad/s]; required (rate-dependent).
+        """
         om = check_omega(omega, "LuGre")
         out = super().hosidf(A, n_max, om)
         a = check_amplitudes(A)
@@ -322,13 +359,32 @@ class LuGre(Hysteresis):
 
     def sine_loop(self, A: float, omega: float | None = None, n_samples: int | None = None
                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """One closed period of the exact periodic response (see :meth:`Hysteresis.sine_loop`)."""
+        """One closed period of the exact periodic response (see :meth:`Hysteresis.sine_loop`).
+
+        Parameters
+        ----------
+        A : float
+            Amplitude [m], > 0.
+        omega : float
+            Angular frequency [rad/s]; required (rate-dependent).
+        n_samples : int, optional
+            Samples per period (default :meth:`default_samples`).
+        """
         _, x, w = self.steady_loop(A, omega, n_samples)
         return np.append(x, x[0]), np.append(w, w[0])
 
     def steady_loop(self, A: float, omega: float, n_samples: int | None = None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """One period of the periodic response to ``x = A sin(theta)``, ``theta = omega t``.
+
+        Parameters
+        ----------
+        A : float
+            Amplitude [m], > 0.
+        omega : float
+            Angular frequency [rad/s], >= 0.
+        n_samples : int, optional
+            Samples per period (default :meth:`default_samples`).
 
         Returns
         -------

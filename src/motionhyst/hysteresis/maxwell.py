@@ -76,7 +76,16 @@ class MaxwellSlip(Hysteresis):
         return self.k.copy(), self.fc.copy()
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
-        """Sum of the elements' closed-form describing functions (eq. 10) [N/m]."""
+        """Sum of the elements' closed-form describing functions (eq. 10) [N/m].
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        omega : array_like, optional
+            Angular frequency [rad/s]; ignored (rate-independent), the result is broadcast against
+            it.
+        """
         a = check_amplitudes(A)
         with np.errstate(divide="ignore", over="ignore"):
             zeta = self.fc / (self.k * a[..., None])
@@ -86,11 +95,28 @@ class MaxwellSlip(Hysteresis):
         return complex(d) if d.ndim == 0 else d
 
     def hosidf_closed_form(self, A: ArrayLike, n_max: int) -> NDArray[np.complex128]:
-        """Sum of the elements' closed-form higher-order describing functions [N/m]."""
+        """Sum of the elements' closed-form higher-order describing functions [N/m].
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        n_max : int
+            Highest harmonic, >= 1.
+        """
         return sum(el.hosidf_closed_form(A, n_max) for el in self.elements)
 
     def response(self, x: ArrayLike, w0: ArrayLike = 0.0) -> NDArray[np.float64]:
-        """Total force for a sampled displacement; `w0` is the initial force per element."""
+        """Total force for a sampled displacement; `w0` is the initial force per element.
+
+        Parameters
+        ----------
+        x : array_like
+            Displacement samples [m].
+        w0 : float or array_like
+            Initial force of each element [N], ``|w0_i| <= fc_i`` (a scalar applies to every
+            element).
+        """
         from motionhyst.hysteresis._kernels import maxwell_response
 
         xs = np.ascontiguousarray(x, dtype=float)
@@ -109,6 +135,15 @@ class MaxwellSlip(Hysteresis):
 
         The elements share the reversal points of `X` and one convolution
         (see :mod:`motionhyst.hysteresis.periodic`).
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement over one period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency of the period [rad/s]; ignored (rate-independent).
         """
         from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 
@@ -120,7 +155,13 @@ class MaxwellSlip(Hysteresis):
         return float(sum(el(x) for el in self.elements))
 
     def reset(self, w: float = 0.0) -> None:
-        """Reset the elements' state (the force `w` is shared in proportion to fc)."""
+        """Reset the elements' state (the force `w` is shared in proportion to fc).
+
+        Parameters
+        ----------
+        w : float
+            Total force to start from [N].
+        """
         share = np.asarray(self.fc) / np.sum(self.fc)
         for el, s in zip(getattr(self, "elements", []), share, strict=False):
             el.reset(w * s)

@@ -299,6 +299,11 @@ class MaxwellIwan(Hysteresis):
 
         The transfer function of the spring and the Maxwell branches, from
         ``x`` to their force: the part of ``D`` that does not depend on the amplitude.
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular frequency(ies) [rad/s].
         """
         jw = 1j * np.asarray(omega, dtype=float)[..., None]
         return self.k0 + np.sum(self.kv * jw * self.cv / (self.kv + jw * self.cv), axis=-1)
@@ -346,6 +351,14 @@ class MaxwellIwan(Hysteresis):
         convergence); ``d_min = d_max`` gives the one Jenkins element.  Beyond
         ``MAX_CUTS`` breaks (an input with many reversals per period) the cuts
         are their quantiles and the convergence at the others algebraic.
+
+        Parameters
+        ----------
+        breaks : array_like
+            Slip displacements [m] at which the integrand has a kink (cuts of the rule); those
+            outside ``(d_min, d_max)`` are ignored.
+        n : int
+            Gauss nodes per interval.
         """
         if self.d_max == self.d_min:
             return np.array([self.ki]), np.array([self.ki * self.d_max])
@@ -423,6 +436,15 @@ class MaxwellIwan(Hysteresis):
         """Higher-order describing functions ``H_1 .. H_n_max`` at `omega` (required) [N/m].
 
         From :meth:`periodic_harmonics`; the linear parts give ``H_1`` only.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        n_max : int
+            Highest harmonic, >= 1.
+        omega : float
+            Angular frequency [rad/s]; required (rate-dependent).
         """
         om = check_omega(omega, "maxwell-iwan")
         out = super().hosidf(A, n_max, om)
@@ -436,6 +458,11 @@ class MaxwellIwan(Hysteresis):
         ``ki u`` up to ``d_min``, ``ki (u - (u - d_min)^2 / (2 (d_max - d_min)))`` up to
         ``d_max`` and ``ki mean(d)`` beyond.  By the Masing rules a branch after a
         reversal at ``(x_r, w_r)`` is ``w_r +- 2 virgin_force(|x - x_r| / 2)``.
+
+        Parameters
+        ----------
+        u : array_like
+            Displacement(s) from the unloaded state [m]; its magnitude is used.
         """
         v = np.abs(np.asarray(u, dtype=float))
         lo, hi = self.d_min, self.d_max

@@ -26,7 +26,15 @@ TWO_PI = 2.0 * np.pi
 
 
 def significant_harmonics(X: NDArray[np.complex128], rtol: float = 1e-15) -> int:
-    """Number of leading harmonics of `X` (excluding DC) whose tail is below `rtol` of the total."""
+    """Number of leading harmonics of `X` (excluding DC) whose tail is below `rtol` of the total.
+
+    Parameters
+    ----------
+    X : ndarray of complex
+        Harmonics ``X_0 .. X_M``.
+    rtol : float
+        Relative size of the tail that may be dropped.
+    """
     mags = np.abs(X[1:])
     total = mags.sum()
     if total == 0.0:
@@ -37,7 +45,17 @@ def significant_harmonics(X: NDArray[np.complex128], rtol: float = 1e-15) -> int
 
 
 def trig_eval(X: NDArray[np.complex128], theta, deriv: int = 0):
-    """Value (or derivative of order `deriv`) of the trigonometric polynomial `X` at `theta`."""
+    """Value (or derivative of order `deriv`) of the trigonometric polynomial `X` at `theta`.
+
+    Parameters
+    ----------
+    X : ndarray of complex
+        Harmonics ``X_0 .. X_M`` of ``X_0 + 2 Re sum X_m exp(j m theta)``.
+    theta : array_like
+        Angle(s) [rad].
+    deriv : int
+        Order of the derivative in ``theta`` (0: the value).
+    """
     m = np.arange(len(X))
     coef = X * (1j * m) ** deriv
     th = np.asarray(theta, dtype=float)

@@ -132,6 +132,11 @@ def register(cls: _H) -> _H:
 def model_class(name: str) -> Any:
     """The registered model class of a scenario's ``model = name``.
 
+    Parameters
+    ----------
+    name : str
+        A registered model's name (``[hysteresis] model = name``).
+
     Raises
     ------
     ValueError

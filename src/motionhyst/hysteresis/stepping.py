@@ -432,6 +432,23 @@ def open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt,
 def open_loop(codes, params, s0, x, h, glt, glw):
     """Force of the elements for the displacement samples `x` (step `h`), from rest at ``x[0]``.
 
+    Parameters
+    ----------
+    codes : ndarray of int
+        Element codes of a :class:`Stepping` (``Stepping.codes``).
+    params : ndarray
+        Element parameters (``Stepping.params``).
+    s0 : array_like
+        Initial element states (``Stepping.state0``: at rest).
+    x : array_like
+        Displacement samples [m].
+    h : float
+        Time step between samples [s].
+    glt : ndarray
+        Gauss-Legendre nodes on [0, 1] of the rate-dependent elements' step (:data:`GL_T`).
+    glw : ndarray
+        Their weights (:data:`GL_W`).
+
     Examples
     --------
     >>> from motionhyst.hysteresis import Dahl
