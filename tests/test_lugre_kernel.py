@@ -3,7 +3,7 @@
 Near a reversal the Stribeck curve ``g(v) = fc + (fs - fc) exp(-(v / vs)^2)``
 varies only while ``|v| < 6 vs``, an angle ``~ 6 vs / (omega A)`` wide: at
 ``A = 0.01 m``, ``vs = 1 mm/s`` and 1 kHz that is 1e-4 rad, a sixteenth of a
-grid cell at ``N = 4096``.  :func:`~motionhyst.hysteresis._ode_kernels.lugre_periodic_state`
+grid cell at ``N = 4096``.  :func:`~motionhyst.hysteresis._lugre_kernels.lugre_periodic_state`
 cuts the steps that meet the window into substeps (``omega x'`` changes by
 at most ``vs / 48`` in each near the reversal), so :meth:`LuGre.default_samples`
 no longer grows with ``omega A / vs``.  These tests check

@@ -65,7 +65,7 @@ _ANCHOR = 4  # phasor powers are recomputed directly every _ANCHOR steps
 
 
 @njit(cache=True)
-def _trig2(A, B, theta):  # pragma: no cover - compiled
+def trig2(A, B, theta):  # pragma: no cover - compiled
     """``2 Re sum_m A_m z^m`` and ``2 Re sum_m B_m z^m`` (m >= 1, ``z = exp(j theta)``), Horner."""
     z = complex(np.cos(theta), np.sin(theta))
     pa = 0j
@@ -101,7 +101,7 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
         lo, hi = a, b
         rising = fb > fa
         for _ in range(100):
-            f, fp = _trig2(A, B, t)
+            f, fp = trig2(A, B, t)
             f -= level
             if f == 0.0:
                 return t
@@ -122,7 +122,7 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
     hi = b + 0.5 * h
     converged = True
     for _ in range(8):
-        f, fp = _trig2(A, B, t)
+        f, fp = trig2(A, B, t)
         if fp == 0.0:
             converged = False
             break
@@ -136,19 +136,19 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
     if converged:
         return t
     # bisection on the widest bracket with a sign change
-    flo = _trig2(A, B, lo)[0] - level
-    fhi = _trig2(A, B, hi)[0] - level
+    flo = trig2(A, B, lo)[0] - level
+    fhi = trig2(A, B, hi)[0] - level
     if flo * fhi > 0.0:
         lo, hi = a, b
-        flo = _trig2(A, B, lo)[0] - level
-        fhi = _trig2(A, B, hi)[0] - level
+        flo = trig2(A, B, lo)[0] - level
+        fhi = trig2(A, B, hi)[0] - level
         if flo * fhi > 0.0:
             return a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if hi - lo <= 1e-15 + 1e-15 * abs(mid) or mid == lo or mid == hi:
             break
-        fm = _trig2(A, B, mid)[0] - level
+        fm = trig2(A, B, mid)[0] - level
         if fm == 0.0:
             return mid
         if (fm > 0.0) == (flo > 0.0):
@@ -218,7 +218,7 @@ def reversal_points(X, C1, C2, d):  # pragma: no cover - compiled
         rev[j] = r
     xr = np.empty(rev.shape[0])
     for q in range(rev.shape[0]):
-        xr[q] = X[0].real + _trig2(X, C1, rev[q])[0]
+        xr[q] = X[0].real + trig2(X, C1, rev[q])[0]
     return rev, xr
 
 
@@ -233,12 +233,12 @@ def _crossing(X, C1, x, level, a, b):  # pragma: no cover - compiled
     i0 = int(np.floor(a / h))
     i1 = int(np.ceil(b / h))
     t_prev = a
-    g_prev = X[0].real + _trig2(X, C1, a)[0] - level
+    g_prev = X[0].real + trig2(X, C1, a)[0] - level
     t_first, g_first = a, g_prev
     for i in range(i0 + 1, i1 + 1):
         if i == i1:
             t = b
-            g = X[0].real + _trig2(X, C1, b)[0] - level
+            g = X[0].real + trig2(X, C1, b)[0] - level
         else:
             t = i * h
             g = x[i % n] - level
@@ -249,7 +249,7 @@ def _crossing(X, C1, x, level, a, b):  # pragma: no cover - compiled
         t_prev, g_prev = t, g
     # no sign change (the level is a round-off outside [x(a), x(b)]): the first cell
     return trig_root(X, C1, level - X[0].real, a, t_first,
-                     X[0].real + _trig2(X, C1, a)[0] - level, g_first)
+                     X[0].real + trig2(X, C1, a)[0] - level, g_first)
 
 
 @njit(cache=True)

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.validation import check_omega
-from motionhyst.hysteresis._ode_kernels import (
+from motionhyst.hysteresis._lugre_kernels import (
     TWO_PI,
     lugre_g,
     lugre_periodic_state,
@@ -70,7 +70,7 @@ class LuGre(Hysteresis):
     affine), integrated by an exponential scheme exact for constant ``g``,
     with substeps where the Stribeck curve varies (``|v| < 6 vs``, near the
     reversals), so the grid does not grow with ``omega A / vs``
-    (see :func:`~motionhyst.hysteresis._ode_kernels.lugre_periodic_state`).
+    (see :func:`~motionhyst.hysteresis._lugre_kernels.lugre_periodic_state`).
 
     Parameters
     ----------
@@ -183,7 +183,7 @@ class LuGre(Hysteresis):
         signature): the Stribeck window ``|v| < 6 vs``, only
         ``~ 6 vs / (omega A)`` rad wide around a reversal at high
         ``omega A / vs``, is resolved by substeps inside
-        :func:`~motionhyst.hysteresis._ode_kernels.lugre_periodic_state`, not by the grid.
+        :func:`~motionhyst.hysteresis._lugre_kernels.lugre_periodic_state`, not by the grid.
         The window leaves a narrow change in ``z`` whose effect on ``D`` falls
         as ``(vs / (omega A))^2``; sampling it on a grid coarser than the window
         costs nothing measurable (measured: ``D`` agrees with an adaptive ODE

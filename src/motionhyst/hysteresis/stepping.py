@@ -28,13 +28,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.compiled import njit
-from motionhyst.hysteresis._ode_kernels import (
-    GL_T,
-    GL_W,
-    bouc_wen_step,
-    dahl_advance,
-    lugre_relax,
-)
+from motionhyst.hysteresis._lugre_kernels import lugre_relax
+from motionhyst.hysteresis._ode_kernels import GL_T, GL_W, bouc_wen_step, dahl_advance
 
 __all__ = ["BOUC_WEN", "COULOMB", "DAHL", "DIFFERENTIATED", "GL_T", "GL_W", "LUGRE", "MAXWELL",
            "N_PARAMS", "N_PARTIALS", "STOP", "Stepping", "advance", "advance_partials",

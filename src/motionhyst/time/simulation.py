@@ -36,8 +36,7 @@ from motionhyst.core.lti import (
 )
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
-from motionhyst.hysteresis._ode_kernels import GL_T, GL_W
-from motionhyst.hysteresis.stepping import Stepping, advance, open_loop_chunk
+from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, advance, open_loop_chunk
 from motionhyst.loop import Loop
 
 STEPS_PER_POLE_PERIOD = 40
