@@ -211,15 +211,15 @@ def test_free_exponent_of_the_benchmark_link_is_fixed_at_one():
 
 
 def test_inseparable_parameters_are_reported_not_given_huge_errors():
-    from motionhyst.identify.io_uncertainty import _uncertainty, _undetermined_notes
+    from motionhyst.identify.io_uncertainty import standard_errors, undetermined_notes
 
     rng = np.random.default_rng(8)
     a, b = rng.standard_normal(200), rng.standard_normal(200)
     J = np.column_stack([a, b, 3.0 * b, np.zeros(200)])  # b, 3b: only b + 3c counts
-    std, groups = _uncertainty(J, rss=2.0, n_rows=200)
+    std, groups = standard_errors(J, rss=2.0, n_rows=200)
     assert sorted(map(sorted, groups)) == [[1, 2], [3]]
     assert np.isfinite(std[0]) and np.all(np.isnan(std[1:]))
-    notes = _undetermined_notes(["m", "k", "link.k", "fc"], groups, 1e-8)
+    notes = undetermined_notes(["m", "k", "link.k", "fc"], groups, 1e-8)
     assert notes["k"].startswith("not determined by these records: only a combination with "
                                  "link.k is")
     assert "no effect on the output" in notes["fc"]

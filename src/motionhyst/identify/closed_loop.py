@@ -17,12 +17,14 @@ from motionhyst.identify.fit import (
     MAX_ELEMENTS,
     MAX_ROWS,
     Criterion,
-    _identify,
-    _Problem,
-    _rows,
+    FitProblem,
+    fit_rows,
+    identify_prepared,
 )
-from motionhyst.identify.records import MIN_SAMPLES, _check_signals, count_reversals
+from motionhyst.identify.records import MIN_SAMPLES, check_signals, count_reversals
 from motionhyst.identify.result import Identification
+
+__all__ = ["LinkForce", "identify_closed_loop", "infer_link_force"]
 
 DECIMATED_RATE = 40.0
 """Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""
@@ -155,7 +157,7 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     ts = np.asarray(t, dtype=float)
     ys = np.ascontiguousarray(np.asarray(y1, dtype=float))
     us = np.asarray(u, dtype=float)
-    _check_signals(ys, {"u": us}, ts, xname="y1")
+    check_signals(ys, {"u": us}, ts, xname="y1")
     dts = np.diff(ts)
     dt = float(np.median(dts))
     if np.max(np.abs(dts - dt)) > UNIFORM_RTOL * dt:
@@ -244,8 +246,8 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     q = max(1, int(1.0 / (dt * DECIMATED_RATE * lf.cutoff_hz)))
     sel = np.arange(0, lf.y1.size, q)
     start = int(np.searchsorted(sel, lf.settle_index))
-    prob = _Problem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],
-                    rows=_rows(start, sel.size, max_rows), filt=lf.lowpass.with_step(q * dt),
-                    fit_initial=initial_state == "fit")
-    return _identify(prob, n_elements, criterion, rtol, atol, max_elements,
-                     "prefiltered force", cutoff_hz=lf.cutoff_hz)
+    prob = FitProblem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],
+                      rows=fit_rows(start, sel.size, max_rows), filt=lf.lowpass.with_step(q * dt),
+                      fit_initial=initial_state == "fit")
+    return identify_prepared(prob, n_elements, criterion, rtol, atol, max_elements,
+                             "prefiltered force", cutoff_hz=lf.cutoff_hz)

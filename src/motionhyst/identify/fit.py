@@ -16,8 +16,10 @@ from scipy.optimize import least_squares, nnls
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import HoldFilter
 from motionhyst.hysteresis import MaxwellSlip
-from motionhyst.identify.records import _check_signals
+from motionhyst.identify.records import check_signals
 from motionhyst.identify.result import Identification
+
+__all__ = ["identify_maxwell_slip"]
 
 N_GRID = 40
 """Candidate slip displacements in the NNLS stage."""
@@ -67,7 +69,7 @@ Criterion = Literal["rms", "bic"]
 
 
 @dataclass
-class _Problem:
+class FitProblem:
     """Data of one fit: operators run on `x`; residual on `rows` of `target`."""
 
     x: NDArray[np.float64]
@@ -179,7 +181,7 @@ def _stops_at(x, d, w0, rows, per_slip_force):  # pragma: no cover - compiled
     return S
 
 
-def _evaluate(prob: _Problem, theta, n: int, jac: bool):
+def _evaluate(prob: FitProblem, theta, n: int, jac: bool):
     """Residual (model - target) at the rows and, optionally, its Jacobian.
 
     Without a prefilter the operators keep only the rows (memory and time
@@ -210,7 +212,7 @@ def _evaluate(prob: _Problem, theta, n: int, jac: bool):
     return r, J
 
 
-def _refine(prob: _Problem, k, fc, alpha, c, max_nfev: int = MAX_NFEV) -> _Fit:
+def _refine(prob: FitProblem, k, fc, alpha, c, max_nfev: int = MAX_NFEV) -> _Fit:
     """Joint bounded least-squares refinement of all parameters."""
     n = len(k)
     theta0 = _pack(k, fc, np.clip(alpha, -0.999, 0.999), c, prob.fit_initial)
@@ -241,12 +243,12 @@ def _refine(prob: _Problem, k, fc, alpha, c, max_nfev: int = MAX_NFEV) -> _Fit:
                 resid=r)
 
 
-def _rss_only(prob: _Problem, k, fc, alpha, c) -> float:
+def _rss_only(prob: FitProblem, k, fc, alpha, c) -> float:
     r, _ = _evaluate(prob, _pack(k, fc, alpha, c, prob.fit_initial), len(k), False)
     return float(r @ r)
 
 
-def _unit_columns(prob: _Problem, d, w0, per_slip_force: bool = False
+def _unit_columns(prob: FitProblem, d, w0, per_slip_force: bool = False
                   ) -> NDArray[np.float64]:
     """Unit-stiffness stop operators of thresholds `d` started at `w0`, at the rows.
 
@@ -268,7 +270,7 @@ def _unit_columns(prob: _Problem, d, w0, per_slip_force: bool = False
     return S
 
 
-def _nnls_start(prob: _Problem) -> tuple[NDArray, NDArray, float]:
+def _nnls_start(prob: FitProblem) -> tuple[NDArray, NDArray, float]:
     """Stage 1-2: stop-operator regressor on a threshold grid, NNLS, merge and prune."""
     h = 0.5 * float(np.ptp(prob.x))
     d = np.geomspace(GRID_SPAN * h, h, N_GRID)
@@ -321,7 +323,7 @@ def _best_merge(prob, k, fc, alpha, c):
     return options[int(np.argmin(costs))]
 
 
-def _grow(prob: _Problem, fit: _Fit):
+def _grow(prob: FitProblem, fit: _Fit):
     """Add the grid element that best explains the residual (greedy, non-negative)."""
     A = prob.grid_A - prob.grid_A.mean(axis=0)
     e = -(fit.resid - fit.resid.mean())
@@ -339,7 +341,7 @@ def _collapsed(fit: _Fit) -> bool:
     return bool(np.any(fit.fc <= 1e-6 * fit.fc.sum()) or np.any(fit.k <= 1e-6 * fit.k.sum()))
 
 
-def _scan_thresholds(prob: _Problem, fit: _Fit):
+def _scan_thresholds(prob: FitProblem, fit: _Fit):
     """A start across the kinks next to a refined fit, or ``None`` if there is none better.
 
     With the slip displacements ``d_i = fc_i / k_i`` (and the initial states
@@ -417,7 +419,7 @@ def _scan_thresholds(prob: _Problem, fit: _Fit):
     return (*_sorted(k, k * d, fit.alpha.copy()), float(y.mean() - a_mean @ k))
 
 
-def _merge_chain(prob: _Problem, k, fc, c) -> dict[int, tuple]:
+def _merge_chain(prob: FitProblem, k, fc, c) -> dict[int, tuple]:
     """Starts ``(k, fc, alpha, c)`` per order: the NNLS elements merged pairwise down to 1.
 
     Each step merges the adjacent pair (by slip displacement) whose merge
@@ -431,7 +433,7 @@ def _merge_chain(prob: _Problem, k, fc, c) -> dict[int, tuple]:
     return chain
 
 
-def _fit_order(prob: _Problem, n: int, chain: dict[int, tuple],
+def _fit_order(prob: FitProblem, n: int, chain: dict[int, tuple],
                fits: dict[int, _Fit]) -> _Fit | None:
     """Best refined ``n``-element fit over several starts; ``None`` if every start collapses.
 
@@ -495,9 +497,9 @@ def _covariance_std(fit: _Fit, n_rows: int) -> NDArray[np.float64]:
     return std
 
 
-def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol: float,
-              atol: float, max_elements: int, signal_name: str, *,
-              cutoff_hz: float | None = None) -> Identification:
+def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Criterion, rtol: float,
+                      atol: float, max_elements: int, signal_name: str, *,
+                      cutoff_hz: float | None = None) -> Identification:
     """Stages 1-5 of the module docstring on a prepared problem."""
     if criterion not in ("rms", "bic"):
         raise ValueError(f"unknown criterion {criterion!r}; use 'rms' or 'bic'")
@@ -573,7 +575,7 @@ def _identify(prob: _Problem, n_elements: int | None, criterion: Criterion, rtol
     )
 
 
-def _rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
+def fit_rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
     stride = max(1, int(np.ceil((n - start) / max(int(max_rows), 1))))
     return np.arange(start, n, stride)
 
@@ -655,9 +657,9 @@ def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = N
     xs = np.ascontiguousarray(np.asarray(x, dtype=float))
     ws = np.asarray(w, dtype=float)
     ts = None if t is None else np.asarray(t, dtype=float)
-    _check_signals(xs, {"force": ws}, ts)
+    check_signals(xs, {"force": ws}, ts)
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
-    prob = _Problem(x=xs, target=ws, rows=_rows(0, xs.size, max_rows), filt=None,
-                    fit_initial=initial_state == "fit")
-    return _identify(prob, n_elements, criterion, rtol, atol, max_elements, "force")
+    prob = FitProblem(x=xs, target=ws, rows=fit_rows(0, xs.size, max_rows), filt=None,
+                      fit_initial=initial_state == "fit")
+    return identify_prepared(prob, n_elements, criterion, rtol, atol, max_elements, "force")

@@ -28,7 +28,7 @@ Method
    outside the model's accepted set; the other links, from the model
    registry: parameters started by their units, the link slipping within the
    records or hardly at all, a rate scale such as LuGre's ``vs`` held on a
-   grid, see :func:`~motionhyst.identify.io_elements._identify_elements`).
+   grid, see :func:`~motionhyst.identify.io_elements.identify_elements_io`).
    Several starts are refined on a short part of the records and the best
    continues.  The two-mass stage:
    :func:`~motionhyst.identify.io_start.best_linear_approximation_two_mass`
@@ -38,7 +38,7 @@ Method
    then three splits of the mass at the same internal mode (see
    :func:`~motionhyst.identify.io_bouc_wen._two_mass_start`); its element
    links from 1, 4 and 16 times that spring and forces of 0.3 to 3 times the
-   force's RMS (see :func:`~motionhyst.identify.io_elements._identify_elements`).
+   force's RMS (see :func:`~motionhyst.identify.io_elements.identify_elements_io`).
 3. Refinement: :func:`scipy.optimize.least_squares` (trust-region reflective)
    on parameters scaled by their start values.  Bouc-Wen: the exact Jacobian
    from forward sensitivities integrated with the model (RK4); other links:
@@ -95,11 +95,11 @@ from motionhyst.identify.io_bouc_wen import START_PRODUCTS as START_PRODUCTS
 from motionhyst.identify.io_bouc_wen import START_RATIOS as START_RATIOS
 from motionhyst.identify.io_bouc_wen import START_REFINED as START_REFINED
 from motionhyst.identify.io_bouc_wen import START_SHARES as START_SHARES
-from motionhyst.identify.io_bouc_wen import _identify_bouc_wen, _identify_two_mass
+from motionhyst.identify.io_bouc_wen import identify_bouc_wen_msd, identify_bouc_wen_two_mass
 from motionhyst.identify.io_elements import PROFILE_CHI2 as PROFILE_CHI2
 from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
-from motionhyst.identify.io_elements import _identify_elements
+from motionhyst.identify.io_elements import identify_elements_io
 from motionhyst.identify.io_records import MIN_SAMPLES as MIN_SAMPLES
 from motionhyst.identify.io_records import IORecord, check_records
 from motionhyst.identify.io_records import load_io_csv as load_io_csv
@@ -113,6 +113,8 @@ from motionhyst.identify.io_start import two_mass_response as two_mass_response
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
 from motionhyst.time.openloop import TwoMass, is_periodic_record
+
+__all__ = ["identify_io"]
 
 #: Link models for input-output records: Bouc-Wen (exact sensitivities) and every other
 #: registered model (its parameters taken from the registry); not maxwell-iwan, whose Iwan
@@ -265,9 +267,9 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     if output not in TwoMass.OUTPUTS:
         raise ValueError(f"unknown output {output!r}; expected y2 or y1")
     if model != "bouc-wen":
-        return _identify_elements(records, model, periodic, substeps, tol, max_nfev,
-                                  n_elements, t_start, start_nfev, plant, output)
+        return identify_elements_io(records, model, periodic, substeps, tol, max_nfev,
+                                    n_elements, t_start, start_nfev, plant, output)
     if plant == "two-mass":
-        return _identify_two_mass(records, periodic, nu, substeps, tol, max_nfev, output,
-                                  t_start)
-    return _identify_bouc_wen(records, periodic, nu, substeps, tol, max_nfev, t_start)
+        return identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output,
+                                          t_start)
+    return identify_bouc_wen_msd(records, periodic, nu, substeps, tol, max_nfev, t_start)

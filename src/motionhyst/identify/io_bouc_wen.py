@@ -2,8 +2,8 @@
 
 The link of the benchmark (Noel and Schoukens 2016) in the general form,
 ``z' = alpha y' - beta (gamma |y'| |z|^(nu-1) z + delta y' |z|^nu)``, on a
-mass-spring-damper (:func:`_identify_bouc_wen`) or on the floating two-mass stage
-of eqs. (1)-(2) (:func:`_identify_two_mass`, its starts :func:`_two_mass_start`).
+mass-spring-damper (:func:`identify_bouc_wen_msd`) or on the floating two-mass stage
+of eqs. (1)-(2) (:func:`identify_bouc_wen_two_mass`, its starts :func:`_two_mass_start`).
 The simulation residuals and their exact Jacobian, from forward sensitivities
 integrated with the model (:func:`~motionhyst.time.openloop.simulate_bouc_wen`), are
 :class:`_BoucWenProblem`'s; the trust-region refinement is :func:`_solve`.
@@ -25,8 +25,8 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import BoucWen, Hysteresis
-from motionhyst.identify.io_records import IORecord, _short_records
-from motionhyst.identify.io_results import IOIdentification, _per_record
+from motionhyst.identify.io_records import IORecord, short_records
+from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
@@ -34,8 +34,8 @@ from motionhyst.identify.io_start import (
 )
 from motionhyst.identify.io_uncertainty import (
     SINGULAR_RTOL,
-    _uncertainty,
-    _undetermined_notes,
+    standard_errors,
+    undetermined_notes,
 )
 from motionhyst.time.openloop import (
     MIN_SUBSTEPS,
@@ -46,6 +46,8 @@ from motionhyst.time.openloop import (
     fine_input,
     simulate_bouc_wen,
 )
+
+__all__ = []
 
 
 class _BoucWenProblem:
@@ -182,9 +184,9 @@ def _force_scale(p: NDArray[np.float64], y_scale: float) -> float:
     return f if math.isfinite(f) and f > 0.0 else 1.0
 
 
-def _identify_bouc_wen(records: list[IORecord], periodic: bool, nu: float | None,
-                       substeps: int | None, tol: float, max_nfev: int, t_start: float
-                       ) -> IOIdentification:
+def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | None,
+                          substeps: int | None, tol: float, max_nfev: int, t_start: float
+                          ) -> IOIdentification:
     """The mass-spring-damper and a Bouc-Wen link (problem order ``m, c, k, alpha,
     beta*gamma, beta*delta, nu``): the linear model by simulation error on a short part
     of the records, the starts of :func:`_bouc_wen_starts` screened there by one
@@ -201,7 +203,7 @@ def _identify_bouc_wen(records: list[IORecord], periodic: bool, nu: float | None
     nu0 = 1.0 if nu is None else float(nu)
 
     # 1. the linear model by simulation error (link off), on a short part of the records
-    short = _short_records(records, periodic)
+    short = short_records(records, periodic)
     lin_free = np.array([True, True, True, False, False, False, False])
     prob = _BoucWenProblem(short, periodic, r, lin_free,
                            np.array([bla.m, bla.c, bla.k, 0.0, 0.0, 0.0, nu0]), y_scale)
@@ -255,8 +257,8 @@ def _identify_bouc_wen(records: list[IORecord], periodic: bool, nu: float | None
                  "gamma": "see beta", "delta": "see beta", **notes}
     for n, s in zip(free_names, std_q, strict=True):
         std[n] = float(s) if math.isfinite(s) else None
-    not_ident.update(_undetermined_notes(free_names, groups, SINGULAR_RTOL))
-    per_record = _per_record(records, res)
+    not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
+    per_record = per_record_errors(records, res)
     return IOIdentification(
         plant=plant, hysteresis=link, estimates=estimates, std=std,
         not_identifiable=not_ident, fit_rms=float(np.sqrt(rss / res.size)),
@@ -312,7 +314,7 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
         p = prob.full(sol.x, scale)
         res, jac = prob.run(p, True)
         res *= y_scale
-        std_q, groups = _uncertainty(jac[:, free] * y_scale, float(res @ res), res.size)
+        std_q, groups = standard_errors(jac[:, free] * y_scale, float(res @ res), res.size)
         if not free[6] or p[4] + p[5] >= 0.0:
             break
         nu_std = std_q[int(np.count_nonzero(free[:6]))]
@@ -327,8 +329,8 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
     return p, free, sol, res, std_q, groups, notes, n_eval
 
 
-def _identify_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start
-                       ) -> IOIdentification:
+def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start
+                               ) -> IOIdentification:
     """The two-mass stage and a Bouc-Wen link: :func:`_two_mass_start`, then :func:`_refine`
     on all records (problem order ``m1, m2, b, alpha, beta*gamma, beta*delta, nu, k``)."""
     structure, r, y_scale, scale, free, p, n_eval = _two_mass_start(records, periodic, nu,
@@ -351,11 +353,11 @@ def _identify_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t
     not_ident = {"beta": "only the products beta*gamma and beta*delta enter the model "
                          "(z is not measured); beta is fixed by |gamma| + |delta| = 1",
                  "gamma": "see beta", "delta": "see beta", **notes}
-    not_ident.update(_undetermined_notes(free_names, groups, SINGULAR_RTOL))
+    not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
     return IOIdentification(
         plant=stage, hysteresis=link, estimates=estimates, std=std,
         not_identifiable=not_ident, fit_rms=float(np.sqrt(rss / res.size)),
-        records=_per_record(records, res), seconds=time.perf_counter() - t_start,
+        records=per_record_errors(records, res), seconds=time.perf_counter() - t_start,
         periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
@@ -380,7 +382,7 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
                       1.0 / y_scale, 1.0 / y_scale, 1.0, bla.k])
     free = np.array([True] * 6 + [nu is None, True])
     nu0 = 1.0 if nu is None else float(nu)
-    short = _short_records(records, periodic)
+    short = short_records(records, periodic)
     free_start = free.copy()
     free_start[6] = False
     n_eval = 0

@@ -4,7 +4,7 @@ Links of exact-update elements (Jenkins, Maxwell-slip, Dahl, LuGre: every
 registered model but Bouc-Wen and the Iwan one), their parameters taken from
 the registry's :class:`~motionhyst.hysteresis.registry.Parameter` list
 (:class:`_LinkLayout`), on a mass-spring-damper or the floating two-mass stage
-of eqs. (1)-(2) (:func:`_identify_elements`).  The simulation residuals and
+of eqs. (1)-(2) (:func:`identify_elements_io`).  The simulation residuals and
 their Jacobian (exact, from the forward sensitivities of
 :func:`~motionhyst.time.openloop.simulate_elements`, or by finite differences for
 an element kind without them) are :class:`_ElementProblem`'s.
@@ -23,8 +23,8 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import Hysteresis, Parameter
-from motionhyst.identify.io_records import _short_records
-from motionhyst.identify.io_results import IOIdentification, _per_record
+from motionhyst.identify.io_records import short_records
+from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
@@ -33,9 +33,9 @@ from motionhyst.identify.io_start import (
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
     SINGULAR_RTOL,
-    _uncertainty,
-    _undetermined_notes,
-    _weak_notes,
+    standard_errors,
+    undetermined_notes,
+    weak_notes,
 )
 from motionhyst.time.openloop import (
     MIN_SUBSTEPS,
@@ -46,6 +46,8 @@ from motionhyst.time.openloop import (
     fine_input,
     simulate_elements,
 )
+
+__all__ = []
 
 # start values and search scales by the parameter's unit (registry.Parameter.unit)
 _STIFFNESS, _FORCE, _DAMPING, _VELOCITY, _LENGTH = "N/m", "N", "N s/m", "m/s", "m"
@@ -326,9 +328,9 @@ RATE_GRID = (0.1, 0.01, 0.03, 0.3, 1.0, 3.0)
 STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 
-def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_start,
-                       start_nfev, plant="mass-spring-damper", output="y2"
-                       ) -> IOIdentification:
+def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t_start,
+                         start_nfev, plant="mass-spring-damper", output="y2"
+                         ) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -386,7 +388,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     n_plant = len((structure or MassSpringDamper).PARAMETERS)
     rate = np.concatenate([[False] * n_plant,
                            [par.unit == _VELOCITY for par, _ in layout._values()]])
-    short = _short_records(records, periodic)
+    short = short_records(records, periodic)
     n_eval = 0
     n_start = start_nfev or 15 * scale.size
 
@@ -423,7 +425,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     J = prob.jacobian(sol.x) * y_scale / prob.derivative(v)  # d residual / d parameter
     n_eval += prob.n_eval
     rtol = SINGULAR_RTOL if prob.exact else FD_SINGULAR_RTOL
-    std_v, groups = _uncertainty(J, rss, res.size, rtol)
+    std_v, groups = standard_errors(J, rss, res.size, rtol)
     names = [*prob.plant.PARAMETERS, *layout.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
@@ -431,8 +433,8 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
         std[nm] = float(sd) if math.isfinite(sd) else None
     not_ident = {f"link.{name}": _parallel_note(layout, name, structure)
                  for name in layout.fixed}
-    not_ident.update(_undetermined_notes(names, groups, rtol))
-    weak = _weak_notes(names, v, std_v, J, rtol, ~prob.log)
+    not_ident.update(undetermined_notes(names, groups, rtol))
+    weak = weak_notes(names, v, std_v, J, rtol, ~prob.log)
     n_short = sum(rec.y.size for rec in short)
     if rate.any() and _flat_profile(profile, n_short - scale.size):
         lo, hi = min(RATE_GRID) * v_scale, max(RATE_GRID) * v_scale
@@ -449,7 +451,7 @@ def _identify_elements(records, model, periodic, substeps, tol, max_nfev, n, t_s
     return IOIdentification(
         plant=prob.plant.with_parameters(v[:n_plant]), hysteresis=layout.build(v[n_plant:]),
         estimates=estimates, std=std, not_identifiable=not_ident,
-        fit_rms=float(np.sqrt(rss / res.size)), records=_per_record(records, res),
+        fit_rms=float(np.sqrt(rss / res.size)), records=per_record_errors(records, res),
         seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "

@@ -3,7 +3,7 @@
 What :func:`motionhyst.identify.input_output.identify_io` takes: an
 :class:`IORecord` per experiment (read from CSV by :func:`load_io_csv`), checked
 by :func:`check_records`; the refinements' starts are tried on the short part
-of the records :func:`_short_records` cuts.
+of the records :func:`short_records` cuts.
 """
 
 from __future__ import annotations
@@ -16,12 +16,35 @@ from numpy.typing import NDArray
 
 from motionhyst.time.openloop import check_record, sampling_rate
 
+__all__ = ["IORecord", "load_io_csv"]
+
 MIN_SAMPLES = 64
 
 
 @dataclass
 class IORecord:
-    """One input-output record: time [s], force [N], displacement [m] and a name."""
+    """One input-output record: time [s], force [N], displacement [m] and a name.
+
+    Attributes
+    ----------
+    t : ndarray
+        Sample times [s], uniformly spaced.
+    u : ndarray
+        Force on the stage [N].
+    y : ndarray
+        Measured displacement [m].
+    name : str
+        Where the record comes from (its file), for messages.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.identify.io_records import IORecord
+    >>> t = np.arange(1000) / 500.0
+    >>> rec = IORecord(t, np.sin(2 * np.pi * 5 * t), 1e-3 * np.sin(2 * np.pi * 5 * t), "sine")
+    >>> round(rec.fs, 9)                                   # sampling frequency [Hz]
+    500.0
+    """
 
     t: NDArray[np.float64]
     u: NDArray[np.float64]
@@ -40,6 +63,30 @@ def load_io_csv(path: str | Path, *, columns: dict[str, str] | None = None,
 
     The file's own names are mapped by `columns` and scaled by `scale`
     (:func:`motionhyst.io.records.read_record`); errors are one-line ``ValueError``.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file with a header naming the columns, or a MATLAB ``.mat`` file.
+    columns : dict, optional
+        Quantity (``"time"``, ``"force"``, ``"displacement"``) -> the file's name for it;
+        a quantity not mapped is read under its own name.
+    scale : dict, optional
+        Quantity -> gain its column is multiplied by (to SI units).
+
+    Returns
+    -------
+    IORecord
+        Named after `path`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "run.csv"
+    >>> _ = path.write_text("time,force,displacement\\n0,0,0\\n0.001,1.5,2e-6\\n")
+    >>> load_io_csv(path).u.tolist()
+    [0.0, 1.5]
     """
     from motionhyst.io.records import read_record
 
@@ -81,8 +128,8 @@ def check_records(records: list[IORecord], periodic: bool) -> list[IORecord]:
 
 
 
-def _short_records(records: list[IORecord], periodic: bool, n_max: int = 4096
-                   ) -> list[IORecord]:
+def short_records(records: list[IORecord], periodic: bool, n_max: int = 4096
+                  ) -> list[IORecord]:
     """The first record, or its first `n_max` samples from rest (whole for periodic records)."""
     rec = records[0]
     if periodic or rec.y.size <= n_max:

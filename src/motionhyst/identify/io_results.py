@@ -11,6 +11,8 @@ from motionhyst.hysteresis import Hysteresis
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop
 
+__all__ = ["IOIdentification"]
+
 
 @dataclass
 class IOIdentification:
@@ -19,6 +21,7 @@ class IOIdentification:
     Attributes
     ----------
     plant : MassSpringDamper or TwoMass
+        The identified stage.
     hysteresis : Hysteresis
         The link model (Bouc-Wen in the general form, normalised so that
         ``|gamma| + |delta| = 1``; or Maxwell-slip).
@@ -41,6 +44,26 @@ class IOIdentification:
         Why the refinement stopped (scipy's message) and its tolerances.
     n_evaluations : int
         Model evaluations of the refinement.
+    substeps : int
+        Integration steps per sample the identification used.
+    extra : dict
+        Further numbers of the model's identification, JSON-ready.
+
+    Examples
+    --------
+    What :func:`~motionhyst.identify.input_output.identify_io` returns:
+
+    >>> import numpy as np
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.identify.input_output import identify_io
+    >>> from motionhyst.identify.io_records import IORecord
+    >>> from motionhyst.openloop import MassSpringDamper, OpenLoop
+    >>> true = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), Jenkins(k=5e4, fc=20.0))
+    >>> t = np.arange(1024) / 750
+    >>> u = 40 * np.sin(2 * np.pi * 8 * t) + 20 * np.sin(2 * np.pi * 31 * t)
+    >>> fit = identify_io([IORecord(t, u, true.simulate(t, u).displacement)], model="jenkins")
+    >>> fit.hysteresis.name, round(fit.estimates["m"], 3)   # the mass [kg]
+    ('jenkins', 2.0)
     """
 
     plant: MassSpringDamper
@@ -94,7 +117,7 @@ def _toml(v: float) -> str:
     return s if any(ch in s for ch in ".en") else s + ".0"
 
 
-def _per_record(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:
+def per_record_errors(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:
     out, i = [], 0
     for rec in records:
         e = res[i:i + rec.y.size]

@@ -19,6 +19,8 @@ from scipy.optimize import least_squares
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
+__all__ = ["best_linear_approximation", "best_linear_approximation_two_mass"]
+
 BLA_STARTS = 6  # two-mass: grid points refined
 
 
@@ -146,6 +148,7 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     Returns
     -------
     plant : TwoMass
+        The stage's start values.
     k_link, c_link : float
         The link's linear stiffness [N/m] and damping [N s/m].
 

@@ -4,8 +4,8 @@ From the Jacobian ``J`` of the simulation residuals at the optimum, standard
 errors ``sqrt(diag(sigma^2 (J^T J)^-1))`` with ``sigma^2 = RSS / (N - p)``,
 a direction of ``J`` with a singular value below :data:`SINGULAR_RTOL` of the
 largest (:data:`FD_SINGULAR_RTOL` for a finite-difference Jacobian) being one
-the data do not determine (:func:`_uncertainty`), and the notes that say so
-(:func:`_undetermined_notes`, :func:`_weak_notes`).
+the data do not determine (:func:`standard_errors`), and the notes that say so
+(:func:`undetermined_notes`, :func:`weak_notes`).
 """
 
 from __future__ import annotations
@@ -15,13 +15,15 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+__all__ = []
+
 SINGULAR_RTOL = 1e-8
 FD_SINGULAR_RTOL = 1e-5  # finite-difference Jacobians (step 1e-6) are no more exact than this
 
 
-def _uncertainty(J: NDArray[np.float64], rss: float, n_rows: int,
-                 rtol: float = SINGULAR_RTOL
-                 ) -> tuple[NDArray[np.float64], list[list[int]]]:
+def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
+                    rtol: float = SINGULAR_RTOL
+                    ) -> tuple[NDArray[np.float64], list[list[int]]]:
     """Standard errors of the parameters and the groups the data cannot separate.
 
     The columns of `J` are normalised; a right singular vector whose singular
@@ -45,8 +47,8 @@ def _uncertainty(J: NDArray[np.float64], rss: float, n_rows: int,
     return std, groups
 
 
-def _undetermined_notes(names: list[str], groups: list[list[int]], rtol: float
-                        ) -> dict[str, str]:
+def undetermined_notes(names: list[str], groups: list[list[int]], rtol: float
+                       ) -> dict[str, str]:
     notes: dict[str, str] = {}
     for g in groups:
         members = [names[i] for i in g]
@@ -71,9 +73,9 @@ def _correlation(J: NDArray[np.float64], rtol: float) -> NDArray[np.float64]:
     return cov / np.outer(d, d)
 
 
-def _weak_notes(names: list[str], values: NDArray[np.float64], std: NDArray[np.float64],
-                J: NDArray[np.float64], rtol: float, may_be_zero: NDArray[np.bool_]
-                ) -> dict[str, str]:
+def weak_notes(names: list[str], values: NDArray[np.float64], std: NDArray[np.float64],
+               J: NDArray[np.float64], rtol: float, may_be_zero: NDArray[np.bool_]
+               ) -> dict[str, str]:
     """Parameters whose standard error exceeds their value: not determined by the records.
 
     A parameter that must be positive is then reported with the parameters its

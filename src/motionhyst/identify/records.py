@@ -10,6 +10,8 @@ from motionhyst.core.compiled import njit
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
+__all__ = ["count_reversals", "load_closed_loop_csv", "load_force_displacement_csv"]
+
 MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
 
@@ -86,8 +88,8 @@ def count_reversals(x: ArrayLike, band: float | None = None) -> int:
     return int(_count_reversals(xs, float(band)))
 
 
-def _check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
-                   xname: str = "displacement") -> None:
+def check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
+                  xname: str = "displacement") -> None:
     """``ValueError`` (one line, no file) for records that cannot be identified from."""
     arrays = {xname: x, **named}
     if t is not None:
@@ -114,7 +116,7 @@ def _load(source: Source, names: tuple[str, str, str], xname: str, columns=None,
     data = read_record(source, names, columns=columns, scale=scale)
     t, x, v = data[:, 0], data[:, 1], data[:, 2]
     try:
-        _check_signals(x, {names[2]: v}, t, xname=xname)
+        check_signals(x, {names[2]: v}, t, xname=xname)
     except ValueError as exc:
         raise ValueError(f"{describe(source)}: {exc}") from None
     return t, x, v

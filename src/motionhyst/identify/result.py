@@ -11,6 +11,8 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import MaxwellSlip
 
+__all__ = ["Identification"]
+
 
 def _fmt(v: float) -> str:
     """A float as a TOML float literal with 7 significant digits."""
