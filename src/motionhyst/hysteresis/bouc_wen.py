@@ -32,6 +32,8 @@ from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.hysteresis.registry import Form, Parameter, register
 from motionhyst.hysteresis.stepping import BOUC_WEN, Stepping
 
+__all__ = ["BoucWen"]
+
 #: least samples per period of the corrected periodic output (:meth:`BoucWen.default_samples`)
 MIN_SAMPLES_CORRECTED = 1024
 

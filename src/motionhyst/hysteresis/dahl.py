@@ -17,6 +17,8 @@ from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_posit
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import DAHL, Stepping
 
+__all__ = ["Dahl"]
+
 
 @register
 class Dahl(NormalisedRateIndependent, Hysteresis):

@@ -12,6 +12,8 @@ from motionhyst.hysteresis.base import Hysteresis, check_amplitudes, check_posit
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import STOP, Stepping
 
+__all__ = ["Jenkins", "jenkins_describing_function"]
+
 # Taylor coefficients of asin(s) - s (1 - 2 s^2) sqrt(1 - s^2) in odd powers s^3, s^5, ...
 _SMALL_ZETA_SERIES = np.array(
     [8.0 / 3.0, -4.0 / 5.0, -1.0 / 7.0, -1.0 / 18.0, -5.0 / 176.0, -7.0 / 416.0, -7.0 / 640.0]

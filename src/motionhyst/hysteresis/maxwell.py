@@ -16,6 +16,8 @@ from motionhyst.hysteresis.jenkins import Jenkins, jenkins_describing_function
 from motionhyst.hysteresis.registry import Parameter, register
 from motionhyst.hysteresis.stepping import STOP, Stepping
 
+__all__ = ["MaxwellSlip"]
+
 
 @register
 class MaxwellSlip(Hysteresis):

@@ -22,11 +22,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis._kernels import jump_series, reversal_points, stop_pieces
 
+__all__ = ["TWO_PI", "sample_period", "significant_harmonics", "stop_periodic_harmonics",
+           "trig_eval"]
+
 TWO_PI = 2.0 * np.pi
 
 
 def significant_harmonics(X: NDArray[np.complex128], rtol: float = 1e-15) -> int:
     """Number of leading harmonics of `X` (excluding DC) whose tail is below `rtol` of the total.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> significant_harmonics(np.array([0.0, 1.0, 1e-3, 1e-20]))      # the last is round-off
+    2
 
     Parameters
     ----------
@@ -46,6 +55,13 @@ def significant_harmonics(X: NDArray[np.complex128], rtol: float = 1e-15) -> int
 
 def trig_eval(X: NDArray[np.complex128], theta, deriv: int = 0):
     """Value (or derivative of order `deriv`) of the trigonometric polynomial `X` at `theta`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> X = np.array([0.0, 0.01 / 2j])                     # x = 0.01 sin(theta)
+    >>> float(trig_eval(X, np.pi / 2)), float(trig_eval(X, 0.0, deriv=1))
+    (0.01, 0.01)
 
     Parameters
     ----------
@@ -89,6 +105,12 @@ def sample_period(X: NDArray[np.complex128], N: int, deriv: int = 0) -> NDArray[
     ------
     ValueError
         If `N` samples cannot represent `M` harmonics.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sample_period(np.array([0.0, 0.01 / 2j]), 4).round(12).tolist()   # 0.01 sin(theta)
+    [0.0, 0.01, 0.0, -0.01]
     """
     X = np.asarray(X, dtype=complex)
     M = X.size - 1
@@ -135,6 +157,16 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     product of ``s`` and ``x`` sampled on the grid that brackets the roots:
     with at least ``2 (H + M) + 1`` samples and ``s`` band-limited to
     ``H + M`` this is the exact (non-aliased) convolution for ``n <= H``.
+
+    Examples
+    --------
+    The first harmonic gives the describing function of eq. (10), ``D = 2 j W_1 / A``:
+
+    >>> import numpy as np
+    >>> W = stop_periodic_harmonics(np.array([0.0, 0.01 / 2j]), 20.0, 0.05, 3)
+    >>> D = complex(2j * W[1] / 0.01)
+    >>> round(D.real, 4), round(D.imag, 4)
+    (3.91, 4.7746)
     """
     M = significant_harmonics(X)
     H = int(n_harmonics)

@@ -22,6 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Literal, TypeVar
 
+__all__ = ["MODELS", "Form", "Parameter", "model_class", "register"]
+
 ParameterKind = Literal["positive", "nonnegative", "finite"]
 
 
@@ -90,6 +92,13 @@ class Form:
         Name of the class method that builds the model from these parameters.
     parameters : tuple of Parameter
         The form's parameters.
+
+    Examples
+    --------
+    >>> from motionhyst import BoucWen
+    >>> form = BoucWen.forms[0]
+    >>> form.name, form.constructor, [p.name for p in form.parameters]
+    ('general', 'from_general', ['alpha', 'beta', 'gamma', 'delta', 'nu'])
     """
 
     name: str
