@@ -12,6 +12,9 @@ from motionhyst.cli._common import (
     warn_plant_fit,
 )
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def run(args: argparse.Namespace) -> int:
     """Quasi-linear analysis of a scenario (paper eqs. 12-21)."""

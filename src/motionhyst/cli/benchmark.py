@@ -7,6 +7,9 @@ import sys
 
 from motionhyst.cli._common import UsageError, g, print_json, table
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def add_parser(sub) -> None:
     """Add the ``benchmark`` command to the subparsers `sub`."""

@@ -22,6 +22,9 @@ from motionhyst.cli._common import (
     table,
 )
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def _df_parameters(model: str) -> dict[str, tuple[bool, bool]]:
     """``{option: (takes a list, required)}`` of a model, from its declared parameters."""

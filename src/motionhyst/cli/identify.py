@@ -21,6 +21,9 @@ from motionhyst.cli._identify_io import (
     run_input_output,
 )
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 RECORD_KINDS = {"force-displacement": ("time", "displacement", "force"),
                 "closed-loop": ("time", "y1", "u")}
 """CSV columns that identify a record's kind (``motionhyst identify``)."""

@@ -9,6 +9,9 @@ import numpy as np
 
 from motionhyst.cli._common import UsageError, add_record_options, print_json
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def add_parser(sub) -> None:
     """Add the ``predict`` command to the subparsers `sub`."""

@@ -6,6 +6,9 @@ import argparse
 
 from motionhyst.cli._common import add_force_option, warn_plant_fit
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def run(args: argparse.Namespace) -> int:
     """The paper's figures and numbers for a scenario, as a report."""

@@ -19,6 +19,9 @@ from motionhyst.cli._common import (
     whole_number,
 )
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 PROG = "motionhyst scan"
 LEAD_IN = 0.01
 """Rest before the setpoint starts [s]: room for the learned force to act ahead of it."""

@@ -22,6 +22,9 @@ from motionhyst.cli._common import (
     warn_plant_fit,
 )
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 TIME_SERIES_ONLY = ("--reference-csv", "--columns", "--scale", "--profile", "--distance",
                     "--v-max", "--a-max", "--j-max", "--duration", "--output-rate",
                     "--settle-band", "--force")

@@ -14,6 +14,9 @@ from motionhyst.cli._common import (
     warn_plant_fit,
 )
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def run(args: argparse.Namespace) -> int:
     """Exact periodic steady state of the nonlinear loop, next to the describing function."""
