@@ -213,7 +213,13 @@ class Loop:
                 "f->y1": P1 * sens}[name]
 
     def transfer_tf(self, name: str) -> control.TransferFunction:
-        """A closed-loop transfer as a python-control transfer function (LTI loops only)."""
+        """A closed-loop transfer as a python-control transfer function (LTI loops only).
+
+        Parameters
+        ----------
+        name : str
+            Which transfer, one of ``TRANSFERS``: ``"r->e"``, ``"r->y1"``, ``"w->e"``, ``"w->y1"``.
+        """
         if self._poly is None:
             raise ValueError("closed-loop transfer functions need LTI plant and controller")
         if name not in TRANSFERS:

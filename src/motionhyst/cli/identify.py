@@ -102,6 +102,13 @@ def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
     ``model = "maxwell-slip"`` with lists (as
     :meth:`motionhyst.identify.Identification.scenario_fragment`).
 
+    Parameters
+    ----------
+    k : sequence of float
+        Stiffnesses of the identified elements [N/m].
+    fc : sequence of float
+        Their slip forces [N].
+
     Examples
     --------
     >>> from motionhyst.cli import feedforward_fragment

@@ -32,6 +32,11 @@ def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
     fit minimises ``sum |G| ^2 |1/G - (k - m w^2 + j c w)|^2``.  Negative
     estimates are clipped to small positive values (a start, not a result).
 
+    Parameters
+    ----------
+    records : list of IORecord
+        Force in, displacement out; one sampling rate.
+
     Examples
     --------
     >>> import numpy as np
@@ -144,6 +149,15 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     parameters (``log`` of each) by nonlinear least squares on the relative
     error of ``G`` (:func:`_spectral_response`).  A start for the simulation-error
     fit, not a result.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        Force in, displacement out; one sampling rate.
+    output : {"y2", "y1"}
+        The measured position.
+    periodic : bool
+        Records are whole periods of a steady state (else from rest).
 
     Returns
     -------

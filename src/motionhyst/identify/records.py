@@ -134,6 +134,11 @@ def load_force_displacement_csv(source: Source, *, columns: dict[str, str] | Non
     CSV dialects, MATLAB levels 4 to 7.3).  A DataFrame has those columns by
     name, an array those three columns in order.
 
+    Parameters
+    ----------
+    source : str, Path, ndarray or DataFrame
+        The CSV file, or the columns themselves.
+
     Returns
     -------
     t, x, w : ndarray
@@ -175,6 +180,11 @@ def load_closed_loop_csv(source: Source, *, columns: dict[str, str] | None = Non
     The file's own names are mapped by `columns` and scaled by `scale` (as
     :func:`load_force_displacement_csv`); an array (those columns in order) or
     a DataFrame is accepted as well.
+
+    Parameters
+    ----------
+    source : str, Path, ndarray or DataFrame
+        The CSV file, or the columns themselves.
 
     Returns
     -------
