@@ -142,6 +142,13 @@ class Coulomb(Hysteresis):
         The slip force's first harmonic (eq. 11, the Jenkins element's small-zeta
         limit) and the viscous terms' mean; an unequal `fc_pos`, `fc_neg` adds a
         constant force, not in ``D``.  `omega` [rad/s] is needed only with viscous terms.
+
+        Parameters
+        ----------
+        A : array_like
+            Amplitude(s) [m], >= 0.
+        omega : array_like, optional
+            Angular frequency [rad/s], broadcast against `A`; required with viscous terms.
         """
         a = check_amplitudes(A)
         c = 0.5 * (self.c_pos + self.c_neg)
@@ -201,7 +208,17 @@ class Coulomb(Hysteresis):
 
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:
-        """Harmonics of the periodic output (the period sampled finely, its last run)."""
+        """Harmonics of the periodic output (the period sampled finely, its last run).
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement over one period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency of the period [rad/s]; required with viscous terms.
+        """
         from motionhyst.hysteresis.periodic import sample_period
 
         H = int(n_harmonics)
