@@ -138,6 +138,11 @@ def load_force_displacement_csv(source: Source, *, columns: dict[str, str] | Non
     ----------
     source : str, Path, ndarray or DataFrame
         The CSV file, or the columns themselves.
+    columns : dict, optional
+        Quantity (``"time"``, ``"displacement"``, ``"force"``) -> the file's name for it; a quantity
+        not mapped is read under its own name.
+    scale : dict, optional
+        Quantity -> gain its column is multiplied by (to SI units).
 
     Returns
     -------
@@ -185,6 +190,11 @@ def load_closed_loop_csv(source: Source, *, columns: dict[str, str] | None = Non
     ----------
     source : str, Path, ndarray or DataFrame
         The CSV file, or the columns themselves.
+    columns : dict, optional
+        Quantity (``"time"``, ``"y1"``, ``"u"``) -> the file's name for it; a quantity not mapped is
+        read under its own name.
+    scale : dict, optional
+        Quantity -> gain its column is multiplied by (to SI units).
 
     Returns
     -------
