@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis.plausibility import check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.analysis.steady import SteadyState, steady_state_sweep
 from motionhyst.core.textfmt import g, table
@@ -97,8 +98,13 @@ class DescribingFunctionComparison:
                       "|e1 lin| [m]", "|E sim|", "angle E sim", "|E df| (18)", "angle E df",
                       "peak e [m]", "rms e-e_lin [m]"], rows)
 
-    def plot(self):
+    def plot(self, ax=None):
         """Fig. 11: the error over a period, exact, without hysteresis and predicted.
+
+        Parameters
+        ----------
+        ax : sequence of N matplotlib.axes.Axes, optional
+            Axes to draw into (one per frequency); default: a new figure.
 
         Returns
         -------
@@ -108,7 +114,7 @@ class DescribingFunctionComparison:
 
         return fig11_errors([p.state for p in self.points],
                             [p.mismatch_df for p in self.points],
-                            [p.error_harmonics_df for p in self.points])
+                            [p.error_harmonics_df for p in self.points], ax=ax)
 
 
 def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike
@@ -128,6 +134,13 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     -------
     DescribingFunctionComparison
 
+    Warns
+    -----
+    MotionhystWarning
+        Where the paper's quasi-linear reading stops holding (a frequency below
+        ``f*``, a link that never slips, a frequency outside measured data):
+        :func:`~motionhyst.analysis.plausibility.check_plausible`.
+
     Examples
     --------
     >>> from motionhyst import compare_with_describing_function, default_scenario
@@ -137,6 +150,7 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     (1.239, 1.24)
     """
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    check_plausible(loop, amplitude, f)
     E_df = loop_mismatch(loop, f, amplitude)
     return DescribingFunctionComparison(float(amplitude), [
         ComparisonPoint(ss, complex(ed), error_harmonics_df(loop, amplitude, ss.frequency_hz))

@@ -234,9 +234,14 @@ class QuasiLinearAnalysis:
             lines += [f"  - {u}" for u in self.unresolved]
         return "\n".join(lines)
 
-    def plot(self):
+    def plot(self, ax=None):
         """The mismatch ``|E|`` (eq. 18) and its asymptote (eq. 20) at the analysed
         frequencies, with the crossovers (:func:`motionhyst.present.figures.plot_analysis`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; default: a new figure.
 
         Returns
         -------
@@ -244,7 +249,7 @@ class QuasiLinearAnalysis:
         """
         from motionhyst.present.figures import plot_analysis
 
-        return plot_analysis(self)
+        return plot_analysis(self, ax=ax)
 
 
 def _parts(loop: Loop, omega: NDArray[np.float64]):
@@ -434,6 +439,13 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     -------
     QuasiLinearAnalysis
 
+    Warns
+    -----
+    MotionhystWarning
+        Where the paper's quasi-linear reading stops holding (a frequency below
+        ``f*``, a link that never slips, a frequency outside measured data):
+        :func:`~motionhyst.analysis.plausibility.check_plausible`.
+
     Examples
     --------
     Table I at 10 mm (the paper's section V):
@@ -461,6 +473,9 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0")
+    from motionhyst.analysis.plausibility import check_plausible  # it imports f_star from here
+
+    check_plausible(loop, amplitude, f)
     sampling = None if loop.sampled is None else _sampling_note(loop, f)
     hyst = loop.hysteresis
     k_link = hyst.initial_stiffness
@@ -534,7 +549,7 @@ def _sampling_note(loop: Loop, f: NDArray[np.float64]) -> str:
 RESOLUTION_FACTOR = 3.0
 
 
-def _resolved(plant: MeasuredPlant, P2, Pf2) -> NDArray[np.bool_]:
+def resolved_lines(plant: MeasuredPlant, P2, Pf2) -> NDArray[np.bool_]:
     """Where ``|Pf2| / |P2|`` exceeds 3 x the data's resolution (everywhere if it is unknown)."""
     ratio = np.abs(Pf2) / np.abs(P2)
     if plant.resolution is None:
@@ -545,7 +560,7 @@ def _resolved(plant: MeasuredPlant, P2, Pf2) -> NDArray[np.bool_]:
 def _measured_limits(plant: MeasuredPlant, f, P2, Pf2, E, Et, amps) -> list[str]:
     """Blank (nan) the mismatch where raw data cannot give it; say why, per frequency."""
     out = []
-    ok = _resolved(plant, P2, Pf2)
+    ok = resolved_lines(plant, P2, Pf2)
     lines = plant.frequency_hz
     for i, fi in enumerate(f):
         if plant.measured_line(fi) is None:
@@ -571,7 +586,7 @@ def _crossover_exact_on_lines(loop: Loop, amplitude: float) -> tuple[float, str]
         return float("nan"), ""
     i = int(idx[0])
     _, _, P2, _, Pf2 = _parts(loop, TWO_PI * f[i:i + 2])
-    if not np.all(_resolved(plant, P2, Pf2)):
+    if not np.all(resolved_lines(plant, P2, Pf2)):
         return float("nan"), (f"exact crossover |E - 1| = 1: between the lines {f[i]:.4g} and "
                               f"{f[i + 1]:.4g} Hz Pf2 = Pr - P2 is not above 3 x the data's "
                               f"resolution {plant.resolution:.2g}")

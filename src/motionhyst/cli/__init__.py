@@ -18,7 +18,14 @@ import os
 import sys
 from collections.abc import Sequence
 
-from motionhyst.cli._common import EXIT_USAGE, Parser, UsageError, memory_size, one_line
+from motionhyst.cli._common import (
+    EXIT_USAGE,
+    Parser,
+    UsageError,
+    memory_size,
+    one_line,
+    warnings_on_stderr,
+)
 from motionhyst.cli.identify import feedforward_fragment, record_kind
 from motionhyst.core.budget import set_max_memory
 
@@ -91,7 +98,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
-        return args.func(args)
+        with warnings_on_stderr(args.command):
+            return args.func(args)
     except BrokenPipeError:  # output piped into head, say: not an error
         sys.stdout = open(os.devnull, "w")
         return 0

@@ -4,8 +4,11 @@ argparse number types, tables and number formatting, JSON output."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
-from collections.abc import Callable, Sequence
+import sys
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 
 from motionhyst.core.jsonio import dumps
 from motionhyst.core.textfmt import g, table
@@ -238,53 +241,61 @@ def distinct(values: Sequence[float] | None, option: str, command: str):
 
 
 # ----------------------------------------------------------------- plausibility warnings
-def warn(message: str) -> None:
-    """A plausibility warning: one line on stderr; the command still succeeds (exit 0)."""
-    import sys
+@contextlib.contextmanager
+def warnings_on_stderr(command: str) -> Iterator[None]:
+    """Show each :class:`~motionhyst.core.warnings.MotionhystWarning` raised inside as one line
+    ``motionhyst: warning: COMMAND: message`` on stderr, when it is raised, every time.
 
-    print(f"motionhyst: warning: {one_line(message)}", file=sys.stderr)
+    Other warnings are shown as Python shows them.  The command still
+    succeeds (exit 0): a warning says a number may mean less than it seems,
+    not that it is wrong.
 
+    Parameters
+    ----------
+    command : str
+        The command's name, put before each message.
 
-def warn_plant_fit(sc, command: str) -> None:
-    """The warnings of a measured plant's fit (:attr:`motionhyst.FrfFit.warnings`) on stderr.
-
-    One line each: the data are not what a rigid body plus modes describes
-    (a stiffness to ground, errors far above the noise), so every number
-    computed on the fitted plant is in doubt.  Nothing for a modelled stage.
+    Examples
+    --------
+    >>> import sys
+    >>> from motionhyst.core.warnings import warn
+    >>> sys.stderr = sys.stdout                            # to show the line here
+    >>> with warnings_on_stderr("analyze"):
+    ...     warn("0.05 Hz below f* = 0.15 Hz (eq. 13)")
+    motionhyst: warning: analyze: 0.05 Hz below f* = 0.15 Hz (eq. 13)
+    >>> sys.stderr = sys.__stderr__
     """
+    from motionhyst.core.warnings import MotionhystWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", MotionhystWarning)
+        python_shows = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, MotionhystWarning):
+                print(f"motionhyst: warning: {one_line(f'{command}: {message}')}", file=sys.stderr)
+            else:
+                python_shows(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        yield
+
+
+def warn_plant_fit(sc) -> None:
+    """The warnings of a measured plant's fit (:attr:`motionhyst.FrfFit.warnings`) as
+    :class:`~motionhyst.core.warnings.MotionhystWarning`.
+
+    One each: the data are not what a rigid body plus modes describes (a
+    stiffness to ground, errors far above the noise), so every number
+    computed on the fitted plant is in doubt.  Nothing for a modelled stage.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The command's scenario.
+    """
+    from motionhyst.core.warnings import warn
+
     fit = sc.plant_fit()
     for message in fit.warnings if fit is not None else ():
-        warn(f"{command}: {message}")
-
-
-def check_plausible(loop, amplitude: float, frequencies, command: str) -> None:
-    """Warn where a sine of `amplitude` at `frequencies` leaves the model's meaning.
-
-    - a frequency below f* (eq. 13): the quasi-linear plant no longer tends to
-      the floating mass P2, so eq. (20) and the crossover of eq. (21) do not apply;
-    - a frequency outside a measured plant's data (the fit or data are extrapolated);
-    - an amplitude at which the element never slips (``zeta = fc / (k A) >= 1``):
-      it is a linear spring at every frequency asked, no hysteresis to see.
-    """
-    from motionhyst.analysis.quasilinear import f_star
-
-    el = loop.hysteresis
-    freqs = [float(f) for f in frequencies]
-    if el is not None:
-        fs = f_star(el.initial_stiffness, loop.M)
-        low = [f for f in freqs if f < fs]
-        if low:
-            warn(f"{command}: {', '.join(f'{f:g}' for f in low)} Hz below f* = {fs:.3g} Hz "
-                 f"(eq. 13): the link shapes the plant there, the asymptote of eq. (20) and "
-                 f"the crossover of eq. (21) do not apply")
-        if el.defines_zeta and float(el.zeta(amplitude)) >= 1.0:
-            warn(f"{command}: at amplitude {amplitude:g} m the element never slips "
-                 f"(zeta = fc / (k A) = {float(el.zeta(amplitude)):.3g} >= 1): it is a linear "
-                 f"spring at every frequency asked, there is no hysteresis to see")
-    data = getattr(loop.plant, "frequency_range_hz", None)
-    if data is not None:
-        lo, hi = data
-        out = [f for f in freqs if f < lo or f > hi]
-        if out:
-            warn(f"{command}: {', '.join(f'{f:g}' for f in out)} Hz outside the measured "
-                 f"plant's data ({lo:g}-{hi:g} Hz): the plant there is extrapolated")
+        warn(message)

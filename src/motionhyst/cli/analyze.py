@@ -4,13 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import (
-    check_plausible,
-    distinct,
-    positive,
-    print_json,
-    warn_plant_fit,
-)
+from motionhyst.cli._common import distinct, positive, print_json, warn_plant_fit
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -25,11 +19,10 @@ def run(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario)
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
-    check_plausible(sc.loop(), amplitude, freqs, args.command)
     mode = "self-consistent" if args.self_consistent else "reference"
     res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
     fit = sc.plant_fit()
-    warn_plant_fit(sc, args.command)
+    warn_plant_fit(sc)
     if args.json:
         d = res.to_dict()
         if fit is not None:

@@ -174,7 +174,7 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "
                              f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
                              f"has a measured [plant] with use = \"data\"")
-        warn_plant_fit(sc, "identify")
+        warn_plant_fit(sc)
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         extra["scenario"] = sc.source
         # a sampled controller: the record is at its samples, u_k acted held and delayed

@@ -20,7 +20,7 @@ def run(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario, check=False)
     reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None, force=args.force,
               inputs=sc.files)
-    warn_plant_fit(sc, "reproduce")
+    warn_plant_fit(sc)
     if not args.quiet:
         print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf), listed in "
               f"{MANIFEST}")

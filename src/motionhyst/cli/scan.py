@@ -120,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
 
     sc = load_scenario(args.scenario)
     loop = sc.loop()
-    warn_plant_fit(sc, "scan")
+    warn_plant_fit(sc)
     has_model = loop.hysteresis_feedforward is not None
     comps = args.compensation or (["none", "model", "ilc"] if has_model else ["none", "ilc"])
     if len(set(comps)) != len(comps):

@@ -12,13 +12,11 @@ from motionhyst.cli._common import (
     UsageError,
     add_force_option,
     add_record_options,
-    check_plausible,
     distinct,
     output_file,
     positive,
     print_json,
     refuse_unused,
-    warn,
     warn_plant_fit,
 )
 
@@ -89,6 +87,8 @@ def _reference(args: argparse.Namespace, sc):
 
 def _time_series(args: argparse.Namespace, sc) -> int:
     """Transient run from rest, streamed to CSV atomically, with its summary."""
+    from motionhyst.analysis.plausibility import check_plausible
+    from motionhyst.core.warnings import warn
     from motionhyst.plants.measured import MeasuredPlant
     from motionhyst.time.references import SineReference
     from motionhyst.time.timeseries import run_time_series
@@ -97,16 +97,16 @@ def _time_series(args: argparse.Namespace, sc) -> int:
         raise UsageError(f"motionhyst simulate: --time-series needs a plant model; {sc.source} "
                          f"uses its measured [plant] as raw data (use = \"data\"), which has no "
                          f"time-domain model; use = \"fit\" fits one")
-    warn_plant_fit(sc, "simulate")
+    warn_plant_fit(sc)
     ref, default_duration, what = _reference(args, sc)
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
     if isinstance(ref, SineReference):
-        check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz], "simulate")
+        check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz])
         if 1.0 / ref.frequency_hz > duration:
-            warn(f"simulate: the period 1/{ref.frequency_hz:g} Hz = {1 / ref.frequency_hz:.3g} s "
-                 f"exceeds --duration {duration:g} s: no full period, the run is start-up only")
+            warn(f"the period 1/{ref.frequency_hz:g} Hz = {1 / ref.frequency_hz:.3g} s exceeds "
+                 f"--duration {duration:g} s: no full period, the run is start-up only")
     options = {"output_rate_hz": args.output_rate}
     if args.settle_band is not None:
         options["settle_band"] = args.settle_band

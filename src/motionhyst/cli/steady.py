@@ -6,13 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import (
-    check_plausible,
-    distinct,
-    positive,
-    print_json,
-    warn_plant_fit,
-)
+from motionhyst.cli._common import distinct, positive, print_json, warn_plant_fit
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -27,9 +21,8 @@ def run(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario)
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
-    check_plausible(sc.loop(), amplitude, freqs, args.command)
-    warn_plant_fit(sc, args.command)
-    result = compare_with_describing_function(sc.loop(), amplitude, freqs)
+    result = compare_with_describing_function(sc.loop(), amplitude, freqs)  # warns as it starts
+    warn_plant_fit(sc)
     if args.json:
         print_json(result.to_dict())
         return 0
