@@ -32,6 +32,8 @@ _EXPORTS = {
     "motionhyst.plants.frf_fit": ("FrfFit", "ModalPlant", "fit_frf"),
     "motionhyst.analysis.comparison": ("DescribingFunctionComparison",
                                        "compare_with_describing_function"),
+    "motionhyst.analysis.describing": ("DescribingFunctionResult", "describing_function"),
+    "motionhyst.core.warnings": ("MotionhystWarning",),
     "motionhyst.hysteresis": ("BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellIwan",
                               "MaxwellSlip"),
     "motionhyst.analysis.margins": ("LoopMargins", "loop_margins"),
@@ -49,13 +51,13 @@ _EXPORTS = {
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = [
-    "BoucWen", "Dahl", "DescribingFunctionComparison", "FrfFit", "Hysteresis", "Jenkins",
-    "LeadLagLowpass", "Loop", "LoopMargins", "LuGre", "MaxwellIwan", "MaxwellSlip",
-    "MeasuredPlant", "ModalPlant", "PointToPoint",
+    "BoucWen", "Dahl", "DescribingFunctionComparison", "DescribingFunctionResult", "FrfFit",
+    "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "LoopMargins", "LuGre", "MaxwellIwan",
+    "MaxwellSlip", "MeasuredPlant", "ModalPlant", "MotionhystWarning", "PointToPoint",
     "QuasiLinearAnalysis", "SampledReference", "Scenario", "ScenarioError", "Simulation",
     "SineReference", "SteadyState", "TwoMassStage", "analyze", "compare_with_describing_function",
-    "default_scenario", "fit_frf", "load_frd_plant", "load_reference_csv", "load_scenario",
-    "loop_margins",
+    "default_scenario", "describing_function", "fit_frf", "load_frd_plant", "load_reference_csv",
+    "load_scenario", "loop_margins",
     "periodic_steady_state", "simulate", "steady_state_sweep",
 ]
 
@@ -64,10 +66,12 @@ if TYPE_CHECKING:
         DescribingFunctionComparison,
         compare_with_describing_function,
     )
+    from motionhyst.analysis.describing import DescribingFunctionResult, describing_function
     from motionhyst.analysis.margins import LoopMargins, loop_margins
     from motionhyst.analysis.quasilinear import QuasiLinearAnalysis, analyze
     from motionhyst.analysis.steady import SteadyState, periodic_steady_state, steady_state_sweep
     from motionhyst.controllers.leadlag import LeadLagLowpass
+    from motionhyst.core.warnings import MotionhystWarning
     from motionhyst.hysteresis import (
         BoucWen,
         Dahl,

@@ -6,20 +6,15 @@ Paper eq. (7); for the Jenkins element eq. (10).
 from __future__ import annotations
 
 import argparse
-import math
-
-import numpy as np
 
 from motionhyst.cli._common import (
     UsageError,
     distinct,
     finite,
-    g,
     harmonic_count,
     nonnegative,
     positive,
     print_json,
-    table,
 )
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
@@ -87,71 +82,19 @@ def _df_frequencies(args: argparse.Namespace, el) -> list[float | None]:
     return list(args.frequency)
 
 
-def _df_point(amplitude: float, zeta: float, D: complex, frequency_hz: float | None) -> dict:
-    point = {"amplitude": float(amplitude)}
-    if frequency_hz is not None:
-        point["frequency_hz"] = float(frequency_hz)
-    point.update({"zeta": float(zeta), "re": float(D.real), "im": float(D.imag),
-                  "abs": float(abs(D)), "phase_deg": float(np.degrees(np.angle(D)))})
-    return point
-
-
 def run(args: argparse.Namespace) -> int:
     """Describing function (and higher harmonics) of a hysteresis element."""
+    from motionhyst.analysis.describing import describing_function
+
     args.frequency = distinct(args.frequency, "--frequency", "df")
     el = _element_from_args(args)
     freqs = _df_frequencies(args, el)
-    A = np.asarray(args.amplitude, dtype=float)
-    zeta = np.atleast_1d(el.zeta(A)) if el.defines_zeta else np.full(A.shape, np.nan)
-    points = []
-    for f in freqs:
-        omega = None if f is None else 2.0 * math.pi * f
-        D = np.atleast_1d(el.describing_function(A, omega))
-        pts = [_df_point(a, z, d, f) for a, z, d in zip(A, zeta, D, strict=True)]
-        if args.harmonics:
-            H = el.hosidf(A, args.harmonics, omega)
-            for p, h in zip(pts, H, strict=True):
-                p["harmonics"] = [{"n": n, "re": float(c.real), "im": float(c.imag),
-                                   "abs_over_amplitude": float(abs(c)),
-                                   "phase_deg": float(np.degrees(np.angle(c)))}
-                                  for n, c in enumerate(h, start=1)]
-        points += pts
-    result = {**el.to_dict(), "points": points}
+    result = describing_function(el, args.amplitude, None if freqs == [None] else freqs,
+                                 harmonics=args.harmonics or 0)
     if args.json:
-        print_json(result)
-        return 0
-    k_init = el.initial_stiffness  # not "k0": a model may have a parameter of that name
-
-    def show(v, unit):
-        if isinstance(v, list):
-            return f"{', '.join(f'{x:g}' for x in v)} {unit}".rstrip() if v else "none"
-        return f"{v:g} {unit}".rstrip()
-
-    units = {p.name: p.unit for p in el.parameters}
-    params = ", ".join(f"{k} = {show(v, units.get(k, ''))}"
-                       for k, v in el.to_dict().items() if k != "model")
-    print(f"Describing function of the {el.name} element, {params} (SI units; paper eq. 7)")
-    rate = el.rate_independent
-    head = ["A [m]"] if rate else ["A [m]", "f [Hz]"]
-
-    def lead(p):
-        return [g(p["amplitude"])] + ([] if rate else [g(p["frequency_hz"])])
-
-    has_zeta = any(not math.isnan(p["zeta"]) for p in points)
-    rows = [[*lead(p), *([g(p["zeta"])] if has_zeta else []), g(p["re"]), g(p["im"]),
-             g(p["abs"]), g(p["abs"] / k_init) if k_init > 0 else "-",
-             f"{p['phase_deg']:.2f}"] for p in points]
-    print(table([*head, *(["zeta [-]"] if has_zeta else []), "Re D [N/m]", "Im D [N/m]",
-                  "|D| [N/m]", "|D|/k_init [-]", "angle D [deg]"], rows))
-    print(f"k_init = {k_init:g} N/m, the initial stiffness"
-          + (" (|D| -> k_init as A -> 0)" if rate else "")
-          + (" (none: the element has no elastic range)" if k_init == 0 else ""))
-    if args.harmonics:
-        print()
-        print("Higher-order describing functions H_n = Y_n / A [N/m], relative to sin(n w t)")
-        rows = [[*lead(p), str(h["n"]), g(h["abs_over_amplitude"]),
-                 f"{h['phase_deg']:.2f}"] for p in points for h in p["harmonics"]]
-        print(table([*head, "n", "|H_n| [N/m]", "angle H_n [deg]"], rows))
+        print_json(result.to_dict())
+    else:
+        print(result)
     return 0
 
 
