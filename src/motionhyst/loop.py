@@ -218,7 +218,7 @@ class Loop:
         Parameters
         ----------
         name : str
-            Which transfer, one of ``TRANSFERS``: ``"r->e"``, ``"r->y1"``, ``"w->e"``, ``"w->y1"``.
+            Which transfer, one of :data:`TRANSFERS` (``"r->e"``: reference to error, ...).
         """
         if self._poly is None:
             raise ValueError("closed-loop transfer functions need LTI plant and controller")

@@ -171,9 +171,14 @@ class SteadyState:
             f"  error RMS {g(self.error_rms)} m (without hysteresis {g(self.error_linear_rms)} m)",
             table(["n", "|e_n| [m]", "angle e_n [deg]", "|w_n| [N]"], rows)])
 
-    def plot(self):
+    def plot(self, ax=None):
         """One period of the error, with and without hysteresis
         (:func:`motionhyst.present.figures.plot_steady_state`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; default: a new figure.
 
         Returns
         -------
@@ -181,7 +186,7 @@ class SteadyState:
         """
         from motionhyst.present.figures import plot_steady_state
 
-        return plot_steady_state(self)
+        return plot_steady_state(self, ax=ax)
 
     def to_dict(self, harmonics: tuple[int, ...] = (1, 3, 5),
                 mismatch_df: complex | None = None,

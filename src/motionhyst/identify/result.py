@@ -134,10 +134,15 @@ class Identification:
             "",
             f"  total stiffness {g(k, 6)} N/m, total slip force {g(fc, 6)} N"])
 
-    def plot(self):
+    def plot(self, ax=None):
         """The identified link's force-displacement loops.
 
         Drawn by :func:`~motionhyst.present.figures.plot_link`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; default: a new figure.
 
         Returns
         -------
@@ -146,7 +151,7 @@ class Identification:
         from motionhyst.present.figures import plot_link
 
         return plot_link(self.model, title=f"Identified Maxwell-slip link, "
-                         f"{self.n_elements} element(s)")
+                         f"{self.n_elements} element(s)", ax=ax)
 
     def scenario_fragment(self) -> str:
         """A ``[hysteresis]`` section of a scenario file (TOML), ready to paste.

@@ -711,14 +711,21 @@ class FrfFit:
         lines += [f"  warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
-    def plot(self, f_range: tuple[float, float] | None = None):
+    def plot(self, f_range: tuple[float, float] | None = None, ax=None):
         """Bode figure of the measured ``P1``, ``P2`` (markers) and the fit (lines).
 
         Returns a matplotlib Figure (see :func:`motionhyst.present.figures.plot_frf_fit`).
+
+        Parameters
+        ----------
+        f_range : (float, float), optional
+            Frequency range [Hz]; default: the data's, widened by 1.5 each side.
+        ax : sequence of 2 matplotlib.axes.Axes, optional
+            Axes to draw into (magnitude, phase); default: a new figure.
         """
         from motionhyst.present.figures import plot_frf_fit
 
-        return plot_frf_fit(self, f_range)
+        return plot_frf_fit(self, f_range, ax=ax)
 
 
 def _num(x: float) -> str:

@@ -25,8 +25,9 @@ from matplotlib.figure import Figure
 
 from motionhyst.present.figure_writer import FigureWriter, save_figures
 
-__all__ = ["STYLE", "DecadeFormatter", "FigureWriter", "MinorLogLocator", "plot_analysis",
-           "plot_frf_fit", "plot_steady_state", "save_figures"]
+__all__ = ["STYLE", "DecadeFormatter", "FigureWriter", "MinorLogLocator", "minor_log_ticks",
+           "new_figure", "plot_analysis", "plot_describing_function", "plot_frf_fit", "plot_link",
+           "plot_simulation", "plot_steady_state", "save_figures"]
 
 STYLE = {
     "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
@@ -100,20 +101,80 @@ class DecadeFormatter(matplotlib.ticker.LogFormatterSciNotation):
         return label
 
 
-def _minor_log_ticks(fig: Figure) -> None:
-    """Give every log axis of `fig` the 1-2-5 minor ticks of :class:`MinorLogLocator` and the
-    labels of :class:`DecadeFormatter`.
+def minor_log_ticks(where) -> None:
+    """Give every log axis the 1-2-5 minor ticks of :class:`MinorLogLocator` and the labels of
+    :class:`DecadeFormatter`.
 
     Called once the data is plotted (setting a log scale resets an axis's locators).
+
+    Parameters
+    ----------
+    where : Figure or sequence of Axes
+        A figure (all its axes) or the axes a result drew into.
+
+    Examples
+    --------
+    >>> fig, (ax,) = new_figure()
+    >>> _ = ax.loglog([1.0, 100.0], [1.0, 10.0])
+    >>> minor_log_ticks(fig)
+    >>> type(ax.xaxis.get_minor_locator()).__name__
+    'MinorLogLocator'
     """
-    for ax in fig.axes:
+    for ax in getattr(where, "axes", where):
         for axis in (ax.xaxis, ax.yaxis):
             if axis.get_scale() == "log":
                 axis.set_minor_locator(MinorLogLocator())
                 axis.set_major_formatter(DecadeFormatter())
 
 
-def _figure(nrows: int = 1, sharex: bool = True):
+def new_figure(nrows: int = 1, sharex: bool = True, ax=None):
+    """A figure of `nrows` axes in one column, in the package's style; or the axes `ax` given.
+
+    What every ``plot(ax=...)`` of a result calls: without `ax` a new
+    :class:`~matplotlib.figure.Figure` (not attached to pyplot); with `ax`
+    the caller's axes, drawn into as they are, and their figure.  Either way
+    the figure carries ``fig.motionhyst_data``, the dictionary the plots put
+    their data in.
+
+    Parameters
+    ----------
+    nrows : int
+        Number of axes the plot draws.
+    sharex : bool
+        New axes share their x axis.
+    ax : matplotlib.axes.Axes or sequence of Axes, optional
+        The axes to draw into: one Axes if `nrows` is 1, else a sequence of `nrows`.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : ndarray of Axes, shape (nrows,)
+
+    Raises
+    ------
+    ValueError
+        If `ax` holds another number of axes than `nrows`.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> mine = Figure().subplots(1, 2)
+    >>> fig, axes = new_figure(2, ax=mine)
+    >>> fig is mine[0].figure, len(axes), fig.motionhyst_data
+    (True, 2, {})
+    """
+    if ax is not None:
+        axes = np.empty(1, dtype=object)
+        if hasattr(ax, "figure") and not hasattr(ax, "__len__"):
+            axes[0] = ax
+        else:
+            axes = np.array(list(ax), dtype=object)
+        if axes.size != nrows:
+            raise ValueError(f"this plot draws {nrows} axes; ax= gives {axes.size}")
+        fig = axes[0].figure
+        if not hasattr(fig, "motionhyst_data"):
+            fig.motionhyst_data = {}
+        return fig, axes
     with matplotlib.rc_context(STYLE):
         fig = Figure(figsize=(6.4, 4.2 if nrows == 1 else 5.6), layout="constrained")
         axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False)
@@ -124,7 +185,7 @@ def _figure(nrows: int = 1, sharex: bool = True):
 
 
 
-def plot_analysis(analysis) -> Figure:
+def plot_analysis(analysis, ax=None) -> Figure:
     """The mismatch of a quasi-linear analysis at its frequencies.
 
     `analysis` is a :class:`~motionhyst.analysis.quasilinear.QuasiLinearAnalysis`.
@@ -134,6 +195,13 @@ def plot_analysis(analysis) -> Figure:
     ``|E - 1| = 1``.  (:func:`~motionhyst.present.plots.fig10_mismatch` draws it on a dense grid
     from the loop.)
 
+    Parameters
+    ----------
+    analysis : QuasiLinearAnalysis
+        What :func:`~motionhyst.analysis.quasilinear.analyze` returned.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; default: a new figure.
+
     Examples
     --------
     >>> from motionhyst import analyze, default_scenario
@@ -142,7 +210,8 @@ def plot_analysis(analysis) -> Figure:
     >>> type(fig).__name__                                 # save it with fig.savefig(...)
     'Figure'
     """
-    fig, (ax,) = _figure()
+    fig, axes = new_figure(ax=ax)
+    (ax,) = axes
     f = np.array([p.frequency_hz for p in analysis.points])
     E = np.array([p.value for p in analysis.points])
     Et = np.array([p.asymptote for p in analysis.points])
@@ -157,14 +226,21 @@ def plot_analysis(analysis) -> Figure:
     ax.set_ylabel("|E| [-]")
     ax.set_title(f"Feedforward mismatch, A_r = {analysis.amplitude:.3g} m")
     ax.legend(loc="upper right")
-    _minor_log_ticks(fig)
+    minor_log_ticks(axes)
     fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
     return fig
 
 
-def plot_steady_state(state) -> Figure:
+def plot_steady_state(state, ax=None) -> Figure:
     """One period of a :class:`~motionhyst.analysis.steady.SteadyState`: the error with and without
     hysteresis.
+
+    Parameters
+    ----------
+    state : SteadyState
+        One periodic steady state.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; default: a new figure.
 
     Examples
     --------
@@ -174,7 +250,8 @@ def plot_steady_state(state) -> Figure:
     >>> len(fig.axes) >= 1
     True
     """
-    fig, (ax,) = _figure()
+    fig, axes = new_figure(ax=ax)
+    (ax,) = axes
     ts = state.time_series()
     t_ms = ts["t"] * 1e3
     ax.plot(t_ms, ts["e"] * 1e9, color="k", label="with hysteresis (exact)")
@@ -188,12 +265,21 @@ def plot_steady_state(state) -> Figure:
     return fig
 
 
-def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
+def plot_frf_fit(fit, f_range: tuple[float, float] | None = None, ax=None) -> Figure:
     """Bode figure of a measured plant (markers) and its rigid-body + modes fit (lines).
 
     `fit` is a :class:`motionhyst.plants.frf_fit.FrfFit`.  The fitted ``P1`` and
     ``P2`` are drawn densely (so a resonance between measured lines shows),
     with the fitted modes' frequencies marked.
+
+    Parameters
+    ----------
+    fit : FrfFit
+        The fit of a measured plant.
+    f_range : (float, float), optional
+        Frequency range [Hz]; default: the data's, widened by 1.5 each side.
+    ax : sequence of two matplotlib.axes.Axes, optional
+        Axes to draw into (magnitude, phase); default: a new figure.
 
     Examples
     --------
@@ -213,7 +299,8 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
     if fit.plant.modes:
         f = np.union1d(f, [m.frequency_hz for m in fit.plant.modes if lo <= m.frequency_hz <= hi])
     m1, m2 = fit.plant.response(2 * np.pi * f)
-    fig, (ax1, ax2) = _figure(2)
+    fig, axes = new_figure(2, ax=ax)
+    ax1, ax2 = axes
     delayed = " (delay divided out)" if fit.delay_s > 0 else ""
     for P, D, color, name in ((m1, fit.P1_data, "tab:blue", "P1 (collocated)"),
                               (m2, fit.P2_data, "tab:red", "P2 (non-collocated)")):
@@ -242,14 +329,14 @@ def plot_frf_fit(fit, f_range: tuple[float, float] | None = None) -> Figure:
                   f"{len(fit.plant.modes)} mode(s){delay},\nRMS relative error "
                   f"{fit.rms_relative_error:.2g}", fontsize=9)
     ax1.legend(loc="lower left")
-    _minor_log_ticks(fig)
+    minor_log_ticks(axes)
     fig.motionhyst_data.update(f=f, P1_fit=m1, P2_fit=m2, f_data=f_data, P1_data=fit.P1_data,
                                P2_data=fit.P2_data)
     return fig
 
 
 
-def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:
+def plot_link(link, amplitudes=None, title: str | None = None, ax=None) -> Figure:
     """Force-displacement loops of a link model for sines of several amplitudes.
 
     Parameters
@@ -262,6 +349,8 @@ def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:
         initial stiffness).
     title : str, optional
         Figure title (default: the model's name).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; default: a new figure.
 
     Examples
     --------
@@ -271,7 +360,8 @@ def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:
     >>> round(float(w.max()), 6)                    # the first element slips, the second not
     0.05
     """
-    fig, (ax,) = _figure()
+    fig, axes = new_figure(ax=ax)
+    (ax,) = axes
     fc = float(np.sum(link.fc))
     if amplitudes is None:
         amplitudes = fc / link.initial_stiffness * np.array([0.5, 1.0, 2.0, 4.0])
@@ -286,9 +376,16 @@ def plot_link(link, amplitudes=None, title: str | None = None) -> Figure:
     return fig
 
 
-def plot_simulation(sim) -> Figure:
+def plot_simulation(sim, ax=None) -> Figure:
     """A :class:`~motionhyst.time.simulation.Simulation`: the error with and without the link, and
     the link force, against time.
+
+    Parameters
+    ----------
+    sim : Simulation
+        A time simulation.
+    ax : sequence of two matplotlib.axes.Axes, optional
+        Axes to draw into (top, bottom); default: a new figure.
 
     Examples
     --------
@@ -297,7 +394,8 @@ def plot_simulation(sim) -> Figure:
     >>> sorted(fig.motionhyst_data)
     ['e', 'e_linear', 't', 'w']
     """
-    fig, (ax1, ax2) = _figure(2)
+    fig, axes = new_figure(2, ax=ax)
+    ax1, ax2 = axes
     ax1.plot(sim.t, sim.e * 1e9, color="k", label="with the link")
     ax1.plot(sim.t, sim.e_linear * 1e9, color=LINEAR_COLOR, label="without the link")
     ax1.set_ylabel("e [nm]")
@@ -307,4 +405,47 @@ def plot_simulation(sim) -> Figure:
     ax2.set_ylabel("link force w [N]")
     ax2.set_xlabel("time [s]")
     fig.motionhyst_data.update(t=sim.t, e=sim.e, e_linear=sim.e_linear, w=sim.w)
+    return fig
+
+
+def plot_describing_function(result, ax=None) -> Figure:
+    """``|D| / k_init`` and the angle of ``D`` (eq. 7) against the amplitude, one curve per
+    frequency.
+
+    Parameters
+    ----------
+    result : DescribingFunctionResult
+        What :func:`~motionhyst.analysis.describing.describing_function` returned.
+    ax : sequence of two matplotlib.axes.Axes, optional
+        Axes to draw into (magnitude, angle); default: a new figure.
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins, describing_function
+    >>> res = describing_function(Jenkins(k=20.0, fc=0.05), [0.001, 0.005, 0.01, 0.1])
+    >>> fig = plot_describing_function(res)
+    >>> fig.motionhyst_data["A"].tolist(), fig.motionhyst_data["D"].shape
+    ([0.001, 0.005, 0.01, 0.1], (1, 4))
+    """
+    fig, axes = new_figure(2, ax=ax)
+    ax1, ax2 = axes
+    k_init = result.link.initial_stiffness
+    freqs = list(dict.fromkeys(p.frequency_hz for p in result.points))
+    A = np.array([p.amplitude for p in result.points if p.frequency_hz == freqs[0]])
+    D = np.array([[p.value for p in result.points if p.frequency_hz == f] for f in freqs])
+    scale = k_init if np.isfinite(k_init) and k_init > 0 else 1.0
+    for f, d in zip(freqs, D, strict=True):
+        label = "" if f is None else f"{f:g} Hz"
+        ax1.plot(A, np.abs(d) / scale, "o-", ms=3, label=label)
+        ax2.plot(A, np.degrees(np.angle(d)), "o-", ms=3, label=label)
+    if np.all(A > 0):
+        ax1.set_xscale("log")
+    ax1.set_ylabel("|D| / k_init [-]" if scale == k_init else "|D| [N/m]")
+    ax2.set_ylabel("angle D [deg]")
+    ax2.set_xlabel("amplitude A [m]")
+    ax1.set_title(f"Describing function of the {result.link.name} link (eq. 7)")
+    if freqs[0] is not None:
+        ax1.legend()
+    minor_log_ticks(axes)
+    fig.motionhyst_data.update(A=A, D=D, frequency_hz=freqs)
     return fig

@@ -22,8 +22,8 @@ from motionhyst.present.figures import (
     MODE2_COLOR,
     MODE3_COLOR,
     STYLE,
-    _figure,
-    _minor_log_ticks,
+    minor_log_ticks,
+    new_figure,
 )
 
 if TYPE_CHECKING:
@@ -157,7 +157,7 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
     `frequency_hz`.
     """
     _check_frequency(el, frequency_hz)
-    fig, (ax,) = _figure()
+    fig, (ax,) = new_figure()
     fc = _force_scale(el)
     for z in zetas:
         A = fc / (el.initial_stiffness * z)
@@ -178,7 +178,7 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
 
 def fig6_modes(el: Jenkins, zeta_mode2: float = 0.4, zeta_mode3: float = 0.7):
     """Fig. 6: the two nonlinear modes: stick-to-slip at x w <= 0 (mode 2) and x w > 0 (mode 3)."""
-    fig, (ax,) = _figure()
+    fig, (ax,) = new_figure()
     for z, color, mode in ((zeta_mode2, MODE2_COLOR, 2), (zeta_mode3, MODE3_COLOR, 3)):
         A = el.fc / (el.k * z)
         x, w = _sine_loop(el, A)
@@ -220,7 +220,7 @@ def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
     ``tau_i`` (eq. 6) marked, and the first harmonic kept by the describing
     function (eq. 7).
     """
-    fig, (ax_x, ax) = _figure(2)
+    fig, (ax_x, ax) = new_figure(2)
     x, w = _sine_loop(el, A)
     t = np.linspace(0.0, 1.0 / frequency_hz, len(x))
     D = el.describing_function(A)
@@ -266,7 +266,7 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
     angle ~50 deg) with its values.
     """
     _check_frequency(el, frequency_hz)
-    fig, (ax1, ax2) = _figure(2)
+    fig, (ax1, ax2) = new_figure(2)
     jenkins = el.defines_zeta  # the paper's Jenkins element: slip modes by zeta (eq. 4)
     z = np.geomspace(*zeta_range, 800 if jenkins else 200)
     k0 = el.initial_stiffness
@@ -303,7 +303,7 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
         ax2.set_xlabel("zeta = fc / (k A) [-], k the initial stiffness")
         ax1.set_title(f"Fig. 8: describing function, {_describe(el, frequency_hz)}",
                       fontsize=9)
-    _minor_log_ticks(fig)
+    minor_log_ticks(fig)
     fig.motionhyst_data.update(zeta=z, abs_over_k=np.abs(D) / k0,
                                phase_deg=np.degrees(np.angle(D)))
     return fig
@@ -398,18 +398,18 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     axes[0, -1].set_title(title.replace("\u00a0", " "), fontsize=9)
     fig.suptitle("Fig. 9: quasi-linear plant P^phi = P2 / (1 + D P1), eq. (12); "
                  "0 dB = 1 m/N", fontsize=10)
-    _minor_log_ticks(fig)
+    minor_log_ticks(fig)
     return fig
 
 
 def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
     """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
-    from motionhyst.analysis.quasilinear import _resolved, loop_mismatch, mismatch_asymptote
+    from motionhyst.analysis.quasilinear import loop_mismatch, mismatch_asymptote, resolved_lines
     from motionhyst.core.lti import freqresp
     from motionhyst.plants.measured import MeasuredPlant
 
-    fig, (ax,) = _figure()
+    fig, (ax,) = new_figure()
     f = _grid(loop, f_range, 800)
     w = TWO_PI * f
     E = loop_mismatch(loop, f, analysis.amplitude, describing_function=describing_function_curve(
@@ -419,7 +419,7 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - P2
     Et = mismatch_asymptote(Pr, Pf2, analysis.D)
     if isinstance(loop.plant, MeasuredPlant):  # raw data: only the lines that resolve Pf2
-        ok = _resolved(loop.plant, P2, Pf2)
+        ok = resolved_lines(loop.plant, P2, Pf2)
         ax.loglog(f[~ok], np.abs(E[~ok]), "x", color="0.6", ms=4,
                   label="measured lines where Pf2 = Pr - P2 is not resolved (noise)")
         E, Et = np.where(ok, E, np.nan), np.where(ok, Et, np.nan)
@@ -447,19 +447,28 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
           else f"A = {analysis.amplitude:.3g} m")
     ax.set_title(f"Fig. 10: feedforward mismatch, {at}")
     ax.legend(loc="upper right", fontsize=7)
-    _minor_log_ticks(fig)
+    minor_log_ticks(fig)
     fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
     return fig
 
 
 def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike,
-                 harmonics_df: list[ArrayLike] | None = None):
+                 harmonics_df: list[ArrayLike] | None = None, ax=None):
     """Fig. 11: steady-state error over a period, with and without hysteresis, and the DF.
 
-    `harmonics_df`, per state, the predicted error harmonics 1, 2, ... from the
-    higher-order describing functions, adds their sum as a dotted line.
+    Parameters
+    ----------
+    states : list of SteadyState
+        The exact steady states, one panel each.
+    mismatch_df : array_like of complex
+        Eq. (18) per state: the describing function's prediction of the first harmonic.
+    harmonics_df : list of array_like, optional
+        Per state, the predicted error harmonics 1, 2, ... from the higher-order
+        describing functions; their sum is added as a dotted line.
+    ax : sequence of matplotlib.axes.Axes, optional
+        One axes per state to draw into; default: a new figure.
     """
-    fig, axes = _figure(len(states), sharex=False)
+    fig, axes = new_figure(len(states), sharex=False, ax=ax)
     hdf = harmonics_df if harmonics_df is not None else [None] * len(states)
     for ax, ss, E, h in zip(axes, states, np.atleast_1d(mismatch_df), hdf, strict=True):
         ts = ss.time_series()

@@ -166,12 +166,20 @@ class ILCResult:
                 f"{first:.4g} m -> {last:.4g} m ({first / last:.3g}x)" if last > 0 else
                 f"ILC, {self.trials} trials: RMS error {first:.4g} m -> 0")
 
-    def plot(self):
-        """Figure of the RMS and peak error against the trial."""
+    def plot(self, ax=None):
+        """Figure of the RMS and peak error against the trial.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; default: a new figure.
+        """
         from matplotlib.figure import Figure
 
-        fig = Figure(figsize=(6.4, 3.6), layout="constrained")
-        ax = fig.subplots()
+        if ax is None:
+            fig = Figure(figsize=(6.4, 3.6), layout="constrained")
+            ax = fig.subplots()
+        fig = ax.figure
         k = np.arange(1, self.trials + 1)
         ax.semilogy(k, self.rms_errors, "o-", label="RMS error")
         ax.semilogy(k, self.peak_errors, "s--", label="peak error")

@@ -383,14 +383,28 @@ class Profile:
         return (f"{what}: {self.duration:.4g} s; peak acceleration {r['acceleration']:.4g} "
                 f"m/s^2, jerk {r['jerk']:.4g} m/s^3, snap {r['snap']:.4g} m/s^4")
 
-    def plot(self, after: float = 0.0):
-        """Figure of position, velocity, acceleration, jerk and snap with the phases shaded."""
+    def plot(self, after: float = 0.0, ax=None):
+        """Figure of position, velocity, acceleration, jerk and snap with the phases shaded.
+
+        Parameters
+        ----------
+        after : float
+            Time shown after the move ends [s].
+        ax : sequence of 5 matplotlib.axes.Axes, optional
+            Axes to draw into (position to snap); default: a new figure.
+        """
         from matplotlib.figure import Figure
 
         t = np.linspace(0.0, self.end + after, 4001)
         d = self.derivatives(t)
-        fig = Figure(figsize=(6.4, 6.4), layout="constrained")
-        axes = fig.subplots(5, 1, sharex=True)
+        if ax is None:
+            fig = Figure(figsize=(6.4, 6.4), layout="constrained")
+            axes = fig.subplots(5, 1, sharex=True)
+        else:
+            axes = list(ax) if hasattr(ax, "__len__") else [ax]
+            if len(axes) != 5:
+                raise ValueError(f"this plot draws 5 axes; ax= gives {len(axes)}")
+            fig = axes[0].figure
         units = ("m", "m/s", "m/s$^2$", "m/s$^3$", "m/s$^4$")
         for ax, name, unit, y in zip(axes, DERIVATIVES, units, d, strict=True):
             ax.plot(t, y, color="0.15", lw=1.2)

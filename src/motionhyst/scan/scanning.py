@@ -288,13 +288,29 @@ class ScanResult:
                     f"{self.carry_over.profile}", self.carry_over._table(without_link=False)]
         return "\n".join(out)
 
-    def plot(self, unit: float = 1e-9, unit_name: str = "nm"):
-        """Figure of ``e``, ``MA`` and ``MSD`` against time, the profile's phases shaded."""
+    def plot(self, unit: float = 1e-9, unit_name: str = "nm", ax=None):
+        """Figure of ``e``, ``MA`` and ``MSD`` against time, the profile's phases shaded.
+
+        Parameters
+        ----------
+        unit : float
+            Unit of the errors on the figure [m] (default 1 nm).
+        unit_name : str
+            Its name.
+        ax : sequence of 3 matplotlib.axes.Axes, optional
+            Axes to draw into (e, MA, MSD); default: a new figure.
+        """
         from matplotlib.figure import Figure
         from matplotlib.patches import Patch
 
-        fig = Figure(figsize=(7.2, 6.4), layout="constrained")
-        axes = fig.subplots(3, 1, sharex=True)
+        if ax is None:
+            fig = Figure(figsize=(7.2, 6.4), layout="constrained")
+            axes = fig.subplots(3, 1, sharex=True)
+        else:
+            axes = list(ax) if hasattr(ax, "__len__") else [ax]
+            if len(axes) != 3:
+                raise ValueError(f"this plot draws 3 axes; ax= gives {len(axes)}")
+            fig = axes[0].figure
         for ax, name in zip(axes, ("e", "ma", "msd"), strict=True):
             ref = getattr(self.without_link, name)
             ax.plot(self.t, ref / unit, color="0.5", lw=0.9, ls="--", label="without link")

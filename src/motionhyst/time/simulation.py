@@ -114,9 +114,14 @@ class Simulation:
                    ["without", g(d["error_linear_peak"]), g(d["error_linear_rms"])]]),
             f"  peak link force {g(d['link_force_peak'])} N"])
 
-    def plot(self):
+    def plot(self, ax=None):
         """The error with and without the link, and the link force, against time
         (:func:`motionhyst.present.figures.plot_simulation`).
+
+        Parameters
+        ----------
+        ax : sequence of 2 matplotlib.axes.Axes, optional
+            Axes to draw into (error, link force); default: a new figure.
 
         Returns
         -------
@@ -124,7 +129,7 @@ class Simulation:
         """
         from motionhyst.present.figures import plot_simulation
 
-        return plot_simulation(self)
+        return plot_simulation(self, ax=ax)
 
 
 def _block_systems(loop: Loop, omega0: float):
