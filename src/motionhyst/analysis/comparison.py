@@ -28,6 +28,8 @@ from motionhyst.analysis.steady import SteadyState, steady_state_sweep
 from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
 
+__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
+
 
 @dataclass
 class ComparisonPoint:

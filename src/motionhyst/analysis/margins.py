@@ -45,6 +45,8 @@ from motionhyst.controllers.sampled import SampledController
 from motionhyst.core.lti import TWO_PI, freqresp, tf_poly, trim
 from motionhyst.core.sampling import ZohEquivalent
 
+__all__ = ["LoopMargins", "loop_margins"]
+
 BANDWIDTH_DEFINITION = ("crossover frequency: the lowest frequency where |L| = |C P2| falls "
                         "through 1 (0 dB)")
 #: Grid density of the scan of an LTI loop [points per decade].

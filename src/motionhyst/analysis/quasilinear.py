@@ -38,6 +38,8 @@ from motionhyst.loop import Loop
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.two_mass import TwoMassStage
 
+__all__ = ["MismatchPoint", "QuasiLinearAnalysis", "analyze", "f_star", "mismatch_crossover"]
+
 
 def quasi_linear_plant(P1: ArrayLike, P2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
     """Quasi-linear plant ``P^phi = P2 / (1 + D P1)`` from ``u`` to ``y2``, paper eq. (12)."""
@@ -77,7 +79,13 @@ def mismatch_asymptote(Pr: ArrayLike, Pf2: ArrayLike, D: ArrayLike) -> NDArray[n
 
 
 def f_star(k: float, M: float) -> float:
-    """Frequency above which ``P^phi`` tends to ``P2``, ``sqrt(k/M) / (2 pi)`` [Hz], eq. (13)."""
+    """Frequency above which ``P^phi`` tends to ``P2``, ``sqrt(k/M) / (2 pi)`` [Hz], eq. (13).
+
+    Examples
+    --------
+    >>> round(f_star(20.0, 22.5), 4)                         # Table I: k = 20 N/m, M = 22.5 kg
+    0.1501
+    """
     return float(np.sqrt(k / M) / TWO_PI)
 
 
@@ -85,13 +93,26 @@ def mismatch_crossover(k: float, m1: float, m2: float, D_abs: float) -> float:
     """Crossover ``|E~| = 1`` of the asymptote, ``(k |D| / (m1 m2))^(1/4) / (2 pi)`` [Hz], eq. (21).
 
     `k` is the stage's internal stiffness, not the link's.
+
+    Examples
+    --------
+    >>> round(mismatch_crossover(7.4e7, 5.0, 17.5, 6.171), 2)  # Table I at 10 mm; the paper: 7.6 Hz
+    7.61
     """
     return float((k * D_abs / (m1 * m2)) ** 0.25 / TWO_PI)
 
 
 @dataclass
 class MismatchPoint:
-    """The mismatch at one frequency."""
+    """The mismatch at one frequency.
+
+    Examples
+    --------
+    >>> from motionhyst import analyze, default_scenario
+    >>> p = analyze(default_scenario().loop(), 0.01, [5.0]).points[0]
+    >>> round(abs(p.value), 2), p.zeta                      # |E| of eq. (18), eq. (4)
+    (6.04, 0.25)
+    """
 
     frequency_hz: float
     value: complex

@@ -43,6 +43,8 @@ from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
 from motionhyst.plants.measured import MeasuredPlant
 
+__all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
+
 MIN_HARMONICS = 32
 MAX_HARMONICS = 4096
 

@@ -9,6 +9,8 @@ from scipy.optimize import brentq
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.hysteresis.base import check_positive
 
+__all__ = ["LeadLagLowpass", "bandwidth"]
+
 
 class LeadLagLowpass(control.TransferFunction):
     """Feedback controller of eq. (23): lead-lag filter times second-order low-pass.
@@ -73,6 +75,13 @@ def bandwidth(controller, plant, f_min: float = 1e-3, f_max: float = 1e6) -> flo
     float
         Lowest frequency where ``|C P2|`` falls through 1, or ``nan`` if it
         does not within the range.
+
+    Examples
+    --------
+    >>> from motionhyst import LeadLagLowpass, TwoMassStage
+    >>> C = LeadLagLowpass(K=6.2e6, f1=60.0, f2=240.0, flp=700.0, beta=0.6)
+    >>> round(bandwidth(C, TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7).P2), 2)
+    120.65
     """
     if isinstance(plant, control.FrequencyResponseData):
         f_min = max(f_min, plant.omega.min() / TWO_PI)

@@ -7,9 +7,18 @@ import math
 
 import numpy as np
 
+__all__ = ["dumps", "jsonable"]
+
 
 def jsonable(obj):
-    """`obj` with numpy scalars made plain and non-finite floats replaced by None."""
+    """`obj` with numpy scalars made plain and non-finite floats replaced by None.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> jsonable({"a": np.float64(1.5), "b": float("nan"), "c": [np.int64(2)]})
+    {'a': 1.5, 'b': None, 'c': [2]}
+    """
     if isinstance(obj, dict):
         return {k: jsonable(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
@@ -22,5 +31,13 @@ def jsonable(obj):
 
 
 def dumps(obj) -> str:
-    """Strict JSON text of `obj`, indented."""
+    """Strict JSON text of `obj`, indented.
+
+    Examples
+    --------
+    >>> print(dumps({"x": float("inf")}))
+    {
+      "x": null
+    }
+    """
     return json.dumps(jsonable(obj), indent=2, allow_nan=False)

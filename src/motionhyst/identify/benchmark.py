@@ -44,6 +44,8 @@ from scipy.signal import firwin, lfilter
 
 from motionhyst.core.compiled import njit
 
+__all__ = ["benchmark_output", "decimate_fir", "multisine", "newmark_bouc_wen", "training_record"]
+
 #: The benchmark's true system (SI units).
 TRUE_PARAMETERS: dict[str, float] = {
     "m": 2.0, "c": 10.0, "k": 5e4, "alpha": 5e4, "beta": 1e3, "gamma": 0.8, "delta": -1.1,

@@ -81,6 +81,8 @@ from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import TWO_PI, polysub_exact, trim
 from motionhyst.plants.measured import MeasuredPlant
 
+__all__ = ["FrfFit", "ModalPlant", "Mode", "fit_frf"]
+
 #: Largest number of modes the automatic choice tries.
 MAX_MODES = 6
 #: Damping ratios and frequency density of the start's scan.
@@ -109,6 +111,11 @@ class Mode:
         Damping ratio ``z`` [-].
     r1, r2 : float
         Residues of the collocated and non-collocated transfers [1/kg].
+
+    Examples
+    --------
+    >>> Mode(4375.0, 0.02, 0.15, -0.04).frequency_hz
+    4375.0
     """
 
     frequency_hz: float

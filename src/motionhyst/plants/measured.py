@@ -13,6 +13,8 @@ from motionhyst.hysteresis.base import check_positive
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record, record_columns
 
+__all__ = ["MeasuredPlant", "load_frd_plant"]
+
 
 @dataclass(frozen=True)
 class MeasuredPlant:

@@ -8,6 +8,8 @@ import numpy as np
 from motionhyst.core.lti import TWO_PI
 from motionhyst.hysteresis.base import check_positive
 
+__all__ = ["TwoMassStage"]
+
 
 class TwoMassStage:
     """Floating two-mass stage of the paper's Fig. 2, eqs. (1)-(2).

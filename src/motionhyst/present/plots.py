@@ -26,6 +26,10 @@ from motionhyst.present.figures import (
     new_figure,
 )
 
+__all__ = ["describing_function_curve", "fig5_loops", "fig6_modes", "fig7_time",
+           "fig8_describing_function", "fig9_quasilinear_plant", "fig10_mismatch", "fig11_errors",
+           "switching_instants"]
+
 if TYPE_CHECKING:
     from motionhyst.analysis.quasilinear import QuasiLinearAnalysis
     from motionhyst.analysis.steady import SteadyState
@@ -155,6 +159,12 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
     ``zeta = fc / (k A)`` (eq. 4); for other models ``fc`` is the total slip
     force and ``k`` the initial stiffness, and a rate-dependent element needs
     `frequency_hz`.
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins
+    >>> len(fig5_loops(Jenkins(k=20.0, fc=0.05)).axes)
+    1
     """
     _check_frequency(el, frequency_hz)
     fig, (ax,) = new_figure()
@@ -177,7 +187,14 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
 
 
 def fig6_modes(el: Jenkins, zeta_mode2: float = 0.4, zeta_mode3: float = 0.7):
-    """Fig. 6: the two nonlinear modes: stick-to-slip at x w <= 0 (mode 2) and x w > 0 (mode 3)."""
+    """Fig. 6: the two nonlinear modes: stick-to-slip at x w <= 0 (mode 2) and x w > 0 (mode 3).
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins
+    >>> len(fig6_modes(Jenkins(k=20.0, fc=0.05)).axes)
+    1
+    """
     fig, (ax,) = new_figure()
     for z, color, mode in ((zeta_mode2, MODE2_COLOR, 2), (zeta_mode3, MODE3_COLOR, 3)):
         A = el.fc / (el.k * z)
@@ -203,6 +220,12 @@ def switching_instants(el: Jenkins, A: float, frequency_hz: float) -> np.ndarray
     (``omega t = pi/2, 3 pi/2``) and slip begins where the stuck spring
     reaches ``-+fc`` (``omega t = pi + gamma, 2 pi + gamma``, ``gamma`` of
     eq. 6).  Sorted; empty for ``zeta >= 1`` (no slip).
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins
+    >>> switching_instants(Jenkins(k=20.0, fc=0.05), 0.01, 1.0).round(4).tolist()
+    [0.25, 0.4167, 0.75, 0.9167]
     """
     z = float(el.zeta(A))
     if z >= 1.0:
@@ -219,6 +242,12 @@ def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
     ``w(t)`` (eq. 5) with the slip intervals shaded, the switching instants
     ``tau_i`` (eq. 6) marked, and the first harmonic kept by the describing
     function (eq. 7).
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins
+    >>> len(fig7_time(Jenkins(k=20.0, fc=0.05), 0.01).axes)               # x(t) and w(t)
+    2
     """
     fig, (ax_x, ax) = new_figure(2)
     x, w = _sine_loop(el, A)
@@ -264,6 +293,12 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
     rate-dependent element is drawn at `frequency_hz`.  `zeta_op` marks an
     operating point (the paper's section V: zeta = 0.25, ``|D| ~ 0.3 k``,
     angle ~50 deg) with its values.
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins
+    >>> len(fig8_describing_function(Jenkins(k=20.0, fc=0.05)).axes)      # |D|/k and angle
+    2
     """
     _check_frequency(el, frequency_hz)
     fig, (ax1, ax2) = new_figure(2)
@@ -359,6 +394,12 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     amplitude; for other models by the amplitude ``fc_total / (k_total zeta)``.
     ``fig.motionhyst_data`` holds the scenario's curves (``f``, ``P2``,
     ``zeta=...``) and the paper's with the prefix ``paper_``.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> len(fig9_quasilinear_plant(default_scenario().loop()).axes) >= 2
+    True
     """
     from motionhyst.analysis.quasilinear import f_star
     from motionhyst.core.lti import freqresp
@@ -404,7 +445,16 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
 
 def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
-    """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers."""
+    """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers.
+
+    Examples
+    --------
+    >>> from motionhyst import analyze, default_scenario
+    >>> loop = default_scenario().loop()
+    >>> fig = fig10_mismatch(loop, analyze(loop, 0.01, [5.0, 10.0]))
+    >>> len(fig.axes)
+    1
+    """
     from motionhyst.analysis.quasilinear import loop_mismatch, mismatch_asymptote, resolved_lines
     from motionhyst.core.lti import freqresp
     from motionhyst.plants.measured import MeasuredPlant
@@ -467,6 +517,13 @@ def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike,
         describing functions; their sum is added as a dotted line.
     ax : sequence of matplotlib.axes.Axes, optional
         One axes per state to draw into; default: a new figure.
+
+    Examples
+    --------
+    >>> from motionhyst import compare_with_describing_function, default_scenario
+    >>> cmp = compare_with_describing_function(default_scenario().loop(), 0.01, [5.0, 10.0])
+    >>> len(cmp.plot().axes)                               # fig11_errors, one panel a frequency
+    2
     """
     fig, axes = new_figure(len(states), sharex=False, ax=ax)
     hdf = harmonics_df if harmonics_df is not None else [None] * len(states)

@@ -26,6 +26,9 @@ from motionhyst.io.outputs import OutputFolder
 from motionhyst.present.figure_writer import FigureWriter
 from motionhyst.scenario import Scenario
 
+# the report is run by `motionhyst reproduce` (motionhyst.cli.reproduce): no library API
+__all__ = []
+
 if TYPE_CHECKING:
     from motionhyst.analysis.digital import DigitalComparison
     from motionhyst.analysis.quasilinear import QuasiLinearAnalysis

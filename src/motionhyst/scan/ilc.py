@@ -33,6 +33,8 @@ from motionhyst.core.lti import TWO_PI
 from motionhyst.loop import Loop
 from motionhyst.time.simulation import Simulation, default_step, simulate
 
+__all__ = ["ILCFilters", "ILCResult", "learn"]
+
 
 @dataclass(frozen=True)
 class ILCFilters:
@@ -130,6 +132,15 @@ class ILCResult:
         learned force.
     last : Simulation
         The last trial.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.scan.profiles import point_to_point
+    >>> p = point_to_point(0.002, 0.05, 2.0, 50.0, 1e3, start=0.005)
+    >>> res = learn(default_scenario().loop(), p, p.end + 0.01, trials=2)
+    >>> res.trials, bool(res.rms_errors[-1] < res.rms_errors[0])   # the second trial is better
+    (2, True)
     """
 
     filters: ILCFilters

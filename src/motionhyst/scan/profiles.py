@@ -32,6 +32,8 @@ from itertools import combinations, pairwise
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+__all__ = ["Profile", "point_to_point", "scan"]
+
 #: Names of the derivatives returned by :meth:`Profile.derivatives`, in order.
 DERIVATIVES = ("position", "velocity", "acceleration", "jerk", "snap")
 

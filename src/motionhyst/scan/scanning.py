@@ -14,6 +14,8 @@ whose whole window lies inside the phase (the points a scan exposes).
 
 :func:`run_scan` simulates a setpoint profile (:mod:`motionhyst.scan.profiles`)
 from rest with the loop's dynamic link and compares compensations: ``none``
+
+__all__ = ["ScanResult", "ScanRun", "moving_statistics", "run_scan", "settling_time"]
 (rigid-body feedforward only), ``model`` (the loop's hysteresis feedforward
 ``phi_hat(r)``, driven by the setpoint) and ``ilc`` (a force learned over
 trials, :mod:`motionhyst.scan.ilc`); and, on another setpoint, whether the learned
@@ -153,6 +155,15 @@ class ScanRun:
         phase until ``|e|`` stays within the tolerance to its end; for a
         point-to-point move, from the end of the move to the end of the run.
         None if the error does not settle.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.scan.profiles import scan
+    >>> p = scan(0.005, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)
+    >>> run = run_scan(default_scenario().loop(), p, window=0.05, tail=0.0).run("none")
+    >>> sorted(run.to_dict())[:3]
+    ['compensation', 'ma_max', 'msd_max']
     """
 
     compensation: str
@@ -219,6 +230,15 @@ class ScanResult:
         The learning's trials, if ``ilc`` was asked.
     carry_over : ScanResult or None
         Another setpoint with the model and the force learned on this one.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.scan.profiles import scan
+    >>> p = scan(0.005, speed=0.05, a_max=2.0, j_max=50.0, s_max=1e3, start=0.01)
+    >>> res = run_scan(default_scenario().loop(), p, window=0.05, tail=0.0)
+    >>> [r.compensation for r in res.runs]
+    ['none']
     """
 
     profile: Profile

@@ -30,6 +30,9 @@ from pydantic import (
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.hysteresis.registry import Form
 
+__all__ = ["Scenario", "ScenarioError", "default_scenario", "default_scenario_path",
+           "hysteresis_from_dict", "load_scenario"]
+
 if TYPE_CHECKING:  # imported where used: validating a file needs neither python-control nor scipy
     import control
 

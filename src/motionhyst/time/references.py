@@ -18,6 +18,8 @@ from motionhyst.core.lti import TWO_PI
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
+__all__ = ["PointToPoint", "SampledReference", "SineReference", "load_reference_csv"]
+
 
 @dataclass(frozen=True)
 class SineReference:

@@ -39,6 +39,8 @@ from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, advance, open_loop_chunk
 from motionhyst.loop import Loop
 
+__all__ = ["Simulation", "simulate", "simulate_chunks"]
+
 STEPS_PER_POLE_PERIOD = 40
 STEPS_PER_REFERENCE_PERIOD = 400
 BYTES_PER_SAMPLE = 160
