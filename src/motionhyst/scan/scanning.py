@@ -14,8 +14,6 @@ whose whole window lies inside the phase (the points a scan exposes).
 
 :func:`run_scan` simulates a setpoint profile (:mod:`motionhyst.scan.profiles`)
 from rest with the loop's dynamic link and compares compensations: ``none``
-
-__all__ = ["ScanResult", "ScanRun", "moving_statistics", "run_scan", "settling_time"]
 (rigid-body feedforward only), ``model`` (the loop's hysteresis feedforward
 ``phi_hat(r)``, driven by the setpoint) and ``ilc`` (a force learned over
 trials, :mod:`motionhyst.scan.ilc`); and, on another setpoint, whether the learned
@@ -37,6 +35,8 @@ from motionhyst.loop import Loop
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
 from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
 from motionhyst.time.simulation import BYTES_PER_SAMPLE, default_step, simulate
+
+__all__ = ["ScanResult", "ScanRun", "moving_statistics", "run_scan", "settling_time"]
 
 COMPENSATIONS = ("none", "model", "ilc")
 """The compensations :func:`run_scan` compares."""
