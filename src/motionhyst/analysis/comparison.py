@@ -66,6 +66,13 @@ class ComparisonPoint:
 class DescribingFunctionComparison:
     """Result of :func:`compare_with_describing_function`, one point per frequency.
 
+    Parameters
+    ----------
+    amplitude : float
+        Reference amplitude ``A_r`` [m].
+    points : list of ComparisonPoint
+        One per frequency.
+
     Examples
     --------
     >>> from motionhyst import compare_with_describing_function, default_scenario

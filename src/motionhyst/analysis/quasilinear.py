@@ -81,6 +81,13 @@ def mismatch_asymptote(Pr: ArrayLike, Pf2: ArrayLike, D: ArrayLike) -> NDArray[n
 def f_star(k: float, M: float) -> float:
     """Frequency above which ``P^phi`` tends to ``P2``, ``sqrt(k/M) / (2 pi)`` [Hz], eq. (13).
 
+    Parameters
+    ----------
+    k : float
+        Initial stiffness of the link [N/m].
+    M : float
+        Total mass of the stage [kg].
+
     Examples
     --------
     >>> round(f_star(20.0, 22.5), 4)                         # Table I: k = 20 N/m, M = 22.5 kg
@@ -94,6 +101,17 @@ def mismatch_crossover(k: float, m1: float, m2: float, D_abs: float) -> float:
 
     `k` is the stage's internal stiffness, not the link's.
 
+    Parameters
+    ----------
+    k : float
+        The stage's internal stiffness [N/m].
+    m1 : float
+        Actuated mass [kg].
+    m2 : float
+        Mass at the point of control [kg].
+    D_abs : float
+        ``|D|`` of the link at the reference amplitude [N/m].
+
     Examples
     --------
     >>> round(mismatch_crossover(7.4e7, 5.0, 17.5, 6.171), 2)  # Table I at 10 mm; the paper: 7.6 Hz
@@ -105,6 +123,21 @@ def mismatch_crossover(k: float, m1: float, m2: float, D_abs: float) -> float:
 @dataclass
 class MismatchPoint:
     """The mismatch at one frequency.
+
+    Parameters
+    ----------
+    frequency_hz : float
+        Frequency [Hz].
+    value : complex
+        The mismatch ``E`` of eq. (18).
+    asymptote : complex
+        Its asymptote ``E~`` of eq. (20).
+    zeta : float
+        ``fc / (k A_y1)`` (eq. 4).
+    y1_amplitude : float
+        Amplitude of ``y1`` the describing function is taken at [m].
+    D : complex
+        The describing function there [N/m].
 
     Examples
     --------

@@ -142,7 +142,13 @@ class SteadyState:
         return float(abs(self.e_linear[1]) / np.sqrt(2.0))
 
     def time_series(self, n_samples: int | None = None) -> dict[str, NDArray[np.float64]]:
-        """One period sampled: ``t`` [s], ``r``, ``e``, ``e_linear``, ``y1`` [m], ``w`` [N]."""
+        """One period sampled: ``t`` [s], ``r``, ``e``, ``e_linear``, ``y1`` [m], ``w`` [N].
+
+        Parameters
+        ----------
+        n_samples : int, optional
+            Samples of the period (default: enough for the harmonics computed).
+        """
         N = n_samples or max(4096, 8 * self.n_harmonics)
         t = np.arange(N) / (N * self.frequency_hz)
 
@@ -193,7 +199,17 @@ class SteadyState:
     def to_dict(self, harmonics: tuple[int, ...] = (1, 3, 5),
                 mismatch_df: complex | None = None,
                 error_harmonics_df: ArrayLike | None = None) -> dict:
-        """JSON-ready dictionary (one point of the ``simulate --json`` schema)."""
+        """JSON-ready dictionary (one point of the ``simulate --json`` schema).
+
+        Parameters
+        ----------
+        harmonics : tuple of int
+            The error harmonics to list.
+        mismatch_df : complex, optional
+            Eq. (18) to report beside the exact mismatch.
+        error_harmonics_df : array_like, optional
+            Error harmonics predicted by the higher-order describing functions [m].
+        """
         eh = [{"n": n, "abs": float(abs(self.e[n])),
                "phase_deg": float(np.degrees(np.angle(self.e[n])))}
               for n in harmonics if n <= self.n_harmonics]
@@ -491,6 +507,15 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
 def steady_state_sweep(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
                        **kwargs) -> list[SteadyState]:
     """:func:`periodic_steady_state` at each frequency [Hz].
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    amplitude : float
+        Reference amplitude ``A_r`` [m].
+    frequencies_hz : array_like
+        Frequencies [Hz].
 
     Examples
     --------

@@ -251,6 +251,13 @@ def njit(func: Callable | str | None = None, **options
     ``cache`` is accepted for symmetry with numba and ignored: the cache is
     chosen once per process (see the module docstring).
 
+    Parameters
+    ----------
+    func : callable or str, optional
+        The function (``@njit``), or a numba signature to compile only that one.
+    options
+        Further numba options (``cache``, ``fastmath``, ...), as keywords.
+
     Examples
     --------
     >>> @njit("(float64, float64)")
@@ -270,6 +277,11 @@ def quiet_compilation(quiet: bool = True) -> None:
 
     For callers whose stderr must stay clean, e.g. a test session that checks
     the commands' error output.
+
+    Parameters
+    ----------
+    quiet : bool
+        True to leave the notice out, False to show it again.
 
     Examples
     --------

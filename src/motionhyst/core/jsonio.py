@@ -13,6 +13,11 @@ __all__ = ["dumps", "jsonable"]
 def jsonable(obj):
     """`obj` with numpy scalars made plain and non-finite floats replaced by None.
 
+    Parameters
+    ----------
+    obj : object
+        Dictionaries, lists, numbers and strings.
+
     Examples
     --------
     >>> import numpy as np
@@ -32,6 +37,11 @@ def jsonable(obj):
 
 def dumps(obj) -> str:
     """Strict JSON text of `obj`, indented.
+
+    Parameters
+    ----------
+    obj : object
+        Dictionaries, lists, numbers and strings.
 
     Examples
     --------

@@ -40,6 +40,13 @@ def tf_poly(sys, what: str = "plant and controller"
             ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Numerator and denominator coefficients of a SISO LTI system.
 
+    Parameters
+    ----------
+    sys : control.LTI
+        A SISO python-control system.
+    what : str
+        Its name, for the message.
+
     Raises
     ------
     TypeError
@@ -92,6 +99,11 @@ def freqresp(sys, omega: ArrayLike) -> NDArray[np.complex128]:
 def trim(p: ArrayLike) -> NDArray[np.float64]:
     """Drop leading coefficients that are exactly zero.
 
+    Parameters
+    ----------
+    p : array_like
+        Coefficients, highest power first.
+
     Examples
     --------
     >>> from motionhyst.core.lti import trim
@@ -105,6 +117,15 @@ def trim(p: ArrayLike) -> NDArray[np.float64]:
 
 def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np.float64]:
     """``a - b`` with coefficients that cancel to round-off set to exactly zero.
+
+    Parameters
+    ----------
+    a : array_like
+        Coefficients, highest power first.
+    b : array_like
+        Coefficients, highest power first.
+    rtol : float
+        Relative size below which a difference counts as round-off.
 
     Examples
     --------
@@ -125,6 +146,13 @@ def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np
 def cancel_s(num: ArrayLike, den: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Cancel common factors ``s`` (trailing zero coefficients) of a ratio.
 
+    Parameters
+    ----------
+    num : array_like
+        Numerator coefficients, highest power first.
+    den : array_like
+        Denominator coefficients, highest power first.
+
     Examples
     --------
     >>> from motionhyst.core.lti import cancel_s
@@ -140,6 +168,15 @@ def cancel_s(num: ArrayLike, den: ArrayLike) -> tuple[NDArray[np.float64], NDArr
 def divide_s2(num: ArrayLike, den: ArrayLike, what: str
               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``num / (den s^2)`` with common factors ``s`` cancelled.
+
+    Parameters
+    ----------
+    num : array_like
+        Numerator coefficients, highest power first.
+    den : array_like
+        Denominator coefficients, highest power first.
+    what : str
+        The transfer's name, for the message.
 
     Raises
     ------
@@ -179,6 +216,13 @@ def polyratio(num, den, omega):  # pragma: no cover - compiled
 class PolyTF:
     """A SISO transfer function as coefficient arrays (highest power first).
 
+    Parameters
+    ----------
+    num : array_like
+        Numerator coefficients, highest power first.
+    den : array_like
+        Denominator coefficients, highest power first.
+
     Examples
     --------
     >>> import numpy as np
@@ -205,6 +249,15 @@ class PolyTF:
 def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
     """State-space realisation ``(A, B, C, D)`` in scaled time ``omega0 t`` (conditioning).
 
+    Parameters
+    ----------
+    num : array_like
+        Numerator coefficients, highest power first.
+    den : array_like
+        Denominator coefficients, highest power first.
+    omega0 : float
+        Time scale [rad/s].
+
     Examples
     --------
     >>> from motionhyst.core.lti import realize_scaled
@@ -222,6 +275,11 @@ def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
 
 def stack(mats):
     """Block-diagonal stack of single-input realisations sharing that input, one output each.
+
+    Parameters
+    ----------
+    mats : list of tuple
+        ``(A, B, C, D)`` of each realisation.
 
     Examples
     --------
@@ -347,6 +405,13 @@ def discretize_foh(sys, h: float):
     """First-order-hold discretisation (input linear between samples) with step `h`.
 
     Returns contiguous ``Ad, Bd, Cd, Dd`` (2-D, as :func:`scipy.signal.cont2discrete`).
+
+    Parameters
+    ----------
+    sys : control.LTI
+        A SISO python-control system.
+    h : float
+        Step [s].
 
     Examples
     --------
@@ -491,6 +556,15 @@ def forced_response_foh(sys, t: NDArray[np.float64], u: NDArray[np.float64]) -> 
     agrees with python-control to round-off; :class:`HoldFilter` is the
     filter for records (conditioned by a time scale, started in steady state).
 
+    Parameters
+    ----------
+    sys : control.LTI
+        A SISO python-control system.
+    t : ndarray
+        Uniform sample times [s].
+    u : ndarray
+        Input samples.
+
     Examples
     --------
     >>> import control
@@ -566,7 +640,13 @@ class HoldFilter:
         self.dc_gain = float(self.Dd + self.Cd @ self._x_unit)
 
     def with_step(self, dt: float) -> HoldFilter:
-        """The same continuous filter discretised for sampling interval `dt` [s]."""
+        """The same continuous filter discretised for sampling interval `dt` [s].
+
+        Parameters
+        ----------
+        dt : float
+            Sampling interval [s].
+        """
         return HoldFilter(self.zeros, self.poles, self.gain, dt, self.omega0)
 
     def __call__(self, u: ArrayLike) -> NDArray[np.float64]:

@@ -19,6 +19,13 @@ __all__ = ["g", "table"]
 def table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     """A plain-text table: right-aligned columns under a ruled header.
 
+    Parameters
+    ----------
+    headers : sequence of str
+        Column titles.
+    rows : sequence of sequence of str
+        The cells, already formatted.
+
     Examples
     --------
     >>> print(table(["f [Hz]", "|E| [-]"], [["5", "6.041"], ["10", "1.239"]]))
@@ -37,6 +44,13 @@ def table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 def g(x: float, digits: int = 4) -> str:
     """`x` with `digits` significant digits; ``nan`` for None or NaN.
+
+    Parameters
+    ----------
+    x : float or None
+        The number.
+    digits : int
+        Significant digits.
 
     Examples
     --------

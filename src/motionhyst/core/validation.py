@@ -22,6 +22,13 @@ __all__ = ["check_amplitudes", "check_finite", "check_omega", "check_positive"]
 def check_finite(name: str, value: float) -> float:
     """Return `value` as float, raising ``ValueError`` unless it is a finite number.
 
+    Parameters
+    ----------
+    name : str
+        The parameter's name, for the message.
+    value : float
+        Its value.
+
     Examples
     --------
     >>> from motionhyst.core.validation import check_finite
@@ -43,6 +50,13 @@ def check_finite(name: str, value: float) -> float:
 
 def check_positive(name: str, value: float) -> float:
     """Return `value` as float, raising ``ValueError`` unless finite and > 0.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name, for the message.
+    value : float
+        Its value.
 
     Examples
     --------
@@ -66,6 +80,11 @@ def check_positive(name: str, value: float) -> float:
 def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
     """Return amplitudes as a float array, raising ``ValueError`` unless finite and >= 0.
 
+    Parameters
+    ----------
+    A : array_like
+        Amplitude(s) [m].
+
     Examples
     --------
     >>> from motionhyst.core.validation import check_amplitudes
@@ -80,6 +99,13 @@ def check_amplitudes(A: ArrayLike) -> NDArray[np.float64]:
 
 def check_omega(omega, model: str) -> float:
     """The angular frequency [rad/s] a rate-dependent `model` needs, as a float >= 0.
+
+    Parameters
+    ----------
+    omega : float or None
+        Angular frequency [rad/s].
+    model : str
+        The model's name, for the message.
 
     Raises
     ------

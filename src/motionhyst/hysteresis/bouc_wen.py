@@ -238,6 +238,12 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
     def from_dict(cls, params: dict) -> BoucWen:
         """The element of either spelling of :meth:`to_dict` (the key ``model`` is ignored).
 
+        Parameters
+        ----------
+        params : dict
+            Parameters in either spelling (``k, fc, n, beta, gamma`` or ``alpha, beta, gamma, delta,
+            nu``).
+
         Raises
         ------
         ValueError

@@ -71,7 +71,15 @@ class Stepping:
 
     @classmethod
     def from_rows(cls, rows: list[tuple[int, tuple[float, ...]]], scale: float) -> Stepping:
-        """From ``(code, parameters)`` rows, the elements at rest."""
+        """From ``(code, parameters)`` rows, the elements at rest.
+
+        Parameters
+        ----------
+        rows : list of (int, tuple of float)
+            Element code and its parameters, one row per element.
+        scale : float
+            Force scale of the link [N] (its total slip force).
+        """
         codes = np.array([c for c, _ in rows], dtype=np.int64)
         params = np.zeros((len(rows), N_PARAMS))
         for j, (_, p) in enumerate(rows):

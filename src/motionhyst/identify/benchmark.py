@@ -359,6 +359,19 @@ def training_record(rng: np.random.Generator, n_periods: int = 5, *,
     the extra last period dropped, and white Gaussian output noise of
     `noise_rms` (band-limited to the 375 Hz Nyquist band) added.
 
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Random numbers of the phases and the noise.
+    n_periods : int
+        Periods of the multisine.
+    noise_rms : float
+        RMS of the output noise [m].
+    period : int
+        Samples per period.
+    parameters : dict, optional
+        System parameters other than the benchmark's.
+
     Examples
     --------
     >>> import numpy as np

@@ -61,6 +61,11 @@ class CSVError(ValueError):
 def normalize_name(name: Any) -> str:
     """A column name as matched: trimmed, lower case, byte-order mark and quotes removed.
 
+    Parameters
+    ----------
+    name : object
+        A column name as read.
+
     Examples
     --------
     >>> normalize_name('\\ufeff Time ')
@@ -71,6 +76,11 @@ def normalize_name(name: Any) -> str:
 
 def describe(source: Source) -> str:
     """How messages name a source: its path, or the kind of in-memory table.
+
+    Parameters
+    ----------
+    source : str, Path, ndarray or DataFrame
+        A record's source.
 
     Examples
     --------

@@ -196,7 +196,13 @@ class ModalPlant:
 
     @classmethod
     def from_two_mass(cls, stage) -> ModalPlant:
-        """The modal form of a :class:`~motionhyst.plants.two_mass.TwoMassStage` (eq. 2)."""
+        """The modal form of a :class:`~motionhyst.plants.two_mass.TwoMassStage` (eq. 2).
+
+        Parameters
+        ----------
+        stage : TwoMassStage
+            The stage of eqs. (1)-(2).
+        """
         m1, m2, M = stage.m1, stage.m2, stage.M
         w = np.sqrt(stage.k * M / (m1 * m2))
         mode = Mode(frequency_hz=w / TWO_PI, damping=stage.b * M / (m1 * m2) / (2 * w),
@@ -246,7 +252,13 @@ class ModalPlant:
         return self.modes[0].frequency_hz if self.modes else float("nan")
 
     def response(self, omega: ArrayLike) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
-        """``P1(j omega)`` and ``P2(j omega)`` evaluated term by term [m/N]."""
+        """``P1(j omega)`` and ``P2(j omega)`` evaluated term by term [m/N].
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular frequencies [rad/s].
+        """
         w = np.asarray(omega, dtype=float)
         s = 1j * w
         with np.errstate(divide="ignore"):

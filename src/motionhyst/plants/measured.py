@@ -58,7 +58,15 @@ class MeasuredPlant:
         return np.asarray(self.P2.omega, dtype=float) / TWO_PI
 
     def measured_line(self, frequency_hz: float, rtol: float = 1e-9) -> float | None:
-        """The measured frequency equal to `frequency_hz` (to `rtol`), else None."""
+        """The measured frequency equal to `frequency_hz` (to `rtol`), else None.
+
+        Parameters
+        ----------
+        frequency_hz : float
+            A frequency [Hz].
+        rtol : float
+            Relative tolerance of the match.
+        """
         f = self.frequency_hz
         i = int(np.argmin(np.abs(f - frequency_hz)))
         return float(f[i]) if abs(f[i] - frequency_hz) <= rtol * frequency_hz else None

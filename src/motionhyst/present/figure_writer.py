@@ -204,7 +204,13 @@ class FigureWriter:
         self.close()
 
     def submit(self, makers: dict[str, FigureMaker]) -> None:
-        """Draw and save `makers` (name -> function returning the figure) in a new worker."""
+        """Draw and save `makers` (name -> function returning the figure) in a new worker.
+
+        Parameters
+        ----------
+        makers : dict
+            File name -> function that returns the figure.
+        """
         self._names += list(makers)
         if not self.parallel:
             for name, make in makers.items():

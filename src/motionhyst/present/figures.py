@@ -67,7 +67,15 @@ class MinorLogLocator(matplotlib.ticker.LogLocator):
         self.max_decades = float(max_decades)
 
     def tick_values(self, vmin: float, vmax: float):
-        """The minor ticks between `vmin` and `vmax` (none on an axis of too many decades)."""
+        """The minor ticks between `vmin` and `vmax` (none on an axis of too many decades).
+
+        Parameters
+        ----------
+        vmin : float
+            Lower end of the axis.
+        vmax : float
+            Upper end of the axis.
+        """
         if vmin > 0 and vmax > 0 and abs(np.log10(vmax / vmin)) > self.max_decades:
             return np.array([])
         return super().tick_values(vmin, vmax)

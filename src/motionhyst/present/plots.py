@@ -160,6 +160,15 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
     force and ``k`` the initial stiffness, and a rate-dependent element needs
     `frequency_hz`.
 
+    Parameters
+    ----------
+    el : Hysteresis
+        The link element.
+    zetas : array_like
+        ``zeta = fc / (k A)`` of the loops (eq. 4).
+    frequency_hz : float, optional
+        Frequency [Hz] for a rate-dependent element.
+
     Examples
     --------
     >>> from motionhyst import Jenkins
@@ -188,6 +197,15 @@ def fig5_loops(el: Hysteresis, zetas: ArrayLike = (0.25, 0.5, 0.75, 1.25),
 
 def fig6_modes(el: Jenkins, zeta_mode2: float = 0.4, zeta_mode3: float = 0.7):
     """Fig. 6: the two nonlinear modes: stick-to-slip at x w <= 0 (mode 2) and x w > 0 (mode 3).
+
+    Parameters
+    ----------
+    el : Jenkins
+        The Jenkins element.
+    zeta_mode2 : float
+        zeta of the mode-2 loop.
+    zeta_mode3 : float
+        zeta of the mode-3 loop.
 
     Examples
     --------
@@ -221,6 +239,15 @@ def switching_instants(el: Jenkins, A: float, frequency_hz: float) -> np.ndarray
     reaches ``-+fc`` (``omega t = pi + gamma, 2 pi + gamma``, ``gamma`` of
     eq. 6).  Sorted; empty for ``zeta >= 1`` (no slip).
 
+    Parameters
+    ----------
+    el : Jenkins
+        The Jenkins element.
+    A : float
+        Amplitude [m].
+    frequency_hz : float
+        Frequency [Hz].
+
     Examples
     --------
     >>> from motionhyst import Jenkins
@@ -242,6 +269,15 @@ def fig7_time(el: Jenkins, A: float, frequency_hz: float = 1.0):
     ``w(t)`` (eq. 5) with the slip intervals shaded, the switching instants
     ``tau_i`` (eq. 6) marked, and the first harmonic kept by the describing
     function (eq. 7).
+
+    Parameters
+    ----------
+    el : Jenkins
+        The Jenkins element.
+    A : float
+        Amplitude [m].
+    frequency_hz : float
+        Frequency [Hz].
 
     Examples
     --------
@@ -293,6 +329,17 @@ def fig8_describing_function(el: Hysteresis, zeta_range=(1e-3, 10.0),
     rate-dependent element is drawn at `frequency_hz`.  `zeta_op` marks an
     operating point (the paper's section V: zeta = 0.25, ``|D| ~ 0.3 k``,
     angle ~50 deg) with its values.
+
+    Parameters
+    ----------
+    el : Hysteresis
+        The link element.
+    zeta_range : (float, float)
+        Range of zeta drawn.
+    frequency_hz : float, optional
+        Frequency [Hz] for a rate-dependent element.
+    zeta_op : float, optional
+        An operating point to mark.
 
     Examples
     --------
@@ -395,6 +442,21 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     ``fig.motionhyst_data`` holds the scenario's curves (``f``, ``P2``,
     ``zeta=...``) and the paper's with the prefix ``paper_``.
 
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    zetas : array_like
+        zeta of the curves, in (0, 1].
+    f_range : (float, float)
+        Frequency range [Hz].
+    f_star_hz : float, optional
+        ``f*`` to mark (eq. 13); default from the loop.
+    paper : bool
+        Add the paper's column beside the scenario's.
+    paper_f_range : (float, float)
+        Frequency range of that column [Hz].
+
     Examples
     --------
     >>> from motionhyst import default_scenario
@@ -446,6 +508,17 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
 def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
                    exact: list[SteadyState] | None = None, f_range=(0.1, 1000.0)):
     """Fig. 10: ``|E|`` (eq. 18), asymptote (eq. 20), crossovers; exact points as markers.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    analysis : QuasiLinearAnalysis
+        The analysis whose points are marked.
+    exact : list of SteadyState, optional
+        Exact steady states to mark.
+    f_range : (float, float)
+        Frequency range [Hz].
 
     Examples
     --------

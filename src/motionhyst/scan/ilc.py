@@ -70,7 +70,13 @@ class ILCFilters:
             raise ValueError(f"ILC filter order must be a whole number >= 1, got {self.order!r}")
 
     def robustness(self, f_hz) -> NDArray[np.float64]:
-        """``Q(f) = 1 / (1 + (f / cutoff_hz)^(2 order))``, real and zero-phase."""
+        """``Q(f) = 1 / (1 + (f / cutoff_hz)^(2 order))``, real and zero-phase.
+
+        Parameters
+        ----------
+        f_hz : array_like
+            Frequencies [Hz].
+        """
         x = np.asarray(f_hz, dtype=float) / self.cutoff_hz
         return 1.0 / (1.0 + x ** (2 * self.order))
 
@@ -78,6 +84,13 @@ class ILCFilters:
         """``L(f) = gain / PS(j 2 pi f)`` with ``PS = P2 / (1 + C P2)`` of `loop`.
 
         Where ``PS`` vanishes (a controller with an integrator at DC) ``L`` is 0.
+
+        Parameters
+        ----------
+        loop : Loop
+            The loop with its link.
+        f_hz : array_like
+            Frequencies [Hz].
         """
         ps = loop.transfer("w->e", TWO_PI * np.asarray(f_hz, dtype=float))
         out = np.zeros(ps.shape, dtype=complex)
@@ -93,6 +106,17 @@ class ILCFilters:
         values, then its first ones (the loop at rest before and after), so
         the non-causal filters see no jump at its ends and do not wrap its
         end onto its start.
+
+        Parameters
+        ----------
+        loop : Loop
+            The loop with its link.
+        t : ndarray
+            Uniform time grid [s].
+        force : ndarray
+            This trial's learned force [N].
+        error : ndarray
+            This trial's error [m].
         """
         n = len(t)
         dt = (t[-1] - t[0]) / (n - 1)

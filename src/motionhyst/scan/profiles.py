@@ -299,6 +299,11 @@ class Profile:
         Exact (piecewise polynomial from the switching instants); at rest
         before the first move and after the last.
 
+        Parameters
+        ----------
+        t : array_like
+            Times [s].
+
         Examples
         --------
         >>> p = scan(0.05, speed=0.25, a_max=10.0, j_max=1000.0, s_max=1e6)
@@ -328,6 +333,13 @@ class Profile:
 
     def feedforward(self, t: ArrayLike, mass: float) -> NDArray[np.float64]:
         """Rigid-body feedforward force ``M r''`` [N] (``C_ff = M s^2``, paper Sec. II, eq. 1).
+
+        Parameters
+        ----------
+        t : array_like
+            Times [s].
+        mass : float
+            Rigid-body mass ``M`` [kg].
 
         Examples
         --------

@@ -119,6 +119,19 @@ def settling_time(t: NDArray[np.float64], e: NDArray[np.float64], start: float, 
                   tolerance: float) -> float | None:
     """Time from `start` after which ``|e| <= tolerance`` until `end` [s]; None if never.
 
+    Parameters
+    ----------
+    t : ndarray
+        Times [s].
+    e : ndarray
+        Error [m].
+    start : float
+        From when [s].
+    end : float
+        Until when [s].
+    tolerance : float
+        Band ``|e| <= tolerance`` [m].
+
     Examples
     --------
     >>> t = np.linspace(0.0, 1.0, 11)
@@ -256,7 +269,13 @@ class ScanResult:
         return self.without_link.t
 
     def run(self, compensation: str) -> ScanRun:
-        """The run of one compensation."""
+        """The run of one compensation.
+
+        Parameters
+        ----------
+        compensation : str
+            One of the compensations compared (``"none"``, ``"model"``, ``"ilc"``).
+        """
         for r in self.runs:
             if r.compensation == compensation:
                 return r

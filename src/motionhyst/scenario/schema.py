@@ -573,6 +573,15 @@ class Scenario:
 
     Use :meth:`from_file`, :meth:`from_dict` or :func:`default_scenario`.
 
+    Parameters
+    ----------
+    model : ScenarioModel
+        The validated content of the file.
+    source : str
+        Where it comes from, for messages.
+    base_dir : Path, optional
+        Folder that relative file names in it are read from (default: the working folder).
+
     Examples
     --------
     A scenario from a dictionary (the layout of a TOML file):
@@ -606,6 +615,17 @@ class Scenario:
         With `check` (the default) the loop is also built and checked for
         stability now; without, at the first :meth:`loop`, which raises the
         same :class:`ScenarioError` (a command that can do other work first).
+
+        Parameters
+        ----------
+        data : dict
+            The scenario, laid out as its TOML file.
+        source : str
+            Where it comes from, for messages.
+        base_dir : Path, optional
+            Folder of relative file names (default: the working folder).
+        check : bool
+            Build the loop and check that it is stable (a :class:`ScenarioError` if not).
         """
         try:
             model = ScenarioModel.model_validate(data)
@@ -621,6 +641,13 @@ class Scenario:
         """Read and validate a TOML scenario; raises :class:`ScenarioError`.
 
         `check` as for :meth:`from_dict`.
+
+        Parameters
+        ----------
+        path : str or Path
+            The TOML file.
+        check : bool
+            Build the loop and check that it is stable (a :class:`ScenarioError` if not).
         """
         path = Path(path)
         try:
@@ -834,6 +861,11 @@ def default_scenario_path() -> Path:
 def default_scenario(check: bool = True) -> Scenario:
     """The paper's Table I scenario (`check` as for :meth:`Scenario.from_dict`).
 
+    Parameters
+    ----------
+    check : bool
+        Build the loop and check that it is stable (a :class:`ScenarioError` if not).
+
     Examples
     --------
     >>> from motionhyst import default_scenario
@@ -853,6 +885,13 @@ def load_scenario(path: str | Path | None, check: bool = True) -> Scenario:
 
     `check` as for :meth:`Scenario.from_dict`: without it the loop is built
     and checked at the first :meth:`Scenario.loop`.
+
+    Parameters
+    ----------
+    path : str, Path or None
+        The TOML file; None for the paper's Table I (:func:`default_scenario`).
+    check : bool
+        Build the loop and check that it is stable (a :class:`ScenarioError` if not).
 
     Examples
     --------

@@ -25,6 +25,13 @@ __all__ = ["PointToPoint", "SampledReference", "SineReference", "load_reference_
 class SineReference:
     """``r = amplitude sin(2 pi frequency_hz t)``.
 
+    Parameters
+    ----------
+    amplitude : float
+        Amplitude ``A_r`` [m].
+    frequency_hz : float
+        Frequency [Hz].
+
     Examples
     --------
     >>> import numpy as np
@@ -171,6 +178,13 @@ class PointToPoint:
 @dataclass(frozen=True)
 class SampledReference:
     """A reference given by samples, interpolated by a quintic spline (acceleration from it).
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s], increasing.
+    r : array_like
+        Reference position at those times [m].
 
     Examples
     --------

@@ -61,6 +61,13 @@ def dynamics_step(loop: Loop, reference) -> float:
     A sampled reference (a file) is interpolated between its samples and does
     not set the step: a 10 kHz file does not force 400 steps per sample.
 
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    reference : reference
+        The reference run.
+
     Examples
     --------
     >>> from motionhyst.scenario import default_scenario
@@ -84,6 +91,11 @@ def reference_rate_hz(reference: SampledReference) -> float:
 
     The output grid of :func:`run_time_series` is uniform at this rate, so a
     file sampled uniformly gets its own time stamps back.
+
+    Parameters
+    ----------
+    reference : SampledReference
+        A sampled reference.
 
     Examples
     --------
