@@ -38,16 +38,48 @@ from motionhyst.loop import Loop
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.two_mass import TwoMassStage
 
-__all__ = ["MismatchPoint", "QuasiLinearAnalysis", "analyze", "f_star", "mismatch_crossover"]
+__all__ = ["MismatchPoint", "QuasiLinearAnalysis", "analyze", "error_harmonics_df", "f_star",
+           "loop_mismatch", "mismatch", "mismatch_asymptote", "mismatch_crossover",
+           "mismatch_crossover_exact", "quasi_linear_plant", "sensitivity_s1"]
 
 
 def quasi_linear_plant(P1: ArrayLike, P2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
-    """Quasi-linear plant ``P^phi = P2 / (1 + D P1)`` from ``u`` to ``y2``, paper eq. (12)."""
+    """Quasi-linear plant ``P^phi = P2 / (1 + D P1)`` from ``u`` to ``y2``, paper eq. (12).
+
+    Parameters
+    ----------
+    P1 : array_like
+        Frequency response from ``u - w`` to ``y1`` [m/N].
+    P2 : array_like
+        Frequency response from ``u`` to ``y2`` [m/N].
+    D : array_like
+        Describing function of the link [N/m].
+
+    Examples
+    --------
+    >>> complex(quasi_linear_plant(-1e-3, -2e-3, 0.0))    # no link: P2
+    (-0.002+0j)
+    >>> round(abs(complex(quasi_linear_plant(-1e-3, -2e-3, 20.0))), 6)
+    0.002041
+    """
     return np.asarray(P2) / (1.0 + np.asarray(D) * np.asarray(P1))
 
 
 def sensitivity_s1(P1: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
-    """Sensitivity ``S1^phi = (1 + D P1)^-1`` from ``u`` to ``u - w``, paper eq. (15)."""
+    """Sensitivity ``S1^phi = (1 + D P1)^-1`` from ``u`` to ``u - w``, paper eq. (15).
+
+    Parameters
+    ----------
+    P1 : array_like
+        Frequency response from ``u - w`` to ``y1`` [m/N].
+    D : array_like
+        Describing function of the link [N/m].
+
+    Examples
+    --------
+    >>> round(complex(sensitivity_s1(-1e-3, 20.0)).real, 4)
+    1.0204
+    """
     return 1.0 / (1.0 + np.asarray(D) * np.asarray(P1))
 
 
@@ -67,6 +99,18 @@ def mismatch(C: ArrayLike, P1: ArrayLike, P2: ArrayLike, Pr: ArrayLike, Pf2: Arr
         Frequency responses of the controller and the plant's parts (eqs. 1-2).
     D : array_like
         Describing function of the hysteresis [N/m].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.core.lti import freqresp
+    >>> loop, w = default_scenario().loop(), 2 * np.pi * 5.0     # Table I at 5 Hz, 10 mm
+    >>> C, P1, P2, Pf2 = (freqresp(s, w) for s in (loop.controller, loop.P1, loop.P2,
+    ...                                            loop.plant.Pf2))
+    >>> Pr, D = 1 / (loop.M * (1j * w) ** 2), loop.hysteresis.describing_function(0.01)
+    >>> np.abs(mismatch(C, P1, P2, Pr, Pf2, D)).round(2).tolist()   # as analyze() gives it
+    [6.04]
     """
     C, P1, P2, Pr, Pf2, D = (np.asarray(x) for x in (C, P1, P2, Pr, Pf2, D))
     S1 = sensitivity_s1(P1, D)
@@ -74,7 +118,29 @@ def mismatch(C: ArrayLike, P1: ArrayLike, P2: ArrayLike, Pr: ArrayLike, Pf2: Arr
 
 
 def mismatch_asymptote(Pr: ArrayLike, Pf2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
-    """Low-frequency asymptote ``E~ = Pr^2 D / Pf2`` of the mismatch, paper eq. (20)."""
+    """Low-frequency asymptote ``E~ = Pr^2 D / Pf2`` of the mismatch, paper eq. (20).
+
+    Parameters
+    ----------
+    Pr : array_like
+        Rigid-body plant ``1 / (M s^2)`` [m/N].
+    Pf2 : array_like
+        The flexible part ``Pr - P2`` [m/N].
+    D : array_like
+        Describing function of the link [N/m].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.core.lti import freqresp
+    >>> loop, w = default_scenario().loop(), 2 * np.pi * 5.0     # Table I at 5 Hz, 10 mm
+    >>> C, P1, P2, Pf2 = (freqresp(s, w) for s in (loop.controller, loop.P1, loop.P2,
+    ...                                            loop.plant.Pf2))
+    >>> Pr, D = 1 / (loop.M * (1j * w) ** 2), loop.hysteresis.describing_function(0.01)
+    >>> np.abs(mismatch_asymptote(Pr, Pf2, D)).round(2).tolist()   # |E| = 6.04 there
+    [5.36]
+    """
     return np.asarray(Pr) ** 2 * np.asarray(D) / np.asarray(Pf2)
 
 
@@ -330,6 +396,26 @@ def loop_mismatch(loop: Loop, frequency_hz: ArrayLike, amplitude: float | ArrayL
     given (one value per frequency, already computed) is used instead.  With
     hysteresis feedforward the residual mismatch is returned, its model driven
     by the reference of amplitude `reference_amplitude` (default `amplitude`).
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    frequency_hz : array_like
+        Frequencies [Hz].
+    amplitude : float or array_like
+        Amplitude of ``y1`` [m], one or one per frequency.
+    reference_amplitude : float, optional
+        Amplitude of the reference the feedforward model is driven by [m].
+    describing_function : array_like, optional
+        ``D`` per frequency, already computed [N/m].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import default_scenario
+    >>> np.abs(loop_mismatch(default_scenario().loop(), [5.0, 10.0], 0.01)).round(3).tolist()
+    [6.04, 1.239]
     """
     f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
     omega = TWO_PI * f
@@ -396,6 +482,27 @@ def error_harmonics_df(loop: Loop, amplitude: float, frequency_hz: float, n_max:
     ``H_n(A_y1)``, passed through ``P2 / (1 + C P2)`` at ``n omega``.  ``phi`` is
     the phase of the linear loop's ``y1``; ``A_y1 = A_r`` (``"reference"``) or
     the quasi-linear loop's solution (``"self-consistent"``).
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    amplitude : float
+        Reference amplitude ``A_r`` [m].
+    frequency_hz : float
+        Frequency [Hz].
+    n_max : int
+        Highest harmonic.
+    amplitude_mode : {"reference", "self-consistent"}
+        How ``A_y1`` is taken (see above).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst import default_scenario
+    >>> h = error_harmonics_df(default_scenario().loop(), 0.01, 5.0)
+    >>> (np.abs(h[:3]) * 1e9).round(3).tolist()            # |e_1|, |e_2|, |e_3| [nm]
+    [11.224, 0.0, 2.575]
     """
     omega = TWO_PI * float(frequency_hz)
     n = np.arange(1, int(n_max) + 1)
@@ -447,6 +554,23 @@ def mismatch_crossover_exact(loop: Loop, amplitude: float, f_min: float = 1e-2,
     condition on eq. (18) itself, with ``D`` at the given amplitude.  (``|E|``
     itself tends to 1 from above as frequency grows and does not cross 1 in
     any meaningful place.)  Returns nan if there is no crossing in the range.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    amplitude : float
+        Reference amplitude ``A_r`` [m].
+    f_min : float
+        Lower end of the search [Hz].
+    f_max : float
+        Upper end of the search [Hz].
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> round(mismatch_crossover_exact(default_scenario().loop(), 0.01), 3)  # eq. (21): 7.61 Hz
+    7.606
     """
     lo, hi = getattr(loop.plant, "frequency_range_hz", (f_min, f_max))
     f_min, f_max = max(f_min, lo), min(f_max, hi)
