@@ -28,9 +28,11 @@ $(DOCS_STAMP): $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
 	touch $(DOCS_STAMP)
 
-# the documentation site, warnings as errors, into docs/_build/html
+# the documentation site, warnings as errors, into docs/_build/html; then every link inside
+# the site checked (page and anchor; links out of it are counted, not fetched: no network)
 docs: $(DOCS_STAMP)
 	$(BIN)/python -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	$(BIN)/python docs/checklinks.py docs/_build/html
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run.py
