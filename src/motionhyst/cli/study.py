@@ -10,6 +10,9 @@ import sys
 
 from motionhyst.cli._common import UsageError, output_file, print_json, whole_number
 
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
 
 def _summary(args: argparse.Namespace) -> int:
     from motionhyst.study import StudyError, open_results, summarize
