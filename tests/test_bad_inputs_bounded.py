@@ -97,6 +97,13 @@ def _from_rest() -> str:
 
 
 LOG = np.geomspace(1.0, 3000.0, 200)
+MODEL = ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
+         '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n')
+
+
+def _force(n: int) -> str:
+    """A force record time,force of `n` samples at 750 Hz."""
+    return "time,force\n" + "".join(f"{i / 750!r},{np.sin(i / 10):.6f}\n" for i in range(n))
 
 
 def _negative_magnitude() -> str:
@@ -129,6 +136,9 @@ CASES = [
                               "plant.csv": _frd(np.linspace(1.0, 3000.0, 200_000),
                                                 noise=0.01)},
      ["analyze", "p.toml"], 0, None, []),
+    ("predict-too-many-substeps", {"model.toml": MODEL, "f.csv": _force(20_000)},
+     ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--substeps", "10000"], 2,
+     ["20000 samples of 10000 integration steps", "memory budget"], []),
     ("io-two-mass-on-one-mass", {}, ["identify", "io.csv", "--record", "input-output",
                                      "--plant", "two-mass"], 2,
      ["integration steps per sample", "--plant mass-spring-damper"], []),
@@ -166,11 +176,7 @@ CASES = [
      ["simulate", "--time-series", "link.csv", "--frequency", "5", "--duration", "0.3",
       "--force"], 0, None, ["link.csv"]),
     ("predict-out-link-forced", {"@symlink:pred.csv": "../outside/target.csv",
-                                 "model.toml": "[stage]\ntype = \"mass-spring-damper\"\n"
-                                 "m = 2.0\nc = 10.0\nk = 5e4\n\n[hysteresis]\n"
-                                 "model = \"jenkins\"\nk = 100.0\nfc = 1.0\n",
-                                 "f.csv": "time,force\n" + "".join(
-                                     f"{i / 750!r},{np.sin(i / 10):.6f}\n" for i in range(300))},
+                                 "model.toml": MODEL, "f.csv": _force(300)},
      ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--force"], 0, None,
      ["pred.csv"]),
     ("reproduce-out-link-to-folder", {"@symlink:out": "../outside"},
@@ -328,3 +334,37 @@ def test_interrupted_or_killed_mid_write_leaves_the_old_file_and_nothing_else(tm
     else:
         assert proc.returncode == -signal.SIGKILL
     assert _snapshot(tmp_path) == before  # the old file, and no temporary file
+
+
+def test_the_command_ignores_a_late_ctrl_c_so_that_its_exit_is_not_interrupted(tmp_path):
+    """Once the work is done (files in place), a Ctrl-C during the interpreter's exit would
+    print tracebacks of its finalisers after exit code 0: the command ignores it by then."""
+    code = ("import signal, sys\n"
+            "from motionhyst.cli import main\n"
+            "sys.argv = ['motionhyst', 'df', '--k', '20', '--fc', '0.05', '--amplitude', "
+            "'0.01']\n"
+            "code = main()\n"
+            "print(code, signal.getsignal(signal.SIGINT) is signal.SIG_IGN)\n")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.stdout.splitlines()[-1] == "0 True", proc.stdout + proc.stderr
+
+
+def test_a_scratch_folder_of_a_killed_process_is_removed_by_the_next(tmp_path, monkeypatch):
+    import tempfile
+
+    from motionhyst.io.outputs import scratch_folder
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    left = tmp_path / f"motionhyst-figures-{dead.pid}-ab_12"  # killed before its cleanup
+    (left / "fig5.png").parent.mkdir()
+    (left / "fig5.png").write_bytes(b"png")
+    other = tmp_path / "motionhyst-figures-notes"  # not a name it gives: kept
+    other.mkdir()
+    with scratch_folder("motionhyst-figures") as name:
+        assert Path(name).parent == tmp_path
+        assert sorted(p.name for p in tmp_path.iterdir()) == sorted([other.name,
+                                                                     Path(name).name])
+    assert [p.name for p in tmp_path.iterdir()] == [other.name]

@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import contextlib
 import gc
 import importlib
 import os
+import signal
 import sys
 from collections.abc import Sequence
 
@@ -94,8 +96,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         # is (files and temporary folders are closed by the command itself); only unreachable
         # cycles are left to the operating system
         atexit.register(gc.freeze)
-    parser = build_parser()
     try:
+        parser = build_parser()
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
         with warnings_on_stderr(args.command):
@@ -115,4 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
               "--max-memory, if the machine has it)", file=sys.stderr)
     finally:
         set_max_memory(None)
+        if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
+            with contextlib.suppress(ValueError, OSError):  # interpreter's exit (tracebacks)
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
     return EXIT_USAGE

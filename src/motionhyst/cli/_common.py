@@ -10,7 +10,6 @@ import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 
-from motionhyst.core.jsonio import dumps
 from motionhyst.core.textfmt import g, table
 
 __all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
@@ -143,6 +142,8 @@ def one_line(text: str) -> str:
 
 def print_json(obj) -> None:
     """Print `obj` as JSON (NumPy values converted, NaN as null)."""
+    from motionhyst.core.jsonio import dumps
+
     print(dumps(obj))
 
 

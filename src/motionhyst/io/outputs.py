@@ -54,6 +54,7 @@ import contextlib
 import json
 import os
 import re
+import shutil
 import signal
 import stat
 import tempfile
@@ -219,6 +220,41 @@ def clean_stale(folder: str | os.PathLike) -> list[str]:
                 os.unlink(os.path.join(folder, name))
                 removed.append(name)
     return removed
+
+
+def scratch_folder(prefix: str) -> tempfile.TemporaryDirectory:
+    """A temporary folder ``PREFIX-PID-XXXX`` in the system's; those of ended processes removed.
+
+    The folder is removed when the returned object is closed (or used as a
+    context manager), as :class:`tempfile.TemporaryDirectory`; a process
+    killed before that leaves it, and the next call with the same `prefix`
+    removes it.
+
+    Parameters
+    ----------
+    prefix : str
+        The folder's name starts with it (``"motionhyst-figures"``).
+
+    Returns
+    -------
+    tempfile.TemporaryDirectory
+        The folder (its ``name``).
+
+    Examples
+    --------
+    >>> import os
+    >>> with scratch_folder("motionhyst-example") as name:
+    ...     os.path.basename(name).startswith(f"motionhyst-example-{os.getpid()}-")
+    True
+    """
+    parent = tempfile.gettempdir()
+    pattern = re.compile(re.escape(prefix) + r"-(\d+)-[A-Za-z0-9_]+")
+    with contextlib.suppress(OSError):
+        for name in os.listdir(parent):
+            m = pattern.fullmatch(name)
+            if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
+                shutil.rmtree(os.path.join(parent, name), ignore_errors=True)
+    return tempfile.TemporaryDirectory(prefix=f"{prefix}-{os.getpid()}-")
 
 
 class _Temporary:
@@ -670,4 +706,4 @@ class OutputFolder:
 
 
 __all__ = ["MANIFEST", "OutputError", "OutputFile", "OutputFolder", "check_not_input",
-           "clean_stale", "umask"]
+           "clean_stale", "scratch_folder", "umask"]

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import sys
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -22,7 +21,7 @@ from tqdm import tqdm
 
 from motionhyst.core.jsonio import dumps
 from motionhyst.hysteresis.periodic import TWO_PI
-from motionhyst.io.outputs import OutputFolder
+from motionhyst.io.outputs import OutputFolder, scratch_folder
 from motionhyst.present.figure_writer import FigureWriter
 from motionhyst.scenario import Scenario
 
@@ -281,7 +280,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 folder.write_bytes(f"{name}.{ext}", (Path(scratch) / f"{name}.{ext}").read_bytes())
             steps.update()
 
-        with (folder, tempfile.TemporaryDirectory(prefix="motionhyst-figures-") as scratch,
+        with (folder, scratch_folder("motionhyst-figures") as scratch,
               FigureWriter(scratch, ("png", "pdf"), done=stage) as figures):
             # Figs. 5-8 need no loop: at once, a worker loads the link's compiled kernels (numba)
             # and matplotlib and draws them while this process imports the analysis

@@ -58,6 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, resample_poly
 
+from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.hysteresis.stepping import (
@@ -335,6 +336,10 @@ def _smooth_length(n: int) -> bool:
         while n % p == 0:
             n //= p
     return n == 1
+
+
+FINE_BYTES = 48
+"""Memory of one integration step of an open-loop run: fine input, midpoints, output [bytes]."""
 
 
 def fine_input(u: NDArray[np.float64], factor: int, periodic: bool) -> NDArray[np.float64]:
@@ -846,6 +851,9 @@ class OpenLoop:
         tt, u = check_record(t, force)
         fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
+        # the force at every integration step and midpoint, and the response at each step
+        check_memory(FINE_BYTES * u.size * r, f"{u.size} samples of {r} integration steps "
+                     f"each", "fewer samples or substeps")
         p = self._bw_parameters()
         if periodic and self.hysteresis is None and self.plant.mechanics().floating:
             y = _floating_linear_periodic(self.plant.mechanics(), u, fs)
