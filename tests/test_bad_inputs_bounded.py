@@ -142,6 +142,10 @@ CASES = [
     ("io-two-mass-on-one-mass", {}, ["identify", "io.csv", "--record", "input-output",
                                      "--plant", "two-mass"], 2,
      ["integration steps per sample", "--plant mass-spring-damper"], []),
+    ("benchmark-mat-header-damaged", {f"bw/{n}.mat": b"MATLAB 5.0 MAT-file\x00\x01\x02"
+                                      for n in ("uval_multisine", "yval_multisine",
+                                                "uval_sinesweep", "yval_sinesweep")},
+     ["benchmark", "bouc-wen", "--data", "bw"], 2, ["uval_multisine.mat: cannot read"], []),
     # ----------------------------------------------------------------- no answer from nothing
     ("frf-two-lines", {"p.toml": _with_plant(), "plant.csv": _frd(np.array([10.0, 100.0]))},
      ["analyze", "p.toml"], 2, ["2 measured lines cannot determine a mode", "Pf2 = 0"], []),

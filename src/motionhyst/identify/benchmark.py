@@ -407,6 +407,9 @@ def load_test_set(directory: str | Path, name: str) -> Record:
             data = loadmat(path)
         except (OSError, ValueError, MatReadError) as exc:
             raise ValueError(f"{path}: cannot read ({exc})") from None
+        except Exception as exc:  # scipy's other ways to fail on a damaged header
+            raise ValueError(f"{path}: cannot read as a MATLAB file "
+                             f"({type(exc).__name__}: {exc})") from None
         key = fname.removesuffix(".mat")
         if key not in data:
             raise ValueError(f"{path}: no variable {key!r}")
