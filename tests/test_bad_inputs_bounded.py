@@ -372,3 +372,23 @@ def test_a_scratch_folder_of_a_killed_process_is_removed_by_the_next(tmp_path, m
         assert sorted(p.name for p in tmp_path.iterdir()) == sorted([other.name,
                                                                      Path(name).name])
     assert [p.name for p in tmp_path.iterdir()] == [other.name]
+
+
+def test_a_defect_is_one_line_and_exit_1_and_its_traceback_on_request(tmp_path, monkeypatch,
+                                                                       capsys):
+    """No input should raise a TypeError inside the tool; if one does, the user still gets
+    one line (and the developer the traceback with MOTIONHYST_TRACEBACK=1)."""
+    from motionhyst.cli import EXIT_INTERNAL, TRACEBACK_VARIABLE, analyze, main
+
+    def broken(args):
+        raise TypeError("unsupported operand type(s) for +: 'int' and 'str'")
+
+    monkeypatch.setattr(analyze, "run", broken)
+    monkeypatch.delenv(TRACEBACK_VARIABLE, raising=False)
+    assert main(["analyze"]) == EXIT_INTERNAL == 1
+    line = _one_line(capsys.readouterr().err.encode())
+    assert line.startswith("motionhyst: internal error: TypeError: unsupported operand")
+    assert TRACEBACK_VARIABLE in line
+    monkeypatch.setenv(TRACEBACK_VARIABLE, "1")
+    with pytest.raises(TypeError):
+        main(["analyze"])

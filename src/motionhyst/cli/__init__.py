@@ -35,8 +35,14 @@ COMMANDS = ("df", "analyze", "steady", "simulate", "scan", "identify", "predict"
             "benchmark", "reproduce")
 """The commands, in the order ``motionhyst --help`` lists them (module names)."""
 
-__all__ = ["COMMANDS", "EXIT_USAGE", "UsageError", "build_parser", "feedforward_fragment",
-           "main", "record_kind"]
+EXIT_INTERNAL = 1
+"""Exit code of a defect of the tool (an exception no input should cause)."""
+
+TRACEBACK_VARIABLE = "MOTIONHYST_TRACEBACK"
+"""Environment variable: set, a defect of the tool ends in its traceback instead of one line."""
+
+__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "TRACEBACK_VARIABLE", "UsageError",
+           "build_parser", "feedforward_fragment", "main", "record_kind"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -115,6 +121,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError:  # an estimate missed: still one line, and the remedy
         print("motionhyst: error: out of memory; give a smaller problem (or a larger "
               "--max-memory, if the machine has it)", file=sys.stderr)
+    except Exception as exc:  # a defect of the tool, not the input: one line, exit 1
+        if os.environ.get(TRACEBACK_VARIABLE):
+            raise
+        print(f"motionhyst: internal error: {one_line(f'{type(exc).__name__}: {exc}')} (a "
+              f"defect of motionhyst, please report it; {TRACEBACK_VARIABLE}=1 shows where)",
+              file=sys.stderr)
+        return EXIT_INTERNAL
     finally:
         set_max_memory(None)
         if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
