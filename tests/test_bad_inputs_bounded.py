@@ -148,9 +148,10 @@ CASES = [
      ["benchmark", "bouc-wen", "--data", "bw"], 2, ["uval_multisine.mat: cannot read"], []),
     # ----------------------------------------------------------------- no answer from nothing
     ("frf-two-lines", {"p.toml": _with_plant(), "plant.csv": _frd(np.array([10.0, 100.0]))},
-     ["analyze", "p.toml"], 2, ["2 measured lines cannot determine a mode", "Pf2 = 0"], []),
+     ["analyze", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: 2 measured lines cannot "
+                                "determine a mode", "Pf2 = 0"], []),
     ("frf-modes-0", {"p.toml": _with_plant("modes = 0"), "plant.csv": _frd(LOG)},
-     ["steady", "p.toml"], 2, ["modes = 0", "Pf2 = 0"], []),
+     ["steady", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: modes = 0", "Pf2 = 0"], []),
     ("frf-negative-magnitude", {"p.toml": _with_plant(), "plant.csv": _negative_magnitude()},
      ["analyze", "p.toml"], 2, ["p1_abs must be > 0", "phase", "at 1 Hz"], []),
     ("frf-in-khz", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, scale_f=1e-3)},
@@ -246,8 +247,11 @@ def test_bounded_honest_and_touching_nothing_it_does_not_own(tmp_path, files, ar
         assert err.decode(errors="replace").strip() == "", err
     else:
         line = _one_line(err)
-        for word in words:
-            assert word in line, (word, line)
+        for word in words:  # "^..." : the message starts so
+            if word.startswith("^"):
+                assert line.startswith(f"motionhyst: error: {word[1:]}"), (word, line)
+            else:
+                assert word in line, (word, line)
         if code != 0:
             assert out == b""
             assert took < 60, took  # refused before the work, not after it

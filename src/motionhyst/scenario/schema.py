@@ -823,9 +823,11 @@ class Scenario:
                                  coulomb=sec.coulomb or 0.0,
                                  advance_samples=sec.advance_samples or 0.0)
             hff = sec.hysteresis
+            # each part's own errors name their section: only the loop's are [controller]'s
+            parts = (self.plant(), self.controller(), self.hysteresis())
+            hff = None if hff is None else build_hysteresis(hff)
             try:
-                loop = Loop(self.plant(), self.controller(), self.hysteresis(), feedforward=ff,
-                            hysteresis_feedforward=None if hff is None else build_hysteresis(hff))
+                loop = Loop(*parts, feedforward=ff, hysteresis_feedforward=hff)
             except ValueError as exc:
                 raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
             try:
