@@ -126,3 +126,19 @@ def test_continuous_simulation_refuses_feedforward_terms_it_cannot_run():
     loop = scenario(None, {"viscous": 3.0}).loop()
     with pytest.raises(ValueError, match="rigid-body feedforward M r'' alone"):
         simulate(loop, SineReference(0.01, 5.0), 0.01)
+
+
+def test_the_shipped_10khz_example():
+    from pathlib import Path
+
+    from motionhyst import analyze
+    from motionhyst.analysis.steady import periodic_steady_state
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "paper_10khz.toml"
+    sc = Scenario.from_file(path)
+    loop = sc.loop()
+    assert loop.sampled.sample_rate_hz == 10e3 and loop.ff.advance_samples == 2.0
+    res = analyze(loop, sc.amplitude, sc.frequencies)
+    for p in res.points:
+        ss = periodic_steady_state(loop, sc.amplitude, p.frequency_hz)
+        assert abs(ss.mismatch / p.value - 1) < 2e-3
