@@ -32,6 +32,7 @@ extensions = [
     "sphinx.ext.viewcode",
     "numpydoc",
     "linkmodels",  # docs/linkmodels.py: the link models' tables from the registry
+    "plants",  # docs/plants.py: the plants' table from the plant registry
 ]
 
 exclude_patterns = ["_build", "_generated/**/*.md"]

@@ -169,8 +169,10 @@ def _add_substitutions(app: Any, config: Any) -> None:
     config.rst_prolog = (config.rst_prolog or "") + substitutions()
 
 
-def _directive(write: Callable[[], list[str]], titles: bool) -> type:
-    """A directive without content that parses the reST `write` returns in its place."""
+def _directive(write: Callable[[], list[str]], titles: bool,
+               files: Callable[[], list[str]] = source_files) -> type:
+    """A directive without content that parses the reST `write` returns in its place (read
+    again when one of `files` changes)."""
     from docutils import nodes
     from docutils.statemachine import StringList
     from sphinx.util.docutils import SphinxDirective
@@ -180,7 +182,7 @@ def _directive(write: Callable[[], list[str]], titles: bool) -> type:
         has_content = False
 
         def run(self) -> list[nodes.Node]:
-            for path in source_files():  # the page is read again when a model changes
+            for path in files():  # the page is read again when a model changes
                 self.env.note_dependency(path)
             source = self.get_source_info()[0]
             content = StringList(write(), source=f"{source} (written by linkmodels.py)")

@@ -46,8 +46,7 @@ from motionhyst.controllers.sampled import SampledController, polyval_zinv
 from motionhyst.core.lti import PolyTF, cancel_s, freqresp, polysub_exact, tf_poly, trim
 from motionhyst.core.sampling import ZohEquivalent, hold_mismatch, hold_response
 from motionhyst.hysteresis.base import Hysteresis
-from motionhyst.plants.measured import MeasuredPlant
-from motionhyst.plants.two_mass import TwoMassStage
+from motionhyst.plants import PLANTS, Plant, TransferPlant
 
 __all__ = ["TRANSFERS", "Loop"]
 
@@ -59,12 +58,14 @@ class Loop:
 
     Parameters
     ----------
-    plant : TwoMassStage or ModalPlant or MeasuredPlant or tuple
-        The stage: a :class:`~motionhyst.plants.two_mass.TwoMassStage`, a plant fitted
-        to a measured FRF (:class:`~motionhyst.plants.frf_fit.ModalPlant`), the raw
-        measured plant, or a tuple ``(P1, P2)`` of python-control LTI systems
-        (then `mass` is required for the feedforward).  Any object with
-        attributes ``P1``, ``P2`` and ``M`` is taken as a plant.
+    plant : Plant or tuple
+        The stage, any plant of :mod:`motionhyst.plants` (the protocol
+        :class:`~motionhyst.plants.registry.Plant`): the two-mass stage
+        :class:`~motionhyst.plants.TwoMassStage`, a plant fitted to a measured
+        FRF (:class:`~motionhyst.plants.ModalPlant`), the raw measured plant
+        (:class:`~motionhyst.plants.MeasuredPlant`), ...; or a tuple
+        ``(P1, P2)`` of python-control LTI systems (then `mass` is required for
+        the feedforward; kept as a :class:`~motionhyst.plants.TransferPlant`).
     controller : python-control LTI system or SampledController
         Feedback controller ``C``, continuous or sampled
         (:class:`~motionhyst.controllers.sampled.SampledController`).
@@ -104,16 +105,22 @@ class Loop:
     def __init__(self, plant, controller, hysteresis: Hysteresis | None = None,
                  feedforward: str | None = "rigid-body", mass: float | None = None,
                  hysteresis_feedforward: Hysteresis | None = None) -> None:
-        if isinstance(plant, TwoMassStage | MeasuredPlant) or all(
-                hasattr(plant, a) for a in ("P1", "P2", "M")):
-            P1, P2 = plant.P1, plant.P2
-            mass = plant.M if mass is None else mass
-        else:
+        if isinstance(plant, tuple | list):
             try:
                 P1, P2 = plant
-            except Exception:
-                raise TypeError("plant must be a TwoMassStage, a ModalPlant, a MeasuredPlant "
-                                "or a tuple (P1, P2)") from None
+            except ValueError:
+                raise TypeError("plant must be a plant of motionhyst.plants or a tuple "
+                                "(P1, P2)") from None
+            plant = TransferPlant(P1, P2, mass)
+        elif not isinstance(plant, Plant):
+            raise TypeError(f"plant must be a plant of motionhyst.plants ({', '.join(PLANTS)}) "
+                            f"or a tuple (P1, P2), got {type(plant).__name__}")
+        if plant.force_offset:
+            raise ValueError(f"the closed loop's analyses take no constant force on the plant "
+                             f"(force_offset = {plant.force_offset:g} N); the open-loop time "
+                             f"runs do")
+        P1, P2 = plant.P1, plant.P2
+        mass = plant.M if mass is None else mass
         if isinstance(feedforward, Feedforward):
             ff = feedforward
             if ff.mass is None and (mass is None or not mass > 0):
@@ -331,7 +338,7 @@ class SampledParts:
         self.P2 = PolyTF(n2, d2)
         n1, d1 = tf_poly(loop.P1)
         self.P1 = PolyTF(n1, d1)
-        pf2 = getattr(loop.plant, "Pf2", None)
+        pf2 = loop.plant.Pf2
         self.Pf2 = None if pf2 is None else PolyTF(*tf_poly(pf2))
         if not c.one_dof:  # Y - R as one ratio, its coefficients exact
             num = np.polysub(np.convolve(c.y_num, c.r_den)[::-1],

@@ -72,7 +72,7 @@ def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
             warn(f"at amplitude {amplitude:g} m the element never slips (zeta = fc / (k A) = "
                  f"{float(el.zeta(amplitude)):.3g} >= 1): it is a linear spring at every "
                  f"frequency asked, there is no hysteresis to see", level)
-    data = getattr(loop.plant, "frequency_range_hz", None)
+    data = loop.plant.frequency_range_hz
     if data is not None:
         lo, hi = data
         out = [f for f in freqs if f < lo or f > hi]

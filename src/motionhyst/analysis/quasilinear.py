@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,8 +36,9 @@ from motionhyst.analysis.margins import LoopMargins, loop_margins
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.core.textfmt import g, table
 from motionhyst.loop import Loop
-from motionhyst.plants.measured import MeasuredPlant
-from motionhyst.plants.two_mass import TwoMassStage
+
+if TYPE_CHECKING:
+    from motionhyst.plants.measured import MeasuredPlant
 
 __all__ = ["MismatchPoint", "QuasiLinearAnalysis", "analyze", "error_harmonics_df", "f_star",
            "loop_mismatch", "mismatch", "mismatch_asymptote", "mismatch_crossover",
@@ -379,7 +381,7 @@ def _parts(loop: Loop, omega: NDArray[np.float64]):
     P1 = freqresp(loop.P1, omega)
     P2 = freqresp(loop.P2, omega)
     Pr = 1.0 / (loop.M * (1j * omega) ** 2)
-    if hasattr(loop.plant, "Pf2"):  # a model: Pf2 from its own terms, not Pr - P2
+    if loop.plant.Pf2 is not None:  # a model: Pf2 from its own terms, not Pr - P2
         Pf2 = freqresp(loop.plant.Pf2, omega)
     else:
         Pf2 = Pr - P2
@@ -572,7 +574,7 @@ def mismatch_crossover_exact(loop: Loop, amplitude: float, f_min: float = 1e-2,
     >>> round(mismatch_crossover_exact(default_scenario().loop(), 0.01), 3)  # eq. (21): 7.61 Hz
     7.606
     """
-    lo, hi = getattr(loop.plant, "frequency_range_hz", (f_min, f_max))
+    lo, hi = loop.plant.frequency_range_hz or (f_min, f_max)
     f_min, f_max = max(f_min, lo), min(f_max, hi)
     if loop.sampled is not None:  # below the Nyquist frequency (the sampled loop repeats above)
         f_max = min(f_max, loop.sampled.nyquist_hz * (1.0 - 1e-9))
@@ -680,7 +682,7 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     margins = loop_margins(loop.controller, loop.P2,
                            None if loop.sampled is None else loop.sampled_parts.zoh)
     unresolved: list[str] = []
-    if isinstance(loop.plant, MeasuredPlant):
+    if not loop.plant.is_lti:  # measured lines
         E, Et, amps = E.copy(), Et.copy(), amps.copy()
         unresolved = _measured_limits(loop.plant, f, P2, Pf2, E, Et, amps)
         crossover_exact, why = _crossover_exact_on_lines(loop, amplitude)
@@ -691,6 +693,10 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     else:
         crossover_exact = mismatch_crossover_exact(loop, amplitude)
         bandwidth_hz = loop.bandwidth_hz()
+        if q is None:  # eq. (21) does not apply: say so rather than print nan
+            unresolved.append(f"eq. (21): needs a flexible mode with a static compliance "
+                              f"Pf2(0) > 0 (the two-mass stage's m1 m2 / (k M^2)); the "
+                              f"{loop.plant.name} plant has none")
     points = [MismatchPoint(float(fi), complex(e), complex(et), float(z), float(a), complex(d))
               for fi, e, et, z, a, d in zip(f, E, Et, np.broadcast_to(zetas, f.shape), amps,
                                             np.broadcast_to(D_pts, f.shape), strict=True)]
@@ -777,14 +783,13 @@ CROSSOVER_MAX_ITERATIONS = 50
 
 
 def _stiffness_over_masses(plant) -> float | None:
-    """``k / (m1 m2)`` of eq. (21): for a modal model ``1 / (M^2 Pf2(0))``; None for data.
+    """``k / (m1 m2)`` of eq. (21), ``1 / (M^2 Pf2(0))``; None for a plant without a static
+    flexible compliance ``Pf2(0) > 0`` (data, a single mass, ground dampers).
 
     Eq. (21) solves ``|Pr^2 D / Pf2| = 1`` with ``Pf2`` at its static value;
     for the two-mass stage ``M^2 Pf2(0) = m1 m2 / k``.
     """
-    if isinstance(plant, TwoMassStage):
-        return plant.k / (plant.m1 * plant.m2)
-    pf2 = getattr(plant, "pf2_static", None)
+    pf2 = plant.pf2_static
     if pf2 is None or not pf2 > 0:
         return None
     return 1.0 / (plant.M**2 * pf2)

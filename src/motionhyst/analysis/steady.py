@@ -41,7 +41,6 @@ from motionhyst.core.sampling import hold_response
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis.periodic import sample_period
 from motionhyst.loop import Loop
-from motionhyst.plants.measured import MeasuredPlant
 
 __all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
 
@@ -293,7 +292,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     for name, v in (("amplitude", amplitude), ("frequency", frequency_hz)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be finite and > 0, got {v!r}")
-    if isinstance(loop.plant, MeasuredPlant):
+    if not loop.plant.is_lti:
         raise ValueError("the steady state needs the plant at every harmonic n f, which raw "
                          "measured lines do not give; fit the data ([plant] use = \"fit\")")
     if loop.sampled is not None:

@@ -6,7 +6,12 @@ import argparse
 
 from motionhyst.cli._common import UsageError, g, print_json, table
 
-PLANTS = ("mass-spring-damper", "two-mass")
+
+def plant_choices() -> list[str]:
+    """``--plant``: the registry's stages with inertia (identification simulates them)."""
+    from motionhyst.plants.registry import PLANTS, stage_types
+
+    return [name for name in stage_types() if PLANTS[name].has_inertia]
 
 
 def _nu(text: str) -> float | str:
@@ -26,7 +31,7 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     """The options of input-output identification."""
     from motionhyst.hysteresis import MODELS
 
-    q.add_argument("--plant", choices=PLANTS,
+    q.add_argument("--plant", choices=plant_choices(),
                    help="input-output records: the stage's model (default mass-spring-damper; "
                         "two-mass: the floating stage of eqs. 1-2, force and link on m1)")
     q.add_argument("--output", choices=("y2", "y1"),
@@ -67,9 +72,11 @@ def run_input_output(args: argparse.Namespace) -> int:
                              f"input-output")
     plant = args.plant or "mass-spring-damper"
     model = args.model or "bouc-wen"
-    if args.output is not None and plant != "two-mass":
-        raise UsageError("motionhyst identify: --output applies to --plant two-mass only (a "
-                         "mass-spring-damper has one position)")
+    from motionhyst.plants.registry import PLANTS
+
+    if args.output is not None and len(PLANTS[plant].outputs) < 2:
+        raise UsageError(f"motionhyst identify: --output applies to --plant two-mass only (a "
+                         f"{plant} has one position)")
     from motionhyst.identify.input_output import MODELS
 
     if model not in MODELS:

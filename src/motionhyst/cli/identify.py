@@ -136,7 +136,6 @@ def run(args: argparse.Namespace) -> int:
         load_closed_loop_csv,
         load_force_displacement_csv,
     )
-    from motionhyst.plants.measured import MeasuredPlant
     from motionhyst.scenario import load_scenario
 
     if args.record == "input-output":
@@ -170,7 +169,7 @@ def run(args: argparse.Namespace) -> int:
                              f"[controller]); give a scenario with a two-mass [stage] without "
                              f"output, or identify with --record input-output")
         plant = sc.plant()
-        if isinstance(plant, MeasuredPlant):
+        if not plant.is_lti:
             raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "
                              f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
                              f"has a measured [plant] with use = \"data\"")

@@ -89,11 +89,10 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     """Transient run from rest, streamed to CSV atomically, with its summary."""
     from motionhyst.analysis.plausibility import check_plausible
     from motionhyst.core.warnings import warn
-    from motionhyst.plants.measured import MeasuredPlant
     from motionhyst.time.references import SineReference
     from motionhyst.time.timeseries import run_time_series
 
-    if isinstance(sc.plant(), MeasuredPlant):
+    if not sc.plant().is_lti:
         raise UsageError(f"motionhyst simulate: --time-series needs a plant model; {sc.source} "
                          f"uses its measured [plant] as raw data (use = \"data\"), which has no "
                          f"time-domain model; use = \"fit\" fits one")

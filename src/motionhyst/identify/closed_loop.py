@@ -23,6 +23,7 @@ from motionhyst.identify.fit import (
 )
 from motionhyst.identify.records import MIN_SAMPLES, check_signals, count_reversals
 from motionhyst.identify.result import Identification
+from motionhyst.plants.registry import Plant
 
 __all__ = ["LinkForce", "identify_closed_loop", "infer_link_force"]
 
@@ -41,10 +42,11 @@ UNIFORM_RTOL = 0.01
 def _p1_poly(stage) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Coefficients of ``P1`` of a stage (or of an LTI ``P1`` itself), leading zeros dropped."""
     try:
-        num, den = tf_poly(getattr(stage, "P1", stage), "P1")
-    except TypeError:
-        raise TypeError("closed-loop identification needs an LTI model of P1 (a TwoMassStage "
-                        f"or a python-control system), got {type(stage).__name__}") from None
+        num, den = tf_poly(stage.P1 if isinstance(stage, Plant) else stage, "P1")
+    except (TypeError, ValueError):
+        raise TypeError("closed-loop identification needs an LTI model of P1 (a plant of "
+                        "motionhyst.plants with transfer functions, or a python-control "
+                        f"system), got {type(stage).__name__}") from None
     return np.trim_zeros(num, "f"), np.trim_zeros(den, "f")
 
 

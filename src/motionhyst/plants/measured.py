@@ -3,19 +3,25 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar
 
-import control
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.core.lti import TWO_PI
-from motionhyst.hysteresis.base import check_positive
-from motionhyst.io.csvdata import Source, describe
-from motionhyst.io.records import read_record, record_columns
+from motionhyst.core.validation import check_positive
+from motionhyst.plants.registry import PlantParameter, register
+
+if TYPE_CHECKING:  # the readers (pandas, scipy.io) are imported when a file is read
+    from motionhyst.io.csvdata import Source
+
+__all__ = ["MeasuredPlant", "load_frd_plant"]
+
+TWO_PI = 2.0 * np.pi
 
 __all__ = ["MeasuredPlant", "load_frd_plant"]
 
 
+@register
 @dataclass(frozen=True)
 class MeasuredPlant:
     """A plant known only by measured frequency responses of ``P1`` and ``P2``.
@@ -46,11 +52,22 @@ class MeasuredPlant:
     (1.0, 1000.0...)
     """
 
-    P1: control.FrequencyResponseData
-    P2: control.FrequencyResponseData
+    P1: Any
+    P2: Any
     M: float
     source: str = ""
     resolution: float | None = None
+
+    name: ClassVar[str] = "frd"
+    parameters: ClassVar[tuple[PlantParameter, ...]] = ()  # read from a file, not a [stage]
+    PARAMETERS: ClassVar[tuple[str, ...]] = ()
+    outputs: ClassVar[tuple[str, ...]] = ("y2",)
+    output: ClassVar[str] = "y2"
+    is_lti: ClassVar[bool] = False
+    has_inertia: ClassVar[bool] = True
+    force_offset: ClassVar[float] = 0.0
+    Pf2: ClassVar[None] = None  # Pr - P2 from the data
+    pf2_static: ClassVar[None] = None  # eq. (21) needs a model of the modes
 
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
@@ -72,8 +89,10 @@ class MeasuredPlant:
         return float(f[i]) if abs(f[i] - frequency_hz) <= rtol * frequency_hz else None
 
     @property
-    def Pr(self) -> control.TransferFunction:
+    def Pr(self) -> Any:
         """Rigid-body model ``1 / (M s^2)``."""
+        import control
+
         return control.tf([1.0], [self.M, 0.0, 0.0])
 
     @property
@@ -81,6 +100,64 @@ class MeasuredPlant:
         """Lowest and highest measured frequency [Hz]."""
         w = self.P2.omega
         return float(w.min() / TWO_PI), float(w.max() / TWO_PI)
+
+    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
+                           ) -> NDArray[np.complex128]:
+        """``y2 / u`` at `f_hz` [m/N] (interpolated between measured lines), the link a spring
+        `k_link` and damper `c_link` on ``y1``: ``P2 / (1 + Z P1)``.
+
+        Parameters
+        ----------
+        f_hz : array_like
+            Frequencies [Hz], inside :attr:`frequency_range_hz`.
+        k_link, c_link : float
+            The link taken as a spring [N/m] and damper [N s/m].
+
+        Returns
+        -------
+        ndarray of complex
+        """
+        from motionhyst.core.lti import freqresp
+
+        w = TWO_PI * np.atleast_1d(np.asarray(f_hz, dtype=float))
+        return freqresp(self.P2, w) / (1.0 + (k_link + 1j * w * c_link) * freqresp(self.P1, w))
+
+    def values(self) -> NDArray[np.float64]:
+        """No parameters of a ``[stage]``: an empty array."""
+        return np.zeros(0)
+
+    def with_parameters(self, values: ArrayLike) -> MeasuredPlant:
+        """The plant itself (it has no :attr:`PARAMETERS`).
+
+        Parameters
+        ----------
+        values : array_like
+            Empty.
+
+        Returns
+        -------
+        MeasuredPlant
+        """
+        if np.size(values):
+            raise ValueError("a measured plant has no parameters to set")
+        return self
+
+    def mechanics(self, values: ArrayLike | None = None) -> Any:
+        """A ``ValueError``: measured lines have no state-space form.
+
+        Parameters
+        ----------
+        values : array_like, optional
+            Ignored.
+        """
+        raise ValueError("a measured plant (frequency-response data) has no state-space form; "
+                         'fit a model to it ([plant] use = "fit")')
+
+    def to_dict(self) -> dict:
+        """``type``, the rigid-body mass, the source and the measured range."""
+        lo, hi = self.frequency_range_hz
+        return {"type": self.name, "M": self.M, "source": self.source,
+                "frequency_range_hz": [lo, hi]}
 
 
 _FRD_COLUMNS = {
@@ -130,6 +207,11 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     >>> plant.frequency_range_hz
     (1.0, 2000.0...)
     """
+    import control
+
+    from motionhyst.io.csvdata import describe
+    from motionhyst.io.records import read_record, record_columns
+
     where = describe(path)
     names = record_columns(path)
     header = set(names)

@@ -44,9 +44,7 @@ def _phase_deg(P) -> np.ndarray:
 
 def _grid(loop: Loop, f_range, n: int) -> np.ndarray:
     """`n` log-spaced frequencies in `f_range` [Hz]; for raw measured data its lines there."""
-    from motionhyst.plants.measured import MeasuredPlant
-
-    if isinstance(loop.plant, MeasuredPlant):
+    if not loop.plant.is_lti:
         f = loop.plant.frequency_hz
         return f[(f >= f_range[0]) & (f <= f_range[1])]
     return np.geomspace(*_frequency_range(loop, f_range), n)
@@ -54,7 +52,7 @@ def _grid(loop: Loop, f_range, n: int) -> np.ndarray:
 
 def _frequency_range(loop: Loop, f_range):
     """`f_range` clipped to the measured range of a measured plant."""
-    lo, hi = getattr(loop.plant, "frequency_range_hz", f_range)
+    lo, hi = loop.plant.frequency_range_hz or f_range
     return max(f_range[0], lo), min(f_range[1], hi)
 
 
@@ -530,7 +528,6 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     """
     from motionhyst.analysis.quasilinear import loop_mismatch, mismatch_asymptote, resolved_lines
     from motionhyst.core.lti import freqresp
-    from motionhyst.plants.measured import MeasuredPlant
 
     fig, (ax,) = new_figure()
     f = _grid(loop, f_range, 800)
@@ -539,14 +536,14 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
         loop.hysteresis, analysis.amplitude, w))
     Pr = 1.0 / (loop.M * (1j * w) ** 2)
     P2 = freqresp(loop.P2, w)
-    Pf2 = freqresp(loop.plant.Pf2, w) if hasattr(loop.plant, "Pf2") else Pr - P2
+    Pf2 = Pr - P2 if loop.plant.Pf2 is None else freqresp(loop.plant.Pf2, w)
     Et = mismatch_asymptote(Pr, Pf2, analysis.D)
-    if isinstance(loop.plant, MeasuredPlant):  # raw data: only the lines that resolve Pf2
+    if not loop.plant.is_lti:  # raw data: only the lines that resolve Pf2
         ok = resolved_lines(loop.plant, P2, Pf2)
         ax.loglog(f[~ok], np.abs(E[~ok]), "x", color="0.6", ms=4,
                   label="measured lines where Pf2 = Pr - P2 is not resolved (noise)")
         E, Et = np.where(ok, E, np.nan), np.where(ok, Et, np.nan)
-    style = "-o" if isinstance(loop.plant, MeasuredPlant) else "-"  # data: the measured lines
+    style = "-" if loop.plant.is_lti else "-o"  # data: the measured lines
     ax.loglog(f, np.abs(E), style, ms=2, color="k",
               label="|E| = |e / e_hat|, eq. (18): quasi-linear mismatch")
     ax.loglog(f, np.abs(Et), "--", color="tab:red",

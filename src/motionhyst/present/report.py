@@ -289,7 +289,6 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             figures.submit(_link_figures(el, A, freqs))
             from motionhyst.analysis.quasilinear import analyze, error_harmonics_df, loop_mismatch
             from motionhyst.analysis.steady import periodic_steady_state
-            from motionhyst.plants.measured import MeasuredPlant
 
             loop = sc.loop()
             analysis = analyze(loop, A, freqs)
@@ -302,7 +301,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             # the link's kernels, loaded only now (Fig. 9 needs none for a rate-independent
             # link): the steady states need them, and the later workers inherit them
             el.sine_loop(A, None if el.rate_independent else TWO_PI * freqs[0])
-            raw_data = isinstance(loop.plant, MeasuredPlant)
+            raw_data = not loop.plant.is_lti
             if raw_data:  # the steady state needs the plant at every harmonic: no exact results
                 states, E_df, H_df, exact = [], [], [], []
             else:
@@ -311,7 +310,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                 H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
                 figures.submit({"fig11": lambda: _plots().fig11_errors(states, E_df, H_df)})
                 steps.update()
-                lo, hi = getattr(loop.plant, "frequency_range_hz", (1.0, 100.0))
+                lo, hi = loop.plant.frequency_range_hz or (1.0, 100.0)
                 f_exact = np.geomspace(max(1.0, lo), min(100.0, hi / 10.0), 13)
                 if loop.sampled is not None:  # the hybrid loop's: whole samples per period
                     rate = loop.sampled.sample_rate_hz

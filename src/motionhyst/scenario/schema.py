@@ -29,6 +29,7 @@ from pydantic import (
 
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.hysteresis.registry import Form
+from motionhyst.plants.registry import PLANTS, plant_class, stage_types
 
 __all__ = ["Scenario", "ScenarioError", "default_scenario", "default_scenario_path",
            "hysteresis_from_dict", "load_scenario"]
@@ -38,10 +39,9 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
 
     from motionhyst.controllers.sampled import SampledController
     from motionhyst.loop import Loop
-    from motionhyst.plants.frf_fit import FrfFit, ModalPlant
-    from motionhyst.plants.measured import MeasuredPlant
-    from motionhyst.plants.two_mass import TwoMassStage
-    from motionhyst.time.openloop import MassSpringDamper, OpenLoop, TwoMass
+    from motionhyst.plants.frf_fit import FrfFit
+    from motionhyst.plants.registry import Plant
+    from motionhyst.time.openloop import OpenLoop
 
 
 class ScenarioError(ValueError):
@@ -63,6 +63,8 @@ class ScenarioError(ValueError):
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+_FIELD_TYPES = {"positive": PositiveFloat, "nonnegative": NonNegativeFloat,
+                "finite": Annotated[float, Field(allow_inf_nan=False)]}
 
 
 class _Section(BaseModel):
@@ -80,49 +82,93 @@ class _Section(BaseModel):
         return data
 
 
-class StageSection(_Section):
-    """``[stage]``: the two-mass stage of eqs. (1)-(2) (``type = "two-mass"``, the default).
+class _StageSection(_Section):
+    """A ``[stage]`` section: field types here, the plant's own rules in its class.
 
-    ``output = "y2"`` or ``"y1"`` makes it an open-loop system
-    (:class:`~motionhyst.time.openloop.TwoMass`: force on ``m1``, the link on ``y1``,
-    that position out, as :func:`motionhyst.identify.identify_io` writes it), with
-    no ``[controller]``, ``[feedforward]`` or ``[reference]``; without it the
-    stage is the plant of the closed loop.
+    After the fields are validated the plant is built once, so that its
+    constructor's checks are the only statement of them.
     """
 
-    type: Annotated[Literal["two-mass"], Field(exclude=True)] = "two-mass"  # the default
-    m1: PositiveFloat
-    m2: PositiveFloat
-    b: NonNegativeFloat
-    k: PositiveFloat
-    output: Literal["y2", "y1"] | None = None
+    @model_validator(mode="after")
+    def _plant_accepts(self):
+        self.build()
+        return self
+
+    def build(self, closed_loop: bool = False):
+        """The plant the section describes (the closed loop's: without an ``output``)."""
+        values = self.model_dump(exclude={"type"}, exclude_none=True)
+        if closed_loop:
+            values.pop("output", None)
+        return plant_class(self.type)(**values)
 
 
-class MassSpringDamperSection(_Section):
-    """``[stage] type = "mass-spring-damper"``: one mass on a spring and damper, open loop.
+#: The plant a ``[stage]`` without ``type`` describes: the paper's two-mass stage.
+DEFAULT_STAGE = "two-mass"
 
-    ``m y'' + c y' + k y + w = u`` with the link force ``w`` on the position
-    (:class:`~motionhyst.time.openloop.MassSpringDamper`); force in, position out,
-    no ``[controller]``, ``[feedforward]`` or ``[reference]``.
+
+def _stage_section(name: str, cls) -> type[_StageSection]:
+    """The ``[stage] type = name`` section, from the plant's declared parameters.
+
+    A plant with more than one measurable position takes an ``output`` (which
+    makes the stage an open-loop system, force in, that position out); a plant
+    with one is always one.
     """
+    if name == DEFAULT_STAGE:
+        fields: dict = {"type": (Annotated[Literal[name], Field(exclude=True)], name)}
+    else:
+        fields = {"type": (Literal[name], ...)}
+    for p in cls.parameters:  # optional ones left out of the table stay out of its dump
+        t = _FIELD_TYPES[p.kind]
+        fields[p.name] = (t, ...) if p.required else (t | None, None)
+    if len(cls.outputs) > 1:
+        fields["output"] = (Literal[cls.outputs] | None, None)
+    section = create_model(f"{cls.__name__}Section", __base__=_StageSection, **fields)
+    what = "the default" if name == DEFAULT_STAGE else "open loop: force in, position out"
+    section.__doc__ = f"``[stage] type = \"{name}\"``: {first_line(cls)} ({what})."
+    return section
 
-    type: Literal["mass-spring-damper"]
-    m: PositiveFloat
-    c: NonNegativeFloat
-    k: NonNegativeFloat
+
+def first_line(obj) -> str:
+    """The first line of an object's docstring."""
+    doc = (obj.__doc__ or "").strip().splitlines()
+    return doc[0].strip().rstrip(".") if doc else ""
+
+
+#: The section of each ``[stage] type = ...``, one per plant built from parameters.
+STAGE_SECTIONS: dict[str, type[_StageSection]] = {
+    name: _stage_section(name, PLANTS[name]) for name in stage_types()}
 
 
 def _stage_tag(data) -> str | None:
     """Tag of a ``[stage]`` table: its ``type``, ``"two-mass"`` when absent."""
     if isinstance(data, dict):
-        return data.get("type", "two-mass")
+        return data.get("type", DEFAULT_STAGE)
     return getattr(data, "type", None)
 
 
 StageUnion = Annotated[
-    Union[Annotated[StageSection, Tag("two-mass")],  # noqa: UP007
-          Annotated[MassSpringDamperSection, Tag("mass-spring-damper")]],
+    Union[tuple(Annotated[section, Tag(tag)]  # noqa: UP007
+                for tag, section in STAGE_SECTIONS.items())],
     Discriminator(_stage_tag)]
+
+
+def _is_open_loop(stage) -> bool:
+    """A ``[stage]`` of an open-loop system: an ``output`` given, or a plant with one position."""
+    return stage is not None and (getattr(stage, "output", None) is not None
+                                  or len(PLANTS[stage.type].outputs) == 1)
+
+
+def _open_loop_kinds() -> str:
+    """The ``[stage]`` types that are always open-loop systems, for messages."""
+    names = [n for n in STAGE_SECTIONS if len(PLANTS[n].outputs) == 1]
+    return ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else names[0]
+
+
+def _open_loop_what(stage) -> str:
+    """What an open-loop ``[stage]`` is, for messages."""
+    if getattr(stage, "output", None) is not None:
+        return f'a {stage.type} stage with output = "{stage.output}"'
+    return f"a {stage.type}"
 
 
 class PlantSection(_Section):
@@ -188,9 +234,6 @@ class _LinkSection(_Section):
         make = cls if form is None else getattr(cls, form.constructor)
         return make(**self.model_dump(exclude={"model"}))
 
-
-_FIELD_TYPES = {"positive": PositiveFloat, "nonnegative": NonNegativeFloat,
-                "finite": Annotated[float, Field(allow_inf_nan=False)]}
 
 
 def _link_section(name: str, cls: type[Hysteresis], form: Form | None = None
@@ -463,9 +506,9 @@ class ScenarioModel(_Section):
         if (self.stage is None) == (self.plant is None):
             raise ValueError("give exactly one of [stage] and [plant]")
         if self.open_loop:
-            what = ("a mass-spring-damper [stage]"
-                    if isinstance(self.stage, MassSpringDamperSection)
-                    else f'a [stage] with output = "{self.stage.output}"')
+            output = getattr(self.stage, "output", None)  # a stage of one position has none
+            what = (f"a {self.stage.type} [stage]" if output is None
+                    else f'a [stage] with output = "{output}"')
             for name in ("controller", "feedforward", "reference"):
                 if getattr(self, name) is not None:
                     raise ValueError(f"[{name}] does not apply to {what} (an open-loop system, "
@@ -474,8 +517,8 @@ class ScenarioModel(_Section):
         for name in ("controller", "reference"):
             if getattr(self, name) is None:
                 hint = ""
-                if (isinstance(self.stage, StageSection) and self.controller is None
-                        and self.reference is None):
+                if (self.stage is not None and len(PLANTS[self.stage.type].outputs) > 1
+                        and self.controller is None and self.reference is None):
                     hint = ' (or give [stage] output = "y2" or "y1" for an open-loop system)'
                 raise ValueError(f"[{name}]: missing{hint}")
         if self.feedforward is None:
@@ -487,15 +530,14 @@ class ScenarioModel(_Section):
 
     @property
     def open_loop(self) -> bool:
-        """True for a mass-spring-damper stage or a two-mass one with an ``output`` (no
-        controller)."""
-        return isinstance(self.stage, MassSpringDamperSection) or (
-            isinstance(self.stage, StageSection) and self.stage.output is not None)
+        """True for a stage of one position (a mass-spring-damper, ...) or one with an
+        ``output`` (no controller)."""
+        return _is_open_loop(self.stage)
 
 
 # tags of the discriminated unions, left out of the key named in an error message
-_UNION_TAGS = {"leadlag-lowpass", "tf", "pid", "tf-z", "two-dof-z", "two-mass",
-               "mass-spring-damper", *MODELS, *FORM_SECTIONS}
+_UNION_TAGS = {"leadlag-lowpass", "tf", "pid", "tf-z", "two-dof-z", *STAGE_SECTIONS,
+               *MODELS, *FORM_SECTIONS}
 
 
 def build_hysteresis(section) -> Hysteresis:
@@ -664,15 +706,13 @@ class Scenario:
 
     @property
     def is_open_loop(self) -> bool:
-        """True for an open-loop system (a mass-spring-damper stage, or a two-mass stage with
-        an ``output``): force in, position out, no controller."""
+        """True for an open-loop system (a stage of one position, such as a mass-spring-damper,
+        or a two-mass stage with an ``output``): force in, position out, no controller."""
         return self.model.open_loop
 
     def _closed(self, what: str) -> None:
         if self.model.open_loop:
-            kind = ("a mass-spring-damper" if isinstance(self.model.stage,
-                                                         MassSpringDamperSection)
-                    else f'a two-mass stage with output = "{self.model.stage.output}"')
+            kind = _open_loop_what(self.model.stage)
             raise ScenarioError(f"{self.source}: [stage] is {kind} (an open-loop system "
                                 f"without [controller] or [reference]); {what} needs a closed "
                                 f"loop (use motionhyst predict for open-loop systems)")
@@ -704,33 +744,27 @@ class Scenario:
     def open_loop(self) -> OpenLoop:
         """The open-loop system of the stage and its link (force in, a position out)."""
         if not self.model.open_loop:
-            raise ScenarioError(f"{self.source}: [stage] is not a mass-spring-damper nor a "
+            raise ScenarioError(f"{self.source}: [stage] is not a {_open_loop_kinds()} nor a "
                                 f"two-mass stage with an output; an open-loop system needs "
-                                f"[stage] type = \"mass-spring-damper\", or output = \"y2\" "
+                                f"[stage] type = one of those, or output = \"y2\" "
                                 f"or \"y1\" in a two-mass [stage] (and no [controller])")
         from motionhyst.time.openloop import OpenLoop
 
         return OpenLoop(self.plant(), self.hysteresis())
 
-    def plant(self) -> TwoMassStage | ModalPlant | MeasuredPlant | MassSpringDamper | TwoMass:
-        """The stage model, the model fitted to a measured plant, or the raw measured plant
-        (an open-loop system's: :class:`~motionhyst.time.openloop.MassSpringDamper` or
-        :class:`~motionhyst.time.openloop.TwoMass`)."""
+    def plant(self) -> Plant:
+        """The stage (a plant of the registry, :mod:`motionhyst.plants`), the model fitted to
+        a measured plant, or the raw measured plant."""
         if self._plant is not None:
             return self._plant
         from motionhyst.plants.frf_fit import fit_measured_plant
         from motionhyst.plants.measured import load_frd_plant
-        from motionhyst.plants.two_mass import TwoMassStage
-        from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
         m = self.model
         if m.open_loop:
-            st = m.stage
-            if isinstance(st, MassSpringDamperSection):
-                return MassSpringDamper(st.m, st.c, st.k)
-            return TwoMass(st.m1, st.m2, st.b, st.k, st.output)
+            return m.stage.build()
         if m.stage is not None:
-            self._plant = TwoMassStage(m.stage.m1, m.stage.m2, m.stage.b, m.stage.k)
+            self._plant = m.stage.build(closed_loop=True)
             return self._plant
         f = Path(m.plant.file)
         if not f.is_absolute():

@@ -1,18 +1,21 @@
 """Open-loop systems: a stage with a dynamic link, force in, a position out.
 
-Two plants, both a linear mechanical plant with lumped masses
-(:class:`Mechanics`: ``M q'' + C q' + K q = e (u - w)``, in state-space form
-``x = (q, q')``), the force ``u`` and the link force ``w`` acting on the
-first mass, ``w`` the force of a hysteresis model (any model of
-:mod:`motionhyst.hysteresis`) of that mass's position:
+The stage is any plant of :mod:`motionhyst.plants` with inertia: its
+state-space form :class:`~motionhyst.plants.mechanics.Mechanics`
+(``M q'' + C q' + K q = e (u + f0 - w)``, ``x = (q, q')``), the force ``u``
+(with the plant's constant offset ``f0``) and the link force ``w`` acting on
+the link's coordinate, ``w`` the force of a hysteresis model (any model of
+:mod:`motionhyst.hysteresis`) of that coordinate's position; for example
 
-* :class:`MassSpringDamper`, the stage of the Bouc-Wen benchmark (Noel and
-  Schoukens 2016) and of any single-mass test rig without feedback,
-  ``m y'' + c y' + k y + w = u``, output ``y``;
-* :class:`TwoMass`, the floating two-mass stage of the paper's eqs. (1)-(2)
-  without its controller: ``m1`` actuated (position ``y1``, where the link
-  acts), ``m2`` the point of control (``y2``), spring ``k`` and damper ``b``
-  between them; output ``y2`` (default) or ``y1``.
+* :class:`~motionhyst.plants.MassSpringDamper`, the stage of the Bouc-Wen
+  benchmark (Noel and Schoukens 2016) and of any single-mass test rig
+  without feedback, ``m y'' + c y' + k y + w = u``, output ``y``;
+* :class:`~motionhyst.plants.MassDamper`, a positioning axis (no spring);
+* :class:`~motionhyst.plants.TwoMassStage`, the floating two-mass stage of
+  the paper's eqs. (1)-(2) without its controller: ``m1`` actuated (position
+  ``y1``, where the link acts), ``m2`` the point of control (``y2``), spring
+  ``k`` and damper ``b`` between them; output ``y2`` (default) or ``y1``
+  (``TwoMass``, its older name here).
 
 :class:`OpenLoop` simulates the response to a sampled force record from rest,
 or the periodic steady state when the record is one period of a periodic
@@ -73,7 +76,9 @@ from motionhyst.hysteresis.stepping import (
     advance_partials,
     coulomb_implicit,
 )
+from motionhyst.plants.mass_spring_damper import MassSpringDamper
 from motionhyst.plants.mechanics import Mechanics
+from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.time.simulation import MAX_FIXED_POINT_ITERATIONS
 
 #: Names of the general Bouc-Wen parameters the compiled integrator carries (sensitivity order).
@@ -85,194 +90,11 @@ SINC_HALF_WIDTH = 64
 MAX_PERIODIC_DECAYS = 60.0  # periodic runs stop after this many time constants of the mode
 
 
-class MassSpringDamper:
-    """A single mass on a linear spring and damper: ``m y'' + c y' + k y = u - w``.
+#: The two-mass stage's name as an open-loop plant before the plants had one class.
+TwoMass = TwoMassStage
 
-    Parameters
-    ----------
-    m : float
-        Mass [kg], > 0.
-    c : float
-        Viscous damping [N s/m], >= 0.
-    k : float
-        Stiffness [N/m], >= 0.
-
-    Examples
-    --------
-    >>> p = MassSpringDamper(m=2.0, c=10.0, k=5e4)
-    >>> round(p.resonance_hz, 2), round(p.damping_ratio, 4)
-    (25.16, 0.0158)
-    >>> abs(p.frequency_response(0.0))   # 1 / k at DC
-    2e-05
-    """
-
-    #: Names of the parameters, in the order of :meth:`parameters`.
-    PARAMETERS = ("m", "c", "k")
-
-    def __init__(self, m: float, c: float, k: float) -> None:
-        self.m = _check(m, "m", positive=True)
-        self.c = _check(c, "c", positive=False)
-        self.k = _check(k, "k", positive=False)
-
-    def __repr__(self) -> str:
-        return f"MassSpringDamper(m={self.m!r}, c={self.c!r}, k={self.k!r})"
-
-    @property
-    def resonance_hz(self) -> float:
-        """Undamped natural frequency ``sqrt(k/m) / (2 pi)`` [Hz]."""
-        return math.sqrt(self.k / self.m) / (2 * math.pi)
-
-    @property
-    def damping_ratio(self) -> float:
-        """``c / (2 sqrt(k m))`` [-] (inf for ``k = 0``)."""
-        return self.c / (2 * math.sqrt(self.k * self.m)) if self.k > 0 else math.inf
-
-    @property
-    def output(self) -> str:
-        """The measured position: ``"y"``, the mass's."""
-        return "y"
-
-    def frequency_response(self, f_hz: ArrayLike) -> NDArray[np.complex128] | complex:
-        """``Y / U = 1 / (m s^2 + c s + k)`` at ``s = 2 pi j f`` [m/N]."""
-        s = 2j * np.pi * np.asarray(f_hz, dtype=float)
-        out = 1.0 / (self.m * s * s + self.c * s + self.k)
-        return complex(out) if np.ndim(out) == 0 else out
-
-    def values(self) -> NDArray[np.float64]:
-        """``(m, c, k)`` (:attr:`PARAMETERS`)."""
-        return np.array([self.m, self.c, self.k])
-
-    def with_parameters(self, values: ArrayLike) -> MassSpringDamper:
-        """The same kind of plant with the parameters `values` (checked)."""
-        m, c, k = (float(v) for v in values)
-        return MassSpringDamper(m, c, k)
-
-    def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
-        """The plant (or the unchecked parameter `values`) as :class:`Mechanics`."""
-        m, c, k = self.values() if values is None else np.asarray(values, dtype=float)
-        return Mechanics([m], [[c]], [[k]], [[1.0], [0.0], [0.0]],
-                         [[[0.0]], [[1.0]], [[0.0]]], [[[0.0]], [[0.0]], [[1.0]]], 0, 0)
-
-    def to_dict(self) -> dict:
-        """Parameters as a JSON-ready dictionary (the ``[stage]`` table of a scenario)."""
-        return {"type": "mass-spring-damper", "m": self.m, "c": self.c, "k": self.k}
-
-
-class TwoMass:
-    """The floating two-mass stage of eqs. (1)-(2) as an open-loop plant, force in.
-
-    .. math::
-
-        m_1 \\ddot y_1 + b (\\dot y_1 - \\dot y_2) + k (y_1 - y_2) = u - w, \\qquad
-        m_2 \\ddot y_2 + b (\\dot y_2 - \\dot y_1) + k (y_2 - y_1) = 0,
-
-    the force ``u`` on the actuated mass ``m1``, where the link acts (its
-    force ``w`` a function of ``y1``), the output the position `output` of
-    the point of control ``y2`` (default) or of ``m1``.  The same stage as
-    :class:`motionhyst.plants.two_mass.TwoMassStage` without a controller.
-
-    No spring holds the stage to the ground except the link: with a link that
-    has no stiffness (or none, ``w = 0``) a force with a nonzero mean makes the
-    stage run away, and a periodic steady state is defined up to a constant
-    position (:meth:`OpenLoop.simulate` returns it with zero mean).
-
-    Parameters
-    ----------
-    m1, m2 : float
-        Masses [kg], > 0.
-    b : float
-        Damper between the masses [N s/m], >= 0.
-    k : float
-        Spring between the masses [N/m], > 0.
-    output : {"y2", "y1"}
-        The measured position.
-
-    Examples
-    --------
-    >>> p = TwoMass(m1=5.0, m2=17.5, b=90.0, k=7.4e7)     # Table I
-    >>> round(p.resonance_hz, 1), p.output
-    (694.3, 'y2')
-    >>> G = p.frequency_response([10.0], k_link=0.0)     # y2 / u: nearly 1 / (M s^2)
-    >>> round(float(abs(G[0]) * p.M * (2 * np.pi * 10.0) ** 2), 4)
-    1.0002
-    """
-
-    #: Names of the parameters, in the order of :meth:`parameters`.
-    PARAMETERS = ("m1", "m2", "b", "k")
-    OUTPUTS = ("y2", "y1")
-
-    def __init__(self, m1: float, m2: float, b: float, k: float, output: str = "y2") -> None:
-        self.m1 = _check(m1, "m1", positive=True)
-        self.m2 = _check(m2, "m2", positive=True)
-        self.b = _check(b, "b", positive=False)
-        self.k = _check(k, "k", positive=True)
-        if output not in self.OUTPUTS:
-            raise ValueError(f"output must be 'y2' or 'y1', got {output!r}")
-        self.output = output
-
-    def __repr__(self) -> str:
-        return (f"TwoMass(m1={self.m1!r}, m2={self.m2!r}, b={self.b!r}, k={self.k!r}, "
-                f"output={self.output!r})")
-
-    @property
-    def M(self) -> float:
-        """Total mass ``m1 + m2`` [kg]."""
-        return self.m1 + self.m2
-
-    @property
-    def resonance_hz(self) -> float:
-        """The internal mode, ``sqrt(k M / (m1 m2)) / (2 pi)`` [Hz]."""
-        return math.sqrt(self.k * self.M / (self.m1 * self.m2)) / (2 * math.pi)
-
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128]:
-        """The output over the force at `f_hz` [m/N], the link a spring `k_link` and damper
-        `c_link` on ``y1`` (both 0: eq. (1), ``P2`` or ``P1``)."""
-        return self.mechanics().frequency_response(f_hz, k_link, c_link)
-
-    def values(self) -> NDArray[np.float64]:
-        """``(m1, m2, b, k)`` (:attr:`PARAMETERS`)."""
-        return np.array([self.m1, self.m2, self.b, self.k])
-
-    def with_parameters(self, values: ArrayLike) -> TwoMass:
-        """The same kind of plant (same output) with the parameters `values` (checked)."""
-        m1, m2, b, k = (float(v) for v in values)
-        return TwoMass(m1, m2, b, k, self.output)
-
-    def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
-        """The plant (or the unchecked parameter `values`) as :class:`Mechanics`."""
-        m1, m2, b, k = self.values() if values is None else np.asarray(values, dtype=float)
-        D = np.array([[1.0, -1.0], [-1.0, 1.0]])
-        Z = np.zeros((2, 2))
-        return Mechanics([m1, m2], b * D, k * D, [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0],
-                                                 [0.0, 0.0]],
-                         [Z, Z, D, Z], [Z, Z, Z, D], 0, 0 if self.output == "y1" else 1)
-
-    def stage(self):
-        """The same stage for the closed loop (:class:`motionhyst.plants.two_mass.TwoMassStage`)."""
-        from motionhyst.plants.two_mass import TwoMassStage
-
-        return TwoMassStage(self.m1, self.m2, self.b, self.k)
-
-    def to_dict(self) -> dict:
-        """Parameters as a JSON-ready dictionary (the ``[stage]`` table of a scenario)."""
-        return {"type": "two-mass", "m1": self.m1, "m2": self.m2, "b": self.b, "k": self.k,
-                "output": self.output}
-
-
-Plant = MassSpringDamper | TwoMass
+Plant = MassSpringDamper | TwoMassStage
 """An open-loop plant: force in, the link on its (first) mass, a position out."""
-
-
-def _check(value, name: str, positive: bool) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v) or (v <= 0 if positive else v < 0):
-        raise ValueError(f"{name} must be finite and {'> 0' if positive else '>= 0'}, "
-                         f"got {value!r}")
-    return v
 
 
 def upsample(u: ArrayLike, factor: int, periodic: bool) -> NDArray[np.float64]:
@@ -773,8 +595,9 @@ class OpenLoop:
 
     Parameters
     ----------
-    plant : MassSpringDamper or TwoMass
-        The stage; the force and the link act on its (first) mass.
+    plant : Plant
+        The stage, a plant with inertia (:class:`~motionhyst.plants.registry.Plant`);
+        the force and the link act on its link coordinate.
     hysteresis : Hysteresis or None
         The link's model (None: the linear stage alone).
 
