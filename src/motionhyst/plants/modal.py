@@ -134,7 +134,17 @@ class ModalPlant:
 
     @classmethod
     def from_two_mass(cls, stage) -> ModalPlant:
-        """The modal form of a :class:`~motionhyst.plants.two_mass.TwoMassStage` (eq. 2)."""
+        """The modal form of a :class:`~motionhyst.plants.two_mass.TwoMassStage` (eq. 2).
+
+        Parameters
+        ----------
+        stage : TwoMassStage
+            The stage; its one flexible mode becomes the plant's mode.
+
+        Returns
+        -------
+        ModalPlant
+        """
         m1, m2, M = stage.m1, stage.m2, stage.M
         w = np.sqrt(stage.k * M / (m1 * m2))
         mode = Mode(frequency_hz=w / TWO_PI, damping=stage.b * M / (m1 * m2) / (2 * w),
@@ -238,7 +248,18 @@ class ModalPlant:
         return self.modes[0].frequency_hz if self.modes else float("nan")
 
     def response(self, omega: ArrayLike) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
-        """``P1(j omega)`` and ``P2(j omega)`` evaluated term by term [m/N]."""
+        """``P1(j omega)`` and ``P2(j omega)`` evaluated term by term [m/N].
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular frequencies [rad/s].
+
+        Returns
+        -------
+        P1, P2 : ndarray of complex
+            The collocated and the non-collocated responses.
+        """
         w = np.asarray(omega, dtype=float)
         s = 1j * w
         with np.errstate(divide="ignore"):
