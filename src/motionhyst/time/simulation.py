@@ -23,7 +23,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.budget import check_memory
-from motionhyst.core.compiled import njit
 from motionhyst.core.lti import (
     TWO_PI,
     FohResponse,
@@ -36,8 +35,15 @@ from motionhyst.core.lti import (
 )
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
-from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, advance, open_loop_chunk
+from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
 from motionhyst.loop import Loop
+from motionhyst.time.engine import (
+    CLOSED,
+    MAX_FIXED_POINT_ITERATIONS,
+    FohStep,
+    LoopState,
+    run_steps,
+)
 
 __all__ = ["Simulation", "simulate", "simulate_chunks"]
 
@@ -146,120 +152,6 @@ def _block_systems(loop: Loop, omega0: float):
     sys_a = stack([realize_scaled(num, den, omega0) for num, den in (n_ae, n_ay)])
     sys_w = stack([realize_scaled(P[name].num, P[name].den, omega0) for name in ("w->e", "w->y1")])
     return sys_a, sys_w
-
-
-MAX_FIXED_POINT_ITERATIONS = 50
-
-
-@njit(cache=True)
-def _run(Ad, Bd, Cd, Dd, r, e_lin, dev_lin, uh, h, codes, params, st_x, st_s, st_sprev,
-         st_scalars, i0, glt, glw, ftol, max_iter):  # pragma: no cover - compiled
-    """The loop driven by the hysteresis force, around the linear response to ``r''``.
-
-    ``Ad .. Dd`` realise ``w - u_h -> (e, y1 - r)`` (first-order hold);
-    ``e_lin``, ``dev_lin`` are the responses to ``r''``.  Each step is implicit
-    in ``w`` through the feedthrough ``Dd``: a fixed-point iteration, stopped
-    when ``w`` changes by at most `ftol`.  Returns ``e``, ``y1 - r``, ``w`` and
-    the largest number of iterations used (``max_iter + 1`` if one step failed
-    to converge; the run stops there).
-
-    The samples are those from index `i0` of the whole run; the state of the
-    linear part `st_x`, of the elements `st_s` (and one step earlier,
-    `st_sprev`) and ``st_scalars = (r, y1 - r, w, dx)`` of the previous sample
-    are read at the start (ignored for ``i0 = 0``, except the elements' rest
-    state `st_s`) and updated at the end, so a run in chunks equals one run.
-    """
-    n_t = r.shape[0]
-    n_x = Ad.shape[0]
-    m = codes.shape[0]
-    x = st_x.copy()
-    xn = np.zeros(n_x)
-    s = st_s.copy()
-    s_new = st_s.copy()
-    s_prev = st_sprev.copy()
-    e = np.zeros(n_t)
-    dev = np.zeros(n_t)
-    w = np.zeros(n_t)
-    worst = 0
-    if i0 == 0:
-        x[:] = 0.0
-        for j in range(m):
-            s_prev[j] = s[j]
-        r_prev = r[0]
-        dev_prev = 0.0  # the element starts at rest at y1 = r(0)
-        w_prev = 0.0
-        dx_prev = 0.0
-        for j in range(m):
-            w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt,
-                              glw)[1]
-    else:
-        r_prev, dev_prev, w_prev, dx_prev = (st_scalars[0], st_scalars[1], st_scalars[2],
-                                             st_scalars[3])
-    for k in range(n_t):
-        i = i0 + k
-        base_e = e_lin[k]
-        base_y = dev_lin[k]
-        for j in range(n_x):
-            base_e += Cd[0, j] * x[j]
-            base_y += Cd[1, j] * x[j]
-        hi = h if i > 0 else 0.0
-        dr = r[k] - r_prev
-        wt = w_prev
-        d = base_y + Dd[1, 0] * (wt - uh[k])
-        it = 0
-        step_prev = np.inf
-        while True:
-            it += 1
-            dx = dr + (d - dev_prev)
-            wn = 0.0
-            for j in range(m):
-                s_new[j], f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, hi,
-                                       i == 1, glt, glw)
-                wn += f
-            d_next = base_y + Dd[1, 0] * (wn - uh[k])
-            # converged when w settles or y1 - r changes by a few ulps only; or at the
-            # round-off floor: no longer contracting while y1 - r moves by < 1e-12 of itself
-            # (a steep element, e.g. LuGre's sigma1 z' / dt, amplifies the round-off of z)
-            step_w = abs(wn - wt)
-            step_d = abs(d_next - d)
-            scale_d = abs(d) + abs(dx)
-            done = (step_w <= ftol or step_d <= 1e-15 * scale_d
-                    or (it >= 3 and step_w >= 0.5 * step_prev and step_d <= 1e-12 * scale_d))
-            step_prev = step_w
-            wt = wn
-            if done or m == 0:
-                break  # d: the y1 - r the element was advanced with
-            d = d_next
-            if it > max_iter:
-                return e[:k], dev[:k], w[:k], it
-        if it > worst:
-            worst = it
-        s_prev, s, s_new = s, s_new, s_prev
-        e[k] = base_e + Dd[0, 0] * (wt - uh[k])
-        dev[k] = d
-        w[k] = wt
-        dx_prev = dr + (d - dev_prev)
-        r_prev = r[k]
-        dev_prev = d
-        w_prev = wt
-        for j in range(n_x):
-            acc = Bd[j, 0] * (wt - uh[k])
-            for q in range(n_x):
-                acc += Ad[j, q] * x[q]
-            xn[j] = acc
-        x, xn = xn, x
-    # element-wise copies: an array assigned to a slice compiles numba's shape-mismatch error
-    # message (seconds of the first compilation)
-    for j in range(n_x):
-        st_x[j] = x[j]
-    for j in range(m):
-        st_s[j] = s[j]
-        st_sprev[j] = s_prev[j]
-    st_scalars[0] = r_prev
-    st_scalars[1] = dev_prev
-    st_scalars[2] = w_prev
-    st_scalars[3] = dx_prev
-    return e, dev, w, worst
 
 
 def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float64],
@@ -435,10 +327,15 @@ class _Engine:
         self.disc_a = (Ad, np.ascontiguousarray(Bd[:, 0]), Cd, np.ascontiguousarray(Dd[:, 0]))
         self.x_a = np.ascontiguousarray(self.x_a[:, None])
         self.disc_w = discretize_foh(sys_w, omega0 * step)
-        self.x_w = np.zeros(self.disc_w[0].shape[0])
-        self.s = np.ascontiguousarray(s0, dtype=float).copy()
-        self.s_prev = self.s.copy()
-        self.scalars = np.zeros(4)
+        # the link force drives the linear part as f = u_h - w: w - u_h -> (e, y1 - r), negated
+        Ad, Bd, Cd, Dd = self.disc_w
+        self.steps = [FohStep(Ad, -Bd[:, 0], np.zeros(Ad.shape[0]), step)]
+        self.C, self.D = Cd, -Dd[:, 0]
+        self.stepping = Stepping(self.codes, self.params, np.ascontiguousarray(s0, dtype=float),
+                                 self.f_scale)
+        self.state = LoopState.at_rest(Ad.shape[0], self.stepping)
+        self.r_prev = None
+        self.uh_prev = 0.0
         self.hff_history = np.empty(0)
         if self.hff is not None and not self.hff.rate_independent:
             self.hff_codes, self.hff_params, hs0, _ = _elements(self.hff)
@@ -471,15 +368,24 @@ class _Engine:
             if uf.shape != t.shape or not np.all(np.isfinite(uf)):
                 raise ValueError("the feedforward force must give one finite value per time")
             uh = np.ascontiguousarray(uh + uf)
-        e, dev, w, iters = _run(*self.disc_w, r, e_lin, np.ascontiguousarray(lin[:, 1]), uh,
-                                step, self.codes, self.params, self.x_w, self.s, self.s_prev,
-                                self.scalars, i0, GL_T, GL_W, 1e-14 * self.f_scale,
-                                MAX_FIXED_POINT_ITERATIONS)
+        # the link between the linear response to r'' and the link force (the engine's
+        # closed-loop convention); the first sample is a step of length 0 from rest
+        r_prev = r[0] if self.r_prev is None else self.r_prev
+        dr = np.ascontiguousarray(np.diff(r, prepend=r_prev))
+        nodes = np.concatenate([[self.uh_prev], uh])
+        Y, _, w, _, iters, done = run_steps(
+            self.steps, self.C, self.D, 1, self.stepping, nodes, self.state,
+            convention=CLOSED, ftol=1e-14 * self.f_scale, dexo=dr,
+            exo=np.ascontiguousarray(lin), i_first=1)
         if iters > MAX_FIXED_POINT_ITERATIONS:
             raise RuntimeError(
-                f"the implicit step at t = {(i0 + len(e)) * step:.6g} s did not converge in "
+                f"the implicit step at t = {(i0 + done) * step:.6g} s did not converge in "
                 f"{MAX_FIXED_POINT_ITERATIONS} iterations: the link is too stiff (or too "
                 "strongly damped) for dt; use a smaller dt")
+        self.r_prev = float(r[-1]) if len(r) else self.r_prev
+        self.uh_prev = float(uh[-1]) if len(uh) else self.uh_prev
+        e = Y[:, 0]
+        dev = Y[:, 1]
         y1 = r + dev
         y2 = r - e
         # feedback force C e, the input linear between samples (as control.forced_response)
