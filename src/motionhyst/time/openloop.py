@@ -65,21 +65,20 @@ from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.hysteresis.stepping import (
-    COULOMB,
     DIFFERENTIATED,
-    GL_T,
-    GL_W,
     N_PARAMS,
-    N_PARTIALS,
     Stepping,
-    advance,
-    advance_partials,
-    coulomb_implicit,
 )
 from motionhyst.plants.mass_spring_damper import MassSpringDamper
 from motionhyst.plants.mechanics import Mechanics
 from motionhyst.plants.two_mass import TwoMassStage
-from motionhyst.time.simulation import MAX_FIXED_POINT_ITERATIONS
+from motionhyst.time.engine import (
+    MAX_FIXED_POINT_ITERATIONS,
+    OPEN,
+    FohStep,
+    LoopState,
+    run_steps,
+)
 
 #: Names of the general Bouc-Wen parameters the compiled integrator carries (sensitivity order).
 BW_PARAMETERS = ("m", "c", "k", "alpha", "beta_gamma", "beta_delta", "nu")
@@ -344,211 +343,6 @@ def _rk4_run(uf, h, r, mass, C, K, dmass, dC, dK, li, lo, lp, x0, s0, sens
                 for j in range(nc):
                     sy[o, j] = s[lo, j]
     return y, sy, x, s
-
-
-# ----------------------------------------------------------------- other links: FOH + exact update
-@njit("(float64[:, ::1], float64[::1], float64[::1], float64[:, :, ::1], float64[:, ::1], "
-      "float64[:, ::1], int64, int64, float64[::1], int64, int64[::1], float64[:, ::1], "
-      "float64[:, :, ::1], float64[::1], float64[::1], float64, float64, int64, float64[::1], "
-      "float64[::1], float64[:, ::1], float64[:, ::1])", nogil=True)
-def _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, li, lo, uf, r, codes, params, dparams, glt, glw,
-                  h, ftol, max_iter, x0, s0, sx0, ss0):  # pragma: no cover - compiled
-    """The plant over the fine steps (FOH, state ``x = (q, q')``, force and link on
-    ``q[li]``), the link's elements advanced exactly; outputs ``q[lo]`` every `r` steps.
-
-    The step's link force is the fixed point ``w = W(dx(w))``, ``dx = base - B1[li] w -
-    q[li]``.  Forward sensitivities in ``P = sx0.shape[1]`` parameters, the plant's
-    first (``dAd, dB0, dB1``: ``Mechanics.foh``'s derivatives in them), then the link's
-    (``dparams[j, l, b]``: element ``j``'s row entry ``l`` in the link's parameter ``b``),
-    are carried only for ``P > 0`` (``P = 0``: empty ``sx0, ss0`` and derivative arrays,
-    the simulation alone).  Each step's are those of the element updates (then advanced
-    by :func:`~motionhyst.hysteresis.stepping.advance_partials`: the states and forces
-    of ``advance``, bit for bit, and their partials, taken at the fixed point's last
-    pass) and of the implicit link force, ``dw = (dW_rest + W_dx dbase) / (1 + W_dx
-    B1[li])``.
-
-    Returns the output and its sensitivities at the samples, the final states ``x, s``
-    and sensitivities ``sx`` (2n, P), ``ss`` (elements, P), and the largest number of
-    fixed-point passes of a step.
-    """
-    n_steps = uf.shape[0] - 1
-    n_out = n_steps // r + 1
-    m = codes.shape[0]
-    ns = x0.shape[0]
-    P = sx0.shape[1]
-    npl = dAd.shape[0]
-    sens = P > 0
-    y = np.empty(n_out)
-    sy = np.zeros((n_out, P))
-    x = x0.copy()
-    xn = x0.copy()
-    s = s0.copy()
-    s_prev = s0.copy()
-    s_new = s0.copy()
-    sx = sx0.copy()
-    sxn = sx0.copy()
-    ss = ss0.copy()
-    ss_prev = ss0.copy()
-    ss_new = ss0.copy()
-    dw_prev = np.zeros(P)
-    ddx_prev = np.zeros(P)
-    dw = np.zeros(P)
-    ddx = np.zeros(P)
-    pds = np.zeros((m, N_PARTIALS))
-    pdf = np.zeros((m, N_PARTIALS))
-    w_prev = 0.0
-    for j in range(m):
-        if not sens:
-            w_prev += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
-        else:
-            w_prev += advance_partials(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True,
-                                       pds[j], pdf[j])[1]
-            for b in range(P):
-                dw_prev[b] += (pdf[j, 0] + pdf[j, 1]) * ss[j, b]
-            for b in range(npl, P):
-                for lp in range(N_PARAMS):
-                    dw_prev[b] += pdf[j, 4 + lp] * dparams[j, lp, b - npl]
-    y[0] = x[lo]
-    for b in range(P):
-        sy[0, b] = sx[lo, b]
-    dx_prev = 0.0
-    worst = 0
-    rigid = m == 1 and codes[0] == COULOMB  # a lone rigid slider: the step in closed form
-    iv = ns // 2 + li  # its velocity's index in x
-    for i in range(n_steps):
-        # q_li at the step's end = base + B1[li] * (-w_{i+1})
-        f0 = uf[i] - w_prev
-        base_y = Ad[li, 0] * x[0]
-        for b in range(1, ns):
-            base_y += Ad[li, b] * x[b]
-        base_y = base_y + B0[li] * f0 + B1[li] * uf[i + 1]
-        wt = w_prev
-        it = 0
-        change = math.inf
-        v_end = 0.0
-        if rigid:  # the velocity at the step's end without the link force, then with it
-            a_v = Ad[iv, 0] * x[0]
-            for b in range(1, ns):
-                a_v += Ad[iv, b] * x[b]
-            a_v = a_v + B0[iv] * f0 + B1[iv] * uf[i + 1]
-            wt, v_end = coulomb_implicit(params[0], a_v, B1[iv])
-            s_new[0] = wt
-            it = 1
-        while not rigid:
-            it += 1
-            dx = base_y - B1[li] * wt - x[li]
-            wn = 0.0
-            if not sens:
-                for j in range(m):
-                    s_new[j], fj = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev,
-                                            h, i == 0, glt, glw)
-                    wn += fj
-            else:  # the same states and forces, and their partials
-                for j in range(m):
-                    s_new[j], fj = advance_partials(codes[j], params[j], s[j], s_prev[j], dx,
-                                                    dx_prev, h, i == 0, pds[j], pdf[j])
-                    wn += fj
-            # converged, or stalled at the rounding floor (a contraction's changes stop
-            # falling only there: rate terms such as LuGre's sigma1 z' amplify the rounding
-            # of dx by ~ sigma1 / h)
-            last = change
-            change = abs(wn - wt)
-            done = change <= ftol or m == 0 or (change <= 1e3 * ftol and change >= last)
-            wt = wn
-            if done or it > max_iter:
-                break
-        if it > worst:
-            worst = it
-        dx = base_y - B1[li] * wt - x[li]
-        f1 = uf[i + 1] - wt
-        if sens:  # the partials of the last pass (at the converged point to rounding)
-            w_dx = 0.0
-            for j in range(m):
-                w_dx += pdf[j, 2]
-            # the plant's step in the sensitivities but for this step's link force:
-            # Ad sx - B0 dw_prev, and dAd x + dB0 f0 + dB1 f1 in the plant's parameters
-            for a in range(ns):
-                for b in range(P):
-                    sxn[a, b] = -B0[a] * dw_prev[b]
-                for c in range(ns):
-                    adc = Ad[a, c]
-                    for b in range(P):
-                        sxn[a, b] += adc * sx[c, b]
-                for b in range(npl):
-                    t = dB0[b, a] * f0 + dB1[b, a] * f1
-                    for c in range(ns):
-                        t += dAd[b, a, c] * x[c]
-                    sxn[a, b] += t
-            # the link force's change: the elements' partials in their states, their
-            # previous displacement and their parameters, then through dx (implicit)
-            for b in range(P):
-                dw[b] = 0.0
-            for j in range(m):
-                c0, c1, c3 = pdf[j, 0], pdf[j, 1], pdf[j, 3]
-                for b in range(P):
-                    dw[b] += c0 * ss[j, b] + c1 * ss_prev[j, b] + c3 * ddx_prev[b]
-                for lp in range(N_PARAMS):
-                    cp = pdf[j, 4 + lp]
-                    if cp != 0.0:
-                        for b in range(npl, P):
-                            dw[b] += cp * dparams[j, lp, b - npl]
-            for b in range(P):
-                dbase = sxn[li, b] - sx[li, b]  # of dx = base - B1[li] w - q[li]
-                if rigid:  # from v_end = a - B1[iv] w (the velocity's own step)
-                    da = sxn[iv, b]
-                    if v_end == 0.0:  # stuck: v_end = 0 whatever the parameters
-                        dw[b] = da / B1[iv]
-                    else:
-                        lp, cv = (0, params[0, 2]) if v_end > 0.0 else (1, params[0, 3])
-                        dpar = 0.0
-                        if b >= npl:
-                            dpar = (dparams[0, lp, b - npl] * (1.0 if lp == 0 else -1.0)
-                                    + dparams[0, lp + 2, b - npl] * v_end)
-                        dw[b] = (dpar + cv * da) / (1.0 + cv * B1[iv])
-                else:
-                    dw[b] = (dw[b] + w_dx * dbase) / (1.0 + w_dx * B1[li])
-                ddx[b] = dbase - B1[li] * dw[b]
-            for a in range(ns):
-                for b in range(P):
-                    sxn[a, b] -= B1[a] * dw[b]
-            for j in range(m):
-                c0, c1, c2, c3 = pds[j, 0], pds[j, 1], pds[j, 2], pds[j, 3]
-                for b in range(P):
-                    ss_new[j, b] = (c0 * ss[j, b] + c1 * ss_prev[j, b] + c2 * ddx[b]
-                                    + c3 * ddx_prev[b])
-                for lp in range(N_PARAMS):
-                    cp = pds[j, 4 + lp]
-                    if cp != 0.0:
-                        for b in range(npl, P):
-                            ss_new[j, b] += cp * dparams[j, lp, b - npl]
-            for a in range(ns):
-                for b in range(P):
-                    sx[a, b] = sxn[a, b]
-            for j in range(m):
-                for b in range(P):
-                    ss_prev[j, b] = ss[j, b]
-                    ss[j, b] = ss_new[j, b]
-            for b in range(P):
-                dw_prev[b] = dw[b]
-                ddx_prev[b] = ddx[b]
-        for a in range(ns):
-            acc = Ad[a, 0] * x[0]
-            for b in range(1, ns):
-                acc += Ad[a, b] * x[b]
-            xn[a] = acc + B0[a] * f0 + B1[a] * f1
-        for a in range(ns):
-            x[a] = xn[a]
-        for j in range(m):
-            s_prev[j] = s[j]
-            s[j] = s_new[j]
-        w_prev = wt
-        dx_prev = dx
-        if (i + 1) % r == 0:
-            o = (i + 1) // r
-            y[o] = x[lo]
-            for b in range(P):
-                sy[o, b] = sx[lo, b]
-    return y, sy, x, s, sx, ss, worst
 
 
 # ----------------------------------------------------------------- the system
@@ -1029,16 +823,21 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
                               else fine_input(u, r, periodic), dtype=float)
     if mech.force_offset:  # the plant's constant force offset adds to the force
         uf = uf + mech.force_offset
-    codes = np.ascontiguousarray(stepping.codes, dtype=np.int64)
-    params = np.ascontiguousarray(stepping.params, dtype=float)
     ftol = 1e-13 * stepping.scale
 
+    steps = [FohStep(Ad, B0, B1, h, dAd, dB0, dB1)]
+    C = np.zeros((2, ns))  # the output, then the link's displacement
+    C[0, mech.output] = 1.0
+    C[1, mech.link] = 1.0
+
     def run(x, s, sx, ss):
-        *out, worst = _foh_link_run(Ad, B0, B1, dAd, dB0, dB1, mech.link, mech.output, uf, r,
-                                    codes, params, dp, GL_T, GL_W, h, ftol,
-                                    MAX_FIXED_POINT_ITERATIONS, x, s, sx, ss)
+        # each period starts afresh from the state the previous one left
+        state = LoopState(x, s, sx, ss)
+        Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(2), 1, stepping, uf, state,
+                                          convention=OPEN, ftol=ftol, record_every=r,
+                                          record_initial=True, dparams=dp if sens else None)
         _check_converged(worst)
-        return out
+        return Y[:, 0], SY[:, 0, :], state.z, state.s, state.sx, state.ss
 
     x, s = np.zeros(ns), np.array(stepping.state0, dtype=float)
     sx, ss = np.zeros((ns, n_sens)), np.zeros((n_el, n_sens))
