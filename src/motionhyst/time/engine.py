@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import expm_small
 from motionhyst.hysteresis.stepping import (
+    COULOMB,
     GL_T,
     GL_W,
     N_PARAMS,
@@ -62,6 +63,7 @@ from motionhyst.hysteresis.stepping import (
     Stepping,
     advance,
     advance_partials,
+    coulomb_implicit,
 )
 
 __all__ = [
@@ -85,7 +87,7 @@ CLOSED, OPEN = 0, 1
 
 _SIGNATURE = (
     "(float64[:, :, ::1], float64[:, ::1], float64[:, ::1], float64[:, ::1], float64[:, ::1], "
-    "float64[::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], int64, "
+    "float64[::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], int64, int64, "
     "float64[::1], float64[::1], float64[:, ::1], int64, boolean, "
     "int64[::1], float64[:, ::1], float64[:, :, ::1], float64[::1], float64[::1], float64, "
     "int64, int64, int64, int64, boolean, "
@@ -96,7 +98,7 @@ _SIGNATURE = (
 
 
 @njit(_SIGNATURE, nogil=True)
-def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, a, dexo, exo, record_every,
+def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo, record_every,
               record_initial, codes, params, dparams, glt, glw, ftol, max_iter, convention, i0,
               i_first, fresh, Ac, Bc, Cc, Dc, ref, ff, u_max, period, r1, meas_row, n_delay,
               z, s, s_prev, sx, ss, ss_prev, dvec, out_prev, scal, xc, uq
@@ -109,7 +111,10 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, a, dexo, exo, record_
         zp = A z + B0 f_old,   z_new = zp + B1 f_new,   y = C zp + G f_new (+ exo)
 
     with ``G = C B1 + D``; ``f = a + u - w`` at the step's two ends.  The link's
-    displacement increment is ``dexo[i] + y[link_row] - y_prev[link_row]``.
+    displacement increment is ``dexo[i] + y[link_row] - y_prev[link_row]``.  A lone
+    rigid slider (``COULOMB``) with its velocity an output (`vel_row` >= 0, ``OPEN``)
+    is solved at the velocity level in closed form
+    (:func:`~motionhyst.hysteresis.stepping.coulomb_implicit`) instead of iterated.
 
     Two conventions of the implicit step, each that of the path it came from (their
     numbers unchanged): ``CLOSED`` (the closed loop's: the linear part's state before
@@ -215,6 +220,8 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, a, dexo, exo, record_
         W[0] = w_prev
     worst = 0
     u_app = 0.0
+    rigid = vel_row >= 0 and m == 1 and codes[0] == COULOMB  # the step in closed form
+    v_end = 0.0
     for i in range(n_steps):
         gi = i0 + i
         kind = 0
@@ -298,7 +305,15 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, a, dexo, exo, record_
         else:
             base = pre + gl * a_new
             change = math.inf
-            while True:
+            if rigid:  # the velocity at the step's end without the link force, then with it
+                a_v = 0.0
+                for q in range(n):
+                    a_v += C[vel_row, q] * zp[q]
+                a_v = a_v + G[kind, vel_row] * a_new
+                wt, v_end = coulomb_implicit(params[0], a_v, G[kind, vel_row])
+                s_new[0] = wt
+                it = 1
+            while not rigid:
                 it += 1
                 dx = dr + (base - gl * wt - out_prev[link_row])
                 wn = 0.0
@@ -364,7 +379,22 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, a, dexo, exo, record_
                 for q in range(n):
                     acc += C[link_row, q] * sxn[q, b]
                 dbase = acc - dout_prev[b]  # of the displacement but for this step's dw
-                dw[b] = (dw[b] + w_dx * dbase) / (1.0 + w_dx * gl)
+                if rigid:  # from v_end = a - G_v w (the velocity's own step)
+                    gv = G[kind, vel_row]
+                    da = 0.0
+                    for q in range(n):
+                        da += C[vel_row, q] * sxn[q, b]
+                    if v_end == 0.0:  # stuck: v_end = 0 whatever the parameters
+                        dw[b] = da / gv
+                    else:
+                        lp, cv = (0, params[0, 2]) if v_end > 0.0 else (1, params[0, 3])
+                        dpar = 0.0
+                        if b >= npl:
+                            dpar = (dparams[0, lp, b - npl] * (1.0 if lp == 0 else -1.0)
+                                    + dparams[0, lp + 2, b - npl] * v_end)
+                        dw[b] = (dpar + cv * da) / (1.0 + cv * gv)
+                else:
+                    dw[b] = (dw[b] + w_dx * dbase) / (1.0 + w_dx * gl)
                 ddx[b] = dbase - gl * dw[b]
             for q in range(n):
                 for b in range(P):
@@ -557,6 +587,7 @@ _EMPTY_CONTROLLER = (np.zeros((0, 0)), np.zeros((0, 2)), np.zeros(0), np.zeros(2
 
 def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
               stepping: Stepping, a: NDArray[np.float64], state: LoopState, *,
+              vel_row: int = -1,
               convention: int, ftol: float, dexo: NDArray[np.float64] | None = None,
               exo: NDArray[np.float64] | None = None, record_every: int = 1,
               record_initial: bool = False, i_first: int = 0,
@@ -574,6 +605,9 @@ def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
         The outputs ``y = C z + D f``.
     link_row : int
         The output that is the link's displacement (with `dexo`).
+    vel_row : int
+        The output that is the link's velocity (-1: none); with it a lone rigid
+        slider's step is solved in closed form.
     stepping : Stepping
         The link's elements (empty: no link).
     a : ndarray
@@ -623,7 +657,7 @@ def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
     ctrl = _EMPTY_CONTROLLER if controller is None else controller
     Ac, Bc, Cc, Dc, ref, ff, u_max, period, r1, meas_row, n_delay = ctrl
     Y, SY, W, U, worst, done = step_loop(
-        A, B0, B1, C, G, hs, dA, dB0, dB1, int(link_row),
+        A, B0, B1, C, G, hs, dA, dB0, dB1, int(link_row), int(vel_row),
         np.ascontiguousarray(a, dtype=float),
         np.zeros(0) if dexo is None else np.ascontiguousarray(dexo, dtype=float),
         np.zeros((0, C.shape[0])) if exo is None else np.ascontiguousarray(exo, dtype=float),
@@ -837,9 +871,10 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
         r1 = 0
         steps = [FohStep.exact(A, B, T / R)]
     ns = A.shape[0]
-    Cout = np.zeros((2, ns))
+    Cout = np.zeros((3, ns))  # the measured output, the link's displacement and velocity
     Cout[0, mech.output] = 1.0
     Cout[1, mech.link] = 1.0
+    Cout[2, ns // 2 + mech.link] = 1.0
     state = LoopState.at_rest(ns, stepping, nc=Ac.shape[0], n_queue=n_delay + 2)
     if x0 is not None:
         z0 = np.ravel(np.asarray(x0, dtype=float))
@@ -850,7 +885,7 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
     # a constant force on the plant (its force offset), beside the held controller force
     a = np.full(n_k * R + 1, float(getattr(mech, "force_offset", 0.0)))
     Y, _, W, U, worst, done = run_steps(
-        steps, Cout, np.zeros(2), 1, stepping, a, state, convention=OPEN,
+        steps, Cout, np.zeros(3), 1, stepping, a, state, vel_row=2, convention=OPEN,
         ftol=1e-13 * stepping.scale, record_every=R, record_initial=True, controller=ctrl)
     if worst > MAX_FIXED_POINT_ITERATIONS:
         raise RuntimeError(f"the link's implicit step at t = {done / R * T:.6g} s did not "

@@ -826,15 +826,17 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     ftol = 1e-13 * stepping.scale
 
     steps = [FohStep(Ad, B0, B1, h, dAd, dB0, dB1)]
-    C = np.zeros((2, ns))  # the output, then the link's displacement
+    C = np.zeros((3, ns))  # the output, then the link's displacement and velocity
     C[0, mech.output] = 1.0
     C[1, mech.link] = 1.0
+    C[2, ns // 2 + mech.link] = 1.0
 
     def run(x, s, sx, ss):
         # each period starts afresh from the state the previous one left
         state = LoopState(x, s, sx, ss)
-        Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(2), 1, stepping, uf, state,
-                                          convention=OPEN, ftol=ftol, record_every=r,
+        Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(3), 1, stepping, uf, state,
+                                          vel_row=2, convention=OPEN, ftol=ftol,
+                                          record_every=r,
                                           record_initial=True, dparams=dp if sens else None)
         _check_converged(worst)
         return Y[:, 0], SY[:, 0, :], state.z, state.s, state.sx, state.ss
