@@ -26,11 +26,11 @@ import numpy as np
 from motionhyst.hysteresis import Jenkins
 from motionhyst.hysteresis.stepping import N_PARAMS
 from motionhyst.loop import Loop
-from motionhyst.openloop import MassSpringDamper, TwoMass, simulate_elements
-from motionhyst.references import SineReference
 from motionhyst.scenario import default_scenario
-from motionhyst.simulate import simulate
 from motionhyst.time.engine import DiscreteController, run_sampled
+from motionhyst.time.openloop import MassSpringDamper, TwoMass, simulate_elements
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 DURATION = 0.5  # s
 REPEATS = 7

@@ -14,14 +14,14 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
+from motionhyst.controllers.leadlag import LeadLagLowpass
 from motionhyst.hysteresis import Jenkins
 from motionhyst.loop import Loop
-from motionhyst.openloop import TwoMass
-from motionhyst.references import SineReference
 from motionhyst.scenario import default_scenario
-from motionhyst.simulate import simulate
-from motionhyst.systems import LeadLagLowpass
 from motionhyst.time.engine import DiscreteController, run_sampled
+from motionhyst.time.openloop import TwoMass
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 T = 1e-4  # 10 kHz
 PLANT = TwoMass(m1=5.0, m2=17.5, b=90.0, k=7.4e7)  # Table I

@@ -639,6 +639,8 @@ def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
     """
     C = np.ascontiguousarray(np.atleast_2d(C), dtype=float)
     D = np.ravel(np.asarray(D, dtype=float))
+    if convention == OPEN and np.any(D != 0.0):
+        raise ValueError("the plant's convention records C z: its outputs have no feedthrough")
     kinds = steps if len(steps) == 2 else [steps[0], steps[0]]
     A = np.ascontiguousarray(np.stack([s.A for s in kinds]))
     B0 = np.ascontiguousarray(np.stack([s.B0 for s in kinds]))
@@ -743,7 +745,7 @@ class SampledRun:
 
 
 #: Fine steps per controller period at least (room for a fractional delay's split), and per
-#: period of the plant's fastest mode (as :data:`motionhyst.simulate.STEPS_PER_POLE_PERIOD`
+#: period of the plant's fastest mode (as :data:`motionhyst.time.simulation.STEPS_PER_POLE_PERIOD`
 #: per period of the continuous loop's fastest pole).
 MIN_SUBSTEPS = 2
 STEPS_PER_MODE_PERIOD = 40
