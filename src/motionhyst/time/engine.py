@@ -541,6 +541,13 @@ class LoopState:
         True before the first call: the start is ``z``, ``s`` (and ``sx``, ``ss``).
     i0 : int
         Steps run so far.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> st = LoopState.at_rest(4, Jenkins(k=20.0, fc=0.05).time_stepping(), parameters=2)
+    >>> st.z.shape, st.s.shape, st.sx.shape, st.fresh
+    ((4,), (1,), (4, 2), True)
     """
 
     z: NDArray[np.float64]
@@ -636,6 +643,25 @@ def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
         The most fixed-point passes a step took.
     done : int
         Steps run (fewer than asked if a step did not converge).
+
+    Examples
+    --------
+    A mass on a spring (``k = 1e4 N/m``) held by a Jenkins link, a force of 5 N from
+    rest: it overshoots, the link slips both ways, and the stage comes to rest where
+    the spring and the link carry the force together.
+
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.time.openloop import MassSpringDamper
+    >>> A, B = MassSpringDamper(1.0, 20.0, 1e4).mechanics().state_space()
+    >>> link = Jenkins(k=1e4, fc=1.0).time_stepping()
+    >>> state = LoopState.at_rest(2, link)
+    >>> Y, _, W, _, worst, done = run_steps(
+    ...     [FohStep.exact(A, B, 1e-4)], [[1.0, 0.0]], [0.0], 0, link, np.full(20001, 5.0),
+    ...     state, convention=OPEN, ftol=1e-13, record_every=100, record_initial=True)
+    >>> Y.shape, done
+    ((201, 1), 20000)
+    >>> print(f"{1e4 * Y[-1, 0] + W[-1]:.6f} N")   # k y + w = 5 N at rest
+    5.000000 N
     """
     C = np.ascontiguousarray(np.atleast_2d(C), dtype=float)
     D = np.ravel(np.asarray(D, dtype=float))
@@ -733,6 +759,18 @@ class SampledRun:
         The link's displacement at ``t_k`` [m].
     w : ndarray
         The link force at ``t_k`` [N].
+
+    Examples
+    --------
+    A proportional controller ``u = 5e3 (r - y)`` on a spring of ``1e4 N/m``: the
+    error rings down towards ``k / (k + 5e3) = 2/3`` of the step.
+
+    >>> from motionhyst.time.openloop import MassSpringDamper
+    >>> ctrl = DiscreteController(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros(0),
+    ...                           [5e3, -5e3], 1e-3)
+    >>> run = run_sampled(MassSpringDamper(1.0, 20.0, 1e4), None, ctrl, np.ones(500))
+    >>> run.t.size, float(run.e[0]), round(float(run.e[-1]), 4)
+    (500, 1.0, 0.665)
     """
 
     t: NDArray[np.float64]
