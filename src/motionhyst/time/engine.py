@@ -473,6 +473,17 @@ class FohStep:
     step; ``dA, dB0, dB1`` are the derivatives in the linear part's parameters (first
     axis; empty: none).
 
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+        State transition over the step.
+    B0, B1 : array_like, shape (n,)
+        Input matrices of the input at the start and at the end of the step.
+    h : float
+        The step [s].
+    dA, dB0, dB1 : ndarray, optional
+        Their derivatives in the linear part's parameters (first axis), none by default.
+
     Examples
     --------
     >>> step = FohStep.exact([[0.0, 1.0], [-1e4, -20.0]], [0.0, 1.0], 1e-3)  # 1/(s^2+20s+1e4)
@@ -504,7 +515,21 @@ class FohStep:
     @classmethod
     def exact(cls, A: ArrayLike, B: ArrayLike, h: float) -> FohStep:
         """The continuous ``x' = A x + B f`` over a step `h`, from the exponential of
-        ``[[A h, B h, 0], [0, 0, 1], [0, 0, 0]]`` (:func:`~motionhyst.lti.expm_small`)."""
+        ``[[A h, B h, 0], [0, 0, 1], [0, 0, 0]]`` (:func:`~motionhyst.core.lti.expm_small`).
+
+        Parameters
+        ----------
+        A : array_like, shape (n, n)
+            The continuous system matrix.
+        B : array_like, shape (n,)
+            Its input vector.
+        h : float
+            The step [s].
+
+        Returns
+        -------
+        FohStep
+        """
         A = np.asarray(A, dtype=float)
         B = np.ravel(np.asarray(B, dtype=float))
         ns = A.shape[0]
@@ -520,6 +545,19 @@ class FohStep:
 @dataclass
 class LoopState:
     """The state :func:`step_loop` carries from one call to the next (a run in pieces).
+
+    Parameters
+    ----------
+    z : array_like
+        The linear part's state at the start.
+    s : array_like
+        The link elements' states at the start.
+    sx, ss : array_like
+        Sensitivities of ``z`` and ``s`` (columns: parameters).
+    nc : int
+        Number of states of a sampled controller (0: none).
+    n_queue : int
+        Length of the queue of controller outputs (the delay in whole samples, plus one).
 
     Attributes
     ----------
@@ -582,7 +620,25 @@ class LoopState:
     @classmethod
     def at_rest(cls, n: int, stepping: Stepping, parameters: int = 0, nc: int = 0,
                 n_queue: int = 1) -> LoopState:
-        """The linear part (`n` states) and the link at rest, `parameters` sensitivities."""
+        """The linear part (`n` states) and the link at rest, `parameters` sensitivities.
+
+        Parameters
+        ----------
+        n : int
+            Number of states of the linear part.
+        stepping : Stepping
+            The link's time stepping (its elements' initial states).
+        parameters : int
+            Number of sensitivities carried.
+        nc : int
+            Number of states of a sampled controller.
+        n_queue : int
+            Length of the queue of controller outputs.
+
+        Returns
+        -------
+        LoopState
+        """
         m = stepping.codes.size
         return cls(np.zeros(n), np.array(stepping.state0, dtype=float),
                    np.zeros((n, parameters)), np.zeros((m, parameters)), nc, n_queue)
