@@ -10,6 +10,10 @@ CPU time of this process over ``REPEATS`` runs):
 2. ``steady``: one exact periodic steady-state point at 10 Hz (the hybrid
    loop's with the aliasing of 1000 samples a period, against the continuous
    loop's); reported, no target.
+3. ``simulation``: :func:`motionhyst.simulate` of 1 s from rest at 10 Hz (the
+   run with the link and the one without it, as the summary reports both),
+   per controller sample against the continuous loop's per integration step:
+   target ratio <= 1.
 
 Run with ``make bench`` or ``python benchmarks/sampled.py [--json]``.
 """
@@ -24,13 +28,14 @@ import time
 
 import numpy as np
 
-from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage, analyze
+from motionhyst import Jenkins, LeadLagLowpass, Loop, SineReference, TwoMassStage, analyze, simulate
 from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.sampled import SampledController
 
 REPEATS = 21
-TARGETS = {"analysis": 2.0}
+SIM_REPEATS = 5
+TARGETS = {"analysis": 2.0, "simulation": 1.0}
 
 
 def loops() -> tuple[Loop, Loop]:
@@ -66,6 +71,17 @@ def measure(repeats: int = REPEATS) -> dict:
         med = {k: statistics.median(v) for k, v in times.items()}
         out[name] = {**med, "ratio": med["sampled"] / med["continuous"],
                      "target": TARGETS.get(name)}
+    ref = SineReference(0.01, 10.0)
+    runs = {"continuous": simulate(cont, ref, 1.0), "sampled": simulate(samp, ref, 1.0)}
+    steps = {k: v.t.size for k, v in runs.items()}
+    times = {"continuous": [], "sampled": []}
+    for _ in range(SIM_REPEATS):
+        times["continuous"].append(_cpu(lambda: simulate(cont, ref, 1.0)))
+        times["sampled"].append(_cpu(lambda: simulate(samp, ref, 1.0)))
+    per = {k: statistics.median(v) / steps[k] for k, v in times.items()}
+    out["simulation"] = {**per, "ratio": per["sampled"] / per["continuous"],
+                         "target": TARGETS["simulation"], "steps": steps,
+                         "unit": "s per integration step (continuous) / controller sample"}
     return out
 
 
@@ -84,6 +100,11 @@ def main() -> None:
     for name, r in res.items():
         target = "" if r["target"] is None else (
             f"  target <= {r['target']:g}x: {'met' if r['ratio'] <= r['target'] else 'MISSED'}")
+        if name == "simulation":
+            print(f"  {name:<9} continuous {r['continuous'] * 1e6:8.2f} us a step ("
+                  f"{r['steps']['continuous']} steps), sampled {r['sampled'] * 1e6:8.2f} us a "
+                  f"sample ({r['steps']['sampled']} samples)   ratio {r['ratio']:.2f}x{target}")
+            continue
         print(f"  {name:<9} continuous {r['continuous'] * 1e3:8.2f} ms   sampled "
               f"{r['sampled'] * 1e3:8.2f} ms   ratio {r['ratio']:.2f}x{target}")
 

@@ -369,6 +369,25 @@ class SampledParts:
         _, _, Y, _, _, Gd = self._parts(w)
         return Y * Gd
 
+    def process_sensitivity(self, w: ArrayLike) -> NDArray[np.complex128]:
+        """``G_d / (1 + Y G_d)``: the output's samples per unit force added to ``u_k``.
+
+        The discrete process sensitivity, from a force added to the controller's
+        output samples to the measured output's samples (``1 / Y(1)`` at ``w = 0``
+        for a plant with integrators).
+
+        Parameters
+        ----------
+        w : array_like
+            Angular frequencies [rad/s], up to the Nyquist frequency.
+        """
+        w = np.asarray(w, dtype=float)
+        Y = self.c.feedback_response(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Gd = self.zoh(w)
+            out = Gd / (1.0 + Y * Gd)
+        return np.where(~np.isfinite(Gd), 1.0 / Y, out)
+
     def transfer(self, name: str, w: ArrayLike) -> NDArray[np.complex128]:
         """The fundamental response `name` (see :meth:`Loop.transfer`).
 

@@ -83,7 +83,10 @@ class ILCFilters:
     def learning(self, loop: Loop, f_hz) -> NDArray[np.complex128]:
         """``L(f) = gain / PS(j 2 pi f)`` with ``PS = P2 / (1 + C P2)`` of `loop`.
 
-        Where ``PS`` vanishes (a controller with an integrator at DC) ``L`` is 0.
+        For a sampled controller the learning runs at its rate on the error's
+        samples, the force added to its output: ``PS = G_d / (1 + Y G_d)`` at
+        ``z = e^{j 2 pi f T}``.  Where ``PS`` vanishes (a controller with an
+        integrator at DC) ``L`` is 0.
 
         Parameters
         ----------
@@ -92,7 +95,11 @@ class ILCFilters:
         f_hz : array_like
             Frequencies [Hz].
         """
-        ps = loop.transfer("w->e", TWO_PI * np.asarray(f_hz, dtype=float))
+        w = TWO_PI * np.asarray(f_hz, dtype=float)
+        if loop.sampled is not None:  # at the controller's samples: G_d / (1 + Y G_d)
+            ps = loop.sampled_parts.process_sensitivity(w)
+        else:
+            ps = loop.transfer("w->e", w)
         out = np.zeros(ps.shape, dtype=complex)
         ok = np.abs(ps) > 0
         out[ok] = self.gain / ps[ok]
@@ -266,7 +273,12 @@ def learn(loop: Loop, reference, duration: float, trials: int = 10,
     if not (isinstance(trials, int) and trials >= 1):
         raise ValueError(f"the number of ILC trials must be a whole number >= 1, got {trials!r}")
     filters = ILCFilters() if filters is None else filters
-    if dt is None:
+    if loop.sampled is not None:  # the trials at the controller's rate
+        if dt is not None and abs(dt - loop.sampled.period) > 1e-9 * loop.sampled.period:
+            raise ValueError(f"a sampled loop learns at its controller's period "
+                             f"{loop.sampled.period:g} s, not dt = {dt:g} s")
+        dt = loop.sampled.period
+    elif dt is None:
         dt = default_step(loop, getattr(reference, "max_frequency_hz", 1.0))
     sim = first if first is not None else simulate(loop, reference, duration, dt)
     t = sim.t

@@ -375,8 +375,8 @@ class ScanResult:
 def _without_hysteresis_feedforward(loop: Loop) -> Loop:
     if loop.hysteresis_feedforward is None:
         return loop
-    return Loop(loop.plant, loop.controller, loop.hysteresis, feedforward=loop.feedforward,
-                mass=loop.M)
+    return Loop(loop.plant, loop.controller, loop.hysteresis,
+                feedforward=loop.ff if loop.ff is not None else None, mass=loop.M)
 
 
 def run_scan(loop: Loop, profile: Profile, window: float,

@@ -168,7 +168,12 @@ def _elements(h: Hysteresis | None) -> tuple[NDArray[np.int64], NDArray[np.float
 
 
 def default_step(loop: Loop, max_frequency_hz: float) -> float:
-    """Time step [s] resolving the loop's fastest pole and the reference."""
+    """Time step [s] resolving the loop's fastest pole and the reference.
+
+    A loop with a sampled controller runs at its controller's period.
+    """
+    if loop.sampled is not None:
+        return loop.sampled.period
     p = float(np.max(np.abs(loop.closed_loop_poles())))
     return float(min(TWO_PI / (STEPS_PER_POLE_PERIOD * p),
                      1.0 / (STEPS_PER_REFERENCE_PERIOD * max_frequency_hz)))
@@ -193,7 +198,9 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     loop : Loop
         An LTI loop whose plant has a rigid-body double integrator; its link
         and hysteresis feedforward (if any) one of Jenkins, MaxwellSlip, Dahl,
-        BoucWen, LuGre.
+        BoucWen, LuGre.  With a sampled controller the run is that of the
+        hybrid loop at the controller's samples
+        (:func:`motionhyst.time.sampled.simulate_sampled`; `dt` is its period).
     reference : callable
         ``reference(t) -> (r, r'')``, e.g. the classes of :mod:`motionhyst.time.references`.
     duration : float
@@ -234,6 +241,13 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
+    if loop.sampled is not None:
+        from motionhyst.time.sampled import simulate_sampled
+
+        if dt is not None and abs(dt - loop.sampled.period) > 1e-9 * loop.sampled.period:
+            raise ValueError(f"a sampled loop runs at its controller's period "
+                             f"{loop.sampled.period:g} s, not dt = {dt:g} s")
+        return simulate_sampled(loop, reference, duration, force=force)
     _check_feedforward(loop)
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
@@ -291,6 +305,12 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
     if int(chunk) < 1:
         raise ValueError("chunk must be >= 1")
+    if loop.sampled is not None:  # one run at the controller's samples, given in pieces
+        whole = simulate(loop, reference, duration, dt, force)
+        cols = ("t", "r", "e", "y1", "y2", "u", "w", "e_linear")
+        for i0 in range(0, whole.t.size, int(chunk)):
+            yield Simulation(**{c: getattr(whole, c)[i0:i0 + int(chunk)] for c in cols})
+        return
     _check_feedforward(loop)
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1

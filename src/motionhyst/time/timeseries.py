@@ -59,7 +59,8 @@ def dynamics_step(loop: Loop, reference) -> float:
     """Integration step [s] from the loop's fastest pole and a built-in reference's time scale.
 
     A sampled reference (a file) is interpolated between its samples and does
-    not set the step: a 10 kHz file does not force 400 steps per sample.
+    not set the step: a 10 kHz file does not force 400 steps per sample.  A
+    loop with a sampled controller runs at the controller's period.
 
     Parameters
     ----------
@@ -77,6 +78,8 @@ def dynamics_step(loop: Loop, reference) -> float:
     >>> 1e-6 < h < 1e-4
     True
     """
+    if loop.sampled is not None:
+        return loop.sampled.period
     p = float(np.max(np.abs(loop.closed_loop_poles())))
     h = TWO_PI / (STEPS_PER_POLE_PERIOD * p)
     if not isinstance(reference, SampledReference):
@@ -202,6 +205,8 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     """
     if not (np.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0, got {duration!r}")
+    if output_rate_hz is None and loop.sampled is not None:   # the controller's samples
+        output_rate_hz = loop.sampled.sample_rate_hz
     if output_rate_hz is None:
         output_rate_hz = (reference_rate_hz(reference) if isinstance(reference, SampledReference)
                           else DEFAULT_OUTPUT_RATE_HZ)
@@ -215,6 +220,12 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
                          f"duration {duration:g} s")
     per_row = max(1, math.ceil(period_out / dynamics_step(loop, reference) * (1 - 1e-12)))
     step = period_out / per_row
+    if loop.sampled is not None:   # rows at every per_row-th of the controller's samples
+        step = loop.sampled.period
+        per_row = round(period_out / step)
+        if per_row < 1 or abs(per_row * step - period_out) > 1e-9 * period_out:
+            raise ValueError(f"the output rate {output_rate_hz:g} Hz must divide the sampled "
+                             f"controller's rate {loop.sampled.sample_rate_hz:g} Hz")
     n_rows = math.floor(duration / period_out * (1 + 1e-12)) + 1
     end = (n_rows - 1) * period_out
     if n_rows > MAX_ROWS or n_rows * per_row > MAX_STEPS:
