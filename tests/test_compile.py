@@ -41,7 +41,7 @@ LINKS = [Jenkins(20.0, 0.05), MaxwellSlip([12.0, 5.0, 3.0], [0.02, 0.02, 0.01]),
 # kernels specialised on purpose, one version per kind of call
 SPECIALISED = {
     # per plant size (the masses as a tuple) and with or without the sensitivities (None)
-    "motionhyst.time.openloop._rk4_run",
+    "motionhyst.time.bouc_wen_rk4._rk4_run",
 }
 
 

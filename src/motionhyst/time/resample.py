@@ -1,0 +1,226 @@
+"""Sampled force records: their uniform time grid and band-limited upsampling.
+
+A sampled force says nothing about the force between samples; like the
+Bouc-Wen benchmark's own data, a record is taken as band-limited and upsampled
+by zero-padding its spectrum (:func:`upsample`: exact for a periodic record,
+the record's even extension otherwise, so that its ends do not ring) before
+the open loop integrates it with a fine step (:mod:`motionhyst.time.openloop`).
+
+Examples
+--------
+>>> import numpy as np
+>>> t = np.arange(64) / 64
+>>> fine = fine_input(np.sin(2 * np.pi * 3 * t), 4, periodic=True)   # one period and its start
+>>> fine.size, bool(np.isclose(fine[4], np.sin(2 * np.pi * 3 / 64)))
+(257, True)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.signal import firwin, resample_poly
+
+__all__ = ["SINC_HALF_WIDTH", "STAMP_TOLERANCE", "check_record", "fine_input",
+           "is_periodic_record", "sampling_rate", "upsample"]
+
+#: Half-width of the windowed-sinc interpolator of a record that is not periodic [samples].
+SINC_HALF_WIDTH = 64
+
+
+#: Largest distance of a time stamp from the record's uniform grid, in sampling intervals
+#: (time columns written with few digits, e.g. 12.3457 s at 750 Hz, are off by up to 4 %)
+STAMP_TOLERANCE = 0.05
+
+
+def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A uniform time grid and a finite force of the same length, as float arrays.
+
+    The grid is the uniform one nearest to `t` (:func:`sampling_rate`);
+    stamps rounded when written are accepted within :data:`STAMP_TOLERANCE` of
+    a sampling interval.  Raises ``ValueError`` (one line) otherwise.
+
+    Parameters
+    ----------
+    t : array_like
+        Time stamps [s].
+    force : array_like
+        Force at the stamps [N].
+
+    Examples
+    --------
+    >>> t = np.round(np.arange(3000) / 750, 4)   # stamps written with 4 decimals
+    >>> tt, u = check_record(t, np.zeros(3000))
+    >>> print(f"{sampling_rate(tt):.4f}")
+    750.0000
+    >>> try:
+    ...     check_record([0.0, 0.1, 0.3], [1.0, 2.0, 3.0])
+    ... except ValueError as exc:
+    ...     print(exc)
+    time must increase in uniform steps (the stamp 0.1 s is 0.22 sampling intervals off the
+    uniform grid)
+    """
+    tt = np.asarray(t, dtype=float)
+    u = np.asarray(force, dtype=float)
+    if tt.ndim != 1 or u.ndim != 1 or tt.size != u.size:
+        raise ValueError("time and force must be 1-D and of equal length")
+    if tt.size < 2:
+        raise ValueError("a record needs at least 2 samples")
+    if not (np.all(np.isfinite(tt)) and np.all(np.isfinite(u))):
+        raise ValueError("time and force must be finite")
+    if not np.all(np.diff(tt) > 0):
+        raise ValueError("time must increase")
+    t0, dt = _uniform_grid(tt)
+    off = np.abs(tt - (t0 + dt * np.arange(tt.size))) / dt
+    worst = int(np.argmax(off))
+    if off[worst] > STAMP_TOLERANCE:
+        raise ValueError(f"time must increase in uniform steps (the stamp {tt[worst]:.9g} s is "
+                         f"{off[worst]:.2g} sampling intervals off the uniform grid)")
+    return tt, u
+
+
+def _uniform_grid(t: NDArray[np.float64]) -> tuple[float, float]:
+    """Start and step of the uniform grid nearest to `t` (least squares)."""
+    i = np.arange(t.size, dtype=float) - 0.5 * (t.size - 1)
+    tc = t - t.mean()
+    dt = float(i @ tc / (i @ i))
+    return float(t.mean() - 0.5 * (t.size - 1) * dt), dt
+
+
+def sampling_rate(t: NDArray[np.float64]) -> float:
+    """Rate of a record's uniform grid [Hz]: the step fitted to all its stamps.
+
+    Exact for exact stamps; for stamps rounded when written, far more exact
+    than the difference of two of them.
+
+    Parameters
+    ----------
+    t : ndarray
+        The record's time stamps [s].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.round(np.arange(1000) / 750, 4)     # stamps written with 4 decimals
+    >>> print(f"{1 / (t[1] - t[0]):.1f} Hz from two stamps, {sampling_rate(t):.3f} Hz from all")
+    769.2 Hz from two stamps, 750.000 Hz from all
+    """
+    return 1.0 / _uniform_grid(np.asarray(t, dtype=float))[1]
+
+
+def upsample(u: ArrayLike, factor: int, periodic: bool) -> NDArray[np.float64]:
+    """Band-limited upsampling of a record.
+
+    Parameters
+    ----------
+    u : array_like
+        Samples, 1-D, at least 2.
+    factor : int
+        New samples per old sample, >= 1.
+    periodic : bool
+        True if the record is a whole number of periods of a periodic signal:
+        the spectrum is zero-padded (exact for a signal band-limited below half
+        the sampling rate) when the record's length has no prime factor above
+        7, else as below with the record wrapped around.  False: the record is
+        extended by its mirror image at both ends (no jump) and interpolated by
+        a Kaiser-windowed sinc (beta = 14) spanning 128 samples, flat to
+        about 1e-7 up to 0.8 of the Nyquist frequency.
+
+    Returns
+    -------
+    ndarray
+        ``(len(u) - 1) * factor + 1`` samples (``len(u) * factor`` if periodic);
+        every `factor`-th one is the input sample (to the interpolator's accuracy).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(64) / 64
+    >>> fine = upsample(np.sin(2 * np.pi * 3 * t), 4, periodic=True)
+    >>> bool(np.allclose(fine, np.sin(2 * np.pi * 3 * np.arange(256) / 256)))
+    True
+    >>> t = np.arange(2000) / 2000   # 40.1 cycles: not periodic in the record
+    >>> fine = upsample(np.sin(2 * np.pi * 40.1 * t), 8, periodic=False)
+    >>> exact = np.sin(2 * np.pi * 40.1 * np.arange(fine.size) / 16000)
+    >>> bool(np.max(np.abs(fine - exact)[400:-400]) < 1e-5)   # away from the ends
+    True
+    """
+    x = np.asarray(u, dtype=float)
+    n = x.size
+    if factor == 1:
+        return x.copy()
+    if periodic and _smooth_length(n):
+        spec = np.fft.rfft(x)
+        if n % 2 == 0:
+            spec[-1] *= 0.5  # the Nyquist line splits between +f and -f
+        padded = np.zeros(n * factor // 2 + 1, dtype=complex)
+        padded[: spec.size] = spec
+        return np.fft.irfft(padded, n * factor) * factor
+    half = SINC_HALF_WIDTH
+    pad = half + 2
+    ext = np.pad(x, pad, mode="wrap" if periodic else "reflect")
+    taps = firwin(2 * half * factor + 1, 1.0 / factor, window=("kaiser", 14.0))
+    fine = resample_poly(ext, factor, 1, window=taps)[pad * factor:]
+    return fine[: n * factor] if periodic else fine[: (n - 1) * factor + 1]
+
+
+def _smooth_length(n: int) -> bool:
+    for p in (2, 3, 5, 7):
+        while n % p == 0:
+            n //= p
+    return n == 1
+
+
+def fine_input(u: NDArray[np.float64], factor: int, periodic: bool) -> NDArray[np.float64]:
+    """The record upsampled for integration: one period plus its first sample again if
+    `periodic`, else ``(len(u) - 1) * factor + 1`` samples.
+
+    A record from rest that holds two or more whole periods of its signal
+    (:func:`is_periodic_record`) is upsampled as periodic (exact), otherwise
+    through its mirror image (:func:`upsample`).
+
+    Parameters
+    ----------
+    u : ndarray
+        The record's samples.
+    factor : int
+        Fine samples per record sample, >= 1.
+    periodic : bool
+        True if `u` is one period of a periodic force.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> fine_input(np.zeros(10), 4, periodic=False).size, fine_input(np.zeros(10), 4, True).size
+    (37, 41)
+    """
+    if periodic:
+        fine = upsample(u, factor, periodic=True)
+        return np.concatenate([fine, fine[:1]])
+    if is_periodic_record(u) is not None:
+        return upsample(u, factor, periodic=True)[: (u.size - 1) * factor + 1]
+    return upsample(u, factor, periodic=False)
+
+
+def is_periodic_record(u: NDArray[np.float64], rtol: float = 1e-9) -> int | None:
+    """Samples per period if `u` is two or more whole periods of one signal, else None.
+
+    Parameters
+    ----------
+    u : ndarray
+        The record's samples.
+    rtol : float
+        Tolerance of the repetition, relative to the largest sample.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> is_periodic_record(np.tile([0.0, 1.0, 0.5], 4)), is_periodic_record(np.arange(6.0))
+    (3, None)
+    """
+    n = u.size
+    scale = float(np.max(np.abs(u))) if n else 0.0
+    for p in range(2, n // 2 + 1):
+        if n % p == 0 and np.all(np.abs(u.reshape(-1, p) - u[:p]) <= rtol * scale):
+            return p
+    return None
