@@ -197,3 +197,33 @@ def test_mass_damper_runs_in_the_time_engine_with_its_force_offset():
     a = OpenLoop(MassDamper(m, c, force_offset=F), bw).simulate(t, np.sin(20 * t))
     b = OpenLoop(MassDamper(m, c), bw).simulate(t, np.sin(20 * t) + F)
     np.testing.assert_allclose(a.displacement, b.displacement, rtol=1e-9, atol=1e-15)
+
+
+def test_a_scenario_may_describe_only_a_plant():
+    from motionhyst.scenario import Scenario, ScenarioError
+
+    two = Scenario.from_dict({"stage": {"m1": 5.0, "m2": 17.5, "b": 90.0, "k": 7.4e7}})
+    assert two.plant().to_dict() == {"m1": 5.0, "m2": 17.5, "b": 90.0, "k": 7.4e7}
+    assert two.hysteresis() is None and not two.is_open_loop
+    with pytest.raises(ScenarioError, match=r"describes only a plant .*needs a closed loop"):
+        two.loop()
+    axis = Scenario.from_dict({"stage": {"type": "mass-damper", "m": 95.1, "c": 203.5,
+                                         "force_offset": 3.16}})
+    assert axis.is_open_loop and axis.open_loop().hysteresis is None
+    assert axis.plant().force_offset == 3.16
+    with pytest.raises(ScenarioError, match=r"\[hysteresis\]: missing"):
+        Scenario.from_dict({"stage": {"m1": 5.0, "m2": 17.5, "b": 90.0, "k": 7.4e7},
+                            "controller": {"type": "tf", "num": [1.0], "den": [1.0]},
+                            "reference": {"amplitude": 0.01, "frequencies": [5.0]}})
+
+
+@pytest.mark.parametrize("name", [n for n in PLANTS if PLANTS[n].parameters])
+def test_every_stage_type_reads_from_a_scenario(name):
+    """The [stage] table of every plant built from parameters is its to_dict()."""
+    from motionhyst.scenario import Scenario, ScenarioError
+
+    plant = PLANTS[name](**_kwargs(PLANTS[name]))
+    sc = Scenario.from_dict({"stage": plant.to_dict()})
+    assert sc.plant().to_dict() == plant.to_dict()
+    with pytest.raises(ScenarioError, match=r"^<dict>: \[stage\] nonsense: unknown key$"):
+        Scenario.from_dict({"stage": {**plant.to_dict(), "nonsense": 1.0}})

@@ -494,7 +494,7 @@ class ScenarioModel(_Section):
 
     stage: StageUnion | None = None
     plant: PlantSection | None = None
-    hysteresis: HysteresisSection
+    hysteresis: HysteresisSection | None = None
     controller: Annotated[LeadLagSection | TransferFunctionSection | PidSection
                           | DiscreteTfSection | TwoDofSection,
                           Field(discriminator="type")] | None = None
@@ -505,6 +505,8 @@ class ScenarioModel(_Section):
     def _one_plant(self):
         if (self.stage is None) == (self.plant is None):
             raise ValueError("give exactly one of [stage] and [plant]")
+        if self.plant_only:
+            return self
         if self.open_loop:
             output = getattr(self.stage, "output", None)  # a stage of one position has none
             what = (f"a {self.stage.type} [stage]" if output is None
@@ -514,7 +516,7 @@ class ScenarioModel(_Section):
                     raise ValueError(f"[{name}] does not apply to {what} (an open-loop system, "
                                      f"force in, position out)")
             return self
-        for name in ("controller", "reference"):
+        for name in ("hysteresis", "controller", "reference"):
             if getattr(self, name) is None:
                 hint = ""
                 if (self.stage is not None and len(PLANTS[self.stage.type].outputs) > 1
@@ -527,6 +529,13 @@ class ScenarioModel(_Section):
             raise ValueError("[feedforward] advance_samples needs a sampled controller "
                              "([controller] sample_rate_hz)")
         return self
+
+    @property
+    def plant_only(self) -> bool:
+        """True for a file that describes only a plant: no ``[hysteresis]``, ``[controller]``,
+        ``[feedforward]`` or ``[reference]``."""
+        return all(getattr(self, name) is None
+                   for name in ("hysteresis", "controller", "feedforward", "reference"))
 
     @property
     def open_loop(self) -> bool:
@@ -674,7 +683,7 @@ class Scenario:
         except ValidationError as err:
             raise ScenarioError(_format_error(source, err)) from None
         sc = cls(model, source, base_dir)
-        if check and not model.open_loop:
+        if check and not (model.open_loop or model.plant_only):
             sc.loop()  # builds and checks stability
         return sc
 
@@ -711,6 +720,9 @@ class Scenario:
         return self.model.open_loop
 
     def _closed(self, what: str) -> None:
+        if self.model.plant_only and not self.model.open_loop:
+            raise ScenarioError(f"{self.source}: describes only a plant (no [hysteresis], "
+                                f"[controller] or [reference]); {what} needs a closed loop")
         if self.model.open_loop:
             kind = _open_loop_what(self.model.stage)
             raise ScenarioError(f"{self.source}: [stage] is {kind} (an open-loop system "
@@ -805,8 +817,10 @@ class Scenario:
         self.plant()
         return self._fit
 
-    def hysteresis(self) -> Hysteresis:
-        """The dynamic link's hysteresis model."""
+    def hysteresis(self) -> Hysteresis | None:
+        """The dynamic link's hysteresis model (None: the scenario describes only a plant)."""
+        if self.model.hysteresis is None:
+            return None
         return build_hysteresis(self.model.hysteresis)
 
     def controller(self) -> control.TransferFunction | SampledController:
