@@ -89,12 +89,6 @@ def record_kind(path: str | Path, kind: str | None = None,
                      f"{expected}{hint}")
 
 
-def _toml_float(v: float) -> str:
-    """A float as a TOML float literal with 7 significant digits."""
-    s = repr(float(f"{float(v):.7g}"))
-    return s if any(c in s for c in ".en") else s + ".0"
-
-
 def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
     """A ``[feedforward]`` section with the identified hysteresis, ready to paste (TOML).
 
@@ -118,14 +112,12 @@ def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
     hysteresis = { model = "maxwell-slip", k = [10.0, 6.0], fc = [0.01, 0.03] }
     <BLANKLINE>
     """
-    if len(k) == 1:
-        table = (f'{{ model = "jenkins", k = {_toml_float(k[0])}, '
-                 f"fc = {_toml_float(fc[0])} }}")
-    else:
-        table = (f'{{ model = "maxwell-slip", k = [{", ".join(map(_toml_float, k))}], '
-                 f'fc = [{", ".join(map(_toml_float, fc))}] }}')
-    return ('[feedforward]\ntype = "rigid-body"   # u_ff = M r\'\' + phi_hat(r)\n'
-            f"hysteresis = {table}\n")
+    from motionhyst.core.textfiles import toml_table
+
+    link = ({"model": "jenkins", "k": k[0], "fc": fc[0]} if len(k) == 1
+            else {"model": "maxwell-slip", "k": list(k), "fc": list(fc)})
+    return toml_table("feedforward", {"type": "rigid-body", "hysteresis": link},
+                      comments={"type": "u_ff = M r'' + phi_hat(r)"}, digits=7)
 
 
 def run(args: argparse.Namespace) -> int:

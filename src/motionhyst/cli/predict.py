@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import io
 
 import numpy as np
 
@@ -60,10 +59,7 @@ def run(args: argparse.Namespace) -> int:
         out = system.simulate(t, u, periodic=args.periodic, substeps=args.substeps)
     except ValueError as exc:
         raise ValueError(f"{args.data}: {exc}") from None
-    buf = io.StringIO()
-    buf.write("time,displacement\n")
-    np.savetxt(buf, np.column_stack([out.t, out.displacement]), delimiter=",", fmt="%.17g")
-    target.write_text(buf.getvalue())
+    target.write_csv({"time": out.t, "displacement": out.displacement}, fmt="%.17g")
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "displacement_rms": float(np.sqrt(np.mean(out.displacement ** 2))),
                "displacement_peak": float(np.max(np.abs(out.displacement)))}

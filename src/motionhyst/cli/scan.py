@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 from motionhyst.cli._common import (
     UsageError,
     nonnegative,
@@ -105,13 +103,6 @@ def _output(args):
                       option="--time-series")
 
 
-def _write_csv(out, cols: dict) -> None:
-    """Write the columns to the checked target `out` (atomically)."""
-    with out.open() as fh:
-        fh.write(",".join(cols) + "\n")
-        np.savetxt(fh, np.column_stack(list(cols.values())), delimiter=",", fmt="%.12e")
-
-
 def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
     from motionhyst.scan.ilc import ILCFilters
@@ -150,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
     res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
                    args.settle_tol, args.tail)
     if out is not None:
-        _write_csv(out, res.columns())
+        out.write_csv(res.columns())
     if args.json:
         d = {"scenario": sc.source, **res.to_dict()}
         if out is not None:

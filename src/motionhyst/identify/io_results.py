@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.textfiles import toml_table
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop
@@ -95,26 +96,10 @@ class IOIdentification:
 
     def scenario_text(self) -> str:
         """A scenario file (TOML) of the identified system: ``[stage]`` and ``[hysteresis]``."""
-        lines = [f"# identified from {len(self.records)} input-output record(s) by simulation "
-                 f"error: fit RMS {self.fit_rms:.4g} m", "[stage]"]
-        for key, value in self.plant.to_dict().items():
-            lines.append(f'{key} = "{value}"' if isinstance(value, str)
-                         else f"{key} = {_toml(value)}")
-        lines.append("")
-        lines.append("[hysteresis]")
-        for key, value in self.hysteresis.to_dict().items():
-            if isinstance(value, str):
-                lines.append(f'{key} = "{value}"')
-            elif isinstance(value, list | tuple | np.ndarray):
-                lines.append(f"{key} = [{', '.join(_toml(v) for v in value)}]")
-            else:
-                lines.append(f"{key} = {_toml(value)}")
-        return "\n".join(lines) + "\n"
-
-
-def _toml(v: float) -> str:
-    s = repr(float(v))
-    return s if any(ch in s for ch in ".en") else s + ".0"
+        return (f"# identified from {len(self.records)} input-output record(s) by simulation "
+                f"error: fit RMS {self.fit_rms:.4g} m\n"
+                + toml_table("stage", self.plant.to_dict()) + "\n"
+                + toml_table("hysteresis", self.hysteresis.to_dict()))
 
 
 def per_record_errors(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:

@@ -8,16 +8,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.textfiles import toml_table
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import MaxwellSlip
 
 __all__ = ["Identification"]
-
-
-def _fmt(v: float) -> str:
-    """A float as a TOML float literal with 7 significant digits."""
-    s = repr(float(f"{float(v):.7g}"))
-    return s if ("." in s or "e" in s or "inf" in s or "nan" in s) else s + ".0"
 
 
 @dataclass
@@ -161,11 +156,11 @@ class Identification:
         """
         k, fc = self.model.k, self.model.fc
         head = (f"# identified from {self.n_samples} samples: fit NRMS "
-                f"{100 * self.fit_nrms:.3g} %, R^2 {self.r2:.6f}\n[hysteresis]\n")
+                f"{100 * self.fit_nrms:.3g} %, R^2 {self.r2:.6f}\n")
         if k.size == 1:
-            return (head + 'model = "jenkins"\n'
-                    f"k = {_fmt(k[0])}      # spring stiffness k_J [N/m]\n"
-                    f"fc = {_fmt(fc[0])}     # slip force f_c [N]\n")
-        return (head + 'model = "maxwell-slip"\n'
-                f"k = [{', '.join(_fmt(v) for v in k)}]      # spring stiffnesses [N/m]\n"
-                f"fc = [{', '.join(_fmt(v) for v in fc)}]     # slip forces [N]\n")
+            entries = {"model": "jenkins", "k": k[0], "fc": fc[0]}
+            comments = {"k": "spring stiffness k_J [N/m]", "fc": "slip force f_c [N]"}
+        else:
+            entries = {"model": "maxwell-slip", "k": k, "fc": fc}
+            comments = {"k": "spring stiffnesses [N/m]", "fc": "slip forces [N]"}
+        return head + toml_table("hysteresis", entries, comments, digits=7)

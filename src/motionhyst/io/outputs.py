@@ -59,9 +59,14 @@ import signal
 import stat
 import tempfile
 import threading
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from motionhyst.core.textfiles import CSV_FORMAT, csv_header, csv_rows
 
 MANIFEST = "motionhyst-manifest.json"
 """Name of the manifest :class:`OutputFolder` writes into a results folder."""
@@ -474,6 +479,33 @@ class OutputFile:
         """Write `text` (UTF-8) atomically (see :meth:`open`)."""
         with self.open("w") as fh:
             fh.write(text)
+
+    def write_csv(self, columns: Mapping[str, ArrayLike], fmt: str = CSV_FORMAT) -> None:
+        """Write named columns of equal length as a CSV file, atomically (see :meth:`open`).
+
+        Parameters
+        ----------
+        columns : mapping of str to array_like
+            The columns, in order: the header line, then one row per sample
+            (:func:`motionhyst.core.textfiles.csv_rows`).
+        fmt : str
+            printf format of a number.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> path = Path(tempfile.mkdtemp()) / "out.csv"
+        >>> OutputFile(path).write_csv({"time": [0.0, 0.5], "force": [1.0, 2.0]}, fmt="%g")
+        >>> print(path.read_text(), end="")
+        time,force
+        0,1
+        0.5,2
+        """
+        with self.open("w") as fh:
+            csv_header(fh, list(columns))
+            csv_rows(fh, np.column_stack([np.asarray(c, dtype=float) for c in columns.values()]),
+                     fmt)
 
 
 def _fsync_dir(folder: Path) -> None:

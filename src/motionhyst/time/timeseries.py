@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.lti import TWO_PI
+from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.loop import Loop
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
 from motionhyst.time.simulation import (
@@ -243,7 +244,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
         move = (reference.start, reference.start + reference.duration)
     sig = {name: _Signals(settling=_Settling(settle_band)) for name in ("e", "e_linear")}
     if out is not None:
-        out.write(",".join(COLUMNS) + "\n")
+        csv_header(out, COLUMNS)
     rows = 0
     steps = 0
     chunk = min(per_row * ROWS_PER_CHUNK, MAX_CHUNK)  # memory bounded, whatever per_row
@@ -303,7 +304,7 @@ def _write_rows(out: IO[str] | None, piece: Simulation, per_row: int, first_samp
     block = np.column_stack([(first_row + np.arange(n)) * period_out if c == "time"
                              else cols[c][skip::per_row] for c in COLUMNS])
     if out is not None and n:
-        np.savetxt(out, block, delimiter=",", fmt="%.12e")
+        csv_rows(out, block)
     return n
 
 
