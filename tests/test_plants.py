@@ -227,3 +227,23 @@ def test_every_stage_type_reads_from_a_scenario(name):
     assert sc.plant().to_dict() == plant.to_dict()
     with pytest.raises(ScenarioError, match=r"^<dict>: \[stage\] nonsense: unknown key$"):
         Scenario.from_dict({"stage": {**plant.to_dict(), "nonsense": 1.0}})
+
+
+def test_eq21_says_why_it_does_not_apply_instead_of_nan():
+    """A plant without a static flexible compliance (ground dampers, a single mass, bare
+    transfer functions) has no eq. (21) estimate: the analysis says so by name."""
+    from motionhyst import Jenkins, LeadLagLowpass, Loop, analyze
+    from motionhyst.plants import MassDamper, TwoMassStage
+
+    C = LeadLagLowpass(K=6.2e6, f1=60.0, f2=240.0, flp=700.0, beta=0.6)
+    link = Jenkins(k=20.0, fc=0.05)
+    paper = analyze(Loop(TwoMassStage(5.0, 17.5, 90.0, 7.4e7), C, link), 0.01, [5.0])
+    assert math.isfinite(paper.mismatch_crossover_hz)
+    assert not any("eq. (21)" in u for u in paper.unresolved)
+    stage = TwoMassStage(5.0, 17.5, 90.0, 7.4e7)
+    for plant in (TwoMassStage(5.0, 17.5, 90.0, 7.4e7, c1=50.0), MassDamper(22.5, 50.0),
+                  (stage.P1, stage.P2)):
+        res = analyze(Loop(plant, C, link, mass=22.5), 0.01, [5.0])
+        assert math.isnan(res.mismatch_crossover_hz)
+        assert any(u.startswith("eq. (21): needs a flexible mode") for u in res.unresolved)
+        assert math.isfinite(res.mismatch_crossover_exact_hz)  # eq. (18) itself still solves
