@@ -99,6 +99,14 @@ def toml_table(name: str, entries: Mapping[str, Any], comments: Mapping[str, str
     -------
     str
         The table's lines, each ending in a newline.
+
+    Examples
+    --------
+    >>> print(toml_table("feedforward", {"type": "rigid-body", "hysteresis": {
+    ...     "model": "jenkins", "k": 20, "fc": 0.05}}, comments={"type": "u_ff = M r''"}), end="")
+    [feedforward]
+    type = "rigid-body"   # u_ff = M r''
+    hysteresis = { model = "jenkins", k = 20.0, fc = 0.05 }
     """
     lines = [f"[{name}]"]
     for key, value in entries.items():
@@ -118,6 +126,12 @@ def csv_header(out: IO[str], names: Sequence[str]) -> None:
         Where to write.
     names : sequence of str
         The columns' names.
+
+    Examples
+    --------
+    >>> import sys
+    >>> csv_header(sys.stdout, ["time", "displacement"])
+    time,displacement
     """
     out.write(",".join(names) + "\n")
 
@@ -133,5 +147,12 @@ def csv_rows(out: IO[str], block: ArrayLike, fmt: str = CSV_FORMAT) -> None:
         The numbers.
     fmt : str
         printf format of a number (default :data:`CSV_FORMAT`).
+
+    Examples
+    --------
+    >>> import sys
+    >>> csv_rows(sys.stdout, [[0.0, 1e-6], [0.5, -2e-6]], fmt="%.17g")
+    0,9.9999999999999995e-07
+    0.5,-1.9999999999999999e-06
     """
     np.savetxt(out, np.asarray(block, dtype=float), delimiter=",", fmt=fmt)
