@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from motionhyst.analysis.quasilinear import f_star
+from motionhyst.analysis.equations import f_star
 from motionhyst.core.warnings import warn
 
 __all__ = ["check_plausible"]

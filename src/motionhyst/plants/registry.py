@@ -229,7 +229,10 @@ class Plant(Protocol):
 
 
 PLANTS: dict[str, Any] = {}
-"""Every registered plant class, keyed by its ``name``, in registration order."""
+"""Every registered plant class, keyed by its ``name``, in registration order.
+
+Complete whenever this module can be used: importing it imports its package
+:mod:`motionhyst.plants` first, and that imports (registers) every plant."""
 
 _P = TypeVar("_P")
 
@@ -265,11 +268,6 @@ def register(cls: _P) -> _P:
     return cls
 
 
-def _load() -> None:
-    """Import every plant module, so that each registers itself."""
-    import motionhyst.plants  # noqa: F401
-
-
 def plant_class(name: str) -> Any:
     """The registered plant class of a scenario's ``[stage] type = name``.
 
@@ -296,7 +294,6 @@ def plant_class(name: str) -> Any:
     ...
     ValueError: unknown plant 'spring'; known: ...
     """
-    _load()
     try:
         return PLANTS[name]
     except KeyError:
@@ -315,5 +312,4 @@ def stage_types() -> list[str]:
     >>> "mass-damper" in stage_types()
     True
     """
-    _load()
     return [name for name, cls in PLANTS.items() if cls.parameters]

@@ -461,7 +461,7 @@ def fig9_quasilinear_plant(loop: Loop, zetas: ArrayLike = (0.01, 0.1, 0.25, 0.5,
     >>> len(fig9_quasilinear_plant(default_scenario().loop()).axes) >= 2
     True
     """
-    from motionhyst.analysis.quasilinear import f_star
+    from motionhyst.analysis.equations import f_star
     from motionhyst.core.lti import freqresp
     from motionhyst.hysteresis import Jenkins as _Jenkins
     from motionhyst.plants.two_mass import TwoMassStage
@@ -526,7 +526,8 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     >>> len(fig.axes)
     1
     """
-    from motionhyst.analysis.quasilinear import loop_mismatch, mismatch_asymptote, resolved_lines
+    from motionhyst.analysis.equations import mismatch_asymptote
+    from motionhyst.analysis.quasilinear import loop_mismatch, resolved_lines
     from motionhyst.core.lti import freqresp
 
     fig, (ax,) = new_figure()
