@@ -30,7 +30,9 @@ from motionhyst.time.periodic_runs import max_periods, periodic_output
 from motionhyst.time.resample import fine_input
 
 if TYPE_CHECKING:
-    from motionhyst.time.openloop import Plant
+    from motionhyst.plants.two_mass import TwoMassStage
+
+    Plant = MassSpringDamper | TwoMassStage
 
 __all__ = ["BW_PARAMETERS", "bouc_wen_general", "simulate_bouc_wen"]
 

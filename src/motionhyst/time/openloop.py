@@ -72,13 +72,8 @@ from motionhyst.plants.mechanics import Mechanics
 from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.time.bouc_wen_rk4 import BW_PARAMETERS as BW_PARAMETERS
 from motionhyst.time.bouc_wen_rk4 import bouc_wen_general, simulate_bouc_wen
-from motionhyst.time.engine import (
-    MAX_FIXED_POINT_ITERATIONS,
-    OPEN,
-    FohStep,
-    LoopState,
-    run_steps,
-)
+from motionhyst.time.engine import FohStep, LoopState, run_steps
+from motionhyst.time.kernel import MAX_FIXED_POINT_ITERATIONS, OPEN
 from motionhyst.time.periodic_runs import MAX_PERIODIC_DECAYS as MAX_PERIODIC_DECAYS
 from motionhyst.time.periodic_runs import PERIODIC_RTOL as PERIODIC_RTOL
 from motionhyst.time.periodic_runs import (

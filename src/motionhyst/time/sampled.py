@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 
 from motionhyst.loop import Loop
 from motionhyst.time.engine import run_sampled
-from motionhyst.time.simulation import Simulation
+from motionhyst.time.simulation_result import Simulation
 
 __all__ = ["simulate_sampled"]
 
