@@ -1,6 +1,7 @@
 """Scenario files: the TOML description of a loop or an open-loop system, read into model objects.
 
-The schema and its reader are in :mod:`motionhyst.scenario.schema`; the paper's Table I is
+The reader and :class:`Scenario` are in :mod:`motionhyst.scenario.schema`, the tables' models
+in :mod:`motionhyst.scenario.sections`; the paper's Table I is
 ``data/paper.toml`` here and the default everywhere (:func:`default_scenario`).
 """
 
