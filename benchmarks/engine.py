@@ -23,9 +23,9 @@ import time
 import control
 import numpy as np
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import Jenkins
 from motionhyst.hysteresis.stepping import N_PARAMS
-from motionhyst.loop import Loop
 from motionhyst.scenario import default_scenario
 from motionhyst.time.engine import DiscreteController, run_sampled
 from motionhyst.time.openloop import MassSpringDamper, TwoMass, simulate_elements

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.compiled import quiet_compilation
 from motionhyst.hysteresis.jenkins import Jenkins
-from motionhyst.loop import Loop
 from motionhyst.plants.two_mass import TwoMassStage
 
 # the tests check the commands' stderr: no notice of the first compilation in this session

@@ -23,9 +23,9 @@ import numpy as np
 import pytest
 
 from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.compiled import Kernel, compiled_in_memory
 from motionhyst.hysteresis import BoucWen, Dahl, Jenkins, LuGre, MaxwellIwan, MaxwellSlip
-from motionhyst.loop import Loop
 from motionhyst.scenario import default_scenario
 from motionhyst.time.references import SineReference
 from motionhyst.time.simulation import simulate

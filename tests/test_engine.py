@@ -15,8 +15,8 @@ import pytest
 from scipy.linalg import expm
 
 from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import Jenkins
-from motionhyst.loop import Loop
 from motionhyst.scenario import default_scenario
 from motionhyst.time.engine import DiscreteController, run_sampled
 from motionhyst.time.openloop import TwoMass

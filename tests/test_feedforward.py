@@ -18,9 +18,9 @@ from motionhyst.analysis.quasilinear import (
     residual_mismatch,
 )
 from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
-from motionhyst.loop import Loop
 from motionhyst.scenario import Scenario, ScenarioError, default_scenario_path
 from motionhyst.time.references import SineReference
 from motionhyst.time.simulation import simulate

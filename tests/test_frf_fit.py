@@ -10,8 +10,8 @@ from numpy.testing import assert_allclose
 
 from motionhyst.analysis.quasilinear import analyze
 from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import freqresp
-from motionhyst.loop import Loop
 from motionhyst.plants.frf_fit import FrfFit, ModalPlant, Mode, fit_frf
 from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.time.references import SineReference

@@ -14,8 +14,8 @@ import pytest
 from motionhyst.analysis.comparison import compare_with_describing_function
 from motionhyst.analysis.quasilinear import error_harmonics_df
 from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
-from motionhyst.loop import Loop
 from motionhyst.scenario import default_scenario
 
 K_J, FC = 20.0, 0.05  # Table I

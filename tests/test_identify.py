@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
 from motionhyst.identify import (
     Identification,
@@ -20,7 +21,6 @@ from motionhyst.identify import (
     load_closed_loop_csv,
     load_force_displacement_csv,
 )
-from motionhyst.loop import Loop
 from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.scenario import hysteresis_from_dict
 from motionhyst.time.simulation import simulate

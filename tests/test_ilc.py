@@ -7,7 +7,7 @@ import pytest
 from conftest import FC_LINK
 from numpy.testing import assert_allclose
 
-from motionhyst.loop import Loop
+from motionhyst.controllers.loop import Loop
 from motionhyst.scan.ilc import ILCFilters, learn
 from motionhyst.scan.profiles import point_to_point, scan
 from motionhyst.time.simulation import simulate

@@ -15,7 +15,7 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parent.parent / "src"
 
-LAYERS = [("core",), ("io",), ("hysteresis",), ("plants", "controllers"), ("loop",),
+LAYERS = [("core",), ("io",), ("hysteresis",), ("plants",), ("controllers",),
           ("analysis", "time"), ("scan", "identify"), ("scenario",), ("study",), ("present",),
           ("cli",)]
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}

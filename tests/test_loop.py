@@ -8,9 +8,9 @@ import pytest
 from numpy.testing import assert_allclose
 
 from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.controllers.loop import TRANSFERS, Loop
 from motionhyst.core.lti import freqresp
 from motionhyst.hysteresis.jenkins import Jenkins
-from motionhyst.loop import TRANSFERS, Loop
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.two_mass import TwoMassStage
 

@@ -11,8 +11,8 @@ import pytest
 from motionhyst.analysis.margins import BANDWIDTH_DEFINITION, loop_margins
 from motionhyst.analysis.quasilinear import analyze
 from motionhyst.controllers.leadlag import LeadLagLowpass
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import freqresp
-from motionhyst.loop import Loop
 from motionhyst.plants.frf_fit import ModalPlant, Mode
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.two_mass import TwoMassStage

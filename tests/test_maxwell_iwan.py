@@ -14,11 +14,11 @@ from scipy.integrate import quad
 
 from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.cli import main
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import MODELS, Jenkins, MaxwellIwan, jenkins_describing_function
 from motionhyst.hysteresis.maxwell_iwan import iwan_describing_function
 from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 from motionhyst.hysteresis.stepping import GL_T, GL_W, MAXWELL, Stepping, open_loop
-from motionhyst.loop import Loop
 from motionhyst.present import plots
 from motionhyst.scenario import (
     ScenarioError,

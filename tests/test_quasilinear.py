@@ -19,9 +19,9 @@ from motionhyst.analysis.quasilinear import (
     self_consistent_amplitude,
     sensitivity_s1,
 )
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import freqresp
 from motionhyst.hysteresis.jenkins import Jenkins
-from motionhyst.loop import Loop
 
 A_REF = 0.01
 

@@ -420,7 +420,7 @@ def test_describing_function_curve_computes_each_point_where_the_spline_misses()
 
 
 def test_figures_of_a_lugre_loop_draw_its_exact_curves(loop):
-    from motionhyst.loop import Loop
+    from motionhyst.controllers.loop import Loop
 
     lugre_loop = Loop(loop.plant, loop.controller, LUGRE, feedforward="rigid-body")
     f = np.geomspace(0.01, 100.0, 600)
@@ -436,7 +436,7 @@ def test_figures_of_a_lugre_loop_draw_its_exact_curves(loop):
 
 
 def test_fig9_wraps_a_long_parameter_list_between_parameters(loop):
-    from motionhyst.loop import Loop
+    from motionhyst.controllers.loop import Loop
 
     lugre_loop = Loop(loop.plant, loop.controller, LUGRE, feedforward="rigid-body")
     title = plots.fig9_quasilinear_plant(lugre_loop).axes[1].get_title()

@@ -12,8 +12,8 @@ from conftest import FC_LINK, K_LINK
 from numpy.testing import assert_allclose
 
 from motionhyst.cli import main as cli_main
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import Jenkins
-from motionhyst.loop import Loop
 from motionhyst.scan.profiles import point_to_point, scan
 from motionhyst.scan.scanning import moving_statistics, run_scan, scan_metrics, settling_time
 

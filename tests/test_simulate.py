@@ -7,8 +7,8 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from motionhyst.analysis.steady import periodic_steady_state
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, LuGre
-from motionhyst.loop import Loop
 from motionhyst.scenario import default_scenario
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
 from motionhyst.time.simulation import Simulation, default_step, simulate

@@ -81,8 +81,8 @@ light = sorted(m for m in sys.modules if m.split(".")[0] in ("control", "scipy",
                                                              "numba", "pydantic"))
 from motionhyst import *  # noqa
 from motionhyst import Loop, periodic_steady_state
-import motionhyst.loop, motionhyst.analysis.steady
-same = (Loop is motionhyst.loop.Loop
+import motionhyst.controllers.loop, motionhyst.analysis.steady
+same = (Loop is motionhyst.controllers.loop.Loop
         and periodic_steady_state is motionhyst.analysis.steady.periodic_steady_state)
 print(json.dumps({"light": light, "same": same, "all": sorted(motionhyst.__all__),
                   "dir": all(n in dir(motionhyst) for n in motionhyst.__all__),

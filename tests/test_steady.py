@@ -15,8 +15,8 @@ from motionhyst.analysis.steady import (
     periodic_steady_state,
     steady_state_sweep,
 )
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis.jenkins import Jenkins
-from motionhyst.loop import Loop
 from motionhyst.scenario import default_scenario
 
 A_REF = 0.01  # section V: r = 10 mm sin(2 pi f t)

@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis import BoucWen, LuGre, MaxwellSlip
-from motionhyst.loop import Loop
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
 from motionhyst.time.simulation import default_step, simulate, simulate_chunks
 from motionhyst.time.timeseries import COLUMNS, dynamics_step, run_time_series

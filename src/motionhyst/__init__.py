@@ -37,7 +37,7 @@ _EXPORTS = {
     "motionhyst.hysteresis": ("BoucWen", "Dahl", "Hysteresis", "Jenkins", "LuGre", "MaxwellIwan",
                               "MaxwellSlip"),
     "motionhyst.analysis.margins": ("LoopMargins", "loop_margins"),
-    "motionhyst.loop": ("Loop",),
+    "motionhyst.controllers.loop": ("Loop",),
     "motionhyst.analysis.quasilinear": ("QuasiLinearAnalysis", "analyze"),
     "motionhyst.time.references": ("PointToPoint", "SampledReference", "SineReference",
                               "load_reference_csv"),
@@ -71,6 +71,7 @@ if TYPE_CHECKING:
     from motionhyst.analysis.quasilinear import QuasiLinearAnalysis, analyze
     from motionhyst.analysis.steady import SteadyState, periodic_steady_state, steady_state_sweep
     from motionhyst.controllers.leadlag import LeadLagLowpass
+    from motionhyst.controllers.loop import Loop
     from motionhyst.core.warnings import MotionhystWarning
     from motionhyst.hysteresis import (
         BoucWen,
@@ -81,7 +82,6 @@ if TYPE_CHECKING:
         MaxwellIwan,
         MaxwellSlip,
     )
-    from motionhyst.loop import Loop
     from motionhyst.plants.frf_fit import FrfFit, ModalPlant, fit_frf
     from motionhyst.plants.measured import MeasuredPlant, load_frd_plant
     from motionhyst.plants.two_mass import TwoMassStage
@@ -126,6 +126,7 @@ _MOVED = {
     "motionhyst.comparison": ("motionhyst.analysis.comparison",),
     "motionhyst.simulate": ("motionhyst.time.simulation",),
     "motionhyst.openloop": ("motionhyst.time.openloop",),
+    "motionhyst.loop": ("motionhyst.controllers.loop",),
     "motionhyst.timeseries": ("motionhyst.time.timeseries",),
     "motionhyst.references": ("motionhyst.time.references",),
     "motionhyst.ilc": ("motionhyst.scan.ilc",),

@@ -25,8 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.analysis.plausibility import check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.analysis.steady import SteadyState, steady_state_sweep
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.textfmt import g, table
-from motionhyst.loop import Loop
 
 __all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
 

@@ -32,10 +32,10 @@ from motionhyst.analysis.margins import LoopMargins, loop_margins
 from motionhyst.analysis.quasilinear import loop_mismatch
 from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.controllers.feedforward import Feedforward
+from motionhyst.controllers.loop import Loop
 from motionhyst.controllers.sampled import SampledController
 from motionhyst.core.jsonio import jsonable
 from motionhyst.core.textfmt import g, table
-from motionhyst.loop import Loop
 
 __all__ = ["DigitalComparison", "DigitalPoint", "DigitalVariant", "compare_digital"]
 

@@ -10,7 +10,7 @@ and its low-frequency asymptote (eq. 20), with the characteristic frequencies
 With a sampled controller the analysis is that of the sampled-data loop:
 the controller and the hold are evaluated at ``z = e^{j w T}``, the plant and the
 link act in continuous time, and eq. (18) is the ratio of the fundamentals of
-the error with and without the link (:meth:`motionhyst.loop.Loop.transfer`).
+the error with and without the link (:meth:`motionhyst.controllers.loop.Loop.transfer`).
 What is approximated, besides the describing function itself: the link
 acts on the fundamental of ``y1`` only.  The held force also has images at
 ``w + k F`` (``k != 0``, all above the Nyquist frequency ``F / 2`` for ``f < F / 2``);
@@ -37,9 +37,9 @@ from motionhyst.analysis.equations import quasi_linear_plant as quasi_linear_pla
 from motionhyst.analysis.equations import sensitivity_s1 as sensitivity_s1
 from motionhyst.analysis.margins import LoopMargins, loop_margins
 from motionhyst.analysis.plausibility import check_plausible
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.core.textfmt import g, table
-from motionhyst.loop import Loop
 
 if TYPE_CHECKING:
     from motionhyst.plants.measured import MeasuredPlant

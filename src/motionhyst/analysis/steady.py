@@ -36,11 +36,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.sampling import hold_response
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis.periodic import sample_period
-from motionhyst.loop import Loop
 
 __all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
 

@@ -85,7 +85,7 @@ class ModalPlant:
     ``P2 = 1/(M s^2) - sum r2_i / (s^2 + 2 z_i w_i s + w_i^2)``.  It offers
     what :class:`~motionhyst.plants.two_mass.TwoMassStage` offers (``P1``, ``P2``,
     ``Pr``, ``Pf1``, ``Pf2`` as python-control transfer functions, ``M``), so
-    a :class:`~motionhyst.loop.Loop` and every analysis take it.
+    a :class:`~motionhyst.controllers.loop.Loop` and every analysis take it.
 
     Parameters
     ----------

@@ -16,7 +16,7 @@ __all__ = ["TransferPlant"]
 class TransferPlant:
     """Any plant as python-control systems: ``y1 = P1 (u - w)``, ``y2 = P2 (u - w)``.
 
-    What a :class:`~motionhyst.loop.Loop` makes of a tuple ``(P1, P2)``: the
+    What a :class:`~motionhyst.controllers.loop.Loop` makes of a tuple ``(P1, P2)``: the
     analyses take ``Pf2 = Pr - P2`` and know no static flexible compliance
     (eq. 21 needs a model of the modes: a :class:`~motionhyst.plants.ModalPlant`).
 

@@ -33,7 +33,7 @@ __all__ = ["describing_function_curve", "fig5_loops", "fig6_modes", "fig7_time",
 if TYPE_CHECKING:
     from motionhyst.analysis.quasilinear import QuasiLinearAnalysis
     from motionhyst.analysis.steady import SteadyState
-    from motionhyst.loop import Loop
+    from motionhyst.controllers.loop import Loop
 
 
 def _phase_deg(P) -> np.ndarray:

@@ -7,7 +7,7 @@ updated from the trial's error ``e_j`` over the whole trial (non-causally)::
 
 ``PS`` is the loop's process sensitivity, the transfer from a force at the
 actuator to the error (``e = -PS u_ff + PS w``, the paper's ``w -> e``
-transfer, see :mod:`motionhyst.loop`).  In the linear loop the error then
+transfer, see :mod:`motionhyst.controllers.loop`).  In the linear loop the error then
 contracts by ``Q (1 - gain)`` per trial, up to what the robustness filter
 ``Q`` leaves out.  ``Q`` is a zero-phase low-pass: the squared magnitude of a
 Butterworth filter, ``Q = 1 / (1 + (f / cutoff_hz)^(2 order))``, i.e. a
@@ -29,8 +29,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI
-from motionhyst.loop import Loop
 from motionhyst.time.simulation import Simulation, default_step, simulate
 
 __all__ = ["ILCFilters", "ILCResult", "learn"]

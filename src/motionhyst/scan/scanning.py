@@ -28,10 +28,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.core.textfmt import g, table
-from motionhyst.loop import Loop
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
 from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
 from motionhyst.time.simulation import BYTES_PER_SAMPLE, default_step, simulate

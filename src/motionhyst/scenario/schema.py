@@ -36,8 +36,8 @@ __all__ = ["Scenario", "ScenarioError", "default_scenario", "default_scenario_pa
 if TYPE_CHECKING:  # imported where used: validating a file needs neither python-control nor scipy
     import control
 
+    from motionhyst.controllers.loop import Loop
     from motionhyst.controllers.sampled import SampledController
-    from motionhyst.loop import Loop
     from motionhyst.plants.frf_fit import FrfFit
     from motionhyst.plants.registry import Plant
     from motionhyst.time.openloop import OpenLoop
@@ -283,7 +283,7 @@ class Scenario:
         """The loop (built once, checked for stability)."""
         self._closed("this")
         if self._loop is None:
-            from motionhyst.loop import Loop
+            from motionhyst.controllers.loop import Loop
 
             sec = self.model.feedforward
             ff = None if sec.type == "none" else "rigid-body"

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from motionhyst.analysis.steady import SteadyState, periodic_steady_state
-from motionhyst.loop import Loop
+from motionhyst.controllers.loop import Loop
 
 __all__ = ["OUTPUTS", "Output", "Point", "register_output"]
 

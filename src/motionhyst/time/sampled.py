@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from motionhyst.loop import Loop
+from motionhyst.controllers.loop import Loop
 from motionhyst.time.engine import run_sampled
 from motionhyst.time.simulation_result import Simulation
 

@@ -1,6 +1,6 @@
 """Time simulation of the nonlinear loop from rest, for any reference.
 
-The loop is split as in :mod:`motionhyst.loop`: the tracking error and the
+The loop is split as in :mod:`motionhyst.controllers.loop`: the tracking error and the
 deviation ``y1 - r`` are computed directly from the reference's acceleration
 ``r''`` and the hysteresis force ``w``::
 
@@ -21,6 +21,7 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import (
     TWO_PI,
@@ -34,7 +35,6 @@ from motionhyst.core.lti import (
 )
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
-from motionhyst.loop import Loop
 from motionhyst.time.engine import FohStep, LoopState, run_steps
 from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS
 from motionhyst.time.sampled import simulate_sampled

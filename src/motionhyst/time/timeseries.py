@@ -23,9 +23,9 @@ from typing import IO
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfiles import csv_header, csv_rows
-from motionhyst.loop import Loop
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
 from motionhyst.time.simulation import (
     STEPS_PER_POLE_PERIOD,
