@@ -295,7 +295,8 @@ def _paper_loop(loop: Loop) -> bool:
     """A continuous loop with the paper's feedforward ``M s^2`` alone: eq. (18) as written."""
     ff = loop.ff
     return (loop.sampled is None and loop.hysteresis_feedforward is None and ff is not None
-            and ff.mass == loop.M and not ff.viscous and not ff.coulomb)
+            and ff.mass == loop.M and not ff.viscous and not ff.coulomb and not ff.jerk
+            and not ff.snap)
 
 
 def _feedforward_df(loop: Loop, amplitude, omega) -> NDArray[np.complex128] | float:

@@ -1,12 +1,13 @@
-"""Feedforward from the setpoint: acceleration, viscous and Coulomb friction terms, advanced.
+"""Feedforward from the setpoint: acceleration, jerk, snap, viscous, Coulomb terms, advanced.
 
 The force a motion controller adds to its feedback, computed from the setpoint
 ``r`` alone::
 
-    u_ff = m r'' + c r' + fc sign(r')          (+ phi_hat(r), a hysteresis model)
+    u_ff = m r'' + cj r''' + cs r'''' + c r' + fc sign(r')   (+ phi_hat(r), a hysteresis model)
 
 with ``m`` the rigid-body mass (the paper's ``C_ff = P_r^-1 = M s^2`` when
-only ``m`` is given).  A sampled controller applies its whole output
+only ``m`` is given; ``cj``, ``cs``: the stage's jerk and snap terms,
+:mod:`motionhyst.controllers.inverse`).  A sampled controller applies its whole output
 ``d`` samples late; a machine reads the setpoint that many samples ahead for
 the feedforward (``advance_samples = a``: ``u_ff,k`` from ``r(t_k + a T)``),
 which takes the delay out of the feedforward path: the rigid-body
@@ -42,7 +43,7 @@ STANDSTILL = 1e-12
 
 @dataclass(frozen=True)
 class Feedforward:
-    """The setpoint feedforward ``u_ff = m r'' + c r' + fc sign(r')``, read `a` samples ahead.
+    """The setpoint feedforward ``m r'' + cj r''' + cs r'''' + c r' + fc sign(r')``, read ahead.
 
     Parameters
     ----------
@@ -56,6 +57,9 @@ class Feedforward:
     advance_samples : float
         ``a >= 0``: the feedforward of a sampled controller reads the setpoint
         ``a`` samples ahead (fractional allowed); needs a sampled controller.
+    jerk, snap : float
+        ``cj`` [N s^3/m] and ``cs`` [N s^4/m], finite (0: none): the stage's damping
+        and compliance terms (:func:`~motionhyst.controllers.inverse.stage_inverse`).
 
     Examples
     --------
@@ -68,8 +72,13 @@ class Feedforward:
     viscous: float = 0.0
     coulomb: float = 0.0
     advance_samples: float = 0.0
+    jerk: float = 0.0
+    snap: float = 0.0
 
     def __post_init__(self) -> None:
+        for name in ("jerk", "snap"):
+            if not math.isfinite(getattr(self, name)):
+                raise ValueError(f"feedforward {name} must be finite, got {getattr(self, name)!r}")
         for name in ("viscous", "coulomb", "advance_samples", "mass"):
             v = getattr(self, name)
             if v is None:
@@ -92,18 +101,25 @@ class Feedforward:
         """True without a Coulomb term."""
         return self.coulomb == 0.0
 
-    def force(self, velocity: ArrayLike, acceleration: ArrayLike) -> NDArray[np.float64]:
-        """``m r'' + c r' + fc sign(r')`` [N] for the setpoint's velocity and acceleration.
+    def force(self, velocity: ArrayLike, acceleration: ArrayLike, jerk: ArrayLike = 0.0,
+              snap: ArrayLike = 0.0) -> NDArray[np.float64]:
+        """``m r'' + cj r''' + cs r'''' + c r' + fc sign(r')`` [N] from the setpoint's derivatives.
 
         Parameters
         ----------
         velocity, acceleration : array_like
             ``r'`` [m/s] and ``r''`` [m/s^2] (already read ahead, if advanced).
+        jerk, snap : array_like
+            ``r'''`` [m/s^3] and ``r''''`` [m/s^4] (needed with those terms only).
         """
         v = np.asarray(velocity, dtype=float)
         m = 0.0 if self.mass is None else self.mass
-        return m * np.asarray(acceleration, dtype=float) + self.viscous * v + \
-            self.coulomb_force(v)
+        out = m * np.asarray(acceleration, dtype=float) + self.viscous * v + self.coulomb_force(v)
+        if self.jerk:
+            out = out + self.jerk * np.asarray(jerk, dtype=float)
+        if self.snap:
+            out = out + self.snap * np.asarray(snap, dtype=float)
+        return out
 
     def coulomb_force(self, velocity: ArrayLike) -> NDArray[np.float64]:
         """``fc sign(r')`` [N], 0 at a standstill (``|r'| <=`` :data:`STANDSTILL`).
@@ -117,7 +133,8 @@ class Feedforward:
         return self.coulomb * np.where(np.abs(v) <= STANDSTILL, 0.0, np.sign(v))
 
     def linear_response(self, omega: ArrayLike) -> NDArray[np.complex128]:
-        """``m (j w)^2 + c j w``: the linear terms' force per unit setpoint at `omega` [rad/s].
+        """``cs (j w)^4 + cj (j w)^3 + m (j w)^2 + c j w``: the linear terms' force per unit
+        setpoint at `omega` [rad/s].
 
         Parameters
         ----------
@@ -126,7 +143,7 @@ class Feedforward:
         """
         s = 1j * np.asarray(omega, dtype=float)
         m = 0.0 if self.mass is None else self.mass
-        return m * s * s + self.viscous * s
+        return ((self.snap * s + self.jerk) * s + m) * s * s + self.viscous * s
 
     def coulomb_fundamental(self, amplitude: float) -> complex:
         """Fundamental of ``fc sign(r')`` per unit setpoint, ``r = A sin(w t)``: ``4j fc / (pi A)``.
@@ -143,7 +160,7 @@ class Feedforward:
         out: dict = {}
         if self.mass is not None:
             out["acceleration"] = self.mass
-        for key in ("viscous", "coulomb", "advance_samples"):
+        for key in ("viscous", "coulomb", "advance_samples", "jerk", "snap"):
             if getattr(self, key):
                 out[key] = getattr(self, key)
         return out

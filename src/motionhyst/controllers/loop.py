@@ -175,8 +175,9 @@ class Loop:
         char = np.polyadd(np.polymul(d2, dc), np.polymul(n2, nc))  # (1 + C P2) d2 dc
         if self.ff is not None:
             # 1 - P2 C_ff = (d2 - C_ff n2) / d2; C + C_ff = (nc + C_ff dc) / dc,
-            # C_ff = m s^2 + c s (m = M: the paper's rigid-body feedforward)
-            c_ff = [self.ff.mass, self.ff.viscous, 0.0]
+            # C_ff = cs s^4 + cj s^3 + m s^2 + c s (m = M: the paper's rigid-body feedforward)
+            ff = self.ff
+            c_ff = np.trim_zeros([ff.snap, ff.jerk, ff.mass, ff.viscous, 0.0], "f")
             ff_num = polysub_exact(d2, np.polymul(n2, c_ff))
             cff = np.polyadd(nc, np.polymul(dc, c_ff))
         else:
@@ -428,7 +429,7 @@ class SampledParts:
             num = (num - 1.0) + lag + He * (1.0 - m / loop.M) + He * m * s * s * self.Pf2(w)
         else:
             num = num - He * m * s * s * P2
-        return (num - He * ff.viscous * s * P2) / den
+        return (num - He * (((ff.snap * s + ff.jerk) * s * s + ff.viscous) * s) * P2) / den
 
     def poles(self) -> NDArray[np.complex128]:
         """``ln(z) / T`` of the sampled loop's poles ``z`` (the link left out)."""

@@ -40,6 +40,7 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
     from motionhyst.controllers.sampled import SampledController
     from motionhyst.plants.frf_fit import FrfFit
     from motionhyst.plants.registry import Plant
+    from motionhyst.scenario.sections import FeedforwardSection
     from motionhyst.time.openloop import OpenLoop
 
 
@@ -279,6 +280,19 @@ class Scenario:
         return SampledController.discretize(cont, c.sample_rate_hz, method, c.prewarp_hz,
                                             delay, c.u_max)
 
+    def _derivative_terms(self, sec: FeedforwardSection) -> dict[str, float]:
+        """``[feedforward]`` jerk and snap, ``"plant"`` taken from the plant's inverse."""
+        out = {"jerk": sec.jerk or 0.0, "snap": sec.snap or 0.0}
+        if "plant" in (sec.jerk, sec.snap):
+            from motionhyst.controllers.inverse import stage_inverse
+
+            try:
+                inverse = stage_inverse(self.plant())
+            except ValueError as exc:
+                raise ScenarioError(f"{self.source}: [feedforward]: {exc}") from None
+            out = {k: getattr(inverse, k) if v == "plant" else v for k, v in out.items()}
+        return out
+
     def loop(self) -> Loop:
         """The loop (built once, checked for stability)."""
         self._closed("this")
@@ -288,12 +302,14 @@ class Scenario:
             sec = self.model.feedforward
             ff = None if sec.type == "none" else "rigid-body"
             if sec.type != "none" and (sec.acceleration is not None or sec.viscous
-                                       or sec.coulomb or sec.advance_samples):
+                                       or sec.coulomb or sec.advance_samples or sec.jerk
+                                       or sec.snap):
                 from motionhyst.controllers.feedforward import Feedforward
 
                 ff = Feedforward(mass=sec.acceleration, viscous=sec.viscous or 0.0,
                                  coulomb=sec.coulomb or 0.0,
-                                 advance_samples=sec.advance_samples or 0.0)
+                                 advance_samples=sec.advance_samples or 0.0,
+                                 **self._derivative_terms(sec))
             hff = sec.hysteresis
             # each part's own errors name their section: only the loop's are [controller]'s
             parts = (self.plant(), self.controller(), self.hysteresis())

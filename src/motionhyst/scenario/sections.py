@@ -294,7 +294,9 @@ class FeedforwardSection(_Section):
     ``acceleration = m`` [kg] replaces the plant's mass in ``m r''``, ``viscous = c``
     [N s/m] adds ``c r'``, ``coulomb = fc`` [N] adds ``fc sign(r')``
     (:class:`~motionhyst.controllers.feedforward.Feedforward`); ``advance_samples = a``
-    reads the setpoint ``a`` samples ahead for a sampled controller.
+    reads the setpoint ``a`` samples ahead for a sampled controller; ``jerk`` and ``snap``
+    [N s^3/m, N s^4/m] add the stage's damping and compliance terms, a number or
+    ``"plant"`` (the terms of the plant's inverse, :mod:`motionhyst.controllers.inverse`).
     """
 
     type: Literal["rigid-body", "none"] = "rigid-body"
@@ -303,11 +305,14 @@ class FeedforwardSection(_Section):
     viscous: NonNegativeFloat | None = None   # None: 0, and not written back by to_dict
     coulomb: NonNegativeFloat | None = None
     advance_samples: NonNegativeFloat | None = None
+    jerk: Annotated[float, Field(allow_inf_nan=False)] | Literal["plant"] | None = None
+    snap: Annotated[float, Field(allow_inf_nan=False)] | Literal["plant"] | None = None
 
     @model_validator(mode="after")
     def _terms_need_a_feedforward(self):
         if self.type == "none":
-            given = [k for k in ("acceleration", "viscous", "coulomb", "advance_samples")
+            given = [k for k in ("acceleration", "viscous", "coulomb", "advance_samples",
+                                 "jerk", "snap")
                      if getattr(self, k)]
             if given:
                 raise ValueError(f"{', '.join(given)} cannot go with type = \"none\" (no "

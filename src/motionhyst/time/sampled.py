@@ -8,6 +8,8 @@ plus the feedforward from the setpoint read ``a`` samples ahead::
 
     u_ff,k = m r''(t_k + a T) + c r'(t_k + a T) + fc sign(r'(t_k + a T)) + phi_hat(r(t_k + a T))
 
+(plus ``cj r'''`` and ``cs r''''`` at ``t_k + a T`` with a jerk and a snap term)
+
 (``phi_hat`` evaluated on the setpoint's samples, as the machine does), limits
 it to ``|u| <= u_max`` and applies it from ``t_k + d T`` on, held.  The output
 is at the controller's samples.  The same run without the link gives the
@@ -68,7 +70,13 @@ def feedforward_samples(loop: Loop, reference, t: ArrayLike) -> np.ndarray:
         return out
     ahead = t + (0.0 if ff is None else ff.advance_samples) * loop.sampled.period
     r, acc = reference(ahead)
-    if ff is not None:
+    if ff is not None and (ff.jerk or ff.snap):
+        if not callable(getattr(reference, "derivatives", None)):
+            raise ValueError("the jerk and snap feedforward need the setpoint's derivatives, "
+                             f"which a {type(reference).__name__} does not give")
+        d = np.asarray(reference.derivatives(ahead), dtype=float)
+        out += ff.force(d[1], d[2], d[3], d[4])
+    elif ff is not None:
         v = _velocity(reference, ahead) if (ff.viscous or ff.coulomb) else np.zeros(t.shape)
         out += ff.force(v, acc)
     if hff is not None:

@@ -170,11 +170,12 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
 def _check_feedforward(loop: Loop) -> None:
     """The continuous run takes the rigid-body feedforward ``M r''`` alone; say so otherwise."""
     ff = loop.ff
-    if ff is not None and (ff.viscous or ff.coulomb or ff.mass != loop.M):
+    if ff is not None and (ff.viscous or ff.coulomb or ff.mass != loop.M or ff.jerk
+                           or ff.snap):
         raise ValueError("the continuous loop's time simulation takes the rigid-body "
-                         "feedforward M r'' alone; [feedforward] acceleration, viscous and "
-                         "coulomb are run with a sampled controller ([controller] "
-                         "sample_rate_hz), and analysed either way")
+                         "feedforward M r'' alone; [feedforward] acceleration, viscous, "
+                         "coulomb, jerk and snap are run with a sampled controller "
+                         "([controller] sample_rate_hz) or by `scan`, and analysed either way")
 
 
 def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = None,
