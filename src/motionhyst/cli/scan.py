@@ -1,6 +1,7 @@
 """``motionhyst scan``: a fourth-order setpoint through the loop, graded by the moving
 average and moving standard deviation of the error over the exposure window, with the
-compensations compared (none, the scenario's hysteresis model, learning control).
+compensations compared (none, the scenario's model feedforward, learning control of a
+force, learning of the model's coefficients).
 """
 
 from __future__ import annotations
@@ -30,11 +31,17 @@ _count = whole_number(1, 1000, "trials")
 ILC_DEFAULTS = {"ilc_trials": 10, "ilc_gain": 1.0, "ilc_cutoff": 300.0, "ilc_order": 2}
 """Learning control's options unless given (they apply with ``--compensation ilc`` only)."""
 
+BASIS_TRIALS = 4
+"""Trials of ``--compensation basis`` unless given (the first is the model's run)."""
+
+TERMS = ("jerk", "snap", "viscous", "coulomb", "hysteresis")
+"""The model feedforward's terms ``--feedforward`` switches on (motionhyst.scan.terms.TERMS)."""
+
 
 def add_parser(sub) -> None:
     """Register ``scan`` on the subcommand parsers `sub`."""
     q = sub.add_parser("scan", help="scan or point-to-point setpoint: MA/MSD of the error, "
-                       "compensation by the hysteresis model and by learning control")
+                       "compensation by the model feedforward and by learning")
     q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
     q.add_argument("--length", type=positive, required=True,
                    help="scan length at constant velocity (point-to-point: move length) [m]")
@@ -53,9 +60,15 @@ def add_parser(sub) -> None:
                    help="controller rate: switching instants on its samples [Hz]")
     q.add_argument("--window", type=positive, default=0.01, metavar="W",
                    help="exposure window of MA and MSD, slit width / scan speed [s] (0.01)")
-    q.add_argument("--compensation", nargs="+", choices=["none", "model", "ilc"],
+    q.add_argument("--compensation", nargs="+", choices=["none", "model", "ilc", "basis"],
                    help="compensations to compare (default: none, model if the scenario has "
-                        "a [feedforward] hysteresis model, ilc)")
+                        "a model feedforward, ilc, basis)")
+    q.add_argument("--feedforward", nargs="+", choices=TERMS, metavar="TERM",
+                   help="the model feedforward's terms beside M r'': jerk, snap (the "
+                        "scenario's, else the plant's inverse), viscous, coulomb, hysteresis "
+                        "(default: those of the scenario's [feedforward])")
+    q.add_argument("--basis-trials", type=_count, metavar="N",
+                   help="trials of the basis learning; the first runs the model (4)")
     q.add_argument("--ilc-trials", type=_count, metavar="N",
                    help="learning trials; the last is the ilc result (10)")
     q.add_argument("--ilc-gain", type=positive,
@@ -112,17 +125,34 @@ def run(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario)
     loop = sc.loop()
     warn_plant_fit(sc)
-    has_model = loop.hysteresis_feedforward is not None
-    comps = args.compensation or (["none", "model", "ilc"] if has_model else ["none", "ilc"])
+    ff = loop.ff
+    terms = args.feedforward
+    if terms is None:
+        terms = [t for t in TERMS[:-1] if ff is not None and getattr(ff, t)]
+        terms += ["hysteresis"] if loop.hysteresis_feedforward is not None else []
+    elif len(set(terms)) != len(terms):
+        raise UsageError(f"{PROG}: --feedforward lists one twice")
+    if "hysteresis" in terms and loop.hysteresis_feedforward is None:
+        raise UsageError(f"{PROG}: --feedforward hysteresis needs a [feedforward] hysteresis "
+                         f"model, and {sc.source} has none")
+    has_model = bool(terms)
+    comps = args.compensation or (["none", "model", "ilc", "basis"] if has_model
+                                  else ["none", "ilc", "basis"])
     if len(set(comps)) != len(comps):
         raise UsageError(f"{PROG}: --compensation lists one twice")
     if "model" in comps and not has_model:
         raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
-                         f"model, and {sc.source} has none")
+                         f"model or feedforward terms (--feedforward), and {sc.source} has none")
     if "ilc" not in comps:
-        refuse_unused(args, ("--ilc-trials", "--ilc-gain", "--ilc-cutoff", "--ilc-order",
-                             "--other-length", "--other-speed"),
+        refuse_unused(args, ("--ilc-trials", "--ilc-gain", "--ilc-cutoff", "--ilc-order"),
                       "without --compensation ilc (it shapes learning control only)")
+    if "basis" not in comps:
+        refuse_unused(args, ("--basis-trials",), "without --compensation basis")
+    if "ilc" not in comps and "basis" not in comps:
+        refuse_unused(args, ("--other-length", "--other-speed"),
+                      "without --compensation ilc or basis (the carry-over of what they learn)")
+    if not {"model", "basis"} & set(comps):
+        refuse_unused(args, ("--feedforward",), "without --compensation model or basis")
     for name, value in ILC_DEFAULTS.items():
         if getattr(args, name) is None:
             setattr(args, name, value)
@@ -132,14 +162,20 @@ def run(args: argparse.Namespace) -> int:
     try:
         profile = _profile(args, args.length, args.speed)
         other = None
-        if "ilc" in comps:
+        if "ilc" in comps or "basis" in comps:
             other = _profile(args, args.other_length or args.length,
                              args.other_speed or 0.5 * args.speed)
     except ValueError as exc:
         raise UsageError(f"{PROG}: {exc}") from None
     filters = ILCFilters(args.ilc_gain, args.ilc_cutoff, args.ilc_order)
-    res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
-                   args.settle_tol, args.tail)
+    try:
+        res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
+                       args.settle_tol, args.tail, feedforward=terms,
+                       basis_trials=args.basis_trials or BASIS_TRIALS)
+    except ValueError as exc:
+        if "feedforward" in str(exc) or "inverse" in str(exc) or "P2" in str(exc):
+            raise UsageError(f"{PROG}: {exc}") from None
+        raise
     if out is not None:
         out.write_csv(res.columns())
     if args.json:

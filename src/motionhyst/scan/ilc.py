@@ -33,7 +33,33 @@ from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI
 from motionhyst.time.simulation import Simulation, default_step, simulate
 
-__all__ = ["ILCFilters", "ILCResult", "learn"]
+__all__ = ["ILCFilters", "ILCResult", "learn", "process_sensitivity"]
+
+
+def process_sensitivity(loop: Loop, f_hz) -> NDArray[np.complex128]:
+    """``PS = P2 / (1 + C P2)`` of `loop` at `f_hz` [Hz]: a force at the actuator gives ``-PS f``.
+
+    For a sampled controller, at its rate on the error's samples (a force added to
+    its output): ``PS = G_d / (1 + Y G_d)`` at ``z = e^{j 2 pi f T}``.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop.
+    f_hz : array_like
+        Frequencies [Hz].
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> ps = process_sensitivity(default_scenario().loop(), [0.0])
+    >>> print(f"{ps[0].real:.4g} m/N")                    # 1 / C(0): no integrator
+    1.613e-07 m/N
+    """
+    w = TWO_PI * np.asarray(f_hz, dtype=float)
+    if loop.sampled is not None:  # at the controller's samples: G_d / (1 + Y G_d)
+        return loop.sampled_parts.process_sensitivity(w)
+    return loop.transfer("w->e", w)
 
 
 @dataclass(frozen=True)
@@ -95,11 +121,7 @@ class ILCFilters:
         f_hz : array_like
             Frequencies [Hz].
         """
-        w = TWO_PI * np.asarray(f_hz, dtype=float)
-        if loop.sampled is not None:  # at the controller's samples: G_d / (1 + Y G_d)
-            ps = loop.sampled_parts.process_sensitivity(w)
-        else:
-            ps = loop.transfer("w->e", w)
+        ps = process_sensitivity(loop, f_hz)
         out = np.zeros(ps.shape, dtype=complex)
         ok = np.abs(ps) > 0
         out[ok] = self.gain / ps[ok]

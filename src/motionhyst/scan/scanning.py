@@ -14,10 +14,13 @@ whose whole window lies inside the phase (the points a scan exposes).
 
 :func:`run_scan` simulates a setpoint profile (:mod:`motionhyst.scan.profiles`)
 from rest with the loop's dynamic link and compares compensations: ``none``
-(rigid-body feedforward only), ``model`` (the loop's hysteresis feedforward
-``phi_hat(r)``, driven by the setpoint) and ``ilc`` (a force learned over
-trials, :mod:`motionhyst.scan.ilc`); and, on another setpoint, whether the learned
-force and the model carry over.
+(rigid-body feedforward ``M r''`` only), ``model`` (the model feedforward's
+terms, :mod:`motionhyst.scan.terms`: the stage's jerk and snap terms, friction,
+the hysteresis model ``phi_hat(r)``, driven by the setpoint), ``ilc`` (a force
+learned over trials, :mod:`motionhyst.scan.ilc`) and ``basis`` (the model's
+coefficients learned over trials, :mod:`motionhyst.scan.basis`); and, on another
+setpoint, whether the learned force, the model and the learned coefficients
+carry over.
 """
 
 from __future__ import annotations
@@ -28,23 +31,26 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.core.textfmt import g, table
+from motionhyst.scan.basis import BasisResult, learn_basis
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
 from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
+from motionhyst.scan.terms import TERMS, FeedforwardTerms, model_terms
 from motionhyst.time.simulation import BYTES_PER_SAMPLE, default_step, simulate
 
 __all__ = ["ScanResult", "ScanRun", "moving_statistics", "run_scan", "settling_time"]
 
-COMPENSATIONS = ("none", "model", "ilc")
+COMPENSATIONS = ("none", "model", "ilc", "basis")
 """The compensations :func:`run_scan` compares."""
 
 DEFAULT_SETTLE_TOLERANCE = 1e-9
 """Error band for the settling time [m]."""
 
-COLORS = {"none": "tab:red", "model": "tab:blue", "ilc": "tab:green"}
+COLORS = {"none": "tab:red", "model": "tab:blue", "ilc": "tab:green", "basis": "tab:purple"}
 
 
 @njit(cache=True)
@@ -154,8 +160,8 @@ class ScanRun:
     Attributes
     ----------
     compensation : str
-        ``"none"``, ``"model"`` or ``"ilc"`` (``"without link"`` for the loop
-        without its dynamic link).
+        ``"none"``, ``"model"``, ``"ilc"`` or ``"basis"`` (``"without link"`` for
+        the loop without its dynamic link).
     t, e, ma, msd : ndarray
         Time [s], error, its moving average and moving standard deviation [m].
     ma_max, msd_max : float or None
@@ -242,7 +248,12 @@ class ScanResult:
     ilc : ILCResult or None
         The learning's trials, if ``ilc`` was asked.
     carry_over : ScanResult or None
-        Another setpoint with the model and the force learned on this one.
+        Another setpoint with the model, the force and the coefficients learned
+        on this one.
+    terms : FeedforwardTerms or None
+        The model feedforward's terms and coefficients (``model``, ``basis``).
+    basis : BasisResult or None
+        The learning of the coefficients, if ``basis`` was asked.
 
     Examples
     --------
@@ -262,6 +273,8 @@ class ScanResult:
     without_link: ScanRun
     ilc: ILCResult | None = None
     carry_over: ScanResult | None = None
+    terms: FeedforwardTerms | None = None
+    basis: BasisResult | None = None
 
     @property
     def t(self) -> NDArray[np.float64]:
@@ -274,7 +287,8 @@ class ScanResult:
         Parameters
         ----------
         compensation : str
-            One of the compensations compared (``"none"``, ``"model"``, ``"ilc"``).
+            One of the compensations compared (``"none"``, ``"model"``, ``"ilc"``,
+            ``"basis"``).
         """
         for r in self.runs:
             if r.compensation == compensation:
@@ -282,13 +296,17 @@ class ScanResult:
         raise KeyError(compensation)
 
     def to_dict(self) -> dict:
-        """Window, profile, results, without link, ILC trials, carry-over (JSON keys here)."""
+        """Window, profile, results, without link, terms, learning, carry-over (JSON keys)."""
         d = {"window_s": self.window, "settle_tolerance": self.settle_tolerance,
              "profile": self.profile.to_dict(), "results": [r.to_dict() for r in self.runs],
              "without_link": {k: v for k, v in self.without_link.to_dict().items()
                               if k != "compensation"}}
+        if self.terms is not None:
+            d["feedforward"] = self.terms.to_dict()
         if self.ilc is not None:
             d["ilc"] = self.ilc.to_dict()
+        if self.basis is not None:
+            d["basis"] = self.basis.to_dict()
         if self.carry_over is not None:
             c = self.carry_over
             d["carry_over"] = {"profile": c.profile.to_dict(),
@@ -322,8 +340,11 @@ class ScanResult:
                f"{self.settle_tolerance:g} m", self._table()]
         if self.ilc is not None:
             out.append(str(self.ilc))
+        if self.basis is not None:
+            out.append(str(self.basis))
         if self.carry_over is not None:
-            out += ["carried over to another setpoint (model and learned force unchanged):",
+            out += ["carried over to another setpoint (model, learned force and learned "
+                    "coefficients unchanged):",
                     f"{self.carry_over.profile}", self.carry_over._table(without_link=False)]
         return "\n".join(out)
 
@@ -372,45 +393,53 @@ class ScanResult:
         return fig
 
 
-def _without_hysteresis_feedforward(loop: Loop) -> Loop:
-    if loop.hysteresis_feedforward is None:
-        return loop
-    return Loop(loop.plant, loop.controller, loop.hysteresis,
-                feedforward=loop.ff if loop.ff is not None else None, mass=loop.M)
+def _rigid_body(loop: Loop, hysteresis_feedforward=None) -> Loop:
+    """`loop` with the rigid-body feedforward ``M r''`` alone (advanced as the loop's)."""
+    advance = 0.0 if loop.ff is None else loop.ff.advance_samples
+    ff = Feedforward(mass=loop.M, advance_samples=advance) if loop.ff is not None else None
+    return Loop(loop.plant, loop.controller, loop.hysteresis, feedforward=ff, mass=loop.M,
+                hysteresis_feedforward=hysteresis_feedforward)
 
 
 def run_scan(loop: Loop, profile: Profile, window: float,
              compensations: tuple[str, ...] | list[str] = ("none",), ilc_trials: int = 10,
              ilc_filters: ILCFilters | None = None, other_profile: Profile | None = None,
              settle_tolerance: float = DEFAULT_SETTLE_TOLERANCE, tail: float = 0.05,
-             dt: float | None = None) -> ScanResult:
+             dt: float | None = None, feedforward: tuple[str, ...] | list[str] | None = None,
+             basis_trials: int = 4) -> ScanResult:
     """Simulate `profile` from rest with each compensation and grade the scans.
 
     Parameters
     ----------
     loop : Loop
-        The loop with its dynamic link; for ``model`` its
-        ``hysteresis_feedforward`` (a scenario's ``[feedforward] hysteresis``).
+        The loop with its dynamic link, its feedforward and its hysteresis
+        feedforward (a scenario's ``[feedforward]``).
     profile : Profile
         The setpoint.
     window : float
         Exposure window ``W`` [s] of MA and MSD.
-    compensations : sequence of {"none", "model", "ilc"}
+    compensations : sequence of {"none", "model", "ilc", "basis"}
         Which to run, in this order.
     ilc_trials : int
         Trials of the learning (the last is the ``ilc`` run).
     ilc_filters : ILCFilters, optional
         Learning and robustness filters.
     other_profile : Profile, optional
-        Another setpoint: run without compensation, with the model (if asked)
-        and with the force learned on `profile` (if ``ilc`` was asked),
-        unchanged.
+        Another setpoint: run without compensation, with the model (if asked),
+        with the force learned on `profile` (if ``ilc`` was asked) and with the
+        coefficients learned on it (if ``basis`` was asked), unchanged.
     settle_tolerance : float
         Error band of the settling time [m].
     tail : float
         Time simulated after the end of the profile [s].
     dt : float, optional
         Time step [s]; by default the simulation's own.
+    feedforward : sequence of str, optional
+        The model feedforward's terms, of :data:`~motionhyst.scan.terms.TERMS`
+        (default: those of the loop's feedforward;
+        :func:`~motionhyst.scan.terms.model_terms`).
+    basis_trials : int
+        Trials of the coefficients' learning (the first is the ``model`` run).
 
     Returns
     -------
@@ -420,8 +449,8 @@ def run_scan(loop: Loop, profile: Profile, window: float,
     ------
     ValueError
         For an unknown or repeated compensation, ``model`` on a loop without
-        hysteresis feedforward, or a scan whose constant-velocity phases are
-        all shorter than the window.
+        hysteresis feedforward or derivative terms, or a scan whose
+        constant-velocity phases are all shorter than the window.
 
     Examples
     --------
@@ -440,9 +469,16 @@ def run_scan(loop: Loop, profile: Profile, window: float,
             raise ValueError(f"unknown compensation {c!r}; use {', '.join(COMPENSATIONS)}")
     if len(set(comps)) != len(comps) or not comps:
         raise ValueError("give each compensation once, at least one")
-    if "model" in comps and loop.hysteresis_feedforward is None:
+    hff = loop.hysteresis_feedforward
+    names = None if feedforward is None else list(feedforward)
+    if names is None:
+        names = [k for k in TERMS[:-1] if loop.ff is not None and getattr(loop.ff, k)]
+        names += ["hysteresis"] if hff is not None else []
+    if "model" in comps and not names:
         raise ValueError("compensation 'model' needs a hysteresis feedforward model "
-                         "(a scenario's [feedforward] hysteresis)")
+                         "(a scenario's [feedforward] hysteresis) or feedforward terms")
+    if not (isinstance(basis_trials, int) and basis_trials >= 1):
+        raise ValueError(f"basis trials must be a whole number >= 1, got {basis_trials!r}")
     if not (math.isfinite(window) and window > 0):
         raise ValueError(f"window must be finite and > 0 s, got {window!r}")
     if not (math.isfinite(settle_tolerance) and settle_tolerance > 0):
@@ -455,40 +491,90 @@ def run_scan(loop: Loop, profile: Profile, window: float,
             raise ValueError(f"the exposure window ({window:g} s) is longer than the scan "
                              f"({p.constant_velocity_phases()[0].duration:g} s at constant "
                              "velocity)")
-    bare = _without_hysteresis_feedforward(loop)
-    result = _runs(loop, bare, profile, window, comps, ilc_trials, ilc_filters,
-                   settle_tolerance, tail, dt, None)
+    # a rate-dependent link model stays in the loop (its time update), out of the terms
+    in_loop = hff is not None and not hff.rate_independent and "hysteresis" in names
+    terms = None
+    if "model" in comps or "basis" in comps:
+        terms = model_terms(loop, [n for n in names if not (in_loop and n == "hysteresis")])
+    bare = _rigid_body(loop)
+    modelled = _rigid_body(loop, hff) if in_loop else bare
+    setup = _Setup(bare, modelled, terms, _learned_terms(terms), window, ilc_trials,
+                   ilc_filters, basis_trials, settle_tolerance, tail)
+    result = setup.runs(profile, comps, dt)
+    result.terms = terms
     if other_profile is not None:
         learned = result.ilc.force_function() if result.ilc is not None else None
-        result.carry_over = _runs(loop, bare, other_profile, window,
-                                  [c for c in comps if c != "ilc" or learned is not None],
-                                  ilc_trials, ilc_filters, settle_tolerance, tail, None, learned)
+        basis = result.basis.terms if result.basis is not None else None
+        result.carry_over = setup.runs(other_profile, comps, None, learned, basis)
     return result
 
 
-def _runs(loop, bare, profile, window, comps, ilc_trials, ilc_filters, tol, tail, dt,
-          learned) -> ScanResult:
-    """The runs of one setpoint; with `learned` the ``ilc`` run replays that force."""
-    duration = profile.end + tail
-    step = default_step(loop, profile.max_frequency_hz) if dt is None else dt
-    n = int(np.ceil(duration / step)) + 1  # each run keeps its signals: checked before any
-    remedy = "shorten the setpoint (its length, dwell) or the tail after it, or raise the speed"
-    if n > 50_000_000:
-        raise ValueError(f"{n} time steps of {step:.3g} s: too many; {remedy}")
-    check_memory(n * BYTES_PER_SAMPLE * (len(comps) + 2),
-                 f"a scan of {len(comps)} runs of {n:.3g} time steps each", remedy)
-    none = simulate(bare, profile, duration, step)
-    runs, ilc = [], None
-    for c in comps:
-        if c == "none":
-            sim = none
-        elif c == "model":
-            sim = simulate(loop, profile, duration, step)
-        elif learned is not None:
-            sim = simulate(bare, profile, duration, step, force=learned)
-        else:
-            ilc = learn(bare, profile, duration, ilc_trials, ilc_filters, step, first=none)
-            sim = ilc.last
-        runs.append(scan_metrics(sim.t, sim.e, profile, window, c, tol))
-    without = scan_metrics(none.t, none.e_linear, profile, window, "without link", tol)
-    return ScanResult(profile, window, tol, none.r, runs, without, ilc)
+def _learned_terms(terms: FeedforwardTerms | None) -> FeedforwardTerms | None:
+    """The terms ``basis`` learns: the model's, and the stage's mass, jerk and snap always
+    (those the model leaves out from 0, the same force as the model's)."""
+    if terms is None:
+        return None
+    c = terms.coefficients
+    order = ("mass", "jerk", "snap", "viscous", "coulomb")
+    coefficients = {k: c.get(k, 0.0) for k in order if k in c or k in ("jerk", "snap")}
+    return FeedforwardTerms(terms.base_mass, coefficients, terms.link, terms.link_scales)
+
+
+@dataclass
+class _Setup:
+    """The loops and settings of one :func:`run_scan`."""
+
+    bare: Loop
+    modelled: Loop
+    terms: FeedforwardTerms | None
+    learned_terms: FeedforwardTerms | None
+    window: float
+    ilc_trials: int
+    ilc_filters: ILCFilters | None
+    basis_trials: int
+    tol: float
+    tail: float
+
+    def runs(self, profile, comps, dt, learned=None, basis=None) -> ScanResult:
+        """The runs of one setpoint; with `learned` (`basis`) the ``ilc`` (``basis``) run
+        replays that force (those coefficients)."""
+        duration = profile.end + self.tail
+        bare = self.bare
+        step = default_step(bare, profile.max_frequency_hz) if dt is None else dt
+        n = int(np.ceil(duration / step)) + 1  # each run keeps its signals: checked before any
+        remedy = "shorten the setpoint (its length, dwell) or the tail after it, or raise the speed"
+        if n > 50_000_000:
+            raise ValueError(f"{n} time steps of {step:.3g} s: too many; {remedy}")
+        check_memory(n * BYTES_PER_SAMPLE * (len(comps) + 2),
+                     f"a scan of {len(comps)} runs of {n:.3g} time steps each", remedy)
+        advance = 0.0 if bare.ff is None or bare.sampled is None else (
+            bare.ff.advance_samples * bare.sampled.period)
+        averaged = None if bare.sampled is not None else step  # see setpoint_samples
+        none = simulate(bare, profile, duration, step)
+        runs, ilc, model, basis_result = [], None, None, None
+        for c in comps:
+            if c == "none":
+                sim = none
+            elif c == "model" or (c == "basis" and basis is None and model is None):
+                model = simulate(self.modelled, profile, duration, step,
+                                 force=self.terms.force_function(profile, advance, averaged))
+                sim = model
+            if c == "ilc" and learned is not None:
+                sim = simulate(bare, profile, duration, step, force=learned)
+            elif c == "ilc":
+                ilc = learn(bare, profile, duration, self.ilc_trials, self.ilc_filters, step,
+                            first=none)
+                sim = ilc.last
+            elif c == "basis" and basis is not None:
+                sim = simulate(self.modelled, profile, duration, step,
+                               force=basis.force_function(profile, advance, averaged))
+            elif c == "basis":
+                basis_result = learn_basis(self.modelled, self.learned_terms, profile,
+                                           duration, self.basis_trials, step, first=model,
+                                           advance=advance)
+                sim = basis_result.last
+            runs.append(scan_metrics(sim.t, sim.e, profile, self.window, c, self.tol))
+        without = scan_metrics(none.t, none.e_linear, profile, self.window, "without link",
+                               self.tol)
+        return ScanResult(profile, self.window, self.tol, none.r, runs, without, ilc,
+                          basis=basis_result)
