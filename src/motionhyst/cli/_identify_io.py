@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import UsageError, g, print_json, table
+from motionhyst.cli._common import UsageError, g, print_json, table, warn
 
 
 def plant_choices() -> list[str]:
@@ -27,13 +27,39 @@ def _nu(text: str) -> float | str:
     return v
 
 
+def _evaluations(text: str) -> int:
+    """argparse type: a number of model evaluations, 10 to 100000."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 10 <= v <= 100000:
+        raise argparse.ArgumentTypeError(f"must be from 10 to 100000, got {v}")
+    return v
+
+
 def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     """The options of input-output identification."""
     from motionhyst.hysteresis import MODELS
 
     q.add_argument("--plant", choices=plant_choices(),
                    help="input-output records: the stage's model (default mass-spring-damper; "
-                        "two-mass: the floating stage of eqs. 1-2, force and link on m1)")
+                        "mass-damper: a positioning axis, no spring; two-mass: the floating "
+                        "stage of eqs. 1-2, force and link on m1)")
+    q.add_argument("--offset", choices=("auto", "none", "input", "output", "both"),
+                   help="input-output records: the offsets estimated with the model: of the "
+                        "force (one) and of the position (one per record); default auto: both "
+                        "for a floating stage's records from a start (mass-damper, two-mass), "
+                        "none for its periodic ones, the position's for a stage on a spring "
+                        "(where a force offset is only a position offset)")
+    q.add_argument("--from-rest", action="store_true",
+                   help="input-output records: each record starts at rest (default: its "
+                        "initial velocity, and position where a spring holds the stage, are "
+                        "estimated)")
+    q.add_argument("--max-evaluations", type=_evaluations, metavar="N",
+                   help="input-output records: the search's budget of model evaluations, "
+                        "starts and refinement together (default: the starts', then at most "
+                        "200 for the refinement)")
     q.add_argument("--output", choices=("y2", "y1"),
                    help="input-output records, --plant two-mass: the measured position, y2 "
                         "(the point of control, default) or y1 (the actuated mass)")
@@ -55,7 +81,9 @@ def check_not_input_output(args: argparse.Namespace) -> None:
     """One-line error for input-output options given with another record kind."""
     for option, value in (("--plant", args.plant), ("--model", args.model),
                           ("--periodic", args.periodic or None), ("--nu", args.nu),
-                          ("--save", args.save), ("--output", args.output)):
+                          ("--save", args.save), ("--output", args.output),
+                          ("--offset", args.offset), ("--from-rest", args.from_rest or None),
+                          ("--max-evaluations", args.max_evaluations)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
                              f"only")
@@ -93,8 +121,22 @@ def run_input_output(args: argparse.Namespace) -> int:
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
+    if model == "bouc-wen" and (args.offset not in (None, "none") or args.from_rest
+                                or args.max_evaluations is not None):
+        raise UsageError("motionhyst identify: --offset, --from-rest and --max-evaluations "
+                         "apply to the element links (not yet to --model bouc-wen); give "
+                         "--offset none")
+    if args.periodic and args.from_rest:
+        raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
+                         "(a steady state has no start)")
+    extras = ({} if model == "bouc-wen" else
+              {"offset": args.offset or "auto", "from_rest": args.from_rest,
+               "max_evaluations": args.max_evaluations})
     fit = identify_io(records, model, periodic=args.periodic, nu=nu,
-                      n_elements=args.elements or 3, plant=plant, output=args.output or "y2")
+                      n_elements=args.elements or 3, plant=plant, output=args.output or "y2",
+                      **extras)
+    for line in fit.warnings:
+        warn(f"identify: {line}")
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         target.write_text(fit.scenario_text())

@@ -74,6 +74,9 @@ class Coulomb(Hysteresis):
 
     name = "coulomb"
     rate_independent = False
+    #: No elastic range: a time step changes from stick to slip at a parameter's whim, so
+    #: identification differentiates its simulation by secants, not sensitivities
+    rigid = True
     parameters = (Parameter("fc", "N", "slip (Coulomb) force f_c, both directions"),)
     forms = (Form("asymmetric", "asymmetric", (
         Parameter("fc_pos", "N", "slip force moving forward"),

@@ -121,7 +121,9 @@ __all__ = ["identify_io"]
 #: element of 256 stop operators makes a simulation too slow for a search
 MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
                                                                       "maxwell-iwan")))
-PLANTS = ("mass-spring-damper", "two-mass")
+PLANTS = ("mass-spring-damper", "mass-damper", "two-mass")
+#: The element links' refinement takes at least this many evaluations unless given a budget
+ELEMENT_NFEV = 200
 
 
 STEADY_RATIO = 1.5
@@ -181,7 +183,9 @@ def check_steady_state(rec: IORecord, period: int) -> None:
 def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
                 nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
                 max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None,
-                plant: str = "mass-spring-damper", output: str = "y2") -> IOIdentification:
+                plant: str = "mass-spring-damper", output: str = "y2", offset: str = "auto",
+                from_rest: bool = False, max_evaluations: int | None = None
+                ) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -199,9 +203,11 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         whole periods of its force).  A floating stage's (the two-mass one) is
         known up to a constant position: records and model are compared with
         their means removed.
-    plant : {"mass-spring-damper", "two-mass"}
-        The stage: :class:`~motionhyst.time.openloop.MassSpringDamper` (``m, c, k``)
-        or the floating :class:`~motionhyst.time.openloop.TwoMass` of eqs. (1)-(2)
+    plant : {"mass-spring-damper", "mass-damper", "two-mass"}
+        The stage: :class:`~motionhyst.time.openloop.MassSpringDamper` (``m, c, k``),
+        :class:`~motionhyst.plants.mass_damper.MassDamper` (``m, c``: a positioning
+        axis, friction the link) or the floating
+        :class:`~motionhyst.time.openloop.TwoMass` of eqs. (1)-(2)
         (``m1, m2, b, k``; the force and the link on ``m1``, no spring to the
         ground but the link's).
     output : {"y2", "y1"}
@@ -228,7 +234,22 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     tol : float
         ``ftol = xtol = gtol`` of the refinement.
     max_nfev : int
-        Largest number of model evaluations of the refinement.
+        Largest number of model evaluations of the refinement (the element links: at
+        least 200 unless `max_evaluations` says otherwise).
+    offset : {"auto", "none", "input", "output", "both"}
+        The offsets estimated with the model (the element links;
+        :class:`~motionhyst.identify.io_offsets.Extras`): of the force (the plant
+        receives ``u - input_offset``; one for all records) and of the measured
+        position (one per record); ``auto``: both for a floating stage's records
+        from a start, none for its periodic records, the position's for a stage
+        on a spring (where a force offset is only a position offset ``u0 / k``).
+        Bouc-Wen: ``auto`` and ``none`` only (none estimated).
+    from_rest : bool
+        The records start at rest; otherwise each record's initial velocity (and
+        position, on a spring) is estimated (the element links).
+    max_evaluations : int, optional
+        The search's whole budget of model evaluations (starts and refinement;
+        Bouc-Wen: the refinement's).
 
     Returns
     -------
@@ -267,8 +288,17 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     if output not in TwoMass.OUTPUTS:
         raise ValueError(f"unknown output {output!r}; expected y2 or y1")
     if model != "bouc-wen":
-        return identify_elements_io(records, model, periodic, substeps, tol, max_nfev,
-                                    n_elements, t_start, start_nfev, plant, output)
+        return identify_elements_io(records, model, periodic, substeps, tol,
+                                    max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
+                                    plant, output, offset, from_rest, max_evaluations)
+    if offset not in ("auto", "none") or from_rest:
+        raise ValueError("offsets and initial states are estimated with the element links, "
+                         "not yet with Bouc-Wen: use offset 'none'")
+    if plant == "mass-damper":
+        raise ValueError("the Bouc-Wen link is identified on a mass-spring-damper or a "
+                         "two-mass stage")
+    if max_evaluations is not None:
+        max_nfev = max_evaluations
     if plant == "two-mass":
         return identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output,
                                           t_start)

@@ -23,12 +23,16 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import Hysteresis, Parameter
+from motionhyst.hysteresis.stepping import Stepping
+from motionhyst.identify.io_checks import judge_fit, plausibility_warnings
+from motionhyst.identify.io_offsets import Extras, initial_state
 from motionhyst.identify.io_records import short_records
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
     check_substeps,
+    inverse_dynamics,
 )
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
@@ -37,6 +41,7 @@ from motionhyst.identify.io_uncertainty import (
     undetermined_notes,
     weak_notes,
 )
+from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import (
     MIN_SUBSTEPS,
     STEPS_PER_MODE_PERIOD,
@@ -51,6 +56,15 @@ __all__ = []
 
 # start values and search scales by the parameter's unit (registry.Parameter.unit)
 _STIFFNESS, _FORCE, _DAMPING, _VELOCITY, _LENGTH = "N/m", "N", "N s/m", "m/s", "m"
+
+
+#: Step of the forward differences where a link has no sensitivities (relative, in the
+#: search variables)
+FD_STEP = 1e-6
+#: Step of the secants of a link with a rigid slider (the Coulomb model)
+RIGID_FD_STEP = 1e-3
+#: Step of the offsets' and initial states' forward differences, in units of their scales
+EXTRA_FD_STEP = 1e-4
 
 
 @dataclass
@@ -184,20 +198,34 @@ class _ElementProblem:
     def __init__(self, records, periodic, substeps, layout: _LinkLayout, y_scale,
                  scale: NDArray[np.float64], free: NDArray[np.bool_] | None = None,
                  fixed: NDArray[np.float64] | None = None, exact: bool = True,
-                 plant: MassSpringDamper | TwoMass | None = None):
+                 plant: MassSpringDamper | TwoMass | None = None,
+                 extras: Extras | None = None):
         self.records, self.periodic, self.r = records, periodic, substeps
         self.layout, self.y_scale = layout, y_scale
         self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
         self.n_plant = len(self.plant.PARAMETERS)
+        self.n_link = len(layout.names)
+        self.extras = extras if extras is not None else Extras(False, False, (),
+                                                               len(records))
         # a floating stage's periodic output is known up to a constant: compared without means
         self.centre = periodic and isinstance(self.plant, TwoMass)
-        self.log = np.concatenate([[True] * self.n_plant, layout.logarithmic])
+        self.log = np.concatenate([np.ones(self.n_plant, bool), layout.logarithmic,
+                                   np.zeros(self.extras.size, bool)]).astype(bool)
+        self.signed = np.arange(self.log.size) >= self.n_plant + self.n_link
         self.scale = scale
         self.free = np.ones(self.log.size, bool) if free is None else free
         self.fixed = np.zeros(self.log.size) if fixed is None else fixed
         self.fine = [fine_input(rec.u, substeps, periodic) for rec in records]
+        # the upsampling is linear: a force offset shifts the fine input by itself times this
+        self.fine_one = ([fine_input(np.ones(rec.u.size), substeps, periodic)
+                          for rec in records] if self.extras.input_offset else None)
         self.n_eval = 0
         self.exact: bool | None = None if exact else False  # sensitivities (None: untried)
+        self.fd_step = FD_STEP
+        if getattr(layout.cls, "rigid", False):
+            # a rigid slider's stick and slip events change step by step with the parameters:
+            # the simulation's own derivative misses what they do together; secants see it
+            self.exact, self.fd_step = False, RIGID_FD_STEP
         self._last: tuple | None = None
 
     def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -219,61 +247,137 @@ class _ElementProblem:
         return q
 
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Lower bound 0 on the linearly searched values, none on the logarithms."""
-        lower = np.where(self.log, -np.inf, 0.0)[self.free]
+        """Lower bound 0 on the linearly searched link values, none on the logarithms and
+        the offsets and initial states."""
+        lower = np.where(self.log | self.signed, -np.inf, 0.0)[self.free]
         return lower, np.full(lower.size, np.inf)
+
+    def outputs(self, v: NDArray[np.float64], sens: bool = False,
+                only: int | None = None) -> list[tuple[NDArray, NDArray]]:
+        """Each record's simulated output (with its offsets and initial state) and, with
+        `sens`, its sensitivities in the plant's and the link's parameters; `only`: that
+        record alone.  Raises ``ValueError`` for parameters the model refuses."""
+        from motionhyst.identify._element_sensitivities import row_derivatives
+
+        k, nl = self.n_plant, self.n_link
+        u0, y0, init = self.extras.split(v[k + nl:])
+        link = self.layout.build(v[k:k + nl])
+        dparams = None
+        if sens:
+            dparams = row_derivatives(self.layout.build, v[k:k + nl])
+            if dparams is None:
+                raise LookupError("no sensitivities for this link")
+        stepping = link.time_stepping()
+        mech = self.plant.mechanics(v[:k])
+        k_link = link.initial_stiffness
+
+        def one(i):
+            rec = self.records[i]
+            fine = self.fine[i] if self.fine_one is None else self.fine[i] - u0 * self.fine_one[i]
+            y, sy = simulate_elements(mech, stepping, rec.u - u0, rec.fs, self.r,
+                                      periodic=self.periodic, k_link=k_link, upsampled=fine,
+                                      dparams=dparams,
+                                      x0=initial_state(mech.n, self.extras.initial, init[i]))
+            return y + y0[i], sy
+
+        which = range(len(self.records)) if only is None else [only]
+        if len(which) > 1:  # the compiled runs release the GIL
+            with ThreadPoolExecutor(max_workers=min(len(which), os.cpu_count() or 1)) as pool:
+                return list(pool.map(one, which))
+        return [one(i) for i in which]
+
+    def _measured(self, rec) -> NDArray[np.float64]:
+        return rec.y - np.mean(rec.y) if self.centre else rec.y
 
     def _run(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         v = self.values(self.whole(q_free))
         try:
-            k = self.n_plant
-            sys = OpenLoop(self.plant.with_parameters(v[:k]), self.layout.build(v[k:]))
-            res = [sys._simulate_elements(rec.u, rec.fs, self.r, self.periodic, fine)
-                   - (rec.y - np.mean(rec.y) if self.centre else rec.y)
-                   for rec, fine in zip(self.records, self.fine, strict=True)]
+            res = [y - self._measured(rec)
+                   for (y, _), rec in zip(self.outputs(v), self.records, strict=True)]
             r = np.concatenate(res) / self.y_scale
         except ValueError:
             r = np.full(sum(rec.y.size for rec in self.records), np.nan)
         return np.where(np.isfinite(r), r, 1e3)
 
+    def _extra_columns(self, v: NDArray[np.float64], y: list[NDArray[np.float64]]
+                       ) -> NDArray[np.float64]:
+        """Derivatives of the outputs in the offsets and initial states (rows of all the
+        records): the position offsets exactly, the others by forward differences (the
+        force offset from a run of every record, an initial state from its record's)."""
+        ex = self.extras
+        base = self.n_plant + self.n_link
+        n_rows = [rec.y.size for rec in self.records]
+        starts = np.concatenate([[0], np.cumsum(n_rows)])
+        J = np.zeros((starts[-1], ex.size))
+        if ex.input_offset:
+            step = EXTRA_FD_STEP * max(abs(v[base]), self.scale[base])
+            w = v.copy()
+            w[base] += step
+            J[:, 0] = (np.concatenate([yy for yy, _ in self.outputs(w)])
+                       - np.concatenate(y)) / step
+            self.n_eval += 1
+        for i in range(len(self.records)):
+            rows = slice(starts[i], starts[i + 1])
+            for j in ex.columns_of_record(i):
+                name = ex.names[j].split("[")[0]
+                if name == "output_offset":
+                    J[rows, j] = 1.0
+                    continue
+                step = EXTRA_FD_STEP * max(abs(v[base + j]), self.scale[base + j])
+                w = v.copy()
+                w[base + j] += step
+                J[rows, j] = (self.outputs(w, only=i)[0][0] - y[i]) / step
+        return J
+
+    def _split_rows(self, res: NDArray[np.float64], measured: bool = False
+                    ) -> list[NDArray[np.float64]]:
+        """Rows of all records split by record (`measured`: residuals plus the data)."""
+        out, i = [], 0
+        for rec in self.records:
+            part = res[i:i + rec.y.size]
+            out.append(part + self._measured(rec) if measured else part)
+            i += rec.y.size
+        return out
+
+    def _with_extras(self, q_free: NDArray[np.float64], J: NDArray[np.float64],
+                     r0: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The Jacobian of the sensitivities (free plant and link columns) with the offsets'
+        and initial states' columns in their places."""
+        if not self.extras.size:
+            return J
+        v = self.values(self.whole(q_free))
+        k = self.n_plant + self.n_link
+        full = np.zeros((J.shape[0], self.log.size))
+        full[:, :k][:, self.free[:k]] = J
+        try:
+            Je = self._extra_columns(v, self._split_rows(r0 * self.y_scale, measured=True))
+            full[:, k:] = Je * self.derivative(v)[k:] / self.y_scale
+        except ValueError:
+            pass  # a model the simulation refuses: the residuals are flat there
+        return full[:, self.free]
+
     def _run_exact(self, q_free: NDArray[np.float64]
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-        """Residuals and their exact Jacobian in the free variables (forward sensitivities);
-        None if the link has an element kind without them."""
-        from motionhyst.identify._element_sensitivities import row_derivatives
-
+        """Residuals and their exact Jacobian in the free plant and link variables (forward
+        sensitivities; the offsets' and initial states' columns are added by
+        :meth:`jacobian`); None if the link has an element kind without them."""
         v = self.values(self.whole(q_free))
         n_rows = sum(rec.y.size for rec in self.records)
-        k = self.n_plant
+        k = self.n_plant + self.n_link
+        n_sens = int(self.free[:k].sum())
         try:
-            dparams = row_derivatives(self.layout.build, v[k:])
-            if dparams is None:
-                return None
-            link = self.layout.build(v[k:])
-            stepping = link.time_stepping()
-            mech = self.plant.mechanics(v[:k])
-
-            def one(i):
-                rec = self.records[i]
-                return simulate_elements(mech, stepping, rec.u, rec.fs, self.r,
-                                         periodic=self.periodic, k_link=link.initial_stiffness,
-                                         upsampled=self.fine[i], dparams=dparams)
-
-            if len(self.records) > 1:  # the compiled runs release the GIL
-                with ThreadPoolExecutor(max_workers=min(len(self.records),
-                                                        os.cpu_count() or 1)) as pool:
-                    outs = list(pool.map(one, range(len(self.records))))
-            else:
-                outs = [one(0)]
-            r = np.concatenate([y - (rec.y - np.mean(rec.y) if self.centre else rec.y)
+            outs = self.outputs(v, sens=True)
+            r = np.concatenate([y - self._measured(rec)
                                 for (y, _), rec in zip(outs, self.records, strict=True)])
-            J = np.concatenate([sy for _, sy in outs]) * self.derivative(v)
+            J = np.concatenate([sy for _, sy in outs]) * self.derivative(v)[:k]
+        except LookupError:
+            return None
         except ValueError:
-            return np.full(n_rows, 1e3), np.zeros((n_rows, int(self.free.sum())))
+            return np.full(n_rows, 1e3), np.zeros((n_rows, n_sens))
         r = r / self.y_scale
         if not np.all(np.isfinite(r)) or not np.all(np.isfinite(J)):
-            return np.full(n_rows, 1e3), np.zeros((n_rows, int(self.free.sum())))
-        return r, J[:, self.free] / self.y_scale
+            return np.full(n_rows, 1e3), np.zeros((n_rows, n_sens))
+        return r, J[:, self.free[:k]] / self.y_scale
 
     def residuals(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Output errors in units of the output's RMS."""
@@ -298,8 +402,8 @@ class _ElementProblem:
             r0 = self.residuals(q_free)
             J = self._last[2]
         if J is not None:
-            return J
-        steps = 1e-6 * np.maximum(1.0, np.abs(q_free))
+            return self._with_extras(q_free, J, r0)
+        steps = self.fd_step * np.maximum(1.0, np.abs(q_free))
 
         def column(j):
             q = q_free.copy()
@@ -329,8 +433,8 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 
 def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t_start,
-                         start_nfev, plant="mass-spring-damper", output="y2"
-                         ) -> IOIdentification:
+                         start_nfev, plant="mass-spring-damper", output="y2", offset="none",
+                         from_rest=True, budget=None) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -348,6 +452,17 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     its forces together 0.3, 1 or 3 times the records' force RMS; a parameter
     that adds a spring or damper in parallel is fixed at 0 (the stage has none
     to the ground to hold it).
+
+    A mass-damper (a positioning axis: no spring, friction holds it) starts from
+    the records' inverse-dynamics mass, damper, Coulomb force and force offset
+    (:func:`~motionhyst.identify.io_start.inverse_dynamics`), the link's forces
+    together that Coulomb force or half of it, slipping after 0.001 to 0.1 of
+    the output's RMS (:data:`AXIS_STARTS`).
+
+    The offsets and initial states of `offset` and `from_rest`
+    (:class:`~motionhyst.identify.io_offsets.Extras`) are estimated with them:
+    started at zero (the position offset of a floating stage at the record's
+    first sample, its velocity at the first samples' slope).
     """
     layout = _LinkLayout.of(model, n)
     y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and plant == "two-mass"
@@ -355,10 +470,12 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     y_scale = float(np.sqrt(np.mean(y_all ** 2)))
     v_scale = float(np.sqrt(np.mean(np.concatenate(
         [np.gradient(rec.y, rec.t) for rec in records]) ** 2)))
+    u_rms = float(np.sqrt(np.mean(np.concatenate([rec.u for rec in records]) ** 2)))
     force = np.array([par.unit == _FORCE for par, _ in layout._values()], dtype=bool)
+    idim = inverse_dynamics(records, plant != "mass-spring-damper")
     if plant == "two-mass":
         bla, k_link, c_link = best_linear_approximation_two_mass(records, output, periodic)
-        structure: MassSpringDamper | TwoMass | None = bla
+        structure: MassSpringDamper | TwoMass | MassDamper = bla
         f_n = bla.mechanics().natural_frequency_hz(16.0 * k_link)
         r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n
                                                     / records[0].fs))
@@ -367,7 +484,6 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         c_scale = max(c_link, 1e-3 * bla.M * 2 * np.pi * records[0].fs)
         stage0 = [bla.m1, bla.m2, max(bla.b, 1e-3 * math.sqrt(bla.k * mu)), bla.k]
         scale = np.concatenate([stage0, layout.scales(k_link, c_scale, y_scale, v_scale)])
-        u_rms = float(np.sqrt(np.mean(np.concatenate([rec.u for rec in records]) ** 2)))
         starts = []
         for stiffer in (1.0, 4.0, 16.0):
             for held_force in (0.3, 1.0, 3.0):
@@ -375,9 +491,26 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
                 if force.any():
                     link0[force] *= held_force * u_rms / np.sum(link0[force])
                 starts.append(np.concatenate([stage0, link0]))
+    elif plant == "mass-damper":
+        bla = best_linear_approximation(records)
+        m0 = idim["m"] if idim["m"] > 0 else bla.m
+        c0 = idim["c"] if idim["c"] > 0 else bla.c
+        f0 = idim["fc"] if idim["fc"] > 0 else 0.3 * u_rms
+        structure = MassDamper(m0, c0)
+        c_scale = max(c0, 1e-3 * m0 * 2 * np.pi * records[0].fs)
+        k_ref = u_rms / y_scale  # a stiffness whose force over the output's RMS is the force's
+        scale = np.concatenate([[m0, c_scale], layout.scales(k_ref, c_scale, y_scale,
+                                                             v_scale)])
+        starts = []
+        for share, slip in AXIS_STARTS:
+            k0 = 2.0 * share * f0 / (slip * y_scale)  # its forces at share * f0
+            starts.append(np.concatenate([[m0, c0],
+                                          layout.start(k0, y_scale, v_scale, c0, slip)]))
+        r = substeps or OpenLoop(structure, layout.build(starts[0][2:])).default_substeps(
+            records[0].fs)
     else:
         bla = best_linear_approximation(records)
-        structure = None
+        structure = MassSpringDamper(bla.m, bla.c, bla.k)
         r = substeps or OpenLoop(bla).default_substeps(records[0].fs)
         c_scale = max(bla.c, 1e-3 * bla.m * 2 * np.pi * records[0].fs)
         scale = np.concatenate([[bla.m, c_scale, bla.k],
@@ -385,23 +518,34 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         starts = [np.concatenate([[bla.m, bla.c, stage * bla.k],
                                   layout.start(share * bla.k, y_scale, v_scale, bla.c, slip)])
                   for stage, share, slip in STARTS]
-    n_plant = len((structure or MassSpringDamper).PARAMETERS)
-    rate = np.concatenate([[False] * n_plant,
-                           [par.unit == _VELOCITY for par, _ in layout._values()]])
+    n_plant = len(structure.PARAMETERS)
+    floating = structure.mechanics().floating
+    extras = Extras.choose(offset, floating=floating, periodic=periodic, from_rest=from_rest,
+                           n_records=len(records))
+    scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale)])
+    rate = np.concatenate([np.zeros(n_plant, bool),
+                           [par.unit == _VELOCITY for par, _ in layout._values()],
+                           np.zeros(extras.size, bool)]).astype(bool)
     short = short_records(records, periodic)
+    short_extras = Extras(extras.input_offset, extras.output_offset, extras.initial, 1)
+    n_base = n_plant + len(layout.names)
+    short_scale = np.concatenate([scale[:n_base], short_extras.scales(u_rms, y_scale, v_scale)])
+    short_rate = rate[:n_base + short_extras.size]
     n_eval = 0
     n_start = start_nfev or 15 * scale.size
 
     def held(p0: NDArray[np.float64], nfev: int):
-        prob = _ElementProblem(short, periodic, r, layout, y_scale, scale, ~rate,
-                               plant=structure)
+        prob = _ElementProblem(short, periodic, r, layout, y_scale, short_scale, ~short_rate,
+                               plant=structure, extras=short_extras)
         prob.fixed = prob.variables(p0)
-        sol = prob.solve(prob.fixed[~rate], 1e-6, nfev)
+        sol = prob.solve(prob.fixed[~short_rate], 1e-6, nfev)
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
+    short_start = _extras_start(short_extras, short, floating, idim["u0"])
     best = None
     for p0 in starts:
-        p0[rate] = RATE_GRID[0] * v_scale
+        p0 = np.concatenate([p0, short_start])
+        p0[short_rate] = RATE_GRID[0] * v_scale
         cost, p, used = held(p0, n_start)
         n_eval += used
         if best is None or cost < best[0]:
@@ -411,14 +555,22 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         p_rest = best[1]
         for fraction in RATE_GRID[1:]:
             p0 = p_rest.copy()
-            p0[rate] = fraction * v_scale
+            p0[short_rate] = fraction * v_scale
             cost, p, used = held(p0, n_start)
             n_eval += used
             profile.append(cost)
             if cost < best[0]:
                 best = (cost, p)
-    prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure)
-    sol = prob.solve(prob.variables(best[1]), tol, max_nfev)
+    full_start = _extras_start(extras, records, floating, idim["u0"])
+    # the short run's force offset and first record's offset and initial state carry over
+    for j, name in enumerate(short_extras.names):
+        full_start[extras.names.index(name if len(records) == 1 or name == "input_offset"
+                                      else f"{name}[0]")] = best[1][n_base + j]
+    remaining = max_nfev if budget is None else max(budget - n_eval, 1)
+    prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
+                           extras=extras)
+    sol = prob.solve(prob.variables(np.concatenate([best[1][:n_base], full_start])), tol,
+                     remaining)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)
@@ -426,7 +578,7 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     n_eval += prob.n_eval
     rtol = SINGULAR_RTOL if prob.exact else FD_SINGULAR_RTOL
     std_v, groups = standard_errors(J, rss, res.size, rtol)
-    names = [*prob.plant.PARAMETERS, *layout.names]
+    names = [*prob.plant.PARAMETERS, *layout.names, *extras.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
     for nm, sd in zip(names, std_v, strict=True):
@@ -436,7 +588,7 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     not_ident.update(undetermined_notes(names, groups, rtol))
     weak = weak_notes(names, v, std_v, J, rtol, ~prob.log)
     n_short = sum(rec.y.size for rec in short)
-    if rate.any() and _flat_profile(profile, n_short - scale.size):
+    if rate.any() and _flat_profile(profile, n_short - short_scale.size):
         lo, hi = min(RATE_GRID) * v_scale, max(RATE_GRID) * v_scale
         for name in np.array(names)[rate]:
             weak[name] = (f"not determined by these records: held anywhere from {lo:.3g} to "
@@ -448,15 +600,72 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         if name not in not_ident:
             not_ident[name] = why
             std[name] = None
+    u0, y0, init = extras.split(v[n_base:])
+    fitted = prob.plant.with_parameters(v[:n_plant])
+    if extras.input_offset:
+        fitted.force_offset = -u0  # the offset of the measured force, on the plant
+    link = layout.build(v[n_plant:n_base])
+    judge_fit(float(np.sqrt(rss / res.size)), records, prob._split_rows(res, measured=True),
+              _linear_rms(records, structure, r, periodic, extras.output_offset),
+              OpenLoop(prob.plant.with_parameters(v[:n_plant]), link), extras.output_offset)
+    bound = [nm for nm, x, lin, sc in zip(names[:n_base], v[:n_base], ~prob.log[:n_base],
+                                          scale[:n_base], strict=True)
+             if lin and nm not in not_ident and abs(x) <= 1e-9 * sc]
+    masses = {nm: float(x) for nm, x in zip(prob.plant.PARAMETERS, v, strict=False)
+              if nm in ("m", "m1", "m2")}
+    linear_mass = idim["m"]
+    notes = plausibility_warnings(estimates, masses, linear_mass, records, bound)
     return IOIdentification(
-        plant=prob.plant.with_parameters(v[:n_plant]), hysteresis=layout.build(v[n_plant:]),
+        plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
         fit_rms=float(np.sqrt(rss / res.size)), records=per_record_errors(records, res),
         seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "
-                 f"at most {max_nfev} evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r)
+                 f"at most {remaining} evaluations; {sol.nfev} used)",
+        n_evaluations=n_eval, substeps=r,
+        extra={"offsets": {"input": u0, "output": y0.tolist()},
+               "initial_state": {name: init[:, a].tolist()
+                                 for a, name in enumerate(extras.initial)},
+               "budget_reached": bool(sol.status == 0)})
+
+
+def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
+    """RMS simulation error of the best linear model (the start's stage without its link)
+    on the records, about its mean with an output offset; None if it cannot be run."""
+    try:
+        mech = structure.mechanics()
+        res = np.concatenate([simulate_elements(mech, Stepping.empty(), rec.u, rec.fs, r,
+                                                periodic=periodic)[0] - rec.y
+                              for rec in records])
+    except ValueError:
+        return None
+    if not np.all(np.isfinite(res)):
+        return None
+    return float(np.std(res) if output_offset else np.sqrt(np.mean(res ** 2)))
+
+
+#: Starts of a link on a mass-damper: (the link's forces as a share of the records'
+#: inverse-dynamics Coulomb force, the displacement it slips after in units of the output's
+#: RMS)
+AXIS_STARTS = ((1.0, 1e-3), (0.5, 1e-2), (1.0, 1e-1))
+
+
+def _extras_start(extras: Extras, records, floating: bool, u0: float) -> NDArray[np.float64]:
+    """Start values of the offsets and initial states: the force offset `u0`, a floating
+    stage's position offset at the record's first sample (else 0), its initial position
+    there and its velocity at the first samples' slope."""
+    out = np.zeros(extras.size)
+    if extras.input_offset:
+        out[0] = u0
+    what = (["output_offset"] if extras.output_offset else []) + list(extras.initial)
+    for i, rec in enumerate(records):
+        n = min(4, rec.y.size - 1)
+        start = {"v0": (rec.y[n] - rec.y[0]) * rec.fs / n, "y0": rec.y[0],
+                 "output_offset": rec.y[0] if floating else 0.0}
+        for j, name in zip(extras.columns_of_record(i), what, strict=True):
+            out[j] = start[name]
+    return out
 
 
 #: 95 % point of the chi-square distribution with one degree of freedom

@@ -48,7 +48,11 @@ class IOIdentification:
     substeps : int
         Integration steps per sample the identification used.
     extra : dict
-        Further numbers of the model's identification, JSON-ready.
+        The offsets and initial states (``offsets``, ``initial_state``) and whether the
+        search stopped at its budget (``budget_reached``).
+    warnings : list of str
+        Implausible estimates, one line each naming the parameter
+        (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
 
     Examples
     --------
@@ -80,6 +84,7 @@ class IOIdentification:
     n_evaluations: int
     substeps: int = 0
     extra: dict = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
 
     def system(self) -> OpenLoop:
         """The identified open-loop system."""
@@ -92,13 +97,24 @@ class IOIdentification:
                 "not_identifiable": dict(self.not_identifiable), "fit_rms": self.fit_rms,
                 "records": [dict(r) for r in self.records], "seconds": self.seconds,
                 "periodic": self.periodic, "stopping": self.stopping,
-                "evaluations": self.n_evaluations, "substeps": self.substeps}
+                "evaluations": self.n_evaluations, "substeps": self.substeps,
+                **self.extra, "warnings": list(self.warnings)}
 
     def scenario_text(self) -> str:
         """A scenario file (TOML) of the identified system: ``[stage]`` and ``[hysteresis]``."""
-        return (f"# identified from {len(self.records)} input-output record(s) by simulation "
-                f"error: fit RMS {self.fit_rms:.4g} m\n"
-                + toml_table("stage", self.plant.to_dict()) + "\n"
+        lines = [f"# identified from {len(self.records)} input-output record(s) by simulation "
+                 f"error: fit RMS {self.fit_rms:.4g} m"]
+        offsets = self.extra.get("offsets", {}).get("output") or []
+        if any(offsets):
+            lines.append(f"# position offset of each record [m] (of its sensor, not the "
+                         f"model's): {', '.join(f'{v:.6g}' for v in offsets)}")
+        for name, values in self.extra.get("initial_state", {}).items():
+            lines.append(f"# initial state {name} of each record: "
+                         f"{', '.join(f'{v:.6g}' for v in values)}")
+        if offsets or self.extra.get("initial_state"):
+            lines.append("# (motionhyst predict --init-from REC sets both from a record's first "
+                         "samples)")
+        return ("\n".join(lines) + "\n" + toml_table("stage", self.plant.to_dict()) + "\n"
                 + toml_table("hysteresis", self.hysteresis.to_dict()))
 
 

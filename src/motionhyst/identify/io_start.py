@@ -64,6 +64,59 @@ def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
     return MassSpringDamper(m, max(c, 1e-6 * m * w.min()), max(k, 1e-6 * m * w.min() ** 2))
 
 
+def inverse_dynamics(records: list[IORecord], floating: bool) -> dict[str, float]:
+    """The records' linear estimate of a single mass: least squares on the equation of motion.
+
+    ``u = m y'' + c y' + f sign(y') + u0`` (a floating stage: viscous and Coulomb
+    friction) or ``u = m y'' + c y' + k y + u0`` (on a spring), the rates of the
+    position from a cubic Savitzky-Golay filter over about 10 ms (at least 7
+    samples): the inverse-dynamics estimate of the EMPS benchmark's reference
+    model (IDIM-LS, Janot et al. 2019).  Linear in its parameters whatever the
+    model, it is what a simulation-error fit's mass is compared with, and where
+    a positioning axis's fit starts.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records.
+    floating : bool
+        No spring to the ground (the Coulomb term instead of the spring's).
+
+    Returns
+    -------
+    dict
+        ``m, c, u0`` and ``fc`` (floating) or ``k``.
+
+    Examples
+    --------
+    >>> t = np.arange(3000) / 1000.0
+    >>> y = 0.05 * np.sin(2 * np.pi * t) + 0.02 * np.sin(2 * np.pi * 3.3 * t)
+    >>> v = np.gradient(y, t, edge_order=2)
+    >>> u = 2.0 * np.gradient(v, t, edge_order=2) + 30.0 * v + 4.0 * np.sign(v) - 1.5
+    >>> est = inverse_dynamics([IORecord(t, u, y)], floating=True)
+    >>> {k: round(v, 1) for k, v in est.items()}
+    {'m': 2.0, 'c': 30.0, 'fc': 4.0, 'u0': -1.5}
+    """
+    from scipy.signal import savgol_filter
+
+    rows, rhs = [], []
+    for rec in records:
+        window = max(7, 2 * round(0.005 * rec.fs) + 1)
+        window = min(window, rec.y.size - (1 - rec.y.size % 2))
+        dt = 1.0 / rec.fs
+        v = savgol_filter(rec.y, window, 3, deriv=1, delta=dt)
+        a = savgol_filter(rec.y, window, 3, deriv=2, delta=dt)
+        third = np.sign(v) if floating else rec.y
+        rows.append(np.column_stack([a, v, third, np.ones_like(v)]))
+        rhs.append(rec.u)
+    A = np.concatenate(rows)
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    m, c, third, u0 = np.linalg.lstsq(A / scale, np.concatenate(rhs), rcond=None)[0] / scale
+    return {"m": float(m), "c": float(c), "fc" if floating else "k": float(third),
+            "u0": float(u0)}
+
+
 def _spectral_response(records: list[IORecord]
                        ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
     """``G(f) = sum Y U* / sum |U|^2`` over the records (each transformed whole), at the

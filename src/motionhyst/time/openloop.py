@@ -254,7 +254,8 @@ def _check_converged(worst: int) -> None:
 def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64], fs: float,
                       r: int, *, periodic: bool, k_link: float = 0.0,
                       upsampled: NDArray[np.float64] | None = None,
-                      dparams: NDArray[np.float64] | None = None
+                      dparams: NDArray[np.float64] | None = None,
+                      x0: NDArray[np.float64] | None = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Output of a plant with a link of exact-update elements, and its sensitivities (FOH).
 
@@ -294,6 +295,9 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         parameters (every element of a kind in
         :data:`~motionhyst.hysteresis.stepping.DIFFERENTIATED`); None: no
         sensitivities.
+    x0 : ndarray, shape (2n,), optional
+        The plant's state ``(q, q')`` at the first sample of a run that is not
+        periodic (default: at rest, ``0``); the link starts relaxed.
 
     Returns
     -------
@@ -358,6 +362,10 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
 
     x, s = np.zeros(ns), np.array(stepping.state0, dtype=float)
     sx, ss = np.zeros((ns, n_sens)), np.zeros((n_el, n_sens))
+    if x0 is not None and not periodic:
+        x = np.array(x0, dtype=float)
+        if x.shape != (ns,):
+            raise ValueError(f"the initial state has {x.size} values; the plant has {ns}")
     if not periodic:
         y, sy, *_ = run(x, s, sx, ss)
         return y, sy

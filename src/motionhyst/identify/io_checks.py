@@ -1,0 +1,160 @@
+"""Whether an input-output fit is a result: failures and implausible estimates.
+
+A fit is *failed*, and nothing of it is a result (:class:`FitFailed`), when
+its simulation error exceeds the output's own RMS (a model that predicts
+nothing, or the mean, does better) or the best linear model's, when its
+prediction is not finite, or when the model it returns cannot be simulated
+(the identified model is what ``motionhyst predict`` runs; a mass collapsed
+towards zero makes that run need an impossibly fine step).
+
+A fit that succeeded can still be *implausible*: each such finding is a
+one-line warning naming the parameter (:func:`plausibility_warnings`): a mass
+far from the records' linear estimate, a parameter at its bound, an inertia
+the records do not show (the quasi-static plant describes such records).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from motionhyst.identify.io_records import IORecord
+
+__all__ = ["MAX_PREDICT_SUBSTEPS", "FitFailed", "judge_fit", "plausibility_warnings"]
+
+#: The finest integration step ``predict`` takes, in steps per record sample; a model that
+#: needs more (a collapsed mass on a stiff link) is not a model ``predict`` can run
+MAX_PREDICT_SUBSTEPS = 2000
+#: A mass more than this factor from the records' linear estimate is reported
+MASS_FACTOR = 2.0
+#: Inertia below this share of the force (``m a_rms / u_rms``) is not visible in the records
+INERTIA_SHARE = 1e-3
+
+
+class FitFailed(RuntimeError):
+    """An identification that produced no usable model (one line saying what failed)."""
+
+
+def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray[np.float64]],
+              linear_rms: float | None, system, output_offset: bool) -> None:
+    """Raise :class:`FitFailed` if the fit is no result.
+
+    Parameters
+    ----------
+    fit_rms : float
+        RMS simulation error of the fit over all records [m].
+    records : list of IORecord
+        The records.
+    predictions : list of ndarray
+        The fitted model's output for each record.
+    linear_rms : float or None
+        RMS simulation error of the best linear model on the same records (None: not known).
+    system : OpenLoop
+        The identified system as ``predict`` runs it.
+    output_offset : bool
+        An output offset was estimated (the output's own RMS is then about its mean).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(100) / 100.0
+    >>> rec = IORecord(t, np.sin(t), 1e-3 * np.sin(t))
+    >>> try:
+    ...     judge_fit(1.0, [rec], [np.zeros(100)], None, None, False)
+    ... except FitFailed as exc:
+    ...     print(exc)
+    the fit failed: its RMS error 1 m exceeds the output's own RMS 0.000519 m (predicting zero
+    does better)
+    """
+    for rec, y in zip(records, predictions, strict=True):
+        if not np.all(np.isfinite(y)):
+            raise FitFailed(f"the fit failed: the identified model's prediction of {rec.name} "
+                            f"is not finite")
+    y_all = np.concatenate([rec.y for rec in records])
+    own = float(np.std(y_all) if output_offset else np.sqrt(np.mean(y_all ** 2)))
+    if not math.isfinite(fit_rms) or fit_rms > own:
+        what = "its mean" if output_offset else "zero"
+        raise FitFailed(f"the fit failed: its RMS error {fit_rms:.3g} m exceeds the output's "
+                        f"own RMS {own:.3g} m (predicting {what} does better)")
+    if linear_rms is not None and fit_rms > linear_rms * (1.0 + 1e-9):
+        raise FitFailed(f"the fit failed: its RMS error {fit_rms:.3g} m exceeds the best "
+                        f"linear model's {linear_rms:.3g} m")
+    if system is None:
+        return
+    try:
+        r = system.default_substeps(records[0].fs)
+    except (ValueError, OverflowError, ArithmeticError) as exc:
+        raise FitFailed(f"the fit failed: the identified model cannot be simulated "
+                        f"({exc})") from None
+    if r > MAX_PREDICT_SUBSTEPS:
+        raise FitFailed(f"the fit failed: the identified model needs {r} integration steps per "
+                        f"sample (a mass collapsed on a stiff link); if the records show no "
+                        f"inertia, use --plant quasi-static")
+    rec = records[0]
+    try:
+        y = system.simulate(rec.t, rec.u, substeps=r).displacement
+    except ValueError as exc:
+        raise FitFailed(f"the fit failed: the identified model cannot be simulated on "
+                        f"{rec.name} ({exc})") from None
+    if not np.all(np.isfinite(y)):
+        raise FitFailed(f"the fit failed: the identified model's simulation of {rec.name} "
+                        f"from rest is not finite")
+
+
+def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
+                          linear_mass: float, records: list[IORecord],
+                          at_bound: list[str]) -> list[str]:
+    """One line for each implausible estimate, naming the parameter.
+
+    Parameters
+    ----------
+    estimates : dict
+        The estimates by name.
+    masses : dict
+        The plant's masses by name (``{"m": ..}`` or ``{"m1": .., "m2": ..}``).
+    linear_mass : float
+        The records' linear estimate of the total mass [kg].
+    records : list of IORecord
+        The records (for the inertia they show: ``m`` times the RMS acceleration).
+    at_bound : list of str
+        Names of the parameters that ended at a bound of the search.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(1000) / 1000.0
+    >>> rec = IORecord(t, 10 * np.sin(2 * np.pi * t), 1e-3 * np.sin(2 * np.pi * t))
+    >>> for line in plausibility_warnings({"m": 1e-9}, {"m": 1e-9}, 2.0, [rec], []):
+    ...     print(line)
+    m = 1e-09 kg is 2e+09 times below the records' linear estimate 2 kg
+    m = 1e-09 kg: the inertia is not visible in these records (m times the RMS acceleration is
+    3.9e-12 of the force's RMS); a quasi-static plant (--plant quasi-static) describes them
+    """
+    out = []
+    total = float(sum(masses.values()))
+    names = "+".join(masses)
+    if linear_mass > 0 and total > 0:
+        ratio = total / linear_mass
+        if ratio > MASS_FACTOR or ratio < 1.0 / MASS_FACTOR:
+            word = "above" if ratio > 1 else "below"
+            factor = ratio if ratio > 1 else 1.0 / ratio
+            out.append(f"{names} = {total:.4g} kg is {factor:.3g} times {word} the records' "
+                       f"linear estimate {linear_mass:.4g} kg")
+    a_rms = math.sqrt(np.mean(np.concatenate(
+        [np.diff(rec.y, 2) * rec.fs ** 2 for rec in records]) ** 2))
+    u_rms = math.sqrt(np.mean(np.concatenate([rec.u - np.mean(rec.u) for rec in records]) ** 2))
+    share = total * a_rms / u_rms if u_rms > 0 else math.inf
+    if share < INERTIA_SHARE:
+        out.append(f"{names} = {total:.4g} kg: the inertia is not visible in these records "
+                   f"({names} times the RMS acceleration is {share:.2g} of the force's RMS); "
+                   f"a quasi-static plant (--plant quasi-static) describes them")
+    for name in at_bound:
+        out.append(f"{name} = {estimates[name]:.4g} ended at a bound of the search: the records "
+                   f"push it beyond the model's range")
+    return out

@@ -1,0 +1,197 @@
+"""Offsets and initial states estimated with an input-output model.
+
+Measured records carry offsets and do not start at rest: the force a drive
+reports is off by a constant (EMPS: -3.2 N, 2 % of its peak), the encoder's
+zero is anywhere, and a record cut from a run starts moving.  A model fitted
+without them takes the bias for dynamics (EMPS: a force offset read as 182 kg
+of inertia instead of 95 kg).  They are estimated with the model's parameters
+as offsets of the measured signals:
+
+.. math::
+
+    \\hat y(t) = y_{model}(t;\\; u - u_0,\\; x(t_0)) + y_0,
+
+``u_0`` (``input_offset`` [N]: the plant receives ``u - u_0``; the EMPS
+benchmark's ``OF``) common to the records, ``y_0`` (``output_offset`` [m])
+and the initial state ``x(t_0)`` (the stage moving as one body at ``v0``
+[m/s], displaced by ``y0`` [m] where a spring holds it) one per record.  On
+a floating stage (no spring to the ground) the output offset and the initial
+position are the same thing: only the offset is estimated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["OFFSET_CHOICES", "Extras", "initial_state"]
+
+#: ``offset`` choices of :func:`~motionhyst.identify.input_output.identify_io` (``--offset``)
+OFFSET_CHOICES = ("auto", "none", "input", "output", "both")
+
+
+@dataclass(frozen=True)
+class Extras:
+    """Which offsets and initial states are estimated, and their names and scales.
+
+    Parameters
+    ----------
+    input_offset, output_offset : bool
+        Estimate the force offset (one) and the position offsets (one per record).
+    initial : tuple of str
+        The initial state's estimates per record: ``()`` (from rest), ``("v0",)``
+        (a floating stage) or ``("y0", "v0")``.
+    n_records : int
+        Number of records.
+
+    Examples
+    --------
+    >>> ex = Extras.choose("auto", floating=True, periodic=False, from_rest=False,
+    ...                    n_records=2)
+    >>> ex.names
+    ['input_offset', 'output_offset[0]', 'output_offset[1]', 'v0[0]', 'v0[1]']
+    >>> Extras.choose("none", floating=False, periodic=False, from_rest=True,
+    ...               n_records=1).names
+    []
+    """
+
+    input_offset: bool
+    output_offset: bool
+    initial: tuple[str, ...]
+    n_records: int
+
+    @classmethod
+    def choose(cls, offset: str, *, floating: bool, periodic: bool, from_rest: bool,
+               n_records: int) -> Extras:
+        """What to estimate for the `offset` choice (:data:`OFFSET_CHOICES`).
+
+        ``auto`` is what records can tell apart: ``both`` for a floating stage's
+        records from a start (a force offset makes it drift), nothing for its
+        periodic ones (compared without their means, and a force offset would
+        make it drift), the output offset for a stage on a spring (a force
+        offset only moves it by ``u0 / k``: the same as a position offset but
+        for the link's nonlinearity).  Periodic records have no initial state;
+        `from_rest` fixes it at rest.
+
+        Parameters
+        ----------
+        offset : str
+            One of :data:`OFFSET_CHOICES`.
+        floating : bool
+            No spring holds the stage to the ground.
+        periodic : bool
+            The records are periods of a steady state.
+        from_rest : bool
+            The records start at rest (no initial state estimated).
+        n_records : int
+            Number of records.
+
+        Returns
+        -------
+        Extras
+        """
+        if offset not in OFFSET_CHOICES:
+            raise ValueError(f"unknown offset choice {offset!r}; expected one of "
+                             f"{', '.join(OFFSET_CHOICES)}")
+        if offset == "auto":  # what the records can tell apart
+            offset = "both" if floating and not periodic else "none" if floating else "output"
+        if periodic and floating and offset != "none":
+            raise ValueError("periodic records of a floating stage are compared without "
+                             "their means and a force offset makes it drift: use --offset none")
+        initial: tuple[str, ...] = ()
+        if not (periodic or from_rest):
+            initial = ("v0",) if floating else ("y0", "v0")
+        return cls(offset in ("input", "both"), offset in ("output", "both"), initial,
+                   int(n_records))
+
+    def _per_record(self, base: str) -> list[str]:
+        return [base] if self.n_records == 1 else [f"{base}[{i}]"
+                                                    for i in range(self.n_records)]
+
+    @property
+    def names(self) -> list[str]:
+        """Names of the estimates, in the search vector's order."""
+        out = ["input_offset"] if self.input_offset else []
+        if self.output_offset:
+            out += self._per_record("output_offset")
+        for what in self.initial:
+            out += self._per_record(what)
+        return out
+
+    @property
+    def size(self) -> int:
+        """Number of estimates."""
+        return len(self.names)
+
+    def scales(self, u_scale: float, y_scale: float, v_scale: float) -> NDArray[np.float64]:
+        """Typical size of each estimate: the force's, the output's or its rate's RMS."""
+        unit = {"input_offset": u_scale, "output_offset": y_scale, "y0": y_scale,
+                "v0": v_scale}
+        return np.array([unit[name.split("[")[0]] for name in self.names])
+
+    def split(self, e: NDArray[np.float64]) -> tuple[float, NDArray[np.float64],
+                                                      NDArray[np.float64]]:
+        """The force offset, the records' position offsets and their initial states
+        ``(n_records, len(initial))`` from the estimates `e`."""
+        j = 0
+        u0 = 0.0
+        if self.input_offset:
+            u0 = float(e[0])
+            j = 1
+        y0 = np.zeros(self.n_records)
+        if self.output_offset:
+            y0 = np.asarray(e[j:j + self.n_records], dtype=float)
+            j += self.n_records
+        init = np.zeros((self.n_records, len(self.initial)))
+        for a in range(len(self.initial)):
+            init[:, a] = e[j:j + self.n_records]
+            j += self.n_records
+        return u0, y0, init
+
+    def columns_of_record(self, i: int) -> list[int]:
+        """Indices (into :attr:`names`) of the estimates that move record `i` alone."""
+        j = int(self.input_offset)
+        out = []
+        if self.output_offset:
+            out.append(j + i)
+            j += self.n_records
+        for _ in self.initial:
+            out.append(j + i)
+            j += self.n_records
+        return out
+
+
+def initial_state(n: int, initial: tuple[str, ...], values: NDArray[np.float64]
+                  ) -> NDArray[np.float64] | None:
+    """The plant's state ``(q, q')`` of `n` coordinates moving as one body.
+
+    Parameters
+    ----------
+    n : int
+        Coordinates of the plant.
+    initial : tuple of str
+        ``()``, ``("v0",)`` or ``("y0", "v0")``.
+    values : ndarray
+        Their values.
+
+    Returns
+    -------
+    ndarray or None
+        None for a start at rest.
+
+    Examples
+    --------
+    >>> initial_state(2, ("y0", "v0"), np.array([1e-3, 0.02])).tolist()
+    [0.001, 0.001, 0.02, 0.02]
+    """
+    if not initial:
+        return None
+    x = np.zeros(2 * n)
+    for name, value in zip(initial, values, strict=True):
+        if name == "y0":
+            x[:n] = value
+        else:
+            x[n:] = value
+    return x

@@ -1,0 +1,106 @@
+"""Offsets, initial states and honest results of input-output identification
+(motionhyst.identify.io_offsets, io_checks, io_predict) on generated records."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from motionhyst.openloop import MassSpringDamper, OpenLoop, simulate_elements
+
+from motionhyst.hysteresis import Coulomb, Jenkins
+from motionhyst.identify.input_output import IORecord, identify_io
+from motionhyst.identify.io_checks import FitFailed, judge_fit
+from motionhyst.identify.io_offsets import Extras
+from motionhyst.identify.io_predict import predict_from_window
+from motionhyst.plants.mass_damper import MassDamper
+
+FS = 1000.0
+TRUE = {"m": 95.0, "c": 200.0, "link.fc": 20.0, "input_offset": -3.0, "output_offset": 2e-3,
+        "v0": 0.02}
+
+
+def _axis_record(n: int = 2500, seed: int = 0, noise: float = 0.0) -> IORecord:
+    """A positioning axis (mass, damper, Coulomb friction) driven by a smooth force, with a
+    force offset, a position offset and an initial velocity (the force drives it on at
+    first: a stage that stops and sticks forgets its initial velocity)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / FS
+    phases = rng.uniform(0, 0.5, 3)
+    u = (30 + 90 * np.sin(2 * np.pi * 0.6 * t + phases[0])
+         + 40 * np.sin(2 * np.pi * 1.7 * t + phases[1])
+         + 15 * np.sin(2 * np.pi * 4.1 * t + phases[2]))
+    mech = MassDamper(TRUE["m"], TRUE["c"]).mechanics()
+    y, _ = simulate_elements(mech, Coulomb(fc=TRUE["link.fc"]).time_stepping(),
+                             u - TRUE["input_offset"], FS, 20, periodic=False,
+                             x0=np.array([0.0, TRUE["v0"]]))
+    y = y + TRUE["output_offset"] + noise * rng.standard_normal(n)
+    return IORecord(t, u, y, f"axis{seed}")
+
+
+@pytest.fixture(scope="module")
+def axis_fit():
+    return identify_io([_axis_record()], "coulomb", plant="mass-damper", substeps=20)
+
+
+def test_offsets_and_initial_state_are_estimated_by_default(axis_fit):
+    """From exact data the force offset, the position offset and the initial velocity are
+    recovered with the axis's mass, damping and friction (a model without them took the
+    EMPS record's force offset for inertia)."""
+    for name, value in TRUE.items():
+        assert axis_fit.estimates[name] == pytest.approx(value, rel=1e-5, abs=1e-9), name
+        assert axis_fit.std[name] is not None, name
+    assert axis_fit.plant.force_offset == pytest.approx(-TRUE["input_offset"], rel=1e-5)
+    assert axis_fit.extra["offsets"]["input"] == axis_fit.estimates["input_offset"]
+    assert axis_fit.warnings == []
+    text = axis_fit.scenario_text()
+    assert "force_offset = 2.99999" in text and "# position offset" in text
+
+
+def test_noise_estimates_lie_within_their_standard_errors():
+    fit = identify_io([_axis_record(seed=1, noise=2e-5), _axis_record(seed=2, noise=2e-5)],
+                      "coulomb", plant="mass-damper", substeps=20)
+    assert set(fit.estimates) >= {"output_offset[0]", "output_offset[1]", "v0[0]", "v0[1]"}
+    for name in ("m", "c", "link.fc", "input_offset"):
+        std = fit.std[name]
+        assert std is not None and abs(fit.estimates[name] - TRUE[name]) <= 4 * std, name
+
+
+def test_predict_sets_the_state_from_the_window_and_scores_after_it(axis_fit):
+    """The identified model predicts another record from its force, its state set from the
+    first 20 samples (the benchmark's convention), to the data's precision."""
+    rec = _axis_record(seed=3)
+    pred = predict_from_window(axis_fit.system(), rec.t, rec.u, rec.y, 20)
+    assert pred.rmse < 1e-6 * np.ptp(rec.y)
+    assert pred.fit_percent > 99.99
+    assert pred.initial_state["velocity"] == pytest.approx(TRUE["v0"], rel=1e-4)
+    with pytest.raises(ValueError, match="at least 2"):
+        predict_from_window(axis_fit.system(), rec.t, rec.u, rec.y, 1)
+
+
+def test_offset_choices():
+    ex = Extras.choose("auto", floating=False, periodic=True, from_rest=False, n_records=1)
+    assert ex.names == ["output_offset"]
+    ex = Extras.choose("input", floating=True, periodic=False, from_rest=True, n_records=1)
+    assert ex.names == ["input_offset"]
+    with pytest.raises(ValueError, match="drift"):
+        Extras.choose("both", floating=True, periodic=True, from_rest=False, n_records=1)
+    with pytest.raises(ValueError, match="unknown offset"):
+        Extras.choose("maybe", floating=True, periodic=False, from_rest=False, n_records=1)
+
+
+def test_a_fit_that_fails_says_so():
+    """Non-finite predictions, an error above the output's RMS or the linear model's, and a
+    model that needs an impossibly fine step (a collapsed mass) are failures, not results."""
+    t = np.arange(200) / FS
+    rec = IORecord(t, np.sin(2 * np.pi * 5 * t), 1e-3 * np.sin(2 * np.pi * 5 * t), "r.csv")
+    good = [rec.y]
+    with pytest.raises(FitFailed, match="not finite"):
+        judge_fit(1e-6, [rec], [np.full(200, np.nan)], None, None, False)
+    with pytest.raises(FitFailed, match="own RMS"):
+        judge_fit(1e-3, [rec], good, None, None, False)
+    with pytest.raises(FitFailed, match="linear model"):
+        judge_fit(2e-5, [rec], good, 1e-5, None, False)
+    collapsed = OpenLoop(MassSpringDamper(1e-12, 1.0, 0.0), Jenkins(k=1e6, fc=1.0))
+    with pytest.raises(FitFailed, match="quasi-static"):
+        judge_fit(1e-6, [rec], good, None, collapsed, False)
+    judge_fit(1e-6, [rec], good, 1e-5, OpenLoop(MassDamper(1.0, 1.0), Coulomb(fc=0.1)), False)
