@@ -216,10 +216,10 @@ def test_closed_loop_record(capsys, closed_loop_case):
     np.testing.assert_allclose([e["k"] for e in d["elements"]], K_TRUE, rtol=2e-3)
     np.testing.assert_allclose([e["fc"] for e in d["elements"]], FC_TRUE, rtol=2e-3)
     assert d["fit_nrms"] < 1e-3
-    # the stage of Table I is the default plant
+    # no silent default plant: the paper's Table I stage is not the stage of a measured loop
     rc, out, err = run(capsys, "identify", str(csv))
-    assert rc == 0, err
-    assert "closed-loop record, plant of paper.toml (Table I, built in)" in out
+    assert rc == 2 and out == ""
+    assert err.count("\n") == 1 and "--scenario" in err
 
 
 def test_closed_loop_prefilter_cutoff(capsys, closed_loop_case):

@@ -154,6 +154,10 @@ def run(args: argparse.Namespace) -> int:
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
     else:
+        if args.scenario is None:
+            raise UsageError(f"motionhyst identify: {path} is a closed-loop record: give the "
+                             f"loop's plant with --scenario FILE (a [stage], or a measured "
+                             f"[plant]); there is no default plant")
         sc = load_scenario(args.scenario)
         if sc.is_open_loop:
             raise UsageError(f"motionhyst identify: closed-loop records need the plant of a "
@@ -220,6 +224,6 @@ def add_parser(sub) -> None:
                         "when --elements is not given (default: rms)")
     q.add_argument("--scenario", metavar="FILE",
                    help="scenario TOML whose [stage] gives P1 for closed-loop records "
-                        "(default: the paper's Table I)")
+                        "(required for them)")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
