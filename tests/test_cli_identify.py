@@ -230,7 +230,8 @@ def test_closed_loop_prefilter_cutoff(capsys, closed_loop_case):
     # the model is fitted through the same prefilter, so a lower cut-off costs no bias
     np.testing.assert_allclose([e["k"] for e in d["elements"]], K_TRUE, rtol=2e-3)
     np.testing.assert_allclose([e["fc"] for e in d["elements"]], FC_TRUE, rtol=2e-3)
-    rc, out, err = run(capsys, "identify", str(csv), "--cutoff", "1e6")
+    rc, out, err = run(capsys, "identify", str(csv), "--scenario", str(scenario), "--cutoff",
+                       "1e6")
     assert rc == 2 and out == "" and err.count("\n") == 1
     assert "cutoff_hz must be in (0, " in err and str(csv) in err
 

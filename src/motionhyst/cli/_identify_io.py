@@ -119,6 +119,7 @@ def run_input_output(args: argparse.Namespace) -> int:
         from motionhyst.io.outputs import OutputFile
 
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
+        _check_savable_plant(plant)
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     if model == "bouc-wen" and (args.offset not in (None, "none") or args.from_rest
@@ -139,7 +140,9 @@ def run_input_output(args: argparse.Namespace) -> int:
         warn(f"identify: {line}")
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
-        target.write_text(fit.scenario_text())
+        text = fit.scenario_text()
+        _check_readable(text, fit)
+        target.write_text(text)
         result["saved"] = args.save
     if args.json:
         print_json(result)
@@ -171,3 +174,40 @@ def run_input_output(args: argparse.Namespace) -> int:
         print("\n# the identified system, a scenario for motionhyst predict (or give --save):")
         print(fit.scenario_text(), end="")
     return 0
+
+
+def _check_readable(text: str, fit) -> None:
+    """Refuse to save a model that ``motionhyst predict`` would not read back as it is."""
+    import tomllib
+
+    from motionhyst.scenario import Scenario, ScenarioError
+
+    try:
+        system = Scenario.from_dict(tomllib.loads(text), "the identified model").open_loop()
+    except ScenarioError as exc:
+        raise ValueError(f"--save: the identified model cannot be written as a scenario that "
+                         f"predict reads ({exc}); nothing saved") from None
+    if (system.plant.to_dict() != fit.plant.to_dict()
+            or system.hysteresis.to_dict() != fit.hysteresis.to_dict()):
+        raise ValueError("--save: the scenario would not give back the identified model; "
+                         "nothing saved")
+
+
+def _check_savable_plant(plant: str) -> None:
+    """Refuse --save before the work if a scenario cannot hold this kind of stage."""
+    import tomllib
+
+    from motionhyst.openloop import MassSpringDamper, TwoMass
+    from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.scenario import Scenario, ScenarioError
+
+    stage = {"mass-damper": MassDamper(1.0, 1.0, 1.0), "mass-spring-damper":
+             MassSpringDamper(1.0, 1.0, 1.0), "two-mass": TwoMass(1.0, 1.0, 1.0, 1.0)}[plant]
+    text = "\n".join(["[stage]", *(f"{k} = {v!r}".replace("'", '"')
+                                    for k, v in stage.to_dict().items()),
+                      "[hysteresis]", 'model = "jenkins"', "k = 1.0", "fc = 1.0"])
+    try:
+        Scenario.from_dict(tomllib.loads(text), "--save").open_loop()
+    except ScenarioError as exc:
+        raise UsageError(f"motionhyst identify: --save cannot write a {plant} stage yet (a "
+                         f"scenario does not read one: {exc})") from None

@@ -34,7 +34,16 @@ INERTIA_SHARE = 1e-3
 
 
 class FitFailed(RuntimeError):
-    """An identification that produced no usable model (one line saying what failed)."""
+    """An identification that produced no usable model (one line saying what failed).
+
+    Examples
+    --------
+    >>> try:
+    ...     raise FitFailed("the fit failed: its prediction is not finite")
+    ... except RuntimeError as exc:   # the command line's error: one line, exit 2
+    ...     print(exc)
+    the fit failed: its prediction is not finite
+    """
 
 
 def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray[np.float64]],

@@ -44,6 +44,14 @@ class WindowPrediction:
         RMS error from sample `window` on [m] (None without a measured position).
     fit_percent : float or None
         ``100 (1 - ||y - yhat|| / ||y - mean(y)||)`` over the same samples.
+
+    Examples
+    --------
+    >>> pred = WindowPrediction(np.arange(3) / 1e3, np.zeros(3), 2,
+    ...                         {"position": 0.0, "velocity": 0.0}, 1e-3, 90.0)
+    >>> print(pred)
+    predicted 3 samples, state set from the first 2 (position 0 m, velocity 0 m/s); RMS error
+    from sample 2 on 0.001 m (fit 90.00 %)
     """
 
     t: NDArray[np.float64]
