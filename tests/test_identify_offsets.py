@@ -104,3 +104,15 @@ def test_a_fit_that_fails_says_so():
     with pytest.raises(FitFailed, match="quasi-static"):
         judge_fit(1e-6, [rec], good, None, collapsed, False)
     judge_fit(1e-6, [rec], good, 1e-5, OpenLoop(MassDamper(1.0, 1.0), Coulomb(fc=0.1)), False)
+
+
+def test_a_parameter_that_ran_away_is_a_warning():
+    from motionhyst.identify.io_checks import plausibility_warnings
+
+    t = np.arange(500) / FS
+    rec = IORecord(t, 10 * np.sin(2 * np.pi * t), 1e-2 * np.sin(2 * np.pi * t))
+    lines = plausibility_warnings({"m": 1.0, "link.fc": 9e13}, {"m": 1.0}, 1.1, [rec], [],
+                                  {"link.fc": 4.5e12})
+    assert lines == ["link.fc = 9e+13 ran 4.5e+12 times above its start: the records do not "
+                     "hold it (at the edge of the model's range; a physically meaningless "
+                     "value)"]

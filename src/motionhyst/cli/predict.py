@@ -90,8 +90,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             out = system.simulate(t, u, periodic=args.periodic, substeps=args.substeps)
             out_t, out_y = out.t, out.displacement
-    except ValueError as exc:
-        raise ValueError(f"{args.data}: {exc}") from None
+    except (ValueError, ArithmeticError) as exc:  # a model the simulation refuses
+        raise ValueError(f"{args.data}: {exc or type(exc).__name__}") from None
     target.write_csv({"time": out_t, "displacement": out_y}, fmt="%.17g")
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "displacement_rms": float(np.sqrt(np.mean(out_y ** 2))),

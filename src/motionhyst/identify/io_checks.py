@@ -104,7 +104,7 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
     rec = records[0]
     try:
         y = system.simulate(rec.t, rec.u, substeps=r).displacement
-    except ValueError as exc:
+    except (ValueError, ArithmeticError) as exc:
         raise FitFailed(f"the fit failed: the identified model cannot be simulated on "
                         f"{rec.name} ({exc})") from None
     if not np.all(np.isfinite(y)):
@@ -114,7 +114,8 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
 
 def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
                           linear_mass: float, records: list[IORecord],
-                          at_bound: list[str]) -> list[str]:
+                          at_bound: list[str], runaway: dict[str, float] | None = None
+                          ) -> list[str]:
     """One line for each implausible estimate, naming the parameter.
 
     Parameters
@@ -129,6 +130,9 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
         The records (for the inertia they show: ``m`` times the RMS acceleration).
     at_bound : list of str
         Names of the parameters that ended at a bound of the search.
+    runaway : dict, optional
+        Parameters (without bounds) that ended orders of magnitude from their start:
+        name -> final over start value.
 
     Returns
     -------
@@ -166,4 +170,9 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
     for name in at_bound:
         out.append(f"{name} = {estimates[name]:.4g} ended at a bound of the search: the records "
                    f"push it beyond the model's range")
+    for name, ratio in (runaway or {}).items():
+        word = "above" if ratio > 1 else "below"
+        out.append(f"{name} = {estimates[name]:.4g} ran {max(ratio, 1 / ratio):.2g} times "
+                   f"{word} its start: the records do not hold it (at the edge of the model's "
+                   f"range; a physically meaningless value)")
     return out

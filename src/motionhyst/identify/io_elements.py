@@ -295,7 +295,7 @@ class _ElementProblem:
             res = [y - self._measured(rec)
                    for (y, _), rec in zip(self.outputs(v), self.records, strict=True)]
             r = np.concatenate(res) / self.y_scale
-        except ValueError:
+        except (ValueError, ArithmeticError):  # parameters the model refuses
             r = np.full(sum(rec.y.size for rec in self.records), np.nan)
         return np.where(np.isfinite(r), r, 1e3)
 
@@ -352,7 +352,7 @@ class _ElementProblem:
         try:
             Je = self._extra_columns(v, self._split_rows(r0 * self.y_scale, measured=True))
             full[:, k:] = Je * self.derivative(v)[k:] / self.y_scale
-        except ValueError:
+        except (ValueError, ArithmeticError):  # parameters the model refuses
             pass  # a model the simulation refuses: the residuals are flat there
         return full[:, self.free]
 
@@ -372,7 +372,7 @@ class _ElementProblem:
             J = np.concatenate([sy for _, sy in outs]) * self.derivative(v)[:k]
         except LookupError:
             return None
-        except ValueError:
+        except (ValueError, ArithmeticError):  # parameters the model refuses
             return np.full(n_rows, 1e3), np.zeros((n_rows, n_sens))
         r = r / self.y_scale
         if not np.all(np.isfinite(r)) or not np.all(np.isfinite(J)):
@@ -458,6 +458,10 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     (:func:`~motionhyst.identify.io_start.inverse_dynamics`), the link's forces
     together that Coulomb force or half of it, slipping after 0.001 to 0.1 of
     the output's RMS (:data:`AXIS_STARTS`).
+
+    A link other than the rigid slider on a mass-damper also starts from the
+    Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit), when
+    that fits the records better than the best of the other starts.
 
     The offsets and initial states of `offset` and `from_rest`
     (:class:`~motionhyst.identify.io_offsets.Extras`) are estimated with them:
@@ -566,11 +570,21 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     for j, name in enumerate(short_extras.names):
         full_start[extras.names.index(name if len(records) == 1 or name == "input_offset"
                                       else f"{name}[0]")] = best[1][n_base + j]
-    remaining = max_nfev if budget is None else max(budget - n_eval, 1)
     prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
                            extras=extras)
-    sol = prob.solve(prob.variables(np.concatenate([best[1][:n_base], full_start])), tol,
-                     remaining)
+    q0 = prob.variables(np.concatenate([best[1][:n_base], full_start]))
+    if plant == "mass-damper" and not getattr(layout.cls, "rigid", False):
+        # the rigid slider is every friction link's limit: its fit is a start for theirs
+        seed, used = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
+                                 start_nfev, plant, output, offset, from_rest, layout, y_scale,
+                                 v_scale, extras, force)
+        n_eval += used
+        if seed is not None:
+            q_seed = prob.variables(seed)
+            if np.sum(prob.residuals(q_seed) ** 2) < np.sum(prob.residuals(q0) ** 2):
+                q0 = q_seed
+    remaining = max_nfev if budget is None else max(budget - n_eval, 1)
+    sol = prob.solve(q0, tol, remaining)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)
@@ -611,10 +625,15 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     bound = [nm for nm, x, lin, sc in zip(names[:n_base], v[:n_base], ~prob.log[:n_base],
                                           scale[:n_base], strict=True)
              if lin and nm not in not_ident and abs(x) <= 1e-9 * sc]
+    # a positive parameter searched as a logarithm has no bound: one that ran orders of
+    # magnitude from its start is at the edge of the model's range all the same
+    runaway = {nm: x / x0 for nm, x, x0, lg in zip(names[:n_base], v[:n_base], best[1][:n_base],
+                                                    prob.log[:n_base], strict=True)
+               if lg and x0 > 0 and not RUNAWAY ** -1 < x / x0 < RUNAWAY}
     masses = {nm: float(x) for nm, x in zip(prob.plant.PARAMETERS, v, strict=False)
               if nm in ("m", "m1", "m2")}
     linear_mass = idim["m"]
-    notes = plausibility_warnings(estimates, masses, linear_mass, records, bound)
+    notes = plausibility_warnings(estimates, masses, linear_mass, records, bound, runaway)
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
@@ -638,11 +657,38 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
         res = np.concatenate([simulate_elements(mech, Stepping.empty(), rec.u, rec.fs, r,
                                                 periodic=periodic)[0] - rec.y
                               for rec in records])
-    except ValueError:
+    except (ValueError, ArithmeticError):
         return None
     if not np.all(np.isfinite(res)):
         return None
     return float(np.std(res) if output_offset else np.sqrt(np.mean(res ** 2)))
+
+
+def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, output,
+                offset, from_rest, layout, y_scale, v_scale, extras, force):
+    """A positioning axis's friction link started from the Coulomb link's fit: the stage, the
+    offsets and initial states as fitted, the link's forces together its slip force, slipping
+    after 1e-5 of the output's RMS (its rigid limit); None if that fit fails."""
+    from motionhyst.identify.io_checks import FitFailed
+
+    try:
+        fit = _identify_elements(records, "coulomb", periodic, substeps, tol, max_nfev, 1,
+                                 t_start, start_nfev, plant, output, offset, from_rest)
+    except (FitFailed, ValueError, ArithmeticError):
+        return None, 0
+    fc = fit.estimates["link.fc"]
+    link0 = layout.start(2.0 * fc / (1e-5 * y_scale), y_scale, v_scale, fit.plant.c, 1e-5)
+    if force.any():
+        link0[force] *= fc / np.sum(link0[force])
+    rate = np.array([par.unit == _VELOCITY for par, _ in layout._values()], dtype=bool)
+    link0[rate] = RATE_GRID[0] * v_scale
+    return (np.concatenate([[fit.plant.m, fit.plant.c], link0,
+                            [fit.estimates[name] for name in extras.names]]),
+            fit.n_evaluations)
+
+
+#: A positive parameter that ends this factor from its start value is reported as at the edge
+RUNAWAY = 1e4
 
 
 #: Starts of a link on a mass-damper: (the link's forces as a share of the records'
