@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from motionhyst.openloop import MassSpringDamper, OpenLoop, simulate_elements
 
 from motionhyst.hysteresis import Coulomb, Jenkins
 from motionhyst.identify.input_output import IORecord, identify_io
@@ -13,6 +12,7 @@ from motionhyst.identify.io_checks import FitFailed, judge_fit
 from motionhyst.identify.io_offsets import Extras
 from motionhyst.identify.io_predict import predict_from_window
 from motionhyst.plants.mass_damper import MassDamper
+from motionhyst.time.openloop import MassSpringDamper, OpenLoop, simulate_elements
 
 FS = 1000.0
 TRUE = {"m": 95.0, "c": 200.0, "link.fc": 20.0, "input_offset": -3.0, "output_offset": 2e-3,

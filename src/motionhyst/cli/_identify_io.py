@@ -197,9 +197,9 @@ def _check_savable_plant(plant: str) -> None:
     """Refuse --save before the work if a scenario cannot hold this kind of stage."""
     import tomllib
 
-    from motionhyst.openloop import MassSpringDamper, TwoMass
     from motionhyst.plants.mass_damper import MassDamper
     from motionhyst.scenario import Scenario, ScenarioError
+    from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
     stage = {"mass-damper": MassDamper(1.0, 1.0, 1.0), "mass-spring-damper":
              MassSpringDamper(1.0, 1.0, 1.0), "two-mass": TwoMass(1.0, 1.0, 1.0, 1.0)}[plant]

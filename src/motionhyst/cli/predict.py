@@ -116,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
 def _check_step(system, t, args) -> None:
     """Refuse, before any work, a model whose own step would be impossibly fine."""
     from motionhyst.identify.io_checks import MAX_PREDICT_SUBSTEPS
-    from motionhyst.openloop import check_record, sampling_rate
+    from motionhyst.time.openloop import check_record, sampling_rate
 
     if args.substeps is not None:
         return

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.hysteresis.stepping import Stepping
-from motionhyst.openloop import OpenLoop, check_record, sampling_rate, simulate_elements
+from motionhyst.time.openloop import OpenLoop, check_record, sampling_rate, simulate_elements
 
 __all__ = ["INIT_WINDOW", "WindowPrediction", "predict_from_window"]
 
@@ -133,7 +133,7 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     A positioning axis with Coulomb friction, moving at 5 mm/s when the record starts:
 
     >>> from motionhyst.hysteresis import Coulomb
-    >>> from motionhyst.openloop import MassSpringDamper
+    >>> from motionhyst.time.openloop import MassSpringDamper
     >>> true = OpenLoop(MassSpringDamper(95.0, 200.0, 0.0), Coulomb(fc=20.0))
     >>> t = np.arange(2000) / 1000.0
     >>> u = 80 * np.sin(2 * np.pi * 0.5 * t) + 25.0
