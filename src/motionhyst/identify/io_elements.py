@@ -672,8 +672,8 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
     from motionhyst.identify.io_checks import FitFailed
 
     try:
-        fit = _identify_elements(records, "coulomb", periodic, substeps, tol, max_nfev, 1,
-                                 t_start, start_nfev, plant, output, offset, from_rest)
+        fit = identify_elements_io(records, "coulomb", periodic, substeps, tol, max_nfev, 1,
+                                   t_start, start_nfev, plant, output, offset, from_rest)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0
     fc = fit.estimates["link.fc"]
