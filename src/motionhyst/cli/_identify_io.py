@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import UsageError, g, print_json, table, warn
+from motionhyst.cli._common import UsageError, g, print_json, table
+from motionhyst.core.warnings import warn
 
 
 def plant_choices() -> list[str]:
@@ -137,7 +138,7 @@ def run_input_output(args: argparse.Namespace) -> int:
                       n_elements=args.elements or 3, plant=plant, output=args.output or "y2",
                       **extras)
     for line in fit.warnings:
-        warn(f"identify: {line}")
+        warn(line)
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         text = fit.scenario_text()

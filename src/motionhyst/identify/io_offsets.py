@@ -126,7 +126,18 @@ class Extras:
         return len(self.names)
 
     def scales(self, u_scale: float, y_scale: float, v_scale: float) -> NDArray[np.float64]:
-        """Typical size of each estimate: the force's, the output's or its rate's RMS."""
+        """Typical size of each estimate: the force's, the output's or its rate's RMS.
+
+        Parameters
+        ----------
+        u_scale, y_scale, v_scale : float
+            Sizes of a force [N], a position [m] and a velocity [m/s].
+
+        Returns
+        -------
+        ndarray
+            One size per name of :attr:`names`.
+        """
         unit = {"input_offset": u_scale, "output_offset": y_scale, "y0": y_scale,
                 "v0": v_scale}
         return np.array([unit[name.split("[")[0]] for name in self.names])
@@ -134,7 +145,18 @@ class Extras:
     def split(self, e: NDArray[np.float64]) -> tuple[float, NDArray[np.float64],
                                                       NDArray[np.float64]]:
         """The force offset, the records' position offsets and their initial states
-        ``(n_records, len(initial))`` from the estimates `e`."""
+        ``(n_records, len(initial))`` from the estimates `e`.
+
+        Parameters
+        ----------
+        e : ndarray
+            The estimates, in the order of :attr:`names`.
+
+        Returns
+        -------
+        tuple
+            ``(u0, y0, init)``.
+        """
         j = 0
         u0 = 0.0
         if self.input_offset:
@@ -151,7 +173,17 @@ class Extras:
         return u0, y0, init
 
     def columns_of_record(self, i: int) -> list[int]:
-        """Indices (into :attr:`names`) of the estimates that move record `i` alone."""
+        """Indices (into :attr:`names`) of the estimates that move record `i` alone.
+
+        Parameters
+        ----------
+        i : int
+            The record's index.
+
+        Returns
+        -------
+        list of int
+        """
         j = int(self.input_offset)
         out = []
         if self.output_offset:

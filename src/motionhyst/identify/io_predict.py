@@ -77,7 +77,17 @@ class WindowPrediction:
         return s
 
     def plot(self, ax=None):
-        """The predicted position against time; returns the Figure."""
+        """The predicted position against time; returns the Figure.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Where to draw (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         import matplotlib.pyplot as plt
 
         fig = ax.figure if ax is not None else plt.figure()
