@@ -198,15 +198,16 @@ def _check_savable_plant(plant: str) -> None:
     """Refuse --save before the work if a scenario cannot hold this kind of stage."""
     import tomllib
 
+    from motionhyst.core.textfiles import toml_table
     from motionhyst.plants.mass_damper import MassDamper
     from motionhyst.scenario import Scenario, ScenarioError
     from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
     stage = {"mass-damper": MassDamper(1.0, 1.0, 1.0), "mass-spring-damper":
-             MassSpringDamper(1.0, 1.0, 1.0), "two-mass": TwoMass(1.0, 1.0, 1.0, 1.0)}[plant]
-    text = "\n".join(["[stage]", *(f"{k} = {v!r}".replace("'", '"')
-                                    for k, v in stage.to_dict().items()),
-                      "[hysteresis]", 'model = "jenkins"', "k = 1.0", "fc = 1.0"])
+             MassSpringDamper(1.0, 1.0, 1.0),
+             "two-mass": TwoMass(1.0, 1.0, 1.0, 1.0, output="y2")}[plant]
+    text = (toml_table("stage", stage.to_dict())
+            + toml_table("hysteresis", {"model": "jenkins", "k": 1.0, "fc": 1.0}))
     try:
         Scenario.from_dict(tomllib.loads(text), "--save").open_loop()
     except ScenarioError as exc:
