@@ -13,6 +13,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.plants.base import LumpedPlant
 from motionhyst.plants.mechanics import Mechanics
 from motionhyst.plants.registry import FORCE_OFFSET, PlantParameter, register
 
@@ -20,7 +21,7 @@ __all__ = ["MassDamper"]
 
 
 @register
-class MassDamper:
+class MassDamper(LumpedPlant):
     """One mass with viscous friction to the ground, no spring: ``m y'' + c y' = u + f0 - w``.
 
     ``P1 = P2 = 1 / (m s^2 + c s)``: the axis floats (only the link holds it).
@@ -57,22 +58,10 @@ class MassDamper:
         FORCE_OFFSET,
     )
     PARAMETERS: ClassVar[tuple[str, ...]] = ("m", "c")
-    outputs: ClassVar[tuple[str, ...]] = ("y",)
-    is_lti: ClassVar[bool] = True
     has_inertia: ClassVar[bool] = True
-    output: str = "y"
-    frequency_range_hz: ClassVar[None] = None
-    pf2_static: ClassVar[None] = None  # no flexible compliance: eq. (21) does not apply
 
     def __init__(self, m: float, c: float, force_offset: float = 0.0) -> None:
-        spec = dict((p.name, p) for p in self.parameters)
-        self.m = spec["m"].check(m)
-        self.c = spec["c"].check(c)
-        self.force_offset = spec["force_offset"].check(force_offset)
-
-    def __repr__(self) -> str:
-        extra = f", force_offset={self.force_offset!r}" if self.force_offset else ""
-        return f"MassDamper(m={self.m!r}, c={self.c!r}{extra})"
+        self._set_checked(m=m, c=c, force_offset=force_offset)
 
     @property
     def M(self) -> float:
@@ -103,45 +92,22 @@ class MassDamper:
 
         return control.tf([self.c], [self.m * self.m, self.m * self.c, 0.0, 0.0])
 
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128] | complex:
-        """``y / u = 1 / (m s^2 + (c + c_link) s + k_link)`` at ``s = 2 pi j f`` [m/N].
+    def dynamic_stiffness(self, s: NDArray[np.complex128], k_link: float, c_link: float
+                          ) -> NDArray[np.complex128]:
+        """``m s^2 + (c + c_link) s + k_link``: force over displacement [N/m].
 
         Parameters
         ----------
-        f_hz : array_like
-            Frequencies [Hz].
+        s : ndarray of complex
+            ``2 pi j f``.
         k_link, c_link : float
             The link taken as a spring [N/m] and damper [N s/m] to the ground.
 
         Returns
         -------
-        complex or ndarray of complex
-            Same shape as `f_hz`.
+        ndarray of complex
         """
-        s = 2j * np.pi * np.asarray(f_hz, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = 1.0 / (self.m * s * s + (self.c + c_link) * s + k_link)
-        return complex(out) if np.ndim(out) == 0 else out
-
-    def values(self) -> NDArray[np.float64]:
-        """``(m, c)`` (:attr:`PARAMETERS`)."""
-        return np.array([self.m, self.c])
-
-    def with_parameters(self, values: ArrayLike) -> MassDamper:
-        """The same axis (same force offset) with ``(m, c) = values`` (checked).
-
-        Parameters
-        ----------
-        values : array_like
-            ``m, c``.
-
-        Returns
-        -------
-        MassDamper
-        """
-        m, c = (float(v) for v in values)
-        return MassDamper(m, c, self.force_offset)
+        return self.m * s * s + (self.c + c_link) * s + k_link
 
     def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
         """The axis (or the unchecked ``(m, c) = values``) as :class:`Mechanics`.
@@ -159,10 +125,3 @@ class MassDamper:
         m, c = self.values() if values is None else np.asarray(values, dtype=float)
         return Mechanics([m], [[c]], [[0.0]], [[1.0], [0.0]], [[[0.0]], [[1.0]]],
                          [[[0.0]], [[0.0]]], 0, 0, force_offset=self.force_offset)
-
-    def to_dict(self) -> dict:
-        """The scenario's ``[stage]`` table (``force_offset`` only when not 0)."""
-        out = {"type": self.name, "m": self.m, "c": self.c}
-        if self.force_offset:
-            out["force_offset"] = self.force_offset
-        return out

@@ -9,6 +9,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.plants.base import LumpedPlant
 from motionhyst.plants.mechanics import Mechanics
 from motionhyst.plants.registry import FORCE_OFFSET, PlantParameter, register
 
@@ -16,7 +17,7 @@ __all__ = ["MassSpringDamper"]
 
 
 @register
-class MassSpringDamper:
+class MassSpringDamper(LumpedPlant):
     """A single mass on a linear spring and damper: ``m y'' + c y' + k y = u + f0 - w``.
 
     ``P1 = P2 = 1 / (m s^2 + c s + k)``, the link on the measured position.
@@ -51,23 +52,10 @@ class MassSpringDamper:
     )
     #: Names of the parameters, in the order of :meth:`values`.
     PARAMETERS: ClassVar[tuple[str, ...]] = ("m", "c", "k")
-    outputs: ClassVar[tuple[str, ...]] = ("y",)
-    is_lti: ClassVar[bool] = True
     has_inertia: ClassVar[bool] = True
-    output: str = "y"
-    frequency_range_hz: ClassVar[None] = None
-    pf2_static: ClassVar[None] = None  # no flexible compliance: eq. (21) does not apply
 
     def __init__(self, m: float, c: float, k: float, force_offset: float = 0.0) -> None:
-        spec = {p.name: p for p in self.parameters}
-        self.m = spec["m"].check(m)
-        self.c = spec["c"].check(c)
-        self.k = spec["k"].check(k)
-        self.force_offset = spec["force_offset"].check(force_offset)
-
-    def __repr__(self) -> str:
-        extra = f", force_offset={self.force_offset!r}" if self.force_offset else ""
-        return f"MassSpringDamper(m={self.m!r}, c={self.c!r}, k={self.k!r}{extra})"
+        self._set_checked(m=m, c=c, k=k, force_offset=force_offset)
 
     @property
     def M(self) -> float:
@@ -104,45 +92,22 @@ class MassSpringDamper:
         m = self.m
         return control.tf([self.c, self.k], [m * m, m * self.c, m * self.k, 0.0, 0.0])
 
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128] | complex:
-        """``Y / U = 1 / (m s^2 + (c + c_link) s + k + k_link)`` at ``s = 2 pi j f`` [m/N].
+    def dynamic_stiffness(self, s: NDArray[np.complex128], k_link: float, c_link: float
+                          ) -> NDArray[np.complex128]:
+        """``m s^2 + (c + c_link) s + k + k_link``: force over displacement [N/m].
 
         Parameters
         ----------
-        f_hz : array_like
-            Frequencies [Hz].
+        s : ndarray of complex
+            ``2 pi j f``.
         k_link, c_link : float
             The link taken as a spring [N/m] and damper [N s/m] to the ground.
 
         Returns
         -------
-        complex or ndarray of complex
-            Same shape as `f_hz`.
+        ndarray of complex
         """
-        s = 2j * np.pi * np.asarray(f_hz, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = 1.0 / (self.m * s * s + (self.c + c_link) * s + (self.k + k_link))
-        return complex(out) if np.ndim(out) == 0 else out
-
-    def values(self) -> NDArray[np.float64]:
-        """``(m, c, k)`` (:attr:`PARAMETERS`)."""
-        return np.array([self.m, self.c, self.k])
-
-    def with_parameters(self, values: ArrayLike) -> MassSpringDamper:
-        """The same kind of plant (same force offset) with ``(m, c, k) = values`` (checked).
-
-        Parameters
-        ----------
-        values : array_like
-            ``m, c, k``.
-
-        Returns
-        -------
-        MassSpringDamper
-        """
-        m, c, k = (float(v) for v in values)
-        return MassSpringDamper(m, c, k, self.force_offset)
+        return self.m * s * s + (self.c + c_link) * s + (self.k + k_link)
 
     def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
         """The plant (or the unchecked ``(m, c, k) = values``) as :class:`Mechanics`.
@@ -160,11 +125,3 @@ class MassSpringDamper:
         return Mechanics([m], [[c]], [[k]], [[1.0], [0.0], [0.0]],
                          [[[0.0]], [[1.0]], [[0.0]]], [[[0.0]], [[0.0]], [[1.0]]], 0, 0,
                          force_offset=self.force_offset)
-
-    def to_dict(self) -> dict:
-        """Parameters as a JSON-ready dictionary (the ``[stage]`` table of a scenario;
-        ``force_offset`` only when not 0)."""
-        out = {"type": self.name, "m": self.m, "c": self.c, "k": self.k}
-        if self.force_offset:
-            out["force_offset"] = self.force_offset
-        return out

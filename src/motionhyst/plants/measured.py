@@ -6,10 +6,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from motionhyst.core.validation import check_positive
-from motionhyst.plants.registry import PlantParameter, register
+from motionhyst.plants.base import FixedPlant
+from motionhyst.plants.registry import register
 
 if TYPE_CHECKING:  # the readers (pandas, scipy.io) are imported when a file is read
     from motionhyst.io.csvdata import Source
@@ -23,7 +24,7 @@ __all__ = ["MeasuredPlant", "load_frd_plant"]
 
 @register
 @dataclass(frozen=True)
-class MeasuredPlant:
+class MeasuredPlant(FixedPlant):
     """A plant known only by measured frequency responses of ``P1`` and ``P2``.
 
     Attributes
@@ -59,15 +60,16 @@ class MeasuredPlant:
     resolution: float | None = None
 
     name: ClassVar[str] = "frd"
-    parameters: ClassVar[tuple[PlantParameter, ...]] = ()  # read from a file, not a [stage]
-    PARAMETERS: ClassVar[tuple[str, ...]] = ()
-    outputs: ClassVar[tuple[str, ...]] = ("y2",)
     output: ClassVar[str] = "y2"
     is_lti: ClassVar[bool] = False
-    has_inertia: ClassVar[bool] = True
     force_offset: ClassVar[float] = 0.0
     Pf2: ClassVar[None] = None  # Pr - P2 from the data
     pf2_static: ClassVar[None] = None  # eq. (21) needs a model of the modes
+    no_parameters: ClassVar[str] = "a measured plant has no parameters to set"
+    no_state_space: ClassVar[str] = (
+        "a measured plant (frequency-response data) has no state-space form; "
+        'fit a model to it ([plant] use = "fit")'
+    )
 
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
@@ -100,58 +102,6 @@ class MeasuredPlant:
         """Lowest and highest measured frequency [Hz]."""
         w = self.P2.omega
         return float(w.min() / TWO_PI), float(w.max() / TWO_PI)
-
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128]:
-        """``y2 / u`` at `f_hz` [m/N] (interpolated between measured lines), the link a spring
-        `k_link` and damper `c_link` on ``y1``: ``P2 / (1 + Z P1)``.
-
-        Parameters
-        ----------
-        f_hz : array_like
-            Frequencies [Hz], inside :attr:`frequency_range_hz`.
-        k_link, c_link : float
-            The link taken as a spring [N/m] and damper [N s/m].
-
-        Returns
-        -------
-        ndarray of complex
-        """
-        from motionhyst.core.lti import freqresp
-
-        w = TWO_PI * np.atleast_1d(np.asarray(f_hz, dtype=float))
-        return freqresp(self.P2, w) / (1.0 + (k_link + 1j * w * c_link) * freqresp(self.P1, w))
-
-    def values(self) -> NDArray[np.float64]:
-        """No parameters of a ``[stage]``: an empty array."""
-        return np.zeros(0)
-
-    def with_parameters(self, values: ArrayLike) -> MeasuredPlant:
-        """The plant itself (it has no :attr:`PARAMETERS`).
-
-        Parameters
-        ----------
-        values : array_like
-            Empty.
-
-        Returns
-        -------
-        MeasuredPlant
-        """
-        if np.size(values):
-            raise ValueError("a measured plant has no parameters to set")
-        return self
-
-    def mechanics(self, values: ArrayLike | None = None) -> Any:
-        """A ``ValueError``: measured lines have no state-space form.
-
-        Parameters
-        ----------
-        values : array_like, optional
-            Ignored.
-        """
-        raise ValueError("a measured plant (frequency-response data) has no state-space form; "
-                         'fit a model to it ([plant] use = "fit")')
 
     def to_dict(self) -> dict:
         """``type``, the rigid-body mass, the source and the measured range."""

@@ -13,7 +13,8 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.plants.registry import PlantParameter, register
+from motionhyst.plants.base import FixedPlant
+from motionhyst.plants.registry import register
 
 __all__ = ["ModalPlant", "Mode"]
 
@@ -78,7 +79,7 @@ def _modal_polys(M: float, modes: tuple[Mode, ...]):
 
 
 @register
-class ModalPlant:
+class ModalPlant(FixedPlant):
     """Rigid body plus flexible modes shared by ``P1`` and ``P2`` (paper eqs. 1-2, modal form).
 
     ``P1 = 1/(M s^2) + sum r1_i / (s^2 + 2 z_i w_i s + w_i^2)``,
@@ -107,14 +108,15 @@ class ModalPlant:
     """
 
     name: ClassVar[str] = "modal"
-    parameters: ClassVar[tuple[PlantParameter, ...]] = ()  # built from a fit, not a [stage]
-    PARAMETERS: ClassVar[tuple[str, ...]] = ()
-    outputs: ClassVar[tuple[str, ...]] = ("y2",)
     output: ClassVar[str] = "y2"
     is_lti: ClassVar[bool] = True
-    has_inertia: ClassVar[bool] = True
     force_offset: ClassVar[float] = 0.0
     frequency_range_hz: ClassVar[None] = None
+    no_parameters: ClassVar[str] = "a modal plant has no parameters to set"
+    no_state_space: ClassVar[str] = (
+        "a modal plant has no state-space form of lumped masses (its residues "
+        "need not be those of masses); the closed loop runs on P1 and P2"
+    )
 
     def __init__(self, M: float, modes=(), source: str = "") -> None:
         M = float(M)
@@ -191,56 +193,6 @@ class ModalPlant:
     def pf2_static(self) -> float:
         """``Pf2(0) = sum r2_i / w_i^2`` [m/N]: the flexible compliance that eq. (20) divides by."""
         return float(sum(m.r2 / (TWO_PI * m.frequency_hz) ** 2 for m in self.modes))
-
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128]:
-        """``y2 / u`` at `f_hz` [m/N], the link a spring `k_link` and damper `c_link` on ``y1``.
-
-        Parameters
-        ----------
-        f_hz : array_like
-            Frequencies [Hz].
-        k_link, c_link : float
-            The link taken as a spring [N/m] and damper [N s/m]: ``P2 / (1 + Z P1)``.
-
-        Returns
-        -------
-        ndarray of complex
-        """
-        w = TWO_PI * np.atleast_1d(np.asarray(f_hz, dtype=float))
-        p1, p2 = self.response(w)
-        return p2 / (1.0 + (k_link + 1j * w * c_link) * p1)
-
-    def values(self) -> NDArray[np.float64]:
-        """No parameters of a ``[stage]``: an empty array."""
-        return np.zeros(0)
-
-    def with_parameters(self, values: ArrayLike) -> ModalPlant:
-        """The plant itself (it has no :attr:`PARAMETERS`).
-
-        Parameters
-        ----------
-        values : array_like
-            Empty.
-
-        Returns
-        -------
-        ModalPlant
-        """
-        if np.size(values):
-            raise ValueError("a modal plant has no parameters to set")
-        return self
-
-    def mechanics(self, values: ArrayLike | None = None) -> Any:
-        """A ``ValueError``: modal residues are not lumped masses.
-
-        Parameters
-        ----------
-        values : array_like, optional
-            Ignored.
-        """
-        raise ValueError("a modal plant has no state-space form of lumped masses (its residues "
-                         "need not be those of masses); the closed loop runs on P1 and P2")
 
     @property
     def resonance_hz(self) -> float:

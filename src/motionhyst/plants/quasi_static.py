@@ -16,13 +16,14 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.plants.base import LumpedPlant
 from motionhyst.plants.registry import FORCE_OFFSET, PlantParameter, register
 
 __all__ = ["QuasiStatic"]
 
 
 @register
-class QuasiStatic:
+class QuasiStatic(LumpedPlant):
     """No inertia: ``u + f0 = w(y) + k y + c y'``.
 
     Parameters
@@ -55,24 +56,12 @@ class QuasiStatic:
         FORCE_OFFSET,
     )
     PARAMETERS: ClassVar[tuple[str, ...]] = ("k", "c")
-    outputs: ClassVar[tuple[str, ...]] = ("y",)
-    is_lti: ClassVar[bool] = True
     has_inertia: ClassVar[bool] = False
-    output: str = "y"
     M: ClassVar[float] = 0.0
-    frequency_range_hz: ClassVar[None] = None
-    pf2_static: ClassVar[None] = None
     Pf2: ClassVar[None] = None
 
     def __init__(self, k: float = 0.0, c: float = 0.0, force_offset: float = 0.0) -> None:
-        spec = {p.name: p for p in self.parameters}
-        self.k = spec["k"].check(k)
-        self.c = spec["c"].check(c)
-        self.force_offset = spec["force_offset"].check(force_offset)
-
-    def __repr__(self) -> str:
-        extra = f", force_offset={self.force_offset!r}" if self.force_offset else ""
-        return f"QuasiStatic(k={self.k!r}, c={self.c!r}{extra})"
+        self._set_checked(k=k, c=c, force_offset=force_offset)
 
     @property
     def P1(self) -> Any:
@@ -89,45 +78,23 @@ class QuasiStatic:
         """The same as :attr:`P1`."""
         return self.P1
 
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128] | complex:
-        """``y / u = 1 / ((c + c_link) s + k + k_link)`` at ``s = 2 pi j f`` [m/N].
+    def dynamic_stiffness(self, s: NDArray[np.complex128], k_link: float, c_link: float
+                          ) -> NDArray[np.complex128]:
+        """``(c + c_link) s + k + k_link``: force over displacement [N/m] (0 where nothing
+        holds the displacement).
 
         Parameters
         ----------
-        f_hz : array_like
-            Frequencies [Hz].
+        s : ndarray of complex
+            ``2 pi j f``.
         k_link, c_link : float
             The link taken as a spring [N/m] and damper [N s/m].
 
         Returns
         -------
-        complex or ndarray of complex
-            Same shape as `f_hz` (inf where nothing holds the displacement).
+        ndarray of complex
         """
-        s = 2j * np.pi * np.asarray(f_hz, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = 1.0 / ((self.c + c_link) * s + (self.k + k_link))
-        return complex(out) if np.ndim(out) == 0 else out
-
-    def values(self) -> NDArray[np.float64]:
-        """``(k, c)`` (:attr:`PARAMETERS`)."""
-        return np.array([self.k, self.c])
-
-    def with_parameters(self, values: ArrayLike) -> QuasiStatic:
-        """The same plant (same force offset) with ``(k, c) = values`` (checked).
-
-        Parameters
-        ----------
-        values : array_like
-            ``k, c``.
-
-        Returns
-        -------
-        QuasiStatic
-        """
-        k, c = (float(v) for v in values)
-        return QuasiStatic(k, c, self.force_offset)
+        return (self.c + c_link) * s + (self.k + k_link)
 
     def mechanics(self, values: ArrayLike | None = None) -> Any:
         """None: a ``ValueError``, the plant has no masses.
@@ -144,10 +111,3 @@ class QuasiStatic:
         """
         raise ValueError("a quasi-static plant has no inertia, hence no state-space form of "
                          "masses: its displacement is where the link's force balances the force")
-
-    def to_dict(self) -> dict:
-        """The scenario's ``[stage]`` table (``force_offset`` only when not 0)."""
-        out = {"type": self.name, "k": self.k, "c": self.c}
-        if self.force_offset:
-            out["force_offset"] = self.force_offset
-        return out

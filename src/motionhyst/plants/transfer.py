@@ -4,16 +4,14 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
-
-from motionhyst.plants.registry import PlantParameter, register
+from motionhyst.plants.base import FixedPlant
+from motionhyst.plants.registry import register
 
 __all__ = ["TransferPlant"]
 
 
 @register
-class TransferPlant:
+class TransferPlant(FixedPlant):
     """Any plant as python-control systems: ``y1 = P1 (u - w)``, ``y2 = P2 (u - w)``.
 
     What a :class:`~motionhyst.controllers.loop.Loop` makes of a tuple ``(P1, P2)``: the
@@ -38,16 +36,17 @@ class TransferPlant:
     """
 
     name: ClassVar[str] = "transfer-functions"
-    parameters: ClassVar[tuple[PlantParameter, ...]] = ()
-    PARAMETERS: ClassVar[tuple[str, ...]] = ()
-    outputs: ClassVar[tuple[str, ...]] = ("y2",)
-    has_inertia: ClassVar[bool] = True
     is_lti: ClassVar[bool] = True
     frequency_range_hz: ClassVar[None] = None
     output: str = "y2"
     force_offset: float = 0.0
     Pf2: ClassVar[None] = None
     pf2_static: ClassVar[None] = None
+    no_parameters: ClassVar[str] = "a plant of transfer functions has no parameters"
+    no_state_space: ClassVar[str] = (
+        "a plant of transfer functions has no state-space form of masses; "
+        "give a stage of the plant registry"
+    )
 
     def __init__(self, P1: Any, P2: Any, M: float | None = None) -> None:
         import control
@@ -61,57 +60,6 @@ class TransferPlant:
 
     def __repr__(self) -> str:
         return f"TransferPlant(P1={self.P1!r}, P2={self.P2!r}, M={self.M!r})"
-
-    def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
-                           ) -> NDArray[np.complex128]:
-        """``y2 / u`` at `f_hz` [m/N], the link a spring `k_link` and damper `c_link` on ``y1``.
-
-        Parameters
-        ----------
-        f_hz : array_like
-            Frequencies [Hz].
-        k_link, c_link : float
-            The link taken as a spring [N/m] and damper [N s/m].
-
-        Returns
-        -------
-        ndarray of complex
-        """
-        from motionhyst.core.lti import freqresp
-
-        w = 2 * np.pi * np.atleast_1d(np.asarray(f_hz, dtype=float))
-        return freqresp(self.P2, w) / (1.0 + (k_link + 1j * w * c_link) * freqresp(self.P1, w))
-
-    def values(self) -> NDArray[np.float64]:
-        """No parameters: an empty array."""
-        return np.zeros(0)
-
-    def with_parameters(self, values: ArrayLike) -> TransferPlant:
-        """The plant itself (it has no parameters).
-
-        Parameters
-        ----------
-        values : array_like
-            Empty.
-
-        Returns
-        -------
-        TransferPlant
-        """
-        if np.size(values):
-            raise ValueError("a plant of transfer functions has no parameters")
-        return self
-
-    def mechanics(self, values: ArrayLike | None = None) -> Any:
-        """A ``ValueError``: transfer functions have no lumped masses.
-
-        Parameters
-        ----------
-        values : array_like, optional
-            Ignored.
-        """
-        raise ValueError("a plant of transfer functions has no state-space form of masses; "
-                         "give a stage of the plant registry")
 
     def to_dict(self) -> dict:
         """``type`` and the rigid-body mass (the systems are not written)."""
