@@ -71,8 +71,7 @@ RESULTS = {
     "ILCResult": (_ilc, 1),
     "ScanResult": (_scan, 3),
     "Profile": (lambda loop: point_to_point(0.002, 0.05, 2.0, 50.0, 1e3), 5),
-    # numbers only, no figure
-    "LoopMargins": (lambda loop: loop_margins(loop.controller, loop.P2), 0),
+    "LoopMargins": (lambda loop: loop_margins(loop.controller, loop.P2), 1),
 }
 
 

@@ -34,7 +34,7 @@ the smallest ``|1 + L|`` on the lines (an upper bound of the true one).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import control
 import numpy as np
@@ -79,6 +79,9 @@ class LoopMargins:
         Smallest ``PM / w_c`` over the gain crossovers [s] (inf without one).
     sample_rate_hz : float or None
         The sampled controller's rate; None for a continuous loop.
+    frequency_hz, open_loop : ndarray or None
+        The frequencies [Hz] the margins were searched on and ``L`` there (what
+        :meth:`plot` draws); not part of :meth:`to_dict`.
 
     Examples
     --------
@@ -101,6 +104,8 @@ class LoopMargins:
     evaluated_on: str = "model"
     delay_margin_s: float = math.inf
     sample_rate_hz: float | None = None
+    frequency_hz: NDArray[np.float64] | None = field(default=None, repr=False, compare=False)
+    open_loop: NDArray[np.complex128] | None = field(default=None, repr=False, compare=False)
 
     @property
     def delay_margin_samples(self) -> float | None:
@@ -145,6 +150,23 @@ class LoopMargins:
             f"  bandwidth                      {self.bandwidth_hz:.4g} Hz ({BANDWIDTH_DEFINITION})"
             + ("" if self.evaluated_on == "model" else
                f"; evaluated on the {self.evaluated_on} only")])
+
+    def plot(self, ax=None):
+        """``|L|`` and ``|S| = 1 / |1 + L|`` against frequency, the bandwidth and the
+        modulus margin marked (:func:`motionhyst.present.figures.plot_margins`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; default: a new figure.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.present.figures import plot_margins
+
+        return plot_margins(self, ax=ax)
 
 
 def _grid_hz(controller, plant) -> NDArray[np.float64]:
@@ -279,4 +301,5 @@ def loop_margins(controller, plant, zoh: ZohEquivalent | None = None) -> LoopMar
                        modulus_margin=mm, modulus_margin_hz=f_mm, bandwidth_hz=float(bw),
                        evaluated_on="measured lines" if data else "model",
                        delay_margin_s=float(dm),
-                       sample_rate_hz=controller.sample_rate_hz if sampled else None)
+                       sample_rate_hz=controller.sample_rate_hz if sampled else None,
+                       frequency_hz=f, open_loop=L)

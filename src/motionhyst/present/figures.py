@@ -27,7 +27,7 @@ from motionhyst.present.figure_writer import FigureWriter, save_figures
 
 __all__ = ["STYLE", "DecadeFormatter", "FigureWriter", "MinorLogLocator", "minor_log_ticks",
            "new_figure", "plot_analysis", "plot_describing_function", "plot_frf_fit", "plot_link",
-           "plot_simulation", "plot_steady_state", "save_figures"]
+           "plot_margins", "plot_simulation", "plot_steady_state", "save_figures"]
 
 STYLE = {
     "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
@@ -413,6 +413,60 @@ def plot_simulation(sim, ax=None) -> Figure:
     ax2.set_ylabel("link force w [N]")
     ax2.set_xlabel("time [s]")
     fig.motionhyst_data.update(t=sim.t, e=sim.e, e_linear=sim.e_linear, w=sim.w)
+    return fig
+
+
+def plot_margins(margins, ax=None) -> Figure:
+    """The open loop ``|L|`` and the sensitivity ``|S| = 1 / |1 + L|`` of a
+    :class:`~motionhyst.analysis.margins.LoopMargins` in dB against frequency.
+
+    Two decades either side of the bandwidth (``|L|`` falling through 0 dB, marked) and
+    the peak of ``|S|`` (the modulus margin ``1 / max |S|``, marked).
+
+    Parameters
+    ----------
+    margins : LoopMargins
+        What :func:`~motionhyst.analysis.margins.loop_margins` returned.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; default: a new figure.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario, loop_margins
+    >>> loop = default_scenario().loop()
+    >>> fig = plot_margins(loop_margins(loop.controller, loop.P2))
+    >>> sorted(fig.motionhyst_data)
+    ['L', 'S', 'f']
+    """
+    if margins.frequency_hz is None:
+        raise ValueError("these margins carry no frequency response to plot (made by hand, "
+                         "not by loop_margins)")
+    fig, axes = new_figure(ax=ax)
+    (ax,) = axes
+    f = np.asarray(margins.frequency_hz)
+    L = np.asarray(margins.open_loop)
+    centre = margins.bandwidth_hz
+    if not np.isfinite(centre):
+        centre = margins.modulus_margin_hz
+    if np.isfinite(centre):  # two decades either side of the crossover: where the margins are
+        keep = (f >= centre / 100.0) & (f <= centre * 100.0)
+        f, L = f[keep], L[keep]
+    S = 1.0 / (1.0 + L)
+    ax.semilogx(f, 20 * np.log10(np.abs(L)), color="k", label="|L| = |C P2|")
+    ax.semilogx(f, 20 * np.log10(np.abs(S)), color=LINEAR_COLOR, label="|S| = 1 / |1 + L|")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    if np.isfinite(margins.bandwidth_hz):
+        ax.axvline(margins.bandwidth_hz, color="tab:green", ls=":", lw=1,
+                   label=f"bandwidth {margins.bandwidth_hz:.4g} Hz")
+    peak = -20 * np.log10(margins.modulus_margin)
+    ax.plot([margins.modulus_margin_hz], [peak], "o", color="tab:red", mfc="none",
+            label=f"max |S| = {peak:.3g} dB at {margins.modulus_margin_hz:.4g} Hz")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("magnitude [dB]")
+    ax.set_title(f"Loop margins ({margins.evaluated_on})")
+    ax.legend(loc="lower left")
+    minor_log_ticks(axes)
+    fig.motionhyst_data.update(f=f, L=L, S=S)
     return fig
 
 
