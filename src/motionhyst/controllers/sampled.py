@@ -290,13 +290,13 @@ class SampledController:
     def response(self, omega: ArrayLike) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
         """``R`` and ``Y`` at ``z = e^{j w T}``.
 
+        The delay is not included (it belongs to the hold,
+        :func:`motionhyst.core.sampling.hold_response`).
+
         Parameters
         ----------
         omega : array_like
             Angular frequencies [rad/s].
-
-        The delay is not included (it belongs to the hold,
-        :func:`motionhyst.core.sampling.hold_response`).
         """
         zinv = np.exp(-1j * np.asarray(omega, dtype=float) * self.period)
         Y = polyval_zinv(self.y_num, zinv) / polyval_zinv(self.y_den, zinv)

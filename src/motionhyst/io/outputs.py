@@ -132,6 +132,15 @@ def check_not_input(path: str | os.PathLike, inputs: Iterable[str | os.PathLike 
                     option: str | None = None) -> None:
     """Raise :class:`OutputError` if `path` is one of `inputs` (same file or same resolved path).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output about to be written.
+    inputs : iterable of str, os.PathLike or None
+        The command's input files (None entries are skipped).
+    option : str, optional
+        The option that named `path`, put in front of it in the message.
+
     Examples
     --------
     >>> check_not_input("a.csv", ["b.toml"])
@@ -471,12 +480,24 @@ class OutputFile:
                             folder.rmdir()
 
     def write_bytes(self, data: bytes) -> None:
-        """Write `data` atomically (see :meth:`open`)."""
+        """Write `data` atomically (see :meth:`open`).
+
+        Parameters
+        ----------
+        data : bytes
+            The whole content of the file.
+        """
         with self.open("wb") as fh:
             fh.write(data)
 
     def write_text(self, text: str) -> None:
-        """Write `text` (UTF-8) atomically (see :meth:`open`)."""
+        """Write `text` (UTF-8) atomically (see :meth:`open`).
+
+        Parameters
+        ----------
+        text : str
+            The whole content of the file.
+        """
         with self.open("w") as fh:
             fh.write(text)
 
@@ -639,7 +660,15 @@ class OutputFolder:
         OutputFile(self.path / MANIFEST, force=True).write_text(text)
 
     def write_bytes(self, name: str, data: bytes) -> None:
-        """Stage the file `name`: a temporary file in the folder, moved by :meth:`finish`."""
+        """Stage the file `name`: a temporary file in the folder, moved by :meth:`finish`.
+
+        Parameters
+        ----------
+        name : str
+            One of the names the folder was made with.
+        data : bytes
+            The whole content of the file.
+        """
         if name not in self.names:
             raise ValueError(f"{name!r} is not among the names given to OutputFolder")
         self._ensure_folder()
@@ -661,7 +690,15 @@ class OutputFolder:
             raise OutputError(f"cannot write {target}: {exc.strerror}") from None
 
     def write_text(self, name: str, text: str) -> None:
-        """Stage the text file `name` (UTF-8), as :meth:`write_bytes`."""
+        """Stage the text file `name` (UTF-8), as :meth:`write_bytes`.
+
+        Parameters
+        ----------
+        name : str
+            One of the names the folder was made with.
+        text : str
+            The whole content of the file.
+        """
         self.write_bytes(name, text.encode("utf-8"))
 
     @property

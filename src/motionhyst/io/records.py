@@ -197,6 +197,11 @@ def _head(path: Path, n: int = 128) -> bytes:
 def is_mat_file(source: Source) -> bool:
     """Whether `source` is read as a MATLAB file: its content says so, or its name ends ``.mat``.
 
+    Parameters
+    ----------
+    source : str, os.PathLike, file or DataFrame
+        A record's file (anything else is not a MATLAB file).
+
     Examples
     --------
     >>> is_mat_file("DATA_EMPS.mat"), is_mat_file("record.csv")
@@ -434,6 +439,13 @@ def record_columns(source: Source, columns: Mapping[str, str] | None = None) -> 
     A name `columns` maps to is reported as the quantity (``t`` as ``time``
     with ``columns={"time": "t"}``); other names normalised as a CSV header's
     (lower case, see :func:`motionhyst.io.csvdata.normalize_name`).
+
+    Parameters
+    ----------
+    source : str, os.PathLike, file or DataFrame
+        The record: a CSV or MATLAB file, or a table already read.
+    columns : mapping of str to str, optional
+        Quantity -> the record's column (or variable) name.
 
     Examples
     --------

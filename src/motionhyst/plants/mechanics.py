@@ -78,7 +78,19 @@ class Mechanics:
     def state_space(self, k_link: float = 0.0, c_link: float = 0.0
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``A`` and ``B`` (``x = (q, q')``), the link taken as a spring `k_link` and
-        damper `c_link` to the ground (0: the link left out)."""
+        damper `c_link` to the ground (0: the link left out).
+
+        Parameters
+        ----------
+        k_link, c_link : float
+            The link taken as a spring [N/m] and damper [N s/m] to the ground (0: left out).
+
+        Returns
+        -------
+        A : ndarray, shape (2n, 2n)
+        B : ndarray, shape (2n,)
+            The force ``u - w`` enters on ``q[link]``.
+        """
         n = self.n
         K = self.K.copy()
         C = self.C.copy()
@@ -166,7 +178,20 @@ class Mechanics:
 
     def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0, c_link: float = 0.0
                            ) -> NDArray[np.complex128]:
-        """``q[output] / u`` at `f_hz`, the link a spring `k_link` and damper `c_link`."""
+        """``q[output] / u`` at `f_hz`, the link a spring `k_link` and damper `c_link`.
+
+        Parameters
+        ----------
+        f_hz : array_like
+            Frequencies [Hz].
+        k_link, c_link : float
+            The link taken as a spring [N/m] and damper [N s/m] to the ground (0: left out).
+
+        Returns
+        -------
+        ndarray of complex
+            [m/N], one per frequency.
+        """
         s = 2j * np.pi * np.atleast_1d(np.asarray(f_hz, dtype=float))
         K = self.K.astype(complex)
         C = self.C.astype(complex)
@@ -182,7 +207,21 @@ class Mechanics:
     def linear_periodic_state(self, u: NDArray[np.float64], fs: float, k_link: float
                               ) -> NDArray[np.float64]:
         """``x = (q, q')`` at the start of the periodic steady state for the period `u`, the
-        link a spring `k_link` to the ground (from the spectrum of `u`)."""
+        link a spring `k_link` to the ground (from the spectrum of `u`).
+
+        Parameters
+        ----------
+        u : ndarray
+            One period of the force [N], sampled at `fs`.
+        fs : float
+            Sampling rate [Hz].
+        k_link : float
+            The link taken as a spring to the ground [N/m].
+
+        Returns
+        -------
+        ndarray, shape (2n,)
+        """
         U = np.fft.rfft(u)
         f = np.fft.rfftfreq(u.size, 1.0 / fs)
         x = np.zeros(2 * self.n)
@@ -204,14 +243,26 @@ class Mechanics:
         return x
 
     def natural_frequency_hz(self, k_link: float = 0.0) -> float:
-        """Highest undamped natural frequency, the link a spring `k_link` to the ground [Hz]."""
+        """Highest undamped natural frequency, the link a spring `k_link` to the ground [Hz].
+
+        Parameters
+        ----------
+        k_link : float
+            The link taken as a spring to the ground [N/m].
+        """
         K = self.K.copy()
         K[self.link, self.link] += k_link
         w2 = np.linalg.eigvals(K / self.mass[:, None]).real
         return math.sqrt(max(float(np.max(w2)), 0.0)) / (2 * math.pi)
 
     def decay_time(self, k_link: float = 0.0) -> float:
-        """Slowest decay time of the modes, the link a spring `k_link` [s] (inf: undamped)."""
+        """Slowest decay time of the modes, the link a spring `k_link` [s] (inf: undamped).
+
+        Parameters
+        ----------
+        k_link : float
+            The link taken as a spring to the ground [N/m] (negative values count as 0).
+        """
         A, _ = self.state_space(max(k_link, 0.0))
         lam = np.linalg.eigvals(A)
         rate = -lam.real

@@ -213,16 +213,36 @@ class Plant(Protocol):
 
     def frequency_response(self, f_hz: ArrayLike, k_link: float = 0.0,
                            c_link: float = 0.0) -> NDArray[np.complex128]:
-        """``output / u`` at `f_hz` [m/N], the link a spring `k_link` and damper `c_link`."""
+        """``output / u`` at `f_hz` [m/N], the link a spring `k_link` and damper `c_link`.
+
+        Parameters
+        ----------
+        f_hz : array_like
+            Frequencies [Hz].
+        k_link, c_link : float
+            The link taken as a spring [N/m] and damper [N s/m].
+        """
 
     def mechanics(self, values: ArrayLike | None = None) -> Mechanics:
-        """The state-space realisation (or that with :attr:`PARAMETERS` at `values`)."""
+        """The state-space realisation (or that with :attr:`PARAMETERS` at `values`).
+
+        Parameters
+        ----------
+        values : array_like, optional
+            Values of :attr:`PARAMETERS` instead of the plant's own (unchecked).
+        """
 
     def values(self) -> NDArray[np.float64]:
         """The values of :attr:`PARAMETERS`."""
 
     def with_parameters(self, values: ArrayLike) -> Plant:
-        """The same plant with :attr:`PARAMETERS` at `values` (checked), the rest kept."""
+        """The same plant with :attr:`PARAMETERS` at `values` (checked), the rest kept.
+
+        Parameters
+        ----------
+        values : array_like
+            One value for each of :attr:`PARAMETERS`.
+        """
 
     def to_dict(self) -> dict:
         """The scenario's ``[stage]`` table, with ``type``."""

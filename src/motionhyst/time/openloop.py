@@ -277,7 +277,9 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     stepping : Stepping
         The link's rows (:meth:`Hysteresis.time_stepping`; empty: no link).
     u : ndarray
-        Force record [N] at `fs` [Hz].
+        Force record [N] at `fs`.
+    fs : float
+        Sampling rate of the record [Hz].
     r : int
         Fine steps per sample.
     periodic : bool
