@@ -8,12 +8,11 @@ afterwards, with no file added (no temporary file, no half-written output).
 
 from __future__ import annotations
 
-import hashlib
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
+from file_trees import populate, snapshot
 
 from motionhyst.cli import main
 from motionhyst.scenario import default_scenario_path
@@ -238,36 +237,7 @@ CASES = [
 
 
 def _populate(root: Path, files: dict) -> None:
-    for name, content in {**BASE, **files}.items():
-        if name.startswith("@"):
-            kind, link = name[1:].split(":")
-            if kind == "symlink":
-                (root / link).symlink_to(content)
-            else:
-                (root / link).hardlink_to(root / content)
-            continue
-        path = root / name
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
-            path.write_bytes(content)
-        else:
-            path.write_text(content)
-
-
-def _snapshot(root: Path) -> dict[str, str]:
-    """Every entry under `root`: links by target, files by hash, folders as such."""
-    snap = {}
-    for dirpath, dirnames, filenames in os.walk(root):
-        for name in dirnames + filenames:
-            path = Path(dirpath) / name
-            rel = str(path.relative_to(root))
-            if path.is_symlink():
-                snap[rel] = "link:" + os.readlink(path)
-            elif path.is_dir():
-                snap[rel] = "dir"
-            else:
-                snap[rel] = hashlib.sha256(path.read_bytes()).hexdigest()
-    return snap
+    populate(root, {**BASE, **files})
 
 
 def test_the_corpus_is_large_enough():
@@ -283,7 +253,7 @@ def test_bad_input_is_exit_2_one_line_and_touches_nothing(tmp_path, monkeypatch,
     root.mkdir()
     _populate(root, files)
     monkeypatch.chdir(root)
-    before = _snapshot(root)
+    before = snapshot(root)
     code = main(list(argv))
     out, err = capsys.readouterr()
     assert code == 2, (code, out, err)
@@ -293,5 +263,5 @@ def test_bad_input_is_exit_2_one_line_and_touches_nothing(tmp_path, monkeypatch,
     assert line.startswith(("error: ", "motionhyst: error: ")), line
     for word in words:
         assert word in line, (word, line)
-    assert _snapshot(root) == before  # nothing changed, nothing added
+    assert snapshot(root) == before  # nothing changed, nothing added
     assert [p.name for p in tmp_path.iterdir()] == ["user"]

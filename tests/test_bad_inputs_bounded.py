@@ -11,7 +11,6 @@ command owns, with no file added (no temporary file, no half-written output).
 
 from __future__ import annotations
 
-import hashlib
 import os
 import resource
 import signal
@@ -22,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from file_trees import populate, snapshot
 
 from motionhyst.plants.frf_fit import ModalPlant
 from motionhyst.plants.two_mass import TwoMassStage
@@ -190,32 +190,7 @@ CASES = [
 
 
 def _populate(root: Path, files: dict) -> None:
-    for name, content in {**BASE, **files}.items():
-        if name.startswith("@"):
-            (root / name.split(":")[1]).symlink_to(content)
-            continue
-        path = root / name
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
-            path.write_bytes(content)
-        else:
-            path.write_text(content)
-
-
-def _snapshot(top: Path) -> dict[str, str]:
-    """Every entry under `top`: links by target, files by hash, folders as such."""
-    snap = {}
-    for dirpath, dirnames, filenames in os.walk(top):
-        for name in dirnames + filenames:
-            path = Path(dirpath) / name
-            rel = str(path.relative_to(top))
-            if path.is_symlink():
-                snap[rel] = "link:" + os.readlink(path)
-            elif path.is_dir():
-                snap[rel] = "dir"
-            else:
-                snap[rel] = hashlib.sha256(path.read_bytes()).hexdigest()
-    return snap
+    populate(root, {**BASE, **files})
 
 
 def _one_line(err: bytes) -> str:
@@ -237,7 +212,7 @@ def test_bounded_honest_and_touching_nothing_it_does_not_own(tmp_path, files, ar
     root = tmp_path / "user"
     root.mkdir()
     _populate(root, files)
-    before = _snapshot(tmp_path)
+    before = snapshot(tmp_path)
     start = time.monotonic()
     proc = _popen(argv, root)
     out, err = proc.communicate(timeout=600)
@@ -255,7 +230,7 @@ def test_bounded_honest_and_touching_nothing_it_does_not_own(tmp_path, files, ar
         if code != 0:
             assert out == b""
             assert took < 60, took  # refused before the work, not after it
-    after = _snapshot(tmp_path)
+    after = snapshot(tmp_path)
     for name in owned:  # the command's own outputs: a regular file now, links replaced
         assert not (root / name).is_symlink() and (root / name).is_file()
         after.pop(f"user/{name}")
@@ -330,7 +305,7 @@ def test_interrupted_or_killed_mid_write_leaves_the_old_file_and_nothing_else(tm
     root = tmp_path / "user"
     root.mkdir()
     _populate(root, {})
-    before = _snapshot(tmp_path)
+    before = snapshot(tmp_path)
     proc = _popen(LONG_RUN, root)
     _writing(proc, root / "old.csv")
     time.sleep(0.5)
@@ -341,7 +316,7 @@ def test_interrupted_or_killed_mid_write_leaves_the_old_file_and_nothing_else(tm
         assert _one_line(err) == "motionhyst: interrupted"
     else:
         assert proc.returncode == -signal.SIGKILL
-    assert _snapshot(tmp_path) == before  # the old file, and no temporary file
+    assert snapshot(tmp_path) == before  # the old file, and no temporary file
 
 
 def test_the_command_ignores_a_late_ctrl_c_so_that_its_exit_is_not_interrupted(tmp_path):
