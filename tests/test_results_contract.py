@@ -26,6 +26,7 @@ from motionhyst import (
     periodic_steady_state,
     simulate,
 )
+from motionhyst.analysis.digital import compare_digital
 from motionhyst.core.jsonio import dumps
 from motionhyst.identify import identify_maxwell_slip
 from motionhyst.plants.frf_fit import ModalPlant
@@ -72,6 +73,7 @@ RESULTS = {
     "ScanResult": (_scan, 3),
     "Profile": (lambda loop: point_to_point(0.002, 0.05, 2.0, 50.0, 1e3), 5),
     "LoopMargins": (lambda loop: loop_margins(loop.controller, loop.P2), 1),
+    "DigitalComparison": (lambda loop: compare_digital(loop, 0.01, [10.0]), 1),
 }
 
 

@@ -175,7 +175,8 @@ class DigitalComparison:
             table(head, rows)])
 
     def plot(self, ax=None):
-        """``|E|`` of eq. (18) (lines) and exact (circles) of each variant.
+        """``|E|`` of eq. (18) (lines) and exact (circles) of each variant
+        (:func:`motionhyst.present.figures.plot_digital`).
 
         Parameters
         ----------
@@ -186,21 +187,9 @@ class DigitalComparison:
         -------
         matplotlib.figure.Figure
         """
-        import matplotlib.pyplot as plt
+        from motionhyst.present.figures import plot_digital
 
-        if ax is None:
-            fig, ax = plt.subplots(figsize=(6.0, 4.0))
-        else:
-            fig = ax.figure
-        for v in self.variants:
-            f = [p.frequency_hz for p in v.points]
-            line, = ax.semilogy(f, [abs(p.mismatch_df) for p in v.points], "-", label=v.name)
-            ax.semilogy(f, [abs(p.mismatch_exact) for p in v.points], "o",
-                        color=line.get_color())
-        ax.set_xlabel("frequency [Hz]")
-        ax.set_ylabel("|E| [-]")
-        ax.legend()
-        return fig
+        return plot_digital(self, ax=ax)
 
 
 def _num(x: float) -> str:

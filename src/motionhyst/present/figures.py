@@ -26,8 +26,9 @@ from matplotlib.figure import Figure
 from motionhyst.present.figure_writer import FigureWriter, save_figures
 
 __all__ = ["STYLE", "DecadeFormatter", "FigureWriter", "MinorLogLocator", "minor_log_ticks",
-           "new_figure", "plot_analysis", "plot_describing_function", "plot_frf_fit", "plot_link",
-           "plot_margins", "plot_simulation", "plot_steady_state", "save_figures"]
+           "new_figure", "plot_analysis", "plot_describing_function", "plot_digital",
+           "plot_frf_fit", "plot_link", "plot_margins", "plot_simulation", "plot_steady_state",
+           "save_figures"]
 
 STYLE = {
     "figure.figsize": (6.4, 4.2), "figure.dpi": 110, "savefig.dpi": 150, "axes.grid": True,
@@ -467,6 +468,43 @@ def plot_margins(margins, ax=None) -> Figure:
     ax.legend(loc="lower left")
     minor_log_ticks(axes)
     fig.motionhyst_data.update(f=f, L=L, S=S)
+    return fig
+
+
+def plot_digital(comparison, ax=None) -> Figure:
+    """``|E|`` of eq. (18) (lines) and exact (circles) of each variant of a
+    :class:`~motionhyst.analysis.digital.DigitalComparison` (continuous, sampled, sampled
+    with the feedforward advanced).
+
+    Parameters
+    ----------
+    comparison : DigitalComparison
+        What :func:`~motionhyst.analysis.digital.compare_digital` returned.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; default: a new figure.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.analysis.digital import compare_digital
+    >>> fig = plot_digital(compare_digital(default_scenario().loop(), 0.01, [10.0]))
+    >>> sorted(fig.motionhyst_data)
+    ['continuous', 'sampled', 'sampled, feedforward advanced']
+    """
+    fig, axes = new_figure(ax=ax)
+    (ax,) = axes
+    for v in comparison.variants:
+        f = np.array([p.frequency_hz for p in v.points])
+        E_df = np.array([p.mismatch_df for p in v.points])
+        E_exact = np.array([p.mismatch_exact for p in v.points])
+        line, = ax.semilogy(f, np.abs(E_df), "-", label=v.name)
+        ax.semilogy(f, np.abs(E_exact), "o", color=line.get_color())
+        fig.motionhyst_data[v.name] = np.vstack([f, E_df, E_exact])
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("|E| [-]")
+    ax.set_title(f"Digital loop at {comparison.sample_rate_hz:g} Hz, "
+                 f"{comparison.delay_samples:g} samples of delay")
+    ax.legend()
     return fig
 
 
