@@ -87,9 +87,9 @@ class Mechanics:
 
         Returns
         -------
-        A : ndarray, shape (2n, 2n)
-        B : ndarray, shape (2n,)
-            The force ``u - w`` enters on ``q[link]``.
+        tuple of ndarray
+            ``A`` of shape (2n, 2n) and ``B`` of shape (2n,) (the force ``u - w`` enters on
+            ``q[link]``).
         """
         n = self.n
         K = self.K.copy()
