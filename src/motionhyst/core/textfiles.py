@@ -136,7 +136,7 @@ def csv_header(out: IO[str], names: Sequence[str]) -> None:
     out.write(",".join(names) + "\n")
 
 
-def csv_rows(out: IO[str], block: ArrayLike, fmt: str = CSV_FORMAT) -> None:
+def csv_rows(out: IO[str], block: ArrayLike, fmt: str | None = CSV_FORMAT) -> None:
     """Write rows of numbers to a CSV file (after its :func:`csv_header`).
 
     Parameters
@@ -145,8 +145,11 @@ def csv_rows(out: IO[str], block: ArrayLike, fmt: str = CSV_FORMAT) -> None:
         Where to write.
     block : array_like, shape (rows, columns)
         The numbers.
-    fmt : str
-        printf format of a number (default :data:`CSV_FORMAT`).
+    fmt : str or None
+        printf format of a number (default :data:`CSV_FORMAT`); None: the shortest text
+        that reads back as the same number, a whole number without a decimal point, and
+        an empty cell for a number that is not finite (a table for people and
+        spreadsheets).
 
     Examples
     --------
@@ -154,5 +157,19 @@ def csv_rows(out: IO[str], block: ArrayLike, fmt: str = CSV_FORMAT) -> None:
     >>> csv_rows(sys.stdout, [[0.0, 1e-6], [0.5, -2e-6]], fmt="%.17g")
     0,9.9999999999999995e-07
     0.5,-1.9999999999999999e-06
+    >>> csv_rows(sys.stdout, [[5.0, 1e-6, float("nan")]], fmt=None)
+    5,1e-06,
     """
-    np.savetxt(out, np.asarray(block, dtype=float), delimiter=",", fmt=fmt)
+    if fmt is not None:
+        np.savetxt(out, np.asarray(block, dtype=float), delimiter=",", fmt=fmt)
+        return
+    for row in np.asarray(block, dtype=float):
+        out.write(",".join(_shortest(x) for x in row) + "\n")
+
+
+def _shortest(x: float) -> str:
+    """``repr`` of `x`, a whole number as an integer, an empty string if not finite."""
+    x = float(x)
+    if not np.isfinite(x):
+        return ""
+    return repr(int(x)) if x == int(x) and abs(x) < 1e15 else repr(x)

@@ -10,6 +10,7 @@ import io
 
 import numpy as np
 
+from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.study.store import field_names
 
 __all__ = ["to_netcdf_bytes", "to_table"]
@@ -47,20 +48,9 @@ def to_table(ds) -> str:
             cols[str(name)] = v
     cols["status"] = ds["status"].values.ravel()
     buf = io.StringIO()
-    buf.write(",".join(cols) + "\n")
-    arrays = list(cols.values())
-    for i in range(len(arrays[0])):
-        buf.write(",".join(_fmt(a[i]) for a in arrays) + "\n")
+    csv_header(buf, list(cols))
+    csv_rows(buf, np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]), fmt=None)
     return buf.getvalue()
-
-
-def _fmt(x) -> str:
-    if isinstance(x, np.integer):
-        return str(int(x))
-    x = float(x)
-    if not np.isfinite(x):
-        return ""
-    return repr(int(x)) if x == int(x) and abs(x) < 1e15 else repr(x)
 
 
 def to_netcdf_bytes(ds) -> bytes:
