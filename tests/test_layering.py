@@ -5,7 +5,8 @@ subpackage and from lower layers only, so there is no circle between subpackages
 arrow back up.  The one arrow up on purpose: a result's ``plot`` method imports
 :mod:`motionhyst.present` inside itself, so that computing never loads matplotlib.
 Inside a subpackage, too, no two modules import each other, however indirectly: every
-import counts (at the top, inside a function, or for type checking only).
+import counts (at the top, inside a function, or for type checking only).  And a module
+holds one concept: none is longer than :data:`MAX_LINES`.
 """
 
 from __future__ import annotations
@@ -19,6 +20,9 @@ LAYERS = [("core",), ("io",), ("hysteresis",), ("plants",), ("controllers",),
           ("analysis", "time"), ("scan", "identify"), ("scenario",), ("study",), ("present",),
           ("cli",)]
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
+
+#: The longest a module may be; a longer one holds more than one concept: split it.
+MAX_LINES = 900
 
 
 def _part(module: str) -> str:
@@ -120,6 +124,12 @@ def test_no_two_modules_import_each_other():
     circles = _circles(_module_graph())
     assert not circles, "modules in a circle of imports (move what they share down):\n" + (
         "\n".join(" <-> ".join(c) for c in circles))
+
+
+def test_no_module_is_longer_than_the_limit():
+    long = {str(path.relative_to(SRC)): n for path in SRC.rglob("*.py")
+            if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
+    assert not long, f"modules over {MAX_LINES} lines (split them by concept): {long}"
 
 
 def test_every_subpackage_has_a_layer():
