@@ -144,7 +144,6 @@ PENDING = {
     "motionhyst.study.StudyStore.matches",
     "motionhyst.study.StudyStore.missing",
     "motionhyst.study.StudyStore.open",
-    "motionhyst.study.StudyStore.write",
     "motionhyst.study.StudySummary.plot",
     "motionhyst.study.engine.Evaluator",
     "motionhyst.study.engine.Evaluator.batch",

@@ -21,9 +21,11 @@ from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.cli import main
 from motionhyst.scenario import Scenario, default_scenario_path
 from motionhyst.study import Study, open_results, run_study, summarize
+from motionhyst.study import store as store_module
+from motionhyst.study.engine import Evaluator, split
 from motionhyst.study.export import to_netcdf_bytes, to_table
 from motionhyst.study.runner import run_lock
-from motionhyst.study.store import FAILED, OK
+from motionhyst.study.store import FAILED, OK, REASONS, StudyStore
 
 BASE = tomllib.loads(default_scenario_path().read_text())
 
@@ -125,6 +127,72 @@ def test_a_point_that_fails_is_counted_and_the_study_goes_on(tmp_path):
     assert np.all(np.isnan(ds["e1"].sel({"controller.K": 1e12}).values))
     assert np.all(ds["status"].sel({"controller.K": 6.2e6}).values == OK)
     assert summarize(ds).failed == 2
+    # the reason is recorded per point, with the message of the first
+    assert np.all(ds["reason"].sel({"controller.K": 1e12}).values == 1)
+    assert np.all(ds["reason"].sel({"controller.K": 6.2e6}).values == 0)
+    [(why, f)] = summarize(ds).failures.items()
+    assert why == REASONS[1] and f["points"] == 2
+    assert "controller.K = 1e+12" in f["example"] and "does not stabilise" in f["example"]
+
+
+def test_a_point_that_does_not_converge_says_so():
+    """A link as stiff as the stage's spring: the fixed point does not converge (reason 2)."""
+    st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0],
+                                                      "hysteresis.k": [20.0, 1e8],
+                                                      "hysteresis.fc": [100.0]}},
+                         scenario=BASE)
+    b = Evaluator(st).batch([0, 1])
+    assert b.status.tolist() == [OK, FAILED] and b.reason.tolist() == [0, 2]
+    assert "hysteresis.k = 1e+08" in b.failures[2] and "did not converge" in b.failures[2]
+
+
+def test_store_chunks_follow_the_computing_order(monkeypatch):
+    """Each chunk of the store is one contiguous run of the points in the order they are
+    computed, so a run holds one or two chunks open whatever the size of the study."""
+    monkeypatch.setattr(store_module, "CHUNK_POINTS", 12)
+    st = Study.from_dict({"outputs": ["e1"],
+                          "axes": {"frequency_hz": [2.0, 5.0, 9.0], "hysteresis.fc": [0.03, 0.05],
+                                   "stage.m2": [17.5, 20.0, 30.0]},
+                          "samples": {"n": 5, "seed": 0,
+                                      "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
+                         scenario=BASE)
+    chunks = store_module._chunks(st)
+    assert np.prod(chunks) <= 12
+    idx = np.unravel_index(st.order(), st.shape)
+    grid = [int(np.ceil(n / c)) for n, c in zip(st.shape, chunks, strict=True)]
+    keys = np.ravel_multi_index(tuple(i // c for i, c in zip(idx, chunks, strict=True)), grid)
+    runs = keys[np.r_[True, keys[1:] != keys[:-1]]]
+    assert len(runs) == len(np.unique(keys)) == np.prod(grid)
+
+
+def test_chunk_writer_holds_few_chunks_and_writes_what_direct_writes_write(tmp_path,
+                                                                          monkeypatch):
+    """Batches that straddle chunks, in the computing order: the writer holds at most two
+    chunks, and the store ends as with one direct write a batch (the first batch is on disk
+    at once, a completed chunk when it completes)."""
+    monkeypatch.setattr(store_module, "CHUNK_POINTS", 8)
+    st = Study.from_dict({"outputs": ["e1", "error_rms"],
+                          "axes": {"frequency_hz": [2.0, 5.0, 9.0, 20.0],
+                                   "hysteresis.fc": [0.03, 0.04, 0.05]},
+                          "samples": {"n": 3, "seed": 0,
+                                      "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
+                         scenario=BASE)
+    ev = Evaluator(st)
+    batches = [ev.batch(b) for b in split(st.order(), 5)]
+    direct = StudyStore.create(tmp_path / "direct.zarr", st)
+    for b in batches:
+        direct.write(b.indices, b.status, b.values, b.reason)
+    gathered = StudyStore.create(tmp_path / "gathered.zarr", st)
+    with gathered.writer(flush_seconds=3600) as w:
+        for j, b in enumerate(batches):
+            w.add(b.indices, b.status, b.values, b.reason, b.failures)
+            if j == 0:
+                assert np.count_nonzero(gathered.status() == OK) == 5
+        assert w.most_open <= 2
+    a, b = open_results(tmp_path / "direct.zarr"), open_results(tmp_path / "gathered.zarr")
+    for name in ("e1", "error_rms", "status", "reason"):
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+    assert np.all(b["status"].values == OK)
 
 
 def test_local_pool_gives_the_numbers_of_this_process(tmp_path, study_file):

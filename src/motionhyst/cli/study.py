@@ -111,11 +111,16 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if client is not None:
             client.close()
-    _exports(open_results(args.out), args)
+    ds = open_results(args.out)
+    _exports(ds, args)
     if args.json:
         print_json(report.to_dict())
     else:
+        from motionhyst.study.summary import failure_reasons
+
         print(report)
+        for why, f in failure_reasons(ds).items():
+            print(f"  {f['points']} failed: {why}; the first: {f['example']}")
     return 0
 
 

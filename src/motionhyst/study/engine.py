@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,12 +26,50 @@ from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
 from motionhyst.study.spec import REFERENCE_AXES, Study
 from motionhyst.study.store import FAILED, OK
 
-__all__ = ["BATCH_SECONDS", "Evaluator", "evaluate_batch", "run_batches"]
+__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "Batch", "Evaluator", "evaluate_batch",
+           "run_batches"]
 
 BATCH_SECONDS = 0.1
-"""Least work in one batch [s]: below it, sending and collecting cost more than computing."""
+"""Least work in one batch of the local pool [s]: below it, sending and collecting cost more
+than computing."""
 
-Batch = tuple[NDArray[np.int64], NDArray[np.int8], dict[str, NDArray]]
+DASK_BATCH_SECONDS = 0.5
+"""Least work in one batch on dask [s]: a task costs its scheduler, client and worker about
+5 ms of CPU together, 1 % of this."""
+
+# why a point failed (motionhyst.study.store.REASONS)
+_LOOP, _CONVERGE, _OUTPUT, _NUMERIC = 1, 2, 3, 4
+
+
+class Batch(NamedTuple):
+    """The compact records of one batch of points.
+
+    Parameters
+    ----------
+    indices : ndarray of int64
+        Flat indices of the points.
+    status : ndarray of int8
+        ``OK`` or ``FAILED`` per point.
+    values : dict of str to ndarray
+        Each output field per point (NaN where the point failed).
+    reason : ndarray of int8
+        Why a point failed (:data:`motionhyst.study.store.REASONS`; 0 if it did not).
+    failures : dict of int to str
+        The message of the batch's first failed point of each reason.
+
+    Examples
+    --------
+    >>> b = Batch(np.array([3]), np.array([OK], np.int8), {"e1": np.array([1j])},
+    ...           np.array([0], np.int8), {})
+    >>> b.indices.tolist(), b.status.tolist()
+    ([3], [1])
+    """
+
+    indices: NDArray[np.int64]
+    status: NDArray[np.int8]
+    values: dict[str, NDArray]
+    reason: NDArray[np.int8]
+    failures: dict[int, str]
 
 
 class Evaluator:
@@ -43,8 +82,8 @@ class Evaluator:
     >>> base = tomllib.loads(default_scenario_path().read_text())
     >>> st = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
-    >>> idx, status, values = Evaluator(st).batch([0, 1])
-    >>> status.tolist(), [round(float(abs(v)), 3) for v in values["mismatch"]]
+    >>> b = Evaluator(st).batch([0, 1])
+    >>> b.status.tolist(), [round(float(abs(v)), 3) for v in b.values["mismatch"]]
     ([1, 1], [6.041, 1.24])
     """
 
@@ -73,28 +112,51 @@ class Evaluator:
     def point(self, index: int) -> dict:
         """The output fields at the flat `index`; raises if the point cannot be computed."""
         values = self.study.point(index)
-        loop = self._loop_at(values)
+        return self._outputs(self._loop_at(values), values)
+
+    def _outputs(self, loop, values: dict[str, float]) -> dict:
         p = Point(loop, values["amplitude"], values["frequency_hz"])
         out: dict = {}
         for name in self.study.outputs:
             out.update(OUTPUTS[name].evaluate(p))
         return out
 
+    def _failure(self, index: int) -> tuple[int, str, dict]:
+        """Compute the point at `index`: (0, "", fields) or (reason, message, {})."""
+        values = self.study.point(index)
+        try:
+            loop = self._loop_at(values)
+        except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            return _LOOP, str(exc), {}
+        try:
+            return 0, "", self._outputs(loop, values)
+        except RuntimeError as exc:
+            return _CONVERGE, str(exc), {}
+        except ValueError as exc:
+            return _OUTPUT, str(exc), {}
+        except (ArithmeticError, np.linalg.LinAlgError) as exc:
+            return _NUMERIC, f"{type(exc).__name__}: {exc}", {}
+
     def batch(self, indices) -> Batch:
-        """Compact records of the points at `indices`: a point that fails is marked failed."""
+        """Compact records of the points at `indices`: a point that fails is marked failed,
+        with its reason."""
         indices = np.asarray(indices, dtype=np.int64)
         status = np.full(len(indices), OK, dtype=np.int8)
+        reason = np.zeros(len(indices), dtype=np.int8)
+        failures: dict[int, str] = {}
         values = {name: np.empty(len(indices), dtype=complex if kind == "complex" else float)
                   for name, kind in self.fields.items()}
         for j, i in enumerate(indices):
-            try:
-                res = self.point(int(i))
-            except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError):
-                status[j] = FAILED
+            code, message, res = self._failure(int(i))
+            if code:
+                status[j], reason[j] = FAILED, code
+                if code not in failures:
+                    at = ", ".join(f"{k} = {v:g}" for k, v in self.study.point(int(i)).items())
+                    failures[code] = f"point {int(i)} ({at}): {message}"
                 res = {name: nan_of(kind) for name, kind in self.fields.items()}
             for name in self.fields:
                 values[name][j] = res[name]
-        return indices, status, values
+        return Batch(indices, status, values, reason, failures)
 
     def warm(self) -> None:
         """Compile the kernels (the first point of the study, result discarded)."""
@@ -104,16 +166,30 @@ class Evaluator:
             pass
 
 
-_LOCAL = threading.local()
+_FREE: dict[str, list[Evaluator]] = {}
+_FREE_LOCK = threading.Lock()
 
 
 def _evaluator(key: str, plain: dict) -> Evaluator:
-    cache = getattr(_LOCAL, "cache", None)
-    if cache is None or key not in cache:
-        ev = Evaluator(Study.from_plain(plain))
-        ev.warm()
-        _LOCAL.cache = {key: ev}
-    return _LOCAL.cache[key]
+    """A warm evaluator of the study `key` that no other thread uses (a worker keeps them
+    between batches whichever of its threads runs the next one; only the last study's)."""
+    with _FREE_LOCK:
+        free = _FREE.get(key)
+        if free is None:
+            _FREE.clear()
+            free = _FREE[key] = []
+        if free:
+            return free.pop()
+    ev = Evaluator(Study.from_plain(plain))
+    ev.warm()
+    return ev
+
+
+def _release(key: str, ev: Evaluator) -> None:
+    with _FREE_LOCK:
+        free = _FREE.get(key)
+        if free is not None:
+            free.append(ev)
 
 
 def evaluate_batch(key: str, plain: dict, indices) -> Batch:
@@ -126,21 +202,30 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
     >>> base = tomllib.loads(default_scenario_path().read_text())
     >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0]}},
     ...                      scenario=base)
-    >>> idx, status, values = evaluate_batch(st.fingerprint(), st.to_dict(), [0])
-    >>> print(f"{values['error_rms'][0]:.3e} m")
+    >>> b = evaluate_batch(st.fingerprint(), st.to_dict(), [0])
+    >>> print(f"{b.values['error_rms'][0]:.3e} m")
     8.176e-09 m
     """
-    return _evaluator(key, plain).batch(indices)
+    ev = _evaluator(key, plain)
+    try:
+        return ev.batch(indices)
+    finally:
+        _release(key, ev)
+
+
+_WORKER_STUDY: dict = {}
 
 
 def _init_worker(key: str, plain: dict) -> None:
     # Ctrl-C reaches the whole process group: the command stops its workers itself
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _evaluator(key, plain)
+    _WORKER_STUDY["plain"] = plain
+    _release(key, _evaluator(key, plain))
 
 
 def _pool_batch(key: str, indices) -> Batch:
-    return _LOCAL.cache[key].batch(indices)
+    # the study came once, with the worker's start
+    return evaluate_batch(key, _WORKER_STUDY["plain"], indices)
 
 
 def split(indices: NDArray[np.int64], size: int) -> list[NDArray[np.int64]]:
@@ -163,23 +248,34 @@ class _Pool:
     def run(self, batches: list) -> Iterator[Batch]:
         import multiprocessing as mp
 
-        pending = list(range(len(batches)))
+        done_batches: set[int] = set()
         restarts = 0
         # forked workers start with this process's modules and compiled kernels (a spawned
         # one imports and loads them again: seconds on a loaded machine)
         method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
-        while pending:
+        # a few batches a worker in flight: waiting on every batch of a large study at once
+        # costs this process O(batches) at each completion (a quarter of the workers' time
+        # at 2000 batches), and holds them all
+        window = 3 * self.workers
+        while len(done_batches) < len(batches):
             ctx = mp.get_context(method)
             pool = ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_init_worker,
                                        initargs=(self.key, self.plain))
             try:
-                futures = {pool.submit(_pool_batch, self.key, batches[i]): i for i in pending}
-                while futures:
+                todo = iter([i for i in range(len(batches)) if i not in done_batches])
+                futures: dict = {}
+                while True:
+                    for i in todo:
+                        futures[pool.submit(_pool_batch, self.key, batches[i])] = i
+                        if len(futures) >= window:
+                            break
+                    if not futures:
+                        break
                     done, _ = wait(futures, return_when=FIRST_COMPLETED)
                     for f in done:
                         i = futures.pop(f)
                         yield f.result()
-                        pending.remove(i)
+                        done_batches.add(i)
             except BrokenProcessPool:
                 restarts += 1
                 if restarts > 3:
@@ -222,7 +318,7 @@ def run_batches(study: Study, batches: list, workers: int = 1, client=None
     >>> base = tomllib.loads(default_scenario_path().read_text())
     >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
-    >>> [idx.tolist() for idx, _, _ in run_batches(st, [[0], [1]], workers=0)]
+    >>> [b.indices.tolist() for b in run_batches(st, [[0], [1]], workers=0)]
     [[0], [1]]
     """
     key = study.fingerprint()
@@ -248,8 +344,21 @@ def seconds_per_point(study: Study, n: int = 3) -> float:
     return (time.perf_counter() - t0) / len(pick)
 
 
-def batch_size(seconds: float, n_missing: int, workers: int) -> int:
-    """Points in a batch: at least BATCH_SECONDS of work, else enough batches for the workers.
+def batch_size(seconds: float, n_missing: int, workers: int,
+               least_seconds: float = BATCH_SECONDS) -> int:
+    """Points in a batch: at least `least_seconds` of work, else enough batches for the
+    workers (eight each, for the balance), at most ten times the least.
+
+    Parameters
+    ----------
+    seconds : float
+        Time of one point [s].
+    n_missing : int
+        Points to compute.
+    workers : int
+        Workers computing them.
+    least_seconds : float
+        Least work in a batch [s] (:data:`BATCH_SECONDS`, :data:`DASK_BATCH_SECONDS`).
 
     Examples
     --------
@@ -257,7 +366,11 @@ def batch_size(seconds: float, n_missing: int, workers: int) -> int:
     625
     >>> batch_size(0.001, 500, 2)           # a small study: batches of 0.1 s
     100
+    >>> batch_size(0.001, 10_000, 2, DASK_BATCH_SECONDS)
+    625
+    >>> batch_size(0.001, 1_000_000, 2, DASK_BATCH_SECONDS)
+    5000
     """
-    least = max(1, math.ceil(BATCH_SECONDS / max(seconds, 1e-9)))
+    least = max(1, math.ceil(least_seconds / max(seconds, 1e-9)))
     spread = max(1, math.ceil(n_missing / (8 * max(workers, 1))))
     return max(least, min(spread, 10 * least))

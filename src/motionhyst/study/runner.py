@@ -1,10 +1,12 @@
 """Run a study into its store, resuming what an earlier run left; estimate it first.
 
 :func:`run_study` opens or creates the store, computes the points whose status is still
-missing in batches of at least :data:`~motionhyst.study.engine.BATCH_SECONDS` of work, and
-writes each batch as it comes back.  A point that fails is recorded as failed and counted;
-Ctrl-C, SIGKILL or a lost worker lose at most the batches in flight, which the same call
-computes again.
+missing in batches of at least :data:`~motionhyst.study.engine.BATCH_SECONDS` of work
+(:data:`~motionhyst.study.engine.DASK_BATCH_SECONDS` on dask), and gathers the results into
+whole chunks of the store (:class:`~motionhyst.study.store.ChunkWriter`).  A point that fails
+is recorded as failed, with its reason, and counted; Ctrl-C writes what came back; SIGKILL
+or a lost worker lose at most the batches in flight and the last
+:data:`~motionhyst.study.store.FLUSH_SECONDS` of results, which the same call computes again.
 """
 
 from __future__ import annotations
@@ -21,7 +23,14 @@ from pathlib import Path
 import numpy as np
 
 from motionhyst.core.textfmt import g
-from motionhyst.study.engine import batch_size, run_batches, seconds_per_point, split
+from motionhyst.study.engine import (
+    BATCH_SECONDS,
+    DASK_BATCH_SECONDS,
+    batch_size,
+    run_batches,
+    seconds_per_point,
+    split,
+)
 from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import Study, StudyError
 from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
@@ -245,7 +254,10 @@ def _compute(study: Study, st: StudyStore, workers: int | None, client, batch: i
         workers = os.cpu_count() or 1
     computed = 0
     if len(todo):
-        size = batch or batch_size(seconds_per_point(study, 2), len(todo), workers)
+        if client is not None:
+            workers = max(1, sum(client.nthreads().values()))
+        size = batch or batch_size(seconds_per_point(study, 2), len(todo), workers,
+                                   BATCH_SECONDS if client is None else DASK_BATCH_SECONDS)
         batches = split(todo, size)
         bar = None
         if progress:
@@ -255,12 +267,15 @@ def _compute(study: Study, st: StudyStore, workers: int | None, client, batch: i
                        desc="study")
         try:
             # closed at once on any exception (Ctrl-C): the workers stop with the command
-            with contextlib.closing(run_batches(study, batches, workers, client)) as results:
-                for indices, status, values in results:
-                    st.write(indices, status, values)
-                    computed += len(indices)
+            # the writer gathers batches into whole chunks and writes what it holds on the
+            # way out, after the workers stopped (Ctrl-C included)
+            with (st.writer() as writer,
+                  contextlib.closing(run_batches(study, batches, workers, client)) as results):
+                for b in results:
+                    writer.add(b.indices, b.status, b.values, b.reason, b.failures)
+                    computed += len(b.indices)
                     if bar is not None:
-                        bar.update(len(indices))
+                        bar.update(len(b.indices))
         finally:
             if bar is not None:
                 bar.close()

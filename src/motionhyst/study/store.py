@@ -14,34 +14,68 @@ from __future__ import annotations
 import json
 import math
 import shutil
+import time
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.study.outputs import fields_of
-from motionhyst.study.spec import Study, StudyError
+from motionhyst.study.spec import REFERENCE_AXES, Study, StudyError
 
-__all__ = ["FAILED", "MISSING", "OK", "StudyStore", "field_names", "is_study_store", "open_results",
-           "remove_store"]
+__all__ = ["FAILED", "FLUSH_SECONDS", "MISSING", "OK", "REASONS", "ChunkWriter", "StudyStore",
+           "field_names", "is_study_store", "open_results", "remove_store"]
 
 MISSING, OK, FAILED = 0, 1, 2
 """Values of the ``status`` array."""
+
+REASONS = {
+    0: "none",
+    1: "the loop at the point's keys could not be built (refused by the scenario, or unstable)",
+    2: "the steady state did not converge",
+    3: "an output could not be computed at the point",
+    4: "a numerical error (overflow, a singular matrix)",
+}
+"""Values of the ``reason`` array: why a point failed (0 for a point that did not fail)."""
+
+FLUSH_SECONDS = 2.0
+"""Least time between two writes of the chunks a run holds open [s] (the first batch is
+written at once, a completed chunk when it completes)."""
 
 KIND = "motionhyst-study"
 CHUNK_POINTS = 65536
 
 
 def _chunks(study: Study) -> tuple[int, ...]:
-    """Chunks of about CHUNK_POINTS points, whole along the fastest (reference) axes."""
+    """Chunks of about CHUNK_POINTS points, each a contiguous run of the computing order.
+
+    The extents are given from the axis that varies fastest in :meth:`Study.order` (the
+    reference axes, the last first, then the other axes, the last first) to the slowest: a
+    chunk is whole along every axis faster than the one where it stops, so consecutive
+    batches fill one chunk after another and a run holds few chunks open at a time.
+
+    Examples
+    --------
+    >>> import tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [1.0, 2.0, 3.0],
+    ...                       "controller.K": [6e6, 7e6]}}, scenario=base)
+    >>> st.dims, _chunks(st)
+    (('frequency_hz', 'controller.K', 'amplitude'), (3, 2, 1))
+    """
     shape = study.shape
+    dims = study.dims
+    inner = [i for i, d in enumerate(dims) if d in REFERENCE_AXES]
+    outer = [i for i, d in enumerate(dims) if d not in REFERENCE_AXES]
     chunks = [1] * len(shape)
     size = 1
-    for i in sorted(range(len(shape)), key=lambda i: study.dims[i] not in ("amplitude",
-                                                                          "frequency_hz")):
+    for i in inner[::-1] + outer[::-1]:
         n = max(1, min(shape[i], CHUNK_POINTS // size))
         chunks[i] = n
         size *= n
+        if n < shape[i]:
+            break
     return tuple(chunks)
 
 
@@ -88,6 +122,10 @@ class StudyStore:
                        fill_value=MISSING, dimension_names=dims)
         g["status"].attrs["flag_values"] = [MISSING, OK, FAILED]
         g["status"].attrs["flag_meanings"] = "missing computed failed"
+        g.create_array("reason", shape=study.shape, chunks=chunks, dtype="int8",
+                       fill_value=0, dimension_names=dims)
+        g["reason"].attrs["flag_values"] = list(REASONS)
+        g["reason"].attrs["flag_meanings"] = json.dumps(REASONS)
         for key, values in study.axes.items():
             a = g.create_array(key, shape=values.shape, dtype="float64", dimension_names=(key,))
             a[:] = values
@@ -105,7 +143,7 @@ class StudyStore:
             "scenario_json": json.dumps(study.scenario), "outputs": json.dumps(study.outputs),
             "samples": json.dumps({k: list(v) for k, v in study.samples.items()}),
             "n_samples": study.n_samples, "seed": study.seed, "version": version,
-            "coordinates": " ".join(study.samples)})
+            "coordinates": " ".join(study.samples), "failures": "{}"})
         return cls(path, g)
 
     @classmethod
@@ -138,16 +176,197 @@ class StudyStore:
             return np.flatnonzero(st == MISSING)
         return order[st[order] == MISSING]
 
-    def write(self, indices, status: NDArray[np.int8], values: dict[str, NDArray]) -> None:
-        """Write one batch: the fields of the points at the flat `indices`, then their status."""
+    @property
+    def arrays(self) -> list[str]:
+        """The store's arrays over the study's dimensions, in the order a write goes: the
+        output fields, ``reason`` (stores of older versions lack it), then ``status``."""
+        names = list(self.fields)
+        if "reason" in self.group:
+            names.append("reason")
+        return [*names, "status"]
+
+    def write(self, indices, status: NDArray[np.int8], values: dict[str, NDArray],
+              reason: NDArray[np.int8] | None = None) -> None:
+        """Write one batch at once: the fields of the points at the flat `indices`, the
+        reasons of those that failed, then their status (a run writes through
+        :meth:`writer`, which gathers batches into whole chunks).
+
+        Parameters
+        ----------
+        indices : array_like of int
+            Flat (C-order) indices of the points.
+        status : ndarray of int8
+            :data:`OK` or :data:`FAILED` per point.
+        values : dict of str to ndarray
+            Each output field per point.
+        reason : ndarray of int8, optional
+            Why a point failed (:data:`REASONS`); default none.
+        """
         idx = np.unravel_index(np.asarray(indices, dtype=np.int64), self.shape)
+        given = {**values, "status": np.asarray(status, dtype=np.int8),
+                 "reason": (np.zeros(len(idx[0]), np.int8) if reason is None
+                            else np.asarray(reason, dtype=np.int8))}
         try:
-            for name in self.fields:
-                self.group[name].vindex[idx] = values[name]
-            self.group["status"].vindex[idx] = np.asarray(status, dtype=np.int8)
+            for name in self.arrays:
+                self.group[name].vindex[idx] = given[name]
         except KeyError as exc:
             raise StudyError(f"{self.path}: the store lost its array {exc} while the study ran "
                              f"(removed by another program?)") from None
+
+    def writer(self, flush_seconds: float = FLUSH_SECONDS) -> ChunkWriter:
+        """A :class:`ChunkWriter` of this store (use it as a context manager).
+
+        Parameters
+        ----------
+        flush_seconds : float
+            Least time between two writes of the chunks it holds open [s].
+        """
+        return ChunkWriter(self, flush_seconds)
+
+    def failures(self) -> dict[int, str]:
+        """The message of the first failed point of each reason (:data:`REASONS`)."""
+        return {int(k): v for k, v in json.loads(self.group.attrs.get("failures", "{}")).items()}
+
+
+class ChunkWriter:
+    """Gathers batches of results into whole chunks of the store and writes each chunk at
+    once: when it is complete, and the chunks still open at most every `flush_seconds`
+    (the first batch at once), and when the writer closes (also on Ctrl-C).
+
+    A chunk is read once when a batch first reaches it (a resumed store keeps its points),
+    then written whole, each array in one call, values before ``reason`` and ``status``: a
+    process killed at any moment leaves every chunk either old or new, and loses at most the
+    results of the last `flush_seconds`.  The writer holds only the chunks still open; with
+    the store's chunks in the computing order (:func:`_chunks`) that is one or two, whatever
+    the size of the study.
+
+    Parameters
+    ----------
+    store : StudyStore
+        The store to write.
+    flush_seconds : float
+        Least time between two writes of the open chunks [s]; the time is raised to 20 times
+        the last write's, so writing never takes more than 5 % of a run.
+
+    Examples
+    --------
+    >>> import tempfile, tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    ...                      scenario=base)
+    >>> store = StudyStore.create(Path(tempfile.mkdtemp()) / "s.zarr", st)
+    >>> with store.writer() as w:
+    ...     w.add([1], np.array([OK], np.int8), {"error_rms": np.array([2.0e-9])})
+    ...     w.open_chunks
+    1
+    >>> store.missing().tolist()
+    [0]
+    """
+
+    def __init__(self, store: StudyStore, flush_seconds: float = FLUSH_SECONDS) -> None:
+        self.store = store
+        self.flush_seconds = float(flush_seconds)
+        self.chunks = tuple(store.group["status"].chunks)
+        self.grid = tuple(math.ceil(n / c) for n, c in zip(store.shape, self.chunks,
+                                                            strict=True))
+        self.names = store.arrays
+        self._open: dict[int, dict[str, NDArray]] = {}
+        self._dirty: set[int] = set()
+        self._failures = store.failures()
+        self._new_failure = False
+        self._last: float | None = None
+        self._interval = self.flush_seconds
+        self.most_open = 0
+
+    @property
+    def open_chunks(self) -> int:
+        """Chunks held in memory (:attr:`most_open`: the most at once so far)."""
+        return len(self._open)
+
+    def _region(self, key: int) -> tuple[slice, ...]:
+        pos = np.unravel_index(key, self.grid)
+        return tuple(slice(p * c, min((p + 1) * c, n))
+                     for p, c, n in zip(pos, self.chunks, self.store.shape, strict=True))
+
+    def _block(self, key: int) -> dict[str, NDArray]:
+        block = self._open.get(key)
+        if block is None:
+            region = self._region(key)
+            block = {name: np.array(self.store.group[name][region]) for name in self.names}
+            self._open[key] = block
+            self.most_open = max(self.most_open, len(self._open))
+        return block
+
+    def add(self, indices, status: NDArray[np.int8], values: dict[str, NDArray],
+            reason: NDArray[np.int8] | None = None, failures: dict[int, str] | None = None
+            ) -> None:
+        """Take one batch; write the chunks it completes, and the open ones when due.
+
+        Parameters
+        ----------
+        indices, status, values, reason
+            The batch, as :meth:`StudyStore.write` takes it.
+        failures : dict of int to str, optional
+            A reason to the message of a point that failed for it (the store keeps the first
+            of each reason).
+        """
+        idx = np.unravel_index(np.asarray(indices, dtype=np.int64), self.store.shape)
+        keys = np.ravel_multi_index(tuple(i // c for i, c in zip(idx, self.chunks,
+                                                                  strict=True)), self.grid)
+        given = {**values, "status": np.asarray(status, dtype=np.int8),
+                 "reason": (np.zeros(len(keys), np.int8) if reason is None
+                            else np.asarray(reason, dtype=np.int8))}
+        for key in np.unique(keys):
+            key = int(key)
+            sel = keys == key
+            block = self._block(key)
+            local = tuple(i[sel] - r.start for i, r in zip(idx, self._region(key),
+                                                             strict=True))
+            for name in self.names:
+                block[name][local] = given[name][sel]
+            if not np.any(block["status"] == MISSING):
+                self._write(key)
+                del self._open[key]
+                self._dirty.discard(key)
+            else:
+                self._dirty.add(key)
+        for code, message in (failures or {}).items():
+            if code not in self._failures:
+                self._failures[int(code)] = message
+                self._new_failure = True
+        now = time.monotonic()
+        if self._last is None or now - self._last >= self._interval:
+            self.flush()
+
+    def _write(self, key: int) -> None:
+        region = self._region(key)
+        block = self._open[key]
+        try:
+            for name in self.names:
+                self.store.group[name][region] = block[name]
+        except KeyError as exc:
+            raise StudyError(f"{self.store.path}: the store lost its array {exc} while the "
+                             f"study ran (removed by another program?)") from None
+
+    def flush(self) -> None:
+        """Write the chunks changed since the last write."""
+        t0 = time.monotonic()
+        for key in sorted(self._dirty):
+            self._write(key)
+        self._dirty.clear()
+        if self._new_failure:
+            self.store.group.attrs["failures"] = json.dumps(
+                {str(k): v for k, v in sorted(self._failures.items())})
+            self._new_failure = False
+        self._last = time.monotonic()
+        self._interval = max(self.flush_seconds, 20.0 * (self._last - t0))
+
+    def __enter__(self) -> ChunkWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.flush()
 
 
 def is_study_store(path: str | Path) -> bool:

@@ -3,15 +3,16 @@ of each output's worst case over the samples (the spread of a fleet of machines)
 
 from __future__ import annotations
 
+import json
 import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from motionhyst.core.textfmt import g, table
-from motionhyst.study.store import FAILED, OK, field_names
+from motionhyst.study.store import FAILED, OK, REASONS, field_names
 
-__all__ = ["BAND", "StudySummary", "plot_band", "summarize"]
+__all__ = ["BAND", "StudySummary", "failure_reasons", "plot_band", "summarize"]
 
 BAND = (5.0, 50.0, 95.0)
 """Percentiles of the Monte-Carlo band [%]."""
@@ -38,12 +39,18 @@ class StudySummary:
         Field to ``{"at": {axis: value}, "5": .., "50": .., "95": ..}``: the percentiles over
         the samples at the point of the axes where they spread most, relative to the median
         (where the machines of a fleet differ most).
+    failures : dict
+        Reason (:data:`~motionhyst.study.store.REASONS`) to ``{"points": .., "example": ..}``:
+        how many points failed for it and the message of the first.
 
     Examples
     --------
-    >>> s = StudySummary(points=10, computed=9, failed=1)
+    >>> s = StudySummary(points=10, computed=9, failed=1,
+    ...                  failures={"the steady state did not converge":
+    ...                            {"points": 1, "example": "point 7: ..."}})
     >>> print(s)
     10 points: 9 computed, 1 failed, 0 not computed yet
+      1 failed: the steady state did not converge (point 7: ...)
     """
 
     points: int
@@ -53,16 +60,20 @@ class StudySummary:
     per_axis: dict = field(default_factory=dict)
     band: dict = field(default_factory=dict)
     widest: dict = field(default_factory=dict)
+    failures: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``study --summary --json`` schema)."""
         return {"points": self.points, "computed": self.computed, "failed": self.failed,
                 "worst": self.worst, "per_axis": self.per_axis, "band": self.band,
-                "widest": self.widest}
+                "widest": self.widest, "failures": self.failures}
 
     def __str__(self) -> str:
         lines = [f"{self.points} points: {self.computed} computed, {self.failed} failed, "
                  f"{self.points - self.computed - self.failed} not computed yet"]
+        for why, f in self.failures.items():
+            lines.append(f"  {f['points']} failed: {why}"
+                         + (f" ({f['example']})" if f.get("example") else ""))
         for name, w in self.worst.items():
             at = ", ".join(f"{k} = {g(v)}" for k, v in w["at"].items())
             lines.append(f"{name}: worst |{name}| = {g(w['value'])} at {at}")
@@ -168,6 +179,34 @@ def plot_band(ds, name: str | None = None, ax=None):
     return ax.figure
 
 
+def failure_reasons(ds) -> dict:
+    """Why the failed points of a study's results failed: reason (:data:`REASONS`) to
+    ``{"points": count, "example": the message of the first}``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The results (:func:`motionhyst.study.open_results`).
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr
+    >>> ds = xr.Dataset({"status": (("f",), np.array([1, 2, 2], np.int8)),
+    ...                  "reason": (("f",), np.array([0, 2, 2], np.int8))},
+    ...                 attrs={"failures": '{"2": "point 1: did not converge"}'})
+    >>> failure_reasons(ds)
+    {'the steady state did not converge': {'points': 2, 'example': 'point 1: did not converge'}}
+    """
+    if "reason" not in ds:
+        return {}
+    examples = json.loads(ds.attrs.get("failures", "{}"))
+    codes, counts = np.unique(ds["reason"].values[ds["status"].values == FAILED],
+                              return_counts=True)
+    return {REASONS.get(code, f"reason {code}"): {"points": count,
+                                                  "example": examples.get(str(code), "")}
+            for code, count in zip(codes.tolist(), counts.tolist(), strict=True)}
+
+
 def summarize(ds) -> StudySummary:
     """The summary of a study's results (:func:`motionhyst.study.open_results`).
 
@@ -191,6 +230,7 @@ def summarize(ds) -> StudySummary:
     ok = status == OK
     out = StudySummary(points=int(status.size), computed=int(np.count_nonzero(ok)),
                        failed=int(np.count_nonzero(status == FAILED)))
+    out.failures = failure_reasons(ds)
     for name in field_names(ds):
         mag = np.where(ok, np.abs(ds[name].values), np.nan)
         if not np.any(np.isfinite(mag)):
