@@ -41,6 +41,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/scan.py
 	$(BIN)/python benchmarks/sampled.py
 	$(BIN)/python benchmarks/study.py
+	$(BIN)/python benchmarks/study_memory.py
 	$(BIN)/python benchmarks/engine.py
 
 # the Bouc-Wen hysteretic benchmark end to end (about a minute; kept out of make test)
