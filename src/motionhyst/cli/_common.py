@@ -11,6 +11,7 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 
 from motionhyst.core.textfmt import g, table
+from motionhyst.core.validation import MAGNITUDES
 
 __all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
            "harmonic_count", "memory_size", "nonnegative", "one_line", "positive", "print_json",
@@ -47,6 +48,10 @@ def _number(text: str, what: str, positive: bool | None) -> float:
         raise argparse.ArgumentTypeError(f"{what} must be a number, got {text!r}") from None
     if not math.isfinite(v):
         raise argparse.ArgumentTypeError(f"{what} must be finite, got {text!r}")
+    if v != 0.0 and not MAGNITUDES[0] <= abs(v) <= MAGNITUDES[1]:
+        raise argparse.ArgumentTypeError(
+            f"{text} is outside the magnitudes {MAGNITUDES[0]:g} to {MAGNITUDES[1]:g} (or 0, "
+            f"SI units) that motionhyst computes with")
     if positive and v <= 0:
         raise argparse.ArgumentTypeError(f"{what} must be > 0, got {text!r}")
     if positive is False and v < 0:

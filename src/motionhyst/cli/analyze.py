@@ -12,11 +12,13 @@ __all__ = []
 
 def run(args: argparse.Namespace) -> int:
     """Quasi-linear analysis of a scenario (paper eqs. 12-21)."""
-    from motionhyst.analysis.quasilinear import analyze
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario)
+    # imported once the input is read: a refusal does not wait for the analysis to load
+    from motionhyst.analysis.quasilinear import analyze
+
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
     mode = "self-consistent" if args.self_consistent else "reference"

@@ -118,11 +118,13 @@ def _output(args):
 
 def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
-    from motionhyst.scan.ilc import ILCFilters
-    from motionhyst.scan.scanning import run_scan
     from motionhyst.scenario import load_scenario
 
     sc = load_scenario(args.scenario)
+    # imported once the input is read: a refusal does not wait for the scan to load
+    from motionhyst.scan.ilc import ILCFilters
+    from motionhyst.scan.scanning import run_scan
+
     loop = sc.loop()
     warn_plant_fit(sc)
     ff = loop.ff

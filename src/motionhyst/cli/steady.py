@@ -14,11 +14,13 @@ __all__ = []
 
 def run(args: argparse.Namespace) -> int:
     """Exact periodic steady state of the nonlinear loop, next to the describing function."""
-    from motionhyst.analysis.comparison import compare_with_describing_function
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario)
+    # imported once the input is read: a refusal does not wait for the analysis to load
+    from motionhyst.analysis.comparison import compare_with_describing_function
+
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
     result = compare_with_describing_function(sc.loop(), amplitude, freqs)  # warns as it starts

@@ -16,7 +16,74 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["check_amplitudes", "check_finite", "check_omega", "check_positive"]
+__all__ = ["MAGNITUDES", "check_amplitudes", "check_finite", "check_magnitude", "check_magnitudes",
+           "check_omega", "check_positive"]
+
+MAGNITUDES = (1e-30, 1e30)
+"""The magnitudes of user-given numbers (in SI units) that motionhyst computes with: beyond
+them, squares and products of the loop's quantities over- or underflow (a mass of 1e300 kg
+gives inf and NaN, not an answer); 0 is always allowed."""
+
+
+def check_magnitude(name: str, value: float) -> float:
+    """Return `value`, raising ``ValueError`` naming `name` if its magnitude is outside
+    :data:`MAGNITUDES` (0 allowed).
+
+    Parameters
+    ----------
+    name : str
+        The key or option, for the message.
+    value : float
+        Its value.
+
+    Examples
+    --------
+    >>> check_magnitude("m2", 17.5)
+    17.5
+    >>> check_magnitude("[stage] m2", 1e300)               # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: [stage] m2 = 1e+300: outside the magnitudes 1e-30 to 1e+30 (or 0, SI units) ...
+    """
+    v = float(value)
+    if v != 0.0 and np.isfinite(v) and not MAGNITUDES[0] <= abs(v) <= MAGNITUDES[1]:
+        raise ValueError(f"{name} = {v:g}: outside the magnitudes {MAGNITUDES[0]:g} to "
+                         f"{MAGNITUDES[1]:g} (or 0, SI units) that motionhyst computes with")
+    return value
+
+
+def check_magnitudes(data, where: str = "") -> None:
+    """Check every number in the nested tables and lists `data` (a parsed TOML file) with
+    :func:`check_magnitude`, naming the first one outside as ``[table] key``.
+
+    Parameters
+    ----------
+    data : dict or list or number
+        The parsed file, or a part of it.
+    where : str
+        The name of `data` itself (``[stage] m2``, ``[hysteresis] k[2]``).
+
+    Examples
+    --------
+    >>> check_magnitudes({"stage": {"m1": 5.0, "m2": 17.5}, "reference": {"frequencies": [5, 10]}})
+    >>> check_magnitudes({"hysteresis": {"model": "maxwell-slip", "k": [20.0, 1e-300]}})
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: [hysteresis] k[1] = 1e-300: outside the magnitudes 1e-30 to 1e+30 ...
+    """
+    if isinstance(data, dict):
+        for key, value in data.items():
+            if isinstance(value, dict):
+                inner = f"{where[1:-1]}.{key}" if where.startswith("[") else str(key)
+                check_magnitudes(value, f"[{inner}]")
+            else:
+                check_magnitudes(value, f"{where} {key}".strip())
+    elif isinstance(data, list):
+        for i, value in enumerate(data):
+            check_magnitudes(value, f"{where}[{i}]")
+    elif isinstance(data, int | float) and not isinstance(data, bool):
+        check_magnitude(where, data)
 
 
 def check_finite(name: str, value: float) -> float:

@@ -762,6 +762,13 @@ class OutputFolder:
     def __enter__(self) -> OutputFolder:
         self._signals = _signals_raise()
         self._signals.__enter__()
+        try:
+            # before the work: a folder that cannot be made fails now, not after it (a
+            # folder made here and left empty is removed again)
+            self._ensure_folder()
+        except BaseException:
+            self._signals.__exit__(None, None, None)
+            raise
         return self
 
     def __exit__(self, kind, value, tb) -> None:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 from pydantic import ValidationError
 
+from motionhyst.core.validation import check_magnitudes
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.scenario.sections import (
     ScenarioError,
@@ -103,6 +104,10 @@ class Scenario:
         check : bool
             Build the loop and check that it is stable (a :class:`ScenarioError` if not).
         """
+        try:
+            check_magnitudes(data)  # 1e300 or 1e-300 would give inf and NaN, not an answer
+        except ValueError as exc:
+            raise ScenarioError(f"{source}: {exc}") from None
         try:
             model = ScenarioModel.model_validate(data)
         except ValidationError as err:

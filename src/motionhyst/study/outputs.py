@@ -10,11 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from motionhyst.analysis.steady import SteadyState, periodic_steady_state
-from motionhyst.controllers.loop import Loop
+if TYPE_CHECKING:  # imported where used: reading a study file needs neither
+    from motionhyst.analysis.steady import SteadyState
+    from motionhyst.controllers.loop import Loop
 
 __all__ = ["OUTPUTS", "Output", "Point", "register_output"]
 
@@ -40,6 +42,8 @@ class Point:
     def steady(self) -> SteadyState:
         """The exact periodic steady state (eq. 18's exact counterpart), computed once."""
         if self._steady is None:
+            from motionhyst.analysis.steady import periodic_steady_state
+
             self._steady = periodic_steady_state(self.loop, self.amplitude, self.frequency_hz)
         return self._steady
 
