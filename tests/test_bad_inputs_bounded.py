@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
+from motionhyst.cli import main
 from motionhyst.plants.frf_fit import ModalPlant
 from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.scenario import default_scenario_path
@@ -165,6 +166,18 @@ CASES = [
     ("scenario-duplicate-frequency", {"d.toml": PAPER.replace(
         "frequencies = [5.0, 10.0, 15.0]", "frequencies = [5.0, 10.0, 5.0]")},
      ["analyze", "d.toml"], 2, ["frequencies: 5 is given twice"], []),
+    ("scenario-mass-1e300", {"h.toml": PAPER.replace("m2 = 17.5 ", "m2 = 1e300 ")},
+     ["analyze", "h.toml"], 2, ["^h.toml: [stage] m2 = 1e+300: outside the magnitudes"], []),
+    ("scenario-mass-1e-300", {"h.toml": PAPER.replace("m2 = 17.5 ", "m2 = 1e-300 ")},
+     ["steady", "h.toml"], 2, ["^h.toml: [stage] m2 = 1e-300: outside the magnitudes"], []),
+    ("scenario-slip-force-list-1e-300", {"h.toml": PAPER.replace(
+        'model = "jenkins"\nk = 20.0', 'model = "maxwell-slip"\nk = [20.0, 10.0]').replace(
+        "fc = 0.05 ", "fc = [0.05, 1e-300] ")},
+     ["analyze", "h.toml"], 2, ["^h.toml: [hysteresis] fc[1] = 1e-300"], []),
+    ("option-stiffness-1e300", {}, ["df", "--k", "1e300", "--fc", "0.05", "--amplitude",
+                                    "0.01"], 2, ["--k: 1e300 is outside the magnitudes"], []),
+    ("option-frequency-1e-300", {}, ["steady", "--frequency", "1e-300"], 2,
+     ["--frequency: 1e-300 is outside the magnitudes"], []),
     # ------------------------------------------------------------------- options not ignored
     ("criterion-with-input-output", {}, ["identify", "io.csv", "--record", "input-output",
                                          "--criterion", "bic"], 2,
@@ -317,6 +330,54 @@ def test_interrupted_or_killed_mid_write_leaves_the_old_file_and_nothing_else(tm
     else:
         assert proc.returncode == -signal.SIGKILL
     assert snapshot(tmp_path) == before  # the old file, and no temporary file
+
+
+@pytest.mark.parametrize("argv", [["analyze", "bad.toml"], ["steady", "huge.toml"],
+                                  ["scan", "bad.toml", "--length", "0.01", "--speed", "0.1",
+                                   "--a-max", "10", "--j-max", "1000", "--s-max", "1e6"],
+                                  ["study", "bad.toml", "--out", "s.zarr"],
+                                  ["reproduce", "huge.toml"]])
+def test_a_refused_input_is_refused_before_the_analysis_loads(tmp_path, argv):
+    """A scenario or study that cannot be read is refused before python-control, scipy.signal
+    and numba are imported (they take seconds to load on a busy machine; the refusal does not
+    wait for them)."""
+    (tmp_path / "bad.toml").write_text("x\n")
+    (tmp_path / "huge.toml").write_text(PAPER.replace("m2 = 17.5 ", "m2 = 1e300 "))
+    code = ("import sys\nfrom motionhyst.cli import main\n"
+            f"code = main({argv!r})\n"
+            "print(code, sorted({'control', 'scipy.signal', 'numba'} & set(sys.modules)))\n")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr
+
+
+@pytest.mark.parametrize("became", [SystemError, ImportError, TypeError, ValueError])
+def test_a_ctrl_c_that_became_another_error_is_still_an_interrupt(monkeypatch, capsys, became):
+    """A Ctrl-C inside the import of a compiled extension, a numba compilation or a C callback
+    comes out as another exception whose context is the KeyboardInterrupt (under load the
+    interrupt of the test above landed in one: exit 1, "internal error"): exit 130."""
+    from motionhyst.cli import df
+
+    def run(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise became("initialization of _extension raised unreported exception") from None
+
+    monkeypatch.setattr(df, "run", run)
+    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 130
+    assert _one_line(capsys.readouterr().err.encode()) == "motionhyst: interrupted"
+
+
+def test_an_error_without_a_ctrl_c_is_not_an_interrupt(monkeypatch, capsys):
+    from motionhyst.cli import df
+
+    def run(args):
+        raise SystemError("a defect")
+
+    monkeypatch.setattr(df, "run", run)
+    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 1
+    assert "internal error: SystemError: a defect" in capsys.readouterr().err
 
 
 def test_the_command_ignores_a_late_ctrl_c_so_that_its_exit_is_not_interrupted(tmp_path):

@@ -111,13 +111,43 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into head, say: not an error
         sys.stdout = open(os.devnull, "w")
         return 0
+    except KeyboardInterrupt:
+        print("motionhyst: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        if not _interrupted(exc):
+            return _failed(exc)
+        print("motionhyst: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        set_max_memory(None)
+        if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
+            with contextlib.suppress(ValueError, OSError):  # interpreter's exit (tracebacks)
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _interrupted(exc: BaseException) -> bool:
+    """Whether `exc` is what a Ctrl-C became: a ``KeyboardInterrupt`` raised inside an import
+    of a compiled extension, a numba compilation or a C callback comes out as a SystemError,
+    an ImportError or another error whose cause or context is the interrupt."""
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
+
+
+def _failed(exc: Exception) -> int:
+    """One line on stderr for an exception that ended a command; its exit code."""
+    try:
+        raise exc
     except UsageError as exc:
         print(f"error: {one_line(str(exc))}", file=sys.stderr)
     except (ValueError, OSError, RuntimeError) as exc:
         print(f"motionhyst: error: {one_line(str(exc))}", file=sys.stderr)
-    except KeyboardInterrupt:
-        print("motionhyst: interrupted", file=sys.stderr)
-        return 130
     except MemoryError:  # an estimate missed: still one line, and the remedy
         print("motionhyst: error: out of memory; give a smaller problem (or a larger "
               "--max-memory, if the machine has it)", file=sys.stderr)
@@ -128,9 +158,4 @@ def main(argv: Sequence[str] | None = None) -> int:
               f"defect of motionhyst, please report it; {TRACEBACK_VARIABLE}=1 shows where)",
               file=sys.stderr)
         return EXIT_INTERNAL
-    finally:
-        set_max_memory(None)
-        if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
-            with contextlib.suppress(ValueError, OSError):  # interpreter's exit (tracebacks)
-                signal.signal(signal.SIGINT, signal.SIG_IGN)
     return EXIT_USAGE
