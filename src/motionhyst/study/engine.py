@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
-from motionhyst.study.spec import REFERENCE_AXES, Study
+from motionhyst.study.spec import REFERENCE_AXES, StudyDefinition
 from motionhyst.study.store import FAILED, OK
 
 __all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "Batch", "Evaluator", "evaluate_batch",
@@ -80,14 +80,15 @@ class Evaluator:
     >>> import tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    >>> st = StudyDefinition.from_dict(
+    ...     {"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
     >>> b = Evaluator(st).batch([0, 1])
     >>> b.status.tolist(), [round(float(abs(v)), 3) for v in b.values["mismatch"]]
     ([1, 1], [6.041, 1.24])
     """
 
-    def __init__(self, study: Study) -> None:
+    def __init__(self, study: StudyDefinition) -> None:
         self.study = study
         self.fields = fields_of(study.outputs)
         self._key: tuple | None = None
@@ -180,7 +181,7 @@ def _evaluator(key: str, plain: dict) -> Evaluator:
             free = _FREE[key] = []
         if free:
             return free.pop()
-    ev = Evaluator(Study.from_plain(plain))
+    ev = Evaluator(StudyDefinition.from_plain(plain))
     ev.warm()
     return ev
 
@@ -200,7 +201,7 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
     >>> import tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0]}},
+    >>> st = StudyDefinition.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0]}},
     ...                      scenario=base)
     >>> b = evaluate_batch(st.fingerprint(), st.to_dict(), [0])
     >>> print(f"{b.values['error_rms'][0]:.3e} m")
@@ -304,7 +305,7 @@ def _dask_run(client, key: str, plain: dict, batches: list) -> Iterator[Batch]:
         client.cancel(futures)
 
 
-def run_batches(study: Study, batches: list, workers: int = 1, client=None
+def run_batches(study: StudyDefinition, batches: list, workers: int = 1, client=None
                 ) -> Iterator[Batch]:
     """Compute `batches` (lists of flat indices) and yield their records as they finish.
 
@@ -316,7 +317,8 @@ def run_batches(study: Study, batches: list, workers: int = 1, client=None
     >>> import tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    >>> st = StudyDefinition.from_dict(
+    ...     {"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
     >>> [b.indices.tolist() for b in run_batches(st, [[0], [1]], workers=0)]
     [[0], [1]]
@@ -333,7 +335,7 @@ def run_batches(study: Study, batches: list, workers: int = 1, client=None
         yield from _Pool(workers, key, plain).run(batches)
 
 
-def seconds_per_point(study: Study, n: int = 3) -> float:
+def seconds_per_point(study: StudyDefinition, n: int = 3) -> float:
     """Time of one point, measured on up to `n` points spread over the study (warm)."""
     ev = Evaluator(study)
     ev.warm()

@@ -32,7 +32,7 @@ from motionhyst.study.engine import (
     split,
 )
 from motionhyst.study.outputs import fields_of
-from motionhyst.study.spec import Study, StudyError
+from motionhyst.study.spec import StudyDefinition, StudyError
 from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
 
 __all__ = ["LOCK_NAME", "Estimate", "RunReport", "estimate_study", "run_lock", "run_study"]
@@ -114,11 +114,12 @@ class Estimate:
             f"  memory of this process about {g(self.memory_bytes / 1e6)} MB"])
 
 
-def _bytes_per_point(study: Study) -> int:
+def _bytes_per_point(study: StudyDefinition) -> int:
     return 1 + sum(16 if k == "complex" else 8 for k in fields_of(study.outputs).values())
 
 
-def estimate_study(study: Study, workers: int = 1, store: str | Path | None = None) -> Estimate:
+def estimate_study(study: StudyDefinition, workers: int = 1,
+                   store: str | Path | None = None) -> Estimate:
     """Points, time per point (measured on a few points), core-hours, disk and memory.
 
     Examples
@@ -126,7 +127,7 @@ def estimate_study(study: Study, workers: int = 1, store: str | Path | None = No
     >>> import tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    >>> st = StudyDefinition.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
     >>> est = estimate_study(st)
     >>> est.points, est.missing, est.seconds_per_point > 0
@@ -144,7 +145,7 @@ def estimate_study(study: Study, workers: int = 1, store: str | Path | None = No
                     memory_bytes=study.n_points * (8 + 1) + 65536 * bpp * 4)
 
 
-def _open_store(study: Study, path: Path, force: bool, version: str) -> StudyStore:
+def _open_store(study: StudyDefinition, path: Path, force: bool, version: str) -> StudyStore:
     if path.exists() or path.is_symlink():
         if not is_study_store(path):
             raise StudyError(f"--out {path}: exists and is not a study's store; refusing to "
@@ -161,14 +162,14 @@ def _open_store(study: Study, path: Path, force: bool, version: str) -> StudySto
     return StudyStore.create(path, study, version)
 
 
-def run_study(study: Study, store: str | Path, workers: int | None = None, client=None,
+def run_study(study: StudyDefinition, store: str | Path, workers: int | None = None, client=None,
               force: bool = False, batch: int | None = None, progress: bool = False
               ) -> RunReport:
     """Compute the points of `study` missing from `store` (created if need be).
 
     Parameters
     ----------
-    study : Study
+    study : StudyDefinition
         The study.
     store : path
         A zarr store (a folder): new, or holding the same study (then only the missing
@@ -193,7 +194,7 @@ def run_study(study: Study, store: str | Path, workers: int | None = None, clien
     >>> import tempfile, tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["error_rms"],
+    >>> st = StudyDefinition.from_dict({"outputs": ["error_rms"],
     ...                       "axes": {"frequency_hz": [5.0, 10.0], "controller.K": [6.2e6, 1e12]}},
     ...                      scenario=base)
     >>> store = Path(tempfile.mkdtemp()) / "s.zarr"
@@ -224,7 +225,8 @@ def run_lock(path: Path) -> Iterator[None]:
     >>> import tempfile, tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0]}}, scenario=base)
+    >>> st = StudyDefinition.from_dict(
+    ...     {"outputs": ["e1"], "axes": {"frequency_hz": [5.0]}}, scenario=base)
     >>> path = Path(tempfile.mkdtemp()) / "s.zarr"
     >>> _ = StudyStore.create(path, st)
     >>> with run_lock(path):
@@ -247,7 +249,7 @@ def run_lock(path: Path) -> Iterator[None]:
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
-def _compute(study: Study, st: StudyStore, workers: int | None, client, batch: int | None,
+def _compute(study: StudyDefinition, st: StudyStore, workers: int | None, client, batch: int | None,
              progress: bool) -> int:
     todo = st.missing(study.order())
     if workers is None:

@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from motionhyst.study.outputs import OUTPUTS
 
-__all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "Study", "StudyError", "set_key"]
+__all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "StudyDefinition", "StudyError", "set_key"]
 
 REFERENCE_AXES = ("amplitude", "frequency_hz")
 """Axes over the reference ``r = amplitude sin(2 pi frequency_hz t)`` (not scenario keys)."""
@@ -56,7 +56,7 @@ class StudyError(ValueError):
     Examples
     --------
     >>> try:
-    ...     Study.from_dict({"outputs": ["e7"]}, scenario={})
+    ...     StudyDefinition.from_dict({"outputs": ["e7"]}, scenario={})
     ... except StudyError as exc:
     ...     print(exc)                                     # doctest: +ELLIPSIS
     'outputs': unknown output 'e7' (known: e1, harmonics, ...)
@@ -136,7 +136,7 @@ def _distribution(key: str, spec) -> tuple[str, float, float]:
 
 
 @dataclass
-class Study:
+class StudyDefinition:
     """A scenario, axes, Monte-Carlo samples and outputs: every point of the cross product.
 
     Parameters
@@ -153,13 +153,15 @@ class Study:
         Number of samples and the seed of their generator.
     source, scenario_source : str
         The study file and the scenario file (attributes of the results).
+    base_dir : Path, optional
+        The folder of the scenario's relative file names (a measured plant's data).
 
     Examples
     --------
     >>> from motionhyst.scenario import default_scenario_path
     >>> import tomllib
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["mismatch"],
+    >>> st = StudyDefinition.from_dict({"outputs": ["mismatch"],
     ...                       "axes": {"frequency_hz": [5.0, 10.0], "hysteresis.fc": [0.03, 0.05]},
     ...                       "samples": {"n": 3, "seed": 1,
     ...                                   "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
@@ -185,8 +187,14 @@ class Study:
 
     # ---------------------------------------------------------------- reading
     @classmethod
-    def from_file(cls, path: str | Path) -> Study:
-        """Read a study file; raises :class:`StudyError` (one line naming the key)."""
+    def from_file(cls, path: str | Path) -> StudyDefinition:
+        """Read a study file; raises :class:`StudyError` (one line naming the key).
+
+        Parameters
+        ----------
+        path : str or Path
+            The study file (TOML); its scenario is named relative to it.
+        """
         path = Path(path)
         try:
             text = path.read_text()
@@ -205,10 +213,21 @@ class Study:
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "<dict>", base_dir: Path | None = None,
-                  scenario: dict | None = None) -> Study:
+                  scenario: dict | None = None) -> StudyDefinition:
         """A study from the layout of a study file; `scenario` given replaces its ``scenario``.
 
         Raises :class:`StudyError` naming the key at fault.
+
+        Parameters
+        ----------
+        data : dict
+            The study file's tables: ``scenario``, ``outputs``, ``[axes]``, ``[samples]``.
+        source : str
+            Where it comes from (an attribute of the results).
+        base_dir : Path, optional
+            The folder the scenario file is named relative to (default: the working folder).
+        scenario : dict, optional
+            The scenario's tables, instead of reading ``data["scenario"]``.
         """
         unknown = sorted(set(data) - {"scenario", "outputs", "axes", "samples"})
         if unknown:
@@ -341,7 +360,13 @@ class Study:
         return math.prod(self.shape)
 
     def point(self, index: int) -> dict[str, float]:
-        """The axes' and samples' values at the flat (C-order) `index` of :attr:`shape`."""
+        """The axes' and samples' values at the flat (C-order) `index` of :attr:`shape`.
+
+        Parameters
+        ----------
+        index : int
+            Flat index of the point.
+        """
         idx = np.unravel_index(int(index), self.shape)
         out = {k: float(v[i]) for (k, v), i in zip(self.axes.items(), idx, strict=False)}
         if self.samples:
@@ -350,7 +375,13 @@ class Study:
         return out
 
     def scenario_at(self, values: dict[str, float]) -> dict:
-        """The scenario dictionary with the scenario keys of `values` set."""
+        """The scenario dictionary with the scenario keys of `values` set.
+
+        Parameters
+        ----------
+        values : dict of str to float
+            Dotted scenario keys (and the reference axes, which are left out) to values.
+        """
         data = copy.deepcopy(self.scenario)
         for key, value in values.items():
             if key not in REFERENCE_AXES:
@@ -383,8 +414,14 @@ class Study:
                 "base_dir": None if self.base_dir is None else str(self.base_dir)}
 
     @classmethod
-    def from_plain(cls, d: dict) -> Study:
-        """The inverse of :meth:`to_dict` (no file read, no check)."""
+    def from_plain(cls, d: dict) -> StudyDefinition:
+        """The inverse of :meth:`to_dict` (no file read, no check).
+
+        Parameters
+        ----------
+        d : dict
+            What :meth:`to_dict` gave.
+        """
         return cls(scenario=d["scenario"],
                    axes={k: np.asarray(v, dtype=float) for k, v in d["axes"].items()},
                    outputs=list(d["outputs"]),

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.study.outputs import fields_of
-from motionhyst.study.spec import REFERENCE_AXES, Study, StudyError
+from motionhyst.study.spec import REFERENCE_AXES, StudyDefinition, StudyError
 
 __all__ = ["FAILED", "FLUSH_SECONDS", "MISSING", "OK", "REASONS", "ChunkWriter", "StudyStore",
            "field_names", "is_study_store", "open_results", "remove_store"]
@@ -46,10 +46,10 @@ KIND = "motionhyst-study"
 CHUNK_POINTS = 65536
 
 
-def _chunks(study: Study) -> tuple[int, ...]:
+def _chunks(study: StudyDefinition) -> tuple[int, ...]:
     """Chunks of about CHUNK_POINTS points, each a contiguous run of the computing order.
 
-    The extents are given from the axis that varies fastest in :meth:`Study.order` (the
+    The extents are given from the axis that varies fastest in :meth:`StudyDefinition.order` (the
     reference axes, the last first, then the other axes, the last first) to the slowest: a
     chunk is whole along every axis faster than the one where it stops, so consecutive
     batches fill one chunk after another and a run holds few chunks open at a time.
@@ -59,7 +59,7 @@ def _chunks(study: Study) -> tuple[int, ...]:
     >>> import tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [1.0, 2.0, 3.0],
+    >>> st = StudyDefinition.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [1.0, 2.0, 3.0],
     ...                       "controller.K": [6e6, 7e6]}}, scenario=base)
     >>> st.dims, _chunks(st)
     (('frequency_hz', 'controller.K', 'amplitude'), (3, 2, 1))
@@ -89,7 +89,8 @@ class StudyStore:
     >>> from pathlib import Path
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    >>> st = StudyDefinition.from_dict(
+    ...     {"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
     >>> store = StudyStore.create(Path(tempfile.mkdtemp()) / "s.zarr", st)
     >>> store.write([1], np.array([OK], np.int8), {"error_rms": np.array([2.0e-9])})
@@ -104,7 +105,7 @@ class StudyStore:
         self.fields = json.loads(group.attrs["fields"])
 
     @classmethod
-    def create(cls, path: str | Path, study: Study, version: str = "") -> StudyStore:
+    def create(cls, path: str | Path, study: StudyDefinition, version: str = "") -> StudyStore:
         """A new store for `study` at `path` (which must not exist)."""
         import zarr
 
@@ -156,7 +157,7 @@ class StudyStore:
             raise StudyError(f"{path}: not a store of motionhyst study")
         return cls(path, zarr.open_group(str(path), mode="r+", zarr_format=3))
 
-    def matches(self, study: Study) -> bool:
+    def matches(self, study: StudyDefinition) -> bool:
         """Whether the store holds `study` (same scenario, axes, samples and outputs)."""
         return self.group.attrs.get("fingerprint") == study.fingerprint()
 
@@ -253,7 +254,8 @@ class ChunkWriter:
     >>> import tempfile, tomllib
     >>> from motionhyst.scenario import default_scenario_path
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    >>> st = StudyDefinition.from_dict(
+    ...     {"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
     >>> store = StudyStore.create(Path(tempfile.mkdtemp()) / "s.zarr", st)
     >>> with store.writer() as w:
@@ -427,7 +429,7 @@ def open_results(path: str | Path):
     >>> from motionhyst.scenario import default_scenario_path
     >>> from motionhyst.study import run_study
     >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0]}},
+    >>> st = StudyDefinition.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0]}},
     ...                      scenario=base)
     >>> path = Path(tempfile.mkdtemp()) / "s.zarr"
     >>> _ = run_study(st, path, workers=0)
