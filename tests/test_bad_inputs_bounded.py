@@ -49,10 +49,14 @@ def _popen(argv, cwd) -> subprocess.Popen:
                             preexec_fn=_limit, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
-def _frd(f, scale_f: float = 1.0, noise: float = 0.0, magphase: bool = False) -> str:
-    """A measured two-mass stage (Table I) at `f` [Hz], written with `f` times `scale_f`."""
+def _frd(f, scale_f: float = 1.0, noise: float = 0.0, magphase: bool = False,
+         lowpass_hz: float | None = None) -> str:
+    """A measured two-mass stage (Table I) at `f` [Hz], written with `f` times `scale_f`
+    (through a sensor's first-order low-pass at `lowpass_hz`, if given)."""
     stage = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
     p1, p2 = stage.response(2 * np.pi * f)
+    if lowpass_hz is not None:
+        p1, p2 = (p / (1.0 + 1j * f / lowpass_hz) for p in (p1, p2))
     if noise:
         rng = np.random.default_rng(0)
         p1 = p1 * (1 + noise * rng.standard_normal(f.size))
@@ -160,6 +164,11 @@ CASES = [
     ("frf-poor-fit-unstable", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, noise=0.01)},
      ["analyze", "p.toml"], 2, ["plant fitted to plant.csv is unstable", "fit is in doubt"],
      []),
+    ("frf-fit-above-its-noise", {"p.toml": _with_plant("modes = 1"),
+                                 "plant.csv": _frd(LOG, noise=0.005, lowpass_hz=2000.0)},
+     ["analyze", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: cannot fit a rigid body "
+                                "plus modes: fit errors far above the data's noise",
+                                "give [plant] modes"], []),
     ("periodic-record-from-rest", {"rest.csv": _from_rest()},
      ["identify", "rest.csv", "--record", "input-output", "--periodic"], 2,
      ["rest.csv: not a periodic steady state", "without --periodic"], []),

@@ -803,6 +803,8 @@ def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
 #: A band's RMS error this many times the line-to-line scatter of its errors is far above
 #: the noise (for noise alone the ratio is 1, within about 0.2 for a band of 9 lines).
 RESIDUAL_NOISE_RATIO = 2.0
+#: How the warning of errors far above the noise begins (a scenario refuses such a fit).
+ABOVE_NOISE = "measured plant: fit errors far above the data's noise"
 #: Relative standard deviation of Pf2(0) above which it is not determined by the data.
 PF2_RELATIVE_STD = 0.1
 #: Fewest lines of a band checked for errors above its noise.
@@ -874,10 +876,9 @@ def _diagnose(fit: FrfFit) -> list[str]:
     if high:
         where = ", ".join(f"{_num(lo)}-{_num(hi)} Hz (RMS {_num(r)}, {q:.2g} x)"
                           for lo, hi, r, q in high)
-        out.append(f"measured plant: fit errors far above the data's noise (their line-to-line "
-                   f"scatter) at {where}: the data hold something a rigid body plus modes and a "
-                   f"pure delay does not describe (a stiffness to ground, amplifier or sensor "
-                   f"dynamics, a missing mode)")
+        out.append(f"{ABOVE_NOISE} (their line-to-line scatter) at {where}: the data hold "
+                   f"something a rigid body plus modes and a pure delay does not describe (a "
+                   f"stiffness to ground, amplifier or sensor dynamics, a missing mode)")
     return out
 
 

@@ -199,7 +199,7 @@ class Scenario:
         a measured plant, or the raw measured plant."""
         if self._plant is not None:
             return self._plant
-        from motionhyst.plants.frf_fit import fit_measured_plant
+        from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
         from motionhyst.plants.measured import load_frd_plant
 
         m = self.model
@@ -239,6 +239,11 @@ class Scenario:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: {why} a rigid body alone, "
                                 f"with Pf2 = 0 and no link between P1 and P2 to analyse; "
                                 f"give data up to above the first resonance (or modes >= 1)")
+        above = [w for w in self._fit.warnings if w.startswith(ABOVE_NOISE)]
+        if above:  # every number on this plant would be in doubt: no answer from it
+            raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body plus "
+                                f"modes: {above[0].removeprefix('measured plant: ')}; give "
+                                f"[plant] modes, or data without those dynamics")
         self._plant = self._fit.plant
         return self._plant
 
