@@ -115,6 +115,32 @@ def test_points_are_the_library_functions(tmp_path):
             assert complex(at["E"]) == complex(loop_mismatch(loop, f, 0.01)[0])
 
 
+def test_margins_are_those_of_the_points_loop():
+    """The margins output is loop_margins of the loop at the point's keys, the same at every
+    amplitude and frequency of that loop."""
+    from motionhyst.analysis.margins import loop_margins
+
+    st = Study.from_dict({"outputs": ["margins"],
+                          "axes": {"frequency_hz": [3.0, 12.0], "controller.K": [4e6, 6.2e6]}},
+                         scenario=BASE)
+    b = Evaluator(st).batch(st.order())
+    assert np.all(b.status == OK)
+    for j, i in enumerate(b.indices):
+        values = st.point(int(i))
+        data = json.loads(json.dumps(BASE))
+        data["controller"]["K"] = values["controller.K"]
+        loop = Scenario.from_dict(data).loop()
+        m = loop_margins(loop.controller, loop.P2)
+        assert b.values["gain_margin_db"][j] == m.gain_margin_db
+        assert b.values["phase_margin_deg"][j] == m.phase_margin_deg
+        assert b.values["modulus_margin"][j] == m.modulus_margin
+        assert b.values["bandwidth_hz"][j] == m.bandwidth_hz
+    # Table I's loop: the paper's margins (eq. 23's controller)
+    k = list(st.axes["controller.K"]).index(6.2e6)
+    at = [j for j, i in enumerate(b.indices) if st.point(int(i))["controller.K"] == 6.2e6]
+    assert k == 1 and b.values["phase_margin_deg"][at[0]] == pytest.approx(24.83, abs=0.01)
+
+
 def test_a_point_that_fails_is_counted_and_the_study_goes_on(tmp_path):
     st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0],
                                                       "controller.K": [6.2e6, 1e12]}},

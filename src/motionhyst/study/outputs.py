@@ -8,6 +8,7 @@ then shared).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -145,6 +146,27 @@ def _quasi_linear(p: Point) -> dict:
     if p.loop.hysteresis is None:
         raise ValueError("the loop has no hysteresis element")
     return {"E": complex(loop_mismatch(p.loop, p.frequency_hz, p.amplitude)[0])}
+
+
+_MARGINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+@register_output("margins", {"gain_margin_db": "real", "phase_margin_deg": "real",
+                             "modulus_margin": "real", "bandwidth_hz": "real"},
+                 "gain [dB], phase [deg] and modulus [-] margins and the bandwidth [Hz] of the "
+                 "linear loop L = C P2 (the same at every amplitude and frequency)")
+def _margins(p: Point) -> dict:
+    # computed once a loop: the points of one loop (its amplitudes and frequencies) share it
+    m = _MARGINS.get(p.loop)
+    if m is None:
+        from motionhyst.analysis.margins import loop_margins
+
+        loop = p.loop
+        m = loop_margins(loop.controller, loop.P2,
+                         None if loop.sampled is None else loop.sampled_parts.zoh)
+        _MARGINS[loop] = m
+    return {"gain_margin_db": m.gain_margin_db, "phase_margin_deg": m.phase_margin_deg,
+            "modulus_margin": m.modulus_margin, "bandwidth_hz": m.bandwidth_hz}
 
 
 def fields_of(names: list[str]) -> dict[str, str]:
