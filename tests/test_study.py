@@ -20,7 +20,7 @@ from motionhyst.analysis.quasilinear import loop_mismatch
 from motionhyst.analysis.steady import periodic_steady_state
 from motionhyst.cli import main
 from motionhyst.scenario import Scenario, default_scenario_path
-from motionhyst.study import Study, open_results, run_study, summarize
+from motionhyst.study import Study, StudyError, open_results, run_study, summarize
 from motionhyst.study import store as store_module
 from motionhyst.study.engine import Evaluator, split
 from motionhyst.study.export import to_netcdf_bytes, to_table
@@ -139,6 +139,33 @@ def test_margins_are_those_of_the_points_loop():
     k = list(st.axes["controller.K"]).index(6.2e6)
     at = [j for j, i in enumerate(b.indices) if st.point(int(i))["controller.K"] == 6.2e6]
     assert k == 1 and b.values["phase_margin_deg"][at[0]] == pytest.approx(24.83, abs=0.01)
+
+
+def test_samples_from_an_identification(tmp_path, study_file):
+    """[samples] from_identification (identify --json) draws the link's k and fc lognormal
+    around the estimates with the relative standard errors; the command's option does the
+    same for a study without [samples] (100 samples, seed 0); a file's own key wins."""
+    fit = {"model": "maxwell-slip", "elements": [{"k": 21.0, "k_std": 0.42, "fc": 0.04,
+                                                  "fc_std": 0.002}]}
+    (tmp_path / "fit.json").write_text(json.dumps(fit))
+    study_file.write_text(STUDY_TOML.replace('"hysteresis.k" = { lognormal = [20.0, 0.1] }',
+                                             'from_identification = "fit.json"')
+                          .replace('"hysteresis.fc" = [0.03, 0.05]', "")
+                          .replace("n = 2", "n = 4000"))
+    st = Study.from_file(study_file)
+    assert st.samples == {"hysteresis.k": ("lognormal", 21.0, 0.02),
+                          "hysteresis.fc": ("lognormal", 0.04, 0.05)}
+    k, fc = st.sample_values.T
+    assert np.median(k) == pytest.approx(21.0, rel=3 * 1.25 * 0.02 / np.sqrt(4000))
+    assert np.std(np.log(fc)) == pytest.approx(0.05, rel=0.05)
+    bare = tmp_path / "bare.toml"
+    bare.write_text('scenario = "paper.toml"\noutputs = ["e1"]\n')
+    st = Study.from_file(bare, from_identification=tmp_path / "fit.json")
+    assert (st.n_samples, st.seed) == (100, 0) and st.samples["hysteresis.fc"][1] == 0.04
+    fit["elements"].append(fit["elements"][0])
+    (tmp_path / "two.json").write_text(json.dumps(fit))
+    with pytest.raises(StudyError, match="2 Jenkins elements"):
+        Study.from_file(bare, from_identification=tmp_path / "two.json")
 
 
 def test_a_point_that_fails_is_counted_and_the_study_goes_on(tmp_path):

@@ -18,6 +18,7 @@ def _summary(args: argparse.Namespace) -> int:
     from motionhyst.study import StudyError, open_results, summarize
 
     for opt, given in (("--out", args.out), ("--estimate", args.estimate),
+                       ("--from-identification", args.from_identification is not None),
                        ("--scheduler", args.scheduler), ("--workers", args.workers is not None)):
         if given:
             raise UsageError(f"study --summary: {opt} is for running a study")
@@ -77,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     if args.study is None:
         raise UsageError("study: give a study file (or --summary STORE)")
     try:
-        study = Study.from_file(args.study)
+        study = Study.from_file(args.study, from_identification=args.from_identification)
     except StudyError as exc:
         raise UsageError(f"study: {exc}") from None
     if args.estimate:
@@ -138,6 +139,10 @@ def add_parser(sub) -> None:
                    help="local worker processes (default: every core; 0: this process)")
     q.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786")
+    q.add_argument("--from-identification", metavar="FIT.json",
+                   help="draw the link's parameters around an identification's estimates with "
+                        "their standard errors (what `motionhyst identify --json` printed; "
+                        "[samples] n and seed from the study file, else 100 and 0)")
     q.add_argument("--estimate", action="store_true",
                    help="state points, time, core-hours, disk and memory; compute nothing")
     q.add_argument("--table", metavar="OUT.csv", help="also write the results as CSV, a row a "

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.study.identified import distributions_from_identification
 from motionhyst.study.outputs import OUTPUTS
 
 __all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "StudyDefinition", "StudyError", "set_key"]
@@ -187,13 +188,18 @@ class StudyDefinition:
 
     # ---------------------------------------------------------------- reading
     @classmethod
-    def from_file(cls, path: str | Path) -> StudyDefinition:
+    def from_file(cls, path: str | Path, from_identification: str | Path | None = None
+                  ) -> StudyDefinition:
         """Read a study file; raises :class:`StudyError` (one line naming the key).
 
         Parameters
         ----------
         path : str or Path
             The study file (TOML); its scenario is named relative to it.
+        from_identification : str or Path, optional
+            An identification (``motionhyst identify --json``) whose link parameters are drawn
+            (:mod:`motionhyst.study.identified`), as ``[samples] from_identification`` (a
+            study without ``[samples]``: 100 samples, seed 0).
         """
         path = Path(path)
         try:
@@ -206,6 +212,11 @@ class StudyDefinition:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise StudyError(f"{path}: TOML syntax error: {exc}") from None
+        if from_identification is not None:
+            samples = data.get("samples")
+            samples = dict(samples) if isinstance(samples, dict) else {"n": 100, "seed": 0}
+            samples["from_identification"] = str(Path(from_identification).absolute())
+            data["samples"] = samples
         try:
             return cls.from_dict(data, source=str(path), base_dir=path.parent)
         except StudyError as exc:
@@ -279,6 +290,20 @@ class StudyDefinition:
             if s is None:
                 raise StudyError("'samples': give a table [samples]")
             n, seed = s.pop("n", None), s.pop("seed", None)
+            identified = s.pop("from_identification", None)
+            if identified is not None:
+                if not isinstance(identified, str) or not identified:
+                    raise StudyError("[samples] 'from_identification': give the JSON of "
+                                     "`motionhyst identify --json`, relative to the study file")
+                ipath = Path(identified)
+                if not ipath.is_absolute():
+                    ipath = (base_dir or Path.cwd()) / ipath
+                try:
+                    drawn = distributions_from_identification(ipath)
+                except ValueError as exc:
+                    raise StudyError(f"[samples] {exc}") from None
+                for key, dist in drawn.items():
+                    s.setdefault(key, {dist[0]: [dist[1], dist[2]]})  # the file's own win
             if not isinstance(n, int) or isinstance(n, bool) or n < 1:
                 raise StudyError("[samples] 'n': give a whole number of samples >= 1")
             if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
