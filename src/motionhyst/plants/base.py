@@ -23,7 +23,6 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.core.lti import TWO_PI
 from motionhyst.plants.registry import PlantParameter
 
 __all__ = ["FixedPlant", "LumpedPlant"]
@@ -198,7 +197,7 @@ class FixedPlant:
         -------
         ndarray of complex
         """
-        w = TWO_PI * np.atleast_1d(np.asarray(f_hz, dtype=float))
+        w = 2.0 * np.pi * np.atleast_1d(np.asarray(f_hz, dtype=float))
         p1, p2 = self.response(w)
         return p2 / (1.0 + (k_link + 1j * w * c_link) * p1)
 
