@@ -92,7 +92,6 @@ def test_feedforward_terms():
      "not be causal"),
     ({"type": "two-dof-z", "r_num": [1.0], "r_den": [1.0], "y_num": [1.0],
       "sample_rate_hz": 1e3}, None, {}, "y_den: missing"),
-    ({"type": "pid", "kp": 1.0, "kd": 1.0}, None, {}, "needs derivative_filter_hz"),
     ({"type": "pid", "kp": 0.0}, None, {}, "non-zero gain"),
     (None, None, {"sample_rate_hz": 2e3, "delay_samples": 1.0}, "does not stabilise"),
 ])

@@ -172,6 +172,9 @@ class Loop:
         n1, d1 = tf_poly(self.P1)
         n2, d2 = tf_poly(self.P2)
         nc, dc = tf_poly(self.controller)
+        if trim(np.polymul(n2, nc)).size >= trim(np.polymul(d2, dc)).size:
+            raise ValueError("the loop gain C P2 must be strictly proper (a pure derivative "
+                             "needs a plant that falls at least twice as fast)")
         char = np.polyadd(np.polymul(d2, dc), np.polymul(n2, nc))  # (1 + C P2) d2 dc
         if self.ff is not None:
             # 1 - P2 C_ff = (d2 - C_ff n2) / d2; C + C_ff = (nc + C_ff dc) / dc,

@@ -99,7 +99,7 @@ def _stage_section(name: str, cls) -> type[_StageSection]:
 
     A plant with more than one measurable position takes an ``output`` (which
     makes the stage an open-loop system, force in, that position out); a plant
-    with one is always one.
+    with one is one unless the scenario gives a ``[controller]`` (which measures it).
     """
     if name == DEFAULT_STAGE:
         fields: dict = {"type": (Annotated[Literal[name], Field(exclude=True)], name)}
@@ -111,7 +111,8 @@ def _stage_section(name: str, cls) -> type[_StageSection]:
     if len(cls.outputs) > 1:
         fields["output"] = (Literal[cls.outputs] | None, None)
     section = create_model(f"{cls.__name__}Section", __base__=_StageSection, **fields)
-    what = "the default" if name == DEFAULT_STAGE else "open loop: force in, position out"
+    what = ("the default" if name == DEFAULT_STAGE else "open loop: force in, position out"
+            + ("" if len(cls.outputs) > 1 else "; with a [controller], its closed loop"))
     section.__doc__ = f"``[stage] type = \"{name}\"``: {first_line(cls)} ({what})."
     return section
 
@@ -140,10 +141,12 @@ StageUnion = Annotated[
     Discriminator(_stage_tag)]
 
 
-def _is_open_loop(stage) -> bool:
-    """A ``[stage]`` of an open-loop system: an ``output`` given, or a plant with one position."""
+def _is_open_loop(stage, controller=None) -> bool:
+    """A ``[stage]`` of an open-loop system: an ``output`` given, or a plant with one position
+    and no ``[controller]`` (with one, the loop measures that position)."""
     return stage is not None and (getattr(stage, "output", None) is not None
-                                  or len(PLANTS[stage.type].outputs) == 1)
+                                  or (len(PLANTS[stage.type].outputs) == 1
+                                      and controller is None))
 
 
 def open_loop_kinds() -> str:
@@ -398,7 +401,8 @@ class NotchSection(_Section):
 class PidSection(_Continuous):
     """``[controller] type = "pid"``: ``kp + ki / s + kd s / (1 + s / w_d)`` with notches
     (:class:`~motionhyst.controllers.pid.Pid`); without ``derivative_filter_hz`` a pure
-    derivative, which needs ``sample_rate_hz`` (a backward difference)."""
+    derivative (sampled: a backward difference; continuous: ``C P2`` must stay strictly
+    proper)."""
 
     type: Literal["pid"]
     kp: NonNegativeFloat
@@ -411,9 +415,6 @@ class PidSection(_Continuous):
     def _realisable(self):
         if self.kp == self.ki == self.kd == 0:
             raise ValueError("a PID needs a non-zero gain (kp, ki or kd)")
-        if self.kd and self.derivative_filter_hz is None and self.sample_rate_hz is None:
-            raise ValueError("a continuous PID with kd needs derivative_filter_hz (a pure "
-                             "derivative is improper); give it, or sample_rate_hz")
         return self
 
 
@@ -534,7 +535,7 @@ class ScenarioModel(_Section):
     def open_loop(self) -> bool:
         """True for a stage of one position (a mass-spring-damper, ...) or one with an
         ``output`` (no controller)."""
-        return _is_open_loop(self.stage)
+        return _is_open_loop(self.stage, self.controller)
 
 
 # tags of the discriminated unions, left out of the key named in an error message
