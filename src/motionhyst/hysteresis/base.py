@@ -157,6 +157,28 @@ class Hysteresis(ABC):
         """
         raise ValueError(f"zeta (eq. 4) is not defined for the {self.name} model")
 
+    #: Number of states of :meth:`state_equation` (0: the model has no smooth state equation).
+    n_states: ClassVar[int] = 0
+
+    def state_equation(self, z: ArrayLike, v: float):
+        """The model as a smooth state equation ``z' = f(z, v)``, ``w = h(z, v)`` with its
+        derivatives (see :meth:`motionhyst.hysteresis.LuGre.state_equation`).
+
+        Parameters
+        ----------
+        z : array_like
+            The model's states.
+        v : float
+            The velocity of its displacement [m/s].
+
+        Raises
+        ------
+        ValueError
+            For a model without one (:attr:`n_states` = 0): a rate-independent element
+            switches between sticking and slipping.
+        """
+        raise ValueError(f"the {self.name} model has no smooth state equation")
+
     def time_stepping(self) -> Stepping:
         """The elements as the compiled time step advances them (:mod:`.stepping`).
 

@@ -104,6 +104,7 @@ class LuGre(Hysteresis):
     """
 
     name = "lugre"
+    n_states = 1
     rate_independent = False
     parameters = (Parameter("sigma0", "N/m", "bristle stiffness sigma0"),
                   Parameter("sigma1", "N s/m", "bristle damping sigma1", 0.0, "nonnegative"),
@@ -446,6 +447,62 @@ class LuGre(Hysteresis):
         raise TypeError("the LuGre model is rate-dependent: it cannot be advanced by a "
                         "displacement alone; use response(x, t=...) or describing_function(A, "
                         "omega)")
+
+    def state_equation(self, z: ArrayLike, v: float
+                       ) -> tuple[NDArray[np.float64], float, NDArray[np.float64],
+                                  NDArray[np.float64], NDArray[np.float64], float]:
+        """The model's state equation at the bristle state `z` and the velocity `v`.
+
+        ``z' = v - sigma0 |v| z / g(v)`` and ``w = sigma0 z + sigma1 z' + sigma2 v``
+        with their derivatives: what an autonomous loop's orbit and its monodromy
+        need (:mod:`motionhyst.analysis.stability`).  ``|v|`` has a corner at
+        ``v = 0``; its one-sided derivative is taken (the vector field is continuous
+        there, so crossings of ``v = 0`` need no jump of the variations).
+
+        Parameters
+        ----------
+        z : array_like, shape (1,)
+            Bristle deflection [m].
+        v : float
+            Velocity [m/s].
+
+        Returns
+        -------
+        zdot : ndarray, shape (1,)
+            ``z'`` [m/s].
+        w : float
+            Force [N].
+        dzdot_dz : ndarray, shape (1, 1)
+            ``d z' / d z``.
+        dzdot_dv : ndarray, shape (1,)
+            ``d z' / d v``.
+        dw_dz : ndarray, shape (1,)
+            ``d w / d z`` [N/m].
+        dw_dv : float
+            ``d w / d v`` [N s/m].
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis.lugre import LuGre
+        >>> el = LuGre(sigma0=1e5, sigma1=0.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
+        >>> zdot, w, *_ = el.state_equation([1e-5], 0.01)      # steady sliding at 1 N
+        >>> round(float(zdot[0]), 12), round(w, 6)
+        (0.0, 1.004)
+        """
+        zz = float(np.ravel(np.asarray(z, dtype=float))[0])
+        v = float(v)
+        r = v / self.vs
+        e = np.exp(-r * r)
+        g = self.fc + (self.fs - self.fc) * e
+        dg = -2.0 * r / self.vs * (self.fs - self.fc) * e
+        av, sv = abs(v), (1.0 if v >= 0.0 else -1.0)
+        zdot = v - self.sigma0 * av * zz / g
+        dzdot_dz = -self.sigma0 * av / g
+        dzdot_dv = 1.0 - self.sigma0 * zz * (sv * g - av * dg) / (g * g)
+        w = self.sigma0 * zz + self.sigma1 * zdot + self.sigma2 * v
+        return (np.array([zdot]), float(w), np.array([[dzdot_dz]]), np.array([dzdot_dv]),
+                np.array([self.sigma0 + self.sigma1 * dzdot_dz]),
+                float(self.sigma1 * dzdot_dv + self.sigma2))
 
     def time_stepping(self) -> Stepping:
         """The elements as the compiled time step advances them (:mod:`.stepping`)."""
