@@ -230,6 +230,23 @@ def run_reproduce(out: Path) -> None:
         raise RuntimeError(f"motionhyst reproduce failed:\n{proc.stderr}")
 
 
+def run_cli(out: Path, args: list[str]) -> None:
+    """``motionhyst ARGS`` run in the build's folder `out` (emptied first): a guide's figure.
+
+    Relative paths in `args` are taken from the repository's top (``examples/...``) and
+    from `out` for the files the command writes (give those as ``OUT/name``).
+    """
+    shutil.rmtree(out, ignore_errors=True)
+    out.mkdir(parents=True)
+    top = Path(__file__).resolve().parent.parent
+    args = [a.replace("OUT/", f"{out}/") for a in args]
+    code = "import sys; from motionhyst.cli import main; sys.exit(main(sys.argv[1:]))"
+    proc = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          env=_env(), cwd=top, check=False, timeout=600)
+    if proc.returncode != 0:
+        raise RuntimeError(f"motionhyst {' '.join(args)} failed:\n{proc.stderr}")
+
+
 def _env() -> dict[str, str]:
     import os
 

@@ -44,6 +44,7 @@ _EXPORTS = {
     "motionhyst.scenario": ("Scenario", "ScenarioError", "default_scenario", "load_scenario"),
     "motionhyst.time.simulation": ("Simulation", "simulate"),
     "motionhyst.analysis.steady": ("SteadyState", "periodic_steady_state", "steady_state_sweep"),
+    "motionhyst.analysis.stability": ("StabilityResult", "stability"),
     "motionhyst.controllers.leadlag": ("LeadLagLowpass",),
     "motionhyst.plants.measured": ("MeasuredPlant", "load_frd_plant"),
     "motionhyst.plants.two_mass": ("TwoMassStage",),
@@ -55,10 +56,11 @@ __all__ = [
     "Hysteresis", "Jenkins", "LeadLagLowpass", "Loop", "LoopMargins", "LuGre", "MaxwellIwan",
     "MaxwellSlip", "MeasuredPlant", "ModalPlant", "MotionhystWarning", "PointToPoint",
     "QuasiLinearAnalysis", "SampledReference", "Scenario", "ScenarioError", "Simulation",
-    "SineReference", "SteadyState", "TwoMassStage", "analyze", "compare_with_describing_function",
+    "SineReference", "StabilityResult", "SteadyState", "TwoMassStage", "analyze",
+    "compare_with_describing_function",
     "default_scenario", "describing_function", "fit_frf", "load_frd_plant", "load_reference_csv",
     "load_scenario", "loop_margins",
-    "periodic_steady_state", "simulate", "steady_state_sweep",
+    "periodic_steady_state", "simulate", "stability", "steady_state_sweep",
 ]
 
 if TYPE_CHECKING:
@@ -69,6 +71,7 @@ if TYPE_CHECKING:
     from motionhyst.analysis.describing import DescribingFunctionResult, describing_function
     from motionhyst.analysis.margins import LoopMargins, loop_margins
     from motionhyst.analysis.quasilinear import QuasiLinearAnalysis, analyze
+    from motionhyst.analysis.stability import StabilityResult, stability
     from motionhyst.analysis.steady import SteadyState, periodic_steady_state, steady_state_sweep
     from motionhyst.controllers.leadlag import LeadLagLowpass
     from motionhyst.controllers.loop import Loop

@@ -1,5 +1,5 @@
-"""Command-line interface: ``motionhyst df | analyze | steady | simulate | scan | identify |
-predict | study | benchmark | reproduce``.
+"""Command-line interface: ``motionhyst df | analyze | steady | stability | simulate | scan |
+identify | predict | study | benchmark | reproduce``.
 
 A thin layer: it parses arguments, calls the library and prints tables or
 JSON.  Every user error ends in one line on stderr and exit code 2.  Each
@@ -31,8 +31,8 @@ from motionhyst.cli._common import (
 from motionhyst.cli.identify import feedforward_fragment, record_kind
 from motionhyst.core.budget import set_max_memory
 
-COMMANDS = ("df", "analyze", "steady", "simulate", "scan", "identify", "predict", "study",
-            "benchmark", "reproduce")
+COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identify", "predict",
+            "study", "benchmark", "reproduce")
 """The commands, in the order ``motionhyst --help`` lists them (module names)."""
 
 EXIT_INTERNAL = 1

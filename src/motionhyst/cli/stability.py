@@ -1,0 +1,68 @@
+"""``motionhyst stability``: will the loop hunt?  Limit cycles of the loop with its link,
+predicted by the describing function and refined to exact orbits with their Floquet
+multipliers (:func:`motionhyst.analysis.stability.stability`).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from motionhyst.cli._common import UsageError, output_file, print_json, warn_plant_fit
+
+# the command is the interface (see motionhyst.cli.main); nothing here is a library API
+__all__ = []
+
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Limit cycles of the scenario's loop with its link."""
+    from motionhyst.scenario import load_scenario
+
+    figure = None
+    if args.figure is not None:
+        figure = output_file(args.figure, args, "--figure",
+                             [] if args.scenario is None else [args.scenario])
+        if figure.path.suffix.lower() not in FIGURE_SUFFIXES:
+            raise UsageError("stability --figure: give a .png, .pdf or .svg file")
+    sc = load_scenario(args.scenario)
+    from motionhyst.analysis.stability import stability
+
+    try:
+        result = stability(sc.loop(), exact=not args.no_exact)
+    except ValueError as exc:
+        raise UsageError(f"stability: {sc.source}: {exc}") from None
+    warn_plant_fit(sc)
+    if figure is not None:
+        import io
+
+        buf = io.BytesIO()
+        result.plot().savefig(buf, format=figure.path.suffix.lower().lstrip("."), dpi=150)
+        figure.write_bytes(buf.getvalue())
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    print(f"Stability of {sc.source}, the setpoint held at 0")
+    print(result)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """Add the ``stability`` command to the subparsers `sub`."""
+    q = sub.add_parser(
+        "stability", help="limit cycles of the loop with its link: describing-function "
+        "prediction, exact orbits, Floquet multipliers",
+        description="Will the loop hunt?  The Nyquist curve of the loop seen by the link "
+        "(G = P1 / (1 + C P2)) against the link's -1/N(A, w) loci, every intersection a "
+        "predicted limit cycle with the describing function's stability criterion; each "
+        "refined to the exact orbit of the nonlinear loop with its Floquet multipliers, with "
+        "the cycles a simulation from kicked rest states settles on.")
+    q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
+    q.add_argument("--no-exact", action="store_true",
+                   help="the describing function's prediction only")
+    q.add_argument("--figure", metavar="OUT.png", help="also draw the Nyquist curve and the "
+                   "loci (.png, .pdf or .svg)")
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.add_argument("--force", action="store_true",
+                   help="replace an existing --figure file (never one of the command's inputs)")
+    q.set_defaults(func=run)

@@ -1,0 +1,196 @@
+"""Limit cycles and stability (analysis/stability.py, ``motionhyst stability``).
+
+The hunting loop of Olsson and Astrom (2001) is checked against a stiff-ODE
+simulation written here from the physics, independently of the library: a 1 kg
+mass, LuGre friction, a PID on the position with the setpoint at 0.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from motionhyst import LuGre, default_scenario, load_scenario
+from motionhyst.analysis.stability import link_loop_response, stability
+from motionhyst.cli import main as cli_main
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+HUNTING = EXAMPLES / "hunting.toml"
+
+# the hunting loop's parameters (Olsson and Astrom 2001)
+M, KP, KI, KD = 1.0, 3.0, 4.0, 6.0
+S0, S1, S2, FC, FS, VS = 1e5, math.sqrt(1e5), 0.4, 1.0, 1.5, 1e-3
+
+
+def independent_run(fs: float, y0: float, t_end: float):
+    """The hunting loop from rest at ``y = y0``: states y, v, the integral of y, z."""
+    def f(t, x):
+        y, v, xi, z = x
+        g = FC + (fs - FC) * math.exp(-(v / VS) ** 2)
+        zdot = v - S0 * abs(v) * z / g
+        w = S0 * z + S1 * zdot + S2 * v
+        u = -(KP * y + KI * xi + KD * v)
+        return [v, (u - w) / M, y, zdot]
+
+    def up(t, x):
+        return x[0]
+
+    up.direction = 1.0
+
+    def turn(t, x):
+        return x[1]
+
+    return solve_ivp(f, (0.0, t_end), [y0, 0.0, 0.0, 0.0], method="LSODA", rtol=1e-11,
+                     atol=[1e-13, 1e-13, 1e-13, 1e-17], events=(up, turn))
+
+
+@pytest.fixture(scope="module")
+def hunting():
+    return stability(load_scenario(HUNTING).loop())
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return independent_run(FS, 0.01, 400.0)
+
+
+def test_hunting_cycle_matches_an_independent_stiff_simulation(hunting, reference):
+    assert len(hunting.exact) == 1
+    cycle = hunting.exact[0]
+    t_up = reference.t_events[0]
+    period = float(t_up[-1] - t_up[-2])
+    last = reference.t_events[1] > t_up[-2]
+    y_turns = reference.y_events[1][last, 0]
+    p2p = float(y_turns.max() - y_turns.min())
+    # measured: period 24.43679 s, peak-to-peak 0.127805 m, both agree to 1e-8 or better
+    assert cycle.period_s == pytest.approx(period, rel=1e-4)
+    assert cycle.peak_to_peak == pytest.approx(p2p, rel=1e-4)
+    assert cycle.stable and cycle.confirmed
+
+
+def test_hunting_floquet_multiplier_matches_the_decay_onto_the_cycle(hunting, reference):
+    # on the section y = 0 (upward), the deviation of the integrator's state from the
+    # cycle's shrinks by |mu|max a period once it is small
+    xi = reference.y_events[0][:, 2]
+    d = np.abs(xi[:-1] - xi[-1])
+    k = int(np.nonzero((d > 1e-6) & (d < 1e-3))[0][-1])
+    ratio = d[k + 1] / d[k]
+    mu = hunting.exact[0].floquet_max
+    assert 1e-3 < mu < 1e-2            # measured 6.146e-3: the sticking forgets the past
+    assert abs(ratio - mu) < 1e-3
+    assert abs(hunting.exact[0].simulated_ratio - mu) < 1e-3
+
+
+def test_the_describing_function_misses_the_hunting(hunting):
+    # the link's -1/N(A, w) runs up the positive imaginary axis; G of a loop whose
+    # linear part is stable stays off it: no intersection, the cycle is found by the search
+    assert hunting.predicted == []
+    assert hunting.exact[0].found_by == "simulation"
+    T, A = hunting.exact[0].period_s, hunting.exact[0].peak_to_peak / 2
+    w = 2 * math.pi / T
+    link = LuGre(S0, S1, S2, FC, FS, VS)
+    G = complex(link_loop_response(load_scenario(HUNTING).loop(), [w])[0])
+    N = complex(link.describing_function(A, w))
+    # at the exact cycle's amplitude and frequency G N = -1.36 + 0.32j (measured): its
+    # magnitude 1.40 instead of 1, its angle 167 deg instead of 180 deg (the sinusoid misses
+    # the sticking, whose phase lag would close the balance)
+    assert abs(1 + G * N) > 0.3
+    assert 160.0 < math.degrees(math.atan2((G * N).imag, (G * N).real)) < 175.0
+
+
+def test_without_stribeck_dip_no_hunting():
+    sc = load_scenario(HUNTING)
+    data = sc.to_dict()
+    data["hysteresis"]["fs"] = FC
+    from motionhyst import Scenario
+
+    res = stability(Scenario.from_dict(data).loop())
+    assert res.predicted == [] and res.exact == []
+    run = independent_run(FC, 0.01, 400.0)
+    # the independent simulation sticks and slips too, but each slip ends nearer the
+    # setpoint (measured: 10 mm, 4.5 mm, 2.0 mm): it converges, no cycle
+    y, t = np.abs(run.y[0]), run.t
+
+    def peak(a, b):
+        return y[(t >= a) & (t < b)].max()
+
+    assert peak(200.0, 400.0) < 0.5 * peak(50.0, 200.0) < 0.25 * peak(0.0, 50.0)
+
+
+def test_table_one_has_no_limit_cycle():
+    res = stability(default_scenario().loop())
+    assert res.to_dict() == {"predicted": [], "exact": []}
+    # the Nyquist curve of G is five orders of magnitude inside -1/N (the link's 20 N/m
+    # against a controller of 6e6 N/m)
+    assert np.max(np.abs(res.nyquist)) < 1e-5 * np.min(np.abs(res.loci))
+    assert any("jenkins link switches" in n for n in res.notes)
+
+
+def test_cli_json_keys(capsys):
+    assert cli_main(["stability", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out == {"predicted": [], "exact": []}
+
+
+def test_cli_hunting_json(capsys, hunting):
+    assert cli_main(["stability", str(HUNTING), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out) == ["predicted", "exact"]
+    assert [sorted(c) for c in out["exact"]] == [["floquet_max", "peak_to_peak", "period_s",
+                                                  "stable"]]
+    assert out["exact"][0]["period_s"] == pytest.approx(hunting.exact[0].period_s, rel=1e-6)
+
+
+def test_cli_figure_and_bad_input(tmp_path, capsys):
+    fig = tmp_path / "nyquist.png"
+    assert cli_main(["stability", "--no-exact", "--figure", str(fig)]) == 0
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert cli_main(["stability", "--figure", str(tmp_path / "x.txt")]) == 2
+    err = capsys.readouterr().err
+    assert "give a .png, .pdf or .svg" in err and err.count("\n") == 1
+
+
+def test_a_pure_derivative_needs_a_strictly_proper_loop_gain():
+    import control
+
+    from motionhyst import Loop
+    from motionhyst.controllers.pid import Pid
+    from motionhyst.plants import MassDamper
+
+    pid = Pid(KP, KI, KD).tf()                       # improper: 6 s + 3 + 4 / s
+    loop = Loop(MassDamper(M, 0.0), pid, feedforward=None)
+    # the closed loop from the link force: s / (s^3 + 6 s^2 + 3 s + 4)
+    G = link_loop_response(loop, [2.0])[0]
+    s = 2j
+    assert G == pytest.approx(s / (s**3 + 6 * s**2 + 3 * s + 4), rel=1e-12)
+    lag = control.tf([1.0], [1.0, 1.0])              # P2 falling once: C P2 not proper
+    with pytest.raises(ValueError, match="strictly proper"):
+        Loop((lag, lag), pid, feedforward=None)
+
+
+def test_table_one_with_an_integrator_and_a_jenkins_link_comes_to_rest():
+    import control
+
+    from motionhyst import Jenkins, Loop, PointToPoint, simulate
+
+    base = default_scenario().loop()
+    C = base.controller * control.tf([1.0, 2 * math.pi * 5.0], [1.0, 0.0])   # PI zero at 5 Hz
+    loop = Loop(base.plant, C, Jenkins(k=20.0, fc=0.05))
+    loop.check_stable()
+    res = stability(loop)
+    assert res.predicted == [] and res.exact == []
+    assert abs(link_loop_response(loop, [1e-3])[0]) < 1e-11      # G(0) = 0: integral action
+    move = PointToPoint(0.02, 0.5, 10.0, 1000.0)
+    sim = simulate(loop, move, move.duration + 1.0)
+    before = simulate(base, move, move.duration + 1.0)
+    # after the move the link stays stuck holding its slip force (measured 0.049998 N); the
+    # integrator takes it over, so the error goes to zero instead of fc / C(0) (8.1e-9 m
+    # without the integrator): no hunting, the Jenkins element has no falling friction
+    assert abs(sim.w[-1]) == pytest.approx(0.05, rel=1e-3)
+    assert abs(before.e[-1]) == pytest.approx(8.06e-9, rel=1e-2)
+    assert abs(sim.e[-1]) < 1e-15
