@@ -1,12 +1,12 @@
 """Limit cycles of the loop with its link: predicted by the describing function, then exact.
 
 The link sees the rest of the loop as one linear system from its force ``w`` to
-its displacement ``y1`` (:mod:`motionhyst.loop`, the setpoint held at 0)::
+its displacement ``y1`` (:mod:`motionhyst.controllers.loop`, the setpoint held at 0)::
 
     y1 = -G w,    G = P1 / (1 + C P2)        (= -T_{w->y1})
 
 the controller with its integral action inside ``G`` (for a sampled controller
-the response of the fundamental, :meth:`~motionhyst.loop.Loop.transfer`).  A
+the response of the fundamental, :meth:`~motionhyst.controllers.loop.Loop.transfer`).  A
 self-sustained oscillation ``y1 = A sin(omega t)`` balances its first harmonic
 when ``1 + G(j omega) N(A, omega) = 0`` with ``N`` the link's describing function
 (paper eq. 7): the Nyquist curve of ``G`` meets the locus ``-1/N(A, omega)`` at
@@ -54,10 +54,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
-from motionhyst.loop import Loop
 
 __all__ = ["ExactCycle", "PredictedCycle", "StabilityResult", "link_loop_response", "stability"]
 
