@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis.floquet import FloquetResult, steady_state_floquet
 from motionhyst.analysis.plausibility import check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.analysis.steady import SteadyState, steady_state_sweep
@@ -50,16 +51,27 @@ class ComparisonPoint:
         Eq. (18) at the reference amplitude.
     error_harmonics_df : ndarray of complex
         Predicted error harmonics ``1 .. n`` [m] (higher-order describing functions).
+    floquet : FloquetResult, None or False
+        The steady state's Floquet multipliers
+        (:func:`~motionhyst.analysis.floquet.steady_state_floquet`); None where they
+        cannot be computed, False when not asked.
     """
 
     state: SteadyState
     mismatch_df: complex
     error_harmonics_df: NDArray[np.complex128]
+    floquet: FloquetResult | bool | None = False
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary: one point of the ``steady --json`` schema."""
-        return self.state.to_dict(mismatch_df=self.mismatch_df,
-                                  error_harmonics_df=self.error_harmonics_df)
+        """JSON-ready dictionary: one point of the ``steady --json`` schema (with
+        ``floquet_max`` and ``stable`` when the multipliers were computed; null where
+        they cannot be)."""
+        out = self.state.to_dict(mismatch_df=self.mismatch_df,
+                                 error_harmonics_df=self.error_harmonics_df)
+        if self.floquet is not False:
+            f = self.floquet
+            out.update({"floquet_max": None, "stable": None} if f is None else f.to_dict())
+        return out
 
 
 @dataclass
@@ -105,7 +117,17 @@ class DescribingFunctionComparison:
         return table(["f [Hz]", "|e1| [m]", "angle e1 [deg]", "|e3| [m]", "|e3| HOSIDF",
                       "|e5| [m]", "|e5| HOSIDF",
                       "|e1 lin| [m]", "|E sim|", "angle E sim", "|E df| (18)", "angle E df",
-                      "peak e [m]", "rms e-e_lin [m]"], rows)
+                      "peak e [m]", "rms e-e_lin [m]"], rows) + self._floquet_lines()
+
+    def _floquet_lines(self) -> str:
+        lines = []
+        for p in self.points:
+            if p.floquet is False:
+                continue
+            head = f"\n  {g(p.state.frequency_hz)} Hz: "
+            lines.append(head + ("Floquet multipliers not available for this loop"
+                                 if p.floquet is None else str(p.floquet)))
+        return "".join(lines)
 
     def plot(self, ax=None):
         """Fig. 11: the error over a period, exact, without hysteresis and predicted.
@@ -126,8 +148,8 @@ class DescribingFunctionComparison:
                             [p.error_harmonics_df for p in self.points], ax=ax)
 
 
-def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike
-                                     ) -> DescribingFunctionComparison:
+def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
+                                     floquet: bool = False) -> DescribingFunctionComparison:
     """Exact steady state next to the mismatch of eq. (18) and the HOSIDF error harmonics.
 
     Parameters
@@ -138,6 +160,9 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
         Reference amplitude ``A_r`` [m] of ``r = A_r sin(2 pi f t)``.
     frequencies_hz : array_like
         Frequencies [Hz].
+    floquet : bool
+        Also the Floquet multipliers of each steady state (is it stable?), where the
+        loop allows (:func:`~motionhyst.analysis.floquet.steady_state_floquet`).
 
     Returns
     -------
@@ -161,6 +186,13 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     check_plausible(loop, amplitude, f)
     E_df = loop_mismatch(loop, f, amplitude)
-    return DescribingFunctionComparison(float(amplitude), [
-        ComparisonPoint(ss, complex(ed), error_harmonics_df(loop, amplitude, ss.frequency_hz))
-        for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)])
+    points = [ComparisonPoint(ss, complex(ed),
+                              error_harmonics_df(loop, amplitude, ss.frequency_hz), False)
+              for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)]
+    if floquet:
+        for p in points:
+            try:
+                p.floquet = steady_state_floquet(loop, p.state)
+            except ValueError:
+                p.floquet = None
+    return DescribingFunctionComparison(float(amplitude), points)

@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis.floquet import LoopStateEquation, from_monodromy
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfmt import g, table
@@ -395,47 +396,8 @@ def _predict(loop: Loop, link: Hysteresis, A: NDArray, omega: NDArray,
 
 
 # ------------------------------------------------------------------ the autonomous loop
-class _Autonomous:
-    """The loop with the setpoint at 0 as one state equation: ``G`` realised, and the link."""
-
-    def __init__(self, loop: Loop, link: Hysteresis) -> None:
-        import control
-        from scipy.linalg import matrix_balance
-
-        tf = loop.transfer_tf("w->y1")
-        num = -np.trim_zeros(np.asarray(tf.num[0][0], dtype=float), "f")
-        den = np.trim_zeros(np.asarray(tf.den[0][0], dtype=float), "f")
-        if len(den) - len(num) < 2:
-            raise ValueError("the link's velocity must be a state of the loop (G = P1 / (1 + "
-                             "C P2) of relative degree >= 2)")
-        ss = control.tf2ss(num / den[0], den / den[0])
-        A, T = matrix_balance(np.asarray(ss.A, dtype=float))
-        self.A = A
-        self.B = np.linalg.solve(T, np.asarray(ss.B, dtype=float)).ravel()
-        self.C = (np.asarray(ss.C, dtype=float) @ T).ravel()
-        self.CA = self.C @ self.A
-        self.link = link
-        self.n = self.A.shape[0]
-        self.ns = link.n_states
-        self.N = self.n + self.ns
-
-    def rhs(self, t, X):
-        x, z = X[:self.n], X[self.n:]
-        v = float(self.CA @ x)
-        zdot, w, *_ = self.link.state_equation(z, v)
-        return np.concatenate([self.A @ x - self.B * w, zdot])
-
-    def jac(self, t, X):
-        n = self.n
-        x, z = X[:n], X[n:]
-        v = float(self.CA @ x)
-        _, _, dzz, dzv, dwz, dwv = self.link.state_equation(z, v)
-        J = np.empty((self.N, self.N))
-        J[:n, :n] = self.A - np.outer(self.B, dwv * self.CA)
-        J[:n, n:] = -np.outer(self.B, dwz)
-        J[n:, :n] = np.outer(dzv, self.CA)
-        J[n:, n:] = dzz
-        return J
+class _Autonomous(LoopStateEquation):
+    """The loop with the setpoint at 0 as one state equation, with its flow and shooting."""
 
     def rhs_var(self, t, Y):
         N = self.N
@@ -560,12 +522,10 @@ def _exact(sys: _Autonomous, X0, T, found_by, predicted) -> ExactCycle:
     X0, T, M = sys.shoot(X0, T, scale)
     scale = _orbit_scale(sys, X0, T, scale)
     mu, vec = np.linalg.eig(M)
-    trivial = int(np.argmin(np.abs(mu - 1.0)))
-    keep = np.arange(mu.size) != trivial
-    rest = mu[keep]
-    order = np.argsort(-np.abs(rest))
-    rest = rest[order]
-    fmax = float(np.abs(rest[0])) if rest.size else 0.0
+    keep = np.arange(mu.size) != int(np.argmin(np.abs(mu - 1.0)))
+    order = np.argsort(-np.abs(mu[keep]))
+    floquet = from_monodromy(M, T, autonomous=True)
+    rest, fmax = floquet.multipliers, floquet.floquet_max
     # one period of the orbit, finely, for its peak-to-peak and the figure
     sol = sys.run(X0, T, scale, rtol=RTOL, method="LSODA", dense_output=True)
     t = np.linspace(0.0, T, 20001)
@@ -700,7 +660,7 @@ def stability(loop: Loop, amplitudes: ArrayLike | None = None,
                          f"{link.name} link switches between sticking and slipping")
         return res
     try:
-        sys = _Autonomous(loop, link)
+        sys = _Autonomous(loop)
     except ValueError as exc:
         res.notes.append(f"exact orbits not computed: {exc}")
         return res

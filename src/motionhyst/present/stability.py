@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 
 from motionhyst.present.figures import new_figure
 
-__all__ = ["plot_stability"]
+__all__ = ["plot_multipliers", "plot_stability"]
 
 #: Loci drawn at most (every k-th amplitude of the result's grid).
 MAX_LOCI = 12
@@ -86,4 +86,43 @@ def plot_stability(result, ax=None) -> Figure:
     fig.motionhyst_data.update(omega=result.omega, G=G, A=A, loci=loci,
                                locus_omega=result.locus_omega,
                                predicted=[p.to_dict() for p in result.predicted])
+    return fig
+
+
+def plot_multipliers(result, ax=None) -> Figure:
+    """Floquet multipliers in the complex plane with the unit circle.
+
+    Parameters
+    ----------
+    result : FloquetResult
+        What :func:`~motionhyst.analysis.floquet.steady_state_floquet` returned.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; default: a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        With the plotted data as ``fig.motionhyst_data``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.analysis.floquet import from_monodromy
+    >>> fig = plot_multipliers(from_monodromy(np.diag([0.5, -0.2]), 1.0))
+    >>> fig.motionhyst_data["multipliers"].tolist()
+    [(0.5+0j), (-0.2+0j)]
+    """
+    fig, axes = new_figure(1, ax=ax)
+    a = axes[0]
+    th = np.linspace(0.0, 2 * np.pi, 361)
+    a.plot(np.cos(th), np.sin(th), color="0.5", lw=0.8, label="|mu| = 1")
+    mu = np.asarray(result.multipliers, dtype=complex)
+    a.plot(mu.real, mu.imag, "x", color="tab:red", label="multipliers")
+    a.set_aspect("equal", adjustable="box")
+    a.set_xlabel("Re mu")
+    a.set_ylabel("Im mu")
+    a.set_title(f"Floquet multipliers, T = {result.period_s:.4g} s: "
+                f"{'stable' if result.stable else 'unstable'}")
+    a.legend(loc="best")
+    fig.motionhyst_data.update(multipliers=mu)
     return fig
