@@ -43,6 +43,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study.py
 	$(BIN)/python benchmarks/study_memory.py
 	$(BIN)/python benchmarks/engine.py
+	$(BIN)/python benchmarks/stability.py
 
 # the Bouc-Wen hysteretic benchmark end to end (about a minute; kept out of make test)
 BENCHMARK_DATA ?= ../shared/benchmarks/bouc-wen
