@@ -102,11 +102,11 @@ def link_loop_response(loop: Loop, omega: ArrayLike) -> NDArray[np.complex128]:
     >>> import control
     >>> from motionhyst import Loop
     >>> from motionhyst.plants import MassDamper
-    >>> loop = Loop(MassDamper(m=1.0, c=0.0), control.tf([3.0, 4.0], [1.0, 0.0]),
-    ...             feedforward=None)                          # PI around a mass
-    >>> G = link_loop_response(loop, [2.0])                     # s / (s^3 + 3 s + 4) at 2 rad/s
+    >>> loop = Loop(MassDamper(m=1.0, c=0.0), control.tf([6.0, 3.0, 4.0], [1.0, 0.0]),
+    ...             feedforward=None)                  # PID (a pure derivative) around a mass
+    >>> G = link_loop_response(loop, [2.0])             # s / (s^3 + 6 s^2 + 3 s + 4) at 2 rad/s
     >>> print(f"{complex(G[0]):.4f}")
-    0.1000-0.2000j
+    -0.0099-0.0990j
     """
     return -np.asarray(loop.transfer("w->y1", np.asarray(omega, dtype=float)))
 

@@ -7,7 +7,7 @@ Examples
 >>> from motionhyst.analysis.stability import stability
 >>> fig = plot_stability(stability(default_scenario().loop()))
 >>> sorted(fig.motionhyst_data)
-['A', 'G', 'loci', 'omega', 'predicted']
+['A', 'G', 'loci', 'locus_omega', 'omega', 'predicted']
 """
 
 from __future__ import annotations
