@@ -168,9 +168,9 @@ class LoopStateEquation:
     >>> from motionhyst import Loop, LuGre
     >>> from motionhyst.plants import MassDamper
     >>> link = LuGre(sigma0=1e5, sigma1=300.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
-    >>> sys = LoopStateEquation(Loop(MassDamper(1.0, 0.0), control.tf([3.0, 4.0], [1.0, 0.0]),
-    ...                              link, feedforward=None))
-    >>> sys.n, sys.N                   # s / (s^3 + 3 s + 4): three states, and z
+    >>> pid = control.tf([6.0, 3.0, 4.0], [1.0, 0.0])
+    >>> sys = LoopStateEquation(Loop(MassDamper(1.0, 0.0), pid, link, feedforward=None))
+    >>> sys.n, sys.N                   # s / (s^3 + 6 s^2 + 3 s + 4): three states, and z
     (3, 4)
     """
 
