@@ -194,3 +194,30 @@ def test_table_one_with_an_integrator_and_a_jenkins_link_comes_to_rest():
     assert abs(sim.w[-1]) == pytest.approx(0.05, rel=1e-3)
     assert abs(before.e[-1]) == pytest.approx(8.06e-9, rel=1e-2)
     assert abs(sim.e[-1]) < 1e-15
+
+
+def test_links_work_in_python_control_and_agree():
+    # python-control's describing-function analysis takes our link objects (their
+    # describing_function(A)); where its assumptions hold (a rate-independent link) its
+    # intersection agrees with ours, found by another search and refinement
+    import warnings
+
+    import control
+
+    from motionhyst import Jenkins
+    from motionhyst.analysis.stability import intersections
+
+    H = control.tf([-2.0], [1.0, 3.0, 3.0, 1.0])
+    link = Jenkins(k=1.0, fc=0.1)
+    ours = intersections(H, link, np.geomspace(0.1, 100, 50), np.geomspace(0.01, 10, 60))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        theirs = control.describing_function_response(H, link, np.geomspace(0.1, 100, 200))
+    assert len(ours) == len(theirs.intersections) == 1
+    a, w = theirs.intersections[0]
+    # measured: both A = 0.2239884, w = 0.2129935 rad/s, to 3e-8
+    assert ours[0].amplitude == pytest.approx(a, rel=1e-6)
+    assert 2 * math.pi * ours[0].frequency_hz == pytest.approx(w, rel=1e-6)
+    # stable: the loop with the link stuck (N = k) is unstable, without it (N = 0) stable
+    assert ours[0].stable
+    assert np.max(control.feedback(H, 1.0).poles().real) > 0

@@ -60,7 +60,8 @@ from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
 
-__all__ = ["ExactCycle", "PredictedCycle", "StabilityResult", "link_loop_response", "stability"]
+__all__ = ["ExactCycle", "PredictedCycle", "StabilityResult", "intersections",
+           "link_loop_response", "stability"]
 
 #: Grid of the search for intersections: points per decade of amplitude and frequency for a
 #: rate-dependent link (each point a periodic solution of the link), and for a
@@ -360,9 +361,60 @@ def _winding(F: NDArray[np.complex128]) -> NDArray[np.int64]:
     return np.rint(total / TWO_PI).astype(np.int64)
 
 
-def _predict(loop: Loop, link: Hysteresis, A: NDArray, omega: NDArray,
+def intersections(response, link: Hysteresis, amplitudes: ArrayLike, omega: ArrayLike
+                  ) -> list[PredictedCycle]:
+    """Where ``1 + G(j omega) N(A, omega) = 0``: the describing function's limit cycles.
+
+    Cells of the amplitude-frequency grid around which ``1 + G N`` winds once, each
+    refined by Newton's method in ``(log A, log omega)``; stable or not by Loeb's criterion
+    (module docstring).  What :func:`stability` predicts with, for any linear part.
+
+    Parameters
+    ----------
+    response : python-control LTI system or callable
+        ``G``: a system (its frequency response is taken), or a function of an array of
+        angular frequencies [rad/s] returning ``G(j omega)``.
+    link : Hysteresis
+        The nonlinearity ``N`` (its :meth:`~motionhyst.hysteresis.Hysteresis.describing_function`).
+    amplitudes : array_like
+        Amplitudes of the grid [m], increasing.
+    omega : array_like
+        Angular frequencies of the grid [rad/s], increasing.
+
+    Returns
+    -------
+    list of PredictedCycle
+        By amplitude.
+
+    Examples
+    --------
+    A Jenkins link in a loop with a third-order lag: one intersection, as python-control's
+    :func:`control.describing_function_response` finds with the same link; stable: the
+    loop with the link stuck is unstable, without it stable, so the oscillation grows to
+    it from below and shrinks to it from above.
+
+    >>> import numpy as np
+    >>> import control
+    >>> from motionhyst import Jenkins
+    >>> H = control.tf([-2.0], [1.0, 3.0, 3.0, 1.0])            # -2 / (s + 1)^3
+    >>> link = Jenkins(k=1.0, fc=0.1)
+    >>> [c] = intersections(H, link, np.geomspace(0.1, 100, 50), np.geomspace(0.01, 10, 60))
+    >>> print(f"A = {c.amplitude:.3f} m at {c.frequency_hz:.4f} Hz, stable: {c.stable}")
+    A = 0.224 m at 0.0339 Hz, stable: True
+    """
+    from motionhyst.core.lti import freqresp
+
+    A = np.asarray(amplitudes, dtype=float)
+    w = np.asarray(omega, dtype=float)
+    if hasattr(response, "poles"):
+        sys = response
+        response = lambda om: freqresp(sys, om)  # noqa: E731
+    return _predict(response, link, A, w, _df(link, A, w), np.asarray(response(w)))
+
+
+def _predict(response, link: Hysteresis, A: NDArray, omega: NDArray,
              N: NDArray[np.complex128], G: NDArray[np.complex128]) -> list[PredictedCycle]:
-    """Intersections: cells of the grid around which ``1 + G N`` winds, refined by Newton."""
+    """:func:`intersections` with ``N`` and ``G`` on the grid already computed."""
     from scipy.optimize import root
 
     F = 1.0 + G[None, :] * N
@@ -372,7 +424,7 @@ def _predict(loop: Loop, link: Hysteresis, A: NDArray, omega: NDArray,
         a, w = math.exp(p[0]), math.exp(p[1])
         n = complex(np.ravel(link.describing_function(a, None if link.rate_independent
                                                        else w))[0])
-        f = 1.0 + complex(link_loop_response(loop, [w])[0]) * n
+        f = 1.0 + complex(np.ravel(response(np.array([w])))[0]) * n
         return np.array([f.real, f.imag])
 
     found: list[PredictedCycle] = []
@@ -648,7 +700,7 @@ def stability(loop: Loop, amplitudes: ArrayLike | None = None,
         loci = -1.0 / N
     fine = np.geomspace(omega[0], omega[-1], NYQUIST_POINTS)
     res = StabilityResult(link, fine, link_loop_response(loop, fine), omega, A, loci)
-    res.predicted = _predict(loop, link, A, omega, N, G)
+    res.predicted = _predict(lambda w: link_loop_response(loop, w), link, A, omega, N, G)
     if not exact:
         return res
     if loop.sampled is not None:
