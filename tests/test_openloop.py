@@ -141,8 +141,13 @@ def test_open_loop_scenario():
                                       "nu": 1.0}
     with pytest.raises(ScenarioError, match=r"mass-spring-damper.*needs a closed loop"):
         sc.loop()
-    with pytest.raises(ScenarioError, match=r"\[controller\] does not apply"):
+    # with a [controller] a stage of one position is the plant of a closed loop (issue 25's
+    # hunting loop), which needs its [reference]
+    with pytest.raises(ScenarioError, match=r"\[reference\]: missing"):
         Scenario.from_dict({**OPEN, "controller": {"type": "tf", "num": [1.0], "den": [1.0]}})
+    closed = Scenario.from_dict({**OPEN, "controller": {"type": "tf", "num": [1e5], "den": [1.0]},
+                                 "reference": {"amplitude": 0.01, "frequencies": [5.0]}})
+    assert not closed.is_open_loop and closed.loop().P1 is not None
     with pytest.raises(ScenarioError, match=r"\[stage\] m: .*greater than 0"):
         Scenario.from_dict({**OPEN, "stage": {**OPEN["stage"], "m": 0.0}})
     with pytest.raises(ScenarioError, match=r"\[stage\]: unknown type 'three-mass'"):
