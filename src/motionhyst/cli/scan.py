@@ -7,6 +7,7 @@ force, learning of the model's coefficients).
 from __future__ import annotations
 
 import argparse
+import math
 
 from motionhyst.cli._common import (
     UsageError,
@@ -81,6 +82,9 @@ def add_parser(sub) -> None:
                    help="carry-over setpoint: length [m] (default: --length)")
     q.add_argument("--other-speed", type=positive, metavar="V",
                    help="carry-over setpoint: speed [m/s] (default: half of --speed)")
+    q.add_argument("--at", type=float, metavar="X",
+                   help="where on the stroke the scan starts, for links whose parameters vary "
+                        "along it ([hysteresis] along) [m] (0)")
     q.add_argument("--settle-tol", type=positive, default=1e-9, metavar="M",
                    help="error band of the settling time [m] (1e-9)")
     q.add_argument("--tail", type=nonnegative, default=0.05,
@@ -116,6 +120,22 @@ def _output(args):
                       option="--time-series")
 
 
+def _at(loop, x0: float, source: str):
+    """`loop` with its links along the stroke seen from `x0` (the scan starts there)."""
+    from motionhyst.controllers.loop import Loop
+    from motionhyst.hysteresis.along_stroke import AlongStroke
+
+    if not math.isfinite(x0):
+        raise UsageError(f"{PROG}: --at must be finite, got {x0}")
+    links = [loop.hysteresis, loop.hysteresis_feedforward]
+    if not any(isinstance(h, AlongStroke) for h in links):
+        raise UsageError(f"{PROG}: --at needs a link that varies along the stroke "
+                         f"([hysteresis] along), and {source} has none")
+    h, hff = (x.shifted(x0) if isinstance(x, AlongStroke) else x for x in links)
+    return Loop(loop.plant, loop.controller, h, feedforward=loop.ff, mass=loop.M,
+                hysteresis_feedforward=hff)
+
+
 def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
     from motionhyst.scenario import load_scenario
@@ -127,6 +147,8 @@ def run(args: argparse.Namespace) -> int:
 
     loop = sc.loop()
     warn_plant_fit(sc)
+    if args.at is not None:
+        loop = _at(loop, args.at, sc.source)
     ff = loop.ff
     terms = args.feedforward
     if terms is None:

@@ -152,20 +152,22 @@ class FeedforwardTerms:
         if self.link is None:
             return None
         scales = self.link_scales if scales is None else scales
-        d = self.link.to_dict()
+        base = getattr(self.link, "base", self.link)  # a link along the stroke: its base
+        d = base.to_dict()
         kw = {}
-        for p in self.link.parameters:
+        for p in base.parameters:
             v = d[p.name]
             kw[p.name] = ([x * scales[p.name] for x in v] if isinstance(v, list)
                           else v * scales[p.name])
-        return type(self.link)(**kw)
+        scaled = type(base)(**kw)
+        return self.link.with_base(scaled) if base is not self.link else scaled
 
     def values(self) -> dict[str, float | list[float]]:
         """The coefficients by name, the link's parameters as values (lists: a parallel model)."""
         out: dict = dict(self.coefficients)
         link = self.scaled_link()
         if link is not None:
-            d = link.to_dict()
+            d = getattr(link, "base", link).to_dict()
             out.update({f"link {p}": d[p] for p in self.link_scales})
         return out
 

@@ -196,8 +196,12 @@ class _LinkSection(_Section):
     statement of them; their messages become validation errors.  A section of
     another :class:`~motionhyst.hysteresis.registry.Form` of a model builds it
     with the form's constructor and rejects the keys of the model's own
-    spelling that the form lacks.
+    spelling that the form lacks.  ``along = { position = [...], NAME = [...] }``
+    scales parameters along the stroke
+    (:class:`~motionhyst.hysteresis.along_stroke.AlongStroke`).
     """
+
+    along: dict[str, list[float]] | None = None
 
     @model_validator(mode="before")
     @classmethod
@@ -205,7 +209,7 @@ class _LinkSection(_Section):
         form = _SECTION_FORMS.get(cls)
         if form is not None and isinstance(data, dict):
             own = {p.name for p in form.parameters}
-            mixed = sorted(k for k in data if k != "model" and k not in own)
+            mixed = sorted(k for k in data if k not in ("model", "along") and k not in own)
             if mixed:
                 theirs = sorted(own - {p.name for p in model_class(data["model"]).parameters})
                 raise ValueError(f"{', '.join(mixed)} (not of the {form.name} form) and "
@@ -223,7 +227,16 @@ class _LinkSection(_Section):
         cls = model_class(self.model)
         form = _SECTION_FORMS.get(type(self))
         make = cls if form is None else getattr(cls, form.constructor)
-        return make(**self.model_dump(exclude={"model"}))
+        link = make(**self.model_dump(exclude={"model", "along"}))
+        if self.along is None:
+            return link
+        from motionhyst.hysteresis.along_stroke import AlongStroke
+
+        along = dict(self.along)
+        if "position" not in along:
+            raise ValueError("along needs position = [...] (the stroke positions [m]) and "
+                             "the scales of the parameters there")
+        return AlongStroke(link, along.pop("position"), along)
 
 
 

@@ -34,6 +34,7 @@ from motionhyst.core.lti import (
     stack,
 )
 from motionhyst.hysteresis import Hysteresis
+from motionhyst.hysteresis.along_stroke import AlongStroke
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
 from motionhyst.time.engine import FohStep, LoopState, run_steps
 from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS
@@ -154,6 +155,7 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
         if dt is not None and abs(dt - loop.sampled.period) > 1e-9 * loop.sampled.period:
             raise ValueError(f"a sampled loop runs at its controller's period "
                              f"{loop.sampled.period:g} s, not dt = {dt:g} s")
+        _refuse_along_stroke(loop, "with a sampled controller")
         return simulate_sampled(loop, reference, duration, force=force)
     _check_feedforward(loop)
     engine = _Engine(loop, reference, dt, force)
@@ -164,7 +166,44 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
                  "shorten the run or lower its frequencies")
     t = np.arange(n) * engine.step
     h_foh = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
+    if isinstance(loop.hysteresis, AlongStroke) or isinstance(engine.hff, AlongStroke):
+        return _along_stroke(engine, t, h_foh)
     return engine.run(t, 0, h_foh)
+
+
+def _refuse_along_stroke(loop: Loop, how: str) -> None:
+    if isinstance(loop.hysteresis, AlongStroke) or isinstance(loop.hysteresis_feedforward,
+                                                              AlongStroke):
+        raise ValueError(f"a link that varies along the stroke is run by simulate and scan "
+                         f"with a continuous controller, not {how}")
+
+
+def _along_stroke(engine: _Engine, t: NDArray[np.float64], h_foh: float) -> Simulation:
+    """The run in the link's pieces (:meth:`AlongStroke.pieces` of the setpoint), the link at
+    the setpoint's mean position over each (the stage's within the error); a feedforward
+    model along the stroke on the whole setpoint."""
+    r = np.asarray(engine.reference(t)[0], dtype=float)
+    # the forces of the whole run (a force may have a state: a link model's), read by piece
+    uf = np.zeros(t.shape) if engine.force is None else np.asarray(engine.force(t), float)
+    if uf.shape != t.shape:
+        raise ValueError("the feedforward force must give one finite value per time")
+    if isinstance(engine.hff, AlongStroke):  # phi_hat(r) of the whole run, as a force
+        uf = uf + engine.hff.response(r)
+        engine.hff = None
+
+    def force(tt):
+        return np.interp(tt, t, uf)
+
+    engine.force = force
+    link = engine.loop.hysteresis
+    if not isinstance(link, AlongStroke):
+        return engine.run(t, 0, h_foh)
+    parts = []
+    for i0, i1 in link.pieces(r):
+        engine.stepping.params[:] = link.stepping_params(float(np.mean(r[i0:i1])))
+        parts.append(engine.run(t[i0:i1], i0, h_foh))
+    return Simulation(**{c: np.concatenate([getattr(p, c) for p in parts])
+                         for c in ("t", "r", "e", "y1", "y2", "u", "w", "e_linear")})
 
 
 def _check_feedforward(loop: Loop) -> None:
@@ -220,6 +259,7 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
             yield Simulation(**{c: getattr(whole, c)[i0:i0 + int(chunk)] for c in cols})
         return
     _check_feedforward(loop)
+    _refuse_along_stroke(loop, "in chunks")
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     for i0 in range(0, n, int(chunk)):
