@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/models.py
 	$(BIN)/python benchmarks/speed.py
 	$(BIN)/python benchmarks/scan.py
+	$(BIN)/python benchmarks/scan_production.py
 	$(BIN)/python benchmarks/sampled.py
 	$(BIN)/python benchmarks/study.py
 	$(BIN)/python benchmarks/study_memory.py

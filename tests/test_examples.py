@@ -191,3 +191,35 @@ def test_identify_input_output_model_predicts_the_same_on_the_command_line(io_re
     assert rmse == pytest.approx(io_result["test_rmse"], rel=1e-6)
     assert files["prediction.png"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in folder.iterdir() if p.name.startswith(".")]
+
+
+# ------------------------------------------------------------------- scan_production
+@pytest.fixture(scope="module")
+def production(tmp_path_factory) -> dict:
+    return load_example("scan_production").main(tmp_path_factory.mktemp("prod"), quiet=True)
+
+
+def test_scan_production_meets_the_targets(production):
+    # issue 24: 0.1 m at 0.5 m/s, the link model 4 % off: model (with the snap term) and
+    # basis cut max MA and max MSD 10x; basis keeps 5x at half and double the speed, the
+    # learned force does not (measured: model 68x / 1.6e3x, basis 2.5e3x / 1.7e3x; at half
+    # the speed basis 2.5e3x, ilc 0.49x)
+    for comp in ("model", "basis"):
+        red = production["reductions"][comp]
+        assert red["ma"] >= 10 and red["msd"] >= 10, comp
+    for speed in ("half_speed", "double_speed"):
+        red = production[speed]
+        assert red["basis"]["ma"] >= 5 and red["basis"]["msd"] >= 5, speed
+        assert red["ilc"]["ma"] < 5 or red["ilc"]["msd"] < 5, speed
+    learned = production["basis"]["learned"]
+    assert learned["snap"] == pytest.approx(5.0 * 17.5 / 7.4e7, rel=0.01)
+    assert learned["link fc"] == pytest.approx(0.05, rel=0.01)
+    assert Path(production["figure"]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_scan_production_along_the_stroke_the_table_matters(production):
+    # the link's fc and k vary along the stroke: a single-parameter model leaves the
+    # variation everywhere; the model with the table leaves its 4 %
+    for row in production["along_stroke"].values():
+        assert row["table"]["model"]["ma"] > 3 * row["single"]["model"]["ma"]
+        assert row["table"]["basis"]["ma"] > 10 * row["single"]["basis"]["ma"]

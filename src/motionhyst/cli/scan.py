@@ -122,18 +122,14 @@ def _output(args):
 
 def _at(loop, x0: float, source: str):
     """`loop` with its links along the stroke seen from `x0` (the scan starts there)."""
-    from motionhyst.controllers.loop import Loop
-    from motionhyst.hysteresis.along_stroke import AlongStroke
+    from motionhyst.scan.scanning import loop_at
 
     if not math.isfinite(x0):
         raise UsageError(f"{PROG}: --at must be finite, got {x0}")
-    links = [loop.hysteresis, loop.hysteresis_feedforward]
-    if not any(isinstance(h, AlongStroke) for h in links):
-        raise UsageError(f"{PROG}: --at needs a link that varies along the stroke "
-                         f"([hysteresis] along), and {source} has none")
-    h, hff = (x.shifted(x0) if isinstance(x, AlongStroke) else x for x in links)
-    return Loop(loop.plant, loop.controller, h, feedforward=loop.ff, mass=loop.M,
-                hysteresis_feedforward=hff)
+    try:
+        return loop_at(loop, x0)
+    except ValueError as exc:
+        raise UsageError(f"{PROG}: --at: {exc} ({source})") from None
 
 
 def run(args: argparse.Namespace) -> int:

@@ -36,13 +36,14 @@ from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.core.textfmt import g, table
+from motionhyst.hysteresis.along_stroke import AlongStroke
 from motionhyst.scan.basis import BasisResult, learn_basis
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
 from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
 from motionhyst.scan.terms import TERMS, FeedforwardTerms, model_terms
 from motionhyst.time.simulation import BYTES_PER_SAMPLE, default_step, simulate
 
-__all__ = ["ScanResult", "ScanRun", "moving_statistics", "run_scan", "settling_time"]
+__all__ = ["ScanResult", "ScanRun", "loop_at", "moving_statistics", "run_scan", "settling_time"]
 
 COMPENSATIONS = ("none", "model", "ilc", "basis")
 """The compensations :func:`run_scan` compares."""
@@ -348,7 +349,7 @@ class ScanResult:
                     f"{self.carry_over.profile}", self.carry_over._table(without_link=False)]
         return "\n".join(out)
 
-    def plot(self, unit: float = 1e-9, unit_name: str = "nm", ax=None):
+    def plot(self, unit: float = 1e-9, unit_name: str = "nm", ax=None, log: bool = False):
         """Figure of ``e``, ``MA`` and ``MSD`` against time, the profile's phases shaded.
 
         Parameters
@@ -359,6 +360,9 @@ class ScanResult:
             Its name.
         ax : sequence of 3 matplotlib.axes.Axes, optional
             Axes to draw into (e, MA, MSD); default: a new figure.
+        log : bool
+            ``|e|``, ``|MA|`` and ``MSD`` on logarithmic axes (compensations that
+            differ by decades).
         """
         from matplotlib.figure import Figure
         from matplotlib.patches import Patch
@@ -371,16 +375,23 @@ class ScanResult:
             if len(axes) != 3:
                 raise ValueError(f"this plot draws 3 axes; ax= gives {len(axes)}")
             fig = axes[0].figure
+        shown = np.abs if log else (lambda x: x)
         for ax, name in zip(axes, ("e", "ma", "msd"), strict=True):
             ref = getattr(self.without_link, name)
-            ax.plot(self.t, ref / unit, color="0.5", lw=0.9, ls="--", label="without link")
+            ax.plot(self.t, shown(ref) / unit, color="0.5", lw=0.9, ls="--",
+                    label="without link")
             for r in self.runs:
-                ax.plot(r.t, getattr(r, name) / unit, color=COLORS.get(r.compensation),
+                ax.plot(r.t, shown(getattr(r, name)) / unit, color=COLORS.get(r.compensation),
                         lw=1.1, label=f"link, {r.compensation}")
+            if log:
+                ax.set_yscale("log")
+                ax.set_ylim(bottom=1e-5 * max(np.max(shown(getattr(r, name))) for r in
+                                              self.runs) / unit)
             shade_phases(ax, self.profile)
             ax.grid(True, alpha=0.3)
-        axes[0].set_ylabel(f"error e [{unit_name}]")
-        axes[1].set_ylabel(f"MA [{unit_name}]")
+        bars = ("|", "|") if log else ("", "")
+        axes[0].set_ylabel(f"error {bars[0]}e{bars[1]} [{unit_name}]")
+        axes[1].set_ylabel(f"{bars[0]}MA{bars[1]} [{unit_name}]")
         axes[2].set_ylabel(f"MSD [{unit_name}]")
         axes[2].set_xlabel("time [s]")
         handles, labels = axes[0].get_legend_handles_labels()
@@ -391,6 +402,41 @@ class ScanResult:
         fig.legend(handles, labels, ncol=4, fontsize=7, loc="outside lower center",
                    frameon=False)
         return fig
+
+
+def loop_at(loop: Loop, x0: float) -> Loop:
+    """`loop` with its links along the stroke seen from `x0`: a setpoint from 0 scans there.
+
+    Parameters
+    ----------
+    loop : Loop
+        A loop whose link or hysteresis feedforward varies along the stroke
+        (:class:`~motionhyst.hysteresis.along_stroke.AlongStroke`).
+    x0 : float
+        Where on the stroke the setpoint's 0 lies [m].
+
+    Raises
+    ------
+    ValueError
+        For a loop without a link along the stroke.
+
+    Examples
+    --------
+    >>> from motionhyst import Jenkins, LeadLagLowpass, Loop, TwoMassStage
+    >>> from motionhyst.hysteresis.along_stroke import AlongStroke
+    >>> link = AlongStroke(Jenkins(20.0, 0.05), [0.0, 0.2], {"fc": [1.0, 2.0]})
+    >>> loop = Loop(TwoMassStage(5.0, 17.5, 90.0, 7.4e7),
+    ...             LeadLagLowpass(6.2e6, 60, 240, 700, 0.6), link)
+    >>> round(loop_at(loop, 0.1).hysteresis.at(0.0).fc, 6)      # 0.1 m on the stroke
+    0.075
+    """
+    links = [loop.hysteresis, loop.hysteresis_feedforward]
+    if not any(isinstance(h, AlongStroke) for h in links):
+        raise ValueError("a scan's place on the stroke needs a link that varies along it "
+                         "([hysteresis] along)")
+    h, hff = (x.shifted(x0) if isinstance(x, AlongStroke) else x for x in links)
+    return Loop(loop.plant, loop.controller, h, feedforward=loop.ff, mass=loop.M,
+                hysteresis_feedforward=hff)
 
 
 def _rigid_body(loop: Loop, hysteresis_feedforward=None) -> Loop:
