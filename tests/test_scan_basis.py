@@ -235,3 +235,16 @@ def test_sampled_controller_computes_the_jerk_and_snap_terms_ahead():
     assert_allclose(feedforward_samples(loop, p, t), expected, rtol=1e-12, atol=1e-12)
     with pytest.raises(ValueError, match="derivatives"):
         feedforward_samples(loop, SineReference(0.01, 5.0), t)
+
+
+def test_without_feedforward_basis_learns_the_mass_from_zero(stage, controller):
+    # a loop without feedforward: the model's acceleration term starts at 0, as the loop
+    # applies none; the learning finds M = m1 + m2 (the error is then the stage's own)
+    loop = Loop(stage, controller, Jenkins(K_LINK, FC_LINK), feedforward=None,
+                hysteresis_feedforward=Jenkins(K_LINK, FC_LINK))
+    terms = model_terms(loop)
+    assert terms.base_mass == 0.0 and terms.coefficients == {"mass": 0.0}
+    p = scan(0.02, **FAST)
+    res = run_scan(loop, p, 0.01, ("none", "basis"), basis_trials=3)
+    assert res.basis.terms.coefficients["mass"] == pytest.approx(stage.M, rel=1e-4)
+    assert res.run("basis").ma_max < 1e-3 * res.run("none").ma_max

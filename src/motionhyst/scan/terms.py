@@ -275,8 +275,8 @@ def model_terms(loop, names=None) -> FeedforwardTerms:
     >>> print(f"{terms.coefficients['snap']:.4g}")                   # m1 m2 / k
     1.182e-06
     """
-    ff = loop.ff
-    mass = loop.M if ff is None or ff.mass is None else ff.mass
+    ff = loop.ff  # without one the acceleration term starts at 0 (and the loop applies none)
+    mass = 0.0 if ff is None else (loop.M if ff.mass is None else ff.mass)
     have = {k: getattr(ff, k, 0.0) if ff is not None else 0.0
             for k in ("jerk", "snap", "viscous", "coulomb")}
     if names is None:
@@ -306,4 +306,4 @@ def model_terms(loop, names=None) -> FeedforwardTerms:
         if link is None:
             raise ValueError("the hysteresis term needs a hysteresis feedforward model "
                              "(a scenario's [feedforward] hysteresis)")
-    return FeedforwardTerms(float(loop.M if loop.M is not None else mass), coefficients, link)
+    return FeedforwardTerms(0.0 if ff is None else float(loop.M), coefficients, link)
