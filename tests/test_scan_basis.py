@@ -248,3 +248,19 @@ def test_without_feedforward_basis_learns_the_mass_from_zero(stage, controller):
     res = run_scan(loop, p, 0.01, ("none", "basis"), basis_trials=3)
     assert res.basis.terms.coefficients["mass"] == pytest.approx(stage.M, rel=1e-4)
     assert res.run("basis").ma_max < 1e-3 * res.run("none").ma_max
+
+
+def test_terms_jacobian_is_the_force_derivative():
+    p = scan(0.01, **FAST)
+    t = np.linspace(0.0, p.end, 3001)
+    d = setpoint_samples(p, t, t[1] - t[0])
+    terms = FeedforwardTerms(22.5, {"mass": 22.0, "jerk": 1e-7, "snap": 1e-6, "viscous": 3.0,
+                                    "coulomb": 0.01}, Jenkins(K_LINK, FC_LINK))
+    J = terms.jacobian(d)
+    theta = terms.vector()
+    for i in range(theta.size):
+        h = 1e-4 * abs(theta[i])  # the force is linear in all but the link's: rounding small
+        up = terms.with_vector(theta + h * np.eye(theta.size)[i]).force(d)
+        down = terms.with_vector(theta - h * np.eye(theta.size)[i]).force(d)
+        assert_allclose(J[:, i], (up - down) / (2 * h), rtol=1e-4,
+                        atol=1e-6 * np.max(np.abs(J[:, i])))
