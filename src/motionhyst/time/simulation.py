@@ -267,6 +267,27 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
         yield engine.run(t, i0, engine.step)
 
 
+#: The discretised linear parts of the last runs: ``(loop, step, omega0, sys_a, disc_a,
+#: disc_w)``; a scan's trials run one loop at one step many times (the matrix exponentials
+#: were half of their time).  The loop is held, so that its identity is its key.
+_DISCRETISED: list[tuple] = []
+
+
+def _discretised(loop: Loop, step: float):
+    """The loop's scale ``omega0``, the system ``r'' -> (e, y1 - r)``, and its and
+    ``w -> (e, y1 - r)``'s discretisations at `step` (from :data:`_DISCRETISED` if there)."""
+    for entry in _DISCRETISED:
+        if entry[0] is loop and entry[1] == step:
+            return entry[2:]
+    omega0 = float(np.max(np.abs(loop.closed_loop_poles())))
+    sys_a, sys_w = _block_systems(loop, omega0)
+    entry = (loop, step, omega0, sys_a, discretize_foh(sys_a, omega0 * step),
+             discretize_foh(sys_w, omega0 * step))
+    _DISCRETISED.insert(0, entry)
+    del _DISCRETISED[4:]
+    return entry[2:]
+
+
 class _Engine:
     """The discretised loop of :func:`simulate`, run chunk by chunk with its state carried."""
 
@@ -285,16 +306,14 @@ class _Engine:
         if not (np.isfinite(step) and step > 0):
             raise ValueError("dt must be finite and > 0")
         self.step = step
-        omega0 = float(np.max(np.abs(loop.closed_loop_poles())))
-        sys_a, sys_w = _block_systems(loop, omega0)
+        omega0, sys_a, disc_a, self.disc_w = _discretised(loop, step)
         # a reference that starts with a velocity v0 has r'' = v0 delta(t) + ...: the impulse
         # sets the initial state (delta(t) = omega0 delta(tau) in scaled time)
         v0 = float(getattr(reference, "initial_velocity", 0.0))
         self.x_a = np.ascontiguousarray(sys_a[1][:, 0] * v0 * omega0, dtype=float)
-        Ad, Bd, Cd, Dd = discretize_foh(sys_a, omega0 * step)
+        Ad, Bd, Cd, Dd = disc_a
         self.disc_a = (Ad, np.ascontiguousarray(Bd[:, 0]), Cd, np.ascontiguousarray(Dd[:, 0]))
         self.x_a = np.ascontiguousarray(self.x_a[:, None])
-        self.disc_w = discretize_foh(sys_w, omega0 * step)
         # the link force drives the linear part as f = u_h - w: w - u_h -> (e, y1 - r), negated
         Ad, Bd, Cd, Dd = self.disc_w
         self.steps = [FohStep(Ad, -Bd[:, 0], np.zeros(Ad.shape[0]), step)]
