@@ -17,6 +17,7 @@ from motionhyst.hysteresis.along_stroke import STEPS_PER_INTERVAL, AlongStroke
 from motionhyst.scan.profiles import scan
 from motionhyst.scan.scanning import run_scan
 from motionhyst.scenario import Scenario, ScenarioError, default_scenario
+from motionhyst.time.simulation import simulate_chunks
 
 FAST = dict(speed=0.5, a_max=20.0, j_max=2000.0, s_max=4e5, start=0.01)
 TABLE = ([0.0, 0.05, 0.1], {"fc": [1.2, 0.7, 1.1], "k": [1.0, 0.8, 1.3]})
@@ -143,3 +144,19 @@ def test_sampled_loop_refuses_a_link_along_the_stroke():
     loop = Scenario.from_dict(d, "s.toml").loop()
     with pytest.raises(ValueError, match="continuous controller"):
         simulate(loop, scan(0.01, **FAST), 0.05)
+
+
+def test_chunks_of_a_run_along_the_stroke_are_the_run(stage, controller):
+    # simulate_chunks (the CLI's time series) splits the link's pieces at its chunks' ends:
+    # the parameters are held over shorter stretches, the run is the same to the holding
+    link = AlongStroke(Jenkins(K_LINK, FC_LINK), *TABLE)
+    loop = Loop(stage, controller, link)
+    p = scan(0.05, **FAST)
+    whole = simulate(loop, p, p.end)
+    pieces = list(simulate_chunks(loop, p, p.end, chunk=1000))
+    e = np.concatenate([c.e for c in pieces])
+    assert len(pieces) > 5 and e.shape == whole.e.shape
+    assert np.max(np.abs(e - whole.e)) < 2e-3 * np.max(np.abs(whole.e))
+    hff = Loop(stage, controller, link, hysteresis_feedforward=link)
+    with pytest.raises(ValueError, match="by scan"):
+        next(simulate_chunks(hff, p, p.end))

@@ -174,8 +174,8 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
 def _refuse_along_stroke(loop: Loop, how: str) -> None:
     if isinstance(loop.hysteresis, AlongStroke) or isinstance(loop.hysteresis_feedforward,
                                                               AlongStroke):
-        raise ValueError(f"a link that varies along the stroke is run by simulate and scan "
-                         f"with a continuous controller, not {how}")
+        raise ValueError(f"a link that varies along the stroke is run with a continuous "
+                         f"controller, not {how}")
 
 
 def _along_stroke(engine: _Engine, t: NDArray[np.float64], h_foh: float) -> Simulation:
@@ -195,13 +195,21 @@ def _along_stroke(engine: _Engine, t: NDArray[np.float64], h_foh: float) -> Simu
         return np.interp(tt, t, uf)
 
     engine.force = force
+    return _in_pieces(engine, t, 0, h_foh, r)
+
+
+def _in_pieces(engine: _Engine, t: NDArray[np.float64], i0: int, h_foh: float,
+               r: NDArray[np.float64] | None = None) -> Simulation:
+    """``engine.run`` of the samples `t` (indices from `i0`), a link along the stroke updated
+    between its pieces of the setpoint `r` (``reference(t)`` if not given)."""
     link = engine.loop.hysteresis
     if not isinstance(link, AlongStroke):
-        return engine.run(t, 0, h_foh)
+        return engine.run(t, i0, h_foh)
+    r = np.asarray(engine.reference(t)[0], dtype=float) if r is None else r
     parts = []
-    for i0, i1 in link.pieces(r):
-        engine.stepping.params[:] = link.stepping_params(float(np.mean(r[i0:i1])))
-        parts.append(engine.run(t[i0:i1], i0, h_foh))
+    for a, b in link.pieces(r):
+        engine.stepping.params[:] = link.stepping_params(float(np.mean(r[a:b])))
+        parts.append(engine.run(t[a:b], i0 + a, h_foh))
     return Simulation(**{c: np.concatenate([getattr(p, c) for p in parts])
                          for c in ("t", "r", "e", "y1", "y2", "u", "w", "e_linear")})
 
@@ -259,12 +267,14 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
             yield Simulation(**{c: getattr(whole, c)[i0:i0 + int(chunk)] for c in cols})
         return
     _check_feedforward(loop)
-    _refuse_along_stroke(loop, "in chunks")
+    if isinstance(loop.hysteresis_feedforward, AlongStroke):
+        raise ValueError("a hysteresis feedforward model along the stroke is run by scan, not "
+                         "in chunks")
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     for i0 in range(0, n, int(chunk)):
         t = np.arange(i0, min(n, i0 + int(chunk))) * engine.step
-        yield engine.run(t, i0, engine.step)
+        yield _in_pieces(engine, t, i0, engine.step)
 
 
 #: The discretised linear parts of the last runs: ``(loop, step, omega0, sys_a, disc_a,
