@@ -75,6 +75,11 @@ class Batch(NamedTuple):
 class Evaluator:
     """Computes points of one study; keeps the loop of the last scenario keys.
 
+    Parameters
+    ----------
+    study : Study
+        The study.
+
     Examples
     --------
     >>> import tomllib
@@ -111,7 +116,13 @@ class Evaluator:
         return self._loop
 
     def point(self, index: int) -> dict:
-        """The output fields at the flat `index`; raises if the point cannot be computed."""
+        """The output fields at the flat `index`; raises if the point cannot be computed.
+
+        Parameters
+        ----------
+        index : int
+            Flat index of the point.
+        """
         values = self.study.point(index)
         return self._outputs(self._loop_at(values), values)
 
@@ -140,7 +151,13 @@ class Evaluator:
 
     def batch(self, indices) -> Batch:
         """Compact records of the points at `indices`: a point that fails is marked failed,
-        with its reason."""
+        with its reason.
+
+        Parameters
+        ----------
+        indices : array_like of int
+            Flat indices of the points.
+        """
         indices = np.asarray(indices, dtype=np.int64)
         status = np.full(len(indices), OK, dtype=np.int8)
         reason = np.zeros(len(indices), dtype=np.int8)
@@ -195,6 +212,15 @@ def _release(key: str, ev: Evaluator) -> None:
 
 def evaluate_batch(key: str, plain: dict, indices) -> Batch:
     """Compute one batch in a worker (the study built and warmed at its first batch).
+
+    Parameters
+    ----------
+    key : str
+        The study's fingerprint (a worker keeps one study's evaluator).
+    plain : dict
+        The study's :meth:`~motionhyst.study.spec.Study.to_dict`.
+    indices : array_like of int
+        Flat indices of the points.
 
     Examples
     --------
@@ -311,6 +337,17 @@ def run_batches(study: StudyDefinition, batches: list, workers: int = 1, client=
 
     ``workers = 0`` computes in this process; ``workers >= 1`` in a local process pool;
     `client` (a ``distributed.Client``) on its cluster.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    batches : list of lists of int
+        The batches, each a list of flat indices.
+    workers : int
+        0: in this process; >= 1: a local process pool of that size.
+    client : distributed.Client, optional
+        A dask cluster's client to compute on instead.
 
     Examples
     --------

@@ -19,6 +19,11 @@ __all__ = ["to_netcdf_bytes", "to_table"]
 def to_table(ds) -> str:
     """CSV text: the axes' values under their keys (and the sampled keys), each output, status.
 
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The results (:func:`motionhyst.study.open_results`).
+
     Examples
     --------
     >>> import numpy as np, xarray as xr
@@ -55,6 +60,11 @@ def to_table(ds) -> str:
 
 def to_netcdf_bytes(ds) -> bytes:
     """The results as a netCDF-3 file's bytes (complex fields split into real and imaginary).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The results (:func:`motionhyst.study.open_results`).
 
     Examples
     --------

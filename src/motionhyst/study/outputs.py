@@ -26,6 +26,15 @@ __all__ = ["OUTPUTS", "Output", "Point", "register_output"]
 class Point:
     """One point of a study: a loop and the reference ``r = amplitude sin(2 pi f t)``.
 
+    Parameters
+    ----------
+    loop : Loop
+        The loop of the point's scenario keys.
+    amplitude : float
+        Reference amplitude [m].
+    frequency_hz : float
+        Reference frequency [Hz].
+
     Examples
     --------
     >>> from motionhyst import default_scenario
@@ -37,7 +46,7 @@ class Point:
     loop: Loop
     amplitude: float
     frequency_hz: float
-    _steady: SteadyState | None = field(default=None, repr=False)
+    _steady: SteadyState | None = field(default=None, init=False, repr=False)
 
     @property
     def steady(self) -> SteadyState:
@@ -76,7 +85,13 @@ class Output:
     description: str
 
     def evaluate(self, point: Point) -> dict:
-        """The fields at `point`."""
+        """The fields at `point`.
+
+        Parameters
+        ----------
+        point : Point
+            The point to evaluate.
+        """
         return self.function(point)
 
 
@@ -87,6 +102,15 @@ OUTPUTS: dict[str, Output] = {}
 def register_output(name: str, fields: dict[str, str], description: str
                     ) -> Callable[[Callable[[Point], dict]], Callable[[Point], dict]]:
     """Register ``function(point) -> {field: value}`` as the output `name` (a decorator).
+
+    Parameters
+    ----------
+    name : str
+        The output's name (a study file's ``outputs`` entry).
+    fields : dict of str to str
+        Field name to its kind, ``"float"`` or ``"complex"``.
+    description : str
+        One line for the documentation and ``study --help``.
 
     Examples
     --------

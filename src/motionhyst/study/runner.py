@@ -46,6 +46,17 @@ class RunReport:
     """What one run did: ``points`` in the study, ``computed`` by this run, ``failed`` in the
     store (points that did not converge or whose loop could not be built), ``seconds``.
 
+    Parameters
+    ----------
+    points : int
+        Points in the study.
+    computed : int
+        Points this run computed.
+    failed : int
+        Points marked failed in the store.
+    seconds : float
+        Wall time of the run [s].
+
     Examples
     --------
     >>> r = RunReport(points=400, computed=100, failed=2, seconds=4.0)
@@ -74,6 +85,21 @@ class RunReport:
 @dataclass
 class Estimate:
     """What a study costs before it runs (:func:`estimate_study`).
+
+    Parameters
+    ----------
+    points : int
+        Points of the study.
+    missing : int
+        Points not computed yet (in the store given).
+    seconds_per_point : float
+        Measured time of one point on one core [s].
+    workers : int
+        Processes the run would use.
+    disk_bytes : int
+        Size of the finished store [bytes].
+    memory_bytes : int
+        Memory the run holds at once [bytes].
 
     Examples
     --------
@@ -121,6 +147,15 @@ def _bytes_per_point(study: StudyDefinition) -> int:
 def estimate_study(study: StudyDefinition, workers: int = 1,
                    store: str | Path | None = None) -> Estimate:
     """Points, time per point (measured on a few points), core-hours, disk and memory.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    workers : int
+        Processes the run would use.
+    store : str or Path, optional
+        An existing store: only its missing points are counted.
 
     Examples
     --------
@@ -219,6 +254,11 @@ def run_study(study: StudyDefinition, store: str | Path, workers: int | None = N
 def run_lock(path: Path) -> Iterator[None]:
     """Hold the lock of the store at `path` (a second run is refused while it is held): two
     runs writing one store at once would undo each other's chunks.
+
+    Parameters
+    ----------
+    path : Path
+        The store's folder.
 
     Examples
     --------

@@ -67,6 +67,15 @@ class StudyError(ValueError):
 def set_key(data: dict, key: str, value: float) -> None:
     """Set the dotted scenario `key` (``"hysteresis.k"``) of the nested `data` to `value`.
 
+    Parameters
+    ----------
+    data : dict
+        The nested scenario dictionary, changed in place.
+    key : str
+        Dotted key, ``"hysteresis.k"``.
+    value : float
+        The value.
+
     Examples
     --------
     >>> d = {"hysteresis": {"model": "jenkins", "k": 20.0}}

@@ -83,6 +83,13 @@ class StudyStore:
     """A zarr store of one study's results (create with :meth:`create`, reopen with
     :meth:`open`).
 
+    Parameters
+    ----------
+    path : Path
+        The store's folder.
+    group : zarr.Group
+        The opened store.
+
     Examples
     --------
     >>> import tempfile, tomllib
@@ -106,7 +113,17 @@ class StudyStore:
 
     @classmethod
     def create(cls, path: str | Path, study: StudyDefinition, version: str = "") -> StudyStore:
-        """A new store for `study` at `path` (which must not exist)."""
+        """A new store for `study` at `path` (which must not exist).
+
+        Parameters
+        ----------
+        path : str or Path
+            Where to create it.
+        study : Study
+            The study whose results it holds.
+        version : str
+            The package version, kept as an attribute.
+        """
         import zarr
 
         path = Path(path)
@@ -149,7 +166,13 @@ class StudyStore:
 
     @classmethod
     def open(cls, path: str | Path) -> StudyStore:
-        """An existing store; :class:`StudyError` if `path` is not a study's store."""
+        """An existing store; :class:`StudyError` if `path` is not a study's store.
+
+        Parameters
+        ----------
+        path : str or Path
+            The store's folder.
+        """
         import zarr
 
         path = Path(path)
@@ -158,7 +181,13 @@ class StudyStore:
         return cls(path, zarr.open_group(str(path), mode="r+", zarr_format=3))
 
     def matches(self, study: StudyDefinition) -> bool:
-        """Whether the store holds `study` (same scenario, axes, samples and outputs)."""
+        """Whether the store holds `study` (same scenario, axes, samples and outputs).
+
+        Parameters
+        ----------
+        study : Study
+            The study to compare with.
+        """
         return self.group.attrs.get("fingerprint") == study.fingerprint()
 
     @property
@@ -171,7 +200,13 @@ class StudyStore:
         return np.asarray(self.group["status"][...]).ravel()
 
     def missing(self, order: NDArray[np.int64] | None = None) -> NDArray[np.int64]:
-        """Flat indices of the points not computed yet, in `order` (default C order)."""
+        """Flat indices of the points not computed yet, in `order` (default C order).
+
+        Parameters
+        ----------
+        order : ndarray of int, optional
+            The order to return them in (default C order).
+        """
         st = self.status()
         if order is None:
             return np.flatnonzero(st == MISSING)
@@ -374,6 +409,11 @@ class ChunkWriter:
 def is_study_store(path: str | Path) -> bool:
     """Whether `path` is a folder holding a study's zarr store.
 
+    Parameters
+    ----------
+    path : str or Path
+        The folder.
+
     Examples
     --------
     >>> import tempfile
@@ -389,6 +429,11 @@ def is_study_store(path: str | Path) -> bool:
 
 def remove_store(path: str | Path) -> None:
     """Delete a study's store (refuses anything else).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store's folder.
 
     Examples
     --------
@@ -407,6 +452,11 @@ def remove_store(path: str | Path) -> None:
 def field_names(ds) -> list[str]:
     """The output fields of a study's Dataset, in the order of the study's outputs.
 
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The results (:func:`open_results`).
+
     Examples
     --------
     >>> import xarray as xr
@@ -422,6 +472,11 @@ def open_results(path: str | Path):
     """The results of a study store as an :class:`xarray.Dataset` (loaded in memory).
 
     Points not computed yet and points that failed are NaN; ``status`` says which.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store's folder.
 
     Examples
     --------

@@ -97,6 +97,11 @@ class StudySummary:
     def plot(self, ax=None):
         """The worst case of each field along ``frequency_hz`` (a line per field).
 
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into; default: a new figure.
+
         Returns
         -------
         matplotlib.figure.Figure
@@ -209,6 +214,11 @@ def failure_reasons(ds) -> dict:
 
 def summarize(ds) -> StudySummary:
     """The summary of a study's results (:func:`motionhyst.study.open_results`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The results (:func:`motionhyst.study.open_results`).
 
     Examples
     --------
