@@ -141,7 +141,8 @@ class Estimate:
 
 
 def _bytes_per_point(study: StudyDefinition) -> int:
-    return 1 + sum(16 if k == "complex" else 8 for k in fields_of(study.outputs).values())
+    # the status and the reason byte, then the fields
+    return 2 + sum(16 if k == "complex" else 8 for k in fields_of(study.outputs).values())
 
 
 def estimate_study(study: StudyDefinition, workers: int = 1,
