@@ -44,7 +44,7 @@ TERMS = {1: "viscous", 2: "acceleration", 3: "jerk", 4: "snap", 5: "crackle"}
 
 @dataclass(frozen=True)
 class StageInverse:
-    """The Taylor coefficients ``c1 ... c5`` of ``1 / P2(s)`` about ``s = 0``.
+    """The Taylor coefficients c1 to c5 of ``1 / P2(s)`` about ``s = 0``.
 
     Parameters
     ----------
