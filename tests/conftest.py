@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import signal
+
 import pytest
 
 from motionhyst.controllers.leadlag import LeadLagLowpass
@@ -13,6 +15,12 @@ from motionhyst.plants.two_mass import TwoMassStage
 # the tests check the commands' stderr: no notice of the first compilation in this session
 # (tests/test_startup.py checks the notice in fresh processes)
 quiet_compilation()
+
+# a suite started in the background by a non-interactive shell (`make test &`) inherits SIGINT
+# ignored, and so would every command the tests start: Python then installs no Ctrl-C handler
+# in them and the tests that send a Ctrl-C would see the command run on (exit 0); a terminal's
+# Ctrl-C reaches a command whose SIGINT is at its default, so the suite restores that
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 # Table I of the paper
 M1, M2, B, K_STAGE = 5.0, 17.5, 90.0, 7.4e7
