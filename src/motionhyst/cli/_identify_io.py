@@ -39,6 +39,17 @@ def _evaluations(text: str) -> int:
     return v
 
 
+def _window(text: str) -> int:
+    """argparse type: an initialisation window, 2 to 100000 samples."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 2 <= v <= 100000:
+        raise argparse.ArgumentTypeError(f"must be from 2 to 100000 samples, got {v}")
+    return v
+
+
 def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     """The options of input-output identification."""
     from motionhyst.hysteresis import MODELS
@@ -57,6 +68,11 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records: each record starts at rest (default: its "
                         "initial velocity, and position where a spring holds the stage, are "
                         "estimated)")
+    q.add_argument("--init-window", type=_window, metavar="N",
+                   help="input-output records: each record's initial state (and a floating "
+                        "stage's position offset) is set from its first N samples as the fit "
+                        "runs, as predict --init-from --init-window N sets it (the EMPS "
+                        "benchmark's convention: 20); only the force offset is estimated")
     q.add_argument("--max-evaluations", type=_evaluations, metavar="N",
                    help="input-output records: the search's budget of model evaluations, "
                         "starts and refinement together (default: the starts', then at most "
@@ -84,7 +100,8 @@ def check_not_input_output(args: argparse.Namespace) -> None:
                           ("--periodic", args.periodic or None), ("--nu", args.nu),
                           ("--save", args.save), ("--output", args.output),
                           ("--offset", args.offset), ("--from-rest", args.from_rest or None),
-                          ("--max-evaluations", args.max_evaluations)):
+                          ("--max-evaluations", args.max_evaluations),
+                          ("--init-window", args.init_window)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
                              f"only")
@@ -124,16 +141,20 @@ def run_input_output(args: argparse.Namespace) -> int:
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     if model == "bouc-wen" and (args.offset not in (None, "none") or args.from_rest
-                                or args.max_evaluations is not None):
-        raise UsageError("motionhyst identify: --offset, --from-rest and --max-evaluations "
-                         "apply to the element links (not yet to --model bouc-wen); give "
-                         "--offset none")
+                                or args.max_evaluations is not None
+                                or args.init_window is not None):
+        raise UsageError("motionhyst identify: --offset, --from-rest, --init-window and "
+                         "--max-evaluations apply to the element links (not yet to --model "
+                         "bouc-wen); give --offset none")
+    if args.init_window is not None and (args.periodic or args.from_rest):
+        raise UsageError("motionhyst identify: --init-window sets the state of records from a "
+                         "start; not with --periodic or --from-rest")
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
     extras = ({} if model == "bouc-wen" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
-               "max_evaluations": args.max_evaluations})
+               "max_evaluations": args.max_evaluations, "init_window": args.init_window})
     fit = identify_io(records, model, periodic=args.periodic, nu=nu,
                       n_elements=args.elements or 3, plant=plant, output=args.output or "y2",
                       **extras)
@@ -148,7 +169,10 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result)
         return 0
-    kind = "periodic steady state" if fit.periodic else "from rest"
+    kind = ("periodic steady state" if fit.periodic else "from rest"
+            if args.from_rest or model == "bouc-wen"
+            else f"state set from the first {args.init_window} samples"
+            if args.init_window is not None else "initial state estimated")
     stage = (f"Two-mass stage ({args.output or 'y2'} measured)" if plant == "two-mass"
              else "Stage")
     print(f"{stage} and {model} link identified from {len(records)} input-output record(s) "

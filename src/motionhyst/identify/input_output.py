@@ -184,8 +184,8 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
                 nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
                 max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None,
                 plant: str = "mass-spring-damper", output: str = "y2", offset: str = "auto",
-                from_rest: bool = False, max_evaluations: int | None = None
-                ) -> IOIdentification:
+                from_rest: bool = False, max_evaluations: int | None = None,
+                init_window: int | None = None) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -250,6 +250,13 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     max_evaluations : int, optional
         The search's whole budget of model evaluations (starts and refinement;
         Bouc-Wen: the refinement's).
+    init_window : int, optional
+        The element links: each record's initial state (and a floating stage's
+        position offset) is not estimated but set, at every step of the search,
+        from its first `init_window` samples as ``predict --init-from
+        --init-window`` sets it (:func:`~motionhyst.identify.io_predict.state_from_window`;
+        the EMPS benchmark's convention, 20): the model is fitted the way it is
+        scored.  Only the force offset is estimated with it (a floating stage).
 
     Returns
     -------
@@ -287,11 +294,20 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
                          f"{', '.join(PLANTS)}")
     if output not in TwoMass.OUTPUTS:
         raise ValueError(f"unknown output {output!r}; expected y2 or y1")
+    if init_window is not None:
+        if not (isinstance(init_window, int | np.integer) and init_window >= 2):
+            raise ValueError(f"the initialisation window must be at least 2 samples, got "
+                             f"{init_window}")
+        short = [rec.name for rec in records if rec.y.size <= 2 * init_window]
+        if short:
+            raise ValueError(f"{short[0]}: too short for an initialisation window of "
+                             f"{init_window} samples")
     if model != "bouc-wen":
         return identify_elements_io(records, model, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
-                                    plant, output, offset, from_rest, max_evaluations)
-    if offset not in ("auto", "none") or from_rest:
+                                    plant, output, offset, from_rest, max_evaluations,
+                                    int(init_window) if init_window is not None else None)
+    if offset not in ("auto", "none") or from_rest or init_window is not None:
         raise ValueError("offsets and initial states are estimated with the element links, "
                          "not yet with Bouc-Wen: use offset 'none'")
     if plant == "mass-damper":

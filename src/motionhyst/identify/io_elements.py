@@ -26,6 +26,7 @@ from motionhyst.hysteresis import Hysteresis, Parameter
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.identify.io_checks import judge_fit, plausibility_warnings
 from motionhyst.identify.io_offsets import Extras, initial_state
+from motionhyst.identify.io_predict import run_from_state, state_from_window
 from motionhyst.identify.io_records import short_records
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
@@ -199,7 +200,7 @@ class _ElementProblem:
                  scale: NDArray[np.float64], free: NDArray[np.bool_] | None = None,
                  fixed: NDArray[np.float64] | None = None, exact: bool = True,
                  plant: MassSpringDamper | TwoMass | None = None,
-                 extras: Extras | None = None):
+                 extras: Extras | None = None, window: int | None = None):
         self.records, self.periodic, self.r = records, periodic, substeps
         self.layout, self.y_scale = layout, y_scale
         self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
@@ -215,6 +216,7 @@ class _ElementProblem:
         self.scale = scale
         self.free = np.ones(self.log.size, bool) if free is None else free
         self.fixed = np.zeros(self.log.size) if fixed is None else fixed
+        self.window = window  # each record's state set from its first samples (None: extras)
         self.fine = [fine_input(rec.u, substeps, periodic) for rec in records]
         # the upsampling is linear: a force offset shifts the fine input by itself times this
         self.fine_one = ([fine_input(np.ones(rec.u.size), substeps, periodic)
@@ -274,6 +276,8 @@ class _ElementProblem:
         def one(i):
             rec = self.records[i]
             fine = self.fine[i] if self.fine_one is None else self.fine[i] - u0 * self.fine_one[i]
+            if self.window is not None:
+                return self._from_window(mech, stepping, k_link, rec, rec.u - u0, fine, dparams)
             y, sy = simulate_elements(mech, stepping, rec.u - u0, rec.fs, self.r,
                                       periodic=self.periodic, k_link=k_link, upsampled=fine,
                                       dparams=dparams,
@@ -285,6 +289,41 @@ class _ElementProblem:
             with ThreadPoolExecutor(max_workers=min(len(which), os.cpu_count() or 1)) as pool:
                 return list(pool.map(one, which))
         return [one(i) for i in which]
+
+    def _from_window(self, mech, stepping, k_link, rec, u, fine, dparams):
+        """A record run from the state its first :attr:`window` samples set
+        (:func:`~motionhyst.identify.io_predict.state_from_window`), as ``predict
+        --init-from`` runs it; the sensitivities include the state's own dependence on
+        the parameters (its least squares over the window, to first order)."""
+        p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
+                                   self.window)
+        y, sy = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine, dparams)
+        if dparams is None or sy.shape[1] == 0:
+            return y, sy
+        cols = []
+        for dp, dv in ((1.0, 0.0), (0.0, 1.0)):
+            if dp and mech.floating:
+                cols.append(np.ones_like(y))
+                continue
+            step = EXTRA_FD_STEP * (dp * max(abs(p), self.y_scale)
+                                    + dv * max(abs(vel), self.y_scale * rec.fs / self.window))
+            y2, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p + dp * step,
+                                   vel + dv * step, fine)
+            cols.append((y2 - y) / step)
+        S = np.column_stack(cols)
+        w = self.window
+        d_state = -np.linalg.lstsq(S[:w], sy[:w], rcond=None)[0]
+        return y, sy + S @ d_state
+
+    def window_states(self, v: NDArray[np.float64]) -> list[tuple[float, float]]:
+        """Each record's ``(position, velocity)`` set from its window at the parameters
+        `v`."""
+        k, nl = self.n_plant, self.n_link
+        u0 = self.extras.split(v[k + nl:])[0]
+        link = self.layout.build(v[k:k + nl])
+        mech = self.plant.mechanics(v[:k])
+        return [state_from_window(mech, link.time_stepping(), link.initial_stiffness, rec.u - u0,
+                                  rec.y, rec.fs, self.r, self.window) for rec in self.records]
 
     def _measured(self, rec) -> NDArray[np.float64]:
         return rec.y - np.mean(rec.y) if self.centre else rec.y
@@ -434,7 +473,7 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t_start,
                          start_nfev, plant="mass-spring-damper", output="y2", offset="none",
-                         from_rest=True, budget=None) -> IOIdentification:
+                         from_rest=True, budget=None, init_window=None) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -525,7 +564,7 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     n_plant = len(structure.PARAMETERS)
     floating = structure.mechanics().floating
     extras = Extras.choose(offset, floating=floating, periodic=periodic, from_rest=from_rest,
-                           n_records=len(records))
+                           n_records=len(records), window=init_window is not None)
     scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale)])
     rate = np.concatenate([np.zeros(n_plant, bool),
                            [par.unit == _VELOCITY for par, _ in layout._values()],
@@ -540,7 +579,7 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
 
     def held(p0: NDArray[np.float64], nfev: int):
         prob = _ElementProblem(short, periodic, r, layout, y_scale, short_scale, ~short_rate,
-                               plant=structure, extras=short_extras)
+                               plant=structure, extras=short_extras, window=init_window)
         prob.fixed = prob.variables(p0)
         sol = prob.solve(prob.fixed[~short_rate], 1e-6, nfev)
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
@@ -571,13 +610,13 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         full_start[extras.names.index(name if len(records) == 1 or name == "input_offset"
                                       else f"{name}[0]")] = best[1][n_base + j]
     prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
-                           extras=extras)
+                           extras=extras, window=init_window)
     q0 = prob.variables(np.concatenate([best[1][:n_base], full_start]))
     if plant == "mass-damper" and not getattr(layout.cls, "rigid", False):
         # the rigid slider is every friction link's limit: its fit is a start for theirs
         seed, used = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
                                  start_nfev, plant, output, offset, from_rest, layout, y_scale,
-                                 v_scale, extras, force)
+                                 v_scale, extras, force, init_window)
         n_eval += used
         if seed is not None:
             q_seed = prob.variables(seed)
@@ -615,13 +654,22 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
             not_ident[name] = why
             std[name] = None
     u0, y0, init = extras.split(v[n_base:])
+    initial_state_out = {name: init[:, a].tolist() for a, name in enumerate(extras.initial)}
+    if init_window is not None:  # the window's state: a floating stage's position is its offset
+        states = np.array(prob.window_states(v))
+        if floating:
+            y0 = states[:, 0]
+            initial_state_out = {"v0": states[:, 1].tolist()}
+        else:
+            initial_state_out = {"y0": states[:, 0].tolist(), "v0": states[:, 1].tolist()}
     fitted = prob.plant.with_parameters(v[:n_plant])
     if extras.input_offset:
         fitted.force_offset = -u0  # the offset of the measured force, on the plant
     link = layout.build(v[n_plant:n_base])
     judge_fit(float(np.sqrt(rss / res.size)), records, prob._split_rows(res, measured=True),
               _linear_rms(records, structure, r, periodic, extras.output_offset),
-              OpenLoop(prob.plant.with_parameters(v[:n_plant]), link), extras.output_offset)
+              OpenLoop(prob.plant.with_parameters(v[:n_plant]), link),
+              extras.output_offset or (init_window is not None and floating))
     bound = [nm for nm, x, lin, sc in zip(names[:n_base], v[:n_base], ~prob.log[:n_base],
                                           scale[:n_base], strict=True)
              if lin and nm not in not_ident and abs(x) <= 1e-9 * sc]
@@ -644,8 +692,7 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
                  f"at most {remaining} evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r,
         extra={"offsets": {"input": u0, "output": y0.tolist()},
-               "initial_state": {name: init[:, a].tolist()
-                                 for a, name in enumerate(extras.initial)},
+               "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0)})
 
 
@@ -665,7 +712,7 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
 
 
 def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, output,
-                offset, from_rest, layout, y_scale, v_scale, extras, force):
+                offset, from_rest, layout, y_scale, v_scale, extras, force, init_window=None):
     """A positioning axis's friction link started from the Coulomb link's fit: the stage, the
     offsets and initial states as fitted, the link's forces together its slip force, slipping
     after 1e-5 of the output's RMS (its rigid limit); None if that fit fails."""
@@ -673,7 +720,8 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
 
     try:
         fit = identify_elements_io(records, "coulomb", periodic, substeps, tol, max_nfev, 1,
-                                   t_start, start_nfev, plant, output, offset, from_rest)
+                                   t_start, start_nfev, plant, output, offset, from_rest,
+                                   init_window=init_window)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0
     fc = fit.estimates["link.fc"]

@@ -64,7 +64,7 @@ class Extras:
 
     @classmethod
     def choose(cls, offset: str, *, floating: bool, periodic: bool, from_rest: bool,
-               n_records: int) -> Extras:
+               n_records: int, window: bool = False) -> Extras:
         """What to estimate for the `offset` choice (:data:`OFFSET_CHOICES`).
 
         ``auto`` is what records can tell apart: ``both`` for a floating stage's
@@ -73,7 +73,11 @@ class Extras:
         make it drift), the output offset for a stage on a spring (a force
         offset only moves it by ``u0 / k``: the same as a position offset but
         for the link's nonlinearity).  Periodic records have no initial state;
-        `from_rest` fixes it at rest.
+        `from_rest` fixes it at rest.  With `window` each record's initial state (and a
+        floating stage's position offset, the same thing) is set from its first samples
+        as the fit runs (:func:`~motionhyst.identify.io_predict.state_from_window`):
+        only the force offset is estimated (``auto``, ``input``, ``both``: on a
+        floating stage).
 
         Parameters
         ----------
@@ -87,14 +91,27 @@ class Extras:
             The records start at rest (no initial state estimated).
         n_records : int
             Number of records.
+        window : bool
+            The records' states are set from their first samples.
 
         Returns
         -------
         Extras
+
+        Raises
+        ------
+        ValueError
+            An unknown choice; a window on periodic records or with `from_rest`.
         """
         if offset not in OFFSET_CHOICES:
             raise ValueError(f"unknown offset choice {offset!r}; expected one of "
                              f"{', '.join(OFFSET_CHOICES)}")
+        if window:
+            if periodic or from_rest:
+                raise ValueError("an initialisation window sets the state of records from a "
+                                 "start: not with periodic records or from rest")
+            return cls(floating and offset in ("auto", "input", "both"), False, (),
+                       int(n_records))
         if offset == "auto":  # what the records can tell apart
             offset = "both" if floating and not periodic else "none" if floating else "output"
         if periodic and floating and offset != "none":

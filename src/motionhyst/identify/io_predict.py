@@ -22,7 +22,8 @@ from scipy.optimize import least_squares
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.time.openloop import OpenLoop, check_record, sampling_rate, simulate_elements
 
-__all__ = ["INIT_WINDOW", "WindowPrediction", "predict_from_window"]
+__all__ = ["INIT_WINDOW", "WindowPrediction", "predict_from_window", "run_from_state",
+           "state_from_window"]
 
 #: The benchmark's initialisation window [samples]
 INIT_WINDOW = 20
@@ -100,18 +101,94 @@ class WindowPrediction:
         return fig
 
 
-def _run(system: OpenLoop, u, fs, r, position, velocity):
-    mech = system.plant.mechanics()
-    st = Stepping.empty() if system.hysteresis is None else system.hysteresis.time_stepping()
+def run_from_state(mech, stepping: Stepping, k_link: float, u, fs: float, r: int,
+                   position: float, velocity: float, upsampled=None, dparams=None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A record simulated from the force, the stage moving as one body at the first sample.
+
+    Parameters
+    ----------
+    mech : Mechanics
+        The plant (:meth:`~motionhyst.plants.registry.Plant.mechanics`).
+    stepping : Stepping
+        The link's rows (empty: no link); the link starts relaxed.
+    k_link : float
+        The link's initial stiffness [N/m].
+    u : ndarray
+        Force [N] at `fs` [Hz].
+    fs : float
+        Sampling rate [Hz].
+    r : int
+        Integration steps per sample.
+    position, velocity : float
+        The first sample's position [m] (a floating stage's: the offset added to
+        its output) and velocity [m/s].
+    upsampled, dparams : ndarray, optional
+        As for :func:`~motionhyst.time.openloop.simulate_elements`.
+
+    Returns
+    -------
+    y, dy : ndarray
+        The position [m] and its sensitivities (as
+        :func:`~motionhyst.time.openloop.simulate_elements`).
+
+    Examples
+    --------
+    >>> from motionhyst.time.openloop import MassSpringDamper
+    >>> mech = MassSpringDamper(2.0, 0.0, 0.0).mechanics()
+    >>> y, _ = run_from_state(mech, Stepping.empty(), 0.0, np.zeros(3), 10.0, 4, 1.0, 0.5)
+    >>> y.round(6).tolist()
+    [1.0, 1.05, 1.1]
+    """
     n = mech.n
     x0 = np.zeros(2 * n)
     floating = mech.floating
     x0[n:] = velocity
     if not floating:
         x0[:n] = position
-    k_link = system.hysteresis.initial_stiffness if system.hysteresis is not None else 0.0
-    y, _ = simulate_elements(mech, st, u, fs, r, periodic=False, k_link=k_link, x0=x0)
-    return y + position if floating else y
+    y, dy = simulate_elements(mech, stepping, u, fs, r, periodic=False, k_link=k_link, x0=x0,
+                              upsampled=upsampled, dparams=dparams)
+    return (y + position if floating else y), dy
+
+
+def state_from_window(mech, stepping: Stepping, k_link: float, u, y, fs: float, r: int,
+                      window: int = INIT_WINDOW) -> tuple[float, float]:
+    """The stage's position and velocity at the first sample that best explain its first
+    `window` positions (least squares), the model run from the force alone.
+
+    Parameters
+    ----------
+    mech, stepping, k_link, fs, r
+        As for :func:`run_from_state`.
+    u, y : ndarray
+        The record's force [N] and measured position [m] (at least `window` samples).
+    window : int
+        Samples that set the state, at least 2.
+
+    Returns
+    -------
+    position, velocity : float
+        [m] and [m/s].
+
+    Examples
+    --------
+    >>> from motionhyst.time.openloop import MassSpringDamper
+    >>> mech = MassSpringDamper(2.0, 0.0, 0.0).mechanics()
+    >>> y = 1e-3 + 0.004 * np.arange(20) / 1000.0
+    >>> p, v = state_from_window(mech, Stepping.empty(), 0.0, np.zeros(20), y, 1000.0, 2)
+    >>> round(p, 9), round(v, 9)
+    (0.001, 0.004)
+    """
+    yw = np.asarray(y[:window], dtype=float)
+    uw = np.asarray(u[:window], dtype=float)
+    v_start = (yw[-1] - yw[0]) * fs / (window - 1)
+    scale_y = max(float(np.ptp(yw)), 1e-12 * max(1.0, abs(float(yw[0]))), 1e-15)
+
+    def res(p):
+        return (run_from_state(mech, stepping, k_link, uw, fs, r, p[0], p[1])[0] - yw) / scale_y
+
+    sol = least_squares(res, [yw[0], v_start], x_scale=[scale_y, scale_y * fs / window])
+    return float(sol.x[0]), float(sol.x[1])
 
 
 def predict_from_window(system: OpenLoop, t, force, displacement,
@@ -147,7 +224,8 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     >>> true = OpenLoop(MassSpringDamper(95.0, 200.0, 0.0), Coulomb(fc=20.0))
     >>> t = np.arange(2000) / 1000.0
     >>> u = 80 * np.sin(2 * np.pi * 0.5 * t) + 25.0
-    >>> y = _run(true, u, 1000.0, 20, 0.01, 0.005)
+    >>> y, _ = run_from_state(true.plant.mechanics(), true.hysteresis.time_stepping(),
+    ...                       true.hysteresis.initial_stiffness, u, 1000.0, 20, 0.01, 0.005)
     >>> pred = predict_from_window(true, t, u, y, window=20)
     >>> round(pred.initial_state["velocity"], 6), pred.rmse < 1e-9
     (0.005, True)
@@ -165,16 +243,11 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
         raise ValueError("this link cannot be simulated")
     fs = sampling_rate(tt)
     r = substeps or system.default_substeps(fs)
-    yw = y[:window]
-    v_start = (yw[-1] - yw[0]) * fs / (window - 1)
-    scale_y = max(float(np.ptp(yw)), 1e-12 * max(1.0, abs(float(yw[0]))), 1e-15)
-
-    def res(p):
-        return (_run(system, u[:window], fs, r, p[0], p[1]) - yw) / scale_y
-
-    sol = least_squares(res, [yw[0], v_start], x_scale=[scale_y, scale_y * fs / window])
-    position, velocity = (float(x) for x in sol.x)
-    yhat = _run(system, u, fs, r, position, velocity)
+    mech = system.plant.mechanics()
+    st = Stepping.empty() if system.hysteresis is None else system.hysteresis.time_stepping()
+    k_link = system.hysteresis.initial_stiffness if system.hysteresis is not None else 0.0
+    position, velocity = state_from_window(mech, st, k_link, u, y, fs, r, window)
+    yhat, _ = run_from_state(mech, st, k_link, u, fs, r, position, velocity)
     if not np.all(np.isfinite(yhat)):
         raise ValueError("the model's prediction is not finite")
     e = yhat[window:] - y[window:]
