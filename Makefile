@@ -46,10 +46,13 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/engine.py
 	$(BIN)/python benchmarks/stability.py
 
-# the Bouc-Wen hysteretic benchmark end to end (about a minute; kept out of make test)
+# the public benchmarks end to end (kept out of make test): Bouc-Wen (about a minute) and
+# EMPS (a few minutes; scored on DATA_EMPS_PULSES.mat when EMPS_DATA holds it)
 BENCHMARK_DATA ?= ../shared/benchmarks/bouc-wen
+EMPS_DATA ?= ../shared/benchmarks/emps
 benchmark: $(STAMP)
 	$(BIN)/motionhyst benchmark bouc-wen --data $(BENCHMARK_DATA)
+	$(BIN)/motionhyst benchmark emps --data $(EMPS_DATA)
 
 clean:
 	rm -rf $(VENV) out docs/_build docs/_generated docs/api docs/cli docs/examples

@@ -1,9 +1,14 @@
-"""``motionhyst benchmark bouc-wen``: the Bouc-Wen hysteretic benchmark in one command."""
+"""``motionhyst benchmark bouc-wen | emps``: a public benchmark in one command.
+
+``bouc-wen``: Noel and Schoukens' hysteretic benchmark (simulated).  ``emps``:
+Janot, Gautier and Brunot's measured positioning axis with friction.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from motionhyst.cli._common import UsageError, g, print_json, table
 
@@ -14,22 +19,51 @@ __all__ = []
 def add_parser(sub) -> None:
     """Add the ``benchmark`` command to the subparsers `sub`."""
     q = sub.add_parser("benchmark", help="run a public benchmark end to end (bouc-wen: "
-                       "Noel & Schoukens' hysteretic benchmark)")
-    q.add_argument("name", choices=["bouc-wen"], help="the benchmark")
+                       "Noel & Schoukens' hysteretic benchmark; emps: Janot, Gautier & "
+                       "Brunot's measured positioning axis)")
+    q.add_argument("name", choices=["bouc-wen", "emps"], help="the benchmark")
     q.add_argument("--data", metavar="DIR",
-                   help="folder with the official test sets uval_/yval_multisine.mat and "
-                        "uval_/yval_sinesweep.mat (default: ../shared/benchmarks/bouc-wen "
-                        "when it exists)")
-    q.add_argument("--seed", type=int, default=0,
-                   help="seed of the training multisines and noise (default 0)")
+                   help="bouc-wen: folder with the official test sets uval_/yval_multisine.mat "
+                        "and uval_/yval_sinesweep.mat; emps: folder with DATA_EMPS.mat and, "
+                        "if downloaded, the test record DATA_EMPS_PULSES.mat (default: "
+                        "../shared/benchmarks/NAME when it exists)")
+    q.add_argument("--seed", type=int, default=None,
+                   help="bouc-wen: seed of the training multisines and noise (default 0)")
+    q.add_argument("--periods", metavar="A-B", type=_periods,
+                   help="emps without the test record: the periods of DATA_EMPS to identify "
+                        "from (default 1-2: validated on periods 3-4; the reference repeats "
+                        "every 6240 samples)")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
 
 
+def _periods(text: str) -> tuple[int, int]:
+    first, sep, last = text.partition("-")
+    try:
+        a, b = int(first), int(last if sep else first)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be A-B (whole periods, e.g. 1-2), got "
+                                         f"{text!r}") from None
+    if not 1 <= a <= b:
+        raise argparse.ArgumentTypeError(f"must be A-B with 1 <= A <= B, got {text!r}")
+    return a, b
+
+
 def run(args: argparse.Namespace) -> int:
+    """Run the benchmark named and print its table (or JSON)."""
+    if args.name == "emps":
+        return run_emps(args)
+    if args.periods is not None:
+        raise UsageError("motionhyst benchmark: --periods applies to emps only")
+    return run_bouc_wen(args)
+
+
+def run_bouc_wen(args: argparse.Namespace) -> int:
     """Make training data, identify, score on the official test sets, print the table."""
     from motionhyst.identify.benchmark import default_data_dir, run_benchmark
 
+    if args.seed is None:
+        args.seed = 0
     data = args.data if args.data is not None else default_data_dir()
     if data is None:
         raise UsageError("motionhyst benchmark: no test sets: give --data DIR (the folder "
@@ -60,4 +94,53 @@ def run(args: argparse.Namespace) -> int:
     rows += [[p["method"], p["multisine_rmse"], "-", "-", "-"] for p in res["published"]]
     print(table(["method", "multisine [m]", "sine sweep [m]", "identify [s]", "test sims [s]"],
                 rows))
+    return 0
+
+
+def _emps_record(path: Path, name: str):
+    from motionhyst.identify.emps import COLUMNS, DRIVE_GAIN
+    from motionhyst.identify.input_output import IORecord
+    from motionhyst.io.records import read_record
+
+    data = read_record(path, ("time", "force", "displacement"), columns=COLUMNS,
+                       scale={"force": DRIVE_GAIN})
+    return IORecord(data[:, 0], data[:, 1], data[:, 2], name)
+
+
+def run_emps(args: argparse.Namespace) -> int:
+    """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
+    from motionhyst.identify.emps import ESTIMATION_FILE, TEST_FILE, run_emps
+
+    if args.seed is not None:
+        raise UsageError("motionhyst benchmark emps: --seed applies to bouc-wen only (the EMPS "
+                         "records are measured)")
+    if args.data is not None:
+        data = Path(args.data)
+    else:
+        data = Path("..") / "shared" / "benchmarks" / "emps"
+        if not data.is_dir():
+            raise UsageError("motionhyst benchmark emps: give --data DIR (the folder with "
+                             "DATA_EMPS.mat; ../shared/benchmarks/emps does not exist)")
+    if not data.is_dir():
+        raise UsageError(f"motionhyst benchmark emps: --data {data}: no such folder")
+    est_path, test_path = data / ESTIMATION_FILE, data / TEST_FILE
+    if not est_path.is_file():
+        raise UsageError(f"motionhyst benchmark emps: {data} has no {ESTIMATION_FILE} (the "
+                         f"benchmark's estimation record)")
+    estimation = _emps_record(est_path, ESTIMATION_FILE.removesuffix(".mat"))
+    test = (_emps_record(test_path, TEST_FILE.removesuffix(".mat"))
+            if test_path.is_file() else None)
+    if test is not None and args.periods is not None:
+        raise UsageError(f"motionhyst benchmark emps: --periods splits DATA_EMPS when there is "
+                         f"no test record; {test_path} is there")
+
+    def say(msg: str) -> None:
+        if not args.json:
+            print(f"  {msg}", file=sys.stderr, flush=True)
+
+    res = run_emps(estimation, test, periods=args.periods or (1, 2), progress=say)
+    if args.json:
+        print_json(res.to_dict())
+        return 0
+    print(res)
     return 0

@@ -1,0 +1,412 @@
+"""The EMPS benchmark: a measured positioning axis with friction, identified and scored.
+
+A. Janot, M. Gautier and M. Brunot, "Data Set and Reference Models of EMPS",
+Workshop on Nonlinear System Identification Benchmarks, Eindhoven, 2019
+(nonlinearbenchmark.org, "EMPS").  A DC motor drives a load through a ball
+screw, in closed loop at 1 kHz; the records hold the controller's output
+``vir`` [V] (the force on the load is ``F = gtau vir``, ``gtau = 35.15065`` N/V)
+and the measured position ``qm`` [m].  The benchmark's reference model
+(inverse-dynamics least squares, IDIM-LS) is
+
+.. math::
+
+    M \\ddot q = F - F_v \\dot q - F_c \\operatorname{sign}(\\dot q) - OF,
+
+a mass with viscous and Coulomb friction and a force offset ``OF``.
+
+The benchmark's metric: the position simulated from the force alone (open
+loop) over the whole test record, the first :data:`INIT_WINDOW` samples used
+only to set the model's initial state; the RMS error in mm of ``qm`` over
+samples ``n >= 20`` and the fit ``100 (1 - ||y - yhat|| / ||y - mean(y)||)`` %
+over the same samples (:func:`motionhyst.identify.io_predict.predict_from_window`).
+
+:func:`run_emps` identifies each link model of :data:`MODELS` on a mass-damper
+(the axis has no spring; friction is the link) from the estimation record by
+simulation error, with the force offset and the record's initial state
+estimated, then scores it on the test record (``DATA_EMPS_PULSES.mat``, the
+same reference with force pulses added; published separately by the
+benchmark) or, without it, on the periods of the estimation record it was not
+identified from (the reference repeats every :data:`PERIOD` samples).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from motionhyst.identify.input_output import IORecord, identify_io
+from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
+
+__all__ = ["COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "INIT_WINDOW", "MODELS", "PERIOD",
+           "PUBLISHED", "REFERENCE_MODEL", "TEST_FILE", "EMPSBenchmark", "EMPSModel",
+           "reference_system", "run_emps", "score", "split_by_periods"]
+
+ESTIMATION_FILE = "DATA_EMPS.mat"
+"""The benchmark's estimation record."""
+TEST_FILE = "DATA_EMPS_PULSES.mat"
+"""The benchmark's test record (the estimation reference with 5 V force pulses added)."""
+COLUMNS = {"time": "t", "force": "vir", "displacement": "qm"}
+"""The records' variables: time [s], controller output [V], measured position [m]."""
+DRIVE_GAIN = 35.15065
+"""The drive's gain ``gtau`` [N/V]: the force on the load is ``gtau * vir``."""
+PERIOD = 6240
+"""Samples per period of the estimation record's reference ``qg``."""
+MODELS = ("coulomb", "jenkins", "dahl")
+"""Link models identified by default: friction of a positioning axis."""
+REFERENCE_MODEL = {"m": 95.1089, "c": 203.5034, "fc": 20.3935, "offset": -3.1648}
+"""The benchmark's IDIM-LS model: M [kg], Fv [N s/m], Fc [N], OF [N]."""
+PUBLISHED: tuple[tuple[str, float | None, float], ...] = (
+    ("dynoNet (neural, black box; Forgione and Piga 2021)", 2.64, 96.8),
+    ("IDIM-LS reference model, simulated open loop from rest with its offset", 9.2, 88.8),
+    ("best linear model (as cited by dynoNet)", None, 25.4),
+)
+"""Published simulation results on the test record: (method, RMSE [mm] or None, fit [%])."""
+
+
+def split_by_periods(record: IORecord, periods: tuple[int, int] = (1, 2),
+                     period: int = PERIOD, name: str = "DATA_EMPS"
+                     ) -> tuple[IORecord, IORecord]:
+    """Split a record into whole periods for estimation and the rest for validation.
+
+    Parameters
+    ----------
+    record : IORecord
+        The estimation record.
+    periods : (int, int)
+        First and last period (1-based) to estimate from; the periods before
+        and after them are validation records (the one that is not empty; a
+        split in the middle is refused, it would make two).
+    period : int
+        Samples per period.
+    name : str
+        The record's name in the pieces' names (``"DATA_EMPS periods 1-2"``).
+
+    Returns
+    -------
+    estimation, validation : IORecord
+        Named after their periods (the last one counted even when it is not whole).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(24841) * 1e-3
+    >>> est, val = split_by_periods(IORecord(t, np.sin(t), np.cos(t)))
+    >>> est.name, est.t.size, val.name, val.t.size
+    ('DATA_EMPS periods 1-2', 12480, 'DATA_EMPS periods 3-4', 12361)
+    >>> split_by_periods(IORecord(t, np.sin(t), np.cos(t)), (3, 4))[1].name
+    'DATA_EMPS periods 1-2'
+    """
+    n = record.t.size
+    count = -(-n // period)
+    first, last = (int(p) for p in periods)
+    if not 1 <= first <= last <= count:
+        raise ValueError(f"periods {first}-{last}: the record has periods 1-{count} of "
+                         f"{period} samples")
+    if first > 1 and last < count:
+        raise ValueError(f"periods {first}-{last} leave periods on both sides; estimate from "
+                         f"the first or the last periods")
+    if first == 1 and last == count:
+        raise ValueError("no period is left for validation")
+    a, b = (first - 1) * period, min(last * period, n)
+    est_slice, val_slice = slice(a, b), (slice(b, n) if first == 1 else slice(0, a))
+    val_periods = (last + 1, count) if first == 1 else (1, first - 1)
+
+    def piece(s: slice, p: tuple[int, int]) -> IORecord:
+        label = f"{name} period {p[0]}" if p[0] == p[1] else f"{name} periods {p[0]}-{p[1]}"
+        return IORecord(record.t[s], record.u[s], record.y[s], label)
+
+    return piece(est_slice, (first, last)), piece(val_slice, val_periods)
+
+
+@dataclass
+class EMPSModel:
+    """One link model on the mass-damper: its parameters and its scores.
+
+    Attributes
+    ----------
+    name : str
+        The link model (``"coulomb"``, ``"jenkins"``, ...).
+    parameters, std : dict
+        Estimates and standard errors (None: not determined by the record):
+        ``m`` [kg], ``c`` [N s/m], the link's parameters, ``offset`` (the
+        force offset ``OF`` [N], the benchmark's sign: the plant receives
+        ``F - OF``).
+    estimation, validation : dict
+        ``{"record", "rmse_mm", "fit_percent"}``: the benchmark's metric on the
+        record identified from and on the held-out one.
+    seconds : float
+        Identification and scoring [s].
+    warnings : list of str
+        The identification's plausibility warnings.
+    prediction : ndarray or None
+        The simulated position on the validation record [m] (for plots).
+    """
+
+    name: str
+    parameters: dict[str, float]
+    std: dict[str, float | None]
+    estimation: dict
+    validation: dict
+    seconds: float
+    warnings: list[str] = field(default_factory=list)
+    prediction: np.ndarray | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``."""
+        return {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
+                "estimation": dict(self.estimation), "validation": dict(self.validation),
+                "seconds": self.seconds}
+
+    def __str__(self) -> str:
+        est, val = self.estimation, self.validation
+        return (f"{self.name}: validation on {val['record']} {val['rmse_mm']:.3g} mm "
+                f"({val['fit_percent']:.2f} %), estimation {est['rmse_mm']:.3g} mm")
+
+
+@dataclass
+class EMPSBenchmark:
+    """The EMPS benchmark's results: one :class:`EMPSModel` per link model.
+
+    Attributes
+    ----------
+    models : list of EMPSModel
+    estimation_record, validation_record : IORecord
+        What the models were identified from and scored on.
+    official_test : bool
+        Whether the validation record is the benchmark's test record.
+    reference : dict
+        The IDIM-LS model's published parameters scored the same way:
+        ``{"estimation": {...}, "validation": {...}}``, each ``{"record",
+        "rmse_mm", "fit_percent"}``.
+    """
+
+    models: list[EMPSModel]
+    estimation_record: IORecord
+    validation_record: IORecord
+    official_test: bool
+    reference: dict
+
+    def to_dict(self) -> dict:
+        """``{"models": [...]}``, each as :meth:`EMPSModel.to_dict`."""
+        return {"models": [m.to_dict() for m in self.models]}
+
+    def best(self) -> EMPSModel:
+        """The model with the smallest validation RMSE."""
+        return min(self.models, key=lambda m: m.validation["rmse_mm"])
+
+    def __str__(self) -> str:
+        from motionhyst.core.textfmt import g, table
+
+        rows = []
+        for m in self.models:
+            p = m.parameters
+            rows.append([f"motionhyst: mass-damper + {m.name}", g(p.get("m"), 4),
+                         g(p.get("c"), 4), _friction(p), g(p.get("offset"), 3),
+                         f"{m.estimation['rmse_mm']:.3g}", f"{m.validation['rmse_mm']:.3g}",
+                         f"{m.validation['fit_percent']:.1f}", f"{m.seconds:.0f}"])
+        ref = self.reference
+        r = REFERENCE_MODEL
+        rows.append(["IDIM-LS reference (published parameters)", g(r["m"], 4), g(r["c"], 4),
+                     g(r["fc"], 4), g(r["offset"], 3),
+                     f"{ref['estimation']['rmse_mm']:.3g}",
+                     f"{ref['validation']['rmse_mm']:.3g}",
+                     f"{ref['validation']['fit_percent']:.1f}", "-"])
+        head = ["model", "m [kg]", "c [N s/m]", "fc [N]", "offset [N]", "est. [mm]",
+                "valid. [mm]", "fit [%]", "time [s]"]
+        lines = [f"EMPS benchmark (Janot, Gautier and Brunot 2019): identified on "
+                 f"{self.estimation_record.name}, validated on {self.validation_record.name}"
+                 + ("" if self.official_test else " (the test record "
+                    f"{TEST_FILE} was not given)"),
+                 f"RMSE of the position simulated from the force, samples n >= {INIT_WINDOW} "
+                 f"(the first {INIT_WINDOW} set the initial state)", "", table(head, rows)]
+        pub = [[name, "-" if rmse is None else f"{rmse:.3g}", f"{fit:.1f}"]
+               for name, rmse, fit in PUBLISHED]
+        lines += ["", "Published, on the test record " + TEST_FILE
+                  + ("" if self.official_test else " (not the record above)") + ":",
+                  table(["method", "RMSE [mm]", "fit [%]"], pub)]
+        for m in self.models:
+            lines += [f"warning: {m.name}: {w}" for w in m.warnings]
+        return "\n".join(lines)
+
+    def plot(self, ax=None):
+        """Measured and simulated position on the validation record, and the errors.
+
+        Parameters
+        ----------
+        ax : sequence of two Axes, optional
+            Where to draw the positions and the errors; a new figure otherwise.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            fig, axes = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
+        else:
+            axes = list(ax)
+            fig = axes[0].figure
+        rec = self.validation_record
+        axes[0].plot(rec.t, 1e3 * rec.y, color="k", lw=1.2, label="measured qm")
+        for m in self.models:
+            if m.prediction is None:
+                continue
+            axes[0].plot(rec.t, 1e3 * m.prediction, lw=0.9,
+                         label=f"{m.name} ({m.validation['rmse_mm']:.3g} mm)")
+            axes[1].plot(rec.t[INIT_WINDOW:], 1e3 * (m.prediction - rec.y)[INIT_WINDOW:], lw=0.8,
+                         label=m.name)
+        axes[0].set_ylabel("position [mm]")
+        axes[0].set_title(f"EMPS: simulated from the force, {rec.name}")
+        axes[0].legend(fontsize="small")
+        axes[1].set_ylabel("error [mm]")
+        axes[1].set_xlabel("time [s]")
+        return fig
+
+
+def _friction(p: dict) -> str:
+    from motionhyst.core.textfmt import g
+
+    if "fc" in p:
+        return g(p["fc"], 4)
+    if "fc_pos" in p:
+        return f"{g(p['fc_pos'], 4)}/{g(p['fc_neg'], 4)}"
+    return "-"
+
+
+def _parameters(fit) -> tuple[dict, dict]:
+    """The identification's estimates under the benchmark's names (``offset`` = OF)."""
+    est, std = {}, {}
+    for name, value in fit.estimates.items():
+        short = name.removeprefix("link.")
+        if short != name and short in fit.estimates:
+            short = name
+        if name == "input_offset":
+            short = "offset"
+        est[short] = float(value)
+        s = fit.std.get(name)
+        std[short] = None if s is None else float(s)
+    return est, std
+
+
+def score(system, record: IORecord) -> tuple[dict, np.ndarray]:
+    """The benchmark's metric of a model on a record, and the simulated position.
+
+    The position is simulated from the force alone, the initial state set from
+    the first :data:`INIT_WINDOW` samples
+    (:func:`~motionhyst.identify.io_predict.predict_from_window`); the RMS error
+    in mm and the fit in % count the samples from :data:`INIT_WINDOW` on.
+
+    Parameters
+    ----------
+    system : OpenLoop
+        The model (its plant's ``force_offset`` applied).
+    record : IORecord
+        Time [s], force [N] and measured position [m].
+
+    Returns
+    -------
+    dict
+        ``{"record": record.name, "rmse_mm": .., "fit_percent": ..}``.
+    ndarray
+        The simulated position [m].
+
+    Examples
+    --------
+    The reference model scored on a record it made itself, shifted by 1 mm (the
+    state set from the window takes the shift up):
+
+    >>> import numpy as np
+    >>> ref = reference_system()
+    >>> t = np.arange(3000) / 1000.0
+    >>> u = 120.0 * np.sin(2 * np.pi * t)
+    >>> y = ref.simulate(t, u).displacement
+    >>> metric, _ = score(ref, IORecord(t, u, y + 1e-3, "shifted"))
+    >>> metric["rmse_mm"] < 0.01, round(metric["fit_percent"], 1)
+    (True, 100.0)
+    """
+    pred = predict_from_window(system, record.t, record.u, record.y, window=INIT_WINDOW)
+    return ({"record": record.name, "rmse_mm": 1e3 * pred.rmse,
+             "fit_percent": pred.fit_percent}, pred.displacement)
+
+
+def reference_system():
+    """The IDIM-LS reference model as an open-loop system (a mass-damper with Coulomb friction).
+
+    Examples
+    --------
+    >>> sys = reference_system()
+    >>> sys.plant.m, sys.hysteresis.fc
+    (95.1089, 20.3935)
+    """
+    from motionhyst.hysteresis import Coulomb
+    from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.time.openloop import OpenLoop
+
+    r = REFERENCE_MODEL
+    return OpenLoop(MassDamper(r["m"], r["c"], force_offset=-r["offset"]), Coulomb(fc=r["fc"]))
+
+
+def run_emps(estimation: IORecord, test: IORecord | None = None, *,
+             models: Sequence[str] | None = None, periods: tuple[int, int] = (1, 2),
+             period: int | None = None, progress: Callable[[str], None] | None = None
+             ) -> EMPSBenchmark:
+    """Identify the axis with each link model and score it by the benchmark's metric.
+
+    Parameters
+    ----------
+    estimation : IORecord
+        The estimation record ``DATA_EMPS`` (time [s], force [N], position [m]).
+    test : IORecord, optional
+        The test record ``DATA_EMPS_PULSES``: the models are identified from the
+        whole estimation record and scored on it.  Without it they are
+        identified from the estimation record's `periods` and scored on the
+        other periods.
+    models : sequence of str, optional
+        Link models on the mass-damper (default :data:`MODELS`).
+    periods : (int, int)
+        Without `test`: the periods identified from (see :func:`split_by_periods`).
+    period : int, optional
+        Samples per period of the estimation record (default :data:`PERIOD`).
+    progress : callable, optional
+        Called with a line of text as each model starts and ends.
+
+    Returns
+    -------
+    EMPSBenchmark
+
+    Raises
+    ------
+    ValueError
+        A record that cannot be used, or a model whose identification failed
+        (one line naming the model).
+    """
+    say = progress or (lambda _msg: None)
+    models = MODELS if models is None else tuple(models)
+    period = PERIOD if period is None else int(period)
+    if test is None:
+        est, val = split_by_periods(estimation, periods, period, name=estimation.name)
+    else:
+        est, val = estimation, test
+    out = []
+    for name in models:
+        say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
+        t0 = time.perf_counter()
+        try:
+            fit = identify_io([est], name, plant="mass-damper")
+            system = fit.system()
+            est_score, _ = score(system, est)
+            val_score, yhat = score(system, val)
+        except (ValueError, RuntimeError) as exc:
+            raise ValueError(f"{name}: {exc}") from None
+        seconds = time.perf_counter() - t0
+        parameters, std = _parameters(fit)
+        out.append(EMPSModel(name, parameters, std, est_score, val_score, seconds,
+                             list(getattr(fit, "warnings", [])), yhat))
+        say(f"{name}: {val_score['rmse_mm']:.3g} mm on {val.name} ({seconds:.0f} s)")
+    ref = {"estimation": score(reference_system(), est)[0],
+           "validation": score(reference_system(), val)[0]}
+    return EMPSBenchmark(out, est, val, test is not None, ref)

@@ -1,0 +1,159 @@
+"""The EMPS benchmark: splits by periods, the metric, a generated axis identified and scored,
+the command's JSON and its refusals."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from motionhyst.cli import main
+from motionhyst.hysteresis import Coulomb
+from motionhyst.identify.emps import (
+    DRIVE_GAIN,
+    INIT_WINDOW,
+    REFERENCE_MODEL,
+    reference_system,
+    run_emps,
+    score,
+    split_by_periods,
+)
+from motionhyst.identify.input_output import IORecord
+from motionhyst.plants.mass_damper import MassDamper
+from motionhyst.time.openloop import OpenLoop
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "benchmarks" / "emps"
+TRUE = {"m": 95.0, "c": 200.0, "fc": 20.0, "offset": -3.2}  # offset: the benchmark's OF
+PERIOD = 1000
+
+
+def axis_record(n_periods: int = 4, period: int = PERIOD, noise: float = 1e-6) -> IORecord:
+    """A positioning axis with Coulomb friction and a force offset, 1 kHz, as a loop moves it:
+    the force of the true model's inverse dynamics along a periodic path, the position the
+    true model's simulation from that force, the state set from its first samples."""
+    t = np.arange(n_periods * period) / 1000.0
+    w = 2 * np.pi * 1000.0 / period
+    path = (0.02 * np.sin(w * t), 0.006 * np.sin(3 * w * t + 1.0))
+    v = 0.02 * w * np.cos(w * t) + 0.018 * w * np.cos(3 * w * t + 1.0)
+    acc = -w ** 2 * (path[0] + 9 * path[1])
+    u = TRUE["m"] * acc + TRUE["c"] * v + TRUE["fc"] * np.sign(v) + TRUE["offset"]
+    y = score(true_system(), IORecord(t, u, path[0] + path[1], "path"))[1]
+    return IORecord(t, u, y + noise * np.random.default_rng(7).standard_normal(t.size), "axis")
+
+
+def true_system(p: dict = TRUE) -> OpenLoop:
+    """The mass-damper with Coulomb friction of the benchmark's parameters (offset = OF)."""
+    return OpenLoop(MassDamper(p["m"], p["c"], force_offset=-p["offset"]), Coulomb(fc=p["fc"]))
+
+
+def test_split_by_periods_names_and_sizes():
+    rec = IORecord(np.arange(24841) * 1e-3, np.zeros(24841), np.zeros(24841), "DATA_EMPS")
+    est, val = split_by_periods(rec)
+    assert (est.name, val.name) == ("DATA_EMPS periods 1-2", "DATA_EMPS periods 3-4")
+    assert est.t.size == 12480 and val.t[0] == pytest.approx(12.48)
+    est, val = split_by_periods(rec, (3, 4))
+    assert (est.name, val.name, est.t.size) == ("DATA_EMPS periods 3-4",
+                                                "DATA_EMPS periods 1-2", 12361)
+    assert split_by_periods(rec, (1, 1))[1].name == "DATA_EMPS periods 2-4"
+    for periods, fragment in (((2, 3), "both sides"), ((1, 4), "no period is left"),
+                              ((0, 1), "periods 1-4"), ((4, 5), "periods 1-4")):
+        with pytest.raises(ValueError, match=fragment):
+            split_by_periods(rec, periods)
+
+
+def test_generated_axis_identified_and_scored():
+    rec = axis_record()
+    res = run_emps(rec, models=("coulomb",), period=PERIOD)
+    (model,) = res.models
+    p = model.parameters
+    assert p["m"] == pytest.approx(TRUE["m"], rel=0.05)
+    assert p["offset"] == pytest.approx(TRUE["offset"], abs=0.5)  # OF's sign: u - OF drives
+    assert model.estimation["record"] == "axis periods 1-2"
+    assert model.validation["record"] == "axis periods 3-4"
+    # the scores are those of the model the reported parameters describe
+    val = IORecord(rec.t[2 * PERIOD:], rec.u[2 * PERIOD:], rec.y[2 * PERIOD:], "v")
+    again, yhat = score(true_system(p), val)
+    assert model.validation["rmse_mm"] == pytest.approx(again["rmse_mm"], rel=1e-6)
+    np.testing.assert_allclose(model.prediction, yhat, rtol=0, atol=1e-9)
+    y_val = val.y[INIT_WINDOW:]
+    assert model.validation["rmse_mm"] < 0.05 * 1e3 * np.std(y_val)
+    assert model.validation["fit_percent"] > 90.0
+    assert set(res.to_dict()) == {"models"}
+    assert set(res.to_dict()["models"][0]) == {"name", "parameters", "std", "estimation",
+                                                "validation", "seconds"}
+    assert set(model.std) == set(p)
+    text = str(res)
+    assert "validated on axis periods 3-4 (the test record DATA_EMPS_PULSES.mat was not" in text
+    assert "dynoNet" in text and "IDIM-LS reference (published parameters)" in text
+    fig = res.plot()
+    assert len(fig.axes) == 2 and fig.axes[0].get_lines()[0].get_label() == "measured qm"
+
+
+def test_metric_is_the_benchmarks():
+    """RMSE in mm over n >= 20 and fit %, from the state set on the first 20 samples: the
+    reference model scored on a record it made itself (noise only) and with a 1 mm shift."""
+    rec = axis_record(n_periods=2, noise=0.0)
+    sys = reference_system()
+    y = sys.simulate(rec.t, rec.u).displacement
+    res, yhat = score(sys, IORecord(rec.t, rec.u, y + 1e-3, "self"))
+    assert res["record"] == "self"
+    # the 1 mm shift is taken up by the state set from the window (to 1 % of it)
+    assert res["rmse_mm"] < 1e-2 and res["fit_percent"] > 99.9
+    np.testing.assert_allclose(yhat[INIT_WINDOW:], y[INIT_WINDOW:] + 1e-3, atol=1e-5)
+    shifted, _ = score(sys, IORecord(rec.t, rec.u, y + 1e-3 * (rec.t > 0.5), "step"))
+    late = rec.t[INIT_WINDOW:] > 0.5  # 1 mm off on these samples only
+    assert shifted["rmse_mm"] == pytest.approx(np.sqrt(late.mean()), rel=0.02)
+    assert sys.plant.m == REFERENCE_MODEL["m"]
+    assert sys.plant.force_offset == -REFERENCE_MODEL["offset"]
+
+
+def test_benchmark_emps_command_refusals(tmp_path, capsys):
+    def err(*args):
+        assert main(["benchmark", *args]) == 2
+        text = capsys.readouterr().err
+        assert text.count("\n") == 1
+        return text
+
+    assert "no such folder" in err("emps", "--data", str(tmp_path / "none"))
+    assert "has no DATA_EMPS.mat" in err("emps", "--data", str(tmp_path))
+    (tmp_path / "DATA_EMPS.mat").write_text("t,vir,qm\n0,0,0\n")
+    assert "not a MATLAB .mat file (a text file)" in err("emps", "--data", str(tmp_path))
+    savemat(tmp_path / "DATA_EMPS.mat", {"t": np.arange(10.0), "qm": np.zeros(10)})
+    assert "no variable 'vir'" in err("emps", "--data", str(tmp_path))
+    assert "--seed applies to bouc-wen only" in err("emps", "--data", str(tmp_path),
+                                                     "--seed", "1")
+    assert "--periods applies to emps only" in err("bouc-wen", "--periods", "1-2")
+    assert "--periods: must be A-B" in err("emps", "--periods", "x")
+
+
+def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
+    """The command on a folder holding a generated DATA_EMPS.mat in the benchmark's variables
+    (the controller's output in volts), its periods shortened for the test."""
+    import motionhyst.identify.emps as emps
+
+    rec = axis_record()
+    savemat(tmp_path / "DATA_EMPS.mat", {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
+                                         "qm": rec.y[:, None], "gtau": DRIVE_GAIN})
+    monkeypatch.setattr(emps, "MODELS", ("coulomb",))
+    monkeypatch.setattr(emps, "PERIOD", PERIOD)
+    assert main(["benchmark", "emps", "--data", str(tmp_path), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert err == ""
+    (model,) = json.loads(out)["models"]
+    assert model["name"] == "coulomb"
+    assert model["validation"]["record"] == "DATA_EMPS periods 3-4"
+    assert model["parameters"]["m"] == pytest.approx(TRUE["m"], rel=0.05)
+    assert model["parameters"]["offset"] == pytest.approx(TRUE["offset"], abs=0.5)
+
+
+@pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),
+                    reason="the EMPS benchmark's files are not beside the repository")
+def test_emps_record_splits_into_its_reference_periods():
+    from scipy.io import loadmat
+
+    qg = loadmat(SHARED / "DATA_EMPS.mat")["qg"].ravel()
+    assert qg.size == 24841
+    np.testing.assert_allclose(qg[6240:12480], qg[:6240], rtol=0, atol=1e-12)  # it repeats
+    np.testing.assert_allclose(qg[18720:], qg[:qg.size - 18720], rtol=0, atol=1e-12)
+    assert np.max(np.abs(qg[6000:12000] - qg[:6000])) > 1e-3  # and not with another period
