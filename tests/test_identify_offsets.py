@@ -147,3 +147,46 @@ def test_init_window_with_exact_sensitivities():
     assert fit.estimates["m"] == pytest.approx(TRUE["m"], rel=2e-2)
     assert fit.estimates["input_offset"] == pytest.approx(TRUE["input_offset"], abs=0.3)
     assert fit.fit_rms < 1e-3 * np.ptp(rec.y)
+
+
+def test_asymmetric_viscous_friction_is_recovered():
+    """An axis with more viscous friction moving backward (the EMPS axis's Fv- > Fv+): the
+    stage's c is the smaller one, the link's c_neg the excess, the force offset the true
+    one; the symmetric model cannot tell them apart from an offset."""
+    t = np.arange(3000) / FS
+    u = 30 + 90 * np.sin(2 * np.pi * 0.6 * t) + 40 * np.sin(2 * np.pi * 1.7 * t + 0.3)
+    true = OpenLoop(MassDamper(95.0, 170.0, force_offset=3.0), Coulomb(fc=20.0, c_neg=70.0))
+    y = true.simulate(t, u, substeps=20).displacement
+    rec = IORecord(t, u, y, "asym")
+    fit = identify_io([rec], "coulomb", plant="mass-damper", substeps=20, from_rest=True,
+                      asymmetric=True)
+    got = fit.estimates
+    assert set(got) == {"m", "c", "link.fc", "link.c_neg", "input_offset", "output_offset"}
+    for name, value in (("m", 95.0), ("c", 170.0), ("link.fc", 20.0), ("link.c_neg", 70.0),
+                        ("input_offset", -3.0)):
+        assert got[name] == pytest.approx(value, rel=1e-3), name
+    assert "link.c_pos" in fit.not_identifiable
+    assert fit.hysteresis.to_dict()["c_neg"] == pytest.approx(70.0, rel=1e-3)
+    with pytest.raises(ValueError, match="Coulomb link on a mass-damper"):
+        identify_io([rec], "jenkins", plant="mass-damper", asymmetric=True)
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    (["--init-window", "1"], "--init-window: must be from 2"),
+    (["--init-window", "20", "--from-rest"], "not with --periodic or --from-rest"),
+    (["--init-window", "20", "--model", "bouc-wen"], "not yet to --model bouc-wen"),
+    (["--asymmetric", "--model", "jenkins"], "--asymmetric applies to --model coulomb"),
+    (["--asymmetric", "--model", "coulomb", "--plant", "two-mass"], "--plant mass-damper only"),
+])
+def test_cli_window_and_asymmetric_refusals(tmp_path, capsys, options, message):
+    from motionhyst.cli import main
+
+    rec = _axis_record(n=300)
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+    options = options if "--model" in options else [*options, "--model", "coulomb"]
+    plant = [] if "--plant" in options else ["--plant", "mass-damper"]
+    assert main(["identify", str(path), "--record", "input-output", *plant, *options]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and message in err

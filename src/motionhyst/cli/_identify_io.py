@@ -73,6 +73,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                         "stage's position offset) is set from its first N samples as the fit "
                         "runs, as predict --init-from --init-window N sets it (the EMPS "
                         "benchmark's convention: 20); only the force offset is estimated")
+    q.add_argument("--asymmetric", action="store_true",
+                   help="input-output records, --model coulomb --plant mass-damper: viscous "
+                        "friction by direction (the link's c_pos or c_neg on top of the "
+                        "stage's c)")
     q.add_argument("--max-evaluations", type=_evaluations, metavar="N",
                    help="input-output records: the search's budget of model evaluations, "
                         "starts and refinement together (default: the starts', then at most "
@@ -101,7 +105,8 @@ def check_not_input_output(args: argparse.Namespace) -> None:
                           ("--save", args.save), ("--output", args.output),
                           ("--offset", args.offset), ("--from-rest", args.from_rest or None),
                           ("--max-evaluations", args.max_evaluations),
-                          ("--init-window", args.init_window)):
+                          ("--init-window", args.init_window),
+                          ("--asymmetric", args.asymmetric or None)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
                              f"only")
@@ -149,12 +154,16 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
+    if args.asymmetric and (model != "coulomb" or plant != "mass-damper"):
+        raise UsageError("motionhyst identify: --asymmetric applies to --model coulomb "
+                         "--plant mass-damper only")
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
     extras = ({} if model == "bouc-wen" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
-               "max_evaluations": args.max_evaluations, "init_window": args.init_window})
+               "max_evaluations": args.max_evaluations, "init_window": args.init_window,
+               "asymmetric": args.asymmetric})
     fit = identify_io(records, model, periodic=args.periodic, nu=nu,
                       n_elements=args.elements or 3, plant=plant, output=args.output or "y2",
                       **extras)

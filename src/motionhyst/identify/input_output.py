@@ -185,7 +185,8 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
                 max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None,
                 plant: str = "mass-spring-damper", output: str = "y2", offset: str = "auto",
                 from_rest: bool = False, max_evaluations: int | None = None,
-                init_window: int | None = None) -> IOIdentification:
+                init_window: int | None = None, asymmetric: bool = False
+                ) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -257,6 +258,11 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         --init-window`` sets it (:func:`~motionhyst.identify.io_predict.state_from_window`;
         the EMPS benchmark's convention, 20): the model is fitted the way it is
         scored.  Only the force offset is estimated with it (a floating stage).
+    asymmetric : bool
+        The Coulomb link on a mass-damper: viscous friction by direction (the
+        link's ``c_pos`` or ``c_neg`` on top of the stage's ``c``; a positioning
+        axis's ``Fv+``, ``Fv-``).  Its force offset is then another number than a
+        symmetric model's: the symmetric one takes up the mean of the difference.
 
     Returns
     -------
@@ -302,11 +308,15 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         if short:
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
+    if asymmetric and (model != "coulomb" or plant != "mass-damper"):
+        raise ValueError("direction-dependent viscous friction is identified with the Coulomb "
+                         "link on a mass-damper")
     if model != "bouc-wen":
         return identify_elements_io(records, model, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
                                     plant, output, offset, from_rest, max_evaluations,
-                                    int(init_window) if init_window is not None else None)
+                                    int(init_window) if init_window is not None else None,
+                                    asymmetric)
     if offset not in ("auto", "none") or from_rest or init_window is not None:
         raise ValueError("offsets and initial states are estimated with the element links, "
                          "not yet with Bouc-Wen: use offset 'none'")

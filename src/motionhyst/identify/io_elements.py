@@ -86,11 +86,20 @@ class _LinkLayout:
     fixed: dict[str, float]
 
     @classmethod
-    def of(cls, model: str, n: int) -> _LinkLayout:
+    def of(cls, model: str, n: int, faster: str | None = None) -> _LinkLayout:
+        """The layout of `model` (`n` values of a list parameter); `faster`: the
+        Coulomb link's direction-dependent viscous friction, ``"c_pos"`` or ``"c_neg"``
+        (the direction with more, estimated on top of the stage's ``c``; the other
+        fixed at 0)."""
         from motionhyst.hysteresis import model_class
 
         klass = model_class(model)
         entries, fixed = [], {}
+        if faster is not None:
+            form = {p.name: p for p in klass.forms[0].parameters}
+            slower = "c_neg" if faster == "c_pos" else "c_pos"
+            return cls(model, klass, [(klass.parameters[0], -1), (form[faster], -1)],
+                       {slower: 0.0})
         for par in klass.parameters:
             if par.parallel:
                 fixed[par.name] = 0.0
@@ -473,7 +482,8 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t_start,
                          start_nfev, plant="mass-spring-damper", output="y2", offset="none",
-                         from_rest=True, budget=None, init_window=None) -> IOIdentification:
+                         from_rest=True, budget=None, init_window=None, asymmetric=False
+                         ) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -496,7 +506,11 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     the records' inverse-dynamics mass, damper, Coulomb force and force offset
     (:func:`~motionhyst.identify.io_start.inverse_dynamics`), the link's forces
     together that Coulomb force or half of it, slipping after 0.001 to 0.1 of
-    the output's RMS (:data:`AXIS_STARTS`).
+    the output's RMS (:data:`AXIS_STARTS`).  With `asymmetric` (the Coulomb link
+    on a mass-damper) the viscous friction depends on the direction: the stage's
+    ``c`` is the smaller one, the link's ``c_pos`` or ``c_neg`` the excess in the
+    other direction (chosen, and started, from the inverse dynamics with a
+    viscous term per direction), its slip force ``fc`` the same both ways.
 
     A link other than the rigid slider on a mass-damper also starts from the
     Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit), when
@@ -507,7 +521,13 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     started at zero (the position offset of a floating stage at the record's
     first sample, its velocity at the first samples' slope).
     """
-    layout = _LinkLayout.of(model, n)
+    asymmetric = asymmetric and model == "coulomb" and plant == "mass-damper"
+    idim = inverse_dynamics(records, plant != "mass-spring-damper", asymmetric)
+    faster = None
+    if asymmetric:  # the stage's c is the smaller viscous friction, the link adds the rest
+        faster = "c_pos" if idim["c_pos"] >= idim["c_neg"] else "c_neg"
+        idim["c"] = min(idim["c_pos"], idim["c_neg"])
+    layout = _LinkLayout.of(model, n, faster)
     y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and plant == "two-mass"
                                      else 0.0) for rec in records])
     y_scale = float(np.sqrt(np.mean(y_all ** 2)))
@@ -515,7 +535,6 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         [np.gradient(rec.y, rec.t) for rec in records]) ** 2)))
     u_rms = float(np.sqrt(np.mean(np.concatenate([rec.u for rec in records]) ** 2)))
     force = np.array([par.unit == _FORCE for par, _ in layout._values()], dtype=bool)
-    idim = inverse_dynamics(records, plant != "mass-spring-damper")
     if plant == "two-mass":
         bla, k_link, c_link = best_linear_approximation_two_mass(records, output, periodic)
         structure: MassSpringDamper | TwoMass | MassDamper = bla
@@ -547,8 +566,10 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
         starts = []
         for share, slip in AXIS_STARTS:
             k0 = 2.0 * share * f0 / (slip * y_scale)  # its forces at share * f0
-            starts.append(np.concatenate([[m0, c0],
-                                          layout.start(k0, y_scale, v_scale, c0, slip)]))
+            link0 = layout.start(k0, y_scale, v_scale, c0, slip)
+            if faster is not None:
+                link0[1] = abs(idim["c_pos"] - idim["c_neg"])
+            starts.append(np.concatenate([[m0, c0], link0]))
         r = substeps or OpenLoop(structure, layout.build(starts[0][2:])).default_substeps(
             records[0].fs)
     else:
@@ -637,6 +658,10 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     for nm, sd in zip(names, std_v, strict=True):
         std[nm] = float(sd) if math.isfinite(sd) else None
     not_ident = {f"link.{name}": _parallel_note(layout, name, structure)
+                 if faster is None else
+                 (f"the viscous friction moving {'backward' if name == 'c_neg' else 'forward'} "
+                  f"is the stage's c (the link's {faster} adds to it in the other "
+                  f"direction): fixed at 0")
                  for name in layout.fixed}
     not_ident.update(undetermined_notes(names, groups, rtol))
     weak = weak_notes(names, v, std_v, J, rtol, ~prob.log)

@@ -64,7 +64,8 @@ def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
     return MassSpringDamper(m, max(c, 1e-6 * m * w.min()), max(k, 1e-6 * m * w.min() ** 2))
 
 
-def inverse_dynamics(records: list[IORecord], floating: bool) -> dict[str, float]:
+def inverse_dynamics(records: list[IORecord], floating: bool, asymmetric: bool = False
+                     ) -> dict[str, float]:
     """The records' linear estimate of a single mass: least squares on the equation of motion.
 
     ``u = m y'' + c y' + f sign(y') + u0`` (a floating stage: viscous and Coulomb
@@ -81,11 +82,16 @@ def inverse_dynamics(records: list[IORecord], floating: bool) -> dict[str, float
         The records.
     floating : bool
         No spring to the ground (the Coulomb term instead of the spring's).
+    asymmetric : bool
+        A floating stage's viscous friction by direction: ``c_pos q'`` moving
+        forward, ``c_neg q'`` backward, in place of ``c q'`` (a direction-dependent
+        Coulomb force is a force offset while the stage moves: not told apart).
 
     Returns
     -------
     dict
-        ``m, c, u0`` and ``fc`` (floating) or ``k``.
+        ``m, c, u0`` and ``fc`` (floating) or ``k``; with `asymmetric` also ``c_pos``
+        and ``c_neg`` (``c`` their mean).
 
     Examples
     --------
@@ -96,6 +102,10 @@ def inverse_dynamics(records: list[IORecord], floating: bool) -> dict[str, float
     >>> est = inverse_dynamics([IORecord(t, u, y)], floating=True)
     >>> {k: round(v, 1) for k, v in est.items()}
     {'m': 2.0, 'c': 30.0, 'fc': 4.0, 'u0': -1.5}
+    >>> u2 = u + 10.0 * np.maximum(v, 0.0)                   # 10 N s/m more moving forward
+    >>> est = inverse_dynamics([IORecord(t, u2, y)], floating=True, asymmetric=True)
+    >>> round(est["c_pos"], 1), round(est["c_neg"], 1)
+    (40.0, 30.0)
     """
     from scipy.signal import savgol_filter
 
@@ -107,12 +117,19 @@ def inverse_dynamics(records: list[IORecord], floating: bool) -> dict[str, float
         v = savgol_filter(rec.y, window, 3, deriv=1, delta=dt)
         a = savgol_filter(rec.y, window, 3, deriv=2, delta=dt)
         third = np.sign(v) if floating else rec.y
-        rows.append(np.column_stack([a, v, third, np.ones_like(v)]))
+        viscous = ([np.maximum(v, 0.0), np.minimum(v, 0.0)] if asymmetric and floating
+                   else [v])
+        rows.append(np.column_stack([a, *viscous, third, np.ones_like(v)]))
         rhs.append(rec.u)
     A = np.concatenate(rows)
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
-    m, c, third, u0 = np.linalg.lstsq(A / scale, np.concatenate(rhs), rcond=None)[0] / scale
+    x = np.linalg.lstsq(A / scale, np.concatenate(rhs), rcond=None)[0] / scale
+    if x.size == 5:
+        m, c_pos, c_neg, third, u0 = x
+        return {"m": float(m), "c": float(0.5 * (c_pos + c_neg)), "fc": float(third),
+                "u0": float(u0), "c_pos": float(c_pos), "c_neg": float(c_neg)}
+    m, c, third, u0 = x
     return {"m": float(m), "c": float(c), "fc" if floating else "k": float(third),
             "u0": float(u0)}
 
