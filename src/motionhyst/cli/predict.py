@@ -71,7 +71,10 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst predict: --init-window must be at least 2, got {window}")
     sc = Scenario.from_file(args.scenario)
     system = sc.open_loop()
-    data = read_record(args.data, ("time", "force"), columns=args.columns, scale=args.scale)
+    both = args.init_from is not None  # the maps also name the --init-from record's position
+    data = read_record(args.data, ("time", "force"),
+                       columns=_only(args.columns) if both else args.columns,
+                       scale=_only(args.scale) if both else args.scale)
     t, u = data[:, 0], data[:, 1]
     _check_step(system, t, args)
     pred = None
@@ -111,6 +114,12 @@ def run(args: argparse.Namespace) -> int:
                   f"{pred.initial_state['velocity']:.6g} m/s; RMS error from sample {window} "
                   f"on {pred.rmse:.4g} m (fit {pred.fit_percent:.2f} %)")
     return 0
+
+
+def _only(mapping, keys=("time", "force")):
+    """The entries of a --columns or --scale map that the force record has (the rest, such
+    as displacement=, are for the --init-from record)."""
+    return None if mapping is None else {k: v for k, v in mapping.items() if k in keys}
 
 
 def _check_step(system, t, args) -> None:
