@@ -140,11 +140,13 @@ def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
     assert main(["benchmark", "emps", "--data", str(tmp_path), "--json"]) == 0
     out, err = capsys.readouterr()
     assert err == ""
-    (model,) = json.loads(out)["models"]
-    assert model["name"] == "coulomb"
-    assert model["validation"]["record"] == "DATA_EMPS periods 3-4"
-    assert model["parameters"]["m"] == pytest.approx(TRUE["m"], rel=0.05)
-    assert model["parameters"]["offset"] == pytest.approx(TRUE["offset"], abs=0.5)
+    models = json.loads(out)["models"]  # without the test record: both splits
+    assert [m["validation"]["record"] for m in models] == ["DATA_EMPS periods 3-4",
+                                                           "DATA_EMPS periods 1-2"]
+    for model in models:
+        assert model["name"] == "coulomb"
+        assert model["parameters"]["m"] == pytest.approx(TRUE["m"], rel=0.05)
+        assert model["parameters"]["offset"] == pytest.approx(TRUE["offset"], abs=0.5)
 
 
 @pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),
@@ -157,3 +159,31 @@ def test_emps_record_splits_into_its_reference_periods():
     np.testing.assert_allclose(qg[6240:12480], qg[:6240], rtol=0, atol=1e-12)  # it repeats
     np.testing.assert_allclose(qg[18720:], qg[:qg.size - 18720], rtol=0, atol=1e-12)
     assert np.max(np.abs(qg[6000:12000] - qg[:6000])) > 1e-3  # and not with another period
+
+
+def test_identify_and_predict_a_mat_record_with_the_window(tmp_path, capsys):
+    """The guide's path on the command line: identify a .mat record in the benchmark's names
+    with --init-window, save, and predict it from its force with --init-from, the --columns
+    and --scale maps naming the position too (the force record takes the keys it has)."""
+    rec = axis_record(n_periods=2)
+    path = tmp_path / "axis.mat"
+    savemat(path, {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
+                   "qm": rec.y[:, None]})
+    maps = ["--columns", "time=t,force=vir,displacement=qm", "--scale", f"force={DRIVE_GAIN}"]
+    model = tmp_path / "axis.toml"
+    assert main(["identify", str(path), "--record", "input-output", "--plant", "mass-damper",
+                 "--model", "coulomb", "--init-window", "20", "--save", str(model), "--json",
+                 *maps]) == 0
+    fit = json.loads(capsys.readouterr().out)
+    assert fit["estimates"]["m"] == pytest.approx(TRUE["m"], rel=0.02)
+    assert fit["estimates"]["input_offset"] == pytest.approx(TRUE["offset"], abs=0.3)
+    out = tmp_path / "pred.csv"
+    assert main(["predict", str(model), str(path), "--init-from", str(path), "--out", str(out),
+                 "--json", *maps]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["init_window"] == INIT_WINDOW
+    assert summary["rmse"] < 0.02 * np.std(rec.y)
+    # without --init-from a position's name is an option without effect: refused
+    assert main(["predict", str(model), str(path), "--out", str(tmp_path / "p2.csv"),
+                 *maps]) == 2
+    assert "displacement" in capsys.readouterr().err

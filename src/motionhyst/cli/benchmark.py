@@ -31,8 +31,8 @@ def add_parser(sub) -> None:
                    help="bouc-wen: seed of the training multisines and noise (default 0)")
     q.add_argument("--periods", metavar="A-B", type=_periods,
                    help="emps without the test record: the periods of DATA_EMPS to identify "
-                        "from (default 1-2: validated on periods 3-4; the reference repeats "
-                        "every 6240 samples)")
+                        "from, validated on the others (default: both ways, 1-2 then 3-4; the "
+                        "reference repeats every 6240 samples)")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
 
@@ -109,7 +109,7 @@ def _emps_record(path: Path, name: str):
 
 def run_emps(args: argparse.Namespace) -> int:
     """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
-    from motionhyst.identify.emps import ESTIMATION_FILE, TEST_FILE, run_emps
+    from motionhyst.identify.emps import ESTIMATION_FILE, TEST_FILE, cross_validate, run_emps
 
     if args.seed is not None:
         raise UsageError("motionhyst benchmark emps: --seed applies to bouc-wen only (the EMPS "
@@ -138,9 +138,16 @@ def run_emps(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"  {msg}", file=sys.stderr, flush=True)
 
-    res = run_emps(estimation, test, periods=args.periods or (1, 2), progress=say)
+    if test is None and args.periods is None:  # both ways: one split alone says little
+        results = cross_validate(estimation, progress=say)
+    else:
+        results = [run_emps(estimation, test, periods=args.periods or (1, 2), progress=say)]
     if args.json:
-        print_json(res.to_dict())
+        print_json({"models": [m for res in results for m in res.to_dict()["models"]]})
         return 0
-    print(res)
+    print("\n\n".join(str(res) for res in results))
+    if len(results) > 1:
+        print("\nMean validation RMSE over both splits: " + ", ".join(
+            f"{a.name} {(a.validation['rmse_mm'] + b.validation['rmse_mm']) / 2:.3g} mm"
+            for a, b in zip(results[0].models, results[1].models, strict=True)))
     return 0

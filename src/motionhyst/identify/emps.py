@@ -22,11 +22,12 @@ over the same samples (:func:`motionhyst.identify.io_predict.predict_from_window
 
 :func:`run_emps` identifies each link model of :data:`MODELS` on a mass-damper
 (the axis has no spring; friction is the link) from the estimation record by
-simulation error, with the force offset and the record's initial state
-estimated, then scores it on the test record (``DATA_EMPS_PULSES.mat``, the
-same reference with force pulses added; published separately by the
-benchmark) or, without it, on the periods of the estimation record it was not
-identified from (the reference repeats every :data:`PERIOD` samples).
+simulation error, with the force offset estimated and the record's initial
+state set from its first :data:`INIT_WINDOW` samples as the fit runs (the
+model is fitted the way the metric runs it), then scores it on the test
+record (``DATA_EMPS_PULSES.mat``, the same reference with force pulses added;
+published separately by the benchmark) or, without it, on the periods of the
+estimation record it was not identified from (the reference repeats every :data:`PERIOD` samples).
 """
 
 from __future__ import annotations
@@ -39,10 +40,11 @@ import numpy as np
 
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
+from motionhyst.identify.io_start import inverse_dynamics
 
 __all__ = ["COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "INIT_WINDOW", "MODELS", "PERIOD",
            "PUBLISHED", "REFERENCE_MODEL", "TEST_FILE", "EMPSBenchmark", "EMPSModel",
-           "reference_system", "run_emps", "score", "split_by_periods"]
+           "cross_validate", "reference_system", "run_emps", "score", "split_by_periods"]
 
 ESTIMATION_FILE = "DATA_EMPS.mat"
 """The benchmark's estimation record."""
@@ -54,8 +56,9 @@ DRIVE_GAIN = 35.15065
 """The drive's gain ``gtau`` [N/V]: the force on the load is ``gtau * vir``."""
 PERIOD = 6240
 """Samples per period of the estimation record's reference ``qg``."""
-MODELS = ("coulomb", "jenkins", "dahl")
-"""Link models identified by default: friction of a positioning axis."""
+MODELS = ("coulomb", "coulomb-asymmetric", "jenkins")
+"""Link models identified by default: friction of a positioning axis (``coulomb-asymmetric``:
+the Coulomb link with viscous friction by direction, ``identify --asymmetric``)."""
 REFERENCE_MODEL = {"m": 95.1089, "c": 203.5034, "fc": 20.3935, "offset": -3.1648}
 """The benchmark's IDIM-LS model: M [kg], Fv [N s/m], Fc [N], OF [N]."""
 PUBLISHED: tuple[tuple[str, float | None, float], ...] = (
@@ -180,7 +183,10 @@ class EMPSBenchmark:
     reference : dict
         The IDIM-LS model's published parameters scored the same way:
         ``{"estimation": {...}, "validation": {...}}``, each ``{"record",
-        "rmse_mm", "fit_percent"}``.
+        "rmse_mm", "fit_percent"}``; under ``"idim"`` the same method (inverse
+        dynamics, :func:`~motionhyst.identify.io_start.inverse_dynamics`) on the
+        estimation record, with its ``"parameters"``: the fair yardstick of a
+        split, whose validation periods the published parameters have seen.
     """
 
     models: list[EMPSModel]
@@ -204,17 +210,25 @@ class EMPSBenchmark:
         for m in self.models:
             p = m.parameters
             rows.append([f"motionhyst: mass-damper + {m.name}", g(p.get("m"), 4),
-                         g(p.get("c"), 4), _friction(p), g(p.get("offset"), 3),
+                         _viscous(p), _friction(p), g(p.get("offset"), 3),
                          f"{m.estimation['rmse_mm']:.3g}", f"{m.validation['rmse_mm']:.3g}",
                          f"{m.validation['fit_percent']:.1f}", f"{m.seconds:.0f}"])
         ref = self.reference
         r = REFERENCE_MODEL
+        if "idim" in ref:
+            own = ref["idim"]
+            q = own["parameters"]
+            rows.append([f"IDIM-LS on {self.estimation_record.name} (one linear solve)",
+                         g(q["m"], 4), g(q["c"], 4), g(q["fc"], 4), g(q["offset"], 3),
+                         f"{own['estimation']['rmse_mm']:.3g}",
+                         f"{own['validation']['rmse_mm']:.3g}",
+                         f"{own['validation']['fit_percent']:.1f}", "-"])
         rows.append(["IDIM-LS reference (published parameters)", g(r["m"], 4), g(r["c"], 4),
                      g(r["fc"], 4), g(r["offset"], 3),
                      f"{ref['estimation']['rmse_mm']:.3g}",
                      f"{ref['validation']['rmse_mm']:.3g}",
                      f"{ref['validation']['fit_percent']:.1f}", "-"])
-        head = ["model", "m [kg]", "c [N s/m]", "fc [N]", "offset [N]", "est. [mm]",
+        head = ["model", "m [kg]", "c (+/-) [N s/m]", "fc [N]", "offset [N]", "est. [mm]",
                 "valid. [mm]", "fit [%]", "time [s]"]
         lines = [f"EMPS benchmark (Janot, Gautier and Brunot 2019): identified on "
                  f"{self.estimation_record.name}, validated on {self.validation_record.name}"
@@ -265,6 +279,16 @@ class EMPSBenchmark:
         axes[1].set_ylabel("error [mm]")
         axes[1].set_xlabel("time [s]")
         return fig
+
+
+def _viscous(p: dict) -> str:
+    """``c``, or ``c+/c-`` (forward/backward) for direction-dependent viscous friction."""
+    from motionhyst.core.textfmt import g
+
+    c = p.get("c")
+    if c is None or ("c_pos" not in p and "c_neg" not in p):
+        return g(c, 4)
+    return f"{g(c + p.get('c_pos', 0.0), 4)}/{g(c + p.get('c_neg', 0.0), 4)}"
 
 
 def _friction(p: dict) -> str:
@@ -333,8 +357,13 @@ def score(system, record: IORecord) -> tuple[dict, np.ndarray]:
              "fit_percent": pred.fit_percent}, pred.displacement)
 
 
-def reference_system():
+def reference_system(parameters: dict | None = None):
     """The IDIM-LS reference model as an open-loop system (a mass-damper with Coulomb friction).
+
+    Parameters
+    ----------
+    parameters : dict, optional
+        ``m, c, fc, offset`` (default :data:`REFERENCE_MODEL`, the published ones).
 
     Examples
     --------
@@ -346,8 +375,41 @@ def reference_system():
     from motionhyst.plants.mass_damper import MassDamper
     from motionhyst.time.openloop import OpenLoop
 
-    r = REFERENCE_MODEL
+    r = REFERENCE_MODEL if parameters is None else parameters
     return OpenLoop(MassDamper(r["m"], r["c"], force_offset=-r["offset"]), Coulomb(fc=r["fc"]))
+
+
+def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
+                   period: int | None = None,
+                   progress: Callable[[str], None] | None = None) -> list[EMPSBenchmark]:
+    """The benchmark without its test record: identified on each half of the estimation
+    record's periods and scored on the other half, both ways.
+
+    One split alone says little on this record: its force offset drifts from period
+    to period (the inverse-dynamics estimate: -3.00, -3.07, -3.27, -3.34 N over
+    periods 1 to 4), and the floating axis integrates the difference over every second
+    of the held-out simulation.
+
+    Parameters
+    ----------
+    estimation : IORecord
+        The estimation record (at least two periods).
+    models, period, progress
+        As for :func:`run_emps`.
+
+    Returns
+    -------
+    list of EMPSBenchmark
+        Identified on the first half of the periods, then on the second.
+    """
+    period = PERIOD if period is None else int(period)
+    count = -(-estimation.t.size // period)
+    if count < 2:
+        raise ValueError(f"{estimation.name}: {count} period of {period} samples; a "
+                         f"cross-validation needs two or more")
+    half = count // 2
+    return [run_emps(estimation, models=models, periods=periods, period=period,
+                     progress=progress) for periods in ((1, half), (half + 1, count))]
 
 
 def run_emps(estimation: IORecord, test: IORecord | None = None, *,
@@ -396,7 +458,8 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
         t0 = time.perf_counter()
         try:
-            fit = identify_io([est], name, plant="mass-damper")
+            fit = identify_io([est], name.removesuffix("-asymmetric"), plant="mass-damper",
+                              init_window=INIT_WINDOW, asymmetric=name.endswith("-asymmetric"))
             system = fit.system()
             est_score, _ = score(system, est)
             val_score, yhat = score(system, val)
@@ -409,4 +472,10 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         say(f"{name}: {val_score['rmse_mm']:.3g} mm on {val.name} ({seconds:.0f} s)")
     ref = {"estimation": score(reference_system(), est)[0],
            "validation": score(reference_system(), val)[0]}
+    idim = inverse_dynamics([est], floating=True)  # the benchmark's own method, on this record
+    own = reference_system({"m": idim["m"], "c": idim["c"], "fc": idim["fc"],
+                            "offset": idim["u0"]})
+    ref["idim"] = {"parameters": {"m": idim["m"], "c": idim["c"], "fc": idim["fc"],
+                                  "offset": idim["u0"]},
+                   "estimation": score(own, est)[0], "validation": score(own, val)[0]}
     return EMPSBenchmark(out, est, val, test is not None, ref)
