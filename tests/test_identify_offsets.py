@@ -174,7 +174,9 @@ def test_asymmetric_viscous_friction_is_recovered():
 @pytest.mark.parametrize(("options", "message"), [
     (["--init-window", "1"], "--init-window: must be from 2"),
     (["--init-window", "20", "--from-rest"], "not with --periodic or --from-rest"),
-    (["--init-window", "20", "--model", "bouc-wen"], "not yet to --model bouc-wen"),
+    (["--init-window", "20", "--model", "bouc-wen"], "apply to the element links"),
+    (["--offset", "both", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
+     "estimates only their position offsets"),
     (["--asymmetric", "--model", "jenkins"], "--asymmetric applies to --model coulomb"),
     (["--asymmetric", "--model", "coulomb", "--plant", "two-mass"], "--plant mass-damper only"),
 ])
@@ -190,3 +192,27 @@ def test_cli_window_and_asymmetric_refusals(tmp_path, capsys, options, message):
     assert main(["identify", str(path), "--record", "input-output", *plant, *options]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and message in err
+
+
+def test_bouc_wen_position_offsets():
+    """The Bouc-Wen route estimates each record's position offset (projected out of the
+    search) with its standard error; from exact data the offsets and the system are found."""
+    from motionhyst.hysteresis import BoucWen
+
+    true = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), BoucWen(k=5e4, fc=20.0, beta=0.6,
+                                                               gamma=0.2))
+    t = np.arange(1024) / 750
+    recs = []
+    for i, (a, offset) in enumerate(((40.0, 3e-5), (25.0, -1e-5))):
+        u = a * np.sin(2 * np.pi * 8 * t + i) + 20 * np.sin(2 * np.pi * 31 * t)
+        recs.append(IORecord(t, u, true.simulate(t, u).displacement + offset, f"r{i}"))
+    fit = identify_io(recs, offset="output")
+    assert fit.plant.m == pytest.approx(2.0, rel=1e-6)
+    assert fit.estimates["alpha"] == pytest.approx(5e4, rel=1e-6)
+    assert fit.estimates["output_offset[0]"] == pytest.approx(3e-5, rel=1e-6)
+    assert fit.estimates["output_offset[1]"] == pytest.approx(-1e-5, rel=1e-6)
+    assert fit.std["output_offset[0]"] is not None
+    assert fit.extra["offsets"]["output"] == [fit.estimates["output_offset[0]"],
+                                              fit.estimates["output_offset[1]"]]
+    with pytest.raises(ValueError, match="only its position offsets"):
+        identify_io(recs, offset="input")

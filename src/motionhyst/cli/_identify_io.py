@@ -145,12 +145,13 @@ def run_input_output(args: argparse.Namespace) -> int:
         _check_savable_plant(plant)
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
-    if model == "bouc-wen" and (args.offset not in (None, "none") or args.from_rest
-                                or args.max_evaluations is not None
-                                or args.init_window is not None):
-        raise UsageError("motionhyst identify: --offset, --from-rest, --init-window and "
-                         "--max-evaluations apply to the element links (not yet to --model "
-                         "bouc-wen); give --offset none")
+    if model == "bouc-wen" and (args.from_rest or args.init_window is not None
+                                or args.offset not in (None, "none", "auto", "output")
+                                or (args.offset == "output" and plant != "mass-spring-damper")):
+        raise UsageError("motionhyst identify: --model bouc-wen starts its records at rest "
+                         "and estimates only their position offsets (--offset output, on a "
+                         "mass-spring-damper); --from-rest, --init-window and the force offset "
+                         "apply to the element links")
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
@@ -160,7 +161,8 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
-    extras = ({} if model == "bouc-wen" else
+    extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
+              if model == "bouc-wen" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
                "asymmetric": args.asymmetric})

@@ -244,7 +244,8 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         position (one per record); ``auto``: both for a floating stage's records
         from a start, none for its periodic records, the position's for a stage
         on a spring (where a force offset is only a position offset ``u0 / k``).
-        Bouc-Wen: ``auto`` and ``none`` only (none estimated).
+        Bouc-Wen: ``auto`` and ``none`` estimate none, ``output`` each record's
+        position offset (on a mass-spring-damper).
     from_rest : bool
         The records start at rest; otherwise each record's initial velocity (and
         position, on a spring) is estimated (the element links).
@@ -317,9 +318,12 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
                                     plant, output, offset, from_rest, max_evaluations,
                                     int(init_window) if init_window is not None else None,
                                     asymmetric)
-    if offset not in ("auto", "none") or from_rest or init_window is not None:
-        raise ValueError("offsets and initial states are estimated with the element links, "
-                         "not yet with Bouc-Wen: use offset 'none'")
+    bouc_wen_offset = offset == "output" and plant == "mass-spring-damper"
+    if (offset not in ("auto", "none") and not bouc_wen_offset) or from_rest \
+            or init_window is not None:
+        raise ValueError("the Bouc-Wen link's records start at rest and only its position "
+                         "offsets are estimated (offset 'output', on a mass-spring-damper); "
+                         "other offsets and initial states are estimated with the element links")
     if plant == "mass-damper":
         raise ValueError("the Bouc-Wen link is identified on a mass-spring-damper or a "
                          "two-mass stage")
@@ -328,4 +332,5 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     if plant == "two-mass":
         return identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output,
                                           t_start)
-    return identify_bouc_wen_msd(records, periodic, nu, substeps, tol, max_nfev, t_start)
+    return identify_bouc_wen_msd(records, periodic, nu, substeps, tol, max_nfev, t_start,
+                                 bouc_wen_offset)

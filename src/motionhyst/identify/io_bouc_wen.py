@@ -61,7 +61,8 @@ class _BoucWenProblem:
 
     def __init__(self, records: list[IORecord], periodic: bool, substeps: int,
                  free: NDArray[np.bool_], fixed: NDArray[np.float64], y_scale: float,
-                 force_scale: float = 1.0, plant: MassSpringDamper | TwoMass | None = None):
+                 force_scale: float = 1.0, plant: MassSpringDamper | TwoMass | None = None,
+                 output_offset: bool = False):
         self.y_scale = y_scale  # residuals in units of the output's RMS
         self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
         n_plant = len(self.plant.PARAMETERS)
@@ -69,6 +70,9 @@ class _BoucWenProblem:
         self.order = np.r_[0:3, 7:4 + n_plant, 3:7]
         # a floating stage's periodic output is known up to a constant: compared without means
         self.centre = periodic and isinstance(self.plant, TwoMass)
+        # each record's position offset, linear: projected out (the residuals and their
+        # sensitivities without their means per record); the offsets are the means
+        self.output_offset = output_offset
         # with nu free the products are searched as beta*gamma F^(nu - 1) (and delta): the
         # size of beta*gamma |z|^nu at |z| ~ F, which then does not move with nu
         self.force_scale = force_scale if free[6] else 1.0
@@ -132,6 +136,10 @@ class _BoucWenProblem:
         res = [y - (rec.y - np.mean(rec.y) if self.centre else rec.y)
                for (y, _), rec in zip(outs, self.records, strict=True)]
         rows = [s for _, s in outs]
+        if self.output_offset:
+            res = [e - np.mean(e) for e in res]
+            if jac:
+                rows = [s - np.mean(s, axis=0) for s in rows]
         r = np.concatenate(res) / self.y_scale
         if not np.all(np.isfinite(r)):
             r = np.full_like(r, 1e3)
@@ -185,13 +193,15 @@ def _force_scale(p: NDArray[np.float64], y_scale: float) -> float:
 
 
 def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | None,
-                          substeps: int | None, tol: float, max_nfev: int, t_start: float
-                          ) -> IOIdentification:
+                          substeps: int | None, tol: float, max_nfev: int, t_start: float,
+                          output_offset: bool = False) -> IOIdentification:
     """The mass-spring-damper and a Bouc-Wen link (problem order ``m, c, k, alpha,
     beta*gamma, beta*delta, nu``): the linear model by simulation error on a short part
     of the records, the starts of :func:`_bouc_wen_starts` screened there by one
     simulation each and the best refined there, then :func:`_refine` on all records from
-    the best start whose result is a valid system."""
+    the best start whose result is a valid system.  With `output_offset` each record's
+    position offset is estimated too (projected out of the search: the residuals are
+    compared without their means; the offsets and their standard errors at the end)."""
     bla = best_linear_approximation(records)
     fs = records[0].fs
     r = substeps or OpenLoop(bla).default_substeps(fs)
@@ -206,7 +216,8 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     short = short_records(records, periodic)
     lin_free = np.array([True, True, True, False, False, False, False])
     prob = _BoucWenProblem(short, periodic, r, lin_free,
-                           np.array([bla.m, bla.c, bla.k, 0.0, 0.0, 0.0, nu0]), y_scale)
+                           np.array([bla.m, bla.c, bla.k, 0.0, 0.0, 0.0, nu0]), y_scale,
+                           output_offset=output_offset)
     sol = _solve(prob, prob.fixed, scale, 1e-10, 30)
     lin = prob.full(sol.x, scale)
     n_eval = prob.n_eval
@@ -215,7 +226,8 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     # once on the short part of the records; the basic ones and the best others refined there
     free_start = free.copy()
     free_start[6] = False
-    sp = _BoucWenProblem(short, periodic, r, free_start, lin, y_scale)
+    sp = _BoucWenProblem(short, periodic, r, free_start, lin, y_scale,
+                         output_offset=output_offset)
     screened = []
     for i, p0 in enumerate(_bouc_wen_starts(lin, y_scale, nu0)):
         res, _ = sp.run(p0, False)
@@ -226,7 +238,8 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     chosen += [c for c in screened if c[1] >= len(BASIC_STARTS)][:START_REFINED]
     refined = []
     for _, _, p0 in chosen:
-        sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale)
+        sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale,
+                             output_offset=output_offset)
         s = _solve(sp, p0, scale, 1e-6, 12)
         n_eval += sp.n_eval
         refined.append((float(s.cost), len(refined), sp.full(s.x, scale)))
@@ -235,7 +248,8 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     error = None
     for _, _, p_start in refined[:FINAL_ATTEMPTS]:
         p, free_used, sol, res, std_q, groups, notes, n = _refine(
-            records, periodic, r, free, p_start, y_scale, scale, tol, max_nfev)
+            records, periodic, r, free, p_start, y_scale, scale, tol, max_nfev,
+            output_offset=output_offset)
         n_eval += n
         try:
             link = _bouc_wen_link(p[3], p[4], p[5], p[6])
@@ -259,13 +273,40 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
         std[n] = float(s) if math.isfinite(s) else None
     not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
     per_record = per_record_errors(records, res)
+    extra: dict = {}
+    if output_offset:
+        offsets, offset_std = _output_offsets(records, periodic, r, free, p, y_scale, rss,
+                                              res.size)
+        for i, (value, sd) in enumerate(zip(offsets, offset_std, strict=True)):
+            name = "output_offset" if len(records) == 1 else f"output_offset[{i}]"
+            estimates[name] = value
+            std[name] = sd
+        extra = {"offsets": {"input": 0.0, "output": offsets}}
     return IOIdentification(
         plant=plant, hysteresis=link, estimates=estimates, std=std,
         not_identifiable=not_ident, fit_rms=float(np.sqrt(rss / res.size)),
         records=per_record, seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r)
+        n_evaluations=n_eval, substeps=r, extra=extra)
+
+
+def _output_offsets(records, periodic, r, free, p, y_scale, rss, n_rows):
+    """Each record's position offset (the mean of its data less the model's output) and its
+    standard error, from the Jacobian of the parameters and offsets together."""
+    prob = _BoucWenProblem(records, periodic, r, free, p, y_scale)
+    res, jac = prob.run(p, True)
+    offsets, columns, i = [], [], 0
+    for rec in records:
+        rows = slice(i, i + rec.y.size)
+        offsets.append(float(-np.mean(res[rows]) * y_scale))
+        e = np.zeros(res.size)
+        e[rows] = 1.0
+        columns.append(e)
+        i += rec.y.size
+    J = np.column_stack([jac[:, free] * y_scale, *columns])
+    std_all, _ = standard_errors(J, rss, n_rows)
+    return offsets, [float(s) if math.isfinite(s) else None for s in std_all[-len(records):]]
 
 
 #: Starts of the Bouc-Wen link, screened by one simulation each: the link's initial
@@ -301,14 +342,16 @@ def _bouc_wen_starts(lin: NDArray[np.float64], y_scale: float, nu: float
     return starts
 
 
-def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=None):
+def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=None,
+            output_offset=False):
     """Refinement on all records; with ``nu`` free and no ultimate force, ``nu = 1`` if the
     data cannot tell it from 1 (the only ``nu`` such links are admitted for)."""
     notes: dict[str, str] = {}
     n_eval = 0
     while True:
         prob = _BoucWenProblem(records, periodic, r, free, p, y_scale,
-                               _force_scale(p, y_scale), plant=plant)
+                               _force_scale(p, y_scale), plant=plant,
+                               output_offset=output_offset)
         sol = _solve(prob, p, scale, tol, max_nfev)
         n_eval += prob.n_eval
         p = prob.full(sol.x, scale)
