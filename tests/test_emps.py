@@ -187,3 +187,19 @@ def test_identify_and_predict_a_mat_record_with_the_window(tmp_path, capsys):
     assert main(["predict", str(model), str(path), "--out", str(tmp_path / "p2.csv"),
                  *maps]) == 2
     assert "displacement" in capsys.readouterr().err
+
+
+def test_with_the_test_record_the_whole_estimation_record_is_used():
+    """With the test record the models are identified on the whole estimation record and
+    scored on the test record (the benchmark's protocol), and the output says so."""
+    rec = axis_record(n_periods=2)
+    test = IORecord(rec.t, rec.u, rec.y, "DATA_EMPS_PULSES")
+    res = run_emps(IORecord(rec.t, rec.u, rec.y, "DATA_EMPS"), test, models=("coulomb",),
+                   period=PERIOD)
+    assert res.official_test
+    assert res.estimation_record.t.size == rec.t.size
+    (model,) = res.models
+    assert model.estimation["record"] == "DATA_EMPS"
+    assert model.validation["record"] == "DATA_EMPS_PULSES"
+    assert model.parameters["m"] == pytest.approx(TRUE["m"], rel=0.02)
+    assert "was not given" not in str(res)
