@@ -146,8 +146,10 @@ class OpenLoop:
     Parameters
     ----------
     plant : Plant
-        The stage, a plant with inertia (:class:`~motionhyst.plants.registry.Plant`);
-        the force and the link act on its link coordinate.
+        The stage (:class:`~motionhyst.plants.registry.Plant`); the force and the
+        link act on its link coordinate.  A plant without inertia
+        (:class:`~motionhyst.plants.quasi_static.QuasiStatic`) is the link's balance
+        at each sample (:mod:`motionhyst.time.quasi_static`).
     hysteresis : Hysteresis or None
         The link's model (None: the linear stage alone).
 
@@ -183,7 +185,10 @@ class OpenLoop:
 
     def default_substeps(self, fs: float) -> int:
         """Integration steps per record sample: >= 20 and >= 400 per period of the fastest
-        mode (the link taken as its initial stiffness)."""
+        mode (the link taken as its initial stiffness); 1 for a plant without inertia (no
+        mode: the balance is solved at the samples, :mod:`motionhyst.time.quasi_static`)."""
+        if not self.plant.has_inertia:
+            return 1
         f_n = self.plant.mechanics().natural_frequency_hz(self._k_link())
         return max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
 
@@ -215,13 +220,19 @@ class OpenLoop:
             only if the link carries the force's mean, and then at any constant
             offset: it is returned with zero mean.
         substeps : int, optional
-            Integration steps per sample (default :meth:`default_substeps`).
+            Integration steps per sample (default :meth:`default_substeps`; a plant
+            without inertia has none: ignored).
 
         Returns
         -------
         OpenLoopResponse
         """
         tt, u = check_record(t, force)
+        if not self.plant.has_inertia:  # no masses: the link balances the force at each sample
+            from motionhyst.time.quasi_static import displacement_from_force
+
+            y = displacement_from_force(self.plant, self.hysteresis, tt, u, periodic=periodic)
+            return OpenLoopResponse(tt, u, y, periodic)
         fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
         # the force at every integration step and midpoint, and the response at each step

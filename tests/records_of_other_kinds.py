@@ -1,0 +1,128 @@
+"""Generated records of machines without visible inertia: a piezo stack and a friction damper.
+
+Each record is simulated from known parameters, with the offsets and the noise of a
+measurement, so that a test can check what identification recovers and how well the model
+predicts a part of the record it did not see.
+
+* A piezo actuator (force from its voltage in, displacement out): rate-dependent hysteresis
+  without inertia, a Bouc-Wen link with a spring and a damper in parallel
+  (``QuasiStatic(k, c)``); its first resonance (kHz) far above the records' content.
+* A friction damper (displacement imposed by a test machine, force measured): a
+  Maxwell-slip link with a parallel spring, under sines and earthquake-like histories
+  (band-limited noise under a rise-plateau-decay envelope).
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy import signal
+
+from motionhyst.hysteresis import BoucWen, MaxwellSlip
+from motionhyst.plants import QuasiStatic
+from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
+
+#: The piezo stack: stiffness 40 N/um, a Bouc-Wen hysteresis of 15 % of the stroke, a damper
+#: whose force is 5 % of the spring's at 100 Hz (the hysteresis' rate dependence)
+PIEZO_PLANT = QuasiStatic(k=4.0e7, c=3.0e3, force_offset=-12.0)
+PIEZO_LINK = BoucWen(k=1.5e7, fc=150.0, n=1.0, beta=0.6, gamma=0.4)
+PIEZO_OUTPUT_OFFSET = 3.0e-6  # the capacitive sensor's zero [m]
+PIEZO_NOISE = 2.0e-9  # [m]
+#: The friction damper: a spring of 50 kN/m and three Jenkins elements (slip 2-8 mm)
+DAMPER_PLANT = QuasiStatic(k=5.0e4)
+DAMPER_LINK = MaxwellSlip(k=[1.5e6, 6.0e5, 2.5e5], fc=[3.0e3, 2.4e3, 2.0e3])
+DAMPER_FORCE_OFFSET = 85.0  # the load cell's zero [N]
+DAMPER_NOISE = 15.0  # [N]
+
+
+@dataclass
+class Record:
+    """A generated record: time, force, displacement as measured."""
+
+    t: np.ndarray
+    force: np.ndarray
+    displacement: np.ndarray
+
+    def split(self, share: float) -> tuple[Record, Record]:
+        """The first `share` of the samples, and the rest (its time from 0)."""
+        n = int(share * self.t.size)
+        rest = Record(self.t[n:] - self.t[n], self.force[n:], self.displacement[n:])
+        return Record(self.t[:n], self.force[:n], self.displacement[:n]), rest
+
+    def write(self, path: Path, columns: tuple[str, ...] = ("time", "force", "displacement")
+              ) -> Path:
+        """A CSV with these columns (of ``time``, ``force``, ``displacement``)."""
+        data = {"time": self.t, "force": self.force, "displacement": self.displacement}
+        with open(path, "w", newline="") as f:
+            out = csv.writer(f)
+            out.writerow(columns)
+            out.writerows(zip(*(data[c] for c in columns), strict=True))
+        return path
+
+
+def fit_percent(y: np.ndarray, y_hat: np.ndarray) -> float:
+    """``100 (1 - |y - y_hat| / |y - mean y|)``, the benchmarks' fit."""
+    return float(100.0 * (1.0 - np.linalg.norm(y - y_hat) / np.linalg.norm(y - np.mean(y))))
+
+
+def stepped_sines(t: np.ndarray, pieces: list[tuple[float, float]]) -> np.ndarray:
+    """Sines of (frequency [Hz], amplitude) one after another, each over an equal share of
+    `t`, each a whole number of periods faded in and out (a Hann taper)."""
+    out = np.zeros_like(t)
+    edges = np.linspace(0, t.size, len(pieces) + 1).astype(int)
+    for (f, a), i0, i1 in zip(pieces, edges[:-1], edges[1:], strict=True):
+        tau = t[i0:i1] - t[i0]
+        n = tau.size
+        out[i0:i1] = a * np.sin(2 * np.pi * f * tau) * np.sin(np.pi * np.arange(n) / n) ** 0.5
+    return out
+
+
+def earthquake_like(t: np.ndarray, rng: np.random.Generator, peak: float,
+                    band_hz: tuple[float, float] = (0.3, 6.0)) -> np.ndarray:
+    """Band-limited noise under a rise, strong phase and decay envelope, scaled to `peak`."""
+    fs = 1.0 / (t[1] - t[0])
+    sos = signal.butter(4, band_hz, btype="bandpass", fs=fs, output="sos")
+    x = signal.sosfiltfilt(sos, rng.standard_normal(t.size))
+    d = t[-1] - t[0]
+    rise = np.clip((t - t[0]) / (0.15 * d), 0.0, 1.0) ** 2
+    decay = np.exp(-np.clip(t - t[0] - 0.45 * d, 0.0, None) / (0.15 * d))
+    x *= rise * decay * np.sin(np.pi * (t - t[0]) / d) ** 0.25  # ends at rest
+    return peak * x / np.max(np.abs(x))
+
+
+def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
+                 seconds: float = 2.0) -> Record:
+    """A piezo stack's record: force (from its voltage) in, displacement out, measured.
+
+    `history`: ``"sines"`` (1 to 100 Hz, 0.3 to 1 of the full force) or ``"earthquake"``.
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(seconds * fs)) / fs
+    if history == "sines":
+        u = stepped_sines(t, [(2.0, 600.0), (10.0, 350.0), (40.0, 500.0), (100.0, 250.0)])
+    else:
+        u = earthquake_like(t, rng, 600.0, (1.0, 60.0))
+    u_measured = u - PIEZO_PLANT.force_offset  # the drive's offset: the stack gets u + f0
+    x = displacement_from_force(PIEZO_PLANT, PIEZO_LINK, t, u_measured)
+    y = x + PIEZO_OUTPUT_OFFSET + PIEZO_NOISE * rng.standard_normal(t.size)
+    return Record(t, u_measured, y)
+
+
+def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
+                  seconds: float = 40.0) -> Record:
+    """A friction damper's record: displacement imposed, force measured (with offset, noise).
+
+    `history`: ``"sines"`` (0.2 to 2 Hz, 3 to 20 mm) or ``"earthquake"`` (20 mm peak).
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(seconds * fs)) / fs
+    if history == "sines":
+        x = stepped_sines(t, [(0.2, 0.02), (0.5, 0.008), (1.0, 0.014), (2.0, 0.003)])
+    else:
+        x = earthquake_like(t, rng, 0.02)
+    w = force_from_displacement(DAMPER_PLANT, DAMPER_LINK, t, x)
+    f = w + DAMPER_FORCE_OFFSET + DAMPER_NOISE * rng.standard_normal(t.size)
+    return Record(t, f, x)
