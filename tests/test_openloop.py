@@ -208,6 +208,15 @@ def test_two_mass_periodic_equals_the_end_of_a_long_run_from_rest(link):
     assert np.max(np.abs(y_long[:n] - np.mean(y_long[:n]) - y_per)) > 1e-3 * np.ptp(y_per)
 
 
+def test_a_record_of_whole_periods_is_the_steady_state_of_one_period_repeated():
+    n = 512
+    u = _odd_multisine(n, 2)
+    sys = OpenLoop(TWO, MaxwellSlip(k=[2e4, 3e4], fc=[10.0, 80.0]))
+    one = sys.simulate(np.arange(n) / FS, u, periodic=True).displacement
+    four = sys.simulate(np.arange(4 * n) / FS, np.tile(u, 4), periodic=True).displacement
+    assert np.array_equal(four, np.tile(one, 4))
+
+
 def test_two_mass_that_drifts_has_no_periodic_steady_state():
     # an unsymmetric force ratchets the floating stage through a Bouc-Wen link: the motion
     # repeats, the position moves on by the same distance every period

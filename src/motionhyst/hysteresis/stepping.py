@@ -86,6 +86,33 @@ class Stepping:
             params[j, :len(p)] = p
         return cls(codes, params, np.zeros(len(rows)), float(scale))
 
+    def state_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The range of each element's state: ``(lo, hi)`` (infinite where it has none).
+
+        A stop operator's force within its slip force, a rigid slider's within its
+        slip forces, a Dahl element's normalised force within 1, LuGre's bristle
+        deflection within ``max(fc, fs) / sigma0``.
+
+        Examples
+        --------
+        >>> from motionhyst import MaxwellSlip
+        >>> MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).time_stepping().state_bounds()[1]
+        array([0.01, 0.03])
+        """
+        lo = np.full(self.codes.size, -np.inf)
+        hi = np.full(self.codes.size, np.inf)
+        for j, (code, p) in enumerate(zip(self.codes, self.params, strict=True)):
+            if code == STOP:
+                lo[j], hi[j] = -p[1], p[1]
+            elif code == COULOMB:
+                lo[j], hi[j] = -p[1], p[0]
+            elif code == DAHL:
+                lo[j], hi[j] = -1.0, 1.0
+            elif code == LUGRE:
+                hi[j] = max(p[3], p[4]) / p[0]
+                lo[j] = -hi[j]
+        return lo, hi
+
     @classmethod
     def empty(cls) -> Stepping:
         """No link: no elements, unit force scale."""

@@ -26,7 +26,12 @@ from numpy.typing import NDArray
 from motionhyst.core.compiled import njit
 from motionhyst.hysteresis import BoucWen
 from motionhyst.plants.mass_spring_damper import MassSpringDamper
-from motionhyst.time.periodic_runs import max_periods, periodic_output
+from motionhyst.time.periodic_runs import (
+    PeriodExtrapolation,
+    max_periods,
+    periodic_output,
+    whole_periods,
+)
 from motionhyst.time.resample import fine_input
 
 if TYPE_CHECKING:
@@ -269,6 +274,11 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
     >>> y.shape, dy.shape
     ((300,), (300, 8))
     """
+    n = whole_periods(u) if periodic else 1
+    if n > 1:  # the steady state of one period, repeated
+        y, sy = simulate_bouc_wen(p, u[: u.size // n], fs, r, periodic=True,
+                                  sensitivities=sensitivities, plant=plant)
+        return np.tile(y, n), np.tile(sy, (n, 1))
     structure = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
     n_plant = len(structure.PARAMETERS)
     p = np.ascontiguousarray(p, dtype=float)
@@ -304,10 +314,15 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
         x0[:-1] = mech.linear_periodic_state(u, fs, lp[0])
         x0[-1] = lp[0] * x0[mech.link]
     state = [x0, s0]
+    extrapolate = PeriodExtrapolation(weighted=(0,))  # the sensitivities follow the state
 
     def next_period():
         y, sy, state[0], state[1] = run(*state)
-        return y, sy, bool(np.all(np.isfinite(state[0])))
+        finite = bool(np.all(np.isfinite(state[0])))
+        jump = extrapolate(state) if finite else None
+        if jump is not None:
+            state[:] = jump
+        return y, sy, finite
 
     return periodic_output(next_period, max_periods(mech_tau, lp[0], u.size / fs),
                             mech.floating, bool(sensitivities))

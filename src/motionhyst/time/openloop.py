@@ -77,9 +77,11 @@ from motionhyst.time.kernel import MAX_FIXED_POINT_ITERATIONS, OPEN
 from motionhyst.time.periodic_runs import MAX_PERIODIC_DECAYS as MAX_PERIODIC_DECAYS
 from motionhyst.time.periodic_runs import PERIODIC_RTOL as PERIODIC_RTOL
 from motionhyst.time.periodic_runs import (
+    PeriodExtrapolation,
     floating_linear_periodic,
     max_periods,
     periodic_output,
+    whole_periods,
 )
 from motionhyst.time.resample import SINC_HALF_WIDTH as SINC_HALF_WIDTH
 from motionhyst.time.resample import STAMP_TOLERANCE as STAMP_TOLERANCE
@@ -337,6 +339,11 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     >>> bool(np.array_equal(y, ref.displacement)), dy.shape    # m, c, k, link k, fc
     (True, (256, 5))
     """
+    n_periods = whole_periods(u) if periodic else 1
+    if n_periods > 1:  # the steady state of one period, repeated
+        y, dy = simulate_elements(mech, stepping, u[: u.size // n_periods], fs, r,
+                                  periodic=True, k_link=k_link, dparams=dparams)
+        return np.tile(y, n_periods), np.tile(dy, (n_periods, 1))
     h = 1.0 / (fs * r)
     sens = dparams is not None
     Ad, B0, B1, dAd, dB0, dB1 = mech.foh(h, derivatives=sens)
@@ -383,10 +390,15 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         y, sy, *_ = run(x, s, sx, ss)
         return y, sy
     state = [x, s, sx, ss]
+    extrapolate = PeriodExtrapolation(bounded={1: stepping.state_bounds()}, weighted=(0, 1))
 
     def next_period():
         y, sy, *state[:] = run(*state)
-        return y, sy, bool(np.all(np.isfinite(state[0])))
+        finite = bool(np.all(np.isfinite(state[0])))
+        jump = extrapolate(state) if finite else None
+        if jump is not None:
+            state[:] = jump
+        return y, sy, finite
 
     return periodic_output(next_period, max_periods(mech, k_link, u.size / fs),
                             mech.floating, sens)

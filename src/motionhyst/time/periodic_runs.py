@@ -29,12 +29,17 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from motionhyst.plants.mechanics import Mechanics
 
-__all__ = ["MAX_PERIODIC_DECAYS", "PERIODIC_RTOL", "periodic_output", "settled"]
+__all__ = ["EXTRAPOLATION_PERIODS", "MAX_PERIODIC_DECAYS", "MIN_PERIOD_SAMPLES", "PERIODIC_RTOL",
+           "PeriodExtrapolation", "periodic_output", "settled", "whole_periods"]
 
 #: A period's output repeats the previous one to this fraction of its amplitude.
 PERIODIC_RTOL = 1e-12
 #: Periodic runs stop after this many time constants of the slowest mode.
 MAX_PERIODIC_DECAYS = 60.0
+#: A record is run as one period repeated only if its period has this many samples
+MIN_PERIOD_SAMPLES = 16
+#: Period-start states that one extrapolation of the period map's fixed point takes
+EXTRAPOLATION_PERIODS = 6
 
 
 _NO_STEADY_STATE = ("the periodic steady state was not reached (the response does not settle "
@@ -81,6 +86,30 @@ def settled(y: NDArray[np.float64], prev: NDArray[np.float64], floating: bool,
                          f"from rest describes this force)")
     last_step[:] = [step]
     return False
+
+
+def whole_periods(u: NDArray[np.float64]) -> int:
+    """How many whole periods of one signal the force record `u` holds (1: not periodic).
+
+    A periodic steady state repeats with the force's period, so a record of
+    ``n`` periods needs the steady state of one, repeated ``n`` times.
+
+    Parameters
+    ----------
+    u : ndarray
+        The record's samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> whole_periods(np.tile(np.sin(np.linspace(0, 6, 50)), 4)), whole_periods(np.arange(7.0))
+    (4, 1)
+    """
+    from motionhyst.time.resample import is_periodic_record
+
+    p = is_periodic_record(np.asarray(u, dtype=float))
+    # a period of a few samples (a constant force) is left whole: too short to upsample
+    return 1 if p is None or p < MIN_PERIOD_SAMPLES else u.size // p
 
 
 def max_periods(mech: Mechanics, k_link: float, period_s: float) -> int:
@@ -146,6 +175,99 @@ def periodic_output(next_period, periods: int, floating: bool, sensitivities: bo
             break
         prev = (y, sy)
     raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if floating else ""))
+
+
+class PeriodExtrapolation:
+    """The periodic state extrapolated from the states that successive periods start from.
+
+    Repeating a period is a fixed-point iteration ``z <- F(z)`` of the state at
+    the period's start; a lightly damped mode (a floating stage on its link's
+    spring) forgets its start only over many periods.  Near the steady state
+    ``F`` is nearly affine, and every :data:`EXTRAPOLATION_PERIODS` states
+    ``z_0 .. z_k`` give its fixed point by reduced-rank extrapolation (RRE,
+    Sidi 2017, ch. 1): ``z* = sum g_j z_j`` with ``sum g_j = 1`` minimising
+    ``|sum g_j (z_{j+1} - z_j)|`` (each component scaled by its block's
+    spread), exact for an affine map with up to ``k - 1`` modes.  Blocks
+    named in `bounded` (element states with a range, such as a stop
+    operator's force within its slip force) are clipped to it.  The run
+    continues from ``z*``; the periodic check (:func:`periodic_output`) still
+    decides when the output repeats.
+
+    Parameters
+    ----------
+    bounded : dict, optional
+        Block index -> ``(lo, hi)``, arrays of the block's shape (or scalars).
+    periods : int
+        States per extrapolation.
+    weighted : tuple of int, optional
+        The blocks whose differences choose the weights ``g`` (default: all); the
+        others (sensitivities) are combined with the same weights, so that a run
+        with them follows the same states as one without.
+
+    Examples
+    --------
+    An affine map with a slowly decaying rotation (a lightly damped mode): its fixed point
+    ``(1, 2)`` from six iterates, where iterating alone is still 0.2 away:
+
+    >>> import numpy as np
+    >>> c, s = 0.98 * np.cos(0.3), 0.98 * np.sin(0.3)
+    >>> A, b = np.array([[c, -s], [s, c]]), np.array([1.0, 2.0])
+    >>> step = lambda z: A @ (z - b) + b
+    >>> ex, z = PeriodExtrapolation(), np.zeros(2)
+    >>> for _ in range(6):
+    ...     z = step(z)
+    ...     jump = ex([z])
+    >>> [round(float(v), 9) for v in jump[0]], round(float(np.linalg.norm(z - b)), 1)
+    ([1.0, 2.0], 2.0)
+    """
+
+    def __init__(self, bounded: dict[int, tuple] | None = None,
+                 periods: int = EXTRAPOLATION_PERIODS,
+                 weighted: tuple[int, ...] | None = None) -> None:
+        self.bounded = dict(bounded or {})
+        self.periods = int(periods)
+        self.weighted = weighted
+        self.history: list[list[NDArray[np.float64]]] = []
+
+    def __call__(self, blocks: list[NDArray[np.float64]]) -> list[NDArray[np.float64]] | None:
+        """Record the state a period starts from; every `periods` states, the extrapolated
+        state (same blocks, copies), else None."""
+        self.history.append([np.array(b, dtype=float, copy=True) for b in blocks])
+        if len(self.history) < self.periods:
+            return None
+        hist, self.history = self.history, []
+        Z = np.array([np.concatenate([b.ravel() for b in h]) for h in hist])  # (k + 1, n)
+        if not np.all(np.isfinite(Z)):
+            return None
+        # each block scaled by its spread over the history (positions, forces, sensitivities)
+        scale = np.empty(Z.shape[1])
+        i = 0
+        for j, b in enumerate(hist[-1]):
+            spread = (float(np.max(np.abs(Z[:, i:i + b.size] - Z[-1, i:i + b.size])))
+                      if b.size and (self.weighted is None or j in self.weighted) else 0.0)
+            scale[i:i + b.size] = 1.0 / spread if spread > 0 else 0.0
+            i += b.size
+        D = np.diff(Z, axis=0) * scale  # (k, n)
+        G = D @ D.T
+        k = G.shape[0]
+        # min |D^T g| with sum g = 1: G g = lambda 1 (Lagrange), solved in the least-squares sense
+        try:
+            g = np.linalg.lstsq(G + 1e-14 * np.trace(G) * np.eye(k), np.ones(k), rcond=None)[0]
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(g)) or abs(np.sum(g)) < 1e-300:
+            return None
+        g /= np.sum(g)
+        z = g @ Z[:-1]
+        out, i = [], 0
+        for j, b in enumerate(hist[-1]):
+            block = z[i:i + b.size]
+            block = block.reshape(b.shape)
+            if j in self.bounded and b.size:
+                block = np.clip(block, *self.bounded[j])
+            out.append(block)
+            i += b.size
+        return out if all(np.all(np.isfinite(b)) for b in out) else None
 
 
 def floating_linear_periodic(mech: Mechanics, u: NDArray[np.float64], fs: float
