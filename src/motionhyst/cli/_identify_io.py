@@ -94,7 +94,9 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                         "'free' to estimate it")
     q.add_argument("--save", metavar="MODEL.toml",
                    help="input-output records: write the identified system as a scenario "
-                        "(read by motionhyst predict)")
+                        "(read by motionhyst predict); force-displacement records: the link "
+                        "as a system without inertia (a quasi-static [stage]), whose force "
+                        "predict gives for a displacement record")
     q.add_argument("--force", action="store_true", help="replace the --save file if it exists")
 
 
@@ -102,7 +104,7 @@ def check_not_input_output(args: argparse.Namespace) -> None:
     """One-line error for input-output options given with another record kind."""
     for option, value in (("--plant", args.plant), ("--model", args.model),
                           ("--periodic", args.periodic or None), ("--nu", args.nu),
-                          ("--save", args.save), ("--output", args.output),
+                          ("--output", args.output),
                           ("--offset", args.offset), ("--from-rest", args.from_rest or None),
                           ("--max-evaluations", args.max_evaluations),
                           ("--init-window", args.init_window),

@@ -146,6 +146,14 @@ def run(args: argparse.Namespace) -> int:
                                  f"record")
     options = {"n_elements": args.elements, "criterion": args.criterion or "rms"}
     extra: dict = {"record": kind, "data": str(path)}
+    target = None
+    if args.save is not None:  # refused before the work, not after
+        if kind != "force-displacement":
+            raise UsageError(f"motionhyst identify: --save applies to input-output and "
+                             f"force-displacement records; {path} is a closed-loop record")
+        from motionhyst.io.outputs import OutputFile
+
+        target = OutputFile(args.save, force=args.force, inputs=[path], option="--save")
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         what = "force-displacement record"
@@ -153,6 +161,9 @@ def run(args: argparse.Namespace) -> int:
             ident = identify_maxwell_slip(x, w, t=t, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+        if target is not None:  # the link alone, a system without inertia, for predict
+            target.write_text(ident.scenario_text(f"{path}"))
+            extra["saved"] = args.save
     else:
         if args.scenario is None:
             raise UsageError(f"motionhyst identify: {path} is a closed-loop record: give the "
@@ -194,6 +205,9 @@ def run(args: argparse.Namespace) -> int:
     print("# hysteresis feedforward, to paste into a scenario (replaces its [feedforward];")
     print("# the same inline table is a valid [hysteresis] section to model the link):")
     print(feedforward_fragment(k, fc), end="")
+    if target is not None:
+        print(f"\nwrote {args.save} (the link without inertia: motionhyst predict gives its "
+              f"force for a displacement record)")
     return 0
 
 

@@ -1,4 +1,5 @@
-"""``motionhyst predict``: the displacement of an open-loop system for a force record."""
+"""``motionhyst predict``: the displacement of an open-loop system for a force record, or the
+force of a system without inertia for a displacement record."""
 
 from __future__ import annotations
 
@@ -16,26 +17,31 @@ INIT_WINDOW = 20  # the EMPS benchmark's initialisation window [samples]
 
 def add_parser(sub) -> None:
     """Add the ``predict`` command to the subparsers `sub`."""
-    q = sub.add_parser("predict", help="displacement of an open-loop system (mass-spring-damper "
-                       "or two-mass scenario without controller) for a force record (CSV)")
+    q = sub.add_parser("predict", help="displacement of an open-loop system (a scenario without "
+                       "controller) for a force record, or force of a system without inertia "
+                       "for a displacement record (CSV)")
     q.add_argument("scenario", metavar="MODEL.toml",
-                   help='open-loop scenario: [stage] type = "mass-spring-damper", or a two-mass '
-                        '[stage] with output = "y2" or "y1" (the position written), and '
-                        "[hysteresis] (as written by motionhyst identify --save)")
-    q.add_argument("data", metavar="INPUT.csv", help="force record: time,force [s, N], uniform "
-                   "time steps (stamps within 0.05 of a step of a uniform grid); CSV with a "
-                   "header or MATLAB .mat")
-    add_record_options(q, "time,force", "time=t,force=vir")
+                   help='open-loop scenario: [stage] type = "mass-spring-damper", '
+                        '"mass-damper", "quasi-static" (no inertia), or a two-mass [stage] '
+                        'with output = "y2" or "y1" (the position written), and [hysteresis] '
+                        "(as written by motionhyst identify --save)")
+    q.add_argument("data", metavar="INPUT.csv", help="force record: time,force [s, N]; or, for "
+                   "a quasi-static model (the link alone, as a force-displacement record's "
+                   "identify --save writes it), displacement record: time,displacement [s, "
+                   "m]; uniform time steps (stamps within 0.05 of a step of a uniform grid); "
+                   "CSV with a header or MATLAB .mat")
+    add_record_options(q, "time,force or time,displacement", "time=t,force=vir")
     q.add_argument("--periodic", action="store_true",
                    help="the record is one period (or whole periods) of a periodic force: "
                         "output the periodic steady state (default: from rest; a floating "
                         "two-mass stage: with zero mean, an error if it drifts)")
     q.add_argument("--out", required=True, metavar="OUT.csv",
                    help="output CSV: time,displacement [s, m] on the input's time grid (a "
-                        "two-mass stage: the position its [stage] output names)")
+                        "two-mass stage: the position its [stage] output names); for a "
+                        "displacement record time,force [s, N]")
     q.add_argument("--substeps", type=int, metavar="N",
                    help="integration steps per sample (default: >= 20 and >= 400 per period "
-                        "of the stage's fastest mode)")
+                        "of the stage's fastest mode; a quasi-static model has none)")
     q.add_argument("--init-from", metavar="REC.csv",
                    help="a measured record of the same samples (time,force,displacement): the "
                         "model's initial state (velocity, and position or the position's "
@@ -71,6 +77,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst predict: --init-window must be at least 2, got {window}")
     sc = Scenario.from_file(args.scenario)
     system = sc.open_loop()
+    if _input_quantity(args, system) == "displacement":
+        return _predict_force(args, sc, system, target)
     both = args.init_from is not None  # the maps also name the --init-from record's position
     data = read_record(args.data, ("time", "force"),
                        columns=_only(args.columns) if both else args.columns,
@@ -138,3 +146,48 @@ def _check_step(system, t, args) -> None:
         raise ValueError(f"{args.scenario}: the model needs {r} integration steps per sample "
                          f"(more than {MAX_PREDICT_SUBSTEPS}: a mass nearly zero on a stiff "
                          f"link); a quasi-static plant describes a stage without inertia")
+
+
+def _input_quantity(args: argparse.Namespace, system) -> str:
+    """``force`` or ``displacement``: what INPUT holds for the model (a model with inertia, or
+    a record with a force, takes the force; only a model without inertia gives the force of
+    a displacement record)."""
+    from motionhyst.io.records import record_columns
+
+    if system.plant.has_inertia:
+        return "force"  # a record without one is refused by its reader, naming the columns
+    names = record_columns(args.data, args.columns)
+    if "force" in names or "displacement" not in names:
+        return "force"
+    for option in ("--init-from", "--substeps"):
+        if getattr(args, option[2:].replace("-", "_"), None) is not None:
+            raise UsageError(f"motionhyst predict: {option} applies to a force record (the "
+                             f"displacement predicted); {args.data} holds a displacement")
+    return "displacement"
+
+
+def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
+    """The force that holds a model without inertia at the displacement record INPUT."""
+    from motionhyst.io.records import read_record
+    from motionhyst.time.quasi_static import force_from_displacement
+
+    data = read_record(args.data, ("time", "displacement"), columns=args.columns,
+                       scale=args.scale)
+    t, x = data[:, 0], data[:, 1]
+    try:
+        w = force_from_displacement(system.plant, system.hysteresis, t, x,
+                                    periodic=args.periodic)
+    except (ValueError, ArithmeticError) as exc:  # a record or model the run refuses
+        raise ValueError(f"{args.data}: {exc or type(exc).__name__}") from None
+    target.write_csv({"time": t, "force": w}, fmt="%.17g")
+    summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
+               "predicted": "force", "force_rms": float(np.sqrt(np.mean(w ** 2))),
+               "force_peak": float(np.max(np.abs(w)))}
+    if args.json:
+        print_json(summary)
+        return 0
+    what = "periodic steady state" if args.periodic else "the link relaxed at 0 before it"
+    print(f"Predicted the force of {sc.source} for the {t.size} displacement samples of "
+          f"{args.data} ({what}) -> {args.out}")
+    print(f"  force RMS {summary['force_rms']:.4g} N, peak {summary['force_peak']:.4g} N")
+    return 0

@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.core.textfiles import toml_table
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.plants.quasi_static import QuasiStatic
 
 __all__ = ["Identification"]
 
@@ -147,6 +148,58 @@ class Identification:
 
         return plot_link(self.model, title=f"Identified Maxwell-slip link, "
                          f"{self.n_elements} element(s)", ax=ax)
+
+    def link_model(self) -> tuple[QuasiStatic, MaxwellSlip]:
+        """The identified link as a system without inertia: the force ``u`` that holds it at
+        a displacement ``x`` is the link's plus the record's offset.
+
+        :class:`~motionhyst.plants.quasi_static.QuasiStatic` (no spring, no damper,
+        ``force_offset = -offset``) and :attr:`model`, what
+        :func:`~motionhyst.time.quasi_static.force_from_displacement` runs.
+
+        Returns
+        -------
+        (QuasiStatic, MaxwellSlip)
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from motionhyst import MaxwellSlip
+        >>> from motionhyst.identify import identify_maxwell_slip
+        >>> from motionhyst.time.quasi_static import force_from_displacement
+        >>> t = np.linspace(0.0, 4.0, 4001)
+        >>> x = 0.01 * np.sin(2 * np.pi * t)
+        >>> w = MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).response(x) + 0.002
+        >>> plant, link = identify_maxwell_slip(x, w, initial_state="relaxed").link_model()
+        >>> round(plant.force_offset, 6)
+        -0.002
+        >>> bool(np.allclose(force_from_displacement(plant, link, t, x), w, atol=1e-9))
+        True
+        """
+        return QuasiStatic(force_offset=-self.offset), self.model
+
+    def scenario_text(self, source: str = "a force-displacement record") -> str:
+        """A whole scenario (TOML) of the link as a system without inertia, for ``predict``.
+
+        ``[stage] type = "quasi-static"`` (:meth:`link_model`: the record's force
+        offset) and the ``[hysteresis]`` of :meth:`scenario_fragment`; ``motionhyst
+        predict`` gives its force for a displacement record (time,displacement) and
+        its displacement for a force record.
+
+        Parameters
+        ----------
+        source : str
+            What it was identified from (the first comment line).
+
+        Returns
+        -------
+        str
+        """
+        plant, _ = self.link_model()
+        head = (f"# the link identified from {source}, without inertia: motionhyst predict "
+                f"gives its force\n# for a displacement record (time,displacement), its "
+                f"displacement for a force record\n")
+        return head + toml_table("stage", plant.to_dict()) + "\n" + self.scenario_fragment()
 
     def scenario_fragment(self) -> str:
         """A ``[hysteresis]`` section of a scenario file (TOML), ready to paste.
