@@ -282,13 +282,16 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
             estimates[name] = value
             std[name] = sd
         extra = {"offsets": {"input": 0.0, "output": offsets}}
+    # with each record's position offset estimated, the fit is judged on the records' variations
+    warnings = _judged(records, res, plant, link, {"m": plant.m}, floating=False,
+                       centred=bool(output_offset))
     return IOIdentification(
         plant=plant, hysteresis=link, estimates=estimates, std=std,
         not_identifiable=not_ident, fit_rms=float(np.sqrt(rss / res.size)),
         records=per_record, seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r, extra=extra)
+        n_evaluations=n_eval, substeps=r, extra=extra, warnings=warnings)
 
 
 def _output_offsets(records, periodic, r, free, p, y_scale, rss, n_rows):
@@ -307,6 +310,24 @@ def _output_offsets(records, periodic, r, free, p, y_scale, rss, n_rows):
     J = np.column_stack([jac[:, free] * y_scale, *columns])
     std_all, _ = standard_errors(J, rss, n_rows)
     return offsets, [float(s) if math.isfinite(s) else None for s in std_all[-len(records):]]
+
+
+def _judged(records: list[IORecord], res: NDArray[np.float64], plant, link,
+            masses: dict[str, float], floating: bool, centred: bool = False) -> list[str]:
+    """:func:`~motionhyst.identify.io_checks.judge_fit` (raises ``FitFailed``) and the
+    implausible estimates' warnings of a Bouc-Wen fit (`res`: predicted minus measured;
+    `centred`: compared without their means, a floating stage's periodic records)."""
+    from motionhyst.identify.io_checks import judge_fit, plausibility_warnings
+    from motionhyst.identify.io_start import inverse_dynamics
+
+    predictions, i = [], 0
+    for rec in records:
+        predictions.append(rec.y + res[i:i + rec.y.size])
+        i += rec.y.size
+    fit_rms = float(np.sqrt(np.mean(res ** 2)))
+    judge_fit(fit_rms, records, predictions, None, OpenLoop(plant, link), centred)
+    linear_mass = inverse_dynamics(records, floating)["m"]
+    return plausibility_warnings({}, masses, linear_mass, records, [])
 
 
 #: Starts of the Bouc-Wen link, screened by one simulation each: the link's initial
@@ -397,6 +418,8 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
                          "(z is not measured); beta is fixed by |gamma| + |delta| = 1",
                  "gamma": "see beta", "delta": "see beta", **notes}
     not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
+    warnings = _judged(records, res, stage, link, {"m1": stage.m1, "m2": stage.m2},
+                       floating=True, centred=periodic)
     return IOIdentification(
         plant=stage, hysteresis=link, estimates=estimates, std=std,
         not_identifiable=not_ident, fit_rms=float(np.sqrt(rss / res.size)),
@@ -404,7 +427,7 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
         periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r)
+        n_evaluations=n_eval, substeps=r, warnings=warnings)
 
 
 def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
