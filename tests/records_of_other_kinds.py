@@ -25,8 +25,8 @@ from motionhyst.hysteresis import BoucWen, MaxwellSlip
 from motionhyst.plants import QuasiStatic
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
 
-#: The piezo stack: stiffness 40 N/um, a Bouc-Wen hysteresis of 15 % of the stroke, a damper
-#: whose force is 5 % of the spring's at 100 Hz (the hysteresis' rate dependence)
+#: The piezo stack: stiffness 40 N/um, a Bouc-Wen link saturating at 150 N (a quarter of the
+#: peak force), a damper whose force is 5 % of the spring's at 100 Hz (the rate dependence)
 PIEZO_PLANT = QuasiStatic(k=4.0e7, c=3.0e3, force_offset=-12.0)
 PIEZO_LINK = BoucWen(k=1.5e7, fc=150.0, n=1.0, beta=0.6, gamma=0.4)
 PIEZO_OUTPUT_OFFSET = 3.0e-6  # the capacitive sensor's zero [m]

@@ -9,13 +9,19 @@ refusal.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from records_of_other_kinds import (
     DAMPER_FORCE_OFFSET,
     DAMPER_LINK,
+    PIEZO_NOISE,
+    PIEZO_OUTPUT_OFFSET,
+    PIEZO_PLANT,
     damper_record,
     fit_percent,
+    piezo_record,
 )
 
 from motionhyst.cli import main
@@ -94,3 +100,50 @@ def test_save_is_refused_for_a_closed_loop_record_before_any_work(capsys, tmp_pa
     record.write_text("time,y1,u\n0.0,0.0,0.0\n0.001,0.0,0.0\n")
     rc, _, err = run(capsys, "identify", str(record), "--save", str(tmp_path / "m.toml"))
     assert rc == 2 and "--save applies to input-output and force-displacement" in err
+
+
+@pytest.fixture(scope="module")
+def piezo_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("piezo")
+    piezo_record("sines", seed=1).write(folder / "sines.csv")
+    held_out = piezo_record("earthquake", seed=2)
+    held_out.write(folder / "earthquake.csv")
+    held_out.write(folder / "earthquake_force.csv", ("time", "force"))
+    return folder
+
+
+def test_a_piezo_identified_without_inertia_predicts_a_held_out_history(capsys, piezo_files):
+    folder = piezo_files
+    model = folder / "piezo.toml"
+    rc, out, err = run(capsys, "identify", str(folder / "sines.csv"), "--record",
+                       "input-output", "--plant", "quasi-static", "--model", "bouc-wen",
+                       "--save", str(model), "--json")
+    assert rc == 0 and err == ""
+    fit = json.loads(out)
+    est = fit["estimates"]
+    # the stack's spring and damper, the drive's force offset and the sensor's zero
+    assert est["k"] == pytest.approx(PIEZO_PLANT.k, rel=0.01)
+    assert est["c"] == pytest.approx(PIEZO_PLANT.c, rel=0.03)
+    assert est["input_offset"] == pytest.approx(-PIEZO_PLANT.force_offset, abs=0.5)
+    assert est["output_offset"] == pytest.approx(PIEZO_OUTPUT_OFFSET, abs=2e-8)
+    assert fit["fit_rms"] < 1.5 * PIEZO_NOISE  # down to the noise
+    rc, out, err = run(capsys, "predict", str(model), str(folder / "earthquake_force.csv"),
+                       "--init-from", str(folder / "earthquake.csv"), "--out",
+                       str(folder / "x.csv"), "--json")
+    assert rc == 0 and err == ""
+    assert json.loads(out)["fit_percent"] > 99.0
+
+
+def test_records_without_a_relation_between_force_and_position_are_refused(capsys, tmp_path):
+    # force and position independent noise: no quasi-static model predicts the position
+    rng = np.random.default_rng(3)
+    t = np.arange(400) / 100.0
+    record = tmp_path / "noise.csv"
+    np.savetxt(record, np.column_stack([t, rng.standard_normal(400),
+                                        1e-3 * rng.standard_normal(400)]),
+               delimiter=",", header="time,force,displacement", comments="")
+    model = tmp_path / "m.toml"
+    rc, out, err = run(capsys, "identify", str(record), "--record", "input-output", "--plant",
+                       "quasi-static", "--model", "jenkins", "--save", str(model))
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert ("the fit failed" in err or "no stiffness" in err) and not model.exists()

@@ -9,10 +9,12 @@ from motionhyst.core.warnings import warn
 
 
 def plant_choices() -> list[str]:
-    """``--plant``: the registry's stages with inertia (identification simulates them)."""
-    from motionhyst.plants.registry import PLANTS, stage_types
+    """``--plant``: the registry's stages (identification simulates each: with inertia, or
+    the quasi-static balance); read from the registry, so that ``--help`` imports nothing
+    heavy."""
+    from motionhyst.plants.registry import stage_types
 
-    return [name for name in stage_types() if PLANTS[name].has_inertia]
+    return stage_types()
 
 
 def _nu(text: str) -> float | str:
@@ -57,13 +59,17 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     q.add_argument("--plant", choices=plant_choices(),
                    help="input-output records: the stage's model (default mass-spring-damper; "
                         "mass-damper: a positioning axis, no spring; two-mass: the floating "
-                        "stage of eqs. 1-2, force and link on m1)")
+                        "stage of eqs. 1-2, force and link on m1; quasi-static: no inertia "
+                        "(piezo actuators, friction dampers), the link with a parallel spring "
+                        "and damper, any --model)")
     q.add_argument("--offset", choices=("auto", "none", "input", "output", "both"),
                    help="input-output records: the offsets estimated with the model: of the "
                         "force (one) and of the position (one per record); default auto: both "
                         "for a floating stage's records from a start (mass-damper, two-mass), "
                         "none for its periodic ones, the position's for a stage on a spring "
-                        "(where a force offset is only a position offset)")
+                        "(where a force offset is only a position offset), both for a "
+                        "quasi-static plant (a force offset moves where on its loops the link "
+                        "works)")
     q.add_argument("--from-rest", action="store_true",
                    help="input-output records: each record starts at rest (default: its "
                         "initial velocity, and position where a spring holds the stage, are "
@@ -139,6 +145,9 @@ def run_input_output(args: argparse.Namespace) -> int:
         raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     if args.nu is not None and model != "bouc-wen":
         raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
+    if args.nu is not None and plant == "quasi-static":
+        raise UsageError("motionhyst identify: --nu does not apply to --plant quasi-static (its "
+                         "Bouc-Wen link has the exponent 1)")
     target = None
     if args.save is not None:  # refused before the work, not after
         from motionhyst.io.outputs import OutputFile
@@ -147,13 +156,17 @@ def run_input_output(args: argparse.Namespace) -> int:
         _check_savable_plant(plant)
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
-    if model == "bouc-wen" and (args.from_rest or args.init_window is not None
-                                or args.offset not in (None, "none", "auto", "output")
-                                or (args.offset == "output" and plant != "mass-spring-damper")):
+    if model == "bouc-wen" and plant != "quasi-static" and (
+            args.from_rest or args.init_window is not None
+            or args.offset not in (None, "none", "auto", "output")
+            or (args.offset == "output" and plant != "mass-spring-damper")):
         raise UsageError("motionhyst identify: --model bouc-wen starts its records at rest "
                          "and estimates only their position offsets (--offset output, on a "
                          "mass-spring-damper); --from-rest, --init-window and the force offset "
                          "apply to the element links")
+    if args.init_window is not None and plant == "quasi-static":
+        raise UsageError("motionhyst identify: --init-window sets a stage's state; a "
+                         "quasi-static plant has none")
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
@@ -164,7 +177,7 @@ def run_input_output(args: argparse.Namespace) -> int:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
     extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
-              if model == "bouc-wen" else
+              if model == "bouc-wen" and plant != "quasi-static" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
                "asymmetric": args.asymmetric})
@@ -237,12 +250,14 @@ def _check_savable_plant(plant: str) -> None:
 
     from motionhyst.core.textfiles import toml_table
     from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.plants.quasi_static import QuasiStatic
     from motionhyst.scenario import Scenario, ScenarioError
     from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
     stage = {"mass-damper": MassDamper(1.0, 1.0, 1.0), "mass-spring-damper":
              MassSpringDamper(1.0, 1.0, 1.0),
-             "two-mass": TwoMass(1.0, 1.0, 1.0, 1.0, output="y2")}[plant]
+             "two-mass": TwoMass(1.0, 1.0, 1.0, 1.0, output="y2"),
+             "quasi-static": QuasiStatic(1.0, 1.0, 1.0)}[plant]
     text = (toml_table("stage", stage.to_dict())
             + toml_table("hysteresis", {"model": "jenkins", "k": 1.0, "fc": 1.0}))
     try:

@@ -121,7 +121,7 @@ __all__ = ["identify_io"]
 #: element of 256 stop operators makes a simulation too slow for a search
 MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
                                                                       "maxwell-iwan")))
-PLANTS = ("mass-spring-damper", "mass-damper", "two-mass")
+PLANTS = ("mass-spring-damper", "mass-damper", "two-mass", "quasi-static")
 #: The element links' refinement takes at least this many evaluations unless given a budget
 ELEMENT_NFEV = 200
 
@@ -204,13 +204,16 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         whole periods of its force).  A floating stage's (the two-mass one) is
         known up to a constant position: records and model are compared with
         their means removed.
-    plant : {"mass-spring-damper", "mass-damper", "two-mass"}
+    plant : {"mass-spring-damper", "mass-damper", "two-mass", "quasi-static"}
         The stage: :class:`~motionhyst.time.openloop.MassSpringDamper` (``m, c, k``),
         :class:`~motionhyst.plants.mass_damper.MassDamper` (``m, c``: a positioning
-        axis, friction the link) or the floating
+        axis, friction the link), the floating
         :class:`~motionhyst.time.openloop.TwoMass` of eqs. (1)-(2)
         (``m1, m2, b, k``; the force and the link on ``m1``, no spring to the
-        ground but the link's).
+        ground but the link's) or, for records without visible inertia (piezo
+        actuators, friction dampers), :class:`~motionhyst.plants.quasi_static.QuasiStatic`
+        (``k, c`` in parallel with the link, any link Bouc-Wen included;
+        :mod:`~motionhyst.identify.io_quasi_static`).
     output : {"y2", "y1"}
         Two-mass stage: the measured position (``y2``, the point of control, or
         ``y1``, the actuated mass).
@@ -312,6 +315,13 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     if asymmetric and (model != "coulomb" or plant != "mass-damper"):
         raise ValueError("direction-dependent viscous friction is identified with the Coulomb "
                          "link on a mass-damper")
+    if plant == "quasi-static":  # no inertia: the link's balance (any link, Bouc-Wen too)
+        from motionhyst.identify.io_quasi_static import identify_quasi_static_io
+
+        return identify_quasi_static_io(records, model, periodic=periodic,
+                                        n_elements=n_elements, offset=offset,
+                                        max_evaluations=max_evaluations, tol=tol,
+                                        t_start=t_start)
     if model != "bouc-wen":
         return identify_elements_io(records, model, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,

@@ -190,6 +190,11 @@ class _LinkLayout:
         return np.array(out)
 
 
+#: The search layout of a registered link's parameters, for the other identification modules
+#: (the quasi-static plant's, :mod:`~motionhyst.identify.io_quasi_static`)
+LinkLayout = _LinkLayout
+
+
 class _ElementProblem:
     """Simulation residuals of the stage with a link of exact-update elements.
 

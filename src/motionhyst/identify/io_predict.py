@@ -196,6 +196,10 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
                         ) -> WindowPrediction:
     """Simulate a record from its force, the initial state set from its first samples.
 
+    A plant without inertia (:class:`~motionhyst.plants.quasi_static.QuasiStatic`)
+    has no state but its link's, relaxed at the start: the window sets only the
+    position's offset (reported as the initial position, velocity 0).
+
     Parameters
     ----------
     system : OpenLoop
@@ -242,12 +246,21 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     if system.hysteresis is not None and not hasattr(system.hysteresis, "time_stepping"):
         raise ValueError("this link cannot be simulated")
     fs = sampling_rate(tt)
+    if not system.plant.has_inertia:  # no state but the link's: only the position's offset
+        x = system.simulate(tt, u).displacement
+        position = float(np.mean(y[:window] - x[:window]))
+        return _scored(tt, x + position, y, window, position, 0.0)
     r = substeps or system.default_substeps(fs)
     mech = system.plant.mechanics()
     st = Stepping.empty() if system.hysteresis is None else system.hysteresis.time_stepping()
     k_link = system.hysteresis.initial_stiffness if system.hysteresis is not None else 0.0
     position, velocity = state_from_window(mech, st, k_link, u, y, fs, r, window)
     yhat, _ = run_from_state(mech, st, k_link, u, fs, r, position, velocity)
+    return _scored(tt, yhat, y, window, position, velocity)
+
+
+def _scored(tt, yhat, y, window, position, velocity) -> WindowPrediction:
+    """The prediction with its error from sample `window` on."""
     if not np.all(np.isfinite(yhat)):
         raise ValueError("the model's prediction is not finite")
     e = yhat[window:] - y[window:]

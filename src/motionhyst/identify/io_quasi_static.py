@@ -1,0 +1,360 @@
+"""Input-output identification of a link without inertia (the quasi-static plant).
+
+Records where no inertia is visible (a piezo actuator below its first
+resonance, a friction damper driven slowly) are the force balancing the link
+and a spring ``k`` and damper ``c`` in parallel at every sample,
+:class:`~motionhyst.plants.quasi_static.QuasiStatic`:
+``u - u_0 = w(x) + k x + c x'``, the measured position ``y = x + y_0``.  The
+link (any registered model with a time step, Bouc-Wen included), ``k``, ``c``
+and the offsets are estimated by the *simulation* error of the position, the
+model run from the force alone
+(:func:`~motionhyst.time.quasi_static.displacement_from_force`), as the other
+plants are (:mod:`~motionhyst.identify.input_output`).
+
+Method
+------
+1. The linear start: ``u = K y + C y' + b`` by least squares (``y'`` by the
+   second-order backward difference of the model), per record's ``b``.
+2. Starts of the link: the link takes 0.3 or 0.6 of ``K``, the spring the
+   rest, slipping across the records' displacement or a tenth of it
+   (:data:`STARTS`); each is refined by the *equation* error (the force
+   predicted from the measured position, one pass of the link per
+   evaluation, :func:`~motionhyst.time.quasi_static.force_from_displacement`).
+   A link of stop operators (Jenkins, Maxwell-slip) also starts from the
+   force-displacement fit of
+   :func:`~motionhyst.identify.fit.identify_maxwell_slip` (a grid and
+   non-negative least squares: no local minima), its element that slips
+   last taken as the spring.
+3. The start whose simulated position fits best continues by the simulation
+   error (trust-region reflective, forward-difference Jacobian).  A result
+   must predict: worse than the linear model's simulation error, or
+   explaining less than :data:`MIN_FIT_PERCENT` of the position's variation,
+   is a failed fit (:func:`~motionhyst.identify.io_checks.judge_fit`,
+   ``FitFailed``); a positive value that ran :data:`RUNAWAY_FACTOR` times
+   from its start is a warning naming it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from motionhyst.identify.io_checks import FitFailed, judge_fit
+from motionhyst.identify.io_elements import LinkLayout
+from motionhyst.identify.io_records import IORecord
+from motionhyst.identify.io_results import IOIdentification, per_record_errors
+from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL, standard_errors, undetermined_notes
+from motionhyst.plants.quasi_static import QuasiStatic
+from motionhyst.time.openloop import OpenLoop
+from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
+
+__all__ = []
+
+#: Starts: (the link's share of the linear stiffness, its slip displacement in units of the
+#: records' displacement RMS)
+STARTS = ((0.3, 1.0), (0.6, 1.0), (0.3, 0.1), (0.6, 0.1))
+#: Evaluations of each start's equation-error refinement, and of the final refinement
+START_NFEV, FINAL_NFEV = 60, 150
+#: A residual where the model cannot run (a force it does not hold), in output RMS units
+FAILED_RESIDUAL = 1e3
+#: A fit that explains less of the position's variation than this [%] predicts nothing
+MIN_FIT_PERCENT = 10.0
+#: A positive value that ends this many times from its start (either way) is reported
+RUNAWAY_FACTOR = 1e6
+
+
+class _Problem:
+    """The search: ``k, c``, the link's values, the input offset, each record's output
+    offset; positive link values as logarithms, the rest scaled."""
+
+    def __init__(self, records: list[IORecord], layout: LinkLayout, periodic: bool,
+                 input_offset: bool, output_offset: bool, k_scale: float, c_scale: float,
+                 y_scale: float, u_scale: float, v_scale: float) -> None:
+        self.records, self.layout, self.periodic = records, layout, periodic
+        link_log = layout.logarithmic
+        self.n_link = link_log.size
+        n_rec = len(records)
+        self.names = (["k", "c", *layout.names, "input_offset"]
+                      + [f"output_offset[{i}]" if n_rec > 1 else "output_offset"
+                         for i in range(n_rec)])
+        self.log = np.concatenate([[False, False], link_log, [False], np.zeros(n_rec, bool)])
+        link_scale = layout.scales(k_scale, c_scale, y_scale, v_scale)
+        self.scale = np.concatenate([[k_scale, c_scale], link_scale, [u_scale],
+                                     np.full(n_rec, y_scale)])
+        # a linear value may be 0 or below only if the model says so ("finite")
+        kinds = [par.kind for par, _ in layout._values()]
+        self.lower = np.concatenate([[0.0, 0.0], [-np.inf if lg or kind == "finite" else 0.0
+                                                  for lg, kind in zip(link_log, kinds,
+                                                                      strict=True)],
+                                     [-np.inf], np.full(n_rec, -np.inf)])
+        self.free = np.ones(self.log.size, dtype=bool)
+        self.free[2 + self.n_link] = input_offset
+        self.free[3 + self.n_link:] = output_offset
+        self.y_scale, self.u_scale = y_scale, u_scale
+        self.fixed = np.zeros(self.log.size)
+        self.n_eval = 0
+
+    def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        with np.errstate(over="ignore"):  # an overflow is a value the model refuses
+            return np.where(self.log, np.exp(np.where(self.log, q, 0.0)), q * self.scale)
+
+    def variables(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.where(self.log, np.log(np.where(self.log, v, 1.0)), v / self.scale)
+
+    def whole(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+        q = self.fixed.copy()
+        q[self.free] = q_free
+        return q
+
+    def model(self, v: NDArray[np.float64]) -> tuple[QuasiStatic, object]:
+        """The plant (its force offset ``-input_offset``) and the link of values `v`."""
+        k = 2 + self.n_link
+        return (QuasiStatic(max(v[0], 0.0), max(v[1], 0.0), force_offset=-v[k]),
+                self.layout.build(v[2:k]))
+
+    def output_offsets(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return v[3 + self.n_link:]
+
+    def positions(self, v: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        """The measured positions the model predicts (offsets included); ValueError if it
+        cannot run."""
+        plant, link = self.model(v)
+        return [displacement_from_force(plant, link, rec.t, rec.u, periodic=self.periodic)
+                + y0 for rec, y0 in zip(self.records, self.output_offsets(v), strict=True)]
+
+    def _residuals(self, q_free: NDArray[np.float64], equation: bool) -> NDArray[np.float64]:
+        self.n_eval += 1
+        v = self.values(self.whole(q_free))
+        n_rows = sum(rec.y.size for rec in self.records)
+        try:
+            if equation:  # the force from the measured position, in units of the force
+                plant, link = self.model(v)
+                r = np.concatenate([
+                    force_from_displacement(plant, link, rec.t, rec.y - y0,
+                                            periodic=self.periodic) - rec.u
+                    for rec, y0 in zip(self.records, self.output_offsets(v), strict=True)]
+                ) / self.u_scale
+            else:
+                r = np.concatenate([y - rec.y for y, rec in
+                                    zip(self.positions(v), self.records, strict=True)]
+                                   ) / self.y_scale
+        except (ValueError, ArithmeticError):  # values the model refuses, a force not held
+            return np.full(n_rows, FAILED_RESIDUAL)
+        return r if np.all(np.isfinite(r)) else np.full(n_rows, FAILED_RESIDUAL)
+
+    def solve(self, q0: NDArray[np.float64], equation: bool, max_nfev: int, tol: float):
+        lower = np.where(self.log, -np.inf, self.lower / self.scale)[self.free]
+        q0 = np.maximum(q0[self.free], lower)
+        return least_squares(lambda q: self._residuals(q, equation), q0, method="trf",
+                             x_scale=1.0, diff_step=1e-6, ftol=tol, xtol=tol, gtol=tol,
+                             max_nfev=max_nfev, bounds=(lower, np.full(lower.size, np.inf)))
+
+
+def _layout(model: str, n_elements: int) -> LinkLayout:
+    """The link's search layout; Bouc-Wen's exponent fixed at its default 1 (exact steps)."""
+    layout = LinkLayout.of(model, n_elements)
+    for par, count in list(layout.entries):
+        if par.name in ("n", "nu") and count < 0 and par.default is not None:
+            layout.entries.remove((par, count))
+            layout.fixed[par.name] = float(par.default)  # type: ignore[arg-type]
+    return layout
+
+
+def _stop_operator_starts(records: list[IORecord], layout: LinkLayout, prob: _Problem,
+                          n_elements: int, input_offset: bool, output_offset: bool
+                          ) -> list[NDArray[np.float64]]:
+    """For a link of stop operators (Jenkins, Maxwell-slip): the force-displacement fit of
+    :func:`~motionhyst.identify.fit.identify_maxwell_slip` (stop operators on a grid,
+    non-negative least squares: no local minima) with one element more, the one that
+    slips last taken as the spring ``k``; the records joined, each relaxed at its first
+    position.  None for other links."""
+    from motionhyst.identify.fit import identify_maxwell_slip
+
+    if layout.model not in ("jenkins", "maxwell-slip"):
+        return []
+    n = 1 if layout.model == "jenkins" else n_elements
+    x = np.concatenate([rec.y - rec.y[0] for rec in records])
+    u = np.concatenate([rec.u for rec in records])
+    try:
+        ident = identify_maxwell_slip(x, u, n + 1, initial_state="relaxed")
+    except ValueError:
+        return []
+    k = np.array([e["k"] for e in ident.elements])
+    fc = np.array([e["fc"] for e in ident.elements])
+    order = np.argsort(fc / k)  # by slip displacement: the last is the spring
+    k, fc = k[order], fc[order]
+    link = np.concatenate([k[:-1], fc[:-1]]) if layout.model == "maxwell-slip" else \
+        np.array([k[0], fc[0]])
+    v = np.concatenate([[k[-1], 0.0], link, [ident.offset if input_offset else 0.0],
+                        [rec.y[0] if output_offset else 0.0 for rec in records]])
+    return [prob.variables(v)]
+
+
+def _linear_start(records: list[IORecord]) -> tuple[float, float, NDArray[np.float64]]:
+    """``K, C`` and each record's ``b`` of ``u = K y + C y' + b`` (least squares)."""
+    rows, rhs = [], []
+    n = len(records)
+    for i, rec in enumerate(records):
+        v = np.gradient(rec.y, rec.t)
+        A = np.zeros((rec.y.size, 2 + n))
+        A[:, 0], A[:, 1], A[:, 2 + i] = rec.y, v, 1.0
+        rows.append(A)
+        rhs.append(rec.u)
+    sol = np.linalg.lstsq(np.concatenate(rows), np.concatenate(rhs), rcond=None)[0]
+    return float(sol[0]), float(sol[1]), sol[2:]
+
+
+def _linear_rms(records: list[IORecord], K: float, C: float, periodic: bool) -> float | None:
+    """Simulation error of the linear model ``K, C`` with the best output offset per record
+    (the bar a model with a link must pass); None if it cannot run."""
+    try:
+        err = []
+        for rec in records:
+            x = displacement_from_force(QuasiStatic(max(K, 0.0), max(C, 0.0)), None, rec.t,
+                                        rec.u - np.mean(rec.u), periodic=periodic)
+            e = x - rec.y
+            err.append(e - np.mean(e))
+        rms = float(np.sqrt(np.mean(np.concatenate(err) ** 2)))
+    except ValueError:
+        return None
+    return rms if math.isfinite(rms) else None
+
+
+def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: bool,
+                             n_elements: int, offset: str, max_evaluations: int | None,
+                             tol: float, t_start: float | None = None) -> IOIdentification:
+    """A quasi-static plant and its link from input-output records (see the module).
+
+    Parameters
+    ----------
+    records : list of IORecord
+        Force in, position out (checked).
+    model : str
+        The link's registered model.
+    periodic : bool
+        Records of whole periods of a periodic steady state.
+    n_elements : int
+        Elements of a list model (Maxwell-slip).
+    offset : {"auto", "none", "input", "output", "both"}
+        Offsets estimated: ``auto`` is both (a force offset moves where on its
+        loops the link works, which a position offset does not).
+    max_evaluations : int, optional
+        The budget of model evaluations (starts and refinement together).
+    tol : float
+        ``ftol = xtol = gtol`` of the refinements.
+    t_start : float, optional
+        ``time.perf_counter()`` at the start of the identification.
+
+    Returns
+    -------
+    IOIdentification
+
+    Raises
+    ------
+    FitFailed
+        A fit that is no result (worse than the linear model, or than the output's
+        own spread; a model that cannot run).
+
+    Examples
+    --------
+    A spring and a Jenkins link, driven by a force, measured with a position offset:
+
+    >>> import numpy as np
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.time.quasi_static import displacement_from_force
+    >>> t = np.arange(2000) / 1000.0
+    >>> u = 300.0 * np.sin(2 * np.pi * 2 * t) * np.minimum(1.0, t)
+    >>> y = displacement_from_force(QuasiStatic(k=1e5), Jenkins(k=3e5, fc=100.0), t, u)
+    >>> fit = identify_quasi_static_io([IORecord(t, u, y + 1e-4)], "jenkins", periodic=False,
+    ...                                n_elements=1, offset="auto", max_evaluations=None,
+    ...                                tol=1e-12)
+    >>> est = fit.estimates
+    >>> round(est["k"]), round(est["link.k"]), round(est["link.fc"], 6)   # N/m, N/m, N
+    (100000, 300000, 100.0)
+    >>> round(est["output_offset"] * 1e6, 6), round(est["input_offset"], 6) + 0.0   # um, N
+    (100.0, 0.0)
+    """
+    t0 = time.perf_counter() if t_start is None else t_start
+    layout = _layout(model, n_elements)
+    K, C, b = _linear_start(records)
+    if not K > 0:
+        raise ValueError("the records show no stiffness (the position does not follow the "
+                         "force): a quasi-static plant does not describe them")
+    y_all = np.concatenate([rec.y for rec in records])
+    u_all = np.concatenate([rec.u for rec in records])
+    y_scale = float(np.std(y_all)) or 1.0
+    u_scale = float(np.std(u_all)) or 1.0
+    v_scale = float(np.sqrt(np.mean(np.concatenate(
+        [np.gradient(rec.y, rec.t) for rec in records]) ** 2))) or 1.0
+    c_scale = max(abs(C), 1e-3 * K * y_scale / v_scale)
+    inp, out = {"auto": (True, True), "none": (False, False), "input": (True, False),
+                "output": (False, True), "both": (True, True)}[offset]
+    prob = _Problem(records, layout, periodic, inp, out, K, c_scale, y_scale, u_scale,
+                    v_scale)
+    budget = max_evaluations
+    # position offsets of the linear fit: u = K (y - y0) + C y' + u0 with u0 = 0 unless estimated
+    y0 = np.array([float(-bi / K) if out else 0.0 for bi in b])
+    starts = []
+    for share, slip in STARTS:
+        link0 = layout.start(share * K, y_scale, v_scale, 0.0, slip)
+        v0 = np.concatenate([[(1.0 - share) * K, max(C, 0.0)], link0, [0.0], y0])
+        n_start = START_NFEV if budget is None else max(5, budget // (2 * len(STARTS)))
+        try:
+            sol = prob.solve(prob.variables(v0), True, n_start, 1e-10)
+        except ValueError:
+            continue
+        starts.append(prob.whole(sol.x))
+    starts += _stop_operator_starts(records, layout, prob, n_elements, inp, out)
+    # the start that predicts the positions best continues
+    costs = [float(np.sum(prob._residuals(q[prob.free], False) ** 2)) for q in starts]
+    if not starts or min(costs) >= 0.5 * FAILED_RESIDUAL ** 2 * y_all.size:  # none runs
+        raise FitFailed(f"the fit failed: no start of the {model} link on a quasi-static "
+                        f"plant can run on these records (a force it does not hold)")
+    n_final = FINAL_NFEV if budget is None else max(10, budget - prob.n_eval)
+    start = starts[int(np.argmin(costs))]
+    sol = prob.solve(start, False, n_final, tol)
+    q = prob.whole(sol.x)
+    v = prob.values(q)
+    plant, link = prob.model(v)
+    predictions = prob.positions(v)
+    res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
+    fit_rms = float(np.sqrt(np.mean(res ** 2)))
+    system = OpenLoop(plant, link)
+    judge_fit(fit_rms, records, predictions, _linear_rms(records, K, C, periodic), system, out)
+    spread = float(np.sqrt(np.sum(np.concatenate([rec.y - np.mean(rec.y) for rec in records])
+                                  ** 2)))
+    explained = 100.0 * (1.0 - math.sqrt(float(np.sum(res ** 2))) / spread) if spread else 0.0
+    if explained < MIN_FIT_PERCENT:
+        raise FitFailed(f"the fit failed: the model explains {explained:.2g} % of the "
+                        f"position's variation (fit below {MIN_FIT_PERCENT:g} %): these records "
+                        f"show no quasi-static relation between force and position")
+    # standard errors from the Jacobian in the parameters' own units
+    J = sol.jac * prob.y_scale / np.where(prob.log, v, prob.scale)[prob.free]
+    std_free, groups = standard_errors(J, float(np.sum(res ** 2)), res.size, FD_SINGULAR_RTOL)
+    names = [n for n, f in zip(prob.names, prob.free, strict=True) if f]
+    notes = undetermined_notes(names, groups, FD_SINGULAR_RTOL)
+    estimates = {n: float(x) for n, x, f in zip(prob.names, v, prob.free, strict=True) if f}
+    std = {n: (None if n in notes or not math.isfinite(s) else float(s))
+           for n, s in zip(names, std_free, strict=True)}
+    v_start = prob.values(start)
+    warnings = [f"{n} = {x:.4g} ran {max(x / x0, x0 / x):.2g} times "
+                f"{'above' if x > x0 else 'below'} its start: the records do not hold it (a "
+                f"physically meaningless value; the link may not be needed, or another model "
+                f"suits them)"
+                for n, x, x0, lg, f in zip(prob.names, v, v_start, prob.log, prob.free,
+                                           strict=True)
+                if lg and f and x > 0 and x0 > 0 and max(x / x0, x0 / x) > RUNAWAY_FACTOR]
+    extra = {"offsets": {"input": float(v[2 + prob.n_link]),
+                         "output": [float(x) for x in prob.output_offsets(v)]},
+             "budget_reached": bool(budget is not None and prob.n_eval >= budget)}
+    return IOIdentification(
+        plant=plant, hysteresis=link, estimates=estimates, std=std, not_identifiable=notes,
+        fit_rms=fit_rms, records=per_record_errors(records, res),
+        seconds=time.perf_counter() - t0, periodic=periodic,
+        stopping=f"{sol.message} (forward differences; ftol = xtol = gtol = {tol:g}, "
+                 f"{prob.n_eval} evaluations with the starts)",
+        n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings)
