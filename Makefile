@@ -45,6 +45,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/study_memory.py
 	$(BIN)/python benchmarks/engine.py
 	$(BIN)/python benchmarks/stability.py
+	$(BIN)/python benchmarks/periodic.py
 
 # the public benchmarks end to end (kept out of make test): Bouc-Wen (about a minute) and
 # EMPS (a few minutes; scored on DATA_EMPS_PULSES.mat when EMPS_DATA holds it)
