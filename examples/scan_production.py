@@ -17,7 +17,8 @@ model 4 % off):
    scans at three places with a single-parameter link model and with the table.
 
 Run ``python examples/scan_production.py [OUT_DIR]`` (default ``out/scan_production``);
-it writes ``scan.png`` (the error, MA and MSD magnitudes against time, logarithmic) and ``summary.json``.
+it writes ``scan.png`` (the error, MA and MSD magnitudes against time, logarithmic) and
+``summary.json``.
 """
 
 from __future__ import annotations
