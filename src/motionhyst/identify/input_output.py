@@ -318,6 +318,9 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     if plant == "quasi-static":  # no inertia: the link's balance (any link, Bouc-Wen too)
         from motionhyst.identify.io_quasi_static import identify_quasi_static_io
 
+        if init_window is not None:
+            raise ValueError("a stage without inertia has no state for an initialisation "
+                             "window to set")
         return identify_quasi_static_io(records, model, periodic=periodic,
                                         n_elements=n_elements, offset=offset,
                                         max_evaluations=max_evaluations, tol=tol,
