@@ -174,6 +174,32 @@ SHORT = ["--length", "0.005", "--speed", "0.05", "--a-max", "2", "--j-max", "50"
          "--s-max", "1000", "--window", "0.02", "--tail", "0.01"]
 
 
+PRODUCTION = ["--length", "0.1", "--speed", "0.5", "--a-max", "20", "--j-max", "2000",
+              "--s-max", "4e5", "--window", "0.01"]
+
+
+def test_cli_scan_model_inverts_the_stage_by_default(capsys):
+    """A [feedforward] that names only the link model (examples/scan.toml) gets the stage's
+    snap term m1 m2 / k from the plant: at production speed the flexible mode's error,
+    (m1 m2 / k) / C(0) times the snap, would swamp the link otherwise (issue of the scan at
+    0.5 m/s); listing the terms keeps exactly those."""
+    argv = ["scan", str(EXAMPLES / "scan.toml"), *PRODUCTION, "--compensation", "none", "model",
+            "--json"]
+    assert cli_main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["feedforward"]["coefficients"]["snap"] == pytest.approx(5.0 * 17.5 / 7.4e7,
+                                                                     rel=1e-12)
+    none, model = d["results"]
+    assert none["ma_max"] / model["ma_max"] >= 10
+    assert none["msd_max"] / model["msd_max"] >= 10
+    assert cli_main([*argv, "--feedforward", "hysteresis"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert "snap" not in d["feedforward"]["coefficients"] or \
+        d["feedforward"]["coefficients"]["snap"] == 0.0
+    none, model = d["results"]
+    assert none["msd_max"] / model["msd_max"] < 2  # the flexible mode's error is left
+
+
 def test_cli_scan_json_and_time_series(tmp_path, capsys):
     out = tmp_path / "ts.csv"
     argv = ["scan", str(EXAMPLES / "scan.toml"), *SHORT, "--compensation", "none", "model",

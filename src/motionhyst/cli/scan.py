@@ -67,7 +67,8 @@ def add_parser(sub) -> None:
     q.add_argument("--feedforward", nargs="+", choices=TERMS, metavar="TERM",
                    help="the model feedforward's terms beside M r'': jerk, snap (the "
                         "scenario's, else the plant's inverse), viscous, coulomb, hysteresis "
-                        "(default: those of the scenario's [feedforward])")
+                        "(default: those of the scenario's [feedforward], and the stage's jerk and "
+                        "snap from the plant where it leaves them unset)")
     q.add_argument("--basis-trials", type=_count, metavar="N",
                    help="trials of the basis learning; the first runs the model (4)")
     q.add_argument("--ilc-trials", type=_count, metavar="N",
@@ -132,6 +133,22 @@ def _at(loop, x0: float, source: str):
         raise UsageError(f"{PROG}: --at: {exc} ({source})") from None
 
 
+def _stage_terms(sc, loop) -> list[str]:
+    """The stage's jerk and snap terms a scan's model feedforward adds by default: those the
+    scenario's ``[feedforward]`` leaves unset, where the plant's inverse has a series."""
+    sec = sc.model.feedforward
+    unset = [t for t in ("jerk", "snap") if getattr(sec, t, 0.0) is None]
+    if not unset:
+        return []
+    from motionhyst.controllers.inverse import stage_inverse
+
+    try:
+        stage_inverse(loop.plant)
+    except (ValueError, TypeError, AttributeError, NotImplementedError):
+        return []
+    return unset
+
+
 def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
     from motionhyst.scenario import load_scenario
@@ -150,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
     if terms is None:
         terms = [t for t in TERMS[:-1] if ff is not None and getattr(ff, t)]
         terms += ["hysteresis"] if loop.hysteresis_feedforward is not None else []
+        if terms:  # a model feedforward inverts the stage too, unless the scenario says how
+            terms = [*_stage_terms(sc, loop), *terms]
     elif len(set(terms)) != len(terms):
         raise UsageError(f"{PROG}: --feedforward lists one twice")
     if "hysteresis" in terms and loop.hysteresis_feedforward is None:
