@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import UsageError, g, print_json, table
+from motionhyst.cli._common import UsageError, g, print_json, table, whole_number
 from motionhyst.core.warnings import warn
 
 
@@ -30,28 +30,6 @@ def _nu(text: str) -> float | str:
     return v
 
 
-def _evaluations(text: str) -> int:
-    """argparse type: a number of model evaluations, 10 to 100000."""
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if not 10 <= v <= 100000:
-        raise argparse.ArgumentTypeError(f"must be from 10 to 100000, got {v}")
-    return v
-
-
-def _window(text: str) -> int:
-    """argparse type: an initialisation window, 2 to 100000 samples."""
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if not 2 <= v <= 100000:
-        raise argparse.ArgumentTypeError(f"must be from 2 to 100000 samples, got {v}")
-    return v
-
-
 def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     """The options of input-output identification."""
     from motionhyst.hysteresis import MODELS
@@ -74,7 +52,7 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records: each record starts at rest (default: its "
                         "initial velocity, and position where a spring holds the stage, are "
                         "estimated)")
-    q.add_argument("--init-window", type=_window, metavar="N",
+    q.add_argument("--init-window", type=whole_number(2, 100000, "samples"), metavar="N",
                    help="input-output records: each record's initial state (and a floating "
                         "stage's position offset) is set from its first N samples as the fit "
                         "runs, as predict --init-from --init-window N sets it (the EMPS "
@@ -83,7 +61,7 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records, --model coulomb --plant mass-damper: viscous "
                         "friction by direction (the link's c_pos or c_neg on top of the "
                         "stage's c)")
-    q.add_argument("--max-evaluations", type=_evaluations, metavar="N",
+    q.add_argument("--max-evaluations", type=whole_number(10, 100000, "evaluations"), metavar="N",
                    help="input-output records: the search's budget of model evaluations, "
                         "starts and refinement together (default: the starts', then at most "
                         "200 for the refinement)")
