@@ -7,7 +7,7 @@ import pytest
 from scipy.linalg import expm
 
 from motionhyst.core.lti import expm_small
-from motionhyst.hysteresis import Dahl, Jenkins, LuGre, MaxwellSlip
+from motionhyst.hysteresis import Dahl, Jenkins, LuGre, MaxwellSlip, model_class
 from motionhyst.identify._element_sensitivities import row_derivatives
 from motionhyst.identify.io_elements import _LinkLayout
 from motionhyst.time.openloop import (
@@ -50,7 +50,7 @@ def _simulate(values: np.ndarray, layout: _LinkLayout, u: np.ndarray, periodic: 
 @pytest.mark.parametrize("name", list(LINKS))
 def test_sensitivities_agree_with_central_differences(name, periodic):
     link, values = LINKS[name]
-    layout = _LinkLayout.of(name.split("-1")[0], 2)
+    layout = _LinkLayout.of(model_class(name.split("-1")[0]), 2)
     v = np.array(values)
     u = _force(256)
     fine = fine_input(u, R, periodic)
@@ -92,7 +92,7 @@ def test_two_mass_sensitivities_agree_with_central_differences(name, output):
     """The same compiled run on the floating two-mass stage (eqs. 1-2), from rest: the link
     on m1, the output y2 or y1; derivatives in m1, m2, b, k and the link's parameters."""
     link, values = TWO_MASS_LINKS[name]
-    layout = _LinkLayout.of(name, 2)
+    layout = _LinkLayout.of(model_class(name), 2)
     plant = TwoMass(*TWO_MASS, output=output)
     v = np.array(values)
     u = _force(256)

@@ -99,7 +99,7 @@ def test_the_exact_jacobian_of_a_periodic_floating_stage():
     # slipping at 20 N of a 20 N RMS force with odd harmonics: no drift, every column alive
     rec = _record(512, 4, periodic=True, rms=20.0, link=Jenkins(k=5e4, fc=20.0), substeps=10)
     rec = IORecord(rec.t, rec.u, rec.y + 3e-3, rec.name)  # the stage's offset is arbitrary
-    layout = _LinkLayout.of("jenkins", 1)
+    layout = _LinkLayout.of(Jenkins, 1)
     values = np.array([*STAGE.values(), 5e4, 20.0])
     prob = _ElementProblem([rec], True, 10, layout, float(np.std(rec.y)), values,
                            plant=TwoMass(**STAGE))

@@ -159,9 +159,12 @@ def run_input_output(args: argparse.Namespace) -> int:
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
                "asymmetric": args.asymmetric})
-    fit = identify_io(records, model, periodic=args.periodic, nu=nu,
-                      n_elements=args.elements or 3, plant=plant, output=args.output or "y2",
-                      **extras)
+    from motionhyst.hysteresis import model_class
+    from motionhyst.plants.registry import plant_class
+
+    fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
+                      n_elements=args.elements or 3, plant=plant_class(plant),
+                      output=args.output, **extras)
     for line in fit.warnings:
         warn(line)
     result = {**fit.to_dict(), "records": fit.records}

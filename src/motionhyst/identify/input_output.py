@@ -89,6 +89,7 @@ import time
 import numpy as np
 
 from motionhyst.hysteresis import MODELS as REGISTERED
+from motionhyst.hysteresis import BoucWen, Coulomb, Hysteresis, model_class
 from motionhyst.identify.io_bouc_wen import BASIC_STARTS as BASIC_STARTS
 from motionhyst.identify.io_bouc_wen import FINAL_ATTEMPTS as FINAL_ATTEMPTS
 from motionhyst.identify.io_bouc_wen import START_PRODUCTS as START_PRODUCTS
@@ -112,7 +113,8 @@ from motionhyst.identify.io_start import (
 from motionhyst.identify.io_start import two_mass_response as two_mass_response
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
-from motionhyst.time.openloop import TwoMass, is_periodic_record
+from motionhyst.plants import MassSpringDamper, Plant, plant_class
+from motionhyst.time.openloop import is_periodic_record
 
 __all__ = ["identify_io"]
 
@@ -180,13 +182,13 @@ def check_steady_state(rec: IORecord, period: int) -> None:
                          f"without --periodic, or drop the periods before the steady state")
 
 
-def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: bool = False,
-                nu: float | None = 1.0, substeps: int | None = None, tol: float = 1e-12,
-                max_nfev: int = 60, n_elements: int = 4, start_nfev: int | None = None,
-                plant: str = "mass-spring-damper", output: str = "y2", offset: str = "auto",
-                from_rest: bool = False, max_evaluations: int | None = None,
-                init_window: int | None = None, asymmetric: bool = False
-                ) -> IOIdentification:
+def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | str = BoucWen,
+                *, periodic: bool = False, nu: float | None = 1.0, substeps: int | None = None,
+                tol: float = 1e-12, max_nfev: int = 60, n_elements: int = 4,
+                start_nfev: int | None = None, plant: Plant | type | str = MassSpringDamper,
+                output: str | None = None, offset: str = "auto", from_rest: bool = False,
+                max_evaluations: int | None = None, init_window: int | None = None,
+                asymmetric: bool = False) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -194,18 +196,23 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     records : list of IORecord
         Force in, displacement out; each from rest (``y = y' = 0``, link relaxed
         at the first sample) or, with `periodic`, whole periods of a steady state.
-    model : str
-        The link's model, one of :data:`MODELS` (``"bouc-wen"``, ``"jenkins"``,
-        ``"maxwell-slip"``, ``"dahl"``, ``"lugre"``): Bouc-Wen with exact
-        sensitivities, the others from the model registry (LuGre's viscous
-        ``sigma2`` is not estimated: it adds to ``c``).
+    model : Hysteresis class or instance, or str
+        The link's model (an instance stands for its class: its values are
+        estimated, not used): :class:`~motionhyst.hysteresis.BoucWen` with exact
+        sensitivities, the registry's others (:data:`MODELS`: Jenkins,
+        Maxwell-slip, Dahl, LuGre, Coulomb) from their parameter lists (LuGre's
+        viscous ``sigma2`` is not estimated: it adds to ``c``).  A registered
+        name (``"jenkins"``) is taken for its class.
     periodic : bool
         Records are steady-state periods (each record one period or several
         whole periods of its force).  A floating stage's (the two-mass one) is
         known up to a constant position: records and model are compared with
         their means removed.
-    plant : {"mass-spring-damper", "mass-damper", "two-mass", "quasi-static"}
-        The stage: :class:`~motionhyst.time.openloop.MassSpringDamper` (``m, c, k``),
+    plant : plant instance or class, or str
+        The stage whose parameters are estimated (an instance stands for its
+        class and measured ``output``; its values are not used), or its
+        registered name (:data:`PLANTS`): :class:`~motionhyst.plants.MassSpringDamper`
+        (``m, c, k``),
         :class:`~motionhyst.plants.mass_damper.MassDamper` (``m, c``: a positioning
         axis, friction the link), the floating
         :class:`~motionhyst.time.openloop.TwoMass` of eqs. (1)-(2)
@@ -214,9 +221,10 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         actuators, friction dampers), :class:`~motionhyst.plants.quasi_static.QuasiStatic`
         (``k, c`` in parallel with the link, any link Bouc-Wen included;
         :mod:`~motionhyst.identify.io_quasi_static`).
-    output : {"y2", "y1"}
-        Two-mass stage: the measured position (``y2``, the point of control, or
-        ``y1``, the actuated mass).
+    output : {"y2", "y1"}, optional
+        With a two-mass stage given by its name or class: the measured position
+        (``y2``, the point of control, the default, or ``y1``, the actuated mass);
+        an instance says it itself (``TwoMassStage(..., output="y1")``).
     nu : float or None
         Bouc-Wen exponent: fixed at this value, or estimated (``nu >= 1``) when
         None, starting from 1.  With ``nu`` free the products ``beta*gamma`` and
@@ -282,14 +290,12 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
     >>> t = np.arange(1024) / 750
     >>> u = 40 * np.sin(2 * np.pi * 8 * t) + 20 * np.sin(2 * np.pi * 31 * t)
     >>> y = true.simulate(t, u).displacement
-    >>> fit = identify_io([IORecord(t, u, y)])
+    >>> fit = identify_io([IORecord(t, u, y)], BoucWen, plant=MassSpringDamper)
     >>> round(fit.plant.m, 6), round(fit.estimates["alpha"])
     (2.0, 50000)
     """
     t_start = time.perf_counter()
-    if model not in MODELS:
-        raise ValueError(f"unknown link model {model!r} for input-output records; expected one "
-                         f"of {', '.join(MODELS)}")
+    link = _link_class(model)
     records = check_records(list(records), periodic)
     if periodic:
         for rec in records:
@@ -299,11 +305,7 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
                                  f"the force; its ends do not join")
             if rec_period is not None:
                 check_steady_state(rec, rec_period)
-    if plant not in PLANTS:
-        raise ValueError(f"unknown plant {plant!r} for input-output records; expected one of "
-                         f"{', '.join(PLANTS)}")
-    if output not in TwoMass.OUTPUTS:
-        raise ValueError(f"unknown output {output!r}; expected y2 or y1")
+    stage = _stage(plant, output)
     if init_window is not None:
         if not (isinstance(init_window, int | np.integer) and init_window >= 2):
             raise ValueError(f"the initialisation window must be at least 2 samples, got "
@@ -312,38 +314,85 @@ def identify_io(records: list[IORecord], model: str = "bouc-wen", *, periodic: b
         if short:
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
-    if asymmetric and (model != "coulomb" or plant != "mass-damper"):
-        raise ValueError("direction-dependent viscous friction is identified with the Coulomb "
-                         "link on a mass-damper")
-    if plant == "quasi-static":  # no inertia: the link's balance (any link, Bouc-Wen too)
+    if not stage.has_inertia:  # the link's balance (any link, Bouc-Wen too)
+        if asymmetric:
+            raise ValueError(_ASYMMETRIC)
         from motionhyst.identify.io_quasi_static import identify_quasi_static_io
 
         if init_window is not None:
             raise ValueError("a stage without inertia has no state for an initialisation "
                              "window to set")
-        return identify_quasi_static_io(records, model, periodic=periodic,
+        return identify_quasi_static_io(records, link, periodic=periodic,
                                         n_elements=n_elements, offset=offset,
                                         max_evaluations=max_evaluations, tol=tol,
                                         t_start=t_start)
-    if model != "bouc-wen":
-        return identify_elements_io(records, model, periodic, substeps, tol,
+    shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
+    if asymmetric and not (link is Coulomb and shape.floating and shape.n == 1):
+        raise ValueError(_ASYMMETRIC)
+    if link is not BoucWen:
+        return identify_elements_io(records, link, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
-                                    plant, output, offset, from_rest, max_evaluations,
+                                    stage, offset, from_rest, max_evaluations,
                                     int(init_window) if init_window is not None else None,
                                     asymmetric)
-    bouc_wen_offset = offset == "output" and plant == "mass-spring-damper"
+    bouc_wen_offset = offset == "output" and not shape.floating
     if (offset not in ("auto", "none") and not bouc_wen_offset) or from_rest \
             or init_window is not None:
         raise ValueError("the Bouc-Wen link's records start at rest and only its position "
                          "offsets are estimated (offset 'output', on a mass-spring-damper); "
                          "other offsets and initial states are estimated with the element links")
-    if plant == "mass-damper":
+    if shape.floating and shape.n == 1:
         raise ValueError("the Bouc-Wen link is identified on a mass-spring-damper or a "
                          "two-mass stage")
     if max_evaluations is not None:
         max_nfev = max_evaluations
-    if plant == "two-mass":
-        return identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output,
-                                          t_start)
+    if shape.n > 1:
+        return identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev,
+                                          stage.output, t_start)
     return identify_bouc_wen_msd(records, periodic, nu, substeps, tol, max_nfev, t_start,
                                  bouc_wen_offset)
+
+
+_ASYMMETRIC = ("direction-dependent viscous friction is identified with the Coulomb link on a "
+               "mass-damper")
+
+
+def _link_class(model: type[Hysteresis] | Hysteresis | str) -> type[Hysteresis]:
+    """The link model's class: `model` itself, an instance's class, or a registered name's
+    (converted here once); a one-line error for a model input-output records do not fit."""
+    if isinstance(model, str):
+        if model not in MODELS:
+            raise ValueError(f"unknown link model {model!r} for input-output records; expected "
+                             f"one of {', '.join(MODELS)}")
+        return model_class(model)
+    cls = model if isinstance(model, type) else type(model)
+    if not (issubclass(cls, Hysteresis) and getattr(cls, "name", None) in MODELS):
+        raise ValueError(f"input-output records fit a link model of {', '.join(MODELS)}, not "
+                         f"{model!r}")
+    return cls
+
+
+def _stage(plant: Plant | type | str, output: str | None) -> Plant:
+    """The stage as a plant instance whose class and measured output the fit takes (its
+    values are not used): `plant` itself, or one built from its class or registered name
+    (converted here once) with `output`."""
+    if isinstance(plant, str):
+        if plant not in PLANTS:
+            raise ValueError(f"unknown plant {plant!r} for input-output records; expected one "
+                             f"of {', '.join(PLANTS)}")
+        plant = plant_class(plant)
+    cls = plant if isinstance(plant, type) else type(plant)
+    if getattr(cls, "name", None) not in PLANTS or cls is not plant_class(cls.name):
+        raise ValueError(f"input-output records identify a {', '.join(PLANTS)} stage, not "
+                         f"{plant!r}")
+    if isinstance(plant, type):
+        several = len(cls.outputs) > 1
+        if output is not None and output not in cls.outputs:
+            raise ValueError(f"unknown output {output!r}; expected {' or '.join(cls.outputs)}"
+                             if several else f"output {output!r}: a {cls.name} stage has one "
+                             f"position")
+        values = {p.name: 1.0 for p in cls.parameters if p.required}
+        return cls(**values, output=output or cls.outputs[0]) if several else cls(**values)
+    if output is not None and output != plant.output:
+        raise ValueError(f"output {output!r} differs from the plant's own {plant.output!r}")
+    return plant

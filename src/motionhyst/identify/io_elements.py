@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from motionhyst.hysteresis import Hysteresis, Parameter
+from motionhyst.hysteresis import Coulomb, Hysteresis, Parameter
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.identify.io_checks import judge_fit, plausibility_warnings
 from motionhyst.identify.io_offsets import Extras, initial_state
@@ -80,25 +80,21 @@ class _LinkLayout:
     is fixed at 0, since the stage's ``k`` or ``c`` holds the sum.
     """
 
-    model: str
     cls: type
     entries: list[tuple[Parameter, int]]  # (parameter, number of values; -1: a scalar)
     fixed: dict[str, float]
 
     @classmethod
-    def of(cls, model: str, n: int, faster: str | None = None) -> _LinkLayout:
-        """The layout of `model` (`n` values of a list parameter); `faster`: the
-        Coulomb link's direction-dependent viscous friction, ``"c_pos"`` or ``"c_neg"``
+    def of(cls, klass: type, n: int, faster: str | None = None) -> _LinkLayout:
+        """The layout of the link model `klass` (`n` values of a list parameter); `faster`:
+        the Coulomb link's direction-dependent viscous friction, ``"c_pos"`` or ``"c_neg"``
         (the direction with more, estimated on top of the stage's ``c``; the other
         fixed at 0)."""
-        from motionhyst.hysteresis import model_class
-
-        klass = model_class(model)
         entries, fixed = [], {}
         if faster is not None:
             form = {p.name: p for p in klass.forms[0].parameters}
             slower = "c_neg" if faster == "c_pos" else "c_pos"
-            return cls(model, klass, [(klass.parameters[0], -1), (form[faster], -1)],
+            return cls(klass, [(klass.parameters[0], -1), (form[faster], -1)],
                        {slower: 0.0})
         for par in klass.parameters:
             if par.parallel:
@@ -107,7 +103,7 @@ class _LinkLayout:
                 entries.append((par, 0 if par.default == () else n))
             else:
                 entries.append((par, -1))
-        return cls(model, klass, entries, fixed)
+        return cls(klass, entries, fixed)
 
     def _values(self):
         for par, count in self.entries:
@@ -485,10 +481,9 @@ RATE_GRID = (0.1, 0.01, 0.03, 0.3, 1.0, 3.0)
 STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 
-def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t_start,
-                         start_nfev, plant="mass-spring-damper", output="y2", offset="none",
-                         from_rest=True, budget=None, init_window=None, asymmetric=False
-                         ) -> IOIdentification:
+def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_start,
+                         start_nfev, plant, offset="none", from_rest=True, budget=None,
+                         init_window=None, asymmetric=False) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -525,23 +520,28 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     (:class:`~motionhyst.identify.io_offsets.Extras`) are estimated with them:
     started at zero (the position offset of a floating stage at the record's
     first sample, its velocity at the first samples' slope).
+
+    `link` is the link model's class, `plant` a plant instance of the stage's class and
+    measured output (its values are not used): a floating stage of two masses is the
+    two-mass stage, of one a mass-damper, else a mass-spring-damper.
     """
-    asymmetric = asymmetric and model == "coulomb" and plant == "mass-damper"
-    idim = inverse_dynamics(records, plant != "mass-spring-damper", asymmetric)
+    shape = plant.mechanics(np.ones(len(plant.PARAMETERS)))  # the structure, whatever values
+    axis = shape.floating and shape.n == 1  # a positioning axis: friction holds it
+    idim = inverse_dynamics(records, shape.floating, asymmetric)
     faster = None
     if asymmetric:  # the stage's c is the smaller viscous friction, the link adds the rest
         faster = "c_pos" if idim["c_pos"] >= idim["c_neg"] else "c_neg"
         idim["c"] = min(idim["c_pos"], idim["c_neg"])
-    layout = _LinkLayout.of(model, n, faster)
-    y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and plant == "two-mass"
+    layout = _LinkLayout.of(link, n, faster)
+    y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and shape.n > 1
                                      else 0.0) for rec in records])
     y_scale = float(np.sqrt(np.mean(y_all ** 2)))
     v_scale = float(np.sqrt(np.mean(np.concatenate(
         [np.gradient(rec.y, rec.t) for rec in records]) ** 2)))
     u_rms = float(np.sqrt(np.mean(np.concatenate([rec.u for rec in records]) ** 2)))
     force = np.array([par.unit == _FORCE for par, _ in layout._values()], dtype=bool)
-    if plant == "two-mass":
-        bla, k_link, c_link = best_linear_approximation_two_mass(records, output, periodic)
+    if shape.n > 1:
+        bla, k_link, c_link = best_linear_approximation_two_mass(records, plant.output, periodic)
         structure: MassSpringDamper | TwoMass | MassDamper = bla
         f_n = bla.mechanics().natural_frequency_hz(16.0 * k_link)
         r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n
@@ -558,7 +558,7 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
                 if force.any():
                     link0[force] *= held_force * u_rms / np.sum(link0[force])
                 starts.append(np.concatenate([stage0, link0]))
-    elif plant == "mass-damper":
+    elif axis:
         bla = best_linear_approximation(records)
         m0 = idim["m"] if idim["m"] > 0 else bla.m
         c0 = idim["c"] if idim["c"] > 0 else bla.c
@@ -638,10 +638,10 @@ def identify_elements_io(records, model, periodic, substeps, tol, max_nfev, n, t
     prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
                            extras=extras, window=init_window)
     q0 = prob.variables(np.concatenate([best[1][:n_base], full_start]))
-    if plant == "mass-damper" and not getattr(layout.cls, "rigid", False):
+    if axis and not getattr(layout.cls, "rigid", False):
         # the rigid slider is every friction link's limit: its fit is a start for theirs
         seed, used = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
-                                 start_nfev, plant, output, offset, from_rest, layout, y_scale,
+                                 start_nfev, plant, offset, from_rest, layout, y_scale,
                                  v_scale, extras, force, init_window)
         n_eval += used
         if seed is not None:
@@ -741,16 +741,16 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
     return float(np.std(res) if output_offset else np.sqrt(np.mean(res ** 2)))
 
 
-def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, output,
-                offset, from_rest, layout, y_scale, v_scale, extras, force, init_window=None):
+def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, offset,
+                from_rest, layout, y_scale, v_scale, extras, force, init_window=None):
     """A positioning axis's friction link started from the Coulomb link's fit: the stage, the
     offsets and initial states as fitted, the link's forces together its slip force, slipping
     after 1e-5 of the output's RMS (its rigid limit); None if that fit fails."""
     from motionhyst.identify.io_checks import FitFailed
 
     try:
-        fit = identify_elements_io(records, "coulomb", periodic, substeps, tol, max_nfev, 1,
-                                   t_start, start_nfev, plant, output, offset, from_rest,
+        fit = identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev, 1,
+                                   t_start, start_nfev, plant, offset, from_rest,
                                    init_window=init_window)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0

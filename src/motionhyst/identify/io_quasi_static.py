@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from motionhyst.hysteresis import Jenkins, MaxwellSlip
 from motionhyst.identify.io_checks import FitFailed, judge_fit
 from motionhyst.identify.io_elements import LinkLayout
 from motionhyst.identify.io_records import IORecord
@@ -154,9 +155,9 @@ class _Problem:
                              max_nfev=max_nfev, bounds=(lower, np.full(lower.size, np.inf)))
 
 
-def _layout(model: str, n_elements: int) -> LinkLayout:
+def _layout(link: type, n_elements: int) -> LinkLayout:
     """The link's search layout; Bouc-Wen's exponent fixed at its default 1 (exact steps)."""
-    layout = LinkLayout.of(model, n_elements)
+    layout = LinkLayout.of(link, n_elements)
     for par, count in list(layout.entries):
         if par.name in ("n", "nu") and count < 0 and par.default is not None:
             layout.entries.remove((par, count))
@@ -174,9 +175,9 @@ def _stop_operator_starts(records: list[IORecord], layout: LinkLayout, prob: _Pr
     position.  None for other links."""
     from motionhyst.identify.fit import identify_maxwell_slip
 
-    if layout.model not in ("jenkins", "maxwell-slip"):
+    if layout.cls not in (Jenkins, MaxwellSlip):
         return []
-    n = 1 if layout.model == "jenkins" else n_elements
+    n = 1 if layout.cls is Jenkins else n_elements
     x = np.concatenate([rec.y - rec.y[0] for rec in records])
     u = np.concatenate([rec.u for rec in records])
     try:
@@ -187,7 +188,7 @@ def _stop_operator_starts(records: list[IORecord], layout: LinkLayout, prob: _Pr
     fc = np.array([e["fc"] for e in ident.elements])
     order = np.argsort(fc / k)  # by slip displacement: the last is the spring
     k, fc = k[order], fc[order]
-    link = np.concatenate([k[:-1], fc[:-1]]) if layout.model == "maxwell-slip" else \
+    link = np.concatenate([k[:-1], fc[:-1]]) if layout.cls is MaxwellSlip else \
         np.array([k[0], fc[0]])
     v = np.concatenate([[k[-1], 0.0], link, [ident.offset if input_offset else 0.0],
                         [rec.y[0] if output_offset else 0.0 for rec in records]])
@@ -224,7 +225,7 @@ def _linear_rms(records: list[IORecord], K: float, C: float, periodic: bool) -> 
     return rms if math.isfinite(rms) else None
 
 
-def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: bool,
+def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: bool,
                              n_elements: int, offset: str, max_evaluations: int | None,
                              tol: float, t_start: float | None = None) -> IOIdentification:
     """A quasi-static plant and its link from input-output records (see the module).
@@ -233,8 +234,8 @@ def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: b
     ----------
     records : list of IORecord
         Force in, position out (checked).
-    model : str
-        The link's registered model.
+    link : type
+        The link's model, a registered :class:`~motionhyst.hysteresis.Hysteresis` class.
     periodic : bool
         Records of whole periods of a periodic steady state.
     n_elements : int
@@ -269,7 +270,7 @@ def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: b
     >>> t = np.arange(2000) / 1000.0
     >>> u = 300.0 * np.sin(2 * np.pi * 2 * t) * np.minimum(1.0, t)
     >>> y = displacement_from_force(QuasiStatic(k=1e5), Jenkins(k=3e5, fc=100.0), t, u)
-    >>> fit = identify_quasi_static_io([IORecord(t, u, y + 1e-4)], "jenkins", periodic=False,
+    >>> fit = identify_quasi_static_io([IORecord(t, u, y + 1e-4)], Jenkins, periodic=False,
     ...                                n_elements=1, offset="auto", max_evaluations=None,
     ...                                tol=1e-12)
     >>> est = fit.estimates
@@ -279,7 +280,7 @@ def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: b
     (100.0, 0.0)
     """
     t0 = time.perf_counter() if t_start is None else t_start
-    layout = _layout(model, n_elements)
+    layout = _layout(link, n_elements)
     K, C, b = _linear_start(records)
     if not K > 0:
         raise ValueError("the records show no stiffness (the position does not follow the "
@@ -312,18 +313,18 @@ def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: b
     # the start that predicts the positions best continues
     costs = [float(np.sum(prob._residuals(q[prob.free], False) ** 2)) for q in starts]
     if not starts or min(costs) >= 0.5 * FAILED_RESIDUAL ** 2 * y_all.size:  # none runs
-        raise FitFailed(f"the fit failed: no start of the {model} link on a quasi-static "
+        raise FitFailed(f"the fit failed: no start of the {link.name} link on a quasi-static "
                         f"plant can run on these records (a force it does not hold)")
     n_final = FINAL_NFEV if budget is None else max(10, budget - prob.n_eval)
     start = starts[int(np.argmin(costs))]
     sol = prob.solve(start, False, n_final, tol)
     q = prob.whole(sol.x)
     v = prob.values(q)
-    plant, link = prob.model(v)
+    plant, fitted = prob.model(v)
     predictions = prob.positions(v)
     res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
     fit_rms = float(np.sqrt(np.mean(res ** 2)))
-    system = OpenLoop(plant, link)
+    system = OpenLoop(plant, fitted)
     judge_fit(fit_rms, records, predictions, _linear_rms(records, K, C, periodic), system, out)
     spread = float(np.sqrt(np.sum(np.concatenate([rec.y - np.mean(rec.y) for rec in records])
                                   ** 2)))
@@ -352,7 +353,7 @@ def identify_quasi_static_io(records: list[IORecord], model: str, *, periodic: b
                          "output": [float(x) for x in prob.output_offsets(v)]},
              "budget_reached": bool(budget is not None and prob.n_eval >= budget)}
     return IOIdentification(
-        plant=plant, hysteresis=link, estimates=estimates, std=std, not_identifiable=notes,
+        plant=plant, hysteresis=fitted, estimates=estimates, std=std, not_identifiable=notes,
         fit_rms=fit_rms, records=per_record_errors(records, res),
         seconds=time.perf_counter() - t0, periodic=periodic,
         stopping=f"{sol.message} (forward differences; ftol = xtol = gtol = {tol:g}, "
