@@ -182,10 +182,10 @@ def _arx_response(records: list[IORecord], f_hz: NDArray[np.float64], na: int = 
     return num / den
 
 
-def two_mass_response(theta: NDArray[np.float64], f_hz: NDArray[np.float64], output: str
+def two_mass_response(theta: NDArray[np.float64], f_hz: NDArray[np.float64], at_link: bool
                       ) -> NDArray[np.complex128]:
-    """``y2 / u`` or ``y1 / u`` of the two-mass stage (eqs. 1-2) held by a spring ``kl``
-    and damper ``cl`` on ``y1``; ``theta = (m1, m2, b, k, kl, cl)``.
+    """``y2 / u`` or, `at_link`, ``y1 / u`` of the two-mass stage (eqs. 1-2) held by a spring
+    ``kl`` and damper ``cl`` on ``y1``; ``theta = (m1, m2, b, k, kl, cl)``.
 
     With ``D = (m1 s^2 + (b + cl) s + k + kl)(m2 s^2 + b s + k) - (b s + k)^2``:
     ``y2 / u = (b s + k) / D`` and ``y1 / u = (m2 s^2 + b s + k) / D``.
@@ -194,7 +194,7 @@ def two_mass_response(theta: NDArray[np.float64], f_hz: NDArray[np.float64], out
     s = 2j * np.pi * f_hz
     inner = b * s + k
     D = (m1 * s * s + (b + cl) * s + k + kl) * (m2 * s * s + inner) - inner * inner
-    return (inner if output == "y2" else m2 * s * s + inner) / D
+    return (m2 * s * s + inner if at_link else inner) / D
 
 
 def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y2",
@@ -249,6 +249,8 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     >>> round(p.m1, 3), round(p.m2, 3), round(p.b, 2), round(p.k), round(kl), round(cl, 6)
     (2.0, 3.0, 20.0, 200000, 50000, 0.0)
     """
+    mech = TwoMass(1.0, 1.0, 0.0, 1.0, output).mechanics()
+    at_link = mech.output == mech.link  # y1 measured: the link's own position
     f, G = _spectral_response(records)
     keep = f < 0.5 * records[0].fs * (1 - 1e-9)  # the Nyquist line is ambiguous
     f, G = f[keep], G[keep]
@@ -259,7 +261,7 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     for om in 2 * np.pi * np.geomspace(0.5 * f[0], 10 * f[-1], 80):
         for zeta in np.geomspace(0.002, 0.5, 12):
             H = (2 * zeta * om * s + om * om) / (s * s + 2 * zeta * om * s + om * om)
-            Z = 1.0 / G if output == "y1" else H / G
+            Z = 1.0 / G if at_link else H / G
             A = np.column_stack([s * s, s, np.ones_like(s), s * s * H]) / np.abs(Z)[:, None]
             rhs = Z / np.abs(Z)
             x = np.linalg.lstsq(np.concatenate([A.real, A.imag]),
@@ -275,7 +277,7 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
 
     def residual(logt):
         with np.errstate(all="ignore"):
-            e = (two_mass_response(np.exp(logt), f, output) - G) / mag
+            e = (two_mass_response(np.exp(logt), f, at_link) - G) / mag
         r = np.concatenate([e.real, e.imag])
         return np.where(np.isfinite(r), r, 1e6)
 
