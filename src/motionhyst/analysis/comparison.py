@@ -141,7 +141,7 @@ class DescribingFunctionComparison:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.plots import fig11_errors
+        from motionhyst.analysis.figures import fig11_errors
 
         return fig11_errors([p.state for p in self.points],
                             [p.mismatch_df for p in self.points],

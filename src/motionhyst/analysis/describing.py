@@ -162,7 +162,7 @@ class DescribingFunctionResult:
 
     def plot(self, ax=None):
         """``|D| / k_init`` and the angle of ``D`` against the amplitude, one curve per
-        frequency (:func:`motionhyst.present.figures.plot_describing_function`).
+        frequency (:func:`motionhyst.analysis.figures.plot_describing_function`).
 
         Parameters
         ----------
@@ -174,7 +174,7 @@ class DescribingFunctionResult:
         matplotlib.figure.Figure
             With the plotted data as ``fig.motionhyst_data``.
         """
-        from motionhyst.present.figures import plot_describing_function
+        from motionhyst.analysis.figures import plot_describing_function
 
         return plot_describing_function(self, ax=ax)
 

@@ -176,7 +176,7 @@ class DigitalComparison:
 
     def plot(self, ax=None):
         """``|E|`` of eq. (18) (lines) and exact (circles) of each variant
-        (:func:`motionhyst.present.figures.plot_digital`).
+        (:func:`motionhyst.analysis.figures.plot_digital`).
 
         Parameters
         ----------
@@ -187,7 +187,7 @@ class DigitalComparison:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.figures import plot_digital
+        from motionhyst.analysis.figures import plot_digital
 
         return plot_digital(self, ax=ax)
 

@@ -99,7 +99,7 @@ class FloquetResult:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.stability import plot_multipliers
+        from motionhyst.analysis.figures import plot_multipliers
 
         return plot_multipliers(self, ax=ax)
 

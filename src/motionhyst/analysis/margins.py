@@ -153,7 +153,7 @@ class LoopMargins:
 
     def plot(self, ax=None):
         """``|L|`` and ``|S| = 1 / |1 + L|`` against frequency, the bandwidth and the
-        modulus margin marked (:func:`motionhyst.present.figures.plot_margins`).
+        modulus margin marked (:func:`motionhyst.analysis.figures.plot_margins`).
 
         Parameters
         ----------
@@ -164,7 +164,7 @@ class LoopMargins:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.figures import plot_margins
+        from motionhyst.analysis.figures import plot_margins
 
         return plot_margins(self, ax=ax)
 

@@ -218,7 +218,7 @@ class QuasiLinearAnalysis:
 
     def plot(self, ax=None):
         """The mismatch ``|E|`` (eq. 18) and its asymptote (eq. 20) at the analysed
-        frequencies, with the crossovers (:func:`motionhyst.present.figures.plot_analysis`).
+        frequencies, with the crossovers (:func:`motionhyst.analysis.figures.plot_analysis`).
 
         Parameters
         ----------
@@ -229,7 +229,7 @@ class QuasiLinearAnalysis:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.figures import plot_analysis
+        from motionhyst.analysis.figures import plot_analysis
 
         return plot_analysis(self, ax=ax)
 

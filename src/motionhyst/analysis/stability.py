@@ -283,7 +283,7 @@ class StabilityResult:
 
     def plot(self, ax=None):
         """The Nyquist curve of ``G`` with the loci ``-1/N(A, omega)`` and the predicted
-        cycles (:func:`motionhyst.present.stability.plot_stability`).
+        cycles (:func:`motionhyst.analysis.figures.plot_stability`).
 
         Parameters
         ----------
@@ -294,7 +294,7 @@ class StabilityResult:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.stability import plot_stability
+        from motionhyst.analysis.figures import plot_stability
 
         return plot_stability(self, ax=ax)
 

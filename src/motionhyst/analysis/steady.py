@@ -180,7 +180,7 @@ class SteadyState:
 
     def plot(self, ax=None):
         """One period of the error, with and without hysteresis
-        (:func:`motionhyst.present.figures.plot_steady_state`).
+        (:func:`motionhyst.analysis.figures.plot_steady_state`).
 
         Parameters
         ----------
@@ -191,7 +191,7 @@ class SteadyState:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.figures import plot_steady_state
+        from motionhyst.analysis.figures import plot_steady_state
 
         return plot_steady_state(self, ax=ax)
 

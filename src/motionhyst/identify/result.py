@@ -133,7 +133,7 @@ class Identification:
     def plot(self, ax=None):
         """The identified link's force-displacement loops.
 
-        Drawn by :func:`~motionhyst.present.figures.plot_link`.
+        Drawn by :func:`~motionhyst.hysteresis.figures.plot_link`.
 
         Parameters
         ----------
@@ -144,7 +144,7 @@ class Identification:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.figures import plot_link
+        from motionhyst.hysteresis.figures import plot_link
 
         return plot_link(self.model, title=f"Identified Maxwell-slip link, "
                          f"{self.n_elements} element(s)", ax=ax)

@@ -553,7 +553,7 @@ class FrfFit:
     def plot(self, f_range: tuple[float, float] | None = None, ax=None):
         """Bode figure of the measured ``P1``, ``P2`` (markers) and the fit (lines).
 
-        Returns a matplotlib Figure (see :func:`motionhyst.present.figures.plot_frf_fit`).
+        Returns a matplotlib Figure (see :func:`motionhyst.plants.figures.plot_frf_fit`).
 
         Parameters
         ----------
@@ -562,7 +562,7 @@ class FrfFit:
         ax : sequence of 2 matplotlib.axes.Axes, optional
             Axes to draw into (magnitude, phase); default: a new figure.
         """
-        from motionhyst.present.figures import plot_frf_fit
+        from motionhyst.plants.figures import plot_frf_fit
 
         return plot_frf_fit(self, f_range, ax=ax)
 

@@ -15,9 +15,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from motionhyst.hysteresis import Hysteresis, Jenkins
-from motionhyst.hysteresis.periodic import TWO_PI
-from motionhyst.present.figures import (
+from motionhyst.analysis.figures import fig11_errors
+from motionhyst.core.plotting import (
     LINEAR_COLOR,
     MODE2_COLOR,
     MODE3_COLOR,
@@ -25,6 +24,8 @@ from motionhyst.present.figures import (
     minor_log_ticks,
     new_figure,
 )
+from motionhyst.hysteresis import Hysteresis, Jenkins
+from motionhyst.hysteresis.periodic import TWO_PI
 
 __all__ = ["describing_function_curve", "fig5_loops", "fig6_modes", "fig7_time",
            "fig8_describing_function", "fig9_quasilinear_plant", "fig10_mismatch", "fig11_errors",
@@ -570,55 +571,4 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
     ax.legend(loc="upper right", fontsize=7)
     minor_log_ticks(fig)
     fig.motionhyst_data.update(f=f, E=E, asymptote=Et)
-    return fig
-
-
-def fig11_errors(states: list[SteadyState], mismatch_df: ArrayLike,
-                 harmonics_df: list[ArrayLike] | None = None, ax=None):
-    """Fig. 11: steady-state error over a period, with and without hysteresis, and the DF.
-
-    Parameters
-    ----------
-    states : list of SteadyState
-        The exact steady states, one panel each.
-    mismatch_df : array_like of complex
-        Eq. (18) per state: the describing function's prediction of the first harmonic.
-    harmonics_df : list of array_like, optional
-        Per state, the predicted error harmonics 1, 2, ... from the higher-order
-        describing functions; their sum is added as a dotted line.
-    ax : sequence of matplotlib.axes.Axes, optional
-        One axes per state to draw into; default: a new figure.
-
-    Examples
-    --------
-    >>> from motionhyst import compare_with_describing_function, default_scenario
-    >>> cmp = compare_with_describing_function(default_scenario().loop(), 0.01, [5.0, 10.0])
-    >>> len(cmp.plot().axes)                               # fig11_errors, one panel a frequency
-    2
-    """
-    fig, axes = new_figure(len(states), sharex=False, ax=ax)
-    hdf = harmonics_df if harmonics_df is not None else [None] * len(states)
-    for ax, ss, E, h in zip(axes, states, np.atleast_1d(mismatch_df), hdf, strict=True):
-        ts = ss.time_series()
-        theta = TWO_PI * ss.frequency_hz * ts["t"]
-        e_df = np.abs(E * ss.e_linear[1]) * np.sin(theta + np.angle(E * ss.e_linear[1]))
-        t_ms = ts["t"] * 1e3
-        ax.plot(t_ms, ts["e"] * 1e9, color="k", label="with hysteresis (exact)")
-        ax.plot(t_ms, ts["e_linear"] * 1e9, color=LINEAR_COLOR, label="without hysteresis")
-        ax.plot(t_ms, e_df * 1e9, "--", color="tab:red", label="describing function")
-        if h is not None:
-            h = np.asarray(h)
-            n = np.arange(1, len(h) + 1)
-            e_hdf = np.imag(np.exp(1j * np.outer(theta, n)) @ h)
-            ax.plot(t_ms, e_hdf * 1e9, ":", color="tab:green",
-                    label=f"higher-order DFs, n <= {len(h)}")
-            fig.motionhyst_data[f"f={ss.frequency_hz:g} hosidf"] = e_hdf
-        ax.set_ylabel("e [nm]")
-        ax.set_title(f"f = {ss.frequency_hz:g} Hz", fontsize=9, loc="left")
-        fig.motionhyst_data[f"f={ss.frequency_hz:g}"] = np.vstack(
-            [ts["t"], ts["e"], ts["e_linear"], e_df])
-    axes[-1].set_xlabel("time [ms]")
-    handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=2)
-    fig.suptitle("Fig. 11: steady-state tracking error", fontsize=10)
     return fig

@@ -98,7 +98,7 @@ class Simulation:
 
     def plot(self, ax=None):
         """The error with and without the link, and the link force, against time
-        (:func:`motionhyst.present.figures.plot_simulation`).
+        (:func:`motionhyst.time.figures.plot_simulation`).
 
         Parameters
         ----------
@@ -109,6 +109,6 @@ class Simulation:
         -------
         matplotlib.figure.Figure
         """
-        from motionhyst.present.figures import plot_simulation
+        from motionhyst.time.figures import plot_simulation
 
         return plot_simulation(self, ax=ax)
