@@ -29,10 +29,14 @@ from motionhyst import (
 from motionhyst.analysis.digital import compare_digital
 from motionhyst.core.jsonio import dumps
 from motionhyst.identify import identify_maxwell_slip
+from motionhyst.identify.input_output import identify_io
+from motionhyst.identify.io_records import IORecord
+from motionhyst.plants import QuasiStatic
 from motionhyst.plants.frf_fit import ModalPlant
 from motionhyst.scan.ilc import learn
 from motionhyst.scan.profiles import point_to_point, scan
 from motionhyst.scan.scanning import run_scan
+from motionhyst.time.quasi_static import displacement_from_force
 
 
 def _identification():
@@ -46,6 +50,13 @@ def _frf_fit():
     exact = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
     f = np.geomspace(1.0, 3000.0, 60)
     return fit_frf(f, *exact.response(2 * np.pi * f))
+
+
+def _io_identification():
+    t = np.arange(1000) / 500.0
+    u = 300.0 * np.sin(2 * np.pi * 2 * t)
+    y = displacement_from_force(QuasiStatic(k=1e5), Jenkins(k=3e5, fc=100.0), t, u)
+    return identify_io([IORecord(t, u, y, "sine")], Jenkins, plant=QuasiStatic)
 
 
 def _ilc(loop):
@@ -74,6 +85,7 @@ RESULTS = {
     "Profile": (lambda loop: point_to_point(0.002, 0.05, 2.0, 50.0, 1e3), 5),
     "LoopMargins": (lambda loop: loop_margins(loop.controller, loop.P2), 1),
     "DigitalComparison": (lambda loop: compare_digital(loop, 0.01, [10.0]), 1),
+    "IOIdentification": (lambda loop: _io_identification(), 2),
 }
 
 

@@ -291,7 +291,8 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
         records=per_record, seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r, extra=extra, warnings=warnings)
+        n_evaluations=n_eval, substeps=r, extra=extra, warnings=warnings,
+        data=list(records), residuals=res)
 
 
 def _output_offsets(records, periodic, r, free, p, y_scale, rss, n_rows):
@@ -427,7 +428,8 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
         periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r, warnings=warnings)
+        n_evaluations=n_eval, substeps=r, warnings=warnings, data=list(records),
+        residuals=res)
 
 
 def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,

@@ -720,7 +720,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "
                  f"at most {remaining} evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r,
+        n_evaluations=n_eval, substeps=r, data=list(records), residuals=res,
         extra={"offsets": {"input": u0, "output": y0.tolist()},
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0)})

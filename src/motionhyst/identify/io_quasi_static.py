@@ -358,4 +358,5 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         seconds=time.perf_counter() - t0, periodic=periodic,
         stopping=f"{sol.message} (forward differences; ftol = xtol = gtol = {tol:g}, "
                  f"{prob.n_eval} evaluations with the starts)",
-        n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings)
+        n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings,
+        data=list(records), residuals=res)

@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.textfiles import toml_table
+from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop
@@ -53,6 +54,11 @@ class IOIdentification:
     warnings : list of str
         Implausible estimates, one line each naming the parameter
         (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
+    data : list of IORecord
+        The records fitted (not in :meth:`to_dict`).
+    residuals : ndarray
+        The model's output less the measured position, the records one after the other, as
+        the fit compared them (offsets and initial states included) [m].
 
     Examples
     --------
@@ -69,6 +75,8 @@ class IOIdentification:
     >>> fit = identify_io([IORecord(t, u, true.simulate(t, u).displacement)], model="jenkins")
     >>> fit.hysteresis.name, round(fit.estimates["m"], 3)   # the mass [kg]
     ('jenkins', 2.0)
+    >>> print(str(fit).splitlines()[0])
+    mass-spring-damper stage and jenkins link from 1 input-output record(s) (from a start)
     """
 
     plant: MassSpringDamper
@@ -85,10 +93,52 @@ class IOIdentification:
     substeps: int = 0
     extra: dict = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    data: list[IORecord] = field(default_factory=list, repr=False, compare=False)
+    residuals: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0), repr=False,
+                                           compare=False)
 
     def system(self) -> OpenLoop:
         """The identified open-loop system."""
         return OpenLoop(self.plant, self.hysteresis)
+
+    def __str__(self) -> str:
+        stage = self.plant.to_dict().get("type", type(self.plant).__name__)
+        kind = "periodic steady state" if self.periodic else "from a start"
+        rows = []
+        for name, value in self.estimates.items():
+            s = self.std.get(name)
+            rows.append([name, g(value, 8), "not identifiable" if s is None else g(s, 2),
+                         "" if s is None or value == 0 else f"{100 * s / abs(value):.2g} %"])
+        lines = [f"{stage} stage and {self.hysteresis.name} link from {len(self.records)} "
+                 f"input-output record(s) ({kind})",
+                 f"  fit RMS {g(self.fit_rms)} m; {self.stopping}", "",
+                 table(["parameter", "estimate", "std", "std/|value|"], rows)]
+        if self.not_identifiable:
+            lines.append("")
+            lines += [f"  {name}: {why}" for name, why in self.not_identifiable.items()]
+        lines += ["", table(["record", "samples", "fit RMS [m]", "output RMS [m]"],
+                            [[r["name"], str(r["samples"]), g(r["fit_rms"]),
+                              g(r["output_rms"])] for r in self.records])]
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def plot(self, ax=None):
+        """Per record, the measured and the predicted position and their difference.
+
+        Drawn by :func:`~motionhyst.identify.figures.plot_io_identification`.
+
+        Parameters
+        ----------
+        ax : sequence of matplotlib.axes.Axes, optional
+            Two axes per record to draw into (positions, residual); default: a new figure.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from motionhyst.identify.figures import plot_io_identification
+
+        return plot_io_identification(self, ax=ax)
 
     def to_dict(self) -> dict:
         """JSON-ready: ``plant``, ``hysteresis``, ``std``, ``fit_rms``, ``records``, ``seconds``."""
