@@ -125,14 +125,6 @@ def undocumented(obj) -> tuple[list[str], list[str]]:
     return missing, stale
 
 
-# Not yet documented when this test was written (in modules being rewritten, or the study
-# package that landed the same hour); the list only shrinks: a name documented since fails
-# here as XPASS and is taken off.
-PENDING = {
-    "motionhyst.time.openloop.OpenLoop.default_substeps",
-}
-
-
 CALLABLES = [(name, obj) for name, obj in public_callables() if parameters(obj)]
 
 
@@ -140,10 +132,7 @@ def test_the_package_has_public_callables_with_parameters():
     assert len(CALLABLES) > 100
 
 
-@pytest.mark.parametrize(("name", "obj"), [
-    pytest.param(name, obj, marks=pytest.mark.xfail(
-        strict=True, reason="in PENDING: documented now? take it off the list"))
-    if name in PENDING else (name, obj) for name, obj in CALLABLES], ids=[n for n, _ in CALLABLES])
+@pytest.mark.parametrize(("name", "obj"), CALLABLES, ids=[n for n, _ in CALLABLES])
 def test_parameters_are_documented(name, obj):
     missing, stale = undocumented(obj)
     assert not missing, f"{name}: parameters without an entry in 'Parameters': {missing}"

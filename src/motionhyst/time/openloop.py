@@ -188,7 +188,26 @@ class OpenLoop:
     def default_substeps(self, fs: float) -> int:
         """Integration steps per record sample: >= 20 and >= 400 per period of the fastest
         mode (the link taken as its initial stiffness); 1 for a plant without inertia (no
-        mode: the balance is solved at the samples, :mod:`motionhyst.time.quasi_static`)."""
+        mode: the balance is solved at the samples, :mod:`motionhyst.time.quasi_static`).
+
+        Parameters
+        ----------
+        fs : float
+            Sampling rate of the record [Hz].
+
+        Returns
+        -------
+        int
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import Jenkins
+        >>> sys = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), Jenkins(k=5e4, fc=20.0))
+        >>> sys.default_substeps(750.0)          # at least 20
+        20
+        >>> sys.default_substeps(50.0)           # 400 a period of its 35.6 Hz mode
+        285
+        """
         if not self.plant.has_inertia:
             return 1
         f_n = self.plant.mechanics().natural_frequency_hz(self._k_link())
