@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 
 from motionhyst.cli._common import UsageError, g, print_json, table, whole_number
-from motionhyst.core.warnings import warn
 
 
 def plant_choices() -> list[str]:
@@ -165,8 +164,6 @@ def run_input_output(args: argparse.Namespace) -> int:
     fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
                       n_elements=args.elements or 3, plant=plant_class(plant),
                       output=args.output, **extras)
-    for line in fit.warnings:
-        warn(line)
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         text = fit.scenario_text()

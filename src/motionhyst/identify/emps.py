@@ -33,11 +33,13 @@ estimation record it was not identified from (the reference repeats every :data:
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from motionhyst.core.warnings import MotionhystWarning
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
 from motionhyst.identify.io_start import inverse_dynamics
@@ -510,8 +512,11 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
         t0 = time.perf_counter()
         try:
-            fit = identify_io([est], name.removesuffix("-asymmetric"), plant="mass-damper",
-                              init_window=INIT_WINDOW, asymmetric=name.endswith("-asymmetric"))
+            with warnings.catch_warnings():  # the report lists the fit's warnings itself
+                warnings.simplefilter("ignore", MotionhystWarning)
+                fit = identify_io([est], name.removesuffix("-asymmetric"), plant="mass-damper",
+                                  init_window=INIT_WINDOW,
+                                  asymmetric=name.endswith("-asymmetric"))
             system = fit.system()
             est_score, _ = score(system, est)
             val_score, yhat = score(system, val)

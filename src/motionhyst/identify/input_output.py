@@ -88,6 +88,7 @@ import time
 
 import numpy as np
 
+from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import MODELS as REGISTERED
 from motionhyst.hysteresis import BoucWen, Coulomb, Hysteresis, model_class
 from motionhyst.identify.io_bouc_wen import BASIC_STARTS as BASIC_STARTS
@@ -280,6 +281,13 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     -------
     IOIdentification
 
+    Warns
+    -----
+    MotionhystWarning
+        One for each line of the result's ``warnings`` (an estimate the records do not
+        hold: a mass far from the records' inertia, a parameter at its bound or run
+        away from its start).
+
     Examples
     --------
     >>> import numpy as np
@@ -314,6 +322,20 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         if short:
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
+    fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps, tol=tol,
+                 max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev, offset=offset,
+                 from_rest=from_rest, max_evaluations=max_evaluations, init_window=init_window,
+                 asymmetric=asymmetric, t_start=t_start)
+    for line in fit.warnings:  # the plausibility checks, for every caller to see
+        warn(line)
+    return fit
+
+
+def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, periodic: bool,
+           nu: float | None, substeps: int | None, tol: float, max_nfev: int, n_elements: int,
+           start_nfev: int | None, offset: str, from_rest: bool, max_evaluations: int | None,
+           init_window: int | None, asymmetric: bool, t_start: float) -> IOIdentification:
+    """The fit of :func:`identify_io` that the stage's structure and the link call for."""
     if not stage.has_inertia:  # the link's balance (any link, Bouc-Wen too)
         if asymmetric:
             raise ValueError(_ASYMMETRIC)
