@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import dataclasses
+import warnings
+
 import numpy as np
 import pytest
 
+from motionhyst import MotionhystWarning
+from motionhyst.cli import main
 from motionhyst.hysteresis import Jenkins
+from motionhyst.identify import input_output
 from motionhyst.identify.input_output import identify_io
 from motionhyst.identify.io_records import IORecord
 from motionhyst.plants import QuasiStatic
@@ -45,3 +51,26 @@ def test_prints_its_estimates_and_records(fit):
         assert name in text
     assert "record 1" in text
     assert round(fit.estimates["link.fc"]) == 100
+
+
+def test_the_library_warns_each_line_and_the_command_shows_it_once(fit, tmp_path, capsys,
+                                                                   monkeypatch):
+    lines = ["link.k = 3e+05 ran 1e+05 times above its start: the records do not hold it",
+             "m = 1e-09 kg: the inertia is not visible in these records"]
+    # the fit itself as computed, its plausibility checks saying these two lines
+    monkeypatch.setattr(input_output, "_route",
+                        lambda *args, **kw: dataclasses.replace(fit, warnings=list(lines)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        identify_io(fit.data, Jenkins, plant=QuasiStatic)
+    assert [(w.category, str(w.message)) for w in caught] == [
+        (MotionhystWarning, line) for line in lines]
+    rec = fit.data[0]
+    data = tmp_path / "rec.csv"
+    np.savetxt(data, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+    assert main(["identify", str(data), "--record", "input-output", "--model", "jenkins",
+                 "--plant", "quasi-static", "--json"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert [e for e in err if "warning" in e] == [
+        f"motionhyst: warning: identify: {line}" for line in lines]
