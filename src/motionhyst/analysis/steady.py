@@ -31,16 +31,20 @@ another frequency the loop has no steady state of the reference's period, and
 
 from __future__ import annotations
 
+import threading
+import weakref
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.controllers.loop import Loop
+from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.sampling import hold_response
 from motionhyst.core.textfmt import g, table
-from motionhyst.hysteresis.periodic import sample_period
+from motionhyst.hysteresis.periodic import sample_period, stop_harmonics, stop_twiddles
 
 __all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
 
@@ -303,18 +307,18 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             raise ValueError("n_harmonics must be >= 1")
         return _sampled_steady_state(loop, float(amplitude), float(frequency_hz), N, H,
                                      tol, max_iter)
-    H = int(n_harmonics) if n_harmonics is not None else default_harmonics(loop, frequency_hz)
+    H = int(n_harmonics) if n_harmonics is not None else _default_harmonics(loop, frequency_hz)
     if H < 1:
         raise ValueError("n_harmonics must be >= 1")
     omega = TWO_PI * frequency_hz
-    wn = omega * np.arange(H + 1)
+    T = _transfers(loop, float(frequency_hz), H)
     R = np.zeros(H + 1, dtype=complex)
     R[1] = -0.5j * amplitude  # r = A sin(theta)
     # the reference has one harmonic, so the linear loop answers with that one only
     e_lin = np.zeros(H + 1, dtype=complex)
     y1_lin = np.zeros(H + 1, dtype=complex)
-    e_lin[1] = loop.transfer("r->e", wn[1:2])[0] * R[1]
-    y1_lin[1] = loop.transfer("r->y1", wn[1:2])[0] * R[1]
+    e_lin[1] = T.r_e * R[1]
+    y1_lin[1] = T.r_y1 * R[1]
     hyst, hff = loop.hysteresis, loop.hysteresis_feedforward
     U_h = (np.zeros(H + 1, dtype=complex) if hff is None
            else hff.periodic_harmonics(R, H, omega))
@@ -329,11 +333,19 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
         z = np.zeros(H + 1, dtype=complex)
         return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e_lin),
                            _to_sin_amplitudes(y1_lin), z, _to_sin_amplitudes(e_lin), 0, 0.0)
-    G_1 = loop.transfer("w->y1", wn)
+    G_1 = T.w_y1
     X = y1_lin - G_1 * U_h
     W = np.zeros(H + 1, dtype=complex)
     residual, it = np.inf, 0
-    if hyst is not None:
+    stops = None if hyst is None else hyst.periodic_stops()
+    if stops is not None:
+        W, X, it, residual, converged = _stop_balance(
+            y1_lin, G_1, U_h, stops[0], stops[1], float(tol), int(max_iter), stop_twiddles(H, H))
+        if not converged:
+            raise RuntimeError(
+                f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
+                f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+    elif hyst is not None:
         previous = np.inf
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(X, H, omega)
@@ -350,11 +362,94 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
                 f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
-    G_e = loop.transfer("w->e", wn)
-    e = e_lin + G_e * (W - U_h)
+    e = e_lin + T.w_e * (W - U_h)
     return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e),
                        _to_sin_amplitudes(X), _to_sin_amplitudes(W),
                        _to_sin_amplitudes(e_lin), it, residual)
+
+
+class _Transfers(NamedTuple):
+    """The loop's transfers at the harmonics ``n omega``, ``n = 0 .. H``, of one frequency."""
+
+    r_e: complex
+    r_y1: complex
+    w_y1: NDArray[np.complex128]
+    w_e: NDArray[np.complex128]
+
+
+#: Bytes of transfers kept per loop: the frequencies of a study's points, whatever their order.
+_TRANSFER_BYTES = 32 * 2**20
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_CACHE_LOCK = threading.Lock()
+
+
+def _loop_cache(loop: Loop) -> dict:
+    with _CACHE_LOCK:
+        c = _CACHE.get(loop)
+        if c is None:
+            c = _CACHE[loop] = {"bytes": 0, "transfers": {}, "f_lim": None}
+        return c
+
+
+def _default_harmonics(loop: Loop, frequency_hz: float) -> int:
+    """:func:`default_harmonics` with the loop's limiting frequency computed once a loop."""
+    if not loop.is_lti:
+        return default_harmonics(loop, frequency_hz)
+    c = _loop_cache(loop)
+    if c["f_lim"] is None:
+        c["f_lim"] = 2.0 * np.max(np.abs(loop.closed_loop_poles())) / TWO_PI
+    return int(np.clip(np.ceil(c["f_lim"] / frequency_hz), MIN_HARMONICS, MAX_HARMONICS))
+
+
+def _transfers(loop: Loop, frequency_hz: float, H: int) -> _Transfers:
+    """The transfers of the continuous loop at `frequency_hz` and its harmonics up to `H`,
+    computed once for all the points (amplitudes) of one frequency."""
+    c = _loop_cache(loop)
+    key = (frequency_hz, H)
+    T = c["transfers"].get(key)
+    if T is None:
+        wn = TWO_PI * frequency_hz * np.arange(H + 1)
+        T = _Transfers(complex(loop.transfer("r->e", wn[1:2])[0]),
+                       complex(loop.transfer("r->y1", wn[1:2])[0]),
+                       loop.transfer("w->y1", wn), loop.transfer("w->e", wn))
+        T.w_y1.flags.writeable = False
+        T.w_e.flags.writeable = False
+        with _CACHE_LOCK:
+            table = c["transfers"]
+            c["bytes"] += T.w_y1.nbytes + T.w_e.nbytes
+            table[key] = T
+            while c["bytes"] > _TRANSFER_BYTES and len(table) > 1:  # the oldest go first
+                old = table.pop(next(iter(table)))
+                c["bytes"] -= old.w_y1.nbytes + old.w_e.nbytes
+    return T
+
+
+@njit(cache=True)
+def _stop_balance(y1_lin, G_1, U_h, k, fc, tol, max_iter, tw):  # pragma: no cover - compiled
+    """The fixed point of :func:`periodic_steady_state` for a link of parallel stop
+    operators, compiled whole: the same iteration and stopping rule as its Python loop.
+
+    Returns ``(W, X, iterations, residual, converged)``.
+    """
+    H = y1_lin.shape[0] - 1
+    X = y1_lin - G_1 * U_h
+    W = np.zeros(H + 1, dtype=np.complex128)
+    residual = np.inf
+    previous = np.inf
+    it = 0
+    for it in range(1, max_iter + 1):
+        W_new = stop_harmonics(X, k, fc, H, tw)
+        change = 0.0
+        for q in range(H + 1):
+            change = max(change, abs(W_new[q] - W[q]))
+        residual = abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300)
+        W = W_new
+        X = y1_lin + G_1 * (W - U_h)
+        rho = residual / previous if it > 2 and previous > 0 else 1.0
+        previous = residual
+        if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
+            return W, X, it, residual, True
+    return W, X, it, residual, False
 
 
 def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:

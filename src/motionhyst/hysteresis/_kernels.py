@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from motionhyst.core.compiled import njit
+from motionhyst.hysteresis._fft import analyze, synthesize
 
 
 @njit(cache=True)
@@ -61,7 +62,7 @@ def maxwell_response(x, k, fc, w0):  # pragma: no cover - compiled
 # ---------------------------------------------------------------------------
 
 _TWO_PI = 2.0 * np.pi
-_ANCHOR = 4  # phasor powers are recomputed directly every _ANCHOR steps
+_ANCHOR = 16  # phasor powers are recomputed directly every _ANCHOR steps
 
 
 @njit(cache=True)
@@ -74,6 +75,34 @@ def trig2(A, B, theta):  # pragma: no cover - compiled
         pa = (pa + A[m]) * z
         pb = (pb + B[m]) * z
     return 2.0 * pa.real, 2.0 * pb.real
+
+
+@njit(cache=True)
+def bracketed_root(A, B, level, lo, hi, rising, t):  # pragma: no cover - compiled
+    """Root of ``2 Re sum_m A_m exp(j m theta) = level`` in [lo, hi], where the function
+    rises (`rising`) or falls through `level` once, by Newton from `t` (in the bracket).
+
+    The bracket is narrowed at each iterate, and a Newton step that would leave it
+    becomes a bisection step.
+    """
+    for _ in range(100):
+        f, fp = trig2(A, B, t)
+        f -= level
+        if f == 0.0:
+            return t
+        if (f > 0.0) == rising:
+            hi = t
+        else:
+            lo = t
+        t_new = t - f / fp if fp != 0.0 else 0.5 * (lo + hi)
+        if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
+            return t_new
+        if not (lo <= t_new <= hi):
+            t_new = 0.5 * (lo + hi)
+        if hi - lo <= 4e-16 * max(1.0, abs(t_new)):
+            return t_new
+        t = t_new
+    return t
 
 
 @njit(cache=True)
@@ -98,26 +127,7 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
     h = b - a
     t = a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
     if fa != fb and (fa <= 0.0 <= fb or fb <= 0.0 <= fa):
-        lo, hi = a, b
-        rising = fb > fa
-        for _ in range(100):
-            f, fp = trig2(A, B, t)
-            f -= level
-            if f == 0.0:
-                return t
-            if (f > 0.0) == rising:
-                hi = t
-            else:
-                lo = t
-            t_new = t - f / fp if fp != 0.0 else 0.5 * (lo + hi)
-            if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
-                return t_new
-            if not (lo <= t_new <= hi):
-                t_new = 0.5 * (lo + hi)
-            if hi - lo <= 4e-16 * max(1.0, abs(t_new)):
-                return t_new
-            t = t_new
-        return t
+        return bracketed_root(A, B, level, a, b, fb > fa, t)
     lo = a - 0.5 * h
     hi = b + 0.5 * h
     converged = True
@@ -253,7 +263,18 @@ def _crossing(X, C1, x, level, a, b):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def stop_pieces(X, C1, x, rev, xr, k, fc):  # pragma: no cover - compiled
+def _monotone_crossing(X, C1, level, a, b, fa, fb):  # pragma: no cover - compiled
+    """Angle in [a, b] where ``x``, monotone there, passes `level` (``fa``, ``fb``: ``x``
+    minus `level` at the ends); Newton from where a half sine would pass it."""
+    if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
+        return a if abs(fa) <= abs(fb) else b
+    u = fa / (fa - fb)
+    t = a + (b - a) * np.arccos(min(max(1.0 - 2.0 * u, -1.0), 1.0)) / np.pi
+    return bracketed_root(X, C1, level, a, b, fb > fa, t)
+
+
+@njit(cache=True)
+def stop_pieces(X, C1, x, rev, xr, k, fc, monotone):  # pragma: no cover - compiled
     """Pieces of the periodic output of parallel stop operators, as jumps.
 
     Over one period each element ``(k_i, fc_i)`` sticks (``w = w_j + k_i (x -
@@ -264,6 +285,9 @@ def stop_pieces(X, C1, x, rev, xr, k, fc):  # pragma: no cover - compiled
     means over the period.  The periodic state is found by running the
     elements twice round the reversal points from the global maximum; where
     an element never slips, the symmetric solution (about mid-range) is used.
+    With `monotone` (`rev` holds every reversal, so ``x`` is monotone between them) a
+    slip onset is found between its reversals directly; else it is bracketed on the
+    grid samples `x` (``2 pi i / n``).
     """
     nr = rev.shape[0]
     m = k.shape[0]
@@ -305,7 +329,11 @@ def stop_pieces(X, C1, x, rev, xr, k, fc):  # pragma: no cover - compiled
             slip_level = xi + (d * fe - wi) / ke  # x where the spring reaches +-fc
             s = b
             if d * (x_end - slip_level) > 0.0:
-                s = min(max(_crossing(X, C1, x, slip_level, a, b), a), b)
+                if monotone:
+                    s = _monotone_crossing(X, C1, slip_level - X[0].real, a, b,
+                                           xi - slip_level, x_end - slip_level)
+                else:
+                    s = min(max(_crossing(X, C1, x, slip_level, a, b), a), b)
             # pieces of non-zero length: stick (g = w_i - k x_i, s = k) on [a, s),
             # slip (g = +-fc, s = 0) on [s, b); jumps are filled in below
             if s > a:
@@ -336,7 +364,7 @@ def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
     (2 pi j q)`` for ``q != 0``.  Returns them for ``q = 0 .. n_g`` (`jg`) and
     ``q = 0 .. n_s`` (`js`); ``q = 0`` (the means) is left 0.  The powers of
     ``exp(-j t_b)`` are multiplied up and recomputed directly every
-    ``_ANCHOR`` steps, which keeps them as accurate as direct evaluation.
+    ``_ANCHOR`` steps (their error grows by a round-off a step in between).
     """
     nq = max(n_g, n_s) + 1
     G = np.zeros(n_g + 1, dtype=np.complex128)
@@ -362,3 +390,131 @@ def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
     for q in range(1, n_s + 1):
         S[q] *= -1j / (_TWO_PI * q)
     return G, S
+
+
+
+@njit(cache=True)
+def dominant_reversals(X, C1, C2):  # pragma: no cover - compiled
+    """The reversal points of ``x`` when its first harmonic dominates, else none.
+
+    With ``x_1' = -a_1 sin(theta + alpha)`` the first harmonic's derivative and the
+    others' bounded by ``R_1 = 2 sum_{m >= 2} m |X_m|`` (``x''``'s by ``R_2``), ``x'``
+    has no root where ``|x_1'| > R_1``, and where ``|x_1'| <= 2 R_1 < a_1 / 2`` around
+    each zero of ``x_1'`` its derivative has one sign (``R_2 < 0.8 a_1``): one root
+    each, two a period, each bracketed without a grid.  Returns ``(ok, rev, xr)`` as
+    :func:`reversal_points`; ``ok`` is False where the bounds do not hold (the roots
+    are then bracketed on a grid).
+    """
+    rev = np.empty(2)
+    xr = np.empty(2)
+    M = X.shape[0] - 1
+    a1 = 2.0 * abs(X[1]) if M >= 1 else 0.0
+    if a1 == 0.0:
+        return False, rev, xr
+    r1 = 0.0
+    r2 = 0.0
+    for m in range(2, M + 1):
+        r1 += m * abs(X[m])
+        r2 += m * m * abs(X[m])
+    r1 *= 2.0
+    r2 *= 2.0
+    if not (r1 < 0.25 * a1 and r2 < 0.8 * a1):
+        return False, rev, xr
+    delta = np.arcsin(2.0 * r1 / a1) + 1e-6
+    alpha = np.arctan2(X[1].imag, X[1].real)
+    for i in range(2):
+        t0 = (i * np.pi - alpha) % _TWO_PI
+        lo = t0 - delta
+        hi = t0 + delta
+        flo = trig2(C1, C2, lo)[0]
+        fhi = trig2(C1, C2, hi)[0]
+        if not (flo != 0.0 and fhi != 0.0 and (flo > 0.0) != (fhi > 0.0)):
+            return False, rev, xr
+        rev[i] = bracketed_root(C1, C2, 0.0, lo, hi, fhi > flo, 0.5 * (lo + hi)) % _TWO_PI
+    if rev[1] < rev[0]:
+        rev[0], rev[1] = rev[1], rev[0]
+    for i in range(2):
+        xr[i] = X[0].real + trig2(X, C1, rev[i])[0]
+    return True, rev, xr
+
+
+@njit(cache=True)
+def grid_size(M, H):  # pragma: no cover - compiled
+    """Samples of the grid of :func:`stop_harmonics`: a power of two that brackets the roots
+    (at least 1024 cells, 4 per harmonic) and carries ``s x`` without aliasing."""
+    need = max(1024, 4 * M, 2 * (H + M) + 1)
+    n = 1024
+    while n < need:
+        n *= 2
+    return n
+
+
+@njit(cache=True)
+def significant_count(X, rtol):  # pragma: no cover - compiled
+    """Number of leading harmonics of `X` (DC aside) whose tail is below `rtol` of the total
+    (:func:`motionhyst.hysteresis.periodic.significant_harmonics`)."""
+    total = 0.0
+    for m in range(1, X.shape[0]):
+        total += abs(X[m])
+    if total == 0.0:
+        return 0
+    tail = 0.0
+    for m in range(X.shape[0] - 1, 0, -1):
+        tail += abs(X[m])
+        if tail > rtol * total:
+            return m
+    return 0
+
+
+@njit(cache=True)
+def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. H`` of the periodic output of parallel stop operators, compiled whole
+    (:func:`motionhyst.hysteresis.periodic.stop_periodic_harmonics`).
+
+    `tw` is the twiddle table (:func:`motionhyst.hysteresis._fft.twiddle_table`) of at
+    least ``grid_size(len(X) - 1, H)`` samples.  The reversals come from
+    :func:`dominant_reversals` where it applies, else from the grid; the product ``s x``
+    is a direct convolution where that takes fewer operations than the transforms.
+    """
+    W = np.zeros(H + 1, dtype=np.complex128)
+    M = significant_count(X, 1e-15)
+    if M == 0:
+        return W
+    Xs = X[: M + 1].copy()
+    Xs[0] = 0.0
+    C1 = np.empty(M + 1, dtype=np.complex128)
+    C2 = np.empty(M + 1, dtype=np.complex128)
+    for m in range(M + 1):
+        C1[m] = 1j * m * Xs[m]
+        C2[m] = -(m * m) * Xs[m]
+    n = grid_size(M, H)
+    z = np.empty(n // 2, dtype=np.complex128)
+    direct = 2 * M * (H + 1) <= 4 * n
+    monotone, rev, xr = dominant_reversals(Xs, C1, C2)
+    x = np.empty(0)
+    if not (monotone and direct):
+        x = synthesize(Xs, n, tw, z)
+    if not monotone:
+        rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw, z))
+    if rev.shape[0] < 2:
+        return W
+    t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, monotone)
+    G, S = jump_series(t_b, jg, js, H, H + M)
+    G[0] = g_mean
+    S[0] = s_mean
+    if direct:
+        for q in range(H + 1):
+            acc = G[q]
+            for m in range(1, M + 1):
+                lo = q - m
+                acc += (S[lo] if lo >= 0 else S[-lo].conjugate()) * Xs[m]
+                acc += S[q + m] * Xs[m].conjugate()
+            W[q] = acc
+        return W
+    s = synthesize(S, n, tw, z)
+    for i in range(n):
+        s[i] *= x[i]
+    P = analyze(s, H, tw, z)
+    for q in range(H + 1):
+        W[q] = G[q] + P[q]
+    return W

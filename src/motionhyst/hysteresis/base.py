@@ -190,6 +190,23 @@ class Hysteresis(ABC):
         raise ValueError(f"time simulation does not support the {self.name!r} model "
                          f"({type(self).__name__})")
 
+    def periodic_stops(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """Stiffnesses and slip forces of the parallel stop operators whose summed output
+        is this element's periodic output, or None for another element.
+
+        A link of stop operators (Jenkins, Maxwell-slip) has its periodic steady state
+        computed by one compiled kernel (:func:`~motionhyst.analysis.steady.periodic_steady_state`).
+
+        Examples
+        --------
+        >>> from motionhyst import Dahl, Jenkins
+        >>> Jenkins(k=20.0, fc=0.05).periodic_stops()
+        (array([20.]), array([0.05]))
+        >>> Dahl(k=20.0, fc=0.05).periodic_stops() is None
+        True
+        """
+        return None
+
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:
         """Harmonics of the periodic output for a periodic input.

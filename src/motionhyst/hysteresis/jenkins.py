@@ -189,6 +189,10 @@ class Jenkins(Hysteresis):
             raise ValueError(f"|w0| must be <= fc = {self.fc}, got {w0}")
         return stop_response(xs, self.k, self.fc, float(w0))
 
+    def periodic_stops(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The element as one stop operator: ``([k], [fc])``."""
+        return np.array([self.k]), np.array([self.fc])
+
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:
         """Exact harmonics of the periodic output (see :mod:`motionhyst.hysteresis.periodic`).

@@ -77,6 +77,10 @@ class MaxwellSlip(Hysteresis):
         """Stiffnesses and slip forces of the parallel stop operators."""
         return self.k.copy(), self.fc.copy()
 
+    def periodic_stops(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The elements as parallel stop operators: ``(k, fc)``."""
+        return self.stop_parameters()
+
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
         """Sum of the elements' closed-form describing functions (eq. 10) [N/m].
 

@@ -10,9 +10,12 @@ form from the pieces: ``w = g + s x`` with ``g`` and ``s`` piecewise constant,
 whose coefficients are sums over their jumps, and ``s x`` a product of two
 band-limited functions.  Unlike a sampled FFT of ``w`` this has no error from
 the corners of ``w`` or from samples that miss a reversal, so the describing
-function and the periodic steady state reach round-off accuracy.  The inner
-loops (roots, the element's pass over its pieces, the jump sums) are compiled
-(:mod:`motionhyst.hysteresis._kernels`).
+function and the periodic steady state reach round-off accuracy.  The whole
+computation (roots, the element's pass over its pieces, the jump sums, the
+transforms of the product) is one compiled kernel,
+:func:`stop_harmonics` (:mod:`motionhyst.hysteresis._kernels`); where the first
+harmonic of ``x`` dominates, its reversals are bracketed by bounds on the other
+harmonics rather than on a grid, and the slip onsets between them directly.
 """
 
 from __future__ import annotations
@@ -20,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.hysteresis._kernels import jump_series, reversal_points, stop_pieces
+from motionhyst.hysteresis._fft import twiddle_table
+from motionhyst.hysteresis._kernels import stop_harmonics
 
 __all__ = ["TWO_PI", "sample_period", "significant_harmonics", "stop_periodic_harmonics",
            "trig_eval"]
@@ -168,7 +172,6 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     >>> round(D.real, 4), round(D.imag, 4)
     (3.91, 4.7746)
     """
-    M = significant_harmonics(X)
     H = int(n_harmonics)
     if H < 0:
         raise ValueError("n_harmonics must be >= 0")
@@ -176,24 +179,37 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     fc_arr = np.atleast_1d(np.asarray(fc, dtype=float))
     if k_arr.ndim != 1 or k_arr.shape != fc_arr.shape:
         raise ValueError("k and fc must be scalars or one-dimensional arrays of equal length")
-    W = np.zeros(H + 1, dtype=complex)
-    if M == 0:
-        return W
-    # a mean displacement does not change the output; without it g and s x cancel less well
-    X = np.asarray(X[: M + 1], dtype=complex).copy()
-    X[0] = 0.0
-    m = np.arange(M + 1)
-    C1 = 1j * m * X  # harmonics of x'
-    # the grid brackets the roots (at least 1024 cells, 4 per harmonic) and carries the
-    # product s x without aliasing (2 (H + M) + 1 samples)
-    from scipy.fft import next_fast_len  # here: scipy.fft takes longer to import than df to run
+    X = np.ascontiguousarray(X, dtype=complex)
+    if X.ndim != 1 or X.size == 0:
+        return np.zeros(H + 1, dtype=complex)
+    return stop_harmonics(X, np.ascontiguousarray(k_arr), np.ascontiguousarray(fc_arr), H,
+                          stop_twiddles(X.size - 1, H))
 
-    n = next_fast_len(max(1024, 4 * M, 2 * (H + M) + 1), real=True)
-    x = sample_period(X, n)
-    rev, xr = reversal_points(X, C1, -(m**2) * X, sample_period(C1, n))
-    if rev.size < 2:
-        return W
-    t_b, jg, js, g_mean, s_mean = stop_pieces(X, C1, x, rev, xr, k_arr, fc_arr)
-    G, S = jump_series(t_b, jg, js, H, H + M)
-    G[0], S[0] = g_mean, s_mean
-    return G + np.fft.rfft(x * sample_period(S, n))[: H + 1] / n
+
+def stop_twiddles(max_harmonic: int, n_harmonics: int) -> NDArray[np.complex128]:
+    """The FFT's twiddle table :func:`stop_harmonics` needs for inputs of up to `max_harmonic`
+    harmonics and `n_harmonics` output harmonics (computed once per size).
+
+    Parameters
+    ----------
+    max_harmonic : int
+        Highest harmonic ``M`` of the input.
+    n_harmonics : int
+        Highest output harmonic ``H``.
+
+    Returns
+    -------
+    ndarray of complex
+        ``exp(-2 pi j k / n)``, ``k < n / 2``, for the largest grid ``n`` of such inputs
+        (read-only).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> X = np.array([0.0, 0.01 / 2j])
+    >>> W = stop_harmonics(X, np.array([20.0]), np.array([0.05]), 3, stop_twiddles(1, 3))
+    >>> round(complex(2j * W[1] / 0.01).imag, 4)                 # Im D of eq. (10)
+    4.7746
+    """
+    need = max(1024, 4 * int(max_harmonic), 2 * (int(n_harmonics) + int(max_harmonic)) + 1)
+    return twiddle_table(1 << (need - 1).bit_length())

@@ -1,0 +1,119 @@
+"""Compiled real FFTs of power-of-two length, for kernels that transform inside a loop.
+
+numpy's FFTs cannot be called from compiled code, and from Python each call costs more
+than the transform of a thousand samples itself.  These are the textbook radix-2
+transforms (a real transform of ``n`` samples as a complex one of ``n / 2``), with the
+twiddle factors of the largest length in use computed once by numpy
+(:func:`twiddle_table`) and passed in; their results agree with numpy's to round-off.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from motionhyst.core.compiled import njit
+
+
+@lru_cache(maxsize=8)
+def twiddle_table(n: int) -> np.ndarray:
+    """``exp(-2 pi j k / n)`` for ``k < n / 2`` (`n` a power of two): the table of every
+    transform of length up to `n`."""
+    if n < 2 or n & (n - 1):
+        raise ValueError(f"the FFT length must be a power of two >= 2, got {n}")
+    table = np.exp(-2j * np.pi * np.arange(n // 2) / n)
+    table.flags.writeable = False
+    return table
+
+
+@njit(cache=True)
+def _complex_fft(a, tw):  # pragma: no cover - compiled
+    """In-place forward DFT of `a` (length a power of two, at most ``2 len(tw)``)."""
+    n = a.shape[0]
+    j = 0
+    for i in range(1, n):
+        bit = n >> 1
+        while j & bit:
+            j ^= bit
+            bit >>= 1
+        j |= bit
+        if i < j:
+            t = a[i]
+            a[i] = a[j]
+            a[j] = t
+    for p in range(0, n - 1, 2):
+        u = a[p]
+        t = a[p + 1]
+        a[p] = u + t
+        a[p + 1] = u - t
+    full = 2 * tw.shape[0]
+    half = 2
+    while half < n:
+        size = 2 * half
+        stride = full // size
+        for k in range(half):
+            w = tw[k * stride]
+            wr = w.real
+            wi = w.imag
+            for p in range(k, n, size):
+                q = p + half
+                b = a[q]
+                tr = wr * b.real - wi * b.imag
+                ti = wr * b.imag + wi * b.real
+                u = a[p]
+                a[p] = complex(u.real + tr, u.imag + ti)
+                a[q] = complex(u.real - tr, u.imag - ti)
+        half = size
+
+
+@njit(cache=True)
+def synthesize(X, n, tw, z):  # pragma: no cover - compiled
+    """Samples ``x_t = X_0 + 2 Re sum_{k >= 1} X_k exp(2 pi j k t / n)``, ``t < n``.
+
+    numpy's ``irfft(X * n, n)``: `X` holds harmonics ``0 .. L`` with ``2 L < n``
+    (the real parts of ``X_0`` count); `z` is complex work space of ``n / 2``.
+    """
+    h = n // 2
+    L = X.shape[0] - 1
+    step = 2 * tw.shape[0] // n
+    for k in range(h):
+        a = X[k] if k <= L else 0j
+        b = X[h - k] if h - k <= L else 0j
+        if k == 0:
+            a = complex(a.real, 0.0)
+            b = complex(b.real, 0.0)
+        bc = b.conjugate()
+        e = a + bc
+        w = tw[k * step].conjugate()
+        o = (a - bc) * w
+        z[k] = complex(e.real - o.imag, e.imag + o.real)  # e + j o, conjugated below
+    for k in range(h):
+        z[k] = z[k].conjugate()
+    _complex_fft(z, tw)
+    x = np.empty(n)
+    for t in range(h):
+        x[2 * t] = z[t].real
+        x[2 * t + 1] = -z[t].imag
+    return x
+
+
+@njit(cache=True)
+def analyze(x, n_out, tw, z):  # pragma: no cover - compiled
+    """Harmonics ``0 .. n_out`` of ``rfft(x) / n`` (``n = len(x)``, ``n_out <= n / 2``);
+    `z` is complex work space of ``n / 2``."""
+    n = x.shape[0]
+    h = n // 2
+    step = 2 * tw.shape[0] // n
+    for t in range(h):
+        z[t] = complex(x[2 * t], x[2 * t + 1])
+    _complex_fft(z, tw)
+    out = np.empty(n_out + 1, dtype=np.complex128)
+    scale = 0.5 / n
+    for k in range(n_out + 1):
+        a = z[k] if k < h else z[0]
+        b = (z[h - k] if k > 0 else z[0]).conjugate()
+        w = tw[k * step] if k < h else -1.0 + 0j
+        d = (a - b) * w
+        out[k] = scale * complex(a.real + b.real + d.imag, a.imag + b.imag - d.real)
+    return out
