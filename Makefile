@@ -46,6 +46,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/engine.py
 	$(BIN)/python benchmarks/stability.py
 	$(BIN)/python benchmarks/periodic.py
+	$(BIN)/python benchmarks/point.py
 
 # the public benchmarks end to end (kept out of make test): Bouc-Wen (about a minute) and
 # EMPS (a few minutes; scored on DATA_EMPS_PULSES.mat when EMPS_DATA holds it)
