@@ -28,20 +28,40 @@ def twiddle_table(n: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _complex_fft(a, tw):  # pragma: no cover - compiled
-    """In-place forward DFT of `a` (length a power of two, at most ``2 len(tw)``)."""
+def _fft_scrambling(a, tw):  # pragma: no cover - compiled
+    """In-place forward DFT of `a` (length a power of two, at most ``2 len(tw)``), input in
+    natural order, output in bit-reversed order (decimation in frequency)."""
     n = a.shape[0]
-    j = 0
-    for i in range(1, n):
-        bit = n >> 1
-        while j & bit:
-            j ^= bit
-            bit >>= 1
-        j |= bit
-        if i < j:
-            t = a[i]
-            a[i] = a[j]
-            a[j] = t
+    full = 2 * tw.shape[0]
+    half = n // 2
+    while half >= 2:
+        size = 2 * half
+        stride = full // size
+        for k in range(half):
+            w = tw[k * stride]
+            wr = w.real
+            wi = w.imag
+            for p in range(k, n, size):
+                q = p + half
+                u = a[p]
+                v = a[q]
+                a[p] = u + v
+                dr = u.real - v.real
+                di = u.imag - v.imag
+                a[q] = complex(wr * dr - wi * di, wr * di + wi * dr)
+        half //= 2
+    for p in range(0, n - 1, 2):
+        u = a[p]
+        v = a[p + 1]
+        a[p] = u + v
+        a[p + 1] = u - v
+
+
+@njit(cache=True)
+def _fft_unscrambling(a, tw):  # pragma: no cover - compiled
+    """In-place forward DFT of `a`, input in bit-reversed order, output in natural order
+    (decimation in time)."""
+    n = a.shape[0]
     for p in range(0, n - 1, 2):
         u = a[p]
         t = a[p + 1]
@@ -68,15 +88,35 @@ def _complex_fft(a, tw):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def synthesize(X, n, tw, z):  # pragma: no cover - compiled
-    """Samples ``x_t = X_0 + 2 Re sum_{k >= 1} X_k exp(2 pi j k t / n)``, ``t < n``.
+def _bit_reverse(a):  # pragma: no cover - compiled
+    """Permute `a` (length a power of two) into bit-reversed order, in place."""
+    n = a.shape[0]
+    j = 0
+    for i in range(1, n):
+        bit = n >> 1
+        while j & bit:
+            j ^= bit
+            bit >>= 1
+        j |= bit
+        if i < j:
+            t = a[i]
+            a[i] = a[j]
+            a[j] = t
 
-    numpy's ``irfft(X * n, n)``: `X` holds harmonics ``0 .. L`` with ``2 L < n``
-    (the real parts of ``X_0`` count); `z` is complex work space of ``n / 2``.
+
+@njit(cache=True)
+def synthesize_packed(X, n, tw):  # pragma: no cover - compiled
+    """Samples ``x_t = X_0 + 2 Re sum_{k >= 1} X_k exp(2 pi j k t / n)``, ``t < n``, packed:
+    ``z_u = x_{2t} - j x_{2t+1}`` at ``u`` the bit reversal of ``t < n / 2``.
+
+    `X` holds harmonics ``0 .. L`` with ``2 L < n`` (the real part of ``X_0`` counts).
+    Two signals packed alike multiply sample by sample in their packed form
+    (:func:`packed_product`).
     """
     h = n // 2
     L = X.shape[0] - 1
     step = 2 * tw.shape[0] // n
+    z = np.empty(h, dtype=np.complex128)
     for k in range(h):
         a = X[k] if k <= L else 0j
         b = X[h - k] if h - k <= L else 0j
@@ -85,29 +125,26 @@ def synthesize(X, n, tw, z):  # pragma: no cover - compiled
             b = complex(b.real, 0.0)
         bc = b.conjugate()
         e = a + bc
-        w = tw[k * step].conjugate()
-        o = (a - bc) * w
-        z[k] = complex(e.real - o.imag, e.imag + o.real)  # e + j o, conjugated below
-    for k in range(h):
-        z[k] = z[k].conjugate()
-    _complex_fft(z, tw)
-    x = np.empty(n)
-    for t in range(h):
-        x[2 * t] = z[t].real
-        x[2 * t + 1] = -z[t].imag
-    return x
+        o = (a - bc) * tw[k * step].conjugate()
+        z[k] = complex(e.real - o.imag, -(e.imag + o.real))  # conj(e + j o)
+    _fft_scrambling(z, tw)
+    return z
 
 
 @njit(cache=True)
-def analyze(x, n_out, tw, z):  # pragma: no cover - compiled
-    """Harmonics ``0 .. n_out`` of ``rfft(x) / n`` (``n = len(x)``, ``n_out <= n / 2``);
-    `z` is complex work space of ``n / 2``."""
-    n = x.shape[0]
+def packed_product(zx, zs):  # pragma: no cover - compiled
+    """The samples ``x s`` packed as :func:`synthesize_packed` packs them, from `zx` and `zs`."""
+    out = np.empty(zx.shape[0], dtype=np.complex128)
+    for u in range(zx.shape[0]):
+        out[u] = complex(zx[u].real * zs[u].real, -(zx[u].imag * zs[u].imag))
+    return out
+
+
+@njit(cache=True)
+def _unpack_spectrum(z, n, n_out, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. n_out`` of ``rfft(x) / n`` from ``z = DFT(x_{2t} + j x_{2t+1})``."""
     h = n // 2
     step = 2 * tw.shape[0] // n
-    for t in range(h):
-        z[t] = complex(x[2 * t], x[2 * t + 1])
-    _complex_fft(z, tw)
     out = np.empty(n_out + 1, dtype=np.complex128)
     scale = 0.5 / n
     for k in range(n_out + 1):
@@ -117,3 +154,38 @@ def analyze(x, n_out, tw, z):  # pragma: no cover - compiled
         d = (a - b) * w
         out[k] = scale * complex(a.real + b.real + d.imag, a.imag + b.imag - d.real)
     return out
+
+
+@njit(cache=True)
+def analyze_packed(zp, n, n_out, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. n_out`` of ``rfft(x) / n`` (``n_out <= n / 2``) of the samples packed
+    as :func:`synthesize_packed` packs them (overwrites `zp`)."""
+    for u in range(zp.shape[0]):
+        zp[u] = zp[u].conjugate()
+    _fft_unscrambling(zp, tw)
+    return _unpack_spectrum(zp, n, n_out, tw)
+
+
+@njit(cache=True)
+def synthesize(X, n, tw):  # pragma: no cover - compiled
+    """Samples ``x_t = X_0 + 2 Re sum_{k >= 1} X_k exp(2 pi j k t / n)``, ``t < n``:
+    numpy's ``irfft(X * n, n)``."""
+    zz = synthesize_packed(X, n, tw)
+    _bit_reverse(zz)
+    x = np.empty(n)
+    for t in range(n // 2):
+        x[2 * t] = zz[t].real
+        x[2 * t + 1] = -zz[t].imag
+    return x
+
+
+@njit(cache=True)
+def analyze(x, n_out, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. n_out`` of ``rfft(x) / n`` (``n = len(x)``, ``n_out <= n / 2``)."""
+    n = x.shape[0]
+    z = np.empty(n // 2, dtype=np.complex128)
+    for t in range(n // 2):
+        z[t] = complex(x[2 * t], x[2 * t + 1])
+    _bit_reverse(z)
+    _fft_unscrambling(z, tw)
+    return _unpack_spectrum(z, n, n_out, tw)

@@ -13,7 +13,12 @@ from __future__ import annotations
 import numpy as np
 
 from motionhyst.core.compiled import njit
-from motionhyst.hysteresis._fft import analyze, synthesize
+from motionhyst.hysteresis._fft import (
+    analyze_packed,
+    packed_product,
+    synthesize,
+    synthesize_packed,
+)
 
 
 @njit(cache=True)
@@ -488,14 +493,12 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
         C1[m] = 1j * m * Xs[m]
         C2[m] = -(m * m) * Xs[m]
     n = grid_size(M, H)
-    z = np.empty(n // 2, dtype=np.complex128)
     direct = 2 * M * (H + 1) <= 4 * n
     monotone, rev, xr = dominant_reversals(Xs, C1, C2)
     x = np.empty(0)
-    if not (monotone and direct):
-        x = synthesize(Xs, n, tw, z)
     if not monotone:
-        rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw, z))
+        x = synthesize(Xs, n, tw)
+        rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
     if rev.shape[0] < 2:
         return W
     t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, monotone)
@@ -511,10 +514,8 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
                 acc += S[q + m] * Xs[m].conjugate()
             W[q] = acc
         return W
-    s = synthesize(S, n, tw, z)
-    for i in range(n):
-        s[i] *= x[i]
-    P = analyze(s, H, tw, z)
+    P = analyze_packed(packed_product(synthesize_packed(Xs, n, tw),
+                                      synthesize_packed(S, n, tw)), n, H, tw)
     for q in range(H + 1):
         W[q] = G[q] + P[q]
     return W
