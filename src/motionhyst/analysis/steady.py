@@ -31,6 +31,7 @@ another frequency the loop has no steady state of the reference's period, and
 
 from __future__ import annotations
 
+import math
 import threading
 import weakref
 from dataclasses import dataclass
@@ -339,13 +340,16 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     residual, it = np.inf, 0
     stops = None if hyst is None else hyst.periodic_stops()
     if stops is not None:
-        W, X, it, residual, converged = _stop_balance(
-            y1_lin, G_1, U_h, stops[0], stops[1], float(tol), int(max_iter), stop_twiddles(H, H))
+        e, y1, w, e_linear, it, residual, converged = _stop_steady_state(
+            complex(R[1]), T.r_e, T.r_y1, G_1, T.w_e, U_h, stops[0], stops[1], float(tol),
+            int(max_iter), stop_twiddles(H, H))
         if not converged:
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
                 f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
-    elif hyst is not None:
+        return SteadyState(float(frequency_hz), float(amplitude), e, y1, w, e_linear, it,
+                           residual)
+    if hyst is not None:
         previous = np.inf
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(X, H, omega)
@@ -397,8 +401,8 @@ def _default_harmonics(loop: Loop, frequency_hz: float) -> int:
         return default_harmonics(loop, frequency_hz)
     c = _loop_cache(loop)
     if c["f_lim"] is None:
-        c["f_lim"] = 2.0 * np.max(np.abs(loop.closed_loop_poles())) / TWO_PI
-    return int(np.clip(np.ceil(c["f_lim"] / frequency_hz), MIN_HARMONICS, MAX_HARMONICS))
+        c["f_lim"] = float(2.0 * np.max(np.abs(loop.closed_loop_poles())) / TWO_PI)
+    return min(max(math.ceil(c["f_lim"] / frequency_hz), MIN_HARMONICS), MAX_HARMONICS)
 
 
 def _transfers(loop: Loop, frequency_hz: float, H: int) -> _Transfers:
@@ -425,18 +429,33 @@ def _transfers(loop: Loop, frequency_hz: float, H: int) -> _Transfers:
 
 
 @njit(cache=True)
-def _stop_balance(y1_lin, G_1, U_h, k, fc, tol, max_iter, tw):  # pragma: no cover - compiled
+def _sin_amplitudes(X):  # pragma: no cover - compiled
+    """:func:`_to_sin_amplitudes`, compiled."""
+    c = 2j * X
+    c[0] = X[0].real
+    return c
+
+
+@njit(cache=True)
+def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter,
+                       tw):  # pragma: no cover - compiled
     """The fixed point of :func:`periodic_steady_state` for a link of parallel stop
     operators, compiled whole: the same iteration and stopping rule as its Python loop.
 
-    Returns ``(W, X, iterations, residual, converged)``.
+    Returns the harmonics of ``e``, ``y1``, ``w`` and of the linear ``e`` (relative to
+    ``sin(n theta)``), the iterations, the last relative change and whether it converged.
     """
-    H = y1_lin.shape[0] - 1
+    H = G_1.shape[0] - 1
+    e_lin = np.zeros(H + 1, dtype=np.complex128)
+    y1_lin = np.zeros(H + 1, dtype=np.complex128)
+    e_lin[1] = r_e * R1
+    y1_lin[1] = r_y1 * R1
     X = y1_lin - G_1 * U_h
     W = np.zeros(H + 1, dtype=np.complex128)
     residual = np.inf
     previous = np.inf
     it = 0
+    converged = False
     for it in range(1, max_iter + 1):
         W_new = stop_harmonics(X, k, fc, H, tw)
         change = 0.0
@@ -448,8 +467,11 @@ def _stop_balance(y1_lin, G_1, U_h, k, fc, tol, max_iter, tw):  # pragma: no cov
         rho = residual / previous if it > 2 and previous > 0 else 1.0
         previous = residual
         if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
-            return W, X, it, residual, True
-    return W, X, it, residual, False
+            converged = True
+            break
+    e = e_lin + G_e * (W - U_h)
+    return (_sin_amplitudes(e), _sin_amplitudes(X), _sin_amplitudes(W), _sin_amplitudes(e_lin),
+            it, residual, converged)
 
 
 def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:

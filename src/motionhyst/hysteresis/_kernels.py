@@ -82,14 +82,18 @@ def trig2(A, B, theta):  # pragma: no cover - compiled
     return 2.0 * pa.real, 2.0 * pb.real
 
 
-@njit(cache=True)
-def bracketed_root(A, B, level, lo, hi, rising, t):  # pragma: no cover - compiled
+@njit("float64(complex128[::1], complex128[::1], float64, float64, float64, boolean, float64, "
+      "boolean)", cache=True)
+def bracketed_root(A, B, level, lo, hi, rising, t, predict):  # pragma: no cover - compiled
     """Root of ``2 Re sum_m A_m exp(j m theta) = level`` in [lo, hi], where the function
     rises (`rising`) or falls through `level` once, by Newton from `t` (in the bracket).
 
     The bracket is narrowed at each iterate, and a Newton step that would leave it
-    becomes a bisection step.
+    becomes a bisection step.  With `predict` (a simple root, Newton converging
+    quadratically from `t`) the steps stop when the next one, ``s_k^3 / s_{k-1}^2``,
+    would be below round-off.
     """
+    last = np.inf
     for _ in range(100):
         f, fp = trig2(A, B, t)
         f -= level
@@ -100,12 +104,19 @@ def bracketed_root(A, B, level, lo, hi, rising, t):  # pragma: no cover - compil
         else:
             lo = t
         t_new = t - f / fp if fp != 0.0 else 0.5 * (lo + hi)
-        if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
+        step = abs(t_new - t)
+        tiny = 4e-16 * max(1.0, abs(t))
+        if step <= tiny:
             return t_new
         if not (lo <= t_new <= hi):
             t_new = 0.5 * (lo + hi)
+            step = np.inf
+        elif (predict and last < np.inf and step < 1e-3 * last
+              and step * step * step <= tiny * last * last):
+            return t_new
         if hi - lo <= 4e-16 * max(1.0, abs(t_new)):
             return t_new
+        last = step
         t = t_new
     return t
 
@@ -132,7 +143,7 @@ def trig_root(A, B, level, a, b, fa, fb):  # pragma: no cover - compiled
     h = b - a
     t = a + h * fa / (fa - fb) if fa != fb else 0.5 * (a + b)
     if fa != fb and (fa <= 0.0 <= fb or fb <= 0.0 <= fa):
-        return bracketed_root(A, B, level, a, b, fb > fa, t)
+        return bracketed_root(A, B, level, a, b, fb > fa, t, False)
     lo = a - 0.5 * h
     hi = b + 0.5 * h
     converged = True
@@ -275,7 +286,7 @@ def _monotone_crossing(X, C1, level, a, b, fa, fb):  # pragma: no cover - compil
         return a if abs(fa) <= abs(fb) else b
     u = fa / (fa - fb)
     t = a + (b - a) * np.arccos(min(max(1.0 - 2.0 * u, -1.0), 1.0)) / np.pi
-    return bracketed_root(X, C1, level, a, b, fb > fa, t)
+    return bracketed_root(X, C1, level, a, b, fb > fa, t, True)
 
 
 @njit(cache=True)
@@ -367,27 +378,39 @@ def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
     Functions with jumps `jg` (`js`) at the angles `t_b` have the coefficients
     ``int_0^{2 pi} f exp(-j q theta) d theta / 2 pi = sum_b J_b exp(-j q t_b) /
     (2 pi j q)`` for ``q != 0``.  Returns them for ``q = 0 .. n_g`` (`jg`) and
-    ``q = 0 .. n_s`` (`js`); ``q = 0`` (the means) is left 0.  The powers of
-    ``exp(-j t_b)`` are multiplied up and recomputed directly every
-    ``_ANCHOR`` steps (their error grows by a round-off a step in between).
+    ``q = 0 .. n_s`` (`js`); ``q = 0`` (the means) is left 0.  The phasors
+    ``exp(-j q t_b)`` are computed directly every ``8 _ANCHOR`` steps, multiplied up by
+    ``exp(-j _ANCHOR t_b)`` every ``_ANCHOR`` steps and by powers of ``exp(-j t_b)`` in
+    between (their error grows by a round-off a multiplication, 24 at most).
     """
     nq = max(n_g, n_s) + 1
     G = np.zeros(n_g + 1, dtype=np.complex128)
     S = np.zeros(n_s + 1, dtype=np.complex128)
+    powers = np.empty(_ANCHOR, dtype=np.complex128)
+    z = np.empty(_ANCHOR, dtype=np.complex128)
     for b in range(t_b.shape[0]):
-        if jg[b] == 0.0 and js[b] == 0.0:
+        cg = jg[b]
+        cs = js[b]
+        if cg == 0.0 and cs == 0.0:
             continue
         t = t_b[b]
         u = complex(np.cos(t), -np.sin(t))
-        z = 0j
-        for q in range(nq):
-            if q % _ANCHOR == 0:
-                z = complex(np.cos(q * t), -np.sin(q * t))
-            if q <= n_g:
-                G[q] += jg[b] * z
-            if q <= n_s:
-                S[q] += js[b] * z
-            z *= u
+        powers[0] = 1.0
+        for r in range(1, _ANCHOR):
+            powers[r] = powers[r - 1] * u
+        step = complex(np.cos(_ANCHOR * t), -np.sin(_ANCHOR * t))
+        anchor = 1.0 + 0j
+        for q0 in range(0, nq, _ANCHOR):
+            if q0 % (8 * _ANCHOR) == 0:
+                anchor = complex(np.cos(q0 * t), -np.sin(q0 * t))
+            else:
+                anchor *= step
+            for r in range(_ANCHOR):
+                z[r] = anchor * powers[r]
+            for r in range(min(_ANCHOR, n_g + 1 - q0)):
+                G[q0 + r] += cg * z[r]
+            for r in range(min(_ANCHOR, n_s + 1 - q0)):
+                S[q0 + r] += cs * z[r]
     G[0] = 0.0
     S[0] = 0.0
     for q in range(1, n_g + 1):
@@ -435,7 +458,8 @@ def dominant_reversals(X, C1, C2):  # pragma: no cover - compiled
         fhi = trig2(C1, C2, hi)[0]
         if not (flo != 0.0 and fhi != 0.0 and (flo > 0.0) != (fhi > 0.0)):
             return False, rev, xr
-        rev[i] = bracketed_root(C1, C2, 0.0, lo, hi, fhi > flo, 0.5 * (lo + hi)) % _TWO_PI
+        rev[i] = bracketed_root(C1, C2, 0.0, lo, hi, fhi > flo, 0.5 * (lo + hi),
+                                True) % _TWO_PI
     if rev[1] < rev[0]:
         rev[0], rev[1] = rev[1], rev[0]
     for i in range(2):
