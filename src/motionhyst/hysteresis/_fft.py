@@ -58,7 +58,7 @@ def _fft_scrambling(a, tw):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _fft_unscrambling(a, tw):  # pragma: no cover - compiled
+def fft_unscrambling(a, tw):  # pragma: no cover - compiled
     """In-place forward DFT of `a`, input in bit-reversed order, output in natural order
     (decimation in time)."""
     n = a.shape[0]
@@ -88,7 +88,7 @@ def _fft_unscrambling(a, tw):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _bit_reverse(a):  # pragma: no cover - compiled
+def bit_reverse(a):  # pragma: no cover - compiled
     """Permute `a` (length a power of two) into bit-reversed order, in place."""
     n = a.shape[0]
     j = 0
@@ -162,7 +162,7 @@ def analyze_packed(zp, n, n_out, tw):  # pragma: no cover - compiled
     as :func:`synthesize_packed` packs them (overwrites `zp`)."""
     for u in range(zp.shape[0]):
         zp[u] = zp[u].conjugate()
-    _fft_unscrambling(zp, tw)
+    fft_unscrambling(zp, tw)
     return _unpack_spectrum(zp, n, n_out, tw)
 
 
@@ -171,7 +171,7 @@ def synthesize(X, n, tw):  # pragma: no cover - compiled
     """Samples ``x_t = X_0 + 2 Re sum_{k >= 1} X_k exp(2 pi j k t / n)``, ``t < n``:
     numpy's ``irfft(X * n, n)``."""
     zz = synthesize_packed(X, n, tw)
-    _bit_reverse(zz)
+    bit_reverse(zz)
     x = np.empty(n)
     for t in range(n // 2):
         x[2 * t] = zz[t].real
@@ -186,6 +186,6 @@ def analyze(x, n_out, tw):  # pragma: no cover - compiled
     z = np.empty(n // 2, dtype=np.complex128)
     for t in range(n // 2):
         z[t] = complex(x[2 * t], x[2 * t + 1])
-    _bit_reverse(z)
-    _fft_unscrambling(z, tw)
+    bit_reverse(z)
+    fft_unscrambling(z, tw)
     return _unpack_spectrum(z, n, n_out, tw)

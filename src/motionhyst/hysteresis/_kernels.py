@@ -15,6 +15,8 @@ import numpy as np
 from motionhyst.core.compiled import njit
 from motionhyst.hysteresis._fft import (
     analyze_packed,
+    bit_reverse,
+    fft_unscrambling,
     packed_product,
     synthesize,
     synthesize_packed,
@@ -67,6 +69,8 @@ def maxwell_response(x, k, fc, w0):  # pragma: no cover - compiled
 # ---------------------------------------------------------------------------
 
 _TWO_PI = 2.0 * np.pi
+CUBIC_ELEMENTS = 16  # from this many elements on, slip onsets may come from the grid's cubic
+BINNED_WORK = 90_000  # jumps x harmonics beyond which the jump sums are binned
 _ANCHOR = 16  # phasor powers are recomputed directly every _ANCHOR steps
 
 
@@ -289,8 +293,70 @@ def _monotone_crossing(X, C1, level, a, b, fa, fb):  # pragma: no cover - compil
     return bracketed_root(X, C1, level, a, b, fb > fa, t, True)
 
 
+#: How :func:`stop_pieces` finds a slip onset: bracketed on the grid samples (some
+#: reversals may be missed), by Newton between two reversals (all of them known), or
+#: on the cubic through the grid samples (all known; where it is accurate enough).
+GRID_BRACKET, BETWEEN_REVERSALS, GRID_CUBIC = 0, 1, 2
+
+
 @njit(cache=True)
-def stop_pieces(X, C1, x, rev, xr, k, fc, monotone):  # pragma: no cover - compiled
+def _cubic_crossing(x, level, a, b, fa, fb):  # pragma: no cover - compiled
+    """Angle in [a, b] where ``x``, monotone there, passes `level`, on the cubic through the
+    grid samples `x` (``2 pi i / n``) around it (``fa``, ``fb``: ``x`` minus `level` at
+    the ends)."""
+    if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
+        return a if abs(fa) <= abs(fb) else b
+    n = x.shape[0]
+    h = _TWO_PI / n
+    lo, flo, hi, fhi = a, fa, b, fb
+    j_lo = int(np.floor(a / h)) + 1
+    j_hi = int(np.ceil(b / h)) - 1
+    while j_lo <= j_hi:  # the grid points inside, by bisection: x is monotone
+        j = (j_lo + j_hi) // 2
+        f = x[j % n] - level
+        if f == 0.0:
+            return j * h
+        if (f > 0.0) == (fa > 0.0):
+            lo, flo, j_lo = j * h, f, j + 1
+        else:
+            hi, fhi, j_hi = j * h, f, j - 1
+    c = int(np.floor(0.5 * (lo + hi) / h))
+    xm, x0, x1, x2 = x[(c - 1) % n], x[c % n], x[(c + 1) % n], x[(c + 2) % n]
+    c1 = -xm / 3.0 - x0 / 2.0 + x1 - x2 / 6.0
+    c2 = xm / 2.0 - x0 + x1 / 2.0
+    c3 = (x2 - xm) / 6.0 + (x0 - x1) / 2.0
+    c0 = x0 - level
+    t = lo + (hi - lo) * flo / (flo - fhi)
+    for _ in range(30):
+        u = t / h - c
+        f = c0 + u * (c1 + u * (c2 + u * c3))
+        fp = (c1 + u * (2.0 * c2 + 3.0 * u * c3)) / h
+        if (f > 0.0) == (fa > 0.0):
+            lo = t
+        else:
+            hi = t
+        t_new = t - f / fp if fp != 0.0 else 0.5 * (lo + hi)
+        if not (lo <= t_new <= hi):
+            t_new = 0.5 * (lo + hi)
+        if abs(t_new - t) <= 4e-16 * max(1.0, abs(t)):
+            return t_new
+        t = t_new
+    return t
+
+
+@njit(cache=True)
+def cubic_error_bound(X, n):  # pragma: no cover - compiled
+    """Bound on the error of the cubic through `n` grid samples of ``x`` (harmonics `X`)
+    between its middle samples: ``(9 / 16) h^4 / 4!`` times the bound on ``|x^(4)|``."""
+    h = _TWO_PI / n
+    r4 = 0.0
+    for m in range(1, X.shape[0]):
+        r4 += float(m) ** 4 * (abs(X[m].real) + abs(X[m].imag))
+    return 2.0 * r4 * h**4 * 9.0 / (16.0 * 24.0)
+
+
+@njit(cache=True)
+def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
     """Pieces of the periodic output of parallel stop operators, as jumps.
 
     Over one period each element ``(k_i, fc_i)`` sticks (``w = w_j + k_i (x -
@@ -298,12 +364,13 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, monotone):  # pragma: no cover - compi
     `xr`).  The output is ``w = g + s x`` with ``g`` piecewise constant and
     ``s`` the sum of the stiffnesses of the sticking elements.  Returns the
     angles where ``g`` or ``s`` jump, the jumps of ``g`` and ``s``, and their
-    means over the period.  The periodic state is found by running the
+    means over the period: each element's slip onsets, then the reversals (every
+    element's jump there summed).  The periodic state is found by running the
     elements twice round the reversal points from the global maximum; where
     an element never slips, the symmetric solution (about mid-range) is used.
-    With `monotone` (`rev` holds every reversal, so ``x`` is monotone between them) a
-    slip onset is found between its reversals directly; else it is bracketed on the
-    grid samples `x` (``2 pi i / n``).
+    `mode` says how a slip onset is found (:data:`GRID_BRACKET`,
+    :data:`BETWEEN_REVERSALS`, :data:`GRID_CUBIC`; `x` holds the grid samples
+    ``2 pi i / n`` of ``x`` the first and the last use).
     """
     nr = rev.shape[0]
     m = k.shape[0]
@@ -322,13 +389,19 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, monotone):  # pragma: no cover - compi
     th[nr] = th[0] + _TWO_PI
     xs[nr] = xs[0]
     mid = 0.5 * (xr[i0] + x_min)
-    t_b = np.empty(2 * nr * m)  # at most a stick and a slip piece per element and interval
-    jg = np.empty(2 * nr * m)
-    js = np.empty(2 * nr * m)
+    t_b = np.empty(nr * m + nr)  # at most a slip onset per element and interval
+    jg = np.empty(nr * m + nr)
+    js = np.empty(nr * m + nr)
+    at_g = np.zeros(nr)  # jumps at the reversals, summed over the elements
+    at_s = np.zeros(nr)
     nb = 0
     g_mean = 0.0
     s_mean = 0.0
     ws = np.empty(nr + 1)
+    first_g = np.empty(nr)  # the element's first and last piece in each interval
+    first_s = np.empty(nr)
+    last_g = np.empty(nr)
+    last_s = np.empty(nr)
     for e in range(m):
         ke, fe = k[e], fc[e]
         w = min(max(ke * (xs[0] - mid), -fe), fe)
@@ -337,7 +410,6 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, monotone):  # pragma: no cover - compi
             for i in range(nr):
                 w = min(max(w + ke * (xs[i + 1] - xs[i]), -fe), fe)
                 ws[i + 1] = w
-        first = nb
         for i in range(nr):
             a, b = th[i], th[i + 1]
             wi, xi, x_end = ws[i], xs[i], xs[i + 1]
@@ -345,29 +417,37 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, monotone):  # pragma: no cover - compi
             slip_level = xi + (d * fe - wi) / ke  # x where the spring reaches +-fc
             s = b
             if d * (x_end - slip_level) > 0.0:
-                if monotone:
-                    s = _monotone_crossing(X, C1, slip_level - X[0].real, a, b,
-                                           xi - slip_level, x_end - slip_level)
+                fa = xi - slip_level
+                fb = x_end - slip_level
+                if mode == BETWEEN_REVERSALS:
+                    s = _monotone_crossing(X, C1, slip_level - X[0].real, a, b, fa, fb)
+                elif mode == GRID_CUBIC:
+                    s = _cubic_crossing(x, slip_level - X[0].real, a, b, fa, fb)
                 else:
                     s = min(max(_crossing(X, C1, x, slip_level, a, b), a), b)
             # pieces of non-zero length: stick (g = w_i - k x_i, s = k) on [a, s),
-            # slip (g = +-fc, s = 0) on [s, b); jumps are filled in below
+            # slip (g = +-fc, s = 0) on [s, b)
+            g_stick = wi - ke * xi
             if s > a:
-                t_b[nb], jg[nb], js[nb] = a, wi - ke * xi, ke
-                nb += 1
-                g_mean += (wi - ke * xi) * (s - a)
+                first_g[i], first_s[i] = g_stick, ke
+                g_mean += g_stick * (s - a)
                 s_mean += ke * (s - a)
+            else:
+                first_g[i], first_s[i] = d * fe, 0.0
             if b > s:
-                t_b[nb], jg[nb], js[nb] = s, d * fe, 0.0
-                nb += 1
+                last_g[i], last_s[i] = d * fe, 0.0
                 g_mean += d * fe * (b - s)
-        # values -> jumps, cyclically within this element's pieces
-        g_last, s_last = jg[nb - 1], js[nb - 1]
-        for p in range(nb - 1, first, -1):
-            jg[p] -= jg[p - 1]
-            js[p] -= js[p - 1]
-        jg[first] -= g_last
-        js[first] -= s_last
+            else:
+                last_g[i], last_s[i] = g_stick, ke
+            if a < s < b:
+                t_b[nb], jg[nb], js[nb] = s, d * fe - g_stick, -ke
+                nb += 1
+        for i in range(nr):
+            at_g[i] += first_g[i] - last_g[i - 1]  # i - 1 = -1: the last interval
+            at_s[i] += first_s[i] - last_s[i - 1]
+    for i in range(nr):
+        t_b[nb], jg[nb], js[nb] = th[i], at_g[i], at_s[i]
+        nb += 1
     return t_b[:nb], jg[:nb], js[:nb], g_mean / _TWO_PI, s_mean / _TWO_PI
 
 
@@ -417,6 +497,72 @@ def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
         G[q] *= -1j / (_TWO_PI * q)
     for q in range(1, n_s + 1):
         S[q] *= -1j / (_TWO_PI * q)
+    return G, S
+
+
+@njit(cache=True)
+def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compiled
+    """:func:`jump_series` for many jumps, in ``O(jumps + Q log Q)`` (``Q = max(n_g, n_s)``).
+
+    The jumps are binned to the nearest point ``c_j`` of a grid of ``N >= 2 Q + 1`` points
+    (``h = 2 pi / N``), with ``t_b = c_j + v h / 2``, ``|v| <= 1``; then ``exp(-j q t_b) =
+    exp(-j q c_j) sum_p (-j q h v / 2)^p / p!`` with ``|q h / 2| <= pi Q / N < pi / 2``,
+    summed until its terms are below 1e-17: one FFT of the bins' moments ``sum v^p J``
+    for each power.  `jg` and `js` are transformed together as ``jg + j r js`` (``r`` a
+    power of two that makes the two sums of magnitudes alike).  `tw` is
+    the twiddle table of at least ``N`` points.
+    """
+    Q = max(n_g, n_s)
+    N = 2
+    while N < 2 * Q + 1:
+        N *= 2
+    h = _TWO_PI / N
+    a_max = 0.5 * Q * h
+    P = 1
+    term = 1.0
+    while term >= 1e-17:
+        term *= a_max / P
+        P += 1
+    # jg + j js r: r, a power of two, brings the two to one size (each keeps its accuracy)
+    sum_g = 0.0
+    sum_s = 0.0
+    for b in range(t_b.shape[0]):
+        sum_g += abs(jg[b])
+        sum_s += abs(js[b])
+    r = 1.0
+    if sum_g > 0.0 and sum_s > 0.0:
+        r = 2.0 ** np.round(np.log2(sum_g / sum_s))
+    mu = np.zeros((P, N), dtype=np.complex128)
+    for b in range(t_b.shape[0]):
+        c = complex(jg[b], js[b] * r)
+        t = t_b[b] % _TWO_PI
+        j = int(np.floor(t / h + 0.5))
+        v = (t - j * h) / (0.5 * h)
+        j %= N
+        vp = 1.0
+        for p in range(P):
+            mu[p, j] += c * vp
+            vp *= v
+    for p in range(P):
+        row = mu[p]
+        bit_reverse(row)
+        fft_unscrambling(row, tw)
+    G = np.zeros(n_g + 1, dtype=np.complex128)
+    S = np.zeros(n_s + 1, dtype=np.complex128)
+    for q in range(1, Q + 1):
+        z_pos = -0.5j * q * h
+        z_neg = 0.5j * q * h
+        up = mu[P - 1, q]
+        um = mu[P - 1, N - q]
+        for p in range(P - 2, -1, -1):
+            up = mu[p, q] + up * (z_pos / (p + 1))
+            um = mu[p, N - q] + um * (z_neg / (p + 1))
+        umc = um.conjugate()
+        scale = -1j / (_TWO_PI * q)
+        if q <= n_g:
+            G[q] = 0.5 * (up + umc) * scale
+        if q <= n_s:
+            S[q] = -0.5j * (up - umc) * (scale / r)
     return G, S
 
 
@@ -525,8 +671,21 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
         rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
     if rev.shape[0] < 2:
         return W
-    t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, monotone)
-    G, S = jump_series(t_b, jg, js, H, H + M)
+    mode = GRID_BRACKET
+    if monotone:
+        mode = BETWEEN_REVERSALS
+        # many elements: slip onsets on the grid's cubic where its error is far below x's
+        # range (the output changes with the square of an onset's error: w is continuous)
+        if (k.shape[0] >= CUBIC_ELEMENTS
+                and cubic_error_bound(Xs, n) <= 1e-9 * abs(xr[0] - xr[1])):
+            mode = GRID_CUBIC
+            x = synthesize(Xs, n, tw)
+    t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode)
+    Q = H + M
+    if t_b.shape[0] * (Q + 1) > BINNED_WORK:
+        G, S = jump_series_binned(t_b, jg, js, H, Q, tw)
+    else:
+        G, S = jump_series(t_b, jg, js, H, Q)
     G[0] = g_mean
     S[0] = s_mean
     if direct:
