@@ -19,7 +19,7 @@ FC_TRUE = np.array([0.01, 0.02, 0.03])  # N; slip displacements 1, 3.3 and 7.5 m
 NOISE = 0.01  # force noise relative to the force RMS
 N_SAMPLES = 2000
 IDENTIFY_KEYS = {"model", "elements", "fit_rms", "fit_nrms", "r2", "n_samples", "offset",
-                 "criterion", "signal", "candidates", "record", "data"}
+                 "criterion", "signal", "candidates", "record", "data", "covariance"}
 ELEMENT_KEYS = {"k", "fc", "k_std", "fc_std"}
 
 

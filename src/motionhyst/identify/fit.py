@@ -16,6 +16,7 @@ from scipy.optimize import least_squares, nnls
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import HoldFilter
 from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.identify.io_uncertainty import covariance, covariance_table
 from motionhyst.identify.records import check_signals
 from motionhyst.identify.result import Identification
 
@@ -497,6 +498,20 @@ def _covariance_std(fit: _Fit, n_rows: int) -> NDArray[np.float64]:
     return std
 
 
+def _covariance_of(fit: _Fit, n_rows: int, order: NDArray[np.intp],
+                   std: NDArray[np.float64]) -> dict:
+    """The covariance of ``k``, ``fc`` (``k1, k2, ..., fc1, ...`` for several elements, in
+    the elements' order) and ``offset``: of the Jacobian that gives :func:`_covariance_std`."""
+    n = fit.n
+    idx = [*order, *(n + order), fit.J.shape[1] - 1]
+    names = (["k", "fc"] if n == 1 else [f"{p}{i + 1}" for p in ("k", "fc") for i in range(n)])
+    names.append("offset")
+    sd = {nm: float(std[i]) if np.isfinite(std[i]) else None
+          for nm, i in zip(names, idx, strict=True)}
+    cov = covariance(fit.J, fit.rss, n_rows, 1e-9)[np.ix_(idx, idx)]
+    return covariance_table(names, cov, sd)
+
+
 def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Criterion, rtol: float,
                       atol: float, max_elements: int, signal_name: str, *,
                       cutoff_hz: float | None = None) -> Identification:
@@ -572,6 +587,7 @@ def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Crite
         candidates=candidates,
         signal=signal_name,
         cutoff_hz=cutoff_hz,
+        covariance=_covariance_of(chosen, n_rows, order, std),
     )
 
 

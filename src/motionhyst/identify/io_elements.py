@@ -38,6 +38,8 @@ from motionhyst.identify.io_start import (
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
     SINGULAR_RTOL,
+    covariance,
+    covariance_table,
     standard_errors,
     undetermined_notes,
     weak_notes,
@@ -723,7 +725,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         n_evaluations=n_eval, substeps=r, data=list(records), residuals=res,
         extra={"offsets": {"input": u0, "output": y0.tolist()},
                "initial_state": initial_state_out, "init_window": init_window,
-               "budget_reached": bool(sol.status == 0)})
+               "budget_reached": bool(sol.status == 0),
+               "covariance": covariance_table(names, covariance(J, rss, res.size, rtol), std)})
 
 
 def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:

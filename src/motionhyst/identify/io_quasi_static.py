@@ -48,7 +48,13 @@ from motionhyst.identify.io_checks import FitFailed, judge_fit
 from motionhyst.identify.io_elements import LinkLayout
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
-from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL, standard_errors, undetermined_notes
+from motionhyst.identify.io_uncertainty import (
+    FD_SINGULAR_RTOL,
+    covariance,
+    covariance_table,
+    standard_errors,
+    undetermined_notes,
+)
 from motionhyst.plants.quasi_static import QuasiStatic
 from motionhyst.time.openloop import OpenLoop
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
@@ -351,7 +357,9 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                 if lg and f and x > 0 and x0 > 0 and max(x / x0, x0 / x) > RUNAWAY_FACTOR]
     extra = {"offsets": {"input": float(v[2 + prob.n_link]),
                          "output": [float(x) for x in prob.output_offsets(v)]},
-             "budget_reached": bool(budget is not None and prob.n_eval >= budget)}
+             "budget_reached": bool(budget is not None and prob.n_eval >= budget),
+             "covariance": covariance_table(names, covariance(J, float(np.sum(res ** 2)),
+                                                              res.size, FD_SINGULAR_RTOL), std)}
     return IOIdentification(
         plant=plant, hysteresis=fitted, estimates=estimates, std=std, not_identifiable=notes,
         fit_rms=fit_rms, records=per_record_errors(records, res),

@@ -11,6 +11,7 @@ from motionhyst.core.textfiles import toml_table
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.identify.io_records import IORecord
+from motionhyst.identify.io_uncertainty import identification_toml
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop
 
 __all__ = ["IOIdentification"]
@@ -49,8 +50,11 @@ class IOIdentification:
     substeps : int
         Integration steps per sample the identification used.
     extra : dict
-        The offsets and initial states (``offsets``, ``initial_state``) and whether the
-        search stopped at its budget (``budget_reached``).
+        The offsets and initial states (``offsets``, ``initial_state``), whether the
+        search stopped at its budget (``budget_reached``) and the covariance of the
+        determined estimates from the fit's Jacobian (``covariance``: ``{"parameters",
+        "matrix"}``, :func:`~motionhyst.identify.io_uncertainty.covariance_table`; not for
+        a Bouc-Wen link).
     warnings : list of str
         Implausible estimates, one line each naming the parameter
         (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
@@ -151,7 +155,10 @@ class IOIdentification:
                 **self.extra, "warnings": list(self.warnings)}
 
     def scenario_text(self) -> str:
-        """A scenario file (TOML) of the identified system: ``[stage]`` and ``[hysteresis]``."""
+        """A scenario file (TOML) of the identified system: ``[stage]`` and ``[hysteresis]``,
+        and the estimates' standard errors and correlations under their scenario keys in
+        ``[identification]`` (:func:`~motionhyst.identify.io_uncertainty.identification_toml`).
+        """
         lines = [f"# identified from {len(self.records)} input-output record(s) by simulation "
                  f"error: fit RMS {self.fit_rms:.4g} m"]
         offsets = self.extra.get("offsets", {}).get("output") or []
@@ -164,8 +171,18 @@ class IOIdentification:
         if offsets or self.extra.get("initial_state"):
             lines.append("# (motionhyst predict --init-from REC sets both from a record's first "
                          "samples)")
-        return ("\n".join(lines) + "\n" + toml_table("stage", self.plant.to_dict()) + "\n"
-                + toml_table("hysteresis", self.hysteresis.to_dict()))
+        stage, link = self.plant.to_dict(), self.hysteresis.to_dict()
+        text = ("\n".join(lines) + "\n" + toml_table("stage", stage) + "\n"
+                + toml_table("hysteresis", link))
+        # the estimates that are scalar keys of these tables, under those keys
+        keys = {**{n: f"stage.{n}" for n, v in stage.items() if _number(v)},
+                **{f"link.{n}": f"hysteresis.{n}" for n, v in link.items() if _number(v)}}
+        ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys)
+        return text + ("\n" + ident if ident else "")
+
+
+def _number(value) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 def per_record_errors(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:

@@ -4,12 +4,16 @@ From the Jacobian ``J`` of the simulation residuals at the optimum, standard
 errors ``sqrt(diag(sigma^2 (J^T J)^-1))`` with ``sigma^2 = RSS / (N - p)``,
 a direction of ``J`` with a singular value below :data:`SINGULAR_RTOL` of the
 largest (:data:`FD_SINGULAR_RTOL` for a finite-difference Jacobian) being one
-the data do not determine (:func:`standard_errors`), and the notes that say so
-(:func:`undetermined_notes`, :func:`weak_notes`).
+the data do not determine (:func:`standard_errors`), the covariance whose
+diagonal they are the square roots of (:func:`covariance`; ``identify --json`` and
+``--save`` carry it for a Monte-Carlo study: :func:`covariance_table`,
+:func:`identification_toml`), and the notes that say so (:func:`undetermined_notes`,
+:func:`weak_notes`).
 """
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -45,6 +49,68 @@ def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
     for g in groups:
         std[g] = np.nan
     return std, groups
+
+
+def covariance(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float = SINGULAR_RTOL
+               ) -> NDArray[np.float64]:
+    """The covariance ``sigma^2 (J^T J)^+`` of the estimates whose diagonal's square roots
+    :func:`standard_errors` gives (the same normalised columns, singular values and
+    pseudo-inverse); the rows and columns of the parameters it marks undetermined are NaN.
+    """
+    norms = np.linalg.norm(J, axis=0)
+    norms[norms == 0] = 1.0
+    _, sv, vt = np.linalg.svd(J / norms, full_matrices=False)
+    sigma2 = rss / max(n_rows - J.shape[1], 1)
+    good = sv > rtol * sv[0]
+    cov = sigma2 * ((vt[good].T / sv[good] ** 2) @ vt[good]) / np.outer(norms, norms)
+    cov = (cov + cov.T) / 2  # symmetric to the last bit (the product is so to round-off)
+    for i in np.nonzero(~good)[0]:
+        g = np.abs(vt[i]) > 1e-3
+        cov[g, :] = np.nan
+        cov[:, g] = np.nan
+    return cov
+
+
+def covariance_table(names: list[str], cov: NDArray[np.float64],
+                     std: dict[str, float | None]) -> dict:
+    """``{"parameters": [...], "matrix": [[...]]}``: the covariance of the parameters whose
+    standard error is determined (`std` not None: the others' rows and columns are left
+    out, which leaves the rest's covariance as it is, a marginal of the normal distribution).
+    """
+    keep = [i for i, n in enumerate(names) if std.get(n) is not None
+            and math.isfinite(cov[i, i])]
+    return {"parameters": [names[i] for i in keep],
+            "matrix": [[float(cov[i, j]) for j in keep] for i in keep]}
+
+
+def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str, str]) -> str:
+    """The ``[identification]`` table of a saved identification (TOML): the parameters of
+    the covariance `table` (:func:`covariance_table`) that `keys` maps to scenario keys, under
+    those keys, with their `estimates`, standard errors and correlations; empty if none.
+
+    Standard errors and correlations rather than covariances: each is a number of the size
+    of a parameter or within [-1, 1], whatever the units (a covariance of 1e-40 would be
+    outside the magnitudes a scenario accepts); correlations are rounded to 1e-12.
+    """
+    names = [n for n in table.get("parameters", []) if n in keys]
+    if not names:
+        return ""
+    where = [table["parameters"].index(n) for n in names]
+    cov = np.array(table["matrix"], dtype=float)[np.ix_(where, where)]
+    std = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(std, std)
+    corr = np.where(np.outer(std, std) > 0, np.clip(np.round((corr + corr.T) / 2, 12), -1, 1),
+                    0.0)
+    np.fill_diagonal(corr, 1.0)
+    rows = "".join(f"    [{', '.join(repr(float(c)) for c in row)}],\n" for row in corr)
+    return ("# the estimates' standard errors and correlations (from the fit's Jacobian) for a "
+            "Monte-Carlo\n# study: motionhyst study STUDY.toml --from-identification "
+            "THIS_FILE\n[identification]\n"
+            f"parameters = [{', '.join(json.dumps(keys[n]) for n in names)}]\n"
+            f"estimates = [{', '.join(repr(float(estimates[n])) for n in names)}]\n"
+            f"std = [{', '.join(repr(float(v)) for v in std)}]\n"
+            f"correlation = [\n{rows}]\n")
 
 
 def undetermined_notes(names: list[str], groups: list[list[int]], rtol: float

@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.core.textfiles import toml_table
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.identify.io_uncertainty import identification_toml
 from motionhyst.plants.quasi_static import QuasiStatic
 
 __all__ = ["Identification"]
@@ -51,6 +52,11 @@ class Identification:
     cutoff_hz : float or None
         Cut-off of the prefilter of a closed-loop record [Hz]; None for a
         force-displacement record.
+    covariance : dict or None
+        ``{"parameters": [...], "matrix": [[...]]}``: the covariance of the determined
+        estimates (``k``, ``fc`` and ``offset``; ``k1, ..., fc1, ...`` for several
+        elements) from the fit's Jacobian, whose diagonal's square roots are the standard
+        errors (:func:`~motionhyst.identify.io_uncertainty.covariance`).
 
     Examples
     --------
@@ -84,6 +90,7 @@ class Identification:
     candidates: list[dict] = field(default_factory=list)
     signal: str = "force"
     cutoff_hz: float | None = None
+    covariance: dict | None = None
 
     @property
     def n_elements(self) -> int:
@@ -109,7 +116,8 @@ class Identification:
                 "n_samples": self.n_samples, "offset": self.offset,
                 "criterion": self.criterion, "signal": self.signal,
                 "candidates": [dict(c) for c in self.candidates],
-                **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz})}
+                **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz}),
+                **({} if self.covariance is None else {"covariance": self.covariance})}
 
     def __str__(self) -> str:
         def std_text(value: float, std: float) -> str:
@@ -184,7 +192,9 @@ class Identification:
         ``[stage] type = "quasi-static"`` (:meth:`link_model`: the record's force
         offset) and the ``[hysteresis]`` of :meth:`scenario_fragment`; ``motionhyst
         predict`` gives its force for a displacement record (time,displacement) and
-        its displacement for a force record.
+        its displacement for a force record.  One element's ``k`` and ``fc`` come with
+        their standard errors and correlation in ``[identification]``
+        (:func:`~motionhyst.identify.io_uncertainty.identification_toml`).
 
         Parameters
         ----------
@@ -199,7 +209,13 @@ class Identification:
         head = (f"# the link identified from {source}, without inertia: motionhyst predict "
                 f"gives its force\n# for a displacement record (time,displacement), its "
                 f"displacement for a force record\n")
-        return head + toml_table("stage", plant.to_dict()) + "\n" + self.scenario_fragment()
+        text = head + toml_table("stage", plant.to_dict()) + "\n" + self.scenario_fragment()
+        if self.covariance is None or self.n_elements != 1:  # several: lists, no scalar keys
+            return text
+        e = self.elements[0]
+        ident = identification_toml(self.covariance, e, {"k": "hysteresis.k",
+                                                         "fc": "hysteresis.fc"})
+        return text + ("\n" + ident if ident else "")
 
     def scenario_fragment(self) -> str:
         """A ``[hysteresis]`` section of a scenario file (TOML), ready to paste.

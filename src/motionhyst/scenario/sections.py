@@ -496,6 +496,37 @@ class ReferenceSection(_Section):
 
 
 
+class IdentificationSection(_Section):
+    """``[identification]`` (optional, written by ``motionhyst identify --save``): the
+    estimates of an identified model's parameters, named by their scenario keys, with their
+    standard errors and correlations (from the fit's Jacobian); it describes the file's
+    ``[stage]`` and ``[hysteresis]`` and changes nothing in the loop.  A Monte-Carlo study
+    draws the link's parameters from it (``motionhyst study --from-identification``)."""
+
+    parameters: Annotated[list[str], Field(min_length=1)]
+    estimates: list[Annotated[float, Field(allow_inf_nan=False)]]
+    std: list[NonNegativeFloat]
+    correlation: list[list[Annotated[float, Field(ge=-1.0, le=1.0, allow_inf_nan=False)]]]
+
+    @model_validator(mode="after")
+    def _square(self):
+        n = len(self.parameters)
+        if len(set(self.parameters)) != n:
+            raise ValueError("parameters: a name is given twice")
+        for name in ("estimates", "std"):
+            if len(getattr(self, name)) != n:
+                raise ValueError(f"{name}: {len(getattr(self, name))} values for {n} "
+                                 f"parameters")
+        r = self.correlation
+        if len(r) != n or any(len(row) != n for row in r):
+            raise ValueError(f"correlation: give {n} rows of {n} values (a row a parameter)")
+        for i in range(n):
+            if r[i][i] != 1.0 or any(abs(r[i][j] - r[j][i]) > 1e-9 for j in range(i)):
+                raise ValueError("correlation: a correlation matrix has 1 on its diagonal and "
+                                 "is symmetric")
+        return self
+
+
 class ScenarioModel(_Section):
     """The whole file."""
 
@@ -507,6 +538,7 @@ class ScenarioModel(_Section):
                           Field(discriminator="type")] | None = None
     feedforward: FeedforwardSection | None = None
     reference: ReferenceSection | None = None
+    identification: IdentificationSection | None = None
 
     @model_validator(mode="after")
     def _one_plant(self):
