@@ -139,10 +139,11 @@ def add_parser(sub) -> None:
                    help="local worker processes (default: every core; 0: this process)")
     q.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786")
-    q.add_argument("--from-identification", metavar="FIT.json",
-                   help="draw the link's parameters around an identification's estimates with "
-                        "their standard errors (what `motionhyst identify --json` printed; "
-                        "[samples] n and seed from the study file, else 100 and 0)")
+    q.add_argument("--from-identification", metavar="MODEL.toml",
+                   help="draw the link's parameters jointly from an identification's estimates "
+                        "and their covariance (the TOML of `motionhyst identify --save`, or "
+                        "the JSON of `identify --json`; [samples] n and seed from the study "
+                        "file, else 100 and 0)")
     q.add_argument("--estimate", action="store_true",
                    help="state points, time, core-hours, disk and memory; compute nothing")
     q.add_argument("--table", metavar="OUT.csv", help="also write the results as CSV, a row a "

@@ -1,23 +1,309 @@
-"""Monte-Carlo samples from an identification: the link's parameters drawn around their
-estimates with their standard errors.
+"""Monte-Carlo samples from an identification: the link's parameters drawn from the
+multivariate normal distribution of their estimates.
 
-``motionhyst identify ... --json > fit.json`` writes the estimates and their standard errors
-(a force-displacement record: ``elements`` with ``k``, ``fc``, ``k_std``, ``fc_std``; an
-input-output record: ``estimates`` and ``std`` with the link's parameters as ``link.NAME``).
-A study's ``[samples] from_identification = "fit.json"`` (or ``motionhyst study
---from-identification fit.json``) draws each of the link's parameters lognormal around its
-estimate with the relative standard error as sigma (a positive parameter stays positive; for
-errors of a few percent this is the normal distribution of the estimate).  The draws are
-independent: the identification reports standard errors, not their correlations.
+An identification carries the covariance of its estimates, from the fit's Jacobian (the
+matrix whose diagonal's square roots are the standard errors):
+
+- ``motionhyst identify ... --save model.toml`` writes it as ``[identification]``:
+  ``parameters`` (scenario keys: ``hysteresis.k``, ``hysteresis.fc``, ``stage.m``, ...),
+  ``estimates``, ``std`` and ``correlation``;
+- ``motionhyst identify ... --json > fit.json`` prints it as ``covariance``: ``parameters``
+  (a force-displacement record: ``k``, ``fc``, ``offset``; an input-output record: the
+  names of ``estimates``, the link's as ``link.NAME``) and ``matrix``.
+
+A study's ``[samples] from_identification = "model.toml"`` (or ``motionhyst study
+--from-identification model.toml``) draws the link's parameters (the keys
+``hysteresis.*``) jointly from that distribution, seeded (:class:`JointNormal`): the marginal
+of the link's parameters, the stage of the study's own scenario being its own.  A parameter
+must stay positive: when every drawn parameter's relative standard error is at most
+:data:`LOG_SPACE_CV`, the draws are those of the normal distribution itself (a draw at or
+below 0 would be five standard deviations away, and is drawn again); above it, of the
+lognormal distribution with the same means and covariance (moment-matched: positive by
+construction).
+
+A JSON of an older ``identify --json``, with standard errors but no covariance, gives
+independent lognormal draws (:func:`distributions_from_identification`).
 """
 
 from __future__ import annotations
 
 import json
 import math
+import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["distributions_from_identification"]
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["LOG_SPACE_CV", "JointNormal", "distributions_from_identification",
+           "joint_from_identification"]
+
+LOG_SPACE_CV = 0.2
+"""Largest relative standard error of a drawn parameter for which the draws are those of the
+normal distribution; above it, of the lognormal one with the same means and covariance."""
+
+_CORRELATION_ROUNDING = 1e-9  # a saved correlation matrix is rounded to 1e-12
+
+
+@dataclass(frozen=True)
+class JointNormal:
+    """Correlated draws of positive scenario keys: a multivariate normal distribution (or,
+    where it would reach 0, the lognormal one with the same means and covariance).
+
+    Parameters
+    ----------
+    keys : tuple of str
+        Scenario keys (``"hysteresis.k"``, ...).
+    mean : tuple of float
+        Their means (the estimates), all > 0.
+    covariance : tuple of tuple of float
+        Their covariance matrix (symmetric, positive semi-definite).
+    source : str
+        Where it comes from (an identification file), for the results' attributes.
+
+    Examples
+    --------
+    >>> d = JointNormal(("hysteresis.k", "hysteresis.fc"), (20.0, 0.05),
+    ...                 ((0.16, 2e-4), (2e-4, 1e-6)))
+    >>> d.log_space, d.correlation[0][1]
+    (False, 0.5)
+    >>> x = d.draw(np.random.default_rng(0), 20000)
+    >>> bool(np.allclose(np.cov(x.T), d.covariance, rtol=0.05))
+    True
+    """
+
+    keys: tuple[str, ...]
+    mean: tuple[float, ...]
+    covariance: tuple[tuple[float, ...], ...]
+    source: str = "<dict>"
+
+    def __post_init__(self) -> None:
+        d = len(self.keys)
+        m = np.asarray(self.mean, dtype=float)
+        c = np.asarray(self.covariance, dtype=float)
+        where = f"{self.source}: " if self.source != "<dict>" else ""
+        if d == 0 or m.shape != (d,) or c.shape != (d, d):
+            raise ValueError(f"{where}give a mean and a {d} x {d} covariance for {d} keys")
+        bad = [k for k, v in zip(self.keys, m, strict=True) if not (math.isfinite(v) and v > 0)]
+        if bad:
+            raise ValueError(f"{where}{bad[0]} = {m[self.keys.index(bad[0])]:g}: a parameter "
+                             f"to draw must be a positive number")
+        if not (np.all(np.isfinite(c)) and np.allclose(c, c.T, rtol=1e-9, atol=0.0)):
+            raise ValueError(f"{where}the covariance must be finite and symmetric")
+        s = np.sqrt(np.clip(np.diag(c), 0.0, None))
+        w = np.linalg.eigvalsh(c / np.outer(np.where(s > 0, s, 1), np.where(s > 0, s, 1)))
+        if np.any(np.diag(c) < 0) or w[0] < -_CORRELATION_ROUNDING * d:
+            raise ValueError(f"{where}the covariance is not positive semi-definite (its "
+                             f"correlation matrix has the eigenvalue {w[0]:.3g})")
+
+    @property
+    def std(self) -> NDArray[np.float64]:
+        """Standard deviation of each key."""
+        return np.sqrt(np.clip(np.diag(np.asarray(self.covariance, dtype=float)), 0.0, None))
+
+    @property
+    def correlation(self) -> list[list[float]]:
+        """The correlation matrix (0 where a standard deviation is 0, 1 on the diagonal)."""
+        s = self.std
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = np.asarray(self.covariance, dtype=float) / np.outer(s, s)
+        r = np.where(np.outer(s, s) > 0, r, 0.0)
+        np.fill_diagonal(r, 1.0)
+        return r.tolist()
+
+    @property
+    def log_space(self) -> bool:
+        """Whether the draws are lognormal: a relative standard error above
+        :data:`LOG_SPACE_CV`."""
+        return bool(np.max(self.std / np.asarray(self.mean)) > LOG_SPACE_CV)
+
+    def without(self, keys) -> JointNormal | None:
+        """The marginal distribution of the other keys (None if none is left).
+
+        Parameters
+        ----------
+        keys : iterable of str
+            The keys to leave out.
+        """
+        keep = [i for i, k in enumerate(self.keys) if k not in set(keys)]
+        if not keep:
+            return None
+        c = np.asarray(self.covariance, dtype=float)[np.ix_(keep, keep)]
+        return JointNormal(tuple(self.keys[i] for i in keep), tuple(self.mean[i] for i in keep),
+                           tuple(map(tuple, c.tolist())), self.source)
+
+    def draw(self, rng: np.random.Generator, n: int) -> NDArray[np.float64]:
+        """`n` draws, a row each (columns in the order of :attr:`keys`), from `rng`.
+
+        Normal draws (:attr:`log_space` false): ``mean + L z`` with ``L L^T`` the
+        covariance; a draw with a parameter at or below 0 is drawn again.  Lognormal ones:
+        ``exp(mu + S z)`` with ``S_ij = log(1 + C_ij / (m_i m_j))`` and
+        ``mu_i = log m_i - S_ii / 2``, whose means are ``m`` and covariance ``C``.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The generator (the study's, seeded).
+        n : int
+            Number of draws.
+        """
+        m = np.asarray(self.mean, dtype=float)
+        c = np.asarray(self.covariance, dtype=float)
+        if self.log_space:
+            s = np.log1p(c / np.outer(m, m))
+            return np.exp(np.log(m) - np.diag(s) / 2 + rng.standard_normal((n, m.size))
+                          @ _factor(s).T)
+        factor = _factor(c)
+        x = m + rng.standard_normal((n, m.size)) @ factor.T
+        bad = np.nonzero(np.any(x <= 0, axis=1))[0]
+        while bad.size:
+            x[bad] = m + rng.standard_normal((bad.size, m.size)) @ factor.T
+            bad = bad[np.any(x[bad] <= 0, axis=1)]
+        return x
+
+    def to_dict(self) -> dict:
+        """Plain parameters: ``keys``, ``mean``, ``covariance``, ``source``, ``log_space``."""
+        return {"keys": list(self.keys), "mean": list(self.mean),
+                "covariance": [list(r) for r in self.covariance], "source": self.source,
+                "log_space": self.log_space}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> JointNormal:
+        """The inverse of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            What :meth:`to_dict` gave.
+        """
+        return cls(tuple(d["keys"]), tuple(float(v) for v in d["mean"]),
+                   tuple(tuple(float(v) for v in r) for r in d["covariance"]),
+                   d.get("source", "<dict>"))
+
+
+def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``L`` with ``L L^T = c`` for a positive semi-definite `c` (from its eigenvectors)."""
+    w, v = np.linalg.eigh(c)
+    return v * np.sqrt(np.clip(w, 0.0, None))
+
+
+def _read(path: Path, where: str):
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot read ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{where}: not a text file") from None
+    if path.suffix.lower() == ".toml":
+        try:
+            return tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"{where}: TOML syntax error: {exc}") from None
+    try:
+        data = json.loads(text)
+    except ValueError:
+        raise ValueError(f"{where}: not JSON (give what `motionhyst identify --json` printed, "
+                         f"or the .toml of `identify --save`)") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{where}: not an identification (`motionhyst identify --json`)")
+    return data
+
+
+def joint_from_identification(path: str | Path) -> JointNormal | None:
+    """The joint distribution of the link's parameters of an identification, under the
+    scenario's ``hysteresis.*`` keys; None for a JSON without covariance (an older
+    ``identify --json``: :func:`distributions_from_identification`).
+
+    Parameters
+    ----------
+    path : str or Path
+        ``motionhyst identify --save`` TOML (its ``[identification]``) or ``identify --json``
+        JSON (its ``covariance``).
+
+    Returns
+    -------
+    JointNormal or None
+
+    Raises
+    ------
+    ValueError
+        One line: the file cannot be read, is not an identification, has more than one
+        Jenkins element, or a link parameter whose standard error is not determined.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "model.toml"
+    >>> _ = path.write_text('''
+    ... [identification]
+    ... parameters = ["stage.m", "hysteresis.k", "hysteresis.fc"]
+    ... estimates = [2.0, 20.0, 0.05]
+    ... std = [0.01, 0.4, 0.001]
+    ... correlation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.5], [0.0, 0.5, 1.0]]
+    ... ''')
+    >>> d = joint_from_identification(path)
+    >>> d.keys, d.mean, d.correlation[0][1]
+    (('hysteresis.k', 'hysteresis.fc'), (20.0, 0.05), 0.5)
+    """
+    path = Path(path)
+    where = f"from_identification {path}"
+    data = _read(path, where)
+    if path.suffix.lower() == ".toml":
+        if not isinstance(data.get("identification"), dict):
+            raise ValueError(f"{where}: no [identification] table (save the identification "
+                             f"with `motionhyst identify ... --save MODEL.toml`)")
+        from pydantic import ValidationError
+
+        from motionhyst.scenario.sections import IdentificationSection, format_error
+
+        try:
+            sec = IdentificationSection.model_validate(data["identification"])
+        except ValidationError as err:
+            raise ValueError(format_error(where, err, ("identification",))) from None
+        names = list(sec.parameters)
+        mean = dict(zip(names, sec.estimates, strict=True))
+        std = np.asarray(sec.std, dtype=float)
+        cov = np.asarray(sec.correlation, dtype=float) * np.outer(std, std)
+        keys = {n: n for n in names if n.startswith("hysteresis.")}
+        missing = []
+        hint = "--save"
+    else:
+        table = data.get("covariance")
+        if not isinstance(table, dict):
+            return None
+        names = list(table.get("parameters", []))
+        cov = np.asarray(table.get("matrix", []), dtype=float)
+        if isinstance(data.get("elements"), list):  # a force-displacement record
+            mean = _one_element(data["elements"], where)
+            keys = {"k": "hysteresis.k", "fc": "hysteresis.fc"}
+        else:
+            mean = dict(data.get("estimates") or {})
+            keys = {n: f"hysteresis.{n[5:]}" for n in mean if n.startswith("link.")}
+        missing = [n for n in keys if n not in names]
+        hint = "--json"
+    if missing:
+        raise ValueError(f"{where}: {missing[0]}: its standard error is not determined by the "
+                         f"identification; give its distribution in [samples]")
+    drawn = [n for n in names if n in keys]
+    if not drawn:
+        raise ValueError(f"{where}: holds no link parameters with standard errors (give what "
+                         f"`motionhyst identify {hint}` wrote)")
+    at = [names.index(n) for n in drawn]
+    if cov.shape != (len(names), len(names)):
+        raise ValueError(f"{where}: the covariance is not a {len(names)} x {len(names)} matrix")
+    sub = cov[np.ix_(at, at)]
+    return JointNormal(tuple(keys[n] for n in drawn), tuple(float(mean[n]) for n in drawn),
+                       tuple(map(tuple, sub.tolist())), str(path))
+
+
+def _one_element(elements: list, where: str) -> dict:
+    """The one Jenkins element of a force-displacement record's identification."""
+    if len(elements) != 1 or not isinstance(elements[0], dict):
+        raise ValueError(f"{where}: {len(elements)} Jenkins elements; a study draws the "
+                         f"parameters of one (a Jenkins link), give the others' "
+                         f"distributions in [samples]")
+    return dict(elements[0])
 
 
 def _lognormal(key: str, value, std, where: str) -> tuple[str, float, float]:
@@ -31,8 +317,14 @@ def _lognormal(key: str, value, std, where: str) -> tuple[str, float, float]:
 
 
 def distributions_from_identification(path: str | Path) -> dict[str, tuple[str, float, float]]:
-    """The link's parameters of an identification (``identify --json``) as distributions of
-    the scenario's ``hysteresis.*`` keys.
+    """The link's parameters of an identification (``identify --json``) as independent
+    distributions of the scenario's ``hysteresis.*`` keys, from their standard errors alone
+    (what a JSON without ``covariance`` gives: :func:`joint_from_identification` reads the
+    covariance where there is one).
+
+    Each is lognormal around its estimate with the relative standard error as sigma (a
+    positive parameter stays positive; for errors of a few percent this is the normal
+    distribution of the estimate).
 
     Parameters
     ----------
@@ -62,22 +354,9 @@ def distributions_from_identification(path: str | Path) -> dict[str, tuple[str, 
     """
     path = Path(path)
     where = f"from_identification {path}"
-    try:
-        data = json.loads(path.read_text())
-    except OSError as exc:
-        raise ValueError(f"{where}: cannot read ({exc.strerror})") from None
-    except (UnicodeDecodeError, ValueError):
-        raise ValueError(f"{where}: not JSON (give what `motionhyst identify --json` "
-                         f"printed)") from None
-    if not isinstance(data, dict):
-        raise ValueError(f"{where}: not an identification (`motionhyst identify --json`)")
+    data = _read(path, where)
     if isinstance(data.get("elements"), list):  # a force-displacement record
-        elements = data["elements"]
-        if len(elements) != 1 or not isinstance(elements[0], dict):
-            raise ValueError(f"{where}: {len(elements)} Jenkins elements; a study draws the "
-                             f"parameters of one (a Jenkins link), give the others' "
-                             f"distributions in [samples]")
-        e = elements[0]
+        e = _one_element(data["elements"], where)
         return {f"hysteresis.{name}": _lognormal(name, e.get(name), e.get(f"{name}_std"), where)
                 for name in ("k", "fc")}
     estimates, std = data.get("estimates"), data.get("std")

@@ -33,7 +33,11 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.study.identified import distributions_from_identification
+from motionhyst.study.identified import (
+    JointNormal,
+    distributions_from_identification,
+    joint_from_identification,
+)
 from motionhyst.study.outputs import OUTPUTS
 
 __all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "StudyDefinition", "StudyError", "set_key"]
@@ -158,13 +162,17 @@ class StudyDefinition:
     outputs : list of str
         Names in :data:`motionhyst.study.outputs.OUTPUTS`.
     samples : dict of str to (kind, a, b)
-        Monte-Carlo distributions of scenario keys (:data:`DISTRIBUTIONS`); may be empty.
+        Monte-Carlo distributions of scenario keys (:data:`DISTRIBUTIONS`), each drawn
+        independently; may be empty.
     n_samples, seed : int
         Number of samples and the seed of their generator.
     source, scenario_source : str
         The study file and the scenario file (attributes of the results).
     base_dir : Path, optional
         The folder of the scenario's relative file names (a measured plant's data).
+    joint : JointNormal, optional
+        Scenario keys drawn jointly (an identification's covariance,
+        :mod:`motionhyst.study.identified`), after the keys of `samples`.
 
     Examples
     --------
@@ -191,6 +199,7 @@ class StudyDefinition:
     source: str = "<dict>"
     scenario_source: str = "<dict>"
     base_dir: Path | None = None
+    joint: JointNormal | None = None
 
     def __post_init__(self) -> None:
         self.sample_values = self._draw()
@@ -206,7 +215,8 @@ class StudyDefinition:
         path : str or Path
             The study file (TOML); its scenario is named relative to it.
         from_identification : str or Path, optional
-            An identification (``motionhyst identify --json``) whose link parameters are drawn
+            An identification (``motionhyst identify --save`` TOML or ``--json``) whose link
+            parameters are drawn jointly from their covariance
             (:mod:`motionhyst.study.identified`), as ``[samples] from_identification`` (a
             study without ``[samples]``: 100 samples, seed 0).
         """
@@ -293,6 +303,7 @@ class StudyDefinition:
                     default = [default]
                 axes[key] = _axis_values(key, default, "[reference] ")
         samples: dict[str, tuple[str, float, float]] = {}
+        joint: JointNormal | None = None
         n, seed = 0, 0
         if "samples" in data:
             s = dict(data["samples"]) if isinstance(data["samples"], dict) else None
@@ -302,23 +313,31 @@ class StudyDefinition:
             identified = s.pop("from_identification", None)
             if identified is not None:
                 if not isinstance(identified, str) or not identified:
-                    raise StudyError("[samples] 'from_identification': give the JSON of "
-                                     "`motionhyst identify --json`, relative to the study file")
+                    raise StudyError("[samples] 'from_identification': give the TOML of "
+                                     "`motionhyst identify --save` or the JSON of `identify "
+                                     "--json`, relative to the study file")
                 ipath = Path(identified)
                 if not ipath.is_absolute():
                     ipath = (base_dir or Path.cwd()) / ipath
                 try:
-                    drawn = distributions_from_identification(ipath)
+                    joint = joint_from_identification(ipath)
+                    drawn = {} if joint is not None else distributions_from_identification(ipath)
                 except ValueError as exc:
                     raise StudyError(f"[samples] {exc}") from None
                 for key, dist in drawn.items():
                     s.setdefault(key, {dist[0]: [dist[1], dist[2]]})  # the file's own win
+                if joint is not None:
+                    for key in joint.keys:
+                        if key in REFERENCE_AXES or key in axes:
+                            raise StudyError(f"[samples] {key!r} (from_identification): "
+                                             f"already an axis")
+                    joint = joint.without(s)  # the file's own win: the others' marginal
             if not isinstance(n, int) or isinstance(n, bool) or n < 1:
                 raise StudyError("[samples] 'n': give a whole number of samples >= 1")
             if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
                 raise StudyError("[samples] 'seed': give a whole number >= 0 (the samples are "
                                  "drawn from it, reproducibly)")
-            if not s:
+            if not s and joint is None:
                 raise StudyError("[samples]: name at least one scenario key and its "
                                  "distribution")
             for key, spec in s.items():
@@ -327,7 +346,7 @@ class StudyDefinition:
                 samples[key] = _distribution(key, spec)
         study = cls(scenario=scenario, axes=axes, outputs=list(outputs), samples=samples,
                     n_samples=n, seed=seed, source=source, scenario_source=scenario_source,
-                    base_dir=base_dir)
+                    base_dir=base_dir, joint=joint)
         study.check()
         return study
 
@@ -343,7 +362,7 @@ class StudyDefinition:
             if key in REFERENCE_AXES:
                 continue
             data = copy.deepcopy(self.scenario)
-            where = "[samples]" if key in self.samples else "[axes]"
+            where = "[samples]" if key in self.sampled_keys else "[axes]"
             try:
                 set_key(data, key, value)
                 Scenario.from_dict(data, source="the scenario", base_dir=self.base_dir,
@@ -365,7 +384,8 @@ class StudyDefinition:
 
     # ---------------------------------------------------------------- points
     def _draw(self) -> NDArray[np.float64]:
-        """The Monte-Carlo samples, one column per sampled key (in file order)."""
+        """The Monte-Carlo samples, one column per sampled key (:attr:`sampled_keys`): the
+        independent ones in file order, then the joint ones, from one seeded generator."""
         rng = np.random.default_rng(self.seed)
         cols = []
         for kind, a, b in self.samples.values():
@@ -375,18 +395,25 @@ class StudyDefinition:
                 cols.append(a + b * rng.standard_normal(self.n_samples))
             else:
                 cols.append(rng.uniform(a, b, self.n_samples))
-        return np.array(cols, dtype=float).T.reshape(self.n_samples, len(self.samples))
+        if self.joint is not None:
+            cols.extend(self.joint.draw(rng, self.n_samples).T)
+        return np.array(cols, dtype=float).T.reshape(self.n_samples, len(self.sampled_keys))
+
+    @property
+    def sampled_keys(self) -> tuple[str, ...]:
+        """The keys drawn by Monte Carlo: those of :attr:`samples`, then :attr:`joint`'s."""
+        return tuple(self.samples) + (() if self.joint is None else self.joint.keys)
 
     @property
     def dims(self) -> tuple[str, ...]:
         """The results' dimensions: the axes in file order, then ``sample``."""
-        return tuple(self.axes) + (("sample",) if self.samples else ())
+        return tuple(self.axes) + (("sample",) if self.sampled_keys else ())
 
     @property
     def shape(self) -> tuple[int, ...]:
         """Number of values along each of :attr:`dims`."""
         return tuple(len(v) for v in self.axes.values()) + (
-            (self.n_samples,) if self.samples else ())
+            (self.n_samples,) if self.sampled_keys else ())
 
     @property
     def n_points(self) -> int:
@@ -403,9 +430,9 @@ class StudyDefinition:
         """
         idx = np.unravel_index(int(index), self.shape)
         out = {k: float(v[i]) for (k, v), i in zip(self.axes.items(), idx, strict=False)}
-        if self.samples:
+        if self.sampled_keys:
             row = self.sample_values[idx[-1]]
-            out.update({k: float(x) for k, x in zip(self.samples, row, strict=True)})
+            out.update({k: float(x) for k, x in zip(self.sampled_keys, row, strict=True)})
         return out
 
     def scenario_at(self, values: dict[str, float]) -> dict:
@@ -436,6 +463,8 @@ class StudyDefinition:
         d = {"scenario": self.scenario, "axes": {k: v.tolist() for k, v in self.axes.items()},
              "outputs": self.outputs, "samples": self.samples, "n": self.n_samples,
              "seed": self.seed}
+        if self.joint is not None:  # (absent otherwise: the stores of older studies resume)
+            d["joint"] = self.joint.to_dict()
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
     def to_dict(self) -> dict:
@@ -445,7 +474,8 @@ class StudyDefinition:
                 "samples": {k: list(v) for k, v in self.samples.items()},
                 "n_samples": self.n_samples, "seed": self.seed, "source": self.source,
                 "scenario_source": self.scenario_source,
-                "base_dir": None if self.base_dir is None else str(self.base_dir)}
+                "base_dir": None if self.base_dir is None else str(self.base_dir),
+                "joint": None if self.joint is None else self.joint.to_dict()}
 
     @classmethod
     def from_plain(cls, d: dict) -> StudyDefinition:
@@ -463,4 +493,5 @@ class StudyDefinition:
                             for k, v in d["samples"].items()},
                    n_samples=d["n_samples"], seed=d["seed"], source=d["source"],
                    scenario_source=d["scenario_source"],
-                   base_dir=None if d["base_dir"] is None else Path(d["base_dir"]))
+                   base_dir=None if d["base_dir"] is None else Path(d["base_dir"]),
+                   joint=None if d.get("joint") is None else JointNormal.from_dict(d["joint"]))

@@ -147,11 +147,11 @@ class StudyStore:
         for key, values in study.axes.items():
             a = g.create_array(key, shape=values.shape, dtype="float64", dimension_names=(key,))
             a[:] = values
-        if study.samples:
+        if study.sampled_keys:
             s = g.create_array("sample", shape=(study.n_samples,), dtype="int64",
                                dimension_names=("sample",))
             s[:] = np.arange(study.n_samples)
-            for j, key in enumerate(study.samples):
+            for j, key in enumerate(study.sampled_keys):
                 a = g.create_array(key, shape=(study.n_samples,), dtype="float64",
                                    dimension_names=("sample",))
                 a[:] = study.sample_values[:, j]
@@ -160,8 +160,9 @@ class StudyStore:
             "study": study.source, "scenario": study.scenario_source,
             "scenario_json": json.dumps(study.scenario), "outputs": json.dumps(study.outputs),
             "samples": json.dumps({k: list(v) for k, v in study.samples.items()}),
+            "joint": json.dumps(None if study.joint is None else study.joint.to_dict()),
             "n_samples": study.n_samples, "seed": study.seed, "version": version,
-            "coordinates": " ".join(study.samples), "failures": "{}"})
+            "coordinates": " ".join(study.sampled_keys), "failures": "{}"})
         return cls(path, g)
 
     @classmethod

@@ -1,0 +1,229 @@
+"""Monte Carlo from an identification's covariance: what ``identify --json`` and ``--save``
+carry, and the study's joint draws of the link's parameters (study/identified.py)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from motionhyst.cli import main
+from motionhyst.hysteresis import Jenkins
+from motionhyst.identify.input_output import IORecord, identify_io
+from motionhyst.scenario import Scenario, default_scenario_path
+from motionhyst.study import Study, StudyError, open_results, run_study
+from motionhyst.study.identified import LOG_SPACE_CV, JointNormal, joint_from_identification
+from motionhyst.time.openloop import MassSpringDamper, OpenLoop
+
+N_DRAWS = 4000
+
+
+def _force_displacement_record(path: Path, noise: float = 0.002, n: int = 4000) -> Path:
+    """A Jenkins link (Table I's k_J = 20 N/m, f_c = 0.05 N) driven by a sine whose amplitude
+    decays from 10 mm to 0.5 mm and grows back, its force with white noise [N]."""
+    t = np.arange(n) / 1000.0
+    env = np.concatenate([np.geomspace(0.01, 5e-4, n // 2), np.geomspace(5e-4, 0.01, n - n // 2)])
+    x = env * np.sin(2 * np.pi * 2.0 * t)
+    w = Jenkins(k=20.0, fc=0.05).response(x) + noise * np.random.default_rng(1).standard_normal(n)
+    np.savetxt(path, np.column_stack([t, x, w]), delimiter=",", comments="", fmt="%.17g",
+               header="time,displacement,force")
+    return path
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory) -> tuple[Path, dict]:
+    """``identify --save`` and ``identify --json`` of one force-displacement record."""
+    folder = tmp_path_factory.mktemp("identified")
+    record = _force_displacement_record(folder / "link.csv")
+    model = folder / "model.toml"
+    assert main(["identify", str(record), "--elements", "1", "--save", str(model)]) == 0
+    fit = folder / "fit.json"
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(["identify", str(record), "--elements", "1", "--json"]) == 0
+    fit.write_text(buf.getvalue())
+    shutil.copy(default_scenario_path(), folder / "paper.toml")
+    return folder, json.loads(buf.getvalue())
+
+
+def _study(folder: Path, source: str, extra: str = "", n: int = N_DRAWS, seed: int = 3) -> Path:
+    path = folder / f"study_{seed}_{n}.toml"
+    path.write_text(f'scenario = "paper.toml"\noutputs = ["mismatch"]\n[axes]\n'
+                    f'frequency_hz = [5.0, 10.0]\n[samples]\nn = {n}\nseed = {seed}\n'
+                    f'from_identification = "{source}"\n{extra}')
+    return path
+
+
+def test_json_and_save_carry_the_covariance_of_the_standard_errors(saved):
+    folder, fit = saved
+    cov = fit["covariance"]
+    assert cov["parameters"] == ["k", "fc", "offset"]
+    c = np.array(cov["matrix"])
+    assert np.array_equal(c, c.T)
+    e = fit["elements"][0]
+    np.testing.assert_allclose(np.sqrt(np.diag(c))[:2], [e["k_std"], e["fc_std"]], rtol=1e-12)
+    assert c[2, 2] > 0
+    r = c[0, 1] / np.sqrt(c[0, 0] * c[1, 1])
+    assert 0.3 < r < 0.95  # k and fc of one element are correlated: independent draws miss it
+    text = (folder / "model.toml").read_text()
+    ident = tomllib.loads(text)["identification"]
+    assert ident["parameters"] == ["hysteresis.k", "hysteresis.fc"]
+    assert ident["estimates"] == [e["k"], e["fc"]]
+    np.testing.assert_allclose(ident["std"], [e["k_std"], e["fc_std"]], rtol=1e-12)
+    assert ident["correlation"][0][1] == pytest.approx(r, abs=1e-12)
+    # the saved file stays a scenario (predict reads it); the table changes nothing in it
+    sc = Scenario.from_file(folder / "model.toml")
+    assert sc.model.identification.parameters == ["hysteresis.k", "hysteresis.fc"]
+
+
+def test_input_output_identification_carries_its_covariance():
+    """The input-output route: every determined estimate in the covariance, whose diagonal
+    is the squares of the standard errors; the saved scenario names them by their keys."""
+    true = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), Jenkins(k=5e4, fc=20.0))
+    t = np.arange(1024) / 750
+    u = 40 * np.sin(2 * np.pi * 8 * t) + 20 * np.sin(2 * np.pi * 31 * t)
+    y = true.simulate(t, u).displacement
+    y = y + 0.02 * np.std(y) * np.random.default_rng(0).standard_normal(y.size)
+    fit = identify_io([IORecord(t, u, y)], model="jenkins")
+    cov = fit.to_dict()["covariance"]
+    determined = [n for n, s in fit.std.items() if s is not None]
+    assert cov["parameters"] == determined
+    assert {"m", "c", "k", "link.k", "link.fc"} <= set(determined)
+    np.testing.assert_allclose(np.sqrt(np.diag(cov["matrix"])),
+                               [fit.std[n] for n in determined], rtol=1e-9)
+    ident = tomllib.loads(fit.scenario_text())["identification"]
+    assert ident["parameters"] == ["stage.m", "stage.c", "stage.k", "hysteresis.k",
+                                   "hysteresis.fc"]
+    d = joint_from_identification(_write(fit.scenario_text()))
+    assert d.keys == ("hysteresis.k", "hysteresis.fc")
+    at = [determined.index("link.k"), determined.index("link.fc")]
+    np.testing.assert_allclose(d.covariance, np.array(cov["matrix"])[np.ix_(at, at)],
+                               rtol=1e-9)
+
+
+def _write(text: str) -> Path:
+    import tempfile
+
+    path = Path(tempfile.mkdtemp()) / "model.toml"
+    path.write_text(text)
+    return path
+
+
+def _within_sampling_error(x: np.ndarray, mean, cov, n_sigma: float = 4.0) -> None:
+    """Sample means and covariances of the rows of `x` against `mean` and `cov`: each within
+    `n_sigma` of its standard error (normal draws: var(s_ij) = (c_ii c_jj + c_ij^2) / n)."""
+    n = x.shape[0]
+    mean, cov = np.asarray(mean), np.asarray(cov)
+    assert np.all(np.abs(x.mean(axis=0) - mean) <= n_sigma * np.sqrt(np.diag(cov) / n))
+    se = np.sqrt((np.outer(np.diag(cov), np.diag(cov)) + cov ** 2) / n)
+    assert np.all(np.abs(np.cov(x.T) - cov) <= n_sigma * se)
+
+
+@pytest.mark.parametrize("source", ["model.toml", "fit.json"])
+def test_draws_have_the_saved_covariance_and_the_seed_gives_the_same_study(saved, source):
+    folder, fit = saved
+    st = Study.from_file(_study(folder, source))
+    assert st.sampled_keys == ("hysteresis.k", "hysteresis.fc") and not st.samples
+    e = fit["elements"][0]
+    saved_cov = np.array(fit["covariance"]["matrix"])[:2, :2]
+    assert not st.joint.log_space  # 0.1 % errors: the normal distribution itself
+    _within_sampling_error(st.sample_values, [e["k"], e["fc"]], saved_cov)
+    again = Study.from_file(_study(folder, source))
+    assert np.array_equal(again.sample_values, st.sample_values)
+    assert again.fingerprint() == st.fingerprint()
+    other = Study.from_file(_study(folder, source, seed=4))
+    assert not np.array_equal(other.sample_values, st.sample_values)
+
+
+def test_the_same_seed_computes_the_same_study(saved, tmp_path):
+    folder, _ = saved
+    stores = []
+    for name in ("a.zarr", "b.zarr"):
+        st = Study.from_file(_study(folder, "model.toml", n=3))
+        run_study(st, tmp_path / name, workers=0)
+        stores.append(open_results(tmp_path / name))
+    a, b = stores
+    assert np.array_equal(a["mismatch"].values, b["mismatch"].values)
+    assert np.all(np.isfinite(a["mismatch"].values))
+    assert np.array_equal(a["hysteresis.k"].values, b["hysteresis.k"].values)
+    assert json.loads(a.attrs["joint"])["keys"] == ["hysteresis.k", "hysteresis.fc"]
+
+
+def test_a_key_the_study_gives_keeps_its_distribution_and_the_rest_their_marginal(saved):
+    folder, fit = saved
+    st = Study.from_file(_study(folder, "model.toml",
+                                '"hysteresis.k" = { lognormal = [20.0, 0.1] }\n'))
+    assert st.samples == {"hysteresis.k": ("lognormal", 20.0, 0.1)}
+    assert st.joint.keys == ("hysteresis.fc",)
+    assert st.joint.covariance[0][0] == pytest.approx(fit["covariance"]["matrix"][1][1],
+                                                      rel=1e-9)
+    assert st.sampled_keys == ("hysteresis.k", "hysteresis.fc")
+
+
+def test_large_errors_are_drawn_lognormal_with_the_same_moments():
+    """Above LOG_SPACE_CV a normal draw could reach 0: the lognormal draws keep every value
+    positive and have the stated means and covariance."""
+    m = np.array([20.0, 0.05])
+    s = np.array([0.4, 0.4]) * m
+    cov = np.outer(s, s) * np.array([[1.0, 0.6], [0.6, 1.0]])
+    d = JointNormal(("hysteresis.k", "hysteresis.fc"), tuple(m), tuple(map(tuple, cov)))
+    assert d.log_space and 0.4 > LOG_SPACE_CV
+    x = d.draw(np.random.default_rng(5), 200_000)
+    assert np.all(x > 0)
+    np.testing.assert_allclose(x.mean(axis=0), m, rtol=0.005)
+    np.testing.assert_allclose(np.cov(x.T), cov, rtol=0.03)
+    normal = JointNormal(d.keys, tuple(m), tuple(map(tuple, cov / 16)))  # 10 %: normal
+    assert not normal.log_space
+    y = normal.draw(np.random.default_rng(5), 200_000)
+    assert np.all(y > 0)
+    # the normal distribution's third moment is 0; the lognormal's is not
+    z = (y - m) / np.sqrt(np.diag(cov / 16))
+    assert abs(np.mean(z ** 3)) < 0.02
+
+
+def test_bad_identifications_are_one_line(saved):
+    folder, fit = saved
+    with pytest.raises(StudyError, match=r"no \[identification\] table"):
+        Study.from_file(_study(folder, "paper.toml"))
+    two = dict(fit, elements=fit["elements"] * 2)
+    (folder / "two.json").write_text(json.dumps(two))
+    with pytest.raises(StudyError, match="2 Jenkins elements"):
+        Study.from_file(_study(folder, "two.json"))
+    undetermined = dict(fit, covariance={"parameters": ["k", "offset"], "matrix": [[1.0, 0.0],
+                                                                                  [0.0, 1.0]]})
+    (folder / "undetermined.json").write_text(json.dumps(undetermined))
+    with pytest.raises(StudyError, match="fc: its standard error is not determined"):
+        Study.from_file(_study(folder, "undetermined.json"))
+    r = tomllib.loads((folder / "model.toml").read_text())["identification"]["correlation"]
+    (folder / "asym.toml").write_text((folder / "model.toml").read_text().replace(
+        f"[{r[1][0]!r}, 1.0]", "[0.1, 1.0]"))
+    with pytest.raises(StudyError, match=r"\[identification\].*symmetric"):
+        Study.from_file(_study(folder, "asym.toml"))
+    with pytest.raises(StudyError, match=r"'hysteresis.k' \(from_identification\): already "
+                                         r"an axis"):
+        Study.from_dict({"scenario": "paper.toml", "outputs": ["e1"],
+                         "axes": {"hysteresis.k": [19.0, 21.0]},
+                         "samples": {"n": 2, "seed": 0, "from_identification": "model.toml"}},
+                        base_dir=folder)
+
+
+def test_cli_runs_a_study_from_a_saved_identification(saved, tmp_path, capsys):
+    folder, _ = saved
+    bare = folder / "bare.toml"
+    bare.write_text('scenario = "paper.toml"\noutputs = ["mismatch"]\n[axes]\n'
+                    'frequency_hz = [5.0]\n')
+    out = tmp_path / "s.zarr"
+    assert main(["study", str(bare), "--from-identification", str(folder / "model.toml"),
+                 "--out", str(out), "--workers", "0", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["points"] == 100 and report["failed"] == 0
+    ds = open_results(out)
+    assert ds["hysteresis.k"].dims == ds["hysteresis.fc"].dims == ("sample",)
+    assert abs(np.median(ds["hysteresis.k"].values) - 20.0) < 0.1
