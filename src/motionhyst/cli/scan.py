@@ -133,22 +133,6 @@ def _at(loop, x0: float, source: str):
         raise UsageError(f"{PROG}: --at: {exc} ({source})") from None
 
 
-def _stage_terms(sc, loop) -> list[str]:
-    """The stage's jerk and snap terms a scan's model feedforward adds by default: those the
-    scenario's ``[feedforward]`` leaves unset, where the plant's inverse has a series."""
-    sec = sc.model.feedforward
-    unset = [t for t in ("jerk", "snap") if getattr(sec, t, 0.0) is None]
-    if not unset:
-        return []
-    from motionhyst.controllers.inverse import stage_inverse
-
-    try:
-        stage_inverse(loop.plant)
-    except (ValueError, TypeError, AttributeError, NotImplementedError):
-        return []
-    return unset
-
-
 def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
     from motionhyst.scenario import load_scenario
@@ -157,18 +141,16 @@ def run(args: argparse.Namespace) -> int:
     # imported once the input is read: a refusal does not wait for the scan to load
     from motionhyst.scan.ilc import ILCFilters
     from motionhyst.scan.scanning import run_scan
+    from motionhyst.scan.terms import scan_terms
 
     loop = sc.loop()
     warn_plant_fit(sc)
     if args.at is not None:
         loop = _at(loop, args.at, sc.source)
-    ff = loop.ff
     terms = args.feedforward
     if terms is None:
-        terms = [t for t in TERMS[:-1] if ff is not None and getattr(ff, t)]
-        terms += ["hysteresis"] if loop.hysteresis_feedforward is not None else []
-        if terms:  # a model feedforward inverts the stage too, unless the scenario says how
-            terms = [*_stage_terms(sc, loop), *terms]
+        unset = [t for t in ("jerk", "snap") if getattr(sc.model.feedforward, t, 0.0) is None]
+        terms = scan_terms(loop, unset)
     elif len(set(terms)) != len(terms):
         raise UsageError(f"{PROG}: --feedforward lists one twice")
     if "hysteresis" in terms and loop.hysteresis_feedforward is None:

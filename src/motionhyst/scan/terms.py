@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from motionhyst.controllers.feedforward import STANDSTILL
 from motionhyst.hysteresis import Hysteresis
 
-__all__ = ["TERMS", "FeedforwardTerms", "model_terms", "setpoint_samples"]
+__all__ = ["TERMS", "FeedforwardTerms", "model_terms", "scan_terms", "setpoint_samples"]
 
 TERMS = ("jerk", "snap", "viscous", "coulomb", "hysteresis")
 """The terms a scan's model feedforward may switch on (the acceleration term is always on)."""
@@ -242,6 +242,46 @@ class FeedforwardTerms:
         values = self.values()
         return {"coefficients": values, "units": {k: units[k] for k in values},
                 **({"link_model": self.link.name} if self.link is not None else {})}
+
+
+def scan_terms(loop, unset: tuple[str, ...] | list[str] = ()) -> list[str]:
+    """The terms a scan's model feedforward runs unless told (``motionhyst scan`` without
+    ``--feedforward``): those of the loop's feedforward and, if it has any, the stage's jerk
+    and snap of `unset` (the scenario's ``[feedforward]`` leaves them unset) where the
+    plant's inverse has a series.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop.
+    unset : sequence of {"jerk", "snap"}
+        The stage terms the scenario leaves unset (``jerk`` and ``snap`` absent from its
+        ``[feedforward]``).
+
+    Examples
+    --------
+    >>> from motionhyst import Scenario
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> import tomllib
+    >>> d = tomllib.loads(default_scenario_path().read_text())
+    >>> d["feedforward"] = {"hysteresis": {"model": "jenkins", "k": 20.8, "fc": 0.052}}
+    >>> scan_terms(Scenario.from_dict(d).loop(), ["jerk", "snap"])
+    ['jerk', 'snap', 'hysteresis']
+    >>> scan_terms(Scenario.from_dict(d).loop())
+    ['hysteresis']
+    """
+    ff = loop.ff
+    terms = [t for t in TERMS[:-1] if ff is not None and getattr(ff, t)]
+    terms += ["hysteresis"] if loop.hysteresis_feedforward is not None else []
+    if not terms or not unset:  # a model feedforward inverts the stage too, unless told how
+        return terms
+    from motionhyst.controllers.inverse import stage_inverse
+
+    try:
+        stage_inverse(loop.plant)
+    except (ValueError, TypeError, AttributeError, NotImplementedError):
+        return terms
+    return [*[t for t in ("jerk", "snap") if t in unset], *terms]
 
 
 def model_terms(loop, names=None) -> FeedforwardTerms:
