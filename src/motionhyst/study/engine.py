@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
-from motionhyst.study.spec import REFERENCE_AXES, StudyDefinition
+from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
 
 __all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "Batch", "Evaluator", "evaluate_batch",
@@ -98,17 +98,21 @@ class Evaluator:
         self.fields = fields_of(study.outputs)
         self._key: tuple | None = None
         self._loop = None
+        self._unset: tuple[str, ...] = ()
         self._error: Exception | None = None
 
     def _loop_at(self, values: dict[str, float]):
         from motionhyst.scenario import Scenario, ScenarioError
 
-        key = tuple(v for k, v in values.items() if k not in REFERENCE_AXES)
+        key = tuple(v for k, v in values.items() if is_scenario_key(k))
         if key != self._key:
             self._key, self._loop, self._error = key, None, None
             try:
-                self._loop = Scenario.from_dict(self.study.scenario_at(values),
-                                                base_dir=self.study.base_dir).loop()
+                sc = Scenario.from_dict(self.study.scenario_at(values),
+                                        base_dir=self.study.base_dir)
+                self._loop = sc.loop()
+                self._unset = tuple(t for t in ("jerk", "snap")
+                                    if getattr(sc.model.feedforward, t, 0.0) is None)
             except (ScenarioError, ValueError) as exc:
                 self._error = exc
         if self._error is not None:
@@ -127,7 +131,8 @@ class Evaluator:
         return self._outputs(self._loop_at(values), values)
 
     def _outputs(self, loop, values: dict[str, float]) -> dict:
-        p = Point(loop, values["amplitude"], values["frequency_hz"])
+        p = Point(loop, values["amplitude"], values["frequency_hz"],
+                  self.study.scan_at(values), self._unset)
         out: dict = {}
         for name in self.study.outputs:
             out.update(OUTPUTS[name].evaluate(p))
@@ -169,7 +174,8 @@ class Evaluator:
             if code:
                 status[j], reason[j] = FAILED, code
                 if code not in failures:
-                    at = ", ".join(f"{k} = {v:g}" for k, v in self.study.point(int(i)).items())
+                    at = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                                   for k, v in self.study.point(int(i)).items())
                     failures[code] = f"point {int(i)} ({at}): {message}"
                 res = {name: nan_of(kind) for name, kind in self.fields.items()}
             for name in self.fields:

@@ -54,7 +54,21 @@ def to_table(ds) -> str:
     cols["status"] = ds["status"].values.ravel()
     buf = io.StringIO()
     csv_header(buf, list(cols))
-    csv_rows(buf, np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]), fmt=None)
+    names = {k: c for k, c in cols.items() if np.asarray(c).dtype.kind in "UTO"}  # compensation
+    if not names:
+        csv_rows(buf, np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]),
+                 fmt=None)
+        return buf.getvalue()
+    numbers = io.StringIO()
+    csv_rows(numbers, np.column_stack([np.asarray(c, dtype=float) if k not in names
+                                       else np.zeros(len(c)) for k, c in cols.items()]),
+             fmt=None)
+    at = [list(cols).index(k) for k in names]
+    for row, line in enumerate(numbers.getvalue().splitlines()):
+        cells = line.split(",")
+        for j, k in zip(at, names, strict=True):
+            cells[j] = str(names[k][row])
+        buf.write(",".join(cells) + "\n")
     return buf.getvalue()
 
 

@@ -34,6 +34,12 @@ class Point:
         Reference amplitude [m].
     frequency_hz : float
         Reference frequency [Hz].
+    scan : dict, optional
+        The settings of the point's scan (:mod:`motionhyst.study.scans`), for the output
+        ``scan``.
+    unset_terms : tuple of str
+        The stage terms (``jerk``, ``snap``) the scenario's ``[feedforward]`` leaves unset
+        (a scan's model feedforward takes the plant's).
 
     Examples
     --------
@@ -46,6 +52,8 @@ class Point:
     loop: Loop
     amplitude: float
     frequency_hz: float
+    scan: dict | None = None
+    unset_terms: tuple[str, ...] = ()
     _steady: SteadyState | None = field(default=None, init=False, repr=False)
 
     @property
@@ -170,6 +178,18 @@ def _quasi_linear(p: Point) -> dict:
     if p.loop.hysteresis is None:
         raise ValueError("the loop has no hysteresis element")
     return {"E": complex(loop_mismatch(p.loop, p.frequency_hz, p.amplitude)[0])}
+
+
+@register_output("scan", {"ma_max": "real", "msd_max": "real", "peak_error": "real",
+                          "settling_time_s": "real"},
+                 "largest |MA| and MSD over the constant-velocity phases and the peak error [m], "
+                 "settling time [s] of the study's scan ([scan], as motionhyst scan)")
+def _scan(p: Point) -> dict:
+    if p.scan is None:
+        raise ValueError("the output 'scan' needs the study's [scan] settings")
+    from motionhyst.study.scans import run_point_scan
+
+    return run_point_scan(p.loop, p.scan, p.unset_terms)
 
 
 _MARGINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

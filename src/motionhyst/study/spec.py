@@ -17,7 +17,8 @@ samples of scenario keys from stated distributions, seeded::
     "hysteresis.k" = { lognormal = [20.0, 0.1] }
 
 The points are the cross product of the axes and the samples (a dimension ``sample``); an axis
-``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one.
+``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one.  A ``[scan]``
+table and axes ``scan.*`` set the scan of the output ``scan`` (:mod:`motionhyst.study.scans`).
 """
 
 from __future__ import annotations
@@ -39,8 +40,10 @@ from motionhyst.study.identified import (
     joint_from_identification,
 )
 from motionhyst.study.outputs import OUTPUTS
+from motionhyst.study.scans import COMPENSATIONS, SCAN_AXES, check_scan_value, scan_settings
 
-__all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "StudyDefinition", "StudyError", "set_key"]
+__all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "StudyDefinition", "StudyError",
+           "is_scenario_key", "set_key"]
 
 REFERENCE_AXES = ("amplitude", "frequency_hz")
 """Axes over the reference ``r = amplitude sin(2 pi frequency_hz t)`` (not scenario keys)."""
@@ -66,6 +69,19 @@ class StudyError(ValueError):
     ...     print(exc)                                     # doctest: +ELLIPSIS
     'outputs': unknown output 'e7' (known: e1, harmonics, ...)
     """
+
+
+def is_scenario_key(key: str) -> bool:
+    """Whether the axis or sampled `key` is a key of the scenario (not the reference's
+    ``amplitude`` or ``frequency_hz``, nor a scan's setting ``scan.*``).
+
+    Examples
+    --------
+    >>> is_scenario_key("hysteresis.k"), is_scenario_key("frequency_hz"), is_scenario_key(
+    ...     "scan.speed")
+    (True, False, False)
+    """
+    return key not in REFERENCE_AXES and not key.startswith("scan.")
 
 
 def set_key(data: dict, key: str, value: float) -> None:
@@ -97,7 +113,15 @@ def set_key(data: dict, key: str, value: float) -> None:
     node[last] = value
 
 
-def _axis_values(key: str, spec, where: str) -> NDArray[np.float64]:
+def _axis_values(key: str, spec, where: str) -> NDArray:
+    if key.startswith("scan.") and key not in SCAN_AXES:
+        raise StudyError(f"{where}{key!r}: not a scan axis (those are {', '.join(SCAN_AXES)})")
+    if key == "scan.compensation":
+        if (not isinstance(spec, list) or not spec or any(v not in COMPENSATIONS for v in spec)
+                or len(set(spec)) != len(spec)):
+            raise StudyError(f"{where}{key!r}: give a list of distinct compensations among "
+                             f"{', '.join(COMPENSATIONS)}")
+        return np.array(spec, dtype=str)
     if isinstance(spec, dict):
         if len(spec) != 1 or next(iter(spec)) not in ("geomspace", "linspace"):
             raise StudyError(f"{where}{key!r}: give a list or {{ geomspace = [a, b, n] }} or "
@@ -126,6 +150,11 @@ def _axis_values(key: str, spec, where: str) -> NDArray[np.float64]:
         raise StudyError(f"{where}{key!r}: values repeat")
     if key in REFERENCE_AXES and np.any(values <= 0):
         raise StudyError(f"{where}{key!r}: values must be > 0")
+    for v in values if key.startswith("scan.") else ():
+        try:
+            check_scan_value(key[5:], float(v), f"{where}{key!r}")
+        except ValueError as exc:
+            raise StudyError(str(exc)) from None
     return values
 
 
@@ -173,6 +202,9 @@ class StudyDefinition:
     joint : JointNormal, optional
         Scenario keys drawn jointly (an identification's covariance,
         :mod:`motionhyst.study.identified`), after the keys of `samples`.
+    scan : dict, optional
+        The scan's settings not swept by an axis ``scan.*``, for the output ``scan``
+        (:func:`motionhyst.study.scans.scan_settings`).
 
     Examples
     --------
@@ -200,6 +232,7 @@ class StudyDefinition:
     scenario_source: str = "<dict>"
     base_dir: Path | None = None
     joint: JointNormal | None = None
+    scan: dict | None = None
 
     def __post_init__(self) -> None:
         self.sample_values = self._draw()
@@ -259,10 +292,10 @@ class StudyDefinition:
         scenario : dict, optional
             The scenario's tables, instead of reading ``data["scenario"]``.
         """
-        unknown = sorted(set(data) - {"scenario", "outputs", "axes", "samples"})
+        unknown = sorted(set(data) - {"scenario", "outputs", "axes", "samples", "scan"})
         if unknown:
             raise StudyError(f"unknown key {unknown[0]!r} (a study has scenario, outputs, "
-                             f"[axes] and [samples])")
+                             f"[axes], [samples] and [scan])")
         scenario_source = "<dict>"
         if scenario is None:
             name = data.get("scenario")
@@ -292,6 +325,17 @@ class StudyDefinition:
         if not isinstance(axes_spec, dict):
             raise StudyError("'axes': give a table [axes]")
         axes = {key: _axis_values(key, spec, "[axes] ") for key, spec in axes_spec.items()}
+        scan = None
+        if "scan" in outputs:
+            if "scan" in data and not isinstance(data["scan"], dict):
+                raise StudyError("'scan': give a table [scan]")
+            try:
+                scan = scan_settings(data.get("scan"), axes)
+            except ValueError as exc:
+                raise StudyError(str(exc)) from None
+        elif "scan" in data or any(k.startswith("scan.") for k in axes):
+            raise StudyError("[scan] and the axes scan.* set the output 'scan'; add it to "
+                             "'outputs'")
         ref = scenario.get("reference") if isinstance(scenario.get("reference"), dict) else {}
         for key, default in (("amplitude", ref.get("amplitude")),
                              ("frequency_hz", ref.get("frequencies"))):
@@ -346,7 +390,7 @@ class StudyDefinition:
                 samples[key] = _distribution(key, spec)
         study = cls(scenario=scenario, axes=axes, outputs=list(outputs), samples=samples,
                     n_samples=n, seed=seed, source=source, scenario_source=scenario_source,
-                    base_dir=base_dir, joint=joint)
+                    base_dir=base_dir, joint=joint, scan=scan)
         study.check()
         return study
 
@@ -359,7 +403,7 @@ class StudyDefinition:
             raise StudyError(f"{self.n_points} points: more than {MAX_POINTS}; split the study")
         first = self.point(0)
         for key, value in first.items():
-            if key in REFERENCE_AXES:
+            if not is_scenario_key(key):
                 continue
             data = copy.deepcopy(self.scenario)
             where = "[samples]" if key in self.sampled_keys else "[axes]"
@@ -429,7 +473,8 @@ class StudyDefinition:
             Flat index of the point.
         """
         idx = np.unravel_index(int(index), self.shape)
-        out = {k: float(v[i]) for (k, v), i in zip(self.axes.items(), idx, strict=False)}
+        out = {k: str(v[i]) if v.dtype.kind == "U" else float(v[i])
+               for (k, v), i in zip(self.axes.items(), idx, strict=False)}
         if self.sampled_keys:
             row = self.sample_values[idx[-1]]
             out.update({k: float(x) for k, x in zip(self.sampled_keys, row, strict=True)})
@@ -445,9 +490,22 @@ class StudyDefinition:
         """
         data = copy.deepcopy(self.scenario)
         for key, value in values.items():
-            if key not in REFERENCE_AXES:
+            if is_scenario_key(key):
                 set_key(data, key, value)
         return data
+
+    def scan_at(self, values: dict) -> dict | None:
+        """The scan's settings at a point: :attr:`scan` and the point's ``scan.*`` `values`
+        (None for a study without the output ``scan``).
+
+        Parameters
+        ----------
+        values : dict
+            The point's values (:meth:`point`).
+        """
+        if self.scan is None:
+            return None
+        return {**self.scan, **{k[5:]: v for k, v in values.items() if k.startswith("scan.")}}
 
     def order(self) -> NDArray[np.int64]:
         """Flat indices in the order points are computed: the reference axes vary fastest,
@@ -465,6 +523,8 @@ class StudyDefinition:
              "seed": self.seed}
         if self.joint is not None:  # (absent otherwise: the stores of older studies resume)
             d["joint"] = self.joint.to_dict()
+        if self.scan is not None:
+            d["scan"] = self.scan
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
     def to_dict(self) -> dict:
@@ -475,7 +535,8 @@ class StudyDefinition:
                 "n_samples": self.n_samples, "seed": self.seed, "source": self.source,
                 "scenario_source": self.scenario_source,
                 "base_dir": None if self.base_dir is None else str(self.base_dir),
-                "joint": None if self.joint is None else self.joint.to_dict()}
+                "joint": None if self.joint is None else self.joint.to_dict(),
+                "scan": self.scan}
 
     @classmethod
     def from_plain(cls, d: dict) -> StudyDefinition:
@@ -487,11 +548,13 @@ class StudyDefinition:
             What :meth:`to_dict` gave.
         """
         return cls(scenario=d["scenario"],
-                   axes={k: np.asarray(v, dtype=float) for k, v in d["axes"].items()},
+                   axes={k: np.asarray(v, dtype=str if k == "scan.compensation" else float)
+                         for k, v in d["axes"].items()},
                    outputs=list(d["outputs"]),
                    samples={k: (v[0], float(v[1]), float(v[2]))
                             for k, v in d["samples"].items()},
                    n_samples=d["n_samples"], seed=d["seed"], source=d["source"],
                    scenario_source=d["scenario_source"],
                    base_dir=None if d["base_dir"] is None else Path(d["base_dir"]),
-                   joint=None if d.get("joint") is None else JointNormal.from_dict(d["joint"]))
+                   joint=None if d.get("joint") is None else JointNormal.from_dict(d["joint"]),
+                   scan=d.get("scan"))

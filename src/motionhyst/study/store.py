@@ -144,8 +144,9 @@ class StudyStore:
                        fill_value=0, dimension_names=dims)
         g["reason"].attrs["flag_values"] = list(REASONS)
         g["reason"].attrs["flag_meanings"] = json.dumps(REASONS)
-        for key, values in study.axes.items():
-            a = g.create_array(key, shape=values.shape, dtype="float64", dimension_names=(key,))
+        for key, values in study.axes.items():  # the numbers' or, scan.compensation, the names
+            a = g.create_array(key, shape=values.shape, dimension_names=(key,),
+                               dtype=str if values.dtype.kind == "U" else "float64")
             a[:] = values
         if study.sampled_keys:
             s = g.create_array("sample", shape=(study.n_samples,), dtype="int64",

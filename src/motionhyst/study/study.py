@@ -18,7 +18,9 @@ class Study(StudyDefinition):
 
     Parameters
     ----------
-    scenario, axes, outputs, samples, n_samples, seed, source, scenario_source, base_dir
+    scenario, axes, outputs, samples, n_samples, seed, source, scenario_source
+        As :class:`~motionhyst.study.spec.StudyDefinition`.
+    base_dir, joint, scan
         As :class:`~motionhyst.study.spec.StudyDefinition`.
 
     Examples

@@ -75,12 +75,12 @@ class StudySummary:
             lines.append(f"  {f['points']} failed: {why}"
                          + (f" ({f['example']})" if f.get("example") else ""))
         for name, w in self.worst.items():
-            at = ", ".join(f"{k} = {g(v)}" for k, v in w["at"].items())
+            at = ", ".join(f"{k} = {_text(v)}" for k, v in w["at"].items())
             lines.append(f"{name}: worst |{name}| = {g(w['value'])} at {at}")
             rows = []
             for axis, d in self.per_axis[name].items():
                 i = int(np.nanargmax(d["worst"])) if np.any(np.isfinite(d["worst"])) else 0
-                rows.append([axis, g(d["values"][i]), g(d["worst"][i]),
+                rows.append([axis, _text(d["values"][i]), g(d["worst"][i]),
                              g(float(np.nanmin(d["worst"])))])
             lines.append(table(["axis", "worst at", "worst", "best of the worst"], rows))
             if name in self.band:
@@ -89,7 +89,7 @@ class StudySummary:
                     f"{k} % {g(v)}" for k, v in b.items()))
             if name in self.widest:
                 w = dict(self.widest[name])
-                at = ", ".join(f"{k} = {g(v)}" for k, v in w.pop("at").items())
+                at = ", ".join(f"{k} = {_text(v)}" for k, v in w.pop("at").items())
                 lines.append(f"  Monte Carlo, widest band at {at}: " + ", ".join(
                     f"{k} % {g(v)}" for k, v in w.items()))
         return "\n".join(lines)
@@ -212,6 +212,15 @@ def failure_reasons(ds) -> dict:
             for code, count in zip(codes.tolist(), counts.tolist(), strict=True)}
 
 
+def _coordinate(v) -> float | str:
+    """An axis value: a number, or a name (``scan.compensation``)."""
+    return str(v) if isinstance(v, str | np.str_) else float(v)
+
+
+def _text(v) -> str:
+    return v if isinstance(v, str) else g(v)
+
+
 def summarize(ds) -> StudySummary:
     """The summary of a study's results (:func:`motionhyst.study.open_results`).
 
@@ -247,7 +256,7 @@ def summarize(ds) -> StudySummary:
             continue
         flat = int(np.nanargmax(mag))
         idx = np.unravel_index(flat, mag.shape)
-        at = {d: float(ds[d].values[i]) for d, i in zip(dims, idx, strict=True)}
+        at = {d: _coordinate(ds[d].values[i]) for d, i in zip(dims, idx, strict=True)}
         out.worst[name] = {"value": float(mag[idx]), "at": at}
         out.per_axis[name] = {}
         for k, d in enumerate(dims):
@@ -255,7 +264,7 @@ def summarize(ds) -> StudySummary:
             with np.errstate(all="ignore"):
                 worst = np.nanmax(np.where(np.isfinite(mag), mag, -np.inf), axis=others)
             worst = np.where(np.isfinite(worst), worst, np.nan)
-            out.per_axis[name][d] = {"values": ds[d].values.astype(float).tolist(),
+            out.per_axis[name][d] = {"values": [_coordinate(v) for v in ds[d].values],
                                      "worst": worst.tolist()}
         if "sample" in dims:
             per_sample = np.array(out.per_axis[name]["sample"]["worst"], dtype=float)
@@ -271,6 +280,6 @@ def summarize(ds) -> StudySummary:
                 j = np.unravel_index(int(np.nanargmax(spread)), spread.shape)
                 grid = [d for d in dims if d != "sample"]
                 out.widest[name] = {
-                    "at": {d: float(ds[d].values[i]) for d, i in zip(grid, j, strict=True)},
+                    "at": {d: _coordinate(ds[d].values[i]) for d, i in zip(grid, j, strict=True)},
                     **{f"{p:g}": float(q[(n, *j)]) for n, p in enumerate(BAND)}}
     return out

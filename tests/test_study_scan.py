@@ -1,0 +1,114 @@
+"""Scans in studies: the output ``scan`` over scan settings as axes, the numbers of
+``motionhyst scan --json`` for the same point (study/scans.py)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from motionhyst.cli import main
+from motionhyst.study import Study, StudyError, open_results, run_study, summarize
+from motionhyst.study.export import to_table
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+STUDY = """\
+scenario = "scan.toml"
+outputs = ["scan", "error_rms"]
+[scan]
+length = 0.005
+a_max = 2.0
+j_max = 50.0
+s_max = 1000.0
+window = 0.02
+[axes]
+"scan.speed" = [0.05, 0.1]
+"scan.compensation" = ["none", "model"]
+frequency_hz = [5.0]
+"""
+
+
+@pytest.fixture
+def study_file(tmp_path: Path) -> Path:
+    shutil.copy(EXAMPLES / "scan.toml", tmp_path / "scan.toml")
+    path = tmp_path / "study.toml"
+    path.write_text(STUDY)
+    return path
+
+
+def _scan_json(*args: str) -> dict:
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(["scan", *args, "--json"]) == 0
+    return json.loads(buf.getvalue())
+
+
+def test_scan_outputs_are_those_of_the_scan_command(study_file, tmp_path):
+    """Each point's MA, MSD, peak error and settling time are the numbers `motionhyst scan
+    --json` prints for the same setpoint, window and compensation (identical)."""
+    st = Study.from_file(study_file)
+    assert st.dims == ("scan.speed", "scan.compensation", "frequency_hz", "amplitude")
+    run_study(st, tmp_path / "s.zarr", workers=0)
+    ds = open_results(tmp_path / "s.zarr")
+    assert list(ds["scan.compensation"].values) == ["none", "model"]
+    for speed in (0.05, 0.1):
+        cli = _scan_json(str(study_file.parent / "scan.toml"), "--length", "0.005",
+                         "--speed", str(speed), "--a-max", "2", "--j-max", "50",
+                         "--s-max", "1000", "--window", "0.02", "--compensation", "none",
+                         "model")
+        for run in cli["results"]:
+            at = ds.sel({"scan.speed": speed, "scan.compensation": run["compensation"]})
+            for name in ("ma_max", "msd_max", "peak_error", "settling_time_s"):
+                got = float(at[name].values.item())
+                want = run[name]
+                assert (np.isnan(got) if want is None else got == want), (speed, name)
+    # the model feedforward (4 % off) cuts the moving average 25-fold here
+    none = ds["ma_max"].sel({"scan.compensation": "none"}).values
+    model = ds["ma_max"].sel({"scan.compensation": "model"}).values
+    assert np.all(model < none / 10)
+    # the sine's outputs beside the scan's: one loop per point serves both
+    assert np.all(ds["error_rms"].values > 0)
+
+
+def test_table_and_summary_name_the_compensation(study_file, tmp_path):
+    study_file.write_text(STUDY.replace('"scan.speed" = [0.05, 0.1]', '"scan.speed" = [0.05]')
+                          .replace('outputs = ["scan", "error_rms"]', 'outputs = ["scan"]'))
+    run_study(Study.from_file(study_file), tmp_path / "s.zarr", workers=0)
+    ds = open_results(tmp_path / "s.zarr")
+    lines = to_table(ds).splitlines()
+    assert lines[0].startswith("scan.speed,scan.compensation,frequency_hz,amplitude,ma_max,")
+    assert [ln.split(",")[1] for ln in lines[1:]] == ["none", "model"]
+    s = summarize(ds)
+    assert s.worst["ma_max"]["at"]["scan.compensation"] == "none"
+    assert "scan.compensation = none" in str(s)
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (("length = 0.005\n", ""), r"\[scan\] 'length': missing"),
+    (('outputs = ["scan", "error_rms"]', 'outputs = ["error_rms"]'),
+     "add it to 'outputs'"),
+    (('"scan.speed" = [0.05, 0.1]', '"scan.rate" = [1e3]'), "'scan.rate': not a scan axis"),
+    (('["none", "model"]', '["none", "learned"]'), "distinct compensations among"),
+    (('"scan.speed" = [0.05, 0.1]', '"scan.speed" = [-0.05]'),
+     r"'scan.speed': give a number > 0"),
+    (("window = 0.02", "window = 0.02\nwindows = 3"), r"\[scan\] 'windows': unknown setting"),
+    (("window = 0.02", 'window = 0.02\nspeed = 0.1'),
+     "also the axis \"scan.speed\""),
+])
+def test_bad_scan_settings_are_one_line_naming_the_key(study_file, change, message):
+    study_file.write_text(STUDY.replace(*change))
+    with pytest.raises(StudyError, match=message):
+        Study.from_file(study_file)
+
+
+def test_the_example_scan_study_reads():
+    st = Study.from_file(EXAMPLES / "scan_study.toml")
+    assert st.outputs == ["scan"] and st.n_points == 24
+    assert st.scan_at(st.point(0))["speed"] == pytest.approx(0.02)
+    assert st.scan_at(st.point(0))["compensation"] == "none"
