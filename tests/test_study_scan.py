@@ -112,3 +112,29 @@ def test_the_example_scan_study_reads():
     assert st.outputs == ["scan"] and st.n_points == 24
     assert st.scan_at(st.point(0))["speed"] == pytest.approx(0.02)
     assert st.scan_at(st.point(0))["compensation"] == "none"
+
+
+def test_summary_says_where_the_link_dominates(tmp_path):
+    """|E - 1| > 1: the error the link adds exceeds the linear loop's. For Table I at 10 mm
+    the link dominates up to 7 Hz of these frequencies and not from 10 Hz on (the paper's
+    low-frequency crossover, eq. 21: 7.6 Hz); the summary counts the points and gives the
+    highest frequency per amplitude."""
+    import tomllib
+
+    from motionhyst.scenario import default_scenario_path
+
+    base = tomllib.loads(default_scenario_path().read_text())
+    st = Study.from_dict({"outputs": ["mismatch"],
+                          "axes": {"amplitude": [0.01, 0.001],
+                                   "frequency_hz": [2.0, 5.0, 7.0, 10.0, 15.0, 30.0]}},
+                         scenario=base)
+    run_study(st, tmp_path / "s.zarr", workers=0)
+    ds = open_results(tmp_path / "s.zarr")
+    d = summarize(ds).dominates["mismatch"]
+    over = np.abs(ds["mismatch"].values - 1) > 1
+    assert d["points"] == int(over.sum()) and d["of"] == 12 and d["never"] == 0
+    per_amplitude = sorted(ds["frequency_hz"].values[row].max() for row in over)
+    assert ds["frequency_hz"].values[over[0]].max() == 7.0  # 10 mm
+    assert [d["crossover_hz"]["min"], d["crossover_hz"]["max"]] == per_amplitude
+    assert d["top"] == 30.0
+    assert "the link dominates (|mismatch - 1| > 1" in str(summarize(ds))

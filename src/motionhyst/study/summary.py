@@ -1,5 +1,6 @@
-"""The closing summary of a study: worst case per axis and, with Monte-Carlo samples, the band
-of each output's worst case over the samples (the spread of a fleet of machines)."""
+"""The closing summary of a study: worst case per axis, where the link dominates the tracking
+error (``|E - 1| > 1``) and, with Monte-Carlo samples, the band of each output's worst case
+over the samples (the spread of a fleet of machines)."""
 
 from __future__ import annotations
 
@@ -12,10 +13,16 @@ import numpy as np
 from motionhyst.core.textfmt import g, table
 from motionhyst.study.store import FAILED, OK, REASONS, field_names
 
-__all__ = ["BAND", "StudySummary", "failure_reasons", "plot_band", "summarize"]
+__all__ = ["BAND", "DOMINANCE_FIELDS", "StudySummary", "failure_reasons", "plot_band",
+           "summarize"]
 
 BAND = (5.0, 50.0, 95.0)
 """Percentiles of the Monte-Carlo band [%]."""
+
+DOMINANCE_FIELDS = ("mismatch", "E")
+"""Fields that are a mismatch ``E = e1 / e1_linear`` (exact, and eq. 18's): the error the link
+adds to the first harmonic is ``(E - 1) e1_linear``; where ``|E - 1| > 1`` it exceeds the linear
+loop's error (the link dominates; compare the crossover frequency of eq. 21)."""
 
 
 @dataclass
@@ -42,6 +49,13 @@ class StudySummary:
     failures : dict
         Reason (:data:`~motionhyst.study.store.REASONS`) to ``{"points": .., "example": ..}``:
         how many points failed for it and the message of the first.
+    dominates : dict
+        Field of :data:`DOMINANCE_FIELDS` to ``{"points": .., "of": .., "crossover_hz": ..}``:
+        the computed points where ``|E - 1| > 1`` (the link dominates: the error it adds
+        exceeds the linear loop's) of all computed, and, over ``frequency_hz``, the highest
+        frequency where it does for each value of the other axes (and samples): ``{"min",
+        "median", "max"}`` of those, ``"never"`` how many have none, ``"top"`` the axis'
+        highest frequency.
 
     Examples
     --------
@@ -61,12 +75,13 @@ class StudySummary:
     band: dict = field(default_factory=dict)
     widest: dict = field(default_factory=dict)
     failures: dict = field(default_factory=dict)
+    dominates: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``study --summary --json`` schema)."""
         return {"points": self.points, "computed": self.computed, "failed": self.failed,
                 "worst": self.worst, "per_axis": self.per_axis, "band": self.band,
-                "widest": self.widest, "failures": self.failures}
+                "widest": self.widest, "failures": self.failures, "dominates": self.dominates}
 
     def __str__(self) -> str:
         lines = [f"{self.points} points: {self.computed} computed, {self.failed} failed, "
@@ -92,6 +107,8 @@ class StudySummary:
                 at = ", ".join(f"{k} = {_text(v)}" for k, v in w.pop("at").items())
                 lines.append(f"  Monte Carlo, widest band at {at}: " + ", ".join(
                     f"{k} % {g(v)}" for k, v in w.items()))
+            if name in self.dominates:
+                lines.append("  " + _dominance_text(name, self.dominates[name]))
         return "\n".join(lines)
 
     def plot(self, ax=None):
@@ -212,6 +229,45 @@ def failure_reasons(ds) -> dict:
             for code, count in zip(codes.tolist(), counts.tolist(), strict=True)}
 
 
+def _dominance_text(name: str, d: dict) -> str:
+    text = (f"the link dominates (|{name} - 1| > 1: it adds more error than the linear loop "
+            f"has) at "
+            f"{d['points']} of {d['of']} points")
+    c = d.get("crossover_hz")
+    if not c:
+        return text
+    top = " (the highest frequency studied)" if c["max"] >= d["top"] else ""
+    spread = (f"{g(c['median'])} Hz" if c["min"] == c["max"] else
+              f"{g(c['median'])} Hz (median; {g(c['min'])} to {g(c['max'])}{top} over the other "
+              f"axes)")
+    never = f"; never for {d['never']} of them" if d["never"] else ""
+    return f"{text}; up to {spread}{never}"
+
+
+def _dominance(ds, name: str, ok: np.ndarray) -> dict:
+    """:attr:`StudySummary.dominates` of the field `name`."""
+    mag = np.where(ok, np.abs(ds[name].values - 1.0), np.nan)
+    over = np.nan_to_num(mag, nan=0.0) > 1.0
+    out: dict = {"points": int(np.count_nonzero(over)), "of": int(np.count_nonzero(ok))}
+    dims = list(ds[name].dims)
+    if "frequency_hz" not in dims:
+        return out
+    k = dims.index("frequency_hz")
+    f = ds["frequency_hz"].values.astype(float)
+    order = np.argsort(f)
+    over = np.moveaxis(over, k, -1)[..., order].reshape(-1, f.size)
+    seen = np.moveaxis(np.isfinite(mag), k, -1).reshape(-1, f.size).any(axis=1)
+    any_over = over.any(axis=1)
+    last = f.size - 1 - np.argmax(over[:, ::-1], axis=1)
+    cross = f[order][last][any_over & seen]
+    out["never"] = int(np.count_nonzero(seen & ~any_over))
+    out["top"] = float(f.max())
+    if cross.size:
+        out["crossover_hz"] = {"min": float(cross.min()), "median": float(np.median(cross)),
+                               "max": float(cross.max())}
+    return out
+
+
 def _coordinate(v) -> float | str:
     """An axis value: a number, or a name (``scan.compensation``)."""
     return str(v) if isinstance(v, str | np.str_) else float(v)
@@ -250,6 +306,9 @@ def summarize(ds) -> StudySummary:
     out = StudySummary(points=int(status.size), computed=int(np.count_nonzero(ok)),
                        failed=int(np.count_nonzero(status == FAILED)))
     out.failures = failure_reasons(ds)
+    for name in DOMINANCE_FIELDS:
+        if name in field_names(ds) and np.any(ok):
+            out.dominates[name] = _dominance(ds, name, ok)
     for name in field_names(ds):
         mag = np.where(ok, np.abs(ds[name].values), np.nan)
         if not np.any(np.isfinite(mag)):
