@@ -223,3 +223,18 @@ def test_scan_production_along_the_stroke_the_table_matters(production):
     for row in production["along_stroke"].values():
         assert row["table"]["model"]["ma"] > 3 * row["single"]["model"]["ma"]
         assert row["table"]["basis"]["ma"] > 10 * row["single"]["basis"]["ma"]
+
+
+def test_link_record_identifies_with_correlated_errors(tmp_path):
+    """examples/link_record.py: the generated record gives k and fc within three standard
+    errors of Table I's, about 3 % each, positively correlated (README, "Studies")."""
+    from motionhyst.identify import identify_maxwell_slip
+
+    path = load_example("link_record").main(tmp_path)
+    t, x, w = np.loadtxt(path, delimiter=",", skiprows=1).T
+    fit = identify_maxwell_slip(x, w, t=t, n_elements=1)
+    e = fit.elements[0]
+    assert abs(e["k"] - 20.0) < 3 * e["k_std"] and abs(e["fc"] - 0.05) < 3 * e["fc_std"]
+    assert 0.02 < e["k_std"] / e["k"] < 0.05 and 0.02 < e["fc_std"] / e["fc"] < 0.05
+    c = np.array(fit.covariance["matrix"])
+    assert 0.5 < c[0, 1] / np.sqrt(c[0, 0] * c[1, 1]) < 0.9

@@ -227,3 +227,11 @@ def test_cli_runs_a_study_from_a_saved_identification(saved, tmp_path, capsys):
     ds = open_results(out)
     assert ds["hysteresis.k"].dims == ds["hysteresis.fc"].dims == ("sample",)
     assert abs(np.median(ds["hysteresis.k"].values) - 20.0) < 0.1
+
+
+def test_the_example_study_draws_from_an_identification(saved):
+    folder, _ = saved
+    example = Path(__file__).resolve().parent.parent / "examples" / "study_identified.toml"
+    st = Study.from_file(example, from_identification=folder / "model.toml")
+    assert (st.n_samples, st.seed, st.n_points) == (100, 0, 3200)
+    assert st.sampled_keys == ("hysteresis.k", "hysteresis.fc")
