@@ -75,6 +75,11 @@ def is_scenario_key(key: str) -> bool:
     """Whether the axis or sampled `key` is a key of the scenario (not the reference's
     ``amplitude`` or ``frequency_hz``, nor a scan's setting ``scan.*``).
 
+    Parameters
+    ----------
+    key : str
+        An axis or a sampled key.
+
     Examples
     --------
     >>> is_scenario_key("hysteresis.k"), is_scenario_key("frequency_hz"), is_scenario_key(
