@@ -30,8 +30,14 @@ origin), the flow and its variations integrated together by a stiff solver
 Its eigenvalues are the Floquet multipliers: one is 1 (a shift along the orbit),
 the others say whether a deviation dies out (``|mu| < 1``: stable) or grows.
 Every predicted cycle is refined so; so are the cycles a simulation from kicked
-rest states runs into (the describing function can miss a cycle: friction that
-sticks moves far from a sinusoid).  Each exact cycle is confirmed by a simulation
+rest states runs into (the describing function of the link can miss a cycle:
+friction that sticks moves far from a sinusoid).
+
+For a controller with integral action a second describing function is taken with the
+loop cut at the integrator (:mod:`motionhyst.analysis.integral_cut`): there the signal
+of a hunting loop is nearly a sinusoid.  Its predictions are marked
+``method = "integral-cut"`` (those of the link ``"link"``); each is refined from a run
+that starts at rest at the bottom of the predicted cycle.  Each exact cycle is confirmed by a simulation
 that starts beside it along its least stable direction and measures the
 deviation one period later.
 
@@ -78,6 +84,10 @@ RTOL = 1e-10
 #: The orbit is closed when ``|x(T) - x(0)|`` is below this fraction of each state's scale.
 CLOSURE = 1e-8
 
+#: Length of the run from a kick to a cycle the cut at the integrator predicts, in its
+#: predicted periods (a stick-slip cycle attracts within a few).
+CUT_SETTLE_PERIODS = 8.0
+
 #: Length of the search's simulations, in periods of the slowest closed-loop pole.
 SEARCH_SLOW_PERIODS = 60.0
 
@@ -115,34 +125,59 @@ def link_loop_response(loop: Loop, omega: ArrayLike) -> NDArray[np.complex128]:
 # ------------------------------------------------------------------ results
 @dataclass
 class PredictedCycle:
-    """A limit cycle the describing function predicts: ``1 + G(j omega) N(A, omega) = 0``.
+    """A limit cycle a describing function predicts.
 
     Attributes
     ----------
     amplitude : float
-        Amplitude ``A`` of the link's displacement ``y1 = A sin(omega t)`` [m].
+        Amplitude of the link's displacement [m]: ``A`` of ``y1 = A sin(omega t)`` for
+        the link's describing function, the first harmonic of ``y1`` for the cut at the
+        integrator.
     frequency_hz : float
         Its frequency [Hz].
     stable : bool
         Loeb's criterion (module docstring).
     loeb : float
         ``(dU/dA dV/domega - dU/domega dV/dA) A omega``, dimensionless; > 0: stable.
+    method : str
+        ``"link"``: ``1 + G N = 0`` with ``N`` the link's describing function;
+        ``"integral-cut"``: ``1 + (ki / s) N = 0`` with ``N`` that of the stage with its
+        link and the rest of the controller, driven by the integral action's force
+        (:mod:`motionhyst.analysis.integral_cut`).
+    peak_to_peak : float or None
+        The predicted peak-to-peak of ``y1`` [m]; None: ``2 A`` (a sinusoid).
+    force_amplitude : float or None
+        Amplitude of the integral action's force [N] (``"integral-cut"`` only).
+    waveform : tuple of ndarray or None
+        ``(t, y1)``: one period of the predicted displacement of the link
+        (``"integral-cut"`` only; for ``"link"`` a sinusoid).
 
     Examples
     --------
-    >>> PredictedCycle(1e-3, 2.0, True, 0.5).to_dict()
-    {'amplitude': 0.001, 'frequency_hz': 2.0, 'stable': True}
+    >>> d = PredictedCycle(1e-3, 2.0, True, 0.5).to_dict()
+    >>> d["amplitude"], d["frequency_hz"], d["stable"], d["method"], d["peak_to_peak"]
+    (0.001, 2.0, True, 'link', 0.002)
     """
 
     amplitude: float
     frequency_hz: float
     stable: bool
     loeb: float
+    method: str = "link"
+    peak_to_peak: float | None = None
+    force_amplitude: float | None = None
+    waveform: tuple[NDArray[np.float64], NDArray[np.float64]] | None = field(default=None,
+                                                                              repr=False)
+
+    def __post_init__(self) -> None:
+        if self.peak_to_peak is None:
+            self.peak_to_peak = 2.0 * self.amplitude
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (one entry of ``predicted`` in ``stability --json``)."""
         return {"amplitude": float(self.amplitude), "frequency_hz": float(self.frequency_hz),
-                "stable": bool(self.stable)}
+                "stable": bool(self.stable), "method": self.method,
+                "peak_to_peak": float(self.peak_to_peak)}
 
 
 @dataclass
@@ -255,13 +290,16 @@ class StabilityResult:
         name = "no" if self.link is None else f"the {self.link.name}"
         lines = [f"Limit cycles of the loop with {name} link (y1 = -G w, G = P1 / (1 + C P2))"]
         if self.predicted:
-            rows = [[g(p.amplitude), g(p.frequency_hz), "stable" if p.stable else "unstable",
-                     g(p.loeb)] for p in self.predicted]
-            lines += ["Predicted by the describing function (1 + G N = 0):",
-                      table(["A [m]", "f [Hz]", "DF criterion", "Loeb [-]"], rows)]
+            rows = [[p.method, g(p.amplitude), g(p.peak_to_peak), g(p.frequency_hz),
+                     g(1.0 / p.frequency_hz), "stable" if p.stable else "unstable", g(p.loeb)]
+                    for p in self.predicted]
+            lines += ["Predicted by describing functions (link: 1 + G N = 0; integral-cut: "
+                      "1 + (ki/s) N = 0):",
+                      table(["method", "A [m]", "y1 p-p [m]", "f [Hz]", "T [s]",
+                             "DF criterion", "Loeb [-]"], rows)]
         else:
-            lines.append("Predicted by the describing function: none (the Nyquist curve of G "
-                         "does not meet -1/N)")
+            lines.append("Predicted by describing functions: none (the Nyquist curve of G "
+                         "does not meet -1/N, nor the cut at the integrator balances)")
         if self.exact:
             rows = [[g(c.period_s), g(c.peak_to_peak), g(c.floquet_max),
                      "stable" if c.stable else "unstable", g(c.simulated_ratio),
@@ -273,8 +311,8 @@ class StabilityResult:
                 if c.predicted is not None:
                     p = c.predicted
                     lines.append(
-                        f"  DF error: amplitude {_rel(p.amplitude, c.peak_to_peak / 2)}, "
-                        f"frequency {_rel(p.frequency_hz, 1.0 / c.period_s)} "
+                        f"  DF error ({p.method}): period {_rel(1.0 / p.frequency_hz, c.period_s)}"
+                        f", peak-to-peak {_rel(p.peak_to_peak, c.peak_to_peak)} "
                         f"(T = {g(c.period_s)} s)")
         else:
             lines.append("Exact periodic orbits: none found")
@@ -283,12 +321,13 @@ class StabilityResult:
 
     def plot(self, ax=None):
         """The Nyquist curve of ``G`` with the loci ``-1/N(A, omega)`` and the predicted
-        cycles (:func:`motionhyst.analysis.figures.plot_stability`).
+        cycles; below it, when there are cycles with a waveform, one period of the link's
+        displacement of each (:func:`motionhyst.analysis.figures.plot_stability`).
 
         Parameters
         ----------
-        ax : matplotlib.axes.Axes, optional
-            Axes to draw into; default: a new figure.
+        ax : matplotlib.axes.Axes or sequence of two Axes, optional
+            Axes to draw into (one: the Nyquist curve only); default: a new figure.
 
         Returns
         -------
@@ -647,9 +686,40 @@ def _search(sys: _Autonomous, loop: Loop, A: NDArray):
     return out
 
 
+def _cut_predictions(loop: Loop, notes: list[str]) -> list[PredictedCycle]:
+    """The cycles of the describing function with the loop cut at its integrator."""
+    from motionhyst.analysis.integral_cut import IntegralCut
+
+    try:
+        cut = IntegralCut(loop)
+    except ValueError as exc:
+        notes.append(f"the cut at the integrator does not apply: {exc}")
+        return []
+    return [PredictedCycle(c.response.amplitude, c.response.frequency_hz, c.stable, c.loeb,
+                           "integral-cut", c.response.peak_to_peak, c.response.force_amplitude,
+                           (c.response.t, c.response.y1))
+            for c in cut.cycles()]
+
+
+def _guess_from_cut(sys: _Autonomous, p: PredictedCycle):
+    """A state on the cycle the cut predicts: the loop at rest with the link's displacement
+    at the bottom of the predicted cycle, the link unloaded, run until it settles."""
+    obs = np.array([sys.C @ np.linalg.matrix_power(sys.A, k) for k in range(sys.n)])
+    X0 = np.zeros(sys.N)
+    X0[:sys.n] = np.linalg.solve(obs, np.eye(sys.n)[0] * (-0.5 * p.peak_to_peak))
+    scale = np.empty(sys.N)
+    scale[:sys.n] = np.abs(X0[:sys.n]) + 1e-3 * np.max(np.abs(X0[:sys.n]))
+    scale[sys.n:] = p.amplitude * 1e-3
+    sim = sys.run(X0, CUT_SETTLE_PERIODS / p.frequency_hz, scale, rtol=1e-8, method="LSODA")
+    te, ye = sim.t_events[0], sim.y_events[0]
+    if te.size < 3:
+        raise RuntimeError("a run from rest at its amplitude does not oscillate")
+    return ye[-1].copy(), float(te[-1] - te[-2])
+
+
 def stability(loop: Loop, amplitudes: ArrayLike | None = None,
               frequencies_hz: ArrayLike | None = None, exact: bool = True,
-              search: bool = True) -> StabilityResult:
+              search: bool = True, integral_cut: bool = True) -> StabilityResult:
     """Limit cycles of the loop with its link: predicted, refined to exact orbits, confirmed.
 
     Parameters
@@ -668,6 +738,10 @@ def stability(loop: Loop, amplitudes: ArrayLike | None = None,
         (continuous loops with a link that has a smooth state equation).
     search : bool
         Also simulate from kicked rest states and refine the cycles they settle on.
+    integral_cut : bool
+        Also predict by the describing function with the loop cut at the controller's
+        integrator (:mod:`motionhyst.analysis.integral_cut`; a continuous controller with
+        integral action and a link with a smooth state equation).
 
     Returns
     -------
@@ -701,6 +775,9 @@ def stability(loop: Loop, amplitudes: ArrayLike | None = None,
     fine = np.geomspace(omega[0], omega[-1], NYQUIST_POINTS)
     res = StabilityResult(link, fine, link_loop_response(loop, fine), omega, A, loci)
     res.predicted = _predict(lambda w: link_loop_response(loop, w), link, A, omega, N, G)
+    if integral_cut:
+        res.predicted = sorted(res.predicted + _cut_predictions(loop, res.notes),
+                               key=lambda c: c.amplitude)
     if not exact:
         return res
     if loop.sampled is not None:
@@ -718,7 +795,15 @@ def stability(loop: Loop, amplitudes: ArrayLike | None = None,
         return res
     candidates = []
     for p in res.predicted:
-        X0, T = _guess_from_prediction(sys, p)
+        if p.method == "link":
+            X0, T = _guess_from_prediction(sys, p)
+        else:
+            try:
+                X0, T = _guess_from_cut(sys, p)
+            except RuntimeError as exc:
+                res.notes.append(f"the cycle the cut predicts at {g(p.frequency_hz)} Hz was "
+                                 f"not refined: {exc}")
+                continue
         candidates.append((X0, T, "prediction", p))
     if search:
         candidates += [(X0, T, "simulation", None) for X0, T in _search(sys, loop, A)]
