@@ -91,6 +91,6 @@ GENERATED = HERE / "_generated"
 apigen.write_api(HERE / "api")
 apigen.write_cli(HERE / "cli")
 apigen.run_reproduce(GENERATED / "reproduce")
-apigen.run_cli(GENERATED / "stability", ["stability", "examples/hunting.toml", "--no-exact",
+apigen.run_cli(GENERATED / "stability", ["stability", "examples/hunting.toml",
                                           "--figure", "OUT/hunting.png"])
 apigen.write_examples(HERE.parent / "examples", HERE / "examples")

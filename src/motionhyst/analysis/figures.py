@@ -250,14 +250,17 @@ def plot_stability(result, ax=None) -> Figure:
     """``G(j omega)`` and ``-1/N(A, omega)`` in the complex plane, the predicted cycles marked.
 
     The view is that of the Nyquist curve (1.3 times its largest value); loci outside
-    it are left out of view, and the title says how far the nearest one is.
+    it are left out of view, and the title says how far the nearest one is.  When the
+    result has exact cycles or a cycle predicted with its waveform (the cut at the
+    integrator), a second panel shows one period of the link's displacement of each,
+    from its upward crossing of 0.
 
     Parameters
     ----------
     result : StabilityResult
         What :func:`~motionhyst.analysis.stability.stability` returned.
-    ax : matplotlib.axes.Axes, optional
-        Axes to draw into; default: a new figure.
+    ax : matplotlib.axes.Axes or sequence of two Axes, optional
+        Axes to draw into (one Axes: the Nyquist curve only); default: a new figure.
 
     Returns
     -------
@@ -272,7 +275,9 @@ def plot_stability(result, ax=None) -> Figure:
     >>> fig.motionhyst_data["G"].shape == fig.motionhyst_data["omega"].shape
     True
     """
-    fig, axes = new_figure(1, ax=ax)
+    waves = [p for p in result.predicted if p.waveform is not None]
+    two = bool(result.exact or waves) and (ax is None or hasattr(ax, "__len__"))
+    fig, axes = new_figure(2 if two else 1, sharex=False, ax=ax)
     a = axes[0]
     G, loci, A = result.nyquist, result.loci, result.amplitudes
     rate_independent = result.link is not None and result.link.rate_independent
@@ -293,6 +298,8 @@ def plot_stability(result, ax=None) -> Figure:
     a.set_ylim(-reach, reach)
     a.set_aspect("equal", adjustable="box")
     for p in result.predicted:
+        if p.method != "link":          # the cut's balance is not on this curve
+            continue
         w = 2 * np.pi * p.frequency_hz
         z = G[int(np.argmin(np.abs(result.omega - w)))]
         a.plot(z.real, z.imag, "x" if not p.stable else "o", ms=7, mfc="none",
@@ -305,11 +312,42 @@ def plot_stability(result, ax=None) -> Figure:
                fontsize=8)
     a.set_xlabel("Re [m/N]")
     a.set_ylabel("Im [m/N]")
-    a.legend(loc="best")
+    a.legend(loc="best", fontsize=8)
     fig.motionhyst_data.update(omega=result.omega, G=G, A=A, loci=loci,
                                locus_omega=result.locus_omega,
                                predicted=[p.to_dict() for p in result.predicted])
+    if two:
+        _plot_waveforms(axes[1], result, waves)
     return fig
+
+
+def _from_upward_crossing(t, y):
+    """One period of ``y`` rolled to start at its upward crossing of 0."""
+    t, y = np.asarray(t)[:-1], np.asarray(y)[:-1]
+    up = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    k = int(up[0]) + 1 if up.size else 0
+    y = np.roll(y, -k)
+    return np.append(t - t[0], t[-1] - t[0] + (t[1] - t[0])), np.append(y, y[0])
+
+
+def _plot_waveforms(a, result, waves) -> None:
+    """One period of the link's displacement of each exact and each predicted cycle."""
+    data = {}
+    for i, c in enumerate(result.exact):
+        a.plot(c.t, c.y1, color="k", lw=1.5, label=f"exact: T = {c.period_s:.4g} s, "
+               f"{c.peak_to_peak:.4g} m p-p")
+        data[f"exact_{i}"] = (c.t, c.y1)
+    for i, p in enumerate(waves):
+        t, y = _from_upward_crossing(*p.waveform)
+        a.plot(t, y, "--", color="tab:red", label=f"{p.method} DF: T = {1 / p.frequency_hz:.4g}"
+               f" s, {p.peak_to_peak:.4g} m p-p")
+        data[f"predicted_{i}"] = (t, y)
+    a.set_xlabel("time from the upward crossing of y1 = 0 [s]")
+    a.set_ylabel("y1 [m]")
+    a.set_title("One period of the link's displacement")
+    a.legend(loc="best", fontsize=8)
+    result_data = a.figure.motionhyst_data
+    result_data["waveforms"] = data
 
 
 def plot_multipliers(result, ax=None) -> Figure:
