@@ -37,9 +37,9 @@ For a controller with integral action a second describing function is taken with
 loop cut at the integrator (:mod:`motionhyst.analysis.integral_cut`): there the signal
 of a hunting loop is nearly a sinusoid.  Its predictions are marked
 ``method = "integral-cut"`` (those of the link ``"link"``); each is refined from a run
-that starts at rest at the bottom of the predicted cycle.  Each exact cycle is confirmed by a simulation
-that starts beside it along its least stable direction and measures the
-deviation one period later.
+that starts at rest at the bottom of the predicted cycle.  Each exact cycle is confirmed
+by a simulation that starts beside it along its least stable direction and measures
+the deviation one period later.
 
 Examples
 --------
