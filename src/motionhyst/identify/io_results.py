@@ -72,7 +72,7 @@ class IOIdentification:
     >>> from motionhyst.hysteresis import Jenkins
     >>> from motionhyst.identify.input_output import identify_io
     >>> from motionhyst.identify.io_records import IORecord
-    >>> from motionhyst.openloop import MassSpringDamper, OpenLoop
+    >>> from motionhyst.time.openloop import MassSpringDamper, OpenLoop
     >>> true = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), Jenkins(k=5e4, fc=20.0))
     >>> t = np.arange(1024) / 750
     >>> u = 40 * np.sin(2 * np.pi * 8 * t) + 20 * np.sin(2 * np.pi * 31 * t)
