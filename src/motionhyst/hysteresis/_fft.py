@@ -27,64 +27,84 @@ def twiddle_table(n: int) -> np.ndarray:
     return table
 
 
+@njit(cache=True, inline="always")
+def _powers(tw, m):  # pragma: no cover - compiled
+    """``w^m``, ``w^2m``, ``w^3m`` of the table's ``w = exp(-2 pi j / (2 len(tw)))``."""
+    top = tw.shape[0]
+    m3 = 3 * m
+    return tw[m], tw[2 * m], tw[m3] if m3 < top else -tw[m3 - top]
+
+
+@njit(cache=True, inline="always")
+def _butterfly(a0, a1, a2, a3):  # pragma: no cover - compiled
+    """The four-point DFT of ``(a0, a2, a1, a3)`` (two radix-2 stages without twiddles):
+    ``s02 + s13``, ``s02 - s13``, ``d02 - j d13``, ``d02 + j d13``."""
+    s02 = a0 + a2
+    d02 = a0 - a2
+    s13 = a1 + a3
+    d13 = a1 - a3
+    jd13 = complex(-d13.imag, d13.real)
+    return s02 + s13, s02 - s13, d02 - jd13, d02 + jd13
+
+
 @njit(cache=True)
 def _fft_scrambling(a, tw):  # pragma: no cover - compiled
     """In-place forward DFT of `a` (length a power of two, at most ``2 len(tw)``), input in
-    natural order, output in bit-reversed order (decimation in frequency)."""
+    natural order, output in bit-reversed order (decimation in frequency, two radix-2
+    stages at a time: three twiddle products for four points)."""
     n = a.shape[0]
     full = 2 * tw.shape[0]
     half = n // 2
     while half >= 2:
-        size = 2 * half
-        stride = full // size
-        for k in range(half):
-            w = tw[k * stride]
-            wr = w.real
-            wi = w.imag
-            for p in range(k, n, size):
-                q = p + half
-                u = a[p]
-                v = a[q]
-                a[p] = u + v
-                dr = u.real - v.real
-                di = u.imag - v.imag
-                a[q] = complex(wr * dr - wi * di, wr * di + wi * dr)
-        half //= 2
-    for p in range(0, n - 1, 2):
-        u = a[p]
-        v = a[p + 1]
-        a[p] = u + v
-        a[p + 1] = u - v
+        q = half // 2
+        stride = full // (4 * q)
+        for k in range(q):
+            w1, w2, w3 = _powers(tw, k * stride)
+            for p in range(k, n, 4 * q):
+                y0, y1, y2, y3 = _butterfly(a[p], a[p + q], a[p + 2 * q], a[p + 3 * q])
+                a[p] = y0
+                a[p + q] = y1 * w2
+                a[p + 2 * q] = y2 * w1
+                a[p + 3 * q] = y3 * w3
+        half //= 4
+    if half == 1:
+        for p in range(0, n - 1, 2):
+            u = a[p]
+            v = a[p + 1]
+            a[p] = u + v
+            a[p + 1] = u - v
 
 
 @njit(cache=True)
 def fft_unscrambling(a, tw):  # pragma: no cover - compiled
     """In-place forward DFT of `a`, input in bit-reversed order, output in natural order
-    (decimation in time)."""
+    (decimation in time, two radix-2 stages at a time)."""
     n = a.shape[0]
-    for p in range(0, n - 1, 2):
-        u = a[p]
-        t = a[p + 1]
-        a[p] = u + t
-        a[p + 1] = u - t
     full = 2 * tw.shape[0]
-    half = 2
+    stages = 0
+    while (1 << stages) < n:
+        stages += 1
+    half = 1
+    if stages % 2 == 1:
+        for p in range(0, n - 1, 2):
+            u = a[p]
+            t = a[p + 1]
+            a[p] = u + t
+            a[p + 1] = u - t
+        half = 2
     while half < n:
-        size = 2 * half
-        stride = full // size
-        for k in range(half):
-            w = tw[k * stride]
-            wr = w.real
-            wi = w.imag
-            for p in range(k, n, size):
-                q = p + half
-                b = a[q]
-                tr = wr * b.real - wi * b.imag
-                ti = wr * b.imag + wi * b.real
-                u = a[p]
-                a[p] = complex(u.real + tr, u.imag + ti)
-                a[q] = complex(u.real - tr, u.imag - ti)
-        half = size
+        q = half
+        stride = full // (4 * q)
+        for k in range(q):
+            w1, w2, w3 = _powers(tw, k * stride)
+            for p in range(k, n, 4 * q):
+                y0, y1, y2, y3 = _butterfly(a[p], a[p + 2 * q] * w1, a[p + q] * w2,
+                                            a[p + 3 * q] * w3)
+                a[p] = y0
+                a[p + q] = y2
+                a[p + 2 * q] = y1
+                a[p + 3 * q] = y3
+        half *= 4
 
 
 @njit(cache=True)
