@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 import threading
-import weakref
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -381,36 +381,35 @@ class _Transfers(NamedTuple):
     w_e: NDArray[np.complex128]
 
 
-#: Bytes of transfers kept per loop: the frequencies of a study's points, whatever their order.
-_TRANSFER_BYTES = 32 * 2**20
-_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+#: Bytes of transfers kept: the frequencies of a study's points, whatever their order.
+_TRANSFER_BYTES = 64 * 2**20
+_TRANSFERS: OrderedDict = OrderedDict()   # (Loop.transfer_key(), f, H) -> _Transfers
+_F_LIM: OrderedDict = OrderedDict()       # Loop.transfer_key() -> fastest pole's f [Hz]
 _CACHE_LOCK = threading.Lock()
-
-
-def _loop_cache(loop: Loop) -> dict:
-    with _CACHE_LOCK:
-        c = _CACHE.get(loop)
-        if c is None:
-            c = _CACHE[loop] = {"bytes": 0, "transfers": {}, "f_lim": None}
-        return c
+_CACHED = {"bytes": 0}
 
 
 def _default_harmonics(loop: Loop, frequency_hz: float) -> int:
-    """:func:`default_harmonics` with the loop's limiting frequency computed once a loop."""
-    if not loop.is_lti:
+    """:func:`default_harmonics` with the loop's limiting frequency computed once for all the
+    loops with the same transfers (:meth:`~motionhyst.controllers.loop.Loop.transfer_key`)."""
+    key = loop.transfer_key()
+    if key is None:
         return default_harmonics(loop, frequency_hz)
-    c = _loop_cache(loop)
-    if c["f_lim"] is None:
-        c["f_lim"] = float(2.0 * np.max(np.abs(loop.closed_loop_poles())) / TWO_PI)
-    return min(max(math.ceil(c["f_lim"] / frequency_hz), MIN_HARMONICS), MAX_HARMONICS)
+    f_lim = _F_LIM.get(key)
+    if f_lim is None:
+        f_lim = float(2.0 * np.max(np.abs(loop.closed_loop_poles())) / TWO_PI)
+        with _CACHE_LOCK:
+            _F_LIM[key] = f_lim
+            if len(_F_LIM) > 4096:
+                _F_LIM.popitem(last=False)
+    return min(max(math.ceil(f_lim / frequency_hz), MIN_HARMONICS), MAX_HARMONICS)
 
 
 def _transfers(loop: Loop, frequency_hz: float, H: int) -> _Transfers:
     """The transfers of the continuous loop at `frequency_hz` and its harmonics up to `H`,
-    computed once for all the points (amplitudes) of one frequency."""
-    c = _loop_cache(loop)
-    key = (frequency_hz, H)
-    T = c["transfers"].get(key)
+    computed once for all the points (amplitudes, links) of one frequency and loop."""
+    key = loop.transfer_key()
+    T = None if key is None else _TRANSFERS.get((key, frequency_hz, H))
     if T is None:
         wn = TWO_PI * frequency_hz * np.arange(H + 1)
         T = _Transfers(complex(loop.transfer("r->e", wn[1:2])[0]),
@@ -418,13 +417,13 @@ def _transfers(loop: Loop, frequency_hz: float, H: int) -> _Transfers:
                        loop.transfer("w->y1", wn), loop.transfer("w->e", wn))
         T.w_y1.flags.writeable = False
         T.w_e.flags.writeable = False
-        with _CACHE_LOCK:
-            table = c["transfers"]
-            c["bytes"] += T.w_y1.nbytes + T.w_e.nbytes
-            table[key] = T
-            while c["bytes"] > _TRANSFER_BYTES and len(table) > 1:  # the oldest go first
-                old = table.pop(next(iter(table)))
-                c["bytes"] -= old.w_y1.nbytes + old.w_e.nbytes
+        if key is not None:
+            with _CACHE_LOCK:
+                _TRANSFERS[(key, frequency_hz, H)] = T
+                _CACHED["bytes"] += T.w_y1.nbytes + T.w_e.nbytes
+                while _CACHED["bytes"] > _TRANSFER_BYTES and len(_TRANSFERS) > 1:
+                    old = _TRANSFERS.popitem(last=False)[1]  # the oldest go first
+                    _CACHED["bytes"] -= old.w_y1.nbytes + old.w_e.nbytes
     return T
 
 

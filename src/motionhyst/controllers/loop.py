@@ -255,6 +255,28 @@ class Loop:
             self._poles = np.roots(self._poly["w->e"].den)
         return self._poles.copy()
 
+    def transfer_key(self) -> tuple | None:
+        """A key equal for continuous LTI loops whose closed-loop transfers are the same (the
+        coefficients of their polynomials), None for another loop.
+
+        Loops that differ only in their link (a study's samples of ``hysteresis.k``) share
+        it, and with it what :func:`~motionhyst.analysis.steady.periodic_steady_state`
+        computes once a frequency.
+
+        Examples
+        --------
+        >>> from motionhyst import Dahl, Loop, default_scenario
+        >>> loop = default_scenario().loop()
+        >>> other = Loop(loop.plant, loop.controller, Dahl(k=20.0, fc=0.05), loop.feedforward)
+        >>> other.transfer_key() == loop.transfer_key()
+        True
+        """
+        key = self.__dict__.get("_transfer_key")
+        if key is None and self._poly is not None:
+            key = self._transfer_key = tuple((name, tf.num.tobytes(), tf.den.tobytes())
+                                             for name, tf in sorted(self._poly.items()))
+        return key
+
     def check_stable(self) -> None:
         """Raise ``ValueError`` unless the linear loop is stable.
 
