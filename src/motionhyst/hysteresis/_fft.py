@@ -108,6 +108,21 @@ def fft_unscrambling(a, tw):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def bit_reversed_indices(n):  # pragma: no cover - compiled
+    """``0 .. n - 1`` (`n` a power of two) in bit-reversed order."""
+    out = np.empty(n, dtype=np.int64)
+    j = 0
+    for i in range(n):
+        out[i] = j
+        bit = n >> 1
+        while j & bit:
+            j ^= bit
+            bit >>= 1
+        j |= bit
+    return out
+
+
+@njit(cache=True)
 def bit_reverse(a):  # pragma: no cover - compiled
     """Permute `a` (length a power of two) into bit-reversed order, in place."""
     n = a.shape[0]
