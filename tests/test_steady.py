@@ -15,6 +15,7 @@ from motionhyst.analysis.steady import (
     periodic_steady_state,
     steady_state_sweep,
 )
+from motionhyst.controllers.leadlag import LeadLagLowpass
 from motionhyst.controllers.loop import Loop
 from motionhyst.hysteresis.jenkins import Jenkins
 from motionhyst.scenario import default_scenario
@@ -266,3 +267,18 @@ def test_invalid_frequency_raises(loop, bad):
 def test_invalid_n_harmonics_raises(loop):
     with pytest.raises(ValueError, match="n_harmonics"):
         periodic_steady_state(loop, A_REF, 10.0, n_harmonics=0)
+
+
+def test_loops_with_one_linear_part_share_transfers_and_keep_their_links(loop):
+    """The transfers a frequency needs are kept by the loop's linear part: another loop with
+    the same plant and controller and another link reuses them and gets its own numbers."""
+    other = Loop(loop.plant, loop.controller, Jenkins(k=10.0, fc=0.08), loop.feedforward)
+    assert other.transfer_key() == loop.transfer_key()
+    first = periodic_steady_state(other, A_REF, 7.0)
+    mine = periodic_steady_state(loop, A_REF, 7.0)
+    again = periodic_steady_state(other, A_REF, 7.0)
+    assert np.array_equal(again.e, first.e) and np.array_equal(again.w, first.w)
+    assert abs(mine.mismatch - first.mismatch) > 0.1 * abs(mine.mismatch)
+    assert Loop(loop.plant, loop.controller, None).transfer_key() == loop.transfer_key()
+    softer = Loop(loop.plant, LeadLagLowpass(3.1e6, 60.0, 240.0, 700.0, 0.6), loop.hysteresis)
+    assert softer.transfer_key() != loop.transfer_key()
