@@ -21,7 +21,7 @@ criterion: writing ``F = 1 + G N = U + j V``, the cycle is stable when
 
 The prediction is then checked exactly.  For a continuous loop and a link with a
 smooth state equation (:meth:`~motionhyst.hysteresis.Hysteresis.state_equation`,
-LuGre) the autonomous loop ``x' = A x - B w``, ``z' = f(z, v1)``,
+LuGre, Dahl, Bouc-Wen) the autonomous loop ``x' = A x - B w``, ``z' = f(z, v1)``,
 ``w = h(z, v1)`` (``y1 = C x``, ``v1 = C A x``: the link acts through the
 plant's inertia) is solved for its periodic orbit by shooting with the period
 unknown and the phase condition ``y1(0) = 0`` (an upward crossing fixes the time
@@ -534,9 +534,20 @@ class _Autonomous(LoopStateEquation):
             return float(self.C @ X[:self.n])
 
         crossing.direction = 1.0
-        return solve_ivp(self.rhs, (0.0, t_end), X0, method=method, jac=self.jac,
-                         rtol=rtol, atol=rtol * 1e-2 * np.maximum(np.abs(scale), 1e-300),
-                         events=crossing, **kw)
+
+        def go(how):
+            return solve_ivp(self.rhs, (0.0, t_end), X0, method=how, jac=self.jac,
+                             rtol=rtol, atol=rtol * 1e-2 * np.maximum(np.abs(scale), 1e-300),
+                             events=crossing, **kw)
+
+        try:
+            return go(method)
+        except ValueError:
+            if method == "Radau":
+                raise
+            # LSODA's interpolant can give an event the same sign at both ends of a step
+            # in which the steps themselves saw it change: Radau's does not
+            return go("Radau")
 
     def shoot(self, X0: NDArray, T: float, scale: NDArray, max_iter: int = 12):
         """Newton on ``X(T) = X0``, ``y1(0) = 0``; returns ``X0, T, M``.
