@@ -11,7 +11,7 @@ The linear part is the loop seen by the link, ``y1 = -G w`` with ``G = P1 / (1 +
 reference drives the solution but not its deviations.  The link's deviations follow its
 own linearisation along the solution:
 
-* a link with a smooth state equation (LuGre,
+* a link with a smooth state equation (LuGre, Dahl, Bouc-Wen,
   :meth:`~motionhyst.hysteresis.Hysteresis.state_equation`): ``z' = f(z, v1)``,
   ``w = h(z, v1)``; the Jacobian along the solution at the midpoints of fine steps, the
   monodromy the product of their exponentials;
@@ -364,7 +364,7 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
     ----------
     loop : Loop
         The loop `ss` belongs to: continuous, LTI, with a link made of stop elements
-        (Jenkins, Maxwell-slip) or with a smooth state equation (LuGre).
+        (Jenkins, Maxwell-slip) or with a smooth state equation (LuGre, Dahl, Bouc-Wen).
     ss : SteadyState
         Its periodic steady state (:func:`~motionhyst.analysis.steady.periodic_steady_state`).
     samples : int, optional

@@ -159,6 +159,7 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
     """
 
     name = "bouc-wen"
+    n_states = 1
     rate_independent = True
     parameters = (Parameter("k", "N/m", "spring stiffness k"),
                   Parameter("fc", "N", "slip (Coulomb) force f_c"),
@@ -421,6 +422,46 @@ class BoucWen(NormalisedRateIndependent, Hysteresis):
         m = min(H + 1, spec.size)
         W[:m] = self.fc * (spec[:m] - alias_of_jumps(*jumps, N, m - 1))
         return W
+
+    def state_equation(self, z: ArrayLike, v: float
+                       ) -> tuple[NDArray[np.float64], float, NDArray[np.float64],
+                                  NDArray[np.float64], NDArray[np.float64], float]:
+        """The model's state equation at the force `z` and the velocity `v`.
+
+        ``z' = k v [1 - (beta_n sign(v z) + gamma_n) |z / fc|^n]`` (form (2) with
+        ``w = z = fc zeta``) with its derivatives: what an autonomous loop's orbit and its
+        monodromy need (:mod:`motionhyst.analysis.stability`).  At ``v = 0`` or ``z = 0``
+        the one-sided derivatives of ``v z > 0`` are taken (``z'`` is continuous there).
+
+        Parameters
+        ----------
+        z : array_like, shape (1,)
+            The force [N].
+        v : float
+            Velocity [m/s].
+
+        Returns
+        -------
+        tuple
+            ``(zdot, w, dzdot_dz, dzdot_dv, dw_dz, dw_dv)`` as
+            :meth:`motionhyst.LuGre.state_equation` returns them; here ``w = z``.
+
+        Examples
+        --------
+        >>> el = BoucWen(k=20.0, fc=0.05, n=1.0, beta=0.5, gamma=0.5)
+        >>> zdot, w, *_ = el.state_equation([0.025], 0.01)   # loading half-way: half of k v
+        >>> round(float(zdot[0]), 12), w
+        (0.1, 0.025)
+        """
+        zz = float(np.ravel(z)[0])
+        sz = 1.0 if zz >= 0.0 else -1.0
+        c = self.beta * (1.0 if v * zz >= 0.0 else -1.0) + self.gamma
+        a = abs(zz) / self.fc
+        g = 1.0 - c * a ** self.n
+        da = self.n * a ** (self.n - 1.0) if a > 0.0 else (1.0 if self.n == 1.0 else 0.0)
+        dzz = -self.k * v * c * da * sz / self.fc
+        return (np.array([self.k * v * g]), zz, np.array([[dzz]]), np.array([self.k * g]),
+                np.array([1.0]), 0.0)
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
         """Numerical describing function ``D = (b1 + j a1) / A`` (eq. 7) at amplitude(s) `A` [N/m].

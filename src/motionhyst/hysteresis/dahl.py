@@ -64,6 +64,7 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
     """
 
     name = "dahl"
+    n_states = 1
     rate_independent = True
     parameters = (Parameter("k", "N/m", "spring stiffness k"),
                   Parameter("fc", "N", "slip (Coulomb) force f_c"),
@@ -94,6 +95,44 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
 
     def _state_bounds(self) -> tuple[float, float]:
         return -1.0, 1.0
+
+    def state_equation(self, z: ArrayLike, v: float
+                       ) -> tuple[NDArray[np.float64], float, NDArray[np.float64],
+                                  NDArray[np.float64], NDArray[np.float64], float]:
+        """The model's state equation at the force `z` and the velocity `v`.
+
+        ``z' = k (1 - sign(v) z / fc)^alpha v`` and ``w = z`` with their derivatives:
+        what an autonomous loop's orbit and its monodromy need
+        (:mod:`motionhyst.analysis.stability`).  At ``v = 0`` the one-sided derivatives
+        of ``v > 0`` are taken (``z'`` is continuous there).
+
+        Parameters
+        ----------
+        z : array_like, shape (1,)
+            The force [N].
+        v : float
+            Velocity [m/s].
+
+        Returns
+        -------
+        tuple
+            ``(zdot, w, dzdot_dz, dzdot_dv, dw_dz, dw_dv)`` as
+            :meth:`motionhyst.LuGre.state_equation` returns them; here ``w = z``.
+
+        Examples
+        --------
+        >>> el = Dahl(k=20.0, fc=0.05)
+        >>> zdot, w, *_ = el.state_equation([0.025], 0.01)   # half-way to fc: half of k v
+        >>> round(float(zdot[0]), 12), w
+        (0.1, 0.025)
+        """
+        zz = float(np.ravel(z)[0])
+        s = 1.0 if v >= 0.0 else -1.0
+        base = max(1.0 - s * zz / self.fc, 1e-12)
+        p = base ** self.alpha
+        dzz = -self.k * self.alpha * abs(v) * base ** (self.alpha - 1.0) / self.fc
+        return (np.array([self.k * p * v]), zz, np.array([[dzz]]), np.array([self.k * p]),
+                np.array([1.0]), 0.0)
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
         """Numerical describing function ``D = (b1 + j a1) / A`` (eq. 7) at amplitude(s) `A` [N/m].
