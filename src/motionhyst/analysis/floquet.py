@@ -274,7 +274,8 @@ def _smooth_monodromy(sys: LoopStateEquation, h: _Harmonics, T: float, samples: 
     stiff link relaxation is exact in it).
     """
     from scipy.integrate import solve_ivp
-    from scipy.linalg import expm
+
+    from motionhyst.core.lti import expm_small
 
     link, ns = sys.link, sys.ns
 
@@ -292,7 +293,7 @@ def _smooth_monodromy(sys: LoopStateEquation, h: _Harmonics, T: float, samples: 
     v = h.v(mid)
     M = np.eye(sys.N)
     for j in range(samples):
-        M = expm(sys.linearised(sol.y[:, j], float(v[j])) * dt) @ M
+        M = expm_small(sys.linearised(sol.y[:, j], float(v[j])) * dt) @ M
     return M
 
 
