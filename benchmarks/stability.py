@@ -9,8 +9,8 @@
    analysis, JSON), wall time, against ``motionhyst analyze --json`` (the baseline);
    target 2 s.
 3. ``hunting``: ``stability`` of ``examples/hunting.toml`` (LuGre: the rate-dependent
-   loci, the search by simulation, the exact orbit), against the same baseline; reported,
-   no target.
+   loci, the cut at the integrator, the search by simulation, the exact orbit), against the
+   same baseline; reported, no target.
 
 Run with ``make bench`` or ``python benchmarks/stability.py [--json]``.
 """

@@ -54,12 +54,15 @@ def add_parser(sub) -> None:
         "prediction, exact orbits, Floquet multipliers",
         description="Will the loop hunt?  The Nyquist curve of the loop seen by the link "
         "(G = P1 / (1 + C P2)) against the link's -1/N(A, w) loci, every intersection a "
-        "predicted limit cycle with the describing function's stability criterion; each "
+        "predicted limit cycle with the describing function's stability criterion; for a "
+        "controller with integral action also the describing function with the loop cut at "
+        "the integrator (it predicts hunting); each "
         "refined to the exact orbit of the nonlinear loop with its Floquet multipliers, with "
         "the cycles a simulation from kicked rest states settles on.")
     q.add_argument("scenario", nargs="?", help="scenario TOML (default: the paper's Table I)")
     q.add_argument("--no-exact", action="store_true",
-                   help="the describing function's prediction only")
+                   help="the describing functions' predictions only (the link's, and the loop "
+                   "cut at the controller's integrator)")
     q.add_argument("--figure", metavar="OUT.png", help="also draw the Nyquist curve and the "
                    "loci (.png, .pdf or .svg)")
     q.add_argument("--json", action="store_true", help="print JSON")
