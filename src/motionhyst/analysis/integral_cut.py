@@ -149,6 +149,9 @@ class CutResponse:
     slipped : bool
         True if the link slipped (False: the block held still, ``N`` is the link's
         presliding stiffness only).
+    start : tuple or None
+        ``(X0, scale)``: the block's state at ``t = 0`` and its states' scales, from
+        which the shooting for a nearby force starts.
 
     Examples
     --------
@@ -166,6 +169,7 @@ class CutResponse:
     t: NDArray[np.float64] = field(repr=False)
     y1: NDArray[np.float64] = field(repr=False)
     slipped: bool
+    start: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def peak_to_peak(self) -> float:
@@ -362,8 +366,7 @@ class IntegralCut:
         omega : float
             Its angular frequency [rad/s].
         start : tuple, optional
-            ``(X0, scale)`` of a nearby response (``response._start``), to start the
-            shooting from.
+            :attr:`CutResponse.start` of a nearby response, to start the shooting from.
 
         Returns
         -------
@@ -378,10 +381,9 @@ class IntegralCut:
         c_y1 = 2.0 * np.fft.rfft(y1)[1] / y1.size
         Y2 = complex(np.ravel(self._p2_over_p1(np.array([omega])))[0]) * c_y1
         slipped = bool(np.ptp(y1) > 20.0 * U / self.link.initial_stiffness)
-        out = CutResponse(float(U), omega / TWO_PI, complex(Y2 / -U), complex(c_y1),
-                          np.linspace(0.0, T, SAMPLES + 1), np.append(y1, y1[0]), slipped)
-        out._start = (X, scale)
-        return out
+        return CutResponse(float(U), omega / TWO_PI, complex(Y2 / -U), complex(c_y1),
+                           np.linspace(0.0, T, SAMPLES + 1), np.append(y1, y1[0]), slipped,
+                           (X, scale))
 
     # ---------------------------------------------------------------- the balance
     def _balance(self, p: NDArray, start=None):
@@ -440,14 +442,14 @@ class IntegralCut:
             for k in range(2):
                 q = p.copy()
                 q[k] += FD_STEP
-                J[:, k] = (self._balance(q, r._start)[0] - f) / FD_STEP
+                J[:, k] = (self._balance(q, r.start)[0] - f) / FD_STEP
             if np.max(np.abs(f)) < BALANCE_TOL:
                 return CutCycle(r, float(J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]))
             d = np.linalg.solve(J, -f)
             d *= min(1.0, 0.5 / np.max(np.abs(d)))          # at most a factor e^0.5 a step
             for _ in range(4):
                 try:
-                    f1, r1 = self._balance(p + d, r._start)
+                    f1, r1 = self._balance(p + d, r.start)
                 except RuntimeError:
                     f1, r1 = None, None
                 if f1 is not None and r1.slipped and np.max(np.abs(f1)) < np.max(np.abs(f)):
