@@ -527,27 +527,37 @@ class _Autonomous(LoopStateEquation):
 
     def run(self, X0: NDArray, t_end: float, scale: NDArray, rtol: float = 1e-8,
             method: str = "Radau", **kw):
-        """A simulation from `X0` with upward crossings of ``y1 = 0`` as events."""
+        """A simulation from `X0`, with its dense output and, as ``t_events[0]`` and
+        ``y_events[0]``, its upward crossings of ``y1 = 0``.
+
+        The crossings are bracketed by the steps' own values and located on the solver's
+        interpolant (scipy's event search can stop with an error when LSODA's interpolant
+        and its steps disagree on a sign); where the interpolant does not bracket one, it
+        is placed by linear interpolation between the steps.
+        """
         from scipy.integrate import solve_ivp
+        from scipy.optimize import brentq
 
-        def crossing(t, X):
-            return float(self.C @ X[:self.n])
+        kw.pop("dense_output", None)
+        sol = solve_ivp(self.rhs, (0.0, t_end), X0, method=method, jac=self.jac, rtol=rtol,
+                        atol=rtol * 1e-2 * np.maximum(np.abs(scale), 1e-300),
+                        dense_output=True, **kw)
+        C, n = self.C, self.n
 
-        crossing.direction = 1.0
+        def y1(t):
+            return float(C @ sol.sol(t)[:n])
 
-        def go(how):
-            return solve_ivp(self.rhs, (0.0, t_end), X0, method=how, jac=self.jac,
-                             rtol=rtol, atol=rtol * 1e-2 * np.maximum(np.abs(scale), 1e-300),
-                             events=crossing, **kw)
-
-        try:
-            return go(method)
-        except ValueError:
-            if method == "Radau":
-                raise
-            # LSODA's interpolant can give an event the same sign at both ends of a step
-            # in which the steps themselves saw it change: Radau's does not
-            return go("Radau")
+        y = C @ sol.y[:n]
+        te = []
+        for i in np.nonzero((y[:-1] < 0.0) & (y[1:] >= 0.0))[0]:
+            a, b = float(sol.t[i]), float(sol.t[i + 1])
+            if y1(a) < 0.0 <= y1(b):
+                te.append(a if y1(a) == 0.0 else brentq(y1, a, b, xtol=1e-15, rtol=1e-15))
+            else:
+                te.append(a + (b - a) * float(-y[i] / (y[i + 1] - y[i])))
+        sol.t_events = [np.array(te)]
+        sol.y_events = [np.array([sol.sol(t) for t in te]).reshape(len(te), sol.y.shape[0])]
+        return sol
 
     def shoot(self, X0: NDArray, T: float, scale: NDArray, max_iter: int = 12):
         """Newton on ``X(T) = X0``, ``y1(0) = 0``; returns ``X0, T, M``.
