@@ -138,3 +138,23 @@ def test_summary_says_where_the_link_dominates(tmp_path):
     assert [d["crossover_hz"]["min"], d["crossover_hz"]["max"]] == per_amplitude
     assert d["top"] == 30.0
     assert "the link dominates (|mismatch - 1| > 1" in str(summarize(ds))
+
+
+def test_figure_of_a_study_of_scans_is_over_its_scan_axis():
+    """A study of scans (one frequency) is drawn over its first scan axis, a line per
+    compensation, each the worst case over the other axes."""
+    import xarray as xr
+
+    from motionhyst.study.summary import plot_band
+
+    ma = np.array([[[1e-8], [1e-9]], [[2e-8], [3e-9]], [[4e-8], [2e-9]]])  # speed x comp x f
+    ds = xr.Dataset({"ma_max": (("scan.speed", "scan.compensation", "frequency_hz"), ma),
+                     "status": (("scan.speed", "scan.compensation", "frequency_hz"),
+                                np.ones(ma.shape, np.int8))},
+                    coords={"scan.speed": [0.05, 0.1, 0.2],
+                            "scan.compensation": ["none", "model"], "frequency_hz": [5.0]},
+                    attrs={"fields": json.dumps({"ma_max": "real"})})
+    ax = plot_band(ds).axes[0]
+    assert ax.get_xlabel() == "scan.speed [m/s]"
+    assert [ln.get_label() for ln in ax.lines] == ["none", "model"]
+    np.testing.assert_array_equal(ax.lines[1].get_ydata(), ma[:, 1, 0])

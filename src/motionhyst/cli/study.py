@@ -150,7 +150,8 @@ def add_parser(sub) -> None:
                    "point")
     q.add_argument("--netcdf", metavar="OUT.nc", help="also write the results as netCDF")
     q.add_argument("--figure", metavar="OUT.png", help="also draw |E| (or the first output) "
-                   "over frequency with its Monte-Carlo band (.png, .pdf or .svg)")
+                   "over frequency with its Monte-Carlo band, or, for a study of scans, over "
+                   "its first scan axis (.png, .pdf or .svg)")
     q.add_argument("--summary", metavar="STORE", help="summarize a store: worst case per axis, "
                    "Monte-Carlo band")
     q.add_argument("--json", action="store_true", help="print JSON")

@@ -135,14 +135,22 @@ class StudySummary:
         return ax.figure
 
 
+SCAN_UNITS = {"scan.length": "m", "scan.speed": "m/s", "scan.a_max": "m/s^2",
+              "scan.j_max": "m/s^3", "scan.s_max": "m/s^4", "scan.window": "s"}
+"""Units of the scan axes, for a figure's label."""
+
+
 def plot_band(ds, name: str | None = None, ax=None):
     """``|name|`` over frequency, a line per amplitude: the median over the Monte-Carlo samples
-    and the band from 5 to 95 % (the worst case over any other axis).
+    and the band from 5 to 95 % (the worst case over any other axis).  A study of scans (a
+    single frequency) is drawn over its first scan axis (``scan.speed``, ...), a line per
+    ``scan.compensation``.
 
     Parameters
     ----------
     ds : xarray.Dataset
-        A study's results (:func:`motionhyst.study.open_results`) with a ``frequency_hz`` axis.
+        A study's results (:func:`motionhyst.study.open_results`) with a ``frequency_hz`` axis
+        (or a numeric ``scan.*`` axis).
     name : str, optional
         The output field; by default ``E`` if the study has it, else its first field.
     ax : matplotlib.axes.Axes, optional
@@ -169,32 +177,40 @@ def plot_band(ds, name: str | None = None, ax=None):
     name = name or ("E" if "E" in names else names[0])
     if name not in names:
         raise ValueError(f"no output {name!r} in the study (it has {', '.join(names)})")
-    if "frequency_hz" not in ds["status"].dims:
-        raise ValueError("the figure needs a frequency_hz axis")
+    dims = ds["status"].dims
+    x, lines = "frequency_hz", "amplitude"
+    if ds.sizes.get("frequency_hz", 0) <= 1:
+        scan = [d for d in dims if d in SCAN_UNITS and ds.sizes[d] > 1]
+        if scan:
+            x, lines = scan[0], "scan.compensation"
+    if x not in dims:
+        raise ValueError("the figure needs a frequency_hz axis (or a scan axis)")
     mag = abs(ds[name]).where(ds["status"] == OK)
-    others = [d for d in mag.dims if d not in ("frequency_hz", "amplitude", "sample")]
+    others = [d for d in mag.dims if d not in (x, lines, "sample")]
     if others:
         mag = mag.max(others)
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
-    amps = mag["amplitude"].values if "amplitude" in mag.dims else [None]
-    f = mag["frequency_hz"].values
-    for a in amps:
-        m = mag if a is None else mag.sel(amplitude=a)
-        label = "" if a is None else f"A = {g(float(a))} m"
+    values = mag[lines].values if lines in mag.dims else [None]
+    f = mag[x].values
+    for a in values:
+        m = mag if a is None else mag.sel({lines: a})
+        label = ("" if a is None else f"A = {g(float(a))} m" if lines == "amplitude"
+                 else str(a))
         if "sample" in m.dims:
             q = m.quantile([BAND[0] / 100, BAND[1] / 100, BAND[2] / 100], dim="sample")
-            (line,) = ax.plot(f, q.isel(quantile=1).transpose("frequency_hz").values,
+            (line,) = ax.plot(f, q.isel(quantile=1).transpose(x).values,
                               label=f"{label} median".strip())
-            ax.fill_between(f, q.isel(quantile=0).transpose("frequency_hz").values,
-                            q.isel(quantile=2).transpose("frequency_hz").values,
+            ax.fill_between(f, q.isel(quantile=0).transpose(x).values,
+                            q.isel(quantile=2).transpose(x).values,
                             color=line.get_color(), alpha=0.25,
                             label=f"{label} {BAND[0]:g}-{BAND[2]:g} %".strip())
         else:
-            ax.plot(f, m.transpose("frequency_hz").values, label=label or name)
+            ax.plot(f, m.transpose(x).values, "o-" if f.size < 10 else "-",
+                    label=label or name)
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("frequency [Hz]")
+    ax.set_xlabel("frequency [Hz]" if x == "frequency_hz" else f"{x} [{SCAN_UNITS[x]}]")
     ax.set_ylabel(f"|{name}|")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
