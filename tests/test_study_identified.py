@@ -206,6 +206,12 @@ def test_bad_identifications_are_one_line(saved):
         f"[{r[1][0]!r}, 1.0]", "[0.1, 1.0]"))
     with pytest.raises(StudyError, match=r"\[identification\].*symmetric"):
         Study.from_file(_study(folder, "asym.toml"))
+    (folder / "negative.toml").write_text('[identification]\nparameters = ["hysteresis.k"]\n'
+                                          'estimates = [-1.0]\nstd = [0.1]\n'
+                                          'correlation = [[1.0]]\n')
+    with pytest.raises(StudyError, match=r"from_identification .*negative.toml: hysteresis.k = "
+                                         r"-1: a parameter to draw must be a positive number"):
+        Study.from_file(_study(folder, "negative.toml"))
     with pytest.raises(StudyError, match=r"'hysteresis.k' \(from_identification\): already "
                                          r"an axis"):
         Study.from_dict({"scenario": "paper.toml", "outputs": ["e1"],

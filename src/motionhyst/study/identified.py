@@ -293,8 +293,11 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
     if cov.shape != (len(names), len(names)):
         raise ValueError(f"{where}: the covariance is not a {len(names)} x {len(names)} matrix")
     sub = cov[np.ix_(at, at)]
-    return JointNormal(tuple(keys[n] for n in drawn), tuple(float(mean[n]) for n in drawn),
-                       tuple(map(tuple, sub.tolist())), str(path))
+    try:
+        return JointNormal(tuple(keys[n] for n in drawn), tuple(float(mean[n]) for n in drawn),
+                           tuple(map(tuple, sub.tolist())), str(path))
+    except ValueError as exc:  # named as the other errors of the file
+        raise ValueError(f"from_identification {exc}") from None
 
 
 def _one_element(elements: list, where: str) -> dict:
