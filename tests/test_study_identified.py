@@ -192,7 +192,8 @@ def test_bad_identifications_are_one_line(saved):
     folder, fit = saved
     with pytest.raises(StudyError, match=r"no \[identification\] table"):
         Study.from_file(_study(folder, "paper.toml"))
-    two = dict(fit, elements=fit["elements"] * 2)
+    two = {k: v for k, v in fit.items() if k != "covariance"}  # an older identify --json
+    two["elements"] = fit["elements"] * 2
     (folder / "two.json").write_text(json.dumps(two))
     with pytest.raises(StudyError, match="2 Jenkins elements"):
         Study.from_file(_study(folder, "two.json"))
@@ -241,3 +242,41 @@ def test_the_example_study_draws_from_an_identification(saved):
     st = Study.from_file(example, from_identification=folder / "model.toml")
     assert (st.n_samples, st.seed, st.n_points) == (100, 0, 3200)
     assert st.sampled_keys == ("hysteresis.k", "hysteresis.fc")
+
+
+def test_a_maxwell_slip_link_is_drawn_element_by_element(tmp_path):
+    """Several elements: their k and fc under the keys hysteresis.k[0], ..., the joint draws
+    with the covariance of the identification (JSON and saved TOML alike)."""
+    from motionhyst.hysteresis import MaxwellSlip
+    from motionhyst.identify import identify_maxwell_slip
+
+    t = np.arange(3000) / 1000.0
+    env = np.concatenate([np.geomspace(0.012, 3e-4, 1500), np.geomspace(3e-4, 0.012, 1500)])
+    x = env * np.sin(2 * np.pi * 3.0 * t)
+    w = (MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.01, 0.02, 0.03]).response(x)
+         + 0.002 * np.random.default_rng(2).standard_normal(t.size))
+    fit = identify_maxwell_slip(x, w, t=t, n_elements=3)
+    (tmp_path / "ms.toml").write_text(fit.scenario_text())
+    (tmp_path / "ms.json").write_text(json.dumps(fit.to_dict()))
+    keys = tuple(f"hysteresis.{p}[{i}]" for p in ("k", "fc") for i in range(3))
+    c = np.array(fit.covariance["matrix"])[:6, :6]
+    for name in ("ms.toml", "ms.json"):
+        d = joint_from_identification(tmp_path / name)
+        assert d.keys == keys
+        np.testing.assert_allclose(d.covariance, c, rtol=1e-9, atol=1e-9 * np.abs(c).max())
+    shutil.copy(default_scenario_path(), tmp_path / "paper.toml")
+    base = tomllib.loads((tmp_path / "paper.toml").read_text())
+    base["hysteresis"] = {"model": "maxwell-slip", "k": [10.0, 6.0, 4.0],
+                          "fc": [0.01, 0.02, 0.03]}
+    st = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0]},
+                          "samples": {"n": N_DRAWS, "seed": 1,
+                                      "from_identification": "ms.toml"}},
+                         base_dir=tmp_path, scenario=base)
+    assert st.sampled_keys == keys
+    _within_sampling_error(st.sample_values, [e[p] for p in ("k", "fc")
+                                              for e in fit.elements], c)
+    at = st.scenario_at(st.point(5))["hysteresis"]
+    assert at["k"][2] == st.point(5)["hysteresis.k[2]"]
+    with pytest.raises(StudyError, match=r"'hysteresis.k\[3\]'.*\[hysteresis\] k has 3 values"):
+        Study.from_dict({"outputs": ["mismatch"], "axes": {"hysteresis.k[3]": [1.0]}},
+                        scenario=base)

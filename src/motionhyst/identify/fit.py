@@ -500,11 +500,11 @@ def _covariance_std(fit: _Fit, n_rows: int) -> NDArray[np.float64]:
 
 def _covariance_of(fit: _Fit, n_rows: int, order: NDArray[np.intp],
                    std: NDArray[np.float64]) -> dict:
-    """The covariance of ``k``, ``fc`` (``k1, k2, ..., fc1, ...`` for several elements, in
-    the elements' order) and ``offset``: of the Jacobian that gives :func:`_covariance_std`."""
+    """The covariance of ``k``, ``fc`` (``k[0], k[1], ..., fc[0], ...`` for several elements,
+    in the elements' order) and ``offset``: of the Jacobian that gives :func:`_covariance_std`."""
     n = fit.n
     idx = [*order, *(n + order), fit.J.shape[1] - 1]
-    names = (["k", "fc"] if n == 1 else [f"{p}{i + 1}" for p in ("k", "fc") for i in range(n)])
+    names = (["k", "fc"] if n == 1 else [f"{p}[{i}]" for p in ("k", "fc") for i in range(n)])
     names.append("offset")
     sd = {nm: float(std[i]) if np.isfinite(std[i]) else None
           for nm, i in zip(names, idx, strict=True)}

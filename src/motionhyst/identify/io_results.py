@@ -176,7 +176,9 @@ class IOIdentification:
                 + toml_table("hysteresis", link))
         # the estimates that are scalar keys of these tables, under those keys
         keys = {**{n: f"stage.{n}" for n, v in stage.items() if _number(v)},
-                **{f"link.{n}": f"hysteresis.{n}" for n, v in link.items() if _number(v)}}
+                **{f"link.{n}": f"hysteresis.{n}" for n, v in link.items() if _number(v)},
+                **{f"link.{n}[{i}]": f"hysteresis.{n}[{i}]" for n, v in link.items()
+                   if isinstance(v, list) for i in range(len(v))}}
         ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys)
         return text + ("\n" + ident if ident else "")
 

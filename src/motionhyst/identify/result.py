@@ -54,7 +54,7 @@ class Identification:
         force-displacement record.
     covariance : dict or None
         ``{"parameters": [...], "matrix": [[...]]}``: the covariance of the determined
-        estimates (``k``, ``fc`` and ``offset``; ``k1, ..., fc1, ...`` for several
+        estimates (``k``, ``fc`` and ``offset``; ``k[0], ..., fc[0], ...`` for several
         elements) from the fit's Jacobian, whose diagonal's square roots are the standard
         errors (:func:`~motionhyst.identify.io_uncertainty.covariance`).
 
@@ -193,7 +193,8 @@ class Identification:
         offset) and the ``[hysteresis]`` of :meth:`scenario_fragment`; ``motionhyst
         predict`` gives its force for a displacement record (time,displacement) and
         its displacement for a force record.  One element's ``k`` and ``fc`` come with
-        their standard errors and correlation in ``[identification]``
+        their standard errors and correlations in ``[identification]`` (several elements' as
+        ``hysteresis.k[0]``, ...)
         (:func:`~motionhyst.identify.io_uncertainty.identification_toml`).
 
         Parameters
@@ -210,11 +211,16 @@ class Identification:
                 f"gives its force\n# for a displacement record (time,displacement), its "
                 f"displacement for a force record\n")
         text = head + toml_table("stage", plant.to_dict()) + "\n" + self.scenario_fragment()
-        if self.covariance is None or self.n_elements != 1:  # several: lists, no scalar keys
+        if self.covariance is None:
             return text
-        e = self.elements[0]
-        ident = identification_toml(self.covariance, e, {"k": "hysteresis.k",
-                                                         "fc": "hysteresis.fc"})
+        names = [n for n in self.covariance["parameters"] if n != "offset"]
+        if self.n_elements == 1:
+            estimates = dict(self.elements[0])
+        else:
+            estimates = {f"{p}[{i}]": e[p] for p in ("k", "fc")
+                         for i, e in enumerate(self.elements)}
+        ident = identification_toml(self.covariance, estimates,
+                                    {n: f"hysteresis.{n}" for n in names})
         return text + ("\n" + ident if ident else "")
 
     def scenario_fragment(self) -> str:

@@ -8,8 +8,12 @@ matrix whose diagonal's square roots are the standard errors):
   ``parameters`` (scenario keys: ``hysteresis.k``, ``hysteresis.fc``, ``stage.m``, ...),
   ``estimates``, ``std`` and ``correlation``;
 - ``motionhyst identify ... --json > fit.json`` prints it as ``covariance``: ``parameters``
-  (a force-displacement record: ``k``, ``fc``, ``offset``; an input-output record: the
-  names of ``estimates``, the link's as ``link.NAME``) and ``matrix``.
+  (a force-displacement record: ``k``, ``fc``, ``offset``, or ``k[0], ..., fc[0], ...`` for
+  several elements; an input-output record: the names of ``estimates``, the link's as
+  ``link.NAME``) and ``matrix``.
+
+The elements of a Maxwell-slip link are the keys ``hysteresis.k[0]``, ``hysteresis.fc[0]``, ...
+(the study's scenario has as many elements).
 
 A study's ``[samples] from_identification = "model.toml"`` (or ``motionhyst study
 --from-identification model.toml``) draws the link's parameters (the keys
@@ -228,8 +232,8 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
     Raises
     ------
     ValueError
-        One line: the file cannot be read, is not an identification, has more than one
-        Jenkins element, or a link parameter whose standard error is not determined.
+        One line: the file cannot be read, is not an identification, or has a link parameter
+        whose standard error is not determined.
 
     Examples
     --------
@@ -275,8 +279,13 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
         names = list(table.get("parameters", []))
         cov = np.asarray(table.get("matrix", []), dtype=float)
         if isinstance(data.get("elements"), list):  # a force-displacement record
-            mean = _one_element(data["elements"], where)
-            keys = {"k": "hysteresis.k", "fc": "hysteresis.fc"}
+            elements = data["elements"]
+            if len(elements) == 1:
+                mean = _one_element(elements, where)
+            else:  # a Maxwell-slip link: its elements' values, in the file's order
+                mean = {f"{p}[{i}]": e.get(p) for p in ("k", "fc")
+                        for i, e in enumerate(elements) if isinstance(e, dict)}
+            keys = {n: f"hysteresis.{n}" for n in mean if n in ("k", "fc") or "[" in n}
         else:
             mean = dict(data.get("estimates") or {})
             keys = {n: f"hysteresis.{n[5:]}" for n in mean if n.startswith("link.")}

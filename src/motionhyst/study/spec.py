@@ -17,7 +17,8 @@ samples of scenario keys from stated distributions, seeded::
     "hysteresis.k" = { lognormal = [20.0, 0.1] }
 
 The points are the cross product of the axes and the samples (a dimension ``sample``); an axis
-``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one.  A ``[scan]``
+``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one; a key of a
+list names one value, ``"hysteresis.fc[1]"`` (an element of a Maxwell-slip link).  A ``[scan]``
 table and axes ``scan.*`` set the scan of the output ``scan`` (:mod:`motionhyst.study.scans`).
 """
 
@@ -90,14 +91,15 @@ def is_scenario_key(key: str) -> bool:
 
 
 def set_key(data: dict, key: str, value: float) -> None:
-    """Set the dotted scenario `key` (``"hysteresis.k"``) of the nested `data` to `value`.
+    """Set the dotted scenario `key` (``"hysteresis.k"``) of the nested `data` to `value`; a
+    key ``"hysteresis.k[1]"`` sets one value of a list (an element of a Maxwell-slip link).
 
     Parameters
     ----------
     data : dict
         The nested scenario dictionary, changed in place.
     key : str
-        Dotted key, ``"hysteresis.k"``.
+        Dotted key, ``"hysteresis.k"``, or ``"hysteresis.k[1]"`` (counted from 0).
     value : float
         The value.
 
@@ -107,6 +109,10 @@ def set_key(data: dict, key: str, value: float) -> None:
     >>> set_key(d, "hysteresis.k", 25.0)
     >>> d
     {'hysteresis': {'model': 'jenkins', 'k': 25.0}}
+    >>> d = {"hysteresis": {"model": "maxwell-slip", "k": [10.0, 6.0], "fc": [0.01, 0.03]}}
+    >>> set_key(d, "hysteresis.fc[1]", 0.04)
+    >>> d["hysteresis"]["fc"]
+    [0.01, 0.04]
     """
     *path, last = key.split(".")
     node = data
@@ -115,7 +121,19 @@ def set_key(data: dict, key: str, value: float) -> None:
         if not isinstance(nxt, dict):
             raise StudyError(f"{key!r}: the scenario has no table [{part}]")
         node = nxt
-    node[last] = value
+    name, bracket, index = last.partition("[")
+    if not bracket:
+        node[last] = value
+        return
+    values = node.get(name)
+    if not (index.endswith("]") and index[:-1].isdigit()):
+        raise StudyError(f"{key!r}: give an index as {name}[0], {name}[1], ...")
+    i = int(index[:-1])
+    if not isinstance(values, list) or i >= len(values):
+        what = (f"{len(values)} values" if isinstance(values, list)
+                else "no list" if name in node else "no such key")
+        raise StudyError(f"{key!r}: the scenario's [{'.'.join(path)}] {name} has {what}")
+    node[name] = [*values[:i], value, *values[i + 1:]]
 
 
 def _axis_values(key: str, spec, where: str) -> NDArray:
