@@ -280,3 +280,16 @@ def test_a_maxwell_slip_link_is_drawn_element_by_element(tmp_path):
     with pytest.raises(StudyError, match=r"'hysteresis.k\[3\]'.*\[hysteresis\] k has 3 values"):
         Study.from_dict({"outputs": ["mismatch"], "axes": {"hysteresis.k[3]": [1.0]}},
                         scenario=base)
+
+
+def test_the_local_pool_draws_and_computes_as_this_process(saved, tmp_path):
+    """The pool's workers rebuild the study from its plain parameters (the joint distribution
+    among them): the same draws and the same numbers as in this process, bit for bit."""
+    folder, _ = saved
+    st = Study.from_file(_study(folder, "model.toml", n=4))
+    run_study(st, tmp_path / "here.zarr", workers=0)
+    run_study(Study.from_file(_study(folder, "model.toml", n=4)), tmp_path / "pool.zarr",
+              workers=2)
+    here, pool = open_results(tmp_path / "here.zarr"), open_results(tmp_path / "pool.zarr")
+    for name in ("mismatch", "status", "hysteresis.k", "hysteresis.fc"):
+        np.testing.assert_array_equal(here[name].values, pool[name].values, err_msg=name)

@@ -158,3 +158,14 @@ def test_figure_of_a_study_of_scans_is_over_its_scan_axis():
     assert ax.get_xlabel() == "scan.speed [m/s]"
     assert [ln.get_label() for ln in ax.lines] == ["none", "model"]
     np.testing.assert_array_equal(ax.lines[1].get_ydata(), ma[:, 1, 0])
+
+
+def test_the_local_pool_computes_scans_as_this_process(study_file, tmp_path):
+    study_file.write_text(STUDY.replace('"scan.speed" = [0.05, 0.1]', '"scan.speed" = [0.05]')
+                          .replace('outputs = ["scan", "error_rms"]', 'outputs = ["scan"]'))
+    run_study(Study.from_file(study_file), tmp_path / "here.zarr", workers=0)
+    run_study(Study.from_file(study_file), tmp_path / "pool.zarr", workers=2)
+    here, pool = open_results(tmp_path / "here.zarr"), open_results(tmp_path / "pool.zarr")
+    for name in ("ma_max", "msd_max", "peak_error", "status"):
+        np.testing.assert_array_equal(here[name].values, pool[name].values, err_msg=name)
+    assert list(pool["scan.compensation"].values) == ["none", "model"]
