@@ -234,6 +234,9 @@ def test_cli_runs_a_study_from_a_saved_identification(saved, tmp_path, capsys):
     ds = open_results(out)
     assert ds["hysteresis.k"].dims == ds["hysteresis.fc"].dims == ("sample",)
     assert abs(np.median(ds["hysteresis.k"].values) - 20.0) < 0.1
+    assert main(["study", "--summary", str(out)]) == 0
+    assert ("100 samples of hysteresis.k, hysteresis.fc drawn jointly from "
+            f"{folder / 'model.toml'} (normal, its covariance)") in capsys.readouterr().out
 
 
 def test_the_example_study_draws_from_an_identification(saved):

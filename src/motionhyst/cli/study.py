@@ -5,6 +5,7 @@ local core (or a dask cluster) into a resumable zarr store; ``--summary`` reads 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 
@@ -35,6 +36,11 @@ def _summary(args: argparse.Namespace) -> int:
     else:
         print(f"Study {ds.attrs.get('study')} on {ds.attrs.get('scenario')} "
               f"(motionhyst {ds.attrs.get('version')}, seed {ds.attrs.get('seed')})")
+        joint = json.loads(ds.attrs.get("joint", "null"))
+        if joint:
+            print(f"  {ds.attrs.get('n_samples')} samples of {', '.join(joint['keys'])} drawn "
+                  f"jointly from {joint['source']} ("
+                  f"{'lognormal' if joint['log_space'] else 'normal'}, its covariance)")
         print(s)
     return 0
 
