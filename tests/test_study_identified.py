@@ -154,6 +154,10 @@ def test_the_same_seed_computes_the_same_study(saved, tmp_path):
     assert np.all(np.isfinite(a["mismatch"].values))
     assert np.array_equal(a["hysteresis.k"].values, b["hysteresis.k"].values)
     assert json.loads(a.attrs["joint"])["keys"] == ["hysteresis.k", "hysteresis.fc"]
+    from motionhyst.study.export import to_table
+
+    # the table's columns of the draws in the order they are drawn
+    assert to_table(a).startswith("frequency_hz,amplitude,sample,hysteresis.k,hysteresis.fc,")
 
 
 def test_a_key_the_study_gives_keeps_its_distribution_and_the_rest_their_marginal(saved):

@@ -7,6 +7,7 @@ which has no complex numbers) ``e1_real`` and ``e1_imag``.
 from __future__ import annotations
 
 import io
+import json
 
 import numpy as np
 
@@ -41,9 +42,11 @@ def to_table(ds) -> str:
     if "sample" in dims:
         k = dims.index("sample")
         sidx = np.meshgrid(*[np.arange(ds.sizes[d]) for d in dims], indexing="ij")[k].ravel()
-        for name, coord in ds.coords.items():
-            if coord.dims == ("sample",) and name != "sample":
-                cols[str(name)] = coord.values[sidx]
+        drawn = [str(n) for n, c in ds.coords.items() if c.dims == ("sample",) and n != "sample"]
+        joint = json.loads(ds.attrs.get("joint", "null")) or {}
+        order = [*json.loads(ds.attrs.get("samples", "{}")), *joint.get("keys", [])]
+        for name in sorted(drawn, key=lambda n: order.index(n) if n in order else len(order)):
+            cols[name] = ds[name].values[sidx]  # in the order they are drawn
     for name in field_names(ds):
         v = ds[name].values.ravel()
         if np.iscomplexobj(v):
