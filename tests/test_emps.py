@@ -203,3 +203,22 @@ def test_with_the_test_record_the_whole_estimation_record_is_used():
     assert model.validation["record"] == "DATA_EMPS_PULSES"
     assert model.parameters["m"] == pytest.approx(TRUE["m"], rel=0.02)
     assert "was not given" not in str(res)
+
+
+def test_a_drifting_offset_is_diagnosed():
+    """A record whose force offset drifts from period to period (as DATA_EMPS's does): the
+    inverse dynamics of each period shows it, and the held-out record's own offset takes
+    the error that the drift made."""
+    rec = axis_record(noise=0.0)
+    # the force measured drifts by 0.15 N/s while the axis moves as before (its offset OF)
+    drifting = IORecord(rec.t, rec.u + 0.15 * rec.t, rec.y, "drifting")
+    res = run_emps(drifting, models=("coulomb",), period=PERIOD)
+    offsets = [d["offset"] for d in res.drift]
+    assert len(offsets) == 4
+    np.testing.assert_allclose(np.diff(offsets), 0.15, rtol=0.1)  # 0.15 N per 1 s period
+    (model,) = res.models
+    own = model.validation["own_offset"]
+    held_out = TRUE["offset"] + 0.15 * 3.0  # the mean offset of periods 3-4
+    assert own["offset"] == pytest.approx(held_out, abs=0.1)
+    assert own["rmse_mm"] < 0.2 * model.validation["rmse_mm"]
+    assert "own offset" in str(res) and "Inverse dynamics (IDIM-LS) of each period" in str(res)
