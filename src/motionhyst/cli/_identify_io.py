@@ -60,6 +60,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records, --model coulomb --plant mass-damper: viscous "
                         "friction by direction (the link's c_pos or c_neg on top of the "
                         "stage's c)")
+    q.add_argument("--drift", action="store_true",
+                   help="input-output records, --plant mass-damper: the force offset drifts "
+                        "in time (a machine warming up): its rate [N/s] over the records' own "
+                        "time is estimated with it and saved as the stage's force_drift")
     q.add_argument("--max-evaluations", type=whole_number(10, 100000, "evaluations"), metavar="N",
                    help="input-output records: the search's budget of model evaluations, "
                         "starts and refinement together (default: the starts', then at most "
@@ -83,15 +87,18 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     q.add_argument("--force", action="store_true", help="replace the --save file if it exists")
 
 
-def check_not_input_output(args: argparse.Namespace) -> None:
-    """One-line error for input-output options given with another record kind."""
+def check_not_input_output(args: argparse.Namespace, closed_loop: bool = False) -> None:
+    """One-line error for input-output options given with another record kind (`closed_loop`:
+    a closed-loop record, which takes ``--offset`` too)."""
     for option, value in (("--plant", args.plant), ("--model", args.model),
                           ("--periodic", args.periodic or None), ("--nu", args.nu),
                           ("--output", args.output),
-                          ("--offset", args.offset), ("--from-rest", args.from_rest or None),
+                          ("--offset", None if closed_loop else args.offset),
+                          ("--from-rest", args.from_rest or None),
                           ("--max-evaluations", args.max_evaluations),
                           ("--init-window", args.init_window),
-                          ("--asymmetric", args.asymmetric or None)):
+                          ("--asymmetric", args.asymmetric or None),
+                          ("--drift", args.drift or None)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
                              f"only")
@@ -150,6 +157,9 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.asymmetric and (model != "coulomb" or plant != "mass-damper"):
         raise UsageError("motionhyst identify: --asymmetric applies to --model coulomb "
                          "--plant mass-damper only")
+    if args.drift and (model == "bouc-wen" or plant != "mass-damper" or args.periodic):
+        raise UsageError("motionhyst identify: --drift applies to records from a start on "
+                         "--plant mass-damper, with an element link")
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
@@ -157,7 +167,7 @@ def run_input_output(args: argparse.Namespace) -> int:
               if model == "bouc-wen" and plant != "quasi-static" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
-               "asymmetric": args.asymmetric})
+               "asymmetric": args.asymmetric, "drift": args.drift})
     from motionhyst.hysteresis import model_class
     from motionhyst.plants.registry import plant_class
 

@@ -119,6 +119,10 @@ class Loop:
             raise ValueError(f"the closed loop's analyses take no constant force on the plant "
                              f"(force_offset = {plant.force_offset:g} N); the open-loop time "
                              f"runs do")
+        if getattr(plant, "force_drift", 0.0):
+            raise ValueError(f"the closed loop takes no drifting force on the plant "
+                             f"(force_drift = {plant.force_drift:g} N/s); the open-loop time "
+                             f"runs do")
         P1, P2 = plant.P1, plant.P2
         mass = plant.M if mass is None else mass
         if isinstance(feedforward, Feedforward):

@@ -189,7 +189,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 start_nfev: int | None = None, plant: Plant | type | str = MassSpringDamper,
                 output: str | None = None, offset: str = "auto", from_rest: bool = False,
                 max_evaluations: int | None = None, init_window: int | None = None,
-                asymmetric: bool = False) -> IOIdentification:
+                asymmetric: bool = False, drift: bool = False) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -276,6 +276,13 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         link's ``c_pos`` or ``c_neg`` on top of the stage's ``c``; a positioning
         axis's ``Fv+``, ``Fv-``).  Its force offset is then another number than a
         symmetric model's: the symmetric one takes up the mean of the difference.
+    drift : bool
+        A mass-damper whose force offset drifts in time: its rate ``input_drift``
+        [N/s] is estimated with the force offset (the plant receives ``u -
+        input_offset - input_drift t``, ``t`` each record's own time; the
+        fitted plant's ``force_drift``).  A machine warming up over a record
+        (EMPS); it assumes a record to be predicted starts as the identified
+        ones did.
 
     Returns
     -------
@@ -325,7 +332,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps, tol=tol,
                  max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev, offset=offset,
                  from_rest=from_rest, max_evaluations=max_evaluations, init_window=init_window,
-                 asymmetric=asymmetric, t_start=t_start)
+                 asymmetric=asymmetric, drift=drift, t_start=t_start)
     for line in fit.warnings:  # the plausibility checks, for every caller to see
         warn(line)
     return fit
@@ -334,8 +341,11 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
 def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, periodic: bool,
            nu: float | None, substeps: int | None, tol: float, max_nfev: int, n_elements: int,
            start_nfev: int | None, offset: str, from_rest: bool, max_evaluations: int | None,
-           init_window: int | None, asymmetric: bool, t_start: float) -> IOIdentification:
+           init_window: int | None, asymmetric: bool, drift: bool, t_start: float
+           ) -> IOIdentification:
     """The fit of :func:`identify_io` that the stage's structure and the link call for."""
+    if drift and not any(p.name == "force_drift" for p in stage.parameters):
+        raise ValueError("a drifting force offset is identified on a mass-damper")
     if not stage.has_inertia:  # the link's balance (any link, Bouc-Wen too)
         if asymmetric:
             raise ValueError(_ASYMMETRIC)
@@ -356,7 +366,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
                                     stage, offset, from_rest, max_evaluations,
                                     int(init_window) if init_window is not None else None,
-                                    asymmetric)
+                                    asymmetric, bool(drift))
     bouc_wen_offset = offset == "output" and not shape.floating
     if (offset not in ("auto", "none") and not bouc_wen_offset) or from_rest \
             or init_window is not None:

@@ -233,6 +233,9 @@ class _ElementProblem:
         # the upsampling is linear: a force offset shifts the fine input by itself times this
         self.fine_one = ([fine_input(np.ones(rec.u.size), substeps, periodic)
                           for rec in records] if self.extras.input_offset else None)
+        # and a drifting offset by its rate times the fine steps' times
+        self.fine_t = ([fine_input(rec.t, substeps, periodic) for rec in records]
+                       if self.extras.input_drift else None)
         self.n_eval = 0
         self.exact: bool | None = None if exact else False  # sensitivities (None: untried)
         self.fd_step = FD_STEP
@@ -275,6 +278,7 @@ class _ElementProblem:
 
         k, nl = self.n_plant, self.n_link
         u0, y0, init = self.extras.split(v[k + nl:])
+        drift = self.extras.drift(v[k + nl:])
         link = self.layout.build(v[k:k + nl])
         dparams = None
         if sens:
@@ -288,9 +292,13 @@ class _ElementProblem:
         def one(i):
             rec = self.records[i]
             fine = self.fine[i] if self.fine_one is None else self.fine[i] - u0 * self.fine_one[i]
+            u = rec.u - u0
+            if self.fine_t is not None:  # the offset drifting over the record's time
+                fine = fine - drift * self.fine_t[i]
+                u = u - drift * rec.t
             if self.window is not None:
-                return self._from_window(mech, stepping, k_link, rec, rec.u - u0, fine, dparams)
-            y, sy = simulate_elements(mech, stepping, rec.u - u0, rec.fs, self.r,
+                return self._from_window(mech, stepping, k_link, rec, u, fine, dparams)
+            y, sy = simulate_elements(mech, stepping, u, rec.fs, self.r,
                                       periodic=self.periodic, k_link=k_link, upsampled=fine,
                                       dparams=dparams,
                                       x0=initial_state(mech.n, self.extras.initial, init[i]))
@@ -332,10 +340,12 @@ class _ElementProblem:
         `v`."""
         k, nl = self.n_plant, self.n_link
         u0 = self.extras.split(v[k + nl:])[0]
+        drift = self.extras.drift(v[k + nl:])
         link = self.layout.build(v[k:k + nl])
         mech = self.plant.mechanics(v[:k])
-        return [state_from_window(mech, link.time_stepping(), link.initial_stiffness, rec.u - u0,
-                                  rec.y, rec.fs, self.r, self.window) for rec in self.records]
+        return [state_from_window(mech, link.time_stepping(), link.initial_stiffness,
+                                  rec.u - u0 - drift * rec.t, rec.y, rec.fs, self.r, self.window)
+                for rec in self.records]
 
     def _measured(self, rec) -> NDArray[np.float64]:
         return rec.y - np.mean(rec.y) if self.centre else rec.y
@@ -360,11 +370,11 @@ class _ElementProblem:
         n_rows = [rec.y.size for rec in self.records]
         starts = np.concatenate([[0], np.cumsum(n_rows)])
         J = np.zeros((starts[-1], ex.size))
-        if ex.input_offset:
-            step = EXTRA_FD_STEP * max(abs(v[base]), self.scale[base])
+        for j in range(int(ex.input_offset) + int(ex.input_drift)):  # those of every record
+            step = EXTRA_FD_STEP * max(abs(v[base + j]), self.scale[base + j])
             w = v.copy()
-            w[base] += step
-            J[:, 0] = (np.concatenate([yy for yy, _ in self.outputs(w)])
+            w[base + j] += step
+            J[:, j] = (np.concatenate([yy for yy, _ in self.outputs(w)])
                        - np.concatenate(y)) / step
             self.n_eval += 1
         for i in range(len(self.records)):
@@ -485,7 +495,7 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_start,
                          start_nfev, plant, offset="none", from_rest=True, budget=None,
-                         init_window=None, asymmetric=False) -> IOIdentification:
+                         init_window=None, asymmetric=False, drift=False) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -592,15 +602,18 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     n_plant = len(structure.PARAMETERS)
     floating = structure.mechanics().floating
     extras = Extras.choose(offset, floating=floating, periodic=periodic, from_rest=from_rest,
-                           n_records=len(records), window=init_window is not None)
-    scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale)])
+                           n_records=len(records), window=init_window is not None, drift=drift)
+    t_span = max(float(rec.t[-1] - rec.t[0]) for rec in records)
+    scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale, t_span)])
     rate = np.concatenate([np.zeros(n_plant, bool),
                            [par.unit == _VELOCITY for par, _ in layout._values()],
                            np.zeros(extras.size, bool)]).astype(bool)
     short = short_records(records, periodic)
-    short_extras = Extras(extras.input_offset, extras.output_offset, extras.initial, 1)
+    short_extras = Extras(extras.input_offset, extras.output_offset, extras.initial, 1,
+                          extras.input_drift)
     n_base = n_plant + len(layout.names)
-    short_scale = np.concatenate([scale[:n_base], short_extras.scales(u_rms, y_scale, v_scale)])
+    short_scale = np.concatenate([scale[:n_base], short_extras.scales(
+        u_rms, y_scale, v_scale, float(short[0].t[-1] - short[0].t[0]))])
     short_rate = rate[:n_base + short_extras.size]
     n_eval = 0
     n_start = start_nfev or 15 * scale.size
@@ -697,6 +710,9 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     fitted = prob.plant.with_parameters(v[:n_plant])
     if extras.input_offset:
         fitted.force_offset = -u0  # the offset of the measured force, on the plant
+    drift_rate = extras.drift(v[n_base:])
+    if extras.input_drift:
+        fitted.force_drift = -drift_rate
     link = layout.build(v[n_plant:n_base])
     judge_fit(float(np.sqrt(rss / res.size)), records, prob._split_rows(res, measured=True),
               _linear_rms(records, structure, r, periodic, extras.output_offset),
@@ -723,7 +739,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "
                  f"at most {remaining} evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r, data=list(records), residuals=res,
-        extra={"offsets": {"input": u0, "output": y0.tolist()},
+        extra={"offsets": {"input": u0, "output": y0.tolist(),
+                           **({"input_drift": drift_rate} if extras.input_drift else {})},
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0),
                "covariance": covariance_table(names, covariance(J, rss, res.size, rtol), std)})
@@ -754,7 +771,7 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
     try:
         fit = identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev, 1,
                                    t_start, start_nfev, plant, offset, from_rest,
-                                   init_window=init_window)
+                                   init_window=init_window, drift=extras.input_drift)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0
     fc = fit.estimates["link.fc"]

@@ -12,7 +12,9 @@ as offsets of the measured signals:
     \\hat y(t) = y_{model}(t;\\; u - u_0,\\; x(t_0)) + y_0,
 
 ``u_0`` (``input_offset`` [N]: the plant receives ``u - u_0``; the EMPS
-benchmark's ``OF``) common to the records, ``y_0`` (``output_offset`` [m])
+benchmark's ``OF``) common to the records (with ``drift``, ``u_0 + u_1 t``: the
+offset drifting at ``input_drift`` [N/s] over the records' own time ``t``, a
+machine warming up), ``y_0`` (``output_offset`` [m])
 and the initial state ``x(t_0)`` (the stage moving as one body at ``v0``
 [m/s], displaced by ``y0`` [m] where a spring holds it) one per record.  On
 a floating stage (no spring to the ground) the output offset and the initial
@@ -45,6 +47,8 @@ class Extras:
         (a floating stage) or ``("y0", "v0")``.
     n_records : int
         Number of records.
+    input_drift : bool
+        Estimate the force offset's drift in time (one, with the force offset).
 
     Examples
     --------
@@ -55,16 +59,20 @@ class Extras:
     >>> Extras.choose("none", floating=False, periodic=False, from_rest=True,
     ...               n_records=1).names
     []
+    >>> Extras.choose("auto", floating=True, periodic=False, from_rest=False, n_records=1,
+    ...               window=True, drift=True).names
+    ['input_offset', 'input_drift']
     """
 
     input_offset: bool
     output_offset: bool
     initial: tuple[str, ...]
     n_records: int
+    input_drift: bool = False
 
     @classmethod
     def choose(cls, offset: str, *, floating: bool, periodic: bool, from_rest: bool,
-               n_records: int, window: bool = False) -> Extras:
+               n_records: int, window: bool = False, drift: bool = False) -> Extras:
         """What to estimate for the `offset` choice (:data:`OFFSET_CHOICES`).
 
         ``auto`` is what records can tell apart: ``both`` for a floating stage's
@@ -93,6 +101,9 @@ class Extras:
             Number of records.
         window : bool
             The records' states are set from their first samples.
+        drift : bool
+            The force offset drifts in time: its rate is estimated with it (records
+            from a start whose force offset is estimated).
 
         Returns
         -------
@@ -101,11 +112,23 @@ class Extras:
         Raises
         ------
         ValueError
-            An unknown choice; a window on periodic records or with `from_rest`.
+            An unknown choice; a window on periodic records or with `from_rest`; a
+            drift without a force offset or on periodic records.
         """
         if offset not in OFFSET_CHOICES:
             raise ValueError(f"unknown offset choice {offset!r}; expected one of "
                              f"{', '.join(OFFSET_CHOICES)}")
+        if drift:
+            if periodic:
+                raise ValueError("a drifting force offset repeats no period: not with "
+                                 "periodic records")
+            out = cls.choose(offset, floating=floating, periodic=False, from_rest=from_rest,
+                             n_records=n_records, window=window)
+            if not out.input_offset:
+                raise ValueError("the force offset's drift is estimated with the force "
+                                 "offset: offset 'auto', 'input' or 'both' on a floating "
+                                 "stage")
+            return cls(True, out.output_offset, out.initial, out.n_records, True)
         if window:
             if periodic or from_rest:
                 raise ValueError("an initialisation window sets the state of records from a "
@@ -131,6 +154,8 @@ class Extras:
     def names(self) -> list[str]:
         """Names of the estimates, in the search vector's order."""
         out = ["input_offset"] if self.input_offset else []
+        if self.input_drift:
+            out.append("input_drift")
         if self.output_offset:
             out += self._per_record("output_offset")
         for what in self.initial:
@@ -142,13 +167,16 @@ class Extras:
         """Number of estimates."""
         return len(self.names)
 
-    def scales(self, u_scale: float, y_scale: float, v_scale: float) -> NDArray[np.float64]:
+    def scales(self, u_scale: float, y_scale: float, v_scale: float, t_scale: float = 1.0
+               ) -> NDArray[np.float64]:
         """Typical size of each estimate: the force's, the output's or its rate's RMS.
 
         Parameters
         ----------
         u_scale, y_scale, v_scale : float
             Sizes of a force [N], a position [m] and a velocity [m/s].
+        t_scale : float
+            The records' duration [s]: a drift's size is ``u_scale / t_scale``.
 
         Returns
         -------
@@ -156,7 +184,7 @@ class Extras:
             One size per name of :attr:`names`.
         """
         unit = {"input_offset": u_scale, "output_offset": y_scale, "y0": y_scale,
-                "v0": v_scale}
+                "v0": v_scale, "input_drift": u_scale / t_scale}
         return np.array([unit[name.split("[")[0]] for name in self.names])
 
     def split(self, e: NDArray[np.float64]) -> tuple[float, NDArray[np.float64],
@@ -174,11 +202,8 @@ class Extras:
         tuple
             ``(u0, y0, init)``.
         """
-        j = 0
-        u0 = 0.0
-        if self.input_offset:
-            u0 = float(e[0])
-            j = 1
+        j = int(self.input_offset) + int(self.input_drift)
+        u0 = float(e[0]) if self.input_offset else 0.0
         y0 = np.zeros(self.n_records)
         if self.output_offset:
             y0 = np.asarray(e[j:j + self.n_records], dtype=float)
@@ -188,6 +213,20 @@ class Extras:
             init[:, a] = e[j:j + self.n_records]
             j += self.n_records
         return u0, y0, init
+
+    def drift(self, e: NDArray[np.float64]) -> float:
+        """The force offset's drift [N/s] from the estimates `e` (0 when not estimated).
+
+        Parameters
+        ----------
+        e : ndarray
+            The estimates, in the order of :attr:`names`.
+
+        Returns
+        -------
+        float
+        """
+        return float(e[1]) if self.input_drift else 0.0
 
     def columns_of_record(self, i: int) -> list[int]:
         """Indices (into :attr:`names`) of the estimates that move record `i` alone.
@@ -201,7 +240,7 @@ class Extras:
         -------
         list of int
         """
-        j = int(self.input_offset)
+        j = int(self.input_offset) + int(self.input_drift)
         out = []
         if self.output_offset:
             out.append(j + i)

@@ -251,6 +251,7 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
         position = float(np.mean(y[:window] - x[:window]))
         return _scored(tt, x + position, y, window, position, 0.0)
     r = substeps or system.default_substeps(fs)
+    u = u + float(getattr(system.plant, "force_drift", 0.0)) * tt  # a drifting force offset
     mech = system.plant.mechanics()
     st = Stepping.empty() if system.hysteresis is None else system.hysteresis.time_stepping()
     k_link = system.hysteresis.initial_stiffness if system.hysteresis is not None else 0.0

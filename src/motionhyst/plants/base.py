@@ -62,9 +62,15 @@ class LumpedPlant:
         for name, value in values.items():
             setattr(self, name, spec[name].check(value))
 
+    def _forces(self) -> dict[str, float]:
+        """The parameters besides :attr:`PARAMETERS` (the force offset, and its drift where
+        the plant has one), by name."""
+        return {p.name: getattr(self, p.name) for p in self.parameters
+                if p.name not in self.PARAMETERS}
+
     def __repr__(self) -> str:
         args = ", ".join(f"{n}={getattr(self, n)!r}" for n in self.PARAMETERS)
-        extra = f", force_offset={self.force_offset!r}" if self.force_offset else ""
+        extra = "".join(f", {n}={v!r}" for n, v in self._forces().items() if v)
         return f"{type(self).__name__}({args}{extra})"
 
     def dynamic_stiffness(self, s: NDArray[np.complex128], k_link: float, c_link: float
@@ -127,14 +133,14 @@ class LumpedPlant:
         if len(values) != len(self.PARAMETERS):
             raise ValueError(f"{len(values)} values for the {len(self.PARAMETERS)} parameters "
                              f"{', '.join(self.PARAMETERS)}")
-        return type(self)(*values, force_offset=self.force_offset)
+        return type(self)(*values, **self._forces())
 
     def to_dict(self) -> dict:
-        """The scenario's ``[stage]`` table, with ``type`` (``force_offset`` only when not 0)."""
+        """The scenario's ``[stage]`` table, with ``type`` (``force_offset`` and
+        ``force_drift`` only when not 0)."""
         out: dict[str, Any] = {"type": self.name}
         out.update((n, getattr(self, n)) for n in self.PARAMETERS)
-        if self.force_offset:
-            out["force_offset"] = self.force_offset
+        out.update((n, v) for n, v in self._forces().items() if v)
         return out
 
 

@@ -1,7 +1,8 @@
 """A positioning axis: one mass with viscous friction to the ground and no spring.
 
-``m y'' + c y' = u + f0 - w``: the carriage of a ball-screw or linear-motor
-axis, the force ``u`` of the drive (with a constant offset ``f0``), the link
+``m y'' + c y' = u + f0 + f1 t - w``: the carriage of a ball-screw or linear-motor
+axis, the force ``u`` of the drive (with an offset ``f0`` that may drift at
+``f1`` over the record's time ``t``: a drive or its friction warming up), the link
 force ``w`` (friction) on the carriage's position ``y``, which is measured.
 The rigid-body mass ``M = m`` is that of the feedforward ``M s^2``.
 """
@@ -34,6 +35,12 @@ class MassDamper(LumpedPlant):
         Viscous damping to the ground [N s/m], >= 0.
     force_offset : float
         Constant force ``f0`` added to the force on the mass [N].
+    force_drift : float
+        Rate ``f1`` at which that force changes with the record's time ``t`` [N/s]:
+        ``f0 + f1 t`` is added at time ``t`` (the time of the record simulated, its
+        first sample not necessarily 0).  A record from a machine warming up (EMPS:
+        the force a period of the same motion needs moves by 0.1 N per period);
+        simulations from a start only, not periodic steady states.
 
     Examples
     --------
@@ -56,12 +63,15 @@ class MassDamper(LumpedPlant):
         PlantParameter("m", "kg", "moving mass"),
         PlantParameter("c", "N s/m", "viscous damping to the ground", "nonnegative"),
         FORCE_OFFSET,
+        PlantParameter("force_drift", "N/s", "rate at which the force offset changes over the "
+                       "record's time (a drive or its friction warming up)", "finite", 0.0),
     )
     PARAMETERS: ClassVar[tuple[str, ...]] = ("m", "c")
     has_inertia: ClassVar[bool] = True
 
-    def __init__(self, m: float, c: float, force_offset: float = 0.0) -> None:
-        self._set_checked(m=m, c=c, force_offset=force_offset)
+    def __init__(self, m: float, c: float, force_offset: float = 0.0,
+                 force_drift: float = 0.0) -> None:
+        self._set_checked(m=m, c=c, force_offset=force_offset, force_drift=force_drift)
 
     @property
     def M(self) -> float:

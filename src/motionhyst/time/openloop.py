@@ -239,7 +239,9 @@ class OpenLoop:
             amplitude from one period to the next.  A floating plant (no spring
             to the ground: the two-mass stage, or ``k = 0``) has such a state
             only if the link carries the force's mean, and then at any constant
-            offset: it is returned with zero mean.
+            offset: it is returned with zero mean.  Not for a plant whose
+            force offset drifts (``force_drift``: its force at ``t`` is ``u(t) +
+            f0 + f1 t``, which repeats no period).
         substeps : int, optional
             Integration steps per sample (default :meth:`default_substeps`; a plant
             without inertia has none: ignored).
@@ -249,6 +251,13 @@ class OpenLoop:
         OpenLoopResponse
         """
         tt, u = check_record(t, force)
+        recorded = u
+        drift = float(getattr(self.plant, "force_drift", 0.0))
+        if drift:  # the force offset at each sample's time (the constant part: mechanics)
+            if periodic:
+                raise ValueError(f"a force offset drifting at {drift:g} N/s has no periodic "
+                                 f"steady state; simulate from a start")
+            u = u + drift * tt
         if not self.plant.has_inertia:  # no masses: the link balances the force at each sample
             from motionhyst.time.quasi_static import displacement_from_force
 
@@ -267,7 +276,7 @@ class OpenLoop:
                                      plant=self.plant)
         else:
             y = self._simulate_elements(u, fs, r, periodic)
-        return OpenLoopResponse(tt, u, y, periodic)
+        return OpenLoopResponse(tt, recorded, y, periodic)
 
     def _simulate_elements(self, u, fs, r, periodic, upsampled=None):
         """Displacement of a link of exact-update elements (`upsampled`: ``fine_input(u, r,
