@@ -19,7 +19,8 @@ FC_TRUE = np.array([0.01, 0.02, 0.03])  # N; slip displacements 1, 3.3 and 7.5 m
 NOISE = 0.01  # force noise relative to the force RMS
 N_SAMPLES = 2000
 IDENTIFY_KEYS = {"model", "elements", "fit_rms", "fit_nrms", "r2", "n_samples", "offset",
-                 "criterion", "signal", "candidates", "record", "data", "covariance"}
+                 "offset_std", "criterion", "signal", "candidates", "record", "data",
+                 "covariance"}
 ELEMENT_KEYS = {"k", "fc", "k_std", "fc_std"}
 
 
@@ -234,6 +235,20 @@ def test_closed_loop_prefilter_cutoff(capsys, closed_loop_case):
                        "1e6")
     assert rc == 2 and out == "" and err.count("\n") == 1
     assert "cutoff_hz must be in (0, " in err and str(csv) in err
+
+
+def test_closed_loop_offset_option(capsys, closed_loop_case):
+    """--offset on a closed-loop record as on input-output ones: none fixes the force
+    offset at 0; a position offset is refused; a force-displacement record takes none."""
+    scenario, csv = closed_loop_case
+    capsys.readouterr()
+    d = run_json(capsys, "identify", str(csv), "--scenario", str(scenario), "--offset", "none")
+    assert d["offset"] == 0.0 and d["offset_std"] == 0.0
+    np.testing.assert_allclose([e["k"] for e in d["elements"]], K_TRUE, rtol=2e-3)
+    rc, out, err = run(capsys, "identify", str(csv), "--scenario", str(scenario), "--offset",
+                       "output")
+    assert rc == 2 and out == "" and err.count("\n") == 1
+    assert "position offset does not enter" in err
 
 
 def test_closed_loop_needs_a_stage_model(capsys, tmp_path, closed_loop_case):

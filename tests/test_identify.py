@@ -494,6 +494,24 @@ def test_closed_loop_with_measurement_noise(train_sim, heldout_sim):
     assert nrms(fit.model.response(heldout_sim.y1), heldout_sim.w) < BAR
 
 
+def test_closed_loop_force_offset_as_the_input_output_route(train_sim, closed_fit):
+    """A drive that reports its force 0.05 N off (the stage receives u - 0.05): estimated as
+    the input-output route's input_offset, same sign, with its standard error; fixed at 0
+    with offset "none" the fit is worse; a position offset is refused."""
+    u = train_sim.u + 0.05
+    fit = identify_closed_loop(train_sim.t, train_sim.y1, u, STAGE, n_elements=3)
+    assert fit.offset - closed_fit.offset == pytest.approx(0.05, rel=1e-3)
+    assert 0 < fit.offset_std < 1e-3
+    np.testing.assert_allclose(fit.model.k, K_TRUE, rtol=0.01)
+    none = identify_closed_loop(train_sim.t, train_sim.y1, u, STAGE, n_elements=3,
+                                offset="none")
+    assert none.offset == 0.0 and none.offset_std == 0.0
+    assert none.fit_rms > 10 * fit.fit_rms
+    for choice in ("output", "both"):
+        with pytest.raises(ValueError, match="position offset is not estimated"):
+            identify_closed_loop(train_sim.t, train_sim.y1, u, STAGE, offset=choice)
+
+
 def test_closed_loop_needs_uniform_sampling(train_sim):
     t = train_sim.t.copy()
     t[1000:] += 0.5 * (t[1] - t[0])

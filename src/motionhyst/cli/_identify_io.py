@@ -46,7 +46,8 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                         "none for its periodic ones, the position's for a stage on a spring "
                         "(where a force offset is only a position offset), both for a "
                         "quasi-static plant (a force offset moves where on its loops the link "
-                        "works)")
+                        "works); closed-loop records: the force offset, estimated (auto, "
+                        "input) or none")
     q.add_argument("--from-rest", action="store_true",
                    help="input-output records: each record starts at rest (default: its "
                         "initial velocity, and position where a spring holds the stage, are "

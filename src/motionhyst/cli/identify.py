@@ -132,12 +132,20 @@ def run(args: argparse.Namespace) -> int:
 
     if args.record == "input-output":
         return run_input_output(args)
-    check_not_input_output(args)
+    check_not_input_output(args, closed_loop=args.record != "force-displacement")
     if len(args.data) > 1:
         raise UsageError("motionhyst identify: several records are read with --record "
                          "input-output only")
     path = Path(args.data[0])
     kind = record_kind(path, args.record, args.columns)
+    if kind == "force-displacement" and args.offset is not None:
+        raise UsageError("motionhyst identify: --offset applies to input-output and closed-loop "
+                         "records only (a force-displacement record's offset is always "
+                         "estimated)")
+    if args.offset in ("output", "both"):
+        raise UsageError(f"motionhyst identify: --offset {args.offset}: a closed-loop record's "
+                         f"position offset does not enter the link force inferred from it; "
+                         f"use --offset auto, input or none")
     if kind == "force-displacement":
         for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
             if value is not None:
@@ -187,7 +195,8 @@ def run(args: argparse.Namespace) -> int:
         ctrl = sc.loop().sampled
         try:
             ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff,
-                                         controller=ctrl, **options)
+                                         controller=ctrl, offset=args.offset or "auto",
+                                         **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         what = (f"closed-loop record, plant of {sc.source}, prefilter cut-off "

@@ -207,7 +207,7 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
                          criterion: Criterion = "rms", rtol: float = 0.01, atol: float = 1e-3,
                          initial_state: Literal["fit", "relaxed"] = "fit",
                          max_elements: int = MAX_ELEMENTS, max_rows: int = MAX_ROWS,
-                         controller=None) -> Identification:
+                         controller=None, offset: str = "auto") -> Identification:
     """Identify Maxwell-slip parameters from a closed-loop record ``(t, y1, u)`` of a stage.
 
     The link force is inferred with :func:`infer_link_force` as ``L w``; the
@@ -223,6 +223,14 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         produced `u`, the record at its samples).
     n_elements, criterion, rtol, atol, initial_state, max_elements, max_rows
         As :func:`identify_maxwell_slip`.
+    offset : {"auto", "input", "none"}
+        The force offset, as the input-output route's ``input_offset``
+        (:func:`~motionhyst.identify.input_output.identify_io`): the stage
+        receives ``u - offset``, so the inferred link force carries it; estimated
+        with its standard error (``auto``, ``input``: the default) or fixed at 0
+        (``none``).  A position offset of ``y1`` does not enter ``L / P1`` of a
+        floating stage and is a constant force ``k y0`` (the same as a force
+        offset) on a spring: ``output`` and ``both`` are refused.
 
     Returns
     -------
@@ -240,6 +248,12 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     >>> print(np.round(ident.model.k, 2), np.round(ident.model.fc, 4), ident.signal)
     [10.  6.] [0.01 0.03] prefiltered force
     """
+    if offset in ("output", "both"):
+        raise ValueError("a closed-loop record's position offset is not estimated: it does not "
+                         "enter the link force inferred through a floating stage and is a "
+                         "force offset on a spring; use offset 'auto', 'input' or 'none'")
+    if offset not in ("auto", "input", "none"):
+        raise ValueError(f"unknown offset choice {offset!r}; expected auto, input or none")
     lf = infer_link_force(t, y1, u, stage, cutoff_hz, controller)
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
@@ -250,6 +264,6 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     start = int(np.searchsorted(sel, lf.settle_index))
     prob = FitProblem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],
                       rows=fit_rows(start, sel.size, max_rows), filt=lf.lowpass.with_step(q * dt),
-                      fit_initial=initial_state == "fit")
+                      fit_initial=initial_state == "fit", fit_offset=offset != "none")
     return identify_prepared(prob, n_elements, criterion, rtol, atol, max_elements,
                              "prefiltered force", cutoff_hz=lf.cutoff_hz)

@@ -80,6 +80,7 @@ class FitProblem:
     fit_initial: bool
     grid_d: NDArray[np.float64] | None = None
     grid_A: NDArray[np.float64] | None = None  # unit stop columns / d at the rows
+    fit_offset: bool = True  # the force offset c estimated (else fixed at 0)
 
     @property
     def y(self) -> NDArray[np.float64]:
@@ -206,16 +207,17 @@ def _evaluate(prob: FitProblem, theta, n: int, jac: bool):
     if prob.filt is not None:
         M = prob.filt(M)[prob.rows]
     # a constant offset passes the prefilter with its DC gain (1 by construction)
-    r = M[:, 0] + c - prob.y
+    r = M[:, 0] + (c if prob.fit_offset else 0.0) - prob.y
     if not jac:
         return r, None
-    J = np.column_stack([M[:, 1:], np.ones(r.size)])
+    J = np.column_stack([M[:, 1:], np.full(r.size, 1.0 if prob.fit_offset else 0.0)])
     return r, J
 
 
 def _refine(prob: FitProblem, k, fc, alpha, c, max_nfev: int = MAX_NFEV) -> _Fit:
     """Joint bounded least-squares refinement of all parameters."""
     n = len(k)
+    c = c if prob.fit_offset else 0.0  # fixed: its column is zero, it stays there
     theta0 = _pack(k, fc, np.clip(alpha, -0.999, 0.999), c, prob.fit_initial)
     k_lo = 1e-9 * float(np.sum(k))
     fc_lo = 1e-9 * float(np.sum(fc))
@@ -279,6 +281,8 @@ def _nnls_start(prob: FitProblem) -> tuple[NDArray, NDArray, float]:
     prob.grid_d, prob.grid_A = d, A
     y = prob.y
     a_mean, y_mean = A.mean(axis=0), float(y.mean())
+    if not prob.fit_offset:  # no offset: the elements alone carry the mean
+        a_mean, y_mean = np.zeros_like(a_mean), 0.0
     R = np.linalg.qr(np.column_stack([A - a_mean, y - y_mean]), mode="r")
     f, _ = nnls(R[:N_GRID, :N_GRID], R[:N_GRID, N_GRID], maxiter=50 * N_GRID)
     c = y_mean - float(a_mean @ f)
@@ -477,8 +481,8 @@ def _bic(rss: float, n_rows: int, n_params: int) -> float:
     return float(n_rows * np.log(max(rss, 1e-300) / n_rows) + n_params * np.log(n_rows))
 
 
-def _n_params(n_el: int, fit_initial: bool) -> int:
-    return (3 if fit_initial else 2) * n_el + 1
+def _n_params(n_el: int, fit_initial: bool, fit_offset: bool = True) -> int:
+    return (3 if fit_initial else 2) * n_el + int(fit_offset)
 
 
 def _covariance_std(fit: _Fit, n_rows: int) -> NDArray[np.float64]:
@@ -556,7 +560,8 @@ def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Crite
             how = (f"rms: smallest N with RMS residual within {100 * rtol:g} % of the best or "
                    f"{100 * atol:g} % of the force RMS (N tried: {', '.join(map(str, orders))})")
         else:
-            bics = {n: _bic(fits[n].rss, n_rows, _n_params(n, prob.fit_initial)) for n in orders}
+            bics = {n: _bic(fits[n].rss, n_rows,
+                            _n_params(n, prob.fit_initial, prob.fit_offset)) for n in orders}
             chosen = fits[min(bics, key=bics.get)]
             how = f"bic: smallest BIC (N tried: {', '.join(map(str, orders))})"
 
@@ -571,13 +576,14 @@ def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Crite
     fit_rms = rms(chosen)
     ref_rms = float(np.sqrt(tss / n_rows))
     candidates = [{"n_elements": m, "fit_rms": rms(fits[m]),
-                   "bic": _bic(fits[m].rss, n_rows, _n_params(m, prob.fit_initial))}
+                   "bic": _bic(fits[m].rss, n_rows,
+                               _n_params(m, prob.fit_initial, prob.fit_offset))}
                   for m in sorted(fits)]
     return Identification(
         model=MaxwellSlip(chosen.k[order], chosen.fc[order]),
         elements=elements,
-        offset=chosen.c,
-        offset_std=float(std[-1]),
+        offset=chosen.c if prob.fit_offset else 0.0,
+        offset_std=float(std[-1]) if prob.fit_offset else 0.0,
         initial_forces=(chosen.alpha * chosen.fc)[order],
         fit_rms=fit_rms,
         fit_nrms=fit_rms / ref_rms if ref_rms > 0 else float("inf"),

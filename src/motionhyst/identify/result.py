@@ -114,7 +114,7 @@ class Identification:
         return {"model": "maxwell-slip", "elements": [dict(e) for e in self.elements],
                 "fit_rms": self.fit_rms, "fit_nrms": self.fit_nrms, "r2": self.r2,
                 "n_samples": self.n_samples, "offset": self.offset,
-                "criterion": self.criterion, "signal": self.signal,
+                "offset_std": self.offset_std, "criterion": self.criterion, "signal": self.signal,
                 "candidates": [dict(c) for c in self.candidates],
                 **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz}),
                 **({} if self.covariance is None else {"covariance": self.covariance})}
