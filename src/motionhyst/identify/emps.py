@@ -59,9 +59,10 @@ DRIVE_GAIN = 35.15065
 """The drive's gain ``gtau`` [N/V]: the force on the load is ``gtau * vir``."""
 PERIOD = 6240
 """Samples per period of the estimation record's reference ``qg``."""
-MODELS = ("coulomb", "coulomb-asymmetric", "jenkins")
+MODELS = ("coulomb", "coulomb-asymmetric", "coulomb-asymmetric-drift", "jenkins")
 """Link models identified by default: friction of a positioning axis (``coulomb-asymmetric``:
-the Coulomb link with viscous friction by direction, ``identify --asymmetric``)."""
+the Coulomb link with viscous friction by direction, ``identify --asymmetric``; ``-drift``:
+the force offset drifting in time from the record's start, ``identify --drift``)."""
 REFERENCE_MODEL = {"m": 95.1089, "c": 203.5034, "fc": 20.3935, "offset": -3.1648}
 """The benchmark's IDIM-LS model: M [kg], Fv [N s/m], Fc [N], OF [N]."""
 PUBLISHED: tuple[tuple[str, float | None, float], ...] = (
@@ -245,7 +246,7 @@ class EMPSBenchmark:
         for m in self.models:
             p = m.parameters
             rows.append([f"motionhyst: mass-damper + {m.name}", g(p.get("m"), 4),
-                         _viscous(p), _friction(p), g(p.get("offset"), 3),
+                         _viscous(p), _friction(p), _offset(p),
                          f"{m.estimation['rmse_mm']:.3g}", f"{m.validation['rmse_mm']:.3g}",
                          f"{m.validation['fit_percent']:.1f}", _own(m.validation),
                          f"{m.seconds:.0f}"])
@@ -336,6 +337,15 @@ def _viscous(p: dict) -> str:
     if c is None or ("c_pos" not in p and "c_neg" not in p):
         return g(c, 4)
     return f"{g(c + p.get('c_pos', 0.0), 4)}/{g(c + p.get('c_neg', 0.0), 4)}"
+
+
+def _offset(p: dict) -> str:
+    """``OF``, or ``OF + rate t`` [N, N/s] for a drifting offset."""
+    from motionhyst.core.textfmt import g
+
+    if "drift" not in p:
+        return g(p.get("offset"), 3)
+    return f"{g(p['offset'], 3)} {p['drift']:+.2g} t"
 
 
 def _friction(p: dict) -> str:
@@ -462,8 +472,8 @@ def _parameters(fit) -> tuple[dict, dict]:
         short = name.removeprefix("link.")
         if short != name and short in fit.estimates:
             short = name
-        if name == "input_offset":
-            short = "offset"
+        if name in ("input_offset", "input_drift"):
+            short = name.removeprefix("input_")
         est[short] = float(value)
         s = fit.std.get(name)
         std[short] = None if s is None else float(s)
@@ -640,11 +650,11 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
         t0 = time.perf_counter()
         try:
+            link, *options = name.split("-")
             with warnings.catch_warnings():  # the report lists the fit's warnings itself
                 warnings.simplefilter("ignore", MotionhystWarning)
-                fit = identify_io([est], name.removesuffix("-asymmetric"), plant="mass-damper",
-                                  init_window=INIT_WINDOW,
-                                  asymmetric=name.endswith("-asymmetric"))
+                fit = identify_io([est], link, plant="mass-damper", init_window=INIT_WINDOW,
+                                  asymmetric="asymmetric" in options, drift="drift" in options)
             system = fit.system()
             est_score, _ = score(system, est)
             val_score, yhat = score(system, val)
