@@ -141,6 +141,7 @@ def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
     out, err = capsys.readouterr()
     assert err == ""
     models = json.loads(out)["models"]  # without the test record: both splits
+    assert json.loads(out)["chosen"]["name"] == "coulomb"  # the only model: the rule's choice
     assert [m["validation"]["record"] for m in models] == ["DATA_EMPS periods 3-4",
                                                            "DATA_EMPS periods 1-2"]
     for model in models:

@@ -109,7 +109,13 @@ def _emps_record(path: Path, name: str):
 
 def run_emps(args: argparse.Namespace) -> int:
     """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
-    from motionhyst.identify.emps import ESTIMATION_FILE, TEST_FILE, cross_validate, run_emps
+    from motionhyst.identify.emps import (
+        ESTIMATION_FILE,
+        TEST_FILE,
+        choose,
+        cross_validate,
+        run_emps,
+    )
 
     if args.seed is not None:
         raise UsageError("motionhyst benchmark emps: --seed applies to bouc-wen only (the EMPS "
@@ -142,12 +148,17 @@ def run_emps(args: argparse.Namespace) -> int:
         results = cross_validate(estimation, progress=say)
     else:
         results = [run_emps(estimation, test, periods=args.periods or (1, 2), progress=say)]
+    chosen = choose(results) if len(results) > 1 else None
     if args.json:
-        print_json({"models": [m for res in results for m in res.to_dict()["models"]]})
+        print_json({"models": [m for res in results for m in res.to_dict()["models"]],
+                    **({} if chosen is None else {"chosen": {"name": chosen[0],
+                                                             "worse_split_rmse_mm": chosen[1]}})})
         return 0
     print("\n\n".join(str(res) for res in results))
-    if len(results) > 1:
+    if chosen is not None:
         print("\nMean validation RMSE over both splits: " + ", ".join(
             f"{a.name} {(a.validation['rmse_mm'] + b.validation['rmse_mm']) / 2:.3g} mm"
             for a, b in zip(results[0].models, results[1].models, strict=True)))
+        print(f"Chosen by the worse of the two splits (the rule stated in advance): {chosen[0]}, "
+              f"{chosen[1]:.3g} mm on its worse split")
     return 0
