@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from file_trees import populate, snapshot
+from records_of_other_kinds import damper_record, piezo_record
 
 from motionhyst.cli import main
 from motionhyst.plants.frf_fit import ModalPlant
@@ -78,11 +79,14 @@ def _with_plant(extra: str = "", text: str = PAPER) -> str:
             + text[text.index("[hysteresis]"):])
 
 
-def _io_record() -> str:
-    """A short input-output record (time,force,displacement) of a mass on a spring."""
+def _io_record(mass: float = 0.0) -> str:
+    """A short input-output record (time,force,displacement) of a spring, or of a mass on it."""
+    from motionhyst.time.openloop import MassSpringDamper, OpenLoop
+
     t = np.arange(600) / 750.0
     u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
-    y = u / 5e4
+    y = (OpenLoop(MassSpringDamper(mass, 10.0, 5e4)).simulate(t, u).displacement if mass
+         else u / 5e4)
     return "time,force,displacement\n" + "".join(
         f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), u.tolist(), y.tolist(),
                                                  strict=True))
@@ -117,6 +121,15 @@ def _negative_magnitude() -> str:
     cells = rows[1].split(",")
     cells[1] = "-" + cells[1]
     return "\n".join([rows[0], ",".join(cells), *rows[2:]]) + "\n"
+def _table(record, columns: tuple[str, ...]) -> str:
+    """A generated record (:mod:`records_of_other_kinds`) as CSV text with these columns."""
+    data = {"time": record.t, "force": record.force, "displacement": record.displacement}
+    return ",".join(columns) + "\n" + "".join(
+        ",".join(repr(float(data[c][i])) for c in columns) + "\n" for i in range(record.t.size))
+
+
+PIEZO = _table(piezo_record(seconds=0.5), ("time", "force", "displacement"))
+DAMPER = _table(damper_record(seconds=10.0), ("time", "displacement", "force"))
 SCAN = ["scan", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
         "--s-max", "1e6"]
 
@@ -144,14 +157,24 @@ CASES = [
     ("predict-too-many-substeps", {"model.toml": MODEL, "f.csv": _force(20_000)},
      ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--substeps", "10000"], 2,
      ["20000 samples of 10000 integration steps", "memory budget"], []),
-    ("io-two-mass-on-one-mass", {}, ["identify", "io.csv", "--record", "input-output",
-                                     "--plant", "two-mass"], 2,
+    ("io-two-mass-on-one-mass", {"mass.csv": _io_record(mass=2.0)},
+     ["identify", "mass.csv", "--record", "input-output", "--plant", "two-mass",
+      "--max-memory", "1G"], 2,
      ["integration steps per sample", "--plant mass-spring-damper"], []),
     ("benchmark-mat-header-damaged", {f"bw/{n}.mat": b"MATLAB 5.0 MAT-file\x00\x01\x02"
                                       for n in ("uval_multisine", "yval_multisine",
                                                 "uval_sinesweep", "yval_sinesweep")},
      ["benchmark", "bouc-wen", "--data", "bw"], 2, ["uval_multisine.mat: cannot read"], []),
     # ----------------------------------------------------------------- no answer from nothing
+    ("io-piezo-without-inertia", {"piezo.csv": PIEZO},
+     ["identify", "piezo.csv", "--record", "input-output", "--model", "jenkins"], 2,
+     ["^piezo.csv: no inertia in the force", "not positive", "--plant quasi-static"], []),
+    ("io-spring-without-inertia", {}, ["identify", "io.csv", "--record", "input-output"], 2,
+     ["^io.csv: no inertia in the force", "--plant quasi-static"], []),
+    ("io-force-displacement-record", {"damper.csv": DAMPER},
+     ["identify", "damper.csv", "--record", "input-output", "--plant", "mass-damper",
+      "--model", "coulomb"], 2,
+     ["^damper.csv: no inertia in the force", "without --record input-output"], []),
     ("frf-two-lines", {"p.toml": _with_plant(), "plant.csv": _frd(np.array([10.0, 100.0]))},
      ["analyze", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: 2 measured lines cannot "
                                 "determine a mode", "Pf2 = 0"], []),
@@ -441,3 +464,49 @@ def test_a_defect_is_one_line_and_exit_1_and_its_traceback_on_request(tmp_path, 
     monkeypatch.setenv(TRACEBACK_VARIABLE, "1")
     with pytest.raises(TypeError):
         main(["analyze"])
+
+
+def test_records_without_inertia_are_refused_before_any_fit(tmp_path, monkeypatch, capsys):
+    """The inertia check comes before the search: none of the fits is reached."""
+    from motionhyst.identify import input_output
+
+    def reached(*args, **kwargs):
+        raise AssertionError("the search started")
+
+    for name in ("identify_elements_io", "identify_bouc_wen_msd", "identify_bouc_wen_two_mass"):
+        monkeypatch.setattr(input_output, name, reached)
+    (tmp_path / "piezo.csv").write_text(PIEZO)
+    for plant, model in (("mass-spring-damper", "bouc-wen"), ("mass-damper", "jenkins"),
+                         ("two-mass", "bouc-wen")):
+        code = main(["identify", str(tmp_path / "piezo.csv"), "--record", "input-output",
+                     "--plant", plant, "--model", model])
+        assert code == 2
+        assert "no inertia in the force" in _one_line(capsys.readouterr().err.encode())
+
+
+@pytest.mark.parametrize("mass", [2.0, 0.05])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_records_of_a_stage_pass_the_inertia_check(mass, periodic):
+    """A stage's mass, 2 kg or 0.05 kg (its mode at 225 Hz, in the band of a record at
+    750 Hz: a 10 ms filter loses its acceleration; the 5-sample one keeps it), passes."""
+    from motionhyst.hysteresis import BoucWen
+    from motionhyst.identify.io_checks import check_inertia
+    from motionhyst.identify.io_records import IORecord
+    from motionhyst.time.openloop import MassSpringDamper, OpenLoop
+
+    n = 256
+    rng = np.random.default_rng(1)
+    spec = np.zeros(n // 2 + 1, dtype=complex)
+    lines = np.arange(2, 52)  # 5.9 to 150 Hz
+    lines = lines[lines % 2 == 1] if periodic else lines
+    spec[lines] = np.exp(2j * np.pi * rng.random(lines.size))
+    u = np.fft.irfft(spec, n)
+    u *= 50.0 / np.std(u)
+    t = np.arange(n) / 750.0
+    system = OpenLoop(MassSpringDamper(mass, 10.0, 5e4), BoucWen(k=5e4, fc=20.0, beta=0.6,
+                                                                   gamma=0.2))
+    y = system.simulate(t, u, periodic=periodic).displacement
+    y += 0.01 * np.std(y) * rng.standard_normal(n)
+    check_inertia([IORecord(t, u, y)])
+    with pytest.raises(ValueError, match="no inertia in the force"):
+        check_inertia([IORecord(t, u, u / 5e4)])  # the spring alone

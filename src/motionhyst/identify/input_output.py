@@ -98,6 +98,7 @@ from motionhyst.identify.io_bouc_wen import START_RATIOS as START_RATIOS
 from motionhyst.identify.io_bouc_wen import START_REFINED as START_REFINED
 from motionhyst.identify.io_bouc_wen import START_SHARES as START_SHARES
 from motionhyst.identify.io_bouc_wen import identify_bouc_wen_msd, identify_bouc_wen_two_mass
+from motionhyst.identify.io_checks import check_inertia
 from motionhyst.identify.io_elements import PROFILE_CHI2 as PROFILE_CHI2
 from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
@@ -221,7 +222,9 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         ground but the link's) or, for records without visible inertia (piezo
         actuators, friction dampers), :class:`~motionhyst.plants.quasi_static.QuasiStatic`
         (``k, c`` in parallel with the link, any link Bouc-Wen included;
-        :mod:`~motionhyst.identify.io_quasi_static`).
+        :mod:`~motionhyst.identify.io_quasi_static`).  A stage with inertia is
+        refused before the search (a ValueError) for records that show none
+        (:func:`~motionhyst.identify.io_checks.check_inertia`).
     output : {"y2", "y1"}, optional
         With a two-mass stage given by its name or class: the measured position
         (``y2``, the point of control, the default, or ``y1``, the actuated mass);
@@ -361,6 +364,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
     shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
     if asymmetric and not (link is Coulomb and shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)
+    check_inertia(records)  # before the search
     if link is not BoucWen:
         return identify_elements_io(records, link, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,

@@ -19,7 +19,7 @@ from scipy.optimize import least_squares
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
-__all__ = ["best_linear_approximation", "best_linear_approximation_two_mass"]
+__all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "equation_rows"]
 
 BLA_STARTS = 6  # two-mass: grid points refined
 
@@ -107,20 +107,7 @@ def inverse_dynamics(records: list[IORecord], floating: bool, asymmetric: bool =
     >>> round(est["c_pos"], 1), round(est["c_neg"], 1)
     (40.0, 30.0)
     """
-    from scipy.signal import savgol_filter
-
-    rows, rhs = [], []
-    for rec in records:
-        window = max(7, 2 * round(0.005 * rec.fs) + 1)
-        window = min(window, rec.y.size - (1 - rec.y.size % 2))
-        dt = 1.0 / rec.fs
-        v = savgol_filter(rec.y, window, 3, deriv=1, delta=dt)
-        a = savgol_filter(rec.y, window, 3, deriv=2, delta=dt)
-        third = np.sign(v) if floating else rec.y
-        viscous = ([np.maximum(v, 0.0), np.minimum(v, 0.0)] if asymmetric and floating
-                   else [v])
-        rows.append(np.column_stack([a, *viscous, third, np.ones_like(v)]))
-        rhs.append(rec.u)
+    rows, rhs = equation_rows(records, floating, asymmetric)
     A = np.concatenate(rows)
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
@@ -132,6 +119,51 @@ def inverse_dynamics(records: list[IORecord], floating: bool, asymmetric: bool =
     m, c, third, u0 = x
     return {"m": float(m), "c": float(c), "fc" if floating else "k": float(third),
             "u0": float(u0)}
+
+
+def equation_rows(records: list[IORecord], floating: bool, asymmetric: bool = False,
+                  window: int | None = None
+                  ) -> tuple[list[NDArray[np.float64]], list[NDArray[np.float64]]]:
+    """The rows of :func:`inverse_dynamics`'s least squares, record by record.
+
+    Parameters
+    ----------
+    records, floating, asymmetric
+        As :func:`inverse_dynamics`.
+    window : int, optional
+        Samples of the Savitzky-Golay filter (odd, at least 5; default about 10 ms,
+        at least 7).
+
+    Returns
+    -------
+    rows : list of ndarray
+        For each record, the regressors at each sample: acceleration, velocity (or
+        its two directions), ``sign(y')`` (floating) or ``y``, and 1 (the offset).
+    rhs : list of ndarray
+        For each record, its force.
+
+    Examples
+    --------
+    >>> t = np.arange(200) / 100.0
+    >>> rows, rhs = equation_rows([IORecord(t, np.sin(t), 1e-3 * t ** 2)], floating=False)
+    >>> rows[0].shape, np.round(rows[0][100, :2], 6).tolist()         # y'' = 2e-3, y' = 2e-3 t
+    ((200, 4), [0.002, 0.002])
+    """
+    from scipy.signal import savgol_filter
+
+    rows, rhs = [], []
+    for rec in records:
+        samples = window or max(7, 2 * round(0.005 * rec.fs) + 1)
+        samples = min(samples, rec.y.size - (1 - rec.y.size % 2))
+        dt = 1.0 / rec.fs
+        v = savgol_filter(rec.y, samples, 3, deriv=1, delta=dt)
+        a = savgol_filter(rec.y, samples, 3, deriv=2, delta=dt)
+        third = np.sign(v) if floating else rec.y
+        viscous = ([np.maximum(v, 0.0), np.minimum(v, 0.0)] if asymmetric and floating
+                   else [v])
+        rows.append(np.column_stack([a, *viscous, third, np.ones_like(v)]))
+        rhs.append(rec.u)
+    return rows, rhs
 
 
 def _spectral_response(records: list[IORecord]
