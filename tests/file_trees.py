@@ -13,12 +13,15 @@ from pathlib import Path
 
 def populate(root: Path, files: dict) -> None:
     """Write `files` under `root`: ``{name: text or bytes}``; ``"@symlink:NAME": target`` makes a
-    symbolic link, ``"@hard:NAME": existing name`` a hard link."""
+    symbolic link, ``"@hard:NAME": existing name`` a hard link, ``"@fifo:NAME": None`` a named
+    pipe."""
     for name, content in files.items():
         if name.startswith("@"):
             kind, link = name[1:].split(":")
             if kind == "symlink":
                 (root / link).symlink_to(content)
+            elif kind == "fifo":
+                os.mkfifo(root / link)
             else:
                 (root / link).hardlink_to(root / content)
             continue
@@ -31,7 +34,7 @@ def populate(root: Path, files: dict) -> None:
 
 
 def snapshot(root: Path) -> dict[str, str]:
-    """Every entry under `root`: links by target, files by hash, folders as such."""
+    """Every entry under `root`: links by target, files by hash, folders and pipes as such."""
     snap = {}
     for dirpath, dirnames, filenames in os.walk(root):
         for name in dirnames + filenames:
@@ -41,6 +44,8 @@ def snapshot(root: Path) -> dict[str, str]:
                 snap[rel] = "link:" + os.readlink(path)
             elif path.is_dir():
                 snap[rel] = "dir"
+            elif not path.is_file():  # a named pipe: reading it would block
+                snap[rel] = "special"
             else:
                 snap[rel] = hashlib.sha256(path.read_bytes()).hexdigest()
     return snap

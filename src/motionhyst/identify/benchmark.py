@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, lfilter
 
 from motionhyst.core.compiled import njit
+from motionhyst.io.inputs import CSV_EXPANSION, input_problem
 
 __all__ = ["benchmark_output", "decimate_fir", "multisine", "newmark_bouc_wen", "training_record"]
 
@@ -403,6 +404,9 @@ def load_test_set(directory: str | Path, name: str) -> Record:
         if not path.is_file():
             raise ValueError(f"{path}: no such file (the benchmark's test sets are "
                              f"{', '.join(f for pair in TEST_SETS.values() for f in pair)})")
+        why = input_problem(path, CSV_EXPANSION)
+        if why:
+            raise ValueError(f"{path}: cannot read ({why})")
         try:
             data = loadmat(path)
         except (OSError, ValueError, MatReadError) as exc:

@@ -36,6 +36,8 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from motionhyst.io.inputs import CSV_EXPANSION, input_problem
+
 Source = str | os.PathLike | np.ndarray | pd.DataFrame | Mapping
 """What the readers accept: a CSV path, a 2-D array or a DataFrame (or a mapping of columns)."""
 
@@ -112,6 +114,9 @@ class _Dialect(typing.NamedTuple):
 
 def _dialect(path: Path) -> _Dialect:
     """Encoding, separator, decimal mark and header line of a CSV file, from its first bytes."""
+    why = input_problem(path, CSV_EXPANSION)
+    if why:
+        raise CSVError(f"cannot read {path}: {why}")
     try:
         with path.open("rb") as fh:
             head = fh.read(_SNIFF_BYTES)

@@ -59,6 +59,7 @@ from motionhyst.io.csvdata import (
     read_columns,
     read_header,
 )
+from motionhyst.io.inputs import CSV_EXPANSION, input_problem
 
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _MAT_TEXT_HEADER = b"MATLAB"
@@ -183,6 +184,9 @@ def _is_path(source: Source) -> bool:
 
 
 def _head(path: Path, n: int = 128) -> bytes:
+    why = input_problem(path, CSV_EXPANSION)
+    if why:
+        raise RecordError(f"cannot read {path}: {why}")
     try:
         with path.open("rb") as fh:
             return fh.read(n)
@@ -213,10 +217,9 @@ def is_mat_file(source: Source) -> bool:
     if path.suffix.lower() == ".mat":
         return True
     try:
-        with path.open("rb") as fh:
-            head = fh.read(520)
-    except OSError:
-        return False
+        head = _head(path, 520)
+    except RecordError:
+        return False  # the reader says why
     return head.startswith(_MAT_TEXT_HEADER) or _HDF5_SIGNATURE in (head[:8], head[512:520])
 
 

@@ -21,6 +21,7 @@ from pydantic import ValidationError
 
 from motionhyst.core.validation import check_magnitudes
 from motionhyst.hysteresis import Hysteresis
+from motionhyst.io.inputs import TOML_EXPANSION, input_problem
 from motionhyst.scenario.sections import (
     ScenarioError,
     ScenarioModel,
@@ -131,6 +132,9 @@ class Scenario:
             Build the loop and check that it is stable (a :class:`ScenarioError` if not).
         """
         path = Path(path)
+        why = input_problem(path, TOML_EXPANSION)
+        if why:
+            raise ScenarioError(f"{path}: cannot read ({why})")
         try:
             text = path.read_text()
         except OSError as exc:

@@ -40,6 +40,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.io.inputs import TOML_EXPANSION, input_problem
+
 __all__ = ["LOG_SPACE_CV", "JointNormal", "distributions_from_identification",
            "joint_from_identification"]
 
@@ -193,6 +195,9 @@ def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _read(path: Path, where: str):
+    why = input_problem(path, TOML_EXPANSION)
+    if why:
+        raise ValueError(f"{where}: cannot read ({why})")
     try:
         text = path.read_text()
     except OSError as exc:

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.io.inputs import TOML_EXPANSION, input_problem
 from motionhyst.study.identified import (
     JointNormal,
     distributions_from_identification,
@@ -277,6 +278,9 @@ class StudyDefinition:
             study without ``[samples]``: 100 samples, seed 0).
         """
         path = Path(path)
+        why = input_problem(path, TOML_EXPANSION)
+        if why:
+            raise StudyError(f"{path}: cannot read ({why})")
         try:
             text = path.read_text()
         except OSError as exc:
@@ -327,6 +331,9 @@ class StudyDefinition:
             spath = Path(name)
             if not spath.is_absolute():
                 spath = (base_dir or Path.cwd()) / spath
+            why = input_problem(spath, TOML_EXPANSION)
+            if why:
+                raise StudyError(f"'scenario': {spath}: cannot read ({why})")
             try:
                 scenario = tomllib.loads(spath.read_text())
             except OSError as exc:
