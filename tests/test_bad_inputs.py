@@ -71,6 +71,9 @@ def _csv(name: str, text: str | bytes) -> dict:
 REF_ROWS = _reference().splitlines()
 REC_ROWS = _record().splitlines()
 
+SCAN = ["scan", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+        "--s-max", "1e6"]
+
 # (id, extra files, argv, words the message must contain)
 CASES = [
     # ---------------------------------------------------------------- scenario files
@@ -198,6 +201,9 @@ CASES = [
     ("output-rate-negative", {}, ["simulate", "--time-series", "o.csv", "--frequency", "5",
                                   "--output-rate", "-5"], ["--output-rate"]),
     ("elements-zero", {}, ["identify", "rec.csv", "--elements", "0"], ["--elements"]),
+    ("scan-dwell-without-back-and-forth", {}, [*SCAN, "--dwell", "0.1"],
+     ["--dwell has no effect without --back-and-forth"]),
+    ("scan-force-without-time-series", {}, [*SCAN, "--force"], ["--force has no effect"]),
     # ---------------------------------------------------------------- output paths
     ("time-series-exists", {}, ["simulate", "--time-series", "old.csv", "--frequency", "5"],
      ["old.csv exists", "--force"]),

@@ -137,6 +137,11 @@ def run(args: argparse.Namespace) -> int:
     """Simulate the setpoint with each compensation and print the scan metrics."""
     from motionhyst.scenario import load_scenario
 
+    if not args.back_and_forth and not args.point_to_point:
+        refuse_unused(args, ("--dwell",), "without --back-and-forth (the rest before the "
+                      "return)", {"--dwell": 0.0})
+    if not args.time_series:
+        refuse_unused(args, ("--force",), "without --time-series (the only file scan writes)")
     sc = load_scenario(args.scenario)
     # imported once the input is read: a refusal does not wait for the scan to load
     from motionhyst.scan.ilc import ILCFilters
