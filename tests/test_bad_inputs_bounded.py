@@ -184,6 +184,13 @@ CASES = [
     ("record-above-max-memory", {"big.csv": _io_record()},
      ["identify", "big.csv", "--max-memory", "20K"], 2,
      ["reading big.csv (", "above the memory budget of 20.5 kB", "give a smaller file"], []),
+    ("record-column-1e300", {"r.csv": "time,displacement,force\n" + "".join(
+        f"{i / 100!r},{1e300 * np.sin(i / 10):.17g},{np.sin(i / 10):.17g}\n" for i in range(400))},
+     ["identify", "r.csv"], 2, ["^r.csv: displacement reaches", "outside the magnitudes"], []),
+    ("record-time-step-1e-300", {"r.csv": "time,force\n" + "".join(
+        f"{i * 1e-300!r},{np.sin(i / 10):.6f}\n" for i in range(300)), "model.toml": MODEL},
+     ["predict", "model.toml", "r.csv", "--out", "p.csv"], 2,
+     ["^r.csv: time reaches 2.99e-298: outside the magnitudes"], []),
     # ----------------------------------------------------------------- no answer from nothing
     ("io-piezo-without-inertia", {"piezo.csv": PIEZO},
      ["identify", "piezo.csv", "--record", "input-output", "--model", "jenkins"], 2,

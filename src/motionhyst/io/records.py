@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.validation import MAGNITUDES
 from motionhyst.io.csvdata import (
     CSVError,
     Source,
@@ -561,7 +562,21 @@ def read_record(source: Source, names: Sequence[str], *,
         gain = (scale or {}).get(n)
         if gain is not None:
             data[:, i] *= gain
+    _check_magnitudes(data, names, where)
     return data
+
+
+def _check_magnitudes(data: NDArray[np.float64], names: Sequence[str], where: str) -> None:
+    """A column whose largest magnitude lies outside the magnitudes motionhyst computes with
+    (:data:`~motionhyst.core.validation.MAGNITUDES`; a column of zeros is allowed) is a
+    RecordError naming it: a unit slip, or a column that is not the quantity named."""
+    with np.errstate(invalid="ignore"):
+        peaks = np.max(np.abs(data), axis=0, initial=0.0) if data.size else []
+    for name, peak in zip(names, peaks, strict=False):
+        if peak != 0.0 and np.isfinite(peak) and not MAGNITUDES[0] <= peak <= MAGNITUDES[1]:
+            raise RecordError(f"{where}: {name} reaches {peak:.3g}: outside the magnitudes "
+                              f"{MAGNITUDES[0]:g} to {MAGNITUDES[1]:g} (SI units) that "
+                              f"motionhyst computes with (its unit? --scale {name}=GAIN)")
 
 
 __all__ = ["RecordError", "is_mat_file", "parse_columns",
