@@ -204,6 +204,10 @@ CASES = [
     ("scan-dwell-without-back-and-forth", {}, [*SCAN, "--dwell", "0.1"],
      ["--dwell has no effect without --back-and-forth"]),
     ("scan-force-without-time-series", {}, [*SCAN, "--force"], ["--force has no effect"]),
+    ("stability-force-without-figure", {}, ["stability", "--no-exact", "--force"],
+     ["--force has no effect without --figure"]),
+    ("identify-force-without-save", {}, ["identify", "rec.csv", "--force"],
+     ["--force has no effect without --save"]),
     # ---------------------------------------------------------------- output paths
     ("time-series-exists", {}, ["simulate", "--time-series", "old.csv", "--frequency", "5"],
      ["old.csv exists", "--force"]),

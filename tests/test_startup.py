@@ -62,6 +62,12 @@ def _probe(*argv: str) -> dict:
     (["analyze", "--frequency", "ten"], 2),
     (["simulate", "--amplitude", "-1"], 2),
     (["identify"], 2),
+    (["identify", "r.csv", "--force"], 2),                                    # no --save
+    (["identify", "r.csv", "--record", "input-output", "--model", "jenkins", "--periodic",
+      "--from-rest"], 2),
+    (["stability", "--force"], 2),                                            # no --figure
+    (["scan", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+      "--s-max", "1e6", "--dwell", "1"], 2),                                  # no return
     (["reproduce", "--bogus"], 2),
     (["no-such-command"], 2),
 ])

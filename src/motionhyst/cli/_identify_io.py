@@ -107,8 +107,6 @@ def check_not_input_output(args: argparse.Namespace, closed_loop: bool = False) 
 
 def run_input_output(args: argparse.Namespace) -> int:
     """Identify the stage and its link from input-output records; print, optionally save."""
-    from motionhyst.identify.input_output import identify_io, load_io_csv
-
     for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff),
                           ("--criterion", args.criterion)):
         if value is not None:
@@ -121,11 +119,6 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.output is not None and len(PLANTS[plant].outputs) < 2:
         raise UsageError(f"motionhyst identify: --output applies to --plant two-mass only (a "
                          f"{plant} has one position)")
-    from motionhyst.identify.input_output import MODELS
-
-    if model not in MODELS:
-        raise UsageError(f"motionhyst identify: --model {model} is not available for "
-                         f"input-output records; use {', '.join(MODELS)}")
     if args.elements is not None and model != "maxwell-slip":
         raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     if args.nu is not None and model != "bouc-wen":
@@ -139,7 +132,6 @@ def run_input_output(args: argparse.Namespace) -> int:
 
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
         _check_savable_plant(plant)
-    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     if model == "bouc-wen" and plant != "quasi-static" and (
             args.from_rest or args.init_window is not None
@@ -164,6 +156,13 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
+    # imported once the options and the output are checked: a refusal does not wait for it
+    from motionhyst.identify.input_output import MODELS, identify_io, load_io_csv
+
+    if model not in MODELS:
+        raise UsageError(f"motionhyst identify: --model {model} is not available for "
+                         f"input-output records; use {', '.join(MODELS)}")
+    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
               if model == "bouc-wen" and plant != "quasi-static" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,

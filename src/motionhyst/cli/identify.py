@@ -12,6 +12,7 @@ from motionhyst.cli._common import (
     g,
     positive,
     print_json,
+    refuse_unused,
     warn_plant_fit,
     whole_number,
 )
@@ -122,14 +123,8 @@ def feedforward_fragment(k: Sequence[float], fc: Sequence[float]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Identify Maxwell-slip hysteresis from a measured record (CSV)."""
-    from motionhyst.identify import (
-        identify_closed_loop,
-        identify_maxwell_slip,
-        load_closed_loop_csv,
-        load_force_displacement_csv,
-    )
-    from motionhyst.scenario import load_scenario
-
+    if args.save is None:
+        refuse_unused(args, ("--force",), "without --save (the only file identify writes)")
     if args.record == "input-output":
         return run_input_output(args)
     check_not_input_output(args, closed_loop=args.record != "force-displacement")
@@ -162,6 +157,15 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.io.outputs import OutputFile
 
         target = OutputFile(args.save, force=args.force, inputs=[path], option="--save")
+    # imported once the options and the record's kind are checked: a refusal does not wait
+    from motionhyst.identify import (
+        identify_closed_loop,
+        identify_maxwell_slip,
+        load_closed_loop_csv,
+        load_force_displacement_csv,
+    )
+    from motionhyst.scenario import load_scenario
+
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         what = "force-displacement record"

@@ -7,7 +7,13 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import UsageError, output_file, print_json, warn_plant_fit
+from motionhyst.cli._common import (
+    UsageError,
+    output_file,
+    print_json,
+    refuse_unused,
+    warn_plant_fit,
+)
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -20,7 +26,9 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.scenario import load_scenario
 
     figure = None
-    if args.figure is not None:
+    if args.figure is None:
+        refuse_unused(args, ("--force",), "without --figure (the only file stability writes)")
+    else:
         figure = output_file(args.figure, args, "--figure",
                              [] if args.scenario is None else [args.scenario])
         if figure.path.suffix.lower() not in FIGURE_SUFFIXES:
