@@ -30,6 +30,9 @@ from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.scenario import default_scenario_path
 
 PAPER = default_scenario_path().read_text()
+STUDY = ('scenario = "s.toml"\noutputs = ["e1"]\n\n[axes]\namplitude = [0.001, 0.01]\n'
+         'frequency_hz = { geomspace = [1.0, 100.0, 50] }\n\n[samples]\nn = 100\nseed = 0\n'
+         '"hysteresis.k" = { lognormal = [20.0, 0.1] }\n')
 LIMIT = 3 << 30
 """Address space of a case's process [bytes]: an estimate that misses is a MemoryError."""
 
@@ -191,6 +194,13 @@ CASES = [
         f"{i * 1e-300!r},{np.sin(i / 10):.6f}\n" for i in range(300)), "model.toml": MODEL},
      ["predict", "model.toml", "r.csv", "--out", "p.csv"], 2,
      ["^r.csv: time reaches 2.99e-298: outside the magnitudes"], []),
+    ("study-axis-of-1e9-values", {"st.toml": STUDY.replace("[1.0, 100.0, 50]",
+                                                           "[1.0, 100.0, 1000000000]")},
+     ["study", "st.toml", "--out", "o.zarr"], 2,
+     ["'frequency_hz': 1000000000 values, more than the 100000000 points"], []),
+    ("study-1e12-samples", {"st.toml": STUDY.replace("n = 100", "n = 1000000000000")},
+     ["study", "st.toml", "--out", "o.zarr"], 2,
+     ["[samples] 'n': 1000000000000 samples, more than the 100000000 points"], []),
     # ----------------------------------------------------------------- no answer from nothing
     ("io-piezo-without-inertia", {"piezo.csv": PIEZO},
      ["identify", "piezo.csv", "--record", "input-output", "--model", "jenkins"], 2,

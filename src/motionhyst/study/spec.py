@@ -157,6 +157,9 @@ def _axis_values(key: str, spec, where: str) -> NDArray:
             raise StudyError(f"{where}{key!r}: {kind} needs [a, b, n] with numbers a, b and a "
                              f"whole number n >= 1")
         a, b, n = args
+        if n > MAX_POINTS:  # before the values are made
+            raise StudyError(f"{where}{key!r}: {n} values, more than the {MAX_POINTS} points a "
+                             f"study holds; split the study")
         if kind == "geomspace" and (a <= 0 or b <= 0):
             raise StudyError(f"{where}{key!r}: geomspace needs a, b > 0")
         values = (np.geomspace if kind == "geomspace" else np.linspace)(float(a), float(b), n)
@@ -408,6 +411,9 @@ class StudyDefinition:
                     joint = joint.without(s)  # the file's own win: the others' marginal
             if not isinstance(n, int) or isinstance(n, bool) or n < 1:
                 raise StudyError("[samples] 'n': give a whole number of samples >= 1")
+            if n > MAX_POINTS:  # before they are drawn
+                raise StudyError(f"[samples] 'n': {n} samples, more than the {MAX_POINTS} "
+                                 f"points a study holds; split the study")
             if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
                 raise StudyError("[samples] 'seed': give a whole number >= 0 (the samples are "
                                  "drawn from it, reproducibly)")
