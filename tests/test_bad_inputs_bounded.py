@@ -228,6 +228,9 @@ CASES = [
      ["analyze", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: cannot fit a rigid body "
                                 "plus modes: fit errors far above the data's noise",
                                 "give [plant] modes"], []),
+    ("predict-periodic-ends-do-not-join", {"model.toml": MODEL, "f.csv": _force(300)},
+     ["predict", "model.toml", "f.csv", "--out", "p.csv", "--periodic"], 2,
+     ["^f.csv: not whole periods of a periodic signal: its ends do not join"], []),
     ("periodic-record-from-rest", {"rest.csv": _from_rest()},
      ["identify", "rest.csv", "--record", "input-output", "--periodic"], 2,
      ["rest.csv: not a periodic steady state", "without --periodic"], []),

@@ -59,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
     """Simulate the scenario's open-loop system for the force record and write the output."""
     from motionhyst.io.records import read_record
     from motionhyst.scenario import Scenario
+    from motionhyst.time.resample import check_whole_periods
 
     if args.substeps is not None and not 1 <= args.substeps <= 10000:
         raise UsageError(f"motionhyst predict: --substeps must be from 1 to 10000, got "
@@ -84,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
                        columns=_only(args.columns) if both else args.columns,
                        scale=_only(args.scale) if both else args.scale)
     t, u = data[:, 0], data[:, 1]
+    if args.periodic:
+        check_whole_periods(u, str(args.data))
     _check_step(system, t, args)
     pred = None
     try:
@@ -170,10 +173,13 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     """The force that holds a model without inertia at the displacement record INPUT."""
     from motionhyst.io.records import read_record
     from motionhyst.time.quasi_static import force_from_displacement
+    from motionhyst.time.resample import check_whole_periods
 
     data = read_record(args.data, ("time", "displacement"), columns=args.columns,
                        scale=args.scale)
     t, x = data[:, 0], data[:, 1]
+    if args.periodic:
+        check_whole_periods(x, str(args.data))
     try:
         w = force_from_displacement(system.plant, system.hysteresis, t, x,
                                     periodic=args.periodic)

@@ -117,6 +117,7 @@ from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_R
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
 from motionhyst.plants import MassSpringDamper, Plant, plant_class
 from motionhyst.time.openloop import is_periodic_record
+from motionhyst.time.resample import check_whole_periods
 
 __all__ = ["identify_io"]
 
@@ -317,10 +318,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     records = check_records(list(records), periodic)
     if periodic:
         for rec in records:
+            check_whole_periods(rec.u, rec.name)
             rec_period = is_periodic_record(rec.u)
-            if rec_period is None and abs(rec.u[0] - rec.u[-1]) > 0.5 * np.ptp(rec.u):
-                raise ValueError(f"{rec.name}: periodic records must hold whole periods of "
-                                 f"the force; its ends do not join")
             if rec_period is not None:
                 check_steady_state(rec, rec_period)
     stage = _stage(plant, output)

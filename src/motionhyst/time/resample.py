@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import firwin, resample_poly
 
-__all__ = ["SINC_HALF_WIDTH", "STAMP_TOLERANCE", "check_record", "fine_input",
-           "is_periodic_record", "sampling_rate", "upsample"]
+__all__ = ["SINC_HALF_WIDTH", "STAMP_TOLERANCE", "check_record", "check_whole_periods",
+           "fine_input", "is_periodic_record", "sampling_rate", "upsample"]
 
 #: Half-width of the windowed-sinc interpolator of a record that is not periodic [samples].
 SINC_HALF_WIDTH = 64
@@ -200,6 +200,45 @@ def fine_input(u: NDArray[np.float64], factor: int, periodic: bool) -> NDArray[n
     if is_periodic_record(u) is not None:
         return upsample(u, factor, periodic=True)[: (u.size - 1) * factor + 1]
     return upsample(u, factor, periodic=False)
+
+
+def check_whole_periods(u: NDArray[np.float64], name: str) -> None:
+    """Refuse a record given as whole periods of a periodic signal whose ends do not join.
+
+    A record of one period (or several) of a periodic signal continues from its
+    last sample into its first as from any sample into the next; one whose ends
+    lie further apart than twice the largest step between neighbouring samples is
+    not such a record (a transient from rest, or periods cut anywhere), and a
+    periodic steady state computed from it would be no answer.
+
+    Parameters
+    ----------
+    u : ndarray
+        The signal that repeats (the force; a displacement for a record without inertia).
+    name : str
+        The record, for the message.
+
+    Raises
+    ------
+    ValueError
+        One line naming the record.
+
+    Examples
+    --------
+    >>> t = np.arange(200) / 200.0
+    >>> check_whole_periods(np.cos(2 * np.pi * 3 * t), "three.csv")   # three whole periods
+    >>> try:
+    ...     check_whole_periods(np.cos(2 * np.pi * 2.5 * t), "cut.csv")
+    ... except ValueError as exc:
+    ...     print(exc)
+    cut.csv: not whole periods of a periodic signal: its ends do not join (first sample 1, \
+last -0.997; the largest step between samples 0.0785)
+    """
+    step = float(np.max(np.abs(np.diff(u)))) if u.size > 1 else 0.0
+    if is_periodic_record(u) is None and abs(u[0] - u[-1]) > 2.0 * step:
+        raise ValueError(f"{name}: not whole periods of a periodic signal: its ends do not "
+                         f"join (first sample {u[0]:.3g}, last {u[-1]:.3g}; the largest step "
+                         f"between samples {step:.3g})")
 
 
 def is_periodic_record(u: NDArray[np.float64], rtol: float = 1e-9) -> int | None:
