@@ -239,6 +239,8 @@ CASES = [
      ["analyze", "d.toml"], 2, ["frequencies: 5 is given twice"], []),
     ("scenario-mass-1e300", {"h.toml": PAPER.replace("m2 = 17.5 ", "m2 = 1e300 ")},
      ["analyze", "h.toml"], 2, ["^h.toml: [stage] m2 = 1e+300: outside the magnitudes"], []),
+    ("scenario-mass-1e20-no-numpy-warning", {"h.toml": PAPER.replace("m1 = 5.0 ", "m1 = 1e20 ")},
+     ["analyze", "h.toml"], 0, None, []),
     ("scenario-mass-1e-300", {"h.toml": PAPER.replace("m2 = 17.5 ", "m2 = 1e-300 ")},
      ["steady", "h.toml"], 2, ["^h.toml: [stage] m2 = 1e-300: outside the magnitudes"], []),
     ("scenario-slip-force-list-1e-300", {"h.toml": PAPER.replace(

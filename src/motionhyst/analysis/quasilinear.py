@@ -445,8 +445,9 @@ def mismatch_crossover_exact(loop: Loop, amplitude: float, f_min: float = 1e-2,
     n = max(2, int(np.ceil(per_decade * np.log10(f_max / f_min))) + 1)
     f = np.geomspace(f_min, f_max, n)
 
-    def g(x):
-        return np.log(np.abs(loop_mismatch(loop, x, amplitude) - 1.0))
+    def g(x):  # -inf where the link changes nothing (E = 1 to the last bit): no crossing
+        with np.errstate(divide="ignore"):
+            return np.log(np.abs(loop_mismatch(loop, x, amplitude) - 1.0))
 
     chunk = 64
     for start in range(0, n - 1, chunk):
