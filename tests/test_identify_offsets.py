@@ -56,6 +56,7 @@ def test_offsets_and_initial_state_are_estimated_by_default(axis_fit):
     assert "force_offset = 2.99999" in text and "# position offset" in text
 
 
+@pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
 def test_noise_estimates_lie_within_their_standard_errors():
     fit = identify_io([_axis_record(seed=1, noise=2e-5), _axis_record(seed=2, noise=2e-5)],
                       "coulomb", plant="mass-damper", substeps=20)
@@ -216,3 +217,16 @@ def test_bouc_wen_position_offsets():
                                               fit.estimates["output_offset[1]"]]
     with pytest.raises(ValueError, match="only its position offsets"):
         identify_io(recs, offset="input")
+
+
+def test_reference_mass_only_where_the_linear_model_explains_the_force():
+    """The mass a fit is compared with is the inverse dynamics' where it explains the
+    force; a stage whose link carries the force (a Jenkins link) has none."""
+    from motionhyst.identify.io_start import reference_mass
+
+    t = np.arange(4000) / 1000.0
+    y = 0.02 * np.sin(2 * np.pi * 0.7 * t) + 0.005 * np.sin(2 * np.pi * 4.1 * t)
+    v = np.gradient(y, t, edge_order=2)
+    u = 95.0 * np.gradient(v, t, edge_order=2) + 200.0 * v + 20.0 * np.sign(v) - 3.2
+    assert reference_mass([IORecord(t, u, y)], floating=True) == pytest.approx(95.0, rel=1e-2)
+    assert np.isnan(reference_mass([_axis_record(seed=1, noise=2e-5)], floating=True))

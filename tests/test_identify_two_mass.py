@@ -45,6 +45,7 @@ def _record(n: int, seed: int, output: str = "y2", noise: float = 0.0, periodic:
     return IORecord(t, u, y, f"record {seed}")
 
 
+@pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
 @pytest.mark.parametrize("output", ["y2", "y1"])
 def test_noise_free_records_give_the_parameters(output):
     fit = identify_io([_record(1536, 1, output)], plant="two-mass", output=output,
@@ -59,6 +60,7 @@ def test_noise_free_records_give_the_parameters(output):
     assert fit.plant.output == output and fit.plant.to_dict()["type"] == "two-mass"
 
 
+@pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
 def test_noisy_records_within_three_standard_errors():
     noise = 2e-5  # about 1 % of the output's RMS
     fit = identify_io([_record(1536, 2, noise=noise), _record(1536, 3, noise=noise)],
@@ -70,6 +72,7 @@ def test_noisy_records_within_three_standard_errors():
     assert fit.fit_rms == pytest.approx(noise, rel=0.1)
 
 
+@pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
 def test_periodic_records_compared_without_their_mean():
     # 20 N RMS: at 50 N this one period of y2 leaves the search in a local minimum
     rec = _record(1024, 4, periodic=True, rms=20.0)
@@ -79,6 +82,7 @@ def test_periodic_records_compared_without_their_mean():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
 
 
+@pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
 @pytest.mark.parametrize("model, link, expected", [
     ("jenkins", Jenkins(k=5e4, fc=60.0), {"link.k": 5e4, "link.fc": 60.0}),
     ("dahl", Dahl(k=5e4, fc=20.0, alpha=1.5),

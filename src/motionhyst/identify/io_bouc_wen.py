@@ -319,7 +319,7 @@ def _judged(records: list[IORecord], res: NDArray[np.float64], plant, link,
     implausible estimates' warnings of a Bouc-Wen fit (`res`: predicted minus measured;
     `centred`: compared without their means, a floating stage's periodic records)."""
     from motionhyst.identify.io_checks import judge_fit, plausibility_warnings
-    from motionhyst.identify.io_start import inverse_dynamics
+    from motionhyst.identify.io_start import reference_mass
 
     predictions, i = [], 0
     for rec in records:
@@ -327,7 +327,7 @@ def _judged(records: list[IORecord], res: NDArray[np.float64], plant, link,
         i += rec.y.size
     fit_rms = float(np.sqrt(np.mean(res ** 2)))
     judge_fit(fit_rms, records, predictions, None, OpenLoop(plant, link), centred)
-    linear_mass = inverse_dynamics(records, floating)["m"]
+    linear_mass = reference_mass(records, floating)
     return plausibility_warnings({}, masses, linear_mass, records, [])
 
 

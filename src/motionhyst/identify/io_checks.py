@@ -131,7 +131,9 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
     masses : dict
         The plant's masses by name (``{"m": ..}`` or ``{"m1": .., "m2": ..}``).
     linear_mass : float
-        The records' linear estimate of the total mass [kg].
+        The records' linear estimate of the total mass [kg]; NaN where the records'
+        linear model does not explain their force
+        (:func:`~motionhyst.identify.io_start.reference_mass`): no mass compared.
     records : list of IORecord
         The records (for the inertia they show: ``m`` times the RMS acceleration).
     at_bound : list of str

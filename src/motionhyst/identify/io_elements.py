@@ -34,6 +34,7 @@ from motionhyst.identify.io_start import (
     best_linear_approximation_two_mass,
     check_substeps,
     inverse_dynamics,
+    reference_mass,
 )
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
@@ -728,7 +729,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                if lg and x0 > 0 and not RUNAWAY ** -1 < x / x0 < RUNAWAY}
     masses = {nm: float(x) for nm, x in zip(prob.plant.PARAMETERS, v, strict=False)
               if nm in ("m", "m1", "m2")}
-    linear_mass = idim["m"]
+    linear_mass = reference_mass(records, shape.floating)
     notes = plausibility_warnings(estimates, masses, linear_mass, records, bound, runaway)
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,

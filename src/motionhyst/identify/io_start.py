@@ -19,7 +19,8 @@ from scipy.optimize import least_squares
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
-__all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "equation_rows"]
+__all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "equation_rows",
+           "reference_mass"]
 
 BLA_STARTS = 6  # two-mass: grid points refined
 
@@ -107,11 +108,7 @@ def inverse_dynamics(records: list[IORecord], floating: bool, asymmetric: bool =
     >>> round(est["c_pos"], 1), round(est["c_neg"], 1)
     (40.0, 30.0)
     """
-    rows, rhs = equation_rows(records, floating, asymmetric)
-    A = np.concatenate(rows)
-    scale = np.linalg.norm(A, axis=0)
-    scale[scale == 0] = 1.0
-    x = np.linalg.lstsq(A / scale, np.concatenate(rhs), rcond=None)[0] / scale
+    x, _ = _least_squares(records, floating, asymmetric)
     if x.size == 5:
         m, c_pos, c_neg, third, u0 = x
         return {"m": float(m), "c": float(0.5 * (c_pos + c_neg)), "fc": float(third),
@@ -119,6 +116,61 @@ def inverse_dynamics(records: list[IORecord], floating: bool, asymmetric: bool =
     m, c, third, u0 = x
     return {"m": float(m), "c": float(c), "fc" if floating else "k": float(third),
             "u0": float(u0)}
+
+
+def _least_squares(records: list[IORecord], floating: bool, asymmetric: bool = False
+                   ) -> tuple[NDArray[np.float64], float]:
+    """:func:`inverse_dynamics`'s solution and the share of the force it leaves
+    unexplained (``||A x - u|| / ||u - mean(u)||``)."""
+    rows, rhs = equation_rows(records, floating, asymmetric)
+    A, u = np.concatenate(rows), np.concatenate(rhs)
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    x = np.linalg.lstsq(A / scale, u, rcond=None)[0] / scale
+    spread = float(np.linalg.norm(u - np.mean(u)))
+    return x, float(np.linalg.norm(A @ x - u)) / spread if spread > 0 else math.inf
+
+
+#: The records' linear model is a reference for a fit's mass only where it explains the
+#: force: at most this share of it unexplained (EMPS: 0.045; a stage whose link carries
+#: the force, or a second mass, leaves 0.7-1)
+LINEAR_MODEL_RESIDUAL = 0.3
+
+
+def reference_mass(records: list[IORecord], floating: bool) -> float:
+    """The mass a fit's is compared with: :func:`inverse_dynamics`'s, where that linear
+    model explains the records' force (:data:`LINEAR_MODEL_RESIDUAL`), else NaN.
+
+    A stage whose link carries much of the force (a Jenkins link before it slips), or
+    whose second mass moves on its own, is no rigid body with friction: its linear
+    estimate of the mass is then off by any factor and says nothing of the fit's.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records.
+    floating : bool
+        No spring to the ground (as :func:`inverse_dynamics`).
+
+    Returns
+    -------
+    float
+        The mass [kg], or NaN.
+
+    Examples
+    --------
+    >>> t = np.arange(3000) / 1000.0
+    >>> y = 0.05 * np.sin(2 * np.pi * t) + 0.02 * np.sin(2 * np.pi * 3.3 * t)
+    >>> v = np.gradient(y, t, edge_order=2)
+    >>> u = 2.0 * np.gradient(v, t, edge_order=2) + 30.0 * v + 4.0 * np.sign(v) - 1.5
+    >>> round(reference_mass([IORecord(t, u, y)], floating=True), 2)
+    2.0
+    >>> u_link = u + 400.0 * y                  # a spring the floating model does not have
+    >>> reference_mass([IORecord(t, u_link, y)], floating=True)
+    nan
+    """
+    x, unexplained = _least_squares(records, floating)
+    return float(x[0]) if unexplained <= LINEAR_MODEL_RESIDUAL else math.nan
 
 
 def equation_rows(records: list[IORecord], floating: bool, asymmetric: bool = False,
