@@ -612,3 +612,24 @@ def test_scan_runs_on_the_fitted_plant(noisy_fit, controller, link):
     a, b = fitted.run("none"), exact.run("none")
     assert a.ma_max == pytest.approx(b.ma_max, rel=0.02)
     assert a.ma_max == pytest.approx(0.05 / 6.2e6, rel=0.02)  # e = fc / C(0) while slipping
+
+
+def test_the_library_warns_of_a_plant_the_model_cannot_describe(tmp_path):
+    """The same warning for a library user: building the scenario's plant issues each of
+    its fit's warnings once, as a MotionhystWarning."""
+    import warnings
+
+    from motionhyst.core.warnings import MotionhystWarning
+    from motionhyst.scenario import Scenario
+
+    p1, p2 = two_mass_held(LINES, 20.0)
+    write_frd(tmp_path / "p.csv", LINES, noisy(p1, 0), noisy(p2, 1))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sc = Scenario.from_file(frd_toml(tmp_path, ""))  # checked: its plant built
+        sc.plant()
+        sc.plant()
+        sc.loop()
+    lines = [str(w.message) for w in caught if issubclass(w.category, MotionhystWarning)]
+    assert lines == sc.plant_fit().warnings and len(lines) == 1
+    assert lines[0].startswith("measured plant: the lowest lines are not a floating rigid body")

@@ -288,20 +288,18 @@ def warnings_on_stderr(command: str) -> Iterator[None]:
 
 
 def warn_plant_fit(sc) -> None:
-    """The warnings of a measured plant's fit (:attr:`motionhyst.FrfFit.warnings`) as
-    :class:`~motionhyst.core.warnings.MotionhystWarning`.
+    """Fit a measured plant now, before the command's work: its fit's warnings
+    (:attr:`motionhyst.FrfFit.warnings`, issued by :meth:`Scenario.plant
+    <motionhyst.scenario.Scenario.plant>` as
+    :class:`~motionhyst.core.warnings.MotionhystWarning`, one each) come first.
 
-    One each: the data are not what a rigid body plus modes describes (a
-    stiffness to ground, errors far above the noise), so every number
-    computed on the fitted plant is in doubt.  Nothing for a modelled stage.
+    The data are then not what a rigid body plus modes describes (a stiffness
+    to ground, errors far above the noise), so every number computed on the
+    fitted plant is in doubt.  Nothing for a modelled stage.
 
     Parameters
     ----------
     sc : Scenario
         The command's scenario.
     """
-    from motionhyst.core.warnings import warn
-
-    fit = sc.plant_fit()
-    for message in fit.warnings if fit is not None else ():
-        warn(message)
+    sc.plant_fit()

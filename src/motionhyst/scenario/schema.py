@@ -203,6 +203,7 @@ class Scenario:
         a measured plant, or the raw measured plant."""
         if self._plant is not None:
             return self._plant
+        from motionhyst.core.warnings import warn
         from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
         from motionhyst.plants.measured import load_frd_plant
 
@@ -248,6 +249,8 @@ class Scenario:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body plus "
                                 f"modes: {above[0].removeprefix('measured plant: ')}; give "
                                 f"[plant] modes, or data without those dynamics")
+        for message in self._fit.warnings:  # once: the plant is built once per scenario
+            warn(message)
         self._plant = self._fit.plant
         return self._plant
 

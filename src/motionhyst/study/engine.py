@@ -13,6 +13,7 @@ import math
 import signal
 import threading
 import time
+import warnings
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -22,6 +23,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.warnings import MotionhystWarning
 from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
 from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
@@ -108,9 +110,11 @@ class Evaluator:
         if key != self._key:
             self._key, self._loop, self._error = key, None, None
             try:
-                sc = Scenario.from_dict(self.study.scenario_at(values),
-                                        base_dir=self.study.base_dir)
-                self._loop = sc.loop()
+                with warnings.catch_warnings():  # a measured plant's fit: not once a point
+                    warnings.simplefilter("ignore", MotionhystWarning)
+                    sc = Scenario.from_dict(self.study.scenario_at(values),
+                                            base_dir=self.study.base_dir)
+                    self._loop = sc.loop()
                 self._unset = tuple(t for t in ("jerk", "snap")
                                     if getattr(sc.model.feedforward, t, 0.0) is None)
             except (ScenarioError, ValueError) as exc:
