@@ -14,6 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import motionhyst
@@ -43,8 +44,8 @@ def _run(code: str, *args: str, env: dict | None = None, cwd: Path | None = None
                           env=env, cwd=cwd, timeout=600, check=False)
 
 
-def _probe(*argv: str) -> dict:
-    proc = _run(_PROBE, *argv)
+def _probe(*argv: str, cwd: Path | None = None) -> dict:
+    proc = _run(_PROBE, *argv, cwd=cwd)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout)
 
@@ -77,6 +78,55 @@ def test_help_df_and_argument_errors_import_nothing_heavy(argv, rc):
     assert out["heavy"] == [], f"motionhyst {' '.join(argv)} imported {out['heavy']}"
     if rc == 2:
         assert out["err"].count("\n") == 1 and "error" in out["err"]
+
+
+def _rows(header: str, *columns: np.ndarray) -> str:
+    return header + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                    for row in np.column_stack(columns))
+
+
+def _bad_records() -> dict[str, str]:
+    """Records of 200 samples at 750 Hz, each with one defect a reader refuses."""
+    t = np.arange(200) / 750
+    u = np.sin(np.arange(200) / 10)
+    y = 1e-3 * np.cos(np.arange(200) / 10)
+    swapped = t.copy()
+    swapped[[50, 51]] = swapped[[51, 50]]  # time goes back once
+    y_hole, u_hole = y.copy(), u.copy()
+    y_hole[7] = u_hole[7] = np.nan
+    return {
+        "io-missing.csv": _rows("time,force", t, u),
+        "io-nan.csv": _rows("time,force,displacement", t, u, y_hole),
+        "io-back.csv": _rows("time,force,displacement", swapped, u, y),
+        "fd-nan.csv": _rows("time,displacement,force", t, y, u_hole),
+        "fd-back.csv": _rows("time,displacement,force", swapped, y, u),
+        "cl-nan.csv": _rows("time,y1,u", t, y_hole, u),
+        "stage.toml": ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
+                       '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n'),
+    }
+
+
+# python-control, matplotlib and scipy.optimize come with the fits and the simulation, not
+# with reading a record (pandas does: it parses the CSV)
+FIT_LIBRARIES = ("control", "matplotlib", "scipy.optimize", "scipy.signal", "numba")
+
+
+@pytest.mark.parametrize("argv, error", [
+    (["identify", "io-missing.csv", "--record", "input-output"], "missing column(s) displacement"),
+    (["identify", "io-nan.csv", "--record", "input-output"], "not finite"),
+    (["identify", "io-back.csv", "--record", "input-output"], "time must increase"),
+    (["identify", "fd-nan.csv"], "non-finite value in force"),
+    (["identify", "fd-back.csv"], "strictly increasing"),
+    (["identify", "cl-nan.csv", "--scenario", "stage.toml"], "non-finite value in y1"),
+])
+def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path, argv, error):
+    for name, text in _bad_records().items():
+        (tmp_path / name).write_text(text)
+    out = _probe(*argv, cwd=tmp_path)
+    assert out["rc"] == 2, out["err"]
+    assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
+    loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
+    assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded}"
 
 
 def test_import_motionhyst_is_light_and_exports_every_name():

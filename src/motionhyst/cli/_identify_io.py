@@ -156,13 +156,17 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
-    # imported once the options and the output are checked: a refusal does not wait for it
-    from motionhyst.identify.input_output import MODELS, identify_io, load_io_csv
+    # the records are read and checked by their light reader; the fit engines (python-control,
+    # matplotlib, scipy.optimize) are imported once options, output and records are checked
+    from motionhyst.identify.io_records import check_records, load_io_csv
+
+    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
+    check_records(records, args.periodic)  # identify_io checks them again: nothing is skipped
+    from motionhyst.identify.input_output import MODELS, identify_io
 
     if model not in MODELS:
         raise UsageError(f"motionhyst identify: --model {model} is not available for "
                          f"input-output records; use {', '.join(MODELS)}")
-    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
               if model == "bouc-wen" and plant != "quasi-static" else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,

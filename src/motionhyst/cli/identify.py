@@ -157,17 +157,23 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.io.outputs import OutputFile
 
         target = OutputFile(args.save, force=args.force, inputs=[path], option="--save")
-    # imported once the options and the record's kind are checked: a refusal does not wait
-    from motionhyst.identify import (
-        identify_closed_loop,
-        identify_maxwell_slip,
-        load_closed_loop_csv,
-        load_force_displacement_csv,
-    )
-    from motionhyst.scenario import load_scenario
+    if kind != "force-displacement" and args.scenario is None:
+        raise UsageError(f"motionhyst identify: {path} is a closed-loop record: give the "
+                         f"loop's plant with --scenario FILE (a [stage], or a measured "
+                         f"[plant]); there is no default plant")
+    # the record is read and checked by its light reader; the fit engines (python-control,
+    # matplotlib, scipy.optimize) are imported once the options and the record are checked
+    from motionhyst.identify.records import load_closed_loop_csv, load_force_displacement_csv
 
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
+    else:
+        t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
+    from motionhyst.identify.closed_loop import identify_closed_loop
+    from motionhyst.identify.fit import identify_maxwell_slip
+    from motionhyst.scenario import load_scenario
+
+    if kind == "force-displacement":
         what = "force-displacement record"
         try:
             ident = identify_maxwell_slip(x, w, t=t, **options)
@@ -177,10 +183,6 @@ def run(args: argparse.Namespace) -> int:
             target.write_text(ident.scenario_text(f"{path}"))
             extra["saved"] = args.save
     else:
-        if args.scenario is None:
-            raise UsageError(f"motionhyst identify: {path} is a closed-loop record: give the "
-                             f"loop's plant with --scenario FILE (a [stage], or a measured "
-                             f"[plant]); there is no default plant")
         sc = load_scenario(args.scenario)
         if sc.is_open_loop:
             raise UsageError(f"motionhyst identify: closed-loop records need the plant of a "
@@ -193,7 +195,6 @@ def run(args: argparse.Namespace) -> int:
                              f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
                              f"has a measured [plant] with use = \"data\"")
         warn_plant_fit(sc)
-        t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         extra["scenario"] = sc.source
         # a sampled controller: the record is at its samples, u_k acted held and delayed
         ctrl = sc.loop().sampled

@@ -84,18 +84,51 @@ result
     :class:`Identification`, the result of (a) and (b).
 """
 
-from motionhyst.core.lti import HoldFilter
-from motionhyst.identify.closed_loop import LinkForce, identify_closed_loop, infer_link_force
-from motionhyst.identify.fit import identify_maxwell_slip
-from motionhyst.identify.records import (
-    count_reversals,
-    load_closed_loop_csv,
-    load_force_displacement_csv,
-)
-from motionhyst.identify.result import Identification
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+# the names below are imported from their modules on first use (PEP 562), as the top-level
+# package does: importing a submodule (the record readers the command line checks a record
+# with) does not import python-control, matplotlib and scipy.optimize with the fit engines
+_EXPORTS = {
+    "motionhyst.core.lti": ("HoldFilter",),
+    "motionhyst.identify.closed_loop": ("LinkForce", "identify_closed_loop", "infer_link_force"),
+    "motionhyst.identify.fit": ("identify_maxwell_slip",),
+    "motionhyst.identify.records": ("count_reversals", "load_closed_loop_csv",
+                                    "load_force_displacement_csv"),
+    "motionhyst.identify.result": ("Identification",),
+}
+_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = [
     "HoldFilter", "Identification", "LinkForce", "count_reversals", "identify_closed_loop",
     "identify_maxwell_slip", "infer_link_force", "load_closed_loop_csv",
     "load_force_displacement_csv",
 ]
+
+if TYPE_CHECKING:
+    from motionhyst.core.lti import HoldFilter
+    from motionhyst.identify.closed_loop import LinkForce, identify_closed_loop, infer_link_force
+    from motionhyst.identify.fit import identify_maxwell_slip
+    from motionhyst.identify.records import (
+        count_reversals,
+        load_closed_loop_csv,
+        load_force_displacement_csv,
+    )
+    from motionhyst.identify.result import Identification
+
+
+def __getattr__(name: str):
+    """Import an exported name from its module on first access (PEP 562)."""
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.time.openloop import check_record, sampling_rate
+from motionhyst.time.resample import check_record, sampling_rate
 
 __all__ = ["IORecord", "load_io_csv"]
 

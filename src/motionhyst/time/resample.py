@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import firwin, resample_poly
 
 __all__ = ["SINC_HALF_WIDTH", "STAMP_TOLERANCE", "check_record", "check_whole_periods",
            "fine_input", "is_periodic_record", "sampling_rate", "upsample"]
@@ -156,6 +155,9 @@ def upsample(u: ArrayLike, factor: int, periodic: bool) -> NDArray[np.float64]:
         padded = np.zeros(n * factor // 2 + 1, dtype=complex)
         padded[: spec.size] = spec
         return np.fft.irfft(padded, n * factor) * factor
+    # scipy.signal (which imports scipy.optimize) only where used: checking a record does not
+    from scipy.signal import firwin, resample_poly
+
     half = SINC_HALF_WIDTH
     pad = half + 2
     ext = np.pad(x, pad, mode="wrap" if periodic else "reflect")
