@@ -101,6 +101,9 @@ def _bad_records() -> dict[str, str]:
         "fd-nan.csv": _rows("time,displacement,force", t, y, u_hole),
         "fd-back.csv": _rows("time,displacement,force", swapped, y, u),
         "cl-nan.csv": _rows("time,y1,u", t, y_hole, u),
+        "f-missing.csv": _rows("time,position", t, y),
+        "f-nan.csv": _rows("time,force", t, u_hole),
+        "f-back.csv": _rows("time,force", swapped, u),
         "stage.toml": ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
                        '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n'),
     }
@@ -118,6 +121,9 @@ FIT_LIBRARIES = ("control", "matplotlib", "scipy.optimize", "scipy.signal", "num
     (["identify", "fd-nan.csv"], "non-finite value in force"),
     (["identify", "fd-back.csv"], "strictly increasing"),
     (["identify", "cl-nan.csv", "--scenario", "stage.toml"], "non-finite value in y1"),
+    (["predict", "stage.toml", "f-missing.csv", "--out", "p.csv"], "missing column(s) force"),
+    (["predict", "stage.toml", "f-nan.csv", "--out", "p.csv"], "must be finite"),
+    (["predict", "stage.toml", "f-back.csv", "--out", "p.csv"], "time must increase"),
 ])
 def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path, argv, error):
     for name, text in _bad_records().items():
@@ -127,6 +133,7 @@ def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path,
     assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
     loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
     assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded}"
+    assert not (tmp_path / "p.csv").exists()
 
 
 def test_import_motionhyst_is_light_and_exports_every_name():

@@ -203,16 +203,17 @@ class Scenario:
         a measured plant, or the raw measured plant."""
         if self._plant is not None:
             return self._plant
-        from motionhyst.core.warnings import warn
-        from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
-        from motionhyst.plants.measured import load_frd_plant
-
         m = self.model
         if m.open_loop:
             return m.stage.build()
         if m.stage is not None:
             self._plant = m.stage.build(closed_loop=True)
             return self._plant
+        # imported for a measured plant only: a [stage] needs neither the fit nor python-control
+        from motionhyst.core.warnings import warn
+        from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
+        from motionhyst.plants.measured import load_frd_plant
+
         f = Path(m.plant.file)
         if not f.is_absolute():
             f = self.base_dir / f

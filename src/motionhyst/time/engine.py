@@ -53,7 +53,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.core.lti import expm_small
 from motionhyst.hysteresis.stepping import GL_T, GL_W, N_PARAMS, Stepping
 from motionhyst.time.kernel import CLOSED as CLOSED
 from motionhyst.time.kernel import MAX_FIXED_POINT_ITERATIONS, OPEN, step_loop
@@ -139,6 +138,10 @@ class FohStep:
         M[:ns, :ns] = A * h
         M[:ns, ns] = B * h
         M[ns, ns + 1] = 1.0
+        # imported where used: core.lti imports python-control, which reading and checking a
+        # record before a run does not need
+        from motionhyst.core.lti import expm_small
+
         E = expm_small(M)
         B1 = E[:ns, ns + 1]
         return cls(E[:ns, :ns], E[:ns, ns] - B1, B1, float(h))
