@@ -26,6 +26,8 @@ import types
 import warnings
 from typing import TYPE_CHECKING
 
+from motionhyst.core.exports import lazy_exports
+
 __version__ = "0.1.0"
 
 _EXPORTS = {
@@ -98,18 +100,7 @@ if TYPE_CHECKING:
     from motionhyst.time.simulation import Simulation, simulate
 
 
-def __getattr__(name: str):
-    """Import an exported name from its module on first access (PEP 562)."""
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 
 # Modules that moved in 0.2 (one subpackage per part of the architecture). Their old

@@ -86,8 +86,9 @@ result
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from motionhyst.core.exports import lazy_exports
 
 # the names below are imported from their modules on first use (PEP 562), as the top-level
 # package does: importing a submodule (the record readers the command line checks a record
@@ -100,8 +101,6 @@ _EXPORTS = {
                                     "load_force_displacement_csv"),
     "motionhyst.identify.result": ("Identification",),
 }
-_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
-
 __all__ = [
     "HoldFilter", "Identification", "LinkForce", "count_reversals", "identify_closed_loop",
     "identify_maxwell_slip", "infer_link_force", "load_closed_loop_csv",
@@ -120,15 +119,4 @@ if TYPE_CHECKING:
     from motionhyst.identify.result import Identification
 
 
-def __getattr__(name: str):
-    """Import an exported name from its module on first access (PEP 562)."""
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
