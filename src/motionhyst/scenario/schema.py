@@ -84,6 +84,7 @@ class Scenario:
         self._loop: Loop | None = None
         self._plant = None
         self._fit: FrfFit | None = None
+        self._fit_warned = False
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "<dict>",
@@ -210,7 +211,6 @@ class Scenario:
             self._plant = m.stage.build(closed_loop=True)
             return self._plant
         # imported for a measured plant only: a [stage] needs neither the fit nor python-control
-        from motionhyst.core.warnings import warn
         from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
         from motionhyst.plants.measured import load_frd_plant
 
@@ -250,10 +250,23 @@ class Scenario:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body plus "
                                 f"modes: {above[0].removeprefix('measured plant: ')}; give "
                                 f"[plant] modes, or data without those dynamics")
-        for message in self._fit.warnings:  # once: the plant is built once per scenario
-            warn(message)
         self._plant = self._fit.plant
+        if m.plant_only:  # no loop to check: its doubts are said now
+            self._warn_fit()
         return self._plant
+
+    def _warn_fit(self) -> None:
+        """The measured plant's fit warnings (:attr:`FrfFit.warnings`) as
+        :class:`~motionhyst.core.warnings.MotionhystWarning`, once a scenario: once its
+        loop is checked (an unstable loop's error says them itself), or with its plant
+        when the scenario has no loop."""
+        if self._fit is None or self._fit_warned:
+            return
+        from motionhyst.core.warnings import warn
+
+        self._fit_warned = True
+        for message in self._fit.warnings:
+            warn(message)
 
     def plant_fit(self) -> FrfFit | None:
         """The fit of a measured plant (``[plant] use = "fit"``), else None."""
@@ -348,6 +361,7 @@ class Scenario:
                         f"{self._fit.warnings[0].removeprefix('measured plant: ')}") from None
                 raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
             self._loop = loop
+            self._warn_fit()
         return self._loop
 
     def to_dict(self) -> dict:
