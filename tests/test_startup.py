@@ -123,7 +123,7 @@ FIT_LIBRARIES = ("control", "matplotlib", "scipy.optimize", "scipy.signal", "num
     (["identify", "cl-nan.csv", "--scenario", "stage.toml"], "non-finite value in y1"),
     (["predict", "stage.toml", "f-missing.csv", "--out", "p.csv"], "missing column(s) force"),
     (["predict", "stage.toml", "f-nan.csv", "--out", "p.csv"], "must be finite"),
-    (["predict", "stage.toml", "f-back.csv", "--out", "p.csv"], "time must increase"),
+    (["predict", "stage.toml", "f-back.csv", "--out", "p.csv"], "f-back.csv: time must increase"),
 ])
 def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path, argv, error):
     for name, text in _bad_records().items():

@@ -142,6 +142,9 @@ def _check_step(system, t, args) -> None:
         return
     try:
         tt, _ = check_record(t, np.zeros(np.size(t)))
+    except ValueError as exc:  # the record's time, not the model, is at fault
+        raise ValueError(f"{args.data}: {exc}") from None
+    try:
         r = system.default_substeps(sampling_rate(tt))
     except (ValueError, OverflowError) as exc:
         raise ValueError(f"{args.scenario}: the model cannot be simulated ({exc})") from None

@@ -67,8 +67,11 @@ def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], N
         raise ValueError("a record needs at least 2 samples")
     if not (np.all(np.isfinite(tt)) and np.all(np.isfinite(u))):
         raise ValueError("time and force must be finite")
-    if not np.all(np.diff(tt) > 0):
-        raise ValueError("time must increase")
+    back = np.flatnonzero(np.diff(tt) <= 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise ValueError(f"time must increase (sample {i + 1} at {tt[i]:.9g} s follows "
+                         f"{tt[i - 1]:.9g} s)")
     t0, dt = _uniform_grid(tt)
     off = np.abs(tt - (t0 + dt * np.arange(tt.size))) / dt
     worst = int(np.argmax(off))
