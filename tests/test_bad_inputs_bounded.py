@@ -109,6 +109,20 @@ def _from_rest() -> str:
 
 
 LOG = np.geomspace(1.0, 3000.0, 200)
+JENKINS = ('model = "jenkins"\nk = 20.0              # spring stiffness k_J [N/m]\n'
+           'fc = 0.05             # slip force f_c [N]\n')
+
+
+def _maxwell_slip(n: int) -> str:
+    """The Table I scenario with a Maxwell-slip link of `n` equal elements."""
+    return PAPER.replace(JENKINS, f'model = "maxwell-slip"\nk = [{", ".join(["1.0"] * n)}]\n'
+                                  f'fc = [{", ".join(["0.01"] * n)}]\n')
+
+
+def _frequencies(n: int) -> str:
+    """The Table I scenario at `n` frequencies from 1 Hz on, 1 mHz apart."""
+    return PAPER.replace("frequencies = [5.0, 10.0, 15.0]",
+                         f"frequencies = [{', '.join(f'{1 + i * 1e-3:.3f}' for i in range(n))}]")
 MODEL = ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
          '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n')
 
@@ -153,6 +167,16 @@ CASES = [
      []),
     ("max-memory-not-a-size", {}, ["analyze", "--max-memory", "lots"], 2,
      ["--max-memory", "not a size"], []),
+    ("steady-100k-frequencies", {"f.toml": _frequencies(100_000)}, ["steady", "f.toml"], 2,
+     ["^the Floquet multipliers at 100000 frequencies would take about", "work budget of 1 h",
+      "--max-seconds", "--no-floquet"], []),
+    ("steady-above-max-seconds", {}, ["steady", "--frequency", "5", "10", "--max-seconds",
+                                      "0.1"], 2, ["work budget of 0.1 s (--max-seconds)"], []),
+    ("steady-maxwell-100k-elements", {"m.toml": _maxwell_slip(100_000)},
+     ["steady", "m.toml", "--frequency", "10"], 2,
+     ["^the monodromy of 100000 stop elements needs", "memory budget", "--no-floquet"], []),
+    ("max-seconds-not-positive", {}, ["steady", "--max-seconds", "0"], 2,
+     ["--max-seconds", "must be"], []),
     ("frf-dense-200k-lines", {"p.toml": _with_plant(),
                               "plant.csv": _frd(np.linspace(1.0, 3000.0, 200_000),
                                                 noise=0.01)},

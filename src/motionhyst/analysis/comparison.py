@@ -22,11 +22,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis.floquet import FloquetResult, steady_state_floquet
+from motionhyst.analysis.floquet import FloquetResult, check_floquet_budget, steady_state_floquet
 from motionhyst.analysis.plausibility import check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.analysis.steady import SteadyState, steady_state_sweep
 from motionhyst.controllers.loop import Loop
+from motionhyst.core.budget import BudgetError
 from motionhyst.core.textfmt import g, table
 
 __all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
@@ -168,6 +169,12 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     -------
     DescribingFunctionComparison
 
+    Raises
+    ------
+    motionhyst.core.budget.BudgetError
+        With `floquet`: the multipliers above the memory or work budget, before any point
+        is computed (:func:`~motionhyst.analysis.floquet.check_floquet_budget`).
+
     Warns
     -----
     MotionhystWarning
@@ -184,6 +191,9 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     (1.239, 1.24)
     """
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    if floquet:  # the multipliers' memory and work, before any point is computed
+        check_floquet_budget(loop, f, remedy="give fewer frequencies or leave the multipliers "
+                                             "out (--no-floquet)")
     check_plausible(loop, amplitude, f)
     E_df = loop_mismatch(loop, f, amplitude)
     points = [ComparisonPoint(ss, complex(ed),
@@ -193,6 +203,8 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
         for p in points:
             try:
                 p.floquet = steady_state_floquet(loop, p.state)
+            except BudgetError:
+                raise
             except ValueError:
                 p.floquet = None
     return DescribingFunctionComparison(float(amplitude), points)

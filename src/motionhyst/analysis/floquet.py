@@ -38,16 +38,28 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis.steady import SteadyState
+from motionhyst.analysis.steady import MAX_HARMONICS, MIN_HARMONICS, SteadyState
 from motionhyst.controllers.loop import Loop
+from motionhyst.core.budget import check_memory, check_work
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfmt import g
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.stepping import STOP
 
-__all__ = ["FloquetResult", "LoopStateEquation", "steady_state_floquet"]
+__all__ = ["SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STATE_CUBED", "SECONDS_PER_STEP",
+           "FloquetResult", "LoopStateEquation", "check_floquet_budget", "steady_state_floquet"]
+
+SECONDS_PER_STEP = 20e-6
+"""Nominal cost of the monodromy per step of the period [s] (one core of a quiet machine:
+the stop elements' intervals, a smooth link's exponentials)."""
+
+SECONDS_PER_ELEMENT_STEP = 10e-9
+"""Nominal cost of the monodromy per step of the period and stop element [s]."""
+
+SECONDS_PER_STATE_CUBED = 1e-8
+"""Nominal cost of the multipliers per cube of the monodromy's states [s] (its eigenvalues)."""
 
 @dataclass
 class FloquetResult:
@@ -357,6 +369,87 @@ def _stop_monodromy(sys: LoopStateEquation, h: _Harmonics, T: float, k: NDArray,
     return M, int(np.sum(np.all(stuck, axis=0)))
 
 
+def _floquet_size(loop: Loop, frequencies_hz: NDArray, samples: int | None
+                  ) -> tuple[float, float, int]:
+    """Bytes of one point (the largest), seconds of all and the link's states of the
+    multipliers at these frequencies; zeros where the loop has none."""
+    link = loop.hysteresis
+    if link is None or loop.sampled is not None or not loop.is_lti or frequencies_hz.size == 0:
+        return 0.0, 0.0, 0
+    m = int(link.n_states)
+    if not m:
+        try:
+            st = link.time_stepping()
+        except ValueError:
+            return 0.0, 0.0, 0
+        if st is None or not np.all(st.codes == STOP):
+            return 0.0, 0.0, 0
+        m = int(st.codes.size)
+    n = int(loop.closed_loop_poles().size) + m
+    # the harmonics of each point as default_harmonics gives them, for all points at once
+    f_lim = 2.0 * float(np.max(np.abs(loop.closed_loop_poles()))) / TWO_PI
+    H = np.clip(np.ceil(f_lim / frequencies_hz), MIN_HARMONICS, MAX_HARMONICS)
+    steps = np.full(H.shape, float(samples)) if samples else np.maximum(8192.0, 16.0 * H)
+    step_bytes = 9.0 * m if not link.n_states else 24.0 * float(H.max())  # stuck, onset / v(t)
+    nbytes = float(steps.max()) * step_bytes + 8.0 * 8.0 * n * n
+    per_step = SECONDS_PER_STEP + (0.0 if link.n_states else m * SECONDS_PER_ELEMENT_STEP)
+    seconds = float(np.sum(steps)) * per_step + H.size * SECONDS_PER_STATE_CUBED * float(n) ** 3
+    return nbytes, seconds, m
+
+
+def check_floquet_budget(loop: Loop, frequencies_hz: ArrayLike, samples: int | None = None,
+                         remedy: str = "give fewer frequencies or a link of fewer elements"
+                         ) -> None:
+    """Refuse the Floquet multipliers of `loop` at these frequencies above the memory or work
+    budget (:mod:`motionhyst.core.budget`), before any is computed.
+
+    The monodromy of a link of ``m`` stop elements has ``n + m`` states: its memory grows
+    as their square, its eigenvalues' work as their cube, and its intervals' work as the
+    steps of the period times ``m`` (nominal costs :data:`SECONDS_PER_STEP`,
+    :data:`SECONDS_PER_STATE_CUBED`).
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop.
+    frequencies_hz : array_like
+        The frequencies of its steady states [Hz].
+    samples : int, optional
+        Steps of the period, as :func:`steady_state_floquet` takes them.
+    remedy : str
+        What the user can change, for the message.
+
+    Raises
+    ------
+    motionhyst.core.budget.BudgetError
+        One line naming the size and `remedy`.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.core.budget import BudgetError, set_max_seconds
+    >>> loop = default_scenario().loop()
+    >>> check_floquet_budget(loop, [5.0, 10.0])          # seconds: within the default hour
+    >>> set_max_seconds(60.0)
+    >>> try:
+    ...     check_floquet_budget(loop, np.linspace(1.0, 100.0, 100_000))
+    ... except BudgetError as exc:
+    ...     print(exc)
+    the Floquet multipliers at 100000 frequencies would take about 4.6 h, above the work budget \
+of 1 min (--max-seconds); give fewer frequencies or a link of fewer elements
+    >>> set_max_seconds(None)
+    """
+    f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    nbytes, seconds, m = _floquet_size(loop, f, samples)
+    if not m:
+        return
+    link = (f" of {m} stop elements" if not loop.hysteresis.n_states
+            else f" of a link of {m} states") if m > 1 else ""
+    check_memory(nbytes, f"the monodromy{link}", remedy)
+    where = f"{f.size} frequencies" if f.size > 1 else f"{g(f[0])} Hz"
+    check_work(seconds, f"the Floquet multipliers{link} at {where}", remedy)
+
+
 def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
                          ) -> FloquetResult:
     """Floquet multipliers of the periodic steady state `ss` of `loop` (exact monodromy).
@@ -380,6 +473,8 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
     ------
     ValueError
         For a sampled controller, a measured plant, no link, or a link of another kind.
+    motionhyst.core.budget.BudgetError
+        Above the memory or work budget (:func:`check_floquet_budget`), before the work.
 
     Examples
     --------
@@ -394,6 +489,7 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
         raise ValueError("the loop has no link")
     if loop.sampled is not None or not loop.is_lti:
         raise ValueError("Floquet multipliers need a continuous loop with a plant model")
+    check_floquet_budget(loop, [ss.frequency_hz], samples)
     sys = LoopStateEquation(loop)
     T = 1.0 / ss.frequency_hz
     h = _Harmonics(ss)

@@ -26,10 +26,11 @@ from motionhyst.cli._common import (
     UsageError,
     memory_size,
     one_line,
+    positive,
     warnings_on_stderr,
 )
 from motionhyst.cli.identify import feedforward_fragment, record_kind
-from motionhyst.core.budget import set_max_memory
+from motionhyst.core.budget import set_max_memory, set_max_seconds
 
 COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identify", "predict",
             "study", "benchmark", "reproduce")
@@ -64,6 +65,10 @@ def build_parser() -> argparse.ArgumentParser:
             "--max-memory", type=memory_size, metavar="SIZE",
             help="memory one computation may take, such as 4G or 500M (default: half of the "
                  "memory available; a larger one is refused before it starts)")
+        sub.choices[name].add_argument(
+            "--max-seconds", type=positive, metavar="S",
+            help="estimated run time a computation may take [s] (default: 3600; a longer one "
+                 "is refused before it starts)")
     return p
 
 
@@ -106,6 +111,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser = build_parser()
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
+        set_max_seconds(args.max_seconds)
         with warnings_on_stderr(args.command):
             return args.func(args)
     except BrokenPipeError:  # output piped into head, say: not an error
@@ -121,6 +127,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     finally:
         set_max_memory(None)
+        set_max_seconds(None)
         if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
             with contextlib.suppress(ValueError, OSError):  # interpreter's exit (tracebacks)
                 signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -1,4 +1,4 @@
-"""A memory budget for every computation: sizes estimated before the arrays are allocated.
+"""A memory and work budget for every computation: sizes estimated before the work starts.
 
 A computation whose size follows from its inputs (time steps of a run,
 lines of a measured frequency response times the candidates of a scan,
@@ -15,6 +15,14 @@ whichever is smallest); ``motionhyst --max-memory SIZE`` (any command) or
 the environment variable ``MOTIONHYST_MAX_MEMORY`` set it explicitly
 (:func:`set_max_memory`).
 
+The work of a computation whose time follows from its inputs (frequencies
+times harmonics, stop elements cubed) is estimated likewise, in seconds at
+the nominal costs its module states (measured on one core of a quiet
+machine: a loaded one takes longer), and refused above the work budget with
+:func:`check_work`: :data:`DEFAULT_SECONDS` unless ``motionhyst
+--max-seconds S`` (any command) or ``MOTIONHYST_MAX_SECONDS`` raise it
+(:func:`set_max_seconds`).  A command never runs for hours unasked.
+
 Examples
 --------
 >>> from motionhyst.core.budget import BudgetError, check_memory, parse_size, set_max_memory
@@ -29,6 +37,15 @@ Examples
 a run of 4e8 time steps needs 3 GB, above the memory budget of 1.07 GB \
 (--max-memory); lower --frequency or --duration
 >>> set_max_memory(None)                                  # back to the default
+>>> from motionhyst.core.budget import check_work, set_max_seconds
+>>> set_max_seconds(60.0)
+>>> try:
+...     check_work(1e4, "the Floquet multipliers at 1e5 frequencies", "give fewer frequencies")
+... except BudgetError as exc:
+...     print(exc)
+the Floquet multipliers at 1e5 frequencies would take about 2.8 h, above the work budget \
+of 1 min (--max-seconds); give fewer frequencies
+>>> set_max_seconds(None)
 """
 
 from __future__ import annotations
@@ -37,8 +54,10 @@ import os
 import re
 import resource
 
-__all__ = ["DEFAULT_FRACTION", "ENV_VARIABLE", "BudgetError", "available_memory",
-           "check_memory", "format_size", "max_memory", "parse_size", "set_max_memory"]
+__all__ = ["DEFAULT_FRACTION", "DEFAULT_SECONDS", "ENV_VARIABLE", "SECONDS_VARIABLE",
+           "BudgetError", "available_memory", "check_memory", "check_work", "format_duration",
+           "format_size", "max_memory", "max_seconds", "parse_size", "set_max_memory",
+           "set_max_seconds"]
 
 DEFAULT_FRACTION = 0.5
 """Share of :func:`available_memory` one computation may take unless a budget is given."""
@@ -48,11 +67,18 @@ ENV_VARIABLE = "MOTIONHYST_MAX_MEMORY"
 
 _UNITS = {"": 1, "B": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
 
+DEFAULT_SECONDS = 3600.0
+"""Work budget of one command [s of estimated run time] unless one is given (an hour)."""
+
+SECONDS_VARIABLE = "MOTIONHYST_MAX_SECONDS"
+"""Environment variable with the work budget in seconds (as ``--max-seconds``)."""
+
 _budget: int | None = None
+_seconds: float | None = None
 
 
 class BudgetError(ValueError):
-    """A computation above the memory budget: one line naming its size and the remedy.
+    """A computation above the memory or work budget: one line naming its size and the remedy.
 
     Examples
     --------
@@ -242,3 +268,104 @@ def check_memory(nbytes: float, what: str, remedy: str = "") -> None:
         tail = f"; {remedy}" if remedy else ""
         raise BudgetError(f"{what} needs {format_size(nbytes)}, above the memory budget of "
                           f"{format_size(budget)} (--max-memory){tail}")
+
+
+def format_duration(seconds: float) -> str:
+    """A duration for messages (``"40 s"``, ``"12 min"``, ``"2.8 h"``, ``"3.1 days"``).
+
+    Parameters
+    ----------
+    seconds : float
+        The duration [s].
+
+    Returns
+    -------
+    str
+        Two or three significant digits and a unit.
+
+    Examples
+    --------
+    >>> format_duration(42.0), format_duration(720.0), format_duration(1e4), format_duration(3e5)
+    ('42 s', '12 min', '2.8 h', '3.5 days')
+    """
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= size:
+            return f"{seconds / size:.2g} {unit}"
+    return f"{seconds:.2g} s"
+
+
+def set_max_seconds(seconds: float | None) -> None:
+    """Set the work budget of one command [s]; None: the default (environment or an hour).
+
+    Parameters
+    ----------
+    seconds : float or None
+        The budget, finite and > 0, or None for the default.
+
+    Examples
+    --------
+    >>> set_max_seconds(7200.0); max_seconds()
+    7200.0
+    >>> set_max_seconds(None); max_seconds() == DEFAULT_SECONDS
+    True
+    """
+    global _seconds
+    if seconds is not None and not 0 < seconds < float("inf"):
+        raise ValueError(f"the work budget must be finite and > 0 s, got {seconds!r}")
+    _seconds = None if seconds is None else float(seconds)
+
+
+def max_seconds() -> float:
+    """The work budget of one command [s]: as set, else from ``MOTIONHYST_MAX_SECONDS``,
+    else :data:`DEFAULT_SECONDS`.
+
+    Returns
+    -------
+    float
+        Seconds of estimated run time.
+
+    Examples
+    --------
+    >>> max_seconds() > 0
+    True
+    """
+    if _seconds is not None:
+        return _seconds
+    env = os.environ.get(SECONDS_VARIABLE)
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            value = float("nan")
+        if not 0 < value < float("inf"):
+            raise BudgetError(f"{SECONDS_VARIABLE}={env!r}: not a number of seconds > 0")
+        return value
+    return DEFAULT_SECONDS
+
+
+def check_work(seconds: float, what: str, remedy: str = "") -> None:
+    """Refuse a computation estimated to run `seconds`, above the work budget, before it starts.
+
+    Parameters
+    ----------
+    seconds : float
+        The estimated run time at the nominal costs of the computation's module [s].
+    what : str
+        The computation, as the message names it.
+    remedy : str
+        What the user can change.
+
+    Raises
+    ------
+    BudgetError
+        One line: `what` would take so long, above the budget, and `remedy`.
+
+    Examples
+    --------
+    >>> check_work(5.0, "three frequencies")
+    """
+    budget = max_seconds()
+    if seconds > budget:
+        tail = f"; {remedy}" if remedy else ""
+        raise BudgetError(f"{what} would take about {format_duration(seconds)}, above the work "
+                          f"budget of {format_duration(budget)} (--max-seconds){tail}")
