@@ -136,18 +136,26 @@ class LoopMargins:
         def at(f):
             return "" if not math.isfinite(f) else f" at {f:.4g} Hz"
 
+        def value(x, unit, none):  # never "inf" or "nan" as an answer: what it means instead
+            return f"{x:.4g} {unit}" if math.isfinite(x) else none
+
         gm = self.gain_margin_db
+        no_crossover = "unbounded (|C P2| never reaches 1: no gain crossover)"
         return "\n".join([
-            f"  gain margin                    {gm:.4g} dB{at(self.gain_margin_hz)}",
-            f"  phase margin                   {self.phase_margin_deg:.4g} deg"
+            f"  gain margin                    "
+            f"{value(gm, 'dB', 'unbounded (the phase of C P2 never crosses -180 deg)')}"
+            f"{at(self.gain_margin_hz)}",
+            f"  phase margin                   {value(self.phase_margin_deg, 'deg', no_crossover)}"
             f"{at(self.phase_margin_hz)}",
             f"  modulus margin 1/max|S|        {self.modulus_margin:.4g}"
             f"{at(self.modulus_margin_hz)}"
             f" (max|S| = {20 * math.log10(1 / self.modulus_margin):.4g} dB)",
-            f"  delay margin                   {self.delay_margin_s:.4g} s"
-            + ("" if self.sample_rate_hz is None else
+            f"  delay margin                   {value(self.delay_margin_s, 's', no_crossover)}"
+            + ("" if self.sample_rate_hz is None or not math.isfinite(self.delay_margin_s) else
                f" ({self.delay_margin_samples:.4g} samples at {self.sample_rate_hz:g} Hz)"),
-            f"  bandwidth                      {self.bandwidth_hz:.4g} Hz ({BANDWIDTH_DEFINITION})"
+            f"  bandwidth                      "
+            f"{value(self.bandwidth_hz, 'Hz', 'none (|C P2| does not fall through 1)')}"
+            f" ({BANDWIDTH_DEFINITION})"
             + ("" if self.evaluated_on == "model" else
                f"; evaluated on the {self.evaluated_on} only")])
 

@@ -187,6 +187,10 @@ class QuasiLinearAnalysis:
     def __str__(self) -> str:
         d = self.to_dict()
         has_zeta = self.zeta is not None and math.isfinite(self.zeta)
+
+        def hz(f: float, why: str) -> str:
+            return _hz(f, why, bool(self.unresolved))
+
         lines = [f"  reference amplitude A_r        {g(self.amplitude)} m"]
         if self.sampling is not None:
             lines.insert(0, f"  {self.sampling}")
@@ -196,12 +200,15 @@ class QuasiLinearAnalysis:
         label = f"|D|/k, angle D  ({'eq. 10' if has_zeta else 'eq. 7'})"
         lines += [f"  {label:<31}{g(d['df_abs_over_k'])}, {d['df_phase_deg']:.2f} deg{at}",
                   f"  f*  (eq. 13)                   {g(self.f_star_hz)} Hz",
-                  f"  bandwidth (first |C P2| = 1)   {g(self.bandwidth_hz)} Hz (the crossover "
+                  f"  bandwidth (first |C P2| = 1)   "
+                  f"{hz(self.bandwidth_hz, '|C P2| does not fall through 1')} (the crossover "
                   "frequency, where |C P2| falls through 0 dB)",
                   *([] if self.margins is None else str(self.margins).splitlines()[
                       :3 if self.sampling is None else 4]),
-                  f"  mismatch crossover (eq. 21)    {g(self.mismatch_crossover_hz)} Hz",
-                  f"  exact crossover |E - 1| = 1    {g(self.mismatch_crossover_exact_hz)} Hz "
+                  f"  mismatch crossover (eq. 21)    "
+                  f"{hz(self.mismatch_crossover_hz, 'eq. 21 does not give one')}",
+                  f"  exact crossover |E - 1| = 1    "
+                  f"{hz(self.mismatch_crossover_exact_hz, '|E - 1| does not fall to 1')} "
                   "(eq. 18: where the error the link adds equals the error without it; "
                   "eq. 21 estimates it from the asymptote, eq. 20)",
                   ""]
@@ -232,6 +239,13 @@ class QuasiLinearAnalysis:
         from motionhyst.analysis.figures import plot_analysis
 
         return plot_analysis(self, ax=ax)
+
+
+def _hz(f: float, why: str, unresolved: bool) -> str:
+    """A frequency for the text, or why there is none (never ``nan Hz``)."""
+    if math.isfinite(f):
+        return f"{g(f)} Hz"
+    return "not resolved (below)" if unresolved else f"none ({why} in the range searched)"
 
 
 def _parts(loop: Loop, omega: NDArray[np.float64]):
