@@ -211,6 +211,9 @@ CASES = [
     ("record-above-max-memory", {"big.csv": _io_record()},
      ["identify", "big.csv", "--max-memory", "20K"], 2,
      ["reading big.csv (", "above the memory budget of 20.5 kB", "give a smaller file"], []),
+    ("record-line-of-2e6-fields", {"r.csv": "time,displacement,force\n0,0,0\n" + "0," * 2_000_000
+                                   + "0\n"}, ["identify", "r.csv"], 2,
+     ["^r.csv: inconsistent lengths: line 3 has 2000001 fields, the header 3"], []),
     ("record-column-1e300", {"r.csv": "time,displacement,force\n" + "".join(
         f"{i / 100!r},{1e300 * np.sin(i / 10):.17g},{np.sin(i / 10):.17g}\n" for i in range(400))},
      ["identify", "r.csv"], 2, ["^r.csv: displacement reaches", "outside the magnitudes"], []),

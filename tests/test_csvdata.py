@@ -79,6 +79,10 @@ def test_nan_and_inf_written_out_are_kept_for_the_caller(tmp_path):
     ("time,position\n0,0\n0.1,1,7\n", ["inconsistent lengths: line 3 has 3 fields"]),
     ("time,position\n0,0,1\n0.1,1,7\n", ["inconsistent lengths: line 2 has 3 fields, "
                                          "the header 2"]),
+    ("time,position\n0,0\n" + "0," * 70_000 + "0\n0.2,1\n",  # refused before pandas reads it
+     ["inconsistent lengths: line 3 has 70001 fields, the header 2 (refused unread)"]),
+    ("time,position\n0,0\n\n0.1," + "7" * 200_000,
+     ["line 4 is 200 kB long: not a row of 2 numbers"]),
     ("t,pos\n0,0\n", ["missing column(s) time, position", "need a header with time,position",
                       "found t,pos"]),
     ("time,Time\n0,0\n", ["column 'time' appears twice"]),

@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from motionhyst.core.budget import format_size
 from motionhyst.io.inputs import CSV_EXPANSION, input_problem
 
 Source = str | os.PathLike | np.ndarray | pd.DataFrame | Mapping
@@ -43,6 +44,10 @@ Source = str | os.PathLike | np.ndarray | pd.DataFrame | Mapping
 
 _SEPARATORS = (",", ";", "\t")
 _SNIFF_BYTES = 64 * 1024
+
+_MAX_EXTRA_FIELDS = 1000   # a data row of more fields than its header's and these is refused
+_MAX_FIELD_BYTES = 64      # ... when its line is longer than this per field (checked unread)
+_CHUNK_BYTES = 1 << 22
 
 
 class CSVError(ValueError):
@@ -245,6 +250,43 @@ def _where(source: Source, row: int) -> str:
     return f"row {row + 1}"
 
 
+def _check_line_lengths(path: Path, d: _Dialect, width: int) -> None:
+    """Refuse a file with a line far longer than a row of `width` fields, before pandas reads
+    it: each of its fields would become a column (minutes for a line of 1e7 fields)."""
+    if d.encoding == "utf-16":  # two bytes a character; such files are small exports
+        return
+    limit = (width + _MAX_EXTRA_FIELDS) * _MAX_FIELD_BYTES
+    line, start, pos = 1, 0, 0   # the current line's number and its first byte's offset
+    with path.open("rb") as fh:
+        while chunk := fh.read(_CHUNK_BYTES):
+            ends = np.flatnonzero(np.frombuffer(chunk, np.uint8) == 10) + pos
+            starts = np.concatenate(([start], ends[:-1] + 1))
+            long = np.flatnonzero(ends - starts > limit)
+            pos += len(chunk)
+            if long.size:
+                line, start = line + int(long[0]), int(starts[long[0]])
+                break
+            if ends.size:
+                line, start = line + ends.size, int(ends[-1]) + 1
+            if pos - start > limit:
+                break
+        else:
+            return
+        fh.seek(start)
+        fields, size = 1, 0
+        while chunk := fh.read(_CHUNK_BYTES):
+            head = chunk.split(b"\n", 1)[0]
+            fields += head.count(d.sep.encode())
+            size += len(head)
+            if len(head) < len(chunk):
+                break
+    if fields > width:
+        raise CSVError(f"{path}: inconsistent lengths: line {line} has {fields} fields, the "
+                       f"header {width} (refused unread)")
+    raise CSVError(f"{path}: line {line} is {format_size(size)} long: not a row of {width} "
+                   f"numbers (refused unread)")
+
+
 def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
     """The columns `names` of a CSV file (floats where they parse), rows checked for length."""
     d = _dialect(path)
@@ -255,8 +297,9 @@ def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
         found = ",".join(header) or "none"
         raise CSVError(f"{path}: missing column(s) {', '.join(missing)}; need a header with "
                        f"{','.join(names)} (found {found})")
-    frame = _read_csv(path, d, "no data rows", header=None, skiprows=d.header_line)
     width = len(header)
+    _check_line_lengths(path, d, width)
+    frame = _read_csv(path, d, "no data rows", header=None, skiprows=d.header_line)
     if frame.shape[1] > width:  # more fields than names: allowed only if empty (trailing sep)
         used = frame.iloc[:, width:].notna().to_numpy().any(axis=1)
         if used.any():
