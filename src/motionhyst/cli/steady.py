@@ -24,7 +24,7 @@ def run(args: argparse.Namespace) -> int:
     freqs = args.frequency or sc.frequencies
     amplitude = args.amplitude or sc.amplitude
     result = compare_with_describing_function(sc.loop(), amplitude, freqs,  # warns as it starts
-                                              floquet=not args.no_floquet)
+                                              floquet=not getattr(args, "no_floquet", False))
     warn_plant_fit(sc)
     if args.json:
         print_json(result.to_dict())
