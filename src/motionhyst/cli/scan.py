@@ -125,50 +125,27 @@ def _at(loop, x0: float, source: str):
     """`loop` with its links along the stroke seen from `x0` (the scan starts there)."""
     from motionhyst.scan.scanning import loop_at
 
-    if not math.isfinite(x0):
-        raise UsageError(f"{PROG}: --at must be finite, got {x0}")
     try:
         return loop_at(loop, x0)
     except ValueError as exc:
         raise UsageError(f"{PROG}: --at: {exc} ({source})") from None
 
 
-def run(args: argparse.Namespace) -> int:
-    """Simulate the setpoint with each compensation and print the scan metrics."""
-    from motionhyst.scenario import load_scenario
+def _check_options(args: argparse.Namespace) -> None:
+    """The options' own checks, before the scenario's loop is built: each compensation
+    and term once, no option that has no effect with the compensations compared, learning
+    options filled in from :data:`ILC_DEFAULTS` and in range.
 
-    if not args.back_and_forth and not args.point_to_point:
-        refuse_unused(args, ("--dwell",), "without --back-and-forth (the rest before the "
-                      "return)", {"--dwell": 0.0})
-    if not args.time_series:
-        refuse_unused(args, ("--force",), "without --time-series (the only file scan writes)")
-    sc = load_scenario(args.scenario)
-    # imported once the input is read: a refusal does not wait for the scan to load
-    from motionhyst.scan.ilc import ILCFilters
-    from motionhyst.scan.scanning import run_scan
-    from motionhyst.scan.terms import scan_terms
-
-    loop = sc.loop()
-    warn_plant_fit(sc)
-    if args.at is not None:
-        loop = _at(loop, args.at, sc.source)
-    terms = args.feedforward
-    if terms is None:
-        unset = [t for t in ("jerk", "snap") if getattr(sc.model.feedforward, t, 0.0) is None]
-        terms = scan_terms(loop, unset)
-    elif len(set(terms)) != len(terms):
+    Without ``--compensation`` the compensations compared are none, model (when there
+    is a model feedforward), ilc and basis: every learning option applies to them.
+    """
+    if args.at is not None and not math.isfinite(args.at):
+        raise UsageError(f"{PROG}: --at must be finite, got {args.at}")
+    if args.feedforward is not None and len(set(args.feedforward)) != len(args.feedforward):
         raise UsageError(f"{PROG}: --feedforward lists one twice")
-    if "hysteresis" in terms and loop.hysteresis_feedforward is None:
-        raise UsageError(f"{PROG}: --feedforward hysteresis needs a [feedforward] hysteresis "
-                         f"model, and {sc.source} has none")
-    has_model = bool(terms)
-    comps = args.compensation or (["none", "model", "ilc", "basis"] if has_model
-                                  else ["none", "ilc", "basis"])
+    comps = args.compensation or ["none", "ilc", "basis"]
     if len(set(comps)) != len(comps):
         raise UsageError(f"{PROG}: --compensation lists one twice")
-    if "model" in comps and not has_model:
-        raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
-                         f"model or feedforward terms (--feedforward), and {sc.source} has none")
     if "ilc" not in comps:
         refuse_unused(args, ("--ilc-trials", "--ilc-gain", "--ilc-cutoff", "--ilc-order"),
                       "without --compensation ilc (it shapes learning control only)")
@@ -184,15 +161,79 @@ def run(args: argparse.Namespace) -> int:
             setattr(args, name, value)
     if not 0 < args.ilc_gain < 2:
         raise UsageError(f"{PROG}: --ilc-gain must be in (0, 2), got {args.ilc_gain:g}")
-    out = _output(args)
+
+
+def _profiles(args: argparse.Namespace):
+    """The setpoint and the carry-over setpoint (None unless a compensation learns),
+    each checked against the exposure window."""
+    learns = {"ilc", "basis"} & set(args.compensation or ["ilc"])
     try:
         profile = _profile(args, args.length, args.speed)
         other = None
-        if "ilc" in comps or "basis" in comps:
+        if learns:
             other = _profile(args, args.other_length or args.length,
                              args.other_speed or 0.5 * args.speed)
     except ValueError as exc:
         raise UsageError(f"{PROG}: {exc}") from None
+    for p in (profile, other):
+        if p is not None:
+            p.check_window(args.window)
+    return profile, other
+
+
+def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
+    """Refuse a scan of far too many time steps before its loop is built: the step is
+    at most the sampled controller's period or the setpoint's (:func:`longest_step`)."""
+    from motionhyst.time.steps import check_scan_steps, longest_step
+
+    controller = sc.model.controller
+    if controller is None:  # no loop: the scenario's own refusal comes first
+        return
+    rate = getattr(controller, "sample_rate_hz", None)
+    runs = len(args.compensation or ["none", "ilc", "basis"])  # model: only with a model
+    for p in (profile, other):
+        if p is not None:
+            step = longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
+            check_scan_steps(p.end + args.tail, step, runs, at_least=True)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Simulate the setpoint with each compensation and print the scan metrics."""
+    from motionhyst.scenario import load_scenario
+
+    if not args.back_and_forth and not args.point_to_point:
+        refuse_unused(args, ("--dwell",), "without --back-and-forth (the rest before the "
+                      "return)", {"--dwell": 0.0})
+    if not args.time_series:
+        refuse_unused(args, ("--force",), "without --time-series (the only file scan writes)")
+    # every check the loop is not needed for comes before it is built (python-control,
+    # scipy): a refusal does not wait for them
+    sc = load_scenario(args.scenario, check=False)
+    _check_options(args)
+    out = _output(args)
+    profile, other = _profiles(args)
+    _check_steps(args, sc, profile, other)
+    loop = sc.loop()
+    from motionhyst.scan.ilc import ILCFilters
+    from motionhyst.scan.scanning import run_scan
+    from motionhyst.scan.terms import scan_terms
+
+    warn_plant_fit(sc)
+    if args.at is not None:
+        loop = _at(loop, args.at, sc.source)
+    terms = args.feedforward
+    if terms is None:
+        unset = [t for t in ("jerk", "snap") if getattr(sc.model.feedforward, t, 0.0) is None]
+        terms = scan_terms(loop, unset)
+    if "hysteresis" in terms and loop.hysteresis_feedforward is None:
+        raise UsageError(f"{PROG}: --feedforward hysteresis needs a [feedforward] hysteresis "
+                         f"model, and {sc.source} has none")
+    has_model = bool(terms)
+    comps = args.compensation or (["none", "model", "ilc", "basis"] if has_model
+                                  else ["none", "ilc", "basis"])
+    if "model" in comps and not has_model:
+        raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
+                         f"model or feedforward terms (--feedforward), and {sc.source} has none")
     filters = ILCFilters(args.ilc_gain, args.ilc_cutoff, args.ilc_order)
     try:
         res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,

@@ -6,6 +6,7 @@ Without ``--time-series`` it is the old spelling of ``motionhyst steady``.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from motionhyst.cli._common import (
@@ -44,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
         print("motionhyst simulate: without --time-series this computes the periodic steady "
               "state; the command for that is now `motionhyst steady`", file=sys.stderr)
         return steady.run(args)
-    return _time_series(args, load_scenario(args.scenario))
+    # the loop is built (python-control) once the run's options and files are checked
+    return _time_series(args, load_scenario(args.scenario, check=False))
 
 
 def _reference(args: argparse.Namespace, sc):
@@ -85,9 +87,29 @@ def _reference(args: argparse.Namespace, sc):
             f"r = {amplitude:g} m sin(2 pi {freqs[0]:g} t)")
 
 
+def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> None:
+    """Refuse a run of far too many rows or steps before its loop is built: the step is at
+    most the sampled controller's period or the reference's
+    (:func:`~motionhyst.time.steps.longest_step`; a file's samples do not set it)."""
+    from motionhyst.time.references import SampledReference
+    from motionhyst.time.steps import longest_step, time_series_grid
+    from motionhyst.time.timeseries import DEFAULT_OUTPUT_RATE_HZ, reference_rate_hz
+
+    controller = sc.model.controller
+    if controller is None:  # no loop: the scenario's own refusal comes first
+        return
+    rate = getattr(controller, "sample_rate_hz", None)
+    sampled = isinstance(ref, SampledReference)
+    output_rate = args.output_rate or rate or (reference_rate_hz(ref) if sampled
+                                               else DEFAULT_OUTPUT_RATE_HZ)
+    f = 0.0 if sampled else float(getattr(ref, "max_frequency_hz", 0.0) or 0.0)
+    step = (math.inf if f <= 0 and rate is None
+            else longest_step(f, None if rate is None else 1.0 / rate))
+    time_series_grid(duration, output_rate, step, rate, at_least=rate is None)
+
+
 def _time_series(args: argparse.Namespace, sc) -> int:
     """Transient run from rest, streamed to CSV atomically, with its summary."""
-    from motionhyst.analysis.plausibility import check_plausible
     from motionhyst.core.warnings import warn
     from motionhyst.time.references import SineReference
     from motionhyst.time.timeseries import run_time_series
@@ -101,6 +123,9 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
+    _check_size(args, sc, ref, duration)
+    from motionhyst.analysis.plausibility import check_plausible
+
     if isinstance(ref, SineReference):
         check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz])
         if 1.0 / ref.frequency_hz > duration:

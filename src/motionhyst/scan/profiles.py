@@ -292,6 +292,38 @@ class Profile:
         """The constant-velocity phases: for a scan, the scans themselves."""
         return [p for p in self.phases() if p.kind == "constant velocity"]
 
+    def check_window(self, window: float) -> None:
+        """Refuse an exposure `window` [s] longer than every scan at constant velocity.
+
+        The moving average and standard deviation of the error over the window
+        (:mod:`motionhyst.scan.scanning`) need a scan at least that long; a
+        point-to-point move has no such condition.
+
+        Parameters
+        ----------
+        window : float
+            The exposure window [s].
+
+        Raises
+        ------
+        ValueError
+            One line: the window and the scan's time at constant velocity.
+
+        Examples
+        --------
+        >>> p = scan(0.01, speed=0.1, a_max=10.0, j_max=1000.0, s_max=1e6)
+        >>> p.check_window(0.01)
+        >>> p.check_window(1.0)
+        Traceback (most recent call last):
+        ...
+        ValueError: the exposure window (1 s) is longer than the scan (0.1 s at constant velocity)
+        """
+        if self.kind == "scan" and not any(ph.duration >= window
+                                           for ph in self.constant_velocity_phases()):
+            raise ValueError(f"the exposure window ({window:g} s) is longer than the scan "
+                             f"({self.constant_velocity_phases()[0].duration:g} s at constant "
+                             "velocity)")
+
     # -------------------------------------------------------------- evaluation
     def derivatives(self, t: ArrayLike) -> NDArray[np.float64]:
         """Position, velocity, acceleration, jerk and snap at times `t`, shape ``(5, *t.shape)``.

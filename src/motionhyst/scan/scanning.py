@@ -33,7 +33,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.loop import Loop
-from motionhyst.core.budget import check_memory
 from motionhyst.core.compiled import njit
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis.along_stroke import AlongStroke
@@ -41,7 +40,8 @@ from motionhyst.scan.basis import BasisResult, learn_basis
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
 from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
 from motionhyst.scan.terms import TERMS, FeedforwardTerms, model_terms
-from motionhyst.time.simulation import BYTES_PER_SAMPLE, default_step, simulate
+from motionhyst.time.simulation import default_step, simulate
+from motionhyst.time.steps import check_scan_steps
 
 __all__ = ["ScanResult", "ScanRun", "loop_at", "moving_statistics", "run_scan", "settling_time"]
 
@@ -532,11 +532,8 @@ def run_scan(loop: Loop, profile: Profile, window: float,
     if not (math.isfinite(tail) and tail >= 0):
         raise ValueError(f"tail must be finite and >= 0 s, got {tail!r}")
     for p in (profile, other_profile):
-        if p is not None and p.kind == "scan" and not any(
-                ph.duration >= window for ph in p.constant_velocity_phases()):
-            raise ValueError(f"the exposure window ({window:g} s) is longer than the scan "
-                             f"({p.constant_velocity_phases()[0].duration:g} s at constant "
-                             "velocity)")
+        if p is not None:
+            p.check_window(window)
     # a rate-dependent link model stays in the loop (its time update), out of the terms
     in_loop = hff is not None and not hff.rate_independent and "hysteresis" in names
     terms = None
@@ -587,12 +584,7 @@ class _Setup:
         duration = profile.end + self.tail
         bare = self.bare
         step = default_step(bare, profile.max_frequency_hz) if dt is None else dt
-        n = int(np.ceil(duration / step)) + 1  # each run keeps its signals: checked before any
-        remedy = "shorten the setpoint (its length, dwell) or the tail after it, or raise the speed"
-        if n > 50_000_000:
-            raise ValueError(f"{n} time steps of {step:.3g} s: too many; {remedy}")
-        check_memory(n * BYTES_PER_SAMPLE * (len(comps) + 2),
-                     f"a scan of {len(comps)} runs of {n:.3g} time steps each", remedy)
+        check_scan_steps(duration, step, len(comps))  # each run keeps its signals
         advance = 0.0 if bare.ff is None or bare.sampled is None else (
             bare.ff.advance_samples * bare.sampled.period)
         averaged = None if bare.sampled is not None else step  # see setpoint_samples

@@ -446,7 +446,7 @@ class SampledRun:
 
 
 #: Fine steps per controller period at least (room for a fractional delay's split), and per
-#: period of the plant's fastest mode (as :data:`motionhyst.time.simulation.STEPS_PER_POLE_PERIOD`
+#: period of the plant's fastest mode (as :data:`motionhyst.time.steps.STEPS_PER_POLE_PERIOD`
 #: per period of the continuous loop's fastest pole).
 MIN_SUBSTEPS = 2
 STEPS_PER_MODE_PERIOD = 40

@@ -8,13 +8,12 @@ data.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import make_interp_spline
 
-from motionhyst.core.lti import TWO_PI
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
@@ -59,13 +58,13 @@ class SineReference:
     @property
     def initial_velocity(self) -> float:
         """Velocity at ``t = 0`` [m/s]: the reference starts from rest with this jump."""
-        return TWO_PI * self.frequency_hz * self.amplitude
+        return math.tau * self.frequency_hz * self.amplitude
 
     def __call__(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Position [m] and acceleration [m/s^2] at times `t` [s]."""
-        th = TWO_PI * self.frequency_hz * np.asarray(t, dtype=float)
+        th = math.tau * self.frequency_hz * np.asarray(t, dtype=float)
         r = self.amplitude * np.sin(th)
-        return r, -((TWO_PI * self.frequency_hz) ** 2) * r
+        return r, -((math.tau * self.frequency_hz) ** 2) * r
 
 
 @dataclass(frozen=True)
@@ -212,6 +211,8 @@ class SampledReference:
             raise ValueError("the reference has non-finite values")
         if np.any(np.diff(t) <= 0):
             raise ValueError("reference time must be strictly increasing")
+        from scipy.interpolate import make_interp_spline  # a file's reference only
+
         object.__setattr__(self, "_spline", make_interp_spline(t, r, k=5))
 
     @property

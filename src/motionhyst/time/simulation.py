@@ -40,13 +40,14 @@ from motionhyst.time.engine import FohStep, LoopState, run_steps
 from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS
 from motionhyst.time.sampled import simulate_sampled
 from motionhyst.time.simulation_result import Simulation
+from motionhyst.time.steps import (
+    BYTES_PER_SAMPLE,
+    STEPS_PER_POLE_PERIOD,
+    STEPS_PER_REFERENCE_PERIOD,
+)
 
 __all__ = ["Simulation", "simulate", "simulate_chunks"]
 
-STEPS_PER_POLE_PERIOD = 40
-STEPS_PER_REFERENCE_PERIOD = 400
-BYTES_PER_SAMPLE = 160
-"""Memory of one time sample of a run: its signals and the loop's intermediate arrays [bytes]."""
 
 
 def _block_systems(loop: Loop, omega0: float):

@@ -18,33 +18,29 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import IO
+from typing import IO, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.controllers.loop import Loop
-from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
-from motionhyst.time.simulation import (
+from motionhyst.time.steps import (
     STEPS_PER_POLE_PERIOD,
     STEPS_PER_REFERENCE_PERIOD,
-    Simulation,
-    simulate_chunks,
+    time_series_grid,
 )
+
+if TYPE_CHECKING:  # the simulation (python-control, numba) loads when a run starts: the
+    # command's checks of its run (time_series_grid) come before it
+    from motionhyst.controllers.loop import Loop
+    from motionhyst.time.simulation import Simulation
 
 DEFAULT_OUTPUT_RATE_HZ = 10_000.0
 """Output rate of built-in references (sines, profiles) unless one is asked for [Hz]."""
 
 DEFAULT_SETTLE_BAND = 10e-9
 """Half-width of the settling band of a point-to-point move [m] (10 nm)."""
-
-MAX_ROWS = 100_000_000
-"""Most rows a run writes (about 10 GB of CSV)."""
-
-MAX_STEPS = 200_000_000
-"""Most integration steps of a run (the work budget: some minutes at about 1.5 us a step)."""
 
 ROWS_PER_CHUNK = 8192
 """Output rows computed and written at a time."""
@@ -82,7 +78,7 @@ def dynamics_step(loop: Loop, reference) -> float:
     if loop.sampled is not None:
         return loop.sampled.period
     p = float(np.max(np.abs(loop.closed_loop_poles())))
-    h = TWO_PI / (STEPS_PER_POLE_PERIOD * p)
+    h = math.tau / (STEPS_PER_POLE_PERIOD * p)
     if not isinstance(reference, SampledReference):
         f = float(getattr(reference, "max_frequency_hz", 0.0) or 0.0)
         if f > 0:
@@ -216,25 +212,10 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     if not (np.isfinite(settle_band) and settle_band > 0):
         raise ValueError(f"settle band must be finite and > 0, got {settle_band!r}")
     period_out = 1.0 / output_rate_hz
-    if period_out > duration:
-        raise ValueError(f"the output period 1/{output_rate_hz:g} Hz is longer than the "
-                         f"duration {duration:g} s")
-    per_row = max(1, math.ceil(period_out / dynamics_step(loop, reference) * (1 - 1e-12)))
-    step = period_out / per_row
-    if loop.sampled is not None:   # rows at every per_row-th of the controller's samples
-        step = loop.sampled.period
-        per_row = round(period_out / step)
-        if per_row < 1 or abs(per_row * step - period_out) > 1e-9 * period_out:
-            raise ValueError(f"the output rate {output_rate_hz:g} Hz must divide the sampled "
-                             f"controller's rate {loop.sampled.sample_rate_hz:g} Hz")
-    n_rows = math.floor(duration / period_out * (1 + 1e-12)) + 1
+    n_rows, per_row, step = time_series_grid(
+        duration, output_rate_hz, dynamics_step(loop, reference),
+        None if loop.sampled is None else loop.sampled.sample_rate_hz)
     end = (n_rows - 1) * period_out
-    if n_rows > MAX_ROWS or n_rows * per_row > MAX_STEPS:
-        fast = "" if per_row < 1000 else (f" (a step of {step:.3g} s follows the "
-                                          f"reference's frequency)")
-        raise ValueError(f"{n_rows} rows of {per_row} steps each: too many time steps{fast}; "
-                         f"lower the frequency, the output rate or the duration (at most "
-                         f"{MAX_ROWS:.0e} rows, {MAX_STEPS:.0e} steps)")
     window = move = None
     if isinstance(reference, SineReference):
         period = 1.0 / reference.frequency_hz
@@ -248,6 +229,8 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     rows = 0
     steps = 0
     chunk = min(per_row * ROWS_PER_CHUNK, MAX_CHUNK)  # memory bounded, whatever per_row
+    from motionhyst.time.simulation import simulate_chunks
+
     for piece in simulate_chunks(loop, reference, end, dt=step, chunk=chunk):
         t = piece.t
         steps += len(t)
