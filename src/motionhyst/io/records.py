@@ -233,15 +233,17 @@ def _mat_kind(path: Path) -> str:
         return "hdf5"
     if head.startswith(_MAT_TEXT_HEADER):
         return "scipy"
-    from scipy.io.matlab import matfile_version
+    what = "a text file"
+    if not _looks_like_text(head):  # known before scipy.io loads
+        from scipy.io.matlab import matfile_version
 
-    try:
-        major, _ = matfile_version(str(path))
-    except Exception:  # scipy raises several kinds for a file that is not MATLAB's
-        major = None
-    if major == 0 and not _looks_like_text(head):  # level 4: no text header
-        return "scipy"
-    what = "a text file" if _looks_like_text(head) else "an unknown format"
+        try:
+            major, _ = matfile_version(str(path))
+        except Exception:  # scipy raises several kinds for a file that is not MATLAB's
+            major = None
+        if major == 0:  # level 4: no text header
+            return "scipy"
+        what = "an unknown format"
     raise RecordError(f"{path}: not a MATLAB .mat file ({what}); a CSV record must be named .csv")
 
 

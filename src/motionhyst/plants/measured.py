@@ -157,8 +157,6 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     >>> plant.frequency_range_hz
     (1.0, 2000.0...)
     """
-    import control
-
     from motionhyst.io.csvdata import describe
     from motionhyst.io.records import read_record, record_columns
 
@@ -199,6 +197,8 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
         if not np.isfinite(mass) or mass <= 0:
             raise ValueError(f"{where}: cannot estimate the rigid-body mass; give it explicitly")
     mass = check_positive("mass", mass)
+    import control  # once the data are read and checked: a refusal does not wait for it
+
     P1 = control.frd(p1, omega, smooth=len(f) > 3)
     P2 = control.frd(p2, omega, smooth=len(f) > 3)
     return MeasuredPlant(P1=P1, P2=P2, M=mass, source=where)

@@ -210,8 +210,6 @@ class Scenario:
         if m.stage is not None:
             self._plant = m.stage.build(closed_loop=True)
             return self._plant
-        # imported for a measured plant only: a [stage] needs neither the fit nor python-control
-        from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
         from motionhyst.plants.measured import load_frd_plant
 
         f = Path(m.plant.file)
@@ -221,6 +219,9 @@ class Scenario:
             data = load_frd_plant(f, m.plant.mass)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
+        # imported once the data are read (a bad file is refused before it loads), and for
+        # a measured plant only: a [stage] needs neither the fit nor python-control
+        from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
         if m.plant.use == "data":
             # the data's resolution: their scatter around the rigid body + modes fit
             try:
@@ -328,8 +329,6 @@ class Scenario:
         """The loop (built once, checked for stability)."""
         self._closed("this")
         if self._loop is None:
-            from motionhyst.controllers.loop import Loop
-
             sec = self.model.feedforward
             ff = None if sec.type == "none" else "rigid-body"
             if sec.type != "none" and (sec.acceleration is not None or sec.viscous
@@ -345,6 +344,8 @@ class Scenario:
             # each part's own errors name their section: only the loop's are [controller]'s
             parts = (self.plant(), self.controller(), self.hysteresis())
             hff = None if hff is None else build_hysteresis(hff)
+            from motionhyst.controllers.loop import Loop  # once the parts' files are read
+
             try:
                 loop = Loop(*parts, feedforward=ff, hysteresis_feedforward=hff)
             except ValueError as exc:
