@@ -136,6 +136,62 @@ def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path,
     assert not (tmp_path / "p.csv").exists()
 
 
+def _refused_scenarios() -> dict[str, str]:
+    """Scenarios a command refuses before it builds their loop, and the files they name."""
+    from motionhyst.scenario import default_scenario_path
+
+    paper = default_scenario_path().read_text()
+    head, tail = paper[:paper.index("[stage]")], paper[paper.index("[hysteresis]"):]
+    return {
+        "paper.toml": paper,
+        "open.toml": _bad_records()["stage.toml"],
+        "plant-dir.toml": head + '[plant]\nfile = "pl"\n' + tail,
+        "plant-text.toml": head + '[plant]\nfile = "plant.mat"\n' + tail,
+        "plant-columns.toml": head + '[plant]\nfile = "plant.csv"\n' + tail,
+        "plant.mat": "not a MATLAB file\n",
+        "plant.csv": "frequency_hz,p1\n1,2\n",
+        "f.csv": _rows("time,force", np.arange(20) / 750, np.sin(np.arange(20) / 3)),
+    }
+
+
+SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max",
+        "1000", "--s-max", "1e6"]
+
+
+@pytest.mark.parametrize("argv, error", [
+    ([*SCAN, "--ilc-gain", "2"], "--ilc-gain must be in (0, 2)"),
+    ([*SCAN, "--compensation", "none", "--ilc-gain", "0.5"], "--ilc-gain has no effect"),
+    ([*SCAN, "--at", "nan"], "--at must be finite"),
+    ([*SCAN, "--window", "1"], "exposure window (1 s) is longer than the scan"),
+    ([*SCAN, "--time-series", "paper.toml"], "it is an input of this command"),
+    (["scan", "paper.toml", "--length", "1e6", "--speed", "0.1", "--a-max", "10", "--j-max",
+      "1000", "--s-max", "1e6"], "time steps of 0.0001 s: too many"),
+    (["simulate", "paper.toml", "--time-series", "o.csv", "--frequency", "5", "--duration",
+      "1e9"], "too many time steps"),
+    (["simulate", "paper.toml", "--time-series", "o.csv", "--profile", "point-to-point",
+      "--v-max", "1e-9"], "too many time steps"),
+    (["simulate", "paper.toml", "--time-series", "o.csv", "--frequency", "5", "--output-rate",
+      "1e-9"], "longer than the duration"),
+    (["analyze", "plant-dir.toml"], "[plant] file: cannot read pl: it is a folder"),
+    (["analyze", "plant-text.toml"], "not a MATLAB .mat file (a text file)"),
+    (["analyze", "plant-columns.toml"], "need columns"),
+    (["stability", "open.toml"], "needs a closed loop"),
+    (["predict", "paper.toml", "f.csv", "--out", "p.csv"], "an open-loop system needs"),
+])
+def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, argv, error):
+    """Options, outputs, files and sizes known from the command line and the scenario are
+    refused before the loop is built (python-control) or anything is fitted."""
+    (tmp_path / "pl").mkdir()
+    for name, text in _refused_scenarios().items():
+        (tmp_path / name).write_text(text)
+    out = _probe(*argv, cwd=tmp_path)
+    assert out["rc"] == 2, out["err"]
+    assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
+    loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
+    assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded}"
+    assert not (tmp_path / "o.csv").exists() and not (tmp_path / "p.csv").exists()
+
+
 def test_import_motionhyst_is_light_and_exports_every_name():
     code = """
 import json, sys

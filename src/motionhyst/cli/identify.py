@@ -169,11 +169,9 @@ def run(args: argparse.Namespace) -> int:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
-    from motionhyst.identify.closed_loop import identify_closed_loop
-    from motionhyst.identify.fit import identify_maxwell_slip
-    from motionhyst.scenario import load_scenario
-
     if kind == "force-displacement":
+        from motionhyst.identify.fit import identify_maxwell_slip
+
         what = "force-displacement record"
         try:
             ident = identify_maxwell_slip(x, w, t=t, **options)
@@ -183,6 +181,9 @@ def run(args: argparse.Namespace) -> int:
             target.write_text(ident.scenario_text(f"{path}"))
             extra["saved"] = args.save
     else:
+        from motionhyst.identify.closed_loop import identify_closed_loop
+        from motionhyst.scenario import load_scenario
+
         sc = load_scenario(args.scenario)
         if sc.is_open_loop:
             raise UsageError(f"motionhyst identify: closed-loop records need the plant of a "

@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
     window = INIT_WINDOW if args.init_window is None else args.init_window
     if window < 2:
         raise UsageError(f"motionhyst predict: --init-window must be at least 2, got {window}")
-    sc = Scenario.from_file(args.scenario)
+    sc = Scenario.from_file(args.scenario, check=False)  # a loop is refused, not built
     system = sc.open_loop()
     if _input_quantity(args, system) == "displacement":
         return _predict_force(args, sc, system, target)
@@ -91,7 +91,6 @@ def run(args: argparse.Namespace) -> int:
     pred = None
     try:
         if args.init_from is not None:
-            from motionhyst.identify.io_predict import predict_from_window
             from motionhyst.identify.io_records import load_io_csv
 
             rec = load_io_csv(args.init_from, columns=args.columns, scale=args.scale)
@@ -99,6 +98,8 @@ def run(args: argparse.Namespace) -> int:
                                                        atol=1e-6 * float(np.ptp(t))):
                 raise UsageError(f"motionhyst predict: {args.init_from} must have the samples "
                                  f"of {args.data} (the same time column)")
+            from motionhyst.identify.io_predict import predict_from_window  # scipy.optimize
+
             pred = predict_from_window(system, t, u, rec.y, window, args.substeps)
             out_t, out_y = pred.t, pred.displacement
         else:

@@ -34,10 +34,14 @@ def run(args: argparse.Namespace) -> int:
         if figure.path.suffix.lower() not in FIGURE_SUFFIXES:
             raise UsageError("stability --figure: give a .png, .pdf or .svg file")
     sc = load_scenario(args.scenario)
+    try:
+        loop = sc.loop()  # an open-loop scenario is refused before the analysis loads
+    except ValueError as exc:
+        raise UsageError(f"stability: {sc.source}: {exc}") from None
     from motionhyst.analysis.stability import stability
 
     try:
-        result = stability(sc.loop(), exact=not args.no_exact)
+        result = stability(loop, exact=not args.no_exact)
     except ValueError as exc:
         raise UsageError(f"stability: {sc.source}: {exc}") from None
     warn_plant_fit(sc)

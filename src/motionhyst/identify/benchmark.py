@@ -40,7 +40,6 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import firwin, lfilter
 
 from motionhyst.core.compiled import njit
 from motionhyst.io.inputs import CSV_EXPANSION, input_problem
@@ -279,6 +278,8 @@ def decimate_fir(y: ArrayLike, r: int, order: int = FIR_ORDER) -> NDArray[np.flo
     n_taps = order + 1
     if x.size <= n_taps:
         raise ValueError(f"decimate_fir needs more than {n_taps} samples, got {x.size}")
+    from scipy.signal import firwin, lfilter  # here: a refusal of the test sets is quicker
+
     b = firwin(n_taps, 1.0 / r)
     delay = order // 2
     head = 2.0 * x[0] - x[n_taps:0:-1]
@@ -477,9 +478,8 @@ def run_benchmark(directory: str | Path, *, seed: int = 0, n_experiments: int = 
     """
     import time
 
-    from motionhyst.identify.input_output import IORecord, identify_io
-
     tests = {name: load_test_set(directory, name) for name in TEST_SETS}
+    from motionhyst.identify.input_output import IORecord, identify_io  # once they are read
     say = progress or (lambda msg: None)
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()

@@ -7,18 +7,20 @@ described in :mod:`motionhyst.identify`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares, nnls
 
 from motionhyst.core.compiled import njit
-from motionhyst.core.lti import HoldFilter
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.identify.io_uncertainty import covariance, covariance_table
 from motionhyst.identify.records import check_signals
 from motionhyst.identify.result import Identification
+
+if TYPE_CHECKING:  # a closed-loop record's prefilter (python-control): a force-displacement
+    from motionhyst.core.lti import HoldFilter  # fit needs neither
 
 __all__ = ["identify_maxwell_slip"]
 
