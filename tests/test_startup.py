@@ -176,6 +176,8 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     (["analyze", "plant-text.toml"], "not a MATLAB .mat file (a text file)"),
     (["analyze", "plant-columns.toml"], "need columns"),
     (["stability", "open.toml"], "needs a closed loop"),
+    (["analyze", "open.toml"], "needs a closed loop"),
+    (["steady", "open.toml"], "needs a closed loop"),
     (["predict", "paper.toml", "f.csv", "--out", "p.csv"], "an open-loop system needs"),
 ])
 def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, argv, error):

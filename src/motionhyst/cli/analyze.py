@@ -16,11 +16,11 @@ def run(args: argparse.Namespace) -> int:
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario)
+    freqs = args.frequency or sc.frequencies  # an open-loop system is refused here
+    amplitude = args.amplitude or sc.amplitude
     # imported once the input is read: a refusal does not wait for the analysis to load
     from motionhyst.analysis.quasilinear import analyze
 
-    freqs = args.frequency or sc.frequencies
-    amplitude = args.amplitude or sc.amplitude
     mode = "self-consistent" if args.self_consistent else "reference"
     res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
     fit = sc.plant_fit()

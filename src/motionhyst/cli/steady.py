@@ -18,11 +18,11 @@ def run(args: argparse.Namespace) -> int:
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario)
+    freqs = args.frequency or sc.frequencies  # an open-loop system is refused here
+    amplitude = args.amplitude or sc.amplitude
     # imported once the input is read: a refusal does not wait for the analysis to load
     from motionhyst.analysis.comparison import compare_with_describing_function
 
-    freqs = args.frequency or sc.frequencies
-    amplitude = args.amplitude or sc.amplitude
     result = compare_with_describing_function(sc.loop(), amplitude, freqs,  # warns as it starts
                                               floquet=not getattr(args, "no_floquet", False))
     warn_plant_fit(sc)
