@@ -298,49 +298,80 @@ def _monotone_crossing(X, C1, level, a, b, fa, fb):  # pragma: no cover - compil
 GRID_BRACKET, BETWEEN_REVERSALS, GRID_CUBIC = 0, 1, 2
 
 
-@njit(cache=True)
-def _cubic_crossing(x, level, a, b, fa, fb):  # pragma: no cover - compiled
+@njit(cache=True, inline="always")
+def _cubic_crossing(x, level, a, b, fa, fb, cursor):  # pragma: no cover - compiled
     """Angle in [a, b] where ``x``, monotone there, passes `level`, on the cubic through the
     grid samples `x` (``2 pi i / n``) around it (``fa``, ``fb``: ``x`` minus `level` at
-    the ends)."""
+    the ends).
+
+    The grid points inside [a, b] are searched from the grid point `cursor` on, or by
+    bisection when ``cursor < 0``.  Returns the angle and the first grid point past the
+    level, where the search for a level further along the branch may start (the
+    elements' levels taken in order along the branch cost one pass over the grid).
+    """
     if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
-        return a if abs(fa) <= abs(fb) else b
+        return (a if abs(fa) <= abs(fb) else b), cursor
     n = x.shape[0]
     h = _TWO_PI / n
     lo, flo, hi, fhi = a, fa, b, fb
     j_lo = int(np.floor(a / h)) + 1
     j_hi = int(np.ceil(b / h)) - 1
-    while j_lo <= j_hi:  # the grid points inside, by bisection: x is monotone
-        j = (j_lo + j_hi) // 2
-        f = x[j if j < n else j - n] - level  # 0 <= j < 2 n: b < 4 pi
-        if f == 0.0:
-            return j * h
-        if (f > 0.0) == (fa > 0.0):
-            lo, flo, j_lo = j * h, f, j + 1
-        else:
-            hi, fhi, j_hi = j * h, f, j - 1
+    if cursor >= 0:  # walk on from the cursor: the grid points before it are on fa's side
+        j = max(cursor, j_lo)
+        while j <= j_hi:
+            f = x[j if j < n else j - n] - level
+            if f == 0.0:
+                return j * h, j
+            if (f > 0.0) != (fa > 0.0):
+                hi, fhi = j * h, f
+                break
+            j += 1
+        cursor = j
+        if j - 1 >= j_lo:
+            lo = (j - 1) * h
+            flo = x[j - 1 if j - 1 < n else j - 1 - n] - level
+    else:
+        while j_lo <= j_hi:  # the grid points inside, by bisection: x is monotone
+            j = (j_lo + j_hi) // 2
+            f = x[j if j < n else j - n] - level  # 0 <= j < 2 n: b < 4 pi
+            if f == 0.0:
+                return j * h, j
+            if (f > 0.0) == (fa > 0.0):
+                lo, flo, j_lo = j * h, f, j + 1
+            else:
+                hi, fhi, j_hi = j * h, f, j - 1
+        cursor = j_lo
     c = int(np.floor(0.5 * (lo + hi) / h))
-    xm, x0, x1, x2 = x[(c - 1) % n], x[c % n], x[(c + 1) % n], x[(c + 2) % n]
+    # the cubic in u = theta / h - c through the samples c - 1 .. c + 2, Newton in u from
+    # the linear interpolant, kept in the bracket
+    i0 = c % n
+    im = i0 - 1 if i0 >= 1 else n - 1
+    i1 = i0 + 1 if i0 + 1 < n else 0
+    i2 = i1 + 1 if i1 + 1 < n else 0
+    xm, x0, x1, x2 = x[im], x[i0], x[i1], x[i2]
     c1 = -xm / 3.0 - x0 / 2.0 + x1 - x2 / 6.0
     c2 = xm / 2.0 - x0 + x1 / 2.0
     c3 = (x2 - xm) / 6.0 + (x0 - x1) / 2.0
     c0 = x0 - level
-    t = lo + (hi - lo) * flo / (flo - fhi)
+    inv_h = 1.0 / h
+    u_lo = lo * inv_h - c
+    u_hi = hi * inv_h - c
+    u = u_lo + (u_hi - u_lo) * flo / (flo - fhi)
+    rising = fa < 0.0
     for _ in range(30):
-        u = t / h - c
         f = c0 + u * (c1 + u * (c2 + u * c3))
-        fp = (c1 + u * (2.0 * c2 + 3.0 * u * c3)) / h
-        if (f > 0.0) == (fa > 0.0):
-            lo = t
+        fp = c1 + u * (2.0 * c2 + 3.0 * u * c3)
+        if (f > 0.0) == rising:
+            u_hi = u
         else:
-            hi = t
-        t_new = t - f / fp if fp != 0.0 else 0.5 * (lo + hi)
-        if not (lo <= t_new <= hi):
-            t_new = 0.5 * (lo + hi)
-        if abs(t_new - t) <= 1e-13:  # far below the cubic's own error
-            return t_new
-        t = t_new
-    return t
+            u_lo = u
+        u_new = u - f / fp if fp != 0.0 else 0.5 * (u_lo + u_hi)
+        if not (u_lo <= u_new <= u_hi):
+            u_new = 0.5 * (u_lo + u_hi)
+        if abs(u_new - u) <= 1e-11:  # far below the cubic's own error
+            return (u_new + c) * h, cursor
+        u = u_new
+    return (u + c) * h, cursor
 
 
 @njit(cache=True)
@@ -397,6 +428,10 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
     g_mean = 0.0
     s_mean = 0.0
     ws = np.empty(nr + 1)
+    # GRID_CUBIC: each interval's search for an onset starts where the last one ended while
+    # the levels come in order along it (elements sorted by fc / k), else bisects
+    cursors = np.full(nr, -1, dtype=np.int64)
+    last_level = np.empty(nr)
     first_g = np.empty(nr)  # the element's first and last piece in each interval
     first_s = np.empty(nr)
     last_g = np.empty(nr)
@@ -421,7 +456,11 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
                 if mode == BETWEEN_REVERSALS:
                     s = _monotone_crossing(X, C1, slip_level - X[0].real, a, b, fa, fb)
                 elif mode == GRID_CUBIC:
-                    s = _cubic_crossing(x, slip_level - X[0].real, a, b, fa, fb)
+                    if cursors[i] >= 0 and d * (slip_level - last_level[i]) < 0.0:
+                        cursors[i] = -1  # behind the last level: bisect
+                    last_level[i] = slip_level
+                    s, cursors[i] = _cubic_crossing(x, slip_level - X[0].real, a, b, fa, fb,
+                                                    cursors[i])
                 else:
                     s = min(max(_crossing(X, C1, x, slip_level, a, b), a), b)
             # pieces of non-zero length: stick (g = w_i - k x_i, s = k) on [a, s),
@@ -500,44 +539,120 @@ def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def binned_grid(Q):  # pragma: no cover - compiled
-    """The grid ``N >= 2 Q + 1`` (a power of two) and the number of powers ``P`` of
-    :func:`jump_series_binned` for harmonics up to `Q`."""
-    N = 2
-    while N < 2 * Q + 1:
-        N *= 2
-    a_max = np.pi * Q / N
+def chebyshev_terms(a_max):  # pragma: no cover - compiled
+    """Terms ``P`` of the Chebyshev series of ``exp(-j a v)``, ``|a| <= a_max``, ``|v| <= 1``,
+    that reach 1e-17: its coefficients are ``2 J_p(a)``, ``|J_p(a)| <= (a / 2)^p / p!``."""
     P = 1
     term = 1.0
     while term >= 1e-17:
-        term *= a_max / P
+        term *= 0.5 * a_max / P
         P += 1
-    return N, P
+    return P
 
 
 @njit(cache=True)
-def binned_is_cheaper(n_jumps, Q):  # pragma: no cover - compiled
+def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
+    """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
+    :func:`jump_series_binned` for `n_jumps` jumps and harmonics up to `Q`: the fewest
+    operations (weights measured on the compiled code), ``N >= Q / 2``."""
+    best_N, best_P, best_cost = 0, 0, np.inf
+    N = 2
+    while N <= N_max:
+        if 2 * N >= Q:
+            P = chebyshev_terms(np.pi * Q / N)
+            cost = P * (n_jumps * 2.0 + N * np.log2(N) * 1.5 + Q * 2.0) + Q * (P + 24.0) * 1.5
+            if cost < best_cost:
+                best_N, best_P, best_cost = N, P, cost
+        N *= 2
+    return best_N, best_P
+
+
+@njit(cache=True)
+def binned_is_cheaper(n_jumps, Q, N_max):  # pragma: no cover - compiled
     """Whether :func:`jump_series_binned` takes fewer operations than :func:`jump_series`
     for `n_jumps` jumps and harmonics up to `Q` (weights measured on the compiled code)."""
-    N, P = binned_grid(Q)
-    stages = np.log2(N)
-    return P * (N * stages * 0.5 + 2.0 * N) + 2.0 * n_jumps * P < 2.5 * n_jumps * (Q + 1)
+    N, P = binned_grid(n_jumps, Q, N_max)
+    cost = P * (n_jumps * 2.0 + N * np.log2(N) * 1.5 + Q * 2.0) + Q * (P + 24.0) * 1.5
+    return cost < 2.5 * n_jumps * (Q + 1)
+
+
+@njit(cache=True)
+def bessel_table(alpha, Q, P):  # pragma: no cover - compiled
+    """``J_p(q alpha)`` for ``q = 0 .. Q``, ``p = 0 .. P - 1`` (rows ``q``), for
+    ``P >= chebyshev_terms(Q alpha)`` (the orders from ``P`` on below 1e-17).
+
+    ``J_P`` and ``J_{P-1}`` come from their power series ``J_p(a) = (a / 2)^p / p! sum_k
+    (-a^2 / 4)^k / (k! (p + 1)_k)``, the lower orders from the (stable) downward
+    recurrence ``J_{p-1} = (2 p / a) J_p - J_{p+1}``, and the series' round-off, common
+    to all orders, is removed by ``J_0 + 2 sum_k J_2k = 1``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = bessel_table(0.5, 4, 20)
+    >>> float(np.round(J[2, 0], 12)), float(np.round(J[4, 1], 12))   # J_0(1), J_1(2)
+    (0.765197686558, 0.576724807757)
+    """
+    out = np.zeros((Q + 1, P))
+    out[0, 0] = 1.0
+    kmax = 40
+    inv_up = np.empty(kmax)  # 1 / (k (P + k)) and 1 / (k (P - 1 + k))
+    inv_down = np.empty(kmax)
+    for k in range(1, kmax):
+        inv_up[k] = 1.0 / (k * (P + k))
+        inv_down[k] = 1.0 / (k * (P - 1 + k))
+    for q in range(1, Q + 1):
+        a = q * alpha
+        half = 0.5 * a
+        lead = 1.0  # (a / 2)^(P - 1) / (P - 1)!
+        for i in range(1, P):
+            lead *= half / i
+        x = -half * half
+        term_up = 1.0
+        sum_up = 1.0
+        term_down = 1.0
+        sum_down = 1.0
+        for k in range(1, kmax):
+            term_up *= x * inv_up[k]
+            term_down *= x * inv_down[k]
+            sum_up += term_up
+            sum_down += term_down
+            if abs(term_up) <= 1e-18 * abs(sum_up) and abs(term_down) <= 1e-18 * abs(sum_down):
+                break
+        row = out[q]
+        j_up = lead * (half / P) * sum_up
+        j_p = lead * sum_down
+        row[P - 1] = j_p
+        two_a = 2.0 / a
+        for p in range(P - 1, 0, -1):
+            j_down = p * two_a * j_p - j_up
+            row[p - 1] = j_down
+            j_up = j_p
+            j_p = j_down
+        norm = row[0]
+        for p in range(2, P, 2):
+            norm += 2.0 * row[p]
+        scale = 1.0 / norm
+        for p in range(P):
+            row[p] *= scale
+    return out
 
 
 @njit(cache=True)
 def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compiled
     """:func:`jump_series` for many jumps, in ``O(jumps + Q log Q)`` (``Q = max(n_g, n_s)``).
 
-    The jumps are binned to the nearest point ``c_j`` of a grid of ``N >= 2 Q + 1`` points
-    (``h = 2 pi / N``), with ``t_b = c_j + v h / 2``, ``|v| <= 1``; then ``exp(-j q t_b) =
-    exp(-j q c_j) sum_p (-j q h v / 2)^p / p!`` with ``|q h / 2| <= pi Q / N < pi / 2``,
-    summed until its terms are below 1e-17: one FFT of the bins' moments ``sum v^p J``
-    for each power.  `jg` and `js` are transformed together as ``jg + j r js`` (``r`` a
-    power of two that makes the two sums of magnitudes alike).  `tw` is
-    the twiddle table of at least ``N`` points.
+    The jumps are binned to the nearest point ``c_j`` of a grid of ``N`` points
+    (``h = 2 pi / N``, :func:`binned_grid`), with ``t_b = c_j + v h / 2``, ``|v| <= 1``;
+    then ``exp(-j q t_b) = exp(-j q c_j) sum_p eps_p (-j)^p J_p(q h / 2) T_p(v)``
+    (Jacobi-Anger: Chebyshev polynomials ``T_p``, Bessel functions ``J_p``, ``eps_0 = 1``,
+    else 2), summed until its terms are below 1e-17: one FFT of the bins' moments ``sum
+    T_p(v) J`` for each term, read at ``q`` modulo ``N``.  `jg` and `js` are transformed
+    together as ``jg + j r js`` (``r`` a power of two that makes the two sums of
+    magnitudes alike).  `tw` is the twiddle table of at least ``N`` points.
     """
     Q = max(n_g, n_s)
-    N, P = binned_grid(Q)
+    N, P = binned_grid(t_b.shape[0], Q, 2 * tw.shape[0])
     h = _TWO_PI / N
     # jg + j js r: r, a power of two, brings the two to one size (each keeps its accuracy)
     sum_g = 0.0
@@ -549,17 +664,34 @@ def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compile
     if sum_g > 0.0 and sum_s > 0.0:
         r = 2.0 ** np.round(np.log2(sum_g / sum_s))
     bins = np.zeros((N, P), dtype=np.complex128)  # a jump's moments side by side
-    for b in range(t_b.shape[0]):
-        c = complex(jg[b], js[b] * r)
-        t = t_b[b] % _TWO_PI
-        j = int(np.floor(t / h + 0.5))
-        v = (t - j * h) / (0.5 * h)
-        if j >= N:
-            j -= N
-        vp = 1.0
-        for p in range(P):
-            bins[j, p] += c * vp
-            vp *= v
+    nj = t_b.shape[0]
+    # four jumps at a time: their Chebyshev recurrences interleaved
+    cell = np.empty(4, dtype=np.int64)
+    v = np.empty(4)
+    T = np.empty((P, 4))
+    for b0 in range(0, nj, 4):
+        nb = min(4, nj - b0)
+        for i in range(4):
+            if i < nb:
+                t = t_b[b0 + i] % _TWO_PI
+                j = int(np.floor(t / h + 0.5))
+                v[i] = (t - j * h) / (0.5 * h)
+                cell[i] = j - N if j >= N else j
+            else:
+                v[i] = 0.0
+        for i in range(4):
+            T[0, i] = 1.0
+        if P > 1:
+            for i in range(4):
+                T[1, i] = v[i]
+        for p in range(2, P):
+            for i in range(4):
+                T[p, i] = 2.0 * v[i] * T[p - 1, i] - T[p - 2, i]
+        for i in range(nb):
+            c = complex(jg[b0 + i], js[b0 + i] * r)
+            row = bins[cell[i]]
+            for p in range(P):
+                row[p] += c * T[p, i]
     reversed_index = bit_reversed_indices(N)
     mu = np.empty((P, N), dtype=np.complex128)
     for p in range(P):
@@ -569,14 +701,30 @@ def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compile
         fft_unscrambling(row, tw)
     G = np.zeros(n_g + 1, dtype=np.complex128)
     S = np.zeros(n_s + 1, dtype=np.complex128)
+    bessel = bessel_table(0.5 * h, Q, P)
     for q in range(1, Q + 1):
-        a = 0.5 * q * h
-        up = mu[P - 1, q]
-        um = mu[P - 1, N - q]
-        for p in range(P - 2, -1, -1):  # sum_p (-+ j a)^p / p! mu_p, by Horner
-            f = a / (p + 1)
-            up = mu[p, q] + complex(up.imag * f, -up.real * f)
-            um = mu[p, N - q] + complex(-um.imag * f, um.real * f)
+        jp = bessel[q]
+        iq = q % N
+        im = (N - iq) % N
+        # sum_p eps_p (-+j)^p J_p mu_p: the powers of -+j cycle with p
+        up = mu[0, iq] * jp[0]
+        um = mu[0, im] * jp[0]
+        for p in range(1, P):
+            fu = 2.0 * jp[p] * mu[p, iq]
+            fm = 2.0 * jp[p] * mu[p, im]
+            ph = p % 4
+            if ph == 0:
+                up += fu
+                um += fm
+            elif ph == 1:
+                up += complex(fu.imag, -fu.real)
+                um += complex(-fm.imag, fm.real)
+            elif ph == 2:
+                up -= fu
+                um -= fm
+            else:
+                up += complex(-fu.imag, fu.real)
+                um += complex(fm.imag, -fm.real)
         umc = um.conjugate()
         scale = -1j / (_TWO_PI * q)
         if q <= n_g:
@@ -584,7 +732,6 @@ def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compile
         if q <= n_s:
             S[q] = -0.5j * (up - umc) * (scale / r)
     return G, S
-
 
 
 @njit(cache=True)
@@ -702,7 +849,7 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
             x = synthesize(Xs, n, tw)
     t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode)
     Q = H + M
-    if binned_is_cheaper(t_b.shape[0], Q):
+    if binned_is_cheaper(t_b.shape[0], Q, 2 * tw.shape[0]):
         G, S = jump_series_binned(t_b, jg, js, H, Q, tw)
     else:
         G, S = jump_series(t_b, jg, js, H, Q)

@@ -78,8 +78,17 @@ class MaxwellSlip(Hysteresis):
         return self.k.copy(), self.fc.copy()
 
     def periodic_stops(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """The elements as parallel stop operators: ``(k, fc)``."""
-        return self.stop_parameters()
+        """The elements as parallel stop operators ``(k, fc)``, in the order of their slip
+        displacements ``fc / k``: the order in which a motion makes them slip, in which
+        the exact periodic output finds their slip onsets in one pass along the period.
+
+        Examples
+        --------
+        >>> MaxwellSlip(k=[1.0, 2.0], fc=[1.0, 0.5]).periodic_stops()
+        (array([2., 1.]), array([0.5, 1. ]))
+        """
+        order = np.argsort(self.fc / self.k, kind="stable")
+        return self.k[order], self.fc[order]
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
         """Sum of the elements' closed-form describing functions (eq. 10) [N/m].
