@@ -72,7 +72,7 @@ def _stop_harmonics_previous(X, k, fc, H):
     if rev.size < 2:
         return W
     t_b, jg, js, g_mean, s_mean = _kernels.stop_pieces(X, C1, x, rev, xr, k, fc,
-                                                       _kernels.GRID_BRACKET)
+                                                       _kernels.GRID_BRACKET, False)
     G, S = _kernels.jump_series(t_b, jg, js, H, H + M)
     G[0], S[0] = g_mean, s_mean
     return G + np.fft.rfft(x * sample_period(S, n))[: H + 1] / n

@@ -386,7 +386,7 @@ def cubic_error_bound(X, n):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
+def stop_pieces(X, C1, x, rev, xr, k, fc, mode, half):  # pragma: no cover - compiled
     """Pieces of the periodic output of parallel stop operators, as jumps.
 
     Over one period each element ``(k_i, fc_i)`` sticks (``w = w_j + k_i (x -
@@ -401,6 +401,11 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
     `mode` says how a slip onset is found (:data:`GRID_BRACKET`,
     :data:`BETWEEN_REVERSALS`, :data:`GRID_CUBIC`; `x` holds the grid samples
     ``2 pi i / n`` of ``x`` the first and the last use).
+
+    With `half` (two reversals and ``x(theta + pi) = -x(theta)``: no even harmonics) only
+    the first half period is run, from the maximum to the minimum: the second mirrors it
+    (``g(theta + pi) = -g(theta)``, ``s(theta + pi) = s(theta)``), so its jumps are
+    those of the first half, the means ``g_mean = 0`` and ``s_mean`` twice the half's.
     """
     nr = rev.shape[0]
     m = k.shape[0]
@@ -419,6 +424,12 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
     th[nr] = th[0] + _TWO_PI
     xs[nr] = xs[0]
     mid = 0.5 * (xr[i0] + x_min)
+    n_run = nr
+    if half:  # the minimum half a period after the maximum, at minus its value
+        th[1] = th[0] + np.pi
+        xs[1] = -xs[0]
+        mid = 0.0
+        n_run = 1
     t_b = np.empty(nr * m + nr)  # at most a slip onset per element and interval
     jg = np.empty(nr * m + nr)
     js = np.empty(nr * m + nr)
@@ -444,7 +455,7 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
             for i in range(nr):
                 w = min(max(w + ke * (xs[i + 1] - xs[i]), -fe), fe)
                 ws[i + 1] = w
-        for i in range(nr):
+        for i in range(n_run):
             a, b = th[i], th[i + 1]
             wi, xi, x_end = ws[i], xs[i], xs[i + 1]
             d = 1.0 if x_end > xi else -1.0
@@ -480,12 +491,18 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode):  # pragma: no cover - compiled
             if a < s < b:
                 t_b[nb], jg[nb], js[nb] = s, d * fe - g_stick, -ke
                 nb += 1
-        for i in range(nr):
-            at_g[i] += first_g[i] - last_g[i - 1]  # i - 1 = -1: the last interval
-            at_s[i] += first_s[i] - last_s[i - 1]
-    for i in range(nr):
+        if half:  # the second half's last piece mirrors the first's
+            at_g[0] += first_g[0] + last_g[0]
+            at_s[0] += first_s[0] - last_s[0]
+        else:
+            for i in range(nr):
+                at_g[i] += first_g[i] - last_g[i - 1]  # i - 1 = -1: the last interval
+                at_s[i] += first_s[i] - last_s[i - 1]
+    for i in range(n_run):
         t_b[nb], jg[nb], js[nb] = th[i], at_g[i], at_s[i]
         nb += 1
+    if half:
+        return t_b[:nb], jg[:nb], js[:nb], 0.0, 2.0 * s_mean / _TWO_PI
     return t_b[:nb], jg[:nb], js[:nb], g_mean / _TWO_PI, s_mean / _TWO_PI
 
 
@@ -824,6 +841,18 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
         return W
     Xs = X[: M + 1].copy()
     Xs[0] = 0.0
+    # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
+    # loop's y1): made exact, its output's second half period mirrors the first
+    total = 0.0
+    even = 0.0
+    for m in range(1, M + 1):
+        total += abs(Xs[m])
+        if m % 2 == 0:
+            even += abs(Xs[m])
+    symmetric = even <= 1e-15 * total
+    if symmetric:
+        for m in range(2, M + 1, 2):
+            Xs[m] = 0.0
     C1 = np.empty(M + 1, dtype=np.complex128)
     C2 = np.empty(M + 1, dtype=np.complex128)
     for m in range(M + 1):
@@ -847,12 +876,18 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
                 and cubic_error_bound(Xs, n) <= 1e-9 * abs(xr[0] - xr[1])):
             mode = GRID_CUBIC
             x = synthesize(Xs, n, tw)
-    t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode)
+    half = symmetric and monotone
+    t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
     Q = H + M
     if binned_is_cheaper(t_b.shape[0], Q, 2 * tw.shape[0]):
         G, S = jump_series_binned(t_b, jg, js, H, Q, tw)
     else:
         G, S = jump_series(t_b, jg, js, H, Q)
+    if half:  # a jump's mirror half a period on: g's of opposite sign, s's alike
+        for q in range(H + 1):
+            G[q] = 2.0 * G[q] if q % 2 == 1 else 0.0
+        for q in range(Q + 1):
+            S[q] = 2.0 * S[q] if q % 2 == 0 else 0.0
     G[0] = g_mean
     S[0] = s_mean
     if direct:
