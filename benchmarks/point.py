@@ -56,7 +56,7 @@ def _stop_harmonics_previous(X, k, fc, H):
     compiled pieces, the roots bracketed on the grid)."""
     from scipy.fft import next_fast_len
 
-    from motionhyst.hysteresis import _kernels
+    from motionhyst.hysteresis import _jump_sums, _kernels
 
     M = significant_harmonics(X)
     W = np.zeros(H + 1, dtype=complex)
@@ -73,7 +73,7 @@ def _stop_harmonics_previous(X, k, fc, H):
         return W
     t_b, jg, js, g_mean, s_mean = _kernels.stop_pieces(X, C1, x, rev, xr, k, fc,
                                                        _kernels.GRID_BRACKET, False)
-    G, S = _kernels.jump_series(t_b, jg, js, H, H + M)
+    G, S = _jump_sums.jump_series(t_b, jg, js, H, H + M)
     G[0], S[0] = g_mean, s_mean
     return G + np.fft.rfft(x * sample_period(S, n))[: H + 1] / n
 
