@@ -61,6 +61,7 @@ SECONDS_PER_ELEMENT_STEP = 10e-9
 SECONDS_PER_STATE_CUBED = 1e-8
 """Nominal cost of the multipliers per cube of the monodromy's states [s] (its eigenvalues)."""
 
+
 @dataclass
 class FloquetResult:
     """Floquet multipliers of a periodic solution.
