@@ -181,10 +181,9 @@ def run(args: argparse.Namespace) -> int:
             target.write_text(ident.scenario_text(f"{path}"))
             extra["saved"] = args.save
     else:
-        from motionhyst.identify.closed_loop import identify_closed_loop
         from motionhyst.scenario import load_scenario
 
-        sc = load_scenario(args.scenario)
+        sc = load_scenario(args.scenario, check=False)  # its loop is built below, once checked
         if sc.is_open_loop:
             raise UsageError(f"motionhyst identify: closed-loop records need the plant of a "
                              f"closed loop; {sc.source} is an open-loop system (no "
@@ -199,6 +198,8 @@ def run(args: argparse.Namespace) -> int:
         extra["scenario"] = sc.source
         # a sampled controller: the record is at its samples, u_k acted held and delayed
         ctrl = sc.loop().sampled
+        from motionhyst.identify.closed_loop import identify_closed_loop
+
         try:
             ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff,
                                          controller=ctrl, offset=args.offset or "auto",
