@@ -47,6 +47,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/stability.py
 	$(BIN)/python benchmarks/periodic.py
 	$(BIN)/python benchmarks/point.py
+	$(BIN)/python benchmarks/refusals.py
 
 # the public benchmarks end to end (kept out of make test): Bouc-Wen (about a minute) and
 # EMPS (a few minutes; scored on DATA_EMPS_PULSES.mat when EMPS_DATA holds it)

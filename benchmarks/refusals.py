@@ -1,0 +1,159 @@
+"""Benchmark: how soon a refusal comes (issue 26: every refusal within 2 s of start).
+
+Each case is a command line that motionhyst refuses (exit 2, one line on stderr), one
+for each way a refusal comes: an argument, a scenario's value, an option against the
+scenario, an output, a file, a record, the size of a run, an open-loop scenario where a
+loop is needed; and those that need the work they refuse: a loop that python-control
+must build (an unstable controller, a run whose step the loop's poles set) and a fit
+that finds nothing.  Each runs as a whole process (the interpreter, the imports, the
+checks) in a folder holding its files, ``REPEATS`` times interleaved with the baseline of
+the same run: ``motionhyst --help``, the command's start alone.  Reported per case: the
+least wall time (the least disturbed run), the processor time of that run (the wall time
+of a quiet machine), and their ratio to the baseline's; target 2 s of wall time.
+
+Run with ``make bench`` or ``python benchmarks/refusals.py [--json] [--repeats N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from motionhyst.scenario import default_scenario_path
+
+REPEATS = 3
+TARGET_S = 2.0
+CODE = "import sys; from motionhyst.cli import main; sys.exit(main(sys.argv[1:]))"
+PAPER = default_scenario_path().read_text()
+SCAN = ["--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+        "--s-max", "1e6"]
+
+
+def _rows(header: str, *columns) -> str:
+    return header + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                    for row in np.column_stack(columns))
+
+
+def _files() -> dict[str, str]:
+    t = np.arange(600) / 750
+    u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    head, tail = PAPER[:PAPER.index("[stage]")], PAPER[PAPER.index("[hysteresis]"):]
+    nan = x.copy()
+    nan[7] = np.nan
+    return {
+        "s.toml": PAPER,
+        "nan.toml": PAPER.replace("m1 = 5.0", "m1 = nan"),
+        "unstable.toml": PAPER.replace("flp = 700.0", "flp = 1e12"),
+        "open.toml": ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
+                      '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n'),
+        "plant-dir.toml": head + '[plant]\nfile = "pl"\n' + tail,
+        "fd-nan.csv": _rows("time,displacement,force", t, nan, 20.0 * x),
+        "fd-zero.csv": _rows("time,displacement,force", t, x, 0.0 * x),
+        "io.csv": _rows("time,force,displacement", t, u, u / 5e4),  # a spring: no inertia
+        "io-missing.csv": _rows("time,force", t, u),
+        "f.mat": "time,force\n0,1\n",
+    }
+
+
+# (name, argv, what the refusal waits for)
+CASES = [
+    ("argument", ["df", "--k", "-20", "--fc", "0.05", "--amplitude", "0.01"], "checks"),
+    ("scenario value", ["analyze", "nan.toml"], "checks"),
+    ("scan option", ["scan", "s.toml", *SCAN, "--ilc-gain", "2"], "checks"),
+    ("scan output", ["scan", "s.toml", *SCAN, "--time-series", "s.toml"], "checks"),
+    ("scan size", ["scan", "s.toml", *SCAN[:1], "1e6", *SCAN[2:]], "checks"),
+    ("simulate size", ["simulate", "s.toml", "--time-series", "o.csv", "--frequency", "5",
+                       "--duration", "1e9"], "checks"),
+    ("plant file", ["analyze", "plant-dir.toml"], "checks"),
+    ("record cell", ["identify", "fd-nan.csv"], "checks"),
+    ("record column", ["identify", "io-missing.csv", "--record", "input-output"], "checks"),
+    ("text .mat", ["predict", "open.toml", "f.mat", "--out", "p.csv"], "checks"),
+    ("open loop", ["stability", "open.toml"], "checks"),
+    ("unstable loop", ["steady", "unstable.toml"], "the loop"),
+    ("scan steps of the loop", ["scan", "s.toml", *SCAN, "--rate", "1e-3"], "the loop"),
+    ("no hysteresis", ["identify", "fd-zero.csv"], "a fit"),
+    ("no inertia", ["identify", "io.csv", "--record", "input-output"], "a fit"),
+]
+
+
+def _run(argv: list[str], cwd: Path) -> tuple[float, float, int, str]:
+    """Wall and processor time of one process, its exit code and stderr."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-c", CODE, *argv], cwd=cwd, capture_output=True,
+                          text=True, check=False)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, proc.returncode, proc.stderr
+
+
+def measure(repeats: int = REPEATS) -> dict:
+    """Each case's least wall time and its processor time, with the baseline's."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "pl").mkdir()
+        for name, text in _files().items():
+            (folder / name).write_text(text)
+        _run(["identify", "fd-zero.csv"], folder)  # compiled kernels cached before timing
+        best: dict[str, tuple[float, float, int, str]] = {}
+        for _ in range(repeats):
+            for name, argv in [("baseline", ["--help"])] + [(c[0], c[1]) for c in CASES]:
+                got = _run(argv, folder)
+                if name not in best or got[0] < best[name][0]:
+                    best[name] = got
+    base_wall, base_cpu = best["baseline"][:2]
+    rows = []
+    for name, argv, waits in CASES:
+        wall, cpu, rc, err = best[name]
+        rows.append({"case": name, "waits_for": waits, "command": " ".join(argv),
+                     "exit": rc, "stderr_lines": len(err.strip().splitlines()),
+                     "wall_s": wall, "cpu_s": cpu, "wall_ratio": wall / base_wall,
+                     "cpu_ratio": cpu / base_cpu, "message": err.strip()[-100:]})
+    slowest = max(rows, key=lambda r: r["wall_s"])
+    return {"baseline": {"command": "motionhyst --help", "wall_s": base_wall,
+                         "cpu_s": base_cpu},
+            "cases": rows, "target_s": TARGET_S, "slowest": slowest["case"],
+            "slowest_wall_s": slowest["wall_s"],
+            "all_refused": all(r["exit"] == 2 and r["stderr_lines"] == 1 for r in rows),
+            "within_target": all(r["wall_s"] <= TARGET_S for r in rows),
+            "repeats": repeats, "python": platform.python_version(),
+            "machine": platform.machine()}
+
+
+def main() -> None:
+    """Print the table (or JSON)."""
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--json", action="store_true")
+    p.add_argument("--repeats", type=int, default=REPEATS)
+    args = p.parse_args()
+    res = measure(args.repeats)
+    if args.json:
+        print(json.dumps(res, indent=2))
+        return
+    b = res["baseline"]
+    print(f"Refusals as whole processes, least wall time of {res['repeats']} runs; baseline "
+          f"`motionhyst --help` {b['wall_s']:.2f} s wall, {b['cpu_s']:.2f} s CPU")
+    print(f"{'case':24s} {'waits for':9s} {'exit':>4s} {'wall [s]':>8s} {'CPU [s]':>7s} "
+          f"{'x base':>6s}")
+    for r in res["cases"]:
+        flag = "" if r["exit"] == 2 and r["stderr_lines"] == 1 else "  NOT A ONE-LINE REFUSAL"
+        print(f"{r['case']:24s} {r['waits_for']:9s} {r['exit']:4d} {r['wall_s']:8.2f} "
+              f"{r['cpu_s']:7.2f} {r['wall_ratio']:6.1f}{flag}")
+    verdict = "all within" if res["within_target"] else "NOT all within"
+    print(f"slowest: {res['slowest']} {res['slowest_wall_s']:.2f} s; {verdict} the "
+          f"{res['target_s']:g} s target")
+
+
+if __name__ == "__main__":
+    main()
