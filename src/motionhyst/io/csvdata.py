@@ -27,19 +27,22 @@ from __future__ import annotations
 import codecs
 import os
 import re
+import sys
 import typing
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
 from motionhyst.core.budget import format_size
 from motionhyst.io.inputs import CSV_EXPANSION, input_problem
 
-Source = str | os.PathLike | np.ndarray | pd.DataFrame | Mapping
+if typing.TYPE_CHECKING:  # pandas loads when a file is parsed: a file refused before it
+    import pandas as pd  # (a folder, a device, an empty or binary file) does not wait for it
+
+Source = typing.Union[str, os.PathLike, np.ndarray, "pd.DataFrame", Mapping]
 """What the readers accept: a CSV path, a 2-D array or a DataFrame (or a mapping of columns)."""
 
 _SEPARATORS = (",", ";", "\t")
@@ -97,13 +100,19 @@ def describe(source: Source) -> str:
     >>> describe(np.zeros((3, 2)))
     'the array'
     """
-    if isinstance(source, pd.DataFrame):
+    if _is_frame(source):
         return "the DataFrame"
     if isinstance(source, np.ndarray):
         return "the array"
     if isinstance(source, Mapping):
         return "the table"
     return str(source)
+
+
+def _is_frame(source: Source) -> bool:
+    """Whether `source` is a pandas DataFrame (there is none unless pandas is loaded)."""
+    pd = sys.modules.get("pandas")
+    return pd is not None and isinstance(source, pd.DataFrame)
 
 
 def _is_path(source: Source) -> bool:
@@ -161,6 +170,8 @@ def _parser_message(text: str, sep: str) -> str:
 def _read_csv(path: Path, d: _Dialect, empty: str = "empty file: no header, no data rows",
               **options) -> pd.DataFrame:
     """The file through pandas' C parser, with one-line errors naming it."""
+    import pandas as pd
+
     try:
         return pd.read_csv(path, sep=d.sep, skipinitialspace=True, encoding=d.encoding,
                            encoding_errors="replace", decimal=d.decimal, engine="c",
@@ -207,7 +218,7 @@ def read_header(source: Source) -> list[str]:
     """
     if isinstance(source, np.ndarray):
         raise CSVError("an array has no column names; give a CSV file or a DataFrame")
-    if isinstance(source, pd.DataFrame):
+    if _is_frame(source):
         names = [normalize_name(c) for c in source.columns]
     elif isinstance(source, Mapping):
         names = [normalize_name(c) for c in source]
@@ -317,6 +328,8 @@ def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
 
 def _bad_cell(frame: pd.DataFrame, names: Sequence[str], source: Source) -> str | None:
     """A message for the first cell that is not a number, or None if all are numbers."""
+    import pandas as pd
+
     where = describe(source)
     for name in names:
         col = frame[name]
@@ -407,8 +420,10 @@ def read_columns(source: Source, names: Sequence[str]) -> NDArray[np.float64]:
         if data.shape[0] == 0:
             raise CSVError(f"{where}: no data rows")
         return data
-    if isinstance(source, pd.DataFrame | Mapping):
-        frame = source if isinstance(source, pd.DataFrame) else pd.DataFrame(dict(source))
+    if _is_frame(source) or isinstance(source, Mapping):
+        import pandas as pd
+
+        frame = source if _is_frame(source) else pd.DataFrame(dict(source))
         frame = frame.rename(columns=normalize_name)
         _check_unique(list(frame.columns), where)
         missing = [n for n in names if n not in frame.columns]
