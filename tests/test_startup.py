@@ -194,6 +194,25 @@ def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, a
     assert not (tmp_path / "o.csv").exists() and not (tmp_path / "p.csv").exists()
 
 
+@pytest.mark.parametrize("argv, error", [
+    (["identify", "d.csv"], "it is a folder"),
+    (["predict", "open.toml", "f.mat", "--out", "p.csv"], "not a MATLAB .mat file (a text file)"),
+    (["analyze", "plant-dir.toml"], "it is a folder"),
+    (["simulate", "paper.toml", "--time-series", "o.csv", "--frequency", "5", "--duration",
+      "1e9"], "too many time steps"),
+    ([*SCAN, "--window", "1"], "longer than the scan"),
+])
+def test_a_file_or_a_size_is_refused_before_any_heavy_library(tmp_path, argv, error):
+    """Neither pandas (it parses a CSV; these are refused before) nor anything else heavy."""
+    (tmp_path / "pl").mkdir()
+    (tmp_path / "d.csv").mkdir()
+    for name, text in {**_refused_scenarios(), "f.mat": "time,force\n0,1\n"}.items():
+        (tmp_path / name).write_text(text)
+    out = _probe(*argv, cwd=tmp_path)
+    assert out["rc"] == 2 and error in out["err"], out["err"]
+    assert out["heavy"] == [], f"motionhyst {' '.join(argv)} imported {out['heavy']}"
+
+
 def test_import_motionhyst_is_light_and_exports_every_name():
     code = """
 import json, sys
