@@ -130,12 +130,20 @@ def bessel_table(alpha, Q, P):  # pragma: no cover - compiled
     for k in range(1, kmax):
         inv_up[k] = 1.0 / (k * (P + k))
         inv_down[k] = 1.0 / (k * (P - 1 + k))
+    inv_factorial = 1.0  # 1 / (P - 1)!
+    for i in range(1, P):
+        inv_factorial /= i
     for q in range(1, Q + 1):
         a = q * alpha
         half = 0.5 * a
-        lead = 1.0  # (a / 2)^(P - 1) / (P - 1)!
-        for i in range(1, P):
-            lead *= half / i
+        lead = inv_factorial  # (a / 2)^(P - 1) / (P - 1)!, by squaring
+        power = half
+        e = P - 1
+        while e > 0:
+            if e & 1:
+                lead *= power
+            power *= power
+            e >>= 1
         x = -half * half
         term_up = 1.0
         sum_up = 1.0

@@ -513,7 +513,7 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode, half):  # pragma: no cover - com
 
 
 @njit(cache=True)
-def dominant_reversals(X, C1, C2):  # pragma: no cover - compiled
+def dominant_reversals(X, C1, C2, half):  # pragma: no cover - compiled
     """The reversal points of ``x`` when its first harmonic dominates, else none.
 
     With ``x_1' = -a_1 sin(theta + alpha)`` the first harmonic's derivative and the
@@ -522,7 +522,8 @@ def dominant_reversals(X, C1, C2):  # pragma: no cover - compiled
     each zero of ``x_1'`` its derivative has one sign (``R_2 < 0.8 a_1``): one root
     each, two a period, each bracketed without a grid.  Returns ``(ok, rev, xr)`` as
     :func:`reversal_points`; ``ok`` is False where the bounds do not hold (the roots
-    are then bracketed on a grid).
+    are then bracketed on a grid).  With `half` (no even harmonics: ``x(theta + pi) - X_0
+    = -(x(theta) - X_0)``) the second reversal is the first's, half a period on.
     """
     rev = np.empty(2)
     xr = np.empty(2)
@@ -541,7 +542,7 @@ def dominant_reversals(X, C1, C2):  # pragma: no cover - compiled
         return False, rev, xr
     delta = np.arcsin(2.0 * r1 / a1) + 1e-6
     alpha = np.arctan2(X[1].imag, X[1].real)
-    for i in range(2):
+    for i in range(1 if half else 2):
         t0 = (i * np.pi - alpha) % _TWO_PI
         lo = t0 - delta
         hi = t0 + delta
@@ -551,10 +552,15 @@ def dominant_reversals(X, C1, C2):  # pragma: no cover - compiled
             return False, rev, xr
         rev[i] = bracketed_root(C1, C2, 0.0, lo, hi, fhi > flo, 0.5 * (lo + hi),
                                 True) % _TWO_PI
+    xr[0] = X[0].real + trig2(X, C1, rev[0])[0]
+    if half:  # x(theta + pi) - X_0 = -(x(theta) - X_0)
+        rev[1] = (rev[0] + np.pi) % _TWO_PI
+        xr[1] = 2.0 * X[0].real - xr[0]
+    else:
+        xr[1] = X[0].real + trig2(X, C1, rev[1])[0]
     if rev[1] < rev[0]:
         rev[0], rev[1] = rev[1], rev[0]
-    for i in range(2):
-        xr[i] = X[0].real + trig2(X, C1, rev[i])[0]
+        xr[0], xr[1] = xr[1], xr[0]
     return True, rev, xr
 
 
@@ -621,7 +627,7 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
         C2[m] = -(m * m) * Xs[m]
     n = grid_size(M, H)
     direct = 2 * M * (H + 1) <= 4 * n
-    monotone, rev, xr = dominant_reversals(Xs, C1, C2)
+    monotone, rev, xr = dominant_reversals(Xs, C1, C2, symmetric)
     x = np.empty(0)
     if not monotone:
         x = synthesize(Xs, n, tw)
