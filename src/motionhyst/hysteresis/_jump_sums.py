@@ -269,3 +269,104 @@ def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compile
         if q <= n_s:
             S[q] = -0.5j * (up - umc) * (scale / r)
     return G, S
+
+
+@njit(cache=True)
+def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compiled
+    """:func:`jump_series_binned` of a period whose second half mirrors the first: `t_b`,
+    `jg`, `js` are the jumps of the first half, those of the second are ``-jg`` and ``js``
+    at ``t_b + pi`` (``g(t + pi) = -g(t)``, ``s(t + pi) = s(t)``).  Returns the whole
+    period's ``G`` (odd harmonics only) and ``S`` (even harmonics only).
+
+    Each jump and its mirror make one sum with real weights, ``(r js + jg) / 2`` at
+    ``t_b`` and ``(r js - jg) / 2`` at ``t_b + pi`` (``r`` as in
+    :func:`jump_series_binned`): ``r`` times the sum of `js` at even ``q``, the sum of
+    `jg` at odd ``q``.  Real weights halve the transforms (two terms' moments in one
+    complex FFT) and need ``q >= 0`` only.
+    """
+    Q = max(n_g, n_s)
+    N, P = binned_grid(2 * t_b.shape[0], Q, 2 * tw.shape[0])
+    if N < 2:
+        N = 2
+    h = _TWO_PI / N
+    half_grid = N // 2
+    sum_g = 0.0
+    sum_s = 0.0
+    for b in range(t_b.shape[0]):
+        sum_g += abs(jg[b])
+        sum_s += abs(js[b])
+    r = 1.0
+    if sum_g > 0.0 and sum_s > 0.0:
+        r = 2.0 ** np.round(np.log2(sum_g / sum_s))
+    P2 = (P + 1) // 2 * 2  # whole pairs of terms, the last padded with zeros
+    bins = np.zeros((N, P2))  # a jump's moments side by side
+    nj = t_b.shape[0]
+    # four jumps at a time: their Chebyshev recurrences interleaved
+    cell = np.empty(4, dtype=np.int64)
+    v = np.empty(4)
+    T = np.empty((P, 4))
+    for b0 in range(0, nj, 4):
+        nb = min(4, nj - b0)
+        for i in range(4):
+            if i < nb:
+                t = t_b[b0 + i] % _TWO_PI
+                j = int(np.floor(t / h + 0.5))
+                v[i] = (t - j * h) / (0.5 * h)
+                cell[i] = j - N if j >= N else j
+            else:
+                v[i] = 0.0
+        for i in range(4):
+            T[0, i] = 1.0
+        if P > 1:
+            for i in range(4):
+                T[1, i] = v[i]
+        for p in range(2, P):
+            for i in range(4):
+                T[p, i] = 2.0 * v[i] * T[p - 1, i] - T[p - 2, i]
+        for i in range(nb):
+            w_plus = 0.5 * (r * js[b0 + i] + jg[b0 + i])
+            w_minus = 0.5 * (r * js[b0 + i] - jg[b0 + i])
+            j = cell[i]
+            row = bins[j]
+            mirror = bins[j + half_grid if j < half_grid else j - half_grid]
+            for p in range(P):
+                row[p] += w_plus * T[p, i]
+                mirror[p] += w_minus * T[p, i]
+    reversed_index = bit_reversed_indices(N)
+    n_pairs = P2 // 2
+    mu = np.empty((n_pairs, N), dtype=np.complex128)
+    for pp in range(n_pairs):
+        row = mu[pp]
+        for j in range(N):
+            src = bins[reversed_index[j]]
+            row[j] = complex(src[2 * pp], src[2 * pp + 1])
+        fft_unscrambling(row, tw)
+    G = np.zeros(n_g + 1, dtype=np.complex128)
+    S = np.zeros(n_s + 1, dtype=np.complex128)
+    bessel = bessel_table(0.5 * h, Q, P)
+    for q in range(1, Q + 1):
+        jp = bessel[q]
+        iq = q % N
+        im = (N - iq) % N
+        # sum_p eps_p (-j)^p J_p F_p, F_p and F_p+1 from the pair's transform at q and -q
+        z = 0j
+        for pp in range(n_pairs):
+            y = mu[pp, iq]
+            yc = mu[pp, im].conjugate()
+            f_even = 0.5 * (y + yc)
+            f_odd = -0.5j * (y - yc)
+            p = 2 * pp
+            c_even = jp[p] if p == 0 else 2.0 * jp[p]
+            c_odd = 2.0 * jp[p + 1] if p + 1 < P else 0.0
+            # (-j)^p: +-1 for the even term, -+j for the odd one
+            if pp % 2 == 0:
+                z += c_even * f_even + c_odd * complex(f_odd.imag, -f_odd.real)
+            else:
+                z += -c_even * f_even + c_odd * complex(-f_odd.imag, f_odd.real)
+        scale = -2j / (_TWO_PI * q)
+        if q % 2 == 1:
+            if q <= n_g:
+                G[q] = z * scale
+        elif q <= n_s:
+            S[q] = z * (scale / r)
+    return G, S

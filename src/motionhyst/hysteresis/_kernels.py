@@ -20,7 +20,12 @@ from motionhyst.hysteresis._fft import (
     synthesize,
     synthesize_packed,
 )
-from motionhyst.hysteresis._jump_sums import binned_is_cheaper, jump_series, jump_series_binned
+from motionhyst.hysteresis._jump_sums import (
+    binned_is_cheaper,
+    jump_series,
+    jump_series_binned,
+    jump_series_binned_half,
+)
 
 
 @njit(cache=True)
@@ -646,15 +651,18 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
     half = symmetric and monotone
     t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
     Q = H + M
-    if binned_is_cheaper(t_b.shape[0], Q, 2 * tw.shape[0]):
-        G, S = jump_series_binned(t_b, jg, js, H, Q, tw)
+    if half and binned_is_cheaper(2 * t_b.shape[0], Q, 2 * tw.shape[0]):
+        G, S = jump_series_binned_half(t_b, jg, js, H, Q, tw)
     else:
-        G, S = jump_series(t_b, jg, js, H, Q)
-    if half:  # a jump's mirror half a period on: g's of opposite sign, s's alike
-        for q in range(H + 1):
-            G[q] = 2.0 * G[q] if q % 2 == 1 else 0.0
-        for q in range(Q + 1):
-            S[q] = 2.0 * S[q] if q % 2 == 0 else 0.0
+        if binned_is_cheaper(t_b.shape[0], Q, 2 * tw.shape[0]):
+            G, S = jump_series_binned(t_b, jg, js, H, Q, tw)
+        else:
+            G, S = jump_series(t_b, jg, js, H, Q)
+        if half:  # a jump's mirror half a period on: g's of opposite sign, s's alike
+            for q in range(H + 1):
+                G[q] = 2.0 * G[q] if q % 2 == 1 else 0.0
+            for q in range(Q + 1):
+                S[q] = 2.0 * S[q] if q % 2 == 0 else 0.0
     G[0] = g_mean
     S[0] = s_mean
     if direct:
