@@ -674,8 +674,15 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
                 acc += S[q + m] * Xs[m].conjugate()
             W[q] = acc
         return W
-    P = analyze_packed(packed_product(synthesize_packed(Xs, n, tw),
-                                      synthesize_packed(S, n, tw)), n, H, tw)
+    if half:  # s repeats after half a period: its samples from half the transform
+        zh = synthesize_packed(S[0::2].copy(), n // 2, tw)
+        zs = np.empty(n // 2, dtype=np.complex128)
+        for u in range(n // 4):  # t and t + n / 4 are neighbours in bit-reversed order
+            zs[2 * u] = zh[u]
+            zs[2 * u + 1] = zh[u]
+    else:
+        zs = synthesize_packed(S, n, tw)
+    P = analyze_packed(packed_product(synthesize_packed(Xs, n, tw), zs), n, H, tw)
     for q in range(H + 1):
         W[q] = G[q] + P[q]
     return W
