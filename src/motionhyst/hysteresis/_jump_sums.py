@@ -83,7 +83,8 @@ def chebyshev_terms(a_max):  # pragma: no cover - compiled
 def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
     """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
     :func:`jump_series_binned` for `n_jumps` jumps and harmonics up to `Q`: the fewest
-    operations (weights measured on the compiled code), ``N >= Q / 2``."""
+    operations, weighted roughly as the compiled code spends its time (binning, FFTs, the
+    sums over the terms, the Bessel table), ``N >= Q / 2``."""
     best_N, best_P, best_cost = 0, 0, np.inf
     N = 2
     while N <= N_max:
@@ -99,7 +100,7 @@ def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
 @njit(cache=True)
 def binned_is_cheaper(n_jumps, Q, N_max):  # pragma: no cover - compiled
     """Whether :func:`jump_series_binned` takes fewer operations than :func:`jump_series`
-    for `n_jumps` jumps and harmonics up to `Q` (weights measured on the compiled code)."""
+    for `n_jumps` jumps and harmonics up to `Q` (weighted as in :func:`binned_grid`)."""
     N, P = binned_grid(n_jumps, Q, N_max)
     cost = P * (n_jumps * 2.0 + N * np.log2(N) * 1.5 + Q * 2.0) + Q * (P + 24.0) * 1.5
     return cost < 2.5 * n_jumps * (Q + 1)
@@ -286,8 +287,6 @@ def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - co
     """
     Q = max(n_g, n_s)
     N, P = binned_grid(2 * t_b.shape[0], Q, 2 * tw.shape[0])
-    if N < 2:
-        N = 2
     h = _TWO_PI / N
     half_grid = N // 2
     sum_g = 0.0

@@ -605,7 +605,10 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
     `tw` is the twiddle table (:func:`motionhyst.hysteresis._fft.twiddle_table`) of at
     least ``grid_size(len(X) - 1, H)`` samples.  The reversals come from
     :func:`dominant_reversals` where it applies, else from the grid; the product ``s x``
-    is a direct convolution where that takes fewer operations than the transforms.
+    is a direct convolution where that takes fewer operations than the transforms.  An
+    input whose even harmonics are below 1e-15 of the total is taken as half-wave
+    symmetric (they are set to zero): with two reversals the output is then found for
+    half a period and mirrored (:func:`stop_pieces`, :func:`jump_series_binned_half`).
     """
     W = np.zeros(H + 1, dtype=np.complex128)
     M = significant_count(X, 1e-15)

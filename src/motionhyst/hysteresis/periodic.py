@@ -15,7 +15,9 @@ computation (roots, the element's pass over its pieces, the jump sums, the
 transforms of the product) is one compiled kernel,
 :func:`stop_harmonics` (:mod:`motionhyst.hysteresis._kernels`); where the first
 harmonic of ``x`` dominates, its reversals are bracketed by bounds on the other
-harmonics rather than on a grid, and the slip onsets between them directly.
+harmonics rather than on a grid, and the slip onsets between them directly.  An input
+without even harmonics (a symmetric loop driven by a sine) makes the second half period
+of the output the mirror of the first, which alone is computed.
 """
 
 from __future__ import annotations
