@@ -343,25 +343,25 @@ def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - co
     G = np.zeros(n_g + 1, dtype=np.complex128)
     S = np.zeros(n_s + 1, dtype=np.complex128)
     bessel = bessel_table(0.5 * h, Q, P)
+    weight_y = np.empty(n_pairs)
+    weight_yc = np.empty(n_pairs)
     for q in range(1, Q + 1):
         jp = bessel[q]
         iq = q % N
         im = (N - iq) % N
-        # sum_p eps_p (-j)^p J_p F_p, F_p and F_p+1 from the pair's transform at q and -q
-        z = 0j
+        # sum_p eps_p (-j)^p J_p F_p with the pair's F_p = (y + conj y_-) / 2 and F_p+1 =
+        # -j (y - conj y_-) / 2 (y, y_- its transform at q and -q): (-j)^p = (-1)^(p/2) for
+        # p even, and (-j) F_p+1 = -(y - conj y_-) / 2
         for pp in range(n_pairs):
-            y = mu[pp, iq]
-            yc = mu[pp, im].conjugate()
-            f_even = 0.5 * (y + yc)
-            f_odd = -0.5j * (y - yc)
             p = 2 * pp
             c_even = jp[p] if p == 0 else 2.0 * jp[p]
             c_odd = 2.0 * jp[p + 1] if p + 1 < P else 0.0
-            # (-j)^p: +-1 for the even term, -+j for the odd one
-            if pp % 2 == 0:
-                z += c_even * f_even + c_odd * complex(f_odd.imag, -f_odd.real)
-            else:
-                z += -c_even * f_even + c_odd * complex(-f_odd.imag, f_odd.real)
+            sign = 0.5 if pp % 2 == 0 else -0.5
+            weight_y[pp] = sign * (c_even - c_odd)
+            weight_yc[pp] = sign * (c_even + c_odd)
+        z = 0j
+        for pp in range(n_pairs):
+            z += weight_y[pp] * mu[pp, iq] + weight_yc[pp] * mu[pp, im].conjugate()
         scale = -2j / (_TWO_PI * q)
         if q % 2 == 1:
             if q <= n_g:
