@@ -303,7 +303,8 @@ def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - co
     # four jumps at a time: their Chebyshev recurrences interleaved
     cell = np.empty(4, dtype=np.int64)
     v = np.empty(4)
-    T = np.empty((P, 4))
+    T = np.empty((4, P2))
+    T[:, P:] = 0.0
     for b0 in range(0, nj, 4):
         nb = min(4, nj - b0)
         for i in range(4):
@@ -315,22 +316,23 @@ def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - co
             else:
                 v[i] = 0.0
         for i in range(4):
-            T[0, i] = 1.0
+            T[i, 0] = 1.0
         if P > 1:
             for i in range(4):
-                T[1, i] = v[i]
+                T[i, 1] = v[i]
         for p in range(2, P):
             for i in range(4):
-                T[p, i] = 2.0 * v[i] * T[p - 1, i] - T[p - 2, i]
+                T[i, p] = 2.0 * v[i] * T[i, p - 1] - T[i, p - 2]
         for i in range(nb):
             w_plus = 0.5 * (r * js[b0 + i] + jg[b0 + i])
             w_minus = 0.5 * (r * js[b0 + i] - jg[b0 + i])
             j = cell[i]
             row = bins[j]
             mirror = bins[j + half_grid if j < half_grid else j - half_grid]
-            for p in range(P):
-                row[p] += w_plus * T[p, i]
-                mirror[p] += w_minus * T[p, i]
+            Ti = T[i]
+            for p in range(P2):
+                row[p] += w_plus * Ti[p]
+                mirror[p] += w_minus * Ti[p]
     reversed_index = bit_reversed_indices(N)
     n_pairs = P2 // 2
     mu = np.empty((n_pairs, N), dtype=np.complex128)
