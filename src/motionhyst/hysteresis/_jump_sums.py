@@ -177,6 +177,43 @@ def bessel_table(alpha, Q, P):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def balance(jg, js):  # pragma: no cover - compiled
+    """The power of two ``r`` that makes ``sum |jg|`` and ``r sum |js|`` alike, so that the
+    two sets of jumps, transformed together, each keep their accuracy."""
+    sum_g = 0.0
+    sum_s = 0.0
+    for b in range(jg.shape[0]):
+        sum_g += abs(jg[b])
+        sum_s += abs(js[b])
+    if sum_g > 0.0 and sum_s > 0.0:
+        return 2.0 ** np.round(np.log2(sum_g / sum_s))
+    return 1.0
+
+
+@njit(cache=True, inline="always")
+def chebyshev_values(t_b, b0, N, P, cell, v, T):  # pragma: no cover - compiled
+    """For the jumps ``b0 .. b0 + 3`` (those that exist): the grid point ``cell[i]`` nearest
+    to each angle (``N`` points) and the Chebyshev polynomials ``T[i, p] = T_p(v)`` of its
+    offset ``v`` in half cells (0 past the last jump), ``p < P``; the four recurrences
+    interleaved."""
+    h = _TWO_PI / N
+    v[:] = 0.0
+    for i in range(min(4, t_b.shape[0] - b0)):
+        t = t_b[b0 + i] % _TWO_PI
+        j = int(np.floor(t / h + 0.5))
+        v[i] = (t - j * h) / (0.5 * h)
+        cell[i] = j - N if j >= N else j
+    for i in range(4):
+        T[i, 0] = 1.0
+    if P > 1:
+        for i in range(4):
+            T[i, 1] = v[i]
+    for p in range(2, P):
+        for i in range(4):
+            T[i, p] = 2.0 * v[i] * T[i, p - 1] - T[i, p - 2]
+
+
+@njit(cache=True)
 def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compiled
     """:func:`jump_series` for many jumps, in ``O(jumps + Q log Q)`` (``Q = max(n_g, n_s)``).
 
@@ -192,44 +229,19 @@ def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compile
     Q = max(n_g, n_s)
     N, P = binned_grid(t_b.shape[0], Q, 2 * tw.shape[0])
     h = _TWO_PI / N
-    # jg + j js r: r, a power of two, brings the two to one size (each keeps its accuracy)
-    sum_g = 0.0
-    sum_s = 0.0
-    for b in range(t_b.shape[0]):
-        sum_g += abs(jg[b])
-        sum_s += abs(js[b])
-    r = 1.0
-    if sum_g > 0.0 and sum_s > 0.0:
-        r = 2.0 ** np.round(np.log2(sum_g / sum_s))
+    r = balance(jg, js)  # jg + j r js
     bins = np.zeros((N, P), dtype=np.complex128)  # a jump's moments side by side
-    nj = t_b.shape[0]
-    # four jumps at a time: their Chebyshev recurrences interleaved
     cell = np.empty(4, dtype=np.int64)
     v = np.empty(4)
-    T = np.empty((P, 4))
-    for b0 in range(0, nj, 4):
-        nb = min(4, nj - b0)
-        for i in range(4):
-            if i < nb:
-                t = t_b[b0 + i] % _TWO_PI
-                j = int(np.floor(t / h + 0.5))
-                v[i] = (t - j * h) / (0.5 * h)
-                cell[i] = j - N if j >= N else j
-            else:
-                v[i] = 0.0
-        for i in range(4):
-            T[0, i] = 1.0
-        if P > 1:
-            for i in range(4):
-                T[1, i] = v[i]
-        for p in range(2, P):
-            for i in range(4):
-                T[p, i] = 2.0 * v[i] * T[p - 1, i] - T[p - 2, i]
-        for i in range(nb):
+    T = np.empty((4, P))
+    for b0 in range(0, t_b.shape[0], 4):
+        chebyshev_values(t_b, b0, N, P, cell, v, T)
+        for i in range(min(4, t_b.shape[0] - b0)):
             c = complex(jg[b0 + i], js[b0 + i] * r)
             row = bins[cell[i]]
+            Ti = T[i]
             for p in range(P):
-                row[p] += c * T[p, i]
+                row[p] += c * Ti[p]
     reversed_index = bit_reversed_indices(N)
     mu = np.empty((P, N), dtype=np.complex128)
     for p in range(P):
@@ -289,41 +301,15 @@ def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - co
     N, P = binned_grid(2 * t_b.shape[0], Q, 2 * tw.shape[0])
     h = _TWO_PI / N
     half_grid = N // 2
-    sum_g = 0.0
-    sum_s = 0.0
-    for b in range(t_b.shape[0]):
-        sum_g += abs(jg[b])
-        sum_s += abs(js[b])
-    r = 1.0
-    if sum_g > 0.0 and sum_s > 0.0:
-        r = 2.0 ** np.round(np.log2(sum_g / sum_s))
+    r = balance(jg, js)
     P2 = (P + 1) // 2 * 2  # whole pairs of terms, the last padded with zeros
     bins = np.zeros((N, P2))  # a jump's moments side by side
-    nj = t_b.shape[0]
-    # four jumps at a time: their Chebyshev recurrences interleaved
     cell = np.empty(4, dtype=np.int64)
     v = np.empty(4)
-    T = np.empty((4, P2))
-    T[:, P:] = 0.0
-    for b0 in range(0, nj, 4):
-        nb = min(4, nj - b0)
-        for i in range(4):
-            if i < nb:
-                t = t_b[b0 + i] % _TWO_PI
-                j = int(np.floor(t / h + 0.5))
-                v[i] = (t - j * h) / (0.5 * h)
-                cell[i] = j - N if j >= N else j
-            else:
-                v[i] = 0.0
-        for i in range(4):
-            T[i, 0] = 1.0
-        if P > 1:
-            for i in range(4):
-                T[i, 1] = v[i]
-        for p in range(2, P):
-            for i in range(4):
-                T[i, p] = 2.0 * v[i] * T[i, p - 1] - T[i, p - 2]
-        for i in range(nb):
+    T = np.zeros((4, P2))
+    for b0 in range(0, t_b.shape[0], 4):
+        chebyshev_values(t_b, b0, N, P, cell, v, T)
+        for i in range(min(4, t_b.shape[0] - b0)):
             w_plus = 0.5 * (r * js[b0 + i] + jg[b0 + i])
             w_minus = 0.5 * (r * js[b0 + i] - jg[b0 + i])
             j = cell[i]
