@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.warnings import MotionhystWarning
+from motionhyst.study.heap import heap_kept
 from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
 from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
@@ -243,11 +244,12 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
     >>> print(f"{b.values['error_rms'][0]:.3e} m")
     8.176e-09 m
     """
-    ev = _evaluator(key, plain)
-    try:
-        return ev.batch(indices)
-    finally:
-        _release(key, ev)
+    with heap_kept():   # a dask worker's trim threshold would return the heap after each point
+        ev = _evaluator(key, plain)
+        try:
+            return ev.batch(indices)
+        finally:
+            _release(key, ev)
 
 
 _WORKER_STUDY: dict = {}
