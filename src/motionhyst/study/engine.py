@@ -384,15 +384,58 @@ def run_batches(study: StudyDefinition, batches: list, workers: int = 1, client=
         yield from _Pool(workers, key, plain).run(batches)
 
 
-def seconds_per_point(study: StudyDefinition, n: int = 3) -> float:
-    """Time of one point, measured on up to `n` points spread over the study (warm)."""
+def seconds_per_point(study: StudyDefinition, n: int = 3, cpu: bool = False) -> float:
+    """Time of one point over the study, measured on about `n` points (warm).
+
+    Consecutive points share their loop (:meth:`StudyDefinition.order`) and what it
+    computes once per frequency: the first point on a loop costs more than the next ones.
+    The points are timed in runs of consecutive ones from spread places of the study; a
+    run's first point's extra counts once for each loop of the study, not once a point.
+
+    Parameters
+    ----------
+    study : StudyDefinition
+        The study.
+    n : int
+        Points to time (at least 2).
+    cpu : bool
+        The CPU time of the thread computing them (the work, whatever the load of the
+        machine: what a batch's size is chosen from) rather than the wall time.
+
+    Examples
+    --------
+    >>> import tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = StudyDefinition.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0]}},
+    ...                                scenario=base)
+    >>> 0 < seconds_per_point(st, cpu=True) < 1
+    True
+    """
+    clock = time.thread_time if cpu else time.perf_counter
     ev = Evaluator(study)
     ev.warm()
     order = study.order()
-    pick = order[np.linspace(0, len(order) - 1, min(n, len(order))).astype(int)]
-    t0 = time.perf_counter()
-    ev.batch(pick)
-    return (time.perf_counter() - t0) / len(pick)
+    runs = 1 if n < 4 else 2
+    size = max(2, n // runs)
+    starts = np.linspace(0, max(len(order) - size, 0), runs).astype(int)
+    first = rest = 0.0
+    n_rest = 0
+    for s in starts:
+        run = order[s:s + size]
+        t0 = clock()
+        ev.batch(run[:1])
+        t1 = clock()
+        ev.batch(run[1:])
+        first += t1 - t0
+        rest += clock() - t1
+        n_rest += len(run) - 1
+    if n_rest == 0:
+        return first / runs
+    steady = rest / n_rest
+    loops = math.prod(len(v) for k, v in study.axes.items() if is_scenario_key(k)) * (
+        study.n_samples if any(map(is_scenario_key, study.sampled_keys)) else 1)
+    return steady + max(first / runs - steady, 0.0) * loops / study.n_points
 
 
 def batch_size(seconds: float, n_missing: int, workers: int,

@@ -299,7 +299,9 @@ def _compute(study: StudyDefinition, st: StudyStore, workers: int | None, client
     if len(todo):
         if client is not None:
             workers = max(1, sum(client.nthreads().values()))
-        size = batch or batch_size(seconds_per_point(study, 2), len(todo), workers,
+        # from the CPU time of a point: its wall time on a loaded machine would make batches
+        # too small for the work each costs the engine
+        size = batch or batch_size(seconds_per_point(study, 2, cpu=True), len(todo), workers,
                                    BATCH_SECONDS if client is None else DASK_BATCH_SECONDS)
         batches = split(todo, size)
         bar = None
