@@ -333,8 +333,9 @@ class _Pool:
 def _dask_run(client, key: str, plain: dict, batches: list) -> Iterator[Batch]:
     from distributed import as_completed
 
-    [plain_f] = client.scatter([plain], broadcast=True, hash=False)
-    futures = [client.submit(evaluate_batch, key, plain_f, b, pure=False) for b in batches]
+    # the study's dictionary (about 1 kB) goes with each batch: scattered, its only copy left
+    # by dask's memory manager on a worker that dies would cancel every batch still to run
+    futures = [client.submit(evaluate_batch, key, plain, b, pure=False) for b in batches]
     try:
         for f in as_completed(futures):
             yield f.result()
