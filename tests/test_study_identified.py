@@ -300,3 +300,109 @@ def test_the_local_pool_draws_and_computes_as_this_process(saved, tmp_path):
     here, pool = open_results(tmp_path / "here.zarr"), open_results(tmp_path / "pool.zarr")
     for name in ("mismatch", "status", "hysteresis.k", "hysteresis.fc"):
         np.testing.assert_array_equal(here[name].values, pool[name].values, err_msg=name)
+
+
+def _bouc_wen_fit():
+    """A Bouc-Wen link on a mass-spring-damper (alpha = 5e4 N/m, beta*gamma = 800,
+    beta*delta = -1100 1/m, nu = 1) identified from a multisine record with 8 um of noise."""
+    from motionhyst.hysteresis import BoucWen
+
+    fs, n = 750.0, 1024
+    rng = np.random.default_rng(2)
+    spec = np.zeros(n // 2 + 1, dtype=complex)
+    lines = np.arange(int(5 / (fs / n)), int(150 / (fs / n)) + 1)
+    spec[lines] = np.exp(2j * np.pi * rng.random(lines.size))
+    u = np.fft.irfft(spec, n)
+    u *= 50.0 / np.std(u)
+    t = np.arange(n) / fs
+    system = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4),
+                      BoucWen.from_general(5e4, 1e3, 0.8, -1.1, 1.0))
+    y = system.simulate(t, u, substeps=20).displacement + 8e-6 * rng.standard_normal(n)
+    return identify_io([IORecord(t, u, y)], substeps=20)
+
+
+BOUC_WEN_KEYS = ("hysteresis.alpha", "hysteresis.beta*gamma", "hysteresis.beta*delta")
+
+
+def test_a_bouc_wen_link_is_drawn_from_its_identified_products(tmp_path):
+    """beta alone is not identified: the covariance is of alpha and the products
+    beta*gamma, beta*delta (of either sign), saved under hysteresis.beta*gamma, ...; a study
+    draws them jointly and sets beta, gamma and delta of the link (|gamma| + |delta| = 1)
+    whose products they are."""
+    fit = _bouc_wen_fit()
+    cov = fit.to_dict()["covariance"]
+    determined = [n for n, s in fit.std.items() if s is not None]
+    assert cov["parameters"] == determined == ["m", "c", "k", "alpha", "beta*gamma",
+                                               "beta*delta"]
+    np.testing.assert_allclose(np.sqrt(np.diag(cov["matrix"])),
+                               [fit.std[n] for n in determined], rtol=1e-9)
+    text = fit.scenario_text()
+    ident = tomllib.loads(text)["identification"]
+    assert ident["parameters"] == ["stage.m", "stage.c", "stage.k", *BOUC_WEN_KEYS]
+    (tmp_path / "model.toml").write_text(text)
+    (tmp_path / "fit.json").write_text(json.dumps(fit.to_dict()))
+    c = np.array(cov["matrix"])[3:, 3:]
+    mean = [fit.estimates[n] for n in ("alpha", "beta*gamma", "beta*delta")]
+    assert mean[2] < 0
+    for name in ("model.toml", "fit.json"):
+        d = joint_from_identification(tmp_path / name)
+        assert d.keys == BOUC_WEN_KEYS and not d.log_space
+        np.testing.assert_allclose(d.covariance, c, rtol=1e-9, atol=1e-9 * np.abs(c).max())
+
+    # the identified system in a loop: the study's scenario
+    (tmp_path / "loop.toml").write_text(
+        text.split("[identification]")[0]
+        + '[controller]\ntype = "pid"\nkp = 2e5\nki = 2e6\nkd = 600.0\n'
+          'derivative_filter_hz = 500.0\n[reference]\namplitude = 1e-4\nfrequencies = [5.0]\n')
+    st = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0]},
+                          "samples": {"n": N_DRAWS, "seed": 1,
+                                      "from_identification": "model.toml"}},
+                         base_dir=tmp_path,
+                         scenario=tomllib.loads((tmp_path / "loop.toml").read_text()))
+    assert st.sampled_keys == BOUC_WEN_KEYS
+    _within_sampling_error(st.sample_values, mean, c)
+    for i in (0, 7, 99):
+        drawn = st.point(i)
+        link = st.scenario_at(drawn)["hysteresis"]
+        assert abs(link["gamma"]) + abs(link["delta"]) == pytest.approx(1.0, rel=1e-15)
+        assert link["beta"] * link["gamma"] == pytest.approx(drawn["hysteresis.beta*gamma"],
+                                                             rel=1e-14)
+        assert link["beta"] * link["delta"] == pytest.approx(drawn["hysteresis.beta*delta"],
+                                                             rel=1e-14)
+        assert link["alpha"] == drawn["hysteresis.alpha"]
+    # two machines of the fleet computed: their loops are built from the drawn links
+    small = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0]},
+                             "samples": {"n": 2, "seed": 1,
+                                         "from_identification": "model.toml"}},
+                            base_dir=tmp_path,
+                            scenario=tomllib.loads((tmp_path / "loop.toml").read_text()))
+    report = run_study(small, tmp_path / "bw.zarr", workers=0)
+    assert (report.computed, report.failed) == (2, 0)
+    ds = open_results(tmp_path / "bw.zarr")
+    np.testing.assert_array_equal(ds["hysteresis.beta*delta"].values, small.sample_values[:, 2])
+    m = ds["mismatch"].values.ravel()
+    assert np.all(np.isfinite(m)) and m[0] != m[1]
+
+
+def test_signed_products_and_the_bouc_wen_exponent_are_drawn_within_their_ranges():
+    """A product keeps its sign freedom (normal, also beside lognormal positive keys, with
+    the stated covariance); nu is drawn again below 1; a mean outside its range is refused."""
+    m = np.array([5e4, -1100.0])
+    s = np.array([0.4 * 5e4, 50.0])
+    cov = np.outer(s, s) * np.array([[1.0, -0.5], [-0.5, 1.0]])
+    d = JointNormal(("hysteresis.alpha", "hysteresis.beta*delta"), tuple(m),
+                    tuple(map(tuple, cov)))
+    assert d.log_space
+    x = d.draw(np.random.default_rng(4), 200_000)
+    assert np.all(x[:, 0] > 0)
+    np.testing.assert_allclose(x.mean(axis=0), m, rtol=0.005)
+    np.testing.assert_allclose(np.cov(x.T), cov, rtol=0.03)
+    z = (x[:, 1] - m[1]) / s[1]
+    assert abs(np.mean(z ** 3)) < 0.02        # the product stays normal
+    nu = JointNormal(("hysteresis.nu",), (1.02,), ((0.02 ** 2,),))
+    y = nu.draw(np.random.default_rng(0), 10_000)
+    assert y.min() >= 1.0 and np.mean(y < 1.02) > 0.2
+    with pytest.raises(ValueError, match=r"hysteresis.nu = 0.9: .* must be a number >= 1"):
+        JointNormal(("hysteresis.nu",), (0.9,), ((0.01,),))
+    with pytest.raises(ValueError, match=r"hysteresis.alpha = -1: .* must be a positive"):
+        JointNormal(("hysteresis.alpha",), (-1.0,), ((0.01,),))

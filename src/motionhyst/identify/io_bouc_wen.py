@@ -34,6 +34,8 @@ from motionhyst.identify.io_start import (
 )
 from motionhyst.identify.io_uncertainty import (
     SINGULAR_RTOL,
+    covariance,
+    covariance_table,
     standard_errors,
     undetermined_notes,
 )
@@ -247,7 +249,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     # 3. refinement on all records, from the best start whose result is a valid system
     error = None
     for _, _, p_start in refined[:FINAL_ATTEMPTS]:
-        p, free_used, sol, res, std_q, groups, notes, n = _refine(
+        p, free_used, sol, res, std_q, groups, notes, n, cov = _refine(
             records, periodic, r, free, p_start, y_scale, scale, tol, max_nfev,
             output_offset=output_offset)
         n_eval += n
@@ -273,7 +275,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
         std[n] = float(s) if math.isfinite(s) else None
     not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
     per_record = per_record_errors(records, res)
-    extra: dict = {}
+    extra: dict = {"covariance": covariance_table(free_names, cov, std)}
     if output_offset:
         offsets, offset_std = _output_offsets(records, periodic, r, free, p, y_scale, rss,
                                               res.size)
@@ -281,7 +283,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
             name = "output_offset" if len(records) == 1 else f"output_offset[{i}]"
             estimates[name] = value
             std[name] = sd
-        extra = {"offsets": {"input": 0.0, "output": offsets}}
+        extra["offsets"] = {"input": 0.0, "output": offsets}
     # with each record's position offset estimated, the fit is judged on the records' variations
     warnings = _judged(records, res, plant, link, {"m": plant.m}, floating=False,
                        centred=bool(output_offset))
@@ -380,6 +382,7 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
         res, jac = prob.run(p, True)
         res *= y_scale
         std_q, groups = standard_errors(jac[:, free] * y_scale, float(res @ res), res.size)
+        cov = covariance(jac[:, free] * y_scale, float(res @ res), res.size)
         if not free[6] or p[4] + p[5] >= 0.0:
             break
         nu_std = std_q[int(np.count_nonzero(free[:6]))]
@@ -391,7 +394,7 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
         free = free.copy()
         free[6] = False
         p[6] = 1.0
-    return p, free, sol, res, std_q, groups, notes, n_eval
+    return p, free, sol, res, std_q, groups, notes, n_eval, cov
 
 
 def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start
@@ -400,7 +403,7 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
     on all records (problem order ``m1, m2, b, alpha, beta*gamma, beta*delta, nu, k``)."""
     structure, r, y_scale, scale, free, p, n_eval = _two_mass_start(records, periodic, nu,
                                                                    substeps, output)
-    p, free, sol, res, std_q, groups, notes, n = _refine(
+    p, free, sol, res, std_q, groups, notes, n, cov = _refine(
         records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=structure)
     n_eval += n
     link = _bouc_wen_link(p[3], p[4], p[5], p[6])
@@ -429,7 +432,7 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r, warnings=warnings, data=list(records),
-        residuals=res)
+        residuals=res, extra={"covariance": covariance_table(free_names, cov, std)})
 
 
 def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,

@@ -11,7 +11,7 @@ from motionhyst.core.textfiles import toml_table
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.identify.io_records import IORecord
-from motionhyst.identify.io_uncertainty import identification_toml
+from motionhyst.identify.io_uncertainty import BOUC_WEN_IDENTIFIED, identification_toml
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop
 
 __all__ = ["IOIdentification"]
@@ -53,8 +53,9 @@ class IOIdentification:
         The offsets and initial states (``offsets``, ``initial_state``), whether the
         search stopped at its budget (``budget_reached``) and the covariance of the
         determined estimates from the fit's Jacobian (``covariance``: ``{"parameters",
-        "matrix"}``, :func:`~motionhyst.identify.io_uncertainty.covariance_table`; not for
-        a Bouc-Wen link).
+        "matrix"}``, :func:`~motionhyst.identify.io_uncertainty.covariance_table`; a
+        Bouc-Wen link's under its identified names ``alpha``, ``beta*gamma``, ``beta*delta``,
+        ``nu``).
     warnings : list of str
         Implausible estimates, one line each naming the parameter
         (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
@@ -177,6 +178,9 @@ class IOIdentification:
         # the estimates that are scalar keys of these tables, under those keys
         keys = {**{n: f"stage.{n}" for n, v in stage.items() if _number(v)},
                 **{f"link.{n}": f"hysteresis.{n}" for n, v in link.items() if _number(v)},
+                # a Bouc-Wen link's identified parameters (the products: study.identified)
+                **({n: f"hysteresis.{n}" for n in BOUC_WEN_IDENTIFIED}
+                   if link.get("model") == "bouc-wen" else {}),
                 **{f"link.{n}[{i}]": f"hysteresis.{n}[{i}]" for n, v in link.items()
                    if isinstance(v, list) for i in range(len(v))}}
         ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys)

@@ -22,6 +22,11 @@ from numpy.typing import NDArray
 __all__ = []
 
 SINGULAR_RTOL = 1e-8
+BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
+"""A Bouc-Wen link's parameters an identification estimates: ``beta`` alone is not
+determined (``z`` is not measured), only the products ``beta*gamma`` and ``beta*delta`` (the
+saved link has ``|gamma| + |delta| = 1``); a saved identification names them
+``hysteresis.beta*gamma``, ... (a study draws them and sets ``beta``, ``gamma``, ``delta``)."""
 FD_SINGULAR_RTOL = 1e-5  # finite-difference Jacobians (step 1e-6) are no more exact than this
 
 

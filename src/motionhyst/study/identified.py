@@ -10,20 +10,25 @@ matrix whose diagonal's square roots are the standard errors):
 - ``motionhyst identify ... --json > fit.json`` prints it as ``covariance``: ``parameters``
   (a force-displacement record: ``k``, ``fc``, ``offset``, or ``k[0], ..., fc[0], ...`` for
   several elements; an input-output record: the names of ``estimates``, the link's as
-  ``link.NAME``) and ``matrix``.
+  ``link.NAME``, a Bouc-Wen link's as ``alpha``, ``beta*gamma``, ``beta*delta``, ``nu``) and
+  ``matrix``.
 
 The elements of a Maxwell-slip link are the keys ``hysteresis.k[0]``, ``hysteresis.fc[0]``, ...
-(the study's scenario has as many elements).
+(the study's scenario has as many elements).  A Bouc-Wen link's are ``hysteresis.alpha``,
+``hysteresis.nu`` and the products ``hysteresis.beta*gamma``, ``hysteresis.beta*delta`` (what
+the records determine: :func:`~motionhyst.study.spec.set_key` sets ``beta``, ``gamma`` and
+``delta`` from them); the products may be of either sign, ``nu`` is at least 1.
 
 A study's ``[samples] from_identification = "model.toml"`` (or ``motionhyst study
 --from-identification model.toml``) draws the link's parameters (the keys
 ``hysteresis.*``) jointly from that distribution, seeded (:class:`JointNormal`): the marginal
 of the link's parameters, the stage of the study's own scenario being its own.  A parameter
-must stay positive: when every drawn parameter's relative standard error is at most
-:data:`LOG_SPACE_CV`, the draws are those of the normal distribution itself (a draw at or
-below 0 would be five standard deviations away, and is drawn again); above it, of the
-lognormal distribution with the same means and covariance (moment-matched: positive by
-construction).
+must stay positive (:func:`least_value`): when every drawn positive parameter's relative
+standard error is at most :data:`LOG_SPACE_CV`, the draws are those of the normal distribution
+itself (a draw at or below 0 would be five standard deviations away, and is drawn again);
+above it, of the lognormal distribution with the same means and covariance (moment-matched:
+positive by construction; a signed parameter stays normal, with the same covariances).  A
+draw below a parameter's least value (a Bouc-Wen ``nu`` below 1) is drawn again.
 
 A JSON of an older ``identify --json``, with standard errors but no covariance, gives
 independent lognormal draws (:func:`distributions_from_identification`).
@@ -40,10 +45,11 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.identify.io_uncertainty import BOUC_WEN_IDENTIFIED
 from motionhyst.io.inputs import TOML_EXPANSION, input_problem
 
 __all__ = ["LOG_SPACE_CV", "JointNormal", "distributions_from_identification",
-           "joint_from_identification"]
+           "joint_from_identification", "least_value"]
 
 LOG_SPACE_CV = 0.2
 """Largest relative standard error of a drawn parameter for which the draws are those of the
@@ -52,17 +58,40 @@ normal distribution; above it, of the lognormal one with the same means and cova
 _CORRELATION_ROUNDING = 1e-9  # a saved correlation matrix is rounded to 1e-12
 
 
+def least_value(key: str) -> float | None:
+    """The least value a drawn scenario `key` takes: None for a Bouc-Wen link's products
+    (``hysteresis.beta*gamma``, ``hysteresis.beta*delta``: either sign), 1 for its exponent
+    ``hysteresis.nu`` (a draw below is drawn again), else 0 (exclusive: a positive parameter).
+
+    Parameters
+    ----------
+    key : str
+        A scenario key.
+
+    Examples
+    --------
+    >>> least_value("hysteresis.k"), least_value("hysteresis.beta*delta"), least_value(
+    ...     "hysteresis.nu")
+    (0.0, None, 1.0)
+    """
+    last = key.rpartition(".")[2]
+    if "*" in last:
+        return None
+    return 1.0 if key == "hysteresis.nu" else 0.0
+
+
 @dataclass(frozen=True)
 class JointNormal:
-    """Correlated draws of positive scenario keys: a multivariate normal distribution (or,
-    where it would reach 0, the lognormal one with the same means and covariance).
+    """Correlated draws of scenario keys, positive ones (and the signed products of a
+    Bouc-Wen link, :func:`least_value`): a multivariate normal distribution (or, where it
+    would reach 0, the lognormal one with the same means and covariance).
 
     Parameters
     ----------
     keys : tuple of str
         Scenario keys (``"hysteresis.k"``, ...).
     mean : tuple of float
-        Their means (the estimates), all > 0.
+        Their means (the estimates), above :func:`least_value` (> 0 for most).
     covariance : tuple of tuple of float
         Their covariance matrix (symmetric, positive semi-definite).
     source : str
@@ -91,10 +120,12 @@ class JointNormal:
         where = f"{self.source}: " if self.source != "<dict>" else ""
         if d == 0 or m.shape != (d,) or c.shape != (d, d):
             raise ValueError(f"{where}give a mean and a {d} x {d} covariance for {d} keys")
-        bad = [k for k, v in zip(self.keys, m, strict=True) if not (math.isfinite(v) and v > 0)]
+        bad = [k for k, v in zip(self.keys, m, strict=True) if not _admitted(k, v)]
         if bad:
+            least = least_value(bad[0])
+            what = "a positive number" if not least else f"a number >= {least:g}"
             raise ValueError(f"{where}{bad[0]} = {m[self.keys.index(bad[0])]:g}: a parameter "
-                             f"to draw must be a positive number")
+                             f"to draw must be {what}")
         if not (np.all(np.isfinite(c)) and np.allclose(c, c.T, rtol=1e-9, atol=0.0)):
             raise ValueError(f"{where}the covariance must be finite and symmetric")
         s = np.sqrt(np.clip(np.diag(c), 0.0, None))
@@ -119,10 +150,16 @@ class JointNormal:
         return r.tolist()
 
     @property
+    def _positive(self) -> NDArray[np.bool_]:
+        return np.array([least_value(k) is not None for k in self.keys])
+
+    @property
     def log_space(self) -> bool:
-        """Whether the draws are lognormal: a relative standard error above
-        :data:`LOG_SPACE_CV`."""
-        return bool(np.max(self.std / np.asarray(self.mean)) > LOG_SPACE_CV)
+        """Whether the draws of the positive keys are lognormal: a relative standard error
+        above :data:`LOG_SPACE_CV`."""
+        pos = self._positive
+        return bool(pos.any() and np.max(self.std[pos] / np.asarray(self.mean)[pos])
+                    > LOG_SPACE_CV)
 
     def without(self, keys) -> JointNormal | None:
         """The marginal distribution of the other keys (None if none is left).
@@ -143,9 +180,11 @@ class JointNormal:
         """`n` draws, a row each (columns in the order of :attr:`keys`), from `rng`.
 
         Normal draws (:attr:`log_space` false): ``mean + L z`` with ``L L^T`` the
-        covariance; a draw with a parameter at or below 0 is drawn again.  Lognormal ones:
-        ``exp(mu + S z)`` with ``S_ij = log(1 + C_ij / (m_i m_j))`` and
-        ``mu_i = log m_i - S_ii / 2``, whose means are ``m`` and covariance ``C``.
+        covariance.  Lognormal ones: ``exp(mu + S z)`` with ``S_ij = log(1 + C_ij / (m_i
+        m_j))`` and ``mu_i = log m_i - S_ii / 2``, whose means are ``m`` and covariance
+        ``C``; a signed key ``j`` stays normal, ``S_ij = C_ij / m_i``, ``S_jj = C_jj``
+        (``Cov(exp(y), x) = E[exp(y)] Cov(y, x)``).  A draw with a parameter at or below its
+        least value (:func:`least_value`) is drawn again.
 
         Parameters
         ----------
@@ -156,16 +195,33 @@ class JointNormal:
         """
         m = np.asarray(self.mean, dtype=float)
         c = np.asarray(self.covariance, dtype=float)
-        if self.log_space:
-            s = np.log1p(c / np.outer(m, m))
-            return np.exp(np.log(m) - np.diag(s) / 2 + rng.standard_normal((n, m.size))
-                          @ _factor(s).T)
-        factor = _factor(c)
-        x = m + rng.standard_normal((n, m.size)) @ factor.T
-        bad = np.nonzero(np.any(x <= 0, axis=1))[0]
+        p = self._positive
+        log = self.log_space
+        mu, s = m.copy(), c.copy()
+        if log:
+            s[np.ix_(p, p)] = np.log1p(c[np.ix_(p, p)] / np.outer(m[p], m[p]))
+            s[np.ix_(p, ~p)] = c[np.ix_(p, ~p)] / m[p][:, None]
+            s[np.ix_(~p, p)] = s[np.ix_(p, ~p)].T
+            mu[p] = np.log(m[p]) - np.diag(s)[p] / 2
+        factor = _factor(s)
+
+        def sample(rows: int) -> NDArray[np.float64]:
+            w = mu + rng.standard_normal((rows, m.size)) @ factor.T
+            if log:
+                w[:, p] = np.exp(w[:, p])
+            return w
+
+        least = np.array([-np.inf if v is None else v for v in map(least_value, self.keys)])
+
+        def outside(x: NDArray[np.float64]) -> NDArray[np.bool_]:  # as _admitted, by rows
+            return np.any(~np.isfinite(x) | (x < least) | ((x == least) & (least == 0.0)),
+                          axis=1)
+
+        x = sample(n)
+        bad = np.nonzero(outside(x))[0]
         while bad.size:
-            x[bad] = m + rng.standard_normal((bad.size, m.size)) @ factor.T
-            bad = bad[np.any(x[bad] <= 0, axis=1)]
+            x[bad] = sample(bad.size)
+            bad = bad[outside(x[bad])]
         return x
 
     def to_dict(self) -> dict:
@@ -186,6 +242,15 @@ class JointNormal:
         return cls(tuple(d["keys"]), tuple(float(v) for v in d["mean"]),
                    tuple(tuple(float(v) for v in r) for r in d["covariance"]),
                    d.get("source", "<dict>"))
+
+
+def _admitted(key: str, value: float) -> bool:
+    """Whether `value` is finite and admitted for `key`: above 0, at least 1 for a Bouc-Wen
+    ``nu``, of either sign for its products (:func:`least_value`)."""
+    least = least_value(key)
+    if not math.isfinite(value):
+        return False
+    return least is None or (value >= least if least else value > least)
 
 
 def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -294,6 +359,9 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
         else:
             mean = dict(data.get("estimates") or {})
             keys = {n: f"hysteresis.{n[5:]}" for n in mean if n.startswith("link.")}
+            link = data.get("hysteresis")
+            if isinstance(link, dict) and link.get("model") == "bouc-wen":
+                keys.update({n: f"hysteresis.{n}" for n in BOUC_WEN_IDENTIFIED if n in mean})
         missing = [n for n in keys if n not in names]
         hint = "--json"
     if missing:

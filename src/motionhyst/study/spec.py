@@ -114,6 +114,16 @@ def set_key(data: dict, key: str, value: float) -> None:
     >>> set_key(d, "hysteresis.fc[1]", 0.04)
     >>> d["hysteresis"]["fc"]
     [0.01, 0.04]
+
+    A Bouc-Wen link's product ``beta*gamma`` or ``beta*delta`` (what an identification
+    determines) sets ``beta``, ``gamma`` and ``delta`` with ``|gamma| + |delta| = 1``, the
+    other product kept:
+
+    >>> d = {"hysteresis": {"model": "bouc-wen", "alpha": 5e4, "beta": 2.0, "gamma": 0.8,
+    ...                     "delta": -0.2, "nu": 1.0}}
+    >>> set_key(d, "hysteresis.beta*delta", -1.0)
+    >>> {k: round(d["hysteresis"][k], 4) for k in ("beta", "gamma", "delta")}
+    {'beta': 2.6, 'gamma': 0.6154, 'delta': -0.3846}
     """
     *path, last = key.split(".")
     node = data
@@ -122,6 +132,9 @@ def set_key(data: dict, key: str, value: float) -> None:
         if not isinstance(nxt, dict):
             raise StudyError(f"{key!r}: the scenario has no table [{part}]")
         node = nxt
+    if "*" in last:
+        _set_product(node, key, last, value)
+        return
     name, bracket, index = last.partition("[")
     if not bracket:
         node[last] = value
@@ -135,6 +148,21 @@ def set_key(data: dict, key: str, value: float) -> None:
                 else "no list" if name in node else "no such key")
         raise StudyError(f"{key!r}: the scenario's [{'.'.join(path)}] {name} has {what}")
     node[name] = [*values[:i], value, *values[i + 1:]]
+
+
+def _set_product(node: dict, key: str, name: str, value: float) -> None:
+    """Set a Bouc-Wen link's ``beta*gamma`` or ``beta*delta`` (`name`) in its table `node`."""
+    if name not in ("beta*gamma", "beta*delta") or not all(
+            isinstance(node.get(k), int | float) and not isinstance(node.get(k), bool)
+            for k in ("beta", "gamma", "delta")):
+        raise StudyError(f"{key!r}: a product of keys is beta*gamma or beta*delta, of a "
+                         f"Bouc-Wen link given by alpha, beta, gamma, delta and nu")
+    bg, bd = node["beta"] * node["gamma"], node["beta"] * node["delta"]
+    bg, bd = (value, bd) if name == "beta*gamma" else (bg, value)
+    beta = abs(bg) + abs(bd)
+    # beta = 0 (a linear spring): the scenario refuses it, as it would a drawn beta of 0
+    node["beta"], node["gamma"], node["delta"] = (beta, bg / beta, bd / beta) if beta else (
+        0.0, 0.0, 0.0)
 
 
 def _axis_values(key: str, spec, where: str) -> NDArray:
