@@ -324,12 +324,36 @@ def _bouc_wen_fit():
 BOUC_WEN_KEYS = ("hysteresis.alpha", "hysteresis.beta*gamma", "hysteresis.beta*delta")
 
 
-def test_a_bouc_wen_link_is_drawn_from_its_identified_products(tmp_path):
+@pytest.fixture(scope="module")
+def bouc_wen(tmp_path_factory):
+    """The Bouc-Wen identification, saved (model.toml), printed (fit.json), and its system
+    in a loop (loop.toml: a PID around the identified stage)."""
+    folder = tmp_path_factory.mktemp("bouc_wen")
+    fit = _bouc_wen_fit()
+    text = fit.scenario_text()
+    (folder / "model.toml").write_text(text)
+    (folder / "fit.json").write_text(json.dumps(fit.to_dict()))
+    (folder / "loop.toml").write_text(
+        text.split("[identification]")[0]
+        + '[controller]\ntype = "pid"\nkp = 2e5\nki = 2e6\nkd = 600.0\n'
+          'derivative_filter_hz = 500.0\n[reference]\namplitude = 1e-4\nfrequencies = [5.0]\n')
+    return folder, fit
+
+
+def _loop_study(folder: Path, n: int, **samples) -> Study:
+    return Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0]},
+                            "samples": {"n": n, "seed": 1, "from_identification": "model.toml",
+                                        **samples}},
+                           base_dir=folder,
+                           scenario=tomllib.loads((folder / "loop.toml").read_text()))
+
+
+def test_a_bouc_wen_link_is_drawn_from_its_identified_products(bouc_wen):
     """beta alone is not identified: the covariance is of alpha and the products
     beta*gamma, beta*delta (of either sign), saved under hysteresis.beta*gamma, ...; a study
     draws them jointly and sets beta, gamma and delta of the link (|gamma| + |delta| = 1)
     whose products they are."""
-    fit = _bouc_wen_fit()
+    tmp_path, fit = bouc_wen
     cov = fit.to_dict()["covariance"]
     determined = [n for n, s in fit.std.items() if s is not None]
     assert cov["parameters"] == determined == ["m", "c", "k", "alpha", "beta*gamma",
@@ -339,8 +363,6 @@ def test_a_bouc_wen_link_is_drawn_from_its_identified_products(tmp_path):
     text = fit.scenario_text()
     ident = tomllib.loads(text)["identification"]
     assert ident["parameters"] == ["stage.m", "stage.c", "stage.k", *BOUC_WEN_KEYS]
-    (tmp_path / "model.toml").write_text(text)
-    (tmp_path / "fit.json").write_text(json.dumps(fit.to_dict()))
     c = np.array(cov["matrix"])[3:, 3:]
     mean = [fit.estimates[n] for n in ("alpha", "beta*gamma", "beta*delta")]
     assert mean[2] < 0
@@ -350,15 +372,7 @@ def test_a_bouc_wen_link_is_drawn_from_its_identified_products(tmp_path):
         np.testing.assert_allclose(d.covariance, c, rtol=1e-9, atol=1e-9 * np.abs(c).max())
 
     # the identified system in a loop: the study's scenario
-    (tmp_path / "loop.toml").write_text(
-        text.split("[identification]")[0]
-        + '[controller]\ntype = "pid"\nkp = 2e5\nki = 2e6\nkd = 600.0\n'
-          'derivative_filter_hz = 500.0\n[reference]\namplitude = 1e-4\nfrequencies = [5.0]\n')
-    st = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0]},
-                          "samples": {"n": N_DRAWS, "seed": 1,
-                                      "from_identification": "model.toml"}},
-                         base_dir=tmp_path,
-                         scenario=tomllib.loads((tmp_path / "loop.toml").read_text()))
+    st = _loop_study(tmp_path, N_DRAWS)
     assert st.sampled_keys == BOUC_WEN_KEYS
     _within_sampling_error(st.sample_values, mean, c)
     for i in (0, 7, 99):
@@ -371,11 +385,7 @@ def test_a_bouc_wen_link_is_drawn_from_its_identified_products(tmp_path):
                                                              rel=1e-14)
         assert link["alpha"] == drawn["hysteresis.alpha"]
     # two machines of the fleet computed: their loops are built from the drawn links
-    small = Study.from_dict({"outputs": ["mismatch"], "axes": {"frequency_hz": [5.0]},
-                             "samples": {"n": 2, "seed": 1,
-                                         "from_identification": "model.toml"}},
-                            base_dir=tmp_path,
-                            scenario=tomllib.loads((tmp_path / "loop.toml").read_text()))
+    small = _loop_study(tmp_path, 2)
     report = run_study(small, tmp_path / "bw.zarr", workers=0)
     assert (report.computed, report.failed) == (2, 0)
     ds = open_results(tmp_path / "bw.zarr")
@@ -406,3 +416,24 @@ def test_signed_products_and_the_bouc_wen_exponent_are_drawn_within_their_ranges
         JointNormal(("hysteresis.nu",), (0.9,), ((0.01,),))
     with pytest.raises(ValueError, match=r"hysteresis.alpha = -1: .* must be a positive"):
         JointNormal(("hysteresis.alpha",), (-1.0,), ((0.01,),))
+
+
+@pytest.mark.parametrize("source", ["model.toml", "fit.json"])
+def test_the_identified_stage_is_drawn_with_its_link_when_asked(bouc_wen, source):
+    """from_identification_tables = ["hysteresis", "stage"]: the study's scenario is the
+    identified system, whose stage's estimates are drawn jointly with the link's."""
+    folder, fit = bouc_wen
+    st = _loop_study(folder, N_DRAWS, from_identification=source,
+                     from_identification_tables=["hysteresis", "stage"])
+    assert st.sampled_keys == ("stage.m", "stage.c", "stage.k", *BOUC_WEN_KEYS)
+    names = ["m", "c", "k", "alpha", "beta*gamma", "beta*delta"]
+    _within_sampling_error(st.sample_values, [fit.estimates[n] for n in names],
+                           fit.to_dict()["covariance"]["matrix"])
+    at = st.point(3)
+    assert st.scenario_at(at)["stage"]["m"] == at["stage.m"]
+    only = _loop_study(folder, 10, from_identification=source,
+                       from_identification_tables=["stage"])
+    assert only.sampled_keys == ("stage.m", "stage.c", "stage.k")
+    for bad in (["controller"], [], "stage"):
+        with pytest.raises(StudyError, match="'from_identification_tables': give a list"):
+            _loop_study(folder, 10, from_identification_tables=bad)

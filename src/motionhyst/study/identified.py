@@ -22,7 +22,10 @@ the records determine: :func:`~motionhyst.study.spec.set_key` sets ``beta``, ``g
 A study's ``[samples] from_identification = "model.toml"`` (or ``motionhyst study
 --from-identification model.toml``) draws the link's parameters (the keys
 ``hysteresis.*``) jointly from that distribution, seeded (:class:`JointNormal`): the marginal
-of the link's parameters, the stage of the study's own scenario being its own.  A parameter
+of the link's parameters, the stage of the study's own scenario being its own; with
+``from_identification_tables = ["hysteresis", "stage"]`` (a study whose scenario is the
+identified system) the stage's estimates (``stage.m``, ...) are drawn jointly with them.  A
+parameter
 must stay positive (:func:`least_value`): when every drawn positive parameter's relative
 standard error is at most :data:`LOG_SPACE_CV`, the draws are those of the normal distribution
 itself (a draw at or below 0 would be five standard deviations away, and is drawn again);
@@ -284,16 +287,22 @@ def _read(path: Path, where: str):
     return data
 
 
-def joint_from_identification(path: str | Path) -> JointNormal | None:
+def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hysteresis",)
+                              ) -> JointNormal | None:
     """The joint distribution of the link's parameters of an identification, under the
-    scenario's ``hysteresis.*`` keys; None for a JSON without covariance (an older
-    ``identify --json``: :func:`distributions_from_identification`).
+    scenario's ``hysteresis.*`` keys (and the stage's, ``stage.*``, with `tables`); None for a
+    JSON without covariance (an older ``identify --json``:
+    :func:`distributions_from_identification`).
 
     Parameters
     ----------
     path : str or Path
         ``motionhyst identify --save`` TOML (its ``[identification]``) or ``identify --json``
         JSON (its ``covariance``).
+    tables : tuple of str
+        The scenario's tables whose identified parameters are drawn: ``"hysteresis"`` (the
+        link), ``"stage"`` (the stage of an input-output identification: a study whose
+        scenario is the identified system).
 
     Returns
     -------
@@ -319,6 +328,8 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
     >>> d = joint_from_identification(path)
     >>> d.keys, d.mean, d.correlation[0][1]
     (('hysteresis.k', 'hysteresis.fc'), (20.0, 0.05), 0.5)
+    >>> joint_from_identification(path, ("hysteresis", "stage")).keys
+    ('stage.m', 'hysteresis.k', 'hysteresis.fc')
     """
     path = Path(path)
     where = f"from_identification {path}"
@@ -339,7 +350,7 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
         mean = dict(zip(names, sec.estimates, strict=True))
         std = np.asarray(sec.std, dtype=float)
         cov = np.asarray(sec.correlation, dtype=float) * np.outer(std, std)
-        keys = {n: n for n in names if n.startswith("hysteresis.")}
+        keys = {n: n for n in names if n.partition(".")[0] in tables}
         missing = []
         hint = "--save"
     else:
@@ -362,6 +373,10 @@ def joint_from_identification(path: str | Path) -> JointNormal | None:
             link = data.get("hysteresis")
             if isinstance(link, dict) and link.get("model") == "bouc-wen":
                 keys.update({n: f"hysteresis.{n}" for n in BOUC_WEN_IDENTIFIED if n in mean})
+            plant = data.get("plant")
+            if "stage" in tables and isinstance(plant, dict):  # its estimates, the stage's keys
+                keys.update({n: f"stage.{n}" for n in plant if n != "type" and n in mean})
+        keys = {n: k for n, k in keys.items() if k.partition(".")[0] in tables}
         missing = [n for n in keys if n not in names]
         hint = "--json"
     if missing:

@@ -416,6 +416,15 @@ class StudyDefinition:
                 raise StudyError("'samples': give a table [samples]")
             n, seed = s.pop("n", None), s.pop("seed", None)
             identified = s.pop("from_identification", None)
+            tables = s.pop("from_identification_tables", ["hysteresis"])
+            if not (isinstance(tables, list) and tables
+                    and set(tables) <= {"hysteresis", "stage"}):
+                raise StudyError("[samples] 'from_identification_tables': give a list of the "
+                                 "tables drawn from the identification, \"hysteresis\" and/or "
+                                 "\"stage\"")
+            if identified is None and tables != ["hysteresis"]:
+                raise StudyError("[samples] 'from_identification_tables': give "
+                                 "from_identification too")
             if identified is not None:
                 if not isinstance(identified, str) or not identified:
                     raise StudyError("[samples] 'from_identification': give the TOML of "
@@ -425,7 +434,7 @@ class StudyDefinition:
                 if not ipath.is_absolute():
                     ipath = (base_dir or Path.cwd()) / ipath
                 try:
-                    joint = joint_from_identification(ipath)
+                    joint = joint_from_identification(ipath, tuple(tables))
                     drawn = {} if joint is not None else distributions_from_identification(ipath)
                 except ValueError as exc:
                     raise StudyError(f"[samples] {exc}") from None
