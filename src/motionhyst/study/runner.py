@@ -300,8 +300,9 @@ def _compute(study: StudyDefinition, st: StudyStore, workers: int | None, client
         if client is not None:
             workers = max(1, sum(client.nthreads().values()))
         # from the CPU time of a point: its wall time on a loaded machine would make batches
-        # too small for the work each costs the engine
-        size = batch or batch_size(seconds_per_point(study, 2, cpu=True), len(todo), workers,
+        # too small for the work each costs the engine; two runs of three points, at the
+        # study's two ends (a point's cost varies along the reference axes)
+        size = batch or batch_size(seconds_per_point(study, 6, cpu=True), len(todo), workers,
                                    BATCH_SECONDS if client is None else DASK_BATCH_SECONDS)
         batches = split(todo, size)
         bar = None
