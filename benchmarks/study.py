@@ -102,7 +102,7 @@ def main() -> None:
     study = make_study(args.samples, args.frequencies)
     n = study.n_points
     load_before = os.getloadavg()
-    per = seconds_per_point(study, 20, cpu=True)   # as run_study chooses its batches
+    per = seconds_per_point(study, 20, cpu=True)   # on CPU time, as run_study (on 6 points)
     batch = batch_size(per, n, 2)
     dask_batch = batch_size(per, n, 2, DASK_BATCH_SECONDS)
     out: dict = {"points": n, "batch": batch, "dask_batch": dask_batch, "cores": os.cpu_count(),
