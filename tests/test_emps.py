@@ -150,6 +150,30 @@ def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
         assert model["parameters"]["offset"] == pytest.approx(TRUE["offset"], abs=0.5)
 
 
+def test_benchmark_emps_every_split(tmp_path, capsys, monkeypatch):
+    """--periods all: both halves, then all periods but the last and all but the first, each
+    validated on what it left out; the rule takes the worst of the four."""
+    import motionhyst.identify.emps as emps
+
+    rec = axis_record()
+    savemat(tmp_path / "DATA_EMPS.mat", {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
+                                         "qm": rec.y[:, None], "gtau": DRIVE_GAIN})
+    monkeypatch.setattr(emps, "MODELS", ("coulomb",))
+    monkeypatch.setattr(emps, "PERIOD", PERIOD)
+    assert main(["benchmark", "emps", "--data", str(tmp_path), "--periods", "all",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [m["validation"]["record"] for m in out["models"]] == [
+        "DATA_EMPS periods 3-4", "DATA_EMPS periods 1-2", "DATA_EMPS period 4",
+        "DATA_EMPS period 1"]
+    worst = max(m["validation"]["rmse_mm"] for m in out["models"])
+    assert out["chosen"] == {"name": "coulomb", "worse_split_rmse_mm": worst}
+    assert worst < 0.05  # the true model's structure: every split predicted
+    assert main(["benchmark", "emps", "--data", str(tmp_path), "--periods", "all"]) == 0
+    text = capsys.readouterr().out
+    assert "Chosen by the worst of the 4 splits (the rule stated in advance): coulomb" in text
+
+
 @pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),
                     reason="the EMPS benchmark's files are not beside the repository")
 def test_emps_record_splits_into_its_reference_periods():

@@ -31,19 +31,22 @@ def add_parser(sub) -> None:
                    help="bouc-wen: seed of the training multisines and noise (default 0)")
     q.add_argument("--periods", metavar="A-B", type=_periods,
                    help="emps without the test record: the periods of DATA_EMPS to identify "
-                        "from, validated on the others (default: both ways, 1-2 then 3-4; the "
+                        "from, validated on the others (default: both ways, 1-2 then 3-4; "
+                        "'all': also 1-3 and 2-4, each validated on the period left out; the "
                         "reference repeats every 6240 samples)")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
 
 
-def _periods(text: str) -> tuple[int, int]:
+def _periods(text: str) -> tuple[int, int] | str:
+    if text == "all":
+        return text
     first, sep, last = text.partition("-")
     try:
         a, b = int(first), int(last if sep else first)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be A-B (whole periods, e.g. 1-2), got "
-                                         f"{text!r}") from None
+        raise argparse.ArgumentTypeError(f"must be A-B (whole periods, e.g. 1-2) or all, "
+                                         f"got {text!r}") from None
     if not 1 <= a <= b:
         raise argparse.ArgumentTypeError(f"must be A-B with 1 <= A <= B, got {text!r}")
     return a, b
@@ -144,8 +147,9 @@ def run_emps(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"  {msg}", file=sys.stderr, flush=True)
 
-    if test is None and args.periods is None:  # both ways: one split alone says little
-        results = cross_validate(estimation, progress=say)
+    if test is None and args.periods in (None, "all"):  # one split alone says little
+        results = cross_validate(estimation, progress=say,
+                                 splits="halves" if args.periods is None else "all")
     else:
         results = [run_emps(estimation, test, periods=args.periods or (1, 2), progress=say)]
     chosen = choose(results) if len(results) > 1 else None
@@ -156,9 +160,10 @@ def run_emps(args: argparse.Namespace) -> int:
         return 0
     print("\n\n".join(str(res) for res in results))
     if chosen is not None:
-        print("\nMean validation RMSE over both splits: " + ", ".join(
-            f"{a.name} {(a.validation['rmse_mm'] + b.validation['rmse_mm']) / 2:.3g} mm"
-            for a, b in zip(results[0].models, results[1].models, strict=True)))
-        print(f"Chosen by the worse of the two splits (the rule stated in advance): {chosen[0]}, "
-              f"{chosen[1]:.3g} mm on its worse split")
+        splits = "both splits" if len(results) == 2 else f"the {len(results)} splits"
+        print(f"\nMean validation RMSE over {splits}: " + ", ".join(
+            f"{runs[0].name} {sum(m.validation['rmse_mm'] for m in runs) / len(runs):.3g} mm"
+            for runs in zip(*(res.models for res in results), strict=True)))
+        print(f"Chosen by the worst of {splits} (the rule stated in advance): {chosen[0]}, "
+              f"{chosen[1]:.3g} mm on its worst split")
     return 0

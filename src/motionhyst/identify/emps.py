@@ -588,9 +588,11 @@ def reference_system(parameters: dict | None = None):
 
 def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
                    period: int | None = None,
-                   progress: Callable[[str], None] | None = None) -> list[EMPSBenchmark]:
+                   progress: Callable[[str], None] | None = None,
+                   splits: str = "halves") -> list[EMPSBenchmark]:
     """The benchmark without its test record: identified on each half of the estimation
-    record's periods and scored on the other half, both ways.
+    record's periods and scored on the other half, both ways (with ``splits="all"`` also
+    on all periods but the last and all but the first, each scored on the one left).
 
     One split alone says little on this record: its force offset drifts from period
     to period (the inverse-dynamics estimate: -3.00, -3.07, -3.27, -3.34 N over
@@ -603,11 +605,16 @@ def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
         The estimation record (at least two periods).
     models, period, progress
         As for :func:`run_emps`.
+    splits : {"halves", "all"}
+        ``"halves"``: periods 1-2 then 3-4 (of four); ``"all"``: then also 1-3 and
+        2-4, each validated on the period it leaves out (a record of three or more
+        periods; a split met before is not run twice).
 
     Returns
     -------
     list of EMPSBenchmark
-        Identified on the first half of the periods, then on the second.
+        Identified on the first half of the periods, then on the second (then on all
+        but the last, then on all but the first).
 
     Examples
     --------
@@ -622,15 +629,33 @@ def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
     [('axis period 1', 'axis period 2'), ('axis period 2', 'axis period 1')]
     >>> all(abs(r.models[0].parameters["m"] - 95.1089) < 0.1 for r in runs)
     True
+
+    Three periods, every split:
+
+    >>> t = np.arange(3000) / 1000.0
+    >>> u = 150 * np.sin(2 * np.pi * t) + 60 * np.sin(6 * np.pi * t)
+    >>> y = reference_system().simulate(t, u).displacement
+    >>> runs = cross_validate(IORecord(t, u, y, "axis"), models=("coulomb",), period=1000,
+    ...                       splits="all")
+    >>> [r.estimation_record.name for r in runs]
+    ['axis period 1', 'axis periods 2-3', 'axis periods 1-2']
     """
+    if splits not in ("halves", "all"):
+        raise ValueError(f"splits must be 'halves' or 'all', got {splits!r}")
     period = PERIOD if period is None else int(period)
     count = -(-estimation.t.size // period)
     if count < 2:
         raise ValueError(f"{estimation.name}: {count} period of {period} samples; a "
                          f"cross-validation needs two or more")
     half = count // 2
+    ways = [(1, half), (half + 1, count)]
+    if splits == "all":
+        if count < 3:
+            raise ValueError(f"{estimation.name}: {count} periods of {period} samples; "
+                             f"every split needs three or more")
+        ways += [w for w in ((1, count - 1), (2, count)) if w not in ways]
     return [run_emps(estimation, models=models, periods=periods, period=period,
-                     progress=progress) for periods in ((1, half), (half + 1, count))]
+                     progress=progress) for periods in ways]
 
 
 def run_emps(estimation: IORecord, test: IORecord | None = None, *,
