@@ -81,7 +81,7 @@ def test_generated_axis_identified_and_scored():
     assert model.validation["fit_percent"] > 90.0
     assert set(res.to_dict()) == {"models"}
     assert set(res.to_dict()["models"][0]) == {"name", "parameters", "std", "estimation",
-                                                "validation", "seconds"}
+                                                "validation", "seconds", "equivalent_offset"}
     assert set(model.std) == set(p)
     text = str(res)
     assert "validated on axis periods 3-4 (the test record DATA_EMPS_PULSES.mat was not" in text
@@ -247,3 +247,28 @@ def test_a_drifting_offset_is_diagnosed():
     assert own["offset"] == pytest.approx(held_out, abs=0.1)
     assert own["rmse_mm"] < 0.2 * model.validation["rmse_mm"]
     assert "own offset" in str(res) and "Inverse dynamics (IDIM-LS) of each period" in str(res)
+
+
+def test_offset_with_viscous_friction_by_direction_as_the_reference_models():
+    """An axis whose viscous friction is larger backward, with no force offset: the
+    reference model's structure (one viscous coefficient) fits it with an offset, and the
+    equivalent offset of the true parameters is that offset; in the benchmark's table too."""
+    from motionhyst.identify.emps import equivalent_offset
+    from motionhyst.identify.io_start import inverse_dynamics
+
+    t = np.arange(4000) / 1000.0
+    y = 0.03 * np.sin(2 * np.pi * t) + 0.01 * np.sin(6 * np.pi * t)
+    v = np.gradient(y, t, edge_order=2)
+    a = np.gradient(v, t, edge_order=2)
+    u = 95.0 * a + 160.0 * v + 80.0 * np.minimum(v, 0.0) + 20.0 * np.sign(v) + 0.1
+    rec = IORecord(t, u, y, "asymmetric")
+    symmetric = inverse_dynamics([rec], floating=True)
+    true = {"offset": 0.1, "c_neg": 80.0}
+    assert symmetric["u0"] < -2.0  # the direction-dependent viscous force taken as an offset
+    assert equivalent_offset(true, rec) == pytest.approx(symmetric["u0"], abs=0.05)
+    res = run_emps(IORecord(t, u, y, "axis"), models=("coulomb",), periods=(1, 2),
+                   period=PERIOD)
+    (model,) = res.models
+    assert model.to_dict()["equivalent_offset"] == pytest.approx(model.parameters["offset"],
+                                                                 abs=1e-9)  # symmetric: itself
+    assert "as OF [N]" in str(res)

@@ -46,8 +46,8 @@ from motionhyst.identify.io_start import inverse_dynamics
 
 __all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "INIT_WINDOW", "MODELS",
            "PERIOD", "PUBLISHED", "REFERENCE_MODEL", "TEST_FILE", "EMPSBenchmark", "EMPSModel",
-           "choose", "cross_validate", "own_offset_score", "period_drift", "reference_system",
-           "run_emps", "score", "split_by_periods"]
+           "choose", "cross_validate", "equivalent_offset", "own_offset_score", "period_drift",
+           "reference_system", "run_emps", "score", "split_by_periods"]
 
 ESTIMATION_FILE = "DATA_EMPS.mat"
 """The benchmark's estimation record."""
@@ -192,6 +192,11 @@ class EMPSModel:
         The identification's plausibility warnings.
     prediction : ndarray or None
         The simulated position on the validation record [m] (for plots).
+    equivalent_offset : float or None
+        The constant offset ``OF`` the model's offset, its drift and its
+        direction-dependent viscous friction amount to on the estimation
+        record's motion (:func:`equivalent_offset`) [N]: comparable with the
+        reference model's.
 
     Examples
     --------
@@ -212,12 +217,17 @@ class EMPSModel:
     seconds: float
     warnings: list[str] = field(default_factory=list)
     prediction: np.ndarray | None = field(default=None, repr=False)
+    equivalent_offset: float | None = None
 
     def to_dict(self) -> dict:
-        """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``."""
-        return {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
-                "estimation": dict(self.estimation), "validation": dict(self.validation),
-                "seconds": self.seconds}
+        """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``, and
+        ``"equivalent_offset"`` when known."""
+        out = {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
+               "estimation": dict(self.estimation), "validation": dict(self.validation),
+               "seconds": self.seconds}
+        if self.equivalent_offset is not None:
+            out["equivalent_offset"] = self.equivalent_offset
+        return out
 
     def __str__(self) -> str:
         est, val = self.estimation, self.validation
@@ -285,6 +295,7 @@ class EMPSBenchmark:
             p = m.parameters
             rows.append([f"motionhyst: mass-damper + {m.name}", g(p.get("m"), 4),
                          _viscous(p), _friction(p), _offset(p),
+                         "-" if m.equivalent_offset is None else g(m.equivalent_offset, 3),
                          f"{m.estimation['rmse_mm']:.3g}", f"{m.validation['rmse_mm']:.3g}",
                          f"{m.validation['fit_percent']:.1f}", _own(m.validation),
                          f"{m.seconds:.0f}"])
@@ -295,15 +306,16 @@ class EMPSBenchmark:
             q = own["parameters"]
             rows.append([f"IDIM-LS on {self.estimation_record.name} (one linear solve)",
                          g(q["m"], 4), g(q["c"], 4), g(q["fc"], 4), g(q["offset"], 3),
-                         f"{own['estimation']['rmse_mm']:.3g}",
+                         g(q["offset"], 3), f"{own['estimation']['rmse_mm']:.3g}",
                          f"{own['validation']['rmse_mm']:.3g}",
                          f"{own['validation']['fit_percent']:.1f}", "-", "-"])
         rows.append(["IDIM-LS reference (published parameters)", g(r["m"], 4), g(r["c"], 4),
-                     g(r["fc"], 4), g(r["offset"], 3),
+                     g(r["fc"], 4), g(r["offset"], 3), g(r["offset"], 3),
                      f"{ref['estimation']['rmse_mm']:.3g}",
                      f"{ref['validation']['rmse_mm']:.3g}",
                      f"{ref['validation']['fit_percent']:.1f}", "-", "-"])
-        head = ["model", "m [kg]", "c (+/-) [N s/m]", "fc [N]", "offset [N]", "est. [mm]",
+        head = ["model", "m [kg]", "c (+/-) [N s/m]", "fc [N]", "offset [N]", "as OF [N]",
+                "est. [mm]",
                 "valid. [mm]", "fit [%]", "own offset: valid. [mm]", "time [s]"]
         lines = [f"EMPS benchmark (Janot, Gautier and Brunot 2019): identified on "
                  f"{self.estimation_record.name}, validated on {self.validation_record.name}"
@@ -321,6 +333,9 @@ class EMPSBenchmark:
             lines += ["", f"motionhyst's figure on {self.validation_record.name}: {CHOSEN}, "
                       f"{chosen.validation['rmse_mm']:.3g} mm (the physical model chosen before "
                       f"the test, by the worse of the two splits of DATA_EMPS)"]
+        lines += ["", "as OF: the constant offset the model's offset, its drift and its "
+                  "direction-dependent viscous friction amount to on "
+                  f"{self.estimation_record.name}'s motion (the reference model's OF)"]
         lines += ["", "own offset: the model with the force offset that suits "
                   f"{self.validation_record.name} best (a diagnosis, not a score): what is "
                   "left is the model's error, the rest is the offset's drift between records"]
@@ -506,6 +521,50 @@ def period_drift(record: IORecord, period: int = PERIOD) -> list[dict]:
                     "c_pos": asym["c_pos"], "c_neg": asym["c_neg"],
                     "offset_asymmetric": asym["u0"]})
     return out
+
+
+def equivalent_offset(parameters: dict, record: IORecord) -> float:
+    """The constant force offset ``OF`` that a model's offset amounts to on a record's motion.
+
+    The benchmark's reference model has one viscous coefficient and a constant
+    offset.  With viscous friction by direction (``c + c_pos`` forward,
+    ``c + c_neg`` backward) the friction's viscous force is ``(c + (c_pos +
+    c_neg)/2) q' + (c_pos - c_neg)/2 |q'|``: its even part acts as an offset
+    that follows the speed, and on a motion whose mean speed is ``mean |q'|``
+    it is the constant offset ``(c_pos - c_neg)/2 mean |q'|``; a drifting
+    offset ``OF + rate t`` is ``OF + rate mean(t)`` on average.  Their sum is
+    what the reference model's ``OF`` is fitted to (EMPS, viscous friction by
+    direction: ``OF`` +0.11 N and ``(c_pos - c_neg)/2 mean |q'|`` = -3.0 N
+    against the published -3.16 N).
+
+    Parameters
+    ----------
+    parameters : dict
+        ``offset`` [N] and optionally ``c_pos``, ``c_neg`` [N s/m], ``drift``
+        [N/s] (as :class:`EMPSModel` holds them).
+    record : IORecord
+        The record whose motion the model was identified on (its velocity is
+        the measured position's gradient).
+
+    Returns
+    -------
+    float
+        ``OF + rate mean(t) + (c_pos - c_neg)/2 mean |q'|`` [N].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(2001) / 1000.0
+    >>> rec = IORecord(t, np.zeros_like(t), 0.05 * np.sin(np.pi * t))  # mean |q'| = 0.1 m/s
+    >>> round(equivalent_offset({"offset": 0.1, "c_neg": 76.0}, rec), 2)
+    -3.7
+    >>> round(equivalent_offset({"offset": -3.0, "drift": -0.02}, rec), 2)  # mean t = 1 s
+    -3.02
+    """
+    v = np.gradient(record.y, record.t)
+    even = 0.5 * (parameters.get("c_pos", 0.0) - parameters.get("c_neg", 0.0))
+    return float(parameters["offset"] + parameters.get("drift", 0.0) * np.mean(record.t)
+                 + even * np.mean(np.abs(v)))
 
 
 def _parameters(fit) -> tuple[dict, dict]:
@@ -732,7 +791,8 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         seconds = time.perf_counter() - t0
         parameters, std = _parameters(fit)
         out.append(EMPSModel(name, parameters, std, est_score, val_score, seconds,
-                             list(getattr(fit, "warnings", [])), yhat))
+                             list(getattr(fit, "warnings", [])), yhat,
+                             equivalent_offset(parameters, est)))
         say(f"{name}: {val_score['rmse_mm']:.3g} mm on {val.name} ({seconds:.0f} s)")
     ref = {"estimation": score(reference_system(), est)[0],
            "validation": score(reference_system(), val)[0]}
