@@ -160,10 +160,12 @@ def run_emps(args: argparse.Namespace) -> int:
         return 0
     print("\n\n".join(str(res) for res in results))
     if chosen is not None:
-        splits = "both splits" if len(results) == 2 else f"the {len(results)} splits"
+        two = len(results) == 2
+        splits = "both splits" if two else f"the {len(results)} splits"
+        worst = "worse" if two else "worst"
         print(f"\nMean validation RMSE over {splits}: " + ", ".join(
             f"{runs[0].name} {sum(m.validation['rmse_mm'] for m in runs) / len(runs):.3g} mm"
             for runs in zip(*(res.models for res in results), strict=True)))
-        print(f"Chosen by the worst of {splits} (the rule stated in advance): {chosen[0]}, "
-              f"{chosen[1]:.3g} mm on its worst split")
+        print(f"Chosen by the {worst} of {'the two splits' if two else splits} (the rule stated "
+              f"in advance): {chosen[0]}, {chosen[1]:.3g} mm on its {worst} split")
     return 0
