@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.controllers.loop import Loop
-from motionhyst.core.budget import check_memory
+from motionhyst.core.budget import check_memory, check_work
 from motionhyst.core.lti import (
     TWO_PI,
     FohResponse,
@@ -46,8 +46,60 @@ from motionhyst.time.steps import (
     STEPS_PER_REFERENCE_PERIOD,
 )
 
-__all__ = ["Simulation", "simulate", "simulate_chunks"]
+__all__ = ["SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "Simulation", "check_run_work",
+           "simulate", "simulate_chunks"]
 
+
+SECONDS_PER_STEP = 1.5e-6
+"""Nominal cost of one time step of a run [s] (one core of a quiet machine)."""
+
+SECONDS_PER_ELEMENT_STEP = 100e-9
+"""Nominal cost of one element of the link (a Maxwell-slip link's stop operators) in one
+time step [s]: a link of 1e5 elements makes a step 7000 times dearer."""
+
+
+def _element_count(link: Hysteresis | None) -> int:
+    """The elements the time step advances for `link` (0 without a link)."""
+    if link is None:
+        return 0
+    try:
+        return int(link.time_stepping().codes.size)
+    except (ValueError, AttributeError):  # advanced otherwise (along the stroke): one
+        return 1
+
+
+def check_run_work(loop: Loop, n_steps: int, remedy: str = "shorten the run or lower its "
+                   "frequencies") -> None:
+    """Refuse a run of `n_steps` time steps above the work budget, before it starts.
+
+    Its work is the steps times :data:`SECONDS_PER_STEP` and the link's elements (and its
+    feedforward model's) times :data:`SECONDS_PER_ELEMENT_STEP`
+    (:func:`motionhyst.core.budget.check_work`).
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop run.
+    n_steps : int
+        Its time steps.
+    remedy : str
+        What the user can change, for the message.
+
+    Raises
+    ------
+    motionhyst.core.budget.BudgetError
+        One line: the run's steps and elements, its estimated time, the remedy.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> check_run_work(default_scenario().loop(), 1_000_000)      # about 1.6 s
+    """
+    m = _element_count(loop.hysteresis) + _element_count(loop.hysteresis_feedforward)
+    seconds = n_steps * (SECONDS_PER_STEP + m * SECONDS_PER_ELEMENT_STEP)
+    of = f" of a link of {m} elements" if m > 2 else ""
+    check_work(seconds, f"a run of {n_steps:.3g} time steps{of}",
+               remedy + (", or give the link fewer elements" if of else ""))
 
 
 def _block_systems(loop: Loop, omega0: float):
@@ -165,6 +217,7 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
         raise ValueError(f"{n} time steps: too many; shorten the run or lower its frequencies")
     check_memory(n * BYTES_PER_SAMPLE, f"a run of {n:.3g} time steps",
                  "shorten the run or lower its frequencies")
+    check_run_work(loop, n)
     t = np.arange(n) * engine.step
     h_foh = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0
     if isinstance(loop.hysteresis, AlongStroke) or isinstance(engine.hff, AlongStroke):
@@ -273,6 +326,7 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
                          "in chunks")
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
+    check_run_work(loop, n)
     for i0 in range(0, n, int(chunk)):
         t = np.arange(i0, min(n, i0 + int(chunk))) * engine.step
         yield _in_pieces(engine, t, i0, engine.step)
