@@ -47,3 +47,32 @@ def test_warnings_are_stderr_lines_and_exit_0(tmp_path, capsys, argv, warnings):
 def test_no_warning_where_the_model_holds(capsys):
     assert main(["analyze", "--frequency", "5", "10"]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_a_loop_without_bandwidth_says_so_and_warns_naming_the_mass(tmp_path, capsys):
+    """m1 = 1e20 kg: |C P2| never reaches 1; no 'nan Hz' or 'inf deg' (issue 26)."""
+    text = default_scenario_path().read_text()
+    assert "m1 = 5.0 " in text
+    (tmp_path / "heavy.toml").write_text(text.replace("m1 = 5.0 ", "m1 = 1e20 "))
+    assert main(["analyze", str(tmp_path / "heavy.toml")]) == 0
+    out, err = capsys.readouterr()
+    assert "none (|C P2| does not fall through 1 in the range searched)" in out
+    assert "unbounded (|C P2| never reaches 1: no gain crossover)" in out
+    assert not {"nan", "inf"} & set(out.replace("(", " ").split()), out
+    lines = [ln for ln in err.splitlines() if ln.startswith("motionhyst: warning: ")]
+    assert len(lines) == 1 and "the loop has no bandwidth" in lines[0], err
+    assert "M = 1e+20 kg" in lines[0]
+
+
+def test_another_librarys_warning_is_one_line_without_a_source_path(capsys, monkeypatch):
+    import warnings
+
+    from motionhyst.cli._common import warnings_on_stderr
+
+    monkeypatch.delenv("MOTIONHYST_TRACEBACK", raising=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        with warnings_on_stderr("steady"):
+            warnings.warn("invalid value encountered in cast", RuntimeWarning, stacklevel=1)
+    err = capsys.readouterr().err
+    assert err == "motionhyst: warning: steady: RuntimeWarning: invalid value encountered in cast\n"

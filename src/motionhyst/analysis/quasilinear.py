@@ -40,6 +40,7 @@ from motionhyst.analysis.plausibility import check_plausible
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.core.textfmt import g, table
+from motionhyst.core.warnings import warn
 
 if TYPE_CHECKING:
     from motionhyst.plants.measured import MeasuredPlant
@@ -541,11 +542,13 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         amps = np.array([self_consistent_amplitude(loop, fi, amplitude) for fi in f])
     D_pts = np.asarray(hyst.describing_function(amps, omega), dtype=complex)
     C, P1, P2, Pr, Pf2 = _parts(loop, omega)
-    if _paper_loop(loop):
-        E = mismatch(C, P1, P2, Pr, Pf2, D_pts)
-    else:
-        E = residual_mismatch(loop, omega, D_pts, _feedforward_df(loop, amplitude, omega))
-    Et = mismatch_asymptote(Pr, Pf2, D_pts)
+    # raw measured lines where Pf2 = Pr - P2 is 0 give no E: named as unresolved below
+    with np.errstate(**({} if loop.plant.is_lti else {"divide": "ignore", "invalid": "ignore"})):
+        if _paper_loop(loop):
+            E = mismatch(C, P1, P2, Pr, Pf2, D_pts)
+        else:
+            E = residual_mismatch(loop, omega, D_pts, _feedforward_df(loop, amplitude, omega))
+        Et = mismatch_asymptote(Pr, Pf2, D_pts)
     zetas = np.asarray(hyst.zeta(amps)) if hyst.defines_zeta else np.full(f.shape, np.nan)
     f_df = None if hyst.rate_independent else float(np.min(f))
     D_ref = complex(np.asarray(hyst.describing_function(
@@ -568,6 +571,10 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     else:
         crossover_exact = mismatch_crossover_exact(loop, amplitude)
         bandwidth_hz = loop.bandwidth_hz()
+        if not math.isfinite(bandwidth_hz):  # a plant or a gain off by orders of magnitude?
+            warn(f"|C P2| does not fall through 1 in the range searched: the loop has no "
+                 f"bandwidth; are the moving mass M = {g(loop.M)} kg and the controller's gain "
+                 f"what was meant?")
         if q is None:  # eq. (21) does not apply: say so rather than print nan
             unresolved.append(f"eq. (21): needs a flexible mode with a static compliance "
                               f"Pf2(0) > 0 (the two-mass stage's m1 m2 / (k M^2)); the "
@@ -639,7 +646,8 @@ def _crossover_exact_on_lines(loop: Loop, amplitude: float) -> tuple[float, str]
     """``|E - 1| = 1`` from the measured lines (log-linear between the two that bracket it)."""
     plant = loop.plant
     f = plant.frequency_hz
-    g = np.log(np.abs(loop_mismatch(loop, f, amplitude) - 1.0))
+    with np.errstate(divide="ignore", invalid="ignore"):  # lines where Pf2 = Pr - P2 is 0
+        g = np.log(np.abs(loop_mismatch(loop, f, amplitude) - 1.0))
     idx = np.nonzero((g[:-1] > 0) & (g[1:] <= 0))[0]
     if idx.size == 0:
         return float("nan"), ""

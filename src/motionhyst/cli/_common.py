@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import os
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -252,7 +253,9 @@ def warnings_on_stderr(command: str) -> Iterator[None]:
     """Show each :class:`~motionhyst.core.warnings.MotionhystWarning` raised inside as one line
     ``motionhyst: warning: COMMAND: message`` on stderr, when it is raised, every time.
 
-    Other warnings are shown as Python shows them.  The command still
+    Another library's warning (numpy's ``invalid value encountered``, say) is one
+    such line as well, naming its kind, never a source path and line (with
+    ``MOTIONHYST_TRACEBACK`` set, as Python shows it).  The command still
     succeeds (exit 0): a warning says a number may mean less than it seems,
     not that it is wrong.
 
@@ -280,8 +283,11 @@ def warnings_on_stderr(command: str) -> Iterator[None]:
         def show(message, category, filename, lineno, file=None, line=None):
             if issubclass(category, MotionhystWarning):
                 print(f"motionhyst: warning: {one_line(f'{command}: {message}')}", file=sys.stderr)
-            else:
+            elif os.environ.get("MOTIONHYST_TRACEBACK"):
                 python_shows(message, category, filename, lineno, file, line)
+            else:
+                text = f"{command}: {category.__name__}: {message}"
+                print(f"motionhyst: warning: {one_line(text)}", file=sys.stderr)
 
         warnings.showwarning = show
         yield
