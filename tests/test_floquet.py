@@ -96,3 +96,20 @@ def test_steady_json_gains_floquet_max_and_stable(capsys):
     p = json.loads(capsys.readouterr().out)["points"][0]
     assert p["stable"] is True
     assert p["floquet_max"] == pytest.approx(0.0988, abs=1e-4)
+
+
+def test_a_loop_whose_time_scales_span_too_much_gets_no_multipliers_that_mean_nothing():
+    """A stage stiffness of 1e20 N/m gave |mu| = 1e239, 'UNSTABLE' (issue 26): now a reason."""
+    from motionhyst.analysis.floquet import MAX_TIME_SCALE_RATIO, unresolved_time_scales
+    from motionhyst.plants.two_mass import TwoMassStage
+
+    loop = default_scenario().loop()
+    stiff = Loop(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=1e20), loop.controller,
+                 loop.hysteresis)
+    p = np.abs(stiff.closed_loop_poles())
+    assert p.max() > MAX_TIME_SCALE_RATIO * p[p > 0].min()
+    why = unresolved_time_scales(stiff)
+    assert why is not None and "not resolved in double precision" in why
+    with pytest.raises(ValueError, match="Floquet multipliers not computed"):
+        steady_state_floquet(stiff, periodic_steady_state(stiff, 0.01, 10.0))
+    assert unresolved_time_scales(loop) is None

@@ -22,13 +22,19 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis.floquet import FloquetResult, check_floquet_budget, steady_state_floquet
+from motionhyst.analysis.floquet import (
+    FloquetResult,
+    check_floquet_budget,
+    steady_state_floquet,
+    unresolved_time_scales,
+)
 from motionhyst.analysis.plausibility import check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.analysis.steady import SteadyState, steady_state_sweep
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import BudgetError
 from motionhyst.core.textfmt import g, table
+from motionhyst.core.warnings import warn
 
 __all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
 
@@ -199,6 +205,13 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     points = [ComparisonPoint(ss, complex(ed),
                               error_harmonics_df(loop, amplitude, ss.frequency_hz), False)
               for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)]
+    why = (unresolved_time_scales(loop) if floquet and loop.hysteresis is not None
+           and loop.is_lti and loop.sampled is None else None)
+    if why:  # said once, rather than multipliers that mean nothing
+        warn(f"Floquet multipliers not computed: {why}")
+        floquet = False
+        for p in points:
+            p.floquet = None
     if floquet:
         for p in points:
             try:

@@ -48,8 +48,14 @@ from motionhyst.core.textfmt import g
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.stepping import STOP
 
-__all__ = ["SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STATE_CUBED", "SECONDS_PER_STEP",
-           "FloquetResult", "LoopStateEquation", "check_floquet_budget", "steady_state_floquet"]
+__all__ = ["MAX_TIME_SCALE_RATIO", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STATE_CUBED",
+           "SECONDS_PER_STEP", "FloquetResult", "LoopStateEquation", "check_floquet_budget",
+           "steady_state_floquet", "unresolved_time_scales"]
+
+MAX_TIME_SCALE_RATIO = 1e6
+"""Largest ratio of the loop's fastest to slowest closed-loop pole whose monodromy, a product
+of matrix exponentials in double precision, is resolved (Table I: 6.5; a stage stiffness of
+1e20 N/m: 7.7e6, and multipliers of 1e239 that mean nothing)."""
 
 SECONDS_PER_STEP = 20e-6
 """Nominal cost of the monodromy per step of the period [s] (one core of a quiet machine:
@@ -451,6 +457,35 @@ of 1 min (--max-seconds); give fewer frequencies or a link of fewer elements
     check_work(seconds, f"the Floquet multipliers{link} at {where}", remedy)
 
 
+def unresolved_time_scales(loop: Loop) -> str | None:
+    """Why the monodromy of `loop` cannot be resolved, or None: its closed-loop poles span
+    more than :data:`MAX_TIME_SCALE_RATIO` (a plant or gain off by orders of magnitude).
+
+    Parameters
+    ----------
+    loop : Loop
+        A continuous LTI loop.
+
+    Returns
+    -------
+    str or None
+        The reason, naming the poles.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> unresolved_time_scales(default_scenario().loop()) is None
+    True
+    """
+    p = np.abs(loop.closed_loop_poles())
+    p = p[p > 0]
+    if p.size and p.max() > MAX_TIME_SCALE_RATIO * p.min():
+        return (f"the loop's closed-loop poles span {g(p.min())} to {g(p.max())} rad/s, a ratio "
+                f"above {MAX_TIME_SCALE_RATIO:.0e}: its monodromy is not resolved in double "
+                f"precision (is a mass, stiffness or gain off by orders of magnitude?)")
+    return None
+
+
 def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
                          ) -> FloquetResult:
     """Floquet multipliers of the periodic steady state `ss` of `loop` (exact monodromy).
@@ -473,7 +508,8 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
     Raises
     ------
     ValueError
-        For a sampled controller, a measured plant, no link, or a link of another kind.
+        For a sampled controller, a measured plant, no link, a link of another kind, or
+        time scales the monodromy does not resolve (:func:`unresolved_time_scales`).
     motionhyst.core.budget.BudgetError
         Above the memory or work budget (:func:`check_floquet_budget`), before the work.
 
@@ -490,6 +526,9 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
         raise ValueError("the loop has no link")
     if loop.sampled is not None or not loop.is_lti:
         raise ValueError("Floquet multipliers need a continuous loop with a plant model")
+    why = unresolved_time_scales(loop)
+    if why:
+        raise ValueError(f"Floquet multipliers not computed: {why}")
     check_floquet_budget(loop, [ss.frequency_hz], samples)
     sys = LoopStateEquation(loop)
     T = 1.0 / ss.frequency_hz
