@@ -69,6 +69,10 @@ FD_STEP = 1e-6
 RIGID_FD_STEP = 1e-3
 #: Step of the offsets' and initial states' forward differences, in units of their scales
 EXTRA_FD_STEP = 1e-4
+#: Periods a periodic record's run may take at a point of the search: a trial point that has
+#: not settled by then (a stage clamped by a stiff link, whose output is rounding noise) is
+#: refused as parameters the model cannot run, and the search steps back
+SEARCH_PERIODS = 30
 
 
 @dataclass
@@ -302,7 +306,8 @@ class _ElementProblem:
             y, sy = simulate_elements(mech, stepping, u, rec.fs, self.r,
                                       periodic=self.periodic, k_link=k_link, upsampled=fine,
                                       dparams=dparams,
-                                      x0=initial_state(mech.n, self.extras.initial, init[i]))
+                                      x0=initial_state(mech.n, self.extras.initial, init[i]),
+                                      periods=SEARCH_PERIODS)
             return y + y0[i], sy
 
         which = range(len(self.records)) if only is None else [only]

@@ -296,7 +296,7 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
                       r: int, *, periodic: bool, k_link: float = 0.0,
                       upsampled: NDArray[np.float64] | None = None,
                       dparams: NDArray[np.float64] | None = None,
-                      x0: NDArray[np.float64] | None = None
+                      x0: NDArray[np.float64] | None = None, periods: int | None = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Output of a plant with a link of exact-update elements, and its sensitivities (FOH).
 
@@ -341,6 +341,11 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     x0 : ndarray, shape (2n,), optional
         The plant's state ``(q, q')`` at the first sample of a run that is not
         periodic (default: at rest, ``0``); the link starts relaxed.
+    periods : int, optional
+        Most periods a periodic run takes before it is refused as not settling
+        (default: until the slowest mode has decayed
+        :data:`~motionhyst.time.periodic_runs.MAX_PERIODIC_DECAYS` times, at most
+        1000); a search caps its trial points' runs with it.
 
     Returns
     -------
@@ -370,7 +375,8 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     n_periods = whole_periods(u) if periodic else 1
     if n_periods > 1:  # the steady state of one period, repeated
         y, dy = simulate_elements(mech, stepping, u[: u.size // n_periods], fs, r,
-                                  periodic=True, k_link=k_link, dparams=dparams)
+                                  periodic=True, k_link=k_link, dparams=dparams,
+                                  periods=periods)
         return np.tile(y, n_periods), np.tile(dy, (n_periods, 1))
     h = 1.0 / (fs * r)
     sens = dparams is not None
@@ -418,7 +424,8 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         y, sy, *_ = run(x, s, sx, ss)
         return y, sy
     state = [x, s, sx, ss]
-    extrapolate = PeriodExtrapolation(bounded={1: stepping.state_bounds()}, weighted=(0, 1))
+    extrapolate = PeriodExtrapolation(bounded={1: stepping.state_bounds()}, weighted=(0, 1),
+                                      own=(2, 3))
 
     def next_period():
         y, sy, *state[:] = run(*state)
@@ -428,5 +435,6 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
             state[:] = jump
         return y, sy, finite
 
-    return periodic_output(next_period, max_periods(mech, k_link, u.size / fs),
+    most = max_periods(mech, k_link, u.size / fs)
+    return periodic_output(next_period, most if periods is None else min(most, int(periods)),
                             mech.floating, sens)

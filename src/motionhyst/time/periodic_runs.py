@@ -30,7 +30,8 @@ if TYPE_CHECKING:
     from motionhyst.plants.mechanics import Mechanics
 
 __all__ = ["EXTRAPOLATION_PERIODS", "MAX_PERIODIC_DECAYS", "MIN_PERIOD_SAMPLES", "PERIODIC_RTOL",
-           "PeriodExtrapolation", "periodic_output", "settled", "whole_periods"]
+           "ROUNDING_RTOL", "STALL_PERIODS", "PeriodExtrapolation", "periodic_output", "settled",
+           "whole_periods"]
 
 #: A period's output repeats the previous one to this fraction of its amplitude.
 PERIODIC_RTOL = 1e-12
@@ -40,6 +41,11 @@ MAX_PERIODIC_DECAYS = 60.0
 MIN_PERIOD_SAMPLES = 16
 #: Period-start states that one extrapolation of the period map's fixed point takes
 EXTRAPOLATION_PERIODS = 6
+#: A run whose change from period to period has not shrunk below its smallest for this many
+#: periods has reached the rounding of its arithmetic (two extrapolations)
+STALL_PERIODS = 2 * EXTRAPOLATION_PERIODS
+#: ... and is taken as settled if that change is below this fraction of the output's amplitude
+ROUNDING_RTOL = 1e-6
 
 
 _NO_STEADY_STATE = ("the periodic steady state was not reached (the response does not settle "
@@ -130,7 +136,18 @@ def periodic_output(next_period, periods: int, floating: bool, sensitivities: bo
     period, and whether the state is still finite.  The output repeats as
     :func:`settled` judges, the sensitivities to 1e-8 of their largest
     values; a floating stage's output is returned with zero mean (it is
-    defined up to a constant).  Raises if `periods` do not settle.
+    defined up to a constant).
+
+    Some runs never repeat to those tolerances: an output (or a sensitivity) far
+    smaller than the states it is computed from, such as a stage clamped by a
+    stiff link, changes by the rounding of those states from period to period.
+    A run whose output changes by less than :data:`ROUNDING_RTOL` of its
+    amplitude, and whose changes (the output's, and the largest of the
+    sensitivities', relative to their amplitudes) have not fallen below half
+    their smallest so far for
+    :data:`STALL_PERIODS` periods, has settled as far as its arithmetic allows: a
+    decaying start shrinks the change every period, rounding does not.  Raises if
+    `periods` do not settle.
 
     Parameters
     ----------
@@ -156,9 +173,20 @@ def periodic_output(next_period, periods: int, floating: bool, sensitivities: bo
     ...                        floating=False, sensitivities=False)
     >>> bool(np.allclose(y, shape[:-1], rtol=0, atol=1e-12))
     True
+
+    One whose output changes by rounding noise of 1e-9 of its amplitude, period after
+    period, settles after :data:`STALL_PERIODS` periods without a smaller change:
+
+    >>> rng = np.random.default_rng(0)
+    >>> noisy = lambda: (shape * (1 + 1e-9 * rng.standard_normal()), np.zeros((65, 0)), True)
+    >>> y, _ = periodic_output(noisy, 100, floating=False, sensitivities=False)
+    >>> bool(np.allclose(y, shape[:-1], rtol=0, atol=1e-8))
+    True
     """
     prev = None
     step: list[float] = []
+    smallest = None  # the smallest relative changes so far (output, sensitivities)
+    since = 0  # periods since one of them last fell
     for _ in range(periods):
         y, sy, finite = next_period()
         y, sy = y[:-1], sy[:-1]
@@ -167,6 +195,14 @@ def periodic_output(next_period, periods: int, floating: bool, sensitivities: bo
             if sensitivities:
                 ok &= bool(np.all(np.max(np.abs(sy - prev[1]), axis=0)
                                   <= 1e-8 * (np.max(np.abs(sy), axis=0) + 1e-300)))
+            if not ok:  # rounding reached? (a change that no longer shrinks)
+                change = _relative_changes(y, prev[0], sy, prev[1], floating)
+                if smallest is None or np.any(change < 0.5 * smallest):
+                    since = 0
+                    smallest = change if smallest is None else np.minimum(smallest, change)
+                else:
+                    since += 1
+                ok = since >= STALL_PERIODS and bool(change[0] <= ROUNDING_RTOL)
             if ok:
                 if floating:  # defined up to a constant: zero mean
                     return y - np.mean(y), sy - np.mean(sy, axis=0)
@@ -175,6 +211,17 @@ def periodic_output(next_period, periods: int, floating: bool, sensitivities: bo
             break
         prev = (y, sy)
     raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if floating else ""))
+
+
+def _relative_changes(y: NDArray[np.float64], prev: NDArray[np.float64],
+                      sy: NDArray[np.float64], sprev: NDArray[np.float64], floating: bool
+                      ) -> NDArray[np.float64]:
+    """The output's change from the previous period relative to its amplitude (a floating
+    stage's spread), and the largest of the sensitivities' relative to their largest values."""
+    amp = float(np.ptp(y) if floating else np.max(np.abs(y)))
+    dy = float(np.max(np.abs(y - prev))) / amp if amp > 0 else math.inf
+    ds = np.max(np.abs(sy - sprev), axis=0) / (np.max(np.abs(sy), axis=0) + 1e-300)
+    return np.array([dy, float(np.max(ds, initial=0.0))])
 
 
 class PeriodExtrapolation:
@@ -201,8 +248,13 @@ class PeriodExtrapolation:
         States per extrapolation.
     weighted : tuple of int, optional
         The blocks whose differences choose the weights ``g`` (default: all); the
-        others (sensitivities) are combined with the same weights, so that a run
-        with them follows the same states as one without.
+        others are combined with the same weights, so that a run with them follows
+        the same states as one without.
+    own : tuple of int
+        Blocks extrapolated with weights chosen from their own differences
+        (sensitivities: given the states, an affine map of their own, which the
+        states' weights fit only as the states settle); the states do not depend
+        on them, so the run's states are those of a run without them.
 
     Examples
     --------
@@ -223,10 +275,12 @@ class PeriodExtrapolation:
 
     def __init__(self, bounded: dict[int, tuple] | None = None,
                  periods: int = EXTRAPOLATION_PERIODS,
-                 weighted: tuple[int, ...] | None = None) -> None:
+                 weighted: tuple[int, ...] | None = None,
+                 own: tuple[int, ...] = ()) -> None:
         self.bounded = dict(bounded or {})
         self.periods = int(periods)
         self.weighted = weighted
+        self.own = tuple(own)
         self.history: list[list[NDArray[np.float64]]] = []
 
     def __call__(self, blocks: list[NDArray[np.float64]]) -> list[NDArray[np.float64]] | None:
@@ -239,26 +293,20 @@ class PeriodExtrapolation:
         Z = np.array([np.concatenate([b.ravel() for b in h]) for h in hist])  # (k + 1, n)
         if not np.all(np.isfinite(Z)):
             return None
-        # each block scaled by its spread over the history (positions, forces, sensitivities)
-        scale = np.empty(Z.shape[1])
-        i = 0
-        for j, b in enumerate(hist[-1]):
-            spread = (float(np.max(np.abs(Z[:, i:i + b.size] - Z[-1, i:i + b.size])))
-                      if b.size and (self.weighted is None or j in self.weighted) else 0.0)
-            scale[i:i + b.size] = 1.0 / spread if spread > 0 else 0.0
-            i += b.size
-        D = np.diff(Z, axis=0) * scale  # (k, n)
-        G = D @ D.T
-        k = G.shape[0]
-        # min |D^T g| with sum g = 1: G g = lambda 1 (Lagrange), solved in the least-squares sense
-        try:
-            g = np.linalg.lstsq(G + 1e-14 * np.trace(G) * np.eye(k), np.ones(k), rcond=None)[0]
-        except np.linalg.LinAlgError:
+        shared = [j for j in range(len(hist[-1])) if j not in self.own
+                  and (self.weighted is None or j in self.weighted)]
+        g = _rre_weights(Z, hist[-1], shared)
+        if g is None:
             return None
-        if not np.all(np.isfinite(g)) or abs(np.sum(g)) < 1e-300:
-            return None
-        g /= np.sum(g)
         z = g @ Z[:-1]
+        if self.own:  # blocks with weights of their own (where they are not found, the shared)
+            g_own = _rre_weights(Z, hist[-1], list(self.own))
+            z_own = g_own @ Z[:-1] if g_own is not None else z
+            i = 0
+            for j, b in enumerate(hist[-1]):
+                if j in self.own:
+                    z[i:i + b.size] = z_own[i:i + b.size]
+                i += b.size
         out, i = [], 0
         for j, b in enumerate(hist[-1]):
             block = z[i:i + b.size]
@@ -268,6 +316,31 @@ class PeriodExtrapolation:
             out.append(block)
             i += b.size
         return out if all(np.all(np.isfinite(b)) for b in out) else None
+
+
+def _rre_weights(Z: NDArray[np.float64], blocks: list[NDArray[np.float64]], which: list[int]
+                 ) -> NDArray[np.float64] | None:
+    """The weights ``g`` (``sum g = 1``) minimising ``|sum g_j (z_{j+1} - z_j)|`` over the
+    blocks `which` of the states `Z` (rows), each block scaled by its spread; None if not
+    found."""
+    scale = np.zeros(Z.shape[1])
+    i = 0
+    for j, b in enumerate(blocks):
+        if b.size and j in which:
+            spread = float(np.max(np.abs(Z[:, i:i + b.size] - Z[-1, i:i + b.size])))
+            scale[i:i + b.size] = 1.0 / spread if spread > 0 else 0.0
+        i += b.size
+    D = np.diff(Z, axis=0) * scale  # (k, n)
+    G = D @ D.T
+    k = G.shape[0]
+    # min |D^T g| with sum g = 1: G g = lambda 1 (Lagrange), solved in the least-squares sense
+    try:
+        g = np.linalg.lstsq(G + 1e-14 * np.trace(G) * np.eye(k), np.ones(k), rcond=None)[0]
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(g)) or abs(np.sum(g)) < 1e-300:
+        return None
+    return g / np.sum(g)
 
 
 def floating_linear_periodic(mech: Mechanics, u: NDArray[np.float64], fs: float
