@@ -9,7 +9,11 @@ predicts a part of the record it did not see.
   (``QuasiStatic(k, c)``); its first resonance (kHz) far above the records' content.
 * A friction damper (displacement imposed by a test machine, force measured): a
   Maxwell-slip link with a parallel spring, under sines and earthquake-like histories
-  (band-limited noise under a rise-plateau-decay envelope).
+  (band-limited noise under a rise-plateau-decay envelope); or a link of another model
+  (:data:`DAMPER_LINKS`: Dahl, whose loops have no elastic range; LuGre with viscous
+  friction), as a test machine logs it (:meth:`Record.write_as_logged`: its own column
+  names and units, a drifting load cell, a displacement sensor's zero, jittered time
+  stamps).
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from scipy import signal
 
-from motionhyst.hysteresis import BoucWen, MaxwellSlip
+from motionhyst.hysteresis import BoucWen, Dahl, LuGre, MaxwellSlip
 from motionhyst.plants import QuasiStatic
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
 
@@ -36,6 +40,11 @@ DAMPER_PLANT = QuasiStatic(k=5.0e4)
 DAMPER_LINK = MaxwellSlip(k=[1.5e6, 6.0e5, 2.5e5], fc=[3.0e3, 2.4e3, 2.0e3])
 DAMPER_FORCE_OFFSET = 85.0  # the load cell's zero [N]
 DAMPER_NOISE = 15.0  # [N]
+#: Dampers whose link Maxwell-slip elements alone do not describe: Dahl's (smooth loops, no
+#: elastic range) and LuGre's (with viscous friction: 2e4 N s/m, the force rises with the rate)
+DAMPER_LINKS = {"dahl": Dahl(k=1.0e6, fc=3.0e3),
+                "lugre": LuGre(sigma0=1.0e6, sigma1=2.0e3, sigma2=2.0e4, fc=2.5e3, fs=3.5e3,
+                               vs=0.01)}
 
 
 @dataclass
@@ -61,6 +70,29 @@ class Record:
             out.writerow(columns)
             out.writerows(zip(*(data[c] for c in columns), strict=True))
         return path
+
+
+    def write_as_logged(self, path: Path, seed: int = 0, force: bool = True) -> Path:
+        """A CSV as a test machine logs it: ``Time (s)`` jittered by 0.2 % of a step,
+        ``LVDT_mm`` (its zero 0.1 mm off, 2 um noise) and ``Load_kN`` (when `force`; its
+        zero drifting by 2 N over the record)."""
+        rng = np.random.default_rng(seed)
+        h = self.t[1] - self.t[0]
+        t = self.t + 2e-3 * h * rng.uniform(-1.0, 1.0, self.t.size)
+        x = self.displacement + 1e-4 + 2e-6 * rng.standard_normal(self.t.size)
+        f = self.force + 2.0 * self.t / self.t[-1]
+        header = ["Time (s)", "LVDT_mm"] + (["Load_kN"] if force else [])
+        columns = [t, 1e3 * x] + ([1e-3 * f] if force else [])
+        with open(path, "w", newline="") as file:
+            out = csv.writer(file)
+            out.writerow(header)
+            out.writerows(zip(*columns, strict=True))
+        return path
+
+
+#: How a user maps the logged columns (:meth:`Record.write_as_logged`) to SI
+LOGGED = ["--columns", "time=Time (s),displacement=LVDT_mm,force=Load_kN",
+          "--scale", "displacement=1e-3,force=1e3"]
 
 
 def fit_percent(y: np.ndarray, y_hat: np.ndarray) -> float:
@@ -112,10 +144,11 @@ def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
 
 
 def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
-                  seconds: float = 40.0) -> Record:
+                  seconds: float = 40.0, link: str | None = None) -> Record:
     """A friction damper's record: displacement imposed, force measured (with offset, noise).
 
-    `history`: ``"sines"`` (0.2 to 2 Hz, 3 to 20 mm) or ``"earthquake"`` (20 mm peak).
+    `history`: ``"sines"`` (0.2 to 2 Hz, 3 to 20 mm) or ``"earthquake"`` (20 mm peak);
+    `link`: a name of :data:`DAMPER_LINKS` (default :data:`DAMPER_LINK`).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(int(seconds * fs)) / fs
@@ -123,6 +156,7 @@ def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
         x = stepped_sines(t, [(0.2, 0.02), (0.5, 0.008), (1.0, 0.014), (2.0, 0.003)])
     else:
         x = earthquake_like(t, rng, 0.02)
-    w = force_from_displacement(DAMPER_PLANT, DAMPER_LINK, t, x)
+    w = force_from_displacement(DAMPER_PLANT, DAMPER_LINK if link is None else
+                                DAMPER_LINKS[link], t, x)
     f = w + DAMPER_FORCE_OFFSET + DAMPER_NOISE * rng.standard_normal(t.size)
     return Record(t, f, x)

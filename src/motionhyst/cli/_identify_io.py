@@ -73,7 +73,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records, --plant two-mass: the measured position, y2 "
                         "(the point of control, default) or y1 (the actuated mass)")
     q.add_argument("--model", choices=list(MODELS),
-                   help="input-output records: the link's model (default bouc-wen)")
+                   help="input-output records: the link's model (default bouc-wen); "
+                        "force-displacement records: the link's model with a spring and "
+                        "damper in parallel, fitted by the force's error (default: "
+                        "Maxwell-slip elements alone, their number chosen by --criterion)")
     q.add_argument("--periodic", action="store_true",
                    help="input-output records: each record holds whole periods of a periodic "
                         "steady state (default: each is an experiment from rest)")
@@ -90,13 +93,13 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
 
 def check_not_input_output(args: argparse.Namespace, closed_loop: bool = False) -> None:
     """One-line error for input-output options given with another record kind (`closed_loop`:
-    a closed-loop record, which takes ``--offset`` too)."""
-    for option, value in (("--plant", args.plant), ("--model", args.model),
+    a closed-loop record, which takes ``--offset`` too; ``--model`` and ``--max-evaluations``
+    are checked with the record's kind)."""
+    for option, value in (("--plant", args.plant),
                           ("--periodic", args.periodic or None), ("--nu", args.nu),
                           ("--output", args.output),
                           ("--offset", None if closed_loop else args.offset),
                           ("--from-rest", args.from_rest or None),
-                          ("--max-evaluations", args.max_evaluations),
                           ("--init-window", args.init_window),
                           ("--asymmetric", args.asymmetric or None),
                           ("--drift", args.drift or None)):

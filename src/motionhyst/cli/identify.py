@@ -147,6 +147,15 @@ def run(args: argparse.Namespace) -> int:
                 raise UsageError(f"motionhyst identify: {option} applies to closed-loop "
                                  f"records (time,y1,u) only; {path} is a force-displacement "
                                  f"record")
+        if args.model is not None:
+            return _run_link_force(args, path)
+        if args.max_evaluations is not None:
+            raise UsageError("motionhyst identify: --max-evaluations applies to input-output "
+                             "records and to force-displacement records with --model")
+    for option, value in (("--model", args.model), ("--max-evaluations", args.max_evaluations)):
+        if value is not None:
+            raise UsageError(f"motionhyst identify: {option} applies to input-output and "
+                             f"force-displacement records; {path} is a closed-loop record")
     options = {"n_elements": args.elements, "criterion": args.criterion or "rms"}
     extra: dict = {"record": kind, "data": str(path)}
     target = None
@@ -169,6 +178,7 @@ def run(args: argparse.Namespace) -> int:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
+    share = 0.0  # a force-displacement fit's systematic error, as a share of the force's RMS
     if kind == "force-displacement":
         from motionhyst.identify.fit import identify_maxwell_slip
 
@@ -177,6 +187,7 @@ def run(args: argparse.Namespace) -> int:
             ident = identify_maxwell_slip(x, w, t=t, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+        share = _judge_elements(path, ident, x, w, args.elements is None or target is not None)
         if target is not None:  # the link alone, a system without inertia, for predict
             target.write_text(ident.scenario_text(f"{path}"))
             extra["saved"] = args.save
@@ -217,6 +228,11 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"Maxwell-slip hysteresis identified from {path} ({what}, {ident.n_samples} samples)")
     print(ident)
+    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE
+
+    if share > SYSTEMATIC_SHARE:  # an order asked for, not saved: said, not refused
+        print(f"  systematic error {100 * share:.2g} % of the force's RMS (beyond its noise): "
+              f"{len(k)} element(s) do not describe this record")
     print()
     print("# hysteresis feedforward, to paste into a scenario (replaces its [feedforward];")
     print("# the same inline table is a valid [hysteresis] section to model the link):")
@@ -225,6 +241,71 @@ def run(args: argparse.Namespace) -> int:
         print(f"\nwrote {args.save} (the link without inertia: motionhyst predict gives its "
               f"force for a displacement record)")
     return 0
+
+
+def _run_link_force(args: argparse.Namespace, path: Path) -> int:
+    """A force-displacement record's link of `--model`, with a spring and damper in parallel,
+    fitted by the force's error; printed, optionally saved (a quasi-static system)."""
+    if args.criterion is not None:
+        raise UsageError("motionhyst identify: --criterion chooses the number of Maxwell-slip "
+                         "elements of a fit without --model")
+    if args.elements is not None and args.model != "maxwell-slip":
+        raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
+    target = None
+    if args.save is not None:  # refused before the work, not after
+        from motionhyst.io.outputs import OutputFile
+
+        target = OutputFile(args.save, force=args.force, inputs=[path], option="--save")
+    from motionhyst.identify.records import load_force_displacement_csv
+
+    t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
+    from motionhyst.hysteresis import model_class
+    from motionhyst.identify.io_quasi_static import identify_link_force
+    from motionhyst.identify.io_records import IORecord
+
+    try:
+        fit = identify_link_force([IORecord(t, w, x, str(path))], model_class(args.model),
+                                  n_elements=args.elements or 3,
+                                  max_evaluations=args.max_evaluations)
+    except (ValueError, RuntimeError) as exc:
+        raise type(exc)(f"{path}: {exc}") from None
+    result = {**fit.to_dict(), "record": "force-displacement", "data": str(path)}
+    if target is not None:
+        target.write_text(fit.scenario_text())
+        result["saved"] = args.save
+    if args.json:
+        print_json(result)
+        return 0
+    print(f"{args.model} link with a spring and damper in parallel identified from {path} "
+          f"(force-displacement record, {t.size} samples) by the force's error in "
+          f"{fit.seconds:.3g} s")
+    print("\n".join(str(fit).splitlines()[1:]))
+    if target is not None:
+        print(f"\nwrote {args.save} (the link without inertia: motionhyst predict gives its "
+              f"force for a displacement record)")
+    else:
+        print("\n# the identified link, a scenario for motionhyst predict (or give --save):")
+        print(fit.scenario_text(), end="")
+    return 0
+
+
+def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
+    """The systematic share of a force-displacement fit's error
+    (:func:`~motionhyst.identify.io_checks.systematic_share`); above
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` a failed fit where `refuse`
+    (the order chosen by the criterion, or a model to save): elements that do not describe
+    the record do not predict another one of the same link."""
+    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed, systematic_share
+
+    share = systematic_share(w - ident.predict(x, ident.initial_forces), w)
+    if refuse and share > SYSTEMATIC_SHARE:
+        raise FitFailed(f"{path}: the fit failed: {ident.n_elements} Maxwell-slip element(s) "
+                        f"leave a systematic error of {100 * share:.2g} % of the force's RMS "
+                        f"(above {100 * SYSTEMATIC_SHARE:g} %, beyond the noise): they do not "
+                        f"describe this link and would not predict another record of it; a "
+                        f"link with a spring and damper in parallel may (--model dahl, "
+                        f"bouc-wen or lugre); nothing saved")
+    return share
 
 
 def add_parser(sub) -> None:

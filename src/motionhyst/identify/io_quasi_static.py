@@ -44,7 +44,12 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
-from motionhyst.identify.io_checks import FitFailed, judge_fit
+from motionhyst.identify.io_checks import (
+    SYSTEMATIC_SHARE,
+    FitFailed,
+    judge_fit,
+    systematic_share,
+)
 from motionhyst.identify.io_elements import LinkLayout
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
@@ -59,7 +64,7 @@ from motionhyst.plants.quasi_static import QuasiStatic
 from motionhyst.time.openloop import OpenLoop
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
 
-__all__ = []
+__all__ = ["identify_link_force"]
 
 #: Starts: (the link's share of the linear stiffness, its slip displacement in units of the
 #: records' displacement RMS)
@@ -133,6 +138,12 @@ class _Problem:
         return [displacement_from_force(plant, link, rec.t, rec.u, periodic=self.periodic)
                 + y0 for rec, y0 in zip(self.records, self.output_offsets(v), strict=True)]
 
+    def forces(self, v: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        """The forces the model predicts from the measured positions (offsets included)."""
+        plant, link = self.model(v)
+        return [force_from_displacement(plant, link, rec.t, rec.y - y0, periodic=self.periodic)
+                for rec, y0 in zip(self.records, self.output_offsets(v), strict=True)]
+
     def _residuals(self, q_free: NDArray[np.float64], equation: bool) -> NDArray[np.float64]:
         self.n_eval += 1
         v = self.values(self.whole(q_free))
@@ -169,6 +180,17 @@ def _layout(link: type, n_elements: int) -> LinkLayout:
             layout.entries.remove((par, count))
             layout.fixed[par.name] = float(par.default)  # type: ignore[arg-type]
     return layout
+
+
+def _inside(layout: LinkLayout, link0: NDArray[np.float64]) -> None:
+    """Move a start off the edge of the link's range where a forward difference would step
+    out of it: Bouc-Wen's default ``beta = gamma`` (``gamma <= beta``) becomes
+    ``beta = 0.6, gamma = 0.4``."""
+    names = list(layout.names)
+    if "link.beta" in names and "link.gamma" in names:
+        i, j = names.index("link.beta"), names.index("link.gamma")
+        if link0[j] >= link0[i]:
+            link0[i], link0[j] = 0.6, 0.4
 
 
 def _stop_operator_starts(records: list[IORecord], layout: LinkLayout, prob: _Problem,
@@ -233,7 +255,8 @@ def _linear_rms(records: list[IORecord], K: float, C: float, periodic: bool) -> 
 
 def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: bool,
                              n_elements: int, offset: str, max_evaluations: int | None,
-                             tol: float, t_start: float | None = None) -> IOIdentification:
+                             tol: float, t_start: float | None = None,
+                             output: str = "position") -> IOIdentification:
     """A quasi-static plant and its link from input-output records (see the module).
 
     Parameters
@@ -255,6 +278,10 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         ``ftol = xtol = gtol`` of the refinements.
     t_start : float, optional
         ``time.perf_counter()`` at the start of the identification.
+    output : {"position", "force"}
+        The error fitted: the position's simulated from the force (a force in, a position
+        out), or the force's from the measured displacement (a force-displacement record:
+        the displacement imposed, the force measured, :func:`identify_link_force`).
 
     Returns
     -------
@@ -286,6 +313,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     (100.0, 0.0)
     """
     t0 = time.perf_counter() if t_start is None else t_start
+    force_error = output == "force"
     layout = _layout(link, n_elements)
     K, C, b = _linear_start(records)
     if not K > 0:
@@ -298,8 +326,8 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     v_scale = float(np.sqrt(np.mean(np.concatenate(
         [np.gradient(rec.y, rec.t) for rec in records]) ** 2))) or 1.0
     c_scale = max(abs(C), 1e-3 * K * y_scale / v_scale)
-    inp, out = {"auto": (True, True), "none": (False, False), "input": (True, False),
-                "output": (False, True), "both": (True, True)}[offset]
+    inp, out = {"auto": (True, not force_error), "none": (False, False),
+                "input": (True, False), "output": (False, True), "both": (True, True)}[offset]
     prob = _Problem(records, layout, periodic, inp, out, K, c_scale, y_scale, u_scale,
                     v_scale)
     budget = max_evaluations
@@ -308,6 +336,8 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     starts = []
     for share, slip in STARTS:
         link0 = layout.start(share * K, y_scale, v_scale, 0.0, slip)
+        if force_error:
+            _inside(layout, link0)
         v0 = np.concatenate([[(1.0 - share) * K, max(C, 0.0)], link0, [0.0], y0])
         n_start = START_NFEV if budget is None else max(5, budget // (2 * len(STARTS)))
         try:
@@ -316,31 +346,41 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
             continue
         starts.append(prob.whole(sol.x))
     starts += _stop_operator_starts(records, layout, prob, n_elements, inp, out)
-    # the start that predicts the positions best continues
-    costs = [float(np.sum(prob._residuals(q[prob.free], False) ** 2)) for q in starts]
+    # the start that predicts the positions (the forces) best continues
+    costs = [float(np.sum(prob._residuals(q[prob.free], force_error) ** 2)) for q in starts]
     if not starts or min(costs) >= 0.5 * FAILED_RESIDUAL ** 2 * y_all.size:  # none runs
         raise FitFailed(f"the fit failed: no start of the {link.name} link on a quasi-static "
                         f"plant can run on these records (a force it does not hold)")
     n_final = FINAL_NFEV if budget is None else max(10, budget - prob.n_eval)
     start = starts[int(np.argmin(costs))]
-    sol = prob.solve(start, False, n_final, tol)
+    sol = prob.solve(start, force_error, n_final, tol)
     q = prob.whole(sol.x)
     v = prob.values(q)
     plant, fitted = prob.model(v)
-    predictions = prob.positions(v)
-    res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
-    fit_rms = float(np.sqrt(np.mean(res ** 2)))
-    system = OpenLoop(plant, fitted)
-    judge_fit(fit_rms, records, predictions, _linear_rms(records, K, C, periodic), system, out)
-    spread = float(np.sqrt(np.sum(np.concatenate([rec.y - np.mean(rec.y) for rec in records])
-                                  ** 2)))
+    if force_error:
+        predictions = prob.forces(v)
+        res = np.concatenate([f - rec.u for f, rec in zip(predictions, records, strict=True)])
+        fit_rms = float(np.sqrt(np.mean(res ** 2)))
+        _judge_force_fit(fit_rms, res, records, predictions, K, C, b)
+    else:
+        predictions = prob.positions(v)
+        res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
+        fit_rms = float(np.sqrt(np.mean(res ** 2)))
+        system = OpenLoop(plant, fitted)
+        judge_fit(fit_rms, records, predictions, _linear_rms(records, K, C, periodic), system,
+                  out)
+        _judge_systematic(res, [rec.y for rec in records], "position")
+    what = "force" if force_error else "position"
+    measured = [rec.u if force_error else rec.y for rec in records]
+    spread = float(np.sqrt(np.sum(np.concatenate([m - np.mean(m) for m in measured]) ** 2)))
     explained = 100.0 * (1.0 - math.sqrt(float(np.sum(res ** 2))) / spread) if spread else 0.0
     if explained < MIN_FIT_PERCENT:
         raise FitFailed(f"the fit failed: the model explains {explained:.2g} % of the "
-                        f"position's variation (fit below {MIN_FIT_PERCENT:g} %): these records "
+                        f"{what}'s variation (fit below {MIN_FIT_PERCENT:g} %): these records "
                         f"show no quasi-static relation between force and position")
     # standard errors from the Jacobian in the parameters' own units
-    J = sol.jac * prob.y_scale / np.where(prob.log, v, prob.scale)[prob.free]
+    J = (sol.jac * (prob.u_scale if force_error else prob.y_scale)
+         / np.where(prob.log, v, prob.scale)[prob.free])
     std_free, groups = standard_errors(J, float(np.sum(res ** 2)), res.size, FD_SINGULAR_RTOL)
     names = [n for n, f in zip(prob.names, prob.free, strict=True) if f]
     notes = undetermined_notes(names, groups, FD_SINGULAR_RTOL)
@@ -362,9 +402,115 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                                                               res.size, FD_SINGULAR_RTOL), std)}
     return IOIdentification(
         plant=plant, hysteresis=fitted, estimates=estimates, std=std, not_identifiable=notes,
-        fit_rms=fit_rms, records=per_record_errors(records, res),
+        fit_rms=fit_rms, records=per_record_errors(records, res, measured),
         seconds=time.perf_counter() - t0, periodic=periodic,
         stopping=f"{sol.message} (forward differences; ftol = xtol = gtol = {tol:g}, "
                  f"{prob.n_eval} evaluations with the starts)",
         n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings,
-        data=list(records), residuals=res)
+        data=list(records), residuals=res, output=what)
+
+
+def _judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IORecord],
+                     forces: list[NDArray[np.float64]], K: float, C: float,
+                     b: NDArray[np.float64]) -> None:
+    """Raise :class:`FitFailed` unless the forces predicted from the displacement are a
+    result: finite, better than the force's own spread and than the linear model's
+    ``K y + C y' + b``, and describing the records to within
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of the force's RMS beyond
+    the noise (:func:`~motionhyst.identify.io_checks.systematic_share`)."""
+    if not all(np.all(np.isfinite(f)) for f in forces) or not math.isfinite(fit_rms):
+        raise FitFailed("the fit failed: the identified link's force is not finite")
+    u = np.concatenate([rec.u for rec in records])
+    own = float(np.std(u))
+    if fit_rms > own:
+        raise FitFailed(f"the fit failed: its RMS error {fit_rms:.3g} N exceeds the force's "
+                        f"own spread {own:.3g} N (predicting its mean does better)")
+    linear = np.concatenate([rec.u - K * rec.y - C * np.gradient(rec.y, rec.t) - bi
+                             for rec, bi in zip(records, b, strict=True)])
+    linear_rms = float(np.sqrt(np.mean(linear ** 2)))
+    if fit_rms > linear_rms * (1.0 + 1e-9):
+        raise FitFailed(f"the fit failed: its RMS error {fit_rms:.3g} N exceeds the linear "
+                        f"spring and damper's {linear_rms:.3g} N")
+    _judge_systematic(res, [rec.u for rec in records], "force")
+
+
+def _judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float64]],
+                      what: str) -> None:
+    """Raise :class:`FitFailed` if the residuals `res` (the records one after the other)
+    leave a systematic error above
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of a record's `measured`
+    signal (:func:`~motionhyst.identify.io_checks.systematic_share`): a model that does
+    not describe its records (a piezo's creep, a rate dependence the link lacks) does not
+    predict another one."""
+    parts = np.split(res, np.cumsum([m.size for m in measured])[:-1])
+    share = max(systematic_share(r, m) for r, m in zip(parts, measured, strict=True))
+    if share > SYSTEMATIC_SHARE:
+        raise FitFailed(f"the fit failed: the model leaves a systematic error of "
+                        f"{100 * share:.2g} % of the {what}'s RMS (above "
+                        f"{100 * SYSTEMATIC_SHARE:g} %, beyond the noise): it does not describe "
+                        f"these records (a creep, a rate dependence or a link another --model "
+                        f"describes) and would not predict another one")
+
+
+def identify_link_force(records: list[IORecord], link: type, *, n_elements: int = 3,
+                        offset: str = "auto", max_evaluations: int | None = None,
+                        tol: float = 1e-10) -> IOIdentification:
+    """A link with a spring and damper in parallel from force-displacement records, by the
+    force's error.
+
+    A friction damper or a link on a test machine: the displacement imposed (``y``),
+    the force measured (``u``).  The model is the quasi-static plant's balance
+    ``u - u_0 = w(y) + k y + c y'`` evaluated on the measured displacement
+    (:func:`~motionhyst.time.quasi_static.force_from_displacement`, one pass of the
+    link) and fitted to the measured force, from the starts of
+    :func:`identify_quasi_static_io`; offset ``auto`` is the force's (the load cell's
+    zero; a displacement offset is a constant force through the spring).  A fit that does
+    not describe the records (a systematic error above
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of the force's RMS beyond
+    the noise) is a failure, not a model.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        ``u`` the measured force [N], ``y`` the imposed displacement [m].
+    link : type
+        The link's model, a registered :class:`~motionhyst.hysteresis.Hysteresis` class.
+    n_elements : int
+        Elements of a list model (Maxwell-slip).
+    offset : {"auto", "none", "input", "output", "both"}
+        Offsets estimated (``input``: the force's, ``output``: the displacement's).
+    max_evaluations : int, optional
+        The budget of model evaluations.
+    tol : float
+        ``ftol = xtol = gtol`` of the refinement.
+
+    Returns
+    -------
+    IOIdentification
+        With ``output = "force"``: the fit RMS and residuals in newtons.
+
+    Raises
+    ------
+    FitFailed
+        A fit that is no result.
+
+    Examples
+    --------
+    A Dahl link and a spring measured with a load cell's offset of 5 N:
+
+    >>> import numpy as np
+    >>> from motionhyst.hysteresis import Dahl
+    >>> from motionhyst.time.quasi_static import force_from_displacement
+    >>> t = np.arange(4000) / 200.0
+    >>> x = 0.01 * np.sin(2 * np.pi * 0.5 * t) * np.minimum(1.0, t / 4)
+    >>> u = force_from_displacement(QuasiStatic(k=2e4), Dahl(k=5e5, fc=800.0), t, x) + 5.0
+    >>> fit = identify_link_force([IORecord(t, u, x)], Dahl)
+    >>> est = fit.estimates
+    >>> round(est["k"]), round(est["link.k"]), round(est["link.fc"], 3), round(est["c"], 6)
+    (20000, 500000, 800.0, 0.0)
+    >>> round(est["input_offset"], 6), fit.output
+    (5.0, 'force')
+    """
+    return identify_quasi_static_io(records, link, periodic=False, n_elements=n_elements,
+                                    offset=offset, max_evaluations=max_evaluations, tol=tol,
+                                    output="force")

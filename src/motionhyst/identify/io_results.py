@@ -36,7 +36,7 @@ class IOIdentification:
     not_identifiable : dict
         Parameter name -> why it is not identifiable and what is.
     fit_rms : float
-        RMS simulation error over all records [m].
+        RMS simulation error over all records [m] (of the force [N], `output` ``"force"``).
     records : list of dict
         Per record: ``{"name", "samples", "fit_rms", "output_rms"}``.
     seconds : float
@@ -63,7 +63,11 @@ class IOIdentification:
         The records fitted (not in :meth:`to_dict`).
     residuals : ndarray
         The model's output less the measured position, the records one after the other, as
-        the fit compared them (offsets and initial states included) [m].
+        the fit compared them (offsets and initial states included) [m] (or [N]).
+    output : {"position", "force"}
+        The signal fitted: the position from the force (input-output records), or the
+        force from the displacement (force-displacement records of a link without
+        inertia).
 
     Examples
     --------
@@ -101,6 +105,13 @@ class IOIdentification:
     data: list[IORecord] = field(default_factory=list, repr=False, compare=False)
     residuals: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0), repr=False,
                                            compare=False)
+    output: str = "position"
+
+    @property
+    def unit(self) -> str:
+        """The unit of the fitted output: ``m`` (the position), ``N`` (the force of a
+        force-displacement record)."""
+        return "N" if self.output == "force" else "m"
 
     def system(self) -> OpenLoop:
         """The identified open-loop system."""
@@ -114,14 +125,17 @@ class IOIdentification:
             s = self.std.get(name)
             rows.append([name, g(value, 8), "not identifiable" if s is None else g(s, 2),
                          "" if s is None or value == 0 else f"{100 * s / abs(value):.2g} %"])
+        what = "force-displacement" if self.output == "force" else "input-output"
         lines = [f"{stage} stage and {self.hysteresis.name} link from {len(self.records)} "
-                 f"input-output record(s) ({kind})",
-                 f"  fit RMS {g(self.fit_rms)} m; {self.stopping}", "",
+                 f"{what} record(s) ({kind})",
+                 f"  fit RMS {g(self.fit_rms)} {self.unit}; {self.stopping}", "",
                  table(["parameter", "estimate", "std", "std/|value|"], rows)]
         if self.not_identifiable:
             lines.append("")
             lines += [f"  {name}: {why}" for name, why in self.not_identifiable.items()]
-        lines += ["", table(["record", "samples", "fit RMS [m]", "output RMS [m]"],
+        lines += ["", table(["record", "samples", f"fit RMS [{self.unit}]",
+                             f"{'force' if self.output == 'force' else 'output'} RMS "
+                             f"[{self.unit}]"],
                             [[r["name"], str(r["samples"]), g(r["fit_rms"]),
                               g(r["output_rms"])] for r in self.records])]
         lines += [f"  warning: {w}" for w in self.warnings]
@@ -153,6 +167,7 @@ class IOIdentification:
                 "records": [dict(r) for r in self.records], "seconds": self.seconds,
                 "periodic": self.periodic, "stopping": self.stopping,
                 "evaluations": self.n_evaluations, "substeps": self.substeps,
+                **({"output": "force"} if self.output == "force" else {}),
                 **self.extra, "warnings": list(self.warnings)}
 
     def scenario_text(self) -> str:
@@ -160,8 +175,10 @@ class IOIdentification:
         and the estimates' standard errors and correlations under their scenario keys in
         ``[identification]`` (:func:`~motionhyst.identify.io_uncertainty.identification_toml`).
         """
-        lines = [f"# identified from {len(self.records)} input-output record(s) by simulation "
-                 f"error: fit RMS {self.fit_rms:.4g} m"]
+        lines = ([f"# identified from {len(self.records)} force-displacement record(s) by the "
+                  f"force's error: fit RMS {self.fit_rms:.4g} N"] if self.output == "force" else
+                 [f"# identified from {len(self.records)} input-output record(s) by simulation "
+                  f"error: fit RMS {self.fit_rms:.4g} m"])
         offsets = self.extra.get("offsets", {}).get("output") or []
         if any(offsets):
             lines.append(f"# position offset of each record [m] (of its sensor, not the "
@@ -191,12 +208,16 @@ def _number(value) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def per_record_errors(records: list[IORecord], res: NDArray[np.float64]) -> list[dict]:
+def per_record_errors(records: list[IORecord], res: NDArray[np.float64],
+                      measured: list[NDArray[np.float64]] | None = None) -> list[dict]:
+    """Per record: its name, samples, the fit's RMS error and the RMS of the signal fitted
+    (`measured`, default: each record's position)."""
     out, i = [], 0
-    for rec in records:
+    for j, rec in enumerate(records):
         e = res[i:i + rec.y.size]
         i += rec.y.size
+        y = rec.y if measured is None else measured[j]
         out.append({"name": rec.name, "samples": int(rec.y.size),
                     "fit_rms": float(np.sqrt(np.mean(e ** 2))),
-                    "output_rms": float(np.sqrt(np.mean(rec.y ** 2)))})
+                    "output_rms": float(np.sqrt(np.mean(y ** 2)))})
     return out
