@@ -358,3 +358,19 @@ def test_stamps_rounded_when_written_are_the_same_record():
     jittered[1234] += 0.1 / 750
     with pytest.raises(ValueError, match=r"stamp 1\.64\d* s is 0\.1 sampling intervals off"):
         sys.simulate(jittered, u)
+
+
+def test_a_periodic_run_takes_at_most_the_periods_it_is_given():
+    """A search caps its trial points' periodic runs (identify's input-output search): a
+    lightly damped stage on a holding link that has not settled by then is refused."""
+    from motionhyst.time.openloop import simulate_elements
+
+    plant, link = MassSpringDamper(1.0, 2.0, 4e4), Jenkins(k=1e4, fc=100.0)  # zeta 4e-3
+    t = np.arange(256) / 512.0
+    u = 5.0 * np.sin(2 * np.pi * 4 * t) + 2.0 * np.sin(2 * np.pi * 12 * t)
+    args = (plant.mechanics(), link.time_stepping(), u, 512.0, 20)
+    with pytest.raises(ValueError, match="steady state was not reached"):
+        simulate_elements(*args, periodic=True, k_link=1e4, periods=2)
+    y, _ = simulate_elements(*args, periodic=True, k_link=1e4)
+    ref = OpenLoop(plant, link).simulate(t, u, periodic=True, substeps=20).displacement
+    np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
