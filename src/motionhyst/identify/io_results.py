@@ -186,7 +186,7 @@ class IOIdentification:
         for name, values in self.extra.get("initial_state", {}).items():
             lines.append(f"# initial state {name} of each record: "
                          f"{', '.join(f'{v:.6g}' for v in values)}")
-        if offsets or self.extra.get("initial_state"):
+        if (offsets or self.extra.get("initial_state")) and self.output != "force":
             lines.append("# (motionhyst predict --init-from REC sets both from a record's first "
                          "samples)")
         stage, link = self.plant.to_dict(), self.hysteresis.to_dict()
