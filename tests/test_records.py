@@ -313,3 +313,16 @@ def test_binary_file_named_csv_is_not_echoed(tmp_path):
             call()
         assert str(info.value) == (f"{path}: not a CSV file (binary data, and not a MATLAB "
                                    f".mat file)")
+
+
+def test_a_structure_field_names_the_record_kind(tmp_path):
+    """A MATLAB 5 structure's fields mapped by --columns give identify the record's kind."""
+    from motionhyst.cli import record_kind
+
+    t, v, q = _signals(seed=4)
+    path = tmp_path / "test.mat"
+    savemat(path, {"test": {"t": t, "d": q, "F": v}})
+    columns = {"time": "test.t", "displacement": "test.d", "force": "test.F"}
+    assert record_kind(path, columns=columns) == "force-displacement"
+    np.testing.assert_array_equal(read_record(path, ("time", "displacement", "force"),
+                                              columns=columns), np.column_stack([t, q, v]))

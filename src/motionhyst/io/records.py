@@ -462,13 +462,16 @@ def record_columns(source: Source, columns: Mapping[str, str] | None = None) -> 
     """
     if _is_path(source) and is_mat_file(source):
         names = _mat_names(Path(source))
-        back = {}
+        back, fields = {}, []
         for quantity, col in (columns or {}).items():
             try:
                 back[_resolve(col, names, Path(source))] = quantity
             except RecordError:
-                pass
-        return [back.get(n, normalize_name(n)) for n in names]
+                # a MATLAB 5 structure is listed whole: its field is read (or refused) later
+                struct = col.split(".", 1)[0].lower() if "." in col else None
+                if struct is not None and struct in (n.lower() for n in names):
+                    fields.append(quantity)
+        return [back.get(n, normalize_name(n)) for n in names] + fields
     _check_text(source)
     try:
         names = read_header(source)
