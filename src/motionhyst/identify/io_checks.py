@@ -38,9 +38,11 @@ MASS_FACTOR = 2.0
 #: Inertia below this share of the force (``m a_rms / u_rms``) is not visible in the records
 INERTIA_SHARE = 1e-3
 #: A fit whose systematic error exceeds this share of the signal's RMS does not describe its
-#: record: on another record of the same machine it explains a few times less (a held-out fit
-#: below 95 %)
-SYSTEMATIC_SHARE = 0.01
+#: record: on another record of the same machine it explains a few times less (measured on
+#: generated dampers and piezos: 2.8 to 15 % gave held-out fits of 47 to 90 %), while the right
+#: model with a sensor's quantisation, resonance above the band, gain nonlinearity of 0.5 % and
+#: a little creep leaves 0.3 to 0.9 %
+SYSTEMATIC_SHARE = 0.02
 
 
 class FitFailed(RuntimeError):
