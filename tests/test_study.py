@@ -321,6 +321,21 @@ def test_bad_study_files_are_one_line_naming_the_key(tmp_path, study_file, capsy
     assert not (tmp_path / "s.zarr").exists()
 
 
+@pytest.mark.parametrize("address, message", [
+    ("tcp://256.1.1.1:8786", "'256.1.1.1' is not an IP address"),
+    ("tcp://127.0.0.1:99999", "the port must be from 1 to 65535"),
+    ("tcp://", "names no host"),
+])
+def test_an_address_that_names_no_scheduler_is_refused_before_connecting(tmp_path, study_file,
+                                                                          capsys, address,
+                                                                          message):
+    assert main(["study", str(study_file), "--out", str(tmp_path / "s.zarr"),
+                 "--scheduler", address]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and "--scheduler" in err, err
+    assert not (tmp_path / "s.zarr").exists()
+
+
 def test_store_of_another_study_needs_force(tmp_path, study_file, capsys):
     out = tmp_path / "s.zarr"
     assert main(["study", str(study_file), "--out", str(out), "--workers", "0", "--json"]) == 0

@@ -5,6 +5,7 @@ local core (or a dask cluster) into a resumable zarr store; ``--summary`` reads 
 from __future__ import annotations
 
 import argparse
+import ipaddress
 import json
 import os
 import sys
@@ -131,6 +132,56 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def scheduler_address(text: str) -> str:
+    """A dask scheduler's address as ``--scheduler`` takes it, refused at once when it cannot
+    name one (a numeric host that is no IP address, a port outside 1-65535), rather than
+    after the connection's timeout.
+
+    Parameters
+    ----------
+    text : str
+        ``[PROTOCOL://]HOST[:PORT]``, as dask.distributed's ``Client`` takes it.
+
+    Returns
+    -------
+    str
+        `text`, unchanged.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        One line saying what is wrong.
+
+    Examples
+    --------
+    >>> scheduler_address("tcp://127.0.0.1:8786")
+    'tcp://127.0.0.1:8786'
+    >>> try:
+    ...     scheduler_address("tcp://256.1.1.1:99999")
+    ... except argparse.ArgumentTypeError as exc:
+    ...     print(exc)
+    '256.1.1.1' is not an IP address
+    """
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(text if "://" in text else f"tcp://{text}")
+    host = parts.hostname or ""
+    if not host:
+        raise argparse.ArgumentTypeError(f"{text!r} names no host")
+    if all(c.isdigit() or c == "." for c in host):
+        try:
+            ipaddress.ip_address(host)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{host!r} is not an IP address") from None
+    try:
+        port = parts.port
+    except ValueError:
+        port = -1
+    if port is not None and not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r}: the port must be from 1 to 65535")
+    return text
+
+
 def add_parser(sub) -> None:
     """Add the ``study`` command to the subparsers `sub`."""
     q = sub.add_parser(
@@ -143,7 +194,7 @@ def add_parser(sub) -> None:
     q.add_argument("--out", metavar="STORE", help="zarr store (a folder) of the results")
     q.add_argument("--workers", type=whole_number(0, 4096, "--workers"),
                    help="local worker processes (default: every core; 0: this process)")
-    q.add_argument("--scheduler", metavar="ADDRESS",
+    q.add_argument("--scheduler", metavar="ADDRESS", type=scheduler_address,
                    help="run on a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786")
     q.add_argument("--from-identification", metavar="MODEL.toml",
                    help="draw the link's parameters jointly from an identification's estimates "
