@@ -114,6 +114,16 @@ def _bad_records() -> dict[str, str]:
 FIT_LIBRARIES = ("control", "matplotlib", "scipy.optimize", "scipy.signal", "numba")
 
 
+def _assert_refused_without_fit_libraries(argv: list[str], error: str, cwd: Path) -> None:
+    """`motionhyst ARGV` run in `cwd` exits 2 with one line holding `error`, having imported
+    none of :data:`FIT_LIBRARIES`."""
+    out = _probe(*argv, cwd=cwd)
+    assert out["rc"] == 2, out["err"]
+    assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
+    loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
+    assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded}"
+
+
 @pytest.mark.parametrize("argv, error", [
     (["identify", "io-missing.csv", "--record", "input-output"], "missing column(s) displacement"),
     (["identify", "io-nan.csv", "--record", "input-output"], "not finite"),
@@ -128,11 +138,7 @@ FIT_LIBRARIES = ("control", "matplotlib", "scipy.optimize", "scipy.signal", "num
 def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path, argv, error):
     for name, text in _bad_records().items():
         (tmp_path / name).write_text(text)
-    out = _probe(*argv, cwd=tmp_path)
-    assert out["rc"] == 2, out["err"]
-    assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
-    loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
-    assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded}"
+    _assert_refused_without_fit_libraries(argv, error, tmp_path)
     assert not (tmp_path / "p.csv").exists()
 
 
@@ -186,11 +192,7 @@ def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, a
     (tmp_path / "pl").mkdir()
     for name, text in _refused_scenarios().items():
         (tmp_path / name).write_text(text)
-    out = _probe(*argv, cwd=tmp_path)
-    assert out["rc"] == 2, out["err"]
-    assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
-    loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
-    assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded}"
+    _assert_refused_without_fit_libraries(argv, error, tmp_path)
     assert not (tmp_path / "o.csv").exists() and not (tmp_path / "p.csv").exists()
 
 
