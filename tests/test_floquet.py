@@ -113,3 +113,24 @@ def test_a_loop_whose_time_scales_span_too_much_gets_no_multipliers_that_mean_no
     with pytest.raises(ValueError, match="Floquet multipliers not computed"):
         steady_state_floquet(stiff, periodic_steady_state(stiff, 0.01, 10.0))
     assert unresolved_time_scales(loop) is None
+
+
+def test_a_stage_with_several_modes_balances_without_a_warning():
+    """Balancing a three-mode stage's state equation warned 'invalid value encountered in
+    cast' from scipy's permutation read-out (balancing factors past 2**63), a line on stderr
+    of every `steady` run on such a stage."""
+    import warnings
+
+    from motionhyst import ModalPlant, TwoMassStage
+    from motionhyst.plants.modal import Mode
+
+    base = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    plant = ModalPlant(base.M, (base.modes[0], Mode(1520.0, 0.01, 0.02, -0.005),
+                                Mode(2630.0, 0.015, 0.03, 0.004)))
+    table = default_scenario().loop()
+    loop = Loop(plant, table.controller, table.hysteresis)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fl = steady_state_floquet(loop, periodic_steady_state(loop, 0.01, 10.0))
+    assert np.isfinite(fl.floquet_max) and 0.0 < fl.floquet_max < 1.0
+    assert fl.stable

@@ -201,7 +201,11 @@ class LoopStateEquation:
             raise ValueError("the link's velocity must be a state of the loop (G = P1 / (1 + "
                              "C P2) of relative degree >= 2)")
         ss = control.tf2ss(num / den[0], den / den[0])
-        A, T = matrix_balance(np.asarray(ss.A, dtype=float))
+        # scipy casts every balancing factor to an integer to read the permutation out of
+        # it; factors past 2**63 (a stage with several modes in companion form) warn in
+        # that cast, which only the permutation entries (none here) would use
+        with np.errstate(invalid="ignore"):
+            A, T = matrix_balance(np.asarray(ss.A, dtype=float))
         self.A = A
         self.B = np.linalg.solve(T, np.asarray(ss.B, dtype=float)).ravel()
         self.C = (np.asarray(ss.C, dtype=float) @ T).ravel()
