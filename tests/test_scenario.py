@@ -404,6 +404,55 @@ def test_leadlag_with_too_much_gain_is_rejected(write):
     assert "pole" in msg
 
 
+def _tf_with_leading_zeros(d: dict) -> None:
+    num, den = leadlag_coefficients()
+    d["controller"] = {"type": "tf", "num": [0, 0.0, *num], "den": [0.0, *den]}
+
+
+@pytest.mark.parametrize("edit", [
+    pytest.param(lambda d: None, id="table-i"),
+    pytest.param(lambda d: d["stage"].update(c1=30.0, c2=50.0), id="grounded"),
+    pytest.param(_tf_with_leading_zeros, id="tf-leading-zeros"),
+    pytest.param(lambda d: d.update(hysteresis={"model": "maxwell-slip", "k": [10.0, 6.0],
+                                                "fc": [0.01, 0.03]}), id="maxwell-slip"),
+    pytest.param(lambda d: d.update(stage={"type": "mass-spring-damper", "m": 22.5,
+                                           "c": 100.0, "k": 1e4}), id="mass-spring-damper"),
+    pytest.param(lambda d: d["controller"].update(flp=1e12), id="unstable-lowpass"),
+    pytest.param(lambda d: d["controller"].update(K=6.2e9), id="unstable-gain"),
+    pytest.param(lambda d: d["hysteresis"].update(k=2.2e8), id="unstable-stuck"),
+])
+def test_the_loop_is_checked_from_its_coefficients_as_the_loop_checks_itself(edit, request):
+    """Before python-control builds the loop, the scenario's coefficients give its poles
+    and its stability: the same numbers and the same refusal as the loop's own."""
+    from motionhyst.controllers.loop import Loop
+
+    d = paper_dict()
+    edit(d)
+    sc = Scenario.from_dict(d, check=False)
+    loop = Loop(sc.plant(), sc.controller(), sc.hysteresis())
+    try:
+        loop.check_stable()
+    except ValueError as exc:
+        assert request.node.callspec.id.startswith("unstable")
+        with pytest.raises(ScenarioError) as info:
+            sc.fastest_pole()
+        assert str(info.value) == f"<dict>: [controller]: {exc}"
+    else:
+        assert not request.node.callspec.id.startswith("unstable")
+        assert sc.fastest_pole() == float(np.max(np.abs(loop.closed_loop_poles())))
+
+
+def test_a_sampled_controller_or_a_measured_plant_has_its_poles_from_the_loop(tmp_path):
+    d = paper_dict()
+    d["controller"]["sample_rate_hz"] = 20e3
+    assert Scenario.from_dict(d).fastest_pole() is None
+    write_frd_csv(tmp_path / "plant.csv", np.geomspace(10.0, 3000.0, 200))
+    d = paper_dict()
+    d.pop("stage")
+    d["plant"] = {"file": "plant.csv"}
+    assert Scenario.from_dict(d, base_dir=tmp_path).fastest_pole() is None
+
+
 def test_tf_controller_accepts_leading_zeros_and_integers(write):
     num, den = leadlag_coefficients()
     d = paper_dict()

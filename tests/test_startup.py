@@ -150,6 +150,7 @@ def _refused_scenarios() -> dict[str, str]:
     head, tail = paper[:paper.index("[stage]")], paper[paper.index("[hysteresis]"):]
     return {
         "paper.toml": paper,
+        "unstable.toml": paper.replace("flp = 700.0", "flp = 1e12"),
         "open.toml": _bad_records()["stage.toml"],
         "plant-dir.toml": head + '[plant]\nfile = "pl"\n' + tail,
         "plant-text.toml": head + '[plant]\nfile = "plant.mat"\n' + tail,
@@ -171,7 +172,7 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     ([*SCAN, "--window", "1"], "exposure window (1 s) is longer than the scan"),
     ([*SCAN, "--time-series", "paper.toml"], "it is an input of this command"),
     (["scan", "paper.toml", "--length", "1e6", "--speed", "0.1", "--a-max", "10", "--j-max",
-      "1000", "--s-max", "1e6"], "time steps of 0.0001 s: too many"),
+      "1000", "--s-max", "1e6"], "time steps of 3.62e-05 s: too many"),
     (["simulate", "paper.toml", "--time-series", "o.csv", "--frequency", "5", "--duration",
       "1e9"], "too many time steps"),
     (["simulate", "paper.toml", "--time-series", "o.csv", "--profile", "point-to-point",
@@ -181,14 +182,18 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     (["analyze", "plant-dir.toml"], "[plant] file: cannot read pl: it is a folder"),
     (["analyze", "plant-text.toml"], "not a MATLAB .mat file (a text file)"),
     (["analyze", "plant-columns.toml"], "need columns"),
+    (["steady", "unstable.toml"], "does not stabilise the loop (closed-loop pole at 22.94"),
+    (["stability", "unstable.toml"], "does not stabilise the loop"),
+    ([*SCAN, "--rate", "1e-3"], "248898681 time steps of 3.62e-05 s: too many"),  # the poles'
     (["stability", "open.toml"], "needs a closed loop"),
     (["analyze", "open.toml"], "needs a closed loop"),
     (["steady", "open.toml"], "needs a closed loop"),
     (["predict", "paper.toml", "f.csv", "--out", "p.csv"], "an open-loop system needs"),
 ])
 def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, argv, error):
-    """Options, outputs, files and sizes known from the command line and the scenario are
-    refused before the loop is built (python-control) or anything is fitted."""
+    """Options, outputs, files and sizes known from the command line and the scenario (an
+    unstable loop, a step its poles set: from its coefficients) are refused before the loop
+    is built (python-control) or anything is fitted."""
     (tmp_path / "pl").mkdir()
     for name, text in _refused_scenarios().items():
         (tmp_path / name).write_text(text)

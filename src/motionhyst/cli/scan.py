@@ -182,19 +182,23 @@ def _profiles(args: argparse.Namespace):
 
 
 def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
-    """Refuse a scan of far too many time steps before its loop is built: the step is
-    at most the sampled controller's period or the setpoint's (:func:`longest_step`)."""
-    from motionhyst.time.steps import check_scan_steps, longest_step
+    """Refuse a scan of far too many time steps before its loop is built: the step is the
+    loop's own where its coefficients give its poles (:func:`pole_step`; an unstable loop
+    is refused there), else at most the sampled controller's period or the setpoint's
+    (:func:`longest_step`)."""
+    from motionhyst.time.steps import check_scan_steps, longest_step, pole_step
 
     controller = sc.model.controller
     if controller is None:  # no loop: the scenario's own refusal comes first
         return
     rate = getattr(controller, "sample_rate_hz", None)
+    pole = sc.fastest_pole() if rate is None else None
     runs = len(args.compensation or ["none", "ilc", "basis"])  # model: only with a model
     for p in (profile, other):
         if p is not None:
-            step = longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
-            check_scan_steps(p.end + args.tail, step, runs, at_least=True)
+            step = (longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
+                    if pole is None else pole_step(pole, p.max_frequency_hz))
+            check_scan_steps(p.end + args.tail, step, runs, at_least=pole is None)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -88,11 +88,13 @@ def _reference(args: argparse.Namespace, sc):
 
 
 def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> None:
-    """Refuse a run of far too many rows or steps before its loop is built: the step is at
-    most the sampled controller's period or the reference's
-    (:func:`~motionhyst.time.steps.longest_step`; a file's samples do not set it)."""
+    """Refuse a run of far too many rows or steps before its loop is built: the step is the
+    loop's own where its coefficients give its poles (:func:`~motionhyst.time.steps.pole_step`;
+    an unstable loop is refused there), else at most the sampled controller's period or the
+    reference's (:func:`~motionhyst.time.steps.longest_step`; a file's samples do not set
+    it)."""
     from motionhyst.time.references import SampledReference
-    from motionhyst.time.steps import longest_step, time_series_grid
+    from motionhyst.time.steps import longest_step, pole_step, time_series_grid
     from motionhyst.time.timeseries import DEFAULT_OUTPUT_RATE_HZ, reference_rate_hz
 
     controller = sc.model.controller
@@ -103,9 +105,13 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> None:
     output_rate = args.output_rate or rate or (reference_rate_hz(ref) if sampled
                                                else DEFAULT_OUTPUT_RATE_HZ)
     f = 0.0 if sampled else float(getattr(ref, "max_frequency_hz", 0.0) or 0.0)
-    step = (math.inf if f <= 0 and rate is None
-            else longest_step(f, None if rate is None else 1.0 / rate))
-    time_series_grid(duration, output_rate, step, rate, at_least=rate is None)
+    pole = sc.fastest_pole() if rate is None else None
+    if pole is not None:
+        step = pole_step(pole, f)
+    else:
+        step = (math.inf if f <= 0 and rate is None
+                else longest_step(f, None if rate is None else 1.0 / rate))
+    time_series_grid(duration, output_rate, step, rate, at_least=rate is None and pole is None)
 
 
 def _time_series(args: argparse.Namespace, sc) -> int:

@@ -6,6 +6,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
+from motionhyst.controllers.characteristic import leadlag_coefficients
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.hysteresis.base import check_positive
 
@@ -49,10 +50,7 @@ class LeadLagLowpass(control.TransferFunction):
         self.f2 = check_positive("f2", f2)
         self.flp = check_positive("flp", flp)
         self.beta = check_positive("beta", beta)
-        w1, w2, wl = TWO_PI * self.f1, TWO_PI * self.f2, TWO_PI * self.flp
-        num = np.polymul([1.0, w1], [self.K * (self.f2 / self.f1) * wl**2])
-        den = np.polymul([1.0, w2], [1.0, 2.0 * self.beta * wl, wl**2])
-        super().__init__(num, den)
+        super().__init__(*leadlag_coefficients(self.K, self.f1, self.f2, self.flp, self.beta))
 
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""

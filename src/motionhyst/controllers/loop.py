@@ -40,10 +40,16 @@ import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.controllers.characteristic import (
+    characteristic,
+    check_stable,
+    strictly_proper,
+    stuck_characteristic,
+)
 from motionhyst.controllers.feedforward import Feedforward
 from motionhyst.controllers.leadlag import bandwidth
 from motionhyst.controllers.sampled import SampledController, polyval_zinv
-from motionhyst.core.lti import PolyTF, cancel_s, freqresp, polysub_exact, tf_poly, trim
+from motionhyst.core.lti import PolyTF, cancel_s, freqresp, polysub_exact, tf_poly
 from motionhyst.core.sampling import ZohEquivalent, hold_mismatch, hold_response
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.plants import PLANTS, Plant, TransferPlant
@@ -176,10 +182,10 @@ class Loop:
         n1, d1 = tf_poly(self.P1)
         n2, d2 = tf_poly(self.P2)
         nc, dc = tf_poly(self.controller)
-        if trim(np.polymul(n2, nc)).size >= trim(np.polymul(d2, dc)).size:
+        if not strictly_proper(n2, d2, nc, dc):
             raise ValueError("the loop gain C P2 must be strictly proper (a pure derivative "
                              "needs a plant that falls at least twice as fast)")
-        char = np.polyadd(np.polymul(d2, dc), np.polymul(n2, nc))  # (1 + C P2) d2 dc
+        char = characteristic(n2, d2, nc, dc)  # (1 + C P2) d2 dc
         if self.ff is not None:
             # 1 - P2 C_ff = (d2 - C_ff n2) / d2; C + C_ff = (nc + C_ff dc) / dc,
             # C_ff = cs s^4 + cj s^3 + m s^2 + c s (m = M: the paper's rigid-body feedforward)
@@ -192,7 +198,7 @@ class Loop:
         out = {
             "r->e": cancel_s(np.polymul(ff_num, dc), char),
             "r->y1": cancel_s(np.polymul(np.polymul(n1, d2), cff), np.polymul(d1, char)),
-            "w->e": cancel_s(np.polymul(n2, dc), char),
+            "w->e": cancel_s(np.polymul(n2, dc), char),  # as loop_denominator
             "w->y1": cancel_s(-np.polymul(np.polymul(n1, d2), dc), np.polymul(d1, char)),
             "f->e": cancel_s(-np.polymul(n2, dc), char),
             "f->y1": cancel_s(np.polymul(np.polymul(n1, d2), dc), np.polymul(d1, char)),
@@ -293,26 +299,14 @@ class Loop:
             return
         if self._poly is None:
             return
-        cases = [("", self._poly["w->e"].den)]
+        stuck = None
         if self.hysteresis is not None:
-            # stuck link, w = kJ y1: characteristic polynomial of 1 + kJ P1 + C P2, over a
-            # common denominator of P1 and P2 (shared by both for a two-mass stage)
             n1, d1 = tf_poly(self.P1)
             n2, d2 = tf_poly(self.P2)
             nc, dc = tf_poly(self.controller)
-            kj = self.hysteresis.initial_stiffness
-            if d1.shape == d2.shape and np.array_equal(d1, d2):
-                n1c, n2c, d = n1, n2, d1
-            else:
-                n1c, n2c, d = np.polymul(n1, d2), np.polymul(n2, d1), np.polymul(d1, d2)
-            stuck = np.polyadd(np.polymul(np.polyadd(d, kj * n1c), dc), np.polymul(n2c, nc))
-            cases.append((" with the dynamic link stuck", stuck))
-        for what, den in cases:
-            p = np.roots(trim(den))
-            if p.size and np.max(p.real) >= 0:
-                worst = p[np.argmax(p.real)]
-                raise ValueError(f"the controller does not stabilise the loop{what} "
-                                 f"(closed-loop pole at {worst.real:.4g}{worst.imag:+.4g}j rad/s)")
+            stuck = stuck_characteristic(n1, d1, n2, d2, nc, dc,
+                                         self.hysteresis.initial_stiffness)
+        check_stable(self._poly["w->e"].den, stuck)
 
     def bandwidth_hz(self) -> float:
         """First 0 dB crossing of ``C P2`` [Hz] (of ``Y(z) G_d(z)`` for a sampled controller)."""

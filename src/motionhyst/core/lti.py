@@ -29,6 +29,7 @@ from scipy.linalg import expm, solve
 from scipy.signal import cont2discrete, zpk2ss
 
 from motionhyst.core.compiled import njit
+from motionhyst.core.polynomials import cancel_s, trim
 
 __all__ = ["HoldFilter", "PolyTF", "cancel_s", "discretize_foh", "divide_s2", "dss_filter",
            "expm_small", "forced_response_foh", "polyratio", "polysub_exact", "realize_scaled",
@@ -96,25 +97,6 @@ def freqresp(sys, omega: ArrayLike) -> NDArray[np.complex128]:
 
 
 
-def trim(p: ArrayLike) -> NDArray[np.float64]:
-    """Drop leading coefficients that are exactly zero.
-
-    Parameters
-    ----------
-    p : array_like
-        Coefficients, highest power first.
-
-    Examples
-    --------
-    >>> from motionhyst.core.lti import trim
-    >>> trim([0.0, 0.0, 1.0, 2.0])
-    array([1., 2.])
-    """
-    p = np.atleast_1d(np.asarray(p, dtype=float))
-    nz = np.nonzero(p != 0.0)[0]
-    return p[nz[0]:] if nz.size else np.zeros(1)
-
-
 def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np.float64]:
     """``a - b`` with coefficients that cancel to round-off set to exactly zero.
 
@@ -141,28 +123,6 @@ def polysub_exact(a: ArrayLike, b: ArrayLike, rtol: float = 1e-12) -> NDArray[np
     d = a - b
     d[np.abs(d) <= rtol * np.maximum(np.abs(a), np.abs(b))] = 0.0
     return d
-
-
-def cancel_s(num: ArrayLike, den: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Cancel common factors ``s`` (trailing zero coefficients) of a ratio.
-
-    Parameters
-    ----------
-    num : array_like
-        Numerator coefficients, highest power first.
-    den : array_like
-        Denominator coefficients, highest power first.
-
-    Examples
-    --------
-    >>> from motionhyst.core.lti import cancel_s
-    >>> cancel_s([1.0, 0.0], [1.0, 2.0, 0.0])               # s / (s^2 + 2 s) = 1 / (s + 2)
-    (array([1.]), array([1., 2.]))
-    """
-    num, den = trim(num), trim(den)
-    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
-        num, den = num[:-1], den[:-1]
-    return num, den
 
 
 def divide_s2(num: ArrayLike, den: ArrayLike, what: str

@@ -72,12 +72,26 @@ class MassSpringDamper(LumpedPlant):
         """``c / (2 sqrt(k m))`` [-] (inf for ``k = 0``)."""
         return self.c / (2 * math.sqrt(self.k * self.m)) if self.k > 0 else math.inf
 
+    def polynomials(self) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                   NDArray[np.float64]]:
+        """Numerators of :attr:`P1` and :attr:`P2` (one mass: the same) and their denominator
+        ``m s^2 + c s + k`` (highest power first), known without python-control.
+
+        Examples
+        --------
+        >>> from motionhyst.plants import MassSpringDamper
+        >>> [p.tolist() for p in MassSpringDamper(m=2.0, c=10.0, k=5e4).polynomials()]
+        [[1.0], [1.0], [2.0, 10.0, 50000.0]]
+        """
+        return np.ones(1), np.ones(1), np.array([self.m, self.c, self.k])
+
     @property
     def P1(self) -> Any:
         """``y / (u - w) = 1 / (m s^2 + c s + k)`` (the link acts on the measured mass)."""
         import control
 
-        return control.tf([1.0], [self.m, self.c, self.k])
+        num, _, den = self.polynomials()
+        return control.tf(num, den)
 
     @property
     def P2(self) -> Any:

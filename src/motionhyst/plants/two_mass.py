@@ -129,8 +129,18 @@ class TwoMassStage:
         """True if a damper connects a mass to the ground (``c1`` or ``c2`` > 0)."""
         return self.c1 > 0 or self.c2 > 0
 
-    def _polys(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Numerators of ``P1``, ``P2`` and their common denominator (highest power first)."""
+    def polynomials(self) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                   NDArray[np.float64]]:
+        """Numerators of ``P1``, ``P2`` and their common denominator (highest power first),
+        eq. (1): the coefficients of :attr:`P1` and :attr:`P2`, known without python-control.
+
+        Examples
+        --------
+        >>> from motionhyst import TwoMassStage
+        >>> n1, n2, den = TwoMassStage(m1=1.0, m2=2.0, b=0.0, k=3.0).polynomials()
+        >>> n1.tolist(), n2.tolist(), den.tolist()    # (2 s^2 + 3) / (2 s^4 + 9 s^2), ...
+        ([2.0, 0.0, 3.0], [0.0, 3.0], [2.0, 0.0, 9.0, 0.0, 0.0])
+        """
         m1, m2, b, k = self.m1, self.m2, self.b, self.k
         if not self.grounded:  # eq. (1) as the paper writes it
             den = np.array([m1 * m2, b * self.M, k * self.M, 0.0, 0.0])
@@ -185,7 +195,7 @@ class TwoMassStage:
         """Collocated transfer ``y1 / (u - w) = Pr + Pf1``, eq. (1)."""
         import control
 
-        num, _, den = self._polys()
+        num, _, den = self.polynomials()
         return control.tf(num, den)
 
     @property
@@ -193,7 +203,7 @@ class TwoMassStage:
         """Non-collocated transfer ``y2 / (u - w) = Pr - Pf2``, eq. (1)."""
         import control
 
-        _, num, den = self._polys()
+        _, num, den = self.polynomials()
         return control.tf(num, den)
 
     @property

@@ -17,8 +17,18 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import ValidationError
 
+from motionhyst.controllers.characteristic import (
+    as_transfer,
+    check_stable,
+    leadlag_coefficients,
+    loop_denominator,
+    strictly_proper,
+    stuck_characteristic,
+)
 from motionhyst.core.validation import check_magnitudes
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.io.inputs import TOML_EXPANSION, input_problem
@@ -325,6 +335,63 @@ class Scenario:
             out = {k: getattr(inverse, k) if v == "plant" else v for k, v in out.items()}
         return out
 
+    def _coefficients(self) -> tuple[NDArray[np.float64], ...] | None:
+        """``n1, d1, n2, d2, nc, dc`` of ``P1``, ``P2`` and the controller as the loop will
+        hold them, where they are known without python-control: a ``[stage]`` that gives its
+        polynomials and a continuous lead-lag or ``"tf"`` controller; else None."""
+        m = self.model
+        c = m.controller
+        if m.stage is None or c.sample_rate_hz is not None or \
+                c.type not in ("leadlag-lowpass", "tf"):
+            return None
+        plant = self.plant()
+        if not hasattr(plant, "polynomials") or plant.force_offset or \
+                getattr(plant, "force_drift", 0.0):
+            return None  # the loop's own errors come first
+        n1, n2, den = plant.polynomials()
+        (n1, d1), (n2, d2) = as_transfer(n1, den), as_transfer(n2, den)
+        nc, dc = as_transfer(*(leadlag_coefficients(c.K, c.f1, c.f2, c.flp, c.beta)
+                               if c.type == "leadlag-lowpass" else (c.num, c.den)))
+        if not strictly_proper(n2, d2, nc, dc):
+            return None
+        return n1, d1, n2, d2, nc, dc
+
+    def _checked_denominator(self) -> NDArray[np.float64] | None:
+        """The loop's characteristic polynomial (:func:`loop_denominator`), its stability
+        checked as :meth:`Loop.check_stable` does, from the coefficients alone; None where
+        python-control is needed for them (:meth:`_coefficients`)."""
+        self._closed("this")
+        coefficients = self._coefficients()
+        if coefficients is None:
+            return None
+        n1, d1, n2, d2, nc, dc = coefficients
+        link = self.hysteresis()
+        den = loop_denominator(n2, d2, nc, dc)
+        try:
+            check_stable(den, None if link is None else stuck_characteristic(
+                n1, d1, n2, d2, nc, dc, link.initial_stiffness))
+        except ValueError as exc:
+            raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
+        return den
+
+    def fastest_pole(self) -> float | None:
+        """The largest magnitude of the loop's closed-loop poles [rad/s]
+        (:meth:`Loop.closed_loop_poles`), known before the loop is built where the
+        coefficients give it (a ``[stage]`` and a continuous lead-lag or ``"tf"``
+        controller), else None.  Raises :class:`ScenarioError` if the loop is unstable.
+
+        Examples
+        --------
+        >>> from motionhyst import default_scenario
+        >>> sc = default_scenario(check=False)
+        >>> print(f"{sc.fastest_pole():.4g} rad/s")             # python-control not loaded
+        4344 rad/s
+        >>> bool(abs(max(abs(sc.loop().closed_loop_poles())) - sc.fastest_pole()) == 0)
+        True
+        """
+        den = self._checked_denominator()
+        return None if den is None else float(np.max(np.abs(np.roots(den))))
+
     def loop(self) -> Loop:
         """The loop (built once, checked for stability)."""
         self._closed("this")
@@ -341,6 +408,7 @@ class Scenario:
                                  advance_samples=sec.advance_samples or 0.0,
                                  **self._derivative_terms(sec))
             hff = sec.hysteresis
+            self._checked_denominator()  # stable, from the coefficients: before python-control
             # each part's own errors name their section: only the loop's are [controller]'s
             parts = (self.plant(), self.controller(), self.hysteresis())
             hff = None if hff is None else build_hysteresis(hff)

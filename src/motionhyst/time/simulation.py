@@ -24,7 +24,6 @@ from numpy.typing import NDArray
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import check_memory, check_work
 from motionhyst.core.lti import (
-    TWO_PI,
     FohResponse,
     discretize_foh,
     divide_s2,
@@ -40,11 +39,7 @@ from motionhyst.time.engine import FohStep, LoopState, run_steps
 from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS
 from motionhyst.time.sampled import simulate_sampled
 from motionhyst.time.simulation_result import Simulation
-from motionhyst.time.steps import (
-    BYTES_PER_SAMPLE,
-    STEPS_PER_POLE_PERIOD,
-    STEPS_PER_REFERENCE_PERIOD,
-)
+from motionhyst.time.steps import BYTES_PER_SAMPLE, pole_step
 
 __all__ = ["SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "Simulation", "check_run_work",
            "simulate", "simulate_chunks"]
@@ -136,9 +131,7 @@ def default_step(loop: Loop, max_frequency_hz: float) -> float:
     """
     if loop.sampled is not None:
         return loop.sampled.period
-    p = float(np.max(np.abs(loop.closed_loop_poles())))
-    return float(min(TWO_PI / (STEPS_PER_POLE_PERIOD * p),
-                     1.0 / (STEPS_PER_REFERENCE_PERIOD * max_frequency_hz)))
+    return pole_step(float(np.max(np.abs(loop.closed_loop_poles()))), max_frequency_hz)
 
 
 def simulate(loop: Loop, reference, duration: float, dt: float | None = None,

@@ -8,7 +8,9 @@ the controller's period are known before the loop is built (python-control):
 :func:`longest_step` bounds the step from above with them alone, so a run of far
 too many steps is refused at once (:func:`check_scan_steps`,
 :func:`time_series_grid` with ``at_least``), and again with the loop's own step
-once the loop is built.
+once the loop is built.  Where a scenario's coefficients give its poles before the
+loop is built (:meth:`motionhyst.scenario.Scenario.fastest_pole`), :func:`pole_step` is
+the run's own step, and the checks are exact.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from motionhyst.core.budget import check_memory
 
 __all__ = ["BYTES_PER_SAMPLE", "MAX_ROWS", "MAX_SCAN_STEPS", "MAX_STEPS", "SCAN_REMEDY",
            "STEPS_PER_POLE_PERIOD", "STEPS_PER_REFERENCE_PERIOD", "check_scan_steps",
-           "longest_step", "time_series_grid"]
+           "longest_step", "pole_step", "time_series_grid"]
 
 STEPS_PER_POLE_PERIOD = 40
 """Time steps per period of the loop's fastest closed-loop pole."""
@@ -42,6 +44,31 @@ step)."""
 
 SCAN_REMEDY = "shorten the setpoint (its length, dwell) or the tail after it, or raise the speed"
 """What a scan refused for its size can change."""
+
+
+def pole_step(fastest_pole: float, max_frequency_hz: float = 0.0) -> float:
+    """A continuous loop's step [s]: its fastest closed-loop pole resolved in
+    :data:`STEPS_PER_POLE_PERIOD` steps, the reference's highest frequency (if any) in
+    :data:`STEPS_PER_REFERENCE_PERIOD`.
+
+    Parameters
+    ----------
+    fastest_pole : float
+        The largest magnitude of the loop's closed-loop poles [rad/s], > 0
+        (:meth:`motionhyst.scenario.Scenario.fastest_pole`, known before the loop is built).
+    max_frequency_hz : float
+        The reference's highest frequency [Hz]; 0: none sets the step.
+
+    Examples
+    --------
+    >>> print(f"{pole_step(4344.0, 5.0):.3g} s")             # Table I's loop: the pole sets it
+    3.62e-05 s
+    >>> pole_step(1.0, 25.0)                                  # a slow loop: the reference does
+    0.0001
+    """
+    h = math.tau / (STEPS_PER_POLE_PERIOD * fastest_pole)
+    return min(h, 1.0 / (STEPS_PER_REFERENCE_PERIOD * max_frequency_hz)) if max_frequency_hz > 0 \
+        else h
 
 
 def longest_step(max_frequency_hz: float, sample_period: float | None = None) -> float:

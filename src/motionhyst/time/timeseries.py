@@ -25,11 +25,7 @@ from numpy.typing import NDArray
 
 from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
-from motionhyst.time.steps import (
-    STEPS_PER_POLE_PERIOD,
-    STEPS_PER_REFERENCE_PERIOD,
-    time_series_grid,
-)
+from motionhyst.time.steps import pole_step, time_series_grid
 
 if TYPE_CHECKING:  # the simulation (python-control, numba) loads when a run starts: the
     # command's checks of its run (time_series_grid) come before it
@@ -77,13 +73,9 @@ def dynamics_step(loop: Loop, reference) -> float:
     """
     if loop.sampled is not None:
         return loop.sampled.period
-    p = float(np.max(np.abs(loop.closed_loop_poles())))
-    h = math.tau / (STEPS_PER_POLE_PERIOD * p)
-    if not isinstance(reference, SampledReference):
-        f = float(getattr(reference, "max_frequency_hz", 0.0) or 0.0)
-        if f > 0:
-            h = min(h, 1.0 / (STEPS_PER_REFERENCE_PERIOD * f))
-    return h
+    f = 0.0 if isinstance(reference, SampledReference) else float(
+        getattr(reference, "max_frequency_hz", 0.0) or 0.0)
+    return pole_step(float(np.max(np.abs(loop.closed_loop_poles()))), f)
 
 
 def reference_rate_hz(reference: SampledReference) -> float:
