@@ -442,6 +442,34 @@ def test_the_loop_is_checked_from_its_coefficients_as_the_loop_checks_itself(edi
         assert sc.fastest_pole() == float(np.max(np.abs(loop.closed_loop_poles())))
 
 
+@pytest.mark.parametrize("layout", ["one-line", "with-comment", "dict"])
+def test_a_list_longer_than_a_scenario_holds_is_refused_naming_it(write, monkeypatch, layout):
+    """Counted in the text before it is parsed (one line, or a trailing comma) or once
+    parsed (an array with a comment, a dictionary): the same one line."""
+    from motionhyst.scenario import schema
+
+    monkeypatch.setattr(schema, "MAX_VALUES", 10)
+    d = paper_dict()
+    d["hysteresis"] = {"model": "maxwell-slip", "k": [1.0] * 10, "fc": [0.01] * 10}
+    assert Scenario.from_file(write(d)).hysteresis().k.size == 10  # at the limit: read
+    d["hysteresis"]["fc"] = [0.01] * 11
+    if layout == "dict":
+        with pytest.raises(ScenarioError) as info:
+            Scenario.from_dict(d, source="from-a-dict")
+        assert_one_line(info.value, "from-a-dict", "[hysteresis] fc: 11 values, more than the "
+                        "10 a list of a scenario may hold")
+        return
+    text = dump_toml(d)
+    long = "fc = [" + ", ".join(["0.01"] * 11) + "]"
+    assert long in text
+    text = text.replace(long, long[:-1] + (",\n  # the last\n]" if layout == "with-comment"
+                                           else ",]"))
+    path = write(text)
+    if layout == "one-line":  # refused before the text is parsed
+        monkeypatch.setattr(schema.tomllib, "loads", lambda text: pytest.fail("parsed"))
+    assert_one_line(load_error(path), path, "[hysteresis] fc: 11 values, more than the 10")
+
+
 def test_a_sampled_controller_or_a_measured_plant_has_its_poles_from_the_loop(tmp_path):
     d = paper_dict()
     d["controller"]["sample_rate_hz"] = 20e3

@@ -151,6 +151,9 @@ def _refused_scenarios() -> dict[str, str]:
     return {
         "paper.toml": paper,
         "unstable.toml": paper.replace("flp = 700.0", "flp = 1e12"),
+        "slip.toml": paper.replace('model = "jenkins"', 'model = "maxwell-slip"').replace(
+            "k = 20.0 ", "k = [" + "1.0," * 100_001 + "] ").replace(
+            "fc = 0.05 ", "fc = [" + "0.01," * 100_001 + "] "),
         "open.toml": _bad_records()["stage.toml"],
         "plant-dir.toml": head + '[plant]\nfile = "pl"\n' + tail,
         "plant-text.toml": head + '[plant]\nfile = "plant.mat"\n' + tail,
@@ -185,6 +188,7 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     (["steady", "unstable.toml"], "does not stabilise the loop (closed-loop pole at 22.94"),
     (["stability", "unstable.toml"], "does not stabilise the loop"),
     ([*SCAN, "--rate", "1e-3"], "248898681 time steps of 3.62e-05 s: too many"),  # the poles'
+    (["steady", "slip.toml"], "[hysteresis] k: 100001 values, more than the 100000"),
     (["stability", "open.toml"], "needs a closed loop"),
     (["analyze", "open.toml"], "needs a closed loop"),
     (["steady", "open.toml"], "needs a closed loop"),

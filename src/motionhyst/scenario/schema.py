@@ -12,6 +12,7 @@ builds the loop, the plant, the link and the reference.
 from __future__ import annotations
 
 import dataclasses
+import re
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -42,8 +43,17 @@ from motionhyst.scenario.sections import (
 )
 from motionhyst.scenario.sections import hysteresis_from_dict as hysteresis_from_dict
 
-__all__ = ["Scenario", "ScenarioError", "default_scenario", "default_scenario_path",
-           "hysteresis_from_dict", "load_scenario"]
+__all__ = ["MAX_VALUES", "Scenario", "ScenarioError", "default_scenario",
+           "default_scenario_path", "hysteresis_from_dict", "load_scenario"]
+
+MAX_VALUES = 100_000
+"""Most values one list of a scenario holds (a Maxwell-slip link's elements, the reference's
+frequencies): reading and checking a value takes some microseconds, and every computation
+grows with them (the monodromy of a link of ``m`` elements as ``m^2``); a longer list is
+refused before the file is parsed."""
+
+#: a TOML array of numbers (no nested array, string or comment): ``key = [1.0, 2.0, ...]``
+_ARRAY = re.compile(r"=[ \t]*\[([^\[\]]*)\]")
 
 if TYPE_CHECKING:  # imported where used: validating a file needs neither python-control nor scipy
     import control
@@ -116,6 +126,7 @@ class Scenario:
         check : bool
             Build the loop and check that it is stable (a :class:`ScenarioError` if not).
         """
+        _check_list_lengths(data, source)
         try:
             check_magnitudes(data)  # 1e300 or 1e-300 would give inf and NaN, not an answer
         except ValueError as exc:
@@ -152,6 +163,7 @@ class Scenario:
             raise ScenarioError(f"{path}: cannot read ({exc.strerror})") from None
         except UnicodeDecodeError:
             raise ScenarioError(f"{path}: not a text file (TOML must be UTF-8)") from None
+        _check_array_lengths(text, str(path))
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
@@ -356,16 +368,12 @@ class Scenario:
             return None
         return n1, d1, n2, d2, nc, dc
 
-    def _checked_denominator(self) -> NDArray[np.float64] | None:
-        """The loop's characteristic polynomial (:func:`loop_denominator`), its stability
-        checked as :meth:`Loop.check_stable` does, from the coefficients alone; None where
-        python-control is needed for them (:meth:`_coefficients`)."""
-        self._closed("this")
-        coefficients = self._coefficients()
-        if coefficients is None:
-            return None
+    def _checked_denominator(self, coefficients: tuple[NDArray[np.float64], ...],
+                             link: Hysteresis | None) -> NDArray[np.float64]:
+        """The loop's characteristic polynomial (:func:`loop_denominator`) from its
+        `coefficients` (:meth:`_coefficients`), its stability with `link` checked as
+        :meth:`Loop.check_stable` does."""
         n1, d1, n2, d2, nc, dc = coefficients
-        link = self.hysteresis()
         den = loop_denominator(n2, d2, nc, dc)
         try:
             check_stable(den, None if link is None else stuck_characteristic(
@@ -389,8 +397,12 @@ class Scenario:
         >>> bool(abs(max(abs(sc.loop().closed_loop_poles())) - sc.fastest_pole()) == 0)
         True
         """
-        den = self._checked_denominator()
-        return None if den is None else float(np.max(np.abs(np.roots(den))))
+        self._closed("this")
+        coefficients = self._coefficients()
+        if coefficients is None:
+            return None
+        den = self._checked_denominator(coefficients, self.hysteresis())
+        return float(np.max(np.abs(np.roots(den))))
 
     def loop(self) -> Loop:
         """The loop (built once, checked for stability)."""
@@ -408,9 +420,14 @@ class Scenario:
                                  advance_samples=sec.advance_samples or 0.0,
                                  **self._derivative_terms(sec))
             hff = sec.hysteresis
-            self._checked_denominator()  # stable, from the coefficients: before python-control
             # each part's own errors name their section: only the loop's are [controller]'s
-            parts = (self.plant(), self.controller(), self.hysteresis())
+            coefficients = self._coefficients()
+            if coefficients is None:
+                parts = (self.plant(), self.controller(), self.hysteresis())
+            else:  # stable, from the coefficients: checked before python-control loads
+                link = self.hysteresis()
+                self._checked_denominator(coefficients, link)
+                parts = (self.plant(), self.controller(), link)
             hff = None if hff is None else build_hysteresis(hff)
             from motionhyst.controllers.loop import Loop  # once the parts' files are read
 
@@ -436,6 +453,38 @@ class Scenario:
     def to_dict(self) -> dict:
         """The validated scenario as a dictionary."""
         return self.model.model_dump(exclude_none=True)
+
+
+def _too_many(source: str, where: str, n: int) -> ScenarioError:
+    return ScenarioError(f"{source}: {where}: {n} values, more than the {MAX_VALUES} a list of "
+                         f"a scenario may hold (every computation grows with them); give "
+                         f"fewer (a link of fewer elements)")
+
+
+def _check_array_lengths(text: str, source: str) -> None:
+    """Refuse an array of more than :data:`MAX_VALUES` numbers in a scenario's text, before it
+    is parsed (a million numbers take seconds to parse and check): counted by their commas,
+    in arrays that hold no string or comment (any other is counted once parsed)."""
+    for m in _ARRAY.finditer(text):
+        body = m.group(1)
+        if len(body) <= 2 * MAX_VALUES or any(c in body for c in "\"'#"):
+            continue  # too short to hold that many (a value and a comma each), or not plain
+        n = body.count(",") + (not body.rstrip().endswith(","))
+        if n > MAX_VALUES:
+            line = text.rfind("\n", 0, m.start()) + 1
+            table = re.findall(r"^[ \t]*(\[[^\[\]\n]+\])", text[:line], re.M)
+            key = text[line:m.start()].strip()
+            raise _too_many(source, f"{table[-1] + ' ' if table else ''}{key}", n)
+
+
+def _check_list_lengths(data: dict, source: str, where: str = "") -> None:
+    """Refuse a list of more than :data:`MAX_VALUES` values in the parsed tables `data`."""
+    for key, value in data.items():
+        name = f"{where} {key}".strip() if where else f"[{key}]"
+        if isinstance(value, dict):
+            _check_list_lengths(value, source, name)
+        elif isinstance(value, list) and len(value) > MAX_VALUES:
+            raise _too_many(source, name, len(value))
 
 
 def default_scenario_path() -> Path:
