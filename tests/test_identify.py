@@ -345,6 +345,41 @@ def test_count_reversals():
     assert count_reversals(ramp) == 0  # noise below the band is not a reversal
 
 
+def test_a_record_is_refused_for_no_reversal_exactly_when_the_count_finds_none():
+    """The reader's check (numpy alone, no compiled kernel) agrees with count_reversals on
+    random walks, noise, noisy ramps and ramps that turn back by about the band."""
+    rng = np.random.default_rng(SEED)
+    seen = set()
+    for trial in range(400):
+        n = 50 + int(rng.integers(0, 40))
+        kind = trial % 4
+        if kind == 0:
+            x = np.cumsum(rng.standard_normal(n))
+        elif kind == 1:
+            x = np.round(rng.standard_normal(n), 1)
+        elif kind == 2:
+            noise = rng.choice([0.0, 1e-3, 1e-2])
+            x = np.sort(rng.standard_normal(n)) + noise * rng.standard_normal(n)
+        else:
+            back = rng.choice([0.005, 0.01, 0.0100001, 0.02])  # the band: 1 % of the range
+            x = np.concatenate([np.linspace(0.0, 1.0, n), [1.0 - back / 2, 1.0 - back]])
+        record = np.column_stack([np.arange(x.size) / 100.0, x, np.cos(np.arange(x.size))])
+        turns = count_reversals(x) >= 1
+        seen.add(turns)
+        if turns:
+            load_force_displacement_csv(record)
+        else:
+            with pytest.raises(ValueError, match="no reversal"):
+                load_force_displacement_csv(record)
+    assert seen == {True, False}
+
+
+def test_a_constant_force_is_refused_when_the_record_is_read():
+    x = np.sin(np.linspace(0.0, 4 * np.pi, 200))
+    with pytest.raises(ValueError, match="no hysteresis found: the force is constant"):
+        load_force_displacement_csv(np.column_stack([np.arange(200) / 100.0, x, 0.0 * x]))
+
+
 # --------------------------------------------------------------------------- CSV
 
 

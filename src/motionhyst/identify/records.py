@@ -88,6 +88,23 @@ def count_reversals(x: ArrayLike, band: float | None = None) -> int:
     return int(_count_reversals(xs, float(band)))
 
 
+def _reverses(x: NDArray[np.float64]) -> bool:
+    """``count_reversals(x) >= 1``, with numpy alone (a record's check imports no compiler):
+    once `x` has left its first band (up from its running minimum, or down from its
+    running maximum, as the count decides), does it retreat by more than the band from its
+    running extreme?"""
+    band = REVERSAL_BAND * float(np.ptp(x))
+    up = np.flatnonzero(x - np.minimum.accumulate(x) > band)
+    down = np.flatnonzero(np.maximum.accumulate(x) - x > band)
+    if up.size == 0 and down.size == 0:
+        return False
+    if down.size == 0 or (up.size and up[0] <= down[0]):  # moving up first (the count's order)
+        seg = x[up[0]:]
+        return bool(np.any(np.maximum.accumulate(seg) - seg > band))
+    seg = x[down[0]:]
+    return bool(np.any(seg - np.minimum.accumulate(seg) > band))
+
+
 def check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
                   xname: str = "displacement") -> None:
     """``ValueError`` (one line, no file) for records that cannot be identified from."""
@@ -108,7 +125,7 @@ def check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
         raise ValueError(f"time must be strictly increasing (sample {i + 1})")
     if not np.ptp(x) > 0:
         raise ValueError(f"constant {xname}: nothing to identify from")
-    if count_reversals(x) < 1:
+    if not _reverses(x):
         raise ValueError(f"no reversal: the {xname} must move back and forth at least once")
 
 
@@ -155,7 +172,7 @@ def load_force_displacement_csv(source: Source, *, columns: dict[str, str] | Non
         With one line naming the file: unreadable, missing column, non-numeric
         or non-finite value, rows of inconsistent length, fewer than
         ``MIN_SAMPLES`` samples, time not strictly increasing, constant
-        displacement, or no reversal of the displacement.
+        displacement or force, or no reversal of the displacement.
 
     Examples
     --------
@@ -173,7 +190,10 @@ def load_force_displacement_csv(source: Source, *, columns: dict[str, str] | Non
     >>> t.size, float(w.max())
     (1001, 0.05)
     """
-    return _load(source, ("time", "displacement", "force"), "displacement", columns, scale)
+    t, x, w = _load(source, ("time", "displacement", "force"), "displacement", columns, scale)
+    if not np.ptp(w) > 0:  # said before a fit is loaded, which would find no stop operator
+        raise ValueError(f"{describe(source)}: no hysteresis found: the force is constant")
+    return t, x, w
 
 
 def load_closed_loop_csv(source: Source, *, columns: dict[str, str] | None = None,
