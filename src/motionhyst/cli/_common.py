@@ -36,15 +36,35 @@ class UsageError(Exception):
 
 
 class Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line (no usage block)."""
+    """ArgumentParser whose errors are one line (no usage block); an empty value is an error.
+
+    An empty argument (``--time-series ""``, an unset shell variable) would
+    otherwise count as an option not given: silently ignored.
+
+    Examples
+    --------
+    >>> from motionhyst.cli import main
+    >>> main(["scan", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+    ...       "--s-max", "1e6", "--time-series", ""])      # one line on stderr, exit code 2
+    2
+    """
 
     def error(self, message: str):
         raise UsageError(f"{self.prog}: {message}")
 
+    def parse_known_args(self, args=None, namespace=None):
+        namespace, extras = super().parse_known_args(args, namespace)
+        for action in self._actions:
+            value = getattr(namespace, action.dest, None)
+            if value == "" or (isinstance(value, list) and "" in value):
+                name = "/".join(action.option_strings) or action.metavar or action.dest
+                self.error(f"{name} is empty; give a value")
+        return namespace, extras
+
 
 def _number(text: str, what: str, positive: bool | None) -> float:
     try:
-        v = float(text)
+        v = float(text) + 0.0  # -0 is 0: its sign would reach a formula as a direction
     except ValueError:
         raise argparse.ArgumentTypeError(f"{what} must be a number, got {text!r}") from None
     if not math.isfinite(v):

@@ -25,6 +25,7 @@ Python objects.
 from __future__ import annotations
 
 import codecs
+import csv
 import os
 import re
 import sys
@@ -185,10 +186,21 @@ def _read_csv(path: Path, d: _Dialect, empty: str = "empty file: no header, no d
 
 
 def _file_header(path: Path, d: _Dialect) -> list[str]:
-    """Normalised names of the header line (an unnamed column is ``""``)."""
+    """Normalised names of the header line (an unnamed column is ``""``); a name given twice
+    is a CSVError (pandas would rename the second ``name.1`` and one of them be read)."""
     head = _read_csv(path, d, nrows=0, skiprows=d.header_line - 1, header=0,
                      index_col=False)
+    _check_unique(_raw_header(path, d), str(path))
     return ["" if str(c).startswith("Unnamed: ") else normalize_name(c) for c in head.columns]
+
+
+def _raw_header(path: Path, d: _Dialect) -> list[str]:
+    """Normalised names of the header line as written, repeated names kept."""
+    with path.open(encoding=d.encoding, errors="replace", newline="") as fh:
+        for number, line in enumerate(fh, 1):
+            if number == d.header_line:
+                return [normalize_name(c) for c in next(csv.reader([line], delimiter=d.sep), [])]
+    return []
 
 
 def read_header(source: Source) -> list[str]:

@@ -51,6 +51,7 @@ True
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import re
@@ -157,7 +158,7 @@ choose another output file
                               f"choose another output file")
 
 
-def _label(path: Path, option: str | None) -> str:
+def _label(path: Path | str, option: str | None) -> str:
     return f"{option} {path}" if option else str(path)
 
 
@@ -169,7 +170,44 @@ def _check_parents(path: Path, label: str) -> None:
                 raise OutputError(f"{label}: {parent} is not a folder")
             if not os.access(parent, os.W_OK | os.X_OK):
                 raise OutputError(f"{label}: no permission to write in {parent}")
+            problem = _cannot_create_in(parent)
+            if problem is not None:
+                raise OutputError(f"{label}: cannot create a file in {parent} ({problem})")
             return
+
+
+_NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL)
+"""Errors of ``O_TMPFILE`` that only say the file system lacks it."""
+
+
+def _cannot_create_in(folder: Path) -> str | None:
+    """Why no file can be created in `folder`, tried before the work; None if one can.
+
+    ``os.access`` answers from the permission bits alone: for root every folder
+    looks writable, also on a read-only file system, in ``/proc`` or ``/sys``.
+    So a file is created: unnamed (``O_TMPFILE``) and closed at once, or,
+    where the file system lacks that, named as a temporary file of this process
+    (:func:`clean_stale`'s pattern) and removed at once.
+    """
+    try:
+        fd = os.open(folder, os.O_TMPFILE | os.O_WRONLY | os.O_CLOEXEC, 0o600)
+    except AttributeError:  # no O_TMPFILE on this system
+        pass
+    except OSError as exc:
+        if exc.errno not in _NO_TMPFILE:
+            return exc.strerror
+    else:
+        os.close(fd)
+        return None
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".probe.motionhyst-{os.getpid()}-", suffix=".part",
+                                    dir=folder)
+    except OSError as exc:
+        return exc.strerror
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(name)
+    return None
 
 
 def _missing_parents(folder: Path) -> list[Path]:
@@ -398,6 +436,12 @@ class OutputFile:
         label = _label(self.path, option)
         if str(path) == "" or self.path.name in ("", ".", ".."):
             raise OutputError(f"{label}: not a file name")
+        if str(path) == "-":  # elsewhere the standard output: a file named '-' surprises
+            raise OutputError(f"{label}: the standard output is not written to; give a file "
+                              f"name")
+        if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: it names a folder
+            raise OutputError(f"{_label(os.fspath(path), option)}: ends in {os.sep}, so names a "
+                              f"folder; give a file name")
         check_not_input(self.path, inputs, option)
         self.target = self.path
         if self.path.is_symlink():
@@ -596,6 +640,8 @@ class OutputFolder:
         self.inputs = _inputs(inputs)
         self.names = list(dict.fromkeys(names))
         label = f"{option} {self.path}"
+        if str(path) in ("", "-"):
+            raise OutputError(f"{label}: not a folder name")
         for name in self.names:
             if Path(name).name != name or name in ("", ".", "..", MANIFEST):
                 raise ValueError(f"not a plain file name: {name!r}")

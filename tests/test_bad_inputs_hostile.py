@@ -1,0 +1,133 @@
+"""The hostile corpus (issue 26, the further cases): output names, empty values, signals.
+
+Each refusal runs the command line in a folder holding the user's files and
+asserts exit code 2, one line on stderr without a traceback, nothing on
+stdout, and that every file that was there before is byte-identical
+afterwards, with no file added.  The signal cases run the command in a child
+process and send SIGTERM as a service manager or ``kill`` would: exit 130,
+one line, the old files intact and no temporary file left.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from file_trees import populate, snapshot
+
+from motionhyst.cli import main
+from motionhyst.scenario import default_scenario_path
+
+PAPER = default_scenario_path().read_text()
+STUDY = ('scenario = "s.toml"\noutputs = ["e1"]\n\n[axes]\namplitude = [0.001, 0.01]\n'
+         'frequency_hz = [1.0, 2.0]\n')
+MODEL = ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
+         '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n')
+
+
+def _force() -> str:
+    t = np.arange(300) / 750.0
+    return "time,force\n" + "".join(f"{a!r},{np.sin(i / 10):.6f}\n"
+                                     for i, a in enumerate(t.tolist()))
+
+
+def _link() -> str:
+    """A force-displacement record of a Jenkins element (time,displacement,force)."""
+    from motionhyst.hysteresis import Jenkins
+
+    t = np.arange(500) / 250.0
+    x = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+    f = Jenkins(k=20.0, fc=0.05).response(x)
+    return "time,displacement,force\n" + "".join(
+        f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), x.tolist(), f.tolist(),
+                                                 strict=True))
+
+
+BASE = {"s.toml": PAPER, "st.toml": STUDY, "model.toml": MODEL, "f.csv": _force(),
+        "rec.csv": _link(), "notes.txt": "my notes", "old.csv": "time,error\n0,0\n"}
+
+SCAN = ["scan", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+        "--s-max", "1e6"]
+WRITERS = {  # a command that writes a file, up to the output's name
+    "simulate": ["simulate", "--frequency", "5", "--time-series"],
+    "scan": [*SCAN, "--time-series"],
+    "identify": ["identify", "rec.csv", "--elements", "1", "--save"],
+    "predict": ["predict", "model.toml", "f.csv", "--out"],
+    "stability": ["stability", "--figure"],
+    "study": ["study", "st.toml", "--workers", "1", "--table"],
+    "reproduce": ["reproduce", "--out"],
+}
+FILE = {"simulate": "o.csv", "scan": "o.csv", "identify": "m.toml", "predict": "p.csv",
+        "stability": "f.png", "study": "t.csv", "reproduce": "out"}
+
+# (id, extra files, argv, words the message must contain)
+CASES = []
+for _name, _argv in WRITERS.items():
+    CASES += [
+        # an empty value (an unset shell variable) is no value: the option is not dropped
+        (f"{_name}-empty-name", {}, [*_argv, ""], ["is empty"]),
+        # the standard output's usual name is not made a file named '-'
+        (f"{_name}-dash", {}, [*_argv, "-"], ["-"]),
+        # a folder that even root cannot create a file in: refused before the work
+        (f"{_name}-proc", {}, [*_argv, f"/proc/{FILE[_name]}", "--force"], ["/proc"]),
+    ]
+    if _name != "reproduce":  # reproduce's --out is a folder
+        CASES.append((f"{_name}-trailing-slash", {}, [*_argv, f"{FILE[_name]}/"], ["ends in /"]))
+CASES += [
+    # a header naming a column twice: pandas would read the first and rename the second
+    ("reference-column-twice", {"r.csv": "time,position,Position\n" + "".join(
+        f"{i / 1000},{i * 1e-5},{-i * 1e-5}\n" for i in range(20))},
+     ["simulate", "--reference-csv", "r.csv", "--time-series", "o.csv"], ["twice"]),
+    ("record-column-twice", {"r.csv": "time;displacement;force;displacement\n0;0;0;1\n"},
+     ["identify", "r.csv"], ["twice"]),
+    ("scenario-empty-name", {}, ["analyze", ""], ["is empty"]),
+    ("columns-empty", {}, ["identify", "rec.csv", "--columns="], ["--columns"]),
+    ("scenario-option-empty", {}, ["identify", "rec.csv", "--scenario", ""], ["is empty"]),
+]
+
+
+def test_the_cases_are_distinct():
+    assert len({c[0] for c in CASES}) == len(CASES) >= 30
+
+
+@pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_hostile_input_is_exit_2_one_line_and_touches_nothing(tmp_path, monkeypatch, capsys,
+                                                              files, argv, words):
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, {**BASE, **files})
+    monkeypatch.chdir(root)
+    before = snapshot(root)
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    assert code == 2, (code, out, err)
+    assert out == ""
+    line = err.strip()
+    assert line and "\n" not in line and "Traceback" not in line, err
+    for word in words:
+        assert word in line, (word, line)
+    assert snapshot(root) == before  # nothing changed, nothing added
+    assert [p.name for p in tmp_path.iterdir()] == ["user"]
+
+
+def test_a_folder_that_takes_no_file_is_refused_by_trying_one(tmp_path):
+    """The check creates a file (unnamed, or named and removed at once) and leaves nothing."""
+    from motionhyst.io.outputs import OutputError, OutputFile, OutputFolder
+
+    OutputFile(tmp_path / "o.csv")
+    OutputFolder(tmp_path / "out", ["report.md"])
+    assert list(tmp_path.iterdir()) == []
+    for make in (lambda: OutputFile("/proc/o.csv"), lambda: OutputFolder("/proc/out", ["a"])):
+        with pytest.raises(OutputError, match="/proc"):
+            make()
+
+
+def test_minus_zero_is_zero(capsys):
+    """``--amplitude -0`` passed the >= 0 check and gave the describing function 0 (its limit
+    at A -> 0 is the initial stiffness)."""
+    argv = ["df", "--k", "20", "--fc", "0.05", "--amplitude", "-0", "--json"]
+    assert main(argv) == 0
+    minus = capsys.readouterr().out
+    assert main([*argv[:-2], "0", "--json"]) == 0
+    assert minus == capsys.readouterr().out
+    assert '"abs": 20.0' in minus
