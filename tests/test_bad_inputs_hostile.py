@@ -10,6 +10,14 @@ one line, the old files intact and no temporary file left.
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
+import sys
+import time
+import types
+from pathlib import Path
+
 import numpy as np
 import pytest
 from file_trees import populate, snapshot
@@ -35,7 +43,8 @@ def _link() -> str:
     from motionhyst.hysteresis import Jenkins
 
     t = np.arange(500) / 250.0
-    x = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+    envelope = np.concatenate([np.geomspace(0.01, 5e-4, 250), np.geomspace(5e-4, 0.01, 250)])
+    x = envelope * np.sin(2 * np.pi * 2.0 * t)
     f = Jenkins(k=20.0, fc=0.05).response(x)
     return "time,displacement,force\n" + "".join(
         f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), x.tolist(), f.tolist(),
@@ -122,6 +131,74 @@ def test_a_folder_that_takes_no_file_is_refused_by_trying_one(tmp_path):
             make()
 
 
+_MAIN = ("import sys\n"
+         "from motionhyst.core.compiled import quiet_compilation\n"
+         "quiet_compilation()\n"
+         "from motionhyst.cli import main\n"
+         "sys.exit(main(sys.argv[1:]))\n")
+
+
+def _started(proc: subprocess.Popen, module: str, timeout: float = 120.0) -> None:
+    """Wait until `proc` has loaded `module` (its work has begun), or fail."""
+    deadline = time.monotonic() + timeout
+    maps = Path(f"/proc/{proc.pid}/maps")
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            pytest.fail(f"ended early: {proc.stderr.read().decode(errors='replace')}")
+        try:
+            if module in maps.read_text():
+                return
+        except OSError:
+            pass
+        time.sleep(0.05)
+    pytest.fail(f"{module} was never loaded")
+
+
+@pytest.mark.skipif(not Path("/proc/self/maps").is_file(), reason="needs /proc")
+@pytest.mark.parametrize("argv", [
+    ["simulate", "--time-series", "old.csv", "--frequency", "5", "--duration", "60", "--force"],
+    ["steady", "s.toml", "--frequency", "0.2", "0.5", "1", "2", "3", "4"],
+], ids=["simulate", "steady"])
+def test_sigterm_before_any_file_is_written_is_exit_130_and_touches_nothing(tmp_path, argv):
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, BASE)
+    before = snapshot(tmp_path)
+    proc = subprocess.Popen([sys.executable, "-c", _MAIN, *argv], cwd=root,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    _started(proc, "_multiarray_umath")  # numpy loaded: the command is under way
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert err.decode().strip().splitlines()[-1:] == ["motionhyst: interrupted"]
+    assert "Traceback" not in err.decode() and "Fatal Python" not in err.decode()
+    assert snapshot(tmp_path) == before
+
+
+def test_sigterm_in_a_process_forked_by_a_command_ends_it_by_default(tmp_path):
+    """A command's SIGTERM handler raises in the command only: a forked worker that gets
+    SIGTERM (a pool shutting down) ends by the signal, without a traceback."""
+    code = ("import os, signal, sys\n"
+            "from motionhyst.cli import _Interrupts\n"
+            "_Interrupts()\n"
+            "pid = os.fork()\n"
+            "if pid == 0:\n"
+            "    os.kill(os.getpid(), signal.SIGTERM)\n"
+            "    os._exit(0)\n"
+            "_, status = os.waitpid(pid, 0)\n"
+            "print(os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60, cwd=tmp_path)
+    assert done.stdout.strip() == "True", done.stderr
+    assert done.stderr == ""
+
+
+def test_main_leaves_the_signal_handlers_as_it_found_them(capsys):
+    before = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)]
+    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 0
+    assert [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)] == before
+
+
 def test_minus_zero_is_zero(capsys):
     """``--amplitude -0`` passed the >= 0 check and gave the describing function 0 (its limit
     at A -> 0 is the initial stiffness)."""
@@ -131,3 +208,39 @@ def test_minus_zero_is_zero(capsys):
     assert main([*argv[:-2], "0", "--json"]) == 0
     assert minus == capsys.readouterr().out
     assert '"abs": 20.0' in minus
+
+
+def test_a_signal_swallowed_during_a_write_still_stops_it(tmp_path):
+    """A KeyboardInterrupt raised inside a C callback (numba's compiler caching a kernel) is
+    swallowed there and the writer goes on: the signal is remembered, the old file kept."""
+    from motionhyst.io.outputs import OutputFile
+
+    target = tmp_path / "o.csv"
+    target.write_text("old\n")
+    with pytest.raises(KeyboardInterrupt), OutputFile(target, force=True).open() as fh:
+        fh.write("new\n")
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)  # the handler raises at once
+        except KeyboardInterrupt:
+            pass  # swallowed, as a C callback does
+    assert target.read_text() == "old\n"
+    assert list(tmp_path.iterdir()) == [target]
+
+
+def test_an_interrupt_swallowed_by_a_c_callback_ends_the_command_130(monkeypatch, capsys):
+    """Python reports an exception it cannot raise (in a C callback) to sys.unraisablehook,
+    with a traceback on stderr, and goes on; the command notes it and ends interrupted."""
+    import motionhyst.cli.df as df
+
+    def run(args):
+        exc = KeyboardInterrupt("SIGINT")
+        sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=exc,
+                                                 exc_traceback=None, err_msg=None,
+                                                 object=None))
+        return 0
+
+    monkeypatch.setattr(df, "run", run)
+    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 130
+    assert capsys.readouterr().err.strip() == "motionhyst: interrupted"
+    assert sys.unraisablehook is not None and "_Interrupts" not in repr(sys.unraisablehook)

@@ -18,6 +18,7 @@ import importlib
 import os
 import signal
 import sys
+import threading
 from collections.abc import Sequence
 
 from motionhyst.cli._common import (
@@ -107,13 +108,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         # is (files and temporary folders are closed by the command itself); only unreachable
         # cycles are left to the operating system
         atexit.register(gc.freeze)
+    interrupts = _Interrupts()
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
         set_max_seconds(args.max_seconds)
         with warnings_on_stderr(args.command):
-            return args.func(args)
+            code = args.func(args)
+        if interrupts.received:  # a library swallowed it (an optional import that failed)
+            raise KeyboardInterrupt
+        return code
     except BrokenPipeError:  # output piped into head, say: not an error
         sys.stdout = open(os.devnull, "w")
         return 0
@@ -121,16 +126,84 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("motionhyst: interrupted", file=sys.stderr)
         return 130
     except Exception as exc:
-        if not _interrupted(exc):
+        if not (interrupts.received or _interrupted(exc)):
             return _failed(exc)
         print("motionhyst: interrupted", file=sys.stderr)
         return 130
     finally:
         set_max_memory(None)
         set_max_seconds(None)
+        interrupts.restore()
         if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
             with contextlib.suppress(ValueError, OSError):  # interpreter's exit (tracebacks)
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class _Interrupts:
+    """Ctrl-C (SIGINT) and SIGTERM end a command the same way, whenever they come: exit 130,
+    the old files intact.
+
+    Each raises ``KeyboardInterrupt`` and is remembered (:attr:`received`): one that
+    reached an import of a compiled extension may come out as another error (numpy's
+    ImportError) that no longer names it, and one raised inside a C callback (numba's
+    compiler caching a kernel) is swallowed there, reported to ``sys.unraisablehook``: it
+    is noted, not shown, and the signal sent again a moment later.  Only in this process:
+    a worker forked from it ends at SIGTERM by the signal's default, as its parent expects,
+    and takes Ctrl-C as Python does.  Outside the main thread nothing is installed, and a
+    signal ignored by the process that started this one (``nohup``) stays ignored.
+    """
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self):
+        self.received: list[int] = []
+        self.previous: dict[int, object] = {}
+        self.pid = os.getpid()
+        self.hook = sys.unraisablehook
+        self.again: threading.Timer | None = None
+        sys.unraisablehook = self._unraisable
+        for sig in self.SIGNALS:
+            try:
+                if signal.getsignal(sig) is signal.SIG_IGN:  # ignored by who started us
+                    continue  # (nohup, a background job): so it stays, as Python does
+                previous = signal.signal(sig, self._handler)
+            except ValueError:  # not the main thread
+                break
+            self.previous[sig] = signal.SIG_DFL if previous is None else previous
+
+    def _handler(self, signum, frame):
+        if os.getpid() != self.pid:  # a forked worker
+            if signum == signal.SIGINT:
+                signal.default_int_handler(signum, frame)
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
+        self.received.append(signum)
+        raise KeyboardInterrupt(signal.Signals(signum).name)
+
+    def _unraisable(self, unraisable) -> None:
+        # raised inside a C callback (numba's compiler caching a kernel), the interrupt is
+        # swallowed there with a traceback on stderr and the work goes on: noted, not shown,
+        # and sent again a moment later, when the callback has returned
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            sig = signal.SIGINT if signal.SIGINT in self.previous else signal.SIGTERM
+            self.received.append(sig)
+            if self.again is None or not self.again.is_alive():
+                self.again = threading.Timer(0.05, os.kill, (self.pid, sig))
+                self.again.daemon = True
+                self.again.start()
+            return
+        self.hook(unraisable)
+
+    def restore(self) -> None:
+        """Put back the handlers found."""
+        if self.again is not None:
+            self.again.cancel()
+        for sig, previous in self.previous.items():
+            with contextlib.suppress(ValueError, OSError, TypeError):
+                signal.signal(sig, previous)
+        if sys.unraisablehook == self._unraisable:
+            sys.unraisablehook = self.hook
 
 
 def _interrupted(exc: BaseException) -> bool:

@@ -12,7 +12,6 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 
 from motionhyst.core.textfmt import g, table
-from motionhyst.core.validation import MAGNITUDES
 
 __all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
            "harmonic_count", "memory_size", "nonnegative", "one_line", "positive", "print_json",
@@ -63,6 +62,10 @@ class Parser(argparse.ArgumentParser):
 
 
 def _number(text: str, what: str, positive: bool | None) -> float:
+    # here, not at the top: importing the command line loads no numpy, so main() installs its
+    # signal handlers sooner (a Ctrl-C or SIGTERM before them is the interpreter's own end)
+    from motionhyst.core.validation import MAGNITUDES
+
     try:
         v = float(text) + 0.0  # -0 is 0: its sign would reach a formula as a direction
     except ValueError:

@@ -371,13 +371,20 @@ class _Temporary:
 
 
 @contextlib.contextmanager
-def _signals_raise() -> Iterator[None]:
-    """SIGINT and SIGTERM raise ``KeyboardInterrupt`` inside the block (main thread only)."""
+def _signals_raise() -> Iterator[list[int]]:
+    """SIGINT and SIGTERM raise ``KeyboardInterrupt`` inside the block (main thread only).
+
+    Yields the signals received: one raised inside a C callback (numba's compiler
+    caching a kernel, say) is swallowed there and the work goes on, so a writer checks
+    the list before it replaces its target (:func:`_stop_if`).
+    """
+    received: list[int] = []
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield received
         return
 
     def handler(signum, frame):
+        received.append(signum)
         raise KeyboardInterrupt(signal.Signals(signum).name)
 
     saved = {}
@@ -387,10 +394,16 @@ def _signals_raise() -> Iterator[None]:
         except (ValueError, OSError):  # pragma: no cover - not the main interpreter
             pass
     try:
-        yield
+        yield received
     finally:
         for sig, old in saved.items():
             signal.signal(sig, old)
+
+
+def _stop_if(received: list[int]) -> None:
+    """Raise ``KeyboardInterrupt`` if a signal came (and was swallowed) during a write."""
+    if received:
+        raise KeyboardInterrupt(signal.Signals(received[0]).name)
 
 
 class OutputFile:
@@ -491,7 +504,7 @@ class OutputFile:
         created = []
         tmp = None
         done = False
-        with _signals_raise():
+        with _signals_raise() as received:
             try:
                 for folder in _missing_parents(self.target.parent):
                     folder.mkdir()
@@ -509,6 +522,7 @@ class OutputFile:
                     os.fsync(fh.fileno())
                 finally:
                     fh.close()
+                _stop_if(received)
                 tmp.commit(self.target)
                 done = True
                 _fsync_dir(self.target.parent)
@@ -769,6 +783,7 @@ class OutputFolder:
         self._ensure_folder()
         with _signals_raise():
             try:
+                _stop_if(getattr(self, "_received", []))
                 self._manifest(self.previous | set(self.written))
                 while self._staged:
                     name, tmp = self._staged[0]
@@ -807,7 +822,7 @@ class OutputFolder:
 
     def __enter__(self) -> OutputFolder:
         self._signals = _signals_raise()
-        self._signals.__enter__()
+        self._received = self._signals.__enter__()
         try:
             # before the work: a folder that cannot be made fails now, not after it (a
             # folder made here and left empty is removed again)
