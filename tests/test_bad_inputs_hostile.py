@@ -210,6 +210,36 @@ def test_minus_zero_is_zero(capsys):
     assert '"abs": 20.0' in minus
 
 
+def _io_record() -> str:
+    """A record of a mass-spring-damper under a two-sine force (time,force,displacement)."""
+    from motionhyst.time.openloop import MassSpringDamper, OpenLoop
+
+    t = np.arange(600) / 750.0
+    u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
+    y = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4)).simulate(t, u).displacement
+    return "time,force,displacement\n" + "".join(
+        f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), u.tolist(), y.tolist(),
+                                                 strict=True))
+
+
+def test_identify_stops_at_its_cpu_time_budget_and_saves_nothing(tmp_path, monkeypatch,
+                                                                 capsys):
+    """A search has no estimate before it runs: it is stopped at --max-seconds of CPU time."""
+    populate(tmp_path, {"io.csv": _io_record()})
+    monkeypatch.chdir(tmp_path)
+    before = snapshot(tmp_path)
+    code = main(["identify", "io.csv", "--record", "input-output", "--model", "jenkins",
+                 "--plant", "mass-spring-damper", "--save", "m.toml", "--max-seconds", "0.05"])
+    out, err = capsys.readouterr()
+    assert code == 2, err
+    assert out == ""
+    line = err.strip().splitlines()[-1]
+    assert "did not finish within the work budget" in line and "--max-seconds" in line
+    assert "Traceback" not in err
+    assert snapshot(tmp_path) == before
+    assert signal.getsignal(signal.SIGPROF) in (signal.SIG_DFL, None)
+
+
 def test_a_signal_swallowed_during_a_write_still_stops_it(tmp_path):
     """A KeyboardInterrupt raised inside a C callback (numba's compiler caching a kernel) is
     swallowed there and the writer goes on: the signal is remembered, the old file kept."""

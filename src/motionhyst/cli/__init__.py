@@ -31,7 +31,12 @@ from motionhyst.cli._common import (
     warnings_on_stderr,
 )
 from motionhyst.cli.identify import feedforward_fragment, record_kind
-from motionhyst.core.budget import set_max_memory, set_max_seconds
+from motionhyst.core.budget import (
+    cpu_time_limit,
+    max_seconds,
+    set_max_memory,
+    set_max_seconds,
+)
 
 COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identify", "predict",
             "study", "benchmark", "reproduce")
@@ -40,11 +45,16 @@ COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identif
 EXIT_INTERNAL = 1
 """Exit code of a defect of the tool (an exception no input should cause)."""
 
+SEARCHES = {"identify": "give a shorter record or fewer --max-evaluations, or a larger "
+                        "--max-seconds"}
+"""Commands whose work is a search no formula sizes in advance, with the remedy when one runs
+out of budget: stopped after ``--max-seconds`` of CPU time, nothing saved (exit 2)."""
+
 TRACEBACK_VARIABLE = "MOTIONHYST_TRACEBACK"
 """Environment variable: set, a defect of the tool ends in its traceback instead of one line."""
 
-__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "TRACEBACK_VARIABLE", "UsageError",
-           "build_parser", "feedforward_fragment", "main", "record_kind"]
+__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "SEARCHES", "TRACEBACK_VARIABLE",
+           "UsageError", "build_parser", "feedforward_fragment", "main", "record_kind"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -114,7 +124,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
         set_max_seconds(args.max_seconds)
-        with warnings_on_stderr(args.command):
+        search = SEARCHES.get(args.command)
+        with (warnings_on_stderr(args.command),
+              cpu_time_limit(max_seconds() if search else None, args.command,
+                             search or "")):
             code = args.func(args)
         if interrupts.received:  # a library swallowed it (an optional import that failed)
             raise KeyboardInterrupt

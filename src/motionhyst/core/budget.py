@@ -21,7 +21,9 @@ the nominal costs its module states (measured on one core of a quiet
 machine: a loaded one takes longer), and refused above the work budget with
 :func:`check_work`: :data:`DEFAULT_SECONDS` unless ``motionhyst
 --max-seconds S`` (any command) or ``MOTIONHYST_MAX_SECONDS`` raise it
-(:func:`set_max_seconds`).  A command never runs for hours unasked.
+(:func:`set_max_seconds`).  A search that no formula sizes (a fit that stops when it
+converges) is stopped after that much CPU time instead (:func:`cpu_time_limit`).  A command
+never runs for hours unasked.
 
 Examples
 --------
@@ -50,14 +52,18 @@ of 1 min (--max-seconds); give fewer frequencies
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import resource
+import signal
+import threading
+from collections.abc import Iterator
 
 __all__ = ["DEFAULT_FRACTION", "DEFAULT_SECONDS", "ENV_VARIABLE", "SECONDS_VARIABLE",
-           "BudgetError", "available_memory", "check_memory", "check_work", "format_duration",
-           "format_size", "max_memory", "max_seconds", "parse_size", "set_max_memory",
-           "set_max_seconds"]
+           "BudgetError", "available_memory", "check_memory", "check_work", "cpu_time_limit",
+           "format_duration", "format_size", "max_memory", "max_seconds", "parse_size",
+           "set_max_memory", "set_max_seconds"]
 
 DEFAULT_FRACTION = 0.5
 """Share of :func:`available_memory` one computation may take unless a budget is given."""
@@ -369,3 +375,72 @@ def check_work(seconds: float, what: str, remedy: str = "") -> None:
         tail = f"; {remedy}" if remedy else ""
         raise BudgetError(f"{what} would take about {format_duration(seconds)}, above the work "
                           f"budget of {format_duration(budget)} (--max-seconds){tail}")
+
+
+class _TimeUp(BaseException):
+    """Raised by the CPU-time alarm: a BaseException, so that no ``except ValueError`` of a
+    model evaluation (values the model refuses) takes it for a bad parameter."""
+
+
+@contextlib.contextmanager
+def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterator[None]:
+    """Stop the work of the block after `seconds` of this process's CPU time (a BudgetError).
+
+    For a computation whose run time no formula tells in advance (a search
+    that stops when it converges): its CPU time, not the wall clock, so a
+    loaded machine does not cut it shorter than a quiet one.  Without a limit
+    (`seconds` None), outside the main thread, or where the system has no
+    profiling timer, the block runs unbounded.
+
+    Parameters
+    ----------
+    seconds : float or None
+        The CPU time allowed [s] (:func:`max_seconds`, say).
+    what : str
+        The computation, as the message names it.
+    remedy : str
+        What the user can change.
+
+    Raises
+    ------
+    BudgetError
+        One line: `what` used its budget without finishing, and `remedy`.
+
+    Examples
+    --------
+    >>> with cpu_time_limit(60.0, "a short sum"):
+    ...     total = sum(range(1000))
+    >>> try:
+    ...     with cpu_time_limit(0.05, "an endless loop", "give it an end"):
+    ...         while True:
+    ...             pass
+    ... except BudgetError as exc:
+    ...     print(exc)
+    an endless loop did not finish within the work budget of 0.05 s of CPU time \
+(--max-seconds); give it an end
+    """
+    if (seconds is None or not hasattr(signal, "setitimer")
+            or threading.current_thread() is not threading.main_thread()):
+        yield
+        return
+    fired = []
+
+    def alarm(signum, frame):
+        fired.append(signum)
+        raise _TimeUp
+
+    previous = signal.signal(signal.SIGPROF, alarm)
+    signal.setitimer(signal.ITIMER_PROF, seconds)
+    try:
+        yield
+    except BaseException as exc:
+        # a C extension may turn the alarm's exception into another (as it does a Ctrl-C)
+        if fired and not isinstance(exc, KeyboardInterrupt):
+            tail = f"; {remedy}" if remedy else ""
+            raise BudgetError(f"{what} did not finish within the work budget of "
+                              f"{format_duration(seconds)} of CPU time (--max-seconds)"
+                              f"{tail}") from None
+        raise
+    finally:
+        signal.setitimer(signal.ITIMER_PROF, 0)
+        signal.signal(signal.SIGPROF, previous)
