@@ -274,3 +274,113 @@ def test_an_interrupt_swallowed_by_a_c_callback_ends_the_command_130(monkeypatch
     assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 130
     assert capsys.readouterr().err.strip() == "motionhyst: interrupted"
     assert sys.unraisablehook is not None and "_Interrupts" not in repr(sys.unraisablehook)
+
+
+# ------------------------------------------------------------------ CSV dialects and .mat kinds
+def _columns() -> list[np.ndarray]:
+    t = np.arange(120) / 1000.0
+    return [t, 1e-3 * np.sin(2 * np.pi * 5.0 * t), -2.5 * np.cos(2 * np.pi * 5.0 * t)]
+
+
+def _csv(sep: str = ",", eol: str = "\n", cell=repr, head=("time", "force", "displacement"),
+         rows: int | None = None) -> str:
+    cols = [c[:rows] for c in _columns()]
+    return sep.join(head) + eol + "".join(sep.join(cell(v) for v in r) + eol
+                                         for r in zip(*[c.tolist() for c in cols], strict=True))
+
+
+DIALECTS = {  # a logger's or a spreadsheet's way of writing the same record
+    "tab": _csv(sep="\t"),
+    "semicolon": _csv(sep=";"),
+    "semicolon-decimal-comma": _csv(sep=";", cell=lambda v: repr(v).replace(".", ",")),
+    "bom": "\ufeff" + _csv(),
+    "crlf": _csv(eol="\r\n"),
+    "bom-crlf": "\ufeff" + _csv(eol="\r\n"),
+    "cr": _csv(eol="\r"),
+    "quoted": _csv(cell=lambda v: f'"{v!r}"', head=('"time"', '"force"', '"displacement"')),
+    "spaces": _csv(sep=" , "),
+    "trailing-separator": _csv().replace("\n", ",\n"),
+    "blank-lines": _csv().replace("\n", "\n\n", 3) + "\n\n",
+    "upper-case-header": _csv(head=("TIME", "Force", "Displacement")),
+    "plus-signs": _csv(cell=lambda v: ("+" if v >= 0 else "") + repr(v)),
+    "utf-16": _csv().encode("utf-16"),
+}
+
+
+@pytest.mark.parametrize("text", DIALECTS.values(), ids=DIALECTS.keys())
+def test_a_csv_dialect_gives_the_same_numbers(tmp_path, text):
+    from motionhyst.io.records import read_record
+
+    path = tmp_path / "r.csv"
+    (path.write_bytes if isinstance(text, bytes) else path.write_text)(text)
+    data = read_record(path, ("time", "force", "displacement"))
+    np.testing.assert_array_equal(data, np.column_stack(_columns()))
+
+
+BAD_CSV = {  # what no dialect reads as the numbers meant: one line naming the place
+    "decimal-comma-quoted": (_csv(cell=lambda v: '"' + repr(v).replace(".", ",") + '"'),
+                             "non-numeric"),
+    "hex-floats": (_csv(cell=float.hex), "non-numeric"),
+    "thousands-separators": (_csv(cell=lambda v: f'"{1e4 * v:,.3f}"'), "non-numeric"),
+    "units-in-header": (_csv(head=("time [s]", "force [N]", "displacement [m]")), "missing"),
+    "comment-line-first": ("# exported by a logger\n" + _csv(), "missing"),
+    "nul-bytes": (_csv().replace("\n", "\x00\n", 3), "not a CSV file"),
+    "one-row": (_csv(rows=1), "r.csv"),
+    "header-only": ("time,force,displacement\n", "no data rows"),
+    "repeated-rows": (_csv() + _csv().split("\n", 1)[1], "time must increase"),
+    "time-twice": (_csv().replace("\n0.06,", "\n0.059,", 1), "r.csv"),
+}
+
+
+@pytest.mark.parametrize(("text", "word"), BAD_CSV.values(), ids=BAD_CSV.keys())
+def test_a_record_no_dialect_reads_is_refused_in_one_line(tmp_path, monkeypatch, capsys,
+                                                            text, word):
+    populate(tmp_path, {"r.csv": text, "model.toml": MODEL})
+    monkeypatch.chdir(tmp_path)
+    before = snapshot(tmp_path)
+    code = main(["predict", "model.toml", "r.csv", "--out", "p.csv"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "", (code, out, err)
+    line = err.strip()
+    assert line and "\n" not in line and "Traceback" not in line, err
+    assert word in line, (word, line)
+    assert snapshot(tmp_path) == before
+
+
+def _mat(kind: str, path: Path) -> None:
+    """A MATLAB file holding time, force and displacement, one of them of an odd kind."""
+    from scipy.io import savemat
+    from scipy.sparse import csr_matrix
+
+    t, f, x = _columns()
+    odd = {"int16": {"displacement": (x * 1e4).astype(np.int16)},
+           "float32": {"force": f.astype(np.float32)},
+           "bool": {"force": f > 0},
+           "3-d": {"force": f.reshape(-1, 1, 1)},
+           "complex": {"force": f + 0j},
+           "sparse": {"force": csr_matrix(f)},
+           "int64-time": {"time": np.arange(t.size, dtype=np.int64) * 256},
+           "uint8-time": {"time": np.arange(t.size).astype(np.uint8) * 3},
+           "empty": {"force": np.zeros((0, 0))}}[kind]
+    savemat(path, {"time": t, "force": f, "displacement": x, **odd})
+
+
+MATS = {"int16": None, "float32": None, "bool": None, "3-d": None, "int64-time": None,
+        "complex": "complex", "sparse": "sparse", "empty": "empty",
+        "uint8-time": "increasing"}
+
+
+@pytest.mark.parametrize(("kind", "word"), MATS.items(), ids=MATS.keys())
+def test_a_mat_variable_of_another_type_is_read_as_its_values_or_refused(tmp_path, kind, word):
+    from motionhyst.identify.records import load_force_displacement_csv
+    from motionhyst.io.records import RecordError, read_record
+
+    path = tmp_path / "r.mat"
+    _mat(kind, path)
+    if word is None:  # integers, singles, logicals, a trailing singleton dimension: values
+        data = read_record(path, ("time", "force", "displacement"))
+        assert data.dtype == np.float64 and data.shape == (120, 3)
+        assert np.isfinite(data).all()
+    else:
+        with pytest.raises((RecordError, ValueError), match=word):
+            load_force_displacement_csv(path)
