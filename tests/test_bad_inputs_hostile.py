@@ -88,6 +88,8 @@ CASES += [
      ["simulate", "--reference-csv", "r.csv", "--time-series", "o.csv"], ["twice"]),
     ("record-column-twice", {"r.csv": "time;displacement;force;displacement\n0;0;0;1\n"},
      ["identify", "r.csv"], ["twice"]),
+    ("max-memory-beyond-floats", {}, ["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01",
+                                      "--max-memory", "1e400"], ["not a size"]),
     ("scenario-empty-name", {}, ["analyze", ""], ["is empty"]),
     ("columns-empty", {}, ["identify", "rec.csv", "--columns="], ["--columns"]),
     ("scenario-option-empty", {}, ["identify", "rec.csv", "--scenario", ""], ["is empty"]),
@@ -384,3 +386,22 @@ def test_a_mat_variable_of_another_type_is_read_as_its_values_or_refused(tmp_pat
     else:
         with pytest.raises((RecordError, ValueError), match=word):
             load_force_displacement_csv(path)
+
+
+@pytest.mark.parametrize("variable", ["MOTIONHYST_MAX_MEMORY", "MOTIONHYST_MAX_SECONDS"])
+@pytest.mark.parametrize("value", ["garbage", "nan", "-1", "1e400"])
+def test_a_budget_variable_that_is_no_size_is_refused_by_every_command(monkeypatch, capsys,
+                                                                       variable, value):
+    """Not only by the commands whose computation consults the budget (df never does)."""
+    monkeypatch.setenv(variable, value)
+    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.strip() == err.strip().splitlines()[0]
+    assert variable in err
+
+
+def test_a_refusal_keeps_its_exit_code_when_stderr_cannot_be_written(monkeypatch):
+    closed = open(os.devnull, "w")
+    closed.close()
+    monkeypatch.setattr(sys, "stderr", closed)
+    assert main(["df", "--k", "-20", "--fc", "0.05", "--amplitude", "0.01"]) == 2

@@ -33,6 +33,7 @@ from motionhyst.cli._common import (
 from motionhyst.cli.identify import feedforward_fragment, record_kind
 from motionhyst.core.budget import (
     cpu_time_limit,
+    max_memory,
     max_seconds,
     set_max_memory,
     set_max_seconds,
@@ -124,6 +125,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
         set_max_seconds(args.max_seconds)
+        max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
         search = SEARCHES.get(args.command)
         with (warnings_on_stderr(args.command),
               cpu_time_limit(max_seconds() if search else None, args.command,
@@ -136,12 +138,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout = open(os.devnull, "w")
         return 0
     except KeyboardInterrupt:
-        print("motionhyst: interrupted", file=sys.stderr)
+        _say("motionhyst: interrupted")
         return 130
     except Exception as exc:
         if not (interrupts.received or _interrupted(exc)):
             return _failed(exc)
-        print("motionhyst: interrupted", file=sys.stderr)
+        _say("motionhyst: interrupted")
         return 130
     finally:
         set_max_memory(None)
@@ -233,22 +235,28 @@ def _interrupted(exc: BaseException) -> bool:
     return False
 
 
+def _say(line: str) -> None:
+    """`line` on stderr; a stderr that cannot be written (a full disk) leaves the exit code
+    to say what happened."""
+    with contextlib.suppress(OSError, ValueError):
+        print(line, file=sys.stderr)
+
+
 def _failed(exc: Exception) -> int:
     """One line on stderr for an exception that ended a command; its exit code."""
     try:
         raise exc
     except UsageError as exc:
-        print(f"error: {one_line(str(exc))}", file=sys.stderr)
+        _say(f"error: {one_line(str(exc))}")
     except (ValueError, OSError, RuntimeError) as exc:
-        print(f"motionhyst: error: {one_line(str(exc))}", file=sys.stderr)
+        _say(f"motionhyst: error: {one_line(str(exc))}")
     except MemoryError:  # an estimate missed: still one line, and the remedy
-        print("motionhyst: error: out of memory; give a smaller problem (or a larger "
-              "--max-memory, if the machine has it)", file=sys.stderr)
+        _say("motionhyst: error: out of memory; give a smaller problem (or a larger "
+             "--max-memory, if the machine has it)")
     except Exception as exc:  # a defect of the tool, not the input: one line, exit 1
         if os.environ.get(TRACEBACK_VARIABLE):
             raise
-        print(f"motionhyst: internal error: {one_line(f'{type(exc).__name__}: {exc}')} (a "
-              f"defect of motionhyst, please report it; {TRACEBACK_VARIABLE}=1 shows where)",
-              file=sys.stderr)
+        _say(f"motionhyst: internal error: {one_line(f'{type(exc).__name__}: {exc}')} (a "
+             f"defect of motionhyst, please report it; {TRACEBACK_VARIABLE}=1 shows where)")
         return EXIT_INTERNAL
     return EXIT_USAGE

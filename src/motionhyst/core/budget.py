@@ -117,6 +117,10 @@ def parse_size(text: str) -> int:
     --------
     >>> parse_size("2G"), parse_size("512mib")
     (2147483648, 536870912)
+    >>> parse_size("1e400")
+    Traceback (most recent call last):
+    ...
+    ValueError: not a size: '1e400' (give bytes or a number with K, M, G or T, such as 2G)
     """
     m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*([kmgtKMGT]?)(?:i?[bB])?\s*",
                      str(text))
@@ -126,6 +130,9 @@ def parse_size(text: str) -> int:
     value = float(m.group(1)) * _UNITS[m.group(2).upper()]
     if not value >= 1:
         raise ValueError(f"a size must be at least 1 byte, got {text!r}")
+    if value == float("inf"):  # 1e400: no integer of bytes
+        raise ValueError(f"not a size: {text!r} (give bytes or a number with K, M, G or T, "
+                         f"such as 2G)")
     return int(value)
 
 
