@@ -45,7 +45,7 @@ from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.sampling import hold_response
 from motionhyst.core.textfmt import g, table
-from motionhyst.hysteresis.periodic import sample_period, stop_harmonics, stop_twiddles
+from motionhyst.hysteresis.periodic import sample_period, stop_harmonics_kept, stop_twiddles
 
 __all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
 
@@ -340,9 +340,12 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     residual, it = np.inf, 0
     stops = None if hyst is None else hyst.periodic_stops()
     if stops is not None:
-        e, y1, w, e_linear, it, residual, converged = _stop_steady_state(
+        table, grid = _BINNED_TABLE[0]
+        grid = grid.copy()  # the kernel sets it to the table it returns
+        e, y1, w, e_linear, it, residual, converged, table = _stop_steady_state(
             complex(R[1]), T.r_e, T.r_y1, G_1, T.w_e, U_h, stops[0], stops[1], float(tol),
-            int(max_iter), stop_twiddles(H, H))
+            int(max_iter), stop_twiddles(H, H), table, grid)
+        _BINNED_TABLE[0] = (table, grid)
         if not converged:
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
@@ -386,6 +389,9 @@ _TRANSFER_BYTES = 64 * 2**20
 _TRANSFERS: OrderedDict = OrderedDict()   # (Loop.transfer_key(), f, H) -> _Transfers
 _F_LIM: OrderedDict = OrderedDict()       # Loop.transfer_key() -> fastest pole's f [Hz]
 _CACHE_LOCK = threading.Lock()
+#: The weights of the binned jump sums of parallel stop operators and their grid ``[N, P]``
+#: (:func:`motionhyst.hysteresis.periodic.stop_harmonics_kept`), kept for the next point.
+_BINNED_TABLE: list = [(np.empty((0, 0)), np.zeros(2, dtype=np.int64))]
 _CACHED = {"bytes": 0}
 
 
@@ -436,8 +442,8 @@ def _sin_amplitudes(X):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter,
-                       tw):  # pragma: no cover - compiled
+def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, table,
+                       grid):  # pragma: no cover - compiled
     """The fixed point of :func:`periodic_steady_state` for a link of parallel stop
     operators, compiled whole: the same iteration and stopping rule as its Python loop.
 
@@ -456,7 +462,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter,
     it = 0
     converged = False
     for it in range(1, max_iter + 1):
-        W_new = stop_harmonics(X, k, fc, H, tw)
+        W_new, table = stop_harmonics_kept(X, k, fc, H, tw, table, grid, 2 * H)
         change = 0.0
         for q in range(H + 1):
             change = max(change, abs(W_new[q] - W[q]))
@@ -470,7 +476,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter,
             break
     e = e_lin + G_e * (W - U_h)
     return (_sin_amplitudes(e), _sin_amplitudes(X), _sin_amplitudes(W), _sin_amplitudes(e_lin),
-            it, residual, converged)
+            it, residual, converged, table)
 
 
 def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:

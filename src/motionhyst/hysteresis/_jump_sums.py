@@ -4,7 +4,8 @@ The exact periodic output of stop operators (:mod:`motionhyst.hysteresis.periodi
 ``w = g + s x`` with ``g`` and ``s`` piecewise constant; their coefficients are sums over
 their jumps, ``sum_b J_b exp(-j q t_b) / (2 pi j q)``: directly (:func:`jump_series`,
 ``O(jumps Q)``) or, for many jumps, binned on a grid with Chebyshev moments and FFTs
-(:func:`jump_series_binned`, ``O(jumps + Q log Q)``); :func:`binned_is_cheaper` chooses.
+(:func:`jump_sums_binned`, ``O(jumps + Q log Q)``, real weights); :func:`binned_is_cheaper`
+chooses.
 """
 
 from __future__ import annotations
@@ -82,7 +83,7 @@ def chebyshev_terms(a_max):  # pragma: no cover - compiled
 @njit(cache=True)
 def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
     """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
-    :func:`jump_series_binned` for `n_jumps` jumps and harmonics up to `Q`: the fewest
+    :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q`: the fewest
     operations, weighted roughly as the compiled code spends its time (binning, FFTs, the
     sums over the terms, the Bessel table), ``N >= Q / 2``."""
     best_N, best_P, best_cost = 0, 0, np.inf
@@ -99,7 +100,7 @@ def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def binned_is_cheaper(n_jumps, Q, N_max):  # pragma: no cover - compiled
-    """Whether :func:`jump_series_binned` takes fewer operations than :func:`jump_series`
+    """Whether :func:`jump_sums_binned` takes fewer operations than :func:`jump_series`
     for `n_jumps` jumps and harmonics up to `Q` (weighted as in :func:`binned_grid`)."""
     N, P = binned_grid(n_jumps, Q, N_max)
     cost = P * (n_jumps * 2.0 + N * np.log2(N) * 1.5 + Q * 2.0) + Q * (P + 24.0) * 1.5
@@ -190,137 +191,116 @@ def balance(jg, js):  # pragma: no cover - compiled
     return 1.0
 
 
-@njit(cache=True, inline="always")
-def chebyshev_values(t_b, b0, N, P, cell, v, T):  # pragma: no cover - compiled
-    """For the jumps ``b0 .. b0 + 3`` (those that exist): the grid point ``cell[i]`` nearest
-    to each angle (``N`` points) and the Chebyshev polynomials ``T[i, p] = T_p(v)`` of its
-    offset ``v`` in half cells (0 past the last jump), ``p < P``; the four recurrences
-    interleaved."""
-    h = _TWO_PI / N
-    v[:] = 0.0
-    for i in range(min(4, t_b.shape[0] - b0)):
-        t = t_b[b0 + i] % _TWO_PI
-        j = int(np.floor(t / h + 0.5))
-        v[i] = (t - j * h) / (0.5 * h)
-        cell[i] = j - N if j >= N else j
-    for i in range(4):
-        T[i, 0] = 1.0
-    if P > 1:
-        for i in range(4):
-            T[i, 1] = v[i]
-    for p in range(2, P):
-        for i in range(4):
-            T[i, p] = 2.0 * v[i] * T[i, p - 1] - T[i, p - 2]
-
-
 @njit(cache=True)
-def jump_series_binned(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compiled
-    """:func:`jump_series` for many jumps, in ``O(jumps + Q log Q)`` (``Q = max(n_g, n_s)``).
+def binned_table(N, P, L):  # pragma: no cover - compiled
+    """The weights of :func:`jump_sums_binned` for the grid of `N` points, `P` terms and the
+    harmonics ``l = 0 .. L``: row ``l`` holds, for each pair of terms ``p, p + 1`` (``p``
+    even), the weights of the pair's transform at ``l`` and of its conjugate at ``-l``.
 
-    The jumps are binned to the nearest point ``c_j`` of a grid of ``N`` points
-    (``h = 2 pi / N``, :func:`binned_grid`), with ``t_b = c_j + v h / 2``, ``|v| <= 1``;
-    then ``exp(-j q t_b) = exp(-j q c_j) sum_p eps_p (-j)^p J_p(q h / 2) T_p(v)``
-    (Jacobi-Anger: Chebyshev polynomials ``T_p``, Bessel functions ``J_p``, ``eps_0 = 1``,
-    else 2), summed until its terms are below 1e-17: one FFT of the bins' moments ``sum
-    T_p(v) J`` for each term, read at ``q`` modulo ``N``.  `jg` and `js` are transformed
-    together as ``jg + j r js`` (``r`` a power of two that makes the two sums of
-    magnitudes alike).  `tw` is the twiddle table of at least ``N`` points.
+    The terms are ``eps_p (-j)^p J_p(l h / 2) F_p`` (:func:`jump_sums_binned`); a pair's
+    transform ``y`` of ``m_p + j m_p+1`` (real moments) gives ``F_p = (y + conj y_-) / 2``
+    and ``(-j) F_p+1 = -(y - conj y_-) / 2`` (``y_-`` at ``-l``), and ``(-j)^p = (-1)^(p / 2)``.
     """
-    Q = max(n_g, n_s)
-    N, P = binned_grid(t_b.shape[0], Q, 2 * tw.shape[0])
-    h = _TWO_PI / N
-    r = balance(jg, js)  # jg + j r js
-    bins = np.zeros((N, P), dtype=np.complex128)  # a jump's moments side by side
-    cell = np.empty(4, dtype=np.int64)
-    v = np.empty(4)
-    T = np.empty((4, P))
-    for b0 in range(0, t_b.shape[0], 4):
-        chebyshev_values(t_b, b0, N, P, cell, v, T)
-        for i in range(min(4, t_b.shape[0] - b0)):
-            c = complex(jg[b0 + i], js[b0 + i] * r)
-            row = bins[cell[i]]
-            Ti = T[i]
-            for p in range(P):
-                row[p] += c * Ti[p]
-    reversed_index = bit_reversed_indices(N)
-    mu = np.empty((P, N), dtype=np.complex128)
-    for p in range(P):
-        row = mu[p]
-        for j in range(N):
-            row[j] = bins[reversed_index[j], p]
-        fft_unscrambling(row, tw)
-    G = np.zeros(n_g + 1, dtype=np.complex128)
-    S = np.zeros(n_s + 1, dtype=np.complex128)
-    bessel = bessel_table(0.5 * h, Q, P)
-    for q in range(1, Q + 1):
+    bessel = bessel_table(np.pi / N, L, P)
+    n_pairs = (P + 1) // 2
+    table = np.empty((L + 1, 2 * n_pairs))
+    for q in range(L + 1):
         jp = bessel[q]
-        iq = q % N
-        im = (N - iq) % N
-        # sum_p eps_p (-+j)^p J_p mu_p: the powers of -+j cycle with p
-        up = mu[0, iq] * jp[0]
-        um = mu[0, im] * jp[0]
-        for p in range(1, P):
-            fu = 2.0 * jp[p] * mu[p, iq]
-            fm = 2.0 * jp[p] * mu[p, im]
-            ph = p % 4
-            if ph == 0:
-                up += fu
-                um += fm
-            elif ph == 1:
-                up += complex(fu.imag, -fu.real)
-                um += complex(-fm.imag, fm.real)
-            elif ph == 2:
-                up -= fu
-                um -= fm
-            else:
-                up += complex(-fu.imag, fu.real)
-                um += complex(fm.imag, -fm.real)
-        umc = um.conjugate()
-        scale = -1j / (_TWO_PI * q)
-        if q <= n_g:
-            G[q] = 0.5 * (up + umc) * scale
-        if q <= n_s:
-            S[q] = -0.5j * (up - umc) * (scale / r)
-    return G, S
+        for pp in range(n_pairs):
+            p = 2 * pp
+            c_even = jp[p] if p == 0 else 2.0 * jp[p]
+            c_odd = 2.0 * jp[p + 1] if p + 1 < P else 0.0
+            sign = 0.5 if pp % 2 == 0 else -0.5
+            table[q, 2 * pp] = sign * (c_even - c_odd)
+            table[q, 2 * pp + 1] = sign * (c_even + c_odd)
+    return table
 
 
 @njit(cache=True)
-def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - compiled
-    """:func:`jump_series_binned` of a period whose second half mirrors the first: `t_b`,
-    `jg`, `js` are the jumps of the first half, those of the second are ``-jg`` and ``js``
-    at ``t_b + pi`` (``g(t + pi) = -g(t)``, ``s(t + pi) = s(t)``).  Returns the whole
-    period's ``G`` (odd harmonics only) and ``S`` (even harmonics only).
+def chebyshev_moments(t_b, w_plus, w_minus, mirror, N, P):  # pragma: no cover - compiled
+    """The moments ``sum_b w_b T_p(v_b)`` of the points `t_b` (angles in ``[-2 pi, 4 pi)``)
+    binned to the nearest of ``N`` grid points ``c_j`` (``t_b = c_j + v_b h / 2``, ``|v_b|
+    <= 1``): rows ``j``, columns ``p < P`` (then zeros to a multiple of 8 columns).
 
-    Each jump and its mirror make one sum with real weights, ``(r js + jg) / 2`` at
-    ``t_b`` and ``(r js - jg) / 2`` at ``t_b + pi`` (``r`` as in
-    :func:`jump_series_binned`): ``r`` times the sum of `js` at even ``q``, the sum of
-    `jg` at odd ``q``.  Real weights halve the transforms (two terms' moments in one
-    complex FFT) and need ``q >= 0`` only.
+    The weights are `w_plus`; with `mirror` each point has a mirror half a period on
+    (``N / 2`` grid points, the same ``v_b``), weighted by `w_minus`.  The polynomials
+    of four points at a time come from four interleaved Chebyshev recurrences.
     """
-    Q = max(n_g, n_s)
-    N, P = binned_grid(2 * t_b.shape[0], Q, 2 * tw.shape[0])
+    nb = t_b.shape[0]
+    width = (P + 7) // 8 * 8
     h = _TWO_PI / N
+    inv_h = N / _TWO_PI
     half_grid = N // 2
-    r = balance(jg, js)
-    P2 = (P + 1) // 2 * 2  # whole pairs of terms, the last padded with zeros
-    bins = np.zeros((N, P2))  # a jump's moments side by side
-    cell = np.empty(4, dtype=np.int64)
-    v = np.empty(4)
-    T = np.zeros((4, P2))
-    for b0 in range(0, t_b.shape[0], 4):
-        chebyshev_values(t_b, b0, N, P, cell, v, T)
-        for i in range(min(4, t_b.shape[0] - b0)):
-            w_plus = 0.5 * (r * js[b0 + i] + jg[b0 + i])
-            w_minus = 0.5 * (r * js[b0 + i] - jg[b0 + i])
-            j = cell[i]
+    bins = np.zeros((N, width))
+    T = np.zeros((4, width))
+    cells = np.zeros(4, dtype=np.int64)
+    v = np.zeros(4)
+    for b0 in range(0, nb, 4):
+        count = min(4, nb - b0)
+        for i in range(4):
+            t = t_b[b0 + i] if i < count else 0.0
+            if t >= _TWO_PI:
+                t -= _TWO_PI
+            elif t < 0.0:
+                t += _TWO_PI
+            j = int(t * inv_h + 0.5)
+            v[i] = (t - j * h) * (2.0 * inv_h)
+            cells[i] = j - N if j >= N else j
+            T[i, 0] = 1.0
+            T[i, 1] = v[i]
+        x0, x1, x2, x3 = 2.0 * v[0], 2.0 * v[1], 2.0 * v[2], 2.0 * v[3]
+        a0, b0_ = 1.0, v[0]
+        a1, b1 = 1.0, v[1]
+        a2, b2 = 1.0, v[2]
+        a3, b3 = 1.0, v[3]
+        for p in range(2, P):
+            n0 = x0 * b0_ - a0
+            n1 = x1 * b1 - a1
+            n2 = x2 * b2 - a2
+            n3 = x3 * b3 - a3
+            T[0, p] = n0
+            T[1, p] = n1
+            T[2, p] = n2
+            T[3, p] = n3
+            a0, b0_ = b0_, n0
+            a1, b1 = b1, n1
+            a2, b2 = b2, n2
+            a3, b3 = b3, n3
+        for i in range(count):
+            j = cells[i]
             row = bins[j]
-            mirror = bins[j + half_grid if j < half_grid else j - half_grid]
             Ti = T[i]
-            for p in range(P2):
-                row[p] += w_plus * Ti[p]
-                mirror[p] += w_minus * Ti[p]
+            wp = w_plus[b0 + i]
+            if mirror:
+                other = bins[j + half_grid if j < half_grid else j - half_grid]
+                wm = w_minus[b0 + i]
+                for p in range(width):
+                    row[p] += wp * Ti[p]
+                    other[p] += wm * Ti[p]
+            else:
+                for p in range(width):
+                    row[p] += wp * Ti[p]
+    return bins
+
+
+@njit(cache=True)
+def jump_sums_binned(t_b, w_plus, w_minus, mirror, L, N, P, table, tw):  # pragma: no cover
+    """``Z_l = sum_b w_b exp(-j l t_b)`` for ``l = 0 .. L``, real weights `w_plus` (and with
+    `mirror`, `w_minus` half a period on), in ``O(points + L log L)`` (the grid ``N`` and
+    terms ``P`` of :func:`binned_grid`).
+
+    The points are binned to the nearest grid point ``c_j`` (``h = 2 pi / N``), with
+    ``t_b = c_j + v h / 2``, ``|v| <= 1``; then ``exp(-j l t_b) = exp(-j l c_j) sum_p
+    eps_p (-j)^p J_p(l h / 2) T_p(v)`` (Jacobi-Anger: Chebyshev polynomials ``T_p``,
+    Bessel functions ``J_p``, ``eps_0 = 1``, else 2), summed until its terms are below
+    1e-17: one FFT of the bins' moments (:func:`chebyshev_moments`) for each term, read at
+    ``l`` modulo ``N``; real moments go two to a complex FFT.  `table` holds the terms'
+    weights (:func:`binned_table` of ``N``, ``P`` and at least ``L``), `tw` the twiddle
+    table of at least ``N`` points.
+    """
+    n_pairs = (P + 1) // 2
+    bins = chebyshev_moments(t_b, w_plus, w_minus, mirror, N, P)
     reversed_index = bit_reversed_indices(N)
-    n_pairs = P2 // 2
     mu = np.empty((n_pairs, N), dtype=np.complex128)
     for pp in range(n_pairs):
         row = mu[pp]
@@ -328,32 +308,13 @@ def jump_series_binned_half(t_b, jg, js, n_g, n_s, tw):  # pragma: no cover - co
             src = bins[reversed_index[j]]
             row[j] = complex(src[2 * pp], src[2 * pp + 1])
         fft_unscrambling(row, tw)
-    G = np.zeros(n_g + 1, dtype=np.complex128)
-    S = np.zeros(n_s + 1, dtype=np.complex128)
-    bessel = bessel_table(0.5 * h, Q, P)
-    weight_y = np.empty(n_pairs)
-    weight_yc = np.empty(n_pairs)
-    for q in range(1, Q + 1):
-        jp = bessel[q]
+    Z = np.empty(L + 1, dtype=np.complex128)
+    for q in range(L + 1):
         iq = q % N
         im = (N - iq) % N
-        # sum_p eps_p (-j)^p J_p F_p with the pair's F_p = (y + conj y_-) / 2 and F_p+1 =
-        # -j (y - conj y_-) / 2 (y, y_- its transform at q and -q): (-j)^p = (-1)^(p/2) for
-        # p even, and (-j) F_p+1 = -(y - conj y_-) / 2
-        for pp in range(n_pairs):
-            p = 2 * pp
-            c_even = jp[p] if p == 0 else 2.0 * jp[p]
-            c_odd = 2.0 * jp[p + 1] if p + 1 < P else 0.0
-            sign = 0.5 if pp % 2 == 0 else -0.5
-            weight_y[pp] = sign * (c_even - c_odd)
-            weight_yc[pp] = sign * (c_even + c_odd)
+        w = table[q]
         z = 0j
         for pp in range(n_pairs):
-            z += weight_y[pp] * mu[pp, iq] + weight_yc[pp] * mu[pp, im].conjugate()
-        scale = -2j / (_TWO_PI * q)
-        if q % 2 == 1:
-            if q <= n_g:
-                G[q] = z * scale
-        elif q <= n_s:
-            S[q] = z * (scale / r)
-    return G, S
+            z += w[2 * pp] * mu[pp, iq] + w[2 * pp + 1] * mu[pp, im].conjugate()
+        Z[q] = z
+    return Z

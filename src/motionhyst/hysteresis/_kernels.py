@@ -21,10 +21,12 @@ from motionhyst.hysteresis._fft import (
     synthesize_packed,
 )
 from motionhyst.hysteresis._jump_sums import (
+    balance,
+    binned_grid,
     binned_is_cheaper,
+    binned_table,
     jump_series,
-    jump_series_binned,
-    jump_series_binned_half,
+    jump_sums_binned,
 )
 
 
@@ -603,17 +605,34 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
     (:func:`motionhyst.hysteresis.periodic.stop_periodic_harmonics`).
 
     `tw` is the twiddle table (:func:`motionhyst.hysteresis._fft.twiddle_table`) of at
-    least ``grid_size(len(X) - 1, H)`` samples.  The reversals come from
-    :func:`dominant_reversals` where it applies, else from the grid; the product ``s x``
-    is a direct convolution where that takes fewer operations than the transforms.  An
-    input whose even harmonics are below 1e-15 of the total is taken as half-wave
-    symmetric (they are set to zero): with two reversals the output is then found for
-    half a period and mirrored (:func:`stop_pieces`, :func:`jump_series_binned_half`).
+    least ``grid_size(len(X) - 1, H)`` samples.  See :func:`stop_harmonics_kept`, which
+    this calls with nothing kept.
+    """
+    return stop_harmonics_kept(X, k, fc, H, tw, np.empty((0, 0)), np.zeros(2, dtype=np.int64),
+                               0)[0]
+
+
+@njit(cache=True)
+def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cover - compiled
+    """:func:`stop_harmonics`, with the weights of the binned jump sums kept from one call to
+    the next (a fixed point's iterations, the points of a sweep): `table` is
+    :func:`binned_table` of the grid ``grid = [N, P]`` (updated in place); returns the
+    harmonics and the table (the one given when it serves, else a new one).  The grid is
+    chosen for harmonics up to `q_grid` where that exceeds the sums' own ``H + M`` (one
+    grid for inputs of any ``M <= q_grid - H``).
+
+    The reversals come from :func:`dominant_reversals` where it applies, else from the
+    grid.  An input whose even harmonics are below 1e-15 of the total is taken as half-wave
+    symmetric (they are set to zero): with two reversals the output is then found for half
+    a period and mirrored (:func:`stop_pieces`).  The output is ``w = g + s x``: the
+    coefficients of ``g`` and ``s`` are sums over their jumps, binned where that is cheaper
+    (:func:`_binned_series`), and those of ``s x`` a direct convolution where that takes
+    fewer operations than the transforms.
     """
     W = np.zeros(H + 1, dtype=np.complex128)
     M = significant_count(X, 1e-15)
     if M == 0:
-        return W
+        return W, table
     Xs = X[: M + 1].copy()
     Xs[0] = 0.0
     # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
@@ -641,7 +660,7 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
         x = synthesize(Xs, n, tw)
         rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
     if rev.shape[0] < 2:
-        return W
+        return W, table
     mode = GRID_BRACKET
     if monotone:
         mode = BETWEEN_REVERSALS
@@ -654,13 +673,12 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
     half = symmetric and monotone
     t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
     Q = H + M
-    if half and binned_is_cheaper(2 * t_b.shape[0], Q, 2 * tw.shape[0]):
-        G, S = jump_series_binned_half(t_b, jg, js, H, Q, tw)
+    nb = t_b.shape[0]
+    if binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0]):
+        G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
+                                     grid)
     else:
-        if binned_is_cheaper(t_b.shape[0], Q, 2 * tw.shape[0]):
-            G, S = jump_series_binned(t_b, jg, js, H, Q, tw)
-        else:
-            G, S = jump_series(t_b, jg, js, H, Q)
+        G, S = jump_series(t_b, jg, js, H, Q)
         if half:  # a jump's mirror half a period on: g's of opposite sign, s's alike
             for q in range(H + 1):
                 G[q] = 2.0 * G[q] if q % 2 == 1 else 0.0
@@ -676,7 +694,64 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
                 acc += (S[lo] if lo >= 0 else S[-lo].conjugate()) * Xs[m]
                 acc += S[q + m] * Xs[m].conjugate()
             W[q] = acc
-        return W
+        return W, table
+    P_x = _product(S, Xs, n, H, half, tw)
+    for q in range(H + 1):
+        W[q] = G[q] + P_x[q]
+    return W, table
+
+
+@njit(cache=True)
+def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma: no cover
+    """:func:`jump_series` of many jumps, binned (:func:`jump_sums_binned`) on the grid for
+    harmonics up to `q_grid` (>= `Q`), with the weights' `table` of the grid ``grid = [N,
+    P]`` kept (a new one where it does not serve).
+
+    With `half` (the jumps of the first half period; the second's are ``-jg`` and ``js``
+    half a period on) each jump and its mirror make one sum with real weights, ``(r js +
+    jg) / 2`` at ``t_b`` and ``(r js - jg) / 2`` at ``t_b + pi`` (``r`` from
+    :func:`balance`): ``r`` times the sum of `js` at even ``q``, the sum of `jg` at odd
+    ``q``.  Returns ``G``, ``S`` and the table.
+    """
+    nb = t_b.shape[0]
+    n_points = 2 * nb if half else nb
+    N, P = binned_grid(n_points, q_grid, 2 * tw.shape[0])
+    if N != grid[0] or P != grid[1] or table.shape[0] <= Q:
+        table = binned_table(N, P, q_grid)
+        grid[0] = N
+        grid[1] = P
+    G = np.zeros(H + 1, dtype=np.complex128)
+    S = np.zeros(Q + 1, dtype=np.complex128)
+    if half:
+        r = balance(jg, js)
+        w_plus = np.empty(nb)
+        w_minus = np.empty(nb)
+        for b in range(nb):
+            w_plus[b] = 0.5 * (r * js[b] + jg[b])
+            w_minus[b] = 0.5 * (r * js[b] - jg[b])
+        Z = jump_sums_binned(t_b, w_plus, w_minus, True, Q, N, P, table, tw)
+        for q in range(1, Q + 1):
+            scale = -2j / (_TWO_PI * q)
+            if q % 2 == 1:
+                if q <= H:
+                    G[q] = Z[q] * scale
+            else:
+                S[q] = Z[q] * (scale / r)
+        return G, S, table
+    Zg = jump_sums_binned(t_b, jg, jg, False, H, N, P, table, tw)
+    Zs = jump_sums_binned(t_b, js, js, False, Q, N, P, table, tw)
+    for q in range(1, Q + 1):
+        scale = -1j / (_TWO_PI * q)
+        if q <= H:
+            G[q] = Zg[q] * scale
+        S[q] = Zs[q] * scale
+    return G, S, table
+
+
+@njit(cache=True)
+def _product(S, Y, n, H, half, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. H`` of ``s y`` from those of ``s`` (`S`) and ``y`` (`Y`), by transforms
+    of `n` samples; with `half` ``s`` repeats after half a period (even harmonics only)."""
     if half:  # s repeats after half a period: its samples from half the transform
         zh = synthesize_packed(S[0::2].copy(), n // 2, tw)
         zs = np.empty(n // 2, dtype=np.complex128)
@@ -685,7 +760,4 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
             zs[2 * u + 1] = zh[u]
     else:
         zs = synthesize_packed(S, n, tw)
-    P = analyze_packed(packed_product(synthesize_packed(Xs, n, tw), zs), n, H, tw)
-    for q in range(H + 1):
-        W[q] = G[q] + P[q]
-    return W
+    return analyze_packed(packed_product(synthesize_packed(Y, n, tw), zs), n, H, tw)

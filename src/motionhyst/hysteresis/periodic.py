@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis._fft import twiddle_table
 from motionhyst.hysteresis._kernels import stop_harmonics
+from motionhyst.hysteresis._kernels import stop_harmonics_kept as stop_harmonics_kept
 
 __all__ = ["TWO_PI", "sample_period", "significant_harmonics", "stop_periodic_harmonics",
            "trig_eval"]
