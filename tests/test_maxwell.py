@@ -245,3 +245,48 @@ def test_single_element_to_dict_stays_a_list():
     d = MaxwellSlip([3.0], [1.0]).to_dict()
     assert d == {"model": "maxwell-slip", "k": [3.0], "fc": [1.0]}
     assert isinstance(hysteresis_from_dict(d), MaxwellSlip)
+
+
+def test_many_elements_steady_state_is_the_same_whatever_came_before():
+    """The binned jump sums' weights are kept from one point to the next: the steady state
+    of each point is the same, bit for bit, whichever points were computed before."""
+    from motionhyst import Loop, default_scenario, periodic_steady_state
+
+    loop = default_scenario().loop()
+    u = np.geomspace(0.1, 10.0, 400) * 2.5e-3  # slip displacements fc / k [m]
+    k = np.full(400, 0.05)
+    link = Loop(loop.plant, loop.controller, MaxwellSlip(k, k * u * 0.05 / np.sum(k * u)))
+    points = [(0.01, 10.5), (0.003, 10.0), (0.01, 3.7), (0.02, 10.2)]
+    forward = [periodic_steady_state(link, A, f).e for A, f in points]
+    backward = [periodic_steady_state(link, A, f).e for A, f in reversed(points)][::-1]
+    for a, b in zip(forward, backward, strict=True):
+        assert_array_equal(a, b)
+    assert abs(forward[0][3]) > 1e-3 * abs(forward[0][1])  # the elements slip
+
+
+@pytest.mark.parametrize("A", [0.004, 0.01])
+def test_half_period_onsets_on_the_cubic_are_the_general_pass(A):
+    """The half-period pass over elements sorted by slip displacement (one walk along the
+    branch) gives the general pass's pieces exactly: elements that slip, that never slip,
+    and several with the same slip displacement."""
+    from motionhyst.hysteresis import _fft, _kernels
+    from motionhyst.hysteresis.periodic import stop_twiddles
+
+    M, n = 41, 1024
+    rng = np.random.default_rng(2)
+    X = np.zeros(M + 1, dtype=complex)
+    X[1] = A / 2j
+    X[3::2] = 1e-6 * A * (rng.standard_normal(20) + 1j * rng.standard_normal(20))
+    m = np.arange(M + 1)
+    C1, C2 = 1j * m * X, -(m**2) * X
+    ok, rev, xr = _kernels.dominant_reversals(X, C1, C2, True)
+    assert ok
+    x = _fft.synthesize(X, n, stop_twiddles(M, M))
+    u = np.sort(np.concatenate([np.geomspace(1e-6, 0.02, 300), [1e-3] * 5]))
+    k = rng.uniform(0.5, 2.0, u.size)
+    top = 1 if xr[1] > xr[0] else 0
+    general = _kernels.stop_pieces(X, C1, x, rev, xr, k, k * u, _kernels.GRID_CUBIC, True)
+    walked = _kernels.half_cubic_pieces(x, rev[top], xr[top], k, k * u)
+    for a, b in zip(general, walked, strict=True):
+        assert_array_equal(a, b)
+    assert 0 < general[0].size - 1 < u.size  # some elements slip, some never do

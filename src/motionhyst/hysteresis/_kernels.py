@@ -362,11 +362,17 @@ def _cubic_crossing(x, level, a, b, fa, fb, cursor):  # pragma: no cover - compi
     c1 = x1 - xm * _THIRD - 0.5 * x0 - x2 * _SIXTH
     c2 = 0.5 * (xm + x1) - x0
     c3 = (x2 - xm) * _SIXTH + 0.5 * (x0 - x1)
-    c0 = x0 - level
-    u_lo = lo - c
-    u_hi = hi - c
+    u = _cubic_root(x0 - level, c1, c2, c3, lo - c, hi - c, flo, fhi, fa < 0.0)
+    return (u + c) * h, cursor
+
+
+@njit(cache=True, inline="always")
+def _cubic_root(c0, c1, c2, c3, u_lo, u_hi, flo, fhi, rising):  # pragma: no cover - compiled
+    """Root ``u`` in [`u_lo`, `u_hi`] of the cubic ``c0 + c1 u + c2 u^2 + c3 u^3`` (`flo`,
+    `fhi` its values at the ends, `rising` if it rises there): Newton from the linear
+    interpolant, kept in the bracket, until the next step would be below 1e-10 cells (far
+    below the cubic's own error; the steps shrink quadratically)."""
     u = u_lo + (u_hi - u_lo) * flo / (flo - fhi)
-    rising = fa < 0.0
     last = np.inf
     for _ in range(30):
         f = c0 + u * (c1 + u * (c2 + u * c3))
@@ -381,10 +387,10 @@ def _cubic_crossing(x, level, a, b, fa, fb, cursor):  # pragma: no cover - compi
             u_new = 0.5 * (u_lo + u_hi)
             step = np.inf
         elif step <= 1e-13 or (step < 1e-3 * last and step * step * step <= 1e-10 * last * last):
-            return (u_new + c) * h, cursor
+            return u_new
         last = step
         u = u_new
-    return (u + c) * h, cursor
+    return u
 
 
 @njit(cache=True)
@@ -517,6 +523,124 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode, half):  # pragma: no cover - com
     if half:
         return t_b[:nb], jg[:nb], js[:nb], 0.0, 2.0 * s_mean / _TWO_PI
     return t_b[:nb], jg[:nb], js[:nb], g_mean / _TWO_PI, s_mean / _TWO_PI
+
+
+@njit(cache=True)
+def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
+    """:func:`stop_pieces` with `half` and :data:`GRID_CUBIC`, for elements sorted by ``fc /
+    k``: the same pieces (the same arithmetic), from the maximum `x_top` at angle `a` down
+    to ``-x_top`` half a period on.
+
+    The elements' slip levels come in order along the branch, so one walk over the grid
+    samples `x` finds their cells (the first by bisection); a cell's cubic
+    (:func:`_cubic_crossing`) is set up once for all the levels in it.
+    """
+    m = k.shape[0]
+    n = x.shape[0]
+    h = _TWO_PI / n
+    inv_h = n / _TWO_PI
+    b = a + np.pi
+    x_end = -x_top
+    down = x_end - x_top
+    up = x_top - x_end
+    lo0 = a * inv_h
+    hi0 = b * inv_h
+    j_lo = int(np.floor(lo0)) + 1
+    j_hi = int(np.ceil(hi0)) - 1
+    t_b = np.empty(m + 1)
+    jg = np.empty(m + 1)
+    js = np.empty(m + 1)
+    nb = 0
+    s_mean = 0.0
+    at_g = 0.0
+    at_s = 0.0
+    cursor = -1
+    last_level = 0.0
+    cell = -1
+    x0 = c1 = c2 = c3 = 0.0
+    for e in range(m):
+        ke, fe = k[e], fc[e]
+        w = min(max(ke * x_top, -fe), fe)
+        w = min(max(w + ke * down, -fe), fe)
+        wi = min(max(w + ke * up, -fe), fe)  # the periodic state at the maximum
+        slip_level = x_top + (-fe - wi) / ke  # x where the spring reaches -fc
+        s = b
+        if -(x_end - slip_level) > 0.0:
+            fa = x_top - slip_level
+            fb = x_end - slip_level
+            if cursor >= 0 and -(slip_level - last_level) < 0.0:
+                cursor = -1  # behind the last level: bisect
+            last_level = slip_level
+            level = slip_level
+            if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
+                s = a if abs(fa) <= abs(fb) else b
+            else:
+                lo, flo, hi, fhi = lo0, fa, hi0, fb
+                found = False
+                if cursor >= 0:
+                    j = max(cursor, j_lo)
+                    while j <= j_hi:
+                        f = x[j if j < n else j - n] - level
+                        if f == 0.0:
+                            s = j * h
+                            found = True
+                            break
+                        if (f > 0.0) != (fa > 0.0):
+                            hi, fhi = float(j), f
+                            break
+                        j += 1
+                    cursor = j
+                    if not found and j - 1 >= j_lo:
+                        lo = float(j - 1)
+                        flo = x[j - 1 if j - 1 < n else j - 1 - n] - level
+                else:
+                    jl, jh = j_lo, j_hi
+                    while jl <= jh:
+                        j = (jl + jh) // 2
+                        f = x[j if j < n else j - n] - level
+                        if f == 0.0:
+                            s = j * h
+                            found = True
+                            jl = j
+                            break
+                        if (f > 0.0) == (fa > 0.0):
+                            lo, flo, jl = float(j), f, j + 1
+                        else:
+                            hi, fhi, jh = float(j), f, j - 1
+                    cursor = jl
+                if not found:
+                    c = int(np.floor(0.5 * (lo + hi)))
+                    if c != cell:
+                        cell = c
+                        i0 = c % n
+                        im = i0 - 1 if i0 >= 1 else n - 1
+                        i1 = i0 + 1 if i0 + 1 < n else 0
+                        i2 = i1 + 1 if i1 + 1 < n else 0
+                        xm, x0, x1, x2 = x[im], x[i0], x[i1], x[i2]
+                        c1 = x1 - xm * _THIRD - 0.5 * x0 - x2 * _SIXTH
+                        c2 = 0.5 * (xm + x1) - x0
+                        c3 = (x2 - xm) * _SIXTH + 0.5 * (x0 - x1)
+                    s = _cubic_root(x0 - level, c1, c2, c3, lo - c, hi - c, flo, fhi,
+                                    fa < 0.0) + c
+                    s *= h
+        g_stick = wi - ke * x_top
+        if s > a:
+            first_g, first_s = g_stick, ke
+            s_mean += ke * (s - a)
+        else:
+            first_g, first_s = -fe, 0.0
+        if b > s:
+            last_g, last_s = -fe, 0.0
+        else:
+            last_g, last_s = g_stick, ke
+        if a < s < b:
+            t_b[nb], jg[nb], js[nb] = s, -fe - g_stick, -ke
+            nb += 1
+        at_g += first_g + last_g
+        at_s += first_s - last_s
+    t_b[nb], jg[nb], js[nb] = a, at_g, at_s
+    nb += 1
+    return t_b[:nb], jg[:nb], js[:nb], 0.0, 2.0 * s_mean / _TWO_PI
 
 
 @njit(cache=True)
@@ -671,7 +795,11 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
             mode = GRID_CUBIC
             x = synthesize(Xs, n, tw)
     half = symmetric and monotone
-    t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
+    if half and mode == GRID_CUBIC:
+        top = 1 if xr[1] > xr[0] else 0
+        t_b, jg, js, g_mean, s_mean = half_cubic_pieces(x, rev[top], xr[top], k, fc)
+    else:
+        t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
     Q = H + M
     nb = t_b.shape[0]
     if binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0]):
