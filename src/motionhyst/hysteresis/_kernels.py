@@ -525,15 +525,18 @@ def stop_pieces(X, C1, x, rev, xr, k, fc, mode, half):  # pragma: no cover - com
     return t_b[:nb], jg[:nb], js[:nb], g_mean / _TWO_PI, s_mean / _TWO_PI
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
     """:func:`stop_pieces` with `half` and :data:`GRID_CUBIC`, for elements sorted by ``fc /
     k``: the same pieces (the same arithmetic), from the maximum `x_top` at angle `a` down
     to ``-x_top`` half a period on.
 
-    The elements' slip levels come in order along the branch, so one walk over the grid
-    samples `x` finds their cells (the first by bisection); a cell's cubic
-    (:func:`_cubic_crossing`) is set up once for all the levels in it.
+    In passes over the elements: their slip levels; their cells along the branch, in one
+    walk over the grid samples `x` (the levels come in order; the first by bisection);
+    the first Newton step on each cell's cubic (:func:`_cubic_crossing`) for all elements
+    side by side, the further steps where it does not end; the pieces.  (Division by
+    zero gives inf here rather than an error, so that the passes run on vectors; the
+    results of such divisions are not used.)
     """
     m = k.shape[0]
     n = x.shape[0]
@@ -547,6 +550,129 @@ def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
     hi0 = b * inv_h
     j_lo = int(np.floor(lo0)) + 1
     j_hi = int(np.ceil(hi0)) - 1
+    # pass 1: the periodic state at the maximum and the slip level of each element
+    level = np.empty(m)
+    wis = np.empty(m)
+    for e in range(m):
+        ke = k[e]
+        fe = fc[e]
+        w = min(max(ke * x_top, -fe), fe)
+        w = min(max(w + ke * down, -fe), fe)
+        wi = min(max(w + ke * up, -fe), fe)
+        wis[e] = wi
+        level[e] = x_top + (-fe - wi) / ke
+    # pass 2: each slipping element's cell along the branch (one walk), or its angle
+    s_of = np.empty(m)
+    c_of = np.empty(m, dtype=np.int64)   # -1: s known
+    lo_of = np.zeros(m)  # the bracket in cells from c, the cubic's values at its ends
+    hi_of = np.ones(m)
+    flo_of = np.ones(m)
+    fhi_of = -np.ones(m)
+    cursor = -1
+    last_level = 0.0
+    for e in range(m):
+        slip_level = level[e]
+        c_of[e] = -1
+        s_of[e] = b
+        if not (-(x_end - slip_level) > 0.0):
+            continue
+        fa = x_top - slip_level
+        fb = x_end - slip_level
+        if cursor >= 0 and -(slip_level - last_level) < 0.0:
+            cursor = -1
+        last_level = slip_level
+        lv = slip_level
+        if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
+            s_of[e] = a if abs(fa) <= abs(fb) else b
+            continue
+        lo, flo, hi, fhi = lo0, fa, hi0, fb
+        found = False
+        if cursor >= 0:
+            j = max(cursor, j_lo)
+            while j <= j_hi:
+                f = x[j if j < n else j - n] - lv
+                if f == 0.0:
+                    s_of[e] = j * h
+                    found = True
+                    break
+                if (f > 0.0) != (fa > 0.0):
+                    hi, fhi = float(j), f
+                    break
+                j += 1
+            cursor = j
+            if not found and j - 1 >= j_lo:
+                lo = float(j - 1)
+                flo = x[j - 1 if j - 1 < n else j - 1 - n] - lv
+        else:
+            jl, jh = j_lo, j_hi
+            while jl <= jh:
+                j = (jl + jh) // 2
+                f = x[j if j < n else j - n] - lv
+                if f == 0.0:
+                    s_of[e] = j * h
+                    found = True
+                    jl = j
+                    break
+                if (f > 0.0) == (fa > 0.0):
+                    lo, flo, jl = float(j), f, j + 1
+                else:
+                    hi, fhi, jh = float(j), f, j - 1
+            cursor = jl
+        if not found:
+            c = int(np.floor(0.5 * (lo + hi)))
+            c_of[e] = c
+            lo_of[e] = lo - c
+            hi_of[e] = hi - c
+            flo_of[e] = flo
+            fhi_of[e] = fhi
+    # pass 3: Newton on each cell's cubic, the first step for all elements side by side
+    u_first = np.empty(m)
+    accepted = np.empty(m, dtype=np.bool_)
+    for e in range(m):
+        c = max(c_of[e], 0)
+        i0 = c - n if c >= n else c
+        im = i0 - 1 if i0 >= 1 else n - 1
+        i1 = i0 + 1 if i0 + 1 < n else 0
+        i2 = i1 + 1 if i1 + 1 < n else 0
+        xm = x[im]
+        x0 = x[i0]
+        x1 = x[i1]
+        x2 = x[i2]
+        c1 = x1 - xm * _THIRD - 0.5 * x0 - x2 * _SIXTH
+        c2 = 0.5 * (xm + x1) - x0
+        c3 = (x2 - xm) * _SIXTH + 0.5 * (x0 - x1)
+        c0 = x0 - level[e]
+        u_lo = lo_of[e]
+        u_hi = hi_of[e]
+        flo = flo_of[e]
+        u = u_lo + (u_hi - u_lo) * flo / (flo - fhi_of[e])
+        f = c0 + u * (c1 + u * (c2 + u * c3))
+        fp = c1 + u * (2.0 * c2 + 3.0 * u * c3)
+        rising_side = f > 0.0  # the cubic falls: f > 0 before the root
+        lo1 = u if rising_side else u_lo
+        hi1 = u_hi if rising_side else u
+        u_new = u - f / fp
+        u_first[e] = u_new
+        accepted[e] = (fp != 0.0) & (lo1 <= u_new) & (u_new <= hi1)
+    for e in range(m):
+        c = c_of[e]
+        if c < 0:
+            continue
+        if accepted[e]:
+            s = u_first[e] + c
+        else:
+            i0 = c % n
+            im = i0 - 1 if i0 >= 1 else n - 1
+            i1 = i0 + 1 if i0 + 1 < n else 0
+            i2 = i1 + 1 if i1 + 1 < n else 0
+            xm, x0, x1, x2 = x[im], x[i0], x[i1], x[i2]
+            c1 = x1 - xm * _THIRD - 0.5 * x0 - x2 * _SIXTH
+            c2 = 0.5 * (xm + x1) - x0
+            c3 = (x2 - xm) * _SIXTH + 0.5 * (x0 - x1)
+            s = _cubic_root(x0 - level[e], c1, c2, c3, lo_of[e], hi_of[e], flo_of[e],
+                            fhi_of[e], False) + c
+        s_of[e] = s * h
+    # pass 4: the pieces
     t_b = np.empty(m + 1)
     jg = np.empty(m + 1)
     js = np.empty(m + 1)
@@ -554,76 +680,11 @@ def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
     s_mean = 0.0
     at_g = 0.0
     at_s = 0.0
-    cursor = -1
-    last_level = 0.0
-    cell = -1
-    x0 = c1 = c2 = c3 = 0.0
     for e in range(m):
-        ke, fe = k[e], fc[e]
-        w = min(max(ke * x_top, -fe), fe)
-        w = min(max(w + ke * down, -fe), fe)
-        wi = min(max(w + ke * up, -fe), fe)  # the periodic state at the maximum
-        slip_level = x_top + (-fe - wi) / ke  # x where the spring reaches -fc
-        s = b
-        if -(x_end - slip_level) > 0.0:
-            fa = x_top - slip_level
-            fb = x_end - slip_level
-            if cursor >= 0 and -(slip_level - last_level) < 0.0:
-                cursor = -1  # behind the last level: bisect
-            last_level = slip_level
-            level = slip_level
-            if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
-                s = a if abs(fa) <= abs(fb) else b
-            else:
-                lo, flo, hi, fhi = lo0, fa, hi0, fb
-                found = False
-                if cursor >= 0:
-                    j = max(cursor, j_lo)
-                    while j <= j_hi:
-                        f = x[j if j < n else j - n] - level
-                        if f == 0.0:
-                            s = j * h
-                            found = True
-                            break
-                        if (f > 0.0) != (fa > 0.0):
-                            hi, fhi = float(j), f
-                            break
-                        j += 1
-                    cursor = j
-                    if not found and j - 1 >= j_lo:
-                        lo = float(j - 1)
-                        flo = x[j - 1 if j - 1 < n else j - 1 - n] - level
-                else:
-                    jl, jh = j_lo, j_hi
-                    while jl <= jh:
-                        j = (jl + jh) // 2
-                        f = x[j if j < n else j - n] - level
-                        if f == 0.0:
-                            s = j * h
-                            found = True
-                            jl = j
-                            break
-                        if (f > 0.0) == (fa > 0.0):
-                            lo, flo, jl = float(j), f, j + 1
-                        else:
-                            hi, fhi, jh = float(j), f, j - 1
-                    cursor = jl
-                if not found:
-                    c = int(np.floor(0.5 * (lo + hi)))
-                    if c != cell:
-                        cell = c
-                        i0 = c % n
-                        im = i0 - 1 if i0 >= 1 else n - 1
-                        i1 = i0 + 1 if i0 + 1 < n else 0
-                        i2 = i1 + 1 if i1 + 1 < n else 0
-                        xm, x0, x1, x2 = x[im], x[i0], x[i1], x[i2]
-                        c1 = x1 - xm * _THIRD - 0.5 * x0 - x2 * _SIXTH
-                        c2 = 0.5 * (xm + x1) - x0
-                        c3 = (x2 - xm) * _SIXTH + 0.5 * (x0 - x1)
-                    s = _cubic_root(x0 - level, c1, c2, c3, lo - c, hi - c, flo, fhi,
-                                    fa < 0.0) + c
-                    s *= h
-        g_stick = wi - ke * x_top
+        ke = k[e]
+        fe = fc[e]
+        s = s_of[e]
+        g_stick = wis[e] - ke * x_top
         if s > a:
             first_g, first_s = g_stick, ke
             s_mean += ke * (s - a)
@@ -732,8 +793,9 @@ def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
     least ``grid_size(len(X) - 1, H)`` samples.  See :func:`stop_harmonics_kept`, which
     this calls with nothing kept.
     """
+    # q_grid = H: the grid for the sums' own H + M harmonics
     return stop_harmonics_kept(X, k, fc, H, tw, np.empty((0, 0)), np.zeros(2, dtype=np.int64),
-                               0)[0]
+                               H)[0]
 
 
 @njit(cache=True)
@@ -857,7 +919,7 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma:
         for b in range(nb):
             w_plus[b] = 0.5 * (r * js[b] + jg[b])
             w_minus[b] = 0.5 * (r * js[b] - jg[b])
-        Z = jump_sums_binned(t_b, w_plus, w_minus, True, Q, N, P, table, tw)
+        Z = jump_sums_binned(t_b, w_plus, w_minus, half, Q, N, P, table, tw)
         for q in range(1, Q + 1):
             scale = -2j / (_TWO_PI * q)
             if q % 2 == 1:
@@ -866,8 +928,8 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma:
             else:
                 S[q] = Z[q] * (scale / r)
         return G, S, table
-    Zg = jump_sums_binned(t_b, jg, jg, False, H, N, P, table, tw)
-    Zs = jump_sums_binned(t_b, js, js, False, Q, N, P, table, tw)
+    Zg = jump_sums_binned(t_b, jg, jg, half, H, N, P, table, tw)  # half is False here
+    Zs = jump_sums_binned(t_b, js, js, half, Q, N, P, table, tw)
     for q in range(1, Q + 1):
         scale = -1j / (_TWO_PI * q)
         if q <= H:
