@@ -13,7 +13,7 @@ the corners of ``w`` or from samples that miss a reversal, so the describing
 function and the periodic steady state reach round-off accuracy.  The whole
 computation (roots, the element's pass over its pieces, the jump sums, the
 transforms of the product) is one compiled kernel,
-:func:`stop_harmonics` (:mod:`motionhyst.hysteresis._kernels`); where the first
+:func:`stop_harmonics` (:mod:`motionhyst.hysteresis._stop_harmonics`); where the first
 harmonic of ``x`` dominates, its reversals are bracketed by bounds on the other
 harmonics rather than on a grid, and the slip onsets between them directly.  An input
 without even harmonics (a symmetric loop driven by a sine) makes the second half period
@@ -26,8 +26,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis._fft import twiddle_table
-from motionhyst.hysteresis._kernels import stop_harmonics
-from motionhyst.hysteresis._kernels import stop_harmonics_kept as stop_harmonics_kept
+from motionhyst.hysteresis._stop_harmonics import stop_harmonics
+from motionhyst.hysteresis._stop_harmonics import stop_harmonics_kept as stop_harmonics_kept
 
 __all__ = ["TWO_PI", "sample_period", "significant_harmonics", "stop_periodic_harmonics",
            "trig_eval"]

@@ -1,0 +1,239 @@
+"""The exact periodic output of parallel stop operators, compiled whole (numba).
+
+:func:`stop_harmonics` is :func:`motionhyst.hysteresis.periodic.stop_periodic_harmonics`
+in one kernel: the input's reversal points and the elements' pieces between them
+(:mod:`motionhyst.hysteresis._kernels`), the sums over the pieces' jumps
+(:mod:`motionhyst.hysteresis._jump_sums`) and the product ``s x`` by compiled FFTs
+(:mod:`motionhyst.hysteresis._fft`).  :func:`stop_harmonics_kept` keeps the binned sums'
+weights from one call to the next (a fixed point's iterations, a sweep's points).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from motionhyst.core.compiled import njit
+from motionhyst.hysteresis._fft import (
+    analyze_packed,
+    packed_product,
+    synthesize,
+    synthesize_packed,
+)
+from motionhyst.hysteresis._jump_sums import (
+    balance,
+    binned_grid,
+    binned_is_cheaper,
+    binned_table,
+    jump_series,
+    jump_sums_binned,
+)
+from motionhyst.hysteresis._kernels import (
+    BETWEEN_REVERSALS,
+    CUBIC_ELEMENTS,
+    GRID_BRACKET,
+    GRID_CUBIC,
+    cubic_error_bound,
+    dominant_reversals,
+    half_cubic_pieces,
+    reversal_points,
+    stop_pieces,
+)
+
+_TWO_PI = 2.0 * np.pi
+
+
+@njit(cache=True)
+def grid_size(M, H):  # pragma: no cover - compiled
+    """Samples of the grid of :func:`stop_harmonics`: a power of two that brackets the roots
+    (at least 1024 cells, 4 per harmonic) and carries ``s x`` without aliasing."""
+    need = max(1024, 4 * M, 2 * (H + M) + 1)
+    n = 1024
+    while n < need:
+        n *= 2
+    return n
+
+
+@njit(cache=True)
+def significant_count(X, rtol):  # pragma: no cover - compiled
+    """Number of leading harmonics of `X` (DC aside) whose tail is below `rtol` of the total
+    (:func:`motionhyst.hysteresis.periodic.significant_harmonics`)."""
+    total = 0.0
+    for m in range(1, X.shape[0]):
+        total += abs(X[m])
+    if total == 0.0:
+        return 0
+    tail = 0.0
+    for m in range(X.shape[0] - 1, 0, -1):
+        tail += abs(X[m])
+        if tail > rtol * total:
+            return m
+    return 0
+
+
+@njit(cache=True)
+def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. H`` of the periodic output of parallel stop operators, compiled whole
+    (:func:`motionhyst.hysteresis.periodic.stop_periodic_harmonics`).
+
+    `tw` is the twiddle table (:func:`motionhyst.hysteresis._fft.twiddle_table`) of at
+    least ``grid_size(len(X) - 1, H)`` samples.  See :func:`stop_harmonics_kept`, which
+    this calls with nothing kept.
+    """
+    # q_grid = H: the grid for the sums' own H + M harmonics
+    return stop_harmonics_kept(X, k, fc, H, tw, np.empty((0, 0)), np.zeros(2, dtype=np.int64),
+                               H)[0]
+
+
+@njit(cache=True)
+def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cover - compiled
+    """:func:`stop_harmonics`, with the weights of the binned jump sums kept from one call to
+    the next (a fixed point's iterations, the points of a sweep): `table` is
+    :func:`binned_table` of the grid ``grid = [N, P]`` (updated in place); returns the
+    harmonics and the table (the one given when it serves, else a new one).  The grid is
+    chosen for harmonics up to `q_grid` where that exceeds the sums' own ``H + M`` (one
+    grid for inputs of any ``M <= q_grid - H``).
+
+    The reversals come from :func:`dominant_reversals` where it applies, else from the
+    grid.  An input whose even harmonics are below 1e-15 of the total is taken as half-wave
+    symmetric (they are set to zero): with two reversals the output is then found for half
+    a period and mirrored (:func:`stop_pieces`).  The output is ``w = g + s x``: the
+    coefficients of ``g`` and ``s`` are sums over their jumps, binned where that is cheaper
+    (:func:`_binned_series`), and those of ``s x`` a direct convolution where that takes
+    fewer operations than the transforms.
+    """
+    W = np.zeros(H + 1, dtype=np.complex128)
+    M = significant_count(X, 1e-15)
+    if M == 0:
+        return W, table
+    Xs = X[: M + 1].copy()
+    Xs[0] = 0.0
+    # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
+    # loop's y1): made exact, its output's second half period mirrors the first
+    total = 0.0
+    even = 0.0
+    for m in range(1, M + 1):
+        total += abs(Xs[m])
+        if m % 2 == 0:
+            even += abs(Xs[m])
+    symmetric = even <= 1e-15 * total
+    if symmetric:
+        for m in range(2, M + 1, 2):
+            Xs[m] = 0.0
+    C1 = np.empty(M + 1, dtype=np.complex128)
+    C2 = np.empty(M + 1, dtype=np.complex128)
+    for m in range(M + 1):
+        C1[m] = 1j * m * Xs[m]
+        C2[m] = -(m * m) * Xs[m]
+    n = grid_size(M, H)
+    direct = 2 * M * (H + 1) <= 4 * n
+    monotone, rev, xr = dominant_reversals(Xs, C1, C2, symmetric)
+    x = np.empty(0)
+    if not monotone:
+        x = synthesize(Xs, n, tw)
+        rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
+    if rev.shape[0] < 2:
+        return W, table
+    mode = GRID_BRACKET
+    if monotone:
+        mode = BETWEEN_REVERSALS
+        # many elements: slip onsets on the grid's cubic where its error is far below x's
+        # range (the output changes with the square of an onset's error: w is continuous)
+        if (k.shape[0] >= CUBIC_ELEMENTS
+                and cubic_error_bound(Xs, n) <= 1e-9 * abs(xr[0] - xr[1])):
+            mode = GRID_CUBIC
+            x = synthesize(Xs, n, tw)
+    half = symmetric and monotone
+    if half and mode == GRID_CUBIC:
+        top = 1 if xr[1] > xr[0] else 0
+        t_b, jg, js, g_mean, s_mean = half_cubic_pieces(x, rev[top], xr[top], k, fc)
+    else:
+        t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
+    Q = H + M
+    nb = t_b.shape[0]
+    if binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0]):
+        G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
+                                     grid)
+    else:
+        G, S = jump_series(t_b, jg, js, H, Q)
+        if half:  # a jump's mirror half a period on: g's of opposite sign, s's alike
+            for q in range(H + 1):
+                G[q] = 2.0 * G[q] if q % 2 == 1 else 0.0
+            for q in range(Q + 1):
+                S[q] = 2.0 * S[q] if q % 2 == 0 else 0.0
+    G[0] = g_mean
+    S[0] = s_mean
+    if direct:
+        for q in range(H + 1):
+            acc = G[q]
+            for m in range(1, M + 1):
+                lo = q - m
+                acc += (S[lo] if lo >= 0 else S[-lo].conjugate()) * Xs[m]
+                acc += S[q + m] * Xs[m].conjugate()
+            W[q] = acc
+        return W, table
+    P_x = _product(S, Xs, n, H, half, tw)
+    for q in range(H + 1):
+        W[q] = G[q] + P_x[q]
+    return W, table
+
+
+@njit(cache=True)
+def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma: no cover
+    """:func:`jump_series` of many jumps, binned (:func:`jump_sums_binned`) on the grid for
+    harmonics up to `q_grid` (>= `Q`), with the weights' `table` of the grid ``grid = [N,
+    P]`` kept (a new one where it does not serve).
+
+    With `half` (the jumps of the first half period; the second's are ``-jg`` and ``js``
+    half a period on) each jump and its mirror make one sum with real weights, ``(r js +
+    jg) / 2`` at ``t_b`` and ``(r js - jg) / 2`` at ``t_b + pi`` (``r`` from
+    :func:`balance`): ``r`` times the sum of `js` at even ``q``, the sum of `jg` at odd
+    ``q``.  Returns ``G``, ``S`` and the table.
+    """
+    nb = t_b.shape[0]
+    n_points = 2 * nb if half else nb
+    N, P = binned_grid(n_points, q_grid, 2 * tw.shape[0])
+    if N != grid[0] or P != grid[1] or table.shape[0] <= Q:
+        table = binned_table(N, P, q_grid)
+        grid[0] = N
+        grid[1] = P
+    G = np.zeros(H + 1, dtype=np.complex128)
+    S = np.zeros(Q + 1, dtype=np.complex128)
+    if half:
+        r = balance(jg, js)
+        w_plus = np.empty(nb)
+        w_minus = np.empty(nb)
+        for b in range(nb):
+            w_plus[b] = 0.5 * (r * js[b] + jg[b])
+            w_minus[b] = 0.5 * (r * js[b] - jg[b])
+        Z = jump_sums_binned(t_b, w_plus, w_minus, half, Q, N, P, table, tw)
+        for q in range(1, Q + 1):
+            scale = -2j / (_TWO_PI * q)
+            if q % 2 == 1:
+                if q <= H:
+                    G[q] = Z[q] * scale
+            else:
+                S[q] = Z[q] * (scale / r)
+        return G, S, table
+    Zg = jump_sums_binned(t_b, jg, jg, half, H, N, P, table, tw)  # half is False here
+    Zs = jump_sums_binned(t_b, js, js, half, Q, N, P, table, tw)
+    for q in range(1, Q + 1):
+        scale = -1j / (_TWO_PI * q)
+        if q <= H:
+            G[q] = Zg[q] * scale
+        S[q] = Zs[q] * scale
+    return G, S, table
+
+
+@njit(cache=True)
+def _product(S, Y, n, H, half, tw):  # pragma: no cover - compiled
+    """Harmonics ``0 .. H`` of ``s y`` from those of ``s`` (`S`) and ``y`` (`Y`), by transforms
+    of `n` samples; with `half` ``s`` repeats after half a period (even harmonics only)."""
+    if half:  # s repeats after half a period: its samples from half the transform
+        zh = synthesize_packed(S[0::2].copy(), n // 2, tw)
+        zs = np.empty(n // 2, dtype=np.complex128)
+        for u in range(n // 4):  # t and t + n / 4 are neighbours in bit-reversed order
+            zs[2 * u] = zh[u]
+            zs[2 * u + 1] = zh[u]
+    else:
+        zs = synthesize_packed(S, n, tw)
+    return analyze_packed(packed_product(synthesize_packed(Y, n, tw), zs), n, H, tw)
