@@ -82,7 +82,8 @@ def test_table_and_summary_name_the_compensation(study_file, tmp_path):
     run_study(Study.from_file(study_file), tmp_path / "s.zarr", workers=0)
     ds = open_results(tmp_path / "s.zarr")
     lines = to_table(ds).splitlines()
-    assert lines[0].startswith("scan.speed,scan.compensation,frequency_hz,amplitude,ma_max,")
+    # frequency_hz is the file's axis; no amplitude (the scenario's [reference]) is carried
+    assert lines[0].startswith("scan.speed,scan.compensation,frequency_hz,ma_max,")
     assert [ln.split(",")[1] for ln in lines[1:]] == ["none", "model"]
     s = summarize(ds)
     assert s.worst["ma_max"]["at"]["scan.compensation"] == "none"
@@ -169,3 +170,41 @@ def test_the_local_pool_computes_scans_as_this_process(study_file, tmp_path):
     for name in ("ma_max", "msd_max", "peak_error", "status"):
         np.testing.assert_array_equal(here[name].values, pool[name].values, err_msg=name)
     assert list(pool["scan.compensation"].values) == ["none", "model"]
+
+
+def test_a_study_of_scans_alone_has_no_reference_dimensions(study_file):
+    """The scan follows its setpoint, not the reference's sine: a study whose only output is
+    ``scan`` carries no amplitude or frequency of the scenario's [reference] (dimensions of
+    one value); one that also asks a sine's output keeps them."""
+    study_file.write_text(STUDY.replace('outputs = ["scan", "error_rms"]', 'outputs = ["scan"]')
+                          .replace("frequency_hz = [5.0]\n", ""))
+    st = Study.from_file(study_file)
+    assert st.dims == ("scan.speed", "scan.compensation") and st.n_points == 4
+    study_file.write_text(STUDY.replace("frequency_hz = [5.0]\n", ""))
+    assert Study.from_file(study_file).dims == ("scan.speed", "scan.compensation",
+                                                "amplitude", "frequency_hz")
+
+
+def test_a_point_with_the_model_alone_simulates_one_run(study_file, monkeypatch):
+    """A point graded with the model feedforward alone runs the loop once (the uncompensated
+    run and the loop without its link are not simulated), with the numbers of the scan that
+    also runs them."""
+    from motionhyst.scan import scanning
+    from motionhyst.study.engine import Evaluator
+
+    study_file.write_text(STUDY.replace('outputs = ["scan", "error_rms"]', 'outputs = ["scan"]')
+                          .replace('["none", "model"]', '["model"]'))
+    st = Study.from_file(study_file)
+    calls = []
+    simulate = scanning.simulate
+    monkeypatch.setattr(scanning, "simulate", lambda *a, **k: calls.append(1) or simulate(*a, **k))
+    got = Evaluator(st).batch([0])
+    assert st.point(0)["scan.speed"] == 0.05 and got.status[0] == 1
+    assert len(calls) == 1
+    cli = _scan_json(str(study_file.parent / "scan.toml"), "--length", "0.005", "--speed",
+                     "0.05", "--a-max", "2", "--j-max", "50", "--s-max", "1000", "--window",
+                     "0.02", "--compensation", "none", "model")
+    assert len(calls) == 3            # the command: without compensation, with the model
+    model = next(r for r in cli["results"] if r["compensation"] == "model")
+    for name in ("ma_max", "msd_max", "peak_error"):
+        assert got.values[name][0] == model[name], name

@@ -244,8 +244,9 @@ class ScanResult:
         The setpoint on the runs' time grid [m].
     runs : list of ScanRun
         One per compensation, in the order asked.
-    without_link : ScanRun
-        The loop without its dynamic link (and without hysteresis feedforward).
+    without_link : ScanRun or None
+        The loop without its dynamic link (and without hysteresis feedforward); None when
+        :func:`run_scan` was asked not to grade it.
     ilc : ILCResult or None
         The learning's trials, if ``ilc`` was asked.
     carry_over : ScanResult or None
@@ -271,7 +272,7 @@ class ScanResult:
     settle_tolerance: float
     r: NDArray[np.float64] = field(repr=False)
     runs: list[ScanRun]
-    without_link: ScanRun
+    without_link: ScanRun | None
     ilc: ILCResult | None = None
     carry_over: ScanResult | None = None
     terms: FeedforwardTerms | None = None
@@ -280,7 +281,7 @@ class ScanResult:
     @property
     def t(self) -> NDArray[np.float64]:
         """Time grid [s]."""
-        return self.without_link.t
+        return self.runs[0].t
 
     def run(self, compensation: str) -> ScanRun:
         """The run of one compensation.
@@ -299,9 +300,10 @@ class ScanResult:
     def to_dict(self) -> dict:
         """Window, profile, results, without link, terms, learning, carry-over (JSON keys)."""
         d = {"window_s": self.window, "settle_tolerance": self.settle_tolerance,
-             "profile": self.profile.to_dict(), "results": [r.to_dict() for r in self.runs],
-             "without_link": {k: v for k, v in self.without_link.to_dict().items()
-                              if k != "compensation"}}
+             "profile": self.profile.to_dict(), "results": [r.to_dict() for r in self.runs]}
+        if self.without_link is not None:
+            d["without_link"] = {k: v for k, v in self.without_link.to_dict().items()
+                                 if k != "compensation"}
         if self.terms is not None:
             d["feedforward"] = self.terms.to_dict()
         if self.ilc is not None:
@@ -330,7 +332,8 @@ class ScanResult:
         def fmt(x):
             return "-" if x is None else g(x)
 
-        runs = [*self.runs, self.without_link] if without_link else self.runs
+        runs = [*self.runs, self.without_link] if (
+            without_link and self.without_link is not None) else self.runs
         return table(["compensation", "max |MA| [m]", "max MSD [m]", "peak |e| [m]",
                       "settling [s]"],
                      [[r.compensation, fmt(r.ma_max), fmt(r.msd_max), fmt(r.peak_error),
@@ -377,9 +380,9 @@ class ScanResult:
             fig = axes[0].figure
         shown = np.abs if log else (lambda x: x)
         for ax, name in zip(axes, ("e", "ma", "msd"), strict=True):
-            ref = getattr(self.without_link, name)
-            ax.plot(self.t, shown(ref) / unit, color="0.5", lw=0.9, ls="--",
-                    label="without link")
+            if self.without_link is not None:
+                ax.plot(self.t, shown(getattr(self.without_link, name)) / unit, color="0.5",
+                        lw=0.9, ls="--", label="without link")
             for r in self.runs:
                 ax.plot(r.t, shown(getattr(r, name)) / unit, color=COLORS.get(r.compensation),
                         lw=1.1, label=f"link, {r.compensation}")
@@ -452,7 +455,7 @@ def run_scan(loop: Loop, profile: Profile, window: float,
              ilc_filters: ILCFilters | None = None, other_profile: Profile | None = None,
              settle_tolerance: float = DEFAULT_SETTLE_TOLERANCE, tail: float = 0.05,
              dt: float | None = None, feedforward: tuple[str, ...] | list[str] | None = None,
-             basis_trials: int = 4) -> ScanResult:
+             basis_trials: int = 4, without_link: bool = True) -> ScanResult:
     """Simulate `profile` from rest with each compensation and grade the scans.
 
     Parameters
@@ -486,6 +489,11 @@ def run_scan(loop: Loop, profile: Profile, window: float,
         :func:`~motionhyst.scan.terms.model_terms`).
     basis_trials : int
         Trials of the coefficients' learning (the first is the ``model`` run).
+    without_link : bool
+        Also grade the loop without its dynamic link (from the uncompensated run); with
+        False the uncompensated run is simulated only if ``none`` or ``ilc`` is asked
+        (a study's point graded with the model alone costs one run, not two), and
+        :attr:`ScanResult.without_link` is None.
 
     Returns
     -------
@@ -542,7 +550,7 @@ def run_scan(loop: Loop, profile: Profile, window: float,
     bare = _rigid_body(loop)
     modelled = _rigid_body(loop, hff) if in_loop else bare
     setup = _Setup(bare, modelled, terms, _learned_terms(terms), window, ilc_trials,
-                   ilc_filters, basis_trials, settle_tolerance, tail)
+                   ilc_filters, basis_trials, settle_tolerance, tail, without_link)
     result = setup.runs(profile, comps, dt)
     result.terms = terms
     if other_profile is not None:
@@ -577,6 +585,7 @@ class _Setup:
     basis_trials: int
     tol: float
     tail: float
+    without_link: bool = True
 
     def runs(self, profile, comps, dt, learned=None, basis=None) -> ScanResult:
         """The runs of one setpoint; with `learned` (`basis`) the ``ilc`` (``basis``) run
@@ -588,7 +597,9 @@ class _Setup:
         advance = 0.0 if bare.ff is None or bare.sampled is None else (
             bare.ff.advance_samples * bare.sampled.period)
         averaged = None if bare.sampled is not None else step  # see setpoint_samples
-        none = simulate(bare, profile, duration, step)
+        none = None
+        if self.without_link or "none" in comps or "ilc" in comps:
+            none = simulate(bare, profile, duration, step)
         runs, ilc, model, basis_result = [], None, None, None
         for c in comps:
             if c == "none":
@@ -612,7 +623,7 @@ class _Setup:
                                            advance=advance)
                 sim = basis_result.last
             runs.append(scan_metrics(sim.t, sim.e, profile, self.window, c, self.tol))
-        without = scan_metrics(none.t, none.e_linear, profile, self.window, "without link",
-                               self.tol)
-        return ScanResult(profile, self.window, self.tol, none.r, runs, without, ilc,
-                          basis=basis_result)
+        without = None if none is None or not self.without_link else scan_metrics(
+            none.t, none.e_linear, profile, self.window, "without link", self.tol)
+        return ScanResult(profile, self.window, self.tol, (sim if none is None else none).r,
+                          runs, without, ilc, basis=basis_result)

@@ -136,7 +136,8 @@ class Evaluator:
         return self._outputs(self._loop_at(values), values)
 
     def _outputs(self, loop, values: dict[str, float]) -> dict:
-        p = Point(loop, values["amplitude"], values["frequency_hz"],
+        # a study of scans alone has no reference axes (its points are no sines)
+        p = Point(loop, values.get("amplitude", math.nan), values.get("frequency_hz", math.nan),
                   self.study.scan_at(values), self._unset)
         out: dict = {}
         for name in self.study.outputs:

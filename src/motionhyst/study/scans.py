@@ -193,7 +193,7 @@ def run_point_scan(loop, settings: dict, unset: tuple[str, ...] = ()) -> dict:
     res = run_scan(loop, profile, s["window"], [s["compensation"]], s["ilc_trials"],
                    ILCFilters(s["ilc_gain"], s["ilc_cutoff"], s["ilc_order"]), None,
                    s["settle_tolerance"], s["tail"], feedforward=terms,
-                   basis_trials=s["basis_trials"])
+                   basis_trials=s["basis_trials"], without_link=False)
     r = res.runs[0]
     return {name: math.nan if getattr(r, name) is None else float(getattr(r, name))
             for name in ("ma_max", "msd_max", "peak_error", "settling_time_s")}

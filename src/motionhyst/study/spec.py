@@ -17,7 +17,9 @@ samples of scenario keys from stated distributions, seeded::
     "hysteresis.k" = { lognormal = [20.0, 0.1] }
 
 The points are the cross product of the axes and the samples (a dimension ``sample``); an axis
-``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one; a key of a
+``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one (a study whose
+only output is ``scan``, with axes or samples of its own, has neither: a scan does not follow
+the reference's sine, and a dimension of one value would only be carried along); a key of a
 list names one value, ``"hysteresis.fc[1]"`` (an element of a Maxwell-slip link).  A ``[scan]``
 table and axes ``scan.*`` set the scan of the output ``scan`` (:mod:`motionhyst.study.scans`).
 """
@@ -398,9 +400,10 @@ class StudyDefinition:
             raise StudyError("[scan] and the axes scan.* set the output 'scan'; add it to "
                              "'outputs'")
         ref = scenario.get("reference") if isinstance(scenario.get("reference"), dict) else {}
+        scan_only = outputs == ["scan"] and bool(axes or "samples" in data)
         for key, default in (("amplitude", ref.get("amplitude")),
                              ("frequency_hz", ref.get("frequencies"))):
-            if key not in axes:
+            if key not in axes and not scan_only:
                 if default is None:
                     raise StudyError(f"[axes]: give {key} (the scenario has no [reference] "
                                      f"{'amplitude' if key == 'amplitude' else 'frequencies'})")
