@@ -477,3 +477,28 @@ def test_the_example_study_is_the_papers_loop():
     assert st.scenario == tomllib.loads(default_scenario_path().read_text())
     assert np.median(st.sample_values[:, 0]) == pytest.approx(20.0, rel=0.05)
     assert np.median(st.sample_values[:, 1]) == pytest.approx(0.05, rel=0.05)
+
+
+def test_a_study_above_the_work_budget_is_refused_before_anything_is_written(tmp_path,
+                                                                              study_file,
+                                                                              capsys):
+    """--max-seconds: the missing points' CPU time (measured on a few) shared by the workers;
+    above it, one line with the remedy, exit 2, no store made and another study's store kept
+    (even with --force); a finished store has nothing missing and passes any budget."""
+    out = tmp_path / "s.zarr"
+    args = ["study", str(study_file), "--out", str(out), "--workers", "2"]
+    assert main([*args, "--max-seconds", "1e-6"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "a study of 32 points (" in err[0] and "on 2 workers" in err[0]
+    assert "above the work budget" in err[0] and "--max-seconds" in err[0]
+    assert not out.exists()
+    assert main([*args, "--workers", "0", "--json"]) == 0
+    capsys.readouterr()
+    assert main([*args, "--max-seconds", "1e-6"]) == 0       # nothing missing: nothing to refuse
+    before = sorted(p.relative_to(out) for p in out.rglob("*"))
+    study_file.write_text(STUDY_TOML.replace("seed = 7", "seed = 8"))
+    assert main([*args, "--max-seconds", "1e-6", "--force"]) == 2
+    assert "above the work budget" in capsys.readouterr().err
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == before
+    kept = open_results(out)
+    assert kept.attrs["seed"] == 7 and (kept["status"].values == OK).all()

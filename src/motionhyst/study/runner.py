@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from motionhyst.core.budget import check_work
 from motionhyst.core.textfmt import g
 from motionhyst.study.engine import (
     BATCH_SECONDS,
@@ -35,7 +36,8 @@ from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import StudyDefinition, StudyError
 from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
 
-__all__ = ["LOCK_NAME", "Estimate", "RunReport", "estimate_study", "run_lock", "run_study"]
+__all__ = ["LOCK_NAME", "Estimate", "RunReport", "check_budget", "estimate_study", "run_lock",
+           "run_study"]
 
 LOCK_NAME = "zarr.json"
 """The store's file that a run holds locked (:func:`fcntl.flock`; never rewritten by a run)."""
@@ -181,7 +183,9 @@ def estimate_study(study: StudyDefinition, workers: int = 1,
                     memory_bytes=study.n_points * (8 + 1) + 65536 * bpp * 4)
 
 
-def _open_store(study: StudyDefinition, path: Path, force: bool, version: str) -> StudyStore:
+def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStore | None:
+    """The store at `path` if it holds `study` (resumed), None if a new one is to be made
+    there; raises before anything is changed if `path` may not be replaced."""
     if path.exists() or path.is_symlink():
         if not is_study_store(path):
             raise StudyError(f"--out {path}: exists and is not a study's store; refusing to "
@@ -192,10 +196,64 @@ def _open_store(study: StudyDefinition, path: Path, force: bool, version: str) -
         if not force:
             raise StudyError(f"--out {path}: holds another study (other scenario, axes, "
                              f"samples or outputs); give --force to replace it")
-        remove_store(path)
     elif not path.parent.is_dir():
         raise StudyError(f"--out {path}: folder {path.parent} does not exist")
+    return None
+
+
+def _new_store(study: StudyDefinition, path: Path, version: str) -> StudyStore:
+    if path.exists() or path.is_symlink():  # another study's, replaced with force
+        remove_store(path)
     return StudyStore.create(path, study, version)
+
+
+def check_budget(study: StudyDefinition, n_missing: int, seconds: float, workers: int) -> None:
+    """Refuse a study whose missing points would take longer than the work budget
+    (:func:`motionhyst.core.budget.check_work`, ``--max-seconds``): their core time shared
+    by the `workers`, before anything is computed or written.
+
+    Parameters
+    ----------
+    study : StudyDefinition
+        The study.
+    n_missing : int
+        Points to compute.
+    seconds : float
+        CPU time of one point on one core [s] (:func:`seconds_per_point`).
+    workers : int
+        Processes computing them.
+
+    Raises
+    ------
+    motionhyst.core.budget.BudgetError
+        One line: the points, the time and the remedy.
+
+    Examples
+    --------
+    >>> import tomllib
+    >>> from motionhyst.core.budget import BudgetError, set_max_seconds
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = StudyDefinition.from_dict({"outputs": ["e1"], "axes": {
+    ...     "frequency_hz": {"geomspace": [1.0, 100.0, 1000]}, "hysteresis.k": [20.0]}},
+    ...     scenario=base)
+    >>> set_max_seconds(60.0)
+    >>> check_budget(st, 1000, 1e-3, 2)                   # 0.5 s on two workers
+    >>> try:
+    ...     check_budget(st, 1000, 0.5, 2)
+    ... except BudgetError as exc:
+    ...     print(exc)
+    a study of 1000 points (500 ms each on one core) on 2 workers would take about 4.2 min, \
+above the work budget of 1 min (--max-seconds); give fewer points (axes, samples), more \
+workers (--workers, --scheduler) or a larger --max-seconds
+    >>> set_max_seconds(None)
+    """
+    workers = max(workers, 1)
+    check_work(n_missing * seconds / workers,
+               f"a study of {n_missing} points ({g(seconds * 1e3)} ms each on one core) on "
+               f"{workers} worker{'s' if workers > 1 else ''}",
+               "give fewer points (axes, samples), more workers (--workers, --scheduler) "
+               "or a larger --max-seconds")
 
 
 def run_study(study: StudyDefinition, store: str | Path, workers: int | None = None, client=None,
@@ -244,9 +302,23 @@ def run_study(study: StudyDefinition, store: str | Path, workers: int | None = N
 
     t0 = time.perf_counter()
     path = Path(store)
-    st = _open_store(study, path, force, __version__)
+    st = _resumed_store(study, path, force)
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if client is not None:
+        workers = max(1, sum(client.nthreads().values()))
+    n_missing = study.n_points if st is None else len(st.missing())
+    per = None
+    if n_missing:
+        # from the CPU time of a point: its wall time on a loaded machine would make batches
+        # too small for the work each costs the engine; two runs of three points, at the
+        # study's two ends (a point's cost varies along the reference axes)
+        per = seconds_per_point(study, 6, cpu=True)
+        check_budget(study, n_missing, per, workers)
+    if st is None:
+        st = _new_store(study, path, __version__)
     with run_lock(path):
-        computed = _compute(study, st, workers, client, batch, progress)
+        computed = _compute(study, st, workers, client, batch, per, progress)
     failed = int(np.count_nonzero(st.status() == FAILED))
     return RunReport(study.n_points, computed, failed, time.perf_counter() - t0)
 
@@ -290,19 +362,14 @@ def run_lock(path: Path) -> Iterator[None]:
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
-def _compute(study: StudyDefinition, st: StudyStore, workers: int | None, client, batch: int | None,
-             progress: bool) -> int:
+def _compute(study: StudyDefinition, st: StudyStore, workers: int, client, batch: int | None,
+             per: float | None, progress: bool) -> int:
     todo = st.missing(study.order())
-    if workers is None:
-        workers = os.cpu_count() or 1
     computed = 0
     if len(todo):
-        if client is not None:
-            workers = max(1, sum(client.nthreads().values()))
-        # from the CPU time of a point: its wall time on a loaded machine would make batches
-        # too small for the work each costs the engine; two runs of three points, at the
-        # study's two ends (a point's cost varies along the reference axes)
-        size = batch or batch_size(seconds_per_point(study, 6, cpu=True), len(todo), workers,
+        if per is None:  # (another run computed points between the count and the lock)
+            per = seconds_per_point(study, 6, cpu=True)
+        size = batch or batch_size(per, len(todo), workers,
                                    BATCH_SECONDS if client is None else DASK_BATCH_SECONDS)
         batches = split(todo, size)
         bar = None
