@@ -208,3 +208,29 @@ def test_a_point_with_the_model_alone_simulates_one_run(study_file, monkeypatch)
     model = next(r for r in cli["results"] if r["compensation"] == "model")
     for name in ("ma_max", "msd_max", "peak_error"):
         assert got.values[name][0] == model[name], name
+
+
+def test_a_dear_point_is_timed_alone_before_a_run(study_file, monkeypatch):
+    """The time a point takes sets a run's batches and its work budget: a dear point (a scan
+    of 2 s, about 0.2 s of CPU) is timed on one point after the warm-up, not six (seconds of
+    work thrown away); a sine's point (0.2 ms) on six."""
+    from motionhyst.study import engine
+
+    computed = []
+    outputs = engine.Evaluator._outputs
+    monkeypatch.setattr(engine.Evaluator, "_outputs",
+                        lambda self, *a: computed.append(1) or outputs(self, *a))
+    study_file.write_text(STUDY.replace('outputs = ["scan", "error_rms"]', 'outputs = ["scan"]')
+                          .replace("length = 0.005", "length = 0.04")
+                          .replace('"scan.speed" = [0.05, 0.1]', '"scan.speed" = [0.02]'))
+    per = engine.seconds_per_point(Study.from_file(study_file), 6, cpu=True)
+    assert per >= engine.ENOUGH_SECONDS and len(computed) == 2
+    import tomllib
+
+    from motionhyst.scenario import default_scenario_path
+
+    sine = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [2.0, 5.0, 10.0, 20.0]}},
+                           scenario=tomllib.loads(default_scenario_path().read_text()))
+    computed.clear()
+    assert engine.seconds_per_point(sine, 6, cpu=True) < engine.ENOUGH_SECONDS
+    assert len(computed) == 7

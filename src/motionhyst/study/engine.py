@@ -29,12 +29,16 @@ from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
 from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
 
-__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "Batch", "Evaluator", "evaluate_batch",
-           "run_batches"]
+__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "ENOUGH_SECONDS", "Batch", "Evaluator",
+           "evaluate_batch", "run_batches"]
 
 BATCH_SECONDS = 0.1
 """Least work in one batch of the local pool [s]: below it, sending and collecting cost more
 than computing."""
+
+ENOUGH_SECONDS = 0.05
+"""A point's time measured on one point alone when it takes this long [s]
+(:func:`seconds_per_point`): half of a batch's least work, known well enough."""
 
 DASK_BATCH_SECONDS = 0.5
 """Least work in one batch on dask [s]: a task costs its scheduler, client and worker about
@@ -193,16 +197,22 @@ class Evaluator:
         try:
             self.point(int(self.study.order()[0]))
         except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError):
-            pass
+            return
+        _WARMED.add(self.study.fingerprint())
+
+
+# the studies whose kernels this process compiled (a worker forked from it has them too)
+_WARMED: set[str] = set()
 
 
 _FREE: dict[str, list[Evaluator]] = {}
 _FREE_LOCK = threading.Lock()
 
 
-def _evaluator(key: str, plain: dict) -> Evaluator:
+def _evaluator(key: str, plain: dict, warm: bool = True) -> Evaluator:
     """A warm evaluator of the study `key` that no other thread uses (a worker keeps them
-    between batches whichever of its threads runs the next one; only the last study's)."""
+    between batches whichever of its threads runs the next one; only the last study's);
+    `warm` False: the process has the study's kernels already."""
     with _FREE_LOCK:
         free = _FREE.get(key)
         if free is None:
@@ -211,7 +221,8 @@ def _evaluator(key: str, plain: dict) -> Evaluator:
         if free:
             return free.pop()
     ev = Evaluator(StudyDefinition.from_plain(plain))
-    ev.warm()
+    if warm:
+        ev.warm()
     return ev
 
 
@@ -256,11 +267,11 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
 _WORKER_STUDY: dict = {}
 
 
-def _init_worker(key: str, plain: dict) -> None:
+def _init_worker(key: str, plain: dict, warm: bool) -> None:
     # Ctrl-C reaches the whole process group: the command stops its workers itself
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _WORKER_STUDY["plain"] = plain
-    _release(key, _evaluator(key, plain))
+    _release(key, _evaluator(key, plain, warm))
 
 
 def _pool_batch(key: str, indices) -> Batch:
@@ -293,6 +304,9 @@ class _Pool:
         # forked workers start with this process's modules and compiled kernels (a spawned
         # one imports and loads them again: seconds on a loaded machine)
         method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+        # forked from a process that computed a point of this study: the kernels are compiled
+        # (a point to warm them costs a scan's point 0.5 s a worker)
+        warm = method != "fork" or self.key not in _WARMED
         # a few batches a worker in flight: waiting on every batch of a large study at once
         # costs this process O(batches) at each completion (a quarter of the workers' time
         # at 2000 batches), and holds them all
@@ -300,7 +314,7 @@ class _Pool:
         while len(done_batches) < len(batches):
             ctx = mp.get_context(method)
             pool = ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_init_worker,
-                                       initargs=(self.key, self.plain))
+                                       initargs=(self.key, self.plain, warm))
             try:
                 todo = iter([i for i in range(len(batches)) if i not in done_batches])
                 futures: dict = {}
@@ -392,7 +406,8 @@ def seconds_per_point(study: StudyDefinition, n: int = 3, cpu: bool = False) -> 
     Consecutive points share their loop (:meth:`StudyDefinition.order`) and what it
     computes once per frequency: the first point on a loop costs more than the next ones.
     The points are timed in runs of consecutive ones from spread places of the study; a
-    run's first point's extra counts once for each loop of the study, not once a point.
+    run's first point's extra counts once for each loop of the study, not once a point.  A
+    point that takes :data:`ENOUGH_SECONDS` or more (a scan's) is timed alone.
 
     Parameters
     ----------
@@ -429,6 +444,10 @@ def seconds_per_point(study: StudyDefinition, n: int = 3, cpu: bool = False) -> 
         t0 = clock()
         ev.batch(run[:1])
         t1 = clock()
+        if t1 - t0 >= ENOUGH_SECONDS and n_rest == 0:
+            # a dear point (a scan's, 0.5 s): its time is known well enough from one, and
+            # timing more would cost seconds of work thrown away
+            return t1 - t0
         ev.batch(run[1:])
         first += t1 - t0
         rest += clock() - t1
