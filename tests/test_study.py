@@ -311,11 +311,20 @@ def test_exports(tmp_path, study_file):
     ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\namplitude = [0.01, 0.01]\n',
      "'amplitude': values repeat"),
     ('scenario = "paper.toml"\noutputs = ["e1"]\nextra = 1\n', "unknown key 'extra'"),
+    ('scenario = "paper.toml"\noutputs = ["e1"\n', "study.toml: TOML syntax error: "),
+    ('scenario = "latin1.toml"\noutputs = ["e1"]\n',
+     "'scenario': latin1.toml: not a text file (TOML must be UTF-8)"),
+    ('scenario = "."\noutputs = ["e1"]\n', "cannot read (it is a folder)"),
+    ('scenario = "paper.toml"\noutputs = ["e1"]\n[samples]\nfrom_identification = "fit.json"\n',
+     "from_identification fit.json: not a text file (JSON must be UTF-8)"),
 ])
-def test_bad_study_files_are_one_line_naming_the_key(tmp_path, study_file, capsys, text,
-                                                     message):
+def test_bad_study_files_are_one_line_naming_the_key(tmp_path, study_file, capsys, monkeypatch,
+                                                     text, message):
+    (tmp_path / "latin1.toml").write_bytes(b"# r\xe9glage\n")
+    (tmp_path / "fit.json").write_bytes(b"\xff\xfe{}")
     study_file.write_text(text)
-    assert main(["study", str(study_file), "--out", str(tmp_path / "s.zarr")]) == 2
+    monkeypatch.chdir(tmp_path)                         # the files named relative, as given
+    assert main(["study", "study.toml", "--out", str(tmp_path / "s.zarr")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err, err
     assert not (tmp_path / "s.zarr").exists()

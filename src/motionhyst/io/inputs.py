@@ -17,7 +17,8 @@ from pathlib import Path
 
 from motionhyst.core.budget import check_memory, format_size
 
-__all__ = ["CSV_EXPANSION", "TOML_EXPANSION", "input_problem"]
+__all__ = ["CSV_EXPANSION", "TOML_EXPANSION", "InputFileError", "input_problem", "read_text",
+           "read_toml"]
 
 TOML_EXPANSION = 16.0
 """Bytes of memory per byte of a TOML or JSON file read (each number a Python object)."""
@@ -70,3 +71,97 @@ def input_problem(path: str | os.PathLike, expansion: float) -> str | None:
     check_memory(expansion * st.st_size, f"reading {Path(path).name} "
                  f"({format_size(st.st_size)})", "give a smaller file")
     return None
+
+
+class InputFileError(ValueError):
+    """A user's input file that cannot be read as asked: one line, without the file's name
+    (the caller names it as its message does: ``path: ...``, ``'scenario': path: ...``).
+
+    Examples
+    --------
+    >>> issubclass(InputFileError, ValueError)           # exit code 2 on the command line
+    True
+    """
+
+
+def read_text(path: str | os.PathLike, expansion: float, kind: str = "text") -> str:
+    """The text of an input file, checked first (:func:`input_problem`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    expansion : float
+        Bytes of memory reading it takes per byte of the file.
+    kind : str
+        What the file should be, for the message of one not UTF-8 (``"TOML"``, ``"JSON"``).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    InputFileError
+        ``cannot read (why)`` or ``not a text file (... must be UTF-8)``.
+    motionhyst.core.budget.BudgetError
+        Reading it would take more than the memory budget.
+
+    Examples
+    --------
+    >>> try:
+    ...     read_text("/dev/zero", TOML_EXPANSION)
+    ... except InputFileError as exc:
+    ...     print(exc)
+    cannot read (not a regular file: a device, a pipe or a socket)
+    """
+    why = input_problem(path, expansion)
+    if why:
+        raise InputFileError(f"cannot read ({why})")
+    try:
+        return Path(path).read_text()
+    except OSError as exc:
+        raise InputFileError(f"cannot read ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise InputFileError(f"not a text file ({kind} must be UTF-8)") from None
+
+
+def read_toml(path: str | os.PathLike) -> dict:
+    """The tables of a TOML input file (a scenario, a study, a saved identification).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    InputFileError
+        One line without the file's name: it cannot be read (:func:`read_text`) or its
+        TOML syntax is wrong (``TOML syntax error: ...``).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "s.toml"
+    >>> _ = path.write_text('outputs = ["e1"]\\n')
+    >>> read_toml(path)
+    {'outputs': ['e1']}
+    >>> _ = path.write_text("outputs = [\\n")
+    >>> try:
+    ...     read_toml(path)
+    ... except InputFileError as exc:
+    ...     print(str(exc).split(":")[0])
+    TOML syntax error
+    """
+    import tomllib
+
+    text = read_text(path, TOML_EXPANSION, "TOML")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputFileError(f"TOML syntax error: {exc}") from None

@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.identify.io_uncertainty import BOUC_WEN_IDENTIFIED
-from motionhyst.io.inputs import TOML_EXPANSION, input_problem
+from motionhyst.io.inputs import TOML_EXPANSION, InputFileError, read_text, read_toml
 
 __all__ = ["LOG_SPACE_CV", "JointNormal", "distributions_from_identification",
            "joint_from_identification", "least_value"]
@@ -263,20 +262,12 @@ def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _read(path: Path, where: str):
-    why = input_problem(path, TOML_EXPANSION)
-    if why:
-        raise ValueError(f"{where}: cannot read ({why})")
     try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ValueError(f"{where}: cannot read ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"{where}: not a text file") from None
-    if path.suffix.lower() == ".toml":
-        try:
-            return tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"{where}: TOML syntax error: {exc}") from None
+        if path.suffix.lower() == ".toml":
+            return read_toml(path)
+        text = read_text(path, TOML_EXPANSION, "JSON")
+    except InputFileError as exc:
+        raise ValueError(f"{where}: {exc}") from None
     try:
         data = json.loads(text)
     except ValueError:

@@ -30,14 +30,13 @@ import copy
 import hashlib
 import json
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.io.inputs import TOML_EXPANSION, input_problem
+from motionhyst.io.inputs import InputFileError, read_toml
 from motionhyst.study.identified import (
     JointNormal,
     distributions_from_identification,
@@ -311,19 +310,10 @@ class StudyDefinition:
             study without ``[samples]``: 100 samples, seed 0).
         """
         path = Path(path)
-        why = input_problem(path, TOML_EXPANSION)
-        if why:
-            raise StudyError(f"{path}: cannot read ({why})")
         try:
-            text = path.read_text()
-        except OSError as exc:
-            raise StudyError(f"{path}: cannot read ({exc.strerror})") from None
-        except UnicodeDecodeError:
-            raise StudyError(f"{path}: not a text file (TOML must be UTF-8)") from None
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise StudyError(f"{path}: TOML syntax error: {exc}") from None
+            data = read_toml(path)
+        except InputFileError as exc:
+            raise StudyError(f"{path}: {exc}") from None
         if from_identification is not None:
             samples = data.get("samples")
             samples = dict(samples) if isinstance(samples, dict) else {"n": 100, "seed": 0}
@@ -364,15 +354,10 @@ class StudyDefinition:
             spath = Path(name)
             if not spath.is_absolute():
                 spath = (base_dir or Path.cwd()) / spath
-            why = input_problem(spath, TOML_EXPANSION)
-            if why:
-                raise StudyError(f"'scenario': {spath}: cannot read ({why})")
             try:
-                scenario = tomllib.loads(spath.read_text())
-            except OSError as exc:
-                raise StudyError(f"'scenario': {spath}: cannot read ({exc.strerror})") from None
-            except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-                raise StudyError(f"'scenario': {spath}: not a TOML file ({exc})") from None
+                scenario = read_toml(spath)
+            except InputFileError as exc:
+                raise StudyError(f"'scenario': {spath}: {exc}") from None
             scenario_source = name
         outputs = data.get("outputs")
         if (not isinstance(outputs, list) or not outputs
