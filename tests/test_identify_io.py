@@ -374,3 +374,18 @@ def test_lugre_link_recovered_from_a_periodic_record():
     for name, value in LUGRE_TRUE.items():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
     assert fit.periodic and "exact Jacobian" in fit.stopping
+
+
+def test_the_rates_of_a_record_are_scipys_savitzky_golay_to_round_off():
+    """numpy alone (the inertia check loads no scipy.signal), the same filter."""
+    from scipy.signal import savgol_filter
+
+    from motionhyst.identify.io_rates import savgol_derivative
+
+    rng = np.random.default_rng(7)
+    for n, window, fs in ((7, 7, 750.0), (200, 5, 100.0), (1501, 9, 750.0), (3000, 21, 5e3)):
+        y = 1e-3 * np.cumsum(rng.standard_normal(n))
+        for deriv in (1, 2):
+            ours = savgol_derivative(y, window, deriv, 1.0 / fs)
+            theirs = savgol_filter(y, window, 3, deriv=deriv, delta=1.0 / fs)
+            assert np.max(np.abs(ours - theirs)) <= 1e-12 * np.max(np.abs(theirs))

@@ -165,6 +165,12 @@ def run_input_output(args: argparse.Namespace) -> int:
 
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     check_records(records, args.periodic)  # identify_io checks them again: nothing is skipped
+    from motionhyst.plants.registry import plant_class
+
+    if plant_class(plant).has_inertia and not args.periodic:  # as identify_io will, but first
+        from motionhyst.identify.io_checks import check_inertia
+
+        check_inertia(records)
     from motionhyst.identify.input_output import MODELS, identify_io
 
     if model not in MODELS:
@@ -176,7 +182,6 @@ def run_input_output(args: argparse.Namespace) -> int:
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
                "asymmetric": args.asymmetric, "drift": args.drift})
     from motionhyst.hysteresis import model_class
-    from motionhyst.plants.registry import plant_class
 
     fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
                       n_elements=args.elements or 3, plant=plant_class(plant),

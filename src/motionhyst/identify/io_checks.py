@@ -285,7 +285,7 @@ def check_inertia(records: list[IORecord]) -> None:
     u_rms = math.sqrt(float(np.mean(u ** 2)))
     found = []
     for window in (None, 7, 5):
-        rows, rhs = equation_rows(records, floating=True, window=window)
+        rows, rhs = equation_rows(records, floating=True, window=window, light=True)
         rows = [np.column_stack([r, rec.y]) for r, rec in zip(rows, records, strict=True)]
         m, std = _mass_and_std(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
         a_rms = math.sqrt(float(np.mean(np.concatenate([r[:, 0] for r in rows]) ** 2)))

@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
 
+from motionhyst.identify.io_rates import savgol_derivative
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
@@ -174,7 +174,7 @@ def reference_mass(records: list[IORecord], floating: bool) -> float:
 
 
 def equation_rows(records: list[IORecord], floating: bool, asymmetric: bool = False,
-                  window: int | None = None
+                  window: int | None = None, light: bool = False
                   ) -> tuple[list[NDArray[np.float64]], list[NDArray[np.float64]]]:
     """The rows of :func:`inverse_dynamics`'s least squares, record by record.
 
@@ -185,6 +185,10 @@ def equation_rows(records: list[IORecord], floating: bool, asymmetric: bool = Fa
     window : int, optional
         Samples of the Savitzky-Golay filter (odd, at least 5; default about 10 ms,
         at least 7).
+    light : bool
+        The rates by :func:`~motionhyst.identify.io_rates.savgol_derivative`, numpy alone
+        (the inertia check, which refuses a record before scipy loads); else by
+        :func:`scipy.signal.savgol_filter`, the same filter to round-off (the fits' start).
 
     Returns
     -------
@@ -201,15 +205,20 @@ def equation_rows(records: list[IORecord], floating: bool, asymmetric: bool = Fa
     >>> rows[0].shape, np.round(rows[0][100, :2], 6).tolist()         # y'' = 2e-3, y' = 2e-3 t
     ((200, 4), [0.002, 0.002])
     """
-    from scipy.signal import savgol_filter
+    rate = savgol_derivative
+    if not light:
+        from scipy.signal import savgol_filter
+
+        def rate(y, samples, deriv, dt):
+            return savgol_filter(y, samples, 3, deriv=deriv, delta=dt)
 
     rows, rhs = [], []
     for rec in records:
         samples = window or max(7, 2 * round(0.005 * rec.fs) + 1)
         samples = min(samples, rec.y.size - (1 - rec.y.size % 2))
         dt = 1.0 / rec.fs
-        v = savgol_filter(rec.y, samples, 3, deriv=1, delta=dt)
-        a = savgol_filter(rec.y, samples, 3, deriv=2, delta=dt)
+        v = rate(rec.y, samples, 1, dt)
+        a = rate(rec.y, samples, 2, dt)
         third = np.sign(v) if floating else rec.y
         viscous = ([np.maximum(v, 0.0), np.minimum(v, 0.0)] if asymmetric and floating
                    else [v])
@@ -364,6 +373,8 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
             e = (two_mass_response(np.exp(logt), f, at_link) - G) / mag
         r = np.concatenate([e.real, e.imag])
         return np.where(np.isfinite(r), r, 1e6)
+
+    from scipy.optimize import least_squares  # here: the inertia check needs no optimizer
 
     best = None
     for start in sorted(grid)[:BLA_STARTS]:  # the best grid points, refined in all six
