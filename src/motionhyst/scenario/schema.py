@@ -473,7 +473,7 @@ def _check_array_lengths(text: str, source: str) -> None:
         if n > MAX_VALUES:
             line = text.rfind("\n", 0, m.start()) + 1
             table = re.findall(r"^[ \t]*(\[[^\[\]\n]+\])", text[:line], re.M)
-            key = text[line:m.start()].strip()
+            key = (re.findall(r"[\w.\"'-]+", text[line:m.start()]) or ["a list"])[-1]
             raise _too_many(source, f"{table[-1] + ' ' if table else ''}{key}", n)
 
 
