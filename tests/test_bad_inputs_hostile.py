@@ -405,3 +405,13 @@ def test_a_refusal_keeps_its_exit_code_when_stderr_cannot_be_written(monkeypatch
     closed.close()
     monkeypatch.setattr(sys, "stderr", closed)
     assert main(["df", "--k", "-20", "--fc", "0.05", "--amplitude", "0.01"]) == 2
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_output_to_a_full_disk_is_exit_2_in_plain_words(tmp_path):
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-c", _MAIN, "df", "--k", "20", "--fc", "0.05",
+                               "--amplitude", "0.01"], stdout=full, stderr=subprocess.PIPE,
+                              cwd=tmp_path, timeout=120)
+    assert done.returncode == 2
+    assert done.stderr.decode().strip() == "motionhyst: error: No space left on device"

@@ -248,7 +248,11 @@ def _failed(exc: Exception) -> int:
         raise exc
     except UsageError as exc:
         _say(f"error: {one_line(str(exc))}")
-    except (ValueError, OSError, RuntimeError) as exc:
+    except OSError as exc:  # "No space left on device: out.csv", not "[Errno 28] ... 'out.csv'"
+        text = (f"{exc.filename}: {exc.strerror}" if exc.strerror and exc.filename is not None
+                else exc.strerror or str(exc))
+        _say(f"motionhyst: error: {one_line(text)}")
+    except (ValueError, RuntimeError) as exc:
         _say(f"motionhyst: error: {one_line(str(exc))}")
     except MemoryError:  # an estimate missed: still one line, and the remedy
         _say("motionhyst: error: out of memory; give a smaller problem (or a larger "
