@@ -415,3 +415,13 @@ def test_output_to_a_full_disk_is_exit_2_in_plain_words(tmp_path):
                               cwd=tmp_path, timeout=120)
     assert done.returncode == 2
     assert done.stderr.decode().strip() == "motionhyst: error: No space left on device"
+
+
+def test_font_fallbacks_are_not_reported_on_stderr():
+    """A font cache without matplotlib's STIX fonts made every figure command print a
+    'findfont: ... not found' line per math font family (21 for reproduce)."""
+    import logging
+
+    import motionhyst.core.plotting  # noqa: F401
+
+    assert logging.getLogger("matplotlib.font_manager").getEffectiveLevel() >= logging.ERROR

@@ -17,10 +17,17 @@ Examples
 
 from __future__ import annotations
 
+import logging
+
 import matplotlib
 import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
+
+# matplotlib logs a "findfont: ... not found" line on stderr for each math font family its
+# font cache lacks (a cache built without its own STIX fonts) and draws with DejaVu Sans: the
+# figure is the same, and a command's stderr stays its one line
+logging.getLogger("matplotlib.font_manager").setLevel(logging.ERROR)
 
 __all__ = ["LINEAR_COLOR", "MODE2_COLOR", "MODE3_COLOR", "STYLE", "DecadeFormatter",
            "MinorLogLocator", "minor_log_ticks", "new_figure"]

@@ -90,6 +90,8 @@ def _warm_up(formats: Sequence[str]) -> None:
     from matplotlib.backend_bases import get_registered_canvas_class
     from matplotlib.figure import Figure
 
+    import motionhyst.core.plotting  # noqa: F401  (matplotlib as the figures have it set up)
+
     for fmt in todo:
         get_registered_canvas_class(fmt)
     fig = Figure(layout="constrained")
