@@ -417,6 +417,30 @@ def test_output_to_a_full_disk_is_exit_2_in_plain_words(tmp_path):
     assert done.stderr.decode().strip() == "motionhyst: error: No space left on device"
 
 
+def test_a_work_budget_beyond_a_timer_is_no_limit(tmp_path, monkeypatch, capsys):
+    """--max-seconds 1e10 (more than setitimer holds) ended in an OverflowError, exit 1."""
+    populate(tmp_path, {"rec.csv": _link()})
+    monkeypatch.chdir(tmp_path)
+    assert main(["identify", "rec.csv", "--elements", "1", "--max-seconds", "1e10"]) == 0
+    assert "k [N/m]" in capsys.readouterr().out
+
+
+def test_main_in_another_thread_leaves_signals_and_hooks_alone(monkeypatch, capsys):
+    import threading
+
+    import motionhyst.cli.df as df
+
+    seen = []
+    monkeypatch.setattr(df, "run", lambda args: seen.append(sys.unraisablehook) or 0)
+    hook = sys.unraisablehook
+    codes = []
+    thread = threading.Thread(target=lambda: codes.append(
+        main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"])))
+    thread.start()
+    thread.join()
+    assert codes == [0] and seen == [hook] and sys.unraisablehook is hook
+
+
 def test_font_fallbacks_are_not_reported_on_stderr():
     """A font cache without matplotlib's STIX fonts made every figure command print a
     'findfont: ... not found' line per math font family (21 for reproduce)."""

@@ -32,7 +32,6 @@ from motionhyst.cli._common import (
 )
 from motionhyst.cli.identify import feedforward_fragment, record_kind
 from motionhyst.core.budget import (
-    cpu_time_limit,
     max_memory,
     max_seconds,
     set_max_memory,
@@ -46,16 +45,11 @@ COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identif
 EXIT_INTERNAL = 1
 """Exit code of a defect of the tool (an exception no input should cause)."""
 
-SEARCHES = {"identify": "give a shorter record or fewer --max-evaluations, or a larger "
-                        "--max-seconds"}
-"""Commands whose work is a search no formula sizes in advance, with the remedy when one runs
-out of budget: stopped after ``--max-seconds`` of CPU time, nothing saved (exit 2)."""
-
 TRACEBACK_VARIABLE = "MOTIONHYST_TRACEBACK"
 """Environment variable: set, a defect of the tool ends in its traceback instead of one line."""
 
-__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "SEARCHES", "TRACEBACK_VARIABLE",
-           "UsageError", "build_parser", "feedforward_fragment", "main", "record_kind"]
+__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "TRACEBACK_VARIABLE", "UsageError",
+           "build_parser", "feedforward_fragment", "main", "record_kind"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -126,10 +120,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         set_max_memory(args.max_memory)
         set_max_seconds(args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
-        search = SEARCHES.get(args.command)
-        with (warnings_on_stderr(args.command),
-              cpu_time_limit(max_seconds() if search else None, args.command,
-                             search or "")):
+        with warnings_on_stderr(args.command):
             code = args.func(args)
         if interrupts.received:  # a library swallowed it (an optional import that failed)
             raise KeyboardInterrupt
@@ -138,9 +129,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout = open(os.devnull, "w")
         return 0
     except KeyboardInterrupt:
+        interrupts.close()
         _say("motionhyst: interrupted")
         return 130
     except Exception as exc:
+        interrupts.close()
         if not (interrupts.received or _interrupted(exc)):
             return _failed(exc)
         _say("motionhyst: interrupted")
@@ -174,9 +167,8 @@ class _Interrupts:
         self.received: list[int] = []
         self.previous: dict[int, object] = {}
         self.pid = os.getpid()
-        self.hook = sys.unraisablehook
+        self.closing = False
         self.again: threading.Timer | None = None
-        sys.unraisablehook = self._unraisable
         for sig in self.SIGNALS:
             try:
                 if signal.getsignal(sig) is signal.SIG_IGN:  # ignored by who started us
@@ -185,6 +177,9 @@ class _Interrupts:
             except ValueError:  # not the main thread
                 break
             self.previous[sig] = signal.SIG_DFL if previous is None else previous
+        self.hook = sys.unraisablehook
+        if self.previous:
+            sys.unraisablehook = self._unraisable
 
     def _handler(self, signum, frame):
         if os.getpid() != self.pid:  # a forked worker
@@ -194,26 +189,42 @@ class _Interrupts:
             os.kill(os.getpid(), signum)
             return
         self.received.append(signum)
+        if self.closing:  # the command is ending: its exit code says it
+            return
         raise KeyboardInterrupt(signal.Signals(signum).name)
 
     def _unraisable(self, unraisable) -> None:
         # raised inside a C callback (numba's compiler caching a kernel), the interrupt is
         # swallowed there with a traceback on stderr and the work goes on: noted, not shown,
-        # and sent again a moment later, when the callback has returned
-        if isinstance(unraisable.exc_value, KeyboardInterrupt):
-            sig = signal.SIGINT if signal.SIGINT in self.previous else signal.SIGTERM
-            self.received.append(sig)
-            if self.again is None or not self.again.is_alive():
-                self.again = threading.Timer(0.05, os.kill, (self.pid, sig))
-                self.again.daemon = True
-                self.again.start()
+        # and the signal sent again a moment later, when the callback has returned
+        if os.getpid() != self.pid or not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            self.hook(unraisable)
             return
-        self.hook(unraisable)
+        name = str(unraisable.exc_value.args[0]) if unraisable.exc_value.args else ""
+        sig = getattr(signal, name, None) if name in ("SIGINT", "SIGTERM") else None
+        if sig not in self.previous:
+            sig = next(iter(self.previous))
+        self.received.append(sig)
+        if not self.closing and (self.again is None or not self.again.is_alive()):
+            self.again = threading.Timer(0.05, self._resend, (sig,))
+            self.again.daemon = True
+            self.again.start()
+
+    def _resend(self, sig: int) -> None:
+        if not self.closing:
+            os.kill(self.pid, sig)
+
+    def close(self) -> None:
+        """The command is ending: no signal raises any more, none is sent again."""
+        self.closing = True
+        if self.again is not None:
+            self.again.cancel()
+            if self.again is not threading.current_thread():
+                self.again.join()
 
     def restore(self) -> None:
         """Put back the handlers found."""
-        if self.again is not None:
-            self.again.cancel()
+        self.close()
         for sig, previous in self.previous.items():
             with contextlib.suppress(ValueError, OSError, TypeError):
                 signal.signal(sig, previous)

@@ -183,9 +183,10 @@ def run_input_output(args: argparse.Namespace) -> int:
                "asymmetric": args.asymmetric, "drift": args.drift})
     from motionhyst.hysteresis import model_class
 
-    fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
-                      n_elements=args.elements or 3, plant=plant_class(plant),
-                      output=args.output, **extras)
+    with search_budget():
+        fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
+                          n_elements=args.elements or 3, plant=plant_class(plant),
+                          output=args.output, **extras)
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         text = fit.scenario_text()
@@ -265,3 +266,16 @@ def _check_savable_plant(plant: str) -> None:
     except ScenarioError as exc:
         raise UsageError(f"motionhyst identify: --save cannot write a {plant} stage yet (a "
                          f"scenario does not read one: {exc})") from None
+
+
+SEARCH_REMEDY = "give a shorter record or fewer --max-evaluations, or a larger --max-seconds"
+"""What a user can change when identify's search runs out of its work budget."""
+
+
+def search_budget():
+    """The work budget of identify's search, a context around the fit alone: no formula sizes
+    a search that stops when it converges, so it is stopped after ``--max-seconds`` of CPU
+    time (:func:`motionhyst.core.budget.cpu_time_limit`), exit 2, nothing saved."""
+    from motionhyst.core.budget import cpu_time_limit, max_seconds
+
+    return cpu_time_limit(max_seconds(), "identify", SEARCH_REMEDY)

@@ -20,6 +20,7 @@ from motionhyst.cli._identify_io import (
     add_input_output_arguments,
     check_not_input_output,
     run_input_output,
+    search_budget,
 )
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
@@ -184,7 +185,8 @@ def run(args: argparse.Namespace) -> int:
 
         what = "force-displacement record"
         try:
-            ident = identify_maxwell_slip(x, w, t=t, **options)
+            with search_budget():
+                ident = identify_maxwell_slip(x, w, t=t, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         share = _judge_elements(path, ident, x, w, args.elements is None or target is not None)
@@ -212,9 +214,10 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.identify.closed_loop import identify_closed_loop
 
         try:
-            ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff,
-                                         controller=ctrl, offset=args.offset or "auto",
-                                         **options)
+            with search_budget():
+                ident = identify_closed_loop(t, y1, u, plant, cutoff_hz=args.cutoff,
+                                             controller=ctrl, offset=args.offset or "auto",
+                                             **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         what = (f"closed-loop record, plant of {sc.source}, prefilter cut-off "
@@ -264,9 +267,10 @@ def _run_link_force(args: argparse.Namespace, path: Path) -> int:
     from motionhyst.identify.io_records import IORecord
 
     try:
-        fit = identify_link_force([IORecord(t, w, x, str(path))], model_class(args.model),
-                                  n_elements=args.elements or 3,
-                                  max_evaluations=args.max_evaluations)
+        with search_budget():
+            fit = identify_link_force([IORecord(t, w, x, str(path))], model_class(args.model),
+                                      n_elements=args.elements or 3,
+                                      max_evaluations=args.max_evaluations)
     except (ValueError, RuntimeError) as exc:
         raise type(exc)(f"{path}: {exc}") from None
     result = {**fit.to_dict(), "record": "force-displacement", "data": str(path)}

@@ -384,6 +384,11 @@ def check_work(seconds: float, what: str, remedy: str = "") -> None:
                           f"budget of {format_duration(budget)} (--max-seconds){tail}")
 
 
+_LONGEST_TIMER = 1e9
+"""Longest CPU-time limit set as a timer [s]; a longer one (which setitimer may not hold) is
+none."""
+
+
 class _TimeUp(BaseException):
     """Raised by the CPU-time alarm: a BaseException, so that no ``except ValueError`` of a
     model evaluation (values the model refuses) takes it for a bad parameter."""
@@ -417,6 +422,8 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
     --------
     >>> with cpu_time_limit(60.0, "a short sum"):
     ...     total = sum(range(1000))
+    >>> with cpu_time_limit(1e10, "a sum without limit"):   # beyond a timer's range: none
+    ...     total = sum(range(1000))
     >>> try:
     ...     with cpu_time_limit(0.05, "an endless loop", "give it an end"):
     ...         while True:
@@ -426,9 +433,9 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
     an endless loop did not finish within the work budget of 0.05 s of CPU time \
 (--max-seconds); give it an end
     """
-    if (seconds is None or not hasattr(signal, "setitimer")
+    if (seconds is None or seconds > _LONGEST_TIMER or not hasattr(signal, "setitimer")
             or threading.current_thread() is not threading.main_thread()):
-        yield
+        yield  # (above a timer's range: over thirty years, no limit)
         return
     fired = []
 
@@ -436,9 +443,10 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
         fired.append(signum)
         raise _TimeUp
 
-    previous = signal.signal(signal.SIGPROF, alarm)
-    signal.setitimer(signal.ITIMER_PROF, seconds)
+    previous = signal.getsignal(signal.SIGPROF)
     try:
+        signal.signal(signal.SIGPROF, alarm)
+        signal.setitimer(signal.ITIMER_PROF, seconds)
         yield
     except BaseException as exc:
         # a C extension may turn the alarm's exception into another (as it does a Ctrl-C)
@@ -450,4 +458,4 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
         raise
     finally:
         signal.setitimer(signal.ITIMER_PROF, 0)
-        signal.signal(signal.SIGPROF, previous)
+        signal.signal(signal.SIGPROF, signal.SIG_DFL if previous is None else previous)

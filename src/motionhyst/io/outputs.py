@@ -204,9 +204,11 @@ def _cannot_create_in(folder: Path) -> str | None:
                                     dir=folder)
     except OSError as exc:
         return exc.strerror
-    os.close(fd)
-    with contextlib.suppress(OSError):
-        os.unlink(name)
+    try:
+        os.close(fd)
+    finally:  # a Ctrl-C here still removes it
+        with contextlib.suppress(OSError):
+            os.unlink(name)
     return None
 
 
