@@ -38,14 +38,16 @@ def _force() -> str:
                                      for i, a in enumerate(t.tolist()))
 
 
-def _link() -> str:
-    """A force-displacement record of a Jenkins element (time,displacement,force)."""
+def _link(force: str = "jenkins") -> str:
+    """A force-displacement record (time,displacement,force) of a Jenkins element, of a
+    spring (`force` "spring": it never slips) or of sensor noise alone ("noise")."""
     from motionhyst.hysteresis import Jenkins
 
     t = np.arange(500) / 250.0
     envelope = np.concatenate([np.geomspace(0.01, 5e-4, 250), np.geomspace(5e-4, 0.01, 250)])
     x = envelope * np.sin(2 * np.pi * 2.0 * t)
-    f = Jenkins(k=20.0, fc=0.05).response(x)
+    f = {"jenkins": lambda: Jenkins(k=20.0, fc=0.05).response(x), "spring": lambda: 20.0 * x,
+         "noise": lambda: 0.02 * np.random.default_rng(0).standard_normal(t.size)}[force]()
     return "time,displacement,force\n" + "".join(
         f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), x.tolist(), f.tolist(),
                                                  strict=True))
@@ -88,6 +90,11 @@ CASES += [
      ["simulate", "--reference-csv", "r.csv", "--time-series", "o.csv"], ["twice"]),
     ("record-column-twice", {"r.csv": "time;displacement;force;displacement\n0;0;0;1\n"},
      ["identify", "r.csv"], ["twice"]),
+    # a force-displacement record that cannot tell a slip force: no answer
+    ("link-force-is-noise", {"r.csv": _link(force="noise")}, ["identify", "r.csv"],
+     ["no hysteresis"]),
+    ("link-force-of-a-spring", {"r.csv": _link(force="spring")}, ["identify", "r.csv"],
+     ["no hysteresis"]),
     ("max-memory-beyond-floats", {}, ["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01",
                                       "--max-memory", "1e400"], ["not a size"]),
     ("scenario-empty-name", {}, ["analyze", ""], ["is empty"]),

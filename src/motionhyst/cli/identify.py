@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -189,6 +190,7 @@ def run(args: argparse.Namespace) -> int:
                 ident = identify_maxwell_slip(x, w, t=t, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+        _check_determined(path, ident, x)
         share = _judge_elements(path, ident, x, w, args.elements is None or target is not None)
         if target is not None:  # the link alone, a system without inertia, for predict
             target.write_text(ident.scenario_text(f"{path}"))
@@ -291,6 +293,26 @@ def _run_link_force(args: argparse.Namespace, path: Path) -> int:
         print("\n# the identified link, a scenario for motionhyst predict (or give --save):")
         print(fit.scenario_text(), end="")
     return 0
+
+
+def _check_determined(path: Path, ident, x) -> None:
+    """No answer from a record without hysteresis: when no element of the fit slips in the
+    record (each one's slip displacement fc/k reaches half the record's displacement range,
+    its fc not determined), the force follows the displacement as a spring's, or is noise,
+    and a slip force would be a guess.  (An element that never slips beside others that do
+    is the model's parallel spring: kept, its fc "not determined" in the table.)"""
+    half = 0.5 * float(x.max() - x.min())
+    never = [e for e in ident.elements
+             if not math.isfinite(e["fc_std"]) and e["fc"] / e["k"] >= half]
+    if never and len(never) == len(ident.elements):
+        e = min(never, key=lambda e: e["fc"] / e["k"])
+        raise ValueError(
+            f"{path}: no hysteresis in the record: no element slips in it (the smallest slip "
+            f"displacement fitted, fc/k = {g(e['fc'] / e['k'])} m, reaches the record's "
+            f"half-range {g(half)} m; R^2 = {ident.r2:.3g}): the force follows the "
+            f"displacement as a spring's, or is noise, and a slip force would be a guess; "
+            f"nothing identified (a record whose displacement makes the link slip, a larger "
+            f"amplitude, may)")
 
 
 def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
