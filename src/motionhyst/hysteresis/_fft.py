@@ -224,3 +224,64 @@ def analyze(x, n_out, tw):  # pragma: no cover - compiled
     bit_reverse(z)
     fft_unscrambling(z, tw)
     return _unpack_spectrum(z, n, n_out, tw)
+
+
+@njit(cache=True)
+def synthesize_packed_odd(X, n, tw):  # pragma: no cover - compiled
+    """:func:`synthesize_packed` of `X` without even harmonics (``x(t + pi) = -x(t)``), in
+    half the work: returns ``y`` (``n / 4`` values) with the packed samples ``(y_0, -y_0,
+    y_1, -y_1, ...)``.
+
+    The packed samples' spectrum has odd entries only, so their DFT is ``+-w^t`` times the
+    DFT of half the length of the odd entries at ``t`` and ``t + n / 4`` (neighbours in
+    bit-reversed order), ``w = exp(-2 pi j / (n / 2))``.
+    """
+    h = n // 2
+    q = h // 2
+    L = X.shape[0] - 1
+    step = 2 * tw.shape[0] // n
+    y = np.empty(q, dtype=np.complex128)
+    for r in range(q):
+        k = 2 * r + 1
+        a = X[k] if k <= L else 0j
+        b = X[h - k] if h - k <= L else 0j
+        bc = b.conjugate()
+        e = a + bc
+        o = (a - bc) * tw[k * step].conjugate()
+        y[r] = complex(e.real - o.imag, -(e.imag + o.real))  # as synthesize_packed
+    _fft_scrambling(y, tw)
+    _twiddle_reversed(y, 2 * tw.shape[0] // h, tw, False)
+    return y
+
+
+@njit(cache=True)
+def analyze_packed_odd(y, n, n_out, tw):  # pragma: no cover - compiled
+    """:func:`analyze_packed` of the packed samples ``(y_0, -y_0, y_1, -y_1, ...)`` (a signal
+    without even harmonics, as :func:`synthesize_packed_odd` gives them), in half the work
+    (overwrites `y`): the even harmonics are zero, the odd ones the DFT of half the length
+    of ``2 w^t conj(y_t)``."""
+    h = n // 2
+    q = h // 2
+    for u in range(q):
+        y[u] = 2.0 * y[u].conjugate()
+    _twiddle_reversed(y, 2 * tw.shape[0] // h, tw, False)
+    fft_unscrambling(y, tw)
+    spectrum = np.zeros(h, dtype=np.complex128)
+    for r in range(q):
+        spectrum[2 * r + 1] = y[r]
+    return _unpack_spectrum(spectrum, n, n_out, tw)
+
+
+@njit(cache=True)
+def _twiddle_reversed(y, step, tw, conjugate):  # pragma: no cover - compiled
+    """Multiply ``y_u`` by ``w^t``, ``t`` the bit reversal of ``u`` (``w = tw[step]``)."""
+    q = y.shape[0]
+    t = 0
+    for u in range(q):
+        w = tw[t * step]
+        y[u] *= w.conjugate() if conjugate else w
+        bit = q >> 1  # the next bit-reversed index
+        while t & bit:
+            t ^= bit
+            bit >>= 1
+        t |= bit

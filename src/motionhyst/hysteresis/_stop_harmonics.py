@@ -15,9 +15,11 @@ import numpy as np
 from motionhyst.core.compiled import njit
 from motionhyst.hysteresis._fft import (
     analyze_packed,
+    analyze_packed_odd,
     packed_product,
     synthesize,
     synthesize_packed,
+    synthesize_packed_odd,
 )
 from motionhyst.hysteresis._jump_sums import (
     balance,
@@ -227,13 +229,14 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma:
 @njit(cache=True)
 def _product(S, Y, n, H, half, tw):  # pragma: no cover - compiled
     """Harmonics ``0 .. H`` of ``s y`` from those of ``s`` (`S`) and ``y`` (`Y`), by transforms
-    of `n` samples; with `half` ``s`` repeats after half a period (even harmonics only)."""
-    if half:  # s repeats after half a period: its samples from half the transform
-        zh = synthesize_packed(S[0::2].copy(), n // 2, tw)
-        zs = np.empty(n // 2, dtype=np.complex128)
-        for u in range(n // 4):  # t and t + n / 4 are neighbours in bit-reversed order
-            zs[2 * u] = zh[u]
-            zs[2 * u + 1] = zh[u]
-    else:
-        zs = synthesize_packed(S, n, tw)
+    of `n` samples.  With `half` ``s`` repeats after half a period (even harmonics only)
+    and ``y`` changes sign (odd harmonics only), and so does ``s y``: each transform is of
+    half the samples (:func:`synthesize_packed_odd`, :func:`analyze_packed_odd`)."""
+    if half:
+        # s's packed samples from half the transform; t and t + n / 4 are neighbours in
+        # bit-reversed order, where y's are y_u and -y_u
+        zs = synthesize_packed(S[0::2].copy(), n // 2, tw)
+        zy = synthesize_packed_odd(Y, n, tw)
+        return analyze_packed_odd(packed_product(zy, zs), n, H, tw)
+    zs = synthesize_packed(S, n, tw)
     return analyze_packed(packed_product(synthesize_packed(Y, n, tw), zs), n, H, tw)
