@@ -340,12 +340,12 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     residual, it = np.inf, 0
     stops = None if hyst is None else hyst.periodic_stops()
     if stops is not None:
-        table, grid = _BINNED_TABLE[0]
-        grid = grid.copy()  # the kernel sets it to the table it returns
-        e, y1, w, e_linear, it, residual, converged, table = _stop_steady_state(
+        weights, grid, first_weights, first_grid = _BINNED_TABLE[0]
+        grid, first_grid = grid.copy(), first_grid.copy()  # set to the weights returned
+        e, y1, w, e_linear, it, residual, converged, weights, first_weights = _stop_steady_state(
             complex(R[1]), T.r_e, T.r_y1, G_1, T.w_e, U_h, stops[0], stops[1], float(tol),
-            int(max_iter), stop_twiddles(H, H), table, grid)
-        _BINNED_TABLE[0] = (table, grid)
+            int(max_iter), stop_twiddles(H, H), weights, grid, first_weights, first_grid)
+        _BINNED_TABLE[0] = (weights, grid, first_weights, first_grid)
         if not converged:
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
@@ -390,8 +390,10 @@ _TRANSFERS: OrderedDict = OrderedDict()   # (Loop.transfer_key(), f, H) -> _Tran
 _F_LIM: OrderedDict = OrderedDict()       # Loop.transfer_key() -> fastest pole's f [Hz]
 _CACHE_LOCK = threading.Lock()
 #: The weights of the binned jump sums of parallel stop operators and their grid ``[N, P]``
-#: (:func:`motionhyst.hysteresis.periodic.stop_harmonics_kept`), kept for the next point.
-_BINNED_TABLE: list = [(np.empty((0, 0)), np.zeros(2, dtype=np.int64))]
+#: (:func:`motionhyst.hysteresis.periodic.stop_harmonics_kept`), kept for the next point:
+#: those of the iterations from the second on, then those of the first (a sine's input).
+_BINNED_TABLE: list = [(np.empty((0, 0)), np.zeros(2, dtype=np.int64), np.empty((0, 0)),
+                        np.zeros(2, dtype=np.int64))]
 _CACHED = {"bytes": 0}
 
 
@@ -442,13 +444,17 @@ def _sin_amplitudes(X):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, table,
-                       grid):  # pragma: no cover - compiled
+def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, weights, grid,
+                       first_weights, first_grid):  # pragma: no cover - compiled
     """The fixed point of :func:`periodic_steady_state` for a link of parallel stop
     operators, compiled whole: the same iteration and stopping rule as its Python loop.
 
-    Returns the harmonics of ``e``, ``y1``, ``w`` and of the linear ``e`` (relative to
-    ``sin(n theta)``), the iterations, the last relative change and whether it converged.
+    `weights` and `grid` (`first_weights`, `first_grid` for the first iteration) are the
+    binned jump sums' weights kept from the point before
+    (:func:`motionhyst.hysteresis.periodic.stop_harmonics_kept`; the grids are updated in
+    place).  Returns the harmonics of ``e``, ``y1``, ``w`` and of the linear ``e``
+    (relative to ``sin(n theta)``), the iterations, the last relative change, whether it
+    converged, and the weights to keep.
     """
     H = G_1.shape[0] - 1
     e_lin = np.zeros(H + 1, dtype=np.complex128)
@@ -462,7 +468,11 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, t
     it = 0
     converged = False
     for it in range(1, max_iter + 1):
-        W_new, table = stop_harmonics_kept(X, k, fc, H, tw, table, grid, 2 * H)
+        if it == 1:  # the linear loop's y1, one harmonic: a grid of its own
+            W_new, first_weights = stop_harmonics_kept(X, k, fc, H, tw, first_weights,
+                                                       first_grid, H)
+        else:  # one grid for any number of harmonics of y1
+            W_new, weights = stop_harmonics_kept(X, k, fc, H, tw, weights, grid, 2 * H)
         change = 0.0
         for q in range(H + 1):
             change = max(change, abs(W_new[q] - W[q]))
@@ -476,7 +486,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, t
             break
     e = e_lin + G_e * (W - U_h)
     return (_sin_amplitudes(e), _sin_amplitudes(X), _sin_amplitudes(W), _sin_amplitudes(e_lin),
-            it, residual, converged, table)
+            it, residual, converged, weights, first_weights)
 
 
 def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:
