@@ -69,6 +69,53 @@ def jump_series(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def jump_series_half(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
+    """:func:`jump_series` of a period whose second half mirrors the first: `t_b`, `jg`, `js`
+    are the jumps of the first half, those of the second ``-jg`` and ``js`` at ``t_b + pi``.
+    The coefficients of ``g`` are then zero at even ``q``, ``2 sum_b jg_b exp(-j q t_b) /
+    (2 pi j q)`` at odd ``q``, and those of ``s`` the other way round: the phasors step by
+    ``exp(-2 j t_b)``, half the steps of :func:`jump_series`."""
+    G = np.zeros(n_g + 1, dtype=np.complex128)
+    S = np.zeros(n_s + 1, dtype=np.complex128)
+    ng = (n_g + 1) // 2  # odd q = 2 i + 1, i < ng
+    ns = n_s // 2  # even q = 2 i, 1 <= i <= ns
+    nq = max(ng, ns + 1)
+    powers = np.empty(_ANCHOR, dtype=np.complex128)
+    z = np.empty(_ANCHOR, dtype=np.complex128)
+    for b in range(t_b.shape[0]):
+        cg = jg[b]
+        cs = js[b]
+        if cg == 0.0 and cs == 0.0:
+            continue
+        t = t_b[b]
+        u2 = complex(np.cos(2.0 * t), -np.sin(2.0 * t))  # exp(-2 j t)
+        u1 = complex(np.cos(t), -np.sin(t))
+        powers[0] = 1.0
+        for r in range(1, _ANCHOR):
+            powers[r] = powers[r - 1] * u2
+        step = complex(np.cos(2.0 * _ANCHOR * t), -np.sin(2.0 * _ANCHOR * t))
+        anchor = 1.0 + 0j
+        for i0 in range(0, nq, _ANCHOR):
+            if i0 % (8 * _ANCHOR) == 0:
+                anchor = complex(np.cos(2.0 * i0 * t), -np.sin(2.0 * i0 * t))
+            else:
+                anchor *= step
+            for r in range(_ANCHOR):
+                z[r] = anchor * powers[r]  # exp(-2 j (i0 + r) t)
+            for r in range(min(_ANCHOR, ns + 1 - i0)):
+                S[2 * (i0 + r)] += cs * z[r]
+            for r in range(min(_ANCHOR, ng - i0)):
+                G[2 * (i0 + r) + 1] += cg * (z[r] * u1)
+    G[0] = 0.0
+    S[0] = 0.0
+    for q in range(1, n_g + 1, 2):
+        G[q] *= -2j / (_TWO_PI * q)
+    for q in range(2, n_s + 1, 2):
+        S[q] *= -2j / (_TWO_PI * q)
+    return G, S
+
+
+@njit(cache=True)
 def chebyshev_terms(a_max):  # pragma: no cover - compiled
     """Terms ``P`` of the Chebyshev series of ``exp(-j a v)``, ``|a| <= a_max``, ``|v| <= 1``,
     that reach 1e-17: its coefficients are ``2 J_p(a)``, ``|J_p(a)| <= (a / 2)^p / p!``."""

@@ -27,6 +27,7 @@ from motionhyst.hysteresis._jump_sums import (
     binned_is_cheaper,
     binned_table,
     jump_series,
+    jump_series_half,
     jump_sums_binned,
 )
 from motionhyst.hysteresis._kernels import (
@@ -155,10 +156,10 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     if binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0]):
         G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
                                      grid)
+    elif half:
+        G, S = jump_series_half(t_b, jg, js, H, Q)
     else:
         G, S = jump_series(t_b, jg, js, H, Q)
-        if half:
-            _add_mirrors(G, S)
     G[0] = g_mean
     S[0] = s_mean
     if direct:
@@ -174,17 +175,6 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     for q in range(H + 1):
         W[q] = G[q] + P_x[q]
     return W, table
-
-
-@njit(cache=True)
-def _add_mirrors(G, S):  # pragma: no cover - compiled
-    """The sums of half a period's jumps made the whole period's: each jump's mirror half a
-    period on has ``g``'s jump of the opposite sign and ``s``'s alike (in place).  (A kernel
-    of its own: inside the caller's the loops ran ten times slower.)"""
-    for q in range(G.shape[0]):
-        G[q] = 2.0 * G[q] if q % 2 == 1 else 0.0
-    for q in range(S.shape[0]):
-        S[q] = 2.0 * S[q] if q % 2 == 0 else 0.0
 
 
 @njit(cache=True)
