@@ -495,6 +495,12 @@ def test_a_study_above_the_work_budget_is_refused_before_anything_is_written(tmp
     above it, one line with the remedy, exit 2, no store made and another study's store kept
     (even with --force); a finished store has nothing missing and passes any budget."""
     out = tmp_path / "s.zarr"
+    for budget, fits in (("1e-6", False), ("3600", True)):    # --estimate says which it is
+        assert main(["study", str(study_file), "--estimate", "--json", "--max-seconds",
+                     budget]) == 0
+        est = json.loads(capsys.readouterr().out)
+        assert est["within_budget"] is fits and est["budget_seconds"] == float(budget)
+    assert est["memory_bytes"] > 50e6                        # the libraries and kernels held
     args = ["study", str(study_file), "--out", str(out), "--workers", "2"]
     assert main([*args, "--max-seconds", "1e-6"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
+import resource
 import sys
 import time
 from collections.abc import Iterator
@@ -22,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionhyst.core.budget import check_work
+from motionhyst.core.budget import check_work, format_duration, max_seconds
 from motionhyst.core.textfmt import g
 from motionhyst.study.engine import (
     BATCH_SECONDS,
@@ -95,20 +96,25 @@ class Estimate:
     missing : int
         Points not computed yet (in the store given).
     seconds_per_point : float
-        Measured time of one point on one core [s].
+        Measured CPU time of one point on one core [s] (as a run measures it).
     workers : int
         Processes the run would use.
     disk_bytes : int
         Size of the finished store [bytes].
     memory_bytes : int
-        Memory the run holds at once [bytes].
+        Memory the command holds at most [bytes]: its libraries and compiled kernels (what
+        it holds once it computed points) and the study's arrays.
+    budget_seconds : float, optional
+        The work budget (``--max-seconds``) the run is held to [s].
 
     Examples
     --------
     >>> e = Estimate(points=1_000_000, missing=1_000_000, seconds_per_point=5e-4, workers=2,
-    ...              disk_bytes=17_000_000, memory_bytes=10_000_000)
+    ...              disk_bytes=17_000_000, memory_bytes=10_000_000, budget_seconds=60.0)
     >>> print(f"{e.core_hours:.3f} core-hours")
     0.139 core-hours
+    >>> print(str(e).splitlines()[-1])
+      work budget            1 min (--max-seconds): above it, the run would be refused
     """
 
     points: int
@@ -117,29 +123,46 @@ class Estimate:
     workers: int
     disk_bytes: int
     memory_bytes: int
+    budget_seconds: float | None = None
 
     @property
     def core_hours(self) -> float:
         """Core-hours of the points still to compute."""
         return self.missing * self.seconds_per_point / 3600.0
 
+    @property
+    def wall_seconds(self) -> float:
+        """The run's time on :attr:`workers` idle cores [s]."""
+        return self.missing * self.seconds_per_point / max(self.workers, 1)
+
+    @property
+    def within_budget(self) -> bool | None:
+        """Whether the run fits the work budget (None: no budget given)."""
+        return None if self.budget_seconds is None else self.wall_seconds <= self.budget_seconds
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
         return {"points": self.points, "missing": self.missing,
                 "seconds_per_point": self.seconds_per_point, "core_hours": self.core_hours,
-                "workers": self.workers,
-                "wall_seconds": self.missing * self.seconds_per_point / max(self.workers, 1),
-                "disk_bytes": self.disk_bytes, "memory_bytes": self.memory_bytes}
+                "workers": self.workers, "wall_seconds": self.wall_seconds,
+                "disk_bytes": self.disk_bytes, "memory_bytes": self.memory_bytes,
+                "budget_seconds": self.budget_seconds, "within_budget": self.within_budget}
 
     def __str__(self) -> str:
-        wall = self.missing * self.seconds_per_point / max(self.workers, 1)
-        return "\n".join([
+        lines = [
             f"  points                 {self.points} ({self.missing} to compute)",
-            f"  one point              {g(self.seconds_per_point * 1e3)} ms (measured here)",
-            f"  work                   {g(self.core_hours)} core-hours, about {wall:.0f} s on "
-            f"{self.workers} worker(s)",
+            f"  one point              {g(self.seconds_per_point * 1e3)} ms of CPU (measured "
+            f"here)",
+            f"  work                   {g(self.core_hours)} core-hours, about "
+            f"{self.wall_seconds:.0f} s on {self.workers} worker(s)",
             f"  store on disk          at most {g(self.disk_bytes / 1e6)} MB",
-            f"  memory of this process about {g(self.memory_bytes / 1e6)} MB"])
+            f"  memory of this process about {g(self.memory_bytes / 1e6)} MB (a worker: at most "
+            f"as much)"]
+        if self.budget_seconds is not None:
+            verdict = "the run fits" if self.within_budget else "above it, the run would be refused"
+            lines.append(f"  work budget            {format_duration(self.budget_seconds)} "
+                         f"(--max-seconds): {verdict}")
+        return "\n".join(lines)
 
 
 def _bytes_per_point(study: StudyDefinition) -> int:
@@ -176,11 +199,17 @@ def estimate_study(study: StudyDefinition, workers: int = 1,
         st = StudyStore.open(store)
         if st.matches(study):
             missing = len(st.missing())
-    per = seconds_per_point(study)
+    # as the run measures it (the budget's refusal and this estimate agree)
+    per = seconds_per_point(study, 6, cpu=True)
     bpp = _bytes_per_point(study)
+    # what the process holds now, its libraries and kernels loaded and points computed, then
+    # the study's index arrays and the writer's chunks
+    held = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (
+        1 if sys.platform == "darwin" else 1024)  # bytes there, kB elsewhere
     return Estimate(points=study.n_points, missing=missing, seconds_per_point=per,
                     workers=max(workers, 1), disk_bytes=study.n_points * bpp,
-                    memory_bytes=study.n_points * (8 + 1) + 65536 * bpp * 4)
+                    memory_bytes=held + study.n_points * (8 + 1) + 65536 * bpp * 4,
+                    budget_seconds=max_seconds())
 
 
 def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStore | None:
