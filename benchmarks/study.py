@@ -17,7 +17,9 @@ error_rms) into fresh stores:
    ``--repeats`` pairs of runs, interleaved (pool then dask, dask then pool, ...; a study of
    another seed each pair, as a dask worker keeps the last study it built): the overheads are
    the medians over the pairs, with their range, as the load of a shared machine moves a
-   single run's CPU time by several per cent.
+   single run's CPU time by several per cent; also the CPU time of the two processes that
+   compute the points alone (dask's workers against the pool's), where a cost a point shows
+   apart from the scheduler's, the nannies' and the client's.
 
 Wall-time ratios hold on a quiet machine only (the load average is printed before and
 after); the CPU times hold on a loaded one too.  From them: the engine's overhead per point
@@ -90,24 +92,30 @@ def _cpu_tree(pids: list[int]) -> float:
 
 
 def timed(study: Study, folder: Path, name: str, pids: list[int] | None = None,
-          **kw) -> tuple[float, float, object]:
-    """Wall time, CPU time of every process taking part, results."""
+          computing_pids: list[int] | None = None, **kw) -> tuple[float, float, object, float]:
+    """Wall time, CPU time of every process taking part, results, CPU time of the processes
+    that compute the points (the pool's workers, or dask's `computing_pids` among `pids`)."""
     reap = pids is None     # dask's workers (pids) live on; the pool's are joined
     w0, c0, k0 = time.perf_counter(), _cpu_self(), _cpu_children(reap)
     t0 = _cpu_tree(pids) if pids else 0.0
+    p0 = _cpu_tree(computing_pids) if computing_pids else 0.0
     rep = run_study(study, folder / f"{name}.zarr", **kw)
     seconds = time.perf_counter() - w0
-    cpu = (_cpu_self() - c0) + (_cpu_children(reap) - k0)
+    children = _cpu_children(reap) - k0
+    cpu = (_cpu_self() - c0) + children
+    computing = children
     if pids:
         cpu += _cpu_tree(pids) - t0
+        computing = _cpu_tree(computing_pids) - p0 if computing_pids else 0.0
     assert rep.computed == study.n_points and rep.failed == 0, rep
-    return seconds, cpu, open_results(folder / f"{name}.zarr")
+    return seconds, cpu, open_results(folder / f"{name}.zarr"), computing
 
 
 @contextlib.contextmanager
-def dask_cluster(folder: Path) -> Iterator[tuple[object, list[int]]]:
+def dask_cluster(folder: Path) -> Iterator[tuple[object, list[int], list[int]]]:
     """A scheduler and two single-thread workers (with their nannies, as ``dask worker``
-    starts them) in processes of their own; the client and the pids of every process."""
+    starts them) in processes of their own; the client, the pids of every process and those
+    of the two workers (the nannies' children)."""
     from distributed import Client
 
     sched_file = folder / "scheduler.json"
@@ -130,7 +138,8 @@ def dask_cluster(folder: Path) -> Iterator[tuple[object, list[int]]]:
 
             pids = [q.pid for p in procs for q in [psutil.Process(p.pid),
                                                     *psutil.Process(p.pid).children(True)]]
-            yield client, pids
+            workers = [q.pid for q in psutil.Process(procs[1].pid).children(True)]
+            yield client, pids, workers
     finally:
         for p in procs:
             if p.poll() is None:
@@ -177,14 +186,16 @@ def main() -> None:
     out: dict = {"points": n, "batch": batch, "dask_batch": dask_batch, "cores": os.cpu_count(),
                  "repeats": args.repeats, "load_before": load_before}
     pool_cpu, dask_cpu, dask_wall, pool_wall, idles = [], [], [], [], []
+    pool_computing: list[float] = []
+    dask_computing: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        t0, c0, ref = timed(study, folder, "inprocess", workers=0, batch=batch)
-        t1, c1, one = timed(study, folder, "pool1", workers=1, batch=batch)
-        t2, c2, two = timed(study, folder, "pool2", workers=2, batch=batch)
+        t0, c0, ref, _ = timed(study, folder, "inprocess", workers=0, batch=batch)
+        t1, c1, one, _ = timed(study, folder, "pool1", workers=1, batch=batch)
+        t2, c2, two, _ = timed(study, folder, "pool2", workers=2, batch=batch)
         _equal(ref, one)
         _equal(ref, two)
-        with dask_cluster(folder) as (client, pids):
+        with dask_cluster(folder) as (client, pids, dask_workers):
             # the workers import the library and load the kernels at their first batch
             timed(make_study(1, 2), folder, "dask_warm", pids=pids, client=client, batch=1)
             for r in range(args.repeats):
@@ -198,11 +209,14 @@ def main() -> None:
                     if engine == "pool":
                         runs[engine] = timed(st, folder, f"pair{r}_pool", workers=2, batch=batch)
                     else:
-                        runs[engine] = timed(st, folder, f"pair{r}_dask", pids=pids, client=client,
+                        runs[engine] = timed(st, folder, f"pair{r}_dask", pids=pids,
+                                             computing_pids=dask_workers, client=client,
                                              batch=dask_batch)
                 _equal(runs["pool"][2], runs["dask"][2])
                 pool_wall.append(runs["pool"][0])
                 pool_cpu.append(runs["pool"][1])
+                pool_computing.append(runs["pool"][3])
+                dask_computing.append(runs["dask"][3])
                 dask_wall.append(runs["dask"][0])
                 dask_cpu.append(runs["dask"][1])
                 for name in (f"pair{r}_pool", f"pair{r}_dask"):
@@ -224,7 +238,12 @@ def main() -> None:
         "pool_2_overhead_ms_per_point": 1e3 * (c2 - c0) / n,
         "pool_2_efficiency": c0 / c2,
         "pairs": {"pool_2_s": pool_wall, "pool_2_cpu_s": pool_cpu, "dask_2_s": dask_wall,
-                  "dask_2_cpu_s": dask_cpu},
+                  "dask_2_cpu_s": dask_cpu, "pool_2_workers_cpu_s": pool_computing,
+                  "dask_2_workers_cpu_s": dask_computing},
+        # the processes computing the points alone (dask's: heartbeats, ticks and profiler
+        # of a worker included; scheduler, nannies and client not)
+        "dask_workers_over_pool_workers": _spread(
+            [d / p - 1 for d, p in zip(dask_computing, pool_computing, strict=True)]),
         "pool_cpu_noise": (max(pool_cpu) - min(pool_cpu)) / float(np.median(pool_cpu)),
         "dask_idle_cpu_per_s": _spread(idles),
         "dask_overhead_ms_per_point": 1e3 * float(np.median(
@@ -263,6 +282,8 @@ def main() -> None:
           f"{out['dask_wall_over_pool']:.2f}x the pool's wall time")
     print(f"    dask's CPU past the pool's: {out['dask_overhead_ms_per_point']:+.4f} ms a point, "
           f"{pct(out['dask_overhead_fraction'])}")
+    print(f"    dask's two workers alone against the pool's: "
+          f"{pct(out['dask_workers_over_pool_workers'])}")
     print(f"    the idle cluster {idle:.3f} s CPU a second; past it "
           f"{pct(out['dask_task_overhead_fraction'])}")
     print(f"    with a run as long as on two idle cores {pct(out['dask_overhead_fraction_quiet'])}"
