@@ -234,3 +234,26 @@ def test_a_dear_point_is_timed_alone_before_a_run(study_file, monkeypatch):
     computed.clear()
     assert engine.seconds_per_point(sine, 6, cpu=True) < engine.ENOUGH_SECONDS
     assert len(computed) == 7
+
+
+def test_a_scan_that_never_settles_is_the_worst_settling_time():
+    """No settling time at a computed point is a scan whose error never settles: the summary
+    counts those points as the worst case and names the first, rather than giving the
+    longest of the others as the worst; a failed point is not counted."""
+    import xarray as xr
+
+    settle = np.array([[np.nan, 0.01], [0.02, np.nan], [np.nan, 0.0]])        # speed x comp
+    status = np.array([[1, 1], [1, 1], [2, 1]], np.int8)                       # one failed
+    ds = xr.Dataset({"settling_time_s": (("scan.speed", "scan.compensation"), settle),
+                     "status": (("scan.speed", "scan.compensation"), status)},
+                    coords={"scan.speed": [0.05, 0.1, 0.2], "scan.compensation": ["none", "model"]},
+                    attrs={"fields": json.dumps({"settling_time_s": "real"})})
+    s = summarize(ds)
+    assert s.never["settling_time_s"] == {
+        "points": 2, "of": 5, "at": {"scan.speed": 0.05, "scan.compensation": "none"}}
+    assert s.worst["settling_time_s"]["value"] == 0.02
+    text = str(s)
+    assert ("settling_time_s: 2 of 5 computed points never settle within the band (the worst "
+            "case; the first at scan.speed = 0.05, scan.compensation = none)") in text
+    assert "worst |settling_time_s| of the others = 0.02" in text
+    assert s.to_dict()["never"] == s.never

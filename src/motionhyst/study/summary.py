@@ -13,8 +13,8 @@ import numpy as np
 from motionhyst.core.textfmt import g, table
 from motionhyst.study.store import FAILED, OK, REASONS, field_names
 
-__all__ = ["BAND", "DOMINANCE_FIELDS", "StudySummary", "failure_reasons", "plot_band",
-           "summarize"]
+__all__ = ["BAND", "DOMINANCE_FIELDS", "NEVER_FIELDS", "StudySummary", "failure_reasons",
+           "plot_band", "summarize"]
 
 BAND = (5.0, 50.0, 95.0)
 """Percentiles of the Monte-Carlo band [%]."""
@@ -23,6 +23,10 @@ DOMINANCE_FIELDS = ("mismatch", "E")
 """Fields that are a mismatch ``E = e1 / e1_linear`` (exact, and eq. 18's): the error the link
 adds to the first harmonic is ``(E - 1) e1_linear``; where ``|E - 1| > 1`` it exceeds the linear
 loop's error (the link dominates; compare the crossover frequency of eq. 21)."""
+
+NEVER_FIELDS = {"settling_time_s": "never settle within the band"}
+"""Fields whose missing value at a computed point is the worst case, not an unknown: a scan
+whose error does not settle has no settling time (the output ``scan``); to what they say."""
 
 
 @dataclass
@@ -49,6 +53,10 @@ class StudySummary:
     failures : dict
         Reason (:data:`~motionhyst.study.store.REASONS`) to ``{"points": .., "example": ..}``:
         how many points failed for it and the message of the first.
+    never : dict
+        Field of :data:`NEVER_FIELDS` to ``{"points": .., "of": .., "at": {axis: value}}``:
+        the computed points without a value (their worst case: a scan that never settles),
+        of all computed, and the first of them; its :attr:`worst` is over the others.
     dominates : dict
         Field of :data:`DOMINANCE_FIELDS` to ``{"points": .., "of": .., "crossover_hz": ..}``:
         the computed points where ``|E - 1| > 1`` (the link dominates: the error it adds
@@ -76,12 +84,14 @@ class StudySummary:
     widest: dict = field(default_factory=dict)
     failures: dict = field(default_factory=dict)
     dominates: dict = field(default_factory=dict)
+    never: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``study --summary --json`` schema)."""
         return {"points": self.points, "computed": self.computed, "failed": self.failed,
                 "worst": self.worst, "per_axis": self.per_axis, "band": self.band,
-                "widest": self.widest, "failures": self.failures, "dominates": self.dominates}
+                "widest": self.widest, "failures": self.failures, "dominates": self.dominates,
+                "never": self.never}
 
     def __str__(self) -> str:
         lines = [f"{self.points} points: {self.computed} computed, {self.failed} failed, "
@@ -89,9 +99,18 @@ class StudySummary:
         for why, f in self.failures.items():
             lines.append(f"  {f['points']} failed: {why}"
                          + (f" ({f['example']})" if f.get("example") else ""))
-        for name, w in self.worst.items():
+        for name in dict.fromkeys([*self.worst, *self.never]):
+            if name in self.never:
+                nv = self.never[name]
+                at = ", ".join(f"{k} = {_text(v)}" for k, v in nv["at"].items())
+                lines.append(f"{name}: {nv['points']} of {nv['of']} computed points "
+                             f"{NEVER_FIELDS[name]} (the worst case; the first at {at})")
+            if name not in self.worst:
+                continue
+            w = self.worst[name]
             at = ", ".join(f"{k} = {_text(v)}" for k, v in w["at"].items())
-            lines.append(f"{name}: worst |{name}| = {g(w['value'])} at {at}")
+            which = " of the others" if name in self.never else ""
+            lines.append(f"{name}: worst |{name}|{which} = {g(w['value'])} at {at}")
             rows = []
             for axis, d in self.per_axis[name].items():
                 i = int(np.nanargmax(d["worst"])) if np.any(np.isfinite(d["worst"])) else 0
@@ -327,6 +346,14 @@ def summarize(ds) -> StudySummary:
             out.dominates[name] = _dominance(ds, name, ok)
     for name in field_names(ds):
         mag = np.where(ok, np.abs(ds[name].values), np.nan)
+        if name in NEVER_FIELDS:
+            never = ok & np.isnan(mag)
+            if np.any(never):
+                idx = np.unravel_index(int(np.argmax(never)), never.shape)
+                out.never[name] = {"points": int(np.count_nonzero(never)),
+                                   "of": out.computed,
+                                   "at": {d: _coordinate(ds[d].values[i])
+                                          for d, i in zip(dims, idx, strict=True)}}
         if not np.any(np.isfinite(mag)):
             continue
         flat = int(np.nanargmax(mag))
