@@ -210,30 +210,44 @@ def test_a_point_with_the_model_alone_simulates_one_run(study_file, monkeypatch)
         assert got.values[name][0] == model[name], name
 
 
-def test_a_dear_point_is_timed_alone_before_a_run(study_file, monkeypatch):
-    """The time a point takes sets a run's batches and its work budget: a dear point (a scan
-    of 2 s, about 0.2 s of CPU) is timed on one point after the warm-up, not six (seconds of
-    work thrown away); a sine's point (0.2 ms) on six."""
+def test_a_dear_point_is_timed_on_two_points_before_a_run(study_file, monkeypatch):
+    """The time a point takes sets a run's batches and its work budget: a dear point (a long
+    scan's) is timed on its loop's first point and the next after the warm-up, not on six
+    (seconds of work thrown away), a cheap one on six; the loop's construction, paid by its
+    first point, counts once a loop either way (a fake clock: each point costs a stated time,
+    its loop's first point 10 ms more)."""
+    from types import SimpleNamespace
+
     from motionhyst.study import engine
 
+    clock = SimpleNamespace(now=0.0)
     computed = []
-    outputs = engine.Evaluator._outputs
-    monkeypatch.setattr(engine.Evaluator, "_outputs",
-                        lambda self, *a: computed.append(1) or outputs(self, *a))
-    study_file.write_text(STUDY.replace('outputs = ["scan", "error_rms"]', 'outputs = ["scan"]')
-                          .replace("length = 0.005", "length = 0.04")
-                          .replace('"scan.speed" = [0.05, 0.1]', '"scan.speed" = [0.02]'))
-    per = engine.seconds_per_point(Study.from_file(study_file), 6, cpu=True)
-    assert per >= engine.ENOUGH_SECONDS and len(computed) == 2
-    import tomllib
 
-    from motionhyst.scenario import default_scenario_path
+    def fake_outputs(self, loop, values):
+        clock.now += cost
+        computed.append(values)
+        return {name: 0.0 for name in self.fields}
 
-    sine = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [2.0, 5.0, 10.0, 20.0]}},
-                           scenario=tomllib.loads(default_scenario_path().read_text()))
-    computed.clear()
-    assert engine.seconds_per_point(sine, 6, cpu=True) < engine.ENOUGH_SECONDS
-    assert len(computed) == 7
+    loop_at = engine.Evaluator._loop_at
+
+    def fake_loop_at(self, values):
+        before = self._key
+        loop = loop_at(self, values)
+        clock.now += 0.01 if self._key != before else 0.0      # the loop built anew
+        return loop
+
+    monkeypatch.setattr(engine.Evaluator, "_outputs", fake_outputs)
+    monkeypatch.setattr(engine.Evaluator, "_loop_at", fake_loop_at)
+    monkeypatch.setattr(engine, "time", SimpleNamespace(thread_time=lambda: clock.now,
+                                                        perf_counter=lambda: clock.now))
+    st = Study.from_file(study_file)              # 2 speeds x 2 compensations x 1 frequency
+    assert st.n_points == 4
+    loops = 1                                      # no scenario key varies: one loop
+    for cost, points in ((0.2, 3), (2e-4, 7)):
+        computed.clear()
+        per = engine.seconds_per_point(st, 6, cpu=True)
+        assert len(computed) == points              # the warm-up's, then the timed ones
+        assert per == pytest.approx(cost + 0.01 * loops / st.n_points, rel=1e-9)
 
 
 def test_a_scan_that_never_settles_is_the_worst_settling_time():

@@ -37,7 +37,7 @@ BATCH_SECONDS = 0.1
 than computing."""
 
 ENOUGH_SECONDS = 0.05
-"""A point's time measured on one point alone when it takes this long [s]
+"""A point that takes this long [s] is timed on two points, its loop's first and the next
 (:func:`seconds_per_point`): half of a batch's least work, known well enough."""
 
 DASK_BATCH_SECONDS = 0.5
@@ -305,7 +305,7 @@ class _Pool:
         # one imports and loads them again: seconds on a loaded machine)
         method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
         # forked from a process that computed a point of this study: the kernels are compiled
-        # (a point to warm them costs a scan's point 0.5 s a worker)
+        # (a point to warm them costs a worker a point's time: a long scan's, seconds)
         warm = method != "fork" or self.key not in _WARMED
         # a few batches a worker in flight: waiting on every batch of a large study at once
         # costs this process O(batches) at each completion (a quarter of the workers' time
@@ -407,7 +407,8 @@ def seconds_per_point(study: StudyDefinition, n: int = 3, cpu: bool = False) -> 
     computes once per frequency: the first point on a loop costs more than the next ones.
     The points are timed in runs of consecutive ones from spread places of the study; a
     run's first point's extra counts once for each loop of the study, not once a point.  A
-    point that takes :data:`ENOUGH_SECONDS` or more (a scan's) is timed alone.
+    point that takes :data:`ENOUGH_SECONDS` or more (a long scan's) is timed with the next
+    point of its loop alone.
 
     Parameters
     ----------
@@ -437,27 +438,31 @@ def seconds_per_point(study: StudyDefinition, n: int = 3, cpu: bool = False) -> 
     size = max(2, n // runs)
     starts = np.linspace(0, max(len(order) - size, 0), runs).astype(int)
     first = rest = 0.0
-    n_rest = 0
+    n_rest = timed = 0
     for s in starts:
         run = order[s:s + size]
         ev._key = None      # its loop built anew (the warm-up's point may be the run's first)
         t0 = clock()
         ev.batch(run[:1])
         t1 = clock()
-        if t1 - t0 >= ENOUGH_SECONDS and n_rest == 0:
-            # a dear point (a scan's, 0.5 s): its time is known well enough from one, and
-            # timing more would cost seconds of work thrown away
-            return t1 - t0
+        dear = t1 - t0 >= ENOUGH_SECONDS and timed == 0
+        if dear:
+            # a dear point (a long scan's): the next point of its loop gives its cost past the
+            # loop's construction well enough; timing more would throw seconds of work away
+            run = run[:2]
         ev.batch(run[1:])
         first += t1 - t0
         rest += clock() - t1
         n_rest += len(run) - 1
+        timed += 1
+        if dear:
+            break
     if n_rest == 0:
-        return first / runs
+        return first / timed
     steady = rest / n_rest
     loops = math.prod(len(v) for k, v in study.axes.items() if is_scenario_key(k)) * (
         study.n_samples if any(map(is_scenario_key, study.sampled_keys)) else 1)
-    return steady + max(first / runs - steady, 0.0) * loops / study.n_points
+    return steady + max(first / timed - steady, 0.0) * loops / study.n_points
 
 
 def batch_size(seconds: float, n_missing: int, workers: int,
