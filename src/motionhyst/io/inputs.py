@@ -119,7 +119,7 @@ def read_text(path: str | os.PathLike, expansion: float, kind: str = "text") -> 
     if why:
         raise InputFileError(f"cannot read ({why})")
     try:
-        return Path(path).read_text()
+        return Path(path).read_text(encoding="utf-8")  # whatever the locale
     except OSError as exc:
         raise InputFileError(f"cannot read ({exc.strerror})") from None
     except UnicodeDecodeError:
