@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import stat
+from collections.abc import Callable
 from pathlib import Path
 
 from motionhyst.core.budget import check_memory, format_size
@@ -126,13 +127,16 @@ def read_text(path: str | os.PathLike, expansion: float, kind: str = "text") -> 
         raise InputFileError(f"not a text file ({kind} must be UTF-8)") from None
 
 
-def read_toml(path: str | os.PathLike) -> dict:
+def read_toml(path: str | os.PathLike, check: Callable[[str], None] | None = None) -> dict:
     """The tables of a TOML input file (a scenario, a study, a saved identification).
 
     Parameters
     ----------
     path : str or os.PathLike
         The file.
+    check : callable, optional
+        Called with the text before it is parsed (a check that refuses, say, sizes whose
+        parsing alone would take long); what it raises goes through.
 
     Returns
     -------
@@ -161,6 +165,8 @@ def read_toml(path: str | os.PathLike) -> dict:
     import tomllib
 
     text = read_text(path, TOML_EXPANSION, "TOML")
+    if check is not None:
+        check(text)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
