@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import tomllib
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -32,7 +31,7 @@ from motionhyst.controllers.characteristic import (
 )
 from motionhyst.core.validation import check_magnitudes
 from motionhyst.hysteresis import Hysteresis
-from motionhyst.io.inputs import TOML_EXPANSION, input_problem
+from motionhyst.io.inputs import InputFileError, read_toml
 from motionhyst.scenario.sections import (
     ScenarioError,
     ScenarioModel,
@@ -154,20 +153,10 @@ class Scenario:
             Build the loop and check that it is stable (a :class:`ScenarioError` if not).
         """
         path = Path(path)
-        why = input_problem(path, TOML_EXPANSION)
-        if why:
-            raise ScenarioError(f"{path}: cannot read ({why})")
         try:
-            text = path.read_text()
-        except OSError as exc:
-            raise ScenarioError(f"{path}: cannot read ({exc.strerror})") from None
-        except UnicodeDecodeError:
-            raise ScenarioError(f"{path}: not a text file (TOML must be UTF-8)") from None
-        _check_array_lengths(text, str(path))
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ScenarioError(f"{path}: TOML syntax error: {exc}") from None
+            data = read_toml(path, check=lambda text: _check_array_lengths(text, str(path)))
+        except InputFileError as exc:
+            raise ScenarioError(f"{path}: {exc}") from None
         return cls.from_dict(data, str(path), path.parent, check=check)
 
     @property
