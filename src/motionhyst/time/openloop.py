@@ -80,6 +80,7 @@ from motionhyst.time.periodic_runs import (
     PeriodExtrapolation,
     floating_linear_periodic,
     max_periods,
+    newton_periodic,
     periodic_output,
     whole_periods,
 )
@@ -296,7 +297,8 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
                       r: int, *, periodic: bool, k_link: float = 0.0,
                       upsampled: NDArray[np.float64] | None = None,
                       dparams: NDArray[np.float64] | None = None,
-                      x0: NDArray[np.float64] | None = None, periods: int | None = None
+                      x0: NDArray[np.float64] | None = None, periods: int | None = None,
+                      shooting: bool = True
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Output of a plant with a link of exact-update elements, and its sensitivities (FOH).
 
@@ -346,6 +348,15 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         (default: until the slowest mode has decayed
         :data:`~motionhyst.time.periodic_runs.MAX_PERIODIC_DECAYS` times, at most
         1000); a search caps its trial points' runs with it.
+    shooting : bool
+        A periodic run's steady state by Newton's method on the period map
+        (:func:`~motionhyst.time.periodic_runs.newton_periodic`: two periods
+        where the map is affine) for elements of the kinds
+        :data:`~motionhyst.hysteresis.stepping.DIFFERENTIATED` (default; the
+        sensitivities of a link that never slips on a plant with a spring, whose
+        preload the path from rest sets, by repeated periods); False: periods
+        repeated (and extrapolated) until the output repeats.  Both give
+        the steady state to the tolerances above.
 
     Returns
     -------
@@ -376,7 +387,7 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     if n_periods > 1:  # the steady state of one period, repeated
         y, dy = simulate_elements(mech, stepping, u[: u.size // n_periods], fs, r,
                                   periodic=True, k_link=k_link, dparams=dparams,
-                                  periods=periods)
+                                  periods=periods, shooting=shooting)
         return np.tile(y, n_periods), np.tile(dy, (n_periods, 1))
     h = 1.0 / (fs * r)
     sens = dparams is not None
@@ -404,13 +415,13 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     C[1, mech.link] = 1.0
     C[2, ns // 2 + mech.link] = 1.0
 
-    def run(x, s, sx, ss):
+    def run(x, s, sx, ss, dpp=dp):
         # each period starts afresh from the state the previous one left
         state = LoopState(x, s, sx, ss)
         Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(3), 1, stepping, uf, state,
                                           vel_row=2, convention=OPEN, ftol=ftol,
-                                          record_every=r,
-                                          record_initial=True, dparams=dp if sens else None)
+                                          record_every=r, record_initial=True,
+                                          dparams=dpp if sx.shape[1] else None)
         _check_converged(worst)
         return Y[:, 0], SY[:, 0, :], state.z, state.s, state.sx, state.ss
 
@@ -423,6 +434,12 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     if not periodic:
         y, sy, *_ = run(x, s, sx, ss)
         return y, sy
+    most = max_periods(mech, k_link, u.size / fs)
+    most = most if periods is None else min(most, int(periods))
+    if shooting and np.all(np.isin(stepping.codes, DIFFERENTIATED)):
+        out = _shooting(run, x, s, dp, n_sens, mech, stepping, most)
+        if out is not None:
+            return out
     state = [x, s, sx, ss]
     extrapolate = PeriodExtrapolation(bounded={1: stepping.state_bounds()}, weighted=(0, 1),
                                       own=(2, 3))
@@ -435,6 +452,27 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
             state[:] = jump
         return y, sy, finite
 
-    most = max_periods(mech, k_link, u.size / fs)
-    return periodic_output(next_period, most if periods is None else min(most, int(periods)),
-                            mech.floating, sens)
+    return periodic_output(next_period, most, mech.floating, sens)
+
+
+def _shooting(run, x, s, dp, n_sens, mech, stepping, periods):
+    """The periodic steady state of :func:`simulate_elements` by Newton's method on the
+    period map (:func:`~motionhyst.time.periodic_runs.newton_periodic`): each period run
+    with the sensitivities to its start state as further columns (no parameter of the
+    plant's or the link's moves them: zero rows' derivatives)."""
+    ns, n_el = x.size, s.size
+    nz = ns + n_el
+    dp_all = np.concatenate([dp, np.zeros((n_el, N_PARAMS, nz))], axis=2)
+    start_x = np.hstack([np.eye(ns), np.zeros((ns, n_el))])
+    start_s = np.hstack([np.zeros((n_el, ns)), np.eye(n_el)])
+
+    def run_period(z, S):
+        y, sy, x_end, s_end, sx_end, ss_end = run(
+            z[:ns], z[ns:], np.hstack([S[:ns], start_x]), np.hstack([S[ns:], start_s]), dp_all)
+        return y, sy, np.concatenate([x_end, s_end]), np.vstack([sx_end, ss_end])
+
+    lo, hi = stepping.state_bounds()
+    bounds = (np.concatenate([np.full(ns, -np.inf), lo]), np.concatenate([np.full(ns, np.inf), hi]))
+    gauge = np.concatenate([np.ones(ns // 2), np.zeros(ns // 2 + n_el)])  # masses' positions
+    return newton_periodic(run_period, np.concatenate([x, s]), n_sens, periods, mech.floating,
+                           bounds, gauge)

@@ -29,12 +29,16 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from motionhyst.plants.mechanics import Mechanics
 
-__all__ = ["EXTRAPOLATION_PERIODS", "MAX_PERIODIC_DECAYS", "MIN_PERIOD_SAMPLES", "PERIODIC_RTOL",
-           "ROUNDING_RTOL", "STALL_PERIODS", "PeriodExtrapolation", "periodic_output", "settled",
-           "whole_periods"]
+__all__ = ["EXTRAPOLATION_PERIODS", "MAX_PERIODIC_DECAYS", "MIN_PERIOD_SAMPLES", "NEUTRAL_RTOL",
+           "PERIODIC_RTOL",
+           "ROUNDING_RTOL", "STALL_PERIODS", "PeriodExtrapolation",
+           "newton_periodic", "periodic_output", "settled", "whole_periods"]
 
 #: A period's output repeats the previous one to this fraction of its amplitude.
 PERIODIC_RTOL = 1e-12
+#: Singular values of ``I - M`` (the period map's, equilibrated) below this fraction of the
+#: largest are directions the period does not forget (:func:`newton_periodic`)
+NEUTRAL_RTOL = 1e-9
 #: Periodic runs stop after this many time constants of the slowest mode.
 MAX_PERIODIC_DECAYS = 60.0
 #: A record is run as one period repeated only if its period has this many samples
@@ -210,6 +214,169 @@ def periodic_output(next_period, periods: int, floating: bool, sensitivities: bo
         if not finite:
             break
         prev = (y, sy)
+    raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if floating else ""))
+
+
+def newton_periodic(run_period, z0: NDArray[np.float64], n_params: int, periods: int,
+                    floating: bool,
+                    bounds: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+                    gauge: NDArray[np.float64] | None = None
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """The periodic steady state by Newton's method on the period map (shooting).
+
+    A period run from the state ``z`` ends in ``F(z)``; the periodic state is
+    the fixed point ``z* = F(z*)``.  Each period is run with the sensitivities of
+    its end state and output to its start state (the monodromy matrix ``M``),
+    and the next start is ``z + (I - M)^-1 (F(z) - z)``: exact at once where
+    the period map is affine (a linear plant with a link that holds or slips in
+    the same pattern), a few periods otherwise, however lightly damped the
+    plant.  The sensitivities ``S`` of the state to the parameters follow the
+    same way: ``S <- S + (I - M)^-1 (T - S)``, ``T`` the end state's.  A
+    period's output is the steady state once the remaining correction of its
+    start changes the output by at most :data:`PERIODIC_RTOL` of its amplitude
+    (a floating stage's: of its spread, up to a constant; first order, through
+    the output's sensitivities to the start state); its sensitivities, linear
+    in their start along that run, are those of the start ``S + dS`` (exact: no
+    further period).  The result equals that of periods repeated until they
+    settle (:func:`periodic_output`) to its tolerances.
+
+    Some states are not forgotten: a floating stage's position (defined up to
+    a constant), the preload of a link that never slips.  Along them ``M`` has
+    the eigenvalue 1 (a singular value of ``I - M`` below
+    :data:`NEUTRAL_RTOL` of the largest, its states each in units of its
+    size).  A floating stage's position (`gauge`) is kept, and what no start
+    closes (the part of ``F(z) - z`` outside the range of ``I - M``) is a step
+    along it every period once the rest has settled: no periodic steady state
+    (raised, with the step); a stage without a link closes its period by its
+    momentum.  A preload (a stage on a spring) is kept as the run from `z0`
+    has it, as repeating the period does.  The sensitivities of a preload
+    depend on the path the run took from `z0` to the steady state, which
+    Newton's steps skip; so does a floating stage with other states left
+    unchanged: None then (repeat the periods).  A
+    correction that no longer shrinks for three periods, below
+    :data:`ROUNDING_RTOL` of the amplitude, is the rounding of the states the
+    output is computed from (a stage clamped by a stiff link): settled as far as
+    the arithmetic allows, as in :func:`periodic_output`.
+
+    Parameters
+    ----------
+    run_period : callable
+        ``run_period(z, S) -> (y, sy, z_end, S_end)``: one period from the state
+        `z`, whose sensitivities to the parameters are `S` (``(nz, n_params)``);
+        its output `y` (one sample longer than the period), the output's
+        sensitivities `sy` (columns: the `n_params` parameters, then the `nz`
+        start states), the end state and its sensitivities (the same columns).
+    z0 : ndarray
+        The first period's start.
+    n_params : int
+        Number of parameters (0: the output alone).
+    periods : int
+        Periods to run at most.
+    floating : bool
+        True for a floating stage.
+    bounds : tuple of ndarray, optional
+        ``(lo, hi)`` of each state (infinite where it has none): the next start is
+        clipped to them (a stop operator's force within its slip force).
+    gauge : ndarray, optional
+        A floating stage's position shift (the masses' positions 1, the rest 0):
+        the state its period leaves unchanged (default: the first state's).
+
+    Returns
+    -------
+    (y, sy) or None
+        The steady state's output over one period (zero mean if floating) and its
+        sensitivities to the parameters; None where those depend on the path.
+
+    Examples
+    --------
+    A period map that is affine, ``F(z) = 0.999 z + 1`` (a mode that forgets its
+    start by 0.1 % a period), its output the state: the fixed point 1000 after
+    one Newton step, where repeating the period would take thousands.
+
+    >>> import numpy as np
+    >>> def run_period(z, S):
+    ...     y = np.full(9, z[0])
+    ...     sy = np.ones((9, 1))                        # d y / d z
+    ...     return y, sy, 0.999 * z + 1.0, np.array([[0.999]])
+    >>> y, _ = newton_periodic(run_period, np.zeros(1), 0, 5, floating=False)
+    >>> round(float(y[0]), 9), y.size
+    (1000.0, 8)
+    """
+    z = np.array(z0, dtype=float)
+    nz = z.size
+    S = np.zeros((nz, n_params))
+    eye = np.eye(nz)
+    g = np.asarray(gauge, dtype=float) if gauge is not None else eye[0]
+    smallest, since = math.inf, 0  # the smallest correction so far, periods since
+    for _ in range(periods):
+        y, sy, z_end, S_end = run_period(z, S)
+        if not (np.all(np.isfinite(z_end)) and np.all(np.isfinite(S_end))
+                and np.all(np.isfinite(y))):
+            break
+        M, T = S_end[:, n_params:], S_end[:, :n_params]
+        # equilibrated: each state in units of its size (positions, velocities, forces)
+        d = np.maximum(np.abs(z), np.abs(z_end))
+        d = np.where(d > 0, d, 1.0)
+        A = (eye - M) * d / d[:, None]
+        rhs = np.column_stack([z_end - z, T - S]) / d[:, None]
+        U, sv, Vt = np.linalg.svd(A)
+        null = sv <= NEUTRAL_RTOL * sv[0]
+        gauge_drift = False  # the correction's border is a floating stage's step per period
+        if null.any():
+            V, L = Vt[null].T, U[:, null]  # right (unchanged states) and left (conserved)
+            k = V.shape[1]
+            if floating:  # its position: pinned; what no start closes, along L
+                g_s = g / d
+                g_s = g_s / np.linalg.norm(g_s)
+                if k > 1 or abs(float(V[:, 0] @ g_s)) < 0.99:
+                    return None  # other states left unchanged too: repeat the periods
+                pin = (g * d / np.linalg.norm(g * d))[:, None]
+                if abs(float(L[:, 0] @ g_s)) > 1e-6:  # a step along the gauge: mu [m]
+                    border, gauge_drift = (g / d)[:, None], True
+                else:  # the gauge is in the range (a free rigid body): L is what no start closes
+                    border = L
+            else:  # a preload: the conserved part kept, what remains a step along V
+                if np.min(np.linalg.svd(L.T @ V, compute_uv=False)) < 1e-6:
+                    return None
+                border, pin = V, L
+            A = np.block([[A, border], [pin.T, np.zeros((k, k))]])
+            rhs = np.vstack([rhs, np.zeros((k, rhs.shape[1]))])
+        step = np.linalg.lstsq(A, rhs, rcond=None)[0]
+        delta, dS = step[:nz, 0] * d, step[:nz, 1:] * d[:, None]
+        y, sy_all = y[:-1], sy[:-1]
+        Y_z = sy_all[:, n_params:]
+        ey = Y_z @ delta
+        if floating:
+            ey = ey - np.mean(ey)
+        amp = float(np.ptp(y) if floating else np.max(np.abs(y)))
+        change = float(np.max(np.abs(ey))) / amp if amp > 0 else math.inf
+        if change < 0.5 * smallest:
+            smallest, since = change, 0
+        else:
+            since += 1
+        if change <= PERIODIC_RTOL or (since >= 3 and change <= ROUNDING_RTOL):
+            if n_params and null.sum() > int(floating):
+                return None  # a preload the parameters move along the path from z0
+            if null.any():  # what no start removes: a step every period
+                if gauge_drift:
+                    step_m = float(step[nz, 0])
+                    if abs(step_m) > 10 * PERIODIC_RTOL * amp:
+                        raise ValueError(
+                            f"no periodic steady state: the stage floats and the link does "
+                            f"not hold it in place; it drifts {step_m:.3g} m per period (only "
+                            f"a run from rest describes this force)")
+                elif np.max(np.abs(Y_z @ ((border @ step[nz:, 0]) * d))) > 10 * PERIODIC_RTOL * amp:
+                    break
+            # the sensitivities are linear in their start along this (settled) run: those of
+            # the periodic ones' start, S + dS, exactly
+            sy_p = sy_all[:, :n_params] + Y_z @ dS
+            if floating:
+                return y - np.mean(y), sy_p - np.mean(sy_p, axis=0)
+            return y, sy_p
+        z = z + delta
+        S = S + dS
+        if bounds is not None:
+            z = np.clip(z, *bounds)
     raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if floating else ""))
 
 
