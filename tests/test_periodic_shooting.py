@@ -147,3 +147,22 @@ def test_a_floating_stage_without_a_link_closes_its_period_by_its_momentum(monke
     # a force with a mean moves it on: no steady state
     with pytest.raises(ValueError, match="steady state"):
         simulate_elements(mech, Stepping.empty(), u + 0.1, FS, 20, periodic=True)
+
+
+def test_the_noise_a_periodic_record_leaves_from_its_periods_spread():
+    """identify's starts end at a fit to the records' own noise (io_elements): its variance
+    from the spread of the periods about their mean, here within 5 % of the noise drawn."""
+    from motionhyst.identify.io_elements import NOISE_COST_FACTOR, _noise_cost
+    from motionhyst.identify.io_records import IORecord
+
+    n, periods, sigma = 390, 8, 2e-3
+    u = np.tile(_odd_multisine(n, 3, 1.0), periods)
+    shape = np.tile(np.sin(2 * np.pi * np.arange(n) / n), periods)
+    y = shape + sigma * np.random.default_rng(1).standard_normal(u.size)
+    rec = IORecord(np.arange(u.size) / FS, u, y, "r")
+    cost = _noise_cost([rec], 0.5)
+    expected = 0.5 * NOISE_COST_FACTOR * u.size * sigma ** 2 / 0.5 ** 2
+    assert abs(cost / expected - 1) < 0.05
+    # a record of one period (or not periodic) says nothing about its noise
+    one = IORecord(rec.t[:n], u[:n], y[:n], "one")
+    assert _noise_cost([one], 0.5) is None

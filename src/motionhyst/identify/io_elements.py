@@ -511,7 +511,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     better, with the rate scales held at each other value of the grid (a
     profile: the rate scale and the force it shapes form a long valley when
     searched together); the best is refined with everything free on all
-    records.
+    records.  Periodic records of whole periods end the starts at the first
+    whose fit leaves no more than their noise (its variance from the periods'
+    spread about their mean, :func:`_noise_cost`): no later start can fit them
+    better.
 
     A two-mass stage (floating: the link is its only hold) starts from
     :func:`best_linear_approximation_two_mass`, the link's stiffness 1, 4 and
@@ -632,6 +635,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
     short_start = _extras_start(short_extras, short, floating, idim["u0"])
+    floor = _noise_cost(short, y_scale) if periodic else None
     best = None
     for p0 in starts:
         p0 = np.concatenate([p0, short_start])
@@ -640,6 +644,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         n_eval += used
         if best is None or cost < best[0]:
             best = (cost, p)
+        if floor is not None and best[0] <= floor:
+            break  # the records fitted to their own noise: no further start can do better
     profile = [best[0]]
     if rate.any():
         p_rest = best[1]
@@ -750,6 +756,30 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0),
                "covariance": covariance_table(names, covariance(J, rss, res.size, rtol), std)})
+
+
+#: A start whose cost is within this factor of the records' noise (from their repeated
+#: periods) ends the search for starts
+NOISE_COST_FACTOR = 1.1
+
+
+def _noise_cost(records, y_scale: float) -> float | None:
+    """The search's cost (half the sum of squared residuals in units of `y_scale`) that the
+    records' noise alone leaves, times :data:`NOISE_COST_FACTOR`: the noise's variance from
+    the spread of the periods of periodic records about their mean; None if a record holds
+    fewer than two periods."""
+    from motionhyst.time.periodic_runs import whole_periods
+
+    total = 0.0
+    for rec in records:
+        p = whole_periods(rec.u)
+        if p < 2:
+            return None
+        n = rec.u.size // p
+        y = rec.y[:p * n].reshape(p, n)
+        variance = float(np.sum((y - np.mean(y, axis=0)) ** 2)) / (n * (p - 1))
+        total += rec.y.size * variance
+    return 0.5 * NOISE_COST_FACTOR * total / y_scale ** 2
 
 
 def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
