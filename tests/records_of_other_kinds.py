@@ -150,11 +150,14 @@ def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
 
 
 def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
-                  seconds: float = 40.0, link: str | None = None) -> Record:
+                  seconds: float = 40.0, link: str | None = None,
+                  stiffening: float = 0.0) -> Record:
     """A friction damper's record: displacement imposed, force measured (with offset, noise).
 
     `history`: ``"sines"`` (0.2 to 2 Hz, 3 to 20 mm) or ``"earthquake"`` (20 mm peak);
-    `link`: a name of :data:`DAMPER_LINKS` (default :data:`DAMPER_LINK`).
+    `link`: a name of :data:`DAMPER_LINKS` (default :data:`DAMPER_LINK`); `stiffening`: the
+    share by which its spring stiffens over the record (a rubber part warming up), which no
+    model of motionhyst describes.
     """
     rng = np.random.default_rng(seed)
     t = np.arange(int(seconds * fs)) / fs
@@ -164,5 +167,6 @@ def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
         x = earthquake_like(t, rng, 0.02)
     w = force_from_displacement(DAMPER_PLANT, DAMPER_LINK if link is None else
                                 DAMPER_LINKS[link], t, x)
+    w = w + stiffening * DAMPER_PLANT.k * (t / t[-1]) * x
     f = w + DAMPER_FORCE_OFFSET + DAMPER_NOISE * rng.standard_normal(t.size)
     return Record(t, f, x)

@@ -223,6 +223,11 @@ def _stop_operator_starts(records: list[IORecord], layout: LinkLayout, prob: _Pr
     return [prob.variables(v)]
 
 
+#: A force and position whose correlation is below minus this describe a negative stiffness:
+#: a sensor's sign reversed rather than a system without one
+SIGN_CORRELATION = 0.5
+
+
 def _linear_start(records: list[IORecord]) -> tuple[float, float, NDArray[np.float64]]:
     """``K, C`` and each record's ``b`` of ``u = K y + C y' + b`` (least squares)."""
     rows, rhs = [], []
@@ -317,6 +322,13 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     layout = _layout(link, n_elements)
     K, C, b = _linear_start(records)
     if not K > 0:
+        u_all = np.concatenate([rec.u - np.mean(rec.u) for rec in records])
+        y_all = np.concatenate([rec.y - np.mean(rec.y) for rec in records])
+        if K < 0 and np.dot(u_all, y_all) < -SIGN_CORRELATION * np.linalg.norm(
+                u_all) * np.linalg.norm(y_all):
+            raise ValueError(f"the position falls as the force rises (a stiffness of {K:.3g} "
+                             f"N/m): is one sensor's sign reversed? (--scale "
+                             f"displacement=-1)")
         raise ValueError("the records show no stiffness (the position does not follow the "
                          "force): a quasi-static plant does not describe them")
     y_all = np.concatenate([rec.y for rec in records])
