@@ -126,13 +126,14 @@ def earthquake_like(t: np.ndarray, rng: np.random.Generator, peak: float,
 
 
 def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
-                 seconds: float = 2.0, creep: float = 0.0) -> Record:
+                 seconds: float = 2.0, creep: float = 0.0, exponent: float = 1.0) -> Record:
     """A piezo stack's record: force (from its voltage) in, displacement out, measured.
 
     `history`: ``"sines"`` (1 to 100 Hz, 0.3 to 1 of the full force) or ``"earthquake"``;
     `creep`: the stack's creep, a share of the spring's displacement added over time
     constants of 0.02, 0.2 and 2 s (three Kelvin-Voigt elements in series, a third each),
-    which the quasi-static plant does not describe.
+    which the quasi-static plant does not describe; `exponent`: its Bouc-Wen link's ``n``
+    (the quasi-static plant's fit keeps 1).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(int(seconds * fs)) / fs
@@ -141,7 +142,10 @@ def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
     else:
         u = earthquake_like(t, rng, 600.0, (1.0, 60.0))
     u_measured = u - PIEZO_PLANT.force_offset  # the drive's offset: the stack gets u + f0
-    x = displacement_from_force(PIEZO_PLANT, PIEZO_LINK, t, u_measured)
+    link = PIEZO_LINK if exponent == 1.0 else BoucWen(k=PIEZO_LINK.k, fc=PIEZO_LINK.fc,
+                                                       n=exponent, beta=PIEZO_LINK.beta,
+                                                       gamma=PIEZO_LINK.gamma)
+    x = displacement_from_force(PIEZO_PLANT, link, t, u_measured)
     for tau in (0.02, 0.2, 2.0) if creep else ():
         b, a = signal.bilinear([1.0], [tau, 1.0], fs)
         x = x + creep / 3 * signal.lfilter(b, a, u / PIEZO_PLANT.k)
