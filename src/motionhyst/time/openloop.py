@@ -92,11 +92,14 @@ from motionhyst.time.resample import upsample as upsample
 
 # the record helpers, the periodic runs and the Bouc-Wen integrator have modules of their own in
 # motionhyst.time (resample, periodic_runs, bouc_wen_rk4); imported here too, where they were
-__all__ = ["FINE_BYTES", "MIN_SUBSTEPS", "STEPS_PER_MODE_PERIOD", "OpenLoop", "OpenLoopResponse",
-           "simulate_elements"]
+__all__ = ["FINE_BYTES", "MAX_SHOOTING_STATES", "MIN_SUBSTEPS", "STEPS_PER_MODE_PERIOD",
+           "OpenLoop", "OpenLoopResponse", "simulate_elements"]
 
 MIN_SUBSTEPS = 20
 STEPS_PER_MODE_PERIOD = 400
+#: States (the plant's and the link elements') up to which a periodic run is found by Newton's
+#: method on the period map: each of them is a further column of sensitivities every period
+MAX_SHOOTING_STATES = 40
 FINE_BYTES = 48
 """Memory of one integration step of an open-loop run: fine input, midpoints, output [bytes]."""
 
@@ -352,10 +355,11 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         A periodic run's steady state by Newton's method on the period map
         (:func:`~motionhyst.time.periodic_runs.newton_periodic`: two periods
         where the map is affine) for elements of the kinds
-        :data:`~motionhyst.hysteresis.stepping.DIFFERENTIATED` (default; the
-        sensitivities of a link that never slips on a plant with a spring, whose
-        preload the path from rest sets, by repeated periods); False: periods
-        repeated (and extrapolated) until the output repeats.  Both give
+        :data:`~motionhyst.hysteresis.stepping.DIFFERENTIATED` and at most
+        :data:`MAX_SHOOTING_STATES` states (default; the sensitivities of a link
+        that never slips on a plant with a spring, whose preload the path from
+        rest sets, by repeated periods); False: periods repeated (and
+        extrapolated) until the output repeats.  Both give
         the steady state to the tolerances above.
 
     Returns
@@ -436,7 +440,8 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         return y, sy
     most = max_periods(mech, k_link, u.size / fs)
     most = most if periods is None else min(most, int(periods))
-    if shooting and np.all(np.isin(stepping.codes, DIFFERENTIATED)):
+    if (shooting and np.all(np.isin(stepping.codes, DIFFERENTIATED))
+            and ns + n_el <= MAX_SHOOTING_STATES):
         out = _shooting(run, x, s, dp, n_sens, mech, stepping, most)
         if out is not None:
             return out
