@@ -330,10 +330,10 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         Fine steps per sample.
     periodic : bool
         From rest (False) or the periodic steady state of the period `u`
-        (True: periods repeated until the output changes by less than
-        :data:`PERIODIC_RTOL` of its amplitude and, with `dparams`, the
-        sensitivities by less than 1e-8 of theirs; returned with zero mean for
-        a floating plant, as :meth:`OpenLoop.simulate`).
+        (True: the output to :data:`PERIODIC_RTOL` of its amplitude and, with
+        `dparams`, the sensitivities to 1e-8 of theirs, found as `shooting`
+        says; returned with zero mean for a floating plant, as
+        :meth:`OpenLoop.simulate`).
     k_link : float
         The link's initial stiffness [N/m] (bounds the periods a periodic run may take).
     upsampled : ndarray, optional
