@@ -168,8 +168,8 @@ def test_asymmetric_viscous_friction_is_recovered():
         assert got[name] == pytest.approx(value, rel=1e-3), name
     assert "link.c_pos" in fit.not_identifiable
     assert fit.hysteresis.to_dict()["c_neg"] == pytest.approx(70.0, rel=1e-3)
-    with pytest.raises(ValueError, match="Coulomb link on a mass-damper"):
-        identify_io([rec], "jenkins", plant="mass-damper", asymmetric=True)
+    with pytest.raises(ValueError, match="on a mass-damper, with a link other than Bouc-Wen"):
+        identify_io([rec], "coulomb", plant="mass-spring-damper", asymmetric=True)
 
 
 @pytest.mark.parametrize(("options", "message"), [
@@ -178,8 +178,10 @@ def test_asymmetric_viscous_friction_is_recovered():
     (["--init-window", "20", "--model", "bouc-wen"], "apply to the element links"),
     (["--offset", "both", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
      "estimates only their position offsets"),
-    (["--asymmetric", "--model", "jenkins"], "--asymmetric applies to --model coulomb"),
-    (["--asymmetric", "--model", "coulomb", "--plant", "two-mass"], "--plant mass-damper only"),
+    (["--asymmetric", "--model", "bouc-wen"], "--asymmetric applies to --plant mass-damper"),
+    (["--asymmetric", "--model", "coulomb", "--plant", "two-mass"],
+     "--asymmetric applies to --plant mass-damper"),
+    (["--asymmetric", "--model", "jenkins", "--periodic"], "applies to --model coulomb only"),
 ])
 def test_cli_window_and_asymmetric_refusals(tmp_path, capsys, options, message):
     from motionhyst.cli import main

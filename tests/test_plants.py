@@ -11,7 +11,7 @@ from motionhyst.plants.registry import PLANTS, Plant, PlantParameter, plant_clas
 
 # a value inside each kind's range, chosen so that no two parameters are equal
 _TYPICAL = {"positive": (3.0, 5.0, 7.0, 2.0e4, 11.0), "nonnegative": (0.7, 0.9, 1.3),
-            "finite": (-0.4, 0.25)}
+            "finite": (-0.4, 0.25, 0.15)}
 
 
 def _kwargs(cls) -> dict:

@@ -58,9 +58,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                         "runs, as predict --init-from --init-window N sets it (the EMPS "
                         "benchmark's convention: 20); only the force offset is estimated")
     q.add_argument("--asymmetric", action="store_true",
-                   help="input-output records, --model coulomb --plant mass-damper: viscous "
-                        "friction by direction (the link's c_pos or c_neg on top of the "
-                        "stage's c)")
+                   help="input-output records, --plant mass-damper, an element link: viscous "
+                        "friction by direction (the stage's c_skew: c + c_skew forward, "
+                        "c - c_skew backward; --model coulomb: its c_pos or c_neg on top of "
+                        "the stage's c)")
     q.add_argument("--drift", action="store_true",
                    help="input-output records, --plant mass-damper: the force offset drifts "
                         "in time (a machine warming up): its rate [N/s] over the records' own "
@@ -150,9 +151,12 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
-    if args.asymmetric and (model != "coulomb" or plant != "mass-damper"):
-        raise UsageError("motionhyst identify: --asymmetric applies to --model coulomb "
-                         "--plant mass-damper only")
+    if args.asymmetric and (model == "bouc-wen" or plant != "mass-damper"):
+        raise UsageError("motionhyst identify: --asymmetric applies to --plant mass-damper "
+                         "with an element link (not bouc-wen)")
+    if args.asymmetric and args.periodic and model != "coulomb":
+        raise UsageError("motionhyst identify: --asymmetric with --periodic applies to --model "
+                         "coulomb only (the stage's c_skew is run from a start)")
     if args.drift and (model == "bouc-wen" or plant != "mass-damper" or args.periodic):
         raise UsageError("motionhyst identify: --drift applies to records from a start on "
                          "--plant mass-damper, with an element link")

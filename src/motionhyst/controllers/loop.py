@@ -129,6 +129,10 @@ class Loop:
             raise ValueError(f"the closed loop takes no drifting force on the plant "
                              f"(force_drift = {plant.force_drift:g} N/s); the open-loop time "
                              f"runs do")
+        if getattr(plant, "c_skew", 0.0):
+            raise ValueError(f"the closed loop takes no viscous friction by direction on the "
+                             f"plant (c_skew = {plant.c_skew:g} N s/m); the open-loop time "
+                             f"runs do")
         P1, P2 = plant.P1, plant.P2
         mass = plant.M if mass is None else mass
         if isinstance(feedforward, Feedforward):

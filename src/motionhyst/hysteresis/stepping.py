@@ -3,7 +3,9 @@
 A link model states how it is stepped (:meth:`Hysteresis.time_stepping`) as a
 :class:`Stepping`: one row per element, each a primitive kind of this module
 (``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``, ``MAXWELL``, ``COULOMB``) with its
-parameters.  The time simulation and the open-loop force of a feedforward model advance the rows
+parameters; ``VISCOUS``, a damper by direction, is no link's own element but a plant's
+viscous friction that depends on the direction (:meth:`Stepping.with_viscous`).  The time
+simulation and the open-loop force of a feedforward model advance the rows
 with :func:`advance`, so they never need to know which model they run;
 :func:`advance_partials` differentiates the step of the kinds in
 :data:`DIFFERENTIATED` (the open loop's sensitivities for identification).
@@ -32,10 +34,10 @@ from motionhyst.hysteresis._lugre_kernels import lugre_relax
 from motionhyst.hysteresis._ode_kernels import GL_T, GL_W, bouc_wen_step, dahl_advance
 
 __all__ = ["BOUC_WEN", "COULOMB", "DAHL", "DIFFERENTIATED", "GL_T", "GL_W", "LUGRE", "MAXWELL",
-           "N_PARAMS", "N_PARTIALS", "STOP", "Stepping", "advance", "advance_partials",
+           "N_PARAMS", "N_PARTIALS", "STOP", "VISCOUS", "Stepping", "advance", "advance_partials",
            "coulomb_implicit", "open_loop", "open_loop_chunk"]
 
-STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL, COULOMB = 0, 1, 2, 3, 4, 5
+STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL, COULOMB, VISCOUS = 0, 1, 2, 3, 4, 5, 6
 N_PARAMS = 6
 
 
@@ -47,7 +49,7 @@ class Stepping:
     ----------
     codes : ndarray of int64, shape (n,)
         Primitive kind of each element (``STOP``, ``DAHL``, ``BOUC_WEN``, ``LUGRE``,
-        ``MAXWELL``, ``COULOMB``).
+        ``MAXWELL``, ``COULOMB``, ``VISCOUS``).
     params : ndarray, shape (n, N_PARAMS)
         Each element's parameters, in the order :func:`advance` reads them.
     state0 : ndarray, shape (n,)
@@ -118,6 +120,46 @@ class Stepping:
         """No link: no elements, unit force scale."""
         return cls(np.zeros(0, np.int64), np.zeros((0, N_PARAMS)), np.zeros(0), 1.0)
 
+    def with_viscous(self, c_pos: float, c_neg: float, keep_zero: bool = False) -> Stepping:
+        """The rows with a viscous force by direction beside the link's: ``c_pos v`` moving
+        forward, ``c_neg v`` backward (a plant's direction-dependent viscous friction on the
+        link's coordinate; either may be negative, the plant's own damper holding the rest).
+
+        A lone rigid slider (``COULOMB``, stepped in closed form) takes them into its own
+        viscous terms; any other link gets a ``VISCOUS`` row after its own (the last row).
+
+        Parameters
+        ----------
+        c_pos, c_neg : float
+            Viscous friction added moving forward and backward [N s/m].
+        keep_zero : bool
+            Add the row even when both are 0 (its sensitivities wanted).
+
+        Returns
+        -------
+        Stepping
+            The same when both are 0 (unless `keep_zero`).
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import Coulomb, Jenkins
+        >>> Jenkins(k=1e4, fc=5.0).time_stepping().with_viscous(30.0, -30.0).codes.tolist()
+        [0, 6]
+        >>> Coulomb(fc=5.0).time_stepping().with_viscous(30.0, -30.0).params[0, :4].tolist()
+        [5.0, 5.0, 30.0, -30.0]
+        """
+        if c_pos == 0.0 and c_neg == 0.0 and not keep_zero:
+            return self
+        if self.codes.size == 1 and self.codes[0] == COULOMB:
+            params = self.params.copy()
+            params[0, 2] += c_pos
+            params[0, 3] += c_neg
+            return Stepping(self.codes, params, self.state0, self.scale)
+        row = np.zeros((1, N_PARAMS))
+        row[0, :2] = c_pos, c_neg
+        return Stepping(np.append(self.codes, VISCOUS), np.vstack([self.params, row]),
+                        np.append(self.state0, 0.0), self.scale)
+
 
 
 @njit("(int64, float64[::1], float64, float64, float64, float64, float64, boolean, "
@@ -157,6 +199,11 @@ def advance(code, p, s, s_prev, dx, dx_prev, h, first, glt, glw):  # pragma: no 
             v = -p[1] + (p[3] * dx / h if h > 0.0 else 0.0)
         else:
             v = s
+        return v, v
+    if code == VISCOUS:  # p = (c_pos, c_neg): a damper by direction; state its force
+        if h <= 0.0:
+            return 0.0, 0.0
+        v = (p[0] if dx > 0.0 else p[1]) * dx / h  # the step's mean velocity
         return v, v
     if code == MAXWELL:  # p = (kv, cv): a spring kv in series with a damper cv; state f
         # exact for dx linear in time: f+ = f e^-a + cv (dx / h) (1 - e^-a), a = h kv / cv,
@@ -219,7 +266,7 @@ def coulomb_implicit(p, a, b):  # pragma: no cover - compiled
 
 
 #: Element kinds :func:`advance_partials` differentiates (not ``BOUC_WEN``)
-DIFFERENTIATED = (STOP, DAHL, LUGRE, MAXWELL, COULOMB)
+DIFFERENTIATED = (STOP, DAHL, LUGRE, MAXWELL, COULOMB, VISCOUS)
 #: Length of :func:`advance_partials`' derivative vectors: in ``s, s_prev, dx, dx_prev``, then
 #: the element's ``N_PARAMS`` parameters
 N_PARTIALS = 4 + N_PARAMS
@@ -346,6 +393,16 @@ def advance_partials(code, p, s, s_prev, dx, dx_prev, h, first, ds, df
         else:
             v = s
             df[0] = 1.0
+        for i in range(N_PARTIALS):
+            ds[i] = df[i]
+        return v, v
+    if code == VISCOUS:  # p = (c_pos, c_neg); state its force
+        if h <= 0.0:
+            return 0.0, 0.0
+        j = 0 if dx > 0.0 else 1
+        v = p[j] * dx / h
+        df[2] = p[j] / h
+        df[4 + j] = dx / h
         for i in range(N_PARTIALS):
             ds[i] = df[i]
         return v, v

@@ -45,9 +45,10 @@ from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
 from motionhyst.identify.io_start import inverse_dynamics
 
 __all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "INIT_WINDOW", "MODELS",
-           "PERIOD", "PUBLISHED", "REFERENCE_MODEL", "TEST_FILE", "EMPSBenchmark", "EMPSModel",
-           "choose", "cross_validate", "equivalent_offset", "own_offset_score", "period_drift",
-           "reference_system", "run_emps", "score", "split_by_periods"]
+           "OPTIONS", "PERIOD", "PUBLISHED", "REFERENCE_MODEL", "TEST_FILE", "EMPSBenchmark",
+           "EMPSModel", "choose", "cross_validate", "equivalent_offset", "model_options",
+           "own_offset_score", "period_drift", "reference_system", "run_emps", "score",
+           "split_by_periods"]
 
 ESTIMATION_FILE = "DATA_EMPS.mat"
 """The benchmark's estimation record."""
@@ -77,6 +78,41 @@ PUBLISHED: tuple[tuple[str, float | None, float], ...] = (
     ("best linear model (as cited by dynoNet)", None, 25.4),
 )
 """Published simulation results on the test record: (method, RMSE [mm] or None, fit [%])."""
+
+
+#: The options a model's name may end with (``jenkins-asymmetric-drift``)
+OPTIONS = ("asymmetric", "drift")
+
+
+def model_options(name: str) -> tuple[str, set[str]]:
+    """A model's link and its options, from its name (the link's, then ``-asymmetric`` and
+    ``-drift``: :func:`~motionhyst.identify.input_output.identify_io`'s options).
+
+    Parameters
+    ----------
+    name : str
+        ``"jenkins-asymmetric-drift"``, ``"maxwell-slip-asymmetric"``, ...
+
+    Returns
+    -------
+    link : str
+        The registered link model's name.
+    options : set of str
+        Of :data:`OPTIONS`.
+
+    Examples
+    --------
+    >>> link, options = model_options("maxwell-slip-asymmetric-drift")
+    >>> link, sorted(options)
+    ('maxwell-slip', ['asymmetric', 'drift'])
+    """
+    link, options = name, set()
+    while True:
+        head, _, tail = link.rpartition("-")
+        if not head or tail not in OPTIONS:
+            return link, options
+        link = head
+        options.add(tail)
 
 
 def choose(runs: Sequence[EMPSBenchmark]) -> tuple[str, float]:
@@ -392,9 +428,10 @@ def _viscous(p: dict) -> str:
     from motionhyst.core.textfmt import g
 
     c = p.get("c")
-    if c is None or ("c_pos" not in p and "c_neg" not in p):
+    if c is None or not {"c_pos", "c_neg", "c_skew"} & set(p):
         return g(c, 4)
-    return f"{g(c + p.get('c_pos', 0.0), 4)}/{g(c + p.get('c_neg', 0.0), 4)}"
+    d = p.get("c_skew", 0.0)
+    return f"{g(c + d + p.get('c_pos', 0.0), 4)}/{g(c - d + p.get('c_neg', 0.0), 4)}"
 
 
 def _offset(p: dict) -> str:
@@ -528,10 +565,11 @@ def equivalent_offset(parameters: dict, record: IORecord) -> float:
 
     The benchmark's reference model has one viscous coefficient and a constant
     offset.  With viscous friction by direction (``c + c_pos`` forward,
-    ``c + c_neg`` backward) the friction's viscous force is ``(c + (c_pos +
-    c_neg)/2) q' + (c_pos - c_neg)/2 |q'|``: its even part acts as an offset
-    that follows the speed, and on a motion whose mean speed is ``mean |q'|``
-    it is the constant offset ``(c_pos - c_neg)/2 mean |q'|``; a drifting
+    ``c + c_neg`` backward: the Coulomb link's own; or the stage's ``c +
+    c_skew`` forward, ``c - c_skew`` backward) the friction's viscous force is
+    ``(c + (c_pos + c_neg)/2) q' + d |q'|``, ``d = c_skew + (c_pos - c_neg)/2``:
+    its even part acts as an offset that follows the speed, and on a motion
+    whose mean speed is ``mean |q'|`` it is the constant offset ``d mean |q'|``; a drifting
     offset ``OF + rate t`` is ``OF + rate mean(t)`` on average.  Their sum is
     what the reference model's ``OF`` is fitted to (EMPS, viscous friction by
     direction: ``OF`` +0.11 N and ``(c_pos - c_neg)/2 mean |q'|`` = -3.0 N
@@ -540,8 +578,8 @@ def equivalent_offset(parameters: dict, record: IORecord) -> float:
     Parameters
     ----------
     parameters : dict
-        ``offset`` [N] and optionally ``c_pos``, ``c_neg`` [N s/m], ``drift``
-        [N/s] (as :class:`EMPSModel` holds them).
+        ``offset`` [N] and optionally ``c_pos``, ``c_neg``, ``c_skew`` [N s/m],
+        ``drift`` [N/s] (as :class:`EMPSModel` holds them).
     record : IORecord
         The record whose motion the model was identified on (its velocity is
         the measured position's gradient).
@@ -549,7 +587,7 @@ def equivalent_offset(parameters: dict, record: IORecord) -> float:
     Returns
     -------
     float
-        ``OF + rate mean(t) + (c_pos - c_neg)/2 mean |q'|`` [N].
+        ``OF + rate mean(t) + d mean |q'|`` [N].
 
     Examples
     --------
@@ -560,9 +598,12 @@ def equivalent_offset(parameters: dict, record: IORecord) -> float:
     -3.7
     >>> round(equivalent_offset({"offset": -3.0, "drift": -0.02}, rec), 2)  # mean t = 1 s
     -3.02
+    >>> round(equivalent_offset({"offset": 0.1, "c_skew": -38.0}, rec), 2)
+    -3.7
     """
     v = np.gradient(record.y, record.t)
-    even = 0.5 * (parameters.get("c_pos", 0.0) - parameters.get("c_neg", 0.0))
+    even = (parameters.get("c_skew", 0.0)
+            + 0.5 * (parameters.get("c_pos", 0.0) - parameters.get("c_neg", 0.0)))
     return float(parameters["offset"] + parameters.get("drift", 0.0) * np.mean(record.t)
                  + even * np.mean(np.abs(v)))
 
@@ -777,7 +818,7 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
         t0 = time.perf_counter()
         try:
-            link, *options = name.split("-")
+            link, options = model_options(name)
             with warnings.catch_warnings():  # the report lists the fit's warnings itself
                 warnings.simplefilter("ignore", MotionhystWarning)
                 fit = identify_io([est], link, plant="mass-damper", init_window=INIT_WINDOW,

@@ -276,10 +276,13 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         the EMPS benchmark's convention, 20): the model is fitted the way it is
         scored.  Only the force offset is estimated with it (a floating stage).
     asymmetric : bool
-        The Coulomb link on a mass-damper: viscous friction by direction (the
-        link's ``c_pos`` or ``c_neg`` on top of the stage's ``c``; a positioning
-        axis's ``Fv+``, ``Fv-``).  Its force offset is then another number than a
-        symmetric model's: the symmetric one takes up the mean of the difference.
+        A mass-damper's viscous friction by direction (a positioning axis's
+        ``Fv+``, ``Fv-``), with any link but Bouc-Wen: the stage's ``c_skew``
+        estimated with ``c`` (``c + c_skew`` moving forward, ``c - c_skew``
+        backward); the Coulomb link holds it itself (its ``c_pos`` or ``c_neg`` on
+        top of the stage's ``c``, the smaller).  Its force offset is then another
+        number than a symmetric model's: the symmetric one takes up the mean of the
+        difference.
     drift : bool
         A mass-damper whose force offset drifts in time: its rate ``input_drift``
         [N/s] is estimated with the force offset (the plant receives ``u -
@@ -315,6 +318,9 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     """
     t_start = time.perf_counter()
     link = _link_class(model)
+    if asymmetric and periodic and link is not Coulomb:
+        raise ValueError("the stage's viscous friction by direction is identified from records "
+                         "from a start, not periodic ones (the Coulomb link's own: both)")
     records = check_records(list(records), periodic)
     if periodic:
         for rec in records:
@@ -361,7 +367,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                         max_evaluations=max_evaluations, tol=tol,
                                         t_start=t_start)
     shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
-    if asymmetric and not (link is Coulomb and shape.floating and shape.n == 1):
+    if asymmetric and not (link is not BoucWen and shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)
     check_inertia(records)  # before the search
     if link is not BoucWen:
@@ -369,7 +375,8 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
                                     stage, offset, from_rest, max_evaluations,
                                     int(init_window) if init_window is not None else None,
-                                    asymmetric, bool(drift))
+                                    asymmetric, bool(drift),
+                                    skew=asymmetric and link is not Coulomb)
     bouc_wen_offset = offset == "output" and not shape.floating
     if (offset not in ("auto", "none") and not bouc_wen_offset) or from_rest \
             or init_window is not None:
@@ -388,8 +395,8 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                  bouc_wen_offset)
 
 
-_ASYMMETRIC = ("direction-dependent viscous friction is identified with the Coulomb link on a "
-               "mass-damper")
+_ASYMMETRIC = ("direction-dependent viscous friction is identified on a mass-damper, with a link "
+               "other than Bouc-Wen")
 
 
 def _link_class(model: type[Hysteresis] | Hysteresis | str) -> type[Hysteresis]:

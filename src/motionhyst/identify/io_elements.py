@@ -84,19 +84,24 @@ class _LinkLayout:
     (a list parameter gives `n` values) is estimated, as a logarithm when it
     must be positive, linearly (scaled, bounded below by 0) when it may be 0;
     a parameter that only adds a spring or damper in parallel (``parallel``)
-    is fixed at 0, since the stage's ``k`` or ``c`` holds the sum.
+    is fixed at 0, since the stage's ``k`` or ``c`` holds the sum.  With `skew`
+    the stage's viscous friction by direction (a mass-damper's ``c_skew``,
+    :data:`SKEW`) is the last value: the link's :meth:`build` leaves it out.
     """
 
     cls: type
     entries: list[tuple[Parameter, int]]  # (parameter, number of values; -1: a scalar)
     fixed: dict[str, float]
+    skew: bool = False
 
     @classmethod
-    def of(cls, klass: type, n: int, faster: str | None = None) -> _LinkLayout:
+    def of(cls, klass: type, n: int, faster: str | None = None,
+           skew: bool = False) -> _LinkLayout:
         """The layout of the link model `klass` (`n` values of a list parameter); `faster`:
         the Coulomb link's direction-dependent viscous friction, ``"c_pos"`` or ``"c_neg"``
         (the direction with more, estimated on top of the stage's ``c``; the other
-        fixed at 0)."""
+        fixed at 0); `skew`: the stage's viscous friction by direction after the link's
+        values."""
         entries, fixed = [], {}
         if faster is not None:
             form = {p.name: p for p in klass.forms[0].parameters}
@@ -110,7 +115,7 @@ class _LinkLayout:
                 entries.append((par, 0 if par.default == () else n))
             else:
                 entries.append((par, -1))
-        return cls(klass, entries, fixed)
+        return cls(klass, entries, fixed, skew)
 
     def _values(self):
         for par, count in self.entries:
@@ -119,11 +124,15 @@ class _LinkLayout:
             else:
                 for i in range(count):
                     yield par, i
+        if self.skew:
+            yield SKEW, None
 
     @property
     def names(self) -> list[str]:
-        """Names of the estimates, ``link.`` before the model's parameter names."""
-        return [f"link.{par.name}" if i is None else f"link.{par.name}[{i}]"
+        """Names of the estimates, ``link.`` before the model's parameter names (the
+        stage's ``c_skew`` as it is)."""
+        return [SKEW.name if par is SKEW else
+                f"link.{par.name}" if i is None else f"link.{par.name}[{i}]"
                 for par, i in self._values()]
 
     @property
@@ -193,6 +202,12 @@ class _LinkLayout:
         return np.array(out)
 
 
+#: A mass-damper's viscous friction by direction, searched with a link's values
+#: (:class:`~motionhyst.plants.mass_damper.MassDamper`'s ``c_skew``)
+SKEW = Parameter("c_skew", _DAMPING, "half the difference of the stage's viscous friction "
+                 "moving forward and backward", 0.0, "finite")
+
+
 #: The search layout of a registered link's parameters, for the other identification modules
 #: (the quasi-static plant's, :mod:`~motionhyst.identify.io_quasi_static`)
 LinkLayout = _LinkLayout
@@ -230,6 +245,8 @@ class _ElementProblem:
         self.log = np.concatenate([np.ones(self.n_plant, bool), layout.logarithmic,
                                    np.zeros(self.extras.size, bool)]).astype(bool)
         self.signed = np.arange(self.log.size) >= self.n_plant + self.n_link
+        if layout.skew:  # the stage's viscous friction by direction: either sign
+            self.signed[self.n_plant + self.n_link - 1] = True
         self.scale = scale
         self.free = np.ones(self.log.size, bool) if free is None else free
         self.fixed = np.zeros(self.log.size) if fixed is None else fixed
@@ -291,7 +308,8 @@ class _ElementProblem:
             if dparams is None:
                 raise LookupError("no sensitivities for this link")
         stepping = link.time_stepping()
-        mech = self.plant.mechanics(v[:k])
+        mech = self.mechanics(v)
+        skew = nl - 1 if self.layout.skew else None
         k_link = link.initial_stiffness
 
         def one(i):
@@ -302,10 +320,10 @@ class _ElementProblem:
                 fine = fine - drift * self.fine_t[i]
                 u = u - drift * rec.t
             if self.window is not None:
-                return self._from_window(mech, stepping, k_link, rec, u, fine, dparams)
+                return self._from_window(mech, stepping, k_link, rec, u, fine, dparams, skew)
             y, sy = simulate_elements(mech, stepping, u, rec.fs, self.r,
                                       periodic=self.periodic, k_link=k_link, upsampled=fine,
-                                      dparams=dparams,
+                                      dparams=dparams, skew_column=skew,
                                       x0=initial_state(mech.n, self.extras.initial, init[i]),
                                       periods=SEARCH_PERIODS)
             return y + y0[i], sy
@@ -316,14 +334,30 @@ class _ElementProblem:
                 return list(pool.map(one, which))
         return [one(i) for i in which]
 
-    def _from_window(self, mech, stepping, k_link, rec, u, fine, dparams):
+    def mechanics(self, v: NDArray[np.float64]):
+        """The stage's mechanics at the parameters `v` (with its viscous friction by
+        direction when the layout estimates it)."""
+        mech = self.plant.mechanics(v[:self.n_plant])
+        if self.layout.skew:
+            mech.c_skew = float(v[self.n_plant + self.n_link - 1])
+        return mech
+
+    def stage(self, v: NDArray[np.float64]):
+        """The stage (a plant) at the parameters `v`, its ``c_skew`` included."""
+        plant = self.plant.with_parameters(v[:self.n_plant])
+        if self.layout.skew:
+            plant.c_skew = float(v[self.n_plant + self.n_link - 1])
+        return plant
+
+    def _from_window(self, mech, stepping, k_link, rec, u, fine, dparams, skew=None):
         """A record run from the state its first :attr:`window` samples set
         (:func:`~motionhyst.identify.io_predict.state_from_window`), as ``predict
         --init-from`` runs it; the sensitivities include the state's own dependence on
         the parameters (its least squares over the window, to first order)."""
         p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
                                    self.window)
-        y, sy = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine, dparams)
+        y, sy = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine, dparams,
+                               skew)
         if dparams is None or sy.shape[1] == 0:
             return y, sy
         cols = []
@@ -348,7 +382,7 @@ class _ElementProblem:
         u0 = self.extras.split(v[k + nl:])[0]
         drift = self.extras.drift(v[k + nl:])
         link = self.layout.build(v[k:k + nl])
-        mech = self.plant.mechanics(v[:k])
+        mech = self.mechanics(v)
         return [state_from_window(mech, link.time_stepping(), link.initial_stiffness,
                                   rec.u - u0 - drift * rec.t, rec.y, rec.fs, self.r, self.window)
                 for rec in self.records]
@@ -501,7 +535,8 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 
 def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_start,
                          start_nfev, plant, offset="none", from_rest=True, budget=None,
-                         init_window=None, asymmetric=False, drift=False) -> IOIdentification:
+                         init_window=None, asymmetric=False, drift=False,
+                         skew=False) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -531,7 +566,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     on a mass-damper) the viscous friction depends on the direction: the stage's
     ``c`` is the smaller one, the link's ``c_pos`` or ``c_neg`` the excess in the
     other direction (chosen, and started, from the inverse dynamics with a
-    viscous term per direction), its slip force ``fc`` the same both ways.
+    viscous term per direction), its slip force ``fc`` the same both ways.  With
+    `skew` (any link on a mass-damper) the stage's own viscous friction depends on
+    the direction: its ``c_skew`` is estimated with the link (started from the
+    inverse dynamics' ``(c_pos - c_neg) / 2``, ``c`` from their mean).
 
     A link other than the rigid slider on a mass-damper also starts from the
     Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit), when
@@ -548,12 +586,13 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     """
     shape = plant.mechanics(np.ones(len(plant.PARAMETERS)))  # the structure, whatever values
     axis = shape.floating and shape.n == 1  # a positioning axis: friction holds it
-    idim = inverse_dynamics(records, shape.floating, asymmetric)
+    idim = inverse_dynamics(records, shape.floating, asymmetric or skew)
     faster = None
-    if asymmetric:  # the stage's c is the smaller viscous friction, the link adds the rest
+    if asymmetric and not skew:  # the stage's c is the smaller viscous friction, the link
+        # adds the rest
         faster = "c_pos" if idim["c_pos"] >= idim["c_neg"] else "c_neg"
         idim["c"] = min(idim["c_pos"], idim["c_neg"])
-    layout = _LinkLayout.of(link, n, faster)
+    layout = _LinkLayout.of(link, n, faster, skew)
     y_all = np.concatenate([rec.y - (np.mean(rec.y) if periodic and shape.n > 1
                                      else 0.0) for rec in records])
     y_scale = float(np.sqrt(np.mean(y_all ** 2)))
@@ -595,6 +634,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
             link0 = layout.start(k0, y_scale, v_scale, c0, slip)
             if faster is not None:
                 link0[1] = abs(idim["c_pos"] - idim["c_neg"])
+            if skew:
+                link0[-1] = 0.5 * (idim["c_pos"] - idim["c_neg"])
             starts.append(np.concatenate([[m0, c0], link0]))
         r = substeps or OpenLoop(structure, layout.build(starts[0][2:])).default_substeps(
             records[0].fs)
@@ -669,7 +710,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         # the rigid slider is every friction link's limit: its fit is a start for theirs
         seed, used = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
                                  start_nfev, plant, offset, from_rest, layout, y_scale,
-                                 v_scale, extras, force, init_window)
+                                 v_scale, extras, force, init_window, skew)
         n_eval += used
         if seed is not None:
             q_seed = prob.variables(seed)
@@ -719,7 +760,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
             initial_state_out = {"v0": states[:, 1].tolist()}
         else:
             initial_state_out = {"y0": states[:, 0].tolist(), "v0": states[:, 1].tolist()}
-    fitted = prob.plant.with_parameters(v[:n_plant])
+    fitted = prob.stage(v)
     if extras.input_offset:
         fitted.force_offset = -u0  # the offset of the measured force, on the plant
     drift_rate = extras.drift(v[n_base:])
@@ -728,9 +769,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     link = layout.build(v[n_plant:n_base])
     judge_fit(float(np.sqrt(rss / res.size)), records, prob._split_rows(res, measured=True),
               _linear_rms(records, structure, r, periodic, extras.output_offset),
-              OpenLoop(prob.plant.with_parameters(v[:n_plant]), link),
+              OpenLoop(prob.stage(v), link),
               extras.output_offset or (init_window is not None and floating))
-    bound = [nm for nm, x, lin, sc in zip(names[:n_base], v[:n_base], ~prob.log[:n_base],
+    bound = [nm for nm, x, lin, sc in zip(names[:n_base], v[:n_base],
+                                          ~(prob.log | prob.signed)[:n_base],
                                           scale[:n_base], strict=True)
              if lin and nm not in not_ident and abs(x) <= 1e-9 * sc]
     # a positive parameter searched as a logarithm has no bound: one that ran orders of
@@ -798,7 +840,8 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
 
 
 def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, offset,
-                from_rest, layout, y_scale, v_scale, extras, force, init_window=None):
+                from_rest, layout, y_scale, v_scale, extras, force, init_window=None,
+                skew=False):
     """A positioning axis's friction link started from the Coulomb link's fit: the stage, the
     offsets and initial states as fitted, the link's forces together its slip force, slipping
     after 1e-5 of the output's RMS (its rigid limit); None if that fit fails."""
@@ -807,13 +850,16 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
     try:
         fit = identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev, 1,
                                    t_start, start_nfev, plant, offset, from_rest,
-                                   init_window=init_window, drift=extras.input_drift)
+                                   init_window=init_window, drift=extras.input_drift,
+                                   skew=skew)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0
     fc = fit.estimates["link.fc"]
     link0 = layout.start(2.0 * fc / (1e-5 * y_scale), y_scale, v_scale, fit.plant.c, 1e-5)
     if force.any():
         link0[force] *= fc / np.sum(link0[force])
+    if skew:
+        link0[-1] = fit.plant.c_skew
     rate = np.array([par.unit == _VELOCITY for par, _ in layout._values()], dtype=bool)
     link0[rate] = RATE_GRID[0] * v_scale
     return (np.concatenate([[fit.plant.m, fit.plant.c], link0,

@@ -102,7 +102,8 @@ class WindowPrediction:
 
 
 def run_from_state(mech, stepping: Stepping, k_link: float, u, fs: float, r: int,
-                   position: float, velocity: float, upsampled=None, dparams=None
+                   position: float, velocity: float, upsampled=None, dparams=None,
+                   skew_column: int | None = None
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A record simulated from the force, the stage moving as one body at the first sample.
 
@@ -124,6 +125,8 @@ def run_from_state(mech, stepping: Stepping, k_link: float, u, fs: float, r: int
         The first sample's position [m] (a floating stage's: the offset added to
         its output) and velocity [m/s].
     upsampled, dparams : ndarray, optional
+        As for :func:`~motionhyst.time.openloop.simulate_elements`.
+    skew_column : int, optional
         As for :func:`~motionhyst.time.openloop.simulate_elements`.
 
     Returns
@@ -147,7 +150,8 @@ def run_from_state(mech, stepping: Stepping, k_link: float, u, fs: float, r: int
     if not floating:
         x0[:n] = position
     y, dy = simulate_elements(mech, stepping, u, fs, r, periodic=False, k_link=k_link, x0=x0,
-                              upsampled=upsampled, dparams=dparams)
+                              upsampled=upsampled, dparams=dparams,
+                              skew_column=skew_column)
     return (y + position if floating else y), dy
 
 

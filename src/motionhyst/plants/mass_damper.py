@@ -1,10 +1,12 @@
 """A positioning axis: one mass with viscous friction to the ground and no spring.
 
-``m y'' + c y' = u + f0 + f1 t - w``: the carriage of a ball-screw or linear-motor
-axis, the force ``u`` of the drive (with an offset ``f0`` that may drift at
+``m y'' + c y' + d |y'| = u + f0 + f1 t - w``: the carriage of a ball-screw or
+linear-motor axis, the force ``u`` of the drive (with an offset ``f0`` that may drift at
 ``f1`` over the record's time ``t``: a drive or its friction warming up), the link
-force ``w`` (friction) on the carriage's position ``y``, which is measured.
-The rigid-body mass ``M = m`` is that of the feedforward ``M s^2``.
+force ``w`` (friction) on the carriage's position ``y``, which is measured.  The
+viscous friction may depend on the direction (``d = c_skew``): ``c + d`` moving
+forward, ``c - d`` backward (the EMPS axis's ``Fv+``, ``Fv-``), continuous in the
+velocity.  The rigid-body mass ``M = m`` is that of the feedforward ``M s^2``.
 """
 
 from __future__ import annotations
@@ -25,14 +27,22 @@ __all__ = ["MassDamper"]
 class MassDamper(LumpedPlant):
     """One mass with viscous friction to the ground, no spring: ``m y'' + c y' = u + f0 - w``.
 
-    ``P1 = P2 = 1 / (m s^2 + c s)``: the axis floats (only the link holds it).
+    ``P1 = P2 = 1 / (m s^2 + c s)``: the axis floats (only the link holds it).  With
+    ``c_skew`` the viscous force is ``c y' + c_skew |y'|``: the transfer functions (and
+    the analyses that use them) take its mean ``c``, the time runs from a start the force
+    by direction.
 
     Parameters
     ----------
     m : float
         Mass [kg], > 0.
     c : float
-        Viscous damping to the ground [N s/m], >= 0.
+        Viscous damping to the ground [N s/m], >= 0: the mean of the two directions'.
+    c_skew : float
+        Half the difference of the viscous friction moving forward and backward [N s/m],
+        ``|c_skew| <= c``: ``c_pos = c + c_skew`` for ``y' > 0``, ``c_neg = c - c_skew``
+        for ``y' < 0`` (the force ``c y' + c_skew |y'|``).  Open-loop time runs from a
+        start only (no periodic steady state, no closed loop).
     force_offset : float
         Constant force ``f0`` added to the force on the mass [N].
     force_drift : float
@@ -56,12 +66,21 @@ class MassDamper(LumpedPlant):
     >>> G = axis.frequency_response([10.0])[0]             # at 10 Hz nearly 1 / (m s^2)
     >>> print(f"{abs(G) * axis.M * (2 * np.pi * 10.0) ** 2:.4f}")
     0.9994
+
+    Viscous friction by direction (163 N s/m forward, 240 backward):
+
+    >>> axis = MassDamper.by_direction(m=95.1, c_pos=163.0, c_neg=240.0)
+    >>> axis.c, axis.c_skew, axis.c_pos, axis.c_neg
+    (201.5, -38.5, 163.0, 240.0)
     """
 
     name: ClassVar[str] = "mass-damper"
     parameters: ClassVar[tuple[PlantParameter, ...]] = (
         PlantParameter("m", "kg", "moving mass"),
         PlantParameter("c", "N s/m", "viscous damping to the ground", "nonnegative"),
+        PlantParameter("c_skew", "N s/m", "half the difference of the viscous friction moving "
+                       "forward and backward (c + c_skew forward, c - c_skew backward)",
+                       "finite", 0.0),
         FORCE_OFFSET,
         PlantParameter("force_drift", "N/s", "rate at which the force offset changes over the "
                        "record's time (a drive or its friction warming up)", "finite", 0.0),
@@ -69,9 +88,43 @@ class MassDamper(LumpedPlant):
     PARAMETERS: ClassVar[tuple[str, ...]] = ("m", "c")
     has_inertia: ClassVar[bool] = True
 
-    def __init__(self, m: float, c: float, force_offset: float = 0.0,
+    def __init__(self, m: float, c: float, c_skew: float = 0.0, force_offset: float = 0.0,
                  force_drift: float = 0.0) -> None:
-        self._set_checked(m=m, c=c, force_offset=force_offset, force_drift=force_drift)
+        self._set_checked(m=m, c=c, c_skew=c_skew, force_offset=force_offset,
+                          force_drift=force_drift)
+        if abs(self.c_skew) > self.c:
+            raise ValueError(f"c_skew must be within -c .. c (viscous friction >= 0 in both "
+                             f"directions), got c_skew = {c_skew!r} with c = {c!r}")
+
+    @classmethod
+    def by_direction(cls, m: float, c_pos: float, c_neg: float, **forces: float) -> MassDamper:
+        """The axis of viscous friction `c_pos` moving forward and `c_neg` backward.
+
+        Parameters
+        ----------
+        m : float
+            Mass [kg].
+        c_pos, c_neg : float
+            Viscous friction moving forward and backward [N s/m], >= 0.
+        **forces : float
+            ``force_offset``, ``force_drift``.
+
+        Returns
+        -------
+        MassDamper
+            ``c = (c_pos + c_neg) / 2``, ``c_skew = (c_pos - c_neg) / 2``.
+        """
+        return cls(m, 0.5 * (c_pos + c_neg), 0.5 * (c_pos - c_neg), **forces)
+
+    @property
+    def c_pos(self) -> float:
+        """Viscous friction moving forward ``c + c_skew`` [N s/m]."""
+        return self.c + self.c_skew
+
+    @property
+    def c_neg(self) -> float:
+        """Viscous friction moving backward ``c - c_skew`` [N s/m]."""
+        return self.c - self.c_skew
 
     @property
     def M(self) -> float:
@@ -130,8 +183,10 @@ class MassDamper(LumpedPlant):
         Returns
         -------
         Mechanics
-            One coordinate, no stiffness (floating), derivatives in ``m, c``.
+            One coordinate, no stiffness (floating), derivatives in ``m, c``; the axis's
+            ``c_skew`` and force offset.
         """
         m, c = self.values() if values is None else np.asarray(values, dtype=float)
         return Mechanics([m], [[c]], [[0.0]], [[1.0], [0.0]], [[[0.0]], [[1.0]]],
-                         [[[0.0]], [[0.0]]], 0, 0, force_offset=self.force_offset)
+                         [[[0.0]], [[0.0]]], 0, 0, force_offset=self.force_offset,
+                         c_skew=self.c_skew)

@@ -43,6 +43,12 @@ class Mechanics:
         Coordinate of the force and link, and of the output.
     force_offset : float
         The constant force ``f0`` added to the force on ``q[link]`` [N].
+    c_skew : float
+        Viscous friction by direction on ``q[link]`` [N s/m]: the force ``c_skew |q'[link]|``
+        against the motion beside ``C``'s, so that a damper ``c`` of ``C`` on that
+        coordinate acts as ``c + c_skew`` moving forward and ``c - c_skew`` backward (not in
+        the matrices: the time engine adds it to the link's elements,
+        :meth:`~motionhyst.hysteresis.stepping.Stepping.with_viscous`).
 
     Examples
     --------
@@ -54,7 +60,7 @@ class Mechanics:
     """
 
     def __init__(self, mass, C, K, dmass, dC, dK, link: int, output: int,
-                 force_offset: float = 0.0) -> None:
+                 force_offset: float = 0.0, c_skew: float = 0.0) -> None:
         self.mass = np.ascontiguousarray(mass, dtype=float)
         self.C = np.ascontiguousarray(C, dtype=float)
         self.K = np.ascontiguousarray(K, dtype=float)
@@ -64,6 +70,7 @@ class Mechanics:
         self.link = int(link)
         self.output = int(output)
         self.force_offset = float(force_offset)
+        self.c_skew = float(c_skew)
 
     @property
     def n(self) -> int:

@@ -16,7 +16,7 @@ Examples
 >>> "mass-damper" in PLANTS
 True
 >>> [p.name for p in plant_class("mass-damper").parameters]
-['m', 'c', 'force_offset', 'force_drift']
+['m', 'c', 'c_skew', 'force_offset', 'force_drift']
 """
 
 from __future__ import annotations

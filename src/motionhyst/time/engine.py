@@ -540,6 +540,9 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
     True
     """
     mech = _mechanics(plant)
+    if getattr(mech, "c_skew", 0.0):
+        raise ValueError("the sampled loop takes no viscous friction by direction on the plant "
+                         "(c_skew); the open-loop time runs do")
     Ac, Bc, Cc, Dc, T = _controller_matrices(controller)
     rr = np.ascontiguousarray(np.ravel(np.asarray(r, dtype=float)))
     n_k = rr.size

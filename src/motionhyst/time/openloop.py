@@ -272,7 +272,8 @@ class OpenLoop:
         # the force at every integration step and midpoint, and the response at each step
         check_memory(FINE_BYTES * u.size * r, f"{u.size} samples of {r} integration steps "
                      f"each", "fewer samples or substeps")
-        p = self._bw_parameters()
+        # the plant's viscous friction by direction is stepped with the link's elements
+        p = None if getattr(self.plant, "c_skew", 0.0) else self._bw_parameters()
         if periodic and self.hysteresis is None and self.plant.mechanics().floating:
             y = floating_linear_periodic(self.plant.mechanics(), u, fs)
         elif p is not None:
@@ -301,7 +302,7 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
                       upsampled: NDArray[np.float64] | None = None,
                       dparams: NDArray[np.float64] | None = None,
                       x0: NDArray[np.float64] | None = None, periods: int | None = None,
-                      shooting: bool = True
+                      shooting: bool = True, skew_column: int | None = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Output of a plant with a link of exact-update elements, and its sensitivities (FOH).
 
@@ -314,7 +315,9 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     :func:`~motionhyst.hysteresis.stepping.advance_partials`, and of the
     implicit link force).  What :meth:`OpenLoop.simulate` runs for such a link,
     and the exact Jacobian of :mod:`motionhyst.identify.input_output`; the
-    output is the same with or without the sensitivities, bit for bit.
+    output is the same with or without the sensitivities, bit for bit.  The plant's
+    viscous friction by direction (``mech.c_skew``) is stepped with the link's elements
+    (:meth:`~motionhyst.hysteresis.stepping.Stepping.with_viscous`); from a start only.
 
     Parameters
     ----------
@@ -387,6 +390,22 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     >>> bool(np.array_equal(y, ref.displacement)), dy.shape    # m, c, k, link k, fc
     (True, (256, 5))
     """
+    if mech.c_skew or skew_column is not None:
+        if periodic:
+            raise ValueError("viscous friction by direction (c_skew) is run from a start, "
+                             "not as a periodic steady state")
+        n_own = stepping.codes.size
+        stepping = stepping.with_viscous(mech.c_skew, -mech.c_skew,
+                                         keep_zero=skew_column is not None)
+        if dparams is not None and stepping.codes.size > n_own:  # the added row's
+            dparams = np.concatenate([dparams, np.zeros((1, *dparams.shape[1:]))])
+        if dparams is not None and skew_column is not None:
+            # c_pos = +c_skew, c_neg = -c_skew of the last row (of a lone rigid slider, which
+            # took them into its own viscous terms)
+            j = 2 if stepping.codes.size == n_own else 0
+            dparams = np.array(dparams, dtype=float)
+            dparams[-1, j, skew_column] += 1.0
+            dparams[-1, j + 1, skew_column] -= 1.0
     n_periods = whole_periods(u) if periodic else 1
     if n_periods > 1:  # the steady state of one period, repeated
         y, dy = simulate_elements(mech, stepping, u[: u.size // n_periods], fs, r,
