@@ -35,6 +35,7 @@ from motionhyst.identify.io_start import (
     check_substeps,
     inverse_dynamics,
     reference_mass,
+    velocity_contradictions,
 )
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
@@ -784,6 +785,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
               if nm in ("m", "m1", "m2")}
     linear_mass = reference_mass(records, shape.floating)
     notes = plausibility_warnings(estimates, masses, linear_mass, records, bound, runaway)
+    if "v0" in extras.initial and init_window is None:
+        notes += velocity_contradictions(records, initial_state_out["v0"])
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
