@@ -97,7 +97,8 @@ class MassDamper(LumpedPlant):
                              f"directions), got c_skew = {c_skew!r} with c = {c!r}")
 
     @classmethod
-    def by_direction(cls, m: float, c_pos: float, c_neg: float, **forces: float) -> MassDamper:
+    def by_direction(cls, m: float, c_pos: float, c_neg: float, force_offset: float = 0.0,
+                     force_drift: float = 0.0) -> MassDamper:
         """The axis of viscous friction `c_pos` moving forward and `c_neg` backward.
 
         Parameters
@@ -106,15 +107,15 @@ class MassDamper(LumpedPlant):
             Mass [kg].
         c_pos, c_neg : float
             Viscous friction moving forward and backward [N s/m], >= 0.
-        **forces : float
-            ``force_offset``, ``force_drift``.
+        force_offset, force_drift : float
+            As for the constructor.
 
         Returns
         -------
         MassDamper
             ``c = (c_pos + c_neg) / 2``, ``c_skew = (c_pos - c_neg) / 2``.
         """
-        return cls(m, 0.5 * (c_pos + c_neg), 0.5 * (c_pos - c_neg), **forces)
+        return cls(m, 0.5 * (c_pos + c_neg), 0.5 * (c_pos - c_neg), force_offset, force_drift)
 
     @property
     def c_pos(self) -> float:
