@@ -364,6 +364,9 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         rest sets, by repeated periods); False: periods repeated (and
         extrapolated) until the output repeats.  Both give
         the steady state to the tolerances above.
+    skew_column : int, optional
+        With `dparams`: its column (a link parameter the rows do not depend on) that
+        stands for ``mech.c_skew``, whose derivative it then holds.
 
     Returns
     -------
