@@ -5,6 +5,7 @@ every link, refused where it has no meaning, identified with every element link
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -154,3 +155,22 @@ def test_predicted_from_the_window_with_its_damper():
     assert pred.rmse < 1e-8 * np.ptp(rec.y)
     mean = OpenLoop(MassDamper(95.0, 201.5, force_offset=3.0), link)  # the mean damper
     assert predict_from_window(mean, rec.t, rec.u, rec.y, 20, substeps=10).rmse > 1e-3
+
+
+EMPS = Path(__file__).resolve().parents[2] / "shared" / "benchmarks" / "emps" / "DATA_EMPS.mat"
+
+
+@pytest.mark.skipif(not EMPS.is_file(),
+                    reason="the EMPS benchmark's files are not beside the repository")
+def test_a_stiff_link_on_the_measured_record_is_simulated():
+    """A nearly rigid Jenkins link (k 2.8e8 N/m, fitted on EMPS periods 3-4) turns the last
+    bit of a step's displacement into more force than the fixed point's rounding floor: the
+    passes repeat in a two-cycle, which is the step's end (it ended the run before)."""
+    from motionhyst.cli.benchmark import _emps_record
+    from motionhyst.identify.emps import split_by_periods
+
+    rec, _ = split_by_periods(_emps_record(EMPS, "DATA_EMPS"), (3, 4))
+    axis = OpenLoop(MassDamper(92.40918701923592, 190.0506702169536, -39.67811826643633),
+                    Jenkins(k=275714121.3158981, fc=21.943279798965058))
+    y = axis.simulate(rec.t, rec.u, substeps=110).displacement
+    assert np.all(np.isfinite(y)) and np.ptp(y) > 0.1

@@ -68,8 +68,8 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
     elements were last advanced with; converged when ``w`` settles to `ftol` or the
     displacement to 1e-15 of itself, or stalls at round-off) and ``OPEN`` (the
     plant's: ``D = 0``, the outputs recorded from ``C z_new``; converged when ``w``
-    settles to `ftol` or stalls within ``1e3 ftol``; sensitivities and the
-    controller only here).
+    settles to `ftol`, stalls within ``1e3 ftol`` or repeats the pass before last
+    exactly (a two-cycle of rounding); sensitivities and the controller only here).
 
     Steps before `i_first` (global index ``i0 + i``) have length 0; step `i_first` is
     the elements' first (LuGre's rates from one step).  `fresh`: the state `z`, `s`
@@ -251,6 +251,7 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
         else:
             base = pre + gl * a_new
             change = math.inf
+            w_back = math.nan  # the force two passes back
             if rigid:  # the velocity at the step's end without the link force, then with it
                 a_v = 0.0
                 for q in range(n):
@@ -275,10 +276,14 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
                         wn += fj
                 # converged, or stalled at the rounding floor (a contraction's changes stop
                 # falling only there: rate terms such as LuGre's sigma1 z' amplify the
-                # rounding of dx by ~ sigma1 / h)
+                # rounding of dx by ~ sigma1 / h), or caught in a two-cycle of rounding (a
+                # stiff element turns the last bit of dx into more than that floor: the
+                # passes repeat exactly, and would forever)
                 last = change
                 change = abs(wn - wt)
-                done = change <= ftol or m == 0 or (change <= 1e3 * ftol and change >= last)
+                done = (change <= ftol or m == 0 or (change <= 1e3 * ftol and change >= last)
+                        or wn == w_back)
+                w_back = wt
                 wt = wn
                 if done or it > max_iter:
                     break
