@@ -125,7 +125,7 @@ def test_identify_asymmetric_on_the_command_line_saves_it_for_predict(tmp_path, 
     runs the saved model with it; Bouc-Wen is refused in one line."""
     from motionhyst.cli import main
 
-    rec = _record(Jenkins(k=2e5, fc=20.0), n=1500)
+    rec = _record(Jenkins(k=2e5, fc=20.0), n=3000)  # both directions' motion, long enough
     path = tmp_path / "axis.csv"
     np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
                header="time,force,displacement", comments="", fmt="%.17g")

@@ -341,6 +341,8 @@ class _ElementProblem:
         mech = self.plant.mechanics(v[:self.n_plant])
         if self.layout.skew:
             mech.c_skew = float(v[self.n_plant + self.n_link - 1])
+            if abs(mech.c_skew) > float(mech.C[0, 0]):  # a direction with negative friction
+                raise ValueError("c_skew beyond the stage's c: parameters the model refuses")
         return mech
 
     def stage(self, v: NDArray[np.float64]):
