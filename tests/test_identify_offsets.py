@@ -232,18 +232,3 @@ def test_reference_mass_only_where_the_linear_model_explains_the_force():
     u = 95.0 * np.gradient(v, t, edge_order=2) + 200.0 * v + 20.0 * np.sign(v) - 3.2
     assert reference_mass([IORecord(t, u, y)], floating=True) == pytest.approx(95.0, rel=1e-2)
     assert np.isnan(reference_mass([_axis_record(seed=1, noise=2e-5)], floating=True))
-
-
-def test_an_initial_velocity_the_record_contradicts_is_named():
-    """An initial velocity estimated against the record's own start (EMPS, one viscous
-    coefficient: -23.7 mm/s where the record starts at +6.4) is a warning naming v0; the
-    true one, with the record's noise, is not."""
-    from motionhyst.identify.io_start import start_velocity, velocity_contradictions
-
-    rec = _axis_record(noise=2e-6)
-    seen, sd = start_velocity(rec)
-    assert seen == pytest.approx(TRUE["v0"], abs=5 * sd + 1e-4)
-    assert velocity_contradictions([rec], [TRUE["v0"]]) == []
-    lines = velocity_contradictions([rec], [-TRUE["v0"]])
-    assert len(lines) == 1 and lines[0].startswith("v0 = -20 mm/s") and rec.name in lines[0]
-    assert "--init-window 20" in lines[0]

@@ -152,7 +152,7 @@ def test_a_floating_stage_without_a_link_closes_its_period_by_its_momentum(monke
 def test_the_noise_a_periodic_record_leaves_from_its_periods_spread():
     """identify's starts end at a fit to the records' own noise (io_elements): its variance
     from the spread of the periods about their mean, here within 5 % of the noise drawn."""
-    from motionhyst.identify.io_elements import NOISE_COST_FACTOR, _noise_cost
+    from motionhyst.identify.io_checks import NOISE_COST_FACTOR, noise_cost
     from motionhyst.identify.io_records import IORecord
 
     n, periods, sigma = 390, 8, 2e-3
@@ -160,9 +160,9 @@ def test_the_noise_a_periodic_record_leaves_from_its_periods_spread():
     shape = np.tile(np.sin(2 * np.pi * np.arange(n) / n), periods)
     y = shape + sigma * np.random.default_rng(1).standard_normal(u.size)
     rec = IORecord(np.arange(u.size) / FS, u, y, "r")
-    cost = _noise_cost([rec], 0.5)
+    cost = noise_cost([rec], 0.5)
     expected = 0.5 * NOISE_COST_FACTOR * u.size * sigma ** 2 / 0.5 ** 2
     assert abs(cost / expected - 1) < 0.05
     # a record of one period (or not periodic) says nothing about its noise
     one = IORecord(rec.t[:n], u[:n], y[:n], "one")
-    assert _noise_cost([one], 0.5) is None
+    assert noise_cost([one], 0.5) is None

@@ -27,8 +27,8 @@ from numpy.typing import NDArray
 
 from motionhyst.identify.io_records import IORecord
 
-__all__ = ["MAX_PREDICT_SUBSTEPS", "SYSTEMATIC_SHARE", "FitFailed", "check_inertia", "judge_fit",
-           "plausibility_warnings", "systematic_share"]
+__all__ = ["MAX_PREDICT_SUBSTEPS", "SYSTEMATIC_SHARE", "FitFailed", "check_inertia", "flat_profile",
+           "judge_fit", "noise_cost", "plausibility_warnings", "systematic_share"]
 
 #: The finest integration step ``predict`` takes, in steps per record sample; a model that
 #: needs more (a collapsed mass on a stiff link) is not a model ``predict`` can run
@@ -325,3 +325,81 @@ def _mass_and_std(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]
             meat += (1.0 - lag / (lags + 1)) * (g + g.T)
     std = math.sqrt(max(float((cov @ meat @ cov)[0, 0]), 0.0)) / scale[0]
     return float(x[0]) / scale[0], std
+
+
+#: A start whose cost is within this factor of the records' noise (from their repeated
+#: periods) ends the search for starts
+NOISE_COST_FACTOR = 1.1
+
+
+def noise_cost(records: list[IORecord], y_scale: float) -> float | None:
+    """The least-squares cost that the records' noise alone leaves, times
+    :data:`NOISE_COST_FACTOR`: a fit at this cost explains all but the noise.
+
+    The cost is half the sum of squared residuals in units of `y_scale`; the
+    noise's variance comes from the spread of the periods of periodic records
+    about their mean.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        Periodic records (their input repeats).
+    y_scale : float
+        The output's unit of the cost [m].
+
+    Returns
+    -------
+    float or None
+        None if a record holds fewer than two periods.
+
+    Examples
+    --------
+    >>> t = np.arange(400) / 100.0
+    >>> u = np.tile(np.sin(2 * np.pi * np.arange(100) / 100), 4)
+    >>> y = u + 0.01 * np.random.default_rng(0).standard_normal(400)
+    >>> c = noise_cost([IORecord(t, u, y)], 1.0)
+    >>> 0.5 * 400 * 0.01 ** 2 * 0.8 < c < 0.5 * 400 * 0.01 ** 2 * 1.4
+    True
+    """
+    from motionhyst.time.periodic_runs import whole_periods
+
+    total = 0.0
+    for rec in records:
+        p = whole_periods(rec.u)
+        if p < 2:
+            return None
+        n = rec.u.size // p
+        y = rec.y[:p * n].reshape(p, n)
+        variance = float(np.sum((y - np.mean(y, axis=0)) ** 2)) / (n * (p - 1))
+        total += rec.y.size * variance
+    return 0.5 * NOISE_COST_FACTOR * total / y_scale ** 2
+
+
+#: 95 % point of the chi-square distribution with one degree of freedom
+PROFILE_CHI2 = 3.84
+
+
+def flat_profile(costs: list[float], dof: int) -> bool:
+    """True if no cost of a profile exceeds the least by the 95 % likelihood-ratio bound:
+    the profiled parameter is not determined by the records.
+
+    ``(RSS_i - RSS_min) / sigma^2 < 3.84`` for every point, ``sigma^2 = RSS_min / dof``.
+
+    Parameters
+    ----------
+    costs : list of float
+        The fit's residual sum of squares at each value of the profiled parameter.
+    dof : int
+        The fit's degrees of freedom (residuals less parameters).
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> flat_profile([1.000, 1.001, 1.002], dof=1000), flat_profile([1.0, 1.5], dof=1000)
+    (True, False)
+    """
+    least = min(costs)
+    return bool(least > 0 and (max(costs) - least) / least * max(dof, 1) < PROFILE_CHI2)

@@ -24,7 +24,13 @@ from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import Coulomb, Hysteresis, Parameter
 from motionhyst.hysteresis.stepping import Stepping
-from motionhyst.identify.io_checks import judge_fit, plausibility_warnings
+from motionhyst.identify.io_checks import (
+    PROFILE_CHI2,
+    flat_profile,
+    judge_fit,
+    noise_cost,
+    plausibility_warnings,
+)
 from motionhyst.identify.io_offsets import Extras, initial_state
 from motionhyst.identify.io_predict import run_from_state, state_from_window
 from motionhyst.identify.io_records import short_records
@@ -35,7 +41,6 @@ from motionhyst.identify.io_start import (
     check_substeps,
     inverse_dynamics,
     reference_mass,
-    velocity_contradictions,
 )
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
@@ -551,7 +556,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     searched together); the best is refined with everything free on all
     records.  Periodic records of whole periods end the starts at the first
     whose fit leaves no more than their noise (its variance from the periods'
-    spread about their mean, :func:`_noise_cost`): no later start can fit them
+    spread about their mean, :func:`noise_cost`): no later start can fit them
     better.
 
     A two-mass stage (floating: the link is its only hold) starts from
@@ -679,7 +684,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
     short_start = _extras_start(short_extras, short, floating, idim["u0"])
-    floor = _noise_cost(short, y_scale) if periodic else None
+    floor = noise_cost(short, y_scale) if periodic else None
     best = None
     for p0 in starts:
         p0 = np.concatenate([p0, short_start])
@@ -742,7 +747,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     not_ident.update(undetermined_notes(names, groups, rtol))
     weak = weak_notes(names, v, std_v, J, rtol, ~prob.log)
     n_short = sum(rec.y.size for rec in short)
-    if rate.any() and _flat_profile(profile, n_short - short_scale.size):
+    if rate.any() and flat_profile(profile, n_short - short_scale.size):
         lo, hi = min(RATE_GRID) * v_scale, max(RATE_GRID) * v_scale
         for name in np.array(names)[rate]:
             weak[name] = (f"not determined by these records: held anywhere from {lo:.3g} to "
@@ -787,8 +792,6 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
               if nm in ("m", "m1", "m2")}
     linear_mass = reference_mass(records, shape.floating)
     notes = plausibility_warnings(estimates, masses, linear_mass, records, bound, runaway)
-    if "v0" in extras.initial and init_window is None:
-        notes += velocity_contradictions(records, initial_state_out["v0"])
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
@@ -803,30 +806,6 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0),
                "covariance": covariance_table(names, covariance(J, rss, res.size, rtol), std)})
-
-
-#: A start whose cost is within this factor of the records' noise (from their repeated
-#: periods) ends the search for starts
-NOISE_COST_FACTOR = 1.1
-
-
-def _noise_cost(records, y_scale: float) -> float | None:
-    """The search's cost (half the sum of squared residuals in units of `y_scale`) that the
-    records' noise alone leaves, times :data:`NOISE_COST_FACTOR`: the noise's variance from
-    the spread of the periods of periodic records about their mean; None if a record holds
-    fewer than two periods."""
-    from motionhyst.time.periodic_runs import whole_periods
-
-    total = 0.0
-    for rec in records:
-        p = whole_periods(rec.u)
-        if p < 2:
-            return None
-        n = rec.u.size // p
-        y = rec.y[:p * n].reshape(p, n)
-        variance = float(np.sum((y - np.mean(y, axis=0)) ** 2)) / (n * (p - 1))
-        total += rec.y.size * variance
-    return 0.5 * NOISE_COST_FACTOR * total / y_scale ** 2
 
 
 def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
@@ -897,19 +876,6 @@ def _extras_start(extras: Extras, records, floating: bool, u0: float) -> NDArray
         for j, name in zip(extras.columns_of_record(i), what, strict=True):
             out[j] = start[name]
     return out
-
-
-#: 95 % point of the chi-square distribution with one degree of freedom
-PROFILE_CHI2 = 3.84
-
-
-def _flat_profile(costs: list[float], dof: int) -> bool:
-    """True if no cost of a profile exceeds the least by the 95 % likelihood-ratio bound.
-
-    ``(RSS_i - RSS_min) / sigma^2 < 3.84`` for every point, ``sigma^2 = RSS_min / dof``.
-    """
-    least = min(costs)
-    return bool(least > 0 and (max(costs) - least) / least * max(dof, 1) < PROFILE_CHI2)
 
 
 def _parallel_note(layout: _LinkLayout, name: str, plant=None) -> str:

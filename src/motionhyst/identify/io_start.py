@@ -20,7 +20,7 @@ from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
 __all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "equation_rows",
-           "reference_mass", "start_velocity", "velocity_contradictions"]
+           "reference_mass"]
 
 BLA_STARTS = 6  # two-mass: grid points refined
 
@@ -171,94 +171,6 @@ def reference_mass(records: list[IORecord], floating: bool) -> float:
     """
     x, unexplained = _least_squares(records, floating)
     return float(x[0]) if unexplained <= LINEAR_MODEL_RESIDUAL else math.nan
-
-
-#: Samples whose quadratic fit gives a record's velocity at its start (the EMPS benchmark's
-#: initialisation window)
-START_SAMPLES = 20
-#: An estimated initial velocity is contradicted by its record when it is this many of its
-#: start velocity's standard errors away from it ...
-START_SIGMAS = 5.0
-#: ... and this share of the record's RMS velocity
-START_SHARE = 0.1
-
-
-def start_velocity(rec: IORecord, samples: int = START_SAMPLES) -> tuple[float, float]:
-    """A record's velocity at its first sample, from a quadratic fit of its first `samples`
-    positions, and the standard error of that fit.
-
-    Parameters
-    ----------
-    rec : IORecord
-        The record.
-    samples : int
-        Positions fitted (at most the record's).
-
-    Returns
-    -------
-    velocity, std : float
-        [m/s].
-
-    Examples
-    --------
-    >>> t = np.arange(100) / 1000.0
-    >>> v, sd = start_velocity(IORecord(t, np.zeros(100), 0.0064 * t + 0.3 * t ** 2))
-    >>> round(v * 1e3, 6), sd < 1e-9
-    (6.4, True)
-    """
-    n = min(int(samples), rec.y.size)
-    tt = rec.t[:n] - rec.t[0]
-    X = np.column_stack([np.ones(n), tt, tt ** 2])
-    coef, *_ = np.linalg.lstsq(X, rec.y[:n], rcond=None)
-    dof = max(n - 3, 1)
-    sigma2 = float(np.sum((X @ coef - rec.y[:n]) ** 2)) / dof
-    cov = sigma2 * np.linalg.pinv(X.T @ X)
-    return float(coef[1]), float(math.sqrt(max(cov[1, 1], 0.0)))
-
-
-def velocity_contradictions(records: list[IORecord], v0: list[float]) -> list[str]:
-    """Warnings for initial velocities estimated against what their records show.
-
-    An initial state estimated with the model (not set from the record) may
-    take up the model's own error: EMPS with one viscous coefficient gave
-    ``v0 = -23.7 mm/s`` where the record starts at +6.4 mm/s.  An estimate is
-    contradicted when it is :data:`START_SIGMAS` standard errors from the
-    record's own start velocity (:func:`start_velocity`) and
-    :data:`START_SHARE` of the record's RMS velocity.
-
-    Parameters
-    ----------
-    records : list of IORecord
-        The records.
-    v0 : list of float
-        Each record's estimated initial velocity [m/s].
-
-    Returns
-    -------
-    list of str
-        One line per record contradicted.
-
-    Examples
-    --------
-    >>> t = np.arange(2000) / 1000.0
-    >>> y = 0.01 * (1 - np.cos(2 * np.pi * t)) + 0.0064 * t          # 6.4 mm/s at the start
-    >>> rec = IORecord(t, np.zeros(2000), y, "axis")
-    >>> velocity_contradictions([rec], [0.0063])
-    []
-    >>> print(velocity_contradictions([rec], [-0.0237])[0][:68])
-    v0 = -23.7 mm/s: the initial velocity estimated for axis contradicts
-    """
-    out = []
-    for rec, v in zip(records, v0, strict=True):
-        seen, sd = start_velocity(rec)
-        v_rms = float(np.sqrt(np.mean(np.gradient(rec.y, rec.t) ** 2)))
-        if abs(v - seen) > max(START_SIGMAS * sd, START_SHARE * v_rms):
-            out.append(f"v0 = {1e3 * v:.3g} mm/s: the initial velocity estimated for "
-                       f"{rec.name} contradicts the record, which starts at {1e3 * seen:+.3g} "
-                       f"mm/s (its first {START_SAMPLES} samples): the initial state takes up "
-                       f"the model's error; --init-window {START_SAMPLES} sets it from the "
-                       f"record")
-    return out
 
 
 def equation_rows(records: list[IORecord], floating: bool, asymmetric: bool = False,
