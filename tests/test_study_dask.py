@@ -28,14 +28,14 @@ scenario = "paper.toml"
 outputs = ["e1", "error_peak"]
 [axes]
 amplitude = [0.001, 0.01]
-frequency_hz = { geomspace = [2.0, 50.0, 5] }
+frequency_hz = { geomspace = [2.0, 50.0, 20] }
 [samples]
 n = 6
 seed = 3
 "hysteresis.k" = { lognormal = [20.0, 0.1] }
 "hysteresis.fc" = { uniform = [0.03, 0.05] }
 """
-POINTS = 60
+POINTS = 240
 
 
 def _start(args: list[str], log: Path) -> subprocess.Popen:
@@ -102,7 +102,8 @@ def test_cluster_gives_the_local_pools_numbers_with_a_worker_killed(cluster, tmp
     run_study(st, tmp_path / "local.zarr", workers=2, batch=4)
     local = open_results(tmp_path / "local.zarr")
 
-    # batches of one point; the first worker killed (SIGKILL) once points came back
+    # batches of one point (240 of them: the study outlasts the polls of its store); the
+    # first worker killed (SIGKILL) once points came back
     out = tmp_path / "dask.zarr"
     result = {}
     runner = threading.Thread(target=lambda: result.update(
