@@ -73,3 +73,35 @@ def test_each_kernel_is_compiled_for_one_signature():
     several = {name: sigs for name, sigs in cached.items()
                if len(sigs) > 1 and name not in SPECIALISED}
     assert not several, several
+
+
+def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
+    """The cache folders of other sources (one per edit or upgrade) do not pile up: those no
+    process used for a day go at a process's first kernel call, the others stay."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    from motionhyst.core.compiled import PRUNE_SECONDS
+
+    parent = tmp_path / "motionhyst"
+    stale, recent = parent / f"numba-{'a' * 16}", parent / f"numba-{'b' * 16}"
+    half = parent / f"numba-{'c' * 16}.removed-7"      # a pruning process died mid-way
+    other = parent / "numba-notes"                     # not a cache folder's name
+    for folder in (stale, recent, half, other):
+        (folder / "sub").mkdir(parents=True)
+        (folder / "sub" / "f.nbi").write_bytes(b"x")
+    old = time.time() - 2 * PRUNE_SECONDS
+    for folder in (stale, half, other):
+        os.utime(folder, (old, old))
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    code = ("from motionhyst.core.compiled import njit, _cache_folder\n"
+            "print(njit(lambda x: x + 1)(1), _cache_folder().name)")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    value, name = out.stdout.split()
+    assert value == "2"
+    assert sorted(p.name for p in parent.iterdir()) == sorted([recent.name, other.name, name])
+    assert time.time() - (parent / name).stat().st_mtime < PRUNE_SECONDS   # marked used

@@ -14,6 +14,9 @@ Jenkins element) does not import numba.  At the first call, once per process:
   failing.  ``<key>`` is a hash of the package's sources: numba checks a
   cached kernel only against its own file, so a kernel whose callee in another
   file changed (an upgrade, an edit) would otherwise run stale machine code;
+  the folders of other sources beside it that no process used for
+  :data:`PRUNE_SECONDS` are removed (:func:`prune_caches`), so that they do
+  not pile up, one per edit or upgrade;
 * the first compilation announces itself with one line on stderr (it takes
   seconds; later runs load the cache).
 
@@ -29,9 +32,12 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
+import shutil
 import sys
 import tempfile
 import threading
+import time
 import types
 from collections.abc import Callable
 from pathlib import Path
@@ -40,6 +46,15 @@ from typing import Any
 _LOCK = threading.RLock()
 _STATE: dict[str, Any] = {"cache": None, "announced": False, "numba": None}
 _PACKAGE = __name__.partition(".")[0]
+
+
+PRUNE_SECONDS = 86400.0
+"""A cache folder of other sources that no process used for this long [s] is removed (a
+day: versions used in turn keep theirs; a process older than that which compiles anew makes
+its folder again, as numba does when it saves a kernel)."""
+
+# the cache folders' names (numba-<key>), and those of folders being removed
+_CACHE_NAME = re.compile(r"numba-[0-9a-f]{16}(\.removed-[0-9]+)?")
 
 
 def _probe() -> None:
@@ -82,6 +97,72 @@ def _cache_folder() -> Path | None:
         elif home:
             candidates.append(Path(home) / ".cache" / "motionhyst" / name)
     return next((c for c in candidates if _writable_folder(c)), None)
+
+
+def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS) -> list[Path]:
+    """Mark the cache folder `folder` used now and remove the cache folders of other sources
+    beside it that no process used for `age` seconds.
+
+    A folder is used when a process chooses it (its time of modification is set then); a
+    folder is first renamed, atomically, then removed, so that two processes pruning at once
+    do not trip over each other and no process finds a half-removed folder under its
+    name.  Only folders named as the cache names them (``numba-<key>``) are touched;
+    nothing that cannot be read or removed stops the caller.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The cache folder of the running sources (``.../numba-<key>``).
+    age : float
+        Least time unused [s] of a folder removed.
+
+    Returns
+    -------
+    list of Path
+        The folders removed.
+
+    Examples
+    --------
+    >>> import os, tempfile, time
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for key in ("0" * 16, "1" * 16, "2" * 16):
+    ...     (root / f"numba-{key}" / "sub").mkdir(parents=True)
+    >>> (root / "notes").mkdir()                                 # not a cache: kept
+    >>> old = time.time() - 2 * PRUNE_SECONDS
+    >>> for name in ("numba-" + "1" * 16, "notes"):
+    ...     os.utime(root / name, (old, old))
+    >>> [p.name for p in prune_caches(root / ("numba-" + "0" * 16))]
+    ['numba-1111111111111111']
+    >>> sorted(p.name for p in root.iterdir())
+    ['notes', 'numba-0000000000000000', 'numba-2222222222222222']
+    """
+    folder = Path(folder)
+    removed: list[Path] = []
+    try:
+        os.utime(folder)
+        entries = list(folder.parent.iterdir())
+    except OSError:
+        return removed
+    now = time.time()
+    for f in entries:
+        match = _CACHE_NAME.fullmatch(f.name)
+        if f.name == folder.name or match is None:
+            continue
+        try:
+            if f.is_symlink() or not f.is_dir():
+                continue
+            if match.group(1) is not None:  # left half-removed by another process: now
+                target = f
+            elif now - f.stat().st_mtime < age:
+                continue
+            else:
+                target = f.with_name(f"{f.name}.removed-{os.getpid()}")
+                os.rename(f, target)
+        except OSError:
+            continue
+        shutil.rmtree(target, ignore_errors=True)
+        removed.append(f)
+    return removed
 
 
 def _can_cache(py_func: Callable = _probe) -> bool:
@@ -183,6 +264,7 @@ class Kernel:
                         folder = _cache_folder()
                         if folder is not None:  # numba's locator for a user-given folder
                             numba.config.CACHE_DIR = str(folder)
+                            prune_caches(folder)
                         _STATE["cache"] = folder is not None and _can_cache()
                     # a function without a source file (a doctest, the REPL) is never cached
                     cache = _STATE["cache"] and _can_cache(self.py_func)
@@ -302,4 +384,5 @@ def compiled_in_memory() -> bool | None:
     return None if c is None else not c
 
 
-__all__ = ["Kernel", "compiled_in_memory", "njit", "quiet_compilation"]
+__all__ = ["PRUNE_SECONDS", "Kernel", "compiled_in_memory", "njit", "prune_caches",
+           "quiet_compilation"]
