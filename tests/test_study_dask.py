@@ -9,7 +9,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -19,7 +18,6 @@ import pytest
 from motionhyst.cli import main
 from motionhyst.scenario import default_scenario_path
 from motionhyst.study import Study, open_results, run_study
-from motionhyst.study.store import OK
 
 distributed = pytest.importorskip("distributed")
 
@@ -87,41 +85,54 @@ def study_file(tmp_path: Path) -> Path:
     return path
 
 
-def _done(store: Path) -> int:
-    try:
-        return int(np.count_nonzero(open_results(store)["status"].values == OK))
-    except (OSError, ValueError, KeyError):
-        return 0
+def _killing_first_holder(run_batches, client, workers: list[subprocess.Popen], killed: dict):
+    """`run_batches` that, when the first batch has come back and before the runner sees it,
+    SIGKILLs the worker holding the most of the study's batches (computed and not yet
+    collected, or being computed, as the scheduler sees them): the study is mid-way by
+    construction, whatever the load; `killed` says how many it held and how it ended."""
+    pids = {p.pid: p for p in workers}
+
+    def wrapped(*args, **kwargs):
+        results = run_batches(*args, **kwargs)
+        try:
+            first = next(results)
+            held = {addr: len(keys) for addr, keys in client.has_what().items()}
+            for addr, keys in client.processing().items():
+                held[addr] = held.get(addr, 0) + len(keys)
+            addr = max(held, key=held.get)
+            proc = pids[client.run(os.getpid, workers=[addr])[addr]]
+            os.kill(proc.pid, signal.SIGKILL)
+            killed.update(held=held[addr], code=proc.wait(timeout=30), left=len(held) - 1)
+            yield first
+            yield from results
+        finally:
+            results.close()
+
+    return wrapped
 
 
 def test_cluster_gives_the_local_pools_numbers_with_a_worker_killed(cluster, tmp_path,
-                                                                    study_file):
+                                                                    study_file, monkeypatch):
+    from motionhyst.study import runner
+
     client, workers = cluster
     st = Study.from_file(study_file)
     assert st.n_points == POINTS
     run_study(st, tmp_path / "local.zarr", workers=2, batch=4)
     local = open_results(tmp_path / "local.zarr")
 
-    # batches of one point (240 of them: the study outlasts the polls of its store); the
-    # first worker killed (SIGKILL) once points came back
+    # batches of one point; a worker killed (SIGKILL) from the runner's loop when the first
+    # batch came back: what it held is lost and computed again by the other
+    killed: dict = {}
+    monkeypatch.setattr(runner, "run_batches",
+                        _killing_first_holder(runner.run_batches, client, workers, killed))
     out = tmp_path / "dask.zarr"
-    result = {}
-    runner = threading.Thread(target=lambda: result.update(
-        report=run_study(st, out, client=client, batch=1)))
-    runner.start()
-    deadline = time.monotonic() + 300
-    done = 0
-    while runner.is_alive() and time.monotonic() < deadline:
-        done = _done(out)
-        if done:
-            break
-        time.sleep(0.02)
-    os.kill(workers[0].pid, signal.SIGKILL)
-    runner.join(timeout=600)
-    assert not runner.is_alive()
-    assert 0 < done < POINTS, "the worker was not killed mid-study"
-    assert workers[0].wait(timeout=30) == -signal.SIGKILL
-    report = result["report"]
+    report = run_study(st, out, client=client, batch=1)
+    monkeypatch.undo()
+    assert killed["code"] == -signal.SIGKILL and killed["left"] == 1, killed
+    # the first batch (collected) and at least one more, lost with the worker
+    assert killed["held"] >= 2, killed
+    assert len(client.scheduler_info()["workers"]) == 1
     assert (report.points, report.computed, report.failed) == (POINTS, POINTS, 0)
     remote = open_results(out)
     for name in ("e1", "error_peak", "status", "hysteresis.k", "hysteresis.fc"):
