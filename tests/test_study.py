@@ -251,9 +251,14 @@ def test_chunk_writer_holds_few_chunks_and_writes_what_direct_writes_write(tmp_p
 def test_local_pool_gives_the_numbers_of_this_process(tmp_path, study_file):
     """Two worker processes, batches of 3 points, equal to one process bit for bit."""
     st = Study.from_file(study_file)
-    run_study(st, tmp_path / "one.zarr", workers=0)
+    t0 = time.thread_time()
+    alone = run_study(st, tmp_path / "one.zarr", workers=0)
+    # the points' work is part of this thread's CPU time (which times points first, makes
+    # the loops and writes the store)
+    assert 0 < alone.cpu_seconds < time.thread_time() - t0
     rep = run_study(st, tmp_path / "pool.zarr", workers=2, batch=3)
     assert (rep.points, rep.computed, rep.failed) == (32, 32, 0)
+    assert rep.cpu_seconds > 0 and rep.to_dict()["cpu_seconds"] == rep.cpu_seconds
     one, pool = open_results(tmp_path / "one.zarr"), open_results(tmp_path / "pool.zarr")
     for name, v in _values(one).items():
         np.testing.assert_array_equal(v, pool[name].values, err_msg=name)

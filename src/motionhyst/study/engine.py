@@ -63,13 +63,16 @@ class Batch(NamedTuple):
         Why a point failed (:data:`motionhyst.study.store.REASONS`; 0 if it did not).
     failures : dict of int to str
         The message of the batch's first failed point of each reason.
+    cpu_seconds : float
+        CPU time of the thread that computed the points [s] (the work of the points, apart
+        from what the engine costs around them).
 
     Examples
     --------
     >>> b = Batch(np.array([3]), np.array([OK], np.int8), {"e1": np.array([1j])},
     ...           np.array([0], np.int8), {})
-    >>> b.indices.tolist(), b.status.tolist()
-    ([3], [1])
+    >>> b.indices.tolist(), b.status.tolist(), b.cpu_seconds
+    ([3], [1], 0.0)
     """
 
     indices: NDArray[np.int64]
@@ -77,6 +80,7 @@ class Batch(NamedTuple):
     values: dict[str, NDArray]
     reason: NDArray[np.int8]
     failures: dict[int, str]
+    cpu_seconds: float = 0.0
 
 
 class Evaluator:
@@ -166,13 +170,14 @@ class Evaluator:
 
     def batch(self, indices) -> Batch:
         """Compact records of the points at `indices`: a point that fails is marked failed,
-        with its reason.
+        with its reason; the CPU time they took.
 
         Parameters
         ----------
         indices : array_like of int
             Flat indices of the points.
         """
+        t0 = time.thread_time()
         indices = np.asarray(indices, dtype=np.int64)
         status = np.full(len(indices), OK, dtype=np.int8)
         reason = np.zeros(len(indices), dtype=np.int8)
@@ -190,7 +195,7 @@ class Evaluator:
                 res = {name: nan_of(kind) for name, kind in self.fields.items()}
             for name in self.fields:
                 values[name][j] = res[name]
-        return Batch(indices, status, values, reason, failures)
+        return Batch(indices, status, values, reason, failures, time.thread_time() - t0)
 
     def warm(self) -> None:
         """Compile the kernels (the first point of the study, result discarded)."""

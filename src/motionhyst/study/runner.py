@@ -47,7 +47,8 @@ LOCK_NAME = "zarr.json"
 @dataclass
 class RunReport:
     """What one run did: ``points`` in the study, ``computed`` by this run, ``failed`` in the
-    store (points that did not converge or whose loop could not be built), ``seconds``.
+    store (points that did not converge or whose loop could not be built), ``seconds``, and
+    ``cpu_seconds``, the CPU time the points took wherever they ran.
 
     Parameters
     ----------
@@ -59,25 +60,29 @@ class RunReport:
         Points marked failed in the store.
     seconds : float
         Wall time of the run [s].
+    cpu_seconds : float
+        CPU time of computing the points [s], summed over the workers (the work alone:
+        not the engine's sending, collecting and writing around it).
 
     Examples
     --------
-    >>> r = RunReport(points=400, computed=100, failed=2, seconds=4.0)
+    >>> r = RunReport(points=400, computed=100, failed=2, seconds=4.0, cpu_seconds=7.6)
     >>> print(r)
     400 points: 100 computed in 4.0 s (25 points/s), 2 failed
     >>> sorted(r.to_dict())                                # the ``study --json`` schema
-    ['computed', 'failed', 'points', 'seconds']
+    ['computed', 'cpu_seconds', 'failed', 'points', 'seconds']
     """
 
     points: int
     computed: int
     failed: int
     seconds: float
+    cpu_seconds: float = 0.0
 
     def to_dict(self) -> dict:
         """The ``study --json`` schema."""
         return {"points": self.points, "computed": self.computed, "failed": self.failed,
-                "seconds": self.seconds}
+                "seconds": self.seconds, "cpu_seconds": self.cpu_seconds}
 
     def __str__(self) -> str:
         rate = self.computed / self.seconds if self.seconds > 0 else float("nan")
@@ -347,9 +352,9 @@ def run_study(study: StudyDefinition, store: str | Path, workers: int | None = N
     if st is None:
         st = _new_store(study, path, __version__)
     with run_lock(path):
-        computed = _compute(study, st, workers, client, batch, per, progress)
+        computed, cpu = _compute(study, st, workers, client, batch, per, progress)
     failed = int(np.count_nonzero(st.status() == FAILED))
-    return RunReport(study.n_points, computed, failed, time.perf_counter() - t0)
+    return RunReport(study.n_points, computed, failed, time.perf_counter() - t0, cpu)
 
 
 @contextlib.contextmanager
@@ -392,9 +397,9 @@ def run_lock(path: Path) -> Iterator[None]:
 
 
 def _compute(study: StudyDefinition, st: StudyStore, workers: int, client, batch: int | None,
-             per: float | None, progress: bool) -> int:
+             per: float | None, progress: bool) -> tuple[int, float]:
     todo = st.missing(study.order())
-    computed = 0
+    computed, cpu = 0, 0.0
     if len(todo):
         if per is None:  # (another run computed points between the count and the lock)
             per = seconds_per_point(study, 6, cpu=True)
@@ -416,9 +421,10 @@ def _compute(study: StudyDefinition, st: StudyStore, workers: int, client, batch
                 for b in results:
                     writer.add(b.indices, b.status, b.values, b.reason, b.failures)
                     computed += len(b.indices)
+                    cpu += b.cpu_seconds
                     if bar is not None:
                         bar.update(len(b.indices))
         finally:
             if bar is not None:
                 bar.close()
-    return computed
+    return computed, cpu
