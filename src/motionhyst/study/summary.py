@@ -142,10 +142,9 @@ class StudySummary:
         -------
         matplotlib.figure.Figure
         """
-        import matplotlib.pyplot as plt
+        from motionhyst.core.plotting import new_figure
 
-        if ax is None:
-            _, ax = plt.subplots()
+        _, (ax,) = new_figure(ax=ax)
         for name, axes in self.per_axis.items():
             axis = "frequency_hz" if "frequency_hz" in axes else next(iter(axes))
             ax.loglog(axes[axis]["values"], axes[axis]["worst"], label=name)
@@ -190,7 +189,7 @@ def plot_band(ds, name: str | None = None, ax=None):
     >>> fig.axes[0].get_ylabel()
     '|E|'
     """
-    import matplotlib.pyplot as plt
+    from motionhyst.core.plotting import new_figure
 
     names = field_names(ds)
     name = name or ("E" if "E" in names else names[0])
@@ -208,8 +207,7 @@ def plot_band(ds, name: str | None = None, ax=None):
     others = [d for d in mag.dims if d not in (x, lines, "sample")]
     if others:
         mag = mag.max(others)
-    if ax is None:
-        _, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
+    _, (ax,) = new_figure(ax=ax)
     values = mag[lines].values if lines in mag.dims else [None]
     f = mag[x].values
     for a in values:
