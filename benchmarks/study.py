@@ -11,24 +11,28 @@ error_rms) into fresh stores:
    one and its workers);
 3. dask.distributed on a local cluster of two single-thread worker processes (``dask
    scheduler`` and ``dask worker --nworkers 2 --nthreads 1``, with their nannies, in
-   processes of their own; warmed by a study of two points): the
-   batches ``run_study`` chooses for dask (at least ``DASK_BATCH_SECONDS`` of work), the same
-   accounting (scheduler, client and workers), against the pool of two workers in
-   ``--repeats`` pairs of runs, interleaved (pool then dask, dask then pool, ...; a study of
-   another seed each pair, as a dask worker keeps the last study it built): the overheads are
-   the medians over the pairs, with their range, as the load of a shared machine moves a
-   single run's CPU time by several per cent; also the CPU time of the two processes that
-   compute the points alone (dask's workers against the pool's), where a cost a point shows
-   apart from the scheduler's, the nannies' and the client's.
+   processes of their own; warmed by a study of two points) with the batches ``run_study``
+   chooses for dask (at least ``DASK_BATCH_SECONDS`` of work), against the pool of two
+   workers in ``--repeats`` pairs of runs, interleaved (pool then dask, dask then pool, ...;
+   a study of another seed each pair, as a dask worker keeps the last study it built).
 
-Wall-time ratios hold on a quiet machine only (the load average is printed before and
-after); the CPU times hold on a loaded one too.  From them: the engine's overhead per point
-(its CPU time past the baseline's), the parallel efficiency (baseline CPU / the engine's CPU:
-two workers give that times 2 on two idle cores; target >= 0.9, i.e. 1.8x) and dask's
-overhead against the local pool (target <= 5 %); the idle cluster's CPU per second is
-measured too, as its share grows with the wall time (with the load).  The numbers of a study
-are checked equal in every engine.  Run with ``make bench`` or
-``python benchmarks/study.py [--samples N] [--frequencies N] [--repeats N] [--json]``.
+Each run counts the CPU time of every process by role (this process, the client, which sends
+the batches and writes the store; the workers; on dask the scheduler and the nannies too) and
+the CPU time the points themselves took (each batch's thread CPU time, which the run reports
+as ``RunReport.cpu_seconds``).  The points are the same work in both engines, but a shared
+machine's load moves their CPU time by several per cent from one run to the next (the caches
+and cores the other jobs take): compared whole, two runs' CPU times hide a 5 % overhead.  An
+engine's cost is therefore its run's CPU time past the points' work, and dask's overhead is
+its engine's cost past the pool's, a share of the pool's CPU time (target <= 5 %): the
+median over the pairs, with the range, and the same past the idle cluster's CPU a second
+(heartbeats, ticks, profiler; measured between the pairs), which grows with the wall time,
+i.e. with the load, and as it would be on two idle cores.  The wall times of the pairs are
+reported too; their ratios hold on a quiet machine only (the load average is printed before
+and after).  From the first runs: the pool's overhead per point past the baseline and its
+parallel efficiency (baseline CPU / the pool's: two workers give that times 2 on two idle
+cores; target >= 0.9, i.e. 1.8x).  The numbers of a study are checked equal in every
+engine.  Run with ``make bench`` or ``python benchmarks/study.py [--samples N]
+[--frequencies N] [--repeats N] [--json]``.
 """
 
 from __future__ import annotations
@@ -47,6 +51,7 @@ import tempfile
 import time
 import tomllib
 from collections.abc import Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -81,7 +86,7 @@ def _cpu_children(reap: bool) -> float:
 
 
 def _cpu_tree(pids: list[int]) -> float:
-    """CPU time of live processes (dask's workers and their nannies)."""
+    """CPU time of live processes (dask's scheduler, nannies and workers)."""
     import psutil
 
     total = 0.0
@@ -91,31 +96,52 @@ def _cpu_tree(pids: list[int]) -> float:
     return total
 
 
-def timed(study: Study, folder: Path, name: str, pids: list[int] | None = None,
-          computing_pids: list[int] | None = None, **kw) -> tuple[float, float, object, float]:
-    """Wall time, CPU time of every process taking part, results, CPU time of the processes
-    that compute the points (the pool's workers, or dask's `computing_pids` among `pids`)."""
-    reap = pids is None     # dask's workers (pids) live on; the pool's are joined
+@dataclass
+class Run:
+    """One run of a study: its wall time, the CPU time of each role taking part (``client``:
+    this process, which sends the batches and writes the store; ``workers``; on dask also
+    ``scheduler`` and ``nannies``), and ``work``, the CPU time the points took in the
+    workers (each batch's thread CPU time, ``RunReport.cpu_seconds``)."""
+
+    wall: float
+    cpu: dict[str, float]
+    work: float
+    results: object = field(repr=False)
+
+    @property
+    def total(self) -> float:
+        return sum(self.cpu.values())
+
+    @property
+    def engine(self) -> float:
+        """The CPU time of everything but the points: what the engine costs."""
+        return self.total - self.work
+
+
+def timed(study: Study, folder: Path, name: str, roles: dict[str, list[int]] | None = None,
+          **kw) -> Run:
+    """Run `study` into a fresh store; `roles`: the pids of dask's processes by role (the
+    pool's workers are this process's children, counted once joined)."""
+    reap = roles is None
     w0, c0, k0 = time.perf_counter(), _cpu_self(), _cpu_children(reap)
-    t0 = _cpu_tree(pids) if pids else 0.0
-    p0 = _cpu_tree(computing_pids) if computing_pids else 0.0
+    r0 = {role: _cpu_tree(pids) for role, pids in (roles or {}).items()}
     rep = run_study(study, folder / f"{name}.zarr", **kw)
-    seconds = time.perf_counter() - w0
-    children = _cpu_children(reap) - k0
-    cpu = (_cpu_self() - c0) + children
-    computing = children
-    if pids:
-        cpu += _cpu_tree(pids) - t0
-        computing = _cpu_tree(computing_pids) - p0 if computing_pids else 0.0
+    wall = time.perf_counter() - w0
+    cpu = {"client": _cpu_self() - c0}
+    if roles is None:
+        cpu["workers"] = _cpu_children(reap) - k0
+    else:
+        cpu.update({role: _cpu_tree(pids) - r0[role] for role, pids in roles.items()})
     assert rep.computed == study.n_points and rep.failed == 0, rep
-    return seconds, cpu, open_results(folder / f"{name}.zarr"), computing
+    return Run(wall, cpu, rep.cpu_seconds, open_results(folder / f"{name}.zarr"))
 
 
 @contextlib.contextmanager
-def dask_cluster(folder: Path) -> Iterator[tuple[object, list[int], list[int]]]:
+def dask_cluster(folder: Path) -> Iterator[tuple[object, dict[str, list[int]]]]:
     """A scheduler and two single-thread workers (with their nannies, as ``dask worker``
-    starts them) in processes of their own; the client, the pids of every process and those
-    of the two workers (the nannies' children)."""
+    starts them) in processes of their own; the client and the pids of the processes by
+    role (``scheduler``; ``nannies``, the ``dask worker`` process that holds them;
+    ``workers``, its children)."""
     from distributed import Client
 
     sched_file = folder / "scheduler.json"
@@ -136,10 +162,11 @@ def dask_cluster(folder: Path) -> Iterator[tuple[object, list[int], list[int]]]:
             client.wait_for_workers(2, timeout=120)
             import psutil
 
-            pids = [q.pid for p in procs for q in [psutil.Process(p.pid),
-                                                    *psutil.Process(p.pid).children(True)]]
-            workers = [q.pid for q in psutil.Process(procs[1].pid).children(True)]
-            yield client, pids, workers
+            sched = psutil.Process(procs[0].pid)
+            roles = {"scheduler": [sched.pid, *(q.pid for q in sched.children(True))],
+                     "nannies": [procs[1].pid],
+                     "workers": [q.pid for q in psutil.Process(procs[1].pid).children(True)]}
+            yield client, roles
     finally:
         for p in procs:
             if p.poll() is None:
@@ -152,8 +179,9 @@ def dask_cluster(folder: Path) -> Iterator[tuple[object, list[int], list[int]]]:
                 p.wait()
 
 
-def idle_rate(pids: list[int], seconds: float) -> float:
+def idle_rate(roles: dict[str, list[int]], seconds: float) -> float:
     """CPU time a second of the idle cluster (heartbeats, ticks, profiler) and this process."""
+    pids = [pid for group in roles.values() for pid in group]
     w0, i0 = time.perf_counter(), _cpu_self() + _cpu_tree(pids)
     time.sleep(seconds)
     return (_cpu_self() + _cpu_tree(pids) - i0) / (time.perf_counter() - w0)
@@ -169,9 +197,18 @@ def _spread(values: list[float]) -> dict:
             "max": float(max(values)), "runs": [float(v) for v in values]}
 
 
+def _fraction(d: Run, p: Run, idle: float = 0.0, quiet: float | None = None) -> float:
+    """Dask's engine cost past the pool's, a share of the pool's CPU time (the points' work
+    taken out of both: it is the same work, and its time moves with the load): `idle` the
+    idle cluster's CPU a second, taken out over the run's wall time; `quiet` the wall time
+    the run would last on idle cores, over which it is put back."""
+    extra = d.engine - p.engine - idle * d.wall + (0.0 if quiet is None else idle * quiet)
+    return extra / p.total
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--samples", type=int, default=100, help="Monte-Carlo samples")
+    ap.add_argument("--samples", type=int, default=300, help="Monte-Carlo samples")
     ap.add_argument("--frequencies", type=int, default=50, help="frequencies 1-100 Hz")
     ap.add_argument("--repeats", type=int, default=5,
                     help="pairs of runs, local pool and dask, interleaved")
@@ -180,80 +217,77 @@ def main() -> None:
     study = make_study(args.samples, args.frequencies)
     n = study.n_points
     load_before = os.getloadavg()
-    per = seconds_per_point(study, 20, cpu=True)   # on CPU time, as run_study (on 6 points)
+    per = seconds_per_point(study, 6, cpu=True)   # on CPU time, as run_study
     batch = batch_size(per, n, 2)
     dask_batch = batch_size(per, n, 2, DASK_BATCH_SECONDS)
     out: dict = {"points": n, "batch": batch, "dask_batch": dask_batch, "cores": os.cpu_count(),
                  "repeats": args.repeats, "load_before": load_before}
-    pool_cpu, dask_cpu, dask_wall, pool_wall, idles = [], [], [], [], []
-    pool_computing: list[float] = []
-    dask_computing: list[float] = []
+    pairs: list[tuple[Run, Run]] = []
+    idles: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        t0, c0, ref, _ = timed(study, folder, "inprocess", workers=0, batch=batch)
-        t1, c1, one, _ = timed(study, folder, "pool1", workers=1, batch=batch)
-        t2, c2, two, _ = timed(study, folder, "pool2", workers=2, batch=batch)
-        _equal(ref, one)
-        _equal(ref, two)
-        with dask_cluster(folder) as (client, pids, dask_workers):
+        alone = timed(study, folder, "inprocess", workers=0, batch=batch)
+        one = timed(study, folder, "pool1", workers=1, batch=batch)
+        two = timed(study, folder, "pool2", workers=2, batch=batch)
+        _equal(alone.results, one.results)
+        _equal(alone.results, two.results)
+        with dask_cluster(folder) as (client, roles):
             # the workers import the library and load the kernels at their first batch
-            timed(make_study(1, 2), folder, "dask_warm", pids=pids, client=client, batch=1)
+            timed(make_study(1, 2), folder, "dask_warm", roles=roles, client=client, batch=1)
             for r in range(args.repeats):
                 # a study of its own each pair (another seed): a dask worker keeps the last
                 # study built, a pool's workers build it anew; the order alternates, so that
                 # a load rising or falling over the pairs weighs on both engines alike
                 st = make_study(args.samples, args.frequencies, seed=1 + r)
-                idles.append(idle_rate(pids, 1.0))
+                idles.append(idle_rate(roles, 2.0))
                 runs = {}
                 for engine in (("pool", "dask") if r % 2 == 0 else ("dask", "pool")):
                     if engine == "pool":
                         runs[engine] = timed(st, folder, f"pair{r}_pool", workers=2, batch=batch)
                     else:
-                        runs[engine] = timed(st, folder, f"pair{r}_dask", pids=pids,
-                                             computing_pids=dask_workers, client=client,
-                                             batch=dask_batch)
-                _equal(runs["pool"][2], runs["dask"][2])
-                pool_wall.append(runs["pool"][0])
-                pool_cpu.append(runs["pool"][1])
-                pool_computing.append(runs["pool"][3])
-                dask_computing.append(runs["dask"][3])
-                dask_wall.append(runs["dask"][0])
-                dask_cpu.append(runs["dask"][1])
+                        runs[engine] = timed(st, folder, f"pair{r}_dask", roles=roles,
+                                             client=client, batch=dask_batch)
+                _equal(runs["pool"].results, runs["dask"].results)
+                pairs.append((runs["pool"], runs["dask"]))
                 for name in (f"pair{r}_pool", f"pair{r}_dask"):
                     shutil.rmtree(folder / f"{name}.zarr")
-            idles.append(idle_rate(pids, 1.0))
+            idles.append(idle_rate(roles, 2.0))
     idle = float(np.median(idles))
-    raw = [(d - p) / p for d, p in zip(dask_cpu, pool_cpu, strict=True)]
-    past = [(d - idle * w - p) / p for d, w, p in zip(dask_cpu, dask_wall, pool_cpu, strict=True)]
-    # on two idle cores a run lasts about half the baseline's CPU time
-    quiet = [(d - idle * w + idle * c0 / 2 - p) / p
-             for d, w, p in zip(dask_cpu, dask_wall, pool_cpu, strict=True)]
+
+    def per_point_us(runs: list[Run], role: str) -> float:
+        # a role's CPU a point; the workers' past the points' work
+        return 1e6 * float(np.median([r.cpu.get(role, 0.0) - (r.work if role == "workers"
+                                                               else 0.0) for r in runs])) / n
+
+    pools, dasks = [p for p, _ in pairs], [d for _, d in pairs]
     out.update({
         "load_after": os.getloadavg(),
-        "in_process_s": t0, "pool_1_s": t1, "pool_2_s": t2,
-        "in_process_cpu_s": c0, "pool_1_cpu_s": c1, "pool_2_cpu_s": c2,
-        "ms_per_point_in_process": 1e3 * t0 / n,
-        "ms_cpu_per_point_in_process": 1e3 * c0 / n,
-        "speedup_2_over_1": t1 / t2,
-        "pool_2_overhead_ms_per_point": 1e3 * (c2 - c0) / n,
-        "pool_2_efficiency": c0 / c2,
-        "pairs": {"pool_2_s": pool_wall, "pool_2_cpu_s": pool_cpu, "dask_2_s": dask_wall,
-                  "dask_2_cpu_s": dask_cpu, "pool_2_workers_cpu_s": pool_computing,
-                  "dask_2_workers_cpu_s": dask_computing},
-        # the processes computing the points alone (dask's: heartbeats, ticks and profiler
-        # of a worker included; scheduler, nannies and client not)
-        "dask_workers_over_pool_workers": _spread(
-            [d / p - 1 for d, p in zip(dask_computing, pool_computing, strict=True)]),
-        "pool_cpu_noise": (max(pool_cpu) - min(pool_cpu)) / float(np.median(pool_cpu)),
+        "in_process_s": alone.wall, "pool_1_s": one.wall, "pool_2_s": two.wall,
+        "in_process_cpu_s": alone.total, "pool_1_cpu_s": one.total, "pool_2_cpu_s": two.total,
+        "ms_cpu_per_point_in_process": 1e3 * alone.total / n,
+        "ms_work_per_point_in_process": 1e3 * alone.work / n,
+        "speedup_2_over_1": one.wall / two.wall,
+        "pool_2_overhead_ms_per_point": 1e3 * (two.engine - alone.engine) / n,
+        "pool_2_efficiency": alone.total / two.total,
+        "pairs": [{"pool": {"wall_s": p.wall, "work_s": p.work, **p.cpu},
+                   "dask": {"wall_s": d.wall, "work_s": d.work, **d.cpu}} for p, d in pairs],
+        # what the load does to the same work: it moves the points' CPU time (both engines)
+        "work_dask_over_pool": _spread([d.work / p.work - 1 for p, d in pairs]),
+        "pool_cpu_noise": (max(r.total for r in pools) - min(r.total for r in pools))
+        / float(np.median([r.total for r in pools])),
+        "us_per_point": {engine: {role: per_point_us(runs, role) for role in
+                                  ("client", "scheduler", "nannies", "workers")}
+                         for engine, runs in (("pool", pools), ("dask", dasks))},
         "dask_idle_cpu_per_s": _spread(idles),
-        "dask_overhead_ms_per_point": 1e3 * float(np.median(
-            [d - p for d, p in zip(dask_cpu, pool_cpu, strict=True)])) / n,
-        "dask_overhead_fraction": _spread(raw),
-        # past the idle cluster's share (which grows with the wall time: the load's doing)
-        "dask_task_overhead_fraction": _spread(past),
-        "dask_overhead_fraction_quiet": _spread(quiet),
-        "dask_wall_over_pool": float(np.median(
-            [d / p for d, p in zip(dask_wall, pool_wall, strict=True)])),
+        # the old measure: all CPU, the points' work included (its noise is the load's)
+        "dask_total_over_pool": _spread([d.total / p.total - 1 for p, d in pairs]),
+        # the engines' costs alone (all CPU past the points' work), against the pool's CPU
+        "dask_overhead_fraction": _spread([_fraction(d, p) for p, d in pairs]),
+        "dask_task_overhead_fraction": _spread([_fraction(d, p, idle) for p, d in pairs]),
+        # on two idle cores a run lasts about half its work
+        "dask_overhead_fraction_quiet": _spread([_fraction(d, p, idle, d.work / 2)
+                                                 for p, d in pairs]),
+        "dask_wall_over_pool": _spread([d.wall / p.wall for p, d in pairs]),
     })
     if args.json:
         print(json.dumps(out, indent=2))
@@ -267,27 +301,34 @@ def main() -> None:
     print(f"study of {n} points (batches of {batch}, on dask {dask_batch}), numbers equal in "
           f"every engine; {os.cpu_count()} cores, load average {la[0]:.1f} before, "
           f"{lb[0]:.1f} after")
-    print(f"  in this process        {t0:7.2f} s, {c0:7.2f} s CPU  "
+    print(f"  in this process        {alone.wall:7.2f} s, {alone.total:7.2f} s CPU  "
           f"({out['ms_cpu_per_point_in_process']:.3f} ms CPU a point: the baseline)")
-    print(f"  local pool, 1 worker   {t1:7.2f} s, {c1:7.2f} s CPU")
-    print(f"  local pool, 2 workers  {t2:7.2f} s, {c2:7.2f} s CPU -> "
+    print(f"  local pool, 1 worker   {one.wall:7.2f} s, {one.total:7.2f} s CPU")
+    print(f"  local pool, 2 workers  {two.wall:7.2f} s, {two.total:7.2f} s CPU -> "
           f"{out['speedup_2_over_1']:.2f}x one worker's wall time; CPU past the baseline "
           f"{out['pool_2_overhead_ms_per_point']:+.4f} ms a point, efficiency "
           f"{out['pool_2_efficiency']:.3f} (2 x that = "
           f"{2 * out['pool_2_efficiency']:.2f}x on two idle cores; target >= 1.8)")
     print(f"  dask against the local pool, 2 workers each, {args.repeats} pairs of runs "
           f"interleaved (another seed each pair):")
-    print(f"    pool {np.median(pool_cpu):.2f} s CPU, dask {np.median(dask_cpu):.2f} s CPU "
-          f"(medians; the pool's own spread {100 * out['pool_cpu_noise']:.0f} %); dask "
-          f"{out['dask_wall_over_pool']:.2f}x the pool's wall time")
-    print(f"    dask's CPU past the pool's: {out['dask_overhead_ms_per_point']:+.4f} ms a point, "
-          f"{pct(out['dask_overhead_fraction'])}")
-    print(f"    dask's two workers alone against the pool's: "
-          f"{pct(out['dask_workers_over_pool_workers'])}")
+    print(f"    the points' work, dask's against the pool's: "
+          f"{pct(out['work_dask_over_pool'])} (the load's doing; taken out below)")
+    print("    CPU a point past the points' work [us]: client, scheduler, nannies, workers")
+    for engine in ("pool", "dask"):
+        u = out["us_per_point"][engine]
+        print(f"      {engine:5s} " + ", ".join(f"{u[r]:.2f}" for r in
+                                               ("client", "scheduler", "nannies", "workers")))
+    print(f"    all CPU, the work included (the load's noise in it): "
+          f"{pct(out['dask_total_over_pool'])}")
+    print(f"    dask's engine past the pool's: {pct(out['dask_overhead_fraction'])} of the "
+          f"pool's CPU")
     print(f"    the idle cluster {idle:.3f} s CPU a second; past it "
           f"{pct(out['dask_task_overhead_fraction'])}")
     print(f"    with a run as long as on two idle cores {pct(out['dask_overhead_fraction_quiet'])}"
           f" (target <= 5 %)")
+    print(f"    wall time, dask over the pool: {out['dask_wall_over_pool']['median']:.2f} "
+          f"({out['dask_wall_over_pool']['min']:.2f} to {out['dask_wall_over_pool']['max']:.2f}"
+          f"; under load it says little)")
 
 
 if __name__ == "__main__":
