@@ -29,10 +29,13 @@ median over the pairs, with the range, and the same past the idle cluster's CPU 
 i.e. with the load, and as it would be on two idle cores.  The wall times of the pairs are
 reported too; their ratios hold on a quiet machine only (the load average is printed before
 and after).  From the first runs: the pool's overhead per point past the baseline and its
-parallel efficiency (baseline CPU / the pool's: two workers give that times 2 on two idle
-cores; target >= 0.9, i.e. 1.8x).  The numbers of a study are checked equal in every
-engine.  Run with ``make bench`` or ``python benchmarks/study.py [--samples N]
-[--frequencies N] [--repeats N] [--json]``.
+parallel efficiency (baseline CPU / the pool's, the pool's points' work taken as the
+baseline's: two workers give that times 2 on two idle cores; target >= 0.9, i.e. 1.8x).
+The numbers of a study are checked equal in every engine.  Dask's worker profiler (a sample
+of the stack of each thread running a task, every 10 ms) is on by default; the environment
+turns it off for the processes the benchmark starts
+(``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``).  Run with ``make bench`` or
+``python benchmarks/study.py [--samples N] [--frequencies N] [--repeats N] [--json]``.
 """
 
 from __future__ import annotations
@@ -197,6 +200,15 @@ def _spread(values: list[float]) -> dict:
             "max": float(max(values)), "runs": [float(v) for v in values]}
 
 
+def _profiler_on() -> bool:
+    """Whether dask's workers sample their threads' stacks (``distributed.worker.profile.
+    enabled``, as the environment sets it for the processes this benchmark starts)."""
+    import dask.config
+    import distributed  # noqa: F401  (its defaults into dask's config)
+
+    return bool(dask.config.get("distributed.worker.profile.enabled"))
+
+
 def _fraction(d: Run, p: Run, idle: float = 0.0, quiet: float | None = None) -> float:
     """Dask's engine cost past the pool's, a share of the pool's CPU time (the points' work
     taken out of both: it is the same work, and its time moves with the load): `idle` the
@@ -268,7 +280,12 @@ def main() -> None:
         "ms_work_per_point_in_process": 1e3 * alone.work / n,
         "speedup_2_over_1": one.wall / two.wall,
         "pool_2_overhead_ms_per_point": 1e3 * (two.engine - alone.engine) / n,
-        "pool_2_efficiency": alone.total / two.total,
+        # the baseline's CPU over the pool's, its points' work taken as the baseline's (the
+        # load moves that work's CPU time; what the pool adds is its engine's cost)
+        "pool_2_efficiency": alone.total / (alone.total + two.engine - alone.engine),
+        "pool_2_efficiency_all_cpu": alone.total / two.total,
+        "work_pool_2_over_in_process": two.work / alone.work - 1,
+        "dask_worker_profiler": _profiler_on(),
         "pairs": [{"pool": {"wall_s": p.wall, "work_s": p.work, **p.cpu},
                    "dask": {"wall_s": d.wall, "work_s": d.work, **d.cpu}} for p, d in pairs],
         # what the load does to the same work: it moves the points' CPU time (both engines)
@@ -300,15 +317,18 @@ def main() -> None:
     la, lb = load_before, out["load_after"]
     print(f"study of {n} points (batches of {batch}, on dask {dask_batch}), numbers equal in "
           f"every engine; {os.cpu_count()} cores, load average {la[0]:.1f} before, "
-          f"{lb[0]:.1f} after")
+          f"{lb[0]:.1f} after; dask's worker profiler "
+          f"{'on' if out['dask_worker_profiler'] else 'off'}")
     print(f"  in this process        {alone.wall:7.2f} s, {alone.total:7.2f} s CPU  "
           f"({out['ms_cpu_per_point_in_process']:.3f} ms CPU a point: the baseline)")
     print(f"  local pool, 1 worker   {one.wall:7.2f} s, {one.total:7.2f} s CPU")
     print(f"  local pool, 2 workers  {two.wall:7.2f} s, {two.total:7.2f} s CPU -> "
-          f"{out['speedup_2_over_1']:.2f}x one worker's wall time; CPU past the baseline "
-          f"{out['pool_2_overhead_ms_per_point']:+.4f} ms a point, efficiency "
-          f"{out['pool_2_efficiency']:.3f} (2 x that = "
-          f"{2 * out['pool_2_efficiency']:.2f}x on two idle cores; target >= 1.8)")
+          f"{out['speedup_2_over_1']:.2f}x one worker's wall time; CPU past the points' work "
+          f"{out['pool_2_overhead_ms_per_point']:+.4f} ms a point more than the baseline's, "
+          f"efficiency {out['pool_2_efficiency']:.3f} (2 x that = "
+          f"{2 * out['pool_2_efficiency']:.2f}x on two idle cores; target >= 1.8; from all "
+          f"CPU {out['pool_2_efficiency_all_cpu']:.3f}, the points' work moving by "
+          f"{100 * out['work_pool_2_over_in_process']:+.1f} %)")
     print(f"  dask against the local pool, 2 workers each, {args.repeats} pairs of runs "
           f"interleaved (another seed each pair):")
     print(f"    the points' work, dask's against the pool's: "
