@@ -218,6 +218,37 @@ def _fraction(d: Run, p: Run, idle: float = 0.0, quiet: float | None = None) -> 
     return extra / p.total
 
 
+def _per_run_and_per_second(runs: list[Run]) -> tuple[np.ndarray, np.ndarray] | None:
+    """An engine's cost as a fixed part per run (its points' and tasks' cost: the runs are
+    of one size) plus a part per second of wall time (the background of its processes:
+    heartbeats, ticks, profiler), fitted over the runs, whose wall times the load varies:
+    the coefficients [per second, per run] and their covariance; None if the wall times
+    vary too little (within 10 %) to tell the parts apart."""
+    wall = np.array([r.wall for r in runs])
+    if len(runs) < 4 or np.std(wall) < 0.1 * np.mean(wall):
+        return None
+    return np.polyfit(wall, [r.engine for r in runs], 1, cov=True)
+
+
+def _quiet_from_fit(pairs: list[tuple[Run, Run]]) -> dict | None:
+    """Dask's engine cost past the pool's on two idle cores, a share of the pool's CPU time,
+    from each engine's fit (:func:`_per_run_and_per_second`) at the wall time of a run on two
+    idle cores (half its points' work): the value and its standard error."""
+    fits = [_per_run_and_per_second([r[i] for r in pairs]) for i in (0, 1)]
+    if None in fits:
+        return None
+    value, var = 0.0, 0.0
+    for sign, (coef, cov), runs in zip((-1.0, 1.0), fits, zip(*pairs, strict=True),
+                                       strict=True):
+        x = np.array([np.mean([r.work for r in runs]) / 2, 1.0])
+        value += sign * float(x @ coef)
+        var += float(x @ cov @ x)
+    total = float(np.mean([p.total for p, _ in pairs]))
+    return {"value": value / total, "std": var ** 0.5 / total,
+            "dask_cpu_per_s": float(fits[1][0][0]), "pool_cpu_per_s": float(fits[0][0][0]),
+            "dask_per_run_s": float(fits[1][0][1]), "pool_per_run_s": float(fits[0][0][1])}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=300, help="Monte-Carlo samples")
@@ -307,6 +338,9 @@ def main() -> None:
         "dask_overhead_fraction_quiet": _spread([_fraction(d, p, idle, d.work / 2)
                                                  for p, d in pairs]),
         "dask_wall_over_pool": _spread([d.wall / p.wall for p, d in pairs]),
+        # the same from the engines' costs fitted over the pairs as a part per run and a part
+        # per second of wall time: no idle window measured apart
+        "dask_overhead_fraction_quiet_fit": _quiet_from_fit(pairs),
     })
     if args.json:
         print(json.dumps(out, indent=2))
@@ -348,6 +382,15 @@ def main() -> None:
           f"{pct(out['dask_task_overhead_fraction'])}")
     print(f"    with a run as long as on two idle cores {pct(out['dask_overhead_fraction_quiet'])}"
           f" (target <= 5 %)")
+    fit = out["dask_overhead_fraction_quiet_fit"]
+    if fit is None:
+        print("    (the wall times of the pairs vary too little to fit a part per run and a part "
+              "per second)")
+    else:
+        print(f"    fitted over the pairs, per run + per second of wall time: dask "
+              f"{fit['dask_per_run_s']:.3f} s + {fit['dask_cpu_per_s']:.4f} s/s, pool "
+              f"{fit['pool_per_run_s']:.3f} s + {fit['pool_cpu_per_s']:.4f} s/s; on two idle "
+              f"cores {100 * fit['value']:+.1f} % +- {100 * fit['std']:.1f} (target <= 5 %)")
     print(f"    wall time, dask over the pool: {out['dask_wall_over_pool']['median']:.2f} "
           f"({out['dask_wall_over_pool']['min']:.2f} to {out['dask_wall_over_pool']['max']:.2f}"
           f"; under load it says little)")
