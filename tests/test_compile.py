@@ -76,25 +76,28 @@ def test_each_kernel_is_compiled_for_one_signature():
 
 
 def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
-    """The cache folders of other sources (one per edit or upgrade) do not pile up: those no
-    process used for a day go at a process's first kernel call, the others stay."""
+    """The cache folders of other sources (one per edit or upgrade) do not pile up: at a
+    process's first kernel call those no process used for a day go, and past the most
+    recently used few those unused for an hour; a folder in use and other names stay."""
     import os
     import subprocess
     import sys
     import time
 
-    from motionhyst.core.compiled import PRUNE_SECONDS
+    from motionhyst.core.compiled import BUSY_SECONDS, KEEP_RECENT, PRUNE_SECONDS
 
     parent = tmp_path / "motionhyst"
-    stale, recent = parent / f"numba-{'a' * 16}", parent / f"numba-{'b' * 16}"
-    half = parent / f"numba-{'c' * 16}.removed-7"      # a pruning process died mid-way
-    other = parent / "numba-notes"                     # not a cache folder's name
-    for folder in (stale, recent, half, other):
-        (folder / "sub").mkdir(parents=True)
-        (folder / "sub" / "f.nbi").write_bytes(b"x")
-    old = time.time() - 2 * PRUNE_SECONDS
-    for folder in (stale, half, other):
-        os.utime(folder, (old, old))
+    now = time.time()
+    ago = {f"numba-{'a' * 16}": 2 * PRUNE_SECONDS,          # unused for two days
+           f"numba-{'b' * 16}": 60.0,                       # in use a minute ago
+           f"numba-{'c' * 16}.removed-7": 0.0,              # a pruning process died mid-way
+           "numba-notes": 2 * PRUNE_SECONDS}                # not a cache folder's name
+    hours = [f"numba-{c * 16}" for c in "123456"]           # unused for 2, 3, ... 7 hours
+    ago.update({name: (2 + i) * BUSY_SECONDS for i, name in enumerate(hours)})
+    for name, seconds in ago.items():
+        (parent / name / "sub").mkdir(parents=True)
+        (parent / name / "sub" / "f.nbi").write_bytes(b"x")
+        os.utime(parent / name, (now - seconds, now - seconds))
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     code = ("from motionhyst.core.compiled import njit, _cache_folder\n"
             "print(njit(lambda x: x + 1)(1), _cache_folder().name)")
@@ -103,5 +106,6 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
     assert out.returncode == 0, out.stderr
     value, name = out.stdout.split()
     assert value == "2"
-    assert sorted(p.name for p in parent.iterdir()) == sorted([recent.name, other.name, name])
-    assert time.time() - (parent / name).stat().st_mtime < PRUNE_SECONDS   # marked used
+    kept = [f"numba-{'b' * 16}", *hours[:KEEP_RECENT - 1]]  # the most recently used others
+    assert sorted(p.name for p in parent.iterdir()) == sorted([*kept, "numba-notes", name])
+    assert time.time() - (parent / name).stat().st_mtime < BUSY_SECONDS   # marked used

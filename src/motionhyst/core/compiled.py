@@ -15,8 +15,9 @@ Jenkins element) does not import numba.  At the first call, once per process:
   cached kernel only against its own file, so a kernel whose callee in another
   file changed (an upgrade, an edit) would otherwise run stale machine code;
   the folders of other sources beside it that no process used for
-  :data:`PRUNE_SECONDS` are removed (:func:`prune_caches`), so that they do
-  not pile up, one per edit or upgrade;
+  :data:`PRUNE_SECONDS`, or for :data:`BUSY_SECONDS` past the
+  :data:`KEEP_RECENT` most recently used, are removed (:func:`prune_caches`),
+  so that they do not pile up, one per edit or upgrade;
 * the first compilation announces itself with one line on stderr (it takes
   seconds; later runs load the cache).
 
@@ -52,6 +53,13 @@ PRUNE_SECONDS = 86400.0
 """A cache folder of other sources that no process used for this long [s] is removed (a
 day: versions used in turn keep theirs; a process older than that which compiles anew makes
 its folder again, as numba does when it saves a kernel)."""
+
+KEEP_RECENT = 4
+"""Cache folders of other sources kept beside the running one whatever their number (the
+most recently used); the others go once no process used them for :data:`BUSY_SECONDS`."""
+
+BUSY_SECONDS = 3600.0
+"""A cache folder used within this time [s] is kept (a process of its sources may run)."""
 
 # the cache folders' names (numba-<key>), and those of folders being removed
 _CACHE_NAME = re.compile(r"numba-[0-9a-f]{16}(\.removed-[0-9]+)?")
@@ -99,22 +107,30 @@ def _cache_folder() -> Path | None:
     return next((c for c in candidates if _writable_folder(c)), None)
 
 
-def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS) -> list[Path]:
+def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEEP_RECENT,
+                 busy: float = BUSY_SECONDS) -> list[Path]:
     """Mark the cache folder `folder` used now and remove the cache folders of other sources
-    beside it that no process used for `age` seconds.
+    beside it that no process used for `age` seconds, and those past the `keep` most
+    recently used that no process used for `busy` seconds.
 
     A folder is used when a process chooses it (its time of modification is set then); a
     folder is first renamed, atomically, then removed, so that two processes pruning at once
     do not trip over each other and no process finds a half-removed folder under its
     name.  Only folders named as the cache names them (``numba-<key>``) are touched;
-    nothing that cannot be read or removed stops the caller.
+    nothing that cannot be read or removed stops the caller.  A working tree whose sources
+    are edited all day keeps the last hour's folders and the `keep` before them; versions
+    used in turn keep theirs for a day.
 
     Parameters
     ----------
     folder : str or Path
         The cache folder of the running sources (``.../numba-<key>``).
     age : float
-        Least time unused [s] of a folder removed.
+        Least time unused [s] of any folder removed.
+    keep : int
+        Folders of other sources kept, the most recently used, unless unused for `age`.
+    busy : float
+        Least time unused [s] of a folder removed past the `keep` most recent.
 
     Returns
     -------
@@ -125,16 +141,17 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS) -> list[Path]:
     --------
     >>> import os, tempfile, time
     >>> root = Path(tempfile.mkdtemp())
-    >>> for key in ("0" * 16, "1" * 16, "2" * 16):
-    ...     (root / f"numba-{key}" / "sub").mkdir(parents=True)
+    >>> now = time.time()
+    >>> unused = {"0": 0, "1": 2 * PRUNE_SECONDS, "2": 60, "3": 2 * BUSY_SECONDS,
+    ...           "4": 3 * BUSY_SECONDS, "5": 4 * BUSY_SECONDS}
+    >>> for key, ago in unused.items():
+    ...     (root / f"numba-{key * 16}" / "sub").mkdir(parents=True)
+    ...     os.utime(root / f"numba-{key * 16}", (now - ago, now - ago))
     >>> (root / "notes").mkdir()                                 # not a cache: kept
-    >>> old = time.time() - 2 * PRUNE_SECONDS
-    >>> for name in ("numba-" + "1" * 16, "notes"):
-    ...     os.utime(root / name, (old, old))
-    >>> [p.name for p in prune_caches(root / ("numba-" + "0" * 16))]
-    ['numba-1111111111111111']
-    >>> sorted(p.name for p in root.iterdir())
-    ['notes', 'numba-0000000000000000', 'numba-2222222222222222']
+    >>> sorted(p.name[6:9] for p in prune_caches(root / ("numba-" + "0" * 16), keep=2))
+    ['111', '444', '555']
+    >>> sorted(p.name[:9] for p in root.iterdir())   # the 2 most recent of the others kept
+    ['notes', 'numba-000', 'numba-222', 'numba-333']
     """
     folder = Path(folder)
     removed: list[Path] = []
@@ -144,6 +161,7 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS) -> list[Path]:
     except OSError:
         return removed
     now = time.time()
+    others: list[tuple[float, Path]] = []
     for f in entries:
         match = _CACHE_NAME.fullmatch(f.name)
         if f.name == folder.name or match is None:
@@ -152,12 +170,19 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS) -> list[Path]:
             if f.is_symlink() or not f.is_dir():
                 continue
             if match.group(1) is not None:  # left half-removed by another process: now
-                target = f
-            elif now - f.stat().st_mtime < age:
-                continue
+                shutil.rmtree(f, ignore_errors=True)
+                removed.append(f)
             else:
-                target = f.with_name(f"{f.name}.removed-{os.getpid()}")
-                os.rename(f, target)
+                others.append((now - f.stat().st_mtime, f))
+        except OSError:
+            continue
+    others.sort(key=lambda item: item[0])
+    for rank, (unused, f) in enumerate(others):
+        if unused < age and (rank < keep or unused < busy):
+            continue
+        target = f.with_name(f"{f.name}.removed-{os.getpid()}")
+        try:
+            os.rename(f, target)
         except OSError:
             continue
         shutil.rmtree(target, ignore_errors=True)
@@ -384,5 +409,5 @@ def compiled_in_memory() -> bool | None:
     return None if c is None else not c
 
 
-__all__ = ["PRUNE_SECONDS", "Kernel", "compiled_in_memory", "njit", "prune_caches",
-           "quiet_compilation"]
+__all__ = ["BUSY_SECONDS", "KEEP_RECENT", "PRUNE_SECONDS", "Kernel", "compiled_in_memory",
+           "njit", "prune_caches", "quiet_compilation"]
