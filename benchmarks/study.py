@@ -222,10 +222,10 @@ def _per_run_and_per_second(runs: list[Run]) -> tuple[np.ndarray, np.ndarray] | 
     """An engine's cost as a fixed part per run (its points' and tasks' cost: the runs are
     of one size) plus a part per second of wall time (the background of its processes:
     heartbeats, ticks, profiler), fitted over the runs, whose wall times the load varies:
-    the coefficients [per second, per run] and their covariance; None if the wall times
-    vary too little (within 10 %) to tell the parts apart."""
+    the coefficients [per second, per run] and their covariance (the less the wall times
+    vary, the larger); None for fewer than four runs or wall times all alike."""
     wall = np.array([r.wall for r in runs])
-    if len(runs) < 4 or np.std(wall) < 0.1 * np.mean(wall):
+    if len(runs) < 4 or np.ptp(wall) < 1e-3 * np.mean(wall):
         return None
     return np.polyfit(wall, [r.engine for r in runs], 1, cov=True)
 
@@ -384,7 +384,7 @@ def main() -> None:
           f" (target <= 5 %)")
     fit = out["dask_overhead_fraction_quiet_fit"]
     if fit is None:
-        print("    (the wall times of the pairs vary too little to fit a part per run and a part "
+        print("    (too few pairs, or wall times all alike, to fit a part per run and a part "
               "per second)")
     else:
         print(f"    fitted over the pairs, per run + per second of wall time: dask "
