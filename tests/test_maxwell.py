@@ -10,6 +10,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
+from motionhyst.hysteresis.periodic import (
+    stop_harmonics_base,
+    stop_harmonics_update,
+    stop_twiddles,
+)
 from motionhyst.scenario import hysteresis_from_dict
 
 K3, FC3 = [8.0, 6.0, 4.0], [0.01, 0.03, 0.06]
@@ -290,3 +295,112 @@ def test_half_period_onsets_on_the_cubic_are_the_general_pass(A):
     for a, b in zip(general, walked, strict=True):
         assert_array_equal(a, b)
     assert 0 < general[0].size - 1 < u.size  # some elements slip, some never do
+
+
+def _rich_symmetric_input(M: int, A: float, seed: int) -> np.ndarray:
+    """A sine of amplitude `A` with small odd harmonics up to `M` (a symmetric loop's y1)."""
+    rng = np.random.default_rng(seed)
+    X = np.zeros(M + 1, dtype=complex)
+    X[1] = A / 2j
+    n_odd = X[3::2].size
+    X[3::2] = 1e-3 * A * (rng.standard_normal(n_odd) + 1j * rng.standard_normal(n_odd))
+    X[3::2] /= np.arange(3, M + 1, 2) ** 2
+    return X
+
+
+def _many_elements() -> tuple[np.ndarray, np.ndarray]:
+    """300 elements, some of which never slip at the amplitudes used (``fc / k`` up to 0.02)."""
+    u = np.geomspace(1e-5, 0.02, 300)
+    k = np.random.default_rng(5).uniform(0.5, 2.0, u.size)
+    return k, k * u
+
+
+def _full(X, k, fc, H, tw):
+    """:func:`stop_harmonics_base` with nothing kept: the output computed in full."""
+    return stop_harmonics_base(X, k, fc, H, tw, np.empty((0, 0)), np.zeros(2, dtype=np.int64),
+                               2 * H)
+
+
+@pytest.mark.parametrize("direction", ["amplitude", "phase", "harmonics"])
+def test_small_change_of_the_input_is_followed_to_first_order(direction):
+    """Near an input whose output was computed in full, the output of an input within 1e-10
+    of it is that output plus the first-order change: the same as computed in full to 1e-14
+    of the largest harmonic, while the change is 6e-12 to 5e-11 of it (a wrong or missing
+    first-order term shows)."""
+    k, fc = _many_elements()
+    M, H = 41, 60
+    X = _rich_symmetric_input(M, 0.01, 1)
+    tw = stop_twiddles(M, H)
+    Wb, _, base, Xb, S, t_b, js, x_top = _full(X, k, fc, H, tw)
+    assert base and 0 < t_b.size - 1 < k.size  # some elements slip, some never do
+    eps = 5e-11
+    if direction == "amplitude":
+        Xn = X * (1 + eps)
+    elif direction == "phase":
+        Xn = X * np.exp(-1j * eps * np.arange(M + 1))
+    else:
+        Xn = X.copy()
+        Xn[3::2] += eps * abs(X[1]) / 20 * np.exp(1j * np.arange(3, M + 1, 2))
+    full = _full(Xn, k, fc, H, tw)[0]
+    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, t_b, js, x_top)
+    assert ok
+    scale = np.max(np.abs(full))
+    assert np.max(np.abs(full - Wb)) > 1e-12 * scale
+    assert_allclose(W, full, rtol=0, atol=1e-14 * scale)
+
+
+def test_a_change_the_first_order_does_not_follow_is_refused():
+    """A change above 1e-10 of the input, even harmonics (no half-wave symmetry) or more
+    harmonics than the input computed in full: the update says no."""
+    k, fc = _many_elements()
+    M, H = 41, 60
+    X = _rich_symmetric_input(M, 0.01, 2)
+    tw = stop_twiddles(M + 2, H)
+    base = _full(X, k, fc, H, tw)
+    assert base[2]
+    kept = (base[0], *base[3:])
+    assert stop_harmonics_update(X * (1 + 1e-11), H, tw, *kept)[0]
+    assert not stop_harmonics_update(X * (1 + 1e-9), H, tw, *kept)[0]
+    even = X.copy()
+    even[2] = 1e-12 * abs(X[1])
+    assert not stop_harmonics_update(even, H, tw, *kept)[0]
+    longer = np.concatenate([X, [0.0, 1e-13 * abs(X[1])]])
+    assert not stop_harmonics_update(longer, H, tw, *kept)[0]
+
+
+def test_many_elements_steady_state_equals_the_fixed_point_of_full_evaluations():
+    """The steady state of 1000 elements (its last iteration a first-order update of the one
+    before) equals the same fixed point run with every iteration computed in full, to
+    1e-13 of the largest harmonic of the error."""
+    from motionhyst import Loop, default_scenario, periodic_steady_state
+    from motionhyst.analysis.steady import default_harmonics
+    from motionhyst.core.lti import TWO_PI
+    from motionhyst.hysteresis.periodic import stop_periodic_harmonics
+
+    loop = default_scenario().loop()
+    u = np.geomspace(0.1, 10.0, 1000) * 2.5e-3
+    k = np.full(1000, 0.02)
+    link = MaxwellSlip(k, k * u * 0.05 / np.sum(k * u))
+    lp = Loop(loop.plant, loop.controller, link)
+    for A, f in ((0.01, 10.5), (0.003, 3.7)):
+        ss = periodic_steady_state(lp, A, f)
+        H = default_harmonics(lp, f)
+        wn = TWO_PI * f * np.arange(H + 1)
+        y1_lin = np.zeros(H + 1, dtype=complex)
+        y1_lin[1] = lp.transfer("r->y1", wn[1:2])[0] * (-0.5j * A)
+        G_1 = lp.transfer("w->y1", wn)
+        X, W, previous = y1_lin, np.zeros(H + 1, dtype=complex), np.inf
+        for it in range(1, 51):
+            W_new = stop_periodic_harmonics(X, link.k, link.fc, H)
+            residual = abs(W_new[1] - W[1]) / abs(W_new[1])
+            W, X = W_new, y1_lin + G_1 * W_new
+            rho = residual / previous if it > 2 else 1.0
+            previous = residual
+            if it > 1 and rho < 0.5 and residual * rho / (1 - rho) <= 1e-12:
+                break
+        e = lp.transfer("w->e", wn) * W
+        e[1] += lp.transfer("r->e", wn[1:2])[0] * (-0.5j * A)
+        e_sin = 2j * e
+        e_sin[0] = e[0].real
+        assert it == ss.iterations
+        assert_allclose(ss.e, e_sin, rtol=0, atol=1e-13 * np.max(np.abs(e_sin)))

@@ -45,7 +45,12 @@ from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.sampling import hold_response
 from motionhyst.core.textfmt import g, table
-from motionhyst.hysteresis.periodic import sample_period, stop_harmonics_kept, stop_twiddles
+from motionhyst.hysteresis.periodic import (
+    sample_period,
+    stop_harmonics_base,
+    stop_harmonics_update,
+    stop_twiddles,
+)
 
 __all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
 
@@ -452,9 +457,12 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     `weights` and `grid` (`first_weights`, `first_grid` for the first iteration) are the
     binned jump sums' weights kept from the point before
     (:func:`motionhyst.hysteresis.periodic.stop_harmonics_kept`; the grids are updated in
-    place).  Returns the harmonics of ``e``, ``y1``, ``w`` and of the linear ``e``
-    (relative to ``sin(n theta)``), the iterations, the last relative change, whether it
-    converged, and the weights to keep.
+    place).  An iteration whose ``y1`` is within 1e-10 of the last one computed in full
+    (the fixed point contracts fast: the last iterations change ``y1`` by 1e-12 of itself)
+    follows it to first order (:func:`motionhyst.hysteresis.periodic.stop_harmonics_update`)
+    where that computation was a costly one.  Returns the harmonics of ``e``, ``y1``, ``w``
+    and of the linear ``e`` (relative to ``sin(n theta)``), the iterations, the last
+    relative change, whether it converged, and the weights to keep.
     """
     H = G_1.shape[0] - 1
     e_lin = np.zeros(H + 1, dtype=np.complex128)
@@ -467,12 +475,27 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     previous = np.inf
     it = 0
     converged = False
+    # the last full evaluation, which a small change of y1 follows to first order
+    base = False
+    Wb = np.empty(0, dtype=np.complex128)
+    Xb = np.empty(0, dtype=np.complex128)
+    Sb = np.empty(0, dtype=np.complex128)
+    t_b = np.empty(0)
+    js = np.empty(0)
+    x_top = 0.0
     for it in range(1, max_iter + 1):
-        if it == 1:  # the linear loop's y1, one harmonic: a grid of its own
-            W_new, first_weights = stop_harmonics_kept(X, k, fc, H, tw, first_weights,
-                                                       first_grid, H)
-        else:  # one grid for any number of harmonics of y1
-            W_new, weights = stop_harmonics_kept(X, k, fc, H, tw, weights, grid, 2 * H)
+        updated = False
+        W_new = Wb
+        if base:
+            updated, W_new = stop_harmonics_update(X, H, tw, Wb, Xb, Sb, t_b, js, x_top)
+        if not updated:
+            if it == 1:  # the linear loop's y1, one harmonic: a grid of its own
+                W_new, first_weights, base, Xb, Sb, t_b, js, x_top = stop_harmonics_base(
+                    X, k, fc, H, tw, first_weights, first_grid, H)
+            else:  # one grid for any number of harmonics of y1
+                W_new, weights, base, Xb, Sb, t_b, js, x_top = stop_harmonics_base(
+                    X, k, fc, H, tw, weights, grid, 2 * H)
+            Wb = W_new
         change = 0.0
         for q in range(H + 1):
             change = max(change, abs(W_new[q] - W[q]))

@@ -118,10 +118,17 @@ def jump_series_half(t_b, jg, js, n_g, n_s):  # pragma: no cover - compiled
 @njit(cache=True)
 def chebyshev_terms(a_max):  # pragma: no cover - compiled
     """Terms ``P`` of the Chebyshev series of ``exp(-j a v)``, ``|a| <= a_max``, ``|v| <= 1``,
-    that reach 1e-17: its coefficients are ``2 J_p(a)``, ``|J_p(a)| <= (a / 2)^p / p!``."""
+    that reach 1e-17 (:func:`chebyshev_terms_to`)."""
+    return chebyshev_terms_to(a_max, 1e-17)
+
+
+@njit(cache=True)
+def chebyshev_terms_to(a_max, tol):  # pragma: no cover - compiled
+    """Terms ``P`` of the Chebyshev series of ``exp(-j a v)``, ``|a| <= a_max``, ``|v| <= 1``,
+    that reach `tol`: its coefficients are ``2 J_p(a)``, ``|J_p(a)| <= (a / 2)^p / p!``."""
     P = 1
     term = 1.0
-    while term >= 1e-17:
+    while term >= tol:
         term *= 0.5 * a_max / P
         P += 1
     return P
@@ -130,14 +137,22 @@ def chebyshev_terms(a_max):  # pragma: no cover - compiled
 @njit(cache=True)
 def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
     """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
-    :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q`: the fewest
-    operations, weighted roughly as the compiled code spends its time (binning, FFTs, the
-    sums over the terms, the Bessel table), ``N >= Q / 2``."""
+    :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q`, to 1e-17 of the
+    sum of the weights (:func:`binned_grid_to`)."""
+    return binned_grid_to(n_jumps, Q, N_max, 1e-17)
+
+
+@njit(cache=True)
+def binned_grid_to(n_jumps, Q, N_max, tol):  # pragma: no cover - compiled
+    """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
+    :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q`, to `tol` of the
+    sum of the weights: the fewest operations, weighted roughly as the compiled code spends
+    its time (binning, FFTs, the sums over the terms, the Bessel table), ``N >= Q / 2``."""
     best_N, best_P, best_cost = 0, 0, np.inf
     N = 2
     while N <= N_max:
         if 2 * N >= Q:
-            P = chebyshev_terms(np.pi * Q / N)
+            P = chebyshev_terms_to(np.pi * Q / N, tol)
             cost = P * (n_jumps * 2.0 + N * np.log2(N) * 1.5 + Q * 2.0) + Q * (P + 24.0) * 1.5
             if cost < best_cost:
                 best_N, best_P, best_cost = N, P, cost

@@ -24,6 +24,7 @@ from motionhyst.hysteresis._fft import (
 from motionhyst.hysteresis._jump_sums import (
     balance,
     binned_grid,
+    binned_grid_to,
     binned_is_cheaper,
     binned_table,
     jump_series,
@@ -43,6 +44,11 @@ from motionhyst.hysteresis._kernels import (
 )
 
 _TWO_PI = 2.0 * np.pi
+#: Largest change of the input, relative to its size (the sums of the harmonics' moduli),
+#: that :func:`stop_harmonics_update` follows to first order.  The output's error is of
+#: the order of the change squared (1e-20 of it); an element that begins to slip right at
+#: the reversal adds at most the change to the power 1.5 times its share of the stiffness.
+LINEAR_CHANGE = 1e-10
 
 
 @njit(cache=True)
@@ -74,6 +80,25 @@ def significant_count(X, rtol):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _without_dc(X, M):  # pragma: no cover - compiled
+    """Harmonics ``0 .. M`` of `X` with ``X_0 = 0``; whether the even ones are below 1e-15 of
+    the total (then set to zero: a half-wave symmetric input); the total of the moduli."""
+    Xs = X[: M + 1].copy()
+    Xs[0] = 0.0
+    total = 0.0
+    even = 0.0
+    for m in range(1, M + 1):
+        total += abs(Xs[m])
+        if m % 2 == 0:
+            even += abs(Xs[m])
+    symmetric = even <= 1e-15 * total
+    if symmetric:
+        for m in range(2, M + 1, 2):
+            Xs[m] = 0.0
+    return Xs, symmetric, total
+
+
+@njit(cache=True)
 def stop_harmonics(X, k, fc, H, tw):  # pragma: no cover - compiled
     """Harmonics ``0 .. H`` of the periodic output of parallel stop operators, compiled whole
     (:func:`motionhyst.hysteresis.periodic.stop_periodic_harmonics`).
@@ -94,7 +119,22 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     :func:`binned_table` of the grid ``grid = [N, P]`` (updated in place); returns the
     harmonics and the table (the one given when it serves, else a new one).  The grid is
     chosen for harmonics up to `q_grid` where that exceeds the sums' own ``H + M`` (one
-    grid for inputs of any ``M <= q_grid - H``).
+    grid for inputs of any ``M <= q_grid - H``).  See :func:`stop_harmonics_base`.
+    """
+    out = stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid)
+    return out[0], out[1]
+
+
+@njit(cache=True)
+def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cover - compiled
+    """:func:`stop_harmonics_kept`, returning also what :func:`stop_harmonics_update` needs to
+    follow a small change of the input: ``(W, table, base, Xs, S, t_b, js, x_top)``.
+
+    ``base`` is True where the output came from many jumps binned (the costly case) over a
+    half-wave symmetric, monotone branch: ``Xs`` is then the input as used (no DC, no even
+    harmonics), ``S`` the harmonics ``0 .. H + M`` of the stiffness ``s``, ``t_b`` and
+    ``js`` the jumps of ``s`` over the first half period (the slip onsets, then the
+    reversal at the maximum ``x_top``).
 
     The reversals come from :func:`dominant_reversals` where it applies, else from the
     grid.  An input whose even harmonics are below 1e-15 of the total is taken as half-wave
@@ -105,23 +145,14 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     fewer operations than the transforms.
     """
     W = np.zeros(H + 1, dtype=np.complex128)
+    none = np.empty(0, dtype=np.complex128)
+    no_jumps = np.empty(0)
     M = significant_count(X, 1e-15)
     if M == 0:
-        return W, table
-    Xs = X[: M + 1].copy()
-    Xs[0] = 0.0
+        return W, table, False, none, none, no_jumps, no_jumps, 0.0
     # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
     # loop's y1): made exact, its output's second half period mirrors the first
-    total = 0.0
-    even = 0.0
-    for m in range(1, M + 1):
-        total += abs(Xs[m])
-        if m % 2 == 0:
-            even += abs(Xs[m])
-    symmetric = even <= 1e-15 * total
-    if symmetric:
-        for m in range(2, M + 1, 2):
-            Xs[m] = 0.0
+    Xs, symmetric, _ = _without_dc(X, M)
     C1 = np.empty(M + 1, dtype=np.complex128)
     C2 = np.empty(M + 1, dtype=np.complex128)
     for m in range(M + 1):
@@ -135,7 +166,7 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
         x = synthesize(Xs, n, tw)
         rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
     if rev.shape[0] < 2:
-        return W, table
+        return W, table, False, none, none, no_jumps, no_jumps, 0.0
     mode = GRID_BRACKET
     if monotone:
         mode = BETWEEN_REVERSALS
@@ -146,14 +177,15 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
             mode = GRID_CUBIC
             x = synthesize(Xs, n, tw)
     half = symmetric and monotone
+    top = 1 if xr[1] > xr[0] else 0
     if half and mode == GRID_CUBIC:
-        top = 1 if xr[1] > xr[0] else 0
         t_b, jg, js, g_mean, s_mean = half_cubic_pieces(x, rev[top], xr[top], k, fc)
     else:
         t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
     Q = H + M
     nb = t_b.shape[0]
-    if binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0]):
+    binned = binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0])
+    if binned:
         G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
                                      grid)
     elif half:
@@ -163,18 +195,99 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     G[0] = g_mean
     S[0] = s_mean
     if direct:
+        _add_convolution(G, S, Xs, 1, W)
+    else:
+        P_x = _product(S, Xs, n, H, half, tw)
         for q in range(H + 1):
-            acc = G[q]
-            for m in range(1, M + 1):
-                lo = q - m
-                acc += (S[lo] if lo >= 0 else S[-lo].conjugate()) * Xs[m]
-                acc += S[q + m] * Xs[m].conjugate()
-            W[q] = acc
-        return W, table
-    P_x = _product(S, Xs, n, H, half, tw)
+            W[q] = G[q] + P_x[q]
+    if half and binned:
+        return W, table, True, Xs, S, t_b, js, xr[top]
+    return W, table, False, none, none, no_jumps, no_jumps, 0.0
+
+
+@njit(cache=True)
+def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top):  # pragma: no cover - compiled
+    """The output of :func:`stop_harmonics_base` for the input `X`, from its output ``Wb`` for
+    an input ``Xb`` near it (``Xb``, ``S``, ``t_b``, ``js``, ``x_top`` as it returned them),
+    to first order in their difference.  Returns ``(ok, W)``; ``ok`` is False (``W``
+    unset) where `X` is not half-wave symmetric, not monotone between two reversals, has
+    more harmonics than ``Xb`` or differs from it by more than :data:`LINEAR_CHANGE`.
+
+    From the maximum ``x_top`` to the minimum an element that slips sticks, ``w = fc - k
+    (x_top - x)``, until its slip onset, then slips, ``w = -fc``; one that never slips
+    follows ``w = k x``.  With ``x`` moved by ``dx`` and its maximum by ``dx_top``, the
+    output moves by ``(s dx)^ - dx_top (s_slip sigma)^``: ``s`` the stiffness of the
+    sticking elements (its harmonics ``S``), ``s_slip`` that of those among them that slip
+    later (its jumps ``js`` at ``t_b``), ``sigma`` +1 from the maximum to the minimum and
+    -1 back.  The onsets move as well, but ``w`` is continuous there: they change it to
+    the second order only.  ``x_top`` moves to the second order of a change of the
+    reversal's angle, so that it is found again (:func:`dominant_reversals`).  The sums of
+    ``js`` are binned to the accuracy the small ``dx_top`` needs.
+    """
+    W = np.zeros(H + 1, dtype=np.complex128)
+    Mb = Xb.shape[0] - 1
+    M = significant_count(X, 1e-15)
+    if M == 0 or M > Mb:
+        return False, W
+    Xs, symmetric, total = _without_dc(X, M)
+    if not symmetric:
+        return False, W
+    D = np.zeros(Mb + 1, dtype=np.complex128)
+    change = 0.0
+    for m in range(1, Mb + 1, 2):
+        D[m] = (Xs[m] if m <= M else 0.0) - Xb[m]
+        change += abs(D[m])
+    if not change <= LINEAR_CHANGE * total:
+        return False, W
+    C1 = np.empty(M + 1, dtype=np.complex128)
+    C2 = np.empty(M + 1, dtype=np.complex128)
+    for m in range(M + 1):
+        C1[m] = 1j * m * Xs[m]
+        C2[m] = -(m * m) * Xs[m]
+    monotone, _, xr = dominant_reversals(Xs, C1, C2, True)
+    if not monotone:
+        return False, W
+    d_top = max(xr[0], xr[1]) - x_top
+    n = grid_size(Mb, H)
+    if 2 * Mb * (H + 1) <= 4 * n:
+        _add_convolution(Wb, S, D, 2, W)
+    else:
+        P_x = _product(S, D, n, H, True, tw)
+        for q in range(H + 1):
+            W[q] = Wb[q] + P_x[q]
+    if d_top == 0.0:
+        return True, W
+    nb = t_b.shape[0]
+    size = 0.0
+    for b in range(nb):
+        size += abs(js[b])
+    w_max = 0.0
     for q in range(H + 1):
-        W[q] = G[q] + P_x[q]
-    return W, table
+        w_max = max(w_max, abs(Wb[q]))
+    # the sums of js with an error below 1e-17 of the output's largest harmonic
+    tol = min(max(1e-17 * w_max / (abs(d_top) * size), 1e-17), 1e-3)
+    N, P = binned_grid_to(2 * nb, H, 2 * tw.shape[0], tol)
+    minus = np.empty(nb)
+    for b in range(nb):
+        minus[b] = -js[b]
+    # js at t_b and -js half a period on: twice the sums of js at odd q
+    Z = jump_sums_binned(t_b, js, minus, True, H, N, P, binned_table(N, P, H), tw)
+    for q in range(1, H + 1, 2):
+        W[q] -= d_top * Z[q] * (-1j / (_TWO_PI * q))
+    return True, W
+
+
+@njit(cache=True, inline="always")
+def _add_convolution(A, S, Y, step, W):  # pragma: no cover - compiled
+    """``W_q = A_q + (s y)_q``, ``q <= len(W) - 1``, by the direct convolution of the harmonics
+    ``S`` and ``Y`` (every `step`-th harmonic of ``Y`` from the first, the others zero)."""
+    for q in range(W.shape[0]):
+        acc = A[q]
+        for m in range(1, Y.shape[0], step):
+            lo = q - m
+            acc += (S[lo] if lo >= 0 else S[-lo].conjugate()) * Y[m]
+            acc += S[q + m] * Y[m].conjugate()
+        W[q] = acc
 
 
 @njit(cache=True)

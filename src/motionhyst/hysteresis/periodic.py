@@ -27,7 +27,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis._fft import twiddle_table
 from motionhyst.hysteresis._stop_harmonics import stop_harmonics
+from motionhyst.hysteresis._stop_harmonics import stop_harmonics_base as stop_harmonics_base
 from motionhyst.hysteresis._stop_harmonics import stop_harmonics_kept as stop_harmonics_kept
+from motionhyst.hysteresis._stop_harmonics import stop_harmonics_update as stop_harmonics_update
 
 __all__ = ["TWO_PI", "sample_period", "significant_harmonics", "stop_periodic_harmonics",
            "trig_eval"]
