@@ -315,10 +315,11 @@ def _many_elements() -> tuple[np.ndarray, np.ndarray]:
     return k, k * u
 
 
-def _full(X, k, fc, H, tw):
-    """:func:`stop_harmonics_base` with nothing kept: the output computed in full."""
-    return stop_harmonics_base(X, k, fc, H, tw, np.empty((0, 0)), np.zeros(2, dtype=np.int64),
-                               2 * H)
+def _full(X, k, fc, H, tw, grid=None):
+    """:func:`stop_harmonics_base` with nothing kept: the output computed in full (the grid
+    of its binned sums in `grid`)."""
+    grid = np.zeros(2, dtype=np.int64) if grid is None else grid
+    return stop_harmonics_base(X, k, fc, H, tw, np.empty((0, 0)), grid, 2 * H, 1e-17)
 
 
 @pytest.mark.parametrize("direction", ["amplitude", "phase", "harmonics"])
@@ -331,7 +332,8 @@ def test_small_change_of_the_input_is_followed_to_first_order(direction):
     M, H = 41, 60
     X = _rich_symmetric_input(M, 0.01, 1)
     tw = stop_twiddles(M, H)
-    Wb, _, base, Xb, S, t_b, js, x_top = _full(X, k, fc, H, tw)
+    grid = np.zeros(2, dtype=np.int64)
+    Wb, table, base, Xb, S, t_b, js, x_top = _full(X, k, fc, H, tw, grid)
     assert base and 0 < t_b.size - 1 < k.size  # some elements slip, some never do
     eps = 5e-11
     if direction == "amplitude":
@@ -342,7 +344,7 @@ def test_small_change_of_the_input_is_followed_to_first_order(direction):
         Xn = X.copy()
         Xn[3::2] += eps * abs(X[1]) / 20 * np.exp(1j * np.arange(3, M + 1, 2))
     full = _full(Xn, k, fc, H, tw)[0]
-    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, t_b, js, x_top)
+    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid)
     assert ok
     scale = np.max(np.abs(full))
     assert np.max(np.abs(full - Wb)) > 1e-12 * scale
@@ -356,9 +358,10 @@ def test_a_change_the_first_order_does_not_follow_is_refused():
     M, H = 41, 60
     X = _rich_symmetric_input(M, 0.01, 2)
     tw = stop_twiddles(M + 2, H)
-    base = _full(X, k, fc, H, tw)
+    grid = np.zeros(2, dtype=np.int64)
+    base = _full(X, k, fc, H, tw, grid)
     assert base[2]
-    kept = (base[0], *base[3:])
+    kept = (base[0], *base[3:], base[1], grid)
     assert stop_harmonics_update(X * (1 + 1e-11), H, tw, *kept)[0]
     assert not stop_harmonics_update(X * (1 + 1e-9), H, tw, *kept)[0]
     even = X.copy()

@@ -56,6 +56,12 @@ __all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady
 
 MIN_HARMONICS = 32
 MAX_HARMONICS = 4096
+#: Accuracy of the binned sums of the fixed point's first iteration for a link of many stop
+#: operators (relative to the sums of their weights).  It is the starting value: an error
+#: ``d`` in it moves the answer by about ``rho^(K-1) d`` (``rho`` the contraction, ``K >=
+#: 3`` the iterations), which the stopping rule bounds by ``1e-12 d / rho`` as well: at
+#: most 1e-8 ``d`` whatever ``rho``, far below round-off.
+FIRST_ITERATION_TOL = 1e-10
 
 
 def _to_sin_amplitudes(X: NDArray[np.complex128]) -> NDArray[np.complex128]:
@@ -487,14 +493,16 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
         updated = False
         W_new = Wb
         if base:
-            updated, W_new = stop_harmonics_update(X, H, tw, Wb, Xb, Sb, t_b, js, x_top)
+            updated, W_new = stop_harmonics_update(X, H, tw, Wb, Xb, Sb, t_b, js, x_top,
+                                                   weights, grid)
         if not updated:
-            if it == 1:  # the linear loop's y1, one harmonic: a grid of its own
+            if it == 1:  # the linear loop's y1, one harmonic: a grid of its own; the
+                # starting value, whose error the contraction damps at each later iteration
                 W_new, first_weights, base, Xb, Sb, t_b, js, x_top = stop_harmonics_base(
-                    X, k, fc, H, tw, first_weights, first_grid, H)
+                    X, k, fc, H, tw, first_weights, first_grid, H, FIRST_ITERATION_TOL)
             else:  # one grid for any number of harmonics of y1
                 W_new, weights, base, Xb, Sb, t_b, js, x_top = stop_harmonics_base(
-                    X, k, fc, H, tw, weights, grid, 2 * H)
+                    X, k, fc, H, tw, weights, grid, 2 * H, 1e-17)
             Wb = W_new
         change = 0.0
         for q in range(H + 1):

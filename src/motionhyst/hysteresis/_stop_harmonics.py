@@ -23,10 +23,10 @@ from motionhyst.hysteresis._fft import (
 )
 from motionhyst.hysteresis._jump_sums import (
     balance,
-    binned_grid,
     binned_grid_to,
     binned_is_cheaper,
     binned_table,
+    chebyshev_terms_to,
     jump_series,
     jump_series_half,
     jump_sums_binned,
@@ -121,14 +121,15 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     chosen for harmonics up to `q_grid` where that exceeds the sums' own ``H + M`` (one
     grid for inputs of any ``M <= q_grid - H``).  See :func:`stop_harmonics_base`.
     """
-    out = stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid)
+    out = stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, 1e-17)
     return out[0], out[1]
 
 
 @njit(cache=True)
-def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cover - compiled
-    """:func:`stop_harmonics_kept`, returning also what :func:`stop_harmonics_update` needs to
-    follow a small change of the input: ``(W, table, base, Xs, S, t_b, js, x_top)``.
+def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: no cover
+    """:func:`stop_harmonics_kept` with the binned sums to `tol` of the sums of their weights'
+    moduli (1e-17: to round-off), returning also what :func:`stop_harmonics_update` needs
+    to follow a small change of the input: ``(W, table, base, Xs, S, t_b, js, x_top)``.
 
     ``base`` is True where the output came from many jumps binned (the costly case) over a
     half-wave symmetric, monotone branch: ``Xs`` is then the input as used (no DC, no even
@@ -187,7 +188,7 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
     binned = binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0])
     if binned:
         G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
-                                     grid)
+                                     grid, tol)
     elif half:
         G, S = jump_series_half(t_b, jg, js, H, Q)
     else:
@@ -206,12 +207,14 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
 
 
 @njit(cache=True)
-def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top):  # pragma: no cover - compiled
+def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # pragma: no cover
     """The output of :func:`stop_harmonics_base` for the input `X`, from its output ``Wb`` for
-    an input ``Xb`` near it (``Xb``, ``S``, ``t_b``, ``js``, ``x_top`` as it returned them),
-    to first order in their difference.  Returns ``(ok, W)``; ``ok`` is False (``W``
-    unset) where `X` is not half-wave symmetric, not monotone between two reversals, has
-    more harmonics than ``Xb`` or differs from it by more than :data:`LINEAR_CHANGE`.
+    an input ``Xb`` near it (``Xb``, ``S``, ``t_b``, ``js``, ``x_top`` as it returned them,
+    `table` and `grid` the weights and grid of its binned sums), to first order in their
+    difference.  Returns ``(ok, W)``; ``ok`` is False (``W`` unset) where `X` is not
+    half-wave symmetric, not monotone between two reversals, has more harmonics than
+    ``Xb``, differs from it by more than :data:`LINEAR_CHANGE`, or would need more terms
+    of the binned sums than `table` holds.
 
     From the maximum ``x_top`` to the minimum an element that slips sticks, ``w = fc - k
     (x_top - x)``, until its slip onset, then slips, ``w = -fc``; one that never slips
@@ -222,7 +225,7 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top):  # pragma: no co
     -1 back.  The onsets move as well, but ``w`` is continuous there: they change it to
     the second order only.  ``x_top`` moves to the second order of a change of the
     reversal's angle, so that it is found again (:func:`dominant_reversals`).  The sums of
-    ``js`` are binned to the accuracy the small ``dx_top`` needs.
+    ``js`` are binned on the grid of ``S``'s, to the accuracy the small ``dx_top`` needs.
     """
     W = np.zeros(H + 1, dtype=np.complex128)
     Mb = Xb.shape[0] - 1
@@ -265,13 +268,15 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top):  # pragma: no co
     for q in range(H + 1):
         w_max = max(w_max, abs(Wb[q]))
     # the sums of js with an error below 1e-17 of the output's largest harmonic
-    tol = min(max(1e-17 * w_max / (abs(d_top) * size), 1e-17), 1e-3)
-    N, P = binned_grid_to(2 * nb, H, 2 * tw.shape[0], tol)
+    N = grid[0]
+    P = chebyshev_terms_to(np.pi * H / N, 1e-17 * w_max / (abs(d_top) * size))
+    if P > grid[1]:  # the table's weights of a term do not depend on the terms after it
+        return False, W
     minus = np.empty(nb)
     for b in range(nb):
         minus[b] = -js[b]
     # js at t_b and -js half a period on: twice the sums of js at odd q
-    Z = jump_sums_binned(t_b, js, minus, True, H, N, P, binned_table(N, P, H), tw)
+    Z = jump_sums_binned(t_b, js, minus, True, H, N, P, table, tw)
     for q in range(1, H + 1, 2):
         W[q] -= d_top * Z[q] * (-1j / (_TWO_PI * q))
     return True, W
@@ -291,10 +296,11 @@ def _add_convolution(A, S, Y, step, W):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma: no cover
+def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol):  # pragma: no cover
     """:func:`jump_series` of many jumps, binned (:func:`jump_sums_binned`) on the grid for
-    harmonics up to `q_grid` (>= `Q`), with the weights' `table` of the grid ``grid = [N,
-    P]`` kept (a new one where it does not serve).
+    harmonics up to `q_grid` (>= `Q`), to `tol` of the sums of the weights' moduli, with
+    the weights' `table` of the grid ``grid = [N, P]`` kept (a new one where it does not
+    serve).
 
     With `half` (the jumps of the first half period; the second's are ``-jg`` and ``js``
     half a period on) each jump and its mirror make one sum with real weights, ``(r js +
@@ -304,7 +310,7 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid):  # pragma:
     """
     nb = t_b.shape[0]
     n_points = 2 * nb if half else nb
-    N, P = binned_grid(n_points, q_grid, 2 * tw.shape[0])
+    N, P = binned_grid_to(n_points, q_grid, 2 * tw.shape[0], tol)
     if N != grid[0] or P != grid[1] or table.shape[0] <= Q:
         table = binned_table(N, P, q_grid)
         grid[0] = N
