@@ -247,7 +247,7 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # 
     for m in range(M + 1):
         C1[m] = 1j * m * Xs[m]
         C2[m] = -(m * m) * Xs[m]
-    monotone, _, xr = dominant_reversals(Xs, C1, C2, True)
+    monotone, _, xr = dominant_reversals(Xs, C1, C2, symmetric)
     if not monotone:
         return False, W
     d_top = max(xr[0], xr[1]) - x_top
@@ -255,7 +255,7 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # 
     if 2 * Mb * (H + 1) <= 4 * n:
         _add_convolution(Wb, S, D, 2, W)
     else:
-        P_x = _product(S, D, n, H, True, tw)
+        P_x = _product(S, D, n, H, symmetric, tw)
         for q in range(H + 1):
             W[q] = Wb[q] + P_x[q]
     if d_top == 0.0:
@@ -276,7 +276,7 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # 
     for b in range(nb):
         minus[b] = -js[b]
     # js at t_b and -js half a period on: twice the sums of js at odd q
-    Z = jump_sums_binned(t_b, js, minus, True, H, N, P, table, tw)
+    Z = jump_sums_binned(t_b, js, minus, symmetric, H, N, P, table, tw)
     for q in range(1, H + 1, 2):
         W[q] -= d_top * Z[q] * (-1j / (_TWO_PI * q))
     return True, W
