@@ -139,20 +139,22 @@ def binned_grid(n_jumps, Q, N_max):  # pragma: no cover - compiled
     """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
     :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q`, to 1e-17 of the
     sum of the weights (:func:`binned_grid_to`)."""
-    return binned_grid_to(n_jumps, Q, N_max, 1e-17)
+    return binned_grid_to(n_jumps, Q, N_max, 1e-17, Q, 1e-17)
 
 
 @njit(cache=True)
-def binned_grid_to(n_jumps, Q, N_max, tol):  # pragma: no cover - compiled
+def binned_grid_to(n_jumps, Q, N_max, tol, Q_full, tol_full):  # pragma: no cover - compiled
     """The grid ``N`` (a power of two up to `N_max`) and the number of terms ``P`` of
-    :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q`, to `tol` of the
-    sum of the weights: the fewest operations, weighted roughly as the compiled code spends
-    its time (binning, FFTs, the sums over the terms, the Bessel table), ``N >= Q / 2``."""
+    :func:`jump_sums_binned` for `n_jumps` jumps and harmonics up to `Q` to `tol` of the sum
+    of the weights, those up to ``Q_full <= Q`` to ``tol_full <= tol``: the fewest
+    operations, weighted roughly as the compiled code spends its time (binning, FFTs, the
+    sums over the terms, the Bessel table), ``N >= Q_full / 2``."""
     best_N, best_P, best_cost = 0, 0, np.inf
     N = 2
     while N <= N_max:
-        if 2 * N >= Q:
-            P = chebyshev_terms_to(np.pi * Q / N, tol)
+        if 2 * N >= Q_full:
+            P = max(chebyshev_terms_to(np.pi * Q / N, tol),
+                    chebyshev_terms_to(np.pi * Q_full / N, tol_full))
             cost = P * (n_jumps * 2.0 + N * np.log2(N) * 1.5 + Q * 2.0) + Q * (P + 24.0) * 1.5
             if cost < best_cost:
                 best_N, best_P, best_cost = N, P, cost

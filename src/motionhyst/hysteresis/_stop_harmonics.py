@@ -153,7 +153,7 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         return W, table, False, none, none, no_jumps, no_jumps, 0.0
     # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
     # loop's y1): made exact, its output's second half period mirrors the first
-    Xs, symmetric, _ = _without_dc(X, M)
+    Xs, symmetric, total = _without_dc(X, M)
     C1 = np.empty(M + 1, dtype=np.complex128)
     C2 = np.empty(M + 1, dtype=np.complex128)
     for m in range(M + 1):
@@ -187,8 +187,14 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
     nb = t_b.shape[0]
     binned = binned_is_cheaper(2 * nb if half else nb, Q, 2 * tw.shape[0])
     if binned:
+        # the harmonics of s above H + 1 meet those of x above the first only: to the
+        # accuracy their small size needs
+        tail = 0.0
+        for m in range(2, M + 1):
+            tail += abs(Xs[m])
+        tol_rest = min(tol * total / tail, 1e-3) if tail > 0.0 else 1e-3
         G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
-                                     grid, tol)
+                                     grid, max(tol, tol_rest), tol)
     elif half:
         G, S = jump_series_half(t_b, jg, js, H, Q)
     else:
@@ -296,11 +302,12 @@ def _add_convolution(A, S, Y, step, W):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol):  # pragma: no cover
+def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
+                   tol_full):  # pragma: no cover - compiled
     """:func:`jump_series` of many jumps, binned (:func:`jump_sums_binned`) on the grid for
-    harmonics up to `q_grid` (>= `Q`), to `tol` of the sums of the weights' moduli, with
-    the weights' `table` of the grid ``grid = [N, P]`` kept (a new one where it does not
-    serve).
+    harmonics up to `q_grid` (>= `Q`), to `tol` of the sums of the weights' moduli (those up
+    to ``H + 1`` to ``tol_full``), with the weights' `table` of the grid ``grid = [N, P]``
+    kept (a new one where it does not serve).
 
     With `half` (the jumps of the first half period; the second's are ``-jg`` and ``js``
     half a period on) each jump and its mirror make one sum with real weights, ``(r js +
@@ -310,7 +317,7 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol):  # pr
     """
     nb = t_b.shape[0]
     n_points = 2 * nb if half else nb
-    N, P = binned_grid_to(n_points, q_grid, 2 * tw.shape[0], tol)
+    N, P = binned_grid_to(n_points, q_grid, 2 * tw.shape[0], tol, H + 1, tol_full)
     if N != grid[0] or P != grid[1] or table.shape[0] <= Q:
         table = binned_table(N, P, q_grid)
         grid[0] = N
