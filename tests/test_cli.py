@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from motionhyst import cli
+from motionhyst import entry
 from motionhyst.cli import main
 from motionhyst.scenario import default_scenario_path
 
@@ -322,10 +322,12 @@ def test_toml_syntax_error(capsys, tmp_path):
 
 # ---------------------------------------------------------- entry point
 def test_console_script_entry_point_is_main():
+    """The console script runs :func:`motionhyst.cli.main` through :mod:`motionhyst.entry`,
+    which handles signals before the command line interface is imported."""
     eps = [ep for ep in metadata.entry_points(group="console_scripts") if ep.name == "motionhyst"]
     assert len(eps) == 1
-    assert eps[0].value == "motionhyst.cli:main"
-    assert eps[0].load() is cli.main
+    assert eps[0].value == "motionhyst.entry:main"
+    assert eps[0].load() is entry.main
 
 
 def test_module_runs_as_script(tmp_path):

@@ -20,7 +20,7 @@ SRC = Path(__file__).resolve().parent.parent / "src"
 
 LAYERS = [("core",), ("io",), ("hysteresis",), ("plants",), ("controllers",),
           ("analysis", "time"), ("scan", "identify"), ("scenario",), ("study",), ("present",),
-          ("cli",)]
+          ("cli",), ("entry",)]
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 
 #: The longest a module may be; a longer one holds more than one concept: split it.

@@ -334,3 +334,43 @@ def test_cache_folder_is_keyed_by_the_sources(tmp_path):
     kernels = root / "motionhyst" / "hysteresis" / "_kernels.py"
     kernels.write_text(kernels.read_text() + "\n# edited\n")
     assert folder() != before
+
+
+_EARLY = """
+import os, signal, sys
+import motionhyst
+
+SIG = getattr(signal, sys.argv[1])
+
+class SignalOnImport:  # the signal arrives while the command line interface is imported
+    def find_spec(self, name, path=None, target=None):
+        if name == "motionhyst.cli._common":
+            os.kill(os.getpid(), SIG)
+        return None
+
+sys.meta_path.insert(0, SignalOnImport())
+from motionhyst.entry import main
+sys.argv[1:] = ["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]
+sys.exit(main())
+"""
+
+
+@pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
+def test_a_signal_before_the_command_handlers_ends_as_an_interruption(tmp_path, name):
+    """The console script (motionhyst.entry) handles signals before argparse and the command
+    line interface load: no traceback, no death by SIGTERM, exit 130, nothing on stdout."""
+    proc = _run(_EARLY, name, cwd=tmp_path)
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr == "motionhyst: interrupted\n" and proc.stdout == ""
+
+
+def test_import_motionhyst_before_the_entry_handles_signals_imports_little():
+    """``import motionhyst`` (before the entry can install its handlers) imports no more than
+    a handful of small modules of the standard library."""
+    code = ("import json, sys; before = set(sys.modules); import motionhyst; "
+            "print(json.dumps(sorted(set(sys.modules) - before)))")
+    proc = _run(code)
+    assert proc.returncode == 0, proc.stderr
+    new = {m for m in json.loads(proc.stdout) if not m.startswith("motionhyst")}
+    assert new <= {"__future__", "importlib", "importlib._bootstrap",
+                   "importlib._bootstrap_external", "importlib.machinery", "types", "warnings"}

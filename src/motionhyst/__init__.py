@@ -19,14 +19,14 @@ Examples
 from __future__ import annotations
 
 import importlib
-import importlib.abc
 import importlib.machinery
 import sys
 import types
 import warnings
-from typing import TYPE_CHECKING
 
 from motionhyst.core.exports import lazy_exports
+
+TYPE_CHECKING = False  # typing's, without typing (see motionhyst.core.exports)
 
 __version__ = "0.1.0"
 
@@ -158,8 +158,10 @@ class _MovedModule(types.ModuleType):
                        for name in dir(importlib.import_module(target))})
 
 
-class _MovedFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Imports an old module path of :data:`_MOVED` with a DeprecationWarning."""
+class _MovedFinder:
+    """Imports an old module path of :data:`_MOVED` with a DeprecationWarning (a finder and
+    loader of ``sys.meta_path`` by its methods: ``importlib.abc`` would cost the command's
+    start 50 ms)."""
 
     def find_spec(self, fullname, path=None, target=None):
         if fullname not in _MOVED:

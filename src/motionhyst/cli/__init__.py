@@ -37,6 +37,7 @@ from motionhyst.core.budget import (
     set_max_memory,
     set_max_seconds,
 )
+from motionhyst.core.interrupts import interrupted
 
 COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identify", "predict",
             "study", "benchmark", "reproduce")
@@ -115,6 +116,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         atexit.register(gc.freeze)
     interrupts = _Interrupts()
     try:
+        if sys.stdout is None:  # started with its output closed (``>&-``): the answer is lost
+            raise UsageError("motionhyst: standard output is closed: the results would be lost; "
+                             "give the command an output (a terminal, a file or a pipe)")
         parser = build_parser()
         args = parser.parse_args(argv)
         set_max_memory(args.max_memory)
@@ -134,7 +138,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     except Exception as exc:
         interrupts.close()
-        if not (interrupts.received or _interrupted(exc)):
+        if not (interrupts.received or interrupted(exc)):
             return _failed(exc)
         _say("motionhyst: interrupted")
         return 130
@@ -230,20 +234,6 @@ class _Interrupts:
                 signal.signal(sig, previous)
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self.hook
-
-
-def _interrupted(exc: BaseException) -> bool:
-    """Whether `exc` is what a Ctrl-C became: a ``KeyboardInterrupt`` raised inside an import
-    of a compiled extension, a numba compilation or a C callback comes out as a SystemError,
-    an ImportError or another error whose cause or context is the interrupt."""
-    seen: set[int] = set()
-    e: BaseException | None = exc
-    while e is not None and id(e) not in seen:
-        if isinstance(e, KeyboardInterrupt):
-            return True
-        seen.add(id(e))
-        e = e.__cause__ or e.__context__
-    return False
 
 
 def _say(line: str) -> None:

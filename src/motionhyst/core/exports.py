@@ -11,8 +11,11 @@ from __future__ import annotations
 
 import importlib
 import sys
-from collections.abc import Callable, Iterable, Mapping
-from typing import Any
+
+TYPE_CHECKING = False  # typing's, without typing: ``import motionhyst`` runs before the command
+if TYPE_CHECKING:      # can handle a signal (motionhyst.entry), so it imports next to nothing
+    from collections.abc import Callable, Iterable, Mapping
+    from typing import Any
 
 __all__ = ["lazy_exports"]
 

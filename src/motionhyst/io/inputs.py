@@ -171,3 +171,6 @@ def read_toml(path: str | os.PathLike, check: Callable[[str], None] | None = Non
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputFileError(f"TOML syntax error: {exc}") from None
+    except RecursionError:  # tomllib parses nested arrays and tables recursively
+        raise InputFileError("TOML nested too deeply: arrays or tables within each other "
+                             "hundreds of levels deep") from None

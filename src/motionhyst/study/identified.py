@@ -270,6 +270,9 @@ def _read(path: Path, where: str):
         raise ValueError(f"{where}: {exc}") from None
     try:
         data = json.loads(text)
+    except RecursionError:  # arrays within arrays thousands of levels deep
+        raise ValueError(f"{where}: JSON nested too deeply (not what `motionhyst identify "
+                         f"--json` printed)") from None
     except ValueError:
         raise ValueError(f"{where}: not JSON (give what `motionhyst identify --json` printed, "
                          f"or the .toml of `identify --save`)") from None

@@ -1,0 +1,65 @@
+"""Refusals of what a command cannot work with: a closed output, input files nested too deeply.
+
+Each is one line on stderr and exit code 2, before any work (issue 26).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from motionhyst.cli import main
+
+_MAIN = "import sys; from motionhyst.cli import main; sys.exit(main(sys.argv[1:]))"
+
+
+def test_a_closed_standard_output_is_refused_not_answered_into_nothing(tmp_path):
+    """``motionhyst df ... >&-``: Python gives a closed stdout as None and print() then
+    writes nothing, so the command exited 0 with its answer lost."""
+    proc = subprocess.run([sys.executable, "-c", _MAIN, "df", "--k", "20", "--fc", "0.05",
+                           "--amplitude", "0.01"], stderr=subprocess.PIPE, text=True,
+                          cwd=tmp_path, timeout=120, preexec_fn=lambda: os.close(1))
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "standard output is closed" in proc.stderr
+
+
+def test_an_output_of_none_is_refused_in_process(monkeypatch, capsys):
+    monkeypatch.setattr(sys, "stdout", None)
+    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "standard output is closed" in err
+
+
+@pytest.mark.parametrize("text", [
+    "a = " + "[" * 5000 + "]" * 5000,                        # arrays within arrays
+    "a = " + "{b = " * 3000 + "1" + "}" * 3000,              # inline tables within tables
+])
+@pytest.mark.parametrize("command", [["analyze"], ["steady"], ["study"]])
+def test_a_toml_file_nested_too_deeply_is_refused_naming_it(tmp_path, monkeypatch, capsys,
+                                                            text, command):
+    """It was "maximum recursion depth exceeded", naming neither the file nor the cause."""
+    (tmp_path / "deep.toml").write_text(text + "\n")
+    monkeypatch.chdir(tmp_path)
+    assert main([*command, "deep.toml"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert "deep.toml: TOML nested too deeply" in err
+
+
+def test_an_identification_nested_too_deeply_is_refused_naming_it(tmp_path, monkeypatch,
+                                                                   capsys):
+    from motionhyst.scenario import default_scenario_path
+
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    (tmp_path / "s.toml").write_text('scenario = "paper.toml"\noutputs = ["mismatch"]\n\n'
+                                     '[axes]\namplitude = [0.01]\nfrequency_hz = [5.0]\n')
+    (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "s.toml", "--from-identification", "deep.json", "--out",
+                 "o.zarr"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "deep.json: JSON nested too deeply" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["deep.json", "paper.toml", "s.toml"]
