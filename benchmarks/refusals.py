@@ -3,15 +3,15 @@
 Each case is a command line that motionhyst refuses (exit 2, one line on stderr), one
 for each way a refusal comes: an argument, a scenario's value, an option against the
 scenario, an output, a file, a record, the size of a run, an open-loop scenario where a
-loop is needed, an unstable controller and a run whose step the loop's poles set (from the
-scenario's coefficients, before python-control builds the loop), a list of a million
-values, a constant force, an input-output record without inertia (its inverse-dynamics
-estimate); and one that needs the work it refuses: a fit that finds no model of the
-record.  Each runs as a whole process (the interpreter, the imports, the checks) in a
-folder holding its files, ``REPEATS`` times interleaved with the baseline of the same run:
-``motionhyst --help``, the command's start alone.  Reported per case: the least wall time
-(the least disturbed run), the processor time of that run (the wall time of a quiet
-machine), and their ratio to the baseline's; target 2 s of wall time.
+loop is needed, an unstable controller (lead-lag, sampled at 10 kHz, PID) and a run whose
+step the loop's poles set (from the scenario's coefficients, before python-control builds
+the loop), a list of a million values, a constant force, an input-output record without
+inertia (its inverse-dynamics estimate); and one that needs the work it refuses: a fit
+that finds no model of the record.  Each runs as a whole process (the interpreter, the
+imports, the checks) in a folder holding its files, ``REPEATS`` times interleaved with the
+baseline of the same run: ``motionhyst --help``, the command's start alone.  Reported per
+case: the least wall time (the least disturbed run), the processor time of that run (the
+wall time of a quiet machine), and their ratio to the baseline's; target 2 s of wall time.
 
 Run with ``make bench`` or ``python benchmarks/refusals.py [--json] [--repeats N]``.
 """
@@ -56,6 +56,11 @@ def _files() -> dict[str, str]:
         "s.toml": PAPER,
         "nan.toml": PAPER.replace("m1 = 5.0", "m1 = nan"),
         "unstable.toml": PAPER.replace("flp = 700.0", "flp = 1e12"),
+        "unstable-10k.toml": PAPER.replace("beta = 0.6 ", "beta = 0.6\nsample_rate_hz = 1e4\n"
+                                           "delay_samples = 8.0 "),  # 8 samples late
+        "unstable-pid.toml": PAPER[:PAPER.index("[controller]")] + (
+            '[controller]\ntype = "pid"\nkp = 6e6\nki = 1e10\nkd = 2e4\n'
+            "derivative_filter_hz = 1500.0\n\n") + PAPER[PAPER.index("[feedforward]"):],
         "open.toml": ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
                       '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n'),
         "plant-dir.toml": head + '[plant]\nfile = "pl"\n' + tail,
@@ -87,6 +92,8 @@ CASES = [
     ("text .mat", ["predict", "open.toml", "f.mat", "--out", "p.csv"], "checks"),
     ("open loop", ["stability", "open.toml"], "checks"),
     ("unstable loop", ["steady", "unstable.toml"], "checks"),
+    ("unstable sampled loop", ["steady", "unstable-10k.toml"], "checks"),
+    ("unstable PID loop", ["steady", "unstable-pid.toml"], "checks"),
     ("scan steps of the loop", ["scan", "s.toml", *SCAN, "--rate", "1e-3"], "checks"),
     ("a million elements", ["steady", "slip.toml"], "checks"),
     ("constant force", ["identify", "fd-zero.csv"], "checks"),

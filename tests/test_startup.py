@@ -155,6 +155,15 @@ def _refused_scenarios() -> dict[str, str]:
     return {
         "paper.toml": paper,
         "unstable.toml": paper.replace("flp = 700.0", "flp = 1e12"),
+        # sampled at 10 kHz with 8 samples of delay; a tf-z controller; a PID
+        "unstable-10k.toml": paper.replace("beta = 0.6 ", "beta = 0.6\nsample_rate_hz = 1e4\n"
+                                           "delay_samples = 8.0 "),
+        "unstable-tfz.toml": paper[:paper.index("[controller]")] + (
+            '[controller]\ntype = "tf-z"\nnum = [2e7, -1.9e7]\nden = [1.0, -0.5]\n'
+            "sample_rate_hz = 1e4\n\n") + paper[paper.index("[feedforward]"):],
+        "unstable-pid.toml": paper[:paper.index("[controller]")] + (
+            '[controller]\ntype = "pid"\nkp = 6e6\nki = 1e10\nkd = 2e4\n'
+            "derivative_filter_hz = 1500.0\n\n") + paper[paper.index("[feedforward]"):],
         "slip.toml": paper.replace('model = "jenkins"', 'model = "maxwell-slip"').replace(
             "k = 20.0 ", "k = [" + "1.0," * 100_001 + "] ").replace(
             "fc = 0.05 ", "fc = [" + "0.01," * 100_001 + "] "),
@@ -191,6 +200,11 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     (["analyze", "plant-columns.toml"], "need columns"),
     (["steady", "unstable.toml"], "does not stabilise the loop (closed-loop pole at 22.94"),
     (["stability", "unstable.toml"], "does not stabilise the loop"),
+    (["steady", "unstable-10k.toml"], "the sampled controller does not stabilise the loop "
+                                      "(closed-loop pole at z = 1.00"),
+    (["analyze", "unstable-tfz.toml"], "the sampled controller does not stabilise the loop"),
+    (["steady", "unstable-pid.toml"], "does not stabilise the loop (closed-loop pole at 380+4218j"),
+    ([*SCAN[:1], "unstable-10k.toml", *SCAN[2:]], "the sampled controller does not stabilise"),
     ([*SCAN, "--rate", "1e-3"], "248898681 time steps of 3.62e-05 s: too many"),  # the poles'
     (["steady", "slip.toml"], "[hysteresis] k: 100001 values, more than the 100000"),
     (["stability", "open.toml"], "needs a closed loop"),

@@ -30,13 +30,20 @@ The paper's Table I loop (:class:`~motionhyst.plants.TwoMassStage`, eq. 23, Jenk
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.polynomials import cancel_s, trim
+from motionhyst.core.zoh import zoh_state_space
 
-__all__ = ["as_transfer", "characteristic", "check_stable", "leadlag_coefficients",
-           "loop_denominator", "strictly_proper", "stuck_characteristic"]
+if TYPE_CHECKING:
+    from motionhyst.controllers.sampled import SampledController
+
+__all__ = ["as_transfer", "characteristic", "check_sampled_stable", "check_stable",
+           "leadlag_coefficients", "loop_denominator", "sampled_loop_matrix", "strictly_proper",
+           "stuck_characteristic"]
 
 
 def as_transfer(num: ArrayLike, den: ArrayLike
@@ -217,3 +224,105 @@ pole at 0.5+0.866j rad/s)
             worst = p[np.argmax(p.real)]
             raise ValueError(f"the controller does not stabilise the loop{what} "
                              f"(closed-loop pole at {worst.real:.4g}{worst.imag:+.4g}j rad/s)")
+
+
+def sampled_loop_matrix(whole: int, plant: tuple[NDArray[np.float64], ...],
+                        controller: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
+    """The state matrix of the sampled loop over one period: the plant behind its delayed
+    hold, the delay line and the controller; its eigenvalues are the loop's poles ``z``.
+
+    Parameters
+    ----------
+    whole : int
+        Whole samples of delay ``D``.
+    plant : tuple
+        ``(Phi, Gamma_a, Gamma_b, C)`` of the held plant
+        (:func:`~motionhyst.core.zoh.zoh_state_space`).
+    controller : tuple
+        ``(A, B, C, D)`` of the controller, input ``[r_k, y_k]``
+        (:meth:`~motionhyst.controllers.sampled.SampledController.state_space`).
+
+    Examples
+    --------
+    ``1 / s`` under ``u_k = -K y_k`` without delay: ``z = 1 - K T`` (and 0, the last sample
+    held, a state of the delay line):
+
+    >>> from motionhyst.core.zoh import zoh_state_space
+    >>> whole, plant = zoh_state_space([1.0], [1.0, 0.0], 0.1)
+    >>> K = np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), np.array([[5.0, -5.0]])
+    >>> np.linalg.eigvals(sampled_loop_matrix(whole, plant, K)).round(12).tolist()
+    [0.0, 0.5]
+    """
+    Phi, ga, gb, Cp = plant
+    Ac, Bc, Cc, Dc = controller
+    by, dy = Bc[:, 1], Dc[0, 1]     # the output enters with the feedback's sign
+    n, nc, nd = Phi.shape[0], Ac.shape[0], whole + 1
+    N = n + nc + nd
+    A = np.zeros((N, N))
+    iu = n + nc                      # delay line: u_{k-1}, ..., u_{k-D-1}
+    # u_k = Cc xc + dy Cp x
+    u_row = np.zeros(N)
+    u_row[:n] = dy * Cp
+    u_row[n:n + nc] = Cc[0]
+    # u_{k-D}: u_k itself without whole delay, else a state of the line
+    u_kd = u_row if whole == 0 else np.eye(N)[iu + whole - 1]
+    A[:n] = np.outer(ga, np.eye(N)[iu + whole]) + np.outer(gb, u_kd)
+    A[:n, :n] += Phi
+    A[n:n + nc, :n] = np.outer(by, Cp)
+    A[n:n + nc, n:n + nc] = Ac
+    A[iu] = u_row
+    for i in range(1, nd):
+        A[iu + i, iu + i - 1] = 1.0
+    return A
+
+
+def check_sampled_stable(n2: ArrayLike, d2: ArrayLike, controller: SampledController,
+                         stuck: tuple[ArrayLike, ArrayLike, float] | None = None) -> None:
+    """Raise ``ValueError`` unless the loop of ``P2 = n2 / d2`` and the sampled `controller`
+    (its hold and delay) is stable, and with the link stuck (a spring ``kJ`` at ``y1``:
+    ``P2`` becomes ``n2 d1 / (d1 d2 + kJ n1 d2)``).
+
+    numpy alone, from the coefficients: a scenario's sampled loop is checked before
+    python-control is imported, as :meth:`Loop.check_stable
+    <motionhyst.controllers.loop.Loop.check_stable>` checks it once built.
+
+    Parameters
+    ----------
+    n2, d2 : array_like
+        ``P2``'s numerator and denominator (strictly proper, at most two integrators).
+    controller : SampledController
+        The controller (rate, delay, feedback path).
+    stuck : tuple, optional
+        ``(n1, d1, kJ)``: ``P1`` and the link's initial stiffness; None: no link.
+
+    Raises
+    ------
+    ValueError
+        One line naming the case, its largest pole ``z``, the rate and the delay.
+
+    Examples
+    --------
+    >>> from motionhyst.controllers.sampled import SampledController
+    >>> c = SampledController([25.0], [1.0], sample_rate_hz=10.0)     # u_k = -25 y_k
+    >>> try:
+    ...     check_sampled_stable([1.0], [1.0, 0.0], c)                  # 1 / s: z = 1 - 2.5
+    ... except ValueError as exc:
+    ...     print(exc)
+    the sampled controller does not stabilise the loop (closed-loop pole at z = -1.5+0j, \
+|z| = 1.5 >= 1, at 10 Hz with 0 samples of delay)
+    """
+    cases = [("", n2, d2)]
+    if stuck is not None:
+        n1, d1, kj = stuck
+        cases.append((" with the dynamic link stuck", np.polymul(n2, d1),
+                      np.polyadd(np.polymul(d1, d2), kj * np.polymul(n1, d2))))
+    for what, num, den in cases:
+        whole, plant = zoh_state_space(num, den, controller.period, controller.delay_samples)
+        z = np.linalg.eigvals(sampled_loop_matrix(whole, plant, controller.state_space()))
+        if z.size and np.max(np.abs(z)) >= 1.0:
+            worst = z[np.argmax(np.abs(z))]
+            raise ValueError(
+                f"the sampled controller does not stabilise the loop{what} (closed-loop "
+                f"pole at z = {worst.real:.6g}{worst.imag:+.6g}j, |z| = {abs(worst):.6g} "
+                f">= 1, at {controller.sample_rate_hz:g} Hz with "
+                f"{controller.delay_samples:g} samples of delay)")

@@ -42,7 +42,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.controllers.characteristic import (
     characteristic,
+    check_sampled_stable,
     check_stable,
+    sampled_loop_matrix,
     strictly_proper,
     stuck_characteristic,
 )
@@ -466,50 +468,19 @@ class SampledParts:
 
     def _poles_z(self, P2) -> NDArray[np.complex128]:
         """Eigenvalues of the sampled loop around ``P2``: plant, delay line and controller."""
-        c = self.c
         G = ZohEquivalent(P2, self.T, self.d)
-        Phi, ga, gb, Cp = G.state_space()
-        Ac, Bc, Cc, Dc = c.state_space()
-        by, dy = Bc[:, 1], Dc[0, 1]     # the output enters with the feedback's sign
-        n, nc, nd = Phi.shape[0], Ac.shape[0], G.whole + 1
-        N = n + nc + nd
-        A = np.zeros((N, N))
-        iu = n + nc                      # delay line: u_{k-1}, ..., u_{k-D-1}
-        # u_k = Cc xc + dy Cp x
-        u_row = np.zeros(N)
-        u_row[:n] = dy * Cp
-        u_row[n:n + nc] = Cc[0]
-        # u_{k-D}: u_k itself without whole delay, else a state of the line
-        u_kd = u_row if G.whole == 0 else np.eye(N)[iu + G.whole - 1]
-        A[:n] = np.outer(ga, np.eye(N)[iu + G.whole]) + np.outer(gb, u_kd)
-        A[:n, :n] += Phi
-        A[n:n + nc, :n] = np.outer(by, Cp)
-        A[n:n + nc, n:n + nc] = Ac
-        A[iu] = u_row
-        for i in range(1, nd):
-            A[iu + i, iu + i - 1] = 1.0
-        return np.linalg.eigvals(A)
+        return np.linalg.eigvals(sampled_loop_matrix(G.whole, G.state_space(),
+                                                     self.c.state_space()))
 
     def check_stable(self) -> None:
-        """Raise ``ValueError`` unless the sampled loop is stable (link absent and stuck)."""
+        """Raise ``ValueError`` unless the sampled loop is stable (link absent and stuck),
+        from the plant's and the controller's coefficients (:func:`check_sampled_stable`: the
+        check a scenario makes before the loop is built)."""
         loop = self.loop
-        cases = [("", loop.P2)]
+        stuck = None
         if loop.hysteresis is not None:
-            kj = loop.hysteresis.initial_stiffness
-            n1, d1 = tf_poly(loop.P1)
-            n2, d2 = tf_poly(loop.P2)
-            # y2 = P2 / (1 + kJ P1) (u) with the link stuck as a spring at y1
-            stuck = control.tf(np.polymul(n2, d1),
-                               np.polyadd(np.polymul(d1, d2), kj * np.polymul(n1, d2)))
-            cases.append((" with the dynamic link stuck", stuck))
-        for what, plant in cases:
-            z = self._poles_z(plant)
-            if z.size and np.max(np.abs(z)) >= 1.0:
-                worst = z[np.argmax(np.abs(z))]
-                raise ValueError(
-                    f"the sampled controller does not stabilise the loop{what} (closed-loop "
-                    f"pole at z = {worst.real:.6g}{worst.imag:+.6g}j, |z| = {abs(worst):.6g} "
-                    f">= 1, at {self.c.sample_rate_hz:g} Hz with {self.d:g} samples of delay)")
+            stuck = (*tf_poly(loop.P1), loop.hysteresis.initial_stiffness)
+        check_sampled_stable(*tf_poly(loop.P2), self.c, stuck)
 
     def bandwidth_hz(self) -> float:
         """First frequency below Nyquist where ``|Y G_d|`` falls through 1 [Hz]."""

@@ -28,11 +28,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import control
 import numpy as np
+from numpy.typing import NDArray
 
-from motionhyst.controllers.sampled import SampledController, discretize
+from motionhyst.controllers.sampled import SampledController, discretize_coefficients
+
+if TYPE_CHECKING:  # imported where used: a scenario's PID is checked without it
+    import control
 
 __all__ = ["Notch", "Pid"]
 
@@ -71,11 +75,17 @@ class Notch:
         if not (math.isfinite(self.zeta_pole) and self.zeta_pole > 0):
             raise ValueError(f"notch zeta_pole must be finite and > 0, got {self.zeta_pole!r}")
 
+    def coefficients(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Numerator and denominator, highest power of ``s`` first."""
+        w = 2.0 * math.pi * self.frequency_hz
+        return (np.array([1.0, 2.0 * self.zeta_zero * w, w * w]),
+                np.array([1.0, 2.0 * self.zeta_pole * w, w * w]))
+
     def tf(self) -> control.TransferFunction:
         """The notch as a python-control transfer function."""
-        w = 2.0 * math.pi * self.frequency_hz
-        return control.tf([1.0, 2.0 * self.zeta_zero * w, w * w],
-                          [1.0, 2.0 * self.zeta_pole * w, w * w])
+        import control
+
+        return control.tf(*self.coefficients())
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (a ``notches`` entry of a scenario)."""
@@ -131,26 +141,50 @@ class Pid:
         """False for a pure derivative (``kd > 0`` without a filter): no continuous realisation."""
         return self.kd == 0 or self.derivative_filter_hz is not None
 
-    def _derivative(self) -> control.TransferFunction:
-        if self.derivative_filter_hz is None:
-            return control.tf([self.kd, 0.0], [1.0])
-        wd = 2.0 * math.pi * self.derivative_filter_hz
-        return control.tf([self.kd, 0.0], [1.0 / wd, 1.0])
+    def _pi(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        return (np.array([self.kp, self.ki]), np.array([1.0, 0.0])) if self.ki else (
+            np.array([self.kp]), np.array([1.0]))
 
-    def _notches(self) -> control.TransferFunction:
-        out = control.tf([1.0], [1.0])
-        for n in self.notches:
-            out = out * n.tf()
-        return out
+    def _derivative(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        if self.derivative_filter_hz is None:
+            return np.array([self.kd, 0.0]), np.array([1.0])
+        wd = 2.0 * math.pi * self.derivative_filter_hz
+        return np.array([self.kd, 0.0]), np.array([1.0 / wd, 1.0])
+
+    def _notches(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        num, den = np.array([1.0]), np.array([1.0])
+        for n in self.notches:  # a product, as python-control forms it
+            nn, dn = n.coefficients()
+            num, den = _sum(np.array([0.0]), np.array([1.0]), np.polymul(num, nn),
+                            np.polymul(den, dn))
+        return num, den
+
+    def coefficients(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Numerator and denominator of ``C(s)``, highest power first (the polynomials of
+        :meth:`tf`, formed as python-control forms the sum and products; improper for a pure
+        derivative).
+
+        Examples
+        --------
+        >>> from motionhyst.controllers.pid import Pid
+        >>> num, den = Pid(kp=2.0, ki=1.0, kd=0.5).coefficients()   # (0.5 s^2 + 2 s + 1) / s
+        >>> num.tolist(), den.tolist()
+        ([0.5, 2.0, 1.0], [1.0, 0.0])
+        """
+        num, den = self._pi()
+        if self.kd:
+            num, den = _sum(num, den, *self._derivative())
+        if self.notches:
+            nn, dn = self._notches()
+            num, den = _sum(np.array([0.0]), np.array([1.0]), np.polymul(num, nn),
+                            np.polymul(den, dn))
+        return np.trim_zeros(num, "f"), np.trim_zeros(den, "f")
 
     def tf(self) -> control.TransferFunction:
         """The continuous controller ``C(s)`` (improper for a pure derivative)."""
-        pi = control.tf([self.kp, self.ki], [1.0, 0.0]) if self.ki else control.tf(
-            [self.kp], [1.0])
-        c = pi + self._derivative() if self.kd else pi
-        c = c * self._notches() if self.notches else c
-        num, den = np.asarray(c.num[0][0], float), np.asarray(c.den[0][0], float)
-        return control.tf(np.trim_zeros(num, "f"), np.trim_zeros(den, "f"))
+        import control
+
+        return control.tf(*self.coefficients())
 
     def sampled(self, sample_rate_hz: float, method: str = "tustin",
                 prewarp_hz: float | None = None, delay_samples: float = 0.0,
@@ -178,18 +212,18 @@ class Pid:
         ([51.0, -50.0], [1.0, 0.0])
         """
         if self.proper:
-            num, den = discretize(self.tf(), sample_rate_hz, method, prewarp_hz)
+            num, den = discretize_coefficients(*self.coefficients(), sample_rate_hz, method,
+                                               prewarp_hz)
         else:
             T = 1.0 / float(sample_rate_hz)
-            rest = (control.tf([self.kp, self.ki], [1.0, 0.0]) if self.ki
-                    else control.tf([self.kp], [1.0]))
-            parts = [discretize(rest, sample_rate_hz, method, prewarp_hz)]
+            parts = [discretize_coefficients(*self._pi(), sample_rate_hz, method, prewarp_hz)]
             parts.append((np.array([self.kd / T, -self.kd / T]), np.array([1.0, 0.0])))
             (n1, d1), (n2, d2) = parts
             num = _add_asc(np.convolve(n1, d2), np.convolve(n2, d1))
             den = np.convolve(d1, d2)
             if self.notches:
-                nn, dn = discretize(self._notches(), sample_rate_hz, method, prewarp_hz)
+                nn, dn = discretize_coefficients(*self._notches(), sample_rate_hz, method,
+                                                 prewarp_hz)
                 num, den = np.convolve(num, nn), np.convolve(den, dn)
         return SampledController(num, den, sample_rate_hz=sample_rate_hz,
                                  delay_samples=delay_samples, u_max=u_max, continuous=self,
@@ -210,3 +244,7 @@ def _add_asc(a, b):
     n = max(len(a), len(b))
     return np.pad(a, (0, n - len(a))) + np.pad(b, (0, n - len(b)))
 
+
+def _sum(n1, d1, n2, d2):
+    """``n1 / d1 + n2 / d2`` over the product of the denominators, as python-control adds."""
+    return np.polyadd(np.polymul(n1, d2), np.polymul(n2, d1)), np.polymul(d1, d2)

@@ -44,14 +44,18 @@ array([1.     , 1.00029])
 from __future__ import annotations
 
 import math
-import warnings
+from typing import TYPE_CHECKING
 
-import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import BadCoefficients
 
-__all__ = ["DISCRETIZATIONS", "SampledController", "ascending", "discretize", "polyval_zinv"]
+from motionhyst.core.zoh import canonical_state_space
+
+if TYPE_CHECKING:  # imported where used: a sampled controller is built and checked without it
+    import control
+
+__all__ = ["DISCRETIZATIONS", "SampledController", "ascending", "discretize",
+           "discretize_coefficients", "polyval_zinv"]
 
 #: The discretisations of a continuous controller, the first the default.
 DISCRETIZATIONS = ("tustin", "tustin-prewarp", "zoh", "matched")
@@ -93,8 +97,13 @@ def ascending(sys: control.TransferFunction) -> tuple[NDArray[np.float64], NDArr
     >>> ascending(control.tf([2.0, 0.0], [2.0, -1.0], 0.1))   # 2 z / (2 z - 1)
     (array([1., 0.]), array([ 1. , -0.5]))
     """
-    num = np.trim_zeros(np.asarray(sys.num[0][0], float), "f")
-    den = np.trim_zeros(np.asarray(sys.den[0][0], float), "f")
+    return _ascending(sys.num[0][0], sys.den[0][0])
+
+
+def _ascending(num: ArrayLike, den: ArrayLike
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    num = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f")
+    den = np.trim_zeros(np.atleast_1d(np.asarray(den, float)), "f")
     if num.size == 0:
         num = np.zeros(1)
     if num.size > den.size:
@@ -144,6 +153,52 @@ def discretize(controller, sample_rate_hz: float, method: str = "tustin",
     >>> num.tolist(), den.tolist()                         # (T / 2) (1 + z^-1) / (1 - z^-1)
     ([0.0005, 0.0005], [1.0, -1.0])
     """
+    import control
+
+    if isinstance(controller, control.StateSpace):
+        controller = control.ss2tf(controller)
+    if not isinstance(controller, control.TransferFunction) or controller.isdtime(strict=True):
+        raise TypeError("only a continuous python-control LTI controller can be discretised")
+    return discretize_coefficients(controller.num[0][0], controller.den[0][0], sample_rate_hz,
+                                   method, prewarp_hz)
+
+
+def discretize_coefficients(num: ArrayLike, den: ArrayLike, sample_rate_hz: float,
+                            method: str = "tustin", prewarp_hz: float | None = None
+                            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`discretize` of the continuous controller ``C(s) = num(s) / den(s)``.
+
+    numpy and scipy's linear algebra alone: a scenario's sampled controller is known, and
+    its loop checked, before python-control (and scipy.signal) is imported.  The
+    coefficients are those of python-control's ``c2d`` (``tests/test_sampled_controllers.py``
+    compares them bit for bit): the same realisation
+    (:func:`~motionhyst.core.zoh.canonical_state_space`), bilinear map or exponential, and
+    the same polynomials of its eigenvalues back; ``"matched"`` maps the roots by
+    ``z = e^{s T}`` and keeps the gain at ``s = 0``.
+
+    Parameters
+    ----------
+    num, den : array_like
+        ``C(s)``, highest power first, proper.
+    sample_rate_hz : float
+        Sampling rate ``1 / T`` [Hz].
+    method : {"tustin", "tustin-prewarp", "zoh", "matched"}
+        The discretisation.
+    prewarp_hz : float, optional
+        For ``"tustin-prewarp"``.
+
+    Returns
+    -------
+    num, den : ndarray
+        ``C_d(z) = num(z^-1) / den(z^-1)``, ``den[0] = 1``.
+
+    Examples
+    --------
+    >>> from motionhyst.controllers.sampled import discretize_coefficients
+    >>> num, den = discretize_coefficients([1.0], [1.0, 1.0], 10.0, "zoh")   # 1 / (s + 1)
+    >>> [round(float(x), 6) for x in (*num, *den)]         # (1 - e^-T) z^-1 / (1 - e^-T z^-1)
+    [0.0, 0.095163, 1.0, -0.904837]
+    """
     if method not in DISCRETIZATIONS:
         raise ValueError(f"unknown discretization {method!r}; one of {', '.join(DISCRETIZATIONS)}")
     rate = _positive("sample_rate_hz", sample_rate_hz)
@@ -151,30 +206,61 @@ def discretize(controller, sample_rate_hz: float, method: str = "tustin",
     if (method == "tustin-prewarp") != (prewarp_hz is not None):
         raise ValueError("prewarp_hz goes with discretization = \"tustin-prewarp\" (the "
                          "frequency it maps exactly), and only with it")
-    if isinstance(controller, control.StateSpace):
-        controller = control.ss2tf(controller)
-    if not isinstance(controller, control.TransferFunction) or controller.isdtime(strict=True):
-        raise TypeError("only a continuous python-control LTI controller can be discretised")
-    num = np.trim_zeros(np.asarray(controller.num[0][0], float), "f")
-    den = np.trim_zeros(np.asarray(controller.den[0][0], float), "f")
+    num = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f")
+    den = np.trim_zeros(np.atleast_1d(np.asarray(den, float)), "f")
     if num.size > den.size:
         raise ValueError("the continuous controller must be proper to be discretised (a pure "
                          "derivative needs a filter)")
-    kwargs = {}
     if den.size == 1:  # a static gain is its own equivalent
         return np.array([num[0] / den[0]]) if num.size else np.zeros(1), np.ones(1)
+    dt = T
     if method == "tustin-prewarp":
         f = _positive("prewarp_hz", prewarp_hz)
         if f >= rate / 2:
             raise ValueError(f"prewarp_hz = {f:g} Hz must lie below the Nyquist frequency "
                              f"{rate / 2:g} Hz")
-        kwargs["prewarp_frequency"] = 2.0 * math.pi * f
-    pc_method = {"tustin": "tustin", "tustin-prewarp": "tustin", "zoh": "zoh",
-                 "matched": "matched"}[method]
-    with warnings.catch_warnings():  # scipy's note on wide-ranging coefficients
-        warnings.simplefilter("ignore", BadCoefficients)
-        sysd = control.c2d(control.tf(num, den), T, pc_method, **kwargs)
-    return ascending(sysd)
+        w = 2.0 * math.pi * f
+        dt = 2.0 * np.tan(w * T / 2.0) / w  # the step that maps w exactly
+    if method == "matched":
+        if den[-1] == 0.0:
+            raise ValueError('discretization = "matched" keeps the gain at s = 0, which a '
+                             'controller with an integrator has not: use "tustin" or "zoh"')
+        return _ascending(*_matched(num, den, T))
+    from scipy.linalg import expm, solve  # numpy's solve rounds otherwise (a triangular one)
+
+    A, B, C, D = canonical_state_space(num, den)
+    n = A.shape[0]
+    if method == "zoh":
+        M = np.zeros((n + 1, n + 1))
+        M[:n, :n], M[:n, n:] = A, B
+        E = expm(dt * M)[:n, :]
+        ad, bd, cd, dd = E[:, :n], E[:, n:], C, D
+    else:  # s = (2 / dt) (z - 1) / (z + 1)
+        eye = np.eye(n)
+        ima = eye - 0.5 * dt * A
+        ad = solve(ima, eye + 0.5 * dt * A)
+        bd = solve(ima, dt * B)
+        cd = solve(ima.T, C.T).T
+        dd = D + 0.5 * (C @ bd)
+    den_d = np.poly(ad)
+    return _ascending(np.poly(ad - bd @ cd) + (dd[0] - 1.0) * den_d, den_d)
+
+
+def _matched(num: NDArray[np.float64], den: NDArray[np.float64], T: float
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Zeros and poles mapped by ``z = e^{s T}``, the gain at ``s = 0`` kept (descending)."""
+    n = num / den[0]
+    big = np.flatnonzero(np.abs(n) > 1e-14)  # leading coefficients dropped as scipy's tf2zpk
+    n = n[big[0] if big.size else n.size - 1:]
+    zeros = [np.exp(s * T) for s in np.roots(n / n[0])]
+    poles = [np.exp(s * T) for s in np.roots(den / den[0])]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        zgain = np.multiply.reduce([1 - z for z in zeros]) / \
+            np.multiply.reduce([1 - p for p in poles])
+        s0 = np.zeros(1, complex)
+        gain = (np.polyval(num, s0) / np.polyval(den, s0))[0].real / zgain.real
+    return (np.atleast_1d(np.real(np.multiply(np.atleast_1d(gain), np.poly(zeros)))),
+            np.atleast_1d(np.real(np.poly(poles))))
 
 
 def _positive(name: str, value) -> float:
@@ -338,6 +424,8 @@ class SampledController:
         num, den = (self.y_num, self.y_den) if path == "y" else (self.r_num, self.r_den)
         n = max(num.size, den.size)
         pad = lambda c: np.concatenate([c, np.zeros(n - c.size)])  # noqa: E731
+        import control
+
         return control.tf(pad(num), pad(den), self.period)
 
     def state_space(self) -> tuple[NDArray[np.float64], NDArray[np.float64],

@@ -39,14 +39,13 @@ True
 from __future__ import annotations
 
 import math
-import warnings
 
 import control
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import BadCoefficients
 
 from motionhyst.core.lti import expm_small
+from motionhyst.core.zoh import canonical_state_space, held_rest, held_state_space, rigid_split
 
 __all__ = ["HeldInputFilter", "ZohEquivalent", "hold_mismatch", "hold_response",
            "unit_circle_minus_one"]
@@ -142,36 +141,6 @@ def hold_mismatch(omega: ArrayLike, period: float, lag_samples: float = 0.0
     return one_minus_q - q * unit_circle_minus_one(-th * lag_samples)
 
 
-def _rigid_split(num: NDArray[np.float64], den: NDArray[np.float64]):
-    """``num / den = a2 / s^2 + a1 / s + rest``: the coefficients and the rest's polynomials."""
-    num = np.trim_zeros(np.asarray(num, float), "f")
-    den = np.trim_zeros(np.asarray(den, float), "f")
-    m = 0
-    while den.size > 1 and den[-1] == 0.0:
-        den, m = den[:-1], m + 1
-    while m > 0 and num.size > 1 and num[-1] == 0.0:
-        num, m = num[:-1], m - 1
-    if m > 2:
-        raise ValueError("a plant with more than two integrators cannot be sampled here")
-    # Taylor coefficients of num / den0 at s = 0: c0, c1
-    n0 = num[-1]
-    n1 = num[-2] if num.size > 1 else 0.0
-    d0, d1 = den[-1], (den[-2] if den.size > 1 else 0.0)
-    c0 = n0 / d0
-    c1 = (n1 - c0 * d1) / d0
-    a = {2: (c0, c1), 1: (0.0, c0), 0: (0.0, 0.0)}[m]
-    # rest = num / (s^m den0) - a2 / s^2 - a1 / s, over s^m den0; the low coefficients vanish
-    sub = np.zeros(1)
-    if m == 2:
-        sub = np.polyadd(np.polymul([a[1], a[0]], den), np.zeros(1))
-    elif m == 1:
-        sub = a[1] * den
-    rest_num = np.polysub(num, sub)
-    if m:
-        rest_num = rest_num[:-m] if rest_num.size > m else np.zeros(1)
-    return a[0], a[1], rest_num, den
-
-
 class ZohEquivalent:
     """Pulse transfer function ``G_d(z)`` of a plant behind a delayed zero-order hold.
 
@@ -223,32 +192,18 @@ class ZohEquivalent:
         self.delay_samples = float(delay_samples)
         self.whole = math.floor(self.delay_samples)
         self.phi = self.delay_samples - self.whole
-        self.a2, self.a1, rest_num, rest_den = _rigid_split(num, den)
+        self.a2, self.a1, rest_num, rest_den = rigid_split(num, den)
         self._rest = None
         if np.any(rest_num != 0.0):
-            with warnings.catch_warnings():  # scipy's note on wide-ranging coefficients
-                warnings.simplefilter("ignore", BadCoefficients)
-                sys = control.tf2ss(control.tf(rest_num, rest_den))
-            A, B, C = np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C)
-            n = A.shape[0]
-            T, phi = self.period, self.phi
-
-            def integral(tau):  # exp(A tau) and int_0^tau exp(A s) ds B
-                M = np.zeros((n + 1, n + 1))
-                M[:n, :n], M[:n, n:] = A * tau, B * tau
-                E = expm_small(M)
-                return E[:n, :n], E[:n, n]
-
-            Phi, _ = integral(T)
-            Eb, gb = integral((1.0 - phi) * T)
-            _, ga = integral(phi * T)
-            self._rest = (Phi, Eb @ ga, gb, C[0])
+            A, B, C, _ = canonical_state_space(rest_num, rest_den)  # python-control's tf2ss
+            self._rest = held_rest(A, B, C, self.period, self.phi, expm_small)
+            Phi, Ebga, gb, _ = self._rest
             # partial fractions over Phi's eigenvalues: sum (ra z^-1 + rb) / (z - lambda)
             lam, V = np.linalg.eig(Phi)
             self._modal = None
             if np.linalg.cond(V) < 1e8:
                 cv = C[0] @ V
-                self._modal = (lam, cv * np.linalg.solve(V, Eb @ ga), cv * np.linalg.solve(V, gb))
+                self._modal = (lam, cv * np.linalg.solve(V, Ebga), cv * np.linalg.solve(V, gb))
 
     def state_space(self) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                    NDArray[np.float64], NDArray[np.float64]]:
@@ -265,27 +220,7 @@ class ZohEquivalent:
         >>> Phi.tolist(), ga.tolist(), gb.tolist(), C.tolist()      # 1 / s
         ([[1.0]], [0.025], [0.075], [1.0])
         """
-        T, phi = self.period, self.phi
-        tb = (1.0 - phi) * T
-        blocks = []
-        if self.a2 or self.a1:
-            rigid = (np.array([[1.0, T], [0.0, 1.0]]),
-                     np.array([(phi * T) ** 2 / 2.0 + tb * phi * T, phi * T]),
-                     np.array([tb**2 / 2.0, tb]), np.array([self.a2, self.a1]))
-            if not self.a2:  # 1 / s alone: the velocity state
-                rigid = tuple(np.atleast_2d(x[1:, 1:]) if x.ndim == 2 else x[1:]
-                              for x in rigid)
-            blocks.append(rigid)
-        if self._rest is not None:
-            blocks.append(self._rest)
-        n = sum(b[0].shape[0] for b in blocks)
-        Phi, ga, gb, C = np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n)
-        i = 0
-        for P, a, b, c in blocks:
-            k = P.shape[0]
-            Phi[i:i + k, i:i + k], ga[i:i + k], gb[i:i + k], C[i:i + k] = P, a, b, c
-            i += k
-        return Phi, ga, gb, C
+        return held_state_space(self.a2, self.a1, self._rest, self.period, self.phi)
 
     def __call__(self, omega: ArrayLike) -> NDArray[np.complex128]:
         """``G_d(e^{j w T})``, the delay included.

@@ -23,6 +23,7 @@ from pydantic import ValidationError
 
 from motionhyst.controllers.characteristic import (
     as_transfer,
+    check_sampled_stable,
     check_stable,
     leadlag_coefficients,
     loop_denominator,
@@ -58,6 +59,7 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
     import control
 
     from motionhyst.controllers.loop import Loop
+    from motionhyst.controllers.pid import Pid
     from motionhyst.controllers.sampled import SampledController
     from motionhyst.plants.frf_fit import FrfFit
     from motionhyst.plants.registry import Plant
@@ -294,13 +296,41 @@ class Scenario:
     def controller(self) -> control.TransferFunction | SampledController:
         """The feedback controller: continuous, or sampled with ``sample_rate_hz``."""
         self._closed("a controller")
+        c = self.model.controller
+        try:
+            sampled = self._sampled_controller()
+        except ValueError as exc:  # a discretisation the controller does not allow
+            raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
+        if sampled is not None and c.type in ("tf-z", "two-dof-z", "pid"):
+            return sampled
         import control
 
         from motionhyst.controllers.leadlag import LeadLagLowpass
+
+        if c.type == "pid":
+            return self._pid().tf()
+        cont = (LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta) if c.type == "leadlag-lowpass"
+                else control.tf(c.num, c.den))
+        if sampled is None:
+            return cont
+        sampled.continuous = cont  # for reports (its own table)
+        return sampled
+
+    def _pid(self) -> Pid:
         from motionhyst.controllers.pid import Notch, Pid
-        from motionhyst.controllers.sampled import SampledController
 
         c = self.model.controller
+        return Pid(c.kp, c.ki, c.kd, c.derivative_filter_hz,
+                   tuple(Notch(n.frequency_hz, n.zeta_zero, n.zeta_pole) for n in c.notches))
+
+    def _sampled_controller(self) -> SampledController | None:
+        """The controller with ``sample_rate_hz`` (a continuous one discretised), None for a
+        continuous one: from the coefficients, without python-control."""
+        from motionhyst.controllers.sampled import SampledController, discretize_coefficients
+
+        c = self.model.controller
+        if c.sample_rate_hz is None:
+            return None
         delay = c.delay_samples or 0.0
         if c.type == "tf-z":
             return SampledController(c.num, c.den, sample_rate_hz=c.sample_rate_hz,
@@ -311,17 +341,13 @@ class Scenario:
                                      delay_samples=delay, u_max=c.u_max)
         method = c.discretization or "tustin"
         if c.type == "pid":
-            pid = Pid(c.kp, c.ki, c.kd, c.derivative_filter_hz,
-                      tuple(Notch(n.frequency_hz, n.zeta_zero, n.zeta_pole) for n in c.notches))
-            if c.sample_rate_hz is None:
-                return pid.tf()
-            return pid.sampled(c.sample_rate_hz, method, c.prewarp_hz, delay, c.u_max)
-        cont = (LeadLagLowpass(c.K, c.f1, c.f2, c.flp, c.beta) if c.type == "leadlag-lowpass"
-                else control.tf(c.num, c.den))
-        if c.sample_rate_hz is None:
-            return cont
-        return SampledController.discretize(cont, c.sample_rate_hz, method, c.prewarp_hz,
-                                            delay, c.u_max)
+            return self._pid().sampled(c.sample_rate_hz, method, c.prewarp_hz, delay, c.u_max)
+        num, den = (leadlag_coefficients(c.K, c.f1, c.f2, c.flp, c.beta)
+                    if c.type == "leadlag-lowpass" else (c.num, c.den))
+        return SampledController(
+            *discretize_coefficients(num, den, c.sample_rate_hz, method, c.prewarp_hz),
+            sample_rate_hz=c.sample_rate_hz, delay_samples=delay, u_max=c.u_max,
+            discretization=method)
 
     def _derivative_terms(self, sec: FeedforwardSection) -> dict[str, float]:
         """``[feedforward]`` jerk and snap, ``"plant"`` taken from the plant's inverse."""
@@ -336,14 +362,15 @@ class Scenario:
             out = {k: getattr(inverse, k) if v == "plant" else v for k, v in out.items()}
         return out
 
-    def _coefficients(self) -> tuple[NDArray[np.float64], ...] | None:
-        """``n1, d1, n2, d2, nc, dc`` of ``P1``, ``P2`` and the controller as the loop will
-        hold them, where they are known without python-control: a ``[stage]`` that gives its
-        polynomials and a continuous lead-lag or ``"tf"`` controller; else None."""
+    def _coefficients(self) -> tuple | None:
+        """``n1, d1, n2, d2`` of ``P1`` and ``P2`` as the loop will hold them and the
+        controller, ``nc, dc`` (continuous) or a :class:`SampledController`, where they are
+        known without python-control: a ``[stage]`` that gives its polynomials, and a
+        controller whose loop gain is strictly proper (continuous); else None."""
         m = self.model
         c = m.controller
-        if m.stage is None or c.sample_rate_hz is not None or \
-                c.type not in ("leadlag-lowpass", "tf"):
+        if m.stage is None or c.type not in ("leadlag-lowpass", "tf", "pid", "tf-z",
+                                             "two-dof-z"):
             return None
         plant = self.plant()
         if not hasattr(plant, "polynomials") or plant.force_offset or \
@@ -351,20 +378,32 @@ class Scenario:
             return None  # the loop's own errors come first
         n1, n2, den = plant.polynomials()
         (n1, d1), (n2, d2) = as_transfer(n1, den), as_transfer(n2, den)
-        nc, dc = as_transfer(*(leadlag_coefficients(c.K, c.f1, c.f2, c.flp, c.beta)
-                               if c.type == "leadlag-lowpass" else (c.num, c.den)))
+        try:
+            sampled = self._sampled_controller()
+            if sampled is not None:
+                return n1, d1, n2, d2, sampled
+            nc, dc = as_transfer(*(self._pid().coefficients() if c.type == "pid" else
+                                   leadlag_coefficients(c.K, c.f1, c.f2, c.flp, c.beta)
+                                   if c.type == "leadlag-lowpass" else (c.num, c.den)))
+        except ValueError:
+            return None  # the controller's own errors come with the loop
         if not strictly_proper(n2, d2, nc, dc):
             return None
         return n1, d1, n2, d2, nc, dc
 
-    def _checked_denominator(self, coefficients: tuple[NDArray[np.float64], ...],
-                             link: Hysteresis | None) -> NDArray[np.float64]:
+    def _checked_denominator(self, coefficients: tuple, link: Hysteresis | None
+                             ) -> NDArray[np.float64] | None:
         """The loop's characteristic polynomial (:func:`loop_denominator`) from its
         `coefficients` (:meth:`_coefficients`), its stability with `link` checked as
-        :meth:`Loop.check_stable` does."""
-        n1, d1, n2, d2, nc, dc = coefficients
-        den = loop_denominator(n2, d2, nc, dc)
+        :meth:`Loop.check_stable` does; None for a sampled controller (checked as well)."""
         try:
+            if len(coefficients) == 5:  # sampled: the loop's poles are those of z
+                n1, d1, n2, d2, sampled = coefficients
+                check_sampled_stable(n2, d2, sampled, None if link is None else (
+                    n1, d1, link.initial_stiffness))
+                return None
+            n1, d1, n2, d2, nc, dc = coefficients
+            den = loop_denominator(n2, d2, nc, dc)
             check_stable(den, None if link is None else stuck_characteristic(
                 n1, d1, n2, d2, nc, dc, link.initial_stiffness))
         except ValueError as exc:
@@ -374,8 +413,9 @@ class Scenario:
     def fastest_pole(self) -> float | None:
         """The largest magnitude of the loop's closed-loop poles [rad/s]
         (:meth:`Loop.closed_loop_poles`), known before the loop is built where the
-        coefficients give it (a ``[stage]`` and a continuous lead-lag or ``"tf"``
-        controller), else None.  Raises :class:`ScenarioError` if the loop is unstable.
+        coefficients give it (a ``[stage]`` and a continuous lead-lag, ``"tf"`` or PID
+        controller), else None.  Raises :class:`ScenarioError` if the loop is unstable
+        (checked also for a sampled controller).
 
         Examples
         --------
@@ -391,7 +431,7 @@ class Scenario:
         if coefficients is None:
             return None
         den = self._checked_denominator(coefficients, self.hysteresis())
-        return float(np.max(np.abs(np.roots(den))))
+        return None if den is None else float(np.max(np.abs(np.roots(den))))
 
     def loop(self) -> Loop:
         """The loop (built once, checked for stability)."""
