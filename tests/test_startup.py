@@ -185,6 +185,8 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     ([*SCAN, "--ilc-gain", "2"], "--ilc-gain must be in (0, 2)"),
     ([*SCAN, "--compensation", "none", "--ilc-gain", "0.5"], "--ilc-gain has no effect"),
     ([*SCAN, "--at", "nan"], "--at must be finite"),
+    ([*SCAN, "--compensation", "model"], "--compensation model needs a [feedforward]"),
+    ([*SCAN, "--feedforward", "hysteresis"], "--feedforward hysteresis needs a [feedforward]"),
     ([*SCAN, "--window", "1"], "exposure window (1 s) is longer than the scan"),
     ([*SCAN, "--time-series", "paper.toml"], "it is an input of this command"),
     (["scan", "paper.toml", "--length", "1e6", "--speed", "0.1", "--a-max", "10", "--j-max",
@@ -205,6 +207,8 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     (["analyze", "unstable-tfz.toml"], "the sampled controller does not stabilise the loop"),
     (["steady", "unstable-pid.toml"], "does not stabilise the loop (closed-loop pole at 380+4218j"),
     ([*SCAN[:1], "unstable-10k.toml", *SCAN[2:]], "the sampled controller does not stabilise"),
+    (["simulate", "unstable-10k.toml", "--time-series", "o.csv", "--frequency", "5"],
+     "the sampled controller does not stabilise"),
     ([*SCAN, "--rate", "1e-3"], "248898681 time steps of 3.62e-05 s: too many"),  # the poles'
     (["steady", "slip.toml"], "[hysteresis] k: 100001 values, more than the 100000"),
     (["stability", "open.toml"], "needs a closed loop"),

@@ -192,13 +192,30 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
     if controller is None:  # no loop: the scenario's own refusal comes first
         return
     rate = getattr(controller, "sample_rate_hz", None)
-    pole = sc.fastest_pole() if rate is None else None
+    pole = sc.fastest_pole()  # None when sampled: its loop is checked all the same
     runs = len(args.compensation or ["none", "ilc", "basis"])  # model: only with a model
     for p in (profile, other):
         if p is not None:
             step = (longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
                     if pole is None else pole_step(pole, p.max_frequency_hz))
             check_scan_steps(p.end + args.tail, step, runs, at_least=pole is None)
+
+
+def _check_model_terms(args: argparse.Namespace, sc) -> None:
+    """Refuse, before the loop is built, a model compensation the scenario's ``[feedforward]``
+    gives no term for (the checks of :func:`run` once the loop is built, where its section
+    alone decides them)."""
+    sec = sc.model.feedforward
+    if sec is None or sc.model.controller is None:
+        return  # no loop: the scenario's own refusal comes first
+    if "hysteresis" in (args.feedforward or []) and sec.hysteresis is None:
+        raise UsageError(f"{PROG}: --feedforward hysteresis needs a [feedforward] hysteresis "
+                         f"model, and {sc.source} has none")
+    given = sec.hysteresis is not None or (  # the terms of scan_terms(loop)
+        sec.type != "none" and any(getattr(sec, t, None) for t in TERMS[:-1]))
+    if args.feedforward is None and "model" in (args.compensation or []) and not given:
+        raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
+                         f"model or feedforward terms (--feedforward), and {sc.source} has none")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -215,6 +232,7 @@ def run(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario, check=False)
     _check_options(args)
     out = _output(args)
+    _check_model_terms(args, sc)
     profile, other = _profiles(args)
     _check_steps(args, sc, profile, other)
     loop = sc.loop()

@@ -105,7 +105,7 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> None:
     output_rate = args.output_rate or rate or (reference_rate_hz(ref) if sampled
                                                else DEFAULT_OUTPUT_RATE_HZ)
     f = 0.0 if sampled else float(getattr(ref, "max_frequency_hz", 0.0) or 0.0)
-    pole = sc.fastest_pole() if rate is None else None
+    pole = sc.fastest_pole()  # None when sampled: its loop is checked all the same
     if pole is not None:
         step = pole_step(pole, f)
     else:
