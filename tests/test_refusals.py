@@ -63,3 +63,34 @@ def test_an_identification_nested_too_deeply_is_refused_naming_it(tmp_path, monk
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "deep.json: JSON nested too deeply" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["deep.json", "paper.toml", "s.toml"]
+
+
+def test_a_dahl_shape_exponent_past_its_range_is_refused_by_df(capsys):
+    """``df --model dahl --alpha 1e25`` printed a describing function of 2e-20 N/m with a
+    negative imaginary part: past about 1e15 the closed form has no digit left."""
+    args = ["df", "--model", "dahl", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]
+    assert main([*args, "--alpha", "1e25"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert "--alpha" in err and "less than or equal to 100" in err
+    assert main([*args, "--alpha", "100", "--json"]) == 0      # the bound itself is taken
+    assert '"alpha": 100.0' in capsys.readouterr().out
+
+
+def test_a_dahl_shape_exponent_past_its_range_is_refused_by_a_scenario():
+    import tomllib
+
+    from motionhyst import Dahl, Scenario, ScenarioError
+    from motionhyst.scenario import default_scenario_path
+
+    data = tomllib.loads(default_scenario_path().read_text())
+    data["hysteresis"] = {"model": "dahl", "k": 20.0, "fc": 0.05, "alpha": 1e3}
+    with pytest.raises(ScenarioError, match=r"\[hysteresis\] alpha: Input should be less "
+                                            r"than or equal to 100"):
+        Scenario.from_dict(data, "s.toml", check=False)
+    # Bouc-Wen's alpha (its general form's stiffness) is another parameter: not bound
+    data["hysteresis"] = {"model": "bouc-wen", "alpha": 5e4, "beta": 1e3, "gamma": 0.8,
+                          "delta": -1.1, "nu": 1.0}
+    Scenario.from_dict(data, "s.toml", check=False)
+    # the class itself takes it (an identification's search is not bound)
+    assert Dahl(k=20.0, fc=0.05, alpha=1e3).alpha == 1e3

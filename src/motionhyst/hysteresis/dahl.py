@@ -52,7 +52,11 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
     fc : float
         Coulomb (saturation) force [N], > 0.
     alpha : float
-        Shape exponent ``i`` of Dahl's model [-], > 0 (1 in most uses).
+        Shape exponent ``i`` of Dahl's model [-], > 0 (1 in most uses).  A scenario and
+        ``motionhyst df`` take at most :attr:`ALPHA_MAX`: past ``alpha = 1`` the force needs
+        a travel of ``(2^(alpha - 1) - 1) / (alpha - 1) fc / k`` to reach ``fc / 2`` (57
+        ``fc / k`` at 10, 6e27 at 100), and past about 1e15 the closed form below loses every
+        digit, so a larger one is a slip, not a link.
 
     Examples
     --------
@@ -66,9 +70,12 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
     name = "dahl"
     n_states = 1
     rate_independent = True
+    ALPHA_MAX = 100.0
+    """The largest shape exponent a scenario or ``motionhyst df`` takes (see `alpha`)."""
     parameters = (Parameter("k", "N/m", "spring stiffness k"),
                   Parameter("fc", "N", "slip (Coulomb) force f_c"),
-                  Parameter("alpha", "", "shape exponent alpha", 1.0))
+                  Parameter("alpha", "", "shape exponent alpha (at most 100 for dahl)", 1.0,
+                            maximum=ALPHA_MAX))
 
     def __init__(self, k: float, fc: float, alpha: float = 1.0) -> None:
         super().__init__()

@@ -54,6 +54,10 @@ class Parameter:
         ``p x`` (damper ``p dx/dt``) in parallel with the rest of the link:
         on a stage with its own spring and damper its effect cannot be told
         from the stage's (input-output identification fixes it at 0).
+    maximum : float, optional
+        The largest value a scenario or ``motionhyst df`` accepts, where the model stops
+        describing a link (a typing slip, not a design: refused, naming it); None: no bound.
+        An identification's search is not bound by it.
 
     Examples
     --------
@@ -69,6 +73,7 @@ class Parameter:
     kind: ParameterKind = "positive"
     many: bool = False
     parallel: Literal["", "spring", "damper"] = ""
+    maximum: float | None = None
 
     @property
     def required(self) -> bool:

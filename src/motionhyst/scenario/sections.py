@@ -247,6 +247,8 @@ def _link_section(name: str, cls: type[Hysteresis], form: Form | None = None
     fields: dict = {"model": (Literal[name], ...)}
     for p in cls.parameters if form is None else form.parameters:
         t = _FIELD_TYPES[p.kind]
+        if p.maximum is not None:
+            t = Annotated[t, Field(le=p.maximum)]
         default = ... if p.required else p.default
         if p.many:  # a list; one with a default (a tuple) may be empty
             t = Annotated[list[t], Field(min_length=1 if p.required else 0)]
