@@ -127,7 +127,8 @@ def _parameter_table(parameters: tuple, df_options: bool = True) -> list[str]:
              f"   * - {head[0]}", *(f"     - {h}" for h in head[1:])]
     for p in parameters:
         option = "--" + p.name.replace("_", "-") + (" ..." if p.many else "")
-        rng = RANGES[p.kind] + (", each" if p.many else "")
+        rng = RANGES[p.kind] + ("" if p.maximum is None else f", <= {p.maximum:g}") + (
+            ", each" if p.many else "")
         cells = [_key(p), f"``{option}``", p.unit or "-", _default(p), rng, p.help]
         if not df_options:
             del cells[1]

@@ -74,7 +74,7 @@ class Dahl(NormalisedRateIndependent, Hysteresis):
     """The largest shape exponent a scenario or ``motionhyst df`` takes (see `alpha`)."""
     parameters = (Parameter("k", "N/m", "spring stiffness k"),
                   Parameter("fc", "N", "slip (Coulomb) force f_c"),
-                  Parameter("alpha", "", "shape exponent alpha (at most 100 for dahl)", 1.0,
+                  Parameter("alpha", "", "shape exponent alpha (dahl: at most 100)", 1.0,
                             maximum=ALPHA_MAX))
 
     def __init__(self, k: float, fc: float, alpha: float = 1.0) -> None:
