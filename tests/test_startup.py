@@ -392,3 +392,18 @@ def test_import_motionhyst_before_the_entry_handles_signals_imports_little():
     new = {m for m in json.loads(proc.stdout) if not m.startswith("motionhyst")}
     assert new <= {"__future__", "importlib", "importlib._bootstrap",
                    "importlib._bootstrap_external", "importlib.machinery", "types", "warnings"}
+
+
+def test_a_signal_ignored_by_the_parent_stays_ignored_before_the_handlers(tmp_path):
+    """nohup (SIGINT and SIGTERM ignored): the entry installs nothing over them, and the
+    command runs to its end."""
+    import signal
+
+    def ignore():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+
+    proc = subprocess.run([sys.executable, "-c", _EARLY, "SIGTERM"], capture_output=True,
+                          text=True, cwd=tmp_path, timeout=600, check=False, preexec_fn=ignore)
+    assert proc.returncode == 0, proc.stderr
+    assert "Describing function of the jenkins element" in proc.stdout
