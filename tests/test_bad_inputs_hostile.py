@@ -1,11 +1,12 @@
 """The hostile corpus (issue 26, the further cases): output names, empty values, signals.
 
-Each refusal runs the command line in a folder holding the user's files and
-asserts exit code 2, one line on stderr without a traceback, nothing on
-stdout, and that every file that was there before is byte-identical
-afterwards, with no file added.  The signal cases run the command in a child
-process and send SIGTERM as a service manager or ``kill`` would: exit 130,
-one line, the old files intact and no temporary file left.
+Each refusal runs the command line in a child process whose address space is
+limited (``RLIMIT_AS``, :mod:`limited_process`), in a folder holding the
+user's files, and asserts exit code 2, one line on stderr without a
+traceback, nothing on stdout, and that every file that was there before is
+byte-identical afterwards, with no file added.  The signal cases send SIGTERM
+as a service manager or ``kill`` would: exit 130, one line, the old files
+intact and no temporary file left.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import time
 import types
 from pathlib import Path
 
+import limited_process
 import numpy as np
 import pytest
 from file_trees import populate, snapshot
@@ -32,8 +34,8 @@ MODEL = ('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
          '[hysteresis]\nmodel = "jenkins"\nk = 100.0\nfc = 1.0\n')
 
 
-def _force() -> str:
-    t = np.arange(300) / 750.0
+def _force(n: int = 300) -> str:
+    t = np.arange(n) / 750.0
     return "time,force\n" + "".join(f"{a!r},{np.sin(i / 10):.6f}\n"
                                      for i, a in enumerate(t.tolist()))
 
@@ -109,15 +111,12 @@ def test_the_cases_are_distinct():
 
 @pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
                          ids=[c[0] for c in CASES])
-def test_hostile_input_is_exit_2_one_line_and_touches_nothing(tmp_path, monkeypatch, capsys,
-                                                              files, argv, words):
+def test_hostile_input_is_exit_2_one_line_and_touches_nothing(tmp_path, files, argv, words):
     root = tmp_path / "user"
     root.mkdir()
     populate(root, {**BASE, **files})
-    monkeypatch.chdir(root)
     before = snapshot(root)
-    code = main(list(argv))
-    out, err = capsys.readouterr()
+    code, out, err = limited_process.run(list(argv), root)
     assert code == 2, (code, out, err)
     assert out == ""
     line = err.strip()
@@ -126,6 +125,28 @@ def test_hostile_input_is_exit_2_one_line_and_touches_nothing(tmp_path, monkeypa
         assert word in line, (word, line)
     assert snapshot(root) == before  # nothing changed, nothing added
     assert [p.name for p in tmp_path.iterdir()] == ["user"]
+
+
+@pytest.mark.parametrize(("budget", "words"), [
+    (None, ["needs 9.6 GB, above the memory budget of", "fewer samples or substeps"]),
+    ("64G", ["out of memory"]),
+], ids=["own-budget", "budget-past-the-limit"])
+def test_the_memory_limit_bites_on_a_case_that_needs_more(tmp_path, budget, words):
+    """The limit of these tests means something: a prediction of 20000 samples of 10000
+    integration steps each (9.6 GB) is refused by its own budget, which follows the limit;
+    with its budget raised past the limit it meets the limit itself: a MemoryError, still one
+    line and exit 2, and nothing written."""
+    populate(tmp_path, {"model.toml": MODEL, "f.csv": _force(20_000)})
+    before = snapshot(tmp_path)
+    argv = ["predict", "model.toml", "f.csv", "--out", "p.csv", "--substeps", "10000"]
+    code, out, err = limited_process.run(argv + (["--max-memory", budget] if budget else []),
+                                         tmp_path)
+    assert code == 2 and out == "", (code, out, err)
+    line = err.strip()
+    assert line and "\n" not in line and "Traceback" not in line, err
+    for word in words:
+        assert word in line, (word, line)
+    assert snapshot(tmp_path) == before
 
 
 def test_a_folder_that_takes_no_file_is_refused_by_trying_one(tmp_path):
@@ -138,13 +159,6 @@ def test_a_folder_that_takes_no_file_is_refused_by_trying_one(tmp_path):
     for make in (lambda: OutputFile("/proc/o.csv"), lambda: OutputFolder("/proc/out", ["a"])):
         with pytest.raises(OutputError, match="/proc"):
             make()
-
-
-_MAIN = ("import sys\n"
-         "from motionhyst.core.compiled import quiet_compilation\n"
-         "quiet_compilation()\n"
-         "from motionhyst.cli import main\n"
-         "sys.exit(main(sys.argv[1:]))\n")
 
 
 def _started(proc: subprocess.Popen, module: str, timeout: float = 120.0) -> None:
@@ -173,8 +187,7 @@ def test_sigterm_before_any_file_is_written_is_exit_130_and_touches_nothing(tmp_
     root.mkdir()
     populate(root, BASE)
     before = snapshot(tmp_path)
-    proc = subprocess.Popen([sys.executable, "-c", _MAIN, *argv], cwd=root,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = limited_process.popen(argv, root)
     _started(proc, "_multiarray_umath")  # numpy loaded: the command is under way
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=120)
@@ -342,13 +355,11 @@ BAD_CSV = {  # what no dialect reads as the numbers meant: one line naming the p
 
 
 @pytest.mark.parametrize(("text", "word"), BAD_CSV.values(), ids=BAD_CSV.keys())
-def test_a_record_no_dialect_reads_is_refused_in_one_line(tmp_path, monkeypatch, capsys,
-                                                            text, word):
+def test_a_record_no_dialect_reads_is_refused_in_one_line(tmp_path, text, word):
     populate(tmp_path, {"r.csv": text, "model.toml": MODEL})
-    monkeypatch.chdir(tmp_path)
     before = snapshot(tmp_path)
-    code = main(["predict", "model.toml", "r.csv", "--out", "p.csv"])
-    out, err = capsys.readouterr()
+    code, out, err = limited_process.run(["predict", "model.toml", "r.csv", "--out", "p.csv"],
+                                         tmp_path)
     assert code == 2 and out == "", (code, out, err)
     line = err.strip()
     assert line and "\n" not in line and "Traceback" not in line, err
@@ -397,12 +408,13 @@ def test_a_mat_variable_of_another_type_is_read_as_its_values_or_refused(tmp_pat
 
 @pytest.mark.parametrize("variable", ["MOTIONHYST_MAX_MEMORY", "MOTIONHYST_MAX_SECONDS"])
 @pytest.mark.parametrize("value", ["garbage", "nan", "-1", "1e400"])
-def test_a_budget_variable_that_is_no_size_is_refused_by_every_command(monkeypatch, capsys,
-                                                                       variable, value):
+def test_a_budget_variable_that_is_no_size_is_refused_by_every_command(tmp_path, variable,
+                                                                       value):
     """Not only by the commands whose computation consults the budget (df never does)."""
-    monkeypatch.setenv(variable, value)
-    assert main(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"]) == 2
-    out, err = capsys.readouterr()
+    code, out, err = limited_process.run(["df", "--k", "20", "--fc", "0.05", "--amplitude",
+                                          "0.01"], tmp_path,
+                                         env=limited_process.environment(**{variable: value}))
+    assert code == 2
     assert out == "" and err.strip() == err.strip().splitlines()[0]
     assert variable in err
 
@@ -417,11 +429,10 @@ def test_a_refusal_keeps_its_exit_code_when_stderr_cannot_be_written(monkeypatch
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
 def test_output_to_a_full_disk_is_exit_2_in_plain_words(tmp_path):
     with open("/dev/full", "w") as full:
-        done = subprocess.run([sys.executable, "-c", _MAIN, "df", "--k", "20", "--fc", "0.05",
-                               "--amplitude", "0.01"], stdout=full, stderr=subprocess.PIPE,
-                              cwd=tmp_path, timeout=120)
-    assert done.returncode == 2
-    assert done.stderr.decode().strip() == "motionhyst: error: No space left on device"
+        code, _, err = limited_process.run(["df", "--k", "20", "--fc", "0.05", "--amplitude",
+                                            "0.01"], tmp_path, stdout=full, timeout=120)
+    assert code == 2
+    assert err.strip() == "motionhyst: error: No space left on device"
 
 
 def test_a_work_budget_beyond_a_timer_is_no_limit(tmp_path, monkeypatch, capsys):

@@ -1,0 +1,74 @@
+"""A command line run in a child process whose address space is limited (``RLIMIT_AS``).
+
+Shared by the bad-input tests: a command that would allocate past the limit gets a
+MemoryError (one line, exit 2) instead of growing until the kernel kills it, so a test that
+passes under the limit shows the command's memory is bounded.  The child runs with one BLAS
+and OpenMP thread, so that the limit measures the command and not the machine's core count
+(each thread reserves a stack and buffers of address space).
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+REFUSAL_LIMIT = 1 << 30
+"""Address space [bytes] for a command that is refused or runs a small case: the commands of
+the hostile corpus peak at 0.15-0.71 GB (VmPeak, numba compiling its kernels included)."""
+
+MAIN = ("import sys\n"
+        "from motionhyst.core.compiled import quiet_compilation\n"
+        "quiet_compilation()\n"
+        "from motionhyst.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n")
+"""The console script, without the notice of a first compilation."""
+
+ONE_THREAD = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                     "MKL_NUM_THREADS")}
+
+
+def environment(**changes: str | None) -> dict[str, str]:
+    """The test's environment without a memory budget of the caller's, one BLAS thread, and
+    `changes` (a value None removes the variable)."""
+    env = {k: v for k, v in os.environ.items() if k != "MOTIONHYST_MAX_MEMORY"}
+    env.update(ONE_THREAD)
+    for name, value in changes.items():
+        if value is None:
+            env.pop(name, None)
+        else:
+            env[name] = value
+    return env
+
+
+def _limiter(limit: int):
+    def limit_address_space() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    return limit_address_space
+
+
+def popen(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,
+          env: dict[str, str] | None = None, **kwargs) -> subprocess.Popen:
+    """``motionhyst argv`` started in `cwd` under an address-space limit of `limit` bytes
+    (its stdout and stderr pipes unless `kwargs` say otherwise)."""
+    kwargs = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE, **kwargs}
+    return subprocess.Popen([sys.executable, "-c", MAIN, *argv], cwd=cwd,
+                            env=environment() if env is None else env,
+                            preexec_fn=_limiter(limit), **kwargs)
+
+
+def run(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,
+        env: dict[str, str] | None = None, timeout: float = 600.0,
+        **kwargs) -> tuple[int, str, str]:
+    """``motionhyst argv`` run to its end in `cwd` under `limit`: exit code, stdout, stderr."""
+    proc = popen(argv, cwd, limit, env, **kwargs)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    return (proc.returncode, (out or b"").decode("utf-8", errors="replace"),
+            (err or b"").decode("utf-8", errors="replace"))
