@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import tomllib
+
 import numpy as np
 import pytest
 
@@ -53,7 +55,10 @@ def test_offsets_and_initial_state_are_estimated_by_default(axis_fit):
     assert axis_fit.extra["offsets"]["input"] == axis_fit.estimates["input_offset"]
     assert axis_fit.warnings == []
     text = axis_fit.scenario_text()
-    assert "force_offset = 2.99999" in text and "# position offset" in text
+    saved = tomllib.loads(text)["stage"]["force_offset"]  # the number, not its digits
+    assert saved == pytest.approx(-TRUE["input_offset"], rel=1e-5)
+    assert saved == axis_fit.plant.force_offset
+    assert "# position offset" in text
 
 
 @pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
