@@ -102,6 +102,18 @@ CASES += [
     ("scenario-empty-name", {}, ["analyze", ""], ["is empty"]),
     ("columns-empty", {}, ["identify", "rec.csv", "--columns="], ["--columns"]),
     ("scenario-option-empty", {}, ["identify", "rec.csv", "--scenario", ""], ["is empty"]),
+    # a study's store: made by the command itself, checked as every output is, before the work
+    ("study-out-dash", {}, ["study", "st.toml", "--out", "-"], ["--out -: not a folder name"]),
+    ("study-out-proc", {}, ["study", "st.toml", "--out", "/proc/o.zarr"],
+     ["cannot create a file in /proc"]),
+    ("study-out-symbolic-link", {"mine/notes.txt": "mine", "@symlink:o.zarr": "mine"},
+     ["study", "st.toml", "--out", "o.zarr", "--force"], ["o.zarr is a symbolic link"]),
+    # options an estimate would ignore (it computes and writes nothing)
+    *[(f"study-estimate-{opt.lstrip('-')}", {}, ["study", "st.toml", "--estimate", opt, *value],
+       [f"--estimate: {opt} has no effect"])
+      for opt, value in (("--table", ["t.csv"]), ("--netcdf", ["t.nc"]),
+                         ("--figure", ["f.png"]), ("--force", []),
+                         ("--scheduler", ["tcp://127.0.0.1:8786"]))],
 ]
 
 

@@ -67,8 +67,26 @@ def _exports(ds, args: argparse.Namespace) -> None:
         args.figure_file.write_bytes(buf.getvalue())
 
 
+def _check_options(args: argparse.Namespace) -> None:
+    """Refuse what a run would ignore or could not write, before the work: an option without
+    effect on an estimate; a store named "-", by a symbolic link (no writer follows one) or
+    where no file can be created."""
+    if args.estimate and args.summary is None:
+        for opt, given in (("--table", args.table), ("--netcdf", args.netcdf),
+                           ("--figure", args.figure), ("--force", args.force),
+                           ("--scheduler", args.scheduler)):
+            if given:
+                raise UsageError(f"study --estimate: {opt} has no effect (an estimate computes "
+                                 f"and writes nothing)")
+    if args.out is not None and args.summary is None:
+        from motionhyst.io.outputs import check_output_folder
+
+        check_output_folder(args.out, "--out")
+
+
 def run(args: argparse.Namespace) -> int:
     """Run a study (or resume it), or summarize a store."""
+    _check_options(args)
     args.table_file = (None if args.table is None
                        else output_file(args.table, args, "--table", [args.study]))
     args.netcdf_file = (None if args.netcdf is None

@@ -212,6 +212,33 @@ def _cannot_create_in(folder: Path) -> str | None:
     return None
 
 
+def check_output_folder(path: str | os.PathLike, option: str) -> None:
+    """Raise :class:`OutputError` before the work if a folder a command fills itself (a study's
+    store) cannot be: no name, ``-``, a symbolic link, or no file can be created where it goes.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> check_output_folder(tempfile.mkdtemp() + "/s.zarr", "--out")
+    >>> check_output_folder("-", "--out")
+    Traceback (most recent call last):
+    ...
+    motionhyst.io.outputs.OutputError: --out -: not a folder name
+    """
+    label = _label(path, option)
+    if str(path) in ("", "-"):
+        raise OutputError(f"{label}: not a folder name")
+    path = Path(path)
+    if path.is_symlink():
+        raise OutputError(f"{label} is a symbolic link; give the folder it points to or "
+                          f"another name")
+    problem = _cannot_create_in(path) if path.is_dir() else None
+    if problem is not None:
+        raise OutputError(f"{label}: cannot create a file in {path} ({problem})")
+    if not path.is_dir():
+        _check_parents(path, label)
+
+
 def _missing_parents(folder: Path) -> list[Path]:
     """Folders that must be created for `folder` to exist, outermost first."""
     missing = []
@@ -845,4 +872,4 @@ class OutputFolder:
 
 
 __all__ = ["MANIFEST", "OutputError", "OutputFile", "OutputFolder", "check_not_input",
-           "clean_stale", "scratch_folder", "umask"]
+           "check_output_folder", "clean_stale", "scratch_folder", "umask"]
