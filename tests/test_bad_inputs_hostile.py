@@ -55,6 +55,18 @@ def _link(force: str = "jenkins") -> str:
                                                  strict=True))
 
 
+def _io_record() -> str:
+    """A record of a mass-spring-damper under a two-sine force (time,force,displacement)."""
+    from motionhyst.time.openloop import MassSpringDamper, OpenLoop
+
+    t = np.arange(600) / 750.0
+    u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
+    y = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4)).simulate(t, u).displacement
+    return "time,force,displacement\n" + "".join(
+        f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), u.tolist(), y.tolist(),
+                                                 strict=True))
+
+
 BASE = {"s.toml": PAPER, "st.toml": STUDY, "model.toml": MODEL, "f.csv": _force(),
         "rec.csv": _link(), "notes.txt": "my notes", "old.csv": "time,error\n0,0\n"}
 
@@ -108,6 +120,10 @@ CASES += [
      ["cannot create a file in /proc"]),
     ("study-out-symbolic-link", {"mine/notes.txt": "mine", "@symlink:o.zarr": "mine"},
      ["study", "st.toml", "--out", "o.zarr", "--force"], ["o.zarr is a symbolic link"]),
+    # the record that sets predict's initial state is an input too: never its output
+    ("predict-out-is-init-from", {"io.csv": _io_record()},
+     ["predict", "model.toml", "f.csv", "--out", "io.csv", "--init-from", "io.csv", "--force"],
+     ["--out io.csv: it is an input of this command"]),
     # options an estimate would ignore (it computes and writes nothing)
     *[(f"study-estimate-{opt.lstrip('-')}", {}, ["study", "st.toml", "--estimate", opt, *value],
        [f"--estimate: {opt} has no effect"])
@@ -242,18 +258,6 @@ def test_minus_zero_is_zero(capsys):
     assert main([*argv[:-2], "0", "--json"]) == 0
     assert minus == capsys.readouterr().out
     assert '"abs": 20.0' in minus
-
-
-def _io_record() -> str:
-    """A record of a mass-spring-damper under a two-sine force (time,force,displacement)."""
-    from motionhyst.time.openloop import MassSpringDamper, OpenLoop
-
-    t = np.arange(600) / 750.0
-    u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
-    y = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4)).simulate(t, u).displacement
-    return "time,force,displacement\n" + "".join(
-        f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(t.tolist(), u.tolist(), y.tolist(),
-                                                 strict=True))
 
 
 def test_identify_stops_at_its_cpu_time_budget_and_saves_nothing(tmp_path, monkeypatch,

@@ -66,7 +66,8 @@ def run(args: argparse.Namespace) -> int:
                          f"{args.substeps}")
     from motionhyst.io.outputs import OutputFile
 
-    target = OutputFile(args.out, force=args.force, inputs=[args.scenario, args.data],
+    target = OutputFile(args.out, force=args.force,
+                        inputs=[args.scenario, args.data, args.init_from],
                         option="--out")  # refused before any work
     if args.init_window is not None and args.init_from is None:
         raise UsageError("motionhyst predict: --init-window applies with --init-from only")
