@@ -97,6 +97,8 @@ for _name, _argv in WRITERS.items():
     ]
     if _name != "reproduce":  # reproduce's --out is a folder
         CASES.append((f"{_name}-trailing-slash", {}, [*_argv, f"{FILE[_name]}/"], ["ends in /"]))
+        # a text file named .mat would be read back as MATLAB (and fail) by every reader
+        CASES.append((f"{_name}-named-mat", {}, [*_argv, "o.MAT"], ["writes no MATLAB file"]))
 CASES += [
     # a header naming a column twice: pandas would read the first and rename the second
     ("reference-column-twice", {"r.csv": "time,position,Position\n" + "".join(

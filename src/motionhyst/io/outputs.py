@@ -484,6 +484,9 @@ class OutputFile:
         if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: it names a folder
             raise OutputError(f"{_label(os.fspath(path), option)}: ends in {os.sep}, so names a "
                               f"folder; give a file name")
+        if self.path.suffix.lower() == ".mat":  # every reader takes a .mat name for MATLAB
+            raise OutputError(f"{label}: motionhyst writes no MATLAB file, and a .mat name is "
+                              f"read back as one; give another name")
         check_not_input(self.path, inputs, option)
         self.target = self.path
         if self.path.is_symlink():
