@@ -52,12 +52,12 @@ class MaxwellSlip(Hysteresis):
         if k_arr.shape != fc_arr.shape:
             raise ValueError(f"k and fc must have the same length ({k_arr.size} != "
                              f"{fc_arr.size})")
-        for i, (ki, fi) in enumerate(zip(k_arr, fc_arr, strict=True)):
-            check_positive(f"k[{i}]", ki)
-            check_positive(f"fc[{i}]", fi)
+        for name, values in (("k", k_arr), ("fc", fc_arr)):  # one pass, the first bad one named
+            bad = np.flatnonzero(~(np.isfinite(values) & (values > 0)))
+            if bad.size:
+                check_positive(f"{name}[{bad[0]}]", float(values[bad[0]]))
         self.k = k_arr
         self.fc = fc_arr
-        self.elements = [Jenkins(ki, fi) for ki, fi in zip(k_arr, fc_arr, strict=True)]
         self.reset()
 
     def __repr__(self) -> str:
@@ -121,6 +121,12 @@ class MaxwellSlip(Hysteresis):
         """
         return sum(el.hosidf_closed_form(A, n_max) for el in self.elements)
 
+    @property
+    def elements(self) -> list[Jenkins]:
+        """The elements as Jenkins elements, made when asked (a link of 1e6 elements holds two
+        arrays, not 1e6 objects)."""
+        return [Jenkins(ki, fi) for ki, fi in zip(self.k, self.fc, strict=True)]
+
     def response(self, x: ArrayLike, w0: ArrayLike = 0.0) -> NDArray[np.float64]:
         """Total force for a sampled displacement; `w0` is the initial force per element.
 
@@ -167,7 +173,15 @@ class MaxwellSlip(Hysteresis):
 
     def __call__(self, x: float) -> float:
         """Advance every element by one displacement sample (python-control interface)."""
-        return float(sum(el(x) for el in self.elements))
+        x = float(np.squeeze(x))
+        if not np.isfinite(x):
+            raise ValueError("x must be finite")
+        if self._x is not None:
+            from motionhyst.hysteresis._kernels import maxwell_response
+
+            self._wi = maxwell_response(np.array([self._x, x]), self.k, self.fc, self._wi)[-1]
+        self._x = x
+        return float(sum(self._wi.tolist()))  # in the elements' order, as they were added
 
     def reset(self, w: float = 0.0) -> None:
         """Reset the elements' state (the force `w` is shared in proportion to fc).
@@ -177,9 +191,8 @@ class MaxwellSlip(Hysteresis):
         w : float
             Total force to start from [N].
         """
-        share = np.asarray(self.fc) / np.sum(self.fc)
-        for el, s in zip(getattr(self, "elements", []), share, strict=False):
-            el.reset(w * s)
+        self._wi = float(w) * (self.fc / np.sum(self.fc))
+        self._x = None
 
     def time_stepping(self) -> Stepping:
         """The elements as the compiled time step advances them (:mod:`.stepping`)."""
