@@ -485,3 +485,82 @@ def test_font_fallbacks_are_not_reported_on_stderr():
     import motionhyst.core.plotting  # noqa: F401
 
     assert logging.getLogger("matplotlib.font_manager").getEffectiveLevel() >= logging.ERROR
+
+
+# ------------------------------------------------------------------ a study's store, damaged
+def _store(root: Path) -> Path:
+    """The store of BASE's study, two of its four points written (as an interrupted run
+    leaves it)."""
+    from motionhyst.study import Study
+    from motionhyst.study.store import OK, StudyStore
+
+    study = Study.from_file(root / "st.toml")
+    store = StudyStore.create(root / "o.zarr", study)
+    store.write([0, 1], np.array([OK, OK], np.int8), {"e1": np.array([1e-9 + 0j, 2e-9 + 0j])})
+    return root / "o.zarr"
+
+
+def _edit_json(path: Path, change) -> None:
+    import json
+
+    meta = json.loads(path.read_text())
+    change(meta)
+    path.write_text(json.dumps(meta))
+
+
+DAMAGES = {  # how a store comes apart (a copy cut short, a disk error, another program), and
+    # the words that name it
+    "status-removed": (lambda s: __import__("shutil").rmtree(s / "status"), "no array 'status'"),
+    "fields-attribute-removed": (lambda s: _edit_json(
+        s / "zarr.json", lambda m: m["attributes"].pop("fields")), "no 'fields' attribute"),
+    "fields-attribute-garbage": (lambda s: _edit_json(
+        s / "zarr.json", lambda m: m["attributes"].update(fields="{x")), "not JSON"),
+    "status-chunk-cut-short": (lambda s: (s / "status/c/0/0").write_bytes(b"\x28\xb5"),
+                               "its status cannot be read"),
+    "status-shape-changed": (lambda s: _edit_json(
+        s / "status/zarr.json", lambda m: m.update(shape=[2, 3])), "has shape (2, 3)"),
+    "status-type-changed": (lambda s: _edit_json(
+        s / "status/zarr.json", lambda m: m.update(data_type="float64")), "holds float64"),
+    "axes-past-their-values": (lambda s: [_edit_json(
+        s / f"{name}/zarr.json", lambda m: m.update(shape=[10**5, 10**5])) for name in (
+        "e1", "status", "reason")], "does not have the 100000 values"),
+    "status-value-unknown": (lambda s: __import__("zarr").open_group(str(s), mode="r+")[
+        "status"].set_basic_selection((0, 0), 7), "status 7 at point 0"),
+}
+
+
+@pytest.mark.parametrize("command", ["summary", "resume", "table"])
+@pytest.mark.parametrize(("damage", "words"), DAMAGES.values(), ids=DAMAGES.keys())
+def test_a_damaged_store_is_named_as_such_and_left_alone(tmp_path, damage, words, command):
+    """A store whose arrays or attributes are missing, cut short or changed: one line naming
+    it a damaged study store (was: 'internal error: KeyError' or a codec's message), exit 2,
+    nothing changed; a resume says how to replace it."""
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, BASE)
+    damage(_store(root))
+    before = snapshot(root)
+    run = ["study", "st.toml", "--out", "o.zarr", "--workers", "0"]
+    argv = {"summary": ["study", "--summary", "o.zarr"], "resume": run,
+            "table": [*run, "--table", "t.csv"]}[command]
+    code, out, err = limited_process.run(argv, root)
+    assert code == 2 and out == "", (code, out, err)
+    line = err.strip()
+    assert line and "\n" not in line and "Traceback" not in line, err
+    assert "o.zarr: a damaged study store" in line and words in line, line
+    if command != "summary":
+        assert line.endswith("give --force to replace it"), line
+    assert snapshot(root) == before
+
+
+def test_force_replaces_a_damaged_store(tmp_path):
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, BASE)
+    (_store(root) / "status/c/0/0").write_bytes(b"\x28\xb5")
+    code, out, err = limited_process.run(["study", "st.toml", "--out", "o.zarr", "--workers",
+                                          "0", "--force"], root)
+    assert code == 0, err
+    assert out.startswith("4 points: 4 computed"), out
+    code, out, err = limited_process.run(["study", "--summary", "o.zarr", "--json"], root)
+    assert code == 0, err

@@ -224,9 +224,15 @@ def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStor
         if not is_study_store(path):
             raise StudyError(f"--out {path}: exists and is not a study's store; refusing to "
                              f"replace it")
-        store = StudyStore.open(path)
-        if store.matches(study):
-            return store
+        try:
+            store = StudyStore.open(path)
+            if store.matches(study):
+                store.status()  # every chunk readable, every value a status
+                return store
+        except StudyError as exc:  # damaged: replaced as another study's store is
+            if force:
+                return None
+            raise StudyError(f"--out {exc}; give --force to replace it") from None
         if not force:
             raise StudyError(f"--out {path}: holds another study (other scenario, axes, "
                              f"samples or outputs); give --force to replace it")
