@@ -24,8 +24,7 @@ from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import REFERENCE_AXES, StudyDefinition, StudyError
 
 __all__ = ["FAILED", "FLUSH_SECONDS", "MISSING", "OK", "REASONS", "ChunkWriter", "StudyStore",
-           "check_layout", "damaged", "field_names", "is_study_store", "open_results",
-           "remove_store"]
+           "field_names", "is_study_store", "open_results", "remove_store"]
 
 MISSING, OK, FAILED = 0, 1, 2
 """Values of the ``status`` array."""
@@ -109,7 +108,7 @@ class StudyStore:
     def __init__(self, path: Path, group) -> None:
         self.path = Path(path)
         self.group = group
-        self.fields = check_layout(path, group)
+        self.fields = _check_layout(path, group)
         self.shape = tuple(group["status"].shape)
 
     @classmethod
@@ -184,7 +183,7 @@ class StudyStore:
         try:
             group = zarr.open_group(str(path), mode="r+", zarr_format=3)
         except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise damaged(path, f"{type(exc).__name__}: {exc}") from None
+            raise _damaged(path, f"{type(exc).__name__}: {exc}") from None
         return cls(path, group)
 
     def matches(self, study: StudyDefinition) -> bool:
@@ -209,10 +208,10 @@ class StudyStore:
         try:
             st = np.asarray(self.group["status"][...]).ravel()
         except (RuntimeError, ValueError, OSError) as exc:  # a chunk damaged or cut short
-            raise damaged(self.path, f"its status cannot be read: {exc}") from None
+            raise _damaged(self.path, f"its status cannot be read: {exc}") from None
         odd = np.flatnonzero((st != MISSING) & (st != OK) & (st != FAILED))
         if odd.size:
-            raise damaged(self.path, f"status {int(st[odd[0]])} at point {int(odd[0])}")
+            raise _damaged(self.path, f"status {int(st[odd[0]])} at point {int(odd[0])}")
         return st
 
     def missing(self, order: NDArray[np.int64] | None = None) -> NDArray[np.int64]:
@@ -422,15 +421,15 @@ class ChunkWriter:
         self.flush()
 
 
-def damaged(path: str | Path, what: str) -> StudyError:
+def _damaged(path: str | Path, what: str) -> StudyError:
     """The error for a store that is a study's but cannot be used as one (`what` is wrong)."""
     return StudyError(f"{path}: a damaged study store ({what})")
 
 
-def check_layout(path: str | Path, group) -> dict[str, str]:
+def _check_layout(path: str | Path, group) -> dict[str, str]:
     """The output fields of the study store `group` at `path` (name: kind), checked against its
     arrays: each field and ``status`` there, of one shape and of their type; else
-    :class:`StudyError` (:func:`damaged`) before anything reads or writes them.
+    :class:`StudyError` (:func:`_damaged`) before anything reads or writes them.
 
     Parameters
     ----------
@@ -442,12 +441,12 @@ def check_layout(path: str | Path, group) -> dict[str, str]:
     try:
         fields = json.loads(group.attrs["fields"])
     except KeyError:
-        raise damaged(path, "no 'fields' attribute") from None
+        raise _damaged(path, "no 'fields' attribute") from None
     except (TypeError, ValueError):
-        raise damaged(path, "its 'fields' attribute is not JSON") from None
+        raise _damaged(path, "its 'fields' attribute is not JSON") from None
     if not isinstance(fields, dict) or not fields or not all(
             isinstance(k, str) and v in ("real", "complex") for k, v in fields.items()):
-        raise damaged(path, "its 'fields' attribute names no output fields")
+        raise _damaged(path, "its 'fields' attribute names no output fields")
     want = {**{name: "complex128" if kind == "complex" else "float64"
                for name, kind in fields.items()}, "status": "int8"}
     shape, first = None, ""
@@ -456,17 +455,17 @@ def check_layout(path: str | Path, group) -> dict[str, str]:
             array = group[name]
             got, here = str(array.dtype), tuple(array.shape)
         except (KeyError, AttributeError, TypeError, ValueError):
-            raise damaged(path, f"no array {name!r}") from None
+            raise _damaged(path, f"no array {name!r}") from None
         if got != dtype:
-            raise damaged(path, f"array {name!r} holds {got}, not {dtype}")
+            raise _damaged(path, f"array {name!r} holds {got}, not {dtype}")
         if shape is not None and here != shape:
-            raise damaged(path, f"array {name!r} has shape {here}, {first!r} {shape}")
+            raise _damaged(path, f"array {name!r} has shape {here}, {first!r} {shape}")
         shape, first = (here, name) if shape is None else (shape, first)
     dims = getattr(group["status"].metadata, "dimension_names", None) or ()
     for dim, n in zip(dims, shape, strict=False):  # the axes' values, one per point along each
         axis = group.get(dim) if dim is not None else None
         if axis is None or tuple(axis.shape) != (n,):
-            raise damaged(path, f"the axis {dim!r} does not have the {n} values of status")
+            raise _damaged(path, f"the axis {dim!r} does not have the {n} values of status")
     return fields
 
 
@@ -562,6 +561,6 @@ def open_results(path: str | Path):
     try:
         ds = xr.open_zarr(str(path), consolidated=False, mask_and_scale=False).load()
     except (RuntimeError, ValueError, KeyError, OSError) as exc:
-        raise StudyError(f"{damaged(path, f'its values cannot be read: {exc}')}; remove it (a "
+        raise StudyError(f"{_damaged(path, f'its values cannot be read: {exc}')}; remove it (a "
                          f"study run again computes every point)") from None
     return ds
