@@ -216,6 +216,13 @@ def check_output_folder(path: str | os.PathLike, option: str) -> None:
     """Raise :class:`OutputError` before the work if a folder a command fills itself (a study's
     store) cannot be: no name, ``-``, a symbolic link, or no file can be created where it goes.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder, existing or to be made.
+    option : str
+        The option naming it, for messages.
+
     Examples
     --------
     >>> import tempfile
