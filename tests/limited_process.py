@@ -19,6 +19,11 @@ REFUSAL_LIMIT = 1 << 30
 """Address space [bytes] for a command that is refused or runs a small case: the commands of
 the hostile corpus peak at 0.15-0.71 GB (VmPeak, numba compiling its kernels included)."""
 
+RUN_LIMIT = 2 << 30
+"""Address space [bytes] for a command that runs to its end with the study engine: a study of
+six points peaks at 1.25 GB (VmPeak: zarr's and numba's threads reserve address space they
+hardly use; its resident peak is 0.33 GB)."""
+
 MAIN = ("import sys\n"
         "from motionhyst.core.compiled import quiet_compilation\n"
         "quiet_compilation()\n"

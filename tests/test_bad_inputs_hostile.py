@@ -558,9 +558,27 @@ def test_force_replaces_a_damaged_store(tmp_path):
     root.mkdir()
     populate(root, BASE)
     (_store(root) / "status/c/0/0").write_bytes(b"\x28\xb5")
+    limit = limited_process.RUN_LIMIT
     code, out, err = limited_process.run(["study", "st.toml", "--out", "o.zarr", "--workers",
-                                          "0", "--force"], root)
+                                          "0", "--force"], root, limit)
     assert code == 0, err
     assert out.startswith("4 points: 4 computed"), out
-    code, out, err = limited_process.run(["study", "--summary", "o.zarr", "--json"], root)
+    code, out, err = limited_process.run(["study", "--summary", "o.zarr", "--json"], root, limit)
     assert code == 0, err
+
+
+def test_an_error_on_the_way_to_the_chunks_is_not_called_damage(tmp_path, monkeypatch):
+    """Under a memory limit zarr may find no thread to start: 'can't start new thread' is
+    not the store's fault, and 'remove it' would be the wrong advice."""
+    from motionhyst.study.store import StudyStore
+
+    populate(tmp_path, BASE)
+    store = StudyStore.open(_store(tmp_path))
+
+    class NoThread:
+        def __getitem__(self, key):
+            raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(store, "group", {"status": NoThread()})
+    with pytest.raises(RuntimeError, match="can't start new thread"):
+        store.status()

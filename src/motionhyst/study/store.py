@@ -207,7 +207,9 @@ class StudyStore:
         :data:`FAILED`."""
         try:
             st = np.asarray(self.group["status"][...]).ravel()
-        except (RuntimeError, ValueError, OSError) as exc:  # a chunk damaged or cut short
+        except (RuntimeError, ValueError) as exc:
+            if not _in_codec(exc):  # not the data (no thread to be had, ...): as it is
+                raise
             raise _damaged(self.path, f"its status cannot be read: {exc}") from None
         odd = np.flatnonzero((st != MISSING) & (st != OK) & (st != FAILED))
         if odd.size:
@@ -421,6 +423,18 @@ class ChunkWriter:
         self.flush()
 
 
+def _in_codec(exc: BaseException) -> bool:
+    """Whether `exc` was raised while a chunk was decoded (its bytes are not what its array's
+    codecs wrote: a chunk cut short or replaced), not by anything else on the way."""
+    tb = exc.__traceback__
+    while tb is not None:
+        name = tb.tb_frame.f_code.co_filename.replace("\\", "/")
+        if "/numcodecs/" in name or "/zarr/codecs/" in name:
+            return True
+        tb = tb.tb_next
+    return False
+
+
 def _damaged(path: str | Path, what: str) -> StudyError:
     """The error for a store that is a study's but cannot be used as one (`what` is wrong)."""
     return StudyError(f"{path}: a damaged study store ({what})")
@@ -560,7 +574,9 @@ def open_results(path: str | Path):
     StudyStore.open(path).status()  # a damaged store is named as such, not by xarray
     try:
         ds = xr.open_zarr(str(path), consolidated=False, mask_and_scale=False).load()
-    except (RuntimeError, ValueError, KeyError, OSError) as exc:
+    except (RuntimeError, ValueError) as exc:
+        if not _in_codec(exc):
+            raise
         raise StudyError(f"{_damaged(path, f'its values cannot be read: {exc}')}; remove it (a "
                          f"study run again computes every point)") from None
     return ds
