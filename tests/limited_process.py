@@ -77,3 +77,14 @@ def run(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,
             proc.communicate()
     return (proc.returncode, (out or b"").decode("utf-8", errors="replace"),
             (err or b"").decode("utf-8", errors="replace"))
+
+
+def refusal(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT, **kwargs) -> str:
+    """``motionhyst argv`` run in `cwd` under `limit`, which must refuse it: exit 2, nothing on
+    stdout, one plain line on stderr (no traceback). The line, for the caller's words."""
+    code, out, err = run(argv, cwd, limit, **kwargs)
+    assert code == 2, (code, out, err)
+    assert out == "", out
+    line = err.strip()
+    assert line and "\n" not in line and "Traceback" not in line, err
+    return line
