@@ -98,7 +98,7 @@ from motionhyst.identify.io_bouc_wen import START_RATIOS as START_RATIOS
 from motionhyst.identify.io_bouc_wen import START_REFINED as START_REFINED
 from motionhyst.identify.io_bouc_wen import START_SHARES as START_SHARES
 from motionhyst.identify.io_bouc_wen import identify_bouc_wen_msd, identify_bouc_wen_two_mass
-from motionhyst.identify.io_checks import check_inertia
+from motionhyst.identify.io_checks import check_inertia, viscous_direction_note
 from motionhyst.identify.io_elements import PROFILE_CHI2 as PROFILE_CHI2
 from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
@@ -371,12 +371,18 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         raise ValueError(_ASYMMETRIC)
     check_inertia(records)  # before the search
     if link is not BoucWen:
-        return identify_elements_io(records, link, periodic, substeps, tol,
-                                    max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
-                                    stage, offset, from_rest, max_evaluations,
-                                    int(init_window) if init_window is not None else None,
-                                    asymmetric, bool(drift),
-                                    skew=asymmetric and link is not Coulomb)
+        fit = identify_elements_io(records, link, periodic, substeps, tol,
+                                   max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
+                                   stage, offset, from_rest, max_evaluations,
+                                   int(init_window) if init_window is not None else None,
+                                   asymmetric, bool(drift),
+                                   skew=asymmetric and link is not Coulomb)
+        if shape.floating and shape.n == 1 and not asymmetric and (not periodic
+                                                                   or link is Coulomb):
+            note = viscous_direction_note(records)  # the symmetric fit's mass is biased
+            if note is not None:
+                fit.warnings.append(note)
+        return fit
     bouc_wen_offset = offset == "output" and not shape.floating
     if (offset not in ("auto", "none") and not bouc_wen_offset) or from_rest \
             or init_window is not None:
