@@ -13,11 +13,15 @@ from motionhyst.hysteresis import Coulomb
 from motionhyst.identify.emps import (
     DRIVE_GAIN,
     INIT_WINDOW,
-    REFERENCE_MODEL,
-    reference_system,
     run_emps,
     score,
     split_by_periods,
+)
+from motionhyst.identify.emps_reference import (
+    REFERENCE_ASYMMETRIC,
+    REFERENCE_MODEL,
+    asymmetric_inverse_dynamics,
+    reference_system,
 )
 from motionhyst.identify.input_output import IORecord
 from motionhyst.plants.mass_damper import MassDamper
@@ -125,6 +129,10 @@ def test_benchmark_emps_command_refusals(tmp_path, capsys):
                                                      "--seed", "1")
     assert "--periods applies to emps only" in err("bouc-wen", "--periods", "1-2")
     assert "--periods: must be A-B" in err("emps", "--periods", "x")
+    assert "--models applies to emps only" in err("bouc-wen", "--models", "coulomb")
+    for bad in ("bouc-wen", "jenkins-fast", "coulomb,,jenkins", "coulomb,coulomb"):
+        text = err("emps", "--data", str(tmp_path / "none"), "--models", bad)
+        assert "--models" in text and "no such folder" not in text  # before the data
 
 
 def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
@@ -135,9 +143,10 @@ def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
     rec = axis_record()
     savemat(tmp_path / "DATA_EMPS.mat", {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
                                          "qm": rec.y[:, None], "gtau": DRIVE_GAIN})
-    monkeypatch.setattr(emps, "MODELS", ("coulomb",))
+    monkeypatch.setattr(emps, "MODELS", ("jenkins",))  # --models replaces the default list
     monkeypatch.setattr(emps, "PERIOD", PERIOD)
-    assert main(["benchmark", "emps", "--data", str(tmp_path), "--json"]) == 0
+    assert main(["benchmark", "emps", "--data", str(tmp_path), "--models", "coulomb",
+                 "--json"]) == 0
     out, err = capsys.readouterr()
     assert err == ""
     models = json.loads(out)["models"]  # without the test record: both splits
@@ -253,7 +262,7 @@ def test_offset_with_viscous_friction_by_direction_as_the_reference_models():
     """An axis whose viscous friction is larger backward, with no force offset: the
     reference model's structure (one viscous coefficient) fits it with an offset, and the
     equivalent offset of the true parameters is that offset; in the benchmark's table too."""
-    from motionhyst.identify.emps import equivalent_offset
+    from motionhyst.identify.emps_reference import equivalent_offset
     from motionhyst.identify.io_start import inverse_dynamics
 
     t = np.arange(4000) / 1000.0
@@ -272,3 +281,44 @@ def test_offset_with_viscous_friction_by_direction_as_the_reference_models():
     assert model.to_dict()["equivalent_offset"] == pytest.approx(model.parameters["offset"],
                                                                  abs=1e-9)  # symmetric: itself
     assert "as OF [N]" in str(res)
+
+
+def test_a_link_at_its_rigid_limit_is_reported_as_that_limit(monkeypatch):
+    """A Jenkins link whose stiffness runs to where predict cannot step it (here: the finest
+    step lowered so that the fitted k of this Coulomb axis is past it) does not fail the run:
+    the model is reported as its rigid limit, the Coulomb link with the same options, and
+    says so; the Coulomb fit already made is reused."""
+    import motionhyst.identify.io_checks as io_checks
+
+    monkeypatch.setattr(io_checks, "MAX_PREDICT_SUBSTEPS", 60)
+    rec = axis_record(n_periods=2)
+    res = run_emps(rec, models=("coulomb", "jenkins"), periods=(1, 1), period=PERIOD)
+    coulomb, jenkins = res.models
+    assert jenkins.limit == "coulomb" and coulomb.limit is None
+    assert jenkins.parameters == coulomb.parameters and "k" not in jenkins.parameters
+    assert jenkins.validation["rmse_mm"] == coulomb.validation["rmse_mm"]
+    assert "rigid limit" in jenkins.warnings[0] and jenkins.to_dict()["limit"] == "coulomb"
+    assert "jenkins (its rigid limit, coulomb)" in str(res)
+    assert "warning: jenkins: the link's stiffness ran to the rigid limit" in str(res)
+
+
+def test_the_asymmetric_reference_model_by_one_linear_solve():
+    """The benchmark's eq. (12) (viscous and Coulomb friction by direction, no offset): its
+    published parameters as a system, and found again from that system's record by the one
+    linear solve; the table lists it beside the symmetric reference, both ways."""
+    t = np.arange(4000) / 1000.0
+    u = 200 * np.sin(2 * np.pi * 0.6 * t) + 80 * np.sin(2 * np.pi * 1.7 * t + 0.3)
+    y = reference_system(REFERENCE_ASYMMETRIC).simulate(t, u).displacement
+    found = asymmetric_inverse_dynamics(IORecord(t, u, y))
+    for name, value in REFERENCE_ASYMMETRIC.items():
+        assert found[name] == pytest.approx(value, rel=0.03), name
+    assert found["c_neg"] - found["c_pos"] == pytest.approx(73.7, rel=0.05)
+    rec = axis_record(n_periods=2, noise=0.0)
+    res = run_emps(rec, models=("coulomb",), periods=(1, 1), period=PERIOD)
+    text = str(res)
+    assert "IDIM-LS, asymmetric friction (eq. 12), published" in text
+    assert "IDIM-LS, asymmetric friction (eq. 12), on axis period 1" in text
+    assert res.reference["asymmetric"]["parameters"] == REFERENCE_ASYMMETRIC
+    own = res.reference["idim_asymmetric"]["parameters"]  # a symmetric axis: c+ = c-
+    assert own["c_pos"] == pytest.approx(own["c_neg"], rel=0.05)
+    assert own["m"] == pytest.approx(TRUE["m"], rel=0.02)

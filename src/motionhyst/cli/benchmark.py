@@ -34,6 +34,12 @@ def add_parser(sub) -> None:
                         "from, validated on the others (default: both ways, 1-2 then 3-4; "
                         "'all': also 1-3 and 2-4, each validated on the period left out; the "
                         "reference repeats every 6240 samples)")
+    q.add_argument("--models", metavar="NAMES",
+                   help="emps: the link models on the mass-damper, comma-separated (default: "
+                        "coulomb-asymmetric,coulomb-asymmetric-drift,jenkins-asymmetric; "
+                        "a link of coulomb, dahl, jenkins, lugre, "
+                        "maxwell-slip, ending in -asymmetric for viscous friction by direction "
+                        "and -drift for a force offset drifting in time)")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
 
@@ -56,8 +62,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the benchmark named and print its table (or JSON)."""
     if args.name == "emps":
         return run_emps(args)
-    if args.periods is not None:
-        raise UsageError("motionhyst benchmark: --periods applies to emps only")
+    for option in ("periods", "models"):
+        if getattr(args, option) is not None:
+            raise UsageError(f"motionhyst benchmark: --{option} applies to emps only")
     return run_bouc_wen(args)
 
 
@@ -115,6 +122,7 @@ def run_emps(args: argparse.Namespace) -> int:
     from motionhyst.identify.emps import (
         ESTIMATION_FILE,
         TEST_FILE,
+        check_model,
         choose,
         cross_validate,
         run_emps,
@@ -123,6 +131,17 @@ def run_emps(args: argparse.Namespace) -> int:
     if args.seed is not None:
         raise UsageError("motionhyst benchmark emps: --seed applies to bouc-wen only (the EMPS "
                          "records are measured)")
+    models = None
+    if args.models is not None:
+        models = [name.strip() for name in args.models.split(",")]
+        if not all(models) or len(set(models)) < len(models):
+            raise UsageError(f"motionhyst benchmark emps: --models {args.models!r}: give "
+                             f"distinct names separated by commas")
+        for name in models:
+            try:
+                check_model(name)
+            except ValueError as exc:
+                raise UsageError(f"motionhyst benchmark emps: --models: {exc}") from None
     if args.data is not None:
         data = Path(args.data)
     else:
@@ -148,10 +167,11 @@ def run_emps(args: argparse.Namespace) -> int:
             print(f"  {msg}", file=sys.stderr, flush=True)
 
     if test is None and args.periods in (None, "all"):  # one split alone says little
-        results = cross_validate(estimation, progress=say,
+        results = cross_validate(estimation, models=models, progress=say,
                                  splits="halves" if args.periods is None else "all")
     else:
-        results = [run_emps(estimation, test, periods=args.periods or (1, 2), progress=say)]
+        results = [run_emps(estimation, test, models=models, periods=args.periods or (1, 2),
+                            progress=say)]
     chosen = choose(results) if len(results) > 1 else None
     if args.json:
         print_json({"models": [m for res in results for m in res.to_dict()["models"]],
