@@ -808,6 +808,17 @@ RIGID_LIMIT = "integration steps per sample"
 def check_model(name: str) -> None:
     """Refuse a model name :func:`run_emps` cannot identify (one line naming the choices).
 
+    Parameters
+    ----------
+    name : str
+        A link of :data:`LINKS`, optionally ending in ``-asymmetric`` and ``-drift``
+        (:func:`model_options`).
+
+    Raises
+    ------
+    ValueError
+        A name that is none of these.
+
     Examples
     --------
     >>> check_model("jenkins-asymmetric-drift")
