@@ -17,10 +17,13 @@ from motionhyst.time.openloop import OpenLoop
 FS = 1000.0
 
 
-def _axis_record(c_pos: float, c_neg: float, n: int = 4000) -> IORecord:
-    """A mass-damper with Coulomb friction driven by a force, position measured (noise 1 um)."""
+def _axis_record(c_pos: float, c_neg: float, n: int = 4000, bias: float = 0.0) -> IORecord:
+    """A mass-damper with Coulomb friction driven by a force, position measured (noise 1 um);
+    with a `bias` of the force it moves mostly forward, turning and sticking briefly."""
     t = np.arange(n) / FS
-    u = 200 * np.sin(2 * np.pi * 0.6 * t) + 80 * np.sin(2 * np.pi * 1.7 * t + 0.3)
+    u = bias + 200 * np.sin(2 * np.pi * 0.6 * t) + 80 * np.sin(2 * np.pi * 1.7 * t + 0.3)
+    if bias:
+        u = bias + 90 * np.sin(2 * np.pi * 0.6 * t) + 40 * np.sin(2 * np.pi * 1.7 * t + 0.3)
     axis = OpenLoop(MassDamper.by_direction(95.0, c_pos, c_neg, force_offset=3.0),
                     Coulomb(fc=20.0))
     y = axis.simulate(t, u, substeps=20).displacement
@@ -36,6 +39,9 @@ def test_the_note_names_both_directions_of_an_asymmetric_axis():
     assert viscous_direction_note([_axis_record(200.0, 200.0)]) is None
     # a difference within the stated share of the mean is no finding, however well determined
     assert viscous_direction_note([_axis_record(195.0, 205.0)]) is None
+    # moving mostly forward: the brief backward motion, where the axis turns and sticks, says
+    # nothing of a backward viscous friction (all samples taken: c- 300-500 N s/m)
+    assert viscous_direction_note([_axis_record(200.0, 200.0, bias=30.0)]) is None
 
 
 @pytest.mark.parametrize(("c_neg", "asymmetric", "warned"), [

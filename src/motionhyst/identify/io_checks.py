@@ -27,7 +27,8 @@ from numpy.typing import NDArray
 
 from motionhyst.identify.io_records import IORecord
 
-__all__ = ["DIRECTION_SHARE", "DIRECTION_SIGNIFICANCE", "MAX_PREDICT_SUBSTEPS", "SYSTEMATIC_SHARE",
+__all__ = ["DIRECTION_MOVING", "DIRECTION_SAMPLES", "DIRECTION_SHARE", "DIRECTION_SIGNIFICANCE",
+           "MAX_PREDICT_SUBSTEPS", "SYSTEMATIC_SHARE",
            "FitFailed", "check_inertia", "flat_profile", "judge_fit", "noise_cost",
            "plausibility_warnings", "systematic_share", "viscous_direction_note"]
 
@@ -418,6 +419,11 @@ def flat_profile(costs: list[float], dof: int) -> bool:
 DIRECTION_SIGNIFICANCE = 3.0
 #: ... and by more than this share of their mean (a difference that biases a symmetric fit)
 DIRECTION_SHARE = 0.1
+#: Samples slower than this share of the velocity's RMS are left out of that comparison (where
+#: the axis sticks or turns, Coulomb friction is no function of the velocity)
+DIRECTION_MOVING = 0.1
+#: Each direction must hold at least this share of the samples compared
+DIRECTION_SAMPLES = 0.05
 
 
 def viscous_direction_note(records: list[IORecord]) -> str | None:
@@ -427,11 +433,15 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
     The inverse dynamics with a viscous coefficient per direction (IDIM-LS with the
     asymmetric friction of Janot et al. 2019, eq. 12: ``u = m y'' + c_pos max(y', 0) +
     c_neg min(y', 0) + f sign(y') + u0``, one linear solve,
-    :func:`~motionhyst.identify.io_start.equation_rows`) gives ``c_pos - c_neg`` and its
+    :func:`~motionhyst.identify.io_start.equation_rows`), on the samples moving faster than
+    :data:`DIRECTION_MOVING` of the velocity's RMS (where the axis sticks or turns, the
+    friction is no function of the velocity: a record that mostly moves one way would
+    show a difference that is not there), gives ``c_pos - c_neg`` and its
     standard error, robust to the residuals' correlation (Newey-West, as
     :func:`check_inertia`).  A difference beyond :data:`DIRECTION_SIGNIFICANCE` standard
     errors and :data:`DIRECTION_SHARE` of the mean coefficient is reported, with the
-    option that estimates it (``--asymmetric``).  On EMPS: c+ 163, c- 240 N s/m.
+    option that estimates it (``--asymmetric``); a direction with fewer than
+    :data:`DIRECTION_SAMPLES` of the samples is not compared.  On EMPS: c+ 162, c- 237 N s/m.
 
     Parameters
     ----------
@@ -453,8 +463,8 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
     >>> viscous_direction_note([IORecord(t, u + noise, y)]) is None
     True
     >>> print(viscous_direction_note([IORecord(t, u + 80 * np.minimum(v, 0) + noise, y)]))
-    the records' inverse dynamics (IDIM-LS) gives viscous friction by direction, c+ 160.4 and
-    c- 240.7 N s/m (difference 80.2 +- 0.34): a fit with one viscous coefficient biases the
+    the records' inverse dynamics (IDIM-LS) gives viscous friction by direction, c+ 160.1 and
+    c- 240.2 N s/m (difference 80.2 +- 0.3): a fit with one viscous coefficient biases the
     mass; --asymmetric estimates one per direction
     """
     from motionhyst.identify.io_start import equation_rows
@@ -462,7 +472,17 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
     if not records or any(rec.y.size < 16 for rec in records):
         return None
     rows, rhs = equation_rows(records, floating=True, asymmetric=True)
-    x, cov = _robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
+    moving_rows, moving_rhs = [], []
+    for r, b in zip(rows, rhs, strict=True):  # columns: y'', max(y', 0), min(y', 0), ...
+        v = r[:, 1] + r[:, 2]
+        moving = np.abs(v) > DIRECTION_MOVING * math.sqrt(float(np.mean(v ** 2)))
+        moving_rows.append(r[moving])
+        moving_rhs.append(b[moving])
+    moving_v = np.concatenate([r[:, 1] + r[:, 2] for r in moving_rows])
+    if min(np.sum(moving_v > 0), np.sum(moving_v < 0)) < DIRECTION_SAMPLES * moving_v.size:
+        return None  # one direction barely seen: nothing to compare
+    x, cov = _robust_least_squares(moving_rows, moving_rhs,
+                                   max(7, 2 * round(0.005 * records[0].fs) + 1))
     c_pos, c_neg = float(x[1]), float(x[2])
     std = math.sqrt(max(float(cov[1, 1] + cov[2, 2] - 2.0 * cov[1, 2]), 0.0))
     diff = c_pos - c_neg
