@@ -236,9 +236,9 @@ class EMPSModel:
         The simulated position on the validation record [m] (for plots).
     equivalent_offset : float or None
         The constant offset ``OF`` the model's offset, its drift and its
-        direction-dependent viscous friction amount to on the estimation
-        record's motion (:func:`equivalent_offset`) [N]: comparable with the
-        reference model's.
+        direction-dependent viscous friction amount to on the estimation record's
+        motion (:func:`~motionhyst.identify.emps_reference.equivalent_offset`) [N]:
+        comparable with the reference model's.
     limit : str or None
         The model whose fit this one is at its limit of (a Jenkins link whose
         stiffness ran to the rigid limit: the Coulomb link with the same options),
@@ -775,7 +775,11 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
             # the link's stiffness ran to the rigid limit: report the limit, the Coulomb link
             rigid = "-".join(["coulomb", *(o for o in OPTIONS if o in options)])
             done = next((m for m in out if m.name == rigid), None)
-            model = done or _identify_and_score(rigid, "coulomb", options, est, val)
+            try:
+                model = done or _identify_and_score(rigid, "coulomb", options, est, val)
+            except FitFailed as limit_failed:
+                raise ValueError(f"{name}: {exc}; its rigid limit {rigid}: "
+                                 f"{limit_failed}") from None
             model = replace(model, name=name, limit=rigid, warnings=[
                 f"the link's stiffness ran to the rigid limit (a model that needs more than "
                 f"{MAX_PREDICT_SUBSTEPS} {RIGID_LIMIT}): reported as that limit, {rigid}",
