@@ -217,7 +217,7 @@ def test_df_usage_errors_are_one_line(capsys, args, fragments):
     assert rc == 2
     assert out == ""
     assert err.endswith("\n") and err.count("\n") == 1, err
-    assert err.startswith("error: ")
+    assert err.startswith("motionhyst: error: df: ")
     assert "Traceback" not in err
     for fragment in fragments:
         assert fragment in err, (fragment, err)

@@ -247,8 +247,9 @@ def _failed(exc: Exception) -> int:
     """One line on stderr for an exception that ended a command; its exit code."""
     try:
         raise exc
-    except UsageError as exc:
-        _say(f"error: {one_line(str(exc))}")
+    except UsageError as exc:  # "motionhyst identify: ..." -> "motionhyst: error: identify: ..."
+        text = str(exc).removeprefix("motionhyst ")
+        _say(f"motionhyst: error: {one_line(text)}")
     except OSError as exc:  # "No space left on device: out.csv", not "[Errno 28] ... 'out.csv'"
         text = (f"{exc.filename}: {exc.strerror}" if exc.strerror and exc.filename is not None
                 else exc.strerror or str(exc))
