@@ -113,6 +113,7 @@ from motionhyst.identify.io_start import (
     best_linear_approximation_two_mass as best_linear_approximation_two_mass,
 )
 from motionhyst.identify.io_start import two_mass_response as two_mass_response
+from motionhyst.identify.io_uncertainty import BOUC_WEN_SCALE, judge_determined, zero_allowed
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
 from motionhyst.plants import MassSpringDamper, Plant, plant_class
@@ -295,12 +296,20 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     -------
     IOIdentification
 
+    Raises
+    ------
+    FitFailed
+        A fit that is no result (:mod:`~motionhyst.identify.io_checks`), or of whose
+        parameters the records determine at most half
+        (:func:`~motionhyst.identify.io_uncertainty.judge_determined`; fewer not determined
+        are one of the result's ``warnings``).
+
     Warns
     -----
     MotionhystWarning
         One for each line of the result's ``warnings`` (an estimate the records do not
         hold: a mass far from the records' inertia, a parameter at its bound or run
-        away from its start).
+        away from its start, parameters the records do not determine).
 
     Examples
     --------
@@ -341,6 +350,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                  max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev, offset=offset,
                  from_rest=from_rest, max_evaluations=max_evaluations, init_window=init_window,
                  asymmetric=asymmetric, drift=drift, t_start=t_start)
+    # parameters the records do not determine: a warning, or (most of them) a failed fit
+    fit.warnings.extend(judge_determined(fit.estimates, fit.std,
+                                         BOUC_WEN_SCALE if link is BoucWen else (),
+                                         zero_allowed(stage, link)))
     for line in fit.warnings:  # the plausibility checks, for every caller to see
         warn(line)
     return fit

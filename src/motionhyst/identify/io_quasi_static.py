@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from motionhyst.hysteresis import Jenkins, MaxwellSlip
+from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
 from motionhyst.identify.io_checks import (
     SYSTEMATIC_SHARE,
     FitFailed,
@@ -54,11 +54,14 @@ from motionhyst.identify.io_elements import LinkLayout
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_uncertainty import (
+    BOUC_WEN_SCALE,
     FD_SINGULAR_RTOL,
     covariance,
     covariance_table,
+    judge_determined,
     standard_errors,
     undetermined_notes,
+    zero_allowed,
 )
 from motionhyst.plants.quasi_static import QuasiStatic
 from motionhyst.time.openloop import OpenLoop
@@ -504,7 +507,9 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     Raises
     ------
     FitFailed
-        A fit that is no result.
+        A fit that is no result, or of whose parameters the records determine at most half
+        (:func:`~motionhyst.identify.io_uncertainty.judge_determined`; fewer not determined
+        are one of the result's ``warnings``).
 
     Examples
     --------
@@ -523,6 +528,11 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     >>> round(est["input_offset"], 6), fit.output
     (5.0, 'force')
     """
-    return identify_quasi_static_io(records, link, periodic=False, n_elements=n_elements,
-                                    offset=offset, max_evaluations=max_evaluations, tol=tol,
-                                    output="force")
+    fit = identify_quasi_static_io(records, link, periodic=False, n_elements=n_elements,
+                                   offset=offset, max_evaluations=max_evaluations, tol=tol,
+                                   output="force")
+    # parameters the records do not determine: a warning, or (most of them) a failed fit
+    fit.warnings.extend(judge_determined(fit.estimates, fit.std,
+                                         BOUC_WEN_SCALE if link is BoucWen else (),
+                                         zero_allowed(fit.plant, link)))
+    return fit

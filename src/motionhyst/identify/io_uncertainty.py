@@ -9,6 +9,15 @@ diagonal they are the square roots of (:func:`covariance`; ``identify --json`` a
 ``--save`` carry it for a Monte-Carlo study: :func:`covariance_table`,
 :func:`identification_toml`), and the notes that say so (:func:`undetermined_notes`,
 :func:`weak_notes`).
+
+The rule for what a fit does with a parameter the records do not determine (its standard
+error not finite, or above :data:`UNDETERMINED_FACTOR` times its value: its one-sigma range
+reaches zero) is :func:`judge_determined`: a warning naming it (the model holds its search
+value, which the records neither confirm nor contradict); when they are more than
+:data:`UNDETERMINED_SHARE` of the model's physical parameters, a failed fit, nothing saved
+(the model is one of many that fit the records as well: it cannot predict); an offset or
+initial state that is not distinguishable from 0 is neither (0 is a value the records
+allow).
 """
 
 from __future__ import annotations
@@ -19,7 +28,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = []
+__all__ = ["BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE", "judge_determined",
+           "undetermined", "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -28,6 +38,19 @@ determined (``z`` is not measured), only the products ``beta*gamma`` and ``beta*
 saved link has ``|gamma| + |delta| = 1``); a saved identification names them
 ``hysteresis.beta*gamma``, ... (a study draws them and sets ``beta``, ``gamma``, ``delta``)."""
 FD_SINGULAR_RTOL = 1e-5  # finite-difference Jacobians (step 1e-6) are no more exact than this
+#: A parameter whose standard error exceeds this factor times its value (its one-sigma range
+#: reaches zero, a sign the records do not fix) is not determined by the records
+UNDETERMINED_FACTOR = 1.0
+#: A Bouc-Wen link in the normalised form ``w = fc zeta`` (eq. 2 of
+#: :class:`~motionhyst.hysteresis.BoucWen`) enters the force only through ``beta / fc^n`` and
+#: ``gamma / fc^n``: scaling these three together changes no output, whatever the record
+BOUC_WEN_SCALE = ("link.fc", "link.beta", "link.gamma")
+#: A fit that leaves more than this share of its physical parameters (the stage's and the
+#: link's) not determined is not a model: the records hold less than it asks
+UNDETERMINED_SHARE = 0.5
+#: Parameters that may be zero or of either sign: offsets, drifts, initial states, the
+#: viscous friction's difference by direction, a Bouc-Wen link's shape products
+_SIGNED = ("offset", "drift", "y0", "v0", "c_skew", "beta*")
 
 
 def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
@@ -171,3 +194,115 @@ def weak_notes(names: list[str], values: NDArray[np.float64], std: NDArray[np.fl
         notes[name] = (f"not determined by these records: its standard error {s:.2g} exceeds "
                        f"the estimate {values[i]:.4g}; {what}")
     return notes
+
+
+def zero_allowed(plant, link) -> set[str]:
+    """The names (as an identification gives them: ``c``, ``link.sigma2``, ``link.k[2]``) of
+    the parameters of `plant` and the link class `link` whose declared range holds 0 (kind
+    ``nonnegative`` or ``finite``).
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import LuGre
+    >>> from motionhyst.plants import MassDamper
+    >>> sorted(zero_allowed(MassDamper(95.0, 200.0), LuGre))
+    ['c', 'c_skew', 'force_drift', 'force_offset', 'link.sigma1', 'link.sigma2']
+    """
+    out = {p.name for p in plant.parameters if p.kind != "positive"}
+    return out | {f"link.{p.name}" for p in link.parameters if p.kind != "positive"}
+
+
+def undetermined(estimates: dict[str, float], std: dict[str, float | None],
+                 invariant: tuple[str, ...] = (), zero: set[str] | frozenset = frozenset()
+                 ) -> list[str]:
+    """The estimated physical parameters the records do not determine: a standard error that
+    is not known (``None``: a direction of the Jacobian the records do not see, or above its
+    value where the route says so) or, for a parameter that must be positive, above
+    :data:`UNDETERMINED_FACTOR` times the estimate (for one whose range holds 0, names in
+    `zero`, an estimate within its standard error of 0 is a value: 0 is one the records
+    allow); offsets and initial states (which may be 0) are left out, and so are the
+    `invariant` parameters (a direction in which the model's output is the same for any
+    record: :data:`BOUC_WEN_SCALE`).
+
+    Examples
+    --------
+    >>> undetermined({"m": 2.0, "link.fc": 20.0, "link.k": 5e4, "output_offset": 1e-9},
+    ...              {"m": 0.01, "link.fc": None, "link.k": 6e4, "output_offset": 1e-6})
+    ['link.fc', 'link.k']
+    """
+    out = []
+    for name, value in estimates.items():
+        if name in invariant or any(word in name for word in _SIGNED):
+            continue
+        s = std.get(name)
+        if s is None or not math.isfinite(s) or (
+                name.split("[")[0] not in zero and s > UNDETERMINED_FACTOR * abs(value)):
+            out.append(name)
+    return out
+
+
+def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
+                     invariant: tuple[str, ...] = (), zero: set[str] | frozenset = frozenset()
+                     ) -> list[str]:
+    """What the records do not determine, judged: the warnings to give, or a failed fit.
+
+    Parameters
+    ----------
+    estimates, std : dict
+        The fit's estimates and their standard errors (``None`` where not determined).
+    invariant : tuple of str
+        Parameters along whose combination the model's output does not change for any
+        record (:data:`BOUC_WEN_SCALE`): not a question of the records, left out.
+    zero : set of str
+        The parameters whose range holds 0 (:func:`zero_allowed`).
+
+    Returns
+    -------
+    list of str
+        One warning naming the parameters the records do not determine, if any.
+
+    Raises
+    ------
+    FitFailed
+        More than :data:`UNDETERMINED_SHARE` of the model's physical parameters (the stage's
+        and the link's: offsets and initial states left out) are not determined: the
+        records hold less than the model asks, the values saved would be the search's, and
+        the model, one of many that fit these records as well, cannot predict another one.
+
+    Examples
+    --------
+    Two of a stage's and link's four parameters not determined: a warning naming them
+
+    >>> from motionhyst.identify.io_checks import FitFailed
+    >>> est = {"m": 2.18, "c": 21.0, "link.k": 946.0, "link.fc": 0.98}
+    >>> [line[:71] for line in judge_determined(
+    ...     est, {"m": 0.04, "c": 0.7, "link.k": 1.8e7, "link.fc": None})]
+    ['the records do not determine link.k, link.fc (their standard errors are']
+
+    Three of four: a failed fit (the command line's error: one line, exit 2, nothing saved)
+
+    >>> try:
+    ...     judge_determined(est, {"m": 0.04, "c": None, "link.k": 1.8e7, "link.fc": None})
+    ... except FitFailed as exc:
+    ...     print(str(exc)[:79])
+    the fit failed: the records determine 1 of the model's 4 parameters (not c, lin
+    """
+    from motionhyst.identify.io_checks import FitFailed
+
+    names = undetermined(estimates, std, invariant, zero)
+    if not names:
+        return []
+    physical = [n for n in estimates
+                if n not in invariant and not any(word in n for word in _SIGNED)]
+    if len(names) > UNDETERMINED_SHARE * len(physical):
+        shown = ", ".join(names[:5]) + (", ..." if len(names) > 5 else "")
+        raise FitFailed(f"the fit failed: the records determine {len(physical) - len(names)} "
+                        f"of the model's {len(physical)} parameters (not {shown}): its values "
+                        f"would be the search's, and the model, one of many that fit these "
+                        f"records as well, cannot predict; give a longer or richer record, or "
+                        f"a simpler link (fewer --elements)")
+    what = "its search value" if len(names) == 1 else "their search values"
+    its = "its standard error is unknown or exceeds its value" if len(names) == 1 else \
+        "their standard errors are unknown or exceed their values"
+    return [f"the records do not determine {', '.join(names)} ({its}): the model holds "
+            f"{what}, which these records neither confirm nor contradict"]
