@@ -27,6 +27,7 @@ from records_of_other_kinds import (
     fit_percent,
     piezo_record,
 )
+from scipy import signal
 
 from motionhyst.cli import main
 from motionhyst.scenario import Scenario
@@ -270,3 +271,51 @@ def test_a_piezo_whose_bouc_wen_exponent_is_not_one_still_predicts(capsys, tmp_p
                        str(tmp_path / "x.csv"), "--json")
     assert rc == 0 and err == ""
     assert json.loads(out)["fit_percent"] >= 95.0
+
+
+def test_a_model_the_record_does_not_determine_is_refused_and_not_saved(capsys, tmp_path):
+    """64 samples of a linear mass-spring-damper (no hysteresis) and five Maxwell-slip
+    elements: the record determines 2 of the model's 13 parameters; a model of search values
+    that predicts nothing else is a one-line refusal, nothing saved (it was exit 0)."""
+    rng = np.random.default_rng(1)
+    t = np.arange(64) * 1e-2
+    u = 100.0 * rng.standard_normal(t.size)
+    _, y, _ = signal.lsim(signal.lti([1.0], [2.0, 20.0, 2e4]), u, t)  # m, c, k
+    record = tmp_path / "short.csv"
+    np.savetxt(record, np.column_stack([t, u, y + 1e-8 * rng.standard_normal(t.size)]),
+               delimiter=",", header="time,force,displacement", comments="")
+    model = tmp_path / "m.toml"
+    rc, out, err = run(capsys, "identify", str(record), "--record", "input-output",
+                       "--model", "maxwell-slip", "--elements", "5", "--save", str(model))
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert "the records determine" in err and "fewer --elements" in err
+    assert not model.exists()
+
+
+def test_force_displacement_records_of_one_damper_are_fitted_together(capsys, tmp_path):
+    """Two histories of one damper: one link from both (it was refused), which predicts a
+    third history's force."""
+    files = []
+    for i, history in enumerate(("sines", "earthquake")):
+        rec = damper_record(history, seed=10 + i, fs=100.0, seconds=20.0)
+        files.append(str(rec.write(tmp_path / f"{history}.csv",
+                                   ("time", "displacement", "force"))))
+    held_out = damper_record("earthquake", seed=12, fs=100.0, seconds=20.0)
+    held_out.write(tmp_path / "quake.csv", ("time", "displacement"))
+    model = tmp_path / "damper.toml"
+    rc, out, err = run(capsys, *["identify", *files], "--save", str(model))
+    assert rc == 2 and "give their link with --model" in err and not model.exists()
+    rc, out, err = run(capsys, *["identify", *files], "--model", "maxwell-slip", "--elements",
+                       "3", "--save", str(model), "--json")
+    assert rc == 0 and err == "", err
+    fit = json.loads(out)
+    assert fit["data"] == files and len(fit["records"]) == 2
+    assert sorted(fit["estimates"][f"link.fc[{i}]"] for i in range(3)) == pytest.approx(
+        sorted(DAMPER_LINK.fc), rel=0.03)
+    assert fit["estimates"]["k"] == pytest.approx(DAMPER_PLANT.k, rel=0.03)
+    force = tmp_path / "force.csv"
+    rc, out, err = run(capsys, "predict", str(model), str(tmp_path / "quake.csv"), "--out",
+                       str(force))
+    assert rc == 0 and err == ""
+    predicted = np.loadtxt(force, delimiter=",", skiprows=1)[:, 1]
+    assert fit_percent(held_out.force, predicted) >= 95.0

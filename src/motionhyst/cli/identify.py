@@ -131,26 +131,28 @@ def run(args: argparse.Namespace) -> int:
         return run_input_output(args)
     check_not_input_output(args, closed_loop=args.record != "force-displacement")
     if len(args.data) > 1:
-        raise UsageError("motionhyst identify: several records are read with --record "
-                         "input-output only")
+        paths = [Path(p) for p in args.data]
+        if any(record_kind(p, args.record, args.columns) != "force-displacement"
+               for p in paths):
+            raise UsageError("motionhyst identify: several records are read with --record "
+                             "input-output, or as force-displacement records (with --model)")
+        if args.model is None:
+            raise UsageError("motionhyst identify: several force-displacement records are "
+                             "fitted together by the force's error: give their link with "
+                             "--model (maxwell-slip, dahl, bouc-wen, lugre, ...)")
+        check_fd_options(args, paths[0])
+        return _run_link_force(args, paths)
     path = Path(args.data[0])
     kind = record_kind(path, args.record, args.columns)
-    if kind == "force-displacement" and args.offset is not None:
-        raise UsageError("motionhyst identify: --offset applies to input-output and closed-loop "
-                         "records only (a force-displacement record's offset is always "
-                         "estimated)")
+    if kind == "force-displacement":
+        check_fd_options(args, path)
     if args.offset in ("output", "both"):
         raise UsageError(f"motionhyst identify: --offset {args.offset}: a closed-loop record's "
                          f"position offset does not enter the link force inferred from it; "
                          f"use --offset auto, input or none")
     if kind == "force-displacement":
-        for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
-            if value is not None:
-                raise UsageError(f"motionhyst identify: {option} applies to closed-loop "
-                                 f"records (time,y1,u) only; {path} is a force-displacement "
-                                 f"record")
         if args.model is not None:
-            return _run_link_force(args, path)
+            return _run_link_force(args, [path])
         if args.max_evaluations is not None:
             raise UsageError("motionhyst identify: --max-evaluations applies to input-output "
                              "records and to force-displacement records with --model")
@@ -248,9 +250,23 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_link_force(args: argparse.Namespace, path: Path) -> int:
-    """A force-displacement record's link of `--model`, with a spring and damper in parallel,
-    fitted by the force's error; printed, optionally saved (a quasi-static system)."""
+def check_fd_options(args: argparse.Namespace, path: Path) -> None:
+    """Refuse the options a force-displacement record (`path`) has no use for."""
+    if args.offset is not None:
+        raise UsageError("motionhyst identify: --offset applies to input-output and closed-loop "
+                         "records only (a force-displacement record's offset is always "
+                         "estimated)")
+    for option, value in (("--scenario", args.scenario), ("--cutoff", args.cutoff)):
+        if value is not None:
+            raise UsageError(f"motionhyst identify: {option} applies to closed-loop "
+                             f"records (time,y1,u) only; {path} is a force-displacement "
+                             f"record")
+
+
+def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
+    """Force-displacement records' link of `--model`, with a spring and damper in parallel,
+    fitted by the force's error (the records together: one link, each record's own
+    displacement offset); printed, optionally saved (a quasi-static system)."""
     if args.criterion is not None:
         raise UsageError("motionhyst identify: --criterion chooses the number of Maxwell-slip "
                          "elements of a fit without --model")
@@ -260,30 +276,37 @@ def _run_link_force(args: argparse.Namespace, path: Path) -> int:
     if args.save is not None:  # refused before the work, not after
         from motionhyst.io.outputs import OutputFile
 
-        target = OutputFile(args.save, force=args.force, inputs=[path], option="--save")
+        target = OutputFile(args.save, force=args.force, inputs=paths, option="--save")
     from motionhyst.identify.records import load_force_displacement_csv
 
-    t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
+    records = []
+    for path in paths:
+        t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
+        records.append((path, t, x, w))
     from motionhyst.hysteresis import model_class
     from motionhyst.identify.io_quasi_static import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
+    names = ", ".join(str(p) for p in paths)
     try:
         with search_budget():
-            fit = identify_link_force([IORecord(t, w, x, str(path))], model_class(args.model),
-                                      n_elements=args.elements or 3,
+            fit = identify_link_force([IORecord(t, w, x, str(p)) for p, t, x, w in records],
+                                      model_class(args.model), n_elements=args.elements or 3,
                                       max_evaluations=args.max_evaluations)
     except (ValueError, RuntimeError) as exc:
-        raise type(exc)(f"{path}: {exc}") from None
-    result = {**fit.to_dict(), "record": "force-displacement", "data": str(path)}
+        raise type(exc)(f"{names}: {exc}") from None
+    result = {**fit.to_dict(), "record": "force-displacement",
+              "data": str(paths[0]) if len(paths) == 1 else [str(p) for p in paths]}
     if target is not None:
         target.write_text(fit.scenario_text())
         result["saved"] = args.save
     if args.json:
         print_json(result)
         return 0
-    print(f"{args.model} link with a spring and damper in parallel identified from {path} "
-          f"(force-displacement record, {t.size} samples) by the force's error in "
+    samples = sum(t.size for _, t, _, _ in records)
+    what = "record" if len(paths) == 1 else f"{len(paths)} records"
+    print(f"{args.model} link with a spring and damper in parallel identified from {names} "
+          f"(force-displacement {what}, {samples} samples) by the force's error in "
           f"{fit.seconds:.3g} s")
     print("\n".join(str(fit).splitlines()[1:]))
     if target is not None:
