@@ -201,6 +201,18 @@ def zero_allowed(plant, link) -> set[str]:
     the parameters of `plant` and the link class `link` whose declared range holds 0 (kind
     ``nonnegative`` or ``finite``).
 
+    Parameters
+    ----------
+    plant : LumpedPlant
+        The identified stage (its class's ``parameters``).
+    link : type
+        The link's model, a registered :class:`~motionhyst.hysteresis.Hysteresis` class.
+
+    Returns
+    -------
+    set of str
+        The names, ``link.`` before the link's.
+
     Examples
     --------
     >>> from motionhyst.hysteresis import LuGre
@@ -223,6 +235,20 @@ def undetermined(estimates: dict[str, float], std: dict[str, float | None],
     allow); offsets and initial states (which may be 0) are left out, and so are the
     `invariant` parameters (a direction in which the model's output is the same for any
     record: :data:`BOUC_WEN_SCALE`).
+
+    Parameters
+    ----------
+    estimates, std : dict
+        The fit's estimates and their standard errors (``None`` where not determined).
+    invariant : tuple of str
+        Parameters along whose combination the model's output does not change.
+    zero : set of str
+        The parameters whose range holds 0 (:func:`zero_allowed`).
+
+    Returns
+    -------
+    list of str
+        Their names, in the order of `estimates`.
 
     Examples
     --------
