@@ -28,8 +28,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE", "judge_determined",
-           "undetermined", "zero_allowed"]
+__all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
+           "judge_determined", "undetermined", "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -48,6 +48,9 @@ BOUC_WEN_SCALE = ("link.fc", "link.beta", "link.gamma")
 #: A fit that leaves more than this share of its physical parameters (the stage's and the
 #: link's) not determined is not a model: the records hold less than it asks
 UNDETERMINED_SHARE = 0.5
+#: A parameter whose range holds 0 and whose estimate is below this share of the fit's largest
+#: estimate ended at 0 (a damper the records do not show)
+AT_ZERO = 1e-12
 #: Parameters that may be zero or of either sign: offsets, drifts, initial states, the
 #: viscous friction's difference by direction, a Bouc-Wen link's shape products
 _SIGNED = ("offset", "drift", "y0", "v0", "c_skew", "beta*")
@@ -232,9 +235,10 @@ def undetermined(estimates: dict[str, float], std: dict[str, float | None],
     value where the route says so) or, for a parameter that must be positive, above
     :data:`UNDETERMINED_FACTOR` times the estimate (for one whose range holds 0, names in
     `zero`, an estimate within its standard error of 0 is a value: 0 is one the records
-    allow); offsets and initial states (which may be 0) are left out, and so are the
-    `invariant` parameters (a direction in which the model's output is the same for any
-    record: :data:`BOUC_WEN_SCALE`).
+    allow, and so is one at 0, below :data:`AT_ZERO` of the largest estimate); offsets and
+    initial states (which may be 0) are left out, and so are the `invariant` parameters (a
+    direction in which the model's output is the same for any record:
+    :data:`BOUC_WEN_SCALE`).
 
     Parameters
     ----------
@@ -255,11 +259,17 @@ def undetermined(estimates: dict[str, float], std: dict[str, float | None],
     >>> undetermined({"m": 2.0, "link.fc": 20.0, "link.k": 5e4, "output_offset": 1e-9},
     ...              {"m": 0.01, "link.fc": None, "link.k": 6e4, "output_offset": 1e-6})
     ['link.fc', 'link.k']
+    >>> undetermined({"k": 1e5, "c": 5.5e-18, "link.fc": 100.0},   # c ended at 0
+    ...              {"k": 0.3, "c": None, "link.fc": 4e-4}, zero={"k", "c"})
+    []
     """
     out = []
+    largest = max([abs(v) for v in estimates.values() if math.isfinite(v)] or [0.0])
     for name, value in estimates.items():
         if name in invariant or any(word in name for word in _SIGNED):
             continue
+        if name.split("[")[0] in zero and abs(value) <= AT_ZERO * largest:
+            continue  # ended at 0, where a forward difference sees no effect: none in the records
         s = std.get(name)
         if s is None or not math.isfinite(s) or (
                 name.split("[")[0] not in zero and s > UNDETERMINED_FACTOR * abs(value)):
