@@ -83,7 +83,8 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                         "steady state (default: each is an experiment from rest)")
     q.add_argument("--nu", type=_nu, metavar="NU|free",
                    help="input-output records, Bouc-Wen: the exponent nu, fixed (default 1) or "
-                        "'free' to estimate it")
+                        "'free' to estimate it (--plant quasi-static: by fits of nu fixed at "
+                        "1, 1.5, 2, 3 and around the best)")
     q.add_argument("--save", metavar="MODEL.toml",
                    help="input-output records: write the identified system as a scenario "
                         "(read by motionhyst predict); force-displacement records: the link "
@@ -127,9 +128,6 @@ def run_input_output(args: argparse.Namespace) -> int:
         raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     if args.nu is not None and model != "bouc-wen":
         raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
-    if args.nu is not None and plant == "quasi-static":
-        raise UsageError("motionhyst identify: --nu does not apply to --plant quasi-static (its "
-                         "Bouc-Wen link has the exponent 1)")
     target = None
     if args.save is not None:  # refused before the work, not after
         from motionhyst.io.outputs import OutputFile

@@ -378,7 +378,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         return identify_quasi_static_io(records, link, periodic=periodic,
                                         n_elements=n_elements, offset=offset,
                                         max_evaluations=max_evaluations, tol=tol,
-                                        t_start=t_start)
+                                        t_start=t_start, nu=nu)
     shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
     if asymmetric and not (link is not BoucWen and shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)

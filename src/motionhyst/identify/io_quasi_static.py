@@ -175,13 +175,14 @@ class _Problem:
                              max_nfev=max_nfev, bounds=(lower, np.full(lower.size, np.inf)))
 
 
-def _layout(link: type, n_elements: int) -> LinkLayout:
-    """The link's search layout; Bouc-Wen's exponent fixed at its default 1 (exact steps)."""
+def _layout(link: type, n_elements: int, nu: float = 1.0) -> LinkLayout:
+    """The link's search layout; Bouc-Wen's exponent fixed at `nu` (default 1: exact steps;
+    estimated by :func:`_exponent_profile`)."""
     layout = LinkLayout.of(link, n_elements)
     for par, count in list(layout.entries):
         if par.name in ("n", "nu") and count < 0 and par.default is not None:
             layout.entries.remove((par, count))
-            layout.fixed[par.name] = float(par.default)  # type: ignore[arg-type]
+            layout.fixed[par.name] = float(nu)
     return layout
 
 
@@ -264,7 +265,8 @@ def _linear_rms(records: list[IORecord], K: float, C: float, periodic: bool) -> 
 def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: bool,
                              n_elements: int, offset: str, max_evaluations: int | None,
                              tol: float, t_start: float | None = None,
-                             output: str = "position") -> IOIdentification:
+                             output: str = "position", nu: float | None = 1.0
+                             ) -> IOIdentification:
     """A quasi-static plant and its link from input-output records (see the module).
 
     Parameters
@@ -290,6 +292,11 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         The error fitted: the position's simulated from the force (a force in, a position
         out), or the force's from the measured displacement (a force-displacement record:
         the displacement imposed, the force measured, :func:`identify_link_force`).
+    nu : float or None
+        A Bouc-Wen link's exponent ``n``: fixed at this value (default 1), or estimated
+        (None: the fit of each exponent of :data:`NU_GRID`, the best refined by a bounded
+        scalar search, :func:`_exponent_profile`; its standard error from the curvature of
+        the fits' cost in ``n``; `max_evaluations` then holds for each fit).
 
     Returns
     -------
@@ -321,8 +328,12 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     (100.0, 0.0)
     """
     t0 = time.perf_counter() if t_start is None else t_start
+    if nu is None and link is BoucWen:
+        return _exponent_profile(records, periodic=periodic, offset=offset,
+                                 max_evaluations=max_evaluations, tol=tol, t_start=t0,
+                                 output=output)
     force_error = output == "force"
-    layout = _layout(link, n_elements)
+    layout = _layout(link, n_elements, 1.0 if nu is None else nu)
     K, C, b = _linear_start(records)
     if not K > 0:
         u_all = np.concatenate([rec.u - np.mean(rec.u) for rec in records])
@@ -423,6 +434,54 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                  f"{prob.n_eval} evaluations with the starts)",
         n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings,
         data=list(records), residuals=res, output=what)
+
+
+#: The exponents of a Bouc-Wen link fitted when it is estimated (``--nu free``): its fits of
+#: ``n`` free together with the rest stall (near saturation ``|zeta|^n`` hardly changes
+#: with ``n``), fits of ``n`` fixed do not
+NU_GRID = (1.0, 1.5, 2.0, 3.0)
+
+
+def _exponent_profile(records: list[IORecord], **options) -> IOIdentification:
+    """A Bouc-Wen link on a quasi-static plant with its exponent estimated: the fit of each
+    exponent of :data:`NU_GRID`, the best one's neighbourhood searched by a bounded scalar
+    search (to 0.01), the exponent's standard error from the curvature of the fits' cost
+    ``RSS(n)`` at its minimum (``sqrt(2 s^2 / RSS'')``, ``s^2`` the residuals' variance)."""
+    from scipy.optimize import minimize_scalar
+
+    fits: dict[float, IOIdentification] = {}
+
+    def cost(nu: float) -> float:
+        try:
+            fit = identify_quasi_static_io(records, BoucWen, nu=float(nu), n_elements=1,
+                                           **options)
+        except FitFailed:
+            return math.inf
+        fits[float(nu)] = fit
+        return float(np.sum(fit.residuals ** 2))
+
+    costs = [cost(nu) for nu in NU_GRID]
+    i = int(np.argmin(costs))
+    if not math.isfinite(costs[i]):
+        raise FitFailed(f"the fit failed: no exponent of {', '.join(map(str, NU_GRID))} gives "
+                        f"a Bouc-Wen link on a quasi-static plant that describes these records")
+    lo, hi = NU_GRID[max(i - 1, 0)], NU_GRID[min(i + 1, len(NU_GRID) - 1)]
+    minimize_scalar(cost, bounds=(lo, hi), method="bounded",
+                    options={"xatol": 0.01, "maxiter": 8})
+    nus = np.array(sorted(fits))
+    rss = np.array([float(np.sum(fits[nu].residuals ** 2)) for nu in nus])
+    j = int(np.argmin(rss))
+    best = fits[float(nus[j])]
+    std = None
+    if 0 < j < nus.size - 1:  # the parabola through the minimum and its neighbours
+        a = np.polyfit(nus[j - 1:j + 2] - nus[j], rss[j - 1:j + 2], 2)[0]
+        s2 = rss[j] / max(best.residuals.size - len(best.estimates) - 1, 1)
+        std = float(np.sqrt(2.0 * s2 / (2.0 * a))) if a > 0 else None
+    best.estimates["link.n"] = float(nus[j])
+    best.std["link.n"] = std
+    best.stopping += (f"; exponent n by the fits of {nus.size} fixed values from "
+                      f"{nus[0]:g} to {nus[-1]:g}")
+    return best
 
 
 def _judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IORecord],
