@@ -72,6 +72,17 @@ class Record:
         return path
 
 
+    def write_in_units(self, path: Path, columns: tuple[str, str, str] = ("t_s", "F_mN", "x_um"),
+                       gains: tuple[float, float, float] = (1.0, 1e3, 1e6)) -> Path:
+        """A CSV of time, force and displacement under the lab's own `columns` names, each
+        multiplied by its gain (default: mN and um, a piezo stack's logger)."""
+        data = (self.t, self.force, self.displacement)
+        with open(path, "w", newline="") as f:
+            out = csv.writer(f)
+            out.writerow(columns)
+            out.writerows(zip(*(g * d for g, d in zip(gains, data, strict=True)), strict=True))
+        return path
+
     def write_as_logged(self, path: Path, seed: int = 0, force: bool = True) -> Path:
         """A CSV as a test machine logs it: ``Time (s)`` jittered by 0.2 % of a step,
         ``LVDT_mm`` (its zero 0.1 mm off, 2 um noise) and ``Load_kN`` (when `force`; its
@@ -155,13 +166,14 @@ def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
 
 def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
                   seconds: float = 40.0, link: str | None = None,
-                  stiffening: float = 0.0) -> Record:
+                  stiffening: float = 0.0, drift: float = 0.0) -> Record:
     """A friction damper's record: displacement imposed, force measured (with offset, noise).
 
     `history`: ``"sines"`` (0.2 to 2 Hz, 3 to 20 mm) or ``"earthquake"`` (20 mm peak);
     `link`: a name of :data:`DAMPER_LINKS` (default :data:`DAMPER_LINK`); `stiffening`: the
     share by which its spring stiffens over the record (a rubber part warming up), which no
-    model of motionhyst describes.
+    model of motionhyst describes; `drift`: the displacement at the end of a linear drift
+    over the record [m] (the test machine's actuator creeping, a residual displacement).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(int(seconds * fs)) / fs
@@ -169,6 +181,7 @@ def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
         x = stepped_sines(t, [(0.2, 0.02), (0.5, 0.008), (1.0, 0.014), (2.0, 0.003)])
     else:
         x = earthquake_like(t, rng, 0.02)
+    x = x + drift * t / t[-1]
     w = force_from_displacement(DAMPER_PLANT, DAMPER_LINK if link is None else
                                 DAMPER_LINKS[link], t, x)
     w = w + stiffening * DAMPER_PLANT.k * (t / t[-1]) * x
