@@ -407,3 +407,30 @@ def test_many_elements_steady_state_equals_the_fixed_point_of_full_evaluations()
         e_sin[0] = e[0].real
         assert it == ss.iterations
         assert_allclose(ss.e, e_sin, rtol=0, atol=1e-13 * np.max(np.abs(e_sin)))
+
+
+def test_a_sines_slip_onsets_in_closed_form_are_the_cubics():
+    """For a sine the slip onsets are ``a + arccos(level / x_top)``, exact to round-off: the
+    same pieces as the walk on the grid's cubic, whose onsets (one Newton step on the cell's
+    cubic) put the sine within 3e-9 of its amplitude of the level (the output changes with
+    the square of an onset's error)."""
+    from motionhyst.hysteresis import _fft, _kernels
+
+    X = np.array([0.0, 0.004 * np.exp(0.7j)])
+    C1, C2 = 1j * np.arange(2) * X, -(np.arange(2) ** 2) * X
+    ok, rev, xr = _kernels.dominant_reversals(X, C1, C2, True)
+    assert ok
+    top = 1 if xr[1] > xr[0] else 0
+    k, fc = _many_elements()
+    x = _fft.synthesize(X, 1024, stop_twiddles(1, 1))
+    cubic = _kernels.half_cubic_pieces(x, rev[top], xr[top], k, fc)
+    closed = _kernels.half_sine_pieces(rev[top], xr[top], k, fc)
+    assert 0 < cubic[0].size - 1 < k.size  # some elements slip, some never do
+    a = rev[top]
+    level = xr[top] - 2 * fc / k  # where an element slips on the way down from +fc
+    slips = level > -xr[top]
+    assert_allclose(np.cos(closed[0][:-1] - a), level[slips] / xr[top], rtol=0, atol=1e-15)
+    assert_allclose(np.cos(closed[0] - a), np.cos(cubic[0] - a), rtol=0, atol=3e-9)
+    assert_array_equal(closed[1], cubic[1])
+    assert_array_equal(closed[2], cubic[2])
+    assert closed[4] == pytest.approx(cubic[4], rel=1e-8)  # the mean stiffness

@@ -553,23 +553,11 @@ def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
     inv_h = n / _TWO_PI
     b = a + np.pi
     x_end = -x_top
-    down = x_end - x_top
-    up = x_top - x_end
     lo0 = a * inv_h
     hi0 = b * inv_h
     j_lo = int(np.floor(lo0)) + 1
     j_hi = int(np.ceil(hi0)) - 1
-    # pass 1: the periodic state at the maximum and the slip level of each element
-    level = np.empty(m)
-    wis = np.empty(m)
-    for e in range(m):
-        ke = k[e]
-        fe = fc[e]
-        w = min(max(ke * x_top, -fe), fe)
-        w = min(max(w + ke * down, -fe), fe)
-        wi = min(max(w + ke * up, -fe), fe)
-        wis[e] = wi
-        level[e] = x_top + (-fe - wi) / ke
+    level, wis = _half_levels(x_top, k, fc)
     # pass 2: each slipping element's cell along the branch (one walk), or its angle
     s_of = np.empty(m)
     c_of = np.empty(m, dtype=np.int64)  # -1: s known
@@ -664,7 +652,36 @@ def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
             s = _cubic_root(x0 - level[e], c1, c2, c3, lo_of[e], hi_of[e], flo_of[e],
                             fhi_of[e], False) + c
         s_of[e] = s * h
-    # pass 4: the pieces
+    return _half_pieces(s_of, a, x_top, wis, k, fc)
+
+
+@njit(cache=True, error_model="numpy")
+def _half_levels(x_top, k, fc):  # pragma: no cover - compiled
+    """The first pass of :func:`half_cubic_pieces`: each element's periodic state at the
+    maximum `x_top` of a half-wave symmetric input and the level of ``x`` at which it
+    slips on the way down."""
+    m = k.shape[0]
+    down = -2.0 * x_top
+    up = 2.0 * x_top
+    level = np.empty(m)
+    wis = np.empty(m)
+    for e in range(m):
+        ke = k[e]
+        fe = fc[e]
+        w = min(max(ke * x_top, -fe), fe)
+        w = min(max(w + ke * down, -fe), fe)
+        wi = min(max(w + ke * up, -fe), fe)
+        wis[e] = wi
+        level[e] = x_top + (-fe - wi) / ke
+    return level, wis
+
+
+@njit(cache=True)
+def _half_pieces(s_of, a, x_top, wis, k, fc):  # pragma: no cover - compiled
+    """The last pass of :func:`half_cubic_pieces`: the jumps of the pieces from the slip
+    onsets `s_of` (``a + pi`` for an element that does not slip) and the states `wis`."""
+    m = k.shape[0]
+    b = a + np.pi
     t_b = np.empty(m + 1)
     jg = np.empty(m + 1)
     js = np.empty(m + 1)
@@ -694,6 +711,25 @@ def half_cubic_pieces(x, a, x_top, k, fc):  # pragma: no cover - compiled
     t_b[nb], jg[nb], js[nb] = a, at_g, at_s
     nb += 1
     return t_b[:nb], jg[:nb], js[:nb], 0.0, 2.0 * s_mean / _TWO_PI
+
+
+@njit(cache=True)
+def half_sine_pieces(a, x_top, k, fc):  # pragma: no cover - compiled
+    """:func:`half_cubic_pieces` of a sine, ``x = x_top cos(theta - a)``: each slip onset in
+    closed form, ``a + arccos(level / x_top)``, rather than on the grid's cubic."""
+    level, wis = _half_levels(x_top, k, fc)
+    m = k.shape[0]
+    b = a + np.pi
+    s_of = np.empty(m)
+    for e in range(m):
+        slip_level = level[e]
+        if not slip_level > -x_top:
+            s_of[e] = b  # never slips
+        elif slip_level >= x_top:
+            s_of[e] = a
+        else:
+            s_of[e] = a + np.arccos(slip_level / x_top)
+    return _half_pieces(s_of, a, x_top, wis, k, fc)
 
 
 @njit(cache=True)

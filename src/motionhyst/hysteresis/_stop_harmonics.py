@@ -39,6 +39,7 @@ from motionhyst.hysteresis._kernels import (
     cubic_error_bound,
     dominant_reversals,
     half_cubic_pieces,
+    half_sine_pieces,
     reversal_points,
     stop_pieces,
 )
@@ -176,10 +177,13 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         if (k.shape[0] >= CUBIC_ELEMENTS
                 and cubic_error_bound(Xs, n) <= 1e-9 * abs(xr[0] - xr[1])):
             mode = GRID_CUBIC
-            x = synthesize(Xs, n, tw)
+            if M > 1:
+                x = synthesize(Xs, n, tw)
     half = symmetric and monotone
     top = 1 if xr[1] > xr[0] else 0
-    if half and mode == GRID_CUBIC:
+    if half and mode == GRID_CUBIC and M == 1:  # a sine: the onsets in closed form
+        t_b, jg, js, g_mean, s_mean = half_sine_pieces(rev[top], xr[top], k, fc)
+    elif half and mode == GRID_CUBIC:
         t_b, jg, js, g_mean, s_mean = half_cubic_pieces(x, rev[top], xr[top], k, fc)
     else:
         t_b, jg, js, g_mean, s_mean = stop_pieces(Xs, C1, x, rev, xr, k, fc, mode, half)
