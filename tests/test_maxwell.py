@@ -333,7 +333,7 @@ def test_small_change_of_the_input_is_followed_to_first_order(direction):
     X = _rich_symmetric_input(M, 0.01, 1)
     tw = stop_twiddles(M, H)
     grid = np.zeros(2, dtype=np.int64)
-    Wb, table, base, Xb, S, t_b, js, x_top = _full(X, k, fc, H, tw, grid)
+    Wb, table, base, Xb, S, zs, t_b, js, x_top = _full(X, k, fc, H, tw, grid)
     assert base and 0 < t_b.size - 1 < k.size  # some elements slip, some never do
     eps = 5e-11
     if direction == "amplitude":
@@ -344,7 +344,7 @@ def test_small_change_of_the_input_is_followed_to_first_order(direction):
         Xn = X.copy()
         Xn[3::2] += eps * abs(X[1]) / 20 * np.exp(1j * np.arange(3, M + 1, 2))
     full = _full(Xn, k, fc, H, tw)[0]
-    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid)
+    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table, grid)
     assert ok
     scale = np.max(np.abs(full))
     assert np.max(np.abs(full - Wb)) > 1e-12 * scale

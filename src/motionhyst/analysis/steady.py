@@ -486,6 +486,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     Wb = np.empty(0, dtype=np.complex128)
     Xb = np.empty(0, dtype=np.complex128)
     Sb = np.empty(0, dtype=np.complex128)
+    zs = np.empty(0, dtype=np.complex128)
     t_b = np.empty(0)
     js = np.empty(0)
     x_top = 0.0
@@ -493,15 +494,15 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
         updated = False
         W_new = Wb
         if base:
-            updated, W_new = stop_harmonics_update(X, H, tw, Wb, Xb, Sb, t_b, js, x_top,
-                                                   weights, grid)
+            updated, W_new = stop_harmonics_update(X, H, tw, Wb, Xb, Sb, zs, t_b, js,
+                                                   x_top, weights, grid)
         if not updated:
             if it == 1:  # the linear loop's y1, one harmonic: a grid of its own; the
                 # starting value, whose error the contraction damps at each later iteration
-                W_new, first_weights, base, Xb, Sb, t_b, js, x_top = stop_harmonics_base(
+                W_new, first_weights, base, Xb, Sb, zs, t_b, js, x_top = stop_harmonics_base(
                     X, k, fc, H, tw, first_weights, first_grid, H, FIRST_ITERATION_TOL)
             else:  # one grid for any number of harmonics of y1
-                W_new, weights, base, Xb, Sb, t_b, js, x_top = stop_harmonics_base(
+                W_new, weights, base, Xb, Sb, zs, t_b, js, x_top = stop_harmonics_base(
                     X, k, fc, H, tw, weights, grid, 2 * H, 1e-17)
             Wb = W_new
         change = 0.0

@@ -733,6 +733,22 @@ def half_sine_pieces(a, x_top, k, fc):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def first_harmonic_dominates(X):  # pragma: no cover - compiled
+    """Whether the bounds of :func:`dominant_reversals` hold for `X` (two reversals a period,
+    one near each zero of the first harmonic's derivative), with ``a_1`` and ``R_1``."""
+    M = X.shape[0] - 1
+    a1 = 2.0 * abs(X[1]) if M >= 1 else 0.0
+    r1 = 0.0
+    r2 = 0.0
+    for m in range(2, M + 1):
+        r1 += m * abs(X[m])
+        r2 += m * m * abs(X[m])
+    r1 *= 2.0
+    r2 *= 2.0
+    return a1 > 0.0 and r1 < 0.25 * a1 and r2 < 0.8 * a1, a1, r1
+
+
+@njit(cache=True)
 def dominant_reversals(X, C1, C2, half):  # pragma: no cover - compiled
     """The reversal points of ``x`` when its first harmonic dominates, else none.
 
@@ -747,18 +763,8 @@ def dominant_reversals(X, C1, C2, half):  # pragma: no cover - compiled
     """
     rev = np.empty(2)
     xr = np.empty(2)
-    M = X.shape[0] - 1
-    a1 = 2.0 * abs(X[1]) if M >= 1 else 0.0
-    if a1 == 0.0:
-        return False, rev, xr
-    r1 = 0.0
-    r2 = 0.0
-    for m in range(2, M + 1):
-        r1 += m * abs(X[m])
-        r2 += m * m * abs(X[m])
-    r1 *= 2.0
-    r2 *= 2.0
-    if not (r1 < 0.25 * a1 and r2 < 0.8 * a1):
+    ok, a1, r1 = first_harmonic_dominates(X)
+    if not ok:
         return False, rev, xr
     delta = np.arcsin(2.0 * r1 / a1) + 1e-6
     alpha = np.arctan2(X[1].imag, X[1].real)

@@ -38,10 +38,12 @@ from motionhyst.hysteresis._kernels import (
     GRID_CUBIC,
     cubic_error_bound,
     dominant_reversals,
+    first_harmonic_dominates,
     half_cubic_pieces,
     half_sine_pieces,
     reversal_points,
     stop_pieces,
+    trig2,
 )
 
 _TWO_PI = 2.0 * np.pi
@@ -130,11 +132,12 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
 def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: no cover
     """:func:`stop_harmonics_kept` with the binned sums to `tol` of the sums of their weights'
     moduli (1e-17: to round-off), returning also what :func:`stop_harmonics_update` needs
-    to follow a small change of the input: ``(W, table, base, Xs, S, t_b, js, x_top)``.
+    to follow a small change of the input: ``(W, table, base, Xs, S, zs, t_b, js, x_top)``.
 
     ``base`` is True where the output came from many jumps binned (the costly case) over a
     half-wave symmetric, monotone branch: ``Xs`` is then the input as used (no DC, no even
-    harmonics), ``S`` the harmonics ``0 .. H + M`` of the stiffness ``s``, ``t_b`` and
+    harmonics), ``S`` the harmonics ``0 .. H + M`` of the stiffness ``s`` (``zs`` its
+    samples as transformed for the product ``s x``, where it was transformed), ``t_b`` and
     ``js`` the jumps of ``s`` over the first half period (the slip onsets, then the
     reversal at the maximum ``x_top``).
 
@@ -151,7 +154,7 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
     no_jumps = np.empty(0)
     M = significant_count(X, 1e-15)
     if M == 0:
-        return W, table, False, none, none, no_jumps, no_jumps, 0.0
+        return W, table, False, none, none, none, no_jumps, no_jumps, 0.0
     # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
     # loop's y1): made exact, its output's second half period mirrors the first
     Xs, symmetric, total = _without_dc(X, M)
@@ -168,7 +171,7 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         x = synthesize(Xs, n, tw)
         rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
     if rev.shape[0] < 2:
-        return W, table, False, none, none, no_jumps, no_jumps, 0.0
+        return W, table, False, none, none, none, no_jumps, no_jumps, 0.0
     mode = GRID_BRACKET
     if monotone:
         mode = BETWEEN_REVERSALS
@@ -207,19 +210,21 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
     S[0] = s_mean
     if direct:
         _add_convolution(G, S, Xs, 1, W)
+        zs = none
     else:
-        P_x = _product(S, Xs, n, H, half, tw)
+        P_x, zs = _product(S, Xs, n, H, half, tw)
         for q in range(H + 1):
             W[q] = G[q] + P_x[q]
     if half and binned:
-        return W, table, True, Xs, S, t_b, js, xr[top]
-    return W, table, False, none, none, no_jumps, no_jumps, 0.0
+        return W, table, True, Xs, S, zs, t_b, js, xr[top]
+    return W, table, False, none, none, none, no_jumps, no_jumps, 0.0
 
 
 @njit(cache=True)
-def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # pragma: no cover
+def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
+                          grid):  # pragma: no cover - compiled
     """The output of :func:`stop_harmonics_base` for the input `X`, from its output ``Wb`` for
-    an input ``Xb`` near it (``Xb``, ``S``, ``t_b``, ``js``, ``x_top`` as it returned them,
+    an input ``Xb`` near it (``Xb``, ``S``, ``zs``, ``t_b``, ``js``, ``x_top`` as it returned them,
     `table` and `grid` the weights and grid of its binned sums), to first order in their
     difference.  Returns ``(ok, W)``; ``ok`` is False (``W`` unset) where `X` is not
     half-wave symmetric, not monotone between two reversals, has more harmonics than
@@ -233,8 +238,9 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # 
     sticking elements (its harmonics ``S``), ``s_slip`` that of those among them that slip
     later (its jumps ``js`` at ``t_b``), ``sigma`` +1 from the maximum to the minimum and
     -1 back.  The onsets move as well, but ``w`` is continuous there: they change it to
-    the second order only.  ``x_top`` moves to the second order of a change of the
-    reversal's angle, so that it is found again (:func:`dominant_reversals`).  The sums of
+    the second order only.  The new maximum is that of the parabola through ``x``, ``x'``
+    and ``x''`` at the old one's angle (its error of the third order in the small move of
+    the angle).  The sums of
     ``js`` are binned on the grid of ``S``'s, to the accuracy the small ``dx_top`` needs.
     """
     W = np.zeros(H + 1, dtype=np.complex128)
@@ -252,20 +258,24 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, t_b, js, x_top, table, grid):  # 
         change += abs(D[m])
     if not change <= LINEAR_CHANGE * total:
         return False, W
+    if not first_harmonic_dominates(Xs)[0]:
+        return False, W
     C1 = np.empty(M + 1, dtype=np.complex128)
     C2 = np.empty(M + 1, dtype=np.complex128)
+    C1_d = np.empty(Mb + 1, dtype=np.complex128)
     for m in range(M + 1):
         C1[m] = 1j * m * Xs[m]
         C2[m] = -(m * m) * Xs[m]
-    monotone, _, xr = dominant_reversals(Xs, C1, C2, symmetric)
-    if not monotone:
-        return False, W
-    d_top = max(xr[0], xr[1]) - x_top
+    for m in range(Mb + 1):
+        C1_d[m] = 1j * m * D[m]
+    a = t_b[t_b.shape[0] - 1]  # the maximum's angle: the reversal's jump comes last
+    slope, curvature = trig2(C1, C2, a)
+    d_top = trig2(D, C1_d, a)[0] - 0.5 * slope * slope / curvature
     n = grid_size(Mb, H)
-    if 2 * Mb * (H + 1) <= 4 * n:
+    if zs.shape[0] == 0:  # the full evaluation's product was a direct convolution
         _add_convolution(Wb, S, D, 2, W)
     else:
-        P_x = _product(S, D, n, H, symmetric, tw)
+        P_x = _product_with(zs, D, n, H, symmetric, tw)
         for q in range(H + 1):
             W[q] = Wb[q] + P_x[q]
     if d_top == 0.0:
@@ -357,14 +367,22 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
 @njit(cache=True)
 def _product(S, Y, n, H, half, tw):  # pragma: no cover - compiled
     """Harmonics ``0 .. H`` of ``s y`` from those of ``s`` (`S`) and ``y`` (`Y`), by transforms
-    of `n` samples.  With `half` ``s`` repeats after half a period (even harmonics only)
-    and ``y`` changes sign (odd harmonics only), and so does ``s y``: each transform is of
-    half the samples (:func:`synthesize_packed_odd`, :func:`analyze_packed_odd`)."""
-    if half:
-        # s's packed samples from half the transform; t and t + n / 4 are neighbours in
-        # bit-reversed order, where y's are y_u and -y_u
+    of `n` samples, and the samples of ``s`` as transformed (:func:`_product_with`)."""
+    if half:  # s's packed samples from half the transform
         zs = synthesize_packed(S[0::2].copy(), n // 2, tw)
+    else:
+        zs = synthesize_packed(S, n, tw)
+    return _product_with(zs, Y, n, H, half, tw), zs
+
+
+@njit(cache=True)
+def _product_with(zs, Y, n, H, half, tw):  # pragma: no cover - compiled
+    """:func:`_product` from the samples `zs` of ``s`` it gave.  With `half` ``s`` repeats
+    after half a period (even harmonics only) and ``y`` changes sign (odd harmonics only),
+    and so does ``s y``: each transform is of half the samples
+    (:func:`synthesize_packed_odd`, :func:`analyze_packed_odd`)."""
+    if half:
+        # t and t + n / 4 are neighbours in bit-reversed order, where y's are y_u and -y_u
         zy = synthesize_packed_odd(Y, n, tw)
         return analyze_packed_odd(packed_product(zy, zs), n, H, tw)
-    zs = synthesize_packed(S, n, tw)
     return analyze_packed(packed_product(synthesize_packed(Y, n, tw), zs), n, H, tw)
