@@ -434,3 +434,30 @@ def test_a_sines_slip_onsets_in_closed_form_are_the_cubics():
     assert_array_equal(closed[1], cubic[1])
     assert_array_equal(closed[2], cubic[2])
     assert closed[4] == pytest.approx(cubic[4], rel=1e-8)  # the mean stiffness
+
+
+@pytest.mark.parametrize("N", [64, 128, 256])
+def test_binned_sums_of_opposite_mirrors_at_odd_harmonics(N):
+    """Points with weights ``w`` and their opposites half a period on: the sums over the
+    half grid equal the direct sums ``2 sum_b w_b exp(-j l t_b)`` at odd ``l`` (zero at even
+    ``l``) to their round-off, and, with fewer terms, the binned sums of both points on
+    the whole grid with as many terms."""
+    from motionhyst.hysteresis import _jump_sums
+
+    rng = np.random.default_rng(4)
+    t = np.sort(rng.uniform(0.3, 0.3 + np.pi, 500))
+    w = rng.standard_normal(500)
+    L = 150
+    tw = stop_twiddles(L, L)
+    P = _jump_sums.chebyshev_terms(np.pi * L / N)
+    table = _jump_sums.binned_table(N, P, L)
+    tol = 1e-14 * np.sum(np.abs(w))  # the direct sums' round-off (phases up to 500 rad)
+    q = np.arange(L + 1)
+    direct = 2 * np.exp(-1j * np.outer(q, t)) @ w
+    direct[::2] = 0.0
+    assert_allclose(_jump_sums.jump_sums_binned_odd(t, w, L, N, P, table, tw), direct,
+                    rtol=0, atol=tol)
+    whole = _jump_sums.jump_sums_binned(t, w, -w, True, L, N, 9, table, tw)
+    odd = _jump_sums.jump_sums_binned_odd(t, w, L, N, 9, table, tw)
+    assert_allclose(odd[1::2], whole[1::2], rtol=0, atol=1e-15 * np.sum(np.abs(w)))
+    assert_array_equal(odd[::2], 0.0)

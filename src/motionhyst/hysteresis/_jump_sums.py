@@ -382,3 +382,43 @@ def jump_sums_binned(t_b, w_plus, w_minus, mirror, L, N, P, table, tw):  # pragm
             z += w[2 * pp] * mu[pp, iq] + w[2 * pp + 1] * mu[pp, im].conjugate()
         Z[q] = z
     return Z
+
+
+@njit(cache=True)
+def jump_sums_binned_odd(t_b, w, L, N, P, table, tw):  # pragma: no cover - compiled
+    """:func:`jump_sums_binned` with `mirror` and the weights ``w`` at ``t_b``, ``-w`` half a
+    period on, whose sums vanish at even ``l``: ``Z_l = 2 sum_b w_b exp(-j l t_b)`` at odd
+    ``l <= L`` (zero at even ``l``), in half the transforms.
+
+    With ``B_j`` the moments of the points alone, those of the pairs are ``B_j - B_{j -
+    N/2}``, and at odd ``l`` their transform is twice that of ``D_j exp(-2 pi j j l / N)``,
+    ``D_j = B_j - B_{j + N/2}``, ``j < N / 2``: the transform of ``N / 2`` points of ``D_j
+    exp(-2 pi j j / N)`` read at ``(l - 1) / 2``.
+    """
+    n_pairs = (P + 1) // 2
+    half = N // 2
+    # the points alone (no mirror: half < 0 is False, passed as a value, not a literal, so
+    # that one compiled version of chebyshev_moments serves every call)
+    bins = chebyshev_moments(t_b, w, w, half < 0, N, P)
+    step = 2 * tw.shape[0] // N
+    reversed_index = bit_reversed_indices(half)
+    y = np.empty((n_pairs, half), dtype=np.complex128)
+    for pp in range(n_pairs):
+        row = y[pp]
+        for j in range(half):
+            jj = reversed_index[j]
+            a = bins[jj]
+            b = bins[jj + half]
+            row[j] = complex(a[2 * pp] - b[2 * pp], a[2 * pp + 1] - b[2 * pp + 1]) * tw[jj * step]
+        fft_unscrambling(row, tw)
+    Z = np.zeros(L + 1, dtype=np.complex128)
+    for q in range(1, L + 1, 2):
+        iq = q % N
+        im = N - iq
+        weights = table[q]
+        z = 0j
+        for pp in range(n_pairs):
+            z += (weights[2 * pp] * y[pp, (iq - 1) // 2]
+                  + weights[2 * pp + 1] * y[pp, (im - 1) // 2].conjugate())
+        Z[q] = 2.0 * z
+    return Z

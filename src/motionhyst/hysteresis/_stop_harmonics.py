@@ -30,6 +30,7 @@ from motionhyst.hysteresis._jump_sums import (
     jump_series,
     jump_series_half,
     jump_sums_binned,
+    jump_sums_binned_odd,
 )
 from motionhyst.hysteresis._kernels import (
     BETWEEN_REVERSALS,
@@ -241,7 +242,8 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
     the second order only.  The new maximum is that of the parabola through ``x``, ``x'``
     and ``x''`` at the old one's angle (its error of the third order in the small move of
     the angle).  The sums of
-    ``js`` are binned on the grid of ``S``'s, to the accuracy the small ``dx_top`` needs.
+    ``js`` are binned on the grid of ``S``'s, to the accuracy the small ``dx_top`` needs
+    (:func:`jump_sums_binned_odd`).
     """
     W = np.zeros(H + 1, dtype=np.complex128)
     Mb = Xb.shape[0] - 1
@@ -287,16 +289,14 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
     w_max = 0.0
     for q in range(H + 1):
         w_max = max(w_max, abs(Wb[q]))
-    # the sums of js with an error below 1e-17 of the output's largest harmonic
+    # the sums of js with an error below 1e-17 of the output's largest harmonic: the terms
+    # from P on are below tol of the weights' 2 size, and 1 / (2 pi q) <= 1 / (2 pi)
     N = grid[0]
-    P = chebyshev_terms_to(np.pi * H / N, 1e-17 * w_max / (abs(d_top) * size))
+    P = chebyshev_terms_to(np.pi * H / N, np.pi * 1e-17 * w_max / (abs(d_top) * size))
     if P > grid[1]:  # the table's weights of a term do not depend on the terms after it
         return False, W
-    minus = np.empty(nb)
-    for b in range(nb):
-        minus[b] = -js[b]
     # js at t_b and -js half a period on: twice the sums of js at odd q
-    Z = jump_sums_binned(t_b, js, minus, symmetric, H, N, P, table, tw)
+    Z = jump_sums_binned_odd(t_b, js, H, N, P, table, tw)
     for q in range(1, H + 1, 2):
         W[q] -= d_top * Z[q] * (-1j / (_TWO_PI * q))
     return True, W
