@@ -61,10 +61,11 @@ TARGETS = {"help": 3.0, "df": 5.0, "steady": 3.0, "steady_ode": 10.0, "identify_
 # "steady": a link of stop operators (Maxwell-slip) against the Jenkins point, both compiled
 # whole with their exact harmonics in closed form.  "steady_ode": a link whose output is not a
 # stop operator's (Bouc-Wen, Dahl, LuGre) runs its equation's segment solutions over a sampled
-# period at each step of the fixed point; its points (0.66-0.85 ms, as when they were 2.1-2.4x
-# a 0.30 ms Jenkins point) are 7.5-9.7x the compiled Jenkins point (0.09 ms here, load average
-# 12; it was 5.6-8.4x before the Jenkins point got faster): 10x is the bound this bench guards,
-# not 3x, and Dahl is at its edge.
+# period at each step of a Python fixed point; its points (0.6-0.8 ms, as when they were
+# 2.1-2.4x a 0.30 ms Jenkins point) are 8.3x (Bouc-Wen), 9.7x (Dahl) and 8.9x (LuGre) the
+# compiled Jenkins point (medians of three runs of ``--only steady``, runs 8.2-8.4x,
+# 9.5-9.8x, 8.5-8.9x; load average 5-7): 10x is the bound this bench guards, not 3x, and Dahl
+# is within 3 % of it.
 
 def _record(n: int, path: Path) -> None:
     """A force-displacement record of `n` samples over the same 20 s of motion (CSV)."""
