@@ -371,42 +371,86 @@ def test_a_change_the_first_order_does_not_follow_is_refused():
     assert not stop_harmonics_update(longer, H, tw, *kept)[0]
 
 
-def test_many_elements_steady_state_equals_the_fixed_point_of_full_evaluations():
-    """The steady state of 1000 elements (its last iteration a first-order update of the one
-    before) equals the same fixed point run with every iteration computed in full, to
-    1e-13 of the largest harmonic of the error."""
-    from motionhyst import Loop, default_scenario, periodic_steady_state
+def _fixed_point_in_full(lp, A: float, f: float) -> tuple[np.ndarray, int]:
+    """The steady state's error harmonics (relative to ``sin(n theta)``) and iterations by the
+    same fixed point and stopping rule, every iteration computed in full."""
     from motionhyst.analysis.steady import default_harmonics
     from motionhyst.core.lti import TWO_PI
     from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 
+    H = default_harmonics(lp, f)
+    wn = TWO_PI * f * np.arange(H + 1)
+    y1_lin = np.zeros(H + 1, dtype=complex)
+    y1_lin[1] = lp.transfer("r->y1", wn[1:2])[0] * (-0.5j * A)
+    G_1 = lp.transfer("w->y1", wn)
+    X, W, previous = y1_lin, np.zeros(H + 1, dtype=complex), np.inf
+    for it in range(1, 51):
+        W_new = stop_periodic_harmonics(X, lp.hysteresis.k, lp.hysteresis.fc, H)
+        residual = abs(W_new[1] - W[1]) / abs(W_new[1])
+        change = np.max(np.abs(W_new - W))
+        W, X = W_new, y1_lin + G_1 * W_new
+        rho = residual / previous if it > 2 else 1.0
+        previous = residual
+        if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= 1e-12)):
+            break
+    e = lp.transfer("w->e", wn) * W
+    e[1] += lp.transfer("r->e", wn[1:2])[0] * (-0.5j * A)
+    e_sin = 2j * e
+    e_sin[0] = e[0].real
+    return e_sin, it
+
+
+def _many_element_loop(n: int, scale: float = 1.0):
+    """The Table I loop with `n` elements (slip displacements over two decades), `k` and `fc`
+    multiplied by `scale`."""
+    from motionhyst import Loop, default_scenario
+
     loop = default_scenario().loop()
-    u = np.geomspace(0.1, 10.0, 1000) * 2.5e-3
-    k = np.full(1000, 0.02)
-    link = MaxwellSlip(k, k * u * 0.05 / np.sum(k * u))
-    lp = Loop(loop.plant, loop.controller, link)
+    u = np.geomspace(0.1, 10.0, n) * 2.5e-3
+    k = np.full(n, 20.0 / n)
+    return Loop(loop.plant, loop.controller,
+                MaxwellSlip(k * scale, scale * k * u * 0.05 / np.sum(k * u)))
+
+
+def test_many_elements_steady_state_equals_the_fixed_point_of_full_evaluations():
+    """The steady state of 1000 elements (its last iteration a first-order update of the one
+    before) equals the same fixed point run with every iteration computed in full, to
+    1e-13 of the largest harmonic of the error."""
+    from motionhyst import periodic_steady_state
+
+    lp = _many_element_loop(1000)
     for A, f in ((0.01, 10.5), (0.003, 3.7)):
         ss = periodic_steady_state(lp, A, f)
-        H = default_harmonics(lp, f)
-        wn = TWO_PI * f * np.arange(H + 1)
-        y1_lin = np.zeros(H + 1, dtype=complex)
-        y1_lin[1] = lp.transfer("r->y1", wn[1:2])[0] * (-0.5j * A)
-        G_1 = lp.transfer("w->y1", wn)
-        X, W, previous = y1_lin, np.zeros(H + 1, dtype=complex), np.inf
-        for it in range(1, 51):
-            W_new = stop_periodic_harmonics(X, link.k, link.fc, H)
-            residual = abs(W_new[1] - W[1]) / abs(W_new[1])
-            W, X = W_new, y1_lin + G_1 * W_new
-            rho = residual / previous if it > 2 else 1.0
-            previous = residual
-            if it > 1 and rho < 0.5 and residual * rho / (1 - rho) <= 1e-12:
-                break
-        e = lp.transfer("w->e", wn) * W
-        e[1] += lp.transfer("r->e", wn[1:2])[0] * (-0.5j * A)
-        e_sin = 2j * e
-        e_sin[0] = e[0].real
+        e, it = _fixed_point_in_full(lp, A, f)
         assert it == ss.iterations
-        assert_allclose(ss.e, e_sin, rtol=0, atol=1e-13 * np.max(np.abs(e_sin)))
+        assert_allclose(ss.e, e, rtol=0, atol=1e-13 * np.max(np.abs(e)))
+
+
+def test_a_weak_link_in_a_fresh_process_equals_the_fixed_point_of_full_evaluations():
+    """A link so weak (stiffnesses and slip forces 1e-9 of Table I's) that its second
+    iteration's y1 is within 1e-10 of the first's: in a fresh process (no grid kept from an
+    earlier point) the first iteration, a sine's output computed to 1e-10 on a grid of its
+    own, is never followed to first order; the point is the fixed point of full evaluations."""
+    import subprocess
+    import sys
+
+    code = (
+        "import json, numpy as np\n"
+        "from motionhyst import periodic_steady_state\n"
+        "from tests.test_maxwell import _many_element_loop\n"
+        "ss = periodic_steady_state(_many_element_loop(400, 1e-9), 0.01, 10.5)\n"
+        "print(json.dumps([ss.iterations, ss.e.real.tolist(), ss.e.imag.tolist()]))\n"
+    )
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=root, timeout=600)
+    assert out.returncode == 0, out.stderr
+    iterations, re, im = json.loads(out.stdout.strip().splitlines()[-1])
+    e, it = _fixed_point_in_full(_many_element_loop(400, 1e-9), 0.01, 10.5)
+    assert iterations == it
+    assert_allclose(np.array(re) + 1j * np.array(im), e, rtol=0, atol=1e-13 * np.max(np.abs(e)))
 
 
 def test_a_sines_slip_onsets_in_closed_form_are_the_cubics():

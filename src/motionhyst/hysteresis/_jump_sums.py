@@ -125,10 +125,11 @@ def chebyshev_terms(a_max):  # pragma: no cover - compiled
 @njit(cache=True)
 def chebyshev_terms_to(a_max, tol):  # pragma: no cover - compiled
     """Terms ``P`` of the Chebyshev series of ``exp(-j a v)``, ``|a| <= a_max``, ``|v| <= 1``,
-    that reach `tol`: its coefficients are ``2 J_p(a)``, ``|J_p(a)| <= (a / 2)^p / p!``."""
+    that reach `tol`: its coefficients are ``2 J_p(a)``, ``|J_p(a)| <= (a / 2)^p / p!``
+    (for ``tol <= 0``, those until the bound underflows; `a_max` finite)."""
     P = 1
     term = 1.0
-    while term >= tol:
+    while term >= tol and 0.0 < term < np.inf:
         term *= 0.5 * a_max / P
         P += 1
     return P

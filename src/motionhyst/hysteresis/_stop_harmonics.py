@@ -292,7 +292,10 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
     # the sums of js with an error below 1e-17 of the output's largest harmonic: the terms
     # from P on are below tol of the weights' 2 size, and 1 / (2 pi q) <= 1 / (2 pi)
     N = grid[0]
-    P = chebyshev_terms_to(np.pi * H / N, np.pi * 1e-17 * w_max / (abs(d_top) * size))
+    tol = np.pi * 1e-17 * w_max / (abs(d_top) * size)
+    if N <= 0 or not tol > 0.0:  # no grid kept with the table, or no output to measure by
+        return False, W
+    P = chebyshev_terms_to(np.pi * H / N, tol)
     if P > grid[1]:  # the table's weights of a term do not depend on the terms after it
         return False, W
     # js at t_b and -js half a period on: twice the sums of js at odd q
