@@ -78,7 +78,8 @@ def test_each_kernel_is_compiled_for_one_signature():
 def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
     """The cache folders of other sources (one per edit or upgrade) do not pile up: at a
     process's first kernel call those no process used for a day go, and past the most
-    recently used few those unused for an hour; a folder in use and other names stay."""
+    recently used few those unused for an hour; a folder a running process marked, however
+    old, and other names stay."""
     import os
     import subprocess
     import sys
@@ -94,9 +95,18 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
            "numba-notes": 2 * PRUNE_SECONDS}                # not a cache folder's name
     hours = [f"numba-{c * 16}" for c in "123456"]           # unused for 2, 3, ... 7 hours
     ago.update({name: (2 + i) * BUSY_SECONDS for i, name in enumerate(hours)})
-    for name, seconds in ago.items():
+    running, ended = f"numba-{'d' * 16}", f"numba-{'e' * 16}"
+    ago.update({running: 2 * PRUNE_SECONDS, ended: 2 * PRUNE_SECONDS})
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    for name in ago:
         (parent / name / "sub").mkdir(parents=True)
         (parent / name / "sub" / "f.nbi").write_bytes(b"x")
+    # a process still running (this one) started from `running`'s sources two days ago; one
+    # that used `ended` was killed without removing its marker
+    (parent / running / f".in-use-{os.getpid()}").write_text("")
+    (parent / ended / f".in-use-{int(gone.stdout)}").write_text("")
+    for name, seconds in ago.items():
         os.utime(parent / name, (now - seconds, now - seconds))
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     code = ("from motionhyst.core.compiled import njit, _cache_folder\n"
@@ -107,5 +117,8 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
     value, name = out.stdout.split()
     assert value == "2"
     kept = [f"numba-{'b' * 16}", *hours[:KEEP_RECENT - 1]]  # the most recently used others
-    assert sorted(p.name for p in parent.iterdir()) == sorted([*kept, "numba-notes", name])
+    assert sorted(p.name for p in parent.iterdir()) == sorted(
+        [*kept, running, "numba-notes", name])
     assert time.time() - (parent / name).stat().st_mtime < BUSY_SECONDS   # marked used
+    # its own marker went with the process
+    assert not [f for f in (parent / name).iterdir() if f.name.startswith(".in-use-")]

@@ -113,13 +113,16 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEE
     beside it that no process used for `age` seconds, and those past the `keep` most
     recently used that no process used for `busy` seconds.
 
-    A folder is used when a process chooses it (its time of modification is set then); a
-    folder is first renamed, atomically, then removed, so that two processes pruning at once
-    do not trip over each other and no process finds a half-removed folder under its
-    name.  Only folders named as the cache names them (``numba-<key>``) are touched;
-    nothing that cannot be read or removed stops the caller.  A working tree whose sources
-    are edited all day keeps the last hour's folders and the `keep` before them; versions
-    used in turn keep theirs for a day.
+    A folder is used when a process chooses it: its time of modification is set then, and
+    the process leaves a marker in it (``.in-use-<pid>``, removed when it exits); a folder
+    with the marker of a running process is never removed, however old.  A folder is first
+    renamed, atomically, then removed, so that two processes pruning at once do not trip
+    over each other and no process finds a half-removed folder under its name; a folder that
+    a process marked between the look and the rename is renamed back.  Only folders named as
+    the cache names them (``numba-<key>``) are touched; nothing that cannot be read or
+    removed stops the caller.  A working tree whose sources are edited all day keeps the
+    last hour's folders and the `keep` before them; versions used in turn keep theirs for a
+    day.
 
     Parameters
     ----------
@@ -152,11 +155,17 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEE
     ['111', '444', '555']
     >>> sorted(p.name[:9] for p in root.iterdir())   # the 2 most recent of the others kept
     ['notes', 'numba-000', 'numba-222', 'numba-333']
+    >>> _ = (root / ("numba-" + "3" * 16) / f".in-use-{os.getpid()}").write_text("")
+    >>> [p.name[6:9] for p in prune_caches(root / ("numba-" + "0" * 16), keep=0, busy=0)]
+    ['222']
+    >>> sorted(p.name[:9] for p in root.iterdir())   # 333: in use by this process
+    ['notes', 'numba-000', 'numba-333']
     """
     folder = Path(folder)
     removed: list[Path] = []
     try:
         os.utime(folder)
+        _mark_in_use(folder)
         entries = list(folder.parent.iterdir())
     except OSError:
         return removed
@@ -178,16 +187,58 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEE
             continue
     others.sort(key=lambda item: item[0])
     for rank, (unused, f) in enumerate(others):
-        if unused < age and (rank < keep or unused < busy):
+        if (unused < age and (rank < keep or unused < busy)) or _in_use(f):
             continue
         target = f.with_name(f"{f.name}.removed-{os.getpid()}")
         try:
             os.rename(f, target)
+            if _in_use(target):         # marked by a process starting meanwhile: give it back
+                os.rename(target, f)
+                continue
         except OSError:
             continue
         shutil.rmtree(target, ignore_errors=True)
         removed.append(f)
     return removed
+
+
+def _pid_alive(pid: int) -> bool:
+    """True if a process `pid` runs here (or may: one of another user's, or not to be told)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
+def _in_use(folder: Path) -> bool:
+    """True if a running process left its marker in the cache folder `folder`."""
+    try:
+        names = [f.name for f in folder.iterdir()]
+    except OSError:
+        return True
+    for name in names:
+        pid = name.removeprefix(".in-use-")
+        if pid != name and pid.isdigit() and _pid_alive(int(pid)):
+            return True
+    return False
+
+
+def _mark_in_use(folder: Path) -> None:
+    """Leave this process's marker in `folder`, removed when the process exits (a marker a
+    killed process leaves names a process that no longer runs: it keeps nothing)."""
+    import atexit
+
+    marker = folder / f".in-use-{os.getpid()}"
+    marker.touch()
+
+    def _unmark() -> None:
+        if os.getpid() == int(marker.name.removeprefix(".in-use-")):
+            marker.unlink(missing_ok=True)
+
+    atexit.register(_unmark)
 
 
 def _can_cache(py_func: Callable = _probe) -> bool:
