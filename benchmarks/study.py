@@ -36,7 +36,8 @@ The numbers of a study are checked equal in every engine.  Dask's worker profile
 of the stack of each thread running a task, every 10 ms) is on by default; the environment
 turns it off for the processes the benchmark starts
 (``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``).  Run with ``make bench`` or
-``python benchmarks/study.py [--samples N] [--frequencies N] [--repeats N] [--json]``.
+``python benchmarks/study.py [--samples N] [--frequencies N] [--repeats N]
+[--dask-batch-seconds S] [--json]``.
 """
 
 from __future__ import annotations
@@ -256,6 +257,9 @@ def main() -> None:
     ap.add_argument("--frequencies", type=int, default=50, help="frequencies 1-100 Hz")
     ap.add_argument("--repeats", type=int, default=5,
                     help="pairs of runs, local pool and dask, interleaved")
+    ap.add_argument("--dask-batch-seconds", type=float, default=DASK_BATCH_SECONDS,
+                    help="least work in a batch on dask [s] (run_study's default: "
+                         f"{DASK_BATCH_SECONDS:g})")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
     study = make_study(args.samples, args.frequencies)
@@ -263,8 +267,9 @@ def main() -> None:
     load_before = os.getloadavg()
     per = seconds_per_point(study, 6, cpu=True)   # on CPU time, as run_study
     batch = batch_size(per, n, 2)
-    dask_batch = batch_size(per, n, 2, DASK_BATCH_SECONDS)
-    out: dict = {"points": n, "batch": batch, "dask_batch": dask_batch, "cores": os.cpu_count(),
+    dask_batch = batch_size(per, n, 2, args.dask_batch_seconds)
+    out: dict = {"points": n, "batch": batch, "dask_batch": dask_batch,
+                 "dask_batch_seconds": args.dask_batch_seconds, "cores": os.cpu_count(),
                  "repeats": args.repeats, "load_before": load_before}
     pairs: list[tuple[Run, Run]] = []
     idles: list[float] = []
