@@ -85,7 +85,7 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
     import sys
     import time
 
-    from motionhyst.core.compiled import BUSY_SECONDS, KEEP_RECENT, PRUNE_SECONDS
+    from motionhyst.core.compiled import BUSY_SECONDS, KEEP_RECENT, PRUNE_SECONDS, _marker_name
 
     parent = tmp_path / "motionhyst"
     now = time.time()
@@ -96,7 +96,9 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
     hours = [f"numba-{c * 16}" for c in "123456"]           # unused for 2, 3, ... 7 hours
     ago.update({name: (2 + i) * BUSY_SECONDS for i, name in enumerate(hours)})
     running, ended = f"numba-{'d' * 16}", f"numba-{'e' * 16}"
-    ago.update({running: 2 * PRUNE_SECONDS, ended: 2 * PRUNE_SECONDS})
+    elsewhere, long_ago = f"numba-{'f' * 16}", f"numba-{'9' * 16}"
+    ago.update({running: 2 * PRUNE_SECONDS, ended: 2 * PRUNE_SECONDS,
+                elsewhere: 2 * PRUNE_SECONDS, long_ago: 2 * PRUNE_SECONDS})
     gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                           capture_output=True, text=True, check=True)
     for name in ago:
@@ -104,8 +106,14 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
         (parent / name / "sub" / "f.nbi").write_bytes(b"x")
     # a process still running (this one) started from `running`'s sources two days ago; one
     # that used `ended` was killed without removing its marker
-    (parent / running / f".in-use-{os.getpid()}").write_text("")
-    (parent / ended / f".in-use-{int(gone.stdout)}").write_text("")
+    (parent / running / _marker_name()).write_text("")
+    (parent / ended / _marker_name(int(gone.stdout))).write_text("")
+    # a cache folder shared with another machine (a home on a network): its processes cannot
+    # be seen from here, so its marker keeps the folder for a day
+    (parent / elsewhere / ".in-use-othermachine-1").write_text("")
+    (parent / long_ago / ".in-use-othermachine-2").write_text("")
+    old = now - 2 * PRUNE_SECONDS
+    os.utime(parent / long_ago / ".in-use-othermachine-2", (old, old))
     for name, seconds in ago.items():
         os.utime(parent / name, (now - seconds, now - seconds))
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
@@ -118,7 +126,7 @@ def test_first_kernel_call_prunes_cache_folders_of_other_sources(tmp_path):
     assert value == "2"
     kept = [f"numba-{'b' * 16}", *hours[:KEEP_RECENT - 1]]  # the most recently used others
     assert sorted(p.name for p in parent.iterdir()) == sorted(
-        [*kept, running, "numba-notes", name])
+        [*kept, running, elsewhere, "numba-notes", name])
     assert time.time() - (parent / name).stat().st_mtime < BUSY_SECONDS   # marked used
     # its own marker went with the process
     assert not [f for f in (parent / name).iterdir() if f.name.startswith(".in-use-")]

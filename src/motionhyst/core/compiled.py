@@ -114,8 +114,9 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEE
     recently used that no process used for `busy` seconds.
 
     A folder is used when a process chooses it: its time of modification is set then, and
-    the process leaves a marker in it (``.in-use-<pid>``, removed when it exits); a folder
-    with the marker of a running process is never removed, however old.  A folder is first
+    the process leaves a marker in it (``.in-use-<host>-<pid>``, removed when it exits); a
+    folder with the marker of a process running on this machine is never removed, however
+    old, nor one with another machine's marker younger than `age`.  A folder is first
     renamed, atomically, then removed, so that two processes pruning at once do not trip
     over each other and no process finds a half-removed folder under its name; a folder that
     a process marked between the look and the rename is renamed back.  Only folders named as
@@ -155,7 +156,7 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEE
     ['111', '444', '555']
     >>> sorted(p.name[:9] for p in root.iterdir())   # the 2 most recent of the others kept
     ['notes', 'numba-000', 'numba-222', 'numba-333']
-    >>> _ = (root / ("numba-" + "3" * 16) / f".in-use-{os.getpid()}").write_text("")
+    >>> _ = (root / ("numba-" + "3" * 16) / _marker_name()).write_text("")
     >>> [p.name[6:9] for p in prune_caches(root / ("numba-" + "0" * 16), keep=0, busy=0)]
     ['222']
     >>> sorted(p.name[:9] for p in root.iterdir())   # 333: in use by this process
@@ -187,12 +188,12 @@ def prune_caches(folder: str | Path, age: float = PRUNE_SECONDS, keep: int = KEE
             continue
     others.sort(key=lambda item: item[0])
     for rank, (unused, f) in enumerate(others):
-        if (unused < age and (rank < keep or unused < busy)) or _in_use(f):
+        if (unused < age and (rank < keep or unused < busy)) or _in_use(f, age):
             continue
         target = f.with_name(f"{f.name}.removed-{os.getpid()}")
         try:
             os.rename(f, target)
-            if _in_use(target):         # marked by a process starting meanwhile: give it back
+            if _in_use(target, age):    # marked by a process starting meanwhile: give it back
                 os.rename(target, f)
                 continue
         except OSError:
@@ -213,16 +214,40 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
-def _in_use(folder: Path) -> bool:
-    """True if a running process left its marker in the cache folder `folder`."""
+def _host() -> str:
+    """This machine's name as a marker holds it (a cache folder may be shared by machines)."""
+    import socket
+
+    return re.sub(r"[^A-Za-z0-9_.]", "_", socket.gethostname()) or "_"
+
+
+def _marker_name(pid: int | None = None) -> str:
+    """The name of the marker process `pid` (default: this one) leaves in its cache folder."""
+    return f".in-use-{_host()}-{os.getpid() if pid is None else pid}"
+
+
+def _in_use(folder: Path, age: float = PRUNE_SECONDS) -> bool:
+    """True if a running process left its marker in the cache folder `folder`: one of this
+    machine whose pid runs, or one of another machine (whose processes cannot be seen from
+    here) younger than `age` seconds."""
     try:
-        names = [f.name for f in folder.iterdir()]
+        markers = [f for f in folder.iterdir() if f.name.startswith(".in-use-")]
     except OSError:
         return True
-    for name in names:
-        pid = name.removeprefix(".in-use-")
-        if pid != name and pid.isdigit() and _pid_alive(int(pid)):
-            return True
+    host = _host()
+    for f in markers:
+        where, _, pid = f.name.removeprefix(".in-use-").rpartition("-")
+        if not pid.isdigit():
+            continue
+        if where == host:
+            if _pid_alive(int(pid)):
+                return True
+            continue
+        try:
+            if time.time() - f.stat().st_mtime < age:
+                return True
+        except OSError:
+            continue
     return False
 
 
@@ -231,11 +256,12 @@ def _mark_in_use(folder: Path) -> None:
     killed process leaves names a process that no longer runs: it keeps nothing)."""
     import atexit
 
-    marker = folder / f".in-use-{os.getpid()}"
+    pid = os.getpid()
+    marker = folder / _marker_name(pid)
     marker.touch()
 
     def _unmark() -> None:
-        if os.getpid() == int(marker.name.removeprefix(".in-use-")):
+        if os.getpid() == pid:          # not in a forked child
             marker.unlink(missing_ok=True)
 
     atexit.register(_unmark)
