@@ -94,3 +94,35 @@ def test_a_dahl_shape_exponent_past_its_range_is_refused_by_a_scenario():
     Scenario.from_dict(data, "s.toml", check=False)
     # the class itself takes it (an identification's search is not bound)
     assert Dahl(k=20.0, fc=0.05, alpha=1e3).alpha == 1e3
+
+
+DEEP_JSON = "[" * 100_000 + "]" * 100_000
+
+
+def test_a_manifest_nested_too_deeply_is_not_ours(tmp_path):
+    """reproduce --out DIR whose motionhyst-manifest.json is arrays thousands of levels deep
+    ended in "maximum recursion depth exceeded" naming nothing: it is no manifest of ours."""
+    from motionhyst.io.outputs import MANIFEST, OutputFolder
+
+    (tmp_path / MANIFEST).write_text(DEEP_JSON)
+    (tmp_path / "report.md").write_text("mine")
+    with pytest.raises(ValueError, match=r"report\.md exists and was not written by"):
+        OutputFolder(tmp_path, ["report.md"])              # it authorises nothing
+    with OutputFolder(tmp_path, ["other.md"]) as out:
+        out.write_text("other.md", "# report")
+    assert (tmp_path / "report.md").read_text() == "mine"
+
+
+def test_a_store_nested_too_deeply_is_no_study_store(tmp_path, monkeypatch, capsys):
+    from motionhyst.scenario import default_scenario_path
+
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    (tmp_path / "s.toml").write_text('scenario = "paper.toml"\noutputs = ["mismatch"]\n\n'
+                                     '[axes]\namplitude = [0.01]\nfrequency_hz = [5.0]\n')
+    (tmp_path / "o.zarr").mkdir()
+    (tmp_path / "o.zarr" / "zarr.json").write_text(DEEP_JSON)
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "s.toml", "--out", "o.zarr"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--out o.zarr: exists and is not a study's store" in err
+    assert (tmp_path / "o.zarr" / "zarr.json").read_text() == DEEP_JSON

@@ -730,7 +730,7 @@ class OutputFolder:
             return set()
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+        except (OSError, ValueError, RecursionError):  # arrays thousands of levels deep
             return set()
         if not isinstance(data, dict) or data.get("kind") != _MANIFEST_KIND:
             return set()

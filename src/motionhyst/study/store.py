@@ -500,8 +500,8 @@ def is_study_store(path: str | Path) -> bool:
     meta = Path(path) / "zarr.json"
     try:
         return json.loads(meta.read_text()).get("attributes", {}).get("kind") == KIND
-    except (OSError, ValueError, AttributeError):
-        return False
+    except (OSError, ValueError, AttributeError, RecursionError):  # RecursionError: nested
+        return False                                                # thousands of levels deep
 
 
 def remove_store(path: str | Path) -> None:
