@@ -16,14 +16,28 @@ from motionhyst.cli import main
 _MAIN = "import sys; from motionhyst.cli import main; sys.exit(main(sys.argv[1:]))"
 
 
+def _closed_stdout(argv: list[str], cwd) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", _MAIN, *argv], stderr=subprocess.PIPE,
+                          text=True, cwd=cwd, timeout=600, preexec_fn=lambda: os.close(1))
+
+
 def test_a_closed_standard_output_is_refused_not_answered_into_nothing(tmp_path):
     """``motionhyst df ... >&-``: Python gives a closed stdout as None and print() then
     writes nothing, so the command exited 0 with its answer lost."""
-    proc = subprocess.run([sys.executable, "-c", _MAIN, "df", "--k", "20", "--fc", "0.05",
-                           "--amplitude", "0.01"], stderr=subprocess.PIPE, text=True,
-                          cwd=tmp_path, timeout=120, preexec_fn=lambda: os.close(1))
+    proc = _closed_stdout(["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"], tmp_path)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "standard output is closed" in proc.stderr
+    assert "writes no file" in proc.stderr
+
+
+def test_a_command_writing_its_results_to_a_file_runs_with_stdout_closed(tmp_path):
+    from motionhyst.scenario import default_scenario_path
+
+    (tmp_path / "s.toml").write_text(default_scenario_path().read_text())
+    proc = _closed_stdout(["stability", "s.toml", "--figure", "n.png"], tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "n.png").stat().st_size > 0
+    assert "Traceback" not in proc.stderr
 
 
 def test_an_output_of_none_is_refused_in_process(monkeypatch, capsys):

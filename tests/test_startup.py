@@ -407,3 +407,22 @@ def test_a_signal_ignored_by_the_parent_stays_ignored_before_the_handlers(tmp_pa
                           text=True, cwd=tmp_path, timeout=600, check=False, preexec_fn=ignore)
     assert proc.returncode == 0, proc.stderr
     assert "Describing function of the jenkins element" in proc.stdout
+
+
+def test_the_entry_leaves_both_signals_ignored_to_the_exit_or_puts_them_back(tmp_path):
+    """As the command (no arguments given) a signal after its work must neither interrupt
+    the interpreter's exit nor turn the finished run into an interrupted one; called from
+    Python, the handlers found are put back."""
+    code = ("import signal, sys\n"
+            "from motionhyst.entry import main\n"
+            "found = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)]\n"
+            "a = main(['df', '--k', '20', '--fc', '0.05', '--amplitude', '0.01'])\n"
+            "back = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)] == found\n"
+            "sys.argv[1:] = ['df', '--k', '20', '--fc', '0.05', '--amplitude', '0.01']\n"
+            "b = main()\n"
+            "ignored = [signal.getsignal(s) is signal.SIG_IGN\n"
+            "           for s in (signal.SIGINT, signal.SIGTERM)]\n"
+            "print(a, back, b, ignored, file=sys.stderr)\n")
+    proc = _run(code, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.splitlines()[-1] == "0 True 0 [True, True]", proc.stderr

@@ -32,9 +32,10 @@ def main(argv: list[str] | None = None) -> int:
     Ctrl-C and SIGTERM raise ``KeyboardInterrupt`` from the first line on (a signal ignored
     by the process that started this one stays ignored; outside the main thread nothing is
     installed): one that comes before the command's own handlers ends in exit code 130 with
-    one line on stderr.  The handlers found are put back at the end; run as the command
-    (`argv` None), Ctrl-C is then ignored, as the command leaves it (the interpreter's exit
-    is not interrupted).
+    one line on stderr.  Once the command has returned its exit code stands.  The handlers
+    found are put back at the end (both signals ignored meanwhile); run as the command
+    (`argv` None), both stay ignored, as the command leaves them (the interpreter's exit is
+    not interrupted).
 
     Parameters
     ----------
@@ -57,21 +58,26 @@ def main(argv: list[str] | None = None) -> int:
                 found[sig] = signal.SIG_DFL if previous is None else previous
         except ValueError:  # not the main thread
             break
+    code = None
     try:
         from motionhyst.cli import main as command
 
-        return command(argv)
+        code = command(argv)
+    except KeyboardInterrupt:
+        pass
     except Exception as exc:  # an interrupt inside an import of a compiled extension
         from motionhyst.core.interrupts import interrupted
 
         if not interrupted(exc):
             raise
-    except KeyboardInterrupt:
-        pass
     finally:
-        for sig, previous in found.items():
-            signal.signal(sig, signal.SIG_IGN if argv is None and sig == signal.SIGINT
-                          else previous)
+        for sig in found:  # nothing interrupts the putting back
+            signal.signal(sig, signal.SIG_IGN)
+        if argv is not None:  # called from Python; as the command they stay ignored to its exit
+            for sig, previous in found.items():
+                signal.signal(sig, previous)
+    if code is not None:  # the command returned: its exit code stands
+        return code
     try:
         print("motionhyst: interrupted", file=sys.stderr)
     except (OSError, ValueError):  # a stderr that cannot be written: the exit code says it

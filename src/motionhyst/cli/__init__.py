@@ -43,14 +43,18 @@ COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identif
             "study", "benchmark", "reproduce")
 """The commands, in the order ``motionhyst --help`` lists them (module names)."""
 
+FILE_OUTPUTS = ("out", "time_series", "save", "figure", "table")
+"""Options naming a file or folder a command writes its results to: given one, a command
+started with its standard output closed still runs (only its summary is lost)."""
+
 EXIT_INTERNAL = 1
 """Exit code of a defect of the tool (an exception no input should cause)."""
 
 TRACEBACK_VARIABLE = "MOTIONHYST_TRACEBACK"
 """Environment variable: set, a defect of the tool ends in its traceback instead of one line."""
 
-__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "TRACEBACK_VARIABLE", "UsageError",
-           "build_parser", "feedforward_fragment", "main", "record_kind"]
+__all__ = ["COMMANDS", "EXIT_INTERNAL", "EXIT_USAGE", "FILE_OUTPUTS", "TRACEBACK_VARIABLE",
+           "UsageError", "build_parser", "feedforward_fragment", "main", "record_kind"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -115,12 +119,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         # cycles are left to the operating system
         atexit.register(gc.freeze)
     interrupts = _Interrupts()
+    closed = sys.stdout is None  # started with its output closed (``>&-``)
     try:
-        if sys.stdout is None:  # started with its output closed (``>&-``): the answer is lost
-            raise UsageError("motionhyst: standard output is closed: the results would be lost; "
-                             "give the command an output (a terminal, a file or a pipe)")
         parser = build_parser()
         args = parser.parse_args(argv)
+        if closed:
+            if not any(getattr(args, name, None) for name in FILE_OUTPUTS):
+                raise UsageError(f"motionhyst {args.command}: standard output is closed and "
+                                 f"the command writes no file: its results would be lost; give "
+                                 f"it an output (a terminal, a file or a pipe)")
+            sys.stdout = open(os.devnull, "w")  # the files are the results; the summary is lost
         set_max_memory(args.max_memory)
         set_max_seconds(args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
@@ -143,12 +151,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         _say("motionhyst: interrupted")
         return 130
     finally:
+        interrupts.close()  # a signal from here on is noted, not raised
         set_max_memory(None)
         set_max_seconds(None)
-        interrupts.restore()
-        if argv is None:  # the work is done or abandoned: a Ctrl-C now must not interrupt the
-            with contextlib.suppress(ValueError, OSError):  # interpreter's exit (tracebacks)
-                signal.signal(signal.SIGINT, signal.SIG_IGN)
+        if closed and sys.stdout is not None:
+            sys.stdout.close()
+            sys.stdout = None
+        # run as the command, the work is done or abandoned: a signal now must neither
+        # interrupt the interpreter's exit (tracebacks) nor turn a finished run into an
+        # interrupted one; called from Python, the handlers found are put back
+        interrupts.restore(ignore=argv is None)
 
 
 class _Interrupts:
@@ -226,12 +238,12 @@ class _Interrupts:
             if self.again is not threading.current_thread():
                 self.again.join()
 
-    def restore(self) -> None:
-        """Put back the handlers found."""
+    def restore(self, ignore: bool = False) -> None:
+        """Put back the handlers found (`ignore`: ignore the signals instead)."""
         self.close()
         for sig, previous in self.previous.items():
             with contextlib.suppress(ValueError, OSError, TypeError):
-                signal.signal(sig, previous)
+                signal.signal(sig, signal.SIG_IGN if ignore else previous)
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self.hook
 
