@@ -498,9 +498,21 @@ def _edit_json(path: Path, change) -> None:
     path.write_text(json.dumps(meta))
 
 
+def _remove_status(store: Path) -> None:
+    import shutil
+
+    shutil.rmtree(store / "status")
+
+
+def _unknown_status(store: Path) -> None:
+    import zarr
+
+    zarr.open_group(str(store), mode="r+")["status"].set_basic_selection((0, 0), 7)
+
+
 DAMAGES = {  # how a store comes apart (a copy cut short, a disk error, another program), and
     # the words that name it
-    "status-removed": (lambda s: __import__("shutil").rmtree(s / "status"), "no array 'status'"),
+    "status-removed": (_remove_status, "no array 'status'"),
     "fields-attribute-removed": (lambda s: _edit_json(
         s / "zarr.json", lambda m: m["attributes"].pop("fields")), "no 'fields' attribute"),
     "fields-attribute-garbage": (lambda s: _edit_json(
@@ -514,8 +526,7 @@ DAMAGES = {  # how a store comes apart (a copy cut short, a disk error, another 
     "axes-past-their-values": (lambda s: [_edit_json(
         s / f"{name}/zarr.json", lambda m: m.update(shape=[10**5, 10**5])) for name in (
         "e1", "status", "reason")], "does not have the 100000 values"),
-    "status-value-unknown": (lambda s: __import__("zarr").open_group(str(s), mode="r+")[
-        "status"].set_basic_selection((0, 0), 7), "status 7 at point 0"),
+    "status-value-unknown": (_unknown_status, "status 7 at point 0"),
 }
 
 
@@ -569,3 +580,24 @@ def test_an_error_on_the_way_to_the_chunks_is_not_called_damage(tmp_path, monkey
     monkeypatch.setattr(store, "group", {"status": NoThread()})
     with pytest.raises(RuntimeError, match="can't start new thread"):
         store.status()
+
+
+def test_a_store_of_another_version_is_resumed_with_a_word(tmp_path):
+    """Its points stay as that version computed them: said, not refused (the layout is
+    checked; a version's numbers may differ in their last digits)."""
+    from motionhyst import __version__
+    from motionhyst.study.store import OK, StudyStore
+
+    populate(tmp_path, BASE)
+    path = _store(tmp_path)
+    store = StudyStore.open(path)
+    store.write([2, 3], np.array([OK, OK], np.int8), {"e1": np.array([3e-9 + 0j, 4e-9 + 0j])})
+    store.group.attrs["version"] = "99.0"
+    code, out, err = limited_process.run(["study", "st.toml", "--out", "o.zarr", "--workers",
+                                          "0"], tmp_path, limited_process.RUN_LIMIT)
+    assert code == 0, err
+    assert out.startswith("4 points: 0 computed"), out
+    assert err.strip().splitlines() == [
+        "motionhyst: warning: study: o.zarr: a store of motionhyst 99.0, resumed by "
+        f"{__version__}: the points it holds stay as that version "
+        "computed them"]

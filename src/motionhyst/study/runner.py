@@ -25,6 +25,7 @@ import numpy as np
 
 from motionhyst.core.budget import check_work, format_duration, max_seconds
 from motionhyst.core.textfmt import g
+from motionhyst.core.warnings import warn
 from motionhyst.study.engine import (
     BATCH_SECONDS,
     DASK_BATCH_SECONDS,
@@ -343,6 +344,10 @@ def run_study(study: StudyDefinition, store: str | Path, workers: int | None = N
     t0 = time.perf_counter()
     path = Path(store)
     st = _resumed_store(study, path, force)
+    written = "" if st is None else str(st.group.attrs.get("version", ""))
+    if written and written != __version__:  # said, not refused: its points stand
+        warn(f"{path}: a store of motionhyst {written}, resumed by {__version__}: the points "
+             f"it holds stay as that version computed them")
     if workers is None:
         workers = os.cpu_count() or 1
     if client is not None:
