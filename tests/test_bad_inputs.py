@@ -1,20 +1,21 @@
 """The bad-input corpus (issue 10): scenarios, CSV files, arguments and output paths.
 
-Every case runs the command line in a folder holding the user's files and
-asserts exit code 2, one line on stderr without a traceback, nothing on
-stdout, and that every file that was there before is byte-identical
-afterwards, with no file added (no temporary file, no half-written output).
+Every case runs the command line in a child process under an address-space limit
+(:mod:`limited_process`), in a folder holding the user's files, and asserts exit code 2,
+one line on stderr without a traceback, nothing on stdout, and that every file that was
+there before is byte-identical afterwards, with no file added (no temporary file, no
+half-written output).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import limited_process
 import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
-from motionhyst.cli import main
 from motionhyst.scenario import default_scenario_path
 
 PAPER = default_scenario_path().read_text()
@@ -257,15 +258,12 @@ def test_the_corpus_is_large_enough():
 
 @pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
                          ids=[c[0] for c in CASES])
-def test_bad_input_is_exit_2_one_line_and_touches_nothing(tmp_path, monkeypatch, capsys,
-                                                          files, argv, words):
+def test_bad_input_is_exit_2_one_line_and_touches_nothing(tmp_path, files, argv, words):
     root = tmp_path / "user"
     root.mkdir()
     _populate(root, files)
-    monkeypatch.chdir(root)
     before = snapshot(root)
-    code = main(list(argv))
-    out, err = capsys.readouterr()
+    code, out, err = limited_process.run(list(argv), root)  # under a memory limit
     assert code == 2, (code, out, err)
     assert out == ""
     line = err.strip()
