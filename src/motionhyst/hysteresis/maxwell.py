@@ -58,6 +58,7 @@ class MaxwellSlip(Hysteresis):
                 check_positive(f"{name}[{bad[0]}]", float(values[bad[0]]))
         self.k = k_arr
         self.fc = fc_arr
+        self._elements: list[Jenkins] | None = None
         self.reset()
 
     def __repr__(self) -> str:
@@ -119,13 +120,22 @@ class MaxwellSlip(Hysteresis):
         n_max : int
             Highest harmonic, >= 1.
         """
-        return sum(el.hosidf_closed_form(A, n_max) for el in self.elements)
+        return sum(Jenkins(ki, fi).hosidf_closed_form(A, n_max)  # no state: not .elements
+                   for ki, fi in zip(self.k, self.fc, strict=True))
 
     @property
     def elements(self) -> list[Jenkins]:
-        """The elements as Jenkins elements, made when asked (a link of 1e6 elements holds two
-        arrays, not 1e6 objects)."""
-        return [Jenkins(ki, fi) for ki, fi in zip(self.k, self.fc, strict=True)]
+        """The elements as Jenkins elements, made once when first asked for (a link of 1e6
+        elements holds two arrays, not 1e6 objects) in the link's present state; from then on
+        they are its state: :meth:`__call__` advances them and :meth:`reset` resets them."""
+        if self._elements is None:
+            elements = [Jenkins(ki, fi) for ki, fi in zip(self.k, self.fc, strict=True)]
+            for el, w in zip(elements, self._wi.tolist(), strict=True):
+                el.reset(w)
+                if self._x is not None:
+                    el(self._x)  # the last input, as the link has it
+            self._elements = elements
+        return self._elements
 
     def response(self, x: ArrayLike, w0: ArrayLike = 0.0) -> NDArray[np.float64]:
         """Total force for a sampled displacement; `w0` is the initial force per element.
@@ -173,6 +183,8 @@ class MaxwellSlip(Hysteresis):
 
     def __call__(self, x: float) -> float:
         """Advance every element by one displacement sample (python-control interface)."""
+        if self._elements is not None:  # they hold the state
+            return float(sum(el(x) for el in self._elements))
         x = float(np.squeeze(x))
         if not np.isfinite(x):
             raise ValueError("x must be finite")
@@ -193,6 +205,8 @@ class MaxwellSlip(Hysteresis):
         """
         self._wi = float(w) * (self.fc / np.sum(self.fc))
         self._x = None
+        for el, share in zip(self._elements or [], self._wi.tolist(), strict=False):
+            el.reset(share)
 
     def time_stepping(self) -> Stepping:
         """The elements as the compiled time step advances them (:mod:`.stepping`)."""
