@@ -110,10 +110,13 @@ def run_bouc_wen(args: argparse.Namespace) -> int:
 def _emps_record(path: Path, name: str):
     from motionhyst.identify.emps import COLUMNS, DRIVE_GAIN
     from motionhyst.identify.input_output import IORecord
+    from motionhyst.identify.io_records import check_records
     from motionhyst.io.records import read_record
 
     data = read_record(path, ("time", "force", "displacement"), columns=COLUMNS,
                        scale={"force": DRIVE_GAIN})
+    # its values checked as it is read: not in the first fit, minutes later for a test record
+    check_records([IORecord(data[:, 0], data[:, 1], data[:, 2], str(path))], periodic=False)
     return IORecord(data[:, 0], data[:, 1], data[:, 2], name)
 
 
@@ -152,6 +155,10 @@ def run_emps(args: argparse.Namespace) -> int:
     if not data.is_dir():
         raise UsageError(f"motionhyst benchmark emps: --data {data}: no such folder")
     est_path, test_path = data / ESTIMATION_FILE, data / TEST_FILE
+    for path in (est_path, test_path):  # there, but not a file: never passed over in silence
+        if (path.exists() or path.is_symlink()) and not path.is_file():
+            raise UsageError(f"motionhyst benchmark emps: {path}: not a regular file (a "
+                             f"folder, a pipe, a device or a broken link)")
     if not est_path.is_file():
         raise UsageError(f"motionhyst benchmark emps: {data} has no {ESTIMATION_FILE} (the "
                          f"benchmark's estimation record)")
