@@ -63,11 +63,15 @@ def _mat(variables: dict):
     return make
 
 
-def _emps(n: int = 24841, drop: str | None = None) -> dict[str, np.ndarray]:
-    """Variables of DATA_EMPS.mat (its names and length; made-up values)."""
+def _emps(n: int = 24841, drop: str | None = None, nan_at: int | None = None
+          ) -> dict[str, np.ndarray]:
+    """Variables of DATA_EMPS.mat (its names and length; made-up values; ``qm`` NaN at
+    `nan_at`)."""
     t = np.arange(n) / FS
     data = {"t": t, "vir": np.sin(t), "qm": 0.1 * np.sin(t), "qg": 0.1 * np.sin(t),
             "gtau": np.array([35.15065]), "kp": np.array([1.0]), "kv": np.array([1.0])}
+    if nan_at is not None:
+        data["qm"][nan_at] = np.nan
     return {k: v[:, None] for k, v in data.items() if k != drop}
 
 
@@ -163,6 +167,19 @@ CASES = [
      [*EMPS, "--periods", "5-6"],
      ["periods 5-6: the record has periods 1-4"]),
     ("emps-seed", {"d/.keep": ""}, [*EMPS, "--seed", "3"], ["--seed applies to bouc-wen only"]),
+    # there but not a file: the test record was passed over in silence (a cross-validation
+    # of minutes instead)
+    ("emps-test-record-is-a-folder", {"d/DATA_EMPS.mat": _mat(_emps()),
+                                      "d/DATA_EMPS_PULSES.mat/x": "1"}, EMPS,
+     ["d/DATA_EMPS_PULSES.mat: not a regular file"]),
+    ("emps-record-is-a-pipe", {"d/.keep": "", "@fifo:d/DATA_EMPS.mat": None}, EMPS,
+     ["d/DATA_EMPS.mat: not a regular file"]),
+    # values that no fit can use, refused as the record is read (was: in the first fit)
+    ("emps-record-with-a-nan", {"d/DATA_EMPS.mat": _mat(_emps(nan_at=100))}, EMPS,
+     ["d/DATA_EMPS.mat: displacement is not finite everywhere"]),
+    ("emps-test-record-of-10-samples", {"d/DATA_EMPS.mat": _mat(_emps()),
+                                        "d/DATA_EMPS_PULSES.mat": _mat(_emps(n=10))}, EMPS,
+     ["d/DATA_EMPS_PULSES.mat: too short (10 samples"]),
 ]
 
 
