@@ -3,8 +3,9 @@
 Shared by the bad-input tests: a command that would allocate past the limit gets a
 MemoryError (one line, exit 2) instead of growing until the kernel kills it, so a test that
 passes under the limit shows the command's memory is bounded.  The child runs with one BLAS
-and OpenMP thread, so that the limit measures the command and not the machine's core count
-(each thread reserves a stack and buffers of address space).
+and OpenMP thread and at most two malloc arenas, so that the limit measures the command and
+not the machine's core count (each thread reserves a stack, buffers and an arena of 64 MB of
+address space it hardly uses).
 """
 
 from __future__ import annotations
@@ -21,8 +22,7 @@ the hostile corpus peak at 0.15-0.71 GB (VmPeak, numba compiling its kernels inc
 
 RUN_LIMIT = 2 << 30
 """Address space [bytes] for a command that runs to its end with the study engine: a study of
-six points peaks at 1.25 GB (VmPeak: zarr's and numba's threads reserve address space they
-hardly use; its resident peak is 0.33 GB)."""
+six points peaks at 0.72 GB (VmPeak; 1.17 GB with an arena per thread; resident 0.33 GB)."""
 
 MAIN = ("import sys\n"
         "from motionhyst.core.compiled import quiet_compilation\n"
@@ -31,8 +31,8 @@ MAIN = ("import sys\n"
         "sys.exit(main(sys.argv[1:]))\n")
 """The console script, without the notice of a first compilation."""
 
-ONE_THREAD = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
-                                     "MKL_NUM_THREADS")}
+ONE_THREAD = {**{name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                        "MKL_NUM_THREADS")}, "MALLOC_ARENA_MAX": "2"}
 
 
 def environment(**changes: str | None) -> dict[str, str]:
