@@ -187,6 +187,10 @@ def test_asymmetric_viscous_friction_is_recovered():
     (["--asymmetric", "--model", "coulomb", "--plant", "two-mass"],
      "--asymmetric applies to --plant mass-damper"),
     (["--asymmetric", "--model", "jenkins", "--periodic"], "applies to --model coulomb only"),
+    (["--init-window", "20", "--offset", "output"], "the window sets each record's position"),
+    (["--init-window", "20", "--offset", "both"], "choose 'auto' or 'input'"),
+    (["--init-window", "20", "--offset", "input", "--plant", "mass-spring-damper"],
+     "on a floating stage only"),
 ])
 def test_cli_window_and_asymmetric_refusals(tmp_path, capsys, options, message):
     from motionhyst.cli import main

@@ -84,8 +84,8 @@ class Extras:
         `from_rest` fixes it at rest.  With `window` each record's initial state (and a
         floating stage's position offset, the same thing) is set from its first samples
         as the fit runs (:func:`~motionhyst.identify.io_predict.state_from_window`):
-        only the force offset is estimated (``auto``, ``input``, ``both``: on a
-        floating stage).
+        only the force offset is estimated (``auto`` or ``input``, on a floating
+        stage; nothing on a stage held by a spring).
 
         Parameters
         ----------
@@ -112,8 +112,10 @@ class Extras:
         Raises
         ------
         ValueError
-            An unknown choice; a window on periodic records or with `from_rest`; a
-            drift without a force offset or on periodic records.
+            An unknown choice; a window on periodic records or with `from_rest`, or
+            with an offset it would leave unestimated (``output`` or ``both``; ``input``
+            on a stage held by a spring); a drift without a force offset or on periodic
+            records.
         """
         if offset not in OFFSET_CHOICES:
             raise ValueError(f"unknown offset choice {offset!r}; expected one of "
@@ -133,8 +135,16 @@ class Extras:
             if periodic or from_rest:
                 raise ValueError("an initialisation window sets the state of records from a "
                                  "start: not with periodic records or from rest")
-            return cls(floating and offset in ("auto", "input", "both"), False, (),
-                       int(n_records))
+            if offset in ("output", "both"):
+                raise ValueError(f"offset {offset!r} with an initialisation window: the window "
+                                 f"sets each record's position (a floating stage's position "
+                                 f"offset) from its first samples; choose 'auto' or 'input' "
+                                 f"(the force offset), or no window")
+            if offset == "input" and not floating:
+                raise ValueError("offset 'input' with an initialisation window: the force "
+                                 "offset is estimated with a window on a floating stage only; "
+                                 "choose 'auto' or 'none', or no window")
+            return cls(floating and offset in ("auto", "input"), False, (), int(n_records))
         if offset == "auto":  # what the records can tell apart
             offset = "both" if floating and not periodic else "none" if floating else "output"
         if periodic and floating and offset != "none":
