@@ -168,6 +168,23 @@ def test_samples_from_an_identification(tmp_path, study_file):
         Study.from_file(bare, from_identification=tmp_path / "two.json")
 
 
+def test_a_study_whose_every_point_fails_is_a_failure(tmp_path, capsys):
+    """Every point failed (the loop unstable at each): the store records why, but the command
+    exits non-zero with one line and exports no table made of failures."""
+    study = tmp_path / "st.toml"
+    study.write_text(f'scenario = "{default_scenario_path().as_posix()}"\n'
+                     f'outputs = ["e1"]\n[axes]\nfrequency_hz = [5.0, 10.0]\n'
+                     f'"controller.K" = [1e12]\n')
+    table = tmp_path / "t.csv"
+    code = main(["study", str(study), "--out", str(tmp_path / "s.zarr"), "--workers", "0",
+                 "--table", str(table)])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "every one of its 2 points failed" in err and "the first: " in err
+    assert not table.exists()
+    assert np.all(open_results(tmp_path / "s.zarr")["status"].values == FAILED)
+
+
 def test_a_point_that_fails_is_counted_and_the_study_goes_on(tmp_path):
     st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0],
                                                       "controller.K": [6.2e6, 1e12]}},

@@ -138,12 +138,17 @@ def run(args: argparse.Namespace) -> int:
         if client is not None:
             client.close()
     ds = open_results(args.out)
+    from motionhyst.study.summary import failure_reasons
+
+    if report.points and report.failed == report.points:  # an answer from nothing: no tables
+        why, first = next(iter(failure_reasons(ds).items()), ("", {"example": ""}))
+        raise ValueError(f"study: every one of its {report.points} points failed ({why}; the "
+                         f"first: {first['example']}); nothing exported ({args.out} records "
+                         f"why)")
     _exports(ds, args)
     if args.json:
         print_json(report.to_dict())
     else:
-        from motionhyst.study.summary import failure_reasons
-
         print(report)
         for why, f in failure_reasons(ds).items():
             print(f"  {f['points']} failed: {why}; the first: {f['example']}")
