@@ -252,6 +252,23 @@ def test_single_element_to_dict_stays_a_list():
     assert isinstance(hysteresis_from_dict(d), MaxwellSlip)
 
 
+def test_parameters_are_read_only_and_the_slip_order_is_kept_whatever_the_caller_does():
+    """The elements in slip order are derived once: the parameters cannot change under them,
+    and a caller changing the arrays it was given does not change the link's."""
+    link = MaxwellSlip([1.0, 2.0, 4.0], [1.0, 0.5, 0.2])
+    for values in (link.k, link.fc):
+        with pytest.raises(ValueError, match="read-only"):
+            values[0] = 9.0
+    k, fc = link.periodic_stops()
+    assert_array_equal(k, [4.0, 2.0, 1.0])
+    assert_array_equal(fc, [0.2, 0.5, 1.0])
+    k[:] = 7.0
+    fc[:] = 7.0
+    assert_array_equal(link.periodic_stops()[0], [4.0, 2.0, 1.0])
+    assert_array_equal(link.periodic_stops()[1], [0.2, 0.5, 1.0])
+    assert_array_equal(link.k, [1.0, 2.0, 4.0])  # the link's own order
+
+
 def test_many_elements_steady_state_is_the_same_whatever_came_before():
     """The binned jump sums' weights are kept from one point to the next: the steady state
     of each point is the same, bit for bit, whichever points were computed before."""

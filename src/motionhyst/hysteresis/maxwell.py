@@ -30,12 +30,22 @@ class MaxwellSlip(Hysteresis):
     fc : array_like
         Slip forces ``fc_i`` [N], each > 0, same length as `k`.
 
+    Notes
+    -----
+    The link's parameters are fixed once it is made: :attr:`k` and :attr:`fc` are read-only
+    arrays (a link with other elements is a new link), so that what is derived from them
+    (the elements in slip order, :meth:`periodic_stops`) is derived once.
+
     Examples
     --------
     >>> from motionhyst.hysteresis import MaxwellSlip
     >>> link = MaxwellSlip(k=[1.0, 2.0], fc=[1.0, 0.5])
     >>> link.initial_stiffness
     3.0
+    >>> link.k[0] = 5.0
+    Traceback (most recent call last):
+    ...
+    ValueError: assignment destination is read-only
     """
 
     name = "maxwell-slip"
@@ -56,10 +66,21 @@ class MaxwellSlip(Hysteresis):
             bad = np.flatnonzero(~(np.isfinite(values) & (values > 0)))
             if bad.size:
                 check_positive(f"{name}[{bad[0]}]", float(values[bad[0]]))
-        self.k = k_arr
-        self.fc = fc_arr
+        self._k = k_arr  # what the compiled kernels are given (writable arrays: one version)
+        self._fc = fc_arr
+        self._stops: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
         self._elements: list[Jenkins] | None = None
         self.reset()
+
+    @property
+    def k(self) -> NDArray[np.float64]:
+        """Spring stiffnesses ``k_i`` [N/m] (read-only)."""
+        return _read_only(self._k)
+
+    @property
+    def fc(self) -> NDArray[np.float64]:
+        """Slip forces ``fc_i`` [N] (read-only)."""
+        return _read_only(self._fc)
 
     def __repr__(self) -> str:
         return f"MaxwellSlip(k={self.k.tolist()!r}, fc={self.fc.tolist()!r})"
@@ -88,8 +109,10 @@ class MaxwellSlip(Hysteresis):
         >>> MaxwellSlip(k=[1.0, 2.0], fc=[1.0, 0.5]).periodic_stops()
         (array([2., 1.]), array([0.5, 1. ]))
         """
-        order = np.argsort(self.fc / self.k, kind="stable")
-        return self.k[order], self.fc[order]
+        if self._stops is None:  # once: a steady state asks for them at each point
+            order = np.argsort(self._fc / self._k, kind="stable")
+            self._stops = (self._k[order], self._fc[order])
+        return self._stops[0].copy(), self._stops[1].copy()
 
     def describing_function(self, A: ArrayLike, omega: ArrayLike | None = None):
         """Sum of the elements' closed-form describing functions (eq. 10) [N/m].
@@ -158,7 +181,7 @@ class MaxwellSlip(Hysteresis):
         w0s = np.broadcast_to(np.asarray(w0, dtype=float), self.k.shape).copy()
         if not np.all(np.abs(w0s) <= self.fc):
             raise ValueError("each initial force must satisfy |w0_i| <= fc_i")
-        return maxwell_response(xs, self.k, self.fc, w0s).sum(axis=1)
+        return maxwell_response(xs, self._k, self._fc, w0s).sum(axis=1)
 
     def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
                            omega: float | None = None) -> NDArray[np.complex128]:
@@ -178,7 +201,7 @@ class MaxwellSlip(Hysteresis):
         """
         from motionhyst.hysteresis.periodic import stop_periodic_harmonics
 
-        return stop_periodic_harmonics(np.asarray(X, dtype=complex), self.k, self.fc,
+        return stop_periodic_harmonics(np.asarray(X, dtype=complex), self._k, self._fc,
                                        n_harmonics)
 
     def __call__(self, x: float) -> float:
@@ -191,7 +214,8 @@ class MaxwellSlip(Hysteresis):
         if self._x is not None:
             from motionhyst.hysteresis._kernels import maxwell_response
 
-            self._wi = maxwell_response(np.array([self._x, x]), self.k, self.fc, self._wi)[-1]
+            self._wi = maxwell_response(np.array([self._x, x]), self._k, self._fc,
+                                        self._wi)[-1]
         self._x = x
         return float(sum(self._wi.tolist()))  # in the elements' order, as they were added
 
@@ -217,3 +241,10 @@ class MaxwellSlip(Hysteresis):
     def to_dict(self) -> dict:
         """Parameters as a JSON-ready dictionary."""
         return {"model": self.name, "k": self.k.tolist(), "fc": self.fc.tolist()}
+
+
+def _read_only(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A read-only view of `a`."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
