@@ -180,8 +180,9 @@ def stop_periodic_harmonics(X: NDArray[np.complex128], k: ArrayLike, fc: ArrayLi
     H = int(n_harmonics)
     if H < 0:
         raise ValueError("n_harmonics must be >= 0")
-    k_arr = np.atleast_1d(np.asarray(k, dtype=float))
-    fc_arr = np.atleast_1d(np.asarray(fc, dtype=float))
+    # copies: a read-only array (MaxwellSlip.k) would make the kernels compile once more
+    k_arr = np.array(k, dtype=float, ndmin=1)
+    fc_arr = np.array(fc, dtype=float, ndmin=1)
     if k_arr.ndim != 1 or k_arr.shape != fc_arr.shape:
         raise ValueError("k and fc must be scalars or one-dimensional arrays of equal length")
     X = np.ascontiguousarray(X, dtype=complex)
