@@ -350,7 +350,7 @@ def test_small_change_of_the_input_is_followed_to_first_order(direction):
     X = _rich_symmetric_input(M, 0.01, 1)
     tw = stop_twiddles(M, H)
     grid = np.zeros(2, dtype=np.int64)
-    Wb, table, base, Xb, S, zs, t_b, js, x_top = _full(X, k, fc, H, tw, grid)
+    Wb, table, base, Xb, S, zs, t_b, js, x_top, moments = _full(X, k, fc, H, tw, grid)
     assert base and 0 < t_b.size - 1 < k.size  # some elements slip, some never do
     eps = 5e-11
     if direction == "amplitude":
@@ -361,7 +361,8 @@ def test_small_change_of_the_input_is_followed_to_first_order(direction):
         Xn = X.copy()
         Xn[3::2] += eps * abs(X[1]) / 20 * np.exp(1j * np.arange(3, M + 1, 2))
     full = _full(Xn, k, fc, H, tw)[0]
-    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table, grid)
+    ok, W = stop_harmonics_update(Xn, H, tw, Wb, Xb, S, zs, t_b, js, x_top, moments, table,
+                                  grid)
     assert ok
     scale = np.max(np.abs(full))
     assert np.max(np.abs(full - Wb)) > 1e-12 * scale
@@ -522,3 +523,28 @@ def test_binned_sums_of_opposite_mirrors_at_odd_harmonics(N):
     odd = _jump_sums.jump_sums_binned_odd(t, w, L, N, 9, table, tw)
     assert_allclose(odd[1::2], whole[1::2], rtol=0, atol=1e-15 * np.sum(np.abs(w)))
     assert_array_equal(odd[::2], 0.0)
+
+
+@pytest.mark.parametrize("N", [64, 128, 256])
+def test_binned_sums_at_even_harmonics_on_half_the_grid(N):
+    """The points' sums at even ``l`` from the moments folded on half the grid equal the
+    direct sums ``sum_b w_b exp(-j l t_b)`` (zero at odd ``l``), and the binned sums on the
+    whole grid there."""
+    from motionhyst.hysteresis import _jump_sums
+
+    rng = np.random.default_rng(5)
+    t = np.sort(rng.uniform(-0.2, 2 * np.pi - 0.2, 400))
+    w = rng.standard_normal(400)
+    L = 150
+    tw = stop_twiddles(L, L)
+    P = _jump_sums.chebyshev_terms(np.pi * L / N)
+    table = _jump_sums.binned_table(N, P, L)
+    bins = _jump_sums.chebyshev_moments(t, w, w, 0, N, P)
+    even = _jump_sums.half_grid_sums(bins, 0, False, L, N, P, table, tw)
+    q = np.arange(L + 1)
+    direct = np.exp(-1j * np.outer(q, t)) @ w
+    direct[1::2] = 0.0
+    assert_allclose(even, direct, rtol=0, atol=1e-14 * np.sum(np.abs(w)))
+    whole = _jump_sums.jump_sums_binned(t, w, w, False, L, N, P, table, tw)
+    assert_allclose(even[::2], whole[::2], rtol=0, atol=1e-15 * np.sum(np.abs(w)))
+    assert_array_equal(even[1::2], 0.0)

@@ -490,22 +490,24 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     t_b = np.empty(0)
     js = np.empty(0)
     x_top = 0.0
+    moments = np.empty((0, 0))
     for it in range(1, max_iter + 1):
         updated = False
         W_new = Wb
         if base:
             updated, W_new = stop_harmonics_update(X, H, tw, Wb, Xb, Sb, zs, t_b, js,
-                                                   x_top, weights, grid)
+                                                   x_top, moments, weights, grid)
         if not updated:
             if it == 1:  # the linear loop's y1, one harmonic: a grid of its own; the
                 # starting value, whose error the contraction damps at each later iteration
                 # (computed to 1e-10 only, on the other grid: never followed to first order)
-                W_new, first_weights, _, Xb, Sb, zs, t_b, js, x_top = stop_harmonics_base(
-                    X, k, fc, H, tw, first_weights, first_grid, H, FIRST_ITERATION_TOL)
+                (W_new, first_weights, _, Xb, Sb, zs, t_b, js, x_top,
+                 moments) = stop_harmonics_base(X, k, fc, H, tw, first_weights, first_grid, H,
+                                                FIRST_ITERATION_TOL)
                 base = False
             else:  # one grid for any number of harmonics of y1
-                W_new, weights, base, Xb, Sb, zs, t_b, js, x_top = stop_harmonics_base(
-                    X, k, fc, H, tw, weights, grid, 2 * H, 1e-17)
+                (W_new, weights, base, Xb, Sb, zs, t_b, js, x_top,
+                 moments) = stop_harmonics_base(X, k, fc, H, tw, weights, grid, 2 * H, 1e-17)
             Wb = W_new
         change = 0.0
         for q in range(H + 1):

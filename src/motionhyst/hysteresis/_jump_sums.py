@@ -243,20 +243,6 @@ def bessel_table(alpha, Q, P):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def balance(jg, js):  # pragma: no cover - compiled
-    """The power of two ``r`` that makes ``sum |jg|`` and ``r sum |js|`` alike, so that the
-    two sets of jumps, transformed together, each keep their accuracy."""
-    sum_g = 0.0
-    sum_s = 0.0
-    for b in range(jg.shape[0]):
-        sum_g += abs(jg[b])
-        sum_s += abs(js[b])
-    if sum_g > 0.0 and sum_s > 0.0:
-        return 2.0 ** np.round(np.log2(sum_g / sum_s))
-    return 1.0
-
-
-@njit(cache=True)
 def binned_table(N, P, L):  # pragma: no cover - compiled
     """The weights of :func:`jump_sums_binned` for the grid of `N` points, `P` terms and the
     harmonics ``l = 0 .. L``: row ``l`` holds, for each pair of terms ``p, p + 1`` (``p``
@@ -282,21 +268,23 @@ def binned_table(N, P, L):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def chebyshev_moments(t_b, w_plus, w_minus, mirror, N, P):  # pragma: no cover - compiled
+def chebyshev_moments(t_b, w_plus, w_minus, shift, N, P):  # pragma: no cover - compiled
     """The moments ``sum_b w_b T_p(v_b)`` of the points `t_b` (angles in ``[-2 pi, 4 pi)``)
     binned to the nearest of ``N`` grid points ``c_j`` (``t_b = c_j + v_b h / 2``, ``|v_b|
     <= 1``): rows ``j``, columns ``p < P`` (then zeros to a multiple of 8 columns).
 
-    The weights are `w_plus`; with `mirror` each point has a mirror half a period on
-    (``N / 2`` grid points, the same ``v_b``), weighted by `w_minus`.  The polynomials
-    of four points at a time come from four interleaved Chebyshev recurrences.
+    The weights are `w_plus`; `shift` places a second set, `w_minus`, at the same
+    points: ``0``, none; ``N / 2``, the mirrors of the points half a period on (``N / 2``
+    grid points on, the same ``v_b``); ``N``, the points' own moments of `w_minus` in rows
+    ``N + j`` (``2 N`` rows).  The polynomials of four points at a time come from four
+    interleaved Chebyshev recurrences.
     """
     nb = t_b.shape[0]
     width = (P + 7) // 8 * 8
     h = _TWO_PI / N
     inv_h = N / _TWO_PI
-    half_grid = N // 2
-    bins = np.zeros((N, width))
+    rows = 2 * N if shift == N else N
+    bins = np.zeros((rows, width))
     T = np.zeros((4, width))
     cells = np.zeros(4, dtype=np.int64)
     v = np.zeros(4)
@@ -336,8 +324,9 @@ def chebyshev_moments(t_b, w_plus, w_minus, mirror, N, P):  # pragma: no cover -
             row = bins[j]
             Ti = T[i]
             wp = w_plus[b0 + i]
-            if mirror:
-                other = bins[j + half_grid if j < half_grid else j - half_grid]
+            if shift > 0:
+                o = j + shift
+                other = bins[o - N if o >= rows else o]
                 wm = w_minus[b0 + i]
                 for p in range(width):
                     row[p] += wp * Ti[p]
@@ -363,8 +352,15 @@ def jump_sums_binned(t_b, w_plus, w_minus, mirror, L, N, P, table, tw):  # pragm
     weights (:func:`binned_table` of ``N``, ``P`` and at least ``L``), `tw` the twiddle
     table of at least ``N`` points.
     """
+    bins = chebyshev_moments(t_b, w_plus, w_minus, N // 2 if mirror else 0, N, P)
+    return binned_sums(bins, L, N, P, table, tw)
+
+
+@njit(cache=True)
+def binned_sums(bins, L, N, P, table, tw):  # pragma: no cover - compiled
+    """:func:`jump_sums_binned` from the moments `bins` (:func:`chebyshev_moments`: rows
+    ``j < N``, columns ``p < P`` at least)."""
     n_pairs = (P + 1) // 2
-    bins = chebyshev_moments(t_b, w_plus, w_minus, mirror, N, P)
     reversed_index = bit_reversed_indices(N)
     mu = np.empty((n_pairs, N), dtype=np.complex128)
     for pp in range(n_pairs):
@@ -389,37 +385,54 @@ def jump_sums_binned(t_b, w_plus, w_minus, mirror, L, N, P, table, tw):  # pragm
 def jump_sums_binned_odd(t_b, w, L, N, P, table, tw):  # pragma: no cover - compiled
     """:func:`jump_sums_binned` with `mirror` and the weights ``w`` at ``t_b``, ``-w`` half a
     period on, whose sums vanish at even ``l``: ``Z_l = 2 sum_b w_b exp(-j l t_b)`` at odd
-    ``l <= L`` (zero at even ``l``), in half the transforms.
+    ``l <= L`` (zero at even ``l``), in half the transforms (:func:`half_grid_sums`).
+    """
+    # the points alone (shift N - N = 0, and odd L >= 0: values, not literals, so that one
+    # compiled version of each kernel serves every call)
+    bins = chebyshev_moments(t_b, w, w, N - N, N, P)
+    return half_grid_sums(bins, N - N, L >= 0, L, N, P, table, tw)
 
-    With ``B_j`` the moments of the points alone, those of the pairs are ``B_j - B_{j -
-    N/2}``, and at odd ``l`` their transform is twice that of ``D_j exp(-2 pi j j l / N)``,
-    ``D_j = B_j - B_{j + N/2}``, ``j < N / 2``: the transform of ``N / 2`` points of ``D_j
-    exp(-2 pi j j / N)`` read at ``(l - 1) / 2``.
+
+@njit(cache=True)
+def half_grid_sums(bins, first, odd, L, N, P, table, tw):  # pragma: no cover - compiled
+    """:func:`jump_sums_binned` at the odd or the even ``l <= L`` only, from the moments of the
+    points alone (:func:`chebyshev_moments`: rows ``first + j``, ``j < N``, columns ``p < P``
+    at least), each set of harmonics by transforms of half the grid (zero at the others).
+
+    With ``B_j`` those moments, ``exp(-j l c_j)`` at even ``l`` repeats after ``N / 2``
+    points: the sums are the transform of the ``N / 2`` points ``B_j + B_{j + N/2}`` read at
+    ``l / 2``.  With `odd` the points have their opposites half a period on (weights ``w``
+    and ``-w``), whose moments are ``B_j - B_{j - N/2}``: at odd ``l`` the transform of
+    these is twice that of ``D_j exp(-2 pi j j l / N)``, ``D_j = B_j - B_{j + N/2}``, ``j <
+    N / 2``: the transform of ``N / 2`` points of ``D_j exp(-2 pi j j / N)`` read at ``(l -
+    1) / 2`` (the sums returned are those of the points and their opposites, ``2 sum_b w_b
+    exp(-j l t_b)``).
     """
     n_pairs = (P + 1) // 2
     half = N // 2
-    # the points alone (no mirror: half < 0 is False, passed as a value, not a literal, so
-    # that one compiled version of chebyshev_moments serves every call)
-    bins = chebyshev_moments(t_b, w, w, half < 0, N, P)
     step = 2 * tw.shape[0] // N
+    sign = -1.0 if odd else 1.0
     reversed_index = bit_reversed_indices(half)
     y = np.empty((n_pairs, half), dtype=np.complex128)
     for pp in range(n_pairs):
         row = y[pp]
         for j in range(half):
             jj = reversed_index[j]
-            a = bins[jj]
-            b = bins[jj + half]
-            row[j] = complex(a[2 * pp] - b[2 * pp], a[2 * pp + 1] - b[2 * pp + 1]) * tw[jj * step]
+            a = bins[first + jj]
+            b = bins[first + jj + half]
+            z = complex(a[2 * pp] + sign * b[2 * pp], a[2 * pp + 1] + sign * b[2 * pp + 1])
+            row[j] = z * tw[jj * step] if odd else z
         fft_unscrambling(row, tw)
     Z = np.zeros(L + 1, dtype=np.complex128)
-    for q in range(1, L + 1, 2):
+    q0 = 1 if odd else 0
+    scale = 2.0 if odd else 1.0
+    for q in range(q0, L + 1, 2):
         iq = q % N
-        im = N - iq
+        im = (N - iq) % N
         weights = table[q]
         z = 0j
         for pp in range(n_pairs):
-            z += (weights[2 * pp] * y[pp, (iq - 1) // 2]
-                  + weights[2 * pp + 1] * y[pp, (im - 1) // 2].conjugate())
-        Z[q] = 2.0 * z
+            z += (weights[2 * pp] * y[pp, iq // 2]
+                  + weights[2 * pp + 1] * y[pp, im // 2].conjugate())
+        Z[q] = scale * z
     return Z

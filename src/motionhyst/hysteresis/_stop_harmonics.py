@@ -22,15 +22,15 @@ from motionhyst.hysteresis._fft import (
     synthesize_packed_odd,
 )
 from motionhyst.hysteresis._jump_sums import (
-    balance,
     binned_grid_to,
     binned_is_cheaper,
     binned_table,
+    chebyshev_moments,
     chebyshev_terms_to,
+    half_grid_sums,
     jump_series,
     jump_series_half,
     jump_sums_binned,
-    jump_sums_binned_odd,
 )
 from motionhyst.hysteresis._kernels import (
     BETWEEN_REVERSALS,
@@ -133,14 +133,17 @@ def stop_harmonics_kept(X, k, fc, H, tw, table, grid, q_grid):  # pragma: no cov
 def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: no cover
     """:func:`stop_harmonics_kept` with the binned sums to `tol` of the sums of their weights'
     moduli (1e-17: to round-off), returning also what :func:`stop_harmonics_update` needs
-    to follow a small change of the input: ``(W, table, base, Xs, S, zs, t_b, js, x_top)``.
+    to follow a small change of the input: ``(W, table, base, Xs, S, zs, t_b, js, x_top,
+    moments)``.
 
     ``base`` is True where the output came from many jumps binned (the costly case) over a
     half-wave symmetric, monotone branch: ``Xs`` is then the input as used (no DC, no even
     harmonics), ``S`` the harmonics ``0 .. H + M`` of the stiffness ``s`` (``zs`` its
     samples as transformed for the product ``s x``, where it was transformed), ``t_b`` and
     ``js`` the jumps of ``s`` over the first half period (the slip onsets, then the
-    reversal at the maximum ``x_top``).
+    reversal at the maximum ``x_top``), ``moments`` the jumps' Chebyshev moments on the
+    binned sums' grid (:func:`chebyshev_moments` with ``shift = N``: those of ``js`` in the
+    first ``N`` rows).
 
     The reversals come from :func:`dominant_reversals` where it applies, else from the
     grid.  An input whose even harmonics are below 1e-15 of the total is taken as half-wave
@@ -153,9 +156,10 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
     W = np.zeros(H + 1, dtype=np.complex128)
     none = np.empty(0, dtype=np.complex128)
     no_jumps = np.empty(0)
+    no_moments = np.empty((0, 0))
     M = significant_count(X, 1e-15)
     if M == 0:
-        return W, table, False, none, none, none, no_jumps, no_jumps, 0.0
+        return W, table, False, none, none, none, no_jumps, no_jumps, 0.0, no_moments
     # half-wave symmetric x (even harmonics a round-off of the odd ones, as a symmetric
     # loop's y1): made exact, its output's second half period mirrors the first
     Xs, symmetric, total = _without_dc(X, M)
@@ -172,7 +176,7 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         x = synthesize(Xs, n, tw)
         rev, xr = reversal_points(Xs, C1, C2, synthesize(C1, n, tw))
     if rev.shape[0] < 2:
-        return W, table, False, none, none, none, no_jumps, no_jumps, 0.0
+        return W, table, False, none, none, none, no_jumps, no_jumps, 0.0, no_moments
     mode = GRID_BRACKET
     if monotone:
         mode = BETWEEN_REVERSALS
@@ -201,8 +205,8 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         for m in range(2, M + 1):
             tail += abs(Xs[m])
         tol_rest = min(tol * total / tail, 1e-3) if tail > 0.0 else 1e-3
-        G, S, table = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw, table,
-                                     grid, max(tol, tol_rest), tol)
+        G, S, table, moments = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw,
+                                              table, grid, max(tol, tol_rest), tol)
     elif half:
         G, S = jump_series_half(t_b, jg, js, H, Q)
     else:
@@ -217,17 +221,17 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         for q in range(H + 1):
             W[q] = G[q] + P_x[q]
     if half and binned:
-        return W, table, True, Xs, S, zs, t_b, js, xr[top]
-    return W, table, False, none, none, none, no_jumps, no_jumps, 0.0
+        return W, table, True, Xs, S, zs, t_b, js, xr[top], moments
+    return W, table, False, none, none, none, no_jumps, no_jumps, 0.0, no_moments
 
 
 @njit(cache=True)
-def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
+def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, moments, table,
                           grid):  # pragma: no cover - compiled
     """The output of :func:`stop_harmonics_base` for the input `X`, from its output ``Wb`` for
-    an input ``Xb`` near it (``Xb``, ``S``, ``zs``, ``t_b``, ``js``, ``x_top`` as it returned them,
-    `table` and `grid` the weights and grid of its binned sums), to first order in their
-    difference.  Returns ``(ok, W)``; ``ok`` is False (``W`` unset) where `X` is not
+    an input ``Xb`` near it (``Xb``, ``S``, ``zs``, ``t_b``, ``js``, ``x_top``, ``moments`` as it
+    returned them, `table` and `grid` the weights and grid of its binned sums), to first
+    order in their difference.  Returns ``(ok, W)``; ``ok`` is False (``W`` unset) where `X` is not
     half-wave symmetric, not monotone between two reversals, has more harmonics than
     ``Xb``, differs from it by more than :data:`LINEAR_CHANGE`, or would need more terms
     of the binned sums than `table` holds.
@@ -242,8 +246,8 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
     the second order only.  The new maximum is that of the parabola through ``x``, ``x'``
     and ``x''`` at the old one's angle (its error of the third order in the small move of
     the angle).  The sums of
-    ``js`` are binned on the grid of ``S``'s, to the accuracy the small ``dx_top`` needs
-    (:func:`jump_sums_binned_odd`).
+    ``js`` are binned on the grid of ``S``'s, from their moments computed there, to the
+    accuracy the small ``dx_top`` needs (:func:`half_grid_sums`).
     """
     W = np.zeros(H + 1, dtype=np.complex128)
     Mb = Xb.shape[0] - 1
@@ -296,10 +300,11 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, table,
     if N <= 0 or not tol > 0.0:  # no grid kept with the table, or no output to measure by
         return False, W
     P = chebyshev_terms_to(np.pi * H / N, tol)
-    if P > grid[1]:  # the table's weights of a term do not depend on the terms after it
+    # the table's weights of a term do not depend on the terms after it, nor the moments
+    if P > grid[1] or moments.shape[0] != 2 * N or moments.shape[1] < P:
         return False, W
     # js at t_b and -js half a period on: twice the sums of js at odd q
-    Z = jump_sums_binned_odd(t_b, js, H, N, P, table, tw)
+    Z = half_grid_sums(moments, N - N, N > 0, H, N, P, table, tw)
     for q in range(1, H + 1, 2):
         W[q] -= d_top * Z[q] * (-1j / (_TWO_PI * q))
     return True, W
@@ -327,10 +332,11 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
     kept (a new one where it does not serve).
 
     With `half` (the jumps of the first half period; the second's are ``-jg`` and ``js``
-    half a period on) each jump and its mirror make one sum with real weights, ``(r js +
-    jg) / 2`` at ``t_b`` and ``(r js - jg) / 2`` at ``t_b + pi`` (``r`` from
-    :func:`balance`): ``r`` times the sum of `js` at even ``q``, the sum of `jg` at odd
-    ``q``.  Returns ``G``, ``S`` and the table.
+    half a period on) ``s`` has only even harmonics, twice the sums of `js` there, and
+    ``g`` only odd ones, the sums of `jg` and their opposites: each from the moments of the
+    jumps alone on half the grid (:func:`half_grid_sums`; the moments of `js` and `jg`
+    together, :func:`chebyshev_moments` with ``shift = N``, returned as well).  Returns
+    ``G``, ``S``, the table and those moments (none without `half`).
     """
     nb = t_b.shape[0]
     n_points = 2 * nb if half else nb
@@ -342,21 +348,15 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
     G = np.zeros(H + 1, dtype=np.complex128)
     S = np.zeros(Q + 1, dtype=np.complex128)
     if half:
-        r = balance(jg, js)
-        w_plus = np.empty(nb)
-        w_minus = np.empty(nb)
-        for b in range(nb):
-            w_plus[b] = 0.5 * (r * js[b] + jg[b])
-            w_minus[b] = 0.5 * (r * js[b] - jg[b])
-        Z = jump_sums_binned(t_b, w_plus, w_minus, half, Q, N, P, table, tw)
-        for q in range(1, Q + 1):
-            scale = -2j / (_TWO_PI * q)
-            if q % 2 == 1:
-                if q <= H:
-                    G[q] = Z[q] * scale
-            else:
-                S[q] = Z[q] * (scale / r)
-        return G, S, table
+        pair = chebyshev_moments(t_b, js, jg, N, N, P)
+        # (the row and the flag as values, not literals: one compiled version serves all)
+        Zs = half_grid_sums(pair, N - N, N < 0, Q, N, P, table, tw)
+        Zg = half_grid_sums(pair, N, N > 0, H, N, P, table, tw)  # twice the sums
+        for q in range(2, Q + 1, 2):
+            S[q] = Zs[q] * (-2j / (_TWO_PI * q))
+        for q in range(1, H + 1, 2):
+            G[q] = Zg[q] * (-1j / (_TWO_PI * q))
+        return G, S, table, pair
     Zg = jump_sums_binned(t_b, jg, jg, half, H, N, P, table, tw)  # half is False here
     Zs = jump_sums_binned(t_b, js, js, half, Q, N, P, table, tw)
     for q in range(1, Q + 1):
@@ -364,7 +364,7 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
         if q <= H:
             G[q] = Zg[q] * scale
         S[q] = Zs[q] * scale
-    return G, S, table
+    return G, S, table, np.empty((0, 0))
 
 
 @njit(cache=True)
