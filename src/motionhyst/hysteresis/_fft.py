@@ -215,6 +215,24 @@ def synthesize(X, n, tw):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def synthesize_odd(X, n, tw):  # pragma: no cover - compiled
+    """:func:`synthesize` of `X` without even harmonics (``x(t + n / 2) = -x(t)``), in half the
+    work: the first half period from :func:`synthesize_packed_odd`, the second its opposite."""
+    y = synthesize_packed_odd(X, n, tw)
+    bit_reverse(y)  # packed samples t < n / 4: x_2t and x_2t+1
+    x = np.empty(n)
+    half = n // 2
+    for t in range(n // 4):
+        a = y[t].real
+        b = -y[t].imag
+        x[2 * t] = a
+        x[2 * t + 1] = b
+        x[2 * t + half] = -a
+        x[2 * t + 1 + half] = -b
+    return x
+
+
+@njit(cache=True)
 def analyze(x, n_out, tw):  # pragma: no cover - compiled
     """Harmonics ``0 .. n_out`` of ``rfft(x) / n`` (``n = len(x)``, ``n_out <= n / 2``)."""
     n = x.shape[0]

@@ -18,6 +18,7 @@ from motionhyst.hysteresis._fft import (
     analyze_packed_odd,
     packed_product,
     synthesize,
+    synthesize_odd,
     synthesize_packed,
     synthesize_packed_odd,
 )
@@ -185,8 +186,8 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
         if (k.shape[0] >= CUBIC_ELEMENTS
                 and cubic_error_bound(Xs, n) <= 1e-9 * abs(xr[0] - xr[1])):
             mode = GRID_CUBIC
-            if M > 1:
-                x = synthesize(Xs, n, tw)
+            if M > 1:  # (without even harmonics: half the transform)
+                x = synthesize_odd(Xs, n, tw) if symmetric else synthesize(Xs, n, tw)
     half = symmetric and monotone
     top = 1 if xr[1] > xr[0] else 0
     if half and mode == GRID_CUBIC and M == 1:  # a sine: the onsets in closed form
