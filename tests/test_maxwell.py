@@ -387,6 +387,8 @@ def test_a_change_the_first_order_does_not_follow_is_refused():
     assert not stop_harmonics_update(even, H, tw, *kept)[0]
     longer = np.concatenate([X, [0.0, 1e-13 * abs(X[1])]])
     assert not stop_harmonics_update(longer, H, tw, *kept)[0]
+    no_moments = (*kept[:7], np.empty((0, 0)), *kept[8:])  # none kept from the evaluation
+    assert not stop_harmonics_update(X * (1 + 1e-11), H, tw, *no_moments)[0]
 
 
 def _fixed_point_in_full(lp, A: float, f: float) -> tuple[np.ndarray, int]:

@@ -235,7 +235,7 @@ def stop_harmonics_update(X, H, tw, Wb, Xb, S, zs, t_b, js, x_top, moments, tabl
     order in their difference.  Returns ``(ok, W)``; ``ok`` is False (``W`` unset) where `X` is not
     half-wave symmetric, not monotone between two reversals, has more harmonics than
     ``Xb``, differs from it by more than :data:`LINEAR_CHANGE`, or would need more terms
-    of the binned sums than `table` holds.
+    of the binned sums than `table` and ``moments`` hold.
 
     From the maximum ``x_top`` to the minimum an element that slips sticks, ``w = fc - k
     (x_top - x)``, until its slip onset, then slips, ``w = -fc``; one that never slips
