@@ -14,8 +14,10 @@ stores:
    scheduler`` and ``dask worker --nworkers 2 --nthreads 1``, with their nannies, in
    processes of their own; warmed by a study of two points) with the batches ``run_study``
    chooses for dask (at least ``DASK_BATCH_SECONDS`` of work), against the pool of two
-   workers in ``--repeats`` pairs of runs, interleaved (pool then dask, dask then pool, ...;
-   a study of another seed each pair, as a dask worker keeps the last study it built).
+   workers in ``--repeats`` pairs of runs, interleaved (a study of another seed each pair, as
+   a dask worker keeps the last study it built); each pair has a third run, dask with the
+   batches sampled by the workers' profiler (``engine.DASK_PROFILED = True``; by default a
+   batch hides its thread from it), against the same pool run, the three in rotating order.
 
 Each run counts the CPU time of every process by role (this process, the client, which sends
 the batches and writes the store; the workers; on dask the scheduler and the nannies too) and
@@ -63,7 +65,12 @@ import numpy as np
 
 from motionhyst.scenario import default_scenario_path
 from motionhyst.study import Study, open_results, run_study
+from motionhyst.study import engine as engine_mod
 from motionhyst.study.engine import DASK_BATCH_SECONDS, batch_size, seconds_per_point
+
+ENGINES = ("pool", "dask", "dask_profiled")
+"""The runs of each pair: the local pool, dask with the batches hidden from the workers'
+profiler (``DASK_PROFILED`` False, the default) and dask with them sampled."""
 
 
 def make_study(samples: int, frequencies: int, seed: int = 0) -> Study:
@@ -251,6 +258,41 @@ def _quiet_from_fit(pairs: list[tuple[Run, Run]]) -> dict | None:
             "dask_per_run_s": float(fits[1][0][1]), "pool_per_run_s": float(fits[0][0][1])}
 
 
+def _dask_against_pool(pairs: list[tuple[Run, Run]], idle: float, n: int) -> dict:
+    """Dask's runs against the pool's of the same pairs: the CPU a point by role, and dask's
+    cost past the pool's, a share of the pool's CPU time, in each of the ways described above."""
+
+    def per_point_us(runs: list[Run], role: str) -> float:
+        # a role's CPU a point; the workers' past the points' work
+        return 1e6 * float(np.median([r.cpu.get(role, 0.0) - (r.work if role == "workers"
+                                                               else 0.0) for r in runs])) / n
+
+    pools, dasks = [p for p, _ in pairs], [d for _, d in pairs]
+    return {
+        "pairs": [{"pool": {"wall_s": p.wall, "work_s": p.work, **p.cpu},
+                   "dask": {"wall_s": d.wall, "work_s": d.work, **d.cpu}} for p, d in pairs],
+        # what the load does to the same work: it moves the points' CPU time (both engines)
+        "work_dask_over_pool": _spread([d.work / p.work - 1 for p, d in pairs]),
+        "pool_cpu_noise": (max(r.total for r in pools) - min(r.total for r in pools))
+        / float(np.median([r.total for r in pools])),
+        "us_per_point": {engine: {role: per_point_us(runs, role) for role in
+                                  ("client", "scheduler", "nannies", "workers")}
+                         for engine, runs in (("pool", pools), ("dask", dasks))},
+        # the old measure: all CPU, the points' work included (its noise is the load's)
+        "dask_total_over_pool": _spread([d.total / p.total - 1 for p, d in pairs]),
+        # the engines' costs alone (all CPU past the points' work), against the pool's CPU
+        "dask_overhead_fraction": _spread([_fraction(d, p) for p, d in pairs]),
+        "dask_task_overhead_fraction": _spread([_fraction(d, p, idle) for p, d in pairs]),
+        # on two idle cores a run lasts about half its work
+        "dask_overhead_fraction_quiet": _spread([_fraction(d, p, idle, d.work / 2)
+                                                 for p, d in pairs]),
+        "dask_wall_over_pool": _spread([d.wall / p.wall for p, d in pairs]),
+        # the same from the engines' costs fitted over the pairs as a part per run and a part
+        # per second of wall time: no idle window measured apart
+        "dask_overhead_fraction_quiet_fit": _quiet_from_fit(pairs),
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=1500, help="Monte-Carlo samples")
@@ -272,6 +314,7 @@ def main() -> None:
                  "dask_batch_seconds": args.dask_batch_seconds, "cores": os.cpu_count(),
                  "repeats": args.repeats, "load_before": load_before}
     pairs: list[tuple[Run, Run]] = []
+    profiled: list[tuple[Run, Run]] = []
     idles: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
@@ -287,30 +330,32 @@ def main() -> None:
             timed(make_study(1, 2), folder, "dask_warm", roles=roles, client=client, batch=1)
             for r in range(args.repeats):
                 # a study of its own each pair (another seed): a dask worker keeps the last
-                # study built, a pool's workers build it anew; the order alternates, so that
-                # a load rising or falling over the pairs weighs on both engines alike
+                # study built, a pool's workers build it anew; the order rotates, so that
+                # a load rising or falling over the pairs weighs on every engine alike
                 st = make_study(args.samples, args.frequencies, seed=1 + r)
                 idles.append(idle_rate(roles, 2.0))
                 runs = {}
-                for engine in (("pool", "dask") if r % 2 == 0 else ("dask", "pool")):
+                for engine in ENGINES[r % 3:] + ENGINES[:r % 3]:
                     if engine == "pool":
-                        runs[engine] = timed(st, folder, f"pair{r}_pool", workers=2, batch=batch)
+                        runs[engine] = timed(st, folder, f"pair{r}_{engine}", workers=2,
+                                             batch=batch)
                     else:
-                        runs[engine] = timed(st, folder, f"pair{r}_dask", roles=roles,
-                                             client=client, batch=dask_batch)
+                        # the batches hidden from the workers' profiler (the default), or not
+                        engine_mod.DASK_PROFILED = engine == "dask_profiled"
+                        try:
+                            runs[engine] = timed(st, folder, f"pair{r}_{engine}", roles=roles,
+                                                 client=client, batch=dask_batch)
+                        finally:
+                            engine_mod.DASK_PROFILED = False
                 _equal(runs["pool"].results, runs["dask"].results)
+                _equal(runs["pool"].results, runs["dask_profiled"].results)
                 pairs.append((runs["pool"], runs["dask"]))
-                for name in (f"pair{r}_pool", f"pair{r}_dask"):
-                    shutil.rmtree(folder / f"{name}.zarr")
+                profiled.append((runs["pool"], runs["dask_profiled"]))
+                for name in ENGINES:
+                    shutil.rmtree(folder / f"pair{r}_{name}.zarr")
             idles.append(idle_rate(roles, 2.0))
     idle = float(np.median(idles))
 
-    def per_point_us(runs: list[Run], role: str) -> float:
-        # a role's CPU a point; the workers' past the points' work
-        return 1e6 * float(np.median([r.cpu.get(role, 0.0) - (r.work if role == "workers"
-                                                               else 0.0) for r in runs])) / n
-
-    pools, dasks = [p for p, _ in pairs], [d for _, d in pairs]
     out.update({
         "load_after": os.getloadavg(),
         "in_process_s": alone.wall, "pool_1_s": one.wall, "pool_2_s": two.wall,
@@ -325,28 +370,10 @@ def main() -> None:
         "pool_2_efficiency_all_cpu": alone.total / two.total,
         "work_pool_2_over_in_process": two.work / alone.work - 1,
         "dask_worker_profiler": _profiler_on(),
-        "pairs": [{"pool": {"wall_s": p.wall, "work_s": p.work, **p.cpu},
-                   "dask": {"wall_s": d.wall, "work_s": d.work, **d.cpu}} for p, d in pairs],
-        # what the load does to the same work: it moves the points' CPU time (both engines)
-        "work_dask_over_pool": _spread([d.work / p.work - 1 for p, d in pairs]),
-        "pool_cpu_noise": (max(r.total for r in pools) - min(r.total for r in pools))
-        / float(np.median([r.total for r in pools])),
-        "us_per_point": {engine: {role: per_point_us(runs, role) for role in
-                                  ("client", "scheduler", "nannies", "workers")}
-                         for engine, runs in (("pool", pools), ("dask", dasks))},
         "dask_idle_cpu_per_s": _spread(idles),
-        # the old measure: all CPU, the points' work included (its noise is the load's)
-        "dask_total_over_pool": _spread([d.total / p.total - 1 for p, d in pairs]),
-        # the engines' costs alone (all CPU past the points' work), against the pool's CPU
-        "dask_overhead_fraction": _spread([_fraction(d, p) for p, d in pairs]),
-        "dask_task_overhead_fraction": _spread([_fraction(d, p, idle) for p, d in pairs]),
-        # on two idle cores a run lasts about half its work
-        "dask_overhead_fraction_quiet": _spread([_fraction(d, p, idle, d.work / 2)
-                                                 for p, d in pairs]),
-        "dask_wall_over_pool": _spread([d.wall / p.wall for p, d in pairs]),
-        # the same from the engines' costs fitted over the pairs as a part per run and a part
-        # per second of wall time: no idle window measured apart
-        "dask_overhead_fraction_quiet_fit": _quiet_from_fit(pairs),
+        # the batches hidden from the workers' profiler (the default), and sampled by it
+        "dask": _dask_against_pool(pairs, idle, n),
+        "dask_profiled": _dask_against_pool(profiled, idle, n),
     })
     if args.json:
         print(json.dumps(out, indent=2))
@@ -371,36 +398,42 @@ def main() -> None:
           f"{2 * out['pool_2_efficiency']:.2f}x on two idle cores; target >= 1.8; from all "
           f"CPU {out['pool_2_efficiency_all_cpu']:.3f}, the points' work moving by "
           f"{100 * out['work_pool_2_over_in_process']:+.1f} %)")
-    print(f"  dask against the local pool, 2 workers each, {args.repeats} pairs of runs "
-          f"interleaved (another seed each pair):")
-    print(f"    the points' work, dask's against the pool's: "
-          f"{pct(out['work_dask_over_pool'])} (the load's doing; taken out below)")
-    print("    CPU a point past the points' work [us]: client, scheduler, nannies, workers")
-    for engine in ("pool", "dask"):
-        u = out["us_per_point"][engine]
-        print(f"      {engine:5s} " + ", ".join(f"{u[r]:.2f}" for r in
-                                               ("client", "scheduler", "nannies", "workers")))
-    print(f"    all CPU, the work included (the load's noise in it): "
-          f"{pct(out['dask_total_over_pool'])}")
-    print(f"    dask's engine past the pool's: {pct(out['dask_overhead_fraction'])} of the "
-          f"pool's CPU")
-    print(f"    the idle cluster {idle:.3f} s CPU a second; past it "
-          f"{pct(out['dask_task_overhead_fraction'])}")
-    print(f"    with a run as long as on two idle cores {pct(out['dask_overhead_fraction_quiet'])}"
-          f" (target <= 5 %)")
-    fit = out["dask_overhead_fraction_quiet_fit"]
-    if fit is None:
-        print("    (too few pairs, or wall times all alike, to fit a part per run and a part "
-              "per second)")
-    else:
-        print(f"    fitted over the pairs, per run + per second of wall time: dask "
-              f"{fit['dask_per_run_s']:.3f} s + {fit['dask_cpu_per_s']:.4f} s/s, pool "
-              f"{fit['pool_per_run_s']:.3f} s + {fit['pool_cpu_per_s']:.4f} s/s; on two idle "
-              f"cores {100 * fit['value']:+.1f} % +- {100 * fit['std']:.1f} (target <= 5 %)")
-    print(f"    wall time, dask over the pool: {out['dask_wall_over_pool']['median']:.2f} "
-          f"({out['dask_wall_over_pool']['min']:.2f} to {out['dask_wall_over_pool']['max']:.2f}"
-          f"; under load it says little)")
-
+    idle = out["dask_idle_cpu_per_s"]["median"]
+    for key, title in (("dask", "the batches hidden from the workers' profiler (the default)"),
+                       ("dask_profiled", "the batches sampled by the workers' profiler "
+                                         "(DASK_PROFILED = True)")):
+        d = out[key]
+        print(f"  dask against the local pool, 2 workers each, {args.repeats} pairs of runs "
+              f"interleaved (another seed each pair); {title}:")
+        print(f"    the points' work, dask's against the pool's: "
+              f"{pct(d['work_dask_over_pool'])} (the load's doing; taken out below)")
+        print("    CPU a point past the points' work [us]: client, scheduler, nannies, workers")
+        for engine in ("pool", "dask"):
+            u = d["us_per_point"][engine]
+            print(f"      {engine:5s} " + ", ".join(f"{u[r]:.2f}" for r in
+                                                   ("client", "scheduler", "nannies",
+                                                    "workers")))
+        print(f"    all CPU, the work included (the load's noise in it): "
+              f"{pct(d['dask_total_over_pool'])}")
+        print(f"    dask's engine past the pool's: {pct(d['dask_overhead_fraction'])} of the "
+              f"pool's CPU")
+        print(f"    the idle cluster {idle:.3f} s CPU a second; past it "
+              f"{pct(d['dask_task_overhead_fraction'])}")
+        print(f"    with a run as long as on two idle cores "
+              f"{pct(d['dask_overhead_fraction_quiet'])} (target <= 5 %)")
+        fit = d["dask_overhead_fraction_quiet_fit"]
+        if fit is None:
+            print("    (too few pairs, or wall times all alike, to fit a part per run and a "
+                  "part per second)")
+        else:
+            print(f"    fitted over the pairs, per run + per second of wall time: dask "
+                  f"{fit['dask_per_run_s']:.3f} s + {fit['dask_cpu_per_s']:.4f} s/s, pool "
+                  f"{fit['pool_per_run_s']:.3f} s + {fit['pool_cpu_per_s']:.4f} s/s; on two "
+                  f"idle cores {100 * fit['value']:+.1f} % +- {100 * fit['std']:.1f} "
+                  f"(target <= 5 %)")
+        w = d["dask_wall_over_pool"]
+        print(f"    wall time, dask over the pool: {w['median']:.2f} ({w['min']:.2f} to "
+              f"{w['max']:.2f}; under load it says little)")
 
 if __name__ == "__main__":
     main()

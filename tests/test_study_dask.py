@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -153,3 +154,37 @@ def test_unreachable_scheduler_is_one_line(tmp_path, study_file, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot connect" in err, err
     assert not (tmp_path / "s.zarr").exists()
+
+
+def _files_sampled(tree: dict) -> set[str]:
+    """The source files of the frames in a dask profile (``Client.profile``)."""
+    out: set[str] = set()
+    stack = [tree]
+    while stack:
+        node = stack.pop()
+        desc = node.get("description")
+        if isinstance(desc, dict):
+            out.add(str(desc.get("filename", "")))
+        stack.extend(node.get("children", {}).values())
+    return out
+
+
+def test_batches_are_hidden_from_the_workers_profiler_unless_asked(cluster, tmp_path,
+                                                                    monkeypatch):
+    from motionhyst.study import engine
+
+    client, _ = cluster
+    # about 0.2-1 s of work in one batch: the profiler samples a running task every 10 ms
+    st = Study.from_dict({"outputs": ["e1"], "axes": {
+        "amplitude": [0.001, 0.01], "frequency_hz": {"geomspace": [1.0, 100.0, 50]}},
+        "samples": {"n": 20, "seed": 1, "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
+        scenario=tomllib.loads(default_scenario_path().read_text()))
+    run_study(st, tmp_path / "hidden.zarr", client=client, batch=st.n_points)
+    hidden = _files_sampled(client.profile())
+    assert not any("motionhyst" in f for f in hidden), sorted(hidden)
+    monkeypatch.setattr(engine, "DASK_PROFILED", True)
+    run_study(st, tmp_path / "profiled.zarr", client=client, batch=st.n_points)
+    sampled = _files_sampled(client.profile())
+    assert any("motionhyst" in f for f in sampled), sorted(sampled)
+    np.testing.assert_array_equal(open_results(tmp_path / "hidden.zarr")["e1"].values,
+                                  open_results(tmp_path / "profiled.zarr")["e1"].values)

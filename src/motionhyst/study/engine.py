@@ -9,6 +9,7 @@ fastest).  A point's numbers do not depend on its batch, its worker or the engin
 
 from __future__ import annotations
 
+import contextlib
 import math
 import signal
 import threading
@@ -29,8 +30,8 @@ from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
 from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
 
-__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "ENOUGH_SECONDS", "Batch", "Evaluator",
-           "evaluate_batch", "run_batches"]
+__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "DASK_PROFILED", "ENOUGH_SECONDS", "Batch",
+           "Evaluator", "dask_batch", "evaluate_batch", "run_batches"]
 
 BATCH_SECONDS = 0.1
 """Least work in one batch of the local pool [s]: below it, sending and collecting cost more
@@ -43,6 +44,14 @@ ENOUGH_SECONDS = 0.05
 DASK_BATCH_SECONDS = 0.5
 """Least work in one batch on dask [s]: a task costs its scheduler, client and worker about
 5 ms of CPU together, 1 % of this."""
+
+DASK_PROFILED = False
+"""Whether dask's worker profiler samples the thread running a study's batch.  The profiler
+(on by default, ``distributed.worker.profile``) takes the stack of every thread running a task
+every 10 ms, about 1.5 % of a point's CPU time here, for a figure of where the time goes that a
+study does not need; so a batch hides its thread from it while it runs (the dashboard's
+profile and call stack show no study work then; the worker's other tasks are sampled as
+before).  True, set in the client's process, leaves the batches sampled."""
 
 # why a point failed (motionhyst.study.store.REASONS)
 _LOOP, _CONVERGE, _OUTPUT, _NUMERIC = 1, 2, 3, 4
@@ -269,6 +278,62 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
             _release(key, ev)
 
 
+@contextlib.contextmanager
+def _unprofiled() -> Iterator[None]:
+    """This thread hidden from its dask worker's profiler while the block runs: out of the
+    worker's ``active_threads`` (the threads running a task, which the profiler samples), put
+    back after; outside a dask worker it does nothing."""
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+        lock, active = worker.active_threads_lock, worker.active_threads
+    except (ImportError, ValueError, AttributeError):
+        worker = None
+    if worker is None:
+        yield
+        return
+    ident = threading.get_ident()
+    with lock:
+        task = active.pop(ident, None)
+    try:
+        yield
+    finally:
+        if task is not None:
+            with lock:
+                active[ident] = task
+
+
+def dask_batch(key: str, plain: dict, indices, profiled: bool = False) -> Batch:
+    """One batch as a dask task: :func:`evaluate_batch`, its thread hidden from the worker's
+    profiler unless `profiled` (:data:`DASK_PROFILED`).
+
+    Parameters
+    ----------
+    key : str
+        The study's fingerprint.
+    plain : dict
+        The study's :meth:`~motionhyst.study.spec.Study.to_dict`.
+    indices : array_like of int
+        Flat indices of the points.
+    profiled : bool
+        Leave the thread to the worker's profiler.
+
+    Examples
+    --------
+    >>> import tomllib
+    >>> from motionhyst.scenario import default_scenario_path
+    >>> base = tomllib.loads(default_scenario_path().read_text())
+    >>> st = StudyDefinition.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0]}},
+    ...                      scenario=base)
+    >>> b = dask_batch(st.fingerprint(), st.to_dict(), [0])     # outside a worker: as is
+    >>> print(f"{b.values['error_rms'][0]:.3e} m")
+    8.176e-09 m
+    """
+    with contextlib.nullcontext() if profiled else _unprofiled():
+        return evaluate_batch(key, plain, indices)
+
+
 _WORKER_STUDY: dict = {}
 
 
@@ -355,7 +420,8 @@ def _dask_run(client, key: str, plain: dict, batches: list) -> Iterator[Batch]:
 
     # the study's dictionary (about 1 kB) goes with each batch: scattered, its only copy left
     # by dask's memory manager on a worker that dies would cancel every batch still to run
-    futures = [client.submit(evaluate_batch, key, plain, b, pure=False) for b in batches]
+    futures = [client.submit(dask_batch, key, plain, b, DASK_PROFILED, pure=False)
+               for b in batches]
     try:
         for f in as_completed(futures):
             yield f.result()
