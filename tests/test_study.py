@@ -480,6 +480,8 @@ def test_cli_summary_table_and_estimate(tmp_path, study_file, capsys):
     assert main(["study", str(study_file), "--estimate", "--json"]) == 0
     est = json.loads(capsys.readouterr().out)
     assert est["points"] == 32 and est["missing"] == 32 and est["seconds_per_point"] > 0
+    assert est["cores"] == (os.cpu_count() or 1)
+    assert est["load_average"] is None or est["load_average"] >= 0
     assert main(["study", str(study_file), "--out", str(out), "--workers", "0",
                  "--table", str(tmp_path / "t.csv")]) == 0
     assert "32 points: 32 computed" in capsys.readouterr().out
@@ -560,3 +562,23 @@ def test_a_study_above_the_work_budget_is_refused_before_anything_is_written(tmp
     assert sorted(p.relative_to(out) for p in out.rglob("*")) == before
     kept = open_results(out)
     assert kept.attrs["seed"] == 7 and (kept["status"].values == OK).all()
+
+
+def test_estimate_and_refusal_say_the_load_they_were_measured_under(study_file, monkeypatch,
+                                                                    capsys, tmp_path):
+    """A point's CPU time reads 3-4 times more on a loaded machine: the estimate and the
+    budget's refusal say so when the load average exceeds the cores, and not otherwise."""
+    from motionhyst.study import runner
+
+    monkeypatch.setattr(runner, "machine_load", lambda: (9.3, 2))
+    assert main(["study", str(study_file), "--estimate"]) == 0
+    out = capsys.readouterr().out
+    assert "measured under load    load average 9.3 on 2 cores: a point's CPU time," in out
+    assert main(["study", str(study_file), "--out", str(tmp_path / "s.zarr"),
+                 "--max-seconds", "1e-9"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "measured under load average 9.3 on 2 cores" in err, err
+    assert not (tmp_path / "s.zarr").exists()
+    monkeypatch.setattr(runner, "machine_load", lambda: (1.5, 2))
+    assert main(["study", str(study_file), "--estimate"]) == 0
+    assert "under load" not in capsys.readouterr().out

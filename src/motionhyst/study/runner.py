@@ -38,8 +38,8 @@ from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import StudyDefinition, StudyError
 from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
 
-__all__ = ["LOCK_NAME", "Estimate", "RunReport", "check_budget", "estimate_study", "run_lock",
-           "run_study"]
+__all__ = ["LOCK_NAME", "Estimate", "RunReport", "check_budget", "estimate_study",
+           "machine_load", "run_lock", "run_study"]
 
 LOCK_NAME = "zarr.json"
 """The store's file that a run holds locked (:func:`fcntl.flock`; never rewritten by a run)."""
@@ -112,6 +112,10 @@ class Estimate:
         it holds once it computed points) and the study's arrays.
     budget_seconds : float, optional
         The work budget (``--max-seconds``) the run is held to [s].
+    load_average : float, optional
+        The machine's load average over the last minute when the point was timed.
+    cores : int, optional
+        The machine's cores.
 
     Examples
     --------
@@ -121,6 +125,10 @@ class Estimate:
     0.139 core-hours
     >>> print(str(e).splitlines()[-1])
       work budget            1 min (--max-seconds): above it, the run would be refused
+    >>> e.load_average, e.cores = 9.3, 2                  # timed on a loaded machine: said
+    >>> print(*str(e).splitlines()[2:4], sep=chr(10))
+      measured under load    load average 9.3 on 2 cores: a point's CPU time,
+                             the work and the time below read up to 3-4 times an idle machine's
     """
 
     points: int
@@ -130,6 +138,15 @@ class Estimate:
     disk_bytes: int
     memory_bytes: int
     budget_seconds: float | None = None
+    load_average: float | None = None
+    cores: int | None = None
+
+    @property
+    def loaded(self) -> bool:
+        """Whether the point was timed with more runnable processes than cores (its CPU time
+        then reads more than on an idle machine: caches and cores shared)."""
+        return (self.load_average is not None and self.cores is not None
+                and self.load_average > self.cores)
 
     @property
     def core_hours(self) -> float:
@@ -152,13 +169,20 @@ class Estimate:
                 "seconds_per_point": self.seconds_per_point, "core_hours": self.core_hours,
                 "workers": self.workers, "wall_seconds": self.wall_seconds,
                 "disk_bytes": self.disk_bytes, "memory_bytes": self.memory_bytes,
-                "budget_seconds": self.budget_seconds, "within_budget": self.within_budget}
+                "budget_seconds": self.budget_seconds, "within_budget": self.within_budget,
+                "load_average": self.load_average, "cores": self.cores}
 
     def __str__(self) -> str:
         lines = [
             f"  points                 {self.points} ({self.missing} to compute)",
             f"  one point              {g(self.seconds_per_point * 1e3)} ms of CPU (measured "
-            f"here)",
+            f"here)"]
+        if self.loaded:
+            lines += [f"  measured under load    {_load_text(self.load_average, self.cores)}: "
+                      f"a point's CPU time,",
+                      "                         the work and the time below read up to 3-4 "
+                      "times an idle machine's"]
+        lines += [
             f"  work                   {g(self.core_hours)} core-hours, about "
             f"{self.wall_seconds:.0f} s on {self.workers} worker(s)",
             f"  store on disk          at most {g(self.disk_bytes / 1e6)} MB",
@@ -169,6 +193,28 @@ class Estimate:
             lines.append(f"  work budget            {format_duration(self.budget_seconds)} "
                          f"(--max-seconds): {verdict}")
         return "\n".join(lines)
+
+
+def machine_load() -> tuple[float | None, int]:
+    """The load average over the last minute (None where the system does not give it) and the
+    cores: a point's CPU time measured with more runnable processes than cores reads more
+    than on an idle machine (3-4 times at a load of 4-6 a core), the caches and cores shared.
+
+    Examples
+    --------
+    >>> load, cores = machine_load()
+    >>> cores >= 1 and (load is None or load >= 0)
+    True
+    """
+    try:
+        load: float | None = os.getloadavg()[0]
+    except OSError:
+        load = None
+    return load, os.cpu_count() or 1
+
+
+def _load_text(load: float | None, cores: int | None) -> str:
+    return f"load average {load:.1f} on {cores} core{'s' if cores != 1 else ''}"
 
 
 def _bytes_per_point(study: StudyDefinition) -> int:
@@ -206,6 +252,7 @@ def estimate_study(study: StudyDefinition, workers: int = 1,
         if st.matches(study):
             missing = len(st.missing())
     # as the run measures it (the budget's refusal and this estimate agree)
+    load, cores = machine_load()
     per = seconds_per_point(study, 6, cpu=True)
     bpp = _bytes_per_point(study)
     # what the process holds now, its libraries and kernels loaded and points computed, then
@@ -215,7 +262,7 @@ def estimate_study(study: StudyDefinition, workers: int = 1,
     return Estimate(points=study.n_points, missing=missing, seconds_per_point=per,
                     workers=max(workers, 1), disk_bytes=study.n_points * bpp,
                     memory_bytes=held + study.n_points * (8 + 1) + 65536 * bpp * 4,
-                    budget_seconds=max_seconds())
+                    budget_seconds=max_seconds(), load_average=load, cores=cores)
 
 
 def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStore | None:
@@ -248,7 +295,8 @@ def _new_store(study: StudyDefinition, path: Path, version: str) -> StudyStore:
     return StudyStore.create(path, study, version)
 
 
-def check_budget(study: StudyDefinition, n_missing: int, seconds: float, workers: int) -> None:
+def check_budget(study: StudyDefinition, n_missing: int, seconds: float, workers: int,
+                 load: tuple[float | None, int] | None = None) -> None:
     """Refuse a study whose missing points would take longer than the work budget
     (:func:`motionhyst.core.budget.check_work`, ``--max-seconds``): their core time shared
     by the `workers`, before anything is computed or written.
@@ -263,6 +311,9 @@ def check_budget(study: StudyDefinition, n_missing: int, seconds: float, workers
         CPU time of one point on one core [s] (:func:`seconds_per_point`).
     workers : int
         Processes computing them.
+    load : (float, int), optional
+        The load average and the cores when `seconds` was measured (:func:`machine_load`):
+        above one a core the refusal says the time was measured under that load.
 
     Raises
     ------
@@ -287,12 +338,20 @@ def check_budget(study: StudyDefinition, n_missing: int, seconds: float, workers
     a study of 1000 points (500 ms each on one core) on 2 workers would take about 4.2 min, \
 above the work budget of 1 min (--max-seconds); give fewer points (axes, samples), more \
 workers (--workers, --scheduler) or a larger --max-seconds
+    >>> try:
+    ...     check_budget(st, 1000, 0.5, 2, load=(9.3, 2))    # timed on a loaded machine
+    ... except BudgetError as exc:
+    ...     print(str(exc).split(") on")[0])
+    a study of 1000 points (500 ms each on one core, measured under load average 9.3 on 2 cores
     >>> set_max_seconds(None)
     """
     workers = max(workers, 1)
+    under = ""
+    if load is not None and load[0] is not None and load[0] > load[1]:
+        under = f", measured under {_load_text(*load)}"
     check_work(n_missing * seconds / workers,
-               f"a study of {n_missing} points ({g(seconds * 1e3)} ms each on one core) on "
-               f"{workers} worker{'s' if workers > 1 else ''}",
+               f"a study of {n_missing} points ({g(seconds * 1e3)} ms each on one core{under}) "
+               f"on {workers} worker{'s' if workers > 1 else ''}",
                "give fewer points (axes, samples), more workers (--workers, --scheduler) "
                "or a larger --max-seconds")
 
@@ -358,8 +417,9 @@ def run_study(study: StudyDefinition, store: str | Path, workers: int | None = N
         # from the CPU time of a point: its wall time on a loaded machine would make batches
         # too small for the work each costs the engine; two runs of three points, at the
         # study's two ends (a point's cost varies along the reference axes)
+        load = machine_load()
         per = seconds_per_point(study, 6, cpu=True)
-        check_budget(study, n_missing, per, workers)
+        check_budget(study, n_missing, per, workers, load)
     if st is None:
         st = _new_store(study, path, __version__)
     with run_lock(path):
