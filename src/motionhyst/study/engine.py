@@ -47,11 +47,12 @@ DASK_BATCH_SECONDS = 0.5
 
 DASK_PROFILED = False
 """Whether dask's worker profiler samples the thread running a study's batch.  The profiler
-(on by default, ``distributed.worker.profile``) takes the stack of every thread running a task
-every 10 ms, about 1.5 % of a point's CPU time here, for a figure of where the time goes that a
-study does not need; so a batch hides its thread from it while it runs (the dashboard's
-profile and call stack show no study work then; the worker's other tasks are sampled as
-before).  True, set in the client's process, leaves the batches sampled."""
+(on by default, ``distributed.worker.profile``) takes the stack of every thread running a
+task every 10 ms of wall time, about 3 % of the pool's CPU time for a study's batches on two
+idle cores (more on a loaded machine, where a batch lasts longer), for a figure of where the
+time goes that a study does not need; so a batch hides its thread from it while it runs (the
+dashboard's profile and call stack show no study work then; the worker's other tasks are
+sampled as before).  True, set in the client's process, leaves the batches sampled."""
 
 # why a point failed (motionhyst.study.store.REASONS)
 _LOOP, _CONVERGE, _OUTPUT, _NUMERIC = 1, 2, 3, 4
