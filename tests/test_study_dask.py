@@ -179,12 +179,18 @@ def test_batches_are_hidden_from_the_workers_profiler_unless_asked(cluster, tmp_
         "amplitude": [0.001, 0.01], "frequency_hz": {"geomspace": [1.0, 100.0, 50]}},
         "samples": {"n": 20, "seed": 1, "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
         scenario=tomllib.loads(default_scenario_path().read_text()))
+    def computing(files: set[str]) -> list[str]:
+        # the points' own frames: the task's entry (study/engine.py) may be sampled in the
+        # microseconds before it hides its thread or after it shows it again
+        return sorted(f for f in files if "motionhyst" in f
+                      and not f.endswith(str(Path("study", "engine.py"))))
+
     run_study(st, tmp_path / "hidden.zarr", client=client, batch=st.n_points)
     hidden = _files_sampled(client.profile())
-    assert not any("motionhyst" in f for f in hidden), sorted(hidden)
+    assert computing(hidden) == [], computing(hidden)
     monkeypatch.setattr(engine, "DASK_PROFILED", True)
     run_study(st, tmp_path / "profiled.zarr", client=client, batch=st.n_points)
     sampled = _files_sampled(client.profile())
-    assert any("motionhyst" in f for f in sampled), sorted(sampled)
+    assert computing(sampled), sorted(sampled)
     np.testing.assert_array_equal(open_results(tmp_path / "hidden.zarr")["e1"].values,
                                   open_results(tmp_path / "profiled.zarr")["e1"].values)
