@@ -30,6 +30,23 @@ def test_a_closed_standard_output_is_refused_not_answered_into_nothing(tmp_path)
     assert "writes no file" in proc.stderr
 
 
+def test_a_standard_output_opened_for_reading_is_named(tmp_path):
+    """``motionhyst df ... 1</dev/null``: every write failed with "Bad file descriptor",
+    naming nothing."""
+    def read_only():
+        fd = os.open(os.devnull, os.O_RDONLY)
+        os.dup2(fd, 1)
+        os.close(fd)
+
+    argv = [sys.executable, "-c", _MAIN, "df", "--k", "20", "--fc", "0.05", "--amplitude",
+            "0.01"]
+    proc = subprocess.run(argv, stderr=subprocess.PIPE, text=True, cwd=tmp_path, timeout=600,
+                          preexec_fn=read_only)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert "standard output is not open for writing" in proc.stderr
+
+
 def test_a_command_writing_its_results_to_a_file_runs_with_stdout_closed(tmp_path):
     from motionhyst.scenario import default_scenario_path
 

@@ -119,13 +119,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         # cycles are left to the operating system
         atexit.register(gc.freeze)
     interrupts = _Interrupts()
-    closed = sys.stdout is None  # started with its output closed (``>&-``)
+    closed = not _writable(sys.stdout)  # ``>&-`` (None) or opened for reading (``1</dev/null``)
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
         if closed:
             if not any(getattr(args, name, None) for name in FILE_OUTPUTS):
-                raise UsageError(f"motionhyst {args.command}: standard output is closed and "
+                state = "closed" if sys.stdout is None else "not open for writing"
+                raise UsageError(f"motionhyst {args.command}: standard output is {state} and "
                                  f"the command writes no file: its results would be lost; give "
                                  f"it an output (a terminal, a file or a pipe)")
             sys.stdout = open(os.devnull, "w")  # the files are the results; the summary is lost
@@ -246,6 +247,21 @@ class _Interrupts:
                 signal.signal(sig, signal.SIG_IGN if ignore else previous)
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self.hook
+
+
+def _writable(stream) -> bool:
+    """Whether `stream` (the standard output) can take the command's results: not closed
+    (None) and, when it is a file descriptor, not opened for reading only (``1</dev/null``,
+    where every write fails with "Bad file descriptor", naming nothing)."""
+    if stream is None:
+        return False
+    try:
+        import fcntl
+
+        flags = fcntl.fcntl(stream.fileno(), fcntl.F_GETFL)
+    except (AttributeError, ImportError, OSError, ValueError):  # no descriptor: a StringIO
+        return True
+    return flags & os.O_ACCMODE != os.O_RDONLY
 
 
 def _say(line: str) -> None:
