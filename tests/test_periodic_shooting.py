@@ -105,6 +105,23 @@ def test_shooting_settles_a_lightly_damped_stage_in_two_periods(monkeypatch):
     assert calls[0] > 5
 
 
+@pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.parametrize("shooting", [True, False])
+def test_a_zero_force_has_rest_as_its_steady_state_at_once(monkeypatch, name, shooting):
+    """Rest repeats exactly: an output that stays zero has not changed (its change relative
+    to an amplitude of zero was infinite, so the run went on to its last period and was
+    reported as not reaching its steady state)."""
+    plant, build, values, _ = CASES[name]
+    v = np.array(values, dtype=float)
+    link = build(v)
+    calls = _counting(monkeypatch)
+    y, sy = simulate_elements(plant.mechanics(), link.time_stepping(), np.zeros(390), FS, 20,
+                              periodic=True, k_link=link.initial_stiffness,
+                              dparams=row_derivatives(build, v), shooting=shooting)
+    assert y.shape == (390,) and not np.any(y) and not np.any(sy)
+    assert calls[0] <= 3
+
+
 def test_newton_on_an_affine_map_with_a_gauge_finds_its_drift():
     """A floating state whose period map moves it on by 0.5 along the gauge: refused with the
     step; without the step, the fixed point (defined up to the gauge) is found."""

@@ -349,7 +349,7 @@ def newton_periodic(run_period, z0: NDArray[np.float64], n_params: int, periods:
         if floating:
             ey = ey - np.mean(ey)
         amp = float(np.ptp(y) if floating else np.max(np.abs(y)))
-        change = float(np.max(np.abs(ey))) / amp if amp > 0 else math.inf
+        change = _relative(float(np.max(np.abs(ey))), amp)
         if change < 0.5 * smallest:
             smallest, since = change, 0
         else:
@@ -380,13 +380,21 @@ def newton_periodic(run_period, z0: NDArray[np.float64], n_params: int, periods:
     raise ValueError(_NO_STEADY_STATE + (_FLOATING_HINT if floating else ""))
 
 
+def _relative(change: float, amp: float) -> float:
+    """`change` relative to the output's amplitude `amp`; an output that stays exactly zero
+    (a stage at rest under a zero force) has not changed at all."""
+    if amp > 0:
+        return change / amp
+    return 0.0 if change == 0 else math.inf
+
+
 def _relative_changes(y: NDArray[np.float64], prev: NDArray[np.float64],
                       sy: NDArray[np.float64], sprev: NDArray[np.float64], floating: bool
                       ) -> NDArray[np.float64]:
     """The output's change from the previous period relative to its amplitude (a floating
     stage's spread), and the largest of the sensitivities' relative to their largest values."""
     amp = float(np.ptp(y) if floating else np.max(np.abs(y)))
-    dy = float(np.max(np.abs(y - prev))) / amp if amp > 0 else math.inf
+    dy = _relative(float(np.max(np.abs(y - prev))), amp)
     ds = np.max(np.abs(sy - sprev), axis=0) / (np.max(np.abs(sy), axis=0) + 1e-300)
     return np.array([dy, float(np.max(ds, initial=0.0))])
 
