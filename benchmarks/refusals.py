@@ -3,8 +3,9 @@
 Each case is a command line that motionhyst refuses (exit 2, one line on stderr), one
 for each way a refusal comes: an argument, a scenario's value, an option against the
 scenario, an output, a file, a record, the size of a run, an open-loop scenario where a
-loop is needed, an unstable controller (lead-lag, sampled at 10 kHz, PID) and a run whose
-step the loop's poles set (from the scenario's coefficients, before python-control builds
+loop is needed, an unstable controller (lead-lag, sampled at 10 kHz, PID), a frequency
+the loop cannot mean (decades above its fastest pole, or below f*) and a run whose step
+the loop's poles set (from the scenario's coefficients, before python-control builds
 the loop), a list of a million values, a constant force, an input-output record without
 inertia (its inverse-dynamics estimate); and one that needs the work it refuses: a fit
 that finds no model of the record.  Each runs as a whole process (the interpreter, the
@@ -90,6 +91,8 @@ CASES = [
     ("record cell", ["identify", "fd-nan.csv"], "checks"),
     ("record column", ["identify", "io-missing.csv", "--record", "input-output"], "checks"),
     ("text .mat", ["predict", "open.toml", "f.mat", "--out", "p.csv"], "checks"),
+    ("frequency far above", ["steady", "s.toml", "--frequency", "1e9"], "checks"),
+    ("frequency far below", ["analyze", "s.toml", "--frequency", "1e-30"], "checks"),
     ("open loop", ["stability", "open.toml"], "checks"),
     ("unstable loop", ["steady", "unstable.toml"], "checks"),
     ("unstable sampled loop", ["steady", "unstable-10k.toml"], "checks"),

@@ -28,7 +28,7 @@ from motionhyst.analysis.floquet import (
     steady_state_floquet,
     unresolved_time_scales,
 )
-from motionhyst.analysis.plausibility import check_plausible
+from motionhyst.analysis.plausibility import check_frequency_range, check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
 from motionhyst.analysis.steady import SteadyState, steady_state_sweep
 from motionhyst.controllers.loop import Loop
@@ -197,6 +197,7 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     (1.239, 1.24)
     """
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    check_frequency_range(loop, f)  # a frequency the loop's model cannot mean: before any work
     if floquet:  # the multipliers' memory and work, before any point is computed
         check_floquet_budget(loop, f, remedy="give fewer frequencies or leave the multipliers "
                                              "out (--no-floquet)")

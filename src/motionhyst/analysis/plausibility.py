@@ -1,7 +1,9 @@
 """Plausibility of a sine analysis: where the paper's quasi-linear reading stops holding.
 
 Each finding is a :class:`~motionhyst.core.warnings.MotionhystWarning`; the
-computation goes on.  :func:`~motionhyst.analysis.quasilinear.analyze` and
+computation goes on (:func:`check_plausible`).  A frequency outside what the loop's
+model can mean at all is refused instead (:func:`check_frequency_range`).
+:func:`~motionhyst.analysis.quasilinear.analyze` and
 :func:`~motionhyst.analysis.comparison.compare_with_describing_function`
 check their arguments here themselves.
 
@@ -18,12 +20,17 @@ Examples
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
-from motionhyst.analysis.equations import f_star
 from motionhyst.core.warnings import warn
 
-__all__ = ["check_plausible"]
+__all__ = ["FREQUENCY_DECADES", "check_frequencies", "check_frequency_range", "check_plausible",
+           "f_star_of"]
+
+FREQUENCY_DECADES = 2
+"""How far (decades) a sine's frequency may lie beyond the loop's dynamics: above its
+fastest closed-loop pole, or below ``f*`` (eq. 13), where a link holds the stage."""
 
 
 def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
@@ -58,6 +65,8 @@ def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
     >>> print(caught[0].message)                        # doctest: +ELLIPSIS
     at amplitude 0.001 m the element never slips (zeta = fc / (k A) = 2.5 >= 1): ...
     """
+    from motionhyst.analysis.equations import f_star
+
     el = loop.hysteresis
     freqs = [float(f) for f in frequencies_hz]
     level = stacklevel + 1
@@ -79,3 +88,121 @@ def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
         if out:
             warn(f"{', '.join(f'{f:g}' for f in out)} Hz outside the measured plant's data "
                  f"({lo:g}-{hi:g} Hz): the plant there is extrapolated", level)
+
+
+def check_frequencies(frequencies_hz: Iterable[float], f_star_hz: float | None = None,
+                      fastest_pole_hz: float | None = None,
+                      sample_rate_hz: float | None = None) -> None:
+    """Refuse a frequency at which a sine analysis of a loop means nothing.
+
+    - more than :data:`FREQUENCY_DECADES` decades above the loop's fastest closed-loop pole
+      (for a sampled loop, above its sampling rate if that is higher): neither the
+      controller nor the stage follows the reference there, the error is the reference
+      itself (``|E| = 1``), and an exact steady state only spends its time on periods the
+      loop's slow modes take to forget their start (25 s of CPU at 1e5 Hz for Table I);
+    - more than :data:`FREQUENCY_DECADES` decades below ``f* = sqrt(k/M) / 2 pi``
+      (eq. 13): the link holds the stage like a spring, the error without it vanishes as
+      ``f^4`` and ``|E|`` (eq. 18) grows without bound (1e123 at 1e-30 Hz for Table I).
+
+    Only numbers: a command checks its scenario here before python-control loads.
+
+    Parameters
+    ----------
+    frequencies_hz : iterable of float
+        The frequencies asked [Hz].
+    f_star_hz : float, optional
+        ``f*`` of the loop's link (none: no lower bound).
+    fastest_pole_hz : float, optional
+        The magnitude of the loop's fastest closed-loop pole over 2 pi [Hz].
+    sample_rate_hz : float, optional
+        A sampled controller's rate [Hz].
+
+    Raises
+    ------
+    ValueError
+        Naming the first frequency outside and the range, before any work.
+
+    Examples
+    --------
+    >>> check_frequencies([0.1, 5.0, 1e4], f_star_hz=0.15, fastest_pole_hz=691.0)
+    >>> check_frequencies([1e-30], f_star_hz=0.15)
+    Traceback (most recent call last):
+    ...
+    ValueError: 1e-30 Hz is more than 2 decades below f* = 0.15 Hz (eq. 13), where the link \
+holds the stage like a spring: the error without it vanishes and |E| means nothing; give \
+frequencies from 0.0015 Hz
+    """
+    freqs = [float(f) for f in frequencies_hz]
+    factor = 10.0 ** FREQUENCY_DECADES
+    if f_star_hz:
+        low = [f for f in freqs if f < f_star_hz / factor]
+        if low:
+            raise ValueError(
+                f"{low[0]:g} Hz is more than {FREQUENCY_DECADES} decades below f* = "
+                f"{f_star_hz:.3g} Hz (eq. 13), where the link holds the stage like a spring: "
+                f"the error without it vanishes and |E| means nothing; give frequencies from "
+                f"{f_star_hz / factor:.3g} Hz")
+    fastest, rate = fastest_pole_hz or 0.0, sample_rate_hz or 0.0
+    top = max(fastest, rate)
+    high = [f for f in freqs if top > 0 and f > top * factor]
+    if high:
+        what = (f"fastest closed-loop pole ({fastest:.3g} Hz)" if fastest >= rate
+                else f"sampling rate ({rate:g} Hz)")
+        raise ValueError(f"{high[0]:g} Hz is more than {FREQUENCY_DECADES} decades above the "
+                         f"loop's {what}: nothing follows a reference there (|E| = 1); give "
+                         f"frequencies up to {top * factor:.3g} Hz")
+
+
+def check_frequency_range(loop, frequencies_hz: Iterable[float]) -> None:
+    """:func:`check_frequencies` for `loop`: ``f*`` of its link (eq. 13), its fastest
+    closed-loop pole (none for measured data) and a sampled controller's rate.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop analysed.
+    frequencies_hz : iterable of float
+        The frequencies asked [Hz].
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> loop = default_scenario().loop()
+    >>> check_frequency_range(loop, [0.1, 5.0, 1e4])                  # Table I: fine
+    >>> check_frequency_range(loop, [1e9])
+    Traceback (most recent call last):
+    ...
+    ValueError: 1e+09 Hz is more than 2 decades above the loop's fastest closed-loop pole \
+(691 Hz): nothing follows a reference there (|E| = 1); give frequencies up to 6.91e+04 Hz
+    """
+    el = loop.hysteresis
+    fs = (f_star_of(el.initial_stiffness, loop.M)
+          if el is not None and loop.M else None)
+    try:
+        poles = loop.closed_loop_poles()
+    except ValueError:  # measured data: no poles (its data range is warned about)
+        poles = []
+    fastest = max((abs(p) for p in poles), default=0.0) / (2 * math.pi)
+    check_frequencies(frequencies_hz, fs, fastest,
+                      None if loop.sampled is None else loop.sampled.sample_rate_hz)
+
+
+def f_star_of(k: float, M: float) -> float | None:
+    """``f* = sqrt(k/M) / 2 pi`` [Hz] (eq. 13, as :func:`~motionhyst.analysis.equations.f_star`
+    without its imports); None where it does not apply (no stiffness, no mass).
+
+    Parameters
+    ----------
+    k : float
+        The link's initial stiffness [N/m].
+    M : float
+        The stage's total mass [kg].
+
+    Examples
+    --------
+    >>> round(f_star_of(20.0, 22.5), 4)                     # Table I
+    0.1501
+    """
+    if not (k > 0 and M and M > 0 and math.isfinite(k) and math.isfinite(M)):
+        return None
+    return math.sqrt(k / M) / (2 * math.pi)

@@ -36,7 +36,7 @@ from motionhyst.analysis.equations import f_star, mismatch, mismatch_asymptote, 
 from motionhyst.analysis.equations import quasi_linear_plant as quasi_linear_plant
 from motionhyst.analysis.equations import sensitivity_s1 as sensitivity_s1
 from motionhyst.analysis.margins import LoopMargins, loop_margins
-from motionhyst.analysis.plausibility import check_plausible
+from motionhyst.analysis.plausibility import check_frequency_range, check_plausible
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI, freqresp
 from motionhyst.core.textfmt import g, table
@@ -531,6 +531,7 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0")
 
+    check_frequency_range(loop, f)
     check_plausible(loop, amplitude, f)
     sampling = None if loop.sampled is None else _sampling_note(loop, f)
     hyst = loop.hysteresis

@@ -270,6 +270,41 @@ def distinct(values: Sequence[float] | None, option: str, command: str):
     return list(values)
 
 
+def scenario_frequencies(sc, given: Sequence[float] | None, command: str) -> list[float]:
+    """The frequencies a sine analysis of scenario `sc` runs at (`given` by --frequency, or
+    the scenario's ``[reference] frequencies``), refused where the loop's model means nothing
+    (:func:`~motionhyst.analysis.plausibility.check_frequencies`): decided from the
+    scenario's numbers where they give the loop's poles, before python-control loads.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The command's scenario, read without building its loop (an open-loop system, an
+        unstable loop are refused here).
+    given : sequence of float or None
+        The --frequency values.
+    command : str
+        The command's name, for the message.
+    """
+    from motionhyst.analysis.plausibility import check_frequencies, f_star_of
+
+    freqs = list(given) if given else sc.frequencies  # an open-loop system is refused here
+    fastest = sc.fastest_pole()  # an unstable loop is refused here; None: not known yet
+    rate = getattr(sc.model.controller, "sample_rate_hz", None)
+    if sc.model.stage is None or (fastest is None and rate is None):
+        return freqs  # the loop's own check (analyze, steady) decides once it is built
+    link = sc.hysteresis()
+    mass = getattr(sc.plant(), "M", None)
+    try:
+        check_frequencies(freqs, None if link is None else f_star_of(link.initial_stiffness,
+                                                                     mass),
+                          None if fastest is None else fastest / (2 * math.pi), rate)
+    except ValueError as exc:
+        where = "--frequency" if given else f"{sc.source}: [reference] frequencies:"
+        raise UsageError(f"motionhyst {command}: {where} {exc}") from None
+    return freqs
+
+
 # ----------------------------------------------------------------- plausibility warnings
 @contextlib.contextmanager
 def warnings_on_stderr(command: str) -> Iterator[None]:

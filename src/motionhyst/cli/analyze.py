@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import distinct, positive, print_json, warn_plant_fit
+from motionhyst.cli._common import (
+    distinct,
+    positive,
+    print_json,
+    scenario_frequencies,
+    warn_plant_fit,
+)
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -15,14 +21,15 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
-    sc = load_scenario(args.scenario)
-    freqs = args.frequency or sc.frequencies  # an open-loop system is refused here
+    sc = load_scenario(args.scenario, check=False)  # the loop is built once the input is checked
+    freqs = scenario_frequencies(sc, args.frequency, args.command)
+    loop = sc.loop()  # its own refusals (a plant's file, stability) before the analysis loads
     amplitude = args.amplitude or sc.amplitude
     # imported once the input is read: a refusal does not wait for the analysis to load
     from motionhyst.analysis.quasilinear import analyze
 
     mode = "self-consistent" if args.self_consistent else "reference"
-    res = analyze(sc.loop(), amplitude, freqs, amplitude_mode=mode)
+    res = analyze(loop, amplitude, freqs, amplitude_mode=mode)
     fit = sc.plant_fit()
     warn_plant_fit(sc)
     if args.json:

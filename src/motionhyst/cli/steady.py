@@ -6,7 +6,13 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import distinct, positive, print_json, warn_plant_fit
+from motionhyst.cli._common import (
+    distinct,
+    positive,
+    print_json,
+    scenario_frequencies,
+    warn_plant_fit,
+)
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -17,13 +23,14 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
-    sc = load_scenario(args.scenario)
-    freqs = args.frequency or sc.frequencies  # an open-loop system is refused here
+    sc = load_scenario(args.scenario, check=False)  # the loop is built once the input is checked
+    freqs = scenario_frequencies(sc, args.frequency, args.command)
+    loop = sc.loop()  # its own refusals (a plant's file, stability) before the analysis loads
     amplitude = args.amplitude or sc.amplitude
     # imported once the input is read: a refusal does not wait for the analysis to load
     from motionhyst.analysis.comparison import compare_with_describing_function
 
-    result = compare_with_describing_function(sc.loop(), amplitude, freqs,  # warns as it starts
+    result = compare_with_describing_function(loop, amplitude, freqs,  # warns as it starts
                                               floquet=not getattr(args, "no_floquet", False))
     warn_plant_fit(sc)
     if args.json:
