@@ -158,6 +158,7 @@ def _refused_scenarios() -> dict[str, str]:
         # sampled at 10 kHz with 8 samples of delay; a tf-z controller; a PID
         "unstable-10k.toml": paper.replace("beta = 0.6 ", "beta = 0.6\nsample_rate_hz = 1e4\n"
                                            "delay_samples = 8.0 "),
+        "sampled-10k.toml": paper.replace("beta = 0.6 ", "beta = 0.6\nsample_rate_hz = 1e4 "),
         "unstable-tfz.toml": paper[:paper.index("[controller]")] + (
             '[controller]\ntype = "tf-z"\nnum = [2e7, -1.9e7]\nden = [1.0, -0.5]\n'
             "sample_rate_hz = 1e4\n\n") + paper[paper.index("[feedforward]"):],
@@ -215,6 +216,11 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     (["analyze", "open.toml"], "needs a closed loop"),
     (["steady", "open.toml"], "needs a closed loop"),
     (["predict", "paper.toml", "f.csv", "--out", "p.csv"], "an open-loop system needs"),
+    (["steady", "paper.toml", "--frequency", "5", "1e9"],
+     "--frequency 1e+09 Hz is more than 2 decades above the loop's fastest closed-loop pole"),
+    (["analyze", "paper.toml", "--frequency", "1e-30"], "2 decades below f* = 0.15 Hz"),
+    (["steady", "sampled-10k.toml", "--frequency", "2e6"],
+     "decades above the loop's sampling rate (10000 Hz)"),
 ])
 def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, argv, error):
     """Options, outputs, files and sizes known from the command line and the scenario (an
@@ -234,6 +240,7 @@ def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, a
     (["simulate", "paper.toml", "--time-series", "o.csv", "--frequency", "5", "--duration",
       "1e9"], "too many time steps"),
     ([*SCAN, "--window", "1"], "longer than the scan"),
+    (["study", "--summary", "pl"], "pl: not a store of motionhyst study"),  # zarr, xarray
 ])
 def test_a_file_or_a_size_is_refused_before_any_heavy_library(tmp_path, argv, error):
     """Neither pandas (it parses a CSV; these are refused before) nor anything else heavy."""

@@ -437,3 +437,43 @@ def test_the_identified_stage_is_drawn_with_its_link_when_asked(bouc_wen, source
     for bad in (["controller"], [], "stage"):
         with pytest.raises(StudyError, match="'from_identification_tables': give a list"):
             _loop_study(folder, 10, from_identification_tables=bad)
+
+
+@pytest.mark.parametrize("suffix", ["json", "toml"])
+def test_an_identification_whose_names_the_scenario_lacks_is_refused_before_its_matrix(
+        tmp_path, monkeypatch, suffix):
+    """A 1000-element Maxwell-slip identification (2000 parameters, a 20 MB JSON) for the
+    paper's Jenkins link was refused by the study's key check only after the covariance had
+    been validated and factored (35-55 s): the names come first, the matrix is never read."""
+    import motionhyst.study.identified as identified
+
+    n = 200
+    names = [f"{p}[{i}]" for p in ("k", "fc") for i in range(n)]
+    if suffix == "json":
+        text = json.dumps({"model": "maxwell-slip",
+                           "elements": [{"k": 20.0, "fc": 0.05}] * n,
+                           "covariance": {"parameters": names,
+                                          "matrix": (1e-4 * np.eye(2 * n)).tolist()}})
+    else:
+        text = ("[identification]\nparameters = " + json.dumps([f"hysteresis.{m}"
+                                                                for m in names])
+                + "\nestimates = " + json.dumps([20.0] * n + [0.05] * n)
+                + "\nstd = " + json.dumps([0.1] * (2 * n))
+                + "\ncorrelation = " + json.dumps(np.eye(2 * n).tolist()) + "\n")
+    (tmp_path / f"big.{suffix}").write_text(text)
+    shutil.copy(default_scenario_path(), tmp_path / "paper.toml")
+
+    def matrix_read(*args, **kwargs):
+        raise AssertionError("the covariance was read before the names were checked")
+
+    monkeypatch.setattr(identified, "JointNormal", matrix_read)
+    study = {"scenario": "paper.toml", "outputs": ["mismatch"],
+             "axes": {"frequency_hz": [5.0]},
+             "samples": {"n": 10, "seed": 0, "from_identification": f"big.{suffix}"}}
+    with pytest.raises(StudyError, match=r"\[samples\] 'hysteresis.k\[0\]': not a key of the "
+                                         r"scenario .*\[hysteresis\] k has no list"):
+        Study.from_dict(study, base_dir=tmp_path)
+    # the study's own numbers come before the identification's matrix
+    study["samples"]["seed"] = -1
+    with pytest.raises(StudyError, match=r"\[samples\] 'seed': give a whole number >= 0"):
+        Study.from_dict(study, base_dir=tmp_path)

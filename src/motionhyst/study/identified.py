@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -281,7 +282,8 @@ def _read(path: Path, where: str):
     return data
 
 
-def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hysteresis",)
+def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hysteresis",),
+                              check: Callable[[list[str], list[float]], None] | None = None
                               ) -> JointNormal | None:
     """The joint distribution of the link's parameters of an identification, under the
     scenario's ``hysteresis.*`` keys (and the stage's, ``stage.*``, with `tables`); None for a
@@ -297,6 +299,10 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
         The scenario's tables whose identified parameters are drawn: ``"hysteresis"`` (the
         link), ``"stage"`` (the stage of an input-output identification: a study whose
         scenario is the identified system).
+    check : callable, optional
+        ``check(keys, estimates)``, called with the scenario keys to draw and their
+        estimates before the covariance is read and validated (a large identification's
+        names refused first); raises ValueError to refuse them.
 
     Returns
     -------
@@ -332,6 +338,14 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
         if not isinstance(data.get("identification"), dict):
             raise ValueError(f"{where}: no [identification] table (save the identification "
                              f"with `motionhyst identify ... --save MODEL.toml`)")
+        raw = data["identification"]
+        names, values = raw.get("parameters"), raw.get("estimates")
+        if (check is not None and isinstance(names, list) and isinstance(values, list)
+                and len(names) == len(values)
+                and all(isinstance(n, str) for n in names)
+                and all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)):
+            at = [i for i, n in enumerate(names) if n.partition(".")[0] in tables]
+            check([names[i] for i in at], [float(values[i]) for i in at])
         from pydantic import ValidationError
 
         from motionhyst.scenario.sections import IdentificationSection, format_error
@@ -352,7 +366,6 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
         if not isinstance(table, dict):
             return None
         names = list(table.get("parameters", []))
-        cov = np.asarray(table.get("matrix", []), dtype=float)
         if isinstance(data.get("elements"), list):  # a force-displacement record
             elements = data["elements"]
             if len(elements) == 1:
@@ -380,6 +393,15 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
     if not drawn:
         raise ValueError(f"{where}: holds no link parameters with standard errors (give what "
                          f"`motionhyst identify {hint}` wrote)")
+    if check is not None and hint == "--json":  # the names before the matrix
+        values = [mean[n] for n in drawn]
+        if all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
+            check([keys[n] for n in drawn], [float(v) for v in values])
+    if hint == "--json":
+        try:
+            cov = np.asarray(table.get("matrix", []), dtype=float)
+        except (TypeError, ValueError):  # ragged or not numbers: not a matrix
+            cov = np.zeros(0)
     at = [names.index(n) for n in drawn]
     if cov.shape != (len(names), len(names)):
         raise ValueError(f"{where}: the covariance is not a {len(names)} x {len(names)} matrix")

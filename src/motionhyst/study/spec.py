@@ -422,8 +422,14 @@ class StudyDefinition:
                 if not ipath.is_absolute():
                     ipath = (base_dir or Path.cwd()) / ipath
                 try:
-                    joint = joint_from_identification(ipath, tuple(tables))
+                    def before_matrix(keys, values, n=n, seed=seed):
+                        _check_count(n, seed)  # an identification's matrix is read after these
+                        _check_drawn(scenario, keys, values, axes, base_dir)
+
+                    joint = joint_from_identification(ipath, tuple(tables), check=before_matrix)
                     drawn = {} if joint is not None else distributions_from_identification(ipath)
+                except StudyError:
+                    raise
                 except ValueError as exc:
                     raise StudyError(f"[samples] {exc}") from None
                 for key, dist in drawn.items():
@@ -434,14 +440,7 @@ class StudyDefinition:
                             raise StudyError(f"[samples] {key!r} (from_identification): "
                                              f"already an axis")
                     joint = joint.without(s)  # the file's own win: the others' marginal
-            if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-                raise StudyError("[samples] 'n': give a whole number of samples >= 1")
-            if n > MAX_POINTS:  # before they are drawn
-                raise StudyError(f"[samples] 'n': {n} samples, more than the {MAX_POINTS} "
-                                 f"points a study holds; split the study")
-            if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-                raise StudyError("[samples] 'seed': give a whole number >= 0 (the samples are "
-                                 "drawn from it, reproducibly)")
+            _check_count(n, seed)
             if not s and joint is None:
                 raise StudyError("[samples]: name at least one scenario key and its "
                                  "distribution")
@@ -619,3 +618,45 @@ class StudyDefinition:
                    base_dir=None if d["base_dir"] is None else Path(d["base_dir"]),
                    joint=None if d.get("joint") is None else JointNormal.from_dict(d["joint"]),
                    scan=d.get("scan"))
+
+
+def _check_drawn(scenario: dict, keys: list[str], values: list[float], axes: dict,
+                 base_dir: Path | None) -> None:
+    """Refuse, before an identification's covariance is read, the keys it would draw that are
+    an axis or not keys of the scenario (a 1000-element link's 2000 parameters for a
+    scenario's Jenkins link): each named, as :meth:`StudyDefinition.check` names them."""
+    from motionhyst.scenario import Scenario, ScenarioError
+
+    data = copy.deepcopy(scenario)
+    for key, value in zip(keys, values, strict=True):
+        if key in REFERENCE_AXES or key in axes:
+            raise ValueError(f"{key!r} (from_identification): already an axis")
+        try:
+            set_key(data, key, value)
+        except StudyError as exc:
+            raise ValueError(f"{key!r}: not a key of the scenario ({exc})") from None
+    try:
+        Scenario.from_dict(data, source="the scenario", base_dir=base_dir, check=False)
+    except ScenarioError as exc:  # which key: one at a time, as check() does
+        if not (str(exc).endswith("unknown key") or "Extra inputs" in str(exc)):
+            return  # a value the scenario refuses: named by check() with its point
+        for key, value in zip(keys, values, strict=True):
+            one = copy.deepcopy(scenario)
+            set_key(one, key, value)
+            try:
+                Scenario.from_dict(one, source="the scenario", base_dir=base_dir, check=False)
+            except ScenarioError as err:
+                if str(err).endswith("unknown key") or "Extra inputs" in str(err):
+                    raise ValueError(f"{key!r}: not a key of the scenario ({err})") from None
+
+
+def _check_count(n, seed) -> None:
+    """Refuse ``[samples]`` ``n`` and ``seed`` that are not whole numbers in range."""
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+        raise StudyError("[samples] 'n': give a whole number of samples >= 1")
+    if n > MAX_POINTS:  # before they are drawn
+        raise StudyError(f"[samples] 'n': {n} samples, more than the {MAX_POINTS} "
+                         f"points a study holds; split the study")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise StudyError("[samples] 'seed': give a whole number >= 0 (the samples are "
+                         "drawn from it, reproducibly)")

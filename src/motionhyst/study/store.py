@@ -175,11 +175,11 @@ class StudyStore:
         path : str or Path
             The store's folder.
         """
+        path = Path(path)
+        if not is_study_store(path):  # decided before zarr loads
+            raise StudyError(f"{path}: not a store of motionhyst study")
         import zarr
 
-        path = Path(path)
-        if not is_study_store(path):
-            raise StudyError(f"{path}: not a store of motionhyst study")
         try:
             group = zarr.open_group(str(path), mode="r+", zarr_format=3)
         except (OSError, ValueError, KeyError, TypeError) as exc:
@@ -569,9 +569,9 @@ def open_results(path: str | Path):
     >>> ds["e1"].dims, str(ds["e1"].dtype)
     (('frequency_hz', 'amplitude'), 'complex128')
     """
-    import xarray as xr
-
     StudyStore.open(path).status()  # a damaged store is named as such, not by xarray
+    import xarray as xr  # loaded once the store is one (pandas with it)
+
     try:
         ds = xr.open_zarr(str(path), consolidated=False, mask_and_scale=False).load()
     except (RuntimeError, ValueError) as exc:
