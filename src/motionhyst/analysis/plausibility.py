@@ -25,12 +25,14 @@ from collections.abc import Iterable
 
 from motionhyst.core.warnings import warn
 
-__all__ = ["FREQUENCY_DECADES", "check_frequencies", "check_frequency_range", "check_plausible",
-           "f_star_of"]
+__all__ = ["DECADES_ABOVE", "DECADES_BELOW", "check_frequencies", "check_frequency_range",
+           "check_plausible", "f_star_of"]
 
-FREQUENCY_DECADES = 2
-"""How far (decades) a sine's frequency may lie beyond the loop's dynamics: above its
-fastest closed-loop pole, or below ``f*`` (eq. 13), where a link holds the stage."""
+DECADES_ABOVE = 2
+"""How far (decades) a sine's frequency may lie above the loop's fastest closed-loop pole."""
+DECADES_BELOW = 3
+"""How far (decades) a sine's frequency may lie below ``f*`` (eq. 13), where a link holds the
+stage (a stiff link's ``f*`` is tens of hertz: its analysis at 0.1 Hz stays)."""
 
 
 def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
@@ -95,12 +97,12 @@ def check_frequencies(frequencies_hz: Iterable[float], f_star_hz: float | None =
                       sample_rate_hz: float | None = None) -> None:
     """Refuse a frequency at which a sine analysis of a loop means nothing.
 
-    - more than :data:`FREQUENCY_DECADES` decades above the loop's fastest closed-loop pole
+    - more than :data:`DECADES_ABOVE` decades above the loop's fastest closed-loop pole
       (for a sampled loop, above its sampling rate if that is higher): neither the
       controller nor the stage follows the reference there, the error is the reference
       itself (``|E| = 1``), and an exact steady state only spends its time on periods the
       loop's slow modes take to forget their start (25 s of CPU at 1e5 Hz for Table I);
-    - more than :data:`FREQUENCY_DECADES` decades below ``f* = sqrt(k/M) / 2 pi``
+    - more than :data:`DECADES_BELOW` decades below ``f* = sqrt(k/M) / 2 pi``
       (eq. 13): the link holds the stage like a spring, the error without it vanishes as
       ``f^4`` and ``|E|`` (eq. 18) grows without bound (1e123 at 1e-30 Hz for Table I).
 
@@ -128,27 +130,28 @@ def check_frequencies(frequencies_hz: Iterable[float], f_star_hz: float | None =
     >>> check_frequencies([1e-30], f_star_hz=0.15)
     Traceback (most recent call last):
     ...
-    ValueError: 1e-30 Hz is more than 2 decades below f* = 0.15 Hz (eq. 13), where the link \
+    ValueError: 1e-30 Hz is more than 3 decades below f* = 0.15 Hz (eq. 13), where the link \
 holds the stage like a spring: the error without it vanishes and |E| means nothing; give \
-frequencies from 0.0015 Hz
+frequencies from 0.00015 Hz
     """
     freqs = [float(f) for f in frequencies_hz]
-    factor = 10.0 ** FREQUENCY_DECADES
     if f_star_hz:
-        low = [f for f in freqs if f < f_star_hz / factor]
+        lowest = f_star_hz / 10.0 ** DECADES_BELOW
+        low = [f for f in freqs if f < lowest]
         if low:
             raise ValueError(
-                f"{low[0]:g} Hz is more than {FREQUENCY_DECADES} decades below f* = "
+                f"{low[0]:g} Hz is more than {DECADES_BELOW} decades below f* = "
                 f"{f_star_hz:.3g} Hz (eq. 13), where the link holds the stage like a spring: "
                 f"the error without it vanishes and |E| means nothing; give frequencies from "
-                f"{f_star_hz / factor:.3g} Hz")
+                f"{lowest:.3g} Hz")
+    factor = 10.0 ** DECADES_ABOVE
     fastest, rate = fastest_pole_hz or 0.0, sample_rate_hz or 0.0
     top = max(fastest, rate)
     high = [f for f in freqs if top > 0 and f > top * factor]
     if high:
         what = (f"fastest closed-loop pole ({fastest:.3g} Hz)" if fastest >= rate
                 else f"sampling rate ({rate:g} Hz)")
-        raise ValueError(f"{high[0]:g} Hz is more than {FREQUENCY_DECADES} decades above the "
+        raise ValueError(f"{high[0]:g} Hz is more than {DECADES_ABOVE} decades above the "
                          f"loop's {what}: nothing follows a reference there (|E| = 1); give "
                          f"frequencies up to {top * factor:.3g} Hz")
 
