@@ -37,7 +37,7 @@ from motionhyst.core.budget import (
     set_max_memory,
     set_max_seconds,
 )
-from motionhyst.core.interrupts import interrupted
+from motionhyst.core.interrupts import DEFERRED, defer, in_numba, interrupted
 
 COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identify", "predict",
             "study", "benchmark", "reproduce")
@@ -172,7 +172,10 @@ class _Interrupts:
     reached an import of a compiled extension may come out as another error (numpy's
     ImportError) that no longer names it, and one raised inside a C callback (numba's
     compiler caching a kernel) is swallowed there, reported to ``sys.unraisablehook``: it
-    is noted, not shown, and the signal sent again a moment later.  Only in this process:
+    is noted, not shown, and the signal sent again a moment later.  One that finds numba's
+    own Python code running (boxing a kernel's results) is not raised there (numba would
+    hand back a tuple with an item missing: a segmentation fault): the kernel's call raises
+    it once numba has returned (:mod:`motionhyst.core.interrupts`).  Only in this process:
     a worker forked from it ends at SIGTERM by the signal's default, as its parent expects,
     and takes Ctrl-C as Python does.  Outside the main thread nothing is installed, and a
     signal ignored by the process that started this one (``nohup``) stays ignored.
@@ -208,7 +211,13 @@ class _Interrupts:
         self.received.append(signum)
         if self.closing:  # the command is ending: its exit code says it
             return
-        raise KeyboardInterrupt(signal.Signals(signum).name)
+        name = signal.Signals(signum).name
+        if in_numba(frame):  # numba boxing a kernel's results: raised there, it would hand
+            defer(name)  # back a broken tuple; the kernel's call raises it (or, if no kernel
+            self._later(signum, deferred=True)  # call returns soon, the signal sent again)
+            return
+        DEFERRED.clear()
+        raise KeyboardInterrupt(name)
 
     def _unraisable(self, unraisable) -> None:
         # raised inside a C callback (numba's compiler caching a kernel), the interrupt is
@@ -222,18 +231,24 @@ class _Interrupts:
         if sig not in self.previous:
             sig = next(iter(self.previous))
         self.received.append(sig)
+        self._later(sig)
+
+    def _later(self, sig: int, deferred: bool = False) -> None:
+        """Send `sig` again a moment later, where it can be raised (`deferred`: unless a
+        kernel's call has raised it meanwhile)."""
         if not self.closing and (self.again is None or not self.again.is_alive()):
-            self.again = threading.Timer(0.05, self._resend, (sig,))
+            self.again = threading.Timer(0.05, self._resend, (sig, deferred))
             self.again.daemon = True
             self.again.start()
 
-    def _resend(self, sig: int) -> None:
-        if not self.closing:
+    def _resend(self, sig: int, deferred: bool = False) -> None:
+        if not self.closing and (DEFERRED or not deferred):
             os.kill(self.pid, sig)
 
     def close(self) -> None:
         """The command is ending: no signal raises any more, none is sent again."""
         self.closing = True
+        DEFERRED.clear()
         if self.again is not None:
             self.again.cancel()
             if self.again is not threading.current_thread():

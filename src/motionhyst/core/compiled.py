@@ -44,6 +44,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from motionhyst.core.interrupts import DEFERRED, raise_deferred
+
 _LOCK = threading.RLock()
 _STATE: dict[str, Any] = {"cache": None, "announced": False, "numba": None}
 _PACKAGE = __name__.partition(".")[0]
@@ -390,7 +392,10 @@ class Kernel:
         d = self._dispatcher
         if d is None:
             d = self.dispatcher()
-        return d(*args)
+        result = d(*args)
+        if DEFERRED:  # a signal came while numba boxed the results: raised now
+            raise_deferred()
+        return result
 
     def __repr__(self) -> str:
         return f"<compiled kernel {self.__module__}.{self.__qualname__}>"

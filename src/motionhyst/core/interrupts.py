@@ -5,6 +5,13 @@ compilation or a C callback comes out as another error (a SystemError, numpy's
 ImportError) whose cause or context is the interrupt; the command line reports it as the
 interruption it was (exit code 130), not as an error.
 
+A signal whose handler would raise while numba runs its own Python code (a kernel's
+compiled wrapper unpickles an array's type as it boxes the results of a kernel returning
+several arrays) must not raise there: numba would hand back a tuple with an item missing,
+and the caller crash with a segmentation fault.  The handler notes it instead
+(:func:`defer`) and the kernel's call raises it once numba has returned
+(:func:`raise_deferred`, from :class:`motionhyst.core.compiled.Kernel`).
+
 Examples
 --------
 >>> try:
@@ -21,7 +28,10 @@ False
 
 from __future__ import annotations
 
-__all__ = ["interrupted"]
+__all__ = ["DEFERRED", "defer", "in_numba", "interrupted", "raise_deferred"]
+
+DEFERRED: list[str] = []
+"""Names of the signals noted while numba's own code ran, not yet raised."""
 
 
 def interrupted(exc: BaseException) -> bool:
@@ -46,3 +56,56 @@ def interrupted(exc: BaseException) -> bool:
         seen.add(id(e))
         e = e.__cause__ or e.__context__
     return False
+
+
+def in_numba(frame) -> bool:
+    """Whether `frame` (where a signal found the interpreter) runs numba's own Python code.
+
+    Parameters
+    ----------
+    frame : frame or None
+        The frame a signal handler is given.
+
+    Examples
+    --------
+    >>> import sys
+    >>> in_numba(sys._getframe())
+    False
+    >>> in_numba(None)
+    False
+    """
+    name = frame.f_globals.get("__name__") if frame is not None else None
+    return isinstance(name, str) and name.partition(".")[0] == "numba"
+
+
+def defer(name: str) -> None:
+    """Note the signal `name` ("SIGINT", "SIGTERM"), to be raised by :func:`raise_deferred`.
+
+    Parameters
+    ----------
+    name : str
+        The signal's name, the ``KeyboardInterrupt``'s argument.
+
+    Examples
+    --------
+    >>> defer("SIGINT")
+    >>> try:
+    ...     raise_deferred()
+    ... except KeyboardInterrupt as exc:
+    ...     print(exc, DEFERRED)
+    SIGINT []
+    """
+    DEFERRED.append(name)
+
+
+def raise_deferred() -> None:
+    """Raise the first signal :func:`defer` noted as ``KeyboardInterrupt`` (none: return).
+
+    Examples
+    --------
+    >>> raise_deferred()        # nothing noted
+    """
+    if DEFERRED:
+        name = DEFERRED[0]
+        DEFERRED.clear()
+        raise KeyboardInterrupt(name)
