@@ -132,6 +132,17 @@ CASES += [
       for opt, value in (("--table", ["t.csv"]), ("--netcdf", ["t.nc"]),
                          ("--figure", ["f.png"]), ("--force", []),
                          ("--scheduler", ["tcp://127.0.0.1:8786"]))],
+    # two outputs of one study naming one file: the second replaced the first after the work
+    ("study-table-and-netcdf-one-file", {},
+     ["study", "st.toml", "--out", "o.zarr", "--table", "x.csv", "--netcdf", "./x.csv"],
+     ["--netcdf ./x.csv: also the --table file"]),
+    ("study-figure-is-the-table", {"old.png": "old"},
+     ["study", "st.toml", "--out", "o.zarr", "--table", "old.png", "--figure", "old.png",
+      "--force"], ["--figure old.png: also the --table file"]),
+    # a file written into the store is not the study's (the store is replaced as a whole)
+    ("study-table-inside-the-store", {},
+     ["study", "st.toml", "--out", "o.zarr", "--table", "o.zarr/t.csv"],
+     ["--table o.zarr/t.csv: inside the store o.zarr"]),
 ]
 
 

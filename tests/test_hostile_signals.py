@@ -67,3 +67,33 @@ def test_a_noted_signal_is_raised_by_the_next_kernel_call_and_only_once():
         total(np.ones(3))
     assert DEFERRED == []
     assert total(np.ones(3)) == 3.0
+
+
+def test_an_interrupt_while_a_study_makes_its_exports_leaves_every_old_file(tmp_path,
+                                                                             monkeypatch,
+                                                                             capsys):
+    """The table was written before the netCDF file was made: a Ctrl-C then gave exit 130
+    with the table replaced. Every export is made first, then written."""
+    import motionhyst.study.export as export
+    from motionhyst.cli import main
+    from motionhyst.scenario import default_scenario_path
+
+    (tmp_path / "s.toml").write_text(default_scenario_path().read_text())
+    (tmp_path / "st.toml").write_text('scenario = "s.toml"\noutputs = ["e1"]\n\n[axes]\n'
+                                      'amplitude = [0.001, 0.01]\nfrequency_hz = [1.0, 2.0]\n')
+    for name in ("t.csv", "t.nc"):
+        (tmp_path / name).write_text("old\n")
+    monkeypatch.chdir(tmp_path)
+
+    def interrupted(ds):
+        raise KeyboardInterrupt("SIGINT")
+
+    monkeypatch.setattr(export, "to_netcdf_bytes", interrupted)
+    code = main(["study", "st.toml", "--out", "s.zarr", "--workers", "0", "--table", "t.csv",
+                 "--netcdf", "t.nc", "--force"])
+    assert code == 130, capsys.readouterr().err
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "motionhyst: interrupted"
+    assert (tmp_path / "t.csv").read_text() == "old\n"
+    assert (tmp_path / "t.nc").read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "s.zarr", "st.toml",
+                                                          "t.csv", "t.nc"]

@@ -47,12 +47,15 @@ def _summary(args: argparse.Namespace) -> int:
 
 
 def _exports(ds, args: argparse.Namespace) -> None:
+    """Write --table, --netcdf and --figure: each made first, then all written one after
+    the other (an interrupt while they are made leaves every old file as it was)."""
     from motionhyst.study.export import to_netcdf_bytes, to_table
 
+    made = []
     if args.table_file is not None:
-        args.table_file.write_text(to_table(ds))
+        made.append((args.table_file, to_table(ds).encode("utf-8")))
     if args.netcdf_file is not None:
-        args.netcdf_file.write_bytes(to_netcdf_bytes(ds))
+        made.append((args.netcdf_file, to_netcdf_bytes(ds)))
     if args.figure_file is not None:
         import io
 
@@ -64,7 +67,9 @@ def _exports(ds, args: argparse.Namespace) -> None:
             raise UsageError(f"study --figure: {exc}") from None
         buf = io.BytesIO()
         fig.savefig(buf, format=args.figure_file.path.suffix.lstrip(".") or "png", dpi=150)
-        args.figure_file.write_bytes(buf.getvalue())
+        made.append((args.figure_file, buf.getvalue()))
+    for out, data in made:
+        out.write_bytes(data)
 
 
 def _check_options(args: argparse.Namespace) -> None:
@@ -82,6 +87,27 @@ def _check_options(args: argparse.Namespace) -> None:
         from motionhyst.io.outputs import check_output_folder
 
         check_output_folder(args.out, "--out")
+    _check_files(args)
+
+
+def _check_files(args: argparse.Namespace) -> None:
+    """--table, --netcdf and --figure name three files, none inside the store (a file there is
+    not the study's: the store is replaced as a whole, and a reader takes it for damage)."""
+    store = args.out if args.summary is None else args.summary
+    seen: dict[str, str] = {}
+    for opt, path in (("--table", args.table), ("--netcdf", args.netcdf),
+                      ("--figure", args.figure)):
+        if not path:
+            continue
+        where = os.path.realpath(path)
+        if where in seen:
+            raise UsageError(f"study {opt} {path}: also the {seen[where]} file; give each "
+                             f"output its own file")
+        seen[where] = opt
+        if store and os.path.commonpath([where, os.path.realpath(store)]) == \
+                os.path.realpath(store):
+            raise UsageError(f"study {opt} {path}: inside the store {store}; write it "
+                             f"outside the store")
 
 
 def run(args: argparse.Namespace) -> int:
