@@ -140,6 +140,10 @@ CASES += [
      ["study", "st.toml", "--out", "o.zarr", "--table", "old.png", "--figure", "old.png",
       "--force"], ["--figure old.png: also the --table file"]),
     # a file written into the store is not the study's (the store is replaced as a whole)
+    # the criterion chooses the number of elements: with --elements it chose nothing
+    ("identify-criterion-with-elements", {},
+     ["identify", "rec.csv", "--elements", "2", "--criterion", "bic"],
+     ["--criterion has no effect with --elements"]),
     ("study-table-inside-the-store", {},
      ["study", "st.toml", "--out", "o.zarr", "--table", "o.zarr/t.csv"],
      ["--table o.zarr/t.csv: inside the store o.zarr"]),

@@ -160,6 +160,9 @@ def run(args: argparse.Namespace) -> int:
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to input-output and "
                              f"force-displacement records; {path} is a closed-loop record")
+    if args.elements is not None and args.criterion is not None:
+        raise UsageError("motionhyst identify: --criterion has no effect with --elements (it "
+                         "chooses the number of elements)")
     options = {"n_elements": args.elements, "criterion": args.criterion or "rms"}
     extra: dict = {"record": kind, "data": str(path)}
     target = None
