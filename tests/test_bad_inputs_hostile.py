@@ -616,3 +616,15 @@ def test_a_store_of_another_version_is_resumed_with_a_word(tmp_path):
         "motionhyst: warning: study: o.zarr: a store of motionhyst 99.0, resumed by "
         f"{__version__}: the points it holds stay as that version "
         "computed them"]
+
+
+def test_df_of_coulomb_friction_is_printed_without_a_ratio_to_its_zero_stiffness(capsys):
+    """Coulomb friction has no elastic range (k_init 0): the table divided by it (internal
+    error, exit 1)."""
+    assert main(["df", "--model", "coulomb", "--fc", "0.05", "--amplitude", "0.01",
+                 "--frequency", "5"]) == 0
+    out = capsys.readouterr().out
+    assert "k_init [-]" not in out and "no elastic range" in out
+    row = out.splitlines()[3].split()
+    assert [float(v) for v in row[:5]] == pytest.approx([0.01, 5, 0, 4 * 0.05 / (np.pi * 0.01),
+                                                         4 * 0.05 / (np.pi * 0.01)], rel=1e-3)

@@ -144,14 +144,17 @@ class DescribingFunctionResult:
             return [g(p.amplitude)] + ([] if rate else [g(p.frequency_hz)])
 
         has_zeta = any(not math.isnan(p.zeta) for p in self.points)
+        elastic = 0.0 < k_init < math.inf  # Coulomb friction has no elastic range: no ratio
         rows = [[*lead(p), *([g(p.zeta)] if has_zeta else []), g(p.value.real),
-                 g(p.value.imag), g(abs(p.value)), g(abs(p.value) / k_init),
+                 g(p.value.imag), g(abs(p.value)),
+                 *([g(abs(p.value) / k_init)] if elastic else []),
                  f"{np.degrees(np.angle(p.value)):.2f}"] for p in self.points]
         lines.append(table([*head, *(["zeta [-]"] if has_zeta else []), "Re D [N/m]",
-                            "Im D [N/m]", "|D| [N/m]", "|D|/k_init [-]", "angle D [deg]"],
-                           rows))
+                            "Im D [N/m]", "|D| [N/m]", *(["|D|/k_init [-]"] if elastic else []),
+                            "angle D [deg]"], rows))
         lines.append(f"k_init = {k_init:g} N/m, the initial stiffness"
-                     + (" (|D| -> k_init as A -> 0)" if rate else ""))
+                     + (" (|D| -> k_init as A -> 0)" if rate and elastic else "")
+                     + ("" if elastic else " (no elastic range: rigid while it sticks)"))
         if self.harmonics:
             lines += ["", "Higher-order describing functions H_n = Y_n / A [N/m], relative "
                       "to sin(n w t)"]
