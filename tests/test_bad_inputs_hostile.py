@@ -11,6 +11,7 @@ intact and no temporary file left.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -140,6 +141,8 @@ CASES += [
      ["study", "st.toml", "--out", "o.zarr", "--table", "old.png", "--figure", "old.png",
       "--force"], ["--figure old.png: also the --table file"]),
     # a file written into the store is not the study's (the store is replaced as a whole)
+    ("study-summary-force-without-a-file", {}, ["study", "--summary", "o.zarr", "--force"],
+     ["--force has no effect without --table, --netcdf or --figure"]),
     # the criterion chooses the number of elements: with --elements it chose nothing
     ("identify-criterion-with-elements", {},
      ["identify", "rec.csv", "--elements", "2", "--criterion", "bic"],
@@ -628,3 +631,49 @@ def test_df_of_coulomb_friction_is_printed_without_a_ratio_to_its_zero_stiffness
     row = out.splitlines()[3].split()
     assert [float(v) for v in row[:5]] == pytest.approx([0.01, 5, 0, 4 * 0.05 / (np.pi * 0.01),
                                                          4 * 0.05 / (np.pi * 0.01)], rel=1e-3)
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize("answer", [None, b"HTTP/1.1 400 Bad Request\r\n\r\n" * 8],
+                         ids=["nothing-listens", "another-service"])
+def test_a_scheduler_address_without_a_dask_scheduler_is_refused_in_one_line(tmp_path, answer):
+    """Nothing listening: refused at once, by the system's answer (dask tried for 10 s, "Timed
+    out"); another service (an HTTP server): dask read a frame length of 3 EiB from its reply
+    ("out of memory")."""
+    import socket
+    import threading
+
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, BASE)
+    port = _free_port()
+    server = None
+    if answer is not None:
+        server = socket.create_server(("127.0.0.1", 0))
+        port = server.getsockname()[1]
+
+        def serve():
+            with contextlib.suppress(OSError):
+                while True:
+                    conn, _ = server.accept()
+                    with conn:
+                        conn.sendall(answer)
+                        time.sleep(0.2)
+
+        threading.Thread(target=serve, daemon=True).start()
+    try:
+        line = limited_process.refusal(["study", "st.toml", "--out", "o.zarr", "--workers", "0",
+                                        "--scheduler", f"tcp://127.0.0.1:{port}"], root)
+    finally:
+        if server is not None:
+            server.close()
+    assert f"--scheduler tcp://127.0.0.1:{port}" in line
+    assert ("Connection refused" if answer is None else "not a dask scheduler") in line, line
+    assert not (root / "o.zarr").exists()

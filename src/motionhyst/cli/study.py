@@ -26,6 +26,9 @@ def _summary(args: argparse.Namespace) -> int:
             raise UsageError(f"study --summary: {opt} is for running a study")
     if args.study is not None:
         raise UsageError("study --summary STORE: give the store alone, not a study file")
+    if args.force and not (args.table or args.netcdf or args.figure):
+        raise UsageError("study --summary: --force has no effect without --table, --netcdf or "
+                         "--figure (a summary replaces no other file)")
     try:
         ds = open_results(args.summary)
     except StudyError as exc:
@@ -88,6 +91,24 @@ def _check_options(args: argparse.Namespace) -> None:
 
         check_output_folder(args.out, "--out")
     _check_files(args)
+    if args.scheduler is not None and not args.estimate and args.summary is None:
+        _check_reachable(args.scheduler)
+
+
+def _check_reachable(address: str) -> None:
+    """A scheduler address nothing answers at is refused at once (dask would try for 10 s)."""
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    if parts.scheme != "tcp" or not parts.hostname:  # tls://, ucx://: dask's own connection
+        return
+    try:
+        with socket.create_connection((parts.hostname, parts.port or 8786), timeout=2.0):
+            pass
+    except OSError as exc:
+        raise UsageError(f"study --scheduler {address}: cannot connect "
+                         f"({exc.strerror or exc})") from None
 
 
 def _check_files(args: argparse.Namespace) -> None:
@@ -155,6 +176,9 @@ def run(args: argparse.Namespace) -> int:
         except (OSError, TimeoutError) as exc:
             raise UsageError(f"study --scheduler {args.scheduler}: cannot connect ({exc})"
                              ) from None
+        except (MemoryError, ValueError, TypeError):  # a frame length read from another
+            raise UsageError(f"study --scheduler {args.scheduler}: what answers there is not "
+                             f"a dask scheduler") from None  # service's reply: 3 EiB
     try:
         report = run_study(study, args.out, workers=args.workers, client=client,
                            force=args.force, progress=not args.json and sys.stderr.isatty())
