@@ -85,7 +85,8 @@ def test_generated_axis_identified_and_scored():
     assert model.validation["fit_percent"] > 90.0
     assert set(res.to_dict()) == {"models"}
     assert set(res.to_dict()["models"][0]) == {"name", "parameters", "std", "estimation",
-                                                "validation", "seconds", "equivalent_offset"}
+                                                "validation", "seconds", "equivalent_offset",
+                                                "model_parameters", "model_std"}
     assert set(model.std) == set(p)
     text = str(res)
     assert "validated on axis periods 3-4 (the test record DATA_EMPS_PULSES.mat was not" in text
@@ -181,6 +182,30 @@ def test_benchmark_emps_every_split(tmp_path, capsys, monkeypatch):
     assert main(["benchmark", "emps", "--data", str(tmp_path), "--periods", "all"]) == 0
     text = capsys.readouterr().out
     assert "Chosen by the worst of the 4 splits (the rule stated in advance): coulomb" in text
+
+
+def test_benchmark_emps_with_the_test_record_names_the_chosen_model(tmp_path, capsys,
+                                                                   monkeypatch):
+    """With the test record the JSON names the model chosen before the test, in the shape
+    the splits give it: {"name", "worse_split_rmse_mm"}, the figure it was chosen by; a list
+    without that model has no chosen one."""
+    import motionhyst.identify.emps as emps
+
+    rec = axis_record(n_periods=2)
+    for name in ("DATA_EMPS.mat", "DATA_EMPS_PULSES.mat"):
+        savemat(tmp_path / name, {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
+                                  "qm": rec.y[:, None], "gtau": DRIVE_GAIN})
+    monkeypatch.setattr(emps, "PERIOD", PERIOD)
+    monkeypatch.setattr(emps, "CHOSEN", "coulomb")
+    assert main(["benchmark", "emps", "--data", str(tmp_path), "--models", "coulomb",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["chosen"] == {"name": "coulomb", "worse_split_rmse_mm": emps.CHOSEN_WORSE_SPLIT_MM}
+    assert [m["validation"]["record"] for m in out["models"]] == ["DATA_EMPS_PULSES"]
+    monkeypatch.setattr(emps, "CHOSEN", "coulomb-drift")
+    assert main(["benchmark", "emps", "--data", str(tmp_path), "--models", "coulomb",
+                 "--json"]) == 0
+    assert "chosen" not in json.loads(capsys.readouterr().out)
 
 
 @pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),

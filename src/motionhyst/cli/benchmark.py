@@ -123,6 +123,8 @@ def _emps_record(path: Path, name: str):
 def run_emps(args: argparse.Namespace) -> int:
     """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
     from motionhyst.identify.emps import (
+        CHOSEN,
+        CHOSEN_WORSE_SPLIT_MM,
         ESTIMATION_FILE,
         TEST_FILE,
         check_model,
@@ -180,13 +182,15 @@ def run_emps(args: argparse.Namespace) -> int:
         results = [run_emps(estimation, test, models=models, periods=args.periods or (1, 2),
                             progress=say)]
     chosen = choose(results) if len(results) > 1 else None
+    if test is not None and CHOSEN in [m.name for m in results[0].models]:
+        chosen = (CHOSEN, CHOSEN_WORSE_SPLIT_MM)  # chosen on the splits, before the test
     if args.json:
         print_json({"models": [m for res in results for m in res.to_dict()["models"]],
                     **({} if chosen is None else {"chosen": {"name": chosen[0],
                                                              "worse_split_rmse_mm": chosen[1]}})})
         return 0
     print("\n\n".join(str(res) for res in results))
-    if chosen is not None:
+    if chosen is not None and test is None:
         two = len(results) == 2
         splits = "both splits" if two else f"the {len(results)} splits"
         worst = "worse" if two else "worst"

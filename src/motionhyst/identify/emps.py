@@ -46,6 +46,7 @@ from motionhyst.identify.emps_reference import (
     REFERENCE_MODEL,
     asymmetric_inverse_dynamics,
     equivalent_offset,
+    reference_form,
     reference_system,
 )
 from motionhyst.identify.input_output import IORecord, identify_io
@@ -53,10 +54,11 @@ from motionhyst.identify.io_checks import MAX_PREDICT_SUBSTEPS, FitFailed
 from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
 from motionhyst.identify.io_start import inverse_dynamics
 
-__all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "INIT_WINDOW", "LINKS",
-           "MODELS", "OPTIONS", "PERIOD", "RIGID_LIMIT", "TEST_FILE", "EMPSBenchmark",
-           "EMPSModel", "check_model", "choose", "cross_validate", "model_options",
-           "own_offset_score", "period_drift", "run_emps", "score", "split_by_periods"]
+__all__ = ["CHOSEN", "CHOSEN_WORSE_SPLIT_MM", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
+           "INIT_WINDOW", "LINKS", "MODELS", "OPTIONS", "PERIOD", "RIGID_LIMIT", "TEST_FILE",
+           "EMPSBenchmark", "EMPSModel", "check_model", "choose", "cross_validate",
+           "model_options", "own_offset_score", "period_drift", "run_emps", "score",
+           "split_by_periods"]
 
 ESTIMATION_FILE = "DATA_EMPS.mat"
 """The benchmark's estimation record."""
@@ -84,6 +86,9 @@ CHOSEN = "coulomb-asymmetric-drift"
 the rule of :func:`choose` on the two splits of ``DATA_EMPS``, among :data:`MODELS`: the
 smallest worse-split validation RMSE, 4.48 mm (``coulomb-asymmetric`` 6.12 mm,
 ``jenkins-asymmetric`` 7.2 mm)."""
+CHOSEN_WORSE_SPLIT_MM = 4.48
+""":data:`CHOSEN`'s validation RMSE on the worse of the two splits when it was chosen [mm]
+(``benchmark emps`` without the test record: ``"chosen"`` in its JSON)."""
 
 
 #: The options a model's name may end with (``jenkins-asymmetric-drift``)
@@ -217,10 +222,15 @@ class EMPSModel:
     name : str
         The link model (``"coulomb"``, ``"jenkins"``, ...).
     parameters, std : dict
-        Estimates and standard errors (None: not determined by the record):
-        ``m`` [kg], ``c`` [N s/m], the link's parameters, ``offset`` (the
-        force offset ``OF`` [N], the benchmark's sign: the plant receives
-        ``F - OF``).
+        The model in the benchmark's reference model's form, comparable with its
+        published parameters, and their standard errors (None: not determined by the
+        record): ``m`` [kg], ``c`` [N s/m] (the odd part of viscous friction by
+        direction), ``fc`` [N], ``offset`` (the constant force offset ``OF`` [N] the
+        model amounts to on the estimation record's motion, the benchmark's sign: the
+        plant receives ``F - OF``), and the link's parameters the reference model has
+        no place for (``k``, ...) as they are
+        (:func:`~motionhyst.identify.emps_reference.reference_form`).  For a model of
+        the reference's own structure (``"coulomb"``) these are its own estimates.
     estimation, validation : dict
         ``{"record", "rmse_mm", "fit_percent"}``: the benchmark's metric on the
         record identified from and on the held-out one; the validation also has
@@ -235,14 +245,18 @@ class EMPSModel:
     prediction : ndarray or None
         The simulated position on the validation record [m] (for plots).
     equivalent_offset : float or None
-        The constant offset ``OF`` the model's offset, its drift and its
-        direction-dependent viscous friction amount to on the estimation record's
-        motion (:func:`~motionhyst.identify.emps_reference.equivalent_offset`) [N]:
-        comparable with the reference model's.
+        ``parameters["offset"]``: the constant offset ``OF`` the model's offset, its
+        drift and its direction-dependent viscous friction amount to on the estimation
+        record's motion (:func:`~motionhyst.identify.emps_reference.equivalent_offset`)
+        [N].
     limit : str or None
         The model whose fit this one is at its limit of (a Jenkins link whose
         stiffness ran to the rigid limit: the Coulomb link with the same options),
         or None.
+    model_parameters, model_std : dict
+        The model's own estimates and standard errors, as ``identify --save`` writes
+        them (``offset`` its own force offset, ``c_pos``, ``c_neg``, ``c_skew``,
+        ``drift``, ...); empty when not known.
 
     Examples
     --------
@@ -265,13 +279,19 @@ class EMPSModel:
     prediction: np.ndarray | None = field(default=None, repr=False)
     equivalent_offset: float | None = None
     limit: str | None = None
+    model_parameters: dict[str, float] = field(default_factory=dict)
+    model_std: dict[str, float | None] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``, and
-        ``"equivalent_offset"`` when known, ``"limit"`` when the model is at one."""
+        ``"model_parameters"``, ``"model_std"`` and ``"equivalent_offset"`` when known,
+        ``"limit"`` when the model is at one."""
         out = {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
                "estimation": dict(self.estimation), "validation": dict(self.validation),
                "seconds": self.seconds}
+        if self.model_parameters:
+            out["model_parameters"] = dict(self.model_parameters)
+            out["model_std"] = dict(self.model_std)
         if self.equivalent_offset is not None:
             out["equivalent_offset"] = self.equivalent_offset
         if self.limit is not None:
@@ -341,7 +361,7 @@ class EMPSBenchmark:
 
         rows = []
         for m in self.models:
-            p = m.parameters
+            p = m.model_parameters or m.parameters
             limit = "" if m.limit is None else f" (its rigid limit, {m.limit})"
             rows.append([f"motionhyst: mass-damper + {m.name}{limit}", g(p.get("m"), 4),
                          _viscous(p), _friction(p), _offset(p),
@@ -577,19 +597,22 @@ def period_drift(record: IORecord, period: int = PERIOD) -> list[dict]:
     return out
 
 
-def _parameters(fit) -> tuple[dict, dict]:
-    """The identification's estimates under the benchmark's names (``offset`` = OF)."""
-    est, std = {}, {}
+def _parameters(fit) -> tuple[dict, dict, dict]:
+    """The identification's estimates, standard errors and covariance under the benchmark's
+    names (``offset`` = the model's own OF, ``drift``, the link's without ``link.``)."""
+    est, std, short = {}, {}, {}
     for name, value in fit.estimates.items():
-        short = name.removeprefix("link.")
-        if short != name and short in fit.estimates:
-            short = name
+        short[name] = name.removeprefix("link.")
+        if short[name] != name and short[name] in fit.estimates:
+            short[name] = name
         if name in ("input_offset", "input_drift"):
-            short = name.removeprefix("input_")
-        est[short] = float(value)
+            short[name] = name.removeprefix("input_")
+        est[short[name]] = float(value)
         s = fit.std.get(name)
-        std[short] = None if s is None else float(s)
-    return est, std
+        std[short[name]] = None if s is None else float(s)
+    cov = fit.extra.get("covariance", {"parameters": [], "matrix": []})
+    return est, std, {"parameters": [short.get(n, n) for n in cov["parameters"]],
+                      "matrix": cov["matrix"]}
 
 
 def score(system, record: IORecord) -> tuple[dict, np.ndarray]:
@@ -858,7 +881,8 @@ def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
         raise
     except (ValueError, RuntimeError) as exc:
         raise ValueError(f"{name}: {exc}") from None
-    parameters, std = _parameters(fit)
+    own, own_std, covariance = _parameters(fit)
+    parameters, std = reference_form(own, est, own_std, covariance)
     return EMPSModel(name, parameters, std, est_score, val_score, 0.0,
-                     list(getattr(fit, "warnings", [])), yhat,
-                     equivalent_offset(parameters, est))
+                     list(getattr(fit, "warnings", [])), yhat, parameters.get("offset"),
+                     model_parameters=own, model_std=own_std)

@@ -20,7 +20,8 @@ viscous and Coulomb coefficients by direction and no offset (the screw's mechani
 ``0+(q') = max(q', 0)``, ``0-(q') = min(q', 0)``.  Here: their published parameters, the
 models as open-loop systems (:func:`reference_system`), eq. (12) by one linear solve
 (:func:`asymmetric_inverse_dynamics`), and the constant offset a model with friction by
-direction amounts to (:func:`equivalent_offset`).
+direction amounts to (:func:`equivalent_offset`), and a model's parameters in the reference
+model's form, with their standard errors (:func:`reference_form`).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ import numpy as np
 from motionhyst.identify.input_output import IORecord
 
 __all__ = ["PUBLISHED", "REFERENCE_ASYMMETRIC", "REFERENCE_MODEL", "asymmetric_inverse_dynamics",
-           "equivalent_offset", "reference_system"]
+           "equivalent_offset", "reference_form", "reference_system"]
 
 REFERENCE_MODEL = {"m": 95.1089, "c": 203.5034, "fc": 20.3935, "offset": -3.1648}
 """The benchmark's IDIM-LS model: M [kg], Fv [N s/m], Fc [N], OF [N]."""
@@ -162,11 +163,93 @@ def equivalent_offset(parameters: dict, record: IORecord) -> float:
     ...                          "fc_neg": 20.2}, rec), 2)
     -3.9
     """
+    weights = _weights(parameters, record)["offset"]
+    return float(sum(w * parameters.get(name, 0.0) for name, w in weights.items()))
+
+def _weights(parameters: dict, record: IORecord) -> dict[str, dict[str, float]]:
+    """Each of the reference model's parameters as a weighted sum of a model's (linear)."""
     v = np.gradient(record.y, record.t)
-    offset = parameters.get("offset", 0.0)
-    if "fc_pos" in parameters:  # Coulomb forces by direction: their difference while moving
-        offset += 0.5 * (parameters["fc_pos"] - parameters["fc_neg"])
-    even = (parameters.get("c_skew", 0.0)
-            + 0.5 * (parameters.get("c_pos", 0.0) - parameters.get("c_neg", 0.0)))
-    return float(offset + parameters.get("drift", 0.0) * np.mean(record.t)
-                 + even * np.mean(np.abs(v)))
+    mean_speed, mean_t = float(np.mean(np.abs(v))), float(np.mean(record.t))
+    fc = {"fc": 1.0} if "fc" in parameters else {"fc_pos": 0.5, "fc_neg": 0.5}
+    offset = {"offset": 1.0, "fc_pos": 0.5, "fc_neg": -0.5, "drift": mean_t,
+              "c_skew": mean_speed, "c_pos": 0.5 * mean_speed, "c_neg": -0.5 * mean_speed}
+    return {"m": {"m": 1.0}, "c": {"c": 1.0, "c_pos": 0.5, "c_neg": 0.5}, "fc": fc,
+            "offset": offset}
+
+
+def reference_form(parameters: dict, record: IORecord, std: dict | None = None,
+                   covariance: dict | None = None) -> tuple[dict, dict]:
+    """A mass-damper model's parameters as the reference model's ``m, c, fc, offset`` (OF).
+
+    The reference model (:data:`REFERENCE_MODEL`) has one viscous coefficient, one
+    Coulomb force and a constant offset.  A model with viscous friction by direction
+    (the Coulomb link's ``c_pos``/``c_neg`` on top of the stage's ``c``, or the stage's
+    ``c_skew``), Coulomb forces by direction or a drifting offset is, on a record's
+    motion, the reference model with ``c`` the odd part of its viscous friction
+    (``c + (c_pos + c_neg)/2``), ``fc`` the mean of its Coulomb forces and ``offset`` the
+    constant offset the rest amounts to (:func:`equivalent_offset`).  The map is linear,
+    so each standard error follows from the model's covariance (the delta method, exact
+    here): ``sqrt(w C w)`` with ``w`` the weights; None when a parameter that enters is not
+    determined by the record.  Parameters the reference model has no place for (a Jenkins
+    link's ``k``, LuGre's ``fs``, ...) are kept as they are.
+
+    Parameters
+    ----------
+    parameters : dict
+        The model's estimates: ``m, c, offset`` and optionally ``c_pos, c_neg, c_skew``
+        [N s/m], ``fc`` or ``fc_pos, fc_neg`` [N], ``drift`` [N/s], and others.
+    record : IORecord
+        The record whose motion the model was identified on.
+    std : dict, optional
+        The estimates' standard errors (None: not determined).
+    covariance : dict, optional
+        ``{"parameters": [...], "matrix": [[...]]}`` of the determined estimates, under
+        the names of `parameters`; without it the estimates are taken as uncorrelated.
+
+    Returns
+    -------
+    parameters, std : dict
+        ``m, c, fc, offset`` (those the model has) and the parameters kept, and their
+        standard errors.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(2001) / 1000.0
+    >>> rec = IORecord(t, np.zeros_like(t), 0.05 * np.sin(np.pi * t))  # mean |q'| = 0.1 m/s
+    >>> own = {"m": 95.0, "c": 160.0, "fc": 20.0, "c_neg": 76.0, "offset": 0.1, "k": 1e7}
+    >>> sd = {"m": 0.1, "c": 1.0, "fc": 0.1, "c_neg": 2.0, "offset": 0.1, "k": 1e5}
+    >>> ref, ref_std = reference_form(own, rec, sd)
+    >>> {k: round(x, 2) for k, x in ref.items()}
+    {'m': 95.0, 'c': 198.0, 'fc': 20.0, 'offset': -3.7, 'k': 10000000.0}
+    >>> round(ref_std["c"], 3), round(ref_std["offset"], 3)  # sqrt(1 + 1), sqrt(0.01 + 0.01)
+    (1.414, 0.141)
+    """
+    std = {} if std is None else std
+    weights = _weights(parameters, record)
+    used = {name for w in weights.values() for name in w}
+    names = [n for n in parameters if n in used]
+    if covariance is not None:
+        order = list(covariance["parameters"])
+        where = [order.index(n) if n in order else -1 for n in names]
+        full = np.array(covariance["matrix"], dtype=float).reshape(len(order), len(order))
+        cov = np.array([[full[i, j] if i >= 0 and j >= 0 else 0.0 for j in where]
+                        for i in where]).reshape(len(names), len(names))
+        known = {n for n, i in zip(names, where, strict=True) if i >= 0}
+    else:
+        var = [0.0 if std.get(n) is None else float(std[n]) ** 2 for n in names]
+        cov = np.diag(var).reshape(len(names), len(names))
+        known = {n for n in names if std.get(n) is not None}
+    out, out_std = {}, {}
+    for key, w in weights.items():
+        enters = [n for n in names if w.get(n, 0.0) != 0.0]
+        if not enters:  # a model without this parameter (no Coulomb force: no fc)
+            continue
+        vec = np.array([w.get(n, 0.0) for n in names])
+        out[key] = float(vec @ np.array([parameters[n] for n in names]))
+        out_std[key] = (float(np.sqrt(max(vec @ cov @ vec, 0.0)))
+                        if all(n in known for n in enters) else None)
+    for name, value in parameters.items():
+        if name not in used:
+            out[name], out_std[name] = value, std.get(name)
+    return out, out_std
