@@ -127,11 +127,11 @@ def run_emps(args: argparse.Namespace) -> int:
         CHOSEN_WORSE_SPLIT_MM,
         ESTIMATION_FILE,
         TEST_FILE,
-        check_model,
         choose,
         cross_validate,
         run_emps,
     )
+    from motionhyst.identify.emps_models import check_model
 
     if args.seed is not None:
         raise UsageError("motionhyst benchmark emps: --seed applies to bouc-wen only (the EMPS "

@@ -40,6 +40,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from motionhyst.core.warnings import MotionhystWarning
+from motionhyst.identify.emps_models import (
+    OPTIONS,
+    RIGID_LIMIT,
+    check_model,
+    model_options,
+    unresolved_stiffness,
+)
 from motionhyst.identify.emps_reference import (
     PUBLISHED,
     REFERENCE_ASYMMETRIC,
@@ -55,9 +62,8 @@ from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
 from motionhyst.identify.io_start import inverse_dynamics
 
 __all__ = ["CHOSEN", "CHOSEN_WORSE_SPLIT_MM", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
-           "INIT_WINDOW", "LINKS", "MODELS", "OPTIONS", "PERIOD", "RIGID_LIMIT", "TEST_FILE",
-           "EMPSBenchmark", "EMPSModel", "check_model", "choose", "cross_validate",
-           "model_options", "own_offset_score", "period_drift", "run_emps", "score",
+           "INIT_WINDOW", "MODELS", "PERIOD", "TEST_FILE", "EMPSBenchmark", "EMPSModel",
+           "choose", "cross_validate", "own_offset_score", "period_drift", "run_emps", "score",
            "split_by_periods"]
 
 ESTIMATION_FILE = "DATA_EMPS.mat"
@@ -89,41 +95,6 @@ smallest worse-split validation RMSE, 4.48 mm (``coulomb-asymmetric`` 6.12 mm,
 CHOSEN_WORSE_SPLIT_MM = 4.48
 """:data:`CHOSEN`'s validation RMSE on the worse of the two splits when it was chosen [mm]
 (``benchmark emps`` without the test record: ``"chosen"`` in its JSON)."""
-
-
-#: The options a model's name may end with (``jenkins-asymmetric-drift``)
-OPTIONS = ("asymmetric", "drift")
-
-
-def model_options(name: str) -> tuple[str, set[str]]:
-    """A model's link and its options, from its name (the link's, then ``-asymmetric`` and
-    ``-drift``: :func:`~motionhyst.identify.input_output.identify_io`'s options).
-
-    Parameters
-    ----------
-    name : str
-        ``"jenkins-asymmetric-drift"``, ``"maxwell-slip-asymmetric"``, ...
-
-    Returns
-    -------
-    link : str
-        The registered link model's name.
-    options : set of str
-        Of :data:`OPTIONS`.
-
-    Examples
-    --------
-    >>> link, options = model_options("maxwell-slip-asymmetric-drift")
-    >>> link, sorted(options)
-    ('maxwell-slip', ['asymmetric', 'drift'])
-    """
-    link, options = name, set()
-    while True:
-        head, _, tail = link.rpartition("-")
-        if not head or tail not in OPTIONS:
-            return link, options
-        link = head
-        options.add(tail)
 
 
 def choose(runs: Sequence[EMPSBenchmark]) -> tuple[str, float]:
@@ -251,8 +222,9 @@ class EMPSModel:
         [N].
     limit : str or None
         The model whose fit this one is at its limit of (a Jenkins link whose
-        stiffness ran to the rigid limit: the Coulomb link with the same options),
-        or None.
+        stiffness the record does not resolve,
+        :func:`~motionhyst.identify.emps_models.unresolved_stiffness`, or ran to where
+        ``predict`` cannot step it: the Coulomb link with the same options), or None.
     model_parameters, model_std : dict
         The model's own estimates and standard errors, as ``identify --save`` writes
         them (``offset`` its own force offset, ``c_pos``, ``c_neg``, ``c_skew``,
@@ -285,7 +257,7 @@ class EMPSModel:
     def to_dict(self) -> dict:
         """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``, and
         ``"model_parameters"``, ``"model_std"`` and ``"equivalent_offset"`` when known,
-        ``"limit"`` when the model is at one."""
+        ``"limit"`` when the model is at one, ``"warnings"`` when there are any."""
         out = {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
                "estimation": dict(self.estimation), "validation": dict(self.validation),
                "seconds": self.seconds}
@@ -296,6 +268,8 @@ class EMPSModel:
             out["equivalent_offset"] = self.equivalent_offset
         if self.limit is not None:
             out["limit"] = self.limit
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
         return out
 
     def __str__(self) -> str:
@@ -792,21 +766,13 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         link, options = model_options(name)
         try:
             model = _identify_and_score(name, link, options, est, val)
+            why = unresolved_stiffness(name, model.model_parameters, model.model_std, est.fs)
         except FitFailed as exc:
             if link == "coulomb" or RIGID_LIMIT not in str(exc):
                 raise ValueError(f"{name}: {exc}") from None
-            # the link's stiffness ran to the rigid limit: report the limit, the Coulomb link
-            rigid = "-".join(["coulomb", *(o for o in OPTIONS if o in options)])
-            done = next((m for m in out if m.name == rigid), None)
-            try:
-                model = done or _identify_and_score(rigid, "coulomb", options, est, val)
-            except FitFailed as limit_failed:
-                raise ValueError(f"{name}: {exc}; its rigid limit {rigid}: "
-                                 f"{limit_failed}") from None
-            model = replace(model, name=name, limit=rigid, warnings=[
-                f"the link's stiffness ran to the rigid limit (a model that needs more than "
-                f"{MAX_PREDICT_SUBSTEPS} {RIGID_LIMIT}): reported as that limit, {rigid}",
-                *model.warnings])
+            why = f"a model that needs more than {MAX_PREDICT_SUBSTEPS} {RIGID_LIMIT}"
+        if why is not None:  # report the limit, the Coulomb link with the same options
+            model = _rigid_limit(name, options, est, val, out, why)
         model.seconds = time.perf_counter() - t0
         out.append(model)
         say(f"{name}: {model.validation['rmse_mm']:.3g} mm on {val.name} "
@@ -827,42 +793,19 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     return EMPSBenchmark(out, est, val, test is not None, ref, drift)
 
 
-#: What a failed fit says when the model needs a finer step than ``predict`` takes: on a
-#: positioning axis, a link whose stiffness ran to the rigid limit (the Coulomb link)
-RIGID_LIMIT = "integration steps per sample"
-
-
-def check_model(name: str) -> None:
-    """Refuse a model name :func:`run_emps` cannot identify (one line naming the choices).
-
-    Parameters
-    ----------
-    name : str
-        A link of :data:`LINKS`, optionally ending in ``-asymmetric`` and ``-drift``
-        (:func:`model_options`).
-
-    Raises
-    ------
-    ValueError
-        A name that is none of these.
-
-    Examples
-    --------
-    >>> check_model("jenkins-asymmetric-drift")
-    >>> check_model("bouc-wen")
-    Traceback (most recent call last):
-    ...
-    ValueError: benchmark model 'bouc-wen': a friction link of coulomb, dahl, jenkins, lugre, ...
-    """
-    link, _ = model_options(name)
-    if link not in LINKS:
-        raise ValueError(f"benchmark model {name!r}: a friction link of {', '.join(LINKS)}, "
-                         f"optionally ending in -asymmetric and/or -drift "
-                         f"(jenkins-asymmetric-drift)")
-
-
-#: The links :func:`run_emps` identifies on the mass-damper
-LINKS = ("coulomb", "dahl", "jenkins", "lugre", "maxwell-slip")
+def _rigid_limit(name: str, options: set[str], est: IORecord, val: IORecord,
+                 done: list[EMPSModel], why: str) -> EMPSModel:
+    """A link reported as its rigid limit: the Coulomb link with the same options (its fit
+    among `done` reused), named `name`, with a warning saying `why`."""
+    rigid = "-".join(["coulomb", *(o for o in OPTIONS if o in options)])
+    model = next((m for m in done if m.name == rigid), None)
+    try:
+        model = model or _identify_and_score(rigid, "coulomb", options, est, val)
+    except FitFailed as limit_failed:
+        raise ValueError(f"{name}: {why}; its rigid limit {rigid}: {limit_failed}") from None
+    return replace(model, name=name, limit=rigid, warnings=[
+        f"the link's stiffness ran to the rigid limit ({why}): reported as that limit, {rigid}",
+        *model.warnings])
 
 
 def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,

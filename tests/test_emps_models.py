@@ -1,0 +1,63 @@
+"""The EMPS benchmark's Jenkins link and its rigid limit: a stiffness whose stuck mode the
+record cannot resolve (above a quarter of the sampling rate, or not determined) is reported
+as the Coulomb link with the same options; a stiffness the record shows is kept."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionhyst.hysteresis import Coulomb, Jenkins
+from motionhyst.identify.emps import run_emps
+from motionhyst.identify.emps_models import unresolved_stiffness
+from motionhyst.identify.input_output import IORecord
+from motionhyst.plants.mass_damper import MassDamper
+from motionhyst.time.openloop import OpenLoop
+
+PERIOD = 1000
+
+
+def _axis(link, n_periods: int = 2) -> IORecord:
+    """A mass-damper with the link and a force offset, driven by a force, 1 kHz."""
+    t = np.arange(n_periods * PERIOD) / 1000.0
+    u = 150 * np.sin(2 * np.pi * t) + 60 * np.sin(6 * np.pi * t)
+    axis = OpenLoop(MassDamper(95.0, 200.0, force_offset=3.2), link)
+    y = axis.simulate(t, u, substeps=40).displacement
+    return IORecord(t, u, y + 1e-6 * np.random.default_rng(2).standard_normal(t.size), "axis")
+
+
+def test_a_stiffness_the_record_cannot_resolve_is_the_rigid_limit():
+    """A Coulomb axis: the Jenkins link's fitted stiffness is the search's (a stuck mode
+    beyond 250 Hz at 1 kHz, or undetermined); reported as the Coulomb fit, which is reused."""
+    res = run_emps(_axis(Coulomb(fc=20.0)), models=("coulomb", "jenkins"), periods=(1, 1),
+                   period=PERIOD)
+    coulomb, jenkins = res.models
+    assert jenkins.limit == "coulomb" and coulomb.limit is None
+    assert jenkins.parameters == coulomb.parameters
+    assert jenkins.parameters["m"] == pytest.approx(95.0, rel=0.01)
+    assert "rigid limit" in jenkins.warnings[0]
+    assert "stuck mode" in jenkins.warnings[0] or "not determined" in jenkins.warnings[0]
+    assert jenkins.to_dict()["warnings"] == jenkins.warnings  # the JSON says it too
+    assert "warnings" not in coulomb.to_dict()
+
+
+def test_a_stiffness_the_record_shows_is_kept():
+    """A Jenkins axis whose stuck mode is at 23 Hz: the link keeps its stiffness."""
+    res = run_emps(_axis(Jenkins(k=2e6, fc=20.0)), models=("jenkins",), periods=(1, 1),
+                   period=PERIOD)
+    (model,) = res.models
+    assert model.limit is None
+    assert model.model_parameters["k"] == pytest.approx(2e6, rel=0.1)
+    assert model.parameters["k"] == model.model_parameters["k"]
+    assert unresolved_stiffness("jenkins", model.model_parameters, model.model_std,
+                                1000.0) is None
+
+
+def test_the_rule_in_numbers():
+    own = {"m": 95.0, "k": 95.0 * (2 * np.pi * 240.0) ** 2}  # stuck mode at 240 Hz: resolved
+    assert unresolved_stiffness("jenkins", own, {"k": 1.0}, 1000.0) is None
+    assert "260 Hz" in unresolved_stiffness("jenkins-drift", {"m": 95.0, "k": own["k"] * (
+        260.0 / 240.0) ** 2}, {"k": 1.0}, 1000.0)
+    assert unresolved_stiffness("jenkins", own, {"k": 1.0}, 900.0) is not None  # 225 Hz limit
+    assert unresolved_stiffness("maxwell-slip", own, {"k": None}, 1000.0) is None  # not Jenkins
+    assert unresolved_stiffness("coulomb", {"m": 95.0, "fc": 20.0}, {}, 1000.0) is None
