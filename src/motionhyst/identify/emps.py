@@ -84,9 +84,10 @@ mass-damper, fitted and scored with the 20-sample initialisation window), the Co
 with the force offset drifting in time from the record's start (``-drift``, ``identify
 --drift``).  Each one's mass on the whole of ``DATA_EMPS`` is within 3 % of the benchmark's 95.1
 kg (93.28-93.89 kg).  Other models are given by name (:func:`run_emps`'s `models`, ``benchmark
-emps --models``): ``jenkins-asymmetric-drift`` (92.15 kg, just below that band), and those with
-one viscous coefficient (``"coulomb"``, ``"jenkins"``, ``"jenkins-drift"``: 90.4-91.5 kg, the
-difference between the directions taken into the mass)."""
+emps --models``): ``jenkins-asymmetric-drift`` (its rigid limit on this record,
+``coulomb-asymmetric-drift``, :func:`~motionhyst.identify.emps_models.unresolved_stiffness`),
+and those with one viscous coefficient (``"coulomb"``, ``"jenkins"``, ``"jenkins-drift"``:
+90.4-91.5 kg, the difference between the directions taken into the mass)."""
 CHOSEN = "coulomb-asymmetric-drift"
 """The physical model whose test-record score is motionhyst's figure, chosen before the test by
 the rule of :func:`choose` on the two splits of ``DATA_EMPS``, among :data:`MODELS`: the

@@ -122,7 +122,7 @@ def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> s
     >>> jenkins(3e7, 1e6) is None   # 89 Hz
     True
     >>> jenkins(8.6e8, 2.8e8)
-    'its stuck mode at 479 Hz (k 8.6e+08 N/m), above 1000 Hz / 4: the record does not resolve it'
+    'its stuck mode at 479 Hz with k 8.6e+08 N/m, above 1000 Hz / 4: the record does not ...'
     >>> jenkins(9.4e9, None)
     'k 9.4e+09 N/m, not determined by the record'
     """
@@ -134,7 +134,7 @@ def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> s
     mode = float(np.sqrt(max(k, 0.0) / parameters["m"]) / (2 * np.pi))
     if mode <= fs / STUCK_MODE_SAMPLES:
         return None
-    return (f"its stuck mode at {mode:.0f} Hz (k {k:.2g} N/m), above {fs:.0f} Hz / "
+    return (f"its stuck mode at {mode:.0f} Hz with k {k:.2g} N/m, above {fs:.0f} Hz / "
             f"{STUCK_MODE_SAMPLES}: the record does not resolve it")
 
 
