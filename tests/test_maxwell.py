@@ -13,6 +13,7 @@ from motionhyst.hysteresis import Jenkins, MaxwellSlip
 from motionhyst.hysteresis.periodic import (
     stop_harmonics_base,
     stop_harmonics_update,
+    stop_periodic_harmonics,
     stop_twiddles,
 )
 from motionhyst.scenario import hysteresis_from_dict
@@ -567,3 +568,22 @@ def test_samples_of_an_input_without_even_harmonics_in_half_the_transform(M, n):
     half = _fft.synthesize_odd(X, n, tw)
     assert_allclose(half, whole, rtol=0, atol=4e-15 * np.sum(np.abs(X)))  # |x| <= 2 sum |X_m|
     assert_array_equal(half[n // 2:], -half[: n // 2])
+
+
+@pytest.mark.parametrize("A", [0.003, 0.05, 0.5])
+def test_a_sines_output_to_the_first_iterations_accuracy_from_the_stiffness_jumps_alone(A):
+    """For the fixed point's first iteration (a sine, asked to 1e-10) the sums of the jumps
+    of ``g`` come from those of ``s`` (``g`` jumps by ``-js x`` at a slip onset): the output
+    equals the one computed in full to that accuracy, some elements slipping or all."""
+    u = np.geomspace(1e-5, 0.02, 400)
+    k = np.random.default_rng(3).uniform(0.5, 2.0, 400)
+    fc = k * u
+    H = 120
+    X = np.array([0.0, A / 2j * np.exp(0.7j)])
+    exact = stop_periodic_harmonics(X, k, fc, H)
+    grid = np.zeros(2, dtype=np.int64)
+    loose = stop_harmonics_base(X, k, fc, H, stop_twiddles(1, H), np.empty((0, 0)), grid, H,
+                                1e-10)[0]
+    assert grid[0] > 0  # binned
+    assert_allclose(loose, exact, rtol=0, atol=1e-10 * A * np.sum(k))
+    assert abs(exact[3]) > 1e-6 * abs(exact[1])  # the elements slip

@@ -54,6 +54,11 @@ _TWO_PI = 2.0 * np.pi
 #: the order of the change squared (1e-20 of it); an element that begins to slip right at
 #: the reversal adds at most the change to the power 1.5 times its share of the stiffness.
 LINEAR_CHANGE = 1e-10
+#: Smallest accuracy asked of a sine's output (relative to the sums of the jumps' moduli) for
+#: which the sums of the jumps of ``g`` come from those of ``s`` (:func:`_binned_series`):
+#: their round-off, up to 1e-14 where ``g``'s sums cancel (every element slips), is then
+#: far below what is asked (the fixed point's first iteration asks 1e-10).
+SINE_TOL = 1e-12
 
 
 @njit(cache=True)
@@ -190,7 +195,8 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
                 x = synthesize_odd(Xs, n, tw) if symmetric else synthesize(Xs, n, tw)
     half = symmetric and monotone
     top = 1 if xr[1] > xr[0] else 0
-    if half and mode == GRID_CUBIC and M == 1:  # a sine: the onsets in closed form
+    sine = half and mode == GRID_CUBIC and M == 1
+    if sine:  # the onsets in closed form
         t_b, jg, js, g_mean, s_mean = half_sine_pieces(rev[top], xr[top], k, fc)
     elif half and mode == GRID_CUBIC:
         t_b, jg, js, g_mean, s_mean = half_cubic_pieces(x, rev[top], xr[top], k, fc)
@@ -207,7 +213,8 @@ def stop_harmonics_base(X, k, fc, H, tw, table, grid, q_grid, tol):  # pragma: n
             tail += abs(Xs[m])
         tol_rest = min(tol * total / tail, 1e-3) if tail > 0.0 else 1e-3
         G, S, table, moments = _binned_series(t_b, jg, js, H, Q, max(Q, q_grid), half, tw,
-                                              table, grid, max(tol, tol_rest), tol)
+                                              table, grid, max(tol, tol_rest), tol,
+                                              xr[top] if sine and tol >= SINE_TOL else 0.0)
     elif half:
         G, S = jump_series_half(t_b, jg, js, H, Q)
     else:
@@ -325,8 +332,8 @@ def _add_convolution(A, S, Y, step, W):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
-                   tol_full):  # pragma: no cover - compiled
+def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol, tol_full,
+                   x_sine):  # pragma: no cover - compiled
     """:func:`jump_series` of many jumps, binned (:func:`jump_sums_binned`) on the grid for
     harmonics up to `q_grid` (>= `Q`), to `tol` of the sums of the weights' moduli (those up
     to ``H + 1`` to ``tol_full``), with the weights' `table` of the grid ``grid = [N, P]``
@@ -338,6 +345,13 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
     jumps alone on half the grid (:func:`half_grid_sums`; the moments of `js` and `jg`
     together, :func:`chebyshev_moments` with ``shift = N``, returned as well).  Returns
     ``G``, ``S``, the table and those moments (none without `half`).
+
+    With `x_sine` > 0 the input is the sine ``x = x_sine cos(theta - a)``, ``a`` the angle
+    of the last jump (the reversal, :func:`half_sine_pieces`): at each slip onset before it
+    ``g`` jumps by ``-js x`` (``w = g + s x`` is continuous there), so that the sums of `jg`
+    at odd ``q`` are ``-x_sine / 2`` times those of `js` at ``q - 1`` and ``q + 1``, turned
+    by ``exp(-+j a)``, plus the reversal's own: only the moments of `js` are binned (those
+    returned).
     """
     nb = t_b.shape[0]
     n_points = 2 * nb if half else nb
@@ -348,6 +362,21 @@ def _binned_series(t_b, jg, js, H, Q, q_grid, half, tw, table, grid, tol,
         grid[1] = P
     G = np.zeros(H + 1, dtype=np.complex128)
     S = np.zeros(Q + 1, dtype=np.complex128)
+    if half and x_sine > 0.0:
+        alone = chebyshev_moments(t_b, js, js, N - N, N, P)
+        Zs = half_grid_sums(alone, N - N, N < 0, Q, N, P, table, tw)  # q <= H + 1 = Q
+        for q in range(2, Q + 1, 2):
+            S[q] = Zs[q] * (-2j / (_TWO_PI * q))
+        last = nb - 1
+        a = t_b[last]
+        turn = complex(np.cos(a), -np.sin(a))  # exp(-j a)
+        # the reversal's jump of g less what the onsets' rule gives it
+        extra = jg[last] + x_sine * js[last]
+        for q in range(1, H + 1, 2):
+            sums = extra * complex(np.cos(q * a), -np.sin(q * a)) - 0.5 * x_sine * (
+                turn * Zs[q - 1] + turn.conjugate() * Zs[q + 1])
+            G[q] = sums * (-2j / (_TWO_PI * q))
+        return G, S, table, alone
     if half:
         pair = chebyshev_moments(t_b, js, jg, N, N, P)
         # (the row and the flag as values, not literals: one compiled version serves all)
