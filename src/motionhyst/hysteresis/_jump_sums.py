@@ -267,7 +267,7 @@ def binned_table(N, P, L):  # pragma: no cover - compiled
     return table
 
 
-@njit(cache=True, fastmath={"contract"})
+@njit(cache=True)
 def chebyshev_moments(t_b, w_plus, w_minus, shift, N, P):  # pragma: no cover - compiled
     """The moments ``sum_b w_b T_p(v_b)`` of the points `t_b` (angles in ``[-2 pi, 4 pi)``)
     binned to the nearest of ``N`` grid points ``c_j`` (``t_b = c_j + v_b h / 2``, ``|v_b|
@@ -277,8 +277,8 @@ def chebyshev_moments(t_b, w_plus, w_minus, shift, N, P):  # pragma: no cover - 
     points: ``0``, none; ``N / 2``, the mirrors of the points half a period on (``N / 2``
     grid points on, the same ``v_b``); ``N``, the points' own moments of `w_minus` in rows
     ``N + j`` (``2 N`` rows).  The polynomials of four points at a time come from four
-    interleaved Chebyshev recurrences (each step a multiplication and an addition fused,
-    where the machine has FMA: the recurrences' latency bounds the kernel).
+    interleaved Chebyshev recurrences (a multiplication and an addition each step, not
+    fused: the same numbers on every machine, whatever its FMA).
     """
     nb = t_b.shape[0]
     width = (P + 7) // 8 * 8
