@@ -268,6 +268,14 @@ def test_parameters_are_read_only_and_the_slip_order_is_kept_whatever_the_caller
     assert_array_equal(link.periodic_stops()[0], [4.0, 2.0, 1.0])
     assert_array_equal(link.periodic_stops()[1], [0.2, 0.5, 1.0])
     assert_array_equal(link.k, [1.0, 2.0, 4.0])  # the link's own order
+    k, fc = np.array([1.0, 2.0]), np.array([1.0, 0.5])
+    link = MaxwellSlip(k, fc)
+    link.periodic_stops()
+    k[:] = [100.0, 200.0]  # the caller's arrays, written after: not the link's
+    fc[:] = 9.0
+    assert_array_equal(link.k, [1.0, 2.0])
+    assert link.initial_stiffness == 3.0
+    assert_array_equal(link.periodic_stops()[0], [2.0, 1.0])
 
 
 def test_many_elements_steady_state_is_the_same_whatever_came_before():

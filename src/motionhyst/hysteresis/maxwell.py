@@ -55,8 +55,9 @@ class MaxwellSlip(Hysteresis):
 
     def __init__(self, k: ArrayLike, fc: ArrayLike) -> None:
         super().__init__()
-        k_arr = np.atleast_1d(np.asarray(k, dtype=float))
-        fc_arr = np.atleast_1d(np.asarray(fc, dtype=float))
+        # copies: the caller's arrays, written later, must not change the link
+        k_arr = np.array(k, dtype=float, ndmin=1)
+        fc_arr = np.array(fc, dtype=float, ndmin=1)
         if k_arr.ndim != 1 or k_arr.size == 0:
             raise ValueError("k must be a non-empty list")
         if k_arr.shape != fc_arr.shape:
