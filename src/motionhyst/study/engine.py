@@ -50,9 +50,15 @@ DASK_PROFILED = False
 (on by default, ``distributed.worker.profile``) takes the stack of every thread running a
 task every 10 ms of wall time, about 3 % of the pool's CPU time for a study's batches on two
 idle cores (more on a loaded machine, where a batch lasts longer), for a figure of where the
-time goes that a study does not need; so a batch hides its thread from it while it runs (the
-dashboard's profile and call stack show no study work then; the worker's other tasks are
-sampled as before).  True, set in the client's process, leaves the batches sampled."""
+time goes that a study does not need; so a batch hides its thread from it while it runs: out
+of the worker's ``active_threads``, which the profiler samples, put back when the batch ends.
+dask's other readers of that table lose the thread as well while the batch runs: the
+dashboard's profile, ``Client.call_stack()`` (empty for a running batch: a batch that hangs
+is diagnosed with ``DASK_PROFILED = True``) and ``distributed.get_worker().get_current_task()``
+(a ``KeyError`` inside the batch; no code of motionhyst calls it there); the worker's other
+tasks are sampled as before.  ``tests/test_study_dask.py`` checks the hiding on a real
+cluster of the installed distributed version.  True, set in the client's process, leaves the
+batches sampled."""
 
 # why a point failed (motionhyst.study.store.REASONS)
 _LOOP, _CONVERGE, _OUTPUT, _NUMERIC = 1, 2, 3, 4
