@@ -207,3 +207,44 @@ def test_the_frequency_range_bounds_are_taken_and_the_library_refuses_too():
         analyze(loop, 0.01, [5.0, 1e-4])
     with pytest.raises(ValueError, match="decades above the loop's fastest"):
         compare_with_describing_function(loop, 0.01, [1e5])
+
+
+def test_a_force_without_loops_that_no_line_describes_is_refused_before_the_fit(tmp_path):
+    """A saturating spring (no hysteresis, not a line): Maxwell-slip elements cannot describe
+    it, which the fit found after its work (1.4 s of CPU); the record shows it at once.
+    With --elements and no --save the fit is reported, its error with it, as before."""
+    t = np.arange(600) / 750
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    w = np.clip(20.0 * x, -0.01, 0.01)
+    np.savetxt(tmp_path / "clip.csv", np.column_stack([t, x, w]), delimiter=",",
+               header="time,displacement,force", comments="")
+    proc = _run(["identify", "clip.csv", "--save", "m.toml"], tmp_path)
+    assert proc.returncode == 2 and proc.stdout == "" and "Traceback" not in proc.stderr
+    assert proc.stderr.count("\n") == 1
+    assert "clip.csv: the force is a curve of the displacement alone" in proc.stderr
+    assert "Maxwell-slip elements are a straight line until one slips" in proc.stderr
+    assert not (tmp_path / "m.toml").exists()
+    proc = _run(["identify", "clip.csv", "--elements", "2"], tmp_path)
+    assert proc.returncode == 0 and "22.3 % of the force RMS" in proc.stdout
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.02])
+def test_records_with_loops_are_never_refused_as_curves(noise):
+    """Maxwell-slip's own records (a Jenkins element slipping a little or much, three
+    elements under a decaying amplitude), Dahl's, and a stiffening spring within what a fit
+    may leave: each goes to its fit."""
+    from motionhyst.hysteresis import Dahl, Jenkins, MaxwellSlip
+    from motionhyst.identify.records import check_loops_open
+
+    rng = np.random.default_rng(1)
+    t = np.arange(3000) / 750
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    env = np.concatenate([np.geomspace(1e-4, 1e-3, 1500), np.geomspace(1e-3, 1e-4, 1500)])
+    cases = [(x, Jenkins(k=20.0, fc=z * 0.02).response(x)) for z in (0.99, 0.9, 0.5, 0.1)]
+    cases += [(env * np.sin(2 * np.pi * 3 * t),
+               MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.002, 0.005, 0.01]).response(
+                   env * np.sin(2 * np.pi * 3 * t))),
+              (x, Dahl(k=20.0, fc=0.01).response(x)),
+              (x, 20.0 * x + 3e6 * x ** 3)]                  # 3.4 % from a line: the fit's
+    for xx, w in cases:
+        check_loops_open(xx, w + noise * np.std(w) * rng.standard_normal(w.size))

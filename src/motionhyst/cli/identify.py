@@ -179,7 +179,11 @@ def run(args: argparse.Namespace) -> int:
                          f"[plant]); there is no default plant")
     # the record is read and checked by its light reader; the fit engines (python-control,
     # matplotlib, scipy.optimize) are imported once the options and the record are checked
-    from motionhyst.identify.records import load_closed_loop_csv, load_force_displacement_csv
+    from motionhyst.identify.records import (
+        check_loops_open,
+        load_closed_loop_csv,
+        load_force_displacement_csv,
+    )
 
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
@@ -187,6 +191,11 @@ def run(args: argparse.Namespace) -> int:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
     share = 0.0  # a force-displacement fit's systematic error, as a share of the force's RMS
     if kind == "force-displacement":
+        if args.elements is None or target is not None:  # refused, not reported: at once
+            try:
+                check_loops_open(x, w)
+            except ValueError as exc:
+                raise ValueError(f"{path}: {exc}") from None
         from motionhyst.identify.fit import identify_maxwell_slip
 
         what = "force-displacement record"

@@ -10,7 +10,8 @@ from motionhyst.core.compiled import njit
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
-__all__ = ["count_reversals", "load_closed_loop_csv", "load_force_displacement_csv"]
+__all__ = ["ELASTIC_CURVE_RATIO", "check_loops_open", "count_reversals", "load_closed_loop_csv",
+           "load_force_displacement_csv"]
 
 MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
@@ -127,6 +128,76 @@ def check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
         raise ValueError(f"constant {xname}: nothing to identify from")
     if not _reverses(x):
         raise ValueError(f"no reversal: the {xname} must move back and forth at least once")
+
+
+#: A force-displacement record whose force a curve of the displacement alone describes to this
+#: fraction of a straight line's systematic error has no loops for Maxwell-slip elements
+ELASTIC_CURVE_RATIO = 0.1
+#: ... where the line's systematic error is this many times what a fit may leave
+#: (:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`): a small curvature is left to the
+#: fit, which may describe it within its bound
+ELASTIC_CURVE_FACTOR = 3.0
+#: Degree of the Chebyshev series in the displacement that stands for "a curve"
+ELASTIC_CURVE_DEGREE = 15
+
+
+def check_loops_open(x: ArrayLike, w: ArrayLike) -> None:
+    """Refuse, before any fit, a force-displacement record that no Maxwell-slip elements can
+    describe because it has no hysteresis but is not a line.
+
+    Maxwell-slip elements (Jenkins elements in parallel, paper eq. 3) are one straight line
+    until one of them slips, and a slipping element opens a loop: the force then depends
+    on the way the displacement came.  A force that is a curve of the displacement alone
+    (a saturating or stiffening spring) is neither: a straight line leaves a systematic
+    error (:func:`~motionhyst.identify.io_checks.systematic_share`) of more than
+    :data:`ELASTIC_CURVE_FACTOR` times what a fit may leave, while a curve in the
+    displacement (a Chebyshev series of degree :data:`ELASTIC_CURVE_DEGREE`) leaves less
+    than :data:`ELASTIC_CURVE_RATIO` of the line's.  The fit would end in the same refusal
+    after its work (seconds); a record with loops (Maxwell-slip's own: the curve leaves
+    about what the line does) is never refused here.
+
+    Parameters
+    ----------
+    x, w : array_like
+        The record's displacement and force (checked by :func:`check_signals`).
+
+    Raises
+    ------
+    ValueError
+        One line naming both shares.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = 1e-3 * np.sin(np.linspace(0.0, 8 * np.pi, 2000))
+    >>> check_loops_open(x, 20.0 * x)                      # a line: the fit decides
+    >>> check_loops_open(x, np.clip(20.0 * x, -0.01, 0.01))
+    Traceback (most recent call last):
+    ...
+    ValueError: the force is a curve of the displacement alone (a curve leaves 0.71 % of its \
+RMS, a straight line 23 %): Maxwell-slip elements are a straight line until one slips and a \
+slip opens a loop, so none describes it (a spring that saturates or stiffens, not \
+hysteresis); nothing identified
+    """
+    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, systematic_share
+
+    x, w = np.asarray(x, dtype=float), np.asarray(w, dtype=float)
+    span = float(np.ptp(x))
+    if x.size <= ELASTIC_CURVE_DEGREE + 1 or not span > 0:
+        return
+    u = 2.0 * (x - float(np.min(x))) / span - 1.0
+    shares = []
+    for basis in (np.column_stack([np.ones_like(u), u]),
+                  np.polynomial.chebyshev.chebvander(u, ELASTIC_CURVE_DEGREE)):
+        coef = np.linalg.lstsq(basis, w, rcond=None)[0]
+        shares.append(systematic_share(w - basis @ coef, w))
+    line, curve = shares
+    if line > ELASTIC_CURVE_FACTOR * SYSTEMATIC_SHARE and curve < ELASTIC_CURVE_RATIO * line:
+        raise ValueError(f"the force is a curve of the displacement alone (a curve leaves "
+                         f"{100 * curve:.2g} % of its RMS, a straight line {100 * line:.2g} %): "
+                         f"Maxwell-slip elements are a straight line until one slips and a "
+                         f"slip opens a loop, so none describes it (a spring that saturates "
+                         f"or stiffens, not hysteresis); nothing identified")
 
 
 def _load(source: Source, names: tuple[str, str, str], xname: str, columns=None, scale=None):
