@@ -4,7 +4,7 @@ Each case is a command line that motionhyst refuses (exit 2, one line on stderr)
 for each way a refusal comes: an argument, a scenario's value, an option against the
 scenario, an output, a file, a record, the size of a run, an open-loop scenario where a
 loop is needed, an unstable controller (lead-lag, sampled at 10 kHz, PID), a frequency
-the loop cannot mean (decades above its fastest pole, or below f*) and a run whose step
+the loop cannot mean (decades above its fastest pole) and a run whose step
 the loop's poles set (from the scenario's coefficients, before python-control builds
 the loop), a list of a million values, a constant force, an input-output record without
 inertia (its inverse-dynamics estimate), a force that is a curve of the displacement
@@ -96,7 +96,6 @@ CASES = [
     ("record column", ["identify", "io-missing.csv", "--record", "input-output"], "checks"),
     ("text .mat", ["predict", "open.toml", "f.mat", "--out", "p.csv"], "checks"),
     ("frequency far above", ["steady", "s.toml", "--frequency", "1e9"], "checks"),
-    ("frequency far below", ["analyze", "s.toml", "--frequency", "1e-30"], "checks"),
     ("open loop", ["stability", "open.toml"], "checks"),
     ("unstable loop", ["steady", "unstable.toml"], "checks"),
     ("unstable sampled loop", ["steady", "unstable-10k.toml"], "checks"),

@@ -286,19 +286,15 @@ def scenario_frequencies(sc, given: Sequence[float] | None, command: str) -> lis
     command : str
         The command's name, for the message.
     """
-    from motionhyst.analysis.plausibility import check_frequencies, f_star_of
+    from motionhyst.analysis.plausibility import check_frequencies
 
     freqs = list(given) if given else sc.frequencies  # an open-loop system is refused here
     fastest = sc.fastest_pole()  # an unstable loop is refused here; None: not known yet
     rate = getattr(sc.model.controller, "sample_rate_hz", None)
     if sc.model.stage is None or (fastest is None and rate is None):
         return freqs  # the loop's own check (analyze, steady) decides once it is built
-    link = sc.hysteresis()
-    mass = getattr(sc.plant(), "M", None)
     try:
-        check_frequencies(freqs, None if link is None else f_star_of(link.initial_stiffness,
-                                                                     mass),
-                          None if fastest is None else fastest / (2 * math.pi), rate)
+        check_frequencies(freqs, None if fastest is None else fastest / (2 * math.pi), rate)
     except ValueError as exc:
         where = "--frequency" if given else f"{sc.source}: [reference] frequencies:"
         raise UsageError(f"motionhyst {command}: {where} {exc}") from None
