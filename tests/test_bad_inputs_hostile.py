@@ -141,6 +141,9 @@ CASES += [
      ["study", "st.toml", "--out", "o.zarr", "--table", "old.png", "--figure", "old.png",
       "--force"], ["--figure old.png: also the --table file"]),
     # a file written into the store is not the study's (the store is replaced as a whole)
+    ("study-workers-with-a-scheduler", {},
+     ["study", "st.toml", "--out", "o.zarr", "--workers", "2", "--scheduler",
+      "tcp://127.0.0.1:8786"], ["--workers has no effect with --scheduler"]),
     ("study-summary-force-without-a-file", {}, ["study", "--summary", "o.zarr", "--force"],
      ["--force has no effect without --table, --netcdf or --figure"]),
     # the criterion chooses the number of elements: with --elements it chose nothing

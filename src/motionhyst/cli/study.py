@@ -91,6 +91,9 @@ def _check_options(args: argparse.Namespace) -> None:
 
         check_output_folder(args.out, "--out")
     _check_files(args)
+    if args.scheduler is not None and args.workers is not None and args.summary is None:
+        raise UsageError("study: --workers has no effect with --scheduler (the cluster's "
+                         "workers compute the points)")
     if args.scheduler is not None and not args.estimate and args.summary is None:
         _check_reachable(args.scheduler)
 
