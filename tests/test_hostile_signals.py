@@ -97,3 +97,46 @@ def test_an_interrupt_while_a_study_makes_its_exports_leaves_every_old_file(tmp_
     assert (tmp_path / "t.nc").read_text() == "old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "s.zarr", "st.toml",
                                                           "t.csv", "t.nc"]
+
+
+def test_a_signal_at_any_moment_of_a_long_prediction_is_130_or_a_finished_run(tmp_path):
+    """Whenever it comes (at fractions of the run's own time, measured first): exit 130 with
+    one line and the old file as it was, or (too late) exit 0 with the new file; never a
+    crash (a signal while the kernel ran gave a segmentation fault), a traceback or a
+    temporary file left."""
+    import signal
+    import time
+
+    import limited_process
+    import numpy as np
+    from file_trees import snapshot
+
+    t = np.arange(200_000) / 750.0
+    np.savetxt(tmp_path / "f.csv", np.column_stack([t, np.sin(t * 75.0)]), delimiter=",",
+               header="time,force", comments="", fmt="%.9g")
+    (tmp_path / "m.toml").write_text('[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\n'
+                                     'k = 5e4\n\n[hysteresis]\nmodel = "jenkins"\nk = 100.0\n'
+                                     'fc = 1.0\n')
+    argv = ["predict", "m.toml", "f.csv", "--out", "p.csv", "--force"]
+    start = time.monotonic()
+    code, _, err = limited_process.run(argv, tmp_path)
+    whole = time.monotonic() - start
+    assert code == 0, err
+    for fraction, name in ((0.4, "SIGINT"), (0.65, "SIGTERM"), (0.85, "SIGINT")):
+        (tmp_path / "p.csv").write_text("old\n")
+        before = snapshot(tmp_path)
+        proc = limited_process.popen(argv, tmp_path)
+        try:
+            proc.wait(timeout=fraction * whole)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(getattr(signal, name))
+        _, err = proc.communicate(timeout=300)
+        err = err.decode()
+        assert "Traceback" not in err and "Fatal Python" not in err, err
+        assert proc.returncode in (0, 130), (fraction, proc.returncode, err)
+        if proc.returncode == 130:
+            assert err.strip().splitlines() == ["motionhyst: interrupted"], err
+            assert snapshot(tmp_path) == before
+        else:
+            assert (tmp_path / "p.csv").read_text().startswith("time,displacement")
+            assert sorted(p.name for p in tmp_path.iterdir()) == ["f.csv", "m.toml", "p.csv"]
