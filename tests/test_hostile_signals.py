@@ -69,6 +69,33 @@ def test_a_noted_signal_is_raised_by_the_next_kernel_call_and_only_once():
     assert total(np.ones(3)) == 3.0
 
 
+def test_a_noted_signal_is_left_to_the_main_thread_by_a_kernel_on_another():
+    """identify runs kernels on pool threads: one of them must not take the interrupt."""
+    import threading
+
+    import numpy as np
+
+    from motionhyst.core.compiled import njit
+    from motionhyst.core.interrupts import DEFERRED, defer
+
+    @njit
+    def total(x):
+        return x.sum()
+
+    assert total(np.ones(2)) == 2.0
+    defer("SIGINT")
+    try:
+        results = []
+        worker = threading.Thread(target=lambda: results.append(total(np.ones(4))))
+        worker.start()
+        worker.join()
+        assert results == [4.0] and DEFERRED == ["SIGINT"]
+        with pytest.raises(KeyboardInterrupt, match="SIGINT"):
+            total(np.ones(3))
+    finally:
+        DEFERRED.clear()
+
+
 def test_an_interrupt_while_a_study_makes_its_exports_leaves_every_old_file(tmp_path,
                                                                              monkeypatch,
                                                                              capsys):

@@ -9,7 +9,7 @@ A signal whose handler would raise while numba runs its own Python code (a kerne
 compiled wrapper unpickles an array's type as it boxes the results of a kernel returning
 several arrays) must not raise there: numba would hand back a tuple with an item missing,
 and the caller crash with a segmentation fault.  The handler notes it instead
-(:func:`defer`) and the kernel's call raises it once numba has returned
+(:func:`defer`) and the main thread's next kernel call raises it once numba has returned
 (:func:`raise_deferred`, from :class:`motionhyst.core.compiled.Kernel`).
 
 Examples
@@ -27,6 +27,8 @@ False
 """
 
 from __future__ import annotations
+
+import threading
 
 __all__ = ["DEFERRED", "defer", "in_numba", "interrupted", "raise_deferred"]
 
@@ -101,11 +103,15 @@ def defer(name: str) -> None:
 def raise_deferred() -> None:
     """Raise the first signal :func:`defer` noted as ``KeyboardInterrupt`` (none: return).
 
+    Only in the main thread, where Python runs signal handlers: a kernel called on a worker
+    thread (identify's thread pools) leaves the signal to the main thread's next kernel call
+    (or to the handler's sending it again).
+
     Examples
     --------
     >>> raise_deferred()        # nothing noted
     """
-    if DEFERRED:
+    if DEFERRED and threading.current_thread() is threading.main_thread():
         name = DEFERRED[0]
         DEFERRED.clear()
         raise KeyboardInterrupt(name)
