@@ -672,8 +672,8 @@ def test_a_scheduler_address_without_a_dask_scheduler_is_refused_in_one_line(tmp
 
         threading.Thread(target=serve, daemon=True).start()
     try:
-        line = limited_process.refusal(["study", "st.toml", "--out", "o.zarr", "--workers", "0",
-                                        "--scheduler", f"tcp://127.0.0.1:{port}"], root)
+        line = limited_process.refusal(["study", "st.toml", "--out", "o.zarr", "--scheduler",
+                                        f"tcp://127.0.0.1:{port}"], root)
     finally:
         if server is not None:
             server.close()
