@@ -60,6 +60,16 @@ def test_an_undetermined_parameter_leaves_what_it_enters_undetermined():
     assert ref["c"] == 200.0 and ref["offset"] == -3.0
 
 
+def test_a_maxwell_slip_links_slip_forces_together_are_its_coulomb_force():
+    own = {"m": 94.0, "c": 200.0, "k[0]": 1e6, "k[1]": 3e6, "fc[0]": 12.0, "fc[1]": 9.0,
+           "offset": -3.1}
+    std = {"m": 0.1, "c": 1.0, "k[0]": 1e4, "k[1]": 3e4, "fc[0]": 0.3, "fc[1]": 0.4,
+           "offset": 0.02}
+    ref, ref_std = reference_form(own, _record(), std)
+    assert ref == {"m": 94.0, "c": 200.0, "fc": 21.0, "offset": -3.1, "k[0]": 1e6, "k[1]": 3e6}
+    assert ref_std["fc"] == pytest.approx(0.5) and ref_std["k[1]"] == 3e4
+
+
 def test_benchmark_lists_an_asymmetric_model_as_the_reference_sees_it():
     """An axis whose viscous friction is larger backward, with no force offset (EMPS's, as
     the benchmark's eq. 12 describes it), moved alike both ways as a loop moves it: the

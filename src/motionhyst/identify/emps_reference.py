@@ -170,7 +170,9 @@ def _weights(parameters: dict, record: IORecord) -> dict[str, dict[str, float]]:
     """Each of the reference model's parameters as a weighted sum of a model's (linear)."""
     v = np.gradient(record.y, record.t)
     mean_speed, mean_t = float(np.mean(np.abs(v))), float(np.mean(record.t))
-    fc = {"fc": 1.0} if "fc" in parameters else {"fc_pos": 0.5, "fc_neg": 0.5}
+    elements = {name: 1.0 for name in parameters if name.startswith("fc[")}  # Maxwell-slip's
+    fc = ({"fc": 1.0} if "fc" in parameters else elements
+          or {"fc_pos": 0.5, "fc_neg": 0.5})
     offset = {"offset": 1.0, "fc_pos": 0.5, "fc_neg": -0.5, "drift": mean_t,
               "c_skew": mean_speed, "c_pos": 0.5 * mean_speed, "c_neg": -0.5 * mean_speed}
     return {"m": {"m": 1.0}, "c": {"c": 1.0, "c_pos": 0.5, "c_neg": 0.5}, "fc": fc,
@@ -187,7 +189,8 @@ def reference_form(parameters: dict, record: IORecord, std: dict | None = None,
     ``c_skew``), Coulomb forces by direction or a drifting offset is, on a record's
     motion, the reference model with ``c`` the odd part of its viscous friction
     (``c + (c_pos + c_neg)/2``), ``fc`` the mean of its Coulomb forces and ``offset`` the
-    constant offset the rest amounts to (:func:`equivalent_offset`).  The map is linear,
+    constant offset the rest amounts to (:func:`equivalent_offset`); a Maxwell-slip link's
+    ``fc`` is its elements' slip forces together (``fc[0] + fc[1] + ...``).  The map is linear,
     so each standard error follows from the model's covariance (the delta method, exact
     here): ``sqrt(w C w)`` with ``w`` the weights; None when a parameter that enters is not
     determined by the record.  Parameters the reference model has no place for (a Jenkins
