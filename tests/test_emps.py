@@ -187,8 +187,8 @@ def test_benchmark_emps_every_split(tmp_path, capsys, monkeypatch):
 def test_benchmark_emps_with_the_test_record_names_the_chosen_model(tmp_path, capsys,
                                                                    monkeypatch):
     """With the test record the JSON names the model chosen before the test, in the shape
-    the splits give it: {"name", "worse_split_rmse_mm"}, the figure it was chosen by; a list
-    without that model has no chosen one."""
+    {"name", "rule", "validation_rmse_mm"}: the rule it was chosen by on the splits, and its
+    RMSE on the test record measured in this run; a list without that model has no chosen one."""
     import motionhyst.identify.emps as emps
 
     rec = axis_record(n_periods=2)
@@ -200,7 +200,9 @@ def test_benchmark_emps_with_the_test_record_names_the_chosen_model(tmp_path, ca
     assert main(["benchmark", "emps", "--data", str(tmp_path), "--models", "coulomb",
                  "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["chosen"] == {"name": "coulomb", "worse_split_rmse_mm": emps.CHOSEN_WORSE_SPLIT_MM}
+    assert out["chosen"]["name"] == "coulomb"
+    assert "worse of the two splits" in out["chosen"]["rule"]
+    assert out["chosen"]["validation_rmse_mm"] == out["models"][0]["validation"]["rmse_mm"]
     assert [m["validation"]["record"] for m in out["models"]] == ["DATA_EMPS_PULSES"]
     monkeypatch.setattr(emps, "CHOSEN", "coulomb-drift")
     assert main(["benchmark", "emps", "--data", str(tmp_path), "--models", "coulomb",

@@ -124,7 +124,6 @@ def run_emps(args: argparse.Namespace) -> int:
     """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
     from motionhyst.identify.emps import (
         CHOSEN,
-        CHOSEN_WORSE_SPLIT_MM,
         ESTIMATION_FILE,
         TEST_FILE,
         choose,
@@ -181,16 +180,23 @@ def run_emps(args: argparse.Namespace) -> int:
     else:
         results = [run_emps(estimation, test, models=models, periods=args.periods or (1, 2),
                             progress=say)]
-    chosen = choose(results) if len(results) > 1 else None
-    if test is not None and CHOSEN in [m.name for m in results[0].models]:
-        chosen = (CHOSEN, CHOSEN_WORSE_SPLIT_MM)  # chosen on the splits, before the test
+    chosen = None
+    if len(results) > 1:
+        name, worst = choose(results)
+        chosen = {"name": name, "worse_split_rmse_mm": worst}
+    elif test is not None:  # chosen on the splits before the test; its score on the test here
+        scored = [m for m in results[0].models if m.name == CHOSEN]
+        if scored:
+            chosen = {"name": CHOSEN, "rule": "chosen before the test, by the smallest "
+                      "validation RMSE on the worse of the two splits of DATA_EMPS",
+                      "validation_rmse_mm": scored[0].validation["rmse_mm"]}
     if args.json:
         print_json({"models": [m for res in results for m in res.to_dict()["models"]],
-                    **({} if chosen is None else {"chosen": {"name": chosen[0],
-                                                             "worse_split_rmse_mm": chosen[1]}})})
+                    **({} if chosen is None else {"chosen": chosen})})
         return 0
     print("\n\n".join(str(res) for res in results))
     if chosen is not None and test is None:
+        worst_rmse = chosen["worse_split_rmse_mm"]
         two = len(results) == 2
         splits = "both splits" if two else f"the {len(results)} splits"
         worst = "worse" if two else "worst"
@@ -198,5 +204,5 @@ def run_emps(args: argparse.Namespace) -> int:
             f"{runs[0].name} {sum(m.validation['rmse_mm'] for m in runs) / len(runs):.3g} mm"
             for runs in zip(*(res.models for res in results), strict=True)))
         print(f"Chosen by the {worst} of {'the two splits' if two else splits} (the rule stated "
-              f"in advance): {chosen[0]}, {chosen[1]:.3g} mm on its {worst} split")
+              f"in advance): {chosen['name']}, {worst_rmse:.3g} mm on its {worst} split")
     return 0

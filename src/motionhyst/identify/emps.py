@@ -61,7 +61,7 @@ from motionhyst.identify.io_checks import MAX_PREDICT_SUBSTEPS, FitFailed
 from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
 from motionhyst.identify.io_start import inverse_dynamics
 
-__all__ = ["CHOSEN", "CHOSEN_WORSE_SPLIT_MM", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
+__all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
            "INIT_WINDOW", "MODELS", "PERIOD", "TEST_FILE", "EMPSBenchmark", "EMPSModel",
            "choose", "cross_validate", "own_offset_score", "period_drift", "run_emps", "score",
            "split_by_periods"]
@@ -93,9 +93,6 @@ CHOSEN = "coulomb-asymmetric-drift"
 the rule of :func:`choose` on the two splits of ``DATA_EMPS``, among :data:`MODELS`: the
 smallest worse-split validation RMSE, 4.48 mm (``coulomb-asymmetric`` 6.12 mm,
 ``jenkins-asymmetric`` 7.2 mm)."""
-CHOSEN_WORSE_SPLIT_MM = 4.48
-""":data:`CHOSEN`'s validation RMSE on the worse of the two splits when it was chosen [mm]
-(``benchmark emps`` without the test record: ``"chosen"`` in its JSON)."""
 
 
 def choose(runs: Sequence[EMPSBenchmark]) -> tuple[str, float]:
