@@ -172,3 +172,26 @@ def test_errors():
         identify_io([rec], plant="three-mass")
     with pytest.raises(ValueError, match="unknown output 'y3'"):
         identify_io([rec], plant="two-mass", output="y3")
+
+
+def test_a_single_mass_record_is_refused_for_a_two_mass_stage(tmp_path, capsys):
+    """A single mass's record fitted as a two-mass stage ran its whole search and exited 0
+    with the link's products not identifiable: its masses move as one (the internal mode
+    of the best linear fit far above the Nyquist frequency), refused in one line before
+    the search."""
+    from motionhyst.time.openloop import MassSpringDamper
+
+    single = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), BoucWen(k=5e4, fc=20.0, beta=0.6,
+                                                                 gamma=0.2))
+    t = np.arange(1536) / FS
+    u = _multisine(1536, 1)
+    rec = IORecord(t, u, single.simulate(t, u).displacement, "single.csv")
+    with pytest.raises(ValueError, match="the records show one mass, not two"):
+        best_linear_approximation_two_mass([rec], "y2", periodic=False)
+    data = tmp_path / "single.csv"
+    _write_csv(data, rec)
+    for model in ("bouc-wen", "jenkins"):
+        assert main(["identify", str(data), "--record", "input-output", "--plant", "two-mass",
+                     "--model", model]) == 2
+        out, err = capsys.readouterr()
+        assert out == "" and err.count("\n") == 1 and "--plant mass-spring-damper" in err

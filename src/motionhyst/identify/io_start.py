@@ -329,6 +329,14 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     k_link, c_link : float
         The link's linear stiffness [N/m] and damping [N s/m].
 
+    Raises
+    ------
+    ValueError
+        One line when the best fit's internal mode (``sqrt(k (m1 + m2) / (m1 m2))``) is
+        above the records' Nyquist frequency: their masses move as one, the records are
+        a single mass's (a two-mass fit would spend its search on parameters the records
+        do not determine).
+
     Examples
     --------
     >>> import numpy as np
@@ -387,6 +395,14 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
             best = sol
     sol = best
     m1, m2, b, k, kl, cl = np.exp(sol.x)
+    f_internal = math.sqrt(k * (m1 + m2) / (m1 * m2)) / (2 * math.pi)
+    nyquist = 0.5 * records[0].fs
+    if not f_internal < nyquist:  # the masses move as one within the records' band
+        names = records[0].name if len(records) == 1 else f"{records[0].name} and the others"
+        raise ValueError(f"{names}: the records show one mass, not two: the two-mass stage "
+                         f"that fits their frequency response best has its internal mode at "
+                         f"{f_internal:.3g} Hz, above their Nyquist frequency {nyquist:.3g} Hz; "
+                         f"identify a single mass (--plant mass-spring-damper or mass-damper)")
     return TwoMass(m1, m2, b, k, output), float(kl), float(cl)
 
 
