@@ -106,8 +106,11 @@ CASES = [
     ("asymmetric-on-a-spring", {}, [*IO, "--plant", "mass-spring-damper", "--model", "jenkins",
                                     "--asymmetric"],
      ["--asymmetric applies to --plant mass-damper"]),
-    ("asymmetric-bouc-wen", {}, [*IO, "--plant", "mass-damper", "--model", "bouc-wen",
-                                 "--asymmetric"], ["not bouc-wen"]),
+    ("asymmetric-bouc-wen-on-a-spring", {}, [*IO, "--plant", "mass-spring-damper", "--model",
+                                             "bouc-wen", "--asymmetric"],
+     ["--asymmetric applies to --plant mass-damper"]),
+    ("bouc-wen-nu-free-on-an-axis", {}, [*IO, "--plant", "mass-damper", "--model", "bouc-wen",
+                                         "--nu", "free"], ["the Bouc-Wen exponent is given"]),
     ("asymmetric-force-displacement", {"link.csv": _table(
         {"time": np.arange(200) / 100, "displacement": 0.01 * np.sin(np.arange(200) / 9),
          "force": np.sin(np.arange(200) / 9)})}, ["identify", "link.csv", "--asymmetric"],

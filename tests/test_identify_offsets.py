@@ -183,7 +183,8 @@ def test_asymmetric_viscous_friction_is_recovered():
     (["--init-window", "20", "--model", "bouc-wen"], "apply to the element links"),
     (["--offset", "both", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
      "estimates only their position offsets"),
-    (["--asymmetric", "--model", "bouc-wen"], "--asymmetric applies to --plant mass-damper"),
+    (["--asymmetric", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
+     "--asymmetric applies to --plant mass-damper"),
     (["--asymmetric", "--model", "coulomb", "--plant", "two-mass"],
      "--asymmetric applies to --plant mass-damper"),
     (["--asymmetric", "--model", "jenkins", "--periodic"], "applies to --model coulomb only"),
@@ -241,3 +242,99 @@ def test_reference_mass_only_where_the_linear_model_explains_the_force():
     u = 95.0 * np.gradient(v, t, edge_order=2) + 200.0 * v + 20.0 * np.sign(v) - 3.2
     assert reference_mass([IORecord(t, u, y)], floating=True) == pytest.approx(95.0, rel=1e-2)
     assert np.isnan(reference_mass([_axis_record(seed=1, noise=2e-5)], floating=True))
+
+
+def test_a_search_stopped_by_its_budget_says_so(tmp_path, capsys):
+    """A fit that stops on its budget of evaluations is kept when it is good, with one
+    warning line naming --max-evaluations (it exited 0 without a word)."""
+    from motionhyst.cli import main
+
+    rec = _axis_record()
+    with pytest.warns(UserWarning, match="--max-evaluations") as caught:
+        fit = identify_io([rec], "coulomb", plant="mass-damper", substeps=20,
+                          max_evaluations=30)
+    assert fit.extra["budget_reached"] is True
+    assert sum("budget of model evaluations" in str(w.message) for w in caught) == 1
+    assert fit.estimates["m"] == pytest.approx(TRUE["m"], rel=1e-3)
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+    assert main(["identify", str(path), "--record", "input-output", "--plant", "mass-damper",
+                 "--model", "coulomb", "--max-evaluations", "30"]) == 0
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if "budget of model evaluations" in line]
+    assert len(lines) == 1 and "--max-evaluations" in lines[0]
+
+
+def _bouc_wen_axis_record(n: int = 2500) -> IORecord:
+    """The axis of :func:`_axis_record` with a Bouc-Wen friction link (beta + gamma = 1:
+    its force saturates at fc when sliding)."""
+    from motionhyst.hysteresis import BoucWen
+
+    rec = _axis_record(n)
+    link = BoucWen(k=4e5, fc=TRUE["link.fc"], n=1.0, beta=0.8, gamma=0.2)
+    y, _ = simulate_elements(MassDamper(TRUE["m"], TRUE["c"]).mechanics(), link.time_stepping(),
+                             rec.u - TRUE["input_offset"], FS, 20, periodic=False,
+                             x0=np.array([0.0, TRUE["v0"]]))
+    return IORecord(rec.t, rec.u, y + TRUE["output_offset"], "bouc-wen axis")
+
+
+@pytest.mark.filterwarnings("error::motionhyst.core.warnings.MotionhystWarning")
+def test_bouc_wen_is_a_friction_link_on_a_mass_damper():
+    """On a positioning axis the Bouc-Wen link is identified as a friction link (it was
+    refused there): k, fc with beta + gamma = 1, the dissipation beta - gamma, with the
+    force and position offsets and the initial velocity; the saved model is the link."""
+    fit = identify_io([_bouc_wen_axis_record()], "bouc-wen", plant="mass-damper", substeps=20)
+    expected = {**TRUE, "link.k": 4e5, "link.dissipation": 0.6}
+    for name, value in expected.items():
+        assert fit.estimates[name] == pytest.approx(value, rel=1e-5, abs=1e-9), name
+        assert fit.std[name] is not None, name
+    saved = tomllib.loads(fit.scenario_text())
+    assert saved["stage"]["type"] == "mass-damper"
+    link = saved["hysteresis"]
+    assert link["model"] == "bouc-wen" and link["n"] == 1.0
+    assert link["beta"] == pytest.approx(0.8, rel=1e-5)
+    assert link["beta"] + link["gamma"] == pytest.approx(1.0, rel=1e-12)
+    with pytest.raises(ValueError, match="exponent is given"):
+        identify_io([_bouc_wen_axis_record(300)], "bouc-wen", plant="mass-damper", nu=None)
+
+
+def test_records_without_a_spring_are_identified_on_a_mass_damper(tmp_path, capsys):
+    """Without --plant, records from a start that show no spring (a positioning axis) are
+    fitted on a mass-damper, said in one line, with the force offset estimated (the
+    default mass-spring-damper took the force offset for a position offset); a stage on a
+    spring keeps the default, without a word."""
+    import json
+
+    from motionhyst.cli import main
+    from motionhyst.identify.io_checks import default_plant
+
+    rec = _axis_record()
+    assert default_plant([rec])[0] == "mass-damper"
+    spring = OpenLoop(MassSpringDamper(TRUE["m"], TRUE["c"], 2e4), Coulomb(fc=TRUE["link.fc"]))
+    held = IORecord(rec.t, rec.u, spring.simulate(rec.t, rec.u).displacement, "held")
+    assert default_plant([held]) == ("mass-spring-damper", None)
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+    assert main(["identify", str(path), "--record", "input-output", "--model", "coulomb",
+                 "--json"]) == 0
+    out, err = capsys.readouterr()
+    lines = [line for line in err.splitlines() if "show no spring" in line]
+    assert len(lines) == 1 and "--plant mass-damper" in lines[0]
+    result = json.loads(out)
+    assert result["plant"]["type"] == "mass-damper"
+    assert result["estimates"]["m"] == pytest.approx(TRUE["m"], rel=1e-4)
+    assert result["estimates"]["input_offset"] == pytest.approx(TRUE["input_offset"], rel=1e-4)
+
+
+def test_maxwell_slip_falls_back_to_the_elements_the_records_determine():
+    """A Coulomb axis fitted with Maxwell-slip elements: the records determine one stiff
+    element, not two (that fit was refused, so a measured axis got no mass); with
+    fewer_elements the fit is redone with one, said in one warning."""
+    with pytest.warns(UserWarning, match="Maxwell-slip elements: fitted with 1"):
+        fit = identify_io([_axis_record(1200)], "maxwell-slip", plant="mass-damper",
+                          substeps=20, n_elements=2, fewer_elements=True)
+    assert "link.k[1]" not in fit.estimates and fit.std["link.fc[0]"] is not None
+    assert fit.estimates["m"] == pytest.approx(TRUE["m"], rel=5e-3)
+    assert fit.estimates["link.fc[0]"] == pytest.approx(TRUE["link.fc"], rel=5e-3)

@@ -34,8 +34,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     from motionhyst.hysteresis import MODELS
 
     q.add_argument("--plant", choices=plant_choices(),
-                   help="input-output records: the stage's model (default mass-spring-damper; "
-                        "mass-damper: a positioning axis, no spring; two-mass: the floating "
+                   help="input-output records: the stage's model (default mass-spring-damper, "
+                        "or mass-damper for records from a start that show no spring, said on "
+                        "stderr; mass-damper: a positioning axis, no spring; two-mass: the "
+                        "floating "
                         "stage of eqs. 1-2, force and link on m1; quasi-static: no inertia "
                         "(piezo actuators, friction dampers), the link with a parallel spring "
                         "and damper, any --model)")
@@ -135,29 +137,33 @@ def run_input_output(args: argparse.Namespace) -> int:
         target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
         _check_savable_plant(plant)
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
-    if model == "bouc-wen" and plant != "quasi-static" and (
+    # on a mass-damper the Bouc-Wen link is a friction link, fitted as the element links
+    bouc_wen_own = model == "bouc-wen" and plant not in ("quasi-static", "mass-damper")
+    if args.nu == "free" and model == "bouc-wen" and plant == "mass-damper":
+        raise UsageError("motionhyst identify: on --plant mass-damper the Bouc-Wen exponent "
+                         "is given (--nu NU, default 1), not estimated")
+    if bouc_wen_own and (
             args.from_rest or args.init_window is not None
             or args.offset not in (None, "none", "auto", "output")
             or (args.offset == "output" and plant != "mass-spring-damper")):
         raise UsageError("motionhyst identify: --model bouc-wen starts its records at rest "
                          "and estimates only their position offsets (--offset output, on a "
                          "mass-spring-damper); --from-rest, --init-window and the force offset "
-                         "apply to the element links")
+                         "apply to the element links and to bouc-wen on --plant mass-damper")
     if args.init_window is not None and plant == "quasi-static":
         raise UsageError("motionhyst identify: --init-window sets a stage's state; a "
                          "quasi-static plant has none")
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
-    if args.asymmetric and (model == "bouc-wen" or plant != "mass-damper"):
-        raise UsageError("motionhyst identify: --asymmetric applies to --plant mass-damper "
-                         "with an element link (not bouc-wen)")
+    if args.asymmetric and plant != "mass-damper":
+        raise UsageError("motionhyst identify: --asymmetric applies to --plant mass-damper")
     if args.asymmetric and args.periodic and model != "coulomb":
         raise UsageError("motionhyst identify: --asymmetric with --periodic applies to --model "
                          "coulomb only (the stage's c_skew is run from a start)")
-    if args.drift and (model == "bouc-wen" or plant != "mass-damper" or args.periodic):
+    if args.drift and (plant != "mass-damper" or args.periodic):
         raise UsageError("motionhyst identify: --drift applies to records from a start on "
-                         "--plant mass-damper, with an element link")
+                         "--plant mass-damper")
     if args.periodic and args.from_rest:
         raise UsageError("motionhyst identify: --from-rest does not apply to --periodic records "
                          "(a steady state has no start)")
@@ -173,16 +179,25 @@ def run_input_output(args: argparse.Namespace) -> int:
         from motionhyst.identify.io_checks import check_inertia
 
         check_inertia(records)
+    if args.plant is None and not args.periodic:  # a positioning axis: no spring to fit
+        from motionhyst.core.warnings import warn
+        from motionhyst.identify.io_checks import default_plant
+
+        plant, note = default_plant(records)
+        if note is not None:
+            warn(note)
+        bouc_wen_own = model == "bouc-wen" and plant not in ("quasi-static", "mass-damper")
     from motionhyst.identify.input_output import MODELS, identify_io
 
     if model not in MODELS:
         raise UsageError(f"motionhyst identify: --model {model} is not available for "
                          f"input-output records; use {', '.join(MODELS)}")
     extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
-              if model == "bouc-wen" and plant != "quasi-static" else
+              if bouc_wen_own else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
-               "asymmetric": args.asymmetric, "drift": args.drift})
+               "asymmetric": args.asymmetric, "drift": args.drift,
+               "fewer_elements": args.elements is None})
     from motionhyst.hysteresis import model_class
 
     with search_budget():
@@ -199,7 +214,7 @@ def run_input_output(args: argparse.Namespace) -> int:
         print_json(result)
         return 0
     kind = ("periodic steady state" if fit.periodic else "from rest"
-            if args.from_rest or model == "bouc-wen"
+            if args.from_rest or bouc_wen_own
             else f"state set from the first {args.init_window} samples"
             if args.init_window is not None else "initial state estimated")
     stage = (f"Two-mass stage ({args.output or 'y2'} measured)" if plant == "two-mass"

@@ -76,6 +76,8 @@ io_bouc_wen
     The Bouc-Wen link: starts, screening, refinement.
 io_elements
     The registry's other links.
+io_friction
+    The Bouc-Wen and LuGre links as a positioning axis's friction, in their search's spellings.
 io_uncertainty
     Standard errors and what the records do not determine.
 io_results
@@ -90,7 +92,7 @@ import numpy as np
 
 from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import MODELS as REGISTERED
-from motionhyst.hysteresis import BoucWen, Coulomb, Hysteresis, model_class
+from motionhyst.hysteresis import BoucWen, Coulomb, Hysteresis, LuGre, MaxwellSlip, model_class
 from motionhyst.identify.io_bouc_wen import BASIC_STARTS as BASIC_STARTS
 from motionhyst.identify.io_bouc_wen import FINAL_ATTEMPTS as FINAL_ATTEMPTS
 from motionhyst.identify.io_bouc_wen import START_PRODUCTS as START_PRODUCTS
@@ -98,11 +100,17 @@ from motionhyst.identify.io_bouc_wen import START_RATIOS as START_RATIOS
 from motionhyst.identify.io_bouc_wen import START_REFINED as START_REFINED
 from motionhyst.identify.io_bouc_wen import START_SHARES as START_SHARES
 from motionhyst.identify.io_bouc_wen import identify_bouc_wen_msd, identify_bouc_wen_two_mass
-from motionhyst.identify.io_checks import check_inertia, viscous_direction_note
+from motionhyst.identify.io_checks import (
+    FitFailed,
+    budget_note,
+    check_inertia,
+    viscous_direction_note,
+)
 from motionhyst.identify.io_elements import PROFILE_CHI2 as PROFILE_CHI2
 from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
 from motionhyst.identify.io_elements import identify_elements_io
+from motionhyst.identify.io_friction import bouc_wen_friction, lugre_stribeck
 from motionhyst.identify.io_records import MIN_SAMPLES as MIN_SAMPLES
 from motionhyst.identify.io_records import IORecord, check_records
 from motionhyst.identify.io_records import load_io_csv as load_io_csv
@@ -113,7 +121,12 @@ from motionhyst.identify.io_start import (
     best_linear_approximation_two_mass as best_linear_approximation_two_mass,
 )
 from motionhyst.identify.io_start import two_mass_response as two_mass_response
-from motionhyst.identify.io_uncertainty import BOUC_WEN_SCALE, judge_determined, zero_allowed
+from motionhyst.identify.io_uncertainty import (
+    BOUC_WEN_SCALE,
+    judge_determined,
+    undetermined,
+    zero_allowed,
+)
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
 from motionhyst.plants import MassSpringDamper, Plant, plant_class
@@ -192,7 +205,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 start_nfev: int | None = None, plant: Plant | type | str = MassSpringDamper,
                 output: str | None = None, offset: str = "auto", from_rest: bool = False,
                 max_evaluations: int | None = None, init_window: int | None = None,
-                asymmetric: bool = False, drift: bool = False) -> IOIdentification:
+                asymmetric: bool = False, drift: bool = False,
+                fewer_elements: bool = False) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -218,7 +232,11 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         registered name (:data:`PLANTS`): :class:`~motionhyst.plants.MassSpringDamper`
         (``m, c, k``),
         :class:`~motionhyst.plants.mass_damper.MassDamper` (``m, c``: a positioning
-        axis, friction the link), the floating
+        axis, friction the link; the Bouc-Wen link there is a friction link, searched
+        with the element links as
+        :func:`~motionhyst.identify.io_friction.bouc_wen_friction` spells it, its exponent
+        fixed at `nu`; LuGre's static force there at least its Coulomb force,
+        :func:`~motionhyst.identify.io_friction.lugre_stribeck`), the floating
         :class:`~motionhyst.time.openloop.TwoMass` of eqs. (1)-(2)
         (``m1, m2, b, k``; the force and the link on ``m1``, no spring to the
         ground but the link's) or, for records without visible inertia (piezo
@@ -243,6 +261,11 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         still ``beta*gamma`` and ``beta*delta`` at the estimated ``nu``.
     n_elements : int
         Maxwell-slip: number of Jenkins elements.
+    fewer_elements : bool
+        Maxwell-slip: records that do not determine every element's stiffness and slip force
+        (:func:`~motionhyst.identify.io_uncertainty.undetermined`) are fitted again with as
+        many elements as the fit determined (at least 1: the Jenkins element), said in a
+        warning; else the fit is judged as it is.
     start_nfev : int, optional
         Links other than Bouc-Wen: evaluations of each start's refinement on the
         short part of the records (default ``15 p``, ``p`` parameters).
@@ -261,8 +284,9 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         position (one per record); ``auto``: both for a floating stage's records
         from a start, none for its periodic records, the position's for a stage
         on a spring (where a force offset is only a position offset ``u0 / k``).
-        Bouc-Wen: ``auto`` and ``none`` estimate none, ``output`` each record's
-        position offset (on a mass-spring-damper).
+        Bouc-Wen (but on a mass-damper, where it is a friction link as the others):
+        ``auto`` and ``none`` estimate none, ``output`` each record's position offset
+        (on a mass-spring-damper).
     from_rest : bool
         The records start at rest; otherwise each record's initial velocity (and
         position, on a spring) is estimated (the element links).
@@ -278,7 +302,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         scored.  Only the force offset is estimated with it (a floating stage).
     asymmetric : bool
         A mass-damper's viscous friction by direction (a positioning axis's
-        ``Fv+``, ``Fv-``), with any link but Bouc-Wen: the stage's ``c_skew``
+        ``Fv+``, ``Fv-``), with any link: the stage's ``c_skew``
         estimated with ``c`` (``c + c_skew`` moving forward, ``c - c_skew``
         backward); the Coulomb link holds it itself (its ``c_pos`` or ``c_neg`` on
         top of the stage's ``c``, the smaller).  Its force offset is then another
@@ -338,6 +362,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
             if rec_period is not None:
                 check_steady_state(rec, rec_period)
     stage = _stage(plant, output)
+    link = _searched(link, stage, nu)
     if init_window is not None:
         if not (isinstance(init_window, int | np.integer) and init_window >= 2):
             raise ValueError(f"the initialisation window must be at least 2 samples, got "
@@ -346,14 +371,35 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         if short:
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
-    fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps, tol=tol,
-                 max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev, offset=offset,
-                 from_rest=from_rest, max_evaluations=max_evaluations, init_window=init_window,
-                 asymmetric=asymmetric, drift=drift, t_start=t_start)
-    # parameters the records do not determine: a warning, or (most of them) a failed fit
-    fit.warnings.extend(judge_determined(fit.estimates, fit.std,
-                                         BOUC_WEN_SCALE if link is BoucWen else (),
-                                         zero_allowed(stage, link)))
+    fewer = None
+    while True:
+        fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps,
+                     tol=tol, max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev,
+                     offset=offset, from_rest=from_rest, max_evaluations=max_evaluations,
+                     init_window=init_window, asymmetric=asymmetric, drift=drift,
+                     t_start=t_start)
+        invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
+        failed = None
+        try:  # parameters the records do not determine: a warning, or (most) a failed fit
+            determined = judge_determined(fit.estimates, fit.std, invariant, zero)
+        except FitFailed as exc:
+            failed = exc
+        kept = (_determined_elements(fit, n_elements, invariant, zero)
+                if fewer_elements and link is MaxwellSlip and n_elements > 1 else n_elements)
+        if kept < n_elements:  # elements the records do not determine: fewer of them
+            fewer = (fewer[0] if fewer else n_elements, kept)
+            n_elements = kept
+            continue
+        if failed is not None:
+            raise failed
+        break
+    if fewer is not None:
+        fit.warnings.append(f"the records do not determine the parameters of {fewer[0]} "
+                            f"Maxwell-slip elements: fitted with {fewer[1]} (the most they "
+                            f"determine; --elements N insists on N)")
+    if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
+        fit.warnings.append(budget_note(fit.n_evaluations))
+    fit.warnings.extend(determined)
     for line in fit.warnings:  # the plausibility checks, for every caller to see
         warn(line)
     return fit
@@ -380,7 +426,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                         max_evaluations=max_evaluations, tol=tol,
                                         t_start=t_start, nu=nu)
     shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
-    if asymmetric and not (link is not BoucWen and shape.floating and shape.n == 1):
+    if asymmetric and not (shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)
     check_inertia(records)  # before the search
     if link is not BoucWen:
@@ -402,9 +448,6 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         raise ValueError("the Bouc-Wen link's records start at rest and only its position "
                          "offsets are estimated (offset 'output', on a mass-spring-damper); "
                          "other offsets and initial states are estimated with the element links")
-    if shape.floating and shape.n == 1:
-        raise ValueError("the Bouc-Wen link is identified on a mass-spring-damper or a "
-                         "two-mass stage")
     if max_evaluations is not None:
         max_nfev = max_evaluations
     if shape.n > 1:
@@ -414,8 +457,35 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                  bouc_wen_offset)
 
 
-_ASYMMETRIC = ("direction-dependent viscous friction is identified on a mass-damper, with a link "
-               "other than Bouc-Wen")
+def _determined_elements(fit: IOIdentification, n: int, invariant: tuple[str, ...],
+                         zero: set[str]) -> int:
+    """The Maxwell-slip elements the fit's records determine: `n` if they determine every
+    element's stiffness and slip force, else as many elements as have both determined, at
+    least 1 and at most ``n - 1``."""
+    bad = set(undetermined(fit.estimates, fit.std, invariant, zero))
+    kept = sum(1 for i in range(n) if f"link.k[{i}]" not in bad and f"link.fc[{i}]" not in bad)
+    return n if kept == n else max(1, min(kept, n - 1))
+
+
+def _searched(link: type[Hysteresis], stage: Plant, nu: float | None) -> type:
+    """The link's class as the search takes it: on a mass-damper (a positioning axis) the
+    Bouc-Wen and LuGre links are friction links in the spellings of
+    :mod:`~motionhyst.identify.io_friction` (a bounded force; the Stribeck effect), searched
+    with the element links; any other link, or these on another stage, as it is."""
+    if link not in (BoucWen, LuGre) or not stage.has_inertia:
+        return link
+    shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))
+    if not (shape.floating and shape.n == 1):
+        return link
+    if link is LuGre:
+        return lugre_stribeck()
+    if nu is None:
+        raise ValueError("on a mass-damper the Bouc-Wen link's exponent is given, not "
+                         "estimated (nu >= 1, default 1)")
+    return bouc_wen_friction(nu)
+
+
+_ASYMMETRIC = "direction-dependent viscous friction is identified on a mass-damper"
 
 
 def _link_class(model: type[Hysteresis] | Hysteresis | str) -> type[Hysteresis]:

@@ -11,6 +11,10 @@ integrated with the model (:func:`~motionhyst.time.openloop.simulate_bouc_wen`),
 ``beta`` only enters as ``beta*gamma`` and ``beta*delta``, so those products are
 estimated and the returned link is normalised to ``|gamma| + |delta| = 1``
 (:func:`_bouc_wen_link`).
+
+On a mass-damper (a positioning axis) the link is a friction link and is searched as
+the registry's element links are
+(:func:`~motionhyst.identify.io_friction.bouc_wen_friction`).
 """
 
 from __future__ import annotations
@@ -275,7 +279,8 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
         std[n] = float(s) if math.isfinite(s) else None
     not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
     per_record = per_record_errors(records, res)
-    extra: dict = {"covariance": covariance_table(free_names, cov, std)}
+    extra: dict = {"covariance": covariance_table(free_names, cov, std),
+                   "budget_reached": bool(sol.status == 0)}
     if output_offset:
         offsets, offset_std = _output_offsets(records, periodic, r, free, p, y_scale, rss,
                                               res.size)
@@ -432,7 +437,8 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
         n_evaluations=n_eval, substeps=r, warnings=warnings, data=list(records),
-        residuals=res, extra={"covariance": covariance_table(free_names, cov, std)})
+        residuals=res, extra={"covariance": covariance_table(free_names, cov, std),
+                              "budget_reached": bool(sol.status == 0)})
 
 
 def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
@@ -508,3 +514,4 @@ def _bouc_wen_link(alpha: float, bg: float, bd: float, nu: float) -> Hysteresis:
         raise ValueError(f"the identified Bouc-Wen parameters (alpha={alpha:.6g}, "
                          f"beta*gamma={bg:.6g}, beta*delta={bd:.6g}, nu={nu:.6g}) are outside "
                          f"the model's accepted set: {exc}") from None
+

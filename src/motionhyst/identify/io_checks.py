@@ -28,8 +28,9 @@ from numpy.typing import NDArray
 from motionhyst.identify.io_records import IORecord
 
 __all__ = ["DIRECTION_MOVING", "DIRECTION_SAMPLES", "DIRECTION_SHARE", "DIRECTION_SIGNIFICANCE",
-           "MAX_PREDICT_SUBSTEPS", "SYSTEMATIC_SHARE",
-           "FitFailed", "check_inertia", "flat_profile", "judge_fit", "noise_cost",
+           "MAX_PREDICT_SUBSTEPS", "SPRING_SHARE", "SYSTEMATIC_SHARE",
+           "FitFailed", "budget_note", "check_inertia", "default_plant", "flat_profile",
+           "judge_fit", "noise_cost",
            "plausibility_warnings", "systematic_share", "viscous_direction_note"]
 
 #: The finest integration step ``predict`` takes, in steps per record sample; a model that
@@ -494,3 +495,85 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
             f"c+ {c_pos:.4g} and c- {c_neg:.4g} N s/m (difference {abs(diff):.3g} +- "
             f"{std:.2g}): a fit with one viscous coefficient biases the mass; --asymmetric "
             f"estimates one per direction")
+
+
+def budget_note(evaluations: int) -> str:
+    """The warning of a search that stopped on its budget of model evaluations
+    (`evaluations` used in all).
+
+    Examples
+    --------
+    >>> budget_note(200)[:68]
+    'the search stopped on its budget of model evaluations (200 used) bef'
+    """
+    return (f"the search stopped on its budget of model evaluations ({evaluations} used) before "
+            f"it converged: the estimates may still move; a larger --max-evaluations lets it "
+            f"finish")
+
+
+SPRING_SHARE = 0.1
+"""A spring to the ground is seen in records where, added to a floating stage's inverse
+dynamics (mass, viscous and Coulomb friction, force offset), it carries at least this share of
+the force's spread.  Measured: the EMPS axis 0.006; generated axes with Coulomb, Jenkins and
+Bouc-Wen friction 0.003-0.04; stages on springs of 1e3-1e5 N/m with Coulomb friction 0.75-1.2;
+the Bouc-Wen benchmark's stage 1.7."""
+
+
+def default_plant(records: list[IORecord]) -> tuple[str, str | None]:
+    """The stage records from a start call for when none is named, and why.
+
+    A positioning axis (a mass on guides: friction holds it, no spring) is a
+    mass-damper; fitted as a mass-spring-damper its spring is not determined, a
+    force offset is only a position offset ``u0 / k`` and the mass takes up what
+    is left.  The records say which: least squares on ``u = m y'' + c y' + f
+    sign(y') + k (y - mean y) + u0`` (:func:`~motionhyst.identify.io_start.equation_rows`);
+    a spring whose force ``k (y - mean y)`` is below :data:`SPRING_SHARE` of the
+    force's spread, where the floating model explains the force
+    (:data:`~motionhyst.identify.io_start.LINEAR_MODEL_RESIDUAL`), is none.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records (force in, position out), from a start.
+
+    Returns
+    -------
+    plant : str
+        ``"mass-damper"`` or ``"mass-spring-damper"`` (the default otherwise).
+    note : str or None
+        For the mass-damper, one line saying why (for the user: it was not named).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(3000) / 1000.0
+    >>> y = 0.05 * np.sin(2 * np.pi * t) + 0.02 * np.sin(2 * np.pi * 3.3 * t)
+    >>> v = np.gradient(y, t, edge_order=2)
+    >>> u = 2.0 * np.gradient(v, t, edge_order=2) + 30.0 * v + 4.0 * np.sign(v) - 1.5
+    >>> default_plant([IORecord(t, u, y)])[0]
+    'mass-damper'
+    >>> default_plant([IORecord(t, u + 400.0 * y, y)])[0]   # a spring of 400 N/m
+    'mass-spring-damper'
+    """
+    from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
+
+    rows, rhs = equation_rows(records, floating=True, light=True)
+    A = np.concatenate([np.column_stack([r, rec.y - np.mean(rec.y)])
+                        for r, rec in zip(rows, records, strict=True)])
+    u = np.concatenate(rhs)
+    spread = float(np.linalg.norm(u - np.mean(u)))
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    both = np.linalg.lstsq(A / scale, u, rcond=None)[0] / scale
+    floating = np.linalg.lstsq(A[:, :-1] / scale[:-1], u, rcond=None)[0] / scale[:-1]
+    if not (spread > 0 and np.all(np.isfinite(both))):
+        return "mass-spring-damper", None
+    share = float(np.linalg.norm(A[:, -1] * both[-1])) / spread
+    unexplained = float(np.linalg.norm(A[:, :-1] @ floating - u)) / spread
+    if share >= SPRING_SHARE or unexplained > LINEAR_MODEL_RESIDUAL:
+        return "mass-spring-damper", None
+    return "mass-damper", (f"the records show no spring (one would carry {100 * share:.2g} % "
+                           f"of the force; friction and inertia explain all but "
+                           f"{100 * unexplained:.2g} %): a positioning axis, identified on "
+                           f"--plant mass-damper with its force offset; --plant "
+                           f"mass-spring-damper fits a spring")

@@ -43,10 +43,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
 from motionhyst.identify.io_checks import (
     SYSTEMATIC_SHARE,
     FitFailed,
+    budget_note,
     judge_fit,
     systematic_share,
 )
@@ -590,8 +592,12 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     fit = identify_quasi_static_io(records, link, periodic=False, n_elements=n_elements,
                                    offset=offset, max_evaluations=max_evaluations, tol=tol,
                                    output="force")
+    if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
+        fit.warnings.append(budget_note(fit.n_evaluations))
     # parameters the records do not determine: a warning, or (most of them) a failed fit
     fit.warnings.extend(judge_determined(fit.estimates, fit.std,
                                          BOUC_WEN_SCALE if link is BoucWen else (),
                                          zero_allowed(fit.plant, link)))
+    for line in fit.warnings:  # for every caller to see, as identify_io's
+        warn(line)
     return fit

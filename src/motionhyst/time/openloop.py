@@ -272,8 +272,13 @@ class OpenLoop:
         # the force at every integration step and midpoint, and the response at each step
         check_memory(FINE_BYTES * u.size * r, f"{u.size} samples of {r} integration steps "
                      f"each", "fewer samples or substeps")
-        # the plant's viscous friction by direction is stepped with the link's elements
-        p = None if getattr(self.plant, "c_skew", 0.0) else self._bw_parameters()
+        # the plant's viscous friction by direction is stepped with the link's elements, and so
+        # is a Bouc-Wen link on a positioning axis (one floating mass): a friction link, whose
+        # exact update in the displacement follows its sticking however stiff (RK4 in time
+        # diverges there once k |y'| / fc exceeds the step's stability limit)
+        mech = self.plant.mechanics()
+        axis = isinstance(self.hysteresis, BoucWen) and mech.floating and mech.n == 1
+        p = None if getattr(self.plant, "c_skew", 0.0) or axis else self._bw_parameters()
         if periodic and self.hysteresis is None and self.plant.mechanics().floating:
             y = floating_linear_periodic(self.plant.mechanics(), u, fs)
         elif p is not None:

@@ -1,0 +1,118 @@
+"""Friction links of a positioning axis, in the spellings their search takes.
+
+On a mass-damper (a positioning axis: a mass on guides, no spring to the ground)
+the link is the axis's friction, and a friction force is bounded by its sliding
+level.  Two registered links need another spelling of their parameters for the
+search to keep to that (the element links' search,
+:func:`~motionhyst.identify.io_elements.identify_elements_io`, takes any class
+with the registry's ``parameters`` whose call returns the link):
+
+- the Bouc-Wen link (:func:`bouc_wen_friction`): its hysteretic force alone,
+  ``beta + gamma = 1`` so that ``fc`` is its sliding force;
+- the LuGre link (:func:`lugre_stribeck`): the static force at least the Coulomb
+  one, ``fs = fc + stribeck`` with ``stribeck >= 0`` (Canudas de Wit et al. 1995).
+
+Without them a search on a measured axis ends outside the models' meaning (EMPS:
+a LuGre ``fc`` of 2.2e6 N against ``fs`` 23 N with ``vs`` 40 m/s, its Stribeck
+curve a quadratic viscous term in place of ``c``, and the mass 70.9 kg for 95.1).
+"""
+
+from __future__ import annotations
+
+import math
+
+from motionhyst.hysteresis import BoucWen, LuGre, Parameter
+
+__all__ = ["bouc_wen_friction", "lugre_stribeck"]
+
+
+def bouc_wen_friction(nu: float) -> type:
+    """The Bouc-Wen link as a positioning axis's friction, in the spelling its search takes.
+
+    On a mass-damper nothing holds the stage but the link, and its force is the
+    normalised model's hysteretic force alone, eq. (2) of
+    :class:`~motionhyst.hysteresis.BoucWen`: the general form's linear share is a
+    spring to the ground, which a positioning axis does not have.  A friction force is
+    bounded: ``beta + gamma > 0``, normalised to ``beta + gamma = 1`` so that ``fc``
+    is the force the link saturates at when sliding (the friction force; only
+    ``beta / fc^n`` and ``gamma / fc^n`` enter eq. (2), so ``fc`` and the two shape
+    parameters are not determined together otherwise).  Searched: ``k``, ``fc`` and the
+    dissipation ``d = beta - gamma >= 0`` (``beta = (1 + d) / 2``, ``gamma = (1 - d) / 2``:
+    ``d = 0`` unloads at ``k``, larger ``d`` stiffer, the loops' area growing with it); the
+    exponent ``n`` is fixed at `nu`.
+
+    Parameters
+    ----------
+    nu : float
+        The exponent ``n >= 1``.
+
+    Returns
+    -------
+    type
+        A class with the registry's ``parameters`` (``k``, ``fc``, ``dissipation``) whose
+        call returns the :class:`~motionhyst.hysteresis.BoucWen` link.
+
+    Examples
+    --------
+    >>> link = bouc_wen_friction(1.0)(k=2e5, fc=20.0, dissipation=0.5)
+    >>> link.beta, link.gamma, link.n
+    (0.75, 0.25, 1.0)
+    """
+    if not (math.isfinite(nu) and nu >= 1.0):
+        raise ValueError(f"the Bouc-Wen exponent must be >= 1, got {nu!r}")
+
+    class BoucWenFriction:
+        """The Bouc-Wen friction link of :func:`bouc_wen_friction` (its search's spelling)."""
+
+        name = BoucWen.name
+        parameters = (Parameter("k", "N/m", "initial stiffness k"),
+                      Parameter("fc", "N", "friction force f_c (beta + gamma = 1)"),
+                      Parameter("dissipation", "", "beta - gamma >= 0", 1.0, "nonnegative"))
+
+        def __new__(cls, k: float, fc: float, dissipation: float) -> BoucWen:  # type: ignore[misc]
+            return BoucWen(k=k, fc=fc, n=nu, beta=0.5 * (1.0 + dissipation),
+                           gamma=0.5 * (1.0 - dissipation))
+
+    return BoucWenFriction
+
+
+class _LuGreStribeck:
+    """The LuGre link of :func:`lugre_stribeck` (its search's spelling)."""
+
+    name = LuGre.name
+    parameters = (*(p for p in LuGre.parameters if p.name not in ("fs", "vs")),
+                  Parameter("stribeck", "N", "static force above the Coulomb one, fs - fc >= 0",
+                            None, "nonnegative"),
+                  next(p for p in LuGre.parameters if p.name == "vs"))
+
+    def __new__(cls, sigma0: float, sigma1: float, sigma2: float, fc: float, stribeck: float,
+                vs: float) -> LuGre:  # type: ignore[misc]
+        return LuGre(sigma0=sigma0, sigma1=sigma1, sigma2=sigma2, fc=fc, fs=fc + stribeck,
+                     vs=vs)
+
+
+def lugre_stribeck() -> type:
+    """The LuGre link as a positioning axis's friction, in the spelling its search takes.
+
+    The Stribeck effect: the friction force falls from the static ``fs`` at rest to the
+    Coulomb ``fc`` when sliding, ``g(v) = fc + (fs - fc) exp(-(v / vs)^2)``, so ``fs >=
+    fc``.  Searched as ``fc`` and ``stribeck = fs - fc >= 0`` (the other parameters as
+    :class:`~motionhyst.hysteresis.LuGre`'s): ``g`` stays between ``fc`` and ``fs``
+    whatever ``vs``; with ``fs < fc`` and ``vs`` above the record's speeds the curve is
+    ``fs + (fc - fs) (v / vs)^2``, a quadratic viscous force that takes the stage's
+    damper's place.
+
+    Returns
+    -------
+    type
+        A class with the registry's ``parameters`` (LuGre's, ``stribeck`` for ``fs``)
+        whose call returns the :class:`~motionhyst.hysteresis.LuGre` link.
+
+    Examples
+    --------
+    >>> link = lugre_stribeck()(sigma0=1e6, sigma1=300.0, sigma2=0.0, fc=20.0, stribeck=5.0,
+    ...                         vs=0.01)
+    >>> link.fc, link.fs
+    (20.0, 25.0)
+    """
+    return _LuGreStribeck
