@@ -498,8 +498,17 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
 
 
 def budget_note(evaluations: int) -> str:
-    """The warning of a search that stopped on its budget of model evaluations
-    (`evaluations` used in all).
+    """The warning of a search that stopped on its budget of model evaluations.
+
+    Parameters
+    ----------
+    evaluations : int
+        The model evaluations the search used in all.
+
+    Returns
+    -------
+    str
+        One line naming ``--max-evaluations``.
 
     Examples
     --------
