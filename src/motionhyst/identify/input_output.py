@@ -110,7 +110,7 @@ from motionhyst.identify.io_elements import PROFILE_CHI2 as PROFILE_CHI2
 from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
 from motionhyst.identify.io_elements import identify_elements_io
-from motionhyst.identify.io_friction import bouc_wen_friction, lugre_stribeck
+from motionhyst.identify.io_friction import bouc_wen_friction, lugre_stribeck, presliding_note
 from motionhyst.identify.io_records import MIN_SAMPLES as MIN_SAMPLES
 from motionhyst.identify.io_records import IORecord, check_records
 from motionhyst.identify.io_records import load_io_csv as load_io_csv
@@ -397,6 +397,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         fit.warnings.append(f"the records do not determine the parameters of {fewer[0]} "
                             f"Maxwell-slip elements: fitted with {fewer[1]} (the most they "
                             f"determine; --elements N insists on N)")
+    if isinstance(fit.hysteresis, LuGre) and link is not LuGre:  # a positioning axis's
+        note = presliding_note(fit.hysteresis, records)
+        if note is not None:
+            fit.warnings.append(note)
     if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
         fit.warnings.append(budget_note(fit.n_evaluations))
     fit.warnings.extend(determined)

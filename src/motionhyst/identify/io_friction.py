@@ -21,9 +21,12 @@ from __future__ import annotations
 
 import math
 
-from motionhyst.hysteresis import BoucWen, LuGre, Parameter
+import numpy as np
 
-__all__ = ["bouc_wen_friction", "lugre_stribeck"]
+from motionhyst.hysteresis import BoucWen, LuGre, Parameter
+from motionhyst.identify.io_records import IORecord
+
+__all__ = ["PRESLIDING_SHARE", "bouc_wen_friction", "lugre_stribeck", "presliding_note"]
 
 
 def bouc_wen_friction(nu: float) -> type:
@@ -116,3 +119,51 @@ def lugre_stribeck() -> type:
     (20.0, 25.0)
     """
     return _LuGreStribeck
+
+
+PRESLIDING_SHARE = 0.01
+"""A LuGre link whose bristles deflect more than this share of the records' motion (RMS about
+each record's mean) before it slides, ``fc / sigma0``, is no friction's presliding (micrometres
+on a machine's guides): a warning names ``sigma0``."""
+
+
+def presliding_note(link: LuGre, records: list[IORecord]) -> str | None:
+    """One warning line when a LuGre link's presliding, ``fc / sigma0``, is a large part of
+    the records' motion (:data:`PRESLIDING_SHARE`), else None.
+
+    The bristles of the LuGre model are the contacts' micro-deflection before sliding;
+    deflecting over a sizeable part of the stroke they are a spring (``sigma0``) and a damper
+    (``sigma1``) in the link, and the fit's friction and mass are another model's.
+
+    Parameters
+    ----------
+    link : LuGre
+        The identified link.
+    records : list of IORecord
+        The records it was identified from.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(1000) / 1000.0
+    >>> rec = IORecord(t, np.sin(2 * np.pi * t), 0.07 * np.sin(2 * np.pi * t))
+    >>> soft = LuGre(sigma0=703.0, sigma1=367.0, sigma2=0.0, fc=14.0, fs=20.0, vs=0.01)
+    >>> presliding_note(soft, [rec])[:62]
+    'link.sigma0 = 703 N/m: the bristles deflect fc / sigma0 = 2 cm'
+    >>> presliding_note(LuGre(1e7, 0.0, 0.0, 14.0, 20.0, 0.01), [rec]) is None
+    True
+    """
+    y = np.concatenate([rec.y - np.mean(rec.y) for rec in records])
+    motion = float(np.sqrt(np.mean(y ** 2)))
+    deflection = link.fc / link.sigma0
+    if not (motion > 0 and deflection > PRESLIDING_SHARE * motion):
+        return None
+    size = f"{100 * deflection:.2g} cm" if deflection >= 1e-2 else f"{1e3 * deflection:.2g} mm"
+    return (f"link.sigma0 = {link.sigma0:.3g} N/m: the bristles deflect fc / sigma0 = {size} "
+            f"before the link slides, {100 * deflection / motion:.2g} % of the records' "
+            f"motion (RMS), not a friction's presliding: the link acts as a spring and damper "
+            f"and the other estimates are that model's")
