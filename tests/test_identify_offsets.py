@@ -173,14 +173,15 @@ def test_asymmetric_viscous_friction_is_recovered():
         assert got[name] == pytest.approx(value, rel=1e-3), name
     assert "link.c_pos" in fit.not_identifiable
     assert fit.hysteresis.to_dict()["c_neg"] == pytest.approx(70.0, rel=1e-3)
-    with pytest.raises(ValueError, match="on a mass-damper, with a link other than Bouc-Wen"):
+    with pytest.raises(ValueError, match="viscous friction is identified on a mass-damper"):
         identify_io([rec], "coulomb", plant="mass-spring-damper", asymmetric=True)
 
 
 @pytest.mark.parametrize(("options", "message"), [
     (["--init-window", "1"], "--init-window: must be from 2"),
     (["--init-window", "20", "--from-rest"], "not with --periodic or --from-rest"),
-    (["--init-window", "20", "--model", "bouc-wen"], "apply to the element links"),
+    (["--init-window", "20", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
+     "apply to the element links"),
     (["--offset", "both", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
      "estimates only their position offsets"),
     (["--asymmetric", "--model", "bouc-wen", "--plant", "mass-spring-damper"],
