@@ -88,7 +88,7 @@ def test_refused_where_it_means_nothing():
     with pytest.raises(ValueError, match="no viscous friction by direction"):
         Loop(MassDamper.by_direction(95.0, 163.0, 240.0), Pid(1e5, 1e6, 1e3).tf())
     rec = IORecord(t, u, axis.simulate(t, u).displacement, "axis")
-    with pytest.raises(ValueError, match="on a mass-damper, with a link other than Bouc-Wen"):
+    with pytest.raises(ValueError, match="viscous friction is identified on a mass-damper"):
         identify_io([rec], "jenkins", plant="mass-spring-damper", asymmetric=True)
     with pytest.raises(ValueError, match="from a start, not periodic"):
         identify_io([rec], "jenkins", plant="mass-damper", asymmetric=True, periodic=True)
