@@ -122,7 +122,7 @@ def test_identified_for_every_element_link(link, name):
 
 def test_identify_asymmetric_on_the_command_line_saves_it_for_predict(tmp_path, capsys):
     """identify --asymmetric --model jenkins saves the stage's c_skew; predict --init-from
-    runs the saved model with it; Bouc-Wen is refused in one line."""
+    runs the saved model with it; on a stage held by a spring it is refused in one line."""
     from motionhyst.cli import main
 
     rec = _record(Jenkins(k=2e5, fc=20.0), n=3000)  # both directions' motion, long enough
@@ -140,8 +140,8 @@ def test_identify_asymmetric_on_the_command_line_saves_it_for_predict(tmp_path, 
     assert main(["predict", str(model), str(path), "--init-from", str(path), "--out", str(out),
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["rmse"] < 1e-5 * np.ptp(rec.y)
-    assert main(["identify", str(path), "--record", "input-output", "--plant", "mass-damper",
-                 "--model", "bouc-wen", "--asymmetric"]) == 2
+    assert main(["identify", str(path), "--record", "input-output", "--plant",
+                 "mass-spring-damper", "--model", "bouc-wen", "--asymmetric"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--asymmetric applies to --plant mass-damper" in err
 
