@@ -27,9 +27,11 @@ six points peaks at 0.72 GB (VmPeak; 1.17 GB with an arena per thread; resident 
 MAIN = ("import sys\n"
         "from motionhyst.core.compiled import quiet_compilation\n"
         "quiet_compilation()\n"
-        "from motionhyst.cli import main\n"
-        "sys.exit(main(sys.argv[1:]))\n")
-"""The console script, without the notice of a first compilation."""
+        "from motionhyst.entry import main\n"
+        "sys.exit(main())\n")
+"""The console script (:func:`motionhyst.entry.main`, which keeps Ctrl-C and SIGTERM from the
+interpreter's exit once the command has returned), without the notice of a first
+compilation."""
 
 ONE_THREAD = {**{name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
                                         "MKL_NUM_THREADS")}, "MALLOC_ARENA_MAX": "2"}
