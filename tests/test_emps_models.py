@@ -17,11 +17,11 @@ from motionhyst.time.openloop import OpenLoop
 PERIOD = 1000
 
 
-def _axis(link, n_periods: int = 2) -> IORecord:
+def _axis(link, n_periods: int = 2, c_skew: float = 0.0) -> IORecord:
     """A mass-damper with the link and a force offset, driven by a force, 1 kHz."""
     t = np.arange(n_periods * PERIOD) / 1000.0
     u = 150 * np.sin(2 * np.pi * t) + 60 * np.sin(6 * np.pi * t)
-    axis = OpenLoop(MassDamper(95.0, 200.0, force_offset=3.2), link)
+    axis = OpenLoop(MassDamper(95.0, 200.0, c_skew, force_offset=3.2), link)
     y = axis.simulate(t, u, substeps=40).displacement
     return IORecord(t, u, y + 1e-6 * np.random.default_rng(2).standard_normal(t.size), "axis")
 
@@ -61,3 +61,21 @@ def test_the_rule_in_numbers():
     assert unresolved_stiffness("jenkins", own, {"k": 1.0}, 900.0) is not None  # 225 Hz limit
     assert unresolved_stiffness("maxwell-slip", own, {"k": None}, 1000.0) is None  # not Jenkins
     assert unresolved_stiffness("coulomb", {"m": 95.0, "fc": 20.0}, {}, 1000.0) is None
+
+
+def test_the_coulomb_fit_is_reused_as_the_friction_links_start():
+    """A Jenkins fit started from a Coulomb fit made already (as the benchmark reuses its
+    ``coulomb-asymmetric`` fit for ``jenkins-asymmetric``) finds what it finds when it fits
+    that start itself, with fewer evaluations; a Coulomb fit of other options is refused."""
+    from motionhyst.identify.input_output import identify_io
+
+    rec = _axis(Jenkins(k=2e6, fc=20.0), c_skew=-35.0)  # EMPS: faster backward
+    options = {"plant": "mass-damper", "init_window": 20, "asymmetric": True}
+    coulomb = identify_io([rec], "coulomb", **options)
+    alone = identify_io([rec], "jenkins", **options)
+    reused = identify_io([rec], "jenkins", rigid=coulomb, **options)
+    for name in ("m", "c", "c_skew", "link.k", "link.fc", "input_offset"):
+        assert reused.estimates[name] == pytest.approx(alone.estimates[name], rel=1e-3), name
+    assert reused.n_evaluations < alone.n_evaluations
+    with pytest.raises(ValueError, match="other options"):
+        identify_io([rec], "jenkins", plant="mass-damper", init_window=20, rigid=coulomb)

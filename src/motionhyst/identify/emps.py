@@ -758,19 +758,20 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     for name in models:
         check_model(name)
     out: list[EMPSModel] = []
+    rigid: dict[frozenset, object] = {}  # the Coulomb fits by options: the others' start
     for name in models:
         say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
         t0 = time.perf_counter()
         link, options = model_options(name)
         try:
-            model = _identify_and_score(name, link, options, est, val)
+            model = _identify_and_score(name, link, options, est, val, rigid)
             why = unresolved_stiffness(name, model.model_parameters, model.model_std, est.fs)
         except FitFailed as exc:
             if link == "coulomb" or RIGID_LIMIT not in str(exc):
                 raise ValueError(f"{name}: {exc}") from None
             why = f"a model that needs more than {MAX_PREDICT_SUBSTEPS} {RIGID_LIMIT}"
         if why is not None:  # report the limit, the Coulomb link with the same options
-            model = _rigid_limit(name, options, est, val, out, why)
+            model = _rigid_limit(name, options, est, val, out, why, rigid)
         model.seconds = time.perf_counter() - t0
         out.append(model)
         say(f"{name}: {model.validation['rmse_mm']:.3g} mm on {val.name} "
@@ -792,28 +793,34 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
 
 
 def _rigid_limit(name: str, options: set[str], est: IORecord, val: IORecord,
-                 done: list[EMPSModel], why: str) -> EMPSModel:
+                 done: list[EMPSModel], why: str, rigid: dict) -> EMPSModel:
     """A link reported as its rigid limit: the Coulomb link with the same options (its fit
     among `done` reused), named `name`, with a warning saying `why`."""
-    rigid = "-".join(["coulomb", *(o for o in OPTIONS if o in options)])
-    model = next((m for m in done if m.name == rigid), None)
+    limit = "-".join(["coulomb", *(o for o in OPTIONS if o in options)])
+    model = next((m for m in done if m.name == limit), None)
     try:
-        model = model or _identify_and_score(rigid, "coulomb", options, est, val)
+        model = model or _identify_and_score(limit, "coulomb", options, est, val, rigid)
     except FitFailed as limit_failed:
-        raise ValueError(f"{name}: {why}; its rigid limit {rigid}: {limit_failed}") from None
-    return replace(model, name=name, limit=rigid, warnings=[
-        f"the link's stiffness ran to the rigid limit ({why}): reported as that limit, {rigid}",
+        raise ValueError(f"{name}: {why}; its rigid limit {limit}: {limit_failed}") from None
+    return replace(model, name=name, limit=limit, warnings=[
+        f"the link's stiffness ran to the rigid limit ({why}): reported as that limit, {limit}",
         *model.warnings])
 
 
 def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
-                        val: IORecord) -> EMPSModel:
-    """One model identified on `est` with the benchmark's window and scored on both records."""
+                        val: IORecord, rigid: dict) -> EMPSModel:
+    """One model identified on `est` with the benchmark's window and scored on both records;
+    `rigid`: the Coulomb fits made so far by options, a friction link's start (one more
+    when `link` is the Coulomb link)."""
+    key = frozenset(options)
     try:
         with warnings.catch_warnings():  # the report lists the fit's warnings itself
             warnings.simplefilter("ignore", MotionhystWarning)
             fit = identify_io([est], link, plant="mass-damper", init_window=INIT_WINDOW,
-                              asymmetric="asymmetric" in options, drift="drift" in options)
+                              asymmetric="asymmetric" in options, drift="drift" in options,
+                              rigid=None if link == "coulomb" else rigid.get(key))
+        if link == "coulomb":
+            rigid[key] = fit
         system = fit.system()
         est_score, _ = score(system, est)
         val_score, yhat = score(system, val)

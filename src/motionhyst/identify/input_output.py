@@ -206,7 +206,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 output: str | None = None, offset: str = "auto", from_rest: bool = False,
                 max_evaluations: int | None = None, init_window: int | None = None,
                 asymmetric: bool = False, drift: bool = False,
-                fewer_elements: bool = False) -> IOIdentification:
+                fewer_elements: bool = False, rigid: IOIdentification | None = None
+                ) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -315,6 +316,11 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         fitted plant's ``force_drift``).  A machine warming up over a record
         (EMPS); it assumes a record to be predicted starts as the identified
         ones did.
+    rigid : IOIdentification, optional
+        A friction link on a mass-damper starts (among others) from the Coulomb link's fit,
+        its rigid limit: that fit, made already on the same records with the same options
+        (offsets, window, drift; viscous friction by direction in either spelling), is
+        reused instead of being fitted again.
 
     Returns
     -------
@@ -377,7 +383,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                      tol=tol, max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev,
                      offset=offset, from_rest=from_rest, max_evaluations=max_evaluations,
                      init_window=init_window, asymmetric=asymmetric, drift=drift,
-                     t_start=t_start)
+                     t_start=t_start, rigid=rigid)
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
         failed = None
         try:  # parameters the records do not determine: a warning, or (most) a failed fit
@@ -412,8 +418,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
 def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, periodic: bool,
            nu: float | None, substeps: int | None, tol: float, max_nfev: int, n_elements: int,
            start_nfev: int | None, offset: str, from_rest: bool, max_evaluations: int | None,
-           init_window: int | None, asymmetric: bool, drift: bool, t_start: float
-           ) -> IOIdentification:
+           init_window: int | None, asymmetric: bool, drift: bool, t_start: float,
+           rigid: IOIdentification | None = None) -> IOIdentification:
     """The fit of :func:`identify_io` that the stage's structure and the link call for."""
     if drift and not any(p.name == "force_drift" for p in stage.parameters):
         raise ValueError("a drifting force offset is identified on a mass-damper")
@@ -439,7 +445,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                    stage, offset, from_rest, max_evaluations,
                                    int(init_window) if init_window is not None else None,
                                    asymmetric, bool(drift),
-                                   skew=asymmetric and link is not Coulomb)
+                                   skew=asymmetric and link is not Coulomb, rigid=rigid)
         if shape.floating and shape.n == 1 and not asymmetric and (not periodic
                                                                    or link is Coulomb):
             note = viscous_direction_note(records)  # the symmetric fit's mass is biased

@@ -544,7 +544,7 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_start,
                          start_nfev, plant, offset="none", from_rest=True, budget=None,
                          init_window=None, asymmetric=False, drift=False,
-                         skew=False) -> IOIdentification:
+                         skew=False, rigid=None) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -580,8 +580,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     inverse dynamics' ``(c_pos - c_neg) / 2``, ``c`` from their mean).
 
     A link other than the rigid slider on a mass-damper also starts from the
-    Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit), when
-    that fits the records better than the best of the other starts.
+    Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit; `rigid`, one
+    already made, is reused), when that fits the records better than the other starts.
 
     The offsets and initial states of `offset` and `from_rest`
     (:class:`~motionhyst.identify.io_offsets.Extras`) are estimated with them:
@@ -718,7 +718,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         # the rigid slider is every friction link's limit: its fit is a start for theirs
         seed, used = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
                                  start_nfev, plant, offset, from_rest, layout, y_scale,
-                                 v_scale, extras, force, init_window, skew)
+                                 v_scale, extras, force, init_window, skew, rigid)
         n_eval += used
         if seed is not None:
             q_seed = prob.variables(seed)
@@ -825,30 +825,35 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
 
 def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, offset,
                 from_rest, layout, y_scale, v_scale, extras, force, init_window=None,
-                skew=False):
-    """A positioning axis's friction link started from the Coulomb link's fit: the stage, the
-    offsets and initial states as fitted, the link's forces together its slip force, slipping
-    after 1e-5 of the output's RMS (its rigid limit); None if that fit fails."""
+                skew=False, rigid=None):
+    """A positioning axis's friction link started from the Coulomb link's fit (`rigid`: one
+    made already): the stage, the offsets and initial states as fitted, the link's forces
+    together its slip force, slipping after 1e-5 of the output's RMS (its rigid limit); None
+    if that fit fails."""
     from motionhyst.identify.io_checks import FitFailed
 
     try:
-        fit = identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev, 1,
-                                   t_start, start_nfev, plant, offset, from_rest,
-                                   init_window=init_window, drift=extras.input_drift,
-                                   skew=skew)
+        fit = rigid or identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev,
+                                            1, t_start, start_nfev, plant, offset, from_rest,
+                                            init_window=init_window, drift=extras.input_drift,
+                                            skew=skew)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0
-    fc = fit.estimates["link.fc"]
-    link0 = layout.start(2.0 * fc / (1e-5 * y_scale), y_scale, v_scale, fit.plant.c, 1e-5)
+    link = fit.hysteresis  # viscous friction by direction: the stage's c_skew, or the link's
+    skewed = getattr(fit.plant, "c_skew", 0.0) + 0.5 * (link.c_pos - link.c_neg)
+    if (not skew and skewed) or any(n not in fit.estimates for n in extras.names):
+        raise ValueError("the Coulomb fit reused as the rigid limit has other options")
+    fc, c = fit.estimates["link.fc"], fit.plant.c + 0.5 * (link.c_pos + link.c_neg)
+    link0 = layout.start(2.0 * fc / (1e-5 * y_scale), y_scale, v_scale, c, 1e-5)
     if force.any():
         link0[force] *= fc / np.sum(link0[force])
     if skew:
-        link0[-1] = fit.plant.c_skew
+        link0[-1] = skewed
     rate = np.array([par.unit == _VELOCITY for par, _ in layout._values()], dtype=bool)
     link0[rate] = RATE_GRID[0] * v_scale
-    return (np.concatenate([[fit.plant.m, fit.plant.c], link0,
+    return (np.concatenate([[fit.plant.m, c], link0,
                             [fit.estimates[name] for name in extras.names]]),
-            fit.n_evaluations)
+            0 if rigid else fit.n_evaluations)
 
 
 #: A positive parameter that ends this factor from its start value is reported as at the edge
