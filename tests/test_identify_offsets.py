@@ -107,8 +107,9 @@ def test_a_fit_that_fails_says_so():
     with pytest.raises(FitFailed, match="linear model"):
         judge_fit(2e-5, [rec], good, 1e-5, None, False)
     collapsed = OpenLoop(MassSpringDamper(1e-12, 1.0, 0.0), Jenkins(k=1e6, fc=1.0))
-    with pytest.raises(FitFailed, match="quasi-static"):
+    with pytest.raises(FitFailed, match="quasi-static") as failed:
         judge_fit(1e-6, [rec], good, None, collapsed, False)
+    assert "its fastest mode at 1.59e+08 Hz" in str(failed.value)  # sqrt(k / m) / 2 pi
     judge_fit(1e-6, [rec], good, 1e-5, OpenLoop(MassDamper(1.0, 1.0), Coulomb(fc=0.1)), False)
 
 

@@ -113,9 +113,14 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
         raise FitFailed(f"the fit failed: the identified model cannot be simulated "
                         f"({exc})") from None
     if r > MAX_PREDICT_SUBSTEPS:
+        from motionhyst.time.openloop import STEPS_PER_MODE_PERIOD
+
+        mode = r * records[0].fs / STEPS_PER_MODE_PERIOD
         raise FitFailed(f"the fit failed: the identified model needs {r} integration steps per "
-                        f"sample (a mass collapsed on a stiff link); if the records show no "
-                        f"inertia, use --plant quasi-static")
+                        f"sample (its fastest mode at {mode:.3g} Hz, {mode / records[0].fs:.3g} "
+                        f"times the sampling rate: a link stiffer than the records resolve, or "
+                        f"a mass collapsed); if the records show no inertia, use --plant "
+                        f"quasi-static")
     rec = records[0]
     try:
         y = system.simulate(rec.t, rec.u, substeps=r).displacement
