@@ -197,7 +197,7 @@ def run_input_output(args: argparse.Namespace) -> int:
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
                "asymmetric": args.asymmetric, "drift": args.drift,
-               "fewer_elements": args.elements is None})
+               "fewer_elements": args.elements is None, "rigid_limit": True})
     from motionhyst.hysteresis import model_class
 
     with search_budget():
@@ -219,7 +219,11 @@ def run_input_output(args: argparse.Namespace) -> int:
             if args.init_window is not None else "initial state estimated")
     stage = (f"Two-mass stage ({args.output or 'y2'} measured)" if plant == "two-mass"
              else "Stage")
-    print(f"{stage} and {model} link identified from {len(records)} input-output record(s) "
+    if fit.extra.get("rigid_limit"):
+        model = f"{fit.hysteresis.name} link (the {model} link's rigid limit)"
+    else:
+        model = f"{model} link"
+    print(f"{stage} and {model} identified from {len(records)} input-output record(s) "
           f"({kind}) by simulation error in {fit.seconds:.3g} s")
     print(f"  fit RMS {g(fit.fit_rms)} m; {fit.stopping}")
     rows = []

@@ -206,8 +206,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 output: str | None = None, offset: str = "auto", from_rest: bool = False,
                 max_evaluations: int | None = None, init_window: int | None = None,
                 asymmetric: bool = False, drift: bool = False,
-                fewer_elements: bool = False, rigid: IOIdentification | None = None
-                ) -> IOIdentification:
+                fewer_elements: bool = False, rigid_limit: bool = False,
+                rigid: IOIdentification | None = None) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -267,6 +267,12 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         (:func:`~motionhyst.identify.io_uncertainty.undetermined`) are fitted again with as
         many elements as the fit determined (at least 1: the Jenkins element), said in a
         warning; else the fit is judged as it is.
+    rigid_limit : bool
+        A Jenkins link on a mass-damper whose stiffness the records do not resolve (not
+        determined, or its stuck mode ``sqrt(k / m) / 2 pi`` above a quarter of the sampling
+        rate: :func:`~motionhyst.identify.io_friction.unresolved_stiffness`) is reported as
+        its rigid limit, the Coulomb link's fit with the same options that its search
+        started from, said in a warning; else it is judged as it is.
     start_nfev : int, optional
         Links other than Bouc-Wen: evaluations of each start's refinement on the
         short part of the records (default ``15 p``, ``p`` parameters).
@@ -383,7 +389,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                      tol=tol, max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev,
                      offset=offset, from_rest=from_rest, max_evaluations=max_evaluations,
                      init_window=init_window, asymmetric=asymmetric, drift=drift,
-                     t_start=t_start, rigid=rigid)
+                     t_start=t_start, rigid_limit=rigid_limit, rigid=rigid)
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
         failed = None
         try:  # parameters the records do not determine: a warning, or (most) a failed fit
@@ -419,7 +425,8 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
            nu: float | None, substeps: int | None, tol: float, max_nfev: int, n_elements: int,
            start_nfev: int | None, offset: str, from_rest: bool, max_evaluations: int | None,
            init_window: int | None, asymmetric: bool, drift: bool, t_start: float,
-           rigid: IOIdentification | None = None) -> IOIdentification:
+           rigid_limit: bool = False, rigid: IOIdentification | None = None
+           ) -> IOIdentification:
     """The fit of :func:`identify_io` that the stage's structure and the link call for."""
     if drift and not any(p.name == "force_drift" for p in stage.parameters):
         raise ValueError("a drifting force offset is identified on a mass-damper")
@@ -445,7 +452,8 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                    stage, offset, from_rest, max_evaluations,
                                    int(init_window) if init_window is not None else None,
                                    asymmetric, bool(drift),
-                                   skew=asymmetric and link is not Coulomb, rigid=rigid)
+                                   skew=asymmetric and link is not Coulomb,
+                                   rigid_limit=rigid_limit, rigid=rigid)
         if shape.floating and shape.n == 1 and not asymmetric and (not periodic
                                                                    or link is Coulomb):
             note = viscous_direction_note(records)  # the symmetric fit's mass is biased

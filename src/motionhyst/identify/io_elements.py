@@ -16,13 +16,13 @@ import math
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from motionhyst.hysteresis import Coulomb, Hysteresis, Parameter
+from motionhyst.hysteresis import Coulomb, Hysteresis, Jenkins, Parameter
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.identify.io_checks import (
     PROFILE_CHI2,
@@ -31,6 +31,7 @@ from motionhyst.identify.io_checks import (
     noise_cost,
     plausibility_warnings,
 )
+from motionhyst.identify.io_friction import as_rigid_limit
 from motionhyst.identify.io_offsets import Extras, initial_state
 from motionhyst.identify.io_predict import run_from_state, state_from_window
 from motionhyst.identify.io_records import short_records
@@ -544,7 +545,7 @@ STARTS = ((0.7, 0.3, 1.0), (0.4, 0.6, 1.0), (0.5, 0.5, 10.0), (1.0, 0.5, 0.1))
 def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_start,
                          start_nfev, plant, offset="none", from_rest=True, budget=None,
                          init_window=None, asymmetric=False, drift=False,
-                         skew=False, rigid=None) -> IOIdentification:
+                         skew=False, rigid=None, rigid_limit=False) -> IOIdentification:
     """Stage and a link of exact-update elements by simulation error.
 
     Starts (on a short part of the records): for the shares of the best linear
@@ -581,7 +582,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
 
     A link other than the rigid slider on a mass-damper also starts from the
     Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit; `rigid`, one
-    already made, is reused), when that fits the records better than the other starts.
+    already made, is reused), when that fits the records better than the other starts
+    (reported instead with `rigid_limit`: :func:`~motionhyst.identify.io_friction.as_rigid_limit`).
 
     The offsets and initial states of `offset` and `from_rest`
     (:class:`~motionhyst.identify.io_offsets.Extras`) are estimated with them:
@@ -714,11 +716,12 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
                            extras=extras, window=init_window)
     q0 = prob.variables(np.concatenate([best[1][:n_base], full_start]))
+    coulomb = None
     if axis and not getattr(layout.cls, "rigid", False):
         # the rigid slider is every friction link's limit: its fit is a start for theirs
-        seed, used = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
-                                 start_nfev, plant, offset, from_rest, layout, y_scale,
-                                 v_scale, extras, force, init_window, skew, rigid)
+        seed, used, coulomb = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
+                                          start_nfev, plant, offset, from_rest, layout, y_scale,
+                                          v_scale, extras, force, init_window, skew, rigid)
         n_eval += used
         if seed is not None:
             q_seed = prob.variables(seed)
@@ -759,6 +762,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         if name not in not_ident:
             not_ident[name] = why
             std[name] = None
+    limit = (as_rigid_limit(coulomb, estimates, std, records[0].fs, math.sqrt(rss / res.size))
+             if rigid_limit and coulomb is not None and layout.cls is Jenkins else None)
+    if limit is not None:  # before the checks: a stiffness beyond the records may not step
+        return replace(limit, n_evaluations=n_eval, seconds=time.perf_counter() - t_start)
     u0, y0, init = extras.split(v[n_base:])
     initial_state_out = {name: init[:, a].tolist() for a, name in enumerate(extras.initial)}
     if init_window is not None:  # the window's state: a floating stage's position is its offset
@@ -800,7 +807,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "
                  f"at most {remaining} evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r, data=list(records), residuals=res,
+        n_evaluations=n_eval, substeps=r, data=list(records), residuals=res, rigid_limit=coulomb,
         extra={"offsets": {"input": u0, "output": y0.tolist(),
                            **({"input_drift": drift_rate} if extras.input_drift else {})},
                "initial_state": initial_state_out, "init_window": init_window,
@@ -828,8 +835,8 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
                 skew=False, rigid=None):
     """A positioning axis's friction link started from the Coulomb link's fit (`rigid`: one
     made already): the stage, the offsets and initial states as fitted, the link's forces
-    together its slip force, slipping after 1e-5 of the output's RMS (its rigid limit); None
-    if that fit fails."""
+    together its slip force, slipping after 1e-5 of the output's RMS (its rigid limit), the
+    evaluations and the fit itself; None (0, None) if that fit fails."""
     from motionhyst.identify.io_checks import FitFailed
 
     try:
@@ -838,7 +845,7 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
                                             init_window=init_window, drift=extras.input_drift,
                                             skew=skew)
     except (FitFailed, ValueError, ArithmeticError):
-        return None, 0
+        return None, 0, None
     link = fit.hysteresis  # viscous friction by direction: the stage's c_skew, or the link's
     skewed = getattr(fit.plant, "c_skew", 0.0) + 0.5 * (link.c_pos - link.c_neg)
     if (not skew and skewed) or any(n not in fit.estimates for n in extras.names):
@@ -853,7 +860,7 @@ def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev,
     link0[rate] = RATE_GRID[0] * v_scale
     return (np.concatenate([[fit.plant.m, c], link0,
                             [fit.estimates[name] for name in extras.names]]),
-            0 if rigid else fit.n_evaluations)
+            0 if rigid else fit.n_evaluations, fit)
 
 
 #: A positive parameter that ends this factor from its start value is reported as at the edge

@@ -68,6 +68,11 @@ class IOIdentification:
         The signal fitted: the position from the force (input-output records), or the
         force from the displacement (force-displacement records of a link without
         inertia).
+    rigid_limit : IOIdentification or None
+        On a positioning axis (a mass-damper), the fit of the link's rigid limit, the
+        Coulomb link with the same options, that a friction link's search started from (not
+        in :meth:`to_dict`): what a Jenkins link whose stiffness the records do not resolve
+        is reported as (:func:`~motionhyst.identify.io_friction.unresolved_stiffness`).
 
     Examples
     --------
@@ -106,6 +111,7 @@ class IOIdentification:
     residuals: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0), repr=False,
                                            compare=False)
     output: str = "position"
+    rigid_limit: IOIdentification | None = field(default=None, repr=False, compare=False)
 
     @property
     def unit(self) -> str:

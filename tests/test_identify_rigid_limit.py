@@ -1,0 +1,70 @@
+"""A Jenkins link on a positioning axis whose stiffness its records do not resolve is reported
+as its rigid limit, the Coulomb link (identify_io(rigid_limit=True), identify --model jenkins;
+motionhyst.identify.io_friction.as_rigid_limit)."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+
+import numpy as np
+import pytest
+
+from motionhyst.hysteresis import Coulomb, Jenkins
+from motionhyst.identify.input_output import IORecord, identify_io
+from motionhyst.plants.mass_damper import MassDamper
+from motionhyst.time.openloop import simulate_elements
+
+FS = 1000.0
+TRUE = {"m": 95.0, "c": 200.0, "link.fc": 20.0, "input_offset": -3.0, "v0": 0.02}
+
+
+def _axis_record(link, n: int = 2500) -> IORecord:
+    """A positioning axis (mass, damper, friction link) driven by a smooth force, with a force
+    offset and an initial velocity."""
+    t = np.arange(n) / FS
+    u = (30 + 90 * np.sin(2 * np.pi * 0.6 * t + 0.1) + 40 * np.sin(2 * np.pi * 1.7 * t + 0.3)
+         + 15 * np.sin(2 * np.pi * 4.1 * t + 0.2))
+    mech = MassDamper(TRUE["m"], TRUE["c"]).mechanics()
+    y, _ = simulate_elements(mech, link.time_stepping(), u - TRUE["input_offset"], FS, 20,
+                             periodic=False, x0=np.array([0.0, TRUE["v0"]]))
+    return IORecord(t, u, y, "axis")
+
+
+def test_identify_jenkins_on_a_rigid_slider_reports_the_coulomb_link(tmp_path, capsys):
+    """Records of a Coulomb axis: the Jenkins search's stiffness is not determined (or, from
+    other starts, a soft link that rings at its stuck mode and fits worse than the Coulomb fit
+    it started from); identify reports that limit, says so in one line and saves the Coulomb
+    link with the axis's values."""
+    from motionhyst.cli import main
+
+    rec = _axis_record(Coulomb(fc=TRUE["link.fc"]))
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+    model = tmp_path / "m.toml"
+    assert main(["identify", str(path), "--record", "input-output", "--plant", "mass-damper",
+                 "--model", "jenkins", "--json", "--save", str(model)]) == 0
+    out, err = capsys.readouterr()
+    lines = [line for line in err.splitlines() if "rigid limit" in line]
+    assert len(lines) == 1 and "the Coulomb link (fc 20 N" in lines[0], err
+    result = json.loads(out)
+    assert result["rigid_limit"].startswith("jenkins: k ")
+    for name, value in TRUE.items():
+        assert result["estimates"][name] == pytest.approx(value, rel=1e-6), name
+    assert "link.k" not in result["estimates"]
+    saved = tomllib.loads(model.read_text())
+    assert saved["hysteresis"]["model"] == "coulomb"
+    assert saved["hysteresis"]["fc"] == pytest.approx(TRUE["link.fc"], rel=1e-6)
+
+
+def test_a_stiffness_the_records_resolve_stays_a_jenkins_link():
+    """Records of a Jenkins axis whose stuck mode (7.3 Hz) the 1 kHz records resolve: the
+    rule leaves the Jenkins link and its stiffness as fitted."""
+    rec = _axis_record(Jenkins(k=2e5, fc=TRUE["link.fc"]))
+    fit = identify_io([rec], "jenkins", plant="mass-damper", substeps=20, rigid_limit=True)
+    assert isinstance(fit.hysteresis, Jenkins) and "rigid_limit" not in fit.extra
+    assert fit.estimates["link.k"] == pytest.approx(2e5, rel=1e-4)
+    assert fit.estimates["m"] == pytest.approx(TRUE["m"], rel=1e-5)
+    assert fit.rigid_limit is not None and isinstance(fit.rigid_limit.hysteresis, Coulomb)
+    assert fit.rigid_limit.fit_rms > fit.fit_rms
