@@ -157,8 +157,14 @@ def test_benchmark_on_one_training_period_meets_the_multisine_target():
 def test_benchmark_command_without_test_sets(tmp_path, capsys, monkeypatch):
     from motionhyst.cli import main
 
-    monkeypatch.chdir(tmp_path)  # no ../shared here
-    assert main(["benchmark", "bouc-wen"]) == 2
-    assert "give --data DIR" in capsys.readouterr().err
+    for name in ("bouc-wen", "emps"):  # the benchmarks' folders beside the working folder
+        (tmp_path / "shared" / "benchmarks" / name).mkdir(parents=True)
+    (tmp_path / "repo").mkdir()
+    monkeypatch.chdir(tmp_path / "repo")
+    for name in ("bouc-wen", "emps"):  # never looked for in ../shared: --data is required
+        assert main(["benchmark", name]) == 2
+        err = capsys.readouterr().err
+        assert "give --data DIR" in err and "nonlinearbenchmark.org" in err
+        assert err.count("\n") == 1
     assert main(["benchmark", "bouc-wen", "--data", str(tmp_path)]) == 2
     assert "uval_multisine.mat: no such file" in capsys.readouterr().err

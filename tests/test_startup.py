@@ -148,6 +148,27 @@ def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path,
     assert not (tmp_path / "p.csv").exists()
 
 
+@pytest.mark.parametrize("argv, error", [
+    (["benchmark", "emps"], "give --data DIR, the folder with DATA_EMPS.mat"),
+    (["benchmark", "bouc-wen"], "give --data DIR, the folder with uval_multisine.mat"),
+    (["benchmark", "emps", "--data", "none"], "--data none: no such folder"),
+    (["benchmark", "emps", "--data", "."], "has no DATA_EMPS.mat"),
+    (["benchmark", "emps", "--data", "text"], "not a MATLAB .mat file (a text file)"),
+    (["benchmark", "emps", "--data", "short"], "no variable 'vir' (the file has: t, qm)"),
+    (["benchmark", "emps", "--data", "short", "--models", "coulomb,coulomb"], "distinct names"),
+    (["benchmark", "emps", "--data", "short", "--seed", "1"], "--seed applies to bouc-wen"),
+])
+def test_a_benchmark_refusal_comes_before_the_fit_libraries(tmp_path, argv, error):
+    """The data folder, its records and the options are checked before the optimisers load."""
+    from scipy.io import savemat
+
+    (tmp_path / "text").mkdir()
+    (tmp_path / "text" / "DATA_EMPS.mat").write_text("t,vir,qm\n0,0,0\n")
+    (tmp_path / "short").mkdir()
+    savemat(tmp_path / "short" / "DATA_EMPS.mat", {"t": np.arange(10.0), "qm": np.zeros(10)})
+    _assert_refused_without_fit_libraries(argv, error, tmp_path)
+
+
 def _refused_scenarios() -> dict[str, str]:
     """Scenarios a command refuses before it builds their loop, and the files they name."""
     from motionhyst.scenario import default_scenario_path

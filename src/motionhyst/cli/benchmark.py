@@ -25,8 +25,8 @@ def add_parser(sub) -> None:
     q.add_argument("--data", metavar="DIR",
                    help="bouc-wen: folder with the official test sets uval_/yval_multisine.mat "
                         "and uval_/yval_sinesweep.mat; emps: folder with DATA_EMPS.mat and, "
-                        "if downloaded, the test record DATA_EMPS_PULSES.mat (default: "
-                        "../shared/benchmarks/NAME when it exists)")
+                        "if downloaded, the test record DATA_EMPS_PULSES.mat (required: both "
+                        "are downloaded from nonlinearbenchmark.org)")
     q.add_argument("--seed", type=int, default=None,
                    help="bouc-wen: seed of the training multisines and noise (default 0)")
     q.add_argument("--periods", metavar="A-B", type=_periods,
@@ -58,6 +58,13 @@ def _periods(text: str) -> tuple[int, int] | str:
     return a, b
 
 
+DATA_FILES = {"bouc-wen": "uval_multisine.mat, yval_multisine.mat, uval_sinesweep.mat and "
+                          "yval_sinesweep.mat",
+              "emps": "DATA_EMPS.mat (and the test record DATA_EMPS_PULSES.mat, if you have it)"}
+"""The files ``--data`` names the folder of, per benchmark (downloaded from
+nonlinearbenchmark.org; never looked for anywhere else)."""
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark named and print its table (or JSON)."""
     if args.name == "emps":
@@ -68,17 +75,21 @@ def run(args: argparse.Namespace) -> int:
     return run_bouc_wen(args)
 
 
+def _data(args: argparse.Namespace) -> Path:
+    """The folder ``--data`` names (required: the product looks for no data anywhere else)."""
+    if args.data is None:
+        raise UsageError(f"motionhyst benchmark {args.name}: give --data DIR, the folder with "
+                         f"{DATA_FILES[args.name]}, downloaded from nonlinearbenchmark.org")
+    return Path(args.data)
+
+
 def run_bouc_wen(args: argparse.Namespace) -> int:
     """Make training data, identify, score on the official test sets, print the table."""
-    from motionhyst.identify.benchmark import default_data_dir, run_benchmark
+    from motionhyst.identify.benchmark import run_benchmark
 
     if args.seed is None:
         args.seed = 0
-    data = args.data if args.data is not None else default_data_dir()
-    if data is None:
-        raise UsageError("motionhyst benchmark: no test sets: give --data DIR (the folder "
-                         "with uval_multisine.mat, ...; ../shared/benchmarks/bouc-wen does "
-                         "not exist)")
+    data = _data(args)
 
     def say(msg: str) -> None:
         if not args.json:
@@ -108,9 +119,8 @@ def run_bouc_wen(args: argparse.Namespace) -> int:
 
 
 def _emps_record(path: Path, name: str):
-    from motionhyst.identify.emps import COLUMNS, DRIVE_GAIN
-    from motionhyst.identify.input_output import IORecord
-    from motionhyst.identify.io_records import check_records
+    from motionhyst.identify.emps_files import COLUMNS, DRIVE_GAIN
+    from motionhyst.identify.io_records import IORecord, check_records
     from motionhyst.io.records import read_record
 
     data = read_record(path, ("time", "force", "displacement"), columns=COLUMNS,
@@ -122,14 +132,7 @@ def _emps_record(path: Path, name: str):
 
 def run_emps(args: argparse.Namespace) -> int:
     """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
-    from motionhyst.identify.emps import (
-        CHOSEN,
-        ESTIMATION_FILE,
-        TEST_FILE,
-        choose,
-        cross_validate,
-        run_emps,
-    )
+    from motionhyst.identify.emps_files import ESTIMATION_FILE, TEST_FILE
     from motionhyst.identify.emps_models import check_model
 
     if args.seed is not None:
@@ -146,13 +149,7 @@ def run_emps(args: argparse.Namespace) -> int:
                 check_model(name)
             except ValueError as exc:
                 raise UsageError(f"motionhyst benchmark emps: --models: {exc}") from None
-    if args.data is not None:
-        data = Path(args.data)
-    else:
-        data = Path("..") / "shared" / "benchmarks" / "emps"
-        if not data.is_dir():
-            raise UsageError("motionhyst benchmark emps: give --data DIR (the folder with "
-                             "DATA_EMPS.mat; ../shared/benchmarks/emps does not exist)")
+    data = _data(args)
     if not data.is_dir():
         raise UsageError(f"motionhyst benchmark emps: --data {data}: no such folder")
     est_path, test_path = data / ESTIMATION_FILE, data / TEST_FILE
@@ -169,6 +166,8 @@ def run_emps(args: argparse.Namespace) -> int:
     if test is not None and args.periods is not None:
         raise UsageError(f"motionhyst benchmark emps: --periods splits DATA_EMPS when there is "
                          f"no test record; {test_path} is there")
+    # the optimisers imported once the folder, its records and the options are known good
+    from motionhyst.identify.emps import CHOSEN, choose, cross_validate, run_emps
 
     def say(msg: str) -> None:
         if not args.json:

@@ -429,12 +429,6 @@ def load_test_set(directory: str | Path, name: str) -> Record:
     return Record(np.arange(u.size) / FS, u, y)
 
 
-def default_data_dir() -> Path | None:
-    """``../shared/benchmarks/bouc-wen`` (relative to the working folder) if it exists."""
-    d = Path("..") / "shared" / "benchmarks" / "bouc-wen"
-    return d if d.is_dir() else None
-
-
 def generator_check(directory: str | Path) -> float:
     """RMS difference [m] between the generator's output and the official multisine test output.
 

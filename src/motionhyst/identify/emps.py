@@ -40,6 +40,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from motionhyst.core.warnings import MotionhystWarning
+from motionhyst.identify.emps_files import COLUMNS, DRIVE_GAIN, ESTIMATION_FILE, TEST_FILE
 from motionhyst.identify.emps_models import (
     OPTIONS,
     RIGID_LIMIT,
@@ -66,14 +67,6 @@ __all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
            "choose", "cross_validate", "own_offset_score", "period_drift", "run_emps", "score",
            "split_by_periods"]
 
-ESTIMATION_FILE = "DATA_EMPS.mat"
-"""The benchmark's estimation record."""
-TEST_FILE = "DATA_EMPS_PULSES.mat"
-"""The benchmark's test record (the estimation reference with 5 V force pulses added)."""
-COLUMNS = {"time": "t", "force": "vir", "displacement": "qm"}
-"""The records' variables: time [s], controller output [V], measured position [m]."""
-DRIVE_GAIN = 35.15065
-"""The drive's gain ``gtau`` [N/V]: the force on the load is ``gtau * vir``."""
 PERIOD = 6240
 """Samples per period of the estimation record's reference ``qg``."""
 MODELS = ("coulomb-asymmetric", "coulomb-asymmetric-drift", "jenkins-asymmetric")
