@@ -48,15 +48,22 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.budget import format_size
 from motionhyst.identify.io_uncertainty import BOUC_WEN_IDENTIFIED
 from motionhyst.io.inputs import TOML_EXPANSION, InputFileError, read_text, read_toml
 
-__all__ = ["LOG_SPACE_CV", "JointNormal", "distributions_from_identification",
-           "joint_from_identification", "least_value"]
+__all__ = ["LOG_SPACE_CV", "MAX_IDENTIFICATION_BYTES", "JointNormal",
+           "distributions_from_identification", "joint_from_identification", "least_value"]
 
 LOG_SPACE_CV = 0.2
 """Largest relative standard error of a drawn parameter for which the draws are those of the
 normal distribution; above it, of the lognormal one with the same means and covariance."""
+
+MAX_IDENTIFICATION_BYTES = 4_000_000
+"""Largest identification file read [bytes].  What ``identify --save`` or ``--json`` writes is
+a few kB (its largest, 20 Maxwell-slip elements with the stage, under 100 kB: the correlation
+of some 50 parameters); a larger file is refused before it is parsed (parsing TOML takes about
+0.1 s of CPU per MB)."""
 
 _CORRELATION_ROUNDING = 1e-9  # a saved correlation matrix is rounded to 1e-12
 
@@ -263,6 +270,14 @@ def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _read(path: Path, where: str):
+    try:
+        size = path.stat().st_size
+    except (OSError, ValueError):  # read_text says why
+        size = 0
+    if size > MAX_IDENTIFICATION_BYTES:
+        raise ValueError(f"{where}: {format_size(size)}, too large for an identification "
+                         f"(`motionhyst identify --save` writes a few kB; at most "
+                         f"{format_size(MAX_IDENTIFICATION_BYTES)} is read)")
     try:
         if path.suffix.lower() == ".toml":
             return read_toml(path)
