@@ -49,6 +49,31 @@ def test_a_standard_output_opened_for_reading_is_named(tmp_path):
     assert "standard output is not open for writing" in proc.stderr
 
 
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full here")
+@pytest.mark.parametrize("argv", [
+    ["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01"],           # a table
+    ["df", "--k", "20", "--fc", "0.05", "--amplitude", "0.01", "--json"],  # a short JSON
+])
+def test_a_full_standard_output_is_named(tmp_path, argv):
+    """``motionhyst df ... > /dev/full`` said "No space left on device", naming nothing."""
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-c", _MAIN, *argv], stdout=full,
+                              stderr=subprocess.PIPE, text=True, cwd=tmp_path, timeout=600)
+    assert proc.returncode == 2
+    assert proc.stderr == ("motionhyst: error: standard output: No space left on device\n")
+
+
+def test_a_broken_pipe_is_still_no_error(tmp_path):
+    """Output piped into ``head``: the reader gone is the end of the output, exit 0."""
+    proc = subprocess.Popen([sys.executable, "-c", _MAIN, "df", "--k", "20", "--fc", "0.05",
+                             "--amplitude", *[str(a) for a in np.geomspace(1e-3, 1, 2000)]],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
+    proc.stdout.readline()
+    proc.stdout.close()
+    assert proc.wait(timeout=600) == 0
+    assert proc.stderr.read() == b""
+
+
 def test_a_command_writing_its_results_to_a_file_runs_with_stdout_closed(tmp_path):
     from motionhyst.scenario import default_scenario_path
 
@@ -96,6 +121,34 @@ def test_an_identification_nested_too_deeply_is_refused_naming_it(tmp_path, monk
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "deep.json: JSON nested too deeply" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["deep.json", "paper.toml", "s.toml"]
+
+
+@pytest.mark.parametrize("suffix", ["toml", "json"])
+def test_an_identification_larger_than_any_is_refused_before_it_is_parsed(
+        tmp_path, monkeypatch, capsys, suffix):
+    """A 64 MB TOML took 7.8 s of CPU to parse before any check: its size is refused first;
+    what ``identify --save`` writes (a few kB) and a 200-element one (0.8 MB) are read."""
+    import motionhyst.study.identified as identified
+    from motionhyst.scenario import default_scenario_path
+
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    (tmp_path / "s.toml").write_text('scenario = "paper.toml"\noutputs = ["mismatch"]\n\n'
+                                     '[axes]\namplitude = [0.01]\nfrequency_hz = [5.0]\n')
+    big = tmp_path / f"big.{suffix}"
+    last = "{}" if suffix == "json" else "#"  # after blank lines: valid, past the limit by 1
+    big.write_text("\n" * (identified.MAX_IDENTIFICATION_BYTES + 1 - len(last)) + last)
+    assert big.stat().st_size == identified.MAX_IDENTIFICATION_BYTES + 1
+
+    def parsed(*args, **kwargs):
+        raise AssertionError("the file was parsed")
+
+    monkeypatch.setattr(identified, "read_toml", parsed)
+    monkeypatch.setattr(identified, "read_text", parsed)
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "s.toml", "--from-identification", big.name, "--out", "o.zarr"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"big.{suffix}: 4 MB, too large for an identification" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [big.name, "paper.toml", "s.toml"]
 
 
 def test_a_dahl_shape_exponent_past_its_range_is_refused_by_df(capsys):

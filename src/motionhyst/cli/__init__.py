@@ -130,6 +130,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                                  f"the command writes no file: its results would be lost; give "
                                  f"it an output (a terminal, a file or a pipe)")
             sys.stdout = open(os.devnull, "w")  # the files are the results; the summary is lost
+        else:
+            sys.stdout = _NamedOutput(sys.stdout)
         set_max_memory(args.max_memory)
         set_max_seconds(args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
@@ -137,6 +139,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             code = args.func(args)
         if interrupts.received:  # a library swallowed it (an optional import that failed)
             raise KeyboardInterrupt
+        sys.stdout.flush()  # a full disk said here, naming the output, not at the exit
         return code
     except BrokenPipeError:  # output piped into head, say: not an error
         sys.stdout = open(os.devnull, "w")
@@ -153,6 +156,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     finally:
         interrupts.close()  # a signal from here on is noted, not raised
+        if isinstance(sys.stdout, _NamedOutput):
+            sys.stdout = sys.stdout.stream
         set_max_memory(None)
         set_max_seconds(None)
         if closed and sys.stdout is not None:
@@ -262,6 +267,34 @@ class _Interrupts:
                 signal.signal(sig, signal.SIG_IGN if ignore else previous)
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self.hook
+
+
+class _NamedOutput:
+    """The standard output, its write errors naming it: ``> /dev/full`` ends in "standard
+    output: No space left on device", not in an error that names nothing (a broken pipe
+    stays what it is: output piped into ``head`` is no error)."""
+
+    def __init__(self, stream):
+        self.stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self.stream.write(text)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, "standard output") from None
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, "standard output") from None
+
+    def __getattr__(self, name: str):
+        return getattr(self.stream, name)
 
 
 def _writable(stream) -> bool:
