@@ -151,6 +151,38 @@ def test_an_identification_larger_than_any_is_refused_before_it_is_parsed(
     assert sorted(p.name for p in tmp_path.iterdir()) == [big.name, "paper.toml", "s.toml"]
 
 
+@pytest.mark.parametrize("points_to", ["a folder", "a store", "nothing"])
+def test_a_store_named_by_a_link_replaces_the_link_with_force_never_its_target(
+        tmp_path, monkeypatch, capsys, points_to):
+    """One rule for every writer: a symbolic link is refused without --force; with it the
+    link itself is replaced (here by a new store), what it points to left as it was (a
+    store holding the same study is not resumed through the link)."""
+    from motionhyst.scenario import default_scenario_path
+    from motionhyst.study.store import is_study_store
+
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    (tmp_path / "s.toml").write_text('scenario = "paper.toml"\noutputs = ["mismatch"]\n\n'
+                                     '[axes]\namplitude = [0.01]\nfrequency_hz = [5.0]\n')
+    monkeypatch.chdir(tmp_path)
+    if points_to == "a folder":
+        (tmp_path / "mine").mkdir()
+        (tmp_path / "mine" / "notes.txt").write_text("mine")
+    elif points_to == "a store":
+        assert main(["study", "s.toml", "--out", "mine", "--workers", "0"]) == 0
+    target = tmp_path / ("mine" if points_to != "nothing" else "gone")
+    before = {p: p.read_bytes() for p in target.rglob("*") if p.is_file()}
+    (tmp_path / "o.zarr").symlink_to(target.name)
+    capsys.readouterr()
+    assert main(["study", "s.toml", "--out", "o.zarr", "--workers", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "o.zarr is a symbolic link" in err and "--force" in err
+    assert (tmp_path / "o.zarr").is_symlink()
+    assert main(["study", "s.toml", "--out", "o.zarr", "--workers", "0", "--force"]) == 0
+    assert not (tmp_path / "o.zarr").is_symlink() and is_study_store(tmp_path / "o.zarr")
+    assert {p: p.read_bytes() for p in target.rglob("*") if p.is_file()} == before
+    assert target.exists() == (points_to != "nothing")
+
+
 def test_a_dahl_shape_exponent_past_its_range_is_refused_by_df(capsys):
     """``df --model dahl --alpha 1e25`` printed a describing function of 2e-20 N/m with a
     negative imaginary part: past about 1e15 the closed form has no digit left."""

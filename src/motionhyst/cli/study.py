@@ -77,8 +77,8 @@ def _exports(ds, args: argparse.Namespace) -> None:
 
 def _check_options(args: argparse.Namespace) -> None:
     """Refuse what a run would ignore or could not write, before the work: an option without
-    effect on an estimate; a store named "-", by a symbolic link (no writer follows one) or
-    where no file can be created."""
+    effect on an estimate; a store named "-", by a symbolic link without --force (no writer
+    follows one; with it, the link itself is replaced) or where no file can be created."""
     if args.estimate and args.summary is None:
         for opt, given in (("--table", args.table), ("--netcdf", args.netcdf),
                            ("--figure", args.figure), ("--force", args.force),
@@ -89,7 +89,7 @@ def _check_options(args: argparse.Namespace) -> None:
     if args.out is not None and args.summary is None:
         from motionhyst.io.outputs import check_output_folder
 
-        check_output_folder(args.out, "--out")
+        check_output_folder(args.out, "--out", force=args.force)
     _check_files(args)
     if args.scheduler is not None and args.workers is not None and args.summary is None:
         raise UsageError("study: --workers has no effect with --scheduler (the cluster's "

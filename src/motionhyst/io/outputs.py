@@ -212,9 +212,11 @@ def _cannot_create_in(folder: Path) -> str | None:
     return None
 
 
-def check_output_folder(path: str | os.PathLike, option: str) -> None:
+def check_output_folder(path: str | os.PathLike, option: str, force: bool = False) -> None:
     """Raise :class:`OutputError` before the work if a folder a command fills itself (a study's
-    store) cannot be: no name, ``-``, a symbolic link, or no file can be created where it goes.
+    store) cannot be: no name, ``-``, a symbolic link without `force` (with it, the link
+    itself is to be replaced by the new folder, never what it points to), or no file can be
+    created where it goes.
 
     Parameters
     ----------
@@ -222,6 +224,8 @@ def check_output_folder(path: str | os.PathLike, option: str) -> None:
         The folder, existing or to be made.
     option : str
         The option naming it, for messages.
+    force : bool
+        The user asked to replace what is there (``--force``).
 
     Examples
     --------
@@ -237,8 +241,14 @@ def check_output_folder(path: str | os.PathLike, option: str) -> None:
         raise OutputError(f"{label}: not a folder name")
     path = Path(path)
     if path.is_symlink():
-        raise OutputError(f"{label} is a symbolic link; give the folder it points to or "
-                          f"another name")
+        if not force:
+            raise OutputError(f"{label} is a symbolic link; give the folder it points to, "
+                              f"another name, or --force to replace the link itself (never "
+                              f"what it points to)")
+        problem = _cannot_create_in(path.parent)
+        if problem is not None:
+            raise OutputError(f"{label}: cannot replace the link in {path.parent} ({problem})")
+        return
     problem = _cannot_create_in(path) if path.is_dir() else None
     if problem is not None:
         raise OutputError(f"{label}: cannot create a file in {path} ({problem})")

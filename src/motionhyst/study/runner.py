@@ -267,8 +267,15 @@ def estimate_study(study: StudyDefinition, workers: int = 1,
 
 def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStore | None:
     """The store at `path` if it holds `study` (resumed), None if a new one is to be made
-    there; raises before anything is changed if `path` may not be replaced."""
-    if path.exists() or path.is_symlink():
+    there; raises before anything is changed if `path` may not be replaced.  A symbolic
+    link is never followed: with `force` the link itself is replaced by the new store."""
+    if path.is_symlink():
+        if not force:
+            raise StudyError(f"--out {path} is a symbolic link; give the folder it points to, "
+                             f"another name, or --force to replace the link itself (never "
+                             f"what it points to)")
+        return None
+    if path.exists():
         if not is_study_store(path):
             raise StudyError(f"--out {path}: exists and is not a study's store; refusing to "
                              f"replace it")
@@ -290,7 +297,9 @@ def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStor
 
 
 def _new_store(study: StudyDefinition, path: Path, version: str) -> StudyStore:
-    if path.exists() or path.is_symlink():  # another study's, replaced with force
+    if path.is_symlink():  # replaced with force; what it points to is left as it is
+        path.unlink()
+    elif path.exists():  # another study's, replaced with force
         remove_store(path)
     return StudyStore.create(path, study, version)
 
@@ -373,7 +382,8 @@ def run_study(study: StudyDefinition, store: str | Path, workers: int | None = N
     client : distributed.Client, optional
         Run the batches on this dask cluster instead.
     force : bool
-        Replace a store holding another study.
+        Replace a store holding another study, or a symbolic link named `store` (the link
+        itself, never what it points to).
     batch : int, optional
         Points a batch (default: at least 0.1 s of work, measured).
     progress : bool
