@@ -8,8 +8,11 @@ the loop cannot mean (decades above its fastest pole) and a run whose step
 the loop's poles set (from the scenario's coefficients, before python-control builds
 the loop), a list of a million values, a constant force, an input-output record without
 inertia (its inverse-dynamics estimate), a force that is a curve of the displacement
-without loops; and one that needs the work it refuses: a fit that finds no model of the
-record (a spring and a damper: loops, but not a stop operator's).  Each runs as a whole
+without loops, a force whose loops are a damper's, a benchmark without its data folder or
+with a text file for its record, an identification file larger than any, a study's store
+named by a symbolic link; and one that needs the work it refuses: a fit that finds no
+model of the record (a Jenkins element, a spring and a damper: loops, but not a stop
+operator's).  Each runs as a whole
 process (the interpreter, the imports, the checks) in a folder holding its files,
 ``REPEATS`` times interleaved with the baseline of the same run: ``motionhyst --help``,
 the command's start alone.  Reported per case: the least wall time (the least disturbed
@@ -33,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from motionhyst.hysteresis import Jenkins
 from motionhyst.scenario import default_scenario_path
 
 REPEATS = 3
@@ -71,8 +75,15 @@ def _files() -> dict[str, str]:
         "fd-zero.csv": _rows("time,displacement,force", t, x, 0.0 * x),
         "fd-elastic.csv": _rows("time,displacement,force", t, x,
                                 np.clip(20.0 * x, -0.01, 0.01)),  # a curve: no loops
-        "fd-viscous.csv": _rows("time,displacement,force", t, x,
-                                20.0 * x + np.gradient(x, t)),  # no stop operator fits
+        "fd-damper.csv": _rows("time,displacement,force", t, x,
+                               20.0 * x + np.gradient(x, t)),  # a damper's loops
+        "fd-jenkins-damper.csv": _rows("time,displacement,force", t, x,  # no stop operator fits
+                                       Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x
+                                       + 1.6 * np.gradient(x, t)),
+        "study.toml": ('scenario = "s.toml"\noutputs = ["mismatch"]\n\n[axes]\n'
+                       'amplitude = [0.01]\nfrequency_hz = [5.0]\n'),
+        "big-identification.toml": "#\n" * 2_500_000,  # 5 MB: larger than any
+        "emps-text/DATA_EMPS.mat": "t,vir,qm\n0,0,0\n",
         "slip.toml": PAPER.replace('model = "jenkins"', 'model = "maxwell-slip"').replace(
             "k = 20.0 ", "k = [" + "1.0," * 1_000_000 + "] ").replace(
             "fc = 0.05 ", "fc = [" + "0.01," * 1_000_000 + "] "),  # a million elements
@@ -105,7 +116,13 @@ CASES = [
     ("constant force", ["identify", "fd-zero.csv"], "checks"),
     ("no inertia", ["identify", "io.csv", "--record", "input-output"], "checks"),
     ("a curve without loops", ["identify", "fd-elastic.csv"], "checks"),
-    ("no stop operator fits", ["identify", "fd-viscous.csv"], "a fit"),
+    ("a damper's loops", ["identify", "fd-damper.csv"], "checks"),
+    ("benchmark without data", ["benchmark", "emps"], "checks"),
+    ("benchmark text .mat", ["benchmark", "emps", "--data", "emps-text"], "checks"),
+    ("identification size", ["study", "study.toml", "--from-identification",
+                             "big-identification.toml", "--out", "o.zarr"], "checks"),
+    ("store named by a link", ["study", "study.toml", "--out", "link.zarr"], "checks"),
+    ("no stop operator fits", ["identify", "fd-jenkins-damper.csv"], "a fit"),
 ]
 
 
@@ -126,9 +143,11 @@ def measure(repeats: int = REPEATS) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         (folder / "pl").mkdir()
+        (folder / "emps-text").mkdir()
+        (folder / "link.zarr").symlink_to("pl")
         for name, text in _files().items():
             (folder / name).write_text(text)
-        _run(["identify", "fd-viscous.csv"], folder)  # compiled kernels cached before timing
+        _run(["identify", "fd-jenkins-damper.csv"], folder)  # compiled kernels cached first
         best: dict[str, tuple[float, float, int, str]] = {}
         for _ in range(repeats):
             for name, argv in [("baseline", ["--help"])] + [(c[0], c[1]) for c in CASES]:

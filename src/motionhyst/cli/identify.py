@@ -193,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
     if kind == "force-displacement":
         if args.elements is None or target is not None:  # refused, not reported: at once
             try:
-                check_loops_open(x, w)
+                check_loops_open(x, w, t)
             except ValueError as exc:
                 raise ValueError(f"{path}: {exc}") from None
         from motionhyst.identify.fit import identify_maxwell_slip
