@@ -265,12 +265,20 @@ def test_a_refusal_that_needs_no_loop_comes_before_the_fit_libraries(tmp_path, a
       "1e9"], "too many time steps"),
     ([*SCAN, "--window", "1"], "longer than the scan"),
     (["study", "--summary", "pl"], "pl: not a store of motionhyst study"),  # zarr, xarray
+    # a CSV header is read as pandas reads it, without pandas: a header refused does not wait
+    (["identify", "notes.csv"], "unknown record header 'my notes'"),
+    (["identify", "twice.csv"], "column 'displacement' appears twice in the header"),
+    (["identify", "io.csv", "--record", "input-output"], "missing column(s) displacement"),
+    (["predict", "open.toml", "notes.csv", "--out", "p.csv"], "missing column(s) time"),
 ])
 def test_a_file_or_a_size_is_refused_before_any_heavy_library(tmp_path, argv, error):
     """Neither pandas (it parses a CSV; these are refused before) nor anything else heavy."""
     (tmp_path / "pl").mkdir()
     (tmp_path / "d.csv").mkdir()
-    for name, text in {**_refused_scenarios(), "f.mat": "time,force\n0,1\n"}.items():
+    files = {"f.mat": "time,force\n0,1\n", "notes.csv": "my notes\n1\n",
+             "twice.csv": 'time; Displacement ;force;"displacement"\n0;0;0;1\n',
+             "io.csv": "\ufeff Time ,\tForce\r\n0,1\r\n"}
+    for name, text in {**_refused_scenarios(), **files}.items():
         (tmp_path / name).write_text(text)
     out = _probe(*argv, cwd=tmp_path)
     assert out["rc"] == 2 and error in out["err"], out["err"]

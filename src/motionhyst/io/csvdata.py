@@ -187,19 +187,27 @@ def _read_csv(path: Path, d: _Dialect, empty: str = "empty file: no header, no d
 
 def _file_header(path: Path, d: _Dialect) -> list[str]:
     """Normalised names of the header line (an unnamed column is ``""``); a name given twice
-    is a CSVError (pandas would rename the second ``name.1`` and one of them be read)."""
-    head = _read_csv(path, d, nrows=0, skiprows=d.header_line - 1, header=0,
-                     index_col=False)
-    _check_unique(_raw_header(path, d), str(path))
-    return ["" if str(c).startswith("Unnamed: ") else normalize_name(c) for c in head.columns]
+    is a CSVError (pandas would rename the second ``name.1`` and one of them be read).  Read
+    without pandas, as its parser reads it (quotes, spaces after the separator): a file
+    whose header is refused does not wait for pandas to load."""
+    names = _raw_header(path, d)
+    _check_unique(names, str(path))
+    return names
 
 
 def _raw_header(path: Path, d: _Dialect) -> list[str]:
     """Normalised names of the header line as written, repeated names kept."""
-    with path.open(encoding=d.encoding, errors="replace", newline="") as fh:
-        for number, line in enumerate(fh, 1):
-            if number == d.header_line:
-                return [normalize_name(c) for c in next(csv.reader([line], delimiter=d.sep), [])]
+    try:
+        with path.open(encoding=d.encoding, errors="replace", newline="") as fh:
+            for number, line in enumerate(fh, 1):
+                if number == d.header_line:
+                    fields = next(csv.reader([line], delimiter=d.sep, skipinitialspace=True),
+                                  [])
+                    return [normalize_name(c) for c in fields]
+    except csv.Error as exc:  # a NUL byte in the header: not a text table
+        raise CSVError(f"{path}: cannot parse the header line: {exc}") from None
+    except OSError as exc:
+        raise CSVError(f"cannot read {path}: {exc.strerror}") from None
     return []
 
 
