@@ -195,16 +195,41 @@ def _scale(text: str) -> dict[str, float]:
         raise argparse.ArgumentTypeError(str(exc).removeprefix("--scale: ")) from None
 
 
+class _Pairs(argparse.Action):
+    """``--columns`` or ``--scale`` given more than once: their pairs together (a quantity
+    named twice is an error), none replacing another's in silence."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = dict(getattr(namespace, self.dest, None) or {})
+        for name in values:
+            if name in given:
+                parser.error(f"argument {option_string}: {name!r} is given twice")
+        setattr(namespace, self.dest, {**given, **values})
+
+
 def add_record_options(q: argparse.ArgumentParser, quantities: str, example: str) -> None:
     """Add ``--columns`` and ``--scale`` (:mod:`motionhyst.io.records`) to a record reader.
 
-    `quantities` names the columns the command reads, `example` is a column map.
+    `quantities` names the columns the command reads, `example` is a column map.  Either
+    may be given more than once: the pairs of all count.
+
+    Examples
+    --------
+    >>> q = Parser(prog="motionhyst predict")
+    >>> add_record_options(q, "time,force", "time=t,force=vir")
+    >>> q.parse_args(["--columns", "time=t", "--columns", "force=vir"]).columns
+    {'time': 't', 'force': 'vir'}
+    >>> try:
+    ...     q.parse_args(["--scale", "force=2", "--scale", "force=3"])
+    ... except UsageError as exc:
+    ...     print(exc)
+    motionhyst predict: argument --scale: 'force' is given twice
     """
-    q.add_argument("--columns", type=_columns, metavar="NAME=COLUMN,...",
+    q.add_argument("--columns", type=_columns, action=_Pairs, metavar="NAME=COLUMN,...",
                    help=f"the record's own names (CSV columns or MATLAB variables, "
                         f"STRUCT.FIELD for a structure's field) of {quantities} (e.g. "
                         f"{example}; default: those names)")
-    q.add_argument("--scale", type=_scale, metavar="NAME=GAIN,...",
+    q.add_argument("--scale", type=_scale, action=_Pairs, metavar="NAME=GAIN,...",
                    help="multiply a column by a gain after reading it (e.g. force=35.15065: "
                         "a drive's volts to newtons)")
 
