@@ -146,14 +146,17 @@ def _check_step(system, t, args) -> None:
         tt, _ = check_record(t, np.zeros(np.size(t)))
     except ValueError as exc:  # the record's time, not the model, is at fault
         raise ValueError(f"{args.data}: {exc}") from None
+    fs = sampling_rate(tt)
     try:
-        r = system.default_substeps(sampling_rate(tt))
+        r = system.default_substeps(fs)
     except (ValueError, OverflowError) as exc:
         raise ValueError(f"{args.scenario}: the model cannot be simulated ({exc})") from None
     if r > MAX_PREDICT_SUBSTEPS:
         raise ValueError(f"{args.scenario}: the model needs {r} integration steps per sample "
-                         f"(more than {MAX_PREDICT_SUBSTEPS}: a mass nearly zero on a stiff "
-                         f"link); a quasi-static plant describes a stage without inertia")
+                         f"of {args.data} (more than {MAX_PREDICT_SUBSTEPS}): its fastest mode "
+                         f"is far above the record's sampling rate {fs:.4g} Hz: a time column "
+                         f"not in seconds (--scale time=GAIN), or a mass nearly zero on a stiff "
+                         f"link (a quasi-static plant describes a stage without inertia)")
 
 
 def _input_quantity(args: argparse.Namespace, system) -> str:
