@@ -116,6 +116,20 @@ _FRD_COLUMNS = {
 }
 
 
+def _first_out_of_order(f: NDArray[np.float64]) -> str:
+    """What is wrong with the first frequency that is not positive or does not increase, and
+    the remedy."""
+    bad = np.flatnonzero(f <= 0)
+    if bad.size:
+        return f"{f[bad[0]]:g} Hz at line {bad[0] + 1} of the data"
+    i = int(np.flatnonzero(np.diff(f) <= 0)[0])
+    if f[i + 1] == f[i]:
+        return (f"{f[i]:g} Hz is given twice (lines {i + 1} and {i + 2} of the data); keep one "
+                f"line for each frequency")
+    return (f"{f[i + 1]:g} Hz follows {f[i]:g} Hz (line {i + 2} of the data); sort the lines "
+            f"by frequency")
+
+
 def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     """Read a measured plant from CSV or MATLAB ``.mat`` (or a DataFrame with the same columns).
 
@@ -175,7 +189,8 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
         raise ValueError(f"{where}: non-finite value in data")
     f = data[:, 0]
     if np.any(f <= 0) or np.any(np.diff(f) <= 0):
-        raise ValueError(f"{where}: frequency_hz must be positive and increasing")
+        raise ValueError(f"{where}: frequency_hz must be positive and increasing: "
+                         f"{_first_out_of_order(f)}")
     if len(f) < 2:
         raise ValueError(f"{where}: need at least two frequencies")
     if kind == "reim":
@@ -195,7 +210,9 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
         low = f <= f[0] * 10
         mass = float(np.median(-1.0 / (omega[low] ** 2 * p2[low].real)))
         if not np.isfinite(mass) or mass <= 0:
-            raise ValueError(f"{where}: cannot estimate the rigid-body mass; give it explicitly")
+            raise ValueError(f"{where}: cannot estimate the rigid-body mass: -1/(omega^2 Re P2) "
+                             f"over the lowest decade is {mass:.3g} kg, not a mass (phases in "
+                             f"radians, or a sign?); check the data or give [plant] mass")
     mass = check_positive("mass", mass)
     import control  # once the data are read and checked: a refusal does not wait for it
 
