@@ -155,6 +155,9 @@ def read_toml(path: str | os.PathLike, check: Callable[[str], None] | None = Non
     >>> _ = path.write_text('outputs = ["e1"]\\n')
     >>> read_toml(path)
     {'outputs': ['e1']}
+    >>> _ = path.write_text('\\ufeffoutputs = ["e1"]\\n')      # a byte-order mark first
+    >>> read_toml(path)
+    {'outputs': ['e1']}
     >>> _ = path.write_text("outputs = [\\n")
     >>> try:
     ...     read_toml(path)
@@ -164,7 +167,9 @@ def read_toml(path: str | os.PathLike, check: Callable[[str], None] | None = Non
     """
     import tomllib
 
-    text = read_text(path, TOML_EXPANSION, "TOML")
+    # a byte-order mark (an editor's "UTF-8 with BOM") is no statement: TOML's parser would
+    # refuse the file's first line for it
+    text = read_text(path, TOML_EXPANSION, "TOML").removeprefix("\ufeff")
     if check is not None:
         check(text)
     try:
