@@ -1,0 +1,135 @@
+"""The hostile corpus over records as engineers have them (issue 26): MATLAB files of every
+level and type, time columns, ``--columns``/``--scale`` misuse, options given twice, and
+records that determine nothing.
+
+Each case runs the command line in a child process under an address-space limit
+(:mod:`limited_process`), in a folder holding the user's files, and asserts exit code 2, one
+line on stderr naming the cause (no traceback), nothing on stdout, and every file there
+before byte-identical afterwards, with no file added.
+"""
+
+from __future__ import annotations
+
+import limited_process
+import numpy as np
+import pytest
+from file_trees import populate, snapshot
+
+from motionhyst.scenario import default_scenario_path
+
+FS = 1000.0
+AXIS = ('[stage]\ntype = "mass-damper"\nm = 2.0\nc = 10.0\n\n'
+        '[hysteresis]\nmodel = "jenkins"\nk = 2e4\nfc = 4.0\n')
+
+
+def _record(n: int = 600) -> dict[str, np.ndarray]:
+    """A 2 kg axis's record (made-up values: the cases are refused before any model runs)."""
+    t = np.arange(n) / FS
+    force = 30 * np.sin(2 * np.pi * 0.5 * t) + 12 * np.sin(2 * np.pi * 2.3 * t + 0.4)
+    return {"t": t, "u": force, "y": np.cumsum(np.cumsum(force - force.mean())) / (2 * FS**2)}
+
+
+def _mat(**variables):
+    """A maker of a MATLAB v5 file: the record's ``t``, ``u``, ``y`` as n x 1 columns, with
+    `variables` added or replacing them."""
+    def make(path) -> None:
+        from scipy.io import savemat
+
+        savemat(path, {**{k: v[:, None] for k, v in _record().items()}, **variables})
+    return make
+
+
+def _frd(f, phase_unit: str = "deg") -> str:
+    """A measured Table I stage at the frequencies `f` [Hz], in their order, as magnitude and
+    phase (the phase column in degrees, or `phase_unit` "rad" under the same name)."""
+    from motionhyst.plants.frf_fit import ModalPlant
+    from motionhyst.plants.two_mass import TwoMassStage
+
+    stage = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    p1, p2 = stage.response(2 * np.pi * np.asarray(f))
+    deg = phase_unit == "deg"
+    rows = np.column_stack([f, np.abs(p1), np.angle(p1, deg=deg), np.abs(p2),
+                            np.angle(p2, deg=deg)])
+    return "frequency_hz,p1_abs,p1_phase_deg,p2_abs,p2_phase_deg\n" + "".join(
+        ",".join(f"{v:.10e}" for v in row) + "\n" for row in rows)
+
+
+PAPER = default_scenario_path().read_text()
+MEASURED = (PAPER[:PAPER.index("[stage]")] + '[plant]\nfile = "plant.csv"\n\n'
+            + PAPER[PAPER.index("[hysteresis]"):])
+LOG = np.geomspace(1.0, 3000.0, 200)
+BASE = {"axis.toml": AXIS, "notes.txt": "my notes", "p.toml": MEASURED}
+PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
+MAP = ["--columns", "time=t,force=u"]
+
+# (id, extra files, argv, words of the one line on stderr); a file given as a callable is
+# made by it (path) -> None
+CASES = [
+    # ------------------------------ --scale given twice: its first gain was silently replaced
+    ("scale-given-twice", {"r.mat": _mat()},
+     [*PREDICT, *MAP, "--scale", "force=2", "--scale", "force=3"],
+     ["argument --scale: 'force' is given twice"]),
+    ("columns-given-twice", {"r.mat": _mat()},
+     [*PREDICT, "--columns", "time=t,force=u", "--columns", "force=y"],
+     ["argument --columns: 'force' is given twice"]),
+    # ------------------------------------------------------- a time column not in seconds
+    ("time-in-milliseconds", {"r.mat": _mat(t=1000 * _record()["t"][:, None])}, [*PREDICT, *MAP],
+     ["integration steps per sample of r.mat", "sampling rate 1 Hz",
+      "a time column not in seconds (--scale time=GAIN)"]),
+    ("time-scaled-to-milliseconds", {"r.mat": _mat()}, [*PREDICT, *MAP, "--scale", "time=1000"],
+     ["sampling rate 1 Hz", "--scale time=GAIN"]),
+    # ------------------------------------------ frequency responses: the lines and their units
+    ("frf-sweep-downwards", {"plant.csv": _frd(LOG[::-1])}, ["analyze", "p.toml"],
+     ["plant.csv: frequency_hz must be positive and increasing: 2881.7 Hz follows 3000 Hz (line 2 "
+      "of the data); sort the lines by frequency"]),
+    ("frf-line-twice", {"plant.csv": _frd(np.sort(np.r_[LOG, LOG[50]]))}, ["analyze", "p.toml"],
+     ["7.47564 Hz is given twice (lines 51 and 52 of the data); keep one line"]),
+    ("frf-zero-hz", {"plant.csv": _frd(LOG).replace("1.0000000000e+00,", "0.0,", 1)},
+     ["analyze", "p.toml"], ["positive and increasing: 0 Hz at line 1 of the data"]),
+    ("frf-phase-in-radians", {"plant.csv": _frd(LOG, "rad")}, ["analyze", "p.toml"],
+     ["cannot estimate the rigid-body mass", "is -22.5 kg, not a mass (phases in radians"]),
+]
+
+
+def test_the_cases_are_distinct():
+    assert len({c[0] for c in CASES}) == len(CASES)
+
+
+@pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_a_record_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv, words):
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, {**BASE, **{k: v for k, v in files.items() if not callable(v)}})
+    for name, make in files.items():
+        if callable(make):
+            make(root / name)
+    before = snapshot(root)
+    line = limited_process.refusal(list(argv), root)
+    for word in words:
+        assert word in line, (word, line)
+    assert snapshot(root) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["user"]
+
+
+def test_a_scenario_saved_with_a_byte_order_mark_is_read_as_without(tmp_path):
+    from motionhyst.scenario import Scenario
+
+    path = tmp_path / "s.toml"
+    path.write_text("\ufeff" + PAPER, encoding="utf-8")
+    assert Scenario.from_file(path).to_dict() == Scenario.from_file(
+        default_scenario_path()).to_dict()
+
+
+def test_columns_and_scale_given_in_pieces_count_together(tmp_path):
+    """Two --columns (or --scale) options: both maps read (the second replaced the first)."""
+    _mat()(tmp_path / "r.mat")
+    (tmp_path / "axis.toml").write_text(AXIS)
+    outputs = []
+    for i, maps in enumerate((["--columns", "time=t,force=u", "--scale", "force=2"],
+                              ["--columns", "time=t", "--scale", "force=2", "--columns",
+                               "force=u"])):
+        code, _, err = limited_process.run([*PREDICT[:4], f"p{i}.csv", *maps], tmp_path)
+        assert code == 0, err
+        outputs.append((tmp_path / f"p{i}.csv").read_text())
+    assert outputs[0] == outputs[1]
