@@ -33,6 +33,10 @@ stamp within 0.05 of a sampling interval of it
 a record whose stamps stray further (a dropped or repeated sample) is refused,
 naming the worst stamp.
 
+Values that no motion stage's record holds in SI units, positions beyond
+:data:`MAX_POSITION` or time steps finer than :data:`MIN_TIME_STEP`, are a
+warning naming the column (a unit slip: millimetres, days).
+
 Every problem is a :class:`RecordError` (a ``ValueError``) with one line
 naming the file: not a CSV or ``.mat`` file, a missing column or variable
 (the message lists those found), a variable that is not a numeric vector,
@@ -568,6 +572,7 @@ def read_record(source: Source, names: Sequence[str], *,
         if gain is not None:
             data[:, i] *= gain
     _check_magnitudes(data, names, where)
+    _check_units(data, names, where)
     return data
 
 
@@ -584,5 +589,38 @@ def _check_magnitudes(data: NDArray[np.float64], names: Sequence[str], where: st
                               f"motionhyst computes with (its unit? --scale {name}=GAIN)")
 
 
-__all__ = ["RecordError", "is_mat_file", "parse_columns",
+MAX_POSITION = 100.0
+"""Largest position [m] a motion stage's record holds in metres: beyond, a warning (a record
+in millimetres or micrometres read as metres)."""
+
+MIN_TIME_STEP = 1e-7
+"""Finest sampling step [s] of a motion stage's record (10 MHz): finer, a warning (time in
+days or hours read as seconds)."""
+
+
+def _check_units(data: NDArray[np.float64], names: Sequence[str], where: str) -> None:
+    """Warn of a column whose values no motion stage's record has in SI units (a unit slip
+    read as seconds or metres): positions beyond :data:`MAX_POSITION` (millimetres or
+    micrometres), time steps below :data:`MIN_TIME_STEP` (time in days or hours)."""
+    from motionhyst.core.warnings import warn
+
+    columns = dict(zip(names, data.T, strict=False))
+    y = columns.get("displacement")
+    if y is not None and y.size:
+        with np.errstate(invalid="ignore"):
+            peak = float(np.max(np.abs(y)))
+        if peak > MAX_POSITION:
+            warn(f"{where}: displacement reaches {peak:.3g} m, beyond the {MAX_POSITION:g} m of a "
+                 f"motion stage's stroke: in mm or um? (--scale displacement=0.001 or 1e-6)", 3)
+    t = columns.get("time")
+    if t is not None and t.size > 1:
+        with np.errstate(invalid="ignore"):
+            step = float(np.median(np.abs(np.diff(t))))
+        if 0.0 < step < MIN_TIME_STEP:
+            warn(f"{where}: time steps of {step:.3g} s ({1 / step:.3g} Hz sampling), finer "
+                 f"than a motion stage's data logger samples: time in seconds? (--scale "
+                 f"time=GAIN; 86400 turns days into seconds)", 3)
+
+
+__all__ = ["MAX_POSITION", "MIN_TIME_STEP", "RecordError", "is_mat_file", "parse_columns",
            "parse_scale", "read_record", "record_columns"]
