@@ -14,7 +14,8 @@ zero after minutes of search.
 
 A fit that succeeded can still be *implausible*: each such finding is a
 one-line warning naming the parameter (:func:`plausibility_warnings`): a mass
-far from the records' linear estimate, a parameter at its bound, an inertia
+far from the records' linear estimate or outside those of motion stages (a unit
+slip in the records), a parameter at its bound, an inertia
 the records do not show (the quasi-static plant describes such records).
 """
 
@@ -168,6 +169,8 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
     >>> for line in plausibility_warnings({"m": 1e-9}, {"m": 1e-9}, 2.0, [rec], []):
     ...     print(line)
     m = 1e-09 kg is 2e+09 times below the records' linear estimate 2 kg
+    m = 1e-09 kg, outside the 0.001-10000 kg of motion stages: check the records' units (time
+    in ms makes it 1e6 times too large, a position in mm or a force in kN 1e3 times too small)
     m = 1e-09 kg: the inertia is not visible in these records (m times the RMS acceleration is
     3.9e-12 of the force's RMS); a quasi-static plant (--plant quasi-static) describes them
     """
@@ -181,6 +184,7 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
             factor = ratio if ratio > 1 else 1.0 / ratio
             out.append(f"{names} = {total:.4g} kg is {factor:.3g} times {word} the records' "
                        f"linear estimate {linear_mass:.4g} kg")
+    out += _unit_slip(names, total)
     a_rms = math.sqrt(np.mean(np.concatenate(
         [np.diff(rec.y, 2) * rec.fs ** 2 for rec in records]) ** 2))
     u_rms = math.sqrt(np.mean(np.concatenate([rec.u - np.mean(rec.u) for rec in records]) ** 2))
@@ -198,6 +202,19 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
                    f"{word} its start: the records do not hold it (at the edge of the model's "
                    f"range; a physically meaningless value)")
     return out
+
+
+def _unit_slip(names: str, total: float) -> list[str]:
+    """A mass outside those of motion stages, as a measured plant's is checked
+    (:data:`~motionhyst.plants.frf_fit.PLAUSIBLE_MASS_KG`): a unit slip in the records."""
+    from motionhyst.plants.frf_fit import PLAUSIBLE_MASS_KG
+
+    low, high = PLAUSIBLE_MASS_KG
+    if total <= 0 or low <= total <= high:
+        return []
+    return [f"{names} = {total:.4g} kg, outside the {low:g}-{high:g} kg of motion stages: check "
+            f"the records' units (time in ms makes it 1e6 times too large, a position in mm "
+            f"or a force in kN 1e3 times too small)"]
 
 
 def systematic_share(residual: NDArray[np.float64], signal: NDArray[np.float64]) -> float:
