@@ -133,3 +133,21 @@ def test_columns_and_scale_given_in_pieces_count_together(tmp_path):
         assert code == 0, err
         outputs.append((tmp_path / f"p{i}.csv").read_text())
     assert outputs[0] == outputs[1]
+
+
+@pytest.mark.parametrize(("variables", "extra", "words"), [
+    ({"t": (739000.0 + _record()["t"] / 86400.0)[:, None]}, [],
+     "Hz sampling), finer than a motion stage's data logger samples: time in seconds? "
+     "(--scale time=GAIN; 86400 turns days"),
+    ({"y": 1000.0 * _record()["y"][:, None]}, ["--init-from", "r.mat"],
+     "r.mat: displacement reaches 457 m, beyond the 100 m of a motion stage's stroke: in "
+     "mm or um? (--scale displacement=0.001"),
+], ids=["time-in-days", "position-in-mm"])
+def test_a_unit_slip_in_a_record_is_a_warning_naming_the_column(tmp_path, variables, extra,
+                                                                 words):
+    _mat(**variables)(tmp_path / "r.mat")
+    (tmp_path / "axis.toml").write_text(AXIS)
+    columns = "time=t,force=u,displacement=y" if extra else "time=t,force=u"
+    code, _, err = limited_process.run([*PREDICT, "--columns", columns, *extra], tmp_path)
+    assert code == 0, err
+    assert "motionhyst: warning: predict: r.mat: " in err and words in err, err
