@@ -15,9 +15,9 @@ stores:
    processes of their own; warmed by a study of two points) with the batches ``run_study``
    chooses for dask (at least ``DASK_BATCH_SECONDS`` of work), against the pool of two
    workers in ``--repeats`` pairs of runs, interleaved (a study of another seed each pair, as
-   a dask worker keeps the last study it built); each pair has a third run, dask with the
-   batches sampled by the workers' profiler (``engine.DASK_PROFILED = True``; by default a
-   batch hides its thread from it), against the same pool run, the three in rotating order.
+   a dask worker keeps the last study it built), the two in alternating order.  The cluster
+   runs with the settings for studies (``engine.DASK_CLUSTER_CONFIG``, in its processes'
+   environment, as the README starts one), or with dask's defaults (``--dask-defaults``).
 
 Each run counts the CPU time of every process by role (this process, the client, which sends
 the batches and writes the store; the workers; on dask the scheduler and the nannies too) and
@@ -34,12 +34,9 @@ reported too; their ratios hold on a quiet machine only (the load average is pri
 and after).  From the first runs: the pool's overhead per point past the baseline and its
 parallel efficiency (baseline CPU / the pool's, the pool's points' work taken as the
 baseline's: two workers give that times 2 on two idle cores; target >= 0.9, i.e. 1.8x).
-The numbers of a study are checked equal in every engine.  Dask's worker profiler (a sample
-of the stack of each thread running a task, every 10 ms) is on by default; the environment
-turns it off for the processes the benchmark starts
-(``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``).  Run with ``make bench`` or
+The numbers of a study are checked equal in every engine.  Run with ``make bench`` or
 ``python benchmarks/study.py [--samples N] [--frequencies N] [--repeats N]
-[--dask-batch-seconds S] [--json]``.
+[--dask-batch-seconds S] [--dask-defaults] [--json]``.
 """
 
 from __future__ import annotations
@@ -65,12 +62,16 @@ import numpy as np
 
 from motionhyst.scenario import default_scenario_path
 from motionhyst.study import Study, open_results, run_study
-from motionhyst.study import engine as engine_mod
-from motionhyst.study.engine import DASK_BATCH_SECONDS, batch_size, seconds_per_point
+from motionhyst.study.engine import (
+    DASK_BATCH_SECONDS,
+    DASK_CLUSTER_CONFIG,
+    batch_size,
+    dask_environment,
+    seconds_per_point,
+)
 
-ENGINES = ("pool", "dask", "dask_profiled")
-"""The runs of each pair: the local pool, dask with the batches hidden from the workers'
-profiler (``DASK_PROFILED`` False, the default) and dask with them sampled."""
+ENGINES = ("pool", "dask")
+"""The runs of each pair: the local pool and dask."""
 
 
 def make_study(samples: int, frequencies: int, seed: int = 0) -> Study:
@@ -149,16 +150,19 @@ def timed(study: Study, folder: Path, name: str, roles: dict[str, list[int]] | N
 
 
 @contextlib.contextmanager
-def dask_cluster(folder: Path) -> Iterator[tuple[object, dict[str, list[int]]]]:
+def dask_cluster(folder: Path, defaults: bool = False
+                 ) -> Iterator[tuple[object, dict[str, list[int]]]]:
     """A scheduler and two single-thread workers (with their nannies, as ``dask worker``
-    starts them) in processes of their own; the client and the pids of the processes by
+    starts them) in processes of their own, with the settings for studies
+    (:func:`dask_environment`) unless `defaults`; the client and the pids of the processes by
     role (``scheduler``; ``nannies``, the ``dask worker`` process that holds them;
     ``workers``, its children)."""
     from distributed import Client
 
     sched_file = folder / "scheduler.json"
+    env = {k: v for k, v in os.environ.items() if not k.startswith("DASK_")}
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL,
-             "start_new_session": True}
+             "start_new_session": True, "env": env if defaults else {**env, **dask_environment()}}
     procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1",
                                "--port", "0", "--no-dashboard", "--scheduler-file",
                                str(sched_file)], **quiet)]
@@ -209,13 +213,17 @@ def _spread(values: list[float]) -> dict:
             "max": float(max(values)), "runs": [float(v) for v in values]}
 
 
-def _profiler_on() -> bool:
-    """Whether dask's workers sample their threads' stacks (``distributed.worker.profile.
-    enabled``, as the environment sets it for the processes this benchmark starts)."""
+def _config_of_this_process() -> dict:
     import dask.config
-    import distributed  # noqa: F401  (its defaults into dask's config)
 
-    return bool(dask.config.get("distributed.worker.profile.enabled"))
+    return {key: dask.config.get(key) for key in DASK_CLUSTER_CONFIG}
+
+
+def _cluster_config(client) -> dict:
+    """The settings of :data:`DASK_CLUSTER_CONFIG` as the cluster's scheduler and workers run
+    with them (the environment they were started with)."""
+    return {"scheduler": client.run_on_scheduler(_config_of_this_process),
+            "workers": list(client.run(_config_of_this_process).values())}
 
 
 def _fraction(d: Run, p: Run, idle: float = 0.0, quiet: float | None = None) -> float:
@@ -302,6 +310,8 @@ def main() -> None:
     ap.add_argument("--dask-batch-seconds", type=float, default=DASK_BATCH_SECONDS,
                     help="least work in a batch on dask [s] (run_study's default: "
                          f"{DASK_BATCH_SECONDS:g})")
+    ap.add_argument("--dask-defaults", action="store_true",
+                    help="the cluster with dask's default settings, not those for studies")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
     study = make_study(args.samples, args.frequencies)
@@ -314,7 +324,6 @@ def main() -> None:
                  "dask_batch_seconds": args.dask_batch_seconds, "cores": os.cpu_count(),
                  "repeats": args.repeats, "load_before": load_before}
     pairs: list[tuple[Run, Run]] = []
-    profiled: list[tuple[Run, Run]] = []
     idles: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
@@ -325,32 +334,26 @@ def main() -> None:
         two = timed(study, folder, "pool2", workers=2, batch=batch)
         _equal(alone.results, one.results)
         _equal(alone.results, two.results)
-        with dask_cluster(folder) as (client, roles):
+        with dask_cluster(folder, args.dask_defaults) as (client, roles):
             # the workers import the library and load the kernels at their first batch
             timed(make_study(1, 2), folder, "dask_warm", roles=roles, client=client, batch=1)
+            out["dask_cluster_config"] = _cluster_config(client)
             for r in range(args.repeats):
                 # a study of its own each pair (another seed): a dask worker keeps the last
-                # study built, a pool's workers build it anew; the order rotates, so that
-                # a load rising or falling over the pairs weighs on every engine alike
+                # study built, a pool's workers build it anew; the order alternates, so that
+                # a load rising or falling over the pairs weighs on both engines alike
                 st = make_study(args.samples, args.frequencies, seed=1 + r)
                 idles.append(idle_rate(roles, 2.0))
                 runs = {}
-                for engine in ENGINES[r % 3:] + ENGINES[:r % 3]:
+                for engine in ENGINES[r % 2:] + ENGINES[:r % 2]:
                     if engine == "pool":
                         runs[engine] = timed(st, folder, f"pair{r}_{engine}", workers=2,
                                              batch=batch)
                     else:
-                        # the batches hidden from the workers' profiler (the default), or not
-                        engine_mod.DASK_PROFILED = engine == "dask_profiled"
-                        try:
-                            runs[engine] = timed(st, folder, f"pair{r}_{engine}", roles=roles,
-                                                 client=client, batch=dask_batch)
-                        finally:
-                            engine_mod.DASK_PROFILED = False
+                        runs[engine] = timed(st, folder, f"pair{r}_{engine}", roles=roles,
+                                             client=client, batch=dask_batch)
                 _equal(runs["pool"].results, runs["dask"].results)
-                _equal(runs["pool"].results, runs["dask_profiled"].results)
                 pairs.append((runs["pool"], runs["dask"]))
-                profiled.append((runs["pool"], runs["dask_profiled"]))
                 for name in ENGINES:
                     shutil.rmtree(folder / f"pair{r}_{name}.zarr")
             idles.append(idle_rate(roles, 2.0))
@@ -369,11 +372,8 @@ def main() -> None:
         "pool_2_efficiency": alone.total / (alone.total + two.engine - alone.engine),
         "pool_2_efficiency_all_cpu": alone.total / two.total,
         "work_pool_2_over_in_process": two.work / alone.work - 1,
-        "dask_worker_profiler": _profiler_on(),
         "dask_idle_cpu_per_s": _spread(idles),
-        # the batches hidden from the workers' profiler (the default), and sampled by it
         "dask": _dask_against_pool(pairs, idle, n),
-        "dask_profiled": _dask_against_pool(profiled, idle, n),
     })
     if args.json:
         print(json.dumps(out, indent=2))
@@ -386,8 +386,9 @@ def main() -> None:
     la, lb = load_before, out["load_after"]
     print(f"study of {n} points (batches of {batch}, on dask {dask_batch}), numbers equal in "
           f"every engine; {os.cpu_count()} cores, load average {la[0]:.1f} before, "
-          f"{lb[0]:.1f} after; dask's worker profiler "
-          f"{'on' if out['dask_worker_profiler'] else 'off'}")
+          f"{lb[0]:.1f} after; the dask cluster with "
+          f"{'dask' if args.dask_defaults else 'the study'}'s settings: "
+          f"{out['dask_cluster_config']['workers'][0]}")
     print(f"  in this process        {alone.wall:7.2f} s, {alone.total:7.2f} s CPU  "
           f"({out['ms_cpu_per_point_in_process']:.3f} ms CPU a point: the baseline)")
     print(f"  local pool, 1 worker   {one.wall:7.2f} s, {one.total:7.2f} s CPU")
@@ -399,41 +400,39 @@ def main() -> None:
           f"CPU {out['pool_2_efficiency_all_cpu']:.3f}, the points' work moving by "
           f"{100 * out['work_pool_2_over_in_process']:+.1f} %)")
     idle = out["dask_idle_cpu_per_s"]["median"]
-    for key, title in (("dask", "the batches hidden from the workers' profiler (the default)"),
-                       ("dask_profiled", "the batches sampled by the workers' profiler "
-                                         "(DASK_PROFILED = True)")):
-        d = out[key]
-        print(f"  dask against the local pool, 2 workers each, {args.repeats} pairs of runs "
-              f"interleaved (another seed each pair); {title}:")
-        print(f"    the points' work, dask's against the pool's: "
-              f"{pct(d['work_dask_over_pool'])} (the load's doing; taken out below)")
-        print("    CPU a point past the points' work [us]: client, scheduler, nannies, workers")
-        for engine in ("pool", "dask"):
-            u = d["us_per_point"][engine]
-            print(f"      {engine:5s} " + ", ".join(f"{u[r]:.2f}" for r in
-                                                   ("client", "scheduler", "nannies",
-                                                    "workers")))
-        print(f"    all CPU, the work included (the load's noise in it): "
-              f"{pct(d['dask_total_over_pool'])}")
-        print(f"    dask's engine past the pool's: {pct(d['dask_overhead_fraction'])} of the "
-              f"pool's CPU")
-        print(f"    the idle cluster {idle:.3f} s CPU a second; past it "
-              f"{pct(d['dask_task_overhead_fraction'])}")
-        print(f"    with a run as long as on two idle cores "
-              f"{pct(d['dask_overhead_fraction_quiet'])} (target <= 5 %)")
-        fit = d["dask_overhead_fraction_quiet_fit"]
-        if fit is None:
-            print("    (too few pairs, or wall times all alike, to fit a part per run and a "
-                  "part per second)")
-        else:
-            print(f"    fitted over the pairs, per run + per second of wall time: dask "
-                  f"{fit['dask_per_run_s']:.3f} s + {fit['dask_cpu_per_s']:.4f} s/s, pool "
-                  f"{fit['pool_per_run_s']:.3f} s + {fit['pool_cpu_per_s']:.4f} s/s; on two "
-                  f"idle cores {100 * fit['value']:+.1f} % +- {100 * fit['std']:.1f} "
-                  f"(target <= 5 %)")
-        w = d["dask_wall_over_pool"]
-        print(f"    wall time, dask over the pool: {w['median']:.2f} ({w['min']:.2f} to "
-              f"{w['max']:.2f}; under load it says little)")
+    d = out["dask"]
+    print(f"  dask against the local pool, 2 workers each, {args.repeats} pairs of runs "
+          f"interleaved (another seed each pair):")
+    print(f"    the points' work, dask's against the pool's: "
+          f"{pct(d['work_dask_over_pool'])} (the load's doing; taken out below)")
+    print("    CPU a point past the points' work [us]: client, scheduler, nannies, workers")
+    for engine in ("pool", "dask"):
+        u = d["us_per_point"][engine]
+        print(f"      {engine:5s} " + ", ".join(f"{u[r]:.2f}" for r in
+                                               ("client", "scheduler", "nannies",
+                                                "workers")))
+    print(f"    all CPU, the work included (the load's noise in it): "
+          f"{pct(d['dask_total_over_pool'])}")
+    print(f"    dask's engine past the pool's: {pct(d['dask_overhead_fraction'])} of the "
+          f"pool's CPU")
+    print(f"    the idle cluster {idle:.3f} s CPU a second; past it "
+          f"{pct(d['dask_task_overhead_fraction'])}")
+    print(f"    with a run as long as on two idle cores "
+          f"{pct(d['dask_overhead_fraction_quiet'])} (target <= 5 %)")
+    fit = d["dask_overhead_fraction_quiet_fit"]
+    if fit is None:
+        print("    (too few pairs, or wall times all alike, to fit a part per run and a "
+              "part per second)")
+    else:
+        print(f"    fitted over the pairs, per run + per second of wall time: dask "
+              f"{fit['dask_per_run_s']:.3f} s + {fit['dask_cpu_per_s']:.4f} s/s, pool "
+              f"{fit['pool_per_run_s']:.3f} s + {fit['pool_cpu_per_s']:.4f} s/s; on two "
+              f"idle cores {100 * fit['value']:+.1f} % +- {100 * fit['std']:.1f} "
+              f"(target <= 5 %)")
+    w = d["dask_wall_over_pool"]
+    print(f"    wall time, dask over the pool: {w['median']:.2f} ({w['min']:.2f} to "
+          f"{w['max']:.2f}; under load it says little)")
+
 
 if __name__ == "__main__":
     main()

@@ -10,7 +10,6 @@ import signal
 import subprocess
 import sys
 import time
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,7 @@ import pytest
 from motionhyst.cli import main
 from motionhyst.scenario import default_scenario_path
 from motionhyst.study import Study, open_results, run_study
+from motionhyst.study.engine import DASK_CLUSTER_CONFIG, dask_environment
 
 distributed = pytest.importorskip("distributed")
 
@@ -38,15 +38,18 @@ POINTS = 240
 
 
 def _start(args: list[str], log: Path) -> subprocess.Popen:
+    """A dask command with the settings for studies (as the README and guide start one)."""
+    env = {**{k: v for k, v in os.environ.items() if not k.startswith("DASK_")},
+           **dask_environment()}
     with open(log, "w") as fh:
         return subprocess.Popen([sys.executable, "-m", "dask", *args], stdout=fh,
-                                stderr=subprocess.STDOUT, start_new_session=True)
+                                stderr=subprocess.STDOUT, start_new_session=True, env=env)
 
 
 @pytest.fixture
 def cluster(tmp_path):
     """``dask scheduler`` and two ``dask worker`` processes (one thread each, no nanny: a
-    killed worker stays dead) on 127.0.0.1."""
+    killed worker stays dead) on 127.0.0.1, with the settings for studies."""
     sched_file = tmp_path / "scheduler.json"
     procs = [_start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
                      "--scheduler-file", str(sched_file)], tmp_path / "scheduler.log")]
@@ -156,41 +159,35 @@ def test_unreachable_scheduler_is_one_line(tmp_path, study_file, capsys):
     assert not (tmp_path / "s.zarr").exists()
 
 
-def _files_sampled(tree: dict) -> set[str]:
-    """The source files of the frames in a dask profile (``Client.profile``)."""
-    out: set[str] = set()
-    stack = [tree]
-    while stack:
-        node = stack.pop()
-        desc = node.get("description")
-        if isinstance(desc, dict):
-            out.add(str(desc.get("filename", "")))
-        stack.extend(node.get("children", {}).values())
-    return out
+def _settings(dask_worker) -> dict:
+    """The settings of DASK_CLUSTER_CONFIG as this dask process runs with them, and what its
+    timers do with them (``client.run`` and ``run_on_scheduler`` pass the process's server
+    as `dask_worker`)."""
+    import dask.config
+
+    from motionhyst.study.engine import DASK_CLUSTER_CONFIG
+
+    out = {key: dask.config.get(key) for key in DASK_CLUSTER_CONFIG}
+    timers = dask_worker.periodic_callbacks
+    return {**out, "profiler": "profile" in timers,
+            **{f"{name}_ms": timers[name].callback_time for name in
+               ("tick", "monitor", "memory_monitor") if name in timers}}
 
 
-def test_batches_are_hidden_from_the_workers_profiler_unless_asked(cluster, tmp_path,
-                                                                    monkeypatch):
-    from motionhyst.study import engine
+def test_the_cluster_for_studies_runs_with_its_settings(cluster):
+    """The environment of ``dask_environment()`` (the README's and the guide's) starts dask's
+    processes with DASK_CLUSTER_CONFIG: a misspelt variable would leave dask's default."""
+    import cloudpickle
 
     client, _ = cluster
-    # about 0.2-1 s of work in one batch: the profiler samples a running task every 10 ms
-    st = Study.from_dict({"outputs": ["e1"], "axes": {
-        "amplitude": [0.001, 0.01], "frequency_hz": {"geomspace": [1.0, 100.0, 50]}},
-        "samples": {"n": 20, "seed": 1, "hysteresis.k": {"lognormal": [20.0, 0.1]}}},
-        scenario=tomllib.loads(default_scenario_path().read_text()))
-    def computing(files: set[str]) -> list[str]:
-        # the points' own frames: the task's entry (study/engine.py) may be sampled in the
-        # microseconds before it hides its thread or after it shows it again
-        return sorted(f for f in files if "motionhyst" in f
-                      and not f.endswith(str(Path("study", "engine.py"))))
-
-    run_study(st, tmp_path / "hidden.zarr", client=client, batch=st.n_points)
-    hidden = _files_sampled(client.profile())
-    assert computing(hidden) == [], computing(hidden)
-    monkeypatch.setattr(engine, "DASK_PROFILED", True)
-    run_study(st, tmp_path / "profiled.zarr", client=client, batch=st.n_points)
-    sampled = _files_sampled(client.profile())
-    assert computing(sampled), sorted(sampled)
-    np.testing.assert_array_equal(open_results(tmp_path / "hidden.zarr")["e1"].values,
-                                  open_results(tmp_path / "profiled.zarr")["e1"].values)
+    # _settings goes by value: the workers cannot import this test module
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    try:
+        on_scheduler, workers = client.run_on_scheduler(_settings), client.run(_settings)
+    finally:
+        cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
+    assert len(workers) == 2
+    for got in [on_scheduler, *workers.values()]:
+        assert got.pop("memory_monitor_ms", None) == (None if got is on_scheduler else 1000)
+        assert got == {**DASK_CLUSTER_CONFIG, "profiler": False, "tick_ms": 1000,
+                       "monitor_ms": 5000}

@@ -146,3 +146,15 @@ def test_fleet_summary_figure(tmp_path):
     assert at.size == 100
     for text, p in zip((lo_t, med_t, hi_t), BAND, strict=True):
         _assert_agrees(text, float(np.percentile(at, p)), f"|E| {p:g} %")
+
+
+def test_the_dask_settings_for_studies_are_the_engines():
+    """The environment the README and the guide start a cluster for studies with is
+    ``dask_environment()``, line for line: one edited alone fails here."""
+    from motionhyst.study.engine import dask_environment
+
+    want = [f"export {name}={value}" for name, value in dask_environment().items()]
+    for text in (RAW, (ROOT / "docs" / "guide" / "studies.rst").read_text()):
+        got = [line.strip() for line in text.splitlines()
+               if line.strip().startswith("export DASK_")]
+        assert got == want

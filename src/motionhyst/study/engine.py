@@ -9,7 +9,6 @@ fastest).  A point's numbers do not depend on its batch, its worker or the engin
 
 from __future__ import annotations
 
-import contextlib
 import math
 import signal
 import threading
@@ -30,8 +29,8 @@ from motionhyst.study.outputs import OUTPUTS, Point, fields_of, nan_of
 from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
 
-__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "DASK_PROFILED", "ENOUGH_SECONDS", "Batch",
-           "Evaluator", "dask_batch", "evaluate_batch", "run_batches"]
+__all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "DASK_CLUSTER_CONFIG", "ENOUGH_SECONDS",
+           "Batch", "Evaluator", "dask_environment", "evaluate_batch", "run_batches"]
 
 BATCH_SECONDS = 0.1
 """Least work in one batch of the local pool [s]: below it, sending and collecting cost more
@@ -45,20 +44,25 @@ DASK_BATCH_SECONDS = 0.5
 """Least work in one batch on dask [s]: a task costs its scheduler, client and worker about
 5 ms of CPU together, 1 % of this."""
 
-DASK_PROFILED = False
-"""Whether dask's worker profiler samples the thread running a study's batch.  The profiler
-(on by default, ``distributed.worker.profile``) takes the stack of every thread running a
-task every 10 ms of wall time, about 3 % of the pool's CPU time for a study's batches on two
-idle cores (more on a loaded machine, where a batch lasts longer), for a figure of where the
-time goes that a study does not need; so a batch hides its thread from it while it runs: out
-of the worker's ``active_threads``, which the profiler samples, put back when the batch ends.
-dask's other readers of that table lose the thread as well while the batch runs: the
-dashboard's profile, ``Client.call_stack()`` (empty for a running batch: a batch that hangs
-is diagnosed with ``DASK_PROFILED = True``) and ``distributed.get_worker().get_current_task()``
-(a ``KeyError`` inside the batch; no code of motionhyst calls it there); the worker's other
-tasks are sampled as before.  ``tests/test_study_dask.py`` checks the hiding on a real
-cluster of the installed distributed version.  True, set in the client's process, leaves the
-batches sampled."""
+DASK_CLUSTER_CONFIG: dict[str, object] = {
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.profile.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+}
+"""dask's settings for a cluster that runs studies: the timers of dask's own diagnostics at a
+pace that costs a study little.  A cluster runs them whether it computes or not, and a study
+pays for them as long as it runs: a scheduler and two single-thread workers with their nannies
+take 0.08-0.09 s of CPU a second with dask's defaults (on two cores, 5 % of the local pool's
+CPU time for the same points), 0.012-0.014 s with these.  Each server's event-loop health
+check (a warning when the loop was blocked for 3 s) every second rather than every 20 ms,
+the most of it; no statistical profiler (a sample of the stack of every thread running a task
+every 10 ms, for the dashboard's profile); the workers' and nannies' memory monitor (spilling,
+pausing and restarting a worker at its memory limits) every second rather than every 0.1 s (a
+study's memory is flat: its batches come back as compact records); the system monitor (the
+dashboard's CPU, memory and network plots) every 5 s rather than 0.5 s.  Work stealing costs
+nothing measurable idle.  :func:`dask_environment` gives them as the environment of ``dask
+scheduler`` and ``dask worker``."""
 
 # why a point failed (motionhyst.study.store.REASONS)
 _LOOP, _CONVERGE, _OUTPUT, _NUMERIC = 1, 2, 3, 4
@@ -285,60 +289,21 @@ def evaluate_batch(key: str, plain: dict, indices) -> Batch:
             _release(key, ev)
 
 
-@contextlib.contextmanager
-def _unprofiled() -> Iterator[None]:
-    """This thread hidden from its dask worker's profiler while the block runs: out of the
-    worker's ``active_threads`` (the threads running a task, which the profiler samples), put
-    back after; outside a dask worker it does nothing."""
-    try:
-        from distributed import get_worker
-
-        worker = get_worker()
-        lock, active = worker.active_threads_lock, worker.active_threads
-    except (ImportError, ValueError, AttributeError):
-        worker = None
-    if worker is None:
-        yield
-        return
-    ident = threading.get_ident()
-    with lock:
-        task = active.pop(ident, None)
-    try:
-        yield
-    finally:
-        if task is not None:
-            with lock:
-                active[ident] = task
-
-
-def dask_batch(key: str, plain: dict, indices, profiled: bool = False) -> Batch:
-    """One batch as a dask task: :func:`evaluate_batch`, its thread hidden from the worker's
-    profiler unless `profiled` (:data:`DASK_PROFILED`).
-
-    Parameters
-    ----------
-    key : str
-        The study's fingerprint.
-    plain : dict
-        The study's :meth:`~motionhyst.study.spec.Study.to_dict`.
-    indices : array_like of int
-        Flat indices of the points.
-    profiled : bool
-        Leave the thread to the worker's profiler.
+def dask_environment() -> dict[str, str]:
+    """:data:`DASK_CLUSTER_CONFIG` as the environment variables dask reads when its processes
+    start (``DASK_`` and the key in capitals, ``__`` between its levels).
 
     Examples
     --------
-    >>> import tomllib
-    >>> from motionhyst.scenario import default_scenario_path
-    >>> base = tomllib.loads(default_scenario_path().read_text())
-    >>> st = StudyDefinition.from_dict({"outputs": ["error_rms"], "axes": {"frequency_hz": [5.0]}},
-    ...                      scenario=base)
-    >>> b = dask_batch(st.fingerprint(), st.to_dict(), [0])     # outside a worker: as is
-    >>> print(f"{b.values['error_rms'][0]:.3e} m")
-    8.176e-09 m
+    >>> for name, value in dask_environment().items():
+    ...     print(f"{name}={value}")
+    DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s
+    DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False
+    DASK_DISTRIBUTED__WORKER__MEMORY__MONITOR_INTERVAL=1s
+    DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__INTERVAL=5s
     """
-    with contextlib.nullcontext() if profiled else _unprofiled():
-        return evaluate_batch(key, plain, indices)
+    return {"DASK_" + key.upper().replace(".", "__").replace("-", "_"): str(value)
+            for key, value in DASK_CLUSTER_CONFIG.items()}
 
 
 _WORKER_STUDY: dict = {}
@@ -427,7 +392,7 @@ def _dask_run(client, key: str, plain: dict, batches: list) -> Iterator[Batch]:
 
     # the study's dictionary (about 1 kB) goes with each batch: scattered, its only copy left
     # by dask's memory manager on a worker that dies would cancel every batch still to run
-    futures = [client.submit(dask_batch, key, plain, b, DASK_PROFILED, pure=False)
+    futures = [client.submit(evaluate_batch, key, plain, b, pure=False)
                for b in batches]
     try:
         for f in as_completed(futures):
