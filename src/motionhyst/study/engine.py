@@ -53,8 +53,9 @@ DASK_CLUSTER_CONFIG: dict[str, object] = {
 """dask's settings for a cluster that runs studies: the timers of dask's own diagnostics at a
 pace that costs a study little.  A cluster runs them whether it computes or not, and a study
 pays for them as long as it runs: a scheduler and two single-thread workers with their nannies
-take 0.08-0.09 s of CPU a second with dask's defaults (on two cores, 5 % of the local pool's
-CPU time for the same points), 0.012-0.014 s with these.  Each server's event-loop health
+take 0.07-0.11 s of CPU a second idle with dask's defaults, 0.005-0.016 s with these (on two
+idle cores dask's cost past the local pool's for the same points: +3.2 % and +1.1 % of the
+pool's CPU time, ``benchmarks/study.py``).  Each server's event-loop health
 check (a warning when the loop was blocked for 3 s) every second rather than every 20 ms,
 the most of it; no statistical profiler (a sample of the stack of every thread running a task
 every 10 ms, for the dashboard's profile); the workers' and nannies' memory monitor (spilling,
