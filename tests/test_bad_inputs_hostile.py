@@ -461,7 +461,7 @@ def test_output_to_a_full_disk_is_exit_2_in_plain_words(tmp_path):
         code, _, err = limited_process.run(["df", "--k", "20", "--fc", "0.05", "--amplitude",
                                             "0.01"], tmp_path, stdout=full, timeout=120)
     assert code == 2
-    assert err.strip() == "motionhyst: error: No space left on device"
+    assert err.strip() == "motionhyst: error: standard output: No space left on device"
 
 
 def test_a_work_budget_beyond_a_timer_is_no_limit(tmp_path, monkeypatch, capsys):
