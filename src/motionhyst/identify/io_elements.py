@@ -833,17 +833,17 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
 def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, offset,
                 from_rest, layout, y_scale, v_scale, extras, force, init_window=None,
                 skew=False, rigid=None):
-    """A positioning axis's friction link started from the Coulomb link's fit (`rigid`: one
-    made already): the stage, the offsets and initial states as fitted, the link's forces
-    together its slip force, slipping after 1e-5 of the output's RMS (its rigid limit), the
-    evaluations and the fit itself; None (0, None) if that fit fails."""
+    """A positioning axis's friction link started from the Coulomb link's fit (`rigid`, else as
+    identify_io fits it: by direction, the link's own): the stage, the offsets and initial states
+    as fitted, the link's forces together its slip force, slipping after 1e-5 of the output's RMS
+    (its rigid limit), the evaluations and the fit itself; None (0, None) if that fit fails."""
     from motionhyst.identify.io_checks import FitFailed
 
     try:
         fit = rigid or identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev,
                                             1, t_start, start_nfev, plant, offset, from_rest,
                                             init_window=init_window, drift=extras.input_drift,
-                                            skew=skew)
+                                            asymmetric=skew)
     except (FitFailed, ValueError, ArithmeticError):
         return None, 0, None
     link = fit.hysteresis  # viscous friction by direction: the stage's c_skew, or the link's
