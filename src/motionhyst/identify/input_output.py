@@ -87,6 +87,7 @@ io_results
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -270,9 +271,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     rigid_limit : bool
         A Jenkins link on a mass-damper whose stiffness the records do not resolve (not
         determined, or its stuck mode ``sqrt(k / m) / 2 pi`` above a quarter of the sampling
-        rate: :func:`~motionhyst.identify.io_friction.unresolved_stiffness`) is reported as
-        its rigid limit, the Coulomb link's fit with the same options that its search
-        started from, said in a warning; else it is judged as it is.
+        rate: :func:`~motionhyst.identify.io_friction.unresolved_stiffness`), or any friction
+        link there of whose parameters the records determine at most half (a failed fit
+        otherwise), is reported as its rigid limit, the Coulomb link's fit with the same
+        options that its search started from, said in a warning; else it is judged as it is.
     start_nfev : int, optional
         Links other than Bouc-Wen: evaluations of each start's refinement on the
         short part of the records (default ``15 p``, ``p`` parameters).
@@ -374,7 +376,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
             if rec_period is not None:
                 check_steady_state(rec, rec_period)
     stage = _stage(plant, output)
-    link = _searched(link, stage, nu)
+    link = _searched(link, stage, nu, records)
     if init_window is not None:
         if not (isinstance(init_window, int | np.integer) and init_window >= 2):
             raise ValueError(f"the initialisation window must be at least 2 samples, got "
@@ -402,7 +404,9 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
             fewer = (fewer[0] if fewer else n_elements, kept)
             n_elements = kept
             continue
-        if failed is not None:
+        if failed is not None and rigid_limit and fit.rigid_limit is not None:
+            fit, determined = _undetermined_link(fit, failed, stage, invariant, zero)
+        elif failed is not None:
             raise failed
         break
     if fewer is not None:
@@ -475,6 +479,31 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                  bouc_wen_offset)
 
 
+def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
+                       invariant: tuple[str, ...], zero: set[str]
+                       ) -> tuple[IOIdentification, list[str]]:
+    """A friction link on a positioning axis most of whose parameters the records do not
+    determine, reported as its rigid limit: the Coulomb link's fit its search started from,
+    with one warning naming what the records did not determine, and that fit's own notes of
+    :func:`~motionhyst.identify.io_uncertainty.judge_determined`; `failed` raised if the
+    limit is no result either."""
+    rigid = fit.rigid_limit
+    if rigid is None:
+        raise failed
+    try:
+        determined = judge_determined(rigid.estimates, rigid.std, (), zero_allowed(stage, Coulomb))
+    except FitFailed:
+        raise failed from None
+    names = undetermined(fit.estimates, fit.std, invariant, zero)
+    why = f"the records do not determine its {', '.join(names)}"
+    note = (f"the {fit.hysteresis.name} link is reported as its rigid limit, the Coulomb link "
+            f"(fc {rigid.estimates['link.fc']:.4g} N, fit RMS {rigid.fit_rms:.3g} m): {why}")
+    return replace(rigid, warnings=[note, *rigid.warnings], n_evaluations=fit.n_evaluations,
+                   seconds=fit.seconds, extra={**rigid.extra,
+                                               "rigid_limit": f"{fit.hysteresis.name}: {why}"}
+                   ), determined
+
+
 def _determined_elements(fit: IOIdentification, n: int, invariant: tuple[str, ...],
                          zero: set[str]) -> int:
     """The Maxwell-slip elements the fit's records determine: `n` if they determine every
@@ -485,7 +514,8 @@ def _determined_elements(fit: IOIdentification, n: int, invariant: tuple[str, ..
     return n if kept == n else max(1, min(kept, n - 1))
 
 
-def _searched(link: type[Hysteresis], stage: Plant, nu: float | None) -> type:
+def _searched(link: type[Hysteresis], stage: Plant, nu: float | None,
+              records: list[IORecord]) -> type:
     """The link's class as the search takes it: on a mass-damper (a positioning axis) the
     Bouc-Wen and LuGre links are friction links in the spellings of
     :mod:`~motionhyst.identify.io_friction` (a bounded force; the Stribeck effect), searched
@@ -496,7 +526,7 @@ def _searched(link: type[Hysteresis], stage: Plant, nu: float | None) -> type:
     if not (shape.floating and shape.n == 1):
         return link
     if link is LuGre:
-        return lugre_stribeck()
+        return lugre_stribeck(records)
     if nu is None:
         raise ValueError("on a mass-damper the Bouc-Wen link's exponent is given, not "
                          "estimated (nu >= 1, default 1)")

@@ -10,7 +10,8 @@ with the registry's ``parameters`` whose call returns the link):
 - the Bouc-Wen link (:func:`bouc_wen_friction`): its hysteretic force alone,
   ``beta + gamma = 1`` so that ``fc`` is its sliding force;
 - the LuGre link (:func:`lugre_stribeck`): the static force at least the Coulomb
-  one, ``fs = fc + stribeck`` with ``stribeck >= 0`` (Canudas de Wit et al. 1995).
+  one, ``fs = fc + stribeck`` with ``stribeck >= 0`` (Canudas de Wit et al. 1995), its
+  bristles between a presliding the records would see and a stuck mode they resolve.
 
 Every friction link's limit is the rigid slider, the Coulomb link: a Jenkins link whose
 stiffness the records do not resolve is that limit (:func:`unresolved_stiffness`).
@@ -31,8 +32,9 @@ from motionhyst.hysteresis import BoucWen, LuGre, Parameter
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification
 
-__all__ = ["PRESLIDING_SHARE", "STUCK_MODE_SAMPLES", "as_rigid_limit", "bouc_wen_friction",
-           "lugre_stribeck", "presliding_note", "unresolved_stiffness"]
+__all__ = ["PRESLIDING_BOUND", "PRESLIDING_SHARE", "STUCK_MODE_SAMPLES", "VS_SHARE",
+           "as_rigid_limit", "bouc_wen_friction", "lugre_stribeck", "presliding_note",
+           "unresolved_stiffness"]
 
 
 def bouc_wen_friction(nu: float) -> type:
@@ -85,46 +87,97 @@ def bouc_wen_friction(nu: float) -> type:
     return BoucWenFriction
 
 
-class _LuGreStribeck:
-    """The LuGre link of :func:`lugre_stribeck` (its search's spelling)."""
+PRESLIDING_BOUND = 1e-3
+"""The LuGre link's search keeps its presliding displacement ``fc / sigma0`` at most this share of
+the records' stroke (bristles are stiff: a friction's presliding is micrometres)."""
 
-    name = LuGre.name
-    parameters = (*(p for p in LuGre.parameters if p.name not in ("fs", "vs")),
-                  Parameter("stribeck", "N", "static force above the Coulomb one, fs - fc >= 0",
-                            None, "nonnegative"),
-                  next(p for p in LuGre.parameters if p.name == "vs"))
-
-    def __new__(cls, sigma0: float, sigma1: float, sigma2: float, fc: float, stribeck: float,
-                vs: float) -> LuGre:  # type: ignore[misc]
-        return LuGre(sigma0=sigma0, sigma1=sigma1, sigma2=sigma2, fc=fc, fs=fc + stribeck,
-                     vs=vs)
+VS_SHARE = 1e-3
+"""The LuGre link's search keeps ``vs`` at least the records' velocity resolution: their position
+quantum times the sampling rate, and at least this share of their largest speed."""
 
 
-def lugre_stribeck() -> type:
+def lugre_stribeck(records: list[IORecord]) -> type:
     """The LuGre link as a positioning axis's friction, in the spelling its search takes.
 
     The Stribeck effect: the friction force falls from the static ``fs`` at rest to the
     Coulomb ``fc`` when sliding, ``g(v) = fc + (fs - fc) exp(-(v / vs)^2)``, so ``fs >=
-    fc``.  Searched as ``fc`` and ``stribeck = fs - fc >= 0`` (the other parameters as
-    :class:`~motionhyst.hysteresis.LuGre`'s): ``g`` stays between ``fc`` and ``fs``
-    whatever ``vs``; with ``fs < fc`` and ``vs`` above the record's speeds the curve is
-    ``fs + (fc - fs) (v / vs)^2``, a quadratic viscous force that takes the stage's
-    damper's place.
+    fc``: searched as ``fc`` and ``stribeck = fs - fc >= 0``.  With ``fs < fc`` and ``vs``
+    above the record's speeds the curve is ``fs + (fc - fs) (v / vs)^2``, a quadratic
+    viscous force that takes the stage's damper's place (EMPS: 70.9 kg).  The bristles are
+    the contacts' micro-deflection before sliding, between two bounds the records set:
+    stiff enough that the presliding ``fc / sigma0`` is at most ``P`` =
+    :data:`PRESLIDING_BOUND` times the records' stroke (softer, they are a spring and damper
+    in the link: EMPS 86.6 kg with 2 cm of presliding), and soft enough that the stuck mode
+    ``sqrt(sigma0 / m) / 2 pi`` is at most a quarter of the sampling rate
+    (:data:`STUCK_MODE_SAMPLES`; ``m`` the records' inverse-dynamics mass): stiffer, the
+    records cannot tell the bristles from the rigid limit, and the search runs to it, a
+    model no time step can follow.  Searched as ``bristle > 0``, ``sigma0 = lo^(1 - w)
+    hi^w`` with ``w = bristle / (1 + bristle)``.  ``vs = v_min + vs_above``, ``vs_above >
+    0``, keeps ``vs`` a speed the records resolve (``v_min``: their position quantum, the
+    smallest step between samples, times the sampling rate, at least :data:`VS_SHARE` of
+    their largest speed).  ``sigma1`` as :class:`~motionhyst.hysteresis.LuGre`'s.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records the link is identified from (their stroke, speeds, resolution and
+        inertia).
 
     Returns
     -------
     type
-        A class with the registry's ``parameters`` (LuGre's, ``stribeck`` for ``fs``)
-        whose call returns the :class:`~motionhyst.hysteresis.LuGre` link.
+        A class with the registry's ``parameters`` (``bristle``, ``sigma1``, ``sigma2``,
+        ``fc``, ``stribeck``, ``vs_above``) whose call returns the
+        :class:`~motionhyst.hysteresis.LuGre` link.
 
     Examples
     --------
-    >>> link = lugre_stribeck()(sigma0=1e6, sigma1=300.0, sigma2=0.0, fc=20.0, stribeck=5.0,
-    ...                         vs=0.01)
-    >>> link.fc, link.fs
-    (20.0, 25.0)
+    >>> t = np.arange(1001) / 1000.0
+    >>> u = 100 * np.sin(2 * np.pi * t)
+    >>> rec = IORecord(t, u, np.round(-u / (2 * np.pi) ** 2 / 10, 6))   # 10 kg, stroke 0.5 m
+    >>> cls = lugre_stribeck([rec])
+    >>> link = cls(bristle=1.0, sigma1=300.0, sigma2=0.0, fc=20.0, stribeck=5.0, vs_above=0.01)
+    >>> link.fs, f"{link.sigma0:.3g}", round(link.vs, 6)   # sigma0 sqrt(3.95e4 x 2.47e7)
+    (25.0, '9.87e+05', 0.015)
+    >>> [f"{cls(b, 0.0, 0.0, 20.0, 0.0, 0.01).sigma0:.3g}" for b in (1e-9, 1e9)]   # lo, hi
+    ['3.95e+04', '2.47e+07']
     """
-    return _LuGreStribeck
+    from motionhyst.identify.io_start import inverse_dynamics
+
+    stroke = max(float(np.ptp(rec.y)) for rec in records)
+    steps = np.concatenate([np.abs(np.diff(rec.y)) for rec in records])
+    moving = steps[steps > 0]
+    quantum = float(np.min(moving)) if moving.size else 0.0
+    fs = records[0].fs
+    v_min = max(quantum * fs, VS_SHARE * float(np.max(steps)) * fs)
+    least = 1.0 / (PRESLIDING_BOUND * stroke) if stroke > 0 else 0.0  # sigma0 / fc
+    mass = inverse_dynamics(records, floating=True)["m"]
+    stiffest = (mass * (2 * math.pi * fs / STUCK_MODE_SAMPLES) ** 2
+                if math.isfinite(mass) and mass > 0 else math.inf)
+    by_name = {p.name: p for p in LuGre.parameters}
+
+    class LuGreStribeck:
+        """The LuGre link of :func:`lugre_stribeck` (its search's spelling)."""
+
+        name = LuGre.name
+        parameters = (Parameter("bristle", "", "the bristles' stiffness between the records' "
+                                "bounds, w / (1 - w)", 1.0),
+                      by_name["sigma1"], by_name["sigma2"], by_name["fc"],
+                      Parameter("stribeck", "N", "static force above the Coulomb one, fs - fc",
+                                None, "nonnegative"),
+                      Parameter("vs_above", "m/s", "Stribeck velocity above the records' "
+                                "resolution"))
+
+        def __new__(cls, bristle: float, sigma1: float, sigma2: float, fc: float,
+                    stribeck: float, vs_above: float) -> LuGre:  # type: ignore[misc]
+            lo = max(fc * least, 1e-300)
+            hi = max(stiffest, lo)
+            w = bristle / (1.0 + bristle) if math.isfinite(bristle) else 1.0
+            sigma0 = lo * (hi / lo) ** w if math.isfinite(hi) else lo * (1.0 + bristle)
+            return LuGre(sigma0=sigma0, sigma1=sigma1, sigma2=sigma2, fc=fc, fs=fc + stribeck,
+                         vs=v_min + vs_above)
+
+    return LuGreStribeck
 
 
 PRESLIDING_SHARE = 0.01
