@@ -9,7 +9,8 @@ is reported as its rigid limit, the Coulomb link with the same options
 
 from __future__ import annotations
 
-import numpy as np
+from motionhyst.identify.io_friction import STUCK_MODE_SAMPLES as STUCK_MODE_SAMPLES
+from motionhyst.identify.io_friction import unresolved_stiffness as stiffness_rule
 
 __all__ = ["LINKS", "OPTIONS", "RIGID_LIMIT", "STUCK_MODE_SAMPLES", "check_model",
            "model_options", "unresolved_stiffness"]
@@ -85,20 +86,12 @@ def check_model(name: str) -> None:
                          f"(jenkins-asymmetric-drift)")
 
 
-#: A stuck mode faster than the sampling rate over this many samples is not resolved
-STUCK_MODE_SAMPLES = 4
-
-
 def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> str | None:
-    """Why a Jenkins link's stiffness is beyond what a record resolves, or None.
-
-    Stuck, the axis's mass ``m`` rests on the link's spring ``k``: a mode at
-    ``sqrt(k/m) / 2 pi``.  A record sampled at `fs` shows a mode only below ``fs /``
-    :data:`STUCK_MODE_SAMPLES` (four samples a period; the Nyquist frequency is two);
-    above, or with ``k`` not determined, the record cannot tell the link from its rigid
-    limit, the Coulomb link, and the stiffness found is the search's, not the axis's
-    (EMPS, ``jenkins-asymmetric-drift`` on the whole record: k 8.6e8 N/m, 486 Hz at
-    1 kHz, which pulled its mass to 92.15 kg).
+    """Why a Jenkins link's stiffness is beyond what a record resolves, or None: the rule of
+    :func:`~motionhyst.identify.io_friction.unresolved_stiffness` (``k`` not determined, or
+    the stuck mode ``sqrt(k/m) / 2 pi`` above ``fs /`` :data:`STUCK_MODE_SAMPLES`), for a
+    benchmark model by name (EMPS, ``jenkins-asymmetric-drift`` on the whole record: k 8.6e8
+    N/m, 486 Hz at 1 kHz, which pulled its mass to 92.15 kg).
 
     Parameters
     ----------
@@ -122,20 +115,13 @@ def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> s
     >>> jenkins(3e7, 1e6) is None   # 89 Hz
     True
     >>> jenkins(8.6e8, 2.8e8)
-    'its stuck mode at 479 Hz with k 8.6e+08 N/m, above 1000 Hz / 4: the record does not ...'
+    'its stuck mode at 479 Hz with k 8.6e+08 N/m, above 1000 Hz / 4: the records do not ...'
     >>> jenkins(9.4e9, None)
-    'k 9.4e+09 N/m, not determined by the record'
+    'k 9.4e+09 N/m, not determined by the records'
     """
     if "k" not in parameters or "m" not in parameters or model_options(name)[0] != "jenkins":
         return None
-    k = parameters["k"]
-    if std.get("k") is None:
-        return f"k {k:.2g} N/m, not determined by the record"
-    mode = float(np.sqrt(max(k, 0.0) / parameters["m"]) / (2 * np.pi))
-    if mode <= fs / STUCK_MODE_SAMPLES:
-        return None
-    return (f"its stuck mode at {mode:.0f} Hz with k {k:.2g} N/m, above {fs:.0f} Hz / "
-            f"{STUCK_MODE_SAMPLES}: the record does not resolve it")
+    return stiffness_rule(parameters["k"], std.get("k"), parameters["m"], fs)
 
 
 #: The links :func:`~motionhyst.identify.emps.run_emps` identifies on the mass-damper

@@ -29,6 +29,7 @@ from dataclasses import replace
 import numpy as np
 
 from motionhyst.hysteresis import BoucWen, LuGre, Parameter
+from motionhyst.identify.io_checks import PROFILE_CHI2
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification
 
@@ -281,14 +282,17 @@ def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
                    std: dict[str, float | None], fs: float,
                    fit_rms: float) -> IOIdentification | None:
     """A Jenkins link's fit on a positioning axis reported as its rigid limit when its records
-    do not resolve its stiffness (:func:`unresolved_stiffness`) or the limit fits them better
-    (the search, run from it among other starts, ended in a softer link's poorer minimum: a
-    stuck Jenkins link rings at its stuck mode, which the limit does not), else None.
+    do not resolve its stiffness (:func:`unresolved_stiffness`) or the limit fits them
+    significantly better (likelihood ratio ``2 N ln(RMS / RMS_limit)`` above
+    :data:`~motionhyst.identify.io_checks.PROFILE_CHI2`, ``N`` the residuals: the search, run
+    from the limit among other starts, ended in a softer link's poorer minimum; a stuck
+    Jenkins link rings at its stuck mode, which the limit does not), else None.
 
     Parameters
     ----------
     rigid : IOIdentification
-        The Coulomb link's fit with the same options (the Jenkins search's start).
+        The Coulomb link's fit with the same options (the Jenkins search's start; its
+        residuals count ``N``).
     estimates, std : dict
         The Jenkins fit's estimates and standard errors (``m``, ``link.k``; None: not
         determined).
@@ -309,7 +313,7 @@ def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
     >>> from motionhyst.plants.mass_damper import MassDamper
     >>> coulomb = IOIdentification(MassDamper(95.0, 200.0), Coulomb(fc=20.0),
     ...                            {"m": 95.0, "c": 200.0, "link.fc": 20.0}, {}, {}, 2.3e-3,
-    ...                            [], 1.0, False, "", 10)
+    ...                            [], 1.0, False, "", 10, residuals=np.zeros(2000))
     >>> jenkins = {"m": 94.0, "c": 201.0, "link.k": 9.4e9, "link.fc": 20.7}
     >>> limit = as_rigid_limit(coulomb, jenkins, {"link.k": None}, 1000.0, 2.29e-3)
     >>> limit.warnings[0][:66]
@@ -320,13 +324,19 @@ def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
     ...                2.29e-3) is None   # resolved (89 Hz), and a better fit than the limit
     True
     >>> as_rigid_limit(coulomb, dict(jenkins, **{"link.k": 3e7}), {"link.k": 1e6}, 1000.0,
-    ...                2.5e-3).extra["rigid_limit"]
-    'jenkins: k 3e+07 N/m fits the records worse than k infinite: RMS 0.0025 m against 0.0023 m'
+    ...                2.3e-3 * (1 + 1e-9)) is None          # worse by nothing that counts
+    True
+    >>> as_rigid_limit(coulomb, dict(jenkins, **{"link.k": 3e7}), {"link.k": 1e6}, 1000.0,
+    ...                2.5e-3).warnings[0][-82:]
+    'than k infinite: RMS 0.0025 m against 0.0023 m, likelihood ratio 334 > 3.84 (95 %)'
     """
     why = unresolved_stiffness(estimates["link.k"], std.get("link.k"), estimates["m"], fs)
-    if why is None and rigid.fit_rms < fit_rms:  # the search ended short of its own limit
+    ratio = (2 * rigid.residuals.size * math.log(fit_rms / rigid.fit_rms)
+             if 0 < rigid.fit_rms < fit_rms else 0.0)  # likelihood ratio, Gaussian errors
+    if why is None and ratio > PROFILE_CHI2:  # the search ended short of its own limit
         why = (f"k {estimates['link.k']:.2g} N/m fits the records worse than k infinite: "
-               f"RMS {fit_rms:.3g} m against {rigid.fit_rms:.3g} m")
+               f"RMS {fit_rms:.4g} m against {rigid.fit_rms:.4g} m, likelihood ratio "
+               f"{ratio:.3g} > {PROFILE_CHI2:g} (95 %)")
     if why is None:
         return None
     note = (f"the Jenkins link is reported as its rigid limit, the Coulomb link (fc "
