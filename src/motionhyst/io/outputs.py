@@ -21,7 +21,7 @@ Rules (issue 10, checked by tests/test_outputs.py and tests/test_bad_inputs.py):
   gets a name, ``.NAME.motionhyst-PID-XXXX.part``, only for the instant
   before it replaces the target (and throughout, where ``O_TMPFILE`` is
   missing); such a file of a process that no longer runs is removed by the
-  next writer in that folder (:func:`clean_stale`).
+  next writer in that folder (:func:`~motionhyst.io.leftovers.clean_stale`).
 - SIGINT or SIGTERM while a file is written leave the old file as it was and
   remove the temporary file; the process then ends with the usual
   ``KeyboardInterrupt``.  Messages name the target, never a temporary path.
@@ -54,8 +54,6 @@ import contextlib
 import errno
 import json
 import os
-import re
-import shutil
 import signal
 import stat
 import tempfile
@@ -68,6 +66,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from motionhyst.core.textfiles import CSV_FORMAT, csv_header, csv_rows
+from motionhyst.io.leftovers import clean_stale as clean_stale
+from motionhyst.io.leftovers import scratch_folder as scratch_folder
 
 MANIFEST = "motionhyst-manifest.json"
 """Name of the manifest :class:`OutputFolder` writes into a results folder."""
@@ -187,7 +187,7 @@ def _cannot_create_in(folder: Path) -> str | None:
     looks writable, also on a read-only file system, in ``/proc`` or ``/sys``.
     So a file is created: unnamed (``O_TMPFILE``) and closed at once, or,
     where the file system lacks that, named as a temporary file of this process
-    (:func:`clean_stale`'s pattern) and removed at once.
+    (:func:`~motionhyst.io.leftovers.clean_stale`'s pattern) and removed at once.
     """
     try:
         fd = os.open(folder, os.O_TMPFILE | os.O_WRONLY | os.O_CLOEXEC, 0o600)
@@ -265,94 +265,6 @@ def _missing_parents(folder: Path) -> list[Path]:
             break
         folder = folder.parent
     return missing[::-1]
-
-
-_STALE = re.compile(r"\..+\.motionhyst-(\d+)-[A-Za-z0-9_]+\.part")
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # another user's process, say: alive
-        return True
-    return True
-
-
-def clean_stale(folder: str | os.PathLike) -> list[str]:
-    """Remove the temporary files of writers in `folder` whose process no longer runs.
-
-    Only names this module gives its temporary files
-    (``.NAME.motionhyst-PID-XXXX.part``) whose process ``PID`` has ended:
-    what a writer killed (``SIGKILL``, a power cut) between naming its file
-    and moving it into place left behind.
-
-    Parameters
-    ----------
-    folder : str or Path
-        The folder.
-
-    Returns
-    -------
-    list of str
-        The names removed.
-
-    Examples
-    --------
-    >>> import os, tempfile
-    >>> folder = tempfile.mkdtemp()
-    >>> open(os.path.join(folder, ".run.csv.motionhyst-999999999-ab12.part"), "w").close()
-    >>> clean_stale(folder), os.listdir(folder)
-    (['.run.csv.motionhyst-999999999-ab12.part'], [])
-    """
-    removed = []
-    try:
-        names = os.listdir(folder)
-    except OSError:
-        return removed
-    for name in names:
-        m = _STALE.fullmatch(name)
-        if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
-            with contextlib.suppress(OSError):
-                os.unlink(os.path.join(folder, name))
-                removed.append(name)
-    return removed
-
-
-def scratch_folder(prefix: str) -> tempfile.TemporaryDirectory:
-    """A temporary folder ``PREFIX-PID-XXXX`` in the system's; those of ended processes removed.
-
-    The folder is removed when the returned object is closed (or used as a
-    context manager), as :class:`tempfile.TemporaryDirectory`; a process
-    killed before that leaves it, and the next call with the same `prefix`
-    removes it.
-
-    Parameters
-    ----------
-    prefix : str
-        The folder's name starts with it (``"motionhyst-figures"``).
-
-    Returns
-    -------
-    tempfile.TemporaryDirectory
-        The folder (its ``name``).
-
-    Examples
-    --------
-    >>> import os
-    >>> with scratch_folder("motionhyst-example") as name:
-    ...     os.path.basename(name).startswith(f"motionhyst-example-{os.getpid()}-")
-    True
-    """
-    parent = tempfile.gettempdir()
-    pattern = re.compile(re.escape(prefix) + r"-(\d+)-[A-Za-z0-9_]+")
-    with contextlib.suppress(OSError):
-        for name in os.listdir(parent):
-            m = pattern.fullmatch(name)
-            if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
-                shutil.rmtree(os.path.join(parent, name), ignore_errors=True)
-    return tempfile.TemporaryDirectory(prefix=f"{prefix}-{os.getpid()}-")
 
 
 class _Temporary:

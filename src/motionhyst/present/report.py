@@ -21,7 +21,8 @@ from tqdm import tqdm
 
 from motionhyst.core.jsonio import dumps
 from motionhyst.hysteresis.periodic import TWO_PI
-from motionhyst.io.outputs import OutputFolder, scratch_folder
+from motionhyst.io.leftovers import scratch_folder
+from motionhyst.io.outputs import OutputFolder
 from motionhyst.present.figure_writer import FigureWriter
 from motionhyst.scenario import Scenario
 
