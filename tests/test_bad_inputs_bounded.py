@@ -292,7 +292,7 @@ CASES = [
      ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--force"], 0, None,
      ["pred.csv"]),
     ("reproduce-out-link-to-folder", {"@symlink:out": "../outside"},
-     ["reproduce", "--out", "out", "--force"], 2, ["symbolic link"], []),
+     ["reproduce", "--out", "out"], 2, ["symbolic link", "--force"], []),
 ]
 
 

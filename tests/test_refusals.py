@@ -183,6 +183,36 @@ def test_a_store_named_by_a_link_replaces_the_link_with_force_never_its_target(
     assert target.exists() == (points_to != "nothing")
 
 
+@pytest.mark.parametrize("points_to", ["folder", "file", "nothing"])
+def test_a_results_folder_named_by_a_link_replaces_the_link_with_force(tmp_path, points_to):
+    """``reproduce --out LINK --force``, the rule of every writer: the link itself is replaced
+    (by a new folder, when the first file is written), never what it points to; a run
+    abandoned puts the link back as it was."""
+    from motionhyst.io.outputs import MANIFEST, OutputError, OutputFolder
+
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "folder" / "report.md").write_text("mine")
+    (tmp_path / "file").write_text("mine")
+    link = tmp_path / "out"
+    link.symlink_to(points_to)
+    listing = {p: p.read_bytes() for p in tmp_path.rglob("*")
+               if p.is_file() and not p.is_symlink()}  # not through the link
+    with pytest.raises(OutputError, match=r"out is a symbolic link; .* or --force to replace "
+                                          r"the link itself"):
+        OutputFolder(link, ["report.md"])
+    with pytest.raises(RuntimeError, match="a failure"), \
+            OutputFolder(link, ["report.md"], force=True) as out:
+        out.write_text("report.md", "new")
+        raise RuntimeError("a failure")
+    assert link.is_symlink() and os.readlink(link) == points_to  # put back as it was
+    with OutputFolder(link, ["report.md"], force=True) as out:
+        out.write_text("report.md", "new")
+    assert not link.is_symlink() and sorted(os.listdir(link)) == [MANIFEST, "report.md"]
+    assert (link / "report.md").read_text() == "new"
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()
+            and p.parent != link} == listing
+
+
 def test_a_dahl_shape_exponent_past_its_range_is_refused_by_df(capsys):
     """``df --model dahl --alpha 1e25`` printed a describing function of 2e-20 N/m with a
     negative imaginary part: past about 1e15 the closed form has no digit left."""

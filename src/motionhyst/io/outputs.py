@@ -212,6 +212,19 @@ def _cannot_create_in(folder: Path) -> str | None:
     return None
 
 
+def _replaceable_link(path: Path, label: str, force: bool) -> bool:
+    """Whether `path` is a symbolic link to replace (with `force`; without it refused)."""
+    if not path.is_symlink():
+        return False
+    if not force:
+        raise OutputError(f"{label} is a symbolic link; give the folder it points to, another "
+                          f"name, or --force to replace the link itself (never what it points "
+                          f"to)")
+    if (problem := _cannot_create_in(path.parent)) is not None:
+        raise OutputError(f"{label}: cannot replace the link in {path.parent} ({problem})")
+    return True
+
+
 def check_output_folder(path: str | os.PathLike, option: str, force: bool = False) -> None:
     """Raise :class:`OutputError` before the work if a folder a command fills itself (a study's
     store) cannot be: no name, ``-``, a symbolic link without `force` (with it, the link
@@ -240,14 +253,7 @@ def check_output_folder(path: str | os.PathLike, option: str, force: bool = Fals
     if str(path) in ("", "-"):
         raise OutputError(f"{label}: not a folder name")
     path = Path(path)
-    if path.is_symlink():
-        if not force:
-            raise OutputError(f"{label} is a symbolic link; give the folder it points to, "
-                              f"another name, or --force to replace the link itself (never "
-                              f"what it points to)")
-        problem = _cannot_create_in(path.parent)
-        if problem is not None:
-            raise OutputError(f"{label}: cannot replace the link in {path.parent} ({problem})")
+    if _replaceable_link(path, label, force):
         return
     problem = _cannot_create_in(path) if path.is_dir() else None
     if problem is not None:
@@ -583,7 +589,9 @@ class OutputFolder:
     names : iterable of str
         Every file name this run may write (plain names, no folders).
     force : bool
-        Also replace files of those names that the tool did not write.
+        Also replace files of those names that the tool did not write, and a symbolic link
+        named `path` (the link itself, by a new folder, when the first file is written; put
+        back if the run is abandoned; what it points to is never written).
     inputs : iterable of paths
         Files the command reads (never replaced).
     option : str
@@ -592,8 +600,8 @@ class OutputFolder:
     Raises
     ------
     OutputError
-        The path is a regular file, a symbolic link or not a folder, or a file
-        to be written exists, was not written by the tool and `force` is false.
+        The path is a regular file or not a folder, a symbolic link and `force` is false, or
+        a file to be written exists, was not written by the tool and `force` is false.
 
     Examples
     --------
@@ -620,17 +628,19 @@ class OutputFolder:
         for name in self.names:
             if Path(name).name != name or name in ("", ".", "..", MANIFEST):
                 raise ValueError(f"not a plain file name: {name!r}")
-        if self.path.is_symlink():
-            raise OutputError(f"{label} is a symbolic link; give the folder it points to "
-                              f"or another name")
-        if self.path.exists() and not self.path.is_dir():
+        # a symbolic link replaced with force: what it held (a new folder in its place)
+        self._link = os.readlink(self.path) if _replaceable_link(self.path, label, force) \
+            else None
+        self._link_removed = False
+        if self._link is None and self.path.exists() and not self.path.is_dir():
             kind = "a file" if self.path.is_file() else "not a folder"
             raise OutputError(f"{label} is {kind}; give a folder (it is left untouched)")
         _check_parents(self.path, label)
-        if self.path.is_dir() and not os.access(self.path, os.W_OK | os.X_OK):
+        if self._link is None and self.path.is_dir() and not os.access(self.path,
+                                                                       os.W_OK | os.X_OK):
             raise OutputError(f"{label}: no permission to write in {self.path}")
-        self.previous = self._read_manifest()
-        for name in self.names:
+        self.previous = self._read_manifest() if self._link is None else set()
+        for name in self.names if self._link is None else ():
             target = self.path / name
             if target.is_symlink() or target.exists():
                 if target.is_dir() and not target.is_symlink():
@@ -664,6 +674,13 @@ class OutputFolder:
                 and f not in ("", ".", "..", MANIFEST)}
 
     def _ensure_folder(self) -> None:
+        if self._link is not None and not self._link_removed:  # replaced, never followed
+            try:
+                self.path.unlink()
+            except OSError as exc:
+                raise OutputError(f"cannot replace the link {self.option} {self.path}: "
+                                  f"{exc.strerror}") from None
+            self._link_removed = True
         if not self.path.exists():
             for folder in _missing_parents(self.path):
                 try:
@@ -780,6 +797,10 @@ class OutputFolder:
                 if {p.name for p in folder.iterdir()} <= {MANIFEST}:
                     (folder / MANIFEST).unlink(missing_ok=True)
                 folder.rmdir()
+        if self._link_removed and not (self.path.exists() or self.path.is_symlink()):
+            with contextlib.suppress(OSError):  # the link the user had, as it was
+                os.symlink(self._link, self.path)
+                self._link_removed = False
 
     def __enter__(self) -> OutputFolder:
         self._signals = _signals_raise()

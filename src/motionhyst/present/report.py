@@ -249,7 +249,8 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
     is_paper : bool
         Compare with the numbers the paper states (Table I scenario).
     force : bool
-        Also replace files of the report's names that motionhyst did not write.
+        Also replace files of the report's names that motionhyst did not write, and a
+        symbolic link named `out_dir`.
     inputs : iterable of paths
         Files the command read (the scenario): never replaced.
 
@@ -261,9 +262,9 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
     Raises
     ------
     motionhyst.io.outputs.OutputError
-        Before any computation, if `out_dir` is a file or a symbolic link, or
-        holds a file of the report's names that motionhyst did not write and
-        `force` is false.
+        Before any computation, if `out_dir` is a file, or a symbolic link or holds a
+        file of the report's names that motionhyst did not write and `force` is false
+        (with it the link itself is replaced by the folder, never what it points to).
     """
     folder = OutputFolder(out_dir, OUTPUT_NAMES, force=force, inputs=inputs)
     A, freqs = sc.amplitude, sc.frequencies
