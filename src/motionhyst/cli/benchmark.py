@@ -80,7 +80,12 @@ def _data(args: argparse.Namespace) -> Path:
     if args.data is None:
         raise UsageError(f"motionhyst benchmark {args.name}: give --data DIR, the folder with "
                          f"{DATA_FILES[args.name]}, downloaded from nonlinearbenchmark.org")
-    return Path(args.data)
+    data = Path(args.data)
+    if not data.is_dir():
+        state = "not a folder" if data.exists() else "no such folder"
+        raise UsageError(f"motionhyst benchmark {args.name}: --data {data}: {state} (give the "
+                         f"folder with {DATA_FILES[args.name]})")
+    return data
 
 
 def run_bouc_wen(args: argparse.Namespace) -> int:
@@ -150,8 +155,6 @@ def run_emps(args: argparse.Namespace) -> int:
             except ValueError as exc:
                 raise UsageError(f"motionhyst benchmark emps: --models: {exc}") from None
     data = _data(args)
-    if not data.is_dir():
-        raise UsageError(f"motionhyst benchmark emps: --data {data}: no such folder")
     est_path, test_path = data / ESTIMATION_FILE, data / TEST_FILE
     for path in (est_path, test_path):  # there, but not a file: never passed over in silence
         if (path.exists() or path.is_symlink()) and not path.is_file():
