@@ -183,6 +183,49 @@ def test_a_store_named_by_a_link_replaces_the_link_with_force_never_its_target(
     assert target.exists() == (points_to != "nothing")
 
 
+@pytest.mark.parametrize("there", ["a link", "another study's store"])
+def test_a_store_replaced_with_force_stays_until_the_new_one_is_made(tmp_path, monkeypatch,
+                                                                      capsys, there):
+    """The new store is made beside what it replaces and renamed into its place: a failure
+    while it is made (a full disk) leaves the link or the other study's store as it was,
+    and nothing else."""
+    import motionhyst.study.runner as runner
+    from motionhyst.scenario import default_scenario_path
+    from motionhyst.study.store import StudyStore, is_study_store
+
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    study = 'scenario = "paper.toml"\noutputs = ["mismatch"]\n\n[axes]\namplitude = [0.01]\n'
+    (tmp_path / "s.toml").write_text(study + "frequency_hz = [5.0]\n")
+    monkeypatch.chdir(tmp_path)
+    if there == "a link":
+        (tmp_path / "mine").mkdir()
+        (tmp_path / "o.zarr").symlink_to("mine")
+    else:
+        assert main(["study", "s.toml", "--out", "o.zarr", "--workers", "0"]) == 0
+        (tmp_path / "s.toml").write_text(study + "frequency_hz = [6.0]\n")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    fingerprint = None if there == "a link" else (tmp_path / "o.zarr" / "zarr.json").read_bytes()
+    created = StudyStore.create
+
+    def full_disk(path, *args, **kwargs):
+        created(path, *args, **kwargs)  # part of it written, then the disk is full
+        raise OSError(28, "No space left on device", str(path))
+
+    monkeypatch.setattr(runner.StudyStore, "create", full_disk)
+    capsys.readouterr()
+    assert main(["study", "s.toml", "--out", "o.zarr", "--workers", "0", "--force"]) == 2
+    assert capsys.readouterr().err == "motionhyst: error: o.zarr: No space left on device\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+    if there == "a link":
+        assert (tmp_path / "o.zarr").is_symlink() and os.readlink(tmp_path / "o.zarr") == "mine"
+    else:
+        assert (tmp_path / "o.zarr" / "zarr.json").read_bytes() == fingerprint
+    monkeypatch.setattr(runner.StudyStore, "create", created)
+    assert main(["study", "s.toml", "--out", "o.zarr", "--workers", "0", "--force"]) == 0
+    assert not (tmp_path / "o.zarr").is_symlink() and is_study_store(tmp_path / "o.zarr")
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
 @pytest.mark.parametrize("points_to", ["folder", "file", "nothing"])
 def test_a_results_folder_named_by_a_link_replaces_the_link_with_force(tmp_path, points_to):
     """``reproduce --out LINK --force``, the rule of every writer: the link itself is replaced

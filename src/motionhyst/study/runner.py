@@ -15,6 +15,7 @@ import contextlib
 import fcntl
 import os
 import resource
+import shutil
 import sys
 import time
 from collections.abc import Iterator
@@ -297,11 +298,33 @@ def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStor
 
 
 def _new_store(study: StudyDefinition, path: Path, version: str) -> StudyStore:
-    if path.is_symlink():  # replaced with force; what it points to is left as it is
-        path.unlink()
-    elif path.exists():  # another study's, replaced with force
-        remove_store(path)
-    return StudyStore.create(path, study, version)
+    """A new store at `path`; what is there (a symbolic link, another study's store: replaced
+    with force) stays until the new store is made beside it and renamed into its place, so a
+    failure or an interrupt leaves the one or the other, never neither."""
+    if not (path.exists() or path.is_symlink()):
+        return StudyStore.create(path, study, version)
+    if not path.is_symlink() and not is_study_store(path):
+        remove_store(path)  # refuses: not a study's store
+    new, old = (path.with_name(f".{path.name}.motionhyst-{os.getpid()}-{end}")
+                for end in ("new", "old"))
+    try:
+        StudyStore.create(new, study, version)
+        os.rename(path, old)  # the link itself, or the other study's folder, aside
+        try:
+            os.rename(new, path)
+        except BaseException:
+            os.rename(old, path)
+            raise
+    except BaseException as exc:
+        shutil.rmtree(new, ignore_errors=True)
+        if isinstance(exc, OSError) and exc.strerror:  # named as the store, not the temporary
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
+        raise
+    if old.is_symlink():  # what the link points to is left as it is
+        old.unlink()
+    else:
+        remove_store(old)
+    return StudyStore.open(path)
 
 
 def check_budget(study: StudyDefinition, n_missing: int, seconds: float, workers: int,
