@@ -353,10 +353,21 @@ def _robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.
         start += n
         lags = min(n - 1, max(int(4 * n ** (1 / 3)), window))
         meat += xe.T @ xe
-        for lag in range(1, lags + 1):
-            g = xe[lag:].T @ xe[:-lag]
-            meat += (1.0 - lag / (lags + 1)) * (g + g.T)
+        if lags > 0:  # sum over the lags of w_l xe[t + l] xe[t]^T, and its transpose
+            g = _ahead(xe, 1.0 - np.arange(1, lags + 1) / (lags + 1)).T @ xe
+            meat += g + g.T
     return x / scale, (cov @ meat @ cov) / np.outer(scale, scale)
+
+
+def _ahead(x: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``sum_l w[l - 1] x[t + l]`` over ``l = 1 .. len(w)`` (zero past the end) at each row
+    ``t``: one FFT convolution of the columns, where a product for each lag took minutes on
+    a record of millions of samples (its ``4 n^(1/3)`` lags)."""
+    n, lags = x.shape[0], w.size
+    size = 1 << (n + lags).bit_length()
+    kernel = np.fft.rfft(np.concatenate([[0.0], w]), size)
+    conv = np.fft.irfft(np.fft.rfft(x[::-1], size, axis=0) * kernel[:, None], size, axis=0)
+    return conv[:n][::-1]
 
 
 #: A start whose cost is within this factor of the records' noise (from their repeated
