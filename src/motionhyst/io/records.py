@@ -55,6 +55,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.budget import BudgetError
 from motionhyst.core.validation import MAGNITUDES
 from motionhyst.io.csvdata import (
     CSVError,
@@ -311,19 +312,35 @@ def _vector(path: Path, name: str, value, matlab_class: str | None) -> NDArray[n
     return np.asarray(arr, dtype=np.float64).ravel()
 
 
+def _check_size(path: Path, name: str, values: int, total: list[int]) -> None:
+    """Refuse, before it is read, a variable whose values (with those already read, `total`)
+    would exceed the memory budget: a compressed file declares its size, and a few MB of
+    zeros can unpack into GBs."""
+    from motionhyst.core.budget import check_memory
+
+    total[0] += values
+    check_memory(VALUE_BYTES * total[0], f"{path}: cannot read variable {name!r}: reading its "
+                 f"{values} values", "give a smaller file")
+
+
 def _read_scipy(path: Path, wanted: Sequence[str]) -> list[NDArray[np.float64]]:
     from scipy.io import loadmat, whosmat
 
     try:
-        info = {n: cls for n, _, cls in whosmat(str(path))}
+        whos = whosmat(str(path))
+        info = {n: cls for n, _, cls in whos}
         try:
             tops = list(dict.fromkeys(_resolve(w.split(".")[0], list(info), path)
                                       for w in wanted))
         except RecordError:
             loadmat(str(path))  # a file cut short lists only its first variables: say so
             raise
+        total = [0]
+        for name, shape, _ in whos:
+            if name in tops:
+                _check_size(path, name, math.prod(shape), total)
         data = loadmat(str(path), variable_names=tops, simplify_cells=True)
-    except RecordError:
+    except (RecordError, BudgetError):
         raise
     except Exception as exc:  # scipy's many ways to fail on a damaged file
         raise RecordError(f"{path}: cannot read as a MATLAB file ({_one_line(exc)})") from None
@@ -364,7 +381,7 @@ def _read_hdf5(path: Path, wanted: Sequence[str]) -> list[NDArray[np.float64]]:
     except Exception as exc:  # h5py raises OSError subclasses with long texts
         raise RecordError(f"{path}: cannot read as a MATLAB 7.3 file ({_one_line(exc)})") from None
     with fh:
-        out = []
+        out, total = [], [0]
         for w in wanted:
             group, name = fh, ""
             parts = w.split(".")
@@ -389,6 +406,7 @@ def _read_hdf5(path: Path, wanted: Sequence[str]) -> list[NDArray[np.float64]]:
             if cls is not None and cls not in _MAT_CLASSES:
                 what = _CLASS_WORDS.get(cls, f"of class {cls}")
                 raise RecordError(f"{path}: variable {name!r} is {what}, not a numeric vector")
+            _check_size(path, name, obj.size, total)
             try:
                 value = obj[()]
             except Exception as exc:
@@ -589,6 +607,10 @@ def _check_magnitudes(data: NDArray[np.float64], names: Sequence[str], where: st
                               f"motionhyst computes with (its unit? --scale {name}=GAIN)")
 
 
+VALUE_BYTES = 16
+"""Memory a MATLAB variable's value takes as it is read [bytes]: its own array (up to 8
+bytes) and its float64 copy."""
+
 MAX_POSITION = 100.0
 """Largest position [m] a motion stage's record holds in metres: beyond, a warning (a record
 in millimetres or micrometres read as metres)."""
@@ -622,5 +644,5 @@ def _check_units(data: NDArray[np.float64], names: Sequence[str], where: str) ->
                  f"time=GAIN; 86400 turns days into seconds)", 3)
 
 
-__all__ = ["MAX_POSITION", "MIN_TIME_STEP", "RecordError", "is_mat_file", "parse_columns",
-           "parse_scale", "read_record", "record_columns"]
+__all__ = ["MAX_POSITION", "MIN_TIME_STEP", "VALUE_BYTES", "RecordError", "is_mat_file",
+           "parse_columns", "parse_scale", "read_record", "record_columns"]
