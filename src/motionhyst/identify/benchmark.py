@@ -42,7 +42,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.compiled import njit
-from motionhyst.io.inputs import CSV_EXPANSION, input_problem
 
 __all__ = ["benchmark_output", "decimate_fir", "multisine", "newmark_bouc_wen", "training_record"]
 
@@ -394,8 +393,7 @@ def load_test_set(directory: str | Path, name: str) -> Record:
     Raises ``ValueError`` with one line naming the file when a file is missing
     or unreadable or the two do not match.
     """
-    from scipy.io import loadmat
-    from scipy.io.matlab import MatReadError
+    from motionhyst.io.records import read_record
 
     if name not in TEST_SETS:
         raise ValueError(f"unknown test set {name!r}; expected one of {sorted(TEST_SETS)}")
@@ -405,22 +403,14 @@ def load_test_set(directory: str | Path, name: str) -> Record:
         if not path.is_file():
             raise ValueError(f"{path}: no such file (the benchmark's test sets are "
                              f"{', '.join(f for pair in TEST_SETS.values() for f in pair)})")
-        why = input_problem(path, CSV_EXPANSION)
-        if why:
-            raise ValueError(f"{path}: cannot read ({why})")
-        try:
-            data = loadmat(path)
-        except (OSError, ValueError, MatReadError) as exc:
-            raise ValueError(f"{path}: cannot read ({exc})") from None
-        except Exception as exc:  # scipy's other ways to fail on a damaged header
-            raise ValueError(f"{path}: cannot read as a MATLAB file "
-                             f"({type(exc).__name__}: {exc})") from None
         key = fname.removesuffix(".mat")
-        if key not in data:
-            raise ValueError(f"{path}: no variable {key!r}")
-        arr = np.asarray(data[key], dtype=float).ravel()
-        if arr.size == 0 or not np.all(np.isfinite(arr)):
-            raise ValueError(f"{path}: empty or non-finite data")
+        try:  # the records' reader: MATLAB levels 4 to 7.3, a vector of real numbers
+            arr = read_record(path, (key,), columns={key: key})[:, 0]
+        except ValueError as exc:
+            raise ValueError(f"{path}: cannot read: "
+                             f"{str(exc).removeprefix(f'{path}: ')}") from None
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"{path}: non-finite data")
         arrays.append(arr)
     u, y = arrays
     if u.size != y.size:
