@@ -58,6 +58,29 @@ PAPER = default_scenario_path().read_text()
 MEASURED = (PAPER[:PAPER.index("[stage]")] + '[plant]\nfile = "plant.csv"\n\n'
             + PAPER[PAPER.index("[hysteresis]"):])
 LOG = np.geomspace(1.0, 3000.0, 200)
+def _zlib_bomb(path) -> None:
+    """A MATLAB v5 file of a few kB whose compressed variables ``t`` and ``u`` declare 2e9
+    values each (32 GB as read), as a file of zeros compressed a thousandfold does."""
+    import io
+    import struct
+    import zlib
+
+    from scipy.io import savemat
+
+    buf = io.BytesIO()
+    savemat(buf, {"t": np.zeros((1000, 1)), "u": np.zeros((1000, 1))}, do_compression=True)
+    raw, pos = buf.getvalue(), 128
+    out = [raw[:pos]]
+    while pos < len(raw):  # each variable: a compressed element whose dimensions are patched
+        kind, size = struct.unpack("<ii", raw[pos:pos + 8])
+        body = zlib.decompress(raw[pos + 8:pos + 8 + size]).replace(
+            struct.pack("<iiii", 5, 8, 1000, 1), struct.pack("<iiii", 5, 8, 2_000_000_000, 1), 1)
+        packed = zlib.compress(body)
+        out.append(struct.pack("<ii", kind, len(packed)) + packed)
+        pos += 8 + size
+    path.write_bytes(b"".join(out))
+
+
 BASE = {"axis.toml": AXIS, "notes.txt": "my notes", "p.toml": MEASURED}
 PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
 MAP = ["--columns", "time=t,force=u"]
@@ -72,6 +95,19 @@ CASES = [
     ("columns-given-twice", {"r.mat": _mat()},
      [*PREDICT, "--columns", "time=t,force=u", "--columns", "force=y"],
      ["argument --columns: 'force' is given twice"]),
+    # ------------------------------------ a compressed variable declaring more than memory
+    ("mat-declaring-32-GB", {"r.mat": _zlib_bomb}, [*PREDICT, *MAP],
+     ["r.mat: cannot read variable 't': reading its 2000000000 values needs 32 GB, above the "
+      "memory budget", "give a smaller file"]),
+    # ------------------------------ the Bouc-Wen benchmark's test sets as MATLAB users save them
+    *[(f"bouc-wen-test-set-{kind}", {"bw/uval_multisine.mat": maker},
+       ["benchmark", "bouc-wen", "--data", "bw"],
+       [f"bw/uval_multisine.mat: cannot read: variable 'uval_multisine' is {words}"])
+      for kind, maker, words in (
+          ("complex", _mat(uval_multisine=np.ones((8192, 1)) + 1j), "complex"),  # was read
+          # as its real part, a numpy warning on stderr
+          ("cell", _mat(uval_multisine=np.array([np.ones(8192)], dtype=object)), "a cell array"),
+          ("two-columns", _mat(uval_multisine=np.ones((8192, 2))), "a 8192x2 matrix"))],
     # ------------------------------------------------------- a time column not in seconds
     ("time-in-milliseconds", {"r.mat": _mat(t=1000 * _record()["t"][:, None])}, [*PREDICT, *MAP],
      ["integration steps per sample of r.mat", "sampling rate 1 Hz",
@@ -103,6 +139,7 @@ def test_a_record_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, 
     populate(root, {**BASE, **{k: v for k, v in files.items() if not callable(v)}})
     for name, make in files.items():
         if callable(make):
+            (root / name).parent.mkdir(parents=True, exist_ok=True)
             make(root / name)
     before = snapshot(root)
     line = limited_process.refusal(list(argv), root)
@@ -167,3 +204,25 @@ def test_the_robust_covariance_sums_every_lag_as_the_products_did(n):
         expected += (1.0 - lag / (lags + 1)) * (g + g.T)
     g = _ahead(xe, 1.0 - np.arange(1, lags + 1) / (lags + 1)).T @ xe
     assert np.allclose(g + g.T, expected, rtol=0.0, atol=1e-12 * np.abs(expected).max())
+
+
+def test_a_benchmark_test_set_saved_as_matlab_7_3_reads_as_version_5(tmp_path):
+    """The Bouc-Wen benchmark's test sets through the records' reader: a file saved with
+    ``-v7.3`` (HDF5) gives the same numbers (it was refused: scipy reads levels 4 and 5)."""
+    import h5py
+    from scipy.io import savemat
+
+    from motionhyst.identify.benchmark import load_test_set
+
+    u, y = (np.sin(np.arange(8192) / k) for k in (7.0, 11.0))
+    v5, v73 = tmp_path / "v5", tmp_path / "v73"
+    for folder in (v5, v73):
+        folder.mkdir()
+        savemat(folder / "yval_multisine.mat", {"yval_multisine": y[:, None]})
+    savemat(v5 / "uval_multisine.mat", {"uval_multisine": u[:, None]})
+    with h5py.File(v73 / "uval_multisine.mat", "w", userblock_size=512) as f:
+        f.create_dataset("uval_multisine", data=u[None, :]).attrs["MATLAB_class"] = b"double"
+    with open(v73 / "uval_multisine.mat", "r+b") as fh:  # the header MATLAB writes
+        fh.write(b"MATLAB 7.3 MAT-file".ljust(116) + b"\x00" * 8 + b"\x00\x02IM")
+    a, b = load_test_set(v5, "multisine"), load_test_set(v73, "multisine")
+    assert np.array_equal(a.u, u) and np.array_equal(b.u, u) and np.array_equal(b.y, y)
