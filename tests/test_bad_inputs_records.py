@@ -174,11 +174,10 @@ def test_columns_and_scale_given_in_pieces_count_together(tmp_path):
 
 @pytest.mark.parametrize(("variables", "extra", "words"), [
     ({"t": (739000.0 + _record()["t"] / 86400.0)[:, None]}, [],
-     "Hz sampling), finer than a motion stage's data logger samples: time in seconds? "
-     "(--scale time=GAIN; 86400 turns days"),
+     "Hz sampling): if the time is not in seconds, scale it (--scale time=86400 for days)"),
     ({"y": 1000.0 * _record()["y"][:, None]}, ["--init-from", "r.mat"],
-     "r.mat: displacement reaches 457 m, beyond the 100 m of a motion stage's stroke: in "
-     "mm or um? (--scale displacement=0.001"),
+     "r.mat: displacement reaches 457 m, beyond the 100 m of a motion stage's stroke: if the "
+     "positions are not in metres, scale them (--scale displacement=0.001 for mm"),
 ], ids=["time-in-days", "position-in-mm"])
 def test_a_unit_slip_in_a_record_is_a_warning_naming_the_column(tmp_path, variables, extra,
                                                                  words):
@@ -226,3 +225,26 @@ def test_a_benchmark_test_set_saved_as_matlab_7_3_reads_as_version_5(tmp_path):
         fh.write(b"MATLAB 7.3 MAT-file".ljust(116) + b"\x00" * 8 + b"\x00\x02IM")
     a, b = load_test_set(v5, "multisine"), load_test_set(v73, "multisine")
     assert np.array_equal(a.u, u) and np.array_equal(b.u, u) and np.array_equal(b.y, y)
+
+
+@pytest.mark.parametrize(("column", "values", "warned"), [
+    ("time", np.arange(2000) / 20e6, False),                  # a 20 MHz capture
+    ("time", 739000.0 + np.arange(2000) / 1000 / 86400, True),  # days at 1 kHz
+    ("displacement", 0.08 * np.sin(np.arange(2000) / 100), False),
+    ("displacement", 80.0 * np.sin(np.arange(2000) / 100), False),  # 80 mm read as m: not seen
+    ("displacement", 150.0 * np.sin(np.arange(2000) / 100), True),
+])
+def test_the_unit_warnings_catch_what_they_say_and_no_more(tmp_path, column, values, warned):
+    """Days at 1 kHz and strokes beyond 100 m are warned; a fast capture and a stroke that may
+    be metres are not."""
+    import warnings
+
+    from motionhyst.core.warnings import MotionhystWarning
+    from motionhyst.io.records import read_record
+
+    other = "time" if column == "displacement" else "force"
+    data = {column: values, other: np.arange(2000) / 1000 if other == "time" else values * 0}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        read_record(data, (column, other))
+    assert [w.category for w in caught] == ([MotionhystWarning] if warned else [])

@@ -169,10 +169,13 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
     >>> for line in plausibility_warnings({"m": 1e-9}, {"m": 1e-9}, 2.0, [rec], []):
     ...     print(line)
     m = 1e-09 kg is 2e+09 times below the records' linear estimate 2 kg
-    m = 1e-09 kg, outside the 0.001-10000 kg of motion stages: check the records' units (time
-    in ms makes it 1e6 times too large, a position in mm or a force in kN 1e3 times too small)
     m = 1e-09 kg: the inertia is not visible in these records (m times the RMS acceleration is
     3.9e-12 of the force's RMS); a quasi-static plant (--plant quasi-static) describes them
+    >>> for line in plausibility_warnings({"m": 2e6}, {"m": 2e6}, 2e6, [rec], []):
+    ...     print(line)                                 # the same record, its time in ms
+    m = 2e+06 kg, outside the usual 0.001-10000 kg of motion stages: if the records' units are
+    not SI, scale them (time in ms makes the mass 1e6 times too large, a position in mm or a
+    force in kN 1e3 times too small)
     """
     out = []
     total = float(sum(masses.values()))
@@ -184,7 +187,6 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
             factor = ratio if ratio > 1 else 1.0 / ratio
             out.append(f"{names} = {total:.4g} kg is {factor:.3g} times {word} the records' "
                        f"linear estimate {linear_mass:.4g} kg")
-    out += _unit_slip(names, total)
     a_rms = math.sqrt(np.mean(np.concatenate(
         [np.diff(rec.y, 2) * rec.fs ** 2 for rec in records]) ** 2))
     u_rms = math.sqrt(np.mean(np.concatenate([rec.u - np.mean(rec.u) for rec in records]) ** 2))
@@ -193,6 +195,8 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
         out.append(f"{names} = {total:.4g} kg: the inertia is not visible in these records "
                    f"({names} times the RMS acceleration is {share:.2g} of the force's RMS); "
                    f"a quasi-static plant (--plant quasi-static) describes them")
+    else:  # a mass the records show: its size may betray a unit
+        out += _unit_slip(names, total)
     for name in at_bound:
         out.append(f"{name} = {estimates[name]:.4g} ended at a bound of the search: the records "
                    f"push it beyond the model's range")
@@ -205,16 +209,17 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
 
 
 def _unit_slip(names: str, total: float) -> list[str]:
-    """A mass outside those of motion stages, as a measured plant's is checked
-    (:data:`~motionhyst.plants.frf_fit.PLAUSIBLE_MASS_KG`): a unit slip in the records."""
+    """A mass outside the usual ones of motion stages, as a measured plant's is checked
+    (:data:`~motionhyst.plants.frf_fit.PLAUSIBLE_MASS_KG`): a unit slip in the records, or a
+    stage lighter than a gram (a flexure, a MEMS device) or heavier than ten tonnes."""
     from motionhyst.plants.frf_fit import PLAUSIBLE_MASS_KG
 
     low, high = PLAUSIBLE_MASS_KG
     if total <= 0 or low <= total <= high:
         return []
-    return [f"{names} = {total:.4g} kg, outside the {low:g}-{high:g} kg of motion stages: check "
-            f"the records' units (time in ms makes it 1e6 times too large, a position in mm "
-            f"or a force in kN 1e3 times too small)"]
+    return [f"{names} = {total:.4g} kg, outside the usual {low:g}-{high:g} kg of motion stages: "
+            f"if the records' units are not SI, scale them (time in ms makes the mass 1e6 "
+            f"times too large, a position in mm or a force in kN 1e3 times too small)"]
 
 
 def systematic_share(residual: NDArray[np.float64], signal: NDArray[np.float64]) -> float:

@@ -33,9 +33,11 @@ stamp within 0.05 of a sampling interval of it
 a record whose stamps stray further (a dropped or repeated sample) is refused,
 naming the worst stamp.
 
-Values that no motion stage's record holds in SI units, positions beyond
-:data:`MAX_POSITION` or time steps finer than :data:`MIN_TIME_STEP`, are a
-warning naming the column (a unit slip: millimetres, days).
+Two unit slips show in the values and are a warning naming the column: positions
+beyond :data:`MAX_POSITION` (100 m: a record in millimetres of a stroke over
+100 mm, or in micrometres) and time steps finer than :data:`MIN_TIME_STEP`
+(2e-8 s: a record stamped in days, sampled at 1 kHz or faster).  Others, a
+short stroke in millimetres or time in hours, look like values a stage may have.
 
 Every problem is a :class:`RecordError` (a ``ValueError``) with one line
 naming the file: not a CSV or ``.mat`` file, a missing column or variable
@@ -612,18 +614,17 @@ VALUE_BYTES = 16
 bytes) and its float64 copy."""
 
 MAX_POSITION = 100.0
-"""Largest position [m] a motion stage's record holds in metres: beyond, a warning (a record
-in millimetres or micrometres read as metres)."""
+"""Largest position [m] of a motion stage's record in metres: beyond, a warning (a record in
+millimetres of a stroke over 100 mm, or in micrometres)."""
 
-MIN_TIME_STEP = 1e-7
-"""Finest sampling step [s] of a motion stage's record (10 MHz): finer, a warning (time in
-days or hours read as seconds)."""
+MIN_TIME_STEP = 2e-8
+"""Finest time step [s] of a record (50 MHz) without a warning: a record stamped in days and
+sampled at 1 kHz or faster has finer steps (1.16e-8 "s" at 1 kHz)."""
 
 
 def _check_units(data: NDArray[np.float64], names: Sequence[str], where: str) -> None:
-    """Warn of a column whose values no motion stage's record has in SI units (a unit slip
-    read as seconds or metres): positions beyond :data:`MAX_POSITION` (millimetres or
-    micrometres), time steps below :data:`MIN_TIME_STEP` (time in days or hours)."""
+    """Warn of the unit slips the values show: positions beyond :data:`MAX_POSITION`, time
+    steps finer than :data:`MIN_TIME_STEP` (each a question: the values may be meant)."""
     from motionhyst.core.warnings import warn
 
     columns = dict(zip(names, data.T, strict=False))
@@ -632,16 +633,16 @@ def _check_units(data: NDArray[np.float64], names: Sequence[str], where: str) ->
         with np.errstate(invalid="ignore"):
             peak = float(np.max(np.abs(y)))
         if peak > MAX_POSITION:
-            warn(f"{where}: displacement reaches {peak:.3g} m, beyond the {MAX_POSITION:g} m of a "
-                 f"motion stage's stroke: in mm or um? (--scale displacement=0.001 or 1e-6)", 3)
+            warn(f"{where}: displacement reaches {peak:.3g} m, beyond the {MAX_POSITION:g} m "
+                 f"of a motion stage's stroke: if the positions are not in metres, scale them "
+                 f"(--scale displacement=0.001 for mm, 1e-6 for um)", 3)
     t = columns.get("time")
     if t is not None and t.size > 1:
         with np.errstate(invalid="ignore"):
             step = float(np.median(np.abs(np.diff(t))))
         if 0.0 < step < MIN_TIME_STEP:
-            warn(f"{where}: time steps of {step:.3g} s ({1 / step:.3g} Hz sampling), finer "
-                 f"than a motion stage's data logger samples: time in seconds? (--scale "
-                 f"time=GAIN; 86400 turns days into seconds)", 3)
+            warn(f"{where}: time steps of {step:.3g} s ({1 / step:.3g} Hz sampling): if the "
+                 f"time is not in seconds, scale it (--scale time=86400 for days)", 3)
 
 
 __all__ = ["MAX_POSITION", "MIN_TIME_STEP", "VALUE_BYTES", "RecordError", "is_mat_file",
