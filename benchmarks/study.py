@@ -17,7 +17,9 @@ stores:
    workers in ``--repeats`` pairs of runs, interleaved (a study of another seed each pair, as
    a dask worker keeps the last study it built), the two in alternating order.  The cluster
    runs with the settings for studies (``engine.DASK_CLUSTER_CONFIG``, in its processes'
-   environment, as the README starts one), or with dask's defaults (``--dask-defaults``).
+   environment, as the README starts one), or is started with dask's defaults
+   (``--dask-defaults``), whose diagnostics a study sets to that pace while it runs
+   (``engine.quiet_cluster``); the idle cluster's CPU is measured at that pace too.
 
 Each run counts the CPU time of every process by role (this process, the client, which sends
 the batches and writes the store; the workers; on dask the scheduler and the nannies too) and
@@ -67,6 +69,7 @@ from motionhyst.study.engine import (
     DASK_CLUSTER_CONFIG,
     batch_size,
     dask_environment,
+    quiet_cluster,
     seconds_per_point,
 )
 
@@ -195,12 +198,29 @@ def dask_cluster(folder: Path, defaults: bool = False
                 p.wait()
 
 
-def idle_rate(roles: dict[str, list[int]], seconds: float) -> float:
-    """CPU time a second of the idle cluster (heartbeats, ticks, profiler) and this process."""
+def idle_rate(client, roles: dict[str, list[int]], seconds: float) -> float:
+    """CPU time a second of the idle cluster (heartbeats, ticks, profiler) and this process,
+    its diagnostics at the pace a study sets while it runs (:func:`quiet_cluster`)."""
     pids = [pid for group in roles.values() for pid in group]
-    w0, i0 = time.perf_counter(), _cpu_self() + _cpu_tree(pids)
-    time.sleep(seconds)
-    return (_cpu_self() + _cpu_tree(pids) - i0) / (time.perf_counter() - w0)
+    with quiet_cluster(client):
+        w0, i0 = time.perf_counter(), _cpu_self() + _cpu_tree(pids)
+        time.sleep(seconds)
+        return (_cpu_self() + _cpu_tree(pids) - i0) / (time.perf_counter() - w0)
+
+
+def _timers(dask_worker) -> dict:
+    return {name: (pc.callback_time, pc.is_running())
+            for name, pc in dask_worker.periodic_callbacks.items()
+            if name in ("tick", "monitor", "memory_monitor", "profile")}
+
+
+def _cluster_timers(client) -> dict:
+    """The intervals [ms] of the diagnostics' timers of the scheduler, workers and nannies
+    and whether they run."""
+    nannies = any(w.get("nanny") for w in client.scheduler_info()["workers"].values())
+    return {"scheduler": client.run_on_scheduler(_timers),
+            "workers": list(client.run(_timers).values()),
+            "nannies": list(client.run(_timers, nanny=True).values()) if nannies else []}
 
 
 def _equal(a, b) -> None:
@@ -338,12 +358,15 @@ def main() -> None:
             # the workers import the library and load the kernels at their first batch
             timed(make_study(1, 2), folder, "dask_warm", roles=roles, client=client, batch=1)
             out["dask_cluster_config"] = _cluster_config(client)
+            out["dask_timers"] = _cluster_timers(client)
+            with quiet_cluster(client):
+                out["dask_timers_during_a_study"] = _cluster_timers(client)
             for r in range(args.repeats):
                 # a study of its own each pair (another seed): a dask worker keeps the last
                 # study built, a pool's workers build it anew; the order alternates, so that
                 # a load rising or falling over the pairs weighs on both engines alike
                 st = make_study(args.samples, args.frequencies, seed=1 + r)
-                idles.append(idle_rate(roles, 2.0))
+                idles.append(idle_rate(client, roles, 2.0))
                 runs = {}
                 for engine in ENGINES[r % 2:] + ENGINES[:r % 2]:
                     if engine == "pool":
@@ -356,7 +379,7 @@ def main() -> None:
                 pairs.append((runs["pool"], runs["dask"]))
                 for name in ENGINES:
                     shutil.rmtree(folder / f"pair{r}_{name}.zarr")
-            idles.append(idle_rate(roles, 2.0))
+            idles.append(idle_rate(client, roles, 2.0))
     idle = float(np.median(idles))
 
     out.update({

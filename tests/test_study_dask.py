@@ -4,12 +4,14 @@ mid-study."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
 import subprocess
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -37,32 +39,31 @@ seed = 3
 POINTS = 240
 
 
-def _start(args: list[str], log: Path) -> subprocess.Popen:
-    """A dask command with the settings for studies (as the README and guide start one)."""
-    env = {**{k: v for k, v in os.environ.items() if not k.startswith("DASK_")},
-           **dask_environment()}
+def _start(args: list[str], log: Path, env: dict[str, str]) -> subprocess.Popen:
     with open(log, "w") as fh:
         return subprocess.Popen([sys.executable, "-m", "dask", *args], stdout=fh,
                                 stderr=subprocess.STDOUT, start_new_session=True, env=env)
 
 
-@pytest.fixture
-def cluster(tmp_path):
+@contextlib.contextmanager
+def _cluster(folder: Path, settings: dict[str, str]):
     """``dask scheduler`` and two ``dask worker`` processes (one thread each, no nanny: a
-    killed worker stays dead) on 127.0.0.1, with the settings for studies."""
-    sched_file = tmp_path / "scheduler.json"
+    killed worker stays dead) on 127.0.0.1, dask's configuration `settings` in their
+    environment; the client and the workers' processes."""
+    env = {**{k: v for k, v in os.environ.items() if not k.startswith("DASK_")}, **settings}
+    sched_file = folder / "scheduler.json"
     procs = [_start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                     "--scheduler-file", str(sched_file)], tmp_path / "scheduler.log")]
+                     "--scheduler-file", str(sched_file)], folder / "scheduler.log", env)]
     try:
         deadline = time.monotonic() + 120
         while not sched_file.exists() and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert sched_file.exists(), (tmp_path / "scheduler.log").read_text()
+        assert sched_file.exists(), (folder / "scheduler.log").read_text()
         for i in range(2):
             procs.append(_start(["worker", "--scheduler-file", str(sched_file), "--nthreads",
                                  "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1",
-                                 "--local-directory", str(tmp_path / f"worker{i}")],
-                                tmp_path / f"worker{i}.log"))
+                                 "--local-directory", str(folder / f"worker{i}")],
+                                folder / f"worker{i}.log", env))
         client = distributed.Client(scheduler_file=str(sched_file), timeout="60s")
         try:
             client.wait_for_workers(2, timeout=120)
@@ -79,6 +80,20 @@ def cluster(tmp_path):
             except subprocess.TimeoutExpired:
                 os.killpg(p.pid, signal.SIGKILL)
                 p.wait()
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    """A cluster with dask's defaults (as ``dask scheduler`` and ``dask worker`` start)."""
+    with _cluster(tmp_path, {}) as out:
+        yield out
+
+
+@pytest.fixture
+def study_cluster(tmp_path):
+    """A cluster started with the settings for studies (the README's and the guide's)."""
+    with _cluster(tmp_path, dask_environment()) as out:
+        yield out
 
 
 @pytest.fixture
@@ -169,25 +184,62 @@ def _settings(dask_worker) -> dict:
 
     out = {key: dask.config.get(key) for key in DASK_CLUSTER_CONFIG}
     timers = dask_worker.periodic_callbacks
-    return {**out, "profiler": "profile" in timers,
+    return {**out, "profiler": "profile" in timers and timers["profile"].is_running(),
             **{f"{name}_ms": timers[name].callback_time for name in
                ("tick", "monitor", "memory_monitor") if name in timers}}
 
 
-def test_the_cluster_for_studies_runs_with_its_settings(cluster):
-    """The environment of ``dask_environment()`` (the README's and the guide's) starts dask's
-    processes with DASK_CLUSTER_CONFIG: a misspelt variable would leave dask's default."""
+def _settings_of(client) -> list[dict]:
+    """:func:`_settings` of the scheduler, then of each worker."""
     import cloudpickle
 
-    client, _ = cluster
     # _settings goes by value: the workers cannot import this test module
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     try:
-        on_scheduler, workers = client.run_on_scheduler(_settings), client.run(_settings)
+        return [client.run_on_scheduler(_settings), *client.run(_settings).values()]
     finally:
         cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
-    assert len(workers) == 2
-    for got in [on_scheduler, *workers.values()]:
-        assert got.pop("memory_monitor_ms", None) == (None if got is on_scheduler else 1000)
+
+
+def test_the_cluster_for_studies_runs_with_its_settings(study_cluster):
+    """The environment of ``dask_environment()`` (the README's and the guide's) starts dask's
+    processes with DASK_CLUSTER_CONFIG: a misspelt variable would leave dask's default."""
+    client, _ = study_cluster
+    everyone = _settings_of(client)
+    assert len(everyone) == 3
+    for got in everyone:
+        assert got.pop("memory_monitor_ms", None) == (None if got is everyone[0] else 1000)
         assert got == {**DASK_CLUSTER_CONFIG, "profiler": False, "tick_ms": 1000,
                        "monitor_ms": 5000}
+
+
+def test_a_study_quiets_a_default_clusters_diagnostics_while_it_runs(cluster):
+    """On a cluster started with dask's defaults the study's run sets the timers of dask's
+    diagnostics to the pace of DASK_CLUSTER_CONFIG (the workers' profiler stopped) and, when
+    it ends, back to each process's configuration."""
+    from motionhyst.study.engine import run_batches
+
+    client, _ = cluster
+    st = Study.from_dict({"outputs": ["e1"], "axes": {"frequency_hz": [5.0, 10.0, 20.0]}},
+                         scenario=tomllib.loads(default_scenario_path().read_text()))
+    defaults = {"distributed.admin.tick.interval": "20ms",
+                "distributed.worker.profile.enabled": True,
+                "distributed.worker.memory.monitor-interval": "100ms",
+                "distributed.admin.system-monitor.interval": "500ms"}
+    before = _settings_of(client)
+    results = run_batches(st, [[0], [1], [2]], client=client)
+    try:
+        next(results)
+        during = _settings_of(client)
+    finally:
+        results.close()
+    after = _settings_of(client)
+    assert before == after
+    for when, got in ((before, {"tick_ms": 20, "monitor_ms": 500, "memory_monitor_ms": 100,
+                                "profiler": True}),
+                      (during, {"tick_ms": 1000, "monitor_ms": 5000, "memory_monitor_ms": 1000,
+                                "profiler": False})):
+        assert when[0] == {**defaults, "tick_ms": got["tick_ms"],
+                           "monitor_ms": got["monitor_ms"], "profiler": False}
+        for worker in when[1:]:
+            assert worker == {**defaults, **got}

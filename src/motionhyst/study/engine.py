@@ -9,6 +9,7 @@ fastest).  A point's numbers do not depend on its batch, its worker or the engin
 
 from __future__ import annotations
 
+import contextlib
 import math
 import signal
 import threading
@@ -30,7 +31,8 @@ from motionhyst.study.spec import StudyDefinition, is_scenario_key
 from motionhyst.study.store import FAILED, OK
 
 __all__ = ["BATCH_SECONDS", "DASK_BATCH_SECONDS", "DASK_CLUSTER_CONFIG", "ENOUGH_SECONDS",
-           "Batch", "Evaluator", "dask_environment", "evaluate_batch", "run_batches"]
+           "Batch", "Evaluator", "dask_environment", "evaluate_batch", "quiet_cluster",
+           "run_batches"]
 
 BATCH_SECONDS = 0.1
 """Least work in one batch of the local pool [s]: below it, sending and collecting cost more
@@ -63,7 +65,15 @@ pausing and restarting a worker at its memory limits) every second rather than e
 study's memory is flat: its batches come back as compact records); the system monitor (the
 dashboard's CPU, memory and network plots) every 5 s rather than 0.5 s.  Work stealing costs
 nothing measurable idle.  :func:`dask_environment` gives them as the environment of ``dask
-scheduler`` and ``dask worker``."""
+scheduler`` and ``dask worker``; a study run on a cluster started otherwise sets its timers to
+this pace while it runs (:func:`quiet_cluster`)."""
+
+# dask's timers (a server's periodic callbacks) that DASK_CLUSTER_CONFIG paces, and the key of
+# each one's interval
+_TIMERS = {"tick": "distributed.admin.tick.interval",
+           "monitor": "distributed.admin.system-monitor.interval",
+           "memory_monitor": "distributed.worker.memory.monitor-interval"}
+_PROFILER = ("profile", "profile-cycle")
 
 # why a point failed (motionhyst.study.store.REASONS)
 _LOOP, _CONVERGE, _OUTPUT, _NUMERIC = 1, 2, 3, 4
@@ -307,6 +317,66 @@ def dask_environment() -> dict[str, str]:
             for key, value in DASK_CLUSTER_CONFIG.items()}
 
 
+def _pace(quiet: bool, dask_worker) -> None:
+    """The timers of one dask server (scheduler, worker or nanny: ``client.run`` passes it as
+    `dask_worker`) at the pace of :data:`DASK_CLUSTER_CONFIG` (`quiet`), or at the one its
+    own configuration gives (whatever a run stopped by SIGKILL left)."""
+    import dask.config
+    from dask.utils import parse_timedelta
+
+    timers = getattr(dask_worker, "periodic_callbacks", {})
+    for name, key in _TIMERS.items():
+        if name in timers:
+            value = DASK_CLUSTER_CONFIG[key] if quiet else dask.config.get(key)
+            timers[name].callback_time = 1000 * parse_timedelta(value, default="ms")
+    for name in _PROFILER:
+        if name in timers:      # its configuration enables the profiler
+            if quiet:
+                timers[name].stop()
+            elif not timers[name].is_running():
+                timers[name].start()
+
+
+def _pace_cluster(client, quiet: bool) -> None:
+    client.run_on_scheduler(_pace, quiet)
+    client.run(_pace, quiet, on_error="ignore")
+    if any(info.get("nanny") for info in client.scheduler_info()["workers"].values()):
+        client.run(_pace, quiet, nanny=True, on_error="ignore")
+
+
+@contextlib.contextmanager
+def quiet_cluster(client) -> Iterator[None]:
+    """dask's diagnostics on `client`'s cluster at the pace of :data:`DASK_CLUSTER_CONFIG`
+    while the block runs, then at the pace each process's configuration gives.
+
+    The scheduler's, the workers' and the nannies' event-loop health check, system monitor
+    and memory monitor take their intervals from :data:`DASK_CLUSTER_CONFIG`, and the workers'
+    profiler stops; after the block (an error or Ctrl-C included) each takes the interval of
+    its process's configuration again and the profiler runs again where it is enabled.  What
+    runs on the cluster meanwhile, a study's batches or others' work, is neither profiled nor
+    health-checked as often.  A run killed (SIGKILL) leaves the pace as it was set, until the
+    next run's end.  A cluster that refuses ``Client.run`` is left as it is.
+
+    Parameters
+    ----------
+    client : distributed.Client
+        The cluster's client.
+    """
+    from distributed.comm.core import CommClosedError
+
+    try:
+        _pace_cluster(client, True)
+    except (OSError, TimeoutError, CommClosedError, ValueError):
+        pass
+    try:
+        yield
+    finally:
+        try:
+            _pace_cluster(client, False)
+        except (OSError, TimeoutError, CommClosedError, ValueError):
+            pass
+
+
 _WORKER_STUDY: dict = {}
 
 
@@ -393,14 +463,15 @@ def _dask_run(client, key: str, plain: dict, batches: list) -> Iterator[Batch]:
 
     # the study's dictionary (about 1 kB) goes with each batch: scattered, its only copy left
     # by dask's memory manager on a worker that dies would cancel every batch still to run
-    futures = [client.submit(evaluate_batch, key, plain, b, pure=False)
-               for b in batches]
-    try:
-        for f in as_completed(futures):
-            yield f.result()
-            f.release()
-    finally:
-        client.cancel(futures)
+    with quiet_cluster(client):
+        futures = [client.submit(evaluate_batch, key, plain, b, pure=False)
+                   for b in batches]
+        try:
+            for f in as_completed(futures):
+                yield f.result()
+                f.release()
+        finally:
+            client.cancel(futures)
 
 
 def run_batches(study: StudyDefinition, batches: list, workers: int = 1, client=None
