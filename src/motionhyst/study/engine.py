@@ -361,6 +361,19 @@ def quiet_cluster(client) -> Iterator[None]:
     ----------
     client : distributed.Client
         The cluster's client.
+
+    Examples
+    --------
+    >>> from distributed import Client, LocalCluster
+    >>> def tick(dask_worker):      # the worker's event-loop health check [ms]
+    ...     return dask_worker.periodic_callbacks["tick"].callback_time
+    >>> with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+    ...                   dashboard_address=":0") as cluster, Client(cluster) as client:
+    ...     with quiet_cluster(client):
+    ...         during = list(client.run(tick).values())
+    ...     after = list(client.run(tick).values())
+    >>> during, after
+    ([1000], [20.0])
     """
     from distributed.comm.core import CommClosedError
 
