@@ -89,16 +89,17 @@ def run(args: argparse.Namespace) -> int:
     if args.periodic:
         check_whole_periods(u, str(args.data))
     _check_step(system, t, args)
-    pred = None
-    try:
-        if args.init_from is not None:
-            from motionhyst.identify.io_records import load_io_csv
+    pred = rec = None
+    if args.init_from is not None:  # its errors name it, not the input record
+        from motionhyst.identify.io_records import load_io_csv
 
-            rec = load_io_csv(args.init_from, columns=args.columns, scale=args.scale)
-            if rec.y.size != t.size or not np.allclose(rec.t, t, rtol=0.0,
-                                                       atol=1e-6 * float(np.ptp(t))):
-                raise UsageError(f"motionhyst predict: {args.init_from} must have the samples "
-                                 f"of {args.data} (the same time column)")
+        rec = load_io_csv(args.init_from, columns=args.columns, scale=args.scale)
+        if rec.y.size != t.size or not np.allclose(rec.t, t, rtol=0.0,
+                                                   atol=1e-6 * float(np.ptp(t))):
+            raise UsageError(f"motionhyst predict: {args.init_from} must have the samples "
+                             f"of {args.data} (the same time column)")
+    try:
+        if rec is not None:
             from motionhyst.identify.io_predict import predict_from_window  # scipy.optimize
 
             pred = predict_from_window(system, t, u, rec.y, window, args.substeps)
