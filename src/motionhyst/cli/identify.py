@@ -204,7 +204,7 @@ def run(args: argparse.Namespace) -> int:
                 ident = identify_maxwell_slip(x, w, t=t, **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
-        _check_determined(path, ident, x)
+        _check_determined(path, ident, x, w)
         share = _judge_elements(path, ident, x, w, args.elements is None or target is not None)
         if target is not None:  # the link alone, a system without inertia, for predict
             target.write_text(ident.scenario_text(f"{path}"))
@@ -330,15 +330,35 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     return 0
 
 
-def _check_determined(path: Path, ident, x) -> None:
-    """No answer from a record without hysteresis: when no element of the fit slips in the
+def _check_determined(path: Path, ident, x, w) -> None:
+    """No answer from a record without hysteresis: when a spring explains the force as well
+    as the elements within the noise (:func:`~motionhyst.identify.io_checks.hysteresis_gain`),
+    or when no element of the fit slips in the
     record (each one's slip displacement fc/k reaches half the record's displacement range,
     its fc not determined), the force follows the displacement as a spring's, or is noise,
     and a slip force would be a guess.  (An element that never slips beside others that do
     is the model's parallel spring: kept, its fc "not determined" in the table.)"""
+    import numpy as np
+
+    from motionhyst.identify.io_checks import NO_HYSTERESIS_GAIN, hysteresis_gain
+
     half = 0.5 * float(x.max() - x.min())
     never = [e for e in ident.elements
              if not math.isfinite(e["fc_std"]) and e["fc"] / e["k"] >= half]
+    # a spring (and offset) by least squares: what the elements explain beyond it, in noise
+    # variances (the smallest slip displacement can fall short of the half-range by noise)
+    A = np.column_stack([x, np.ones_like(x)])
+    linear = w - A @ np.linalg.lstsq(A, w, rcond=None)[0]
+    gain = hysteresis_gain(float(np.sum(linear ** 2)),
+                           w - ident.predict(x, ident.initial_forces))
+    if gain < NO_HYSTERESIS_GAIN:
+        raise ValueError(
+            f"{path}: no hysteresis in the record: a spring explains its force as well as "
+            f"{ident.n_elements} Maxwell-slip element(s), within the noise (they explain "
+            f"{max(gain, 0.0):.3g} times the noise's variance more, below "
+            f"{NO_HYSTERESIS_GAIN:g}; R^2 = {ident.r2:.3g}): a slip force would be a guess; "
+            f"nothing identified (a record whose displacement makes the link slip, a larger "
+            f"amplitude, may)")
     if never and len(never) == len(ident.elements):
         e = min(never, key=lambda e: e["fc"] / e["k"])
         raise ValueError(

@@ -335,7 +335,7 @@ def _judged(records: list[IORecord], res: NDArray[np.float64], plant, link,
     fit_rms = float(np.sqrt(np.mean(res ** 2)))
     judge_fit(fit_rms, records, predictions, None, OpenLoop(plant, link), centred)
     linear_mass = reference_mass(records, floating)
-    return plausibility_warnings({}, masses, linear_mass, records, [])
+    return plausibility_warnings({}, masses, linear_mass, records, [], floating=floating)
 
 
 #: Starts of the Bouc-Wen link, screened by one simulation each: the link's initial

@@ -29,16 +29,22 @@ from numpy.typing import NDArray
 from motionhyst.identify.io_records import IORecord
 
 __all__ = ["DIRECTION_MOVING", "DIRECTION_SAMPLES", "DIRECTION_SHARE", "DIRECTION_SIGNIFICANCE",
-           "MAX_PREDICT_SUBSTEPS", "SPRING_SHARE", "SYSTEMATIC_SHARE",
+           "MASS_FACTOR", "MASS_SHARE", "MASS_SIGMAS", "MAX_PREDICT_SUBSTEPS",
+           "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE",
            "FitFailed", "budget_note", "check_inertia", "default_plant", "flat_profile",
-           "judge_fit", "noise_cost",
+           "hysteresis_gain", "judge_fit", "linear_mass_std", "noise_cost",
            "plausibility_warnings", "systematic_share", "viscous_direction_note"]
 
 #: The finest integration step ``predict`` takes, in steps per record sample; a model that
 #: needs more (a collapsed mass on a stiff link) is not a model ``predict`` can run
 MAX_PREDICT_SUBSTEPS = 2000
-#: A mass more than this factor from the records' linear estimate is reported
+#: A mass more than this factor from the records' linear estimate is reported ...
 MASS_FACTOR = 2.0
+#: ... and one off by more than this share of it and by more than :data:`MASS_SIGMAS` of
+#: its robust standard error (the linear model's own bias on a measured axis: EMPS's friction
+#: links' fits lie 1-2 % from it; LuGre's 86.6 kg lay 9 % and 35 standard errors below)
+MASS_SHARE = 0.05
+MASS_SIGMAS = 3.0
 #: Inertia below this share of the force (``m a_rms / u_rms``) is not visible in the records
 INERTIA_SHARE = 1e-3
 #: A fit whose systematic error exceeds this share of the signal's RMS does not describe its
@@ -135,8 +141,8 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
 
 def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
                           linear_mass: float, records: list[IORecord],
-                          at_bound: list[str], runaway: dict[str, float] | None = None
-                          ) -> list[str]:
+                          at_bound: list[str], runaway: dict[str, float] | None = None,
+                          floating: bool | None = None) -> list[str]:
     """One line for each implausible estimate, naming the parameter.
 
     Parameters
@@ -156,6 +162,12 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
     runaway : dict, optional
         Parameters (without bounds) that ended orders of magnitude from their start:
         name -> final over start value.
+    floating : bool, optional
+        The plant has no spring (as the linear estimate's model,
+        :func:`~motionhyst.identify.io_start.inverse_dynamics`): given, a mass off the
+        linear estimate by more than :data:`MASS_SHARE` of it and by more than
+        :data:`MASS_SIGMAS` of its robust standard error (:func:`linear_mass_std`) is
+        reported too; else only beyond :data:`MASS_FACTOR`.
 
     Returns
     -------
@@ -182,11 +194,19 @@ def plausibility_warnings(estimates: dict[str, float], masses: dict[str, float],
     names = "+".join(masses)
     if linear_mass > 0 and total > 0:
         ratio = total / linear_mass
+        word = "above" if ratio > 1 else "below"
         if ratio > MASS_FACTOR or ratio < 1.0 / MASS_FACTOR:
-            word = "above" if ratio > 1 else "below"
             factor = ratio if ratio > 1 else 1.0 / ratio
             out.append(f"{names} = {total:.4g} kg is {factor:.3g} times {word} the records' "
                        f"linear estimate {linear_mass:.4g} kg")
+        elif floating is not None and abs(ratio - 1.0) > MASS_SHARE:
+            std = linear_mass_std(records, floating)
+            if abs(total - linear_mass) > MASS_SIGMAS * std:
+                out.append(f"{names} = {total:.4g} kg is {100 * abs(ratio - 1.0):.2g} % "
+                           f"{word} the records' linear estimate {linear_mass:.4g} +- "
+                           f"{std:.2g} kg ({abs(total - linear_mass) / std:.3g} standard "
+                           f"errors): the model may trade inertia for a force it "
+                           f"describes poorly")
     a_rms = math.sqrt(np.mean(np.concatenate(
         [np.diff(rec.y, 2) * rec.fs ** 2 for rec in records]) ** 2))
     u_rms = math.sqrt(np.mean(np.concatenate([rec.u - np.mean(rec.u) for rec in records]) ** 2))
@@ -220,6 +240,40 @@ def _unit_slip(names: str, total: float) -> list[str]:
     return [f"{names} = {total:.4g} kg, outside the usual {low:g}-{high:g} kg of motion stages: "
             f"if the records' units are not SI, scale them (time in ms makes the mass 1e6 "
             f"times too large, a position in mm or a force in kN 1e3 times too small)"]
+
+
+def linear_mass_std(records: list[IORecord], floating: bool) -> float:
+    """The robust standard error of the records' linear estimate of the mass
+    (:func:`~motionhyst.identify.io_start.reference_mass`): Newey-West, as
+    :func:`check_inertia`'s (the residuals of a linear model of a link are no white noise).
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records.
+    floating : bool
+        No spring to the ground.
+
+    Returns
+    -------
+    float
+        [kg]
+
+    Examples
+    --------
+    >>> t = np.arange(3000) / 1000.0
+    >>> y = 0.05 * np.sin(2 * np.pi * t) + 0.02 * np.sin(2 * np.pi * 3.3 * t)
+    >>> v = np.gradient(y, t, edge_order=2)
+    >>> u = 2.0 * np.gradient(v, t, edge_order=2) + 30.0 * v + 4.0 * np.sign(v)
+    >>> noise = 0.05 * np.random.default_rng(0).standard_normal(t.size)
+    >>> 0.0 < linear_mass_std([IORecord(t, u + noise, y)], floating=True) < 0.01
+    True
+    """
+    from motionhyst.identify.io_start import equation_rows
+
+    rows, rhs = equation_rows(records, floating)
+    _, cov = _robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
+    return math.sqrt(max(float(cov[0, 0]), 0.0))
 
 
 def systematic_share(residual: NDArray[np.float64], signal: NDArray[np.float64]) -> float:
@@ -261,6 +315,50 @@ def systematic_share(residual: NDArray[np.float64], signal: NDArray[np.float64])
         return 0.0
     noise = float(np.mean(np.diff(r) ** 2)) / 2.0
     return math.sqrt(max(float(np.mean(r ** 2)) - noise, 0.0)) / spread
+
+
+#: A link's fit must explain at least this many times the noise's variance beyond the
+#: linear model's (a spring, and a damper where the model has one); below, the records show
+#: no hysteresis (a link with p parameters fitted to noise alone explains about p of them)
+NO_HYSTERESIS_GAIN = 100.0
+
+
+def hysteresis_gain(linear_ss: float, residual: NDArray[np.float64]) -> float:
+    """What a link's fit explains beyond the linear model's, in units of the noise's variance.
+
+    ``(RSS_lin - sum(r^2)) / sigma^2``, the noise's variance ``sigma^2`` from the
+    fit's residual's differences between successive samples (as in
+    :func:`systematic_share`).  A fit to records without hysteresis (a spring and noise)
+    gains about its link's number of parameters; below :data:`NO_HYSTERESIS_GAIN` the
+    records show none, and a link's parameters would be a guess.
+
+    Parameters
+    ----------
+    linear_ss : float
+        The sum of squares of the measured signal minus the best linear model's (a spring,
+        a damper, an offset).
+    residual : ndarray
+        The measured signal minus the fit's.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> x = np.sin(np.linspace(0.0, 20.0, 2000))
+    >>> noise = 0.01 * rng.standard_normal(x.size)
+    >>> hysteresis_gain(np.sum(noise ** 2), 0.999 * noise)        # a spring and noise
+    3.9...
+    >>> friction = 0.05 * np.sign(np.cos(np.linspace(0.0, 20.0, 2000)))
+    >>> hysteresis_gain(np.sum((noise + friction) ** 2), noise) > NO_HYSTERESIS_GAIN
+    True
+    """
+    r = np.asarray(residual, dtype=float)
+    noise = float(np.mean(np.diff(r) ** 2)) / 2.0 if r.size > 2 else 0.0
+    gain = float(linear_ss) - float(np.sum(r ** 2))
+    return gain / noise if noise > 0 else (math.inf if gain > 0 else 0.0)
 
 
 def check_inertia(records: list[IORecord]) -> None:

@@ -797,8 +797,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                if lg and x0 > 0 and not RUNAWAY ** -1 < x / x0 < RUNAWAY}
     masses = {nm: float(x) for nm, x in zip(prob.plant.PARAMETERS, v, strict=False)
               if nm in ("m", "m1", "m2")}
-    linear_mass = reference_mass(records, shape.floating)
-    notes = plausibility_warnings(estimates, masses, linear_mass, records, bound, runaway)
+    notes = plausibility_warnings(estimates, masses, reference_mass(records, shape.floating),
+                                  records, bound, runaway, shape.floating)
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,

@@ -46,9 +46,11 @@ from scipy.optimize import least_squares
 from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
 from motionhyst.identify.io_checks import (
+    NO_HYSTERESIS_GAIN,
     SYSTEMATIC_SHARE,
     FitFailed,
     budget_note,
+    hysteresis_gain,
     judge_fit,
     systematic_share,
 )
@@ -395,8 +397,10 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
         fit_rms = float(np.sqrt(np.mean(res ** 2)))
         system = OpenLoop(plant, fitted)
-        judge_fit(fit_rms, records, predictions, _linear_rms(records, K, C, periodic), system,
-                  out)
+        linear_rms = _linear_rms(records, K, C, periodic)
+        judge_fit(fit_rms, records, predictions, linear_rms, system, out)
+        if linear_rms is not None:
+            _judge_hysteresis(linear_rms ** 2 * res.size, res, "position", K, C)
         _judge_systematic(res, [rec.y for rec in records], "position")
     what = "force" if force_error else "position"
     measured = [rec.u if force_error else rec.y for rec in records]
@@ -507,7 +511,24 @@ def _judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IOR
     if fit_rms > linear_rms * (1.0 + 1e-9):
         raise FitFailed(f"the fit failed: its RMS error {fit_rms:.3g} N exceeds the linear "
                         f"spring and damper's {linear_rms:.3g} N")
+    _judge_hysteresis(float(np.sum(linear ** 2)), res, "force", K, C)
     _judge_systematic(res, [rec.u for rec in records], "force")
+
+
+def _judge_hysteresis(linear_ss: float, res: NDArray[np.float64], what: str, K: float,
+                      C: float) -> None:
+    """Raise :class:`FitFailed` if the link explains no more of the `what` than the linear
+    spring and damper ``K, C`` (sum of squares `linear_ss`), within the noise
+    (:func:`~motionhyst.identify.io_checks.hysteresis_gain` below
+    :data:`~motionhyst.identify.io_checks.NO_HYSTERESIS_GAIN`): the records show no
+    hysteresis, and the link's parameters would be a guess."""
+    gain = hysteresis_gain(linear_ss, res)
+    if gain < NO_HYSTERESIS_GAIN:
+        raise FitFailed(f"no hysteresis in the records: a spring of {K:.4g} N/m and a damper "
+                        f"of {max(C, 0.0):.4g} N s/m explain the {what} as well as the link, "
+                        f"within the noise (the link explains {max(gain, 0.0):.3g} times the "
+                        f"noise's variance more, below {NO_HYSTERESIS_GAIN:g}): its parameters "
+                        f"would be a guess; nothing identified")
 
 
 def _judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float64]],
