@@ -9,6 +9,7 @@ import json
 import numpy as np
 import pytest
 import scipy.io
+from records_of_other_kinds import damper_record
 
 from motionhyst.cli import main
 from motionhyst.identify.io_checks import (
@@ -139,3 +140,22 @@ def test_an_init_from_record_without_a_column_is_named_once(capsys, tmp_path):
     assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
     assert err.count("rec.mat") == 1 and "in.mat" not in err
     assert "no variable 'displacement'" in err and not out_csv.exists()
+
+
+def test_max_evaluations_is_the_search_s_whole_budget(capsys, tmp_path):
+    """A force-displacement fit by the force's error with --max-evaluations N uses at most N
+    model evaluations, starts and the Jacobians' differences counted (it counted the
+    refinement's steps only: 30 used 193); a budget below what the search needs at least is
+    one line."""
+    record = damper_record("sines", seed=3, fs=50.0, seconds=20.0, link="dahl").write(
+        tmp_path / "dahl.csv", ("time", "displacement", "force"))
+    rc, out, err = run(capsys, "identify", str(record), "--model", "dahl", "--max-evaluations",
+                       "100", "--json")
+    assert rc == 0, err
+    fit = json.loads(out)
+    assert fit["evaluations"] <= 100
+    assert "stopped on its budget of model evaluations" in err
+    rc, out, err = run(capsys, "identify", str(record), "--model", "dahl", "--max-evaluations",
+                       "10")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "a budget of 10 model evaluations is below the least this search needs" in err

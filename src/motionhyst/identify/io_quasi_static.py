@@ -287,7 +287,9 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         Offsets estimated: ``auto`` is both (a force offset moves where on its
         loops the link works, which a position offset does not).
     max_evaluations : int, optional
-        The budget of model evaluations (starts and refinement together).
+        The budget of model evaluations: starts and refinements together, each Jacobian's
+        forward differences counted; the search uses at most this many (a budget below
+        the least it needs is a ``ValueError``).
     tol : float
         ``ftol = xtol = gtol`` of the refinements.
     t_start : float, optional
@@ -361,6 +363,17 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     prob = _Problem(records, layout, periodic, inp, out, K, c_scale, y_scale, u_scale,
                     v_scale)
     budget = max_evaluations
+    # a refinement's step costs one evaluation, and its Jacobian one for each free value
+    # (forward differences; scipy counts the steps only): a budget of evaluations holds
+    # when each refinement is given at most its share over this
+    per_step = int(np.count_nonzero(prob.free)) + 1
+    n_starts = len(STARTS) + (layout.cls in (Jenkins, MaxwellSlip))
+    if budget is not None and budget < n_starts + 2 * per_step:
+        raise ValueError(f"a budget of {budget} model evaluations is below the least this "
+                         f"search needs, {n_starts + 2 * per_step} (one for each of its "
+                         f"{n_starts} starts, {per_step} for each step of its refinement with "
+                         f"its {per_step - 1} parameters' differences, two steps)")
+    n_start = START_NFEV if budget is None else (budget // 2) // (len(STARTS) * per_step)
     # position offsets of the linear fit: u = K (y - y0) + C y' + u0 with u0 = 0 unless estimated
     y0 = np.array([float(-bi / K) if out else 0.0 for bi in b])
     starts = []
@@ -369,7 +382,9 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         if force_error:
             _inside(layout, link0)
         v0 = np.concatenate([[(1.0 - share) * K, max(C, 0.0)], link0, [0.0], y0])
-        n_start = START_NFEV if budget is None else max(5, budget // (2 * len(STARTS)))
+        if n_start < 1:  # a small budget: the starts compared as they are
+            starts.append(prob.variables(v0))
+            continue
         try:
             sol = prob.solve(prob.variables(v0), True, n_start, 1e-10)
         except ValueError:
@@ -381,27 +396,21 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     if not starts or min(costs) >= 0.5 * FAILED_RESIDUAL ** 2 * y_all.size:  # none runs
         raise FitFailed(f"the fit failed: no start of the {link.name} link on a quasi-static "
                         f"plant can run on these records (a force it does not hold)")
-    n_final = FINAL_NFEV if budget is None else max(10, budget - prob.n_eval)
+    n_final = FINAL_NFEV if budget is None else (budget - prob.n_eval) // per_step
     start = starts[int(np.argmin(costs))]
     sol = prob.solve(start, force_error, n_final, tol)
     q = prob.whole(sol.x)
     v = prob.values(q)
     plant, fitted = prob.model(v)
-    if force_error:
-        predictions = prob.forces(v)
-        res = np.concatenate([f - rec.u for f, rec in zip(predictions, records, strict=True)])
-        fit_rms = float(np.sqrt(np.mean(res ** 2)))
-        _judge_force_fit(fit_rms, res, records, predictions, K, C, b)
-    else:
-        predictions = prob.positions(v)
-        res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
-        fit_rms = float(np.sqrt(np.mean(res ** 2)))
-        system = OpenLoop(plant, fitted)
-        linear_rms = _linear_rms(records, K, C, periodic)
-        judge_fit(fit_rms, records, predictions, linear_rms, system, out)
-        if linear_rms is not None:
-            _judge_hysteresis(linear_rms ** 2 * res.size, res, "position", K, C)
-        _judge_systematic(res, [rec.y for rec in records], "position")
+    stopped = budget is not None and sol.status == 0  # on its budget, before it converged
+    try:
+        res, fit_rms = _judge(prob, v, records, force_error, K, C, b, periodic, out)
+    except FitFailed as exc:
+        if not stopped:
+            raise
+        raise FitFailed(f"{exc}; the search stopped on its budget of {budget} model "
+                        f"evaluations ({prob.n_eval} used) before it converged (a larger "
+                        f"--max-evaluations may let it)") from None
     what = "force" if force_error else "position"
     measured = [rec.u if force_error else rec.y for rec in records]
     spread = float(np.sqrt(np.sum(np.concatenate([m - np.mean(m) for m in measured]) ** 2)))
@@ -429,7 +438,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                 if lg and f and x > 0 and x0 > 0 and max(x / x0, x0 / x) > RUNAWAY_FACTOR]
     extra = {"offsets": {"input": float(v[2 + prob.n_link]),
                          "output": [float(x) for x in prob.output_offsets(v)]},
-             "budget_reached": bool(budget is not None and prob.n_eval >= budget),
+             "budget_reached": stopped,
              "covariance": covariance_table(names, covariance(J, float(np.sum(res ** 2)),
                                                               res.size, FD_SINGULAR_RTOL), std)}
     return IOIdentification(
@@ -440,6 +449,31 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                  f"{prob.n_eval} evaluations with the starts)",
         n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings,
         data=list(records), residuals=res, output=what)
+
+
+def _judge(prob: _Problem, v: NDArray[np.float64], records: list[IORecord], force_error: bool,
+           K: float, C: float, b: NDArray[np.float64], periodic: bool, out: bool
+           ) -> tuple[NDArray[np.float64], float]:
+    """The fitted model's residuals and RMS error; :class:`FitFailed` if they are no result
+    (:func:`_judge_force_fit`, or :func:`~motionhyst.identify.io_checks.judge_fit` and the
+    link's gain and systematic error on the positions)."""
+    plant, fitted = prob.model(v)
+    if force_error:
+        predictions = prob.forces(v)
+        res = np.concatenate([f - rec.u for f, rec in zip(predictions, records, strict=True)])
+        fit_rms = float(np.sqrt(np.mean(res ** 2)))
+        _judge_force_fit(fit_rms, res, records, predictions, K, C, b)
+    else:
+        predictions = prob.positions(v)
+        res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
+        fit_rms = float(np.sqrt(np.mean(res ** 2)))
+        system = OpenLoop(plant, fitted)
+        linear_rms = _linear_rms(records, K, C, periodic)
+        judge_fit(fit_rms, records, predictions, linear_rms, system, out)
+        if linear_rms is not None:
+            _judge_hysteresis(linear_rms ** 2 * res.size, res, "position", K, C)
+        _judge_systematic(res, [rec.y for rec in records], "position")
+    return res, fit_rms
 
 
 #: The exponents of a Bouc-Wen link fitted when it is estimated (``--nu free``): its fits of
