@@ -1,6 +1,6 @@
 """A Jenkins link on a positioning axis whose stiffness its records do not resolve is reported
 as its rigid limit, the Coulomb link (identify_io(rigid_limit=True), identify --model jenkins;
-motionhyst.identify.io_friction.as_rigid_limit)."""
+motionhyst.identify.rigid_limit.as_rigid_limit)."""
 
 from __future__ import annotations
 

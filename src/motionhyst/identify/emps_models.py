@@ -10,7 +10,7 @@ is reported as its rigid limit, the Coulomb link with the same options
 from __future__ import annotations
 
 from motionhyst.identify.io_friction import STUCK_MODE_SAMPLES as STUCK_MODE_SAMPLES
-from motionhyst.identify.io_friction import unresolved_stiffness as stiffness_rule
+from motionhyst.identify.rigid_limit import unresolved_stiffness as stiffness_rule
 
 __all__ = ["LINKS", "OPTIONS", "RIGID_LIMIT", "STUCK_MODE_SAMPLES", "check_model",
            "model_options", "unresolved_stiffness"]
@@ -88,7 +88,7 @@ def check_model(name: str) -> None:
 
 def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> str | None:
     """Why a Jenkins link's stiffness is beyond what a record resolves, or None: the rule of
-    :func:`~motionhyst.identify.io_friction.unresolved_stiffness` (``k`` not determined, or
+    :func:`~motionhyst.identify.rigid_limit.unresolved_stiffness` (``k`` not determined, or
     the stuck mode ``sqrt(k/m) / 2 pi`` above ``fs /`` :data:`STUCK_MODE_SAMPLES`), for a
     benchmark model by name (EMPS, ``jenkins-asymmetric-drift`` on the whole record: k 8.6e8
     N/m, 486 Hz at 1 kHz, which pulled its mass to 92.15 kg).

@@ -271,7 +271,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     rigid_limit : bool
         A Jenkins link on a mass-damper whose stiffness the records do not resolve (not
         determined, or its stuck mode ``sqrt(k / m) / 2 pi`` above a quarter of the sampling
-        rate: :func:`~motionhyst.identify.io_friction.unresolved_stiffness`), or any friction
+        rate: :func:`~motionhyst.identify.rigid_limit.unresolved_stiffness`), or any friction
         link there of whose parameters the records determine at most half (a failed fit
         otherwise), is reported as its rigid limit, the Coulomb link's fit with the same
         options that its search started from, said in a warning; else it is judged as it is.

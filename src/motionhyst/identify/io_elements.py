@@ -31,7 +31,6 @@ from motionhyst.identify.io_checks import (
     noise_cost,
     plausibility_warnings,
 )
-from motionhyst.identify.io_friction import as_rigid_limit
 from motionhyst.identify.io_offsets import Extras, initial_state
 from motionhyst.identify.io_predict import run_from_state, state_from_window
 from motionhyst.identify.io_records import short_records
@@ -40,6 +39,7 @@ from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
     check_substeps,
+    extras_start,
     inverse_dynamics,
     reference_mass,
 )
@@ -52,6 +52,7 @@ from motionhyst.identify.io_uncertainty import (
     undetermined_notes,
     weak_notes,
 )
+from motionhyst.identify.rigid_limit import as_rigid_limit, rigid_seed
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import (
     MIN_SUBSTEPS,
@@ -581,9 +582,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     inverse dynamics' ``(c_pos - c_neg) / 2``, ``c`` from their mean).
 
     A link other than the rigid slider on a mass-damper also starts from the
-    Coulomb link's fit (:func:`_rigid_seed`: every friction link's limit; `rigid`, one
-    already made, is reused), when that fits the records better than the other starts
-    (reported instead with `rigid_limit`: :func:`~motionhyst.identify.io_friction.as_rigid_limit`).
+    Coulomb link's fit (:func:`~motionhyst.identify.rigid_limit.rigid_seed`: every friction
+    link's limit; `rigid`, one already made, is reused), when that fits the records better than
+    the other starts (reported instead with `rigid_limit`:
+    :func:`~motionhyst.identify.rigid_limit.as_rigid_limit`).
 
     The offsets and initial states of `offset` and `from_rest`
     (:class:`~motionhyst.identify.io_offsets.Extras`) are estimated with them:
@@ -685,7 +687,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         sol = prob.solve(prob.fixed[~short_rate], 1e-6, nfev)
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
-    short_start = _extras_start(short_extras, short, floating, idim["u0"])
+    short_start = extras_start(short_extras, short, floating, idim["u0"])
     floor = noise_cost(short, y_scale) if periodic else None
     best = None
     for p0 in starts:
@@ -708,7 +710,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
             profile.append(cost)
             if cost < best[0]:
                 best = (cost, p)
-    full_start = _extras_start(extras, records, floating, idim["u0"])
+    full_start = extras_start(extras, records, floating, idim["u0"])
     # the short run's force offset and first record's offset and initial state carry over
     for j, name in enumerate(short_extras.names):
         full_start[extras.names.index(name if len(records) == 1 or name == "input_offset"
@@ -719,9 +721,13 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     coulomb = None
     if axis and not getattr(layout.cls, "rigid", False):
         # the rigid slider is every friction link's limit: its fit is a start for theirs
-        seed, used, coulomb = _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start,
-                                          start_nfev, plant, offset, from_rest, layout, y_scale,
-                                          v_scale, extras, force, init_window, skew, rigid)
+        seed, used, coulomb = rigid_seed(
+            lambda: identify_elements_io(
+                records, Coulomb, periodic, substeps, tol, max_nfev, 1, t_start, start_nfev,
+                plant, offset, from_rest, init_window=init_window, drift=extras.input_drift,
+                asymmetric=skew),
+            layout, y_scale, v_scale, extras.names, force, rate[n_plant:n_base],
+            RATE_GRID[0] * v_scale, skew, rigid)
         n_eval += used
         if seed is not None:
             q_seed = prob.variables(seed)
@@ -830,39 +836,6 @@ def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:
     return float(np.std(res) if output_offset else np.sqrt(np.mean(res ** 2)))
 
 
-def _rigid_seed(records, periodic, substeps, tol, max_nfev, t_start, start_nfev, plant, offset,
-                from_rest, layout, y_scale, v_scale, extras, force, init_window=None,
-                skew=False, rigid=None):
-    """A positioning axis's friction link started from the Coulomb link's fit (`rigid`, else as
-    identify_io fits it: by direction, the link's own): the stage, the offsets and initial states
-    as fitted, the link's forces together its slip force, slipping after 1e-5 of the output's RMS
-    (its rigid limit), the evaluations and the fit itself; None (0, None) if that fit fails."""
-    from motionhyst.identify.io_checks import FitFailed
-
-    try:
-        fit = rigid or identify_elements_io(records, Coulomb, periodic, substeps, tol, max_nfev,
-                                            1, t_start, start_nfev, plant, offset, from_rest,
-                                            init_window=init_window, drift=extras.input_drift,
-                                            asymmetric=skew)
-    except (FitFailed, ValueError, ArithmeticError):
-        return None, 0, None
-    link = fit.hysteresis  # viscous friction by direction: the stage's c_skew, or the link's
-    skewed = getattr(fit.plant, "c_skew", 0.0) + 0.5 * (link.c_pos - link.c_neg)
-    if (not skew and skewed) or any(n not in fit.estimates for n in extras.names):
-        raise ValueError("the Coulomb fit reused as the rigid limit has other options")
-    fc, c = fit.estimates["link.fc"], fit.plant.c + 0.5 * (link.c_pos + link.c_neg)
-    link0 = layout.start(2.0 * fc / (1e-5 * y_scale), y_scale, v_scale, c, 1e-5)
-    if force.any():
-        link0[force] *= fc / np.sum(link0[force])
-    if skew:
-        link0[-1] = skewed
-    rate = np.array([par.unit == _VELOCITY for par, _ in layout._values()], dtype=bool)
-    link0[rate] = RATE_GRID[0] * v_scale
-    return (np.concatenate([[fit.plant.m, c], link0,
-                            [fit.estimates[name] for name in extras.names]]),
-            0 if rigid else fit.n_evaluations, fit)
-
-
 #: A positive parameter that ends this factor from its start value is reported as at the edge
 RUNAWAY = 1e4
 
@@ -871,23 +844,6 @@ RUNAWAY = 1e4
 #: inverse-dynamics Coulomb force, the displacement it slips after in units of the output's
 #: RMS)
 AXIS_STARTS = ((1.0, 1e-3), (0.5, 1e-2), (1.0, 1e-1))
-
-
-def _extras_start(extras: Extras, records, floating: bool, u0: float) -> NDArray[np.float64]:
-    """Start values of the offsets and initial states: the force offset `u0`, a floating
-    stage's position offset at the record's first sample (else 0), its initial position
-    there and its velocity at the first samples' slope."""
-    out = np.zeros(extras.size)
-    if extras.input_offset:
-        out[0] = u0
-    what = (["output_offset"] if extras.output_offset else []) + list(extras.initial)
-    for i, rec in enumerate(records):
-        n = min(4, rec.y.size - 1)
-        start = {"v0": (rec.y[n] - rec.y[0]) * rec.fs / n, "y0": rec.y[0],
-                 "output_offset": rec.y[0] if floating else 0.0}
-        for j, name in zip(extras.columns_of_record(i), what, strict=True):
-            out[j] = start[name]
-    return out
 
 
 def _parallel_note(layout: _LinkLayout, name: str, plant=None) -> str:

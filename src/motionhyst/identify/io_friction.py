@@ -14,7 +14,8 @@ with the registry's ``parameters`` whose call returns the link):
   bristles between a presliding the records would see and a stuck mode they resolve.
 
 Every friction link's limit is the rigid slider, the Coulomb link: a Jenkins link whose
-stiffness the records do not resolve is that limit (:func:`unresolved_stiffness`).
+stiffness the records do not resolve is that limit
+(:func:`~motionhyst.identify.rigid_limit.unresolved_stiffness`).
 
 Without them a search on a measured axis ends outside the models' meaning (EMPS:
 a LuGre ``fc`` of 2.2e6 N against ``fs`` 23 N with ``vs`` 40 m/s, its Stribeck
@@ -24,18 +25,14 @@ curve a quadratic viscous term in place of ``c``, and the mass 70.9 kg for 95.1)
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
 from motionhyst.hysteresis import BoucWen, LuGre, Parameter
-from motionhyst.identify.io_checks import PROFILE_CHI2
 from motionhyst.identify.io_records import IORecord
-from motionhyst.identify.io_results import IOIdentification
 
 __all__ = ["PRESLIDING_BOUND", "PRESLIDING_SHARE", "STUCK_MODE_SAMPLES", "VS_SHARE",
-           "as_rigid_limit", "bouc_wen_friction", "lugre_stribeck", "presliding_note",
-           "unresolved_stiffness"]
+           "bouc_wen_friction", "lugre_stribeck", "presliding_note"]
 
 
 def bouc_wen_friction(nu: float) -> type:
@@ -232,114 +229,3 @@ def presliding_note(link: LuGre, records: list[IORecord]) -> str | None:
 STUCK_MODE_SAMPLES = 4
 """A stuck mode faster than the sampling rate over this many samples (four samples a period;
 the Nyquist frequency is two) is not resolved by a record."""
-
-
-def unresolved_stiffness(k: float, k_std: float | None, m: float, fs: float) -> str | None:
-    """Why a Jenkins link's stiffness on a positioning axis is beyond what its records resolve,
-    or None.
-
-    Stuck, the axis's mass ``m`` rests on the link's spring ``k``: a mode at
-    ``sqrt(k / m) / 2 pi``.  Records sampled at `fs` show a mode only below ``fs /``
-    :data:`STUCK_MODE_SAMPLES`; above, or with ``k`` not determined, they cannot tell the
-    link from its rigid limit, the Coulomb link (the Jenkins link with ``k`` infinite, its
-    sticking exact), and the stiffness found is the search's, not the axis's.
-
-    Parameters
-    ----------
-    k : float
-        The link's stiffness [N/m].
-    k_std : float or None
-        Its standard error (None: not determined by the records).
-    m : float
-        The axis's mass [kg].
-    fs : float
-        The records' sampling rate [Hz].
-
-    Returns
-    -------
-    str or None
-        One phrase saying why; None for a stiffness the records resolve.
-
-    Examples
-    --------
-    >>> unresolved_stiffness(3e7, 1e6, 95.0, 1000.0) is None   # 89 Hz
-    True
-    >>> unresolved_stiffness(8.6e8, 2.8e8, 95.0, 1000.0)
-    'its stuck mode at 479 Hz with k 8.6e+08 N/m, above 1000 Hz / 4: the records do not resolve it'
-    >>> unresolved_stiffness(9.4e9, None, 95.0, 1000.0)
-    'k 9.4e+09 N/m, not determined by the records'
-    """
-    if k_std is None:
-        return f"k {k:.2g} N/m, not determined by the records"
-    mode = math.sqrt(max(k, 0.0) / m) / (2 * math.pi) if m > 0 else math.inf
-    if mode <= fs / STUCK_MODE_SAMPLES:
-        return None
-    return (f"its stuck mode at {mode:.0f} Hz with k {k:.2g} N/m, above {fs:.0f} Hz / "
-            f"{STUCK_MODE_SAMPLES}: the records do not resolve it")
-
-
-def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
-                   std: dict[str, float | None], fs: float,
-                   fit_rms: float) -> IOIdentification | None:
-    """A Jenkins link's fit on a positioning axis reported as its rigid limit when its records
-    do not resolve its stiffness (:func:`unresolved_stiffness`) or the limit fits them
-    significantly better (likelihood ratio ``2 N ln(RMS / RMS_limit)`` above
-    :data:`~motionhyst.identify.io_checks.PROFILE_CHI2`, ``N`` the residuals: the search, run
-    from the limit among other starts, ended in a softer link's poorer minimum; a stuck
-    Jenkins link rings at its stuck mode, which the limit does not), else None.
-
-    Parameters
-    ----------
-    rigid : IOIdentification
-        The Coulomb link's fit with the same options (the Jenkins search's start; its
-        residuals count ``N``).
-    estimates, std : dict
-        The Jenkins fit's estimates and standard errors (``m``, ``link.k``; None: not
-        determined).
-    fs : float
-        The records' sampling rate [Hz].
-    fit_rms : float
-        The Jenkins fit's RMS error [m], compared with the Coulomb link's.
-
-    Returns
-    -------
-    IOIdentification or None
-        `rigid` with a first warning saying why it is reported (and why in its ``extra``'s
-        ``rigid_limit``); None when the records resolve the stiffness.
-
-    Examples
-    --------
-    >>> from motionhyst.hysteresis import Coulomb
-    >>> from motionhyst.plants.mass_damper import MassDamper
-    >>> coulomb = IOIdentification(MassDamper(95.0, 200.0), Coulomb(fc=20.0),
-    ...                            {"m": 95.0, "c": 200.0, "link.fc": 20.0}, {}, {}, 2.3e-3,
-    ...                            [], 1.0, False, "", 10, residuals=np.zeros(2000))
-    >>> jenkins = {"m": 94.0, "c": 201.0, "link.k": 9.4e9, "link.fc": 20.7}
-    >>> limit = as_rigid_limit(coulomb, jenkins, {"link.k": None}, 1000.0, 2.29e-3)
-    >>> limit.warnings[0][:66]
-    'the Jenkins link is reported as its rigid limit, the Coulomb link '
-    >>> limit.extra["rigid_limit"]
-    'jenkins: k 9.4e+09 N/m, not determined by the records'
-    >>> as_rigid_limit(coulomb, dict(jenkins, **{"link.k": 3e7}), {"link.k": 1e6}, 1000.0,
-    ...                2.29e-3) is None   # resolved (89 Hz), and a better fit than the limit
-    True
-    >>> as_rigid_limit(coulomb, dict(jenkins, **{"link.k": 3e7}), {"link.k": 1e6}, 1000.0,
-    ...                2.3e-3 * (1 + 1e-9)) is None          # worse by nothing that counts
-    True
-    >>> as_rigid_limit(coulomb, dict(jenkins, **{"link.k": 3e7}), {"link.k": 1e6}, 1000.0,
-    ...                2.5e-3).warnings[0][-82:]
-    'than k infinite: RMS 0.0025 m against 0.0023 m, likelihood ratio 334 > 3.84 (95 %)'
-    """
-    why = unresolved_stiffness(estimates["link.k"], std.get("link.k"), estimates["m"], fs)
-    ratio = (2 * rigid.residuals.size * math.log(fit_rms / rigid.fit_rms)
-             if 0 < rigid.fit_rms < fit_rms else 0.0)  # likelihood ratio, Gaussian errors
-    if why is None and ratio > PROFILE_CHI2:  # the search ended short of its own limit
-        why = (f"k {estimates['link.k']:.2g} N/m fits the records worse than k infinite: "
-               f"RMS {fit_rms:.4g} m against {rigid.fit_rms:.4g} m, likelihood ratio "
-               f"{ratio:.3g} > {PROFILE_CHI2:g} (95 %)")
-    if why is None:
-        return None
-    note = (f"the Jenkins link is reported as its rigid limit, the Coulomb link (fc "
-            f"{rigid.estimates['link.fc']:.4g} N, fit RMS {rigid.fit_rms:.3g} m): {why}")
-    return replace(rigid, warnings=[note, *rigid.warnings],
-                   extra={**rigid.extra, "rigid_limit": f"jenkins: {why}"})

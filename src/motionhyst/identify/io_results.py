@@ -72,7 +72,7 @@ class IOIdentification:
         On a positioning axis (a mass-damper), the fit of the link's rigid limit, the
         Coulomb link with the same options, that a friction link's search started from (not
         in :meth:`to_dict`): what a Jenkins link whose stiffness the records do not resolve
-        is reported as (:func:`~motionhyst.identify.io_friction.unresolved_stiffness`).
+        is reported as (:func:`~motionhyst.identify.rigid_limit.unresolved_stiffness`).
 
     Examples
     --------

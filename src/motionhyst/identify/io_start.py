@@ -15,6 +15,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.identify.io_offsets import Extras
 from motionhyst.identify.io_rates import savgol_derivative
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
@@ -456,3 +457,20 @@ def check_substeps(records: list[IORecord], substeps: int, f_n: float, factor: i
     if n > MAX_FINE_SAMPLES:
         raise ValueError(f"{what}: more than {MAX_FINE_SAMPLES:.0e}; {remedy}")
     check_memory(8.0 * factor * n * 4, what, remedy)
+
+
+def extras_start(extras: Extras, records, floating: bool, u0: float) -> NDArray[np.float64]:
+    """Start values of the offsets and initial states: the force offset `u0`, a floating
+    stage's position offset at the record's first sample (else 0), its initial position
+    there and its velocity at the first samples' slope."""
+    out = np.zeros(extras.size)
+    if extras.input_offset:
+        out[0] = u0
+    what = (["output_offset"] if extras.output_offset else []) + list(extras.initial)
+    for i, rec in enumerate(records):
+        n = min(4, rec.y.size - 1)
+        start = {"v0": (rec.y[n] - rec.y[0]) * rec.fs / n, "y0": rec.y[0],
+                 "output_offset": rec.y[0] if floating else 0.0}
+        for j, name in zip(extras.columns_of_record(i), what, strict=True):
+            out[j] = start[name]
+    return out
