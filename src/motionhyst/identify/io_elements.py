@@ -400,6 +400,9 @@ class _ElementProblem:
     def _measured(self, rec) -> NDArray[np.float64]:
         return rec.y - np.mean(rec.y) if self.centre else rec.y
 
+    # a value the model refuses (a mass run to 0 or overflowing) is a large residual, without
+    # numpy's warnings on stderr; threaded, so on each run and not around the search
+    @np.errstate(all="ignore")
     def _run(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         v = self.values(self.whole(q_free))
         try:
@@ -467,6 +470,7 @@ class _ElementProblem:
             pass  # a model the simulation refuses: the residuals are flat there
         return full[:, self.free]
 
+    @np.errstate(all="ignore")  # as _run
     def _run_exact(self, q_free: NDArray[np.float64]
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
         """Residuals and their exact Jacobian in the free plant and link variables (forward
