@@ -82,6 +82,24 @@ def test_the_coulomb_fit_is_reused_as_the_friction_links_start():
         identify_io([rec], "jenkins", plant="mass-damper", init_window=20, rigid=coulomb)
 
 
+def test_the_rigid_limit_a_friction_link_starts_from_is_identify_ios_coulomb_fit():
+    """The Coulomb fit a Jenkins link on a mass-damper starts from when none is given (with
+    viscous friction by direction) is the fit ``identify_io(..., "coulomb")`` makes with the same
+    options, bit for bit: the link's ``c_pos``/``c_neg`` on the stage's smaller ``c``, not the
+    stage's ``c_skew`` (a Coulomb start spelled that way followed another search path, and the
+    benchmark's ``jenkins-asymmetric`` depended on whether ``coulomb-asymmetric`` ran before)."""
+    from motionhyst.identify.input_output import identify_io
+
+    rec = _axis(Jenkins(k=2e6, fc=20.0), c_skew=-35.0)
+    options = {"plant": "mass-damper", "init_window": 20, "asymmetric": True}
+    coulomb = identify_io([rec], "coulomb", **options)
+    seed = identify_io([rec], "jenkins", **options).rigid_limit
+    assert seed is not None and seed.estimates == coulomb.estimates
+    # more viscous friction backward (c_skew < 0): the link's c_neg holds the excess
+    assert seed.hysteresis.c_neg == coulomb.hysteresis.c_neg > 0
+    assert seed.hysteresis.c_pos == coulomb.hysteresis.c_pos == 0.0
+
+
 def test_the_benchmarks_jenkins_fit_does_not_depend_on_the_models_listed():
     """``jenkins-asymmetric`` alone, or after ``coulomb-asymmetric`` (whose fit it reuses as its
     start), or after another Coulomb model: the same parameters and scores."""
