@@ -117,3 +117,33 @@ def test_a_friction_link_the_records_do_not_determine_is_its_rigid_limit(monkeyp
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
     with pytest.raises(FitFailed, match="determine 2 of"):
         identify_io([rec], "lugre", plant="mass-damper", substeps=20)
+
+
+def test_the_rigid_limit_keeps_the_viscous_friction_by_direction_warning(monkeypatch):
+    """A friction link reported as its rigid limit (the records determine too few of its
+    parameters: the judgement forced, as above) on records whose viscous friction differs by
+    direction: the Coulomb fit reported says so too, with --asymmetric (it was said of the
+    link's fit and lost with it)."""
+    from motionhyst.identify import input_output
+    from motionhyst.identify.io_checks import FitFailed
+    from motionhyst.time.openloop import OpenLoop
+
+    judged = input_output.judge_determined
+
+    def jenkins_undetermined(estimates, std, invariant, zero):
+        if "link.k" in estimates:
+            raise FitFailed("the fit failed: the records determine 1 of the model's 2 parameters")
+        return judged(estimates, std, invariant, zero)
+
+    monkeypatch.setattr(input_output, "judge_determined", jenkins_undetermined)
+    t = np.arange(2000) / FS
+    u = 150 * np.sin(2 * np.pi * t) + 60 * np.sin(6 * np.pi * t)
+    axis = OpenLoop(MassDamper(TRUE["m"], TRUE["c"], -35.0, force_offset=3.0),
+                    Jenkins(k=2e6, fc=TRUE["link.fc"]))
+    rec = IORecord(t, u, axis.simulate(t, u, substeps=40).displacement, "axis")
+    with pytest.warns(UserWarning, match="rigid limit"):
+        fit = identify_io([rec], "jenkins", plant="mass-damper", substeps=20, rigid_limit=True)
+    assert isinstance(fit.hysteresis, Coulomb)
+    assert "link is reported as its rigid limit" in fit.warnings[0]
+    direction = [line for line in fit.warnings if "--asymmetric" in line]
+    assert len(direction) == 1 and "viscous friction by direction, c+ 1" in direction[0]

@@ -409,6 +409,11 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         elif failed is not None:
             raise failed
         break
+    if (stage.has_inertia and not asymmetric and _is_axis(stage)
+            and (not periodic or isinstance(fit.hysteresis, Coulomb))):
+        note = viscous_direction_note(records)  # a symmetric fit's mass is biased: its rigid
+        if note is not None:  # limit's too (the fit reported when the link is not resolved)
+            fit.warnings.append(note)
     if fewer is not None:
         fit.warnings.append(f"the records do not determine the parameters of {fewer[0]} "
                             f"Maxwell-slip elements: fitted with {fewer[1]} (the most they "
@@ -451,19 +456,13 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         raise ValueError(_ASYMMETRIC)
     check_inertia(records)  # before the search
     if link is not BoucWen:
-        fit = identify_elements_io(records, link, periodic, substeps, tol,
-                                   max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
-                                   stage, offset, from_rest, max_evaluations,
-                                   int(init_window) if init_window is not None else None,
-                                   asymmetric, bool(drift),
-                                   skew=asymmetric and link is not Coulomb,
-                                   rigid_limit=rigid_limit, rigid=rigid)
-        if shape.floating and shape.n == 1 and not asymmetric and (not periodic
-                                                                   or link is Coulomb):
-            note = viscous_direction_note(records)  # the symmetric fit's mass is biased
-            if note is not None:
-                fit.warnings.append(note)
-        return fit
+        return identify_elements_io(records, link, periodic, substeps, tol,
+                                    max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
+                                    stage, offset, from_rest, max_evaluations,
+                                    int(init_window) if init_window is not None else None,
+                                    asymmetric, bool(drift),
+                                    skew=asymmetric and link is not Coulomb,
+                                    rigid_limit=rigid_limit, rigid=rigid)
     bouc_wen_offset = offset == "output" and not shape.floating
     if (offset not in ("auto", "none") and not bouc_wen_offset) or from_rest \
             or init_window is not None:
@@ -477,6 +476,12 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
                                           stage.output, t_start)
     return identify_bouc_wen_msd(records, periodic, nu, substeps, tol, max_nfev, t_start,
                                  bouc_wen_offset)
+
+
+def _is_axis(stage: Plant) -> bool:
+    """A positioning axis: one mass, no spring to the ground (a mass-damper)."""
+    shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
+    return bool(shape.floating and shape.n == 1)
 
 
 def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
