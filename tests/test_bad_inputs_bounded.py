@@ -121,6 +121,12 @@ def _force(n: int) -> str:
     return "time,force\n" + "".join(f"{i / 750!r},{np.sin(i / 10):.6f}\n" for i in range(n))
 
 
+def _one_period(n: int) -> str:
+    """A force record of one period of a sine, `n` samples at 750 Hz (a --periodic input)."""
+    return "time,force\n" + "".join(f"{i / 750!r},{np.sin(2 * np.pi * i / n):.6f}\n"
+                                     for i in range(n))
+
+
 def _negative_magnitude() -> str:
     """Magnitude and phase, the first line's ``p1_abs`` negative (a sign slipped in)."""
     rows = _frd(LOG, magphase=True).splitlines()
@@ -174,8 +180,9 @@ CASES = [
                               "plant.csv": _frd(np.linspace(1.0, 3000.0, 200_000),
                                                 noise=0.01)},
      ["analyze", "p.toml"], 0, None, []),
-    ("predict-too-many-substeps", {"model.toml": MODEL, "f.csv": _force(20_000)},
-     ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--substeps", "10000"], 2,
+    ("predict-too-many-substeps", {"model.toml": MODEL, "f.csv": _one_period(20_000)},
+     ["predict", "model.toml", "f.csv", "--out", "pred.csv", "--substeps", "10000",
+      "--periodic"], 2,
      ["20000 samples of 10000 integration steps", "memory budget"], []),
     ("io-two-mass-on-one-mass", {"mass.csv": _io_record(mass=2.0)},
      ["identify", "mass.csv", "--record", "input-output", "--plant", "two-mass",

@@ -41,6 +41,12 @@ def _force(n: int = 300) -> str:
                                      for i, a in enumerate(t.tolist()))
 
 
+def _one_period(n: int) -> str:
+    """A force record of one period of a sine, `n` samples (a --periodic input)."""
+    return "time,force\n" + "".join(f"{i / 750!r},{np.sin(2 * np.pi * i / n):.6f}\n"
+                                     for i in range(n))
+
+
 def _link(force: str = "jenkins") -> str:
     """A force-displacement record (time,displacement,force) of a Jenkins element, of a
     spring (`force` "spring": it never slips) or of sensor noise alone ("noise")."""
@@ -179,13 +185,15 @@ def test_hostile_input_is_exit_2_one_line_and_touches_nothing(tmp_path, files, a
     ("64G", ["out of memory"]),
 ], ids=["own-budget", "budget-past-the-limit"])
 def test_the_memory_limit_bites_on_a_case_that_needs_more(tmp_path, budget, words):
-    """The limit of these tests means something: a prediction of 20000 samples of 10000
-    integration steps each (9.6 GB) is refused by its own budget, which follows the limit;
-    with its budget raised past the limit it meets the limit itself: a MemoryError, still one
-    line and exit 2, and nothing written."""
-    populate(tmp_path, {"model.toml": MODEL, "f.csv": _force(20_000)})
+    """The limit of these tests means something: a periodic prediction of 20000 samples of
+    10000 integration steps each (9.6 GB: the period upsampled at once; a run from rest goes
+    in blocks) is refused by its own budget, which follows the limit; with its budget raised
+    past the limit it meets the limit itself: a MemoryError, still one line and exit 2, and
+    nothing written."""
+    populate(tmp_path, {"model.toml": MODEL, "f.csv": _one_period(20_000)})
     before = snapshot(tmp_path)
-    argv = ["predict", "model.toml", "f.csv", "--out", "p.csv", "--substeps", "10000"]
+    argv = ["predict", "model.toml", "f.csv", "--out", "p.csv", "--substeps", "10000",
+            "--periodic"]
     line = limited_process.refusal(argv + (["--max-memory", budget] if budget else []),
                                    tmp_path)
     for word in words:

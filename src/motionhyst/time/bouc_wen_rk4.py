@@ -32,7 +32,7 @@ from motionhyst.time.periodic_runs import (
     periodic_output,
     whole_periods,
 )
-from motionhyst.time.resample import fine_input
+from motionhyst.time.resample import fine_blocks, fine_input
 
 if TYPE_CHECKING:
     from motionhyst.plants.two_mass import TwoMassStage
@@ -287,23 +287,31 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
     mech = structure.mechanics(p[:n_plant])
     lp = np.ascontiguousarray(p[n_plant:])
     h = 1.0 / (fs * r)
-    uf = upsampled if upsampled is not None else fine_input(u, 2 * r, periodic)
-    if mech.force_offset:  # the plant's constant force offset adds to the force
-        uf = uf + mech.force_offset
     ns = 2 * mech.n + 1
     x0 = np.zeros(ns)
     s0 = np.zeros((ns, p.size))
 
-    def run(x0, s0):
+    def run(x0, s0, uf):
         # the masses and parameter count as tuples: compiled for their sizes (unrolled loops);
         # no sensitivities: None, which removes their code from the compiled run
+        if mech.force_offset:  # the plant's constant force offset adds to the force
+            uf = uf + mech.force_offset
         return _rk4_run(uf, h, r, tuple(mech.mass), mech.C, mech.K,
                         tuple(tuple(row) for row in mech.dmass), mech.dC, mech.dK, mech.link,
                         mech.output, lp, x0, s0, True if sensitivities else None)
 
-    if not periodic:
-        y, sy, _, _ = run(x0, s0)
+    if not periodic:  # through the record's fine input block by block, the state carried on
+        y, sy = np.empty(u.size), np.empty((u.size, p.size if sensitivities else 0))
+        k = 0
+        for uf in [upsampled] if upsampled is not None else fine_blocks(u, 2 * r):
+            yb, syb, x0, s0 = run(x0, s0, uf)
+            first = 0 if k == 0 else 1  # a block's first output is the previous one's last
+            y[k:k + yb.size - first] = yb[first:]
+            if sensitivities:
+                sy[k:k + yb.size - first] = syb[first:]
+            k += yb.size - first
         return y, sy
+    uf = upsampled if upsampled is not None else fine_input(u, 2 * r, periodic)
     if isinstance(structure, MassSpringDamper):  # as ever: a negative c or k taken as 0
         mech_tau = structure.mechanics([p[0], max(p[1], 0.0), max(p[2], 0.0)])
     else:
@@ -317,7 +325,7 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
     extrapolate = PeriodExtrapolation(weighted=(0,))  # the sensitivities follow the state
 
     def next_period():
-        y, sy, state[0], state[1] = run(*state)
+        y, sy, state[0], state[1] = run(*state, uf)
         finite = bool(np.all(np.isfinite(state[0])))
         jump = extrapolate(state) if finite else None
         if jump is not None:

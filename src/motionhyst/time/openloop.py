@@ -49,7 +49,11 @@ period of the undamped mode):
   link's parameters when asked.
 
 Periodic runs repeat the period until the output settles
-(:mod:`motionhyst.time.periodic_runs`).
+(:mod:`motionhyst.time.periodic_runs`).  A run from a start goes through the
+record in blocks (:func:`~motionhyst.time.resample.fine_blocks`), its state
+carried from one block to the next, with the numbers of one run over the whole
+upsampled record: its memory is the record's and one block's, whatever its
+length.
 """
 
 from __future__ import annotations
@@ -86,14 +90,20 @@ from motionhyst.time.periodic_runs import (
 )
 from motionhyst.time.resample import SINC_HALF_WIDTH as SINC_HALF_WIDTH
 from motionhyst.time.resample import STAMP_TOLERANCE as STAMP_TOLERANCE
-from motionhyst.time.resample import check_record, fine_input, sampling_rate
+from motionhyst.time.resample import (
+    block_samples,
+    check_record,
+    fine_blocks,
+    fine_input,
+    sampling_rate,
+)
 from motionhyst.time.resample import is_periodic_record as is_periodic_record
 from motionhyst.time.resample import upsample as upsample
 
 # the record helpers, the periodic runs and the Bouc-Wen integrator have modules of their own in
 # motionhyst.time (resample, periodic_runs, bouc_wen_rk4); imported here too, where they were
-__all__ = ["FINE_BYTES", "MAX_SHOOTING_STATES", "MIN_SUBSTEPS", "STEPS_PER_MODE_PERIOD",
-           "OpenLoop", "OpenLoopResponse", "simulate_elements"]
+__all__ = ["FINE_BYTES", "MAX_SHOOTING_STATES", "MIN_SUBSTEPS", "SAMPLE_BYTES",
+           "STEPS_PER_MODE_PERIOD", "OpenLoop", "OpenLoopResponse", "simulate_elements"]
 
 MIN_SUBSTEPS = 20
 STEPS_PER_MODE_PERIOD = 400
@@ -102,6 +112,8 @@ STEPS_PER_MODE_PERIOD = 400
 MAX_SHOOTING_STATES = 40
 FINE_BYTES = 48
 """Memory of one integration step of an open-loop run: fine input, midpoints, output [bytes]."""
+SAMPLE_BYTES = 64
+"""Memory of one record sample of an open-loop run: time, force, output and their copies [bytes]."""
 
 
 #: The two-mass stage's name as an open-loop plant before the plants had one class.
@@ -269,9 +281,11 @@ class OpenLoop:
             return OpenLoopResponse(tt, u, y, periodic)
         fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
-        # the force at every integration step and midpoint, and the response at each step
-        check_memory(FINE_BYTES * u.size * r, f"{u.size} samples of {r} integration steps "
-                     f"each", "fewer samples or substeps")
+        # a periodic run: the force at every integration step and midpoint of the period; a run
+        # from a start: of one block at a time (time.resample.fine_blocks), and the record
+        fine = u.size * r if periodic else min(u.size, block_samples(r) + 1) * r
+        check_memory(FINE_BYTES * fine + SAMPLE_BYTES * u.size, f"{u.size} samples of {r} "
+                     f"integration steps each", "fewer samples or substeps")
         # the plant's viscous friction by direction is stepped with the link's elements, and so
         # is a Bouc-Wen link on a positioning axis (one floating mass): a friction link, whose
         # exact update in the displacement follows its sticking however stiff (RK4 in time
@@ -434,10 +448,6 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     else:
         dp = np.zeros((n_el, N_PARAMS, 0))
         n_sens = 0
-    uf = np.ascontiguousarray(upsampled if upsampled is not None
-                              else fine_input(u, r, periodic), dtype=float)
-    if mech.force_offset:  # the plant's constant force offset adds to the force
-        uf = uf + mech.force_offset
     ftol = 1e-13 * stepping.scale
 
     steps = [FohStep(Ad, B0, B1, h, dAd, dB0, dB1)]
@@ -446,15 +456,25 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     C[1, mech.link] = 1.0
     C[2, ns // 2 + mech.link] = 1.0
 
-    def run(x, s, sx, ss, dpp=dp):
-        # each period starts afresh from the state the previous one left
+    def run(x, s, sx, ss, dpp=dp, blocks=None, n_out=None):
+        # each period starts afresh from the state the previous one left; a run from a start
+        # goes through the record's fine input block by block (`n_out` samples in all), the
+        # state carried on
         state = LoopState(x, s, sx, ss)
-        Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(3), 1, stepping, uf, state,
-                                          vel_row=2, convention=OPEN, ftol=ftol,
-                                          record_every=r, record_initial=True,
-                                          dparams=dpp if sx.shape[1] else None)
-        _check_converged(worst)
-        return Y[:, 0], SY[:, 0, :], state.z, state.s, state.sx, state.ss
+        if blocks is None:
+            blocks, n_out = [fine], (fine.size - 1) // r + 1
+        y, sy, k = np.empty(n_out), np.empty((n_out, sx.shape[1])), 0
+        for a in blocks:
+            if mech.force_offset:  # the plant's constant force offset adds to the force
+                a = a + mech.force_offset
+            Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(3), 1, stepping, a, state,
+                                              vel_row=2, convention=OPEN, ftol=ftol,
+                                              record_every=r, record_initial=k == 0,
+                                              dparams=dpp if sx.shape[1] else None)
+            _check_converged(worst)
+            y[k:k + Y.shape[0]], sy[k:k + Y.shape[0]] = Y[:, 0], SY[:, 0, :]
+            k += Y.shape[0]
+        return y, sy, state.z, state.s, state.sx, state.ss
 
     x, s = np.zeros(ns), np.array(stepping.state0, dtype=float)
     sx, ss = np.zeros((ns, n_sens)), np.zeros((n_el, n_sens))
@@ -463,8 +483,12 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         if x.shape != (ns,):
             raise ValueError(f"the initial state has {x.size} values; the plant has {ns}")
     if not periodic:
-        y, sy, *_ = run(x, s, sx, ss)
+        blocks = [upsampled] if upsampled is not None else fine_blocks(u, r)
+        y, sy, *_ = run(x, s, sx, ss, blocks=(np.ascontiguousarray(b, dtype=float)
+                                              for b in blocks), n_out=u.size)
         return y, sy
+    fine = np.ascontiguousarray(upsampled if upsampled is not None
+                                else fine_input(u, r, periodic), dtype=float)
     most = max_periods(mech, k_link, u.size / fs)
     most = most if periods is None else min(most, int(periods))
     if (shooting and np.all(np.isin(stepping.codes, DIFFERENTIATED))

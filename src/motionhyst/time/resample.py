@@ -17,14 +17,20 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["SINC_HALF_WIDTH", "STAMP_TOLERANCE", "check_record", "check_whole_periods",
-           "fine_input", "is_periodic_record", "sampling_rate", "upsample"]
+__all__ = ["BLOCK_NODES", "SINC_HALF_WIDTH", "STAMP_TOLERANCE", "block_samples", "check_record",
+           "check_whole_periods", "fine_blocks", "fine_input", "is_periodic_record",
+           "sampling_rate", "upsample"]
 
 #: Half-width of the windowed-sinc interpolator of a record that is not periodic [samples].
 SINC_HALF_WIDTH = 64
+
+#: Fine nodes of a block of :func:`fine_blocks` (at least 256 record samples a block)
+BLOCK_NODES = 1 << 21
 
 
 #: Largest distance of a time stamp from the record's uniform grid, in sampling intervals
@@ -207,6 +213,88 @@ def fine_input(u: NDArray[np.float64], factor: int, periodic: bool) -> NDArray[n
     return upsample(u, factor, periodic=False)
 
 
+def fine_blocks(u: NDArray[np.float64], factor: int, nodes: int | None = None
+                ) -> Iterator[NDArray[np.float64]]:
+    """:func:`fine_input` of a record from rest in consecutive blocks, for long records.
+
+    Block ``k`` holds the fine nodes of record samples ``k S`` to ``(k + 1) S``
+    (``S = max(256, nodes // factor)`` samples; the last block to the record's
+    end), both ends included: consecutive blocks share a node.  Their nodes are
+    those of ``fine_input(u, factor, periodic=False)``: bit for bit where the
+    record is interpolated by the windowed sinc (each block from the samples
+    around it), to rounding where it holds whole periods of its signal (the
+    period's spectrum, zero-padded, repeated).  Memory: one block, whatever the
+    record's length.
+
+    Parameters
+    ----------
+    u : ndarray
+        The record's samples (at least 2).
+    factor : int
+        Fine samples per record sample, >= 1.
+    nodes : int, optional
+        Fine nodes a block holds at most, but at least 256 samples' worth (default
+        :data:`BLOCK_NODES`).
+
+    Yields
+    ------
+    ndarray
+        The blocks' fine nodes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u = np.cos(np.arange(3201) / 7.0)
+    >>> blocks = list(fine_blocks(u, 4, nodes=4000))
+    >>> [b.size for b in blocks]
+    [4001, 4001, 4001, 801]
+    >>> whole = fine_input(u, 4, periodic=False)
+    >>> bool(np.array_equal(np.concatenate([blocks[0]] + [b[1:] for b in blocks[1:]]), whole))
+    True
+    """
+    x = np.asarray(u, dtype=float)
+    n = x.size
+    step = block_samples(factor, nodes)
+    if n - 1 <= step or factor == 1:
+        yield fine_input(x, factor, periodic=False)
+        return
+    p = is_periodic_record(x)
+    if p is not None and _smooth_length(n):  # the whole record's spectrum: the period's
+        period = upsample(x[:p], factor, periodic=True)
+        for i0 in range(0, n - 1, step):
+            i1 = min(i0 + step, n - 1)
+            yield period[np.arange(i0 * factor, i1 * factor + 1) % period.size]
+        return
+    from scipy.signal import firwin, resample_poly
+
+    half = SINC_HALF_WIDTH
+    pad = half + 2  # as upsample: the record extended, then each block with `pad` around it
+    ext = np.pad(x, pad, mode="reflect" if p is None else "wrap")
+    taps = firwin(2 * half * factor + 1, 1.0 / factor, window=("kaiser", 14.0))
+    for i0 in range(0, n - 1, step):
+        i1 = min(i0 + step, n - 1)
+        fine = resample_poly(ext[i0:i1 + 2 * pad + 1], factor, 1, window=taps)
+        yield fine[pad * factor: (pad + i1 - i0) * factor + 1]
+
+
+def block_samples(factor: int, nodes: int | None = None) -> int:
+    """Record samples of a block of :func:`fine_blocks` (the last block may hold fewer).
+
+    Parameters
+    ----------
+    factor : int
+        Fine samples per record sample.
+    nodes : int, optional
+        As for :func:`fine_blocks`.
+
+    Examples
+    --------
+    >>> block_samples(20), block_samples(10000)
+    (104857, 256)
+    """
+    return max(256, int(BLOCK_NODES if nodes is None else nodes) // int(factor))
+
+
 def check_whole_periods(u: NDArray[np.float64], name: str) -> None:
     """Refuse a record given as whole periods of a periodic signal whose ends do not join.
 
@@ -264,7 +352,10 @@ def is_periodic_record(u: NDArray[np.float64], rtol: float = 1e-9) -> int | None
     """
     n = u.size
     scale = float(np.max(np.abs(u))) if n else 0.0
-    for p in range(2, n // 2 + 1):
-        if n % p == 0 and np.all(np.abs(u.reshape(-1, p) - u[:p]) <= rtol * scale):
+    tol = rtol * scale
+    small = [p for p in range(2, int(n ** 0.5) + 1) if n % p == 0]
+    large = [n // p for p in reversed(small) if n // p != p and n // p <= n // 2]
+    for p in small + large:  # the divisors of n, ascending; a first sample that differs: not p
+        if abs(u[p] - u[0]) <= tol and np.all(np.abs(u.reshape(-1, p) - u[:p]) <= tol):
             return p
     return None
