@@ -160,8 +160,13 @@ def csv_rows(out: IO[str], block: ArrayLike, fmt: str | None = CSV_FORMAT) -> No
     >>> csv_rows(sys.stdout, [[5.0, 1e-6, float("nan")]], fmt=None)
     5,1e-06,
     """
-    if fmt is not None:
-        np.savetxt(out, np.asarray(block, dtype=float), delimiter=",", fmt=fmt)
+    if fmt is not None:  # as numpy.savetxt writes them, a thousand rows a write (faster)
+        rows = np.asarray(block, dtype=float)
+        rows = rows.reshape(-1, 1) if rows.ndim == 1 else rows
+        line = ",".join([fmt] * rows.shape[1]) + "\n"
+        for i in range(0, rows.shape[0], 1000):
+            part = rows[i:i + 1000]
+            out.write((line * part.shape[0]) % tuple(part.ravel().tolist()))
         return
     for row in np.asarray(block, dtype=float):
         out.write(",".join(_shortest(x) for x in row) + "\n")
