@@ -43,6 +43,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/sampled.py
 	$(BIN)/python benchmarks/study.py
 	$(BIN)/python benchmarks/study_memory.py
+	$(BIN)/python benchmarks/predict_memory.py
 	$(BIN)/python benchmarks/engine.py
 	$(BIN)/python benchmarks/stability.py
 	$(BIN)/python benchmarks/periodic.py
