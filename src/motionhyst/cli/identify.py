@@ -127,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
     """Identify Maxwell-slip hysteresis from a measured record (CSV)."""
     if args.save is None:
         refuse_unused(args, ("--force",), "without --save (the only file identify writes)")
+    _refuse_a_record_twice([Path(p) for p in args.data])
     if args.record == "input-output":
         return run_input_output(args)
     check_not_input_output(args, closed_loop=args.record != "force-displacement")
@@ -260,6 +261,51 @@ def run(args: argparse.Namespace) -> int:
         print(f"\nwrote {args.save} (the link without inertia: motionhyst predict gives its "
               f"force for a displacement record)")
     return 0
+
+
+def _refuse_a_record_twice(paths: list[Path]) -> None:
+    """One record given twice (the same file by two names, or two files of identical bytes)
+    would count its samples twice: the standard errors sqrt(2) too small.  Refused before any
+    reading (files of different sizes differ; equal sizes are compared in blocks)."""
+    import os
+
+    seen: dict[tuple[int, int], Path] = {}
+    sizes: dict[int, list[Path]] = {}
+    for path in paths:
+        try:
+            st = os.stat(path)
+        except OSError:
+            continue  # the reader names what is wrong with it
+        first = seen.setdefault((st.st_dev, st.st_ino), path)
+        if first is not path:
+            what = (f"{path} is given twice" if str(first) == str(path)
+                    else f"{first} and {path} are the same file")
+            raise UsageError(f"motionhyst identify: {what}: a record given twice counts its "
+                             f"samples twice (standard errors too small); give each record "
+                             f"once")
+        if not os.path.isfile(path):
+            continue
+        for other in sizes.setdefault(st.st_size, []):
+            if _same_bytes(other, path):
+                raise UsageError(f"motionhyst identify: {other} and {path} hold the same "
+                                 f"record byte for byte: a record given twice counts its "
+                                 f"samples twice (standard errors too small); give each "
+                                 f"record once")
+        sizes[st.st_size].append(path)
+
+
+def _same_bytes(a: Path, b: Path, block: int = 1 << 20) -> bool:
+    """Whether the files `a` and `b` (of one size) hold the same bytes."""
+    try:
+        with open(a, "rb") as fa, open(b, "rb") as fb:
+            while True:
+                x, y = fa.read(block), fb.read(block)
+                if x != y:
+                    return False
+                if not x:
+                    return True
+    except OSError:
+        return False
 
 
 def check_fd_options(args: argparse.Namespace, path: Path) -> None:
