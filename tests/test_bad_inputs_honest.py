@@ -32,12 +32,44 @@ def _axis(n: int = 600) -> str:
     return _csv({"time": t, "force": force, "displacement": y})
 
 
+def _declaring(n: int, **variables):
+    """A maker of a MATLAB v5 file of a few kB whose `variables` (a structure's or a cell's
+    arrays of 1000 zeros) declare `n` values each, as a file of zeros compressed a
+    thousandfold does (its data is cut short: the declaration alone must refuse it)."""
+    def make(path) -> None:
+        import io
+        import struct
+        import zlib
+
+        from scipy.io import savemat
+
+        buf = io.BytesIO()
+        savemat(buf, variables, do_compression=True)
+        raw, pos = buf.getvalue(), 128
+        out = [raw[:pos]]
+        while pos < len(raw):  # each variable: a compressed element whose arrays are patched
+            kind, size = struct.unpack("<ii", raw[pos:pos + 8])
+            body = zlib.decompress(raw[pos + 8:pos + 8 + size]).replace(
+                struct.pack("<iiii", 5, 8, 1000, 1), struct.pack("<iiii", 5, 8, n, 1))
+            packed = zlib.compress(body)
+            out.append(struct.pack("<ii", kind, len(packed)) + packed)
+            pos += 8 + size
+        path.write_bytes(b"".join(out))
+    return make
+
+
 def _link(path) -> None:
     """A symbolic link ``l.csv`` beside `path` pointing to ``a.csv``."""
     path.symlink_to("a.csv")
 
 
 IO = ["--record", "input-output"]
+PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
+ZEROS = np.zeros((1000, 1))
+CELL = np.empty((1, 1), dtype=object)
+CELL[0, 0] = ZEROS
+AXIS = ('[stage]\ntype = "mass-damper"\nm = 2.0\nc = 10.0\n\n'
+        '[hysteresis]\nmodel = "jenkins"\nk = 2e4\nfc = 4.0\n')
 TWICE = "a record given twice counts its samples twice (standard errors too small)"
 
 # (id, extra files, argv, words of the one line on stderr); a file given as a callable is
@@ -52,8 +84,25 @@ CASES = [
      ["identify: a.csv and b.csv hold the same record byte for byte: " + TWICE]),
     ("record-copied-force-displacement", {"b.csv": _axis()},
      ["identify", "a.csv", "b.csv", "--model", "dahl"], ["a.csv and b.csv hold the same"]),
+    # ------- a structure's or cell's arrays declaring more than memory (whosmat lists 1x1)
+    ("mat-structure-declaring-32-GB",
+     {"r.mat": _declaring(2_000_000_000, data={"t": ZEROS, "u": ZEROS})},
+     [*PREDICT, "--columns", "time=data.t,force=data.u"],
+     ["r.mat: cannot read variable 'data.t': reading its 2000000000 values needs 32 GB, above "
+      "the memory budget", "give a smaller file"]),
+    ("mat-nested-structure-declaring-4-GB",
+     {"r.mat": _declaring(250_000_000, data={"t": ZEROS[:10], "run": {"u": ZEROS}})},
+     [*PREDICT, "--columns", "time=data.t,force=data.run.u"],
+     ["cannot read variable 'data.run.u': reading its 250000000 values needs 4 GB"]),
+    ("mat-cell-in-a-structure-declaring-32-GB",
+     {"r.mat": _declaring(2_000_000_000, data={"t": ZEROS[:10], "c": CELL})},
+     [*PREDICT, "--columns", "time=data.t,force=data.c"],
+     ["cannot read variable 'data.c{1}': reading its 2000000000 values needs 32 GB"]),
+    ("mat-cell-wanted", {"r.mat": _declaring(2_000_000_000, c=CELL, t=ZEROS[:10])},
+     [*PREDICT, "--columns", "time=t,force=c"],
+     ["r.mat: variable 'c' is a cell array, not a numeric vector"]),
 ]
-BASE = {"a.csv": _axis(), "notes.txt": "my notes"}
+BASE = {"a.csv": _axis(), "axis.toml": AXIS, "notes.txt": "my notes"}
 
 
 def test_the_cases_are_distinct():
@@ -76,3 +125,48 @@ def test_a_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv, w
         assert word in line, (word, line)
     assert snapshot(root) == before
     assert [p.name for p in tmp_path.iterdir()] == ["user"]
+
+
+@pytest.mark.parametrize("compressed", [True, False])
+def test_the_sizes_a_matlab_file_declares_are_its_arrays(tmp_path, compressed):
+    """The walk of a level-5 file's headers finds every array of a structure (nested, an
+    array of structures), a cell, complex and sparse values, with the sizes they hold."""
+    import scipy.sparse
+    from scipy.io import savemat
+
+    from motionhyst.io._mat_sizes import declared_values
+
+    variables = {
+        "a": np.zeros((7, 1)),
+        "s": {"t": np.zeros(5), "z": np.ones(3) + 1j, "in": {"deep": np.zeros((2, 4))},
+              "text": "abc", "empty": np.zeros(0)},
+        "arr": np.array([({"x": np.zeros(2)}), ({"x": np.zeros(9)})], dtype=object),
+        "c": np.array([np.zeros(6), "ab"], dtype=object),
+        "sp": scipy.sparse.csc_matrix(np.diag([1.0, 2.0, 0.0])),
+    }
+    savemat(tmp_path / "r.mat", variables, do_compression=compressed)
+    found: list[tuple[str, int]] = []
+    declared_values(tmp_path / "r.mat", ["s", "arr", "c", "sp", "a"],
+                    lambda name, n: found.append((name, n)))
+    assert found == [("a", 7), ("s.t", 5), ("s.z", 6), ("s.in.deep", 8), ("s.text", 3),
+                     ("s.empty", 0), ("arr{1}.x", 2), ("arr{2}.x", 9), ("c{1}", 6),
+                     ("c{2}", 2), ("sp", 2)]
+
+
+def test_a_level_4_matlab_file_is_read_by_what_it_holds_not_its_name(tmp_path):
+    """A MATLAB ``-v4`` file (no text header) named ``.dat`` or ``.csv`` predicts as the same
+    file named ``.mat`` (it was refused as "not a MATLAB file")."""
+    from scipy.io import savemat
+
+    t = np.arange(400) / FS
+    savemat(tmp_path / "r.mat", {"t": t[:, None], "u": np.sin(7 * t)[:, None]}, format="4")
+    (tmp_path / "axis.toml").write_text(AXIS)
+    outputs = []
+    for name in ("r.mat", "r.dat", "r.csv"):
+        if name != "r.mat":
+            (tmp_path / name).write_bytes((tmp_path / "r.mat").read_bytes())
+        code, _, err = limited_process.run(["predict", "axis.toml", name, "--out", f"{name}.out",
+                                            "--columns", "time=t,force=u"], tmp_path)
+        assert code == 0, err
+        outputs.append((tmp_path / f"{name}.out").read_text())
+    assert outputs[0] == outputs[1] == outputs[2]

@@ -51,6 +51,7 @@ from __future__ import annotations
 import codecs
 import math
 import os
+import struct
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -59,6 +60,7 @@ from numpy.typing import NDArray
 
 from motionhyst.core.budget import BudgetError
 from motionhyst.core.validation import MAGNITUDES
+from motionhyst.io._mat_sizes import declared_values
 from motionhyst.io.csvdata import (
     CSVError,
     Source,
@@ -73,6 +75,7 @@ _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _MAT_TEXT_HEADER = b"MATLAB"
 _MAT_CLASSES = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
                 "int64", "uint64", "logical"}
+_CONTAINERS = {"struct", "cell", "object"}
 _CLASS_WORDS = {"cell": "a cell array", "char": "text (char)", "struct": "a structure",
                 "function_handle": "a function handle"}
 
@@ -228,7 +231,27 @@ def is_mat_file(source: Source) -> bool:
         head = _head(path, 520)
     except RecordError:
         return False  # the reader says why
-    return head.startswith(_MAT_TEXT_HEADER) or _HDF5_SIGNATURE in (head[:8], head[512:520])
+    return (head.startswith(_MAT_TEXT_HEADER) or _HDF5_SIGNATURE in (head[:8], head[512:520])
+            or _is_level4(head))
+
+
+def _is_level4(head: bytes) -> bool:
+    """Whether `head` opens a MATLAB level-4 file (``-v4``, no text header): a first matrix
+    header of five integers (type MOPT, rows, columns, imaginary flag, name length) that
+    MATLAB writes, and the name it announces."""
+    if len(head) < 21:
+        return False
+    for order in "<>":
+        mopt, rows, cols, imag, length = struct.unpack(order + "5i", head[:20])
+        m, o, p, t = mopt // 1000, mopt // 100 % 10, mopt // 10 % 10, mopt % 10
+        if not (0 <= mopt < 5000 and m <= 4 and o == 0 and p <= 5 and t <= 2
+                and rows >= 0 and cols >= 0 and imag in (0, 1) and 2 <= length <= 64):
+            continue
+        name = head[20:20 + length]
+        if len(name) == length and name.endswith(b"\0") and name[:-1].isascii() \
+                and name[:-1].decode().isprintable():
+            return True
+    return False
 
 
 def _mat_kind(path: Path) -> str:
@@ -240,17 +263,9 @@ def _mat_kind(path: Path) -> str:
         return "hdf5"
     if head.startswith(_MAT_TEXT_HEADER):
         return "scipy"
-    what = "a text file"
-    if not _looks_like_text(head):  # known before scipy.io loads
-        from scipy.io.matlab import matfile_version
-
-        try:
-            major, _ = matfile_version(str(path))
-        except Exception:  # scipy raises several kinds for a file that is not MATLAB's
-            major = None
-        if major == 0:  # level 4: no text header
-            return "scipy"
-        what = "an unknown format"
+    if _is_level4(head):  # level 4: no text header
+        return "scipy"
+    what = "a text file" if _looks_like_text(head) else "an unknown format"
     raise RecordError(f"{path}: not a MATLAB .mat file ({what}); a CSV record must be named .csv")
 
 
@@ -337,10 +352,17 @@ def _read_scipy(path: Path, wanted: Sequence[str]) -> list[NDArray[np.float64]]:
         except RecordError:
             loadmat(str(path))  # a file cut short lists only its first variables: say so
             raise
+        for w in wanted:  # a variable of another class is refused before it is read
+            top = _resolve(w.split(".")[0], list(info), path)
+            if "." not in w and info[top] not in _MAT_CLASSES | {"struct"}:
+                _vector(path, top, None, info[top])
         total = [0]
-        for name, shape, _ in whos:
-            if name in tops:
+        for name, shape, cls in whos:
+            if name in tops and cls not in _CONTAINERS:
                 _check_size(path, name, math.prod(shape), total)
+        # whosmat lists a structure or cell as 1x1: the sizes its arrays declare, walked
+        declared_values(path, [n for n, _, cls in whos if n in tops and cls in _CONTAINERS],
+                        lambda name, values: _check_size(path, name, values, total))
         data = loadmat(str(path), variable_names=tops, simplify_cells=True)
     except (RecordError, BudgetError):
         raise
