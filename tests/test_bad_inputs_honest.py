@@ -84,6 +84,19 @@ CASES = [
      ["identify: a.csv and b.csv hold the same record byte for byte: " + TWICE]),
     ("record-copied-force-displacement", {"b.csv": _axis()},
      ["identify", "a.csv", "b.csv", "--model", "dahl"], ["a.csv and b.csv hold the same"]),
+    # --------------------- errors in a CSV's first data rows: decided before pandas loads
+    ("csv-units-row", {"r.csv": "time,force\ns,N\n0,1\n0.001,2\n"},
+     ["predict", "axis.toml", "r.csv", "--out", "p.csv"],
+     ["r.csv: non-numeric value 's' at line 2, column 'time'"]),
+    ("csv-empty-cell", {"r.csv": "time,force\n0,1\n\n0.001, \n"},
+     ["predict", "axis.toml", "r.csv", "--out", "p.csv"],
+     ["r.csv: an empty cell at line 4, column 'force'"]),
+    ("csv-row-short-of-a-column", {"r.csv": "time,force,other\n0,1,2\n0.001\n"},
+     ["predict", "axis.toml", "r.csv", "--out", "p.csv"],
+     ["r.csv: inconsistent lengths: line 3 has 1 fields, the header 3"]),
+    ("csv-row-too-long", {"r.csv": "time;force\n0;1\n0,001;2;5\n"},
+     ["predict", "axis.toml", "r.csv", "--out", "p.csv"],
+     ["r.csv: inconsistent lengths: line 3 has 3 fields, the header 2"]),
     # ------- a structure's or cell's arrays declaring more than memory (whosmat lists 1x1)
     ("mat-structure-declaring-32-GB",
      {"r.mat": _declaring(2_000_000_000, data={"t": ZEROS, "u": ZEROS})},
@@ -170,3 +183,30 @@ def test_a_level_4_matlab_file_is_read_by_what_it_holds_not_its_name(tmp_path):
         assert code == 0, err
         outputs.append((tmp_path / f"{name}.out").read_text())
     assert outputs[0] == outputs[1] == outputs[2]
+
+
+@pytest.mark.parametrize(("text", "refused"), [
+    ("time,force\ns,N\n0,1\n", True),                    # a units row
+    ("time,force\n0,1\n0.001,\n", True),                  # an empty cell
+    ("time;force\n0;1\n0,001;2;3\n", True),               # a row longer than the header
+    ("time,force,x\n0,1\n0.001,2,\n", False),             # a cell pandas reads as NaN
+    ("time,force\n0,NA\n0.001,2\n", False),               # pandas' NaN: the caller's value
+    ("time;force\n0;1,5\n0,001;-,5e3\n", False),           # decimal commas
+    ("time,force\n0,1\n0.001,2,\n0.002,3\n", None),      # pandas' error: its message
+])
+def test_a_csv_whose_first_rows_are_refused_does_not_load_pandas(tmp_path, text, refused):
+    """The first rows' errors are said without pandas (a second of loading on a busy
+    machine); what the check cannot decide is read, or refused, by pandas as before."""
+    import subprocess
+    import sys
+
+    (tmp_path / "r.csv").write_text(text)
+    code = ("import sys\nfrom motionhyst.io.csvdata import CSVError, read_columns\n"
+            "try:\n    print(read_columns(sys.argv[1], ('time', 'force')).tolist())\n"
+            "except CSVError as e:\n    print(e)\nprint('pandas' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "r.csv")],
+                         capture_output=True, text=True, check=True).stdout.splitlines()
+    assert out[-1] == str(not refused), out
+    if refused is not False:
+        assert "r.csv: " in out[0] and ("line 2" in out[0] or "line 3" in out[0]), out
+

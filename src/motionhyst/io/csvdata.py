@@ -52,6 +52,10 @@ _SNIFF_BYTES = 64 * 1024
 _MAX_EXTRA_FIELDS = 1000   # a data row of more fields than its header's and these is refused
 _MAX_FIELD_BYTES = 64      # ... when its line is longer than this per field (checked unread)
 _CHUNK_BYTES = 1 << 22
+_FIRST_ROWS = 2000         # data rows checked without pandas (a units row, a short row...)
+_NUMBER = r"[+-]?(?:\d+[.{0}]?\d*|[.{0}]\d+)(?:[eE][+-]?\d+)?"
+_UNDECIDED = ("nan", "na", "inf", "null", "none", "#", "ind", "true", "false")  # words pandas
+# may read as NaN, an infinity or a column of booleans: pandas decides
 
 
 class CSVError(ValueError):
@@ -318,6 +322,40 @@ def _check_line_lengths(path: Path, d: _Dialect, width: int) -> None:
                    f"numbers (refused unread)")
 
 
+def _check_first_rows(path: Path, d: _Dialect, wanted: list[int], names: Sequence[str],
+                      width: int) -> None:
+    """Refuse, before pandas loads, the first of the first :data:`_FIRST_ROWS` data rows
+    that pandas' reading would refuse for certain (a units row under the header, an empty
+    cell, a row short of a wanted column or with more fields than the header), with the
+    message its reading gives; a cell that pandas may read as a number or NaN passes (pandas
+    decides)."""
+    number = re.compile(_NUMBER.format(re.escape(d.decimal)))
+    try:
+        with path.open(encoding=d.encoding, errors="replace", newline="") as fh:
+            rows = 0
+            for line_number, line in enumerate(fh, 1):
+                if line_number <= d.header_line or not line.strip():
+                    continue
+                rows += 1
+                if rows > _FIRST_ROWS:
+                    return
+                fields = next(csv.reader([line], delimiter=d.sep, skipinitialspace=True), [])
+                cells = [f.strip() for f in fields]
+                if len(cells) <= max(wanted) or any(cells[width:]):
+                    raise CSVError(f"{path}: inconsistent lengths: line {line_number} has "
+                                   f"{len(cells)} fields, the header {width}")
+                for i, name in zip(wanted, names, strict=True):
+                    if not cells[i]:
+                        raise CSVError(f"{path}: an empty cell at line {line_number}, column "
+                                       f"{name!r}")
+                    if not number.fullmatch(cells[i]) and not any(
+                            w in cells[i].lower() for w in _UNDECIDED):
+                        raise CSVError(f"{path}: non-numeric value {cells[i]!r} at line "
+                                       f"{line_number}, column {name!r}")
+    except (csv.Error, OSError):
+        return  # pandas reads it and says what is wrong
+
+
 def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
     """The columns `names` of a CSV file (floats where they parse), rows checked for length."""
     d = _dialect(path)
@@ -330,6 +368,7 @@ def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
                        f"{','.join(names)} (found {found})")
     width = len(header)
     _check_line_lengths(path, d, width)
+    _check_first_rows(path, d, [header.index(n) for n in names], names, width)
     frame = _read_csv(path, d, "no data rows", header=None, skiprows=d.header_line)
     if frame.shape[1] > width:  # more fields than names: allowed only if empty (trailing sep)
         used = frame.iloc[:, width:].notna().to_numpy().any(axis=1)
