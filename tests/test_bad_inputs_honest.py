@@ -193,6 +193,7 @@ def test_a_level_4_matlab_file_is_read_by_what_it_holds_not_its_name(tmp_path):
     ("time,force\n0,NA\n0.001,2\n", False),               # pandas' NaN: the caller's value
     ("time;force\n0;1,5\n0,001;-,5e3\n", False),           # decimal commas
     ("time,force\n0,1\n0.001,2,\n0.002,3\n", None),      # pandas' error: its message
+    ('time,force\n0,"1\n"\n0.001,2\n', False),            # a quoted cell over two lines
 ])
 def test_a_csv_whose_first_rows_are_refused_does_not_load_pandas(tmp_path, text, refused):
     """The first rows' errors are said without pandas (a second of loading on a busy

@@ -337,7 +337,7 @@ def _check_first_rows(path: Path, d: _Dialect, wanted: list[int], names: Sequenc
                 if line_number <= d.header_line or not line.strip():
                     continue
                 rows += 1
-                if rows > _FIRST_ROWS:
+                if rows > _FIRST_ROWS or '"' in line:  # a quoted cell may span lines
                     return
                 fields = next(csv.reader([line], delimiter=d.sep, skipinitialspace=True), [])
                 cells = [f.strip() for f in fields]
