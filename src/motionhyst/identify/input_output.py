@@ -101,6 +101,7 @@ from motionhyst.identify.io_bouc_wen import START_RATIOS as START_RATIOS
 from motionhyst.identify.io_bouc_wen import START_REFINED as START_REFINED
 from motionhyst.identify.io_bouc_wen import START_SHARES as START_SHARES
 from motionhyst.identify.io_bouc_wen import identify_bouc_wen_msd, identify_bouc_wen_two_mass
+from motionhyst.identify.io_budget import EvaluationBudget
 from motionhyst.identify.io_checks import (
     FitFailed,
     budget_note,
@@ -300,8 +301,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         The records start at rest; otherwise each record's initial velocity (and
         position, on a spring) is estimated (the element links).
     max_evaluations : int, optional
-        The search's whole budget of model evaluations (starts and refinement;
-        Bouc-Wen: the refinement's).
+        The search's whole budget of model evaluations: every start, profile point,
+        Coulomb fit a friction link starts from, refinement and the standard errors'
+        evaluations, and a refit with fewer elements, together
+        (:class:`~motionhyst.identify.io_budget.EvaluationBudget`).
     init_window : int, optional
         The element links: each record's initial state (and a floating stage's
         position offset) is not estimated but set, at every step of the search,
@@ -385,11 +388,11 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         if short:
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
-    fewer = None
+    fewer, budget = None, EvaluationBudget(max_evaluations)  # the whole search's, refits too
     while True:
         fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps,
                      tol=tol, max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev,
-                     offset=offset, from_rest=from_rest, max_evaluations=max_evaluations,
+                     offset=offset, from_rest=from_rest, max_evaluations=budget,
                      init_window=init_window, asymmetric=asymmetric, drift=drift,
                      t_start=t_start, rigid_limit=rigid_limit, rigid=rigid)
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
@@ -409,6 +412,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         elif failed is not None:
             raise failed
         break
+    fit.n_evaluations = budget.used  # refits with fewer elements included
     if (stage.has_inertia and not asymmetric and _is_axis(stage)
             and (not periodic or isinstance(fit.hysteresis, Coulomb))):
         note = viscous_direction_note(records)  # a symmetric fit's mass is biased: its rigid
@@ -432,7 +436,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
 
 def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, periodic: bool,
            nu: float | None, substeps: int | None, tol: float, max_nfev: int, n_elements: int,
-           start_nfev: int | None, offset: str, from_rest: bool, max_evaluations: int | None,
+           start_nfev: int | None, offset: str, from_rest: bool,
+           max_evaluations: EvaluationBudget,
            init_window: int | None, asymmetric: bool, drift: bool, t_start: float,
            rigid_limit: bool = False, rigid: IOIdentification | None = None
            ) -> IOIdentification:
@@ -447,10 +452,12 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         if init_window is not None:
             raise ValueError("a stage without inertia has no state for an initialisation "
                              "window to set")
-        return identify_quasi_static_io(records, link, periodic=periodic,
-                                        n_elements=n_elements, offset=offset,
-                                        max_evaluations=max_evaluations, tol=tol,
-                                        t_start=t_start, nu=nu)
+        fit = identify_quasi_static_io(records, link, periodic=periodic,
+                                       n_elements=n_elements, offset=offset,
+                                       max_evaluations=max_evaluations.left, tol=tol,
+                                       t_start=t_start, nu=nu)
+        max_evaluations.used += fit.n_evaluations
+        return fit
     shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
     if asymmetric and not (shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)
@@ -469,13 +476,13 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         raise ValueError("the Bouc-Wen link's records start at rest and only its position "
                          "offsets are estimated (offset 'output', on a mass-spring-damper); "
                          "other offsets and initial states are estimated with the element links")
-    if max_evaluations is not None:
-        max_nfev = max_evaluations
+    if max_evaluations.limit is not None:
+        max_nfev = max_evaluations.limit
     if shape.n > 1:
         return identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev,
-                                          stage.output, t_start)
+                                          stage.output, t_start, max_evaluations)
     return identify_bouc_wen_msd(records, periodic, nu, substeps, tol, max_nfev, t_start,
-                                 bouc_wen_offset)
+                                 bouc_wen_offset, max_evaluations)
 
 
 def _is_axis(stage: Plant) -> bool:

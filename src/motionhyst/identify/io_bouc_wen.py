@@ -26,9 +26,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult
 
 from motionhyst.hysteresis import BoucWen, Hysteresis
+from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
 from motionhyst.identify.io_records import IORecord, short_records
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
@@ -68,7 +69,7 @@ class _BoucWenProblem:
     def __init__(self, records: list[IORecord], periodic: bool, substeps: int,
                  free: NDArray[np.bool_], fixed: NDArray[np.float64], y_scale: float,
                  force_scale: float = 1.0, plant: MassSpringDamper | TwoMass | None = None,
-                 output_offset: bool = False):
+                 output_offset: bool = False, budget: EvaluationBudget | None = None):
         self.y_scale = y_scale  # residuals in units of the output's RMS
         self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
         n_plant = len(self.plant.PARAMETERS)
@@ -88,7 +89,8 @@ class _BoucWenProblem:
         self.free = free
         self.fixed = fixed
         self.fine = [fine_input(rec.u, 2 * substeps, periodic) for rec in records]
-        self.n_eval = 0
+        self.n_eval = 0  # the runs, each charged to the search's budget first
+        self.budget = budget if budget is not None else EvaluationBudget()
 
     def full(self, q_free: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray:
         """Parameters ``m, c, k, alpha, beta*gamma, beta*delta, nu`` (and a two-mass stage's
@@ -118,7 +120,9 @@ class _BoucWenProblem:
         return J[:, self.free]
 
     def run(self, p: NDArray[np.float64], jac: bool):
+        self.budget.charge(1)
         self.n_eval += 1
+
         def one(i):
             rec = self.records[i]
             try:
@@ -153,8 +157,9 @@ class _BoucWenProblem:
 
 
 def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.float64],
-           tol: float, max_nfev: int):
-    """Trust-region refinement of the free parameters (m > 0; c, k, alpha >= 0; nu >= 1)."""
+           tol: float, max_nfev: int, share: int | None = None):
+    """Trust-region refinement of the free parameters (m > 0; c, k, alpha >= 0; nu >= 1),
+    within `share` more of the problem's budget (at its start if not even that runs)."""
     cache: dict = {}
 
     # the sensitivities cost ~40 % of a run and are needed at every accepted point:
@@ -184,9 +189,13 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
         low = np.array([1e-6, 1e-6, 0.0, 0.0, -np.inf, -np.inf, 1.0 / scale[6], 1e-6])
     lower = low[prob.free]
     q0 = np.where(np.isfinite(lower), np.maximum(q0, lower + 1e-9 * np.abs(q0) + 1e-12), q0)
-    sol = least_squares(fun, q0, jac=jacobian, method="trf", x_scale=1.0, ftol=tol, xtol=tol,
-                        gtol=tol, max_nfev=max_nfev, bounds=(lower, np.inf))
-    return sol
+    with prob.budget.share(share):
+        try:
+            return solve_within(fun, q0, jac=jacobian, method="trf", x_scale=1.0, ftol=tol,
+                                xtol=tol, gtol=tol, max_nfev=max_nfev, bounds=(lower, np.inf))
+        except BudgetSpent:
+            return OptimizeResult(x=q0, cost=math.inf, status=0, nfev=0,
+                                  message="The budget of model evaluations is spent.")
 
 
 def _force_scale(p: NDArray[np.float64], y_scale: float) -> float:
@@ -200,14 +209,20 @@ def _force_scale(p: NDArray[np.float64], y_scale: float) -> float:
 
 def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | None,
                           substeps: int | None, tol: float, max_nfev: int, t_start: float,
-                          output_offset: bool = False) -> IOIdentification:
+                          output_offset: bool = False,
+                          budget: EvaluationBudget | int | None = None) -> IOIdentification:
     """The mass-spring-damper and a Bouc-Wen link (problem order ``m, c, k, alpha,
     beta*gamma, beta*delta, nu``): the linear model by simulation error on a short part
     of the records, the starts of :func:`_bouc_wen_starts` screened there by one
     simulation each and the best refined there, then :func:`_refine` on all records from
     the best start whose result is a valid system.  With `output_offset` each record's
     position offset is estimated too (projected out of the search: the residuals are
-    compared without their means; the offsets and their standard errors at the end)."""
+    compared without their means; the offsets and their standard errors at the end).
+    `budget` (its limit ``identify --max-evaluations``) is charged by every run."""
+    plan = budget if isinstance(budget, EvaluationBudget) else EvaluationBudget(budget)
+    used0, n_chosen = plan.used, len(BASIC_STARTS) + START_REFINED
+    _, shares = plan.plan_starts(1 + n_chosen, 1, runs=len(_bouc_wen_starts(
+        np.ones(7), 1.0, 1.0)))
     bla = best_linear_approximation(records)
     fs = records[0].fs
     r = substeps or OpenLoop(bla).default_substeps(fs)
@@ -223,45 +238,53 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     lin_free = np.array([True, True, True, False, False, False, False])
     prob = _BoucWenProblem(short, periodic, r, lin_free,
                            np.array([bla.m, bla.c, bla.k, 0.0, 0.0, 0.0, nu0]), y_scale,
-                           output_offset=output_offset)
-    sol = _solve(prob, prob.fixed, scale, 1e-10, 30)
+                           output_offset=output_offset, budget=plan)
+    sol = _solve(prob, prob.fixed, scale, 1e-10, 30, next(shares))
     lin = prob.full(sol.x, scale)
-    n_eval = prob.n_eval
 
     # 2. starts (nu at its start value; a free nu joins in the refinement): each simulated
     # once on the short part of the records; the basic ones and the best others refined there
     free_start = free.copy()
     free_start[6] = False
     sp = _BoucWenProblem(short, periodic, r, free_start, lin, y_scale,
-                         output_offset=output_offset)
+                         output_offset=output_offset, budget=plan)
     screened = []
     for i, p0 in enumerate(_bouc_wen_starts(lin, y_scale, nu0)):
-        res, _ = sp.run(p0, False)
+        try:
+            res, _ = sp.run(p0, False)
+        except BudgetSpent:  # the linear fit took the screening's part: screened so far
+            break
         screened.append((float(res @ res), i, p0))
-    n_eval += sp.n_eval
     screened.sort(key=lambda c: c[:2])
     chosen = [c for c in screened if c[1] < len(BASIC_STARTS)]
     chosen += [c for c in screened if c[1] >= len(BASIC_STARTS)][:START_REFINED]
     refined = []
     for _, _, p0 in chosen:
         sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale,
-                             output_offset=output_offset)
-        s = _solve(sp, p0, scale, 1e-6, 12)
-        n_eval += sp.n_eval
+                             output_offset=output_offset, budget=plan)
+        s = _solve(sp, p0, scale, 1e-6, 12, next(shares))
         refined.append((float(s.cost), len(refined), sp.full(s.x, scale)))
     refined.sort(key=lambda c: c[:2])
     # 3. refinement on all records, from the best start whose result is a valid system
     error = None
     for _, _, p_start in refined[:FINAL_ATTEMPTS]:
-        p, free_used, sol, res, std_q, groups, notes, n, cov = _refine(
+        if error is not None and plan.left is not None and plan.left < 3 + output_offset:
+            raise error  # no budget for another attempt
+        p, free_used, sol, res, std_q, groups, notes, _, cov = _refine(
             records, periodic, r, free, p_start, y_scale, scale, tol, max_nfev,
-            output_offset=output_offset)
-        n_eval += n
+            output_offset=output_offset, budget=plan, keep=1 + output_offset)
         try:
             link = _bouc_wen_link(p[3], p[4], p[5], p[6])
             plant = MassSpringDamper(p[0], p[1], p[2])
         except ValueError as exc:
             error = error or exc
+            if plan.limit is not None and sol.status == 0:
+                from motionhyst.identify.io_checks import FitFailed
+
+                error = FitFailed(f"the fit failed: the search stopped on its budget of "
+                                  f"{plan.limit} model evaluations ({plan.used} used) before "
+                                  f"it reached a valid Bouc-Wen link (a larger "
+                                  f"--max-evaluations may let it)")
             continue
         break
     else:
@@ -282,7 +305,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     extra: dict = {"covariance": covariance_table(free_names, cov, std),
                    "budget_reached": bool(sol.status == 0)}
     if output_offset:
-        offsets, offset_std = _output_offsets(records, periodic, r, free, p, y_scale, rss,
+        offsets, offset_std = _output_offsets(records, periodic, r, free, p, y_scale, rss, plan,
                                               res.size)
         for i, (value, sd) in enumerate(zip(offsets, offset_std, strict=True)):
             name = "output_offset" if len(records) == 1 else f"output_offset[{i}]"
@@ -298,14 +321,14 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
         records=per_record, seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r, extra=extra, warnings=warnings,
+        n_evaluations=plan.used - used0, substeps=r, extra=extra, warnings=warnings,
         data=list(records), residuals=res)
 
 
-def _output_offsets(records, periodic, r, free, p, y_scale, rss, n_rows):
+def _output_offsets(records, periodic, r, free, p, y_scale, rss, budget, n_rows):
     """Each record's position offset (the mean of its data less the model's output) and its
     standard error, from the Jacobian of the parameters and offsets together."""
-    prob = _BoucWenProblem(records, periodic, r, free, p, y_scale)
+    prob = _BoucWenProblem(records, periodic, r, free, p, y_scale, budget=budget)
     res, jac = prob.run(p, True)
     offsets, columns, i = [], [], 0
     for rec in records:
@@ -372,26 +395,30 @@ def _bouc_wen_starts(lin: NDArray[np.float64], y_scale: float, nu: float
 
 
 def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=None,
-            output_offset=False):
+            output_offset=False, budget=None, keep=1):
     """Refinement on all records; with ``nu`` free and no ultimate force, ``nu = 1`` if the
-    data cannot tell it from 1 (the only ``nu`` such links are admitted for)."""
+    data cannot tell it from 1 (the only ``nu`` such links are admitted for).  Of `budget`,
+    `keep` runs are left for after it (its standard errors' run is one)."""
     notes: dict[str, str] = {}
     n_eval = 0
+    plan = budget if budget is not None else EvaluationBudget()
     while True:
         prob = _BoucWenProblem(records, periodic, r, free, p, y_scale,
                                _force_scale(p, y_scale), plant=plant,
-                               output_offset=output_offset)
-        sol = _solve(prob, p, scale, tol, max_nfev)
-        n_eval += prob.n_eval
+                               output_offset=output_offset, budget=plan)
+        sol = _solve(prob, p, scale, tol, max_nfev,
+                     None if plan.left is None else plan.left - keep)
         p = prob.full(sol.x, scale)
         res, jac = prob.run(p, True)
+        n_eval += prob.n_eval
         res *= y_scale
         std_q, groups = standard_errors(jac[:, free] * y_scale, float(res @ res), res.size)
         cov = covariance(jac[:, free] * y_scale, float(res @ res), res.size)
         if not free[6] or p[4] + p[5] >= 0.0:
             break
         nu_std = std_q[int(np.count_nonzero(free[:6]))]
-        if not abs(p[6] - 1.0) <= max(3.0 * nu_std, 1e-9):
+        if not abs(p[6] - 1.0) <= max(3.0 * nu_std, 1e-9) or (
+                plan.left is not None and plan.left < keep + 2):  # or no budget to refit
             break
         notes["nu"] = (f"not distinguishable from 1 (estimate {p[6]:.9g} +- {nu_std:.2g}); "
                        f"fixed at 1, as the link has no ultimate force "
@@ -402,15 +429,19 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
     return p, free, sol, res, std_q, groups, notes, n_eval, cov
 
 
-def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start
+def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start,
+                               budget: EvaluationBudget | int | None = None
                                ) -> IOIdentification:
     """The two-mass stage and a Bouc-Wen link: :func:`_two_mass_start`, then :func:`_refine`
-    on all records (problem order ``m1, m2, b, alpha, beta*gamma, beta*delta, nu, k``)."""
-    structure, r, y_scale, scale, free, p, n_eval = _two_mass_start(records, periodic, nu,
-                                                                   substeps, output)
-    p, free, sol, res, std_q, groups, notes, n, cov = _refine(
-        records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=structure)
-    n_eval += n
+    on all records (problem order ``m1, m2, b, alpha, beta*gamma, beta*delta, nu, k``),
+    every run charged to `budget` (its limit ``identify --max-evaluations``)."""
+    plan = budget if isinstance(budget, EvaluationBudget) else EvaluationBudget(budget)
+    used0 = plan.used
+    structure, r, y_scale, scale, free, p, _ = _two_mass_start(records, periodic, nu,
+                                                              substeps, output, plan)
+    p, free, sol, res, std_q, groups, notes, _, cov = _refine(
+        records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=structure,
+        budget=plan)
     link = _bouc_wen_link(p[3], p[4], p[5], p[6])
     stage = _two_mass_result(p[0], p[1], p[2], p[7], output)
     rss = float(res @ res)
@@ -436,13 +467,13 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
         periodic=periodic,
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
-        n_evaluations=n_eval, substeps=r, warnings=warnings, data=list(records),
+        n_evaluations=plan.used - used0, substeps=r, warnings=warnings, data=list(records),
         residuals=res, extra={"covariance": covariance_table(free_names, cov, std),
                               "budget_reached": bool(sol.status == 0)})
 
 
 def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
-                    substeps: int | None, output: str):
+                    substeps: int | None, output: str, plan: EvaluationBudget):
     """Steps 1-2 for the two-mass stage (problem order ``m1, m2, b, alpha, beta*gamma,
     beta*delta, nu, k``): the linear model with the link a spring ``alpha`` (its only
     hold), then starts with the link's nonlinearity, refined on a short part."""
@@ -464,6 +495,7 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
     free_start[6] = False
     n_eval = 0
     best = None
+    _, shares = plan.plan_starts(18, 1)  # 15 starts and 3 splits of the mass
     # the link's initial stiffness is above the linear (secant) one, up to an order of
     # magnitude for a link driven into saturation; its nonlinearity neither hardening nor
     # softening (gamma + delta = 0), or softening (delta = 0), mild to strong
@@ -472,8 +504,8 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
             p0 = np.array([bla.m1, bla.m2, bla.b, stiffer * k_link, lam_g / y_scale,
                            lam_d / y_scale, nu0, bla.k])
             sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale,
-                                 plant=structure)
-            s = _solve(sp, p0, scale, 1e-6, 12)
+                                 plant=structure, budget=plan)
+            s = _solve(sp, p0, scale, 1e-6, 12, next(shares))
             n_eval += sp.n_eval
             if best is None or s.cost < best[0]:
                 best = (s.cost, sp.full(s.x, scale))
@@ -486,8 +518,9 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
         p0 = best[1].copy()
         p0[0], p0[1] = share * m_total, (1 - share) * m_total
         p0[7] = omega2 * p0[0] * p0[1] / m_total
-        sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale, plant=structure)
-        s = _solve(sp, p0, scale, 1e-6, 12)
+        sp = _BoucWenProblem(short, periodic, r, free_start, p0, y_scale, plant=structure,
+                             budget=plan)
+        s = _solve(sp, p0, scale, 1e-6, 12, next(shares))
         n_eval += sp.n_eval
         if s.cost < best[0]:
             best = (s.cost, sp.full(s.x, scale))

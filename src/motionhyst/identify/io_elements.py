@@ -20,10 +20,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import Coulomb, Hysteresis, Jenkins, Parameter
 from motionhyst.hysteresis.stepping import Stepping
+from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
 from motionhyst.identify.io_checks import (
     PROFILE_CHI2,
     flat_profile,
@@ -240,7 +240,8 @@ class _ElementProblem:
                  scale: NDArray[np.float64], free: NDArray[np.bool_] | None = None,
                  fixed: NDArray[np.float64] | None = None, exact: bool = True,
                  plant: MassSpringDamper | TwoMass | None = None,
-                 extras: Extras | None = None, window: int | None = None):
+                 extras: Extras | None = None, window: int | None = None,
+                 budget: EvaluationBudget | None = None):
         self.records, self.periodic, self.r = records, periodic, substeps
         self.layout, self.y_scale = layout, y_scale
         self.plant = plant if plant is not None else MassSpringDamper(1.0, 0.0, 0.0)
@@ -266,7 +267,8 @@ class _ElementProblem:
         # and a drifting offset by its rate times the fine steps' times
         self.fine_t = ([fine_input(rec.t, substeps, periodic) for rec in records]
                        if self.extras.input_drift else None)
-        self.n_eval = 0
+        self.n_eval = 0  # the evaluations, each charged to the search's budget first
+        self.budget = budget if budget is not None else EvaluationBudget()
         self.exact: bool | None = None if exact else False  # sensitivities (None: untried)
         self.fd_step = FD_STEP
         if getattr(layout.cls, "rigid", False):
@@ -427,9 +429,9 @@ class _ElementProblem:
             step = EXTRA_FD_STEP * max(abs(v[base + j]), self.scale[base + j])
             w = v.copy()
             w[base + j] += step
+            self._count(1)
             J[:, j] = (np.concatenate([yy for yy, _ in self.outputs(w)])
                        - np.concatenate(y)) / step
-            self.n_eval += 1
         for i in range(len(self.records)):
             rows = slice(starts[i], starts[i + 1])
             for j in ex.columns_of_record(i):
@@ -440,6 +442,7 @@ class _ElementProblem:
                 step = EXTRA_FD_STEP * max(abs(v[base + j]), self.scale[base + j])
                 w = v.copy()
                 w[base + j] += step
+                self._count(1)
                 J[rows, j] = (self.outputs(w, only=i)[0][0] - y[i]) / step
         return J
 
@@ -496,7 +499,7 @@ class _ElementProblem:
 
     def residuals(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Output errors in units of the output's RMS."""
-        self.n_eval += 1
+        self._count(1)
         if self.exact is not False:
             out = self._run_exact(q_free)
             if out is not None:
@@ -525,16 +528,21 @@ class _ElementProblem:
             q[j] += steps[j]
             return (self._run(q) - r0) / steps[j]
 
-        self.n_eval += q_free.size
+        self._count(q_free.size)
         with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
             cols = list(pool.map(column, range(q_free.size)))
         return np.column_stack(cols)
 
+    def _count(self, n: int) -> None:
+        self.budget.charge(n)
+        self.n_eval += n
+
     def solve(self, q0_free: NDArray[np.float64], tol: float, max_nfev: int):
-        """Trust-region refinement of the free variables from `q0_free`."""
-        return least_squares(self.residuals, q0_free, jac=self.jacobian, method="trf",
-                             ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev,
-                             bounds=self.bounds())
+        """Trust-region refinement of the free variables from `q0_free`, ended where its
+        budget is spent (:func:`~motionhyst.identify.io_budget.solve_within`)."""
+        return solve_within(self.residuals, q0_free, jac=self.jacobian, method="trf",
+                            ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev,
+                            bounds=self.bounds())
 
 
 #: The rate scales (velocity parameters, e.g. LuGre's vs) are held at each of these
@@ -683,12 +691,22 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     short_rate = rate[:n_base + short_extras.size]
     n_eval = 0
     n_start = start_nfev or 15 * scale.size
+    plan = budget if isinstance(budget, EvaluationBudget) else EvaluationBudget(budget)
+    final, shares = plan.plan_starts(len(starts) + (len(RATE_GRID) - 1) * rate.any(),
+                                     1 + scale.size, axis and not getattr(layout.cls, "rigid",
+                                                                         False) and not rigid)
 
     def held(p0: NDArray[np.float64], nfev: int):
+        """A start refined on the short records within its share of the starts' budget."""
         prob = _ElementProblem(short, periodic, r, layout, y_scale, short_scale, ~short_rate,
-                               plant=structure, extras=short_extras, window=init_window)
+                               plant=structure, extras=short_extras, window=init_window,
+                               budget=plan)
         prob.fixed = prob.variables(p0)
-        sol = prob.solve(prob.fixed[~short_rate], 1e-6, nfev)
+        with plan.share(next(shares)):
+            try:
+                sol = prob.solve(prob.fixed[~short_rate], 1e-6, nfev)
+            except BudgetSpent:  # not even the start ran: no better than any
+                return math.inf, p0, prob.n_eval
         return sol.cost, prob.values(prob.whole(sol.x)), prob.n_eval
 
     short_start = extras_start(short_extras, short, floating, idim["u0"])
@@ -711,7 +729,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
             p0[short_rate] = fraction * v_scale
             cost, p, used = held(p0, n_start)
             n_eval += used
-            profile.append(cost)
+            profile += [cost] if math.isfinite(cost) else []  # one its budget did not run
             if cost < best[0]:
                 best = (cost, p)
     full_start = extras_start(extras, records, floating, idim["u0"])
@@ -720,25 +738,29 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         full_start[extras.names.index(name if len(records) == 1 or name == "input_offset"
                                       else f"{name}[0]")] = best[1][n_base + j]
     prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
-                           extras=extras, window=init_window)
+                           extras=extras, window=init_window, budget=plan)
     q0 = prob.variables(np.concatenate([best[1][:n_base], full_start]))
     coulomb = None
     if axis and not getattr(layout.cls, "rigid", False):
         # the rigid slider is every friction link's limit: its fit is a start for theirs
-        seed, used, coulomb = rigid_seed(
-            lambda: identify_elements_io(
-                records, Coulomb, periodic, substeps, tol, max_nfev, 1, t_start, start_nfev,
-                plant, offset, from_rest, init_window=init_window, drift=extras.input_drift,
-                asymmetric=skew),
-            layout, y_scale, v_scale, extras.names, force, rate[n_plant:n_base],
-            RATE_GRID[0] * v_scale, skew, rigid)
+        with plan.share(None if plan.left is None else (plan.left - final) // 2):
+            seed, used, coulomb = rigid_seed(
+                lambda: identify_elements_io(
+                    records, Coulomb, periodic, substeps, tol, max_nfev, 1, t_start,
+                    start_nfev, plant, offset, from_rest, budget=plan, init_window=init_window,
+                    drift=extras.input_drift, asymmetric=skew),
+                layout, y_scale, v_scale, extras.names, force, rate[n_plant:n_base],
+                RATE_GRID[0] * v_scale, skew, rigid)
         n_eval += used
         if seed is not None:
             q_seed = prob.variables(seed)
             if np.sum(prob.residuals(q_seed) ** 2) < np.sum(prob.residuals(q0) ** 2):
                 q0 = q_seed
-    remaining = max_nfev if budget is None else max(budget - n_eval, 1)
-    sol = prob.solve(q0, tol, remaining)
+    # what the standard errors at the end take: a run and the Jacobian's differences
+    reserve = 1 + (prob.extras.size if prob.exact else q0.size)
+    remaining = max_nfev if plan.left is None else plan.left - reserve
+    with plan.share(remaining if plan.left is not None else None):
+        sol = prob.solve(q0, tol, remaining)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)

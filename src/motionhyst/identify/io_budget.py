@@ -1,0 +1,176 @@
+"""The search's whole budget of model evaluations (``identify --max-evaluations N``).
+
+An input-output search runs many fits: starts on a short part of the records, a profile of
+its rate scales, a positioning axis's Coulomb fit (its rigid limit, a start for the other
+friction links) and the refinement on all records.  One :class:`EvaluationBudget` is charged
+by every model evaluation of them all (a run of the records, each column of a Jacobian's
+forward differences); a phase may be given a share of what is left
+(:meth:`EvaluationBudget.share`), and a refinement stopped where its share is spent ends at
+the best point it has evaluated (:func:`solve_within`).  Without a limit nothing is stopped:
+the searches and their numbers are what they are without a budget.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import OptimizeResult, least_squares
+
+__all__ = ["BudgetSpent", "EvaluationBudget", "solve_within"]
+
+
+class BudgetSpent(Exception):
+    """An evaluation the budget (or the running phase's share of it) has no room for.
+
+    Examples
+    --------
+    >>> budget = EvaluationBudget(2)
+    >>> budget.charge(2)
+    >>> try:
+    ...     budget.charge()
+    ... except BudgetSpent as exc:
+    ...     print(exc)
+    1 more model evaluations past the budget
+    """
+
+
+class EvaluationBudget:
+    """The model evaluations a search may use in all, and those it has used.
+
+    Parameters
+    ----------
+    limit : int, optional
+        The most evaluations in all; None: no limit (only counted).
+
+    Examples
+    --------
+    >>> budget = EvaluationBudget(10)
+    >>> budget.charge(3)
+    >>> with budget.share(4):          # a phase: at most 4 more
+    ...     budget.charge(4)
+    ...     try:
+    ...         budget.charge(1)
+    ...     except BudgetSpent:
+    ...         print("share spent")
+    share spent
+    >>> budget.used, budget.left
+    (7, 3)
+    """
+
+    def __init__(self, limit: int | None = None) -> None:
+        if limit is not None and not (isinstance(limit, int | np.integer) and limit >= 1):
+            raise ValueError(f"a budget of model evaluations is a whole number >= 1, got "
+                             f"{limit!r}")
+        self.limit = None if limit is None else int(limit)
+        self.used = 0
+        self._stop = self.limit
+
+    @property
+    def left(self) -> int | None:
+        """What the running phase may still use (None: no limit)."""
+        return None if self._stop is None else max(self._stop - self.used, 0)
+
+    def charge(self, n: int = 1) -> None:
+        """Count `n` evaluations about to run; :class:`BudgetSpent` if they do not fit."""
+        if self._stop is not None and self.used + n > self._stop:
+            raise BudgetSpent(f"{n} more model evaluations past the budget")
+        self.used += n
+
+    def plan_starts(self, n_fits: int, per_step: int, seeded: bool = False, runs: int = 0
+                    ) -> tuple[int, Iterator[int | None]]:
+        """A multi-start search's plan: of what is left, ``final`` evaluations kept for its
+        refinement (the comparison of its starts, two steps of `per_step` evaluations each
+        and its standard errors) and the shares of its `n_fits` fits on the starts in turn:
+        each an equal part of what the fits before it left of their half of the rest (a
+        third if `seeded`: another third for the Coulomb fit it also starts from); `runs`
+        more single evaluations among them (starts screened by one run each) are kept apart.
+
+        Raises ValueError, naming the least, if what is left is too small for one
+        evaluation of each start and the final steps.
+
+        Examples
+        --------
+        >>> budget = EvaluationBudget(100)
+        >>> final, shares = budget.plan_starts(4, 10)
+        >>> used = []
+        >>> for _ in range(4):         # each fit uses its whole share
+        ...     used.append(next(shares))
+        ...     budget.charge(used[-1])
+        >>> final, used, budget.left
+        (22, [9, 10, 10, 10], 61)
+        >>> try:
+        ...     EvaluationBudget(20).plan_starts(4, 10)
+        ... except ValueError as exc:
+        ...     print(str(exc)[:72])
+        a budget of 20 model evaluations is below the least this search needs, 3
+        """
+        final = 2 + 2 * per_step
+        least = runs + (3 if seeded else 2) * n_fits + final
+        left = self.left
+        if left is not None and left < least:
+            raise ValueError(f"a budget of {left} model evaluations is below the least this "
+                             f"search needs, {least} ({f'{runs} screening runs, ' if runs else ''}"
+                             f"two for each of its {n_fits} starts, "
+                             f"{'as many for the Coulomb fit it starts from, ' if seeded else ''}"
+                             f"{per_step} for each step of its refinement, two steps)")
+        return final, self._shares(n_fits, None if left is None else
+                                   runs + (left - final - runs) // (3 if seeded else 2))
+
+    def _shares(self, n: int, of: int | None) -> Iterator[int | None]:
+        end = None if of is None else self.used + of
+        for k in range(n, 0, -1):
+            yield None if end is None else max(end - self.used, 0) // k
+        while True:
+            yield None if end is None else 0
+
+    @contextmanager
+    def share(self, n: int | None) -> Iterator[None]:
+        """Inside the block at most `n` more evaluations (within what is left; None: all)."""
+        stop = self._stop
+        if n is not None and stop is not None:
+            self._stop = min(stop, self.used + max(int(n), 0))
+        try:
+            yield
+        finally:
+            self._stop = stop
+
+
+def solve_within(fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+                 x0: NDArray[np.float64], **kwargs) -> OptimizeResult:
+    """:func:`scipy.optimize.least_squares` of `fun` from `x0` (`kwargs` its options), ended
+    where a budget `fun` or the Jacobian charges is spent: then at the best point evaluated,
+    with ``status`` 0 (as on ``max_nfev``) and a message saying so.
+
+    Raises :class:`BudgetSpent` if not even `x0` could be evaluated.
+
+    Examples
+    --------
+    >>> budget = EvaluationBudget(5)
+    >>> def fun(x):
+    ...     budget.charge()
+    ...     return np.array([x[0] - 3.0, 0.1 * (x[0] - 3.0) ** 2])
+    >>> sol = solve_within(fun, np.array([0.0]))
+    >>> sol.status, budget.used, bool(abs(sol.x[0] - 3.0) < 3.0)
+    (0, 5, True)
+    """
+    best: list = [math.inf, None, 0]  # the least cost, its point, the calls of `fun`
+
+    def tracked(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        best[2] += 1
+        r = fun(x)
+        cost = float(np.dot(r, r))
+        if best[1] is None or cost < best[0]:
+            best[:2] = [cost, np.array(x, dtype=float)]
+        return r
+
+    try:
+        return least_squares(tracked, x0, **kwargs)
+    except BudgetSpent:
+        if best[1] is None:
+            raise
+        return OptimizeResult(x=best[1], cost=0.5 * best[0], status=0, success=False,
+                              nfev=best[2], message="The budget of model evaluations is spent.")
