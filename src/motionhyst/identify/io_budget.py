@@ -75,22 +75,62 @@ class EvaluationBudget:
         return None if self._stop is None else max(self._stop - self.used, 0)
 
     def charge(self, n: int = 1) -> None:
-        """Count `n` evaluations about to run; :class:`BudgetSpent` if they do not fit."""
+        """Count `n` evaluations about to run.
+
+        Parameters
+        ----------
+        n : int
+            The evaluations.
+
+        Raises
+        ------
+        BudgetSpent
+            If they do not fit in the budget or the running phase's share.
+
+        Examples
+        --------
+        >>> budget = EvaluationBudget()
+        >>> budget.charge(7)
+        >>> budget.used, budget.left
+        (7, None)
+        """
         if self._stop is not None and self.used + n > self._stop:
             raise BudgetSpent(f"{n} more model evaluations past the budget")
         self.used += n
 
     def plan_starts(self, n_fits: int, per_step: int, seeded: bool = False, runs: int = 0
                     ) -> tuple[int, Iterator[int | None]]:
-        """A multi-start search's plan: of what is left, ``final`` evaluations kept for its
-        refinement (the comparison of its starts, two steps of `per_step` evaluations each
-        and its standard errors) and the shares of its `n_fits` fits on the starts in turn:
-        each an equal part of what the fits before it left of their half of the rest (a
-        third if `seeded`: another third for the Coulomb fit it also starts from); `runs`
-        more single evaluations among them (starts screened by one run each) are kept apart.
+        """A multi-start search's plan: what it keeps for its refinement, and its starts'
+        shares.
 
-        Raises ValueError, naming the least, if what is left is too small for one
-        evaluation of each start and the final steps.
+        Parameters
+        ----------
+        n_fits : int
+            The fits on the starts (each refined on a short part of the records).
+        per_step : int
+            The evaluations of one step of the refinement (a run and its Jacobian's
+            forward differences, at most).
+        seeded : bool
+            The search also starts from a Coulomb fit (a positioning axis's friction
+            link): it takes a third of the rest, as the starts do.
+        runs : int
+            Single evaluations among the starts (starts screened by one run each).
+
+        Returns
+        -------
+        final : int
+            Evaluations kept for the refinement: the comparison of its starts, two steps
+            and its standard errors.
+        shares : iterator
+            The share of each fit on the starts in turn: an equal part of what the fits
+            before it left of the starts' part (half of the rest, a third if `seeded`,
+            with `runs`); None without a limit.
+
+        Raises
+        ------
+        ValueError
+            Naming the least, if what is left is too small for the screening runs, two
+            evaluations of each start (three if `seeded`) and the final steps.
 
         Examples
         --------
@@ -129,7 +169,22 @@ class EvaluationBudget:
 
     @contextmanager
     def share(self, n: int | None) -> Iterator[None]:
-        """Inside the block at most `n` more evaluations (within what is left; None: all)."""
+        """A phase: inside the block at most `n` more evaluations.
+
+        Parameters
+        ----------
+        n : int or None
+            The phase's share, within what is left (None: all that is left).
+
+        Examples
+        --------
+        >>> budget = EvaluationBudget(10)
+        >>> with budget.share(3):
+        ...     budget.left
+        3
+        >>> budget.left
+        10
+        """
         stop = self._stop
         if n is not None and stop is not None:
             self._stop = min(stop, self.used + max(int(n), 0))
@@ -141,11 +196,28 @@ class EvaluationBudget:
 
 def solve_within(fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                  x0: NDArray[np.float64], **kwargs) -> OptimizeResult:
-    """:func:`scipy.optimize.least_squares` of `fun` from `x0` (`kwargs` its options), ended
-    where a budget `fun` or the Jacobian charges is spent: then at the best point evaluated,
-    with ``status`` 0 (as on ``max_nfev``) and a message saying so.
+    """:func:`scipy.optimize.least_squares`, ended where the budget it charges is spent.
 
-    Raises :class:`BudgetSpent` if not even `x0` could be evaluated.
+    Parameters
+    ----------
+    fun : callable
+        The residuals of the search variables; it (or the Jacobian in `kwargs`) charges an
+        :class:`EvaluationBudget`.
+    x0 : ndarray
+        The start.
+    **kwargs
+        Options of :func:`scipy.optimize.least_squares`.
+
+    Returns
+    -------
+    OptimizeResult
+        least_squares' result; where the budget was spent, the best point evaluated, with
+        ``status`` 0 (as on ``max_nfev``) and a message saying so.
+
+    Raises
+    ------
+    BudgetSpent
+        If not even `x0` could be evaluated.
 
     Examples
     --------
