@@ -153,10 +153,12 @@ class EvaluationBudget:
         left = self.left
         if left is not None and left < least:
             raise ValueError(f"a budget of {left} model evaluations is below the least this "
-                             f"search needs, {least} ({f'{runs} screening runs, ' if runs else ''}"
-                             f"two for each of its {n_fits} starts, "
-                             f"{'as many for the Coulomb fit it starts from, ' if seeded else ''}"
-                             f"{per_step} for each step of its refinement, two steps)")
+                             f"search needs, {least}: "
+                             f"{f'{runs} to screen starts, ' if runs else ''}"
+                             f"{3 if seeded else 2} for each of its {n_fits} starts"
+                             f"{' (one for the Coulomb fit it also starts from)' if seeded else ''}"
+                             f", {per_step} for each of two steps of its refinement and 2 to "
+                             f"choose its start")
         return final, self._shares(n_fits, None if left is None else
                                    runs + (left - final - runs) // (3 if seeded else 2))
 
