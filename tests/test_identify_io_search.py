@@ -82,6 +82,7 @@ def _bouc_wen_record() -> IORecord:
     ("jenkins", "mass-damper", 40),        # starts, then the Coulomb fit it starts from
     ("lugre", "mass-damper", 80),          # and the profile of its rate scale
     ("maxwell-slip", "mass-damper", 60),
+    ("dahl", "mass-damper", 60),
     ("coulomb", "mass-damper", 30),        # forward differences
     ("bouc-wen", "mass-spring-damper", 120),   # the Bouc-Wen search with a mass
 ])

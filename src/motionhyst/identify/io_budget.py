@@ -206,9 +206,7 @@ def solve_within(fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
         The residuals of the search variables; it (or the Jacobian in `kwargs`) charges an
         :class:`EvaluationBudget`.
     x0 : ndarray
-        The start.
-    **kwargs
-        Options of :func:`scipy.optimize.least_squares`.
+        The start; the keyword arguments are least_squares' options.
 
     Returns
     -------
