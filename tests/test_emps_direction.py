@@ -1,8 +1,11 @@
 """identify on a positioning axis whose viscous friction differs by direction (EMPS: c+ 163,
-c- 240 N s/m) without --asymmetric: the records' inverse dynamics says so in one warning line
-naming c+ and c- (the symmetric fit's mass is biased); a symmetric axis gets no such line."""
+c- 240 N s/m): the records' inverse dynamics says so in one warning line naming c+ and c- (a
+symmetric fit's mass is biased), and by default the fit then has a coefficient per direction
+(--symmetric: one); a symmetric axis gets no such line and one coefficient."""
 
 from __future__ import annotations
+
+import json
 
 import numpy as np
 import pytest
@@ -59,3 +62,53 @@ def test_identify_warns_without_asymmetric(tmp_path, capsys, c_neg, asymmetric, 
     assert len(lines) == int(warned)
     if warned:
         assert "c+ " in lines[0] and "c- " in lines[0] and "--asymmetric" in lines[0]
+
+
+def _identify(tmp_path, capsys, rec, *options):
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="")
+    code = main(["identify", str(path), "--record", "input-output", "--plant", "mass-damper",
+                 "--model", "coulomb", "--json", *options])
+    out, err = capsys.readouterr()
+    return code, (json.loads(out) if code == 0 else None), err
+
+
+def test_identify_fits_viscous_friction_by_direction_where_the_records_show_it(tmp_path, capsys):
+    """The default on a mass-damper: the records' inverse dynamics shows two viscous
+    coefficients, so the fit has them (as --asymmetric) and says so in one line; --symmetric
+    fits one, with the warning that its mass is biased; a symmetric axis is fitted with one."""
+    code, fit, err = _identify(tmp_path, capsys, _axis_record(163.0, 240.0))
+    assert code == 0
+    lines = [line for line in err.splitlines() if "by direction" in line]
+    assert len(lines) == 1 and "fitted with one viscous coefficient per direction" in lines[0]
+    assert "--symmetric" in lines[0]
+    est = fit["estimates"]
+    assert est["c"] == pytest.approx(163.0, rel=0.01)
+    assert est["c"] + est["link.c_neg"] == pytest.approx(240.0, rel=0.01)
+    assert est["m"] == pytest.approx(95.0, rel=0.01)
+    code, fit, err = _identify(tmp_path, capsys, _axis_record(163.0, 240.0), "--symmetric")
+    assert code == 0 and "link.c_neg" not in fit["estimates"]
+    lines = [line for line in err.splitlines() if "by direction" in line]
+    assert len(lines) == 1 and "a fit with one viscous coefficient biases the mass" in lines[0]
+    code, fit, err = _identify(tmp_path, capsys, _axis_record(200.0, 200.0))
+    assert code == 0 and "by direction" not in err
+    assert not {"link.c_pos", "link.c_neg", "c_skew"} & set(fit["estimates"])
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    (["--asymmetric", "--symmetric"], "--asymmetric and --symmetric exclude each other"),
+    (["--symmetric", "--plant", "mass-spring-damper"], "--symmetric applies to --plant "
+                                                        "mass-damper"),
+])
+def test_symmetric_refusals(tmp_path, capsys, options, message):
+    rec = _axis_record(163.0, 240.0, n=500)
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="")
+    args = ["identify", str(path), "--record", "input-output", "--model", "coulomb", *options]
+    if "--plant" not in options:
+        args += ["--plant", "mass-damper"]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0]

@@ -63,7 +63,11 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records, --plant mass-damper, an element link: viscous "
                         "friction by direction (the stage's c_skew: c + c_skew forward, "
                         "c - c_skew backward; --model coulomb: its c_pos or c_neg on top of "
-                        "the stage's c)")
+                        "the stage's c); the default where the records' inverse dynamics "
+                        "shows it (said in a warning)")
+    q.add_argument("--symmetric", action="store_true",
+                   help="input-output records, --plant mass-damper: one viscous coefficient "
+                        "for both directions, even where the records show two")
     q.add_argument("--drift", action="store_true",
                    help="input-output records, --plant mass-damper: the force offset drifts "
                         "in time (a machine warming up): its rate [N/s] over the records' own "
@@ -106,6 +110,7 @@ def check_not_input_output(args: argparse.Namespace, closed_loop: bool = False) 
                           ("--from-rest", args.from_rest or None),
                           ("--init-window", args.init_window),
                           ("--asymmetric", args.asymmetric or None),
+                          ("--symmetric", args.symmetric or None),
                           ("--drift", args.drift or None)):
         if value is not None:
             raise UsageError(f"motionhyst identify: {option} applies to --record input-output "
@@ -156,6 +161,10 @@ def run_input_output(args: argparse.Namespace) -> int:
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
+    if args.asymmetric and args.symmetric:
+        raise UsageError("motionhyst identify: --asymmetric and --symmetric exclude each other")
+    if args.symmetric and plant != "mass-damper":
+        raise UsageError("motionhyst identify: --symmetric applies to --plant mass-damper")
     if args.asymmetric and plant != "mass-damper":
         raise UsageError("motionhyst identify: --asymmetric applies to --plant mass-damper")
     if args.asymmetric and args.periodic and model != "coulomb":
@@ -196,7 +205,8 @@ def run_input_output(args: argparse.Namespace) -> int:
               if bouc_wen_own else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
                "max_evaluations": args.max_evaluations, "init_window": args.init_window,
-               "asymmetric": args.asymmetric, "drift": args.drift,
+               "asymmetric": True if args.asymmetric else (False if args.symmetric else None),
+               "drift": args.drift,
                "fewer_elements": args.elements is None, "rigid_limit": True})
     from motionhyst.hysteresis import model_class
 
