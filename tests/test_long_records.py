@@ -15,7 +15,7 @@ from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.time import resample
 from motionhyst.time.bouc_wen_rk4 import simulate_bouc_wen
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop, simulate_elements
-from motionhyst.time.resample import block_samples, fine_blocks, fine_input
+from motionhyst.time.resample import block_samples, fine_blocks, fine_input, held_nodes
 
 FS = 1000.0
 
@@ -49,6 +49,9 @@ def test_a_record_of_whole_periods_is_interpolated_as_one():
     assert len(blocks) == 10
     whole = fine_input(u, 20, periodic=False)
     assert np.max(np.abs(_joined(blocks) - whole)) <= 1e-13 * np.max(np.abs(whole))
+    # what the memory check counts: a block and the upsampled period (with its index)
+    assert held_nodes(u, 20, nodes=20 * 1000) == blocks[0].size + 2 * 250 * 20
+    assert held_nodes(np.cumsum(u), 20, nodes=20 * 1000) == blocks[0].size
     u = np.tile(period[:143], 70)  # 10010 samples, 13 x 11 x 70: the windowed sinc, wrapped
     np.testing.assert_array_equal(_joined(list(fine_blocks(u, 20, nodes=20 * 1000))),
                                   fine_input(u, 20, periodic=False))
@@ -135,7 +138,7 @@ def test_predict_needs_the_record_and_one_block_not_the_whole_upsampled_record(t
     assert main([*base, "--out", str(tmp_path / "p.csv"), "--max-memory", "150M"]) == 0
     monkeypatch.setattr(resample, "BLOCK_NODES", 1 << 40)  # the whole record as one block
     assert main([*base, "--out", str(tmp_path / "q.csv"), "--max-memory", "150M"]) == 2
-    assert "8000 samples of 500 integration steps each needs 193 MB" in capsys.readouterr().err
+    assert "8000 samples of 500 integration steps each needs 192 MB" in capsys.readouterr().err
     assert main([*base, "--out", str(tmp_path / "q.csv")]) == 0
     p = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
     assert p.shape == (8000, 2) and np.ptp(p[:, 1]) > 1e-3

@@ -91,10 +91,10 @@ from motionhyst.time.periodic_runs import (
 from motionhyst.time.resample import SINC_HALF_WIDTH as SINC_HALF_WIDTH
 from motionhyst.time.resample import STAMP_TOLERANCE as STAMP_TOLERANCE
 from motionhyst.time.resample import (
-    block_samples,
     check_record,
     fine_blocks,
     fine_input,
+    held_nodes,
     sampling_rate,
 )
 from motionhyst.time.resample import is_periodic_record as is_periodic_record
@@ -283,7 +283,7 @@ class OpenLoop:
         r = substeps or self.default_substeps(fs)
         # a periodic run: the force at every integration step and midpoint of the period; a run
         # from a start: of one block at a time (time.resample.fine_blocks), and the record
-        fine = u.size * r if periodic else min(u.size, block_samples(r) + 1) * r
+        fine = u.size * r if periodic else held_nodes(u, r)
         check_memory(FINE_BYTES * fine + SAMPLE_BYTES * u.size, f"{u.size} samples of {r} "
                      f"integration steps each", "fewer samples or substeps")
         # the plant's viscous friction by direction is stepped with the link's elements, and so

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["BLOCK_NODES", "SINC_HALF_WIDTH", "STAMP_TOLERANCE", "block_samples", "check_record",
-           "check_whole_periods", "fine_blocks", "fine_input", "is_periodic_record",
+           "check_whole_periods", "fine_blocks", "fine_input", "held_nodes", "is_periodic_record",
            "sampling_rate", "upsample"]
 
 #: Half-width of the windowed-sinc interpolator of a record that is not periodic [samples].
@@ -293,6 +293,34 @@ def block_samples(factor: int, nodes: int | None = None) -> int:
     (104857, 256)
     """
     return max(256, int(BLOCK_NODES if nodes is None else nodes) // int(factor))
+
+
+def held_nodes(u: NDArray[np.float64], factor: int, nodes: int | None = None) -> int:
+    """Fine nodes :func:`fine_blocks` holds at once at most: a block's, and a record of whole
+    periods' upsampled period.
+
+    Parameters
+    ----------
+    u : ndarray
+        The record's samples.
+    factor : int
+        Fine samples per record sample.
+    nodes : int, optional
+        As for :func:`fine_blocks`.
+
+    Examples
+    --------
+    >>> held_nodes(np.arange(10.0), 20), held_nodes(np.arange(1e6), 20)
+    (181, 2097141)
+    >>> held_nodes(np.tile([0.0, 1.0, 0.5, 0.2], 25000), 20, nodes=100)   # 256-sample blocks
+    5281
+    """
+    x = np.asarray(u, dtype=float)
+    step = block_samples(factor, nodes)
+    block = (min(x.size - 1, step) * factor + 1) if x.size > 1 else x.size
+    p = is_periodic_record(x) if x.size - 1 > step and factor > 1 else None
+    period = p * factor if p is not None and _smooth_length(x.size) else 0
+    return block + 2 * period  # with the block's index into the period
 
 
 def check_whole_periods(u: NDArray[np.float64], name: str) -> None:
