@@ -293,9 +293,8 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
 
     def run(x0, s0, uf):
         # the masses and parameter count as tuples: compiled for their sizes (unrolled loops);
-        # no sensitivities: None, which removes their code from the compiled run
-        if mech.force_offset:  # the plant's constant force offset adds to the force
-            uf = uf + mech.force_offset
+        # no sensitivities: None, which removes their code from the compiled run; `uf` with
+        # the plant's constant force offset added
         return _rk4_run(uf, h, r, tuple(mech.mass), mech.C, mech.K,
                         tuple(tuple(row) for row in mech.dmass), mech.dC, mech.dK, mech.link,
                         mech.output, lp, x0, s0, True if sensitivities else None)
@@ -304,7 +303,7 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
         y, sy = np.empty(u.size), np.empty((u.size, p.size if sensitivities else 0))
         k = 0
         for uf in [upsampled] if upsampled is not None else fine_blocks(u, 2 * r):
-            yb, syb, x0, s0 = run(x0, s0, uf)
+            yb, syb, x0, s0 = run(x0, s0, uf + mech.force_offset if mech.force_offset else uf)
             first = 0 if k == 0 else 1  # a block's first output is the previous one's last
             y[k:k + yb.size - first] = yb[first:]
             if sensitivities:
@@ -312,6 +311,8 @@ def simulate_bouc_wen(p: NDArray[np.float64], u: NDArray[np.float64], fs: float,
             k += yb.size - first
         return y, sy
     uf = upsampled if upsampled is not None else fine_input(u, 2 * r, periodic)
+    if mech.force_offset:  # the plant's constant force offset adds to the force, once
+        uf = uf + mech.force_offset
     if isinstance(structure, MassSpringDamper):  # as ever: a negative c or k taken as 0
         mech_tau = structure.mechanics([p[0], max(p[1], 0.0), max(p[2], 0.0)])
     else:

@@ -311,6 +311,12 @@ class OpenLoop:
         return y
 
 
+def _with_offset(fine: NDArray[np.float64], mech: Mechanics) -> NDArray[np.float64]:
+    """The fine input with the plant's constant force offset added (contiguous floats)."""
+    fine = np.ascontiguousarray(fine, dtype=float)
+    return fine + mech.force_offset if mech.force_offset else fine
+
+
 def _check_converged(worst: int) -> None:
     if worst > MAX_FIXED_POINT_ITERATIONS:
         raise ValueError("the link's implicit step did not converge; use more substeps")
@@ -465,8 +471,6 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
             blocks, n_out = [fine], (fine.size - 1) // r + 1
         y, sy, k = np.empty(n_out), np.empty((n_out, sx.shape[1])), 0
         for a in blocks:
-            if mech.force_offset:  # the plant's constant force offset adds to the force
-                a = a + mech.force_offset
             Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(3), 1, stepping, a, state,
                                               vel_row=2, convention=OPEN, ftol=ftol,
                                               record_every=r, record_initial=k == 0,
@@ -484,11 +488,10 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
             raise ValueError(f"the initial state has {x.size} values; the plant has {ns}")
     if not periodic:
         blocks = [upsampled] if upsampled is not None else fine_blocks(u, r)
-        y, sy, *_ = run(x, s, sx, ss, blocks=(np.ascontiguousarray(b, dtype=float)
-                                              for b in blocks), n_out=u.size)
+        y, sy, *_ = run(x, s, sx, ss, blocks=(_with_offset(b, mech) for b in blocks),
+                        n_out=u.size)
         return y, sy
-    fine = np.ascontiguousarray(upsampled if upsampled is not None
-                                else fine_input(u, r, periodic), dtype=float)
+    fine = _with_offset(upsampled if upsampled is not None else fine_input(u, r, periodic), mech)
     most = max_periods(mech, k_link, u.size / fs)
     most = most if periods is None else min(most, int(periods))
     if (shooting and np.all(np.isin(stepping.codes, DIFFERENTIATED))
