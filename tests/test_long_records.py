@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from motionhyst.cli import main
+from motionhyst.core.budget import BudgetError, parse_size, set_max_memory
 from motionhyst.hysteresis import BoucWen, Coulomb, Dahl, Jenkins, LuGre, MaxwellSlip
 from motionhyst.identify.io_predict import predict_from_window
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.plants.two_mass import TwoMassStage
-from motionhyst.time import resample
+from motionhyst.time import openloop, resample
 from motionhyst.time.bouc_wen_rk4 import simulate_bouc_wen
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop, simulate_elements
 from motionhyst.time.resample import block_samples, fine_blocks, fine_input, held_nodes
@@ -116,11 +117,31 @@ def test_a_prediction_from_a_window_in_blocks_is_the_same(monkeypatch):
     u = _force(3000)
     t = np.arange(u.size) / FS
     y = system.simulate(t, u).displacement + 0.01
+    monkeypatch.setattr(resample, "BLOCK_NODES", 1 << 40)  # the whole record as one block
     whole = predict_from_window(system, t, u, y)
-    monkeypatch.setattr(resample, "BLOCK_NODES", 1)
+    seen = []
+    blocks_of = resample.fine_blocks
+
+    def counted(*args, **kwargs):
+        for b in blocks_of(*args, **kwargs):
+            seen.append(b.size)
+            yield b
+
+    monkeypatch.setattr(resample, "BLOCK_NODES", 1)  # blocks of 256 samples
+    monkeypatch.setattr(openloop, "fine_blocks", counted)
     blocks = predict_from_window(system, t, u, y)
+    assert len(seen) == -(-2999 // 256)  # the run went through the record in blocks
     np.testing.assert_array_equal(blocks.displacement, whole.displacement)
     assert whole.rmse < 1e-9
+    monkeypatch.setattr(resample, "BLOCK_NODES", 1 << 40)
+    set_max_memory(parse_size("10M"))
+    try:
+        with pytest.raises(BudgetError, match="3000 samples of 200 integration steps each"):
+            predict_from_window(system, t, u, y, substeps=200)  # 29 MB at once
+        monkeypatch.setattr(resample, "BLOCK_NODES", 1)
+        predict_from_window(system, t, u, y, substeps=200)  # 256-sample blocks: 2.7 MB
+    finally:
+        set_max_memory(None)
 
 
 def test_predict_needs_the_record_and_one_block_not_the_whole_upsampled_record(tmp_path,

@@ -19,9 +19,17 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from motionhyst.core.budget import check_memory
 from motionhyst.hysteresis.stepping import Stepping
-from motionhyst.time.openloop import OpenLoop, check_record, sampling_rate, simulate_elements
-from motionhyst.time.resample import fine_input
+from motionhyst.time.openloop import (
+    FINE_BYTES,
+    SAMPLE_BYTES,
+    OpenLoop,
+    check_record,
+    sampling_rate,
+    simulate_elements,
+)
+from motionhyst.time.resample import fine_blocks, held_nodes
 
 __all__ = ["INIT_WINDOW", "WindowPrediction", "predict_from_window", "run_from_state",
            "state_from_window"]
@@ -177,7 +185,8 @@ def state_from_window(mech, stepping: Stepping, k_link: float, u, y, fs: float, 
         Samples that set the state, at least 2.
     upsampled : ndarray, optional
         The record's force upsampled for its run (``fine_input(u, r, False)``, as
-        :func:`run_from_state` takes it), if already computed.
+        :func:`run_from_state` takes it), if already computed (default: the head of its
+        first block, :func:`~motionhyst.time.resample.fine_blocks`).
 
     Returns
     -------
@@ -195,8 +204,8 @@ def state_from_window(mech, stepping: Stepping, k_link: float, u, y, fs: float, 
     """
     yw = np.asarray(y[:window], dtype=float)
     uw = np.asarray(u[:window], dtype=float)
-    if upsampled is None:
-        upsampled = fine_input(np.asarray(u, dtype=float), r, False)
+    if upsampled is None:  # the head of the record's first block: that of the whole record
+        upsampled = next(fine_blocks(np.asarray(u, dtype=float), r))
     fine = np.asarray(upsampled[:(window - 1) * r + 1], dtype=float)
     v_start = (yw[-1] - yw[0]) * fs / (window - 1)
     scale_y = max(float(np.ptp(yw)), 1e-12 * max(1.0, abs(float(yw[0]))), 1e-15)
@@ -273,9 +282,11 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     mech = system.plant.mechanics()
     st = Stepping.empty() if system.hysteresis is None else system.hysteresis.time_stepping()
     k_link = system.hysteresis.initial_stiffness if system.hysteresis is not None else 0.0
-    fine = fine_input(u, r, False)
-    position, velocity = state_from_window(mech, st, k_link, u, y, fs, r, window, fine)
-    yhat, _ = run_from_state(mech, st, k_link, u, fs, r, position, velocity, fine)
+    # the record's force in blocks (time.resample.fine_blocks), as OpenLoop.simulate runs it
+    check_memory(FINE_BYTES * held_nodes(u, r) + SAMPLE_BYTES * u.size,
+                 f"{u.size} samples of {r} integration steps each", "fewer samples or substeps")
+    position, velocity = state_from_window(mech, st, k_link, u, y, fs, r, window)
+    yhat, _ = run_from_state(mech, st, k_link, u, fs, r, position, velocity)
     return _scored(tt, yhat, y, window, position, velocity)
 
 

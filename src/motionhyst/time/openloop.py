@@ -52,8 +52,9 @@ Periodic runs repeat the period until the output settles
 (:mod:`motionhyst.time.periodic_runs`).  A run from a start goes through the
 record in blocks (:func:`~motionhyst.time.resample.fine_blocks`), its state
 carried from one block to the next, with the numbers of one run over the whole
-upsampled record: its memory is the record's and one block's, whatever its
-length.
+upsampled record (bit for bit; to rounding for a record of whole periods longer
+than a block, upsampled from its period): its memory is the record's and one
+block's, whatever its length.
 """
 
 from __future__ import annotations
