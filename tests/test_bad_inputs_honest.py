@@ -58,12 +58,33 @@ def _declaring(n: int, **variables):
     return make
 
 
+def _closed_loop(kind: str, n: int = 6000) -> str:
+    """A closed-loop record (time,y1,u at 2 kHz) whose columns are not one loop's: `kind`
+    "noise" (y1 white noise under a sine force), "other" (y1 a sine of another frequency)
+    or "u-noise" (u white noise, y1 a sine)."""
+    rng = np.random.default_rng(1)
+    t = np.arange(n) / 2000.0
+    sine = np.sin(2 * np.pi * 2.0 * t)
+    y1, u = {"noise": (1e-4 * rng.standard_normal(n), 30 * sine),
+             "other": (0.01 * np.sin(2 * np.pi * 3.1 * t + 0.3), 30 * sine),
+             "u-noise": (0.01 * sine, 30 * rng.standard_normal(n))}[kind]
+    return _csv({"time": t, "y1": y1, "u": u})
+
+
+def _force_noise(n: int = 6000) -> str:
+    """A force-displacement record whose force is white noise under a sine displacement."""
+    t = np.arange(n) / FS
+    force = np.random.default_rng(5).standard_normal(n)
+    return _csv({"time": t, "displacement": 0.01 * np.sin(5 * t), "force": force})
+
+
 def _link(path) -> None:
     """A symbolic link ``l.csv`` beside `path` pointing to ``a.csv``."""
     path.symlink_to("a.csv")
 
 
 IO = ["--record", "input-output"]
+CLOSED = ["identify", "c.csv", "--scenario", "paper.toml"]
 PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
 ZEROS = np.zeros((1000, 1))
 CELL = np.empty((1, 1), dtype=object)
@@ -84,6 +105,19 @@ CASES = [
      ["identify: a.csv and b.csv hold the same record byte for byte: " + TWICE]),
     ("record-copied-force-displacement", {"b.csv": _axis()},
      ["identify", "a.csv", "b.csv", "--model", "dahl"], ["a.csv and b.csv hold the same"]),
+    # ------------- records that determine nothing: refused before any fit, not fitted to noise
+    ("closed-loop-y1-noise", {"c.csv": _closed_loop("noise")}, CLOSED,
+     ["c.csv: y1 does not follow u: their coherence where they have power is 0.0",
+      "nothing identified"]),
+    ("closed-loop-y1-another-sine", {"c.csv": _closed_loop("other")}, CLOSED,
+     ["c.csv: y1 does not follow u"]),
+    ("closed-loop-u-noise", {"c.csv": _closed_loop("u-noise")}, CLOSED,
+     ["c.csv: y1 does not follow u"]),
+    ("force-displacement-force-noise", {"f.csv": _force_noise()}, ["identify", "f.csv"],
+     ["f.csv: no hysteresis in the record", "nothing identified"]),
+    ("force-displacement-force-noise-model", {"f.csv": _force_noise()},
+     ["identify", "f.csv", "--model", "dahl"],
+     ["f.csv: the records show no stiffness (the position does not follow the force)"]),
     # --------------------- errors in a CSV's first data rows: decided before pandas loads
     ("csv-units-row", {"r.csv": "time,force\ns,N\n0,1\n0.001,2\n"},
      ["predict", "axis.toml", "r.csv", "--out", "p.csv"],
@@ -125,9 +159,12 @@ def test_the_cases_are_distinct():
 @pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
                          ids=[c[0] for c in CASES])
 def test_a_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv, words):
+    from motionhyst.scenario import default_scenario_path
+
     root = tmp_path / "user"
     root.mkdir()
-    populate(root, {**BASE, **{k: v for k, v in files.items() if not callable(v)}})
+    populate(root, {**BASE, "paper.toml": default_scenario_path().read_text(),
+                    **{k: v for k, v in files.items() if not callable(v)}})
     for name, make in files.items():
         if callable(make):
             (root / name).parent.mkdir(parents=True, exist_ok=True)
@@ -211,3 +248,67 @@ def test_a_csv_whose_first_rows_are_refused_does_not_load_pandas(tmp_path, text,
     if refused is not False:
         assert "r.csv: " in out[0] and ("line 2" in out[0] or "line 3" in out[0]), out
 
+
+@pytest.mark.parametrize(("link", "amplitudes"), [
+    ({"k": [10.0, 6.0], "fc": [0.01, 0.03]}, (0.005, 0.002, 0.001)),
+    ({"k": [1e5], "fc": [50.0]}, (0.005, 0.002, 0.001)),   # a link force as large as u's
+    ({"k": [1e4], "fc": [20.0]}, (0.0005, 0.0, 0.0)),       # held by the link, mostly
+])
+def test_a_loops_position_follows_its_force_with_a_wide_margin(link, amplitudes):
+    """The closed-loop check's coherence on the paper's loop (multisine 0.5-11 Hz, 1e-5 m
+    of encoder noise) is well above its threshold, and a noise column well below."""
+    from motionhyst import Loop, MaxwellSlip, SampledReference, default_scenario, simulate
+    from motionhyst.identify.coherence import MIN_COHERENCE, band_coherence
+
+    sc = default_scenario()
+    t = np.arange(0.0, 3.0, 1e-3)
+    r = sum(a * np.sin(2 * np.pi * f * t) for a, f in zip(amplitudes, (0.5, 3.3, 11.0),
+                                                          strict=True))
+    sim = simulate(Loop(sc.plant(), sc.controller(), MaxwellSlip(**link)),
+                   SampledReference(t, r), 3.0, dt=5e-4)
+    rng = np.random.default_rng(0)
+    y1 = sim.y1 + 1e-5 * rng.standard_normal(sim.t.size)
+    assert band_coherence(sim.u, y1, 2000.0) > 2 * MIN_COHERENCE
+    assert band_coherence(sim.u, rng.permutation(y1), 2000.0) < MIN_COHERENCE / 2
+
+
+@pytest.fixture(scope="module")
+def loop_record() -> dict[str, np.ndarray]:
+    """A closed-loop record of the paper's loop with a two-element link (3 s of a 2 Hz
+    sine, 5 kHz)."""
+    from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+
+    sc = default_scenario()
+    loop = Loop(sc.plant(), sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    sim = simulate(loop, SineReference(0.01, 2.0), 3.0, dt=2e-4)
+    return {"time": sim.t, "y1": sim.y1, "u": sim.u}
+
+
+@pytest.mark.parametrize(("mistake", "words"), [
+    ("none", None),
+    ("y1-in-mm", "fc/k = 10 m against y1's half-range 10 m"),
+    ("columns-swapped", "the link force inferred through the plant follows y1 as a spring's"),
+])
+def test_a_closed_loop_record_whose_link_shows_no_hysteresis_is_refused(tmp_path, loop_record,
+                                                                        mistake, words):
+    """y1 in mm, or u and y1 swapped, passed the coherence check (one loop's signals) and
+    were fitted: a spring k = M w^2 (the sine's inertia) whose slip force was 2.2e5 +- 5e7 N
+    or slipped only at the stroke's end; exit 0.  No element that both slips and has a
+    determined slip force: refused."""
+    from motionhyst.scenario import default_scenario_path
+
+    record = dict(loop_record)
+    if mistake == "y1-in-mm":
+        record["y1"] = 1000 * record["y1"]
+    elif mistake == "columns-swapped":
+        record["y1"], record["u"] = record["u"], record["y1"]
+    (tmp_path / "c.csv").write_text(_csv(record))
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    argv = ["identify", "c.csv", "--scenario", "paper.toml"]
+    if words is None:
+        code, out, err = limited_process.run(argv, tmp_path)
+        assert code == 0 and "elements: 2" in out, err
+    else:
+        line = limited_process.refusal(argv, tmp_path)
+        assert "c.csv: no hysteresis in the record: no element both slips" in line, line
+        assert words in line and "nothing identified" in line, line

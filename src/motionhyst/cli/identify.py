@@ -190,6 +190,12 @@ def run(args: argparse.Namespace) -> int:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
+        from motionhyst.identify.coherence import check_follows
+
+        try:  # before the loop's plant is built: a record of nothing is refused at once
+            check_follows(t, y1, u)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
     share = 0.0  # a force-displacement fit's systematic error, as a share of the force's RMS
     if kind == "force-displacement":
         if args.elements is None or target is not None:  # refused, not reported: at once
@@ -237,6 +243,7 @@ def run(args: argparse.Namespace) -> int:
                                              **options)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+        _check_slips(path, ident, y1)
         what = (f"closed-loop record, plant of {sc.source}, prefilter cut-off "
                 f"{g(ident.cutoff_hz)} Hz"
                 + ("" if ctrl is None else f", the force held by the controller at "
@@ -414,6 +421,33 @@ def _check_determined(path: Path, ident, x, w) -> None:
             f"displacement as a spring's, or is noise, and a slip force would be a guess; "
             f"nothing identified (a record whose displacement makes the link slip, a larger "
             f"amplitude, may)")
+
+
+def _check_slips(path: Path, ident, y1) -> None:
+    """No answer from a closed-loop record whose inferred link force shows no hysteresis:
+    when no element both slips in the record (its slip displacement fc/k short of half the
+    range of y1) and has a slip force the record determines (its standard error below the
+    value), the elements are a spring or noise: the inferred force follows y1 as a spring's
+    (y1 not in metres, columns swapped, a plant that is not the record's), or is noise."""
+    import numpy as np
+
+    half = 0.5 * float(np.ptp(y1))
+    shown = [e for e in ident.elements
+             if e["fc"] / e["k"] < SLIP_SHARE * half and e["fc_std"] < e["fc"]]
+    if not shown:
+        e = min(ident.elements, key=lambda e: e["fc"] / e["k"])
+        raise ValueError(
+            f"{path}: no hysteresis in the record: no element both slips in it and has a slip "
+            f"force the record determines (the smallest slip displacement fitted, fc/k = "
+            f"{g(e['fc'] / e['k'])} m against y1's half-range {g(half)} m; fc {g(e['fc'])} +- "
+            f"{g(e['fc_std'])} N): the link force inferred through the plant follows y1 as a "
+            f"spring's, or is noise (y1 not in metres? u and y1 swapped? the plant not the "
+            f"record's?); nothing identified")
+
+
+SLIP_SHARE = 0.99
+"""An element slips in a record when its slip displacement fc/k is short of this share of
+half the record's displacement range (one at the range's end is a spring there)."""
 
 
 def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
