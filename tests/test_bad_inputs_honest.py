@@ -249,6 +249,54 @@ def test_a_csv_whose_first_rows_are_refused_does_not_load_pandas(tmp_path, text,
         assert "r.csv: " in out[0] and ("line 2" in out[0] or "line 3" in out[0]), out
 
 
+STUDY = ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\namplitude = [0.001]\n'
+         'frequency_hz = [2.0, 5.0]\n')
+
+
+def _dead_pid() -> int:
+    """The id of a process that has ended."""
+    import subprocess
+
+    proc = subprocess.Popen(["true"])
+    proc.wait()
+    return proc.pid
+
+
+@pytest.mark.parametrize("killed", ["building", "swapping"])
+@pytest.mark.parametrize("next_command", ["study", "predict"])
+def test_what_a_killed_study_left_beside_its_store_is_cleaned_by_the_next_writer(
+        tmp_path, killed, next_command):
+    """``study --force`` builds the new store as ``.NAME.motionhyst-PID-new`` and moves the
+    old aside as ``.NAME.motionhyst-PID-old`` for the swap: a SIGKILL in between left them
+    (the next run did not see them).  The next command writing in that folder removes the new
+    one and, if the store's name is missing, puts the old store back."""
+    import shutil
+
+    from motionhyst.scenario import default_scenario_path
+
+    shutil.copy(default_scenario_path(), tmp_path / "paper.toml")
+    (tmp_path / "study.toml").write_text(STUDY)
+    (tmp_path / "axis.toml").write_text(AXIS)
+    (tmp_path / "r.csv").write_text(_axis()[:2000].rsplit("\n", 1)[0] + "\n")
+    run = ["study", "study.toml", "--out", "s.zarr", "--workers", "0"]
+    code, _, err = limited_process.run(run, tmp_path, limited_process.RUN_LIMIT)
+    assert code == 0, err
+    store = snapshot(tmp_path / "s.zarr")
+    pid = _dead_pid()
+    new, old = (tmp_path / f".s.zarr.motionhyst-{pid}-{end}" for end in ("new", "old"))
+    shutil.copytree(tmp_path / "s.zarr", new)  # a store half built
+    if killed == "swapping":  # the old store moved aside, the new one not yet in its place
+        (tmp_path / "s.zarr").rename(old)
+    argv = run if next_command == "study" else ["predict", "axis.toml", "r.csv", "--out",
+                                                "p.csv", "--columns", "time=time,force=force"]
+    code, out, err = limited_process.run(argv, tmp_path, limited_process.RUN_LIMIT)
+    assert code == 0, err
+    assert not new.exists() and not old.exists()
+    assert snapshot(tmp_path / "s.zarr") == store  # put back as it was (then resumed)
+    if next_command == "study":
+        assert "2 points: 0 computed" in out, out  # resumed: the old store's points stand
+
+
 @pytest.mark.parametrize(("link", "amplitudes"), [
     ({"k": [10.0, 6.0], "fc": [0.01, 0.03]}, (0.005, 0.002, 0.001)),
     ({"k": [1e5], "fc": [50.0]}, (0.005, 0.002, 0.001)),   # a link force as large as u's

@@ -2,10 +2,13 @@
 
 A writer (:mod:`motionhyst.io.outputs`) names its temporary file
 ``.NAME.motionhyst-PID-XXXX.part`` only for the instant before it replaces its target; a
-command that draws figures in worker processes does so in a scratch folder
-``PREFIX-PID-XXXX`` of the system's temporary folder.  A process killed meanwhile
-(``SIGKILL``, a power cut) cannot remove them: the next writer in that folder, or the next
-scratch folder of that prefix, removes those of processes that no longer run.
+store replaced with ``--force`` (:mod:`motionhyst.study`) is built beside it as
+``.NAME.motionhyst-PID-new`` and the old one moved aside as ``.NAME.motionhyst-PID-old``
+for the instant of the swap; a command that draws figures in worker processes does so in a
+scratch folder ``PREFIX-PID-XXXX`` of the system's temporary folder.  A process killed
+meanwhile (``SIGKILL``, a power cut) cannot remove them: the next writer in that folder, or
+the next scratch folder of that prefix, removes those of processes that no longer run (an
+old store whose replacement never took its name is put back in its place).
 
 Examples
 --------
@@ -27,6 +30,7 @@ import tempfile
 __all__ = ["clean_stale", "scratch_folder"]
 
 _STALE = re.compile(r"\..+\.motionhyst-(\d+)-[A-Za-z0-9_]+\.part")
+_BESIDE = re.compile(r"\.(.+)\.motionhyst-(\d+)-(new|old)")
 
 
 def _alive(pid: int) -> bool:
@@ -43,9 +47,12 @@ def clean_stale(folder: str | os.PathLike) -> list[str]:
     """Remove the temporary files of writers in `folder` whose process no longer runs.
 
     Only names this module gives its temporary files
-    (``.NAME.motionhyst-PID-XXXX.part``) whose process ``PID`` has ended:
-    what a writer killed (``SIGKILL``, a power cut) between naming its file
-    and moving it into place left behind.
+    (``.NAME.motionhyst-PID-XXXX.part``) and folders built beside their target
+    (``.NAME.motionhyst-PID-new``, ``.NAME.motionhyst-PID-old``) whose process
+    ``PID`` has ended: what a writer killed (``SIGKILL``, a power cut) between
+    naming them and moving them into place left behind.  An ``-old`` folder
+    (or link) whose ``NAME`` is missing is the one replaced when the writer was
+    killed before the new one took its name: it is put back as ``NAME``.
 
     Parameters
     ----------
@@ -55,7 +62,7 @@ def clean_stale(folder: str | os.PathLike) -> list[str]:
     Returns
     -------
     list of str
-        The names removed.
+        The names removed (or put back).
 
     Examples
     --------
@@ -75,6 +82,17 @@ def clean_stale(folder: str | os.PathLike) -> list[str]:
         if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
             with contextlib.suppress(OSError):
                 os.unlink(os.path.join(folder, name))
+                removed.append(name)
+        m = _BESIDE.fullmatch(name)
+        if m and int(m.group(2)) != os.getpid() and not _alive(int(m.group(2))):
+            path, target = (os.path.join(folder, n) for n in (name, m.group(1)))
+            with contextlib.suppress(OSError):
+                if m.group(3) == "old" and not os.path.lexists(target):
+                    os.rename(path, target)  # its replacement never took the name
+                elif os.path.islink(path) or not os.path.isdir(path):
+                    os.unlink(path)  # a link replaced: never what it points to
+                else:
+                    shutil.rmtree(path)
                 removed.append(name)
     return removed
 

@@ -269,7 +269,11 @@ def estimate_study(study: StudyDefinition, workers: int = 1,
 def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStore | None:
     """The store at `path` if it holds `study` (resumed), None if a new one is to be made
     there; raises before anything is changed if `path` may not be replaced.  A symbolic
-    link is never followed: with `force` the link itself is replaced by the new store."""
+    link is never followed: with `force` the link itself is replaced by the new store.  What a
+    killed run left beside it is cleaned first (a store it was replacing put back)."""
+    from motionhyst.io.leftovers import clean_stale
+
+    clean_stale(path.parent)
     if path.is_symlink():
         if not force:
             raise StudyError(f"--out {path} is a symbolic link; give the folder it points to, "
