@@ -12,9 +12,9 @@ from pathlib import Path
 
 
 def populate(root: Path, files: dict) -> None:
-    """Write `files` under `root`: ``{name: text or bytes}``; ``"@symlink:NAME": target`` makes a
-    symbolic link, ``"@hard:NAME": existing name`` a hard link, ``"@fifo:NAME": None`` a named
-    pipe."""
+    """Write `files` under `root`: ``{name: text or bytes}``, or a maker ``{name: make}`` that
+    writes the file (``make(path)``); ``"@symlink:NAME": target`` makes a symbolic link,
+    ``"@hard:NAME": existing name`` a hard link, ``"@fifo:NAME": None`` a named pipe."""
     for name, content in files.items():
         if name.startswith("@"):
             kind, link = name[1:].split(":")
@@ -27,7 +27,9 @@ def populate(root: Path, files: dict) -> None:
             continue
         path = root / name
         path.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
+        if callable(content):
+            content(path)
+        elif isinstance(content, bytes):
             path.write_bytes(content)
         else:
             path.write_text(content)

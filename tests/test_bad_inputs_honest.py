@@ -78,11 +78,6 @@ def _force_noise(n: int = 6000) -> str:
     return _csv({"time": t, "displacement": 0.01 * np.sin(5 * t), "force": force})
 
 
-def _link(path) -> None:
-    """A symbolic link ``l.csv`` beside `path` pointing to ``a.csv``."""
-    path.symlink_to("a.csv")
-
-
 IO = ["--record", "input-output"]
 CLOSED = ["identify", "c.csv", "--scenario", "paper.toml"]
 PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
@@ -93,13 +88,13 @@ AXIS = ('[stage]\ntype = "mass-damper"\nm = 2.0\nc = 10.0\n\n'
         '[hysteresis]\nmodel = "jenkins"\nk = 2e4\nfc = 4.0\n')
 TWICE = "a record given twice counts its samples twice (standard errors too small)"
 
-# (id, extra files, argv, words of the one line on stderr); a file given as a callable is
-# made by it (path) -> None
+# (id, extra files as file_trees.populate takes them, argv, words of the one line on stderr)
 CASES = [
     # ------------------------ one record given twice: its standard errors sqrt(2) too small
     ("record-given-twice", {}, ["identify", "a.csv", "a.csv", *IO],
      ["identify: a.csv is given twice: " + TWICE]),
-    ("record-twice-through-a-link", {"l.csv": _link}, ["identify", "a.csv", "l.csv", *IO],
+    ("record-twice-through-a-link", {"@symlink:l.csv": "a.csv"},
+     ["identify", "a.csv", "l.csv", *IO],
      ["identify: a.csv and l.csv are the same file: " + TWICE]),
     ("record-copied", {"b.csv": _axis()}, ["identify", "a.csv", "b.csv", *IO],
      ["identify: a.csv and b.csv hold the same record byte for byte: " + TWICE]),
@@ -163,12 +158,7 @@ def test_a_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv, w
 
     root = tmp_path / "user"
     root.mkdir()
-    populate(root, {**BASE, "paper.toml": default_scenario_path().read_text(),
-                    **{k: v for k, v in files.items() if not callable(v)}})
-    for name, make in files.items():
-        if callable(make):
-            (root / name).parent.mkdir(parents=True, exist_ok=True)
-            make(root / name)
+    populate(root, {**BASE, "paper.toml": default_scenario_path().read_text(), **files})
     before = snapshot(root)
     line = limited_process.refusal(list(argv), root)
     for word in words:
