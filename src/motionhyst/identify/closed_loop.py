@@ -177,7 +177,13 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         cutoff_hz = min(20.0 * f0, fs / 20.0)
     cutoff_hz = float(cutoff_hz)
     if not (np.isfinite(cutoff_hz) and 0 < cutoff_hz < fs / 2):
-        raise ValueError(f"cutoff_hz must be in (0, {fs / 2:g}) Hz, got {cutoff_hz!r}")
+        raise ValueError(f"cutoff_hz must be in (0, {fs / 2:g}) Hz, below half the record's "
+                         f"sampling rate (the prefilter's cut-off, --cutoff), got {cutoff_hz:g}")
+    settle = int(np.searchsorted(ts - ts[0], SETTLE_PERIODS / cutoff_hz))
+    if ts.size - settle < MIN_SAMPLES:  # known before the filters run
+        raise ValueError(f"too short: the prefilter settles in {SETTLE_PERIODS / cutoff_hz:.3g} "
+                         f"s, leaving {max(ts.size - settle, 0)} samples; record longer or "
+                         "raise the prefilter's cut-off (cutoff_hz, --cutoff)")
     wl = TWO_PI * cutoff_hz
     order = den.size - 1 + EXTRA_ORDER
     zb, pb, kb = butter(order, wl, analog=True, output="zpk")
@@ -195,11 +201,6 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     else:
         Lu = L(us)
     w_f = Lu - L_over_P1(ys - ys[0])
-    settle = int(np.searchsorted(ts - ts[0], SETTLE_PERIODS / cutoff_hz))
-    if ts.size - settle < MIN_SAMPLES:
-        raise ValueError(f"too short: the prefilter settles in {SETTLE_PERIODS / cutoff_hz:.3g} "
-                         f"s, leaving {max(ts.size - settle, 0)} samples; record longer or "
-                         "raise cutoff_hz")
     return LinkForce(t=ts, y1=ys, w=w_f, lowpass=L, cutoff_hz=cutoff_hz, settle_index=settle)
 
 
