@@ -71,6 +71,15 @@ def _closed_loop(kind: str, n: int = 6000) -> str:
     return _csv({"time": t, "y1": y1, "u": u})
 
 
+def _paper(old: str, new: str) -> str:
+    """The paper's scenario with one value changed."""
+    from motionhyst.scenario import default_scenario_path
+
+    text = default_scenario_path().read_text()
+    assert old in text
+    return text.replace(old, new)
+
+
 def _force_noise(n: int = 6000) -> str:
     """A force-displacement record whose force is white noise under a sine displacement."""
     t = np.arange(n) / FS
@@ -113,6 +122,13 @@ CASES = [
     ("force-displacement-force-noise-model", {"f.csv": _force_noise()},
      ["identify", "f.csv", "--model", "dahl"],
      ["f.csv: the records show no stiffness (the position does not follow the force)"]),
+    # ---------------- a scenario's unit slip: the loop's pole, not the setpoint, sets the step
+    ("scan-actuated-mass-of-a-nanogram", {"s.toml": _paper("m1 = 5.0", "m1 = 1e-9")},
+     ["scan", "s.toml", "--length", "0.1", "--speed", "0.1", "--a-max", "10", "--j-max",
+      "1000", "--s-max", "1e5", "--compensation", "none"],
+     ["time steps of 1.75e-12 s: too many; the step resolves the loop's fastest closed-loop "
+      "pole, 1.432e+10 Hz (beyond a motion stage's 1e+05 Hz: are s.toml's [stage] and "
+      "[controller] values in SI units?); shorten the setpoint"]),
     # --------------------- errors in a CSV's first data rows: decided before pandas loads
     ("csv-units-row", {"r.csv": "time,force\ns,N\n0,1\n0.001,2\n"},
      ["predict", "axis.toml", "r.csv", "--out", "p.csv"],

@@ -11,6 +11,7 @@ import math
 
 from motionhyst.cli._common import (
     UsageError,
+    g,
     nonnegative,
     positive,
     print_json,
@@ -23,6 +24,11 @@ from motionhyst.cli._common import (
 __all__ = []
 
 PROG = "motionhyst scan"
+
+PLAUSIBLE_POLE_HZ = 1e5
+"""Fastest closed-loop pole of a motion stage's loop [Hz] (its bandwidth is some 100 Hz, its
+internal modes some kHz): beyond, a scan refused for its size asks whether the scenario's
+values are in SI units."""
 LEAD_IN = 0.01
 """Rest before the setpoint starts [s]: room for the learned force to act ahead of it."""
 
@@ -186,7 +192,7 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
     loop's own where its coefficients give its poles (:func:`pole_step`; an unstable loop
     is refused there), else at most the sampled controller's period or the setpoint's
     (:func:`longest_step`)."""
-    from motionhyst.time.steps import check_scan_steps, longest_step, pole_step
+    from motionhyst.time.steps import SCAN_REMEDY, check_scan_steps, longest_step, pole_step
 
     controller = sc.model.controller
     if controller is None:  # no loop: the scenario's own refusal comes first
@@ -198,7 +204,16 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
         if p is not None:
             step = (longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
                     if pole is None else pole_step(pole, p.max_frequency_hz))
-            check_scan_steps(p.end + args.tail, step, runs, at_least=pole is None)
+            remedy = SCAN_REMEDY
+            if pole is not None and step < 0.999 * longest_step(p.max_frequency_hz):
+                # the loop's own pole sets the step: said, and beyond a motion stage's poles
+                # a unit slip in the scenario is likelier than a setpoint too long
+                hz = pole / math.tau
+                remedy = (f"the step resolves the loop's fastest closed-loop pole, {g(hz)} Hz"
+                          + (f" (beyond a motion stage's {g(PLAUSIBLE_POLE_HZ)} Hz: are "
+                             f"{sc.source}'s [stage] and [controller] values in SI units?)"
+                             if hz > PLAUSIBLE_POLE_HZ else "") + f"; {SCAN_REMEDY}")
+            check_scan_steps(p.end + args.tail, step, runs, remedy, at_least=pole is None)
 
 
 def _check_model_terms(args: argparse.Namespace, sc) -> None:
