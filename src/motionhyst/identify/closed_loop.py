@@ -12,7 +12,6 @@ from scipy.signal import butter
 
 from motionhyst.core.lti import TWO_PI, HoldFilter, tf_poly
 from motionhyst.core.sampling import HeldInputFilter
-from motionhyst.identify.coherence import check_follows
 from motionhyst.identify.fit import (
     EXTRA_ORDER,
     MAX_ELEMENTS,
@@ -256,7 +255,6 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
                          "force offset on a spring; use offset 'auto', 'input' or 'none'")
     if offset not in ("auto", "input", "none"):
         raise ValueError(f"unknown offset choice {offset!r}; expected auto, input or none")
-    check_follows(t, y1, u)
     lf = infer_link_force(t, y1, u, stage, cutoff_hz, controller)
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
