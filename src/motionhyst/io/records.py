@@ -238,7 +238,9 @@ def is_mat_file(source: Source) -> bool:
 def _is_level4(head: bytes) -> bool:
     """Whether `head` opens a MATLAB level-4 file (``-v4``, no text header): a first matrix
     header of five integers (type MOPT, rows, columns, imaginary flag, name length) that
-    MATLAB writes, and the name it announces."""
+    MATLAB writes, and the name it announces.  For a file not named ``.mat``: scipy's
+    ``matfile_version`` calls level 4 any file with a zero among its first four bytes (most
+    binary files), which is too loose to decide that a file is MATLAB's."""
     if len(head) < 21:
         return False
     for order in "<>":
@@ -265,7 +267,17 @@ def _mat_kind(path: Path) -> str:
         return "scipy"
     if _is_level4(head):  # level 4: no text header
         return "scipy"
-    what = "a text file" if _looks_like_text(head) else "an unknown format"
+    what = "a text file"
+    if not _looks_like_text(head):  # scipy's own test, looser than the header's: a file
+        from scipy.io.matlab import matfile_version  # named .mat is given to scipy's reader
+
+        try:
+            major, _ = matfile_version(str(path))
+        except Exception:  # scipy raises several kinds for a file that is not MATLAB's
+            major = None
+        if major == 0:
+            return "scipy"
+        what = "an unknown format"
     raise RecordError(f"{path}: not a MATLAB .mat file ({what}); a CSV record must be named .csv")
 
 
