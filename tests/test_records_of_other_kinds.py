@@ -207,6 +207,7 @@ def test_a_piezo_that_creeps_beyond_the_model_is_refused(capsys, tmp_path):
                        "quasi-static", "--model", "bouc-wen", "--save", str(model))
     assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
     assert "systematic error" in err and "creep" in err and not model.exists()
+    assert err.startswith(f"motionhyst: error: {record}: the fit failed")  # the record named
 
 
 def test_a_sensor_whose_sign_is_reversed_is_named(capsys, tmp_path):

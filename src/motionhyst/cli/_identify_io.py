@@ -209,11 +209,17 @@ def run_input_output(args: argparse.Namespace) -> int:
                "drift": args.drift,
                "fewer_elements": args.elements is None, "rigid_limit": True})
     from motionhyst.hysteresis import model_class
+    from motionhyst.identify.io_checks import FitFailed
 
-    with search_budget():
-        fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
-                          n_elements=args.elements or 3, plant=plant_class(plant),
-                          output=args.output, **extras)
+    try:
+        with search_budget():
+            fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
+                              n_elements=args.elements or 3, plant=plant_class(plant),
+                              output=args.output, **extras)
+    except FitFailed as exc:  # the records it was refused on, named once
+        if any(str(path) in str(exc) for path in args.data):
+            raise
+        raise FitFailed(f"{', '.join(map(str, args.data))}: {exc}") from None
     result = {**fit.to_dict(), "records": fit.records}
     if target is not None:
         text = fit.scenario_text()

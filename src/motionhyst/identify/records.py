@@ -139,6 +139,10 @@ ELASTIC_CURVE_RATIO = 0.1
 ELASTIC_CURVE_FACTOR = 3.0
 #: Degree of the Chebyshev series in the displacement that stands for "a curve"
 ELASTIC_CURVE_DEGREE = 15
+#: A damper's loops are told once a straight line leaves this share of
+#: :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` (below, a spring's record: the fit
+#: decides, and its own check refuses it)
+DAMPER_LINE_SHARE = 0.25
 
 
 def check_loops_open(x: ArrayLike, w: ArrayLike, t: ArrayLike | None = None) -> None:
@@ -162,7 +166,10 @@ def check_loops_open(x: ArrayLike, w: ArrayLike, t: ArrayLike | None = None) -> 
     are a damper's: their width grows with the speed, while elements that slip give loops
     of the path alone.  Hysteresis of every rate-independent kind leaves a damper at least
     a fifth of the line's error (Jenkins, Maxwell-slip and Iwan distributions, Dahl and
-    Bouc-Wen links, under sines, amplitude sweeps, two tones and band-limited noise).
+    Bouc-Wen links, under sines, amplitude sweeps, two tones and band-limited noise).  They
+    are judged once the line leaves :data:`DAMPER_LINE_SHARE` of what a fit may leave (a
+    damper too weak to bend the line further is the fit's to judge), the message every
+    ``--model`` gives for such a record.
 
     Parameters
     ----------
@@ -210,15 +217,13 @@ element's follow the path alone; nothing identified
         coef = np.linalg.lstsq(basis, w, rcond=None)[0]
         shares.append(systematic_share(w - basis @ coef, w))
     line, curve = shares
-    if not line > ELASTIC_CURVE_FACTOR * SYSTEMATIC_SHARE:
-        return
-    if curve < ELASTIC_CURVE_RATIO * line:
+    if line > ELASTIC_CURVE_FACTOR * SYSTEMATIC_SHARE and curve < ELASTIC_CURVE_RATIO * line:
         raise ValueError(f"the force is a curve of the displacement alone (a curve leaves "
                          f"{100 * curve:.2g} % of its RMS, a straight line {100 * line:.2g} %): "
                          f"Maxwell-slip elements are a straight line until one slips and a "
                          f"slip opens a loop, so none describes it (a spring that saturates "
                          f"or stiffens, not hysteresis); nothing identified")
-    if t is None:
+    if t is None or not line > DAMPER_LINE_SHARE * SYSTEMATIC_SHARE:
         return
     v = np.gradient(x, np.asarray(t, dtype=float))
     basis = np.column_stack([np.ones_like(u), u, v / float(np.max(np.abs(v)))])
