@@ -182,6 +182,9 @@ def run_input_output(args: argparse.Namespace) -> int:
 
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     check_records(records, args.periodic)  # identify_io checks them again: nothing is skipped
+    from motionhyst.identify.io_response import check_response
+
+    check_response(records)  # a position that does not depend on the force: no fit explains it
     from motionhyst.plants.registry import plant_class
 
     if plant_class(plant).has_inertia and not args.periodic:  # as identify_io will, but first

@@ -116,6 +116,7 @@ from motionhyst.identify.io_friction import bouc_wen_friction, lugre_stribeck, p
 from motionhyst.identify.io_records import MIN_SAMPLES as MIN_SAMPLES
 from motionhyst.identify.io_records import IORecord, check_records
 from motionhyst.identify.io_records import load_io_csv as load_io_csv
+from motionhyst.identify.io_response import check_response
 from motionhyst.identify.io_results import IOIdentification
 from motionhyst.identify.io_start import BLA_STARTS as BLA_STARTS
 from motionhyst.identify.io_start import best_linear_approximation as best_linear_approximation
@@ -247,7 +248,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         (``k, c`` in parallel with the link, any link Bouc-Wen included;
         :mod:`~motionhyst.identify.io_quasi_static`).  A stage with inertia is
         refused before the search (a ValueError) for records that show none
-        (:func:`~motionhyst.identify.io_checks.check_inertia`).
+        (:func:`~motionhyst.identify.io_checks.check_inertia`).  Records whose
+        position does not depend on their force (noise, another record's position)
+        are refused first, whatever the stage
+        (:func:`~motionhyst.identify.io_response.check_response`).
     output : {"y2", "y1"}, optional
         With a two-mass stage given by its name or class: the measured position
         (``y2``, the point of control, the default, or ``y1``, the actuated mass);
@@ -378,6 +382,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         raise ValueError("the stage's viscous friction by direction is identified from records "
                          "from a start, not periodic ones (the Coulomb link's own: both)")
     records = check_records(list(records), periodic)
+    check_response(records)  # milliseconds: before anything else looks at the records
     if periodic:
         for rec in records:
             check_whole_periods(rec.u, rec.name)
