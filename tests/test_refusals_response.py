@@ -236,3 +236,24 @@ def test_identify_refuses_a_noise_record_before_its_fit(tmp_path, capsys, monkey
         p = [float(v) for v in err.split("(p = ")[1:3] for v in [v.split(")")[0]]]
         assert p[0] > COHERENCE_P and p[1] > RESPONSE_P and not any(map(math.isnan, p))
 
+
+@pytest.mark.parametrize("alpha, bg, bd, nu, why", [
+    (5e4, 100.0, 800.0, 1.0, "loops would give out energy"),
+    (5e4, -100.0, -300.0, 2.0, "grows without bound"),
+    (5e4, -300.0, 300.0, 1.0, "loops would give out energy"),
+    (5e4, -100.0, -300.0, 1.0, "small cycles raise its force"),
+    (-5.0, 100.0, -50.0, 1.0, "no spring at small motion"),
+    (5e4, 0.0, 0.0, 1.0, "a linear spring"),
+])
+def test_a_bouc_wen_fit_outside_the_model_says_what_the_records_do_not_determine(
+        alpha, bg, bd, nu, why):
+    """The default Bouc-Wen on a noise record ended after 16 s in "gamma must be >= delta",
+    the link class's own constraint; now the fit's message says it in the link's terms."""
+    from motionhyst.identify.io_bouc_wen import _bouc_wen_link
+
+    with pytest.raises(ValueError) as exc:
+        _bouc_wen_link(alpha, bg, bd, nu)
+    text = str(exc.value)
+    assert text.startswith("the records do not determine a Bouc-Wen link: its best fit")
+    assert why in text and "must be" not in text and "\n" not in text
+    assert _bouc_wen_link(5e4, 800.0, -1100.0, 1.0).to_dict()["model"] == "bouc-wen"

@@ -537,14 +537,36 @@ def _two_mass_result(m1: float, m2: float, b: float, k: float, output: str) -> T
 
 
 def _bouc_wen_link(alpha: float, bg: float, bd: float, nu: float) -> Hysteresis:
-    """The general Bouc-Wen link with ``|gamma| + |delta| = 1`` (``beta`` is not identifiable)."""
+    """The general Bouc-Wen link with ``|gamma| + |delta| = 1`` (``beta`` is not identifiable);
+    a one-line ``ValueError`` in the link's terms when the best fit is no such link."""
     beta = abs(bg) + abs(bd)
-    try:
-        if beta == 0.0:
-            raise ValueError("beta*gamma = beta*delta = 0: the link is a linear spring")
-        return BoucWen.from_general(alpha, beta, bg / beta, bd / beta, nu)
-    except ValueError as exc:
-        raise ValueError(f"the identified Bouc-Wen parameters (alpha={alpha:.6g}, "
-                         f"beta*gamma={bg:.6g}, beta*delta={bd:.6g}, nu={nu:.6g}) are outside "
-                         f"the model's accepted set: {exc}") from None
+    why = _not_a_link(alpha, bg, bd, nu)
+    if why is None:
+        try:
+            return BoucWen.from_general(alpha, beta, bg / beta, bd / beta, nu)
+        except ValueError:
+            why = "a link without a finite force scale (alpha / beta)"
+    raise ValueError(f"the records do not determine a Bouc-Wen link: its best fit (alpha="
+                     f"{alpha:.6g}, beta*gamma={bg:.6g}, beta*delta={bd:.6g}, nu={nu:.6g}) is "
+                     f"{why}; another --model (jenkins, dahl) or records of larger motion may "
+                     f"determine one")
+
+
+def _not_a_link(alpha: float, bg: float, bd: float, nu: float) -> str | None:
+    """Why the general Bouc-Wen parameters are no link, in the link's terms (None if they
+    are one; :meth:`~motionhyst.hysteresis.BoucWen.from_general`'s accepted set)."""
+    if not all(map(math.isfinite, (alpha, bg, bd, nu))):
+        return "not finite"
+    if not alpha > 0:
+        return "no spring at small motion (alpha <= 0)"
+    if bg == 0.0 and bd == 0.0:
+        return "a linear spring (beta*gamma = beta*delta = 0): no hysteresis"
+    if bg < bd:
+        return "a link whose loops would give out energy (beta*gamma < beta*delta)"
+    if bg + bd <= 0 and nu != 1.0:
+        return ("a link whose force grows without bound within a finite motion (beta*gamma "
+                "+ beta*delta <= 0 with nu > 1)")
+    if bg + bd <= 0 and bg < 0:
+        return "a link whose small cycles raise its force without bound (beta*gamma < 0)"
+    return None
 
