@@ -17,27 +17,29 @@ from pathlib import Path
 import numpy as np
 import pytest
 from records_of_other_kinds import damper_record, piezo_record
-from scipy import signal, stats
+from scipy import signal
 
 from motionhyst.cli import main
-from motionhyst.hysteresis import BoucWen, Jenkins
-from motionhyst.identify import io_response
+from motionhyst.hysteresis import BoucWen, Coulomb, Jenkins
 from motionhyst.identify.input_output import identify_io
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_response import (
     COHERENCE_P,
     MIN_JUDGED,
+    MIN_SPREAD,
     PIECE,
     PIECES,
     RESPONSE_P,
     check_response,
     coherence,
     dependence,
+    force_spread,
 )
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import MassSpringDamper, OpenLoop, TwoMass
 
 EMPS = Path(__file__).resolve().parents[2] / "shared" / "benchmarks" / "emps" / "DATA_EMPS.mat"
+NO_RESPONSE = "the force's variations show no response of the position"
 #: Evidence a record of a stage must show beyond the thresholds: a factor of 100 on the
 #: p-value of at least one test
 MARGIN = 100.0
@@ -117,21 +119,11 @@ def test_coherence_is_welchs(nperseg):
     inner = slice(1, -1)  # scipy's one-sided density doubles all but 0 and fs/2
     assert p_uu[inner] / p_uu[5] == pytest.approx(p_scipy[inner] / p_scipy[5], rel=1e-9)
     count = (3001 - nperseg) // (nperseg - nperseg // 2) + 1
-    assert 0.8 * count < segments <= count  # steady signals: every segment counts
+    assert 0.5 * count < segments <= count  # steady signals: each segment counts (its power
+    # varies by chance: 0.7 of them over 16 samples)
     step, response = (np.arange(3001) >= 1500).astype(float), np.zeros(3001)
     response[1500:] = 1.0 - np.exp(-np.arange(1501) / 40.0)  # a transient's response
     assert coherence(step, response, nperseg)[2] < 3.0  # two transients: a segment or two
-
-
-def test_the_p_values_are_the_distributions():
-    for d2 in (30, 491, 24000):  # the F-test's
-        for f in (0.0, 0.3, 1.0, 2.5, 8.0):
-            assert io_response._f_sf(10, d2, f) == pytest.approx(stats.f.sf(f, 10, d2),
-                                                                 rel=1e-9, abs=1e-300)
-    for m in (1, 7, 60):  # the sum of exponentials (coherence)
-        for x in (0.0, 0.5, m, 3.0 * m + 10):
-            assert io_response._gamma_sf(m, x) == pytest.approx(stats.gamma.sf(x, m),
-                                                                rel=1e-9, abs=1e-300)
 
 
 def test_independent_positions_give_uniform_p_values():
@@ -176,17 +168,15 @@ def _independent() -> list[tuple[str, IORecord]]:
             ("random walk", IORecord(t, u, 1e-4 * np.cumsum(rng.standard_normal(n)), "a.csv")),
             ("stuck stage", IORecord(t, 3 * np.sin(3 * t), 0.02 + 1e-7 * rng.standard_normal(n),
                                      "a.csv")),
-            ("a step and another record's position",
-             IORecord(t, np.where(t > 1.0, 30.0, 0.0), axis.y, "a.csv")),
             ("quantised noise", IORecord(t, u, np.round(1e-7 * rng.standard_normal(n), 7),
                                          "a.csv"))]
 
 
 @pytest.mark.parametrize("name, record", _independent(), ids=[n for n, _ in _independent()])
 def test_positions_independent_of_the_force_are_refused(name, record):
-    with pytest.raises(ValueError, match=r"^a\.csv: the position does not follow the force"):
+    with pytest.raises(ValueError, match=r"^a\.csv: " + NO_RESPONSE):
         check_response([_axis(0.0), record])
-    with pytest.raises(ValueError, match="the position does not follow the force"):
+    with pytest.raises(ValueError, match=NO_RESPONSE):
         identify_io([record], Jenkins, plant="mass-damper")  # before the search
 
 
@@ -206,7 +196,7 @@ def test_a_long_record_is_judged_where_its_force_moves_the_stage():
     rng = np.random.default_rng(7)
     t = np.arange(n) / 1000.0
     u = 0.01 * rng.standard_normal(n)
-    burst = slice(3 * PIECE + 500, 3 * PIECE + 9000)
+    burst = slice(3 * PIECE + 500, 3 * PIECE + 24000)
     u[burst] += 40 * np.sin(2 * np.pi * 3.0 * t[burst])
     y = OpenLoop(MassDamper(2.0, 10.0), Jenkins(k=2e4, fc=4.0)).simulate(t, u).displacement
     y = y + 1e-7 * rng.standard_normal(n)
@@ -232,8 +222,8 @@ def test_identify_refuses_a_noise_record_before_its_fit(tmp_path, capsys, monkey
         assert main(["identify", str(path), "--record", "input-output", *extra]) == 2
         out, err = capsys.readouterr()
         assert out == "" and err.count("\n") == 1 and "Traceback" not in err
-        assert "noise.csv: the position does not follow the force" in err
-        p = [float(v) for v in err.split("(p = ")[1:3] for v in [v.split(")")[0]]]
+        assert "noise.csv: the force's variations show no response of the position" in err
+        p = [float(v.split(",")[0].split(")")[0]) for v in err.split("p = ")[1:3]]
         assert p[0] > COHERENCE_P and p[1] > RESPONSE_P and not any(map(math.isnan, p))
 
 
@@ -257,3 +247,60 @@ def test_a_bouc_wen_fit_outside_the_model_says_what_the_records_do_not_determine
     assert text.startswith("the records do not determine a Bouc-Wen link: its best fit")
     assert why in text and "must be" not in text and "\n" not in text
     assert _bouc_wen_link(5e4, 800.0, -1100.0, 1.0).to_dict()["model"] == "bouc-wen"
+
+
+def _step_axis(n: int, noise: float, seed: int) -> IORecord:
+    """One step of force (0 -> 60 N at 0.2 s) on a 95 kg axis with 200 N s/m and 20 N of
+    Coulomb friction, at 1 kHz, with white position noise [m]."""
+    t = np.arange(n) / 1000.0
+    u = np.where(t >= 0.2, 60.0, 0.0)
+    y = OpenLoop(MassDamper(95.0, 200.0), Coulomb(fc=20.0)).simulate(t, u).displacement
+    return IORecord(t, u, y + noise * np.random.default_rng(seed).standard_normal(n), "step.csv")
+
+
+@pytest.mark.parametrize("n", [1000, 2000])
+@pytest.mark.parametrize("noise", [1e-6, 1e-5, 3e-5, 1e-4])
+def test_a_record_of_one_step_is_not_refused(n, noise):
+    """Review A9 finding 2: refused 10/10 at 1e-5 m; one event, about which neither test
+    can judge: left to the fit."""
+    for seed in range(3):
+        rec = _step_axis(n, noise, seed)
+        assert force_spread(rec.u) < MIN_SPREAD
+        check_response([rec])
+    check_response([IORecord(rec.t, rec.u, _axis(0.0, n).y, "step.csv")])  # unrelated too
+
+
+def test_a_few_pulses_of_force_are_not_judged():
+    t = np.arange(3000) / 1000.0
+    u = sum(np.where((t > a) & (t < a + 0.05), 50.0, 0.0) for a in (0.3, 1.3, 2.3))
+    y = OpenLoop(MassDamper(95.0, 200.0), Coulomb(fc=20.0)).simulate(t, u).displacement
+    assert force_spread(u) < MIN_SPREAD
+    check_response([IORecord(t, u, y + 1e-5 * np.random.default_rng(0).standard_normal(t.size),
+                             "pulses.csv")])
+
+
+@pytest.mark.skipif(not EMPS.is_file(), reason="needs the EMPS benchmark's files beside")
+def test_the_emps_record_with_pulses_of_force_passes():
+    """The benchmark's held-out record has pulses on its periodic motion: 20 pulses of
+    40 N for 50 ms added, with the response of the axis's mass and viscous friction."""
+    rec = _emps()
+    pulses = np.zeros(rec.t.size)
+    for start in np.linspace(500, rec.t.size - 600, 20).astype(int):
+        pulses[start:start + 50] = 40.0
+    extra = OpenLoop(MassDamper(95.0, 200.0)).simulate(rec.t - rec.t[0], pulses).displacement
+    for piece in (slice(None), slice(0, 6210), slice(6210, 12420)):
+        check_response([IORecord(rec.t[piece], (rec.u + pulses)[piece],
+                                 (rec.y + extra)[piece], "EMPS with pulses")])
+
+
+def test_a_force_steady_but_for_its_noise_is_refused_for_what_it_is():
+    """Review A9 finding 8: a scan at constant speed (22 N and 0.5 N of noise, 0.25 m) was
+    refused as "a stage that did not move?"; the message now says what is true."""
+    rng = np.random.default_rng(4)
+    t = np.arange(2500) / 1000.0
+    rec = IORecord(t, 22.0 + 0.5 * rng.standard_normal(t.size),
+                   0.1 * t + 1e-6 * rng.standard_normal(t.size), "scan.csv")
+    assert force_spread(rec.u) > MIN_SPREAD
+    with pytest.raises(ValueError, match=r"scan\.csv: " + NO_RESPONSE + r".* too little "
+                                         r"excitation"):
+        check_response([rec])

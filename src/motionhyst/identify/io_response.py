@@ -24,9 +24,13 @@ not depend on the force", each a p-value, take milliseconds (numpy only, no fit)
   floating stage's record (a stroke whose period is the record's length), which no
   segment resolves.
 
-A record of at least :data:`MIN_JUDGED` samples where neither test finds the position
-dependent (p-values above :data:`COHERENCE_P` and :data:`RESPONSE_P`) is refused in
-one line by :func:`check_response`.  Measured (``benchmarks/refusals.py``'s classes and
+A record of at least :data:`MIN_JUDGED` samples whose force varies throughout (not one
+step or a few pulses, about which neither test can judge: :func:`force_spread`) where
+neither test finds the position dependent (p-values above :data:`COHERENCE_P` and
+:data:`RESPONSE_P`) is refused in one line by :func:`check_response`; where a test
+cannot judge, nothing is refused.  The coherence is computed here with numpy
+(:func:`coherence`, equal to ``scipy.signal.coherence`` with a linear detrend): importing
+``scipy.signal`` costs 0.75 s of processor time, more than the whole refusal.  Measured (``benchmarks/refusals.py``'s classes and
 600 generated independent pairs of 512 to 24000 samples: white, random-walk,
 doubly integrated, quantised and drifting positions against white, sine, random-walk,
 square and measured forces): independent pairs have ``-log10 p`` at most 2.2 (coherence)
@@ -49,9 +53,9 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.core.triangular import upper_triangle
 from motionhyst.identify.io_records import IORecord
 
-__all__ = ["BAND_SHARE", "COHERENCE_P", "DIVISIONS", "LAGS", "MIN_JUDGED", "PIECE", "PIECES",
-           "RESPONSE_P", "Dependence",
-           "check_response", "coherence", "dependence"]
+__all__ = ["BAND_SHARE", "COHERENCE_P", "DIVISIONS", "LAGS", "MIN_JUDGED", "MIN_SPREAD", "PIECE",
+           "PIECES", "RESPONSE_P", "SPREAD_BLOCKS", "Dependence", "check_response", "coherence",
+           "dependence", "force_spread"]
 
 #: Records shorter than this are not judged: a stage's record of fewer samples can show
 #: neither test's evidence (a piezo's 128 samples: coherence p 0.016, response p 3e-4), and
@@ -70,6 +74,11 @@ LAGS = 9
 DIVISIONS = (2, 4, 8, 16, 32)
 #: The force's frequencies are those with at least this share of its largest power density
 BAND_SHARE = 1e-2
+#: A force's variation is measured over this many equal blocks of its record ...
+SPREAD_BLOCKS = 16
+#: ... and a record is judged when it is spread over at least this many of them (a step: 1;
+#: pulses: about their number; a force that varies throughout: 16)
+MIN_SPREAD = 4.0
 #: A longer record is judged on its :data:`PIECES` pieces of this many samples where the
 #: force's first differences have the most power (milliseconds, however long the record)
 PIECE = 1 << 15
@@ -126,12 +135,11 @@ def coherence(u: ArrayLike, y: ArrayLike, nperseg: int, block: int = 1 << 18
         The power density of `u` there, unscaled (its shape is what counts).
     segments : float
         How many segments carry the signals' power: ``(sum P_s)^2 / sum P_s^2`` of
-        the segments' powers ``P_s``, of `u` or of `y`, whichever is the more evenly
-        spread: the number of segments if either is steady, about one if both are
-        one transient (a step of force and the stage's response to it).  Independent
-        of `u`, a steady `y` makes ``C`` at a frequency a ``Beta(1, K - 1)``
-        variable, ``K`` the number of independent segments; two transients make it
-        near 1 whatever they are.
+        the segments' powers ``P_s``, of `u` and of `y`, the less evenly spread of
+        the two: the number of segments if both are steady, about one if either is
+        one transient (a step of force).  Independent steady signals make ``C`` at a
+        frequency a ``Beta(1, K - 1)`` variable, ``K`` the number of independent
+        segments; a transient leaves ``C`` no evidence either way.
 
     Examples
     --------
@@ -172,7 +180,7 @@ def coherence(u: ArrayLike, y: ArrayLike, nperseg: int, block: int = 1 << 18
     squares = np.sum(powers ** 2, axis=1)
     spread = [float(np.sum(q)) ** 2 / s2 for q, s2 in zip(powers, squares, strict=True)
               if s2 > 0]
-    return np.minimum(c, 1.0), p_uu, max(spread, default=0.0)
+    return np.minimum(c, 1.0), p_uu, min(spread, default=0.0)
 
 
 def _segments(view: NDArray[np.float64], line: NDArray[np.float64],
@@ -216,6 +224,8 @@ def dependence(u: ArrayLike, y: ArrayLike) -> Dependence:
 
 def _coherence_p(du: NDArray[np.float64], dy: NDArray[np.float64]) -> float:
     """The smallest p-value of the coherence over :data:`DIVISIONS` (module text)."""
+    from scipy.special import gammaincc  # the Gamma variable's survival function
+
     best = 1.0
     for division in DIVISIONS:
         nperseg = du.size // division
@@ -230,20 +240,8 @@ def _coherence_p(du: NDArray[np.float64], dy: NDArray[np.float64]) -> float:
         # independent segments' worth: two overlapping by half count as about one
         k = min(du.size / nperseg, segments / 2.0)
         x = float(np.sum(-(k - 1.0) * np.log1p(-np.minimum(c[band], 1.0 - 1e-16))))
-        best = min(best, _gamma_sf(band.size, x))
+        best = min(best, float(gammaincc(band.size, x)) if x > 0 else 1.0)
     return best
-
-
-def _gamma_sf(m: int, x: float) -> float:
-    """``P(X > x)`` for ``X`` a sum of `m` unit exponentials (a Poisson sum, in logs)."""
-    if m <= 0:
-        return 1.0
-    if x <= 0:
-        return 1.0
-    k = np.arange(m)
-    logs = k * math.log(x) - x - np.array([math.lgamma(i + 1.0) for i in k])
-    top = float(np.max(logs))
-    return min(1.0, math.exp(top) * float(np.sum(np.exp(logs - top))))
 
 
 def _response_p(u: NDArray[np.float64], y: NDArray[np.float64]) -> float:
@@ -253,6 +251,8 @@ def _response_p(u: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     0..LAGS; the upper triangle of a QR of them with ``y`` last
     (:func:`~motionhyst.core.triangular.upper_triangle`) gives both residual sums (without
     and with the force's columns)."""
+    from scipy.special import fdtrc  # the F distribution's survival function
+
     n = y.size
     lags = LAGS
     rows = n - lags
@@ -273,30 +273,21 @@ def _response_p(u: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     if not full > 0:
         return 0.0 if restricted > 0 else 1.0
     f = max((restricted - full) / q / (full / dof), 0.0)
-    return _f_sf(q, dof, f)
-
-
-def _f_sf(d1: int, d2: int, f: float) -> float:
-    """``P(F > f)`` of an F distribution with an even `d1`: ``I_w(d2/2, d1/2)``,
-    ``w = d2 / (d2 + d1 f)``, a finite sum for the integer ``d1/2`` (in logs)."""
-    a, b = d2 / 2.0, d1 // 2
-    w = d2 / (d2 + d1 * f)
-    if w >= 1.0:
-        return 1.0
-    j = np.arange(b)
-    logs = (np.array([math.lgamma(a + i) - math.lgamma(a) - math.lgamma(i + 1.0) for i in j])
-            + a * math.log(w) + j * math.log1p(-w))
-    top = float(np.max(logs))
-    return min(1.0, math.exp(top) * float(np.sum(np.exp(logs - top))))
+    return float(fdtrc(q, dof, f))
 
 
 def check_response(records: list[IORecord]) -> None:
     """Refuse, before any fit, a record whose position does not depend on its force.
 
-    Each record of at least :data:`MIN_JUDGED` samples is judged by :func:`dependence`;
-    one where neither test rejects independence (p-values above :data:`COHERENCE_P`
-    and :data:`RESPONSE_P`) is noise, another experiment's position, a drift, or a
-    stage that did not move: no model explains it by the force.
+    A record is judged when it has at least :data:`MIN_JUDGED` samples and its force
+    varies throughout (:func:`force_spread` at least :data:`MIN_SPREAD`): a step or a
+    few pulses of force are one event each, about which neither test can say anything
+    (the position's own past absorbs one smooth response), so such a record is left to
+    the fit.  A judged record where neither test rejects independence (p-values above
+    :data:`COHERENCE_P` and :data:`RESPONSE_P`) shows no response of the position to
+    the force's variations: too little excitation (a force steady but for its noise,
+    as in a scan at constant speed), or unrelated signals (noise, another experiment's
+    position, a drift); no model explains it by the force.
 
     Parameters
     ----------
@@ -317,20 +308,56 @@ def check_response(records: list[IORecord]) -> None:
     >>> try:
     ...     check_response([IORecord(t, u, 1e-3 * rng.standard_normal(1000), "noise.csv")])
     ... except ValueError as exc:
-    ...     print(str(exc)[:49])
-    noise.csv: the position does not follow the force
+    ...     print(str(exc)[:67])
+    noise.csv: the force's variations show no response of the position
+    >>> step = np.where(t > 0.2, 60.0, 0.0)                    # one event: not judged
+    >>> check_response([IORecord(t, step, 1e-3 * rng.standard_normal(1000), "step.csv")])
     """
     for rec in records:
         if rec.y.size < MIN_JUDGED:
             continue
-        found = [dependence(rec.u[piece], rec.y[piece]) for piece in _pieces(rec.u)]
+        pieces = [piece for piece in _pieces(rec.u) if force_spread(rec.u[piece]) >= MIN_SPREAD]
+        if not pieces:
+            continue
+        found = [dependence(rec.u[piece], rec.y[piece]) for piece in pieces]
         p = Dependence(min(f.coherence for f in found), min(f.response for f in found))
         if p.coherence > COHERENCE_P and p.response > RESPONSE_P:
             raise ValueError(
-                f"{rec.name}: the position does not follow the force: one independent of "
-                f"it would show as much coherence (p = {p.coherence:.2g}) and linear "
-                f"response (p = {p.response:.2g}); no model explains it (noise, another "
-                f"record's position, a stage that did not move?)")
+                f"{rec.name}: the force's variations show no response of the position (a "
+                f"position independent of the force would show as much coherence, p = "
+                f"{p.coherence:.2g}, and linear response, p = {p.response:.2g}): too little "
+                f"excitation, or unrelated signals (noise, another record's position); no "
+                f"model explains it by the force")
+
+
+def force_spread(u: ArrayLike) -> float:
+    """Over how many of :data:`SPREAD_BLOCKS` equal blocks a force's variation is spread:
+    ``(sum P_b)^2 / sum P_b^2`` of the blocks' powers ``P_b`` of its first differences.
+
+    Parameters
+    ----------
+    u : array_like
+        A force, at least ``SPREAD_BLOCKS + 1`` samples.
+
+    Returns
+    -------
+    float
+        :data:`SPREAD_BLOCKS` for a force that varies alike throughout, 1 for one step,
+        about ``k`` for ``k`` separate pulses; 0 for a constant force.
+
+    Examples
+    --------
+    >>> t = np.arange(1600) / 1000.0
+    >>> round(force_spread(np.sin(2 * np.pi * 5 * t)), 1)
+    16.0
+    >>> round(force_spread(np.where(t > 0.7, 60.0, 0.0)), 1)
+    1.0
+    """
+    d = np.diff(np.asarray(u, dtype=float))
+    n = d.size // SPREAD_BLOCKS * SPREAD_BLOCKS
+    power = np.sum(d[:n].reshape(SPREAD_BLOCKS, -1) ** 2, axis=1)
+    total = float(np.sum(power))
+    return total ** 2 / float(np.sum(power ** 2)) if total > 0 else 0.0
 
 
 def _pieces(u: NDArray[np.float64]) -> list[slice]:
