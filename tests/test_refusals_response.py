@@ -304,3 +304,19 @@ def test_a_force_steady_but_for_its_noise_is_refused_for_what_it_is():
     with pytest.raises(ValueError, match=r"scan\.csv: " + NO_RESPONSE + r".* too little "
                                          r"excitation"):
         check_response([rec])
+
+
+def test_a_closed_loop_record_whose_position_is_noise_is_refused(tmp_path, capsys):
+    """Closed-loop identify with y1 = noise answered 2 Maxwell-slip elements 'determined'
+    (R^2 0.3, exit 0); the same check refuses it before the loop is built."""
+    from motionhyst.scenario import default_scenario_path
+
+    t = np.arange(3000) / 1000.0
+    u = 0.5 * np.sin(2 * np.pi * 2.0 * t) + 0.1 * np.sin(2 * np.pi * 11.0 * t)
+    y1 = 1e-4 * np.random.default_rng(8).standard_normal(t.size)
+    path = tmp_path / "c.csv"
+    np.savetxt(path, np.column_stack([t, y1, u]), delimiter=",", header="time,y1,u",
+               comments="")
+    assert main(["identify", str(path), "--scenario", str(default_scenario_path())]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and f"{path}: {NO_RESPONSE}" in err

@@ -190,6 +190,10 @@ def run(args: argparse.Namespace) -> int:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
+        from motionhyst.identify.io_records import IORecord
+        from motionhyst.identify.io_response import check_response
+
+        check_response([IORecord(t, u, y1, str(path))])  # y1 of the loop follows u
     share = 0.0  # a force-displacement fit's systematic error, as a share of the force's RMS
     if kind == "force-displacement":
         if args.elements is None or target is not None:  # refused, not reported: at once
