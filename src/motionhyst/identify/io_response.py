@@ -332,7 +332,14 @@ def check_response(records: list[IORecord]) -> None:
 
 def force_spread(u: ArrayLike) -> float:
     """Over how many of :data:`SPREAD_BLOCKS` equal blocks a force's variation is spread:
-    ``(sum P_b)^2 / sum P_b^2`` of the blocks' powers ``P_b`` of its first differences.
+    ``(sum P_b)^2 / sum P_b^2`` of the blocks' powers ``P_b`` of its first differences,
+    taken after a moving average over a quarter of a block.
+
+    The average keeps a step or a pulse one event (its differences stay in one block) while
+    it divides the differences of a force sensor's white noise by the window: a step of
+    60 N with 2-4 N of noise counts as one event, not as a force that varies throughout.
+    The measure does not depend on the force's scale, so a steady force (a sine, a
+    multisine, white noise as an excitation) stays spread over every block.
 
     Parameters
     ----------
@@ -342,18 +349,26 @@ def force_spread(u: ArrayLike) -> float:
     Returns
     -------
     float
-        :data:`SPREAD_BLOCKS` for a force that varies alike throughout, 1 for one step,
-        about ``k`` for ``k`` separate pulses; 0 for a constant force.
+        :data:`SPREAD_BLOCKS` for a force that varies alike throughout, 1-2 for one step
+        (two where the averaged step straddles two blocks), about ``k`` for ``k`` separate
+        pulses; 0 for a constant force.
 
     Examples
     --------
     >>> t = np.arange(1600) / 1000.0
     >>> round(force_spread(np.sin(2 * np.pi * 5 * t)), 1)
     16.0
-    >>> round(force_spread(np.where(t > 0.7, 60.0, 0.0)), 1)
-    1.0
+    >>> step = np.where(t > 0.7, 60.0, 0.0)                 # one event, with sensor noise too
+    >>> noise = np.random.default_rng(0).standard_normal(t.size)
+    >>> round(force_spread(step), 1), round(force_spread(step + 2.0 * noise), 1)
+    (1.9, 2.4)
     """
-    d = np.diff(np.asarray(u, dtype=float))
+    u = np.asarray(u, dtype=float)
+    width = max(1, u.size // SPREAD_BLOCKS // 4)
+    if width > 1:
+        total = np.concatenate(([0.0], np.cumsum(u)))
+        u = (total[width:] - total[:-width]) / width
+    d = np.diff(u)
     n = d.size // SPREAD_BLOCKS * SPREAD_BLOCKS
     power = np.sum(d[:n].reshape(SPREAD_BLOCKS, -1) ** 2, axis=1)
     total = float(np.sum(power))
