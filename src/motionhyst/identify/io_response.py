@@ -31,9 +31,10 @@ neither test finds the position dependent (p-values above :data:`COHERENCE_P` an
 cannot judge, nothing is refused.  The coherence is computed here with numpy
 (:func:`coherence`, equal to ``scipy.signal.coherence`` with a linear detrend): importing
 ``scipy.signal`` costs 0.75 s of processor time, more than the whole refusal.  Measured
-(``benchmarks/refusals.py``'s classes and 600 generated independent pairs of 512 to 24000 samples: white, random-walk,
-doubly integrated, quantised and drifting positions against white, sine, random-walk,
-square and measured forces): independent pairs have ``-log10 p`` at most 2.2 (coherence)
+(``benchmarks/refusals.py``'s classes and 600 generated independent pairs of 512 to
+24000 samples: white, random-walk, doubly integrated, quantised and drifting positions
+against white, sine, random-walk, square and measured forces): independent pairs have
+``-log10 p`` at most 2.2 (coherence)
 and 8.2 (response), both beyond the thresholds in 1 % of pairs (those are fitted, and
 refused by the fit as before); records of stages, at 512 samples and more, at least 2.8
 (coherence) or 10 (response): generated floating axes with Jenkins friction and 1-10 %
