@@ -174,3 +174,32 @@ def test_a_stiff_link_on_the_measured_record_is_simulated():
                     Jenkins(k=275714121.3158981, fc=21.943279798965058))
     y = axis.simulate(rec.t, rec.u, substeps=110).displacement
     assert np.all(np.isfinite(y)) and np.ptp(y) > 0.1
+
+
+def test_identify_reports_the_fit_as_one_viscous_coefficient_and_an_offset(tmp_path, capsys):
+    """With viscous friction by direction the fit's own force offset is the drive's (3 N); on
+    the record's motion its even part (c_pos - c_neg)/2 |q'| is a further constant offset, and
+    identify reports the fit in that form too (c, fc and the offset a model with one viscous
+    coefficient would carry, with standard errors); a symmetric fit has nothing to add."""
+    from motionhyst.cli import main
+
+    rec = _record(Coulomb(fc=20.0), n=3000)
+    path = tmp_path / "axis.csv"
+    np.savetxt(path, np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="", fmt="%.17g")
+    args = ["identify", str(path), "--record", "input-output", "--plant", "mass-damper",
+            "--model", "coulomb", "--from-rest"]
+    assert main([*args, "--asymmetric", "--json"]) == 0
+    (form,) = json.loads(capsys.readouterr().out)["reference_form"]
+    mean_speed = float(np.mean(np.abs(np.gradient(rec.y, rec.t))))
+    expected = {"c": 201.5, "fc": 20.0, "offset": -AXIS["force_offset"] - 38.5 * mean_speed}
+    for name, value in expected.items():
+        assert form["parameters"][name] == pytest.approx(value, rel=1e-2), name
+        assert 0 < form["std"][name] < 1e-2 * abs(value)
+    assert form["record"] == str(path)
+    assert main([*args, "--asymmetric"]) == 0
+    out = capsys.readouterr().out
+    assert f"constant force offset on the motion of {path}:\n" in out
+    assert f"input_offset {form['parameters']['offset']:.4g} +- " in out
+    assert main([*args, "--symmetric", "--json"]) == 0
+    assert "reference_form" not in json.loads(capsys.readouterr().out)

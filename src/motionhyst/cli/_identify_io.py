@@ -224,6 +224,9 @@ def run_input_output(args: argparse.Namespace) -> int:
             raise
         raise FitFailed(f"{', '.join(map(str, args.data))}: {exc}") from None
     result = {**fit.to_dict(), "records": fit.records}
+    reference = reference_forms(fit, records) if plant == "mass-damper" else []
+    if reference:
+        result["reference_form"] = reference
     if target is not None:
         text = fit.scenario_text()
         _check_readable(text, fit)
@@ -256,6 +259,9 @@ def run_input_output(args: argparse.Namespace) -> int:
         print()
         for name, why in fit.not_identifiable.items():
             print(f"  {name}: {why}")
+    for form in reference:
+        print()
+        print(_reference_line(form))
     print()
     print(table(["record", "samples", "fit RMS [m]", "output RMS [m]"],
                 [[r["name"], str(r["samples"]), g(r["fit_rms"]), g(r["output_rms"])]
@@ -266,6 +272,64 @@ def run_input_output(args: argparse.Namespace) -> int:
         print("\n# the identified system, a scenario for motionhyst predict (or give --save):")
         print(fit.scenario_text(), end="")
     return 0
+
+
+#: The parameters by which a mass-damper's friction differs from one viscous coefficient and a
+#: constant force offset (by direction, or an offset drifting in time)
+BEYOND_REFERENCE = ("c_skew", "link.c_pos", "link.c_neg", "link.fc_pos", "link.fc_neg",
+                    "input_drift")
+
+
+def reference_forms(fit, records) -> list[dict]:
+    """A mass-damper fit as one viscous coefficient and a constant force offset, per record.
+
+    With viscous (or Coulomb) friction by direction or a drifting offset, a fit's own force
+    offset is near 0 on an axis where a model with one viscous coefficient finds a large one
+    (EMPS: 0.05 N against -3.2 N): the even part of the friction, ``(c_pos - c_neg)/2 |q'|``,
+    acts as an offset that follows the speed.  On a record's motion it amounts to the
+    constant ``(c_pos - c_neg)/2 mean |q'|``; the fit in that form, the form of the
+    benchmark's reference model (:func:`~motionhyst.identify.emps_reference.reference_form`,
+    standard errors from the fit's covariance), can be set beside such an estimate.
+
+    Parameters
+    ----------
+    fit : IOIdentificationResult
+        A mass-damper's identification.
+    records : list of IORecord
+        The records it was identified on.
+
+    Returns
+    -------
+    list of dict
+        Per record ``{"record", "parameters": {"c", "fc", "offset"}, "std": {...}}`` (the
+        ``offset`` in the sense of ``input_offset``); [] for a fit without such parameters.
+    """
+    if not any(name in fit.estimates for name in BEYOND_REFERENCE):
+        return []
+    from motionhyst.identify.emps_reference import fit_parameters, reference_form
+
+    own, std, covariance = fit_parameters(fit)
+    forms = []
+    for rec in records:
+        parameters, errors = reference_form(own, rec, std, covariance)
+        forms.append({"record": rec.name,
+                      "parameters": {k: parameters[k] for k in ("c", "fc", "offset")
+                                     if k in parameters},
+                      "std": {k: errors[k] for k in ("c", "fc", "offset") if k in parameters}})
+    return forms
+
+
+def _reference_line(form: dict) -> str:
+    """One line of :func:`reference_forms`' result."""
+    units = {"c": "N s/m", "fc": "N", "offset": "N"}
+    names = {"c": "c", "fc": "link.fc", "offset": "input_offset"}
+    parts = []
+    for key, value in form["parameters"].items():
+        s = form["std"].get(key)
+        parts.append(f"{names[key]} {g(value, 4)}" + ("" if s is None else f" +- {g(s, 2)}")
+                     + f" {units[key]}")
+    return (f"  as one viscous coefficient and a constant force offset on the motion of "
+            f"{form['record']}:\n    {', '.join(parts)}")
 
 
 def _check_readable(text: str, fit) -> None:

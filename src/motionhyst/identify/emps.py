@@ -54,6 +54,7 @@ from motionhyst.identify.emps_reference import (
     REFERENCE_MODEL,
     asymmetric_inverse_dynamics,
     equivalent_offset,
+    fit_parameters,
     reference_form,
     reference_system,
 )
@@ -562,24 +563,6 @@ def period_drift(record: IORecord, period: int = PERIOD) -> list[dict]:
     return out
 
 
-def _parameters(fit) -> tuple[dict, dict, dict]:
-    """The identification's estimates, standard errors and covariance under the benchmark's
-    names (``offset`` = the model's own OF, ``drift``, the link's without ``link.``)."""
-    est, std, short = {}, {}, {}
-    for name, value in fit.estimates.items():
-        short[name] = name.removeprefix("link.")
-        if short[name] != name and short[name] in fit.estimates:
-            short[name] = name
-        if name in ("input_offset", "input_drift"):
-            short[name] = name.removeprefix("input_")
-        est[short[name]] = float(value)
-        s = fit.std.get(name)
-        std[short[name]] = None if s is None else float(s)
-    cov = fit.extra.get("covariance", {"parameters": [], "matrix": []})
-    return est, std, {"parameters": [short.get(n, n) for n in cov["parameters"]],
-                      "matrix": cov["matrix"]}
-
-
 def score(system, record: IORecord) -> tuple[dict, np.ndarray]:
     """The benchmark's metric of a model on a record, and the simulated position.
 
@@ -822,7 +805,7 @@ def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
         raise
     except (ValueError, RuntimeError) as exc:
         raise ValueError(f"{name}: {exc}") from None
-    own, own_std, covariance = _parameters(fit)
+    own, own_std, covariance = fit_parameters(fit)
     parameters, std = reference_form(own, est, own_std, covariance)
     return EMPSModel(name, parameters, std, est_score, val_score, 0.0,
                      list(getattr(fit, "warnings", [])), yhat, parameters.get("offset"),

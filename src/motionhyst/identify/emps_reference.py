@@ -21,7 +21,8 @@ viscous and Coulomb coefficients by direction and no offset (the screw's mechani
 models as open-loop systems (:func:`reference_system`), eq. (12) by one linear solve
 (:func:`asymmetric_inverse_dynamics`), and the constant offset a model with friction by
 direction amounts to (:func:`equivalent_offset`), and a model's parameters in the reference
-model's form, with their standard errors (:func:`reference_form`).
+model's form, with their standard errors (:func:`reference_form`; an input-output
+identification's under the benchmark's names: :func:`fit_parameters`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ import numpy as np
 from motionhyst.identify.input_output import IORecord
 
 __all__ = ["PUBLISHED", "REFERENCE_ASYMMETRIC", "REFERENCE_MODEL", "asymmetric_inverse_dynamics",
-           "equivalent_offset", "reference_form", "reference_system"]
+           "equivalent_offset", "fit_parameters", "reference_form",
+           "reference_system"]
 
 REFERENCE_MODEL = {"m": 95.1089, "c": 203.5034, "fc": 20.3935, "offset": -3.1648}
 """The benchmark's IDIM-LS model: M [kg], Fv [N s/m], Fc [N], OF [N]."""
@@ -177,6 +179,49 @@ def _weights(parameters: dict, record: IORecord) -> dict[str, dict[str, float]]:
               "c_skew": mean_speed, "c_pos": 0.5 * mean_speed, "c_neg": -0.5 * mean_speed}
     return {"m": {"m": 1.0}, "c": {"c": 1.0, "c_pos": 0.5, "c_neg": 0.5}, "fc": fc,
             "offset": offset}
+
+
+
+def fit_parameters(fit) -> tuple[dict, dict, dict]:
+    """An input-output identification's estimates under the reference model's names.
+
+    ``input_offset`` becomes ``offset`` (the model's own OF) and ``input_drift`` ``drift``;
+    a link's parameters lose their ``link.`` (kept where the stage has the same name), as
+    :func:`reference_form` takes them.
+
+    Parameters
+    ----------
+    fit : IOIdentificationResult
+        An identification of a mass-damper and its link
+        (:func:`~motionhyst.identify.input_output.identify_io`).
+
+    Returns
+    -------
+    estimates, std, covariance : dict
+        The estimates, their standard errors (None: not determined) and
+        ``{"parameters": [...], "matrix": [[...]]}`` under those names.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> fit = SimpleNamespace(estimates={"m": 93.0, "link.fc": 20.6, "input_offset": 0.05},
+    ...                       std={"m": 0.07, "link.fc": 0.05, "input_offset": None}, extra={})
+    >>> fit_parameters(fit)[:2]
+    ({'m': 93.0, 'fc': 20.6, 'offset': 0.05}, {'m': 0.07, 'fc': 0.05, 'offset': None})
+    """
+    est, std, short = {}, {}, {}
+    for name, value in fit.estimates.items():
+        short[name] = name.removeprefix("link.")
+        if short[name] != name and short[name] in fit.estimates:
+            short[name] = name
+        if name in ("input_offset", "input_drift"):
+            short[name] = name.removeprefix("input_")
+        est[short[name]] = float(value)
+        s = fit.std.get(name)
+        std[short[name]] = None if s is None else float(s)
+    cov = fit.extra.get("covariance", {"parameters": [], "matrix": []})
+    return est, std, {"parameters": [short.get(n, n) for n in cov["parameters"]],
+                      "matrix": cov["matrix"]}
 
 
 def reference_form(parameters: dict, record: IORecord, std: dict | None = None,
