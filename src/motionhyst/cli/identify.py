@@ -188,6 +188,10 @@ def run(args: argparse.Namespace) -> int:
 
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
+        from motionhyst.identify.displacement_noise import estimate_displacement
+
+        x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
+        extra["displacement_noise"] = noise.to_dict()
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         from motionhyst.identify.io_records import IORecord
@@ -253,6 +257,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"Maxwell-slip hysteresis identified from {path} ({what}, {ident.n_samples} samples)")
     print(ident)
+    if extra.get("displacement_noise", {}).get("sigma"):
+        print(f"  displacement: {extra['displacement_noise']['reason']}")
     from motionhyst.identify.io_checks import SYSTEMATIC_SHARE
 
     if share > SYSTEMATIC_SHARE:  # an order asked for, not saved: said, not refused

@@ -189,7 +189,11 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     t, x = data[:, 0], data[:, 1]
     if args.periodic:
         check_whole_periods(x, str(args.data))
+    from motionhyst.identify.displacement_noise import estimate_displacement
+
     try:
+        # the link's input without the sensor's white noise, as identify estimates it
+        x, noise = estimate_displacement(t, x, periodic=args.periodic)
         w = force_from_displacement(system.plant, system.hysteresis, t, x,
                                     periodic=args.periodic)
     except (ValueError, ArithmeticError) as exc:  # a record or model the run refuses
@@ -197,7 +201,8 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     target.write_csv({"time": t, "force": w}, fmt="%.17g")
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "predicted": "force", "force_rms": float(np.sqrt(np.mean(w ** 2))),
-               "force_peak": float(np.max(np.abs(w)))}
+               "force_peak": float(np.max(np.abs(w))),
+               "displacement_noise": noise.to_dict()}
     if args.json:
         print_json(summary)
         return 0
@@ -205,4 +210,6 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     print(f"Predicted the force of {sc.source} for the {t.size} displacement samples of "
           f"{args.data} ({what}) -> {args.out}")
     print(f"  force RMS {summary['force_rms']:.4g} N, peak {summary['force_peak']:.4g} N")
+    if noise.sigma > 0:
+        print(f"  displacement: {noise.reason}")
     return 0

@@ -45,6 +45,7 @@ from scipy.optimize import least_squares
 
 from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
+from motionhyst.identify.displacement_noise import estimate_displacement
 from motionhyst.identify.io_checks import (
     NO_HYSTERESIS_GAIN,
     SYSTEMATIC_SHARE,
@@ -646,9 +647,13 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     >>> round(est["input_offset"], 6), fit.output
     (5.0, 'force')
     """
-    fit = identify_quasi_static_io(records, link, periodic=False, n_elements=n_elements,
+    noise = [estimate_displacement(rec.t, rec.y) for rec in records]
+    used = [rec if x is rec.y else IORecord(rec.t, rec.u, x, rec.name)
+            for rec, (x, _) in zip(records, noise, strict=True)]
+    fit = identify_quasi_static_io(used, link, periodic=False, n_elements=n_elements,
                                    offset=offset, max_evaluations=max_evaluations, tol=tol,
                                    output="force")
+    fit.extra["displacement_noise"] = [est.to_dict() for _, est in noise]
     if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
         fit.warnings.append(budget_note(fit.n_evaluations))
     # parameters the records do not determine: a warning, or (most of them) a failed fit

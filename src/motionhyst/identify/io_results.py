@@ -50,7 +50,10 @@ class IOIdentification:
     substeps : int
         Integration steps per sample the identification used.
     extra : dict
-        The offsets and initial states (``offsets``, ``initial_state``), whether the
+        The offsets and initial states (``offsets``, ``initial_state``), a force-displacement
+        record's displacement noise and whether it was filtered (``displacement_noise``, one
+        :meth:`~motionhyst.identify.displacement_noise.DisplacementEstimate.to_dict` per
+        record), whether the
         search stopped at its budget (``budget_reached``) and the covariance of the
         determined estimates from the fit's Jacobian (``covariance``: ``{"parameters",
         "matrix"}``, :func:`~motionhyst.identify.io_uncertainty.covariance_table`; a
@@ -144,6 +147,9 @@ class IOIdentification:
                              f"[{self.unit}]"],
                             [[r["name"], str(r["samples"]), g(r["fit_rms"]),
                               g(r["output_rms"])] for r in self.records])]
+        lines += [f"  displacement of {r['name']}: {est['reason']}" for r, est in
+                  zip(self.records, self.extra.get("displacement_noise", []), strict=False)
+                  if est["sigma"] > 0]
         lines += [f"  warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 

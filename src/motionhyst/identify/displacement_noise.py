@@ -1,0 +1,262 @@
+"""A displacement sensor's white noise, and the displacement without it (errors in variables).
+
+A force-displacement record's displacement is the *input* of a link model: its
+sensor's noise enters the model, not only the comparison.  A link with memory
+does not average it out: each reversal the noise makes near a slip opens a
+small loop, and a Dahl or Bouc-Wen link run on a displacement sampled at 1 kHz
+with 5 to 20 um of white noise gives a force that misses the one of the true,
+smooth displacement by 1 to 36 % of its RMS beyond the noise (earthquake-like
+and sine histories), an error no fit of the link's parameters can remove and no
+judgement of its residual can call noise.  The record's
+displacement is therefore estimated first (:func:`estimate_displacement`), the
+same way by ``identify`` and by ``predict``:
+
+1. The noise: the scale of the displacement's ``n``-th differences (for white
+   noise of deviation ``sigma``, ``C(2n, n) sigma^2``), each by its median
+   absolute deviation, which the few samples around a step, a corner or a
+   slip do not move (:func:`difference_scales`).  It is white noise when the
+   scales of orders 5 and 6 agree within :data:`WHITE_RATIO` (a smooth signal's
+   shrink with each order, by ``2 sin(pi f / fs)``) and above
+   :data:`MIN_RELATIVE_NOISE` of the displacement's range (rounding is not a
+   sensor's noise).  A noise-free record (a staircase, a trapezoid, a stick-slip
+   record, a sampled sine) has none and is used as it is, to the bit.
+2. The band that holds noise alone: above the highest frequency at which the
+   displacement's spectrum (Welch) stands :data:`SIGNAL_TO_NOISE` times above
+   the white noise's, times :data:`CUTOFF_MARGIN`; the displacement is low-passed
+   there (a Butterworth of order :data:`ORDER` run forwards and backwards: no
+   delay), unless that band is less than :data:`MIN_REMOVED_BAND` of the band up
+   to half the sampling rate.
+3. What the filter removed must be that white noise: its RMS within
+   :data:`REMOVED_RMS_RANGE` of the noise's share above the cut-off, and in each
+   of up to :data:`BLOCKS` blocks of the record alike (below :data:`BLOCK_FACTOR`
+   times it).  A step, whose fast part is in one place and rings once filtered, fails
+   this; the record is then used as it is, and the estimate says why.
+
+Examples
+--------
+>>> import numpy as np
+>>> t = np.arange(20000) / 1000.0
+>>> x = 0.01 * np.sin(2 * np.pi * 0.5 * t)
+>>> noisy = x + 10e-6 * np.random.default_rng(0).standard_normal(t.size)
+>>> x_hat, est = estimate_displacement(t, noisy)
+>>> est.filtered, round(est.sigma * 1e6, 1), round(est.cutoff_hz, 3)   # um, Hz
+(True, 10.1, 5.859)
+>>> round(float(np.std(noisy - x)) * 1e6, 2), round(float(np.std(x_hat - x)) * 1e6, 2)
+(9.96, 1.13)
+>>> stairs = 1e-3 * np.floor(t)                       # noise-free steps: untouched
+>>> same, est = estimate_displacement(t, stairs)
+>>> same is stairs, est.filtered, est.sigma
+(True, False, 0.0)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from motionhyst.time.resample import check_record, sampling_rate
+
+__all__ = ["BLOCKS", "BLOCK_FACTOR", "BLOCK_SAMPLES", "CUTOFF_MARGIN", "MIN_RELATIVE_NOISE",
+           "MIN_REMOVED_BAND", "ORDER", "REMOVED_RMS_RANGE", "SIGNAL_TO_NOISE", "WHITE_RATIO",
+           "DisplacementEstimate", "difference_scales", "estimate_displacement"]
+
+#: The orders of the differences whose scales must agree for white noise
+WHITE_ORDERS = (5, 6)
+#: ... to within this ratio (the smaller over the larger)
+WHITE_RATIO = 0.85
+#: Noise below this share of the displacement's range is rounding, not a sensor's
+MIN_RELATIVE_NOISE = 1e-9
+#: The displacement's spectrum holds signal where it stands this many times above the noise's
+SIGNAL_TO_NOISE = 10.0
+#: The cut-off is this many times the highest frequency that holds signal
+CUTOFF_MARGIN = 2.0
+#: The Butterworth's order (run forwards and backwards: twice that in magnitude)
+ORDER = 6
+#: A filter that would remove less than this share of the band (up to half the sampling
+#: rate) removes too little noise to be worth its risk: the record is used as it is
+MIN_REMOVED_BAND = 0.5
+#: What the filter removed, as RMS over the white noise's above the cut-off, must lie here
+REMOVED_RMS_RANGE = (0.85, 1.1)
+#: ... and in each of at most this many blocks of the record (of at least
+#: :data:`BLOCK_SAMPLES` samples), below this many times that RMS
+BLOCKS, BLOCK_SAMPLES, BLOCK_FACTOR = 16, 256, 1.3
+#: Records shorter than this many samples are used as they are
+MIN_SAMPLES = 512
+#: The median absolute deviation of a normal variable, in standard deviations
+MAD_NORMAL = 0.6744897501960817
+
+
+@dataclass
+class DisplacementEstimate:
+    """What :func:`estimate_displacement` found and did.
+
+    Attributes
+    ----------
+    sigma : float
+        The white noise's standard deviation [m] (0: none found).
+    filtered : bool
+        Whether the displacement was low-passed.
+    cutoff_hz : float or None
+        The low-pass's cut-off [Hz] (None: no band of noise alone).
+    reason : str
+        One line: what was found, and why the record was, or was not, filtered.
+    """
+
+    sigma: float
+    filtered: bool
+    cutoff_hz: float | None
+    reason: str
+
+    def to_dict(self) -> dict:
+        """The JSON form: ``sigma``, ``filtered``, ``cutoff_hz``, ``reason``."""
+        return {"sigma": self.sigma, "filtered": self.filtered, "cutoff_hz": self.cutoff_hz,
+                "reason": self.reason}
+
+    def __str__(self) -> str:
+        return self.reason
+
+
+def difference_scales(x: ArrayLike, orders: tuple[int, ...] = WHITE_ORDERS
+                      ) -> NDArray[np.float64]:
+    """The deviation of white noise that each order's differences of `x` show.
+
+    ``MAD(diff(x, n)) / 0.6745 / sqrt(C(2n, n))`` for each ``n`` of `orders`: white noise
+    of deviation ``sigma`` gives ``sigma`` at every order, a smooth signal less at each
+    higher order, and the samples around a few steps or corners (fewer than half the
+    differences) do not count.
+
+    Parameters
+    ----------
+    x : array_like
+        Samples, uniformly spaced.
+    orders : tuple of int
+        The orders of the differences.
+
+    Returns
+    -------
+    ndarray
+        One deviation per order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> e = np.random.default_rng(1).standard_normal(100000)
+    >>> [round(float(s), 2) for s in difference_scales(e, (1, 3, 6))]
+    [1.0, 1.0, 1.0]
+    >>> x = np.sin(np.arange(100000) / 100.0)            # smooth: each order far less
+    >>> [float(f"{s:.2g}") for s in difference_scales(x, (1, 2, 3))]
+    [0.0074, 4.3e-05, 2.3e-07]
+    """
+    x = np.asarray(x, dtype=float)
+    out = []
+    for n in orders:
+        d = np.diff(x, n)
+        mad = float(np.median(np.abs(d - np.median(d)))) if d.size else 0.0
+        out.append(mad / MAD_NORMAL / math.sqrt(math.comb(2 * n, n)))
+    return np.array(out)
+
+
+def _lowpass(x: NDArray[np.float64], fs: float, cutoff: float, periodic: bool
+             ) -> NDArray[np.float64]:
+    """`x` low-passed at `cutoff` without delay: the Butterworth of order :data:`ORDER` run
+    forwards and backwards (a periodic record: its magnitude squared applied around the
+    period)."""
+    from scipy import signal
+
+    if periodic:
+        f = np.fft.rfftfreq(x.size, 1.0 / fs)
+        gain = 1.0 / (1.0 + (f / cutoff) ** (2 * ORDER))
+        return np.fft.irfft(np.fft.rfft(x) * gain, x.size)
+    sos = signal.butter(ORDER, cutoff, fs=fs, output="sos")
+    pad = min(x.size - 1, math.ceil(3.0 * fs / cutoff))
+    return signal.sosfiltfilt(sos, x, padtype="odd", padlen=pad)
+
+
+def _removed_share(fs: float, cutoff: float) -> float:
+    """The share of white noise's variance that the low-pass removes (``mean |1 - H|^2``
+    over the band up to half the sampling rate)."""
+    f = np.linspace(0.0, fs / 2.0, 4097)
+    removed = 1.0 - 1.0 / (1.0 + (f / cutoff) ** (2 * ORDER))
+    return float(np.mean(removed ** 2))
+
+
+def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False
+                          ) -> tuple[NDArray[np.float64], DisplacementEstimate]:
+    """The displacement without its sensor's white noise, where the record shows such noise
+    and a band that holds it alone (see the module); else `x` itself.
+
+    Parameters
+    ----------
+    t : array_like
+        Uniform time grid [s].
+    x : array_like
+        The measured displacement [m].
+    periodic : bool
+        `x` holds whole periods (filtered around the period).
+
+    Returns
+    -------
+    x_hat : ndarray
+        The displacement estimated: `x` itself (the same object, if it was an ndarray of
+        floats) unless filtered.
+    estimate : DisplacementEstimate
+        The noise found, the cut-off, and why.
+
+    Examples
+    --------
+    A sampled sine without noise is used as it is:
+
+    >>> import numpy as np
+    >>> t = np.arange(4000) / 200.0
+    >>> x = 0.003 * np.sin(2 * np.pi * 2.0 * t)
+    >>> x_hat, est = estimate_displacement(t, x)
+    >>> bool(np.array_equal(x_hat, x)), est.filtered
+    (True, False)
+    >>> print(est)
+    no white noise: used as measured
+    """
+    tt, xs = check_record(t, x)
+    if not (isinstance(x, np.ndarray) and x.dtype == np.float64):
+        x = xs
+    none = DisplacementEstimate(0.0, False, None, "no white noise: used as measured")
+    span = float(np.ptp(xs)) if xs.size else 0.0
+    if xs.size < MIN_SAMPLES or not span > 0:
+        return x, none
+    s5, s6 = difference_scales(xs)
+    if not (min(s5, s6) >= WHITE_RATIO * max(s5, s6) and s6 > MIN_RELATIVE_NOISE * span):
+        return x, none
+    sigma = float(s6)
+    fs = sampling_rate(tt)
+    from scipy import signal
+
+    nperseg = int(min(xs.size, max(256, 2 ** round(math.log2(xs.size / 8)))))
+    f, p = signal.welch(xs, fs=fs, nperseg=nperseg)
+    floor = 2.0 * sigma ** 2 / fs  # white noise's one-sided density
+    above = np.nonzero(p > SIGNAL_TO_NOISE * floor)[0]
+    f_signal = float(f[above[-1]]) if above.size else float(f[1])
+    cutoff = CUTOFF_MARGIN * max(f_signal, float(f[1]))
+    what = f"white noise of {sigma:.2g} m RMS"
+    if cutoff > (1.0 - MIN_REMOVED_BAND) * fs / 2.0:
+        return x, DisplacementEstimate(sigma, False, None,
+                                       f"{what}, but the displacement's spectrum stands "
+                                       f"above it up to {f_signal:.3g} Hz: used as measured")
+    x_hat = _lowpass(xs, fs, cutoff, periodic)
+    removed = xs - x_hat
+    expected = sigma * math.sqrt(_removed_share(fs, cutoff))
+    rms = float(np.sqrt(np.mean(removed ** 2)))
+    blocks = np.array_split(removed, max(1, min(BLOCKS, xs.size // BLOCK_SAMPLES)))
+    worst = max(float(np.sqrt(np.mean(b ** 2))) for b in blocks)
+    low, high = REMOVED_RMS_RANGE
+    if not (low * expected <= rms <= high * expected and worst <= BLOCK_FACTOR * expected):
+        return x, DisplacementEstimate(sigma, False, cutoff,
+                                       f"{what}, but what a low-pass at {cutoff:.3g} Hz would "
+                                       f"remove is not that noise (RMS {rms:.3g} m, "
+                                       f"{worst:.3g} m in one part, against {expected:.3g} m: "
+                                       f"a step, or motion that fast): used as measured")
+    return x_hat, DisplacementEstimate(sigma, True, cutoff,
+                                       f"{what}, alone above {cutoff:.3g} Hz: low-passed "
+                                       f"there (the link's input estimated: errors in "
+                                       f"variables)")
