@@ -90,7 +90,9 @@ def identified(record) -> dict:
 
 
 def test_json_schema(identified, record):
-    assert set(identified) == IDENTIFY_KEYS
+    # a force-displacement record's displacement: its noise found, and whether it was removed
+    assert set(identified) == IDENTIFY_KEYS | {"displacement_noise"}
+    assert set(identified["displacement_noise"]) == {"sigma", "filtered", "cutoff_hz", "reason"}
     assert identified["model"] == "maxwell-slip"
     assert identified["record"] == "force-displacement"
     assert identified["data"] == str(record)
