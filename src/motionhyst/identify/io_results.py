@@ -53,17 +53,18 @@ class IOIdentification:
         The offsets and initial states (``offsets``, ``initial_state``), a force-displacement
         record's displacement noise and whether it was filtered (``displacement_noise``, one
         :meth:`~motionhyst.identify.displacement_noise.DisplacementEstimate.to_dict` per
-        record), whether the
-        search stopped at its budget (``budget_reached``) and the covariance of the
-        determined estimates from the fit's Jacobian (``covariance``: ``{"parameters",
-        "matrix"}``, :func:`~motionhyst.identify.io_uncertainty.covariance_table`; a
-        Bouc-Wen link's under its identified names ``alpha``, ``beta*gamma``, ``beta*delta``,
-        ``nu``).
+        record), whether the search stopped at its budget (``budget_reached``) and the
+        covariance of the determined estimates from the fit's Jacobian (``covariance``:
+        ``{"parameters", "matrix"}``,
+        :func:`~motionhyst.identify.io_uncertainty.covariance_table`; a Bouc-Wen link's
+        under its identified names ``alpha``, ``beta*gamma``, ``beta*delta``, ``nu``).
     warnings : list of str
         Implausible estimates, one line each naming the parameter
         (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
     data : list of IORecord
-        The records fitted (not in :meth:`to_dict`).
+        The records fitted (not in :meth:`to_dict`); a force-displacement record's
+        displacement as estimated without its sensor's white noise
+        (:func:`~motionhyst.identify.displacement_noise.estimate_displacement`).
     residuals : ndarray
         The model's output less the measured position, the records one after the other, as
         the fit compared them (offsets and initial states included) [m] (or [N]).
