@@ -248,3 +248,68 @@ def test_the_unit_warnings_catch_what_they_say_and_no_more(tmp_path, column, val
         warnings.simplefilter("always")
         read_record(data, (column, other))
     assert [w.category for w in caught] == ([MotionhystWarning] if warned else [])
+
+
+# ------------------------------------------------------------ MATLAB files by their format
+def _v73(path, variables: dict[str, np.ndarray]) -> None:
+    """A MATLAB 7.3 (HDF5) file of row vectors, as MATLAB writes them."""
+    import h5py
+
+    with h5py.File(path, "w", userblock_size=512) as fh:
+        for name, v in variables.items():
+            fh[name] = v[None, :]
+            fh[name].attrs["MATLAB_class"] = np.bytes_("double")
+    header = b"MATLAB 7.3 MAT-file".ljust(116, b" ") + b"\0" * 8 + b"\x00\x02IM"
+    with path.open("r+b") as fh:
+        fh.write(header)
+
+
+def _write(path, fmt: str, variables: dict[str, np.ndarray]) -> None:
+    from scipy.io import savemat
+
+    if fmt == "7.3":
+        _v73(path, variables)
+    else:
+        savemat(path, {k: v[:, None] for k, v in variables.items()},
+                do_compression=fmt == "7")
+
+
+@pytest.mark.parametrize("fmt", ["5", "7", "7.3"])
+def test_a_matlab_file_is_budgeted_by_the_variables_read_not_its_size(tmp_path, fmt):
+    """A MATLAB file of 19 MB holding a long signal beside the record's two columns, read
+    under a budget of 64 MB: its readers skip the other variables (peak resident memory
+    the same for a file of 1 MB and of 200 MB, measured), so it is read; a text factor of 4
+    on the file's size refused it (81 MB)."""
+    n = 20_000
+    t = np.arange(n) / 1000.0
+    u = 50.0 * np.sin(2 * np.pi * 3 * t)
+    other = np.random.default_rng(0).standard_normal(2_400_000)
+    _write(tmp_path / "r.mat", fmt, {"t": t, "u": u, "camera": other})
+    (tmp_path / "axis.toml").write_text(AXIS)
+    assert (tmp_path / "r.mat").stat().st_size > 17e6
+    before = (tmp_path / "r.mat").read_bytes()
+    code, _, err = limited_process.run(["predict", "axis.toml", "r.mat", "--columns",
+                                        "time=t,force=u", "--out", "p.csv",
+                                        "--max-memory", "64M"], tmp_path)
+    assert code == 0, err
+    assert "budget" not in err
+    p = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
+    assert p.shape[0] == n and np.all(np.isfinite(p))
+    assert (tmp_path / "r.mat").read_bytes() == before
+
+
+@pytest.mark.parametrize("fmt", ["5", "7.3"])
+def test_a_matlab_variable_read_beyond_the_budget_is_still_refused(tmp_path, fmt):
+    """The variables read count: 2 x 400000 values of 16 bytes as read are 12.8 MB, above a
+    budget of 8 MB, whatever the file's size."""
+    n = 400_000
+    t = np.arange(n) / 1000.0
+    _write(tmp_path / "r.mat", fmt, {"t": t, "u": np.sin(t)})
+    (tmp_path / "axis.toml").write_text(AXIS)
+    before = snapshot(tmp_path)
+    line = limited_process.refusal(["predict", "axis.toml", "r.mat", "--columns",
+                                    "time=t,force=u", "--out", "p.csv", "--max-memory",
+                                    "8M"], tmp_path)
+    assert "r.mat: cannot read variable 'u': reading its 400000 values needs" in line, line
+    assert "above the memory budget" in line
+    assert snapshot(tmp_path) == before

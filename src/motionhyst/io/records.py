@@ -69,7 +69,7 @@ from motionhyst.io.csvdata import (
     read_columns,
     read_header,
 )
-from motionhyst.io.inputs import CSV_EXPANSION, input_problem
+from motionhyst.io.inputs import input_problem
 
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _MAT_TEXT_HEADER = b"MATLAB"
@@ -195,7 +195,12 @@ def _is_path(source: Source) -> bool:
 
 
 def _head(path: Path, n: int = 128) -> bytes:
-    why = input_problem(path, CSV_EXPANSION)
+    """The first `n` bytes of a record's file, which say its kind.  Only the file's type is
+    checked here: what reading it takes depends on the kind (a CSV file's text parsed
+    whole, ``CSV_EXPANSION`` times its size, checked by its reader; a MATLAB file's
+    variables read one by one, the others skipped, each checked by :func:`_check_size`
+    from the size it declares), not on the file's size alone."""
+    why = input_problem(path, 0.0)
     if why:
         raise RecordError(f"cannot read {path}: {why}")
     try:
