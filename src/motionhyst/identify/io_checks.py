@@ -28,12 +28,14 @@ from numpy.typing import NDArray
 
 from motionhyst.identify.io_records import IORecord
 
-__all__ = ["DIRECTION_MOVING", "DIRECTION_SAMPLES", "DIRECTION_SHARE", "DIRECTION_SIGNIFICANCE",
+__all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTION_SHARE",
+           "DIRECTION_SIGNIFICANCE", "DIRECTION_TOP",
            "MASS_FACTOR", "MASS_SHARE", "MASS_SIGMAS", "MAX_PREDICT_SUBSTEPS",
            "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE",
            "FitFailed", "budget_note", "check_inertia", "default_plant", "flat_profile",
            "hysteresis_gain", "judge_fit", "linear_mass_std", "noise_cost",
-           "plausibility_warnings", "systematic_share", "viscous_direction_note"]
+           "plausibility_warnings", "systematic_share", "viscous_direction",
+           "viscous_direction_note"]
 
 #: The finest integration step ``predict`` takes, in steps per record sample; a model that
 #: needs more (a collapsed mass on a stiff link) is not a model ``predict`` can run
@@ -558,29 +560,119 @@ def flat_profile(costs: list[float], dof: int) -> bool:
 DIRECTION_SIGNIFICANCE = 3.0
 #: ... and by more than this share of their mean (a difference that biases a symmetric fit)
 DIRECTION_SHARE = 0.1
-#: Samples slower than this share of the velocity's RMS are left out of that comparison (where
-#: the axis sticks or turns, Coulomb friction is no function of the velocity)
-DIRECTION_MOVING = 0.1
-#: Each direction must hold at least this share of the samples compared
-DIRECTION_SAMPLES = 0.05
+#: Samples slower than this share of the velocity's RMS are left out of that comparison: where
+#: the axis sticks, turns or breaks away, friction is no function of the velocity (a LuGre link
+#: driven 2.5-3 times faster one way than the other, symmetric, showed a difference of 60-130
+#: N s/m with 0.1 of the RMS, none beyond its standard error with 0.3; EMPS the same 75 N s/m)
+DIRECTION_MOVING = 0.3
+#: Each direction must hold at least this share of the samples compared (a direction driven 3
+#: times faster than the other passes the slower one's speeds in 6 % of them)
+DIRECTION_SAMPLES = 0.02
+#: The speeds compared reach the slower direction's quantile of this level (not one sample's
+#: peak, where the other direction would be compared with itself alone)
+DIRECTION_TOP = 0.99
+#: Nodes of the piecewise-linear friction curve ``f(|v|) sign(v)`` fitted with the difference
+DIRECTION_NODES = 6
+
+
+def viscous_direction(records: list[IORecord]
+                      ) -> dict[str, float | tuple[float, float]] | None:
+    """The difference of a positioning axis's viscous friction between its directions, as the
+    records show it at the speeds both directions cover, with its standard error.
+
+    Friction that depends on the speed in any way the same in both directions (the
+    Stribeck effect: higher at low speed) is an odd function of the velocity, ``f(|v|)
+    sign(v)``; viscous friction by direction (Janot et al. 2019, eq. 12: ``c_pos`` moving
+    forward, ``c_neg`` backward) adds an even part ``(c_pos - c_neg) / 2 |v|``, and a
+    force offset or Coulomb forces by direction a constant.  The inverse dynamics
+    (:func:`~motionhyst.identify.io_start.equation_rows`) ``u = m y'' + f(|y'|) sign(y') +
+    (c_pos - c_neg) / 2 |y'| + u0``, ``f`` piecewise linear in the speed
+    (:data:`DIRECTION_NODES` nodes at its quantiles), one linear solve, tells the two
+    apart only over the band of speeds both directions cover: from :data:`DIRECTION_MOVING`
+    of the velocity's RMS (slower, the axis sticks, turns or breaks away) to the slower
+    direction's :data:`DIRECTION_TOP` quantile.  Compared at other speeds (the direction
+    driven faster is seen where the Stribeck curve is flat, the slower one where it falls)
+    the curve's shape would read as a difference.  The standard error is robust to the
+    residuals' correlation (Newey-West, as :func:`check_inertia`).  The mean coefficient
+    ``c`` is the one-coefficient inverse dynamics' on the moving samples with that even
+    part taken out.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        Records of a positioning axis (a mass-damper: force in, position out).
+
+    Returns
+    -------
+    dict or None
+        ``c_pos``, ``c_neg``, ``difference`` (``c_pos - c_neg``), ``std`` (its standard
+        error), ``c`` (the mean), ``band`` (lowest and highest speed compared [m/s]); None
+        when a direction holds fewer than :data:`DIRECTION_SAMPLES` of the samples in the
+        band (nothing to compare).
+
+    Examples
+    --------
+    >>> t = np.arange(4000) / 1000.0
+    >>> y = 0.03 * np.sin(2 * np.pi * t) + 0.01 * np.sin(6 * np.pi * t)
+    >>> v = np.gradient(y, t, edge_order=2)
+    >>> u = 95 * np.gradient(v, t, edge_order=2) + 160 * v + 20 * np.sign(v)
+    >>> noise = np.random.default_rng(0).standard_normal(t.size)
+    >>> est = viscous_direction([IORecord(t, u + 80 * np.minimum(v, 0) + noise, y)])
+    >>> round(est["difference"], 1), round(est["std"], 1), round(est["c"], 1)
+    (-80.2, 0.3, 200.1)
+    """
+    from motionhyst.identify.io_start import equation_rows
+
+    if not records or any(rec.y.size < 16 for rec in records):
+        return None
+    rows, rhs = equation_rows(records, floating=True, asymmetric=True)
+    velocities = [r[:, 1] + r[:, 2] for r in rows]  # columns: y'', max(y', 0), min(y', 0), ..
+    v = np.concatenate(velocities)
+    low = DIRECTION_MOVING * math.sqrt(float(np.mean(v ** 2)))
+    if not (np.sum(v > low) and np.sum(v < -low)):
+        return None
+    high = min(float(np.quantile(v[v > low], DIRECTION_TOP)),
+               float(np.quantile(-v[v < -low], DIRECTION_TOP)))
+    speed = np.abs(v)
+    band = (speed > low) & (speed <= high)
+    if min(np.sum(band & (v > 0)), np.sum(band & (v < 0))) < max(
+            DIRECTION_SAMPLES * np.sum(band), DIRECTION_NODES + 4):
+        return None  # one direction barely seen at the other's speeds: nothing to compare
+    nodes = np.quantile(speed[band], np.linspace(0.0, 1.0, DIRECTION_NODES))
+    nodes[0], nodes[-1] = low, high
+    shapes = np.eye(DIRECTION_NODES)
+    compared, forces = [], []
+    for r, b, vel in zip(rows, rhs, velocities, strict=True):
+        s = np.abs(vel)
+        inside = (s > low) & (s <= high)
+        hats = [np.interp(s[inside], nodes, shape) * np.sign(vel[inside]) for shape in shapes]
+        compared.append(np.column_stack([r[inside, 0], s[inside], np.ones(np.sum(inside)),
+                                         *hats]))
+        forces.append(b[inside])
+    x, cov = _robust_least_squares(compared, forces,
+                                   max(7, 2 * round(0.005 * records[0].fs) + 1))
+    even, even_std = float(x[1]), math.sqrt(max(float(cov[1, 1]), 0.0))
+    moving = speed > low  # the one-coefficient inverse dynamics, that even part taken out
+    A = np.column_stack([np.concatenate([r[:, 0] for r in rows]), v, np.sign(v),
+                         np.ones_like(v)])[moving]
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    b = np.concatenate(rhs)[moving] - even * speed[moving]
+    c = float(np.linalg.lstsq(A / scale, b, rcond=None)[0][1] / scale[1])
+    return {"c_pos": c + even, "c_neg": c - even, "difference": 2.0 * even,
+            "std": 2.0 * even_std, "c": c, "band": (low, high)}
 
 
 def viscous_direction_note(records: list[IORecord]) -> str | None:
     """A warning when the records' viscous friction differs by direction: the mass of a fit
     with one viscous coefficient is biased then.
 
-    The inverse dynamics with a viscous coefficient per direction (IDIM-LS with the
-    asymmetric friction of Janot et al. 2019, eq. 12: ``u = m y'' + c_pos max(y', 0) +
-    c_neg min(y', 0) + f sign(y') + u0``, one linear solve,
-    :func:`~motionhyst.identify.io_start.equation_rows`), on the samples moving faster than
-    :data:`DIRECTION_MOVING` of the velocity's RMS (where the axis sticks or turns, the
-    friction is no function of the velocity: a record that mostly moves one way would
-    show a difference that is not there), gives ``c_pos - c_neg`` and its
-    standard error, robust to the residuals' correlation (Newey-West, as
-    :func:`check_inertia`).  A difference beyond :data:`DIRECTION_SIGNIFICANCE` standard
-    errors and :data:`DIRECTION_SHARE` of the mean coefficient is reported, with the
-    option that estimates it (``--asymmetric``); a direction with fewer than
-    :data:`DIRECTION_SAMPLES` of the samples is not compared.  On EMPS: c+ 162, c- 237 N s/m.
+    The difference and its standard error at the speeds both directions cover
+    (:func:`viscous_direction`: friction that depends on the speed alike both ways, the
+    Stribeck effect, is no difference, however differently the two directions were
+    driven); beyond :data:`DIRECTION_SIGNIFICANCE` standard errors and
+    :data:`DIRECTION_SHARE` of the mean coefficient it is reported, with the option that
+    estimates it (``--asymmetric``).  On EMPS: c+ 158, c- 234 N s/m.
 
     Parameters
     ----------
@@ -602,37 +694,24 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
     >>> viscous_direction_note([IORecord(t, u + noise, y)]) is None
     True
     >>> print(viscous_direction_note([IORecord(t, u + 80 * np.minimum(v, 0) + noise, y)]))
-    the records' inverse dynamics (IDIM-LS) gives viscous friction by direction, c+ 160.1 and
-    c- 240.2 N s/m (difference 80.2 +- 0.3): a fit with one viscous coefficient biases the
-    mass; --asymmetric estimates one per direction
+    the records' inverse dynamics (IDIM-LS) gives viscous friction by direction, c+ 160 and
+    c- 240.2 N s/m (difference 80.2 +- 0.33 at the speeds both directions cover, 56.5-377
+    mm/s): a fit with one viscous coefficient biases the mass; --asymmetric estimates one per
+    direction
     """
-    from motionhyst.identify.io_start import equation_rows
-
-    if not records or any(rec.y.size < 16 for rec in records):
+    est = viscous_direction(records)
+    if est is None:
         return None
-    rows, rhs = equation_rows(records, floating=True, asymmetric=True)
-    moving_rows, moving_rhs = [], []
-    for r, b in zip(rows, rhs, strict=True):  # columns: y'', max(y', 0), min(y', 0), ...
-        v = r[:, 1] + r[:, 2]
-        moving = np.abs(v) > DIRECTION_MOVING * math.sqrt(float(np.mean(v ** 2)))
-        moving_rows.append(r[moving])
-        moving_rhs.append(b[moving])
-    moving_v = np.concatenate([r[:, 1] + r[:, 2] for r in moving_rows])
-    if min(np.sum(moving_v > 0), np.sum(moving_v < 0)) < DIRECTION_SAMPLES * moving_v.size:
-        return None  # one direction barely seen: nothing to compare
-    x, cov = _robust_least_squares(moving_rows, moving_rhs,
-                                   max(7, 2 * round(0.005 * records[0].fs) + 1))
-    c_pos, c_neg = float(x[1]), float(x[2])
-    std = math.sqrt(max(float(cov[1, 1] + cov[2, 2] - 2.0 * cov[1, 2]), 0.0))
-    diff = c_pos - c_neg
-    mean = 0.5 * (c_pos + c_neg)
+    diff, std, mean = est["difference"], est["std"], est["c"]
     if not (mean > 0 and abs(diff) > DIRECTION_SIGNIFICANCE * std
             and abs(diff) > DIRECTION_SHARE * mean):
         return None
+    low, high = est["band"]
     return (f"the records' inverse dynamics (IDIM-LS) gives viscous friction by direction, "
-            f"c+ {c_pos:.4g} and c- {c_neg:.4g} N s/m (difference {abs(diff):.3g} +- "
-            f"{std:.2g}): a fit with one viscous coefficient biases the mass; --asymmetric "
-            f"estimates one per direction")
+            f"c+ {est['c_pos']:.4g} and c- {est['c_neg']:.4g} N s/m (difference {abs(diff):.3g}"
+            f" +- {std:.2g} at the speeds both directions cover, {1e3 * low:.3g}-"
+            f"{1e3 * high:.3g} mm/s): a fit with one viscous coefficient biases the mass; "
+            f"--asymmetric estimates one per direction")
 
 
 def budget_note(evaluations: int) -> str:
