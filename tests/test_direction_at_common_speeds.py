@@ -2,19 +2,22 @@
 ways: a symmetric axis whose friction is higher at low speed (LuGre's Stribeck effect),
 driven 2.5-3 times faster one way than the other, shows none (the old comparison, over all
 moving samples, read the Stribeck curve as c+ 166 and c- -28 N s/m); an asymmetric one is
-still found, with its difference; EMPS still shows it."""
+still found, with its difference; EMPS still shows it.  The library's default is the
+command's: by direction where the records show it."""
 
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from motionhyst.cli import main
-from motionhyst.hysteresis import LuGre
-from motionhyst.identify.input_output import IORecord
+from motionhyst.core.warnings import MotionhystWarning
+from motionhyst.hysteresis import Coulomb, LuGre
+from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_checks import viscous_direction, viscous_direction_note
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import OpenLoop
@@ -101,6 +104,37 @@ def test_identify_fits_one_viscous_coefficient_on_a_symmetric_stribeck_axis(tmp_
     assert est["m"] == pytest.approx(95.0, rel=0.04)
 
 
+def _axis(c_pos: float, c_neg: float, n: int = 4000) -> IORecord:
+    """A mass-damper with Coulomb friction, viscous friction by direction, a force offset."""
+    t = np.arange(n) / FS
+    u = 200 * np.sin(2 * np.pi * 0.6 * t) + 80 * np.sin(2 * np.pi * 1.7 * t + 0.3)
+    axis = OpenLoop(MassDamper.by_direction(95.0, c_pos, c_neg, force_offset=3.0),
+                    Coulomb(fc=20.0))
+    y = axis.simulate(t, u, substeps=20).displacement
+    return IORecord(t, u, y + 1e-6 * np.random.default_rng(3).standard_normal(n), "axis")
+
+
+def test_the_librarys_default_is_the_commands():
+    """identify_io without `asymmetric` fits viscous friction by direction where the records
+    show it, with the command's warning line (before: one coefficient, as
+    ``benchmark emps --models coulomb`` fitted it); False fits one, and warns that its mass
+    is biased."""
+    rec = _axis(163.0, 240.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MotionhystWarning)
+        fit = identify_io([rec], "coulomb", plant="mass-damper", init_window=20)
+    lines = [str(w.message) for w in caught if "by direction" in str(w.message)]
+    assert len(lines) == 1 and "fitted with one viscous coefficient per direction" in lines[0]
+    assert fit.estimates["c"] == pytest.approx(163.0, rel=0.01)
+    assert fit.estimates["c"] + fit.estimates["link.c_neg"] == pytest.approx(240.0, rel=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MotionhystWarning)
+        one = identify_io([rec], "coulomb", plant="mass-damper", init_window=20,
+                          asymmetric=False)
+    assert not {"link.c_pos", "link.c_neg"} & set(one.estimates)
+    assert any("biases the mass" in line for line in one.warnings)
+
+
 @pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").exists(), reason="../shared absent")
 def test_emps_still_shows_it_on_every_split():
     """The EMPS record (whole, and the estimation periods of its four splits): c+ about 158,
@@ -121,3 +155,27 @@ def test_emps_still_shows_it_on_every_split():
         assert est["c_neg"] == pytest.approx(234.0, abs=5.0), rec.name
         assert -est["difference"] > 15.0 * est["std"], rec.name
 
+
+def test_benchmark_emps_models_named_by_their_link_are_fitted_as_identify_fits_them():
+    """``benchmark emps --models coulomb`` fits what ``identify --model coulomb`` fits: by
+    direction where the record shows it (before: always one coefficient); ``-symmetric``
+    insists on one, and a name with both ``-symmetric`` and ``-asymmetric`` is refused."""
+    from motionhyst.identify.emps import run_emps
+    from motionhyst.identify.emps_models import check_model
+
+    t = np.arange(4000) / FS
+    y = 0.03 * np.sin(2 * np.pi * t) + 0.01 * np.sin(6 * np.pi * t)
+    v = np.gradient(y, t, edge_order=2)
+    u = (95.0 * np.gradient(v, t, edge_order=2) + 160.0 * v + 80.0 * np.minimum(v, 0.0)
+         + 20.0 * np.sign(v) + 0.1)
+    res = run_emps(IORecord(t, u, y, "axis"), models=("coulomb", "coulomb-symmetric"),
+                   periods=(1, 1), period=2000)
+    default, symmetric = res.models
+    assert default.parameters["c"] == pytest.approx(200.0, rel=0.02)  # c + (c+ + c-)/2
+    own = default.model_parameters
+    assert own["c"] == pytest.approx(160.0, rel=0.02)
+    assert own["c"] + own["c_neg"] == pytest.approx(240.0, rel=0.02)
+    assert not {"c_pos", "c_neg", "c_skew"} & set(symmetric.model_parameters)
+    assert default.validation["rmse_mm"] < 0.2 * symmetric.validation["rmse_mm"]
+    with pytest.raises(ValueError, match="exclude each other"):
+        check_model("jenkins-asymmetric-symmetric")

@@ -302,7 +302,7 @@ def test_offset_with_viscous_friction_by_direction_as_the_reference_models():
     true = {"offset": 0.1, "c_neg": 80.0}
     assert symmetric["u0"] < -2.0  # the direction-dependent viscous force taken as an offset
     assert equivalent_offset(true, rec) == pytest.approx(symmetric["u0"], abs=0.05)
-    res = run_emps(IORecord(t, u, y, "axis"), models=("coulomb",), periods=(1, 2),
+    res = run_emps(IORecord(t, u, y, "axis"), models=("coulomb-symmetric",), periods=(1, 2),
                    period=PERIOD)
     (model,) = res.models
     assert model.to_dict()["equivalent_offset"] == pytest.approx(model.parameters["offset"],

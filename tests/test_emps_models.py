@@ -79,7 +79,8 @@ def test_the_coulomb_fit_is_reused_as_the_friction_links_start():
         assert reused.estimates[name] == alone.estimates[name], name
     assert reused.n_evaluations < alone.n_evaluations
     with pytest.raises(ValueError, match="other options"):
-        identify_io([rec], "jenkins", plant="mass-damper", init_window=20, rigid=coulomb)
+        identify_io([rec], "jenkins", plant="mass-damper", init_window=20, asymmetric=False,
+                    rigid=coulomb)
 
 
 def test_the_rigid_limit_a_friction_link_starts_from_is_identify_ios_coulomb_fit():

@@ -39,7 +39,9 @@ def add_parser(sub) -> None:
                         "coulomb-asymmetric,coulomb-asymmetric-drift,jenkins-asymmetric; "
                         "a link of coulomb, dahl, jenkins, lugre, "
                         "maxwell-slip, ending in -asymmetric for viscous friction by direction "
-                        "and -drift for a force offset drifting in time)")
+                        "or -symmetric for one coefficient (neither: by direction where the "
+                        "record shows it, as identify fits it) and -drift for a force offset "
+                        "drifting in time)")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
 

@@ -80,8 +80,10 @@ with the force offset drifting in time from the record's start (``-drift``, ``id
 kg (93.28-93.89 kg).  Other models are given by name (:func:`run_emps`'s `models`, ``benchmark
 emps --models``): ``jenkins-asymmetric-drift`` (its rigid limit on this record,
 ``coulomb-asymmetric-drift``, :func:`~motionhyst.identify.emps_models.unresolved_stiffness`),
-and those with one viscous coefficient (``"coulomb"``, ``"jenkins"``, ``"jenkins-drift"``:
-90.4-91.5 kg, the difference between the directions taken into the mass)."""
+those with one viscous coefficient (``"coulomb-symmetric"``, ``"jenkins-symmetric"``,
+``"jenkins-symmetric-drift"``: 90.4-91.5 kg, the difference between the directions taken into
+the mass), and those named by their link alone (``"jenkins"``), fitted as ``identify`` fits
+them: by direction where the record shows it (this one does)."""
 CHOSEN = "coulomb-asymmetric-drift"
 """The physical model whose test-record score is motionhyst's figure, chosen before the test by
 the rule of :func:`choose` on the two splits of ``DATA_EMPS``, among :data:`MODELS`: the
@@ -783,6 +785,13 @@ def _rigid_limit(name: str, options: set[str], est: IORecord, val: IORecord,
         *model.warnings])
 
 
+def _by_direction(options: set[str]) -> bool | None:
+    """:func:`~motionhyst.identify.input_output.identify_io`'s `asymmetric` for a model's
+    options: True (``-asymmetric``), False (``-symmetric``), else None (by direction where
+    the record shows it, ``identify``'s default)."""
+    return True if "asymmetric" in options else False if "symmetric" in options else None
+
+
 def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
                         val: IORecord, rigid: dict) -> EMPSModel:
     """One model identified on `est` with the benchmark's window and scored on both records;
@@ -793,7 +802,7 @@ def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
         with warnings.catch_warnings():  # the report lists the fit's warnings itself
             warnings.simplefilter("ignore", MotionhystWarning)
             fit = identify_io([est], link, plant="mass-damper", init_window=INIT_WINDOW,
-                              asymmetric="asymmetric" in options, drift="drift" in options,
+                              asymmetric=_by_direction(options), drift="drift" in options,
                               rigid=None if link == "coulomb" else rigid.get(key))
         if link == "coulomb":
             rigid[key] = fit

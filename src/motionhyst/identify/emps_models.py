@@ -2,9 +2,10 @@
 
 :func:`~motionhyst.identify.emps.run_emps` identifies a friction link on a mass-damper,
 named as the link (:data:`LINKS`) followed by options (:data:`OPTIONS`:
-``jenkins-asymmetric-drift``).  A Jenkins link whose stiffness the record cannot resolve
-is reported as its rigid limit, the Coulomb link with the same options
-(:func:`unresolved_stiffness`, :data:`RIGID_LIMIT`).
+``jenkins-asymmetric-drift``; without ``-asymmetric`` or ``-symmetric``, viscous friction by
+direction where the record shows it, as ``identify`` fits it).  A Jenkins link whose
+stiffness the record cannot resolve is reported as its rigid limit, the Coulomb link with the
+same options (:func:`unresolved_stiffness`, :data:`RIGID_LIMIT`).
 """
 
 from __future__ import annotations
@@ -16,13 +17,16 @@ __all__ = ["LINKS", "OPTIONS", "RIGID_LIMIT", "STUCK_MODE_SAMPLES", "check_model
            "model_options", "unresolved_stiffness"]
 
 
-#: The options a model's name may end with (``jenkins-asymmetric-drift``)
-OPTIONS = ("asymmetric", "drift")
+#: The options a model's name may end with (``jenkins-asymmetric-drift``): viscous friction by
+#: direction (``identify --asymmetric``) or one coefficient (``--symmetric``; neither: by
+#: direction where the record shows it, ``identify``'s default), a drifting force offset
+OPTIONS = ("asymmetric", "symmetric", "drift")
 
 
 def model_options(name: str) -> tuple[str, set[str]]:
-    """A model's link and its options, from its name (the link's, then ``-asymmetric`` and
-    ``-drift``: :func:`~motionhyst.identify.input_output.identify_io`'s options).
+    """A model's link and its options, from its name (the link's, then ``-asymmetric`` or
+    ``-symmetric`` and ``-drift``: :func:`~motionhyst.identify.input_output.identify_io`'s
+    options).
 
     Parameters
     ----------
@@ -41,6 +45,8 @@ def model_options(name: str) -> tuple[str, set[str]]:
     >>> link, options = model_options("maxwell-slip-asymmetric-drift")
     >>> link, sorted(options)
     ('maxwell-slip', ['asymmetric', 'drift'])
+    >>> model_options("jenkins-symmetric")
+    ('jenkins', {'symmetric'})
     """
     link, options = name, set()
     while True:
@@ -63,8 +69,8 @@ def check_model(name: str) -> None:
     Parameters
     ----------
     name : str
-        A link of :data:`LINKS`, optionally ending in ``-asymmetric`` and ``-drift``
-        (:func:`model_options`).
+        A link of :data:`LINKS`, optionally ending in ``-asymmetric`` or ``-symmetric`` and
+        in ``-drift`` (:func:`model_options`).
 
     Raises
     ------
@@ -78,12 +84,19 @@ def check_model(name: str) -> None:
     Traceback (most recent call last):
     ...
     ValueError: benchmark model 'bouc-wen': a friction link of coulomb, dahl, jenkins, lugre, ...
+    >>> check_model("coulomb-symmetric-asymmetric")
+    Traceback (most recent call last):
+    ...
+    ValueError: benchmark model 'coulomb-symmetric-asymmetric': -asymmetric and -symmetric ...
     """
-    link, _ = model_options(name)
+    link, options = model_options(name)
     if link not in LINKS:
         raise ValueError(f"benchmark model {name!r}: a friction link of {', '.join(LINKS)}, "
-                         f"optionally ending in -asymmetric and/or -drift "
+                         f"optionally ending in -asymmetric or -symmetric and/or -drift "
                          f"(jenkins-asymmetric-drift)")
+    if {"asymmetric", "symmetric"} <= options:
+        raise ValueError(f"benchmark model {name!r}: -asymmetric and -symmetric exclude each "
+                         f"other")
 
 
 def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> str | None:

@@ -208,7 +208,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 start_nfev: int | None = None, plant: Plant | type | str = MassSpringDamper,
                 output: str | None = None, offset: str = "auto", from_rest: bool = False,
                 max_evaluations: int | None = None, init_window: int | None = None,
-                asymmetric: bool | None = False, drift: bool = False,
+                asymmetric: bool | None = None, drift: bool = False,
                 fewer_elements: bool = False, rigid_limit: bool = False,
                 rigid: IOIdentification | None = None) -> IOIdentification:
     """Identify a stage and its link from input-output records.
@@ -323,13 +323,20 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         backward); the Coulomb link holds it itself (its ``c_pos`` or ``c_neg`` on
         top of the stage's ``c``, the smaller).  Its force offset is then another
         number than a symmetric model's: the symmetric one takes up the mean of the
-        difference.  None (``identify``'s default): by direction where the records
-        show it (:func:`~motionhyst.identify.io_checks.viscous_direction_note`: a
-        symmetric fit's mass is biased there), said in a warning; else one coefficient.
-        On the EMPS record's period splits (1-2 > 3-4, 3-4 > 1-2, 1-3 > 4, 2-4 > 1,
-        the held-out periods predicted from a 20-sample window) the Jenkins link's error
-        fell from 5.57, 9.71, 3.17, 6.10 mm to 5.20, 6.30, 1.02, 3.31 mm, the Coulomb
-        link's from 5.10, 9.71, 3.17, 6.10 to 5.20, 6.30, 1.12, 3.32 mm.
+        difference.  None, the default (``identify``'s too, and ``benchmark emps``'s for a
+        model named without ``-asymmetric`` or ``-symmetric``): by direction where the
+        records show it, said in a warning; else one coefficient.  The records show it
+        when their inverse dynamics finds a difference at the speeds both directions
+        cover, beyond three standard errors and a tenth of the mean coefficient
+        (:func:`~motionhyst.identify.io_checks.viscous_direction_note`; a symmetric fit's
+        mass is biased there): friction that is higher at low speed alike both ways (the
+        Stribeck effect) is no difference, however differently the two directions were
+        driven.  True (``--asymmetric``) fits two coefficients, False (``--symmetric``)
+        one, whatever the records show.  On the EMPS record's period splits (1-2 > 3-4,
+        3-4 > 1-2, 1-3 > 4, 2-4 > 1, the held-out periods predicted from a 20-sample
+        window) the Jenkins link's error fell from 5.57, 9.71, 3.17, 6.10 mm to 5.20, 6.30,
+        1.02, 3.31 mm, the Coulomb link's from 5.10, 9.71, 3.17, 6.10 to 5.20, 6.30, 1.12,
+        3.32 mm.
     drift : bool
         A mass-damper whose force offset drifts in time: its rate ``input_drift``
         [N/s] is estimated with the force offset (the plant receives ``u -
