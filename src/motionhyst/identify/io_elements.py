@@ -46,11 +46,13 @@ from motionhyst.identify.io_start import (
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
     SINGULAR_RTOL,
+    WindowNoise,
     covariance,
     covariance_table,
     standard_errors,
     undetermined_notes,
     weak_notes,
+    white_noise_variance,
 )
 from motionhyst.identify.rigid_limit import as_rigid_limit, rigid_seed
 from motionhyst.plants.mass_damper import MassDamper
@@ -324,11 +326,7 @@ class _ElementProblem:
 
         def one(i):
             rec = self.records[i]
-            fine = self.fine[i] if self.fine_one is None else self.fine[i] - u0 * self.fine_one[i]
-            u = rec.u - u0
-            if self.fine_t is not None:  # the offset drifting over the record's time
-                fine = fine - drift * self.fine_t[i]
-                u = u - drift * rec.t
+            u, fine = self._inputs(i, u0, drift)
             if self.window is not None:
                 return self._from_window(mech, stepping, k_link, rec, u, fine, dparams, skew)
             y, sy = simulate_elements(mech, stepping, u, rec.fs, self.r,
@@ -372,6 +370,16 @@ class _ElementProblem:
                                skew)
         if dparams is None or sy.shape[1] == 0:
             return y, sy
+        S = self._state_columns(mech, stepping, k_link, rec, u, fine, p, vel, y)
+        w = self.window
+        d_state = -np.linalg.lstsq(S[:w], sy[:w], rcond=None)[0]
+        return y, sy + S @ d_state
+
+    def _state_columns(self, mech, stepping, k_link, rec, u, fine, p, vel, y
+                       ) -> NDArray[np.float64]:
+        """``d y / d (position, velocity)`` of a record's run from the state ``p, vel``
+        (`y`): a floating stage's position exactly (its offset), the rest by forward
+        differences."""
         cols = []
         for dp, dv in ((1.0, 0.0), (0.0, 1.0)):
             if dp and mech.floating:
@@ -382,10 +390,18 @@ class _ElementProblem:
             y2, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p + dp * step,
                                    vel + dv * step, fine)
             cols.append((y2 - y) / step)
-        S = np.column_stack(cols)
-        w = self.window
-        d_state = -np.linalg.lstsq(S[:w], sy[:w], rcond=None)[0]
-        return y, sy + S @ d_state
+        return np.column_stack(cols)
+
+    def _inputs(self, i: int, u0: float, drift: float):
+        """Record `i`'s force and its upsampled run's, less the force offset `u0` and its
+        drift."""
+        rec = self.records[i]
+        fine = self.fine[i] if self.fine_one is None else self.fine[i] - u0 * self.fine_one[i]
+        u = rec.u - u0
+        if self.fine_t is not None:  # the offset drifting over the record's time
+            fine = fine - drift * self.fine_t[i]
+            u = u - drift * rec.t
+        return u, fine
 
     def window_states(self, v: NDArray[np.float64]) -> list[tuple[float, float]]:
         """Each record's ``(position, velocity)`` set from its window at the parameters
@@ -398,6 +414,30 @@ class _ElementProblem:
         return [state_from_window(mech, link.time_stepping(), link.initial_stiffness,
                                   rec.u - u0 - drift * rec.t, rec.y, rec.fs, self.r, self.window)
                 for rec in self.records]
+
+    def window_noise(self, v: NDArray[np.float64], sigma2: float | None = None
+                     ) -> WindowNoise:
+        """How the noise of each record's window reaches its residuals at the parameters `v`
+        (:class:`~motionhyst.identify.io_uncertainty.WindowNoise`, the positions' noise
+        variance `sigma2`): the run's sensitivity to the state its window sets, and that
+        state's least squares over the window (a simulation per record and state column, a
+        floating stage's position exact)."""
+        k, nl = self.n_plant, self.n_link
+        u0 = self.extras.split(v[k + nl:])[0]
+        drift = self.extras.drift(v[k + nl:])
+        link = self.layout.build(v[k:k + nl])
+        mech, stepping, k_link = self.mechanics(v), link.time_stepping(), link.initial_stiffness
+        parts, row = [], 0
+        for i, rec in enumerate(self.records):
+            u, fine = self._inputs(i, u0, drift)
+            p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
+                                       self.window)
+            y, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine)
+            self._count(2 - int(mech.floating))
+            S = self._state_columns(mech, stepping, k_link, rec, u, fine, p, vel, y)
+            parts.append((row, S, np.linalg.pinv(S[:self.window])))
+            row += rec.y.size
+        return WindowNoise(row, parts, sigma2)
 
     def _measured(self, rec) -> NDArray[np.float64]:
         return rec.y - np.mean(rec.y) if self.centre else rec.y
@@ -757,7 +797,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
             if np.sum(prob.residuals(q_seed) ** 2) < np.sum(prob.residuals(q0) ** 2):
                 q0 = q_seed
     # what the standard errors at the end take: a run and the Jacobian's differences
-    reserve = 1 + (prob.extras.size if prob.exact else q0.size)
+    reserve = (1 + (prob.extras.size if prob.exact else q0.size)
+               + (2 * len(records) if init_window is not None else 0))
     remaining = max_nfev if plan.left is None else plan.left - reserve
     with plan.share(remaining if plan.left is not None else None):
         sol = prob.solve(q0, tol, remaining)
@@ -767,7 +808,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     J = prob.jacobian(sol.x) * y_scale / prob.derivative(v)  # d residual / d parameter
     n_eval += prob.n_eval
     rtol = SINGULAR_RTOL if prob.exact else FD_SINGULAR_RTOL
-    std_v, groups = standard_errors(J, rss, res.size, rtol)
+    # a window's state moves with its samples' noise, and so every residual after it
+    noise = (prob.window_noise(v, white_noise_variance(prob._split_rows(res)))
+             if init_window is not None else None)
+    std_v, groups = standard_errors(J, rss, res.size, rtol, noise)
     names = [*prob.plant.PARAMETERS, *layout.names, *extras.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
@@ -844,7 +888,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                            **({"input_drift": drift_rate} if extras.input_drift else {})},
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0),
-               "covariance": covariance_table(names, covariance(J, rss, res.size, rtol), std)})
+               "covariance": covariance_table(names, covariance(J, rss, res.size, rtol, noise),
+                                                std)})
 
 
 def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:

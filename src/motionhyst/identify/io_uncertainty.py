@@ -4,7 +4,10 @@ From the Jacobian ``J`` of the simulation residuals at the optimum, standard
 errors ``sqrt(diag(sigma^2 (J^T J)^-1))`` with ``sigma^2 = RSS / (N - p)``,
 a direction of ``J`` with a singular value below :data:`SINGULAR_RTOL` of the
 largest (:data:`FD_SINGULAR_RTOL` for a finite-difference Jacobian) being one
-the data do not determine (:func:`standard_errors`), the covariance whose
+the data do not determine (:func:`standard_errors`); where each record's initial state
+is set from its first samples (an initialisation window), the noise of those samples
+moves every residual after them, and the covariance is the sandwich of
+:class:`WindowNoise`.  The covariance whose
 diagonal they are the square roots of (:func:`covariance`; ``identify --json`` and
 ``--save`` carry it for a Monte-Carlo study: :func:`covariance_table`,
 :func:`identification_toml`), and the notes that say so (:func:`undetermined_notes`,
@@ -29,7 +32,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
-           "judge_determined", "undetermined", "zero_allowed"]
+           "WindowNoise", "judge_determined", "undetermined", "white_noise_variance",
+           "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -56,8 +60,158 @@ AT_ZERO = 1e-12
 _SIGNED = ("offset", "drift", "y0", "v0", "c_skew", "beta*")
 
 
+class WindowNoise:
+    """How the noise of the measured positions reaches the residuals of a fit whose records'
+    initial states are set from their first samples (an initialisation window).
+
+    Record ``i``'s state ``s_i`` (its position and velocity at the first sample) is the
+    least-squares fit of the model's run to its first ``N`` measured positions, so it
+    moves with their noise: ``d s_i = B_i e_w`` with ``B_i = (S_w^T S_w)^-1 S_w^T``,
+    ``S = d y / d s_i`` (the run's sensitivity to the state) and ``S_w`` its first ``N``
+    rows.  A residual is then ``r = J dtheta - L e`` with ``L = I - S B`` (block by
+    record): the window's noise moves every residual of the record after it, as much as
+    the state's error carries (a velocity error of a floating stage integrates into a
+    position error for as long as the stage slides).  The least-squares estimate
+    ``dtheta = (J^T J)^-1 J^T L e`` has the covariance
+    ``sigma_n^2 (J^T J)^-1 J^T L L^T J (J^T J)^-1`` when the residuals are the records'
+    noise (variance ``sigma_n^2``; ``L = I``: the usual ``sigma^2 (J^T J)^-1``).  When
+    they are mostly the model's error (a measured axis: EMPS's fit RMS is 0.45 mm, its
+    encoder's noise 0.03 um), that error is not what the window's samples carry into the
+    state; with the positions' own noise ``sigma_n^2`` (`sigma2`,
+    :func:`white_noise_variance`: their residuals' sum of squares would take the model's
+    error for noise, and the few samples of a short window make it scatter) the covariance
+    is
+
+    .. math::
+
+        \\sigma_r^2 (J^T J)^{-1} + \\sigma_n^2 (J^T J)^{-1} J^T (L L^T - I) J (J^T J)^{-1},
+        \\qquad \\sigma_r^2 = \\max\\left(\\frac{RSS - \\sigma_n^2 (\\lVert (I - H) L
+        \\rVert_F^2 - (N - p))}{N - p}, \\sigma_n^2\\right),
+
+    the first term the usual one for the residuals less what the window's noise adds to
+    them in expectation (``H`` the projection on the columns of ``J``), the second what
+    that noise moves the estimates by; residuals that are the noise alone give the
+    sandwich.
+
+    Parameters
+    ----------
+    n_rows : int
+        The residuals' rows, all records.
+    parts : list of (int, ndarray, ndarray)
+        For each record, its first row, ``S`` (its rows by the state's columns) and ``B``
+        (the state's columns by the window's rows).
+    sigma2 : float
+        The measured positions' noise variance [m^2].
+
+    Examples
+    --------
+    A constant measured over 20 samples, its value set from the first 2: their noise
+    shifts all 20 residuals together.
+
+    >>> S = np.ones((20, 1))
+    >>> noise = WindowNoise(20, [(0, S, np.full((1, 2), 0.5))], 1e-12)
+    >>> round(noise.frobenius2(), 6)                    # ||L||^2 = 20 - 2 + 20 * 0.5
+    28.0
+    >>> X = np.linspace(0.0, 1.0, 20)[:, None]
+    >>> np.allclose(noise.left(X), X.T - X.T @ S @ np.array([[0.5, 0.5] + [0.0] * 18]))
+    True
+    """
+
+    def __init__(self, n_rows: int, parts: list[tuple[int, NDArray[np.float64],
+                                                      NDArray[np.float64]]],
+                 sigma2: float) -> None:
+        self.n_rows = int(n_rows)
+        self.parts = [(int(a), np.asarray(S, float), np.asarray(B, float)) for a, S, B in parts]
+        self.sigma2 = float(sigma2)
+
+    def left(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``X^T L`` for ``X`` of `n_rows` rows."""
+        out = np.array(X, dtype=float).T.copy()
+        for a, S, B in self.parts:
+            rows = slice(a, a + S.shape[0])
+            out[:, a:a + B.shape[1]] -= (out[:, rows] @ S) @ B
+        return out
+
+    def frobenius2(self) -> float:
+        """``||L||_F^2``: ``n_rows - 2 tr(S B) + tr(S^T S B B^T)`` over the records."""
+        total = float(self.n_rows)
+        for _, S, B in self.parts:
+            total += -2.0 * float(np.trace(B @ S[:B.shape[1]])) + float(
+                np.sum((S.T @ S) * (B @ B.T)))
+        return total
+
+
+#: Differences whose scatter measures a record's white noise (:func:`white_noise_variance`):
+#: the third, which leave a smooth signal's acceleration-rate and take ``20 sigma^2`` of noise
+NOISE_DIFFERENCES = 3
+
+
+def white_noise_variance(parts: list[NDArray[np.float64]]) -> float:
+    """The white noise variance of measured positions, from their residuals' third
+    differences (robustly: their median absolute deviation).
+
+    A residual is noise plus the model's error; the error of a simulated stage varies
+    smoothly from sample to sample, and its third differences are far below its size,
+    while white noise's have ``20 sigma^2`` (``C(6, 3)``).  The median absolute deviation
+    keeps a few steps of the error (a slider sticking a sample early) out.  A record's
+    quantisation (an encoder's step ``q``: ``q^2 / 12``) counts as its noise.
+
+    Parameters
+    ----------
+    parts : list of ndarray
+        Each record's residuals [m] (at least 4 samples each to count).
+
+    Returns
+    -------
+    float
+        ``sigma^2`` [m^2] (0 for records too short).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.arange(5000) / 1000.0
+    >>> smooth = 1e-4 * np.sin(2 * np.pi * 3 * t)           # a model's error: 100 um, slow
+    >>> e = smooth + 1e-6 * rng.standard_normal(t.size)     # and 1 um of noise
+    >>> round(float(np.sqrt(white_noise_variance([e]))) * 1e6, 2)
+    1.0
+    """
+    k = NOISE_DIFFERENCES
+    d = [np.diff(np.asarray(r, dtype=float), k) for r in parts if len(r) > k]
+    if not d:
+        return 0.0
+    d = np.concatenate(d)
+    mad = float(np.median(np.abs(d - np.median(d))))
+    return (1.4826 * mad) ** 2 / math.comb(2 * k, k)
+
+
+def _decomposed(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float,
+                noise: WindowNoise | None):
+    """The normalised columns' scales, the covariance of the estimates in normalised
+    coordinates over the determined directions (``sigma^2 V S^-2 V^T``; with `noise`,
+    ``V S^-1 (sigma_r^2 I + sigma_n^2 (W W^T - I)) S^-1 V^T``, ``W = U^T L``) and the
+    undetermined directions (rows of right singular vectors)."""
+    norms = np.linalg.norm(J, axis=0)
+    norms[norms == 0] = 1.0
+    u, sv, vt = np.linalg.svd(J / norms, full_matrices=False)
+    good = sv > rtol * sv[0]
+    dof = max(n_rows - J.shape[1], 1)
+    eye = np.eye(int(good.sum()))
+    if noise is None:
+        inner = rss / dof * eye
+    else:
+        if noise.n_rows != J.shape[0]:
+            raise ValueError("the noise map's rows differ from the Jacobian's")
+        W = noise.left(u[:, good])
+        spread = noise.frobenius2() - float(np.sum(W * W))  # E RSS / sigma_n^2, noise alone
+        # the residuals less what the window's noise adds to them, at least that noise
+        sigma2 = max((rss - noise.sigma2 * (spread - dof)) / dof, noise.sigma2)
+        inner = sigma2 * eye + noise.sigma2 * (W @ W.T - eye)
+    vg = vt[good].T / sv[good]
+    return norms, vg @ inner @ vg.T, vt[~good]
+
+
 def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
-                    rtol: float = SINGULAR_RTOL
+                    rtol: float = SINGULAR_RTOL, noise: WindowNoise | None = None
                     ) -> tuple[NDArray[np.float64], list[list[int]]]:
     """Standard errors of the parameters and the groups the data cannot separate.
 
@@ -65,38 +219,29 @@ def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
     value is below `rtol` of the largest is a direction the data do not
     determine, and the parameters with a component above 1e-3 in it form a
     group (only other combinations of them are determined).  Their standard
-    errors are NaN; the others come from the pseudo-inverse.
+    errors are NaN; the others come from the pseudo-inverse, with `noise` (an
+    initialisation window's, :class:`WindowNoise`) its sandwich.
     """
-    norms = np.linalg.norm(J, axis=0)
-    norms[norms == 0] = 1.0
-    Jn = J / norms
-    _, sv, vt = np.linalg.svd(Jn, full_matrices=False)
-    p = J.shape[1]
-    sigma2 = rss / max(n_rows - p, 1)
-    good = sv > rtol * sv[0]
-    groups = [list(np.nonzero(np.abs(vt[i]) > 1e-3)[0]) for i in np.nonzero(~good)[0]]
-    cov = (vt[good].T / sv[good] ** 2) @ vt[good]
-    std = np.sqrt(sigma2 * np.diag(cov)) / norms
+    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise)
+    groups = [list(np.nonzero(np.abs(row) > 1e-3)[0]) for row in bad]
+    std = np.sqrt(np.maximum(np.diag(cov), 0.0)) / norms
     for g in groups:
         std[g] = np.nan
     return std, groups
 
 
-def covariance(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float = SINGULAR_RTOL
-               ) -> NDArray[np.float64]:
+def covariance(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float = SINGULAR_RTOL,
+               noise: WindowNoise | None = None) -> NDArray[np.float64]:
     """The covariance ``sigma^2 (J^T J)^+`` of the estimates whose diagonal's square roots
     :func:`standard_errors` gives (the same normalised columns, singular values and
-    pseudo-inverse); the rows and columns of the parameters it marks undetermined are NaN.
+    pseudo-inverse; with `noise` its sandwich); the rows and columns of the parameters it
+    marks undetermined are NaN.
     """
-    norms = np.linalg.norm(J, axis=0)
-    norms[norms == 0] = 1.0
-    _, sv, vt = np.linalg.svd(J / norms, full_matrices=False)
-    sigma2 = rss / max(n_rows - J.shape[1], 1)
-    good = sv > rtol * sv[0]
-    cov = sigma2 * ((vt[good].T / sv[good] ** 2) @ vt[good]) / np.outer(norms, norms)
+    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise)
+    cov = cov / np.outer(norms, norms)
     cov = (cov + cov.T) / 2  # symmetric to the last bit (the product is so to round-off)
-    for i in np.nonzero(~good)[0]:
-        g = np.abs(vt[i]) > 1e-3
+    for row in bad:
+        g = np.abs(row) > 1e-3
         cov[g, :] = np.nan
         cov[:, g] = np.nan
     return cov
