@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from motionhyst.core.warnings import MotionhystWarning
 from motionhyst.hysteresis import Jenkins
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_uncertainty import (
@@ -106,9 +107,10 @@ def test_a_window_fit_holds_the_truth_within_its_standard_errors(seed):
     and the stage carries that into its position while it slides: the estimates move with
     it (k by 1-3 %).  They were reported with the standard errors of white residuals, the
     truth 20 to 45 of them away (seed 0: k 1.5 % high, 26 standard errors); the window's
-    noise is now in them, and the truth within 1.5."""
-    fit = identify_io([_jenkins_axis(seed)], "jenkins", plant="mass-damper", substeps=20,
-                      init_window=20)
+    noise is now in them, and the truth within 1.5.  A warning says what the window costs."""
+    with pytest.warns(MotionhystWarning, match="initialisation window's 20 samples"):
+        fit = identify_io([_jenkins_axis(seed)], "jenkins", plant="mass-damper", substeps=20,
+                          init_window=20)
     for name, value in TRUE.items():
         std = fit.std[name]
         assert std is not None, name
@@ -117,3 +119,9 @@ def test_a_window_fit_holds_the_truth_within_its_standard_errors(seed):
     cov = fit.extra["covariance"]
     k = cov["parameters"].index("link.k")
     assert np.sqrt(cov["matrix"][k][k]) == pytest.approx(fit.std["link.k"], rel=1e-9)
+    # the price is said: the same record fitted with its state estimated from all samples
+    # gives standard errors some 40 times smaller
+    price = [w for w in fit.warnings if w.startswith("the initialisation window's 20 samples")]
+    assert len(price) == 1 and "identify without --init-window" in price[0]
+    times = float(price[0].split("are up to ")[1].split(" times")[0])
+    assert 10 < times < 200

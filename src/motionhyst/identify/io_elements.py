@@ -46,6 +46,7 @@ from motionhyst.identify.io_start import (
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
     SINGULAR_RTOL,
+    WINDOW_INFLATION,
     WindowNoise,
     covariance,
     covariance_table,
@@ -53,6 +54,7 @@ from motionhyst.identify.io_uncertainty import (
     undetermined_notes,
     weak_notes,
     white_noise_variance,
+    window_inflation,
 )
 from motionhyst.identify.rigid_limit import as_rigid_limit, rigid_seed
 from motionhyst.plants.mass_damper import MassDamper
@@ -875,6 +877,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
               if nm in ("m", "m1", "m2")}
     notes = plausibility_warnings(estimates, masses, reference_mass(records, shape.floating),
                                   records, bound, runaway, shape.floating)
+    if noise is not None:
+        notes.extend(_window_price(J, rss, res.size, rtol, noise, names[:n_base], init_window))
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
@@ -890,6 +894,24 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                "budget_reached": bool(sol.status == 0),
                "covariance": covariance_table(names, covariance(J, rss, res.size, rtol, noise),
                                                 std)})
+
+
+def _window_price(J, rss, n_rows, rtol, noise: WindowNoise, names: list[str], window: int
+                  ) -> list[str]:
+    """One line when the noise of the initialisation window's samples makes the standard
+    error of one of the stage's or link's parameters (`names`, the first columns of `J`)
+    more than :data:`~motionhyst.identify.io_uncertainty.WINDOW_INFLATION` times that with
+    the records' states estimated from all their samples; else none."""
+    ratio = window_inflation(J, rss, n_rows, rtol, noise)[:len(names)]
+    ratio = np.where(np.isfinite(ratio), ratio, 0.0)
+    worst = int(np.argmax(ratio)) if ratio.size else 0
+    if not ratio.size or ratio[worst] <= WINDOW_INFLATION:
+        return []
+    return [f"the initialisation window's {window} samples set each record's initial state "
+            f"with their noise (its velocity to +- {noise.velocity_std():.2g} m/s): the "
+            f"standard errors are up to {ratio[worst]:.3g} times ({names[worst]}) those with "
+            f"the state estimated from all the samples (identify without --init-window); a "
+            f"longer window narrows them"]
 
 
 def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:

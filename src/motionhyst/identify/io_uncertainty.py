@@ -32,8 +32,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
-           "WindowNoise", "judge_determined", "undetermined", "white_noise_variance",
-           "zero_allowed"]
+           "WINDOW_INFLATION", "WindowNoise", "judge_determined", "undetermined",
+           "white_noise_variance", "window_inflation", "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -132,6 +132,28 @@ class WindowNoise:
             out[:, a:a + B.shape[1]] -= (out[:, rows] @ S) @ B
         return out
 
+    def residual_variance(self, W: NDArray[np.float64], rss: float, dof: int) -> float:
+        """``sigma_r^2``: the residuals' variance less what the window's noise adds to them
+        in expectation, at least that noise (``W = U^T L``, ``U`` the Jacobian's left
+        singular vectors; `dof` ``N - p``)."""
+        spread = self.frobenius2() - float(np.sum(W * W))  # E RSS / sigma_n^2, noise alone
+        return max((rss - self.sigma2 * (spread - dof)) / max(dof, 1), self.sigma2)
+
+    def states(self) -> NDArray[np.float64]:
+        """The state's columns of every record, each in its own rows (zero elsewhere)."""
+        cols = []
+        for a, S, _ in self.parts:
+            col = np.zeros((self.n_rows, S.shape[1]))
+            col[a:a + S.shape[0]] = S
+            cols.append(col)
+        return np.hstack(cols) if cols else np.zeros((self.n_rows, 0))
+
+    def velocity_std(self) -> float:
+        """The largest standard deviation of a record's initial velocity as its window sets
+        it [m/s] (the state's second column; 0 without one)."""
+        return max((math.sqrt(self.sigma2 * float((B @ B.T)[1, 1])) for _, _, B in self.parts
+                    if B.shape[0] > 1), default=0.0)
+
     def frobenius2(self) -> float:
         """``||L||_F^2``: ``n_rows - 2 tr(S B) + tr(S^T S B B^T)`` over the records."""
         total = float(self.n_rows)
@@ -139,6 +161,11 @@ class WindowNoise:
             total += -2.0 * float(np.trace(B @ S[:B.shape[1]])) + float(
                 np.sum((S.T @ S) * (B @ B.T)))
         return total
+
+
+#: An initialisation window whose noise makes a parameter's standard error more than this
+#: many times that with the records' states estimated from all their samples is said
+WINDOW_INFLATION = 2.0
 
 
 #: Differences whose scatter measures a record's white noise (:func:`white_noise_variance`):
@@ -202,10 +229,8 @@ def _decomposed(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float,
         if noise.n_rows != J.shape[0]:
             raise ValueError("the noise map's rows differ from the Jacobian's")
         W = noise.left(u[:, good])
-        spread = noise.frobenius2() - float(np.sum(W * W))  # E RSS / sigma_n^2, noise alone
-        # the residuals less what the window's noise adds to them, at least that noise
-        sigma2 = max((rss - noise.sigma2 * (spread - dof)) / dof, noise.sigma2)
-        inner = sigma2 * eye + noise.sigma2 * (W @ W.T - eye)
+        inner = (noise.residual_variance(W, rss, dof) * eye
+                 + noise.sigma2 * (W @ W.T - eye))
     vg = vt[good].T / sv[good]
     return norms, vg @ inner @ vg.T, vt[~good]
 
@@ -245,6 +270,38 @@ def covariance(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float = SI
         cov[g, :] = np.nan
         cov[:, g] = np.nan
     return cov
+
+
+def window_inflation(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float,
+                     noise: WindowNoise) -> NDArray[np.float64]:
+    """How many times the standard errors of a fit whose states its windows set
+    (:func:`standard_errors` with `noise`) are those of the same records with each state
+    estimated with the parameters from all their samples (``J`` with the states' columns,
+    the same residual variance): the price of the window, column by column (NaN where
+    either is not determined).
+
+    Examples
+    --------
+    A line's slope, its offset set from the first 2 of 200 samples (their mean) or
+    estimated from all of them: the window's noise more than quadruples the slope's
+    standard error.
+
+    >>> t = np.linspace(0.0, 1.0, 200)
+    >>> J = (t - t[:2].mean())[:, None]          # the slope's column, the offset set
+    >>> noise = WindowNoise(200, [(0, np.ones((200, 1)), np.full((1, 2), 0.5))], 1.0)
+    >>> round(float(window_inflation(J, 200.0, 200, SINGULAR_RTOL, noise)[0]), 2)
+    4.38
+    """
+    norms = np.linalg.norm(J, axis=0)
+    norms[norms == 0] = 1.0
+    u, sv, _ = np.linalg.svd(J / norms, full_matrices=False)
+    dof = max(n_rows - J.shape[1], 1)
+    sigma2 = noise.residual_variance(noise.left(u[:, sv > rtol * sv[0]]), rss, dof)
+    with_window, _ = standard_errors(J, rss, n_rows, rtol, noise)
+    joint = np.column_stack([J, noise.states()])
+    estimated, _ = standard_errors(joint, sigma2 * (n_rows - joint.shape[1]), n_rows, rtol)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return with_window / estimated[:J.shape[1]]
 
 
 def covariance_table(names: list[str], cov: NDArray[np.float64],
