@@ -58,7 +58,10 @@ Method
    parameters its estimate is correlated with), a rate scale whose profile is
    flat (95 % likelihood ratio), and a parameter that only adds a spring or
    damper in parallel with the stage's (``Parameter.parallel``, e.g. LuGre's
-   ``sigma2``: only ``c + sigma2`` enters the output; fixed at 0).
+   ``sigma2``: only ``c + sigma2`` enters the output; fixed at 0).  With an
+   initialisation window the noise of its samples moves the state it sets, and
+   with it every later residual: the covariance is the sandwich of
+   :class:`~motionhyst.identify.io_uncertainty.WindowNoise`.
 
 The benchmark's Bouc-Wen parameters ``beta, gamma, delta`` enter the model only
 as ``beta*gamma`` and ``beta*delta`` (``z`` is not measured and ``beta`` always
