@@ -125,3 +125,26 @@ def test_a_window_fit_holds_the_truth_within_its_standard_errors(seed):
     assert len(price) == 1 and "identify without --init-window" in price[0]
     times = float(price[0].split("are up to ")[1].split(" times")[0])
     assert 10 < times < 200
+
+
+@pytest.mark.parametrize(("window", "floor"), [(20, (10.0, 25.0)), (200, (1.0, 1.3))])
+def test_predict_says_what_the_windows_noise_leaves_a_true_model(window, floor):
+    """The true axis predicting its own noisy records from a window: the error from sample N
+    on is the noise carried by the state the window sets (20 samples of 1 um: 16 um RMS over
+    seeds, not the 1 um of noise), and ``predict`` says so; the noise is measured from the
+    error's third differences."""
+    from motionhyst.identify.io_predict import predict_from_window
+    from motionhyst.time.openloop import OpenLoop
+
+    true = OpenLoop(MassDamper(TRUE["m"], TRUE["c"], force_offset=-TRUE["input_offset"]),
+                    Jenkins(k=TRUE["link.k"], fc=TRUE["link.fc"]))
+    preds = []
+    for seed in range(8):
+        rec = _jenkins_axis(seed)
+        preds.append(predict_from_window(true, rec.t, rec.u, rec.y, window, substeps=20))
+    for pred in preds:
+        assert pred.noise == pytest.approx(1e-6, rel=0.1)
+        assert floor[0] * 1e-6 < pred.noise_floor < floor[1] * 1e-6
+        assert "gives a true model an RMS error of about" in str(pred)
+    rms = np.sqrt(np.mean([p.rmse ** 2 for p in preds]))
+    assert rms == pytest.approx(np.mean([p.noise_floor for p in preds]), rel=0.35)

@@ -127,6 +127,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"  initial position {pred.initial_state['position']:.6g} m, velocity "
                   f"{pred.initial_state['velocity']:.6g} m/s; RMS error from sample {window} "
                   f"on {pred.rmse:.4g} m (fit {pred.fit_percent:.2f} %)")
+            if pred.floor_text():
+                print(f"  ({pred.floor_text()})")
     return 0
 
 

@@ -21,6 +21,7 @@ from scipy.optimize import least_squares
 
 from motionhyst.core.budget import check_memory
 from motionhyst.hysteresis.stepping import Stepping
+from motionhyst.identify.io_uncertainty import white_noise_variance
 from motionhyst.time.openloop import (
     FINE_BYTES,
     SAMPLE_BYTES,
@@ -32,7 +33,7 @@ from motionhyst.time.openloop import (
 from motionhyst.time.resample import fine_blocks, held_nodes
 
 __all__ = ["INIT_WINDOW", "WindowPrediction", "predict_from_window", "run_from_state",
-           "state_from_window"]
+           "state_from_window", "window_noise_floor"]
 
 #: The benchmark's initialisation window [samples]
 INIT_WINDOW = 20
@@ -54,14 +55,22 @@ class WindowPrediction:
         RMS error from sample `window` on [m] (None without a measured position).
     fit_percent : float or None
         ``100 (1 - ||y - yhat|| / ||y - mean(y)||)`` over the same samples.
+    noise_floor : float or None
+        The RMS error from sample `window` on that the measured positions' noise gives the
+        true model, through the state its window sets (:func:`window_noise_floor`) [m]; None
+        where there is no state (a stage without inertia).
+    noise : float or None
+        That noise [m] (the error's third differences:
+        :func:`~motionhyst.identify.io_uncertainty.white_noise_variance`).
 
     Examples
     --------
     >>> pred = WindowPrediction(np.arange(3) / 1e3, np.zeros(3), 2,
-    ...                         {"position": 0.0, "velocity": 0.0}, 1e-3, 90.0)
+    ...                         {"position": 0.0, "velocity": 0.0}, 1e-3, 90.0, 1e-5, 1e-6)
     >>> print(pred)
     predicted 3 samples, state set from the first 2 (position 0 m, velocity 0 m/s); RMS error
-    from sample 2 on 0.001 m (fit 90.00 %)
+    from sample 2 on 0.001 m (fit 90.00 %); the positions' noise (1e-06 m), carried by the
+    state the window sets, gives a true model an RMS error of about 1e-05 m
     """
 
     t: NDArray[np.float64]
@@ -70,12 +79,22 @@ class WindowPrediction:
     initial_state: dict
     rmse: float | None = None
     fit_percent: float | None = None
+    noise_floor: float | None = None
+    noise: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready summary (no arrays)."""
         return {"samples": int(self.t.size), "init_window": self.window,
                 "initial_state": dict(self.initial_state), "rmse": self.rmse,
-                "fit_percent": self.fit_percent}
+                "fit_percent": self.fit_percent, "noise_floor_rmse": self.noise_floor,
+                "noise": self.noise}
+
+    def floor_text(self) -> str:
+        """What the noise alone would leave of the error (empty without it)."""
+        if self.noise_floor is None or self.noise is None:
+            return ""
+        return (f"the positions' noise ({self.noise:.3g} m), carried by the state the window "
+                f"sets, gives a true model an RMS error of about {self.noise_floor:.4g} m")
 
     def __str__(self) -> str:
         s = (f"predicted {self.t.size} samples, state set from the first {self.window} "
@@ -84,6 +103,8 @@ class WindowPrediction:
         if self.rmse is not None:
             s += (f"; RMS error from sample {self.window} on {self.rmse:.4g} m "
                   f"(fit {self.fit_percent:.2f} %)")
+        if self.floor_text():
+            s += f"; {self.floor_text()}"
         return s
 
     def plot(self, ax=None):
@@ -287,7 +308,69 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
                  f"{u.size} samples of {r} integration steps each", "fewer samples or substeps")
     position, velocity = state_from_window(mech, st, k_link, u, y, fs, r, window)
     yhat, _ = run_from_state(mech, st, k_link, u, fs, r, position, velocity)
-    return _scored(tt, yhat, y, window, position, velocity)
+    pred = _scored(tt, yhat, y, window, position, velocity)
+    pred.noise = math.sqrt(white_noise_variance([yhat - y]))
+    pred.noise_floor = window_noise_floor(mech, st, k_link, u, fs, r, position, velocity, yhat,
+                                          window, pred.noise)
+    return pred
+
+
+def window_noise_floor(mech, stepping: Stepping, k_link: float, u, fs: float, r: int,
+                       position: float, velocity: float, y, window: int, noise: float
+                       ) -> float:
+    """The RMS error from sample `window` on that white noise of `noise` [m] on the measured
+    positions gives the true model, its state set from the first `window` of them.
+
+    The state is the least squares of the run over the window (:func:`state_from_window`):
+    its error is ``B e_w``, ``B = (S_w^T S_w)^-1 S_w^T`` with ``S`` the run's sensitivity to
+    the state, and it moves sample ``n`` by ``S_n B e_w``; with the noise of the sample
+    itself, ``sqrt(noise^2 (1 + mean_n ||S_n B||^2))``.  On a floating stage a velocity
+    error integrates into the position while the stage slides: 20 samples at 1 kHz leave a
+    positioning axis some 15 times its noise, 200 samples 1.1 times.
+
+    Parameters
+    ----------
+    mech, stepping, k_link, u, fs, r, position, velocity
+        As for :func:`run_from_state` (the state the window set).
+    y : ndarray
+        The run from that state (:func:`run_from_state`'s position).
+    window : int
+        Samples that set the state.
+    noise : float
+        The positions' noise [m].
+
+    Returns
+    -------
+    float
+        [m].
+
+    Examples
+    --------
+    A free mass (no force) whose position and velocity are set from 20 samples: a straight
+    line fitted to them, carried on over 200.
+
+    >>> from motionhyst.time.openloop import MassSpringDamper
+    >>> mech = MassSpringDamper(1.0, 0.0, 0.0).mechanics()
+    >>> y, _ = run_from_state(mech, Stepping.empty(), 0.0, np.zeros(200), 1000.0, 2, 0.0, 0.0)
+    >>> floor = window_noise_floor(mech, Stepping.empty(), 0.0, np.zeros(200), 1000.0, 2,
+    ...                            0.0, 0.0, y, 20, 1e-6)
+    >>> round(floor * 1e6, 2)     # um: sqrt(1 + 1/20 + mean (n - 9.5)^2 / 665) of 1 um
+    4.49
+    """
+    scale = max(float(np.ptp(y)), 1e-12 * max(1.0, abs(position)), 1e-15)
+    cols = []
+    for dp, dv in ((1.0, 0.0), (0.0, 1.0)):
+        if dp and mech.floating:
+            cols.append(np.ones_like(y))
+            continue
+        step = 1e-4 * (dp * max(abs(position), scale) + dv * max(abs(velocity),
+                                                                scale * fs / window))
+        y2, _ = run_from_state(mech, stepping, k_link, u, fs, r, position + dp * step,
+                               velocity + dv * step)
+        cols.append((y2 - y) / step)
+    S = np.column_stack(cols)
+    G = S[window:] @ np.linalg.pinv(S[:window])
+    return float(noise * math.sqrt(1.0 + float(np.mean(np.sum(G * G, axis=1)))))
 
 
 def _scored(tt, yhat, y, window, position, velocity) -> WindowPrediction:
