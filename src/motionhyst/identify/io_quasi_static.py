@@ -17,7 +17,9 @@ Method
    second-order backward difference of the model), per record's ``b``.
 2. Starts of the link: the link takes 0.3 or 0.6 of ``K``, the spring the
    rest, slipping across the records' displacement or a tenth of it
-   (:data:`STARTS`); each is refined by the *equation* error (the force
+   (:data:`STARTS`); a velocity of the link (LuGre's Stribeck velocity) at a
+   tenth of the records' velocity RMS and at the RMS
+   (:data:`VELOCITY_STARTS`); each is refined by the *equation* error (the force
    predicted from the measured position, one pass of the link per
    evaluation, :func:`~motionhyst.time.quasi_static.force_from_displacement`).
    A link of stop operators (Jenkins, Maxwell-slip) also starts from the
@@ -77,6 +79,11 @@ __all__ = ["identify_link_force"]
 #: Starts: (the link's share of the linear stiffness, its slip displacement in units of the
 #: records' displacement RMS)
 STARTS = ((0.3, 1.0), (0.6, 1.0), (0.3, 0.1), (0.6, 0.1))
+#: A link's velocities (LuGre's Stribeck velocity) start at these multiples of the records'
+#: velocity RMS, each with each of :data:`STARTS`: at a tenth the Stribeck drop is confined to
+#: the reversals and a refinement can lose it (``fs`` or ``vs`` running to 0, the link left
+#: with a constant Coulomb force: a local minimum), at the RMS it spans the records' velocities
+VELOCITY_STARTS = (0.1, 1.0)
 #: Evaluations of each start's equation-error refinement, and of the final refinement
 START_NFEV, FINAL_NFEV = 60, 150
 #: A residual where the model cannot run (a force it does not hold), in output RMS units
@@ -368,18 +375,22 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     # (forward differences; scipy counts the steps only): a budget of evaluations holds
     # when each refinement is given at most its share over this
     per_step = int(np.count_nonzero(prob.free)) + 1
-    n_starts = len(STARTS) + (layout.cls in (Jenkins, MaxwellSlip))
+    velocity = [j for j, (par, _) in enumerate(layout._values()) if par.unit == "m/s"]
+    grid = [(share, slip, speed) for share, slip in STARTS
+            for speed in (VELOCITY_STARTS if velocity else VELOCITY_STARTS[:1])]
+    n_starts = len(grid) + (layout.cls in (Jenkins, MaxwellSlip))
     if budget is not None and budget < n_starts + 2 * per_step:
         raise ValueError(f"a budget of {budget} model evaluations is below the least this "
                          f"search needs, {n_starts + 2 * per_step} (one for each of its "
                          f"{n_starts} starts, {per_step} for each step of its refinement with "
                          f"its {per_step - 1} parameters' differences, two steps)")
-    n_start = START_NFEV if budget is None else (budget // 2) // (len(STARTS) * per_step)
+    n_start = START_NFEV if budget is None else (budget // 2) // (len(grid) * per_step)
     # position offsets of the linear fit: u = K (y - y0) + C y' + u0 with u0 = 0 unless estimated
     y0 = np.array([float(-bi / K) if out else 0.0 for bi in b])
     starts = []
-    for share, slip in STARTS:
+    for share, slip, speed in grid:
         link0 = layout.start(share * K, y_scale, v_scale, 0.0, slip)
+        link0[velocity] = speed * v_scale
         if force_error:
             _inside(layout, link0)
         v0 = np.concatenate([[(1.0 - share) * K, max(C, 0.0)], link0, [0.0], y0])
