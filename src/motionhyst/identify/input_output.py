@@ -277,7 +277,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         many elements as the fit determined (at least 1: the Jenkins element), said in a
         warning; else the fit is judged as it is.
     rigid_limit : bool
-        A Jenkins link on a mass-damper whose stiffness the records do not resolve (not
+        A Jenkins link (or a Maxwell-slip link of one element, a Jenkins link) on a
+        mass-damper whose stiffness the records do not resolve (not
         determined, or its stuck mode ``sqrt(k / m) / 2 pi`` above a quarter of the sampling
         rate: :func:`~motionhyst.identify.rigid_limit.unresolved_stiffness`), or any friction
         link there of whose parameters the records determine at most half (a failed fit

@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.hysteresis import Coulomb, Hysteresis, Jenkins, Parameter
+from motionhyst.hysteresis import Coulomb, Hysteresis, Jenkins, MaxwellSlip, Parameter
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
 from motionhyst.identify.io_checks import (
@@ -840,8 +840,13 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         if name not in not_ident:
             not_ident[name] = why
             std[name] = None
-    limit = (as_rigid_limit(coulomb, estimates, std, records[0].fs, math.sqrt(rss / res.size))
-             if rigid_limit and coulomb is not None and layout.cls is Jenkins else None)
+    # a Jenkins link, or a Maxwell-slip link of one element (a Jenkins link): its stiffness
+    k_name = ("link.k" if layout.cls is Jenkins else "link.k[0]"
+              if layout.cls is MaxwellSlip and n == 1 else None)
+    limit = (as_rigid_limit(coulomb, {"m": estimates["m"], "link.k": estimates[k_name]},
+                            {"link.k": std[k_name]}, records[0].fs, math.sqrt(rss / res.size),
+                            layout.cls.name)
+             if rigid_limit and coulomb is not None and k_name is not None else None)
     if limit is not None:  # before the checks: a stiffness beyond the records may not step
         return replace(limit, n_evaluations=n_eval, seconds=time.perf_counter() - t_start)
     u0, y0, init = extras.split(v[n_base:])

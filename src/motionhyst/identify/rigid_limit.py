@@ -106,9 +106,10 @@ def unresolved_stiffness(k: float, k_std: float | None, m: float, fs: float) -> 
 
 
 def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
-                   std: dict[str, float | None], fs: float,
-                   fit_rms: float) -> IOIdentification | None:
-    """A Jenkins link's fit on a positioning axis reported as its rigid limit when its records
+                   std: dict[str, float | None], fs: float, fit_rms: float,
+                   link: str = "jenkins") -> IOIdentification | None:
+    """A Jenkins link's fit on a positioning axis (or a Maxwell-slip link of one element: a
+    Jenkins link) reported as its rigid limit when its records
     do not resolve its stiffness (:func:`unresolved_stiffness`) or the limit fits them
     significantly better (likelihood ratio ``2 N ln(RMS / RMS_limit)`` above
     :data:`~motionhyst.identify.io_checks.PROFILE_CHI2`, ``N`` the residuals: the search, run
@@ -127,6 +128,9 @@ def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
         The records' sampling rate [Hz].
     fit_rms : float
         The Jenkins fit's RMS error [m], compared with the Coulomb link's.
+    link : str
+        The link fitted: ``"jenkins"``, or ``"maxwell-slip"`` (of one element, its
+        ``link.k[0]`` given as ``link.k``).
 
     Returns
     -------
@@ -156,6 +160,10 @@ def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
     >>> as_rigid_limit(coulomb, dict(jenkins, **{"link.k": 3e7}), {"link.k": 1e6}, 1000.0,
     ...                2.5e-3).warnings[0][-82:]
     'than k infinite: RMS 0.0025 m against 0.0023 m, likelihood ratio 334 > 3.84 (95 %)'
+    >>> one = as_rigid_limit(coulomb, jenkins, {"link.k": None}, 1000.0, 2.29e-3,
+    ...                      "maxwell-slip")
+    >>> one.extra["rigid_limit"]
+    'maxwell-slip: k 9.4e+09 N/m, not determined by the records'
     """
     why = unresolved_stiffness(estimates["link.k"], std.get("link.k"), estimates["m"], fs)
     ratio = (2 * rigid.residuals.size * math.log(fit_rms / rigid.fit_rms)
@@ -166,7 +174,8 @@ def as_rigid_limit(rigid: IOIdentification, estimates: dict[str, float],
                f"{ratio:.3g} > {PROFILE_CHI2:g} (95 %)")
     if why is None:
         return None
-    note = (f"the Jenkins link is reported as its rigid limit, the Coulomb link (fc "
+    title = "Jenkins link" if link == "jenkins" else "Maxwell-slip link of one element"
+    note = (f"the {title} is reported as its rigid limit, the Coulomb link (fc "
             f"{rigid.estimates['link.fc']:.4g} N, fit RMS {rigid.fit_rms:.3g} m): {why}")
     return replace(rigid, warnings=[note, *rigid.warnings],
-                   extra={**rigid.extra, "rigid_limit": f"jenkins: {why}"})
+                   extra={**rigid.extra, "rigid_limit": f"{link}: {why}"})
