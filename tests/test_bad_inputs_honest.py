@@ -75,6 +75,14 @@ def _force_noise(n: int = 6000) -> str:
 
 
 IO = ["--record", "input-output"]
+DAMPED_LINK = _paper('model = "jenkins"\nk = 20.0              # spring stiffness k_J [N/m]\n'
+                     'fc = 0.05             # slip force f_c [N]',
+                     'model = "lugre"\nsigma0 = 20.0\nsigma1 = 1e7\nfc = 0.05\nfs = 0.07\n'
+                     'vs = 0.1')
+TOO_DAMPED = ["s.toml: [hysteresis]: the implicit step at t = ", "did not converge in 50 "
+              "iterations: the link is too stiff (or too strongly damped) for the time step of",
+              "which the command sets from the loop's poles and the reference; is the link's "
+              "stiffness or damping meant (in SI units)?"]
 PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
 ZEROS = np.zeros((1000, 1))
 CELL = np.empty((1, 1), dtype=object)
@@ -108,6 +116,14 @@ CASES = [
      ["time steps of 1.75e-12 s: too many; the step resolves the loop's fastest closed-loop "
       "pole, 1.432e+10 Hz (beyond a motion stage's 1e+05 Hz: are s.toml's [stage] and "
       "[controller] values in SI units?); shorten the setpoint"]),
+    # ---------- a link too damped for the step the command sets: no advice of an option it
+    # lacks (the library's "use a smaller dt"), the scenario's section to check instead
+    ("scan-link-too-damped-for-its-step", {"s.toml": DAMPED_LINK},
+     ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max",
+      "1000", "--s-max", "1e6", "--compensation", "none"], TOO_DAMPED),
+    ("simulate-link-too-damped-for-its-step", {"s.toml": DAMPED_LINK},
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5", "--duration",
+      "0.2"], TOO_DAMPED),
     # --------------------- errors in a CSV's first data rows: decided before pandas loads
     ("csv-units-row", {"r.csv": "time,force\ns,N\n0,1\n0.001,2\n"},
      ["predict", "axis.toml", "r.csv", "--out", "p.csv"],
@@ -140,6 +156,18 @@ CASES = [
      ["r.mat: variable 'c' is a cell array, not a numeric vector"]),
 ]
 BASE = {"a.csv": _axis(), "axis.toml": AXIS, "notes.txt": "my notes"}
+
+
+def test_no_advice_names_an_option_the_command_lacks(tmp_path):
+    """scan and simulate set their own time step: the library's remedy (a smaller dt) is
+    not theirs to give."""
+    (tmp_path / "s.toml").write_text(DAMPED_LINK)
+    for case in CASES:
+        if case[0].endswith("link-too-damped-for-its-step"):
+            line = limited_process.refusal(list(case[2]), tmp_path)
+            assert "dt" not in line.split() and "smaller dt" not in line, line
+            assert "substeps" not in line, line
+    assert not (tmp_path / "ts.csv").exists()
 
 
 def test_the_cases_are_distinct():

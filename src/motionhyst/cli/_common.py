@@ -388,3 +388,28 @@ def warn_plant_fit(sc) -> None:
         The command's scenario.
     """
     sc.plant_fit()
+
+
+@contextlib.contextmanager
+def step_of_the_command(sc) -> Iterator[None]:
+    """A link's implicit step that did not converge
+    (:class:`~motionhyst.time.kernel.StepNotConverged`) inside, said in the terms of a
+    command whose step is its own (``scan``, ``simulate``: set from the loop's poles and
+    the reference, no option for it): the library's remedy (a smaller ``dt``, more
+    ``substeps``) names arguments the command does not have, so the message names the
+    scenario's ``[hysteresis]``, what its user can change.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The command's scenario.
+    """
+    from motionhyst.time.kernel import StepNotConverged
+
+    try:
+        yield
+    except StepNotConverged as exc:
+        raise StepNotConverged(f"{sc.source}: [hysteresis]: {exc.what}, which the command "
+                               f"sets from the loop's poles and the reference",
+                               "is the link's stiffness or damping meant (in SI units)?"
+                               ) from None

@@ -16,6 +16,7 @@ from motionhyst.cli._common import (
     positive,
     print_json,
     refuse_unused,
+    step_of_the_command,
     warn_plant_fit,
     whole_number,
 )
@@ -273,9 +274,10 @@ def run(args: argparse.Namespace) -> int:
                          f"model or feedforward terms (--feedforward), and {sc.source} has none")
     filters = ILCFilters(args.ilc_gain, args.ilc_cutoff, args.ilc_order)
     try:
-        res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
-                       args.settle_tol, args.tail, feedforward=terms,
-                       basis_trials=args.basis_trials or BASIS_TRIALS)
+        with step_of_the_command(sc):
+            res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
+                           args.settle_tol, args.tail, feedforward=terms,
+                           basis_trials=args.basis_trials or BASIS_TRIALS)
     except ValueError as exc:
         if "feedforward" in str(exc) or "inverse" in str(exc) or "P2" in str(exc):
             raise UsageError(f"{PROG}: {exc}") from None

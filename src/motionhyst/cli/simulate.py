@@ -18,6 +18,7 @@ from motionhyst.cli._common import (
     positive,
     print_json,
     refuse_unused,
+    step_of_the_command,
     warn_plant_fit,
 )
 
@@ -140,7 +141,7 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     options = {"output_rate_hz": args.output_rate}
     if args.settle_band is not None:
         options["settle_band"] = args.settle_band
-    with out.open(newline="") as fh:
+    with out.open(newline="") as fh, step_of_the_command(sc):
         s = run_time_series(sc.loop(), ref, duration, fh, **options)
     s = {"time_series": str(out.path), **s}
     if args.json:

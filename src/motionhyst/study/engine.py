@@ -192,8 +192,8 @@ class Evaluator:
             return _LOOP, str(exc), {}
         try:
             return 0, "", self._outputs(loop, values)
-        except RuntimeError as exc:
-            return _CONVERGE, str(exc), {}
+        except RuntimeError as exc:  # a link's step: its remedy is an argument a study lacks
+            return _CONVERGE, getattr(exc, "what", str(exc)), {}
         except ValueError as exc:
             return _OUTPUT, str(exc), {}
         except (ArithmeticError, np.linalg.LinAlgError) as exc:

@@ -55,7 +55,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.hysteresis.stepping import GL_T, GL_W, N_PARAMS, Stepping
 from motionhyst.time.kernel import CLOSED as CLOSED
-from motionhyst.time.kernel import MAX_FIXED_POINT_ITERATIONS, OPEN, step_loop
+from motionhyst.time.kernel import (
+    MAX_FIXED_POINT_ITERATIONS,
+    OPEN,
+    StepNotConverged,
+    step_loop,
+)
 
 __all__ = [
     "DiscreteController",
@@ -594,8 +599,10 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
         steps, Cout, np.zeros(3), 1, stepping, a, state, vel_row=2, convention=OPEN,
         ftol=1e-13 * stepping.scale, record_every=R, record_initial=True, controller=ctrl)
     if worst > MAX_FIXED_POINT_ITERATIONS:
-        raise RuntimeError(f"the link's implicit step at t = {done / R * T:.6g} s did not "
-                           f"converge; use more substeps")
+        raise StepNotConverged(f"the link's implicit step at t = {done / R * T:.6g} s did "
+                               f"not converge in {MAX_FIXED_POINT_ITERATIONS} iterations: the "
+                               f"link is too stiff (or too strongly damped) for the time step "
+                               f"of {T / R:.3g} s", "use more substeps")
     t = np.arange(n_k) * T
     y = Y[:n_k, 0]
     return SampledRun(t=t, r=rr, y=y, e=rr - y, u=U[:n_k], y_link=Y[:n_k, 1], w=W[:n_k])

@@ -23,10 +23,35 @@ from motionhyst.hysteresis.stepping import (
     coulomb_implicit,
 )
 
-__all__ = ["CLOSED", "MAX_FIXED_POINT_ITERATIONS", "OPEN", "step_loop"]
+__all__ = ["CLOSED", "MAX_FIXED_POINT_ITERATIONS", "OPEN", "StepNotConverged", "step_loop"]
 
 #: Fixed-point passes a step's link force may take before the run stops.
 MAX_FIXED_POINT_ITERATIONS = 50
+
+
+class StepNotConverged(RuntimeError):
+    """A link's implicit step that did not converge: the link is too stiff, or too strongly
+    damped, for the time step (its force changes more over a step than the loop's
+    feedthrough lets a fixed point settle).
+
+    The message is :attr:`what` happened and :attr:`remedy`, the caller's own way to a
+    finer step (a library function's ``dt`` or ``substeps``); a command that has no such
+    option says what its user can change instead, from :attr:`what`.
+
+    Examples
+    --------
+    >>> err = StepNotConverged("the implicit step at t = 0.01 s did not converge",
+    ...                        "use a smaller dt")
+    >>> print(err)
+    the implicit step at t = 0.01 s did not converge; use a smaller dt
+    >>> isinstance(err, RuntimeError), err.what
+    (True, 'the implicit step at t = 0.01 s did not converge')
+    """
+
+    def __init__(self, what: str, remedy: str):
+        super().__init__(f"{what}; {remedy}")
+        self.what = what
+        self.remedy = remedy
 
 #: Conventions of the implicit step (see :func:`step_loop`).
 CLOSED, OPEN = 0, 1

@@ -36,7 +36,7 @@ from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.along_stroke import AlongStroke
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
 from motionhyst.time.engine import FohStep, LoopState, run_steps
-from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS
+from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS, StepNotConverged
 from motionhyst.time.sampled import simulate_sampled
 from motionhyst.time.simulation_result import Simulation
 from motionhyst.time.steps import BYTES_PER_SAMPLE, pole_step
@@ -423,10 +423,10 @@ class _Engine:
             convention=CLOSED, ftol=1e-14 * self.f_scale, dexo=dr,
             exo=np.ascontiguousarray(lin), i_first=1)
         if iters > MAX_FIXED_POINT_ITERATIONS:
-            raise RuntimeError(
+            raise StepNotConverged(
                 f"the implicit step at t = {(i0 + done) * step:.6g} s did not converge in "
                 f"{MAX_FIXED_POINT_ITERATIONS} iterations: the link is too stiff (or too "
-                "strongly damped) for dt; use a smaller dt")
+                f"strongly damped) for the time step of {step:.3g} s", "use a smaller dt")
         self.r_prev = float(r[-1]) if len(r) else self.r_prev
         self.uh_prev = float(uh[-1]) if len(uh) else self.uh_prev
         e = Y[:, 0]
