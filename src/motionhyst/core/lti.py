@@ -224,13 +224,25 @@ def realize_scaled(num: ArrayLike, den: ArrayLike, omega0: float):
     >>> A, B, C, D = realize_scaled([1.0], [1.0, 100.0], 100.0)   # 1 / (s + 100), time 100 t
     >>> float(A[0, 0]), float(B[0, 0] * C[0, 0])
     (-1.0, 0.01)
+    >>> A, B, C, D = realize_scaled([1e-20, 2e-20], [1.0, 3.0, 2.0], 1.0)  # a tiny gain: kept
+    >>> float(np.real(C @ np.linalg.solve(-A, B) + D)[0, 0])                 # at s = 0
+    1e-20
     """
     n = len(den) - 1
     # substitute s = omega0 * s_hat, then divide numerator and denominator by omega0^n
-    num_h = np.asarray(num) * omega0 ** (np.arange(len(num) - 1, -1, -1.0) - n)
-    den_h = np.asarray(den) * omega0 ** (np.arange(n, -1, -1.0) - n)
-    sys = control.tf2ss(control.tf(num_h / den_h[0], den_h / den_h[0]))
-    return sys.A, sys.B, sys.C, sys.D
+    num_h = np.asarray(num, dtype=float) * omega0 ** (np.arange(len(num) - 1, -1, -1.0) - n)
+    den_h = np.asarray(den, dtype=float) * omega0 ** (np.arange(n, -1, -1.0) - n)
+    num_h, den_h = num_h / den_h[0], den_h / den_h[0]
+    # realised at unit gain: scipy drops leading numerator coefficients below 1e-14 in
+    # absolute terms (BadCoefficients), which for a small gain (a mass of 1e9 kg) is every
+    # one but the last; the leading ones below round-off of the largest are dropped here
+    gain = float(np.max(np.abs(num_h)))
+    if gain > 0:
+        keep = np.flatnonzero(np.abs(num_h) > 1e-14 * gain)
+        num_h = num_h[keep[0]:] / gain
+    sys = control.tf2ss(control.tf(num_h, den_h))
+    scale = gain if gain > 0 else 1.0
+    return sys.A, sys.B, sys.C * scale, sys.D * scale
 
 
 def stack(mats):

@@ -80,6 +80,7 @@ from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import TWO_PI
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.modal import ModalPlant, Mode
+from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
 
 __all__ = ["FrfFit", "ModalPlant", "Mode", "fit_frf"]
 
@@ -88,8 +89,6 @@ MAX_MODES = 6
 #: Damping ratios and frequency density of the start's scan.
 _SCAN_DAMPING = (0.001, 0.003, 0.01, 0.03, 0.1, 0.2)
 _SCAN_PER_DECADE = 50
-#: Rigid-body masses of motion stages [kg]: a fitted mass outside is a warning (a unit slip).
-PLAUSIBLE_MASS_KG = (1e-3, 1e4)
 #: Most measured lines a fit uses: a denser response is thinned (:func:`thin_lines`).
 MAX_FIT_LINES = 1000
 #: Bytes the start's scan holds per line and candidate mode (its complex and real arrays).

@@ -32,7 +32,8 @@ if TYPE_CHECKING:
 
     from motionhyst.plants.mechanics import Mechanics
 
-__all__ = ["PLANTS", "Plant", "PlantParameter", "plant_class", "register", "stage_types"]
+__all__ = ["PLANTS", "PLAUSIBLE_MASS_KG", "Plant", "PlantParameter", "plant_class", "register",
+           "stage_types"]
 
 ParameterKind = Literal["positive", "nonnegative", "finite"]
 
@@ -110,6 +111,9 @@ class PlantParameter:
             raise ValueError(f"{self.name} must be finite{rng}, got {value!r}")
         return v
 
+
+PLAUSIBLE_MASS_KG = (1e-3, 1e4)
+"""Masses of motion stages [kg]: one outside, given or fitted, is a warning (a unit slip)."""
 
 #: The optional constant force on the plant, which every plant built from parameters has.
 FORCE_OFFSET = PlantParameter("force_offset", "N", "constant force added to the force on the "

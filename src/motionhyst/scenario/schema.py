@@ -44,7 +44,7 @@ from motionhyst.scenario.sections import (
 from motionhyst.scenario.sections import hysteresis_from_dict as hysteresis_from_dict
 
 __all__ = ["MAX_VALUES", "Scenario", "ScenarioError", "default_scenario",
-           "default_scenario_path", "hysteresis_from_dict", "load_scenario"]
+           "default_scenario_path", "hysteresis_from_dict", "load_scenario", "warn_implausible"]
 
 MAX_VALUES = 100_000
 """Most values one list of a scenario holds (a Maxwell-slip link's elements, the reference's
@@ -106,6 +106,7 @@ class Scenario:
         self._plant = None
         self._fit: FrfFit | None = None
         self._fit_warned = False
+        self._masses_unwarned = False  # set for a user's file (load_scenario)
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "<dict>",
@@ -477,7 +478,15 @@ class Scenario:
                 raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
             self._loop = loop
             self._warn_fit()
+        self._warn_masses()
         return self._loop
+
+    def _warn_masses(self) -> None:
+        """:func:`warn_implausible` once, for a user's file, once its loop is built: a
+        command that refuses the scenario before (too many time steps, say) says one line."""
+        if self._masses_unwarned:
+            self._masses_unwarned = False
+            warn_implausible(self)
 
     def to_dict(self) -> dict:
         """The validated scenario as a dictionary."""
@@ -598,5 +607,54 @@ def load_scenario(path: str | Path | None, check: bool = True) -> Scenario:
     (MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.01, 0.02, 0.03]), MaxwellSlip(k=[10.0, 6.0, 4.0], \
 fc=[0.01, 0.02, 0.03]))
     """
-    return default_scenario(check) if path is None else Scenario.from_file(path, check)
+    if path is None:
+        return default_scenario(check)
+    sc = Scenario.from_file(path, check)
+    sc._masses_unwarned = True
+    if sc._loop is not None:  # built and checked by from_file
+        sc._warn_masses()
+    return sc
+
+
+def warn_implausible(sc: Scenario) -> None:
+    """Warn of each ``[stage]`` mass outside a motion stage's
+    (:data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`), naming it: a unit slip (grams,
+    tonnes) or a value off by orders of magnitude makes every number computed on the loop
+    doubtful, and some computations slow (a microgram's pole at 1e10 Hz sets the step of a
+    time run) or ill-conditioned.  One :class:`~motionhyst.core.warnings.MotionhystWarning`
+    each; the command goes on.  A scenario read by :func:`load_scenario` says so once its
+    loop is built (:meth:`Scenario.loop`).
+
+    Parameters
+    ----------
+    sc : Scenario
+        The scenario read.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from motionhyst import default_scenario
+    >>> sc = default_scenario(check=False)
+    >>> sc.model.stage.m1 = 1e-9
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_implausible(sc)
+    >>> print(caught[0].message)
+    paper.toml (Table I, built in): [stage] m1 = 1e-09 kg, a factor 1e+06 below the \
+0.001-10000 kg of motion stages: is it in kg?
+    """
+    from motionhyst.core.warnings import warn
+    from motionhyst.plants.registry import PLAUSIBLE_MASS_KG, plant_class
+
+    stage = sc.model.stage
+    if stage is None:
+        return  # a measured plant: its fit says so of its mass
+    low, high = PLAUSIBLE_MASS_KG
+    for p in plant_class(stage.type).parameters:
+        value = getattr(stage, p.name, None)
+        if p.unit != "kg" or value is None or low <= value <= high:
+            continue
+        factor, where = (low / value, "below") if value < low else (value / high, "above")
+        warn(f"{sc.source}: [stage] {p.name} = {value:g} kg, a factor {factor:.2g} {where} the "
+             f"{low:g}-{high:g} kg of motion stages: is it in kg?")
 
