@@ -417,13 +417,13 @@ class _ElementProblem:
                                   rec.u - u0 - drift * rec.t, rec.y, rec.fs, self.r, self.window)
                 for rec in self.records]
 
-    def window_noise(self, v: NDArray[np.float64], sigma2: float | None = None
-                     ) -> WindowNoise:
+    def window_noise(self, v: NDArray[np.float64], sigma2: float) -> WindowNoise:
         """How the noise of each record's window reaches its residuals at the parameters `v`
         (:class:`~motionhyst.identify.io_uncertainty.WindowNoise`, the positions' noise
         variance `sigma2`): the run's sensitivity to the state its window sets, and that
         state's least squares over the window (a simulation per record and state column, a
-        floating stage's position exact)."""
+        floating stage's position exact; the window's own least squares runs only its
+        samples)."""
         k, nl = self.n_plant, self.n_link
         u0 = self.extras.split(v[k + nl:])[0]
         drift = self.extras.drift(v[k + nl:])
@@ -435,7 +435,7 @@ class _ElementProblem:
             p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
                                        self.window)
             y, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine)
-            self._count(2 - int(mech.floating))
+            self._count(3 - int(mech.floating))  # the run and its state's columns
             S = self._state_columns(mech, stepping, k_link, rec, u, fine, p, vel, y)
             parts.append((row, S, np.linalg.pinv(S[:self.window])))
             row += rec.y.size
@@ -800,7 +800,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                 q0 = q_seed
     # what the standard errors at the end take: a run and the Jacobian's differences
     reserve = (1 + (prob.extras.size if prob.exact else q0.size)
-               + (2 * len(records) if init_window is not None else 0))
+               + (3 * len(records) if init_window is not None else 0))
     remaining = max_nfev if plan.left is None else plan.left - reserve
     with plan.share(remaining if plan.left is not None else None):
         sol = prob.solve(q0, tol, remaining)
