@@ -76,7 +76,7 @@ class WindowNoise:
     ``sigma_n^2 (J^T J)^-1 J^T L L^T J (J^T J)^-1`` when the residuals are the records'
     noise (variance ``sigma_n^2``; ``L = I``: the usual ``sigma^2 (J^T J)^-1``).  When
     they are mostly the model's error (a measured axis: EMPS's fit RMS is 0.45 mm, its
-    encoder's noise 0.03 um), that error is not what the window's samples carry into the
+    encoder's noise 0.02 um), that error is not what the window's samples carry into the
     state; with the positions' own noise ``sigma_n^2`` (`sigma2`,
     :func:`white_noise_variance`: their residuals' sum of squares would take the model's
     error for noise, and the few samples of a short window make it scatter) the covariance
@@ -169,7 +169,8 @@ WINDOW_INFLATION = 2.0
 
 
 #: Differences whose scatter measures a record's white noise (:func:`white_noise_variance`):
-#: the third, which leave a smooth signal's acceleration-rate and take ``20 sigma^2`` of noise
+#: the third, which take a smooth error down to its jerk times the step cubed and white
+#: noise to ``20 sigma^2``
 NOISE_DIFFERENCES = 3
 
 
