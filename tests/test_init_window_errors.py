@@ -36,7 +36,7 @@ def _window_fit(y, g, S, window):
     return theta, J, float(res @ res), B, res
 
 
-def _linear_case(n=600, window=5):
+def _linear_case(n=600):
     t = np.arange(n) / n
     return np.sin(2 * np.pi * 3 * t) + 0.5 * t, np.column_stack([np.ones(n), t])
 
@@ -45,10 +45,10 @@ def test_the_window_sandwich_is_the_estimates_scatter():
     """A linear stand-in whose state (an offset and a rate) is set from its first 5 samples:
     over 400 noise seeds the estimate scatters as the sandwich says (the positions' noise
     from the residuals' third differences), while the standard error of white residuals is
-    6 times too small (the noise of 5 samples, carried by the rate into every later
-    residual, is most of the estimate's error)."""
+    some 500 times too small (the noise of 5 samples, carried by the rate into every later
+    residual, is nearly all of the estimate's error)."""
     n, window, theta_true, sigma = 600, 5, 2.0, 1e-3
-    g, S = _linear_case(n, window)
+    g, S = _linear_case(n)
     rng = np.random.default_rng(1)
     est, sandwich, white = [], [], []
     for _ in range(400):
@@ -61,7 +61,7 @@ def test_the_window_sandwich_is_the_estimates_scatter():
     spread = float(np.std(est))
     assert np.mean(est) == pytest.approx(theta_true, abs=3 * spread / np.sqrt(len(est)))
     assert np.median(sandwich) == pytest.approx(spread, rel=0.1)
-    assert np.median(white) < spread / 5
+    assert np.median(white) < spread / 100
     z = np.abs(np.array(est) - theta_true) / np.array(sandwich)
     assert np.mean(z <= 3) >= 0.98
     assert np.sqrt(covariance(J, rss, n, noise=noise)[0, 0]) == sandwich[-1]
@@ -73,7 +73,7 @@ def test_a_model_error_is_not_taken_for_the_windows_noise():
     and the standard error is that of white residuals; taken for noise, the error would
     make it 6 times as large."""
     n, window = 6000, 50
-    g, S = _linear_case(n, window)
+    g, S = _linear_case(n)
     t = S[:, 1]
     y = (2.0 * g + 1e-3 * np.sin(2 * np.pi * 7 * t)
          + 1e-8 * np.random.default_rng(2).standard_normal(n))
