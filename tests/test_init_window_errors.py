@@ -71,7 +71,7 @@ def test_a_model_error_is_not_taken_for_the_windows_noise():
     """Residuals that are a smooth model error of 1e-3 with noise of 1e-8 (a measured axis's
     encoder): the window's share is that of the noise (the residuals' third differences),
     and the standard error is that of white residuals; taken for noise, the error would
-    make it 6 times as large."""
+    make it 2600 times as large."""
     n, window = 6000, 50
     g, S = _linear_case(n)
     t = S[:, 1]
@@ -84,7 +84,7 @@ def test_a_model_error_is_not_taken_for_the_windows_noise():
     with_noise = standard_errors(J, rss, n, noise=WindowNoise(n, [(0, S, B)], sigma2))[0][0]
     assert with_noise == pytest.approx(white, rel=0.01)
     as_noise = WindowNoise(n, [(0, S, B)], rss / (n - 1))
-    assert standard_errors(J, rss, n, noise=as_noise)[0][0] > 5 * white
+    assert standard_errors(J, rss, n, noise=as_noise)[0][0] > 100 * white
 
 
 def _jenkins_axis(seed: int, noise: float = 1e-6, n: int = 2500) -> IORecord:
