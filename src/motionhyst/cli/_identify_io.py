@@ -88,9 +88,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records: each record holds whole periods of a periodic "
                         "steady state (default: each is an experiment from rest)")
     q.add_argument("--nu", type=_nu, metavar="NU|free",
-                   help="input-output records, Bouc-Wen: the exponent nu, fixed (default 1) or "
-                        "'free' to estimate it (--plant quasi-static: by fits of nu fixed at "
-                        "1, 1.5, 2, 3 and around the best)")
+                   help="--model bouc-wen: the exponent nu, fixed or 'free' to estimate it "
+                        "(input-output records: default 1; --plant quasi-static: by fits of "
+                        "nu fixed at 1, 1.5, 2, 3 and around the best; force-displacement "
+                        "records: default free, estimated with the rest)")
     q.add_argument("--save", metavar="MODEL.toml",
                    help="input-output records: write the identified system as a scenario "
                         "(read by motionhyst predict); force-displacement records: the link "
@@ -104,7 +105,7 @@ def check_not_input_output(args: argparse.Namespace, closed_loop: bool = False) 
     a closed-loop record, which takes ``--offset`` too; ``--model`` and ``--max-evaluations``
     are checked with the record's kind)."""
     for option, value in (("--plant", args.plant),
-                          ("--periodic", args.periodic or None), ("--nu", args.nu),
+                          ("--periodic", args.periodic or None),
                           ("--output", args.output),
                           ("--offset", None if closed_loop else args.offset),
                           ("--from-rest", args.from_rest or None),

@@ -131,6 +131,8 @@ def run(args: argparse.Namespace) -> int:
     if args.record == "input-output":
         return run_input_output(args)
     check_not_input_output(args, closed_loop=args.record != "force-displacement")
+    if args.nu is not None and args.model != "bouc-wen":
+        raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
     if len(args.data) > 1:
         paths = [Path(p) for p in args.data]
         if any(record_kind(p, args.record, args.columns) != "force-displacement"
@@ -361,7 +363,8 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         with search_budget():
             fit = identify_link_force([IORecord(t, w, x, str(p)) for p, t, x, w in records],
                                       model_class(args.model), n_elements=args.elements or 3,
-                                      max_evaluations=args.max_evaluations)
+                                      max_evaluations=args.max_evaluations,
+                                      nu=None if args.nu in (None, "free") else args.nu)
     except (ValueError, RuntimeError) as exc:
         raise type(exc)(f"{names}: {exc}") from None
     result = {**fit.to_dict(), "record": "force-displacement",
