@@ -156,6 +156,23 @@ def test_emps_still_shows_it_on_every_split():
         assert -est["difference"] > 15.0 * est["std"], rec.name
 
 
+
+@pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").exists(), reason="../shared absent")
+def test_a_short_window_with_a_negative_coefficient_claims_nothing():
+    """Two seconds of EMPS (samples 20000-22000) share a narrow band of speeds both ways: the
+    comparison there gives c- below 0 (a damper that would drive the axis), which is no
+    friction by direction to claim (it was claimed: c+ 157.8, c- -119.2 N s/m, while the fit
+    it set off found c- 361)."""
+    from motionhyst.identify.emps_files import COLUMNS, DRIVE_GAIN
+    from motionhyst.io.records import read_record
+
+    data = read_record(SHARED / "DATA_EMPS.mat", ("time", "force", "displacement"),
+                       columns=COLUMNS, scale={"force": DRIVE_GAIN})[20000:22000]
+    rec = IORecord(data[:, 0], data[:, 1], data[:, 2], "EMPS 20000-22000")
+    est = viscous_direction([rec])
+    assert est is not None and min(est["c_pos"], est["c_neg"]) < 0
+    assert viscous_direction_note([rec]) is None
+
 def test_benchmark_emps_models_named_by_their_link_are_fitted_as_identify_fits_them():
     """``benchmark emps --models coulomb`` fits what ``identify --model coulomb`` fits: by
     direction where the record shows it (before: always one coefficient); ``-symmetric``

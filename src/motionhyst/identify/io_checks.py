@@ -672,7 +672,9 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
     Stribeck effect, is no difference, however differently the two directions were
     driven); beyond :data:`DIRECTION_SIGNIFICANCE` standard errors and
     :data:`DIRECTION_SHARE` of the mean coefficient it is reported, with the option that
-    estimates it (``--asymmetric``).  On EMPS: c+ 158, c- 234 N s/m.
+    estimates it (``--asymmetric``), unless a coefficient comes out negative (a damper that
+    drives the axis is no friction: a short record whose directions share a narrow band of
+    speeds).  On EMPS: c+ 158, c- 234 N s/m.
 
     Parameters
     ----------
@@ -705,6 +707,8 @@ def viscous_direction_note(records: list[IORecord]) -> str | None:
     diff, std, mean = est["difference"], est["std"], est["c"]
     if not (mean > 0 and abs(diff) > DIRECTION_SIGNIFICANCE * std
             and abs(diff) > DIRECTION_SHARE * mean):
+        return None
+    if not (est["c_pos"] > 0 and est["c_neg"] > 0):  # a damper that drives: no friction
         return None
     low, high = est["band"]
     return (f"the records' inverse dynamics (IDIM-LS) gives viscous friction by direction, "
