@@ -582,3 +582,51 @@ def test_estimate_and_refusal_say_the_load_they_were_measured_under(study_file, 
     monkeypatch.setattr(runner, "machine_load", lambda: (1.5, 2))
     assert main(["study", str(study_file), "--estimate"]) == 0
     assert "under load" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("replacing", [False, True], ids=["new-store", "force-over-another"])
+def test_a_study_killed_while_it_writes_leaves_no_temporary_file(tmp_path, study_file,
+                                                                 replacing):
+    """A real ``motionhyst study`` killed with SIGKILL while it writes its store (new, or
+    built with --force over another study's store and swapped into its place): after the next
+    command in the folder no temporary file of either outlives them (no ``.part``,
+    ``.partial`` or ``.motionhyst-PID-`` name anywhere, in the store either), the user's
+    files are byte-identical and the store is whole (resumed to the end)."""
+    from file_trees import snapshot as files
+
+    study_file.write_text(STUDY_TOML.replace("n = 2", "n = 24")
+                          .replace('outputs = ["e1", "mismatch", "error_rms", "E"]',
+                                   'outputs = ["e1", "error_peak"]'))
+    (tmp_path / "notes.txt").write_text("mine\n")
+    out = tmp_path / "s.zarr"
+    if replacing:  # another study's store, replaced with --force: built beside it first
+        other = tmp_path / "other.toml"
+        other.write_text(STUDY_TOML)
+        run_study(Study.from_file(other), out, workers=0)
+    mine = {n: (tmp_path / n).read_bytes() for n in ("paper.toml", "study.toml", "notes.txt")}
+    cmd = [sys.executable, "-m", "motionhyst.cli", "study", str(study_file), "--out", str(out),
+           "--workers", "0", "--json", *(["--force"] if replacing else [])]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline and proc.poll() is None:
+            try:
+                status = zarr.open_array(out / "status", mode="r")[...]
+                if status.size == 384 and np.any(status == OK):  # this study's, half written
+                    break
+            except (OSError, ValueError, KeyError):
+                pass
+            time.sleep(0.002)
+        assert proc.poll() is None, proc.communicate()[1].decode()
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait()
+    assert proc.returncode == -signal.SIGKILL
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    assert json.loads(res.stdout)["failed"] == 0
+    left = [p for p in files(tmp_path) if any(
+        w in Path(p).name for w in (".part", ".partial", ".motionhyst-"))]
+    assert left == [], left
+    assert {n: (tmp_path / n).read_bytes() for n in mine} == mine
+    assert np.all(open_results(out)["status"].values == OK)
