@@ -10,8 +10,12 @@ set, CPU time (user + system) and wall time, and against the base record in the 
 ratio of resident sets and of CPU time per sample.  A run from rest goes through the record in
 blocks (``motionhyst.time.resample.fine_blocks``): its memory grows with the record's samples
 only (reading, output and writing: tens of bytes a sample), not with samples x substeps
-(which made 3e6 samples need 2.9 GB before).  Run with ``make bench`` or
-``python benchmarks/predict_memory.py [--samples N ...] [--json]``.
+(which made 3e6 samples need 2.9 GB before).  With ``--identify N ...`` also ``motionhyst
+identify --record input-output --plant mass-damper --model jenkins`` on input-output records
+of that axis (its force offset -3 N, 1e-7 m of position noise) of N samples: its search holds
+the record's upsampled force once (3e5 samples: 874 MB before, 644 MB), CPU about 50 s per
+3e5 samples.  Run with ``make bench`` or
+``python benchmarks/predict_memory.py [--samples N ...] [--identify N ...] [--json]``.
 """
 
 from __future__ import annotations
@@ -81,10 +85,47 @@ def measure(folder: Path, n: int) -> dict:
             "max_rss_mb": field("Maximum resident set size (kbytes)") / 1024}
 
 
+def measure_identify(folder: Path, n: int) -> dict:
+    """Identify the axis from an input-output record of `n` samples under /usr/bin/time -v."""
+    from scipy.io import savemat
+
+    from motionhyst.hysteresis import Jenkins
+    from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.time.openloop import OpenLoop
+
+    t = np.arange(n) / FS
+    rng = np.random.default_rng(0)
+    u = (60.0 * np.sin(2 * np.pi * 1.3 * t) + 25.0 * np.sin(2 * np.pi * 7.1 * t + 1.0)
+         + rng.standard_normal(n))
+    system = OpenLoop(MassDamper(95.0, 200.0, force_offset=-3.0), Jenkins(k=1e6, fc=20.0))
+    y = system.simulate(t, u).displacement + 1e-7 * rng.standard_normal(n)
+    data = folder / f"io{n}.mat"
+    savemat(data, {"time": t[:, None], "force": u[:, None], "displacement": y[:, None]})
+    cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "motionhyst.cli", "identify", str(data),
+           "--record", "input-output", "--plant", "mass-damper", "--model", "jenkins",
+           "--columns", "time=time,force=force,displacement=displacement", "--json"]
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise SystemExit(f"identify of {n} samples failed: {proc.stderr.strip()[-500:]}")
+    err = proc.stderr
+
+    def field(name: str) -> float:
+        return float(re.search(rf"{re.escape(name)}: ([\d.]+)", err).group(1))
+
+    data.unlink()
+    return {"samples": n, "wall_s": wall, "estimates": json.loads(proc.stdout)["estimates"],
+            "cpu_s": field("User time (seconds)") + field("System time (seconds)"),
+            "max_rss_mb": field("Maximum resident set size (kbytes)") / 1024}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=float, nargs="+", default=[3e5, 3e6],
                     help="record lengths; the first is the base (default 3e5 3e6)")
+    ap.add_argument("--identify", type=float, nargs="*", default=[],
+                    help="also identify the axis from input-output records of these lengths")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
     if not Path("/usr/bin/time").exists():
@@ -96,11 +137,13 @@ def main() -> None:
         # a first small run compiles the kernels (cached), so that no run below pays for it
         measure(folder, 2000)
         runs = [measure(folder, int(n)) for n in args.samples]
+        fits = [measure_identify(folder, int(n)) for n in args.identify]
     base = runs[0]
     for r in runs:
         r["rss_ratio"] = r["max_rss_mb"] / base["max_rss_mb"]
         r["cpu_per_sample_ratio"] = (r["cpu_s"] / r["samples"]) / (base["cpu_s"] / base["samples"])
-    out = {"load_before": load, "load_after": os.getloadavg(), "runs": runs}
+    out = {"load_before": load, "load_after": os.getloadavg(), "runs": runs,
+           "identify": fits}
     if args.json:
         print(json.dumps(out, indent=2))
         return
@@ -111,6 +154,10 @@ def main() -> None:
               f"({r['rss_ratio']:.2f}x the base), CPU {r['cpu_s']:6.1f} s "
               f"({r['cpu_per_sample_ratio']:.2f}x the base's per sample), "
               f"wall {r['wall_s']:6.1f} s")
+    for r in fits:
+        print(f"  identify, {r['samples']:>9.3g} samples: peak RSS {r['max_rss_mb']:6.0f} MB, "
+              f"CPU {r['cpu_s']:6.1f} s, wall {r['wall_s']:6.1f} s, m = "
+              f"{r['estimates']['m']:.6g} kg, fc = {r['estimates']['link.fc']:.6g} N")
 
 
 if __name__ == "__main__":
