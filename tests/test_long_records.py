@@ -166,3 +166,88 @@ def test_predict_needs_the_record_and_one_block_not_the_whole_upsampled_record(t
     p = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
     assert p.shape == (8000, 2) and np.ptp(p[:, 1]) > 1e-3
     np.testing.assert_array_equal(p, np.loadtxt(tmp_path / "q.csv", delimiter=",", skiprows=1))
+
+
+def _many_elements() -> OpenLoop:
+    """A stage on a spring with a Maxwell-slip link of 38 elements: a periodic run carries
+    the sensitivities of the output to 40 start states (Newton's steps on the period map)."""
+    return OpenLoop(MassSpringDamper(2.0, 10.0, 5e4),
+                    MaxwellSlip(k=[500.0] * 38, fc=[0.1 * (i + 1) for i in range(38)]))
+
+
+def _periodic_force(n: int) -> np.ndarray:
+    """Three sines of whole cycles in `n` samples [N]."""
+    i = np.arange(n)
+    return sum(10.0 * np.sin(2 * np.pi * c * i / n + c) for c in (3, 17, 40))
+
+
+@pytest.mark.parametrize("name", ["spring-dahl", "spring-lugre",
+                                  "many-elements"])
+def test_a_period_run_in_blocks_is_the_run_over_the_whole_period(monkeypatch, name):
+    """A periodic steady state goes through its period in blocks (the kernel's record of the
+    start state's sensitivities, three rows of them, held for one block): the numbers of the
+    whole period's run, bit for bit."""
+    system = _many_elements() if name == "many-elements" else SYSTEMS[name]
+    u = _periodic_force(3000) / (20.0 if name == "many-elements" else 10.0)
+    t = np.arange(u.size) / FS
+    whole = system.simulate(t, u, periodic=True, substeps=10).displacement
+    monkeypatch.setattr(resample, "BLOCK_NODES", 1)  # blocks of 256 samples
+    blocks = system.simulate(t, u, periodic=True, substeps=10).displacement
+    assert np.all(np.isfinite(whole)) and np.ptp(whole) > 0
+    np.testing.assert_array_equal(blocks, whole)
+
+
+def test_a_periodic_run_is_sized_with_its_start_states_sensitivities(tmp_path):
+    """predict --periodic of one period of 1e5 samples, 2 substeps, a link of 38 elements:
+    the estimate counts the output's sensitivities to the 40 states (2 x 32 MB), not only the
+    force (16 MB): above --max-memory 40M it is refused before the run, one line."""
+    import limited_process
+    from scipy.io import savemat
+
+    n = 100000
+    savemat(tmp_path / "f.mat", {"time": (np.arange(n) / FS)[:, None],
+                                 "force": (_periodic_force(n) / 20.0)[:, None]})
+    (tmp_path / "m.toml").write_text(
+        '[stage]\ntype = "mass-spring-damper"\nm = 2.0\nc = 10.0\nk = 5e4\n\n'
+        '[hysteresis]\nmodel = "maxwell-slip"\n'
+        f'k = {[500.0] * 38}\nfc = {[0.1 * (i + 1) for i in range(38)]}\n')
+    line = limited_process.refusal(["predict", "m.toml", "f.mat", "--periodic", "--substeps",
+                                    "2", "--out", "p.csv", "--max-memory", "40M"], tmp_path)
+    assert ("f.mat: 100000 samples of 2 integration steps each (and the periodic steady "
+            "state's sensitivities to its 40 states) needs 80 MB") in line, line
+    assert "(--max-memory)" in line and not (tmp_path / "p.csv").exists()
+
+
+def test_a_periodic_run_holds_its_sensitivities_once_a_period(tmp_path):
+    """The periodic steady state of a link of 38 elements over a period of 1e5 samples (its
+    output's sensitivities to 40 start states: 32 MB a period) runs within 120 MB of address
+    space above what the process held before; the period's run held the kernel's record of
+    three rows of them too (96 MB more)."""
+    script = tmp_path / "period.py"
+    script.write_text(
+        "import resource, sys\n"
+        "import numpy as np\n"
+        "sys.path.insert(0, sys.argv[1])\n"
+        "from test_long_records import FS, _many_elements, _periodic_force\n"
+        "from motionhyst.core.budget import set_max_memory\n"
+        "set_max_memory(1 << 30)\n"  # the address-space limit alone decides
+        "system = _many_elements()\n"
+        "u = _periodic_force(2000) / 20.0\n"
+        "system.simulate(np.arange(2000) / FS, u, periodic=True, substeps=2)\n"
+        "t = np.arange(100000) / FS\n"
+        "u = _periodic_force(100000) / 20.0\n"
+        "with open('/proc/self/status') as f:\n"
+        "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + (120 << 20),) * 2)\n"
+        "y = system.simulate(t, u, periodic=True, substeps=2).displacement\n"
+        "print(y.size, float(np.ptp(y)))\n")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from limited_process import environment
+
+    proc = subprocess.run([sys.executable, str(script), str(Path(__file__).parent)],
+                          capture_output=True, text=True, env=environment(), timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.startswith("100000 "), proc.stdout

@@ -92,6 +92,7 @@ from motionhyst.time.periodic_runs import (
 from motionhyst.time.resample import SINC_HALF_WIDTH as SINC_HALF_WIDTH
 from motionhyst.time.resample import STAMP_TOLERANCE as STAMP_TOLERANCE
 from motionhyst.time.resample import (
+    block_samples,
     check_record,
     fine_blocks,
     fine_input,
@@ -230,6 +231,16 @@ class OpenLoop:
         f_n = self.plant.mechanics().natural_frequency_hz(self._k_link())
         return max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
 
+    def _shooting_states(self) -> int:
+        """States whose sensitivities a periodic run of exact-update elements carries
+        (:func:`simulate_elements`' Newton steps on the period map); 0 where it repeats
+        periods instead."""
+        if self.hysteresis is None or not hasattr(self.hysteresis, "time_stepping"):
+            return 0
+        codes = self.hysteresis.time_stepping().codes
+        n = 2 * self.plant.mechanics().n + codes.size
+        return n if np.all(np.isin(codes, DIFFERENTIATED)) and n <= MAX_SHOOTING_STATES else 0
+
     def _bw_parameters(self) -> NDArray[np.float64] | None:
         h = self.hysteresis
         if h is None:
@@ -282,11 +293,16 @@ class OpenLoop:
             return OpenLoopResponse(tt, u, y, periodic)
         fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
-        # a periodic run: the force at every integration step and midpoint of the period; a run
-        # from a start: of one block at a time (time.resample.fine_blocks), and the record
+        # a periodic run: the force at every integration step and midpoint of the period, and
+        # the output's sensitivities to the start state of Newton's steps on the period map
+        # (two periods' at once); a run from a start: of one block at a time
+        # (time.resample.fine_blocks), and the record
         fine = u.size * r if periodic else held_nodes(u, r)
-        check_memory(FINE_BYTES * fine + SAMPLE_BYTES * u.size, f"{u.size} samples of {r} "
-                     f"integration steps each", "fewer samples or substeps")
+        states = self._shooting_states() if periodic else 0
+        check_memory(FINE_BYTES * fine + (SAMPLE_BYTES + 16 * states) * u.size,
+                     f"{u.size} samples of {r} integration steps each"
+                     + (f" (and the periodic steady state's sensitivities to its {states} "
+                        f"states)" if states else ""), "fewer samples or substeps")
         # the plant's viscous friction by direction is stepped with the link's elements, and so
         # is a Bouc-Wen link on a positioning axis (one floating mass): a friction link, whose
         # exact update in the displacement follows its sticking however stiff (RK4 in time
@@ -466,10 +482,14 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
     def run(x, s, sx, ss, dpp=dp, blocks=None, n_out=None):
         # each period starts afresh from the state the previous one left; a run from a start
         # goes through the record's fine input block by block (`n_out` samples in all), the
-        # state carried on
+        # state carried on; a period through views of its fine input, as many samples at a
+        # time as keep the kernel's record of the sensitivities (three rows) within a block's
         state = LoopState(x, s, sx, ss)
         if blocks is None:
-            blocks, n_out = [fine], (fine.size - 1) // r + 1
+            n_out = (fine.size - 1) // r + 1
+            step = block_samples(max(r, 3 * (1 + sx.shape[1])))
+            blocks = (fine[a * r:min(a + step, n_out - 1) * r + 1]
+                      for a in range(0, max(n_out - 1, 1), step))
         y, sy, k = np.empty(n_out), np.empty((n_out, sx.shape[1])), 0
         for a in blocks:
             Y, SY, _, _, worst, _ = run_steps(steps, C, np.zeros(3), 1, stepping, a, state,
