@@ -103,6 +103,12 @@ class DisplacementEstimate:
         The low-pass's cut-off [Hz] (None: no band of noise alone).
     reason : str
         One line: what was found, and why the record was, or was not, filtered.
+
+    Examples
+    --------
+    >>> est = DisplacementEstimate(1e-5, True, 29.3, "white noise of 1e-05 m RMS")
+    >>> est.to_dict()["cutoff_hz"], str(est)
+    (29.3, 'white noise of 1e-05 m RMS')
     """
 
     sigma: float

@@ -16,8 +16,7 @@ from numpy.typing import NDArray
 
 from motionhyst.hysteresis import Hysteresis, Parameter
 
-__all__ = ["DAMPING_UNIT", "FORCE_UNIT", "LENGTH_UNIT", "SKEW", "STIFFNESS_UNIT",
-           "VELOCITY_UNIT", "LinkLayout"]
+__all__: list[str] = []  # the search's internals, for the identification modules
 
 #: Start values and search scales by the parameter's unit (registry.Parameter.unit)
 STIFFNESS_UNIT, FORCE_UNIT, DAMPING_UNIT, VELOCITY_UNIT, LENGTH_UNIT = (

@@ -125,7 +125,18 @@ class WindowNoise:
         self.sigma2 = float(sigma2)
 
     def left(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``X^T L`` for ``X`` of `n_rows` rows."""
+        """``X^T L`` for ``X`` of `n_rows` rows.
+
+        Parameters
+        ----------
+        X : ndarray
+            A matrix of `n_rows` rows.
+
+        Returns
+        -------
+        ndarray
+            ``X^T L``.
+        """
         out = np.array(X, dtype=float).T.copy()
         for a, S, B in self.parts:
             rows = slice(a, a + S.shape[0])
@@ -135,7 +146,22 @@ class WindowNoise:
     def residual_variance(self, W: NDArray[np.float64], rss: float, dof: int) -> float:
         """``sigma_r^2``: the residuals' variance less what the window's noise adds to them
         in expectation, at least that noise (``W = U^T L``, ``U`` the Jacobian's left
-        singular vectors; `dof` ``N - p``)."""
+        singular vectors; `dof` ``N - p``).
+
+        Parameters
+        ----------
+        W : ndarray
+            ``U^T L``.
+        rss : float
+            The fit's residual sum of squares.
+        dof : int
+            Its degrees of freedom, ``N - p``.
+
+        Returns
+        -------
+        float
+            ``sigma_r^2``.
+        """
         spread = self.frobenius2() - float(np.sum(W * W))  # E RSS / sigma_n^2, noise alone
         return max((rss - self.sigma2 * (spread - dof)) / max(dof, 1), self.sigma2)
 
@@ -280,6 +306,24 @@ def window_inflation(J: NDArray[np.float64], rss: float, n_rows: int, rtol: floa
     estimated with the parameters from all their samples (``J`` with the states' columns,
     the same residual variance): the price of the window, column by column (NaN where
     either is not determined).
+
+    Parameters
+    ----------
+    J : ndarray
+        The fit's Jacobian (rows: residuals; columns: parameters).
+    rss : float
+        Its residual sum of squares.
+    n_rows : int
+        The residuals.
+    rtol : float
+        Singular values below this share of the largest are not determined.
+    noise : WindowNoise
+        The windows' noise map.
+
+    Returns
+    -------
+    ndarray
+        One ratio per column of `J` (NaN where either standard error is not determined).
 
     Examples
     --------

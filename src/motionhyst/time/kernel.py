@@ -38,6 +38,13 @@ class StepNotConverged(RuntimeError):
     finer step (a library function's ``dt`` or ``substeps``); a command that has no such
     option says what its user can change instead, from :attr:`what`.
 
+    Parameters
+    ----------
+    what : str
+        What happened (where the step did not converge).
+    remedy : str
+        The caller's way to a finer step.
+
     Examples
     --------
     >>> err = StepNotConverged("the implicit step at t = 0.01 s did not converge",
