@@ -339,8 +339,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         one, whatever the records show.  On the EMPS record's period splits (1-2 > 3-4,
         3-4 > 1-2, 1-3 > 4, 2-4 > 1, the held-out periods predicted from a 20-sample
         window) the Jenkins link's error fell from 5.57, 9.71, 3.17, 6.10 mm to 5.19, 6.31,
-        1.06, 3.34 mm, the Coulomb link's from 5.10, 9.71, 3.17, 6.10 to 5.20, 6.30, 1.12,
-        3.32 mm.
+        1.06, 3.34 mm, the Coulomb link's from 5.10, 9.71, 3.17, 6.10 to 5.19, 6.31, 1.18,
+        3.24 mm.
     drift : bool
         A mass-damper whose force offset drifts in time: its rate ``input_drift``
         [N/s] is estimated with the force offset (the plant receives ``u -

@@ -60,6 +60,7 @@ class StepNotConverged(RuntimeError):
         self.what = what
         self.remedy = remedy
 
+
 #: Conventions of the implicit step (see :func:`step_loop`).
 CLOSED, OPEN = 0, 1
 
