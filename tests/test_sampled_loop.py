@@ -34,10 +34,12 @@ def _pc_loop(cd: SampledController, d: int, form: str = "ss"):
 
 # python-control's "frd" method (its default here) samples L on a grid and can miss or invent
 # a crossing at the stage's resonance (694 Hz, |L| up to 8.5); each case takes the form and the
-# method whose answers agree with python-control's other method at this loop
+# method whose answers agree with python-control's other method at this loop (the transfer
+# functions at 10 kHz with two samples of delay do not: on one machine "best" and "frd" found a
+# phase margin of -4.49 deg at 719 Hz, "poly" 13.976 deg at 120.67 Hz; state space: 13.9693)
 @pytest.mark.parametrize(("rate", "d", "form", "method", "rtol"),
                          [(10e3, 0, "ss", "best", 1e-6), (10e3, 1, "ss", "best", 1e-6),
-                          (10e3, 2, "tf", "best", 2e-5), (4e3, 1, "ss", "poly", 1e-6)])
+                          (10e3, 2, "ss", "best", 1e-6), (4e3, 1, "ss", "poly", 1e-6)])
 def test_margins_are_python_controls_stability_margins(rate, d, form, method, rtol):
     cd = SampledController.discretize(C, rate, delay_samples=d)
     m = loop_margins(cd, STAGE.P2)
