@@ -65,24 +65,30 @@ def measure(folder: Path, n: int) -> dict:
     data = folder / f"f{n}.mat"
     record(data, n)
     out = folder / f"p{n}.csv"
-    cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "motionhyst.cli", "predict",
-           str(folder / "model.toml"), str(data), "--out", str(out), "--json"]
+    _, usage = _timed(["predict", str(folder / "model.toml"), str(data), "--out", str(out),
+                       "--json"], f"predict of {n} samples")
+    lines = sum(1 for _ in out.open()) - 1
+    data.unlink()
+    out.unlink()
+    return {"samples": n, "lines_written": lines, **usage}
+
+
+def _timed(args: list[str], what: str) -> tuple[str, dict]:
+    """``motionhyst ARGS`` run under /usr/bin/time -v: its standard output, and its wall and
+    CPU seconds and peak resident set [MB]; `what` names it if it fails."""
+    cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "motionhyst.cli", *args]
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
-        raise SystemExit(f"predict of {n} samples failed: {proc.stderr.strip()[-500:]}")
-    err = proc.stderr
+        raise SystemExit(f"{what} failed: {proc.stderr.strip()[-500:]}")
 
     def field(name: str) -> float:
-        return float(re.search(rf"{re.escape(name)}: ([\d.]+)", err).group(1))
+        return float(re.search(rf"{re.escape(name)}: ([\d.]+)", proc.stderr).group(1))
 
-    lines = sum(1 for _ in out.open()) - 1
-    data.unlink()
-    out.unlink()
-    return {"samples": n, "lines_written": lines, "wall_s": wall,
-            "cpu_s": field("User time (seconds)") + field("System time (seconds)"),
-            "max_rss_mb": field("Maximum resident set size (kbytes)") / 1024}
+    return proc.stdout, {"wall_s": wall,
+                         "cpu_s": field("User time (seconds)") + field("System time (seconds)"),
+                         "max_rss_mb": field("Maximum resident set size (kbytes)") / 1024}
 
 
 def measure_identify(folder: Path, n: int) -> dict:
@@ -101,23 +107,12 @@ def measure_identify(folder: Path, n: int) -> dict:
     y = system.simulate(t, u).displacement + 1e-7 * rng.standard_normal(n)
     data = folder / f"io{n}.mat"
     savemat(data, {"time": t[:, None], "force": u[:, None], "displacement": y[:, None]})
-    cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "motionhyst.cli", "identify", str(data),
-           "--record", "input-output", "--plant", "mass-damper", "--model", "jenkins",
-           "--columns", "time=time,force=force,displacement=displacement", "--json"]
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise SystemExit(f"identify of {n} samples failed: {proc.stderr.strip()[-500:]}")
-    err = proc.stderr
-
-    def field(name: str) -> float:
-        return float(re.search(rf"{re.escape(name)}: ([\d.]+)", err).group(1))
-
+    out, usage = _timed(["identify", str(data), "--record", "input-output", "--plant",
+                         "mass-damper", "--model", "jenkins", "--columns",
+                         "time=time,force=force,displacement=displacement", "--json"],
+                        f"identify of {n} samples")
     data.unlink()
-    return {"samples": n, "wall_s": wall, "estimates": json.loads(proc.stdout)["estimates"],
-            "cpu_s": field("User time (seconds)") + field("System time (seconds)"),
-            "max_rss_mb": field("Maximum resident set size (kbytes)") / 1024}
+    return {"samples": n, "estimates": json.loads(out)["estimates"], **usage}
 
 
 def main() -> None:
