@@ -209,6 +209,8 @@ def run(args: argparse.Namespace) -> int:
                 raise ValueError(f"{path}: {exc}") from None
         from motionhyst.identify.fit import identify_maxwell_slip
 
+        if args.elements is None or target is not None:  # what no fit can pass: before it
+            _refuse_beyond_bound(path, x, w)
         what = "force-displacement record"
         try:
             with search_budget():
@@ -455,6 +457,26 @@ def _check_slips(path: Path, ident, y1) -> None:
 SLIP_SHARE = 0.99
 """An element slips in a record when its slip displacement fc/k is short of this share of
 half the record's displacement range (one at the range's end is a spring there)."""
+
+
+def _refuse_beyond_bound(path: Path, x, w) -> None:
+    """Refuse, before the fit, a force-displacement record that no number of Maxwell-slip
+    elements describes: when even the best of them leave more systematic error
+    (:func:`~motionhyst.identify.fit.systematic_share_bound`, a lower bound) than a fit may
+    (:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`), the fit would end in
+    :func:`_judge_elements`'s refusal after its work.  The checks that name another cause
+    (no hysteresis, a sensor's sign reversed) stay the fit's: the bound leaves them alone."""
+    from motionhyst.identify.fit import systematic_share_bound
+    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed
+
+    bound = systematic_share_bound(x, w)
+    if bound > SYSTEMATIC_SHARE:
+        raise FitFailed(f"{path}: no Maxwell-slip elements describe this record: any number "
+                        f"of them leave a systematic error of at least {100 * bound:.2g} % of "
+                        f"the force's RMS (above {100 * SYSTEMATIC_SHARE:g} %, beyond the "
+                        f"noise) and would not predict another record of this link; a link "
+                        f"with a spring and damper in parallel may (--model dahl, bouc-wen or "
+                        f"lugre); nothing identified")
 
 
 def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:

@@ -6,6 +6,7 @@ described in :mod:`motionhyst.identify`)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
@@ -15,6 +16,7 @@ from scipy.optimize import least_squares, nnls
 
 from motionhyst.core.compiled import njit
 from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.identify.io_checks import NO_HYSTERESIS_GAIN, hysteresis_gain
 from motionhyst.identify.io_uncertainty import covariance, covariance_table
 from motionhyst.identify.records import check_signals
 from motionhyst.identify.result import Identification
@@ -22,7 +24,7 @@ from motionhyst.identify.result import Identification
 if TYPE_CHECKING:  # a closed-loop record's prefilter (python-control): a force-displacement
     from motionhyst.core.lti import HoldFilter  # fit needs neither
 
-__all__ = ["identify_maxwell_slip"]
+__all__ = ["identify_maxwell_slip", "systematic_share_bound"]
 
 N_GRID = 40
 """Candidate slip displacements in the NNLS stage."""
@@ -66,6 +68,16 @@ MAX_ROWS = 50_000
 
 EXTRA_ORDER = 2
 """Order of the prefilter beyond ``deg d1``: ``L / P1`` then rolls off at high frequency."""
+
+
+BOUND_GRID = 400
+"""Slip displacements of :func:`systematic_share_bound`, log-spaced over the span of the
+NNLS stage's (neighbours 1.7 % apart: a threshold between two of them costs a clean
+three-element record 2e-4 of its force's RMS, measured)."""
+
+
+BOUND_ROWS = 5000
+"""Most samples in the residual of :func:`systematic_share_bound` (evenly strided)."""
 
 
 Criterion = Literal["rms", "bic"]
@@ -606,6 +618,85 @@ def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Crite
 def fit_rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
     stride = max(1, int(np.ceil((n - start) / max(int(max_rows), 1))))
     return np.arange(start, n, stride)
+
+
+def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROWS) -> float:
+    """A lower bound, before any fit, of the systematic error any Maxwell-slip elements leave
+    in a force-displacement record (:func:`~motionhyst.identify.io_checks.systematic_share`
+    of the whole record, the elements' initial forces and the offset fitted).
+
+    Once the displacement has run from one end of its range to the other, every element
+    whose slip displacement is at most half the range has slipped all the way, whatever its
+    state at the start: from then on its force is its stop operator's, started relaxed
+    anywhere before.  On those samples Maxwell-slip elements of any number are a
+    non-negative sum of :data:`BOUND_GRID` stop operators (their slip displacements as
+    dense as the NNLS stage's grid is sparse) plus an offset, a problem one non-negative
+    least squares solves: no fit of fewer elements leaves less there, and the other samples
+    add to a fit's error, never take from it.  The bound is that error, beyond the white
+    noise, over the whole record's samples.  It errs low (a record sampled coarsely, an
+    element that never slips: a spring the offset and line absorb), so a refusal on it is
+    safe; a record that sweeps its range only at its end has no samples for it (0).
+
+    Parameters
+    ----------
+    x, w : array_like
+        The record's displacement [m] and force [N] (checked by the reader).
+    max_rows : int
+        Most samples in the residual (evenly strided); the stop operators run on every one.
+
+    Returns
+    -------
+    float
+        The share of the force's RMS about its mean that every Maxwell-slip model leaves
+        as systematic error, at least; 0 where the record is the fit's to judge: no samples
+        after the sweep, a force that falls as the displacement rises (a sensor's sign
+        reversed) or that a spring explains as well as the stop operators do, within the
+        noise (no hysteresis): the fit's own checks name them.
+
+    Examples
+    --------
+    A Jenkins element with a damper in parallel: loops that widen with the speed, which no
+    Maxwell-slip elements have, against elements that describe the force exactly.
+
+    >>> import numpy as np
+    >>> from motionhyst import Jenkins, MaxwellSlip
+    >>> t = np.arange(600) / 750
+    >>> x = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    >>> w = Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x + 1.6 * np.gradient(x, t)
+    >>> print(f"{systematic_share_bound(x, w):.3f}")     # the fit's own: 0.101
+    0.069
+    >>> w = MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.004, 0.003, 0.002]).response(x)
+    >>> systematic_share_bound(x, w) < 1e-3
+    True
+    """
+    xs = np.ascontiguousarray(np.asarray(x, dtype=float))
+    ws = np.asarray(w, dtype=float)
+    x0, w0 = xs - xs.mean(), ws - ws.mean()
+    spread = float(np.std(ws))
+    if not spread > 0 or np.dot(x0, w0) < -0.5 * np.linalg.norm(x0) * np.linalg.norm(w0):
+        return 0.0  # as _nnls_start: a force that falls as the displacement rises
+    start = max(int(np.argmin(xs)), int(np.argmax(xs)))
+    if xs.size - start < 3:
+        return 0.0
+    prob = FitProblem(x=xs, target=ws, rows=fit_rows(start, xs.size, max_rows), filt=None,
+                      fit_initial=False)
+    h = 0.5 * float(np.ptp(xs))
+    d = np.geomspace(GRID_SPAN * h, h, BOUND_GRID)
+    A = _unit_columns(prob, d, np.zeros_like(d), per_slip_force=True)
+    y = prob.y
+    A = A - A.mean(axis=0)
+    y = y - y.mean()
+    # on the columns themselves: a QR of them first (the NNLS stage's way, for its 5e4
+    # rows) runs LAPACK's threads, which on a loaded machine take seconds
+    f, _ = nnls(A, y, maxiter=50 * BOUND_GRID)
+    r = y - A @ f
+    line = xs[prob.rows] - xs[prob.rows].mean()
+    linear = y - line * (float(line @ y) / float(line @ line))
+    if hysteresis_gain(float(linear @ linear), r) < NO_HYSTERESIS_GAIN:
+        return 0.0  # a spring's force: the fit's own check says there is no hysteresis
+    noise = float(np.mean(np.diff(r) ** 2)) / 2.0
+    swept = xs.size - start  # the samples the rows stand for, of all the record's
+    return math.sqrt(max(float(np.mean(r ** 2)) - noise, 0.0) * swept / xs.size) / spread
 
 
 def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = None, *,

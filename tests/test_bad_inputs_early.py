@@ -1,0 +1,151 @@
+"""Refusals that come before the expensive work, and the work a refusal must not prevent
+(issue 26: every refusal within 2 s of start).
+
+The corpus cases run the command line in a child process under an address-space limit
+(:mod:`limited_process`), in a folder holding the user's files, and assert exit code 2, one
+line on stderr naming the cause (no traceback), nothing on stdout, and every file there
+before byte-identical afterwards, with no file added.
+"""
+
+from __future__ import annotations
+
+import limited_process
+import numpy as np
+import pytest
+from file_trees import populate, snapshot
+
+from motionhyst import Jenkins, MaxwellSlip
+from motionhyst.cli import main
+
+FS = 750.0
+NOT_MAXWELL_SLIP = "no Maxwell-slip elements describe this record: any number of them leave"
+
+
+def _csv(columns: dict[str, np.ndarray]) -> str:
+    """A CSV record with a header of the `columns`' names."""
+    rows = np.column_stack(list(columns.values()))
+    return ",".join(columns) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                              for row in rows)
+
+
+def _displacement(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Time and a sine of 1 mm at 2 Hz whose amplitude breathes (100 % down to 60 % and back
+    every 20 s), sampled at FS."""
+    t = np.arange(n) / FS
+    return t, 1e-3 * np.sin(2 * np.pi * 2 * t) * (0.8 + 0.2 * np.cos(2 * np.pi * 0.05 * t))
+
+
+def _jenkins_and_damper(n: int = 6000, damping: float = 1.6) -> tuple[np.ndarray, ...]:
+    """A Jenkins element with a spring and a damper in parallel: loops that widen with the
+    speed, which no Maxwell-slip elements have (a fit of them leaves 12 % of the force's
+    RMS, measured, against 2 % allowed, after 5 s of CPU)."""
+    t, x = _displacement(n)
+    w = (Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x + damping * np.gradient(x, t)
+         + 1e-4 * np.random.default_rng(1).standard_normal(n))
+    return t, x, w
+
+
+def _record(n: int = 6000, **kw) -> str:
+    t, x, w = _jenkins_and_damper(n, **kw)
+    return _csv({"time": t, "displacement": x, "force": w})
+
+
+BASE = {"notes.txt": "my notes", "jd.csv": _record()}
+IDENTIFY = ["identify", "jd.csv"]
+
+# (id, extra files, argv, words of the one line on stderr)
+CASES = [
+    ("jenkins-with-a-damper", {}, IDENTIFY,
+     ["jd.csv: " + NOT_MAXWELL_SLIP, "(above 2 %, beyond the noise)",
+      "--model dahl, bouc-wen or lugre", "nothing identified"]),
+    ("jenkins-with-a-damper-saved", {}, [*IDENTIFY, "--save", "link.toml"],
+     ["jd.csv: " + NOT_MAXWELL_SLIP]),
+    ("jenkins-with-a-damper-long", {"long.csv": _record(60_000)}, ["identify", "long.csv"],
+     ["long.csv: " + NOT_MAXWELL_SLIP]),
+]
+
+
+def test_the_cases_are_distinct():
+    assert len({c[0] for c in CASES}) == len(CASES)
+
+
+@pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_a_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv, words):
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, {**BASE, **files})
+    before = snapshot(root)
+    line = limited_process.refusal(list(argv), root)
+    for word in words:
+        assert word in line, (word, line)
+    assert snapshot(root) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["user"]
+
+
+def test_a_record_no_maxwell_slip_describes_is_refused_before_the_fit(tmp_path, monkeypatch,
+                                                                      capsys):
+    """The bound comes before the fit (which took 5 s of CPU on this record, 30 s on one of
+    60000 samples, to end in the same refusal): the fit is not reached."""
+    from motionhyst.identify import fit
+
+    def reached(*args, **kwargs):
+        raise AssertionError("the fit started")
+
+    monkeypatch.setattr(fit, "identify_maxwell_slip", reached)
+    (tmp_path / "jd.csv").write_text(BASE["jd.csv"])
+    for extra in ([], ["--save", str(tmp_path / "link.toml")]):
+        assert main(["identify", str(tmp_path / "jd.csv"), *extra]) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and NOT_MAXWELL_SLIP in err
+    assert not (tmp_path / "link.toml").exists()
+
+
+def test_an_order_asked_for_is_fitted_and_its_error_reported_not_refused(tmp_path, capsys):
+    """With --elements and no --save the command reports the error of what was asked (as
+    before): the bound refuses only where the fit's own check would."""
+    (tmp_path / "jd.csv").write_text(_record(1200))
+    assert main(["identify", str(tmp_path / "jd.csv"), "--elements", "2"]) == 0
+    assert "systematic error" in capsys.readouterr().out
+
+
+def _swept_share(x, w, t) -> float:
+    """What the whole fit leaves (systematic share of its residual)."""
+    from motionhyst.identify import identify_maxwell_slip
+    from motionhyst.identify.io_checks import systematic_share
+
+    ident = identify_maxwell_slip(x, w, t=t)
+    return systematic_share(w - ident.predict(x, ident.initial_forces), w)
+
+
+def test_the_bound_lies_below_what_the_fit_leaves_and_near_zero_for_maxwell_slip():
+    from motionhyst.identify.fit import systematic_share_bound
+
+    # loops of a damper: the bound (6.9 %, measured) refuses, and the fit leaves more
+    t, x, w = _jenkins_and_damper(600)
+    bound = systematic_share_bound(x, w)
+    assert 0.05 < bound <= _swept_share(x, w, t)
+    # Maxwell-slip elements whose slip displacements fall between the bound's grid
+    # points, started in a state the record does not show, with 1 % force noise: the
+    # bound is below 0.1 % of the force (the fit leaves 0)
+    t = np.linspace(0.0, 4.0, 4001)
+    x = 0.005 + 0.01 * np.sin(2 * np.pi * 1.3 * t) * (0.5 + 0.5 * np.sin(2 * np.pi * 0.2 * t))
+    link = MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.0101, 0.0203, 0.0307])
+    w = link.response(np.concatenate([[0.0, 0.02], x]))[2:]
+    w = w + 0.01 * np.std(w) * np.random.default_rng(2).standard_normal(w.size)
+    assert systematic_share_bound(x, w) < 1e-3
+    # a weak damper beside the element: below the 2 % a fit may leave, so the fit decides
+    t, x, w = _jenkins_and_damper(600, damping=0.16)
+    assert systematic_share_bound(x, w) < 0.02
+
+
+def test_the_bound_leaves_the_fits_own_reasons_first():
+    """A force of noise (no hysteresis) and a force whose sign is reversed: 0, so that the
+    fit's own messages say so (the first reason stays the message)."""
+    from motionhyst.identify.fit import systematic_share_bound
+
+    _, x = _displacement(6000)
+    noise = np.random.default_rng(5).standard_normal(x.size)
+    assert systematic_share_bound(x, noise) == 0.0
+    _, x, w = _jenkins_and_damper(600)
+    assert systematic_share_bound(x, -w) == 0.0
