@@ -70,14 +70,25 @@ EXTRA_ORDER = 2
 """Order of the prefilter beyond ``deg d1``: ``L / P1`` then rolls off at high frequency."""
 
 
-BOUND_GRID = 400
-"""Slip displacements of :func:`systematic_share_bound`, log-spaced over the span of the
-NNLS stage's (neighbours 1.7 % apart: a threshold between two of them costs a clean
-three-element record 2e-4 of its force's RMS, measured)."""
+BOUND_TOLERANCE = 1e-3
+"""How closely the columns of :func:`systematic_share_bound` stand for every slip displacement
+between them: the RMS over its rows by which the stop operator (per unit slip force) of the
+geometric mean of two neighbouring slip displacements may differ from the nearest blend of
+the two's; where more, the interval is halved."""
+
+
+BOUND_PER_DECADE = 4
+"""Slip displacements per decade of :func:`systematic_share_bound` before its refinement."""
+
+
+BOUND_COLUMNS = 2000
+"""Most stop operators of :func:`systematic_share_bound` (its refinement stops there; the
+bound then allows for the error of the coarsest interval left)."""
 
 
 BOUND_ROWS = 5000
-"""Most samples in the residual of :func:`systematic_share_bound` (evenly strided)."""
+"""Most samples in the residual of :func:`systematic_share_bound`: pairs of successive
+samples, evenly strided (a pair's difference is the noise's, as in the fit's judgement)."""
 
 
 Criterion = Literal["rms", "bic"]
@@ -620,6 +631,48 @@ def fit_rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
     return np.arange(start, n, stride)
 
 
+def _bound_columns(x: NDArray[np.float64], rows: NDArray[np.intp], h: float
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """The stop operators per unit slip force of :func:`systematic_share_bound`, at `rows`.
+
+    Their slip displacements run from a quarter of the smallest step of `x` (every step
+    saturates that stop: its column is the limit of zero slip, a Coulomb element's sign of
+    the motion since the last reversal) up to `h`, :data:`BOUND_PER_DECADE` a decade from
+    1e-12 `h` on, and every interval whose geometric mean's column is farther than
+    :data:`BOUND_TOLERANCE` (RMS) from the nearest blend of its ends' is halved, until none
+    is or there are :data:`BOUND_COLUMNS`.  Returns the slip displacements (ascending), the
+    columns and how closely they stand for the slip displacements between them (the
+    tolerance, or the error of the coarsest interval left).
+    """
+    steps = np.abs(np.diff(x))
+    zero = min(max(0.25 * float(steps[steps > 0].min()), np.finfo(float).tiny), h)
+    low = max(zero, 1e-12 * h)  # below it, one interval to the limit (steps of round-off)
+    d = np.geomspace(low, h, max(2, math.ceil(BOUND_PER_DECADE * math.log10(h / low)) + 1))
+    d = np.append(zero, d) if zero < low else d
+    cols = dict(zip(d.tolist(), _stops_at(x, d, np.zeros_like(d), rows, True).T, strict=True))
+    pending = list(zip(d[:-1].tolist(), d[1:].tolist(), strict=True))
+    left = BOUND_TOLERANCE
+    while pending:
+        mids = np.array([math.sqrt(a) * math.sqrt(b) for a, b in pending])  # no underflow
+        M = _stops_at(x, mids, np.zeros_like(mids), rows, True)
+        Sa = np.column_stack([cols[a] for a, _ in pending])
+        Sb = np.column_stack([cols[b] for _, b in pending])
+        span, off = Sa - Sb, M - Sb
+        den = np.einsum("ij,ij->j", span, span)
+        blend = np.clip(np.einsum("ij,ij->j", off, span) / np.where(den > 0, den, 1.0),
+                        0.0, 1.0)
+        error = np.sqrt(np.mean((off - span * blend) ** 2, axis=0))
+        cols.update(zip(mids.tolist(), M.T, strict=True))
+        coarse = [(j, a, b) for j, (a, b) in enumerate(pending)
+                  if error[j] > BOUND_TOLERANCE and b > a * (1.0 + 1e-12)]
+        pending = [pair for j, a, b in coarse for pair in ((a, mids[j]), (mids[j], b))]
+        if pending and len(cols) + len(pending) // 2 > BOUND_COLUMNS:
+            left = max(float(error[j]) for j, _, _ in coarse)
+            break
+    d = np.array(sorted(cols))
+    return d, np.column_stack([cols[v] for v in d.tolist()]), left
+
+
 def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROWS) -> float:
     """A lower bound, before any fit, of the systematic error any Maxwell-slip elements leave
     in a force-displacement record (:func:`~motionhyst.identify.io_checks.systematic_share`
@@ -627,22 +680,27 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
 
     Once the displacement has run from one end of its range to the other, every element
     whose slip displacement is at most half the range has slipped all the way, whatever its
-    state at the start: from then on its force is its stop operator's, started relaxed
-    anywhere before.  On those samples Maxwell-slip elements of any number are a
-    non-negative sum of :data:`BOUND_GRID` stop operators (their slip displacements as
-    dense as the NNLS stage's grid is sparse) plus an offset, a problem one non-negative
-    least squares solves: no fit of fewer elements leaves less there, and the other samples
-    add to a fit's error, never take from it.  The bound is that error, beyond the white
-    noise, over the whole record's samples.  It errs low (a record sampled coarsely, an
-    element that never slips: a spring the offset and line absorb), so a refusal on it is
-    safe; a record that sweeps its range only at its end has no samples for it (0).
+    state at the start, and one whose slip displacement is longer never slips again (a
+    spring there, as the longest stop operator and the offset): from then on Maxwell-slip
+    elements of any number and any slip displacements, down to the limit of zero slip (a
+    Coulomb element), are a non-negative sum of stop operators plus an offset.  The stop
+    operators are those of :func:`_bound_columns`: every slip displacement between two of
+    them is a blend of the two within a tolerance, which the bound allows for (the
+    tolerance times the slip forces, in RMS).  One non-negative least squares over them
+    leaves, on those samples, no more than any fit of any number of elements, and the other
+    samples add to a fit's error, never take from it.  The bound is that error, beyond the
+    white noise (from the differences of successive samples, as the fit's judgement), over
+    the whole record's samples.  It errs low (a record sampled coarsely, the noise the many
+    operators absorb), so a refusal on it is safe; a record that sweeps its range only at
+    its end has no samples for it (0).
 
     Parameters
     ----------
     x, w : array_like
         The record's displacement [m] and force [N] (checked by the reader).
     max_rows : int
-        Most samples in the residual (evenly strided); the stop operators run on every one.
+        Most samples in the residual (pairs of successive samples, evenly strided); the
+        stop operators run on every one.
 
     Returns
     -------
@@ -656,7 +714,8 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     Examples
     --------
     A Jenkins element with a damper in parallel: loops that widen with the speed, which no
-    Maxwell-slip elements have, against elements that describe the force exactly.
+    Maxwell-slip elements have, against elements that describe the force exactly, one of
+    them a stiff contact that slips over 2e-6 of the stroke (a Coulomb element, nearly).
 
     >>> import numpy as np
     >>> from motionhyst import Jenkins, MaxwellSlip
@@ -664,8 +723,8 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     >>> x = 1e-3 * np.sin(2 * np.pi * 2 * t)
     >>> w = Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x + 1.6 * np.gradient(x, t)
     >>> print(f"{systematic_share_bound(x, w):.3f}")     # the fit's own: 0.101
-    0.069
-    >>> w = MaxwellSlip(k=[10.0, 6.0, 4.0], fc=[0.004, 0.003, 0.002]).response(x)
+    0.058
+    >>> w = MaxwellSlip(k=[5e3, 6.0, 4.0], fc=[0.004, 0.003, 0.002]).response(x)
     >>> systematic_share_bound(x, w) < 1e-3
     True
     """
@@ -676,27 +735,28 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     if not spread > 0 or np.dot(x0, w0) < -0.5 * np.linalg.norm(x0) * np.linalg.norm(w0):
         return 0.0  # as _nnls_start: a force that falls as the displacement rises
     start = max(int(np.argmin(xs)), int(np.argmax(xs)))
-    if xs.size - start < 3:
+    if xs.size - start < 4:
         return 0.0
-    prob = FitProblem(x=xs, target=ws, rows=fit_rows(start, xs.size, max_rows), filt=None,
-                      fit_initial=False)
-    h = 0.5 * float(np.ptp(xs))
-    d = np.geomspace(GRID_SPAN * h, h, BOUND_GRID)
-    A = _unit_columns(prob, d, np.zeros_like(d), per_slip_force=True)
-    y = prob.y
+    stride = max(2, math.ceil((xs.size - 1 - start) / max(max_rows // 2, 1)))
+    first = np.arange(start, xs.size - 1, stride)
+    rows = np.column_stack([first, first + 1]).ravel()
+    d, A, tolerance = _bound_columns(xs, rows, 0.5 * float(np.ptp(xs)))
+    y = ws[rows]
     A = A - A.mean(axis=0)
     y = y - y.mean()
     # on the columns themselves: a QR of them first (the NNLS stage's way, for its 5e4
     # rows) runs LAPACK's threads, which on a loaded machine take seconds
-    f, _ = nnls(A, y, maxiter=50 * BOUND_GRID)
+    f, _ = nnls(A, y, maxiter=50 * d.size)
     r = y - A @ f
-    line = xs[prob.rows] - xs[prob.rows].mean()
+    line = xs[rows] - xs[rows].mean()
     linear = y - line * (float(line @ y) / float(line @ line))
     if hysteresis_gain(float(linear @ linear), r) < NO_HYSTERESIS_GAIN:
         return 0.0  # a spring's force: the fit's own check says there is no hysteresis
-    noise = float(np.mean(np.diff(r) ** 2)) / 2.0
+    noise = float(np.mean((r[1::2] - r[::2]) ** 2)) / 2.0
+    slip = max(float(f.sum()), 0.5 * float(np.ptp(y)))  # the best model's slip forces, about
+    rms = max(math.sqrt(float(np.mean(r ** 2))) - tolerance * slip, 0.0)
     swept = xs.size - start  # the samples the rows stand for, of all the record's
-    return math.sqrt(max(float(np.mean(r ** 2)) - noise, 0.0) * swept / xs.size) / spread
+    return math.sqrt(max(rms ** 2 - noise, 0.0) * swept / xs.size) / spread
 
 
 def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = None, *,
