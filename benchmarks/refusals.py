@@ -13,7 +13,7 @@ with a text file for its record, an identification file larger than any, a study
 named by a symbolic link, and a record no Maxwell-slip elements describe (a Jenkins
 element, a spring and a damper: loops, but not a stop operator's; a short record and one
 of 60000 samples), refused by a bound on what any of them can leave before the fit that
-took 1.4 s and 30 s of CPU to refuse them.  Each runs as a whole
+took 1.8 s and 26 s of CPU to refuse them.  Each runs as a whole
 process (the interpreter, the imports, the checks) in a folder holding its files,
 ``REPEATS`` times interleaved with the baseline of the same run: ``motionhyst --help``,
 the command's start alone.  Reported per case: the least wall time (the least disturbed
