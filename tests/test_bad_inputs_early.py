@@ -221,6 +221,31 @@ def test_the_bound_never_exceeds_what_the_elements_that_made_the_record_leave(ki
     assert systematic_share_bound(x, w) <= systematic_share(w - true, w) + 1e-3
 
 
+@pytest.mark.parametrize("kind", ["slips", "earthquake", "100 Hz", "quantised"])
+def test_every_slip_displacement_between_the_bounds_columns_is_a_blend_of_its_neighbours(kind):
+    """The bound's claim on its columns: the stop operator of any slip displacement from the
+    limit of zero slip to half the range is within twice the tolerance (RMS, per unit slip
+    force) of a blend of the two columns around it (measured: at most 1.44 times)."""
+    from motionhyst.identify.fit import BOUND_TOLERANCE, _bound_columns, _stops_at
+
+    x, _, _ = _family(kind, 3)
+    x = np.ascontiguousarray(x)
+    rows = np.arange(int(np.argmax(x)), x.size)
+    d, columns, tolerance = _bound_columns(x, rows, 0.5 * float(np.ptp(x)))
+    assert tolerance == BOUND_TOLERANCE and d[-1] == 0.5 * np.ptp(x)
+    trial = np.exp(np.random.default_rng(4).uniform(np.log(d[0]), np.log(d[-1]), 500))
+    between = _stops_at(x, trial, np.zeros_like(trial), rows, True)
+    j = np.clip(np.searchsorted(d, trial), 1, d.size - 1)
+    span, off = columns[:, j - 1] - columns[:, j], between - columns[:, j]
+    square = np.einsum("ij,ij->j", span, span)  # 0 where the two are one (steps below both)
+    blend = np.clip(np.einsum("ij,ij->j", off, span) / np.where(square > 0, square, 1.0), 0, 1)
+    assert np.sqrt(np.mean((off - span * blend) ** 2, axis=0)).max() <= 2 * BOUND_TOLERANCE
+    coulomb = np.sign(np.diff(x))  # the limit of zero slip: the sign of the last step
+    for i in range(1, coulomb.size):
+        coulomb[i] = coulomb[i] or coulomb[i - 1]
+    assert np.array_equal(columns[:, 0], coulomb[rows - 1])
+
+
 def test_the_bound_leaves_the_fits_own_reasons_first():
     """A force of noise (no hysteresis) and a force whose sign is reversed: 0, so that the
     fit's own messages say so (the first reason stays the message)."""

@@ -74,7 +74,9 @@ BOUND_TOLERANCE = 1e-3
 """How closely the columns of :func:`systematic_share_bound` stand for every slip displacement
 between them: the RMS over its rows by which the stop operator (per unit slip force) of the
 geometric mean of two neighbouring slip displacements may differ from the nearest blend of
-the two's; where more, the interval is halved."""
+the two's; where more, the interval is halved.  The bound allows for twice that at every
+slip displacement between (measured: at most 1.44 times it, at 24000 random ones on sines,
+earthquake-like inputs, 100 Hz sampling and a 1 um encoder)."""
 
 
 BOUND_PER_DECADE = 4
@@ -685,8 +687,8 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     elements of any number and any slip displacements, down to the limit of zero slip (a
     Coulomb element), are a non-negative sum of stop operators plus an offset.  The stop
     operators are those of :func:`_bound_columns`: every slip displacement between two of
-    them is a blend of the two within a tolerance, which the bound allows for (the
-    tolerance times the slip forces, in RMS).  One non-negative least squares over them
+    them is a blend of the two within twice a tolerance, which the bound allows for (that
+    times the slip forces, in RMS).  One non-negative least squares over them
     leaves, on those samples, no more than any fit of any number of elements, and the other
     samples add to a fit's error, never take from it.  The bound is that error, beyond the
     white noise (from the differences of successive samples, as the fit's judgement), over
@@ -723,7 +725,7 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     >>> x = 1e-3 * np.sin(2 * np.pi * 2 * t)
     >>> w = Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x + 1.6 * np.gradient(x, t)
     >>> print(f"{systematic_share_bound(x, w):.3f}")     # the fit's own: 0.101
-    0.058
+    0.057
     >>> w = MaxwellSlip(k=[5e3, 6.0, 4.0], fc=[0.004, 0.003, 0.002]).response(x)
     >>> systematic_share_bound(x, w) < 1e-3
     True
@@ -754,7 +756,7 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
         return 0.0  # a spring's force: the fit's own check says there is no hysteresis
     noise = float(np.mean((r[1::2] - r[::2]) ** 2)) / 2.0
     slip = max(float(f.sum()), 0.5 * float(np.ptp(y)))  # the best model's slip forces, about
-    rms = max(math.sqrt(float(np.mean(r ** 2))) - tolerance * slip, 0.0)
+    rms = max(math.sqrt(float(np.mean(r ** 2))) - 2.0 * tolerance * slip, 0.0)
     swept = xs.size - start  # the samples the rows stand for, of all the record's
     return math.sqrt(max(rms ** 2 - noise, 0.0) * swept / xs.size) / spread
 
