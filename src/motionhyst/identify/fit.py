@@ -692,9 +692,10 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     leaves, on those samples, no more than any fit of any number of elements, and the other
     samples add to a fit's error, never take from it.  The bound is that error, beyond the
     white noise (from the differences of successive samples, as the fit's judgement), over
-    the whole record's samples.  It errs low (a record sampled coarsely, the noise the many
-    operators absorb), so a refusal on it is safe; a record that sweeps its range only at
-    its end has no samples for it (0).
+    the whole record's samples, less four times the spread of that difference's estimate
+    (the noise divided by the square root of the pairs).  It errs low (a record sampled
+    coarsely, the noise the many operators absorb), so a refusal on it is safe; a record
+    that sweeps its range only at its end has no samples for it (0).
 
     Parameters
     ----------
@@ -758,7 +759,11 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     slip = max(float(f.sum()), 0.5 * float(np.ptp(y)))  # the best model's slip forces, about
     rms = max(math.sqrt(float(np.mean(r ** 2))) - 2.0 * tolerance * slip, 0.0)
     swept = xs.size - start  # the samples the rows stand for, of all the record's
-    return math.sqrt(max(rms ** 2 - noise, 0.0) * swept / xs.size) / spread
+    # the residual's mean square less the noise taken from the same pairs is the mean of
+    # the products of each pair's two noises: it spreads by noise / sqrt(pairs), 4 of which
+    # are allowed (a heavy noise otherwise passes for systematic error)
+    margin = 4.0 * noise / math.sqrt(rows.size // 2)
+    return math.sqrt(max(rms ** 2 - noise - margin, 0.0) * swept / xs.size) / spread
 
 
 def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = None, *,
