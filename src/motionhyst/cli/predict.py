@@ -79,6 +79,10 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst predict: --init-window must be at least 2, got {window}")
     sc = Scenario.from_file(args.scenario, check=False)  # a loop is refused, not built
     system = sc.open_loop()
+    if args.substeps is not None and not system.plant.has_inertia:
+        raise UsageError(f"motionhyst predict: --substeps sets the integration steps of a "
+                         f"model with inertia; {sc.source} is quasi-static (its balance is "
+                         f"solved at each sample, with no steps between)")
     if _input_quantity(args, system) == "displacement":
         return _predict_force(args, sc, system, target)
     both = args.init_from is not None  # the maps also name the --init-from record's position
@@ -173,10 +177,9 @@ def _input_quantity(args: argparse.Namespace, system) -> str:
     names = record_columns(args.data, args.columns)
     if "force" in names or "displacement" not in names:
         return "force"
-    for option in ("--init-from", "--substeps"):
-        if getattr(args, option[2:].replace("-", "_"), None) is not None:
-            raise UsageError(f"motionhyst predict: {option} applies to a force record (the "
-                             f"displacement predicted); {args.data} holds a displacement")
+    if args.init_from is not None:
+        raise UsageError(f"motionhyst predict: --init-from applies to a force record (the "
+                         f"displacement predicted); {args.data} holds a displacement")
     return "displacement"
 
 

@@ -1,0 +1,83 @@
+"""The hostile corpus over the measured-record commands (issue 26, the sweep of identify,
+predict and their records): options a model or record kind has no use for, a record of one
+kind read as another, and checks that the record alone decides, made before the plant's
+engines load.
+
+Each refusal runs the command line in a child process under an address-space limit
+(:mod:`limited_process`), in a folder holding the user's files, and asserts exit code 2, one
+line on stderr naming the cause (no traceback), nothing on stdout, and every file there
+before byte-identical afterwards, with no file added.
+"""
+
+from __future__ import annotations
+
+import limited_process
+import numpy as np
+import pytest
+from file_trees import populate, snapshot
+
+from motionhyst.scenario import default_scenario_path
+
+FS = 1000.0
+QUASI_STATIC = ('[stage]\ntype = "quasi-static"\nk = 1e4\nc = 5.0\n\n'
+                '[hysteresis]\nmodel = "jenkins"\nk = 2e4\nfc = 4.0\n')
+
+
+def _table(columns: dict[str, np.ndarray]) -> str:
+    return ",".join(columns) + "\n" + "".join(
+        ",".join(repr(float(v)) for v in row) + "\n" for row in zip(*columns.values(),
+                                                                    strict=True))
+
+
+def _stage(n: int = 3000, m: float = 2.0, c: float = 10.0, fc: float = 1.0
+           ) -> dict[str, np.ndarray]:
+    """A positioning axis's record, force in and position out: the force that moves a mass
+    `m` [kg] along two sines against viscous (`c`) and smoothed Coulomb (`fc`) friction."""
+    t = np.arange(n) / FS
+    w1, w2 = 2 * np.pi * 1.0, 2 * np.pi * 3.7
+    y = 2e-2 * np.sin(w1 * t) + 3e-3 * np.sin(w2 * t + 0.4)
+    v = 2e-2 * w1 * np.cos(w1 * t) + 3e-3 * w2 * np.cos(w2 * t + 0.4)
+    a = -2e-2 * w1 ** 2 * np.sin(w1 * t) - 3e-3 * w2 ** 2 * np.sin(w2 * t + 0.4)
+    return {"time": t, "force": m * a + c * v + fc * np.tanh(v / 1e-3), "displacement": y}
+
+
+def _closed_loop(n: int = 4000) -> str:
+    """A closed-loop record's columns (time,y1,u; made-up values: the cases are refused
+    before any plant is loaded)."""
+    t = np.arange(n) / 10_000.0
+    return _table({"time": t, "y1": 0.01 * np.sin(2 * np.pi * 2.0 * t),
+                   "u": 50.0 * np.sin(2 * np.pi * 2.0 * t + 0.2)})
+
+
+BASE = {"qs.toml": QUASI_STATIC, "paper.toml": default_scenario_path().read_text(),
+        "f.csv": _table({k: v for k, v in _stage().items() if k != "displacement"}),
+        "stage.csv": _table(_stage()), "cl.csv": _closed_loop(), "notes.txt": "my notes"}
+CLOSED_LOOP = ["identify", "cl.csv", "--scenario", "paper.toml"]
+
+# (id, extra files, argv, words of the one line on stderr)
+CASES = [
+    # ----------------------------------------- an option the model has no use for (was exit 0)
+    ("predict-substeps-on-a-quasi-static-model", {},
+     ["predict", "qs.toml", "f.csv", "--out", "p.csv", "--substeps", "7"],
+     ["--substeps sets the integration steps of a model with inertia; qs.toml is "
+      "quasi-static"]),
+]
+
+
+def test_the_cases_are_distinct():
+    assert len({c[0] for c in CASES}) == len(CASES)
+
+
+@pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_a_measured_record_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv,
+                                                                       words):
+    root = tmp_path / "user"
+    root.mkdir()
+    populate(root, {**BASE, **files})
+    before = snapshot(root)
+    line = limited_process.refusal(list(argv), root)
+    for word in words:
+        assert word in line, (word, line)
+    assert snapshot(root) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["user"]
