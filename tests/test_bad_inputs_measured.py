@@ -11,6 +11,9 @@ before byte-identical afterwards, with no file added.
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import limited_process
 import numpy as np
 import pytest
@@ -61,6 +64,11 @@ CASES = [
      ["predict", "qs.toml", "f.csv", "--out", "p.csv", "--substeps", "7"],
      ["--substeps sets the integration steps of a model with inertia; qs.toml is "
       "quasi-static"]),
+    # -------------------------- a prefilter cut-off the record cannot have (was after the plant)
+    ("closed-loop-cutoff-above-nyquist", {}, [*CLOSED_LOOP, "--cutoff", "1e9"],
+     ["cl.csv: cutoff_hz must be in (0, 5000) Hz"]),
+    ("closed-loop-cutoff-longer-than-the-record", {}, [*CLOSED_LOOP, "--cutoff", "1e-3"],
+     ["cl.csv: too short: the prefilter settles in 1e+04 s"]),
 ]
 
 
@@ -81,3 +89,17 @@ def test_a_measured_record_case_refuses_in_one_line_and_touches_nothing(tmp_path
         assert word in line, (word, line)
     assert snapshot(root) == before
     assert [p.name for p in tmp_path.iterdir()] == ["user"]
+
+
+@pytest.mark.parametrize("cutoff", ["1e9", "1e-3"])
+def test_a_closed_loop_cutoff_is_refused_before_the_plant_loads(tmp_path, cutoff):
+    """The cut-off is judged from the record alone, before the scenario's plant loads
+    python-control and scipy.signal (seconds on a busy machine: the refusal came 4 s after
+    the start)."""
+    populate(tmp_path, BASE)
+    code = ("import sys\nfrom motionhyst.cli import main\n"
+            f"code = main({[*CLOSED_LOOP, '--cutoff', cutoff]!r})\n"
+            "print(code, sorted({'control', 'scipy.signal'} & set(sys.modules)))\n")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120, env=limited_process.environment())
+    assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr

@@ -196,6 +196,12 @@ def run(args: argparse.Namespace) -> int:
         extra["displacement_noise"] = noise.to_dict()
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
+        from motionhyst.identify.records import prefilter_cutoff
+
+        try:  # before the plant's scenario loads python-control
+            prefilter_cutoff(t, y1, args.cutoff)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
         from motionhyst.identify.io_records import IORecord
         from motionhyst.identify.io_response import check_response
 

@@ -21,7 +21,7 @@ from motionhyst.identify.fit import (
     fit_rows,
     identify_prepared,
 )
-from motionhyst.identify.records import MIN_SAMPLES, check_signals, count_reversals
+from motionhyst.identify.records import check_signals, prefilter_cutoff
 from motionhyst.identify.result import Identification
 from motionhyst.plants.registry import Plant
 
@@ -29,10 +29,6 @@ __all__ = ["LinkForce", "identify_closed_loop", "infer_link_force"]
 
 DECIMATED_RATE = 40.0
 """Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""
-
-
-SETTLE_PERIODS = 10.0
-"""Start-up transient of the closed-loop prefilter, in units of ``1 / cutoff_hz``."""
 
 
 UNIFORM_RTOL = 0.01
@@ -169,20 +165,7 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         raise ValueError("P1 must be proper")
     if num[-1] == 0:
         raise ValueError("P1 must not have a zero at s = 0")
-    fs = 1.0 / dt
-    if cutoff_hz is None:
-        duration = float(ts[-1] - ts[0])
-        f0 = (count_reversals(ys) + 1) / (2.0 * duration)
-        cutoff_hz = min(20.0 * f0, fs / 20.0)
-    cutoff_hz = float(cutoff_hz)
-    if not (np.isfinite(cutoff_hz) and 0 < cutoff_hz < fs / 2):
-        raise ValueError(f"cutoff_hz must be in (0, {fs / 2:g}) Hz, below half the record's "
-                         f"sampling rate (the prefilter's cut-off, --cutoff), got {cutoff_hz:g}")
-    settle = int(np.searchsorted(ts - ts[0], SETTLE_PERIODS / cutoff_hz))
-    if ts.size - settle < MIN_SAMPLES:  # known before the filters run
-        raise ValueError(f"too short: the prefilter settles in {SETTLE_PERIODS / cutoff_hz:.3g} "
-                         f"s, leaving {max(ts.size - settle, 0)} samples; record longer or "
-                         "raise the prefilter's cut-off (cutoff_hz, --cutoff)")
+    cutoff_hz, settle = prefilter_cutoff(ts, ys, cutoff_hz)  # known before the filters run
     wl = TWO_PI * cutoff_hz
     order = den.size - 1 + EXTRA_ORDER
     zb, pb, kb = butter(order, wl, analog=True, output="zpk")

@@ -11,7 +11,7 @@ from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
 __all__ = ["ELASTIC_CURVE_RATIO", "check_loops_open", "count_reversals", "load_closed_loop_csv",
-           "load_force_displacement_csv"]
+           "load_force_displacement_csv", "prefilter_cutoff"]
 
 MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
@@ -345,3 +345,72 @@ def load_closed_loop_csv(source: Source, *, columns: dict[str, str] | None = Non
     (1001,)
     """
     return _load(source, ("time", "y1", "u"), "y1", columns, scale)
+
+
+SETTLE_PERIODS = 10.0
+"""Start-up transient of the closed-loop prefilter, in units of ``1 / cutoff_hz``."""
+
+
+def prefilter_cutoff(t: ArrayLike, y1: ArrayLike,
+                     cutoff_hz: float | None = None) -> tuple[float, int]:
+    """The cut-off of a closed-loop record's prefilter and the sample at which it has settled.
+
+    The default cut-off is 20 times the record's fundamental (from the reversals of
+    `y1`), at most a twentieth of the sampling rate; a cut-off given must lie below half
+    the sampling rate and leave :data:`MIN_SAMPLES` samples after the prefilter's
+    start-up transient, :data:`SETTLE_PERIODS` periods of the cut-off.  Checked from the
+    record alone, before the plant is loaded and the filters run
+    (:func:`~motionhyst.identify.closed_loop.infer_link_force` applies it).
+
+    Parameters
+    ----------
+    t : array_like
+        The record's time stamps [s] (uniform).
+    y1 : array_like
+        Position of the actuated mass [m].
+    cutoff_hz : float, optional
+        The cut-off asked for (``--cutoff``) [Hz].
+
+    Returns
+    -------
+    cutoff_hz : float
+        The cut-off [Hz].
+    settle : int
+        Index of the first sample after the start-up transient.
+
+    Raises
+    ------
+    ValueError
+        A cut-off at or above half the sampling rate, not positive, or one whose
+        transient leaves fewer than :data:`MIN_SAMPLES` samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(4000) / 1000.0
+    >>> cutoff, settle = prefilter_cutoff(t, np.sin(2 * np.pi * 2.0 * t))  # 2 Hz: 16 reversals
+    >>> round(cutoff, 1), settle                  # 20 x (16 + 1) / (2 x 4 s), settled at 0.24 s
+    (42.5, 236)
+    >>> try:
+    ...     prefilter_cutoff(t, np.sin(t), cutoff_hz=1e9)
+    ... except ValueError as exc:
+    ...     print(exc)
+    cutoff_hz must be in (0, 500) Hz, below half the record's sampling rate (the prefilter's \
+cut-off, --cutoff), got 1e+09
+    """
+    ts = np.asarray(t, dtype=float)
+    fs = 1.0 / float(np.median(np.diff(ts)))
+    if cutoff_hz is None:
+        duration = float(ts[-1] - ts[0])
+        f0 = (count_reversals(np.asarray(y1, dtype=float)) + 1) / (2.0 * duration)
+        cutoff_hz = min(20.0 * f0, fs / 20.0)
+    cutoff_hz = float(cutoff_hz)
+    if not (np.isfinite(cutoff_hz) and 0 < cutoff_hz < fs / 2):
+        raise ValueError(f"cutoff_hz must be in (0, {fs / 2:g}) Hz, below half the record's "
+                         f"sampling rate (the prefilter's cut-off, --cutoff), got {cutoff_hz:g}")
+    settle = int(np.searchsorted(ts - ts[0], SETTLE_PERIODS / cutoff_hz))
+    if ts.size - settle < MIN_SAMPLES:
+        raise ValueError(f"too short: the prefilter settles in {SETTLE_PERIODS / cutoff_hz:.3g} "
+                         f"s, leaving {max(ts.size - settle, 0)} samples; record longer or "
+                         "raise the prefilter's cut-off (cutoff_hz, --cutoff)")
+    return cutoff_hz, settle
