@@ -64,6 +64,9 @@ CASES = [
      ["predict", "qs.toml", "f.csv", "--out", "p.csv", "--substeps", "7"],
      ["--substeps sets the integration steps of a model with inertia; qs.toml is "
       "quasi-static"]),
+    ("from-rest-on-a-quasi-static-plant", {},
+     ["identify", "stage.csv", "--record", "input-output", "--plant", "quasi-static",
+      "--from-rest"], ["--from-rest sets a stage's state; a quasi-static plant has none"]),
     # -------------------------- a prefilter cut-off the record cannot have (was after the plant)
     ("closed-loop-cutoff-above-nyquist", {}, [*CLOSED_LOOP, "--cutoff", "1e9"],
      ["cl.csv: cutoff_hz must be in (0, 5000) Hz"]),

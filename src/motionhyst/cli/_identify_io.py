@@ -156,9 +156,10 @@ def run_input_output(args: argparse.Namespace) -> int:
                          "and estimates only their position offsets (--offset output, on a "
                          "mass-spring-damper); --from-rest, --init-window and the force offset "
                          "apply to the element links and to bouc-wen on --plant mass-damper")
-    if args.init_window is not None and plant == "quasi-static":
-        raise UsageError("motionhyst identify: --init-window sets a stage's state; a "
-                         "quasi-static plant has none")
+    for option, value in (("--init-window", args.init_window), ("--from-rest", args.from_rest)):
+        if value and plant == "quasi-static":
+            raise UsageError(f"motionhyst identify: {option} sets a stage's state; a "
+                             f"quasi-static plant has none")
     if args.init_window is not None and (args.periodic or args.from_rest):
         raise UsageError("motionhyst identify: --init-window sets the state of records from a "
                          "start; not with --periodic or --from-rest")
