@@ -52,6 +52,14 @@ def _closed_loop(n: int = 4000) -> str:
                    "u": 50.0 * np.sin(2 * np.pi * 2.0 * t + 0.2)})
 
 
+def _reversed_damper(path) -> None:
+    """A friction damper logged 300 s at 200 Hz (60000 samples) with its load cell reversed."""
+    import records_of_other_kinds as kinds
+
+    r = kinds.damper_record("sines", seconds=300.0)
+    path.write_text(_table({"time": r.t, "displacement": r.displacement, "force": -r.force}))
+
+
 BASE = {"qs.toml": QUASI_STATIC, "paper.toml": default_scenario_path().read_text(),
         "f.csv": _table({k: v for k, v in _stage().items() if k != "displacement"}),
         "stage.csv": _table(_stage()), "cl.csv": _closed_loop(), "notes.txt": "my notes"}
@@ -67,6 +75,12 @@ CASES = [
     ("from-rest-on-a-quasi-static-plant", {},
      ["identify", "stage.csv", "--record", "input-output", "--plant", "quasi-static",
       "--from-rest"], ["--from-rest sets a stage's state; a quasi-static plant has none"]),
+    # ---------- a long record (above the fit's 50000 rows) whose load cell is reversed: numpy's
+    # "shapes (60000,) and (30000,) not aligned" was the message
+    ("long-record-with-the-load-cell-reversed", {"rev.csv": _reversed_damper},
+     ["identify", "rev.csv"],
+     ["rev.csv: no hysteresis found: the force falls as the displacement rises (is one "
+      "sensor's sign reversed? --scale force=-1)"]),
     # -------------------------- a prefilter cut-off the record cannot have (was after the plant)
     ("closed-loop-cutoff-above-nyquist", {}, [*CLOSED_LOOP, "--cutoff", "1e9"],
      ["cl.csv: cutoff_hz must be in (0, 5000) Hz"]),
@@ -106,3 +120,21 @@ def test_a_closed_loop_cutoff_is_refused_before_the_plant_loads(tmp_path, cutoff
     proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
                           text=True, timeout=120, env=limited_process.environment())
     assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr
+
+
+def test_a_closed_loop_record_through_another_plant_names_the_plant():
+    """The paper's loop recorded, inferred through a 1 kg axis (another plant): the force
+    falls as y1 rises, and the message names the plant and the closed-loop columns (it was
+    numpy's "shapes (3751,) and (3215,) not aligned": the sign check compared every sample
+    with the rows after the prefilter settles)."""
+    from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+    from motionhyst.identify import identify_closed_loop
+    from motionhyst.plants.mass_damper import MassDamper
+
+    sc = default_scenario()
+    loop = Loop(sc.plant(), sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    sim = simulate(loop, SineReference(0.01, 2.0), 1.5, dt=2e-4)
+    with pytest.raises(ValueError, match=r"the force falls as the displacement rises \(the "
+                       r"force inferred through the plant: is the sign of u or y1 reversed "
+                       r"\(--scale u=-1\), or the plant not the record's\?\)"):
+        identify_closed_loop(sim.t, sim.y1, sim.u, MassDamper(1.0, 0.0))

@@ -326,10 +326,14 @@ def _nnls_start(prob: FitProblem) -> tuple[NDArray, NDArray, float]:
         j = run.stop
     ks_a, fcs_a = np.array(ks), np.array(fcs)
     if ks_a.size == 0:
-        x0, y0 = prob.x - np.mean(prob.x), y - y_mean
+        xr = prob.x[prob.rows]  # the force's rows: a closed-loop fit's skip the settling
+        x0, y0 = xr - np.mean(xr), y - y_mean
         if np.dot(x0, y0) < -0.5 * np.linalg.norm(x0) * np.linalg.norm(y0):
-            raise ValueError("no hysteresis found: the force falls as the displacement rises "
-                             "(is one sensor's sign reversed? --scale force=-1)")
+            why = ("is one sensor's sign reversed? --scale force=-1" if prob.filt is None
+                   else "the force inferred through the plant: is the sign of u or y1 "
+                        "reversed (--scale u=-1), or the plant not the record's?")
+            raise ValueError(f"no hysteresis found: the force falls as the displacement rises "
+                             f"({why})")
         raise ValueError("no hysteresis found: the force does not follow any stop operator "
                          "of the displacement")
     keep = fcs_a >= PRUNE * fcs_a.sum()
