@@ -44,10 +44,10 @@ def _stage(n: int = 3000, m: float = 2.0, c: float = 10.0, fc: float = 1.0
     return {"time": t, "force": m * a + c * v + fc * np.tanh(v / 1e-3), "displacement": y}
 
 
-def _closed_loop(n: int = 4000) -> str:
+def _closed_loop(n: int = 4000, rate: float = 10_000.0) -> str:
     """A closed-loop record's columns (time,y1,u; made-up values: the cases are refused
-    before any plant is loaded)."""
-    t = np.arange(n) / 10_000.0
+    before any plant is loaded), `rate` [Hz]."""
+    t = np.arange(n) / rate
     return _table({"time": t, "y1": 0.01 * np.sin(2 * np.pi * 2.0 * t),
                    "u": 50.0 * np.sin(2 * np.pi * 2.0 * t + 0.2)})
 
@@ -108,18 +108,28 @@ def test_a_measured_record_case_refuses_in_one_line_and_touches_nothing(tmp_path
     assert [p.name for p in tmp_path.iterdir()] == ["user"]
 
 
-@pytest.mark.parametrize("cutoff", ["1e9", "1e-3"])
-def test_a_closed_loop_cutoff_is_refused_before_the_plant_loads(tmp_path, cutoff):
-    """The cut-off is judged from the record alone, before the scenario's plant loads
-    python-control and scipy.signal (seconds on a busy machine: the refusal came 4 s after
-    the start)."""
-    populate(tmp_path, BASE)
+@pytest.mark.parametrize(("argv", "words"), [
+    ([*CLOSED_LOOP, "--cutoff", "1e9"], "cl.csv: cutoff_hz must be in (0, 5000) Hz"),
+    ([*CLOSED_LOOP, "--cutoff", "1e-3"], "cl.csv: too short: the prefilter settles"),
+    (["identify", "cl_1k.csv", "--scenario", "sampled.toml"],
+     "cl_1k.csv: the record's sampling interval 0.001 s is not the controller's period "
+     "0.0001 s"),
+], ids=["cutoff-above-nyquist", "cutoff-too-low", "sampled-at-another-rate"])
+def test_a_closed_loop_record_is_judged_before_the_plant_loads(tmp_path, argv, words):
+    """The cut-off, and the rate of a sampled controller, are judged from the record (and
+    the scenario's [controller] section) alone, before the plant and its loop load
+    python-control and scipy.signal: seconds on a busy machine (the refusals came 3.9-4.1 s
+    after the start; a 1 kHz record for a 10 kHz sampled loop 9.0 s, 2.3 s of CPU)."""
+    sampled = PAPER.replace("beta = 0.6 ", "sample_rate_hz = 10000.0\nbeta = 0.6 ")
+    assert "sample_rate_hz" in sampled
+    populate(tmp_path, {**BASE, "sampled.toml": sampled, "cl_1k.csv": _closed_loop(rate=1e3)})
     code = ("import sys\nfrom motionhyst.cli import main\n"
-            f"code = main({[*CLOSED_LOOP, '--cutoff', cutoff]!r})\n"
+            f"code = main({argv!r})\n"
             "print(code, sorted({'control', 'scipy.signal'} & set(sys.modules)))\n")
     proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
                           text=True, timeout=120, env=limited_process.environment())
     assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr
+    assert words in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
 
 
 def test_a_closed_loop_record_through_another_plant_names_the_plant():

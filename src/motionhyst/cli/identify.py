@@ -237,6 +237,14 @@ def run(args: argparse.Namespace) -> int:
                              f"closed loop; {sc.source} is an open-loop system (no "
                              f"[controller]); give a scenario with a two-mass [stage] without "
                              f"output, or identify with --record input-output")
+        rate = getattr(sc.model.controller, "sample_rate_hz", None)
+        if rate is not None:  # before the sampled loop is built
+            from motionhyst.identify.records import check_controller_period
+
+            try:
+                check_controller_period(t, 1.0 / rate)
+            except ValueError as exc:
+                raise ValueError(f"{path}: {exc}") from None
         plant = sc.plant()
         if not plant.is_lti:
             raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "

@@ -21,7 +21,12 @@ from motionhyst.identify.fit import (
     fit_rows,
     identify_prepared,
 )
-from motionhyst.identify.records import check_signals, prefilter_cutoff
+from motionhyst.identify.records import (
+    UNIFORM_RTOL,
+    check_controller_period,
+    check_signals,
+    prefilter_cutoff,
+)
 from motionhyst.identify.result import Identification
 from motionhyst.plants.registry import Plant
 
@@ -29,10 +34,6 @@ __all__ = ["LinkForce", "identify_closed_loop", "infer_link_force"]
 
 DECIMATED_RATE = 40.0
 """Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""
-
-
-UNIFORM_RTOL = 0.01
-"""Allowed relative deviation of the closed-loop sampling interval from its median."""
 
 
 def _p1_poly(stage) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -174,9 +175,7 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     L_over_P1 = HoldFilter(np.concatenate([zb, np.roots(den)]), pb, kb * den[0] / n0, dt, wl)
     # y1 enters through s^k factors: removing its first value keeps the filter well scaled
     if controller is not None:
-        if abs(dt - controller.period) > UNIFORM_RTOL * controller.period:
-            raise ValueError(f"the record's sampling interval {dt:g} s is not the controller's "
-                             f"period {controller.period:g} s")
+        check_controller_period(ts, controller.period)
         held = HeldInputFilter(np.concatenate([zb, np.roots(num)]), pb, kb * num[0] / n0,
                                controller.period, controller.delay_samples, wl)
         Lu = held(us)

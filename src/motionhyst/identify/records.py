@@ -10,8 +10,8 @@ from motionhyst.core.compiled import njit
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
-__all__ = ["ELASTIC_CURVE_RATIO", "check_loops_open", "count_reversals", "load_closed_loop_csv",
-           "load_force_displacement_csv", "prefilter_cutoff"]
+__all__ = ["ELASTIC_CURVE_RATIO", "check_controller_period", "check_loops_open", "count_reversals",
+           "load_closed_loop_csv", "load_force_displacement_csv", "prefilter_cutoff"]
 
 MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
@@ -414,3 +414,44 @@ cut-off, --cutoff), got 1e+09
                          f"s, leaving {max(ts.size - settle, 0)} samples; record longer or "
                          "raise the prefilter's cut-off (cutoff_hz, --cutoff)")
     return cutoff_hz, settle
+
+
+UNIFORM_RTOL = 0.01
+"""Allowed relative deviation of a closed-loop record's sampling interval from its median,
+and from a sampled controller's period."""
+
+
+def check_controller_period(t: ArrayLike, period: float) -> None:
+    """Refuse a closed-loop record that is not at the samples of its sampled controller.
+
+    The force a sampled controller held is inferred at its samples (the record's rows);
+    a record at another rate is refused from its time column alone, before the loop is
+    built (:func:`~motionhyst.identify.closed_loop.infer_link_force` applies it too).
+
+    Parameters
+    ----------
+    t : array_like
+        The record's time stamps [s].
+    period : float
+        The controller's sampling period [s].
+
+    Raises
+    ------
+    ValueError
+        The record's median sampling interval differs from `period` by more than
+        :data:`UNIFORM_RTOL` of it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_controller_period(np.arange(100) / 1e4, 1e-4)        # a 10 kHz loop's record
+    >>> try:
+    ...     check_controller_period(np.arange(100) / 1e3, 1e-4)
+    ... except ValueError as exc:
+    ...     print(exc)
+    the record's sampling interval 0.001 s is not the controller's period 0.0001 s
+    """
+    dt = float(np.median(np.diff(np.asarray(t, dtype=float))))
+    if abs(dt - period) > UNIFORM_RTOL * period:
+        raise ValueError(f"the record's sampling interval {dt:g} s is not the controller's "
+                         f"period {period:g} s")
