@@ -251,3 +251,109 @@ def test_a_periodic_run_holds_its_sensitivities_once_a_period(tmp_path):
                           capture_output=True, text=True, env=environment(), timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.startswith("100000 "), proc.stdout
+
+
+
+def _axis_problem(n: int, r: int, drift: bool = False):
+    """The search problem of a positioning axis with a Jenkins link, its force offset (and a
+    drift) and initial velocity estimated, on one record of `n` samples, `r` substeps; and a
+    point of it."""
+    from motionhyst.identify.io_elements import _ElementProblem, _LinkLayout
+    from motionhyst.identify.io_offsets import Extras
+    from motionhyst.identify.io_records import IORecord
+
+    u = _force(n)
+    t = np.arange(n) / FS
+    y = SYSTEMS["axis-jenkins-offset"].simulate(t, u).displacement
+    layout = _LinkLayout.of(Jenkins, 1)
+    extras = Extras.choose("auto", floating=True, periodic=False, from_rest=False,
+                           n_records=1, drift=drift)
+    y_scale = float(np.sqrt(np.mean(y ** 2)))
+    scale = np.concatenate([[95.0, 200.0], layout.scales(1e6, 200.0, y_scale, 0.1),
+                            extras.scales(60.0, y_scale, 0.1, t[-1])])
+    prob = _ElementProblem([IORecord(t, u, y)], False, r, layout, y_scale, scale,
+                           plant=MassDamper(1.0, 1.0), extras=extras)
+    v = np.concatenate([[94.0, 210.0, 9e5, 21.0], 0.03 * scale[4:] + 2.9 * (
+        np.array(extras.names) == "input_offset")])
+    return prob, prob.variables(v)
+
+
+@pytest.mark.parametrize("drift", [False, True])
+def test_a_search_runs_the_fine_force_in_blocks_with_the_numbers_of_the_whole(monkeypatch,
+                                                                             drift):
+    """The residuals and the Jacobian of identify's search (a force offset and its drift
+    applied to each block as the run goes) are those of the whole record's fine force less
+    the offsets, bit for bit."""
+    monkeypatch.setattr(resample, "BLOCK_NODES", 1 << 40)  # the whole record as one block
+    prob, q = _axis_problem(1500, 10, drift)
+    r_whole, J_whole = prob.residuals(q), prob.jacobian(q)
+    monkeypatch.setattr(resample, "BLOCK_NODES", 1)  # blocks of 256 samples
+    prob, q = _axis_problem(1500, 10, drift)
+    r_blocks, J_blocks = prob.residuals(q), prob.jacobian(q)
+    assert J_whole.shape == (1500, 8 if drift else 7) and np.ptp(r_whole) > 0.1
+    np.testing.assert_array_equal(r_blocks, r_whole)
+    np.testing.assert_array_equal(J_blocks, J_whole)
+    # the run of the whole fine force less the offsets, as the search ran it before
+    u0 = prob.extras.split(prob.values(q)[4:])[0]
+    rate = prob.extras.drift(prob.values(q)[4:])
+    rec = prob.records[0]
+    fine = fine_input(rec.u, 10, False) - u0 * fine_input(np.ones(1500), 10, False)
+    if drift:
+        fine = fine - rate * fine_input(rec.t, 10, False)
+    force = prob.forces[0]
+    np.testing.assert_array_equal(force.whole(u0, rate), fine)
+    np.testing.assert_array_equal(_joined(list(force.blocks(u0, rate))), fine)
+
+
+@pytest.mark.parametrize(("n", "phases"), [(1499, True), (1500, True), (2800, False),
+                                          (3 * 2 ** 10, True)])
+def test_the_upsampled_constant_is_kept_as_its_phases(monkeypatch, n, phases):
+    """The force offset's fine force (the upsampled 1) repeats the fine step's phases: kept
+    as those (checked block by block), equal to the whole one bit for bit where the record
+    is interpolated by the windowed sinc (a prime length; 1500 = 2 x 750), to rounding where
+    by its spectrum (3072 samples in blocks of 256); a record of one block whose constant
+    does not repeat to the last bit (2800 samples, by its spectrum) keeps it whole."""
+    from motionhyst.identify.io_force import RecordForce
+    from motionhyst.identify.io_records import IORecord
+
+    if n > 3000:
+        monkeypatch.setattr(resample, "BLOCK_NODES", 1)  # blocks of 256 samples
+    rec = IORecord(np.arange(n) / FS, _force(n), np.zeros(n))
+    force = RecordForce(rec, 20, periodic=False, offset=True)
+    # the phases: 20 values, not 20 n
+    assert force.nbytes == (1 if phases else 2) * force.fine.nbytes
+    one = fine_input(np.ones(n), 20, periodic=False)
+    if n > 3000:
+        assert np.max(np.abs(force.whole(1.0) - (force.fine - one))) <= 2.5e-16 * 60.0
+    else:
+        np.testing.assert_array_equal(force.whole(1.0), force.fine - one)
+
+
+def test_a_search_holds_the_records_fine_force_once(tmp_path):
+    """An evaluation of identify's search (residuals and exact Jacobian, with the force
+    offset) on 20000 samples of 500 substeps (80 MB of fine force) runs within 150 MB of
+    address space above what the process held before it; the search held the fine force, the
+    upsampled constant of the force offset and their difference (240 MB)."""
+    script = tmp_path / "evaluate.py"
+    script.write_text(
+        "import resource, sys\n"
+        "sys.path.insert(0, sys.argv[1])\n"
+        "from test_long_records import _axis_problem\n"
+        "prob, q = _axis_problem(600, 20)\n"  # the kernels compiled, the modules loaded
+        "prob.residuals(q), prob.jacobian(q)\n"
+        "with open('/proc/self/status') as f:\n"
+        "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + (150 << 20),) * 2)\n"
+        "prob, q = _axis_problem(20000, 500)\n"
+        "r, J = prob.residuals(q), prob.jacobian(q)\n"
+        "print(J.shape, float(abs(r).max()))\n")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from limited_process import environment
+
+    proc = subprocess.run([sys.executable, str(script), str(Path(__file__).parent)],
+                          capture_output=True, text=True, env=environment(), timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.startswith("(20000, 7) "), proc.stdout

@@ -31,6 +31,7 @@ from motionhyst.identify.io_checks import (
     noise_cost,
     plausibility_warnings,
 )
+from motionhyst.identify.io_force import RecordForce
 from motionhyst.identify.io_layout import FORCE_UNIT, VELOCITY_UNIT
 from motionhyst.identify.io_layout import LinkLayout as _LinkLayout
 from motionhyst.identify.io_offsets import Extras, initial_state
@@ -52,6 +53,7 @@ from motionhyst.identify.io_uncertainty import (
     WindowNoise,
     covariance,
     covariance_table,
+    parallel_note,
     standard_errors,
     undetermined_notes,
     weak_notes,
@@ -66,7 +68,6 @@ from motionhyst.time.openloop import (
     MassSpringDamper,
     OpenLoop,
     TwoMass,
-    fine_input,
     simulate_elements,
 )
 
@@ -83,6 +84,9 @@ FD_STEP = 1e-6
 RIGID_FD_STEP = 1e-3
 #: Step of the offsets' and initial states' forward differences, in units of their scales
 EXTRA_FD_STEP = 1e-4
+#: Rows of the sensitivities scaled into the Jacobian at a time (bounds the temporary copy)
+_ROWS = 1 << 16
+_TAKEN = object()  # a Jacobian handed to the search: computed again if asked for again
 #: Periods a periodic record's run may take at a point of the search: a trial point that has
 #: not settled by then (a stage clamped by a stiff link, whose output is rounding noise) is
 #: refused as parameters the model cannot run, and the search steps back
@@ -133,13 +137,7 @@ class _ElementProblem:
         self.free = np.ones(self.log.size, bool) if free is None else free
         self.fixed = np.zeros(self.log.size) if fixed is None else fixed
         self.window = window  # each record's state set from its first samples (None: extras)
-        self.fine = [fine_input(rec.u, substeps, periodic) for rec in records]
-        # the upsampling is linear: a force offset shifts the fine input by itself times this
-        self.fine_one = ([fine_input(np.ones(rec.u.size), substeps, periodic)
-                          for rec in records] if self.extras.input_offset else None)
-        # and a drifting offset by its rate times the fine steps' times
-        self.fine_t = ([fine_input(rec.t, substeps, periodic) for rec in records]
-                       if self.extras.input_drift else None)
+        self._forces: list[RecordForce] | None = None  # upsampled at the first run
         self.n_eval = 0  # the evaluations, each charged to the search's budget first
         self.budget = budget if budget is not None else EvaluationBudget()
         self.exact: bool | None = None if exact else False  # sensitivities (None: untried)
@@ -149,6 +147,14 @@ class _ElementProblem:
             # the simulation's own derivative misses what they do together; secants see it
             self.exact, self.fd_step = False, RIGID_FD_STEP
         self._last: tuple | None = None
+
+    @property
+    def forces(self) -> list[RecordForce]:
+        """Each record's upsampled force, made at the first run (not held before it)."""
+        if self._forces is None:
+            self._forces = [RecordForce(rec, self.r, self.periodic, self.extras.input_offset,
+                                        self.extras.input_drift) for rec in self.records]
+        return self._forces
 
     def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """Parameters ``m, c, k, link...`` of the (whole) search vector `q`."""
@@ -201,7 +207,7 @@ class _ElementProblem:
             if self.window is not None:
                 return self._from_window(mech, stepping, k_link, rec, u, fine, dparams, skew)
             y, sy = simulate_elements(mech, stepping, u, rec.fs, self.r,
-                                      periodic=self.periodic, k_link=k_link, upsampled=fine,
+                                      periodic=self.periodic, k_link=k_link, upsampled=fine(),
                                       dparams=dparams, skew_column=skew,
                                       x0=initial_state(mech.n, self.extras.initial, init[i]),
                                       periods=SEARCH_PERIODS)
@@ -234,11 +240,12 @@ class _ElementProblem:
         """A record run from the state its first :attr:`window` samples set
         (:func:`~motionhyst.identify.io_predict.state_from_window`), as ``predict
         --init-from`` runs it; the sensitivities include the state's own dependence on
-        the parameters (its least squares over the window, to first order)."""
+        the parameters (its least squares over the window, to first order); `fine()` gives the
+        upsampled force (:meth:`_inputs`)."""
         p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
                                    self.window)
-        y, sy = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine, dparams,
-                               skew)
+        y, sy = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine(),
+                               dparams, skew)
         if dparams is None or sy.shape[1] == 0:
             return y, sy
         S = self._state_columns(mech, stepping, k_link, rec, u, fine, p, vel, y)
@@ -259,20 +266,21 @@ class _ElementProblem:
             step = EXTRA_FD_STEP * (dp * max(abs(p), self.y_scale)
                                     + dv * max(abs(vel), self.y_scale * rec.fs / self.window))
             y2, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p + dp * step,
-                                   vel + dv * step, fine)
+                                   vel + dv * step, fine())
             cols.append((y2 - y) / step)
         return np.column_stack(cols)
 
     def _inputs(self, i: int, u0: float, drift: float):
-        """Record `i`'s force and its upsampled run's, less the force offset `u0` and its
-        drift."""
-        rec = self.records[i]
-        fine = self.fine[i] if self.fine_one is None else self.fine[i] - u0 * self.fine_one[i]
+        """Record `i`'s force less the force offset `u0` and its drift, and a callable
+        giving its upsampled run's: a period's whole, a run from a start's blocks (a fresh
+        iterator at each call; :class:`~motionhyst.identify.io_force.RecordForce`)."""
+        rec, force = self.records[i], self.forces[i]
         u = rec.u - u0
-        if self.fine_t is not None:  # the offset drifting over the record's time
-            fine = fine - drift * self.fine_t[i]
+        if self.extras.input_drift:  # the offset drifting over the record's time
             u = u - drift * rec.t
-        return u, fine
+        if self.periodic:
+            return u, lambda: force.whole(u0, drift)
+        return u, lambda: force.blocks(u0, drift)
 
     def window_states(self, v: NDArray[np.float64]) -> list[tuple[float, float]]:
         """Each record's ``(position, velocity)`` set from its window at the parameters
@@ -303,7 +311,7 @@ class _ElementProblem:
             u, fine = self._inputs(i, u0, drift)
             p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
                                        self.window)
-            y, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine)
+            y, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine())
             self._count(3 - int(mech.floating))  # the run and its state's columns
             S = self._state_columns(mech, stepping, k_link, rec, u, fine, p, vel, y)
             parts.append((row, S, np.linalg.pinv(S[:self.window])))
@@ -375,14 +383,16 @@ class _ElementProblem:
             return J
         v = self.values(self.whole(q_free))
         k = self.n_plant + self.n_link
-        full = np.zeros((J.shape[0], self.log.size))
-        full[:, :k][:, self.free[:k]] = J
+        full = np.zeros((J.shape[0], int(self.free.sum())))
+        full[:, :J.shape[1]] = J
         try:
             Je = self._extra_columns(v, self._split_rows(r0 * self.y_scale, measured=True))
-            full[:, k:] = Je * self.derivative(v)[k:] / self.y_scale
+            Je *= self.derivative(v)[k:]
+            Je /= self.y_scale
+            full[:, J.shape[1]:] = Je[:, self.free[k:]]
         except (ValueError, ArithmeticError):  # parameters the model refuses
             pass  # a model the simulation refuses: the residuals are flat there
-        return full[:, self.free]
+        return full
 
     @np.errstate(all="ignore")  # as _run
     def _run_exact(self, q_free: NDArray[np.float64]
@@ -398,15 +408,27 @@ class _ElementProblem:
             outs = self.outputs(v, sens=True)
             r = np.concatenate([y - self._measured(rec)
                                 for (y, _), rec in zip(outs, self.records, strict=True)])
-            J = np.concatenate([sy for _, sy in outs]) * self.derivative(v)[:k]
         except LookupError:
             return None
         except (ValueError, ArithmeticError):  # parameters the model refuses
             return np.full(n_rows, 1e3), np.zeros((n_rows, n_sens))
         r = r / self.y_scale
-        if not np.all(np.isfinite(r)) or not np.all(np.isfinite(J)):
+        if not np.all(np.isfinite(r)):
             return np.full(n_rows, 1e3), np.zeros((n_rows, n_sens))
-        return r, J[:, self.free[:k]] / self.y_scale
+        # the free columns of (sensitivities x d value / d variable) / y_scale, checked finite,
+        # a block of rows at a time into one array (each record's released once copied)
+        d, free = self.derivative(v)[:k], self.free[:k]
+        J, at = np.empty((n_rows, n_sens)), 0
+        for i in range(len(outs)):
+            sy, outs[i] = outs[i][1], None
+            for a in range(0, sy.shape[0], _ROWS):
+                part = sy[a:a + _ROWS] * d
+                if not np.all(np.isfinite(part)):
+                    return np.full(n_rows, 1e3), np.zeros((n_rows, n_sens))
+                J[at + a:at + a + part.shape[0]] = part[:, free]
+            at += sy.shape[0]
+        J /= self.y_scale
+        return r, J
 
     def residuals(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Output errors in units of the output's RMS."""
@@ -425,24 +447,27 @@ class _ElementProblem:
     def jacobian(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Exact (forward sensitivities, computed with the residuals), else forward
         differences, one column per free variable, in parallel threads."""
-        if self._last is not None and self._last[0] == q_free.tobytes():
+        if (self._last is not None and self._last[0] == q_free.tobytes()
+                and self._last[2] is not _TAKEN):
             r0, J = self._last[1], self._last[2]
         else:
             r0 = self.residuals(q_free)
             J = self._last[2]
         if J is not None:
+            self._last = (self._last[0], r0, _TAKEN)  # not held beside the search's copy
             return self._with_extras(q_free, J, r0)
         steps = self.fd_step * np.maximum(1.0, np.abs(q_free))
+        out = np.empty((r0.size, q_free.size))
 
         def column(j):
             q = q_free.copy()
             q[j] += steps[j]
-            return (self._run(q) - r0) / steps[j]
+            out[:, j] = (self._run(q) - r0) / steps[j]
 
         self._count(q_free.size)
         with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-            cols = list(pool.map(column, range(q_free.size)))
-        return np.column_stack(cols)
+            list(pool.map(column, range(q_free.size)))
+        return out
 
     def _count(self, n: int) -> None:
         self.budget.charge(n)
@@ -688,7 +713,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     std: dict[str, float | None] = {}
     for nm, sd in zip(names, std_v, strict=True):
         std[nm] = float(sd) if math.isfinite(sd) else None
-    not_ident = {f"link.{name}": _parallel_note(layout, name, structure)
+    two_mass = isinstance(structure, TwoMass)
+    not_ident = {f"link.{name}": parallel_note(layout.cls, name, two_mass)
                  if faster is None else
                  (f"the viscous friction moving {'backward' if name == 'c_neg' else 'forward'} "
                   f"is the stage's c (the link's {faster} adds to it in the other "
@@ -811,13 +837,3 @@ RUNAWAY = 1e4
 #: inverse-dynamics Coulomb force, the displacement it slips after in units of the output's
 #: RMS)
 AXIS_STARTS = ((1.0, 1e-3), (0.5, 1e-2), (1.0, 1e-1))
-
-
-def _parallel_note(layout: _LinkLayout, name: str, plant=None) -> str:
-    par = next(p for p in layout.cls.parameters if p.name == name)
-    what, stage = ("a spring", "k") if par.parallel == "spring" else ("a damper", "c")
-    if isinstance(plant, TwoMass):
-        return (f"{what} to the ground in parallel with the link; not estimated with a "
-                f"two-mass stage (which has none to the ground): fixed at 0")
-    return (f"{what} in parallel with the stage's: only the sum {stage} + {name} enters the "
-            f"output; fixed at 0, the stage's {stage} holds the sum")

@@ -32,8 +32,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
-           "WINDOW_INFLATION", "WindowNoise", "judge_determined", "undetermined",
-           "white_noise_variance", "window_inflation", "zero_allowed"]
+           "WINDOW_INFLATION", "WindowNoise", "judge_determined", "parallel_note",
+           "undetermined", "white_noise_variance", "window_inflation", "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -589,3 +589,36 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
         "their standard errors are unknown or exceed their values"
     return [f"the records do not determine {', '.join(names)} ({its}): the model holds "
             f"{what}, which these records neither confirm nor contradict"]
+
+
+def parallel_note(cls: type, name: str, two_mass: bool = False) -> str:
+    """Why the link parameter `name` that only adds a spring or damper in parallel
+    (``Parameter.parallel``) is fixed at 0.
+
+    Parameters
+    ----------
+    cls : type
+        The link model's class.
+    name : str
+        The parameter.
+    two_mass : bool
+        The stage is the floating two-mass stage (no spring or damper to the ground).
+
+    Returns
+    -------
+    str
+        The note.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import LuGre
+    >>> parallel_note(LuGre, "sigma2")[:47]
+    "a damper in parallel with the stage's: only the"
+    """
+    par = next(p for p in cls.parameters if p.name == name)
+    what, stage = ("a spring", "k") if par.parallel == "spring" else ("a damper", "c")
+    if two_mass:
+        return (f"{what} to the ground in parallel with the link; not estimated with a "
+                f"two-mass stage (which has none to the ground): fixed at 0")
+    return (f"{what} in parallel with the stage's: only the sum {stage} + {name} enters the "
+            f"output; fixed at 0, the stage's {stage} holds the sum")

@@ -60,6 +60,7 @@ block's, whatever its length.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -341,7 +342,7 @@ def _check_converged(worst: int) -> None:
 
 def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64], fs: float,
                       r: int, *, periodic: bool, k_link: float = 0.0,
-                      upsampled: NDArray[np.float64] | None = None,
+                      upsampled: NDArray[np.float64] | Iterable[NDArray[np.float64]] | None = None,
                       dparams: NDArray[np.float64] | None = None,
                       x0: NDArray[np.float64] | None = None, periods: int | None = None,
                       shooting: bool = True, skew_column: int | None = None
@@ -381,8 +382,10 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         :meth:`OpenLoop.simulate`).
     k_link : float
         The link's initial stiffness [N/m] (bounds the periods a periodic run may take).
-    upsampled : ndarray, optional
-        ``fine_input(u, r, periodic)``, if already computed.
+    upsampled : ndarray or iterator of ndarray, optional
+        ``fine_input(u, r, periodic)``, if already computed; for a run that is not
+        periodic also its consecutive blocks, each sharing its last node with the next
+        block's first (as :func:`~motionhyst.time.resample.fine_blocks` yields them).
     dparams : ndarray, shape (elements, N_PARAMS, P_link), optional
         The derivatives of the rows' parameters in the link's `P_link`
         parameters (every element of a kind in
@@ -508,7 +511,8 @@ def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64
         if x.shape != (ns,):
             raise ValueError(f"the initial state has {x.size} values; the plant has {ns}")
     if not periodic:
-        blocks = [upsampled] if upsampled is not None else fine_blocks(u, r)
+        blocks = (fine_blocks(u, r) if upsampled is None else
+                  [upsampled] if isinstance(upsampled, np.ndarray) else upsampled)
         y, sy, *_ = run(x, s, sx, ss, blocks=(_with_offset(b, mech) for b in blocks),
                         n_out=u.size)
         return y, sy
