@@ -591,13 +591,13 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
             f"{what}, which these records neither confirm nor contradict"]
 
 
-def parallel_note(cls: type, name: str, two_mass: bool = False) -> str:
+def parallel_note(model: type, name: str, two_mass: bool = False) -> str:
     """Why the link parameter `name` that only adds a spring or damper in parallel
     (``Parameter.parallel``) is fixed at 0.
 
     Parameters
     ----------
-    cls : type
+    model : type
         The link model's class.
     name : str
         The parameter.
@@ -615,7 +615,7 @@ def parallel_note(cls: type, name: str, two_mass: bool = False) -> str:
     >>> parallel_note(LuGre, "sigma2")[:47]
     "a damper in parallel with the stage's: only the"
     """
-    par = next(p for p in cls.parameters if p.name == name)
+    par = next(p for p in model.parameters if p.name == name)
     what, stage = ("a spring", "k") if par.parallel == "spring" else ("a damper", "c")
     if two_mass:
         return (f"{what} to the ground in parallel with the link; not estimated with a "
