@@ -357,3 +357,87 @@ def test_a_search_holds_the_records_fine_force_once(tmp_path):
                           capture_output=True, text=True, env=environment(), timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.startswith("(20000, 7) "), proc.stdout
+
+
+def _axis_record(n: int, seed: int = 0):
+    """An input-output record of the positioning axis with a Jenkins link and a -3 N force
+    offset, `n` samples at 1 kHz, 1e-7 m of position noise."""
+    from motionhyst.identify.io_records import IORecord
+
+    t = np.arange(n) / FS
+    u = _force(n, seed)
+    y = SYSTEMS["axis-jenkins-offset"].simulate(t, u).displacement
+    return IORecord(t, u, y + 1e-7 * np.random.default_rng(seed + 1).standard_normal(n))
+
+
+def test_identify_refuses_a_search_above_the_budget_before_any_run(monkeypatch, tmp_path):
+    """identify's search of 20000 samples (20 integration steps each: a Jenkins axis, 7
+    parameters) is sized before the starts run (the records upsampled, the runs of two threads,
+    the Jacobian's copies: 58 MB): above --max-memory it is refused with one line naming what
+    takes the memory and the option, no model run first (the search ran before, and a long
+    record's was killed by the operating system)."""
+    import limited_process
+
+    from motionhyst.identify import io_elements
+    from motionhyst.identify.input_output import identify_io
+    from motionhyst.identify.io_start import search_memory
+
+    rec = _axis_record(20000)
+    need = search_memory([rec], 20, 7, 4)["total"]
+    assert 30e6 < need < 120e6
+    runs = []
+    monkeypatch.setattr(io_elements, "simulate_elements", lambda *a, **k: runs.append(1))
+    monkeypatch.setattr(io_elements, "run_from_state", lambda *a, **k: runs.append(1))
+    set_max_memory(int(need) - 1)
+    try:
+        with pytest.raises(BudgetError, match=r"^identify's search of 20000 samples \(20 "
+                                              r"integration steps each, 7 parameters\) needs"):
+            identify_io([rec], "jenkins", plant="mass-damper")
+    finally:
+        set_max_memory(None)
+    assert runs == []
+    np.savetxt(tmp_path / "axis.csv", np.column_stack([rec.t, rec.u, rec.y]), delimiter=",",
+               header="time,force,displacement", comments="")
+    line = limited_process.refusal(["identify", "axis.csv", "--record", "input-output",
+                                    "--plant", "mass-damper", "--model", "jenkins",
+                                    "--max-memory", "20M", "--save", "m.toml"], tmp_path)
+    assert line.startswith("motionhyst: error: identify's search of 20000 samples"), line
+    assert "above the memory budget of 21 MB (--max-memory)" in line, line
+    assert "a larger --max-memory if the machine has it" in line, line
+    assert not (tmp_path / "m.toml").exists()
+
+
+def test_identify_within_the_budget_stays_within_its_estimate(tmp_path):
+    """identify of a Jenkins axis from 20000 samples (its starts, the Coulomb fit it starts
+    from with two threads of forward differences, the refinement with exact sensitivities, the
+    standard errors) runs within its estimate of address space above what the process held
+    before it (kernels compiled, threads made), and finds the axis."""
+    script = tmp_path / "within.py"
+    script.write_text(
+        "import resource, sys, warnings\n"
+        "sys.path.insert(0, sys.argv[1])\n"
+        "from test_long_records import _axis_record\n"
+        "from motionhyst.core.budget import set_max_memory\n"
+        "from motionhyst.identify.input_output import identify_io\n"
+        "from motionhyst.identify.io_start import search_memory\n"
+        "set_max_memory(1 << 40)\n"  # the address-space limit alone decides
+        "warnings.simplefilter('ignore')\n"
+        "identify_io([_axis_record(3000, 1)], 'jenkins', plant='mass-damper')\n"
+        "rec = _axis_record(20000)\n"
+        "need = search_memory([rec], 20, 7, 4)['total']\n"
+        "with open('/proc/self/status') as f:\n"
+        "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + int(need),) * 2)\n"
+        "fit = identify_io([rec], 'jenkins', plant='mass-damper')\n"
+        "print(round(need / 1e6), fit.fit_rms, fit.estimates['m'])\n")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from limited_process import environment
+
+    proc = subprocess.run([sys.executable, str(script), str(Path(__file__).parent)],
+                          capture_output=True, text=True, env=environment(), timeout=900)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    need, rms, m = (float(x) for x in proc.stdout.split())
+    assert 30 < need < 120 and rms < 1.05e-7 and m == pytest.approx(95.0, rel=1e-4), proc.stdout

@@ -41,6 +41,7 @@ from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
     best_linear_approximation,
     best_linear_approximation_two_mass,
+    check_search_memory,
     check_substeps,
     extras_start,
     inverse_dynamics,
@@ -63,6 +64,7 @@ from motionhyst.identify.io_uncertainty import (
 from motionhyst.identify.rigid_limit import as_rigid_limit, rigid_seed
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import (
+    MAX_SHOOTING_STATES,
     MIN_SUBSTEPS,
     STEPS_PER_MODE_PERIOD,
     MassSpringDamper,
@@ -615,6 +617,12 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                            n_records=len(records), window=init_window is not None, drift=drift)
     t_span = max(float(rec.t[-1] - rec.t[0]) for rec in records)
     scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale, t_span)])
+    # the whole search's memory (its Coulomb fit's is no more), before anything is upsampled
+    states = (2 * structure.mechanics().n
+              + layout.build(starts[0][n_plant:]).time_stepping().codes.size) if periodic else 0
+    check_search_memory(records, r, scale.size, n_plant + len(layout.names),
+                        periodic=periodic, drift=extras.input_drift,
+                        states=states if states <= MAX_SHOOTING_STATES else 0)
     rate = np.concatenate([np.zeros(n_plant, bool),
                            [par.unit == _VELOCITY for par, _ in layout._values()],
                            np.zeros(extras.size, bool)]).astype(bool)

@@ -11,6 +11,7 @@ simulation-error fits, not results.
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 from numpy.typing import NDArray
@@ -457,6 +458,132 @@ def check_substeps(records: list[IORecord], substeps: int, f_n: float, factor: i
     if n > MAX_FINE_SAMPLES:
         raise ValueError(f"{what}: more than {MAX_FINE_SAMPLES:.0e}; {remedy}")
     check_memory(8.0 * factor * n * 4, what, remedy)
+
+
+JACOBIAN_COPIES = 6
+"""Arrays of samples x parameters a search holds at once at most: its Jacobian, the problem's
+assembly of it (the sensitivities, the offsets' and initial states' columns), the trust-region
+solver's scaled and augmented copy, the SVD's own copy and left singular vectors."""
+
+RESIDUAL_BYTES = 32
+"""Bytes per sample of a run's residuals besides the run (the records' outputs joined, scaled,
+cleaned of non-finite values, differenced): a Jacobian column by forward differences."""
+
+
+def search_memory(records: list[IORecord], substeps: int, parameters: int, sensitivities: int,
+                  *, periodic: bool = False, drift: bool = False, states: int = 0,
+                  threads: int | None = None) -> dict[str, float]:
+    """Bytes an input-output search of the records needs at once at most, by what holds them.
+
+    The search holds each record's upsampled force (and, for a drifting force offset, the
+    upsampled time stamps) once; a model evaluation runs the records in parallel threads,
+    each holding a block of its fine force (:func:`~motionhyst.time.resample.held_nodes`, at
+    :data:`~motionhyst.time.openloop.FINE_BYTES` a node) and, as
+    :meth:`~motionhyst.time.openloop.OpenLoop.simulate` estimates its runs,
+    :data:`~motionhyst.time.openloop.SAMPLE_BYTES` a sample, with its `sensitivities`
+    columns (a link without them: the Jacobian's columns by forward differences, one
+    evaluation per thread, with their residuals); the Jacobian of all samples x
+    `parameters` is held :data:`JACOBIAN_COPIES` times.
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records.
+    substeps : int
+        Integration steps per sample.
+    parameters : int
+        The search's variables (the Jacobian's columns).
+    sensitivities : int
+        Columns of the runs' sensitivities (the plant's and the link's parameters).
+    periodic : bool
+        Records of whole periods (a run holds its period's fine force whole, and the
+        sensitivities to its `states` start states).
+    drift : bool
+        A drifting force offset is estimated.
+    states : int
+        A periodic run's start states (Newton's steps on the period map; 0: none).
+    threads : int, optional
+        Threads of the evaluations (default: the machine's cores).
+
+    Returns
+    -------
+    dict
+        ``force``, ``runs``, ``jacobian`` and their ``total`` [bytes].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> n = 1_000_000
+    >>> rec = IORecord(np.arange(n) / 1e3, np.zeros(n), np.zeros(n))
+    >>> need = search_memory([rec], 20, 7, 4, threads=2)
+    >>> {k: round(v / 1e6) for k, v in need.items()}
+    {'force': 160, 'runs': 393, 'jacobian': 336, 'total': 889}
+    """
+    from motionhyst.time.openloop import FINE_BYTES, SAMPLE_BYTES
+    from motionhyst.time.resample import held_nodes
+
+    r = int(substeps)
+    n_all = sum(rec.u.size for rec in records)
+    threads = max(int(threads or os.cpu_count() or 1), 1)
+    parallel = min(len(records), threads)  # the records of one evaluation in parallel
+    force = 8.0 * (2 if drift else 1) * sum(r * (rec.u.size - 1) + 1 for rec in records)
+    block = max(FINE_BYTES * (r * rec.u.size if periodic else held_nodes(rec.u, r))
+                for rec in records)
+    per_sample = SAMPLE_BYTES + 16 * states
+    # with the sensitivities: one evaluation; without: one for each column in parallel
+    exact = parallel * block + (per_sample + 8.0 * sensitivities) * n_all
+    differences = threads * (parallel * block + (per_sample + RESIDUAL_BYTES) * n_all)
+    runs = float(max(exact, differences))
+    jacobian = JACOBIAN_COPIES * 8.0 * n_all * parameters
+    return {"force": force, "runs": runs, "jacobian": jacobian,
+            "total": force + runs + jacobian}
+
+
+def check_search_memory(records: list[IORecord], substeps: int, parameters: int,
+                        sensitivities: int, **kwargs) -> None:
+    """Refuse an input-output search above the memory budget before it starts
+    (:func:`search_memory`; :func:`motionhyst.core.budget.check_memory`).
+
+    Parameters
+    ----------
+    records, substeps, parameters, sensitivities
+        As for :func:`search_memory`.
+    **kwargs
+        Its keywords.
+
+    Raises
+    ------
+    BudgetError
+        One line: the search, what it needs and what takes it, the remedy.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.core.budget import BudgetError, set_max_memory
+    >>> rec = IORecord(np.arange(1000) / 1e3, np.zeros(1000), np.zeros(1000))
+    >>> set_max_memory(1 << 20)
+    >>> try:
+    ...     check_search_memory([rec] * 3, 20, 7, 4, threads=2)
+    ... except BudgetError as exc:
+    ...     print(exc)
+    identify's search of 3000 samples (20 integration steps each, 7 parameters) needs \
+5.9 MB, above the memory budget of 1.05 MB (--max-memory); its runs take 4.41 MB, its \
+Jacobian's copies 1.01 MB, the upsampled force 480 kB: a larger --max-memory if the machine \
+has it, or shorter records
+    >>> set_max_memory(None)
+    """
+    from motionhyst.core.budget import check_memory, format_size
+
+    need = search_memory(records, substeps, parameters, sensitivities, **kwargs)
+    n_all = sum(rec.u.size for rec in records)
+    parts = sorted(((need["runs"], "its runs"), (need["jacobian"], "its Jacobian's copies"),
+                    (need["force"], "the upsampled force")), reverse=True)
+    takes = ", ".join(f"{name} {format_size(size) if i else 'take ' + format_size(size)}"
+                      for i, (size, name) in enumerate(parts))
+    check_memory(need["total"],
+                 f"identify's search of {n_all} samples ({int(substeps)} integration steps "
+                 f"each, {parameters} parameters)",
+                 f"{takes}: a larger --max-memory if the machine has it, or shorter records")
 
 
 def extras_start(extras: Extras, records, floating: bool, u0: float) -> NDArray[np.float64]:
