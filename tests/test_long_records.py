@@ -373,7 +373,7 @@ def _axis_record(n: int, seed: int = 0):
 def test_identify_refuses_a_search_above_the_budget_before_any_run(monkeypatch, tmp_path):
     """identify's search of 20000 samples (20 integration steps each: a Jenkins axis, 7
     parameters) is sized before the starts run (the records upsampled, the runs of two threads,
-    the Jacobian's copies: 58 MB): above --max-memory it is refused with one line naming what
+    the Jacobian's copies: 52 MB): above --max-memory it is refused with one line naming what
     takes the memory and the option, no model run first (the search ran before, and a long
     record's was killed by the operating system)."""
     import limited_process
@@ -383,8 +383,8 @@ def test_identify_refuses_a_search_above_the_budget_before_any_run(monkeypatch, 
     from motionhyst.identify.io_start import search_memory
 
     rec = _axis_record(20000)
-    need = search_memory([rec], 20, 7, 4)["total"]
-    assert 30e6 < need < 120e6
+    assert 30e6 < search_memory([rec], 20, 7, 4, threads=2)["total"] < 120e6
+    need = search_memory([rec], 20, 7, 4)["total"]  # this machine's threads
     runs = []
     monkeypatch.setattr(io_elements, "simulate_elements", lambda *a, **k: runs.append(1))
     monkeypatch.setattr(io_elements, "run_from_state", lambda *a, **k: runs.append(1))
@@ -409,9 +409,9 @@ def test_identify_refuses_a_search_above_the_budget_before_any_run(monkeypatch, 
 
 def test_identify_within_the_budget_stays_within_its_estimate(tmp_path):
     """identify of a Jenkins axis from 20000 samples (its starts, the Coulomb fit it starts
-    from with two threads of forward differences, the refinement with exact sensitivities, the
-    standard errors) runs within its estimate of address space above what the process held
-    before it (kernels compiled, threads made), and finds the axis."""
+    from with a thread of forward differences a core, the refinement with exact
+    sensitivities, the standard errors) runs within its estimate of address space above what
+    the process held before it (kernels compiled, threads made), and finds the axis."""
     script = tmp_path / "within.py"
     script.write_text(
         "import resource, sys, warnings\n"
@@ -440,4 +440,4 @@ def test_identify_within_the_budget_stays_within_its_estimate(tmp_path):
                           capture_output=True, text=True, env=environment(), timeout=900)
     assert proc.returncode == 0, proc.stderr[-2000:]
     need, rms, m = (float(x) for x in proc.stdout.split())
-    assert 30 < need < 120 and rms < 1.05e-7 and m == pytest.approx(95.0, rel=1e-4), proc.stdout
+    assert need > 30 and rms < 1.05e-7 and m == pytest.approx(95.0, rel=1e-4), proc.stdout
