@@ -384,6 +384,9 @@ def test_identify_refuses_a_search_above_the_budget_before_any_run(monkeypatch, 
 
     rec = _axis_record(20000)
     assert 30e6 < search_memory([rec], 20, 7, 4, threads=2)["total"] < 120e6
+    # the forward differences run a column a thread: 64 cores run the 7 columns 7 at a time
+    assert (search_memory([rec], 20, 7, 4, threads=64)
+            == search_memory([rec], 20, 7, 4, threads=7))
     need = search_memory([rec], 20, 7, 4)["total"]  # this machine's threads
     runs = []
     monkeypatch.setattr(io_elements, "simulate_elements", lambda *a, **k: runs.append(1))

@@ -482,7 +482,8 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     :meth:`~motionhyst.time.openloop.OpenLoop.simulate` estimates its runs,
     :data:`~motionhyst.time.openloop.SAMPLE_BYTES` a sample, with its `sensitivities`
     columns (a link without them: the Jacobian's columns by forward differences, one
-    evaluation per thread, with their residuals); the Jacobian of all samples x
+    evaluation per thread, as many at once as there are threads and columns, with their
+    residuals); the Jacobian of all samples x
     `parameters` is held :data:`JACOBIAN_COPIES` times.
 
     Parameters
@@ -518,6 +519,8 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     >>> need = search_memory([rec], 20, 7, 4, threads=2)
     >>> {k: round(v / 1e6) for k, v in need.items()}
     {'force': 160, 'runs': 393, 'jacobian': 336, 'total': 889}
+    >>> round(search_memory([rec], 20, 7, 4, threads=64)["total"] / 1e6)   # 7 columns at once
+    1873
     """
     from motionhyst.time.openloop import FINE_BYTES, SAMPLE_BYTES
     from motionhyst.time.resample import held_nodes
@@ -532,7 +535,8 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     per_sample = SAMPLE_BYTES + 16 * states
     # with the sensitivities: one evaluation; without: one for each column in parallel
     exact = parallel * block + (per_sample + 8.0 * sensitivities) * n_all
-    differences = threads * (parallel * block + (per_sample + RESIDUAL_BYTES) * n_all)
+    columns = min(threads, int(parameters))  # the differences' pool: a column a thread
+    differences = columns * (parallel * block + (per_sample + RESIDUAL_BYTES) * n_all)
     runs = float(max(exact, differences))
     jacobian = JACOBIAN_COPIES * 8.0 * n_all * parameters
     return {"force": force, "runs": runs, "jacobian": jacobian,
