@@ -13,8 +13,8 @@ only (reading, output and writing: tens of bytes a sample), not with samples x s
 (which made 3e6 samples need 2.9 GB before).  With ``--identify N ...`` also ``motionhyst
 identify --record input-output --plant mass-damper --model jenkins`` on input-output records
 of that axis (its force offset -3 N, 1e-7 m of position noise) of N samples: its search holds
-the record's upsampled force once (3e5 samples: 874 MB before, 644 MB), CPU about 50 s per
-3e5 samples.  Run with ``make bench`` or
+the record's upsampled force once (3e5 samples: peak RSS 793 MB before, 571 MB), CPU about
+55 s per 3e5 samples.  Run with ``make bench`` or
 ``python benchmarks/predict_memory.py [--samples N ...] [--identify N ...] [--json]``.
 """
 
