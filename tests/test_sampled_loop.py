@@ -17,15 +17,11 @@ C = LeadLagLowpass(K=6.2e6, f1=60.0, f2=240.0, flp=700.0, beta=0.6)
 LINK = Jenkins(k=20.0, fc=0.05)
 
 
-def _pc_loop(cd: SampledController, d: int, form: str = "ss"):
-    """python-control's sampled loop ``c2d(P2, T, "zoh") C_d(z) z^-d``.
-
-    In state space throughout (``"ss"``) or as transfer functions (``"tf"``, as the issue's
-    numbers were measured; its coefficients lose about 1e-5 of the loop near 120 Hz).
-    """
+def _pc_loop(cd: SampledController, d: int):
+    """python-control's sampled loop ``c2d(P2, T, "zoh") C_d(z) z^-d``, in state space
+    throughout (as transfer functions its coefficients lose about 1e-5 of the loop near
+    120 Hz, and its margins at 10 kHz with two samples of delay are not this loop's)."""
     T = cd.period
-    if form == "tf":
-        return cd.tf() * control.c2d(STAGE.P2, T, "zoh") * control.tf([1.0], [1.0, 0.0], T) ** d
     loop = control.c2d(control.ss(STAGE.P2), T, "zoh") * control.ss(cd.tf())
     for _ in range(d):
         loop = loop * control.ss(control.tf([1.0], [1.0, 0.0], T))
@@ -33,19 +29,19 @@ def _pc_loop(cd: SampledController, d: int, form: str = "ss"):
 
 
 # python-control's "frd" method (its default here) samples L on a grid and can miss or invent
-# a crossing at the stage's resonance (694 Hz, |L| up to 8.5); each case takes the form and the
-# method whose answers agree with python-control's other method at this loop (the transfer
-# functions at 10 kHz with two samples of delay do not: on one machine "best" and "frd" found a
-# phase margin of -4.49 deg at 719 Hz, "poly" 13.976 deg at 120.67 Hz; state space: 13.9693)
-@pytest.mark.parametrize(("rate", "d", "form", "method", "rtol"),
-                         [(10e3, 0, "ss", "best", 1e-6), (10e3, 1, "ss", "best", 1e-6),
-                          (10e3, 2, "ss", "best", 1e-6), (4e3, 1, "ss", "poly", 1e-6)])
-def test_margins_are_python_controls_stability_margins(rate, d, form, method, rtol):
+# a crossing at the stage's resonance (694 Hz, |L| up to 8.5); each case takes the method whose
+# answers agree with python-control's other method at this loop (the transfer functions at
+# 10 kHz with two samples of delay do not: on one machine "best" and "frd" found a phase
+# margin of -4.49 deg at 719 Hz, "poly" 13.976 deg at 120.67 Hz; state space: 13.9693)
+@pytest.mark.parametrize(("rate", "d", "method", "rtol"),
+                         [(10e3, 0, "best", 1e-6), (10e3, 1, "best", 1e-6),
+                          (10e3, 2, "best", 1e-6), (4e3, 1, "poly", 1e-6)])
+def test_margins_are_python_controls_stability_margins(rate, d, method, rtol):
     cd = SampledController.discretize(C, rate, delay_samples=d)
     m = loop_margins(cd, STAGE.P2)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")    # python-control's notes on its own conditioning
-        gm, pm, sm, wg, wp, ws = control.stability_margins(_pc_loop(cd, d, form), method=method)
+        gm, pm, sm, wg, wp, ws = control.stability_margins(_pc_loop(cd, d), method=method)
     assert m.gain_margin == pytest.approx(gm, rel=rtol)
     assert m.gain_margin_hz == pytest.approx(wg / (2 * np.pi), rel=rtol)
     assert m.phase_margin_deg == pytest.approx(pm, rel=rtol)
