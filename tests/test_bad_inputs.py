@@ -156,7 +156,8 @@ CASES = [
                                                         *REF_ROWS[3:]])),
      ["simulate", "--time-series", "o.csv", "--reference-csv", "r.csv"], ["increasing"]),
     ("reference-inf", _csv("r.csv", "\n".join([*REF_ROWS[:3], "0.002,inf", *REF_ROWS[4:]])),
-     ["simulate", "--time-series", "o.csv", "--reference-csv", "r.csv"], ["non-finite"]),
+     ["simulate", "--time-series", "o.csv", "--reference-csv", "r.csv"],
+     ["r.csv: the reference's position must be finite: sample 3 is inf"]),
     # ---------------------------------------------------------------- arguments
     ("unknown-command", {}, ["fly"], ["invalid choice"]),
     ("unknown-option", {}, ["analyze", "--colour"], ["--colour"]),

@@ -179,7 +179,7 @@ CASES = [
      ["d/DATA_EMPS.mat: not a regular file"]),
     # values that no fit can use, refused as the record is read (was: in the first fit)
     ("emps-record-with-a-nan", {"d/DATA_EMPS.mat": _mat(_emps(nan_at=100))}, EMPS,
-     ["d/DATA_EMPS.mat: displacement is not finite everywhere"]),
+     ["d/DATA_EMPS.mat: displacement must be finite: sample 101 (t = 0.1 s) is nan"]),
     ("emps-test-record-of-10-samples", {"d/DATA_EMPS.mat": _mat(_emps()),
                                         "d/DATA_EMPS_PULSES.mat": _mat(_emps(n=10))}, EMPS,
      ["d/DATA_EMPS_PULSES.mat: too short (10 samples"]),

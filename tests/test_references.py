@@ -160,7 +160,7 @@ def test_sampled_sine_reproduces_acceleration():
     (np.arange(8.0), np.zeros(7), "equal length"),
     (np.array([0, 1, 2, 2, 3, 4.0]), np.zeros(6), "increasing"),
     (np.array([0, 1, 3, 2, 4, 5.0]), np.zeros(6), "increasing"),
-    (np.arange(6.0), np.array([0, 1, np.nan, 0, 0, 0]), "non-finite"),
+    (np.arange(6.0), np.array([0, 1, np.nan, 0, 0, 0]), "position must be finite: sample 3 is nan"),
 ])
 def test_sampled_reference_invalid(t, r, match):
     with pytest.raises(ValueError, match=match):

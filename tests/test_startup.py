@@ -130,7 +130,8 @@ def _assert_refused_without_fit_libraries(argv: list[str], error: str, cwd: Path
 
 @pytest.mark.parametrize("argv, error", [
     (["identify", "io-missing.csv", "--record", "input-output"], "missing column(s) displacement"),
-    (["identify", "io-nan.csv", "--record", "input-output"], "not finite"),
+    (["identify", "io-nan.csv", "--record", "input-output"],
+     "io-nan.csv: displacement must be finite: sample 8"),
     (["identify", "io-back.csv", "--record", "input-output"], "time must increase"),
     (["identify", "io-spring.csv", "--record", "input-output"], "no inertia in the force"),
     (["identify", "fd-zero.csv"], "no hysteresis found: the force is constant"),
@@ -140,7 +141,8 @@ def _assert_refused_without_fit_libraries(argv: list[str], error: str, cwd: Path
     (["identify", "fd-back.csv"], "strictly increasing"),
     (["identify", "cl-nan.csv", "--scenario", "stage.toml"], "non-finite value in y1"),
     (["predict", "stage.toml", "f-missing.csv", "--out", "p.csv"], "missing column(s) force"),
-    (["predict", "stage.toml", "f-nan.csv", "--out", "p.csv"], "must be finite"),
+    (["predict", "stage.toml", "f-nan.csv", "--out", "p.csv"],
+     "f-nan.csv: force must be finite: sample 8"),
     (["predict", "stage.toml", "f-back.csv", "--out", "p.csv"], "f-back.csv: time must increase"),
 ])
 def test_a_bad_record_is_refused_before_the_fit_libraries_are_imported(tmp_path, argv, error):

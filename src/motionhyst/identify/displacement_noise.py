@@ -224,7 +224,7 @@ def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False
     >>> print(est)
     no white noise: used as measured
     """
-    tt, xs = check_record(t, x)
+    tt, xs = check_record(t, x, what="displacement")
     if not (isinstance(x, np.ndarray) and x.dtype == np.float64):
         x = xs
     none = DisplacementEstimate(0.0, False, None, "no white noise: used as measured")

@@ -120,7 +120,8 @@ def check_signals(x: NDArray, named: dict[str, NDArray], t: NDArray | None,
         raise ValueError(f"too short: {x.size} samples, need at least {MIN_SAMPLES}")
     for k, v in arrays.items():
         if not np.all(np.isfinite(v)):
-            raise ValueError(f"non-finite value in {k} (sample {int(np.argmin(np.isfinite(v)))})")
+            raise ValueError(f"non-finite value in {k} (sample "
+                             f"{int(np.argmin(np.isfinite(v))) + 1})")
     if t is not None and np.any(np.diff(t) <= 0):
         i = int(np.argmax(np.diff(t) <= 0))
         raise ValueError(f"time must be strictly increasing (sample {i + 1})")

@@ -378,7 +378,7 @@ def force_from_displacement(plant, link: Hysteresis | None, t: ArrayLike,
     >>> [round(float(v), 9) for v in u]                 # k x + the link (slips at 10 N)
     [0.0, 5.5, 12.0, 1.0]
     """
-    tt, x = check_record(t, displacement)
+    tt, x = check_record(t, displacement, what="displacement")
     h = 1.0 / sampling_rate(tt)
     st, k, c, f0 = _parts(plant, link)
     xs = np.ascontiguousarray(x, dtype=float)

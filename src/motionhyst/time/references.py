@@ -207,8 +207,12 @@ class SampledReference:
             raise ValueError("time and position must be one-dimensional and of equal length")
         if t.size < 6:
             raise ValueError("a sampled reference needs at least 6 samples")
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(r))):
-            raise ValueError("the reference has non-finite values")
+        for name, v in (("time", t), ("position", r)):
+            bad = np.flatnonzero(~np.isfinite(v))
+            if bad.size:  # the column and the first sample named
+                more = f", and {bad.size - 1} more" if bad.size > 1 else ""
+                raise ValueError(f"the reference's {name} must be finite: sample "
+                                 f"{int(bad[0]) + 1} is {v[bad[0]]}{more}")
         if np.any(np.diff(t) <= 0):
             raise ValueError("reference time must be strictly increasing")
         from scipy.interpolate import make_interp_spline  # a file's reference only

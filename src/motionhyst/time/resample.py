@@ -38,7 +38,8 @@ BLOCK_NODES = 1 << 21
 STAMP_TOLERANCE = 0.05
 
 
-def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def check_record(t: ArrayLike, force: ArrayLike, what: str = "force"
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A uniform time grid and a finite force of the same length, as float arrays.
 
     The grid is the uniform one nearest to `t` (:func:`sampling_rate`);
@@ -50,7 +51,9 @@ def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], N
     t : array_like
         Time stamps [s].
     force : array_like
-        Force at the stamps [N].
+        Force at the stamps [N] (or the record's other quantity).
+    what : str
+        The quantity `force` is, as messages name it (``"displacement"``).
 
     Examples
     --------
@@ -64,15 +67,25 @@ def check_record(t: ArrayLike, force: ArrayLike) -> tuple[NDArray[np.float64], N
     ...     print(exc)
     time must increase in uniform steps (the stamp 0.1 s is 0.22 sampling intervals off the
     uniform grid)
+    >>> try:
+    ...     check_record([0.0, 0.1, 0.2], [1.0, np.nan, 3.0], what="displacement")
+    ... except ValueError as exc:
+    ...     print(exc)
+    displacement must be finite: sample 2 (t = 0.1 s) is nan
     """
     tt = np.asarray(t, dtype=float)
     u = np.asarray(force, dtype=float)
     if tt.ndim != 1 or u.ndim != 1 or tt.size != u.size:
-        raise ValueError("time and force must be 1-D and of equal length")
+        raise ValueError(f"time and {what} must be 1-D and of equal length")
     if tt.size < 2:
         raise ValueError("a record needs at least 2 samples")
-    if not (np.all(np.isfinite(tt)) and np.all(np.isfinite(u))):
-        raise ValueError("time and force must be finite")
+    for name, v in (("time", tt), (what, u)):
+        bad = np.flatnonzero(~np.isfinite(v))
+        if bad.size:
+            i = int(bad[0])
+            at = f" (t = {tt[i]:.9g} s)" if name != "time" else ""
+            more = f", and {bad.size - 1} more" if bad.size > 1 else ""
+            raise ValueError(f"{name} must be finite: sample {i + 1}{at} is {v[i]}{more}")
     back = np.flatnonzero(np.diff(tt) <= 0)
     if back.size:
         i = int(back[0]) + 1
