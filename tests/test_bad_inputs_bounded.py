@@ -153,7 +153,7 @@ BASE = {"s.toml": PAPER, "notes.txt": "my notes", "old.csv": "time,error\n0,0\n"
 CASES = [
     # ------------------------------------------------------------------------ memory and work
     ("simulate-1MHz-sine", {}, ["simulate", "s.toml", "--time-series", "t.csv", "--frequency",
-                                "1e6"], 2, ["too many time steps", "lower the frequency"], []),
+                                "1e6"], 2, ["too many time steps", "lower --frequency"], []),
     ("scan-long-tail", {}, [*SCAN, "--tail", "1e5"], 2, ["too many", "tail"], []),
     ("scan-above-max-memory", {}, [*SCAN, "--tail", "10", "--max-memory", "50M"], 2,
      ["memory budget of 52.4 MB", "--max-memory"], []),

@@ -14,6 +14,8 @@ one line on stderr (no traceback), and every file is byte-identical afterwards.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import limited_process
 import numpy as np
 import pytest
@@ -22,8 +24,27 @@ from file_trees import populate, snapshot
 from motionhyst.scenario import default_scenario_path
 
 PAPER = default_scenario_path().read_text()
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+PAPER_10KHZ = EXAMPLES / "paper_10khz.toml"
+JENKINS = ('model = "jenkins"\nk = 20.0              # spring stiffness k_J [N/m]\n'
+           'fc = 0.05             # slip force f_c [N]')
+SCAN = ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max",
+        "1000", "--s-max", "1e6", "--compensation", "none"]
+SCAN_REMEDY = "shorten the setpoint (--length, --dwell) or --tail, or raise --speed"
 QUASI_STATIC = ('[stage]\ntype = "quasi-static"\nk = 10.0\n\n'
                 '[hysteresis]\nmodel = "jenkins"\nk = 20.0\nfc = 0.05\n')
+
+
+def _paper(old: str, new: str) -> str:
+    """The paper's scenario with one value changed."""
+    assert old in PAPER
+    return PAPER.replace(old, new)
+
+
+def _maxwell_slip(n: int) -> str:
+    """The Table I scenario with a Maxwell-slip link of `n` equal elements."""
+    return _paper(JENKINS, f'model = "maxwell-slip"\nk = [{", ".join(["20.0"] * n)}]\n'
+                           f'fc = [{", ".join(["0.05"] * n)}]')
 
 
 def _record(columns: dict[str, np.ndarray]) -> str:
@@ -39,6 +60,49 @@ WITH_NAN[50] = np.nan
 
 # (id, the user's files, argv, words of the one line on stderr, words it must not have)
 CASES = [
+    # ------------------- a run's size: the command's options, not the library's arguments
+    ("scan-link-of-3000-elements-over-the-work-budget", {"s.toml": _maxwell_slip(3000)},
+     [*SCAN, "--max-seconds", "1"],
+     ["a run of 5.59e+03 time steps of a link of 3000 elements would take about",
+      "(--max-seconds); " + SCAN_REMEDY + ", or give the link fewer elements ([hysteresis])"],
+     ["lower its frequencies", "duration"]),
+    ("simulate-link-of-100000-elements-over-the-work-budget",
+     {"s.toml": _maxwell_slip(100_000)},
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "20", "--duration", "20"],
+     ["a run of 6e+05 time steps of a link of 100000 elements would take about",
+      "(--max-seconds); shorten --duration, or give the link fewer elements ([hysteresis])"],
+     ["lower its frequencies"]),
+    ("simulate-sampled-loop-of-too-many-controller-samples", {"s.toml": PAPER_10KHZ.read_text()},
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5", "--duration",
+      "6000"],
+     ["60000001 controller samples at 10000 Hz: too many (at most 5e+07); shorten --duration"],
+     ["lower --frequency", "shorten the duration"]),
+    ("simulate-sine-of-1MHz", {"s.toml": PAPER},
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "1e6"],
+     ["too many time steps (a step of 2.5e-09 s: the reference's 1e+06 Hz, resolved in 400 "
+      "steps a period)", "; shorten --duration or lower --frequency"], ["output rate"]),
+    ("steady-floquet-of-100000-frequencies", {"s.toml": PAPER},
+     ["steady", "s.toml", "--frequency", *[f"{1 + i * 1e-3:.3f}" for i in range(100_000)]],
+     ["the Floquet multipliers at 100000 frequencies would take about",
+      "; give fewer frequencies (--frequency) or leave the multipliers out (--no-floquet)"],
+     ["floquet=False"]),
+    # ---------- an implausible [stage] value sets the step: named, not the reference's
+    ("simulate-actuated-mass-of-a-nanogram", {"s.toml": _paper("m1 = 5.0", "m1 = 1e-9")},
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5", "--duration",
+      "0.05"],
+     ["too many time steps (a step of 1.75e-12 s: the loop's fastest closed-loop pole, "
+      "1.432e+10 Hz, resolved in 40 steps, beyond a motion stage's 1e+05 Hz: s.toml: [stage] "
+      "m1 = 1e-09 kg, a factor 1e+06 below the 0.001-10000 kg of motion stages: is it in kg?)",
+      "; shorten --duration"], ["reference's frequency", "lower --frequency"]),
+    ("simulate-stage-damping-off-by-1e9", {"s.toml": _paper("b = 90.0", "b = 9e10")},
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5", "--duration",
+      "0.05"],
+     ["s.toml: [stage] b = 9e+10 N s/m gives the stage a pole at 3.7e+09 Hz, beyond the "
+      "1e+05 Hz of motion stages: is it in N s/m?"], ["reference's frequency"]),
+    ("scan-stage-stiffness-off-by-1e9", {"s.toml": _paper("k = 7.4e7", "k = 7.4e16")}, SCAN,
+     ["the step resolves the loop's fastest closed-loop pole, 2.195e+07 Hz (beyond a motion "
+      "stage's 1e+05 Hz: s.toml: [stage] k = 7.4e+16 N/m gives the stage a mode at 2.2e+07 "
+      "Hz, beyond the 1e+05 Hz of motion stages: is it in N/m?); " + SCAN_REMEDY], []),
     # ----------------------------- a value that is not finite: its column and sample named
     ("predict-force-of-a-displacement-with-a-nan", {"m.toml": QUASI_STATIC,
                                                     "d.csv": _record({"time": T,
@@ -66,3 +130,108 @@ def test_a_refusal_names_the_cause_and_a_remedy_the_command_has(tmp_path, files,
     for word in not_words:
         assert word not in line, (word, line)
     assert snapshot(root) == before
+
+
+def test_simulate_s_old_spelling_names_steady_s_option(tmp_path):
+    """``simulate`` without ``--time-series`` is the old spelling of ``steady``: a refusal of
+    its Floquet multipliers names ``steady --no-floquet`` (``simulate`` has no such option),
+    after the one line that says the spelling is old."""
+    populate(tmp_path, {"s.toml": _paper("frequencies = [5.0, 10.0, 15.0]", "frequencies = ["
+                                         + ", ".join(f"{1 + i * 1e-3:.3f}"
+                                                     for i in range(100_000)) + "]")})
+    before = snapshot(tmp_path)
+    code, out, err = limited_process.run(["simulate", "s.toml"], tmp_path)
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 2, err
+    assert lines[0].startswith("motionhyst simulate: without --time-series"), err
+    assert lines[1].endswith("give fewer frequencies (s.toml's [reference] frequencies) or "
+                             "leave the multipliers out (motionhyst steady --no-floquet)"), err
+    assert snapshot(tmp_path) == before
+
+
+# (id, scenario, argv, the warning's words)
+WARNED = [
+    ("analyze-stage-stiffness-off-by-1e9", _paper("k = 7.4e7", "k = 7.4e16"),
+     ["analyze", "s.toml", "--frequency", "5"],
+     "s.toml: [stage] k = 7.4e+16 N/m gives the stage a mode at 2.2e+07 Hz, beyond the "
+     "1e+05 Hz of motion stages: is it in N/m?"),
+    ("stability-stage-damping-off-by-1e9", _paper("b = 90.0", "b = 9e10"),
+     ["stability", "s.toml"],
+     "s.toml: [stage] b = 9e+10 N s/m gives the stage a pole at 3.7e+09 Hz, beyond the "
+     "1e+05 Hz of motion stages: is it in N s/m?"),
+]
+
+
+@pytest.mark.parametrize(("scenario", "argv", "words"), [c[1:] for c in WARNED],
+                         ids=[c[0] for c in WARNED])
+def test_a_stage_value_off_by_orders_of_magnitude_is_a_warning_naming_it(tmp_path, scenario,
+                                                                         argv, words):
+    populate(tmp_path, {"s.toml": scenario})
+    code, out, err = limited_process.run(list(argv), tmp_path)
+    assert code == 0 and out, err
+    lines = err.strip().splitlines()
+    assert all(line.startswith("motionhyst: warning: ") for line in lines), err
+    assert sum(words in line for line in lines) == 1, err
+
+
+def test_a_study_names_its_scenario_s_implausible_mass(tmp_path):
+    """``study`` built its points' loops with their warnings silenced: a microgram's stage
+    ran (73 s for two points, its pole at 1.4e10 Hz) without a word."""
+    populate(tmp_path, {"s.toml": _paper("m1 = 5.0", "m1 = 1e-9"),
+                        "st.toml": 'scenario = "s.toml"\noutputs = ["e1"]\n\n[axes]\n'
+                                   'frequency_hz = [5.0, 10.0]\n'})
+    code, out, err = limited_process.run(["study", "st.toml", "--estimate"], tmp_path)
+    assert code == 0 and out, err
+    assert ("motionhyst: warning: study: s.toml: [stage] m1 = 1e-09 kg, a factor 1e+06 below "
+            "the 0.001-10000 kg of motion stages: is it in kg?") in err.splitlines(), err
+
+
+def test_a_plausible_stage_of_every_example_says_nothing():
+    """The stages of the examples (Table I, the hunting loop, the EMPS axis's) are motion
+    stages: no warning."""
+    from motionhyst.scenario import load_scenario
+    from motionhyst.scenario.schema import implausible_stage
+
+    paths = sorted(EXAMPLES.glob("*.toml"))
+    for path in [None, *paths]:
+        try:
+            sc = load_scenario(path, check=False)
+        except Exception:  # a study file, not a scenario
+            continue
+        assert implausible_stage(sc) == [], path
+
+
+def test_predict_s_implicit_step_names_its_substeps_option(tmp_path, monkeypatch, capsys):
+    """The open-loop run's implicit step that does not converge says the library's remedy
+    ("use more substeps", an argument of ``OpenLoop.simulate``); ``predict`` names its
+    ``--substeps``.  The run is made to fail (no record of a real axis fails it at the
+    default substeps)."""
+    from motionhyst.cli import main
+    from motionhyst.time import openloop
+
+    def not_converged(*args, **kwargs):
+        openloop._check_converged(10**6)
+
+    monkeypatch.setattr(openloop, "simulate_elements", not_converged)
+    populate(tmp_path, {"m.toml": '[stage]\ntype = "mass-damper"\nm = 2.0\nc = 10.0\n\n'
+                                  '[hysteresis]\nmodel = "jenkins"\nk = 2e4\nfc = 4.0\n',
+                        "f.csv": _record({"time": T, "force": 50 * np.sin(2 * np.pi * T)})})
+    monkeypatch.chdir(tmp_path)
+    assert main(["predict", "m.toml", "f.csv", "--out", "p.csv"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip().endswith("the link is too stiff (or too strongly damped) for the "
+                                "integration step; give more --substeps"), err
+    assert "use more substeps" not in err and not (tmp_path / "p.csv").exists()
+
+
+def test_the_open_loop_step_refusal_is_a_value_error_a_search_leaves():
+    """A search takes a ``ValueError`` for parameters to leave: the refusal stays one, and
+    says its cause apart from the library's remedy."""
+    from motionhyst.time.kernel import StepNotConverged
+    from motionhyst.time.openloop import _check_converged
+
+    with pytest.raises(ValueError, match=r"use more substeps$") as caught:
+        _check_converged(10**6)
+    assert isinstance(caught.value, StepNotConverged)
+    assert "substeps" not in caught.value.what
+

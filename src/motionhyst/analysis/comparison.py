@@ -200,7 +200,7 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     check_frequency_range(loop, f)  # a frequency the loop's model cannot mean: before any work
     if floquet:  # the multipliers' memory and work, before any point is computed
         check_floquet_budget(loop, f, remedy="give fewer frequencies or leave the multipliers "
-                                             "out (--no-floquet)")
+                                             "out (floquet=False)")
     check_plausible(loop, amplitude, f)
     E_df = loop_mismatch(loop, f, amplitude)
     points = [ComparisonPoint(ss, complex(ed),

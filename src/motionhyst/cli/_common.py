@@ -391,25 +391,62 @@ def warn_plant_fit(sc) -> None:
 
 
 @contextlib.contextmanager
-def step_of_the_command(sc) -> Iterator[None]:
-    """A link's implicit step that did not converge
-    (:class:`~motionhyst.time.kernel.StepNotConverged`) inside, said in the terms of a
-    command whose step is its own (``scan``, ``simulate``: set from the loop's poles and
-    the reference, no option for it): the library's remedy (a smaller ``dt``, more
-    ``substeps``) names arguments the command does not have, so the message names the
-    scenario's ``[hysteresis]``, what its user can change.
+def in_the_commands_terms(sc, remedy: str) -> Iterator[None]:
+    """The library's refusals inside, said in the terms of a command whose options differ
+    from the library function's arguments.
+
+    A run too large (:class:`~motionhyst.time.steps.RunTooLarge`) is refused with the
+    command's `remedy` in place of the library's (``shorten the duration`` names an
+    argument ``scan`` does not have); other refusals keep theirs.  A link's implicit step
+    that did not converge
+    (:class:`~motionhyst.time.kernel.StepNotConverged`) in a command whose step is its own
+    (``scan``, ``simulate``: set from the loop's poles and the reference, no option for
+    it): the library's remedy (a smaller ``dt``, more ``substeps``) names arguments the
+    command does not have, so the message names the scenario's ``[hysteresis]``, what its
+    user can change.
 
     Parameters
     ----------
     sc : Scenario
         The command's scenario.
+    remedy : str
+        What the command's user can change to make a run smaller (its options).
     """
     from motionhyst.time.kernel import StepNotConverged
+    from motionhyst.time.steps import RunTooLarge
 
     try:
         yield
+    except RunTooLarge as exc:
+        elements = " elements" in exc.cause and "link" in exc.cause
+        raise exc.with_remedy(remedy + (", or give the link fewer elements ([hysteresis])"
+                                        if elements else "")) from None
     except StepNotConverged as exc:
         raise StepNotConverged(f"{sc.source}: [hysteresis]: {exc.what}, which the command "
                                f"sets from the loop's poles and the reference",
                                "is the link's stiffness or damping meant (in SI units)?"
                                ) from None
+
+
+def fast_pole(sc, pole: float) -> str:
+    """Why a loop's fastest closed-loop pole `pole` [rad/s] is beyond a motion stage's
+    (:data:`~motionhyst.plants.registry.PLAUSIBLE_POLE_HZ`), for a refusal of the many
+    steps it takes: the implausible ``[stage]`` value that likely sets it, else a question
+    about units; "" for a pole within a motion stage's.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The command's scenario.
+    pole : float
+        Its loop's fastest closed-loop pole [rad/s].
+    """
+    from motionhyst.plants.registry import PLAUSIBLE_POLE_HZ
+    from motionhyst.scenario.schema import implausible_stage
+
+    if pole / math.tau <= PLAUSIBLE_POLE_HZ:
+        return ""
+    named = implausible_stage(sc)
+    return (f"beyond a motion stage's {g(PLAUSIBLE_POLE_HZ)} Hz: "
+            + (named[0] if named else f"are {sc.source}'s [stage] and [controller] values in "
+               f"SI units?"))

@@ -59,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
     """Simulate the scenario's open-loop system for the force record and write the output."""
     from motionhyst.io.records import read_record
     from motionhyst.scenario import Scenario
+    from motionhyst.time.kernel import StepNotConverged
     from motionhyst.time.resample import check_whole_periods
 
     if args.substeps is not None and not 1 <= args.substeps <= 10000:
@@ -111,6 +112,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             out = system.simulate(t, u, periodic=args.periodic, substeps=args.substeps)
             out_t, out_y = out.t, out.displacement
+    except StepNotConverged as exc:  # the library's remedy names its argument
+        raise ValueError(f"{args.data}: {exc.what}; give more --substeps") from None
     except (ValueError, ArithmeticError) as exc:  # a model the simulation refuses
         raise ValueError(f"{args.data}: {exc or type(exc).__name__}") from None
     target.write_csv({"time": out_t, "displacement": out_y}, fmt="%.17g")

@@ -11,12 +11,13 @@ import math
 
 from motionhyst.cli._common import (
     UsageError,
+    fast_pole,
     g,
+    in_the_commands_terms,
     nonnegative,
     positive,
     print_json,
     refuse_unused,
-    step_of_the_command,
     warn_plant_fit,
     whole_number,
 )
@@ -26,10 +27,8 @@ __all__ = []
 
 PROG = "motionhyst scan"
 
-PLAUSIBLE_POLE_HZ = 1e5
-"""Fastest closed-loop pole of a motion stage's loop [Hz] (its bandwidth is some 100 Hz, its
-internal modes some kHz): beyond, a scan refused for its size asks whether the scenario's
-values are in SI units."""
+REMEDY = "shorten the setpoint (--length, --dwell) or --tail, or raise --speed"
+"""What the user of ``scan`` can change to make its runs shorter."""
 LEAD_IN = 0.01
 """Rest before the setpoint starts [s]: room for the learned force to act ahead of it."""
 
@@ -189,11 +188,16 @@ def _profiles(args: argparse.Namespace):
 
 
 def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
-    """Refuse a scan of far too many time steps before its loop is built: the step is the
-    loop's own where its coefficients give its poles (:func:`pole_step`; an unstable loop
-    is refused there), else at most the sampled controller's period or the setpoint's
-    (:func:`longest_step`)."""
-    from motionhyst.time.steps import SCAN_REMEDY, check_scan_steps, longest_step, pole_step
+    """Refuse a scan of far too many time steps, or of too much work (a link of many
+    elements), before its loop is built: the step is the loop's own where its coefficients
+    give its poles (:func:`pole_step`; an unstable loop is refused there), else at most the
+    sampled controller's period or the setpoint's (:func:`longest_step`)."""
+    from motionhyst.time.steps import (
+        check_scan_steps,
+        check_steps_work,
+        longest_step,
+        pole_step,
+    )
 
     controller = sc.model.controller
     if controller is None:  # no loop: the scenario's own refusal comes first
@@ -205,16 +209,17 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
         if p is not None:
             step = (longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
                     if pole is None else pole_step(pole, p.max_frequency_hz))
-            remedy = SCAN_REMEDY
+            remedy = REMEDY
             if pole is not None and step < 0.999 * longest_step(p.max_frequency_hz):
                 # the loop's own pole sets the step: said, and beyond a motion stage's poles
-                # a unit slip in the scenario is likelier than a setpoint too long
-                hz = pole / math.tau
-                remedy = (f"the step resolves the loop's fastest closed-loop pole, {g(hz)} Hz"
-                          + (f" (beyond a motion stage's {g(PLAUSIBLE_POLE_HZ)} Hz: are "
-                             f"{sc.source}'s [stage] and [controller] values in SI units?)"
-                             if hz > PLAUSIBLE_POLE_HZ else "") + f"; {SCAN_REMEDY}")
-            check_scan_steps(p.end + args.tail, step, runs, remedy, at_least=pole is None)
+                # the stage's value that makes it so (a unit slip) rather than the setpoint
+                cause = fast_pole(sc, pole)
+                remedy = (f"the step resolves the loop's fastest closed-loop pole, "
+                          f"{g(pole / math.tau)} Hz" + (f" ({cause})" if cause else "")
+                          + f"; {REMEDY}")
+            n = check_scan_steps(p.end + args.tail, step, runs, remedy, at_least=pole is None)
+            with in_the_commands_terms(sc, REMEDY):
+                check_steps_work(n, (sc.hysteresis(),), REMEDY)
 
 
 def _check_model_terms(args: argparse.Namespace, sc) -> None:
@@ -274,7 +279,7 @@ def run(args: argparse.Namespace) -> int:
                          f"model or feedforward terms (--feedforward), and {sc.source} has none")
     filters = ILCFilters(args.ilc_gain, args.ilc_cutoff, args.ilc_order)
     try:
-        with step_of_the_command(sc):
+        with in_the_commands_terms(sc, REMEDY):
             res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,
                            args.settle_tol, args.tail, feedforward=terms,
                            basis_trials=args.basis_trials or BASIS_TRIALS)

@@ -14,11 +14,12 @@ from motionhyst.cli._common import (
     add_force_option,
     add_record_options,
     distinct,
+    fast_pole,
+    in_the_commands_terms,
     output_file,
     positive,
     print_json,
     refuse_unused,
-    step_of_the_command,
     warn_plant_fit,
 )
 
@@ -88,31 +89,64 @@ def _reference(args: argparse.Namespace, sc):
             f"r = {amplitude:g} m sin(2 pi {freqs[0]:g} t)")
 
 
-def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> None:
-    """Refuse a run of far too many rows or steps before its loop is built: the step is the
+def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
+    """Refuse a run of far too many rows or steps, or of too much work (a link of many
+    elements), before its loop is built: the step is the
     loop's own where its coefficients give its poles (:func:`~motionhyst.time.steps.pole_step`;
     an unstable loop is refused there), else at most the sampled controller's period or the
     reference's (:func:`~motionhyst.time.steps.longest_step`; a file's samples do not set
-    it)."""
+    it).  The refusal names what sets the step (the reference's frequency, or the loop's
+    fastest pole and the ``[stage]`` value that likely makes it fast) and the options that
+    shorten the run.  Returns that remedy, for the run's own refusals."""
     from motionhyst.time.references import SampledReference
-    from motionhyst.time.steps import longest_step, pole_step, time_series_grid
+    from motionhyst.time.steps import (
+        MAX_ROWS,
+        check_steps_work,
+        longest_step,
+        pole_step,
+        step_set_by,
+        time_series_grid,
+    )
     from motionhyst.time.timeseries import DEFAULT_OUTPUT_RATE_HZ, reference_rate_hz
 
     controller = sc.model.controller
-    if controller is None:  # no loop: the scenario's own refusal comes first
-        return
-    rate = getattr(controller, "sample_rate_hz", None)
     sampled = isinstance(ref, SampledReference)
+    f = 0.0 if sampled else float(getattr(ref, "max_frequency_hz", 0.0) or 0.0)
+    pole = None if controller is None else sc.fastest_pole()  # None when sampled
+    rate = getattr(controller, "sample_rate_hz", None)
     output_rate = args.output_rate or rate or (reference_rate_hz(ref) if sampled
                                                else DEFAULT_OUTPUT_RATE_HZ)
-    f = 0.0 if sampled else float(getattr(ref, "max_frequency_hz", 0.0) or 0.0)
-    pole = sc.fastest_pole()  # None when sampled: its loop is checked all the same
+    by_pole = pole is not None and pole_step(pole, f) >= pole_step(pole)
+    # the loop's pole or the controller's period sets the step: a lower frequency helps not
+    remedy = _remedy(args, by_pole or rate is not None, duration * output_rate > MAX_ROWS)
+    if controller is None:  # no loop: the scenario's own refusal comes first
+        return remedy
+    why = ""
     if pole is not None:
         step = pole_step(pole, f)
+        why = step_set_by(pole, f)
+        cause = fast_pole(sc, pole) if by_pole else ""
+        why += f", {cause}" if cause else ""
     else:
         step = (math.inf if f <= 0 and rate is None
                 else longest_step(f, None if rate is None else 1.0 / rate))
-    time_series_grid(duration, output_rate, step, rate, at_least=rate is None and pole is None)
+    with in_the_commands_terms(sc, remedy):
+        rows, per_row, _ = time_series_grid(duration, output_rate, step, rate,
+                                            at_least=rate is None and pole is None,
+                                            step_set_by=why)
+        check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy)
+    return remedy
+
+
+def _remedy(args: argparse.Namespace, fixed_step: bool, rows: bool) -> str:
+    """What the user of ``simulate --time-series`` can change to make the run smaller: the
+    options of its reference (the frequency of a sine, unless the loop sets the step; a
+    move's length and speed), ``--duration``, and ``--output-rate`` where the rows are too
+    many."""
+    shorten = ("--duration (or the file)" if args.reference_csv
+               else "--duration or the move (--distance, --v-max)" if args.profile
+               else "--duration" if fixed_step else "--duration or lower --frequency")
+    return f"shorten {shorten}" + (", or lower --output-rate" if rows else "")
 
 
 def _time_series(args: argparse.Namespace, sc) -> int:
@@ -130,7 +164,7 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
-    _check_size(args, sc, ref, duration)
+    remedy = _check_size(args, sc, ref, duration)
     from motionhyst.analysis.plausibility import check_plausible
 
     if isinstance(ref, SineReference):
@@ -141,8 +175,9 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     options = {"output_rate_hz": args.output_rate}
     if args.settle_band is not None:
         options["settle_band"] = args.settle_band
-    with out.open(newline="") as fh, step_of_the_command(sc):
-        s = run_time_series(sc.loop(), ref, duration, fh, **options)
+    loop = sc.loop()
+    with out.open(newline="") as fh, in_the_commands_terms(sc, remedy):
+        s = run_time_series(loop, ref, duration, fh, **options)
     s = {"time_series": str(out.path), **s}
     if args.json:
         print_json(s)

@@ -29,9 +29,16 @@ def run(args: argparse.Namespace) -> int:
     amplitude = args.amplitude or sc.amplitude
     # imported once the input is read: a refusal does not wait for the analysis to load
     from motionhyst.analysis.comparison import compare_with_describing_function
+    from motionhyst.analysis.floquet import check_floquet_budget
 
+    floquet = not getattr(args, "no_floquet", False)  # simulate's old spelling has no option
+    if floquet:  # refused with what this command can change (the library says its argument)
+        given = "--frequency" if args.frequency else f"{sc.source}'s [reference] frequencies"
+        option = "--no-floquet" if args.command == "steady" else "motionhyst steady --no-floquet"
+        check_floquet_budget(loop, freqs, remedy=f"give fewer frequencies ({given}) or leave "
+                                                 f"the multipliers out ({option})")
     result = compare_with_describing_function(loop, amplitude, freqs,  # warns as it starts
-                                              floquet=not getattr(args, "no_floquet", False))
+                                              floquet=floquet)
     warn_plant_fit(sc)
     if args.json:
         print_json(result.to_dict())

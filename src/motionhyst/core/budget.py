@@ -86,12 +86,47 @@ _seconds: float | None = None
 class BudgetError(ValueError):
     """A computation above the memory or work budget: one line naming its size and the remedy.
 
+    The message is :attr:`cause` and :attr:`remedy`, the caller's own way to a smaller
+    computation (a library function's arguments); a command whose options differ says its
+    own remedy instead (:meth:`with_remedy`).
+
+    Parameters
+    ----------
+    cause : str
+        What is too large, and the budget.
+    remedy : str
+        What the caller can change ("" for none).
+
     Examples
     --------
     >>> from motionhyst.core.budget import BudgetError
     >>> issubclass(BudgetError, ValueError)              # exit code 2 on the command line
     True
+    >>> err = BudgetError("a run of 6e7 time steps: too many", "shorten the duration")
+    >>> print(err)
+    a run of 6e7 time steps: too many; shorten the duration
+    >>> print(err.with_remedy("shorten the setpoint (--length)"))
+    a run of 6e7 time steps: too many; shorten the setpoint (--length)
     """
+
+    def __init__(self, cause: str, remedy: str = ""):
+        super().__init__(f"{cause}; {remedy}" if remedy else cause)
+        self.cause = cause
+        self.remedy = remedy
+
+    def with_remedy(self, remedy: str) -> BudgetError:
+        """The same refusal with `remedy` in place of the caller's.
+
+        Parameters
+        ----------
+        remedy : str
+            What the user of a command can change.
+
+        Returns
+        -------
+        BudgetError
+        """
+        return type(self)(self.cause, remedy)
 
 
 def parse_size(text: str) -> int:
@@ -278,9 +313,8 @@ def check_memory(nbytes: float, what: str, remedy: str = "") -> None:
     """
     budget = max_memory()
     if nbytes > budget:
-        tail = f"; {remedy}" if remedy else ""
         raise BudgetError(f"{what} needs {format_size(nbytes)}, above the memory budget of "
-                          f"{format_size(budget)} (--max-memory){tail}")
+                          f"{format_size(budget)} (--max-memory)", remedy)
 
 
 def format_duration(seconds: float) -> str:
@@ -379,9 +413,8 @@ def check_work(seconds: float, what: str, remedy: str = "") -> None:
     """
     budget = max_seconds()
     if seconds > budget:
-        tail = f"; {remedy}" if remedy else ""
         raise BudgetError(f"{what} would take about {format_duration(seconds)}, above the work "
-                          f"budget of {format_duration(budget)} (--max-seconds){tail}")
+                          f"budget of {format_duration(budget)} (--max-seconds)", remedy)
 
 
 _LONGEST_TIMER = 1e9
@@ -451,10 +484,9 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
     except BaseException as exc:
         # a C extension may turn the alarm's exception into another (as it does a Ctrl-C)
         if fired and not isinstance(exc, KeyboardInterrupt):
-            tail = f"; {remedy}" if remedy else ""
             raise BudgetError(f"{what} did not finish within the work budget of "
-                              f"{format_duration(seconds)} of CPU time (--max-seconds)"
-                              f"{tail}") from None
+                              f"{format_duration(seconds)} of CPU time (--max-seconds)",
+                              remedy) from None
         raise
     finally:
         signal.setitimer(signal.ITIMER_PROF, 0)

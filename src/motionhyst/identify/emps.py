@@ -812,8 +812,8 @@ def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
         val_score["own_offset"] = own_offset_score(system, val)
     except FitFailed:
         raise
-    except (ValueError, RuntimeError) as exc:
-        raise ValueError(f"{name}: {exc}") from None
+    except (ValueError, RuntimeError) as exc:  # the cause, not a library's argument
+        raise ValueError(f"{name}: {getattr(exc, 'what', exc)}") from None
     own, own_std, covariance = fit_parameters(fit)
     parameters, std = reference_form(own, est, own_std, covariance)
     return EMPSModel(name, parameters, std, est_score, val_score, 0.0,

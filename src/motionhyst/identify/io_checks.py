@@ -133,9 +133,9 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
     rec = records[0]
     try:
         y = system.simulate(rec.t, rec.u, substeps=r).displacement
-    except (ValueError, ArithmeticError) as exc:
+    except (ValueError, ArithmeticError) as exc:  # the cause, not a library's argument
         raise FitFailed(f"the fit failed: the identified model cannot be simulated on "
-                        f"{rec.name} ({exc})") from None
+                        f"{rec.name} ({getattr(exc, 'what', exc)})") from None
     if not np.all(np.isfinite(y)):
         raise FitFailed(f"the fit failed: the identified model's simulation of {rec.name} "
                         f"from rest is not finite")

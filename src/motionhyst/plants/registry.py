@@ -32,8 +32,8 @@ if TYPE_CHECKING:
 
     from motionhyst.plants.mechanics import Mechanics
 
-__all__ = ["PLANTS", "PLAUSIBLE_MASS_KG", "Plant", "PlantParameter", "plant_class", "register",
-           "stage_types"]
+__all__ = ["PLANTS", "PLAUSIBLE_MASS_KG", "PLAUSIBLE_POLE_HZ", "Plant", "PlantParameter",
+           "plant_class", "register", "stage_types"]
 
 ParameterKind = Literal["positive", "nonnegative", "finite"]
 
@@ -114,6 +114,10 @@ class PlantParameter:
 
 PLAUSIBLE_MASS_KG = (1e-3, 1e4)
 """Masses of motion stages [kg]: one outside, given or fitted, is a warning (a unit slip)."""
+
+PLAUSIBLE_POLE_HZ = 1e5
+"""Fastest pole of a motion stage or its loop [Hz] (its bandwidth is some 100 Hz, its internal
+modes some kHz): a stiffness or damping that puts one beyond is a warning (a unit slip)."""
 
 #: The optional constant force on the plant, which every plant built from parameters has.
 FORCE_OFFSET = PlantParameter("force_offset", "N", "constant force added to the force on the "

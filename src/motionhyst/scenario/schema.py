@@ -12,6 +12,7 @@ builds the loop, the plant, the link and the reference.
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from importlib import resources
 from pathlib import Path
@@ -44,7 +45,8 @@ from motionhyst.scenario.sections import (
 from motionhyst.scenario.sections import hysteresis_from_dict as hysteresis_from_dict
 
 __all__ = ["MAX_VALUES", "Scenario", "ScenarioError", "default_scenario",
-           "default_scenario_path", "hysteresis_from_dict", "load_scenario", "warn_implausible"]
+           "default_scenario_path", "hysteresis_from_dict", "implausible_stage", "load_scenario",
+           "warn_implausible"]
 
 MAX_VALUES = 100_000
 """Most values one list of a scenario holds (a Maxwell-slip link's elements, the reference's
@@ -617,13 +619,13 @@ fc=[0.01, 0.02, 0.03]))
 
 
 def warn_implausible(sc: Scenario) -> None:
-    """Warn of each ``[stage]`` mass outside a motion stage's
-    (:data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`), naming it: a unit slip (grams,
-    tonnes) or a value off by orders of magnitude makes every number computed on the loop
-    doubtful, and some computations slow (a microgram's pole at 1e10 Hz sets the step of a
-    time run) or ill-conditioned.  One :class:`~motionhyst.core.warnings.MotionhystWarning`
-    each; the command goes on.  A scenario read by :func:`load_scenario` says so once its
-    loop is built (:meth:`Scenario.loop`).
+    """Warn of each ``[stage]`` value outside a motion stage's (:func:`implausible_stage`),
+    naming it: a unit slip (grams, tonnes) or a value off by orders of magnitude makes every
+    number computed on the loop doubtful, and some computations slow (a microgram's pole at
+    1e10 Hz sets the step of a time run) or ill-conditioned.  One
+    :class:`~motionhyst.core.warnings.MotionhystWarning` each; the command goes on.  A
+    scenario read by :func:`load_scenario` says so once its loop is built
+    (:meth:`Scenario.loop`).
 
     Parameters
     ----------
@@ -644,17 +646,66 @@ def warn_implausible(sc: Scenario) -> None:
 0.001-10000 kg of motion stages: is it in kg?
     """
     from motionhyst.core.warnings import warn
-    from motionhyst.plants.registry import PLAUSIBLE_MASS_KG, plant_class
+
+    for line in implausible_stage(sc):
+        warn(line)
+
+
+def implausible_stage(sc: Scenario) -> list[str]:
+    """One line for each ``[stage]`` value outside a motion stage's, naming it.
+
+    A mass outside :data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`; with the masses
+    within it, a stiffness or a damping that alone gives the stage a mode or a pole
+    faster than :data:`~motionhyst.plants.registry.PLAUSIBLE_POLE_HZ` (against the
+    stage's masses in series, as its internal mode sees them).
+
+    Parameters
+    ----------
+    sc : Scenario
+        The scenario read.
+
+    Returns
+    -------
+    list of str
+        The lines, each beginning with the scenario's name; empty for a plausible
+        stage or a measured plant (its fit says so of its mass).
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> sc = default_scenario(check=False)
+    >>> implausible_stage(sc)
+    []
+    >>> sc.model.stage.k = 7.4e16                          # N/m: off by 1e9
+    >>> print(implausible_stage(sc)[0])
+    paper.toml (Table I, built in): [stage] k = 7.4e+16 N/m gives the stage a mode at \
+2.2e+07 Hz, beyond the 1e+05 Hz of motion stages: is it in N/m?
+    """
+    from motionhyst.plants.registry import PLAUSIBLE_MASS_KG, PLAUSIBLE_POLE_HZ, plant_class
 
     stage = sc.model.stage
     if stage is None:
-        return  # a measured plant: its fit says so of its mass
+        return []
     low, high = PLAUSIBLE_MASS_KG
-    for p in plant_class(stage.type).parameters:
-        value = getattr(stage, p.name, None)
+    params = [(p, getattr(stage, p.name, None)) for p in plant_class(stage.type).parameters]
+    lines = []
+    for p, value in params:
         if p.unit != "kg" or value is None or low <= value <= high:
             continue
         factor, where = (low / value, "below") if value < low else (value / high, "above")
-        warn(f"{sc.source}: [stage] {p.name} = {value:g} kg, a factor {factor:.2g} {where} the "
-             f"{low:g}-{high:g} kg of motion stages: is it in kg?")
-
+        lines.append(f"{sc.source}: [stage] {p.name} = {value:g} kg, a factor {factor:.2g} "
+                     f"{where} the {low:g}-{high:g} kg of motion stages: is it in kg?")
+    masses = [v for p, v in params if p.unit == "kg" and v]
+    if lines or not masses:
+        return lines
+    per_mass = sum(1.0 / m for m in masses)
+    for p, value in params:
+        if p.unit not in ("N/m", "N s/m") or not value:
+            continue
+        stiff = p.unit == "N/m"
+        hz = (math.sqrt(abs(value) * per_mass) if stiff else abs(value) * per_mass) / math.tau
+        if hz > PLAUSIBLE_POLE_HZ:
+            lines.append(f"{sc.source}: [stage] {p.name} = {value:g} {p.unit} gives the stage a "
+                         f"{'mode' if stiff else 'pole'} at {hz:.2g} Hz, beyond the "
+                         f"{PLAUSIBLE_POLE_HZ:.0e} Hz of motion stages: is it in {p.unit}?")
+    return lines

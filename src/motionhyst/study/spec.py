@@ -456,8 +456,10 @@ class StudyDefinition:
 
     def check(self) -> None:
         """Validate the scenario with the first value of each axis and sample; a key the
-        scenario does not accept raises :class:`StudyError` naming it."""
+        scenario does not accept raises :class:`StudyError` naming it, an implausible value
+        of its stage is a warning (:func:`~motionhyst.scenario.schema.warn_implausible`)."""
         from motionhyst.scenario import Scenario, ScenarioError
+        from motionhyst.scenario.schema import warn_implausible
 
         if self.n_points > MAX_POINTS:
             raise StudyError(f"{self.n_points} points: more than {MAX_POINTS}; split the study")
@@ -485,6 +487,8 @@ class StudyDefinition:
             raise StudyError(str(exc)) from None
         if sc.is_open_loop:
             raise StudyError("the scenario is an open-loop system; a study needs a closed loop")
+        sc.source = self.scenario_source  # its stage's implausible values named once
+        warn_implausible(sc)
 
     # ---------------------------------------------------------------- points
     def _draw(self) -> NDArray[np.float64]:

@@ -79,7 +79,7 @@ from motionhyst.plants.two_mass import TwoMassStage
 from motionhyst.time.bouc_wen_rk4 import BW_PARAMETERS as BW_PARAMETERS
 from motionhyst.time.bouc_wen_rk4 import bouc_wen_general, simulate_bouc_wen
 from motionhyst.time.engine import FohStep, LoopState, run_steps
-from motionhyst.time.kernel import MAX_FIXED_POINT_ITERATIONS, OPEN
+from motionhyst.time.kernel import MAX_FIXED_POINT_ITERATIONS, OPEN, StepNotConverged
 from motionhyst.time.periodic_runs import MAX_PERIODIC_DECAYS as MAX_PERIODIC_DECAYS
 from motionhyst.time.periodic_runs import PERIODIC_RTOL as PERIODIC_RTOL
 from motionhyst.time.periodic_runs import (
@@ -335,9 +335,17 @@ def _with_offset(fine: NDArray[np.float64], mech: Mechanics) -> NDArray[np.float
     return fine + mech.force_offset if mech.force_offset else fine
 
 
+class _SubstepsNotConverged(StepNotConverged, ValueError):
+    """The link's implicit step of an open-loop run that did not converge: a ``ValueError``
+    too, which a search takes for a point of the parameters to leave."""
+
+
 def _check_converged(worst: int) -> None:
     if worst > MAX_FIXED_POINT_ITERATIONS:
-        raise ValueError("the link's implicit step did not converge; use more substeps")
+        raise _SubstepsNotConverged(f"the link's implicit step did not converge in "
+                                    f"{MAX_FIXED_POINT_ITERATIONS} iterations: the link is too "
+                                    f"stiff (or too strongly damped) for the integration step",
+                                    "use more substeps")
 
 
 def simulate_elements(mech: Mechanics, stepping: Stepping, u: NDArray[np.float64], fs: float,

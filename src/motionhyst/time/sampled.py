@@ -26,11 +26,9 @@ from numpy.typing import ArrayLike
 from motionhyst.controllers.loop import Loop
 from motionhyst.time.engine import run_sampled
 from motionhyst.time.simulation_result import Simulation
+from motionhyst.time.steps import MAX_SAMPLES, RunTooLarge
 
 __all__ = ["simulate_sampled"]
-
-#: The most controller samples one run may take.
-MAX_SAMPLES = 50_000_000
 
 
 def _velocity(reference, t):
@@ -137,7 +135,8 @@ def simulate_sampled(loop: Loop, reference, duration: float, *, force=None,
                          f"{type(loop.plant).__name__} has none")
     n = math.floor(duration * c.sample_rate_hz + 1e-9) + 1
     if n > MAX_SAMPLES:
-        raise ValueError(f"{n} controller samples: too many; shorten the duration")
+        raise RunTooLarge(f"{n} controller samples: too many (at most {MAX_SAMPLES:.0e})",
+                          "shorten the duration")
     t = np.arange(n) * c.period
     r, _ = reference(t)
     r = np.asarray(r, dtype=float)

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.controllers.loop import Loop
-from motionhyst.core.budget import check_memory, check_work
+from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import (
     FohResponse,
     discretize_foh,
@@ -39,37 +39,28 @@ from motionhyst.time.engine import FohStep, LoopState, run_steps
 from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS, StepNotConverged
 from motionhyst.time.sampled import simulate_sampled
 from motionhyst.time.simulation_result import Simulation
-from motionhyst.time.steps import BYTES_PER_SAMPLE, pole_step
+from motionhyst.time.steps import (
+    BYTES_PER_SAMPLE,
+    RUN_REMEDY,
+    SECONDS_PER_ELEMENT_STEP,
+    SECONDS_PER_STEP,
+    RunTooLarge,
+    a_run,
+    check_steps_work,
+    pole_step,
+)
 
-__all__ = ["SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "Simulation", "check_run_work",
-           "simulate", "simulate_chunks"]
-
-
-SECONDS_PER_STEP = 1.5e-6
-"""Nominal cost of one time step of a run [s] (one core of a quiet machine)."""
-
-SECONDS_PER_ELEMENT_STEP = 100e-9
-"""Nominal cost of one element of the link (a Maxwell-slip link's stop operators) in one
-time step [s]: a link of 1e5 elements makes a step 7000 times dearer."""
-
-
-def _element_count(link: Hysteresis | None) -> int:
-    """The elements the time step advances for `link` (0 without a link)."""
-    if link is None:
-        return 0
-    try:
-        return int(link.time_stepping().codes.size)
-    except (ValueError, AttributeError):  # advanced otherwise (along the stroke): one
-        return 1
+__all__ = ["RUN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "Simulation",
+           "check_run_work", "simulate", "simulate_chunks"]
 
 
-def check_run_work(loop: Loop, n_steps: int, remedy: str = "shorten the run or lower its "
-                   "frequencies") -> None:
+
+def check_run_work(loop: Loop, n_steps: int, remedy: str = RUN_REMEDY) -> None:
     """Refuse a run of `n_steps` time steps above the work budget, before it starts.
 
     Its work is the steps times :data:`SECONDS_PER_STEP` and the link's elements (and its
     feedforward model's) times :data:`SECONDS_PER_ELEMENT_STEP`
-    (:func:`motionhyst.core.budget.check_work`).
+    (:func:`motionhyst.time.steps.check_steps_work`).
 
     Parameters
     ----------
@@ -90,11 +81,7 @@ def check_run_work(loop: Loop, n_steps: int, remedy: str = "shorten the run or l
     >>> from motionhyst import default_scenario
     >>> check_run_work(default_scenario().loop(), 1_000_000)      # about 1.6 s
     """
-    m = _element_count(loop.hysteresis) + _element_count(loop.hysteresis_feedforward)
-    seconds = n_steps * (SECONDS_PER_STEP + m * SECONDS_PER_ELEMENT_STEP)
-    of = f" of a link of {m} elements" if m > 2 else ""
-    check_work(seconds, f"a run of {n_steps:.3g} time steps{of}",
-               remedy + (", or give the link fewer elements" if of else ""))
+    check_steps_work(n_steps, (loop.hysteresis, loop.hysteresis_feedforward), remedy)
 
 
 def _block_systems(loop: Loop, omega0: float):
@@ -207,9 +194,9 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     if n > 50_000_000:
-        raise ValueError(f"{n} time steps: too many; shorten the run or lower its frequencies")
-    check_memory(n * BYTES_PER_SAMPLE, f"a run of {n:.3g} time steps",
-                 "shorten the run or lower its frequencies")
+        raise RunTooLarge(f"{n} time steps of {engine.step:.3g} s: too many", RUN_REMEDY)
+    with a_run():
+        check_memory(n * BYTES_PER_SAMPLE, f"a run of {n:.3g} time steps", RUN_REMEDY)
     check_run_work(loop, n)
     t = np.arange(n) * engine.step
     h_foh = (t[-1] - t[0]) / (len(t) - 1) if len(t) > 1 else 0.0

@@ -15,13 +15,17 @@ the run's own step, and the checks are exact.
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator, Sequence
 
-from motionhyst.core.budget import check_memory
+from motionhyst.core.budget import BudgetError, check_memory, check_work
 
-__all__ = ["BYTES_PER_SAMPLE", "MAX_ROWS", "MAX_SCAN_STEPS", "MAX_STEPS", "SCAN_REMEDY",
-           "STEPS_PER_POLE_PERIOD", "STEPS_PER_REFERENCE_PERIOD", "check_scan_steps",
-           "longest_step", "pole_step", "time_series_grid"]
+__all__ = ["BYTES_PER_SAMPLE", "MAX_ROWS", "MAX_SAMPLES", "MAX_SCAN_STEPS", "MAX_STEPS",
+           "RUN_REMEDY",
+           "SCAN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "STEPS_PER_POLE_PERIOD",
+           "STEPS_PER_REFERENCE_PERIOD", "RunTooLarge", "a_run", "check_scan_steps",
+           "check_steps_work", "longest_step", "pole_step", "step_set_by", "time_series_grid"]
 
 STEPS_PER_POLE_PERIOD = 40
 """Time steps per period of the loop's fastest closed-loop pole."""
@@ -35,12 +39,26 @@ BYTES_PER_SAMPLE = 160
 MAX_SCAN_STEPS = 50_000_000
 """Most time steps of one run of a scan (each run keeps its signals)."""
 
+MAX_SAMPLES = 50_000_000
+"""Most controller samples of one run of a loop with a sampled controller."""
+
 MAX_ROWS = 100_000_000
 """Most rows a time series writes (about 10 GB of CSV)."""
 
 MAX_STEPS = 200_000_000
 """Most integration steps of a time series (the work budget: some minutes at about 1.5 us a
 step)."""
+
+SECONDS_PER_STEP = 1.5e-6
+"""Nominal cost of one time step of a run [s] (one core of a quiet machine)."""
+
+SECONDS_PER_ELEMENT_STEP = 100e-9
+"""Nominal cost of one element of the link (a Maxwell-slip link's stop operators) in one
+time step [s]: a link of 1e5 elements makes a step 7000 times dearer."""
+
+RUN_REMEDY = "shorten the duration or lower the reference's frequencies"
+"""What the caller of :func:`~motionhyst.time.simulation.simulate` can change to make a run
+smaller (its arguments); a command says its own options instead."""
 
 SCAN_REMEDY = "shorten the setpoint (its length, dwell) or the tail after it, or raise the speed"
 """What a scan refused for its size can change."""
@@ -69,6 +87,86 @@ def pole_step(fastest_pole: float, max_frequency_hz: float = 0.0) -> float:
     h = math.tau / (STEPS_PER_POLE_PERIOD * fastest_pole)
     return min(h, 1.0 / (STEPS_PER_REFERENCE_PERIOD * max_frequency_hz)) if max_frequency_hz > 0 \
         else h
+
+
+class RunTooLarge(BudgetError):
+    """A time run refused for its size (steps, rows, memory or work) before it starts.
+
+    Its :attr:`remedy` names the library function's arguments (a duration, a
+    reference); a command names its own options instead
+    (:meth:`~motionhyst.core.budget.BudgetError.with_remedy`), and only for these
+    refusals, not for others of the same command (a measured plant's fit).
+
+    Parameters
+    ----------
+    cause : str
+        What is too large (the steps, the rows), and the limit.
+    remedy : str
+        What the caller can change.
+
+    Examples
+    --------
+    >>> err = RunTooLarge("6e+07 time steps of 1e-06 s: too many", "shorten the duration")
+    >>> print(err.with_remedy("shorten --tail"))
+    6e+07 time steps of 1e-06 s: too many; shorten --tail
+    >>> isinstance(err, ValueError), type(err.with_remedy("")).__name__
+    (True, 'RunTooLarge')
+    """
+
+
+@contextlib.contextmanager
+def a_run() -> Iterator[None]:
+    """A budget refusal inside (:func:`~motionhyst.core.budget.check_memory`,
+    :func:`~motionhyst.core.budget.check_work`) raised as the :class:`RunTooLarge` it is.
+
+    Examples
+    --------
+    >>> from motionhyst.core.budget import set_max_memory
+    >>> set_max_memory(1 << 20)
+    >>> try:
+    ...     with a_run():
+    ...         check_memory(1e9, "a run of 6e6 time steps", "shorten the duration")
+    ... except RunTooLarge as exc:
+    ...     print(exc.remedy)
+    shorten the duration
+    >>> set_max_memory(None)
+    """
+    try:
+        yield
+    except RunTooLarge:
+        raise
+    except BudgetError as exc:
+        raise RunTooLarge(exc.cause, exc.remedy) from None
+
+
+def step_set_by(fastest_pole: float, max_frequency_hz: float = 0.0) -> str:
+    """What sets :func:`pole_step` of a loop and a reference, for messages.
+
+    Parameters
+    ----------
+    fastest_pole : float
+        The largest magnitude of the loop's closed-loop poles [rad/s], > 0.
+    max_frequency_hz : float
+        The reference's highest frequency [Hz]; 0: none sets the step.
+
+    Returns
+    -------
+    str
+        The loop's fastest pole or the reference's frequency, with its frequency.
+
+    Examples
+    --------
+    >>> step_set_by(4344.0, 5.0)
+    "the loop's fastest closed-loop pole, 691.4 Hz, resolved in 40 steps"
+    >>> step_set_by(1.0, 25.0)
+    "the reference's 25 Hz, resolved in 400 steps a period"
+    """
+    if max_frequency_hz > 0 and pole_step(fastest_pole, max_frequency_hz) < pole_step(
+            fastest_pole):
+        return (f"the reference's {max_frequency_hz:.4g} Hz, resolved in "
+                f"{STEPS_PER_REFERENCE_PERIOD} steps a period")
+    return (f"the loop's fastest closed-loop pole, {fastest_pole / math.tau:.4g} Hz, resolved "
+            f"in {STEPS_PER_POLE_PERIOD} steps")
 
 
 def longest_step(max_frequency_hz: float, sample_period: float | None = None) -> float:
@@ -125,8 +223,8 @@ def check_scan_steps(duration: float, step: float, runs: int, remedy: str = SCAN
 
     Raises
     ------
-    ValueError
-        One line: the count, the step and `remedy`.
+    RunTooLarge
+        One line: the count, the step and `remedy` (a ``ValueError``).
 
     Examples
     --------
@@ -140,17 +238,73 @@ def check_scan_steps(duration: float, step: float, runs: int, remedy: str = SCAN
     """
     n = math.ceil(duration / step) + 1
     if n > MAX_SCAN_STEPS:
-        raise ValueError(f"{'at least ' if at_least else ''}{n} time steps of {step:.3g} s: "
-                         f"too many; {remedy}")
-    check_memory(n * BYTES_PER_SAMPLE * (runs + 2),
-                 f"a scan of {runs} runs of {'at least ' if at_least else ''}{n:.3g} time "
-                 f"steps each", remedy)
+        raise RunTooLarge(f"{'at least ' if at_least else ''}{n} time steps of {step:.3g} s: "
+                          f"too many", remedy)
+    with a_run():
+        check_memory(n * BYTES_PER_SAMPLE * (runs + 2),
+                     f"a scan of {runs} runs of {'at least ' if at_least else ''}{n:.3g} time "
+                     f"steps each", remedy)
     return n
 
 
+def _element_count(link) -> int:
+    """The elements the time step advances for `link` (0 without a link)."""
+    if link is None:
+        return 0
+    try:
+        return int(link.time_stepping().codes.size)
+    except (ValueError, AttributeError):  # advanced otherwise (along the stroke): one
+        return 1
+
+
+def check_steps_work(n_steps: int, links: Sequence, remedy: str) -> None:
+    """Refuse a run of `n_steps` time steps of `links` above the work budget, before it
+    starts (known before the loop is built: a scenario's link gives its elements).
+
+    Its work is the steps times :data:`SECONDS_PER_STEP` and the links' elements (a
+    Maxwell-slip link's stop operators) times :data:`SECONDS_PER_ELEMENT_STEP`
+    (:func:`motionhyst.core.budget.check_work`).
+
+    Parameters
+    ----------
+    n_steps : int
+        The run's time steps.
+    links : sequence of Hysteresis or None
+        The links the run advances (the loop's, its feedforward model's).
+    remedy : str
+        What the user can change, for the message.
+
+    Raises
+    ------
+    RunTooLarge
+        One line: the run's steps and elements, its estimated time, the remedy.
+
+    Examples
+    --------
+    >>> from motionhyst.core.budget import BudgetError, set_max_seconds
+    >>> from motionhyst.hysteresis import MaxwellSlip
+    >>> link = MaxwellSlip(k=[20.0] * 3000, fc=[0.05] * 3000)
+    >>> check_steps_work(5_000, [link, None], "shorten the setpoint")     # about 1.5 s
+    >>> set_max_seconds(1.0)
+    >>> try:
+    ...     check_steps_work(5_000, [link, None], "shorten the setpoint")
+    ... except BudgetError as exc:
+    ...     print(exc)
+    a run of 5e+03 time steps of a link of 3000 elements would take about 1.5 s, above the \
+work budget of 1 s (--max-seconds); shorten the setpoint, or give the link fewer elements
+    >>> set_max_seconds(None)
+    """
+    m = sum(_element_count(link) for link in links)
+    seconds = n_steps * (SECONDS_PER_STEP + m * SECONDS_PER_ELEMENT_STEP)
+    of = f" of a link of {m} elements" if m > 2 else ""
+    with a_run():
+        check_work(seconds, f"a run of {n_steps:.3g} time steps{of}",
+                   remedy + (", or give the link fewer elements" if of else ""))
+
+
 def time_series_grid(duration: float, output_rate_hz: float, step: float,
-                     sample_rate_hz: float | None = None, at_least: bool = False
-                     ) -> tuple[int, int, float]:
+                     sample_rate_hz: float | None = None, at_least: bool = False,
+                     step_set_by: str = "") -> tuple[int, int, float]:
     """The rows, the steps a row and the step of a time series written at `output_rate_hz`,
     refused above :data:`MAX_ROWS` rows or :data:`MAX_STEPS` steps.
 
@@ -172,6 +326,9 @@ def time_series_grid(duration: float, output_rate_hz: float, step: float,
     at_least : bool
         The steps a row are a lower bound (the loop's step is not known yet); the
         message says so.
+    step_set_by : str
+        What sets `step`, for the message (``"the reference's frequency"``, ``"the loop's
+        fastest closed-loop pole, 1e+10 Hz"``); "": the message does not say.
 
     Returns
     -------
@@ -186,7 +343,8 @@ def time_series_grid(duration: float, output_rate_hz: float, step: float,
     ------
     ValueError
         One line: an output period longer than the run, an output rate a sampled
-        controller's rate is no multiple of, or too many rows or steps (and the remedy).
+        controller's rate is no multiple of, or too many rows or steps (a
+        :class:`RunTooLarge`, with the remedy).
 
     Examples
     --------
@@ -197,6 +355,11 @@ def time_series_grid(duration: float, output_rate_hz: float, step: float,
     ... except ValueError as exc:
     ...     print(str(exc)[:60])
     10000000001 rows of at least 1 steps each: too many time ste
+    >>> try:
+    ...     time_series_grid(6000.0, 10_000.0, 1e-4, sample_rate_hz=10_000.0)
+    ... except RunTooLarge as exc:
+    ...     print(exc)
+    60000001 controller samples at 10000 Hz: too many (at most 5e+07); shorten the duration
     """
     period_out = 1.0 / output_rate_hz
     if period_out > duration:
@@ -211,11 +374,14 @@ def time_series_grid(duration: float, output_rate_hz: float, step: float,
             raise ValueError(f"the output rate {output_rate_hz:g} Hz must divide the sampled "
                              f"controller's rate {sample_rate_hz:g} Hz")
     n_rows = math.floor(duration / period_out * (1 + 1e-12)) + 1
+    if sample_rate_hz is not None and math.floor(duration * sample_rate_hz + 1e-9) >= MAX_SAMPLES:
+        raise RunTooLarge(f"{math.floor(duration * sample_rate_hz + 1e-9) + 1} controller "
+                          f"samples at {sample_rate_hz:g} Hz: too many (at most "
+                          f"{MAX_SAMPLES:.0e})", "shorten the duration")
     if n_rows > MAX_ROWS or n_rows * per_row > MAX_STEPS:
-        fast = "" if per_row < 1000 else (f" (a step of {step:.3g} s follows the "
-                                          f"reference's frequency)")
-        raise ValueError(f"{n_rows} rows of {'at least ' if at_least else ''}{per_row} steps "
-                         f"each: too many time steps{fast}; lower the frequency, the output "
-                         f"rate or the duration (at most {MAX_ROWS:.0e} rows, "
-                         f"{MAX_STEPS:.0e} steps)")
+        why = f" (a step of {step:.3g} s: {step_set_by})" if step_set_by else ""
+        raise RunTooLarge(f"{n_rows} rows of {'at least ' if at_least else ''}{per_row} steps "
+                          f"each: too many time steps{why} (at most {MAX_ROWS:.0e} rows, "
+                          f"{MAX_STEPS:.0e} steps)", "lower the frequency, the output rate "
+                          "or the duration")
     return n_rows, per_row, step

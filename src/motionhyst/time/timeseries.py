@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
-from motionhyst.time.steps import pole_step, time_series_grid
+from motionhyst.time.steps import pole_step, step_set_by, time_series_grid
 
 if TYPE_CHECKING:  # the simulation (python-control, numba) loads when a run starts: the
     # command's checks of its run (time_series_grid) come before it
@@ -73,9 +73,15 @@ def dynamics_step(loop: Loop, reference) -> float:
     """
     if loop.sampled is not None:
         return loop.sampled.period
-    f = 0.0 if isinstance(reference, SampledReference) else float(
+    return pole_step(float(np.max(np.abs(loop.closed_loop_poles()))),
+                     _reference_frequency(reference))
+
+
+def _reference_frequency(reference) -> float:
+    """The highest frequency of a built-in reference [Hz]; 0 for a file's (it does not set
+    the step) or none."""
+    return 0.0 if isinstance(reference, SampledReference) else float(
         getattr(reference, "max_frequency_hz", 0.0) or 0.0)
-    return pole_step(float(np.max(np.abs(loop.closed_loop_poles()))), f)
 
 
 def reference_rate_hz(reference: SampledReference) -> float:
@@ -204,9 +210,11 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     if not (np.isfinite(settle_band) and settle_band > 0):
         raise ValueError(f"settle band must be finite and > 0, got {settle_band!r}")
     period_out = 1.0 / output_rate_hz
+    why = "" if loop.sampled is not None else step_set_by(
+        float(np.max(np.abs(loop.closed_loop_poles()))), _reference_frequency(reference))
     n_rows, per_row, step = time_series_grid(
         duration, output_rate_hz, dynamics_step(loop, reference),
-        None if loop.sampled is None else loop.sampled.sample_rate_hz)
+        None if loop.sampled is None else loop.sampled.sample_rate_hz, step_set_by=why)
     end = (n_rows - 1) * period_out
     window = move = None
     if isinstance(reference, SineReference):
