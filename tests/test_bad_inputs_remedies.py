@@ -235,3 +235,29 @@ def test_the_open_loop_step_refusal_is_a_value_error_a_search_leaves():
     assert isinstance(caught.value, StepNotConverged)
     assert "substeps" not in caught.value.what
 
+
+def test_the_top_parser_s_refusal_has_one_prefix(capsys):
+    """A command that is none of motionhyst's was "motionhyst: error: motionhyst: argument
+    command: ..."."""
+    from motionhyst.cli import main
+
+    assert main(["no-such-command"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("motionhyst: error: argument command: invalid choice: "
+                          "'no-such-command'") and err.count("\n") == 1, err
+
+
+def test_the_budget_options_before_the_command_set_the_budget(capsys):
+    """``motionhyst --max-seconds S COMMAND`` (as the budget's documentation spelt it) was
+    "invalid choice: '0.01'"; it sets the budget as the command's own option does, which
+    wins where both are given."""
+    from motionhyst.cli import main
+
+    argv = ["steady", "--frequency", "5", "10"]
+    assert main(["--max-seconds", "0.01", *argv]) == 2
+    err = capsys.readouterr().err
+    assert "above the work budget of 0.01 s (--max-seconds)" in err, err
+    assert main(["--max-seconds", "1e-9", *argv, "--max-seconds", "0.02"]) == 2
+    assert "above the work budget of 0.02 s (--max-seconds)" in capsys.readouterr().err
+    assert main(["--max-memory", "1K", *argv]) == 2
+    assert "above the memory budget of 1.02 kB (--max-memory)" in capsys.readouterr().err

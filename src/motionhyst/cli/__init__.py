@@ -69,6 +69,11 @@ def build_parser() -> argparse.ArgumentParser:
     """
     p = Parser(prog="motionhyst", description="Hysteresis of dynamic links in motion control "
                "loops: describing functions, quasi-linear analysis, exact steady state.")
+    budget = {"--max-memory": memory_size, "--max-seconds": positive}
+    for option, kind in budget.items():  # before the command too: every command has them
+        p.add_argument(option, type=kind, metavar="SIZE" if option == "--max-memory" else "S",
+                       dest="before_" + option[2:].replace("-", "_"),
+                       help=f"as the command's {option}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     for name in COMMANDS:
         importlib.import_module(f"motionhyst.cli.{name}").add_parser(sub)
@@ -132,8 +137,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             sys.stdout = open(os.devnull, "w")  # the files are the results; the summary is lost
         else:
             sys.stdout = _NamedOutput(sys.stdout)
-        set_max_memory(args.max_memory)
-        set_max_seconds(args.max_seconds)
+        set_max_memory(args.before_max_memory if args.max_memory is None else args.max_memory)
+        set_max_seconds(args.before_max_seconds if args.max_seconds is None
+                        else args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
         with warnings_on_stderr(args.command):
             code = args.func(args)
@@ -324,7 +330,8 @@ def _failed(exc: Exception) -> int:
     try:
         raise exc
     except UsageError as exc:  # "motionhyst identify: ..." -> "motionhyst: error: identify: ..."
-        text = str(exc).removeprefix("motionhyst ")
+        # "motionhyst identify: ..." of a command's parser, "motionhyst: ..." of the top one
+        text = str(exc).removeprefix("motionhyst ").removeprefix("motionhyst: ")
         _say(f"motionhyst: error: {one_line(text)}")
     except OSError as exc:  # "No space left on device: out.csv", not "[Errno 28] ... 'out.csv'"
         text = (f"{exc.filename}: {exc.strerror}" if exc.strerror and exc.filename is not None

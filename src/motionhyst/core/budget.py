@@ -11,7 +11,7 @@ instead of being killed by the operating system minutes later.
 The budget is :data:`DEFAULT_FRACTION` of the memory the process may use
 (:func:`available_memory`: the machine's memory, the container's limit, the
 address-space limit ``RLIMIT_AS`` less what the process already uses,
-whichever is smallest); ``motionhyst --max-memory SIZE`` (any command) or
+whichever is smallest); ``motionhyst COMMAND --max-memory SIZE`` (every command) or
 the environment variable ``MOTIONHYST_MAX_MEMORY`` set it explicitly
 (:func:`set_max_memory`).
 
@@ -19,8 +19,8 @@ The work of a computation whose time follows from its inputs (frequencies
 times harmonics, stop elements cubed) is estimated likewise, in seconds at
 the nominal costs its module states (measured on one core of a quiet
 machine: a loaded one takes longer), and refused above the work budget with
-:func:`check_work`: :data:`DEFAULT_SECONDS` unless ``motionhyst
---max-seconds S`` (any command) or ``MOTIONHYST_MAX_SECONDS`` raise it
+:func:`check_work`: :data:`DEFAULT_SECONDS` unless ``motionhyst COMMAND
+--max-seconds S`` (every command) or ``MOTIONHYST_MAX_SECONDS`` raise it
 (:func:`set_max_seconds`).  A search that no formula sizes (a fit that stops when it
 converges) is stopped after that much CPU time instead (:func:`cpu_time_limit`).  A command
 never runs for hours unasked.
