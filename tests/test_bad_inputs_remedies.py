@@ -103,6 +103,16 @@ CASES = [
      ["the step resolves the loop's fastest closed-loop pole, 2.195e+07 Hz (beyond a motion "
       "stage's 1e+05 Hz: s.toml: [stage] k = 7.4e+16 N/m gives the stage a mode at 2.2e+07 "
       "Hz, beyond the 1e+05 Hz of motion stages: is it in N/m?); " + SCAN_REMEDY], []),
+    # --------------------------------------------- a sampled controller's keys and options
+    ("sampled-delay-of-1e9-samples",
+     {"s.toml": PAPER_10KHZ.read_text().replace("delay_samples = 1.5", "delay_samples = 1e9")},
+     ["analyze", "s.toml"],
+     ["s.toml: [controller]: delay_samples = 1e+09 is more than 1000 samples (1e+05 s at "
+      "10000 Hz): is it in samples?"], ["memory"]),
+    ("scan-rate-between-the-controller-s-samples", {"s.toml": PAPER_10KHZ.read_text()},
+     [*SCAN, "--rate", "3000"],
+     ["scan: --rate 3000 Hz: s.toml's controller samples at 10000 Hz, which is no whole "
+      "multiple of it"], []),
     # ----------------------------- a value that is not finite: its column and sample named
     ("predict-force-of-a-displacement-with-a-nan", {"m.toml": QUASI_STATIC,
                                                     "d.csv": _record({"time": T,
@@ -155,6 +165,9 @@ WARNED = [
      ["analyze", "s.toml", "--frequency", "5"],
      "s.toml: [stage] k = 7.4e+16 N/m gives the stage a mode at 2.2e+07 Hz, beyond the "
      "1e+05 Hz of motion stages: is it in N/m?"),
+    ("analyze-amplitude-in-millimetres", _paper("amplitude = 0.01 ", "amplitude = 10.0 "),
+     ["analyze", "s.toml", "--frequency", "5"],
+     "amplitude 10 m, above the 2 m of a motion stage's half stroke: is it in m?"),
     ("stability-stage-damping-off-by-1e9", _paper("b = 90.0", "b = 9e10"),
      ["stability", "s.toml"],
      "s.toml: [stage] b = 9e+10 N s/m gives the stage a pole at 3.7e+09 Hz, beyond the "

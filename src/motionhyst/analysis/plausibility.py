@@ -25,10 +25,16 @@ from collections.abc import Iterable
 
 from motionhyst.core.warnings import warn
 
-__all__ = ["DECADES_ABOVE", "check_frequencies", "check_frequency_range", "check_plausible"]
+__all__ = ["DECADES_ABOVE", "PLAUSIBLE_AMPLITUDE_M", "check_frequencies", "check_frequency_range",
+           "check_plausible"]
 
 DECADES_ABOVE = 2
 """How far (decades) a sine's frequency may lie above the loop's fastest closed-loop pole."""
+
+PLAUSIBLE_AMPLITUDE_M = 2.0
+"""Largest reference amplitude of a motion stage [m] (half its stroke: a wafer stage's is
+some 0.2 m, a long gantry's a metre or two): beyond, a warning asks for the unit (10 for
+10 mm is 10 m)."""
 
 
 def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
@@ -40,7 +46,8 @@ def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
       eq. (21) do not apply;
     - an amplitude at which the element never slips (``zeta = fc / (k A) >= 1``,
       eq. 4): it is a linear spring at every frequency asked, no hysteresis to see;
-    - a frequency outside a measured plant's data (the plant is extrapolated).
+    - a frequency outside a measured plant's data (the plant is extrapolated);
+    - an amplitude above :data:`PLAUSIBLE_AMPLITUDE_M` (a unit slip: millimetres).
 
     Parameters
     ----------
@@ -68,6 +75,9 @@ def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
     el = loop.hysteresis
     freqs = [float(f) for f in frequencies_hz]
     level = stacklevel + 1
+    if amplitude > PLAUSIBLE_AMPLITUDE_M:
+        warn(f"amplitude {amplitude:g} m, above the {PLAUSIBLE_AMPLITUDE_M:g} m of a motion "
+             f"stage's half stroke: is it in m?", level)
     if el is not None:
         fs = f_star(el.initial_stiffness, loop.M)
         low = [f for f in freqs if f < fs]

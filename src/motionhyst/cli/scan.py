@@ -169,6 +169,20 @@ def _check_options(args: argparse.Namespace) -> None:
         raise UsageError(f"{PROG}: --ilc-gain must be in (0, 2), got {args.ilc_gain:g}")
 
 
+def _check_rate(args: argparse.Namespace, sc) -> None:
+    """Refuse a ``--rate`` whose samples are not the sampled controller's: the setpoint's
+    switching instants would fall between the samples the controller reads it at."""
+    rate = getattr(sc.model.controller, "sample_rate_hz", None)
+    if args.rate is None or rate is None:
+        return
+    ratio = rate / args.rate
+    if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * ratio:
+        raise UsageError(f"{PROG}: --rate {args.rate:g} Hz: {sc.source}'s controller samples "
+                         f"at {rate:g} Hz, which is no whole multiple of it (the setpoint's "
+                         f"switching instants would fall between its samples); give --rate "
+                         f"{rate:g} or a whole fraction of it")
+
+
 def _profiles(args: argparse.Namespace):
     """The setpoint and the carry-over setpoint (None unless a compensation learns),
     each checked against the exposure window."""
@@ -252,6 +266,7 @@ def run(args: argparse.Namespace) -> int:
     # scipy): a refusal does not wait for them
     sc = load_scenario(args.scenario, check=False)
     _check_options(args)
+    _check_rate(args, sc)
     out = _output(args)
     _check_model_terms(args, sc)
     profile, other = _profiles(args)

@@ -54,8 +54,13 @@ from motionhyst.core.zoh import canonical_state_space
 if TYPE_CHECKING:  # imported where used: a sampled controller is built and checked without it
     import control
 
-__all__ = ["DISCRETIZATIONS", "SampledController", "ascending", "discretize",
+__all__ = ["DISCRETIZATIONS", "MAX_DELAY_SAMPLES", "SampledController", "ascending", "discretize",
            "discretize_coefficients", "polyval_zinv"]
+
+MAX_DELAY_SAMPLES = 1000
+"""Longest delay of a sampled controller [samples]: its ``z^-d`` is a polynomial of degree
+``d`` in every analysis of the loop (a motion stage's loop takes a few samples; a loop slow
+enough for 1000 has no use for its sampling rate)."""
 
 #: The discretisations of a continuous controller, the first the default.
 DISCRETIZATIONS = ("tustin", "tustin-prewarp", "zoh", "matched")
@@ -320,6 +325,10 @@ class SampledController:
         d = float(delay_samples)
         if not (math.isfinite(d) and d >= 0):
             raise ValueError(f"delay_samples must be finite and >= 0, got {delay_samples!r}")
+        if d > MAX_DELAY_SAMPLES:  # its z^-d would be a polynomial of that degree
+            raise ValueError(f"delay_samples = {d:g} is more than {MAX_DELAY_SAMPLES} samples "
+                             f"({d * self.period:.3g} s at {self.sample_rate_hz:g} Hz): is it "
+                             f"in samples?")
         self.delay_samples = d
         self.u_max = None if u_max is None else _positive("u_max", u_max)
         self.r_num = _checked_poly("num" if y_num is None else "r_num", r_num)
