@@ -116,7 +116,8 @@ CASES = [
      ["time steps of 1.75e-12 s: too many; the step resolves the loop's fastest closed-loop "
       "pole, 1.432e+10 Hz (beyond a motion stage's 1e+05 Hz: s.toml: [stage] m1 = 1e-09 kg, "
       "a factor 1e+06 below the 0.001-10000 kg of motion stages: is it in kg?); shorten the "
-      "setpoint (--length, --dwell) or --tail, or raise --speed"]),
+      "setpoint (--length, --dwell) or --tail, or raise its limits (--speed, --a-max, "
+      "--j-max, --s-max)"]),
     # ---------- a link too damped for the step the command sets: no advice of an option it
     # lacks (the library's "use a smaller dt"), the scenario's section to check instead
     ("scan-link-too-damped-for-its-step", {"s.toml": DAMPED_LINK},

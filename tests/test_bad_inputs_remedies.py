@@ -30,7 +30,8 @@ JENKINS = ('model = "jenkins"\nk = 20.0              # spring stiffness k_J [N/m
            'fc = 0.05             # slip force f_c [N]')
 SCAN = ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max",
         "1000", "--s-max", "1e6", "--compensation", "none"]
-SCAN_REMEDY = "shorten the setpoint (--length, --dwell) or --tail, or raise --speed"
+SCAN_REMEDY = ("shorten the setpoint (--length, --dwell) or --tail, or raise its limits "
+               "(--speed, --a-max, --j-max, --s-max)")
 QUASI_STATIC = ('[stage]\ntype = "quasi-static"\nk = 10.0\n\n'
                 '[hysteresis]\nmodel = "jenkins"\nk = 20.0\nfc = 0.05\n')
 
@@ -103,6 +104,10 @@ CASES = [
      ["the step resolves the loop's fastest closed-loop pole, 2.195e+07 Hz (beyond a motion "
       "stage's 1e+05 Hz: s.toml: [stage] k = 7.4e+16 N/m gives the stage a mode at 2.2e+07 "
       "Hz, beyond the 1e+05 Hz of motion stages: is it in N/m?); " + SCAN_REMEDY], []),
+    ("scan-acceleration-limit-of-1e-9", {"s.toml": PAPER},
+     ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "1e-9", "--j-max",
+      "1000", "--s-max", "1e6", "--compensation", "none"],
+     ["time steps of 3.16e-09 s: too many; " + SCAN_REMEDY], []),
     # --------------------------------------------- a sampled controller's keys and options
     ("sampled-delay-of-1e9-samples",
      {"s.toml": PAPER_10KHZ.read_text().replace("delay_samples = 1.5", "delay_samples = 1e9")},
@@ -168,6 +173,10 @@ WARNED = [
     ("analyze-amplitude-in-millimetres", _paper("amplitude = 0.01 ", "amplitude = 10.0 "),
      ["analyze", "s.toml", "--frequency", "5"],
      "amplitude 10 m, above the 2 m of a motion stage's half stroke: is it in m?"),
+    ("simulate-move-in-millimetres", PAPER,
+     ["simulate", "s.toml", "--time-series", "ts.csv", "--profile", "point-to-point",
+      "--distance", "10", "--duration", "0.01"],
+     "--distance 10 m, longer than the 4 m stroke of a motion stage: is it in m?"),
     ("stability-stage-damping-off-by-1e9", _paper("b = 90.0", "b = 9e10"),
      ["stability", "s.toml"],
      "s.toml: [stage] b = 9e+10 N s/m gives the stage a pole at 3.7e+09 Hz, beyond the "

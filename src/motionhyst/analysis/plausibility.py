@@ -26,7 +26,7 @@ from collections.abc import Iterable
 from motionhyst.core.warnings import warn
 
 __all__ = ["DECADES_ABOVE", "PLAUSIBLE_AMPLITUDE_M", "check_frequencies", "check_frequency_range",
-           "check_plausible"]
+           "check_plausible", "check_stroke"]
 
 DECADES_ABOVE = 2
 """How far (decades) a sine's frequency may lie above the loop's fastest closed-loop pole."""
@@ -96,6 +96,35 @@ def check_plausible(loop, amplitude: float, frequencies_hz: Iterable[float],
         if out:
             warn(f"{', '.join(f'{f:g}' for f in out)} Hz outside the measured plant's data "
                  f"({lo:g}-{hi:g} Hz): the plant there is extrapolated", level)
+
+
+def check_stroke(length: float, what: str, stacklevel: int = 2) -> None:
+    """Warn of a move or a scan longer than a motion stage's stroke (twice
+    :data:`PLAUSIBLE_AMPLITUDE_M`): a unit slip (millimetres) likelier than a stage of a
+    kilometre, and a run as long as it.
+
+    Parameters
+    ----------
+    length : float
+        The move's length [m] (its sign is its direction).
+    what : str
+        The option or key that gives it, as the warning names it.
+    stacklevel : int
+        As for :func:`motionhyst.core.warnings.warn`.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     check_stroke(0.3, "--distance")
+    ...     check_stroke(-1000.0, "--distance")
+    >>> print(caught[0].message)
+    --distance -1000 m, longer than the 4 m stroke of a motion stage: is it in m?
+    """
+    if abs(length) > 2 * PLAUSIBLE_AMPLITUDE_M:
+        warn(f"{what} {length:g} m, longer than the {2 * PLAUSIBLE_AMPLITUDE_M:g} m stroke of a "
+             f"motion stage: is it in m?", stacklevel + 1)
 
 
 def check_frequencies(frequencies_hz: Iterable[float], fastest_pole_hz: float | None = None,

@@ -27,7 +27,8 @@ __all__ = []
 
 PROG = "motionhyst scan"
 
-REMEDY = "shorten the setpoint (--length, --dwell) or --tail, or raise --speed"
+REMEDY = ("shorten the setpoint (--length, --dwell) or --tail, or raise its limits (--speed, "
+          "--a-max, --j-max, --s-max)")
 """What the user of ``scan`` can change to make its runs shorter."""
 LEAD_IN = 0.01
 """Rest before the setpoint starts [s]: room for the learned force to act ahead of it."""
@@ -198,6 +199,11 @@ def _profiles(args: argparse.Namespace):
     for p in (profile, other):
         if p is not None:
             p.check_window(args.window)
+    from motionhyst.analysis.plausibility import check_stroke
+
+    check_stroke(args.length, "--length")
+    if other is not None and args.other_length is not None:
+        check_stroke(args.other_length, "--other-length")
     return profile, other
 
 

@@ -76,6 +76,9 @@ def _reference(args: argparse.Namespace, sc):
                   for k, v in PROFILE_DEFAULTS.items()}
         if limits["distance"] == 0:
             raise UsageError("motionhyst simulate: --distance must be non-zero")
+        from motionhyst.analysis.plausibility import check_stroke
+
+        check_stroke(limits["distance"], "--distance")
         ref = PointToPoint(**limits)
         return (ref, ref.duration + 0.2,
                 f"point-to-point move of {limits['distance']:g} m")
