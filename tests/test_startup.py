@@ -196,6 +196,9 @@ def _refused_scenarios() -> dict[str, str]:
         "slip.toml": paper.replace('model = "jenkins"', 'model = "maxwell-slip"').replace(
             "k = 20.0 ", "k = [" + "1.0," * 100_001 + "] ").replace(
             "fc = 0.05 ", "fc = [" + "0.01," * 100_001 + "] "),
+        "slip-3000.toml": paper.replace('model = "jenkins"', 'model = "maxwell-slip"').replace(
+            "k = 20.0 ", "k = [" + "20.0," * 3000 + "] ").replace(
+            "fc = 0.05 ", "fc = [" + "0.05," * 3000 + "] "),
         "open.toml": _bad_records()["stage.toml"],
         "plant-dir.toml": head + '[plant]\nfile = "pl"\n' + tail,
         "plant-text.toml": head + '[plant]\nfile = "plant.mat"\n' + tail,
@@ -214,6 +217,9 @@ SCAN = ["scan", "paper.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "
     ([*SCAN, "--ilc-gain", "2"], "--ilc-gain must be in (0, 2)"),
     ([*SCAN, "--compensation", "none", "--ilc-gain", "0.5"], "--ilc-gain has no effect"),
     ([*SCAN, "--at", "nan"], "--at must be finite"),
+    ([*SCAN, "--at", "0.1"], "--at: a scan's place on the stroke needs a link that varies"),
+    ([*SCAN[:1], "slip-3000.toml", *SCAN[2:], "--compensation", "none", "--max-seconds", "1"],
+     "time steps of a link of 3000 elements would take about"),
     ([*SCAN, "--compensation", "model"], "--compensation model needs a [feedforward]"),
     ([*SCAN, "--feedforward", "hysteresis"], "--feedforward hysteresis needs a [feedforward]"),
     ([*SCAN, "--window", "1"], "exposure window (1 s) is longer than the scan"),

@@ -199,11 +199,6 @@ def _profiles(args: argparse.Namespace):
     for p in (profile, other):
         if p is not None:
             p.check_window(args.window)
-    from motionhyst.analysis.plausibility import check_stroke
-
-    check_stroke(args.length, "--length")
-    if other is not None and args.other_length is not None:
-        check_stroke(args.other_length, "--other-length")
     return profile, other
 
 
@@ -242,6 +237,19 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
                 check_steps_work(n, (sc.hysteresis(),), REMEDY)
 
 
+def _check_at(args: argparse.Namespace, sc) -> None:
+    """Refuse ``--at`` before the loop is built where the scenario's link (and its
+    feedforward model, if any) does not vary along the stroke (the check of :func:`_at`)."""
+    from motionhyst.hysteresis.along_stroke import AlongStroke
+
+    if args.at is None or sc.model.controller is None:
+        return
+    ff = sc.model.feedforward
+    if getattr(ff, "hysteresis", None) is None and not isinstance(sc.hysteresis(), AlongStroke):
+        raise UsageError(f"{PROG}: --at: a scan's place on the stroke needs a link that varies "
+                         f"along it ([hysteresis] along) ({sc.source})")
+
+
 def _check_model_terms(args: argparse.Namespace, sc) -> None:
     """Refuse, before the loop is built, a model compensation the scenario's ``[feedforward]``
     gives no term for (the checks of :func:`run` once the loop is built, where its section
@@ -275,8 +283,14 @@ def run(args: argparse.Namespace) -> int:
     _check_rate(args, sc)
     out = _output(args)
     _check_model_terms(args, sc)
+    _check_at(args, sc)
     profile, other = _profiles(args)
     _check_steps(args, sc, profile, other)
+    from motionhyst.analysis.plausibility import check_stroke
+
+    check_stroke(args.length, "--length")  # once it is not refused: a refusal is one line
+    if other is not None and args.other_length is not None:
+        check_stroke(args.other_length, "--other-length")
     loop = sc.loop()
     from motionhyst.scan.ilc import ILCFilters
     from motionhyst.scan.scanning import run_scan

@@ -76,9 +76,6 @@ def _reference(args: argparse.Namespace, sc):
                   for k, v in PROFILE_DEFAULTS.items()}
         if limits["distance"] == 0:
             raise UsageError("motionhyst simulate: --distance must be non-zero")
-        from motionhyst.analysis.plausibility import check_stroke
-
-        check_stroke(limits["distance"], "--distance")
         ref = PointToPoint(**limits)
         return (ref, ref.duration + 0.2,
                 f"point-to-point move of {limits['distance']:g} m")
@@ -168,7 +165,10 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
     remedy = _check_size(args, sc, ref, duration)
-    from motionhyst.analysis.plausibility import check_plausible
+    from motionhyst.analysis.plausibility import check_plausible, check_stroke
+
+    if args.profile:  # once it is not refused: a refusal is one line
+        check_stroke(ref.distance, "--distance")
 
     if isinstance(ref, SineReference):
         check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz])
