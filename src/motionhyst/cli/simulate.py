@@ -133,7 +133,7 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
     with in_the_commands_terms(sc, remedy):
         rows, per_row, _ = time_series_grid(duration, output_rate, step, rate,
                                             at_least=rate is None and pole is None,
-                                            step_set_by=why)
+                                            set_by=why)
         check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy)
     return remedy
 

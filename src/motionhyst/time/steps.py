@@ -22,10 +22,10 @@ from collections.abc import Iterator, Sequence
 from motionhyst.core.budget import BudgetError, check_memory, check_work
 
 __all__ = ["BYTES_PER_SAMPLE", "MAX_ROWS", "MAX_SAMPLES", "MAX_SCAN_STEPS", "MAX_STEPS",
-           "RUN_REMEDY",
-           "SCAN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "STEPS_PER_POLE_PERIOD",
-           "STEPS_PER_REFERENCE_PERIOD", "RunTooLarge", "a_run", "check_scan_steps",
-           "check_steps_work", "longest_step", "pole_step", "step_set_by", "time_series_grid"]
+           "RUN_REMEDY", "SCAN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP",
+           "STEPS_PER_POLE_PERIOD", "STEPS_PER_REFERENCE_PERIOD", "RunTooLarge", "a_run",
+           "check_scan_steps", "check_steps_work", "longest_step", "pole_step", "step_set_by",
+           "time_series_grid"]
 
 STEPS_PER_POLE_PERIOD = 40
 """Time steps per period of the loop's fastest closed-loop pole."""
@@ -304,7 +304,7 @@ work budget of 1 s (--max-seconds); shorten the setpoint, or give the link fewer
 
 def time_series_grid(duration: float, output_rate_hz: float, step: float,
                      sample_rate_hz: float | None = None, at_least: bool = False,
-                     step_set_by: str = "") -> tuple[int, int, float]:
+                     set_by: str = "") -> tuple[int, int, float]:
     """The rows, the steps a row and the step of a time series written at `output_rate_hz`,
     refused above :data:`MAX_ROWS` rows or :data:`MAX_STEPS` steps.
 
@@ -326,9 +326,8 @@ def time_series_grid(duration: float, output_rate_hz: float, step: float,
     at_least : bool
         The steps a row are a lower bound (the loop's step is not known yet); the
         message says so.
-    step_set_by : str
-        What sets `step`, for the message (``"the reference's frequency"``, ``"the loop's
-        fastest closed-loop pole, 1e+10 Hz"``); "": the message does not say.
+    set_by : str
+        What sets `step`, for the message (:func:`step_set_by`); "": the message does not say.
 
     Returns
     -------
@@ -379,7 +378,7 @@ def time_series_grid(duration: float, output_rate_hz: float, step: float,
                           f"samples at {sample_rate_hz:g} Hz: too many (at most "
                           f"{MAX_SAMPLES:.0e})", "shorten the duration")
     if n_rows > MAX_ROWS or n_rows * per_row > MAX_STEPS:
-        why = f" (a step of {step:.3g} s: {step_set_by})" if step_set_by else ""
+        why = f" (a step of {step:.3g} s: {set_by})" if set_by else ""
         raise RunTooLarge(f"{n_rows} rows of {'at least ' if at_least else ''}{per_row} steps "
                           f"each: too many time steps{why} (at most {MAX_ROWS:.0e} rows, "
                           f"{MAX_STEPS:.0e} steps)", "lower the frequency, the output rate "

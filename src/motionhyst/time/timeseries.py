@@ -214,7 +214,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
         float(np.max(np.abs(loop.closed_loop_poles()))), _reference_frequency(reference))
     n_rows, per_row, step = time_series_grid(
         duration, output_rate_hz, dynamics_step(loop, reference),
-        None if loop.sampled is None else loop.sampled.sample_rate_hz, step_set_by=why)
+        None if loop.sampled is None else loop.sampled.sample_rate_hz, set_by=why)
     end = (n_rows - 1) * period_out
     window = move = None
     if isinstance(reference, SineReference):
