@@ -142,6 +142,31 @@ def test_a_parameter_that_ran_away_is_a_warning():
                      "value)"]
 
 
+def test_a_stiffness_near_its_final_start_has_not_run_away():
+    """The final search of a stiff friction link on an axis starts from the Coulomb fit's
+    values at its rigid limit (k near 2 fc / (1e-5 of the output's RMS)) when they fit
+    better than the short runs' best: a stiffness that ends near that start has not run
+    away, however far the short runs' value was (a Jenkins axis of k 1e8 N/m, the short runs
+    held at their starts: main said "link.k[0] = 1.97e+07 ran 1.4e+04 times above its
+    start"; EMPS, one Maxwell-slip element: 5.3e+11 times, with the stiffness's standard
+    error 19 %)."""
+    rng = np.random.default_rng(0)
+    t = np.arange(2500) / FS
+    u = (30 + 90 * np.sin(2 * np.pi * 0.6 * t + 0.2) + 40 * np.sin(2 * np.pi * 1.7 * t + 0.4)
+         + 15 * np.sin(2 * np.pi * 4.1 * t + 0.1))
+    y, _ = simulate_elements(MassDamper(TRUE["m"], TRUE["c"]).mechanics(),
+                             Jenkins(k=1e8, fc=TRUE["link.fc"]).time_stepping(),
+                             u - TRUE["input_offset"], FS, 20, periodic=False,
+                             x0=np.array([0.0, TRUE["v0"]]))
+    rec = IORecord(t, u, y + TRUE["output_offset"] + 1e-7 * rng.standard_normal(t.size))
+    fit = identify_io([rec], "maxwell-slip", plant="mass-damper", substeps=20, n_elements=1,
+                      start_nfev=1)
+    assert not any("ran" in line for line in fit.warnings), fit.warnings
+    for name in ("m", "c", "link.fc[0]", "input_offset"):
+        assert fit.estimates[name] == pytest.approx(TRUE[name.split("[")[0]], rel=0.02), name
+    assert 1e7 < fit.estimates["link.k[0]"] < 1e9
+
+
 def test_init_window_fits_the_model_the_way_predict_scores_it():
     """With an initialisation window the state of each record is set from its first samples
     inside the fit (not estimated): from exact data the axis and its force offset are

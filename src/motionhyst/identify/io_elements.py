@@ -777,8 +777,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                                           scale[:n_base], strict=True)
              if lin and nm not in not_ident and abs(x) <= 1e-9 * sc]
     # a positive parameter searched as a logarithm has no bound: one that ran orders of
-    # magnitude from its start is at the edge of the model's range all the same
-    runaway = {nm: x / x0 for nm, x, x0, lg in zip(names[:n_base], v[:n_base], best[1][:n_base],
+    # magnitude from the final search's start (the short runs' best or the rigid seed) is at
+    # the edge of the model's range all the same
+    runaway = {nm: x / x0 for nm, x, x0, lg in zip(names[:n_base], v[:n_base],
+                                                    prob.values(q0)[:n_base],
                                                     prob.log[:n_base], strict=True)
                if lg and x0 > 0 and not RUNAWAY ** -1 < x / x0 < RUNAWAY}
     masses = {nm: float(x) for nm, x in zip(prob.plant.PARAMETERS, v, strict=False)
