@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from scipy import signal
 
-from motionhyst.hysteresis import BoucWen, Dahl, LuGre, MaxwellSlip
+from motionhyst.hysteresis import BoucWen, Dahl, Hysteresis, LuGre, MaxwellSlip
 from motionhyst.plants import QuasiStatic
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
 
@@ -165,12 +165,14 @@ def piezo_record(history: str = "sines", seed: int = 0, fs: float = 5000.0,
 
 
 def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
-                  seconds: float = 40.0, link: str | None = None,
-                  stiffening: float = 0.0, drift: float = 0.0) -> Record:
+                  seconds: float = 40.0, link: str | Hysteresis | None = None,
+                  stiffening: float = 0.0, drift: float = 0.0,
+                  plant: QuasiStatic | None = None) -> Record:
     """A friction damper's record: displacement imposed, force measured (with offset, noise).
 
     `history`: ``"sines"`` (0.2 to 2 Hz, 3 to 20 mm) or ``"earthquake"`` (20 mm peak);
-    `link`: a name of :data:`DAMPER_LINKS` (default :data:`DAMPER_LINK`); `stiffening`: the
+    `link`: a name of :data:`DAMPER_LINKS` or a link (default :data:`DAMPER_LINK`); `plant`:
+    its spring (a neighbour of :data:`DAMPER_PLANT`); `stiffening`: the
     share by which its spring stiffens over the record (a rubber part warming up), which no
     model of motionhyst describes; `drift`: the displacement at the end of a linear drift
     over the record [m] (the test machine's actuator creeping, a residual displacement).
@@ -182,8 +184,9 @@ def damper_record(history: str = "sines", seed: int = 0, fs: float = 200.0,
     else:
         x = earthquake_like(t, rng, 0.02)
     x = x + drift * t / t[-1]
-    w = force_from_displacement(DAMPER_PLANT, DAMPER_LINK if link is None else
-                                DAMPER_LINKS[link], t, x)
-    w = w + stiffening * DAMPER_PLANT.k * (t / t[-1]) * x
+    link = DAMPER_LINK if link is None else DAMPER_LINKS[link] if isinstance(link, str) else link
+    plant = DAMPER_PLANT if plant is None else plant
+    w = force_from_displacement(plant, link, t, x)
+    w = w + stiffening * plant.k * (t / t[-1]) * x
     f = w + DAMPER_FORCE_OFFSET + DAMPER_NOISE * rng.standard_normal(t.size)
     return Record(t, f, x)

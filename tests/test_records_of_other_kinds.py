@@ -221,6 +221,47 @@ def test_a_lugre_damper_s_stribeck_curve_is_found():
     assert fit.fit_rms < 1.1 * DAMPER_NOISE
 
 
+def _neighbour(name: str, i: int):
+    """The damper of ``DAMPER_LINKS[name]`` and its spring with each true parameter (a Dahl
+    link's exponent aside) times a draw from U(0.9, 1.1): a neighbour record's truth."""
+    from motionhyst.plants import QuasiStatic
+
+    rng = np.random.default_rng(1000 + i)
+    true = DAMPER_LINKS[name]
+    varied = {p.name: getattr(true, p.name) * rng.uniform(0.9, 1.1)
+              for p in type(true).parameters if p.name != "alpha"}
+    return QuasiStatic(k=DAMPER_PLANT.k * rng.uniform(0.9, 1.1)), type(true)(**varied)
+
+
+@pytest.mark.parametrize(("name", "i"), [("dahl", 1), ("dahl", 2), ("lugre", 1), ("lugre", 2)])
+def test_the_link_force_searches_find_neighbour_records(name, i):
+    """The searches of the Dahl and LuGre dampers' force fits find the truth on neighbour
+    records too (another noise, every true parameter within 10 %), not only on the records
+    the tests above were written on (the LuGre search had ended in a local minimum on one
+    machine).  Measured on ten neighbours of each (sines, by the force's error; the CLI's
+    logged files for Dahl and LuGre, the plain record for LuGre's Stribeck curve): 10/10
+    each, spring within 0.6 %, fc within 0.2 %, LuGre's fs within 0.6 %, vs within 1 %."""
+    from motionhyst.identify.io_quasi_static import identify_link_force
+    from motionhyst.identify.io_records import IORecord
+
+    plant, true = _neighbour(name, i)
+    record = damper_record("sines", seed=1 + 10 * i, fs=100.0, seconds=30.0, link=true,
+                           plant=plant)
+    fit = identify_link_force([IORecord(record.t, record.force, record.displacement)],
+                              type(true))
+    est = fit.estimates
+    assert est["k"] == pytest.approx(plant.k, rel=0.02)
+    assert est["link.fc"] == pytest.approx(true.fc, rel=0.01)
+    if name == "lugre":
+        assert est["link.fs"] == pytest.approx(true.fs, rel=0.02)
+        assert est["link.vs"] == pytest.approx(true.vs, rel=0.05)
+        assert est["link.sigma0"] == pytest.approx(true.sigma0, rel=0.03)
+        assert est["c"] == pytest.approx(true.sigma2, rel=0.02)
+    else:
+        assert est["link.k"] == pytest.approx(true.k, rel=0.03)
+    assert fit.fit_rms < 1.1 * DAMPER_NOISE
+
+
 def test_a_piezo_that_creeps_beyond_the_model_is_refused(capsys, tmp_path):
     # creep of 20 % of the spring's displacement: the model fitted to the sines explained 90 %
     # of a held-out history (measured); its systematic error on the sines is 3.4 % (measured)
