@@ -107,6 +107,7 @@ from motionhyst.identify.io_bouc_wen import identify_bouc_wen_msd, identify_bouc
 from motionhyst.identify.io_budget import EvaluationBudget
 from motionhyst.identify.io_checks import (
     FitFailed,
+    StiffFit,
     budget_note,
     check_inertia,
     viscous_direction_note,
@@ -275,7 +276,9 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         Maxwell-slip: records that do not determine every element's stiffness and slip force
         (:func:`~motionhyst.identify.io_uncertainty.undetermined`) are fitted again with as
         many elements as the fit determined (at least 1: the Jenkins element), said in a
-        warning; else the fit is judged as it is.
+        warning, and so is a fit refused for an element stiffer than they resolve
+        (:class:`~motionhyst.identify.io_checks.StiffFit`: with one element fewer); else the
+        fit is judged as it is.
     rigid_limit : bool
         A Jenkins link (or a Maxwell-slip link of one element, a Jenkins link) on a
         mass-damper whose stiffness the records do not resolve (not
@@ -416,11 +419,19 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                              f"{init_window} samples")
     fewer, budget = None, EvaluationBudget(max_evaluations)  # the whole search's, refits too
     while True:
-        fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps,
-                     tol=tol, max_nfev=max_nfev, n_elements=n_elements, start_nfev=start_nfev,
-                     offset=offset, from_rest=from_rest, max_evaluations=budget,
-                     init_window=init_window, asymmetric=asymmetric, drift=drift,
-                     t_start=t_start, rigid_limit=rigid_limit, rigid=rigid)
+        try:
+            fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps,
+                         tol=tol, max_nfev=max_nfev, n_elements=n_elements,
+                         start_nfev=start_nfev, offset=offset, from_rest=from_rest,
+                         max_evaluations=budget, init_window=init_window,
+                         asymmetric=asymmetric, drift=drift, t_start=t_start,
+                         rigid_limit=rigid_limit, rigid=rigid)
+        except StiffFit:  # an element stiffer than the records resolve: one fewer
+            if not (fewer_elements and link is MaxwellSlip and n_elements > 1):
+                raise
+            fewer = (fewer[0] if fewer else n_elements, n_elements - 1)
+            n_elements -= 1
+            continue
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
         failed = None
         try:  # parameters the records do not determine: a warning, or (most) a failed fit

@@ -32,7 +32,7 @@ __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTIO
            "DIRECTION_SIGNIFICANCE", "DIRECTION_TOP",
            "MASS_FACTOR", "MASS_SHARE", "MASS_SIGMAS", "MAX_PREDICT_SUBSTEPS",
            "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE",
-           "FitFailed", "budget_note", "check_inertia", "default_plant", "flat_profile",
+           "FitFailed", "StiffFit", "budget_note", "check_inertia", "default_plant", "flat_profile",
            "hysteresis_gain", "judge_fit", "linear_mass_std", "noise_cost",
            "plausibility_warnings", "systematic_share", "viscous_direction",
            "viscous_direction_note"]
@@ -67,6 +67,19 @@ class FitFailed(RuntimeError):
     ... except RuntimeError as exc:   # the command line's error: one line, exit 2
     ...     print(exc)
     the fit failed: its prediction is not finite
+    """
+
+
+class StiffFit(FitFailed):
+    """A fit whose model needs more integration steps per sample than ``predict`` takes (a
+    link stiffer than the records resolve, or a mass collapsed): a Maxwell-slip link may be
+    fitted again with fewer elements.
+
+    Examples
+    --------
+    >>> isinstance(StiffFit("the fit failed: the identified model needs 3643 integration "
+    ...                     "steps per sample"), FitFailed)
+    True
     """
 
 
@@ -125,7 +138,7 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
         from motionhyst.time.openloop import STEPS_PER_MODE_PERIOD
 
         mode = r * records[0].fs / STEPS_PER_MODE_PERIOD
-        raise FitFailed(f"the fit failed: the identified model needs {r} integration steps per "
+        raise StiffFit(f"the fit failed: the identified model needs {r} integration steps per "
                         f"sample (its fastest mode at {mode:.3g} Hz, {mode / records[0].fs:.3g} "
                         f"times the sampling rate: a link stiffer than the records resolve, or "
                         f"a mass collapsed); if the records show no inertia, use --plant "
