@@ -24,6 +24,7 @@ from motionhyst.scenario import default_scenario_path
 FS = 1000.0
 QUASI_STATIC = ('[stage]\ntype = "quasi-static"\nk = 1e4\nc = 5.0\n\n'
                 '[hysteresis]\nmodel = "jenkins"\nk = 2e4\nfc = 4.0\n')
+PAPER = default_scenario_path().read_text()
 
 
 def _table(columns: dict[str, np.ndarray]) -> str:
@@ -60,7 +61,7 @@ def _reversed_damper(path) -> None:
     path.write_text(_table({"time": r.t, "displacement": r.displacement, "force": -r.force}))
 
 
-BASE = {"qs.toml": QUASI_STATIC, "paper.toml": default_scenario_path().read_text(),
+BASE = {"qs.toml": QUASI_STATIC, "paper.toml": PAPER,
         "f.csv": _table({k: v for k, v in _stage().items() if k != "displacement"}),
         "stage.csv": _table(_stage()), "cl.csv": _closed_loop(), "notes.txt": "my notes"}
 CLOSED_LOOP = ["identify", "cl.csv", "--scenario", "paper.toml"]
