@@ -459,11 +459,13 @@ def _check_slips(path: Path, ident, y1) -> None:
              if e["fc"] / e["k"] < SLIP_SHARE * half and e["fc_std"] < e["fc"]]
     if not shown:
         e = min(ident.elements, key=lambda e: e["fc"] / e["k"])
+        std = (f"+- {g(e['fc_std'])} N" if math.isfinite(e["fc_std"])
+               else "N, its standard error not determined")
         raise ValueError(
             f"{path}: no hysteresis in the record: no element both slips in it and has a slip "
             f"force the record determines (the smallest slip displacement fitted, fc/k = "
-            f"{g(e['fc'] / e['k'])} m against y1's half-range {g(half)} m; fc {g(e['fc'])} +- "
-            f"{g(e['fc_std'])} N): the link force inferred through the plant follows y1 as a "
+            f"{g(e['fc'] / e['k'])} m against y1's half-range {g(half)} m; fc {g(e['fc'])} "
+            f"{std}): the link force inferred through the plant follows y1 as a "
             f"spring's, or is noise (y1 not in metres? u and y1 swapped? the plant not the "
             f"record's?); nothing identified")
 

@@ -46,7 +46,7 @@ def add_parser(sub) -> None:
                    help="a measured record of the same samples (time,force,displacement): the "
                         "model's initial state (velocity, and position or the position's "
                         "offset) is set from its first --init-window samples, and the error "
-                        "from that sample on is reported (the benchmark convention)")
+                        "after them is reported (the benchmark convention)")
     q.add_argument("--init-window", type=int, metavar="N",
                    help=f"with --init-from: samples that set the state (default "
                         f"{INIT_WINDOW}, the EMPS benchmark's)")
@@ -132,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
               f"{summary['displacement_peak']:.4g} m")
         if pred is not None:
             print(f"  initial position {pred.initial_state['position']:.6g} m, velocity "
-                  f"{pred.initial_state['velocity']:.6g} m/s; RMS error from sample {window} "
+                  f"{pred.initial_state['velocity']:.6g} m/s; RMS error from sample {window + 1} "
                   f"on {pred.rmse:.4g} m (fit {pred.fit_percent:.2f} %)")
             if pred.floor_text():
                 print(f"  ({pred.floor_text()})")

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 
 from motionhyst.cli._common import (
     UsageError,
@@ -44,9 +43,9 @@ def run(args: argparse.Namespace) -> int:
     if not args.time_series:
         refuse_unused(args, TIME_SERIES_ONLY, "without --time-series (it shapes the transient "
                       "run written to CSV)")
-        print("motionhyst simulate: without --time-series this computes the periodic steady "
-              "state; the command for that is now `motionhyst steady`", file=sys.stderr)
-        return steady.run(args)
+        return steady.run(args, notice="motionhyst simulate: without --time-series this "
+                          "computes the periodic steady state; the command for that is now "
+                          "`motionhyst steady`")
     # the loop is built (python-control) once the run's options and files are checked
     return _time_series(args, load_scenario(args.scenario, check=False))
 

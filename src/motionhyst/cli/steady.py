@@ -5,6 +5,7 @@ next to the describing function's prediction (paper section V, eq. 18).
 from __future__ import annotations
 
 import argparse
+import sys
 
 from motionhyst.cli._common import (
     distinct,
@@ -18,8 +19,10 @@ from motionhyst.cli._common import (
 __all__ = []
 
 
-def run(args: argparse.Namespace) -> int:
-    """Exact periodic steady state of the nonlinear loop, next to the describing function."""
+def run(args: argparse.Namespace, notice: str = "") -> int:
+    """Exact periodic steady state of the nonlinear loop, next to the describing function;
+    `notice` (an old spelling's) goes to stderr once the input is checked, before the work: a
+    refusal stays one line."""
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
@@ -37,6 +40,8 @@ def run(args: argparse.Namespace) -> int:
         option = "--no-floquet" if args.command == "steady" else "motionhyst steady --no-floquet"
         check_floquet_budget(loop, freqs, remedy=f"give fewer frequencies ({given}) or leave "
                                                  f"the multipliers out ({option})")
+    if notice:
+        print(notice, file=sys.stderr)
     result = compare_with_describing_function(loop, amplitude, freqs,  # warns as it starts
                                               floquet=floquet)
     warn_plant_fit(sc)

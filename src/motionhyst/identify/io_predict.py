@@ -3,7 +3,8 @@
 The benchmark convention for models of measured records (the EMPS benchmark,
 Janot, Gautier and Brunot 2019): the model runs open loop from the force
 alone over the whole record, the first ``N`` samples (``N = 20``) may be used
-to set its initial state, and the error is scored from sample ``N`` on.
+to set its initial state, and the error is scored after them, from sample ``N + 1`` on
+(samples counted from 1, as every message counts them).
 :func:`predict_from_window` estimates the stage's initial state (its
 velocity and its position, or the position offset of a floating stage, which
 is the same thing) by least squares over the window, then simulates the
@@ -48,17 +49,18 @@ class WindowPrediction:
     t, displacement : ndarray
         Time [s] and predicted position [m] (with the estimated position offset).
     window : int
-        Samples used to set the state; the error counts from this sample on.
+        Samples used to set the state; the error counts from the next on (sample
+        ``window + 1``, counted from 1).
     initial_state : dict
         ``{"position": .., "velocity": ..}`` set from the window [m, m/s].
     rmse : float or None
-        RMS error from sample `window` on [m] (None without a measured position).
+        RMS error after the first `window` samples [m] (None without a measured position).
     fit_percent : float or None
         ``100 (1 - ||y - yhat|| / ||y - mean(y)||)`` over the same samples.
     noise_floor : float or None
-        The RMS error from sample `window` on that the measured positions' noise gives the
-        true model, through the state its window sets (:func:`window_noise_floor`) [m]; None
-        where there is no state (a stage without inertia).
+        The RMS error after the first `window` samples that the measured positions' noise
+        gives the true model, through the state its window sets (:func:`window_noise_floor`)
+        [m]; None where there is no state (a stage without inertia).
     noise : float or None
         That noise [m] (the error's third differences:
         :func:`~motionhyst.identify.io_uncertainty.white_noise_variance`).
@@ -69,7 +71,7 @@ class WindowPrediction:
     ...                         {"position": 0.0, "velocity": 0.0}, 1e-3, 90.0, 1e-5, 1e-6)
     >>> print(pred)
     predicted 3 samples, state set from the first 2 (position 0 m, velocity 0 m/s); RMS error
-    from sample 2 on 0.001 m (fit 90.00 %); the positions' noise (1e-06 m), carried by the
+    from sample 3 on 0.001 m (fit 90.00 %); the positions' noise (1e-06 m), carried by the
     state the window sets, gives a true model an RMS error of about 1e-05 m
     """
 
@@ -101,7 +103,7 @@ class WindowPrediction:
              f"(position {self.initial_state['position']:.6g} m, velocity "
              f"{self.initial_state['velocity']:.6g} m/s)")
         if self.rmse is not None:
-            s += (f"; RMS error from sample {self.window} on {self.rmse:.4g} m "
+            s += (f"; RMS error from sample {self.window + 1} on {self.rmse:.4g} m "
                   f"(fit {self.fit_percent:.2f} %)")
         if self.floor_text():
             s += f"; {self.floor_text()}"
@@ -318,8 +320,8 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
 def window_noise_floor(mech, stepping: Stepping, k_link: float, u, fs: float, r: int,
                        position: float, velocity: float, y, window: int, noise: float
                        ) -> float:
-    """The RMS error from sample `window` on that white noise of `noise` [m] on the measured
-    positions gives the true model, its state set from the first `window` of them.
+    """The RMS error after the first `window` samples that white noise of `noise` [m] on the
+    measured positions gives the true model, its state set from those samples.
 
     The state is the least squares of the run over the window (:func:`state_from_window`):
     its error is ``B e_w``, ``B = (S_w^T S_w)^-1 S_w^T`` with ``S`` the run's sensitivity to
@@ -374,7 +376,7 @@ def window_noise_floor(mech, stepping: Stepping, k_link: float, u, fs: float, r:
 
 
 def _scored(tt, yhat, y, window, position, velocity) -> WindowPrediction:
-    """The prediction with its error from sample `window` on."""
+    """The prediction with its error after the first `window` samples."""
     if not np.all(np.isfinite(yhat)):
         raise ValueError("the model's prediction is not finite")
     e = yhat[window:] - y[window:]
