@@ -104,18 +104,54 @@ def add_parser(sub) -> None:
     q.set_defaults(func=run)
 
 
-def _profile(args, length: float, speed: float):
+def _profile(args, length: float, speed: float, rated: bool = True):
+    """The setpoint of `length` and `speed`, its switching instants on ``--rate``'s samples
+    unless not `rated`."""
     from motionhyst.scan.profiles import point_to_point, scan
 
+    rate = args.rate if rated else None
     if args.point_to_point:
         if args.back_and_forth or args.dwell:
             raise UsageError(f"{PROG}: --back-and-forth and --dwell apply to scans, not to "
                              "--point-to-point")
         return point_to_point(length, speed, args.a_max, args.j_max, args.s_max,
-                              rate_hz=args.rate, start=LEAD_IN)
+                              rate_hz=rate, start=LEAD_IN)
     return scan(length, speed, args.a_max, args.j_max, args.s_max,
-                back_and_forth=args.back_and_forth, dwell=args.dwell, rate_hz=args.rate,
+                back_and_forth=args.back_and_forth, dwell=args.dwell, rate_hz=rate,
                 start=LEAD_IN)
+
+
+RATE_STRETCH = 1.1
+"""A setpoint whose switching instants on ``--rate``'s samples last longer than this times the
+setpoint asked for is said in a warning: its peak acceleration, jerk and snap are below the
+limits given."""
+
+
+def _check_rate_resolves(args: argparse.Namespace, length: float, speed: float, profile,
+                         what: str = "setpoint") -> str:
+    """Refuse a ``--rate`` whose sample period is longer than the setpoint's acceleration
+    (its snap, jerk and acceleration phases as the limits give them): on its samples every
+    phase is at least one period, a move of another time scale than the one asked for, whose
+    peak acceleration is far below ``--a-max``.  A rate that resolves the acceleration but
+    still stretches the setpoint by more than :data:`RATE_STRETCH` is said in a warning:
+    returned, for the caller to issue once every setpoint is checked ("" for none).  `what`
+    names the setpoint (the carry-over setpoint's options differ)."""
+    if args.rate is None:
+        return ""
+    asked = _profile(args, length, speed, rated=False)
+    ramp = sum(asked.durations[:3])
+    period = 1.0 / args.rate
+    got = (f"{g(asked.duration, 3)} s -> {g(profile.duration, 3)} s, peak acceleration "
+           f"{g(profile.reached()['acceleration'], 3)} m/s^2 for --a-max {g(args.a_max)}")
+    if period > ramp:
+        raise UsageError(f"{PROG}: --rate {args.rate:g} Hz: its sample period {g(period, 3)} s "
+                         f"is longer than the {what}'s acceleration ({g(ramp, 3)} s): "
+                         f"with its switching instants on the samples it is another move "
+                         f"({got}); give the controller's rate (above {g(1.0 / ramp, 3)} Hz)")
+    if profile.duration > RATE_STRETCH * asked.duration:
+        return (f"--rate {args.rate:g} Hz: the {what}'s switching instants on its samples "
+                f"stretch the move ({got})")
+    return ""
 
 
 def _output(args):
@@ -186,20 +222,24 @@ def _check_rate(args: argparse.Namespace, sc) -> None:
 
 def _profiles(args: argparse.Namespace):
     """The setpoint and the carry-over setpoint (None unless a compensation learns),
-    each checked against the exposure window."""
+    each checked against the exposure window and ``--rate``, and the warnings of a rate that
+    stretches them."""
     learns = {"ilc", "basis"} & set(args.compensation or ["ilc"])
     try:
         profile = _profile(args, args.length, args.speed)
+        stretched = [_check_rate_resolves(args, args.length, args.speed, profile)]
         other = None
         if learns:
-            other = _profile(args, args.other_length or args.length,
-                             args.other_speed or 0.5 * args.speed)
+            length, speed = args.other_length or args.length, args.other_speed or 0.5 * args.speed
+            other = _profile(args, length, speed)
+            stretched.append(_check_rate_resolves(args, length, speed, other, "carry-over "
+                                                  "setpoint (--other-length, --other-speed)"))
     except ValueError as exc:
         raise UsageError(f"{PROG}: {exc}") from None
     for p in (profile, other):
         if p is not None:
             p.check_window(args.window)
-    return profile, other
+    return profile, other, [w for w in stretched if w]
 
 
 def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
@@ -207,6 +247,7 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
     elements), before its loop is built: the step is the loop's own where its coefficients
     give its poles (:func:`pole_step`; an unstable loop is refused there), else at most the
     sampled controller's period or the setpoint's (:func:`longest_step`)."""
+    from motionhyst.scan.profiles import check_window_samples
     from motionhyst.time.steps import (
         check_scan_steps,
         check_steps_work,
@@ -233,6 +274,11 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
                           f"{g(pole / math.tau)} Hz" + (f" ({cause})" if cause else "")
                           + f"; {REMEDY}")
             n = check_scan_steps(p.end + args.tail, step, runs, remedy, at_least=pole is None)
+            if pole is not None or rate is not None:  # the run's own step: known
+                try:
+                    check_window_samples(args.window, step, "give a longer --window")
+                except ValueError as exc:
+                    raise UsageError(f"{PROG}: --window: {exc}") from None
             with in_the_commands_terms(sc, REMEDY):
                 check_steps_work(n, (sc.hysteresis(),), REMEDY)
 
@@ -284,8 +330,12 @@ def run(args: argparse.Namespace) -> int:
     out = _output(args)
     _check_model_terms(args, sc)
     _check_at(args, sc)
-    profile, other = _profiles(args)
+    profile, other, stretched = _profiles(args)
     _check_steps(args, sc, profile, other)
+    from motionhyst.core.warnings import warn
+
+    for text in stretched:  # once nothing is refused: a refusal is one line
+        warn(text)
     from motionhyst.analysis.plausibility import check_stroke
 
     check_stroke(args.length, "--length")  # once it is not refused: a refusal is one line

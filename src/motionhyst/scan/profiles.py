@@ -32,7 +32,7 @@ from itertools import combinations, pairwise
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["Profile", "point_to_point", "scan"]
+__all__ = ["Profile", "check_window_samples", "point_to_point", "scan"]
 
 #: Names of the derivatives returned by :meth:`Profile.derivatives`, in order.
 DERIVATIVES = ("position", "velocity", "acceleration", "jerk", "snap")
@@ -162,6 +162,46 @@ def _whole_samples(durations, period: float, scan_time: float | None = None):
     nv = ns + nj + na + up(scan_time) if scan_time is not None else max(
         up(durations[3]), ns + nj + na)
     return ns * period, nj * period, na * period, nv * period
+
+
+def check_window_samples(window: float, step: float, remedy: str = "give a longer window"
+                         ) -> None:
+    """Refuse an exposure `window` that holds one sample of a run of time step `step`.
+
+    The window centred on a sample holds the samples with ``|t_k - t| <= W / 2``: below two
+    steps only the sample itself, whose moving standard deviation is 0 and moving average
+    the error itself, whatever the error does.  Nothing is measured over the window then.
+
+    Parameters
+    ----------
+    window : float
+        The exposure window ``W`` [s].
+    step : float
+        The run's time step [s].
+    remedy : str
+        What the caller can change, for the message.
+
+    Raises
+    ------
+    ValueError
+        One line: the window, the step and the shortest window that holds three samples.
+
+    Examples
+    --------
+    >>> check_window_samples(0.01, 3.62e-5)
+    >>> try:
+    ...     check_window_samples(1e-9, 3.62e-5)
+    ... except ValueError as exc:
+    ...     print(exc)
+    the exposure window 1e-09 s is shorter than two time steps of the run (3.62e-05 s): it \
+holds one sample, whose moving standard deviation is 0 and moving average the error itself; \
+give a longer window (at least 7.24e-05 s)
+    """
+    if window < 2.0 * step * (1.0 - 1e-9):
+        raise ValueError(f"the exposure window {window:.3g} s is shorter than two time steps "
+                         f"of the run ({step:.3g} s): it holds one sample, whose moving "
+                         f"standard deviation is 0 and moving average the error itself; "
+                         f"{remedy} (at least {2.0 * step:.3g} s)")
 
 
 def _check_positive(**values: float) -> None:

@@ -38,7 +38,7 @@ from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis.along_stroke import AlongStroke
 from motionhyst.scan.basis import BasisResult, learn_basis
 from motionhyst.scan.ilc import ILCFilters, ILCResult, learn
-from motionhyst.scan.profiles import PHASE_COLORS, Profile, shade_phases
+from motionhyst.scan.profiles import PHASE_COLORS, Profile, check_window_samples, shade_phases
 from motionhyst.scan.terms import TERMS, FeedforwardTerms, model_terms
 from motionhyst.time.simulation import default_step, simulate
 from motionhyst.time.steps import check_scan_steps
@@ -594,6 +594,7 @@ class _Setup:
         bare = self.bare
         step = default_step(bare, profile.max_frequency_hz) if dt is None else dt
         check_scan_steps(duration, step, len(comps))  # each run keeps its signals
+        check_window_samples(self.window, step)
         advance = 0.0 if bare.ff is None or bare.sampled is None else (
             bare.ff.advance_samples * bare.sampled.period)
         averaged = None if bare.sampled is not None else step  # see setpoint_samples
