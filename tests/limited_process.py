@@ -50,20 +50,24 @@ def environment(**changes: str | None) -> dict[str, str]:
     return env
 
 
-def _limiter(limit: int):
+def _limiter(limit: int, file_limit: int | None = None):
     def limit_address_space() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        if file_limit is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (file_limit, file_limit))
     return limit_address_space
 
 
 def popen(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,
-          env: dict[str, str] | None = None, **kwargs) -> subprocess.Popen:
-    """``motionhyst argv`` started in `cwd` under an address-space limit of `limit` bytes
-    (its stdout and stderr pipes unless `kwargs` say otherwise)."""
+          env: dict[str, str] | None = None, file_limit: int | None = None,
+          **kwargs) -> subprocess.Popen:
+    """``motionhyst argv`` started in `cwd` under an address-space limit of `limit` bytes,
+    and a file size limit of `file_limit` bytes if given (``ulimit -f``: a disk that holds
+    no more), its stdout and stderr pipes unless `kwargs` say otherwise."""
     kwargs = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE, **kwargs}
     return subprocess.Popen([sys.executable, "-c", MAIN, *argv], cwd=cwd,
                             env=environment() if env is None else env,
-                            preexec_fn=_limiter(limit), **kwargs)
+                            preexec_fn=_limiter(limit, file_limit), **kwargs)
 
 
 def run(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,

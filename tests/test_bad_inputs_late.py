@@ -1,6 +1,7 @@
 """Inputs that ran to an answer without a word, or refused only after the work (issue 26:
 every refusal within 2 s of start, 0 exit-0 answers from undetermined inputs): an exposure
-window that holds one sample, a controller rate that cannot resolve the setpoint.
+window that holds one sample, a controller rate that cannot resolve the setpoint, a time
+series larger than the disk holds (a file size limit, ``ulimit -f``, stands for a full disk).
 
 The corpus cases run the command line in a child process under an address-space limit
 (:mod:`limited_process`), in a folder holding the user's files, and assert exit code 2, one
@@ -11,6 +12,7 @@ file there before byte-identical afterwards, with no file added.
 from __future__ import annotations
 
 import limited_process
+import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
@@ -20,7 +22,22 @@ from motionhyst.scenario import default_scenario_path
 PAPER = default_scenario_path().read_text()
 SCAN = ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max",
         "1000", "--s-max", "1e6", "--compensation", "none"]
-BASE = {"s.toml": PAPER, "notes.txt": "my notes"}
+SIMULATE = ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5"]
+QUASI_STATIC = ('[stage]\ntype = "quasi-static"\nk = 10.0\n\n'
+                '[hysteresis]\nmodel = "jenkins"\nk = 20.0\nfc = 0.05\n')
+FILE_LIMIT = 10 << 20
+"""A file size limit [bytes] for the cases that write a time series: 10 MiB."""
+
+
+def _displacement_record(n: int) -> str:
+    """time,displacement: `n` samples of a 1 mm sine at 2 Hz, sampled at 1 kHz."""
+    t = np.arange(n) / 1000.0
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    return "time,displacement\n" + "".join(f"{a:.17g},{b:.17g}\n"
+                                            for a, b in zip(t, x, strict=True))
+
+
+BASE = {"s.toml": PAPER, "notes.txt": "my notes", "ts.csv": "an old time series\n"}
 
 # (id, extra files, argv, words of the one line on stderr)
 CASES = [
@@ -45,6 +62,26 @@ CASES = [
 ]
 
 
+# (id, extra files, argv, words of the one line on stderr): run under FILE_LIMIT
+WRITERS = [
+    # 5e7 rows of 8 numbers: 8.4 GB (was written until the limit killed the command)
+    ("simulate-a-time-series-larger-than-the-disk-holds", {},
+     [*SIMULATE, "--force", "--output-rate", "1e9", "--duration", "0.05"],
+     ["--time-series ts.csv: 5e+07 rows of 8 numbers needs 8.4 GB, above the 10.5 MB a file "
+      "may take (the file size limit, ulimit -f); lower --output-rate (1e+09 Hz) or shorten "
+      "--duration (0.05 s), or write --time-series where there is room"]),
+    ("scan-a-time-series-larger-than-the-disk-holds", {},
+     [*SCAN, "--tail", "10", "--time-series", "new.csv"],
+     ["--time-series new.csv: 2.81e+05 rows of 6 numbers needs 35.4 MB, above the 10.5 MB",
+      "or --tail", "or write --time-series where there is room"]),
+    ("predict-a-force-larger-than-the-disk-holds",
+     {"m.toml": QUASI_STATIC, "d.csv": _displacement_record(300_000)},
+     ["predict", "m.toml", "d.csv", "--out", "p.csv"],
+     ["--out p.csv: 3e+05 rows of 2 numbers needs 15 MB, above the 10.5 MB a file may take",
+      "give a shorter record, or write --out where there is room"]),
+]
+
+
 def test_the_cases_are_distinct():
     assert len({c[0] for c in CASES}) == len(CASES)
 
@@ -58,6 +95,48 @@ def test_a_case_refuses_in_one_line_and_touches_nothing(tmp_path, files, argv, w
     for word in words:
         assert word in line, (word, line)
     assert snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize(("files", "argv", "words"), [c[1:] for c in WRITERS],
+                         ids=[c[0] for c in WRITERS])
+def test_an_output_that_does_not_fit_is_refused_before_the_work(tmp_path, files, argv, words):
+    populate(tmp_path, {**BASE, **files})
+    before = snapshot(tmp_path)
+    line = limited_process.refusal(argv, tmp_path, file_limit=FILE_LIMIT, timeout=120)
+    for word in words:
+        assert word in line, (word, line)
+    assert snapshot(tmp_path) == before
+
+
+def test_a_time_series_s_rows_count_in_its_work(tmp_path):
+    """5e7 rows of a step each: 3.4 min of work at 1.5 us a step and 2.5 us a row (1e6 such
+    rows measured at 4 s), above a budget of one minute; the remedy names --output-rate."""
+    populate(tmp_path, BASE)
+    before = snapshot(tmp_path)
+    line = limited_process.refusal([*SIMULATE, "--force", "--output-rate", "1e9", "--duration",
+                                    "0.05", "--max-seconds", "60"], tmp_path, timeout=120)
+    assert line.endswith("a run of 5e+07 time steps, 5e+07 rows written would take about "
+                         "3.4 min, above the work budget of 1 min (--max-seconds); shorten "
+                         "--duration, or lower --output-rate"), line
+    assert snapshot(tmp_path) == before
+
+
+def test_the_disk_s_free_space_bounds_a_file(tmp_path, monkeypatch):
+    """Without a file size limit the free space of the output's folder is the budget."""
+    import resource
+    import shutil
+
+    from motionhyst.core.budget import BudgetError, check_disk
+
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: shutil._ntuple_diskusage(
+        10 ** 9, 10 ** 9 - 2 * 10 ** 6, 2 * 10 ** 6))
+    monkeypatch.setattr(resource, "getrlimit", lambda which: (resource.RLIM_INFINITY,) * 2)
+    check_disk(1.9e6, tmp_path / "new-folder", "a file")
+    with pytest.raises(BudgetError) as err:
+        check_disk(8.4e9, tmp_path / "new-folder", "--time-series ts.csv: 5e+07 rows",
+                   "lower --output-rate")
+    assert str(err.value) == (f"--time-series ts.csv: 5e+07 rows needs 8.4 GB, above the 2 MB "
+                              f"free in {tmp_path}; lower --output-rate")
 
 
 def test_a_rate_that_stretches_the_setpoint_is_said(capsys):

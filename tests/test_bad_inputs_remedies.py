@@ -70,7 +70,8 @@ CASES = [
     ("simulate-link-of-100000-elements-over-the-work-budget",
      {"s.toml": _maxwell_slip(100_000)},
      ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "20", "--duration", "20"],
-     ["a run of 6e+05 time steps of a link of 100000 elements would take about",
+     ["a run of 6e+05 time steps of a link of 100000 elements, 2e+05 rows written would take "
+      "about",
       "(--max-seconds); shorten --duration, or give the link fewer elements ([hysteresis])"],
      ["lower its frequencies"]),
     ("simulate-sampled-loop-of-too-many-controller-samples", {"s.toml": PAPER_10KHZ.read_text()},

@@ -14,6 +14,9 @@ __all__ = []
 
 INIT_WINDOW = 20  # the EMPS benchmark's initialisation window [samples]
 
+SHORTER = "give a shorter record, or write --out where there is room"
+"""What the user of ``predict`` can change when its output does not fit."""
+
 
 def add_parser(sub) -> None:
     """Add the ``predict`` command to the subparsers `sub`."""
@@ -91,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
                        columns=_only(args.columns) if both else args.columns,
                        scale=_only(args.scale) if both else args.scale)
     t, u = data[:, 0], data[:, 1]
+    target.check_csv_size(t.size, 2, "%.17g", remedy=SHORTER)
     if args.periodic:
         check_whole_periods(u, str(args.data))
     _check_step(system, t, args)
@@ -195,6 +199,7 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     data = read_record(args.data, ("time", "displacement"), columns=args.columns,
                        scale=args.scale)
     t, x = data[:, 0], data[:, 1]
+    target.check_csv_size(t.size, 2, "%.17g", remedy=SHORTER)
     if args.periodic:
         check_whole_periods(x, str(args.data))
     from motionhyst.identify.displacement_noise import estimate_displacement

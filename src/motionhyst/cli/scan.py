@@ -242,11 +242,13 @@ def _profiles(args: argparse.Namespace):
     return profile, other, [w for w in stretched if w]
 
 
-def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
+def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None:
     """Refuse a scan of far too many time steps, or of too much work (a link of many
     elements), before its loop is built: the step is the loop's own where its coefficients
     give its poles (:func:`pole_step`; an unstable loop is refused there), else at most the
-    sampled controller's period or the setpoint's (:func:`longest_step`)."""
+    sampled controller's period or the setpoint's (:func:`longest_step`).  An exposure window
+    that holds one of those steps, and a ``--time-series`` (`out`) that does not fit where it
+    is written, are refused too."""
     from motionhyst.scan.profiles import check_window_samples
     from motionhyst.time.steps import (
         check_scan_steps,
@@ -274,6 +276,10 @@ def _check_steps(args: argparse.Namespace, sc, profile, other) -> None:
                           f"{g(pole / math.tau)} Hz" + (f" ({cause})" if cause else "")
                           + f"; {REMEDY}")
             n = check_scan_steps(p.end + args.tail, step, runs, remedy, at_least=pole is None)
+            if out is not None and p is profile:  # time, r, scan; e, ma, msd of each run
+                out.check_csv_size(n, 3 + 3 * (runs + (args.compensation is None)),
+                                   remedy=f"{REMEDY}, or write --time-series where there "
+                                   f"is room")
             if pole is not None or rate is not None:  # the run's own step: known
                 try:
                     check_window_samples(args.window, step, "give a longer --window")
@@ -331,7 +337,7 @@ def run(args: argparse.Namespace) -> int:
     _check_model_terms(args, sc)
     _check_at(args, sc)
     profile, other, stretched = _profiles(args)
-    _check_steps(args, sc, profile, other)
+    _check_steps(args, sc, profile, other, out)
     from motionhyst.core.warnings import warn
 
     for text in stretched:  # once nothing is refused: a refusal is one line

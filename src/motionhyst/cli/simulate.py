@@ -88,7 +88,7 @@ def _reference(args: argparse.Namespace, sc):
             f"r = {amplitude:g} m sin(2 pi {freqs[0]:g} t)")
 
 
-def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
+def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
     """Refuse a run of far too many rows or steps, or of too much work (a link of many
     elements), before its loop is built: the step is the
     loop's own where its coefficients give its poles (:func:`~motionhyst.time.steps.pole_step`;
@@ -96,7 +96,9 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
     reference's (:func:`~motionhyst.time.steps.longest_step`; a file's samples do not set
     it).  The refusal names what sets the step (the reference's frequency, or the loop's
     fastest pole and the ``[stage]`` value that likely makes it fast) and the options that
-    shorten the run.  Returns that remedy, for the run's own refusals."""
+    shorten the run.  A CSV that would not fit where `out` is written (the disk's free
+    space, the file size limit) is refused too, naming ``--output-rate`` and ``--duration``.
+    Returns that remedy, for the run's own refusals."""
     from motionhyst.time.references import SampledReference
     from motionhyst.time.steps import (
         MAX_ROWS,
@@ -106,7 +108,7 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
         step_set_by,
         time_series_grid,
     )
-    from motionhyst.time.timeseries import DEFAULT_OUTPUT_RATE_HZ, reference_rate_hz
+    from motionhyst.time.timeseries import COLUMNS, DEFAULT_OUTPUT_RATE_HZ, reference_rate_hz
 
     controller = sc.model.controller
     sampled = isinstance(ref, SampledReference)
@@ -117,7 +119,8 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
                                                else DEFAULT_OUTPUT_RATE_HZ)
     by_pole = pole is not None and pole_step(pole, f) >= pole_step(pole)
     # the loop's pole or the controller's period sets the step: a lower frequency helps not
-    remedy = _remedy(args, by_pole or rate is not None, duration * output_rate > MAX_ROWS)
+    remedy = _remedy(args, by_pole or rate is not None,
+                     duration * output_rate > MAX_ROWS or args.output_rate is not None)
     if controller is None:  # no loop: the scenario's own refusal comes first
         return remedy
     why = ""
@@ -133,7 +136,10 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float) -> str:
         rows, per_row, _ = time_series_grid(duration, output_rate, step, rate,
                                             at_least=rate is None and pole is None,
                                             set_by=why)
-        check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy)
+        out.check_csv_size(rows, len(COLUMNS), remedy=f"lower --output-rate ({output_rate:g} "
+                           f"Hz) or shorten --duration ({duration:g} s), or write "
+                           f"--time-series where there is room")
+        check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy, rows)
     return remedy
 
 
@@ -141,7 +147,7 @@ def _remedy(args: argparse.Namespace, fixed_step: bool, rows: bool) -> str:
     """What the user of ``simulate --time-series`` can change to make the run smaller: the
     options of its reference (the frequency of a sine, unless the loop sets the step; a
     move's length and speed), ``--duration``, and ``--output-rate`` where the rows are too
-    many."""
+    many or it was given."""
     shorten = ("--duration (or the file)" if args.reference_csv
                else "--duration or the move (--distance, --v-max)" if args.profile
                else "--duration" if fixed_step else "--duration or lower --frequency")
@@ -163,7 +169,7 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
-    remedy = _check_size(args, sc, ref, duration)
+    remedy = _check_size(args, sc, ref, duration, out)
     from motionhyst.analysis.plausibility import check_plausible, check_stroke
 
     if args.profile:  # once it is not refused: a refusal is one line

@@ -61,9 +61,9 @@ import threading
 from collections.abc import Iterator
 
 __all__ = ["DEFAULT_FRACTION", "DEFAULT_SECONDS", "ENV_VARIABLE", "SECONDS_VARIABLE",
-           "BudgetError", "available_memory", "check_memory", "check_work", "cpu_time_limit",
-           "format_duration", "format_size", "max_memory", "max_seconds", "parse_size",
-           "set_max_memory", "set_max_seconds"]
+           "BudgetError", "available_disk", "available_memory", "check_disk", "check_memory",
+           "check_work", "cpu_time_limit", "format_duration", "format_size", "max_memory",
+           "max_seconds", "parse_size", "set_max_memory", "set_max_seconds"]
 
 DEFAULT_FRACTION = 0.5
 """Share of :func:`available_memory` one computation may take unless a budget is given."""
@@ -315,6 +315,85 @@ def check_memory(nbytes: float, what: str, remedy: str = "") -> None:
     if nbytes > budget:
         raise BudgetError(f"{what} needs {format_size(nbytes)}, above the memory budget of "
                           f"{format_size(budget)} (--max-memory)", remedy)
+
+
+def available_disk(folder: str | os.PathLike) -> tuple[int, str]:
+    """Bytes one file written in `folder` may take, and what sets them.
+
+    The free space of its file system for this user (:func:`shutil.disk_usage`; a folder
+    not created yet: its nearest existing parent's), or the process's file size limit
+    (``RLIMIT_FSIZE``, ``ulimit -f``), whichever is smaller.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        The folder the file is written in.
+
+    Returns
+    -------
+    nbytes : int
+        The bytes.
+    what : str
+        What sets them, for a message (``"free in /data"``).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> nbytes, what = available_disk(tempfile.gettempdir())
+    >>> nbytes > 0, what.startswith(("free in", "a file may take"))
+    (True, True)
+    """
+    import shutil
+    from pathlib import Path
+
+    where = Path(os.path.abspath(folder))
+    while not where.is_dir() and where != where.parent:
+        where = where.parent
+    try:
+        free, what = shutil.disk_usage(where).free, f"free in {where}"
+    except OSError:  # a file system that does not say: the limit alone
+        free, what = None, ""
+    soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
+    if soft != resource.RLIM_INFINITY and (free is None or soft < free):
+        return int(soft), "a file may take (the file size limit, ulimit -f)"
+    return (int(free), what) if free is not None else (2 ** 63 - 1, "")
+
+
+def check_disk(nbytes: float, folder: str | os.PathLike, what: str, remedy: str = "") -> None:
+    """Refuse to write a file of `nbytes` into `folder` where it does not fit
+    (:func:`available_disk`), before anything is computed or written.
+
+    Parameters
+    ----------
+    nbytes : float
+        The file's estimated size [bytes].
+    folder : str or path-like
+        Where it is written (a temporary file beside the target, then renamed: the old
+        file stays until the new one is whole).
+    what : str
+        The file, as the message names it (``"--time-series o.csv: 5e+07 rows"``).
+    remedy : str
+        What the user can change.
+
+    Raises
+    ------
+    BudgetError
+        One line: `what` needs so much, above the space there, and `remedy`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> check_disk(1e3, tempfile.gettempdir(), "a small file")
+    >>> try:
+    ...     check_disk(1e30, tempfile.gettempdir(), "out.csv: 1e+28 rows", "lower --output-rate")
+    ... except BudgetError as exc:
+    ...     print(str(exc)[:32], "...", exc.remedy)
+    out.csv: 1e+28 rows needs 1e+18 ... lower --output-rate
+    """
+    budget, where = available_disk(folder)
+    if nbytes > budget:
+        raise BudgetError(f"{what} needs {format_size(nbytes)}, above the "
+                          f"{format_size(budget)} {where}", remedy)
 
 
 def format_duration(seconds: float) -> str:

@@ -526,6 +526,49 @@ class OutputFile:
         with self.open("w") as fh:
             fh.write(text)
 
+    def check_csv_size(self, rows: int, columns: int, fmt: str = CSV_FORMAT,
+                       remedy: str = "") -> None:
+        """Refuse, before the work, a CSV of `rows` rows of `columns` numbers in `fmt` that
+        does not fit where it is written (:func:`~motionhyst.core.budget.check_disk`: the
+        free disk space of its folder, the file size limit).
+
+        A number takes at most the width `fmt` gives ``-1.2345678901234567e-100`` and a
+        separator (``%.12e``: 21 bytes).
+
+        Parameters
+        ----------
+        rows, columns : int
+            The CSV's rows (after its header) and numbers a row.
+        fmt : str
+            printf format of a number.
+        remedy : str
+            What the user can change (the command's options), for the message.
+
+        Raises
+        ------
+        motionhyst.core.budget.BudgetError
+            One line: the file, its rows, their size and the space, and `remedy` (exit 2).
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> out = OutputFile(Path(tempfile.mkdtemp()) / "ts.csv", option="--time-series")
+        >>> out.check_csv_size(1000, 8)                         # 168 kB: written
+        >>> try:
+        ...     out.check_csv_size(10 ** 12, 8, remedy="lower --output-rate")
+        ... except ValueError as exc:
+        ...     print(str(exc).split("ts.csv: ")[1].split(", above")[0])
+        1e+12 rows of 8 numbers needs 168 TB
+        """
+        from motionhyst.core.budget import check_disk
+
+        cell = len(fmt % -1.2345678901234567e-100) + 1
+        nbytes = (rows + 1) * columns * cell
+        check_disk(nbytes, self.target.parent,
+                   f"{_label(self.path, self.option)}: {rows:.3g} rows of {columns} numbers",
+                   remedy)
+
     def write_csv(self, columns: Mapping[str, ArrayLike], fmt: str = CSV_FORMAT) -> None:
         """Write named columns of equal length as a CSV file, atomically (see :meth:`open`).
 
