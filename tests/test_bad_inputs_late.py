@@ -1,7 +1,9 @@
 """Inputs that ran to an answer without a word, or refused only after the work (issue 26:
 every refusal within 2 s of start, 0 exit-0 answers from undetermined inputs): an exposure
 window that holds one sample, a controller rate that cannot resolve the setpoint, a time
-series larger than the disk holds (a file size limit, ``ulimit -f``, stands for a full disk).
+series larger than the disk holds (a file size limit, ``ulimit -f``, stands for a full disk),
+a stage's record and a link's given together (over 120 s of search), a time column in ms
+(its 2e6 kg said only after the fit).
 
 The corpus cases run the command line in a child process under an address-space limit
 (:mod:`limited_process`), in a folder holding the user's files, and assert exit code 2, one
@@ -16,6 +18,7 @@ import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
+from motionhyst import Jenkins
 from motionhyst.cli import main
 from motionhyst.scenario import default_scenario_path
 
@@ -35,6 +38,36 @@ def _displacement_record(n: int) -> str:
     x = 1e-3 * np.sin(2 * np.pi * 2 * t)
     return "time,displacement\n" + "".join(f"{a:.17g},{b:.17g}\n"
                                             for a, b in zip(t, x, strict=True))
+
+
+def _csv(columns: dict[str, np.ndarray]) -> str:
+    rows = np.column_stack(list(columns.values()))
+    return ",".join(columns) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                              for row in rows)
+
+
+def _stage(n: int = 3000, seed: int = 0, time_unit: float = 1.0) -> str:
+    """A positioning axis's record at 1 kHz: a 2 kg mass on viscous friction (10 N s/m) and a
+    Jenkins link (2000 N/m, 1 N) driven by two sines, its position with 0.1 um of noise;
+    its time column in seconds times `time_unit`."""
+    from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.time.openloop import OpenLoop
+
+    t = np.arange(n) / 1000.0
+    u = 5 * np.sin(2 * np.pi * 1.3 * t) + 3 * np.sin(2 * np.pi * 4.1 * t + 0.4)
+    y = OpenLoop(MassDamper(2.0, 10.0), Jenkins(k=2000.0, fc=1.0)).simulate(t, u).displacement
+    y = y + 1e-7 * np.random.default_rng(seed).standard_normal(n)
+    return _csv({"time": t * time_unit, "force": u, "displacement": y})
+
+
+def _link(n: int = 3000) -> str:
+    """A link's force-displacement record at 1 kHz: a Jenkins element with a spring and a
+    damper in parallel, driven by a 1 mm sine at 2 Hz (no mass)."""
+    t = np.arange(n) / 1000.0
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t) * (0.8 + 0.2 * np.cos(2 * np.pi * 0.05 * t))
+    w = (Jenkins(k=40.0, fc=0.01).response(x) + 10 * x + 1.6 * np.gradient(x, t)
+         + 1e-4 * np.random.default_rng(1).standard_normal(n))
+    return _csv({"time": t, "displacement": x, "force": w})
 
 
 BASE = {"s.toml": PAPER, "notes.txt": "my notes", "ts.csv": "an old time series\n"}
@@ -59,6 +92,12 @@ CASES = [
      [*SCAN[:-1], "ilc", "--other-speed", "1e-4", "--rate", "100"],
      ["--rate 100 Hz: its sample period 0.01 s is longer than the carry-over setpoint "
       "(--other-length, --other-speed)'s acceleration"]),
+    # the link's record shows -0.115 +- 0.002 kg, the stage's 1.94 +- 0.02 kg
+    ("identify-a-stage-s-record-and-a-link-s", {"stage.csv": _stage(), "link.csv": _link()},
+     ["identify", "stage.csv", "link.csv", "--record", "input-output"],
+     ["link.csv: no inertia in the force (its inverse-dynamics mass -0.11", "while stage.csv "
+      "shows 1.9", "the records cannot describe one stage; a link's force against an imposed "
+      "displacement is identified on its own, without --record input-output"]),
 ]
 
 
@@ -137,6 +176,33 @@ def test_the_disk_s_free_space_bounds_a_file(tmp_path, monkeypatch):
                    "lower --output-rate")
     assert str(err.value) == (f"--time-series ts.csv: 5e+07 rows needs 8.4 GB, above the 2 MB "
                               f"free in {tmp_path}; lower --output-rate")
+
+
+def test_records_of_one_stage_are_not_refused_as_two(tmp_path):
+    """Two records of the same stage (noise of two seeds) pass the check: the search starts
+    (and here meets its work budget of one second, exit 2, after it)."""
+    populate(tmp_path, {"a.csv": _stage(seed=0), "b.csv": _stage(seed=2)})
+    code, out, err = limited_process.run(["identify", "a.csv", "b.csv", "--record",
+                                          "input-output", "--max-seconds", "1"], tmp_path)
+    assert out == "" and code == 2 and "cannot describe one stage" not in err, err
+    assert err.strip().splitlines()[-1].startswith(
+        "motionhyst: error: identify did not finish within the work budget of 1 s"), err
+
+
+def test_a_time_column_in_ms_is_said_before_the_search(tmp_path):
+    """A time column in ms makes the records' inverse-dynamics mass 1e6 times too large
+    (1.98e6 kg for 2 kg): said before the search, naming the time column and the scale
+    that makes it 1.98 kg (the search then meets its budget of one second)."""
+    populate(tmp_path, {"ms.csv": _stage(time_unit=1000.0)})
+    code, out, err = limited_process.run(["identify", "ms.csv", "--record", "input-output",
+                                          "--max-seconds", "1"], tmp_path)
+    lines = err.strip().splitlines()
+    assert out == "" and code == 2 and len(lines) == 3, err
+    assert lines[0] == ("motionhyst: warning: identify: ms.csv: the records' inverse-dynamics "
+                        "mass is 1.98e+06 kg, outside the usual 0.001-10000 kg of motion "
+                        "stages: is the time column in ms (sampled at 1 Hz)? --scale "
+                        "time=0.001 makes it 1.98 kg"), err
+    assert lines[2].startswith("motionhyst: error: identify did not finish within"), err
 
 
 def test_a_rate_that_stretches_the_setpoint_is_said(capsys):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import warnings
 
 from motionhyst.cli._common import UsageError, g, print_json, table, whole_number
 
@@ -189,18 +190,29 @@ def run_input_output(args: argparse.Namespace) -> int:
     check_response(records)  # a position that does not depend on the force: no fit explains it
     from motionhyst.plants.registry import plant_class
 
+    notes = []  # warnings, once nothing is refused: a refusal is one line
     if plant_class(plant).has_inertia and not args.periodic:  # as identify_io will, but first
         from motionhyst.identify.io_checks import check_inertia
+        from motionhyst.identify.io_consistency import mass_units_note
 
-        check_inertia(records)
+        # the fit would end at a mass of another unit: said before its search
+        notes.append(mass_units_note(records, check_inertia(records)))
+    unit_slip = any(note is not None for note in notes)
     if args.plant is None and not args.periodic:  # a positioning axis: no spring to fit
-        from motionhyst.core.warnings import warn
         from motionhyst.identify.io_checks import default_plant
 
         plant, note = default_plant(records)
+        notes.append(note)
+        bouc_wen_own = model == "bouc-wen" and plant not in ("quasi-static", "mass-damper")
+    if plant_class(plant).has_inertia and not args.periodic:  # the plant now decided
+        from motionhyst.identify.io_consistency import check_one_stage
+
+        check_one_stage(records, floating=plant in ("mass-damper", "two-mass"))
+    from motionhyst.core.warnings import warn
+
+    for note in notes:
         if note is not None:
             warn(note)
-        bouc_wen_own = model == "bouc-wen" and plant not in ("quasi-static", "mass-damper")
     from motionhyst.identify.input_output import MODELS, identify_io
 
     if model not in MODELS:
@@ -217,7 +229,10 @@ def run_input_output(args: argparse.Namespace) -> int:
     from motionhyst.identify.io_checks import FitFailed
 
     try:
-        with search_budget():
+        with search_budget(), warnings.catch_warnings():
+            if unit_slip:  # the fit's own line on the mass's size says it again
+                warnings.filterwarnings("ignore", message=r".* kg, outside the usual .* of "
+                                        r"motion stages: if the records' units are not SI")
             fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
                               n_elements=args.elements or 3, plant=plant_class(plant),
                               output=args.output, **extras)

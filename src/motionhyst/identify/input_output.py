@@ -112,6 +112,7 @@ from motionhyst.identify.io_checks import (
     check_inertia,
     viscous_direction_note,
 )
+from motionhyst.identify.io_consistency import check_one_stage
 from motionhyst.identify.io_elements import PROFILE_CHI2 as PROFILE_CHI2
 from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
@@ -252,7 +253,9 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         (``k, c`` in parallel with the link, any link Bouc-Wen included;
         :mod:`~motionhyst.identify.io_quasi_static`).  A stage with inertia is
         refused before the search (a ValueError) for records that show none
-        (:func:`~motionhyst.identify.io_checks.check_inertia`).  Records whose
+        (:func:`~motionhyst.identify.io_checks.check_inertia`), or among which one shows
+        none and a mass the others do not share
+        (:func:`~motionhyst.identify.io_consistency.check_one_stage`).  Records whose
         position does not depend on their force (noise, another record's position)
         are refused first, whatever the stage
         (:func:`~motionhyst.identify.io_response.check_response`).
@@ -501,6 +504,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
     if asymmetric and not (shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)
     check_inertia(records)  # before the search
+    check_one_stage(records, shape.floating)
     if link is not BoucWen:
         return identify_elements_io(records, link, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,

@@ -378,7 +378,7 @@ def hysteresis_gain(linear_ss: float, residual: NDArray[np.float64]) -> float:
     return gain / noise if noise > 0 else (math.inf if gain > 0 else 0.0)
 
 
-def check_inertia(records: list[IORecord]) -> None:
+def check_inertia(records: list[IORecord]) -> float:
     """Refuse records that show no inertia, before a stage with a mass is fitted to them.
 
     The records' inverse-dynamics estimate (least squares on ``u = m y'' + c y' +
@@ -404,6 +404,12 @@ def check_inertia(records: list[IORecord]) -> None:
     records : list of IORecord
         The records (force in, position out).
 
+    Returns
+    -------
+    float
+        The inverse-dynamics mass that shows the inertia [kg]
+        (:func:`~motionhyst.identify.io_consistency.mass_units_note` judges its size).
+
     Raises
     ------
     ValueError
@@ -416,7 +422,8 @@ def check_inertia(records: list[IORecord]) -> None:
     >>> t = np.arange(2000) / 1000.0
     >>> y = 1e-3 * np.sin(2 * np.pi * 3 * t) + 4e-4 * np.sin(2 * np.pi * 17 * t)
     >>> a = np.gradient(np.gradient(y, t), t)
-    >>> check_inertia([IORecord(t, 2.0 * a + 5e4 * y, y, "stage.csv")])
+    >>> round(check_inertia([IORecord(t, 2.0 * a + 5e4 * y, y, "stage.csv")]), 2)
+    2.0
     >>> try:                                   # stiffer at 17 Hz than at 3 Hz: no mass
     ...     check_inertia([IORecord(t, 5e4 * y + 2e6 * (y - np.convolve(y, np.ones(25) / 25,
     ...                                                             "same")), y, "piezo.csv")])
@@ -435,7 +442,7 @@ def check_inertia(records: list[IORecord]) -> None:
         m, std = _mass_and_std(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
         a_rms = math.sqrt(float(np.mean(np.concatenate([r[:, 0] for r in rows]) ** 2)))
         if m > 0 and m * a_rms > INERTIA_SHARE * u_rms:
-            return
+            return m
         found.append((m, std, m * a_rms / u_rms if u_rms > 0 else 0.0))
     m, std, share = found[0]
     why = "not positive" if m <= 0 else f"m y'' is {share:.2g} of the force's RMS"
