@@ -6,14 +6,15 @@ scenario, an output, a file, a record, the size of a run, an open-loop scenario 
 loop is needed, an unstable controller (lead-lag, sampled at 10 kHz, PID), a frequency
 the loop cannot mean (decades above its fastest pole) and a run whose step
 the loop's poles set (from the scenario's coefficients, before python-control builds
-the loop), a list of a million values, a constant force, an input-output record without
-inertia (its inverse-dynamics estimate), a force that is a curve of the displacement
-without loops, a force whose loops are a damper's, a benchmark without its data folder or
-with a text file for its record, an identification file larger than any, a study's store
-named by a symbolic link, and a record no Maxwell-slip elements describe (a Jenkins
-element, a spring and a damper: loops, but not a stop operator's; a short record and one
-of 60000 samples), refused by a bound on what any of them can leave before the fit that
-took 1.8 s and 26 s of CPU to refuse them.  Each runs as a whole
+the loop), a controller rate or an exposure window that cannot resolve a scan, a list of a
+million values, a constant force, an input-output record without inertia (its
+inverse-dynamics estimate), a stage's record given with a link's, a force that is a curve
+of the displacement without loops, a force whose loops are a damper's, a benchmark without
+its data folder or with a text file for its record, an identification file larger than
+any, a study's store named by a symbolic link, and a record no Maxwell-slip elements
+describe (a Jenkins element, a spring and a damper: loops, but not a stop operator's; a
+short record and one of 60000 samples), refused by a bound on what any of them can leave
+before the fit that took 1.8 s and 26 s of CPU to refuse them.  Each runs as a whole
 process (the interpreter, the imports, the checks) in a folder holding its files,
 ``REPEATS`` times interleaved with the baseline of the same run: ``motionhyst --help``,
 the command's start alone.  Reported per case: the least wall time (the least disturbed
@@ -61,6 +62,21 @@ def _long_jenkins_damper(n: int = 60_000) -> str:
                  + 10.0 * x + 1.6 * np.gradient(x, t))
 
 
+def _stage_and_link(n: int = 3000) -> tuple[str, str]:
+    """A 2 kg axis's input-output record (viscous friction, a Jenkins link) and a link's
+    force-displacement record, which together describe no one stage."""
+    from motionhyst.plants.mass_damper import MassDamper
+    from motionhyst.time.openloop import OpenLoop
+
+    t = np.arange(n) / 750
+    u = 5.0 * np.sin(2 * np.pi * 1.3 * t) + 3.0 * np.sin(2 * np.pi * 4.1 * t + 0.4)
+    y = OpenLoop(MassDamper(2.0, 10.0), Jenkins(k=2000.0, fc=1.0)).simulate(t, u).displacement
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t) * (0.8 + 0.2 * np.cos(2 * np.pi * 0.05 * t))
+    return (_rows("time,force,displacement", t, u, y),
+            _rows("time,displacement,force", t, x, Jenkins(k=40.0, fc=0.01).response(x)
+                  + 10.0 * x + 1.6 * np.gradient(x, t)))
+
+
 def _files() -> dict[str, str]:
     t = np.arange(600) / 750
     u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
@@ -98,6 +114,7 @@ def _files() -> dict[str, str]:
             "k = 20.0 ", "k = [" + "1.0," * 1_000_000 + "] ").replace(
             "fc = 0.05 ", "fc = [" + "0.01," * 1_000_000 + "] "),  # a million elements
         "io.csv": _rows("time,force,displacement", t, u, u / 5e4),  # a spring: no inertia
+        **dict(zip(("io-stage.csv", "fd-link.csv"), _stage_and_link(), strict=True)),
         "io-missing.csv": _rows("time,force", t, u),
         "f.mat": "time,force\n0,1\n",
     }
@@ -123,6 +140,9 @@ CASES = [
     ("unstable PID loop", ["steady", "unstable-pid.toml"], "checks"),
     ("scan steps of the loop", ["scan", "s.toml", *SCAN, "--tail", "1e4"], "checks"),
     ("scan rate", ["scan", "s.toml", *SCAN, "--rate", "1e-3"], "checks"),
+    ("scan window", ["scan", "s.toml", *SCAN, "--window", "1e-9"], "checks"),
+    ("records of two systems", ["identify", "io-stage.csv", "fd-link.csv", "--record",
+                                "input-output"], "checks"),
     ("a million elements", ["steady", "slip.toml"], "checks"),
     ("constant force", ["identify", "fd-zero.csv"], "checks"),
     ("no inertia", ["identify", "io.csv", "--record", "input-output"], "checks"),
