@@ -13,6 +13,8 @@ file there before byte-identical afterwards, with no file added.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import limited_process
 import numpy as np
 import pytest
@@ -103,7 +105,7 @@ CASES = [
 
 # (id, extra files, argv, words of the one line on stderr): run under FILE_LIMIT
 WRITERS = [
-    # 5e7 rows of 8 numbers: 8.4 GB (was written until the limit killed the command)
+    # 5e7 rows of 8 numbers: 8.4 GB (main wrote 10 MiB, then failed with "File too large")
     ("simulate-a-time-series-larger-than-the-disk-holds", {},
      [*SIMULATE, "--force", "--output-rate", "1e9", "--duration", "0.05"],
      ["--time-series ts.csv: 5e+07 rows of 8 numbers needs 8.4 GB, above the 10.5 MB a file "
@@ -216,3 +218,27 @@ def test_a_rate_that_stretches_the_setpoint_is_said(capsys):
                       "instants on its samples stretch the move (0.142 s -> 0.18 s, peak "
                       "acceleration 5 m/s^2 for --a-max 10)"], captured.err
     assert "scan of 0.01 m at 0.1 m/s: 0.18 s; peak acceleration 5 m/s^2" in captured.out
+
+
+def test_an_infinite_standard_error_is_not_printed_as_a_figure():
+    """A closed-loop record refused for an element it cannot determine: its slip force's
+    infinite standard error is said as not determined, never ``+- inf``."""
+    from types import SimpleNamespace
+
+    from motionhyst.cli.identify import _check_slips
+
+    ident = SimpleNamespace(elements=[{"k": 7.102, "fc": 71.02, "fc_std": float("inf")}])
+    with pytest.raises(ValueError) as err:
+        _check_slips(Path("cl.csv"), ident, np.array([-10.0, 10.0]))
+    assert "fc 71.02 N, its standard error not determined)" in str(err.value)
+    assert "+- inf" not in str(err.value)
+
+
+def test_predict_counts_the_first_scored_sample_from_one():
+    """After a window of 20 samples the error is scored from the 21st, as the finite checks
+    count samples (from 1)."""
+    from motionhyst.identify.io_predict import WindowPrediction
+
+    pred = WindowPrediction(np.arange(100) / 1e3, np.zeros(100), 20,
+                            {"position": 0.0, "velocity": 0.0}, 1e-6, 99.0)
+    assert "; RMS error from sample 21 on 1e-06 m" in str(pred)
