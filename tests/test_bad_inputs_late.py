@@ -80,20 +80,20 @@ CASES = [
     ("scan-window-shorter-than-a-step", {}, [*SCAN, "--window", "1e-9"],
      ["scan: --window: the exposure window 1e-09 s is shorter than two time steps of the run "
       "(3.62e-05 s): it holds one sample, whose moving standard deviation is 0",
-      "give a longer --window (at least 7.23e-05 s)"]),
+      "give a longer --window (at least 7.24e-05 s)"]),
     ("scan-window-of-one-sample", {}, [*SCAN, "--window", "7e-5"],
      ["--window: the exposure window 7e-05 s is shorter than two time steps"]),
-    # the setpoint's acceleration lasts 21 ms: on 1 s samples the move of 0.142 s takes 9 s
+    # on 1 s samples the move of 0.142 s takes 9 s
     ("scan-rate-slower-than-the-move", {}, [*SCAN, "--rate", "1"],
-     ["scan: --rate 1 Hz: its sample period 1 s is longer than the setpoint's acceleration "
-      "(0.021 s)", "(0.142 s -> 9 s, peak acceleration 0.05 m/s^2 for --a-max 10)",
-      "give the controller's rate (above 47.6 Hz)"]),
-    # 100 Hz resolves the setpoint (a warning) but not the carry-over setpoint at 0.1 mm/s:
-    # the refusal alone, one line
+     ["scan: --rate 1 Hz cannot resolve the setpoint: its switching instants on the samples "
+      "make another move (0.142 s -> 9 s, peak acceleration 0.05 m/s^2 for --a-max 10); give "
+      "the controller's rate"]),
+    # 100 Hz stretches the setpoint 1.27 times (a warning) and the carry-over setpoint of
+    # 0.1 mm at 10 mm/s 3.6 times: the refusal alone, one line
     ("scan-rate-of-the-carry-over", {},
-     [*SCAN[:-1], "ilc", "--other-speed", "1e-4", "--rate", "100"],
-     ["--rate 100 Hz: its sample period 0.01 s is longer than the carry-over setpoint "
-      "(--other-length, --other-speed)'s acceleration"]),
+     [*SCAN[:-1], "ilc", "--other-length", "1e-4", "--other-speed", "1e-2", "--rate", "100"],
+     ["--rate 100 Hz cannot resolve the carry-over setpoint (--other-length, --other-speed): "
+      "its switching instants on the samples make another move (0.0248 s -> 0.09 s"]),
     # the link's record shows -0.115 +- 0.002 kg, the stage's 1.94 +- 0.02 kg
     ("identify-a-stage-s-record-and-a-link-s", {"stage.csv": _stage(), "link.csv": _link()},
      ["identify", "stage.csv", "link.csv", "--record", "input-output"],
@@ -205,6 +205,18 @@ def test_a_time_column_in_ms_is_said_before_the_search(tmp_path):
                         "stages: is the time column in ms (sampled at 1 Hz)? --scale "
                         "time=0.001 makes it 1.98 kg"), err
     assert lines[2].startswith("motionhyst: error: identify did not finish within"), err
+
+
+def test_a_rate_whose_samples_are_longer_than_a_short_snap_is_not_refused(tmp_path):
+    """A snap pulse of 8 us (s-max 1e12) on a 10 kHz controller's samples: the setpoint of
+    1 s lasts 1 s on them, a move the rate resolves; the run goes on (here to the work budget
+    of a millisecond, refused before the loop)."""
+    populate(tmp_path, BASE)
+    line = limited_process.refusal(["scan", "s.toml", "--length", "1e-3", "--speed", "1e-3",
+                                    "--a-max", "100", "--j-max", "1e6", "--s-max", "1e12",
+                                    "--rate", "10000", "--compensation", "none",
+                                    "--max-seconds", "0.001"], tmp_path)
+    assert "--rate" not in line and "above the work budget of 0.001 s" in line, line
 
 
 def test_a_rate_that_stretches_the_setpoint_is_said(capsys):

@@ -126,28 +126,28 @@ RATE_STRETCH = 1.1
 setpoint asked for is said in a warning: its peak acceleration, jerk and snap are below the
 limits given."""
 
+RATE_REFUSED = 2.0
+"""... and one that lasts longer than this times the setpoint asked for is refused: the rate
+cannot resolve the move, the run would be of another move (1 Hz: 0.142 s -> 9 s)."""
+
 
 def _check_rate_resolves(args: argparse.Namespace, length: float, speed: float, profile,
                          what: str = "setpoint") -> str:
-    """Refuse a ``--rate`` whose sample period is longer than the setpoint's acceleration
-    (its snap, jerk and acceleration phases as the limits give them): on its samples every
-    phase is at least one period, a move of another time scale than the one asked for, whose
-    peak acceleration is far below ``--a-max``.  A rate that resolves the acceleration but
-    still stretches the setpoint by more than :data:`RATE_STRETCH` is said in a warning:
-    returned, for the caller to issue once every setpoint is checked ("" for none).  `what`
-    names the setpoint (the carry-over setpoint's options differ)."""
+    """Refuse a ``--rate`` whose samples cannot resolve the setpoint: its switching instants on
+    them make it last more than :data:`RATE_REFUSED` times the setpoint the limits give (a
+    move of another time scale, its peak acceleration far below ``--a-max``).  One that
+    stretches it by more than :data:`RATE_STRETCH` is said in a warning: returned, for the
+    caller to issue once every setpoint is checked ("" for none).  `what` names the setpoint
+    (the carry-over setpoint's options differ)."""
     if args.rate is None:
         return ""
     asked = _profile(args, length, speed, rated=False)
-    ramp = sum(asked.durations[:3])
-    period = 1.0 / args.rate
     got = (f"{g(asked.duration, 3)} s -> {g(profile.duration, 3)} s, peak acceleration "
            f"{g(profile.reached()['acceleration'], 3)} m/s^2 for --a-max {g(args.a_max)}")
-    if period > ramp:
-        raise UsageError(f"{PROG}: --rate {args.rate:g} Hz: its sample period {g(period, 3)} s "
-                         f"is longer than the {what}'s acceleration ({g(ramp, 3)} s): "
-                         f"with its switching instants on the samples it is another move "
-                         f"({got}); give the controller's rate (above {g(1.0 / ramp, 3)} Hz)")
+    if profile.duration > RATE_REFUSED * asked.duration:
+        raise UsageError(f"{PROG}: --rate {args.rate:g} Hz cannot resolve the {what}: its "
+                         f"switching instants on the samples make another move ({got}); "
+                         f"give the controller's rate")
     if profile.duration > RATE_STRETCH * asked.duration:
         return (f"--rate {args.rate:g} Hz: the {what}'s switching instants on its samples "
                 f"stretch the move ({got})")

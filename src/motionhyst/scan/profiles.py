@@ -198,10 +198,12 @@ holds one sample, whose moving standard deviation is 0 and moving average the er
 give a longer window (at least 7.24e-05 s)
     """
     if window < 2.0 * step * (1.0 - 1e-9):
+        least = 2.0 * step  # said rounded up: the figure given is then not refused
+        scale = 10.0 ** (math.floor(math.log10(least)) - 2)
         raise ValueError(f"the exposure window {window:.3g} s is shorter than two time steps "
                          f"of the run ({step:.3g} s): it holds one sample, whose moving "
                          f"standard deviation is 0 and moving average the error itself; "
-                         f"{remedy} (at least {2.0 * step:.3g} s)")
+                         f"{remedy} (at least {math.ceil(least / scale) * scale:.3g} s)")
 
 
 def _check_positive(**values: float) -> None:
