@@ -119,8 +119,12 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
                                                else DEFAULT_OUTPUT_RATE_HZ)
     by_pole = pole is not None and pole_step(pole, f) >= pole_step(pole)
     # the loop's pole or the controller's period sets the step: a lower frequency helps not
+    # a lower output rate shortens the run where its rows are too many, or where it sets the
+    # step (a row every step, finer than the loop's poles need); not where they set it
+    finer = (args.output_rate is not None and pole is not None
+             and 1.0 / args.output_rate < pole_step(pole, f))
     remedy = _remedy(args, by_pole or rate is not None,
-                     duration * output_rate > MAX_ROWS or args.output_rate is not None)
+                     duration * output_rate > MAX_ROWS or finer)
     if controller is None:  # no loop: the scenario's own refusal comes first
         return remedy
     why = ""
@@ -147,7 +151,7 @@ def _remedy(args: argparse.Namespace, fixed_step: bool, rows: bool) -> str:
     """What the user of ``simulate --time-series`` can change to make the run smaller: the
     options of its reference (the frequency of a sine, unless the loop sets the step; a
     move's length and speed), ``--duration``, and ``--output-rate`` where the rows are too
-    many or it was given."""
+    many or it sets the step."""
     shorten = ("--duration (or the file)" if args.reference_csv
                else "--duration or the move (--distance, --v-max)" if args.profile
                else "--duration" if fixed_step else "--duration or lower --frequency")
