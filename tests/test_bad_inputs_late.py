@@ -166,10 +166,12 @@ def test_the_disk_s_free_space_bounds_a_file(tmp_path, monkeypatch):
     """Without a file size limit the free space of the output's folder is the budget."""
     import resource
     import shutil
+    from collections import namedtuple
 
     from motionhyst.core.budget import BudgetError, check_disk
 
-    monkeypatch.setattr(shutil, "disk_usage", lambda path: shutil._ntuple_diskusage(
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(
         10 ** 9, 10 ** 9 - 2 * 10 ** 6, 2 * 10 ** 6))
     monkeypatch.setattr(resource, "getrlimit", lambda which: (resource.RLIM_INFINITY,) * 2)
     check_disk(1.9e6, tmp_path / "new-folder", "a file")

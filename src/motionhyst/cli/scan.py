@@ -377,6 +377,8 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         if "feedforward" in str(exc) or "inverse" in str(exc) or "P2" in str(exc):
             raise UsageError(f"{PROG}: {exc}") from None
+        if str(exc).startswith("the exposure window"):  # a step known once the loop is built
+            raise UsageError(f"{PROG}: --window: {exc}") from None
         raise
     if out is not None:
         out.write_csv(res.columns())
