@@ -190,6 +190,11 @@ def run(args: argparse.Namespace) -> int:
 
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
+        from motionhyst.identify.fd_memory import check_elements_fit_memory
+
+        # its checks, the bound (where it runs) and the fit, before any of them
+        check_elements_fit_memory(t.size, str(path), bound=args.elements is None
+                                  or target is not None)
         from motionhyst.identify.displacement_noise import estimate_displacement
 
         x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
@@ -371,6 +376,11 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         records.append((path, t, x, w))
     from motionhyst.hysteresis import model_class
+    from motionhyst.identify.fd_memory import check_link_force_memory
+
+    nu = None if args.nu in (None, "free") else args.nu
+    check_link_force_memory([t.size for _, t, _, _ in records], model_class(args.model),
+                            args.elements or 3, nu)  # before the starts are fitted
     from motionhyst.identify.io_quasi_static import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
@@ -380,7 +390,7 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
             fit = identify_link_force([IORecord(t, w, x, str(p)) for p, t, x, w in records],
                                       model_class(args.model), n_elements=args.elements or 3,
                                       max_evaluations=args.max_evaluations,
-                                      nu=None if args.nu in (None, "free") else args.nu)
+                                      nu=nu)
     except (ValueError, RuntimeError) as exc:
         raise type(exc)(f"{names}: {exc}") from None
     result = {**fit.to_dict(), "record": "force-displacement",
@@ -482,10 +492,11 @@ def _refuse_beyond_bound(path: Path, x, w) -> None:
     (:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`), the fit would end in
     :func:`_judge_elements`'s refusal after its work.  The checks that name another cause
     (no hysteresis, a sensor's sign reversed) stay the fit's: the bound leaves them alone."""
+    from motionhyst.identify.fd_memory import bound_columns
     from motionhyst.identify.fit import systematic_share_bound
     from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed
 
-    bound = systematic_share_bound(x, w)
+    bound = systematic_share_bound(x, w, max_columns=bound_columns(x.size))
     if bound > SYSTEMATIC_SHARE:
         raise FitFailed(f"{path}: no Maxwell-slip elements describe this record: any number "
                         f"of them leave a systematic error of at least {100 * bound:.2g} % of "

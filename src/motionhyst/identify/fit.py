@@ -84,8 +84,8 @@ BOUND_PER_DECADE = 4
 
 
 BOUND_COLUMNS = 2000
-"""Most stop operators of :func:`systematic_share_bound` (its refinement stops there; the
-bound then allows for the error of the coarsest interval left)."""
+"""Most stop operators of :func:`systematic_share_bound` (its refinement stops short of more;
+the bound then allows for the error of the coarsest interval left)."""
 
 
 BOUND_ROWS = 5000
@@ -637,7 +637,8 @@ def fit_rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:
     return np.arange(start, n, stride)
 
 
-def _bound_columns(x: NDArray[np.float64], rows: NDArray[np.intp], h: float
+def _bound_columns(x: NDArray[np.float64], rows: NDArray[np.intp], h: float,
+                   max_columns: int = BOUND_COLUMNS
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
     """The stop operators per unit slip force of :func:`systematic_share_bound`, at `rows`.
 
@@ -646,9 +647,9 @@ def _bound_columns(x: NDArray[np.float64], rows: NDArray[np.intp], h: float
     the motion since the last reversal) up to `h`, :data:`BOUND_PER_DECADE` a decade from
     1e-12 `h` on, and every interval whose geometric mean's column is farther than
     :data:`BOUND_TOLERANCE` (RMS) from the nearest blend of its ends' is halved, until none
-    is or there are :data:`BOUND_COLUMNS`.  Returns the slip displacements (ascending), the
-    columns and how closely they stand for the slip displacements between them (the
-    tolerance, or the error of the coarsest interval left).
+    is or halving them all would make more than `max_columns`.  Returns the slip
+    displacements (ascending), the columns and how closely they stand for the slip
+    displacements between them (the tolerance, or the error of the coarsest interval left).
     """
     steps = np.abs(np.diff(x))
     zero = min(max(0.25 * float(steps[steps > 0].min()), np.finfo(float).tiny), h)
@@ -672,14 +673,15 @@ def _bound_columns(x: NDArray[np.float64], rows: NDArray[np.intp], h: float
         coarse = [(j, a, b) for j, (a, b) in enumerate(pending)
                   if error[j] > BOUND_TOLERANCE and b > a * (1.0 + 1e-12)]
         pending = [pair for j, a, b in coarse for pair in ((a, mids[j]), (mids[j], b))]
-        if pending and len(cols) + len(pending) // 2 > BOUND_COLUMNS:
+        if pending and len(cols) + len(pending) > max_columns:
             left = max(float(error[j]) for j, _, _ in coarse)
             break
     d = np.array(sorted(cols))
     return d, np.column_stack([cols[v] for v in d.tolist()]), left
 
 
-def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROWS) -> float:
+def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROWS,
+                           max_columns: int = BOUND_COLUMNS) -> float:
     """A lower bound, before any fit, of the systematic error any Maxwell-slip elements leave
     in a force-displacement record (:func:`~motionhyst.identify.io_checks.systematic_share`
     of the whole record, the elements' initial forces and the offset fitted).
@@ -708,6 +710,10 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     max_rows : int
         Most samples in the residual (pairs of successive samples, evenly strided); the
         stop operators run on every one.
+    max_columns : int
+        Most stop operators (their memory: about seven copies of `max_rows` x
+        `max_columns`, :func:`motionhyst.identify.fd_memory.bound_columns`); fewer make a
+        lower bound.
 
     Returns
     -------
@@ -747,7 +753,7 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     stride = max(2, math.ceil((xs.size - 1 - start) / max(max_rows // 2, 1)))
     first = np.arange(start, xs.size - 1, stride)
     rows = np.column_stack([first, first + 1]).ravel()
-    d, A, tolerance = _bound_columns(xs, rows, 0.5 * float(np.ptp(xs)))
+    d, A, tolerance = _bound_columns(xs, rows, 0.5 * float(np.ptp(xs)), max_columns)
     y = ws[rows]
     A = A - A.mean(axis=0)
     y = y - y.mean()

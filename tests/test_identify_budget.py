@@ -1,0 +1,139 @@
+"""identify's memory budget on every route, from the record's length, before any of its work
+(issue 26): the force-displacement fits (Maxwell-slip elements, a link by the force's
+error).  Each refusal is exit 2 and one line naming what takes the memory and the remedy;
+a fit within its estimate runs within that much address space."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import limited_process
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from motionhyst.hysteresis import Jenkins, MaxwellSlip
+from motionhyst.identify import fd_memory
+
+FS = 1000.0
+
+
+def _fd_record(path: Path, n: int) -> None:
+    """A force-displacement record of two Maxwell-slip elements, `n` samples at 1 kHz, 0.01 N
+    of force noise."""
+    t = np.arange(n) / FS
+    x = 1e-3 * np.sin(2 * np.pi * t) + 3e-4 * np.sin(2 * np.pi * 3.3 * t)
+    w = (MaxwellSlip(k=[1e4, 2e4], fc=[1.0, 8.0]).response(x)
+         + 0.01 * np.random.default_rng(1).standard_normal(n))
+    np.savetxt(path, np.column_stack([t, x, w]), delimiter=",", fmt="%.9g",
+               header="time,displacement,force", comments="")
+
+
+def _io_record(path: Path, n: int) -> None:
+    """An input-output record of `n` samples (MATLAB): any force and position, for the checks
+    that come before the records are looked at."""
+    rng = np.random.default_rng(2)
+    savemat(path, {"time": (np.arange(n) / FS)[:, None],
+                   "force": rng.standard_normal((n, 1)),
+                   "displacement": np.cumsum(rng.standard_normal(n))[:, None] * 1e-6})
+
+
+IO_COLUMNS = ["--columns", "time=time,force=force,displacement=displacement"]
+
+
+def test_the_elements_fit_of_a_force_displacement_record_is_refused_above_the_budget(tmp_path):
+    """`identify fd.csv --max-memory 20M` exited 0: its rows were bounded but not budgeted.
+    Now its checks and fit (78 MB for 2e4 samples) are sized before any of them runs."""
+    _fd_record(tmp_path / "fd.csv", 20_000)
+    need = fd_memory.elements_fit_memory(20_000)
+    assert 60e6 < need["fit"] < need["total"] == need["bound"] < 100e6
+    line = limited_process.refusal(["identify", "fd.csv", "--max-memory", "20M"], tmp_path)
+    assert line.startswith("motionhyst: error: fd.csv: the Maxwell-slip fit of 20000 samples "
+                           "needs 92 MB, above the memory budget of 21 MB (--max-memory); the "
+                           "bound of what any elements leave takes 92 MB, the fit 78 MB"), line
+    assert line.endswith("a larger --max-memory if the machine has it, or a shorter record")
+
+
+@pytest.mark.parametrize("model", ["maxwell-slip", "dahl", "lugre", "bouc-wen"])
+def test_a_link_fitted_by_the_force_error_is_refused_above_the_budget(tmp_path, model):
+    """Every link of --model on a force-displacement record (and a quasi-static stage's
+    input-output record, the same search) is sized before its starts are fitted (the old
+    code ran its search; --max-seconds keeps that short)."""
+    _fd_record(tmp_path / "fd.csv", 20_000)
+    line = limited_process.refusal(["identify", "fd.csv", "--model", model, "--max-memory",
+                                    "20M", "--max-seconds", "20", "--save", "m.toml"],
+                                   tmp_path)
+    assert line.startswith(f"motionhyst: error: identify's {model} fit of a force-displacement "
+                           f"record (20000 samples, "), line
+    assert "above the memory budget of 21 MB (--max-memory)" in line, line
+    assert "the elements' fit it starts from 78 MB" in line, line
+    assert not (tmp_path / "m.toml").exists()
+
+
+def test_the_link_fit_counts_its_parameters_and_the_larger_of_its_phases():
+    one = fd_memory.link_force_memory([50_000], 6)
+    assert one["total"] == one["starts"] > one["search"]
+    # the starts' fit holds at most MAX_ROWS rows; the search's Jacobian grows with samples
+    many = fd_memory.link_force_memory([500_000], 12)
+    assert many["total"] == many["search"] > many["starts"]
+    assert many["search"] - fd_memory.link_force_memory([500_000], 11)["search"] == 6 * 8 * 5e5
+
+
+def test_the_bound_holds_fewer_stop_operators_within_a_small_budget(monkeypatch):
+    """The bound of what any elements leave takes as many stop operators as the budget holds:
+    2000 within a large one, fewer (a lower bound still) within a small one."""
+    from motionhyst.core.budget import set_max_memory
+    from motionhyst.identify.fit import BOUND_COLUMNS, systematic_share_bound
+
+    try:
+        set_max_memory(1 << 40)
+        assert fd_memory.bound_columns(20_000) == BOUND_COLUMNS
+        set_max_memory(200 << 20)
+        columns = fd_memory.bound_columns(20_000)
+        assert fd_memory.MIN_BOUND_COLUMNS < columns < BOUND_COLUMNS
+        assert fd_memory.elements_fit_memory(20_000, columns)["bound"] <= 200 << 20
+        set_max_memory(20 << 20)  # refused by the estimate, which counts the fewest
+        assert fd_memory.bound_columns(20_000) == fd_memory.MIN_BOUND_COLUMNS
+    finally:
+        set_max_memory(None)
+    t = np.arange(3000) / 750
+    x = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    w = Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x + 1.6 * np.gradient(x, t)
+    full = systematic_share_bound(x, w)
+    few = systematic_share_bound(x, w, max_columns=fd_memory.MIN_BOUND_COLUMNS)
+    assert full == pytest.approx(0.0936, abs=5e-4)
+    assert 0.07 < few <= full  # lower, and still a refusal (above 2 %)
+
+
+def test_the_elements_fit_runs_within_its_estimate_and_is_refused_just_below(tmp_path):
+    """The Maxwell-slip fit of 2e4 samples (reading, checks, the bound and the fit, kernels
+    compiled before) runs within its estimate of address space above what the process held,
+    at --max-memory the estimate (measured 66 MB of 92); a byte less is refused."""
+    _fd_record(tmp_path / "fd.csv", 20_000)
+    _fd_record(tmp_path / "small.csv", 2000)
+    script = tmp_path / "within.py"
+    script.write_text(
+        "import contextlib, io, resource, sys, warnings\n"
+        "from motionhyst.cli import main\n"
+        "from motionhyst.identify.fd_memory import elements_fit_memory\n"
+        "warnings.simplefilter('ignore')\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main(['identify', 'small.csv'])\n"
+        "need = int(elements_fit_memory(20000)['total'])\n"
+        "below = main(['identify', 'fd.csv', '--max-memory', str(need - 1)])\n"
+        "with open('/proc/self/status') as f:\n"
+        "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + need,) * 2)\n"
+        "out = io.StringIO()\n"
+        "with contextlib.redirect_stdout(out):\n"
+        "    code = main(['identify', 'fd.csv', '--max-memory', str(need)])\n"
+        "print(below, code, need, out.getvalue().splitlines()[1])\n")
+    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
+                          text=True, env=limited_process.environment(), timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    below, code, _, elements = proc.stdout.split(maxsplit=3)
+    assert (below, code) == ("2", "0"), proc.stdout
+    assert "the Maxwell-slip fit of 20000 samples needs" in proc.stderr
+    assert elements.startswith("elements: 2"), elements
