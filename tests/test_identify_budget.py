@@ -1,7 +1,8 @@
 """identify's memory budget on every route, from the record's length, before any of its work
 (issue 26): the force-displacement fits (Maxwell-slip elements, a link by the force's
-error).  Each refusal is exit 2 and one line naming what takes the memory and the remedy;
-a fit within its estimate runs within that much address space."""
+error), the input-output search's least size before its checks, and the integration steps of
+every plant and link.  Each refusal is exit 2 and one line naming what takes the memory and
+the remedy; a fit within its estimate runs within that much address space."""
 
 from __future__ import annotations
 
@@ -14,8 +15,10 @@ import numpy as np
 import pytest
 from scipy.io import savemat
 
-from motionhyst.hysteresis import Jenkins, MaxwellSlip
-from motionhyst.identify import fd_memory
+from motionhyst.hysteresis import Dahl, Jenkins, MaxwellSlip
+from motionhyst.identify import fd_memory, io_memory, io_start
+from motionhyst.plants.mass_damper import MassDamper
+from motionhyst.plants.mass_spring_damper import MassSpringDamper
 
 FS = 1000.0
 
@@ -70,6 +73,15 @@ def test_a_link_fitted_by_the_force_error_is_refused_above_the_budget(tmp_path, 
     assert "above the memory budget of 21 MB (--max-memory)" in line, line
     assert "the elements' fit it starts from 78 MB" in line, line
     assert not (tmp_path / "m.toml").exists()
+
+
+def test_a_quasi_static_stage_is_sized_as_a_fit_by_the_error(tmp_path):
+    _io_record(tmp_path / "io.mat", 20_000)
+    line = limited_process.refusal(["identify", "io.mat", "--record", "input-output",
+                                    "--plant", "quasi-static", "--model", "dahl", *IO_COLUMNS,
+                                    "--max-memory", "20M", "--max-seconds", "20"], tmp_path)
+    assert line.startswith("motionhyst: error: identify's dahl fit of an input-output record "
+                           "(20000 samples, 7 parameters) needs 78 MB"), line
 
 
 def test_the_link_fit_counts_its_parameters_and_the_larger_of_its_phases():
@@ -137,3 +149,68 @@ def test_the_elements_fit_runs_within_its_estimate_and_is_refused_just_below(tmp
     assert (below, code) == ("2", "0"), proc.stdout
     assert "the Maxwell-slip fit of 20000 samples needs" in proc.stderr
     assert elements.startswith("elements: 2"), elements
+
+
+def test_an_input_output_search_is_refused_from_its_records_length_before_its_checks(
+        tmp_path, monkeypatch):
+    """1e6 samples with --max-memory 50M: the checks before the search took 640 MB and 3.8 s
+    before the search's estimate refused; the least search of the records (693 MB) is
+    refused before any check looks at them."""
+    from motionhyst.identify import io_checks
+
+    need = io_memory.search_floor([1_000_000], 20, MassDamper, Jenkins)
+    assert need["parameters"] == 7
+    full = io_start.search_memory([io_start.IORecord(np.arange(1_000_000) / FS,
+                                                     np.zeros(1_000_000),
+                                                     np.zeros(1_000_000))], 20, 7, 4)
+    assert need["total"] <= full["total"]  # the search's own estimate can only be larger
+    _io_record(tmp_path / "io.mat", 1_000_000)
+    line = limited_process.refusal(["identify", "io.mat", "--record", "input-output",
+                                    "--plant", "mass-damper", "--model", "jenkins",
+                                    *IO_COLUMNS, "--max-memory", "50M"], tmp_path)
+    assert line == ("motionhyst: error: identify's search of 1000000 samples (at least 20 "
+                    "integration steps each, 7 parameters) needs at least 693 MB, above the "
+                    "memory budget of 52.4 MB (--max-memory); its Jacobian's copies take 336 "
+                    "MB, its runs 197 MB, the upsampled force 160 MB: a larger --max-memory "
+                    "if the machine has it, or shorter records"), line
+    from motionhyst.cli import main
+
+    calls = []
+    monkeypatch.setattr(io_checks, "check_inertia", lambda *a: calls.append(a))
+    for options in (["--plant", "two-mass", "--model", "coulomb"], ["--periodic"],
+                    ["--init-window", "20", "--plant", "mass-damper"], []):
+        assert main(["identify", str(tmp_path / "io.mat"), "--record", "input-output",
+                     *IO_COLUMNS, *options, "--max-memory", "50M"]) == 2
+    assert calls == []
+
+
+def test_every_plant_and_link_counts_its_integration_steps_before_the_search(tmp_path,
+                                                                              monkeypatch):
+    """A 3e6-sample axis at 20 steps a sample passed the 5e7-step cap (checked for two-mass
+    stages and Bouc-Wen only); now every stage is checked, in the command before the
+    records are, and in the library once the steps are known."""
+    with pytest.raises(ValueError, match=r"^identify's search of 3000000 samples runs at "
+                                         r"least 20 integration steps a sample \(6e\+07 in "
+                                         r"all\), more than 5e\+07"):
+        io_memory.check_io_floor([3_000_000], MassDamper, Jenkins)
+    _io_record(tmp_path / "io.mat", 3_000_000)
+    line = limited_process.refusal(["identify", "io.mat", "--record", "input-output",
+                                    *IO_COLUMNS, "--max-memory", "8G", "--max-seconds", "20"],
+                                   tmp_path)
+    assert "more than 5e+07 in one simulation of the records; give shorter records" in line
+    from motionhyst.identify.input_output import identify_io
+    from motionhyst.identify.io_records import IORecord
+    from motionhyst.time.openloop import OpenLoop
+
+    monkeypatch.setattr(io_start, "MAX_FINE_SAMPLES", 5000)
+    t = np.arange(400) / FS
+    u = 60.0 * np.sin(2 * np.pi * 3.1 * t) + 25.0 * np.sin(2 * np.pi * 17.3 * t + 1.0)
+    for plant, link, system in (
+            ("mass-damper", "jenkins", OpenLoop(MassDamper(95.0, 200.0), Jenkins(1e6, 20.0))),
+            ("mass-spring-damper", "dahl", OpenLoop(MassSpringDamper(2.0, 10.0, 5e4),
+                                                    Dahl(k=2e4, fc=5.0)))):
+        rec = IORecord(t, u, system.simulate(t, u).displacement)
+        with pytest.raises(ValueError, match=r"^identify's search of 400 samples runs \d+ "
+                                             r"integration steps a sample \([\d.e+]+ in all\): "
+                                             r"more than 5e\+03; give shorter records"):
+            identify_io([rec], link, plant=plant, from_rest=True)

@@ -184,11 +184,22 @@ def run_input_output(args: argparse.Namespace) -> int:
     from motionhyst.identify.io_records import check_records, load_io_csv
 
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
+    from motionhyst.hysteresis import model_class
+    from motionhyst.identify.io_memory import check_io_floor
+    from motionhyst.plants.registry import plant_class
+
+    # the least search of the records, from their lengths, before any check looks at them (a
+    # positioning axis may be chosen from the records below: the smaller of the two counts)
+    chosen = (plant_class(plant) if args.plant is not None or args.periodic
+              else (plant_class(plant), plant_class("mass-damper")))
+    check_io_floor([rec.u.size for rec in records], chosen, model_class(model),
+                   n_elements=args.elements or 3, nu=nu, periodic=args.periodic,
+                   offset=args.offset or "auto", from_rest=args.from_rest,
+                   window=args.init_window is not None, drift=args.drift)
     check_records(records, args.periodic)  # identify_io checks them again: nothing is skipped
     from motionhyst.identify.io_response import check_response
 
     check_response(records)  # a position that does not depend on the force: no fit explains it
-    from motionhyst.plants.registry import plant_class
 
     notes = []  # warnings, once nothing is refused: a refusal is one line
     if plant_class(plant).has_inertia and not args.periodic:  # as identify_io will, but first
@@ -225,7 +236,6 @@ def run_input_output(args: argparse.Namespace) -> int:
                "asymmetric": True if args.asymmetric else (False if args.symmetric else None),
                "drift": args.drift,
                "fewer_elements": args.elements is None, "rigid_limit": True})
-    from motionhyst.hysteresis import model_class
     from motionhyst.identify.io_checks import FitFailed
 
     try:

@@ -611,6 +611,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         starts = [np.concatenate([[bla.m, bla.c, stage * bla.k],
                                   layout.start(share * bla.k, y_scale, v_scale, bla.c, slip)])
                   for stage, share, slip in STARTS]
+    if shape.n == 1:  # a stage of one mass (a two-mass stage's steps are checked above)
+        check_substeps(records, r, None)
     n_plant = len(structure.PARAMETERS)
     floating = structure.mechanics().floating
     extras = Extras.choose(offset, floating=floating, periodic=periodic, from_rest=from_rest,

@@ -412,7 +412,8 @@ MAX_FINE_SAMPLES = 50_000_000
 """Most integration steps of one simulation of the records (the work budget of a fit)."""
 
 
-def check_substeps(records: list[IORecord], substeps: int, f_n: float, factor: int = 1) -> None:
+def check_substeps(records: list[IORecord], substeps: int, f_n: float | None,
+                   factor: int = 1) -> None:
     """Refuse a fit whose records need too many integration steps, before it starts.
 
     The integration takes `substeps` steps per sample (``factor`` times as
@@ -427,8 +428,9 @@ def check_substeps(records: list[IORecord], substeps: int, f_n: float, factor: i
         The records.
     substeps : int
         Integration steps per sample.
-    f_n : float
-        The fastest mode of the start [Hz].
+    f_n : float or None
+        The fastest mode of the start [Hz], which sets `substeps`; None: they are the
+        least a stage runs (or what its link's stiffness at the start calls for).
     factor : int
         Input samples per integration step (2: the midpoints too).
 
@@ -447,17 +449,29 @@ def check_substeps(records: list[IORecord], substeps: int, f_n: float, factor: i
     ... except ValueError as exc:
     ...     print(str(exc)[:43])
     the start's fastest mode, 4e+08 Hz, needs 1
+    >>> try:
+    ...     check_substeps([rec] * 30_000, 20, None)
+    ... except ValueError as exc:
+    ...     print(exc)
+    identify's search of 3000000 samples runs 20 integration steps a sample (6e+07 in all): \
+more than 5e+07; give shorter records
     """
     from motionhyst.core.budget import check_memory
 
     n = sum(rec.u.size for rec in records) * int(substeps)
-    what = (f"the start's fastest mode, {f_n:.3g} Hz, needs {substeps} integration steps per "
-            f"sample of {records[0].fs:.3g} Hz ({n:.3g} in all)")
-    remedy = ("the records may not show that stage (a single mass fitted as two masses: try "
-              "--plant mass-spring-damper)")
+    if f_n is None:
+        what = (f"identify's search of {sum(rec.u.size for rec in records)} samples runs "
+                f"{substeps} integration steps a sample ({n:.3g} in all)")
+        remedy = "give shorter records"
+    else:
+        what = (f"the start's fastest mode, {f_n:.3g} Hz, needs {substeps} integration steps "
+                f"per sample of {records[0].fs:.3g} Hz ({n:.3g} in all)")
+        remedy = ("the records may not show that stage (a single mass fitted as two masses: "
+                  "try --plant mass-spring-damper)")
     if n > MAX_FINE_SAMPLES:
         raise ValueError(f"{what}: more than {MAX_FINE_SAMPLES:.0e}; {remedy}")
-    check_memory(8.0 * factor * n * 4, what, remedy)
+    if f_n is not None:  # the search's own estimate sizes the rest
+        check_memory(8.0 * factor * n * 4, what, remedy)
 
 
 JACOBIAN_COPIES = 6
