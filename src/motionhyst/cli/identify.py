@@ -201,6 +201,9 @@ def run(args: argparse.Namespace) -> int:
         extra["displacement_noise"] = noise.to_dict()
     else:
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
+        from motionhyst.identify.fd_memory import check_closed_loop_memory
+
+        check_closed_loop_memory(t.size, str(path))  # before its link force is inferred
         from motionhyst.identify.records import prefilter_cutoff
 
         try:  # before the plant's scenario loads python-control

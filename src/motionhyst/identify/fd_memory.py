@@ -28,9 +28,10 @@ from __future__ import annotations
 
 from motionhyst.core.budget import check_memory, format_size
 
-__all__ = ["BOUND_COPIES", "FIT_ROW_BYTES", "LOOP_BYTES", "MIN_BOUND_COLUMNS", "RECORD_BYTES",
-           "bound_columns", "check_elements_fit_memory", "check_link_force_memory",
-           "elements_fit_memory", "link_force_memory"]
+__all__ = ["BOUND_COPIES", "CLOSED_LOOP_BYTES", "FIT_ROW_BYTES", "LOOP_BYTES",
+           "MIN_BOUND_COLUMNS", "RECORD_BYTES", "bound_columns", "check_closed_loop_memory",
+           "check_elements_fit_memory", "check_link_force_memory", "elements_fit_memory",
+           "link_force_memory"]
 
 FIT_ROW_BYTES = 3500
 """Bytes of the Maxwell-slip fit per row of its residual (its 40 stop operators and their
@@ -53,6 +54,14 @@ MIN_BOUND_COLUMNS = 300
 """Fewest stop operators of the bound's refinement within a small budget (its first grid
 holds up to 49; a hundred leave no bound on a record of a Jenkins element and a damper that
 three hundred bound at 0.079 of its 0.094)."""
+
+CLOSED_LOOP_BYTES = 600
+"""Bytes per sample of a closed-loop record's link force, inferred through the stage and the
+prefilter (:func:`~motionhyst.identify.closed_loop.infer_link_force`), besides the fit's rows:
+its elements are fitted on every q-th sample, q = 1 at the highest cut-off, so the estimate
+counts a row a sample up to :data:`~motionhyst.identify.fit.MAX_ROWS` (measured on the
+default scenario's record at 5 kHz, q = 3: 34 MB of 82 estimated at 2e4 samples, 121 MB of
+235 at 1e5)."""
 
 LINK_SAMPLE_BYTES = 160
 """Bytes per sample of one evaluation of a link fitted by the force's error besides its
@@ -257,3 +266,42 @@ has it, or shorter records
                  f"its search's Jacobian and runs take {format_size(need['search'])}, the "
                  f"elements' fit it starts from {format_size(need['starts'])}: a larger "
                  f"--max-memory if the machine has it, or shorter records")
+
+
+def check_closed_loop_memory(n_samples: int, name: str) -> None:
+    """Refuse the Maxwell-slip fit of a closed-loop record above the memory budget, before
+    its link force is inferred (:data:`CLOSED_LOOP_BYTES` a sample and the fit's rows).
+
+    Parameters
+    ----------
+    n_samples : int
+        The record's samples.
+    name : str
+        The record, as messages name it.
+
+    Raises
+    ------
+    BudgetError
+        One line: the fit, what it needs, the remedy.
+
+    Examples
+    --------
+    >>> from motionhyst.core.budget import BudgetError, set_max_memory
+    >>> set_max_memory(20 << 20)
+    >>> try:
+    ...     check_closed_loop_memory(20_000, "run.csv")
+    ... except BudgetError as exc:
+    ...     print(exc)
+    run.csv: the Maxwell-slip fit of a closed-loop record of 20000 samples needs 82 MB, above \
+the memory budget of 21 MB (--max-memory); its link force takes 12 MB, the fit's rows 70 MB: \
+a larger --max-memory if the machine has it, or a shorter record
+    >>> set_max_memory(None)
+    """
+    from motionhyst.identify.fit import MAX_ROWS
+
+    n = int(n_samples)
+    force, rows = CLOSED_LOOP_BYTES * n, FIT_ROW_BYTES * min(n, MAX_ROWS)
+    check_memory(force + rows, f"{name}: the Maxwell-slip fit of a closed-loop record of {n} "
+                 f"samples", f"its link force takes {format_size(force)}, the fit's rows "
+                 f"{format_size(rows)}: a larger --max-memory if the machine has it, or a "
+                 f"shorter record")
