@@ -240,3 +240,21 @@ def test_a_closed_loop_record_is_sized_before_its_link_force_is_inferred(tmp_pat
     code, out, err = limited_process.run([*argv, str(need)], tmp_path)
     assert code == 0, err
     assert len(json.loads(out)["elements"]) == 2
+
+
+def test_the_bouc_wen_link_on_a_spring_counts_its_integration_steps(monkeypatch):
+    """The Bouc-Wen link on a mass-spring-damper (the command's default) had no step cap."""
+    from motionhyst.hysteresis import BoucWen
+    from motionhyst.identify.input_output import identify_io
+    from motionhyst.identify.io_records import IORecord
+    from motionhyst.time.openloop import OpenLoop
+
+    monkeypatch.setattr(io_start, "MAX_FINE_SAMPLES", 5000)
+    t = np.arange(400) / 750.0
+    u = 40.0 * np.sin(2 * np.pi * 8 * t) + 20.0 * np.sin(2 * np.pi * 31 * t)
+    system = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), BoucWen(k=5e4, fc=20.0))
+    rec = IORecord(t, u, system.simulate(t, u).displacement)
+    with pytest.raises(ValueError, match=r"^identify's search of 400 samples runs 20 "
+                                         r"integration steps a sample \(8e\+03 in all\): more "
+                                         r"than 5e\+03; give shorter records"):
+        identify_io([rec], BoucWen, plant=MassSpringDamper)

@@ -226,6 +226,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     bla = best_linear_approximation(records)
     fs = records[0].fs
     r = substeps or OpenLoop(bla).default_substeps(fs)
+    check_substeps(records, r, None)  # its steps, as every stage's, before the starts run
     y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2)))
     # scales: m, c, k from the BLA; alpha like k; the products like 1 / y_scale; nu 1
     scale = np.array([bla.m, max(bla.c, 1e-3 * bla.m), bla.k, bla.k, 1.0 / y_scale,
