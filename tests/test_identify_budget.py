@@ -258,3 +258,48 @@ def test_the_bouc_wen_link_on_a_spring_counts_its_integration_steps(monkeypatch)
                                          r"integration steps a sample \(8e\+03 in all\): more "
                                          r"than 5e\+03; give shorter records"):
         identify_io([rec], BoucWen, plant=MassSpringDamper)
+
+
+def test_the_bouc_wen_search_runs_within_its_measured_estimate(tmp_path):
+    """The Bouc-Wen link on a mass-spring-damper (the command's default), 2e4 samples at 20
+    steps each, 100 evaluations: within its estimate of address space above what the process
+    held (measured 13 MB of 24); a byte below the estimate is refused before the records are
+    checked, one line naming the search."""
+    from motionhyst.hysteresis import BoucWen
+    from motionhyst.time.openloop import OpenLoop
+
+    system = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), BoucWen(k=5e4, fc=20.0, beta=0.6,
+                                                                 gamma=0.2))
+    for name, n in (("small.mat", 1500), ("bw.mat", 20_000)):
+        t = np.arange(n) / 750.0
+        rng = np.random.default_rng(0)
+        u = (40 * np.sin(2 * np.pi * 8 * t) + 20 * np.sin(2 * np.pi * 31 * t)
+             + rng.standard_normal(n))
+        y = system.simulate(t, u).displacement + 1e-7 * rng.standard_normal(n)
+        savemat(tmp_path / name, {"time": t[:, None], "force": u[:, None],
+                                  "displacement": y[:, None]})
+    need = int(io_memory.bouc_wen_memory([20_000], 20)["total"])
+    argv = ["identify", "bw.mat", "--record", "input-output", *IO_COLUMNS,
+            "--max-evaluations", "100", "--json", "--max-memory"]
+    line = limited_process.refusal([*argv, str(need - 1)], tmp_path)
+    assert line.startswith("motionhyst: error: identify's Bouc-Wen search of 20000 samples (at "
+                           "least 20 integration steps each) needs at least 24"), line
+    script = tmp_path / "within.py"
+    script.write_text(
+        "import contextlib, io, json, resource, sys, warnings\n"
+        "from motionhyst.cli import main\n"
+        "warnings.simplefilter('ignore')\n"
+        f"argv = {argv!r}\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main([argv[0], 'small.mat', *argv[2:], '1G'])\n"
+        "with open('/proc/self/status') as f:\n"
+        "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
+        f"resource.setrlimit(resource.RLIMIT_AS, (size + {need},) * 2)\n"
+        "out = io.StringIO()\n"
+        "with contextlib.redirect_stdout(out):\n"
+        f"    code = main([*argv, '{need}'])\n"
+        "print(code, json.loads(out.getvalue())['substeps'])\n")
+    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
+                          text=True, env=limited_process.environment(), timeout=900)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.split() == ["0", "20"], (proc.stdout, proc.stderr[-2000:])

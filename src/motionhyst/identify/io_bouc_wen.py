@@ -30,6 +30,7 @@ from scipy.optimize import OptimizeResult
 
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
+from motionhyst.identify.io_memory import check_bouc_wen_memory
 from motionhyst.identify.io_records import IORecord, short_records
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
@@ -227,6 +228,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     fs = records[0].fs
     r = substeps or OpenLoop(bla).default_substeps(fs)
     check_substeps(records, r, None)  # its steps, as every stage's, before the starts run
+    check_bouc_wen_memory([rec.u.size for rec in records], r)
     y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2)))
     # scales: m, c, k from the BLA; alpha like k; the products like 1 / y_scale; nu 1
     scale = np.array([bla.m, max(bla.c, 1e-3 * bla.m), bla.k, bla.k, 1.0 / y_scale,

@@ -12,8 +12,8 @@ samples, the model and the options alone, what no search of them can do within t
   :data:`~motionhyst.time.openloop.MIN_SUBSTEPS` steps a sample, every plant and link);
 * more memory than the budget for the least search of the records: the element links' at
   the fewest steps a sample and the fewest parameters of the model and its offsets
-  (:func:`search_floor`), the Bouc-Wen link's its upsampled force and Jacobian, a
-  quasi-static stage's as a link's fit by the force's error
+  (:func:`search_floor`), the Bouc-Wen link's at the fewest steps (:func:`bouc_wen_memory`,
+  measured), a quasi-static stage's as a link's fit by the force's error
   (:func:`~motionhyst.identify.fd_memory.check_link_force_memory`).
 
 The search's own estimate, from its start, still follows (it can only be larger).
@@ -23,7 +23,18 @@ from __future__ import annotations
 
 from motionhyst.core.budget import BudgetError, format_size, max_memory
 
-__all__ = ["check_io_floor", "search_floor"]
+__all__ = ["BOUC_WEN_SAMPLE_BYTES", "BOUC_WEN_STEP_BYTES", "bouc_wen_memory",
+           "check_bouc_wen_memory", "check_io_floor", "search_floor"]
+
+BOUC_WEN_STEP_BYTES = 16
+"""Bytes per integration step of the Bouc-Wen link's search on a mass-spring-damper: the
+records' force upsampled at twice the steps (the midpoints of its Runge-Kutta steps), whole."""
+
+BOUC_WEN_SAMPLE_BYTES = 900
+"""Bytes per sample of that search besides: its runs' sensitivities to the seven parameters,
+their reordered, scaled and joined copies and the trust-region solver's (measured with 100
+evaluations, 20 steps a sample: 13 MB of 24 estimated at 2e4 samples, 101 MB of 122 at
+1e5)."""
 
 REMEDY = "a larger --max-memory if the machine has it, or shorter records"
 """What a user can change when the least search of the records is above the budget."""
@@ -90,6 +101,77 @@ def search_floor(sizes: list[int], substeps: int, plant: type, link: type, *,
     jacobian = JACOBIAN_COPIES * 8.0 * n_all * parameters
     return {"force": force, "runs": runs, "jacobian": jacobian,
             "total": force + runs + jacobian, "parameters": parameters}
+
+
+def bouc_wen_memory(sizes: list[int], substeps: int) -> dict[str, float]:
+    """Bytes the Bouc-Wen link's input-output search on a mass-spring-damper needs at most.
+
+    Parameters
+    ----------
+    sizes : list of int
+        Each record's samples.
+    substeps : int
+        Integration steps per sample.
+
+    Returns
+    -------
+    dict
+        ``force`` (upsampled), ``runs`` (their sensitivities and the solver's copies) and
+        the ``total`` [bytes].
+
+    Examples
+    --------
+    >>> need = bouc_wen_memory([100_000], 20)
+    >>> {k: round(v / 1e6) for k, v in need.items()}
+    {'force': 32, 'runs': 90, 'total': 122}
+    """
+    n_all = sum(int(n) for n in sizes)
+    force = BOUC_WEN_STEP_BYTES * int(substeps) * n_all
+    runs = BOUC_WEN_SAMPLE_BYTES * n_all
+    return {"force": float(force), "runs": float(runs), "total": float(force + runs)}
+
+
+def check_bouc_wen_memory(sizes: list[int], substeps: int, least: bool = False) -> None:
+    """Refuse the Bouc-Wen link's search on a mass-spring-damper above the memory budget,
+    before its starts run (:func:`bouc_wen_memory`).
+
+    Parameters
+    ----------
+    sizes : list of int
+        Each record's samples.
+    substeps : int
+        Integration steps per sample.
+    least : bool
+        `substeps` are the fewest the search may take (its size at least).
+
+    Raises
+    ------
+    BudgetError
+        One line: the search, what it needs and what takes it, the remedy.
+
+    Examples
+    --------
+    >>> from motionhyst.core.budget import BudgetError, set_max_memory
+    >>> set_max_memory(50 << 20)
+    >>> try:
+    ...     check_bouc_wen_memory([100_000], 20)
+    ... except BudgetError as exc:
+    ...     print(exc)
+    identify's Bouc-Wen search of 100000 samples (20 integration steps each) needs 122 MB, \
+above the memory budget of 52.4 MB (--max-memory); its runs take 90 MB, the upsampled force \
+32 MB: a larger --max-memory if the machine has it, or shorter records
+    >>> set_max_memory(None)
+    """
+    need = bouc_wen_memory(sizes, substeps)
+    budget = max_memory()
+    if need["total"] > budget:
+        at_least = "at least " if least else ""
+        raise BudgetError(f"identify's Bouc-Wen search of {sum(int(n) for n in sizes)} samples "
+                          f"({at_least}{int(substeps)} integration steps each) needs "
+                          f"{at_least}{format_size(need['total'])}, above the memory budget of "
+                          f"{format_size(budget)} (--max-memory)",
+                          f"its runs take {format_size(need['runs'])}, the upsampled force "
+                          f"{format_size(need['force'])}: {REMEDY}")
 
 
 def check_io_floor(sizes: list[int], plant: type | tuple[type, ...], link: type, *,
@@ -163,9 +245,21 @@ the machine has it, or shorter records
                          f"steps a sample ({n_all * r:.3g} in all), more than "
                          f"{MAX_FINE_SAMPLES:.0e} in one simulation of the records; give "
                          f"shorter records")
-    need = min((search_floor(sizes, r, p, link, n_elements=n_elements, periodic=periodic,
-                             offset=offset, from_rest=from_rest, window=window, drift=drift)
-                for p in plants if p.has_inertia), key=lambda need: need["total"])
+    from motionhyst.hysteresis import BoucWen
+    from motionhyst.plants.mass_damper import MassDamper
+
+    needs = []  # the Bouc-Wen link's own search, but on a mass-damper (a friction link there)
+    for p in plants:
+        if link is BoucWen and p is not MassDamper:
+            needs.append(bouc_wen_memory(sizes, r))
+        elif p.has_inertia:
+            needs.append(search_floor(sizes, r, p, link, n_elements=n_elements,
+                                      periodic=periodic, offset=offset, from_rest=from_rest,
+                                      window=window, drift=drift))
+    need = min(needs, key=lambda need: need["total"])
+    if "jacobian" not in need:
+        check_bouc_wen_memory(sizes, r, least=True)
+        return
     parts = sorted(((need["runs"], "its runs"), (need["jacobian"], "its Jacobian's copies"),
                     (need["force"], "the upsampled force")), reverse=True)
     takes = ", ".join(f"{name} {'take ' if i == 0 else ''}{format_size(size)}"
