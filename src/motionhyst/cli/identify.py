@@ -195,6 +195,8 @@ def run(args: argparse.Namespace) -> int:
         # its checks, the bound (where it runs) and the fit, before any of them
         check_elements_fit_memory(t.size, str(path), bound=args.elements is None
                                   or target is not None)
+        measured = [(path, t, x, w)]
+        mass = _refuse_a_mass(measured)
         from motionhyst.identify.displacement_noise import estimate_displacement
 
         x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
@@ -224,7 +226,18 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.identify.fit import identify_maxwell_slip
 
         if args.elements is None or target is not None:  # what no fit can pass: before it
-            _refuse_beyond_bound(path, x, w)
+            from motionhyst.identify.io_checks import FitFailed
+
+            try:
+                _refuse_beyond_bound(path, x, w)
+            except FitFailed:
+                if mass is not None:  # the cause to name: the mass
+                    _refuse_a_mass(measured, refuse=True)
+                raise
+        if mass is not None:
+            from motionhyst.core.warnings import warn
+
+            warn(mass)
         what = "force-displacement record"
         try:
             with search_budget():
@@ -378,6 +391,11 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     for path in paths:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         records.append((path, t, x, w))
+    mass = _refuse_a_mass(records)
+    if mass is not None:
+        from motionhyst.core.warnings import warn
+
+        warn(mass)
     from motionhyst.hysteresis import model_class
     from motionhyst.identify.fd_memory import check_link_force_memory
 
@@ -417,6 +435,28 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         print("\n# the identified link, a scenario for motionhyst predict (or give --save):")
         print(fit.scenario_text(), end="")
     return 0
+
+
+def _refuse_a_mass(records: list[tuple], refuse: bool = False) -> str | None:
+    """Force-displacement records ``(path, t, x, w)`` whose force accelerates a mass (a
+    fixture, a carriage, or a stage's input-output record, which has the same header) are
+    refused before a link is fitted to them; a smaller mass is returned as a warning's line,
+    or refused with `refuse`
+    (:func:`~motionhyst.identify.fd_inertia.check_no_inertia`: a regression in which the
+    link's hysteresis, as stop operators, cannot pose as a mass).  Records whose stamps are
+    not uniform are not judged."""
+    from motionhyst.identify.fd_inertia import check_no_inertia
+    from motionhyst.identify.io_records import IORecord
+    from motionhyst.time.resample import check_record
+
+    uniform = []
+    for path, t, x, w in records:
+        try:
+            check_record(t, w)
+        except ValueError:
+            return None
+        uniform.append(IORecord(t, w, x, str(path)))
+    return check_no_inertia(uniform, refuse)
 
 
 def _check_determined(path: Path, ident, x, w) -> None:

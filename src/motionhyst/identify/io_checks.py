@@ -34,8 +34,8 @@ __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTIO
            "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE",
            "FitFailed", "StiffFit", "budget_note", "check_inertia", "default_plant", "flat_profile",
            "hysteresis_gain", "judge_fit", "linear_mass_std", "noise_cost",
-           "plausibility_warnings", "systematic_share", "viscous_direction",
-           "viscous_direction_note"]
+           "plausibility_warnings", "robust_least_squares", "systematic_share",
+           "viscous_direction", "viscous_direction_note"]
 
 #: The finest integration step ``predict`` takes, in steps per record sample; a model that
 #: needs more (a collapsed mass on a stiff link) is not a model ``predict`` can run
@@ -289,7 +289,7 @@ def linear_mass_std(records: list[IORecord], floating: bool) -> float:
     from motionhyst.identify.io_start import equation_rows
 
     rows, rhs = equation_rows(records, floating)
-    _, cov = _robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
+    _, cov = robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
     return math.sqrt(max(float(cov[0, 0]), 0.0))
 
 
@@ -458,14 +458,38 @@ def _mass_and_std(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]
                   window: int) -> tuple[float, float]:
     """The least-squares coefficient of the first column and its Newey-West standard error
     (Bartlett weights over ``max(4 n^(1/3), window)`` lags, within each record)."""
-    x, cov = _robust_least_squares(rows, rhs, window)
+    x, cov = robust_least_squares(rows, rhs, window)
     return float(x[0]), math.sqrt(max(float(cov[0, 0]), 0.0))
 
 
-def _robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]],
-                          window: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]],
+                         window: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The least-squares coefficients and their Newey-West covariance (Bartlett weights over
-    ``max(4 n^(1/3), window)`` lags, within each record)."""
+    ``max(4 n^(1/3), window)`` lags, within each record): standard errors that hold for
+    residuals correlated over time (a model's error, a filtered noise).
+
+    Parameters
+    ----------
+    rows : list of ndarray
+        Each record's regressors, one row a sample.
+    rhs : list of ndarray
+        Each record's observations.
+    window : int
+        The fewest lags of the Bartlett weights (the samples a residual is correlated over).
+
+    Returns
+    -------
+    coefficients, covariance : ndarray
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 1.0, 200)
+    >>> A = np.column_stack([t, np.ones_like(t)])
+    >>> b = 2.0 * t + 0.5 + 0.01 * np.random.default_rng(0).standard_normal(t.size)
+    >>> x, cov = robust_least_squares([A], [b], 7)
+    >>> np.round(x, 2).tolist(), bool(np.sqrt(cov[0, 0]) < 0.01)
+    ([2.0, 0.5], True)
+    """
     A = np.concatenate(rows)
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
@@ -669,7 +693,7 @@ def viscous_direction(records: list[IORecord]
         compared.append(np.column_stack([r[inside, 0], s[inside], np.ones(np.sum(inside)),
                                          *hats]))
         forces.append(b[inside])
-    x, cov = _robust_least_squares(compared, forces,
+    x, cov = robust_least_squares(compared, forces,
                                    max(7, 2 * round(0.005 * records[0].fs) + 1))
     even, even_std = float(x[1]), math.sqrt(max(float(cov[1, 1]), 0.0))
     moving = speed > low  # the one-coefficient inverse dynamics, that even part taken out
