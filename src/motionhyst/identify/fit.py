@@ -93,6 +93,12 @@ BOUND_ROWS = 5000
 samples, evenly strided (a pair's difference is the noise's, as in the fit's judgement)."""
 
 
+BOUND_SLACK = (1e-3, 1e-2)
+"""Shares of the range by which :func:`systematic_share_bound` may also take the record as
+swept before it reaches its extremes (a record that reaches them only at its end), where
+that leaves it more samples."""
+
+
 Criterion = Literal["rms", "bic"]
 
 
@@ -699,9 +705,13 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     samples add to a fit's error, never take from it.  The bound is that error, beyond the
     white noise (from the differences of successive samples, as the fit's judgement), over
     the whole record's samples, less four times the spread of that difference's estimate
-    (the noise divided by the square root of the pairs).  It errs low (a record sampled
-    coarsely, the noise the many operators absorb), so a refusal on it is safe; a record
-    that sweeps its range only at its end has no samples for it (0).
+    (the noise divided by the square root of the pairs).  A record that reaches its extremes
+    only at its end (a dithering encoder's last count) is also taken from where it comes
+    within :data:`BOUND_SLACK` of them, much earlier: the elements longer than half the
+    range swept by then are a spring there, but for moving by the slack left (allowed for:
+    the force's range over the swept one times half the slack); the larger bound holds.  It
+    errs low (a record sampled coarsely, the noise the many operators absorb), so a refusal
+    on it is safe.
 
     Parameters
     ----------
@@ -747,14 +757,40 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     spread = float(np.std(ws))
     if not spread > 0 or np.dot(x0, w0) < -0.5 * np.linalg.norm(x0) * np.linalg.norm(w0):
         return 0.0  # as _nnls_start: a force that falls as the displacement rises
-    start = max(int(np.argmin(xs)), int(np.argmax(xs)))
+    return max(_bound_after(xs, ws, start, slack, max_rows, spread, max_columns)
+               for start, slack in _sweeps(xs))
+
+
+def _sweeps(x: NDArray[np.float64]) -> list[tuple[int, float]]:
+    """Where `x` has swept its range (the later of its extremes, slack 0) and, where it
+    comes :data:`BOUND_SLACK` of the range short of its extremes a tenth of the record
+    earlier, that sample and the displacement left to each extreme (together)."""
+    out = [(max(int(np.argmin(x)), int(np.argmax(x))), 0.0)]
+    top, bottom = np.maximum.accumulate(x), np.minimum.accumulate(x)
+    span = float(top[-1] - bottom[-1])
+    for share in BOUND_SLACK:
+        near = np.flatnonzero((top >= top[-1] - share * span)
+                              & (bottom <= bottom[-1] + share * span))
+        start = int(near[0])
+        if start < out[-1][0] - x.size // 10:
+            out.append((start, float(top[-1] - top[start] + bottom[start] - bottom[-1])))
+    return out
+
+
+def _bound_after(xs: NDArray[np.float64], ws: NDArray[np.float64], start: int, slack: float,
+                 max_rows: int, spread: float, max_columns: int = BOUND_COLUMNS) -> float:
+    """:func:`systematic_share_bound` on the samples from `start`, where the record has swept
+    its range but for `slack` (see there)."""
     if xs.size - start < 4:
         return 0.0
     stride = max(2, math.ceil((xs.size - 1 - start) / max(max_rows // 2, 1)))
     first = np.arange(start, xs.size - 1, stride)
     rows = np.column_stack([first, first + 1]).ravel()
-    d, A, tolerance = _bound_columns(xs, rows, 0.5 * float(np.ptp(xs)), max_columns)
+    swept = 0.5 * (float(np.ptp(xs)) - slack)
+    d, A, tolerance = _bound_columns(xs, rows, swept, max_columns)
     y = ws[rows]
+    if slack > 0:  # the elements longer than the swept half range: a spring, but for slack
+        A = np.column_stack([A, xs[rows]])
     A = A - A.mean(axis=0)
     y = y - y.mean()
     # on the columns themselves: a QR of them first (the NNLS stage's way, for its 5e4
@@ -766,14 +802,17 @@ def systematic_share_bound(x: ArrayLike, w: ArrayLike, max_rows: int = BOUND_ROW
     if hysteresis_gain(float(linear @ linear), r) < NO_HYSTERESIS_GAIN:
         return 0.0  # a spring's force: the fit's own check says there is no hysteresis
     noise = float(np.mean((r[1::2] - r[::2]) ** 2)) / 2.0
-    slip = max(float(f.sum()), 0.5 * float(np.ptp(y)))  # the best model's slip forces, about
-    rms = max(math.sqrt(float(np.mean(r ** 2))) - 2.0 * tolerance * slip, 0.0)
-    swept = xs.size - start  # the samples the rows stand for, of all the record's
+    slip = max(float(f[:d.size].sum()), 0.5 * float(np.ptp(y)))  # the best model's, about
+    # a longer element moves by at most the slack after start: its force differs from a
+    # spring's by its stiffness (about the force's range over the swept one) times half it
+    longer = 0.5 * slack * float(np.ptp(ws)) / (2.0 * swept) if slack > 0 else 0.0
+    rms = max(math.sqrt(float(np.mean(r ** 2))) - 2.0 * tolerance * slip - longer, 0.0)
+    covered = xs.size - start  # the samples the rows stand for, of all the record's
     # the residual's mean square less the noise taken from the same pairs is the mean of
     # the products of each pair's two noises: it spreads by noise / sqrt(pairs), 4 of which
     # are allowed (a heavy noise otherwise passes for systematic error)
     margin = 4.0 * noise / math.sqrt(rows.size // 2)
-    return math.sqrt(max(rms ** 2 - noise - margin, 0.0) * swept / xs.size) / spread
+    return math.sqrt(max(rms ** 2 - noise - margin, 0.0) * covered / xs.size) / spread
 
 
 def identify_maxwell_slip(x: ArrayLike, w: ArrayLike, n_elements: int | None = None, *,
