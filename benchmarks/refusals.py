@@ -11,10 +11,11 @@ million values, a constant force, an input-output record without inertia (its
 inverse-dynamics estimate), a stage's record given with a link's, a force that is a curve
 of the displacement without loops, a force whose loops are a damper's, a benchmark without
 its data folder or with a text file for its record, an identification file larger than
-any, a study's store named by a symbolic link, and a record no Maxwell-slip elements
-describe (a Jenkins element, a spring and a damper: loops, but not a stop operator's; a
-short record and one of 60000 samples), refused by a bound on what any of them can leave
-before the fit that took 1.8 s and 26 s of CPU to refuse them.  Each runs as a whole
+any, a study's store named by a symbolic link, a force-displacement record whose force
+accelerates a mass, and a record no Maxwell-slip elements describe (a Jenkins element, a
+spring and a damper: loops, but not a stop operator's; a short record and one of 60000
+samples), refused by a bound on what any of them can leave before the fit that took 1.8 s
+and 26 s of CPU to refuse them.  Each runs as a whole
 process (the interpreter, the imports, the checks) in a folder holding its files,
 ``REPEATS`` times interleaved with the baseline of the same run: ``motionhyst --help``,
 the command's start alone.  Reported per case: the least wall time (the least disturbed
@@ -82,6 +83,7 @@ def _files() -> dict[str, str]:
     u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
     x = 1e-3 * np.sin(2 * np.pi * 2 * t)
     head, tail = PAPER[:PAPER.index("[stage]")], PAPER[PAPER.index("[hysteresis]"):]
+    x2 = x + 4e-4 * np.sin(2 * np.pi * 31.0 * t)  # a fixture of 2 g on the link: m x''
     nan = x.copy()
     nan[7] = np.nan
     return {
@@ -106,6 +108,8 @@ def _files() -> dict[str, str]:
                                        Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x
                                        + 1.6 * np.gradient(x, t)),
         "fd-jenkins-damper-long.csv": _long_jenkins_damper(),
+        "fd-mass.csv": _rows("time,displacement,force", t, x2, Jenkins(k=40.0, fc=0.01).response(x2)
+                             + 10.0 * x2 + 0.002 * np.gradient(np.gradient(x2, t), t)),
         "study.toml": ('scenario = "s.toml"\noutputs = ["mismatch"]\n\n[axes]\n'
                        'amplitude = [0.01]\nfrequency_hz = [5.0]\n'),
         "big-identification.toml": "#\n" * 2_500_000,  # 5 MB: larger than any
@@ -155,6 +159,7 @@ CASES = [
     ("store named by a link", ["study", "study.toml", "--out", "link.zarr"], "checks"),
     ("no stop operator fits", ["identify", "fd-jenkins-damper.csv"], "checks"),
     ("no stop operator, long", ["identify", "fd-jenkins-damper-long.csv"], "checks"),
+    ("a mass on the link", ["identify", "fd-mass.csv"], "checks"),
 ]
 
 

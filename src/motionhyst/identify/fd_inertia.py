@@ -241,7 +241,7 @@ def check_no_inertia(records: list[IORecord], refuse: bool = False) -> str | Non
         return None
     names = records[0].name if len(records) == 1 else f"{records[0].name} and the others"
     what = (f"a mass of {found.mass:.3g} +- {found.std:.2g} kg, whose force m x'' is "
-            f"{100 * found.share:.2g} % of the force's RMS, {100 * found.beyond:.2g} % beyond "
+            f"{100 * found.share:.3g} % of the force's RMS, {100 * found.beyond:.3g} % beyond "
             f"what a link describes (its hysteresis as stop operators in the same regression)")
     if refuse or found.share >= REFUSE_SHARE or found.beyond > SYSTEMATIC_SHARE:
         raise ValueError(f"{names}: the force accelerates {what}: a link's force against an "
