@@ -83,6 +83,12 @@ class LinkInertia:
     beyond : float
         What the mass explains that the link's columns do not, RMS over the force's RMS:
         about what a link fitted to the record leaves for it.
+
+    Examples
+    --------
+    >>> found = LinkInertia(mass=0.5, std=1e-3, share=0.4, explained=0.99, beyond=0.15)
+    >>> found.proven
+    True
     """
 
     mass: float
