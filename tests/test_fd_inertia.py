@@ -100,3 +100,20 @@ def test_a_small_mass_that_no_elements_can_describe_is_named_as_the_cause(tmp_pa
                                              seconds=2.0))})
     line = limited_process.refusal(["identify", "rig.csv"], root)
     assert "rig.csv: the force accelerates a mass of 0.49" in line
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("kind", ["slips", "presliding", "coloured", "quantised", "100 Hz",
+                                  "earthquake", "lag"])
+def test_the_bounds_records_of_maxwell_slip_links_show_no_mass(kind, seed):
+    """The Maxwell-slip records of the bound's tests (stiff contacts down to a Coulomb
+    element, presliding, coloured and quantised noise, 100 Hz, an earthquake, a lag): no mass
+    proven, no warning (last session's 66 records of 22 kinds: 0, measured)."""
+    from test_bad_inputs_early import _family
+
+    from motionhyst.identify.fd_inertia import check_no_inertia, link_inertia
+
+    x, w, _ = _family(kind, seed)
+    t = np.arange(x.size) / (100.0 if kind == "100 Hz" else 1000.0)
+    assert not link_inertia([IORecord(t, w, x)]).proven
+    assert check_no_inertia([IORecord(t, w, x)]) is None
