@@ -64,6 +64,9 @@ MASS_EXPLAINED = 0.5
 REFUSE_SHARE = 0.1
 #: ... and one of this share or more is a warning
 WARN_SHARE = 0.01
+#: A mass that a displacement lagging the force by at most this many samples would give
+#: through the damping found (``m = c tau``) is said to be that, as well
+LAG_SAMPLES = 5.0
 
 
 @dataclass(frozen=True)
@@ -83,10 +86,14 @@ class LinkInertia:
     beyond : float
         What the mass explains that the link's columns do not, RMS over the force's RMS:
         about what a link fitted to the record leaves for it.
+    damping : float
+        The velocity's coefficient [N s/m]: with it the mass is also a displacement that
+        lags the force by ``mass / damping`` (``c x'(t + tau) = c x' + c tau x''``).
 
     Examples
     --------
-    >>> found = LinkInertia(mass=0.5, std=1e-3, share=0.4, explained=0.99, beyond=0.15)
+    >>> found = LinkInertia(mass=0.5, std=1e-3, share=0.4, explained=0.99, beyond=0.15,
+    ...                     damping=0.0)
     >>> found.proven
     True
     """
@@ -96,6 +103,7 @@ class LinkInertia:
     share: float
     explained: float
     beyond: float
+    damping: float
 
     @property
     def proven(self) -> bool:
@@ -202,7 +210,7 @@ def link_inertia(records: list[IORecord]) -> LinkInertia | None:
                        share=abs(m) * a_rms / u_rms if u_rms > 0 else 0.0,
                        explained=1.0 - full_ss / left_ss if left_ss > 0 else 0.0,
                        beyond=(math.sqrt(max(left_ss - full_ss, 0.0) / b.size) / u_rms
-                               if u_rms > 0 else 0.0))
+                               if u_rms > 0 else 0.0), damping=float(coef[1]))
 
 
 def check_no_inertia(records: list[IORecord], refuse: bool = False) -> str | None:
@@ -249,11 +257,18 @@ def check_no_inertia(records: list[IORecord], refuse: bool = False) -> str | Non
     what = (f"a mass of {found.mass:.3g} +- {found.std:.2g} kg, whose force m x'' is "
             f"{100 * found.share:.3g} % of the force's RMS, {100 * found.beyond:.3g} % beyond "
             f"what a link describes (its hysteresis as stop operators in the same regression)")
+    dt = float(records[0].t[-1] - records[0].t[0]) / (records[0].t.size - 1)
+    align = ""
+    if 0.0 < found.mass <= LAG_SAMPLES * dt * found.damping:  # a sensor's delay, as well
+        lag = found.mass / found.damping
+        what += (f", or equally the displacement lagging the force by {1e3 * lag:.2g} ms "
+                 f"({lag / dt:.2g} samples) through a damping of {found.damping:.3g} N s/m")
+        align = ", or advance the displacement by its lag"
     if refuse or found.share >= REFUSE_SHARE or found.beyond > SYSTEMATIC_SHARE:
         raise ValueError(f"{names}: the force accelerates {what}: a link's force against an "
                          f"imposed displacement has no inertia; identify the mass and its "
                          f"link with --record input-output --plant mass-damper (or "
-                         f"mass-spring-damper), or subtract m x'' from the force; nothing "
-                         f"identified")
+                         f"mass-spring-damper), or subtract m x'' from the force{align}; "
+                         f"nothing identified")
     return (f"{names}: the force accelerates {what}: the link identified absorbs it (a mass "
             f"and its link are --record input-output --plant mass-damper)")
