@@ -196,7 +196,6 @@ def run(args: argparse.Namespace) -> int:
         check_elements_fit_memory(t.size, str(path), bound=args.elements is None
                                   or target is not None)
         measured = [(path, t, x, w)]
-        mass = _refuse_a_mass(measured)
         from motionhyst.identify.displacement_noise import estimate_displacement
 
         x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
@@ -223,6 +222,8 @@ def run(args: argparse.Namespace) -> int:
                 check_loops_open(x, w, t)
             except ValueError as exc:
                 raise ValueError(f"{path}: {exc}") from None
+        # a mass (its stop operators load the compiled kernels: after the light checks)
+        mass = _refuse_a_mass(measured)
         from motionhyst.identify.fit import identify_maxwell_slip
 
         if args.elements is None or target is not None:  # what no fit can pass: before it
