@@ -30,7 +30,10 @@ Method
    records or hardly at all, a rate scale such as LuGre's ``vs`` held on a
    grid, see :func:`~motionhyst.identify.io_elements.identify_elements_io`).
    Several starts are refined on a short part of the records and the best
-   continues.  The two-mass stage:
+   continues, refined on all records both from there and from there with each
+   record's initial state as its first 20 samples set it (the state carried
+   over from the starts may lie in another well of the initial velocity, where
+   a friction link slips at the start); the better end is kept.  The two-mass stage:
    :func:`~motionhyst.identify.io_start.best_linear_approximation_two_mass`
    (the link a spring and damper to the ground; from rest, the frequency
    response of an ARX model of the records), then the link's initial
