@@ -441,7 +441,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
         failed = None
         try:  # parameters the records do not determine: a warning, or (most) a failed fit
-            determined = judge_determined(fit.estimates, fit.std, invariant, zero)
+            determined = judge_determined(fit.estimates, fit.std, invariant, zero,
+                                          _one_way_names(fit))
         except FitFailed as exc:
             failed = exc
         kept = (_determined_elements(fit, n_elements, invariant, zero)
@@ -565,7 +566,8 @@ def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
     if rigid is None:
         raise failed
     try:
-        determined = judge_determined(rigid.estimates, rigid.std, (), zero_allowed(stage, Coulomb))
+        determined = judge_determined(rigid.estimates, rigid.std, (), zero_allowed(stage, Coulomb),
+                                      _one_way_names(rigid))
     except FitFailed:
         raise failed from None
     names = undetermined(fit.estimates, fit.std, invariant, zero)
@@ -576,6 +578,12 @@ def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
                    seconds=fit.seconds, extra={**rigid.extra,
                                                "rigid_limit": f"{fit.hysteresis.name}: {why}"}
                    ), determined
+
+
+def _one_way_names(fit: IOIdentification) -> set[str]:
+    """The slip forces and force offset the fit's own warning names as one force
+    (:func:`~motionhyst.identify.io_one_way.one_way_slip`)."""
+    return set(fit.extra.get("one_way", {}).get("parameters", []))
 
 
 def _determined_elements(fit: IOIdentification, n: int, invariant: tuple[str, ...],

@@ -35,6 +35,7 @@ from motionhyst.identify.io_force import RecordForce
 from motionhyst.identify.io_layout import FORCE_UNIT, VELOCITY_UNIT
 from motionhyst.identify.io_layout import LinkLayout as _LinkLayout
 from motionhyst.identify.io_offsets import Extras, initial_state
+from motionhyst.identify.io_one_way import one_way_slip, slider_slips
 from motionhyst.identify.io_predict import run_from_state, state_from_window
 from motionhyst.identify.io_records import short_records
 from motionhyst.identify.io_refine import refine
@@ -338,6 +339,12 @@ class _ElementProblem:
         except (ValueError, ArithmeticError):  # parameters the model refuses
             r = np.full(sum(rec.y.size for rec in self.records), np.nan)
         return np.where(np.isfinite(r), r, 1e3)
+
+    def rss_at(self, v: NDArray[np.float64]) -> float:
+        """The residual sum of squares [m^2] of the model at the values `v` (not counted in
+        the search's budget; ``ValueError`` for values the model refuses)."""
+        return float(sum(np.sum((y - self._measured(rec)) ** 2)
+                         for (y, _), rec in zip(self.outputs(v), self.records, strict=True)))
 
     def _extra_columns(self, v: NDArray[np.float64], y: list[NDArray[np.float64]]
                        ) -> NDArray[np.float64]:
@@ -760,6 +767,13 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         if name not in not_ident:
             not_ident[name] = why
             std[name] = None
+    cov = covariance(J, rss, res.size, rtol, noise)
+    slips = (slider_slips(layout.build(v[n_plant:n_base]), prob._split_rows(res, measured=True))
+             if shape.n == 1 else None)  # the link moves with the measured position
+    one_way = one_way_slip(names, v, rss, res.size, prob.rss_at, cov, layout.cls.name, slips)
+    for name in one_way.names if one_way is not None else ():  # one force: the sum's known
+        std[name] = None
+        not_ident[name] = one_way.note
     # a Jenkins link, or a Maxwell-slip link of one element (a Jenkins link): its stiffness
     k_name = ("link.k" if layout.cls is Jenkins else "link.k[0]"
               if layout.cls is MaxwellSlip and n == 1 else None)
@@ -804,6 +818,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
               if nm in ("m", "m1", "m2")}
     notes = plausibility_warnings(estimates, masses, reference_mass(records, shape.floating),
                                   records, bound, runaway, shape.floating)
+    if one_way is not None:
+        notes.append(one_way.line)
     if noise is not None:
         notes.extend(_window_price(J, rss, res.size, rtol, noise, names[:n_base], init_window))
     return IOIdentification(
@@ -819,8 +835,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                            **({"input_drift": drift_rate} if extras.input_drift else {})},
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0),
-               "covariance": covariance_table(names, covariance(J, rss, res.size, rtol, noise),
-                                                std)})
+               "covariance": covariance_table(names, cov, std),
+               **({"one_way": one_way.to_dict()} if one_way is not None else {})})
 
 
 def _window_price(J, rss, n_rows, rtol, noise: WindowNoise, names: list[str], window: int

@@ -525,8 +525,8 @@ def undetermined(estimates: dict[str, float], std: dict[str, float | None],
 
 
 def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
-                     invariant: tuple[str, ...] = (), zero: set[str] | frozenset = frozenset()
-                     ) -> list[str]:
+                     invariant: tuple[str, ...] = (), zero: set[str] | frozenset = frozenset(),
+                     explained: set[str] | frozenset = frozenset()) -> list[str]:
     """What the records do not determine, judged: the warnings to give, or a failed fit.
 
     Parameters
@@ -538,6 +538,10 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
         record (:data:`BOUC_WEN_SCALE`): not a question of the records, left out.
     zero : set of str
         The parameters whose range holds 0 (:func:`zero_allowed`).
+    explained : set of str
+        Parameters another warning names already (a slip force the fit's link holds one
+        way only, :func:`~motionhyst.identify.io_one_way.one_way_slip`): counted, not named
+        again.
 
     Returns
     -------
@@ -584,6 +588,9 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
                         f"would be the search's, and the model, one of many that fit these "
                         f"records as well, cannot predict; give a longer or richer record, or "
                         f"a simpler link (fewer --elements)")
+    names = [n for n in names if n not in explained]
+    if not names:
+        return []
     what = "its search value" if len(names) == 1 else "their search values"
     its = "its standard error is unknown or exceeds its value" if len(names) == 1 else \
         "their standard errors are unknown or exceed their values"
