@@ -105,3 +105,29 @@ def test_the_time_engine_realises_a_loop_of_a_huge_mass_exactly(m1):
         realised = (C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D)[1, 0]
         exact = polyratio(tf.num, tf.den, np.array([w]))[0]
         assert abs(realised - exact) < 1e-9 * abs(exact), (w, realised, exact)
+
+
+@pytest.mark.parametrize(("values", "named"), [
+    ({"c1": 5e4}, None),        # c1 / m1: a pole at 2.7 Hz (main: 1.6e5 Hz, both in series)
+    ({"c2": 5e4}, "c2"),        # c2 / m2: 1.6e5 Hz
+    ({"b": 5e4}, "b"),          # between the masses: both in series, 1.6e5 Hz
+    ({"c1": 4e9}, "c1"),        # c1 / m1: 2.1e5 Hz
+])
+def test_a_ground_damper_is_judged_against_its_own_mass(values, named):
+    """Review C11 LOW-1: a two-mass stage's damper from m1 (3000 kg) to the ground was
+    judged against both masses in series (m2 0.05 kg): c1 = 5e4 N s/m "gives the stage a
+    pole at 1.6e+05 Hz"; its pole is c1 / m1 = 2.7 Hz."""
+    from motionhyst import default_scenario
+    from motionhyst.scenario.schema import implausible_stage
+
+    sc = default_scenario(check=False)
+    for name, value in {"m1": 3000.0, "m2": 0.05, "k": 1e8, **values}.items():
+        setattr(sc.model.stage, name, value)
+    lines = implausible_stage(sc)
+    if named is None:
+        assert lines == []
+        return
+    assert len(lines) == 1 and f"[stage] {named} = " in lines[0], lines
+    pole = float(lines[0].split("pole at ")[1].split(" Hz")[0])
+    mass = 3000.0 if named == "c1" else 0.05 if named == "c2" else 1 / (1 / 3000 + 1 / 0.05)
+    assert pole == pytest.approx(values[named] / mass / (2 * np.pi), rel=0.02)

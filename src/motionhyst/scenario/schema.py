@@ -656,8 +656,9 @@ def implausible_stage(sc: Scenario) -> list[str]:
 
     A mass outside :data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`; with the masses
     within it, a stiffness or a damping that alone gives the stage a mode or a pole
-    faster than :data:`~motionhyst.plants.registry.PLAUSIBLE_POLE_HZ` (against the
-    stage's masses in series, as its internal mode sees them).
+    faster than :data:`~motionhyst.plants.registry.PLAUSIBLE_POLE_HZ` with the masses it
+    joins (a spring or damper between two masses: both in series, as the internal mode sees
+    them; a damper from one mass to the ground: that mass).
 
     Parameters
     ----------
@@ -698,12 +699,20 @@ def implausible_stage(sc: Scenario) -> list[str]:
     masses = [v for p, v in params if p.unit == "kg" and v]
     if lines or not masses:
         return lines
-    per_mass = sum(1.0 / m for m in masses)
+    values = stage.model_dump(exclude={"type"}, exclude_none=True)
+    values.pop("output", None)
+    base = plant_class(stage.type)(**values).mechanics()
     for p, value in params:
         if p.unit not in ("N/m", "N s/m") or not value:
             continue
         stiff = p.unit == "N/m"
-        hz = (math.sqrt(abs(value) * per_mass) if stiff else abs(value) * per_mass) / math.tau
+        try:  # the value's own matrix (the stage's are linear in it): what it joins
+            mech = plant_class(stage.type)(**{**values, p.name: 2.0 * value}).mechanics()
+        except (ValueError, TypeError):
+            continue
+        own = (mech.K - base.K) if stiff else (mech.C - base.C)
+        rate = float(np.max(np.abs(np.linalg.eigvals(own / base.mass[:, None]))))
+        hz = (math.sqrt(rate) if stiff else rate) / math.tau
         if hz > PLAUSIBLE_POLE_HZ:
             lines.append(f"{sc.source}: [stage] {p.name} = {value:g} {p.unit} gives the stage a "
                          f"{'mode' if stiff else 'pole'} at {hz:.2g} Hz, beyond the "
