@@ -415,6 +415,13 @@ def test_maxwell_slip_falls_back_when_an_element_is_too_stiff_to_run():
                           n_elements=2, fewer_elements=True, rigid_limit=True)
     said = [str(w.message) for w in caught]
     assert sum("Maxwell-slip elements: fitted with 1" in line for line in said) == 1, said
+    # the cause, not the undetermined path's words (review C11 LOW-2: main said "the most
+    # they determine" and nothing of the stiffness)
+    line = next(line for line in said if "Maxwell-slip elements: fitted with 1" in line)
+    assert line.startswith("the records do not resolve the parameters of 2 "), line
+    assert "with 2, an element ran stiffer than the records resolve (its fastest mode at " \
+        in line and " integration steps per sample)" in line, line
+    assert "the most they determine" not in line
     assert isinstance(fit.hysteresis, Coulomb)
     for name, value in true.items():
         assert fit.estimates[name] == pytest.approx(value, rel=1e-5), name

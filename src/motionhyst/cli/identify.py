@@ -583,7 +583,8 @@ def add_parser(sub) -> None:
     q.add_argument("--elements", type=_element_count, metavar="N",
                    help="number of Jenkins elements (default: chosen by --criterion; "
                         "input-output records: 3, fewer where the records do not determine "
-                        "them, said on stderr)")
+                        "them or an element runs stiffer than they resolve, said on stderr "
+                        "with the cause)")
     q.add_argument("--cutoff", type=positive, metavar="HZ",
                    help="closed-loop records: cut-off of the prefilter through which the link "
                         "force is inferred [Hz] (default: 20 times the record's fundamental, "

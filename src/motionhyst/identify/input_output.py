@@ -424,6 +424,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
     fewer, budget = None, EvaluationBudget(max_evaluations)  # the whole search's, refits too
+    why: dict[int, str] = {}  # why a Maxwell-slip fit of so many elements was given up
     while True:
         try:
             fit = _route(records, link, stage, periodic=periodic, nu=nu, substeps=substeps,
@@ -432,10 +433,15 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                          max_evaluations=budget, init_window=init_window,
                          asymmetric=asymmetric, drift=drift, t_start=t_start,
                          rigid_limit=rigid_limit, rigid=rigid)
-        except StiffFit:  # an element stiffer than the records resolve: one fewer
+        except StiffFit as exc:  # an element stiffer than the records resolve: one fewer
             if not (fewer_elements and link is MaxwellSlip and n_elements > 1):
                 raise
             fewer = (fewer[0] if fewer else n_elements, n_elements - 1)
+            mode = f"its fastest mode at {exc.mode_hz:.3g} Hz, " if exc.mode_hz else ""
+            steps = f"{exc.steps} integration steps per sample" if exc.steps else "too many " \
+                "integration steps per sample"
+            why[n_elements] = (f"an element ran stiffer than the records resolve ({mode}"
+                               f"{steps})")
             n_elements -= 1
             continue
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
@@ -449,6 +455,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 if fewer_elements and link is MaxwellSlip and n_elements > 1 else n_elements)
         if kept < n_elements:  # elements the records do not determine: fewer of them
             fewer = (fewer[0] if fewer else n_elements, kept)
+            why[n_elements] = "the records do not determine every element's parameters"
             n_elements = kept
             continue
         if failed is not None and rigid_limit and fit.rigid_limit is not None:
@@ -465,9 +472,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     if by_direction is not None:
         fit.warnings.append(by_direction)
     if fewer is not None:
-        fit.warnings.append(f"the records do not determine the parameters of {fewer[0]} "
-                            f"Maxwell-slip elements: fitted with {fewer[1]} (the most they "
-                            f"determine; --elements N insists on N)")
+        fit.warnings.append(_fewer_line(fewer, why))
     if isinstance(fit.hysteresis, LuGre) and link is not LuGre:  # a positioning axis's
         note = presliding_note(fit.hysteresis, records)
         if note is not None:
@@ -578,6 +583,18 @@ def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
                    seconds=fit.seconds, extra={**rigid.extra,
                                                "rigid_limit": f"{fit.hysteresis.name}: {why}"}
                    ), determined
+
+
+def _fewer_line(fewer: tuple[int, int], why: dict[int, str]) -> str:
+    """The warning of a Maxwell-slip link fitted with fewer elements than asked: each count
+    given up and why (not determined, or an element too stiff to run)."""
+    if all(cause.startswith("the records do not determine") for cause in why.values()):
+        return (f"the records do not determine the parameters of {fewer[0]} Maxwell-slip "
+                f"elements: fitted with {fewer[1]} (the most they determine; --elements N "
+                f"insists on N)")
+    causes = "; ".join(f"with {n}, {cause}" for n, cause in sorted(why.items(), reverse=True))
+    return (f"the records do not resolve the parameters of {fewer[0]} Maxwell-slip elements: "
+            f"fitted with {fewer[1]} ({causes}; --elements N insists on N)")
 
 
 def _one_way_names(fit: IOIdentification) -> set[str]:

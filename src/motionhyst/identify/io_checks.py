@@ -77,10 +77,17 @@ class StiffFit(FitFailed):
 
     Examples
     --------
-    >>> isinstance(StiffFit("the fit failed: the identified model needs 3643 integration "
-    ...                     "steps per sample"), FitFailed)
-    True
+    >>> exc = StiffFit("the fit failed: the identified model needs 3643 integration steps per "
+    ...                "sample", steps=3643, mode_hz=3.6e5)
+    >>> isinstance(exc, FitFailed), exc.steps, exc.mode_hz
+    (True, 3643, 360000.0)
     """
+
+    def __init__(self, message: str, steps: int | None = None,
+                 mode_hz: float | None = None) -> None:
+        super().__init__(message)
+        self.steps = steps  # the integration steps per sample the model needs
+        self.mode_hz = mode_hz  # its fastest mode [Hz]
 
 
 def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray[np.float64]],
@@ -142,7 +149,7 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
                         f"sample (its fastest mode at {mode:.3g} Hz, {mode / records[0].fs:.3g} "
                         f"times the sampling rate: a link stiffer than the records resolve, or "
                         f"a mass collapsed); if the records show no inertia, use --plant "
-                        f"quasi-static")
+                        f"quasi-static", steps=r, mode_hz=mode)
     rec = records[0]
     try:
         y = system.simulate(rec.t, rec.u, substeps=r).displacement
