@@ -126,3 +126,25 @@ def test_a_slider_follows_through_its_play():
     x = np.array([0.0, 2.0, 1.5, 1.2, 3.0])
     assert slider_slips(Jenkins(k=10.0, fc=3.0), [x]) == pytest.approx((0.2, 2.7))
     assert slider_slips(Coulomb(fc=3.0), [x]) == pytest.approx((0.8, 3.0))
+
+
+def test_a_shift_an_initial_state_makes_up_is_one_way():
+    """A search's free initial velocity may tie itself to the slip force (the link slips
+    back at the start, by as much as fc lets it): the shifted model is judged with each
+    record's initial state refitted (the stop-and-go Coulomb fit's shift: 20 residual
+    variances with the fit's v0, 1.4 refitted).  Here the errors depend on v0 - fc / 50
+    besides the sum: with v0 refitted the shift fits as well; with no initial state to
+    refit it does not."""
+    from motionhyst.identify.io_one_way import one_way_slip
+
+    def errors_at(w):
+        sum_ = w[2] + w[3] - 17.0
+        tied = w[-1] - w[2] / 50.0 if w.size > 4 else w[2] - 5.0
+        return 1e-6 * np.cos(np.arange(1000)) + 1e-3 * sum_ + 1e-5 * tied
+
+    v = np.array([95.0, 200.0, 5.0, 12.0, 0.1])
+    names = ["m", "c", "link.fc", "input_offset", "v0"]
+    found = one_way_slip(names, v, float(np.sum(errors_at(v) ** 2)), 1000, errors_at)
+    assert found is not None and found.combination == "input_offset + link.fc"
+    assert one_way_slip(names[:4], v[:4], float(np.sum(errors_at(v[:4]) ** 2)), 1000,
+                        errors_at) is None

@@ -340,11 +340,11 @@ class _ElementProblem:
             r = np.full(sum(rec.y.size for rec in self.records), np.nan)
         return np.where(np.isfinite(r), r, 1e3)
 
-    def rss_at(self, v: NDArray[np.float64]) -> float:
-        """The residual sum of squares [m^2] of the model at the values `v` (not counted in
-        the search's budget; ``ValueError`` for values the model refuses)."""
-        return float(sum(np.sum((y - self._measured(rec)) ** 2)
-                         for (y, _), rec in zip(self.outputs(v), self.records, strict=True)))
+    def errors_at(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The output errors [m] of the model at the values `v`, every record's (not counted
+        in the search's budget; ``ValueError`` for values the model refuses)."""
+        return np.concatenate([y - self._measured(rec) for (y, _), rec
+                               in zip(self.outputs(v), self.records, strict=True)])
 
     def _extra_columns(self, v: NDArray[np.float64], y: list[NDArray[np.float64]]
                        ) -> NDArray[np.float64]:
@@ -770,7 +770,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     cov = covariance(J, rss, res.size, rtol, noise)
     slips = (slider_slips(layout.build(v[n_plant:n_base]), prob._split_rows(res, measured=True))
              if shape.n == 1 else None)  # the link moves with the measured position
-    one_way = one_way_slip(names, v, rss, res.size, prob.rss_at, cov, layout.cls.name, slips)
+    one_way = one_way_slip(names, v, rss, res.size, prob.errors_at, cov, layout.cls.name, slips)
     for name in one_way.names if one_way is not None else ():  # one force: the sum's known
         std[name] = None
         not_ident[name] = one_way.note
