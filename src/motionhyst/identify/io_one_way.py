@@ -116,9 +116,9 @@ def slider_slips(link, positions: list[NDArray[np.float64]]) -> tuple[float, flo
     for x in positions:
         x = np.asarray(x, dtype=float)
         for play in plays:
-            z = np.empty_like(x)
+            z = x if play == 0.0 else np.empty_like(x)  # a rigid slider: the position
             zi = x[0] if x.size else 0.0  # relaxed at the first sample
-            for i, xi in enumerate(x):
+            for i, xi in enumerate(x if play > 0.0 else ()):
                 zi = min(max(zi, xi - play), xi + play)
                 z[i] = zi
             if z.size:
