@@ -75,6 +75,15 @@ class StiffFit(FitFailed):
     link stiffer than the records resolve, or a mass collapsed): a Maxwell-slip link may be
     fitted again with fewer elements.
 
+    Parameters
+    ----------
+    message : str
+        The refusal, one line.
+    steps : int, optional
+        The integration steps per sample the model needs.
+    mode_hz : float, optional
+        Its fastest mode [Hz].
+
     Examples
     --------
     >>> exc = StiffFit("the fit failed: the identified model needs 3643 integration steps per "
