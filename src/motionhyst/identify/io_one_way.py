@@ -64,6 +64,13 @@ class OneWay:
         The warning.
     note : str
         The note on each of `names` (why it has no standard error).
+
+    Examples
+    --------
+    >>> found = OneWay(1, ["link.fc", "input_offset"], "input_offset + link.fc", 17.0, 0.0025,
+    ...                "the fitted link slips forward only ...", "not determined ...")
+    >>> found.to_dict()["direction"], found.to_dict()["value"]
+    ('forward', 17.0)
     """
 
     direction: int
@@ -75,7 +82,8 @@ class OneWay:
     note: str
 
     def to_dict(self) -> dict:
-        """The JSON form: direction, parameters, and the combination with its value."""
+        """The JSON form: direction, parameters, and the combination with its value and
+        standard error."""
         return {"direction": "forward" if self.direction > 0 else "backward",
                 "parameters": list(self.names), "combination": self.combination,
                 "value": self.value, "std": self.std}
