@@ -132,7 +132,7 @@ def test_a_shift_an_initial_state_makes_up_is_one_way():
     """A search's free initial velocity may tie itself to the slip force (the link slips
     back at the start, by as much as fc lets it): the shifted model is judged with each
     record's initial state refitted (the stop-and-go Coulomb fit's shift: 20 residual
-    variances with the fit's v0, 1.4 refitted).  Here the errors depend on v0 - fc / 50
+    variances with the fit's v0, 0.27 refitted).  Here the errors depend on v0 - fc / 50
     besides the sum: with v0 refitted the shift fits as well; with no initial state to
     refit it does not."""
     from motionhyst.identify.io_one_way import one_way_slip
