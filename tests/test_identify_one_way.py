@@ -120,6 +120,22 @@ def test_an_axis_that_slips_back_keeps_both(noise):
         assert abs(fit.estimates[name] - truth) < 0.15  # 0.5 % of fc: its local minima
 
 
+def test_a_slip_back_below_the_noise_keeps_both():
+    """Review A12b H2: pulled back so that the axis slips back by 0.3 um (a third of the
+    position noise, held over hundreds of samples): the records separate fc and the offset
+    (main fc 19.93 +- 0.057, offset -2.926 +- 0.055).  A rule "the fitted slider slips back by
+    less than the fit RMS" called it one-way and dropped both standard errors; a slider is
+    one-way only when it never slips back, else the shifted model's chi-square decides."""
+    s = np.sin(2 * np.pi * 2.0 * np.arange(2000) / FS)
+    push = 10 + 45 * np.maximum(s, 0) ** 2 - 30.5 * np.maximum(-s, 0) ** 8
+    fit = _fit(_axis(push, 1e-6, 0, "slips-back-0.3um"))
+    assert "one_way" not in fit.extra and not _said(fit, "forward")
+    for name, truth in (("link.fc", FC), ("input_offset", OFFSET)):
+        std = fit.std[name]
+        assert std is not None and std < 0.2
+        assert abs(fit.estimates[name] - truth) < 0.15
+
+
 def test_a_slider_follows_through_its_play():
     """A Jenkins slider takes no back move within its play fc / k; the Coulomb slider is
     the stage."""

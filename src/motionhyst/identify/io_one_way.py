@@ -8,17 +8,16 @@ Where the link would slip back (``u - input_offset < -fc`` while it sticks) the 
 go: they bound ``fc`` from below and leave it open above.
 
 The question is answered by the fitted model itself, which is exact, not by the measured
-positions (a back move below their noise may be a slip that separates the two, and one above
-it the elastic unloading of a link that never slips back), in two ways, either enough
-(:func:`one_way_slip`): its sliders, run on its own simulated positions
-(:func:`slider_slips`), slip back by no more than the fit's RMS error (a slip the records do
-not resolve); or its slip forces doubled and the force offset moved by as much the other way
-(a Dahl link's stiffness so that its force curve moves with them), each record's initial
-state refitted, fit the records as well as the fit (a residual sum of squares larger by less
-than :data:`ONE_WAY_CHI2` residual variances: inside the 95 % likelihood region of one
-parameter).  Jacobian-based standard errors do not see it: the search ends where the link is
-about to slip back, a kink, and their differences there report both to a few tenths of a per
-cent (a stop-and-go axis: fc 5.007 +- 0.019 N, offset 11.993 +- 0.017 N for a true 20 and -3).
+positions (a back move below their noise may be a slip that separates the two, and one above it
+the elastic unloading of a link that never slips back), in two ways, either enough
+(:func:`one_way_slip`): its sliders, run on its own simulated positions (:func:`slider_slips`),
+never slip back; or its slip forces doubled and the force offset moved by as much the other way
+(a Dahl link's stiffness so that its force curve moves with them), each record's initial state
+refitted, fit the records as well as the fit (a residual sum of squares larger by less than
+:data:`ONE_WAY_CHI2` residual variances: inside the 95 % likelihood region of one parameter).
+Jacobian-based standard errors do not see it: the search ends where the link is about to slip
+back, a kink, and their differences there report both to a few tenths of a per cent (a
+stop-and-go axis: fc 5.007 +- 0.019 N, offset 11.993 +- 0.017 N for a true 20 and -3).
 """
 
 from __future__ import annotations
@@ -32,12 +31,16 @@ from numpy.typing import NDArray
 
 from motionhyst.hysteresis import Jenkins, MaxwellSlip
 
-__all__ = ["ONE_WAY_CHI2", "REFIT_CAP", "OneWay", "one_way_slip", "slider_slips"]
+__all__ = ["NEVER_SLIPS", "ONE_WAY_CHI2", "REFIT_CAP", "OneWay", "one_way_slip", "slider_slips"]
 
 #: The 95 % point of the chi-square distribution with one degree of freedom: a model whose
 #: residual sum of squares exceeds the fit's by less than this many residual variances fits
 #: the records as well
 ONE_WAY_CHI2 = 3.841
+
+#: A slider's slip the other way up to this share of its slip one way is round-off: it never
+#: slips back
+NEVER_SLIPS = 1e-9
 
 #: A shifted model (:func:`one_way_slip`) that costs more than this many residual variances
 #: has its initial states refitted only up to here: beyond, no initial state makes it up (the
@@ -188,9 +191,8 @@ def one_way_slip(names: list[str], v: NDArray[np.float64], rss: float, n_rows: i
     and the force offset are one constant force.
 
     Two ways of the fitted model's own, either enough: its sliders (`slips`,
-    :func:`slider_slips`) slip back by no more than the fit's RMS error (a slip the records
-    do not resolve: a search's value ends where the link is about to slip back, and
-    slips there by a fraction of the noise), or the model with its slip forces doubled and
+    :func:`slider_slips`) never slip back (to :data:`NEVER_SLIPS` of their slip forward:
+    round-off), or the model with its slip forces doubled and
     the force offset moved by as much fits the records as well as the fit (by
     :data:`ONE_WAY_CHI2`), each record's initial state refitted where that shift costs at
     most :data:`REFIT_CAP` residual variances (a search's free initial velocity makes the
@@ -245,13 +247,12 @@ def one_way_slip(names: list[str], v: NDArray[np.float64], rss: float, n_rows: i
     sigma2 = rss / (n_rows - len(names))
     rms = math.sqrt(rss / n_rows)
     found = None  # (direction, the reason)
-    if slips is not None:
+    if slips is not None:  # a slider that never slips back: exactly (to round-off)
         back, ahead = slips
-        if back <= rms < ahead or ahead <= rms < back:
-            direction = 1 if back <= rms else -1
-            found = (direction, f"its slider slips {'back' if direction > 0 else 'forward'} "
-                                f"by {min(back, ahead):.2g} m at most, less than the fit's "
-                                f"RMS error {rms:.3g} m")
+        never = NEVER_SLIPS * max(back, ahead)
+        if back <= never < ahead or ahead <= never < back:
+            direction = 1 if back <= never else -1
+            found = (direction, f"its slider never slips {'back' if direction > 0 else 'forward'}")
     for direction in (1, -1) if found is None and sigma2 > 0 else ():
         w = _shifted(names, v, direction, link)
         try:
