@@ -46,7 +46,9 @@ def add_parser(sub) -> None:
                    help="integration steps per sample (default: >= 20 and >= 400 per period "
                         "of the stage's fastest mode; a quasi-static model has none)")
     q.add_argument("--init-from", metavar="REC.csv",
-                   help="a measured record of the same samples (time,force,displacement): the "
+                   help="a measured record of the same run and samples (time,force,"
+                        "displacement; one whose force varies independently of INPUT's is "
+                        "refused, a load cell's offset, gain or noise is not): the "
                         "model's initial state (velocity, and position or the position's "
                         "offset) is set from its first --init-window samples, and the error "
                         "after them is reported (the benchmark convention)")
@@ -107,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
                                                    atol=1e-6 * float(np.ptp(t))):
             raise UsageError(f"motionhyst predict: {args.init_from} must have the samples "
                              f"of {args.data} (the same time column)")
+        _check_same_run(args, u, rec.u)
     try:
         if rec is not None:
             from motionhyst.identify.io_predict import predict_from_window  # scipy.optimize
@@ -147,6 +150,57 @@ def _only(mapping, keys=("time", "force")):
     """The entries of a --columns or --scale map that the force record has (the rest, such
     as displacement=, are for the --init-from record)."""
     return None if mapping is None else {k: v for k, v in mapping.items() if k in keys}
+
+
+SAME_RUN_CORRELATION = 0.5
+"""An ``--init-from`` record whose force's variations correlate with INPUT's by at least this
+(in magnitude) is taken for the same run: a load cell's offset or gain error leaves the
+correlation 1, white noise of 15 % of the force's RMS 0.989, and noise (of any colour) up to
+1.7 times that RMS keeps it above 0.5."""
+
+SAME_RUN_NOISE_FACTOR = 2.0
+"""Below :data:`SAME_RUN_CORRELATION`, the two forces are still taken for the same run when
+what one does not share with the other is, in RMS, within this factor of their sensors'
+white noise (:func:`_white_noise_variance`): a load cell's noise larger than the force."""
+
+
+def _white_noise_variance(f) -> float:
+    """The variance of a record's white noise, from its third differences (20 times the
+    noise's variance; a force sampled well above its bandwidth adds little to them)."""
+    return float(np.mean(np.diff(f, 3) ** 2)) / 20.0 if f.size > 3 else 0.0
+
+
+def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
+    """Refuse an ``--init-from`` record that is provably of another run than INPUT: its
+    position would set the state, and be the reference of the error reported, of another run.
+
+    Judged by the forces' shapes, not their levels: a load cell's offset, gain error or sign
+    (a sensor of the same run) change neither the magnitude of the correlation of the
+    de-meaned forces nor how far they differ beyond their noise.  Refused only when the
+    correlation is below :data:`SAME_RUN_CORRELATION` and what the record's force does not
+    share with INPUT's exceeds :data:`SAME_RUN_NOISE_FACTOR` times the white noise of the
+    two; a force constant in either record, or non-finite samples, are not judged (the
+    record's force is not used)."""
+    ok = np.isfinite(u) & np.isfinite(u_rec)
+    a, b = u[ok] - np.mean(u[ok]), u_rec[ok] - np.mean(u_rec[ok])
+    aa, bb = float(a @ a), float(b @ b)
+    if a.size < 4 or not (aa > 0 and bb > 0):
+        return
+    rho = float(a @ b) / np.sqrt(aa * bb)
+    if abs(rho) >= SAME_RUN_CORRELATION:
+        return
+    unshared = (1.0 - rho ** 2) * bb / b.size  # b's variance about its regression on a
+    noise = _white_noise_variance(u_rec[ok]) + rho ** 2 * bb / aa * _white_noise_variance(u[ok])
+    if unshared <= SAME_RUN_NOISE_FACTOR ** 2 * noise:
+        return
+    beyond = (f"differ by {np.sqrt(unshared / noise):.3g} times their white noise"
+              if noise > 0 else "differ while neither has white noise")
+    raise UsageError(f"motionhyst predict: {args.init_from} is not the run of {args.data}: "
+                     f"their forces vary independently (the de-meaned forces correlate by "
+                     f"{rho:.2g}, less than {SAME_RUN_CORRELATION:g} in magnitude, and "
+                     f"{beyond}), while a sensor's offset, gain error or noise keeps one "
+                     f"run's forces correlated; its position would set the state, and score "
+                     f"the prediction, of another run")
 
 
 def _check_step(system, t, args) -> None:
