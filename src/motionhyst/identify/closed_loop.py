@@ -153,6 +153,12 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     >>> bool(error < 5e-3 * np.abs(sim.w).max())             # measured: 0.1 % of the force
     True
     """
+    return _infer(t, y1, u, stage, cutoff_hz, controller)[0]
+
+
+def _infer(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage, cutoff_hz: float | None,
+           controller) -> tuple[LinkForce, HoldFilter]:
+    """:func:`infer_link_force`, and its filter ``L / P1``."""
     ts = np.asarray(t, dtype=float)
     ys = np.ascontiguousarray(np.asarray(y1, dtype=float))
     us = np.asarray(u, dtype=float)
@@ -182,7 +188,88 @@ def infer_link_force(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     else:
         Lu = L(us)
     w_f = Lu - L_over_P1(ys - ys[0])
-    return LinkForce(t=ts, y1=ys, w=w_f, lowpass=L, cutoff_hz=cutoff_hz, settle_index=settle)
+    lf = LinkForce(t=ts, y1=ys, w=w_f, lowpass=L, cutoff_hz=cutoff_hz, settle_index=settle)
+    return lf, L_over_P1
+
+
+PASSIVE_SIGMAS = 5.0
+"""A closed-loop record's inferred link force creates energy, and is refused, when its work
+over the record's whole cycles is below zero by more than this many times its noise spread,
+beyond the energy a link's elements could have released (:func:`_check_passive`)."""
+
+
+def _white_noise_variance(x: NDArray[np.float64]) -> float:
+    """The variance of a signal's white noise, from its third differences (20 times the
+    noise's variance); the controller's fast action on ``u`` counts as noise (more spread)."""
+    return float(np.mean(np.diff(x, 3) ** 2)) / 20.0 if x.size > 3 else 0.0
+
+
+def _whole_cycles(z: NDArray[np.float64], start: int) -> tuple[int, int, int]:
+    """The first and last rise of `z` (from `start` on) through the middle of its range, each
+    after a fall below it by a tenth of the range, and the whole cycles between them."""
+    zs = z[start:]
+    mid, band = 0.5 * (float(np.min(zs)) + float(np.max(zs))), 0.1 * float(np.ptp(zs))
+    rises = start + 1 + np.flatnonzero((zs[:-1] < mid) & (zs[1:] >= mid))
+    below = start + np.flatnonzero(zs < mid - band)
+    kept, last = [], -1
+    for i in rises:  # a rise counts once z fell below the band since the last one
+        j = int(np.searchsorted(below, last + 1))
+        if j < below.size and below[j] < i:
+            kept.append(int(i))
+            last = int(i)
+    if len(kept) < 2:
+        return 0, 0, 0
+    return kept[0], kept[-1], len(kept) - 1
+
+
+def _check_passive(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64]) -> None:
+    """Refuse a closed-loop record whose inferred link force provably creates energy.
+
+    A link (any passive element between the stage and the world) dissipates: over whole
+    cycles of its position the work of its force on it is at least minus the energy its
+    elements had stored.  The work of the prefiltered force ``L w`` along ``L y1`` over the
+    whole cycles after the prefilter settles (from the first to the last rise through the
+    middle of the range), the line of ``L w`` in ``L y1`` taken out (a spring and an offset
+    do no work over whole cycles), is compared with its noise spread (the white noise of
+    ``u`` and ``y1``, estimated from their third differences, carried through ``L`` and
+    ``L / P1`` exactly) and with what a link could release: its elements' stored energy,
+    at most a quarter of the force's spread about the line times half the range of
+    ``L y1``.  Below zero by :data:`PASSIVE_SIGMAS` spreads plus that energy, the record is
+    refused: noise alone, or a link's own nonlinearity, does not cross it."""
+    z = lf.lowpass(lf.y1 - lf.y1[0])
+    a, b, cycles = _whole_cycles(z, lf.settle_index)
+    if cycles < 1:
+        return  # no whole cycle: nothing to judge
+    zz, ww = z[a:b + 1], lf.w[a:b + 1]
+    basis = np.column_stack([np.ones_like(zz), zz - zz[0]])
+    r = ww - basis @ np.linalg.lstsq(basis, ww, rcond=None)[0]
+    rbar, dz = 0.5 * (r[1:] + r[:-1]), np.diff(zz)
+    work = float(rbar @ dz)
+    # the work's first-order response to the force (ga) and to L y1 (gb) at each sample
+    ga, gb = np.zeros(z.size), np.zeros(z.size)
+    ga[a:b] += 0.5 * dz
+    ga[a + 1:b + 1] += 0.5 * dz
+    gb[a:b] -= rbar
+    gb[a + 1:b + 1] += rbar
+    L = lf.lowpass
+
+    def transposed(f, x):  # sum_j x_j (f v)_j = sum_i v_i (transposed(f, x))_i
+        return f(x[::-1])[::-1]
+
+    on_u = transposed(L, ga)
+    on_y1 = transposed(L, gb) - transposed(L_over_P1, ga)
+    spread = float(np.sqrt(_white_noise_variance(u) * (on_u @ on_u)
+                           + _white_noise_variance(lf.y1) * (on_y1 @ on_y1)))
+    stored = 0.125 * float(np.ptp(r)) * float(np.ptp(zz))
+    if work + PASSIVE_SIGMAS * spread + stored < 0:
+        raise ValueError(
+            f"the link force inferred through the plant creates energy: over the record's "
+            f"{cycles} whole cycle(s) of y1 (t = {lf.t[a]:.4g} to {lf.t[b]:.4g} s, "
+            f"prefiltered) its work on the stage is {work:.3g} J, below zero by more than "
+            f"{PASSIVE_SIGMAS:g} times its noise spread ({spread:.2g} J) and the energy a "
+            f"link could have stored ({stored:.2g} J), while a link dissipates: not a link's "
+            f"force (u or y1 of the wrong sign? the plant not the record's?); nothing "
+            f"identified")
 
 
 def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
@@ -237,9 +324,10 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
                          "force offset on a spring; use offset 'auto', 'input' or 'none'")
     if offset not in ("auto", "input", "none"):
         raise ValueError(f"unknown offset choice {offset!r}; expected auto, input or none")
-    lf = infer_link_force(t, y1, u, stage, cutoff_hz, controller)
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
+    lf, L_over_P1 = _infer(t, y1, u, stage, cutoff_hz, controller)
+    _check_passive(lf, L_over_P1, np.asarray(u, dtype=float))  # before the fit's work
     # L w is band-limited: fit on every q-th sample (the model's prefilter re-discretised)
     dt = lf.lowpass.dt
     q = max(1, int(1.0 / (dt * DECIMATED_RATE * lf.cutoff_hz)))
