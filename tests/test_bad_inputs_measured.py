@@ -87,6 +87,12 @@ CASES = [
      ["cl.csv: cutoff_hz must be in (0, 5000) Hz"]),
     ("closed-loop-cutoff-longer-than-the-record", {}, [*CLOSED_LOOP, "--cutoff", "1e-3"],
      ["cl.csv: too short: the prefilter settles in 1e+04 s"]),
+    # ------------- a made-up closed-loop record whose inferred link force is an ellipse, a
+    # spring's and a damper's (was 6 Maxwell-slip elements, R^2 0.99999, exit 0)
+    ("closed-loop-record-of-a-spring-and-a-damper", {}, CLOSED_LOOP,
+     ["cl.csv: no hysteresis in the record: the link force inferred through the plant is a "
+      "spring's and a damper's (they leave 0 % of its RMS, a straight line 5.6 %)",
+      "nothing identified"]),
 ]
 
 

@@ -101,3 +101,20 @@ def test_an_ellipse_run_the_wrong_way_is_refused(paper_loop, damping, u_noise, s
     with pytest.raises(ValueError, match=r"creates energy: over the record's 8 whole cycle"):
         identify_closed_loop(t, y1, u, plant)
 
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("phase", [0.1, 0.2, 0.5])
+def test_a_spring_and_damper_s_ellipse_is_refused(paper_loop, phase, seed):
+    """A made-up record: y1 a 2 Hz sine of 10 mm, u a sine of 50 N leading it by `phase`
+    [rad], with 0.1 N of noise: the inferred force is a spring's and a damper's (they leave
+    0.02 % of its RMS, a straight line 6-30 %), refused before the fit (was 6 Maxwell-slip
+    elements at R^2 0.99999, exit 0)."""
+    plant = paper_loop[0]
+    t = np.arange(20_000) / RATE
+    y1 = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+    u = _noisy(50.0 * np.sin(2 * np.pi * 2.0 * t + phase), 0.1, seed)
+    with pytest.raises(ValueError, match=r"no hysteresis in the record: the link force "
+                       r"inferred through the plant is a spring's and a damper's \(they leave "
+                       r"0[.0-9]* % of its RMS, a straight line \d+ %\): its loops widen with the "
+                       r"speed"):
+        identify_closed_loop(t, y1, u, plant)

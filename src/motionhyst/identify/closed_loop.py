@@ -222,6 +222,41 @@ def _whole_cycles(z: NDArray[np.float64], start: int) -> tuple[int, int, int]:
     return kept[0], kept[-1], len(kept) - 1
 
 
+def _check_not_a_damper(lf: LinkForce) -> None:
+    """Refuse a closed-loop record whose inferred link force is a spring's and a damper's.
+
+    The test of :func:`~motionhyst.identify.records.check_loops_open` in the prefiltered
+    domain (``L (k y1 + c dy1/dt) = k L y1 + c d(L y1)/dt``): after the prefilter settles,
+    a spring and a damper on ``L y1`` leaving less than
+    :data:`~motionhyst.identify.records.ELASTIC_CURVE_RATIO` of a straight line's systematic
+    error, and less than what a fit may leave, describe loops that widen with the speed,
+    which elements that slip do not (they leave a damper at least a fifth of the line's).
+    Noise, which the prefilter makes smooth, is left by both alike and refuses nothing."""
+    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, systematic_share
+    from motionhyst.identify.records import DAMPER_LINE_SHARE, ELASTIC_CURVE_RATIO
+
+    i = lf.settle_index
+    z = lf.lowpass(lf.y1 - lf.y1[0])[i:]
+    w = lf.w[i:]
+    v = np.gradient(z, lf.t[i:])
+    if z.size < 3 or not (np.ptp(z) > 0 and np.max(np.abs(v)) > 0):
+        return
+    shares = []
+    for basis in (np.column_stack([np.ones_like(z), z - z[0]]),
+                  np.column_stack([np.ones_like(z), z - z[0], v / float(np.max(np.abs(v)))])):
+        shares.append(systematic_share(w - basis @ np.linalg.lstsq(basis, w, rcond=None)[0], w))
+    line, damper = shares
+    if line > DAMPER_LINE_SHARE * SYSTEMATIC_SHARE and \
+            damper < min(ELASTIC_CURVE_RATIO * line, SYSTEMATIC_SHARE):
+        raise ValueError(f"no hysteresis in the record: the link force inferred through the "
+                         f"plant is a spring's and a damper's (they leave "
+                         f"{round(100 * damper, 2):.2g} % of its RMS, a straight line "
+                         f"{100 * line:.2g} %): its loops widen with the speed, while a "
+                         f"slipping element's follow the path alone (u and y1 sampled at "
+                         f"different instants? the plant's damping not the record's?); "
+                         f"nothing identified")
+
+
 def _check_passive(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64]) -> None:
     """Refuse a closed-loop record whose inferred link force provably creates energy.
 
@@ -328,6 +363,7 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
     lf, L_over_P1 = _infer(t, y1, u, stage, cutoff_hz, controller)
     _check_passive(lf, L_over_P1, np.asarray(u, dtype=float))  # before the fit's work
+    _check_not_a_damper(lf)
     # L w is band-limited: fit on every q-th sample (the model's prefilter re-discretised)
     dt = lf.lowpass.dt
     q = max(1, int(1.0 / (dt * DECIMATED_RATE * lf.cutoff_hz)))
