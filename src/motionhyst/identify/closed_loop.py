@@ -341,6 +341,13 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     -------
     Identification
 
+    Raises
+    ------
+    ValueError
+        Before the fit, for a record whose inferred link force is no link's: one that
+        creates energy over the record's whole cycles beyond its noise and what a link could
+        have stored, or a spring's and a damper's (loops that widen with the speed).
+
     Examples
     --------
     >>> import numpy as np
