@@ -101,7 +101,7 @@ def test_the_same_run_s_record_with_a_sensor_s_error_sets_the_state(tmp_path, ca
     out, err = capsys.readouterr()
     assert code == 0, err
     rmse = json.loads(out)["rmse"]
-    assert rmse < 3 * POSITION_NOISE, rmse  # measured 1.0e-7: the same run's position
+    assert rmse < 3 * POSITION_NOISE, rmse  # measured 1.1e-7 to 1.5e-7: the run's position
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
