@@ -1,13 +1,17 @@
-"""A closed-loop record whose inferred link force creates energy is not a link's (issue 26).
+"""A closed-loop record whose inferred link force is no link's is refused before the fit
+(issue 26).
 
 ``identify REC --scenario S`` infers the link force through the plant and fits Maxwell-slip
-elements to it; a made-up record whose inferred force is an ellipse run the wrong way (a
-spring with a negative damper), or the paper's loop with the link force of the wrong sign,
-was fitted with elements and exit 0.  A link dissipates: the work of its prefiltered force
-along the prefiltered position over the record's whole cycles, below zero by more than five
-times its noise spread and what a link could have stored, is refused before the fit.  The
-paper's loop under heavy noise (the reviewer's: 0.5-1 um on y1, 0.6-2 N on u, where an
-R^2 floor refused it) is identified as before.
+elements to it.  A made-up record whose inferred force is an ellipse (a spring and a damper)
+was fitted with 6 elements and exit 0; one whose damper pushes (it creates energy) was
+fitted by :func:`identify_closed_loop`, which returned elements, and refused by the command
+only after the fit, as "no hysteresis"; the paper's loop with the link force of the wrong
+sign was refused by the fit's start, as "the force falls as the displacement rises".  A link
+dissipates: the work of its prefiltered force along the prefiltered position over the
+record's whole cycles, below zero by more than five times its noise spread and what a link
+could have stored, is refused before the fit, and so is a force a spring and a damper
+describe.  The paper's loop under heavy noise (the reviewer's: 0.5-1 um on y1, 0.6-2 N on
+u, where an R^2 floor refused it) is identified as before.
 """
 
 from __future__ import annotations
@@ -68,7 +72,8 @@ def test_the_paper_s_loop_with_a_noisy_force_is_not_refused(paper_loop, y1_noise
 def test_a_link_force_of_the_wrong_sign_is_refused(paper_loop, y1_noise, u_noise, seed):
     """The paper's loop with the link's force reversed in u (u - 2 w: the inferred force the
     link's negated, it pushes the stage along): it does -3 mJ of work over two cycles,
-    refused before the fit (was 1 element "identified", exit 0)."""
+    refused before the fit, naming the work (was refused by the fit's start, as "the force
+    falls as the displacement rises")."""
     plant, t, y1, u, w = paper_loop
     with pytest.raises(ValueError, match=r"the link force inferred through the plant creates "
                        r"energy: over the record's \d whole cycle\(s\) of y1 .* its work on the "
@@ -95,7 +100,8 @@ def _ellipse(plant, damping: float, u_noise: float, seed: int):
 @pytest.mark.parametrize(("damping", "u_noise"), [(-2e-3, 0.0), (-0.05, 0.01), (-0.2, 0.05)])
 def test_an_ellipse_run_the_wrong_way_is_refused(paper_loop, damping, u_noise, seed):
     """The inferred force an ellipse whose damper pushes (6e-4 to 0.06 N against a 0.2 N
-    spring force; noise up to a quarter of it): refused (was 6-7 elements, exit 0)."""
+    spring force; noise up to a quarter of it): refused before the fit (was fitted,
+    elements returned; the command refused it after the fit as "no hysteresis")."""
     plant = paper_loop[0]
     t, y1, u = _ellipse(plant, damping, u_noise, seed)
     with pytest.raises(ValueError, match=r"creates energy: over the record's 8 whole cycle"):
