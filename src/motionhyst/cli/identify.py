@@ -190,11 +190,6 @@ def run(args: argparse.Namespace) -> int:
 
     if kind == "force-displacement":
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
-        from motionhyst.identify.fd_memory import check_elements_fit_memory
-
-        # its checks, the bound (where it runs) and the fit, before any of them
-        check_elements_fit_memory(t.size, str(path), bound=args.elements is None
-                                  or target is not None)
         measured = [(path, t, x, w)]
         from motionhyst.identify.displacement_noise import estimate_displacement
 
@@ -222,6 +217,12 @@ def run(args: argparse.Namespace) -> int:
                 check_loops_open(x, w, t)
             except ValueError as exc:
                 raise ValueError(f"{path}: {exc}") from None
+        from motionhyst.identify.fd_memory import check_elements_fit_memory
+
+        # the mass check, the bound (where it runs) and the fit, before any of them (after
+        # the light checks: its sizes are the fit module's, which loads the fit libraries)
+        check_elements_fit_memory(t.size, str(path), bound=args.elements is None
+                                  or target is not None)
         # a mass (its stop operators load the compiled kernels: after the light checks)
         mass = _refuse_a_mass(measured)
         from motionhyst.identify.fit import identify_maxwell_slip
