@@ -393,17 +393,17 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     for path in paths:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         records.append((path, t, x, w))
-    mass = _refuse_a_mass(records)
-    if mass is not None:
-        from motionhyst.core.warnings import warn
-
-        warn(mass)
     from motionhyst.hysteresis import model_class
     from motionhyst.identify.fd_memory import check_link_force_memory
 
     nu = None if args.nu in (None, "free") else args.nu
     check_link_force_memory([t.size for _, t, _, _ in records], model_class(args.model),
-                            args.elements or 3, nu)  # before the starts are fitted
+                            args.elements or 3, nu)  # before the mass check and the starts
+    mass = _refuse_a_mass(records)
+    if mass is not None:
+        from motionhyst.core.warnings import warn
+
+        warn(mass)
     from motionhyst.identify.io_quasi_static import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
