@@ -123,7 +123,7 @@ def _swept_share(x, w, t) -> float:
 
 
 def test_the_bound_lies_below_what_the_fit_leaves_and_near_zero_for_maxwell_slip():
-    from motionhyst.identify.fit import systematic_share_bound
+    from motionhyst.identify.fd_bound import systematic_share_bound
 
     # loops of a damper: the bound (6.9 %, measured) refuses, and the fit leaves more
     t, x, w = _jenkins_and_damper(600)
@@ -214,7 +214,7 @@ def test_the_bound_never_exceeds_what_the_elements_that_made_the_record_leave(ki
     noise, the coloured noise's, the lag's), whatever their slip displacements.  A bound
     whose slip displacements stopped at 1e-3 of the half range was above it on 20 of these
     21 records (up to 27 % of the force's RMS where they leave 0, measured)."""
-    from motionhyst.identify.fit import systematic_share_bound
+    from motionhyst.identify.fd_bound import systematic_share_bound
     from motionhyst.identify.io_checks import systematic_share
 
     x, w, true = _family(kind, seed)
@@ -230,7 +230,7 @@ def test_the_bound_stays_below_the_elements_share_under_heavy_force_noise(share,
     the allowance for its noise estimate's spread the bound claimed 2.9 % (8000 samples,
     seed 4, 50 %), 5.5 % and 2.7 % (30000 samples, seed 7, 50 % and 30 %): refused before
     the fit, which identifies these records (measured)."""
-    from motionhyst.identify.fit import systematic_share_bound
+    from motionhyst.identify.fd_bound import systematic_share_bound
 
     t = np.arange(samples) / 1000.0
     x = 20e-6 * np.sin(2 * np.pi * t) * (0.6 + 0.4 * np.cos(2 * np.pi * 0.25 * t))
@@ -247,7 +247,8 @@ def test_every_slip_displacement_between_the_bounds_columns_is_a_blend_of_its_ne
     """The bound's claim on its columns: the stop operator of any slip displacement from the
     limit of zero slip to half the range is within twice the tolerance (RMS, per unit slip
     force) of a blend of the two columns around it (measured: at most 1.44 times)."""
-    from motionhyst.identify.fit import BOUND_TOLERANCE, _bound_columns, _stops_at
+    from motionhyst.identify.fd_bound import BOUND_TOLERANCE, _bound_columns
+    from motionhyst.identify.stop_operators import _stops_at
 
     x, _, _ = _family(kind, 3)
     x = np.ascontiguousarray(x)
@@ -270,7 +271,7 @@ def test_every_slip_displacement_between_the_bounds_columns_is_a_blend_of_its_ne
 def test_the_bound_leaves_the_fits_own_reasons_first():
     """A force of noise (no hysteresis) and a force whose sign is reversed: 0, so that the
     fit's own messages say so (the first reason stays the message)."""
-    from motionhyst.identify.fit import systematic_share_bound
+    from motionhyst.identify.fd_bound import systematic_share_bound
 
     _, x = _displacement(6000)
     noise = np.random.default_rng(5).standard_normal(x.size)
@@ -296,7 +297,7 @@ def test_a_record_that_reaches_its_extremes_only_at_its_end_is_judged_before_the
     0.1 % of its range of its extremes (sample 750), the bound says 2.07-2.08 %
     (measured): refused before the fit, below what the fit leaves."""
     from motionhyst.identify.displacement_noise import estimate_displacement
-    from motionhyst.identify.fit import _sweeps, systematic_share_bound
+    from motionhyst.identify.fd_bound import _sweeps, systematic_share_bound
 
     rng = np.random.default_rng(200 + seed)
     t, x = _breathing()
@@ -314,7 +315,7 @@ def test_the_bound_taken_short_of_the_extremes_stays_below_what_the_elements_lea
     Coulomb element, on a record whose amplitude grows by 1e-4 to its end (its extremes
     there): the bound taken short of them (allowing for the longer elements' slack) is below
     the elements' own systematic share (0, white noise) plus 0.1 %."""
-    from motionhyst.identify.fit import _sweeps, systematic_share_bound
+    from motionhyst.identify.fd_bound import _sweeps, systematic_share_bound
     from motionhyst.identify.io_checks import systematic_share
 
     rng = np.random.default_rng(seed)
@@ -342,9 +343,10 @@ def test_a_long_dahl_record_is_refused_before_the_fit(tmp_path, monkeypatch, cap
     of CPU.  From where it comes within 0.1 % of them (5 s) the bound says 3.75 % (measured):
     no number of elements describes it, refused before the fit."""
     from motionhyst.identify import fit
+    from motionhyst.identify.fd_bound import systematic_share_bound
 
     t, x, w = _dahl()
-    assert fit.systematic_share_bound(x, w) > 0.03
+    assert systematic_share_bound(x, w) > 0.03
 
     def reached(*args, **kwargs):
         raise AssertionError("the fit started")

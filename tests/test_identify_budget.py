@@ -98,7 +98,7 @@ def test_the_bound_holds_fewer_stop_operators_within_a_small_budget(monkeypatch)
     """The bound of what any elements leave takes as many stop operators as the budget holds:
     2000 within a large one, fewer (a lower bound still) within a small one."""
     from motionhyst.core.budget import set_max_memory
-    from motionhyst.identify.fit import BOUND_COLUMNS, systematic_share_bound
+    from motionhyst.identify.fd_bound import BOUND_COLUMNS, systematic_share_bound
 
     try:
         set_max_memory(1 << 40)

@@ -533,12 +533,12 @@ half the record's displacement range (one at the range's end is a spring there).
 def _refuse_beyond_bound(path: Path, x, w) -> None:
     """Refuse, before the fit, a force-displacement record that no number of Maxwell-slip
     elements describes: when even the best of them leave more systematic error
-    (:func:`~motionhyst.identify.fit.systematic_share_bound`, a lower bound) than a fit may
+    (:func:`~motionhyst.identify.fd_bound.systematic_share_bound`, a lower bound) than a fit may
     (:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`), the fit would end in
     :func:`_judge_elements`'s refusal after its work.  The checks that name another cause
     (no hysteresis, a sensor's sign reversed) stay the fit's: the bound leaves them alone."""
     from motionhyst.identify.fd_memory import bound_columns
-    from motionhyst.identify.fit import systematic_share_bound
+    from motionhyst.identify.fd_bound import systematic_share_bound
     from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed
 
     bound = systematic_share_bound(x, w, max_columns=bound_columns(x.size))

@@ -6,9 +6,9 @@ routes, each sized here from the record's samples alone and refused above the me
 
 * Maxwell-slip elements by non-negative least squares (``identify`` without ``--model``):
   the check that the loops open (:func:`~motionhyst.identify.records.check_loops_open`), the
-  bound of what any elements leave (:func:`~motionhyst.identify.fit.systematic_share_bound`:
-  at most :data:`~motionhyst.identify.fit.BOUND_COLUMNS` stop operators on
-  :data:`~motionhyst.identify.fit.BOUND_ROWS` samples) and the fit (its operators on at most
+  bound of what any elements leave (:func:`~motionhyst.identify.fd_bound.systematic_share_bound`:
+  at most :data:`~motionhyst.identify.fd_bound.BOUND_COLUMNS` stop operators on
+  :data:`~motionhyst.identify.fd_bound.BOUND_ROWS` samples) and the fit (its operators on at most
   :data:`~motionhyst.identify.fit.MAX_ROWS` samples), one after the other: the largest of
   them counts (:func:`elements_fit_memory`).
 * A link with a spring and damper in parallel fitted by the force's error (``--model``:
@@ -70,8 +70,8 @@ Jacobian (the link's run, its force and residuals, the forward difference's)."""
 
 def bound_columns(n_samples: int) -> int:
     """The most stop operators the bound of what any Maxwell-slip elements leave
-    (:func:`~motionhyst.identify.fit.systematic_share_bound`) may hold within the memory
-    budget: :data:`~motionhyst.identify.fit.BOUND_COLUMNS`, fewer within a small one (a
+    (:func:`~motionhyst.identify.fd_bound.systematic_share_bound`) may hold within the memory
+    budget: :data:`~motionhyst.identify.fd_bound.BOUND_COLUMNS`, fewer within a small one (a
     bound that allows for a coarser interval, lower), at least :data:`MIN_BOUND_COLUMNS`.
 
     Parameters
@@ -92,7 +92,7 @@ def bound_columns(n_samples: int) -> int:
     >>> set_max_memory(None)
     """
     from motionhyst.core.budget import max_memory
-    from motionhyst.identify.fit import BOUND_COLUMNS, BOUND_ROWS
+    from motionhyst.identify.fd_bound import BOUND_COLUMNS, BOUND_ROWS
 
     n = int(n_samples)
     room = max_memory() - RECORD_BYTES * n
@@ -123,7 +123,8 @@ def elements_fit_memory(n_samples: int, columns: int = MIN_BOUND_COLUMNS) -> dic
     >>> {k: round(v / 1e6) for k, v in need.items()}
     {'loops': 62, 'bound': 600, 'fit': 215, 'total': 600}
     """
-    from motionhyst.identify.fit import BOUND_ROWS, MAX_ROWS
+    from motionhyst.identify.fd_bound import BOUND_ROWS
+    from motionhyst.identify.fit import MAX_ROWS
 
     n = int(n_samples)
     record = RECORD_BYTES * n
