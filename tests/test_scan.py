@@ -251,3 +251,43 @@ def test_cli_scan_never_writes_over_its_scenario(tmp_path, capsys):
     assert cli_main(["scan", str(sc), *SHORT, "--compensation", "none", "--time-series",
                      str(sc), "--force"]) == 2
     assert "input" in capsys.readouterr().err and sc.read_bytes() == before
+
+
+@pytest.mark.parametrize(("scenario", "runs"), [(None, 3), (EXAMPLES / "scan.toml", 4)])
+def test_cli_scan_sizes_the_runs_it_compares(tmp_path, monkeypatch, scenario, runs):
+    """Without --compensation a scan compares a model run only where the scenario has a
+    model feedforward (Table I has none: none, ilc, basis; examples/scan.toml: none, model,
+    ilc, basis): its memory estimate counts those runs and its --time-series estimate their
+    columns, as many as it writes (review A12a L1: 4 runs and 15 columns were counted for
+    Table I's 12, 27 % high; 3 runs for scan.toml's 4)."""
+    from motionhyst.io import outputs
+    from motionhyst.time import steps
+
+    counted, columns = [], []
+    check_steps, check_csv = steps.check_scan_steps, outputs.OutputFile.check_csv_size
+    monkeypatch.setattr(steps, "check_scan_steps",
+                        lambda *a, **k: counted.append(a[2]) or check_steps(*a, **k))
+    monkeypatch.setattr(outputs.OutputFile, "check_csv_size",
+                        lambda self, rows, cols, *a, **k: columns.append(cols)
+                        or check_csv(self, rows, cols, *a, **k))
+    out = tmp_path / "ts.csv"
+    assert cli_main(["scan", *([str(scenario)] if scenario else []), *SHORT, "--ilc-trials",
+                     "1", "--basis-trials", "2", "--time-series", str(out)]) == 0
+    written = len(out.read_text().splitlines()[0].split(","))
+    assert written == 3 + 3 * runs and columns == [written]
+    assert counted == [runs, runs]  # the setpoint and the carry-over setpoint
+
+
+def test_cli_scan_time_series_fits_a_disk_that_holds_it(tmp_path):
+    """Under a file size limit 15 % above the file a scan of Table I writes with its default
+    compensations (12 columns), the file is written (its estimate, 21 bytes a number, is
+    about 10 % above the file); main counted 15 columns (37 % above) and refused it."""
+    import limited_process
+
+    argv = ["scan", *SHORT, "--ilc-trials", "1", "--basis-trials", "2", "--time-series"]
+    assert cli_main([*argv, str(tmp_path / "whole.csv")]) == 0
+    size = (tmp_path / "whole.csv").stat().st_size
+    code, _, err = limited_process.run([*argv, "ts.csv"], tmp_path,
+                                       file_limit=int(1.15 * size), timeout=300)
+    assert code == 0, err
+    assert (tmp_path / "ts.csv").stat().st_size == size

@@ -262,7 +262,8 @@ def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None
         return
     rate = getattr(controller, "sample_rate_hz", None)
     pole = sc.fastest_pole()  # None when sampled: its loop is checked all the same
-    runs = len(args.compensation or ["none", "ilc", "basis"])  # model: only with a model
+    runs = len(args.compensation or (["none", "model", "ilc", "basis"] if _model_given(args, sc)
+                                     else ["none", "ilc", "basis"]))  # as run() compares
     for p in (profile, other):
         if p is not None:
             step = (longest_step(p.max_frequency_hz, None if rate is None else 1.0 / rate)
@@ -277,7 +278,7 @@ def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None
                           + f"; {REMEDY}")
             n = check_scan_steps(p.end + args.tail, step, runs, remedy, at_least=pole is None)
             if out is not None and p is profile:  # time, r, scan; e, ma, msd of each run
-                out.check_csv_size(n, 3 + 3 * (runs + (args.compensation is None)),
+                out.check_csv_size(n, 3 + 3 * runs,
                                    remedy=f"{REMEDY}, or write --time-series where there "
                                    f"is room")
             if pole is not None or rate is not None:  # the run's own step: known
@@ -302,6 +303,18 @@ def _check_at(args: argparse.Namespace, sc) -> None:
                          f"along it ([hysteresis] along) ({sc.source})")
 
 
+def _model_given(args: argparse.Namespace, sc) -> bool:
+    """Whether the scan has a model compensation's terms (``--feedforward``, else the
+    scenario's ``[feedforward]``: the terms of :func:`scan_terms` on its loop), from the
+    scenario's sections before the loop is built: without ``--compensation`` a model run is
+    compared only then."""
+    if args.feedforward is not None:
+        return bool(args.feedforward)
+    sec = sc.model.feedforward
+    return sec is not None and (sec.hysteresis is not None or (
+        sec.type != "none" and any(getattr(sec, t, None) for t in TERMS[:-1])))
+
+
 def _check_model_terms(args: argparse.Namespace, sc) -> None:
     """Refuse, before the loop is built, a model compensation the scenario's ``[feedforward]``
     gives no term for (the checks of :func:`run` once the loop is built, where its section
@@ -312,9 +325,8 @@ def _check_model_terms(args: argparse.Namespace, sc) -> None:
     if "hysteresis" in (args.feedforward or []) and sec.hysteresis is None:
         raise UsageError(f"{PROG}: --feedforward hysteresis needs a [feedforward] hysteresis "
                          f"model, and {sc.source} has none")
-    given = sec.hysteresis is not None or (  # the terms of scan_terms(loop)
-        sec.type != "none" and any(getattr(sec, t, None) for t in TERMS[:-1]))
-    if args.feedforward is None and "model" in (args.compensation or []) and not given:
+    if args.feedforward is None and "model" in (args.compensation or []) \
+            and not _model_given(args, sc):
         raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
                          f"model or feedforward terms (--feedforward), and {sc.source} has none")
 
