@@ -169,7 +169,8 @@ def test_an_input_output_search_is_refused_from_its_records_length_before_its_ch
     line = limited_process.refusal(["identify", "io.mat", "--record", "input-output",
                                     "--plant", "mass-damper", "--model", "jenkins",
                                     *IO_COLUMNS, "--max-memory", "50M"], tmp_path)
-    assert line == ("motionhyst: error: identify's search of 1000000 samples (at least 20 "
+    assert line == ("motionhyst: error: io.mat (1000000 samples, not read yet): identify's "
+                    "search of 1000000 samples (at least 20 "
                     "integration steps each, 7 parameters) needs at least 693 MB, above the "
                     "memory budget of 52.4 MB (--max-memory); its Jacobian's copies take 336 "
                     "MB, its runs 197 MB, the upsampled force 160 MB: a larger --max-memory "

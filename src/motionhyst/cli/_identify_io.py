@@ -181,21 +181,27 @@ def run_input_output(args: argparse.Namespace) -> int:
                          "(a steady state has no start)")
     # the records are read and checked by their light reader; the fit engines (python-control,
     # matplotlib, scipy.optimize) are imported once options, output and records are checked
-    from motionhyst.identify.io_records import check_records, load_io_csv
-
-    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     from motionhyst.hysteresis import model_class
     from motionhyst.identify.io_memory import check_io_floor
+    from motionhyst.identify.io_records import check_records, load_io_csv
+    from motionhyst.io.records import check_unread
     from motionhyst.plants.registry import plant_class
 
     # the least search of the records, from their lengths, before any check looks at them (a
     # positioning axis may be chosen from the records below: the smaller of the two counts)
     chosen = (plant_class(plant) if args.plant is not None or args.periodic
               else (plant_class(plant), plant_class("mass-damper")))
-    check_io_floor([rec.u.size for rec in records], chosen, model_class(model),
-                   n_elements=args.elements or 3, nu=nu, periodic=args.periodic,
-                   offset=args.offset or "auto", from_rest=args.from_rest,
-                   window=args.init_window is not None, drift=args.drift)
+
+    def floor(sizes: list[int]) -> None:
+        check_io_floor(sizes, chosen, model_class(model), n_elements=args.elements or 3, nu=nu,
+                       periodic=args.periodic, offset=args.offset or "auto",
+                       from_rest=args.from_rest, window=args.init_window is not None,
+                       drift=args.drift)
+
+    # long records from their files' sizes, unread; then from what was read
+    check_unread(args.data, ("time", "force", "displacement"), floor, columns=args.columns)
+    records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
+    floor([rec.u.size for rec in records])
     check_records(records, args.periodic)  # identify_io checks them again: nothing is skipped
     from motionhyst.identify.io_response import check_response
 

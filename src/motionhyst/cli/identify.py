@@ -187,8 +187,14 @@ def run(args: argparse.Namespace) -> int:
         load_closed_loop_csv,
         load_force_displacement_csv,
     )
+    from motionhyst.io.records import check_unread
 
     if kind == "force-displacement":
+        from motionhyst.identify.fd_memory import check_elements_fit_memory
+
+        bound = args.elements is None or target is not None
+        check_unread([path], RECORD_KINDS[kind], lambda sizes: check_elements_fit_memory(
+            sizes[0], str(path), bound=bound), columns=args.columns)  # a long record: unread
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         measured = [(path, t, x, w)]
         from motionhyst.identify.displacement_noise import estimate_displacement
@@ -196,9 +202,11 @@ def run(args: argparse.Namespace) -> int:
         x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
         extra["displacement_noise"] = noise.to_dict()
     else:
-        t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         from motionhyst.identify.fd_memory import check_closed_loop_memory
 
+        check_unread([path], RECORD_KINDS[kind], lambda sizes: check_closed_loop_memory(
+            sizes[0], str(path)), columns=args.columns)  # a long record: unread
+        t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
         check_closed_loop_memory(t.size, str(path))  # before its link force is inferred
         from motionhyst.identify.records import prefilter_cutoff
 
@@ -217,8 +225,6 @@ def run(args: argparse.Namespace) -> int:
                 check_loops_open(x, w, t)
             except ValueError as exc:
                 raise ValueError(f"{path}: {exc}") from None
-        from motionhyst.identify.fd_memory import check_elements_fit_memory
-
         # the mass check, the bound (where it runs) and the fit, before any of them (after
         # the light checks: its sizes are the fit module's, which loads the fit libraries)
         check_elements_fit_memory(t.size, str(path), bound=args.elements is None
@@ -387,18 +393,23 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         from motionhyst.io.outputs import OutputFile
 
         target = OutputFile(args.save, force=args.force, inputs=paths, option="--save")
+    from motionhyst.hysteresis import model_class
+    from motionhyst.identify.fd_memory import check_link_force_memory
     from motionhyst.identify.records import load_force_displacement_csv
+    from motionhyst.io.records import check_unread
 
+    nu = None if args.nu in (None, "free") else args.nu
+
+    def check(sizes: list[int]) -> None:
+        check_link_force_memory(sizes, model_class(args.model), args.elements or 3, nu)
+
+    # a long record is refused unread
+    check_unread(paths, RECORD_KINDS["force-displacement"], check, columns=args.columns)
     records = []
     for path in paths:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         records.append((path, t, x, w))
-    from motionhyst.hysteresis import model_class
-    from motionhyst.identify.fd_memory import check_link_force_memory
-
-    nu = None if args.nu in (None, "free") else args.nu
-    check_link_force_memory([t.size for _, t, _, _ in records], model_class(args.model),
-                            args.elements or 3, nu)  # before the mass check and the starts
+    check([t.size for _, t, _, _ in records])  # before the mass check and the starts
     mass = _refuse_a_mass(records)
     if mass is not None:
         from motionhyst.core.warnings import warn
