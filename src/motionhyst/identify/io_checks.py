@@ -506,10 +506,10 @@ def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.f
     >>> np.round(x, 2).tolist(), bool(np.sqrt(cov[0, 0]) < 0.01)
     ([2.0, 0.5], True)
     """
-    A = np.concatenate(rows)
-    scale = np.linalg.norm(A, axis=0)
+    As = np.concatenate(rows, dtype=np.float64)  # a copy: scaled in place
+    scale = np.linalg.norm(As, axis=0)
     scale[scale == 0] = 1.0
-    As = A / scale
+    As /= scale
     x = np.linalg.lstsq(As, np.concatenate(rhs), rcond=None)[0]
     cov = np.linalg.pinv(As.T @ As)
     meat = np.zeros_like(cov)
@@ -521,20 +521,31 @@ def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.f
         lags = min(n - 1, max(int(4 * n ** (1 / 3)), window))
         meat += xe.T @ xe
         if lags > 0:  # sum over the lags of w_l xe[t + l] xe[t]^T, and its transpose
-            g = _ahead(xe, 1.0 - np.arange(1, lags + 1) / (lags + 1)).T @ xe
+            w = 1.0 - np.arange(1, lags + 1) / (lags + 1)
+            kernel = _kernel(n, w)
+            g = np.stack([_ahead(xe[:, j], w, kernel) @ xe for j in range(xe.shape[1])])
             meat += g + g.T
     return x / scale, (cov @ meat @ cov) / np.outer(scale, scale)
 
 
-def _ahead(x: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
+def _kernel(n: int, w: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """The spectrum of ``[0, w]`` over the FFT length of :func:`_ahead` for `n` samples."""
+    return np.fft.rfft(np.concatenate([[0.0], w]), 1 << (n + w.size).bit_length())
+
+
+def _ahead(x: NDArray[np.float64], w: NDArray[np.float64],
+           kernel: NDArray[np.complex128] | None = None) -> NDArray[np.float64]:
     """``sum_l w[l - 1] x[t + l]`` over ``l = 1 .. len(w)`` (zero past the end) at each row
-    ``t``: one FFT convolution of the columns, where a product for each lag took minutes on
-    a record of millions of samples (its ``4 n^(1/3)`` lags)."""
-    n, lags = x.shape[0], w.size
-    size = 1 << (n + lags).bit_length()
-    kernel = np.fft.rfft(np.concatenate([[0.0], w]), size)
-    conv = np.fft.irfft(np.fft.rfft(x[::-1], size, axis=0) * kernel[:, None], size, axis=0)
-    return conv[:n][::-1]
+    ``t``: an FFT convolution (`kernel`: :func:`_kernel`, computed if not given), where a
+    product for each lag took minutes on a record of millions of samples (its ``4 n^(1/3)``
+    lags); a column at a time, so that the spectra take three columns' memory, not three of
+    every column's (240 B a sample of 11 columns)."""
+    n = x.shape[0]
+    kernel = _kernel(n, w) if kernel is None else kernel
+    if x.ndim > 1:
+        return np.column_stack([_ahead(c, w, kernel) for c in x.T])
+    size = 2 * (kernel.size - 1)
+    return np.fft.irfft(np.fft.rfft(x[::-1], size) * kernel, size)[:n][::-1]
 
 
 #: A start whose cost is within this factor of the records' noise (from their repeated
@@ -705,9 +716,12 @@ def viscous_direction(records: list[IORecord]
     for r, b, vel in zip(rows, rhs, velocities, strict=True):
         s = np.abs(vel)
         inside = (s > low) & (s <= high)
-        hats = [np.interp(s[inside], nodes, shape) * np.sign(vel[inside]) for shape in shapes]
-        compared.append(np.column_stack([r[inside, 0], s[inside], np.ones(np.sum(inside)),
-                                         *hats]))
+        cols = np.empty((int(np.sum(inside)), 3 + DIRECTION_NODES))  # filled, not stacked
+        cols[:, 0], cols[:, 1], cols[:, 2] = r[inside, 0], s[inside], 1.0
+        sign = np.sign(vel[inside])
+        for i, shape in enumerate(shapes):
+            cols[:, 3 + i] = np.interp(cols[:, 1], nodes, shape) * sign
+        compared.append(cols)
         forces.append(b[inside])
     x, cov = robust_least_squares(compared, forces,
                                    max(7, 2 * round(0.005 * records[0].fs) + 1))
