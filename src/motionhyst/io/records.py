@@ -533,8 +533,9 @@ def _mat_samples(path: Path, wanted: Sequence[str]) -> int | None:
     whos = whosmat(str(path))
     shapes = {n: shape for n, shape, cls in whos if cls not in _CONTAINERS}
     fields: dict[str, int] = {}
-    tops = {n for n, _, cls in whos if cls in _CONTAINERS}
-    declared_values(path, tops, lambda name, values: fields.setdefault(name.lower(), values))
+    tops = {_resolve(w.split(".")[0], [n for n, _, _ in whos], path) for w in wanted if "." in w}
+    declared_values(path, tops - set(shapes),  # the structures named: their fields walked
+                    lambda name, values: fields.setdefault(name.lower(), values))
     for w in wanted:
         top = _resolve(w.split(".")[0], [n for n, _, _ in whos], path)
         if "." not in w and top in shapes:
