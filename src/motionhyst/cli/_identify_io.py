@@ -128,6 +128,11 @@ def run_input_output(args: argparse.Namespace) -> int:
                              f"input-output")
     plant = args.plant or "mass-spring-damper"
     model = args.model or "bouc-wen"
+    from motionhyst.identify.io_memory import IO_MODELS
+
+    if model not in IO_MODELS:  # known from the name: before the records are read
+        raise UsageError(f"motionhyst identify: --model {model} is not available for "
+                         f"input-output records; use {', '.join(IO_MODELS)}")
     from motionhyst.plants.registry import PLANTS
 
     if args.output is not None and len(PLANTS[plant].outputs) < 2:
@@ -230,11 +235,8 @@ def run_input_output(args: argparse.Namespace) -> int:
     for note in notes:
         if note is not None:
             warn(note)
-    from motionhyst.identify.input_output import MODELS, identify_io
+    from motionhyst.identify.input_output import identify_io
 
-    if model not in MODELS:
-        raise UsageError(f"motionhyst identify: --model {model} is not available for "
-                         f"input-output records; use {', '.join(MODELS)}")
     extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
               if bouc_wen_own else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,

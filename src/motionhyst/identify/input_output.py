@@ -98,7 +98,6 @@ from dataclasses import replace
 import numpy as np
 
 from motionhyst.core.warnings import warn
-from motionhyst.hysteresis import MODELS as REGISTERED
 from motionhyst.hysteresis import BoucWen, Coulomb, Hysteresis, LuGre, MaxwellSlip, model_class
 from motionhyst.identify.io_bouc_wen import BASIC_STARTS as BASIC_STARTS
 from motionhyst.identify.io_bouc_wen import FINAL_ATTEMPTS as FINAL_ATTEMPTS
@@ -121,6 +120,7 @@ from motionhyst.identify.io_elements import RATE_GRID as RATE_GRID
 from motionhyst.identify.io_elements import STARTS as STARTS
 from motionhyst.identify.io_elements import identify_elements_io
 from motionhyst.identify.io_friction import bouc_wen_friction, lugre_stribeck, presliding_note
+from motionhyst.identify.io_memory import IO_MODELS
 from motionhyst.identify.io_records import MIN_SAMPLES as MIN_SAMPLES
 from motionhyst.identify.io_records import IORecord, check_records
 from motionhyst.identify.io_records import load_io_csv as load_io_csv
@@ -149,8 +149,7 @@ __all__ = ["identify_io"]
 #: Link models for input-output records: Bouc-Wen (exact sensitivities) and every other
 #: registered model (its parameters taken from the registry); not maxwell-iwan, whose Iwan
 #: element of 256 stop operators makes a simulation too slow for a search
-MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
-                                                                      "maxwell-iwan")))
+MODELS = IO_MODELS
 PLANTS = ("mass-spring-damper", "mass-damper", "two-mass", "quasi-static")
 #: The element links' refinement takes at least this many evaluations unless given a budget
 ELEMENT_NFEV = 200

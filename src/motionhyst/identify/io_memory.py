@@ -22,6 +22,7 @@ The search's own estimate, from its start, still follows (it can only be larger)
 from __future__ import annotations
 
 from motionhyst.core.budget import BudgetError, format_size, max_memory
+from motionhyst.hysteresis import MODELS as REGISTERED
 
 __all__ = ["BOUC_WEN_SAMPLE_BYTES", "BOUC_WEN_STEP_BYTES", "bouc_wen_memory",
            "check_bouc_wen_memory", "check_io_floor", "search_floor"]
@@ -35,6 +36,13 @@ BOUC_WEN_SAMPLE_BYTES = 900
 their reordered, scaled and joined copies and the trust-region solver's (measured with 100
 evaluations, 20 steps a sample: 13 MB of 24 estimated at 2e4 samples, 101 MB of 122 at
 1e5)."""
+
+IO_MODELS = ("bouc-wen", *(name for name in REGISTERED if name not in ("bouc-wen",
+                                                                         "maxwell-iwan")))
+"""Link models for input-output records (:data:`~motionhyst.identify.input_output.MODELS`):
+Bouc-Wen (exact sensitivities) and every other registered model but maxwell-iwan, whose Iwan
+element of 256 stop operators makes a simulation too slow for a search.  Here, where the
+command checks its options before it reads the records (the fit's module loads scipy)."""
 
 REMEDY = "a larger --max-memory if the machine has it, or shorter records"
 """What a user can change when the least search of the records is above the budget."""

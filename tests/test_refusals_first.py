@@ -1,0 +1,74 @@
+"""Refusals decided before the expensive work (issue 26: every refusal within 2 s of start).
+
+Each case shows that the work a refusal used to wait for never starts: a fresh interpreter
+(a subprocess) runs the command and reports the modules it imported, or the work is replaced
+by one that fails the test if called.  Nothing here is timed (``benchmarks/refusals.py``
+measures how soon each refusal comes, as ratios to the command's start).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+# what an identification's search, a simulation's kernels or a loop's model load: each takes
+# longer to import than a refusal may take
+HEAVY = ("control", "scipy", "matplotlib", "numba", "pandas")
+
+_PROBE = """
+import contextlib, io, json, sys
+from motionhyst.cli import main
+err = io.StringIO()
+with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+    try:
+        rc = main(sys.argv[1:])
+    except SystemExit as exc:
+        rc = exc.code
+heavy = sorted({m.split(".")[0] for m in sys.modules for h in HEAVY
+                if m == h or m.startswith(h + ".")})
+print(json.dumps({"rc": rc, "heavy": heavy, "err": err.getvalue()}))
+""".replace("HEAVY", repr(HEAVY))
+
+
+def _probe(argv: list[str], cwd: Path) -> dict:
+    """``motionhyst argv`` in a fresh interpreter: its exit code, stderr and the heavy
+    packages it imported."""
+    proc = subprocess.run([sys.executable, "-c", _PROBE, *argv], capture_output=True,
+                          text=True, cwd=cwd, timeout=600, check=False)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
+
+
+def _csv(columns: dict[str, np.ndarray]) -> str:
+    """A CSV record with a header of the `columns`' names."""
+    rows = np.column_stack(list(columns.values()))
+    return ",".join(columns) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                              for row in rows)
+
+
+def _axis(n: int = 600, fs: float = 1000.0) -> str:
+    """An input-output record of a 2 kg positioning axis (no spring)."""
+    t = np.arange(n) / fs
+    force = 30 * np.sin(2 * np.pi * 0.5 * t) + 12 * np.sin(2 * np.pi * 2.3 * t + 0.4)
+    y = np.cumsum(np.cumsum(force - force.mean())) / (2 * fs**2)
+    return _csv({"time": t, "force": force, "displacement": y})
+
+
+def test_a_link_model_input_output_records_cannot_fit_is_refused_before_they_are_read(
+        tmp_path):
+    """``--model maxwell-iwan --record input-output`` was refused after the records were
+    read and checked (scipy loaded, the positioning axis's warning printed first: two
+    lines).  The model's name alone decides it: one line, the record never opened."""
+    (tmp_path / "a.csv").write_text(_axis())
+    for record in ("a.csv", "missing.csv"):
+        out = _probe(["identify", record, "--record", "input-output", "--model",
+                      "maxwell-iwan"], tmp_path)
+        assert out["rc"] == 2, out["err"]
+        assert out["err"].count("\n") == 1, out["err"]
+        assert ("--model maxwell-iwan is not available for input-output records; use "
+                "bouc-wen, jenkins, maxwell-slip, dahl, lugre, coulomb") in out["err"]
+        assert out["heavy"] == [], out["heavy"]
