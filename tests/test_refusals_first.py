@@ -11,9 +11,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 # what an identification's search, a simulation's kernels or a loop's model load: each takes
 # longer to import than a refusal may take
@@ -72,3 +74,61 @@ def test_a_link_model_input_output_records_cannot_fit_is_refused_before_they_are
         assert ("--model maxwell-iwan is not available for input-output records; use "
                 "bouc-wen, jenkins, maxwell-slip, dahl, lugre, coulomb") in out["err"]
         assert out["heavy"] == [], out["heavy"]
+
+
+def _spin(seconds: float) -> None:
+    """Use `seconds` of this process's CPU time."""
+    start = time.process_time()
+    while time.process_time() - start < seconds:
+        pass
+
+
+def test_a_work_budget_that_runs_out_in_a_c_callback_stops_the_work_without_a_traceback(
+        capfd):
+    """The CPU-time alarm raised where the interpreter was: in a callback from C (llvmlite's
+    cache notice while numba compiled a kernel, on a cold cache) ctypes printed the
+    exception with a traceback on stderr, ignored it, and the work went on past its budget
+    to exit 0.  The alarm comes again until the work stops, its exception unseen."""
+    import ctypes
+    import ctypes.util
+
+    from motionhyst.core.budget import BudgetError, cpu_time_limit
+
+    libc = ctypes.CDLL(ctypes.util.find_library("c"))
+    compare = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p)
+
+    def slow_compare(a, b) -> int:  # the alarm comes in here, a callback from C
+        _spin(0.3)
+        return 0
+
+    values = (ctypes.c_int * 2)(2, 1)
+    after = []
+    with pytest.raises(BudgetError, match=r"did not finish within the work budget of 0\.05 s"):
+        with cpu_time_limit(0.05, "a sort"):
+            libc.qsort(values, 2, ctypes.sizeof(ctypes.c_int), compare(slow_compare))
+            after.append(time.process_time())
+            _spin(5.0)  # the old alarm never came back: the work ran on to its end
+            after.append("ended")
+    assert after and after[-1] != "ended"
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "_TimeUp" not in err and "ignored" not in err, err
+
+
+def test_a_work_budget_that_runs_out_while_the_compiler_runs_stops_once_it_returns():
+    """In numba's own code (compiling a kernel, boxing its results) the alarm's exception
+    would leave the compiler's state broken: it is raised once that code has returned."""
+    from motionhyst.core.budget import BudgetError, cpu_time_limit
+
+    compiler = {"__name__": "numba.core.compiler", "clock": time.process_time}
+    exec("def compile_kernel():\n"  # its own loop: the alarm comes in the compiler's frame
+         "    start = clock()\n"
+         "    while clock() - start < 0.3:\n"
+         "        pass\n"
+         "    return 'compiled'\n", compiler)
+    done = []
+    with pytest.raises(BudgetError):
+        with cpu_time_limit(0.05, "a compilation"):
+            done.append(compiler["compile_kernel"]())  # not interrupted inside
+            _spin(5.0)
+            done.append("ended")
+    assert done == ["compiled"]

@@ -57,6 +57,7 @@ import os
 import re
 import resource
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 
@@ -506,6 +507,23 @@ class _TimeUp(BaseException):
     model evaluation (values the model refuses) takes it for a bad parameter."""
 
 
+AGAIN_SECONDS = 0.02
+"""CPU time [s] after which the alarm of :func:`cpu_time_limit` comes again while the work
+has not stopped: an alarm that came where it may not raise (the kernels' compiler), or
+whose exception a C callback swallowed, is raised at the next one."""
+
+_COMPILER = ("numba", "llvmlite")
+"""Packages in whose own Python code the alarm does not raise: numba compiling a kernel, or
+boxing its results (a tuple would come back with an item missing, and the caller crash), and
+llvmlite's callbacks from the compiler (whose exception is printed, then ignored)."""
+
+
+def _in_compiler(frame) -> bool:
+    """Whether `frame`, where the alarm found the interpreter, runs :data:`_COMPILER`'s code."""
+    name = frame.f_globals.get("__name__") if frame is not None else None
+    return isinstance(name, str) and name.partition(".")[0] in _COMPILER
+
+
 @contextlib.contextmanager
 def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterator[None]:
     """Stop the work of the block after `seconds` of this process's CPU time (a BudgetError).
@@ -553,14 +571,25 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
 
     def alarm(signum, frame):
         fired.append(signum)
-        raise _TimeUp
+        # again soon, until the work stops: raised in the compiler it would break a kernel, or
+        # in a C callback be swallowed (with a traceback on stderr) and the work go on
+        signal.setitimer(signal.ITIMER_PROF, AGAIN_SECONDS)
+        if not _in_compiler(frame):
+            raise _TimeUp
+
+    def unraisable(report) -> None:  # the alarm's exception swallowed by a C callback
+        if not isinstance(report.exc_value, _TimeUp):
+            hook(report)
 
     previous = signal.getsignal(signal.SIGPROF)
+    hook = sys.unraisablehook
     try:
         signal.signal(signal.SIGPROF, alarm)
+        sys.unraisablehook = unraisable
         signal.setitimer(signal.ITIMER_PROF, seconds)
         yield
     except BaseException as exc:
+        signal.setitimer(signal.ITIMER_PROF, 0)
         # a C extension may turn the alarm's exception into another (as it does a Ctrl-C)
         if fired and not isinstance(exc, KeyboardInterrupt):
             raise BudgetError(f"{what} did not finish within the work budget of "
@@ -570,3 +599,5 @@ def cpu_time_limit(seconds: float | None, what: str, remedy: str = "") -> Iterat
     finally:
         signal.setitimer(signal.ITIMER_PROF, 0)
         signal.signal(signal.SIGPROF, signal.SIG_DFL if previous is None else previous)
+        if sys.unraisablehook is unraisable:
+            sys.unraisablehook = hook
