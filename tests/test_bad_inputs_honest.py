@@ -79,10 +79,11 @@ DAMPED_LINK = _paper('model = "jenkins"\nk = 20.0              # spring stiffnes
                      'fc = 0.05             # slip force f_c [N]',
                      'model = "lugre"\nsigma0 = 20.0\nsigma1 = 1e7\nfc = 0.05\nfs = 0.07\n'
                      'vs = 0.1')
-TOO_DAMPED = ["s.toml: [hysteresis]: the implicit step at t = ", "did not converge in 50 "
-              "iterations: the link is too stiff (or too strongly damped) for the time step of",
-              "which the command sets from the loop's poles and the reference; is the link's "
-              "stiffness or damping meant (in SI units)?"]
+TOO_DAMPED = ["s.toml: [hysteresis]: the link's damping for small motions, 1e+07 N s/m on "
+              "the 5 kg it moves, is too strong for the time step of",
+              "the run would stop at the stage's first motion; the step is the command's, set "
+              "from the loop's poles and the reference: is the link's damping meant (in SI "
+              "units)?"]
 PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]
 ZEROS = np.zeros((1000, 1))
 CELL = np.empty((1, 1), dtype=object)

@@ -132,3 +132,67 @@ def test_a_work_budget_that_runs_out_while_the_compiler_runs_stops_once_it_retur
             _spin(5.0)
             done.append("ended")
     assert done == ["compiled"]
+
+
+def _paper_with(link: str, *changes: tuple[str, str]) -> str:
+    """The paper's scenario with its Jenkins link replaced by `link` (and `changes`)."""
+    from motionhyst.scenario import default_scenario_path
+
+    text = default_scenario_path().read_text()
+    jenkins = ('model = "jenkins"\nk = 20.0              # spring stiffness k_J [N/m]\n'
+               'fc = 0.05             # slip force f_c [N]')
+    assert jenkins in text
+    text = text.replace(jenkins, link)
+    for old, new in changes:
+        assert old in text
+        text = text.replace(old, new)
+    return text
+
+
+def _lugre(sigma1: float) -> str:
+    return f'model = "lugre"\nsigma0 = 20.0\nsigma1 = {sigma1!r}\nfc = 0.05\nfs = 0.07\nvs = 0.1'
+
+
+@pytest.mark.parametrize("argv", [
+    ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
+     "--s-max", "1e6", "--compensation", "none"],
+    ["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5", "--duration", "0.2"],
+])
+def test_a_link_too_damped_for_the_step_is_refused_before_the_loop_is_built(tmp_path, argv):
+    """A LuGre link of sigma1 = 1e7 N s/m on the paper's stage was refused when the run's
+    implicit step failed at the stage's first motion, after python-control built the loop
+    and numba loaded the kernels.  The scenario and the step, known before, decide it."""
+    (tmp_path / "s.toml").write_text(_paper_with(_lugre(1e7)))
+    out = _probe(argv, tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert "s.toml: [hysteresis]: the link's damping for small motions, 1e+07 N s/m" in out["err"]
+    assert out["heavy"] == [], out["heavy"]
+    assert not (tmp_path / "ts.csv").exists()
+
+
+@pytest.mark.parametrize(("m1", "frequency_hz"), [(5.0, 5.0), (2.0, 5.0), (20.0, 50.0)])
+def test_a_link_refused_for_its_damping_is_one_whose_run_fails(tmp_path, m1, frequency_hz):
+    """The nearest damping :func:`check_link_damping` refuses (its factor 5 % above the
+    margin) is one whose run's implicit step does fail: the check refuses no run that would
+    converge; just below the margin it leaves the run to judge (which, measured, fails from
+    a factor of 0.6 on)."""
+    from motionhyst import Loop, SineReference, simulate
+    from motionhyst.hysteresis import LuGre
+    from motionhyst.scenario import load_scenario
+    from motionhyst.time.kernel import StepNotConverged
+    from motionhyst.time.steps import IMPLICIT_STEP_MARGIN, check_link_damping, pole_step
+
+    (tmp_path / "s.toml").write_text(_paper_with(_lugre(1.0), ("m1 = 5.0", f"m1 = {m1}")))
+    sc = load_scenario(tmp_path / "s.toml")
+    step = pole_step(sc.fastest_pole(), frequency_hz)
+    at_margin = IMPLICIT_STEP_MARGIN * 4 * m1 / step  # c step / (4 m) = the margin
+
+    def lugre(c: float) -> LuGre:
+        return LuGre(sigma0=20.0, sigma1=c, sigma2=0.0, fc=0.05, fs=0.07, vs=0.1)
+
+    check_link_damping(lugre(0.95 * at_margin), sc.plant(), step)
+    with pytest.raises(ValueError, match="is too strong for the time step"):
+        check_link_damping(lugre(1.05 * at_margin), sc.plant(), step)
+    loop = Loop(sc.plant(), sc.controller(), lugre(1.05 * at_margin))
+    with pytest.raises(StepNotConverged):
+        simulate(loop, SineReference(0.01, frequency_hz), 0.02, dt=step)

@@ -428,6 +428,30 @@ def in_the_commands_terms(sc, remedy: str) -> Iterator[None]:
                                ) from None
 
 
+def check_link_damping_for(sc, step: float) -> None:
+    """Refuse, before a run of ``scan`` or ``simulate`` (whose step is their own: set from the
+    loop's poles and the reference), a scenario whose link is too strongly damped for that
+    step (:func:`~motionhyst.time.steps.check_link_damping`), naming its ``[hysteresis]``:
+    the run would stop at the stage's first motion, after its loop was built.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The command's scenario.
+    step : float
+        The run's step [s], known before its loop is built.
+    """
+    from motionhyst.scenario import ScenarioError
+    from motionhyst.time.steps import check_link_damping
+
+    try:
+        check_link_damping(sc.hysteresis(), sc.plant(), step)
+    except ValueError as exc:
+        raise ScenarioError(f"{sc.source}: [hysteresis]: {exc}; the step is the command's, "
+                            f"set from the loop's poles and the reference: is the link's "
+                            f"damping meant (in SI units)?") from None
+
+
 def fast_pole(sc, pole: float) -> str:
     """Why a loop's fastest closed-loop pole `pole` [rad/s] is beyond a motion stage's
     (:data:`~motionhyst.plants.registry.PLAUSIBLE_POLE_HZ`), for a refusal of the many

@@ -11,6 +11,7 @@ import math
 
 from motionhyst.cli._common import (
     UsageError,
+    check_link_damping_for,
     fast_pole,
     g,
     in_the_commands_terms,
@@ -281,6 +282,8 @@ def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None
                 out.check_csv_size(n, 3 + 3 * runs,
                                    remedy=f"{REMEDY}, or write --time-series where there "
                                    f"is room")
+            if pole is not None:  # the run's own step: before its loop is built
+                check_link_damping_for(sc, step)
             if pole is not None or rate is not None:  # the run's own step: known
                 try:
                     check_window_samples(args.window, step, "give a longer --window")

@@ -12,6 +12,7 @@ from motionhyst.cli._common import (
     UsageError,
     add_force_option,
     add_record_options,
+    check_link_damping_for,
     distinct,
     fast_pole,
     in_the_commands_terms,
@@ -137,13 +138,15 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
         step = (math.inf if f <= 0 and rate is None
                 else longest_step(f, None if rate is None else 1.0 / rate))
     with in_the_commands_terms(sc, remedy):
-        rows, per_row, _ = time_series_grid(duration, output_rate, step, rate,
-                                            at_least=rate is None and pole is None,
-                                            set_by=why)
+        rows, per_row, run_step = time_series_grid(duration, output_rate, step, rate,
+                                                   at_least=rate is None and pole is None,
+                                                   set_by=why)
         out.check_csv_size(rows, len(COLUMNS), remedy=f"lower --output-rate ({output_rate:g} "
                            f"Hz) or shorten --duration ({duration:g} s), or write "
                            f"--time-series where there is room")
         check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy, rows)
+    if pole is not None:  # the run's own step, known before its loop is built
+        check_link_damping_for(sc, run_step)
     return remedy
 
 

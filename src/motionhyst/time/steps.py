@@ -21,12 +21,12 @@ from collections.abc import Iterator, Sequence
 
 from motionhyst.core.budget import BudgetError, check_memory, check_work
 
-__all__ = ["BYTES_PER_SAMPLE", "MAX_ROWS", "MAX_SAMPLES", "MAX_SCAN_STEPS", "MAX_STEPS",
-           "RUN_REMEDY", "SCAN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_ROW",
-           "SECONDS_PER_STEP",
+__all__ = ["BYTES_PER_SAMPLE", "IMPLICIT_STEP_MARGIN", "MAX_ROWS", "MAX_SAMPLES",
+           "MAX_SCAN_STEPS", "MAX_STEPS", "RUN_REMEDY", "SCAN_REMEDY",
+           "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_ROW", "SECONDS_PER_STEP",
            "STEPS_PER_POLE_PERIOD", "STEPS_PER_REFERENCE_PERIOD", "RunTooLarge", "a_run",
-           "check_scan_steps", "check_steps_work", "longest_step", "pole_step", "step_set_by",
-           "time_series_grid"]
+           "check_link_damping", "check_scan_steps", "check_steps_work", "longest_step",
+           "pole_step", "step_set_by", "time_series_grid"]
 
 STEPS_PER_POLE_PERIOD = 40
 """Time steps per period of the loop's fastest closed-loop pole."""
@@ -92,6 +92,80 @@ def pole_step(fastest_pole: float, max_frequency_hz: float = 0.0) -> float:
     h = math.tau / (STEPS_PER_POLE_PERIOD * fastest_pole)
     return min(h, 1.0 / (STEPS_PER_REFERENCE_PERIOD * max_frequency_hz)) if max_frequency_hz > 0 \
         else h
+
+
+IMPLICIT_STEP_MARGIN = 1.0
+"""A link's damping is refused before a run when it would amplify a change of the link's
+force over one step by more than this (:func:`check_link_damping`): above 1 the step's
+fixed-point iteration diverges.  Measured on Table I's stage (m1 of 2, 5 and 20 kg, a LuGre
+link): runs fail from a factor of 0.6 on (their 50 passes do not reach the tolerance) and
+converge at 0.5, so the coupling of the link's mass to the rest of the stage within a step,
+which the factor leaves out, refuses no run that would converge."""
+
+
+def check_link_damping(link, plant, step: float, where: str = "") -> None:
+    """Refuse a link whose damping is too strong for a run's time step, before the run.
+
+    The run's implicit step settles the link force by a fixed-point iteration: a change of
+    the force (ramped over the step, as the run holds it) moves the link's mass ``m`` by
+    ``step^2 / (6 m)`` per newton, and a damping ``c`` (the link's for small motions,
+    ``Im D / omega``: LuGre's ``sigma1 + sigma2`` from rest) turns that back into a force
+    through the velocity at the step's end, ``1.5 / step`` per metre (the second-order
+    backward difference).  Their product ``c step / (4 m)`` is the factor by which each pass
+    amplifies the error: above 1 the iteration diverges at the stage's first motion and the
+    run stops there, after its loop is built and its kernels loaded.  A link without
+    damping (a rate-independent one), a plant without lumped masses, or a factor within
+    :data:`IMPLICIT_STEP_MARGIN` passes: the run judges it (one whose iteration converges
+    too slowly still stops it).
+
+    Parameters
+    ----------
+    link : Hysteresis
+        The link (its ``small_amplitude_limit`` gives its damping, where it has one).
+    plant : Plant
+        The stage (its :meth:`mechanics` gives the mass the link moves).
+    step : float
+        The run's time step [s].
+    where : str
+        What to name in the message (the scenario's section).
+
+    Raises
+    ------
+    ValueError
+        One line naming the damping, the mass, the step and the factor.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import LuGre
+    >>> from motionhyst.plants import TwoMassStage
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> link = LuGre(sigma0=20.0, sigma1=0.0, sigma2=1e3, fc=0.05, fs=0.07, vs=0.1)
+    >>> check_link_damping(link, stage, 3.62e-5)                 # factor 0.0018: runs
+    >>> try:
+    ...     check_link_damping(LuGre(20.0, 1e7, 0.0, 0.05, 0.07, 0.1), stage, 3.62e-5)
+    ... except ValueError as exc:
+    ...     print(exc)
+    the link's damping for small motions, 1e+07 N s/m on the 5 kg it moves, is too strong \
+for the time step of 3.62e-05 s: it would amplify each pass of the step's implicit \
+iteration 18 times (it settles below 1): the run would stop at the stage's first motion
+    """
+    small = getattr(link, "small_amplitude_limit", None)
+    mechanics = getattr(plant, "mechanics", None)
+    if small is None or mechanics is None or not step > 0:
+        return
+    try:
+        mech = mechanics()
+    except (TypeError, ValueError, NotImplementedError):
+        return
+    damping = float(complex(small(1.0)).imag)
+    mass = float(mech.mass[mech.link])
+    factor = damping * step / (4.0 * mass)
+    if factor > IMPLICIT_STEP_MARGIN:
+        raise ValueError(f"{where}the link's damping for small motions, {damping:.4g} N s/m on "
+                         f"the {mass:.4g} kg it moves, is too strong for the time step of "
+                         f"{step:.3g} s: it would amplify each pass of the step's implicit "
+                         f"iteration {factor:.2g} times (it settles below 1): the run would "
+                         f"stop at the stage's first motion")
 
 
 class RunTooLarge(BudgetError):
