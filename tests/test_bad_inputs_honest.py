@@ -327,15 +327,16 @@ def loop_record() -> dict[str, np.ndarray]:
 
 @pytest.mark.parametrize(("mistake", "words"), [
     ("none", None),
-    ("y1-in-mm", "fc/k = 10 m against y1's half-range 10 m"),
-    ("columns-swapped", "the link force inferred through the plant follows y1 as a spring's"),
+    ("y1-in-mm", "c.csv: the plant's force for y1 as recorded is 1000 times u"),
+    ("columns-swapped", "c.csv: the plant's force for y1 as recorded is 1.3e+07 times u"),
 ])
 def test_a_closed_loop_record_whose_link_shows_no_hysteresis_is_refused(tmp_path, loop_record,
                                                                         mistake, words):
     """y1 in mm, or u and y1 swapped (one loop's signals, each a column of the record) were
     fitted: a spring k = M w^2 (the sine's inertia) whose slip force was 2.2e5 +- 5e7 N
-    or slipped only at the stroke's end; exit 0.  No element that both slips and has a
-    determined slip force: refused."""
+    or slipped only at the stroke's end; exit 0.  Then refused after the fit (no element
+    that both slips and has a determined slip force); now before it, from the plant's force
+    for y1 against u (:func:`~motionhyst.identify.records.check_force_scale`)."""
     from motionhyst.scenario import default_scenario_path
 
     record = dict(loop_record)
@@ -351,5 +352,6 @@ def test_a_closed_loop_record_whose_link_shows_no_hysteresis_is_refused(tmp_path
         assert code == 0 and "elements: 2" in out, err
     else:
         line = limited_process.refusal(argv, tmp_path)
-        assert "c.csv: no hysteresis in the record: no element both slips" in line, line
-        assert words in line and "nothing identified" in line, line
+        assert words in line, line
+        assert "(y1 not in metres? u not in newtons? u and y1 swapped? the plant not the " \
+               "record's?); nothing identified" in line, line

@@ -196,3 +196,57 @@ def test_a_link_refused_for_its_damping_is_one_whose_run_fails(tmp_path, m1, fre
     loop = Loop(sc.plant(), sc.controller(), lugre(1.05 * at_margin))
     with pytest.raises(StepNotConverged):
         simulate(loop, SineReference(0.01, frequency_hz), 0.02, dt=step)
+
+
+@pytest.fixture(scope="module")
+def loop_record() -> dict[str, np.ndarray]:
+    """A closed-loop record of the paper's loop with a two-element link (3 s of a 2 Hz
+    sine, 5 kHz)."""
+    from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+
+    sc = default_scenario()
+    loop = Loop(sc.plant(), sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    sim = simulate(loop, SineReference(0.01, 2.0), 3.0, dt=2e-4)
+    return {"time": sim.t, "y1": sim.y1, "u": sim.u}
+
+
+@pytest.mark.parametrize(("mistake", "ratio"), [("y1 in mm", "1000"), ("u in kN", "1000"),
+                                                ("columns swapped", "1.3e+07")])
+def test_a_closed_loop_record_off_its_plant_s_scale_is_refused_before_the_loop_is_built(
+        tmp_path, loop_record, mistake, ratio):
+    """y1 in mm, u in kN or the two columns swapped: the plant's force for y1 is a
+    thousandfold u or more.  Refused "no hysteresis" after the loop was built
+    (python-control) and the fit ran (2.2-2.4 s of CPU); now from the scenario's plant
+    before either."""
+    from motionhyst.scenario import default_scenario_path
+
+    record = dict(loop_record)
+    if mistake == "y1 in mm":
+        record["y1"] = 1000 * record["y1"]
+    elif mistake == "u in kN":
+        record["u"] = record["u"] / 1000
+    else:
+        record["y1"], record["u"] = record["u"], record["y1"]
+    (tmp_path / "c.csv").write_text(_csv(record))
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    out = _probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert f"c.csv: the plant's force for y1 as recorded is {ratio} times u" in out["err"]
+    assert "control" not in out["heavy"] and "matplotlib" not in out["heavy"], out["heavy"]
+
+
+def test_the_force_scale_of_a_record_of_its_plant_is_near_one(loop_record):
+    """The record the paper's loop makes, its link's force included: the plant's force for
+    y1 is u's to 10 % (measured 1.029: refused with u a hundredth, not with u a 91st), a
+    hundredth of the refusal's ratio, with or without noise of a micron on y1."""
+    from motionhyst import default_scenario
+    from motionhyst.identify.records import SCALE_RATIO, check_force_scale
+
+    mech = default_scenario().plant().mechanics()
+    t, y1, u = loop_record["time"], loop_record["y1"], loop_record["u"]
+    noisy = y1 + 1e-6 * np.random.default_rng(3).standard_normal(y1.size)
+    for y in (y1, noisy):
+        check_force_scale(t, y, u, mech, 43.3)
+        check_force_scale(t, y, u * 1.1 / SCALE_RATIO, mech, 43.3)  # the ratio below 1.1
+        with pytest.raises(ValueError, match="is 100 times u"):    # and at least 1
+            check_force_scale(t, y, u / SCALE_RATIO, mech, 43.3)

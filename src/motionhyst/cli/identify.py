@@ -211,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.identify.records import prefilter_cutoff
 
         try:  # before the plant's scenario loads python-control
-            prefilter_cutoff(t, y1, args.cutoff)
+            cutoff, _ = prefilter_cutoff(t, y1, args.cutoff)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         from motionhyst.identify.io_records import IORecord
@@ -279,6 +279,17 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"motionhyst identify: closed-loop records need P1 as a model (a "
                              f"[stage], or a [plant] fitted with use = \"fit\"); {sc.source} "
                              f"has a measured [plant] with use = \"data\"")
+        try:  # the plant's scales against the record's, before the loop is built
+            mechanics = plant.mechanics()
+        except ValueError:
+            mechanics = None  # a plant without lumped masses: the fit judges the record
+        if mechanics is not None:
+            from motionhyst.identify.records import check_force_scale
+
+            try:
+                check_force_scale(t, y1, u, mechanics, cutoff)
+            except ValueError as exc:
+                raise ValueError(f"{path}: {exc}") from None
         warn_plant_fit(sc)
         extra["scenario"] = sc.source
         # a sampled controller: the record is at its samples, u_k acted held and delayed

@@ -10,7 +10,8 @@ from motionhyst.core.compiled import njit
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
-__all__ = ["ELASTIC_CURVE_RATIO", "check_controller_period", "check_loops_open", "count_reversals",
+__all__ = ["ELASTIC_CURVE_RATIO", "SCALE_RATIO", "check_controller_period", "check_force_scale",
+           "check_loops_open", "count_reversals",
            "load_closed_loop_csv", "load_force_displacement_csv", "prefilter_cutoff"]
 
 MIN_SAMPLES = 50
@@ -456,3 +457,89 @@ def check_controller_period(t: ArrayLike, period: float) -> None:
     if abs(dt - period) > UNIFORM_RTOL * period:
         raise ValueError(f"the record's sampling interval {dt:g} s is not the controller's "
                          f"period {period:g} s")
+
+
+SCALE_RATIO = 100.0
+"""A closed-loop record is refused before its fit when the force its plant needs to move
+``y1`` as recorded is this many times ``u`` in the prefilter's band
+(:func:`check_force_scale`): the link would push the stage harder than its actuator a
+hundredfold, cancelling the plant's own dynamics."""
+
+
+def check_force_scale(t: ArrayLike, y1: ArrayLike, u: ArrayLike, mechanics,
+                      cutoff_hz: float) -> None:
+    """Refuse a closed-loop record whose position and force do not fit its plant's scales.
+
+    The link force is inferred as ``w = u - P1^-1 y1``: where the plant's force for ``y1``,
+    ``P1^-1 y1``, is :data:`SCALE_RATIO` times ``u`` or more (RMS over the frequencies up
+    to the prefilter's cut-off, both windowed alike, ``y1``'s straight line removed: a
+    constant speed needs no force), the inferred force is the plant's force alone: its
+    spring-like part dwarfs any slip of a link, the fit finds a spring (a slip force it
+    cannot determine) and is refused after its work.  So is ``y1`` in mm (1000 times the
+    plant's force), ``u`` in kN, the columns swapped, or a plant not the record's; a stage
+    with a link of its own (the record's ``u`` and the link's force comparable) is not.
+
+    Parameters
+    ----------
+    t, y1, u : array_like
+        The record (uniform time [s], position of the actuated mass [m], force [N]).
+    mechanics : Mechanics
+        The plant's lumped masses (:meth:`~motionhyst.plants.registry.Plant.mechanics`):
+        ``P1`` is its force-to-position response at the link's coordinate.
+    cutoff_hz : float
+        The prefilter's cut-off [Hz] (:func:`prefilter_cutoff`).
+
+    Raises
+    ------
+    ValueError
+        One line naming the ratio and the likely causes.
+
+    Examples
+    --------
+    >>> from motionhyst import TwoMassStage
+    >>> mech = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7).mechanics()
+    >>> t = np.arange(5000) / 1e3
+    >>> y1 = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+    >>> u = -22.5 * (2 * np.pi * 2.0) ** 2 * y1               # the stage's inertia: 22.5 kg
+    >>> check_force_scale(t, y1, u, mech, 40.0)
+    >>> try:
+    ...     check_force_scale(t, 1000.0 * y1, u, mech, 40.0)     # y1 in mm
+    ... except ValueError as exc:
+    ...     print(exc)
+    the plant's force for y1 as recorded is 1000 times u (RMS up to the prefilter's cut-off \
+40 Hz): a link would push the stage harder than its actuator, cancelling the plant's own \
+dynamics, and its slip force would be a guess (y1 not in metres? u not in newtons? u and y1 \
+swapped? the plant not the record's?); nothing identified
+    """
+    ts = np.asarray(t, dtype=float)
+    ys = np.asarray(y1, dtype=float)
+    us = np.asarray(u, dtype=float)
+    n = ts.size
+    if n < 3 or not ts[-1] > ts[0]:
+        return
+    dt = (ts[-1] - ts[0]) / (n - 1)
+    tau = (ts - ts[0]) / (ts[-1] - ts[0])
+    slope, offset = np.polyfit(tau, ys, 1)
+    window = np.hanning(n)
+    f = np.fft.rfftfreq(n, dt)
+    band = np.flatnonzero((f > 0) & (f <= cutoff_hz))
+    if band.size == 0:
+        return
+    s = 2j * np.pi * f[band]
+    impedance = (np.diag(mechanics.mass)[None] * s[:, None, None] ** 2
+                 + mechanics.C[None] * s[:, None, None] + mechanics.K[None])
+    unit = np.zeros((band.size, mechanics.n, 1), dtype=complex)
+    unit[:, mechanics.link, 0] = 1.0
+    p1 = np.linalg.solve(impedance, unit)[:, mechanics.link, 0]
+    need = np.fft.rfft((ys - slope * tau - offset) * window)[band] / p1
+    given = np.fft.rfft((us - us.mean()) * window)[band]
+    given_rms = float(np.sqrt(np.sum(np.abs(given) ** 2)))
+    need_rms = float(np.sqrt(np.sum(np.abs(need) ** 2)))
+    if need_rms >= SCALE_RATIO * given_rms:
+        ratio = f"{float(f'{need_rms / given_rms:.2g}'):g}" if given_rms > 0 else "infinitely many"
+        raise ValueError(f"the plant's force for y1 as recorded is {ratio} times u (RMS up to "
+                         f"the prefilter's cut-off {cutoff_hz:.4g} Hz): a link would push the "
+                         f"stage harder than its actuator, cancelling the plant's own "
+                         f"dynamics, and its slip force would be a guess (y1 not in metres? "
+                         f"u not in newtons? u and y1 swapped? the plant not the record's?); "
+                         f"nothing identified")
