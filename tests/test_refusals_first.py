@@ -250,3 +250,34 @@ def test_the_force_scale_of_a_record_of_its_plant_is_near_one(loop_record):
         check_force_scale(t, y, u * 1.1 / SCALE_RATIO, mech, 43.3)  # the ratio below 1.1
         with pytest.raises(ValueError, match="is 100 times u"):    # and at least 1
             check_force_scale(t, y, u / SCALE_RATIO, mech, 43.3)
+
+
+@pytest.mark.parametrize("rows", [6000, 200_000])
+def test_a_small_regression_runs_on_one_blas_thread_a_large_one_on_the_machine_s(
+        monkeypatch, rows):
+    """The inertia check's regression (6000 x 36) ran on the machine's BLAS threads: on a
+    loaded machine 0.94 s of wall time a call for 0.31 s of CPU (one thread: 0.07 s and
+    0.03 s).  A small one now runs on one; a large one (200000 x 36) keeps the threads."""
+    from threadpoolctl import threadpool_info
+
+    from motionhyst.core.blas import SMALL_FLOPS
+    from motionhyst.identify.io_checks import robust_least_squares
+
+    def blas_threads() -> list[int]:
+        return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+    machine = blas_threads()
+    seen = []
+    lstsq = np.linalg.lstsq
+
+    def counting(*args, **kwargs):
+        seen.append(blas_threads())
+        return lstsq(*args, **kwargs)
+
+    monkeypatch.setattr(np.linalg, "lstsq", counting)
+    A = np.random.default_rng(0).standard_normal((rows, 36))
+    x, _ = robust_least_squares([A], [A @ np.arange(36.0)], 7)
+    assert np.allclose(x, np.arange(36.0))
+    small = rows * 36**2 <= SMALL_FLOPS
+    assert seen == [[1] * len(machine) if small else machine], (seen, machine)
+    assert blas_threads() == machine  # the limit was the regression's only

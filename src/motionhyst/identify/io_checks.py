@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.blas import few_blas_threads
 from motionhyst.identify.io_records import IORecord
 
 __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTION_SHARE",
@@ -510,22 +511,23 @@ def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.f
     scale = np.linalg.norm(As, axis=0)
     scale[scale == 0] = 1.0
     As /= scale
-    x = np.linalg.lstsq(As, np.concatenate(rhs), rcond=None)[0]
-    cov = np.linalg.pinv(As.T @ As)
-    meat = np.zeros_like(cov)
-    start = 0
-    for b in rhs:
-        n = b.size
-        xe = As[start:start + n] * (b - As[start:start + n] @ x)[:, None]
-        start += n
-        lags = min(n - 1, max(int(4 * n ** (1 / 3)), window))
-        meat += xe.T @ xe
-        if lags > 0:  # sum over the lags of w_l xe[t + l] xe[t]^T, and its transpose
-            w = 1.0 - np.arange(1, lags + 1) / (lags + 1)
-            kernel = _kernel(n, w)
-            g = np.stack([_ahead(xe[:, j], w, kernel) @ xe for j in range(xe.shape[1])])
-            meat += g + g.T
-    return x / scale, (cov @ meat @ cov) / np.outer(scale, scale)
+    with few_blas_threads(*As.shape):  # a small fit: the threads cost more than the work
+        x = np.linalg.lstsq(As, np.concatenate(rhs), rcond=None)[0]
+        cov = np.linalg.pinv(As.T @ As)
+        meat = np.zeros_like(cov)
+        start = 0
+        for b in rhs:
+            n = b.size
+            xe = As[start:start + n] * (b - As[start:start + n] @ x)[:, None]
+            start += n
+            lags = min(n - 1, max(int(4 * n ** (1 / 3)), window))
+            meat += xe.T @ xe
+            if lags > 0:  # sum over the lags of w_l xe[t + l] xe[t]^T, and its transpose
+                w = 1.0 - np.arange(1, lags + 1) / (lags + 1)
+                kernel = _kernel(n, w)
+                g = np.stack([_ahead(xe[:, j], w, kernel) @ xe for j in range(xe.shape[1])])
+                meat += g + g.T
+        return x / scale, (cov @ meat @ cov) / np.outer(scale, scale)
 
 
 def _kernel(n: int, w: NDArray[np.float64]) -> NDArray[np.complex128]:
