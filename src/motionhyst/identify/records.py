@@ -530,7 +530,10 @@ swapped? the plant not the record's?); nothing identified
                  + mechanics.C[None] * s[:, None, None] + mechanics.K[None])
     unit = np.zeros((band.size, mechanics.n, 1), dtype=complex)
     unit[:, mechanics.link, 0] = 1.0
-    p1 = np.linalg.solve(impedance, unit)[:, mechanics.link, 0]
+    try:
+        p1 = np.linalg.solve(impedance, unit)[:, mechanics.link, 0]
+    except np.linalg.LinAlgError:  # an undamped mode on a line of the record: the fit judges
+        return
     need = np.fft.rfft((ys - slope * tau - offset) * window)[band] / p1
     given = np.fft.rfft((us - us.mean()) * window)[band]
     given_rms = float(np.sqrt(np.sum(np.abs(given) ** 2)))
