@@ -229,7 +229,8 @@ def run_input_output(args: argparse.Namespace) -> int:
     if plant_class(plant).has_inertia and not args.periodic:  # the plant now decided
         from motionhyst.identify.io_consistency import check_one_stage
 
-        check_one_stage(records, floating=plant in ("mass-damper", "two-mass"))
+        check_one_stage(records, floating=plant in ("mass-damper", "two-mass"),
+                        single_mass=plant != "two-mass")
     from motionhyst.core.warnings import warn
 
     for note in notes:

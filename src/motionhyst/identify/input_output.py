@@ -256,10 +256,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         :mod:`~motionhyst.identify.io_quasi_static`).  A stage with inertia is
         refused before the search (a ValueError) for records that show none
         (:func:`~motionhyst.identify.io_checks.check_inertia`), or among which one shows
-        none and a mass the others do not share
-        (:func:`~motionhyst.identify.io_consistency.check_one_stage`).  Records whose
-        position does not depend on their force (noise, another record's position)
-        are refused first, whatever the stage
+        none and a mass the others do not share, or of single-mass stages whose masses
+        differ by a factor (:func:`~motionhyst.identify.io_consistency.check_one_stage`).
+        Records whose position does not depend on their force (noise, another record's
+        position) are refused first, whatever the stage
         (:func:`~motionhyst.identify.io_response.check_response`).
     output : {"y2", "y1"}, optional
         With a two-mass stage given by its name or class: the measured position
@@ -512,7 +512,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
     if asymmetric and not (shape.floating and shape.n == 1):
         raise ValueError(_ASYMMETRIC)
     check_inertia(records)  # before the search
-    check_one_stage(records, shape.floating)
+    check_one_stage(records, shape.floating, single_mass=shape.n == 1)
     if link is not BoucWen:
         return identify_elements_io(records, link, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,
