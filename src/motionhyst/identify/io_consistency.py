@@ -18,7 +18,8 @@ from motionhyst.identify.io_checks import check_inertia, robust_least_squares
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
 
-__all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "check_one_stage", "mass_units_note"]
+__all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "SI_READINGS", "check_one_stage",
+           "mass_units_note"]
 
 ONE_STAGE_SIGMAS = 5.0
 """A record whose mass lies more than this many robust standard errors from the other records'
@@ -190,13 +191,23 @@ def _names(rest: list[IORecord]) -> str:
     return f"{rest[0].name} shows" if len(rest) == 1 else f"{rest[0].name} and the others show"
 
 
+SI_READINGS = {"rate": 100.0, "stroke": 1.0, "force": (1e-3, 1e4)}
+"""What makes a unit slip likely (:func:`mass_units_note`), beside the mass: a sampling rate
+below ``rate`` [Hz] (a time column in ms), a position's range above ``stroke`` [m] (in mm or
+um), a force's peak outside ``force`` [N] (in kN below, in mN above)."""
+
+
 def mass_units_note(records: list[IORecord], mass: float) -> str | None:
     """A warning, before the search, where the records' inverse-dynamics `mass`
     (:func:`~motionhyst.identify.io_checks.check_inertia`) lies outside the usual masses of
-    motion stages (:data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`): the unit its
-    factor points to, a time column in ms first (it makes the mass 1e6 times too large, and
-    the records' sampling rate a thousandth of a stage's).  The fit would end at that mass
-    after its search; the warning says so before it.
+    motion stages (:data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`).  A unit is named
+    only where the records read in SI are unlike a motion stage's as well
+    (:data:`SI_READINGS`) and that unit makes the mass usual: a time column in ms first (it
+    makes the mass 1e6 times too large, and the sampling rate a thousandth of a stage's),
+    a position in mm or um (a range of metres), a force in mN or kN; otherwise the line
+    says what each unit would do (a 0.5 g stage sampled at 1 kHz, moving 1 mm under 5 N,
+    is no unit slip).  The fit would end at that mass after its search; the warning says
+    so before it.
 
     Parameters
     ----------
@@ -220,6 +231,11 @@ of motion stages: is the time column in ms (sampled at 1 Hz)? --scale time=0.001
 2 kg
     >>> mass_units_note([IORecord(t / 1e3, np.sin(t), np.cos(t), "io.csv")], 2.0) is None
     True
+    >>> print(mass_units_note([IORecord(t / 1e3, np.sin(t), 1e-3 * np.cos(t), "io.csv")],
+    ...                       5e-4))                     # a 0.5 g stage: SI readings
+    io.csv: the records' inverse-dynamics mass is 0.0005 kg, outside the usual 0.001-10000 kg \
+of motion stages: if the records' units are not SI, scale them (--scale; time in ms makes \
+the mass 1e6 times too large, a position in mm or a force in kN 1e3 times too small)
     """
     from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
 
@@ -230,14 +246,23 @@ of motion stages: is the time column in ms (sampled at 1 Hz)? --scale time=0.001
     text = (f"{names}: the records' inverse-dynamics mass is {mass:.3g} kg, outside the usual "
             f"{low:g}-{high:g} kg of motion stages: ")
     fs = records[0].fs
-    for factor, unit, scale in ((1e-6, "is the time column in ms", "time=0.001"),
-                                (1e-3, "is the force in mN", "force=0.001"),
-                                (1e3, "is the position in mm or the force in kN",
-                                 "displacement=0.001 or force=1000"),
-                                (1e6, "is the position in um", "displacement=1e-6")):
-        if low <= mass * factor <= high:
-            at = f" (sampled at {fs:.3g} Hz)" if factor == 1e-6 else ""
-            return f"{text}{unit}{at}? --scale {scale} makes it {mass * factor:.3g} kg"
+    stroke = max(float(np.ptp(rec.y)) for rec in records)
+    force = max(float(np.max(np.abs(rec.u - np.mean(rec.u)))) for rec in records)
+    f_low, f_high = SI_READINGS["force"]
+    rate, longest = SI_READINGS["rate"], SI_READINGS["stroke"]
+    for factor, unit, scale, unlike in (  # unlike a stage in SI, like one in the unit
+            (1e-6, f"is the time column in ms (sampled at {fs:.3g} Hz)", "time=0.001",
+             fs < rate <= 1e3 * fs),
+            (1e-3, f"is the force in mN (a peak of {force:.3g} N)", "force=0.001",
+             force > f_high >= 1e-3 * force),
+            (1e3, f"is the position in mm (a range of {stroke:.3g} m)", "displacement=0.001",
+             stroke > longest >= 1e-3 * stroke),
+            (1e3, f"is the force in kN (a peak of {force:.3g} N)", "force=1000",
+             force < f_low <= 1e3 * force),
+            (1e6, f"is the position in um (a range of {stroke:.3g} m)", "displacement=1e-6",
+             stroke > longest >= 1e-6 * stroke)):
+        if unlike and low <= mass * factor <= high:
+            return f"{text}{unit}? --scale {scale} makes it {mass * factor:.3g} kg"
     return (f"{text}if the records' units are not SI, scale them (--scale; time in ms makes "
             f"the mass 1e6 times too large, a position in mm or a force in kN 1e3 times too "
             f"small)")
