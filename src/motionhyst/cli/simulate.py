@@ -34,6 +34,12 @@ TIME_SERIES_ONLY = ("--reference-csv", "--columns", "--scale", "--profile", "--d
 PROFILE_DEFAULTS = {"distance": 0.01, "v_max": 0.5, "a_max": 10.0, "j_max": 1000.0}
 """Limits of the built-in point-to-point profile unless given [m, m/s, m/s^2, m/s^3]."""
 
+OUTPUT_RATE_FACTORS = (10.0, 1000.0)
+"""An ``--output-rate`` above the rate a continuous loop's step needs (its fastest pole's,
+or the reference's; Table I's loop: 27.6 kHz) by the first factor is warned of, by the
+second refused: its rows only make the run's step finer than the loop's dynamics need
+(1e9 Hz: 5e7 rows of a 0.05 s run, 8.4 GB)."""
+
 
 def run(args: argparse.Namespace) -> int:
     """A transient run from rest (``--time-series``); without it, the old spelling of ``steady``."""
@@ -150,6 +156,36 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
     return remedy
 
 
+def _check_output_rate(args: argparse.Namespace, sc, ref) -> str | None:
+    """Refuse an ``--output-rate`` above the rate a continuous loop's step needs by more than
+    the second of :data:`OUTPUT_RATE_FACTORS`; above the first, the warning to give once the
+    run is not refused (None otherwise, and for a sampled controller, whose samples set the
+    run)."""
+    from motionhyst.time.references import SampledReference
+    from motionhyst.time.steps import pole_step, step_set_by
+
+    if args.output_rate is None or sc.model.controller is None:
+        return None
+    pole = sc.fastest_pole()
+    if pole is None:
+        return None
+    f = (0.0 if isinstance(ref, SampledReference)
+         else float(getattr(ref, "max_frequency_hz", 0.0) or 0.0))
+    needed = 1.0 / pole_step(pole, f)
+    factor = args.output_rate / needed
+    warn_above, refuse_above = OUTPUT_RATE_FACTORS
+    if factor <= warn_above:
+        return None
+    what = (f"--output-rate {args.output_rate:g} Hz is {factor:.2g} times the rate the loop "
+            f"needs ({needed:.3g} Hz: {step_set_by(pole, f)})")
+    if factor > refuse_above:
+        raise UsageError(f"motionhyst simulate: {what}: its rows would only make the run's "
+                         f"step finer than the loop's dynamics need; give --output-rate "
+                         f"{needed:.3g} (at most {refuse_above:g} times it)")
+    return (f"{what}: its rows make the run's step and the file {factor:.2g} times finer and "
+            f"longer than the loop's dynamics need; --output-rate {needed:.3g} resolves it")
+
+
 def _remedy(args: argparse.Namespace, fixed_step: bool, rows: bool) -> str:
     """What the user of ``simulate --time-series`` can change to make the run smaller: the
     options of its reference (the frequency of a sine, unless the loop sets the step; a
@@ -177,6 +213,7 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
     remedy = _check_size(args, sc, ref, duration, out)
+    rate_note = _check_output_rate(args, sc, ref)
     from motionhyst.analysis.plausibility import check_plausible, check_stroke
 
     if args.profile:  # once it is not refused: a refusal is one line
@@ -187,6 +224,8 @@ def _time_series(args: argparse.Namespace, sc) -> int:
         if 1.0 / ref.frequency_hz > duration:
             warn(f"the period 1/{ref.frequency_hz:g} Hz = {1 / ref.frequency_hz:.3g} s exceeds "
                  f"--duration {duration:g} s: no full period, the run is start-up only")
+    if rate_note is not None:
+        warn(rate_note)
     options = {"output_rate_hz": args.output_rate}
     if args.settle_band is not None:
         options["settle_band"] = args.settle_band
@@ -250,7 +289,8 @@ def add_parser(sub) -> None:
     q.add_argument("--output-rate", type=positive, metavar="HZ",
                    help="rows per second of the CSV (default: the reference file's own rate, "
                         "10 kHz for sines and profiles); the integration step follows the "
-                        "loop's dynamics")
+                        "loop's dynamics, or the rows where they are finer (a rate 10 times "
+                        "what the loop needs is warned of, 1000 times refused)")
     q.add_argument("--settle-band", type=positive, metavar="M",
                    help="point-to-point: half-width of the settling band [m] (1e-8 = 10 nm)")
     add_force_option(q)
