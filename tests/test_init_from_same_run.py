@@ -134,3 +134,42 @@ def test_a_record_with_a_non_finite_force_sample_is_judged_by_the_others(tmp_pat
     code = main(["predict", str(tmp_path / "axis.toml"), str(tmp_path / "force.csv"), "--out",
                  str(tmp_path / "p.csv"), "--init-from", str(tmp_path / "rec.csv")])
     assert code == 0, capsys.readouterr().err
+
+
+def test_mains_hum_larger_than_the_force_is_said_in_the_refusal(tmp_path, capsys):
+    """The same run's record with 50 Hz mains hum of twice the force's RMS (review B12 M2):
+    the forces correlate by 0.45, refused, and the line says what the help says, that noise
+    other than white above 1.7 times the force's RMS decorrelates one run's forces, and
+    that its force column sets nothing (main: "a sensor's ... noise keeps one run's forces
+    correlated"); the column low-passed at 20 Hz, the record passes and sets the state."""
+    from scipy.signal import butter, filtfilt
+
+    t, u = _time(), _input_force()
+    rms = float(np.sqrt(np.mean(u ** 2)))
+    hum = u + 2 * rms * np.sqrt(2) * np.sin(2 * np.pi * 50 * t)
+    y = _run(u) + POSITION_NOISE * np.random.default_rng(3).standard_normal(N)
+    populate(tmp_path, {"axis.toml": AXIS, "force.csv": _table({"time": t, "force": u}),
+                        "hum.csv": _table({"time": t, "force": hum, "displacement": y}),
+                        "low.csv": _table({"time": t, "displacement": y, "force": filtfilt(
+                            *butter(4, 20.0 / (FS / 2)), hum)})})
+    before = snapshot(tmp_path)
+    line = limited_process.refusal(["predict", "axis.toml", "force.csv", "--out", "p.csv",
+                                    "--init-from", "hum.csv"], tmp_path)
+    assert "correlate by 0.45, less than 0.5" in line, line
+    assert line.endswith("(if it is this run's, noise other than white, mains hum or a drift, "
+                         "above 1.7 times the force's RMS decorrelates them: filter its force "
+                         "column, which sets nothing)"), line
+    assert snapshot(tmp_path) == before
+    code = main(["predict", str(tmp_path / "axis.toml"), str(tmp_path / "force.csv"), "--out",
+                 str(tmp_path / "p.csv"), "--init-from", str(tmp_path / "low.csv"), "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0 and json.loads(out)["rmse"] < 3 * POSITION_NOISE, err
+
+
+def test_the_help_says_which_noise_passes(capsys):
+    with pytest.raises(SystemExit):
+        main(["predict", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert ("a load cell's offset, gain or white noise is not, nor other noise below about 1.7 "
+            "times the force's RMS; mains hum or drift larger than that makes the same run's "
+            "force look another's") in text, text

@@ -48,7 +48,10 @@ def add_parser(sub) -> None:
     q.add_argument("--init-from", metavar="REC.csv",
                    help="a measured record of the same run and samples (time,force,"
                         "displacement; one whose force varies independently of INPUT's is "
-                        "refused, a load cell's offset, gain or noise is not): the "
+                        "refused, a load cell's offset, gain or white noise is not, nor "
+                        "other noise below about 1.7 times the force's RMS; mains hum or "
+                        "drift larger than that makes the same run's force look another's): "
+                        "the "
                         "model's initial state (velocity, and position or the position's "
                         "offset) is set from its first --init-window samples, and the error "
                         "after them is reported (the benchmark convention)")
@@ -156,7 +159,8 @@ SAME_RUN_CORRELATION = 0.5
 """An ``--init-from`` record whose force's variations correlate with INPUT's by at least this
 (in magnitude) is taken for the same run: a load cell's offset or gain error leaves the
 correlation 1, white noise of 15 % of the force's RMS 0.989, and noise (of any colour) up to
-1.7 times that RMS keeps it above 0.5."""
+1.7 times that RMS keeps it above 0.5 (mains hum or a drift of twice the force's RMS brings
+it to 0.41-0.45: the same run refused, its white-noise escape blind to them)."""
 
 SAME_RUN_NOISE_FACTOR = 2.0
 """Below :data:`SAME_RUN_CORRELATION`, the two forces are still taken for the same run when
@@ -198,9 +202,11 @@ def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
     raise UsageError(f"motionhyst predict: {args.init_from} is not the run of {args.data}: "
                      f"their forces vary independently (the de-meaned forces correlate by "
                      f"{rho:.2g}, less than {SAME_RUN_CORRELATION:g} in magnitude, and "
-                     f"{beyond}), while a sensor's offset, gain error or noise keeps one "
-                     f"run's forces correlated; its position would set the state, and score "
-                     f"the prediction, of another run")
+                     f"{beyond}), while a sensor's offset, gain error or white noise keeps "
+                     f"one run's forces correlated; its position would set the state, and "
+                     f"score the prediction, of another run (if it is this run's, noise "
+                     f"other than white, mains hum or a drift, above 1.7 times the force's "
+                     f"RMS decorrelates them: filter its force column, which sets nothing)")
 
 
 def _check_step(system, t, args) -> None:
