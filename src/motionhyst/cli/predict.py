@@ -165,13 +165,8 @@ it to 0.41-0.45: the same run refused, its white-noise escape blind to them)."""
 SAME_RUN_NOISE_FACTOR = 2.0
 """Below :data:`SAME_RUN_CORRELATION`, the two forces are still taken for the same run when
 what one does not share with the other is, in RMS, within this factor of their sensors'
-white noise (:func:`_white_noise_variance`): a load cell's noise larger than the force."""
-
-
-def _white_noise_variance(f) -> float:
-    """The variance of a record's white noise, from its third differences (20 times the
-    noise's variance; a force sampled well above its bandwidth adds little to them)."""
-    return float(np.mean(np.diff(f, 3) ** 2)) / 20.0 if f.size > 3 else 0.0
+white noise (:func:`~motionhyst.identify.io_uncertainty.white_noise_variance`, the mean
+square of the third differences): a load cell's noise larger than the force."""
 
 
 def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
@@ -185,6 +180,8 @@ def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
     share with INPUT's exceeds :data:`SAME_RUN_NOISE_FACTOR` times the white noise of the
     two; a force constant in either record, or non-finite samples, are not judged (the
     record's force is not used)."""
+    from motionhyst.identify.io_uncertainty import white_noise_variance
+
     ok = np.isfinite(u) & np.isfinite(u_rec)
     a, b = u[ok] - np.mean(u[ok]), u_rec[ok] - np.mean(u_rec[ok])
     aa, bb = float(a @ a), float(b @ b)
@@ -194,7 +191,8 @@ def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
     if abs(rho) >= SAME_RUN_CORRELATION:
         return
     unshared = (1.0 - rho ** 2) * bb / b.size  # b's variance about its regression on a
-    noise = _white_noise_variance(u_rec[ok]) + rho ** 2 * bb / aa * _white_noise_variance(u[ok])
+    noise = (white_noise_variance(u_rec[ok], robust=False)
+             + rho ** 2 * bb / aa * white_noise_variance(u[ok], robust=False))
     if unshared <= SAME_RUN_NOISE_FACTOR ** 2 * noise:
         return
     beyond = (f"differ by {np.sqrt(unshared / noise):.3g} times their white noise"

@@ -21,6 +21,7 @@ from motionhyst.identify.fit import (
     fit_rows,
     identify_prepared,
 )
+from motionhyst.identify.io_uncertainty import white_noise_variance
 from motionhyst.identify.records import (
     UNIFORM_RTOL,
     check_controller_period,
@@ -198,12 +199,6 @@ over the record's whole cycles is below zero by more than this many times its no
 beyond the energy a link's elements could have released (:func:`_check_passive`)."""
 
 
-def _white_noise_variance(x: NDArray[np.float64]) -> float:
-    """The variance of a signal's white noise, from its third differences (20 times the
-    noise's variance); the controller's fast action on ``u`` counts as noise (more spread)."""
-    return float(np.mean(np.diff(x, 3) ** 2)) / 20.0 if x.size > 3 else 0.0
-
-
 def _whole_cycles(z: NDArray[np.float64], start: int) -> tuple[int, int, int]:
     """The first and last rise of `z` (from `start` on) through the middle of its range, each
     after a fall below it by a tenth of the range, and the whole cycles between them."""
@@ -267,12 +262,13 @@ def _check_passive(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64],
     whole cycles after the prefilter settles (from the first to the last rise through the
     middle of the range), the line of ``L w`` in ``L y1`` taken out (a spring and an offset
     do no work over whole cycles), is compared with its noise spread (the white noise of
-    ``u`` and ``y1``, estimated from their third differences, carried through ``L`` and
-    ``L / P1`` exactly) and with what a link could release: its elements' stored energy,
-    at most a quarter of the force's spread about the line times half the range of
-    ``L y1``.  Below zero by :data:`PASSIVE_SIGMAS` spreads plus that energy, the record is
-    refused: noise alone, or a link's own nonlinearity, does not cross it.  `aligned`, where
-    given, says which shift of the columns makes the record a link's
+    ``u`` and ``y1``, :func:`~motionhyst.identify.io_uncertainty.white_noise_variance`: their
+    third differences' mean square, the controller's fast action on ``u`` counted, carried
+    through ``L`` and ``L / P1`` exactly) and with what a link could release: its elements'
+    stored energy, at most a quarter of the force's spread about the line times half the
+    range of ``L y1``.  Below zero by :data:`PASSIVE_SIGMAS` spreads plus that energy, the
+    record is refused: noise alone, or a link's own nonlinearity, does not cross it.
+    `aligned`, where given, says which shift of the columns makes the record a link's
     (:func:`_aligning_shift`)."""
     z = lf.lowpass(lf.y1 - lf.y1[0])
     a, b, cycles = _whole_cycles(z, lf.settle_index)
@@ -296,8 +292,8 @@ def _check_passive(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64],
 
     on_u = transposed(L, ga)
     on_y1 = transposed(L, gb) - transposed(L_over_P1, ga)
-    spread = float(np.sqrt(_white_noise_variance(u) * (on_u @ on_u)
-                           + _white_noise_variance(lf.y1) * (on_y1 @ on_y1)))
+    spread = float(np.sqrt(white_noise_variance(u, robust=False) * (on_u @ on_u)
+                           + white_noise_variance(lf.y1, robust=False) * (on_y1 @ on_y1)))
     stored = 0.125 * float(np.ptp(r)) * float(np.ptp(zz))
     if work + PASSIVE_SIGMAS * spread + stored < 0:
         cause = (f"not a link's force ({aligned + '; or ' if aligned else ''}u or y1 of the "

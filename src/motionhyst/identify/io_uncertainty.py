@@ -200,40 +200,58 @@ WINDOW_INFLATION = 2.0
 NOISE_DIFFERENCES = 3
 
 
-def white_noise_variance(parts: list[NDArray[np.float64]]) -> float:
-    """The white noise variance of measured positions, from their residuals' third
-    differences (robustly: their median absolute deviation).
+def white_noise_variance(parts: NDArray[np.float64] | list[NDArray[np.float64]],
+                         robust: bool = True) -> float:
+    """The variance of a signal's white noise, from its third differences: one estimate
+    for every part of motionhyst that needs a record's noise (the standard errors of an
+    input-output fit, ``predict``'s error, a closed-loop record's passivity check,
+    ``predict --init-from``'s same-run check).
 
-    A residual is noise plus the model's error; the error of a simulated stage varies
-    smoothly from sample to sample, and its third differences are far below its size,
-    while white noise's have ``20 sigma^2`` (``C(6, 3)``).  The median absolute deviation
-    keeps a few steps of the error (a slider sticking a sample early) out.  A record's
-    quantisation (an encoder's step ``q``: ``q^2 / 12``) counts as its noise.
+    A residual (or a measured signal) is noise plus something smooth: a simulated stage's
+    error, a force sampled well above its bandwidth.  The smooth part's third differences
+    are its jerk times the step cubed, far below its size, while white noise's have
+    ``20 sigma^2`` (``C(6, 3)``).  With `robust` (the default) their median absolute
+    deviation is taken, which keeps a few steps out (a slider sticking a sample early);
+    without, their mean square, which counts every fast move as noise (a controller's fast
+    action on a closed loop's force: an upper estimate, what a check that must not refuse
+    noise needs).  A record's quantisation (an encoder's step ``q``: ``q^2 / 12``) counts
+    as its noise.
 
     Parameters
     ----------
-    parts : list of ndarray
-        Each record's residuals [m] (at least 4 samples each to count).
+    parts : ndarray or list of ndarray
+        The signal [any unit], or several records' (each differenced on its own; a part
+        of 3 samples or fewer does not count).
+    robust : bool
+        The median absolute deviation (default) rather than the mean square.
 
     Returns
     -------
     float
-        ``sigma^2`` [m^2] (0 for records too short).
+        ``sigma^2`` [the signal's unit squared] (0 for records too short).
 
     Examples
     --------
+    A model's error of 100 um, slow, and 1 um of white noise: the noise is found.
+
     >>> rng = np.random.default_rng(0)
     >>> t = np.arange(5000) / 1000.0
-    >>> smooth = 1e-4 * np.sin(2 * np.pi * 3 * t)           # a model's error: 100 um, slow
-    >>> e = smooth + 1e-6 * rng.standard_normal(t.size)     # and 1 um of noise
-    >>> round(float(np.sqrt(white_noise_variance([e]))) * 1e6, 2)
+    >>> smooth = 1e-4 * np.sin(2 * np.pi * 3 * t)
+    >>> e = smooth + 1e-6 * rng.standard_normal(t.size)
+    >>> round(float(np.sqrt(white_noise_variance(e))) * 1e6, 2)
+    1.0
+    >>> round(float(np.sqrt(white_noise_variance([e[:2500], e[2500:]], robust=False))) * 1e6, 2)
     1.0
     """
     k = NOISE_DIFFERENCES
+    if isinstance(parts, np.ndarray) and parts.ndim == 1:
+        parts = [parts]
     d = [np.diff(np.asarray(r, dtype=float), k) for r in parts if len(r) > k]
     if not d:
         return 0.0
     d = np.concatenate(d)
+    if not robust:
+        return float(np.mean(d ** 2)) / math.comb(2 * k, k)
     mad = float(np.median(np.abs(d - np.median(d))))
     return (1.4826 * mad) ** 2 / math.comb(2 * k, k)
 
