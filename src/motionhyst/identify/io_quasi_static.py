@@ -192,9 +192,13 @@ class _Problem:
     def solve(self, q0: NDArray[np.float64], equation: bool, max_nfev: int, tol: float):
         lower = np.where(self.log, -np.inf, self.lower / self.scale)[self.free]
         q0 = np.maximum(q0[self.free], lower)
-        return least_squares(lambda q: self._residuals(q, equation), q0, method="trf",
-                             x_scale=1.0, diff_step=1e-6, ftol=tol, xtol=tol, gtol=tol,
-                             max_nfev=max_nfev, bounds=(lower, np.full(lower.size, np.inf)))
+        # a trial step far out (a piezo's Bouc-Wen link on 24,000 samples) may predict positions
+        # whose sum of squares overflows: an infinite cost, a step the search rejects, not a
+        # warning on the user's terminal
+        with np.errstate(over="ignore"):
+            return least_squares(lambda q: self._residuals(q, equation), q0, method="trf",
+                                 x_scale=1.0, diff_step=1e-6, ftol=tol, xtol=tol, gtol=tol,
+                                 max_nfev=max_nfev, bounds=(lower, np.full(lower.size, np.inf)))
 
 
 #: The search's shape values of a Bouc-Wen link (:class:`BoucWenShape`)
@@ -571,7 +575,9 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     if exponent is not None:
         prob.free[exponent] = True
     # the start that predicts the positions (the forces) best continues
-    costs = [float(np.sum(prob._residuals(q[prob.free], force_error) ** 2)) for q in starts]
+    with np.errstate(over="ignore"):  # a start far out: an infinite cost, never the best
+        costs = [float(np.sum(prob._residuals(q[prob.free], force_error) ** 2))
+                 for q in starts]
     if not starts or min(costs) >= 0.5 * FAILED_RESIDUAL ** 2 * y_all.size:  # none runs
         raise FitFailed(f"the fit failed: no start of the {link.name} link on a quasi-static "
                         f"plant can run on these records (a force it does not hold)")
