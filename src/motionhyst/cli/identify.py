@@ -559,8 +559,8 @@ def _refuse_beyond_bound(path: Path, x, w) -> None:
     (:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`), the fit would end in
     :func:`_judge_elements`'s refusal after its work.  The checks that name another cause
     (no hysteresis, a sensor's sign reversed) stay the fit's: the bound leaves them alone."""
-    from motionhyst.identify.fd_memory import bound_columns
     from motionhyst.identify.fd_bound import systematic_share_bound
+    from motionhyst.identify.fd_memory import bound_columns
     from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed
 
     bound = systematic_share_bound(x, w, max_columns=bound_columns(x.size))
