@@ -247,8 +247,8 @@ def test_every_slip_displacement_between_the_bounds_columns_is_a_blend_of_its_ne
     """The bound's claim on its columns: the stop operator of any slip displacement from the
     limit of zero slip to half the range is within twice the tolerance (RMS, per unit slip
     force) of a blend of the two columns around it (measured: at most 1.44 times)."""
+    from motionhyst.identify._stop_operators import stops_at
     from motionhyst.identify.fd_bound import BOUND_TOLERANCE, _bound_columns
-    from motionhyst.identify.stop_operators import _stops_at
 
     x, _, _ = _family(kind, 3)
     x = np.ascontiguousarray(x)
@@ -256,7 +256,7 @@ def test_every_slip_displacement_between_the_bounds_columns_is_a_blend_of_its_ne
     d, columns, tolerance = _bound_columns(x, rows, 0.5 * float(np.ptp(x)))
     assert tolerance == BOUND_TOLERANCE and d[-1] == 0.5 * np.ptp(x)
     trial = np.exp(np.random.default_rng(4).uniform(np.log(d[0]), np.log(d[-1]), 500))
-    between = _stops_at(x, trial, np.zeros_like(trial), rows, True)
+    between = stops_at(x, trial, np.zeros_like(trial), rows, True)
     j = np.clip(np.searchsorted(d, trial), 1, d.size - 1)
     span, off = columns[:, j - 1] - columns[:, j], between - columns[:, j]
     square = np.einsum("ij,ij->j", span, span)  # 0 where the two are one (steps below both)

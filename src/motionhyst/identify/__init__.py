@@ -72,7 +72,7 @@ records
     Reading and checking records.
 fit
     The Maxwell-slip fit engine (force-displacement records): its compiled stop operators are
-    stop_operators, the bound before it of what any elements leave is fd_bound.
+    _stop_operators, the bound before it of what any elements leave is fd_bound.
 closed_loop
     The link force inferred from closed-loop records, and its fit.
 input_output

@@ -13,8 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import nnls
 
+from motionhyst.identify._stop_operators import stops_at
 from motionhyst.identify.io_checks import NO_HYSTERESIS_GAIN, hysteresis_gain
-from motionhyst.identify.stop_operators import _stops_at
 
 __all__ = ["systematic_share_bound"]
 
@@ -66,12 +66,12 @@ def _bound_columns(x: NDArray[np.float64], rows: NDArray[np.intp], h: float,
     low = max(zero, 1e-12 * h)  # below it, one interval to the limit (steps of round-off)
     d = np.geomspace(low, h, max(2, math.ceil(BOUND_PER_DECADE * math.log10(h / low)) + 1))
     d = np.append(zero, d) if zero < low else d
-    cols = dict(zip(d.tolist(), _stops_at(x, d, np.zeros_like(d), rows, True).T, strict=True))
+    cols = dict(zip(d.tolist(), stops_at(x, d, np.zeros_like(d), rows, True).T, strict=True))
     pending = list(zip(d[:-1].tolist(), d[1:].tolist(), strict=True))
     left = BOUND_TOLERANCE
     while pending:
         mids = np.array([math.sqrt(a) * math.sqrt(b) for a, b in pending])  # no underflow
-        M = _stops_at(x, mids, np.zeros_like(mids), rows, True)
+        M = stops_at(x, mids, np.zeros_like(mids), rows, True)
         Sa = np.column_stack([cols[a] for a, _ in pending])
         Sb = np.column_stack([cols[b] for _, b in pending])
         span, off = Sa - Sb, M - Sb

@@ -14,10 +14,10 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares, nnls
 
 from motionhyst.hysteresis import MaxwellSlip
+from motionhyst.identify._stop_operators import maxwell_at, stops_at
 from motionhyst.identify.io_uncertainty import covariance, covariance_table
 from motionhyst.identify.records import check_signals
 from motionhyst.identify.result import Identification
-from motionhyst.identify.stop_operators import _maxwell_at, _stops_at
 
 if TYPE_CHECKING:  # a closed-loop record's prefilter (python-control): a force-displacement
     from motionhyst.core.lti import HoldFilter  # fit needs neither
@@ -127,7 +127,7 @@ def _evaluate(prob: FitProblem, theta, n: int, jac: bool):
     k = np.ascontiguousarray(k)
     fc = np.ascontiguousarray(fc)
     keep = prob.rows if prob.filt is None else np.arange(prob.x.size)
-    W, sign, before = _maxwell_at(prob.x, k, fc, np.ascontiguousarray(alpha * fc), keep)
+    W, sign, before = maxwell_at(prob.x, k, fc, np.ascontiguousarray(alpha * fc), keep)
     cols = [W.sum(axis=1)[:, None]]
     if jac:
         # d w_i / d fc_i = sigma_i: the sign of the last saturation (alpha_i before the first);
@@ -196,12 +196,12 @@ def _unit_columns(prob: FitProblem, d, w0, per_slip_force: bool = False
     d = np.ascontiguousarray(d, dtype=float)
     w0 = np.ascontiguousarray(w0, dtype=float)
     if prob.filt is None:
-        return _stops_at(prob.x, d, w0, prob.rows, per_slip_force)
+        return stops_at(prob.x, d, w0, prob.rows, per_slip_force)
     # the prefilter needs every sample: one column at a time keeps memory to a few records
     every = np.arange(prob.x.size)
     S = np.empty((prob.rows.size, d.size))
     for j in range(d.size):
-        col = _stops_at(prob.x, d[j:j + 1], w0[j:j + 1], every, per_slip_force)
+        col = stops_at(prob.x, d[j:j + 1], w0[j:j + 1], every, per_slip_force)
         S[:, j] = prob.filt(col)[prob.rows, 0]
     return S
 

@@ -13,7 +13,7 @@ from motionhyst.core.compiled import njit
 
 
 @njit(cache=True)
-def _maxwell_at(x, k, fc, w0, rows):  # pragma: no cover - compiled
+def maxwell_at(x, k, fc, w0, rows):  # pragma: no cover - compiled
     """Parallel stop operators run over every sample of `x`, kept only at `rows` (ascending).
 
     Returns the element forces ``W``, the sign of each element's force at its
@@ -55,7 +55,7 @@ def _maxwell_at(x, k, fc, w0, rows):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _stops_at(x, d, w0, rows, per_slip_force):  # pragma: no cover - compiled
+def stops_at(x, d, w0, rows, per_slip_force):  # pragma: no cover - compiled
     """Unit-stiffness stop operators of thresholds `d` from `w0`, kept only at `rows`.
 
     The recursion of :func:`~motionhyst.hysteresis._kernels.stop_response`
