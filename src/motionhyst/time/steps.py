@@ -147,7 +147,7 @@ def check_link_damping(link, plant, step: float, where: str = "") -> None:
     ...     print(exc)
     the link's damping for small motions, 1e+07 N s/m on the 5 kg it moves, is too strong \
 for the time step of 3.62e-05 s: it would amplify each pass of the step's implicit \
-iteration 18 times (it settles below 1): the run would stop at the stage's first motion
+iteration 18.1 times (it settles below 1): the run would stop at the stage's first motion
     """
     small = getattr(link, "small_amplitude_limit", None)
     mechanics = getattr(plant, "mechanics", None)
@@ -164,7 +164,7 @@ iteration 18 times (it settles below 1): the run would stop at the stage's first
         raise ValueError(f"{where}the link's damping for small motions, {damping:.4g} N s/m on "
                          f"the {mass:.4g} kg it moves, is too strong for the time step of "
                          f"{step:.3g} s: it would amplify each pass of the step's implicit "
-                         f"iteration {factor:.2g} times (it settles below 1): the run would "
+                         f"iteration {factor:.3g} times (it settles below 1): the run would "
                          f"stop at the stage's first motion")
 
 
