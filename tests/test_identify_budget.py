@@ -337,3 +337,46 @@ def test_the_checks_before_the_search_stay_below_its_least_estimate(tmp_path):
     m, c = (float(v) for v in proc.stdout.split())
     # the inverse dynamics without the link: the mass 3 % low, the damping found
     assert m == pytest.approx(95.0, rel=0.05) and c == pytest.approx(200.0, rel=0.02), proc.stdout
+
+
+def test_a_two_mass_bouc_wen_search_is_sized_by_its_measured_estimate(tmp_path):
+    """A two-mass stage with a Bouc-Wen link (test_identify_two_mass's), 2e4 samples at
+    750 Hz: the search runs 35 steps a sample or more, and main sized it at 64 B a step (45
+    MB: refused under --max-memory 40M); sized as the mass-spring-damper's search (16 B a step
+    and 900 B a sample: 29 MB; measured on two masses: 24 MB of 27 at 2e4 samples, 92 MB of
+    135 at 1e5) it runs within 40 MB of address space above the warmed process (its run of
+    the fitted model at the end, sized by its own estimate once that model is known, takes
+    37 MB)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_identify_two_mass import FS as FS_TWO_MASS
+    from test_identify_two_mass import _record
+
+    for n, name in ((1536, "small.mat"), (20_000, "run.mat")):
+        rec = _record(n, 1, noise=1e-7)
+        savemat(tmp_path / name, {"time": rec.t[:, None], "force": rec.u[:, None],
+                                  "displacement": rec.y[:, None]})
+    assert FS_TWO_MASS == 750.0
+    assert io_memory.bouc_wen_memory([20_000], 35)["total"] < 40 << 20 < 64 * 35 * 20_000
+    argv = ("['identify', '{}', '--record', 'input-output', '--plant', 'two-mass', '--model', "
+            "'bouc-wen', *" + repr(IO_COLUMNS) + ", '--max-evaluations', '40', "
+            "'--max-memory', '40M', '--json']")
+    script = tmp_path / "two_mass.py"
+    script.write_text(
+        "import contextlib, io, json, resource, warnings\n"
+        "from motionhyst.cli import main\n"
+        "warnings.simplefilter('ignore')\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        f"    main({argv.format('small.mat')})\n"
+        "with open('/proc/self/status') as f:\n"
+        "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + (40 << 20),) * 2)\n"
+        "out = io.StringIO()\n"
+        "with contextlib.redirect_stdout(out):\n"
+        f"    code = main({argv.format('run.mat')})\n"
+        "fit = json.loads(out.getvalue()) if code == 0 else {}\n"
+        "print(code, fit.get('substeps'), fit.get('estimates', {}).get('m2'))\n")
+    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
+                          text=True, env=limited_process.environment(), timeout=900)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    code, substeps, _ = proc.stdout.split()  # 40 evaluations: sized, not converged
+    assert code == "0" and int(substeps) >= 35, (proc.stdout, proc.stderr[-1000:])

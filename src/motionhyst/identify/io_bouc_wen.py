@@ -485,7 +485,8 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
     fs = records[0].fs
     f_n = bla.mechanics().natural_frequency_hz(k_link)
     r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
-    check_substeps(records, r, f_n, 2)
+    check_substeps(records, r, f_n, 2, sized=True)
+    check_bouc_wen_memory([rec.u.size for rec in records], r)  # measured on two masses too
     y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y - (np.mean(rec.y) if periodic else 0.0)
                                                     for rec in records]) ** 2)))
     mu = bla.m1 * bla.m2 / bla.M

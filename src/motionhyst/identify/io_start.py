@@ -413,7 +413,7 @@ MAX_FINE_SAMPLES = 50_000_000
 
 
 def check_substeps(records: list[IORecord], substeps: int, f_n: float | None,
-                   factor: int = 1) -> None:
+                   factor: int = 1, sized: bool = False) -> None:
     """Refuse a fit whose records need too many integration steps, before it starts.
 
     The integration takes `substeps` steps per sample (``factor`` times as
@@ -433,6 +433,10 @@ def check_substeps(records: list[IORecord], substeps: int, f_n: float | None,
         least a stage runs (or what its link's stiffness at the start calls for).
     factor : int
         Input samples per integration step (2: the midpoints too).
+    sized : bool
+        The caller sizes the search's memory by its own, measured estimate (the Bouc-Wen
+        link's, :func:`~motionhyst.identify.io_memory.check_bouc_wen_memory`): the steps
+        alone are checked here.
 
     Raises
     ------
@@ -470,7 +474,7 @@ more than 5e+07; give shorter records
                   "try --plant mass-spring-damper)")
     if n > MAX_FINE_SAMPLES:
         raise ValueError(f"{what}: more than {MAX_FINE_SAMPLES:.0e}; {remedy}")
-    if f_n is not None:  # the search's own estimate sizes the rest
+    if f_n is not None and not sized:  # the search's own estimate sizes the rest
         check_memory(8.0 * factor * n * 4, what, remedy)
 
 
