@@ -281,3 +281,31 @@ def test_a_small_regression_runs_on_one_blas_thread_a_large_one_on_the_machine_s
     small = rows * 36**2 <= SMALL_FLOPS
     assert seen == [[1] * len(machine) if small else machine], (seen, machine)
     assert blas_threads() == machine  # the limit was the regression's only
+
+
+def test_a_measured_plant_s_fit_runs_on_one_blas_thread(monkeypatch):
+    """A measured plant's fit (60 lines, a rigid body and a mode) spent its time in the
+    SVDs of its small Jacobians on the machine's BLAS threads: ``analyze`` of a noisy
+    FRF refused (the fitted loop unstable) after 11-15 s of wall time, 2.7-3.6 s of CPU
+    (2 cores, load 19); 8-9 s and 1.7-1.9 s on one thread.  Each of its searches runs on
+    one thread now, and the fit is the same."""
+    from threadpoolctl import threadpool_info
+
+    from motionhyst import ModalPlant, TwoMassStage
+    from motionhyst.plants import frf_fit
+
+    machine = [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+    seen = []
+    least_squares = frf_fit.least_squares
+
+    def counting(*args, **kwargs):
+        seen.append([i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"])
+        return least_squares(*args, **kwargs)
+
+    monkeypatch.setattr(frf_fit, "least_squares", counting)
+    exact = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    f = np.geomspace(1.0, 3000.0, 60)
+    fit = frf_fit.fit_frf(f, *exact.response(2 * np.pi * f))
+    assert len(fit.plant.modes) == 1 and abs(fit.plant.M - 22.5) < 1e-6
+    assert abs(fit.plant.modes[0].frequency_hz - 694.262) < 1e-3
+    assert seen and all(threads == [1] * len(machine) for threads in seen), (seen, machine)

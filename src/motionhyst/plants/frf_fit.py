@@ -76,6 +76,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
+from motionhyst.core.blas import few_blas_threads
 from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import TWO_PI
 from motionhyst.plants.measured import MeasuredPlant
@@ -375,8 +376,9 @@ def _solve(prob: _Problem, x0, n):
     x0 = np.clip(x0, np.nextafter(lo, hi), np.nextafter(hi, lo))
     if x0.size == 0:
         return x0, prob.residuals(x0, n)
-    sol = least_squares(prob.residuals, x0, jac=prob.jacobian, bounds=(lo, hi), args=(n,),
-                        x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500)
+    with few_blas_threads(4 * prob.f.size, x0.size):  # its SVDs: small, one thread
+        sol = least_squares(prob.residuals, x0, jac=prob.jacobian, bounds=(lo, hi), args=(n,),
+                            x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500)
     return sol.x, sol.fun
 
 
