@@ -15,7 +15,12 @@ any, a study's store named by a symbolic link, a force-displacement record whose
 accelerates a mass, and a record no Maxwell-slip elements describe (a Jenkins element, a
 spring and a damper: loops, but not a stop operator's; a short record and one of 60000
 samples), refused by a bound on what any of them can leave before the fit that took 1.8 s
-and 26 s of CPU to refuse them.  Each runs as a whole
+and 26 s of CPU to refuse them, a closed-loop record with y1 in mm or its columns swapped
+(refused from the plant's scales before the loop is built; was after the fit, 3.1 s of
+CPU), a link too damped for the step of scan and simulate (from the scenario before the
+loop is built; was during the run, 1.45 s), a link model that input-output records cannot
+fit (by its name, before the records are read) and a force of white noise (its small
+regressions on one BLAS thread).  Each runs as a whole
 process (the interpreter, the imports, the checks) in a folder holding its files,
 ``REPEATS`` times interleaved with the baseline of the same run: ``motionhyst --help``,
 the command's start alone.  Reported per case: the least wall time (the least disturbed
@@ -78,6 +83,18 @@ def _stage_and_link(n: int = 3000) -> tuple[str, str]:
                   + 10.0 * x + 1.6 * np.gradient(x, t)))
 
 
+def _closed_loop() -> dict[str, str]:
+    """The paper's loop with a two-element link, 3 s of a 2 Hz sine at 5 kHz: closed-loop
+    records with y1 in mm and with u and y1 swapped."""
+    from motionhyst import Loop, MaxwellSlip, SineReference, default_scenario, simulate
+
+    sc = default_scenario()
+    loop = Loop(sc.plant(), sc.controller(), MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]))
+    sim = simulate(loop, SineReference(0.01, 2.0), 3.0, dt=2e-4)
+    return {"cl-mm.csv": _rows("time,y1,u", sim.t, 1000 * sim.y1, sim.u),
+            "cl-swapped.csv": _rows("time,y1,u", sim.t, sim.u, sim.y1)}
+
+
 def _files() -> dict[str, str]:
     t = np.arange(600) / 750
     u = 50.0 * np.sin(2 * np.pi * 7.0 * t) + 20.0 * np.sin(2 * np.pi * 31.0 * t)
@@ -121,6 +138,11 @@ def _files() -> dict[str, str]:
         **dict(zip(("io-stage.csv", "fd-link.csv"), _stage_and_link(), strict=True)),
         "io-missing.csv": _rows("time,force", t, u),
         "f.mat": "time,force\n0,1\n",
+        "damped.toml": PAPER.replace('model = "jenkins"', 'model = "lugre"').replace(
+            "k = 20.0 ", "sigma0 = 20.0\nsigma1 = 1e7\nfs = 0.07\nvs = 0.1 "),
+        "fd-noise.csv": _rows("time,displacement,force", t, 10 * x,
+                              np.random.default_rng(5).standard_normal(t.size)),
+        **_closed_loop(),
     }
 
 
@@ -160,6 +182,16 @@ CASES = [
     ("no stop operator fits", ["identify", "fd-jenkins-damper.csv"], "checks"),
     ("no stop operator, long", ["identify", "fd-jenkins-damper-long.csv"], "checks"),
     ("a mass on the link", ["identify", "fd-mass.csv"], "checks"),
+    ("closed loop, y1 in mm", ["identify", "cl-mm.csv", "--scenario", "s.toml"], "checks"),
+    ("closed loop, swapped", ["identify", "cl-swapped.csv", "--scenario", "s.toml"],
+     "checks"),
+    ("scan, link too damped", ["scan", "damped.toml", *SCAN, "--compensation", "none"],
+     "checks"),
+    ("simulate, too damped", ["simulate", "damped.toml", "--time-series", "o.csv",
+                              "--frequency", "5", "--duration", "0.2"], "checks"),
+    ("io, maxwell-iwan", ["identify", "io-stage.csv", "--record", "input-output", "--model",
+                          "maxwell-iwan"], "checks"),
+    ("force of white noise", ["identify", "fd-noise.csv"], "fit"),
 ]
 
 
