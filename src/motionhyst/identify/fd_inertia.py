@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.blas import few_blas_threads
 from motionhyst.hysteresis import Jenkins
 from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, robust_least_squares
 from motionhyst.identify.io_records import IORecord
@@ -198,7 +199,8 @@ def link_inertia(records: list[IORecord]) -> LinkInertia | None:
     A, b = np.concatenate(rows), np.concatenate(rhs)
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
-    rest = np.linalg.lstsq(A[:, 1:] / scale[1:], b, rcond=None)[0]
+    with few_blas_threads(*A.shape):  # a small fit: its threads cost more than the work
+        rest = np.linalg.lstsq(A[:, 1:] / scale[1:], b, rcond=None)[0]
     left = b - A[:, 1:] @ (rest / scale[1:])
     full = b - A @ coef
     left_ss, full_ss = float(left @ left), float(full @ full)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.blas import few_blas_threads
 from motionhyst.core.compiled import njit
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
@@ -216,7 +217,8 @@ element's follow the path alone; nothing identified
     shares = []
     for basis in (np.column_stack([np.ones_like(u), u]),
                   np.polynomial.chebyshev.chebvander(u, ELASTIC_CURVE_DEGREE)):
-        coef = np.linalg.lstsq(basis, w, rcond=None)[0]
+        with few_blas_threads(*basis.shape):  # a small fit: its threads cost more
+            coef = np.linalg.lstsq(basis, w, rcond=None)[0]
         shares.append(systematic_share(w - basis @ coef, w))
     line, curve = shares
     if line > ELASTIC_CURVE_FACTOR * SYSTEMATIC_SHARE and curve < ELASTIC_CURVE_RATIO * line:
@@ -229,7 +231,9 @@ element's follow the path alone; nothing identified
         return
     v = np.gradient(x, np.asarray(t, dtype=float))
     basis = np.column_stack([np.ones_like(u), u, v / float(np.max(np.abs(v)))])
-    damper = systematic_share(w - basis @ np.linalg.lstsq(basis, w, rcond=None)[0], w)
+    with few_blas_threads(*basis.shape):
+        coef = np.linalg.lstsq(basis, w, rcond=None)[0]
+    damper = systematic_share(w - basis @ coef, w)
     if damper < min(ELASTIC_CURVE_RATIO * line, SYSTEMATIC_SHARE):
         raise ValueError(f"no hysteresis in the record: the force is a spring's and a "
                          f"damper's (they leave {round(100 * damper, 2):.2g} % of its RMS, a "
