@@ -380,3 +380,17 @@ def test_a_two_mass_bouc_wen_search_is_sized_by_its_measured_estimate(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     code, substeps, _ = proc.stdout.split()  # 40 evaluations: sized, not converged
     assert code == "0" and int(substeps) >= 35, (proc.stdout, proc.stderr[-1000:])
+
+
+def test_the_help_says_how_max_evaluations_is_shared(capsys):
+    """Review A12b L2: with --max-evaluations the refinement from the starts' best gets half
+    of what the starts leave, the run from the window's state the other half; said in the
+    help (and the guide), as the stopping line's "at most ... evaluations" shows it."""
+    from motionhyst.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["identify", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert ("records from a start whose state is estimated are refined twice (from the starts' "
+            "best and from the state their first samples set), each run with half of what the "
+            "starts leave") in text, text

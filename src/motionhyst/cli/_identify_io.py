@@ -76,7 +76,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     q.add_argument("--max-evaluations", type=whole_number(10, 100000, "evaluations"), metavar="N",
                    help="input-output records: the search's budget of model evaluations, "
                         "starts and refinement together (default: the starts', then at most "
-                        "200 for the refinement)")
+                        "200 for the refinement); records from a start whose state is "
+                        "estimated are refined twice (from the starts' best and from the "
+                        "state their first samples set), each run with half of what the "
+                        "starts leave")
     q.add_argument("--output", choices=("y2", "y1"),
                    help="input-output records, --plant two-mass: the measured position, y2 "
                         "(the point of control, default) or y1 (the actuated mass)")
