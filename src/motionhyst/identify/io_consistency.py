@@ -71,7 +71,7 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
     record given with a stage's) is refused where its mass lies more than
     :data:`ONE_STAGE_SIGMAS` robust standard errors from theirs; on a spring its mass is
     taken with the others' spring (at one frequency a mass is a negative spring: alone,
-    a link's record shows -1.2 +- 0.99 kg beside a stage's 1.9 +- 0.048, with its spring
+    a link's record shows -1.2 +- 0.99 kg beside a stage's 1.9 +- 0.048, with the stage's spring
     -0.11 +- 0.0024 kg).  A slow record of the same stage, its inertia hidden in its friction,
     agrees with theirs within its larger error.  A record that shows a mass of its own
     (with a single-mass stage, `single_mass`) is refused where its mass and the others'
