@@ -156,9 +156,9 @@ def test_mains_hum_larger_than_the_force_is_said_in_the_refusal(tmp_path, capsys
     line = limited_process.refusal(["predict", "axis.toml", "force.csv", "--out", "p.csv",
                                     "--init-from", "hum.csv"], tmp_path)
     assert "correlate by 0.45, less than 0.5" in line, line
-    assert line.endswith("(if it is this run's, noise other than white, mains hum or a drift, "
-                         "above 1.7 times the force's RMS decorrelates them: filter its force "
-                         "column, which sets nothing)"), line
+    assert line.endswith("(if it is this run's, noise other than white, mains hum or "
+                         "low-frequency noise, above 1.7 times the force's RMS decorrelates "
+                         "them: filter its force column, which sets nothing)"), line
     assert snapshot(tmp_path) == before
     code = main(["predict", str(tmp_path / "axis.toml"), str(tmp_path / "force.csv"), "--out",
                  str(tmp_path / "p.csv"), "--init-from", str(tmp_path / "low.csv"), "--json"])
@@ -171,5 +171,5 @@ def test_the_help_says_which_noise_passes(capsys):
         main(["predict", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert ("a load cell's offset, gain or white noise is not, nor other noise below about 1.7 "
-            "times the force's RMS; mains hum or drift larger than that makes the same run's "
-            "force look another's") in text, text
+            "times the force's RMS; mains hum or low-frequency noise larger than that makes "
+            "the same run's force look another's") in text, text

@@ -50,7 +50,8 @@ def add_parser(sub) -> None:
                         "displacement; one whose force varies independently of INPUT's is "
                         "refused, a load cell's offset, gain or white noise is not, nor "
                         "other noise below about 1.7 times the force's RMS; mains hum or "
-                        "drift larger than that makes the same run's force look another's): "
+                        "low-frequency noise larger than that makes the same run's force look "
+                        "another's): "
                         "the "
                         "model's initial state (velocity, and position or the position's "
                         "offset) is set from its first --init-window samples, and the error "
@@ -159,8 +160,8 @@ SAME_RUN_CORRELATION = 0.5
 """An ``--init-from`` record whose force's variations correlate with INPUT's by at least this
 (in magnitude) is taken for the same run: a load cell's offset or gain error leaves the
 correlation 1, white noise of 15 % of the force's RMS 0.989, and noise (of any colour) up to
-1.7 times that RMS keeps it above 0.5 (mains hum or a drift of twice the force's RMS brings
-it to 0.41-0.45: the same run refused, its white-noise escape blind to them)."""
+1.7 times that RMS keeps it above 0.5 (50 Hz hum or noise below 20 Hz of twice the force's
+RMS brings it to 0.45 or 0.41: the same run refused, its white-noise escape blind to them)."""
 
 SAME_RUN_NOISE_FACTOR = 2.0
 """Below :data:`SAME_RUN_CORRELATION`, the two forces are still taken for the same run when
@@ -203,8 +204,9 @@ def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
                      f"{beyond}), while a sensor's offset, gain error or white noise keeps "
                      f"one run's forces correlated; its position would set the state, and "
                      f"score the prediction, of another run (if it is this run's, noise "
-                     f"other than white, mains hum or a drift, above 1.7 times the force's "
-                     f"RMS decorrelates them: filter its force column, which sets nothing)")
+                     f"other than white, mains hum or low-frequency noise, above 1.7 times "
+                     f"the force's RMS decorrelates them: filter its force column, which sets "
+                     f"nothing)")
 
 
 def _check_step(system, t, args) -> None:
