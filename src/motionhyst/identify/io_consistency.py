@@ -40,17 +40,20 @@ its coefficient towards zero (a slow record's mass 0.014 kg for 2 kg)."""
 
 
 def _linear_fit(records: list[IORecord], floating: bool
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float]:
     """:func:`~motionhyst.identify.io_start.inverse_dynamics`'s coefficients (``m, c``, ``fc``
     or ``k``, ``u0``), their robust covariance
-    (:func:`~motionhyst.identify.io_checks.robust_least_squares`) and the records' squared
-    angular frequency ``-sum(y'' y) / sum(y^2)`` (``y`` about its mean) [rad^2/s^2]."""
+    (:func:`~motionhyst.identify.io_checks.robust_least_squares`), the records' squared
+    angular frequency ``-sum(y'' y) / sum(y^2)`` (``y`` about its mean) [rad^2/s^2] and
+    the share of their acceleration their position's noise makes
+    (:func:`_acceleration_noise`)."""
     rows, rhs = equation_rows(records, floating)
     x, cov = robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
     acc = np.concatenate([r[:, 0] for r in rows])
     y = np.concatenate([rec.y - np.mean(rec.y) for rec in records])
     yy = float(np.dot(y, y))
-    return x, cov, (float(-np.dot(acc, y)) / yy if yy > 0 else 0.0)
+    return (x, cov, float(-np.dot(acc, y)) / yy if yy > 0 else 0.0,
+            _acceleration_noise(records, acc))
 
 
 def _shows_a_mass(record: IORecord) -> bool:
@@ -65,21 +68,24 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
     """Refuse records that cannot describe one stage, before the search.
 
     Each record's inverse-dynamics mass, in the model of the plant fitted (a spring to the
-    ground unless `floating`), is compared with the mass the other records show together.
-    A record that shows no inertia on its own
+    ground unless `floating`), is compared with the mass the other records show together.  A
+    record that shows no inertia on its own
     (:func:`~motionhyst.identify.io_checks.check_inertia`; a link's force-displacement
     record given with a stage's) is refused where its mass lies more than
     :data:`ONE_STAGE_SIGMAS` robust standard errors from theirs; on a spring its mass is
-    taken with the others' spring (at one frequency a mass is a negative spring: alone,
-    a link's record shows -1.2 +- 0.99 kg beside a stage's 1.9 +- 0.048, with the stage's spring
-    -0.11 +- 0.0024 kg).  A slow record of the same stage, its inertia hidden in its friction,
-    agrees with theirs within its larger error.  A record that shows a mass of its own
-    (with a single-mass stage, `single_mass`) is refused where its mass and the others'
-    differ by more than :data:`ONE_STAGE_SIGMAS` standard errors and by more than the
-    factor :data:`ONE_STAGE_RATIO`, each mass in a model that takes any stage's force
-    and only where the record determines it (records of a 2 kg and a 20 kg stage: a joint
-    mass of 10.7 kg).  Their joint fit would search for minutes a stage that is neither
-    (a stage's record and a link's: over 120 s, to the work budget).
+    taken with the others' spring (at one frequency a mass is a negative spring: alone, a
+    link's record shows -1.2 +- 0.99 kg beside a stage's 1.9 +- 0.048, with the stage's
+    spring -0.11 +- 0.0024 kg).  A slow record of the same stage, its inertia hidden in its
+    friction, agrees with theirs within its larger error, less what its position's noise
+    takes from its mass (by the share of its acceleration that noise makes: a 0.5 Hz record
+    of 20 s with 1 um of noise shows 1.33 +- 0.11 kg beside 1.93, 5.4 errors below, not
+    refused).  A record that shows a mass of its own (with a single-mass stage,
+    `single_mass`) is refused where its mass and the others' differ by more than
+    :data:`ONE_STAGE_SIGMAS` standard errors and by more than the factor
+    :data:`ONE_STAGE_RATIO`, each mass in a model that takes any stage's force and only
+    where the record determines it (records of a 2 kg and a 20 kg stage: a joint mass of
+    10.7 kg).  Their joint fit would search for minutes a stage that is neither (a stage's
+    record and a link's: over 120 s, to the work budget).
 
     Parameters
     ----------
@@ -122,8 +128,8 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
         rest = records[:i] + records[i + 1:]
         if own[i] or not any(own[:i] + own[i + 1:]):  # none shows a mass to compare with
             continue
-        x, cov, w2 = _linear_fit([rec], floating)
-        x_rest, cov_rest, _ = _linear_fit(rest, floating)
+        x, cov, w2, noise = _linear_fit([rec], floating)
+        x_rest, cov_rest, _, _ = _linear_fit(rest, floating)
         gradient, spring = np.array([1.0, 0.0, 0.0, 0.0]), ""
         if not floating and w2 > 0:  # at its frequencies a mass is a negative spring
             gradient, spring = np.array([1.0, 0.0, -1.0 / w2, 0.0]), " with the others' spring"
@@ -133,7 +139,9 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
             continue
         std = math.sqrt(max(float(gradient @ cov @ gradient), 0.0))
         std_rest = math.sqrt(max(float(gradient @ cov_rest @ gradient), 0.0))
-        if abs(m - m_rest) > ONE_STAGE_SIGMAS * math.hypot(std, std_rest):
+        # the position's noise draws the record's mass towards zero: so far is no gap
+        gap = m - m_rest if m > m_rest else min(0.0, m - (1.0 - noise) * m_rest)
+        if abs(gap) > ONE_STAGE_SIGMAS * math.hypot(std, std_rest):
             raise ValueError(f"{rec.name}: no inertia in the force (its inverse-dynamics mass"
                              f"{spring} {m:.3g} +- {std:.2g} kg), while {_names(rest)} "
                              f"{m_rest:.3g} +- {std_rest:.2g} kg: the records cannot describe "
@@ -166,8 +174,6 @@ def _own_mass(records: list[IORecord]) -> tuple[float, float] | None:
     leaves more than :data:`~motionhyst.identify.io_start.LINEAR_MODEL_RESIDUAL` of the force
     (a link that carries it), or the position's white noise makes more than
     :data:`ACCELERATION_NOISE` of the acceleration's variance (the mass then errs low)."""
-    from scipy.signal import savgol_coeffs
-
     rows, rhs = equation_rows(records, floating=True)
     rows = [np.column_stack([r, rec.y]) for r, rec in zip(rows, records, strict=True)]
     window = max(7, 2 * round(0.005 * records[0].fs) + 1)
@@ -176,15 +182,26 @@ def _own_mass(records: list[IORecord]) -> tuple[float, float] | None:
     spread = float(np.linalg.norm(u - np.mean(u)))
     if not (spread > 0 and float(np.linalg.norm(A @ x - u)) <= LINEAR_MODEL_RESIDUAL * spread):
         return None
-    noise = 0.0  # the white noise's share of the filtered acceleration, summed over samples
-    for rec in records:
-        samples = min(window, rec.y.size - (1 - rec.y.size % 2))
-        gain = float(np.sum(savgol_coeffs(samples, 3, deriv=2, delta=1.0 / rec.fs) ** 2))
-        noise += rec.y.size * gain * float(np.mean(np.diff(rec.y, 3) ** 2)) / 20.0
-    acc = A[:, 0]
-    if not noise <= ACCELERATION_NOISE * float(np.sum((acc - np.mean(acc)) ** 2)):
+    if not _acceleration_noise(records, A[:, 0]) <= ACCELERATION_NOISE:
         return None
     return float(x[0]), math.sqrt(max(float(cov[0, 0]), 0.0))
+
+
+def _acceleration_noise(records: list[IORecord], acc: NDArray[np.float64]) -> float:
+    """The share of the records' filtered acceleration `acc` (all records' samples, in
+    order) that their position's white noise makes (from its third differences, through
+    each record's Savitzky-Golay filter, as :func:`~motionhyst.identify.io_start.equation_rows`
+    has it); 1 at most.  A regressor's noise draws its coefficient towards zero by about
+    this share."""
+    from scipy.signal import savgol_coeffs
+
+    noise = 0.0
+    for rec in records:
+        samples = min(max(7, 2 * round(0.005 * rec.fs) + 1), rec.y.size - (1 - rec.y.size % 2))
+        gain = float(np.sum(savgol_coeffs(samples, 3, deriv=2, delta=1.0 / rec.fs) ** 2))
+        noise += rec.y.size * gain * float(np.mean(np.diff(rec.y, 3) ** 2)) / 20.0
+    total = float(np.sum((acc - np.mean(acc)) ** 2))
+    return min(1.0, noise / total) if total > 0 else 1.0
 
 
 def _names(rest: list[IORecord]) -> str:
