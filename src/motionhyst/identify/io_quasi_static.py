@@ -61,6 +61,7 @@ from motionhyst.identify.displacement_noise import estimate_displacement
 from motionhyst.identify.io_checks import (
     NO_HYSTERESIS_GAIN,
     SYSTEMATIC_SHARE,
+    SYSTEMATIC_WARN_SHARE,
     FitFailed,
     budget_note,
     hysteresis_gain,
@@ -589,7 +590,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     plant, fitted = prob.model(v)
     stopped = budget is not None and sol.status == 0  # on its budget, before it converged
     try:
-        res, fit_rms = _judge(prob, v, records, force_error, K, C, b, periodic, out)
+        res, fit_rms, share = _judge(prob, v, records, force_error, K, C, b, periodic, out)
     except FitFailed as exc:
         if not stopped:
             raise
@@ -634,6 +635,12 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                 for n, x, x0, lg, f in zip(prob.names, v, v_start, prob.log, prob.free,
                                            strict=True)
                 if lg and f and x > 0 and x0 > 0 and max(x / x0, x0 / x) > RUNAWAY_FACTOR]
+    if share > SYSTEMATIC_WARN_SHARE:
+        warnings.append(f"the model leaves a systematic error of {100 * share:.2g} % of the "
+                        f"{what}'s RMS beyond the noise (above {100 * SYSTEMATIC_WARN_SHARE:g} "
+                        f"%): on another record of this machine it may explain a few times "
+                        f"less (a fit below 95 %); another --model may describe them better "
+                        f"(the loops' shape, a rate or speed dependence)")
     extra = {"offsets": {"input": float(v[2 + prob.n_link]),
                          "output": [float(x) for x in prob.output_offsets(v)]},
              "budget_reached": stopped,
@@ -676,8 +683,9 @@ def _inward_jacobian(prob: _Problem, sol, force_error: bool, layout: LinkLayout
 
 def _judge(prob: _Problem, v: NDArray[np.float64], records: list[IORecord], force_error: bool,
            K: float, C: float, b: NDArray[np.float64], periodic: bool, out: bool
-           ) -> tuple[NDArray[np.float64], float]:
-    """The fitted model's residuals and RMS error; :class:`FitFailed` if they are no result
+           ) -> tuple[NDArray[np.float64], float, float]:
+    """The fitted model's residuals, RMS error and systematic share
+    (:func:`_judge_systematic`); :class:`FitFailed` if they are no result
     (:func:`_judge_force_fit`, or :func:`~motionhyst.identify.io_checks.judge_fit` and the
     link's gain and systematic error on the positions)."""
     plant, fitted = prob.model(v)
@@ -685,7 +693,7 @@ def _judge(prob: _Problem, v: NDArray[np.float64], records: list[IORecord], forc
         predictions = prob.forces(v)
         res = np.concatenate([f - rec.u for f, rec in zip(predictions, records, strict=True)])
         fit_rms = float(np.sqrt(np.mean(res ** 2)))
-        _judge_force_fit(fit_rms, res, records, predictions, K, C, b)
+        share = _judge_force_fit(fit_rms, res, records, predictions, K, C, b)
     else:
         predictions = prob.positions(v)
         res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
@@ -695,8 +703,8 @@ def _judge(prob: _Problem, v: NDArray[np.float64], records: list[IORecord], forc
         judge_fit(fit_rms, records, predictions, linear_rms, system, out)
         if linear_rms is not None:
             _judge_hysteresis(linear_rms ** 2 * res.size, res, "position", K, C)
-        _judge_systematic(res, [rec.y for rec in records], "position")
-    return res, fit_rms
+        share = _judge_systematic(res, [rec.y for rec in records], "position")
+    return res, fit_rms, share
 
 
 #: The exponents of a Bouc-Wen link fitted when it is estimated (``--nu free``): its fits of
@@ -749,12 +757,12 @@ def _exponent_profile(records: list[IORecord], **options) -> IOIdentification:
 
 def _judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IORecord],
                      forces: list[NDArray[np.float64]], K: float, C: float,
-                     b: NDArray[np.float64]) -> None:
+                     b: NDArray[np.float64]) -> float:
     """Raise :class:`FitFailed` unless the forces predicted from the displacement are a
     result: finite, better than the force's own spread and than the linear model's
     ``K y + C y' + b``, and describing the records to within
     :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of the force's RMS beyond
-    the noise (:func:`~motionhyst.identify.io_checks.systematic_share`)."""
+    the noise (:func:`~motionhyst.identify.io_checks.systematic_share`, returned)."""
     if not all(np.all(np.isfinite(f)) for f in forces) or not math.isfinite(fit_rms):
         raise FitFailed("the fit failed: the identified link's force is not finite")
     u = np.concatenate([rec.u for rec in records])
@@ -771,7 +779,7 @@ def _judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IOR
                         f"(RMS error {linear_rms:.3g} N against its {fit_rms:.3g} N): its "
                         f"parameters would be a guess; nothing identified")
     _judge_hysteresis(float(np.sum(linear ** 2)), res, "force", K, C)
-    _judge_systematic(res, [rec.u for rec in records], "force")
+    return _judge_systematic(res, [rec.u for rec in records], "force")
 
 
 def _judge_hysteresis(linear_ss: float, res: NDArray[np.float64], what: str, K: float,
@@ -791,9 +799,9 @@ def _judge_hysteresis(linear_ss: float, res: NDArray[np.float64], what: str, K: 
 
 
 def _judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float64]],
-                      what: str) -> None:
-    """Raise :class:`FitFailed` if the residuals `res` (the records one after the other)
-    leave a systematic error above
+                      what: str) -> float:
+    """The largest systematic share of the residuals `res` (the records one after the
+    other) over the records; raise :class:`FitFailed` if it is above
     :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of a record's `measured`
     signal (:func:`~motionhyst.identify.io_checks.systematic_share`): a model that does
     not describe its records (a piezo's creep, a rate dependence the link lacks) does not
@@ -806,6 +814,7 @@ def _judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float6
                         f"{100 * SYSTEMATIC_SHARE:g} %, beyond the noise): it does not describe "
                         f"these records (a creep, a rate dependence or a link another --model "
                         f"describes) and would not predict another one")
+    return share
 
 
 def identify_link_force(records: list[IORecord], link: type, *, n_elements: int = 3,
