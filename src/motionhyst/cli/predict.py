@@ -127,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"{args.data}: {exc.what}; give more --substeps") from None
     except (ValueError, ArithmeticError) as exc:  # a model the simulation refuses
         raise ValueError(f"{args.data}: {exc or type(exc).__name__}") from None
+    _warn_loaded_start(args, system, u)  # a prediction made: a refusal stays one line
     target.write_csv({"time": out_t, "displacement": out_y}, fmt="%.17g")
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "displacement_rms": float(np.sqrt(np.mean(out_y ** 2))),
@@ -207,6 +208,31 @@ def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
                      f"other than white, mains hum or low-frequency noise, above 1.7 times "
                      f"the force's RMS decorrelates them: filter its force column, which sets "
                      f"nothing)")
+
+
+LOADED_START = 0.05
+"""A model without inertia whose force record starts farther than this share of the force's
+range from the model's rest (0 N with its offset) starts under a load whose link state is not
+known: the later half of a piezo's record, predicted from its link relaxed at its first
+sample, scored 0.5 % (from the whole record's history: 98.9 %)."""
+
+
+def _warn_loaded_start(args: argparse.Namespace, system, u) -> None:
+    """Warn when a model without inertia is run from a force record that starts under load
+    (:data:`LOADED_START`): its link starts relaxed there, as at rest, which a record cut
+    from a longer run does not."""
+    from motionhyst.core.warnings import warn
+
+    if system.plant.has_inertia or system.hysteresis is None or args.periodic:
+        return  # a periodic steady state has no start
+    load = float(u[0]) + float(getattr(system.plant, "force_offset", 0.0))
+    span = float(np.ptp(u))
+    if span > 0 and abs(load) > LOADED_START * span:
+        warn(f"{args.data} starts under a load of {load:.4g} N ({100 * abs(load) / span:.0f} % "
+             f"of its force's range) where the model rests at 0 N: a model without inertia "
+             f"starts its link relaxed, not where on its loops the part of a longer run "
+             f"begins, and may miss by the loops' width; predict the record from its start "
+             f"(or a record that starts at rest)")
 
 
 def _check_step(system, t, args) -> None:
