@@ -32,7 +32,7 @@ from motionhyst.identify.io_records import IORecord
 __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTION_SHARE",
            "DIRECTION_SIGNIFICANCE", "DIRECTION_TOP",
            "MASS_FACTOR", "MASS_SHARE", "MASS_SIGMAS", "MAX_PREDICT_SUBSTEPS",
-           "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE",
+           "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE", "SYSTEMATIC_WARN_SHARE",
            "FitFailed", "StiffFit", "budget_note", "check_inertia", "default_plant", "flat_profile",
            "hysteresis_gain", "judge_fit", "linear_mass_std", "noise_cost",
            "plausibility_warnings", "robust_least_squares", "systematic_share",
