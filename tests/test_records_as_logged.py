@@ -1,8 +1,10 @@
-"""Records of a piezo stack and a friction damper as a lab logs them, checked as a user runs
-the tool on them (issue 21: a model that predicts the held-out part, or one line).
+"""Cases met running the tool as a user on generated records of a piezo stack and a friction
+damper as a lab logs them (issue 21: a model that predicts the held-out part, or one line).
 
-Generated, seeded and small; each case is one that went wrong on measured-like records
-(/work/team/scratch-other21 holds the campaign that found them).
+Each case is generated, seeded and small: the quasi-static search's handling of trial steps and
+starts whose cost overflows (a piezo's Bouc-Wen fit printed numpy's overflow warning; here
+the search itself, on a synthetic cost), a damper fit that may not predict another record
+(the command line), a record cut from a longer run (``predict``).
 """
 
 from __future__ import annotations
@@ -48,6 +50,31 @@ def test_a_trial_step_whose_cost_overflows_is_rejected_without_a_warning():
         warnings.simplefilter("error")
         sol = prob.solve(q0, False, 200, 1e-12)
     np.testing.assert_allclose(sol.x, target, atol=1e-8)
+
+
+def test_a_start_whose_cost_overflows_is_never_the_best_and_no_warning(monkeypatch):
+    # The starts are compared by their costs before the refinement: a start predicting
+    # positions of 1e200 m has an infinite cost (main printed numpy's "overflow encountered
+    # in square"), never chosen
+    t = np.arange(2000) / 1000.0
+    u = 300.0 * np.sin(2 * np.pi * 2 * t) * np.minimum(1.0, t)
+    y = displacement_from_force(QuasiStatic(k=1e5), Jenkins(k=3e5, fc=100.0), t, u)
+    real = qs._Problem._residuals
+    far = []
+
+    def residuals(self, q, equation):
+        if not equation and not far:  # the first start compared: far out
+            far.append(q.copy())
+            return np.full(y.size, 1e200)
+        return real(self, q, equation)
+
+    monkeypatch.setattr(qs._Problem, "_residuals", residuals)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fit = qs.identify_quasi_static_io([IORecord(t, u, y + 1e-4)], Jenkins, periodic=False,
+                                          n_elements=1, offset="auto", max_evaluations=None,
+                                          tol=1e-12)
+    assert far and fit.estimates["link.fc"] == pytest.approx(100.0, rel=1e-6)
 
 
 def _damper_force(t: np.ndarray, x: np.ndarray, speed_gain: float) -> np.ndarray:
