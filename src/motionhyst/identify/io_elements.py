@@ -728,8 +728,11 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     # samples ended at 19.5 times its noise there).  Both are refined and the better end kept:
     # the lower cost at the start is no guide (two Coulomb records, one moving each way: the
     # window's state fitted better at the start and ended at fc 18.5 N for a true 20 N)
-    sol, q_start, most = refine(prob, q0, tol, max_nfev, reserve, bool(extras.initial)
-                                and init_window is None and not periodic)
+    own = init_window is None and not periodic  # each record's state estimated from its start
+    rigid_link = bool(getattr(layout.cls, "rigid", False))
+    sol, q_start, most = refine(prob, q0, tol, max_nfev, reserve, bool(extras.initial) and own,
+                                rigid_link, rigid_link and own and floating
+                                and extras.output_offset and extras.initial == ("v0",))
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)
