@@ -427,7 +427,7 @@ def test_identify_within_the_budget_stays_within_its_estimate(tmp_path):
         "warnings.simplefilter('ignore')\n"
         "identify_io([_axis_record(3000, 1)], 'jenkins', plant='mass-damper')\n"
         "rec = _axis_record(20000)\n"
-        "need = search_memory([rec], 20, 7, 4)['total']\n"
+        "need = search_memory([rec], 20, 7, 4, segments=True)['total']\n"
         "with open('/proc/self/status') as f:\n"
         "    size = next(int(x.split()[1]) * 1024 for x in f if x.startswith('VmSize'))\n"
         "resource.setrlimit(resource.RLIMIT_AS, (size + int(need),) * 2)\n"

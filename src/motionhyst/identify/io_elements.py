@@ -31,6 +31,7 @@ from motionhyst.identify.io_checks import (
     noise_cost,
     plausibility_warnings,
 )
+from motionhyst.identify.io_differences import REFUSED, forward_differences
 from motionhyst.identify.io_force import RecordForce
 from motionhyst.identify.io_layout import FORCE_UNIT, VELOCITY_UNIT
 from motionhyst.identify.io_layout import LinkLayout as _LinkLayout
@@ -318,7 +319,7 @@ class _ElementProblem:
             p, vel = state_from_window(mech, stepping, k_link, u, rec.y, rec.fs, self.r,
                                        self.window)
             y, _ = run_from_state(mech, stepping, k_link, u, rec.fs, self.r, p, vel, fine())
-            self._count(3 - int(mech.floating))  # the run and its state's columns
+            self.charge(3 - int(mech.floating))  # the run and its state's columns
             S = self._state_columns(mech, stepping, k_link, rec, u, fine, p, vel, y)
             parts.append((row, S, np.linalg.pinv(S[:self.window])))
             row += rec.y.size
@@ -330,15 +331,24 @@ class _ElementProblem:
     # a value the model refuses (a mass run to 0 or overflowing) is a large residual, without
     # numpy's warnings on stderr; threaded, so on each run and not around the search
     @np.errstate(all="ignore")
-    def _run(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+    def run_rows(self, q_free: NDArray[np.float64], only: int | None = None
+                 ) -> NDArray[np.float64] | None:
+        """The residuals (of record `only` alone: its rows), non-finite ones as
+        :data:`~motionhyst.identify.io_differences.REFUSED`; None for values the model
+        refuses."""
         v = self.values(self.whole(q_free))
+        recs = self.records if only is None else [self.records[only]]
         try:
             res = [y - self._measured(rec)
-                   for (y, _), rec in zip(self.outputs(v), self.records, strict=True)]
-            r = np.concatenate(res) / self.y_scale
+                   for (y, _), rec in zip(self.outputs(v, only=only), recs, strict=True)]
         except (ValueError, ArithmeticError):  # parameters the model refuses
-            r = np.full(sum(rec.y.size for rec in self.records), np.nan)
-        return np.where(np.isfinite(r), r, 1e3)
+            return None
+        r = np.concatenate(res) / self.y_scale
+        return np.where(np.isfinite(r), r, REFUSED)
+
+    def _run(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
+        r = self.run_rows(q_free)
+        return np.full(sum(rec.y.size for rec in self.records), REFUSED) if r is None else r
 
     def errors_at(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
         """The output errors [m] of the model at the values `v`, every record's (not counted
@@ -360,7 +370,7 @@ class _ElementProblem:
             step = EXTRA_FD_STEP * max(abs(v[base + j]), self.scale[base + j])
             w = v.copy()
             w[base + j] += step
-            self._count(1)
+            self.charge(1)
             J[:, j] = (np.concatenate([yy for yy, _ in self.outputs(w)])
                        - np.concatenate(y)) / step
         for i in range(len(self.records)):
@@ -373,7 +383,7 @@ class _ElementProblem:
                 step = EXTRA_FD_STEP * max(abs(v[base + j]), self.scale[base + j])
                 w = v.copy()
                 w[base + j] += step
-                self._count(1)
+                self.charge(1)
                 J[rows, j] = (self.outputs(w, only=i)[0][0] - y[i]) / step
         return J
 
@@ -448,7 +458,7 @@ class _ElementProblem:
 
     def residuals(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Output errors in units of the output's RMS."""
-        self._count(1)
+        self.charge(1)
         if self.exact is not False:
             out = self._run_exact(q_free)
             if out is not None:
@@ -462,7 +472,7 @@ class _ElementProblem:
 
     def jacobian(self, q_free: NDArray[np.float64]) -> NDArray[np.float64]:
         """Exact (forward sensitivities, computed with the residuals), else forward
-        differences, one column per free variable, in parallel threads."""
+        differences (:func:`~motionhyst.identify.io_differences.forward_differences`)."""
         if (self._last is not None and self._last[0] == q_free.tobytes()
                 and self._last[2] is not _TAKEN):
             r0, J = self._last[1], self._last[2]
@@ -472,20 +482,11 @@ class _ElementProblem:
         if J is not None:
             self._last = (self._last[0], r0, _TAKEN)  # not held beside the search's copy
             return self._with_extras(q_free, J, r0)
-        steps = self.fd_step * np.maximum(1.0, np.abs(q_free))
-        out = np.empty((r0.size, q_free.size))
+        return forward_differences(self, q_free, r0,
+                                   self.fd_step * np.maximum(1.0, np.abs(q_free)))
 
-        def column(j):
-            q = q_free.copy()
-            q[j] += steps[j]
-            out[:, j] = (self._run(q) - r0) / steps[j]
-
-        self._count(q_free.size)
-        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-            list(pool.map(column, range(q_free.size)))
-        return out
-
-    def _count(self, n: int) -> None:
+    def charge(self, n: int) -> None:
+        """Count `n` evaluations about to run (the search's budget first)."""
         self.budget.charge(n)
         self.n_eval += n
 
@@ -636,11 +637,16 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                            n_records=len(records), window=init_window is not None, drift=drift)
     t_span = max(float(rec.t[-1] - rec.t[0]) for rec in records)
     scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale, t_span)])
-    # the whole search's memory (its Coulomb fit's is no more), before anything is upsampled
+    # the whole search's memory (its Coulomb fit's is no more), before anything is upsampled;
+    # a rigid slider's (every axis link's first) refines on the records' segments first
     states = (2 * structure.mechanics().n
               + layout.build(starts[0][n_plant:]).time_stepping().codes.size) if periodic else 0
+    own = init_window is None and not periodic  # each record's state estimated from its start
+    rigid_link = bool(getattr(layout.cls, "rigid", False))
+    segments = (rigid_link or axis) and own and floating and extras.output_offset \
+        and extras.initial == ("v0",)
     check_search_memory(records, r, scale.size, n_plant + len(layout.names),
-                        periodic=periodic, drift=extras.input_drift,
+                        periodic=periodic, drift=extras.input_drift, segments=segments,
                         states=states if states <= MAX_SHOOTING_STATES else 0)
     rate = np.concatenate([np.zeros(n_plant, bool),
                            [par.unit == _VELOCITY for par, _ in layout._values()],
@@ -728,11 +734,8 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     # samples ended at 19.5 times its noise there).  Both are refined and the better end kept:
     # the lower cost at the start is no guide (two Coulomb records, one moving each way: the
     # window's state fitted better at the start and ended at fc 18.5 N for a true 20 N)
-    own = init_window is None and not periodic  # each record's state estimated from its start
-    rigid_link = bool(getattr(layout.cls, "rigid", False))
     sol, q_start, most = refine(prob, q0, tol, max_nfev, reserve, bool(extras.initial) and own,
-                                rigid_link, rigid_link and own and floating
-                                and extras.output_offset and extras.initial == ("v0",))
+                                rigid_link, rigid_link and segments)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)

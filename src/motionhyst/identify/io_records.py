@@ -19,6 +19,11 @@ from motionhyst.time.resample import check_record, sampling_rate
 __all__ = ["IORecord", "load_io_csv"]
 
 MIN_SAMPLES = 64
+#: Samples of each segment a rigid slider's search first cuts the records into
+#: (:func:`segment_records`)
+SEGMENT = 500
+#: The most segments (of the records' first samples; bounds their search's Jacobian)
+MAX_SEGMENTS = 32
 
 
 @dataclass
@@ -134,3 +139,39 @@ def short_records(records: list[IORecord], periodic: bool, n_max: int = 4096
     if periodic or rec.y.size <= n_max:
         return [rec]
     return [IORecord(rec.t[:n_max], rec.u[:n_max], rec.y[:n_max], rec.name)]
+
+
+def segment_records(records: list[IORecord]) -> list[tuple[int, IORecord]]:
+    """The records cut into segments of :data:`SEGMENT` samples, at most
+    :data:`MAX_SEGMENTS` of them, from each record's start on (a shorter tail joins the
+    segment before it; views of the records' arrays).
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records.
+
+    Returns
+    -------
+    list of (int, IORecord)
+        Each segment with the index of its record, in the records' order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(1800) / 1e3
+    >>> [(i, s.y.size) for i, s in segment_records([IORecord(t, np.sin(t), np.cos(t))])]
+    [(0, 500), (0, 500), (0, 800)]
+    >>> n = 100_000
+    >>> rec = IORecord(np.arange(n) / 1e3, np.zeros(n), np.zeros(n))
+    >>> parts = segment_records([rec, rec])
+    >>> len(parts), sum(s.y.size for _, s in parts)
+    (32, 16000)
+    """
+    parts: list[tuple[int, IORecord]] = []
+    for i, rec in enumerate(records):
+        n = rec.y.size
+        for a in list(range(0, n - SEGMENT, SEGMENT))[:MAX_SEGMENTS - len(parts)]:
+            b = n if a + 2 * SEGMENT > n else a + SEGMENT
+            parts.append((i, IORecord(rec.t[a:b], rec.u[a:b], rec.y[a:b], rec.name)))
+    return parts

@@ -11,10 +11,11 @@ A rigid slider (the Coulomb link) sticks and slips at events that move step by s
 parameters: on a floating stage a stick mispredicted shifts the whole rest of the record, so
 that the records' cost has wells side by side (on a Coulomb axis of 6000 samples, 1e-4 apart
 in the logarithm of the mass), and its secants (a step of 1e-3) span many of them.  Its
-refinement therefore starts with the records cut into segments of :data:`SEGMENT` samples,
-each with its own position offset and initial velocity (:func:`on_segments`: a stick
-mispredicted costs only its segment), and ends with its secants' step shrunk tenfold in turn
-(to :data:`FINEST_SECANT`), each end kept where it fits the records better.
+refinement therefore starts with the records cut into segments
+(:func:`~motionhyst.identify.io_records.segment_records`), each with its own position offset
+and initial velocity (:func:`on_segments`: a stick mispredicted costs only its segment), and
+ends with its secants' step shrunk tenfold in turn (to :data:`FINEST_SECANT`), each end kept
+where it fits the records better.
 """
 
 from __future__ import annotations
@@ -27,15 +28,11 @@ from scipy.optimize import OptimizeResult
 
 from motionhyst.identify.io_budget import BudgetSpent
 from motionhyst.identify.io_predict import INIT_WINDOW
-from motionhyst.identify.io_records import IORecord
+from motionhyst.identify.io_records import segment_records
 from motionhyst.identify.io_start import extras_start
 
 __all__: list[str] = []
 
-#: Samples of each segment of a rigid slider's first refinement (:func:`on_segments`)
-SEGMENT = 500
-#: The most segments (of the records' first samples; bounds the Jacobian's columns)
-MAX_SEGMENTS = 32
 #: The finest step of a rigid slider's secants (relative, in the search variables)
 FINEST_SECANT = 1e-6
 #: Steps of the whole records' refinement a budget must leave for a rigid slider's segments
@@ -74,22 +71,15 @@ def state_start(prob, q_free: NDArray[np.float64], window: int = INIT_WINDOW
 def on_segments(prob, q_free: NDArray[np.float64], tol: float, max_nfev: int | None
                 ) -> NDArray[np.float64]:
     """`q_free` refined on the records of the search problem `prob` (a floating stage's,
-    each record's position offset and initial velocity estimated) cut into segments of
-    :data:`SEGMENT` samples (at most :data:`MAX_SEGMENTS`, from each record's start; a
-    shorter tail joins the segment before it), each with its own position offset and
+    each record's position offset and initial velocity estimated) cut into segments
+    (:func:`~motionhyst.identify.io_records.segment_records`), each with its own position offset and
     initial velocity (started at its first sample and its first samples' slope), the stage's
     and link's values and the force offset shared; the records' own offsets and states as
     they were.  `q_free` itself where no record is longer than two segments or the
     refinement cannot run."""
     ex = prob.extras
     base = prob.n_plant + prob.n_link
-    parts: list[IORecord] = []
-    for rec in prob.records:
-        n = rec.y.size
-        cuts = list(range(0, n - SEGMENT, SEGMENT))[:MAX_SEGMENTS - len(parts)]
-        for a in cuts:
-            b = n if a + 2 * SEGMENT > n else a + SEGMENT
-            parts.append(IORecord(rec.t[a:b], rec.u[a:b], rec.y[a:b], rec.name))
+    parts = [part for _, part in segment_records(prob.records)]
     if len(parts) <= len(prob.records) or not prob.free.all():
         return q_free
     cut = replace(ex, n_records=len(parts))

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from motionhyst.identify.io_offsets import Extras
 from motionhyst.identify.io_rates import savgol_derivative
-from motionhyst.identify.io_records import IORecord
+from motionhyst.identify.io_records import IORecord, segment_records
 from motionhyst.time.openloop import MassSpringDamper, TwoMass
 
 __all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "equation_rows",
@@ -490,7 +490,7 @@ cleaned of non-finite values, differenced): a Jacobian column by forward differe
 
 def search_memory(records: list[IORecord], substeps: int, parameters: int, sensitivities: int,
                   *, periodic: bool = False, drift: bool = False, states: int = 0,
-                  threads: int | None = None) -> dict[str, float]:
+                  threads: int | None = None, segments: bool = False) -> dict[str, float]:
     """Bytes an input-output search of the records needs at once at most, by what holds them.
 
     The search holds each record's upsampled force (and, for a drifting force offset, the
@@ -502,7 +502,11 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     columns (a link without them: the Jacobian's columns by forward differences, one
     evaluation per thread, as many at once as there are threads and columns, with their
     residuals); the Jacobian of all samples x
-    `parameters` is held :data:`JACOBIAN_COPIES` times.
+    `parameters` is held :data:`JACOBIAN_COPIES` times.  With `segments`, a rigid slider's
+    search first runs on the records cut into segments
+    (:func:`~motionhyst.identify.io_records.segment_records`), each with its own position offset
+    and initial velocity: that stage's force, runs and Jacobian (its samples x `parameters`
+    and two columns a segment) count where they are larger.
 
     Parameters
     ----------
@@ -523,6 +527,9 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
         A periodic run's start states (Newton's steps on the period map; 0: none).
     threads : int, optional
         Threads of the evaluations (default: the machine's cores).
+    segments : bool
+        The search runs on the records' segments first (a rigid slider's on a floating
+        stage, each record's position offset and initial velocity estimated).
 
     Returns
     -------
@@ -539,6 +546,10 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     {'force': 160, 'runs': 393, 'jacobian': 336, 'total': 889}
     >>> round(search_memory([rec], 20, 7, 4, threads=64)["total"] / 1e6)   # 7 columns at once
     1873
+    >>> rec = IORecord(np.arange(20_000) / 1e3, np.zeros(20_000), np.zeros(20_000))
+    >>> need = search_memory([rec], 20, 7, 4, threads=2, segments=True)  # 32 segments
+    >>> {k: round(v / 1e6) for k, v in need.items()}
+    {'force': 6, 'runs': 42, 'jacobian': 55, 'total': 103}
     """
     from motionhyst.time.openloop import FINE_BYTES, SAMPLE_BYTES
     from motionhyst.time.resample import held_nodes
@@ -557,6 +568,13 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     differences = columns * (parallel * block + (per_sample + RESIDUAL_BYTES) * n_all)
     runs = float(max(exact, differences))
     jacobian = JACOBIAN_COPIES * 8.0 * n_all * parameters
+    parts = [part for _, part in segment_records(records)] if segments else records
+    if len(parts) > len(records):  # the segments' search: runs of a segment, one a thread
+        n_cut = sum(rec.u.size for rec in parts)
+        force += 8.0 * (2 if drift else 1) * sum(r * (rec.u.size - 1) + 1 for rec in parts)
+        runs = max(runs, threads * max(FINE_BYTES * held_nodes(rec.u, r) + (
+            per_sample + 8.0 * sensitivities + RESIDUAL_BYTES) * rec.u.size for rec in parts))
+        jacobian = max(jacobian, JACOBIAN_COPIES * 8.0 * n_cut * (parameters + 2 * len(parts)))
     return {"force": force, "runs": runs, "jacobian": jacobian,
             "total": force + runs + jacobian}
 

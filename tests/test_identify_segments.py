@@ -1,0 +1,107 @@
+"""The Coulomb link's search on an axis: its forward differences in one pool of threads and
+its refinement on the records' segments (motionhyst.identify.io_differences,
+motionhyst.identify.io_refine)."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from motionhyst.hysteresis import Coulomb
+from motionhyst.identify.input_output import IORecord, identify_io
+from motionhyst.identify.io_differences import REFUSED, forward_differences
+from motionhyst.identify.io_offsets import Extras
+from motionhyst.plants.mass_damper import MassDamper
+from motionhyst.time.openloop import OpenLoop
+
+FS = 1000.0
+
+
+class _Linear:
+    """A search problem of two records (30 and 10 samples) whose residuals are linear in its
+    six variables (two shared; each record's position offset and initial velocity, in
+    :class:`Extras`' order), counting the runs of each record."""
+
+    n_plant, n_link = 1, 1
+
+    def __init__(self, refuse_above: float = np.inf):
+        self.records = [IORecord(np.arange(n) / FS, np.zeros(n), np.zeros(n)) for n in (30, 10)]
+        self.extras = Extras(False, True, ("v0",), 2)
+        self.free = np.ones(2 + self.extras.size, bool)
+        rng = np.random.default_rng(0)
+        self.A = [rng.standard_normal((rec.y.size, 7)) for rec in self.records]
+        self.A[0][:, [3, 5]] = 0.0  # record 1's own variables
+        self.A[1][:, [2, 4]] = 0.0
+        self.runs = [0, 0]
+        self.charged = 0
+        self.refuse_above = refuse_above
+
+    def run_rows(self, q, only=None):
+        if q[0] > self.refuse_above:  # values the model refuses
+            return None
+        which = range(2) if only is None else [only]
+        for i in which:
+            self.runs[i] += 1
+        return np.concatenate([self.A[i] @ np.append(q, 1.0) for i in which])
+
+    def charge(self, n):
+        self.charged += n
+
+
+def test_forward_differences_run_a_record_alone_for_its_own_offsets():
+    """Each record's own position offset and initial velocity move its rows alone: their
+    columns run that record only (the others' rows are zero, as whole runs give them), the
+    shared variables run every record, and the budget is charged the runs' share of the
+    samples: 2 + 2 evaluations for the six columns (each column ran every record before: 6)."""
+    prob = _Linear()
+    q = np.zeros(6)
+    r0 = prob.run_rows(q)
+    prob.runs = [0, 0]
+    J = forward_differences(prob, q, r0, np.full(6, 1e-3))
+    assert J == pytest.approx(np.vstack([a[:, :6] for a in prob.A]), rel=1e-9, abs=1e-9)
+    assert prob.runs == [2 + 2, 2 + 2]  # the two shared columns, each record's own two
+    assert prob.charged == 2 + 2
+
+
+def test_a_column_the_model_refuses_is_refused_in_every_row():
+    """A step to values the model refuses gives that column a refused run's residuals in
+    every record's rows, as a run of all the records gives them."""
+    prob = _Linear(refuse_above=1e-4)
+    q = np.zeros(6)
+    r0 = prob.run_rows(q)
+    J = forward_differences(prob, q, r0, np.full(6, 1e-3))
+    assert J[:, 0] == pytest.approx((REFUSED - r0) / 1e-3)
+    assert J[:, 1:] == pytest.approx(np.vstack([a[:, 1:6] for a in prob.A]), abs=1e-9)
+
+
+def _coulomb_axis(n: int, seed: int, offset: float = -3.0) -> IORecord:
+    """A Coulomb axis (95 kg, 200 N s/m, fc 20 N, a force offset) driven by two sines and a
+    random force, `n` samples, 1e-7 m of position noise."""
+    t = np.arange(n) / FS
+    rng = np.random.default_rng(seed)
+    u = (60.0 * np.sin(2 * np.pi * 1.3 * t) + 25.0 * np.sin(2 * np.pi * 7.1 * t + 1.0)
+         + rng.standard_normal(n))
+    y = OpenLoop(MassDamper(95.0, 200.0, force_offset=offset), Coulomb(fc=20.0)).simulate(
+        t, u).displacement
+    return IORecord(t, u, y + 1e-7 * rng.standard_normal(n), f"axis{seed}")
+
+
+def test_the_search_on_segments_starts_threads_from_one_level_only(monkeypatch):
+    """The Coulomb search of two records on an axis (its segments' search of six records,
+    and its secants' columns) starts every thread from the main thread: a column's runs of
+    the records are tasks of the one pool, not a pool of their own (each thread's stack is
+    address space the search's estimate does not hold; the nested pools ran out of it)."""
+    starters = []
+    start = threading.Thread.start
+
+    def spy(self):
+        starters.append(threading.current_thread() is threading.main_thread())
+        start(self)
+
+    monkeypatch.setattr(threading.Thread, "start", spy)
+    records = [_coulomb_axis(1500, 0), _coulomb_axis(1500, 1)]
+    fit = identify_io(records, "coulomb", plant="mass-damper", max_evaluations=400)
+    assert starters and all(starters), f"{starters.count(False)} threads started in a thread"
+    assert fit.estimates["m"] == pytest.approx(95.0, rel=0.01)
