@@ -210,14 +210,16 @@ def test_the_coulomb_search_ends_at_the_truth_on_neighbour_records(which):
         assert fit.estimates[name] == pytest.approx(value, rel=1e-6), name
 
 
-def test_a_coulomb_axis_with_noise_is_fitted_to_its_noise():
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_coulomb_axis_with_noise_is_fitted_to_its_noise(seed):
     """A Coulomb axis (95 kg, 200 N s/m, fc 20 N, a 3 N force offset) driven by two sines and
-    a random force, 6000 samples with 1e-7 m of noise: main's search stopped at fit RMS
-    3.18e-6 m, 32 times the noise (c 202.4 +- 0.018 N s/m, fc 19.896 +- 0.0007 N: 130 and 150
-    standard errors off); now at the noise, every value within 3 standard errors."""
+    a random force, 6000 samples with 1e-7 m of noise: main's search stopped at fit RMS 31.8,
+    3.68 and 9.54 times the noise on the three seeds (seed 0: c 202.4 +- 0.018 N s/m, fc
+    19.896 +- 0.0007 N, 130 and 150 standard errors off); now at the noise, every value within
+    3 standard errors."""
     n, noise = 6000, 1e-7
     t = np.arange(n) / FS
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(seed)
     u = (60.0 * np.sin(2 * np.pi * 1.3 * t) + 25.0 * np.sin(2 * np.pi * 7.1 * t + 1.0)
          + rng.standard_normal(n))
     y, _ = simulate_elements(MassDamper(95.0, 200.0).mechanics(),

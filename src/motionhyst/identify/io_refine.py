@@ -11,11 +11,13 @@ A rigid slider (the Coulomb link) sticks and slips at events that move step by s
 parameters: on a floating stage a stick mispredicted shifts the whole rest of the record, so
 that the records' cost has wells side by side (on a Coulomb axis of 6000 samples, 1e-4 apart
 in the logarithm of the mass), and its secants (a step of 1e-3) span many of them.  Its
-refinement therefore starts with the records cut into segments
-(:func:`~motionhyst.identify.io_records.segment_records`), each with its own position offset
-and initial velocity (:func:`on_segments`: a stick mispredicted costs only its segment), and
-ends with its secants' step shrunk tenfold in turn (to :data:`FINEST_SECANT`), each end kept
-where it fits the records better.
+refinement therefore also runs from the end of one on the records cut into segments, each
+with its own position offset and initial velocity (:func:`on_segments`: a stick mispredicted
+costs only its segment), and its best end is refined again with its secants' step shrunk
+tenfold in turn (to :data:`FINEST_SECANT`), each end kept where it fits the records better.
+Where the model does not fit the records to their noise (a measured axis) the segments' end
+can be the worse start, and the segments' own offsets make its cost on the whole records no
+guide: the ends are compared, not the starts.
 """
 
 from __future__ import annotations
@@ -72,16 +74,17 @@ def on_segments(prob, q_free: NDArray[np.float64], tol: float, max_nfev: int | N
                 ) -> NDArray[np.float64]:
     """`q_free` refined on the records of the search problem `prob` (a floating stage's,
     each record's position offset and initial velocity estimated) cut into segments
-    (:func:`~motionhyst.identify.io_records.segment_records`), each with its own position offset and
-    initial velocity (started at its first sample and its first samples' slope), the stage's
-    and link's values and the force offset shared; the records' own offsets and states as
-    they were.  `q_free` itself where no record is longer than two segments or the
-    refinement cannot run."""
+    (:func:`~motionhyst.identify.io_records.segment_records`), each with its own position
+    offset and initial velocity, the stage's and link's values and the force offset shared;
+    a record's first segment starts at the record's own offset and state and gives them
+    back, the others start at their first sample and their first samples' slope.  `q_free`
+    itself where no record is longer than two segments or the refinement cannot run."""
     ex = prob.extras
     base = prob.n_plant + prob.n_link
-    parts = [part for _, part in segment_records(prob.records)]
-    if len(parts) <= len(prob.records) or not prob.free.all():
+    cut_of = segment_records(prob.records)
+    if len(cut_of) <= len(prob.records) or not prob.free.all():
         return q_free
+    parts = [part for _, part in cut_of]
     cut = replace(ex, n_records=len(parts))
     size = {name.split("[")[0]: sc for name, sc in zip(ex.names, prob.scale[base:], strict=True)}
     scale = np.concatenate([prob.scale[:base], [size[nm.split("[")[0]] for nm in cut.names]])
@@ -90,16 +93,21 @@ def on_segments(prob, q_free: NDArray[np.float64], tol: float, max_nfev: int | N
     seg.exact, seg.fd_step = prob.exact, prob.fd_step
     v = prob.values(q_free)
     shared = int(ex.input_offset) + int(ex.input_drift)
+    first = {i: k for k, (i, _) in reversed(list(enumerate(cut_of)))}  # each record's first
     start = extras_start(cut, parts, True, 0.0)
     start[:shared] = v[base:base + shared]
+    for i, k in first.items():
+        start[cut.columns_of_record(k)] = v[base + np.array(ex.columns_of_record(i))]
     try:
         sol = seg.solve(seg.variables(np.concatenate([v[:base], start])), tol, max_nfev)
     except BudgetSpent:
         return q_free
     finally:
         prob.n_eval += seg.n_eval
-    w = v.copy()
-    w[:base + shared] = seg.values(sol.x)[:base + shared]
+    w, end = v.copy(), seg.values(sol.x)
+    w[:base + shared] = end[:base + shared]
+    for i, k in first.items():
+        w[base + np.array(ex.columns_of_record(i))] = end[base + np.array(cut.columns_of_record(k))]
     return prob.variables(w)
 
 
@@ -107,45 +115,48 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
            from_window: bool, rigid: bool = False, segments: bool = False
            ) -> tuple[OptimizeResult, NDArray[np.float64], int | None]:
     """The search problem `prob` refined from `q0` and, with `from_window`, from
-    :func:`state_start` of it too, the end of least cost kept; with `segments`, on segments
-    first (:func:`on_segments`), and a `rigid` slider's at its end with its secants' step
-    shrunk tenfold in turn to :data:`FINEST_SECANT`, each end kept where it lowers the cost
-    (the step set back after: the standard errors' secants are the search's).
+    :func:`state_start` of it too; with `segments`, also from the end of a refinement on the
+    records' segments (:func:`on_segments`; near a well's bottom: with secants a tenth as
+    wide); the end of least cost kept.  A `rigid` slider's best end is
+    refined again with its secants' step shrunk tenfold in turn to :data:`FINEST_SECANT`,
+    each end kept where it lowers the cost (the step set back after: the standard errors'
+    secants are the search's).
 
     With a budget (``prob.budget``), `reserve` evaluations are kept for what follows and the
-    stages share the rest, each an equal part of what those before it left (the refinement
-    from the window's state and each shrunk step only where its part is two steps, the
+    stages share the rest, each an equal part of what those before it left (a refinement
+    from a window's state and each shrunk step only where its part is two steps, the
     segments and finer secants only where the rest is :data:`RIGID_STEPS` steps).
     Returns the refinement's result, its start and the evaluations it was allowed.
     """
     plan, secant = prob.budget, prob.fd_step
     if plan.left is not None and plan.left - reserve < RIGID_STEPS * (1 + q0.size):
         rigid = segments = False  # a budget too small for them: the refinements alone
-    shrinks = round(np.log10(prob.fd_step / FINEST_SECANT)) if rigid else 0
-    stages = [segments, True, from_window, *([True] * shrinks)]
+    shrinks = round(np.log10(secant / FINEST_SECANT)) if rigid else 0
+    stages = [segments, *([True] * (1 + from_window + segments + shrinks))]
 
     def part(k: int) -> int | None:  # the share of stage k
-        return None if plan.left is None else (plan.left - reserve) // sum(stages[k:])
+        return None if plan.left is None else (plan.left - reserve) // max(sum(stages[k:]), 1)
 
     def enough(k: int) -> bool:
         return plan.left is None or part(k) >= 2 * (1 + q0.size)
 
+    starts = [(q0, secant)]
     if segments:
         share = part(0)
         with plan.share(share):
             q1 = on_segments(prob, q0, tol, max_nfev if share is None else share)
-        if q1 is not q0:  # near the wells' bottom: the records refined with finer secants
-            q0, shrinks = q1, shrinks - 1
-            prob.fd_step /= 10.0
-            stages.pop()
-    runs = [q0]
-    if from_window and enough(1):
+        if q1 is not q0:  # near a well's bottom: refined with finer secants
+            starts.append((q1, secant / 10.0))
+    runs = starts[:1]
+    if from_window and enough(2):
         q_state = state_start(prob, q0)
-        runs += [] if q_state is None else [q_state]
-    stages[2] = len(runs) > 1
-    sol, start, most = None, q0, max_nfev
-    for k, q in enumerate(runs, 1):
+        runs += [] if q_state is None else [(q_state, secant)]
+    runs += starts[1:]  # the segments' end: each record's state its first segment's
+    stages[1:2 + from_window + segments] = [True] * len(runs)
+    sol, start, most, at = None, q0, max_nfev, secant
+    for k, (q, step) in enumerate(runs, 1):
         share = part(k)
+        prob.fd_step = step
         try:
             with plan.share(share):
                 end = prob.solve(q, tol, max_nfev if share is None else share)
@@ -154,12 +165,12 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
                 raise
             continue  # the further refinement's share ran not even its start
         if sol is None or end.cost < sol.cost:
-            sol, start, most = end, q, max_nfev if share is None else share
-    for k in range(3, 3 + shrinks):
-        if not enough(k):
-            break
-        prob.fd_step /= 10.0
-        share = part(k)
+            sol, start, most, at = end, q, max_nfev if share is None else share, step
+    k = len(runs) + 1
+    while rigid and at > FINEST_SECANT * 1.5 and enough(k):
+        at /= 10.0
+        prob.fd_step, share = at, part(k)
+        k += 1
         try:
             with plan.share(share):
                 end = prob.solve(sol.x, tol, max_nfev if share is None else share)
