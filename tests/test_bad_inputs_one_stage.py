@@ -167,3 +167,21 @@ def test_a_slow_noisy_record_of_the_axis_is_not_refused():
     check_one_stage([fast, slow], floating=True)
     with pytest.raises(ValueError, match="no inertia in the force"):
         check_one_stage([fast, _link()], floating=True)
+
+
+@pytest.mark.parametrize("n", [64, 80, 100, 120, 300, 600])
+def test_short_records_of_the_axis_are_not_judged_by_their_own_mass(n):
+    """Records of 64-600 samples of the same 2 kg axis (1 um noise), from rest and cut from a
+    running record, beside its 3000-sample record: their linear mass errs far beyond its
+    Newey-West error (80 samples: 0.45 +- 0.2 kg; review A13b H1: refused as "stages of
+    different masses"), so a record shorter than 20 of its lags is not judged by it."""
+    stage = _axis(noise=1e-6, name="stage")
+    running = _axis(n=5000, noise=1e-6, seed=99, name="running")
+    for seed in range(4):
+        check_one_stage([stage, _axis(n=n, noise=1e-6, seed=seed, name="short")], floating=True)
+        a = 500 + 900 * seed
+        window = IORecord(running.t[a:a + n] - running.t[a], running.u[a:a + n],
+                          running.y[a:a + n], "window")
+        check_one_stage([stage, window], floating=True)
+    with pytest.raises(ValueError, match="records of stages of different masses"):
+        check_one_stage([stage, _heavy()], floating=True)

@@ -33,6 +33,12 @@ mass errs with the record (EMPS's windows of 1000-12000 samples: within 3 %, up 
 standard errors; generated axes' slow, noisy or small records, their link stuck: up to a
 factor 3.3, 7 standard errors)."""
 
+OWN_MASS_WINDOWS = 20
+"""A record's own mass is judged (:func:`check_one_stage`) only where it holds at least this
+many of its Newey-West lags (``max(4 n^(1/3), 10 ms)``; 716 samples at 1 kHz): a shorter
+one's standard error is no measure of its linear model's error (80 samples of a 2 kg axis:
+0.45 +- 0.2 kg)."""
+
 ACCELERATION_NOISE = 0.1
 """A record's own mass is judged (:func:`check_one_stage`) only where its position's white
 noise makes at most this share of its acceleration's variance: noise in a regressor draws
@@ -172,11 +178,15 @@ def _own_mass(records: list[IORecord]) -> tuple[float, float] | None:
     takes any stage's force (:func:`~motionhyst.identify.io_checks.check_inertia`'s: viscous
     and Coulomb friction, a spring), or None where they do not determine it: the linear model
     leaves more than :data:`~motionhyst.identify.io_start.LINEAR_MODEL_RESIDUAL` of the force
-    (a link that carries it), or the position's white noise makes more than
-    :data:`ACCELERATION_NOISE` of the acceleration's variance (the mass then errs low)."""
+    (a link that carries it), the position's white noise makes more than
+    :data:`ACCELERATION_NOISE` of the acceleration's variance (the mass then errs low), or a
+    record is shorter than :data:`OWN_MASS_WINDOWS` of its Newey-West lags."""
+    window = max(7, 2 * round(0.005 * records[0].fs) + 1)
+    if any(rec.y.size < OWN_MASS_WINDOWS * max(int(4 * rec.y.size ** (1 / 3)), window)
+           for rec in records):
+        return None
     rows, rhs = equation_rows(records, floating=True)
     rows = [np.column_stack([r, rec.y]) for r, rec in zip(rows, records, strict=True)]
-    window = max(7, 2 * round(0.005 * records[0].fs) + 1)
     x, cov = robust_least_squares(rows, rhs, window)
     A, u = np.concatenate(rows), np.concatenate(rhs)
     spread = float(np.linalg.norm(u - np.mean(u)))
