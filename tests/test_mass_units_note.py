@@ -55,14 +55,15 @@ def test_a_heavy_stage_s_force_in_mn_is_named_by_its_peak():
 
 def test_the_command_warns_a_light_stage_without_naming_a_unit(tmp_path):
     """Main: "is the position in mm or the force in kN? --scale displacement=0.001 or
-    force=1000 makes it 0.549 kg"; the search then meets its budget of a second."""
+    force=1000 makes it 0.549 kg"; the search then runs (here to its budget of a second, or
+    to its end on a fast machine: only the warning is asserted)."""
     populate(tmp_path, {"light.csv": _csv(_light())})
     before = snapshot(tmp_path)
-    code, out, err = limited_process.run(["identify", "light.csv", "--record", "input-output",
-                                          "--plant", "mass-damper", "--max-seconds", "1"],
-                                         tmp_path)
+    code, _, err = limited_process.run(["identify", "light.csv", "--record", "input-output",
+                                        "--plant", "mass-damper", "--max-seconds", "1"],
+                                       tmp_path)
     lines = err.strip().splitlines()
-    assert out == "" and code == 2 and snapshot(tmp_path) == before, err
+    assert code in (0, 2) and snapshot(tmp_path) == before, err
     assert lines[0] == ("motionhyst: warning: identify: light.csv: the records' inverse-"
                         "dynamics mass is 0.000549 kg, outside the usual 0.001-10000 kg of "
                         f"motion stages: {GENERIC}"), err
