@@ -24,7 +24,7 @@ def test_an_output_rate_a_thousand_times_the_loop_s_is_refused(tmp_path):
     before = snapshot(tmp_path)
     line = limited_process.refusal([*SIMULATE, "--output-rate", "1e9", "--duration", "1e-5"],
                                    tmp_path, file_limit=10 << 20)
-    assert line == (f"motionhyst: error: simulate: --output-rate 1e+09 Hz is 3.6e+04 times "
+    assert line == (f"motionhyst: error: simulate: --output-rate 1e+09 Hz is 3.62e+04 times "
                     f"{NEEDED}: its rows would only make the run's step finer than the loop's "
                     f"dynamics need; give --output-rate 2.77e+04 (at most 1000 times it)"), line
     assert snapshot(tmp_path) == before
@@ -39,7 +39,7 @@ def test_an_output_rate_ten_times_the_loop_s_is_warned_of(tmp_path, monkeypatch,
     (tmp_path / "s.toml").write_text(default_scenario_path().read_text())
     assert main([*SIMULATE, "--output-rate", rate, "--duration", "0.001"]) == 0
     lines = [line for line in capsys.readouterr().err.splitlines() if "--output-rate" in line]
-    assert lines == ([f"motionhyst: warning: simulate: --output-rate 1e+06 Hz is 36 times "
-                      f"{NEEDED}: its rows make the run's step and the file 36 times finer and "
+    assert lines == ([f"motionhyst: warning: simulate: --output-rate 1e+06 Hz is 36.2 times "
+                      f"{NEEDED}: its rows make the run's step and the file 36.2 times finer and "
                       f"longer than the loop's dynamics need; --output-rate 2.77e+04 resolves "
                       f"it"] if warned else []), lines

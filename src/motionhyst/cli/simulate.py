@@ -159,10 +159,11 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
 def _check_output_rate(args: argparse.Namespace, sc, ref) -> str | None:
     """Refuse an ``--output-rate`` above the rate a continuous loop's step needs by more than
     the second of :data:`OUTPUT_RATE_FACTORS`; above the first, the warning to give once the
-    run is not refused (None otherwise, and for a sampled controller, whose samples set the
-    run)."""
+    run is not refused (None otherwise, for a rate at or below the default's, and for a
+    sampled controller, whose samples set the run)."""
     from motionhyst.time.references import SampledReference
     from motionhyst.time.steps import pole_step, step_set_by
+    from motionhyst.time.timeseries import DEFAULT_OUTPUT_RATE_HZ
 
     if args.output_rate is None or sc.model.controller is None:
         return None
@@ -174,15 +175,16 @@ def _check_output_rate(args: argparse.Namespace, sc, ref) -> str | None:
     needed = 1.0 / pole_step(pole, f)
     factor = args.output_rate / needed
     warn_above, refuse_above = OUTPUT_RATE_FACTORS
-    if factor <= warn_above:
-        return None
-    what = (f"--output-rate {args.output_rate:g} Hz is {factor:.2g} times the rate the loop "
+    if factor <= warn_above or (factor <= refuse_above
+                                and args.output_rate <= DEFAULT_OUTPUT_RATE_HZ):
+        return None  # the default's rate, or below it, is no choice to warn of
+    what = (f"--output-rate {args.output_rate:g} Hz is {factor:.3g} times the rate the loop "
             f"needs ({needed:.3g} Hz: {step_set_by(pole, f)})")
     if factor > refuse_above:
         raise UsageError(f"motionhyst simulate: {what}: its rows would only make the run's "
                          f"step finer than the loop's dynamics need; give --output-rate "
                          f"{needed:.3g} (at most {refuse_above:g} times it)")
-    return (f"{what}: its rows make the run's step and the file {factor:.2g} times finer and "
+    return (f"{what}: its rows make the run's step and the file {factor:.3g} times finer and "
             f"longer than the loop's dynamics need; --output-rate {needed:.3g} resolves it")
 
 
