@@ -64,8 +64,8 @@ from motionhyst.io._mat_sizes import declared_values
 from motionhyst.io.csvdata import (
     CSVError,
     Source,
+    count_rows,
     describe,
-    estimate_rows,
     normalize_name,
     read_columns,
     read_header,
@@ -550,8 +550,8 @@ def _mat_samples(path: Path, wanted: Sequence[str]) -> int | None:
 def record_samples(source: Source, names: Sequence[str],
                    columns: Mapping[str, str] | None = None) -> tuple[int, bool] | None:
     """The samples of a record file before its values are read, and whether the count is
-    exact: a MATLAB file's from the sizes its variables declare (exact), a CSV file's from
-    its size and its lines' lengths (:func:`~motionhyst.io.csvdata.estimate_rows`).
+    exact: a MATLAB file's from the sizes its variables declare, a CSV file's from its lines
+    (:func:`~motionhyst.io.csvdata.count_rows`: exact, but a line of spaces would count).
 
     Parameters
     ----------
@@ -591,8 +591,7 @@ def record_samples(source: Source, names: Sequence[str],
         _check_text(source)
         if not {normalize_name(w) for w in wanted} <= set(read_header(source)):
             return None
-        n = estimate_rows(source)
-        return int(float(f"{n:.3g}")), False  # an estimate: three digits
+        return count_rows(source), True
     except BudgetError:  # the file alone is above the budget
         raise
     except Exception:  # a damaged file, a name not found: its reader says what is wrong
@@ -632,7 +631,8 @@ def check_unread(sources: Sequence[Source], names: Sequence[str],
     >>> from scipy.io import savemat
     >>> from motionhyst.core.budget import BudgetError, check_memory, set_max_memory
     >>> set_max_memory(1 << 30)
-    >>> path = Path(tempfile.mkdtemp()) / "long.mat"
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = Path(folder.name) / "long.mat"
     >>> savemat(path, {"time": np.zeros(2_000_000), "force": np.zeros(2_000_000)})
     >>> def search(sizes):
     ...     check_memory(700.0 * sum(sizes), f"a search of {sum(sizes)} samples", "fewer")
@@ -642,6 +642,7 @@ def check_unread(sources: Sequence[Source], names: Sequence[str],
     ...     print(str(exc).replace(str(path), "long.mat"))      # doctest: +ELLIPSIS
     long.mat (2000000 samples, not read yet): a search of 2000000 samples needs 1.4 GB, ...
     >>> set_max_memory(None)
+    >>> folder.cleanup()
     """
     paths = [Path(s) for s in sources if _is_path(s)]
     if len(paths) < len(sources) or not paths:
