@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from motionhyst.identify.io_checks import check_inertia, robust_least_squares
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
+from motionhyst.identify.io_uncertainty import white_noise_variance
 
 __all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "SI_READINGS", "check_one_stage",
            "mass_units_note"]
@@ -209,7 +210,7 @@ def _acceleration_noise(records: list[IORecord], acc: NDArray[np.float64]) -> fl
     for rec in records:
         samples = min(max(7, 2 * round(0.005 * rec.fs) + 1), rec.y.size - (1 - rec.y.size % 2))
         gain = float(np.sum(savgol_coeffs(samples, 3, deriv=2, delta=1.0 / rec.fs) ** 2))
-        noise += rec.y.size * gain * float(np.mean(np.diff(rec.y, 3) ** 2)) / 20.0
+        noise += rec.y.size * gain * white_noise_variance(rec.y, robust=False)
     total = float(np.sum((acc - np.mean(acc)) ** 2))
     return min(1.0, noise / total) if total > 0 else 1.0
 
