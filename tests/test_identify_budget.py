@@ -383,14 +383,16 @@ def test_a_two_mass_bouc_wen_search_is_sized_by_its_measured_estimate(tmp_path):
 
 
 def test_the_help_says_how_max_evaluations_is_shared(capsys):
-    """Review A12b L2: with --max-evaluations the refinement from the starts' best gets half
-    of what the starts leave, the run from the window's state the other half; said in the
-    help (and the guide), as the stopping line's "at most ... evaluations" shows it."""
+    """Review A12b L2: with --max-evaluations the refinement's stages (the starts' best, the
+    window's state, for a Coulomb link on an axis the segments' end and finer secants) share
+    what the starts leave, each an equal part of what those before it left; said in the help
+    (and the guide), as the stopping line's "at most ... evaluations" shows it."""
     from motionhyst.cli import main
 
     with pytest.raises(SystemExit):
         main(["identify", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    assert ("records from a start whose state is estimated are refined twice (from the starts' "
-            "best and from the state their first samples set), each run with half of what the "
-            "starts leave") in text, text
+    assert ("records from a start whose state is estimated are refined in stages (from the "
+            "starts' best, from the state their first samples set and, for a Coulomb link on an "
+            "axis, from a fit on the records' segments and with finer secants), each stage with an "
+            "equal part of what the stages before it left") in text, text

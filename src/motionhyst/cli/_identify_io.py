@@ -77,9 +77,10 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                    help="input-output records: the search's budget of model evaluations, "
                         "starts and refinement together (default: the starts', then at most "
                         "200 for the refinement); records from a start whose state is "
-                        "estimated are refined twice (from the starts' best and from the "
-                        "state their first samples set), each run with half of what the "
-                        "starts leave")
+                        "estimated are refined in stages (from the starts' best, from the "
+                        "state their first samples set and, for a Coulomb link on an axis, "
+                        "from a fit on the records' segments and with finer secants), each "
+                        "stage with an equal part of what the stages before it left")
     q.add_argument("--output", choices=("y2", "y1"),
                    help="input-output records, --plant two-mass: the measured position, y2 "
                         "(the point of control, default) or y1 (the actuated mass)")
