@@ -148,7 +148,7 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
         if q1 is not q0:  # near a well's bottom: refined with finer secants
             starts.append((q1, secant / 10.0))
     runs = starts[:1]
-    if from_window and enough(2):
+    if from_window and enough(1):  # where the first refinement's share is two steps
         q_state = state_start(prob, q0)
         runs += [] if q_state is None else [(q_state, secant)]
     runs += starts[1:]  # the segments' end: each record's state its first segment's
