@@ -181,12 +181,12 @@ def test_hostile_input_is_exit_2_one_line_and_touches_nothing(tmp_path, files, a
 
 
 @pytest.mark.parametrize(("budget", "words"), [
-    (None, ["needs 9.6 GB, above the memory budget of", "fewer samples or substeps"]),
+    (None, ["needs 6.4 GB, above the memory budget of", "fewer samples or substeps"]),
     ("64G", ["out of memory"]),
 ], ids=["own-budget", "budget-past-the-limit"])
 def test_the_memory_limit_bites_on_a_case_that_needs_more(tmp_path, budget, words):
     """The limit of these tests means something: a periodic prediction of 20000 samples of
-    10000 integration steps each (9.6 GB: the period upsampled at once; a run from rest goes
+    10000 integration steps each (6.4 GB: the period upsampled at once; a run from rest goes
     in blocks) is refused by its own budget, which follows the limit; with its budget raised
     past the limit it meets the limit itself: a MemoryError, still one line and exit 2, and
     nothing written."""

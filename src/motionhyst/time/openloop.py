@@ -98,6 +98,7 @@ from motionhyst.time.resample import (
     fine_blocks,
     fine_input,
     held_nodes,
+    period_upsampling_bytes,
     sampling_rate,
 )
 from motionhyst.time.resample import is_periodic_record as is_periodic_record
@@ -294,16 +295,6 @@ class OpenLoop:
             return OpenLoopResponse(tt, u, y, periodic)
         fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
-        # a periodic run: the force at every integration step and midpoint of the period, and
-        # the output's sensitivities to the start state of Newton's steps on the period map
-        # (two periods' at once); a run from a start: of one block at a time
-        # (time.resample.fine_blocks), and the record
-        fine = u.size * r if periodic else held_nodes(u, r)
-        states = self._shooting_states() if periodic else 0
-        check_memory(FINE_BYTES * fine + (SAMPLE_BYTES + 16 * states) * u.size,
-                     f"{u.size} samples of {r} integration steps each"
-                     + (f" (and the periodic steady state's sensitivities to its {states} "
-                        f"states)" if states else ""), "fewer samples or substeps")
         # the plant's viscous friction by direction is stepped with the link's elements, and so
         # is a Bouc-Wen link on a positioning axis (one floating mass): a friction link, whose
         # exact update in the displacement follows its sticking however stiff (RK4 in time
@@ -311,7 +302,15 @@ class OpenLoop:
         mech = self.plant.mechanics()
         axis = isinstance(self.hysteresis, BoucWen) and mech.floating and mech.n == 1
         p = None if getattr(self.plant, "c_skew", 0.0) or axis else self._bw_parameters()
-        if periodic and self.hysteresis is None and self.plant.mechanics().floating:
+        # a run from a start: the force at the integration steps of one block at a time
+        # (time.resample.fine_blocks), and the record; a periodic run: _periodic_memory
+        states = self._shooting_states() if periodic and p is None else 0
+        check_memory(self._periodic_memory(u, r, p is not None) if periodic
+                     else FINE_BYTES * held_nodes(u, r) + SAMPLE_BYTES * u.size,
+                     f"{u.size} samples of {r} integration steps each"
+                     + (f" (and the periodic steady state's sensitivities to its {states} "
+                        f"states)" if states else ""), "fewer samples or substeps")
+        if periodic and self.hysteresis is None and mech.floating:
             y = floating_linear_periodic(self.plant.mechanics(), u, fs)
         elif p is not None:
             y, _ = simulate_bouc_wen(p, u, fs, r, periodic=periodic, sensitivities=False,
@@ -319,6 +318,28 @@ class OpenLoop:
         else:
             y = self._simulate_elements(u, fs, r, periodic)
         return OpenLoopResponse(tt, recorded, y, periodic)
+
+    def _periodic_memory(self, u: NDArray[np.float64], r: int, rk4: bool) -> float:
+        """Bytes of a periodic run of the force `u` (:meth:`simulate`): the record and the
+        output (:data:`SAMPLE_BYTES` a sample), and the larger of the upsampling of its period
+        (:func:`~motionhyst.time.resample.period_upsampling_bytes`) and the run of it: the
+        period's fine force (steps and their midpoints for a Bouc-Wen link run by RK4),
+        the outputs of two periods and, for Newton's steps on the period map, the output's
+        sensitivities to the start states (16 bytes a state and sample), with the kernel's
+        record of them, three rows a sample, for a block of the period (two blocks' while
+        the next is made).  Measured (address space above a warmed process): a Dahl link on
+        a spring, 3 states, 1e5 samples of 1, 20, 100 steps: 16, 65, 320 MB (estimate 23,
+        70, 326); Maxwell-slip of 38 elements, 40 states: 98 and 163 MB at 1e5 and 2e5
+        samples of 1 step (106 and 179)."""
+        m = u.size // whole_periods(u)  # the steady state of one period, repeated
+        if self.hysteresis is None and self.plant.mechanics().floating:
+            return SAMPLE_BYTES * u.size + 16.0 * m  # in the frequency domain, per sample
+        factor = 2 * r if rk4 else r
+        cols = 0 if rk4 else self._shooting_states()
+        step = block_samples(max(factor, 3 * (1 + cols)))
+        record = 0 if rk4 else 24.0 * (1 + cols) * min(m, step) * (2 if m > step else 1)
+        run = 8.0 * (m * factor + 1) + record + (16.0 + 16.0 * cols) * m
+        return SAMPLE_BYTES * u.size + max(period_upsampling_bytes(m, factor), run)
 
     def _simulate_elements(self, u, fs, r, periodic, upsampled=None):
         """Displacement of a link of exact-update elements (`upsampled`: ``fine_input(u, r,
