@@ -332,3 +332,25 @@ def test_the_light_checks_of_a_force_displacement_record_run_on_one_blas_thread(
     with pytest.raises(ValueError, match="a spring's and a damper's"):
         check_loops_open(x, 20.0 * x + 0.5 * np.gradient(x, t), t)
     assert len(seen) == 3 and all(threads == [1] * len(machine) for threads in seen), seen
+
+
+@pytest.mark.parametrize(("options", "words"), [
+    (["--max-memory", "8M"], "c.csv: the Maxwell-slip fit of a closed-loop record of 15001 "
+                             "samples needs"),
+    (["--cutoff", "1e9"], "c.csv: cutoff_hz must be in (0, 2500) Hz"),
+    (["--cutoff", "1e-3"], "c.csv: too short: the prefilter settles"),
+])
+def test_a_closed_loop_record_s_size_and_cut_off_are_judged_before_the_fit_loads(
+        tmp_path, loop_record, options, words):
+    """The memory check of a closed-loop fit read the fit's row limit from the fit module,
+    which loads scipy.optimize and the link models (about 1 s of the 1.2 s of CPU of such a
+    refusal): the size and the prefilter's cut-off are now judged with the record's reader
+    alone (pandas, which parsed it)."""
+    from motionhyst.scenario import default_scenario_path
+
+    (tmp_path / "c.csv").write_text(_csv(loop_record))
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    out = _probe(["identify", "c.csv", "--scenario", "paper.toml", *options], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert words in out["err"], out["err"]
+    assert out["heavy"] == ["pandas"], out["heavy"]

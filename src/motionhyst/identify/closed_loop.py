@@ -15,7 +15,6 @@ from motionhyst.core.sampling import HeldInputFilter
 from motionhyst.identify.fit import (
     EXTRA_ORDER,
     MAX_ELEMENTS,
-    MAX_ROWS,
     Criterion,
     FitProblem,
     fit_rows,
@@ -23,6 +22,7 @@ from motionhyst.identify.fit import (
 )
 from motionhyst.identify.io_uncertainty import white_noise_variance
 from motionhyst.identify.records import (
+    MAX_ROWS,
     UNIFORM_RTOL,
     check_controller_period,
     check_signals,

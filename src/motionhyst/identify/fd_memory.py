@@ -9,7 +9,7 @@ routes, each sized here from the record's samples alone and refused above the me
   bound of what any elements leave (:func:`~motionhyst.identify.fd_bound.systematic_share_bound`:
   at most :data:`~motionhyst.identify.fd_bound.BOUND_COLUMNS` stop operators on
   :data:`~motionhyst.identify.fd_bound.BOUND_ROWS` samples) and the fit (its operators on at most
-  :data:`~motionhyst.identify.fit.MAX_ROWS` samples), one after the other: the largest of
+  :data:`~motionhyst.identify.records.MAX_ROWS` samples), one after the other: the largest of
   them counts (:func:`elements_fit_memory`).
 * A link with a spring and damper in parallel fitted by the force's error (``--model``:
   Maxwell-slip, Dahl, LuGre, Bouc-Wen, ...;
@@ -59,7 +59,7 @@ CLOSED_LOOP_BYTES = 600
 """Bytes per sample of a closed-loop record's link force, inferred through the stage and the
 prefilter (:func:`~motionhyst.identify.closed_loop.infer_link_force`), besides the fit's rows:
 its elements are fitted on every q-th sample, q = 1 at the highest cut-off, so the estimate
-counts a row a sample up to :data:`~motionhyst.identify.fit.MAX_ROWS` (measured on the
+counts a row a sample up to :data:`~motionhyst.identify.records.MAX_ROWS` (measured on the
 default scenario's record at 5 kHz, q = 3: 34 MB of 82 estimated at 2e4 samples, 121 MB of
 235 at 1e5)."""
 
@@ -124,7 +124,7 @@ def elements_fit_memory(n_samples: int, columns: int = MIN_BOUND_COLUMNS) -> dic
     {'loops': 62, 'bound': 600, 'fit': 215, 'total': 600}
     """
     from motionhyst.identify.fd_bound import BOUND_ROWS
-    from motionhyst.identify.fit import MAX_ROWS
+    from motionhyst.identify.records import MAX_ROWS
 
     n = int(n_samples)
     record = RECORD_BYTES * n
@@ -298,7 +298,7 @@ the memory budget of 21 MB (--max-memory); its link force takes 12 MB, the fit's
 a larger --max-memory if the machine has it, or a shorter record
     >>> set_max_memory(None)
     """
-    from motionhyst.identify.fit import MAX_ROWS
+    from motionhyst.identify.records import MAX_ROWS
 
     n = int(n_samples)
     force, rows = CLOSED_LOOP_BYTES * n, FIT_ROW_BYTES * min(n, MAX_ROWS)

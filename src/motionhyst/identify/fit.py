@@ -16,7 +16,7 @@ from scipy.optimize import least_squares, nnls
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.identify._stop_operators import maxwell_at, stops_at
 from motionhyst.identify.io_uncertainty import covariance, covariance_table
-from motionhyst.identify.records import check_signals
+from motionhyst.identify.records import MAX_ROWS, check_signals
 from motionhyst.identify.result import Identification
 
 if TYPE_CHECKING:  # a closed-loop record's prefilter (python-control): a force-displacement
@@ -58,10 +58,6 @@ MAX_NFEV = 100
 
 SCREEN_NFEV = 15
 """Residual evaluations after which the starts of one order are compared (the best goes on)."""
-
-
-MAX_ROWS = 50_000
-"""Most samples used in the residual (the operators always run on the full record)."""
 
 
 EXTRA_ORDER = 2

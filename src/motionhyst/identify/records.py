@@ -19,6 +19,12 @@ MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
 
 
+MAX_ROWS = 50_000
+"""Most samples used in the residual of a Maxwell-slip fit (the operators always run on the
+full record); here, beside the record's checks, so that a record's size is judged before the
+fit's libraries load."""
+
+
 REVERSAL_BAND = 0.01
 """A reversal is a retreat of more than this fraction of the range from a running extreme."""
 
