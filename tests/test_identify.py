@@ -345,6 +345,44 @@ def test_count_reversals():
     assert count_reversals(ramp) == 0  # noise below the band is not a reversal
 
 
+def _walk(x: np.ndarray, band: float) -> int:
+    """The reversal count sample by sample (the compiled kernel count_reversals was)."""
+    n_rev, direction = 0, 0
+    hi = lo = ext = x[0]
+    for v in x[1:]:
+        if direction == 0:
+            hi, lo = max(hi, v), min(lo, v)
+            if v - lo > band:
+                direction, ext = 1, v
+            elif hi - v > band:
+                direction, ext = -1, v
+        elif direction == 1:
+            if v > ext:
+                ext = v
+            elif ext - v > band:
+                n_rev, direction, ext = n_rev + 1, -1, v
+        elif v < ext:
+            ext = v
+        elif v - ext > band:
+            n_rev, direction, ext = n_rev + 1, 1, v
+    return n_rev
+
+
+def test_count_reversals_is_the_sample_by_sample_walk():
+    """count_reversals visits only the samples where x turns (numpy, no compiler): its count
+    is the walk over every sample's, on random walks, rounded noise (plateaus), steps held
+    five samples, noisy sines, at bands of 0 to the whole range."""
+    rng = np.random.default_rng(SEED)
+    for trial in range(1500):
+        n = int(rng.integers(2, 300))
+        x = [np.cumsum(rng.standard_normal(n)), np.round(rng.standard_normal(n), 1),
+             np.repeat(rng.standard_normal(n // 5 + 1), 5),
+             np.sin(np.linspace(0, rng.uniform(0, 30), n)) + 0.05 * rng.standard_normal(n)
+             ][trial % 4]
+        band = float(rng.choice([0.0, 0.01, 0.3, 1.0])) * float(np.ptp(x))
+        assert count_reversals(x, band) == _walk(x.tolist(), band), (trial, band)
+
+
 def test_a_record_is_refused_for_no_reversal_exactly_when_the_count_finds_none():
     """The reader's check (numpy alone, no compiled kernel) agrees with count_reversals on
     random walks, noise, noisy ramps and ramps that turn back by about the band."""

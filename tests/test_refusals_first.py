@@ -354,3 +354,21 @@ def test_a_closed_loop_record_s_size_and_cut_off_are_judged_before_the_fit_loads
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert words in out["err"], out["err"]
     assert out["heavy"] == ["pandas"], out["heavy"]
+
+
+def test_a_closed_loop_record_off_its_plant_s_scale_is_refused_with_the_reader_alone(
+        tmp_path, loop_record):
+    """y1 in mm, its prefilter's cut-off from its reversals: the count of reversals was a
+    compiled kernel (numba and its cache: 1.40 s of CPU for the refusal, with the fit
+    module's scipy.optimize); now numpy and a walk over the turns (0.64 s): nothing heavy
+    is loaded but the reader's pandas."""
+    from motionhyst.scenario import default_scenario_path
+
+    record = dict(loop_record)
+    record["y1"] = 1000 * record["y1"]
+    (tmp_path / "c.csv").write_text(_csv(record))
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    out = _probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert "c.csv: the plant's force for y1 as recorded is 1000 times u" in out["err"]
+    assert out["heavy"] == ["pandas"], out["heavy"]

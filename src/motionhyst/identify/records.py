@@ -7,7 +7,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.blas import few_blas_threads
-from motionhyst.core.compiled import njit
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
@@ -29,39 +28,34 @@ REVERSAL_BAND = 0.01
 """A reversal is a retreat of more than this fraction of the range from a running extreme."""
 
 
-@njit(cache=True)
-def _count_reversals(x, band):  # pragma: no cover - compiled
-    """Direction changes of `x` that retreat more than `band` from a running extreme."""
-    n_rev = 0
-    direction = 0
-    hi = x[0]
-    lo = x[0]
-    ext = x[0]
-    for i in range(1, x.shape[0]):
-        v = x[i]
+def _count_reversals(x: NDArray[np.float64], band: float) -> int:
+    """Direction changes of `x` that retreat more than `band` from a running extreme.
+
+    The walk visits only the samples where the sign of ``diff(x)`` changes (and the last):
+    between two of them `x` is monotone, and a monotone run moves the walk's state (its
+    direction, its running extreme, the count) as its last sample alone does, so the count
+    is the sample-by-sample walk's, with numpy and a loop over the turns (no compiler: a
+    closed-loop record's cut-off is decided before any kernel loads)."""
+    d = np.sign(np.diff(x))
+    keep = np.flatnonzero(d[1:] != d[:-1]) + 1
+    n_rev, direction = 0, 0
+    hi = lo = ext = float(x[0])
+    for v in [*x[keep].tolist(), float(x[-1])]:
         if direction == 0:
-            hi = max(hi, v)
-            lo = min(lo, v)
+            hi, lo = max(hi, v), min(lo, v)
             if v - lo > band:
-                direction = 1
-                ext = v
+                direction, ext = 1, v
             elif hi - v > band:
-                direction = -1
-                ext = v
+                direction, ext = -1, v
         elif direction == 1:
             if v > ext:
                 ext = v
             elif ext - v > band:
-                n_rev += 1
-                direction = -1
-                ext = v
-        else:
-            if v < ext:
-                ext = v
-            elif v - ext > band:
-                n_rev += 1
-                direction = 1
-                ext = v
+                n_rev, direction, ext = n_rev + 1, -1, v
+        elif v < ext:
+            ext = v
+        elif v - ext > band:
+            n_rev, direction, ext = n_rev + 1, 1, v
     return n_rev
 
 
@@ -94,7 +88,7 @@ def count_reversals(x: ArrayLike, band: float | None = None) -> int:
         return 0
     if band is None:
         band = REVERSAL_BAND * float(np.ptp(xs))
-    return int(_count_reversals(xs, float(band)))
+    return _count_reversals(xs, float(band))
 
 
 def _reverses(x: NDArray[np.float64]) -> bool:
