@@ -372,3 +372,50 @@ def test_a_closed_loop_record_off_its_plant_s_scale_is_refused_with_the_reader_a
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert "c.csv: the plant's force for y1 as recorded is 1000 times u" in out["err"]
     assert out["heavy"] == ["pandas"], out["heavy"]
+
+
+@pytest.fixture(scope="module")
+def loop_record_5hz() -> dict[str, np.ndarray]:
+    """The paper's loop (Table I) recorded 1 s at 10 kHz on a 5 Hz sine of 10 mm."""
+    from motionhyst import Jenkins, Loop, SineReference, default_scenario, simulate
+
+    sc = default_scenario()
+    sim = simulate(Loop(sc.plant(), sc.controller(), Jenkins(k=20.0, fc=0.05)),
+                   SineReference(0.01, 5.0), 1.0, dt=1e-4)
+    return {"time": sim.t, "y1": sim.y1, "u": sim.u}
+
+
+@pytest.mark.parametrize(("mistake", "words"), [
+    ("a spring and a damper", "c.csv: no hysteresis in the record: the link force inferred "
+                              "through the plant is a spring's and a damper's"),
+    ("u negated", "with u negated the record is a link's: --scale u=-1 reads it so"),
+    ("y1 a sample ahead", "shifted by 1 sample (y1's row i beside u's row i + 1)"),
+])
+def test_a_closed_loop_record_that_is_no_link_s_is_refused_before_the_loop_is_built(
+        tmp_path, loop_record_5hz, mistake, words):
+    """A closed-loop record whose inferred force is no link's was refused once the loop was
+    built (python-control, scipy.signal, the compiled filters: a made-up spring and damper
+    2.0-2.3 s of CPU, the paper's loop with u negated 1.8-1.9 s); the same checks now run on
+    the same force inferred with numpy from the plant's lumped masses, before the loop:
+    none of the loop's or the fit's libraries is loaded (0.5-0.6 s of CPU)."""
+    from motionhyst.scenario import default_scenario_path
+
+    record = dict(loop_record_5hz)
+    t = record["time"]
+    if mistake == "a spring and a damper":
+        record["y1"] = 0.01 * np.sin(2 * np.pi * 2.0 * t)
+        record["u"] = 50.0 * np.sin(2 * np.pi * 2.0 * t + 0.2)
+    elif mistake == "u negated":
+        record["u"] = -record["u"]
+    else:
+        record = {"time": t[:-1], "y1": record["y1"][1:], "u": record["u"][:-1]}
+    (tmp_path / "c.csv").write_text(_csv(record))
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    code = ("import sys\nfrom motionhyst.cli import main\n"
+            "code = main(['identify', 'c.csv', '--scenario', 'paper.toml'])\n"
+            "print(code, sorted({'control', 'scipy.signal', 'scipy.optimize', 'numba', "
+            "'matplotlib'} & set(sys.modules)))\n")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600, check=False)
+    assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr
+    assert proc.stderr.count("\n") == 1 and words in proc.stderr, proc.stderr

@@ -211,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.identify.records import prefilter_cutoff
 
         try:  # before the plant's scenario loads python-control
-            cutoff, _ = prefilter_cutoff(t, y1, args.cutoff)
+            cutoff, settle = prefilter_cutoff(t, y1, args.cutoff)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         from motionhyst.identify.io_records import IORecord
@@ -288,6 +288,10 @@ def run(args: argparse.Namespace) -> int:
 
             try:
                 check_force_scale(t, y1, u, mechanics, cutoff)
+                if rate is None:  # a sampled loop's force is held: its filter is the loop's
+                    from motionhyst.identify.link_checks import check_closed_loop_link
+
+                    check_closed_loop_link(t, y1, u, mechanics, cutoff, settle)
             except ValueError as exc:
                 raise ValueError(f"{path}: {exc}") from None
         warn_plant_fit(sc)
