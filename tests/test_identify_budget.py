@@ -345,8 +345,8 @@ def test_a_two_mass_bouc_wen_search_is_sized_by_its_measured_estimate(tmp_path):
     MB: refused under --max-memory 40M); sized as the mass-spring-damper's search (16 B a step
     and 900 B a sample: 29 MB; measured on two masses: 24 MB of 27 at 2e4 samples, 92 MB of
     135 at 1e5) it runs within 40 MB of address space above the warmed process (its run of
-    the fitted model at the end, sized by its own estimate once that model is known, takes
-    37 MB)."""
+    the fitted model at the end, sized before the search at the search's steps, takes 37
+    MB)."""
     sys.path.insert(0, str(Path(__file__).parent))
     from test_identify_two_mass import FS as FS_TWO_MASS
     from test_identify_two_mass import _record
@@ -380,6 +380,28 @@ def test_a_two_mass_bouc_wen_search_is_sized_by_its_measured_estimate(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     code, substeps, _ = proc.stdout.split()  # 40 evaluations: sized, not converged
     assert code == "0" and int(substeps) >= 35, (proc.stdout, proc.stderr[-1000:])
+
+
+def test_a_two_mass_bouc_wen_fit_is_refused_before_its_search_where_its_last_run_is_not_held(
+        tmp_path):
+    """The same record under --max-memory 31M: the search (29 MB) fits, the run of the fitted
+    model from rest that judges it (37 steps a sample: 36.8 MB) does not; refused in one line
+    before the search, naming that run (it was refused after the whole search, 13 s of CPU, as
+    "the fit failed: the identified model cannot be simulated"), nothing saved."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_identify_two_mass import _record
+
+    rec = _record(20_000, 1, noise=1e-7)
+    savemat(tmp_path / "run.mat", {"time": rec.t[:, None], "force": rec.u[:, None],
+                                   "displacement": rec.y[:, None]})
+    line = limited_process.refusal(["identify", "run.mat", "--record", "input-output",
+                                    "--plant", "two-mass", "--model", "bouc-wen", *IO_COLUMNS,
+                                    "--max-evaluations", "40", "--max-memory", "31M",
+                                    "--save", "m.toml"], tmp_path)
+    assert line.startswith("motionhyst: error: run.mat: the run of the fitted model from rest "
+                           "(20000 samples of at least 37 integration steps each) needs 36.8 "
+                           "MB, above the memory budget of 32.5 MB (--max-memory)"), line
+    assert not (tmp_path / "m.toml").exists()
 
 
 def test_the_help_says_how_max_evaluations_is_shared(capsys):

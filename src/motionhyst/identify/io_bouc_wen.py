@@ -30,7 +30,7 @@ from scipy.optimize import OptimizeResult
 
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
-from motionhyst.identify.io_memory import check_bouc_wen_memory
+from motionhyst.identify.io_memory import REMEDY, check_bouc_wen_memory
 from motionhyst.identify.io_records import IORecord, short_records
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_start import (
@@ -487,6 +487,7 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
     r = substeps or max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n / fs))
     check_substeps(records, r, f_n, 2, sized=True)
     check_bouc_wen_memory([rec.u.size for rec in records], r)  # measured on two masses too
+    _check_final_run(records[0], OpenLoop(bla), r)
     y_scale = float(np.sqrt(np.mean(np.concatenate([rec.y - (np.mean(rec.y) if periodic else 0.0)
                                                     for rec in records]) ** 2)))
     mu = bla.m1 * bla.m2 / bla.M
@@ -529,6 +530,18 @@ def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,
         if s.cost < best[0]:
             best = (s.cost, sp.full(s.x, scale))
     return structure, r, y_scale, scale, free, best[1], n_eval
+
+
+def _check_final_run(rec: IORecord, system: OpenLoop, r: int) -> None:
+    """Refuse, before the search, a record whose run of the fitted model from rest (the fit's
+    judge, :func:`~motionhyst.identify.io_checks.judge_fit`, runs it at the model's own
+    steps) would be above the memory budget at the search's `r` steps a sample: above the
+    search's own estimate on two masses (2e4 samples: 28 MB against 27), it was refused
+    only after the search."""
+    from motionhyst.core.budget import check_memory
+
+    check_memory(system.memory(rec.u, r), f"{rec.name}: the run of the fitted model from rest "
+                 f"({rec.u.size} samples of at least {r} integration steps each)", REMEDY)
 
 
 def _two_mass_result(m1: float, m2: float, b: float, k: float, output: str) -> TwoMass:

@@ -302,11 +302,8 @@ class OpenLoop:
         mech = self.plant.mechanics()
         axis = isinstance(self.hysteresis, BoucWen) and mech.floating and mech.n == 1
         p = None if getattr(self.plant, "c_skew", 0.0) or axis else self._bw_parameters()
-        # a run from a start: the force at the integration steps of one block at a time
-        # (time.resample.fine_blocks), and the record; a periodic run: _periodic_memory
         states = self._shooting_states() if periodic and p is None else 0
-        check_memory(self._periodic_memory(u, r, p is not None) if periodic
-                     else FINE_BYTES * held_nodes(u, r) + SAMPLE_BYTES * u.size,
+        check_memory(self.memory(u, r, periodic=periodic),
                      f"{u.size} samples of {r} integration steps each"
                      + (f" (and the periodic steady state's sensitivities to its {states} "
                         f"states)" if states else ""), "fewer samples or substeps")
@@ -318,6 +315,41 @@ class OpenLoop:
         else:
             y = self._simulate_elements(u, fs, r, periodic)
         return OpenLoopResponse(tt, recorded, y, periodic)
+
+    def memory(self, force: ArrayLike, substeps: int, *, periodic: bool = False) -> float:
+        """Bytes :meth:`simulate` needs for the force record `force`, as it checks them
+        against the memory budget before its run: from a start, the record's force at the
+        integration steps of one block at a time (:func:`~motionhyst.time.resample.fine_blocks`)
+        and the record; a periodic run as :meth:`_periodic_memory` says.
+
+        Parameters
+        ----------
+        force : array_like
+            The force record [N].
+        substeps : int
+            Integration steps per sample.
+        periodic : bool
+            As for :meth:`simulate`.
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import Jenkins
+        >>> sys = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), Jenkins(k=5e4, fc=20.0))
+        >>> u = np.sin(np.arange(20000) / 7.0)
+        >>> round(sys.memory(u, 28) / 1e6, 1)                  # 5.6e5 steps from rest
+        28.2
+        """
+        u = np.asarray(force, dtype=float)
+        if not periodic:
+            return FINE_BYTES * held_nodes(u, int(substeps)) + SAMPLE_BYTES * u.size
+        mech = self.plant.mechanics()
+        axis = isinstance(self.hysteresis, BoucWen) and mech.floating and mech.n == 1
+        rk4 = not (getattr(self.plant, "c_skew", 0.0) or axis) and self._bw_parameters() is not None
+        return self._periodic_memory(u, int(substeps), rk4)
 
     def _periodic_memory(self, u: NDArray[np.float64], r: int, rk4: bool) -> float:
         """Bytes of a periodic run of the force `u` (:meth:`simulate`): the record and the
