@@ -49,6 +49,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/periodic.py
 	$(BIN)/python benchmarks/point.py
 	$(BIN)/python benchmarks/refusals.py
+	$(BIN)/python benchmarks/one_stage.py
 
 # the public benchmarks end to end (kept out of make test): Bouc-Wen (about a minute) and
 # EMPS (a few minutes; scored on DATA_EMPS_PULSES.mat when EMPS_DATA holds it)

@@ -185,3 +185,43 @@ def test_short_records_of_the_axis_are_not_judged_by_their_own_mass(n):
         check_one_stage([stage, window], floating=True)
     with pytest.raises(ValueError, match="records of stages of different masses"):
         check_one_stage([stage, _heavy()], floating=True)
+
+
+def test_the_others_mass_is_their_own_fit():
+    """Each record is compared with the fit of all the others, summed from each record's
+    pieces, not refitted for each record: the figures of the refusal are those of the
+    robust least squares of the other records' samples (3 significant digits)."""
+    from motionhyst.identify.io_checks import robust_least_squares
+    from motionhyst.identify.io_start import equation_rows
+
+    records = [_axis(noise=1e-6, name="stage.csv"), _heavy(),
+               _axis(n=4000, noise=1e-6, seed=7, name="again.csv")]
+    with pytest.raises(ValueError) as exc:
+        check_one_stage(records, floating=True)
+    rest = [records[0], records[2]]  # the records before and after the one refused
+    rows, rhs = equation_rows(rest, floating=True)
+    x, cov = robust_least_squares([np.column_stack([r, rec.y])
+                                   for r, rec in zip(rows, rest, strict=True)], rhs, 11)
+    expected = f"while stage.csv and the others show {x[0]:.3g} +- {np.sqrt(cov[0, 0]):.2g} kg"
+    assert str(exc.value).startswith("heavy.csv: an inverse-dynamics mass of 19.9 +- 0.27"), exc
+    assert expected in str(exc.value) and "1.96 +- 0.019" in expected, (expected, exc)
+
+
+def test_the_check_reads_each_record_a_bounded_number_of_times(monkeypatch):
+    """Eight records of the axis: the check filtered every other record again for each
+    record (review A13b M5: 40 records of 10,000 samples took 5.1 s of CPU, 25 times
+    two records' share); now each record's rows are formed a fixed number of times."""
+    from motionhyst.identify import io_consistency, io_start
+
+    samples, rows = [], io_start.equation_rows
+
+    def counting(records, *args, **kwargs):
+        samples.append(sum(rec.y.size for rec in records))
+        return rows(records, *args, **kwargs)
+
+    monkeypatch.setattr(io_consistency, "equation_rows", counting)
+    monkeypatch.setattr(io_start, "equation_rows", counting)
+    records = [_axis(n=2000, noise=1e-6, seed=s, name=f"r{s}") for s in range(8)]
+    check_one_stage(records, floating=True)
+    every = sum(rec.y.size for rec in records)  # the inertia check's filter, the fit's
+    assert sum(samples) <= 3 * every, (sum(samples), every)  # main: 9 times (k + 1)

@@ -14,7 +14,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.identify.io_checks import check_inertia, robust_least_squares
+from motionhyst.core.blas import few_blas_threads
+from motionhyst.identify.io_checks import check_inertia
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
 from motionhyst.identify.io_uncertainty import white_noise_variance
@@ -44,23 +45,6 @@ ACCELERATION_NOISE = 0.1
 """A record's own mass is judged (:func:`check_one_stage`) only where its position's white
 noise makes at most this share of its acceleration's variance: noise in a regressor draws
 its coefficient towards zero (a slow record's mass 0.014 kg for 2 kg)."""
-
-
-def _linear_fit(records: list[IORecord], floating: bool
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float]:
-    """:func:`~motionhyst.identify.io_start.inverse_dynamics`'s coefficients (``m, c``, ``fc``
-    or ``k``, ``u0``), their robust covariance
-    (:func:`~motionhyst.identify.io_checks.robust_least_squares`), the records' squared
-    angular frequency ``-sum(y'' y) / sum(y^2)`` (``y`` about its mean) [rad^2/s^2] and
-    the share of their acceleration their position's noise makes
-    (:func:`_acceleration_noise`)."""
-    rows, rhs = equation_rows(records, floating)
-    x, cov = robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * records[0].fs) + 1))
-    acc = np.concatenate([r[:, 0] for r in rows])
-    y = np.concatenate([rec.y - np.mean(rec.y) for rec in records])
-    yy = float(np.dot(y, y))
-    return (x, cov, float(-np.dot(acc, y)) / yy if yy > 0 else 0.0,
-            _acceleration_noise(records, acc))
 
 
 def _shows_a_mass(record: IORecord) -> bool:
@@ -130,13 +114,24 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
     """
     if len(records) < 2:
         return
+    with few_blas_threads(max(rec.y.size for rec in records), 5):  # a record's rows at most
+        _check_one_stage(records, floating, single_mass)
+
+
+def _check_one_stage(records: list[IORecord], floating: bool, single_mass: bool) -> None:
     own = [_shows_a_mass(rec) for rec in records]
+    if all(own) and not single_mass:
+        return
+    pieces = [_Pieces(rec) for rec in records]  # any set's fit from sums: linear in records
+    total, others = _leave_one_out(pieces)
+    columns = [0, 1, 2, 3] if floating else [0, 1, 4, 3]  # a, v, sign(v) or y, 1
     for i, rec in enumerate(records):  # a record without inertia first: its message says why
         rest = records[:i] + records[i + 1:]
         if own[i] or not any(own[:i] + own[i + 1:]):  # none shows a mass to compare with
             continue
-        x, cov, w2, noise = _linear_fit([rec], floating)
-        x_rest, cov_rest, _, _ = _linear_fit(rest, floating)
+        x, cov, _ = pieces[i].fit(columns)
+        x_rest, cov_rest, _ = others[i].fit(columns)
+        w2, noise = pieces[i].w2, pieces[i].acceleration_noise()
         gradient, spring = np.array([1.0, 0.0, 0.0, 0.0]), ""
         if not floating and w2 > 0:  # at its frequencies a mass is a negative spring
             gradient, spring = np.array([1.0, 0.0, -1.0 / w2, 0.0]), " with the others' spring"
@@ -156,63 +151,155 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
                              f"identified on its own, without --record input-output")
     if not single_mass:
         return
-    judged = [_own_mass([rec]) for rec in records]  # (mass, std) where a record shows it
+    judged = [_own_mass(piece) for piece in pieces]  # (mass, std) where a record shows it
+    if any(j is None for j in judged):
+        return
     for i, rec in enumerate(records):
         rest = records[:i] + records[i + 1:]
-        if judged[i] is None or any(j is None for j in judged[:i] + judged[i + 1:]):
-            continue
-        together = _own_mass(rest)
+        together = _own_mass(others[i])
         if together is None:
             continue
         (m, std), (m_rest, std_rest) = judged[i], together
         if (m > 0 and m_rest > 0 and max(m / m_rest, m_rest / m) > ONE_STAGE_RATIO
                 and abs(m - m_rest) > ONE_STAGE_SIGMAS * math.hypot(std, std_rest)):
-            joint = float(_linear_fit(records, floating)[0][0])
+            joint = float(total.fit(columns)[0][0])
             raise ValueError(f"{rec.name}: an inverse-dynamics mass of {m:.3g} +- {std:.2g} "
                              f"kg, while {_names(rest)} {m_rest:.3g} +- {std_rest:.2g} kg: "
                              f"records of stages of different masses (together {joint:.3g} kg, "
                              f"neither's); identify each stage from its own records")
 
 
-def _own_mass(records: list[IORecord]) -> tuple[float, float] | None:
+def _own_mass(pieces: _Pieces) -> tuple[float, float] | None:
     """The records' inverse-dynamics mass and its robust standard error in the model that
     takes any stage's force (:func:`~motionhyst.identify.io_checks.check_inertia`'s: viscous
-    and Coulomb friction, a spring), or None where they do not determine it: the linear model
-    leaves more than :data:`~motionhyst.identify.io_start.LINEAR_MODEL_RESIDUAL` of the force
-    (a link that carries it), the position's white noise makes more than
-    :data:`ACCELERATION_NOISE` of the acceleration's variance (the mass then errs low), or a
-    record is shorter than :data:`OWN_MASS_WINDOWS` of its Newey-West lags."""
-    window = max(7, 2 * round(0.005 * records[0].fs) + 1)
-    if any(rec.y.size < OWN_MASS_WINDOWS * max(int(4 * rec.y.size ** (1 / 3)), window)
-           for rec in records):
+    and Coulomb friction, a spring), from their :class:`_Pieces`, or None where they do not
+    determine it: the linear model leaves more than
+    :data:`~motionhyst.identify.io_start.LINEAR_MODEL_RESIDUAL` of the force (a link that
+    carries it), the position's white noise makes more than :data:`ACCELERATION_NOISE` of the
+    acceleration's variance (the mass then errs low), or a record is shorter than
+    :data:`OWN_MASS_WINDOWS` of its Newey-West lags."""
+    if pieces.short:
         return None
-    rows, rhs = equation_rows(records, floating=True)
-    rows = [np.column_stack([r, rec.y]) for r, rec in zip(rows, records, strict=True)]
-    x, cov = robust_least_squares(rows, rhs, window)
-    A, u = np.concatenate(rows), np.concatenate(rhs)
-    spread = float(np.linalg.norm(u - np.mean(u)))
-    if not (spread > 0 and float(np.linalg.norm(A @ x - u)) <= LINEAR_MODEL_RESIDUAL * spread):
+    x, cov, residual = pieces.fit([0, 1, 2, 3, 4])
+    spread = pieces.bb - pieces.g[3] ** 2 / pieces.n  # the force's squares about its mean
+    if not (spread > 0 and residual <= LINEAR_MODEL_RESIDUAL ** 2 * spread):
         return None
-    if not _acceleration_noise(records, A[:, 0]) <= ACCELERATION_NOISE:
+    if not pieces.acceleration_noise() <= ACCELERATION_NOISE:
         return None
     return float(x[0]), math.sqrt(max(float(cov[0, 0]), 0.0))
 
 
-def _acceleration_noise(records: list[IORecord], acc: NDArray[np.float64]) -> float:
-    """The share of the records' filtered acceleration `acc` (all records' samples, in
-    order) that their position's white noise makes (from its third differences, through
-    each record's Savitzky-Golay filter, as :func:`~motionhyst.identify.io_start.equation_rows`
-    has it); 1 at most.  A regressor's noise draws its coefficient towards zero by about
-    this share."""
-    from scipy.signal import savgol_coeffs
+MEAT_FFT = 1 << 15
+"""Points of the spectra of a block of a record's Newey-West products (:class:`_Pieces`)."""
 
-    noise = 0.0
-    for rec in records:
-        samples = min(max(7, 2 * round(0.005 * rec.fs) + 1), rec.y.size - (1 - rec.y.size % 2))
+
+class _Pieces:
+    """One record's share of the inverse-dynamics least squares that :func:`check_one_stage`
+    solves for a set of records: the normal equations of its rows ``a, v, sign(v), 1, y``
+    (acceleration, velocity, direction, offset, position; the rates as
+    :func:`~motionhyst.identify.io_start.equation_rows` filters them), its Newey-West meat
+    as a quadratic form in the coefficients, its acceleration's white noise (through the
+    filter, from the position's third differences) and whether it is long enough to judge
+    its own mass (:data:`OWN_MASS_WINDOWS`).  The sum of records' pieces is their set's: the
+    others' fit, for each record, needs no pass over their samples (refitted, the check was
+    quadratic in the number of records: 40 records of 10,000 samples, 5.1 s of CPU)."""
+
+    def __init__(self, rec: IORecord) -> None:
+        from scipy.signal import savgol_coeffs
+
+        rows, rhs = equation_rows([rec], floating=True)
+        A, b = np.column_stack([rows[0], rec.y]), np.asarray(rhs[0], dtype=np.float64)
+        n, window = b.size, max(7, 2 * round(0.005 * rec.fs) + 1)
+        self.H, self.g, self.bb, self.n = A.T @ A, A.T @ b, float(b @ b), n
+        self.G = _meat_products(A, b, min(n - 1, max(int(4 * n ** (1 / 3)), window)))
+        samples = min(window, n - (1 - n % 2))
         gain = float(np.sum(savgol_coeffs(samples, 3, deriv=2, delta=1.0 / rec.fs) ** 2))
-        noise += rec.y.size * gain * white_noise_variance(rec.y, robust=False)
-    total = float(np.sum((acc - np.mean(acc)) ** 2))
-    return min(1.0, noise / total) if total > 0 else 1.0
+        self.noise = n * gain * white_noise_variance(rec.y, robust=False)
+        self.short = n < OWN_MASS_WINDOWS * max(int(4 * n ** (1 / 3)), window)
+        y = rec.y - np.mean(rec.y)
+        yy = float(y @ y)  # the squared angular frequency -sum(y'' y) / sum(y^2) [rad^2/s^2]
+        self.w2 = float(-(A[:, 0] @ y)) / yy if yy > 0 else 0.0
+
+    def __add__(self, other: _Pieces) -> _Pieces:
+        out = object.__new__(_Pieces)
+        for name in ("H", "g", "bb", "n", "G", "noise"):
+            setattr(out, name, getattr(self, name) + getattr(other, name))
+        out.short, out.w2 = self.short or other.short, math.nan  # w2: one record's only
+        return out
+
+    def fit(self, columns: list[int]) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+        """The least-squares coefficients of `columns` (indices into ``a, v, sign(v), 1,
+        y``), their Newey-West covariance (as
+        :func:`~motionhyst.identify.io_checks.robust_least_squares` has it, each record's
+        lags its own) and the residual's sum of squares."""
+        H, g = self.H[np.ix_(columns, columns)], self.g[columns]
+        scale = np.sqrt(np.diag(H))
+        scale[scale == 0] = 1.0
+        inverse = (np.linalg.pinv(H / np.outer(scale, scale), rcond=1e-12)
+                   / np.outer(scale, scale))
+        x = inverse @ g
+        p, q = self.H.shape[0], len(columns)
+        flat = np.array([[i * (p + 1) + a for a in (0, *(c + 1 for c in columns))]
+                         for i in columns]).ravel()
+        z = np.concatenate([[1.0], -x])  # the residual b - A x is [b, A] @ z
+        meat = np.einsum("iajb,a,b->ij", self.G[np.ix_(flat, flat)].reshape(q, q + 1, q, q + 1),
+                         z, z)
+        residual = self.bb - 2.0 * float(x @ g) + float(x @ H @ x)
+        return x, inverse @ meat @ inverse, max(residual, 0.0)
+
+    def acceleration_noise(self) -> float:
+        """The share of the acceleration's variance that the position's white noise makes
+        (1 at most): a regressor's noise draws its coefficient towards zero by about it."""
+        total = float(self.H[0, 0] - self.H[0, 3] ** 2 / self.H[3, 3])
+        return min(1.0, self.noise / total) if total > 0 else 1.0
+
+
+def _leave_one_out(pieces: list[_Pieces]) -> tuple[_Pieces, list[_Pieces]]:
+    """All records' pieces, and for each record the others', from sums before and after it
+    (a difference of sums would lose a record read in other units to round-off)."""
+    before, after = [pieces[0]], [pieces[-1]]
+    for piece in pieces[1:-1]:
+        before.append(before[-1] + piece)
+    for piece in pieces[-2:0:-1]:
+        after.append(after[-1] + piece)
+    after.reverse()  # after[i]: the records from i + 1 on
+    k = len(pieces)
+    others = [after[0]] + [before[i - 1] + after[i] for i in range(1, k - 1)] + [before[-1]]
+    return before[-1] + pieces[-1], others
+
+
+def _meat_products(A: NDArray[np.float64], b: NDArray[np.float64], lags: int
+                   ) -> NDArray[np.float64]:
+    """The Newey-West sums (Bartlett weights over `lags`, as
+    :func:`~motionhyst.identify.io_checks.robust_least_squares`) of the products of the
+    columns ``A[:, i] [b, A][:, a]``: the meat of the residual ``b - A x`` is their quadratic
+    form in ``[1, -x]``, for any ``x``.  In blocks of samples, each with the `lags` after it,
+    whose spectra take at most :data:`MEAT_FFT` points (a few MB, whatever the record's
+    length)."""
+    n, p = A.shape
+    w = 1.0 - np.arange(1, lags + 1) / (lags + 1)
+    size = min(max(MEAT_FFT, 1 << (4 * lags).bit_length()), 1 << (n + 2 * lags).bit_length())
+    block = size - 2 * lags - 1  # a block and its lags convolved with the weights: no wrap
+    kernel = np.fft.rfft(np.concatenate([[0.0], w]), size)
+    # A_i b, and A_i A_j once for i <= j: 20 products of the 30 (p = 5)
+    pairs = [(i, 0) for i in range(p)] + [(i, 1 + j) for i in range(p) for j in range(i, p)]
+    first, second = (np.array(k) for k in zip(*pairs, strict=True))
+    G = np.zeros((len(pairs), len(pairs)))
+    for s in range(0, n, block):
+        e = min(n, s + block)
+        f = min(n, e + lags)
+        C = np.vstack([b[s:f], A[s:f].T])
+        D = A[s:f].T[first] * C[second]
+        head = D[:, :e - s]
+        G += head @ head.T
+        if lags > 0:  # sum over l of w_l D[t + l] D[t]^T, and its transpose
+            ahead = np.fft.irfft(np.fft.rfft(D[:, ::-1], size) * kernel, size)
+            lag = ahead[:, f - e:f - s][:, ::-1] @ head.T
+            G += lag + lag.T
+    where = {pair: k for k, pair in enumerate(pairs)}  # each of the 30 products' row
+    index = [where[(i, 0)] if a == 0 else where[(min(i, a - 1), 1 + max(i, a - 1))]
+             for i in range(p) for a in range(p + 1)]
+    return G[np.ix_(index, index)]
 
 
 def _names(rest: list[IORecord]) -> str:
