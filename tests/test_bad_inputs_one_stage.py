@@ -187,6 +187,49 @@ def test_short_records_of_the_axis_are_not_judged_by_their_own_mass(n):
         check_one_stage([stage, _heavy()], floating=True)
 
 
+def _in_units(rec: IORecord, name: str, position: float = 1.0, force: float = 1.0) -> IORecord:
+    return IORecord(rec.t, force * rec.u, position * rec.y, name)
+
+
+def test_a_record_in_mm_beside_one_in_m_is_named_a_unit_slip(tmp_path):
+    """The same 2 kg axis logged once in m and once in mm: main refused them as "stages of
+    different masses" (1.99 kg against 0.00195 kg; review A13b M3), which leads the user to
+    identify a 2 g stage from the record in mm; the refusal names that record, its column,
+    the factor and the --scale that undoes it."""
+    stage = _axis(n=4000, noise=1e-6, name="stage.csv")
+    in_mm = _in_units(_axis(n=4000, noise=1e-6, seed=5), "stage_mm.csv", position=1e3)
+    for records in ([stage, in_mm], [in_mm, stage]):
+        line = _refusal(tmp_path / records[0].name, records, "--plant", "mass-damper")
+        assert line.startswith("motionhyst: error: stage_mm.csv: its position reads 100"), line
+        assert " times stage.csv's (a range of 76." in line and "against 0.076" in line, line
+        assert "is stage_mm.csv's position in mm?" in line, line
+        assert "--scale displacement=0.001" in line and "different masses" not in line, line
+        ratio = float(line.split("reads ")[1].split(" times")[0])
+        assert abs(ratio / 1000.0 - 1.0) < 0.02, ratio
+
+
+@pytest.mark.parametrize(("position", "force", "named"), [
+    (1e6, 1.0, "is odd's position in um? --scale scales every record alike: write odd in m, "
+               "or identify it alone with --scale displacement=1e-6"),
+    (1.0, 1e3, "is odd's force in mN, or the other records' in kN? --scale scales every "
+               "record alike: write the records in N"),
+    (1e-3, 1.0, "are the other records' positions in mm? --scale scales every record alike: "
+                "write the records in m")], ids=["um", "mN", "others-in-mm"])
+def test_the_unit_slip_is_named_among_several_records(position, force, named):
+    """One record of three in other units than the two others (the axis's records of 3000
+    and 4000 samples): the odd one is named with the unit that explains both its readings
+    and its mass; records of two stages (2 and 20 kg, forces ten times apart) are still
+    "of different masses"."""
+    records = [_axis(n=3000, noise=1e-6, name="a"), _axis(n=4000, noise=1e-6, seed=3, name="b"),
+               _in_units(_axis(n=4000, noise=1e-6, seed=4), "odd", position, force)]
+    for order in (records, records[::-1]):
+        with pytest.raises(ValueError) as exc:
+            check_one_stage(order, floating=True)
+        assert str(exc.value).startswith("odd: its ") and str(exc.value).endswith(named), exc
+    with pytest.raises(ValueError, match="records of stages of different masses"):
+        check_one_stage([records[0], records[1], _heavy()], floating=True)
+
+
 def test_the_others_mass_is_their_own_fit():
     """Each record is compared with the fit of all the others, summed from each record's
     pieces, not refitted for each record: the figures of the refusal are those of the

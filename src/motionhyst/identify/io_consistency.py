@@ -20,8 +20,8 @@ from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
 from motionhyst.identify.io_uncertainty import white_noise_variance
 
-__all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "SI_READINGS", "check_one_stage",
-           "mass_units_note"]
+__all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "SI_READINGS", "UNIT_FACTORS",
+           "UNIT_READINGS", "check_one_stage", "mass_units_note"]
 
 ONE_STAGE_SIGMAS = 5.0
 """A record whose mass lies more than this many robust standard errors from the other records'
@@ -75,8 +75,10 @@ def check_one_stage(records: list[IORecord], floating: bool, single_mass: bool =
     :data:`ONE_STAGE_SIGMAS` standard errors and by more than the factor
     :data:`ONE_STAGE_RATIO`, each mass in a model that takes any stage's force and only
     where the record determines it (records of a 2 kg and a 20 kg stage: a joint mass of
-    10.7 kg).  Their joint fit would search for minutes a stage that is neither (a stage's
-    record and a link's: over 120 s, to the work budget).
+    10.7 kg); where the masses and one column's readings differ by a factor of
+    :data:`UNIT_FACTORS`, the line names that record's unit instead (a record in mm beside
+    one in m: 0.00195 kg against 1.99 kg).  Their joint fit would search for minutes a stage
+    that is neither (a stage's record and a link's: over 120 s, to the work budget).
 
     Parameters
     ----------
@@ -162,6 +164,9 @@ def _check_one_stage(records: list[IORecord], floating: bool, single_mass: bool)
         (m, std), (m_rest, std_rest) = judged[i], together
         if (m > 0 and m_rest > 0 and max(m / m_rest, m_rest / m) > ONE_STAGE_RATIO
                 and abs(m - m_rest) > ONE_STAGE_SIGMAS * math.hypot(std, std_rest)):
+            slip = _unit_slip(rec, rest, judged[i], together)
+            if slip is not None:
+                raise ValueError(slip)
             joint = float(total.fit(columns)[0][0])
             raise ValueError(f"{rec.name}: an inverse-dynamics mass of {m:.3g} +- {std:.2g} "
                              f"kg, while {_names(rest)} {m_rest:.3g} +- {std_rest:.2g} kg: "
@@ -300,6 +305,64 @@ def _meat_products(A: NDArray[np.float64], b: NDArray[np.float64], lags: int
     index = [where[(i, 0)] if a == 0 else where[(min(i, a - 1), 1 + max(i, a - 1))]
              for i in range(p) for a in range(p + 1)]
     return G[np.ix_(index, index)]
+
+
+UNIT_READINGS = 30.0
+"""Records of one stage read positions and forces within this factor of each other (their
+amplitudes); a reading :data:`UNIT_FACTORS` times another's, beside a mass off by the same
+factor, points to a unit (:func:`check_one_stage`)."""
+
+UNIT_FACTORS = ((1e3, "position", "mm", "displacement=0.001", "m"),
+                (1e6, "position", "um", "displacement=1e-6", "m"),
+                (1e3, "force", "mN", "force=0.001", "N"))
+"""The unit slips :func:`check_one_stage` names between records: a factor of readings, the
+column, the unit that reads it, the --scale that undoes it, the SI unit.  A position read
+``F`` times too large makes the mass ``F`` times too small, a force ``F`` times too large
+(in mN, or the other record's in kN) the mass ``F`` times too large."""
+
+
+def _unit_slip(rec: IORecord, rest: list[IORecord], mass: tuple[float, float],
+               mass_rest: tuple[float, float]) -> str | None:
+    """One line naming a unit slip between `rec` and the other records `rest` (their masses
+    and standard errors), or None: the masses differ by a factor of :data:`UNIT_FACTORS`
+    (within :data:`ONE_STAGE_RATIO`) and one column's readings by that factor too (within
+    :data:`UNIT_READINGS`)."""
+    readings = {"position": lambda r: float(np.ptp(r.y)),
+                "force": lambda r: float(np.max(np.abs(r.u - np.mean(r.u))))}
+    (m, std), (m_rest, std_rest) = mass, mass_rest
+    for factor, column, unit, scale, si in UNIT_FACTORS:
+        own = readings[column](rec)
+        other = max(readings[column](r) for r in rest)
+        if not (own > 0 and other > 0):
+            continue
+        ratio = own / other
+        d = 1.0 if ratio > 1.0 else -1.0  # rec reads the larger numbers, or the others do
+        if not (abs(math.log10(ratio ** d / factor)) <= math.log10(UNIT_READINGS)
+                and abs(math.log10((m / m_rest) ** (d if column == "force" else -d) / factor))
+                <= math.log10(ONE_STAGE_RATIO)):
+            continue
+        if d < 0 and len(rest) == 1:  # named from the record that reads the larger numbers
+            return _unit_slip(rest[0], [rec], mass_rest, mass)
+        whose = f"{rest[0].name}'s" if len(rest) == 1 else "the other records'"
+        what = "range" if column == "position" else "peak"
+        times = f"{_factor(ratio)} times" if ratio > 1.0 else f"1/{_factor(1.0 / ratio)} of"
+        line = (f"{rec.name}: its {column} reads {times} {whose} (a {what} of {own:.3g} {si} "
+                f"against {other:.3g} {si}) and its inverse-dynamics mass is {m:.3g} +- "
+                f"{std:.2g} kg against {m_rest:.3g} +- {std_rest:.2g} kg: ")
+        if d < 0 and len(rest) > 1:  # the others read the larger numbers
+            kn = f", or {rec.name}'s in kN" if column == "force" else ""
+            return (f"{line}are the other records' {column}s in {unit}{kn}? --scale scales "
+                    f"every record alike: write the records in {si}")
+        if column == "force":  # mN here or kN there: both read as a stage's force may
+            return (f"{line}is {rec.name}'s force in mN, or {whose} in kN? --scale scales "
+                    f"every record alike: write the records in N")
+        return (f"{line}is {rec.name}'s {column} in {unit}? --scale scales every record "
+                f"alike: write {rec.name} in {si}, or identify it alone with --scale {scale}")
+    return None
+
+
+def _factor(x: float) -> str:
+    return f"{x:.0f}" if x < 1e4 else f"{x:.2g}"
 
 
 def _names(rest: list[IORecord]) -> str:
