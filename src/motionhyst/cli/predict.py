@@ -234,27 +234,37 @@ def _centred(u, ok, line: bool):
 
 LOADED_START = 0.05
 """A model without inertia whose force record starts farther than this share of the force's
-range from the model's rest (0 N with its offset) starts under a load whose link state is not
-known: the later half of a piezo's record, predicted from its link relaxed at its first
-sample, scored 0.5 % (from the whole record's history: 98.9 %)."""
+range from the model's rest (``-f0``, its force offset) starts under a load whose link state
+is not known: the later half of a piezo's record, predicted from its link relaxed at its
+first sample, scored 0.5 % (from the whole record's history: 98.9 %)."""
+
+LOADED_START_SAMPLES = 10
+"""The first samples of a force record whose median is where it starts
+(:data:`LOADED_START`): one sample's noise or spike does not decide."""
 
 
 def _warn_loaded_start(args: argparse.Namespace, system, u) -> None:
     """Warn when a model without inertia is run from a force record that starts under load
-    (:data:`LOADED_START`): its link starts relaxed there, as at rest, which a record cut
-    from a longer run does not."""
+    (:data:`LOADED_START`, from the median of its first :data:`LOADED_START_SAMPLES`): its
+    link starts relaxed there, where the force balances the model's offset alone, which a
+    record cut from a longer run does not."""
     from motionhyst.core.warnings import warn
 
     if system.plant.has_inertia or system.hysteresis is None or args.periodic:
         return  # a periodic steady state has no start
-    load = float(u[0]) + float(getattr(system.plant, "force_offset", 0.0))
+    start = float(np.median(u[:LOADED_START_SAMPLES]))
+    offset = float(getattr(system.plant, "force_offset", 0.0))
+    rest = -offset if offset else 0.0  # u + f0 = w(y) + k y + c y': at rest u = -f0
     span = float(np.ptp(u))
-    if span > 0 and abs(load) > LOADED_START * span:
-        warn(f"{args.data} starts under a load of {load:.4g} N ({100 * abs(load) / span:.0f} % "
-             f"of its force's range) where the model rests at 0 N: a model without inertia "
+    if span > 0 and abs(start - rest) > LOADED_START * span:
+        share = f"{100 * abs(start - rest) / span:.0f} % of its force's range"
+        where = (f", {abs(start - rest):.4g} N ({share}) from where the model rests ({rest:.4g} "
+                 f"N, its force offset)" if offset else f" ({share} from where the model rests, "
+                 f"0 N)")
+        warn(f"{args.data} starts under load, at {start:.4g} N{where}: a model without inertia "
              f"starts its link relaxed, not where on its loops the part of a longer run "
-             f"begins, and may miss by the loops' width; predict the record from its start "
-             f"(or a record that starts at rest)")
+             f"begins, and may miss by the loops' width; predict the record from its start (or "
+             f"a record that starts at rest)")
 
 
 def _check_step(system, t, args) -> None:

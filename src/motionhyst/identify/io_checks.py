@@ -56,10 +56,12 @@ INERTIA_SHARE = 1e-3
 #: model with a sensor's quantisation, resonance above the band, gain nonlinearity of 0.5 % and
 #: a little creep leaves 0.3 to 0.9 %
 SYSTEMATIC_SHARE = 0.02
-#: ... and one above this share is a warning: on another record of the machine it explains a
-#: few times less (measured on generated dampers and piezos: 1.8 to 1.9 % on sines gave
-#: held-out fits of 92 to 93 % on earthquake-like histories and other sines; the right model
-#: left 0.8 % and predicted them at 96.7 to 99.5 %)
+#: ... and one above this share is a warning, on a link's force or a stage's position: on
+#: another record of the machine its error may be a few times larger (measured on generated
+#: dampers and piezos: a Dahl link on a damper's forces, 1.5 to 1.9 % on sines, predicted
+#: earthquake-like histories at 92.3 to 94.8 %; a Bouc-Wen link on a piezo's positions, 1.8 %,
+#: other records at 93 to 98 %; the right models left 0 to 0.8 % and predicted them at 98.5
+#: to 99.9 %)
 SYSTEMATIC_WARN_SHARE = 0.0125
 
 

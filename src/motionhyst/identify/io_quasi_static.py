@@ -638,8 +638,8 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     if share > SYSTEMATIC_WARN_SHARE:
         warnings.append(f"the model leaves a systematic error of {100 * share:.2g} % of the "
                         f"{what}'s RMS beyond the noise (above {100 * SYSTEMATIC_WARN_SHARE:g} "
-                        f"%): on another record of this machine it may explain a few times "
-                        f"less (a fit below 95 %); another --model may describe them better "
+                        f"%): on another record of this machine its error may be a few times "
+                        f"larger (a fit below 95 %); another --model may describe them better "
                         f"(the loops' shape, a rate or speed dependence)")
     extra = {"offsets": {"input": float(v[2 + prob.n_link]),
                          "output": [float(x) for x in prob.output_offsets(v)]},
