@@ -419,3 +419,38 @@ def test_a_closed_loop_record_that_is_no_link_s_is_refused_before_the_loop_is_bu
                           text=True, timeout=600, check=False)
     assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr
     assert proc.stderr.count("\n") == 1 and words in proc.stderr, proc.stderr
+
+
+def _damper(force_sign: float = 1.0, noise_only: bool = False) -> str:
+    """A force-displacement record of 6000 samples at 1 kHz: a Jenkins element with a spring
+    under a sine, its force reversed by `force_sign`, or white noise for a force."""
+    from motionhyst.hysteresis import Jenkins
+
+    t = np.arange(6000) / 1000.0
+    x = 1e-3 * np.sin(2 * np.pi * 2.0 * t) * (0.6 + 0.4 * np.cos(2 * np.pi * 0.1 * t))
+    w = (np.random.default_rng(5).standard_normal(t.size) if noise_only
+         else force_sign * (Jenkins(k=40.0, fc=0.01).response(x) + 10.0 * x))
+    return _csv({"time": t, "displacement": x, "force": w})
+
+
+@pytest.mark.parametrize(("force_sign", "noise_only", "words"), [
+    (-1.0, False, "rev.csv: no hysteresis found: the force falls as the displacement rises (is "
+                  "one sensor's sign reversed? --scale force=-1)"),
+    (1.0, True, "rev.csv: no hysteresis in the record: its force does not follow the "
+                "displacement (a spring, a damper and a friction force explain ")],
+    ids=["load-cell-reversed", "force-of-white-noise"])
+def test_a_force_that_does_not_follow_the_displacement_is_refused_before_the_mass_check(
+        tmp_path, force_sign, noise_only, words):
+    """A force-displacement record with its load cell reversed, or whose force is white
+    noise: refused after the mass check's stop operators (numba) and the fit's first stage
+    (scipy), 1.3-1.6 s of CPU (review of issue 26); now from a least squares of the force on
+    a spring, a damper and a friction force, before either loads.  The record itself
+    (``--scale force=-1``) is identified."""
+    (tmp_path / "rev.csv").write_text(_damper(force_sign, noise_only))
+    out = _probe(["identify", "rev.csv"], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert out["err"].startswith(f"motionhyst: error: {words}"), out["err"]
+    assert "numba" not in out["heavy"] and "scipy" not in out["heavy"], out["heavy"]
+    if not noise_only:
+        fixed = _probe(["identify", "rev.csv", "--scale", "force=-1"], tmp_path)
+        assert fixed["rc"] == 0, fixed["err"]

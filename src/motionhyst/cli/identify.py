@@ -201,6 +201,12 @@ def run(args: argparse.Namespace) -> int:
 
         x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
         extra["displacement_noise"] = noise.to_dict()
+        from motionhyst.identify.records import check_force_follows
+
+        try:  # a force that is noise, or of a sensor reversed: before the mass check and fit
+            check_force_follows(x, w, t)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
     else:
         from motionhyst.identify.fd_memory import check_closed_loop_memory
 

@@ -3,6 +3,8 @@ that they can be identified from (length, finite values, increasing time, revers
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -10,8 +12,8 @@ from motionhyst.core.blas import few_blas_threads
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
-__all__ = ["ELASTIC_CURVE_RATIO", "SCALE_RATIO", "check_controller_period", "check_force_scale",
-           "check_loops_open", "count_reversals",
+__all__ = ["ELASTIC_CURVE_RATIO", "FOLLOW_GAIN", "SCALE_RATIO", "check_controller_period",
+           "check_force_follows", "check_force_scale", "check_loops_open", "count_reversals",
            "load_closed_loop_csv", "load_force_displacement_csv", "prefilter_cutoff"]
 
 MIN_SAMPLES = 50
@@ -146,6 +148,69 @@ ELASTIC_CURVE_DEGREE = 15
 #: :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` (below, a spring's record: the fit
 #: decides, and its own check refuses it)
 DAMPER_LINE_SHARE = 0.25
+
+
+FOLLOW_GAIN = 25.0
+"""A force-displacement record's force follows its displacement (:func:`check_force_follows`)
+where a spring, a damper and a friction force explain more than this many times its white
+noise's variance: white noise explains about 3 of them; a link the fit keeps explains at
+least :data:`~motionhyst.identify.io_checks.NO_HYSTERESIS_GAIN` beyond a spring, most of it
+through those three."""
+
+
+def check_force_follows(x: ArrayLike, w: ArrayLike, t: ArrayLike) -> None:
+    """Refuse, before any fit, a force-displacement record whose force does not follow its
+    displacement: it falls as the displacement rises (their correlation below -0.5: a
+    sensor's sign reversed, which no link of positive stiffness describes; the fit's first
+    stage refused it after the mass check, 1.4 s of CPU for 60000 samples), or a spring
+    ``x``, a damper ``x'`` and a friction force ``sign(x')`` explain at most
+    :data:`FOLLOW_GAIN` times the variance of the force's white noise (the residual's
+    differences, as :func:`~motionhyst.identify.io_checks.hysteresis_gain` has it): noise,
+    which no link's force is (the fit refused it as "no hysteresis" after its work, 1.3 s).
+
+    Parameters
+    ----------
+    x, w, t : array_like
+        The record's displacement (as the fit takes it), force and time.
+
+    Raises
+    ------
+    ValueError
+        One line: what the force does, and what would help.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(3000) / 1000.0
+    >>> x = 1e-3 * np.sin(2 * np.pi * 2.0 * t)
+    >>> check_force_follows(x, 20.0 * x + 0.01 * np.sign(np.cos(2 * np.pi * 2.0 * t)), t)
+    >>> try:
+    ...     check_force_follows(x, np.random.default_rng(0).standard_normal(t.size), t)
+    ... except ValueError as exc:
+    ...     print(str(exc)[:68])
+    no hysteresis in the record: its force does not follow the displacem
+    """
+    x, w, t = (np.asarray(a, dtype=float) for a in (x, w, t))
+    x0, w0 = x - np.mean(x), w - np.mean(w)
+    xx, ww = float(x0 @ x0), float(w0 @ w0)
+    if x.size < 8 or not (xx > 0 and ww > 0):
+        return
+    if float(x0 @ w0) < -0.5 * math.sqrt(xx * ww):
+        raise ValueError("no hysteresis found: the force falls as the displacement rises (is "
+                         "one sensor's sign reversed? --scale force=-1)")
+    v = np.gradient(x, t)
+    basis = np.column_stack([np.ones_like(x), x0, v, np.sign(v)])
+    with few_blas_threads(*basis.shape):
+        coef = np.linalg.lstsq(basis, w, rcond=None)[0]
+    r = w - basis @ coef
+    noise = float(np.mean(np.diff(r) ** 2)) / 2.0
+    gain = (ww - float(r @ r)) / noise if noise > 0 else math.inf
+    if gain <= FOLLOW_GAIN:
+        raise ValueError(f"no hysteresis in the record: its force does not follow the "
+                         f"displacement (a spring, a damper and a friction force explain "
+                         f"{max(gain, 0.0):.2g} times its white noise's variance, at most "
+                         f"{FOLLOW_GAIN:g}): it is noise, or the link is not loaded; nothing "
+                         f"identified (a record whose displacement loads the link may be)")
 
 
 def check_loops_open(x: ArrayLike, w: ArrayLike, t: ArrayLike | None = None) -> None:
