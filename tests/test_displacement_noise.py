@@ -22,7 +22,8 @@ from motionhyst.cli import main
 from motionhyst.hysteresis import BoucWen, Dahl, Jenkins, MaxwellSlip
 from motionhyst.identify.displacement_noise import difference_scales, estimate_displacement
 from motionhyst.identify.io_checks import systematic_share
-from motionhyst.identify.io_quasi_static import identify_link_force, identify_quasi_static_io
+from motionhyst.identify.io_link_force import identify_link_force
+from motionhyst.identify.io_quasi_static import identify_quasi_static_io
 from motionhyst.identify.io_records import IORecord
 from motionhyst.plants import QuasiStatic
 from motionhyst.time.quasi_static import force_from_displacement

@@ -4,7 +4,7 @@ stiffness, exponents 1 to 3 and the link's shapes.
 A damper of a Bouc-Wen link and a spring, its displacement imposed by sines (0.2 to 2 Hz, 3 to
 20 mm), its force measured with a load cell's offset and noise
 (:mod:`records_of_other_kinds`); identified by the force's error
-(:func:`~motionhyst.identify.io_quasi_static.identify_link_force`), the model must give the
+(:func:`~motionhyst.identify.io_link_force.identify_link_force`), the model must give the
 link's parameters back and predict the force of an earthquake-like history it did not see.  A
 stiff link (its slip displacement a small share of the stroke) was refused with its own class
 (a search that started soft and stalled at ``beta = gamma``), and a link of exponent 2 or 3 was
@@ -20,7 +20,7 @@ import pytest
 from records_of_other_kinds import DAMPER_FORCE_OFFSET, DAMPER_PLANT, Record, fit_percent
 
 from motionhyst.hysteresis import BoucWen
-from motionhyst.identify.io_quasi_static import identify_link_force
+from motionhyst.identify.io_link_force import identify_link_force
 from motionhyst.identify.io_records import IORecord
 from motionhyst.time.quasi_static import force_from_displacement
 

@@ -204,7 +204,7 @@ def test_a_lugre_damper_s_stribeck_curve_is_found():
     to 0, a constant Coulomb force: a systematic error of 3.1 % of the force's RMS, refused,
     from the starts whose Stribeck velocity was a tenth of the record's velocity RMS)."""
     from motionhyst.hysteresis import LuGre
-    from motionhyst.identify.io_quasi_static import identify_link_force
+    from motionhyst.identify.io_link_force import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
     true = DAMPER_LINKS["lugre"]
@@ -241,7 +241,7 @@ def test_the_link_force_searches_find_neighbour_records(name, i):
     machine).  Measured on ten neighbours of each (sines, by the force's error; the CLI's
     logged files for Dahl and LuGre, the plain record for LuGre's Stribeck curve): 10/10
     each, spring within 0.6 %, fc within 0.2 %, LuGre's fs within 0.6 %, vs within 1 %."""
-    from motionhyst.identify.io_quasi_static import identify_link_force
+    from motionhyst.identify.io_link_force import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
     plant, true = _neighbour(name, i)

@@ -436,7 +436,7 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         from motionhyst.core.warnings import warn
 
         warn(mass)
-    from motionhyst.identify.io_quasi_static import identify_link_force
+    from motionhyst.identify.io_link_force import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
     names = ", ".join(str(p) for p in paths)

@@ -13,7 +13,7 @@ routes, each sized here from the record's samples alone and refused above the me
   them counts (:func:`elements_fit_memory`).
 * A link with a spring and damper in parallel fitted by the force's error (``--model``:
   Maxwell-slip, Dahl, LuGre, Bouc-Wen, ...;
-  :func:`~motionhyst.identify.io_quasi_static.identify_link_force`), and a quasi-static
+  :func:`~motionhyst.identify.io_link_force.identify_link_force`), and a quasi-static
   stage's input-output records: a least-squares search whose Jacobian of all samples x
   parameters is held :data:`~motionhyst.identify.io_start.JACOBIAN_COPIES` times, after the
   elements' fit it starts from (:func:`link_force_memory`).
@@ -251,8 +251,8 @@ has it, or shorter records
     >>> set_max_memory(None)
     """
     from motionhyst.hysteresis import BoucWen
+    from motionhyst.identify.io_bouc_wen_shape import BoucWenShape
     from motionhyst.identify.io_layout import LinkLayout
-    from motionhyst.identify.io_quasi_static import BoucWenShape
 
     layout = (BoucWenShape.of_exponent(nu) if link is BoucWen
               else LinkLayout.of(link, n_elements))  # the search's, with k, c and offsets

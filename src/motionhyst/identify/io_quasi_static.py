@@ -32,9 +32,9 @@ Method
    the slope right after each reversal gives its initial stiffness, the
    force's half-range at large stroke its saturation force
    (:func:`_saturation_starts`).  A Bouc-Wen link is searched at a fixed force
-   scale with ``beta - gamma >= 0`` a bound (:class:`BoucWenShape`); its
-   exponent, when estimated by the force's error, joins the rest from ``n = 2``
-   once the starts are refined.
+   scale with ``beta - gamma >= 0`` a bound
+   (:class:`~motionhyst.identify.io_bouc_wen_shape.BoucWenShape`); its exponent, when estimated by
+   the force's error, joins the rest from ``n = 2`` once the starts are refined.
 3. The start whose simulated position fits best continues by the simulation
    error (trust-region reflective, forward-difference Jacobian).  A result
    must predict: worse than the linear model's simulation error, or
@@ -48,44 +48,35 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from motionhyst.core.warnings import warn
-from motionhyst.hysteresis import BoucWen, Hysteresis, Jenkins, MaxwellSlip
-from motionhyst.hysteresis.registry import Parameter
-from motionhyst.identify.displacement_noise import estimate_displacement
-from motionhyst.identify.io_checks import (
-    NO_HYSTERESIS_GAIN,
-    SYSTEMATIC_SHARE,
-    SYSTEMATIC_WARN_SHARE,
-    FitFailed,
-    budget_note,
-    hysteresis_gain,
-    judge_fit,
-    systematic_share,
-)
+from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
+from motionhyst.identify.io_bouc_wen_shape import EXPONENT_START, BoucWenShape
+from motionhyst.identify.io_checks import SYSTEMATIC_WARN_SHARE, FitFailed, judge_fit
 from motionhyst.identify.io_elements import LinkLayout
+from motionhyst.identify.io_quasi_static_checks import (
+    judge_force_fit,
+    judge_hysteresis,
+    judge_systematic,
+    linear_rms,
+)
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_uncertainty import (
-    BOUC_WEN_SCALE,
     FD_SINGULAR_RTOL,
     covariance,
     covariance_table,
-    judge_determined,
     standard_errors,
     undetermined_notes,
-    zero_allowed,
 )
 from motionhyst.plants.quasi_static import QuasiStatic
 from motionhyst.time.openloop import OpenLoop
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
 
-__all__ = ["identify_link_force"]
+__all__: list[str] = []  # the search, for identify_io and io_link_force
 
 #: Starts: (the link's share of the linear stiffness, its slip displacement in units of the
 #: records' displacement RMS)
@@ -202,113 +193,11 @@ class _Problem:
                                  max_nfev=max_nfev, bounds=(lower, np.full(lower.size, np.inf)))
 
 
-#: The search's shape values of a Bouc-Wen link (:class:`BoucWenShape`)
-SHAPE_SUM = Parameter("beta+gamma", "", "beta + gamma at the force scale fc", None, "finite")
-SHAPE_DIFFERENCE = Parameter("beta-gamma", "", "beta - gamma at the force scale fc", None,
-                             "nonnegative")
-EXPONENT_EXCESS = Parameter("n-1", "", "the exponent n less 1", None, "nonnegative")
-#: Where an estimated exponent starts (``n = 2``: exact steps)
-EXPONENT_START = 2.0
-
-
-@dataclass
-class BoucWenShape(LinkLayout):
-    """A Bouc-Wen link's search layout: ``k``, ``beta + gamma`` and ``beta - gamma >= 0``
-    at a fixed force scale ``fc``, and ``n - 1 >= 0`` unless the exponent is fixed.
-
-    Only ``beta / fc^n`` and ``gamma / fc^n`` enter the link's force (eq. 2 of
-    :class:`~motionhyst.hysteresis.BoucWen`), so a search of ``fc, beta, gamma`` has a
-    direction that changes nothing, and ``beta >= gamma`` is a wall of the model's accepted
-    set on which many links lie (``beta = gamma``: unloading as stiff as the initial
-    stiffness), where a forward difference steps out of it: such a search stalls there
-    (measured: a link of 1e6 N/m fitted to 25 N RMS on 15 N of noise).  Here the fixed
-    scale removes the first, and ``beta - gamma`` is a bound of the search (stepped along,
-    not across).  :meth:`normalised` gives the result as the link is written:
-    ``beta + gamma = 1`` (``fc`` the saturation force) when it has an ultimate force.
-    """
-
-    fc: float = 1.0
-    n: float | None = 1.0
-
-    @classmethod
-    def of_exponent(cls, n: float | None) -> BoucWenShape:
-        """The layout of a Bouc-Wen link of exponent `n` (None: estimated; the force scale
-        set later)."""
-        entries = [(BoucWen.parameters[0], -1), (SHAPE_SUM, -1), (SHAPE_DIFFERENCE, -1)]
-        if n is None:
-            entries.append((EXPONENT_EXCESS, -1))
-        return cls(BoucWen, entries, {} if n is None else {"n": float(n)},
-                   n=None if n is None else float(n))
-
-    def exponent(self, v: NDArray[np.float64] | None = None) -> float:
-        """The exponent: fixed, or of the values `v` (its start without them)."""
-        if self.n is not None:
-            return self.n
-        return EXPONENT_START if v is None else 1.0 + float(v[3])
-
-    def shape(self, force: float, beta: float, gamma: float) -> NDArray[np.float64]:
-        """``beta + gamma, beta - gamma`` at this layout's scale of the link whose force
-        scale is `force` with shape `beta`, `gamma` (and ``n - 1`` at its start if
-        estimated)."""
-        r = (self.fc / force) ** self.exponent()
-        tail = [] if self.n is not None else [EXPONENT_START - 1.0]
-        return np.array([(beta + gamma) * r, (beta - gamma) * r, *tail])
-
-    def build(self, v: NDArray[np.float64]) -> Hysteresis:
-        return BoucWen(k=float(v[0]), fc=self.fc, n=self.exponent(v),
-                       beta=0.5 * float(v[1] + v[2]), gamma=0.5 * float(v[1] - v[2]))
-
-    def start(self, k_link: float, y_scale: float, v_scale: float, c: float,
-              slip: float = 1.0) -> NDArray[np.float64]:
-        """As :meth:`LinkLayout.start`: the link's force scale at ``0.5 y_scale`` times its
-        stiffness, times `slip`, ``beta = 0.6, gamma = 0.4``."""
-        return np.concatenate([[k_link], self.shape(k_link * 0.5 * y_scale * slip, 0.6, 0.4)])
-
-    def normalised(self, names: list[str], values: NDArray[np.float64],
-                   cov: NDArray[np.float64]):
-        """The estimates `values` of `names` (the search's) and their covariance `cov`, with
-        ``link.fc, link.beta, link.gamma`` (and ``link.n``) for the shape values:
-        ``beta + gamma = 1`` when it is positive (scale ``fc (beta + gamma)^(-1/n)``), else
-        at the search's scale; the covariance by the derivatives of that map.  Returns
-        names, values, covariance, the link."""
-        i, j = names.index("link.beta+gamma"), names.index("link.beta-gamma")
-        e = names.index("link.n-1") if self.n is None else None
-        ssum, diff = float(values[i]), float(values[j])
-        n = self.n if e is None else 1.0 + float(values[e])
-        if ssum > 0.0:
-            fc = self.fc * ssum ** (-1.0 / n)
-            beta, gamma = 0.5 + 0.5 * diff / ssum, 0.5 - 0.5 * diff / ssum
-            d = np.array([[-fc / (n * ssum), 0.0, fc * math.log(ssum) / n ** 2],
-                          [-0.5 * diff / ssum ** 2, 0.5 / ssum, 0.0],
-                          [0.5 * diff / ssum ** 2, -0.5 / ssum, 0.0]])
-        else:
-            fc, beta, gamma = self.fc, 0.5 * (ssum + diff), 0.5 * (ssum - diff)
-            d = np.array([[0.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, -0.5, 0.0]])
-        shape = [i, j] + ([] if e is None else [e])
-        keep = [m for m in range(len(names)) if m not in shape]
-        at = sum(m < min(shape) for m in keep)
-        new = ["link.fc", "link.beta", "link.gamma"] + ([] if e is None else ["link.n"])
-        out_names = [names[m] for m in keep]
-        out_names[at:at] = new
-        T = np.zeros((len(out_names), len(names)))
-        for row, m in enumerate(keep):
-            T[row + (len(new) if row >= at else 0), m] = 1.0
-        T[at:at + 3, shape] = d[:, :len(shape)]
-        if e is not None:
-            T[at + 3, e] = 1.0
-        out = np.zeros(len(out_names))
-        out[[r for r in range(len(out_names)) if not at <= r < at + len(new)]] = values[keep]
-        out[at:at + len(new)] = [fc, beta, gamma, n][:len(new)]
-        unknown = np.isnan(cov)  # undetermined: so is what depends on it
-        cov_out = T @ np.where(unknown, 0.0, cov) @ T.T
-        cov_out[(np.abs(T) @ unknown @ np.abs(T).T) > 0] = np.nan
-        return out_names, out, cov_out, BoucWen(k=float(values[names.index("link.k")]),
-                                                fc=fc, n=n, beta=beta, gamma=gamma)
-
 
 def _layout(link: type, n_elements: int, nu: float | None = 1.0) -> LinkLayout:
-    """The link's search layout; Bouc-Wen's (:class:`BoucWenShape`) with its exponent fixed
-    at `nu` (default 1: exact steps), or estimated with the rest (None)."""
+    """The link's search layout; Bouc-Wen's
+    (:class:`~motionhyst.identify.io_bouc_wen_shape.BoucWenShape`) with its exponent fixed at
+    `nu` (default 1: exact steps), or estimated with the rest (None)."""
     if link is BoucWen:
         return BoucWenShape.of_exponent(nu)
     return LinkLayout.of(link, n_elements)
@@ -406,22 +295,6 @@ def _linear_start(records: list[IORecord]) -> tuple[float, float, NDArray[np.flo
     return float(sol[0]), float(sol[1]), sol[2:]
 
 
-def _linear_rms(records: list[IORecord], K: float, C: float, periodic: bool) -> float | None:
-    """Simulation error of the linear model ``K, C`` with the best output offset per record
-    (the bar a model with a link must pass); None if it cannot run."""
-    try:
-        err = []
-        for rec in records:
-            x = displacement_from_force(QuasiStatic(max(K, 0.0), max(C, 0.0)), None, rec.t,
-                                        rec.u - np.mean(rec.u), periodic=periodic)
-            e = x - rec.y
-            err.append(e - np.mean(e))
-        rms = float(np.sqrt(np.mean(np.concatenate(err) ** 2)))
-    except ValueError:
-        return None
-    return rms if math.isfinite(rms) else None
-
-
 def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: bool,
                              n_elements: int, offset: str, max_evaluations: int | None,
                              tol: float, t_start: float | None = None,
@@ -453,7 +326,8 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     output : {"position", "force"}
         The error fitted: the position's simulated from the force (a force in, a position
         out), or the force's from the measured displacement (a force-displacement record:
-        the displacement imposed, the force measured, :func:`identify_link_force`).
+        the displacement imposed, the force measured,
+        :func:`~motionhyst.identify.io_link_force.identify_link_force`).
     nu : float or None
         A Bouc-Wen link's exponent ``n``: fixed at this value (default 1), or estimated
         (None: by the force's error, with the rest, from ``n = 2``; by the position's, the
@@ -685,25 +559,27 @@ def _judge(prob: _Problem, v: NDArray[np.float64], records: list[IORecord], forc
            K: float, C: float, b: NDArray[np.float64], periodic: bool, out: bool
            ) -> tuple[NDArray[np.float64], float, float]:
     """The fitted model's residuals, RMS error and systematic share
-    (:func:`_judge_systematic`); :class:`FitFailed` if they are no result
-    (:func:`_judge_force_fit`, or :func:`~motionhyst.identify.io_checks.judge_fit` and the
-    link's gain and systematic error on the positions)."""
+    (:func:`~motionhyst.identify.io_quasi_static_checks.judge_systematic`);
+    :class:`FitFailed` if they are no result
+    (:func:`~motionhyst.identify.io_quasi_static_checks.judge_force_fit`, or
+    :func:`~motionhyst.identify.io_checks.judge_fit` and the link's gain and systematic error
+    on the positions)."""
     plant, fitted = prob.model(v)
     if force_error:
         predictions = prob.forces(v)
         res = np.concatenate([f - rec.u for f, rec in zip(predictions, records, strict=True)])
         fit_rms = float(np.sqrt(np.mean(res ** 2)))
-        share = _judge_force_fit(fit_rms, res, records, predictions, K, C, b)
+        share = judge_force_fit(fit_rms, res, records, predictions, K, C, b)
     else:
         predictions = prob.positions(v)
         res = np.concatenate([y - rec.y for y, rec in zip(predictions, records, strict=True)])
         fit_rms = float(np.sqrt(np.mean(res ** 2)))
         system = OpenLoop(plant, fitted)
-        linear_rms = _linear_rms(records, K, C, periodic)
-        judge_fit(fit_rms, records, predictions, linear_rms, system, out)
-        if linear_rms is not None:
-            _judge_hysteresis(linear_rms ** 2 * res.size, res, "position", K, C)
-        share = _judge_systematic(res, [rec.y for rec in records], "position")
+        lin_rms = linear_rms(records, K, C, periodic)
+        judge_fit(fit_rms, records, predictions, lin_rms, system, out)
+        if lin_rms is not None:
+            judge_hysteresis(lin_rms ** 2 * res.size, res, "position", K, C)
+        share = judge_systematic(res, [rec.y for rec in records], "position")
     return res, fit_rms, share
 
 
@@ -753,148 +629,3 @@ def _exponent_profile(records: list[IORecord], **options) -> IOIdentification:
     best.stopping += (f"; exponent n by the fits of {nus.size} fixed values from "
                       f"{nus[0]:g} to {nus[-1]:g}")
     return best
-
-
-def _judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IORecord],
-                     forces: list[NDArray[np.float64]], K: float, C: float,
-                     b: NDArray[np.float64]) -> float:
-    """Raise :class:`FitFailed` unless the forces predicted from the displacement are a
-    result: finite, better than the force's own spread and than the linear model's
-    ``K y + C y' + b``, and describing the records to within
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of the force's RMS beyond
-    the noise (:func:`~motionhyst.identify.io_checks.systematic_share`, returned)."""
-    if not all(np.all(np.isfinite(f)) for f in forces) or not math.isfinite(fit_rms):
-        raise FitFailed("the fit failed: the identified link's force is not finite")
-    u = np.concatenate([rec.u for rec in records])
-    own = float(np.std(u))
-    if fit_rms > own:
-        raise FitFailed(f"the fit failed: its RMS error {fit_rms:.3g} N exceeds the force's "
-                        f"own spread {own:.3g} N (predicting its mean does better)")
-    linear = np.concatenate([rec.u - K * rec.y - C * np.gradient(rec.y, rec.t) - bi
-                             for rec, bi in zip(records, b, strict=True)])
-    linear_rms = float(np.sqrt(np.mean(linear ** 2)))
-    if fit_rms > linear_rms * (1.0 + 1e-9):  # as the records' own check says it
-        raise FitFailed(f"no hysteresis in the records: a spring of {K:.4g} N/m and a damper "
-                        f"of {max(C, 0.0):.4g} N s/m describe the force better than the link "
-                        f"(RMS error {linear_rms:.3g} N against its {fit_rms:.3g} N): its "
-                        f"parameters would be a guess; nothing identified")
-    _judge_hysteresis(float(np.sum(linear ** 2)), res, "force", K, C)
-    return _judge_systematic(res, [rec.u for rec in records], "force")
-
-
-def _judge_hysteresis(linear_ss: float, res: NDArray[np.float64], what: str, K: float,
-                      C: float) -> None:
-    """Raise :class:`FitFailed` if the link explains no more of the `what` than the linear
-    spring and damper ``K, C`` (sum of squares `linear_ss`), within the noise
-    (:func:`~motionhyst.identify.io_checks.hysteresis_gain` below
-    :data:`~motionhyst.identify.io_checks.NO_HYSTERESIS_GAIN`): the records show no
-    hysteresis, and the link's parameters would be a guess."""
-    gain = hysteresis_gain(linear_ss, res)
-    if gain < NO_HYSTERESIS_GAIN:
-        raise FitFailed(f"no hysteresis in the records: a spring of {K:.4g} N/m and a damper "
-                        f"of {max(C, 0.0):.4g} N s/m explain the {what} as well as the link, "
-                        f"within the noise (the link explains {max(gain, 0.0):.3g} times the "
-                        f"noise's variance more, below {NO_HYSTERESIS_GAIN:g}): its parameters "
-                        f"would be a guess; nothing identified")
-
-
-def _judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float64]],
-                      what: str) -> float:
-    """The largest systematic share of the residuals `res` (the records one after the
-    other) over the records; raise :class:`FitFailed` if it is above
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of a record's `measured`
-    signal (:func:`~motionhyst.identify.io_checks.systematic_share`): a model that does
-    not describe its records (a piezo's creep, a rate dependence the link lacks) does not
-    predict another one."""
-    parts = np.split(res, np.cumsum([m.size for m in measured])[:-1])
-    share = max(systematic_share(r, m) for r, m in zip(parts, measured, strict=True))
-    if share > SYSTEMATIC_SHARE:
-        raise FitFailed(f"the fit failed: the model leaves a systematic error of "
-                        f"{100 * share:.2g} % of the {what}'s RMS (above "
-                        f"{100 * SYSTEMATIC_SHARE:g} %, beyond the noise): it does not describe "
-                        f"these records (a creep, a rate dependence or a link another --model "
-                        f"describes) and would not predict another one")
-    return share
-
-
-def identify_link_force(records: list[IORecord], link: type, *, n_elements: int = 3,
-                        offset: str = "auto", max_evaluations: int | None = None,
-                        tol: float = 1e-10, nu: float | None = None) -> IOIdentification:
-    """A link with a spring and damper in parallel from force-displacement records, by the
-    force's error.
-
-    A friction damper or a link on a test machine: the displacement imposed (``y``),
-    the force measured (``u``).  The model is the quasi-static plant's balance
-    ``u - u_0 = w(y) + k y + c y'`` evaluated on the measured displacement
-    (:func:`~motionhyst.time.quasi_static.force_from_displacement`, one pass of the
-    link) and fitted to the measured force, from the starts of
-    :func:`identify_quasi_static_io`; offset ``auto`` is the force's (the load cell's
-    zero; a displacement offset is a constant force through the spring).  A fit that does
-    not describe the records (a systematic error above
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of the force's RMS beyond
-    the noise) is a failure, not a model.
-
-    Parameters
-    ----------
-    records : list of IORecord
-        ``u`` the measured force [N], ``y`` the imposed displacement [m].
-    link : type
-        The link's model, a registered :class:`~motionhyst.hysteresis.Hysteresis` class.
-    n_elements : int
-        Elements of a list model (Maxwell-slip).
-    offset : {"auto", "none", "input", "output", "both"}
-        Offsets estimated (``input``: the force's, ``output``: the displacement's).
-    max_evaluations : int, optional
-        The budget of model evaluations.
-    tol : float
-        ``ftol = xtol = gtol`` of the refinement.
-    nu : float, optional
-        A Bouc-Wen link's exponent ``n``, fixed; None (default): estimated with the rest
-        (from ``n = 2``, once the starts are refined there).
-
-    Returns
-    -------
-    IOIdentification
-        With ``output = "force"``: the fit RMS and residuals in newtons.
-
-    Raises
-    ------
-    FitFailed
-        A fit that is no result, or of whose parameters the records determine at most half
-        (:func:`~motionhyst.identify.io_uncertainty.judge_determined`; fewer not determined
-        are one of the result's ``warnings``).
-
-    Examples
-    --------
-    A Dahl link and a spring measured with a load cell's offset of 5 N:
-
-    >>> import numpy as np
-    >>> from motionhyst.hysteresis import Dahl
-    >>> from motionhyst.time.quasi_static import force_from_displacement
-    >>> t = np.arange(4000) / 200.0
-    >>> x = 0.01 * np.sin(2 * np.pi * 0.5 * t) * np.minimum(1.0, t / 4)
-    >>> u = force_from_displacement(QuasiStatic(k=2e4), Dahl(k=5e5, fc=800.0), t, x) + 5.0
-    >>> fit = identify_link_force([IORecord(t, u, x)], Dahl)
-    >>> est = fit.estimates
-    >>> round(est["k"]), round(est["link.k"]), round(est["link.fc"], 3), round(est["c"], 6)
-    (20000, 500000, 800.0, 0.0)
-    >>> round(est["input_offset"], 6), fit.output
-    (5.0, 'force')
-    """
-    noise = [estimate_displacement(rec.t, rec.y) for rec in records]
-    used = [rec if x is rec.y else IORecord(rec.t, rec.u, x, rec.name)
-            for rec, (x, _) in zip(records, noise, strict=True)]
-    fit = identify_quasi_static_io(used, link, periodic=False, n_elements=n_elements,
-                                   offset=offset, max_evaluations=max_evaluations, tol=tol,
-                                   output="force", nu=nu)
-    fit.extra["displacement_noise"] = [est.to_dict() for _, est in noise]
-    if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
-        fit.warnings.append(budget_note(fit.n_evaluations))
-    # parameters the records do not determine: a warning, or (most of them) a failed fit
-    fit.warnings.extend(judge_determined(fit.estimates, fit.std,
-                                         BOUC_WEN_SCALE if link is BoucWen else (),
-                                         zero_allowed(fit.plant, link)))
-    for line in fit.warnings:  # for every caller to see, as identify_io's
-        warn(line)
-    return fit
-
