@@ -34,6 +34,13 @@ def add_parser(sub) -> None:
                    "m]; uniform time steps (stamps within 0.05 of a step of a uniform grid); "
                    "CSV with a header or MATLAB .mat")
     add_record_options(q, "time,force or time,displacement", "time=t,force=vir")
+    q.add_argument("--predict", choices=["displacement", "force"],
+                   help="what to predict from INPUT, where it holds both a force and a "
+                        "displacement (a quasi-static model only: the force from the "
+                        "displacement, or the displacement from the force; default: what the "
+                        "record the model was identified from measured, its [identification] "
+                        "record: a force-displacement record's force, an input-output "
+                        "record's position; a model with inertia predicts the displacement)")
     q.add_argument("--periodic", action="store_true",
                    help="the record is one period (or whole periods) of a periodic force: "
                         "output the periodic steady state (default: from rest; a floating "
@@ -93,12 +100,13 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst predict: --substeps sets the integration steps of a "
                          f"model with inertia; {sc.source} is quasi-static (its balance is "
                          f"solved at each sample, with no steps between)")
-    if _input_quantity(args, system) == "displacement":
+    if _input_quantity(args, sc, system) == "displacement":
         return _predict_force(args, sc, system, target)
-    both = args.init_from is not None  # the maps also name the --init-from record's position
+    # the maps may also name the position (the --init-from record's, or INPUT's measured one,
+    # as the map given to identify): only time and force are read from INPUT
     data = read_record(args.data, ("time", "force"),
-                       columns=_only(args.columns) if both else args.columns,
-                       scale=_only(args.scale) if both else args.scale)
+                       columns=_without(args.columns, "displacement"),
+                       scale=_without(args.scale, "displacement"))
     t, u = data[:, 0], data[:, 1]
     target.check_csv_size(t.size, 2, "%.17g", remedy=SHORTER)
     if args.periodic:
@@ -130,6 +138,7 @@ def run(args: argparse.Namespace) -> int:
     _warn_loaded_start(args, system, u)  # a prediction made: a refusal stays one line
     target.write_csv({"time": out_t, "displacement": out_y}, fmt="%.17g")
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
+               "predicted": "displacement",
                "displacement_rms": float(np.sqrt(np.mean(out_y ** 2))),
                "displacement_peak": float(np.max(np.abs(out_y)))}
     if pred is not None:
@@ -139,7 +148,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         what = ("periodic steady state" if args.periodic else "from rest" if pred is None
                 else f"state set from the first {window} samples of {args.init_from}")
-        print(f"Predicted {t.size} samples of {sc.source} ({what}) for {args.data} -> {args.out}")
+        print(f"Predicted the displacement of {sc.source} ({what}) for the {t.size} force "
+              f"samples of {args.data} -> {args.out}")
         print(f"  displacement RMS {summary['displacement_rms']:.4g} m, peak "
               f"{summary['displacement_peak']:.4g} m")
         if pred is not None:
@@ -151,10 +161,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _only(mapping, keys=("time", "force")):
-    """The entries of a --columns or --scale map that the force record has (the rest, such
-    as displacement=, are for the --init-from record)."""
-    return None if mapping is None else {k: v for k, v in mapping.items() if k in keys}
+def _without(mapping, quantity: str):
+    """A --columns or --scale map without its entry for `quantity`, the one INPUT is not read
+    for (the position of a force record: the --init-from record's, or INPUT's measured
+    position, as the map a user gave identify names it); other names are the reader's to
+    judge."""
+    return None if mapping is None else {k: v for k, v in mapping.items() if k != quantity}
 
 
 SAME_RUN_CORRELATION = 0.5
@@ -291,21 +303,43 @@ def _check_step(system, t, args) -> None:
                          f"link (a quasi-static plant describes a stage without inertia)")
 
 
-def _input_quantity(args: argparse.Namespace, system) -> str:
-    """``force`` or ``displacement``: what INPUT holds for the model (a model with inertia, or
-    a record with a force, takes the force; only a model without inertia gives the force of
-    a displacement record)."""
+def _input_quantity(args: argparse.Namespace, sc, system) -> str:
+    """``force`` or ``displacement``: what INPUT gives the model.  A model with inertia takes
+    the force; one without inertia the quantity INPUT holds alone, or, where it holds both,
+    the one ``--predict`` does not name, or else the one the model's own record imposed
+    (``[identification] record``: a force-displacement record's displacement, an
+    input-output record's force); a record with both and a model that does not say is
+    refused, not guessed."""
     from motionhyst.io.records import record_columns
 
     if system.plant.has_inertia:
+        if args.predict == "force":
+            raise UsageError(f"motionhyst predict: --predict force gives the force of a model "
+                             f"without inertia for a displacement record; {sc.source} has "
+                             f"inertia (its displacement is predicted from a force)")
         return "force"  # a record without one is refused by its reader, naming the columns
     names = record_columns(args.data, args.columns)
-    if "force" in names or "displacement" not in names:
-        return "force"
     if args.init_from is not None:
-        raise UsageError(f"motionhyst predict: --init-from applies to a force record (the "
-                         f"displacement predicted); {args.data} holds a displacement")
-    return "displacement"
+        if args.predict == "force":
+            raise UsageError("motionhyst predict: --init-from sets the state of a displacement "
+                             "predicted from a force; --predict force predicts no "
+                             "displacement")
+        if "force" not in names and "displacement" in names:
+            raise UsageError(f"motionhyst predict: --init-from applies to a force record (the "
+                             f"displacement predicted); {args.data} holds a displacement")
+        return "force"
+    if args.predict is not None:
+        return "force" if args.predict == "displacement" else "displacement"
+    if "force" not in names or "displacement" not in names:
+        return "displacement" if "displacement" in names else "force"
+    ident = sc.model.identification
+    record = None if ident is None else ident.record
+    if record is None:
+        raise UsageError(f"motionhyst predict: {args.data} holds a force and a displacement, "
+                         f"and {sc.source} does not say which it was identified to predict: "
+                         f"give --predict force (from the displacement) or --predict "
+                         f"displacement (from the force)")
+    return "displacement" if record == "force-displacement" else "force"
 
 
 def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
@@ -314,8 +348,10 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     from motionhyst.time.quasi_static import force_from_displacement
     from motionhyst.time.resample import check_whole_periods
 
-    data = read_record(args.data, ("time", "displacement"), columns=args.columns,
-                       scale=args.scale)
+    # the maps may name the force too (as the map a user gave identify)
+    data = read_record(args.data, ("time", "displacement"),
+                       columns=_without(args.columns, "force"),
+                       scale=_without(args.scale, "force"))
     t, x = data[:, 0], data[:, 1]
     target.check_csv_size(t.size, 2, "%.17g", remedy=SHORTER)
     if args.periodic:

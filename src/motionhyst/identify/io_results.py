@@ -213,7 +213,9 @@ class IOIdentification:
                    if link.get("model") == "bouc-wen" else {}),
                 **{f"link.{n}[{i}]": f"hysteresis.{n}[{i}]" for n, v in link.items()
                    if isinstance(v, list) for i in range(len(v))}}
-        ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys)
+        ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys,
+                                    "force-displacement" if self.output == "force"
+                                    else "input-output")
         return text + ("\n" + ident if ident else "")
 
 

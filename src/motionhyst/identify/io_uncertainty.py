@@ -379,10 +379,12 @@ def covariance_table(names: list[str], cov: NDArray[np.float64],
             "matrix": [[float(cov[i, j]) for j in keep] for i in keep]}
 
 
-def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str, str]) -> str:
-    """The ``[identification]`` table of a saved identification (TOML): the parameters of
-    the covariance `table` (:func:`covariance_table`) that `keys` maps to scenario keys, under
-    those keys, with their `estimates`, standard errors and correlations; empty if none.
+def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str, str],
+                        record: str | None = None) -> str:
+    """The ``[identification]`` table of a saved identification (TOML): the kind of `record`
+    it was identified from (what ``predict`` predicts), the parameters of the covariance
+    `table` (:func:`covariance_table`) that `keys` maps to scenario keys, under those keys,
+    with their `estimates`, standard errors and correlations; empty if none.
 
     Standard errors and correlations rather than covariances: each is a number of the size
     of a parameter or within [-1, 1], whatever the units (a covariance of 1e-40 would be
@@ -403,7 +405,8 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
     return ("# the estimates' standard errors and correlations (from the fit's Jacobian) for a "
             "Monte-Carlo\n# study: motionhyst study STUDY.toml --from-identification "
             "THIS_FILE\n[identification]\n"
-            f"parameters = [{', '.join(json.dumps(keys[n]) for n in names)}]\n"
+            + ("" if record is None else f"record = {json.dumps(record)}\n")
+            + f"parameters = [{', '.join(json.dumps(keys[n]) for n in names)}]\n"
             f"estimates = [{', '.join(repr(float(estimates[n])) for n in names)}]\n"
             f"std = [{', '.join(repr(float(v)) for v in std)}]\n"
             f"correlation = [\n{rows}]\n")

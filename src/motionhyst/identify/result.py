@@ -220,7 +220,7 @@ class Identification:
             estimates = {f"{p}[{i}]": e[p] for p in ("k", "fc")
                          for i, e in enumerate(self.elements)}
         ident = identification_toml(self.covariance, estimates,
-                                    {n: f"hysteresis.{n}" for n in names})
+                                    {n: f"hysteresis.{n}" for n in names}, "force-displacement")
         return text + ("\n" + ident if ident else "")
 
     def scenario_fragment(self) -> str:

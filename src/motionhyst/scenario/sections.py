@@ -503,8 +503,12 @@ class IdentificationSection(_Section):
     estimates of an identified model's parameters, named by their scenario keys, with their
     standard errors and correlations (from the fit's Jacobian); it describes the file's
     ``[stage]`` and ``[hysteresis]`` and changes nothing in the loop.  A Monte-Carlo study
-    draws the link's parameters from it (``motionhyst study --from-identification``)."""
+    draws the link's parameters from it (``motionhyst study --from-identification``).
+    ``record`` is the kind of record the model was identified from: ``motionhyst predict``
+    predicts what that record measured (a force-displacement record's force from a
+    displacement, an input-output record's position from a force)."""
 
+    record: Literal["force-displacement", "input-output"] | None = None
     parameters: Annotated[list[str], Field(min_length=1)]
     estimates: list[Annotated[float, Field(allow_inf_nan=False)]]
     std: list[NonNegativeFloat]

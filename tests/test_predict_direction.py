@@ -1,0 +1,121 @@
+"""What ``predict`` predicts from a record that holds both a force and a displacement.
+
+A held-out record of a test machine has both columns, as the record a model was identified
+from.  A model without inertia runs either way (the force of a displacement, the
+displacement of a force); it predicts what the record it was identified from measured
+(``[identification] record``, written by ``identify --save``), or what ``--predict`` names,
+and says which.  The map of the columns the user gave ``identify`` is accepted as it is.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from records_of_other_kinds import LOGGED, damper_record, fit_percent
+
+from motionhyst.cli import main
+from motionhyst.hysteresis import Jenkins
+from motionhyst.identify.io_quasi_static import identify_quasi_static_io
+from motionhyst.identify.io_records import IORecord
+from motionhyst.plants import QuasiStatic
+from motionhyst.scenario import Scenario
+from motionhyst.time.quasi_static import displacement_from_force
+
+BOTH = ("time", "displacement", "force")
+
+
+def run(capsys, *args: str) -> tuple[int, str, str]:
+    rc = main(list(args))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.fixture(scope="module")
+def damper(tmp_path_factory):
+    """A damper's link saved from sines (force-displacement), and a held-out earthquake
+    with both columns."""
+    folder = tmp_path_factory.mktemp("direction")
+    train = damper_record("sines", seed=1).write(folder / "sines.csv", BOTH)
+    model = folder / "damper.toml"
+    assert main(["identify", str(train), "--elements", "4", "--save", str(model)]) == 0
+    held_out = damper_record("earthquake", seed=2)
+    return model, held_out, held_out.write(folder / "quake.csv", BOTH)
+
+
+def test_a_force_displacement_model_predicts_the_force_of_a_record_with_both(capsys, tmp_path,
+                                                                             damper):
+    """Before: the displacement predicted from the measured force, exit 0, no word of it."""
+    model, held_out, quake = damper
+    assert Scenario.from_file(model).model.identification.record == "force-displacement"
+    out_csv = tmp_path / "force.csv"
+    rc, out, err = run(capsys, "predict", str(model), str(quake), "--out", str(out_csv))
+    assert rc == 0 and err == "", err
+    assert out.startswith(f"Predicted the force of {model} for the")
+    assert open(out_csv).readline().strip() == "time,force"
+    predicted = np.loadtxt(out_csv, delimiter=",", skiprows=1)[:, 1]
+    assert fit_percent(held_out.force, predicted) > 98.0
+
+
+def test_the_map_given_identify_is_the_map_predict_takes(capsys, tmp_path):
+    """A lab's own column names and units, mapped as for identify (time, displacement and
+    force); before: refused without --init-from ("--columns names 'displacement', which
+    is not read here")."""
+    train = damper_record("sines", seed=1).write_as_logged(tmp_path / "sines.csv")
+    held_out = damper_record("earthquake", seed=2)
+    quake = held_out.write_as_logged(tmp_path / "quake.csv", seed=3)
+    model, out_csv = tmp_path / "damper.toml", tmp_path / "force.csv"
+    rc, _, err = run(capsys, "identify", str(train), *LOGGED, "--elements", "4", "--save",
+                     str(model))
+    assert rc == 0, err
+    rc, out, err = run(capsys, "predict", str(model), str(quake), *LOGGED, "--out",
+                       str(out_csv))
+    assert rc == 0 and err == "", err
+    assert "Predicted the force" in out
+    predicted = np.loadtxt(out_csv, delimiter=",", skiprows=1)[:, 1]
+    assert fit_percent(held_out.force, predicted) > 97.0
+
+
+def test_a_model_that_does_not_say_is_asked_not_guessed(capsys, tmp_path, damper):
+    _, _, quake = damper
+    model, out_csv = tmp_path / "link.toml", tmp_path / "out.csv"
+    model.write_text('[stage]\ntype = "quasi-static"\nk = 5e4\n[hysteresis]\nmodel = "jenkins"\n'
+                     'k = 1e6\nfc = 3e3\n')
+    rc, out, err = run(capsys, "predict", str(model), str(quake), "--out", str(out_csv))
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "give --predict force (from the displacement) or --predict displacement" in err
+    assert not out_csv.exists()
+    for quantity in ("force", "displacement"):
+        rc, out, err = run(capsys, "predict", str(model), str(quake), "--out", str(out_csv),
+                           "--predict", quantity, "--json", "--force")
+        assert rc == 0 and f'"predicted": "{quantity}"' in out, err
+        assert open(out_csv).readline().strip() == f"time,{quantity}"
+
+
+def test_a_model_with_inertia_predicts_no_force(capsys, tmp_path, damper):
+    _, _, quake = damper
+    model, out_csv = tmp_path / "stage.toml", tmp_path / "out.csv"
+    model.write_text('[stage]\ntype = "mass-spring-damper"\nm = 1.0\nc = 10.0\nk = 1e4\n')
+    rc, out, err = run(capsys, "predict", str(model), str(quake), "--out", str(out_csv),
+                       "--predict", "force")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "has inertia" in err and not out_csv.exists()
+
+
+def test_an_input_output_model_predicts_the_position_of_a_record_with_both(capsys, tmp_path):
+    """A link without inertia identified from force in, position out: a record with both
+    gets its position predicted from its force."""
+    t = np.arange(2000) / 1000.0
+    u = 300.0 * np.sin(2 * np.pi * 2 * t) * np.minimum(1.0, t)
+    plant, link = QuasiStatic(k=1e5), Jenkins(k=3e5, fc=100.0)
+    y = displacement_from_force(plant, link, t, u)
+    fit = identify_quasi_static_io([IORecord(t, u, y)], Jenkins, periodic=False, n_elements=1,
+                                   offset="none", max_evaluations=None, tol=1e-12)
+    model, record, out_csv = tmp_path / "m.toml", tmp_path / "r.csv", tmp_path / "y.csv"
+    model.write_text(fit.scenario_text())
+    assert Scenario.from_file(model).model.identification.record == "input-output"
+    np.savetxt(record, np.column_stack([t, y, u]), delimiter=",",
+               header="time,displacement,force", comments="")
+    rc, out, err = run(capsys, "predict", str(model), str(record), "--out", str(out_csv))
+    assert rc == 0 and err == "" and out.startswith("Predicted the displacement")
+    predicted = np.loadtxt(out_csv, delimiter=",", skiprows=1)[:, 1]
+    assert fit_percent(y, predicted) > 99.9
