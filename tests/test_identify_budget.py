@@ -406,7 +406,7 @@ def test_a_two_mass_bouc_wen_fit_is_refused_before_its_search_where_its_last_run
 
 def test_the_help_says_how_max_evaluations_is_shared(capsys):
     """Review A12b L2: with --max-evaluations the refinement's stages (the starts' best, the
-    window's state, for a Coulomb link on an axis the segments' end and finer secants) share
+    window's state, for a link on an axis the segments' end, a Coulomb link's finer secants) share
     what the starts leave, each an equal part of what those before it left; said in the help
     (and the guide), as the stopping line's "at most ... evaluations" shows it."""
     from motionhyst.cli import main
@@ -415,6 +415,6 @@ def test_the_help_says_how_max_evaluations_is_shared(capsys):
         main(["identify", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert ("records from a start whose state is estimated are refined in stages (from the "
-            "starts' best, from the state their first samples set and, for a Coulomb link on an "
-            "axis, from a fit on the records' segments and with finer secants), each stage with an "
-            "equal part of what the stages before it left") in text, text
+            "starts' best, from the state their first samples set and, for a link on an axis, "
+            "from a fit on the records' segments, a Coulomb link's also with finer secants), each "
+            "stage with an equal part of what the stages before it left") in text, text

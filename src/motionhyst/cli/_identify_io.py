@@ -78,9 +78,9 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
                         "starts and refinement together (default: the starts', then at most "
                         "200 for the refinement); records from a start whose state is "
                         "estimated are refined in stages (from the starts' best, from the "
-                        "state their first samples set and, for a Coulomb link on an axis, "
-                        "from a fit on the records' segments and with finer secants), each "
-                        "stage with an equal part of what the stages before it left")
+                        "state their first samples set and, for a link on an axis, from a fit "
+                        "on the records' segments, a Coulomb link's also with finer secants), "
+                        "each stage with an equal part of what the stages before it left")
     q.add_argument("--output", choices=("y2", "y1"),
                    help="input-output records, --plant two-mass: the measured position, y2 "
                         "(the point of control, default) or y1 (the actuated mass)")

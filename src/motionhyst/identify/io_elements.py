@@ -638,7 +638,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     t_span = max(float(rec.t[-1] - rec.t[0]) for rec in records)
     scale = np.concatenate([scale, extras.scales(u_rms, y_scale, v_scale, t_span)])
     # the whole search's memory (its Coulomb fit's is no more), before anything is upsampled;
-    # a rigid slider's (every axis link's first) refines on the records' segments first
+    # a link's on an axis also refines on the records' segments (its Coulomb fit's first)
     states = (2 * structure.mechanics().n
               + layout.build(starts[0][n_plant:]).time_stepping().codes.size) if periodic else 0
     own = init_window is None and not periodic  # each record's state estimated from its start
@@ -735,7 +735,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     # the lower cost at the start is no guide (two Coulomb records, one moving each way: the
     # window's state fitted better at the start and ended at fc 18.5 N for a true 20 N)
     sol, q_start, most = refine(prob, q0, tol, max_nfev, reserve, bool(extras.initial) and own,
-                                rigid_link, rigid_link and segments)
+                                rigid_link, segments)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)

@@ -17,7 +17,8 @@ costs only its segment), and its best end is refined again with its secants' ste
 tenfold in turn (to :data:`FINEST_SECANT`), each end kept where it fits the records better.
 Where the model does not fit the records to their noise (a measured axis) the segments' end
 can be the worse start, and the segments' own offsets make its cost on the whole records no
-guide: the ends are compared, not the starts.
+guide: the ends are compared, not the starts.  Every other link on an axis refines from the
+segments' end too: a stiff Jenkins link sticks and slips as sharply (k 1e8 N/m on 95 kg).
 """
 
 from __future__ import annotations
@@ -116,8 +117,8 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
            ) -> tuple[OptimizeResult, NDArray[np.float64], int | None]:
     """The search problem `prob` refined from `q0` and, with `from_window`, from
     :func:`state_start` of it too; with `segments`, also from the end of a refinement on the
-    records' segments (:func:`on_segments`; near a well's bottom: with secants a tenth as
-    wide); the end of least cost kept.  A `rigid` slider's best end is
+    records' segments (:func:`on_segments`; near a well's bottom: a rigid slider's with
+    secants a tenth as wide); the end of least cost kept.  A `rigid` slider's best end is
     refined again with its secants' step shrunk tenfold in turn to :data:`FINEST_SECANT`,
     each end kept where it lowers the cost (the step set back after: the standard errors'
     secants are the search's).
@@ -145,8 +146,8 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
         share = part(0)
         with plan.share(share):
             q1 = on_segments(prob, q0, tol, max_nfev if share is None else share)
-        if q1 is not q0:  # near a well's bottom: refined with finer secants
-            starts.append((q1, secant / 10.0))
+        if q1 is not q0:  # near a well's bottom: a rigid slider's with finer secants
+            starts.append((q1, secant / 10.0 if rigid else secant))
     runs = starts[:1]
     if from_window and enough(1):  # where the first refinement's share is two steps
         q_state = state_start(prob, q0)

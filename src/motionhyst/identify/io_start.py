@@ -502,8 +502,8 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     columns (a link without them: the Jacobian's columns by forward differences, one
     evaluation per thread, as many at once as there are threads and columns, with their
     residuals); the Jacobian of all samples x
-    `parameters` is held :data:`JACOBIAN_COPIES` times.  With `segments`, a rigid slider's
-    search first runs on the records cut into segments
+    `parameters` is held :data:`JACOBIAN_COPIES` times.  With `segments`, a search on an
+    axis (and its rigid slider's) also runs on the records cut into segments
     (:func:`~motionhyst.identify.io_records.segment_records`), each with its own position offset
     and initial velocity: that stage's force, runs and Jacobian (its samples x `parameters`
     and two columns a segment) count where they are larger.
@@ -528,8 +528,8 @@ def search_memory(records: list[IORecord], substeps: int, parameters: int, sensi
     threads : int, optional
         Threads of the evaluations (default: the machine's cores).
     segments : bool
-        The search runs on the records' segments first (a rigid slider's on a floating
-        stage, each record's position offset and initial velocity estimated).
+        The search also runs on the records' segments (on a floating stage, each record's
+        position offset and initial velocity estimated).
 
     Returns
     -------
