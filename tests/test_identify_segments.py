@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from motionhyst.hysteresis import Coulomb
+from motionhyst.identify import io_refine
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_differences import REFUSED, forward_differences
 from motionhyst.identify.io_offsets import Extras
@@ -94,18 +95,36 @@ def test_the_search_on_segments_starts_threads_from_one_level_only(monkeypatch):
     """The Coulomb search of two records on an axis (its segments' search of six records,
     and its secants' columns) starts every thread from the main thread: a column's runs of
     the records are tasks of the one pool, not a pool of their own (each thread's stack is
-    address space the search's estimate does not hold; the nested pools ran out of it)."""
-    starters = []
-    start = threading.Thread.start
+    address space the search's estimate does not hold; the nested pools ran out of it).
+    Without a budget, so that the segments' search runs (a budget of 400 evaluations turned
+    it off: it leaves less than RIGID_STEPS steps), and threads are started inside it."""
+    starters: list[tuple[bool, bool]] = []  # (from the main thread, in the segments' search)
+    segments: list[int] = []
+    start, on_segments = threading.Thread.start, io_refine.on_segments
+
+    def in_segments() -> bool:
+        return bool(segments) and segments[-1] > 0
 
     def spy(self):
-        starters.append(threading.current_thread() is threading.main_thread())
+        starters.append((threading.current_thread() is threading.main_thread(), in_segments()))
         start(self)
 
+    def spy_segments(prob, q, tol, max_nfev):
+        segments.append(len(prob.records))
+        try:
+            end = on_segments(prob, q, tol, max_nfev)
+        finally:
+            segments[-1] = -segments[-1]  # done: threads after it are not its
+        return end
+
     monkeypatch.setattr(threading.Thread, "start", spy)
+    monkeypatch.setattr(io_refine, "on_segments", spy_segments)
     records = [_coulomb_axis(1500, 0), _coulomb_axis(1500, 1)]
-    fit = identify_io(records, "coulomb", plant="mass-damper", max_evaluations=400)
-    assert starters and all(starters), f"{starters.count(False)} threads started in a thread"
+    fit = identify_io(records, "coulomb", plant="mass-damper")
+    assert segments == [-2], segments  # the segments' search ran once, on the two records
+    assert any(inside for _, inside in starters), "no thread started in the segments' search"
+    assert all(main for main, _ in starters), \
+        f"{sum(not main for main, _ in starters)} threads started in a thread"
     assert fit.estimates["m"] == pytest.approx(95.0, rel=0.01)
 
 
