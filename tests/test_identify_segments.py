@@ -15,6 +15,7 @@ from motionhyst.identify import io_refine
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_differences import REFUSED, forward_differences
 from motionhyst.identify.io_offsets import Extras
+from motionhyst.identify.io_records import MAX_SEGMENTS, segment_records
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import OpenLoop
 
@@ -126,6 +127,22 @@ def test_the_search_on_segments_starts_threads_from_one_level_only(monkeypatch):
     assert all(main for main, _ in starters), \
         f"{sum(not main for main, _ in starters)} threads started in a thread"
     assert fit.estimates["m"] == pytest.approx(95.0, rel=0.01)
+
+
+def test_every_sample_of_a_record_is_in_a_segment():
+    """A record's segments hold every one of its samples, its tail in the last (review C13
+    M4: a record whose length was a multiple of 500 lost its last 500 samples, 6000 samples
+    cut into 11 segments over 5500), a record shorter than a segment is one, and the
+    segments stop at MAX_SEGMENTS (of the records' first samples)."""
+    def sizes(*lengths):
+        recs = [IORecord(np.arange(n) / FS, np.zeros(n), np.zeros(n)) for n in lengths]
+        return [(i, s.y.size, float(s.t[-1])) for i, s in segment_records(recs)]
+
+    assert sizes(6000) == [(0, 500, (500 * k + 499) / FS) for k in range(12)]
+    assert sizes(1000, 300) == [(0, 500, 0.499), (0, 500, 0.999), (1, 300, 0.299)]
+    assert sizes(1499) == [(0, 500, 0.499), (0, 999, 1.498)]
+    assert [n for _, n, _ in sizes(500, 64)] == [500, 64]
+    assert len(sizes(20000, 20000)) == MAX_SEGMENTS
 
 
 @pytest.mark.skipif(not EMPS.is_file(),

@@ -143,8 +143,9 @@ def short_records(records: list[IORecord], periodic: bool, n_max: int = 4096
 
 def segment_records(records: list[IORecord]) -> list[tuple[int, IORecord]]:
     """The records cut into segments of :data:`SEGMENT` samples, at most
-    :data:`MAX_SEGMENTS` of them, from each record's start on (a shorter tail joins the
-    segment before it; views of the records' arrays).
+    :data:`MAX_SEGMENTS` of them, from each record's start on: every sample of a record
+    in one (a shorter tail joins the segment before it, a record shorter than a segment is
+    one) until the segments run out (views of the records' arrays).
 
     Parameters
     ----------
@@ -162,6 +163,10 @@ def segment_records(records: list[IORecord]) -> list[tuple[int, IORecord]]:
     >>> t = np.arange(1800) / 1e3
     >>> [(i, s.y.size) for i, s in segment_records([IORecord(t, np.sin(t), np.cos(t))])]
     [(0, 500), (0, 500), (0, 800)]
+    >>> parts = segment_records([IORecord(t[:1000], t[:1000], t[:1000]),
+    ...                          IORecord(t[:300], t[:300], t[:300])])
+    >>> [(i, s.y.size) for i, s in parts]
+    [(0, 500), (0, 500), (1, 300)]
     >>> n = 100_000
     >>> rec = IORecord(np.arange(n) / 1e3, np.zeros(n), np.zeros(n))
     >>> parts = segment_records([rec, rec])
@@ -171,7 +176,7 @@ def segment_records(records: list[IORecord]) -> list[tuple[int, IORecord]]:
     parts: list[tuple[int, IORecord]] = []
     for i, rec in enumerate(records):
         n = rec.y.size
-        for a in list(range(0, n - SEGMENT, SEGMENT))[:MAX_SEGMENTS - len(parts)]:
+        for a in list(range(0, max(n - SEGMENT, 0) + 1, SEGMENT))[:MAX_SEGMENTS - len(parts)]:
             b = n if a + 2 * SEGMENT > n else a + SEGMENT
             parts.append((i, IORecord(rec.t[a:b], rec.u[a:b], rec.y[a:b], rec.name)))
     return parts

@@ -76,10 +76,14 @@ def on_segments(prob, q_free: NDArray[np.float64], tol: float, max_nfev: int | N
     """`q_free` refined on the records of the search problem `prob` (a floating stage's,
     each record's position offset and initial velocity estimated) cut into segments
     (:func:`~motionhyst.identify.io_records.segment_records`), each with its own position
-    offset and initial velocity, the stage's and link's values and the force offset shared;
-    a record's first segment starts at the record's own offset and state and gives them
-    back, the others start at their first sample and their first samples' slope.  `q_free`
-    itself where no record is longer than two segments or the refinement cannot run."""
+    offset and initial velocity, the stage's and link's values and the force offset shared.
+    Each segment starts at the state its first samples set at `q_free`'s other values
+    (:func:`state_start`; where the model refuses them, a record's first segment at the
+    record's own offset and state, the others at their first sample and their first
+    samples' slope: a state in another well of the initial velocity, its position offset
+    making up for it, is where a segment's refinement stops short), and a record's first
+    segment gives its end back to the record.  `q_free` itself where no record is cut (none
+    is two segments long) or the refinement cannot run."""
     ex = prob.extras
     base = prob.n_plant + prob.n_link
     cut_of = segment_records(prob.records)
@@ -99,8 +103,10 @@ def on_segments(prob, q_free: NDArray[np.float64], tol: float, max_nfev: int | N
     start[:shared] = v[base:base + shared]
     for i, k in first.items():
         start[cut.columns_of_record(k)] = v[base + np.array(ex.columns_of_record(i))]
+    q_seg = seg.variables(np.concatenate([v[:base], start]))
+    q_win = state_start(seg, q_seg)
     try:
-        sol = seg.solve(seg.variables(np.concatenate([v[:base], start])), tol, max_nfev)
+        sol = seg.solve(q_seg if q_win is None else q_win, tol, max_nfev)
     except BudgetSpent:
         return q_free
     finally:
