@@ -50,6 +50,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/point.py
 	$(BIN)/python benchmarks/refusals.py
 	$(BIN)/python benchmarks/one_stage.py
+	$(BIN)/python benchmarks/axis_search.py
 
 # the public benchmarks end to end (kept out of make test): Bouc-Wen (about a minute) and
 # EMPS (a few minutes; scored on DATA_EMPS_PULSES.mat when EMPS_DATA holds it)

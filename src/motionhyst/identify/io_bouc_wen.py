@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import OptimizeResult
 
+from motionhyst.core.blas import few_blas_threads
 from motionhyst.hysteresis import BoucWen, Hysteresis
 from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
 from motionhyst.identify.io_memory import REMEDY, check_bouc_wen_memory
@@ -190,7 +191,8 @@ def _solve(prob: _BoucWenProblem, p0: NDArray[np.float64], scale: NDArray[np.flo
         low = np.array([1e-6, 1e-6, 0.0, 0.0, -np.inf, -np.inf, 1.0 / scale[6], 1e-6])
     lower = low[prob.free]
     q0 = np.where(np.isfinite(lower), np.maximum(q0, lower + 1e-9 * np.abs(q0) + 1e-12), q0)
-    with prob.budget.share(share):
+    rows = sum(rec.y.size for rec in prob.records)
+    with prob.budget.share(share), few_blas_threads(rows, q0.size):  # each step's SVD: small
         try:
             return solve_within(fun, q0, jac=jacobian, method="trf", x_scale=1.0, ftol=tol,
                                 xtol=tol, gtol=tol, max_nfev=max_nfev, bounds=(lower, np.inf))

@@ -21,6 +21,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.blas import few_blas_threads
 from motionhyst.hysteresis import Coulomb, Jenkins, MaxwellSlip
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
@@ -492,10 +493,14 @@ class _ElementProblem:
 
     def solve(self, q0_free: NDArray[np.float64], tol: float, max_nfev: int):
         """Trust-region refinement of the free variables from `q0_free`, ended where its
-        budget is spent (:func:`~motionhyst.identify.io_budget.solve_within`)."""
-        return solve_within(self.residuals, q0_free, jac=self.jacobian, method="trf",
-                            ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev,
-                            bounds=self.bounds())
+        budget is spent (:func:`~motionhyst.identify.io_budget.solve_within`); on one BLAS
+        thread where its Jacobian is small (:func:`~motionhyst.core.blas.few_blas_threads`:
+        each step's SVD of it)."""
+        rows = sum(rec.y.size for rec in self.records)
+        with few_blas_threads(rows, int(self.free.sum())):
+            return solve_within(self.residuals, q0_free, jac=self.jacobian, method="trf",
+                                ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev,
+                                bounds=self.bounds())
 
 
 #: The rate scales (velocity parameters, e.g. LuGre's vs) are held at each of these
