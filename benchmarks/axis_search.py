@@ -131,6 +131,8 @@ def main() -> None:
                         help="half the samples, one repeat")
     parser.add_argument("--repeats", type=int, default=REPEATS)
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats must be at least 1, got {args.repeats}")
     repeats = 1 if args.quick else args.repeats
     res = measure(repeats, args.quick)
     if args.json:
