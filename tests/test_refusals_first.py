@@ -8,41 +8,13 @@ measures how soon each refusal comes, as ratios to the command's start).
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-# what an identification's search, a simulation's kernels or a loop's model load: each takes
-# longer to import than a refusal may take
-HEAVY = ("control", "scipy", "matplotlib", "numba", "pandas")
-
-_PROBE = """
-import contextlib, io, json, sys
-from motionhyst.cli import main
-err = io.StringIO()
-with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
-    try:
-        rc = main(sys.argv[1:])
-    except SystemExit as exc:
-        rc = exc.code
-heavy = sorted({m.split(".")[0] for m in sys.modules for h in HEAVY
-                if m == h or m.startswith(h + ".")})
-print(json.dumps({"rc": rc, "heavy": heavy, "err": err.getvalue()}))
-""".replace("HEAVY", repr(HEAVY))
-
-
-def _probe(argv: list[str], cwd: Path) -> dict:
-    """``motionhyst argv`` in a fresh interpreter: its exit code, stderr and the heavy
-    packages it imported."""
-    proc = subprocess.run([sys.executable, "-c", _PROBE, *argv], capture_output=True,
-                          text=True, cwd=cwd, timeout=600, check=False)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout)
+from cli_probe import probe
 
 
 def _csv(columns: dict[str, np.ndarray]) -> str:
@@ -67,13 +39,13 @@ def test_a_link_model_input_output_records_cannot_fit_is_refused_before_they_are
     lines).  The model's name alone decides it: one line, the record never opened."""
     (tmp_path / "a.csv").write_text(_axis())
     for record in ("a.csv", "missing.csv"):
-        out = _probe(["identify", record, "--record", "input-output", "--model",
+        out = probe(["identify", record, "--record", "input-output", "--model",
                       "maxwell-iwan"], tmp_path)
         assert out["rc"] == 2, out["err"]
         assert out["err"].count("\n") == 1, out["err"]
         assert ("--model maxwell-iwan is not available for input-output records; use "
                 "bouc-wen, jenkins, maxwell-slip, dahl, lugre, coulomb") in out["err"]
-        assert out["heavy"] == [], out["heavy"]
+        assert out["packages"] == [], out["packages"]
 
 
 def _spin(seconds: float) -> None:
@@ -163,10 +135,10 @@ def test_a_link_too_damped_for_the_step_is_refused_before_the_loop_is_built(tmp_
     implicit step failed at the stage's first motion, after python-control built the loop
     and numba loaded the kernels.  The scenario and the step, known before, decide it."""
     (tmp_path / "s.toml").write_text(_paper_with(_lugre(1e7)))
-    out = _probe(argv, tmp_path)
+    out = probe(argv, tmp_path)
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert "s.toml: [hysteresis]: the link's damping for small motions, 1e+07 N s/m" in out["err"]
-    assert out["heavy"] == [], out["heavy"]
+    assert out["packages"] == [], out["packages"]
     assert not (tmp_path / "ts.csv").exists()
 
 
@@ -229,10 +201,10 @@ def test_a_closed_loop_record_off_its_plant_s_scale_is_refused_before_the_loop_i
         record["y1"], record["u"] = record["u"], record["y1"]
     (tmp_path / "c.csv").write_text(_csv(record))
     (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
-    out = _probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
+    out = probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert f"c.csv: the plant's force for y1 as recorded is {ratio} times u" in out["err"]
-    assert "control" not in out["heavy"] and "matplotlib" not in out["heavy"], out["heavy"]
+    assert "control" not in out["packages"] and "matplotlib" not in out["packages"], out["packages"]
 
 
 def test_the_force_scale_of_a_record_of_its_plant_is_near_one(loop_record):
@@ -350,10 +322,10 @@ def test_a_closed_loop_record_s_size_and_cut_off_are_judged_before_the_fit_loads
 
     (tmp_path / "c.csv").write_text(_csv(loop_record))
     (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
-    out = _probe(["identify", "c.csv", "--scenario", "paper.toml", *options], tmp_path)
+    out = probe(["identify", "c.csv", "--scenario", "paper.toml", *options], tmp_path)
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert words in out["err"], out["err"]
-    assert out["heavy"] == ["pandas"], out["heavy"]
+    assert out["packages"] == ["pandas"], out["packages"]
 
 
 def test_a_closed_loop_record_off_its_plant_s_scale_is_refused_with_the_reader_alone(
@@ -368,10 +340,10 @@ def test_a_closed_loop_record_off_its_plant_s_scale_is_refused_with_the_reader_a
     record["y1"] = 1000 * record["y1"]
     (tmp_path / "c.csv").write_text(_csv(record))
     (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
-    out = _probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
+    out = probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert "c.csv: the plant's force for y1 as recorded is 1000 times u" in out["err"]
-    assert out["heavy"] == ["pandas"], out["heavy"]
+    assert out["packages"] == ["pandas"], out["packages"]
 
 
 @pytest.fixture(scope="module")
@@ -447,10 +419,10 @@ def test_a_force_that_does_not_follow_the_displacement_is_refused_before_the_mas
     a spring, a damper and a friction force, before either loads.  The record itself
     (``--scale force=-1``) is identified."""
     (tmp_path / "rev.csv").write_text(_damper(force_sign, noise_only))
-    out = _probe(["identify", "rev.csv"], tmp_path)
+    out = probe(["identify", "rev.csv"], tmp_path)
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
     assert out["err"].startswith(f"motionhyst: error: {words}"), out["err"]
-    assert "numba" not in out["heavy"] and "scipy" not in out["heavy"], out["heavy"]
+    assert "numba" not in out["packages"] and "scipy" not in out["packages"], out["packages"]
     if not noise_only:
-        fixed = _probe(["identify", "rev.csv", "--scale", "force=-1"], tmp_path)
+        fixed = probe(["identify", "rev.csv", "--scale", "force=-1"], tmp_path)
         assert fixed["rc"] == 0, fixed["err"]

@@ -16,38 +16,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_probe import probe
 
 import motionhyst
 
-# python-control, scipy (scipy.signal, scipy.fft, ...), matplotlib, numba and pandas each take
-# longer to import than these commands take to run
-HEAVY = ("control", "scipy", "matplotlib", "numba", "pandas")
 PACKAGE = Path(motionhyst.__file__).parent
-
-_PROBE = """
-import contextlib, io, json, sys
-from motionhyst.cli import main
-err = io.StringIO()
-with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
-    try:
-        rc = main(sys.argv[1:])
-    except SystemExit as exc:
-        rc = exc.code
-heavy = sorted({m for m in sys.modules for h in HEAVY if m == h or m.startswith(h + ".")})
-print(json.dumps({"rc": rc, "heavy": heavy, "err": err.getvalue()}))
-""".replace("HEAVY", repr(HEAVY))
-
 
 def _run(code: str, *args: str, env: dict | None = None, cwd: Path | None = None
          ) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
                           env=env, cwd=cwd, timeout=600, check=False)
-
-
-def _probe(*argv: str, cwd: Path | None = None) -> dict:
-    proc = _run(_PROBE, *argv, cwd=cwd)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout)
 
 
 @pytest.mark.parametrize("argv, rc", [
@@ -73,7 +51,7 @@ def _probe(*argv: str, cwd: Path | None = None) -> dict:
     (["no-such-command"], 2),
 ])
 def test_help_df_and_argument_errors_import_nothing_heavy(argv, rc):
-    out = _probe(*argv)
+    out = probe(argv)
     assert out["rc"] == rc, out["err"]
     assert out["heavy"] == [], f"motionhyst {' '.join(argv)} imported {out['heavy']}"
     if rc == 2:
@@ -121,7 +99,7 @@ FIT_LIBRARIES = ("control", "matplotlib", "scipy.optimize", "scipy.signal", "num
 def _assert_refused_without_fit_libraries(argv: list[str], error: str, cwd: Path) -> None:
     """`motionhyst ARGV` run in `cwd` exits 2 with one line holding `error`, having imported
     none of :data:`FIT_LIBRARIES`."""
-    out = _probe(*argv, cwd=cwd)
+    out = probe(argv, cwd=cwd)
     assert out["rc"] == 2, out["err"]
     assert out["err"].count("\n") == 1 and error in out["err"], out["err"]
     loaded = [m for m in out["heavy"] if m.startswith(FIT_LIBRARIES)]
@@ -293,7 +271,7 @@ def test_a_file_or_a_size_is_refused_before_any_heavy_library(tmp_path, argv, er
              "io.csv": "\ufeff Time ,\tForce\r\n0,1\r\n"}
     for name, text in {**_refused_scenarios(), **files}.items():
         (tmp_path / name).write_text(text)
-    out = _probe(*argv, cwd=tmp_path)
+    out = probe(argv, cwd=tmp_path)
     assert out["rc"] == 2 and error in out["err"], out["err"]
     assert out["heavy"] == [], f"motionhyst {' '.join(argv)} imported {out['heavy']}"
 
