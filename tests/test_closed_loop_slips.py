@@ -198,3 +198,20 @@ def test_the_light_inference_is_the_prefilters(paper_5hz, plant):
     assert np.abs(light.w - full.w).max() < 1e-9 * np.abs(u).max()
     z = full.lowpass(y1 - y1[0])
     assert np.abs(light.lowpass(y1 - y1[0]) - z).max() < 1e-9 * np.abs(z).max()
+
+
+@pytest.mark.parametrize("sigma2", [0.3, 1.0])
+def test_a_link_with_viscous_friction_is_refused_naming_damping(sigma2):
+    """A LuGre link whose viscous force at the stroke's peak speed exceeds about twice its
+    slip force (sigma2 0.3-1.0 N s/m at 5 Hz, 10 mm: c v 0.09-0.3 N against fc 0.05 N):
+    its force falls from where each stroke is fastest to its end, as a damper's does, and
+    Maxwell-slip elements cannot describe it (main fitted sigma2 0.3 as k 1.0e6 N/m, fc
+    0.112 N at 23.7 % of the force's RMS).  Refused, the line naming first the viscous force
+    the plant's damping leaves out (review A14a M1: it asked about a logging offset)."""
+    t, y1, u = _record(LuGre(sigma0=1e4, sigma1=10.0, sigma2=sigma2, fc=0.05, fs=0.07,
+                             vs=0.01), 5.0, 1.0)
+    with pytest.raises(ValueError, match=r"grows with the speed: .* \(a viscous force the "
+                       r"plant's damping leaves out \(the link's, or the plant not the "
+                       r"record's\)\? u and y1 logged at different instants\?\); nothing "
+                       r"identified$"):
+        identify_closed_loop(t, y1, u, default_scenario().plant())

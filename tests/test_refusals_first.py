@@ -8,8 +8,6 @@ measures how soon each refusal comes, as ratios to the command's start).
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import time
 
 import numpy as np
@@ -383,14 +381,13 @@ def test_a_closed_loop_record_that_is_no_link_s_is_refused_before_the_loop_is_bu
         record = {"time": t[:-1], "y1": record["y1"][1:], "u": record["u"][:-1]}
     (tmp_path / "c.csv").write_text(_csv(record))
     (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
-    code = ("import sys\nfrom motionhyst.cli import main\n"
-            "code = main(['identify', 'c.csv', '--scenario', 'paper.toml'])\n"
-            "print(code, sorted({'control', 'scipy.signal', 'scipy.optimize', 'numba', "
-            "'matplotlib'} & set(sys.modules)))\n")
-    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=600, check=False)
-    assert proc.stdout.splitlines()[-1] == "2 []", proc.stdout + proc.stderr
-    assert proc.stderr.count("\n") == 1 and words in proc.stderr, proc.stderr
+    out = probe(["identify", "c.csv", "--scenario", "paper.toml"], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert words in out["err"], out["err"]
+    loaded = [m for m in out["heavy"] if m.startswith(("control", "scipy.signal",
+                                                          "scipy.optimize", "numba",
+                                                          "matplotlib"))]
+    assert loaded == [], loaded
 
 
 def _damper(force_sign: float = 1.0, noise_only: bool = False) -> str:

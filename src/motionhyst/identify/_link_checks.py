@@ -226,7 +226,8 @@ def check_rate_independent(lf, cause: str = "") -> None:
     fall, swing = float(np.median(falls)), float(np.median(swings))
     error = 1.2533 * float(np.std(falls, ddof=1)) / np.sqrt(len(falls))
     if fall > FALL_SHARE * swing and fall > FALL_SIGMAS * error:
-        cause = cause or "u and y1 logged at different instants? the plant not the record's?"
+        cause = cause or ("a viscous force the plant's damping leaves out (the link's, or the "
+                          "plant not the record's)? u and y1 logged at different instants?")
         raise ValueError(
             f"the link force inferred through the plant grows with the speed: along a stroke "
             f"of y1 it falls {fall:.3g} N from where the stroke is fastest to its end, "
@@ -278,8 +279,8 @@ def likely_cause(lf, u: NDArray[np.float64], infer) -> str:
         candidates += [((shift, True), t[:-shift], y1[shift:], u[:-shift]),
                        ((shift, False), t[:-shift], y1[:-shift], u[shift:])]
     for slip, ts, ys, us in candidates:  # u's row i beside y1's row i + shift, or the reverse
-        other, L_over_P1 = infer(ts, ys, us)
-        try:
+        try:  # a copy the inference itself refuses names nothing
+            other, L_over_P1 = infer(ts, ys, us)
             check_link(other, L_over_P1, us)
         except ValueError:
             continue
