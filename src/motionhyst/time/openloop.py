@@ -295,13 +295,8 @@ class OpenLoop:
             return OpenLoopResponse(tt, u, y, periodic)
         fs = sampling_rate(tt)
         r = substeps or self.default_substeps(fs)
-        # the plant's viscous friction by direction is stepped with the link's elements, and so
-        # is a Bouc-Wen link on a positioning axis (one floating mass): a friction link, whose
-        # exact update in the displacement follows its sticking however stiff (RK4 in time
-        # diverges there once k |y'| / fc exceeds the step's stability limit)
         mech = self.plant.mechanics()
-        axis = isinstance(self.hysteresis, BoucWen) and mech.floating and mech.n == 1
-        p = None if getattr(self.plant, "c_skew", 0.0) or axis else self._bw_parameters()
+        p = self._rk4_parameters()
         states = self._shooting_states() if periodic and p is None else 0
         check_memory(self.memory(u, r, periodic=periodic),
                      f"{u.size} samples of {r} integration steps each"
@@ -346,10 +341,18 @@ class OpenLoop:
         u = np.asarray(force, dtype=float)
         if not periodic:
             return FINE_BYTES * held_nodes(u, int(substeps)) + SAMPLE_BYTES * u.size
+        return self._periodic_memory(u, int(substeps), self._rk4_parameters() is not None)
+
+    def _rk4_parameters(self) -> NDArray[np.float64] | None:
+        """The parameters of a run by RK4 (a Bouc-Wen link, or none), None for a link stepped
+        as elements: the plant's viscous friction by direction is stepped with the link's
+        elements, and so is a Bouc-Wen link on a positioning axis (one floating mass): a
+        friction link, whose exact update in the displacement follows its sticking however
+        stiff (RK4 in time diverges there once k |y'| / fc exceeds the step's stability
+        limit)."""
         mech = self.plant.mechanics()
         axis = isinstance(self.hysteresis, BoucWen) and mech.floating and mech.n == 1
-        rk4 = not (getattr(self.plant, "c_skew", 0.0) or axis) and self._bw_parameters() is not None
-        return self._periodic_memory(u, int(substeps), rk4)
+        return None if getattr(self.plant, "c_skew", 0.0) or axis else self._bw_parameters()
 
     def _periodic_memory(self, u: NDArray[np.float64], r: int, rk4: bool) -> float:
         """Bytes of a periodic run of the force `u` (:meth:`simulate`): the record and the
