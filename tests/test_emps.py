@@ -227,7 +227,8 @@ def test_emps_record_splits_into_its_reference_periods():
 def test_identify_and_predict_a_mat_record_with_the_window(tmp_path, capsys):
     """The guide's path on the command line: identify a .mat record in the benchmark's names
     with --init-window, save, and predict it from its force with --init-from, the --columns
-    and --scale maps naming the position too (the force record takes the keys it has)."""
+    and --scale maps naming the position too (the force record takes the keys it has), and
+    without --init-from from rest with the same maps."""
     rec = axis_record(n_periods=2)
     path = tmp_path / "axis.mat"
     savemat(path, {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
@@ -246,10 +247,14 @@ def test_identify_and_predict_a_mat_record_with_the_window(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["init_window"] == INIT_WINDOW
     assert summary["rmse"] < 0.02 * np.std(rec.y)
-    # without --init-from a position's name is an option without effect: refused
+    # without --init-from the map given identify is taken as it is: the model predicts what
+    # its own record measured, the position from the force, from rest
     assert main(["predict", str(model), str(path), "--out", str(tmp_path / "p2.csv"),
-                 *maps]) == 2
-    assert "displacement" in capsys.readouterr().err
+                 *maps]) == 0
+    assert capsys.readouterr().out.startswith(f"Predicted the displacement of {model} (from rest)")
+    predicted = np.genfromtxt(tmp_path / "p2.csv", delimiter=",", names=True)
+    assert predicted.dtype.names == ("time", "displacement")
+    assert predicted["time"] == pytest.approx(rec.t, abs=1e-12)
 
 
 def test_with_the_test_record_the_whole_estimation_record_is_used():
