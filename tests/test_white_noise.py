@@ -5,7 +5,7 @@ predict --init-from's same-run check (motionhyst.identify.io_uncertainty)."""
 import numpy as np
 import pytest
 
-from motionhyst.identify.io_uncertainty import white_noise_variance
+from motionhyst.identify.residual_noise import white_noise_variance
 
 
 @pytest.mark.parametrize("seed", range(5))

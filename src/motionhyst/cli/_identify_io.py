@@ -289,12 +289,15 @@ def run_input_output(args: argparse.Namespace) -> int:
           f"({kind}) by simulation error in {fit.seconds:.3g} s")
     print(f"  fit RMS {g(fit.fit_rms)} m; {fit.stopping}")
     rows = []
+    at_least = ">= " if fit.extra.get("std_lower_bound") else ""  # why: the line below
     for name, value in fit.estimates.items():
         s = fit.std.get(name)
-        rows.append([name, g(value, 8), "not identifiable" if s is None else g(s, 2),
+        rows.append([name, g(value, 8), "not identifiable" if s is None else at_least + g(s, 2),
                      "" if s is None or value == 0 else f"{100 * s / abs(value):.2g} %"])
     print()
     print(table(["parameter", "estimate", "std", "std/|value|"], rows))
+    if fit.extra.get("std_note"):
+        print(f"  {fit.extra['std_note']}")
     if fit.not_identifiable:
         print()
         for name, why in fit.not_identifiable.items():

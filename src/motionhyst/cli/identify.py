@@ -542,8 +542,10 @@ def _check_slips(path: Path, ident, y1) -> None:
     import numpy as np
 
     half = 0.5 * float(np.ptp(y1))
-    shown = [e for e in ident.elements
-             if e["fc"] / e["k"] < SLIP_SHARE * half and e["fc_std"] < e["fc"]]
+    judged = [ident.judged_std.get(f"fc[{i}]", e["fc_std"])  # white residuals' std
+              for i, e in enumerate(ident.elements)]
+    shown = [e for e, s in zip(ident.elements, judged, strict=True)
+             if e["fc"] / e["k"] < SLIP_SHARE * half and s < e["fc"]]
     if not shown:
         e = min(ident.elements, key=lambda e: e["fc"] / e["k"])
         std = (f"+- {g(e['fc_std'])} N" if math.isfinite(e["fc_std"])

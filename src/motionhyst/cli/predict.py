@@ -180,7 +180,7 @@ refused, its white-noise escape blind to them)."""
 SAME_RUN_NOISE_FACTOR = 2.0
 """Below :data:`SAME_RUN_CORRELATION`, the two forces are still taken for the same run when
 what one does not share with the other is, in RMS, within this factor of their sensors'
-white noise (:func:`~motionhyst.identify.io_uncertainty.white_noise_variance`, the mean
+white noise (:func:`~motionhyst.identify.residual_noise.white_noise_variance`, the mean
 square of the third differences): a load cell's noise larger than the force."""
 
 
@@ -199,7 +199,7 @@ def _check_same_run(args: argparse.Namespace, u, u_rec) -> None:
     exceeds :data:`SAME_RUN_NOISE_FACTOR` times the white noise of the two; a force constant
     in either record, or non-finite samples, are not judged (the record's force is not
     used)."""
-    from motionhyst.identify.io_uncertainty import white_noise_variance
+    from motionhyst.identify.residual_noise import white_noise_variance
 
     ok = np.isfinite(u) & np.isfinite(u_rec)
     judged = []

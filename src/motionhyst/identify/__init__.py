@@ -80,7 +80,8 @@ input_output
     entry point of its parts: io_records (the records), io_start (the best
     linear approximations), io_bouc_wen (the Bouc-Wen link), io_elements (the
     registry's other links), io_uncertainty (standard errors, what the records
-    do not determine) and io_results (:class:`~motionhyst.identify.io_results.IOIdentification`).
+    do not determine), residual_noise (the records' white noise, the residuals'
+    correlation) and io_results (:class:`~motionhyst.identify.io_results.IOIdentification`).
 result
     :class:`Identification`, the result of (a) and (b).
 """

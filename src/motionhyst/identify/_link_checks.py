@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.identify.io_uncertainty import white_noise_variance
 from motionhyst.identify.records import REVERSAL_BAND
+from motionhyst.identify.residual_noise import white_noise_variance
 
 __all__ = ["FirFilter", "LightForce", "check_link", "force_rms", "light_link_force",
            "likely_cause"]
@@ -87,7 +87,7 @@ def noise_variances(lf, u: NDArray[np.float64], a: int, b: int
                      ) -> tuple[float, float]:
     """The white noise variances of `u` and ``y1`` over the samples `a` to `b` judged: the
     mean square of their third differences
-    (:func:`~motionhyst.identify.io_uncertainty.white_noise_variance`, an upper estimate
+    (:func:`~motionhyst.identify.residual_noise.white_noise_variance`, an upper estimate
     that counts the controller's fast action as noise), not over the whole record: a record
     from rest starts with the loop's transient, whose differences are no noise (the paper's
     loop at 5 Hz from rest: 1.2 N on u over the record, 1e-6 N over its cycles)."""

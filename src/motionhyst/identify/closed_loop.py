@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -20,13 +21,20 @@ from motionhyst.identify.fit import (
     FitProblem,
     fit_rows,
     identify_prepared,
+    residuals_and_jacobian,
 )
+from motionhyst.identify.io_uncertainty import covariance, covariance_table, standard_errors
 from motionhyst.identify.records import (
     MAX_ROWS,
     UNIFORM_RTOL,
     check_controller_period,
     check_signals,
     prefilter_cutoff,
+)
+from motionhyst.identify.residual_noise import (
+    ResidualCorrelation,
+    lower_bound_note,
+    white_noise_variance,
 )
 from motionhyst.identify.result import Identification
 from motionhyst.plants.registry import Plant
@@ -273,5 +281,54 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
     prob = FitProblem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],
                       rows=fit_rows(start, sel.size, max_rows), filt=lf.lowpass.with_step(q * dt),
                       fit_initial=initial_state == "fit", fit_offset=offset != "none")
-    return identify_prepared(prob, n_elements, criterion, rtol, atol, max_elements,
-                             "prefiltered force", cutoff_hz=lf.cutoff_hz)
+    ident = identify_prepared(prob, n_elements, criterion, rtol, atol, max_elements,
+                              "prefiltered force", cutoff_hz=lf.cutoff_hz)
+    return _correlated_std(ident, prob, _noise_rms(lf, L_over_P1, np.asarray(u, dtype=float)))
+
+
+def _noise_rms(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64]) -> float:
+    """The RMS of what the white noise of ``u`` and ``y1`` (their third differences' mean
+    square: an upper estimate, the controller's fast action counted) leaves in the
+    prefiltered link force ``L u - (L / P1) y1`` (the filters' impulse responses' norms)."""
+    delta = np.zeros(lf.y1.size)
+    delta[0] = 1.0
+    h_u, h_y = lf.lowpass(delta), L_over_P1(delta)
+    return float(np.sqrt(white_noise_variance(u, robust=False) * float(h_u @ h_u)
+                         + white_noise_variance(lf.y1, robust=False) * float(h_y @ h_y)))
+
+
+def _correlated_std(ident: Identification, prob: FitProblem, noise_rms: float
+                    ) -> Identification:
+    """The standard errors of a closed-loop fit with its residuals' autocorrelation (the
+    prefilter makes the noise of ``u`` and ``y1`` coloured:
+    :class:`~motionhyst.identify.residual_noise.ResidualCorrelation`), and marked as lower
+    bounds, with the line that says why, when the fit leaves more than the records' noise
+    (:func:`~motionhyst.identify.residual_noise.lower_bound_note`); the fit's own (white
+    residuals') standard errors kept as ``judged_std``, what judges a slip force determined."""
+    n = ident.n_elements
+    r, J = residuals_and_jacobian(prob, ident)
+    rss, rows = float(r @ r), r.size
+    corr = ResidualCorrelation([r])
+    std, _ = standard_errors(J, rss, rows, 1e-9, correlation=corr)
+    white, _ = standard_errors(J, rss, rows, 1e-9)
+    idx = [*range(2 * n), J.shape[1] - 1]
+    names = (["k", "fc"] if n == 1 else [f"{p}[{i}]" for p in ("k", "fc") for i in range(n)])
+    names.append("offset")
+    ident.judged_std = {f"{p}[{i}]": e[f"{p}_std"] for i, e in enumerate(ident.elements)
+                        for p in ("k", "fc")}
+    for i, e in enumerate(ident.elements):  # where the fit says not determined, it stays so
+        for name, j in (("k_std", i), ("fc_std", n + i)):
+            if math.isfinite(e[name]) and math.isfinite(std[j]):
+                e[name] = float(std[j])
+    if prob.fit_offset and math.isfinite(std[-1]):
+        ident.offset_std = float(std[-1])
+    sd = {nm: float(std[j]) if math.isfinite(std[j]) else None
+          for nm, j in zip(names, idx, strict=True)}
+    ident.covariance = covariance_table(
+        names, covariance(J, rss, rows, 1e-9, correlation=corr)[np.ix_(idx, idx)], sd)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        widened = float(np.nanmax(np.where(white > 0, std / white, np.nan), initial=1.0))
+    note = lower_bound_note(math.sqrt(rss / rows), noise_rms, widened, corr.lags, "N",
+                            float(np.sqrt(np.mean(prob.y ** 2))))
+    ident.std_lower_bound = note
+    return ident

@@ -223,6 +223,9 @@ class EMPSModel:
         The model's own estimates and standard errors, as ``identify --save`` writes
         them (``offset`` its own force offset, ``c_pos``, ``c_neg``, ``c_skew``,
         ``drift``, ...); empty when not known.
+    std_note : str or None
+        Why the standard errors are lower bounds (the fit leaves more than the record's white
+        noise, :func:`~motionhyst.identify.residual_noise.lower_bound_note`), or None.
 
     Examples
     --------
@@ -247,11 +250,13 @@ class EMPSModel:
     limit: str | None = None
     model_parameters: dict[str, float] = field(default_factory=dict)
     model_std: dict[str, float | None] = field(default_factory=dict)
+    std_note: str | None = None
 
     def to_dict(self) -> dict:
         """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``, and
         ``"model_parameters"``, ``"model_std"`` and ``"equivalent_offset"`` when known,
-        ``"limit"`` when the model is at one, ``"warnings"`` when there are any."""
+        ``"limit"`` when the model is at one, ``"std_lower_bound"`` (True) and ``"std_note"``
+        when the standard errors are lower bounds, ``"warnings"`` when there are any."""
         out = {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
                "estimation": dict(self.estimation), "validation": dict(self.validation),
                "seconds": self.seconds}
@@ -262,6 +267,8 @@ class EMPSModel:
             out["equivalent_offset"] = self.equivalent_offset
         if self.limit is not None:
             out["limit"] = self.limit
+        if self.std_note is not None:
+            out["std_lower_bound"], out["std_note"] = True, self.std_note
         if self.warnings:
             out["warnings"] = list(self.warnings)
         return out
@@ -818,4 +825,5 @@ def _identify_and_score(name: str, link: str, options: set[str], est: IORecord,
     parameters, std = reference_form(own, est, own_std, covariance)
     return EMPSModel(name, parameters, std, est_score, val_score, 0.0,
                      list(getattr(fit, "warnings", [])), yhat, parameters.get("offset"),
-                     model_parameters=own, model_std=own_std)
+                     model_parameters=own, model_std=own_std,
+                     std_note=fit.extra.get("std_note"))

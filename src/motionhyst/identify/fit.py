@@ -22,7 +22,7 @@ from motionhyst.identify.result import Identification
 if TYPE_CHECKING:  # a closed-loop record's prefilter (python-control): a force-displacement
     from motionhyst.core.lti import HoldFilter  # fit needs neither
 
-__all__ = ["identify_maxwell_slip"]
+__all__ = ["identify_maxwell_slip", "residuals_and_jacobian"]
 
 N_GRID = 40
 """Candidate slip displacements in the NNLS stage."""
@@ -532,6 +532,50 @@ def identify_prepared(prob: FitProblem, n_elements: int | None, criterion: Crite
         cutoff_hz=cutoff_hz,
         covariance=_covariance_of(chosen, n_rows, order, std),
     )
+
+
+def residuals_and_jacobian(prob: FitProblem, ident: Identification
+                           ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The residuals of an identification's link on its fit's problem and their Jacobian:
+    what its standard errors come from (:func:`~motionhyst.identify.io_uncertainty.covariance`;
+    the closed-loop route's with the residuals' autocorrelation,
+    :func:`~motionhyst.identify.closed_loop.identify_closed_loop`).
+
+    Parameters
+    ----------
+    prob : FitProblem
+        The problem `ident` was fitted on (:func:`identify_prepared`).
+    ident : Identification
+        Its result: the link's elements in their order, their initial forces and the
+        offset.
+
+    Returns
+    -------
+    r : ndarray
+        The model's force less the target at the problem's rows [N].
+    J : ndarray
+        ``d r / d theta``, columns ``k[0..n-1]``, ``fc[0..n-1]``, the elements' initial
+        states ``alpha = f_0 / fc`` where the problem estimates them, and the offset (a
+        column of zeros where the problem fixes it at 0).
+
+    Examples
+    --------
+    >>> from motionhyst import MaxwellSlip
+    >>> t = np.linspace(0.0, 4.0, 4001)
+    >>> x = 0.01 * np.exp(-t / 2) * np.sin(2 * np.pi * 2.0 * t)
+    >>> w = MaxwellSlip(k=[10.0, 6.0], fc=[0.01, 0.03]).response(x)
+    >>> prob = FitProblem(x=x, target=w, rows=fit_rows(0, x.size, MAX_ROWS), filt=None,
+    ...                   fit_initial=True)
+    >>> ident = identify_prepared(prob, None, "rms", 0.01, 1e-3, MAX_ELEMENTS, "force")
+    >>> r, J = residuals_and_jacobian(prob, ident)
+    >>> J.shape, bool(np.sqrt(np.mean(r ** 2)) <= ident.fit_rms * (1 + 1e-9))
+    ((4001, 7), True)
+    """
+    n = ident.n_elements
+    k, fc = np.asarray(ident.model.k, float), np.asarray(ident.model.fc, float)
+    alpha = np.divide(ident.initial_forces, fc, out=np.zeros(n), where=fc > 0)
+    r, J = _evaluate(prob, _pack(k, fc, alpha, ident.offset, prob.fit_initial), n, True)
+    return r, J
 
 
 def fit_rows(start: int, n: int, max_rows: int) -> NDArray[np.intp]:

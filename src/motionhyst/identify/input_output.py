@@ -446,8 +446,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(stage, link)
         failed = None
         try:  # parameters the records do not determine: a warning, or (most) a failed fit
-            determined = judge_determined(fit.estimates, fit.std, invariant, zero,
-                                          _one_way_names(fit))
+            determined = judge_determined(fit.estimates, fit.judged_std or fit.std, invariant,
+                                          zero, _one_way_names(fit))
         except FitFailed as exc:
             failed = exc
         kept = (_determined_elements(fit, n_elements, invariant, zero)
@@ -570,11 +570,11 @@ def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
     if rigid is None:
         raise failed
     try:
-        determined = judge_determined(rigid.estimates, rigid.std, (), zero_allowed(stage, Coulomb),
-                                      _one_way_names(rigid))
+        determined = judge_determined(rigid.estimates, rigid.judged_std or rigid.std, (),
+                                      zero_allowed(stage, Coulomb), _one_way_names(rigid))
     except FitFailed:
         raise failed from None
-    names = undetermined(fit.estimates, fit.std, invariant, zero)
+    names = undetermined(fit.estimates, fit.judged_std or fit.std, invariant, zero)
     why = f"the records do not determine its {', '.join(names)}"
     note = (f"the {fit.hysteresis.name} link is reported as its rigid limit, the Coulomb link "
             f"(fc {rigid.estimates['link.fc']:.4g} N, fit RMS {rigid.fit_rms:.3g} m): {why}")
@@ -607,7 +607,7 @@ def _determined_elements(fit: IOIdentification, n: int, invariant: tuple[str, ..
     """The Maxwell-slip elements the fit's records determine: `n` if they determine every
     element's stiffness and slip force, else as many elements as have both determined, at
     least 1 and at most ``n - 1``."""
-    bad = set(undetermined(fit.estimates, fit.std, invariant, zero))
+    bad = set(undetermined(fit.estimates, fit.judged_std or fit.std, invariant, zero))
     kept = sum(1 for i in range(n) if f"link.k[{i}]" not in bad and f"link.fc[{i}]" not in bad)
     return n if kept == n else max(1, min(kept, n - 1))
 

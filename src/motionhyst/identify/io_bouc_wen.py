@@ -41,9 +41,8 @@ from motionhyst.identify.io_start import (
 )
 from motionhyst.identify.io_uncertainty import (
     SINGULAR_RTOL,
-    covariance,
+    correlated_errors,
     covariance_table,
-    standard_errors,
     undetermined_notes,
 )
 from motionhyst.time.openloop import (
@@ -275,7 +274,7 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     for _, _, p_start in refined[:FINAL_ATTEMPTS]:
         if error is not None and plan.left is not None and plan.left < 3 + output_offset:
             raise error  # no budget for another attempt
-        p, free_used, sol, res, std_q, groups, notes, _, cov = _refine(
+        p, free_used, sol, res, errors, notes, _ = _refine(
             records, periodic, r, free, p_start, y_scale, scale, tol, max_nfev,
             output_offset=output_offset, budget=plan, keep=1 + output_offset)
         try:
@@ -303,19 +302,20 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
     not_ident = {"beta": "only the products beta*gamma and beta*delta enter the model "
                          "(z is not measured); beta is fixed by |gamma| + |delta| = 1",
                  "gamma": "see beta", "delta": "see beta", **notes}
-    for n, s in zip(free_names, std_q, strict=True):
+    judged = _finite(free_names, errors.white_std)
+    for n, s in zip(free_names, errors.std, strict=True):
         std[n] = float(s) if math.isfinite(s) else None
-    not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
+    not_ident.update(undetermined_notes(free_names, errors.groups, SINGULAR_RTOL))
     per_record = per_record_errors(records, res)
-    extra: dict = {"covariance": covariance_table(free_names, cov, std),
-                   "budget_reached": bool(sol.status == 0)}
+    extra: dict = {"covariance": covariance_table(free_names, errors.cov, std),
+                   "budget_reached": bool(sol.status == 0), **errors.flags}
     if output_offset:
-        offsets, offset_std = _output_offsets(records, periodic, r, free, p, y_scale, rss, plan,
-                                              res.size)
-        for i, (value, sd) in enumerate(zip(offsets, offset_std, strict=True)):
+        offsets, offset_std, offset_judged = _output_offsets(records, periodic, r, free, p,
+                                                             y_scale, plan)
+        for i, (value, sd, sw) in enumerate(zip(offsets, offset_std, offset_judged,
+                                                strict=True)):
             name = "output_offset" if len(records) == 1 else f"output_offset[{i}]"
-            estimates[name] = value
-            std[name] = sd
+            estimates[name], std[name], judged[name] = value, sd, sw
         extra["offsets"] = {"input": 0.0, "output": offsets}
     # with each record's position offset estimated, the fit is judged on the records' variations
     warnings = _judged(records, res, plant, link, {"m": plant.m}, floating=False,
@@ -327,12 +327,13 @@ def identify_bouc_wen_msd(records: list[IORecord], periodic: bool, nu: float | N
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
         n_evaluations=plan.used - used0, substeps=r, extra=extra, warnings=warnings,
-        data=list(records), residuals=res)
+        data=list(records), residuals=res, judged_std=judged)
 
 
-def _output_offsets(records, periodic, r, free, p, y_scale, rss, budget, n_rows):
-    """Each record's position offset (the mean of its data less the model's output) and its
-    standard error, from the Jacobian of the parameters and offsets together."""
+def _output_offsets(records, periodic, r, free, p, y_scale, budget):
+    """Each record's position offset (the mean of its data less the model's output), its
+    standard error and that of white residuals, from the Jacobian of the parameters and
+    offsets together."""
     prob = _BoucWenProblem(records, periodic, r, free, p, y_scale, budget=budget)
     res, jac = prob.run(p, True)
     offsets, columns, i = [], [], 0
@@ -344,8 +345,10 @@ def _output_offsets(records, periodic, r, free, p, y_scale, rss, budget, n_rows)
         columns.append(e)
         i += rec.y.size
     J = np.column_stack([jac[:, free] * y_scale, *columns])
-    std_all, _ = standard_errors(J, rss, n_rows)
-    return offsets, [float(s) if math.isfinite(s) else None for s in std_all[-len(records):]]
+    parts = [e - np.mean(e) for e in _by_record(records, res * y_scale)]  # offsets taken out
+    errors = correlated_errors(J, parts)
+    return offsets, *([float(s) if math.isfinite(s) else None for s in std[-len(records):]]
+                      for std in (errors.std, errors.white_std))
 
 
 def _judged(records: list[IORecord], res: NDArray[np.float64], plant, link,
@@ -417,11 +420,11 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
         res, jac = prob.run(p, True)
         n_eval += prob.n_eval
         res *= y_scale
-        std_q, groups = standard_errors(jac[:, free] * y_scale, float(res @ res), res.size)
-        cov = covariance(jac[:, free] * y_scale, float(res @ res), res.size)
+        errors = correlated_errors(jac[:, free] * y_scale, _by_record(records, res),
+                                   signal_rms=_rms(records))
         if not free[6] or p[4] + p[5] >= 0.0:
             break
-        nu_std = std_q[int(np.count_nonzero(free[:6]))]
+        nu_std = errors.white_std[int(np.count_nonzero(free[:6]))]  # judged as white
         if not abs(p[6] - 1.0) <= max(3.0 * nu_std, 1e-9) or (
                 plan.left is not None and plan.left < keep + 2):  # or no budget to refit
             break
@@ -431,7 +434,22 @@ def _refine(records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=
         free = free.copy()
         free[6] = False
         p[6] = 1.0
-    return p, free, sol, res, std_q, groups, notes, n_eval, cov
+    return p, free, sol, res, errors, notes, n_eval
+
+
+def _finite(names: list[str], std: NDArray[np.float64]) -> dict[str, float | None]:
+    """Standard errors by name, None where not determined (not finite)."""
+    return {n: float(s) if math.isfinite(s) else None for n, s in zip(names, std, strict=True)}
+
+
+def _rms(records: list[IORecord]) -> float:
+    """The records' positions' RMS [m]."""
+    return float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2)))
+
+
+def _by_record(records: list[IORecord], res: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """The residuals `res` (the records one after the other) split by record."""
+    return np.split(res, np.cumsum([rec.y.size for rec in records])[:-1])
 
 
 def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, output, t_start,
@@ -444,7 +462,7 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
     used0 = plan.used
     structure, r, y_scale, scale, free, p, _ = _two_mass_start(records, periodic, nu,
                                                               substeps, output, plan)
-    p, free, sol, res, std_q, groups, notes, _, cov = _refine(
+    p, free, sol, res, errors, notes, _ = _refine(
         records, periodic, r, free, p, y_scale, scale, tol, max_nfev, plant=structure,
         budget=plan)
     link = _bouc_wen_link(p[3], p[4], p[5], p[6])
@@ -453,16 +471,16 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
     names = ["m1", "m2", "b", "alpha", "beta*gamma", "beta*delta", "nu", "k"]
     free_names = [n for n, f in zip(names, free, strict=True) if f]
     values = dict(zip(names, p, strict=True))
-    std_of = dict(zip(free_names, std_q, strict=True))
+    std_of = _finite(free_names, errors.std)
+    judged = _finite(free_names, errors.white_std)
     # the plant's parameters first, then the link's
     order = ["m1", "m2", "b", "k", "alpha", "beta*gamma", "beta*delta", "nu"]
     estimates = {n: float(values[n]) for n in order if n in free_names}
-    std: dict[str, float | None] = {n: float(std_of[n]) if math.isfinite(std_of[n]) else None
-                                    for n in estimates}
+    std: dict[str, float | None] = {n: std_of[n] for n in estimates}
     not_ident = {"beta": "only the products beta*gamma and beta*delta enter the model "
                          "(z is not measured); beta is fixed by |gamma| + |delta| = 1",
                  "gamma": "see beta", "delta": "see beta", **notes}
-    not_ident.update(undetermined_notes(free_names, groups, SINGULAR_RTOL))
+    not_ident.update(undetermined_notes(free_names, errors.groups, SINGULAR_RTOL))
     warnings = _judged(records, res, stage, link, {"m1": stage.m1, "m2": stage.m2},
                        floating=True, centred=periodic)
     return IOIdentification(
@@ -473,8 +491,9 @@ def identify_bouc_wen_two_mass(records, periodic, nu, substeps, tol, max_nfev, o
         stopping=f"{sol.message} (ftol = xtol = gtol = {tol:g}, at most {max_nfev} "
                  f"evaluations; {sol.nfev} used)",
         n_evaluations=plan.used - used0, substeps=r, warnings=warnings, data=list(records),
-        residuals=res, extra={"covariance": covariance_table(free_names, cov, std),
-                              "budget_reached": bool(sol.status == 0)})
+        residuals=res, judged_std={n: judged[n] for n in estimates},
+        extra={"covariance": covariance_table(free_names, errors.cov, std),
+               "budget_reached": bool(sol.status == 0), **errors.flags})
 
 
 def _two_mass_start(records: list[IORecord], periodic: bool, nu: float | None,

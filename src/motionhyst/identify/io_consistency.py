@@ -18,7 +18,7 @@ from motionhyst.core.blas import few_blas_threads
 from motionhyst.identify.io_checks import check_inertia
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
-from motionhyst.identify.io_uncertainty import white_noise_variance
+from motionhyst.identify.residual_noise import white_noise_variance
 
 __all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "SI_READINGS", "UNIT_FACTORS",
            "UNIT_READINGS", "check_one_stage", "mass_units_note"]

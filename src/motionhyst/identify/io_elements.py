@@ -56,15 +56,14 @@ from motionhyst.identify.io_uncertainty import (
     SINGULAR_RTOL,
     WINDOW_INFLATION,
     WindowNoise,
-    covariance,
+    correlated_errors,
     covariance_table,
     parallel_note,
-    standard_errors,
     undetermined_notes,
     weak_notes,
-    white_noise_variance,
     window_inflation,
 )
+from motionhyst.identify.residual_noise import white_noise_variance
 from motionhyst.identify.rigid_limit import as_rigid_limit, rigid_seed
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import (
@@ -750,7 +749,12 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     # a window's state moves with its samples' noise, and so every residual after it
     noise = (prob.window_noise(v, white_noise_variance(prob._split_rows(res)))
              if init_window is not None else None)
-    std_v, groups = standard_errors(J, rss, res.size, rtol, noise)
+    # the residuals' correlation widens them; a fit above the noise makes them lower bounds;
+    # what the records determine is judged as white residuals say
+    errors = correlated_errors(
+        J, prob._split_rows(res), rtol, noise,
+        signal_rms=float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2))))
+    std_v, groups, cov, white = errors.std, errors.groups, errors.cov, errors.white_std
     names = [*prob.plant.PARAMETERS, *layout.names, *extras.names]
     estimates = {nm: float(x) for nm, x in zip(names, v, strict=True)}
     std: dict[str, float | None] = {}
@@ -764,7 +768,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                   f"direction): fixed at 0")
                  for name in layout.fixed}
     not_ident.update(undetermined_notes(names, groups, rtol))
-    weak = weak_notes(names, v, std_v, J, rtol, ~prob.log)
+    weak = weak_notes(names, v, white, J, rtol, ~prob.log)
     n_short = sum(rec.y.size for rec in short)
     if rate.any() and flat_profile(profile, n_short - short_scale.size):
         lo, hi = min(RATE_GRID) * v_scale, max(RATE_GRID) * v_scale
@@ -778,7 +782,6 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         if name not in not_ident:
             not_ident[name] = why
             std[name] = None
-    cov = covariance(J, rss, res.size, rtol, noise)
     slips = (slider_slips(layout.build(v[n_plant:n_base]), prob._split_rows(res, measured=True))
              if shape.n == 1 else None)  # the link moves with the measured position
     one_way = one_way_slip(names, v, rss, res.size, prob.errors_at, cov, layout.cls.name, slips)
@@ -847,7 +850,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                "initial_state": initial_state_out, "init_window": init_window,
                "budget_reached": bool(sol.status == 0),
                "covariance": covariance_table(names, cov, std),
-               **({"one_way": one_way.to_dict()} if one_way is not None else {})})
+               **errors.flags,
+               **({"one_way": one_way.to_dict()} if one_way is not None else {})},
+        judged_std={nm: None if s is None else float(w)
+                    for (nm, s), w in zip(std.items(), white, strict=True)})
 
 
 def _window_price(J, rss, n_rows, rtol, noise: WindowNoise, names: list[str], window: int

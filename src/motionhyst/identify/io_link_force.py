@@ -94,7 +94,7 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
         fit.warnings.append(budget_note(fit.n_evaluations))
     # parameters the records do not determine: a warning, or (most of them) a failed fit
-    fit.warnings.extend(judge_determined(fit.estimates, fit.std,
+    fit.warnings.extend(judge_determined(fit.estimates, fit.judged_std or fit.std,
                                          BOUC_WEN_SCALE if link is BoucWen else (),
                                          zero_allowed(fit.plant, link)))
     for line in fit.warnings:  # for every caller to see, as identify_io's

@@ -22,7 +22,7 @@ from scipy.optimize import least_squares
 
 from motionhyst.core.budget import check_memory
 from motionhyst.hysteresis.stepping import Stepping
-from motionhyst.identify.io_uncertainty import white_noise_variance
+from motionhyst.identify.residual_noise import white_noise_variance
 from motionhyst.time.openloop import (
     FINE_BYTES,
     SAMPLE_BYTES,
@@ -63,7 +63,7 @@ class WindowPrediction:
         [m]; None where there is no state (a stage without inertia).
     noise : float or None
         That noise [m] (the error's third differences:
-        :func:`~motionhyst.identify.io_uncertainty.white_noise_variance`).
+        :func:`~motionhyst.identify.residual_noise.white_noise_variance`).
 
     Examples
     --------

@@ -1,15 +1,13 @@
 """Input-output identification of a link without inertia (the quasi-static plant).
 
-Records where no inertia is visible (a piezo actuator below its first
-resonance, a friction damper driven slowly) are the force balancing the link
-and a spring ``k`` and damper ``c`` in parallel at every sample,
-:class:`~motionhyst.plants.quasi_static.QuasiStatic`:
-``u - u_0 = w(x) + k x + c x'``, the measured position ``y = x + y_0``.  The
-link (any registered model with a time step, Bouc-Wen included), ``k``, ``c``
-and the offsets are estimated by the *simulation* error of the position, the
-model run from the force alone
-(:func:`~motionhyst.time.quasi_static.displacement_from_force`), as the other
-plants are (:mod:`~motionhyst.identify.input_output`).
+Records where no inertia is visible (a piezo actuator below its first resonance, a friction
+damper driven slowly) are the force balancing the link and a spring ``k`` and damper ``c`` in
+parallel at every sample, :class:`~motionhyst.plants.quasi_static.QuasiStatic`:
+``u - u_0 = w(x) + k x + c x'``, the measured position ``y = x + y_0``.  The link (any
+registered model with a time step, Bouc-Wen included), ``k``, ``c`` and the offsets are
+estimated by the *simulation* error of the position, the model run from the force alone
+(:func:`~motionhyst.time.quasi_static.displacement_from_force`), as the other plants are
+(:mod:`~motionhyst.identify.input_output`).
 
 Method
 ------
@@ -67,9 +65,8 @@ from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
-    covariance,
+    correlated_errors,
     covariance_table,
-    standard_errors,
     undetermined_notes,
 )
 from motionhyst.plants.quasi_static import QuasiStatic
@@ -483,13 +480,18 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     J = (_inward_jacobian(prob, sol, force_error, layout)
          * (prob.u_scale if force_error else prob.y_scale)
          / np.where(prob.log, v, prob.scale)[prob.free])
-    std_free, groups = standard_errors(J, float(np.sum(res ** 2)), res.size, FD_SINGULAR_RTOL)
+    errors = correlated_errors(
+        J, np.split(res, np.cumsum([rec.y.size for rec in records])[:-1]), FD_SINGULAR_RTOL,
+        unit="N" if force_error else "m",
+        signal_rms=float(np.sqrt(np.mean(np.concatenate(measured) ** 2))))
+    std_free, cov, white = errors.std, errors.cov, errors.white_std
     names = [n for n, f in zip(prob.names, prob.free, strict=True) if f]
-    notes = undetermined_notes(names, groups, FD_SINGULAR_RTOL)
-    cov = covariance(J, float(np.sum(res ** 2)), res.size, FD_SINGULAR_RTOL)
+    notes = undetermined_notes(names, errors.groups, FD_SINGULAR_RTOL)
     values = v[prob.free]
     if isinstance(layout, BoucWenShape):  # written as the link is: beta + gamma = 1
         shape_notes = [n for n in ("link.beta+gamma", "link.beta-gamma") if n in notes]
+        white = np.sqrt(np.maximum(np.diag(layout.normalised(names, values,
+                                                             errors.white_cov)[2]), 0.0))
         names, values, cov, fitted = layout.normalised(names, values, cov)
         std_free = np.sqrt(np.maximum(np.diag(cov), 0.0))
         for n in shape_notes:
@@ -501,6 +503,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     estimates = {n: float(x) for n, x in zip(names, values, strict=True)}
     std = {n: (None if n in notes or not math.isfinite(s) else float(s))
            for n, s in zip(names, std_free, strict=True)}
+    judged = {n: None if std[n] is None else float(w) for n, w in zip(names, white, strict=True)}
     v_start = prob.values(start)
     warnings = [f"{n} = {x:.4g} ran {max(x / x0, x0 / x):.2g} times "
                 f"{'above' if x > x0 else 'below'} its start: the records do not hold it (a "
@@ -518,7 +521,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     extra = {"offsets": {"input": float(v[2 + prob.n_link]),
                          "output": [float(x) for x in prob.output_offsets(v)]},
              "budget_reached": stopped,
-             "covariance": covariance_table(names, cov, std)}
+             "covariance": covariance_table(names, cov, std), **errors.flags}
     return IOIdentification(
         plant=plant, hysteresis=fitted, estimates=estimates, std=std, not_identifiable=notes,
         fit_rms=fit_rms, records=per_record_errors(records, res, measured),
@@ -526,7 +529,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         stopping=f"{sol.message} (forward differences; ftol = xtol = gtol = {tol:g}, "
                  f"{prob.n_eval} evaluations with the starts)",
         n_evaluations=prob.n_eval, substeps=1, extra=extra, warnings=warnings,
-        data=list(records), residuals=res, output=what)
+        data=list(records), residuals=res, output=what, judged_std=judged)
 
 
 def _inward_jacobian(prob: _Problem, sol, force_error: bool, layout: LinkLayout
@@ -625,7 +628,7 @@ def _exponent_profile(records: list[IORecord], **options) -> IOIdentification:
         s2 = rss[j] / max(best.residuals.size - len(best.estimates) - 1, 1)
         std = float(np.sqrt(2.0 * s2 / (2.0 * a))) if a > 0 else None
     best.estimates["link.n"] = float(nus[j])
-    best.std["link.n"] = std
+    best.std["link.n"] = best.judged_std["link.n"] = std  # white residuals' curvature
     best.stopping += (f"; exponent n by the fits of {nus.size} fixed values from "
                       f"{nus[0]:g} to {nus[-1]:g}")
     return best

@@ -32,7 +32,9 @@ class IOIdentification:
         Every estimated parameter (identifiable quantities only) by name.
     std : dict
         Standard error of each estimate (same keys); ``None`` where the data
-        do not determine it (then listed in `not_identifiable`).
+        do not determine it (then listed in `not_identifiable`).  With the residuals'
+        autocorrelation (:class:`~motionhyst.identify.io_uncertainty.CorrelatedErrors`):
+        wider than `judged_std` where the fit leaves more than white noise.
     not_identifiable : dict
         Parameter name -> why it is not identifiable and what is.
     fit_rms : float
@@ -57,7 +59,10 @@ class IOIdentification:
         covariance of the determined estimates from the fit's Jacobian (``covariance``:
         ``{"parameters", "matrix"}``,
         :func:`~motionhyst.identify.io_uncertainty.covariance_table`; a Bouc-Wen link's
-        under its identified names ``alpha``, ``beta*gamma``, ``beta*delta``, ``nu``).
+        under its identified names ``alpha``, ``beta*gamma``, ``beta*delta``, ``nu``), and
+        ``std_lower_bound`` (True) where the standard errors are lower bounds, with
+        ``std_note``, the line of the result that says why (the fit leaves more than the
+        records' white noise, :func:`~motionhyst.identify.residual_noise.lower_bound_note`).
     warnings : list of str
         Implausible estimates, one line each naming the parameter
         (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
@@ -77,6 +82,12 @@ class IOIdentification:
         Coulomb link with the same options, that a friction link's search started from (not
         in :meth:`to_dict`): what a Jenkins link whose stiffness the records do not resolve
         is reported as (:func:`~motionhyst.identify.rigid_limit.unresolved_stiffness`).
+    judged_std : dict
+        The standard errors white residuals give (keys and ``None`` as `std`; not in
+        :meth:`to_dict`): what judges whether a parameter is determined
+        (:func:`~motionhyst.identify.io_uncertainty.judge_determined`), so that a fit's
+        model error widens the standard errors it reports, not what the records determine;
+        empty: `std`.
 
     Examples
     --------
@@ -116,6 +127,8 @@ class IOIdentification:
                                            compare=False)
     output: str = "position"
     rigid_limit: IOIdentification | None = field(default=None, repr=False, compare=False)
+    judged_std: dict[str, float | None] = field(default_factory=dict, repr=False,
+                                                compare=False)
 
     @property
     def unit(self) -> str:
@@ -131,15 +144,19 @@ class IOIdentification:
         stage = self.plant.to_dict().get("type", type(self.plant).__name__)
         kind = "periodic steady state" if self.periodic else "from a start"
         rows = []
+        at_least = ">= " if self.extra.get("std_lower_bound") else ""
         for name, value in self.estimates.items():
             s = self.std.get(name)
-            rows.append([name, g(value, 8), "not identifiable" if s is None else g(s, 2),
+            rows.append([name, g(value, 8), "not identifiable" if s is None else
+                         at_least + g(s, 2),
                          "" if s is None or value == 0 else f"{100 * s / abs(value):.2g} %"])
         what = "force-displacement" if self.output == "force" else "input-output"
         lines = [f"{stage} stage and {self.hysteresis.name} link from {len(self.records)} "
                  f"{what} record(s) ({kind})",
                  f"  fit RMS {g(self.fit_rms)} {self.unit}; {self.stopping}", "",
                  table(["parameter", "estimate", "std", "std/|value|"], rows)]
+        if self.extra.get("std_note"):
+            lines.append(f"  {self.extra['std_note']}")
         if self.not_identifiable:
             lines.append("")
             lines += [f"  {name}: {why}" for name, why in self.not_identifiable.items()]
@@ -215,7 +232,7 @@ class IOIdentification:
                    if isinstance(v, list) for i in range(len(v))}}
         ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys,
                                     "force-displacement" if self.output == "force"
-                                    else "input-output")
+                                    else "input-output", lower_bound=self.extra.get("std_note"))
         return text + ("\n" + ident if ident else "")
 
 

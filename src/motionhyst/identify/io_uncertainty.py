@@ -27,13 +27,22 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.identify.residual_noise import (
+    ResidualCorrelation,
+    lower_bound_note,
+    white_noise_variance,
+)
+
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
-           "WINDOW_INFLATION", "WindowNoise", "judge_determined", "parallel_note",
-           "undetermined", "white_noise_variance", "window_inflation", "zero_allowed"]
+           "WINDOW_INFLATION", "CorrelatedErrors", "WindowNoise", "correlated_errors",
+           "judge_determined", "parallel_note", "undetermined", "window_inflation",
+           "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -78,7 +87,8 @@ class WindowNoise:
     they are mostly the model's error (a measured axis: EMPS's fit RMS is 0.45 mm, its
     encoder's noise 0.02 um), that error is not what the window's samples carry into the
     state; with the positions' own noise ``sigma_n^2`` (`sigma2`,
-    :func:`white_noise_variance`: their residuals' sum of squares would take the model's
+    :func:`~motionhyst.identify.residual_noise.white_noise_variance`: their residuals' sum of
+    squares would take the model's
     error for noise, and the few samples of a short window make it scatter) the covariance
     is
 
@@ -194,94 +204,168 @@ class WindowNoise:
 WINDOW_INFLATION = 2.0
 
 
-#: Differences whose scatter measures a record's white noise (:func:`white_noise_variance`):
-#: the third, which take a smooth error down to its jerk times the step cubed and white
-#: noise to ``20 sigma^2``
-NOISE_DIFFERENCES = 3
-
-
-def white_noise_variance(parts: NDArray[np.float64] | list[NDArray[np.float64]],
-                         robust: bool = True) -> float:
-    """The variance of a signal's white noise, from its third differences: one estimate
-    for every part of motionhyst that needs a record's noise (the standard errors of an
-    input-output fit, ``predict``'s error, a closed-loop record's passivity check,
-    ``predict --init-from``'s same-run check).
-
-    A residual (or a measured signal) is noise plus something smooth: a simulated stage's
-    error, a force sampled well above its bandwidth.  The smooth part's third differences
-    are its jerk times the step cubed, far below its size, while white noise's have
-    ``20 sigma^2`` (``C(6, 3)``).  With `robust` (the default) their median absolute
-    deviation is taken, which keeps a few steps out (a slider sticking a sample early);
-    without, their mean square, which counts every fast move as noise (a controller's fast
-    action on a closed loop's force: an upper estimate, what a check that must not refuse
-    noise needs).  A record's quantisation (an encoder's step ``q``: ``q^2 / 12``) counts
-    as its noise.
-
-    Parameters
-    ----------
-    parts : ndarray or list of ndarray
-        The signal [any unit], or several records' (each differenced on its own; a part
-        of 3 samples or fewer does not count).
-    robust : bool
-        The median absolute deviation (default) rather than the mean square.
-
-    Returns
-    -------
-    float
-        ``sigma^2`` [the signal's unit squared] (0 for records too short).
-
-    Examples
-    --------
-    A model's error of 100 um, slow, and 1 um of white noise: the noise is found.
-
-    >>> rng = np.random.default_rng(0)
-    >>> t = np.arange(5000) / 1000.0
-    >>> smooth = 1e-4 * np.sin(2 * np.pi * 3 * t)
-    >>> e = smooth + 1e-6 * rng.standard_normal(t.size)
-    >>> round(float(np.sqrt(white_noise_variance(e))) * 1e6, 2)
-    1.0
-    >>> round(float(np.sqrt(white_noise_variance([e[:2500], e[2500:]], robust=False))) * 1e6, 2)
-    1.0
-    """
-    k = NOISE_DIFFERENCES
-    if isinstance(parts, np.ndarray) and parts.ndim == 1:
-        parts = [parts]
-    d = [np.diff(np.asarray(r, dtype=float), k) for r in parts if len(r) > k]
-    if not d:
-        return 0.0
-    d = np.concatenate(d)
-    if not robust:
-        return float(np.mean(d ** 2)) / math.comb(2 * k, k)
-    mad = float(np.median(np.abs(d - np.median(d))))
-    return (1.4826 * mad) ** 2 / math.comb(2 * k, k)
-
-
 def _decomposed(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float,
-                noise: WindowNoise | None):
+                noise: WindowNoise | None, correlation: ResidualCorrelation | None = None,
+                spread: list[float] | None = None):
     """The normalised columns' scales, the covariance of the estimates in normalised
     coordinates over the determined directions (``sigma^2 V S^-2 V^T``; with `noise`,
     ``V S^-1 (sigma_r^2 I + sigma_n^2 (W W^T - I)) S^-1 V^T``, ``W = U^T L``) and the
-    undetermined directions (rows of right singular vectors)."""
+    undetermined directions (rows of right singular vectors); with `correlation`, the
+    residuals' part ``sigma^2 I`` is ``sigma^2 U^T C U``
+    (:class:`~motionhyst.identify.residual_noise.ResidualCorrelation`);
+    `spread`, if a list, receives ``E RSS / sigma_n^2`` of the window's noise alone."""
     norms = np.linalg.norm(J, axis=0)
     norms[norms == 0] = 1.0
     u, sv, vt = np.linalg.svd(J / norms, full_matrices=False)
     good = sv > rtol * sv[0]
     dof = max(n_rows - J.shape[1], 1)
     eye = np.eye(int(good.sum()))
+    own = eye if correlation is None else correlation.inner(u[:, good])
     if noise is None:
-        inner = rss / dof * eye
+        inner = rss / dof * own
     else:
         if noise.n_rows != J.shape[0]:
             raise ValueError("the noise map's rows differ from the Jacobian's")
         W = noise.left(u[:, good])
-        inner = (noise.residual_variance(W, rss, dof) * eye
+        if spread is not None:
+            spread.append(noise.frobenius2() - float(np.sum(W * W)))
+        inner = (noise.residual_variance(W, rss, dof) * own
                  + noise.sigma2 * (W @ W.T - eye))
     vg = vt[good].T / sv[good]
     return norms, vg @ inner @ vg.T, vt[~good]
 
 
+class CorrelatedErrors(NamedTuple):
+    """A fit's standard errors with its residuals' autocorrelation
+    (:func:`correlated_errors`), and those white residuals would give.
+
+    The first are the ones reported; the second judge whether a parameter is determined
+    (:func:`weak_notes`, :func:`judge_determined`): that a fit leaves model error
+    (coloured residuals) widens what it reports, not what the records determine.
+
+    Parameters
+    ----------
+    std : ndarray
+        The standard errors, NaN where not determined.
+    groups : list of list of int
+        The columns of each direction the data do not determine.
+    cov : ndarray
+        Their covariance (NaN rows and columns where not determined).
+    note : str or None
+        Why they are lower bounds (:func:`~motionhyst.identify.residual_noise.lower_bound_note`).
+    white_cov : ndarray
+        The covariance white residuals give (:func:`covariance`).
+    """
+
+    std: NDArray[np.float64]
+    groups: list[list[int]]
+    cov: NDArray[np.float64]
+    note: str | None
+    white_cov: NDArray[np.float64]
+
+    @property
+    def white_std(self) -> NDArray[np.float64]:
+        """The standard errors white residuals give (NaN where not determined)."""
+        return np.sqrt(np.maximum(np.diag(self.white_cov), 0.0))
+
+    @property
+    def flags(self) -> dict:
+        """``{"std_lower_bound": True, "std_note": note}`` for a result's ``extra`` where
+        the standard errors are lower bounds, else empty."""
+        return {} if self.note is None else {"std_lower_bound": True, "std_note": self.note}
+
+
+def correlated_errors(J: NDArray[np.float64], parts: list[NDArray[np.float64]],
+                      rtol: float = SINGULAR_RTOL, noise: WindowNoise | None = None,
+                      unit: str = "m", signal_rms: float = 0.0) -> CorrelatedErrors:
+    """Standard errors, the groups the data cannot separate and the covariance
+    (:func:`standard_errors`, :func:`covariance`) with the residuals' autocorrelation
+    (:class:`~motionhyst.identify.residual_noise.ResidualCorrelation`), those of white
+    residuals, and why they are lower bounds
+    (:func:`~motionhyst.identify.residual_noise.lower_bound_note`: the fit leaves more than
+    the records' white noise, or with an initialisation window's `noise`, more than that
+    noise leaves in expectation; the residuals' correlation is then taken beyond the
+    records' states, whose noise the window's sandwich counts).
+
+    Parameters
+    ----------
+    J : ndarray
+        The Jacobian of the residuals (rows: the records' residuals, record by record).
+    parts : list of ndarray
+        Each record's residuals, in time order.
+    rtol : float
+        Singular values below this share of the largest are not determined.
+    noise : WindowNoise, optional
+        An initialisation window's noise map.
+    unit : str
+        The residuals' unit.
+    signal_rms : float
+        The records' RMS (:func:`~motionhyst.identify.residual_noise.lower_bound_note`: a
+        fit exact to it is not said).
+
+    Returns
+    -------
+    CorrelatedErrors
+        ``std, groups, cov, note, white_cov``.
+
+    Examples
+    --------
+    A line fitted to a record whose noise is white, then to one whose noise is a
+    first-order autoregression (``rho = 0.95``): the offset's standard error widens by
+    about ``sqrt((1 + rho) / (1 - rho)) = 6.2``, and the fit leaves more than the white
+    noise; the white residuals' standard error is the usual one.
+
+    >>> from scipy.signal import lfilter
+    >>> rng = np.random.default_rng(1)
+    >>> t = np.linspace(0.0, 1.0, 5000)
+    >>> J = np.column_stack([np.ones_like(t), t])
+    >>> e = 1e-6 * rng.standard_normal(t.size)
+    >>> out = correlated_errors(J, [e - J @ np.linalg.lstsq(J, e)[0]])
+    >>> round(float(out.std[0] / (1e-6 * np.sqrt(4 / 5000))), 1), out.note is None
+    (1.0, True)
+    >>> c = lfilter([1.0], [1.0, -0.95], e)
+    >>> out = correlated_errors(J, [c - J @ np.linalg.lstsq(J, c)[0]])
+    >>> out.note[:65]
+    'standard errors are lower bounds: the fit leaves 5.7 times its re'
+    >>> out.note.split("widened ")[1][:3], round(float(out.std[0] / out.white_std[0]), 1)
+    ('6.1', 6.1)
+    """
+    parts = [np.asarray(p, dtype=float) for p in parts]
+    res = np.concatenate(parts)
+    rss, n_rows = float(res @ res), res.size
+    own = parts
+    if noise is not None:  # what the window's noise moves along the states: its sandwich's
+        X = noise.states()
+        own = np.split(res - X @ np.linalg.lstsq(X, res, rcond=None)[0],
+                       np.cumsum([p.size for p in parts])[:-1])
+    corr = ResidualCorrelation(own)
+    spread: list[float] = []
+    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise, corr, spread)
+    groups = [list(np.nonzero(np.abs(row) > 1e-3)[0]) for row in bad]
+    std = np.sqrt(np.maximum(np.diag(cov), 0.0)) / norms
+    cov = cov / np.outer(norms, norms)
+    cov = (cov + cov.T) / 2
+    white_cov = covariance(J, rss, n_rows, rtol, noise)
+    for row in bad:
+        g = np.abs(row) > 1e-3
+        cov[g, :] = np.nan
+        cov[:, g] = np.nan
+    for g in groups:
+        std[g] = np.nan
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = std / np.sqrt(np.maximum(np.diag(white_cov), 0.0))
+    widened = float(np.max(ratio[np.isfinite(ratio)], initial=1.0))
+    # the noise's share of the residuals: white, or a window's carried after it
+    noise_rms = (math.sqrt(noise.sigma2 * max(spread[0], 0.0) / n_rows) if spread
+                 else math.sqrt(white_noise_variance(parts)))
+    note = lower_bound_note(math.sqrt(rss / max(n_rows, 1)), noise_rms, widened, corr.lags,
+                            unit, signal_rms)
+    return CorrelatedErrors(std, groups, cov, note, white_cov)
+
+
 def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
-                    rtol: float = SINGULAR_RTOL, noise: WindowNoise | None = None
+                    rtol: float = SINGULAR_RTOL, noise: WindowNoise | None = None,
+                    correlation: ResidualCorrelation | None = None
                     ) -> tuple[NDArray[np.float64], list[list[int]]]:
     """Standard errors of the parameters and the groups the data cannot separate.
 
@@ -290,9 +374,11 @@ def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
     determine, and the parameters with a component above 1e-3 in it form a
     group (only other combinations of them are determined).  Their standard
     errors are NaN; the others come from the pseudo-inverse, with `noise` (an
-    initialisation window's, :class:`WindowNoise`) its sandwich.
+    initialisation window's, :class:`WindowNoise`) its sandwich, with `correlation` (the
+    residuals', :class:`~motionhyst.identify.residual_noise.ResidualCorrelation`) that of residuals
+    that are not white.
     """
-    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise)
+    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise, correlation)
     groups = [list(np.nonzero(np.abs(row) > 1e-3)[0]) for row in bad]
     std = np.sqrt(np.maximum(np.diag(cov), 0.0)) / norms
     for g in groups:
@@ -301,13 +387,14 @@ def standard_errors(J: NDArray[np.float64], rss: float, n_rows: int,
 
 
 def covariance(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float = SINGULAR_RTOL,
-               noise: WindowNoise | None = None) -> NDArray[np.float64]:
+               noise: WindowNoise | None = None,
+               correlation: ResidualCorrelation | None = None) -> NDArray[np.float64]:
     """The covariance ``sigma^2 (J^T J)^+`` of the estimates whose diagonal's square roots
     :func:`standard_errors` gives (the same normalised columns, singular values and
-    pseudo-inverse; with `noise` its sandwich); the rows and columns of the parameters it
-    marks undetermined are NaN.
+    pseudo-inverse; with `noise`, `correlation` its sandwich); the rows and columns of the
+    parameters it marks undetermined are NaN.
     """
-    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise)
+    norms, cov, bad = _decomposed(J, rss, n_rows, rtol, noise, correlation)
     cov = cov / np.outer(norms, norms)
     cov = (cov + cov.T) / 2  # symmetric to the last bit (the product is so to round-off)
     for row in bad:
@@ -380,7 +467,7 @@ def covariance_table(names: list[str], cov: NDArray[np.float64],
 
 
 def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str, str],
-                        record: str | None = None) -> str:
+                        record: str | None = None, lower_bound: str | None = None) -> str:
     """The ``[identification]`` table of a saved identification (TOML): the kind of `record`
     it was identified from (what ``predict`` predicts), the parameters of the covariance
     `table` (:func:`covariance_table`) that `keys` maps to scenario keys, under those keys,
@@ -388,7 +475,10 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
 
     Standard errors and correlations rather than covariances: each is a number of the size
     of a parameter or within [-1, 1], whatever the units (a covariance of 1e-40 would be
-    outside the magnitudes a scenario accepts); correlations are rounded to 1e-12.
+    outside the magnitudes a scenario accepts); correlations are rounded to 1e-12.  With
+    `lower_bound` (why they are lower bounds:
+    :func:`~motionhyst.identify.residual_noise.lower_bound_note`) a comment says it, and that
+    a study drawn from them understates the spread.
     """
     names = [n for n in table.get("parameters", []) if n in keys]
     if not names:
@@ -402,9 +492,11 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
                     0.0)
     np.fill_diagonal(corr, 1.0)
     rows = "".join(f"    [{', '.join(repr(float(c)) for c in row)}],\n" for row in corr)
+    said = textwrap.wrap(f"{lower_bound}; a study drawn from them understates the spread", 98)
+    bound = "".join(f"# {line}\n" for line in said) if lower_bound else ""
     return ("# the estimates' standard errors and correlations (from the fit's Jacobian) for a "
             "Monte-Carlo\n# study: motionhyst study STUDY.toml --from-identification "
-            "THIS_FILE\n[identification]\n"
+            f"THIS_FILE\n{bound}[identification]\n"
             + ("" if record is None else f"record = {json.dumps(record)}\n")
             + f"parameters = [{', '.join(json.dumps(keys[n]) for n in names)}]\n"
             f"estimates = [{', '.join(repr(float(estimates[n])) for n in names)}]\n"
@@ -441,7 +533,9 @@ def _correlation(J: NDArray[np.float64], rtol: float) -> NDArray[np.float64]:
 def weak_notes(names: list[str], values: NDArray[np.float64], std: NDArray[np.float64],
                J: NDArray[np.float64], rtol: float, may_be_zero: NDArray[np.bool_]
                ) -> dict[str, str]:
-    """Parameters whose standard error exceeds their value: not determined by the records.
+    """Parameters whose standard error exceeds their value: not determined by the records
+    (`std` those of white residuals, :attr:`CorrelatedErrors.white_std`: a fit's model error
+    widens what it reports, not what the records determine).
 
     A parameter that must be positive is then reported with the parameters its
     estimate is correlated with (``|r| > 0.99``: only that combination is
@@ -553,7 +647,10 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
     Parameters
     ----------
     estimates, std : dict
-        The fit's estimates and their standard errors (``None`` where not determined).
+        The fit's estimates and their standard errors (``None`` where not determined): those
+        of white residuals (an input-output fit's ``judged_std``,
+        :class:`~motionhyst.identify.io_results.IOIdentification`), not the wider ones a fit
+        that leaves model error reports.
     invariant : tuple of str
         Parameters along whose combination the model's output does not change for any
         record (:data:`BOUC_WEN_SCALE`): not a question of the records, left out.

@@ -57,6 +57,15 @@ class Identification:
         estimates (``k``, ``fc`` and ``offset``; ``k[0], ..., fc[0], ...`` for several
         elements) from the fit's Jacobian, whose diagonal's square roots are the standard
         errors (:func:`~motionhyst.identify.io_uncertainty.covariance`).
+    std_lower_bound : str or None
+        Why the standard errors are lower bounds (the fit leaves more than the record's
+        noise: :func:`~motionhyst.identify.residual_noise.lower_bound_note`; a line of the
+        printed result says it, the table marks them ``>=``), else None.
+    judged_std : dict
+        Where the standard errors take the residuals' autocorrelation (a closed-loop fit's),
+        the elements' own of white residuals, ``{"k[i]": .., "fc[i]": ..}`` (element ``i``
+        in the order of `elements`; not in :meth:`to_dict`): what judges whether a slip
+        force is determined; empty: those of `elements`.
 
     Examples
     --------
@@ -91,6 +100,8 @@ class Identification:
     signal: str = "force"
     cutoff_hz: float | None = None
     covariance: dict | None = None
+    std_lower_bound: str | None = None
+    judged_std: dict[str, float] = field(default_factory=dict, repr=False)
 
     @property
     def n_elements(self) -> int:
@@ -117,12 +128,16 @@ class Identification:
                 "offset_std": self.offset_std, "criterion": self.criterion, "signal": self.signal,
                 "candidates": [dict(c) for c in self.candidates],
                 **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz}),
-                **({} if self.covariance is None else {"covariance": self.covariance})}
+                **({} if self.covariance is None else {"covariance": self.covariance}),
+                **({} if self.std_lower_bound is None else
+                   {"std_lower_bound": True, "std_note": self.std_lower_bound})}
 
     def __str__(self) -> str:
+        at_least = ">= " if self.std_lower_bound else ""
+
         def std_text(value: float, std: float) -> str:
             return "not determined" if not math.isfinite(std) else \
-                f"{std:.2g} ({100 * std / value:.2g} %)"
+                f"{at_least}{std:.2g} ({100 * std / value:.2g} %)"
 
         rows = [[str(i), g(e["k"], 6), std_text(e["k"], e["k_std"]), g(e["fc"], 6),
                  std_text(e["fc"], e["fc_std"]), g(e["fc"] / e["k"] * 1e3)]
@@ -135,6 +150,7 @@ class Identification:
             f"{self.signal} RMS, R^2 = {self.r2:.6f}, offset {g(self.offset)} N",
             "",
             table(["i", "k [N/m]", "std k [N/m]", "fc [N]", "std fc [N]", "fc/k [mm]"], rows),
+            *([f"  {self.std_lower_bound}"] if self.std_lower_bound else []),
             "",
             f"  total stiffness {g(k, 6)} N/m, total slip force {g(fc, 6)} N"])
 
@@ -220,7 +236,8 @@ class Identification:
             estimates = {f"{p}[{i}]": e[p] for p in ("k", "fc")
                          for i, e in enumerate(self.elements)}
         ident = identification_toml(self.covariance, estimates,
-                                    {n: f"hysteresis.{n}" for n in names}, "force-displacement")
+                                    {n: f"hysteresis.{n}" for n in names}, "force-displacement",
+                                    lower_bound=self.std_lower_bound)
         return text + ("\n" + ident if ident else "")
 
     def scenario_fragment(self) -> str:
