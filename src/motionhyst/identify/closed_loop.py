@@ -287,14 +287,16 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
 
 
 def _noise_rms(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64]) -> float:
-    """The RMS of what the white noise of ``u`` and ``y1`` (their third differences' mean
-    square: an upper estimate, the controller's fast action counted) leaves in the
-    prefiltered link force ``L u - (L / P1) y1`` (the filters' impulse responses' norms)."""
+    """The RMS of what the white noise of ``u`` and ``y1`` (their third differences' median
+    absolute deviation: the noise, not the controller's fast action, which the passivity
+    check's mean square counts as an upper estimate; a flag of lower bounds must not take
+    model error for noise) leaves in the prefiltered link force ``L u - (L / P1) y1`` (the
+    filters' impulse responses' norms)."""
     delta = np.zeros(lf.y1.size)
     delta[0] = 1.0
     h_u, h_y = lf.lowpass(delta), L_over_P1(delta)
-    return float(np.sqrt(white_noise_variance(u, robust=False) * float(h_u @ h_u)
-                         + white_noise_variance(lf.y1, robust=False) * float(h_y @ h_y)))
+    return float(np.sqrt(white_noise_variance(u) * float(h_u @ h_u)
+                         + white_noise_variance(lf.y1) * float(h_y @ h_y)))
 
 
 def _correlated_std(ident: Identification, prob: FitProblem, noise_rms: float
