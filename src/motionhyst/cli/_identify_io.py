@@ -304,7 +304,7 @@ def run_input_output(args: argparse.Namespace) -> int:
             print(f"  {name}: {why}")
     for form in reference:
         print()
-        print(_reference_line(form))
+        print(_reference_line(form, at_least))
     print()
     print(table(["record", "samples", "fit RMS [m]", "output RMS [m]"],
                 [[r["name"], str(r["samples"]), g(r["fit_rms"]), g(r["output_rms"])]
@@ -362,15 +362,16 @@ def reference_forms(fit, records) -> list[dict]:
     return forms
 
 
-def _reference_line(form: dict) -> str:
-    """One line of :func:`reference_forms`' result."""
+def _reference_line(form: dict, at_least: str = "") -> str:
+    """One line of :func:`reference_forms`' result (`at_least` ``">= "`` before standard
+    errors that are lower bounds)."""
     units = {"c": "N s/m", "fc": "N", "offset": "N"}
     names = {"c": "c", "fc": "link.fc", "offset": "input_offset"}
     parts = []
     for key, value in form["parameters"].items():
         s = form["std"].get(key)
-        parts.append(f"{names[key]} {g(value, 4)}" + ("" if s is None else f" +- {g(s, 2)}")
-                     + f" {units[key]}")
+        std = "" if s is None else f" +- {at_least}{g(s, 2)}"
+        parts.append(f"{names[key]} {g(value, 4)}{std} {units[key]}")
     return (f"  as one viscous coefficient and a constant force offset on the motion of "
             f"{form['record']}:\n    {', '.join(parts)}")
 
