@@ -255,6 +255,16 @@ class CorrelatedErrors(NamedTuple):
         Why they are lower bounds (:func:`~motionhyst.identify.residual_noise.lower_bound_note`).
     white_cov : ndarray
         The covariance white residuals give (:func:`covariance`).
+
+    Examples
+    --------
+    A mean of 1000 samples of white noise: the two standard errors agree (a few lags of
+    scatter), nothing is said.
+
+    >>> e = np.random.default_rng(0).standard_normal(1000)
+    >>> out = correlated_errors(np.ones((1000, 1)), [e - e.mean()])
+    >>> out.note is None, out.flags, round(float(out.std[0] / out.white_std[0]), 1)
+    (True, {}, 1.0)
     """
 
     std: NDArray[np.float64]
