@@ -64,12 +64,15 @@ def test_identify_and_compensate_outputs(result, capsys):
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["reduction"] == pytest.approx(result["reduction"])
     assert not [p for p in folder.iterdir() if p.name.startswith(".")]  # no temporary files
-    # the training record it wrote gives the same model on the command line
+    # the training record it wrote gives the same model on the command line, which estimates
+    # the displacement without its sensor's 0.19 um of white noise first (the example fits it
+    # as measured): the same to 1e-4 (measured 2e-5)
     assert cli_main(["identify", str(folder / "train.csv"), "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
+    assert d["displacement_noise"]["filtered"]
     for cli_el, ex_el in zip(d["elements"], result["identified"]["elements"], strict=True):
-        assert cli_el["k"] == pytest.approx(ex_el["k"], rel=1e-6)
-        assert cli_el["fc"] == pytest.approx(ex_el["fc"], rel=1e-6)
+        assert cli_el["k"] == pytest.approx(ex_el["k"], rel=1e-4)
+        assert cli_el["fc"] == pytest.approx(ex_el["fc"], rel=1e-4)
 
 
 # ------------------------------------------------------------------- scan_compensation
