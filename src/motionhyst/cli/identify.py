@@ -590,11 +590,23 @@ def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
     (:func:`~motionhyst.identify.io_checks.systematic_share`); above
     :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` a failed fit where `refuse`
     (the order chosen by the criterion, or a model to save): elements that do not describe
-    the record do not predict another one of the same link."""
+    the record do not predict another one of the same link; above
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_WARN_SHARE` a warning
+    (:func:`~motionhyst.identify.io_quasi_static_checks.systematic_warning`)."""
     from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed, systematic_share
 
     share = systematic_share(w - ident.predict(x, ident.initial_forces), w)
-    if refuse and share > SYSTEMATIC_SHARE:
+    if share <= SYSTEMATIC_SHARE:  # a fit, which may still predict another record worse
+        from motionhyst.core.warnings import warn
+        from motionhyst.identify.io_quasi_static_checks import systematic_warning
+
+        line = systematic_warning(share, "force", f"more --elements than "
+                                  f"{ident.n_elements}, or a link with a spring and damper in "
+                                  f"parallel (--model dahl, bouc-wen or lugre), may describe "
+                                  f"it better")
+        if line is not None:
+            warn(f"{path}: {line}")
+    elif refuse:
         raise FitFailed(f"{path}: the fit failed: {ident.n_elements} Maxwell-slip element(s) "
                         f"leave a systematic error of {100 * share:.2g} % of the force's RMS "
                         f"(above {100 * SYSTEMATIC_SHARE:g} %, beyond the noise): they do not "

@@ -53,13 +53,14 @@ from scipy.optimize import least_squares
 
 from motionhyst.hysteresis import BoucWen, Jenkins, MaxwellSlip
 from motionhyst.identify.io_bouc_wen_shape import EXPONENT_START, BoucWenShape
-from motionhyst.identify.io_checks import SYSTEMATIC_WARN_SHARE, FitFailed, judge_fit
+from motionhyst.identify.io_checks import FitFailed, judge_fit
 from motionhyst.identify.io_elements import LinkLayout
 from motionhyst.identify.io_quasi_static_checks import (
     judge_force_fit,
     judge_hysteresis,
     judge_systematic,
     linear_rms,
+    systematic_warning,
 )
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
@@ -512,12 +513,10 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                 for n, x, x0, lg, f in zip(prob.names, v, v_start, prob.log, prob.free,
                                            strict=True)
                 if lg and f and x > 0 and x0 > 0 and max(x / x0, x0 / x) > RUNAWAY_FACTOR]
-    if share > SYSTEMATIC_WARN_SHARE:
-        warnings.append(f"the model leaves a systematic error of {100 * share:.2g} % of the "
-                        f"{what}'s RMS beyond the noise (above {100 * SYSTEMATIC_WARN_SHARE:g} "
-                        f"%): on another record of this machine its error may be a few times "
-                        f"larger (a fit below 95 %); another --model may describe them better "
-                        f"(the loops' shape, a rate or speed dependence)")
+    systematic = systematic_warning(share, what, "another --model may describe them better "
+                                    "(the loops' shape, a rate or speed dependence)")
+    if systematic is not None:
+        warnings.append(systematic)
     extra = {"offsets": {"input": float(v[2 + prob.n_link]),
                          "output": [float(x) for x in prob.output_offsets(v)]},
              "budget_reached": stopped,

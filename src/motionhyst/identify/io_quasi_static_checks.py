@@ -5,7 +5,9 @@ linear spring and damper's simulation error (:func:`linear_rms`), a force fit th
 finite and better than the force's spread and the linear model (:func:`judge_force_fit`),
 a link that explains more than the linear model within the noise
 (:func:`judge_hysteresis`), and a systematic error within
-:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` (:func:`judge_systematic`).
+:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` (:func:`judge_systematic`), one
+above :data:`~motionhyst.identify.io_checks.SYSTEMATIC_WARN_SHARE` a warning
+(:func:`systematic_warning`, on the force-displacement Maxwell-slip route too).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from numpy.typing import NDArray
 from motionhyst.identify.io_checks import (
     NO_HYSTERESIS_GAIN,
     SYSTEMATIC_SHARE,
+    SYSTEMATIC_WARN_SHARE,
     FitFailed,
     hysteresis_gain,
     systematic_share,
@@ -105,3 +108,16 @@ def judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float64
                         f"these records (a creep, a rate dependence or a link another --model "
                         f"describes) and would not predict another one")
     return share
+
+
+def systematic_warning(share: float, what: str, remedy: str) -> str | None:
+    """The warning for a fit that leaves a systematic `share` of the `what`'s RMS beyond the
+    noise above :data:`~motionhyst.identify.io_checks.SYSTEMATIC_WARN_SHARE` (and within
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`, or it is no fit): on another
+    record of the machine its error may be a few times larger; `remedy` says what may describe
+    the records better.  None below."""
+    if not share > SYSTEMATIC_WARN_SHARE:
+        return None
+    return (f"the model leaves a systematic error of {100 * share:.2g} % of the {what}'s RMS "
+            f"beyond the noise (above {100 * SYSTEMATIC_WARN_SHARE:g} %): on another record "
+            f"of this machine its error may be a few times larger (a fit below 95 %); {remedy}")
