@@ -216,3 +216,15 @@ def test_a_record_cut_from_a_longer_run_is_filtered_after_its_start():
     x_hat, est = estimate_displacement(t, noisy)
     assert est.filtered
     assert np.sqrt(np.mean((x_hat - x)[t > 1.0] ** 2)) < 0.4 * 2e-6  # measured 0.27
+
+
+def test_a_record_that_is_mostly_steps_says_so():
+    """A sine with 15 steps of 0.2 mm under 10 um of noise: more than half of it would be
+    used as measured, so all of it is, and the line says that reason (before: "what a
+    low-pass would remove is not that noise", with its RMS 1.03 times the noise's)."""
+    t = np.arange(8000) / FS
+    x = 0.003 * np.sin(2 * np.pi * 0.5 * t) + 2e-4 * np.floor(t * 15 / 8.0)
+    noisy = x + 1e-5 * np.random.default_rng(0).standard_normal(t.size)
+    x_hat, est = estimate_displacement(t, noisy)
+    assert x_hat is noisy and not est.filtered
+    assert "(steps) over 93 % of the record (more than 50 %): used as measured" in est.reason

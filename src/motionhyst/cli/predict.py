@@ -336,8 +336,9 @@ def _input_quantity(args: argparse.Namespace, sc, system) -> str:
     record = None if ident is None else ident.record
     if record is None:
         raise UsageError(f"motionhyst predict: {args.data} holds a force and a displacement, "
-                         f"and {sc.source} does not say which it was identified to predict: "
-                         f"give --predict force (from the displacement) or --predict "
+                         f"and {sc.source} does not say which it was identified to predict "
+                         f"(saved before identify --save wrote its record's kind, or written "
+                         f"by hand): give --predict force (from the displacement) or --predict "
                          f"displacement (from the force)")
     return "displacement" if record == "force-displacement" else "force"
 
