@@ -241,7 +241,8 @@ def test_an_infinite_standard_error_is_not_printed_as_a_figure():
 
     from motionhyst.cli.identify import _check_slips
 
-    ident = SimpleNamespace(elements=[{"k": 7.102, "fc": 71.02, "fc_std": float("inf")}])
+    ident = SimpleNamespace(elements=[{"k": 7.102, "fc": 71.02, "fc_std": float("inf")}],
+                            judged_std={"fc[0]": float("inf")})
     with pytest.raises(ValueError) as err:
         _check_slips(Path("cl.csv"), ident, np.array([-10.0, 10.0]))
     assert "fc 71.02 N, its standard error not determined)" in str(err.value)
