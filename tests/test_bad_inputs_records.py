@@ -193,16 +193,16 @@ def test_a_unit_slip_in_a_record_is_a_warning_naming_the_column(tmp_path, variab
 def test_the_robust_covariance_sums_every_lag_as_the_products_did(n):
     """Newey-West's weighted lag products, summed by one FFT convolution (a record of two
     million samples took 110 s of CPU in its 500 products), equal the products' sum."""
-    from motionhyst.identify.io_checks import _ahead
+    from motionhyst.identify.residual_noise import bartlett_sum, bartlett_weights
 
     xe = np.random.default_rng(n).standard_normal((n, 6)).cumsum(axis=0)
     lags = min(n - 1, max(int(4 * n ** (1 / 3)), 7))
-    expected = np.zeros((6, 6))
+    expected = xe.T @ xe
     for lag in range(1, lags + 1):
         g = xe[lag:].T @ xe[:-lag]
         expected += (1.0 - lag / (lags + 1)) * (g + g.T)
-    g = _ahead(xe, 1.0 - np.arange(1, lags + 1) / (lags + 1)).T @ xe
-    assert np.allclose(g + g.T, expected, rtol=0.0, atol=1e-12 * np.abs(expected).max())
+    got = bartlett_sum(xe, bartlett_weights(lags))
+    assert np.allclose(got, expected, rtol=0.0, atol=1e-12 * np.abs(expected).max())
 
 
 def test_a_benchmark_test_set_saved_as_matlab_7_3_reads_as_version_5(tmp_path):

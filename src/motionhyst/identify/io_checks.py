@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from motionhyst.core.blas import few_blas_threads
 from motionhyst.identify.io_records import IORecord
+from motionhyst.identify.residual_noise import bartlett_sum, bartlett_weights, regression_lags
 
 __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTION_SHARE",
            "DIRECTION_SIGNIFICANCE", "DIRECTION_TOP",
@@ -481,7 +482,7 @@ def check_inertia(records: list[IORecord]) -> float:
 def _mass_and_std(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]],
                   window: int) -> tuple[float, float]:
     """The least-squares coefficient of the first column and its Newey-West standard error
-    (Bartlett weights over ``max(4 n^(1/3), window)`` lags, within each record)."""
+    (:func:`robust_least_squares`)."""
     x, cov = robust_least_squares(rows, rhs, window)
     return float(x[0]), math.sqrt(max(float(cov[0, 0]), 0.0))
 
@@ -489,8 +490,10 @@ def _mass_and_std(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]
 def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]],
                          window: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The least-squares coefficients and their Newey-West covariance (Bartlett weights over
-    ``max(4 n^(1/3), window)`` lags, within each record): standard errors that hold for
-    residuals correlated over time (a model's error, a filtered noise).
+    ``max(4 n^(1/3), window)`` lags, within each record:
+    :func:`~motionhyst.identify.residual_noise.bartlett_sum` over
+    :func:`~motionhyst.identify.residual_noise.regression_lags`): standard errors that hold
+    for residuals correlated over time (a model's error, a filtered noise).
 
     Parameters
     ----------
@@ -523,38 +526,12 @@ def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.f
         cov = np.linalg.pinv(As.T @ As)
         meat = np.zeros_like(cov)
         start = 0
-        for b in rhs:
+        for b in rhs:  # each record's own sum (residual_noise.bartlett_sum)
             n = b.size
             xe = As[start:start + n] * (b - As[start:start + n] @ x)[:, None]
             start += n
-            lags = min(n - 1, max(int(4 * n ** (1 / 3)), window))
-            meat += xe.T @ xe
-            if lags > 0:  # sum over the lags of w_l xe[t + l] xe[t]^T, and its transpose
-                w = 1.0 - np.arange(1, lags + 1) / (lags + 1)
-                kernel = _kernel(n, w)
-                g = np.stack([_ahead(xe[:, j], w, kernel) @ xe for j in range(xe.shape[1])])
-                meat += g + g.T
+            meat += bartlett_sum(xe, bartlett_weights(regression_lags(n, window)))
         return x / scale, (cov @ meat @ cov) / np.outer(scale, scale)
-
-
-def _kernel(n: int, w: NDArray[np.float64]) -> NDArray[np.complex128]:
-    """The spectrum of ``[0, w]`` over the FFT length of :func:`_ahead` for `n` samples."""
-    return np.fft.rfft(np.concatenate([[0.0], w]), 1 << (n + w.size).bit_length())
-
-
-def _ahead(x: NDArray[np.float64], w: NDArray[np.float64],
-           kernel: NDArray[np.complex128] | None = None) -> NDArray[np.float64]:
-    """``sum_l w[l - 1] x[t + l]`` over ``l = 1 .. len(w)`` (zero past the end) at each row
-    ``t``: an FFT convolution (`kernel`: :func:`_kernel`, computed if not given), where a
-    product for each lag took minutes on a record of millions of samples (its ``4 n^(1/3)``
-    lags); a column at a time, so that the spectra take three columns' memory, not three of
-    every column's (240 B a sample of 11 columns)."""
-    n = x.shape[0]
-    kernel = _kernel(n, w) if kernel is None else kernel
-    if x.ndim > 1:
-        return np.column_stack([_ahead(c, w, kernel) for c in x.T])
-    size = 2 * (kernel.size - 1)
-    return np.fft.irfft(np.fft.rfft(x[::-1], size) * kernel, size)[:n][::-1]
 
 
 #: A start whose cost is within this factor of the records' noise (from their repeated

@@ -18,7 +18,12 @@ from motionhyst.core.blas import few_blas_threads
 from motionhyst.identify.io_checks import check_inertia
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
-from motionhyst.identify.residual_noise import white_noise_variance
+from motionhyst.identify.residual_noise import (
+    bartlett_sum,
+    bartlett_weights,
+    regression_lags,
+    white_noise_variance,
+)
 
 __all__ = ["ONE_STAGE_RATIO", "ONE_STAGE_SIGMAS", "SI_READINGS", "UNIT_FACTORS",
            "UNIT_READINGS", "check_one_stage", "mass_units_note"]
@@ -194,10 +199,6 @@ def _own_mass(pieces: _Pieces) -> tuple[float, float] | None:
     return float(x[0]), math.sqrt(max(float(cov[0, 0]), 0.0))
 
 
-MEAT_FFT = 1 << 15
-"""Points of the spectra of a block of a record's Newey-West products (:class:`_Pieces`)."""
-
-
 class _Pieces:
     """One record's share of the inverse-dynamics least squares that :func:`check_one_stage`
     solves for a set of records: the normal equations of its rows ``a, v, sign(v), 1, y``
@@ -216,7 +217,7 @@ class _Pieces:
         A, b = np.column_stack([rows[0], rec.y]), np.asarray(rhs[0], dtype=np.float64)
         n, window = b.size, max(7, 2 * round(0.005 * rec.fs) + 1)
         self.H, self.g, self.bb, self.n = A.T @ A, A.T @ b, float(b @ b), n
-        self.G = _meat_products(A, b, min(n - 1, max(int(4 * n ** (1 / 3)), window)))
+        self.G = _meat_products(A, b, regression_lags(n, window))
         samples = min(window, n - (1 - n % 2))
         gain = float(np.sum(savgol_coeffs(samples, 3, deriv=2, delta=1.0 / rec.fs) ** 2))
         self.noise = n * gain * white_noise_variance(rec.y, robust=False)
@@ -275,32 +276,20 @@ def _leave_one_out(pieces: list[_Pieces]) -> tuple[_Pieces, list[_Pieces]]:
 
 def _meat_products(A: NDArray[np.float64], b: NDArray[np.float64], lags: int
                    ) -> NDArray[np.float64]:
-    """The Newey-West sums (Bartlett weights over `lags`, as
+    """The Newey-West sums (:func:`~motionhyst.identify.residual_noise.bartlett_sum`, as
     :func:`~motionhyst.identify.io_checks.robust_least_squares`) of the products of the
     columns ``A[:, i] [b, A][:, a]``: the meat of the residual ``b - A x`` is their quadratic
-    form in ``[1, -x]``, for any ``x``.  In blocks of samples, each with the `lags` after it,
-    whose spectra take at most :data:`MEAT_FFT` points (a few MB, whatever the record's
-    length)."""
-    n, p = A.shape
-    w = 1.0 - np.arange(1, lags + 1) / (lags + 1)
-    size = min(max(MEAT_FFT, 1 << (4 * lags).bit_length()), 1 << (n + 2 * lags).bit_length())
-    block = size - 2 * lags - 1  # a block and its lags convolved with the weights: no wrap
-    kernel = np.fft.rfft(np.concatenate([[0.0], w]), size)
+    form in ``[1, -x]``, for any ``x``.  The products made a block of samples at a time (a
+    few MB, whatever the record's length)."""
+    p = A.shape[1]
     # A_i b, and A_i A_j once for i <= j: 20 products of the 30 (p = 5)
     pairs = [(i, 0) for i in range(p)] + [(i, 1 + j) for i in range(p) for j in range(i, p)]
     first, second = (np.array(k) for k in zip(*pairs, strict=True))
-    G = np.zeros((len(pairs), len(pairs)))
-    for s in range(0, n, block):
-        e = min(n, s + block)
-        f = min(n, e + lags)
-        C = np.vstack([b[s:f], A[s:f].T])
-        D = A[s:f].T[first] * C[second]
-        head = D[:, :e - s]
-        G += head @ head.T
-        if lags > 0:  # sum over l of w_l D[t + l] D[t]^T, and its transpose
-            ahead = np.fft.irfft(np.fft.rfft(D[:, ::-1], size) * kernel, size)
-            lag = ahead[:, f - e:f - s][:, ::-1] @ head.T
-            G += lag + lag.T
+
+    def products(start: int, stop: int) -> NDArray[np.float64]:
+        C = np.column_stack([b[start:stop], A[start:stop]])
+        return A[start:stop][:, first] * C[:, second]
+    G = bartlett_sum(products, bartlett_weights(lags), b.size)
     where = {pair: k for k, pair in enumerate(pairs)}  # each of the 30 products' row
     index = [where[(i, 0)] if a == 0 else where[(min(i, a - 1), 1 + max(i, a - 1))]
              for i in range(p) for a in range(p + 1)]

@@ -4,6 +4,9 @@ from sample to sample, and what that says of the fit's standard errors.
 :func:`white_noise_variance` (the third differences' scatter) is the one estimate of a
 signal's white noise that every part uses (the input-output standard errors, ``predict``'s
 error, a closed-loop record's passivity check, ``predict --init-from``'s same-run check);
+:func:`bartlett_sum` the one Newey-West sum of every standard error robust to the
+residuals' correlation (the inverse dynamics' checks over :func:`regression_lags`, a fit's
+over :class:`ResidualCorrelation`'s bandwidth);
 :class:`ResidualCorrelation` the residuals' autocorrelation that the standard errors'
 sandwich takes (:func:`~motionhyst.identify.io_uncertainty.correlated_errors`);
 :func:`lower_bound_note` the line of a result that says its standard errors are lower
@@ -13,11 +16,13 @@ bounds.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["EXACT_SHARE", "LOWER_BOUND_FACTOR", "ResidualCorrelation", "lower_bound_note",
+__all__ = ["BLOCK_FFT", "EXACT_SHARE", "LOWER_BOUND_FACTOR", "ResidualCorrelation",
+           "bartlett_sum", "bartlett_weights", "lower_bound_note", "regression_lags",
            "white_noise_variance"]
 
 
@@ -81,6 +86,136 @@ def white_noise_variance(parts: NDArray[np.float64] | list[NDArray[np.float64]],
         return float(np.mean(d ** 2)) / math.comb(2 * k, k)
     mad = float(np.median(np.abs(d - np.median(d))))
     return (1.4826 * mad) ** 2 / math.comb(2 * k, k)
+
+
+#: Points of the spectra of a block of samples in :func:`bartlett_sum` (a few MB a column,
+#: whatever the record's length)
+BLOCK_FFT = 1 << 15
+
+
+def bartlett_sum(rows: NDArray[np.float64] | Callable[[int, int], NDArray[np.float64]],
+                 weights: NDArray[np.float64], n: int | None = None) -> NDArray[np.float64]:
+    """``sum_t D_t^T D_t + sum_l k_l sum_t (D_{t+l}^T D_t + D_t^T D_{t+l})``, ``l = 1 .. L``,
+    over one record's rows ``D_t``: the Newey-West sum that every standard error of
+    motionhyst robust to the residuals' correlation takes (one implementation).
+
+    With ``D_t`` a regression's scores (regressors times residual, ``x_t e_t``) and ``k_l``
+    the Bartlett weights ``1 - l / (L + 1)`` (:func:`bartlett_weights`) it is Newey and
+    West's meat (:func:`~motionhyst.identify.io_checks.robust_least_squares`, the one-stage
+    check's sums, :func:`~motionhyst.identify.io_consistency.check_one_stage`); with ``D_t``
+    a Jacobian's rows and ``k_l`` the residuals' weighted autocorrelation it is
+    ``J^T Omega J`` (:meth:`ResidualCorrelation.inner`).  In blocks of samples, each with
+    the ``L`` after it, by FFT (:data:`BLOCK_FFT` points at most, unless ``4 L`` is more):
+    a product for each lag took minutes on a record of millions of samples.
+
+    Parameters
+    ----------
+    rows : ndarray or callable
+        ``D``, one row a sample, or a function of ``(start, stop)`` giving its rows
+        ``start .. stop - 1`` (a record whose rows are made block by block: its memory
+        is a block's, not the record's).
+    weights : ndarray
+        ``k_1 .. k_L``.
+    n : int, optional
+        The rows' number (required with a callable).
+
+    Returns
+    -------
+    ndarray
+        The symmetric ``p x p`` sum.
+
+    Examples
+    --------
+    The same as a product for each lag:
+
+    >>> rng = np.random.default_rng(0)
+    >>> D = rng.standard_normal((500, 3))
+    >>> w = bartlett_weights(4)
+    >>> direct = D.T @ D + sum(w[l - 1] * (D[l:].T @ D[:-l] + D[:-l].T @ D[l:])
+    ...                        for l in range(1, 5))
+    >>> bool(np.allclose(bartlett_sum(D, w), direct))
+    True
+    """
+    if not callable(rows):
+        data = np.asarray(rows, dtype=np.float64)
+        n = data.shape[0]
+
+        def rows(start: int, stop: int) -> NDArray[np.float64]:
+            return data[start:stop]
+    if not n:
+        p = np.asarray(rows(0, 0)).shape[-1]
+        return np.zeros((p, p))
+    weights = np.asarray(weights, dtype=np.float64)
+    lags = weights.size
+    size = min(max(BLOCK_FFT, 1 << (4 * lags).bit_length()), 1 << (n + 2 * lags).bit_length())
+    block = size - 2 * lags - 1  # a block and its lags convolved with the weights: no wrap
+    kernel = np.fft.rfft(np.concatenate([[0.0], weights]), size) if lags else None
+    out = np.zeros(0)
+    for s in range(0, n, block):
+        e = min(n, s + block)
+        f = min(n, e + lags)
+        D = np.asarray(rows(s, f), dtype=np.float64).T
+        head = D[:, :e - s]
+        out = head @ head.T if s == 0 else out + head @ head.T
+        if lags > 0:  # sum over l of k_l D[t + l] D[t]^T, and its transpose
+            ahead = np.fft.irfft(np.fft.rfft(D[:, ::-1], size) * kernel, size)
+            lag = ahead[:, f - e:f - s][:, ::-1] @ head.T
+            out += lag + lag.T
+    return (out + out.T) / 2
+
+
+def bartlett_weights(lags: int) -> NDArray[np.float64]:
+    """The Bartlett kernel's weights ``1 - l / (L + 1)``, ``l = 1 .. L`` (Newey and West,
+    Econometrica 55, 703-708, 1987: weights that keep the sum positive semi-definite).
+
+    Parameters
+    ----------
+    lags : int
+        ``L``.
+
+    Returns
+    -------
+    ndarray
+
+    Examples
+    --------
+    >>> bartlett_weights(3).tolist()
+    [0.75, 0.5, 0.25]
+    """
+    return 1.0 - np.arange(1, lags + 1) / (lags + 1.0)
+
+
+def regression_lags(n: int, window: int) -> int:
+    """The lags of a linear regression's Newey-West sum (the inverse dynamics' checks:
+    :func:`~motionhyst.identify.io_checks.robust_least_squares`,
+    :func:`~motionhyst.identify.io_consistency.check_one_stage`): ``max(4 n^(1/3), window)``,
+    at most ``n - 1``.
+
+    A fixed rule, not :class:`ResidualCorrelation`'s Andrews bandwidth: the thresholds of
+    the decisions these regressions make (a record without inertia, a mass of another
+    stage, friction by direction) were measured with it (the one-stage check: none of 3618
+    pairs of the EMPS record's windows refused).  Andrews' rule on their residuals (a linear
+    model's error of a link's force, ``rho`` 0.89-0.95) would sum over more lags: 64-80
+    for 54 on a 2500-sample Jenkins axis, 248 for 116 on the EMPS record.  `window` is the
+    derivative filter's length: the rates are correlated over it whatever the residuals.
+
+    Parameters
+    ----------
+    n : int
+        The record's samples.
+    window : int
+        The fewest lags.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> regression_lags(2500, 11), regression_lags(1000, 60), regression_lags(20, 60)
+    (54, 60, 19)
+    """
+    return max(min(n - 1, max(int(4 * n ** (1 / 3)), window)), 0)
 
 
 #: Andrews' (1991) constant of the Bartlett kernel's bandwidth, ``1.1447 (alpha N)^(1/3)``
@@ -157,7 +292,7 @@ class ResidualCorrelation:
             acov = np.fft.irfft(spec * np.conj(spec), 2 * p.size)[:p.size]
             m = min(self.lags + 1, p.size)
             gamma[:m] += acov[:m]
-        weights = 1.0 - np.arange(self.lags + 1) / (self.lags + 1.0)
+        weights = np.concatenate([[1.0], bartlett_weights(self.lags)])
         self.kernel = weights * gamma / gamma[0] if gamma[0] > 0 else np.eye(1, self.lags + 1)[0]
         self.rho = rho
 
@@ -175,20 +310,15 @@ class ResidualCorrelation:
         ndarray
             ``U^T C U``.
         """
-        from scipy.signal import oaconvolve
-
         U = np.asarray(U, dtype=float)
         if self.lags == 0:
             return U.T @ U
-        k = np.concatenate([self.kernel[:0:-1], self.kernel])
         out = np.zeros((U.shape[1], U.shape[1]))
         a = 0
-        for size in self.sizes:  # a column at a time: memory of a record, not of U
-            block = U[a:a + size]
-            for j in range(block.shape[1]):
-                out[:, j] += block.T @ oaconvolve(block[:, j], k, mode="same")
+        for size in self.sizes:  # each record's own sum (:func:`bartlett_sum`)
+            out += bartlett_sum(U[a:a + size], self.kernel[1:])
             a += size
-        return (out + out.T) / 2
+        return out
 
 
 #: A fit that leaves more than this many times its records' white noise (RMS) leaves
