@@ -230,7 +230,8 @@ def run_input_output(args: argparse.Namespace) -> int:
         plant, note = default_plant(records)
         notes.append(note)
         bouc_wen_own = model == "bouc-wen" and plant not in ("quasi-static", "mass-damper")
-    if plant_class(plant).has_inertia and not args.periodic:  # the plant now decided
+    checked = plant_class(plant).has_inertia and not args.periodic  # identify_io: not again
+    if checked:  # the plant now decided
         from motionhyst.identify.io_consistency import check_one_stage
 
         check_one_stage(records, floating=plant in ("mass-damper", "two-mass"),
@@ -258,7 +259,7 @@ def run_input_output(args: argparse.Namespace) -> int:
                                         r"motion stages: if the records' units are not SI")
             fit = identify_io(records, model_class(model), periodic=args.periodic, nu=nu,
                               n_elements=args.elements or 3, plant=plant_class(plant),
-                              output=args.output, **extras)
+                              output=args.output, checked=checked, **extras)
     except FitFailed as exc:  # the records it was refused on, named once
         if any(str(path) in str(exc) for path in args.data):
             raise

@@ -61,7 +61,8 @@ import sys
 import threading
 from collections.abc import Iterator
 
-__all__ = ["DEFAULT_FRACTION", "DEFAULT_SECONDS", "ENV_VARIABLE", "SECONDS_VARIABLE",
+__all__ = ["DEFAULT_FRACTION", "DEFAULT_SECONDS", "ENV_VARIABLE", "RECORDS_REMEDY",
+           "SECONDS_VARIABLE",
            "BudgetError", "available_disk", "available_memory", "check_disk", "check_memory",
            "check_work", "cpu_time_limit", "format_duration", "format_size", "max_memory",
            "max_seconds", "parse_size", "set_max_memory", "set_max_seconds"]
@@ -71,6 +72,10 @@ DEFAULT_FRACTION = 0.5
 
 ENV_VARIABLE = "MOTIONHYST_MAX_MEMORY"
 """Environment variable with the budget (as ``--max-memory``: ``2G``, ``500M``, bytes)."""
+
+RECORDS_REMEDY = "a larger --max-memory if the machine has it, or shorter records"
+"""What the user of a command can change when the work its records need is above the
+budget (``identify``'s search, the check run of the model it identified)."""
 
 _UNITS = {"": 1, "B": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
 

@@ -217,7 +217,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 max_evaluations: int | None = None, init_window: int | None = None,
                 asymmetric: bool | None = None, drift: bool = False,
                 fewer_elements: bool = False, rigid_limit: bool = False,
-                rigid: IOIdentification | None = None) -> IOIdentification:
+                rigid: IOIdentification | None = None, checked: bool = False
+                ) -> IOIdentification:
     """Identify a stage and its link from input-output records.
 
     Parameters
@@ -361,6 +362,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         its rigid limit: that fit, made already on the same records with the same options
         (offsets, window, drift; viscous friction by direction in either spelling), is
         reused instead of being fitted again.
+    checked : bool
+        The records passed :func:`~motionhyst.identify.io_checks.check_inertia` and
+        :func:`~motionhyst.identify.io_consistency.check_one_stage` for this stage already
+        (``identify`` checks them before it says anything else): not checked again.
 
     Returns
     -------
@@ -422,6 +427,13 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         if short:
             raise ValueError(f"{short[0]}: too short for an initialisation window of "
                              f"{init_window} samples")
+    if stage.has_inertia:  # once, before the search (refits too)
+        shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, any values
+        if asymmetric and not (shape.floating and shape.n == 1):
+            raise ValueError(_ASYMMETRIC)
+        if not checked:
+            check_inertia(records)
+            check_one_stage(records, shape.floating, single_mass=shape.n == 1)
     fewer, budget = None, EvaluationBudget(max_evaluations)  # the whole search's, refits too
     why: dict[int, str] = {}  # why a Maxwell-slip fit of so many elements was given up
     while True:
@@ -509,10 +521,6 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         max_evaluations.used += fit.n_evaluations
         return fit
     shape = stage.mechanics(np.ones(len(stage.PARAMETERS)))  # its structure, whatever values
-    if asymmetric and not (shape.floating and shape.n == 1):
-        raise ValueError(_ASYMMETRIC)
-    check_inertia(records)  # before the search
-    check_one_stage(records, shape.floating, single_mass=shape.n == 1)
     if link is not BoucWen:
         return identify_elements_io(records, link, periodic, substeps, tol,
                                     max(max_nfev, ELEMENT_NFEV), n_elements, t_start, start_nfev,

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.blas import few_blas_threads
+from motionhyst.core.budget import RECORDS_REMEDY, BudgetError
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.residual_noise import bartlett_sum, bartlett_weights, regression_lags
 
@@ -127,6 +128,14 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
     output_offset : bool
         An output offset was estimated (the output's own RMS is then about its mean).
 
+    Raises
+    ------
+    FitFailed
+        The fit is no result.
+    BudgetError
+        The check run of the identified model is above the memory budget (``--max-memory``):
+        not a failed fit, a refusal naming the budget and its remedy.
+
     Examples
     --------
     >>> import numpy as np
@@ -171,6 +180,9 @@ def judge_fit(fit_rms: float, records: list[IORecord], predictions: list[NDArray
     rec = records[0]
     try:
         y = system.simulate(rec.t, rec.u, substeps=r).displacement
+    except BudgetError as exc:  # the model may run: the budget refused its run
+        raise BudgetError(f"the identified model's run of {rec.name} (the check that predict "
+                          f"can run it): {exc.cause}", RECORDS_REMEDY) from None
     except (ValueError, ArithmeticError) as exc:  # the cause, not a library's argument
         raise FitFailed(f"the fit failed: the identified model cannot be simulated on "
                         f"{rec.name} ({getattr(exc, 'what', exc)})") from None

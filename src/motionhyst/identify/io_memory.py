@@ -21,7 +21,7 @@ The search's own estimate, from its start, still follows (it can only be larger)
 
 from __future__ import annotations
 
-from motionhyst.core.budget import BudgetError, format_size, max_memory
+from motionhyst.core.budget import RECORDS_REMEDY, BudgetError, format_size, max_memory
 from motionhyst.hysteresis import MODELS as REGISTERED
 
 __all__ = ["BOUC_WEN_SAMPLE_BYTES", "BOUC_WEN_STEP_BYTES", "bouc_wen_memory",
@@ -44,7 +44,7 @@ Bouc-Wen (exact sensitivities) and every other registered model but maxwell-iwan
 element of 256 stop operators makes a simulation too slow for a search.  Here, where the
 command checks its options before it reads the records (the fit's module loads scipy)."""
 
-REMEDY = "a larger --max-memory if the machine has it, or shorter records"
+REMEDY = RECORDS_REMEDY
 """What a user can change when the least search of the records is above the budget."""
 
 
