@@ -114,3 +114,50 @@ def test_a_model_that_is_not_the_records_says_its_standard_errors_are_lower_boun
     said = [line.strip() for line in out.splitlines() if "lower bounds" in line]
     assert said[0] == note and all(line.startswith("# ") for line in said[1:]), out
     assert "lower bounds" not in err
+
+
+def test_a_value_within_its_widened_standard_error_is_said_not_determined():
+    """An EMPS-like axis with friction by direction (tests/test_emps_reference.py's record,
+    no force offset), its asymmetric Coulomb fit leaving 40 times the white noise: its own
+    force offset -0.052 +- 0.059 N (white residuals' 0.0018) and position offset 4.2e-5 +-
+    6.9e-5 m were reported as values, judged determined on the white standard errors, without
+    a word.  Now one warning names them as not distinguishable from 0 (the truth is 0); the
+    fit is still a result, the others' values are not named (95.02 +- 0.0072 kg ...)."""
+    from motionhyst.identify.emps import PERIOD
+
+    t = np.arange(4 * PERIOD) / 1000.0
+    y = 0.03 * np.sin(2 * np.pi * t) + 0.01 * np.sin(6 * np.pi * t)
+    v = np.gradient(y, t, edge_order=2)
+    a = np.gradient(v, t, edge_order=2)
+    u = 95.0 * a + 160.0 * v + 80.0 * np.minimum(v, 0.0) + 20.0 * np.sign(v)
+    rec = IORecord(t, u, y + 1e-6 * np.random.default_rng(5).standard_normal(t.size), "axis")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fit = identify_io([rec], "coulomb", plant="mass-damper", asymmetric=True, substeps=20)
+    assert fit.extra["std_lower_bound"]
+    for name in ("input_offset", "output_offset"):
+        assert fit.judged_std[name] < abs(fit.estimates[name]) < fit.std[name], name
+    said = [w for w in fit.warnings if w.startswith("with the fit's model error")]
+    assert len(said) == 1, fit.warnings
+    assert "input_offset (-0.052 +- 0.059), output_offset (4.2e-05 +- 6.9e-05) are not " \
+           "distinguishable from 0" in said[0]
+    for name in ("m", "c", "link.fc", "link.c_neg"):
+        assert f" {name} (" not in said[0]
+        assert fit.std[name] < 0.05 * abs(fit.estimates[name]), name
+
+
+def test_the_widened_note_names_what_only_the_wider_standard_errors_leave_undetermined():
+    """A stiffness whose widened standard error exceeds it (a Jenkins link 4.4e7 +- 9.7e7 N/m,
+    white 6e6) is not determined beyond the fit's model error; one already not determined on
+    white residuals (judge_determined names it) is not named again; white standard errors
+    (reported as judged) name nothing."""
+    from motionhyst.identify.io_uncertainty import widened_note
+
+    est = {"m": 95.0, "c": 200.0, "link.k": 4.4e7, "link.fc": 20.0, "input_offset": -3.0}
+    judged = {"m": 0.02, "c": 0.03, "link.k": 6e6, "link.fc": 0.01, "input_offset": 0.002}
+    wide = {**judged, "m": 0.3, "link.k": 9.7e7, "link.fc": 0.2, "input_offset": 0.04}
+    note = widened_note(est, wide, judged)
+    assert note.startswith("with the fit's model error, the records do not determine link.k "
+                           "(4.4e+07 +- 9.7e+07): ")
+    assert widened_note(est, wide, {**judged, "link.k": 5e7}) is None
+    assert widened_note(est, judged, judged) is None

@@ -136,6 +136,7 @@ from motionhyst.identify.io_uncertainty import (
     BOUC_WEN_SCALE,
     judge_determined,
     undetermined,
+    widened_note,
     zero_allowed,
 )
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
@@ -491,6 +492,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
         fit.warnings.append(budget_note(fit.n_evaluations))
     fit.warnings.extend(determined)
+    widened = widened_note(fit.estimates, fit.std, fit.judged_std, invariant, zero) \
+        if fit.judged_std and fit.extra.get("std_lower_bound") else None
+    if widened is not None:  # determined on white residuals, not beyond the model's error
+        fit.warnings.append(widened)
     for line in fit.warnings:  # the plausibility checks, for every caller to see
         warn(line)
     return fit

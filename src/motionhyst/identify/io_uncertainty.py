@@ -41,8 +41,8 @@ from motionhyst.identify.residual_noise import (
 
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
            "WINDOW_INFLATION", "CorrelatedErrors", "WindowNoise", "correlated_errors",
-           "judge_determined", "parallel_note", "undetermined", "window_inflation",
-           "zero_allowed"]
+           "judge_determined", "parallel_note", "undetermined", "widened_note",
+           "window_inflation", "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
 BOUC_WEN_IDENTIFIED = ("alpha", "beta*gamma", "beta*delta", "nu")
@@ -724,6 +724,78 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
         "their standard errors are unknown or exceed their values"
     return [f"the records do not determine {', '.join(names)} ({its}): the model holds "
             f"{what}, which these records neither confirm nor contradict"]
+
+
+#: Parameters of either sign whose standard error above their value says they are not
+#: distinguishable from 0 (:func:`widened_note`): offsets, a drift, the viscous friction's
+#: difference by direction (not the records' initial states, nor a Bouc-Wen link's shape)
+_OFFSETS = ("offset", "drift", "c_skew")
+
+
+def widened_note(estimates: dict[str, float], std: dict[str, float | None],
+                 judged: dict[str, float | None], invariant: tuple[str, ...] = (),
+                 zero: set[str] | frozenset = frozenset()) -> str | None:
+    """The parameters whose reported standard error exceeds their value where those of
+    white residuals do not: one line of a result's warnings, or None (for a fit whose
+    standard errors are lower bounds: :func:`correlated_errors`' note).
+
+    A fit that leaves model error or coloured noise reports standard errors widened for
+    the residuals' correlation (lower bounds, :func:`correlated_errors`), while whether the
+    records determine a parameter is judged from those of white residuals
+    (:func:`judge_determined`: model error does not make a record say less).  Where the
+    reported one exceeds the value (a Jenkins stiffness ``4.4e7 +- >= 9.7e7``), the value is
+    not determined beyond the fit's model error, whatever the white one says: said here,
+    named, for a parameter that must be positive as :func:`undetermined` has it, for an
+    offset, a drift or a difference by direction as not distinguishable from 0.  The fit is
+    not refused for it (model error is a result), nor is its model changed.
+
+    Parameters
+    ----------
+    estimates : dict
+        The fit's estimates.
+    std : dict
+        The standard errors it reports (``None`` where not determined).
+    judged : dict
+        Those of white residuals (``judged_std``).
+    invariant, zero
+        As :func:`undetermined`.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> est = {"m": 95.0, "link.k": 4.4e7, "link.fc": 20.0, "input_offset": 0.031}
+    >>> print(widened_note(est, {"m": 0.3, "link.k": 9.7e7, "link.fc": 0.2,
+    ...                          "input_offset": 0.043},
+    ...                    {"m": 0.02, "link.k": 6e6, "link.fc": 0.01, "input_offset": 0.004}))
+    ... # doctest: +NORMALIZE_WHITESPACE
+    with the fit's model error, the records do not determine link.k (4.4e+07 +- 9.7e+07), and
+    input_offset (0.031 +- 0.043) is not distinguishable from 0: standard errors widened for
+    the residuals' correlation exceed the values, which the model holds as the search found them
+    """
+    white = set(undetermined(estimates, judged, invariant, zero))
+    names = [n for n in undetermined(estimates, std, invariant, zero) if n not in white]
+
+    def exceeds(table: dict[str, float | None], name: str) -> bool:
+        s = table.get(name)
+        return s is not None and math.isfinite(s) and s > abs(estimates[name])
+    signed = [n for n in estimates if any(w in n for w in _OFFSETS) and n not in invariant
+              and exceeds(std, n) and judged.get(n) is not None and not exceeds(judged, n)]
+    if not names and not signed:
+        return None
+
+    def shown(group: list[str]) -> str:
+        return ", ".join(f"{n} ({estimates[n]:.2g} +- {std[n]:.2g})"
+                         if std.get(n) is not None and math.isfinite(std[n]) else n
+                         for n in group)
+    parts = ([f"the records do not determine {shown(names)}"] if names else []) + (
+        [f"{shown(signed)} {'is' if len(signed) == 1 else 'are'} not distinguishable from 0"]
+        if signed else [])
+    return (f"with the fit's model error, {', and '.join(parts)}: standard errors widened for "
+            f"the residuals' correlation exceed the values, which the model holds as the "
+            f"search found them")
 
 
 def parallel_note(model: type, name: str, two_mass: bool = False) -> str:
