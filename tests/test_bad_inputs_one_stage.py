@@ -142,6 +142,22 @@ def test_records_of_one_axis_pass_together(m, c, link):
     check_one_stage(records, floating=True)
 
 
+@pytest.mark.parametrize("m2", [3.0, 4.0])
+def test_stages_of_close_masses_are_told_apart_where_their_records_show_them(m2):
+    """A 2 kg axis's fast record beside a 3 or 4 kg axis's (each 1 um of noise): their own
+    masses differ by a factor 1.47 or 1.96, at 21 or 36 robust standard errors, which main
+    passed (it refused from a factor 4), searching one stage of neither mass; refused now
+    beyond a factor 1.4 and 15 standard errors (one axis's records differ by 7.7 at most,
+    test_records_of_one_axis_pass_together)."""
+    scale = m2 / 2.0
+    other = _axis(m2, 5 * m2, Jenkins(k=1000 * m2, fc=0.5 * m2), n=5000, noise=1e-6, seed=7,
+                  force=lambda t: scale * (5 * np.sin(2 * np.pi * 1.3 * t)
+                                           + 3 * np.sin(2 * np.pi * 4.1 * t + 0.4)),
+                  name="other.csv")
+    with pytest.raises(ValueError, match="records of stages of different masses"):
+        check_one_stage([_axis(noise=1e-6, name="stage.csv"), other], floating=True)
+
+
 @pytest.mark.skipif(not EMPS.is_file(), reason="needs ../shared/benchmarks/emps")
 @pytest.mark.parametrize("floating", [True, False], ids=["mass-damper", "spring"])
 def test_emps_windows_pass_together(floating):
