@@ -9,16 +9,20 @@ and says which.  The map of the columns the user gave ``identify`` is accepted a
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from records_of_other_kinds import LOGGED, damper_record, fit_percent
 
 from motionhyst.cli import main
 from motionhyst.hysteresis import Jenkins
+from motionhyst.identify.fit import identify_maxwell_slip
 from motionhyst.identify.io_quasi_static import identify_quasi_static_io
 from motionhyst.identify.io_records import IORecord
 from motionhyst.plants import QuasiStatic
 from motionhyst.scenario import Scenario
+from motionhyst.study.identified import joint_from_identification
 from motionhyst.time.quasi_static import displacement_from_force
 
 BOTH = ("time", "displacement", "force")
@@ -119,3 +123,31 @@ def test_an_input_output_model_predicts_the_position_of_a_record_with_both(capsy
     assert rc == 0 and err == "" and out.startswith("Predicted the displacement")
     predicted = np.loadtxt(out_csv, delimiter=",", skiprows=1)[:, 1]
     assert fit_percent(y, predicted) > 99.9
+
+
+def test_a_model_without_standard_errors_still_says_its_record(capsys, tmp_path):
+    """A model none of whose standard errors is determined saves its record's kind all the
+    same (review A14b L2: ``[identification] record`` was written only inside a non-empty
+    covariance table, and predict then asked which to predict of a record with both)."""
+    t = np.arange(2000) / 1000.0
+    u = 300.0 * np.sin(2 * np.pi * 2 * t) * np.minimum(1.0, t)
+    y = displacement_from_force(QuasiStatic(k=1e5), Jenkins(k=3e5, fc=100.0), t, u)
+    fit = identify_quasi_static_io([IORecord(t, u, y)], Jenkins, periodic=False, n_elements=1,
+                                   offset="none", max_evaluations=None, tol=1e-12)
+    fit.extra["covariance"] = {"parameters": [], "matrix": []}  # no std determined
+    links = identify_maxwell_slip(y, u, 2, t=t)
+    links = dataclasses.replace(links, covariance=None)
+    record, out_csv = tmp_path / "r.csv", tmp_path / "out.csv"
+    np.savetxt(record, np.column_stack([t, y, u]), delimiter=",",
+               header="time,displacement,force", comments="")
+    for text, kind, predicted in ((fit.scenario_text(), "input-output", "displacement"),
+                                  (links.scenario_text(), "force-displacement", "force")):
+        model = tmp_path / f"{kind}.toml"
+        model.write_text(text)
+        ident = Scenario.from_file(model).model.identification
+        assert ident.record == kind and ident.parameters == []
+        rc, out, err = run(capsys, "predict", str(model), str(record), "--out", str(out_csv),
+                           "--force")
+        assert rc == 0 and err == "" and out.startswith(f"Predicted the {predicted}"), err
+        with pytest.raises(ValueError, match="holds no link parameters with standard errors"):
+            joint_from_identification(model)  # a study has nothing to draw: said, one line

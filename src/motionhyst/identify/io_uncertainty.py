@@ -481,7 +481,8 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
     """The ``[identification]`` table of a saved identification (TOML): the kind of `record`
     it was identified from (what ``predict`` predicts), the parameters of the covariance
     `table` (:func:`covariance_table`) that `keys` maps to scenario keys, under those keys,
-    with their `estimates`, standard errors and correlations; empty if none.
+    with their `estimates`, standard errors and correlations; the kind alone if none (empty
+    without a kind).
 
     Standard errors and correlations rather than covariances: each is a number of the size
     of a parameter or within [-1, 1], whatever the units (a covariance of 1e-40 would be
@@ -491,8 +492,8 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
     a study drawn from them understates the spread.
     """
     names = [n for n in table.get("parameters", []) if n in keys]
-    if not names:
-        return ""
+    if not names:  # the record's kind alone: what predict predicts
+        return "" if record is None else f"[identification]\nrecord = {json.dumps(record)}\n"
     where = [table["parameters"].index(n) for n in names]
     cov = np.array(table["matrix"], dtype=float)[np.ix_(where, where)]
     std = np.sqrt(np.diag(cov))

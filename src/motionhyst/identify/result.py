@@ -227,8 +227,8 @@ class Identification:
                 f"gives its force\n# for a displacement record (time,displacement), its "
                 f"displacement for a force record\n")
         text = head + toml_table("stage", plant.to_dict()) + "\n" + self.scenario_fragment()
-        if self.covariance is None:
-            return text
+        if self.covariance is None:  # the record's kind all the same: what predict predicts
+            return text + "\n" + identification_toml({}, {}, {}, "force-displacement")
         names = [n for n in self.covariance["parameters"] if n != "offset"]
         if self.n_elements == 1:
             estimates = dict(self.elements[0])

@@ -506,13 +506,14 @@ class IdentificationSection(_Section):
     draws the link's parameters from it (``motionhyst study --from-identification``).
     ``record`` is the kind of record the model was identified from: ``motionhyst predict``
     predicts what that record measured (a force-displacement record's force from a
-    displacement, an input-output record's position from a force)."""
+    displacement, an input-output record's position from a force); a model none of whose
+    standard errors the records determine holds ``record`` alone (no parameters)."""
 
     record: Literal["force-displacement", "input-output"] | None = None
-    parameters: Annotated[list[str], Field(min_length=1)]
-    estimates: list[Annotated[float, Field(allow_inf_nan=False)]]
-    std: list[NonNegativeFloat]
-    correlation: list[list[Annotated[float, Field(ge=-1.0, le=1.0, allow_inf_nan=False)]]]
+    parameters: list[str] = []
+    estimates: list[Annotated[float, Field(allow_inf_nan=False)]] = []
+    std: list[NonNegativeFloat] = []
+    correlation: list[list[Annotated[float, Field(ge=-1.0, le=1.0, allow_inf_nan=False)]]] = []
 
     @model_validator(mode="after")
     def _square(self):
