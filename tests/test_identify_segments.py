@@ -145,6 +145,22 @@ def test_every_sample_of_a_record_is_in_a_segment():
     assert len(sizes(20000, 20000)) == MAX_SEGMENTS
 
 
+def test_the_segments_are_shared_by_the_records_lengths():
+    """Two long records share the MAX_SEGMENTS segments by their lengths (review A14b: two
+    records of 20,000 samples gave all 32 to the first, none to the second); a short record
+    keeps its one; more records than segments: one each of the first."""
+    def counts(*lengths):
+        recs = [IORecord(np.arange(n) / FS, np.zeros(n), np.zeros(n)) for n in lengths]
+        got = [i for i, _ in segment_records(recs)]
+        return [got.count(i) for i in range(len(lengths))]
+
+    assert counts(20000, 20000) == [16, 16]
+    assert counts(30000, 10000) == [24, 8]
+    assert counts(20000, 300) == [31, 1]
+    assert counts(*[600] * 40) == [1] * MAX_SEGMENTS + [0] * 8
+    assert sum(counts(50000, 1700, 1700)) == MAX_SEGMENTS
+
+
 @pytest.mark.skipif(not EMPS.is_file(),
                     reason="the EMPS benchmark's files are not beside the repository")
 def test_the_segments_end_is_kept_only_where_it_ends_better():

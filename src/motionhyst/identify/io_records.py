@@ -142,10 +142,13 @@ def short_records(records: list[IORecord], periodic: bool, n_max: int = 4096
 
 
 def segment_records(records: list[IORecord]) -> list[tuple[int, IORecord]]:
-    """The records cut into segments of :data:`SEGMENT` samples, at most
-    :data:`MAX_SEGMENTS` of them, from each record's start on: every sample of a record
-    in one (a shorter tail joins the segment before it, a record shorter than a segment is
-    one) until the segments run out (views of the records' arrays).
+    """The records cut into segments of :data:`SEGMENT` samples from each record's start
+    on: every sample of a record in one (a shorter tail joins the segment before it, a record
+    shorter than a segment is one) until the record's share of the :data:`MAX_SEGMENTS`
+    runs out (views of the records' arrays).
+
+    The segments are shared by the records' lengths (largest remainders; every record one at
+    least, while there are enough): two long records get half each, not all to the first.
 
     Parameters
     ----------
@@ -170,13 +173,32 @@ def segment_records(records: list[IORecord]) -> list[tuple[int, IORecord]]:
     >>> n = 100_000
     >>> rec = IORecord(np.arange(n) / 1e3, np.zeros(n), np.zeros(n))
     >>> parts = segment_records([rec, rec])
-    >>> len(parts), sum(s.y.size for _, s in parts)
-    (32, 16000)
+    >>> len(parts), [sum(i == j for i, _ in parts) for j in (0, 1)]
+    (32, [16, 16])
     """
+    shares = _segment_shares([max(rec.y.size // SEGMENT, 1) for rec in records])
     parts: list[tuple[int, IORecord]] = []
-    for i, rec in enumerate(records):
+    for i, (rec, share) in enumerate(zip(records, shares, strict=True)):
         n = rec.y.size
-        for a in list(range(0, max(n - SEGMENT, 0) + 1, SEGMENT))[:MAX_SEGMENTS - len(parts)]:
+        for a in list(range(0, max(n - SEGMENT, 0) + 1, SEGMENT))[:share]:
             b = n if a + 2 * SEGMENT > n else a + SEGMENT
             parts.append((i, IORecord(rec.t[a:b], rec.u[a:b], rec.y[a:b], rec.name)))
     return parts
+
+
+def _segment_shares(counts: list[int]) -> list[int]:
+    """How many of the :data:`MAX_SEGMENTS` segments each record gives, of the `counts` it
+    holds: all where they fit, else in proportion to them (largest remainders), every record
+    one at least while there are enough, the first records' where there are not."""
+    total = sum(counts)
+    if total <= MAX_SEGMENTS:
+        return list(counts)
+    if len(counts) >= MAX_SEGMENTS:
+        return [1 if i < MAX_SEGMENTS else 0 for i in range(len(counts))]
+    spare = MAX_SEGMENTS - len(counts)  # one each, the rest by what is left of each count
+    ideal = [spare * (c - 1) / (total - len(counts)) for c in counts]
+    shares = [1 + int(x) for x in ideal]
+    by_remainder = sorted(range(len(counts)), key=lambda i: (int(ideal[i]) - ideal[i], i))
+    for i in by_remainder[:MAX_SEGMENTS - sum(shares)]:
+        shares[i] += 1
+    return shares
