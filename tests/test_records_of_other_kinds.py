@@ -219,6 +219,7 @@ def test_a_lugre_damper_s_stribeck_curve_is_found():
     # the damper in parallel holds the link's viscous friction sigma2
     assert est["c"] == pytest.approx(true.sigma2, rel=0.02)
     assert fit.fit_rms < 1.1 * DAMPER_NOISE
+    assert not any("Stribeck" in line for line in fit.warnings)  # one it holds: no warning
 
 
 def _neighbour(name: str, i: int):

@@ -253,9 +253,12 @@ def run(args: argparse.Namespace) -> int:
 
             warn(mass)
         what = "force-displacement record"
+        from motionhyst.identify.io_checks import SYSTEMATIC_SHARE
+
         try:
-            with search_budget():
-                ident = identify_maxwell_slip(x, w, t=t, **options)
+            with search_budget():  # the order chosen: a search that cannot reach 2 % stops
+                ident = identify_maxwell_slip(x, w, t=t, **options, target_share=(
+                    SYSTEMATIC_SHARE if args.elements is None else None))
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         _check_determined(path, ident, x, w)
@@ -610,7 +613,8 @@ def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
         raise FitFailed(f"{path}: the fit failed: {ident.n_elements} Maxwell-slip element(s) "
                         f"leave a systematic error of {100 * share:.2g} % of the force's RMS "
                         f"(above {100 * SYSTEMATIC_SHARE:g} %, beyond the noise): they do not "
-                        f"describe this link and would not predict another record of it; a "
+                        f"describe this link and would not predict another record of it"
+                        f"{'' if ident.order_stop is None else f' ({ident.order_stop})'}; a "
                         f"link with a spring and damper in parallel may (--model dahl, "
                         f"bouc-wen or lugre); nothing saved")
     return share

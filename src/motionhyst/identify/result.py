@@ -66,6 +66,10 @@ class Identification:
         the elements' own of white residuals, ``{"k[i]": .., "fc[i]": ..}`` (element ``i``
         in the order of `elements`; not in :meth:`to_dict`): what judges whether a slip
         force is determined; empty: those of `elements`.
+    order_stop : str or None
+        Why the automatic order search stopped before its largest order (its systematic
+        error's trend could not reach the share asked: ``target_share`` of
+        :func:`~motionhyst.identify.fit.identify_maxwell_slip`), else None.
 
     Examples
     --------
@@ -102,6 +106,7 @@ class Identification:
     covariance: dict | None = None
     std_lower_bound: str | None = None
     judged_std: dict[str, float] = field(default_factory=dict, repr=False)
+    order_stop: str | None = None
 
     @property
     def n_elements(self) -> int:
@@ -130,7 +135,8 @@ class Identification:
                 **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz}),
                 **({} if self.covariance is None else {"covariance": self.covariance}),
                 **({} if self.std_lower_bound is None else
-                   {"std_lower_bound": True, "std_note": self.std_lower_bound})}
+                   {"std_lower_bound": True, "std_note": self.std_lower_bound}),
+                **({} if self.order_stop is None else {"order_stop": self.order_stop})}
 
     def __str__(self) -> str:
         at_least = ">= " if self.std_lower_bound else ""
