@@ -310,6 +310,9 @@ def run_input_output(args: argparse.Namespace) -> int:
     print(table(["record", "samples", "fit RMS [m]", "output RMS [m]"],
                 [[r["name"], str(r["samples"]), g(r["fit_rms"]), g(r["output_rms"])]
                  for r in fit.records]))
+    for r, est in zip(fit.records, fit.extra.get("force_noise", []), strict=False):
+        if est["sigma"] > 0:  # the model's input without its load cell's white noise
+            print(f"  force of {r['name']}: {est['reason']}")
     if args.save is not None:
         print(f"\nwrote {args.save}")
     else:

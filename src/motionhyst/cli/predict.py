@@ -122,14 +122,21 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"motionhyst predict: {args.init_from} must have the samples "
                              f"of {args.data} (the same time column)")
         _check_same_run(args, u, rec.u)
+    u_model, noise = u, None
     try:
+        if not system.plant.has_inertia:  # the link's input without the load cell's white
+            from motionhyst.identify.displacement_noise import estimate_displacement
+
+            # noise, as identify estimates it (a stage with inertia filters it itself)
+            u_model, noise = estimate_displacement(t, u, periodic=args.periodic,
+                                                   quantity="force", unit="N")
         if rec is not None:
             from motionhyst.identify.io_predict import predict_from_window  # scipy.optimize
 
-            pred = predict_from_window(system, t, u, rec.y, window, args.substeps)
+            pred = predict_from_window(system, t, u_model, rec.y, window, args.substeps)
             out_t, out_y = pred.t, pred.displacement
         else:
-            out = system.simulate(t, u, periodic=args.periodic, substeps=args.substeps)
+            out = system.simulate(t, u_model, periodic=args.periodic, substeps=args.substeps)
             out_t, out_y = out.t, out.displacement
     except StepNotConverged as exc:  # the library's remedy names its argument
         raise ValueError(f"{args.data}: {exc.what}; give more --substeps") from None
@@ -143,6 +150,8 @@ def run(args: argparse.Namespace) -> int:
                "displacement_peak": float(np.max(np.abs(out_y)))}
     if pred is not None:
         summary.update(pred.to_dict())
+    if noise is not None:
+        summary["force_noise"] = noise.to_dict()
     if args.json:
         print_json(summary)
     else:
@@ -158,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
                   f"on {pred.rmse:.4g} m (fit {pred.fit_percent:.2f} %)")
             if pred.floor_text():
                 print(f"  ({pred.floor_text()})")
+        if noise is not None and noise.sigma > 0:
+            print(f"  force: {noise.reason}")
     return 0
 
 

@@ -205,19 +205,28 @@ def _removed_share(fs: float, cutoff: float) -> float:
     return float(np.mean(removed ** 2))
 
 
-def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False
+def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False,
+                          quantity: str = "displacement", unit: str = "m"
                           ) -> tuple[NDArray[np.float64], DisplacementEstimate]:
     """The displacement without its sensor's white noise, where the record shows such noise
     and a band that holds it alone (see the module); else `x` itself.
+
+    The same for any model's input measured with white noise: the force of a record without
+    inertia driven by a force (`quantity` ``"force"``, `unit` ``"N"``), whose load cell's
+    noise drives the link's small loops as a displacement sensor's does.
 
     Parameters
     ----------
     t : array_like
         Uniform time grid [s].
     x : array_like
-        The measured displacement [m].
+        The measured displacement [m] (or `quantity`, in `unit`).
     periodic : bool
         `x` holds whole periods (filtered around the period).
+    quantity : str
+        What `x` is, as the messages name it.
+    unit : str
+        Its unit, as the messages give it.
 
     Returns
     -------
@@ -239,8 +248,19 @@ def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False
     (True, False)
     >>> print(est)
     no white noise: used as measured
+
+    A force with a load cell's 5 N of white noise, the input of a link without inertia:
+
+    >>> f = 3000.0 * np.sin(2 * np.pi * 0.5 * t)
+    >>> noisy = f + 5.0 * np.random.default_rng(1).standard_normal(t.size)
+    >>> f_hat, est = estimate_displacement(t, noisy, quantity="force", unit="N")
+    >>> print(est)
+    white noise of 5.2 N RMS, alone above 7.03 Hz: low-passed there (the link's input estimated:
+    errors in variables)
+    >>> round(float(np.std(f_hat - f)), 2)    # N
+    1.3
     """
-    tt, xs = check_record(t, x, what="displacement")
+    tt, xs = check_record(t, x, what=quantity)
     if not (isinstance(x, np.ndarray) and x.dtype == np.float64):
         x = xs
     none = DisplacementEstimate(0.0, False, None, "no white noise: used as measured")
@@ -260,10 +280,10 @@ def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False
     above = np.nonzero(p > SIGNAL_TO_NOISE * floor)[0]
     f_signal = float(f[above[-1]]) if above.size else float(f[1])
     cutoff = CUTOFF_MARGIN * max(f_signal, float(f[1]))
-    what = f"white noise of {sigma:.2g} m RMS"
+    what = f"white noise of {sigma:.2g} {unit} RMS"
     if cutoff > (1.0 - MIN_REMOVED_BAND) * fs / 2.0:
         return x, DisplacementEstimate(sigma, False, None,
-                                       f"{what}, but the displacement's spectrum stands "
+                                       f"{what}, but the {quantity}'s spectrum stands "
                                        f"above it up to {f_signal:.3g} Hz: used as measured")
     x_hat = _lowpass(xs, fs, cutoff, periodic)
     removed = xs - x_hat
@@ -284,16 +304,17 @@ def estimate_displacement(t: ArrayLike, x: ArrayLike, *, periodic: bool = False
     if not low * expected <= rms <= high * expected:
         return x, DisplacementEstimate(sigma, False, cutoff,
                                        f"{what}, but what a low-pass at {cutoff:.3g} Hz would "
-                                       f"remove is not that noise (RMS {rms:.3g} m, "
-                                       f"{worst:.3g} m in one part, against {expected:.3g} m: "
+                                       f"remove is not that noise (RMS {rms:.3g} {unit}, "
+                                       f"{worst:.3g} {unit} in one part, against "
+                                       f"{expected:.3g} {unit}: "
                                        f"a step, or motion that fast): used as measured")
     x_hat = x_hat + measured * removed
     parts = ""
     if share > 0.0:
         n_parts = int(np.count_nonzero(np.diff(np.concatenate([[0], measured > 0, [0]])) > 0))
         parts = (f", except {n_parts} part{'s' if n_parts > 1 else ''} ({100 * share:.2g} % of "
-                 f"the record) where it moves that fast (a step: {worst:.3g} m removed there "
-                 f"against {expected:.3g} m), used as measured")
+                 f"the record) where it moves that fast (a step: {worst:.3g} {unit} removed "
+                 f"there against {expected:.3g} {unit}), used as measured")
     return x_hat, DisplacementEstimate(sigma, True, cutoff,
                                        f"{what}, alone above {cutoff:.3g} Hz: low-passed "
                                        f"there{parts} (the link's input estimated: errors in "

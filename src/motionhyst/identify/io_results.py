@@ -55,9 +55,10 @@ class IOIdentification:
         The offsets and initial states (``offsets``, ``initial_state``), a force-displacement
         record's displacement noise and whether it was filtered (``displacement_noise``, one
         :meth:`~motionhyst.identify.displacement_noise.DisplacementEstimate.to_dict` per
-        record), whether the search stopped at its budget (``budget_reached``) and the
-        covariance of the determined estimates from the fit's Jacobian (``covariance``:
-        ``{"parameters", "matrix"}``,
+        record; ``force_noise`` the same of the force driving a quasi-static plant), whether
+        the search stopped at its budget (``budget_reached``) and the covariance of the
+        determined estimates from the fit's Jacobian (``covariance``: ``{"parameters",
+        "matrix"}``,
         :func:`~motionhyst.identify.io_uncertainty.covariance_table`; a Bouc-Wen link's
         under its identified names ``alpha``, ``beta*gamma``, ``beta*delta``, ``nu``), and
         ``std_lower_bound`` (True) where the standard errors are lower bounds, with
@@ -68,8 +69,8 @@ class IOIdentification:
         (:func:`~motionhyst.identify.io_checks.plausibility_warnings`).
     data : list of IORecord
         The records fitted (not in :meth:`to_dict`); a force-displacement record's
-        displacement as estimated without its sensor's white noise
-        (:func:`~motionhyst.identify.displacement_noise.estimate_displacement`).
+        displacement (a quasi-static plant's force) as estimated without its sensor's white
+        noise (:func:`~motionhyst.identify.displacement_noise.estimate_displacement`).
     residuals : ndarray
         The model's output less the measured position, the records one after the other, as
         the fit compared them (offsets and initial states included) [m] (or [N]).
@@ -165,8 +166,9 @@ class IOIdentification:
                              f"[{self.unit}]"],
                             [[r["name"], str(r["samples"]), g(r["fit_rms"]),
                               g(r["output_rms"])] for r in self.records])]
-        lines += [f"  displacement of {r['name']}: {est['reason']}" for r, est in
-                  zip(self.records, self.extra.get("displacement_noise", []), strict=False)
+        lines += [f"  {what} of {r['name']}: {est['reason']}"
+                  for what in ("displacement", "force") for r, est in
+                  zip(self.records, self.extra.get(f"{what}_noise", []), strict=False)
                   if est["sigma"] > 0]
         lines += [f"  warning: {w}" for w in self.warnings]
         return "\n".join(lines)
