@@ -171,15 +171,11 @@ def test_a_force_of_the_wrong_sign_is_not_told_a_time_offset(paper_loop):
 
 def test_the_command_asks_about_a_time_offset_in_one_line(fast_loop, tmp_path):
     import limited_process
+    from closed_loop_files import closed_loop_files
     from file_trees import populate, snapshot
 
-    from motionhyst.scenario import default_scenario_path
-
     t, y1, u = fast_loop
-    rows = np.column_stack([t[:-1], y1[:-1], u[1:]])
-    populate(tmp_path, {"s.toml": default_scenario_path().read_text(),
-                        "rec.csv": "time,y1,u\n" + "".join(
-                            ",".join(repr(float(v)) for v in row) + "\n" for row in rows)})
+    populate(tmp_path, closed_loop_files(t[:-1], y1[:-1], u[1:]))
     before = snapshot(tmp_path)
     line = limited_process.refusal(["identify", "rec.csv", "--scenario", "s.toml"], tmp_path)
     assert line.startswith("motionhyst: error: rec.csv: the link force inferred through the "

@@ -157,15 +157,11 @@ def test_a_record_with_offsets_is_still_identified(paper_5hz):
 def test_the_command_names_the_negated_column_in_one_line(paper_5hz, tmp_path):
     """One line, exit 2, nothing written; the option it names reads the record right."""
     import limited_process
+    from closed_loop_files import closed_loop_files
     from file_trees import populate, snapshot
 
-    from motionhyst.scenario import default_scenario_path
-
     t, y1, u = paper_5hz
-    rows = np.column_stack([t, y1, -u])
-    populate(tmp_path, {"s.toml": default_scenario_path().read_text(),
-                        "rec.csv": "time,y1,u\n" + "".join(
-                            ",".join(repr(float(v)) for v in row) + "\n" for row in rows)})
+    populate(tmp_path, closed_loop_files(t, y1, -u))
     before = snapshot(tmp_path)
     line = limited_process.refusal(["identify", "rec.csv", "--scenario", "s.toml"], tmp_path)
     assert line.startswith("motionhyst: error: rec.csv: the link force inferred through the "
