@@ -109,7 +109,8 @@ CASES = [
      ["f.csv: no hysteresis in the record", "nothing identified"]),
     ("force-displacement-force-noise-model", {"f.csv": _force_noise()},
      ["identify", "f.csv", "--model", "dahl"],
-     ["f.csv: the records show no stiffness (the position does not follow the force)"]),
+     ["f.csv: no hysteresis in the record: its force does not follow the displacement",
+      "nothing identified"]),
     # ---------------- a scenario's unit slip: the loop's pole, not the setpoint, sets the step
     ("scan-actuated-mass-of-a-nanogram", {"s.toml": _paper("m1 = 5.0", "m1 = 1e-9")},
      ["scan", "s.toml", "--length", "0.1", "--speed", "0.1", "--a-max", "10", "--j-max",

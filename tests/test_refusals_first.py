@@ -423,3 +423,24 @@ def test_a_force_that_does_not_follow_the_displacement_is_refused_before_the_mas
     if not noise_only:
         fixed = probe(["identify", "rev.csv", "--scale", "force=-1"], tmp_path)
         assert fixed["rc"] == 0, fixed["err"]
+
+
+@pytest.mark.parametrize("model", ["jenkins", "maxwell-slip", "bouc-wen", "dahl", "lugre",
+                                   "maxwell-iwan", "coulomb"])
+@pytest.mark.parametrize(("force_sign", "noise_only", "words"), [
+    (-1.0, False, "rev.csv: no hysteresis found: the force falls as the displacement rises (is "
+                  "one sensor's sign reversed? --scale force=-1)"),
+    (1.0, True, "rev.csv: no hysteresis in the record: its force does not follow the "
+                "displacement (a spring, a damper and a friction force explain ")],
+    ids=["load-cell-reversed", "force-of-white-noise"])
+def test_every_link_model_refuses_a_force_that_does_not_follow_before_its_fit(
+        tmp_path, model, force_sign, noise_only, words):
+    """The same records with ``--model``: the link's fit of a force of white noise refused
+    after its start, "the records show no stiffness", and a reversed load cell as "the
+    position falls as the force rises", after the fit's libraries loaded (scipy.optimize:
+    0.8-1.1 s of CPU); now the check the elements' fit runs, before any of them."""
+    (tmp_path / "rev.csv").write_text(_damper(force_sign, noise_only))
+    out = probe(["identify", "rev.csv", "--model", model], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert out["err"].startswith(f"motionhyst: error: {words}"), out["err"]
+    assert "numba" not in out["packages"] and "scipy" not in out["packages"], out["packages"]

@@ -433,6 +433,7 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     for path in paths:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         records.append((path, t, x, w))
+    _check_forces_follow(records)  # light: before the fit's sizes load its libraries
     check([t.size for _, t, _, _ in records])  # before the mass check and the starts
     mass = _refuse_a_mass(records)
     if mass is not None:
@@ -472,6 +473,23 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         print("\n# the identified link, a scenario for motionhyst predict (or give --save):")
         print(fit.scenario_text(), end="")
     return 0
+
+
+def _check_forces_follow(records: list[tuple]) -> None:
+    """Refuse force-displacement records ``(path, t, x, w)`` of which one has a force that
+    does not follow its displacement (noise, or a sensor's sign reversed:
+    :func:`~motionhyst.identify.records.check_force_follows`, on the displacement the fit
+    takes, its sensor's noise estimated), before the mass check and any link's fit: the same
+    refusal for every ``--model`` as for the elements' fit (a Dahl link's fit refused white
+    noise only after its start)."""
+    from motionhyst.identify.displacement_noise import estimate_displacement
+    from motionhyst.identify.records import check_force_follows
+
+    for path, t, x, w in records:
+        try:
+            check_force_follows(estimate_displacement(t, x)[0], w, t)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
 
 
 def _refuse_a_mass(records: list[tuple], refuse: bool = False) -> str | None:
