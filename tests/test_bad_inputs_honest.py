@@ -81,7 +81,8 @@ DAMPED_LINK = _paper('model = "jenkins"\nk = 20.0              # spring stiffnes
                      'vs = 0.1')
 TOO_DAMPED = ["s.toml: [hysteresis]: the link's damping for small motions, 1e+07 N s/m on "
               "the 5 kg it moves, is too strong for the time step of",
-              "the run would stop at the stage's first motion; the step is the command's, set "
+              "the run would stop at the stage's first motion or end in a motion that is no "
+              "solution; the step is the command's, set "
               "from the loop's poles and the reference: is the link's damping meant (in SI "
               "units)?"]
 PREDICT = ["predict", "axis.toml", "r.mat", "--out", "p.csv"]

@@ -428,28 +428,37 @@ def in_the_commands_terms(sc, remedy: str) -> Iterator[None]:
                                ) from None
 
 
-def check_link_damping_for(sc, step: float) -> None:
+def check_link_damping_for(sc, step: float | None = None) -> None:
     """Refuse, before a run of ``scan`` or ``simulate`` (whose step is their own: set from the
-    loop's poles and the reference), a scenario whose link is too strongly damped for that
-    step (:func:`~motionhyst.time.steps.check_link_damping`), naming its ``[hysteresis]``:
-    the run would stop at the stage's first motion, after its loop was built.
+    loop's poles and the reference, or a sampled controller's period split for the stage's
+    fastest mode), a scenario whose link is too strongly damped for that step
+    (:func:`~motionhyst.time.steps.check_link_damping`), naming its ``[hysteresis]``: the run
+    would stop at the stage's first motion, after its loop was built, or end in no solution.
 
     Parameters
     ----------
     sc : Scenario
         The command's scenario.
-    step : float
-        The run's step [s], known before its loop is built.
+    step : float, optional
+        A continuous loop's step [s], known before its loop is built; None: the scenario's
+        sampled controller's longest fine step
+        (:func:`~motionhyst.time.steps.sampled_step`).
     """
     from motionhyst.scenario import ScenarioError
-    from motionhyst.time.steps import check_link_damping
+    from motionhyst.time.steps import check_link_damping, sampled_step
 
+    set_by = "set from the loop's poles and the reference"
+    if step is None:
+        c = sc.model.controller
+        rate, delay = c.sample_rate_hz, c.delay_samples or 0.0
+        step = sampled_step(sc.plant(), sc.hysteresis(), rate, delay)
+        set_by = (f"the sampled controller's period ({rate:g} Hz, {delay:g} samples late) "
+                  f"split for the stage's fastest mode")
     try:
         check_link_damping(sc.hysteresis(), sc.plant(), step)
     except ValueError as exc:
         raise ScenarioError(f"{sc.source}: [hysteresis]: {exc}; the step is the command's, "
-                            f"set from the loop's poles and the reference: is the link's "
-                            f"damping meant (in SI units)?") from None
+                            f"{set_by}: is the link's damping meant (in SI units)?") from None
 
 
 def fast_pole(sc, pole: float) -> str:

@@ -282,8 +282,8 @@ def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None
                 out.check_csv_size(n, 3 + 3 * runs,
                                    remedy=f"{REMEDY}, or write --time-series where there "
                                    f"is room")
-            if pole is not None:  # the run's own step: before its loop is built
-                check_link_damping_for(sc, step)
+            if pole is not None or rate is not None:  # the run's own step: before the loop
+                check_link_damping_for(sc, None if pole is None else step)
             if pole is not None or rate is not None:  # the run's own step: known
                 try:
                     check_window_samples(args.window, step, "give a longer --window")

@@ -151,8 +151,8 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
                            f"Hz) or shorten --duration ({duration:g} s), or write "
                            f"--time-series where there is room")
         check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy, rows)
-    if pole is not None:  # the run's own step, known before its loop is built
-        check_link_damping_for(sc, run_step)
+    if pole is not None or rate is not None:  # the run's own step, before its loop is built
+        check_link_damping_for(sc, None if pole is None else run_step)
     return remedy
 
 

@@ -61,6 +61,12 @@ from motionhyst.time.kernel import (
     StepNotConverged,
     step_loop,
 )
+from motionhyst.time.steps import (
+    SAMPLED_MIN_SUBSTEPS,
+    SAMPLED_STEPS_PER_MODE_PERIOD,
+    check_link_damping,
+    sampled_substeps,
+)
 
 __all__ = [
     "DiscreteController",
@@ -451,10 +457,9 @@ class SampledRun:
 
 
 #: Fine steps per controller period at least (room for a fractional delay's split), and per
-#: period of the plant's fastest mode (as :data:`motionhyst.time.steps.STEPS_PER_POLE_PERIOD`
-#: per period of the continuous loop's fastest pole).
-MIN_SUBSTEPS = 2
-STEPS_PER_MODE_PERIOD = 40
+#: period of the plant's fastest mode (:func:`motionhyst.time.steps.sampled_substeps`).
+MIN_SUBSTEPS = SAMPLED_MIN_SUBSTEPS
+STEPS_PER_MODE_PERIOD = SAMPLED_STEPS_PER_MODE_PERIOD
 
 
 def _mechanics(plant):
@@ -564,23 +569,13 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
         raise ValueError(f"u_max must be > 0, got {u_max!r}")
     stepping = Stepping.empty() if link is None else link.time_stepping()
     k_link = link.initial_stiffness if link is not None else 0.0
-    if substeps is None:
-        f_n = mech.natural_frequency_hz(k_link)
-        substeps = max(MIN_SUBSTEPS, math.ceil(STEPS_PER_MODE_PERIOD * f_n * T))
-    R = int(substeps)
-    if R < 1:
-        raise ValueError("substeps must be >= 1")
+    R, r1, h, h1 = sampled_substeps(T, d, substeps, mech.natural_frequency_hz(k_link)
+                                    if substeps is None else 0.0)
+    if link is not None:  # a damping its steps cannot settle: refused, not run to no answer
+        check_link_damping(link, mech, max(h, h1))
     n_delay = math.floor(d)
-    frac = d - n_delay
     A, B = mech.state_space()
-    if frac > 0.0:
-        r1 = min(max(1, round(frac * R)), R - 1) if R > 1 else 1
-        r2 = max(R - r1, 1)
-        R = r1 + r2
-        steps = [FohStep.exact(A, B, (1.0 - frac) * T / r2), FohStep.exact(A, B, frac * T / r1)]
-    else:
-        r1 = 0
-        steps = [FohStep.exact(A, B, T / R)]
+    steps = [FohStep.exact(A, B, h)] + ([FohStep.exact(A, B, h1)] if r1 else [])
     ns = A.shape[0]
     Cout = np.zeros((3, ns))  # the measured output, the link's displacement and velocity
     Cout[0, mech.output] = 1.0

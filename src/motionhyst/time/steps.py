@@ -21,12 +21,35 @@ from collections.abc import Iterator, Sequence
 
 from motionhyst.core.budget import BudgetError, check_memory, check_work
 
-__all__ = ["BYTES_PER_SAMPLE", "IMPLICIT_STEP_MARGIN", "MAX_ROWS", "MAX_SAMPLES",
-           "MAX_SCAN_STEPS", "MAX_STEPS", "RUN_REMEDY", "SCAN_REMEDY",
-           "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_ROW", "SECONDS_PER_STEP",
-           "STEPS_PER_POLE_PERIOD", "STEPS_PER_REFERENCE_PERIOD", "RunTooLarge", "a_run",
-           "check_link_damping", "check_scan_steps", "check_steps_work", "longest_step",
-           "pole_step", "step_set_by", "time_series_grid"]
+__all__ = [
+    "BYTES_PER_SAMPLE",
+    "IMPLICIT_STEP_MARGIN",
+    "MAX_ROWS",
+    "MAX_SAMPLES",
+    "MAX_SCAN_STEPS",
+    "MAX_STEPS",
+    "RUN_REMEDY",
+    "SAMPLED_MIN_SUBSTEPS",
+    "SAMPLED_STEPS_PER_MODE_PERIOD",
+    "SCAN_REMEDY",
+    "SECONDS_PER_ELEMENT_STEP",
+    "SECONDS_PER_ROW",
+    "SECONDS_PER_STEP",
+    "STEPS_PER_POLE_PERIOD",
+    "STEPS_PER_REFERENCE_PERIOD",
+    "RunTooLarge",
+    "a_run",
+    "check_link_damping",
+    "check_scan_steps",
+    "check_steps_work",
+    "damping_factor",
+    "longest_step",
+    "pole_step",
+    "sampled_step",
+    "sampled_substeps",
+    "step_set_by",
+    "time_series_grid",
+]
 
 STEPS_PER_POLE_PERIOD = 40
 """Time steps per period of the loop's fastest closed-loop pole."""
@@ -100,7 +123,162 @@ force over one step by more than this (:func:`check_link_damping`): above 1 the 
 fixed-point iteration diverges.  Measured on Table I's stage (m1 of 2, 5 and 20 kg, a LuGre
 link): runs fail from a factor of 0.6 on (their 50 passes do not reach the tolerance) and
 converge at 0.5, so the coupling of the link's mass to the rest of the stage within a step,
-which the factor leaves out, refuses no run that would converge."""
+which the factor leaves out, refuses no run that would converge.  The runs of a sampled
+loop's fine steps and of an open-loop system (``predict``) fail from 0.34-0.6 on (sigma1 or
+sigma2 of a LuGre link; 0.5-20 kg, 1-20 kHz, delays of 0-1.5 samples); above the margin
+some of them end, their answer meaningless (a 30 N force moving a damped 2 kg axis by
+100-1000 m, a loop's link force of 3e10 N)."""
+
+SAMPLED_MIN_SUBSTEPS = 2
+"""Fine steps per controller period of a sampled loop's run at least (room for a fractional
+delay's split)."""
+
+SAMPLED_STEPS_PER_MODE_PERIOD = 40
+"""Fine steps of a sampled loop's run per period of the plant's fastest mode (the link taken
+as its initial stiffness), as :data:`STEPS_PER_POLE_PERIOD` per period of a continuous
+loop's fastest pole."""
+
+
+def sampled_substeps(period: float, delay_samples: float = 0.0, substeps: int | None = None,
+                     natural_frequency_hz: float = 0.0) -> tuple[int, int, float, float]:
+    """The fine steps of a sampled loop's run (:func:`motionhyst.time.engine.run_sampled`):
+    how many a controller period, and their lengths.
+
+    A fractional delay ``frac(d)`` splits the period at ``(1 - frac(d)) T``: ``r1`` steps of
+    ``frac(d) T / r1`` after the split (the delayed force applied), the others before it.
+
+    Parameters
+    ----------
+    period : float
+        The controller's period ``T`` [s].
+    delay_samples : float
+        Its delay ``d`` [samples], >= 0.
+    substeps : int, optional
+        Fine steps a period asked for (>= 1); default: at least
+        :data:`SAMPLED_MIN_SUBSTEPS` and :data:`SAMPLED_STEPS_PER_MODE_PERIOD` a period of
+        `natural_frequency_hz`.
+    natural_frequency_hz : float
+        The plant's fastest mode with the link [Hz] (for the default).
+
+    Returns
+    -------
+    R : int
+        Fine steps a period.
+    r1 : int
+        Of them, the steps after a fractional delay's split (0 without one).
+    h : float
+        Length of the other ``R - r1`` steps [s].
+    h1 : float
+        Length of the `r1` steps [s] (0 without them).
+
+    Raises
+    ------
+    ValueError
+        For `substeps` below 1.
+
+    Examples
+    --------
+    >>> sampled_substeps(1e-4, 1.5, natural_frequency_hz=694.3)   # the paper's loop at 10 kHz
+    (3, 2, 5e-05, 2.5e-05)
+    >>> sampled_substeps(1e-3, 1.0, natural_frequency_hz=694.3)   # at 1 kHz
+    (28, 0, 3.5714285714285716e-05, 0.0)
+    """
+    if substeps is None:
+        substeps = max(SAMPLED_MIN_SUBSTEPS,
+                       math.ceil(SAMPLED_STEPS_PER_MODE_PERIOD * natural_frequency_hz * period))
+    R = int(substeps)
+    if R < 1:
+        raise ValueError("substeps must be >= 1")
+    frac = float(delay_samples) - math.floor(delay_samples)
+    if frac > 0.0:
+        r1 = min(max(1, round(frac * R)), R - 1) if R > 1 else 1
+        r2 = max(R - r1, 1)
+        return r1 + r2, r1, (1.0 - frac) * period / r2, frac * period / r1
+    return R, 0, period / R, 0.0
+
+
+def sampled_step(plant, link, sample_rate_hz: float, delay_samples: float = 0.0) -> float:
+    """The longest fine step of a sampled loop's run [s] (:func:`sampled_substeps`, by
+    default), known before its loop is built.
+
+    Parameters
+    ----------
+    plant : Plant
+        The stage (its :meth:`mechanics` gives its fastest mode).
+    link : Hysteresis or None
+        The link (its initial stiffness stiffens that mode).
+    sample_rate_hz : float
+        The controller's rate [Hz].
+    delay_samples : float
+        Its delay [samples].
+
+    Returns
+    -------
+    float
+        The step; the controller's period for a plant without lumped masses.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.plants import TwoMassStage
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> sampled_step(stage, Jenkins(k=20.0, fc=0.05), 10_000.0, 1.5)
+    5e-05
+    """
+    period = 1.0 / sample_rate_hz
+    try:
+        mech = plant.mechanics()
+        k = 0.0 if link is None else float(getattr(link, "initial_stiffness", 0.0))
+        f_n = float(mech.natural_frequency_hz(k))
+    except (AttributeError, TypeError, ValueError, NotImplementedError):
+        return period
+    _, _, h, h1 = sampled_substeps(period, delay_samples, natural_frequency_hz=f_n)
+    return max(h, h1)
+
+
+def damping_factor(link, plant, step: float) -> float:
+    """The factor by which a link's damping amplifies each pass of a run's implicit step
+    (:func:`check_link_damping`); 0 for a link without damping or a plant without lumped
+    masses.
+
+    Parameters
+    ----------
+    link : Hysteresis
+        The link (its ``small_amplitude_limit`` gives its damping, where it has one).
+    plant : Plant or Mechanics
+        The stage (its :meth:`mechanics` gives the mass the link moves), or its lumped
+        masses.
+    step : float
+        The run's time step [s].
+
+    Returns
+    -------
+    float
+        ``c step / (4 m)``.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import LuGre
+    >>> from motionhyst.plants import TwoMassStage
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> print(f"{damping_factor(LuGre(20.0, 1e7, 0.0, 0.05, 0.07, 0.1), stage, 3.62e-5):.3g}")
+    18.1
+    """
+    small = getattr(link, "small_amplitude_limit", None)
+    mass = _link_mass(plant)
+    if small is None or mass is None or not step > 0:
+        return 0.0
+    return float(complex(small(1.0)).imag) * step / (4.0 * mass)
+
+
+def _link_mass(plant) -> float | None:
+    """The mass the link moves [kg] of a plant (or of its lumped masses themselves); None
+    without them."""
+    try:
+        mech = plant.mechanics() if callable(getattr(plant, "mechanics", None)) else plant
+        return float(mech.mass[mech.link])
+    except (AttributeError, IndexError, TypeError, ValueError, NotImplementedError):
+        return None
 
 
 def check_link_damping(link, plant, step: float, where: str = "") -> None:
@@ -111,10 +289,13 @@ def check_link_damping(link, plant, step: float, where: str = "") -> None:
     ``step^2 / (6 m)`` per newton, and a damping ``c`` (the link's for small motions,
     ``Im D / omega``: LuGre's ``sigma1 + sigma2`` from rest) turns that back into a force
     through the velocity at the step's end, ``1.5 / step`` per metre (the second-order
-    backward difference).  Their product ``c step / (4 m)`` is the factor by which each pass
-    amplifies the error: above 1 the iteration diverges at the stage's first motion and the
-    run stops there, after its loop is built and its kernels loaded.  A link without
-    damping (a rate-independent one), a plant without lumped masses, or a factor within
+    backward difference).  Their product ``c step / (4 m)`` (:func:`damping_factor`) is the
+    factor by which each pass amplifies the error: above 1 the iteration diverges at the
+    stage's first motion and the run stops there, after its loop is built and its kernels
+    loaded, or, where a pass happens to settle, ends with a motion that is no solution
+    (:data:`IMPLICIT_STEP_MARGIN`).  The same holds for the fine steps of a sampled loop's
+    run (:func:`sampled_step`) and for an open-loop system's.  A link without damping (a
+    rate-independent one), a plant without lumped masses, or a factor within
     :data:`IMPLICIT_STEP_MARGIN` passes: the run judges it (one whose iteration converges
     too slowly still stops it).
 
@@ -122,8 +303,9 @@ def check_link_damping(link, plant, step: float, where: str = "") -> None:
     ----------
     link : Hysteresis
         The link (its ``small_amplitude_limit`` gives its damping, where it has one).
-    plant : Plant
-        The stage (its :meth:`mechanics` gives the mass the link moves).
+    plant : Plant or Mechanics
+        The stage (its :meth:`mechanics` gives the mass the link moves), or its lumped
+        masses.
     step : float
         The run's time step [s].
     where : str
@@ -147,25 +329,19 @@ def check_link_damping(link, plant, step: float, where: str = "") -> None:
     ...     print(exc)
     the link's damping for small motions, 1e+07 N s/m on the 5 kg it moves, is too strong \
 for the time step of 3.62e-05 s: it would amplify each pass of the step's implicit \
-iteration 18.1 times (it settles below 1): the run would stop at the stage's first motion
+iteration 18.1 times (it settles below 1): the run would stop at the stage's first motion \
+or end in a motion that is no solution
     """
-    small = getattr(link, "small_amplitude_limit", None)
-    mechanics = getattr(plant, "mechanics", None)
-    if small is None or mechanics is None or not step > 0:
-        return
-    try:
-        mech = mechanics()
-    except (TypeError, ValueError, NotImplementedError):
-        return
-    damping = float(complex(small(1.0)).imag)
-    mass = float(mech.mass[mech.link])
-    factor = damping * step / (4.0 * mass)
+    factor = damping_factor(link, plant, step)
     if factor > IMPLICIT_STEP_MARGIN:
+        mass = float(_link_mass(plant))
+        damping = 4.0 * factor * mass / step
         raise ValueError(f"{where}the link's damping for small motions, {damping:.4g} N s/m on "
                          f"the {mass:.4g} kg it moves, is too strong for the time step of "
                          f"{step:.3g} s: it would amplify each pass of the step's implicit "
                          f"iteration {factor:.3g} times (it settles below 1): the run would "
-                         f"stop at the stage's first motion")
+                         f"stop at the stage's first motion or end in a motion that is no "
+                         f"solution")
 
 
 class RunTooLarge(BudgetError):
