@@ -282,6 +282,18 @@ def run(args: argparse.Namespace) -> int:
             try:
                 check_controller_period(t, 1.0 / rate)
             except ValueError as exc:
+                from motionhyst.identify.link_checks import held_rows
+
+                k, first = held_rows(u)  # logged faster than the controller: its rows named
+                at = (f" (u is held over {k} rows: take one row in {k}, from row {first + 1})"
+                      if k > 1 and abs(k * float(t[1] - t[0]) * rate - 1) < 1e-3 else "")
+                raise ValueError(f"{path}: {exc}{at}") from None
+        else:  # a sampled controller's staircase read as ramps: no link's force
+            from motionhyst.identify.link_checks import check_not_held
+
+            try:
+                check_not_held(t, u, f"{sc.source}'s [controller]")
+            except ValueError as exc:
                 raise ValueError(f"{path}: {exc}") from None
         plant = sc.plant()
         if not plant.is_lti:

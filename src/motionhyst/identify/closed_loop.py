@@ -24,6 +24,7 @@ from motionhyst.identify.fit import (
     residuals_and_jacobian,
 )
 from motionhyst.identify.io_uncertainty import covariance, covariance_table, standard_errors
+from motionhyst.identify.link_checks import check_not_held
 from motionhyst.identify.records import (
     MAX_ROWS,
     UNIFORM_RTOL,
@@ -242,7 +243,9 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         creates energy over the record's whole cycles beyond its noise and what a link could
         have stored, a spring's and a damper's (loops that widen with the speed), or one
         that grows with the speed (it falls back along the strokes); naming, where one
-        makes the record a link's, u's sign reversed or a time offset of the columns.
+        makes the record a link's, u's sign reversed or a time offset of the columns.  Without
+        `controller`, a record whose u is held over several rows (a sampled controller's
+        force logged faster than it updates: :func:`~motionhyst.identify.link_checks.held_rows`).
 
     Examples
     --------
@@ -264,6 +267,9 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         raise ValueError(f"unknown offset choice {offset!r}; expected auto, input or none")
     if initial_state not in ("fit", "relaxed"):
         raise ValueError(f"unknown initial_state {initial_state!r}; use 'fit' or 'relaxed'")
+    if controller is None:  # a sampled controller's staircase, read as ramps: no link's force
+        check_not_held(np.asarray(t, dtype=float), np.asarray(u, dtype=float),
+                       "the SampledController (controller=)")
     lf, L_over_P1 = _infer(t, y1, u, stage, cutoff_hz, controller)
     us = np.asarray(u, dtype=float)
     try:
