@@ -148,8 +148,8 @@ def test_a_record_with_a_non_finite_force_sample_is_judged_by_the_others(tmp_pat
 
 def test_mains_hum_larger_than_the_force_is_said_in_the_refusal(tmp_path, capsys):
     """The same run's record with 50 Hz mains hum of twice the force's RMS (review B12 M2):
-    the forces correlate by 0.45, refused, and the line says what the help says, that noise
-    other than white above 1.7 times the force's RMS decorrelates one run's forces, and
+    the forces correlate by 0.45, refused, and the line says what the help says, that hum
+    above 1.7 times the force's RMS decorrelates one run's forces, and
     that its force column sets nothing (main: "a sensor's ... noise keeps one run's forces
     correlated"); the column low-passed at 20 Hz, the record passes and sets the state."""
     from scipy.signal import butter, filtfilt
@@ -166,9 +166,9 @@ def test_mains_hum_larger_than_the_force_is_said_in_the_refusal(tmp_path, capsys
     line = limited_process.refusal(["predict", "axis.toml", "force.csv", "--out", "p.csv",
                                     "--init-from", "hum.csv"], tmp_path)
     assert "correlate by 0.45, less than 0.5" in line, line
-    assert line.endswith("(if it is this run's, noise other than white, mains hum or "
-                         "low-frequency noise, above 1.7 times the force's RMS decorrelates "
-                         "them: filter its force column, which sets nothing)"), line
+    assert line.endswith("(if it is this run's, noise other than white, low-frequency noise "
+                         "above about the force's RMS or mains hum above 1.7 times it, "
+                         "decorrelates them: filter its force column, which sets nothing)"), line
     assert snapshot(tmp_path) == before
     code = main(["predict", str(tmp_path / "axis.toml"), str(tmp_path / "force.csv"), "--out",
                  str(tmp_path / "p.csv"), "--init-from", str(tmp_path / "low.csv"), "--json"])
@@ -180,7 +180,45 @@ def test_the_help_says_which_noise_passes(capsys):
     with pytest.raises(SystemExit):
         main(["predict", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    assert ("a load cell's offset, drift, gain or white noise is not, nor other noise below "
-            "about 1.7 "
-            "times the force's RMS; mains hum or low-frequency noise larger than that makes "
-            "the same run's force look another's") in text, text
+    assert ("a load cell's offset, drift, gain or white noise is not, nor other noise up to "
+            "about the force's RMS (mains hum up to 1.7 times it); low-frequency noise larger "
+            "than that may make the same run's force look another's") in text, text
+
+
+def _noise(colour: str, seed: int) -> np.ndarray:
+    """Unit-RMS noise on the records' grid: white, 50 Hz hum of a random phase, or white
+    noise low-passed (second-order Butterworth) below ``lp<Hz>``."""
+    from scipy.signal import butter, lfilter
+
+    rng = np.random.default_rng(seed)
+    if colour == "white":
+        return rng.standard_normal(N)
+    if colour == "hum":
+        return np.sqrt(2) * np.sin(2 * np.pi * 50 * _time() + rng.uniform(0, 2 * np.pi))
+    c = lfilter(*butter(2, float(colour[2:]) / (FS / 2)), rng.standard_normal(N))
+    return c / np.std(c)
+
+
+@pytest.mark.parametrize(("colour", "factor"), [
+    ("white", 3.0), ("hum", 1.7), ("lp50", 1.0), ("lp20", 1.0), ("lp5", 1.0), ("lp1", 1.0),
+    ("lp0.5", 1.0)])
+def test_the_noise_the_help_lets_pass_passes_for_every_seed(colour, factor):
+    """What the help claims, for 20 seeds each: the same run's force with noise of the factor
+    of its RMS is taken for the same run.  The old claim, any noise below 1.7 times the RMS,
+    failed for band-limited noise in half the seeds at 1.7 (in 1-6 of 20 at 1.5: the
+    correlation of a few independent values scatters about 1 / sqrt(1 + 1.7^2) = 0.51)."""
+    import argparse
+
+    from motionhyst.cli._common import UsageError
+    from motionhyst.cli.predict import _check_same_run
+
+    u = _input_force()
+    rms = float(np.sqrt(np.mean(u ** 2)))
+    args = argparse.Namespace(init_from="rec.csv", data="force.csv")
+    refused = []
+    for seed in range(20):
+        try:
+            _check_same_run(args, u, u + factor * rms * _noise(colour, seed))
+        except UsageError as exc:
+            refused.append((seed, str(exc)[:120]))
+    assert refused == [], refused
