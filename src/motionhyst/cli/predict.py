@@ -105,6 +105,7 @@ def run(args: argparse.Namespace) -> int:
         return _predict_force(args, sc, system, target)
     # the maps may also name the position (the --init-from record's, or INPUT's measured one,
     # as the map given to identify): only time and force are read from INPUT
+    _check_unread(args, system)
     data = read_record(args.data, ("time", "force"),
                        columns=_without(args.columns, "displacement"),
                        scale=_without(args.scale, "displacement"))
@@ -171,6 +172,28 @@ def run(args: argparse.Namespace) -> int:
         if noise is not None and noise.sigma > 0:
             print(f"  force: {noise.reason}")
     return 0
+
+
+def _check_unread(args: argparse.Namespace, system) -> None:
+    """Refuse a long force record before it is read where its run cannot fit the memory
+    budget: its samples (from the file) times the least its run takes, the record and its
+    outputs and, from rest, one block of integration steps at the least substeps."""
+    from motionhyst.core.budget import check_memory
+    from motionhyst.io.records import check_unread
+    from motionhyst.time.openloop import FINE_BYTES, MIN_SUBSTEPS, SAMPLE_BYTES
+    from motionhyst.time.resample import block_samples
+
+    r = args.substeps or MIN_SUBSTEPS
+
+    def least(sizes: list[int]) -> None:
+        n = sizes[0]
+        block = 0 if args.periodic else FINE_BYTES * (min(n - 1, block_samples(r)) * r + 1)
+        check_memory(SAMPLE_BYTES * n + block, f"predicting {n} samples "
+                     f"{'as a periodic steady state' if args.periodic else 'from rest'} (at "
+                     f"least {r} integration steps each)", "fewer samples or --substeps")
+
+    check_unread([args.data], ("time", "force"), least,
+                 columns=_without(args.columns, "displacement"))
 
 
 def _without(mapping, quantity: str):

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.core.budget import format_size
+from motionhyst.core.budget import check_memory, format_size
 from motionhyst.io.inputs import CSV_EXPANSION, input_problem
 
 if typing.TYPE_CHECKING:  # pandas loads when a file is parsed: a file refused before it
@@ -138,8 +138,10 @@ class _Dialect(typing.NamedTuple):
 
 
 def _dialect(path: Path) -> _Dialect:
-    """Encoding, separator, decimal mark and header line of a CSV file, from its first bytes."""
-    why = input_problem(path, CSV_EXPANSION)
+    """Encoding, separator, decimal mark and header line of a CSV file, from its first bytes.
+    Only the file's type is checked here (a folder, a device): what reading it takes is
+    sized from its rows (:func:`reading_bytes`), not from its bytes."""
+    why = input_problem(path, 0.0)
     if why:
         raise CSVError(f"cannot read {path}: {why}")
     try:
@@ -368,7 +370,12 @@ def _check_first_rows(path: Path, d: _Dialect, wanted: list[int], names: Sequenc
 
 
 def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
-    """The columns `names` of a CSV file (floats where they parse), rows checked for length."""
+    """The columns `names` of a CSV file (floats where they parse), rows checked for length:
+    read whole, as a file whose cells are not all plain numbers is (its message found), within
+    :data:`~motionhyst.io.inputs.CSV_EXPANSION` times its size."""
+    why = input_problem(path, CSV_EXPANSION)
+    if why:
+        raise CSVError(f"cannot read {path}: {why}")
     d = _dialect(path)
     header = _file_header(path, d)
     _check_unique(header, str(path))
@@ -394,6 +401,69 @@ def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
         raise CSVError(f"{path}: inconsistent lengths: {_where(path, 0)} has "
                        f"{frame.shape[1]} fields, the header {width}")
     return frame[list(names)]
+
+
+def _file_array(path: Path, names: tuple[str, ...]) -> NDArray[np.float64] | None:
+    """The columns `names` of a CSV file as one float array, filled a chunk of rows at a time
+    (:func:`_chunk_rows`) after its rows are sized against the memory budget
+    (:func:`reading_bytes`); None where a chunk is not plain numbers (a cell pandas does not
+    read as a float, a NaN, a row with more used fields than the header or short of them):
+    :func:`_file_columns` then reads it whole and says what is wrong (or keeps a written
+    ``nan``)."""
+    d = _dialect(path)
+    header = _file_header(path, d)
+    missing = [n for n in names if n not in header]
+    if missing:
+        found = ",".join(header) or "none"
+        raise CSVError(f"{path}: missing column(s) {', '.join(missing)}; need a header with "
+                       f"{','.join(names)} (found {found})")
+    width = len(header)
+    wanted = [header.index(n) for n in names]
+    _check_line_lengths(path, d, width)
+    _check_first_rows(path, d, wanted, names, width)
+    rows, exact = data_rows(path)
+    said = f"{rows} rows" if exact else f"about {rows} rows"
+    check_memory(reading_bytes(rows, len(names), width), f"{path} ({said}, not read yet): reading "
+                 f"its {len(names)} columns", "give a smaller file")
+    import pandas as pd  # once the file's first rows are checked: a refusal does not wait
+
+    capacity = rows if exact else rows + rows // 8 + 1024
+    data = np.empty((capacity, len(names)))
+    filled = 0
+    try:
+        with pd.read_csv(path, sep=d.sep, skipinitialspace=True, encoding=d.encoding,
+                         encoding_errors="replace", decimal=d.decimal, engine="c",
+                         skip_blank_lines=True, chunksize=_chunk_rows(width), header=None,
+                         skiprows=d.header_line) as reader:
+            for chunk in reader:
+                if chunk.shape[1] < width or (chunk.shape[1] > width and bool(
+                        chunk.iloc[:, width:].notna().to_numpy().any())):
+                    return None
+                if not all(pd.api.types.is_float_dtype(t) or pd.api.types.is_integer_dtype(t)
+                           for t in chunk.dtypes.iloc[wanted]):
+                    return None
+                end = filled + len(chunk)
+                if end > data.shape[0]:  # more rows than estimated
+                    capacity = max(end, data.shape[0] * 3 // 2)
+                    check_memory(reading_bytes(capacity, len(names), width), f"{path} (more than "
+                                 f"{filled} rows, in reading): reading its {len(names)} "
+                                 f"columns", "give a smaller file")
+                    data.resize((capacity, len(names)), refcheck=False)
+                for j, i in enumerate(wanted):  # a column at a time: no copy of the chunk
+                    data[filled:end, j] = chunk.iloc[:, i].to_numpy(dtype=np.float64)
+                if np.isnan(data[filled:end]).any():
+                    return None
+                filled = end
+    except pd.errors.EmptyDataError:
+        raise CSVError(f"{path}: no data rows") from None
+    except pd.errors.ParserError as exc:
+        raise CSVError(f"{path}: {_parser_message(str(exc), d.sep)}") from None
+    except (OSError, UnicodeError) as exc:
+        raise CSVError(f"cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if filled == 0:
+        raise CSVError(f"{path}: no data rows")
+    data.resize((filled, len(names)), refcheck=False)  # in place: no copy
+    return data
 
 
 def _bad_cell(frame: pd.DataFrame, names: Sequence[str], source: Source) -> str | None:
@@ -440,6 +510,122 @@ def _bad_cell(frame: pd.DataFrame, names: Sequence[str], source: Source) -> str 
     return f"{where}: an empty cell at {_where(source, i)}, column {name!r}"
 
 
+COUNTED_BYTES = 64 << 20
+"""CSV files up to this size have their rows counted (:func:`count_rows`, 0.2 s); a larger
+one's are estimated from its size and the lengths of lines sampled across it
+(:func:`data_rows`), so that a file of gigabytes is sized in milliseconds."""
+
+_PROBES = 64
+_PROBE_BYTES = 1 << 14
+
+VALUE_READ_BYTES = 8
+"""Memory a value read from a CSV file takes in its array [bytes] (float64): the rows are
+parsed :data:`_CHUNK_ROWS` at a time and their wanted columns copied into one array; a row
+has one more, the time steps its reader checks."""
+
+CHUNK_VALUE_BYTES = 256
+"""Memory of reading a value of a chunk of rows besides the array [bytes]: pandas' parser,
+its tokens and its frame of every column of the chunk (:func:`_chunk_rows`: 33.6 MB for a
+whole chunk).  Measured, address space above a warmed process: 1e5 and 1e6 rows of 2
+columns 29 and 46 MB (:func:`reading_bytes` 36 and 57), of 5 columns 37 and 75 MB (38 and
+82)."""
+
+
+def _chunk_rows(width: int) -> int:
+    """Rows read at a time from a file of `width` columns: about 1.3e5 values a chunk."""
+    return max(1024, _CHUNK_ROWS // max(width, 1))
+
+
+def reading_bytes(rows: int, columns: int, width: int | None = None) -> float:
+    """Memory :func:`read_columns` takes to read `columns` columns of `rows` rows of a CSV
+    file [bytes]: the array, the time steps checked and one chunk's parsing.
+
+    Parameters
+    ----------
+    rows : int
+        The file's data rows.
+    columns : int
+        The columns read.
+    width : int, optional
+        The file's columns, all parsed a chunk at a time (default `columns`).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> round(reading_bytes(1_000_000, 5) / 1e6, 1)           # 40 MB of values, one chunk
+    81.6
+    >>> round(reading_bytes(200, 5) / 1e6, 2)                 # a chunk of 200 rows
+    0.27
+    """
+    width = columns if width is None else width
+    return (VALUE_READ_BYTES * float(rows) * (columns + 1)
+            + CHUNK_VALUE_BYTES * float(min(rows, _chunk_rows(width))) * width)
+
+
+def _estimated_rows(path: Path, d: _Dialect) -> int:
+    """The data rows of a CSV file from its size over the mean length of the lines found in
+    :data:`_PROBES` pieces of :data:`_PROBE_BYTES` spread over it (a record at rest at both
+    ends has its longest lines in the middle)."""
+    size = path.stat().st_size
+    spans = lines = 0
+    with path.open("rb") as fh:
+        head = fh.read(_PROBE_BYTES)
+        ends = np.flatnonzero(np.frombuffer(head, np.uint8) == 10)[:d.header_line]
+        start = int(ends[-1]) + 1 if len(ends) == d.header_line else len(head)
+        for offset in np.linspace(start, size, _PROBES, endpoint=False).astype(int):
+            fh.seek(max(int(offset) - 1, 0))
+            piece = np.frombuffer(fh.read(_PROBE_BYTES + 1), np.uint8)
+            where = np.flatnonzero(piece == 10)
+            if where.size >= 2:
+                spans += int(where[-1] - where[0])
+                lines += where.size - 1
+    if lines == 0:  # lines longer than a piece: one row at most each
+        return max(1, (size - start) // _PROBE_BYTES)
+    return max(1, round((size - start) * lines / spans))
+
+
+def data_rows(path: str | os.PathLike) -> tuple[int, bool]:
+    """The data rows of a CSV file before it is read, and whether the count is exact: counted
+    (:func:`count_rows`) in a file up to :data:`COUNTED_BYTES`, estimated from the lengths of
+    lines sampled across a larger one.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A CSV file.
+
+    Returns
+    -------
+    (int, bool)
+        The rows, and True where they were counted.
+
+    Raises
+    ------
+    CSVError
+        The file cannot be read (a folder, a device, an empty file).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "r.csv"
+    ...     _ = path.write_text("time,force\\n" + "".join(f"{i},{i % 7}\\n" for i in range(999)))
+    ...     data_rows(path)
+    (999, True)
+    """
+    path = Path(path)
+    d = _dialect(path)
+    try:
+        if path.stat().st_size <= COUNTED_BYTES or d.encoding == "utf-16":
+            return count_rows(path), True
+        return _estimated_rows(path, d), False
+    except OSError as exc:
+        raise CSVError(f"cannot read {path}: {exc.strerror}") from None
+
+
 def count_rows(path: str | os.PathLike) -> int:
     """The data rows of a CSV file, counted without parsing it: its lines after the header
     that hold more than a line end, read 1 MB at a time (0.15 s for 47 MB).
@@ -447,8 +633,8 @@ def count_rows(path: str | os.PathLike) -> int:
     Parameters
     ----------
     path : str or os.PathLike
-        A CSV file (checked as :func:`read_columns` checks it: a folder, a device, an empty
-        file or one above the memory budget are refused).
+        A CSV file (checked as :func:`read_columns` checks it: a folder, a device or an empty
+        file are refused).
 
     Returns
     -------
@@ -553,6 +739,9 @@ def read_columns(source: Source, names: Sequence[str]) -> NDArray[np.float64]:
                            f"{','.join(map(str, frame.columns)) or 'none'})")
         frame = frame[list(names)]
     else:
+        data = _file_array(Path(source), names)
+        if data is not None:
+            return data
         frame = _file_columns(Path(source), names)
     if len(frame) == 0:
         raise CSVError(f"{where}: no data rows")
@@ -565,5 +754,6 @@ def read_columns(source: Source, names: Sequence[str]) -> NDArray[np.float64]:
     return data
 
 
-__all__ = ["CSVError", "count_rows", "describe", "normalize_name", "read_columns",
-           "read_header"]
+__all__ = ["CHUNK_VALUE_BYTES", "COUNTED_BYTES", "VALUE_READ_BYTES", "CSVError", "count_rows",
+           "data_rows", "describe", "normalize_name", "read_columns", "read_header",
+           "reading_bytes"]

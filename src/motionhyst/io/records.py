@@ -64,7 +64,7 @@ from motionhyst.io._mat_sizes import declared_values
 from motionhyst.io.csvdata import (
     CSVError,
     Source,
-    count_rows,
+    data_rows,
     describe,
     normalize_name,
     read_columns,
@@ -551,7 +551,8 @@ def record_samples(source: Source, names: Sequence[str],
                    columns: Mapping[str, str] | None = None) -> tuple[int, bool] | None:
     """The samples of a record file before its values are read, and whether the count is
     exact: a MATLAB file's from the sizes its variables declare, a CSV file's from its lines
-    (:func:`~motionhyst.io.csvdata.count_rows`: exact, but a line of spaces would count).
+    (:func:`~motionhyst.io.csvdata.data_rows`: counted up to 64 MB, a line of spaces
+    counting, estimated from lines sampled across a larger file).
 
     Parameters
     ----------
@@ -591,9 +592,7 @@ def record_samples(source: Source, names: Sequence[str],
         _check_text(source)
         if not {normalize_name(w) for w in wanted} <= set(read_header(source)):
             return None
-        return count_rows(source), True
-    except BudgetError:  # the file alone is above the budget
-        raise
+        return data_rows(source)
     except Exception:  # a damaged file, a name not found: its reader says what is wrong
         return None
 
@@ -808,8 +807,9 @@ def _check_magnitudes(data: NDArray[np.float64], names: Sequence[str], where: st
     """A column whose largest magnitude lies outside the magnitudes motionhyst computes with
     (:data:`~motionhyst.core.validation.MAGNITUDES`; a column of zeros is allowed) is a
     RecordError naming it: a unit slip, or a column that is not the quantity named."""
-    with np.errstate(invalid="ignore"):
-        peaks = np.max(np.abs(data), axis=0, initial=0.0) if data.size else []
+    with np.errstate(invalid="ignore"):  # the largest magnitude without a copy of the data
+        peaks = (np.maximum(np.abs(np.max(data, axis=0)), np.abs(np.min(data, axis=0)))
+                 if data.size else [])
     for name, peak in zip(names, peaks, strict=False):
         if peak != 0.0 and np.isfinite(peak) and not MAGNITUDES[0] <= peak <= MAGNITUDES[1]:
             raise RecordError(f"{where}: {name} reaches {peak:.3g}: outside the magnitudes "
@@ -846,8 +846,9 @@ def _check_units(data: NDArray[np.float64], names: Sequence[str], where: str) ->
                  f"(--scale displacement=0.001 for mm, 1e-6 for um)", 3)
     t = columns.get("time")
     if t is not None and t.size > 1:
-        with np.errstate(invalid="ignore"):
-            step = float(np.median(np.abs(np.diff(t))))
+        with np.errstate(invalid="ignore"):  # one array of the steps, sorted in place
+            steps = np.diff(t)
+            step = float(np.median(np.abs(steps, out=steps), overwrite_input=True))
         if 0.0 < step < MIN_TIME_STEP:
             warn(f"{where}: time steps of {step:.3g} s ({1 / step:.3g} Hz sampling): if the "
                  f"time is not in seconds, scale it (--scale time=86400 for days)", 3)
