@@ -325,10 +325,21 @@ def _moving_rms(r: NDArray[np.float64]) -> NDArray[np.float64]:
     """The RMS of `r` in the window of :data:`BLOCK_SAMPLES` samples centred on each sample
     (shorter at the ends)."""
     half = BLOCK_SAMPLES // 2
-    c = np.concatenate([[0.0], np.cumsum(r ** 2)])
-    i = np.arange(r.size)
-    lo, hi = np.maximum(i - half, 0), np.minimum(i + half, r.size)
-    return np.sqrt((c[hi] - c[lo]) / (hi - lo))
+    n = r.size
+    c = np.empty(n + 1)  # the running sum of squares, in place: two arrays of the record
+    c[0] = 0.0
+    np.square(r, out=c[1:])
+    np.cumsum(c[1:], out=c[1:])
+    out = np.empty(n)
+    if n > 2 * half:  # the whole windows, then the shorter ones at the ends
+        np.subtract(c[2 * half:n], c[:n - 2 * half], out=out[half:n - half])
+        out[half:n - half] /= 2 * half
+        ends = np.r_[0:half, n - half:n]
+    else:
+        ends = np.arange(n)
+    lo, hi = np.maximum(ends - half, 0), np.minimum(ends + half, n)
+    out[ends] = (c[hi] - c[lo]) / (hi - lo)
+    return np.sqrt(out, out=out)
 
 
 def _fast_parts(fast: NDArray[np.bool_], period: float) -> NDArray[np.float64]:
@@ -340,14 +351,29 @@ def _fast_parts(fast: NDArray[np.bool_], period: float) -> NDArray[np.float64]:
         return np.zeros(fast.size)
     reach = BLOCK_SAMPLES // 2 + math.ceil(RING_PERIODS * period)
     fade = max(1, math.ceil(period))
-    # the distance of each sample from the nearest fast one, in samples
-    i = np.arange(fast.size)
-    idx = np.nonzero(fast)[0]
-    pos = np.searchsorted(idx, i)
-    before = i - idx[np.clip(pos - 1, 0, idx.size - 1)]
-    after = idx[np.clip(pos, 0, idx.size - 1)] - i
-    nearest = np.minimum(np.where(before >= 0, before, fast.size),
-                         np.where(after >= 0, after, fast.size))
-    beyond = nearest - reach
-    ramp = np.clip(beyond / fade, 0.0, 1.0)
-    return np.where(beyond <= 0, 1.0, 0.5 * (1.0 + np.cos(np.pi * ramp)))
+    # the distance of each sample from the nearest fast one, in samples: the last fast one
+    # at or before it and the first at or after it, by running extremes of their indices
+    # (in place: four arrays of the record at most, not eight)
+    n = fast.size
+    i = np.arange(n)
+    last = np.where(fast, i, -n)
+    np.maximum.accumulate(last, out=last)
+    np.subtract(i, last, out=last)             # from the last fast sample (n or more: none)
+    first = np.where(fast, i, 2 * n)[::-1]
+    np.minimum.accumulate(first, out=first)
+    first = first[::-1]
+    np.subtract(first, i, out=first)           # to the next fast sample (n or more: none)
+    np.minimum(last, first, out=last)
+    del i, first
+    part = last.astype(float)
+    del last
+    part -= reach                              # beyond the reach: fading over `fade`
+    inside = part <= 0
+    np.divide(part, fade, out=part)
+    np.clip(part, 0.0, 1.0, out=part)
+    np.multiply(part, np.pi, out=part)
+    np.cos(part, out=part)
+    part += 1.0
+    part *= 0.5
+    part[inside] = 1.0
+    return part
