@@ -211,15 +211,18 @@ def run(args: argparse.Namespace) -> int:
         from motionhyst.identify.fd_memory import check_closed_loop_memory
 
         check_unread([path], RECORD_KINDS[kind], lambda sizes: check_closed_loop_memory(
-            sizes[0], str(path)), columns=args.columns)  # a long record: unread
+            sizes[0], str(path), every=None), columns=args.columns)  # a long record: unread
         t, y1, u = load_closed_loop_csv(path, columns=args.columns, scale=args.scale)
-        check_closed_loop_memory(t.size, str(path))  # before its link force is inferred
-        from motionhyst.identify.records import prefilter_cutoff
+        from motionhyst.identify.records import fit_every, prefilter_cutoff
 
         try:  # before the plant's scenario loads python-control
             cutoff, settle = prefilter_cutoff(t, y1, args.cutoff)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+        # before its link force is inferred: the fit's rows, one every few samples (a record
+        # of uniform steps, checked by its reader)
+        check_closed_loop_memory(t.size, str(path),
+                                 every=fit_every(float(t[-1] - t[0]) / (t.size - 1), cutoff))
         from motionhyst.identify.io_records import IORecord
         from motionhyst.identify.io_response import check_response
 

@@ -25,11 +25,13 @@ from motionhyst.identify.fit import (
 )
 from motionhyst.identify.io_uncertainty import covariance, covariance_table, standard_errors
 from motionhyst.identify.link_checks import check_not_held
+from motionhyst.identify.records import DECIMATED_RATE as DECIMATED_RATE
 from motionhyst.identify.records import (
     MAX_ROWS,
     UNIFORM_RTOL,
     check_controller_period,
     check_signals,
+    fit_every,
     prefilter_cutoff,
 )
 from motionhyst.identify.residual_noise import (
@@ -41,9 +43,6 @@ from motionhyst.identify.result import Identification
 from motionhyst.plants.registry import Plant
 
 __all__ = ["LinkForce", "identify_closed_loop", "infer_link_force"]
-
-DECIMATED_RATE = 40.0
-"""Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""
 
 
 def _p1_poly(stage) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -281,7 +280,7 @@ def identify_closed_loop(t: ArrayLike, y1: ArrayLike, u: ArrayLike, stage,
         check_link(lf, L_over_P1, us, cause)
     # L w is band-limited: fit on every q-th sample (the model's prefilter re-discretised)
     dt = lf.lowpass.dt
-    q = max(1, int(1.0 / (dt * DECIMATED_RATE * lf.cutoff_hz)))
+    q = fit_every(dt, lf.cutoff_hz)
     sel = np.arange(0, lf.y1.size, q)
     start = int(np.searchsorted(sel, lf.settle_index))
     prob = FitProblem(x=np.ascontiguousarray(lf.y1[sel]), target=lf.w[sel],

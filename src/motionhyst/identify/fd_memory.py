@@ -28,10 +28,10 @@ from __future__ import annotations
 
 from motionhyst.core.budget import check_memory, format_size
 
-__all__ = ["BOUND_COPIES", "CLOSED_LOOP_BYTES", "FIT_ROW_BYTES", "LOOP_BYTES",
-           "MIN_BOUND_COLUMNS", "RECORD_BYTES", "bound_columns", "check_closed_loop_memory",
-           "check_elements_fit_memory", "check_link_force_memory", "elements_fit_memory",
-           "link_force_memory"]
+__all__ = ["BOUND_COPIES", "CLOSED_LOOP_BYTES", "CLOSED_LOOP_ROW_BYTES", "FIT_ROW_BYTES",
+           "LOOP_BYTES", "MIN_BOUND_COLUMNS", "RECORD_BYTES", "bound_columns",
+           "check_closed_loop_memory", "check_elements_fit_memory", "check_link_force_memory",
+           "elements_fit_memory", "link_force_memory"]
 
 FIT_ROW_BYTES = 3500
 """Bytes of the Maxwell-slip fit per row of its residual (its 40 stop operators and their
@@ -55,13 +55,18 @@ MIN_BOUND_COLUMNS = 300
 holds up to 49; a hundred leave no bound on a record of a Jenkins element and a damper that
 three hundred bound at 0.079 of its 0.094)."""
 
-CLOSED_LOOP_BYTES = 600
+CLOSED_LOOP_BYTES = 500
 """Bytes per sample of a closed-loop record's link force, inferred through the stage and the
-prefilter (:func:`~motionhyst.identify.closed_loop.infer_link_force`), besides the fit's rows:
-its elements are fitted on every q-th sample, q = 1 at the highest cut-off, so the estimate
-counts a row a sample up to :data:`~motionhyst.identify.records.MAX_ROWS` (measured on the
-default scenario's record at 5 kHz, q = 3: 34 MB of 82 estimated at 2e4 samples, 121 MB of
-235 at 1e5)."""
+prefilter (:func:`~motionhyst.identify.closed_loop.infer_link_force`), besides the fit's rows
+(:data:`CLOSED_LOOP_ROW_BYTES`), its elements fitted on every q-th sample
+(:func:`~motionhyst.identify.records.fit_every`) up to
+:data:`~motionhyst.identify.records.MAX_ROWS` rows."""
+
+CLOSED_LOOP_ROW_BYTES = 2600
+"""Bytes per row of a closed-loop record's Maxwell-slip fit.  With :data:`CLOSED_LOOP_BYTES`,
+measured on the paper's loop with a two-element link at 5 kHz, default cut-off (q = 2 or 3),
+address space above a warmed process: 30.9 MB at 2e4 samples (estimate 36; a row a sample,
+600 and 3500 bytes, said 82), 57.8 MB at 5e4 (68.3; was 118)."""
 
 LINK_SAMPLE_BYTES = 160
 """Bytes per sample of one evaluation of a link fitted by the force's error besides its
@@ -269,9 +274,10 @@ has it, or shorter records
                  f"--max-memory if the machine has it, or shorter records")
 
 
-def check_closed_loop_memory(n_samples: int, name: str) -> None:
+def check_closed_loop_memory(n_samples: int, name: str, every: int | None = 1) -> None:
     """Refuse the Maxwell-slip fit of a closed-loop record above the memory budget, before
-    its link force is inferred (:data:`CLOSED_LOOP_BYTES` a sample and the fit's rows).
+    its link force is inferred (:data:`CLOSED_LOOP_BYTES` a sample and
+    :data:`CLOSED_LOOP_ROW_BYTES` a row of the fit, one every `every` samples).
 
     Parameters
     ----------
@@ -279,6 +285,11 @@ def check_closed_loop_memory(n_samples: int, name: str) -> None:
         The record's samples.
     name : str
         The record, as messages name it.
+    every : int or None
+        Samples between the fit's rows (:func:`~motionhyst.identify.records.fit_every`,
+        from the record's sampling interval and its prefilter's cut-off); None where they
+        are not known yet (the record unread): its link force alone, what the fit needs at
+        least.
 
     Raises
     ------
@@ -290,18 +301,25 @@ def check_closed_loop_memory(n_samples: int, name: str) -> None:
     >>> from motionhyst.core.budget import BudgetError, set_max_memory
     >>> set_max_memory(20 << 20)
     >>> try:
-    ...     check_closed_loop_memory(20_000, "run.csv")
+    ...     check_closed_loop_memory(20_000, "run.csv", every=3)
     ... except BudgetError as exc:
     ...     print(exc)
-    run.csv: the Maxwell-slip fit of a closed-loop record of 20000 samples needs 82 MB, above \
-the memory budget of 21 MB (--max-memory); its link force takes 12 MB, the fit's rows 70 MB: \
-a larger --max-memory if the machine has it, or a shorter record
+    run.csv: the Maxwell-slip fit of a closed-loop record of 20000 samples needs 27.3 MB, \
+above the memory budget of 21 MB (--max-memory); its link force takes 10 MB, the fit's rows \
+17.3 MB: a larger --max-memory if the machine has it, or a shorter record
+    >>> check_closed_loop_memory(20_000, "run.csv", every=None)       # its link force: 10 MB
     >>> set_max_memory(None)
     """
+    n = int(n_samples)
+    force = CLOSED_LOOP_BYTES * n
+    if every is None:
+        check_memory(force, f"{name}: the Maxwell-slip fit of a closed-loop record of {n} "
+                     f"samples (its link force)", "a larger --max-memory if the machine has "
+                     "it, or a shorter record")
+        return
     from motionhyst.identify.records import MAX_ROWS
 
-    n = int(n_samples)
-    force, rows = CLOSED_LOOP_BYTES * n, FIT_ROW_BYTES * min(n, MAX_ROWS)
+    rows = CLOSED_LOOP_ROW_BYTES * min(-(-n // max(int(every), 1)), MAX_ROWS)
     check_memory(force + rows, f"{name}: the Maxwell-slip fit of a closed-loop record of {n} "
                  f"samples", f"its link force takes {format_size(force)}, the fit's rows "
                  f"{format_size(rows)}: a larger --max-memory if the machine has it, or a "

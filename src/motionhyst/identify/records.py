@@ -12,9 +12,10 @@ from motionhyst.core.blas import few_blas_threads
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
-__all__ = ["ELASTIC_CURVE_RATIO", "FOLLOW_GAIN", "SCALE_RATIO", "check_controller_period",
-           "check_force_follows", "check_force_scale", "check_loops_open", "count_reversals",
-           "load_closed_loop_csv", "load_force_displacement_csv", "prefilter_cutoff"]
+__all__ = ["DECIMATED_RATE", "ELASTIC_CURVE_RATIO", "FOLLOW_GAIN", "SCALE_RATIO",
+           "check_controller_period", "check_force_follows", "check_force_scale",
+           "check_loops_open", "count_reversals", "fit_every", "load_closed_loop_csv",
+           "load_force_displacement_csv", "prefilter_cutoff"]
 
 MIN_SAMPLES = 50
 """Fewest samples accepted in a record."""
@@ -420,6 +421,35 @@ def load_closed_loop_csv(source: Source, *, columns: dict[str, str] | None = Non
 
 SETTLE_PERIODS = 10.0
 """Start-up transient of the closed-loop prefilter, in units of ``1 / cutoff_hz``."""
+
+
+DECIMATED_RATE = 40.0
+"""Closed-loop fits run at no less than this multiple of the prefilter cut-off [-]."""
+
+
+def fit_every(dt: float, cutoff_hz: float) -> int:
+    """Samples between the rows of a closed-loop record's fit: its link force, prefiltered at
+    `cutoff_hz`, is band-limited, and fitted at no less than :data:`DECIMATED_RATE` times
+    the cut-off.
+
+    Parameters
+    ----------
+    dt : float
+        The record's sampling interval [s].
+    cutoff_hz : float
+        The prefilter's cut-off (:func:`prefilter_cutoff`) [Hz].
+
+    Returns
+    -------
+    int
+        At least 1.
+
+    Examples
+    --------
+    >>> fit_every(2e-4, 41.0), fit_every(2e-4, 250.0)     # 5 kHz
+    (3, 1)
+    """
+    return max(1, int(1.0 / (dt * DECIMATED_RATE * cutoff_hz)))
 
 
 def prefilter_cutoff(t: ArrayLike, y1: ArrayLike,
