@@ -199,3 +199,26 @@ def test_a_long_measured_response_is_refused_unread(tmp_path, unread, budget):
                               f"the memory budget of 31.5 MB (--max-memory); give fewer lines "
                               f"(a measurement thinned to the lines that resolve the plant: "
                               f"a few hundred log-spaced)")
+
+
+def test_predict_refuses_a_long_displacement_record_unread(tmp_path, unread, capsys):
+    """The force of a model without inertia for 3e5 displacement samples (11 MB of CSV) under
+    --max-memory 25M: the record, its noise estimate and the link's run take 96 bytes a
+    sample (28.8 MB; measured 28.2 MB of address space): refused unread (main sized this
+    route by its reading alone, after the file was read: 78 MB at 1e6 samples, 125 on
+    main, against an estimate of 58 and 102)."""
+    n = 300_000
+    t = np.arange(n) / 1000.0
+    x = 0.003 * np.sin(np.pi * t) + 1e-5 * np.random.default_rng(0).standard_normal(n)
+    path = _write(tmp_path / "d.csv", "time,displacement", [t, x], "%.17g")
+    assert path.stat().st_size > records.SIZED_UNREAD_BYTES
+    model = tmp_path / "link.toml"
+    model.write_text('[stage]\ntype = "quasi-static"\nk = 5e4\n[hysteresis]\nmodel = "jenkins"\n'
+                     'k = 1e6\nfc = 3e3\n')
+    line = _refused(["predict", str(model), str(path), "--predict", "force", "--out",
+                     str(tmp_path / "o.csv"), "--max-memory", "25M"], capsys)
+    assert line == (f"motionhyst: error: {path} ({n} samples, not read yet): predicting the "
+                    f"force of {n} displacement samples (the record, its noise estimate and "
+                    f"the link's run) needs 28.8 MB, above the memory budget of 26.2 MB "
+                    f"(--max-memory); give a shorter record"), line
+    assert not (tmp_path / "o.csv").exists()

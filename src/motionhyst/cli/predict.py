@@ -404,17 +404,39 @@ def _input_quantity(args: argparse.Namespace, sc, system) -> str:
     return "displacement" if record == "force-displacement" else "force"
 
 
+QUASI_STATIC_SAMPLE_BYTES = 96
+"""Memory of predicting the force of a model without inertia per displacement sample
+[bytes]: the record, the estimate of its sensor's noise and the link's run.  Measured,
+address space above a warmed process (a Jenkins link on a spring, a sine with a step in 10
+um of noise): 3e5 samples 28.2 MB, 1e6 77.6 MB (124.7 before the noise estimate was made in
+place)."""
+
+
+def _check_force_memory(sizes: list[int]) -> None:
+    """Refuse a displacement record whose force prediction does not fit the memory budget
+    (:data:`QUASI_STATIC_SAMPLE_BYTES` a sample)."""
+    from motionhyst.core.budget import check_memory
+
+    n = sizes[0]
+    check_memory(QUASI_STATIC_SAMPLE_BYTES * float(n), f"predicting the force of {n} "
+                 f"displacement samples (the record, its noise estimate and the link's run)",
+                 "give a shorter record")
+
+
 def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     """The force that holds a model without inertia at the displacement record INPUT."""
-    from motionhyst.io.records import read_record
+    from motionhyst.io.records import check_unread, read_record
     from motionhyst.time.quasi_static import force_from_displacement
     from motionhyst.time.resample import check_whole_periods
 
     # the maps may name the force too (as the map a user gave identify)
+    check_unread([args.data], ("time", "displacement"), _check_force_memory,
+                 columns=_without(args.columns, "force"))  # a long record: unread
     data = read_record(args.data, ("time", "displacement"),
                        columns=_without(args.columns, "force"),
                        scale=_without(args.scale, "force"))
     t, x = data[:, 0], data[:, 1]
+    _check_force_memory([t.size])
     target.check_csv_size(t.size, 2, "%.17g", remedy=SHORTER)
     if args.periodic:
         check_whole_periods(x, str(args.data))
