@@ -222,3 +222,27 @@ def test_predict_refuses_a_long_displacement_record_unread(tmp_path, unread, cap
                     f"the link's run) needs 28.8 MB, above the memory budget of 26.2 MB "
                     f"(--max-memory); give a shorter record"), line
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_a_model_without_inertia_is_not_sized_by_integration_steps(tmp_path, capsys):
+    """The displacement of a model without inertia for 3e5 force samples (its balance solved
+    at each sample: no integration steps) under --max-memory 40M: its least is the record and
+    its outputs, 64 bytes a sample (19.2 MB), and it runs; sized with a block of 20 steps a
+    sample, it was refused for 120 MB it never needs."""
+    n = 300_000
+    t = np.arange(n) / 1000.0
+    path = _write(tmp_path / "f.csv", "time,force", [t, 2000 * np.sin(t)], "%.17g")
+    assert path.stat().st_size > records.SIZED_UNREAD_BYTES
+    model = tmp_path / "link.toml"
+    model.write_text('[stage]\ntype = "quasi-static"\nk = 5e4\n[hysteresis]\nmodel = "jenkins"\n'
+                     'k = 1e6\nfc = 3e3\n')
+    argv = ["predict", str(model), str(path), "--predict", "displacement", "--out",
+            str(tmp_path / "o.csv")]
+    assert main([*argv, "--max-memory", "40M"]) == 0, capsys.readouterr().err
+    out = read_columns(tmp_path / "o.csv", ("time", "displacement"))
+    assert out.shape == (n, 2) and 1e-3 < np.max(np.abs(out[:, 1])) < 0.1
+    capsys.readouterr()
+    line = _refused([*argv, "--force", "--max-memory", "15M"], capsys)
+    assert line == (f"motionhyst: error: {path} ({n} samples, not read yet): predicting {n} "
+                    f"samples from rest needs 19.2 MB, above the memory budget of 15.7 MB "
+                    f"(--max-memory); give a shorter record"), line

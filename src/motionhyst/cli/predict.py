@@ -177,20 +177,24 @@ def run(args: argparse.Namespace) -> int:
 def _check_unread(args: argparse.Namespace, system) -> None:
     """Refuse a long force record before it is read where its run cannot fit the memory
     budget: its samples (from the file) times the least its run takes, the record and its
-    outputs and, from rest, one block of integration steps at the least substeps."""
+    outputs and, from rest with inertia, one block of integration steps at the least
+    substeps (a model without inertia has none)."""
     from motionhyst.core.budget import check_memory
     from motionhyst.io.records import check_unread
     from motionhyst.time.openloop import FINE_BYTES, MIN_SUBSTEPS, SAMPLE_BYTES
     from motionhyst.time.resample import block_samples
 
     r = args.substeps or MIN_SUBSTEPS
+    steps = system.plant.has_inertia
 
     def least(sizes: list[int]) -> None:
         n = sizes[0]
-        block = 0 if args.periodic else FINE_BYTES * (min(n - 1, block_samples(r)) * r + 1)
+        block = (FINE_BYTES * (min(n - 1, block_samples(r)) * r + 1)
+                 if steps and not args.periodic else 0)
         check_memory(SAMPLE_BYTES * n + block, f"predicting {n} samples "
-                     f"{'as a periodic steady state' if args.periodic else 'from rest'} (at "
-                     f"least {r} integration steps each)", "fewer samples or --substeps")
+                     f"{'as a periodic steady state' if args.periodic else 'from rest'}"
+                     + (f" (at least {r} integration steps each)" if steps else ""),
+                     "fewer samples or --substeps" if steps else "give a shorter record")
 
     check_unread([args.data], ("time", "force"), least,
                  columns=_without(args.columns, "displacement"))
