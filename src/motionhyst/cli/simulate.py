@@ -40,6 +40,11 @@ or the reference's; Table I's loop: 27.6 kHz) by the first factor is warned of, 
 second refused: its rows only make the run's step finer than the loop's dynamics need
 (1e9 Hz: 5e7 rows of a 0.05 s run, 8.4 GB)."""
 
+SLOWEST_REFERENCE_HZ = 10.0
+"""A reference file sampled slower than this is warned of: a record logged in milliseconds
+reads as one sampled at 1 Hz, and its 2 s as 2000 s of simulation (a stage's setpoints are
+logged at 100 Hz to 10 kHz)."""
+
 
 def run(args: argparse.Namespace) -> int:
     """A transient run from rest (``--time-series``); without it, the old spelling of ``steady``."""
@@ -93,6 +98,27 @@ def _reference(args: argparse.Namespace, sc):
     amplitude = args.amplitude or sc.amplitude
     return (SineReference(amplitude, freqs[0]), 1.0,
             f"r = {amplitude:g} m sin(2 pi {freqs[0]:g} t)")
+
+
+def _check_reference_units(source: str, ref) -> None:
+    """Warn, before the run, of a reference file whose values look like a unit slip: a
+    position spanning more than a stage's stroke (millimetres read as metres), or samples
+    slower than :data:`SLOWEST_REFERENCE_HZ` (a time in milliseconds)."""
+    import numpy as np
+
+    from motionhyst.analysis.plausibility import PLAUSIBLE_AMPLITUDE_M
+    from motionhyst.core.warnings import warn
+
+    span = float(np.ptp(ref.r))
+    if span > 2 * PLAUSIBLE_AMPLITUDE_M:
+        warn(f"{source}: the reference's position spans {span:.3g} m, more than the "
+             f"{2 * PLAUSIBLE_AMPLITUDE_M:g} m stroke of a motion stage: if it is not in "
+             f"metres, scale it (--scale position=0.001 for mm)")
+    step = float(np.median(np.diff(ref.t)))
+    if step > 1.0 / SLOWEST_REFERENCE_HZ:
+        warn(f"{source}: the reference is sampled at {1 / step:.3g} Hz ({ref.t.size} samples "
+             f"over {float(ref.t[-1] - ref.t[0]):.4g} s): if its time is not in seconds, scale it "
+             f"(--scale time=0.001 for ms)")
 
 
 def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
@@ -220,6 +246,8 @@ def _time_series(args: argparse.Namespace, sc) -> int:
 
     if args.profile:  # once it is not refused: a refusal is one line
         check_stroke(ref.distance, "--distance")
+    if args.reference_csv:
+        _check_reference_units(args.reference_csv, ref)
 
     if isinstance(ref, SineReference):
         check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz])

@@ -1,0 +1,59 @@
+"""The hostile15 campaign's cases that failed (issue 26, the hidden cases): each command line
+runs in a child process under an address-space limit (:mod:`limited_process`) in a folder of
+the user's files; a refusal is exit 2 with one line on stderr and no traceback, a run from
+implausible values exits 0 with one warning naming the quantity, and every file the command
+does not own is byte-identical afterwards.
+
+The campaign itself (about 500 cases over every command) is
+/work/team/scratch-hostile15/campaign.py.
+"""
+
+from __future__ import annotations
+
+import limited_process
+import numpy as np
+import pytest
+from file_trees import populate, snapshot
+
+
+def _reference(time_gain: float, position_gain: float) -> str:
+    """A 2 s sine setpoint of 1 mm at 1 kHz, its time and position multiplied by the gains (a
+    log in ms, in mm)."""
+    t = np.arange(2000) * 1e-3
+    r = 1e-3 * np.sin(2 * np.pi * 2.0 * t)
+    return "time,position\n" + "".join(f"{a * time_gain:.10g},{b * position_gain:.10g}\n"
+                                       for a, b in zip(t, r, strict=True))
+
+
+REFERENCE_SLIPS = [
+    ("time-in-ms", _reference(1e3, 1.0),
+     "simulate: r.csv: the reference is sampled at 1 Hz (2000 samples over 1999 s): if its "
+     "time is not in seconds, scale it (--scale time=0.001 for ms)"),
+    ("position-in-mm", _reference(1.0, 1e4),
+     "simulate: r.csv: the reference's position spans 20 m, more than the 4 m stroke of a "
+     "motion stage: if it is not in metres, scale it (--scale position=0.001 for mm)"),
+    ("as-logged", _reference(1.0, 1.0), None),
+]
+
+
+@pytest.mark.parametrize(("text", "warning"), [c[1:] for c in REFERENCE_SLIPS],
+                         ids=[c[0] for c in REFERENCE_SLIPS])
+def test_a_reference_file_in_another_unit_is_warned_of_before_the_run(tmp_path, text, warning):
+    """A reference logged in ms ran 1999 s (55 million steps, 58 s) without a word, one in mm
+    a 20 m stroke; the sine and the point-to-point move were already warned of."""
+    populate(tmp_path, {"r.csv": text})
+    before = snapshot(tmp_path)
+    code, out, err = limited_process.run(["simulate", "--reference-csv", "r.csv",
+                                          "--time-series", "o.csv", "--duration", "0.05",
+                                          "--output-rate", "1000"], tmp_path)
+    assert code == 0, err
+    assert out.startswith("Simulated 0.05 s of paper.toml"), out
+    lines = err.strip().splitlines()
+    if warning is None:
+        assert lines == [], err
+    else:
+        assert lines == [f"motionhyst: warning: {warning}"], err
+    after = snapshot(tmp_path)
+    assert after.pop("o.csv") and after == before
+    rows = (tmp_path / "o.csv").read_text().splitlines()
+    assert len(rows) == 52  # 0.05 s at 1 kHz and the header: the run is the one asked
