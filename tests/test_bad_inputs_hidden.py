@@ -57,3 +57,41 @@ def test_a_reference_file_in_another_unit_is_warned_of_before_the_run(tmp_path, 
     assert after.pop("o.csv") and after == before
     rows = (tmp_path / "o.csv").read_text().splitlines()
     assert len(rows) == 52  # 0.05 s at 1 kHz and the header: the run is the one asked
+
+
+def _controller(body: str) -> str:
+    from motionhyst.scenario import default_scenario_path
+
+    paper = default_scenario_path().read_text()
+    head, rest = paper.split("[controller]")
+    return head + "[controller]\n" + body + "\n[feedforward]" + rest.split("[feedforward]")[1]
+
+
+_ONES = "[" + ", ".join(["1.0"] * 150) + "]"
+CONTROLLER_ORDERS = [
+    ("tf-den", f'type = "tf"\nnum = [1.0]\nden = {_ONES}\n', "den has 150"),
+    ("tf-z-num", f'type = "tf-z"\nsample_rate_hz = 1e4\nnum = {_ONES}\nden = [1.0]\n',
+     "num has 150"),
+    ("two-dof-z-y-num", 'type = "two-dof-z"\nsample_rate_hz = 1e4\nr_num = [1.0]\n'
+     f'r_den = [1.0]\ny_num = {_ONES}\ny_den = [1.0]\n', "y_num has 150"),
+]
+
+
+@pytest.mark.parametrize(("body", "words"), [c[1:] for c in CONTROLLER_ORDERS],
+                         ids=[c[0] for c in CONTROLLER_ORDERS])
+def test_a_controller_of_absurd_order_is_refused_with_the_scenario(tmp_path, body, words):
+    """A controller polynomial of 3000 coefficients was accepted and its loop's poles
+    computed: 59 s (s) and more than 80 s of CPU (z, not stopped by SIGTERM while in LAPACK)
+    before the answer; now the scenario check refuses it, before python-control is loaded."""
+    import cli_probe
+
+    populate(tmp_path, {"s.toml": _controller(body)})
+    before = snapshot(tmp_path)
+    result = cli_probe.probe(["analyze", "s.toml"], tmp_path)
+    assert result["rc"] == 2, result
+    assert result["err"] == (f"motionhyst: error: s.toml: [controller]: {words} coefficients, "
+                             "more than the 101 (degree 100) a controller's polynomial may "
+                             "have: give a controller of lower order\n")
+    assert result["heavy"] == []
+    assert snapshot(tmp_path) == before
+
