@@ -10,6 +10,9 @@ The campaign itself (about 500 cases over every command) is
 
 from __future__ import annotations
 
+import re
+import resource
+
 import limited_process
 import numpy as np
 import pytest
@@ -95,3 +98,61 @@ def test_a_controller_of_absurd_order_is_refused_with_the_scenario(tmp_path, bod
     assert result["heavy"] == []
     assert snapshot(tmp_path) == before
 
+
+@pytest.mark.parametrize(("argv", "env", "given"), [
+    (["--max-memory", "1e308"], {}, "--max-memory 1e+296 TB"),
+    (["--max-memory", "100T"], {}, "--max-memory 110 TB"),
+    ([], {"MOTIONHYST_MAX_MEMORY": "100T"}, "MOTIONHYST_MAX_MEMORY 110 TB"),
+], ids=["1e308", "100T", "environment"])
+def test_a_memory_budget_beyond_the_machine_is_warned_of(tmp_path, argv, env, given):
+    """--max-memory 1e308 was taken without a word: a computation it lets through is killed by
+    the operating system, not refused (the issue's OOM kills); the budget is kept as given.
+    Without an address-space limit (under one within the machine's memory, the limit refuses
+    first: no warning)."""
+    code, out, err = limited_process.run(["df", "--k", "20", "--fc", "0.05", "--amplitude",
+                                          "0.01", *argv], tmp_path,
+                                         limit=resource.RLIM_INFINITY,
+                                         env=limited_process.environment(**env))
+    assert code == 0 and "Describing function" in out
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert re.fullmatch(rf"motionhyst: warning: df: {re.escape(given)} is more than the "
+                        r"[0-9.]+ [kMGT]B of memory this machine has: a computation that "
+                        r"large would be killed by the system, not refused", lines[0]), lines
+
+
+@pytest.mark.parametrize(("budget", "limit"), [("1G", resource.RLIM_INFINITY),
+                                               ("64G", limited_process.REFUSAL_LIMIT)],
+                         ids=["within-the-machine", "under-an-address-space-limit"])
+def test_a_memory_budget_that_cannot_get_the_process_killed_says_nothing(tmp_path, budget,
+                                                                         limit):
+    code, _, err = limited_process.run(["df", "--k", "20", "--fc", "0.05", "--amplitude",
+                                        "0.01", "--max-memory", budget], tmp_path, limit=limit)
+    assert code == 0 and err == ""
+
+
+@pytest.mark.parametrize("seed", ["-1", "1.5", "99999999999999999999999"])
+def test_a_benchmark_seed_that_numpy_cannot_take_is_refused_by_the_option(tmp_path, seed):
+    """--seed -1 ended in numpy's "expected non-negative integer" (no option named), after the
+    benchmark's files were read; a seed above 2**32 - 1 was taken."""
+    (tmp_path / "d").mkdir()
+    line = limited_process.refusal(["benchmark", "bouc-wen", "--data", "d", "--seed", seed],
+                                   tmp_path)
+    assert line.startswith("motionhyst: error: benchmark: argument --seed: must be"), line
+
+
+def test_reproduce_keeps_to_its_work_budget(tmp_path):
+    """reproduce --max-seconds 0.001 ran the whole report (minutes at load) and exited 0: the
+    option every command takes was silently ignored by this one. Its CPU time is now bounded
+    as a search's is; the folder keeps what it held and gets none of the report's files."""
+    populate(tmp_path, {"o/old.txt": "mine\n"})
+    before = snapshot(tmp_path)
+    code, out, err = limited_process.run(["reproduce", "--out", "o", "--quiet",
+                                          "--max-seconds", "0.5"], tmp_path,
+                                         limit=limited_process.RUN_LIMIT)
+    lines = [line for line in err.strip().splitlines() if "compiling" not in line]
+    assert code == 2 and out == "", (code, out, err)
+    assert lines == ["motionhyst: error: reproduce did not finish within the work budget of "
+                     "0.5 s of CPU time (--max-seconds); raise --max-seconds (Table I's report "
+                     "takes about a minute of CPU time)"], err
+    assert snapshot(tmp_path) == before

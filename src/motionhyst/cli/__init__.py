@@ -32,6 +32,8 @@ from motionhyst.cli._common import (
 )
 from motionhyst.cli.identify import feedforward_fragment, record_kind
 from motionhyst.core.budget import (
+    format_size,
+    machine_memory,
     max_memory,
     max_seconds,
     set_max_memory,
@@ -142,6 +144,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         else args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
         with warnings_on_stderr(args.command):
+            _warn_budget_beyond_machine(args)
             code = args.func(args)
         if interrupts.received:  # a library swallowed it (an optional import that failed)
             raise KeyboardInterrupt
@@ -323,6 +326,27 @@ def _say(line: str) -> None:
     to say what happened."""
     with contextlib.suppress(OSError, ValueError):
         print(line, file=sys.stderr)
+
+
+def _warn_budget_beyond_machine(args: argparse.Namespace) -> None:
+    """Warn of a memory budget larger than the machine: a computation it lets through is
+    killed by the operating system (or swaps for hours) instead of refused in one line.
+    Under an address-space limit (``ulimit -v``) within the machine's memory the limit
+    refuses first (a MemoryError, one line): no warning."""
+    import resource
+
+    from motionhyst.core.warnings import warn
+
+    budget, machine = max_memory(), machine_memory()
+    limit, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if limit != resource.RLIM_INFINITY and machine is not None and limit <= machine:
+        return
+    if machine is not None and budget > machine:
+        given = ("--max-memory" if args.max_memory is not None or args.before_max_memory
+                 is not None else "MOTIONHYST_MAX_MEMORY")
+        warn(f"{given} {format_size(budget)} is more than the {format_size(machine)} of memory "
+             f"this machine has: a computation that large would be killed by the system, not "
+             f"refused")
 
 
 def _failed(exc: Exception) -> int:

@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from motionhyst.cli._common import UsageError, g, print_json, table
+from motionhyst.cli._common import UsageError, g, print_json, table, whole_number
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -27,7 +27,7 @@ def add_parser(sub) -> None:
                         "and uval_/yval_sinesweep.mat; emps: folder with DATA_EMPS.mat and, "
                         "if downloaded, the test record DATA_EMPS_PULSES.mat (required: both "
                         "are downloaded from nonlinearbenchmark.org)")
-    q.add_argument("--seed", type=int, default=None,
+    q.add_argument("--seed", type=whole_number(0, 2**32 - 1, "seed"), default=None,
                    help="bouc-wen: seed of the training multisines and noise (default 0)")
     q.add_argument("--periods", metavar="A-B", type=_periods,
                    help="emps without the test record: the periods of DATA_EMPS to identify "

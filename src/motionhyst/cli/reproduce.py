@@ -12,14 +12,19 @@ __all__ = []
 
 def run(args: argparse.Namespace) -> int:
     """The paper's figures and numbers for a scenario, as a report."""
+    from motionhyst.core.budget import cpu_time_limit, max_seconds
     from motionhyst.io.outputs import MANIFEST
     from motionhyst.present.report import reproduce
     from motionhyst.scenario import load_scenario
 
     # the loop is built (and checked) inside reproduce, while the first figures are drawn
     sc = load_scenario(args.scenario, check=False)
-    reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None, force=args.force,
-              inputs=sc.files)
+    # no formula sizes the report's figures: its CPU time is bounded as a search's is, and a
+    # report stopped writes none of its files
+    with cpu_time_limit(max_seconds(), "reproduce", "raise --max-seconds (Table I's report "
+                        "takes about a minute of CPU time)"):
+        reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None,
+                  force=args.force, inputs=sc.files)
     warn_plant_fit(sc)
     if not args.quiet:
         print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf), listed in "

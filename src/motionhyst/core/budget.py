@@ -64,8 +64,8 @@ from collections.abc import Iterator
 __all__ = ["DEFAULT_FRACTION", "DEFAULT_SECONDS", "ENV_VARIABLE", "RECORDS_REMEDY",
            "SECONDS_VARIABLE",
            "BudgetError", "available_disk", "available_memory", "check_disk", "check_memory",
-           "check_work", "cpu_time_limit", "format_duration", "format_size", "max_memory",
-           "max_seconds", "parse_size", "set_max_memory", "set_max_seconds"]
+           "check_work", "cpu_time_limit", "format_duration", "format_size", "machine_memory",
+           "max_memory", "max_seconds", "parse_size", "set_max_memory", "set_max_seconds"]
 
 DEFAULT_FRACTION = 0.5
 """Share of :func:`available_memory` one computation may take unless a budget is given."""
@@ -223,6 +223,32 @@ def _vm_size() -> int:
         return 0
 
 
+def machine_memory() -> int | None:
+    """Bytes of memory the machine (or its container) has: past them the operating system
+    kills a process rather than refusing it memory (an address-space limit refuses instead).
+
+    Returns
+    -------
+    int or None
+        The smaller of the machine's physical memory and the container's limit; None where
+        neither is known.
+
+    Examples
+    --------
+    >>> machine_memory() > 0
+    True
+    """
+    limits = []
+    try:
+        limits.append(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (OSError, ValueError):  # pragma: no cover - not a POSIX system
+        pass
+    cgroup = _cgroup_limit()
+    if cgroup is not None:
+        limits.append(cgroup)
+    return min(limits) if limits else None
+
+
 def available_memory() -> int:
     """Bytes the process may still use: the smallest of the machine's memory, the
     container's limit and the address-space limit less the current size.
@@ -237,14 +263,8 @@ def available_memory() -> int:
     >>> available_memory() > 0
     True
     """
-    limits = []
-    try:
-        limits.append(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (OSError, ValueError):  # pragma: no cover - not a POSIX system
-        pass
-    cgroup = _cgroup_limit()
-    if cgroup is not None:
-        limits.append(cgroup)
+    machine = machine_memory()
+    limits = [] if machine is None else [machine]
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
         limits.append(max(soft - _vm_size(), 1 << 20))
