@@ -249,9 +249,12 @@ CASES = [
      ["analyze", "p.toml"], 2, ["p1_abs must be > 0", "phase", "at 1 Hz"], []),
     ("frf-in-khz", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, scale_f=1e-3)},
      ["analyze", "p.toml"], 0, ["warning", "M = 2.25e+07 kg", "kHz"], []),
-    ("frf-poor-fit-unstable", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, noise=0.01)},
-     ["analyze", "p.toml"], 2, ["plant fitted to plant.csv is unstable", "fit is in doubt"],
-     []),
+    # 1 % noise: the BIC's second 'mode' (r1 within its std of zero) made the loop unstable,
+    # refused as a fit in doubt; it is dropped now, and the one-mode fit (M 22.51 kg, 694 Hz,
+    # its error the noise) analysed without a word
+    ("frf-noisy-fit-keeps-the-mode-it-determines", {"p.toml": _with_plant(),
+                                                     "plant.csv": _frd(LOG, noise=0.01)},
+     ["analyze", "p.toml"], 0, None, []),
     ("frf-fit-above-its-noise", {"p.toml": _with_plant("modes = 1"),
                                  "plant.csv": _frd(LOG, noise=0.005, lowpass_hz=2000.0)},
      ["analyze", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: cannot fit a rigid body "

@@ -156,3 +156,65 @@ def test_reproduce_keeps_to_its_work_budget(tmp_path):
                      "0.5 s of CPU time (--max-seconds); raise --max-seconds (Table I's report "
                      "takes about a minute of CPU time)"], err
     assert snapshot(tmp_path) == before
+
+
+def _measured(n_lines: int) -> str:
+    """The lowest `n_lines` of a measured Table I stage (60 lines from 1 to 3000 Hz, 0.5 %
+    noise; its mode is at 695 Hz), as magnitude and phase."""
+    from motionhyst.plants.frf_fit import ModalPlant
+    from motionhyst.plants.two_mass import TwoMassStage
+
+    f = np.geomspace(1.0, 3000.0, 60)
+    p1, p2 = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0,
+                                                   k=7.4e7)).response(2 * np.pi * f)
+    rng = np.random.default_rng(0)
+    p1, p2 = (p * (1 + 0.005 * rng.standard_normal(f.size)) for p in (p1, p2))
+    rows = np.column_stack([f, np.abs(p1), np.angle(p1, deg=True), np.abs(p2),
+                            np.angle(p2, deg=True)])[:n_lines]
+    return ("frequency_hz,p1_abs,p1_phase_deg,p2_abs,p2_phase_deg\n"
+            + "".join(",".join(f"{v:.10e}" for v in row) + "\n" for row in rows))
+
+
+def _with_measured_plant() -> str:
+    from motionhyst.scenario import default_scenario_path
+
+    paper = default_scenario_path().read_text()
+    return (paper[:paper.index("[stage]")] + '[plant]\nfile = "plant.csv"\n\n'
+            + paper[paper.index("[hysteresis]"):])
+
+
+@pytest.mark.parametrize("n_lines", [30, 35])
+def test_measured_lines_that_determine_no_mode_are_refused(tmp_path, n_lines):
+    """The lowest 30 or 35 lines (up to 51 or 101 Hz) of a stage resonating at 695 Hz were
+    fitted with a 'mode' beyond them whose residue lies within its own standard deviation of
+    zero (152 Hz, r1 0.0072 +- 0.024 1/kg; 1009 Hz, 0.33 +- 3.4): with 35 lines the analysis
+    ran on it, exit 0 with a warning on Pf2(0); with 30 its loop was refused as unstable, the
+    fit 'in doubt'. Now the modes the lines do not determine are dropped, which leaves a rigid
+    body alone: refused as such, as two lines are."""
+    populate(tmp_path, {"s.toml": _with_measured_plant(), "plant.csv": _measured(n_lines)})
+    before = snapshot(tmp_path)
+    line = limited_process.refusal(["analyze", "s.toml"], tmp_path)
+    assert re.fullmatch(rf"motionhyst: error: s\.toml: \[plant\] file: plant\.csv: "
+                        rf"{n_lines} measured lines \(1-[0-9.]+ Hz\) determine none of the 1 "
+                        r"mode\(s\) the BIC chose \(each residue r1 within its standard "
+                        r"deviation of zero\), which leaves a rigid body alone, .*", line), line
+    assert snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize(("n_lines", "criterion"), [
+    (50, "the BIC's 2 modes less 1 the lines do not determine"),
+    (60, "modes chosen by the BIC, first minimum over n = 0..2")])
+def test_a_stage_measured_beyond_its_mode_keeps_the_mode_the_lines_determine(tmp_path, n_lines,
+                                                                            criterion):
+    """Up to 772 Hz the BIC added a second 'mode' at 7723 Hz (r1 -0.22 +- 18 1/kg) beside the
+    695 Hz one; it is dropped and the fit redone with the one mode."""
+    import json
+
+    populate(tmp_path, {"s.toml": _with_measured_plant(), "plant.csv": _measured(n_lines)})
+    code, out, err = limited_process.run(["analyze", "s.toml", "--json"], tmp_path)
+    assert code == 0 and err == "", err
+    fit = json.loads(out)["plant_fit"]
+    assert fit["criterion"] == criterion
+    assert abs(fit["M"] / 22.5 - 1) < 0.01
+    assert [round(m["frequency_hz"] / 695.0, 1) for m in fit["modes"]] == [1.0], fit["modes"]
+
