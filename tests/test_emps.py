@@ -356,3 +356,19 @@ def test_the_asymmetric_reference_model_by_one_linear_solve():
     own = res.reference["idim_asymmetric"]["parameters"]  # a symmetric axis: c+ = c-
     assert own["c_pos"] == pytest.approx(own["c_neg"], rel=0.05)
     assert own["m"] == pytest.approx(TRUE["m"], rel=0.02)
+
+
+def test_the_table_marks_what_the_record_does_not_determine():
+    """A parameter without a standard error (the Jenkins link's offset on DATA_EMPS periods
+    1-2, +0.0004 N) is marked in the benchmark's table, as JSON's None says; others not."""
+    res = run_emps(axis_record(n_periods=2), models=("coulomb",), periods=(1, 1),
+                   period=PERIOD)
+    (model,) = res.models
+    assert all(model.model_std[n] is not None for n in ("m", "offset"))
+    assert "(not determined)" not in str(res)
+    model.model_std["offset"], model.std["offset"] = None, None
+    row = next(line for line in str(res).splitlines() if "mass-damper + coulomb" in line)
+    assert row.count("(not determined)") == 2  # its own offset, and as OF, which it enters
+    model.model_std["m"] = None
+    row = next(line for line in str(res).splitlines() if "mass-damper + coulomb" in line)
+    assert row.count("(not determined)") == 3

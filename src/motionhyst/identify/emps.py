@@ -336,11 +336,16 @@ class EMPSBenchmark:
 
         rows = []
         for m in self.models:
-            p = m.model_parameters or m.parameters
+            p, s = (m.model_parameters, m.model_std) if m.model_parameters else (m.parameters,
+                                                                                 m.std)
             limit = "" if m.limit is None else f" (its rigid limit, {m.limit})"
-            rows.append([f"motionhyst: mass-damper + {m.name}{limit}", g(p.get("m"), 4),
-                         _viscous(p), _friction(p), _offset(p),
-                         "-" if m.equivalent_offset is None else g(m.equivalent_offset, 3),
+            rows.append([f"motionhyst: mass-damper + {m.name}{limit}",
+                         _marked(g(p.get("m"), 4), s, "m"),
+                         _marked(_viscous(p), s, "c", "c_skew", "c_pos", "c_neg"),
+                         _marked(_friction(p), s, "fc", "fc_pos", "fc_neg"),
+                         _marked(_offset(p), s, "offset", "drift"),
+                         "-" if m.equivalent_offset is None else
+                         _marked(g(m.equivalent_offset, 3), m.std, "offset"),
                          f"{m.estimation['rmse_mm']:.3g}", f"{m.validation['rmse_mm']:.3g}",
                          f"{m.validation['fit_percent']:.1f}", _own(m.validation),
                          f"{m.seconds:.0f}"])
@@ -463,6 +468,13 @@ def _friction(p: dict) -> str:
     if "fc_pos" in p:
         return f"{g(p['fc_pos'], 4)}/{g(p['fc_neg'], 4)}"
     return "-"
+
+
+def _marked(cell: str, std: dict, *names: str) -> str:
+    """`cell`, marked when the record does not determine a parameter it shows (its standard
+    error None, as the JSON's ``std`` and ``model_std`` say)."""
+    return f"{cell} (not determined)" if any(n in std and std[n] is None for n in names) \
+        else cell
 
 
 def _own(validation: dict) -> str:
