@@ -713,7 +713,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     prob = _ElementProblem(records, periodic, r, layout, y_scale, scale, plant=structure,
                            extras=extras, window=init_window, budget=plan)
     q0 = prob.variables(np.concatenate([best[1][:n_base], full_start]))
-    coulomb = None
+    coulomb, other = None, []
     if axis and not getattr(layout.cls, "rigid", False):
         # the rigid slider is every friction link's limit: its fit is a start for theirs
         with plan.share(None if plan.left is None else (plan.left - final) // 2):
@@ -725,10 +725,9 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                 layout, y_scale, v_scale, extras.names, force, rate[n_plant:n_base],
                 RATE_GRID[0] * v_scale, skew, rigid)
         n_eval += used
-        if seed is not None:
+        if seed is not None:  # both refined (refine's others): a start's cost is no guide
             q_seed = prob.variables(seed)
-            if prob.cost(q_seed) < prob.cost(q0):
-                q0 = q_seed
+            q0, other = (q_seed, [q0]) if prob.cost(q_seed) < prob.cost(q0) else (q0, [q_seed])
     # what the standard errors at the end take: a run and the Jacobian's differences
     reserve = (1 + (prob.extras.size if prob.exact else q0.size)
                + (3 * len(records) if init_window is not None else 0))
@@ -739,7 +738,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     # the lower cost at the start is no guide (two Coulomb records, one moving each way: the
     # window's state fitted better at the start and ended at fc 18.5 N for a true 20 N)
     sol, q_start, most = refine(prob, q0, tol, max_nfev, reserve, bool(extras.initial) and own,
-                                rigid_link, segments)
+                                rigid_link, segments, other)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)

@@ -23,6 +23,7 @@ segments' end too: a stiff Jenkins link sticks and slips as sharply (k 1e8 N/m o
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -119,10 +120,14 @@ def on_segments(prob, q_free: NDArray[np.float64], tol: float, max_nfev: int | N
 
 
 def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, reserve: int,
-           from_window: bool, rigid: bool = False, segments: bool = False
+           from_window: bool, rigid: bool = False, segments: bool = False,
+           others: Sequence[NDArray[np.float64]] = ()
            ) -> tuple[OptimizeResult, NDArray[np.float64], int | None]:
     """The search problem `prob` refined from `q0` and, with `from_window`, from
-    :func:`state_start` of it too; with `segments`, also from the end of a refinement on the
+    :func:`state_start` of it too; from each of `others` (starts whose cost was higher at the
+    start, which is no guide to where they end: a Jenkins axis whose force offset drifts,
+    EMPS periods 1-2, started from its rigid limit ended at 0.288 mm, from the short runs'
+    best at 0.234 mm); with `segments`, also from the end of a refinement on the
     records' segments (:func:`on_segments`; near a well's bottom: a rigid slider's with
     secants a tenth as wide); the end of least cost kept.  A `rigid` slider's best end is
     refined again with its secants' step shrunk tenfold in turn to :data:`FINEST_SECANT`,
@@ -139,7 +144,7 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
     if plan.left is not None and plan.left - reserve < RIGID_STEPS * (1 + q0.size):
         rigid = segments = False  # a budget too small for them: the refinements alone
     shrinks = round(np.log10(secant / FINEST_SECANT)) if rigid else 0
-    stages = [segments, *([True] * (1 + from_window + segments + shrinks))]
+    stages = [segments, *([True] * (1 + len(others) + from_window + segments + shrinks))]
 
     def part(k: int) -> int | None:  # the share of stage k
         return None if plan.left is None else (plan.left - reserve) // max(sum(stages[k:]), 1)
@@ -158,8 +163,9 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
     if from_window and enough(1):  # where the first refinement's share is two steps
         q_state = state_start(prob, q0)
         runs += [] if q_state is None else [(q_state, secant)]
+    runs += [(q, secant) for q in others]
     runs += starts[1:]  # the segments' end: each record's state its first segment's
-    stages[1:2 + from_window + segments] = [True] * len(runs)
+    stages[1:2 + len(others) + from_window + segments] = [True] * len(runs)
     sol, start, most, at = None, q0, max_nfev, secant
     for k, (q, step) in enumerate(runs, 1):
         share = part(k)
