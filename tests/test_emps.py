@@ -372,3 +372,60 @@ def test_the_table_marks_what_the_record_does_not_determine():
     model.model_std["m"] = None
     row = next(line for line in str(res).splitlines() if "mass-damper + coulomb" in line)
     assert row.count("(not determined)") == 3
+
+
+def _data_emps() -> IORecord:
+    """DATA_EMPS as the command reads it (its force in N)."""
+    from motionhyst.identify.emps_files import COLUMNS
+    from motionhyst.io.records import read_record
+
+    data = read_record(SHARED / "DATA_EMPS.mat", ("time", "force", "displacement"),
+                       columns=COLUMNS, scale={"force": DRIVE_GAIN})
+    return IORecord(data[:, 0], data[:, 1], data[:, 2], "DATA_EMPS")
+
+
+@pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),
+                    reason="the EMPS benchmark's files are not beside the repository")
+def test_jenkins_with_a_drifting_offset_keeps_the_stiffness_the_record_shows():
+    """The Jenkins link with viscous friction by direction and the offset drifting, on
+    periods 1-2: its search refines both its starts, the short runs' best and its rigid
+    limit (the Coulomb fit, which cost less at the start), and keeps the better end: a
+    stiffness the record resolves (2.9e6 N/m, 28 Hz) fitting the periods to 0.234 mm, not
+    the rigid limit's 0.288 mm reported as that limit (main)."""
+    res = run_emps(_data_emps(), models=("jenkins-asymmetric-drift",), periods=(1, 2))
+    (model,) = res.models
+    assert model.limit is None
+    assert model.parameters["k"] == pytest.approx(2.9e6, rel=0.3)
+    assert model.model_std["k"] is not None and model.model_std["k"] < model.parameters["k"]
+    assert model.estimation["rmse_mm"] < 0.25
+    assert model.parameters["m"] == pytest.approx(95.1, rel=0.03)
+
+
+@pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),
+                    reason="the EMPS benchmark's files are not beside the repository")
+def test_every_default_model_finds_the_axis_on_the_raw_record():
+    """Issue 21's target on the raw estimation record (no preprocessing), as the command
+    identifies it when it has the test record: a default model's mass within 3 % of the
+    benchmark's 95.1 kg and its force offset, as the reference model's OF, within 0.6 N of
+    -3.16 N, or a warning that says which misses and by how much.  Measured: Coulomb with
+    viscous friction by direction 93.47 kg, Jenkins 93.91 kg, in the band; the Coulomb link
+    with the offset drifting 92.05 kg, 3.2 % low (the drift in time takes part of the
+    inertia: 93.3 kg costs it 0.49 against 0.43 mm), said; every OF -3.15 to -3.21 N."""
+    from motionhyst.identify.emps import MODELS
+
+    rec = _data_emps()
+    res = run_emps(rec, rec, models=MODELS)
+    assert [m.name for m in res.models] == list(MODELS)
+    for model in res.models:
+        mass_noted = any("published 95.11 kg" in w for w in model.warnings)
+        in_band = model.parameters["m"] == pytest.approx(95.1089, rel=0.03)
+        assert in_band != mass_noted, model.name
+        assert model.parameters["offset"] == pytest.approx(-3.16, abs=0.6), model.name
+        assert not any("as OF" in w for w in model.warnings), model.name
+    by_name = {m.name: m for m in res.models}
+    assert by_name["coulomb-asymmetric"].parameters["m"] == pytest.approx(93.5, abs=0.5)
+    assert by_name["jenkins-asymmetric"].parameters["m"] == pytest.approx(93.9, abs=0.5)
+    drifting = by_name["coulomb-asymmetric-drift"]
+    assert drifting.parameters["m"] == pytest.approx(92.05, abs=0.15)
+    assert drifting.warnings[-1].startswith(f"m = {drifting.parameters['m']:.2f} kg is 3.")
+    assert f"warning: coulomb-asymmetric-drift: {drifting.warnings[-1]}" in str(res)
