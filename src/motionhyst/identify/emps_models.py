@@ -103,8 +103,8 @@ def unresolved_stiffness(name: str, parameters: dict, std: dict, fs: float) -> s
     """Why a Jenkins link's stiffness is beyond what a record resolves, or None: the rule of
     :func:`~motionhyst.identify.rigid_limit.unresolved_stiffness` (``k`` not determined, or
     the stuck mode ``sqrt(k/m) / 2 pi`` above ``fs /`` :data:`STUCK_MODE_SAMPLES`), for a
-    benchmark model by name (EMPS, ``jenkins-asymmetric-drift`` on the whole record: k 8.6e8
-    N/m, 486 Hz at 1 kHz, which pulled its mass to 92.15 kg).
+    benchmark model by name (a stiffness run to 8.6e8 N/m, a stuck mode of 486 Hz at 1 kHz,
+    pulled a mass 3 % low on ``DATA_EMPS``).
 
     Parameters
     ----------
