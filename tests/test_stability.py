@@ -18,6 +18,8 @@ from scipy.integrate import solve_ivp
 from motionhyst import BoucWen, Dahl, LuGre, default_scenario, load_scenario
 from motionhyst.analysis.stability import link_loop_response, stability
 from motionhyst.cli import main as cli_main
+from motionhyst.time.references import SineReference
+from motionhyst.time.simulation import simulate
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 HUNTING = EXAMPLES / "hunting.toml"
@@ -363,3 +365,20 @@ def test_two_cycles_exact_with_a_dahl_link():
         p = c.predicted
         assert 1.0 / p.frequency_hz == pytest.approx(c.period_s, rel=0.15)
         assert p.peak_to_peak == pytest.approx(c.peak_to_peak, rel=0.15)
+
+
+def test_the_hunting_loop_is_refused_by_a_time_simulation_naming_the_filter(tmp_path, capsys):
+    """Its PID has a pure derivative (kd, no derivative_filter_hz): no continuous realisation
+    to run in time.  ``simulate`` says so in one line naming the key that gives one, before
+    the run, and writes nothing; before, python-control's "transfer function is non-proper;
+    can't convert to StateSpace system" came out of the run, naming no key."""
+    out = tmp_path / "h.csv"
+    argv = ["simulate", str(HUNTING), "--time-series", str(out), "--duration", "1"]
+    assert cli_main(argv) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if "error" in ln]
+    assert err == ["motionhyst: error: the controller is not proper (more zeros than poles: "
+                   "a PID's kd without derivative_filter_hz): a time simulation needs "
+                   "[controller] derivative_filter_hz, or sample_rate_hz to run it sampled"]
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(ValueError, match="derivative_filter_hz"):
+        simulate(load_scenario(HUNTING).loop(), SineReference(0.01, 0.1), 0.1)

@@ -31,6 +31,7 @@ from motionhyst.core.lti import (
     polysub_exact,
     realize_scaled,
     stack,
+    tf_poly,
 )
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.along_stroke import AlongStroke
@@ -205,6 +206,16 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     return engine.run(t, 0, h_foh)
 
 
+def _check_proper(loop: Loop) -> None:
+    """Refuse a continuous controller with more zeros than poles (a PID's pure derivative):
+    its force has no realisation to run in time."""
+    num, den = tf_poly(loop.controller, "controller")
+    if len(np.trim_zeros(num, "f")) > len(np.trim_zeros(den, "f")):
+        raise ValueError("the controller is not proper (more zeros than poles: a PID's kd "
+                         "without derivative_filter_hz): a time simulation needs [controller] "
+                         "derivative_filter_hz, or sample_rate_hz to run it sampled")
+
+
 def _refuse_along_stroke(loop: Loop, how: str) -> None:
     if isinstance(loop.hysteresis, AlongStroke) or isinstance(loop.hysteresis_feedforward,
                                                               AlongStroke):
@@ -339,6 +350,7 @@ class _Engine:
     def __init__(self, loop: Loop, reference, dt: float | None, force):
         if loop.feedforward != "rigid-body" and loop.feedforward is not None:
             raise ValueError("unknown feedforward")
+        _check_proper(loop)
         self.loop = loop
         self.reference = reference
         self.force = force
