@@ -3,9 +3,6 @@ runs in a child process under an address-space limit (:mod:`limited_process`) in
 the user's files; a refusal is exit 2 with one line on stderr and no traceback, a run from
 implausible values exits 0 with one warning naming the quantity, and every file the command
 does not own is byte-identical afterwards.
-
-The campaign itself (about 500 cases over every command) is
-/work/team/scratch-hostile15/campaign.py.
 """
 
 from __future__ import annotations
@@ -19,10 +16,10 @@ import pytest
 from file_trees import populate, snapshot
 
 
-def _reference(time_gain: float, position_gain: float) -> str:
-    """A 2 s sine setpoint of 1 mm at 1 kHz, its time and position multiplied by the gains (a
-    log in ms, in mm)."""
-    t = np.arange(2000) * 1e-3
+def _reference(time_gain: float, position_gain: float, rate: float = 1e3) -> str:
+    """A 2 s sine setpoint of 1 mm sampled at `rate`, its time and position multiplied by the
+    gains (a log in ms, in mm)."""
+    t = np.arange(int(2 * rate)) / rate
     r = 1e-3 * np.sin(2 * np.pi * 2.0 * t)
     return "time,position\n" + "".join(f"{a * time_gain:.10g},{b * position_gain:.10g}\n"
                                        for a, b in zip(t, r, strict=True))
@@ -35,7 +32,11 @@ REFERENCE_SLIPS = [
     ("position-in-mm", _reference(1.0, 1e4),
      "simulate: r.csv: the reference's position spans 20 m, more than the 4 m stroke of a "
      "motion stage: if it is not in metres, scale it (--scale position=0.001 for mm)"),
+    ("time-in-ms-at-10-khz", _reference(1e3, 1.0, 1e4),
+     "simulate: r.csv: the reference is sampled at 10 Hz (20000 samples over 2000 s): if its "
+     "time is not in seconds, scale it (--scale time=0.001 for ms)"),
     ("as-logged", _reference(1.0, 1.0), None),
+    ("as-logged-at-100-hz", _reference(1.0, 1.0, 100.0), None),
 ]
 
 
@@ -70,19 +71,23 @@ def _controller(body: str) -> str:
     return head + "[controller]\n" + body + "\n[feedforward]" + rest.split("[feedforward]")[1]
 
 
-_ONES = "[" + ", ".join(["1.0"] * 150) + "]"
+def _ones(n: int) -> str:
+    return "[" + ", ".join(["1.0"] * n) + "]"
+
+
 CONTROLLER_ORDERS = [
-    ("tf-den", f'type = "tf"\nnum = [1.0]\nden = {_ONES}\n', "den has 150"),
-    ("tf-z-num", f'type = "tf-z"\nsample_rate_hz = 1e4\nnum = {_ONES}\nden = [1.0]\n',
-     "num has 150"),
+    ("tf-den", f'type = "tf"\nnum = [1.0]\nden = {_ones(150)}\n', "den has 150", 101),
+    ("tf-z-num", f'type = "tf-z"\nsample_rate_hz = 1e4\nnum = {_ones(1500)}\nden = [1.0]\n',
+     "num has 1500", 1001),
     ("two-dof-z-y-num", 'type = "two-dof-z"\nsample_rate_hz = 1e4\nr_num = [1.0]\n'
-     f'r_den = [1.0]\ny_num = {_ONES}\ny_den = [1.0]\n', "y_num has 150"),
+     f'r_den = [1.0]\ny_num = {_ones(1500)}\ny_den = [1.0]\n', "y_num has 1500", 1001),
 ]
 
 
-@pytest.mark.parametrize(("body", "words"), [c[1:] for c in CONTROLLER_ORDERS],
+@pytest.mark.parametrize(("body", "words", "limit"), [c[1:] for c in CONTROLLER_ORDERS],
                          ids=[c[0] for c in CONTROLLER_ORDERS])
-def test_a_controller_of_absurd_order_is_refused_with_the_scenario(tmp_path, body, words):
+def test_a_controller_of_absurd_order_is_refused_with_the_scenario(tmp_path, body, words,
+                                                                   limit):
     """A controller polynomial of 3000 coefficients was accepted and its loop's poles
     computed: 59 s (s) and more than 80 s of CPU (z, not stopped by SIGTERM while in LAPACK)
     before the answer; now the scenario check refuses it, before python-control is loaded."""
@@ -93,10 +98,24 @@ def test_a_controller_of_absurd_order_is_refused_with_the_scenario(tmp_path, bod
     result = cli_probe.probe(["analyze", "s.toml"], tmp_path)
     assert result["rc"] == 2, result
     assert result["err"] == (f"motionhyst: error: s.toml: [controller]: {words} coefficients, "
-                             "more than the 101 (degree 100) a controller's polynomial may "
-                             "have: give a controller of lower order\n")
+                             f"more than the {limit} (degree {limit - 1}) a controller's "
+                             "polynomial may have: give a controller of lower order\n")
     assert result["heavy"] == []
     assert snapshot(tmp_path) == before
+
+
+def test_a_sampled_reference_filter_of_150_taps_is_a_controller_the_scenario_takes(tmp_path):
+    """A sampled controller counts a filter's taps: the paper's lead-lag at 10 kHz with a
+    150-tap moving-average reference filter (153 coefficients) is a controller, not an absurd
+    order; its scenario loads and builds its loop."""
+    from motionhyst.scenario import load_scenario
+
+    body = ('type = "two-dof-z"\nsample_rate_hz = 1e4\n'
+            f'r_num = [{", ".join(["0.0066666666666666671"] * 150)}]\nr_den = [1.0]\n'
+            'y_num = [1.0, -0.9]\ny_den = [1.0, -0.5]\n')
+    populate(tmp_path, {"s.toml": _controller(body)})
+    loop = load_scenario(tmp_path / "s.toml").loop()
+    assert loop.sampled is not None and loop.sampled.r_num.size == 150
 
 
 @pytest.mark.parametrize(("argv", "env", "given"), [
