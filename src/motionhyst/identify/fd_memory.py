@@ -62,11 +62,13 @@ prefilter (:func:`~motionhyst.identify.closed_loop.infer_link_force`), besides t
 (:func:`~motionhyst.identify.records.fit_every`) up to
 :data:`~motionhyst.identify.records.MAX_ROWS` rows."""
 
-CLOSED_LOOP_ROW_BYTES = 2600
+CLOSED_LOOP_ROW_BYTES = 3300
 """Bytes per row of a closed-loop record's Maxwell-slip fit.  With :data:`CLOSED_LOOP_BYTES`,
-measured on the paper's loop with a two-element link at 5 kHz, default cut-off (q = 2 or 3),
-address space above a warmed process: 30.9 MB at 2e4 samples (estimate 36; a row a sample,
-600 and 3500 bytes, said 82), 57.8 MB at 5e4 (68.3; was 118)."""
+measured on the paper's loop at 5 kHz, default cut-off (q = 2 or 3), address space above a
+warmed process: a two-element link 30.9-34.7 MB at 2e4 samples, 57.8 MB at 5e4 (2600 bytes a
+row would say 36 and 68.3; a row a sample, 600 and 3500 bytes, said 82 and 118); a
+six-element link's wider Jacobian 36.1 MB at 2e4, above 2600 bytes' 36: 3300 leave a margin
+for the elements the order search may reach (43 MB at 2e4)."""
 
 LINK_SAMPLE_BYTES = 160
 """Bytes per sample of one evaluation of a link fitted by the force's error besides its
@@ -304,9 +306,9 @@ def check_closed_loop_memory(n_samples: int, name: str, every: int | None = 1) -
     ...     check_closed_loop_memory(20_000, "run.csv", every=3)
     ... except BudgetError as exc:
     ...     print(exc)
-    run.csv: the Maxwell-slip fit of a closed-loop record of 20000 samples needs 27.3 MB, \
+    run.csv: the Maxwell-slip fit of a closed-loop record of 20000 samples needs 32 MB, \
 above the memory budget of 21 MB (--max-memory); its link force takes 10 MB, the fit's rows \
-17.3 MB: a larger --max-memory if the machine has it, or a shorter record
+22 MB: a larger --max-memory if the machine has it, or a shorter record
     >>> check_closed_loop_memory(20_000, "run.csv", every=None)       # its link force: 10 MB
     >>> set_max_memory(None)
     """
