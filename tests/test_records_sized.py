@@ -148,7 +148,8 @@ def test_a_file_longer_than_its_estimate_is_read_whole(tmp_path, monkeypatch):
 def test_predict_refuses_a_long_force_record_unread(tmp_path, unread, capsys):
     """3e5 force samples (11 MB of CSV) predicted from rest under --max-memory 30M: the run
     needs at least 64 bytes a sample and a block of 20 steps a sample (119 MB): refused
-    before the file is read, with its samples (main: XX"""
+    before the file is read, with its samples (main refused its reading, naming its bytes and
+    not its samples)."""
     n = 300_000
     t = np.arange(n) / 1000.0
     path = _write(tmp_path / "f.csv", "time,force", [t, 20 * np.sin(2 * np.pi * t)], "%.17g")
