@@ -138,7 +138,9 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
     stages share the rest, each an equal part of what those before it left (a refinement
     from a window's state and each shrunk step only where its part is two steps, the
     segments and finer secants only where the rest is :data:`RIGID_STEPS` steps).
-    Returns the refinement's result, its start and the evaluations it was allowed.
+    Returns the refinement's result, its start (each variable the nearest of the starts
+    refined: a value that ends near any of them has not run away from the search) and the
+    evaluations it was allowed.
     """
     plan, secant = prob.budget, prob.fd_step
     if plan.left is not None and plan.left - reserve < RIGID_STEPS * (1 + q0.size):
@@ -192,4 +194,6 @@ def refine(prob, q0: NDArray[np.float64], tol: float, max_nfev: int | None, rese
         if end.cost < sol.cost:
             sol, most = end, max_nfev if share is None else share
     prob.fd_step = secant  # the standard errors' differences as the search's
-    return sol, start, most
+    tried = np.array([q for q, _ in runs] + [start])
+    nearest = np.argmin(np.abs(tried - sol.x), axis=0)
+    return sol, tried[nearest, np.arange(sol.x.size)], most
