@@ -369,6 +369,15 @@ def _check_first_rows(path: Path, d: _Dialect, wanted: list[int], names: Sequenc
         return  # pandas reads it and says what is wrong
 
 
+def _check_has(path: Path, header: list[str], names: tuple[str, ...]) -> None:
+    """Refuse a file whose header lacks any of the columns `names`, naming them."""
+    missing = [n for n in names if n not in header]
+    if missing:
+        found = ",".join(header) or "none"
+        raise CSVError(f"{path}: missing column(s) {', '.join(missing)}; need a header with "
+                       f"{','.join(names)} (found {found})")
+
+
 def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
     """The columns `names` of a CSV file (floats where they parse), rows checked for length:
     read whole, as a file whose cells are not all plain numbers is (its message found), within
@@ -379,11 +388,7 @@ def _file_columns(path: Path, names: tuple[str, ...]) -> pd.DataFrame:
     d = _dialect(path)
     header = _file_header(path, d)
     _check_unique(header, str(path))
-    missing = [n for n in names if n not in header]
-    if missing:
-        found = ",".join(header) or "none"
-        raise CSVError(f"{path}: missing column(s) {', '.join(missing)}; need a header with "
-                       f"{','.join(names)} (found {found})")
+    _check_has(path, header, names)
     width = len(header)
     _check_line_lengths(path, d, width)
     _check_first_rows(path, d, [header.index(n) for n in names], names, width)
@@ -412,11 +417,7 @@ def _file_array(path: Path, names: tuple[str, ...]) -> NDArray[np.float64] | Non
     ``nan``)."""
     d = _dialect(path)
     header = _file_header(path, d)
-    missing = [n for n in names if n not in header]
-    if missing:
-        found = ",".join(header) or "none"
-        raise CSVError(f"{path}: missing column(s) {', '.join(missing)}; need a header with "
-                       f"{','.join(names)} (found {found})")
+    _check_has(path, header, names)
     width = len(header)
     wanted = [header.index(n) for n in names]
     _check_line_lengths(path, d, width)
