@@ -167,3 +167,52 @@ def test_a_signal_at_any_moment_of_a_long_prediction_is_130_or_a_finished_run(tm
         else:
             assert (tmp_path / "p.csv").read_text().startswith("time,displacement")
             assert sorted(p.name for p in tmp_path.iterdir()) == ["f.csv", "m.toml", "p.csv"]
+
+
+WORKER_SIGNALLED_AT_FORK = """
+import os, signal, sys, tempfile
+from motionhyst.present.figure_writer import FigureWriter
+
+CALLER = os.getpid()
+
+def handler(signum, frame):  # a caller's handler that raises, as the command's and outputs' do
+    if os.getpid() != CALLER:
+        os.write(2, b"the caller's handler ran in a worker\\n")
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+signal.signal(signal.SIG{name}, handler)
+# the signal comes while the worker is still being forked (as FigureWriter.close's SIGTERM
+# can, or a Ctrl-C sent to the whole process group)
+os.register_at_fork(after_in_child=lambda: os.kill(os.getpid(), signal.SIG{name}))
+
+def empty():
+    from matplotlib.figure import Figure
+    return Figure()
+
+with tempfile.TemporaryDirectory() as folder:
+    writer = FigureWriter(folder, formats=("png",), parallel=True)
+    writer.submit({{"a": empty}})
+    try:
+        print("saved", writer.wait())
+    except RuntimeError as exc:
+        print(exc)
+print("caller", os.getpid() == CALLER)
+"""
+
+
+@pytest.mark.parametrize(("name", "worker_end"), [
+    ("TERM", "a figure worker ended with exit code -15"),  # a worker dies at SIGTERM
+    ("INT", "saved ['a']"),  # and leaves Ctrl-C to its caller
+])
+def test_a_signal_while_a_figure_worker_is_forked_is_never_taken_by_the_callers_handler(
+        name, worker_end):
+    """A handler of the caller's that raises, run in a worker before multiprocessing's guard,
+    sent that copy of the caller on through the caller's own code: a test run went on in
+    two processes, the first waiting for the second for ever (CI stopped at 90 minutes)."""
+    done = subprocess.run([sys.executable, "-c",
+                           WORKER_SIGNALLED_AT_FORK.replace("{name}", name).format()],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    assert "handler ran in a worker" not in done.stderr, done.stderr[-2000:]
+    assert done.stdout.splitlines() == [worker_end, "caller True"], (done.stdout,
+                                                                     done.stderr[-2000:])

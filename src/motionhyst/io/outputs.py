@@ -347,7 +347,15 @@ def _signals_raise() -> Iterator[list[int]]:
         yield received
         return
 
+    pid = os.getpid()
+
     def handler(signum, frame):
+        if os.getpid() != pid:  # a process forked inside the block: the signal is its own
+            if signum == signal.SIGINT:
+                signal.default_int_handler(signum, frame)
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
         received.append(signum)
         raise KeyboardInterrupt(signal.Signals(signum).name)
 

@@ -102,6 +102,15 @@ def _warm_up(formats: Sequence[str]) -> None:
     _warm_formats.update(todo)
 
 
+_WORKER_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+"""The signals a worker takes as its own from its start (see :func:`_draw_batch`)."""
+
+
+def _block(signals: frozenset[signal.Signals]) -> set[signal.Signals]:
+    """Block `signals` in this thread; the mask there was before, to set back."""
+    return signal.pthread_sigmask(signal.SIG_BLOCK, signals)
+
+
 class _WorkerTraceback(Exception):
     """The traceback of an error in a figure worker (the cause of the error re-raised)."""
 
@@ -114,11 +123,16 @@ def _draw_batch(makers: dict[str, FigureMaker], folder: Path, formats: Sequence[
     """
     from motionhyst.core.compiled import quiet_compilation
 
-    quiet_compilation()
     # the caller ends its workers (FigureWriter.close, with SIGTERM), whatever handlers it has:
-    # a worker dies at SIGTERM and leaves Ctrl-C to the caller
+    # a worker dies at SIGTERM and leaves Ctrl-C to the caller.  Both signals are blocked
+    # from before the fork (FigureWriter.submit) until the worker's own dispositions are
+    # set: one that comes sooner waits and is then taken as set here, never by a handler
+    # of the caller's, which would raise in the worker before multiprocessing's guard and
+    # send this copy of the caller on through the caller's own code
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _WORKER_SIGNALS)
+    quiet_compilation()
     try:
         for name, make in makers.items():
             _draw_and_save(name, make, folder, formats)
@@ -229,9 +243,11 @@ class FigureWriter:
         # process's): without, each goes through them all and copies their memory pages, a
         # quarter of a figure's drawing time
         gc.freeze()
+        blocked = _block(_WORKER_SIGNALS)  # unblocked in the worker by _draw_batch
         try:
             worker.start()
         finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
             gc.unfreeze()
         send.close()
         self._workers.append((worker, receive))
