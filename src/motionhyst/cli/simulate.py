@@ -123,8 +123,9 @@ def _check_reference_units(source: str, ref) -> None:
 
 
 def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
-    """Refuse a run of far too many rows or steps, or of too much work (a link of many
-    elements), before its loop is built: the step is the
+    """Refuse a run of far too many rows or steps, of too much work (a link of many
+    elements) or memory (a sampled controller's run is held whole), before its loop is
+    built: the step is the
     loop's own where its coefficients give its poles (:func:`~motionhyst.time.steps.pole_step`;
     an unstable loop is refused there), else at most the sampled controller's period or the
     reference's (:func:`~motionhyst.time.steps.longest_step`; a file's samples do not set
@@ -142,7 +143,12 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
         step_set_by,
         time_series_grid,
     )
-    from motionhyst.time.timeseries import COLUMNS, DEFAULT_OUTPUT_RATE_HZ, reference_rate_hz
+    from motionhyst.time.timeseries import (
+        COLUMNS,
+        DEFAULT_OUTPUT_RATE_HZ,
+        check_time_series_memory,
+        reference_rate_hz,
+    )
 
     controller = sc.model.controller
     sampled = isinstance(ref, SampledReference)
@@ -178,6 +184,7 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
                            f"Hz) or shorten --duration ({duration:g} s), or write "
                            f"--time-series where there is room")
         check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy, rows)
+        check_time_series_memory((rows - 1) * per_row + 1, per_row, rate is not None, remedy)
     if pole is not None or rate is not None:  # the run's own step, before its loop is built
         check_link_damping_for(sc, None if pole is None else run_step)
     return remedy

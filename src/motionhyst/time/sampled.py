@@ -24,9 +24,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from motionhyst.controllers.loop import Loop
+from motionhyst.core.budget import check_memory
 from motionhyst.time.engine import run_sampled
 from motionhyst.time.simulation_result import Simulation
-from motionhyst.time.steps import MAX_SAMPLES, RunTooLarge
+from motionhyst.time.steps import MAX_SAMPLES, SAMPLED_SAMPLE_BYTES, RunTooLarge, a_run
 
 __all__ = ["simulate_sampled"]
 
@@ -137,6 +138,9 @@ def simulate_sampled(loop: Loop, reference, duration: float, *, force=None,
     if n > MAX_SAMPLES:
         raise RunTooLarge(f"{n} controller samples: too many (at most {MAX_SAMPLES:.0e})",
                           "shorten the duration")
+    with a_run():
+        check_memory(SAMPLED_SAMPLE_BYTES * float(n), f"a run of {n} controller samples at "
+                     f"{c.sample_rate_hz:g} Hz (held whole)", "shorten the duration")
     t = np.arange(n) * c.period
     r, _ = reference(t)
     r = np.asarray(r, dtype=float)

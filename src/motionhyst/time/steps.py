@@ -30,6 +30,7 @@ __all__ = [
     "MAX_STEPS",
     "RUN_REMEDY",
     "SAMPLED_MIN_SUBSTEPS",
+    "SAMPLED_SAMPLE_BYTES",
     "SAMPLED_STEPS_PER_MODE_PERIOD",
     "SCAN_REMEDY",
     "SECONDS_PER_ELEMENT_STEP",
@@ -59,6 +60,13 @@ STEPS_PER_REFERENCE_PERIOD = 400
 
 BYTES_PER_SAMPLE = 160
 """Memory of one time sample of a run: its signals and the loop's intermediate arrays [bytes]."""
+
+SAMPLED_SAMPLE_BYTES = 200
+"""Memory of one controller sample of a run of a loop with a sampled controller, which is held
+whole: the reference and the feedforward at the samples, the signals of the run and of the
+run without the link, the kernel's arrays [bytes] (measured, Table I at 10 kHz with a file's
+or a sine reference, 1e4-3e5 samples: 164-176 traced and of address space; 20 % above).
+"""
 
 MAX_SCAN_STEPS = 50_000_000
 """Most time steps of one run of a scan (each run keeps its signals)."""

@@ -23,9 +23,17 @@ from typing import IO, TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from motionhyst.core.budget import check_memory
 from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
-from motionhyst.time.steps import pole_step, step_set_by, time_series_grid
+from motionhyst.time.steps import (
+    RUN_REMEDY,
+    SAMPLED_SAMPLE_BYTES,
+    a_run,
+    pole_step,
+    step_set_by,
+    time_series_grid,
+)
 
 if TYPE_CHECKING:  # the simulation (python-control, numba) loads when a run starts: the
     # command's checks of its run (time_series_grid) come before it
@@ -42,7 +50,13 @@ ROWS_PER_CHUNK = 8192
 """Output rows computed and written at a time."""
 
 MAX_CHUNK = 1 << 18
-"""Most integration samples computed at a time (about 30 MB), however many a row holds."""
+"""Most integration samples computed at a time (about 55 MB), however many a row holds."""
+
+CHUNK_SAMPLE_BYTES = 250
+"""Memory of :func:`run_time_series` (a continuous loop) per integration sample of a chunk: the
+signals of the chunk written and of the next one computed, the loop's intermediate arrays
+and the rows [bytes] (measured, Table I with a file's reference, runs of three chunks or more:
+200-211 traced a sample of a chunk of 24576 and of 262144; 20 % above)."""
 
 COLUMNS = ("time", "reference", "error", "y1", "y2", "u", "w", "error_linear")
 """Columns of the CSV, in order (as :meth:`motionhyst.time.simulation.Simulation.columns`)."""
@@ -103,6 +117,53 @@ def reference_rate_hz(reference: SampledReference) -> float:
     10000
     """
     return 1.0 / float(np.median(np.diff(reference.t)))
+
+
+def check_time_series_memory(steps: int, per_row: int, sampled: bool,
+                             remedy: str = RUN_REMEDY) -> None:
+    """Refuse, before it starts, a run of :func:`run_time_series` whose memory is above the
+    budget: a continuous loop's run is computed a chunk at a time (at most
+    :data:`MAX_CHUNK` samples, :data:`CHUNK_SAMPLE_BYTES` each); a
+    sampled controller's is held whole
+    (:data:`~motionhyst.time.steps.SAMPLED_SAMPLE_BYTES` a controller sample).
+
+    Parameters
+    ----------
+    steps : int
+        Integration samples of the run (controller samples of a sampled loop).
+    per_row : int
+        Samples a row (:func:`~motionhyst.time.steps.time_series_grid`).
+    sampled : bool
+        The loop's controller is sampled.
+    remedy : str
+        What the caller can change.
+
+    Raises
+    ------
+    motionhyst.time.steps.RunTooLarge
+        One line: the run's samples, its bytes, the budget and `remedy`.
+
+    Examples
+    --------
+    >>> from motionhyst.core.budget import set_max_memory
+    >>> set_max_memory(100 << 20)
+    >>> check_time_series_memory(3_000_001, 3, sampled=False)   # in chunks: 6.1 MB
+    >>> try:
+    ...     check_time_series_memory(1_000_001, 1, sampled=True)
+    ... except ValueError as exc:
+    ...     print(exc)
+    a run of 1000001 controller samples (held whole) needs 200 MB, above the memory budget \
+of 105 MB (--max-memory); shorten the duration or lower the reference's frequencies
+    >>> set_max_memory(None)
+    """
+    if sampled:
+        nbytes, what = SAMPLED_SAMPLE_BYTES * float(steps), f"{steps} controller samples " \
+            "(held whole)"
+    else:
+        chunk = min(int(steps), per_row * ROWS_PER_CHUNK, MAX_CHUNK)
+        nbytes, what = CHUNK_SAMPLE_BYTES * float(chunk), f"{steps} time steps ({chunk} at a time)"
+    with a_run():
+        check_memory(nbytes, f"a run of {what}", remedy)
 
 
 @dataclass
@@ -215,6 +276,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     n_rows, per_row, step = time_series_grid(
         duration, output_rate_hz, dynamics_step(loop, reference),
         None if loop.sampled is None else loop.sampled.sample_rate_hz, set_by=why)
+    check_time_series_memory((n_rows - 1) * per_row + 1, per_row, loop.sampled is not None)
     end = (n_rows - 1) * period_out
     window = move = None
     if isinstance(reference, SineReference):
@@ -291,5 +353,5 @@ def _write_rows(out: IO[str] | None, piece: Simulation, per_row: int, first_samp
     return n
 
 
-__all__ = ["COLUMNS", "DEFAULT_OUTPUT_RATE_HZ", "DEFAULT_SETTLE_BAND", "dynamics_step",
-           "reference_rate_hz", "run_time_series"]
+__all__ = ["CHUNK_SAMPLE_BYTES", "COLUMNS", "DEFAULT_OUTPUT_RATE_HZ", "DEFAULT_SETTLE_BAND",
+           "check_time_series_memory", "dynamics_step", "reference_rate_hz", "run_time_series"]
