@@ -4,7 +4,8 @@ a controller sample), a continuous one a chunk of it
 (:data:`~motionhyst.time.timeseries.CHUNK_SAMPLE_BYTES` a sample); each refused in one line
 before its loop is built, and each estimate an upper bound of the run's address space within
 its margin of the traced peak.  Before, a reference file's run was not sized at all (mem15:
-100 s of Table I at ``--max-memory 60M`` ran to its end at 430 MB)."""
+100 s of Table I at ``--max-memory 60M`` ran to its end at 430 MB), and a reference logged in
+milliseconds was refused for its steps without a word of its unit (review A15b M5)."""
 
 from __future__ import annotations
 
@@ -152,3 +153,29 @@ def test_a_runs_estimate_bounds_its_memory_within_its_margin(tmp_path, scenario,
     steps, estimate, traced = (int(x) for x in proc.stdout.split())
     assert steps == (200_001 if "10khz" in scenario else 1_108_001)
     assert traced <= estimate <= 1.4 * traced, (estimate, traced)
+
+
+def test_a_size_refusal_of_a_reference_in_ms_names_its_unit(tmp_path, capsys, no_loop):
+    """A 60 s, 1 kHz setpoint log with its time in ms (60000 s as read) is refused for its
+    steps; the one line says first that its time looks like ms (main: "shorten --duration
+    (or the file)" alone, review A15b M5), and no warning line besides it."""
+    ref = _reference(tmp_path / "ms.csv", 60.0, 1000.0, time_gain=1e3)
+    line = _refused(["simulate", "--reference-csv", str(ref), "--time-series",
+                     str(tmp_path / "o.csv")], capsys)
+    assert line.startswith("motionhyst: error: 60001 rows of 27656 steps each: too many time "
+                           "steps"), line
+    assert line.endswith("ms.csv: the reference is sampled at 1 Hz (60001 samples over 6e+04 "
+                         "s): if its time is not in seconds, scale it (--scale time=0.001 for "
+                         "ms); else shorten --duration (or the file)"), line
+
+
+def test_a_memory_refusal_of_a_reference_in_ms_names_its_unit(tmp_path, capsys, no_loop):
+    """The same hint on a refusal of the run's memory: 2 s logged at 100 Hz in ms, run by the
+    sampled loop at 10 kHz, 2000 s as read (20000001 samples, 4 GB)."""
+    ref = _reference(tmp_path / "ms.csv", 2.0, 100.0, time_gain=1e3)
+    line = _refused(["simulate", str(EXAMPLES / "paper_10khz.toml"), "--reference-csv",
+                     str(ref), "--time-series", str(tmp_path / "o.csv"), "--max-memory",
+                     "1G"], capsys)
+    assert line.startswith("motionhyst: error: a run of 20000001 controller samples (held "
+                           "whole) needs 4 GB"), line
+    assert "(--scale time=0.001 for ms); else shorten --duration (or the file)" in line, line

@@ -101,25 +101,36 @@ def _reference(args: argparse.Namespace, sc):
             f"r = {amplitude:g} m sin(2 pi {freqs[0]:g} t)")
 
 
-def _check_reference_units(source: str, ref) -> None:
-    """Warn, before the run, of a reference file whose values look like a unit slip: a
-    position spanning more than a stage's stroke (millimetres read as metres), or samples
-    slower than :data:`SLOWEST_REFERENCE_HZ` (a time in milliseconds)."""
+def _reference_unit_notes(source: str, ref) -> tuple[str | None, str | None]:
+    """What looks like a unit slip in a reference file, judged once it is read and before the
+    run is sized: a position spanning more than a stage's stroke (millimetres read as
+    metres), and samples slower than :data:`SLOWEST_REFERENCE_HZ` (a time in milliseconds,
+    whose run is a thousand times too long).  The warning of each, or None; the second
+    ends where a refusal of the run's size goes on with its remedy (:func:`_with_unit_hint`)."""
     import numpy as np
 
     from motionhyst.analysis.plausibility import PLAUSIBLE_AMPLITUDE_M
-    from motionhyst.core.warnings import warn
 
     span = float(np.ptp(ref.r))
+    position = None
     if span > 2 * PLAUSIBLE_AMPLITUDE_M:
-        warn(f"{source}: the reference's position spans {span:.3g} m, more than the "
-             f"{2 * PLAUSIBLE_AMPLITUDE_M:g} m stroke of a motion stage: if it is not in "
-             f"metres, scale it (--scale position=0.001 for mm)")
+        position = (f"{source}: the reference's position spans {span:.3g} m, more than the "
+                    f"{2 * PLAUSIBLE_AMPLITUDE_M:g} m stroke of a motion stage: if it is not "
+                    f"in metres, scale it (--scale position=0.001 for mm)")
     step = float(np.median(np.diff(ref.t)))
+    time = None
     if step * SLOWEST_REFERENCE_HZ > 1.01:  # slower, beyond the rounding of a logged time
-        warn(f"{source}: the reference is sampled at {1 / step:.3g} Hz ({ref.t.size} samples "
-             f"over {float(ref.t[-1] - ref.t[0]):.4g} s): if its time is not in seconds, scale it "
-             f"(--scale time=0.001 for ms)")
+        time = (f"{source}: the reference is sampled at {1 / step:.3g} Hz ({ref.t.size} "
+                f"samples over {float(ref.t[-1] - ref.t[0]):.4g} s): if its time is not in "
+                f"seconds, scale it (--scale time=0.001 for ms)")
+    return position, time
+
+
+def _with_unit_hint(exc, time_note: str):
+    """A refusal of a run's size (a :class:`~motionhyst.core.budget.BudgetError`) whose
+    reference's time looks like milliseconds (`time_note`): its one line names that first,
+    then the refusal's own remedy."""
+    return exc.with_remedy(f"{time_note}; else {exc.remedy}" if exc.remedy else time_note)
 
 
 def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
@@ -248,14 +259,25 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
-    remedy = _check_size(args, sc, ref, duration, out)
+    # a file's units are judged before its run is sized: a time in ms makes the run 1000 times
+    # too long, which the size's refusal then names; warned of once the run is not refused
+    notes = _reference_unit_notes(args.reference_csv, ref) if args.reference_csv else ()
+    from motionhyst.core.budget import BudgetError
+
+    try:
+        remedy = _check_size(args, sc, ref, duration, out)
+    except BudgetError as exc:  # too many steps or rows, too much memory, disk or work
+        if not notes or notes[1] is None:
+            raise
+        raise _with_unit_hint(exc, notes[1]) from None
     rate_note = _check_output_rate(args, sc, ref)
     from motionhyst.analysis.plausibility import check_plausible, check_stroke
 
     if args.profile:  # once it is not refused: a refusal is one line
         check_stroke(ref.distance, "--distance")
-    if args.reference_csv:
-        _check_reference_units(args.reference_csv, ref)
+    for note in notes:
+        if note is not None:
+            warn(note)
 
     if isinstance(ref, SineReference):
         check_plausible(sc.loop(), ref.amplitude, [ref.frequency_hz])
