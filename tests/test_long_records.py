@@ -149,22 +149,23 @@ def test_a_prediction_from_a_window_in_blocks_is_the_same(monkeypatch):
 def test_predict_needs_the_record_and_one_block_not_the_whole_upsampled_record(tmp_path,
                                                                                 monkeypatch,
                                                                                 capsys):
-    """8000 samples of 500 steps: 192 MB upsampled at once, above --max-memory 150M; in
-    blocks of 4194 samples about 100 MB: predicted, the numbers of the whole record's run."""
-    u = _force(8000)
+    """20000 samples of 500 steps: 101 MB upsampled at once (10 bytes a step), above
+    --max-memory 70M; in blocks of 4194 samples 46.5 MB (22 bytes a step): predicted, the
+    numbers of the whole record's run."""
+    u = _force(20000)
     t = np.arange(u.size) / FS
     np.savetxt(tmp_path / "f.csv", np.column_stack([t, u]), delimiter=",", header="time,force",
                comments="")
     (tmp_path / "m.toml").write_text('[stage]\ntype = "mass-damper"\nm = 95.0\nc = 200.0\n\n'
                                      '[hysteresis]\nmodel = "jenkins"\nk = 1e6\nfc = 20.0\n')
     base = ["predict", str(tmp_path / "m.toml"), str(tmp_path / "f.csv"), "--substeps", "500"]
-    assert main([*base, "--out", str(tmp_path / "p.csv"), "--max-memory", "150M"]) == 0
+    assert main([*base, "--out", str(tmp_path / "p.csv"), "--max-memory", "70M"]) == 0
     monkeypatch.setattr(resample, "BLOCK_NODES", 1 << 40)  # the whole record as one block
-    assert main([*base, "--out", str(tmp_path / "q.csv"), "--max-memory", "150M"]) == 2
-    assert "8000 samples of 500 integration steps each needs 192 MB" in capsys.readouterr().err
+    assert main([*base, "--out", str(tmp_path / "q.csv"), "--max-memory", "70M"]) == 2
+    assert "20000 samples of 500 integration steps each needs 101 MB" in capsys.readouterr().err
     assert main([*base, "--out", str(tmp_path / "q.csv")]) == 0
     p = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
-    assert p.shape == (8000, 2) and np.ptp(p[:, 1]) > 1e-3
+    assert p.shape == (20000, 2) and np.ptp(p[:, 1]) > 1e-3
     np.testing.assert_array_equal(p, np.loadtxt(tmp_path / "q.csv", delimiter=",", skiprows=1))
 
 

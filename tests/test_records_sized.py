@@ -147,7 +147,8 @@ def test_a_file_longer_than_its_estimate_is_read_whole(tmp_path, monkeypatch):
 
 def test_predict_refuses_a_long_force_record_unread(tmp_path, unread, capsys):
     """3e5 force samples (11 MB of CSV) predicted from rest under --max-memory 30M: the run
-    needs at least 64 bytes a sample and a block of 20 steps a sample (119 MB): refused
+    needs at least a block of 20 steps a sample and the record (35.4 MB, the smaller of a
+    run in blocks and in one block): refused
     before the file is read, with its samples (main refused its reading, naming its bytes and
     not its samples)."""
     n = 300_000
@@ -161,7 +162,7 @@ def test_predict_refuses_a_long_force_record_unread(tmp_path, unread, capsys):
                      "--max-memory", "30M"], capsys)
     assert line.startswith(f"motionhyst: error: {path} ({n} samples, not read yet): "
                            f"predicting {n} samples from rest (at least 20 integration steps "
-                           f"each) needs 120 MB, above the memory budget of 31.5 MB"), line
+                           f"each) needs 35.4 MB, above the memory budget of 31.5 MB"), line
     assert line.endswith("fewer samples or --substeps"), line
     assert not (tmp_path / "o.csv").exists()
 

@@ -181,7 +181,13 @@ def _check_unread(args: argparse.Namespace, system) -> None:
     substeps (a model without inertia has none)."""
     from motionhyst.core.budget import check_memory
     from motionhyst.io.records import check_unread
-    from motionhyst.time.openloop import FINE_BYTES, MIN_SUBSTEPS, SAMPLE_BYTES
+    from motionhyst.time.openloop import (
+        MIN_SUBSTEPS,
+        ONE_BLOCK_BYTES,
+        REST_NODE_BYTES,
+        REST_SAMPLE_BYTES,
+        SAMPLE_BYTES,
+    )
     from motionhyst.time.resample import block_samples
 
     r = args.substeps or MIN_SUBSTEPS
@@ -189,9 +195,13 @@ def _check_unread(args: argparse.Namespace, system) -> None:
 
     def least(sizes: list[int]) -> None:
         n = sizes[0]
-        block = (FINE_BYTES * (min(n - 1, block_samples(r)) * r + 1)
-                 if steps and not args.periodic else 0)
-        check_memory(SAMPLE_BYTES * n + block, f"predicting {n} samples "
+        if steps and not args.periodic:  # the smaller of a run in blocks and in one block
+            nodes = min(n - 1, block_samples(r)) * r + 1
+            nbytes = min(REST_NODE_BYTES * nodes + REST_SAMPLE_BYTES * n,
+                         ONE_BLOCK_BYTES[0] * nodes + ONE_BLOCK_BYTES[1] * n)
+        else:
+            nbytes = SAMPLE_BYTES * n
+        check_memory(nbytes, f"predicting {n} samples "
                      f"{'as a periodic steady state' if args.periodic else 'from rest'}"
                      + (f" (at least {r} integration steps each)" if steps else ""),
                      "fewer samples or --substeps" if steps else "give a shorter record")

@@ -106,7 +106,8 @@ from motionhyst.time.resample import upsample as upsample
 
 # the record helpers, the periodic runs and the Bouc-Wen integrator have modules of their own in
 # motionhyst.time (resample, periodic_runs, bouc_wen_rk4); imported here too, where they were
-__all__ = ["FINE_BYTES", "MAX_SHOOTING_STATES", "MIN_SUBSTEPS", "SAMPLE_BYTES",
+__all__ = ["FINE_BYTES", "MAX_SHOOTING_STATES", "MIN_SUBSTEPS", "ONE_BLOCK_BYTES",
+           "REST_NODE_BYTES", "REST_SAMPLE_BYTES", "SAMPLE_BYTES",
            "STEPS_PER_MODE_PERIOD", "OpenLoop", "OpenLoopResponse", "simulate_elements"]
 
 MIN_SUBSTEPS = 20
@@ -118,6 +119,18 @@ FINE_BYTES = 48
 """Memory of one integration step of an open-loop run: fine input, midpoints, output [bytes]."""
 SAMPLE_BYTES = 64
 """Memory of one record sample of an open-loop run: time, force, output and their copies [bytes]."""
+REST_NODE_BYTES = 22
+"""Memory of one integration step of an open-loop run from rest, the record's force at the
+steps of one block at a time [bytes] (measured, traced, blocks of 2.1e6 steps: 16.6 a step
+for Jenkins on an axis at 20 and 100 substeps, 17.5-18.7 for Bouc-Wen on a two-mass stage by
+RK4; 9-13 for a record upsampled in one block; 18-33 % above the blocks')."""
+REST_SAMPLE_BYTES = 20
+"""Memory of one record sample of an open-loop run from rest: time, force, output [bytes]
+(measured: 16 traced; 25 % above)."""
+ONE_BLOCK_BYTES = (10, 48)
+"""Memory of a run from rest of a link stepped as elements whose record is upsampled in one
+block, a step and a sample [bytes] (measured, traced, Jenkins on an axis: 8 and 40, within
+3 % at 2e4 and 1e5 samples of 5 and 20 steps; 20 % above)."""
 
 
 #: The two-mass stage's name as an open-loop plant before the plants had one class.
@@ -314,8 +327,10 @@ class OpenLoop:
     def memory(self, force: ArrayLike, substeps: int, *, periodic: bool = False) -> float:
         """Bytes :meth:`simulate` needs for the force record `force`, as it checks them
         against the memory budget before its run: from a start, the record's force at the
-        integration steps of one block at a time (:func:`~motionhyst.time.resample.fine_blocks`)
-        and the record; a periodic run as :meth:`_periodic_memory` says.
+        integration steps of one block at a time (:func:`~motionhyst.time.resample.fine_blocks`,
+        :data:`REST_NODE_BYTES` a step) and the record (:data:`REST_SAMPLE_BYTES` a sample),
+        or a link's elements stepped on a record in one block (:data:`ONE_BLOCK_BYTES`);
+        a periodic run as :meth:`_periodic_memory` says.
 
         Parameters
         ----------
@@ -336,11 +351,14 @@ class OpenLoop:
         >>> sys = OpenLoop(MassSpringDamper(2.0, 10.0, 5e4), Jenkins(k=5e4, fc=20.0))
         >>> u = np.sin(np.arange(20000) / 7.0)
         >>> round(sys.memory(u, 28) / 1e6, 1)                  # 5.6e5 steps from rest
-        28.2
+        6.6
         """
         u = np.asarray(force, dtype=float)
         if not periodic:
-            return FINE_BYTES * held_nodes(u, int(substeps)) + SAMPLE_BYTES * u.size
+            nodes = held_nodes(u, int(substeps))
+            if u.size - 1 <= block_samples(int(substeps)) and self._rk4_parameters() is None:
+                return ONE_BLOCK_BYTES[0] * nodes + ONE_BLOCK_BYTES[1] * u.size
+            return REST_NODE_BYTES * nodes + REST_SAMPLE_BYTES * u.size
         return self._periodic_memory(u, int(substeps), self._rk4_parameters() is not None)
 
     def _rk4_parameters(self) -> NDArray[np.float64] | None:
