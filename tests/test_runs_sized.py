@@ -1,11 +1,13 @@
 """The run of ``simulate --time-series`` sized before it starts (issue 26): a loop with a
 sampled controller holds its whole run (:data:`~motionhyst.time.steps.SAMPLED_SAMPLE_BYTES`
-a controller sample), a continuous one a chunk of it
-(:data:`~motionhyst.time.timeseries.CHUNK_SAMPLE_BYTES` a sample); each refused in one line
-before its loop is built, and each estimate an upper bound of the run's address space within
-its margin of the traced peak.  Before, a reference file's run was not sized at all (mem15:
-100 s of Table I at ``--max-memory 60M`` ran to its end at 430 MB), and a reference logged in
-milliseconds was refused for its steps without a word of its unit (review A15b M5)."""
+a controller sample) and is refused in one line before its loop is built where the budget
+does not hold it; a continuous one holds a chunk of it
+(:data:`~motionhyst.time.timeseries.CHUNK_SAMPLE_BYTES` a sample), made smaller where the
+budget holds less than :data:`~motionhyst.time.timeseries.MAX_CHUNK` samples; each estimate
+an upper bound of the run's address space within its margin of the traced peak.  Before, a
+reference file's run was not sized at all (mem15: 100 s of Table I at ``--max-memory 60M``
+ran to its end at 430 MB), and a reference logged in milliseconds was refused for its steps
+without a word of its unit (review A15b M5)."""
 
 from __future__ import annotations
 
@@ -73,15 +75,26 @@ def test_a_sampled_loops_run_of_a_reference_file_is_refused_for_its_memory(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv"]
 
 
-def test_a_continuous_loops_run_is_sized_by_its_chunk(tmp_path, capsys, no_loop):
-    """Table I's loop computes a run a chunk at a time: 100 s of a 100 Hz reference is
-    2770001 steps (277 a row), 262144 at a time (65.5 MB), refused at 40 MB, not for its
-    length."""
-    ref = _reference(tmp_path / "r.csv", 100.0, 100.0)
-    line = _refused(["simulate", "--reference-csv", str(ref), "--time-series",
-                     str(tmp_path / "o.csv"), "--max-memory", "40M"], capsys)
-    assert line.startswith("motionhyst: error: a run of 2770001 time steps (262144 at a time) "
-                           "needs 65.5 MB, above the memory budget of 41.9 MB"), line
+def test_a_continuous_loops_run_is_written_in_chunks_the_budget_holds(tmp_path, capsys,
+                                                                      monkeypatch):
+    """Table I's loop computes a run a chunk at a time: 100 s of a 100 Hz reference (2770001
+    steps, 277 a row) at ``--max-memory 20M`` runs in chunks of 83886 steps (20 MB at 250
+    bytes a step) instead of 262144 (65.5 MB): not refused, nor above the budget."""
+    from motionhyst.time import simulation
+
+    seen = []
+    chunks = simulation.simulate_chunks
+
+    def recorded(*args, **kwargs):
+        seen.append(kwargs["chunk"])
+        return chunks(*args, **kwargs)
+
+    monkeypatch.setattr(simulation, "simulate_chunks", recorded)
+    ref = _reference(tmp_path / "r.csv", 10.0, 100.0)
+    assert main(["simulate", "--reference-csv", str(ref), "--time-series",
+                 str(tmp_path / "o.csv"), "--max-memory", "20M"]) == 0, capsys.readouterr().err
+    assert seen == [83886]
+    assert len((tmp_path / "o.csv").read_text().splitlines()) == 1002  # 10 s at 100 Hz
 
 
 def test_a_sampled_run_is_refused_by_the_library_too(budget):
@@ -109,12 +122,14 @@ set_max_memory(1 << 40)  # the address-space limit alone decides
 from motionhyst.scenario import load_scenario
 from motionhyst.time.references import SampledReference, SineReference
 from motionhyst.time.steps import time_series_grid
-from motionhyst.time.timeseries import CHUNK_SAMPLE_BYTES, MAX_CHUNK, ROWS_PER_CHUNK
+from motionhyst.time.timeseries import CHUNK_SAMPLE_BYTES, time_series_chunk
 from motionhyst.time.timeseries import dynamics_step, run_time_series
 from motionhyst.time.steps import SAMPLED_SAMPLE_BYTES
 
 loop = load_scenario(sys.argv[1]).loop()
 seconds, rate = float(sys.argv[2]), float(sys.argv[3])
+if len(sys.argv) > 4:
+    set_max_memory(int(sys.argv[4]))  # a budget: smaller chunks
 out = open(os.devnull, "w")
 run_time_series(loop, SineReference(0.01, 2.0), 0.05, out)  # compiled, warmed
 t = np.arange(int(seconds * rate) + 1) / rate
@@ -124,7 +139,7 @@ rows, per_row, _ = time_series_grid(seconds, rate, dynamics_step(loop, ref),
                                     loop.sampled.sample_rate_hz if sampled else None)
 steps = (rows - 1) * per_row + 1
 estimate = (SAMPLED_SAMPLE_BYTES * steps if sampled
-            else CHUNK_SAMPLE_BYTES * min(steps, per_row * ROWS_PER_CHUNK, MAX_CHUNK))
+            else CHUNK_SAMPLE_BYTES * time_series_chunk(steps, per_row))
 with open("/proc/self/status") as f:
     size = next(int(x.split()[1]) * 1024 for x in f if x.startswith("VmSize"))
 resource.setrlimit(resource.RLIMIT_AS, (size + estimate, size + estimate))
@@ -134,11 +149,13 @@ print(s["steps"], estimate, tracemalloc.get_traced_memory()[1])
 """
 
 
-@pytest.mark.parametrize(("scenario", "seconds", "rate"), [
-    ("paper_10khz.toml", 20.0, 10_000.0),   # 200001 controller samples held whole: 40 MB
-    ("paper.toml", 40.0, 100.0),            # 1108001 steps, chunks of 262144: 65.5 MB
-], ids=["sampled-whole", "continuous-chunk"])
-def test_a_runs_estimate_bounds_its_memory_within_its_margin(tmp_path, scenario, seconds, rate):
+@pytest.mark.parametrize(("scenario", "seconds", "rate", "budget"), [
+    ("paper_10khz.toml", 20.0, 10_000.0, None),  # 200001 controller samples held whole: 40 MB
+    ("paper.toml", 40.0, 100.0, None),           # 1108001 steps, chunks of 262144: 65.5 MB
+    ("paper.toml", 40.0, 100.0, 20 << 20),       # chunks of 83886 steps: 21 MB
+], ids=["sampled-whole", "continuous-chunk", "continuous-chunk-in-a-budget"])
+def test_a_runs_estimate_bounds_its_memory_within_its_margin(tmp_path, scenario, seconds, rate,
+                                                             budget):
     """The run under an address-space limit of its estimate above a warmed process (main's
     chunk estimate, 160 B a sample, was below the 200-211 traced), and the estimate at most
     40 % above the traced peak (measured 1.19 for the sampled run, 1.19-1.25 for a chunk)."""
@@ -147,8 +164,8 @@ def test_a_runs_estimate_bounds_its_memory_within_its_margin(tmp_path, scenario,
     script = tmp_path / "run.py"
     script.write_text(RUN_SCRIPT)
     proc = subprocess.run([sys.executable, str(script), str(EXAMPLES / scenario), str(seconds),
-                           str(rate)], capture_output=True, text=True, env=environment(),
-                          timeout=600)
+                           str(rate), *([] if budget is None else [str(budget)])],
+                          capture_output=True, text=True, env=environment(), timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
     steps, estimate, traced = (int(x) for x in proc.stdout.split())
     assert steps == (200_001 if "10khz" in scenario else 1_108_001)

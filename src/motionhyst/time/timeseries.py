@@ -23,7 +23,7 @@ from typing import IO, TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from motionhyst.core.budget import check_memory
+from motionhyst.core.budget import check_memory, max_memory
 from motionhyst.core.textfiles import csv_header, csv_rows
 from motionhyst.time.references import PointToPoint, SampledReference, SineReference
 from motionhyst.time.steps import (
@@ -50,7 +50,11 @@ ROWS_PER_CHUNK = 8192
 """Output rows computed and written at a time."""
 
 MAX_CHUNK = 1 << 18
-"""Most integration samples computed at a time (about 55 MB), however many a row holds."""
+"""Most integration samples computed at a time (65.5 MB as sized, 52.5 traced), however many a
+row holds."""
+
+MIN_CHUNK = 4096
+"""Fewest integration samples computed at a time where the memory budget holds no more."""
 
 CHUNK_SAMPLE_BYTES = 250
 """Memory of :func:`run_time_series` (a continuous loop) per integration sample of a chunk: the
@@ -119,13 +123,45 @@ def reference_rate_hz(reference: SampledReference) -> float:
     return 1.0 / float(np.median(np.diff(reference.t)))
 
 
+def time_series_chunk(steps: int, per_row: int) -> int:
+    """Integration samples :func:`run_time_series` computes at a time for a continuous loop:
+    the samples of :data:`ROWS_PER_CHUNK` rows, at most :data:`MAX_CHUNK`, and no more than
+    the memory budget holds (:data:`CHUNK_SAMPLE_BYTES` a sample; at least
+    :data:`MIN_CHUNK`), so that a long run is written in smaller pieces rather than refused.
+
+    Parameters
+    ----------
+    steps : int
+        Integration samples of the run.
+    per_row : int
+        Samples a row (:func:`~motionhyst.time.steps.time_series_grid`).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> from motionhyst.core.budget import set_max_memory
+    >>> set_max_memory(1 << 30)
+    >>> time_series_chunk(3_000_001, 3), time_series_chunk(3_000_001, 277)
+    (24576, 262144)
+    >>> set_max_memory(20 << 20)                     # 20 MB hold 83886 samples
+    >>> time_series_chunk(3_000_001, 277)
+    83886
+    >>> set_max_memory(None)
+    """
+    fit = max(MIN_CHUNK, int(max_memory() // CHUNK_SAMPLE_BYTES))
+    return max(1, min(int(steps), int(per_row) * ROWS_PER_CHUNK, MAX_CHUNK, fit))
+
+
 def check_time_series_memory(steps: int, per_row: int, sampled: bool,
                              remedy: str = RUN_REMEDY) -> None:
     """Refuse, before it starts, a run of :func:`run_time_series` whose memory is above the
-    budget: a continuous loop's run is computed a chunk at a time (at most
-    :data:`MAX_CHUNK` samples, :data:`CHUNK_SAMPLE_BYTES` each); a
-    sampled controller's is held whole
-    (:data:`~motionhyst.time.steps.SAMPLED_SAMPLE_BYTES` a controller sample).
+    budget: a continuous loop's run is computed a chunk at a time
+    (:func:`time_series_chunk`, :data:`CHUNK_SAMPLE_BYTES` a sample: refused only where
+    the budget holds less than :data:`MIN_CHUNK` samples); a sampled controller's is held
+    whole (:data:`~motionhyst.time.steps.SAMPLED_SAMPLE_BYTES` a controller sample).
 
     Parameters
     ----------
@@ -147,7 +183,7 @@ def check_time_series_memory(steps: int, per_row: int, sampled: bool,
     --------
     >>> from motionhyst.core.budget import set_max_memory
     >>> set_max_memory(100 << 20)
-    >>> check_time_series_memory(3_000_001, 3, sampled=False)   # in chunks: 6.1 MB
+    >>> check_time_series_memory(30_000_001, 277, sampled=False)   # in chunks of 65.5 MB
     >>> try:
     ...     check_time_series_memory(1_000_001, 1, sampled=True)
     ... except ValueError as exc:
@@ -160,7 +196,7 @@ of 105 MB (--max-memory); shorten the duration or lower the reference's frequenc
         nbytes, what = SAMPLED_SAMPLE_BYTES * float(steps), f"{steps} controller samples " \
             "(held whole)"
     else:
-        chunk = min(int(steps), per_row * ROWS_PER_CHUNK, MAX_CHUNK)
+        chunk = time_series_chunk(steps, per_row)
         nbytes, what = CHUNK_SAMPLE_BYTES * float(chunk), f"{steps} time steps ({chunk} at a time)"
     with a_run():
         check_memory(nbytes, f"a run of {what}", remedy)
@@ -290,7 +326,7 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
         csv_header(out, COLUMNS)
     rows = 0
     steps = 0
-    chunk = min(per_row * ROWS_PER_CHUNK, MAX_CHUNK)  # memory bounded, whatever per_row
+    chunk = time_series_chunk((n_rows - 1) * per_row + 1, per_row)  # within the budget
     from motionhyst.time.simulation import simulate_chunks
 
     for piece in simulate_chunks(loop, reference, end, dt=step, chunk=chunk):
@@ -354,4 +390,5 @@ def _write_rows(out: IO[str] | None, piece: Simulation, per_row: int, first_samp
 
 
 __all__ = ["CHUNK_SAMPLE_BYTES", "COLUMNS", "DEFAULT_OUTPUT_RATE_HZ", "DEFAULT_SETTLE_BAND",
-           "check_time_series_memory", "dynamics_step", "reference_rate_hz", "run_time_series"]
+           "MIN_CHUNK", "check_time_series_memory", "dynamics_step", "reference_rate_hz",
+           "run_time_series", "time_series_chunk"]
