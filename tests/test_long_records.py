@@ -150,7 +150,7 @@ def test_predict_needs_the_record_and_one_block_not_the_whole_upsampled_record(t
                                                                                 monkeypatch,
                                                                                 capsys):
     """20000 samples of 500 steps: 101 MB upsampled at once (10 bytes a step), above
-    --max-memory 70M; in blocks of 4194 samples 46.5 MB (22 bytes a step): predicted, the
+    --max-memory 70M; in blocks of 4194 samples 44.4 MB (21 bytes a step): predicted, the
     numbers of the whole record's run."""
     u = _force(20000)
     t = np.arange(u.size) / FS

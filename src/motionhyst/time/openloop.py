@@ -119,11 +119,11 @@ FINE_BYTES = 48
 """Memory of one integration step of an open-loop run: fine input, midpoints, output [bytes]."""
 SAMPLE_BYTES = 64
 """Memory of one record sample of an open-loop run: time, force, output and their copies [bytes]."""
-REST_NODE_BYTES = 22
+REST_NODE_BYTES = 21
 """Memory of one integration step of an open-loop run from rest, the record's force at the
 steps of one block at a time [bytes] (measured, traced, blocks of 2.1e6 steps: 16.6 a step
 for Jenkins on an axis at 20 and 100 substeps, 17.5-18.7 for Bouc-Wen on a two-mass stage by
-RK4; 9-13 for a record upsampled in one block; 18-33 % above the blocks')."""
+RK4, in blocks or one; 12-27 % above)."""
 REST_SAMPLE_BYTES = 20
 """Memory of one record sample of an open-loop run from rest: time, force, output [bytes]
 (measured: 16 traced; 25 % above)."""
