@@ -77,9 +77,10 @@ def test_a_sampled_loops_run_of_a_reference_file_is_refused_for_its_memory(
 
 def test_a_continuous_loops_run_is_written_in_chunks_the_budget_holds(tmp_path, capsys,
                                                                       monkeypatch):
-    """Table I's loop computes a run a chunk at a time: 100 s of a 100 Hz reference (2770001
+    """Table I's loop computes a run a chunk at a time: 10 s of a 100 Hz reference (277001
     steps, 277 a row) at ``--max-memory 20M`` runs in chunks of 83886 steps (20 MB at 250
-    bytes a step) instead of 262144 (65.5 MB): not refused, nor above the budget."""
+    bytes a step) instead of 262144 (65.5 MB): not refused, nor above the budget (fe53321's
+    parent refused it: "a run of 277001 time steps (262144 at a time) needs 65.5 MB")."""
     from motionhyst.time import simulation
 
     seen = []
