@@ -77,8 +77,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.core.blas import few_blas_threads
-from motionhyst.core.budget import check_memory
 from motionhyst.core.lti import TWO_PI
+from motionhyst.plants._frf_problem import DAMPING_BOUNDS, FREQ_BOUNDS, FrfProblem, candidates
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.modal import ModalPlant, Mode
 from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
@@ -87,177 +87,8 @@ __all__ = ["FrfFit", "ModalPlant", "Mode", "fit_frf"]
 
 #: Largest number of modes the automatic choice tries.
 MAX_MODES = 6
-#: Damping ratios and frequency density of the start's scan.
-_SCAN_DAMPING = (0.001, 0.003, 0.01, 0.03, 0.1, 0.2)
-_SCAN_PER_DECADE = 50
 #: Most measured lines a fit uses: a denser response is thinned (:func:`thin_lines`).
 MAX_FIT_LINES = 1000
-#: Bytes the start's scan holds per line and candidate mode (its complex and real arrays).
-_SCAN_BYTES = 136
-#: Bounds of a fitted mode: damping ratio, and frequency relative to the measured range.
-DAMPING_BOUNDS = (1e-5, 1.0)
-_FREQ_BOUNDS = (0.5, 10.0)
-
-
-# ------------------------------------------------------------------------------------ fitting
-class _Problem:
-    """Relative complex residuals of P1 and P2 and their Jacobian (real and imaginary parts).
-
-    The parameters are ``ln M`` (unless the mass is given), the delay ``tau``
-    [s] (when it is fitted) and ``ln w, ln z, r1, r2`` of each mode.  The
-    delay is divided out of the data, ``(P_model - P_data e^{s tau}) /
-    |P_data|``, which has the modulus of ``(P_model e^{-s tau} - P_data) /
-    |P_data|``: the model itself stays the mechanics.
-    """
-
-    def __init__(self, f, p1, p2, mass, fit_delay: bool = False):
-        self.f = f
-        self.s = 1j * TWO_PI * f
-        self.p1, self.p2 = p1, p2
-        self.w1, self.w2 = 1.0 / np.abs(p1), 1.0 / np.abs(p2)
-        self.mass = mass
-        self.fit_delay = fit_delay
-        self.n_head = int(mass is None) + int(fit_delay)
-
-    def unpack(self, x: NDArray[np.float64], n: int):
-        """``M, tau, w, z, r1, r2`` from the parameter vector `x` of `n` modes."""
-        k = 0
-        if self.mass is None:
-            M, k = float(np.exp(x[0])), 1
-        else:
-            M = self.mass
-        tau = 0.0
-        if self.fit_delay:
-            tau, k = float(x[k]), k + 1
-        p = x[k:].reshape(n, 4) if n else np.zeros((0, 4))
-        return M, tau, np.exp(p[:, 0]), np.exp(p[:, 1]), p[:, 2], p[:, 3]
-
-    def pack(self, M, tau, wn, z, r1, r2) -> NDArray[np.float64]:
-        """The parameter vector of :meth:`unpack`."""
-        head = [np.log(M)] if self.mass is None else []
-        head += [tau] if self.fit_delay else []
-        body = np.column_stack([np.log(wn), np.log(z), r1, r2]).ravel() if len(wn) else []
-        return np.concatenate([head, body])
-
-    def data(self, tau: float):
-        """The measured ``P1``, ``P2`` with the delay `tau` divided out, ``P e^{s tau}``."""
-        if tau == 0.0:
-            return self.p1, self.p2
-        rot = np.exp(self.s * tau)
-        return self.p1 * rot, self.p2 * rot
-
-    def model(self, x, n):
-        M, tau, wn, z, r1, r2 = self.unpack(x, n)
-        s = self.s[:, None]
-        g = 1.0 / (s**2 + 2 * z * wn * s + wn**2)
-        pr = 1.0 / (M * self.s**2)
-        return pr + g @ r1, pr - g @ r2, g, M, tau, wn, z, r1, r2
-
-    def residuals(self, x, n):
-        m1, m2, _, _, tau, *_ = self.model(x, n)
-        d1, d2 = self.data(tau)
-        c = np.concatenate([(m1 - d1) * self.w1, (m2 - d2) * self.w2])
-        return np.concatenate([c.real, c.imag])
-
-    def jacobian(self, x, n):
-        _, _, g, M, tau, wn, z, r1, r2 = self.model(x, n)
-        s = self.s[:, None]
-        nf = self.f.size
-        cols = []
-        zero = np.zeros(nf, complex)
-        if self.mass is None:
-            dpr = -1.0 / (M * self.s**2)  # d/d ln M
-            cols.append(np.concatenate([dpr * self.w1, dpr * self.w2]))
-        if self.fit_delay:
-            d1, d2 = self.data(tau)  # d/d tau of -P_data e^{s tau}
-            cols.append(np.concatenate([-self.s * d1 * self.w1, -self.s * d2 * self.w2]))
-        dg_dlnw = -(2 * z * wn * s + 2 * wn**2) * g**2
-        dg_dlnz = -(2 * z * wn * s) * g**2
-        for i in range(n):
-            cols.append(np.concatenate([r1[i] * dg_dlnw[:, i] * self.w1,
-                                        -r2[i] * dg_dlnw[:, i] * self.w2]))
-            cols.append(np.concatenate([r1[i] * dg_dlnz[:, i] * self.w1,
-                                        -r2[i] * dg_dlnz[:, i] * self.w2]))
-            cols.append(np.concatenate([g[:, i] * self.w1, zero]))
-            cols.append(np.concatenate([zero, -g[:, i] * self.w2]))
-        J = np.array(cols).T
-        return np.vstack([J.real, J.imag])
-
-    def _fixed(self, wn, z, taus):
-        """Columns of the linear parameters for fixed poles, and the data (one column per delay)."""
-        s = self.s[:, None]
-        nf = self.f.size
-        fixed = []
-        if self.mass is None:
-            fixed.append(np.concatenate([self.w1 / self.s**2, self.w2 / self.s**2]))
-        g = 1.0 / (s**2 + 2 * z * wn * s + wn**2)
-        zero = np.zeros(nf, complex)
-        for i in range(wn.size):
-            fixed.append(np.concatenate([g[:, i] * self.w1, zero]))
-            fixed.append(np.concatenate([zero, -g[:, i] * self.w2]))
-        ys = []
-        for tau in taus:
-            d1, d2 = self.data(tau)
-            y = np.concatenate([d1 * self.w1, d2 * self.w2])
-            if self.mass is not None:
-                pr = 1.0 / (self.mass * self.s**2)
-                y = y - np.concatenate([self.w1 * pr, self.w2 * pr])
-            ys.append(np.concatenate([y.real, y.imag]))
-        F = np.array(fixed).T if fixed else np.zeros((2 * nf, 0), complex)
-        return np.vstack([F.real, F.imag]), np.array(ys).T
-
-    def linear_start(self, wn, z, extra=None, tau: float = 0.0):
-        """Solve ``1/M`` and the residues for fixed poles; with `extra` candidate poles scanned.
-
-        Returns ``(rss, a, r1, r2)`` for the fixed poles alone, or the index of the
-        best candidate and its solution when `extra = (wn_c, z_c)` arrays are given.
-        The data are taken with the delay `tau` divided out.
-        """
-        best, rss, coef = self._scan(wn, z, extra, (tau,))
-        return (float(rss[0]), coef) if extra is None else (int(best[0]), float(rss[0]))
-
-    def _scan(self, wn, z, extra, taus):
-        """:meth:`linear_start` for every delay in `taus` at once: best candidates and RSS."""
-        Fr, Y = self._fixed(wn, z, taus)
-        if Fr.shape[1]:
-            Q, _ = np.linalg.qr(Fr)
-        else:
-            Q = np.zeros((Y.shape[0], 0))
-        if Y.shape[1] == 1:
-            y = Y[:, 0]
-            y_perp = (y - Q @ (Q.T @ y))[:, None]
-        else:
-            y_perp = Y - Q @ (Q.T @ Y)
-        rss0 = np.einsum("rt,rt->t", y_perp, y_perp)
-        if extra is None:
-            coef = np.linalg.lstsq(Fr, Y[:, 0], rcond=None)[0] if Fr.shape[1] else np.zeros(0)
-            return None, rss0, coef
-        s = self.s[:, None]
-        wc, zc = extra
-        check_memory(_SCAN_BYTES * s.size * np.size(wc), f"the scan of {np.size(wc)} candidate "
-                     f"modes over {s.size} lines", "thin the measured lines")
-        gc = 1.0 / (s**2 + 2 * zc * wc * s + wc**2)  # (nf, ncand)
-        g1, g2 = gc * self.w1[:, None], -gc * self.w2[:, None]
-        zr = np.zeros_like(g1.real)
-        G1 = np.concatenate([g1.real, zr, g1.imag, zr])  # rows ordered as the data
-        G2 = np.concatenate([zr, g2.real, zr, g2.imag])
-        if Q.shape[1]:
-            # einsum, not BLAS: thin products, where BLAS threads only add overhead
-            G1 -= np.einsum("rk,kc->rc", Q, np.einsum("rk,rc->kc", Q, G1))
-            G2 -= np.einsum("rk,kc->rc", Q, np.einsum("rk,rc->kc", Q, G2))
-        a11 = np.einsum("rc,rc->c", G1, G1)
-        a22 = np.einsum("rc,rc->c", G2, G2)
-        a12 = np.einsum("rc,rc->c", G1, G2)
-        if Y.shape[1] == 1:
-            b1, b2 = (y_perp[:, 0] @ G1)[None, :], (y_perp[:, 0] @ G2)[None, :]
-        else:
-            b1, b2 = y_perp.T @ G1, y_perp.T @ G2  # (ntau, ncand)
-        det = a11 * a22 - a12**2
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gain = (a22 * b1**2 - 2 * a12 * b1 * b2 + a11 * b2**2) / det
-        gain[~np.isfinite(gain)] = -np.inf
-        best = np.argmax(gain, axis=1)
-        return best, rss0 - gain[np.arange(best.size), best], None
 
 
 def thin_lines(f: NDArray[np.float64], p1: NDArray[np.complex128], p2: NDArray[np.complex128],
@@ -307,24 +138,14 @@ def thin_lines(f: NDArray[np.float64], p1: NDArray[np.complex128], p2: NDArray[n
     return np.unique(np.concatenate(keep))
 
 
-def _candidates(f: NDArray[np.float64]):
-    """Poles of the start's scan: frequencies and damping ratios (flattened grid)."""
-    lo, hi = f.min() * _FREQ_BOUNDS[0], f.max() * 3.0
-    n_grid = int(np.ceil(_SCAN_PER_DECADE * np.log10(hi / lo))) + 1
-    wc = TWO_PI * np.geomspace(lo, hi, n_grid)
-    zc = np.asarray(_SCAN_DAMPING)
-    W, Z = (a.ravel() for a in np.meshgrid(wc, zc))
-    return W, Z
-
-
-def _start(prob: _Problem, x_prev, n_prev, tau: float | None = None):
+def _start(prob: FrfProblem, x_prev, n_prev, tau: float | None = None):
     """Add one mode to the solution `x_prev` with `n_prev` modes by the separable scan.
 
     The data are taken with the delay of `x_prev` divided out, or with `tau` when given.
     """
     _, tau_prev, wn, z, _, _ = prob.unpack(x_prev, n_prev)
     tau = tau_prev if tau is None else tau
-    W, Z = _candidates(prob.f)
+    W, Z = candidates(prob.f)
     best, _ = prob.linear_start(wn, z, (W, Z), tau=tau)
     wn2, z2 = np.append(wn, W[best]), np.append(z, Z[best])
     _, coef = prob.linear_start(wn2, z2, tau=tau)
@@ -343,7 +164,7 @@ _DELAY_STEP_RAD = 0.1
 _DELAY_SCAN_TURNS = 3.0
 
 
-def _delay_start(prob: _Problem) -> float:
+def _delay_start(prob: FrfProblem) -> float:
     """The delay [s] at which a rigid body plus one mode (the scan of :func:`_start`) fits best.
 
     Every delay of a grid (phase steps of 0.1 rad at the highest measured line,
@@ -353,13 +174,13 @@ def _delay_start(prob: _Problem) -> float:
     """
     w_max = TWO_PI * prob.f.max()
     taus = np.arange(0.0, _DELAY_SCAN_TURNS * TWO_PI, _DELAY_STEP_RAD) / w_max
-    _, rss, _ = prob._scan(np.zeros(0), np.zeros(0), _candidates(prob.f), taus)
+    _, rss, _ = prob._scan(np.zeros(0), np.zeros(0), candidates(prob.f), taus)
     return float(taus[int(np.argmin(rss))])
 
 
-def _bounds(prob: _Problem, n: int):
-    w_lo = TWO_PI * prob.f.min() * _FREQ_BOUNDS[0]
-    w_hi = TWO_PI * prob.f.max() * _FREQ_BOUNDS[1]
+def _bounds(prob: FrfProblem, n: int):
+    w_lo = TWO_PI * prob.f.min() * FREQ_BOUNDS[0]
+    w_hi = TWO_PI * prob.f.max() * FREQ_BOUNDS[1]
     lo = [-np.inf] if prob.mass is None else []
     hi = [np.inf] if prob.mass is None else []
     if prob.fit_delay:
@@ -371,7 +192,7 @@ def _bounds(prob: _Problem, n: int):
     return np.array(lo), np.array(hi)
 
 
-def _solve(prob: _Problem, x0, n):
+def _solve(prob: FrfProblem, x0, n):
     lo, hi = _bounds(prob, n)
     x0 = np.clip(x0, np.nextafter(lo, hi), np.nextafter(hi, lo))
     if x0.size == 0:
@@ -685,7 +506,7 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
             raise ValueError(f"{f.size} measured lines cannot determine {modes} modes "
                              f"({n_fixed + 4 * modes} parameters from {n_res} real values; "
                              f"at least twice as many values as parameters are needed)")
-    prob = _Problem(f, p1, p2, mass)
+    prob = FrfProblem(f, p1, p2, mass)
     if mass is None:
         # start: the rigid body of the lowest decade, -1 / (omega^2 Re P), both transfers
         low = f <= f[0] * 10.0
@@ -701,7 +522,7 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     n_best = _choose(bic, modes)
     chosen, other = (prob, fits, bic, n_best), {}
     if delay is None:
-        probd = _Problem(f, p1, p2, mass, fit_delay=True)
+        probd = FrfProblem(f, p1, p2, mass, fit_delay=True)
         tau0 = _delay_start(probd)
         fits_d, bic_d = _chain(probd, np.append(x, tau0), n_res, modes, max_modes, tau0)
         other = bic_d
@@ -726,7 +547,7 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     return fit
 
 
-def _chain(prob: _Problem, x0, n_res: int, modes: int | None, max_modes: int,
+def _chain(prob: FrfProblem, x0, n_res: int, modes: int | None, max_modes: int,
            tau_first: float | None = None):
     """Fits with 0, 1, 2, ... modes, each started from the one before (module docstring).
 
@@ -762,7 +583,7 @@ def _choose(bic: dict, modes: int | None) -> int:
     return modes if modes is not None else min(bic, key=lambda k: (bic[k], k))
 
 
-def _result(prob: _Problem, x, n, rss, criterion, bic, source) -> FrfFit:
+def _result(prob: FrfProblem, x, n, rss, criterion, bic, source) -> FrfFit:
     M, tau, wn, z, r1, r2 = prob.unpack(x, n)
     n_res = 4 * prob.f.size
     n_par = x.size
