@@ -83,7 +83,7 @@ from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.modal import ModalPlant, Mode
 from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
 
-__all__ = ["FrfFit", "ModalPlant", "Mode", "fit_frf"]
+__all__ = ["FrfFit", "ModalPlant", "Mode", "determined_modes", "fit_frf"]
 
 #: Largest number of modes the automatic choice tries.
 MAX_MODES = 6
@@ -620,6 +620,83 @@ def _result(prob: FrfProblem, x, n, rss, criterion, bic, source) -> FrfFit:
     e1, e2 = fit.relative_errors()
     fit.rms_relative_error = float(np.sqrt(np.mean(np.concatenate([e1, e2]) ** 2)))
     return fit
+
+
+#: A fitted mode is seen by the lines when it changes ``P1`` or ``P2`` at one of them by more
+#: than this many times the data's noise (:func:`determined_modes`); a peak narrower than the
+#: lines resolve, next to them, needs :data:`NEEDLE_SEEN_RATIO` times.
+SEEN_RATIO = 5.0
+NEEDLE_SEEN_RATIO = 50.0
+
+
+def determined_modes(fit: FrfFit) -> list[bool]:
+    """Whether the measured lines determine each fitted mode (in the order of ``fit.plant.modes``).
+
+    A mode is determined when its collocated residue ``r1`` (how strongly the
+    force moves it) stands more than one standard deviation from zero, and
+    when it changes the response at one of the lines, ``max |r g(w)| / |P|``
+    over ``P1`` and ``P2``, by more than :data:`SEEN_RATIO` times the data's
+    noise (the fit's RMS complex relative error, counted over the values the
+    parameters leave free).  A "needle", a peak narrower than the lines
+    resolve (its half-power band ``2 z f`` narrower than the distance to the
+    nearest line) next to them (that distance below the spacing of the lines
+    there), is what the scan of candidate poles places between or beside
+    lines to fit their noise: it must change a line by
+    :data:`NEEDLE_SEEN_RATIO` times the noise.  The lowest 3-12 lines of a
+    stage resonating at 695 Hz, with 0.5 % noise, gave needles at 0.9-4 Hz
+    changing a line by 0.3-1.6 %, 2-16 times the noise; the stage's mode,
+    between two lines 90 Hz apart, changes them by 19 times the response,
+    thousands of times the noise.  A mode beyond the lines by more than their
+    spacing is seen through its compliance ``r / w^2`` alone: its damping
+    does not matter there.
+
+    Parameters
+    ----------
+    fit : FrfFit
+        A fit of :func:`fit_frf`.
+
+    Returns
+    -------
+    list of bool
+        One per mode of ``fit.plant.modes``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.plants.frf_fit import ModalPlant, determined_modes, fit_frf
+    >>> from motionhyst.plants.two_mass import TwoMassStage
+    >>> stage = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7))
+    >>> f = np.geomspace(1.0, 3000.0, 60)
+    >>> p1, p2 = stage.response(2 * np.pi * f)
+    >>> noise = 1 + 0.005 * np.random.default_rng(0).standard_normal((2, f.size))
+    >>> determined_modes(fit_frf(f, p1 * noise[0], p2 * noise[1]))
+    [True]
+    >>> fit = fit_frf(f[:3], p1[:3] * noise[0, :3], p2[:3] * noise[1, :3])  # 1-1.3 Hz
+    >>> [round(m.frequency_hz, 2) for m in fit.plant.modes], determined_modes(fit)
+    ([1.23], [False])
+    """
+    p, f = fit.plant, fit.frequency_hz
+    if not p.modes:
+        return []
+    c1, c2 = fit._complex_errors()
+    n_par = int(not fit.mass_given) + int(fit.delay_s > 0 and not fit.delay_given) \
+        + 4 * len(p.modes)
+    rss = float(np.sum(np.abs(c1) ** 2 + np.abs(c2) ** 2))  # of the 4 f.size real residuals
+    noise = np.sqrt(2.0 * rss / max(4 * f.size - n_par, 1))  # complex, per value
+    s = 1j * TWO_PI * f
+    out = []
+    for m, std in zip(p.modes, fit.mode_std, strict=True):
+        w = TWO_PI * m.frequency_hz
+        g = 1.0 / (s**2 + 2.0 * m.damping * w * s + w**2)
+        share = max(float(np.max(np.abs(m.r1 * g) / np.abs(fit.P1_data))),
+                    float(np.max(np.abs(m.r2 * g) / np.abs(fit.P2_data))))
+        i = int(np.clip(np.searchsorted(f, m.frequency_hz), 1, max(f.size - 1, 1)))
+        spacing = float(f[i] - f[i - 1]) if f.size > 1 else np.inf
+        near = float(np.min(np.abs(f - m.frequency_hz)))
+        needle = 2.0 * m.damping * m.frequency_hz < near < spacing
+        ratio = NEEDLE_SEEN_RATIO if needle else SEEN_RATIO
+        out.append(bool(std["r1"] < abs(m.r1) and share > ratio * noise))
+    return out
 
 
 #: A band's RMS error this many times the line-to-line scatter of its errors is far above

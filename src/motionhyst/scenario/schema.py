@@ -69,21 +69,6 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
     from motionhyst.time.openloop import OpenLoop
 
 
-def _is_determined(mode, std: dict) -> bool:
-    """Whether the lines determine a fitted mode: its collocated residue ``r1`` (how strongly
-    the force moves it) is more than one standard deviation from zero.  The lowest 30 lines
-    (1-51 Hz) of a stage resonating at 695 Hz gave a "mode" at 152 Hz (r1 0.0072 +- 0.024
-    1/kg), the lowest 3 of another one at 1.313 Hz (r1 1.7e-05 +- 4e-05 1/kg) and a 395 us
-    delay, and the analysis ran on them."""
-    return bool(std["r1"] < abs(mode.r1))
-
-
-def _determined_modes(fit) -> int:
-    """How many of `fit`'s modes the lines determine (:func:`_is_determined`)."""
-    return sum(_is_determined(mode, std)
-               for mode, std in zip(fit.plant.modes, fit.mode_std, strict=True))
-
-
 class Scenario:
     """A validated scenario; builds the loop and holds the reference.
 
@@ -252,7 +237,13 @@ class Scenario:
             raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
         # imported once the data are read (a bad file is refused before it loads), and for
         # a measured plant only: a [stage] needs neither the fit nor python-control
-        from motionhyst.plants.frf_fit import ABOVE_NOISE, fit_measured_plant
+        from motionhyst.plants.frf_fit import (
+            ABOVE_NOISE,
+            NEEDLE_SEEN_RATIO,
+            SEEN_RATIO,
+            determined_modes,
+            fit_measured_plant,
+        )
         if m.plant.use == "data":
             # the data's resolution: their scatter around the rigid body + modes fit
             try:
@@ -267,7 +258,10 @@ class Scenario:
                                            delay=m.plant.delay)
             if m.plant.modes is None:  # the BIC's modes, less those the lines do not determine
                 chosen = len(self._fit.plant.modes)
-                while (n := _determined_modes(self._fit)) < len(self._fit.plant.modes):
+                while (n := sum(determined_modes(self._fit))) < len(self._fit.plant.modes):
+                    # one mode is tried before none: the BIC may split a mode the lines
+                    # determine into two, each undetermined alone
+                    n = max(n, 1) if len(self._fit.plant.modes) > 1 else 0
                     self._fit = fit_measured_plant(data, modes=n, mass=m.plant.mass,
                                                    delay=m.plant.delay)
                     self._fit.criterion = self._fit.criterion.replace(
@@ -283,8 +277,10 @@ class Scenario:
                    f"leaves" if 4 * n < 2 * (4 + (m.plant.mass is None)) else
                    f"{n} measured lines ({self._fit.frequency_hz.min():.4g}-"
                    f"{self._fit.frequency_hz.max():.4g} Hz) determine none of the {chosen} "
-                   f"mode(s) the BIC chose (each residue r1 within its standard deviation of "
-                   f"zero), which leaves" if chosen else
+                   f"mode(s) the BIC chose (each with its residue r1 within its standard "
+                   f"deviation of zero, or changing the response at no line by more than "
+                   f"{SEEN_RATIO:g} times the data's noise, {NEEDLE_SEEN_RATIO:g} for a peak "
+                   f"narrower than the lines resolve), which leaves" if chosen else
                    "the data show no flexible mode (the BIC keeps a rigid body alone), which "
                    "leaves")
             raise ScenarioError(f"{self.source}: [plant] file: {f}: {why} a rigid body alone, "
