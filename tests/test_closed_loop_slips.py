@@ -34,7 +34,7 @@ from motionhyst import (
     simulate,
 )
 from motionhyst.identify import closed_loop, identify_closed_loop
-from motionhyst.identify._link_checks import check_link, light_link_force
+from motionhyst.identify._inferred_force_checks import check_link, light_link_force
 
 RATE = 10_000.0  # the records' sampling rate [Hz]
 

@@ -13,7 +13,7 @@ from scipy.signal import butter
 
 from motionhyst.core.lti import TWO_PI, HoldFilter, tf_poly
 from motionhyst.core.sampling import HeldInputFilter
-from motionhyst.identify._link_checks import check_link, likely_cause
+from motionhyst.identify._inferred_force_checks import check_link, likely_cause
 from motionhyst.identify.fit import (
     EXTRA_ORDER,
     MAX_ELEMENTS,

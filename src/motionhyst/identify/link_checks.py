@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from motionhyst.identify._link_checks import check_link, light_link_force, likely_cause
+from motionhyst.identify._inferred_force_checks import check_link, light_link_force, likely_cause
 
 __all__ = ["HELD_SHARE", "MIN_HELD_STEPS", "check_closed_loop_link", "check_not_held",
            "held_rows"]
