@@ -322,12 +322,16 @@ def test_toml_syntax_error(capsys, tmp_path):
 
 # ---------------------------------------------------------- entry point
 def test_console_script_entry_point_is_main():
-    """The console script runs :func:`motionhyst.cli.main` through :mod:`motionhyst.entry`,
-    which handles signals before the command line interface is imported."""
+    """The console script runs :func:`motionhyst.cli.main` through :mod:`_motionhyst_entry`,
+    which handles signals before the package and its command line interface are imported;
+    :mod:`motionhyst.entry` (an older install's console script) is the same function."""
+    import _motionhyst_entry
+
+    with open(Path(__file__).parent.parent / "pyproject.toml", "rb") as f:
+        assert tomllib.load(f)["project"]["scripts"] == {"motionhyst": "_motionhyst_entry:main"}
     eps = [ep for ep in metadata.entry_points(group="console_scripts") if ep.name == "motionhyst"]
     assert len(eps) == 1
-    assert eps[0].value == "motionhyst.entry:main"
-    assert eps[0].load() is entry.main
+    assert eps[0].load() is entry.main is _motionhyst_entry.main
 
 
 def test_module_runs_as_script(tmp_path):
