@@ -321,3 +321,29 @@ def test_folder_moves_nothing_until_everything_is_staged(tmp_path):
     assert folder.written == ["report.md"]  # staged, unnamed until finish
     folder.abandon()
     assert sorted(os.listdir(out)) == sorted([*NAMES, MANIFEST])
+
+
+LONG = "x" * 300
+"""A name longer than any common file system's 255 bytes."""
+
+
+@pytest.mark.parametrize(("argv", "option"), [
+    (["simulate", "--time-series", f"{LONG}.csv", "--frequency", "10"], "--time-series"),
+    (["simulate", "--time-series", f"sub/{LONG}/t.csv", "--frequency", "10"], "--time-series"),
+    (["reproduce", "--out", LONG], "--out"),
+    (["stability", "--figure", f"{LONG}.png"], "--figure"),
+    (["study", "--out", f"{LONG}.zarr"], "--out"),
+])
+def test_an_output_name_too_long_is_refused_naming_its_option(tmp_path, capsys, monkeypatch,
+                                                              argv, option):
+    """A file name longer than the file system takes is refused before the work, in one line
+    that names the option and the limit (main f318d46: 'xxx...csv: File name too long', the
+    option named only when the long part was a folder)."""
+    from motionhyst.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"motionhyst: error: {option} "), err
+    assert "more than the 255 the file system allows; give a shorter one" in err
+    assert list(tmp_path.iterdir()) == []

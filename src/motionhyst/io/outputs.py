@@ -162,6 +162,20 @@ def _label(path: Path | str, option: str | None) -> str:
     return f"{option} {path}" if option else str(path)
 
 
+def _check_name(path: str | os.PathLike, label: str) -> None:
+    """Each part of `path` within the file system's longest name, the whole within its longest
+    path (else the system's "File name too long" would name no option)."""
+    try:
+        most = os.pathconf(os.path.dirname(os.path.abspath(path)), "PC_NAME_MAX")
+    except (OSError, ValueError):  # a folder still to be made: the usual limit
+        most = 255
+    longest = max((len(os.fsencode(part)) for part in Path(path).parts), default=0)
+    if longest > most or len(os.fsencode(os.path.abspath(path))) >= 4096:
+        what = (f"a name of {longest} bytes, more than the {most} the file system allows"
+                if longest > most else "a path longer than the system allows (4096 bytes)")
+        raise OutputError(f"{label}: {what}; give a shorter one")
+
+
 def _check_parents(path: Path, label: str) -> None:
     """The nearest existing folder above `path` is a folder we may write in."""
     for parent in path.parents:
@@ -252,6 +266,7 @@ def check_output_folder(path: str | os.PathLike, option: str, force: bool = Fals
     label = _label(path, option)
     if str(path) in ("", "-"):
         raise OutputError(f"{label}: not a folder name")
+    _check_name(path, label)
     path = Path(path)
     if _replaceable_link(path, label, force):
         return
@@ -430,6 +445,7 @@ class OutputFile:
         if self.path.suffix.lower() == ".mat":  # every reader takes a .mat name for MATLAB
             raise OutputError(f"{label}: motionhyst writes no MATLAB file, and a .mat name is "
                               f"read back as one; give another name")
+        _check_name(self.path, label)
         check_not_input(self.path, inputs, option)
         self.target = self.path
         if self.path.is_symlink():
@@ -676,6 +692,7 @@ class OutputFolder:
         label = f"{option} {self.path}"
         if str(path) in ("", "-"):
             raise OutputError(f"{label}: not a folder name")
+        _check_name(self.path, label)
         for name in self.names:
             if Path(name).name != name or name in ("", ".", "..", MANIFEST):
                 raise ValueError(f"not a plain file name: {name!r}")
