@@ -47,7 +47,7 @@ Examples
 >>> est.filtered, round(est.sigma * 1e6, 1), round(est.cutoff_hz, 3)   # um, Hz
 (True, 10.1, 5.859)
 >>> round(float(np.std(noisy - x)) * 1e6, 2), round(float(np.std(x_hat - x)) * 1e6, 2)
-(9.96, 1.13)
+(9.96, 1.24)
 >>> stairs = 1e-3 * np.floor(t)                       # noise-free steps: untouched
 >>> same, est = estimate_displacement(t, stairs)
 >>> same is stairs, est.filtered, est.sigma
@@ -97,6 +97,12 @@ BLOCK_SAMPLES, BLOCK_FACTOR = 256, 1.3
 #: (the Butterworth's step response settles within 1 % in 3 of them), and the fade to the
 #: filtered displacement over one
 RING_PERIODS = 3.0
+#: The slope with which a record goes on beyond each end, before the low-pass: that of a
+#: quadratic over this many periods of the cut-off (a clean sine of 100-400 times its noise,
+#: 300 s at 1 kHz, 24 ends: the removed RMS near the end within 1.21 times the noise's, the
+#: estimate's error there within 0.2 times the noise; the odd reflection about the last sample:
+#: 2.5 times in 12 of them, 'a step'), and over at least this many samples (its noise)
+END_PERIODS, END_SAMPLES = 0.25, 8
 #: A record of which more than this share would be used as measured is used as measured
 MAX_MEASURED_SHARE = 0.5
 #: Records shorter than this many samples are used as they are
@@ -185,7 +191,13 @@ def _lowpass(x: NDArray[np.float64], fs: float, cutoff: float, periodic: bool
              ) -> NDArray[np.float64]:
     """`x` low-passed at `cutoff` without delay: the Butterworth of order :data:`ORDER` run
     forwards and backwards (a periodic record: its magnitude squared applied around the
-    period)."""
+    period).
+
+    The record is extended at each end by three periods of the cut-off so that its value,
+    slope and curvature go on (:func:`_extension`); the odd reflection about the last
+    sample flips the curvature and doubles that sample's noise into a constant, which the
+    filter spread over the record's last seconds (a clean sine with white noise was told to
+    end in 'a step', its last 1.6 % used as measured)."""
     from scipy import signal
 
     if periodic:
@@ -194,7 +206,21 @@ def _lowpass(x: NDArray[np.float64], fs: float, cutoff: float, periodic: bool
         return np.fft.irfft(np.fft.rfft(x) * gain, x.size)
     sos = signal.butter(ORDER, cutoff, fs=fs, output="sos")
     pad = min(x.size - 1, math.ceil(3.0 * fs / cutoff))
-    return signal.sosfiltfilt(sos, x, padtype="odd", padlen=pad)
+    n_end = min(x.size, max(END_SAMPLES, math.ceil(END_PERIODS * fs / cutoff)))
+    head = _extension(x[::-1], n_end, pad)[::-1]
+    tail = _extension(x, n_end, pad)
+    y = signal.sosfiltfilt(sos, np.concatenate([head, x, tail]), padtype=None)
+    return y[pad:pad + x.size]
+
+
+def _extension(x: NDArray[np.float64], n_end: int, pad: int) -> NDArray[np.float64]:
+    """`pad` samples after the end of `x`: `x` reflected about its last sample (even: its
+    curvature goes on, its noise is not doubled) plus twice the slope at the end times the
+    distance (its slope goes on), the slope from a quadratic over its last `n_end` samples."""
+    k = np.arange(1, pad + 1, dtype=float)
+    u = np.arange(-n_end + 1, 1, dtype=float)
+    slope = float(np.polyfit(u, x[-n_end:], 2)[1])
+    return x[-pad - 1:-1][::-1] + 2.0 * slope * k
 
 
 def _removed_share(fs: float, cutoff: float) -> float:
