@@ -9,10 +9,11 @@ interface is imported.  A signal at any moment from then on ends the command as 
 interruption does: ``motionhyst: interrupted`` on stderr, exit code 130.
 
 What comes before is the interpreter's own start (loading itself, its encodings and ``site``:
-15 ms on an idle machine, 40 ms under load), which no code of the command can shorten: until
-the interpreter installs its own Ctrl-C handler, SIGINT and SIGTERM end the process by their
-defaults (a shell reports 130 and 143); from then on to the console script's first line a
-Ctrl-C ends it with the interpreter's traceback, and SIGTERM still by its default.
+15 ms on an idle machine, 40 ms at a load of 13 on 2 cores, 100 ms and more at 20), which no
+code of the command can shorten: until the interpreter installs its own Ctrl-C handler,
+SIGINT and SIGTERM end the process by their defaults (a shell reports 130 and 143); from then
+on to the console script's first line a Ctrl-C ends it with the interpreter's traceback (or,
+in CPython's check of the script's path, is dropped), and SIGTERM still by its default.
 The library never touches signals: only the console script runs this.
 
 Examples
@@ -49,8 +50,8 @@ def main(argv: list[str] | None = None) -> int:
     installed): one that comes before the command's own handlers ends in exit code 130 with
     one line on stderr, also one raised where an exception cannot propagate (a callback of
     the import system's locks, reported to ``sys.unraisablehook``: noted there, not shown,
-    and the command not started).  Once the command has returned its exit code stands.  The handlers
-    found are put back at the end (both signals ignored meanwhile); run as the command
+    and the command not started).  Once the command has returned its exit code stands.  The
+    handlers found are put back at the end (both signals ignored meanwhile); run as the command
     (`argv` None), both stay ignored, as the command leaves them (the interpreter's exit is
     not interrupted).
 
