@@ -13,6 +13,7 @@ from scipy.signal import butter
 
 from motionhyst.core.lti import TWO_PI, HoldFilter, tf_poly
 from motionhyst.core.sampling import HeldInputFilter
+from motionhyst.core.warnings import warn
 from motionhyst.identify._inferred_force_checks import check_link, likely_cause
 from motionhyst.identify.fit import (
     EXTRA_ORDER,
@@ -311,7 +312,9 @@ def _correlated_std(ident: Identification, prob: FitProblem, noise_rms: float
     :class:`~motionhyst.identify.residual_noise.ResidualCorrelation`), and marked as lower
     bounds, with the line that says why, when the fit leaves more than the records' noise
     (:func:`~motionhyst.identify.residual_noise.lower_bound_note`); the fit's own (white
-    residuals') standard errors kept as ``judged_std``, what judges a slip force determined."""
+    residuals') standard errors kept as ``judged_std``, what judges a slip force determined;
+    a value its widened standard error exceeds where the white one does not is warned
+    (:meth:`~motionhyst.identify.result.Identification.widened_note`)."""
     n = ident.n_elements
     r, J = residuals_and_jacobian(prob, ident)
     rss, rows = float(r @ r), r.size
@@ -328,6 +331,8 @@ def _correlated_std(ident: Identification, prob: FitProblem, noise_rms: float
             if math.isfinite(e[name]) and math.isfinite(std[j]):
                 e[name] = float(std[j])
     if prob.fit_offset and math.isfinite(std[-1]):
+        if math.isfinite(white[-1]):
+            ident.judged_std["offset"] = float(white[-1])
         ident.offset_std = float(std[-1])
     sd = {nm: float(std[j]) if math.isfinite(std[j]) else None
           for nm, j in zip(names, idx, strict=True)}
@@ -338,4 +343,7 @@ def _correlated_std(ident: Identification, prob: FitProblem, noise_rms: float
     note = lower_bound_note(math.sqrt(rss / rows), noise_rms, widened, corr.lags, "N",
                             float(np.sqrt(np.mean(prob.y ** 2))))
     ident.std_lower_bound = note
+    widened_line = ident.widened_note()
+    if widened_line is not None:  # determined on white residuals, not beyond the model's error
+        warn(widened_line)
     return ident

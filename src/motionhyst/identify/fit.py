@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares, nnls
 
+from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import MaxwellSlip
 from motionhyst.identify._stop_operators import maxwell_at, stops_at
 from motionhyst.identify.io_checks import systematic_share
@@ -735,7 +736,8 @@ def correlated_std(ident: Identification, prob: FitProblem) -> Identification:
     worst).  The elements' and the offset's standard errors and the covariance are widened;
     those of white residuals are kept as ``judged_std`` (what judges a slip force
     determined); a fit leaving more than the record's white noise says its standard errors
-    are lower bounds (``std_lower_bound``).
+    are lower bounds (``std_lower_bound``), and a value its widened standard error exceeds
+    where the white one does not is warned (:meth:`Identification.widened_note`).
 
     Parameters
     ----------
@@ -778,6 +780,7 @@ def correlated_std(ident: Identification, prob: FitProblem) -> Identification:
             if math.isfinite(e[name]) and math.isfinite(std[j]):
                 e[name] = float(std[j])
     if prob.fit_offset and math.isfinite(ident.offset_std) and math.isfinite(std[-1]):
+        ident.judged_std["offset"] = ident.offset_std
         ident.offset_std = float(std[-1])
     idx = [*range(2 * n), J.shape[1] - 1]  # k, fc in the elements' order, the offset
     names = [*(["k", "fc"] if n == 1 else [f"{p}[{i}]" for p in ("k", "fc") for i in range(n)]),
@@ -789,4 +792,7 @@ def correlated_std(ident: Identification, prob: FitProblem) -> Identification:
         sd = {nm: v if nm in kept else None for nm, v in sd.items()}
         ident.covariance = covariance_table(names, errors.cov[np.ix_(idx, idx)], sd)
     ident.std_lower_bound = errors.note
+    note = ident.widened_note()
+    if note is not None:  # determined on white residuals, not beyond the model's error
+        warn(note)
     return ident

@@ -14,7 +14,12 @@ from motionhyst.identify.io_checks import budget_note
 from motionhyst.identify.io_quasi_static import identify_quasi_static_io
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification
-from motionhyst.identify.io_uncertainty import BOUC_WEN_SCALE, judge_determined, zero_allowed
+from motionhyst.identify.io_uncertainty import (
+    BOUC_WEN_SCALE,
+    judge_determined,
+    widened_note,
+    zero_allowed,
+)
 
 __all__ = ["identify_link_force"]
 
@@ -64,7 +69,9 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     FitFailed
         A fit that is no result, or of whose parameters the records determine at most half
         (:func:`~motionhyst.identify.io_uncertainty.judge_determined`; fewer not determined
-        are one of the result's ``warnings``).
+        are one of the result's ``warnings``, and so are the values that only its standard
+        errors widened for the residuals' correlation leave undetermined or not
+        distinguishable from 0, :func:`~motionhyst.identify.io_uncertainty.widened_note`).
 
     Examples
     --------
@@ -93,10 +100,14 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     fit.extra["displacement_noise"] = [est.to_dict() for _, est in noise]
     if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
         fit.warnings.append(budget_note(fit.n_evaluations))
+    invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(fit.plant, link)
     # parameters the records do not determine: a warning, or (most of them) a failed fit
-    fit.warnings.extend(judge_determined(fit.estimates, fit.judged_std or fit.std,
-                                         BOUC_WEN_SCALE if link is BoucWen else (),
-                                         zero_allowed(fit.plant, link)))
+    fit.warnings.extend(judge_determined(fit.estimates, fit.judged_std or fit.std, invariant,
+                                         zero))
+    widened = widened_note(fit.estimates, fit.std, fit.judged_std, invariant, zero) \
+        if fit.judged_std and fit.extra.get("std_lower_bound") else None
+    if widened is not None:  # determined on white residuals, not beyond the model's error
+        fit.warnings.append(widened)
     for line in fit.warnings:  # for every caller to see, as identify_io's
         warn(line)
     return fit

@@ -74,6 +74,7 @@ from motionhyst.identify.io_uncertainty import (
     covariance_table,
     undetermined_notes,
 )
+from motionhyst.identify.residual_noise import ResidualCorrelation
 from motionhyst.plants.quasi_static import QuasiStatic
 from motionhyst.time.openloop import OpenLoop
 from motionhyst.time.quasi_static import displacement_from_force, force_from_displacement
@@ -703,6 +704,24 @@ def _judge(prob: _Problem, v: NDArray[np.float64], records: list[IORecord], forc
     return res, fit_rms, share
 
 
+def _profile_widening(below: IOIdentification, above: IOIdentification,
+                      best: IOIdentification, records: list[IORecord]) -> float:
+    """How many times the residuals' correlation widens the standard error of a parameter
+    profiled by refits (a Bouc-Wen link's exponent, :func:`_exponent_profile`):
+    ``sqrt(d^T C d / d^T d)`` with ``d`` the residuals' derivative along the profile (the
+    refits' difference either side of the minimum: the other parameters follow, so it is the
+    part of the exponent's column that they do not take) and ``C`` the best fit's residuals'
+    weighted autocorrelation (:class:`~motionhyst.identify.residual_noise.ResidualCorrelation`,
+    the sandwich of the other parameters' standard errors); 1 for white residuals."""
+    d = above.residuals - below.residuals
+    sizes = np.cumsum([rec.y.size for rec in records])[:-1]
+    if d.size != best.residuals.size or not float(d @ d) > 0:
+        return 1.0
+    corr = ResidualCorrelation(np.split(best.residuals, sizes))
+    inner = float(corr.inner(d[:, None])[0, 0])
+    return math.sqrt(max(inner / float(d @ d), 0.0))
+
+
 #: The exponents of a Bouc-Wen link fitted when it is estimated (``--nu free``): its fits of
 #: ``n`` free together with the rest stall (near saturation ``|zeta|^n`` hardly changes
 #: with ``n``), fits of ``n`` fixed do not
@@ -713,7 +732,9 @@ def _exponent_profile(records: list[IORecord], **options) -> IOIdentification:
     """A Bouc-Wen link on a quasi-static plant with its exponent estimated: the fit of each
     exponent of :data:`NU_GRID`, the best one's neighbourhood searched by a bounded scalar
     search (to 0.01), the exponent's standard error from the curvature of the fits' cost
-    ``RSS(n)`` at its minimum (``sqrt(2 s^2 / RSS'')``, ``s^2`` the residuals' variance)."""
+    ``RSS(n)`` at its minimum (``sqrt(2 s^2 / RSS'')``, ``s^2`` the residuals' variance: white
+    residuals', ``judged_std``), widened for the residuals' correlation as the other
+    parameters' are (:func:`_profile_widening`)."""
     from scipy.optimize import minimize_scalar
 
     fits: dict[float, IOIdentification] = {}
@@ -739,13 +760,15 @@ def _exponent_profile(records: list[IORecord], **options) -> IOIdentification:
     rss = np.array([float(np.sum(fits[nu].residuals ** 2)) for nu in nus])
     j = int(np.argmin(rss))
     best = fits[float(nus[j])]
-    std = None
+    std = white = None
     if 0 < j < nus.size - 1:  # the parabola through the minimum and its neighbours
         a = np.polyfit(nus[j - 1:j + 2] - nus[j], rss[j - 1:j + 2], 2)[0]
         s2 = rss[j] / max(best.residuals.size - len(best.estimates) - 1, 1)
-        std = float(np.sqrt(2.0 * s2 / (2.0 * a))) if a > 0 else None
+        white = float(np.sqrt(2.0 * s2 / (2.0 * a))) if a > 0 else None
+        std = None if white is None else white * _profile_widening(
+            fits[float(nus[j - 1])], fits[float(nus[j + 1])], best, records)
     best.estimates["link.n"] = float(nus[j])
-    best.std["link.n"] = best.judged_std["link.n"] = std  # white residuals' curvature
+    best.std["link.n"], best.judged_std["link.n"] = std, white
     best.stopping += (f"; exponent n by the fits of {nus.size} fixed values from "
                       f"{nus[0]:g} to {nus[-1]:g}")
     return best

@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.core.textfiles import toml_table
 from motionhyst.core.textfmt import g, table
 from motionhyst.hysteresis import MaxwellSlip
-from motionhyst.identify.io_uncertainty import identification_toml
+from motionhyst.identify.io_uncertainty import identification_toml, widened_note
 from motionhyst.plants.quasi_static import QuasiStatic
 
 __all__ = ["Identification"]
@@ -62,10 +62,11 @@ class Identification:
         noise: :func:`~motionhyst.identify.residual_noise.lower_bound_note`; a line of the
         printed result says it, the table marks them ``>=``), else None.
     judged_std : dict
-        Where the standard errors take the residuals' autocorrelation (a closed-loop fit's),
-        the elements' own of white residuals, ``{"k[i]": .., "fc[i]": ..}`` (element ``i``
-        in the order of `elements`; not in :meth:`to_dict`): what judges whether a slip
-        force is determined; empty: those of `elements`.
+        Where the standard errors take the residuals' autocorrelation, those of white
+        residuals, ``{"k[i]": .., "fc[i]": .., "offset": ..}`` (element ``i`` in the order of
+        `elements`; the offset's where it is estimated and determined; not in
+        :meth:`to_dict`): what judges whether a slip force is determined
+        (:meth:`widened_note`); empty: those of `elements`.
     order_stop : str or None
         Why the automatic order search stopped before its largest order (its systematic
         error's trend could not reach the share asked: ``target_share`` of
@@ -159,6 +160,56 @@ class Identification:
             *([f"  {self.std_lower_bound}"] if self.std_lower_bound else []),
             "",
             f"  total stiffness {g(k, 6)} N/m, total slip force {g(fc, 6)} N"])
+
+    def widened_note(self) -> str | None:
+        """The elements' values and the offset whose standard error, widened for the
+        residuals' correlation, exceeds them where that of white residuals (`judged_std`)
+        does not (:func:`~motionhyst.identify.io_uncertainty.widened_note`, as an
+        input-output fit's): one warning's line, or None (also for standard errors that are
+        not lower bounds, `std_lower_bound` None).
+
+        Returns
+        -------
+        str or None
+            Names as the covariance has them (``k``, ``fc`` for one element, ``k[0]``, ...
+            for several, ``offset``).
+
+        Examples
+        --------
+        A slip force and an offset of a fit that leaves model error: the offset's widened
+        standard error exceeds it, the white one does not.
+
+        >>> import numpy as np
+        >>> from motionhyst import MaxwellSlip
+        >>> ident = Identification(
+        ...     MaxwellSlip(k=[20.0], fc=[0.05]),
+        ...     [{"k": 20.0, "fc": 0.05, "k_std": 0.4, "fc_std": 0.001}], offset=0.002,
+        ...     offset_std=0.003, initial_forces=np.zeros(1), fit_rms=0.01, fit_nrms=0.02,
+        ...     r2=0.999, n_samples=1000, criterion="given",
+        ...     std_lower_bound="standard errors are lower bounds: ...",
+        ...     judged_std={"k[0]": 0.1, "fc[0]": 0.0002, "offset": 0.0005})
+        >>> print(ident.widened_note()[:70])
+        with the fit's model error, offset (0.002 +- 0.003) is not distinguish
+        """
+        if not self.std_lower_bound or not self.judged_std:
+            return None
+        n = self.n_elements
+
+        def named(p: str, i: int) -> str:
+            return p if n == 1 else f"{p}[{i}]"
+
+        def finite(value: float | None) -> float | None:
+            return value if value is not None and math.isfinite(value) else None
+        estimates = {named(p, i): e[p] for p in ("k", "fc") for i, e in enumerate(self.elements)}
+        std = {named(p, i): finite(e[f"{p}_std"]) for p in ("k", "fc")
+               for i, e in enumerate(self.elements)}
+        judged = {named(p, i): finite(self.judged_std.get(f"{p}[{i}]"))
+                  for p in ("k", "fc") for i in range(n)}
+        if "offset" in self.judged_std:
+            estimates["offset"] = self.offset
+            std["offset"] = finite(self.offset_std)
+            judged["offset"] = finite(self.judged_std["offset"])
+        return widened_note(estimates, std, judged)
 
     def plot(self, ax=None):
         """The identified link's force-displacement loops.
