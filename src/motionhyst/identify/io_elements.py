@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from motionhyst.core.blas import few_blas_threads
 from motionhyst.hysteresis import Coulomb, Jenkins, MaxwellSlip
 from motionhyst.hysteresis.stepping import Stepping
-from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, solve_within
+from motionhyst.identify.io_budget import BudgetSpent, EvaluationBudget, settled, solve_within
 from motionhyst.identify.io_checks import (
     PROFILE_CHI2,
     flat_profile,
@@ -835,6 +835,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         notes.append(one_way.line)
     if noise is not None:
         notes.extend(_window_price(J, rss, res.size, rtol, noise, names[:n_base], init_window))
+    calm = settled(sol, prob.values, std_v)  # on its cap, its estimates still to 1 % of std
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
@@ -842,12 +843,13 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         seconds=time.perf_counter() - t_start, periodic=periodic,
         stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "
-                 f"at most {most} evaluations; {sol.nfev} used)",
+                 f"at most {most} evaluations; {sol.nfev} used"
+                 f"{'; settled to 1 % of each std' if calm else ''})",
         n_evaluations=n_eval, substeps=r, data=list(records), residuals=res, rigid_limit=coulomb,
         extra={"offsets": {"input": u0, "output": y0.tolist(),
                            **({"input_drift": drift_rate} if extras.input_drift else {})},
                "initial_state": initial_state_out, "init_window": init_window,
-               "budget_reached": bool(sol.status == 0),
+               "budget_reached": bool(sol.status == 0 and not calm),
                "covariance": covariance_table(names, cov, std),
                **errors.flags,
                **({"one_way": one_way.to_dict()} if one_way is not None else {})},
