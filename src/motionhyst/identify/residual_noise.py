@@ -95,7 +95,7 @@ BLOCK_FFT = 1 << 15
 
 def bartlett_sum(rows: NDArray[np.float64] | Callable[[int, int], NDArray[np.float64]],
                  weights: NDArray[np.float64], n: int | None = None) -> NDArray[np.float64]:
-    """``sum_t D_t^T D_t + sum_l k_l sum_t (D_{t+l}^T D_t + D_t^T D_{t+l})``, ``l = 1 .. L``,
+    """``sum_t D_t^T D_t + sum_l k_l sum_t (D_{t+l}^T D_t + D_t^T D_{t+l})``, ``l = 1, ..., L``,
     over one record's rows ``D_t``: the Newey-West sum that every standard error of
     motionhyst robust to the residuals' correlation takes (one implementation).
 
@@ -165,7 +165,7 @@ def bartlett_sum(rows: NDArray[np.float64] | Callable[[int, int], NDArray[np.flo
 
 
 def bartlett_weights(lags: int) -> NDArray[np.float64]:
-    """The Bartlett kernel's weights ``1 - l / (L + 1)``, ``l = 1 .. L`` (Newey and West,
+    """The Bartlett kernel's weights ``1 - l / (L + 1)``, ``l = 1, ..., L`` (Newey and West,
     Econometrica 55, 703-708, 1987: weights that keep the sum positive semi-definite).
 
     Parameters
