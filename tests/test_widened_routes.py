@@ -158,3 +158,21 @@ def test_a_bouc_wen_exponents_profile_is_widened_as_the_other_parameters_are():
         above = SimpleNamespace(residuals=best.residuals + d / 2)
         assert _profile_widening(below, above, best, records) == pytest.approx(expected,
                                                                                rel=tol)
+
+
+def test_the_command_shows_an_accepted_fits_warning_after_judging_it(tmp_path, capsys):
+    """``identify`` on a force-displacement record holds the fit's warnings on its values until
+    the fit is judged (a refused fit is one line: test_searches_bounded), then shows them: the
+    seed-0 record of the Maxwell-slip route, two elements asked, exit 0 and the warning."""
+    from motionhyst.cli import main
+
+    t, x, w = _fd_record(0)
+    path = tmp_path / "fd.csv"
+    np.savetxt(path, np.column_stack([t, x, w]), delimiter=",",
+               header="time,displacement,force", comments="")
+    rc = main(["identify", str(path), "--elements", "2"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    said = [line for line in err.splitlines() if "warning" in line]
+    assert len(said) == 1 and "offset (-0.0015 +- 0.0037) is not distinguishable from 0" in said[0]
+    assert "elements: 2" in out and "offset -0.001523 N" in out, out

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -258,14 +259,17 @@ def run(args: argparse.Namespace) -> int:
         what = "force-displacement record"
         from motionhyst.identify.io_checks import SYSTEMATIC_SHARE
 
-        try:
-            with search_budget():  # the order chosen: a search that cannot reach 2 % stops
+        try:  # the fit's warnings on its values wait for its judgement: a refusal is one line
+            with search_budget(), warnings.catch_warnings(record=True) as held:
+                warnings.simplefilter("always")
                 ident = identify_maxwell_slip(x, w, t=t, **options, target_share=(
                     SYSTEMATIC_SHARE if args.elements is None else None))
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         _check_determined(path, ident, x, w)
         share = _judge_elements(path, ident, x, w, args.elements is None or target is not None)
+        for h in held:
+            warnings.warn_explicit(h.message, h.category, h.filename, h.lineno)
         if target is not None:  # the link alone, a system without inertia, for predict
             target.write_text(ident.scenario_text(f"{path}"))
             extra["saved"] = args.save
