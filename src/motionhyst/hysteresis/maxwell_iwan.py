@@ -188,7 +188,8 @@ def _run_rows(codes, params, s0, x, t, glt, glw):  # pragma: no cover - compiled
         h = t[i] - t[i - 1]
         total = 0.0
         for j in range(codes.shape[0]):
-            s[j], f = advance(codes[j], params[j], s[j], s[j], dx, 0.0, h, i == 1, glt, glw)
+            s[j], f = advance(codes[j], params[j], s[j], s[j], dx, 0.0, h, h, i == 1, glt,
+                              glw)
             total += f
         w[i] = total
     return w

@@ -188,7 +188,7 @@ class LoopState:
     out_prev : ndarray
         The outputs at the last node.
     scal : ndarray
-        The link force and displacement increment of the last step.
+        The link force, displacement increment and length of the last step.
     xc, uq : ndarray
         The controller's state and its queue of outputs ``u_k, u_{k-1}, ...``.
     fresh : bool
@@ -229,7 +229,7 @@ class LoopState:
         self.ss_prev = self.ss.copy()
         self.dvec = np.zeros((3, self.sx.shape[1]))
         self.out_prev = np.zeros(0)
-        self.scal = np.zeros(2)
+        self.scal = np.zeros(3)
         self.xc = np.zeros(self.nc)
         self.uq = np.zeros(self.n_queue)
 

@@ -155,12 +155,14 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
         for j in range(m):
             s_prev[j] = s[j]
             if not sens:
-                w0 += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True, glt, glw)[1]
+                w0 += advance(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, 0.0, True, glt,
+                              glw)[1]
             else:
-                w0 += advance_partials(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, True,
-                                       pds[j], pdf[j])[1]
+                w0 += advance_partials(codes[j], params[j], s[j], s[j], 0.0, 0.0, 0.0, 0.0,
+                                       True, pds[j], pdf[j])[1]
         scal[0] = w0
         scal[1] = 0.0
+        scal[2] = 0.0
         for b in range(P):
             dw_prev[b] = 0.0
             ddx_prev[b] = 0.0
@@ -188,6 +190,7 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
             uq[q] = 0.0
     w_prev = scal[0]
     dx_prev = scal[1]
+    h_prev = scal[2]
     if record_initial:
         for o in range(p):
             Y[0, o] = out_prev[o]
@@ -265,7 +268,7 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
                 wn = 0.0
                 for j in range(m):
                     s_new[j], fj = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, h,
-                                           first, glt, glw)
+                                           h_prev, first, glt, glw)
                     wn += fj
                 d_next = pre + gl * (a_new - wn)
                 step_w = abs(wn - wt)
@@ -300,12 +303,13 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
                 if not sens:
                     for j in range(m):
                         s_new[j], fj = advance(codes[j], params[j], s[j], s_prev[j], dx,
-                                               dx_prev, h, first, glt, glw)
+                                               dx_prev, h, h_prev, first, glt, glw)
                         wn += fj
                 else:  # the same states and forces, and their partials
                     for j in range(m):
                         s_new[j], fj = advance_partials(codes[j], params[j], s[j], s_prev[j],
-                                                        dx, dx_prev, h, first, pds[j], pdf[j])
+                                                        dx, dx_prev, h, h_prev, first, pds[j],
+                                                        pdf[j])
                         wn += fj
                 # converged, or stalled at the rounding floor (a contraction's changes stop
                 # falling only there: rate terms such as LuGre's sigma1 z' amplify the
@@ -434,8 +438,10 @@ def step_loop(A, B0, B1, C, G, hs, dA, dB0, dB1, link_row, vel_row, a, dexo, exo
             s[j] = s_new[j]
         w_prev = wt
         dx_prev = dx
+        h_prev = h
         scal[0] = w_prev
         scal[1] = dx_prev
+        scal[2] = h_prev
         if (i + 1) % record_every == 0:
             o_i = (i + 1) // record_every - (0 if record_initial else 1)
             for o in range(p):

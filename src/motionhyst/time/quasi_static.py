@@ -79,7 +79,8 @@ def _link_force(codes, params, s, s_prev, s_new, dx, dx_prev, h, first, glt,
     """The link's force after a step `dx` (the new states into `s_new`)."""
     w = 0.0
     for j in range(codes.shape[0]):
-        sj, f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, h, first, glt, glw)
+        sj, f = advance(codes[j], params[j], s[j], s_prev[j], dx, dx_prev, h, h, first, glt,
+                        glw)
         s_new[j] = sj
         w += f
     return w
@@ -98,8 +99,8 @@ def _stuck(codes, params, s, s_prev, s_new, dx_prev, h, first, glt, glw, need,
             hi += params[j, 0]
             lo -= params[j, 1]
         else:
-            sj, f = advance(codes[j], params[j], s[j], s_prev[j], 0.0, dx_prev, h, first, glt,
-                            glw)
+            sj, f = advance(codes[j], params[j], s[j], s_prev[j], 0.0, dx_prev, h, h, first,
+                            glt, glw)
             s_new[j] = sj
             rest += f
     held = need - rest
