@@ -51,14 +51,15 @@ def _force_csv() -> str:
     ["scan", "s.toml", "--length", "0.01", "--speed", "0.1", "--a-max", "10", "--j-max", "1000",
      "--s-max", "1e6", "--compensation", "none"],
 ])
-@pytest.mark.parametrize(("sigma1", "sigma2", "factor"), [(1e6, 0.0, "2.5"), (0.0, 1e6, "2.5"),
-                                                          (1e8, 0.0, "250")])
+@pytest.mark.parametrize(("sigma1", "sigma2", "factor"), [(1e6, 0.0, "2.78"), (0.0, 1e6, "2.78"),
+                                                          (1e8, 0.0, "278")])
 def test_a_sampled_loop_s_link_too_damped_for_its_fine_steps_is_refused_first(
         tmp_path, argv, sigma1, sigma2, factor):
     """The paper's loop at 10 kHz, 1.5 samples late (fine steps of 5e-5 s on the 5 kg m1):
     was refused after the loop was built and the run started (1.5 s of CPU), its message
     naming "the loop's poles and the reference"; now before either, naming the sampled
-    controller."""
+    controller.  The factor is the step of 5e-5 s after one of 2.5e-5 s: its rates weigh
+    its change 1 + 5 / 7.5 times (c h (1 + 5 / 7.5) / (6 m)), not 1.5."""
     (tmp_path / "s.toml").write_text(_sampled_with(sigma1, sigma2))
     out = probe(argv, tmp_path)
     assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
@@ -98,20 +99,22 @@ def test_the_sampled_margin_refuses_only_runs_that_fail(monkeypatch, delay):
     from motionhyst.time import engine
     from motionhyst.time.kernel import StepNotConverged
     from motionhyst.time.sampled import simulate_sampled
-    from motionhyst.time.steps import IMPLICIT_STEP_MARGIN, check_link_damping, sampled_step
+    from motionhyst.time.steps import IMPLICIT_STEP_MARGIN, check_link_damping, sampled_steps
 
     sc = Scenario.from_dict(tomllib.loads(_sampled_with(delay=delay)), "s")
-    step = sampled_step(sc.plant(), sc.hysteresis(), 10_000.0, delay)
-    assert step == pytest.approx(5e-5 if delay == 1.5 else 1e-4 / 3, rel=1e-12)
-    at_margin = IMPLICIT_STEP_MARGIN * 4 * 5.0 / step
+    step, shorter = sampled_steps(sc.plant(), sc.hysteresis(), 10_000.0, delay)
+    assert (step, shorter) == pytest.approx((5e-5, 2.5e-5) if delay == 1.5 else (1e-4 / 3, 0.0),
+                                            rel=1e-12)
+    weight = 1.0 + 5.0 / 7.5 if delay == 1.5 else 1.5  # of the step's change in its rates
+    at_margin = IMPLICIT_STEP_MARGIN * 6 * 5.0 / (step * weight)
 
     def lugre(c: float) -> LuGre:
         return LuGre(sigma0=20.0, sigma1=0.0, sigma2=c, fc=0.05, fs=0.07, vs=0.1)
 
-    check_link_damping(lugre(0.95 * at_margin), sc.plant(), step)
+    check_link_damping(lugre(0.95 * at_margin), sc.plant(), step, shorter=shorter)
     with pytest.raises(ValueError, match="is too strong for the time step"):
-        check_link_damping(lugre(1.05 * at_margin), sc.plant(), step)
-    monkeypatch.setattr(engine, "check_link_damping", lambda *args: None)
+        check_link_damping(lugre(1.05 * at_margin), sc.plant(), step, shorter=shorter)
+    monkeypatch.setattr(engine, "check_link_damping", lambda *args, **kwargs: None)
     with pytest.raises(StepNotConverged):
         simulate_sampled(Loop(sc.plant(), sc.controller(), lugre(1.05 * at_margin)),
                          SineReference(0.01, 5.0), 0.02, linear=False)
@@ -157,23 +160,25 @@ def test_no_example_s_link_is_refused_for_its_damping(path):
     continuous loop's from its poles and its reference's highest frequency, a sampled
     loop's fine steps, an open-loop axis at 1 kHz), by a factor of ten: no false refusal."""
     from motionhyst.scenario import load_scenario
-    from motionhyst.time.steps import IMPLICIT_STEP_MARGIN, damping_factor, pole_step, sampled_step
+    from motionhyst.time.steps import IMPLICIT_STEP_MARGIN, damping_factor, pole_step, sampled_steps
 
     sc = load_scenario(path, check=False)
     link = sc.hysteresis()
     if link is None:
         return
     c = sc.model.controller
+    shorter = 0.0
     if c is None:
         system = sc.open_loop()
         if not system.plant.has_inertia:
             return
         step = 1.0 / (1000.0 * system.default_substeps(1000.0))
     elif getattr(c, "sample_rate_hz", None) is not None:
-        step = sampled_step(sc.plant(), link, c.sample_rate_hz, c.delay_samples or 0.0)
+        step, shorter = sampled_steps(sc.plant(), link, c.sample_rate_hz,
+                                      c.delay_samples or 0.0)
     else:  # the step the commands check (hunting.toml's pure derivative is no time run's)
         pole = sc.fastest_pole()
         if pole is None:
             return
         step = pole_step(pole, max(sc.model.reference.frequencies))
-    assert damping_factor(link, sc.plant(), step) < 0.1 * IMPLICIT_STEP_MARGIN
+    assert damping_factor(link, sc.plant(), step, shorter) < 0.1 * IMPLICIT_STEP_MARGIN

@@ -148,6 +148,35 @@ def test_lugre_s_partials_follow_its_step_over_unequal_lengths():
         assert df[i] == pytest.approx(fd, rel=1e-6), i
 
 
+def test_the_damping_check_weighs_a_long_step_after_a_short_one(tmp_path):
+    """1.05 samples late the long fine step (4.75e-5 s) follows a short one (5e-6 s): its
+    velocity weighs its own change 1.905 times, not 1.5, so the implicit step's factor is
+    1.27 times that of equal steps; sigma2 = 3.5e5 N s/m (factor 0.83 by equal steps, 1.06
+    so) ran into 50 passes that did not converge, after the loop was built; now refused
+    first, by the command and by the library."""
+    from motionhyst.scenario import Scenario
+    from motionhyst.time.steps import check_link_damping, damping_factor, sampled_steps
+
+    (tmp_path / "s.toml").write_text(_scenario(3.5e5, 1.05))
+    out = probe(["simulate", "s.toml", "--time-series", "ts.csv", "--frequency", "5",
+                 "--duration", "0.2"], tmp_path)
+    assert out["rc"] == 2 and out["err"].count("\n") == 1, out["err"]
+    assert ("too strong for the time step of 4.75e-05 s: it would amplify each pass of the "
+            "step's implicit iteration 1.06 times") in out["err"], out["err"]
+    assert "numba" not in out["packages"] and not (tmp_path / "ts.csv").exists()
+    sc = Scenario.from_dict(tomllib.loads(_scenario(3.5e5, 1.05)), "s")
+    long, short = sampled_steps(sc.plant(), sc.hysteresis(), 1e4, 1.05)
+    assert (long, short) == pytest.approx((4.75e-5, 5e-6), rel=1e-12)
+    equal = damping_factor(sc.hysteresis(), sc.plant(), long)
+    assert damping_factor(sc.hysteresis(), sc.plant(), long, short) == pytest.approx(
+        equal * (1.0 + 4.75 / 5.25) / 1.5, rel=1e-12)
+    with pytest.raises(ValueError, match=r"time step of 4\.75e-05 s: it would amplify each "
+                                         r"pass of the step's implicit iteration 1\.06 times"):
+        check_link_damping(sc.hysteresis(), sc.plant(), long, shorter=short)
+    with pytest.raises(ValueError, match=r"4\.75e-05 s: .* 1\.06 times"):
+        _e1(_loop("lugre", 3.5e5, 1.05))
+
+
 def test_lugre_link_with_damping_sigma1_also_agrees():
     """The rate of the bristles' state (sigma1 z') takes the same weights: sigma1 = 1e3 N s/m,
     1.05 samples late, was 90 % off as well."""

@@ -441,21 +441,21 @@ def check_link_damping_for(sc, step: float | None = None) -> None:
         The command's scenario.
     step : float, optional
         A continuous loop's step [s], known before its loop is built; None: the scenario's
-        sampled controller's longest fine step
-        (:func:`~motionhyst.time.steps.sampled_step`).
+        sampled controller's fine steps (:func:`~motionhyst.time.steps.sampled_steps`).
     """
     from motionhyst.scenario import ScenarioError
-    from motionhyst.time.steps import check_link_damping, sampled_step
+    from motionhyst.time.steps import check_link_damping, sampled_steps
 
     set_by = "set from the loop's poles and the reference"
+    shorter = 0.0
     if step is None:
         c = sc.model.controller
         rate, delay = c.sample_rate_hz, c.delay_samples or 0.0
-        step = sampled_step(sc.plant(), sc.hysteresis(), rate, delay)
+        step, shorter = sampled_steps(sc.plant(), sc.hysteresis(), rate, delay)
         set_by = (f"the sampled controller's period ({rate:g} Hz, {delay:g} samples late) "
                   f"split for the stage's fastest mode")
     try:
-        check_link_damping(sc.hysteresis(), sc.plant(), step)
+        check_link_damping(sc.hysteresis(), sc.plant(), step, shorter=shorter)
     except ValueError as exc:
         raise ScenarioError(f"{sc.source}: [hysteresis]: {exc}; the step is the command's, "
                             f"{set_by}: is the link's damping meant (in SI units)?") from None

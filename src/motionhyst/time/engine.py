@@ -572,7 +572,8 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
     R, r1, h, h1 = sampled_substeps(T, d, substeps, mech.natural_frequency_hz(k_link)
                                     if substeps is None else 0.0)
     if link is not None:  # a damping its steps cannot settle: refused, not run to no answer
-        check_link_damping(link, mech, max(h, h1))
+        check_link_damping(link, mech, max(h, h1),
+                           shorter=min(h, h1) if r1 and h != h1 else 0.0)
     n_delay = math.floor(d)
     A, B = mech.state_space()
     steps = [FohStep.exact(A, B, h)] + ([FohStep.exact(A, B, h1)] if r1 else [])

@@ -47,6 +47,7 @@ __all__ = [
     "longest_step",
     "pole_step",
     "sampled_step",
+    "sampled_steps",
     "sampled_substeps",
     "step_set_by",
     "time_series_grid",
@@ -205,9 +206,52 @@ def sampled_substeps(period: float, delay_samples: float = 0.0, substeps: int | 
     return R, 0, period / R, 0.0
 
 
+def sampled_steps(plant, link, sample_rate_hz: float, delay_samples: float = 0.0
+                  ) -> tuple[float, float]:
+    """The fine steps of a sampled loop's run [s] (:func:`sampled_substeps`, by default),
+    known before its loop is built: the longest, and the other where the delay splits a
+    controller period into steps of two lengths.
+
+    Parameters
+    ----------
+    plant : Plant
+        The stage (its :meth:`mechanics` gives its fastest mode).
+    link : Hysteresis or None
+        The link (its initial stiffness stiffens that mode).
+    sample_rate_hz : float
+        The controller's rate [Hz].
+    delay_samples : float
+        Its delay [samples].
+
+    Returns
+    -------
+    tuple of float
+        The longest step and the shorter (0 where all are of one length); the controller's
+        period and 0 for a plant without lumped masses.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> from motionhyst.plants import TwoMassStage
+    >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    >>> sampled_steps(stage, Jenkins(k=20.0, fc=0.05), 10_000.0, 1.5)
+    (5e-05, 2.5e-05)
+    >>> sampled_steps(stage, Jenkins(k=20.0, fc=0.05), 10_000.0, 1.0)
+    (3.3333333333333335e-05, 0.0)
+    """
+    period = 1.0 / sample_rate_hz
+    try:
+        mech = plant.mechanics()
+        k = 0.0 if link is None else float(getattr(link, "initial_stiffness", 0.0))
+        f_n = float(mech.natural_frequency_hz(k))
+    except (AttributeError, TypeError, ValueError, NotImplementedError):
+        return period, 0.0
+    _, r1, h, h1 = sampled_substeps(period, delay_samples, natural_frequency_hz=f_n)
+    return max(h, h1), (min(h, h1) if r1 and h != h1 else 0.0)
+
+
 def sampled_step(plant, link, sample_rate_hz: float, delay_samples: float = 0.0) -> float:
-    """The longest fine step of a sampled loop's run [s] (:func:`sampled_substeps`, by
-    default), known before its loop is built.
+    """The longest fine step of a sampled loop's run [s] (:func:`sampled_steps`' first).
 
     Parameters
     ----------
@@ -233,18 +277,10 @@ def sampled_step(plant, link, sample_rate_hz: float, delay_samples: float = 0.0)
     >>> sampled_step(stage, Jenkins(k=20.0, fc=0.05), 10_000.0, 1.5)
     5e-05
     """
-    period = 1.0 / sample_rate_hz
-    try:
-        mech = plant.mechanics()
-        k = 0.0 if link is None else float(getattr(link, "initial_stiffness", 0.0))
-        f_n = float(mech.natural_frequency_hz(k))
-    except (AttributeError, TypeError, ValueError, NotImplementedError):
-        return period
-    _, _, h, h1 = sampled_substeps(period, delay_samples, natural_frequency_hz=f_n)
-    return max(h, h1)
+    return sampled_steps(plant, link, sample_rate_hz, delay_samples)[0]
 
 
-def damping_factor(link, plant, step: float) -> float:
+def damping_factor(link, plant, step: float, shorter: float = 0.0) -> float:
     """The factor by which a link's damping amplifies each pass of a run's implicit step
     (:func:`check_link_damping`); 0 for a link without damping or a plant without lumped
     masses.
@@ -257,26 +293,38 @@ def damping_factor(link, plant, step: float) -> float:
         The stage (its :meth:`mechanics` gives the mass the link moves), or its lumped
         masses.
     step : float
-        The run's time step [s].
+        The run's (longest) time step [s].
+    shorter : float
+        A sampled run's other fine step [s], which `step` follows once a controller period
+        (:func:`sampled_steps`); 0: all steps of length `step`.
 
     Returns
     -------
     float
-        ``c step / (4 m)``.
+        ``c step a / (6 m)`` with ``a`` the weight of the step's change in its rate by the
+        backward difference (:func:`~motionhyst.hysteresis.stepping.backward_weights`):
+        ``1 + step / (step + shorter)`` after a shorter step, 1.5 (``c step / (4 m)``)
+        after one as long.
 
     Examples
     --------
     >>> from motionhyst.hysteresis import LuGre
     >>> from motionhyst.plants import TwoMassStage
     >>> stage = TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
-    >>> print(f"{damping_factor(LuGre(20.0, 1e7, 0.0, 0.05, 0.07, 0.1), stage, 3.62e-5):.3g}")
+    >>> link = LuGre(20.0, 1e7, 0.0, 0.05, 0.07, 0.1)
+    >>> print(f"{damping_factor(link, stage, 3.62e-5):.3g}")
     18.1
+    >>> print(f"{damping_factor(link, stage, 4.75e-5, 5e-6):.3g}")   # 1.05 samples at 10 kHz
+    30.2
     """
     small = getattr(link, "small_amplitude_limit", None)
     mass = _link_mass(plant)
     if small is None or mass is None or not step > 0:
         return 0.0
-    return float(complex(small(1.0)).imag) * step / (4.0 * mass)
+    c = float(complex(small(1.0)).imag)
+    if 0.0 < shorter < step:
+        return c * step * (1.0 + step / (step + shorter)) / (6.0 * mass)
+    return c * step / (4.0 * mass)
 
 
 def _link_mass(plant) -> float | None:
@@ -289,7 +337,8 @@ def _link_mass(plant) -> float | None:
         return None
 
 
-def check_link_damping(link, plant, step: float, where: str = "") -> None:
+def check_link_damping(link, plant, step: float, where: str = "", shorter: float = 0.0
+                       ) -> None:
     """Refuse a link whose damping is too strong for a run's time step, before the run.
 
     The run's implicit step settles the link force by a fixed-point iteration: a change of
@@ -297,15 +346,16 @@ def check_link_damping(link, plant, step: float, where: str = "") -> None:
     ``step^2 / (6 m)`` per newton, and a damping ``c`` (the link's for small motions,
     ``Im D / omega``: LuGre's ``sigma1 + sigma2`` from rest) turns that back into a force
     through the velocity at the step's end, ``1.5 / step`` per metre (the second-order
-    backward difference).  Their product ``c step / (4 m)`` (:func:`damping_factor`) is the
-    factor by which each pass amplifies the error: above 1 the iteration diverges at the
-    stage's first motion and the run stops there, after its loop is built and its kernels
-    loaded, or, where a pass happens to settle, ends with a motion that is no solution
-    (:data:`IMPLICIT_STEP_MARGIN`).  The same holds for the fine steps of a sampled loop's
-    run (:func:`sampled_step`) and for an open-loop system's.  A link without damping (a
-    rate-independent one), a plant without lumped masses, or a factor within
-    :data:`IMPLICIT_STEP_MARGIN` passes: the run judges it (one whose iteration converges
-    too slowly still stops it).
+    backward difference; up to ``2 / step`` after a shorter step, as a sampled run's longer
+    fine step follows its shorter once a period: `shorter`).  Their product ``c step / (4 m)``
+    (:func:`damping_factor`) is the factor by which each pass amplifies the error: above 1
+    the iteration diverges at the stage's first motion and the run stops there, after its
+    loop is built and its kernels loaded, or, where a pass happens to settle, ends with a
+    motion that is no solution (:data:`IMPLICIT_STEP_MARGIN`).  The same holds for the fine
+    steps of a sampled loop's run (:func:`sampled_steps`) and for an open-loop system's.  A
+    link without damping (a rate-independent one), a plant without lumped masses, or a
+    factor within :data:`IMPLICIT_STEP_MARGIN` passes: the run judges it (one whose
+    iteration converges too slowly still stops it).
 
     Parameters
     ----------
@@ -318,6 +368,8 @@ def check_link_damping(link, plant, step: float, where: str = "") -> None:
         The run's time step [s].
     where : str
         What to name in the message (the scenario's section).
+    shorter : float
+        A sampled run's other fine step [s] (:func:`damping_factor`); 0: none.
 
     Raises
     ------
@@ -340,10 +392,10 @@ for the time step of 3.62e-05 s: it would amplify each pass of the step's implic
 iteration 18.1 times (it settles below 1): the run would stop at the stage's first motion \
 or end in a motion that is no solution
     """
-    factor = damping_factor(link, plant, step)
+    factor = damping_factor(link, plant, step, shorter)
     if factor > IMPLICIT_STEP_MARGIN:
         mass = float(_link_mass(plant))
-        damping = 4.0 * factor * mass / step
+        damping = float(complex(link.small_amplitude_limit(1.0)).imag)
         raise ValueError(f"{where}the link's damping for small motions, {damping:.4g} N s/m on "
                          f"the {mass:.4g} kg it moves, is too strong for the time step of "
                          f"{step:.3g} s: it would amplify each pass of the step's implicit "
