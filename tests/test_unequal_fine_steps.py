@@ -177,6 +177,18 @@ def test_the_damping_check_weighs_a_long_step_after_a_short_one(tmp_path):
         _e1(_loop("lugre", 3.5e5, 1.05))
 
 
+def test_a_step_that_does_not_converge_names_the_longest_fine_step(monkeypatch):
+    """The run's own refusal named the period over the substeps, 3.33e-5 s, for steps of
+    4.75e-5 and 5e-6 s (1.05 samples late); now the longest, the one the check judges."""
+    from motionhyst.time import engine
+    from motionhyst.time.kernel import StepNotConverged
+
+    monkeypatch.setattr(engine, "check_link_damping", lambda *args, **kwargs: None)
+    with pytest.raises(StepNotConverged, match=r"for the time step of 4\.75e-05 s; use more "
+                                               r"substeps"):
+        _e1(_loop("lugre", 3.5e5, 1.05))
+
+
 def test_lugre_link_with_damping_sigma1_also_agrees():
     """The rate of the bristles' state (sigma1 z') takes the same weights: sigma1 = 1e3 N s/m,
     1.05 samples late, was 90 % off as well."""

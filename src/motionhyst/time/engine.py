@@ -598,7 +598,7 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
         raise StepNotConverged(f"the link's implicit step at t = {done / R * T:.6g} s did "
                                f"not converge in {MAX_FIXED_POINT_ITERATIONS} iterations: the "
                                f"link is too stiff (or too strongly damped) for the time step "
-                               f"of {T / R:.3g} s", "use more substeps")
+                               f"of {max(h, h1):.3g} s", "use more substeps")
     t = np.arange(n_k) * T
     y = Y[:n_k, 0]
     return SampledRun(t=t, r=rr, y=y, e=rr - y, u=U[:n_k], y_link=Y[:n_k, 1], w=W[:n_k])
