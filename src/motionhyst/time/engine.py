@@ -65,6 +65,7 @@ from motionhyst.time.steps import (
     SAMPLED_MIN_SUBSTEPS,
     SAMPLED_STEPS_PER_MODE_PERIOD,
     check_link_damping,
+    run_delay,
     sampled_substeps,
 )
 
@@ -565,6 +566,7 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
     d = float(delay_samples)
     if not (math.isfinite(d) and d >= 0):
         raise ValueError(f"delay_samples must be finite and >= 0, got {delay_samples!r}")
+    d = run_delay(d)  # a hair off a whole number: that number, not a fine step of 4e-20 s
     if not (float(u_max) > 0):
         raise ValueError(f"u_max must be > 0, got {u_max!r}")
     stepping = Stepping.empty() if link is None else link.time_stepping()
