@@ -677,3 +677,71 @@ def test_a_mode_the_lines_see_is_determined(exact, b, noise, n_lines):
         assert determined_modes(fit) == [True], (seed, str(fit.plant.modes[0]))
         tol = 0.01 if n_lines >= 50 else 0.25  # beyond the lines, its frequency is loose
         assert abs(fit.plant.modes[0].frequency_hz / 694.26 - 1) < tol
+
+
+# ---------------------------------------------------- one rule for the modes on every route
+def test_the_library_drops_needles_as_the_scenario_does(exact):
+    """60 lines of Table I's stage with 0.5 % magnitude noise (seed 1): the BIC chose five
+    modes, four of them needles at 25-113 Hz (damping at its bound, r1 within 1-3 standard
+    deviations of zero) that a scenario dropped while a library caller of fit_frf got them
+    (main: 5 modes and a warning naming four).  Now fit_frf drops them itself: the 694 Hz mode
+    alone, as determined as before, and the BIC's 5 kept in ``bic_modes``."""
+    p1, p2 = _magnitude_noise(exact, LINES, seed=1)
+    fit = fit_frf(LINES, p1, p2)
+    assert [round(m.frequency_hz) for m in fit.plant.modes] == [694]
+    assert determined_modes(fit) == [True] and fit.bic_modes == 5
+    assert fit.criterion.startswith("the BIC's 5 modes less 4 the lines do not determine")
+    assert fit.warnings == [] and fit.to_dict()["bic_modes"] == 5
+    assert fit.plant.M == pytest.approx(22.5, rel=0.002)
+    given = fit_frf(LINES, p1, p2, modes=5)  # given modes are fitted as they are
+    assert len(given.plant.modes) == 5 and given.bic_modes is None
+
+
+def test_lines_that_determine_no_mode_are_said_so_by_the_library(exact):
+    """The lowest 8 lines (1-2.6 Hz): the BIC put needles between them; none is determined,
+    which the library's fit now says first among its warnings (main: the needles without a
+    word on them but their damping)."""
+    p1, p2 = _magnitude_noise(exact, LINES, seed=0)
+    fit = fit_frf(LINES[:8], p1[:8], p2[:8])
+    assert fit.plant.modes and not any(determined_modes(fit))
+    assert fit.warnings[0].startswith("measured plant: no mode determined: the 8 lines "
+                                      f"(1-2.585 Hz) determine none of the {fit.bic_modes} "
+                                      "mode(s) the BIC chose")
+
+
+def test_every_route_gets_the_same_modes(capsys, tmp_path, exact):
+    """The file a scenario reads, fitted by the library (load_frd_plant, fit_measured_plant)
+    and by ``analyze --json``: the same one mode (main: the library's five)."""
+    import json
+
+    from motionhyst.cli import main
+    from motionhyst.plants.frf_fit import fit_measured_plant
+    from motionhyst.plants.measured import load_frd_plant
+
+    write_frd(tmp_path / "p.csv", LINES, *_magnitude_noise(exact, LINES, seed=1))
+    library = fit_measured_plant(load_frd_plant(tmp_path / "p.csv"))
+    assert main(["analyze", frd_toml(tmp_path, ""), "--frequency", "5", "--json"]) == 0
+    cli = json.loads(capsys.readouterr().out)["plant_fit"]
+    assert len(library.plant.modes) == len(cli["modes"]) == 1
+    assert cli["modes"][0]["frequency_hz"] == pytest.approx(library.plant.modes[0].frequency_hz,
+                                                            rel=1e-9)
+    assert cli["criterion"] == library.criterion and cli["bic_modes"] == 5
+
+
+# ---------------------------------------------------------------- a damping at its bound
+def test_a_damping_at_its_bound_says_so(exact):
+    """Table I's stage with b = 0.1 N s/m (damping 2.9e-6, below the fit's bound 1e-5): the
+    fit holds the damping at 1e-5, where the covariance's standard deviation is not the
+    data's (main printed 'damping = 1e-05 +- 5.8e-05' here, '+- 5.1e-17' for a needle); now
+    '(at its bound)', and in the JSON no standard deviation and ``damping_at_bound``."""
+    stage = ModalPlant.from_two_mass(TwoMassStage(5.0, 17.5, 0.1, 7.4e7))
+    fit = fit_frf(LINES, *measure(stage, seed=1))  # seeds 1, 2, 5 at the bound; 0, 3, 4 not
+    assert len(fit.plant.modes) == 1 and fit.plant.modes[0].damping == pytest.approx(1e-5)
+    line = next(x for x in str(fit).splitlines() if x.startswith("  mode 1:"))
+    assert "damping = 1e-05 (at its bound), r1 = " in line and "+- (" not in line
+    mode = fit.to_dict()["modes"][0]
+    assert mode["damping_std"] is None and mode["damping_at_bound"] is True
+    assert mode["r1_std"] == pytest.approx(7e-5, rel=0.2)  # the others keep theirs
+    free = fit_frf(LINES, *measure(exact, seed=0)).to_dict()["modes"][0]
+    assert free["damping_at_bound"] is False
+    assert free["damping_std"] == pytest.approx(6e-5, rel=0.2)

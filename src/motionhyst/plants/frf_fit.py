@@ -83,7 +83,8 @@ from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.modal import ModalPlant, Mode
 from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
 
-__all__ = ["FrfFit", "ModalPlant", "Mode", "determined_modes", "fit_frf"]
+__all__ = ["FrfFit", "ModalPlant", "Mode", "damping_at_bound", "determined_modes",
+           "fit_frf"]
 
 #: Largest number of modes the automatic choice tries.
 MAX_MODES = 6
@@ -245,6 +246,9 @@ class FrfFit:
         stiffness to ground (a negative ``Pf2(0)``, a mode below the lowest
         line), a mode a passive stage does not have, errors far above the
         noise in a decade band.  Empty for a fit to trust.
+    bic_modes : int or None
+        The number of modes the BIC chose, before those the lines do not determine were
+        dropped (:func:`fit_frf`); None where the modes were given.
 
     Examples
     --------
@@ -277,6 +281,7 @@ class FrfFit:
     delay_given: bool = False
     bic_other: dict = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    bic_modes: int | None = None
 
     def _complex_errors(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
         """``(P_model - P_data) / |P_data|`` of ``P1`` and ``P2`` at each measured frequency."""
@@ -324,9 +329,12 @@ class FrfFit:
             "model": "rigid body + modes (modal form, shared poles)",
             "M": p.M, "M_std": self.M_std, "mass_given": self.mass_given,
             "modes": [{"frequency_hz": m.frequency_hz, "frequency_hz_std": s["frequency_hz"],
-                       "damping": m.damping, "damping_std": s["damping"],
+                       "damping": m.damping,
+                       "damping_std": None if damping_at_bound(m.damping) else s["damping"],
+                       "damping_at_bound": damping_at_bound(m.damping),
                        "r1": m.r1, "r1_std": s["r1"], "r2": m.r2, "r2_std": s["r2"]}
                       for m, s in zip(p.modes, self.mode_std, strict=True)],
+            "bic_modes": self.bic_modes,
             "pf2_static": p.pf2_static, "pf2_static_std": self.pf2_static_std,
             "criterion": self.criterion,
             "bic": {str(k): v for k, v in self.bic.items()},
@@ -349,7 +357,7 @@ class FrfFit:
                  f"  M = {_pm(p.M, self.M_std)} kg" + (" (given)" if self.mass_given else "")]
         for i, (m, s) in enumerate(zip(p.modes, self.mode_std, strict=True), start=1):
             lines.append(f"  mode {i}: f = {_pm(m.frequency_hz, s['frequency_hz'])} Hz, "
-                         f"damping = {_pm(m.damping, s['damping'])}, "
+                         f"damping = {_damping(m.damping, s['damping'])}, "
                          f"r1 = {_pm(m.r1, s['r1'])} 1/kg, r2 = {_pm(m.r2, s['r2'])} 1/kg")
         lines.append(f"  Pf2(0) = {_pm(p.pf2_static, self.pf2_static_std)} m/N "
                      f"(flexible compliance at P2; sets eqs. 18-21 at low frequency)")
@@ -393,6 +401,34 @@ def _num(x: float) -> str:
     return "nan" if not np.isfinite(x) else f"{x:.4g}"
 
 
+def damping_at_bound(damping: float) -> bool:
+    """True for a mode's damping ratio at a bound of the fit (:data:`DAMPING_BOUNDS`, within
+    0.1 %): its standard deviation is then not the data's (the covariance drops the
+    direction the bound holds), nor is the value determined.
+
+    Parameters
+    ----------
+    damping : float
+        A fitted mode's damping ratio.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> damping_at_bound(1e-5), damping_at_bound(2.6e-3), damping_at_bound(1.0)
+    (True, False, True)
+    """
+    return bool(damping <= DAMPING_BOUNDS[0] * 1.001 or damping >= DAMPING_BOUNDS[1] * 0.999)
+
+
+def _damping(v: float, s: float) -> str:
+    """A damping ratio and its standard deviation, or "(at its bound)" where the fit holds it
+    at one."""
+    return f"{_num(v)} (at its bound)" if damping_at_bound(v) else _pm(v, s)
+
+
 def _pm(v: float, s: float) -> str:
     if s == 0:
         return _num(v)
@@ -420,6 +456,15 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     it is estimated with the modes and kept when it lowers the BIC (module
     docstring), and divided out of the data; the fitted plant is the
     mechanics without it.
+
+    Modes the BIC chooses but the lines do not determine (:func:`determined_modes`:
+    needles between or beside the lowest lines fitting their noise) are dropped: the
+    fit is made again with the modes the lines determine (at least one when the BIC
+    chose several, which may split a determined mode in two), until every mode is
+    determined; :attr:`FrfFit.criterion` says so and :attr:`FrfFit.bic_modes` keeps
+    the BIC's number.  Where the lines determine none of them, the BIC's fit is
+    returned with a first warning saying so (:data:`NONE_DETERMINED`).  Given `modes`
+    are fitted as they are.
 
     Parameters
     ----------
@@ -471,7 +516,46 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     >>> fit = fit_frf(f, p1 * lag, p2 * lag)
     >>> len(fit.plant.modes), round(fit.delay_s * 1e6, 3), round(fit.plant.M, 6)
     (1, 50.0, 22.5)
+
+    With 0.5 % noise the BIC puts needles between the lowest lines, which the lines do not
+    determine; they are dropped:
+
+    >>> rng = np.random.default_rng(1)
+    >>> noise = 1 + 0.005 * rng.standard_normal((2, f.size))
+    >>> fit = fit_frf(f, p1 * noise[0], p2 * noise[1])
+    >>> [round(m.frequency_hz) for m in fit.plant.modes], fit.bic_modes
+    ([694], 5)
+    >>> fit.criterion.split(";")[0]
+    "the BIC's 5 modes less 4 the lines do not determine"
     """
+    bic = _fit_frf(frequency_hz, P1, P2, modes, mass, max_modes, source, delay)
+    if modes is not None:
+        return bic
+    fit, chosen = bic, len(bic.plant.modes)
+    while (n := sum(determined_modes(fit))) < len(fit.plant.modes):
+        # one mode is tried before none: the BIC may split a mode the lines determine into
+        # two, each undetermined alone
+        n = max(n, 1) if len(fit.plant.modes) > 1 else 0
+        if n == 0:  # none determined: the BIC's fit, saying so (a scenario refuses it)
+            fit = bic
+            fit.warnings.insert(0, f"{NONE_DETERMINED} the {fit.frequency_hz.size} lines "
+                                f"({_num(fit.frequency_hz.min())}-{_num(fit.frequency_hz.max())}"
+                                f" Hz) determine none of the {chosen} mode(s) the BIC chose: "
+                                f"the modes, Pf2(0) and |E| are not the data's; measure up to "
+                                f"and beyond the first resonance")
+            break
+        fit = _fit_frf(frequency_hz, P1, P2, n, mass, max_modes, source, delay)
+        fit.criterion = fit.criterion.replace(
+            "modes given", f"the BIC's {chosen} modes less {chosen - n} the lines do not "
+            f"determine", 1)
+    fit.bic_modes = chosen
+    return fit
+
+
+def _fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | None,
+             mass: float | None, max_modes: int, source: str, delay: float | None) -> FrfFit:
+    """:func:`fit_frf` with the modes the BIC chooses (`modes` None) or those given, as they
+    are."""
     f = np.asarray(frequency_hz, dtype=float).ravel()
     p1 = np.asarray(P1, dtype=complex).ravel()
     p2 = np.asarray(P2, dtype=complex).ravel()
@@ -622,6 +706,10 @@ def _result(prob: FrfProblem, x, n, rss, criterion, bic, source) -> FrfFit:
     return fit
 
 
+#: How the warning of a fit whose lines determine none of its modes begins (:func:`fit_frf`;
+#: a scenario refuses such a fit).
+NONE_DETERMINED = "measured plant: no mode determined:"
+
 #: A fitted mode is seen by the lines when it changes ``P1`` or ``P2`` at one of them by more
 #: than this many times the data's noise (:func:`determined_modes`); a peak narrower than the
 #: lines resolve, next to them, needs :data:`NEEDLE_SEEN_RATIO` times.
@@ -671,9 +759,13 @@ def determined_modes(fit: FrfFit) -> list[bool]:
     >>> noise = 1 + 0.005 * np.random.default_rng(0).standard_normal((2, f.size))
     >>> determined_modes(fit_frf(f, p1 * noise[0], p2 * noise[1]))
     [True]
-    >>> fit = fit_frf(f[:3], p1[:3] * noise[0, :3], p2[:3] * noise[1, :3])  # 1-1.3 Hz
+    >>> fit = fit_frf(f[:3], p1[:3] * noise[0, :3], p2[:3] * noise[1, :3], modes=1)  # 1-1.3 Hz
     >>> [round(m.frequency_hz, 2) for m in fit.plant.modes], determined_modes(fit)
     ([1.23], [False])
+    >>> print(fit_frf(f[:3], p1[:3] * noise[0, :3], p2[:3] * noise[1, :3]).warnings[0])
+    measured plant: no mode determined: the 3 lines (1-1.312 Hz) determine none of the 1 \
+mode(s) the BIC chose: the modes, Pf2(0) and |E| are not the data's; measure up to and beyond \
+the first resonance
     """
     p, f = fit.plant, fit.frequency_hz
     if not p.modes:
@@ -753,7 +845,7 @@ def _diagnose(fit: FrfFit) -> list[str]:
         why = []
         if m.r1 < -3 * s["r1"]:
             why.append(f"r1 = {_num(m.r1)} 1/kg < 0")
-        if m.damping <= DAMPING_BOUNDS[0] * 1.001 or m.damping >= DAMPING_BOUNDS[1] * 0.999:
+        if damping_at_bound(m.damping):
             why.append(f"damping at its bound {_num(m.damping)}")
         if why and m not in low:  # those are in the warning above
             odd.append(f"mode {i} at {_num(m.frequency_hz)} Hz ({', '.join(why)})")

@@ -240,8 +240,8 @@ class Scenario:
         from motionhyst.plants.frf_fit import (
             ABOVE_NOISE,
             NEEDLE_SEEN_RATIO,
+            NONE_DETERMINED,
             SEEN_RATIO,
-            determined_modes,
             fit_measured_plant,
         )
         if m.plant.use == "data":
@@ -252,26 +252,15 @@ class Scenario:
                 scatter = None
             self._plant = dataclasses.replace(data, resolution=scatter)
             return self._plant
-        chosen = None
-        try:
+        try:  # the BIC's modes, less those the lines do not determine (fit_frf drops them)
             self._fit = fit_measured_plant(data, modes=m.plant.modes, mass=m.plant.mass,
                                            delay=m.plant.delay)
-            if m.plant.modes is None:  # the BIC's modes, less those the lines do not determine
-                chosen = len(self._fit.plant.modes)
-                while (n := sum(determined_modes(self._fit))) < len(self._fit.plant.modes):
-                    # one mode is tried before none: the BIC may split a mode the lines
-                    # determine into two, each undetermined alone
-                    n = max(n, 1) if len(self._fit.plant.modes) > 1 else 0
-                    self._fit = fit_measured_plant(data, modes=n, mass=m.plant.mass,
-                                                   delay=m.plant.delay)
-                    self._fit.criterion = self._fit.criterion.replace(
-                        "modes given", f"the BIC's {chosen} modes less {chosen - n} the lines "
-                        f"do not determine", 1)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body "
                                 f"plus modes: {exc}") from None
-        if not self._fit.plant.modes:  # Pf2 = 0: eqs. (18)-(21) divide by it
-            n = len(self._fit.frequency_hz)
+        none = [w for w in self._fit.warnings if w.startswith(NONE_DETERMINED)]
+        if not self._fit.plant.modes or none:  # Pf2 = 0: eqs. (18)-(21) divide by it
+            n, chosen = len(self._fit.frequency_hz), self._fit.bic_modes
             why = ("modes = 0 leaves" if m.plant.modes == 0 else
                    f"{n} measured lines cannot determine a mode (4 parameters more), which "
                    f"leaves" if 4 * n < 2 * (4 + (m.plant.mass is None)) else
