@@ -466,6 +466,44 @@ def test_a_two_mass_bouc_wen_fits_last_run_is_held_wherever_its_search_is(tmp_pa
     assert not (tmp_path / "m.toml").exists()
 
 
+def test_a_fits_last_run_above_the_search_is_refused_before_the_search(monkeypatch):
+    """Review A16 L3: the run of the fitted model from rest that judges a two-mass Bouc-Wen
+    fit (io_bouc_wen._check_final_run) is sized before the search, at the search's steps.  It
+    is above the search's own estimate where the steps a sample are many (2000 samples at
+    400 steps: 16.8 MB against 14.6; at 200 steps 8.4 against 8.2; at 37, 1.6 against 3.0):
+    under a budget of 15 MB the search would fit, its last run would not, and the refusal
+    is that run's, one line, before any evaluation."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_identify_two_mass import _record
+
+    from motionhyst.core.budget import BudgetError, set_max_memory
+    from motionhyst.identify import io_bouc_wen
+    from motionhyst.identify.input_output import identify_io
+    from motionhyst.plants.two_mass import TwoMassStage
+    from motionhyst.time.openloop import OpenLoop
+
+    rec = _record(2000, 1, noise=1e-7)
+    stage = TwoMassStage(m1=2.0, m2=3.0, b=20.0, k=2e5, output="y2")
+    run = OpenLoop(stage).memory(rec.u, 400)
+    search = io_memory.bouc_wen_memory([2000], 400)["total"]
+    assert search < 15 << 20 < run < 1.25 * search  # 14.6 MB < 15.7 MB < 16.8 MB
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("the search started")
+
+    monkeypatch.setattr(io_bouc_wen, "_BoucWenProblem", no_search)
+    set_max_memory(15 << 20)
+    try:
+        with pytest.raises(BudgetError) as refused:
+            identify_io([rec], "bouc-wen", plant=stage, substeps=400)
+    finally:
+        set_max_memory(None)
+    line = str(refused.value)
+    assert "\n" not in line and line.startswith(
+        "record 1: the run of the fitted model from rest (2000 samples of at least 400 "
+        "integration steps each) needs 16.8 MB, above the memory budget of 15.7 MB"), line
+
+
 def test_the_help_says_how_max_evaluations_is_shared(capsys):
     """Review A12b L2: with --max-evaluations the refinement's stages (the starts' best, the
     window's state, for a link on an axis the segments' end, a Coulomb link's finer secants) share
