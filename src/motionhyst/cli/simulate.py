@@ -195,7 +195,8 @@ def _check_size(args: argparse.Namespace, sc, ref, duration: float, out) -> str:
                            f"Hz) or shorten --duration ({duration:g} s), or write "
                            f"--time-series where there is room")
         check_steps_work((rows - 1) * per_row + 1, (sc.hysteresis(),), remedy, rows)
-        check_time_series_memory((rows - 1) * per_row + 1, per_row, rate is not None, remedy)
+        check_time_series_memory((rows - 1) * per_row + 1, per_row, rate is not None, remedy,
+                                 ref)
     if pole is not None or rate is not None:  # the run's own step, before its loop is built
         check_link_damping_for(sc, None if pole is None else run_step)
     return remedy

@@ -17,8 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import check_unread, read_record
 
-__all__ = ["SPLINE_SAMPLE_BYTES", "PointToPoint", "SampledReference", "SineReference",
-           "check_spline_memory", "load_reference_csv"]
+__all__ = ["SPLINE_KEPT_BYTES", "SPLINE_SAMPLE_BYTES", "PointToPoint", "SampledReference",
+           "SineReference", "check_spline_memory", "load_reference_csv", "reference_bytes"]
 
 
 @dataclass(frozen=True)
@@ -248,6 +248,36 @@ SPLINE_SAMPLE_BYTES = 240
 """Memory a sampled reference takes per sample while its quintic spline is made [bytes]
 (the spline keeps 56).  Measured, 1e6 samples read from a CSV file: 216 MB traced, 271 MB of
 address space above a warmed process, the reading's 46 MB included."""
+
+
+SPLINE_KEPT_BYTES = 56
+"""Memory a sampled reference keeps per sample once its spline is made, for as long as a run
+uses it [bytes]: its time and position, the spline's knots and coefficients (measured, 1e6
+samples read from a CSV file by :func:`load_reference_csv`: 56.2 traced)."""
+
+
+def reference_bytes(reference) -> float:
+    """Memory a run's `reference` holds while the run goes [bytes]: a sampled reference's
+    :data:`SPLINE_KEPT_BYTES` a sample, none for a built-in one.
+
+    Parameters
+    ----------
+    reference : object
+        The run's reference.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(10_000) / 1e3
+    >>> reference_bytes(SampledReference(t, 1e-3 * np.sin(t))), reference_bytes(None)
+    (560000.0, 0.0)
+    """
+    return SPLINE_KEPT_BYTES * float(reference.t.size) \
+        if isinstance(reference, SampledReference) else 0.0
 
 
 def check_spline_memory(samples: list[int]) -> None:

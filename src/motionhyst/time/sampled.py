@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import check_memory
 from motionhyst.time.engine import run_sampled
+from motionhyst.time.references import reference_bytes
 from motionhyst.time.simulation_result import Simulation
 from motionhyst.time.steps import MAX_SAMPLES, SAMPLED_SAMPLE_BYTES, RunTooLarge, a_run
 
@@ -139,8 +140,9 @@ def simulate_sampled(loop: Loop, reference, duration: float, *, force=None,
         raise RunTooLarge(f"{n} controller samples: too many (at most {MAX_SAMPLES:.0e})",
                           "shorten the duration")
     with a_run():
-        check_memory(SAMPLED_SAMPLE_BYTES * float(n), f"a run of {n} controller samples at "
-                     f"{c.sample_rate_hz:g} Hz (held whole)", "shorten the duration")
+        check_memory(SAMPLED_SAMPLE_BYTES * float(n) + reference_bytes(reference),
+                     f"a run of {n} controller samples at {c.sample_rate_hz:g} Hz (held whole)",
+                     "shorten the duration")
     t = np.arange(n) * c.period
     r, _ = reference(t)
     r = np.asarray(r, dtype=float)

@@ -25,7 +25,12 @@ from numpy.typing import NDArray
 
 from motionhyst.core.budget import check_memory, max_memory
 from motionhyst.core.textfiles import csv_header, csv_rows
-from motionhyst.time.references import PointToPoint, SampledReference, SineReference
+from motionhyst.time.references import (
+    PointToPoint,
+    SampledReference,
+    SineReference,
+    reference_bytes,
+)
 from motionhyst.time.steps import (
     RUN_REMEDY,
     SAMPLED_SAMPLE_BYTES,
@@ -123,10 +128,10 @@ def reference_rate_hz(reference: SampledReference) -> float:
     return 1.0 / float(np.median(np.diff(reference.t)))
 
 
-def time_series_chunk(steps: int, per_row: int) -> int:
+def time_series_chunk(steps: int, per_row: int, held: float = 0.0) -> int:
     """Integration samples :func:`run_time_series` computes at a time for a continuous loop:
     the samples of :data:`ROWS_PER_CHUNK` rows, at most :data:`MAX_CHUNK`, and no more than
-    the memory budget holds (:data:`CHUNK_SAMPLE_BYTES` a sample; at least
+    the memory budget holds beside `held` (:data:`CHUNK_SAMPLE_BYTES` a sample; at least
     :data:`MIN_CHUNK`), so that a long run is written in smaller pieces rather than refused.
 
     Parameters
@@ -135,6 +140,9 @@ def time_series_chunk(steps: int, per_row: int) -> int:
         Integration samples of the run.
     per_row : int
         Samples a row (:func:`~motionhyst.time.steps.time_series_grid`).
+    held : float
+        Bytes the run holds beside its chunks (a sampled reference:
+        :func:`~motionhyst.time.references.reference_bytes`).
 
     Returns
     -------
@@ -151,17 +159,19 @@ def time_series_chunk(steps: int, per_row: int) -> int:
     83886
     >>> set_max_memory(None)
     """
-    fit = max(MIN_CHUNK, int(max_memory() // CHUNK_SAMPLE_BYTES))
+    fit = max(MIN_CHUNK, int(max(max_memory() - held, 0.0) // CHUNK_SAMPLE_BYTES))
     return max(1, min(int(steps), int(per_row) * ROWS_PER_CHUNK, MAX_CHUNK, fit))
 
 
 def check_time_series_memory(steps: int, per_row: int, sampled: bool,
-                             remedy: str = RUN_REMEDY) -> None:
+                             remedy: str = RUN_REMEDY, reference=None) -> None:
     """Refuse, before it starts, a run of :func:`run_time_series` whose memory is above the
     budget: a continuous loop's run is computed a chunk at a time
     (:func:`time_series_chunk`, :data:`CHUNK_SAMPLE_BYTES` a sample: refused only where
     the budget holds less than :data:`MIN_CHUNK` samples); a sampled controller's is held
-    whole (:data:`~motionhyst.time.steps.SAMPLED_SAMPLE_BYTES` a controller sample).
+    whole (:data:`~motionhyst.time.steps.SAMPLED_SAMPLE_BYTES` a controller sample); a
+    sampled `reference` is held beside either
+    (:func:`~motionhyst.time.references.reference_bytes`).
 
     Parameters
     ----------
@@ -173,6 +183,8 @@ def check_time_series_memory(steps: int, per_row: int, sampled: bool,
         The loop's controller is sampled.
     remedy : str
         What the caller can change.
+    reference : object, optional
+        The run's reference (a sampled one's spline counts).
 
     Raises
     ------
@@ -192,14 +204,15 @@ def check_time_series_memory(steps: int, per_row: int, sampled: bool,
 of 105 MB (--max-memory); shorten the duration or lower the reference's frequencies
     >>> set_max_memory(None)
     """
+    held = reference_bytes(reference)
     if sampled:
         nbytes, what = SAMPLED_SAMPLE_BYTES * float(steps), f"{steps} controller samples " \
             "(held whole)"
     else:
-        chunk = time_series_chunk(steps, per_row)
+        chunk = time_series_chunk(steps, per_row, held)
         nbytes, what = CHUNK_SAMPLE_BYTES * float(chunk), f"{steps} time steps ({chunk} at a time)"
     with a_run():
-        check_memory(nbytes, f"a run of {what}", remedy)
+        check_memory(nbytes + held, f"a run of {what}", remedy)
 
 
 @dataclass
@@ -312,7 +325,8 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
     n_rows, per_row, step = time_series_grid(
         duration, output_rate_hz, dynamics_step(loop, reference),
         None if loop.sampled is None else loop.sampled.sample_rate_hz, set_by=why)
-    check_time_series_memory((n_rows - 1) * per_row + 1, per_row, loop.sampled is not None)
+    check_time_series_memory((n_rows - 1) * per_row + 1, per_row, loop.sampled is not None,
+                             reference=reference)
     end = (n_rows - 1) * period_out
     window = move = None
     if isinstance(reference, SineReference):
@@ -326,7 +340,8 @@ def run_time_series(loop: Loop, reference, duration: float, out: IO[str] | None 
         csv_header(out, COLUMNS)
     rows = 0
     steps = 0
-    chunk = time_series_chunk((n_rows - 1) * per_row + 1, per_row)  # within the budget
+    chunk = time_series_chunk((n_rows - 1) * per_row + 1, per_row,  # within the budget
+                              reference_bytes(reference))
     from motionhyst.time.simulation import simulate_chunks
 
     for piece in simulate_chunks(loop, reference, end, dt=step, chunk=chunk):
