@@ -24,8 +24,6 @@ from motionhyst.core.budget import check_memory
 from motionhyst.hysteresis.stepping import Stepping
 from motionhyst.identify.residual_noise import white_noise_variance
 from motionhyst.time.openloop import (
-    FINE_BYTES,
-    SAMPLE_BYTES,
     OpenLoop,
     check_record,
     sampling_rate,
@@ -33,11 +31,59 @@ from motionhyst.time.openloop import (
 )
 from motionhyst.time.resample import fine_blocks, held_nodes
 
-__all__ = ["INIT_WINDOW", "WindowPrediction", "predict_from_window", "run_from_state",
-           "state_from_window", "window_noise_floor"]
+__all__ = ["INIT_WINDOW", "WINDOW_NODE_BYTES", "WINDOW_RUN_SAMPLE_BYTES", "WINDOW_SAMPLE_BYTES",
+           "WindowPrediction", "predict_from_window", "run_from_state", "state_from_window",
+           "window_memory", "window_noise_floor"]
 
 #: The benchmark's initialisation window [samples]
 INIT_WINDOW = 20
+
+WINDOW_SAMPLE_BYTES = 480
+"""Memory of :func:`predict_from_window` per record sample where its samples decide [bytes]
+(the noise floor's runs and sensitivities, :func:`window_noise_floor`): measured 384.0 traced
+and 352 of address space, Jenkins, Dahl, Maxwell-slip, LuGre and Bouc-Wen links, on a
+mass-spring-damper, an axis and a two-mass stage, 2e4 to 2e5 samples at 5 to 20 steps; 25 %
+above."""
+WINDOW_NODE_BYTES = 40
+"""Memory of :func:`predict_from_window` per fine node of a block where its blocks decide
+[bytes]: measured 31 of address space (16.4 traced: the compiled kernels' arrays are not),
+blocks of 2e6 nodes, 2e4 to 1e5 samples at 20 to 100 steps; with
+:data:`WINDOW_RUN_SAMPLE_BYTES` a sample, 25-31 % above."""
+WINDOW_RUN_SAMPLE_BYTES = 60
+"""Memory of :func:`predict_from_window` per record sample beside its blocks [bytes]
+(measured 46 of address space, 32 traced)."""
+
+
+def window_memory(u: NDArray[np.float64], substeps: int) -> float:
+    """Bytes :func:`predict_from_window` needs at most for the force `u` at `substeps`
+    integration steps a sample: the larger of its samples' (:data:`WINDOW_SAMPLE_BYTES` a
+    sample) and its blocks' (:data:`WINDOW_NODE_BYTES` a node held,
+    :func:`~motionhyst.time.resample.held_nodes`, and :data:`WINDOW_RUN_SAMPLE_BYTES` a
+    sample); main's 48 a node and 64 a sample were 1.5-1.6 times the peak where the
+    blocks decide, and below it where the samples do (2e4 samples at 5 steps: 6.1 MB against
+    7.7 traced).
+
+    Parameters
+    ----------
+    u : ndarray
+        The record's force.
+    substeps : int
+        Integration steps per sample.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> round(window_memory(np.zeros(200_000), 10) / 1e6, 1)       # its samples decide
+    96.0
+    >>> round(window_memory(np.zeros(20_000), 100) / 1e6, 1)       # its blocks
+    81.2
+    """
+    return max(WINDOW_SAMPLE_BYTES * float(u.size),
+               WINDOW_NODE_BYTES * float(held_nodes(u, int(substeps)))
+               + WINDOW_RUN_SAMPLE_BYTES * float(u.size))
 
 
 @dataclass
@@ -306,8 +352,8 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     st = Stepping.empty() if system.hysteresis is None else system.hysteresis.time_stepping()
     k_link = system.hysteresis.initial_stiffness if system.hysteresis is not None else 0.0
     # the record's force in blocks (time.resample.fine_blocks), as OpenLoop.simulate runs it
-    check_memory(FINE_BYTES * held_nodes(u, r) + SAMPLE_BYTES * u.size,
-                 f"{u.size} samples of {r} integration steps each", "fewer samples or substeps")
+    check_memory(window_memory(u, r), f"{u.size} samples of {r} integration steps each",
+                 "fewer samples or substeps")
     position, velocity = state_from_window(mech, st, k_link, u, y, fs, r, window)
     yhat, _ = run_from_state(mech, st, k_link, u, fs, r, position, velocity)
     pred = _scored(tt, yhat, y, window, position, velocity)
