@@ -52,7 +52,8 @@ from motionhyst.hysteresis.periodic import (
     stop_twiddles,
 )
 
-__all__ = ["SteadyState", "periodic_steady_state", "samples_per_period", "steady_state_sweep"]
+__all__ = ["SteadyState", "check_steady_frequencies", "periodic_steady_state",
+           "samples_per_period", "steady_state_sweep"]
 
 MIN_HARMONICS = 32
 MAX_HARMONICS = 4096
@@ -523,6 +524,46 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     e = e_lin + G_e * (W - U_h)
     return (_sin_amplitudes(e), _sin_amplitudes(X), _sin_amplitudes(W), _sin_amplitudes(e_lin),
             it, residual, converged, weights, first_weights)
+
+
+def check_steady_frequencies(loop: Loop, frequencies_hz: ArrayLike) -> None:
+    """Refuse, before any work, the frequencies at which :func:`periodic_steady_state` of
+    `loop` has no answer: a plant of raw measured lines (no harmonics), a sampled loop's
+    frequency whose period is not a whole number of samples (:func:`samples_per_period`).
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop with its link.
+    frequencies_hz : array_like
+        The frequencies asked [Hz].
+
+    Raises
+    ------
+    ValueError
+        The message :func:`periodic_steady_state` would give at the first such frequency.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario
+    >>> from motionhyst.analysis.steady import check_steady_frequencies
+    >>> sc = default_scenario(check=False)
+    >>> sc.model.controller.sample_rate_hz = 10e3          # Table I's controller at 10 kHz
+    >>> loop = sc.loop()
+    >>> check_steady_frequencies(loop, [5.0, 10.0])
+    >>> try:
+    ...     check_steady_frequencies(loop, [5.0, 7.0])
+    ... except ValueError as err:
+    ...     print(err)
+    the steady state of a loop sampled at 10000 Hz needs a whole number of samples per \
+period: 7 Hz has 1428.57; the nearest frequency that has one is 6.997900629811 Hz (1429 samples)
+    """
+    if not loop.plant.is_lti:
+        raise ValueError("the steady state needs the plant at every harmonic n f, which raw "
+                         "measured lines do not give; fit the data ([plant] use = \"fit\")")
+    if loop.sampled is not None:
+        for f in np.atleast_1d(frequencies_hz):
+            samples_per_period(loop.sampled.sample_rate_hz, float(f))
 
 
 def samples_per_period(sample_rate_hz: float, frequency_hz: float) -> int:

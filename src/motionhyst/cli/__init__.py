@@ -23,11 +23,13 @@ from collections.abc import Sequence
 
 from motionhyst.cli._common import (
     EXIT_USAGE,
+    HeldWarnings,
     Parser,
     UsageError,
     memory_size,
     one_line,
     positive,
+    release_held,
     warnings_on_stderr,
 )
 from motionhyst.cli.identify import feedforward_fragment, record_kind
@@ -126,6 +128,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # cycles are left to the operating system
         atexit.register(gc.freeze)
     interrupts = _Interrupts()
+    held = HeldWarnings()
     closed = not _writable(sys.stdout)  # ``>&-`` (None) or opened for reading (``1</dev/null``)
     try:
         parser = build_parser()
@@ -143,8 +146,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         set_max_seconds(args.before_max_seconds if args.max_seconds is None
                         else args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
-        with warnings_on_stderr(args.command):
-            _warn_budget_beyond_machine(args)
+        with warnings_on_stderr(args.command, held):
+            _warn_budget_beyond_machine(args)  # at once: it is about the process being killed
+            held.hold()  # the others until the command's checks before its work pass
             code = args.func(args)
         if interrupts.received:  # a library swallowed it (an optional import that failed)
             raise KeyboardInterrupt
@@ -152,15 +156,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         return code
     except BrokenPipeError:  # output piped into head, say: not an error
         sys.stdout = open(os.devnull, "w")
+        held.release()
         return 0
     except KeyboardInterrupt:
         interrupts.close()
+        held.release()  # no warning lost: an interrupted run shows what it was warned of
         _say("motionhyst: interrupted")
         return 130
     except Exception as exc:
         interrupts.close()
         if not (interrupts.received or interrupted(exc)):
-            return _failed(exc)
+            return _failed(exc, held)
+        held.release()
         _say("motionhyst: interrupted")
         return 130
     finally:
@@ -287,6 +294,7 @@ class _NamedOutput:
         self.stream = stream
 
     def write(self, text: str) -> int:
+        release_held()  # the results begin: the warnings held so far come first
         try:
             return self.stream.write(text)
         except BrokenPipeError:
@@ -349,8 +357,14 @@ def _warn_budget_beyond_machine(args: argparse.Namespace) -> None:
              f"refused")
 
 
-def _failed(exc: Exception) -> int:
-    """One line on stderr for an exception that ended a command; its exit code."""
+def _failed(exc: Exception, held: HeldWarnings) -> int:
+    """One line on stderr for an exception that ended a command; its exit code.  The
+    warnings `held` while the command checked its input are dropped for a refusal of it,
+    shown before the line of a defect of the tool."""
+    if isinstance(exc, (UsageError, OSError, ValueError, RuntimeError, MemoryError)):
+        held.drop()
+    else:
+        held.release()
     try:
         raise exc
     except UsageError as exc:  # "motionhyst identify: ..." -> "motionhyst: error: identify: ..."

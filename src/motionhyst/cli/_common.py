@@ -7,15 +7,16 @@ import argparse
 import contextlib
 import math
 import os
+import signal
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 
 from motionhyst.core.textfmt import g, table
 
-__all__ = ["EXIT_USAGE", "Parser", "UsageError", "add_record_options", "finite", "g",
-           "harmonic_count", "memory_size", "nonnegative", "one_line", "positive", "print_json",
-           "table", "whole_number"]
+__all__ = ["EXIT_USAGE", "HeldWarnings", "Parser", "UsageError", "add_record_options", "finite",
+           "g", "harmonic_count", "memory_size", "nonnegative", "one_line", "positive",
+           "print_json", "release_held", "say_later", "table", "whole_number"]
 
 EXIT_USAGE = 2
 """Exit code of every user error."""
@@ -327,10 +328,129 @@ def scenario_frequencies(sc, given: Sequence[float] | None, command: str) -> lis
 
 
 # ----------------------------------------------------------------- plausibility warnings
+class HeldWarnings:
+    """The warning lines of a running command, held while it checks its input.
+
+    A command reads, judges and sizes its input before its work; a warning raised meanwhile
+    (a stage's mass off by orders of magnitude, a record's time in ms) is held
+    (:meth:`hold`) until those checks pass (:meth:`release`, from :func:`release_held`),
+    then shown at once, and every later one as it comes.  A refusal before the work
+    (:meth:`drop`) is then the one line it says; an interruption shows them
+    (:meth:`release`) before ``motionhyst: interrupted``.  Nothing is held in a forked
+    worker: its lines are shown as they come.
+
+    Examples
+    --------
+    >>> import sys
+    >>> sys.stderr = sys.stdout                            # to show the lines here
+    >>> held = HeldWarnings()
+    >>> held.hold()
+    >>> held.say("motionhyst: warning: steady: a line")    # held: nothing shown yet
+    >>> held.release()                                     # the checks passed
+    motionhyst: warning: steady: a line
+    >>> held.say("motionhyst: warning: steady: another")   # shown as it comes
+    motionhyst: warning: steady: another
+    >>> sys.stderr = sys.__stderr__
+    """
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.holding = False
+        self.pid = os.getpid()
+
+    def hold(self) -> None:
+        """Hold the lines from now on, until :meth:`release` or :meth:`drop`."""
+        self.holding = True
+
+    def say(self, line: str) -> None:
+        """Show `line` on stderr, or hold it while the command checks its input."""
+        if self.holding and os.getpid() == self.pid:
+            self.lines.append(line)
+        else:
+            _write_lines([line])
+
+    def release(self) -> None:
+        """Show the lines held (one write) and every later one as it comes.
+
+        Ctrl-C and SIGTERM are blocked while they are written and forgotten: a signal then
+        comes after, never between (its interruption would show them again, or, forgotten
+        first, lose them)."""
+        self.holding = False
+        if not self.lines:
+            return
+        mask = getattr(signal, "pthread_sigmask", None)
+        previous = None
+        try:
+            if mask is not None:
+                previous = mask(signal.SIG_BLOCK, ())
+                mask(signal.SIG_BLOCK, (signal.SIGINT, signal.SIGTERM))
+            _write_lines(self.lines)
+            self.lines = []
+        finally:
+            if previous is not None:
+                mask(signal.SIG_SETMASK, previous)
+
+    def drop(self) -> None:
+        """Forget the lines held: a refusal of the input says all, in one line."""
+        self.holding = False
+        self.lines = []
+
+
+_RUNNING: list[HeldWarnings] = []
+"""The held warnings of the command running (:func:`warnings_on_stderr`), if any."""
+
+
+def _write_lines(lines: Sequence[str]) -> None:
+    """`lines` on stderr in one write; a stderr that cannot be written loses them."""
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write("".join(f"{line}\n" for line in lines))
+        sys.stderr.flush()
+
+
+def say_later(line: str) -> None:
+    """`line` (a warning or notice of the running command) on stderr, held with its warnings
+    while the command checks its input (:class:`HeldWarnings`); at once outside a command.
+
+    Parameters
+    ----------
+    line : str
+        The whole line, ``motionhyst: warning: ...``.
+
+    Examples
+    --------
+    >>> import sys
+    >>> sys.stderr = sys.stdout                            # to show the line here
+    >>> say_later("motionhyst: warning: analyze: a line")
+    motionhyst: warning: analyze: a line
+    >>> sys.stderr = sys.__stderr__
+    """
+    if _RUNNING:
+        _RUNNING[-1].say(line)
+    else:
+        _write_lines([line])
+
+
+def release_held() -> None:
+    """The running command's checks before its work have passed (its input read, judged and
+    sized): the warnings held so far are shown now, the later ones as they come.
+
+    Every command calls it where its long work starts; its first line of results calls it
+    too, so its warnings come before them.
+
+    Examples
+    --------
+    >>> release_held()  # nothing held outside a command
+    """
+    if _RUNNING:
+        _RUNNING[-1].release()
+
+
 @contextlib.contextmanager
-def warnings_on_stderr(command: str) -> Iterator[None]:
+def warnings_on_stderr(command: str, held: HeldWarnings | None = None) -> Iterator[None]:
     """Show each :class:`~motionhyst.core.warnings.MotionhystWarning` raised inside as one line
-    ``motionhyst: warning: COMMAND: message`` on stderr, when it is raised, every time.
+    ``motionhyst: warning: COMMAND: message`` on stderr, every time: when it is raised, or,
+    while `held` holds (:class:`HeldWarnings`: the command checks its input), once the checks
+    pass.
 
     Another library's warning (numpy's ``invalid value encountered``, say) is one
     such line as well, naming its kind, never a source path and line (with
@@ -342,6 +462,10 @@ def warnings_on_stderr(command: str) -> Iterator[None]:
     ----------
     command : str
         The command's name, put before each message.
+    held : HeldWarnings, optional
+        Where the lines are held; shown when the block ends normally.  When it ends in an
+        exception, its caller decides: :meth:`~HeldWarnings.drop` for a refusal,
+        :meth:`~HeldWarnings.release` for an interruption.
 
     Examples
     --------
@@ -351,25 +475,40 @@ def warnings_on_stderr(command: str) -> Iterator[None]:
     >>> with warnings_on_stderr("analyze"):
     ...     warn("0.05 Hz below f* = 0.15 Hz (eq. 13)")
     motionhyst: warning: analyze: 0.05 Hz below f* = 0.15 Hz (eq. 13)
+    >>> held = HeldWarnings()
+    >>> try:
+    ...     with warnings_on_stderr("analyze", held):
+    ...         held.hold()                                # the command checks its input
+    ...         warn("0.05 Hz below f* = 0.15 Hz (eq. 13)")
+    ...         raise ValueError("refused")                # a refusal before the work
+    ... except ValueError:
+    ...     held.drop()                                    # its one line is all it says
     >>> sys.stderr = sys.__stderr__
     """
     from motionhyst.core.warnings import MotionhystWarning
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("always", MotionhystWarning)
-        python_shows = warnings.showwarning
+    held = HeldWarnings() if held is None else held
+    _RUNNING.append(held)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", MotionhystWarning)
+            python_shows = warnings.showwarning
 
-        def show(message, category, filename, lineno, file=None, line=None):
-            if issubclass(category, MotionhystWarning):
-                print(f"motionhyst: warning: {one_line(f'{command}: {message}')}", file=sys.stderr)
-            elif os.environ.get("MOTIONHYST_TRACEBACK"):
-                python_shows(message, category, filename, lineno, file, line)
-            else:
-                text = f"{command}: {category.__name__}: {message}"
-                print(f"motionhyst: warning: {one_line(text)}", file=sys.stderr)
+            def show(message, category, filename, lineno, file=None, line=None):
+                if issubclass(category, MotionhystWarning):
+                    held.say(f"motionhyst: warning: {one_line(f'{command}: {message}')}")
+                elif os.environ.get("MOTIONHYST_TRACEBACK"):
+                    held.release()
+                    python_shows(message, category, filename, lineno, file, line)
+                else:
+                    text = f"{command}: {category.__name__}: {message}"
+                    held.say(f"motionhyst: warning: {one_line(text)}")
 
-        warnings.showwarning = show
-        yield
+            warnings.showwarning = show
+            yield
+    finally:
+        _RUNNING.remove(held)
+    held.release()
 
 
 def warn_plant_fit(sc) -> None:

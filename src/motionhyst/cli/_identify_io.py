@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import warnings
 
-from motionhyst.cli._common import UsageError, g, print_json, table, whole_number
+from motionhyst.cli._common import UsageError, g, print_json, release_held, table, whole_number
 
 
 def plant_choices() -> list[str]:
@@ -427,7 +427,10 @@ SEARCH_REMEDY = "give a shorter record or fewer --max-evaluations, or a larger -
 def search_budget():
     """The work budget of identify's search, a context around the fit alone: no formula sizes
     a search that stops when it converges, so it is stopped after ``--max-seconds`` of CPU
-    time (:func:`motionhyst.core.budget.cpu_time_limit`), exit 2, nothing saved."""
+    time (:func:`motionhyst.core.budget.cpu_time_limit`), exit 2, nothing saved.  The search
+    is the command's work: the warnings held while its input was checked are shown as it
+    starts."""
     from motionhyst.core.budget import cpu_time_limit, max_seconds
 
+    release_held()
     return cpu_time_limit(max_seconds(), "identify", SEARCH_REMEDY)

@@ -8,6 +8,7 @@ from motionhyst.cli._common import (
     distinct,
     positive,
     print_json,
+    release_held,
     scenario_frequencies,
     warn_plant_fit,
 )
@@ -29,6 +30,7 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.analysis.quasilinear import analyze
 
     mode = "self-consistent" if args.self_consistent else "reference"
+    release_held()  # the analysis starts: the warnings so far are shown
     res = analyze(loop, amplitude, freqs, amplitude_mode=mode)
     fit = sc.plant_fit()
     warn_plant_fit(sc)

@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from motionhyst.cli._common import UsageError, g, print_json, table, whole_number
+from motionhyst.cli._common import UsageError, g, print_json, release_held, table, whole_number
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -102,6 +102,7 @@ def run_bouc_wen(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"  {msg}", file=sys.stderr, flush=True)
 
+    release_held()  # the work starts: the warnings so far are shown
     res = run_benchmark(data, seed=args.seed, progress=say)
     res["data"] = str(data)
     if args.json:
@@ -178,6 +179,7 @@ def run_emps(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"  {msg}", file=sys.stderr, flush=True)
 
+    release_held()  # the fits start: the warnings so far are shown
     if test is None and args.periods in (None, "all"):  # one split alone says little
         results = cross_validate(estimation, models=models, progress=say,
                                  splits="halves" if args.periods is None else "all")

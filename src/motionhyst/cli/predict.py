@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from motionhyst.cli._common import UsageError, add_record_options, print_json
+from motionhyst.cli._common import UsageError, add_record_options, print_json, release_held
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -125,6 +125,7 @@ def run(args: argparse.Namespace) -> int:
                              f"of {args.data} (the same time column)")
         _check_same_run(args, u, rec.u)
     u_model, noise = u, None
+    release_held()  # the run starts: the warnings so far are shown
     try:
         if not system.plant.has_inertia:  # the link's input without the load cell's white
             from motionhyst.identify.displacement_noise import estimate_displacement
@@ -456,6 +457,7 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
         check_whole_periods(x, str(args.data))
     from motionhyst.identify.displacement_noise import estimate_displacement
 
+    release_held()  # the run starts: the warnings so far are shown
     try:
         # the link's input without the sensor's white noise, as identify estimates it
         x, noise = estimate_displacement(t, x, periodic=args.periodic)

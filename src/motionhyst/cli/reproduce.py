@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import add_force_option, warn_plant_fit
+from motionhyst.cli._common import add_force_option, release_held, warn_plant_fit
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -17,14 +17,15 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.present.report import reproduce
     from motionhyst.scenario import load_scenario
 
-    # the loop is built (and checked) inside reproduce, while the first figures are drawn
+    # the loop is built (and checked) inside reproduce, while the first figures are drawn; the
+    # warnings held until then are shown once it is (checked), as the long work starts
     sc = load_scenario(args.scenario, check=False)
     # no formula sizes the report's figures: its CPU time is bounded as a search's is, and a
     # report stopped writes none of its files
     with cpu_time_limit(max_seconds(), "reproduce", "raise --max-seconds (Table I's report "
                         "takes about a minute of CPU time)"):
         reproduce(sc, args.out, quiet=args.quiet, is_paper=args.scenario is None,
-                  force=args.force, inputs=sc.files)
+                  force=args.force, inputs=sc.files, checked=release_held)
     warn_plant_fit(sc)
     if not args.quiet:
         print(f"wrote {args.out}/report.md, summary.json and fig5-fig11 (.png, .pdf), listed in "

@@ -19,6 +19,7 @@ from motionhyst.cli._common import (
     positive,
     print_json,
     refuse_unused,
+    release_held,
     warn_plant_fit,
     whole_number,
 )
@@ -384,6 +385,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"{PROG}: --compensation model needs a [feedforward] hysteresis "
                          f"model or feedforward terms (--feedforward), and {sc.source} has none")
     filters = ILCFilters(args.ilc_gain, args.ilc_cutoff, args.ilc_order)
+    release_held()  # the runs start: the warnings so far are shown
     try:
         with in_the_commands_terms(sc, REMEDY):
             res = run_scan(loop, profile, args.window, comps, args.ilc_trials, filters, other,

@@ -20,6 +20,7 @@ from motionhyst.cli._common import (
     positive,
     print_json,
     refuse_unused,
+    release_held,
     warn_plant_fit,
 )
 
@@ -291,6 +292,7 @@ def _time_series(args: argparse.Namespace, sc) -> int:
     if args.settle_band is not None:
         options["settle_band"] = args.settle_band
     loop = sc.loop()
+    release_held()  # the run starts: the warnings so far are shown
     with out.open(newline="") as fh, in_the_commands_terms(sc, remedy):
         s = run_time_series(loop, ref, duration, fh, **options)
     s = {"time_series": str(out.path), **s}

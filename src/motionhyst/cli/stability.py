@@ -12,6 +12,7 @@ from motionhyst.cli._common import (
     output_file,
     print_json,
     refuse_unused,
+    release_held,
     warn_plant_fit,
 )
 
@@ -40,6 +41,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"stability: {sc.source}: {exc}") from None
     from motionhyst.analysis.stability import stability
 
+    release_held()  # the search for cycles starts: the warnings so far are shown
     try:
         result = stability(loop, exact=not args.no_exact)
     except ValueError as exc:

@@ -5,12 +5,13 @@ next to the describing function's prediction (paper section V, eq. 18).
 from __future__ import annotations
 
 import argparse
-import sys
 
 from motionhyst.cli._common import (
     distinct,
     positive,
     print_json,
+    release_held,
+    say_later,
     scenario_frequencies,
     warn_plant_fit,
 )
@@ -21,8 +22,8 @@ __all__ = []
 
 def run(args: argparse.Namespace, notice: str = "") -> int:
     """Exact periodic steady state of the nonlinear loop, next to the describing function;
-    `notice` (an old spelling's) goes to stderr once the input is checked, before the work: a
-    refusal stays one line."""
+    `notice` (an old spelling's) goes to stderr with the warnings, once the input is checked,
+    before the work: a refusal stays one line."""
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
@@ -33,6 +34,8 @@ def run(args: argparse.Namespace, notice: str = "") -> int:
     # imported once the input is read: a refusal does not wait for the analysis to load
     from motionhyst.analysis.comparison import compare_with_describing_function
     from motionhyst.analysis.floquet import check_floquet_budget
+    from motionhyst.analysis.plausibility import check_frequency_range
+    from motionhyst.analysis.steady import check_steady_frequencies
 
     floquet = not getattr(args, "no_floquet", False)  # simulate's old spelling has no option
     if floquet:  # refused with what this command can change (the library says its argument)
@@ -41,7 +44,10 @@ def run(args: argparse.Namespace, notice: str = "") -> int:
         check_floquet_budget(loop, freqs, remedy=f"give fewer frequencies ({given}) or leave "
                                                  f"the multipliers out ({option})")
     if notice:
-        print(notice, file=sys.stderr)
+        say_later(notice)
+    check_frequency_range(loop, freqs)  # what the analysis refuses as it starts: before
+    check_steady_frequencies(loop, freqs)  # the warnings held are shown
+    release_held()  # the work starts: the warnings so far are shown
     result = compare_with_describing_function(loop, amplitude, freqs,  # warns as it starts
                                               floquet=floquet)
     warn_plant_fit(sc)

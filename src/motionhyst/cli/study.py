@@ -10,7 +10,13 @@ import json
 import os
 import sys
 
-from motionhyst.cli._common import UsageError, output_file, print_json, whole_number
+from motionhyst.cli._common import (
+    UsageError,
+    output_file,
+    print_json,
+    release_held,
+    whole_number,
+)
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -182,6 +188,7 @@ def run(args: argparse.Namespace) -> int:
         except (MemoryError, ValueError, TypeError):  # a frame length read from another
             raise UsageError(f"study --scheduler {args.scheduler}: what answers there is not "
                              f"a dask scheduler") from None  # service's reply: 3 EiB
+    release_held()  # the runs start: the warnings so far are shown
     try:
         report = run_study(study, args.out, workers=args.workers, client=client,
                            force=args.force, progress=not args.json and sys.stderr.isatty())

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -229,7 +229,8 @@ def _link_figures(el: Hysteresis, A: float, freqs: list[float]) -> dict:
 
 def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
               is_paper: bool = False, force: bool = False,
-              inputs: Iterable[str | Path | None] = ()) -> dict:
+              inputs: Iterable[str | Path | None] = (),
+              checked: Callable[[], None] | None = None) -> dict:
     """Write the figures, ``summary.json`` and ``report.md`` for scenario `sc` into `out_dir`.
 
     The folder is an :class:`~motionhyst.io.outputs.OutputFolder`: it may hold
@@ -253,6 +254,11 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
         symbolic link named `out_dir`.
     inputs : iterable of paths
         Files the command read (the scenario): never replaced.
+    checked : callable, optional
+        Called once the loop is built and checked and its frequencies are known good
+        (:func:`~motionhyst.analysis.plausibility.check_frequency_range`,
+        :func:`~motionhyst.analysis.steady.check_steady_frequencies`), as the long work
+        starts (the command shows the warnings it held until then).
 
     Returns
     -------
@@ -289,10 +295,16 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             # (python-control) and builds the loop; the later workers inherit both from this
             # process (python-control imports matplotlib)
             figures.submit(_link_figures(el, A, freqs))
+            from motionhyst.analysis.plausibility import check_frequency_range
             from motionhyst.analysis.quasilinear import analyze, error_harmonics_df, loop_mismatch
-            from motionhyst.analysis.steady import periodic_steady_state
+            from motionhyst.analysis.steady import check_steady_frequencies, periodic_steady_state
 
             loop = sc.loop()
+            check_frequency_range(loop, freqs)  # what the analyses refuse as they start
+            if loop.plant.is_lti:  # raw measured lines have no steady state: none computed
+                check_steady_frequencies(loop, freqs)
+            if checked is not None:
+                checked()
             analysis = analyze(loop, A, freqs)
             steps.update()
             figures.submit({"fig9": lambda: _plots().fig9_quasilinear_plant(
