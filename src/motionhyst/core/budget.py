@@ -372,11 +372,11 @@ def available_disk(folder: str | os.PathLike) -> tuple[int, str]:
     import shutil
     from pathlib import Path
 
-    where = Path(os.path.abspath(folder))
+    where = Path(folder)  # as given: a relative path is short under however deep a folder
     while not where.is_dir() and where != where.parent:
         where = where.parent
     try:
-        free, what = shutil.disk_usage(where).free, f"free in {where}"
+        free, what = shutil.disk_usage(where).free, f"free in {os.path.abspath(where)}"
     except OSError:  # a file system that does not say: the limit alone
         free, what = None, ""
     soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)

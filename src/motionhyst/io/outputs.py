@@ -2,35 +2,31 @@
 
 Rules (issue 10, checked by tests/test_outputs.py and tests/test_bad_inputs.py):
 
-- A file is written to a temporary file in the target's own folder, flushed
-  and ``fsync``-ed, then moved over the target with :func:`os.replace`: a
-  reader sees the old file or the new one, never half of one.
-- An existing target is replaced only when the user asked (``force=True``,
-  the ``--force`` option); otherwise :class:`OutputError` names it.  A target
-  that is an input of the same command (the same file by
-  :func:`os.path.samefile`, hard links and symbolic links included) is refused
-  even with ``force``.
-- A replaced file keeps its permission bits; a new file gets ``0666`` and a
-  new folder ``0777``, both less the process umask (``0644`` / ``0755`` under
-  ``022``), as ``open`` and ``mkdir`` would give them.
-- A target that is a symbolic link is refused without ``force``; with it, the
-  link itself is replaced by the new file and the file it points to is left
-  as it was (a link never makes the tool write outside the folder named).
-- The temporary file has no name while it is written (``O_TMPFILE``, where
-  the system has it): a process killed meanwhile leaves nothing behind.  It
-  gets a name, ``.NAME.motionhyst-PID-XXXX.part``, only for the instant
-  before it replaces the target (and throughout, where ``O_TMPFILE`` is
-  missing); such a file of a process that no longer runs is removed by the
-  next writer in that folder (:func:`~motionhyst.io.leftovers.clean_stale`).
-- SIGINT or SIGTERM while a file is written leave the old file as it was and
-  remove the temporary file; the process then ends with the usual
-  ``KeyboardInterrupt``.  Messages name the target, never a temporary path.
+- A file is written to a temporary file in the target's own folder, flushed and
+  ``fsync``-ed, then moved over the target with :func:`os.replace`: a reader sees the old
+  file or the new one, never half of one.
+- An existing target is replaced only when the user asked (``force=True``, the ``--force``
+  option); otherwise :class:`OutputError` names it.  A target that is an input of the same
+  command (the same file by :func:`os.path.samefile`, hard links and symbolic links
+  included) is refused even with ``force``.
+- A replaced file keeps its permission bits; a new file gets ``0666`` and a new folder
+  ``0777``, both less the process umask (``0644`` / ``0755`` under ``022``), as ``open``
+  and ``mkdir`` would give them.
+- A target that is a symbolic link is refused without ``force``; with it, the link itself is
+  replaced by the new file and the file it points to is left as it was (a link never makes
+  the tool write outside the folder named).
+- The temporary file has no name while it is written (``O_TMPFILE``, where the system has
+  it): a process killed meanwhile leaves nothing behind.  It gets a name,
+  ``.NAME.motionhyst-PID-XXXXXXXX.part``, only for the instant before it replaces the target
+  (and throughout, where ``O_TMPFILE`` is missing); such a file of a process that no longer
+  runs is removed by the next writer in that folder (:func:`~motionhyst.io.leftovers.clean_stale`).
+- SIGINT or SIGTERM while a file is written leave the old file as it was and remove the
+  temporary file; the process then ends with the usual ``KeyboardInterrupt``.  Messages name
+  the target, never a temporary path.
 
-:class:`OutputFolder` applies the same rules to a folder of results
-(``motionhyst reproduce --out DIR``): it writes a manifest,
-:data:`MANIFEST`, listing the files the tool wrote there; a later run
-replaces those files and no others, and never deletes anything it did not
-write.
+:class:`OutputFolder` applies the same rules to a folder of results (``motionhyst reproduce
+--out DIR``): it writes a manifest, :data:`MANIFEST`, listing the files the tool wrote there;
+a later run replaces those files and no others, and never deletes anything it did not write.
 
 Examples
 --------
@@ -162,17 +158,24 @@ def _label(path: Path | str, option: str | None) -> str:
     return f"{option} {path}" if option else str(path)
 
 
-def _check_name(path: str | os.PathLike, label: str) -> None:
-    """Each part of `path` within the file system's longest name, the whole within its longest
-    path (else the system's "File name too long" would name no option)."""
+def _check_name(path: str | os.PathLike, label: str, extra: int = 0) -> None:
+    """Each part of `path` within the file system's longest name (its last with the `extra`
+    bytes it gets while written), the path as given (as the system judges it) within its
+    longest: else the system's "File name too long" names no option."""
+    text = os.fspath(path)
     try:
-        most = os.pathconf(os.path.dirname(os.path.abspath(path)), "PC_NAME_MAX")
+        most = os.pathconf(os.path.dirname(text) or ".", "PC_NAME_MAX")
     except (OSError, ValueError):  # a folder still to be made: the usual limit
         most = 255
-    longest = max((len(os.fsencode(part)) for part in Path(path).parts), default=0)
-    if longest > most or len(os.fsencode(os.path.abspath(path))) >= 4096:
-        what = (f"a name of {longest} bytes, more than the {most} the file system allows"
-                if longest > most else "a path longer than the system allows (4096 bytes)")
+    longest, name = (max((len(os.fsencode(part)) for part in Path(text).parts), default=0),
+                     len(os.fsencode(Path(text).name)))
+    what = (f"a name of {longest} bytes, more than the {most} the file system allows"
+            if longest > most else f"a name of {name} bytes, more than the {most - extra} it "
+            f"may have (written under a name {extra} bytes longer)" if name + extra > most
+            else "a path longer than the system allows (4096 bytes)"
+            if len(os.fsencode(text)) + extra >= 4096 else "")
+    if what:  # a path of kilobytes quoted whole would cut the line's end: its middle is left out
+        label = label if len(label) <= 240 else f"{label[:120]}...{label[-80:]}"
         raise OutputError(f"{label}: {what}; give a shorter one")
 
 
@@ -445,7 +448,7 @@ class OutputFile:
         if self.path.suffix.lower() == ".mat":  # every reader takes a .mat name for MATLAB
             raise OutputError(f"{label}: motionhyst writes no MATLAB file, and a .mat name is "
                               f"read back as one; give another name")
-        _check_name(self.path, label)
+        _check_name(self.path, label, extra=34)  # written as .NAME.motionhyst-PID-XXXXXXXX.part
         check_not_input(self.path, inputs, option)
         self.target = self.path
         if self.path.is_symlink():
