@@ -130,3 +130,7 @@ def _interrupt(signum, frame):
     if not _ENDED:
         _RECEIVED.append(signum)
         raise KeyboardInterrupt("SIGINT" if signum == signals.SIGINT else "SIGTERM")
+
+
+if __name__ == "__main__":  # python -m _motionhyst_entry: the console script's route
+    sys.exit(main())

@@ -343,3 +343,17 @@ def test_module_runs_as_script(tmp_path):
     d = strict_json(proc.stdout)
     assert d["points"][0]["zeta"] == pytest.approx(0.25)
     assert d["points"][1]["zeta"] is None
+
+
+@pytest.mark.parametrize("module", ["_motionhyst_entry", "motionhyst.cli"])
+def test_both_module_routes_run_the_command(tmp_path, module):
+    """``python -m _motionhyst_entry`` is the console script's route, its handlers installed
+    before the package loads (main 5c12916: it ran nothing, exit 0); ``python -m
+    motionhyst.cli`` goes through the same entry once Python has loaded the package: a
+    refusal is one line, exit 2."""
+    proc = subprocess.run([sys.executable, "-m", module, "df", "--k", "-20", "--fc", "0.05",
+                           "--amplitude", "0.01"], capture_output=True, text=True, cwd=tmp_path,
+                          timeout=120, check=False)
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    assert proc.stdout == "" and proc.stderr.startswith("motionhyst: error: ")
+    assert proc.stderr.count("\n") == 1, proc.stderr
