@@ -63,6 +63,32 @@ def test_a_reference_file_in_another_unit_is_warned_of_before_the_run(tmp_path, 
     assert len(rows) == 52  # 0.05 s at 1 kHz and the header: the run is the one asked
 
 
+def test_a_reference_file_refused_unread_for_its_size_names_its_unit_from_its_first_rows(
+        tmp_path, capsys, monkeypatch):
+    """A reference file of 8 MB or more is sized before it is read and may be refused unread
+    (its spline beyond the budget): a log in ms then got only 'give fewer samples' (main
+    5c12916), though its first rows show 1 Hz sampling; its one line names the unit first."""
+    from motionhyst.cli import main
+
+    n = np.arange(450_000)
+    np.savetxt(tmp_path / "big.csv", np.column_stack([n * 1.0, 1e-3 * np.sin(4e-3 * np.pi * n)]),
+               delimiter=",", header="time,position", comments="", fmt="%.10g")
+    assert (tmp_path / "big.csv").stat().st_size > 8 << 20
+    before = snapshot(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--reference-csv", "big.csv", "--time-series", "o.csv",
+                 "--max-memory", "50M"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert err.startswith("motionhyst: error: big.csv (450000 samples, not read yet): the "
+                          "reference's spline through 450000 samples needs 108 MB"), err
+    assert err.endswith("; big.csv: the reference is sampled at 1 Hz (its first 3124 "
+                        "samples): if its time is not in seconds, scale it (--scale "
+                        "time=0.001 for ms); else give fewer samples (a coarser or shorter "
+                        "reference)\n"), err
+    assert snapshot(tmp_path) == before
+
+
 def _controller(body: str) -> str:
     from motionhyst.scenario import default_scenario_path
 

@@ -127,6 +127,35 @@ def _reference_unit_notes(source: str, ref) -> tuple[str | None, str | None]:
     return position, time
 
 
+def _unread_time_note(args: argparse.Namespace) -> str | None:
+    """:func:`_reference_unit_notes`' time note of a reference file refused before it was
+    read (for its size), judged on its first rows (64 kB of a CSV file, read as the whole
+    file would be), or None."""
+    import io
+
+    import numpy as np
+    import pandas as pd
+
+    from motionhyst.io.records import is_mat_file, read_record
+
+    path = args.reference_csv
+    try:
+        if is_mat_file(path):
+            return None
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+        head = head[:head.rfind(b"\n") + 1].decode("utf-8", errors="replace")
+        t = read_record(pd.read_csv(io.StringIO(head)), ("time", "position"),
+                        columns=args.columns, scale=args.scale)[:, 0]
+    except Exception:  # rows that say nothing (any error) leave the refusal as it is
+        return None
+    step = float(np.median(np.diff(t))) if t.size > 2 else 0.0
+    if step * SLOWEST_REFERENCE_HZ <= 1.01:
+        return None
+    return (f"{path}: the reference is sampled at {1 / step:.3g} Hz (its first {t.size} "
+            f"samples): if its time is not in seconds, scale it (--scale time=0.001 for ms)")
+
+
 def _with_unit_hint(exc, time_note: str):
     """A refusal of a run's size (a :class:`~motionhyst.core.budget.BudgetError`) whose
     reference's time looks like milliseconds (`time_note`): its one line names that first,
@@ -257,15 +286,21 @@ def _time_series(args: argparse.Namespace, sc) -> int:
                          f"uses its measured [plant] as raw data (use = \"data\"), which has no "
                          f"time-domain model; use = \"fit\" fits one")
     warn_plant_fit(sc)
-    ref, default_duration, what = _reference(args, sc)
+    from motionhyst.core.budget import BudgetError
+
+    try:
+        ref, default_duration, what = _reference(args, sc)
+    except BudgetError as exc:  # a reference file refused unread: its first rows' units
+        note = _unread_time_note(args) if args.reference_csv else None
+        if note is None:
+            raise
+        raise _with_unit_hint(exc, note) from None
     inputs = [*sc.files, args.reference_csv]
     out = output_file(args.time_series, args, "--time-series", inputs)
     duration = args.duration or default_duration
     # a file's units are judged before its run is sized: a time in ms makes the run 1000 times
     # too long, which the size's refusal then names; warned of once the run is not refused
     notes = _reference_unit_notes(args.reference_csv, ref) if args.reference_csv else ()
-    from motionhyst.core.budget import BudgetError
-
     try:
         remedy = _check_size(args, sc, ref, duration, out)
     except BudgetError as exc:  # too many steps or rows, too much memory, disk or work
