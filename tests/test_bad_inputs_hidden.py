@@ -145,9 +145,9 @@ def test_a_sampled_reference_filter_of_150_taps_is_a_controller_the_scenario_tak
 
 
 @pytest.mark.parametrize(("argv", "env", "given"), [
-    (["--max-memory", "1e308"], {}, "--max-memory 1e+296 TB"),
-    (["--max-memory", "100T"], {}, "--max-memory 110 TB"),
-    ([], {"MOTIONHYST_MAX_MEMORY": "100T"}, "MOTIONHYST_MAX_MEMORY 110 TB"),
+    (["--max-memory", "1e308"], {}, "--max-memory 1e308 (1e+296 TB)"),
+    (["--max-memory", "100T"], {}, "--max-memory 100T (110 TB)"),
+    ([], {"MOTIONHYST_MAX_MEMORY": "100T"}, "MOTIONHYST_MAX_MEMORY 100T (110 TB)"),
 ], ids=["1e308", "100T", "environment"])
 def test_a_memory_budget_beyond_the_machine_is_warned_of(tmp_path, argv, env, given):
     """--max-memory 1e308 was taken without a word: a computation it lets through is killed by

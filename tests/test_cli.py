@@ -320,6 +320,16 @@ def test_toml_syntax_error(capsys, tmp_path):
     assert str(path) in line and "line" in line
 
 
+def test_max_seconds_help_says_what_it_stops(capsys):
+    """--max-seconds refuses an estimated run before it starts and stops a search (and
+    reproduce) after that much CPU time; the help said only the first (review A15b L6)."""
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert ("a longer one is refused before it starts; a search no formula sizes, and "
+            "reproduce, are stopped after S s of CPU time)") in text
+
+
 # ---------------------------------------------------------- entry point
 def test_console_script_entry_point_is_main():
     """The console script runs :func:`motionhyst.cli.main` through :mod:`_motionhyst_entry`,

@@ -206,7 +206,7 @@ def test_the_budget_beyond_the_machine_is_warned_of_before_a_kill(tmp_path):
         proc.communicate()
     lines = first.decode().splitlines()
     assert len(lines) == 1 and re.fullmatch(
-        r"motionhyst: warning: simulate: --max-memory [0-9.]+ TB is more than the [0-9.]+ "
+        r"motionhyst: warning: simulate: --max-memory 100T \(110 TB\) is more than the [0-9.]+ "
         r"[kMGT]B of memory this machine has: a computation that large would be killed by the "
         r"system, not refused", lines[0]), lines
     assert list(tmp_path.iterdir()) == []

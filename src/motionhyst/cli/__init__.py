@@ -88,7 +88,8 @@ def build_parser() -> argparse.ArgumentParser:
         sub.choices[name].add_argument(
             "--max-seconds", type=positive, metavar="S",
             help="estimated run time a computation may take [s] (default: 3600; a longer one "
-                 "is refused before it starts)")
+                 "is refused before it starts; a search no formula sizes, and reproduce, are "
+                 "stopped after S s of CPU time)")
     return p
 
 
@@ -350,11 +351,13 @@ def _warn_budget_beyond_machine(args: argparse.Namespace) -> None:
     if limit != resource.RLIM_INFINITY and machine is not None and limit <= machine:
         return
     if machine is not None and budget > machine:
-        given = ("--max-memory" if args.max_memory is not None or args.before_max_memory
-                 is not None else "MOTIONHYST_MAX_MEMORY")
-        warn(f"{given} {format_size(budget)} is more than the {format_size(machine)} of memory "
-             f"this machine has: a computation that large would be killed by the system, not "
-             f"refused")
+        option = args.max_memory if args.max_memory is not None else args.before_max_memory
+        given = "--max-memory" if option is not None else "MOTIONHYST_MAX_MEMORY"
+        text = (getattr(option, "text", "") if option is not None  # as given: 100T, not 110 TB
+                else os.environ.get("MOTIONHYST_MAX_MEMORY", "").strip())
+        size = f"{text} ({format_size(budget)})" if text else format_size(budget)
+        warn(f"{given} {size} is more than the {format_size(machine)} of memory this machine "
+             f"has: a computation that large would be killed by the system, not refused")
 
 
 def _failed(exc: Exception, held: HeldWarnings) -> int:

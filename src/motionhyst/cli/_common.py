@@ -120,20 +120,30 @@ def whole_number(lo: int, hi: int, what: str) -> Callable[[str], int]:
     return parse
 
 
+class _GivenSize(int):
+    """A size in bytes that keeps the text it was given as (``.text``), for messages."""
+
+    text = ""
+
+
 def memory_size(text: str) -> int:
-    """argparse type: a memory size such as ``4G`` or ``500M`` (bytes).
+    """argparse type: a memory size such as ``4G`` or ``500M`` (bytes; the text given is its
+    ``.text``, for messages that quote it).
 
     Examples
     --------
-    >>> memory_size("4G")
-    4294967296
+    >>> size = memory_size("4G")
+    >>> size, size.text
+    (4294967296, '4G')
     """
     from motionhyst.core.budget import parse_size
 
     try:
-        return parse_size(text)
+        size = _GivenSize(parse_size(text))
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+    size.text = text
+    return size
 
 
 harmonic_count = whole_number(1, 1000, "harmonics")
