@@ -214,7 +214,9 @@ def solve_within(fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     OptimizeResult
         least_squares' result; where the budget was spent, the best point evaluated, with
         ``status`` 0 (as on ``max_nfev``) and a message saying so; ``path``: the best point
-        after each evaluation of `fun` (what :func:`settled` reads).
+        after each of the search's steps (each evaluation of `fun`, what :func:`settled`
+        reads) with a callable ``jac``; None with least_squares' own finite differences
+        (``jac="2-point"``...), whose columns' evaluations of `fun` are no steps.
 
     Raises
     ------
@@ -233,6 +235,7 @@ def solve_within(fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     """
     best: list = [math.inf, None, 0]  # the least cost, its point, the calls of `fun`
     path: list[NDArray[np.float64]] = []
+    jac = kwargs.get("jac")
 
     def tracked(x: NDArray[np.float64]) -> NDArray[np.float64]:
         best[2] += 1
@@ -250,22 +253,22 @@ def solve_within(fun: Callable[[NDArray[np.float64]], NDArray[np.float64]],
             raise
         sol = OptimizeResult(x=best[1], cost=0.5 * best[0], status=0, success=False,
                              nfev=best[2], message="The budget of model evaluations is spent.")
-    sol.path = np.array(path)
+    sol.path = np.array(path) if callable(jac) else None
     return sol
 
 
 #: A search stopped on its cap of evaluations has settled (:func:`settled`) where its last
-#: quarter of them moved no estimate by more than this share of its standard error ...
+#: quarter of its steps moved no estimate by more than this share of its standard error ...
 SETTLED_SHARE = 0.01
-#: ... over at least this many evaluations
+#: ... over at least this many (the evaluations of its steps)
 SETTLED_EVALUATIONS = 20
 
 
 def settled(sol: OptimizeResult, values: Callable[[NDArray[np.float64]], NDArray[np.float64]],
             std: NDArray[np.float64]) -> bool:
     """Whether a search that stopped on its cap of evaluations (``status`` 0) had settled: the
-    last quarter of its evaluations (at least :data:`SETTLED_EVALUATIONS`) moved no estimate by
-    more than :data:`SETTLED_SHARE` of its standard error.
+    last quarter of its steps (of at least :data:`SETTLED_EVALUATIONS`) moved no estimate by more
+    than :data:`SETTLED_SHARE` of its standard error.
 
     A model whose cost is not smooth to the search's tolerances (a link that sticks: each
     step's sticking and slipping samples change with the parameters; ``ftol = 1e-12``) keeps
@@ -273,7 +276,10 @@ def settled(sol: OptimizeResult, values: Callable[[NDArray[np.float64]], NDArray
     EMPS record used its 200 evaluations, the last 100 lowering the cost by 1.3e-5 of itself
     and moving the mass by 0.001 kg of its 3.4 kg standard error.  Such a
     search has converged at the precision the records give its estimates; one still moving
-    has not (:func:`~motionhyst.identify.io_checks.budget_note`).
+    has not (:func:`~motionhyst.identify.io_checks.budget_note`).  Only the search's steps
+    count (:func:`solve_within`'s ``path``: a search that evaluates its own Jacobian): the
+    evaluations of least_squares' finite-difference columns move no estimate, and a search
+    30-38 standard errors from its optimum looked settled over them (review B16 L2).
 
     Parameters
     ----------
@@ -282,29 +288,36 @@ def settled(sol: OptimizeResult, values: Callable[[NDArray[np.float64]], NDArray
     values : callable
         The parameters of a point of the search.
     std : ndarray
-        Their standard errors as the fit reports them (NaN, 0 or inf where not determined:
-        not judged).
+        Their standard errors (NaN, 0 or inf where not determined: not judged); the
+        caller says which (identify: the reported ones, widened for the residuals'
+        correlation).
 
     Returns
     -------
     bool
-        False for a search that ended otherwise (``status`` not 0) or without a path.
+        False for a search that ended otherwise (``status`` not 0), without a path (a
+        Jacobian of least_squares' own), with fewer steps, or with no estimate judged.
 
     Examples
     --------
-    A search whose 40 evaluations crept towards 3 (``3 + 1e-3 0.9^k``): its last 10 moved
-    ``x`` by 3e-5, settled for a standard error of 0.1, not for one of 1e-4.
+    A search whose 40 steps crept towards 3 (``3 + 1e-3 0.9^k``): its last 10 moved
+    ``x`` by 3e-5, settled for a standard error of 0.1, not for one of 1e-4, nor where no
+    standard error is known.
 
     >>> path = np.array([[3.0 + 1e-3 * 0.9 ** k] for k in range(40)])
     >>> sol = OptimizeResult(x=path[-1], status=0, path=path)
     >>> settled(sol, lambda x: x, np.array([0.1])), settled(sol, lambda x: x, np.array([1e-4]))
     (True, False)
+    >>> settled(sol, lambda x: x, np.array([np.nan]))
+    False
     """
     path = sol.get("path")
     if sol.status != 0 or path is None or len(path) < SETTLED_EVALUATIONS:
         return False
     back = max(len(path) // 4, SETTLED_EVALUATIONS // 4)
-    moved = np.abs(values(path[-1]) - values(path[-1 - back]))
+    moved = np.abs(values(sol.x) - values(path[-1 - back]))
     std = np.asarray(std, dtype=float)
     judged = np.isfinite(std) & (std > 0)
+    if not judged.any():
+        return False
     return bool(np.all(moved[judged] <= SETTLED_SHARE * std[judged]))

@@ -835,7 +835,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         notes.append(one_way.line)
     if noise is not None:
         notes.extend(_window_price(J, rss, res.size, rtol, noise, names[:n_base], init_window))
-    calm = settled(sol, prob.values, std_v)  # on its cap, its estimates still to 1 % of std
+    calm = settled(sol, prob.values, std_v)  # on its cap, still to 1 % of the reported std
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
         estimates=estimates, std=std, not_identifiable=not_ident,
@@ -844,7 +844,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
         stopping=f"{sol.message} ({'exact' if prob.exact else 'finite-difference'} "
                  f"Jacobian; ftol = xtol = gtol = {tol:g}, "
                  f"at most {most} evaluations; {sol.nfev} used"
-                 f"{'; settled to 1 % of each std' if calm else ''})",
+                 f"{'; settled to 1 % of each reported (widened) std' if calm else ''})",
         n_evaluations=n_eval, substeps=r, data=list(records), residuals=res, rigid_limit=coulomb,
         extra={"offsets": {"input": u0, "output": y0.tolist(),
                            **({"input_drift": drift_rate} if extras.input_drift else {})},
