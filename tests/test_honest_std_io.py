@@ -137,7 +137,8 @@ def test_a_value_within_its_widened_standard_error_is_said_not_determined():
     assert fit.extra["std_lower_bound"]
     for name in ("input_offset", "output_offset"):
         assert fit.judged_std[name] < abs(fit.estimates[name]) < fit.std[name], name
-    said = [w for w in fit.warnings if w.startswith("with the fit's model error")]
+    said = [w for w in fit.warnings
+            if w.startswith("with residuals beyond white noise (model error or coloured noise)")]
     assert len(said) == 1, fit.warnings
     assert "input_offset (-0.052 +- 0.059), output_offset (4.2e-05 +- 6.9e-05) are not " \
            "distinguishable from 0" in said[0]
@@ -148,16 +149,17 @@ def test_a_value_within_its_widened_standard_error_is_said_not_determined():
 
 def test_the_widened_note_names_what_only_the_wider_standard_errors_leave_undetermined():
     """A stiffness whose widened standard error exceeds it (a Jenkins link 4.4e7 +- 9.7e7 N/m,
-    white 6e6) is not determined beyond the fit's model error; one already not determined on
-    white residuals (judge_determined names it) is not named again; white standard errors
-    (reported as judged) name nothing."""
+    white 6e6) is not determined beyond what the residuals carry besides white noise; one
+    already not determined on white residuals (judge_determined names it) is not named again;
+    white standard errors (reported as judged) name nothing."""
     from motionhyst.identify.io_uncertainty import widened_note
 
     est = {"m": 95.0, "c": 200.0, "link.k": 4.4e7, "link.fc": 20.0, "input_offset": -3.0}
     judged = {"m": 0.02, "c": 0.03, "link.k": 6e6, "link.fc": 0.01, "input_offset": 0.002}
     wide = {**judged, "m": 0.3, "link.k": 9.7e7, "link.fc": 0.2, "input_offset": 0.04}
     note = widened_note(est, wide, judged)
-    assert note.startswith("with the fit's model error, the records do not determine link.k "
+    assert note.startswith("with residuals beyond white noise (model error or coloured "
+                           "noise), the records do not determine link.k "
                            "(4.4e+07 +- 9.7e+07): ")
     assert widened_note(est, wide, {**judged, "link.k": 5e7}) is None
     assert widened_note(est, judged, judged) is None

@@ -23,7 +23,7 @@ from motionhyst import MaxwellSlip
 from motionhyst.core.warnings import MotionhystWarning
 
 RHO = 0.95
-SAID = "with the fit's model error, "
+SAID = "with residuals beyond white noise (model error or coloured noise), "
 
 
 def _coloured(rng: np.random.Generator, n: int, sigma: float) -> np.ndarray:

@@ -745,7 +745,9 @@ def widened_note(estimates: dict[str, float], std: dict[str, float | None],
     records determine a parameter is judged from those of white residuals
     (:func:`judge_determined`: model error does not make a record say less).  Where the
     reported one exceeds the value (a Jenkins stiffness ``4.4e7 +- >= 9.7e7``), the value is
-    not determined beyond the fit's model error, whatever the white one says: said here,
+    not determined beyond what the residuals carry besides white noise (the fit's model error
+    or coloured noise: the records do not tell them apart), whatever the white one says: said
+    here,
     named, for a parameter that must be positive as :func:`undetermined` has it, for an
     offset, a drift or a difference by direction as not distinguishable from 0.  The fit is
     not refused for it (model error is a result), nor is its model changed.
@@ -772,9 +774,10 @@ def widened_note(estimates: dict[str, float], std: dict[str, float | None],
     ...                          "input_offset": 0.043},
     ...                    {"m": 0.02, "link.k": 6e6, "link.fc": 0.01, "input_offset": 0.004}))
     ... # doctest: +NORMALIZE_WHITESPACE
-    with the fit's model error, the records do not determine link.k (4.4e+07 +- 9.7e+07), and
-    input_offset (0.031 +- 0.043) is not distinguishable from 0: standard errors widened for
-    the residuals' correlation exceed the values, which the model holds as the search found them
+    with residuals beyond white noise (model error or coloured noise), the records do not
+    determine link.k (4.4e+07 +- 9.7e+07), and input_offset (0.031 +- 0.043) is not
+    distinguishable from 0: standard errors widened for the residuals' correlation exceed the
+    values, which the model holds as the search found them
     """
     white = set(undetermined(estimates, judged, invariant, zero))
     names = [n for n in undetermined(estimates, std, invariant, zero) if n not in white]
@@ -794,9 +797,9 @@ def widened_note(estimates: dict[str, float], std: dict[str, float | None],
     parts = ([f"the records do not determine {shown(names)}"] if names else []) + (
         [f"{shown(signed)} {'is' if len(signed) == 1 else 'are'} not distinguishable from 0"]
         if signed else [])
-    return (f"with the fit's model error, {', and '.join(parts)}: standard errors widened for "
-            f"the residuals' correlation exceed the values, which the model holds as the "
-            f"search found them")
+    return (f"with residuals beyond white noise (model error or coloured noise), "
+            f"{', and '.join(parts)}: standard errors widened for the residuals' correlation "
+            f"exceed the values, which the model holds as the search found them")
 
 
 def parallel_note(model: type, name: str, two_mass: bool = False) -> str:

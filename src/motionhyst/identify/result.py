@@ -176,8 +176,8 @@ class Identification:
 
         Examples
         --------
-        A slip force and an offset of a fit that leaves model error: the offset's widened
-        standard error exceeds it, the white one does not.
+        A slip force and an offset of a fit that leaves model error or coloured noise: the
+        offset's widened standard error exceeds it, the white one does not.
 
         >>> import numpy as np
         >>> from motionhyst import MaxwellSlip
@@ -188,8 +188,10 @@ class Identification:
         ...     r2=0.999, n_samples=1000, criterion="given",
         ...     std_lower_bound="standard errors are lower bounds: ...",
         ...     judged_std={"k[0]": 0.1, "fc[0]": 0.0002, "offset": 0.0005})
-        >>> print(ident.widened_note()[:70])
-        with the fit's model error, offset (0.002 +- 0.003) is not distinguish
+        >>> print(ident.widened_note()[:66])
+        with residuals beyond white noise (model error or coloured noise),
+        >>> print(ident.widened_note()[67:120])
+        offset (0.002 +- 0.003) is not distinguishable from 0
         """
         if not self.std_lower_bound or not self.judged_std:
             return None
