@@ -297,9 +297,11 @@ def _noise_rms(lf: LinkForce, L_over_P1: HoldFilter, u: NDArray[np.float64]) -> 
     absolute deviation: the noise, not the controller's fast action, which the passivity
     check's mean square counts as an upper estimate; a flag of lower bounds must not take
     model error for noise) leaves in the prefiltered link force ``L u - (L / P1) y1`` (the
-    filters' impulse responses' norms)."""
+    filters' impulse responses' norms, of an impulse in the record's middle: the filters start
+    in steady state on the first sample, so an impulse there is a step that was on before the
+    record, and its response 40 times the noise's on Table I's loop)."""
     delta = np.zeros(lf.y1.size)
-    delta[0] = 1.0
+    delta[lf.y1.size // 2] = 1.0
     h_u, h_y = lf.lowpass(delta), L_over_P1(delta)
     return float(np.sqrt(white_noise_variance(u) * float(h_u @ h_u)
                          + white_noise_variance(lf.y1) * float(h_y @ h_y)))
