@@ -64,16 +64,20 @@ def test_force_noise_through_the_prefilter_is_covered(run):
 
 
 def test_position_noise_keeps_its_coverage(run):
-    """0.5 um of white noise on y1 (seeds 0-5): covered before and after (|z| <= 2.3); the
-    standard errors change by the residuals' correlation only (k's 1.2-1.5 times, fc's
-    0.7-0.8: the noise through L / P1 alternates from sample to sample)."""
+    """0.5 um of white noise on y1 (seeds 0-5): covered (|z| <= 1.6 on main, 1.1 now).  The
+    noise through L / P1 alternates from sample to sample, and Andrews' lags alone (main) made
+    fc's standard error 0.7-0.8 of white residuals' (0.57-0.69e-3 against 0.74-0.88e-3);
+    no standard error is narrower than white residuals' or the fixed rule's now
+    (residual_noise.newey_west_lags), which is wider here: k 1.15-1.37 (white 0.61-0.72, main
+    0.79-0.94), fc 1.17-1.38e-3 (scratch-nw17/cl_position.py)."""
     fits = _fits(run, 5e-7, 0.0, range(6))
     for f in fits:
         e = f.elements[0]
         assert abs(e["fc"] - FC) <= 3 * e["fc_std"]
         assert abs(e["k"] - K) <= 3 * e["k_std"]
-        assert e["k_std"] < 1.5  # measured 0.7-0.9 (main 0.6-0.7): not widened much
-        assert e["fc_std"] < 1e-3
+        assert e["k_std"] >= f.judged_std["k[0]"] and e["fc_std"] >= f.judged_std["fc[0]"]
+        assert e["k_std"] < 2.0  # measured 1.15-1.37: not widened beyond the fixed rule's
+        assert e["fc_std"] < 2e-3
 
 
 def test_a_link_the_fit_cannot_describe_says_its_standard_errors_are_lower_bounds():

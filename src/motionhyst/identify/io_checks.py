@@ -29,7 +29,12 @@ from numpy.typing import NDArray
 from motionhyst.core.blas import few_blas_threads
 from motionhyst.core.budget import RECORDS_REMEDY, BudgetError
 from motionhyst.identify.io_records import IORecord
-from motionhyst.identify.residual_noise import bartlett_sum, bartlett_weights, regression_lags
+from motionhyst.identify.residual_noise import (
+    bartlett_sum,
+    bartlett_weights,
+    newey_west_lags,
+    widest_covariance,
+)
 
 __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTION_SHARE",
            "DIRECTION_SIGNIFICANCE", "DIRECTION_TOP",
@@ -501,11 +506,13 @@ def _mass_and_std(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]
 
 def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.float64]],
                          window: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The least-squares coefficients and their Newey-West covariance (Bartlett weights over
-    ``max(4 n^(1/3), window)`` lags, within each record:
-    :func:`~motionhyst.identify.residual_noise.bartlett_sum` over
-    :func:`~motionhyst.identify.residual_noise.regression_lags`): standard errors that hold
-    for residuals correlated over time (a model's error, a filtered noise).
+    """The least-squares coefficients and their Newey-West covariance (Bartlett weights within
+    each record, :func:`~motionhyst.identify.residual_noise.bartlett_sum`, over each lag count
+    of :func:`~motionhyst.identify.residual_noise.newey_west_lags` for its residuals, each
+    variance the largest: :func:`~motionhyst.identify.residual_noise.widest_covariance`):
+    standard errors that hold for residuals correlated over time (a model's error, a filtered
+    noise), never narrower than white residuals' or the fixed ``max(4 n^(1/3), window)``
+    lags' that the checks' thresholds were measured with.
 
     Parameters
     ----------
@@ -536,14 +543,17 @@ def robust_least_squares(rows: list[NDArray[np.float64]], rhs: list[NDArray[np.f
     with few_blas_threads(*As.shape):  # a small fit: the threads cost more than the work
         x = np.linalg.lstsq(As, np.concatenate(rhs), rcond=None)[0]
         cov = np.linalg.pinv(As.T @ As)
-        meat = np.zeros_like(cov)
+        meats = [np.zeros_like(cov) for _ in range(3)]  # none, fixed and Andrews' lags
         start = 0
-        for b in rhs:  # each record's own sum (residual_noise.bartlett_sum)
+        for b in rhs:  # each record's own sums (residual_noise.bartlett_sum)
             n = b.size
-            xe = As[start:start + n] * (b - As[start:start + n] @ x)[:, None]
+            e = b - As[start:start + n] @ x
+            xe = As[start:start + n] * e[:, None]
             start += n
-            meat += bartlett_sum(xe, bartlett_weights(regression_lags(n, window)))
-        return x / scale, (cov @ meat @ cov) / np.outer(scale, scale)
+            for meat, lags in zip(meats, newey_west_lags([e], window), strict=True):
+                meat += bartlett_sum(xe, bartlett_weights(lags))
+        covs = [cov @ meat @ cov for meat in meats]
+        return x / scale, widest_covariance(covs) / np.outer(scale, scale)
 
 
 #: A start whose cost is within this factor of the records' noise (from their repeated

@@ -21,7 +21,7 @@ from motionhyst.identify.io_start import LINEAR_MODEL_RESIDUAL, equation_rows
 from motionhyst.identify.residual_noise import (
     bartlett_sum,
     bartlett_weights,
-    regression_lags,
+    newey_west_lags,
     white_noise_variance,
 )
 
@@ -51,9 +51,9 @@ by 1.47-3.91 at 21-62 of them."""
 
 OWN_MASS_WINDOWS = 20
 """A record's own mass is judged (:func:`check_one_stage`) only where it holds at least this
-many of its Newey-West lags (``max(4 n^(1/3), 10 ms)``; 716 samples at 1 kHz): a shorter
-one's standard error is no measure of its linear model's error (80 samples of a 2 kg axis:
-0.45 +- 0.2 kg)."""
+many of the fixed rule's Newey-West lags (``max(4 n^(1/3), 10 ms)``; 716 samples at 1 kHz):
+a shorter one's standard error is no measure of its linear model's error (80 samples of a 2 kg
+axis: 0.45 +- 0.2 kg)."""
 
 ACCELERATION_NOISE = 0.1
 """A record's own mass is judged (:func:`check_one_stage`) only where its position's white
@@ -145,8 +145,8 @@ def _check_one_stage(records: list[IORecord], floating: bool, single_mass: bool)
         rest = records[:i] + records[i + 1:]
         if own[i] or not any(own[:i] + own[i + 1:]):  # none shows a mass to compare with
             continue
-        x, cov, _ = pieces[i].fit(columns)
-        x_rest, cov_rest, _ = others[i].fit(columns)
+        x, covs, _ = pieces[i].fit(columns)
+        x_rest, covs_rest, _ = others[i].fit(columns)
         w2, noise = pieces[i].w2, pieces[i].acceleration_noise()
         gradient, spring = np.array([1.0, 0.0, 0.0, 0.0]), ""
         if not floating and w2 > 0:  # at its frequencies a mass is a negative spring
@@ -155,8 +155,7 @@ def _check_one_stage(records: list[IORecord], floating: bool, single_mass: bool)
         m_rest = float(x_rest[0])
         if m_rest <= 0:  # the others' inertia is not this model's mass: nothing to compare
             continue
-        std = math.sqrt(max(float(gradient @ cov @ gradient), 0.0))
-        std_rest = math.sqrt(max(float(gradient @ cov_rest @ gradient), 0.0))
+        std, std_rest = _widest_std(covs, gradient), _widest_std(covs_rest, gradient)
         # the position's noise draws the record's mass towards zero: so far is no gap
         gap = m - m_rest if m > m_rest else min(0.0, m - (1.0 - noise) * m_rest)
         if abs(gap) > ONE_STAGE_SIGMAS * math.hypot(std, std_rest):
@@ -202,21 +201,30 @@ def _own_mass(pieces: _Pieces) -> tuple[float, float] | None:
     :data:`OWN_MASS_WINDOWS` of its Newey-West lags."""
     if pieces.short:
         return None
-    x, cov, residual = pieces.fit([0, 1, 2, 3, 4])
+    x, covs, residual = pieces.fit([0, 1, 2, 3, 4])
     spread = pieces.bb - pieces.g[3] ** 2 / pieces.n  # the force's squares about its mean
     if not (spread > 0 and residual <= LINEAR_MODEL_RESIDUAL ** 2 * spread):
         return None
     if not pieces.acceleration_noise() <= ACCELERATION_NOISE:
         return None
-    return float(x[0]), math.sqrt(max(float(cov[0, 0]), 0.0))
+    return float(x[0]), _widest_std(covs, np.eye(1, len(x))[0])
+
+
+def _widest_std(covs: list[NDArray[np.float64]], gradient: NDArray[np.float64]) -> float:
+    """The standard error of ``gradient @ x``, the largest over the covariances of the lag
+    counts (:func:`~motionhyst.identify.residual_noise.newey_west_lags`: never narrower than
+    white residuals' or the fixed rule's)."""
+    return math.sqrt(max(max(float(gradient @ c @ gradient) for c in covs), 0.0))
 
 
 class _Pieces:
     """One record's share of the inverse-dynamics least squares that :func:`check_one_stage`
     solves for a set of records: the normal equations of its rows ``a, v, sign(v), 1, y``
     (acceleration, velocity, direction, offset, position; the rates as
-    :func:`~motionhyst.identify.io_start.equation_rows` filters them), its Newey-West meat
-    as a quadratic form in the coefficients, its acceleration's white noise (through the
+    :func:`~motionhyst.identify.io_start.equation_rows` filters them), its Newey-West meats
+    as quadratic forms in the coefficients (one for each lag count of
+    :func:`~motionhyst.identify.residual_noise.newey_west_lags`, Andrews' from its own fit's
+    residuals), its acceleration's white noise (through the
     filter, from the position's third differences) and whether it is long enough to judge
     its own mass (:data:`OWN_MASS_WINDOWS`).  The sum of records' pieces is their set's: the
     others' fit, for each record, needs no pass over their samples (refitted, the check was
@@ -229,7 +237,10 @@ class _Pieces:
         A, b = np.column_stack([rows[0], rec.y]), np.asarray(rhs[0], dtype=np.float64)
         n, window = b.size, max(7, 2 * round(0.005 * rec.fs) + 1)
         self.H, self.g, self.bb, self.n = A.T @ A, A.T @ b, float(b @ b), n
-        self.G = _meat_products(A, b, regression_lags(n, window))
+        scale = np.linalg.norm(A, axis=0)
+        scale[scale == 0] = 1.0
+        own = b - (A / scale) @ np.linalg.lstsq(A / scale, b, rcond=None)[0]
+        self.G = [_meat_products(A, b, lags) for lags in newey_west_lags([own], window)]
         samples = min(window, n - (1 - n % 2))
         gain = float(np.sum(savgol_coeffs(samples, 3, deriv=2, delta=1.0 / rec.fs) ** 2))
         self.noise = n * gain * white_noise_variance(rec.y, robust=False)
@@ -240,16 +251,19 @@ class _Pieces:
 
     def __add__(self, other: _Pieces) -> _Pieces:
         out = object.__new__(_Pieces)
-        for name in ("H", "g", "bb", "n", "G", "noise"):
+        for name in ("H", "g", "bb", "n", "noise"):
             setattr(out, name, getattr(self, name) + getattr(other, name))
+        out.G = [a + b for a, b in zip(self.G, other.G, strict=True)]  # lag count by count
         out.short, out.w2 = self.short or other.short, math.nan  # w2: one record's only
         return out
 
-    def fit(self, columns: list[int]) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    def fit(self, columns: list[int]
+            ) -> tuple[NDArray[np.float64], list[NDArray[np.float64]], float]:
         """The least-squares coefficients of `columns` (indices into ``a, v, sign(v), 1,
-        y``), their Newey-West covariance (as
-        :func:`~motionhyst.identify.io_checks.robust_least_squares` has it, each record's
-        lags its own) and the residual's sum of squares."""
+        y``), their Newey-West covariances (one for each lag count, each record's lags its
+        own: :func:`~motionhyst.identify.io_checks.robust_least_squares`' covariance is
+        their :func:`~motionhyst.identify.residual_noise.widest_covariance`) and the
+        residual's sum of squares."""
         H, g = self.H[np.ix_(columns, columns)], self.g[columns]
         scale = np.sqrt(np.diag(H))
         scale[scale == 0] = 1.0
@@ -260,10 +274,11 @@ class _Pieces:
         flat = np.array([[i * (p + 1) + a for a in (0, *(c + 1 for c in columns))]
                          for i in columns]).ravel()
         z = np.concatenate([[1.0], -x])  # the residual b - A x is [b, A] @ z
-        meat = np.einsum("iajb,a,b->ij", self.G[np.ix_(flat, flat)].reshape(q, q + 1, q, q + 1),
-                         z, z)
+        covs = [inverse @ np.einsum("iajb,a,b->ij",
+                                    G[np.ix_(flat, flat)].reshape(q, q + 1, q, q + 1), z, z)
+                @ inverse for G in self.G]
         residual = self.bb - 2.0 * float(x @ g) + float(x @ H @ x)
-        return x, inverse @ meat @ inverse, max(residual, 0.0)
+        return x, covs, max(residual, 0.0)
 
     def acceleration_noise(self) -> float:
         """The share of the acceleration's variance that the position's white noise makes

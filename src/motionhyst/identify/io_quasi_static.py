@@ -717,13 +717,14 @@ def _profile_widening(below: IOIdentification, above: IOIdentification,
     refits' difference either side of the minimum: the other parameters follow, so it is the
     part of the exponent's column that they do not take) and ``C`` the best fit's residuals'
     weighted autocorrelation (:class:`~motionhyst.identify.residual_noise.ResidualCorrelation`,
-    the sandwich of the other parameters' standard errors); 1 for white residuals."""
+    the sandwich of the other parameters' standard errors, the largest over its lag counts);
+    1 for white residuals."""
     d = above.residuals - below.residuals
     sizes = np.cumsum([rec.y.size for rec in records])[:-1]
     if d.size != best.residuals.size or not float(d @ d) > 0:
         return 1.0
     corr = ResidualCorrelation(np.split(best.residuals, sizes))
-    inner = float(corr.inner(d[:, None])[0, 0])
+    inner = max(float(c[0, 0]) for c in corr.inners(d[:, None]))
     return math.sqrt(max(inner / float(d @ d), 0.0))
 
 

@@ -37,6 +37,7 @@ from motionhyst.identify.residual_noise import (
     ResidualCorrelation,
     lower_bound_note,
     white_noise_variance,
+    widest_covariance,
 )
 
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
@@ -212,7 +213,9 @@ def _decomposed(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float,
     ``V S^-1 (sigma_r^2 I + sigma_n^2 (W W^T - I)) S^-1 V^T``, ``W = U^T L``) and the
     undetermined directions (rows of right singular vectors); with `correlation`, the
     residuals' part ``sigma^2 I`` is ``sigma^2 U^T C U``
-    (:class:`~motionhyst.identify.residual_noise.ResidualCorrelation`);
+    (:class:`~motionhyst.identify.residual_noise.ResidualCorrelation`) for each of its lag
+    counts, each variance the largest
+    (:func:`~motionhyst.identify.residual_noise.widest_covariance`);
     `spread`, if a list, receives ``E RSS / sigma_n^2`` of the window's noise alone."""
     norms = np.linalg.norm(J, axis=0)
     norms[norms == 0] = 1.0
@@ -220,19 +223,19 @@ def _decomposed(J: NDArray[np.float64], rss: float, n_rows: int, rtol: float,
     good = sv > rtol * sv[0]
     dof = max(n_rows - J.shape[1], 1)
     eye = np.eye(int(good.sum()))
-    own = eye if correlation is None else correlation.inner(u[:, good])
+    owns = [eye] if correlation is None else correlation.inners(u[:, good])
+    vg = vt[good].T / sv[good]
     if noise is None:
-        inner = rss / dof * own
+        covs = [vg @ (rss / dof * own) @ vg.T for own in owns]
     else:
         if noise.n_rows != J.shape[0]:
             raise ValueError("the noise map's rows differ from the Jacobian's")
         W = noise.left(u[:, good])
         if spread is not None:
             spread.append(noise.frobenius2() - float(np.sum(W * W)))
-        inner = (noise.residual_variance(W, rss, dof) * own
-                 + noise.sigma2 * (W @ W.T - eye))
-    vg = vt[good].T / sv[good]
-    return norms, vg @ inner @ vg.T, vt[~good]
+        variance, window = noise.residual_variance(W, rss, dof), noise.sigma2 * (W @ W.T - eye)
+        covs = [vg @ (variance * own + window) @ vg.T for own in owns]
+    return norms, covs[0] if len(covs) == 1 else widest_covariance(covs), vt[~good]
 
 
 class CorrelatedErrors(NamedTuple):

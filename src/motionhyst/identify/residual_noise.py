@@ -5,8 +5,9 @@ from sample to sample, and what that says of the fit's standard errors.
 signal's white noise that every part uses (the input-output standard errors, ``predict``'s
 error, a closed-loop record's passivity check, ``predict --init-from``'s same-run check);
 :func:`bartlett_sum` the one Newey-West sum of every standard error robust to the
-residuals' correlation (the inverse dynamics' checks over :func:`regression_lags`, a fit's
-over :class:`ResidualCorrelation`'s bandwidth);
+residuals' correlation, over the lags of one rule, :func:`newey_west_lags` (none, the fixed
+:func:`regression_lags` and Andrews' bandwidth: each standard error the widest they give,
+:func:`widest_covariance`), for the inverse dynamics' checks as for a fit's standard errors;
 :class:`ResidualCorrelation` the residuals' autocorrelation that the standard errors'
 sandwich takes (:func:`~motionhyst.identify.io_uncertainty.correlated_errors`);
 :func:`lower_bound_note` the line of a result that says its standard errors are lower
@@ -22,8 +23,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["BLOCK_FFT", "EXACT_SHARE", "LOWER_BOUND_FACTOR", "ResidualCorrelation",
-           "bartlett_sum", "bartlett_weights", "lower_bound_note", "regression_lags",
-           "white_noise_variance"]
+           "bartlett_sum", "bartlett_weights", "lower_bound_note", "newey_west_lags",
+           "regression_lags", "white_noise_variance", "widest_covariance"]
 
 
 #: Differences whose scatter measures a record's white noise (:func:`white_noise_variance`):
@@ -186,18 +187,17 @@ def bartlett_weights(lags: int) -> NDArray[np.float64]:
 
 
 def regression_lags(n: int, window: int) -> int:
-    """The lags of a linear regression's Newey-West sum (the inverse dynamics' checks:
-    :func:`~motionhyst.identify.io_checks.robust_least_squares`,
-    :func:`~motionhyst.identify.io_consistency.check_one_stage`): ``max(4 n^(1/3), window)``,
-    at most ``n - 1``.
+    """The fixed lag count of :func:`newey_west_lags`: ``max(4 n^(1/3), window)``, at most
+    ``n - 1``.
 
-    A fixed rule, not :class:`ResidualCorrelation`'s Andrews bandwidth: the thresholds of
-    the decisions these regressions make (a record without inertia, a mass of another
-    stage, friction by direction) were measured with it (the one-stage check: none of 3618
-    pairs of the EMPS record's windows refused).  Andrews' rule on their residuals (a linear
-    model's error of a link's force, ``rho`` 0.89-0.95) would sum over more lags: 64-80
-    for 54 on a 2500-sample Jenkins axis, 248 for 116 on the EMPS record.  `window` is the
-    derivative filter's length: the rates are correlated over it whatever the residuals.
+    The rule the inverse dynamics' checks were measured with (a record without inertia, a
+    mass of another stage, friction by direction; the one-stage check: none of 3618 pairs of
+    the EMPS record's windows refused), and the floor of every Newey-West standard error:
+    a residual whose autocovariance turns negative at long lags (a slow record's periodic
+    model error) sums to less over Andrews' longer bandwidth, and a standard error over it
+    alone narrowed below this rule's (a good record refused as no inertia: 1.33 +- 0.019 kg,
+    0.11 with this rule).  `window` is the derivative filter's length: the rates are
+    correlated over it whatever the residuals.
 
     Parameters
     ----------
@@ -225,6 +225,107 @@ BARTLETT_BANDWIDTH = 1.1447
 MAX_LAG_SHARE = 0.25
 
 
+def newey_west_lags(parts: list[NDArray[np.float64]], window: int = 0) -> tuple[int, int, int]:
+    """The lags of every Newey-West sum of motionhyst, one rule for every route (a fit's
+    standard errors, :class:`ResidualCorrelation`; the inverse dynamics' checks,
+    :func:`~motionhyst.identify.io_checks.robust_least_squares` and
+    :func:`~motionhyst.identify.io_consistency.check_one_stage`): three lag counts, each
+    standard error the widest of the three (:func:`widest_covariance`).
+
+    ``0``: the residuals taken as white, the usual standard errors.  The fixed
+    :func:`regression_lags` of all the records' samples, at most the shortest record's less
+    one.  Andrews' (Econometrica 59, 817-858, 1991) bandwidth of the Bartlett kernel for a
+    first-order autoregression of the residuals, ``1.1447 (alpha N)^(1/3)``,
+    ``alpha = (2 rho / (1 - rho^2))^2`` (``rho`` their lag-one autocorrelation pooled over
+    the records, ``N`` their samples), at least `window`, at most :data:`MAX_LAG_SHARE` of
+    the shortest record: the lags grow with how long the residuals stay correlated (a
+    regression under AR(1) residuals, ``rho`` 0.99, 25,000 samples: 4 n^(1/3) = 116 lags put
+    the truth within 3 standard errors in 90 % of draws, Andrews' 700-odd in 98 %).  None of
+    them alone is safe: Andrews' longer sum takes in the negative autocovariances of a
+    periodic model error and narrows the standard error below the white residuals' or the
+    fixed rule's.  The widest of the three never does.
+
+    Parameters
+    ----------
+    parts : list of ndarray
+        Each record's residuals, in time order.
+    window : int
+        The fewest lags of the fixed rule and of Andrews' (a derivative filter's length).
+
+    Returns
+    -------
+    tuple of int
+        ``(0, fixed, Andrews)`` (zeros for no samples).
+
+    Examples
+    --------
+    White residuals: Andrews' rule takes a few lags, the fixed one ``4 N^(1/3)``; a
+    first-order autoregression of ``rho = 0.95`` over 25,000 samples: 245.
+
+    >>> from scipy.signal import lfilter
+    >>> e = np.random.default_rng(0).standard_normal(25000)
+    >>> newey_west_lags([e]), newey_west_lags([e], 11)
+    ((0, 116, 2), (0, 116, 11))
+    >>> newey_west_lags([lfilter([1.0], [1.0, -0.95], e)])
+    (0, 116, 245)
+    """
+    sizes = [np.asarray(p).size for p in parts]
+    if not sizes or not min(sizes):
+        return 0, 0, 0
+    n, shortest = sum(sizes), min(sizes)
+    rho = _lag_one(parts)
+    alpha = (2.0 * rho / (1.0 - rho * rho)) ** 2
+    bandwidth = max(math.ceil(BARTLETT_BANDWIDTH * (alpha * n) ** (1 / 3)), window)
+    fixed = min(regression_lags(n, window), shortest - 1)
+    return 0, max(fixed, 0), max(min(bandwidth, int(MAX_LAG_SHARE * shortest)), 0)
+
+
+def _lag_one(parts: list[NDArray[np.float64]]) -> float:
+    """The residuals' lag-one autocorrelation pooled over the records (within +-0.999999)."""
+    g0 = sum(float(np.dot(p, p)) for p in parts)
+    g1 = sum(float(np.dot(p[1:], p[:-1])) for p in parts if np.asarray(p).size > 1)
+    return min(max(g1 / g0, -0.999999), 0.999999) if g0 > 0 else 0.0
+
+
+def widest_covariance(covs: list[NDArray[np.float64]]) -> NDArray[np.float64]:
+    """One covariance from those of the lag counts of :func:`newey_west_lags`: each variance
+    the largest of them, the correlations those of the last (Andrews' lags, in that
+    function's order), so that no standard error is narrower than white residuals' or the
+    fixed rule's.
+
+    The largest variance of each parameter, not of every combination: a check that judges
+    a combination (:func:`~motionhyst.identify.io_consistency.check_one_stage`'s mass with
+    another record's spring) takes the largest of its variances over the lag counts itself.
+
+    Parameters
+    ----------
+    covs : list of ndarray
+        The ``p x p`` covariances, the last's correlations kept.
+
+    Returns
+    -------
+    ndarray
+        ``D C D``, ``C`` the last covariance, ``D`` the diagonal that makes its variances
+        the largest; positive semi-definite where ``C`` is (a parameter whose variance in
+        ``C`` is 0 keeps the largest, uncorrelated).
+
+    Examples
+    --------
+    >>> white = np.array([[4.0, 1.0], [1.0, 1.0]])
+    >>> longer = np.array([[1.0, -0.5], [-0.5, 9.0]])
+    >>> widest_covariance([white, longer]).tolist()
+    [[4.0, -1.0], [-1.0, 9.0]]
+    """
+    covs = [np.asarray(c, dtype=np.float64) for c in covs]
+    top = np.max([np.diag(c) for c in covs], axis=0)
+    last = np.diag(covs[-1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.where(last > 0, np.sqrt(top / np.where(last > 0, last, 1.0)), 0.0)
+    out = covs[-1] * np.outer(scale, scale)
+    np.fill_diagonal(out, top)
+    return out
+
+
 class ResidualCorrelation:
     """The residuals' autocorrelation, for standard errors that do not take them for white
     noise.
@@ -238,11 +339,10 @@ class ResidualCorrelation:
     It is taken Toeplitz within each record (a stationary residual) with the
     residuals' own autocovariance ``gamma_l``, pooled over the records, weighted by the
     Bartlett kernel ``1 - l / (B + 1)`` up to lag ``B`` (Newey and West, Econometrica 55,
-    703-708, 1987: a weighting that keeps ``Omega`` positive semi-definite); ``B`` is
-    Andrews' (Econometrica 59, 817-858, 1991) for a first-order autoregression of the
-    residuals, ``1.1447 (alpha N)^(1/3)``, ``alpha = (2 rho / (1 - rho^2))^2``, at most
-    :data:`MAX_LAG_SHARE` of the shortest record.  White residuals give ``B`` of a few
-    samples and the usual standard errors within their own scatter.
+    703-708, 1987: a weighting that keeps ``Omega`` positive semi-definite), for each ``B``
+    of :func:`newey_west_lags` (none, the fixed rule's, Andrews'): the standard errors are
+    the widest they give (:func:`widest_covariance`).  White residuals give the usual
+    standard errors within the fixed rule's scatter (a few per cent).
 
     Parameters
     ----------
@@ -251,39 +351,37 @@ class ResidualCorrelation:
 
     Attributes
     ----------
+    rules : tuple of int
+        The lag counts (:func:`newey_west_lags`).
     lags : int
-        ``B``.
-    kernel : ndarray
-        ``w_l gamma_l / gamma_0``, ``l = 0 .. B``.
+        The most of them.
+    kernels : list of ndarray
+        For each, ``w_l gamma_l / gamma_0``, ``l = 0 .. B``.
 
     Examples
     --------
-    White residuals: one or two lags, the usual standard errors; a first-order
-    autoregression with ``rho = 0.9``: ``sqrt((1 + rho) / (1 - rho)) = 4.4`` times wider
-    for a mean.
+    White residuals: the usual standard error of a mean, the fixed rule's scatter above it
+    (6 % in this draw); a first-order autoregression with ``rho = 0.9``:
+    ``sqrt((1 + rho) / (1 - rho)) = 4.4`` times wider.
 
     >>> rng = np.random.default_rng(0)
     >>> e = rng.standard_normal(20000)
-    >>> J = np.ones((20000, 1))
+    >>> J = np.ones((20000, 1)) / np.sqrt(20000)
     >>> white = ResidualCorrelation([e])
-    >>> white.lags <= 3, round(float(np.sqrt(white.inner(J / np.sqrt(20000))[0, 0])), 1)
-    (True, 1.0)
+    >>> white.rules, [round(float(np.sqrt(c[0, 0])), 2) for c in white.inners(J)]
+    ((0, 108, 1), [1.0, 1.06, 1.0])
     >>> from scipy.signal import lfilter
     >>> ar = ResidualCorrelation([lfilter([1.0], [1.0, -0.9], e)])
-    >>> round(float(np.sqrt(ar.inner(J / np.sqrt(20000))[0, 0])), 1)
+    >>> round(float(np.sqrt(max(c[0, 0] for c in ar.inners(J)))), 1)
     4.4
     """
 
     def __init__(self, parts: list[NDArray[np.float64]]) -> None:
         parts = [np.asarray(p, dtype=float) for p in parts]
         self.sizes = [p.size for p in parts]
-        n = sum(self.sizes)
-        g0 = sum(float(p @ p) for p in parts)
-        g1 = sum(float(p[1:] @ p[:-1]) for p in parts if p.size > 1)
-        rho = min(max(g1 / g0, -0.999999), 0.999999) if g0 > 0 else 0.0
-        alpha = (2.0 * rho / (1.0 - rho * rho)) ** 2
-        most = int(MAX_LAG_SHARE * min(self.sizes)) if self.sizes else 0
-        self.lags = max(min(math.ceil(BARTLETT_BANDWIDTH * (alpha * n) ** (1 / 3)), most), 0)
+        self.rho = _lag_one(parts)
+        self.rules = newey_west_lags(parts)
+        self.lags = max(self.rules)
         gamma = np.zeros(self.lags + 1)
         for p in parts:
             if p.size == 0:
@@ -292,13 +390,15 @@ class ResidualCorrelation:
             acov = np.fft.irfft(spec * np.conj(spec), 2 * p.size)[:p.size]
             m = min(self.lags + 1, p.size)
             gamma[:m] += acov[:m]
-        weights = np.concatenate([[1.0], bartlett_weights(self.lags)])
-        self.kernel = weights * gamma / gamma[0] if gamma[0] > 0 else np.eye(1, self.lags + 1)[0]
-        self.rho = rho
+        self.kernels = []
+        for lags in self.rules:
+            weights = np.concatenate([[1.0], bartlett_weights(lags)])
+            self.kernels.append(weights * gamma[:lags + 1] / gamma[0] if gamma[0] > 0
+                                else np.eye(1, lags + 1)[0])
 
-    def inner(self, U: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``U^T C U`` with ``C`` the residuals' weighted autocorrelation (Toeplitz within
-        each record, its diagonal 1): ``U^T U`` for white residuals.
+    def inners(self, U: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        """``U^T C U`` for each lag count, ``C`` the residuals' weighted autocorrelation
+        (Toeplitz within each record, its diagonal 1): ``U^T U`` for white residuals.
 
         Parameters
         ----------
@@ -307,17 +407,21 @@ class ResidualCorrelation:
 
         Returns
         -------
-        ndarray
-            ``U^T C U``.
+        list of ndarray
+            ``U^T C U``, one for each of :attr:`rules`.
         """
         U = np.asarray(U, dtype=float)
-        if self.lags == 0:
-            return U.T @ U
-        out = np.zeros((U.shape[1], U.shape[1]))
-        a = 0
-        for size in self.sizes:  # each record's own sum (:func:`bartlett_sum`)
-            out += bartlett_sum(U[a:a + size], self.kernel[1:])
-            a += size
+        out = []
+        for kernel in self.kernels:
+            if kernel.size == 1:
+                out.append(U.T @ U)
+                continue
+            total = np.zeros((U.shape[1], U.shape[1]))
+            a = 0
+            for size in self.sizes:  # each record's own sum (:func:`bartlett_sum`)
+                total += bartlett_sum(U[a:a + size], kernel[1:])
+                a += size
+            out.append(total)
         return out
 
 
@@ -354,7 +458,7 @@ def lower_bound_note(fit_rms: float, noise_rms: float, widened: float, lags: int
     widened : float
         How many times the residuals' correlation widened the standard errors (the most).
     lags : int
-        The lags over which it was summed (:attr:`ResidualCorrelation.lags`).
+        The most lags over which it was summed (:attr:`ResidualCorrelation.lags`).
     unit : str
         The residuals' unit.
     signal_rms : float
@@ -378,7 +482,7 @@ def lower_bound_note(fit_rms: float, noise_rms: float, widened: float, lags: int
     what = (f"leaves {fit_rms / noise_rms:.2g} times its records' white noise "
             f"({noise_rms:.2g} {unit})" if noise_rms > 0 else
             f"leaves {fit_rms:.2g} {unit} RMS where its records have no white noise")
-    wider = (f"; widened {widened:.2g} times for the residuals' correlation over {lags} "
+    wider = (f"; widened {widened:.2g} times for the residuals' correlation over up to {lags} "
              f"samples (Newey-West)" if widened > 1.05 else "")
     return (f"standard errors are lower bounds: the fit {what}, model error (a search that "
             f"stopped short, a link or plant unlike the records') or noise that is not "
