@@ -183,6 +183,59 @@ def test_benchmark_emps_command_json(tmp_path, capsys, monkeypatch):
         assert model["parameters"]["offset"] == pytest.approx(TRUE["offset"], abs=0.5)
 
 
+def test_a_failed_model_is_a_row_and_the_others_go_on(tmp_path, capsys, monkeypatch):
+    """One model whose fit fails (here at once: identify_io refuses every Dahl link) is a row
+    with its one-line reason, in the table and in the JSON as {"name", "error", ...}; the
+    other models are identified and scored on both splits, the rule chooses among those
+    that did not fail, and the command ends with one line on stderr and exit 2.  main ended
+    the whole command at the first failure and printed no row."""
+    import motionhyst.identify.emps as emps
+    from motionhyst.identify.io_checks import FitFailed
+
+    real = emps.identify_io
+
+    def identify_io(records, link, **kwargs):
+        if link == "dahl":
+            raise FitFailed("the fit failed: its prediction is not finite")
+        return real(records, link, **kwargs)
+
+    rec = axis_record()
+    savemat(tmp_path / "DATA_EMPS.mat", {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
+                                         "qm": rec.y[:, None], "gtau": DRIVE_GAIN})
+    monkeypatch.setattr(emps, "identify_io", identify_io)
+    monkeypatch.setattr(emps, "PERIOD", PERIOD)
+    args = ["benchmark", "emps", "--data", str(tmp_path), "--models", "dahl,coulomb"]
+    assert main([*args, "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert err == ("motionhyst: error: benchmark emps: 2 of 4 fits failed (dahl on DATA_EMPS "
+                   "periods 1-2, dahl on DATA_EMPS periods 3-4): their rows say why; the "
+                   "others are above\n")
+    result = json.loads(out)
+    dahl, coulomb = result["models"][0::2], result["models"][1::2]
+    for split, (est, val) in enumerate((("1-2", "3-4"), ("3-4", "1-2"))):
+        assert dahl[split]["name"] == "dahl" and "parameters" not in dahl[split]
+        assert dahl[split]["error"] == "the fit failed: its prediction is not finite"
+        assert dahl[split]["estimation"] == {"record": f"DATA_EMPS periods {est}"}
+        assert dahl[split]["validation"] == {"record": f"DATA_EMPS periods {val}"}
+        assert coulomb[split]["parameters"]["m"] == pytest.approx(TRUE["m"], rel=0.05)
+        assert coulomb[split]["validation"]["record"] == f"DATA_EMPS periods {val}"
+        assert coulomb[split]["validation"]["rmse_mm"] < 0.05  # the true model's structure
+    worst = max(m["validation"]["rmse_mm"] for m in coulomb)
+    assert result["chosen"] == {"name": "coulomb", "worse_split_rmse_mm": worst}
+    assert main(args) == 2
+    out, err = capsys.readouterr()
+    assert "dahl: failed (" in err and "s): the fit failed" in err  # its progress line
+    assert err.splitlines()[-1].startswith("motionhyst: error: benchmark emps: 2 of 4 fits")
+    assert err.count("motionhyst: error") == 1
+    rows = [line.strip() for line in out.splitlines()
+            if line.strip().startswith("motionhyst: mass-damper")]
+    assert rows[0] == ("motionhyst: mass-damper + dahl  failed: the fit failed: its "
+                       "prediction is not finite")
+    assert rows[1].startswith("motionhyst: mass-damper + coulomb") and "failed" not in rows[1]
+    assert "dahl - (failed on 2 of 2 splits)" in out and "warning: dahl" not in out
+    assert f"(the rule stated in advance): coulomb, {worst:.3g} mm" in out
+
+
 def test_benchmark_emps_every_split(tmp_path, capsys, monkeypatch):
     """--periods all: both halves, then all periods but the last and all but the first, each
     validated on what it left out; the rule takes the worst of the four."""
@@ -355,6 +408,32 @@ def test_a_link_at_its_rigid_limit_is_reported_as_that_limit(monkeypatch):
     assert "rigid limit" in jenkins.warnings[0] and jenkins.to_dict()["limit"] == "coulomb"
     assert "jenkins (its rigid limit, coulomb)" in str(res)
     assert "warning: jenkins: the link's stiffness ran to the rigid limit" in str(res)
+
+
+def test_a_link_whose_rigid_limit_failed_is_a_failed_row(monkeypatch):
+    """A Jenkins link run to its rigid limit when that limit, the Coulomb fit, failed on the
+    same records: its row says both, and the Coulomb fit is not made again."""
+    import motionhyst.identify.emps as emps
+    import motionhyst.identify.io_checks as io_checks
+    from motionhyst.identify.io_checks import FitFailed
+
+    real, links = emps.identify_io, []
+
+    def identify_io(records, link, **kwargs):
+        links.append(link)
+        if link == "coulomb":
+            raise FitFailed("the fit failed: its prediction is not finite")
+        return real(records, link, **kwargs)
+
+    monkeypatch.setattr(io_checks, "MAX_PREDICT_SUBSTEPS", 60)
+    monkeypatch.setattr(emps, "identify_io", identify_io)
+    res = run_emps(axis_record(n_periods=2), models=("coulomb", "jenkins"), periods=(1, 1),
+                   period=PERIOD)
+    assert links == ["coulomb", "jenkins"]
+    assert res.failed == res.models  # both rows say why
+    assert res.models[1].error.startswith("a model that needs more than ")
+    assert res.models[1].error.endswith("integration steps per sample; its rigid limit coulomb: "
+                                        "the fit failed: its prediction is not finite")
 
 
 def test_the_asymmetric_reference_model_by_one_linear_solve():

@@ -188,10 +188,11 @@ def run_emps(args: argparse.Namespace) -> int:
                             progress=say)]
     chosen = None
     if len(results) > 1:
-        name, worst = choose(results)
-        chosen = {"name": name, "worse_split_rmse_mm": worst}
+        picked = choose(results)  # None: every model failed on some split
+        if picked is not None:
+            chosen = {"name": picked[0], "worse_split_rmse_mm": picked[1]}
     elif test is not None:  # chosen on the splits before the test; its score on the test here
-        scored = [m for m in results[0].models if m.name == CHOSEN]
+        scored = [m for m in results[0].models if m.name == CHOSEN and m.error is None]
         if scored:
             chosen = {"name": CHOSEN, "rule": "chosen before the test, by the smallest "
                       "validation RMSE on the worse of the two splits of DATA_EMPS",
@@ -199,16 +200,40 @@ def run_emps(args: argparse.Namespace) -> int:
     if args.json:
         print_json({"models": [m for res in results for m in res.to_dict()["models"]],
                     **({} if chosen is None else {"chosen": chosen})})
-        return 0
-    print("\n\n".join(str(res) for res in results))
-    if chosen is not None and test is None:
-        worst_rmse = chosen["worse_split_rmse_mm"]
-        two = len(results) == 2
-        splits = "both splits" if two else f"the {len(results)} splits"
-        worst = "worse" if two else "worst"
-        print(f"\nMean validation RMSE over {splits}: " + ", ".join(
-            f"{runs[0].name} {sum(m.validation['rmse_mm'] for m in runs) / len(runs):.3g} mm"
-            for runs in zip(*(res.models for res in results), strict=True)))
-        print(f"Chosen by the {worst} of {'the two splits' if two else splits} (the rule stated "
-              f"in advance): {chosen['name']}, {worst_rmse:.3g} mm on its {worst} split")
+    else:
+        print("\n\n".join(str(res) for res in results))
+        if len(results) > 1:
+            _print_splits(results, chosen)
+    failed = [f"{m.name} on {res.estimation_record.name}" for res in results
+              for m in res.failed]
+    if failed:  # the table or JSON above has every row; the exit code says some failed
+        from motionhyst.identify.io_checks import FitFailed
+
+        count = sum(len(res.models) for res in results)
+        rows = "its row says" if len(failed) == 1 else "their rows say"
+        others = "; the others are above" if len(failed) < count else ""
+        raise FitFailed(f"benchmark emps: {len(failed)} of {count} fits failed "
+                        f"({', '.join(failed)}): {rows} why{others}")
     return 0
+
+
+def _print_splits(results, chosen: dict | None) -> None:
+    """The mean validation RMSE of each model over the splits, and the rule's choice."""
+    two = len(results) == 2
+    splits = "both splits" if two else f"the {len(results)} splits"
+    worst = "worse" if two else "worst"
+
+    def mean(runs) -> str:
+        failed = sum(m.error is not None for m in runs)
+        if failed:
+            return f"{runs[0].name} - (failed on {failed} of {len(runs)} splits)"
+        return f"{runs[0].name} {sum(m.validation['rmse_mm'] for m in runs) / len(runs):.3g} mm"
+
+    print(f"\nMean validation RMSE over {splits}: " + ", ".join(
+        mean(runs) for runs in zip(*(res.models for res in results), strict=True)))
+    if chosen is None:
+        print("No model chosen: every model failed on at least one split")
+        return
+    print(f"Chosen by the {worst} of {'the two splits' if two else splits} (the rule stated "
+          f"in advance): {chosen['name']}, {chosen['worse_split_rmse_mm']:.3g} mm on its "
+          f"{worst} split")

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from motionhyst.core.warnings import MotionhystWarning
+from motionhyst.identify._emps_cells import failed_table, friction, marked, offset, own, viscous
 from motionhyst.identify.emps_files import COLUMNS, DRIVE_GAIN, ESTIMATION_FILE, TEST_FILE
 from motionhyst.identify.emps_models import (
     OPTIONS,
@@ -56,6 +57,7 @@ from motionhyst.identify.emps_reference import (
     equivalent_offset,
     fit_parameters,
     reference_form,
+    reference_notes,
     reference_system,
 )
 from motionhyst.identify.input_output import IORecord, identify_io
@@ -64,9 +66,9 @@ from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
 from motionhyst.identify.io_start import inverse_dynamics
 
 __all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
-           "INIT_WINDOW", "MASS_BAND", "MODELS", "OFFSET_BAND", "PERIOD", "TEST_FILE",
+           "INIT_WINDOW", "MODELS", "PERIOD", "TEST_FILE",
            "EMPSBenchmark", "EMPSModel", "choose", "cross_validate", "own_offset_score",
-           "period_drift", "reference_notes", "run_emps", "score", "split_by_periods"]
+           "period_drift", "run_emps", "score", "split_by_periods"]
 
 PERIOD = 6240
 """Samples per period of the estimation record's reference ``qg``."""
@@ -78,7 +80,8 @@ mass-damper, fitted and scored with the 20-sample initialisation window), the Co
 with the force offset drifting in time from the record's start (``-drift``, ``identify
 --drift``).  On the whole of ``DATA_EMPS`` the first and the third find 93.47 and 93.91 kg,
 within 3 % of the benchmark's 95.1 kg; the drifting offset takes part of the inertia, 92.05 kg,
-3.2 % low, which its warnings say (:func:`reference_notes`).  Other models are given by name
+3.2 % low, which its warnings say
+(:func:`~motionhyst.identify.emps_reference.reference_notes`).  Other models are given by name
 (:func:`run_emps`'s `models`, ``benchmark emps --models``): ``jenkins-asymmetric-drift`` (a
 stiffness the halves resolve, 2.3e6-2.9e6 N/m; 1.29 and 5.72 mm on the two splits), those
 with one viscous coefficient (``"coulomb-symmetric"``, ``"jenkins-symmetric"``,
@@ -92,9 +95,10 @@ smallest worse-split validation RMSE, 4.50 mm (``coulomb-asymmetric`` 6.11 mm,
 ``jenkins-asymmetric`` 7.2 mm)."""
 
 
-def choose(runs: Sequence[EMPSBenchmark]) -> tuple[str, float]:
+def choose(runs: Sequence[EMPSBenchmark]) -> tuple[str, float] | None:
     """The model a rule stated in advance picks from runs on several splits: the smallest
-    worse-split validation RMSE (a model is judged by the split it does worst on).
+    worse-split validation RMSE (a model is judged by the split it does worst on; one whose
+    fit failed on a split is not chosen: its worse split has no figure).
 
     Parameters
     ----------
@@ -103,25 +107,33 @@ def choose(runs: Sequence[EMPSBenchmark]) -> tuple[str, float]:
 
     Returns
     -------
-    name : str
-        The model chosen.
-    worst : float
-        Its validation RMSE on the split it does worst on [mm].
+    (name, worst) or None
+        The model chosen and its validation RMSE on the split it does worst on [mm]; None
+        when every model failed on some split.
 
     Examples
     --------
     >>> def run(**rmse):
     ...     return EMPSBenchmark([EMPSModel(n, {}, {}, {}, {"rmse_mm": r}, 0.0)
+    ...                           if r is not None else EMPSModel.failed(n, {}, {}, "no fit")
     ...                           for n, r in rmse.items()], None, None, False, {})
     >>> choose([run(a=1.0, b=3.0), run(a=5.0, b=3.5)])
     ('b', 3.5)
+    >>> choose([run(a=1.0, b=3.0), run(a=2.0, b=None)])    # b failed on the second split
+    ('a', 2.0)
+    >>> choose([run(a=None), run(a=1.0)]) is None
+    True
     """
     worst: dict[str, float] = {}
     for res in runs:
         for m in res.models:
-            worst[m.name] = max(worst.get(m.name, 0.0), float(m.validation["rmse_mm"]))
-    name = min(worst, key=worst.__getitem__)
-    return name, worst[name]
+            worst[m.name] = max(worst.get(m.name, 0.0),
+                                np.inf if m.error is not None else float(m.validation["rmse_mm"]))
+    scored = {name: rmse for name, rmse in worst.items() if np.isfinite(rmse)}
+    if not scored:
+        return None
+    name = min(scored, key=scored.__getitem__)
+    return name, scored[name]
 
 
 def split_by_periods(record: IORecord, periods: tuple[int, int] = (1, 2),
@@ -227,6 +239,10 @@ class EMPSModel:
     std_note : str or None
         Why the standard errors are lower bounds (the fit leaves more than the record's white
         noise, :func:`~motionhyst.identify.residual_noise.lower_bound_note`), or None.
+    error : str or None
+        Why the model's identification or scoring failed (one line), or None; a failed
+        model (:meth:`failed`) has no parameters and its records' names alone as its
+        estimation and validation.
 
     Examples
     --------
@@ -237,6 +253,12 @@ class EMPSModel:
     coulomb: validation on DATA_EMPS periods 3-4 6.1 mm (92.60 %), estimation 1.8 mm
     >>> sorted(m.to_dict())
     ['estimation', 'name', 'parameters', 'seconds', 'std', 'validation']
+    >>> bad = EMPSModel.failed("dahl", {"record": "DATA_EMPS periods 1-2"},
+    ...                        {"record": "DATA_EMPS periods 3-4"}, "the fit failed: ...")
+    >>> print(bad)
+    dahl: failed on DATA_EMPS periods 1-2: the fit failed: ...
+    >>> sorted(bad.to_dict())
+    ['error', 'estimation', 'name', 'seconds', 'validation']
     """
 
     name: str
@@ -252,12 +274,48 @@ class EMPSModel:
     model_parameters: dict[str, float] = field(default_factory=dict)
     model_std: dict[str, float | None] = field(default_factory=dict)
     std_note: str | None = None
+    error: str | None = None
+
+    @classmethod
+    def failed(cls, name: str, estimation: dict, validation: dict, error: str,
+               seconds: float = 0.0) -> EMPSModel:
+        """A model whose identification or scoring failed, and why.
+
+        Parameters
+        ----------
+        name : str
+            The model's name.
+        estimation, validation : dict
+            ``{"record": name}`` of the records it was to be identified from and scored on.
+        error : str
+            Why it failed (one line).
+        seconds : float
+            The time it took to fail [s].
+
+        Returns
+        -------
+        EMPSModel
+            With :attr:`error` set, no parameters.
+
+        Examples
+        --------
+        >>> EMPSModel.failed("lugre", {"record": "a"}, {"record": "b"}, "no fit").error
+        'no fit'
+        """
+        return cls(name, {}, {}, dict(estimation), dict(validation), seconds, error=error)
 
     def to_dict(self) -> dict:
         """``{"name", "parameters", "std", "estimation", "validation", "seconds"}``, and
         ``"model_parameters"``, ``"model_std"`` and ``"equivalent_offset"`` when known,
         ``"limit"`` when the model is at one, ``"std_lower_bound"`` (True) and ``"std_note"``
-        when the standard errors are lower bounds, ``"warnings"`` when there are any."""
+        when the standard errors are lower bounds, ``"warnings"`` when there are any; a
+        failed model: ``{"name", "error", "estimation", "validation", "seconds"}``, the two
+        records by name alone."""
+        if self.error is not None:
+            return {"name": self.name, "error": self.error,
+                    "estimation": {"record": self.estimation.get("record")},
+                    "validation": {"record": self.validation.get("record")},
+                    "seconds": self.seconds}
         out = {"name": self.name, "parameters": dict(self.parameters), "std": dict(self.std),
                "estimation": dict(self.estimation), "validation": dict(self.validation),
                "seconds": self.seconds}
@@ -276,6 +334,8 @@ class EMPSModel:
 
     def __str__(self) -> str:
         est, val = self.estimation, self.validation
+        if self.error is not None:
+            return f"{self.name}: failed on {est.get('record')}: {self.error}"
         return (f"{self.name}: validation on {val['record']} {val['rmse_mm']:.3g} mm "
                 f"({val['fit_percent']:.2f} %), estimation {est['rmse_mm']:.3g} mm")
 
@@ -329,26 +389,36 @@ class EMPSBenchmark:
         return {"models": [m.to_dict() for m in self.models]}
 
     def best(self) -> EMPSModel:
-        """The model with the smallest validation RMSE."""
-        return min(self.models, key=lambda m: m.validation["rmse_mm"])
+        """The model with the smallest validation RMSE (of those that did not fail)."""
+        return min((m for m in self.models if m.error is None),
+                   key=lambda m: m.validation["rmse_mm"])
+
+    @property
+    def failed(self) -> list[EMPSModel]:
+        """The models whose identification or scoring failed (:attr:`EMPSModel.error`)."""
+        return [m for m in self.models if m.error is not None]
 
     def __str__(self) -> str:
         from motionhyst.core.textfmt import g, table
 
-        rows = []
+        rows, failures = [], {}
         for m in self.models:
+            if m.error is not None:  # its reason on its row; the others' columns kept
+                failures[len(rows)] = m.error
+                rows.append([f"motionhyst: mass-damper + {m.name}", *["-"] * 10])
+                continue
             p, s = (m.model_parameters, m.model_std) if m.model_parameters else (m.parameters,
                                                                                  m.std)
             limit = "" if m.limit is None else f" (its rigid limit, {m.limit})"
             rows.append([f"motionhyst: mass-damper + {m.name}{limit}",
-                         _marked(g(p.get("m"), 4), s, "m"),
-                         _marked(_viscous(p), s, "c", "c_skew", "c_pos", "c_neg"),
-                         _marked(_friction(p), s, "fc", "fc_pos", "fc_neg"),
-                         _marked(_offset(p), s, "offset", "drift"),
+                         marked(g(p.get("m"), 4), s, "m"),
+                         marked(viscous(p), s, "c", "c_skew", "c_pos", "c_neg"),
+                         marked(friction(p), s, "fc", "fc_pos", "fc_neg"),
+                         marked(offset(p), s, "offset", "drift"),
                          "-" if m.equivalent_offset is None else
-                         _marked(g(m.equivalent_offset, 3), m.std, "offset"),
+                         marked(g(m.equivalent_offset, 3), m.std, "offset"),
                          f"{m.estimation['rmse_mm']:.3g}", f"{m.validation['rmse_mm']:.3g}",
-                         f"{m.validation['fit_percent']:.1f}", _own(m.validation),
+                         f"{m.validation['fit_percent']:.1f}", own(m.validation),
                          f"{m.seconds:.0f}"])
         ref, est = self.reference, self.estimation_record
         for key, what in (("idim", f"IDIM-LS on {est.name} (one linear solve)"),
@@ -361,7 +431,7 @@ class EMPSBenchmark:
                 continue
             q = row.get("parameters", REFERENCE_MODEL)
             of = equivalent_offset(q, est)
-            rows.append([what, g(q["m"], 4), _viscous(q), _friction(q),
+            rows.append([what, g(q["m"], 4), viscous(q), friction(q),
                          g(q.get("offset", 0.0), 3), g(of, 3),
                          f"{row['estimation']['rmse_mm']:.3g}",
                          f"{row['validation']['rmse_mm']:.3g}",
@@ -374,13 +444,15 @@ class EMPSBenchmark:
                  + ("" if self.official_test else " (the test record "
                     f"{TEST_FILE} was not given)"),
                  f"RMSE of the position simulated from the force, samples n >= {INIT_WINDOW} "
-                 f"(the first {INIT_WINDOW} set the initial state)", "", table(head, rows)]
+                 f"(the first {INIT_WINDOW} set the initial state)", "",
+                 failed_table(head, rows, failures)]
         pub = [[name, "-" if rmse is None else f"{rmse:.3g}", f"{fit:.1f}"]
                for name, rmse, fit in PUBLISHED]
         lines += ["", "Published, on the test record " + TEST_FILE
                   + ("" if self.official_test else " (not the record above)") + ":",
                   table(["method", "RMSE [mm]", "fit [%]"], pub)]
-        if self.official_test and any(m.name == CHOSEN for m in self.models):
+        if self.official_test and any(m.name == CHOSEN and m.error is None
+                                      for m in self.models):
             chosen = next(m for m in self.models if m.name == CHOSEN)
             lines += ["", f"motionhyst's figure on {self.validation_record.name}: {CHOSEN}, "
                       f"{chosen.validation['rmse_mm']:.3g} mm (the physical model chosen before "
@@ -437,93 +509,6 @@ class EMPSBenchmark:
         axes[1].set_ylabel("error [mm]")
         axes[1].set_xlabel("time [s]")
         return fig
-
-
-def _viscous(p: dict) -> str:
-    """``c``, or ``c+/c-`` (forward/backward) for direction-dependent viscous friction."""
-    from motionhyst.core.textfmt import g
-
-    c = p.get("c")
-    if c is None and "c_pos" in p:  # the asymmetric reference model's own
-        return f"{g(p['c_pos'], 4)}/{g(p['c_neg'], 4)}"
-    if c is None or not {"c_pos", "c_neg", "c_skew"} & set(p):
-        return g(c, 4)
-    d = p.get("c_skew", 0.0)
-    return f"{g(c + d + p.get('c_pos', 0.0), 4)}/{g(c - d + p.get('c_neg', 0.0), 4)}"
-
-
-def _offset(p: dict) -> str:
-    """``OF``, or ``OF + rate t`` [N, N/s] for a drifting offset."""
-    from motionhyst.core.textfmt import g
-
-    if "drift" not in p:
-        return g(p.get("offset"), 3)
-    return f"{g(p['offset'], 3)} {p['drift']:+.2g} t"
-
-
-def _friction(p: dict) -> str:
-    from motionhyst.core.textfmt import g
-
-    if "fc" in p:
-        return g(p["fc"], 4)
-    if "fc_pos" in p:
-        return f"{g(p['fc_pos'], 4)}/{g(p['fc_neg'], 4)}"
-    return "-"
-
-
-def _marked(cell: str, std: dict, *names: str) -> str:
-    """`cell`, marked when the record does not determine a parameter it shows (its standard
-    error None, as the JSON's ``std`` and ``model_std`` say)."""
-    return f"{cell} (not determined)" if any(n in std and std[n] is None for n in names) \
-        else cell
-
-
-def _own(validation: dict) -> str:
-    own = validation.get("own_offset")
-    return "-" if own is None else f"{own['rmse_mm']:.3g} ({own['offset']:.3g} N)"
-
-
-MASS_BAND = 0.03
-"""How far (relative) a model's mass may lie from the benchmark's published IDIM-LS mass
-(95.1 kg) before :func:`reference_notes` says so."""
-OFFSET_BAND = 0.6
-"""How far [N] a model's offset as the reference model's OF may lie from the published -3.16 N
-before :func:`reference_notes` says so."""
-
-
-def reference_notes(parameters: dict) -> list[str]:
-    """What of a model in the reference model's form lies beyond the benchmark's published
-    IDIM-LS estimate: its mass by more than :data:`MASS_BAND`, its offset as OF by more than
-    :data:`OFFSET_BAND` (one line each, for the model's warnings).
-
-    Parameters
-    ----------
-    parameters : dict
-        ``m`` [kg] and ``offset`` (as OF) [N], as :attr:`EMPSModel.parameters`.
-
-    Returns
-    -------
-    list of str
-
-    Examples
-    --------
-    >>> reference_notes({"m": 93.5, "offset": -3.19})
-    []
-    >>> reference_notes({"m": 92.05, "offset": -3.21})
-    ["m = 92.05 kg is 3.2 % below the benchmark's published 95.11 kg (IDIM-LS), beyond 3 %: ..."]
-    """
-    notes = []
-    m, ref = parameters.get("m"), REFERENCE_MODEL["m"]
-    if m is not None and abs(m / ref - 1.0) > MASS_BAND:
-        notes.append(f"m = {m:.2f} kg is {100 * abs(m / ref - 1.0):.1f} % "
-                     f"{'below' if m < ref else 'above'} the benchmark's published {ref:.2f} kg "
-                     f"(IDIM-LS), beyond {100 * MASS_BAND:.0f} %: the model may trade inertia "
-                     f"for a force it describes poorly")
-    of, ref_of = parameters.get("offset"), REFERENCE_MODEL["offset"]
-    if of is not None and abs(of - ref_of) > OFFSET_BAND:
-        notes.append(f"its offset as OF, {of:.2f} N, is {abs(of - ref_of):.2f} N from the "
-                     f"benchmark's published {ref_of:.2f} N (IDIM-LS), beyond {OFFSET_BAND} N")
-    return notes
 
 
 def own_offset_score(system, record: IORecord, span: float = 2.0) -> dict:
@@ -772,8 +757,9 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     Raises
     ------
     ValueError
-        A record that cannot be used, or a model whose identification failed
-        (one line naming the model).
+        A record that cannot be used, or a model name that is none of the benchmark's.
+        A model whose identification or scoring fails does not end the run: it is a
+        row with its reason (:meth:`EMPSModel.failed`) and the others go on.
 
     Examples
     --------
@@ -803,19 +789,15 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     for name in models:
         say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
         t0 = time.perf_counter()
-        link, options = model_options(name)
         try:
-            model = _identify_and_score(name, link, options, est, val, rigid)
-            why = unresolved_stiffness(name, model.model_parameters, model.model_std, est.fs)
-        except FitFailed as exc:
-            if link == "coulomb" or RIGID_LIMIT not in str(exc):
-                raise ValueError(f"{name}: {exc}") from None
-            why = f"a model that needs more than {MAX_PREDICT_SUBSTEPS} {RIGID_LIMIT}"
-        if why is not None:  # report the limit, the Coulomb link with the same options
-            model = _rigid_limit(name, options, est, val, out, why, rigid)
+            model = _model(name, est, val, out, rigid)
+        except ValueError as exc:  # this model's row says why; the others' minutes are kept
+            why = " ".join(str(exc).removeprefix(f"{name}: ").split())
+            model = EMPSModel.failed(name, {"record": est.name}, {"record": val.name}, why)
         model.seconds = time.perf_counter() - t0
         out.append(model)
-        say(f"{name}: {model.validation['rmse_mm']:.3g} mm on {val.name} "
+        say(f"{name}: failed ({model.seconds:.0f} s): {model.error}" if model.error else
+            f"{name}: {model.validation['rmse_mm']:.3g} mm on {val.name} "
             f"({model.seconds:.0f} s)")
     ref = {"estimation": score(reference_system(), est)[0],
            "validation": score(reference_system(), val)[0],
@@ -833,16 +815,37 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     return EMPSBenchmark(out, est, val, test is not None, ref, drift)
 
 
+def _model(name: str, est: IORecord, val: IORecord, done: list[EMPSModel], rigid: dict
+           ) -> EMPSModel:
+    """The model `name` identified on `est` and scored on `val`, or its rigid limit (a
+    Jenkins link whose stiffness the record does not resolve); `done`: the models made so
+    far, `rigid`: the Coulomb fits by options.  A failure is a ValueError naming the model."""
+    link, options = model_options(name)
+    try:
+        model = _identify_and_score(name, link, options, est, val, rigid)
+        why = unresolved_stiffness(name, model.model_parameters, model.model_std, est.fs)
+    except FitFailed as exc:
+        if link == "coulomb" or RIGID_LIMIT not in str(exc):
+            raise ValueError(f"{name}: {exc}") from None
+        why = f"a model that needs more than {MAX_PREDICT_SUBSTEPS} {RIGID_LIMIT}"
+    if why is not None:  # report the limit, the Coulomb link with the same options
+        model = _rigid_limit(name, options, est, val, done, why, rigid)
+    return model
+
+
 def _rigid_limit(name: str, options: set[str], est: IORecord, val: IORecord,
                  done: list[EMPSModel], why: str, rigid: dict) -> EMPSModel:
     """A link reported as its rigid limit: the Coulomb link with the same options (its fit
     among `done` reused), named `name`, with a warning saying `why`."""
     limit = "-".join(["coulomb", *(o for o in OPTIONS if o in options)])
     model = next((m for m in done if m.name == limit), None)
+    if model is not None and model.error is not None:  # failed already: not fitted again
+        raise ValueError(f"{name}: {why}; its rigid limit {limit}: {model.error}")
     try:
         model = model or _identify_and_score(limit, "coulomb", options, est, val, rigid)
-    except FitFailed as limit_failed:
-        raise ValueError(f"{name}: {why}; its rigid limit {limit}: {limit_failed}") from None
+    except (FitFailed, ValueError) as limit_failed:
+        what = str(limit_failed).removeprefix(f"{limit}: ")
+        raise ValueError(f"{name}: {why}; its rigid limit {limit}: {what}") from None
     return replace(model, name=name, limit=limit, warnings=[
         f"the link's stiffness ran to the rigid limit ({why}): reported as that limit, {limit}",
         *model.warnings])

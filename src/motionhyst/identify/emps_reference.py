@@ -31,9 +31,9 @@ import numpy as np
 
 from motionhyst.identify.input_output import IORecord
 
-__all__ = ["PUBLISHED", "REFERENCE_ASYMMETRIC", "REFERENCE_MODEL", "asymmetric_inverse_dynamics",
-           "equivalent_offset", "fit_parameters", "reference_form",
-           "reference_system"]
+__all__ = ["MASS_BAND", "OFFSET_BAND", "PUBLISHED", "REFERENCE_ASYMMETRIC", "REFERENCE_MODEL",
+           "asymmetric_inverse_dynamics", "equivalent_offset", "fit_parameters", "reference_form",
+           "reference_notes", "reference_system"]
 
 REFERENCE_MODEL = {"m": 95.1089, "c": 203.5034, "fc": 20.3935, "offset": -3.1648}
 """The benchmark's IDIM-LS model: M [kg], Fv [N s/m], Fc [N], OF [N]."""
@@ -301,3 +301,47 @@ def reference_form(parameters: dict, record: IORecord, std: dict | None = None,
         if name not in used:
             out[name], out_std[name] = value, std.get(name)
     return out, out_std
+
+
+MASS_BAND = 0.03
+"""How far (relative) a model's mass may lie from the benchmark's published IDIM-LS mass
+(95.1 kg) before :func:`reference_notes` says so."""
+OFFSET_BAND = 0.6
+"""How far [N] a model's offset as the reference model's OF may lie from the published -3.16 N
+before :func:`reference_notes` says so."""
+
+
+def reference_notes(parameters: dict) -> list[str]:
+    """What of a model in the reference model's form lies beyond the benchmark's published
+    IDIM-LS estimate: its mass by more than :data:`MASS_BAND`, its offset as OF by more than
+    :data:`OFFSET_BAND` (one line each, for the model's warnings).
+
+    Parameters
+    ----------
+    parameters : dict
+        ``m`` [kg] and ``offset`` (as OF) [N], as
+        :attr:`~motionhyst.identify.emps.EMPSModel.parameters`.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> reference_notes({"m": 93.5, "offset": -3.19})
+    []
+    >>> reference_notes({"m": 92.05, "offset": -3.21})
+    ["m = 92.05 kg is 3.2 % below the benchmark's published 95.11 kg (IDIM-LS), beyond 3 %: ..."]
+    """
+    notes = []
+    m, ref = parameters.get("m"), REFERENCE_MODEL["m"]
+    if m is not None and abs(m / ref - 1.0) > MASS_BAND:
+        notes.append(f"m = {m:.2f} kg is {100 * abs(m / ref - 1.0):.1f} % "
+                     f"{'below' if m < ref else 'above'} the benchmark's published {ref:.2f} kg "
+                     f"(IDIM-LS), beyond {100 * MASS_BAND:.0f} %: the model may trade inertia "
+                     f"for a force it describes poorly")
+    of, ref_of = parameters.get("offset"), REFERENCE_MODEL["offset"]
+    if of is not None and abs(of - ref_of) > OFFSET_BAND:
+        notes.append(f"its offset as OF, {of:.2f} N, is {abs(of - ref_of):.2f} N from the "
+                     f"benchmark's published {ref_of:.2f} N (IDIM-LS), beyond {OFFSET_BAND} N")
+    return notes
