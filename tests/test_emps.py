@@ -286,6 +286,37 @@ def test_benchmark_emps_with_the_test_record_names_the_chosen_model(tmp_path, ca
     assert "chosen" not in json.loads(capsys.readouterr().out)
 
 
+def test_a_chosen_model_that_failed_on_the_test_record_has_no_figure(tmp_path, capsys,
+                                                                     monkeypatch):
+    """With the test record, the model chosen before the test whose fit failed: no "chosen"
+    in the JSON, no figure below the table, the other model scored, exit 2."""
+    import motionhyst.identify.emps as emps
+    from motionhyst.identify.io_checks import FitFailed
+
+    real = emps.identify_io
+
+    def identify_io(records, link, **kwargs):
+        if link == "dahl":
+            raise FitFailed("the fit failed: its prediction is not finite")
+        return real(records, link, **kwargs)
+
+    rec = axis_record(n_periods=2)
+    for name in ("DATA_EMPS.mat", "DATA_EMPS_PULSES.mat"):
+        savemat(tmp_path / name, {"t": rec.t[:, None], "vir": rec.u[:, None] / DRIVE_GAIN,
+                                  "qm": rec.y[:, None], "gtau": DRIVE_GAIN})
+    monkeypatch.setattr(emps, "identify_io", identify_io)
+    monkeypatch.setattr(emps, "PERIOD", PERIOD)
+    monkeypatch.setattr(emps, "CHOSEN", "dahl")
+    args = ["benchmark", "emps", "--data", str(tmp_path), "--models", "dahl,coulomb"]
+    assert main([*args, "--json"]) == 2
+    out = json.loads(capsys.readouterr().out)
+    assert "chosen" not in out and out["models"][0]["error"].startswith("the fit failed")
+    assert out["models"][1]["validation"]["record"] == "DATA_EMPS_PULSES"
+    assert out["models"][1]["validation"]["rmse_mm"] < 0.05
+    assert main(args) == 2
+    assert "motionhyst's figure" not in capsys.readouterr().out
+
+
 @pytest.mark.skipif(not (SHARED / "DATA_EMPS.mat").is_file(),
                     reason="the EMPS benchmark's files are not beside the repository")
 def test_emps_record_splits_into_its_reference_periods():
