@@ -47,6 +47,10 @@ COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identif
             "study", "benchmark", "reproduce")
 """The commands, in the order ``motionhyst --help`` lists them (module names)."""
 
+_STOPPED = {"identify": "; its search, which no formula sizes, is stopped after S s of CPU time",
+            "reproduce": "; the report is stopped after S s of CPU time"}
+# what --max-seconds also stops once it runs, by command (core.budget.cpu_time_limit's callers)
+
 FILE_OUTPUTS = ("out", "time_series", "save", "figure", "table")
 """Options naming a file or folder a command writes its results to: given one, a command
 started with its standard output closed still runs (only its summary is lost)."""
@@ -88,8 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
         sub.choices[name].add_argument(
             "--max-seconds", type=positive, metavar="S",
             help="estimated run time a computation may take [s] (default: 3600; a longer one "
-                 "is refused before it starts; a search no formula sizes, and reproduce, are "
-                 "stopped after S s of CPU time)")
+                 f"is refused before it starts{_STOPPED.get(name, '')})")
     return p
 
 
