@@ -10,7 +10,11 @@ known in closed form; only the hysteresis-driven part is iterated::
 with the harmonics of ``w(y1)`` from the element's exact periodic output.  In
 a stiff loop ``y1`` follows ``r`` closely, so the fixed point converges in a
 few iterations, and ``e`` (about 1e-8 m against positions of 1e-2 m) is never
-formed by subtracting positions.
+formed by subtracting positions.  A link's force linear in its velocity at every
+amplitude (LuGre's ``sigma2``) is solved with the continuous loop, ``y1 = (y1_lin +
+T_{w->y1} (w(y1) - L y1)) / (1 - T_{w->y1} L)`` with ``L = j n w c``, where the iteration
+would multiply a change by ``|T_{w->y1} L|`` each pass; every pass is judged at every
+harmonic (:mod:`motionhyst.analysis._fixed_point`): no answer where it did not converge.
 
 Complex amplitudes are reported relative to ``sin(n omega t)``:
 a signal is ``c_0 + sum_n |c_n| sin(n omega t + angle c_n)``.
@@ -40,6 +44,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis._fixed_point import Passes, chord, viscous_damping
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
@@ -70,6 +75,13 @@ def _to_sin_amplitudes(X: NDArray[np.complex128]) -> NDArray[np.complex128]:
     c = 2j * np.asarray(X, dtype=complex)
     c[0] = X[0].real
     return c
+
+
+def _from_sin_amplitudes(c: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """The inverse of :func:`_to_sin_amplitudes`."""
+    X = np.asarray(c, dtype=complex) / 2j
+    X[0] = c[0].real
+    return X
 
 
 def default_harmonics(loop: Loop, frequency_hz: float) -> int:
@@ -292,7 +304,11 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
         measured plant (``[plant] use = "data"``): the steady state needs the
         plant at every harmonic ``n f``, which measured lines do not give.
     RuntimeError
-        If the fixed point does not converge (a link too stiff for the loop).
+        If the fixed point does not converge (a link too stiff for the loop), or diverges
+        at a harmonic, or leaves one unconverged when its first harmonic has settled (a
+        link too damped for the loop: :mod:`motionhyst.analysis._fixed_point`; a
+        damping at every amplitude, LuGre's ``sigma2``, is solved with the continuous
+        loop instead).
 
     Examples
     --------
@@ -354,7 +370,8 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     if stops is not None:
         weights, grid, first_weights, first_grid = _BINNED_TABLE[0]
         grid, first_grid = grid.copy(), first_grid.copy()  # set to the weights returned
-        e, y1, w, e_linear, it, residual, converged, weights, first_weights = _stop_steady_state(
+        (e, y1, w, e_linear, it, residual, converged, weights, first_weights,
+         dW) = _stop_steady_state(
             complex(R[1]), T.r_e, T.r_y1, G_1, T.w_e, U_h, stops[0], stops[1], float(tol),
             int(max_iter), stop_twiddles(H, H), weights, grid, first_weights, first_grid)
         _BINNED_TABLE[0] = (weights, grid, first_weights, first_grid)
@@ -362,16 +379,26 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
                 f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+        Passes(frequency_hz, hyst).judge(_from_sin_amplitudes(e), T.w_e * dW, it)
         return SteadyState(float(frequency_hz), float(amplitude), e, y1, w, e_linear, it,
                            residual)
     if hyst is not None:
         previous = np.inf
+        passes = Passes(frequency_hz, hyst)
+        # a damping at every amplitude is solved with the linear loop, the rest iterated
+        linear = chord(G_1, frequency_hz, viscous_damping(hyst))
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(X, H, omega)
+            if linear is None:
+                X_new = y1_lin + G_1 * (W_new - U_h)
+            else:  # W_new + L (X_new - X): the force with its linear part at X_new
+                L, inverse = linear
+                X_new = (y1_lin + G_1 * (W_new - L * X - U_h)) * inverse
+                W_new = W_new + L * (X_new - X)
             change = float(np.max(np.abs(W_new - W)))
             residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
-            W = W_new
-            X = y1_lin + G_1 * (W - U_h)
+            passes.step(T.w_e * (W_new - W), e_lin + T.w_e * (W_new - U_h))
+            W, X = W_new, X_new
             # error of a contraction with observed rate rho is about residual * rho / (1 - rho)
             rho = residual / previous if it > 2 and previous > 0 else 1.0
             previous = residual
@@ -381,6 +408,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
                 f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+        passes.judge(e_lin + T.w_e * (W - U_h))
     e = e_lin + T.w_e * (W - U_h)
     return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e),
                        _to_sin_amplitudes(X), _to_sin_amplitudes(W),
@@ -469,7 +497,8 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     follows it to first order (:func:`motionhyst.hysteresis.periodic.stop_harmonics_update`)
     where that computation was a costly one.  Returns the harmonics of ``e``, ``y1``, ``w``
     and of the linear ``e`` (relative to ``sin(n theta)``), the iterations, the last
-    relative change, whether it converged, and the weights to keep.
+    relative change, whether it converged, the weights to keep, and the last iteration's
+    change of ``w`` (``rfft / N`` scaling).
     """
     H = G_1.shape[0] - 1
     e_lin = np.zeros(H + 1, dtype=np.complex128)
@@ -492,6 +521,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
     js = np.empty(0)
     x_top = 0.0
     moments = np.empty((0, 0))
+    dW = np.zeros(H + 1, dtype=np.complex128)
     for it in range(1, max_iter + 1):
         updated = False
         W_new = Wb
@@ -514,6 +544,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
         for q in range(H + 1):
             change = max(change, abs(W_new[q] - W[q]))
         residual = abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300)
+        dW = W_new - W
         W = W_new
         X = y1_lin + G_1 * (W - U_h)
         rho = residual / previous if it > 2 and previous > 0 else 1.0
@@ -523,7 +554,7 @@ def _stop_steady_state(R1, r_e, r_y1, G_1, G_e, U_h, k, fc, tol, max_iter, tw, w
             break
     e = e_lin + G_e * (W - U_h)
     return (_sin_amplitudes(e), _sin_amplitudes(X), _sin_amplitudes(W), _sin_amplitudes(e_lin),
-            it, residual, converged, weights, first_weights)
+            it, residual, converged, weights, first_weights, dW)
 
 
 def check_steady_frequencies(loop: Loop, frequencies_hz: ArrayLike) -> None:
@@ -693,12 +724,15 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
     residual, it = 0.0, 0
     if hyst is not None:
         previous = np.inf
+        passes = Passes(frequency_hz, hyst)
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(Y1[H:], H, omega)
             change = float(np.max(np.abs(W_new - W)))
             residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
             W = W_new
+            E_old = E[H:]
             Y1, E = respond(W)
+            passes.step(E[H:] - E_old, E[H:])
             rho = residual / previous if it > 2 and previous > 0 else 1.0
             previous = residual
             if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
@@ -707,6 +741,7 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
             raise RuntimeError(
                 f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
                 f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+        passes.judge(E[H:])
     return SteadyState(frequency_hz, amplitude, _to_sin_amplitudes(E[H:]),
                        _to_sin_amplitudes(Y1[H:]), _to_sin_amplitudes(W),
                        _to_sin_amplitudes(E_lin[H:]), it, residual, samples_per_period=N)
