@@ -157,3 +157,20 @@ def test_a_change_left_at_a_harmonic_is_judged_after_the_passes():
         Passes(5.0, _lugre(0.0, 1e4)).judge(E, last, 42)
     last[139] = 1e-11  # round-off grown 1.4x a pass for 23 passes (sigma1 = 2000): kept
     Passes(5.0, _lugre(2000.0, 0.0)).judge(E, last, 23)
+
+
+def test_a_loop_that_hunts_is_said_to_hunt(tmp_path):
+    """``simulate examples/hunting.toml`` (the old spelling of ``steady``): the PID loop with
+    a Stribeck dip hunts, a self-excited cycle of 24.44 s (tests/test_stability.py checks it
+    against a stiff ODE solver), so its fixed point at the reference's 0.1 Hz cannot settle
+    (relative change 0.86 after 50 passes).  Main said 'the dynamic link is too stiff for this
+    loop'; now one line says that it hunts, the cycle's period and what to run instead."""
+    out = probe(["simulate", str(EXAMPLES / "hunting.toml")], tmp_path)
+    assert out["rc"] == 2, out
+    errors = [ln for ln in out["err"].splitlines() if ln.startswith("motionhyst: error")]
+    assert len(errors) == 1 and "Traceback" not in out["err"], out["err"]
+    assert errors[0] == (
+        "motionhyst: error: steady state at 0.1 Hz: the loop hunts: it has a stable "
+        "self-excited limit cycle of period 24.44 s (its exact orbit; motionhyst stability "
+        "shows it), so no periodic steady state of the reference's 10 s period; run it in "
+        "time (motionhyst simulate --time-series)"), errors

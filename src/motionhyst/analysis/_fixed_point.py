@@ -31,6 +31,24 @@ GROWING_PASSES = 3
 GROWTH = 1.05
 
 
+class NoFixedPoint(RuntimeError):
+    """The fixed point did not converge in its passes at `frequency_hz` [Hz] (a link too
+    stiff for the loop, or a loop with no steady state of the reference's period: one that
+    hunts); a caller that can tell which says so."""
+
+    def __init__(self, message: str, frequency_hz: float) -> None:
+        super().__init__(message)
+        self.frequency_hz = float(frequency_hz)
+
+
+def not_converged(frequency_hz: float, max_iter: int, residual: float) -> NoFixedPoint:
+    """The refusal of a fixed point that did not converge in `max_iter` passes."""
+    return NoFixedPoint(
+        f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
+        f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop",
+        frequency_hz)
+
+
 def viscous_damping(link) -> float:
     """The part of a link's force linear in its velocity at every amplitude [N s/m]: LuGre's
     ``sigma2``, the mean of an asymmetric Coulomb link's ``c_pos`` and ``c_neg``; 0 else."""

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis._fixed_point import NoFixedPoint
 from motionhyst.analysis.floquet import (
     FloquetResult,
     check_floquet_budget,
@@ -155,6 +156,43 @@ class DescribingFunctionComparison:
                             [p.error_harmonics_df for p in self.points], ax=ax)
 
 
+def _steady_states(loop: Loop, amplitude: float, f: NDArray[np.float64]) -> list[SteadyState]:
+    """:func:`~motionhyst.analysis.steady.steady_state_sweep`; a fixed point that does not
+    converge because the loop hunts is refused saying so (:func:`_hunting`)."""
+    try:
+        return steady_state_sweep(loop, amplitude, f)
+    except NoFixedPoint as exc:
+        raise _hunting(loop, exc) from None
+
+
+def _hunting(loop: Loop, exc: NoFixedPoint) -> RuntimeError:
+    """The refusal of a steady state whose fixed point did not converge (`exc`): where the
+    loop has a stable limit cycle (:func:`~motionhyst.analysis.stability.stability` with its
+    setpoint held, the exact orbit where the loop allows, else the describing function's
+    prediction) it hunts, and has no steady state of the reference's period; else `exc`."""
+    from motionhyst.analysis.stability import stability
+
+    link = loop.hysteresis
+    if link is None or not loop.is_lti:
+        return exc
+    try:
+        res = stability(loop, exact=loop.sampled is None and link.n_states > 0, search=False)
+    except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError):
+        return exc
+    exact = [c.period_s for c in res.exact if c.stable]
+    predicted = [1.0 / p.frequency_hz for p in res.predicted if p.stable]
+    if not (exact or predicted):
+        return exc
+    period, how = ((exact[0], "its exact orbit") if exact
+                   else (predicted[0], "predicted by the describing function"))
+    f = exc.frequency_hz
+    return RuntimeError(
+        f"steady state at {f:g} Hz: the loop hunts: it has a stable self-excited limit cycle "
+        f"of period {period:.4g} s ({how}; motionhyst stability shows it), so no periodic "
+        f"steady state of the reference's {1 / f:.4g} s period; run it in time "
+        f"(motionhyst simulate --time-series)")
+
+
 def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
                                      floquet: bool = False) -> DescribingFunctionComparison:
     """Exact steady state next to the mismatch of eq. (18) and the HOSIDF error harmonics.
@@ -205,7 +243,7 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     E_df = loop_mismatch(loop, f, amplitude)
     points = [ComparisonPoint(ss, complex(ed),
                               error_harmonics_df(loop, amplitude, ss.frequency_hz), False)
-              for ss, ed in zip(steady_state_sweep(loop, amplitude, f), E_df, strict=True)]
+              for ss, ed in zip(_steady_states(loop, amplitude, f), E_df, strict=True)]
     why = (unresolved_time_scales(loop) if floquet and loop.hysteresis is not None
            and loop.is_lti and loop.sampled is None else None)
     if why:  # said once, rather than multipliers that mean nothing

@@ -44,7 +44,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis._fixed_point import Passes, chord, viscous_damping
+from motionhyst.analysis._fixed_point import Passes, chord, not_converged, viscous_damping
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
@@ -376,9 +376,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             int(max_iter), stop_twiddles(H, H), weights, grid, first_weights, first_grid)
         _BINNED_TABLE[0] = (weights, grid, first_weights, first_grid)
         if not converged:
-            raise RuntimeError(
-                f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
-                f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+            raise not_converged(frequency_hz, max_iter, residual)
         Passes(frequency_hz, hyst).judge(_from_sin_amplitudes(e), T.w_e * dW, it)
         return SteadyState(float(frequency_hz), float(amplitude), e, y1, w, e_linear, it,
                            residual)
@@ -405,9 +403,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
                 break
         else:
-            raise RuntimeError(
-                f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
-                f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+            raise not_converged(frequency_hz, max_iter, residual)
         passes.judge(e_lin + T.w_e * (W - U_h))
     e = e_lin + T.w_e * (W - U_h)
     return SteadyState(float(frequency_hz), float(amplitude), _to_sin_amplitudes(e),
@@ -738,9 +734,7 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
             if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
                 break
         else:
-            raise RuntimeError(
-                f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
-                f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop")
+            raise not_converged(frequency_hz, max_iter, residual)
         passes.judge(E[H:])
     return SteadyState(frequency_hz, amplitude, _to_sin_amplitudes(E[H:]),
                        _to_sin_amplitudes(Y1[H:]), _to_sin_amplitudes(W),
