@@ -11,10 +11,11 @@ with the harmonics of ``w(y1)`` from the element's exact periodic output.  In
 a stiff loop ``y1`` follows ``r`` closely, so the fixed point converges in a
 few iterations, and ``e`` (about 1e-8 m against positions of 1e-2 m) is never
 formed by subtracting positions.  A link's force linear in its velocity at every
-amplitude (LuGre's ``sigma2``) is solved with the continuous loop, ``y1 = (y1_lin +
-T_{w->y1} (w(y1) - L y1)) / (1 - T_{w->y1} L)`` with ``L = j n w c``, where the iteration
-would multiply a change by ``|T_{w->y1} L|`` each pass; every pass is judged at every
-harmonic (:mod:`motionhyst.analysis._fixed_point`): no answer where it did not converge.
+amplitude (LuGre's ``sigma2``) is solved with the loop, ``y1 = (y1_lin + T_{w->y1} (w(y1) -
+L y1)) / (1 - T_{w->y1} L)`` with ``L = j n w c`` (a sampled loop: per alias class), where
+the iteration would multiply a change by ``|T_{w->y1} L|`` each pass; every pass is judged
+at every harmonic (:mod:`motionhyst.analysis._fixed_point`): no answer where it did not
+converge.
 
 Complex amplitudes are reported relative to ``sin(n omega t)``:
 a signal is ``c_0 + sum_n |c_n| sin(n omega t + angle c_n)``.
@@ -307,8 +308,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
         If the fixed point does not converge (a link too stiff for the loop), or diverges
         at a harmonic, or leaves one unconverged when its first harmonic has settled (a
         link too damped for the loop: :mod:`motionhyst.analysis._fixed_point`; a
-        damping at every amplitude, LuGre's ``sigma2``, is solved with the continuous
-        loop instead).
+        damping at every amplitude, LuGre's ``sigma2``, is solved with the loop instead).
 
     Examples
     --------
@@ -716,13 +716,42 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
             Y1[H] = P1[H] * (U[H] - Wn[H])
         return Y1, E
 
+    def damped(W_pos, Y1):
+        """The link's force `W_pos` at `Y1` with its part ``L Y1`` (``L = j n w c``, the
+        damping :func:`viscous_damping`) moved to where the loop's answer puts ``Y1``: the
+        linear loop with the damper solved per alias class (the held force of class ``m``
+        is one number, ``ud[m]``)."""
+        Wn = np.concatenate([np.conj(W_pos[:0:-1]), W_pos]) - L * Y1   # L = 0 at n = 0
+        a = 1.0 / (1.0 + P1 * L)                   # the direct path with the damper
+        free = np.where(n == 0, 0.0, a * (Y1_lin - P1 * Wn))
+        gain = np.where(n == 0, 0.0, a * P1 * Hn)
+        wd2, A, B = (np.zeros(N, dtype=complex) for _ in range(3))
+        np.add.at(wd2, m_of_n, np.where(n == 0, 0.0, P2 * Wn))
+        np.add.at(A, m_of_n, P2 * L * free)
+        np.add.at(B, m_of_n, P2 * L * gain)
+        if not integrating:
+            wd2[0] += P2[H] * Wn[H]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ud = (FF + Ym * (wd2 + A)) / (den - Ym * B)
+        if integrating:
+            ud[0] = Wn[H]
+        Y1_new = free + gain * ud[m_of_n]
+        return (Wn + L * Y1_new)[H:]
+
     Y1, E = respond(W)
     residual, it = 0.0, 0
+    L = 1j * wn * viscous_damping(hyst)
+    if hyst is not None and np.any(L != 0):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if not np.all(np.isfinite(damped(W, Y1))):  # a loop the damper makes singular
+                L = np.zeros(n.size, dtype=complex)
     if hyst is not None:
         previous = np.inf
         passes = Passes(frequency_hz, hyst)
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(Y1[H:], H, omega)
+            if np.any(L != 0):
+                W_new = damped(W_new, Y1)
             change = float(np.max(np.abs(W_new - W)))
             residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
             W = W_new
