@@ -163,6 +163,16 @@ def test_a_loop_too_damped_for_the_fixed_point_is_refused_within_a_few_passes(
         periodic_steady_state(_paper_loop(link, sampled), 0.01, 5.0)
 
 
+def test_a_refusal_names_the_damping_it_iterates_not_the_one_it_solves():
+    """sigma1 = 1e4 with sigma2 = 1e3 on Table I: sigma2 is solved with the loop, sigma1
+    makes the iteration diverge; the refusal names sigma1 alone."""
+    from motionhyst import periodic_steady_state
+
+    with pytest.raises(RuntimeError, match=r"bristle damping sigma1 = 1e\+04 N s/m") as err:
+        periodic_steady_state(_paper_loop(_lugre(1e4, 1e3)), 0.01, 5.0)
+    assert "sigma2" not in str(err.value)
+
+
 @pytest.mark.parametrize("command", ["steady", "simulate"])
 def test_the_command_refuses_in_one_line(tmp_path, command):
     """``steady`` (and ``simulate``'s old spelling) of the sampled loop with sigma1 = 1e6:

@@ -61,16 +61,18 @@ def viscous_damping(link) -> float:
     return 0.0
 
 
-def _damping_words(link) -> str:
-    """The link's damping keys and values, for a refusal (empty for a link without any)."""
+def _damping_words(link, solved: bool) -> str:
+    """The link's damping keys and values that the iteration feeds back, for a refusal (empty
+    for a link without any; its :func:`viscous_damping` left out where it is `solved` with
+    the loop)."""
     name = type(link).__name__
     words = []
     if name == "LuGre":
-        if link.sigma2:
+        if link.sigma2 and not solved:
             words.append(f"viscous friction sigma2 = {link.sigma2:.4g} N s/m")
         if link.sigma1:
             words.append(f"bristle damping sigma1 = {link.sigma1:.4g} N s/m (while it sticks)")
-    elif name == "Coulomb" and (link.c_pos or link.c_neg):
+    elif name == "Coulomb" and (link.c_pos or link.c_neg) and not solved:
         words.append(f"viscous friction c_pos = {link.c_pos:.4g}, c_neg = {link.c_neg:.4g} "
                      f"N s/m")
     return " and ".join(words)
@@ -85,11 +87,14 @@ class Passes:
         The steady state's frequency [Hz].
     link : Hysteresis
         The loop's link, named in a refusal.
+    solved : bool
+        Whether the link's :func:`viscous_damping` is solved with the loop (not named).
     """
 
-    def __init__(self, frequency_hz: float, link) -> None:
+    def __init__(self, frequency_hz: float, link, solved: bool = False) -> None:
         self.frequency_hz = float(frequency_hz)
         self.link = link
+        self.solved = bool(solved)
         self.sizes: list[float] = []
         self.growing = 0
         self.last: NDArray[np.complex128] | None = None
@@ -127,7 +132,7 @@ class Passes:
     def refuse(self, what: str, dE: NDArray[np.complex128], passes: int) -> None:
         """Raise the refusal: `what` the iteration did, at the harmonic where `dE` is largest."""
         n = int(np.nanargmax(np.abs(dE))) if np.any(np.isfinite(dE)) else 0
-        words = _damping_words(self.link)
+        words = _damping_words(self.link, self.solved)
         which = "damping" if words else "stiffness"
         raise RuntimeError(
             f"steady state at {self.frequency_hz:g} Hz: the fixed point {what} at harmonic "

@@ -382,9 +382,9 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
                            residual)
     if hyst is not None:
         previous = np.inf
-        passes = Passes(frequency_hz, hyst)
         # a damping at every amplitude is solved with the linear loop, the rest iterated
         linear = chord(G_1, frequency_hz, viscous_damping(hyst))
+        passes = Passes(frequency_hz, hyst, solved=linear is not None)
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(X, H, omega)
             if linear is None:
@@ -747,7 +747,7 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
                 L = np.zeros(n.size, dtype=complex)
     if hyst is not None:
         previous = np.inf
-        passes = Passes(frequency_hz, hyst)
+        passes = Passes(frequency_hz, hyst, solved=bool(np.any(L != 0)))
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(Y1[H:], H, omega)
             if np.any(L != 0):
