@@ -218,6 +218,10 @@ def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_h
     motionhyst.core.budget.BudgetError
         With `floquet`: the multipliers above the memory or work budget, before any point
         is computed (:func:`~motionhyst.analysis.floquet.check_floquet_budget`).
+    RuntimeError
+        A steady state that has no answer
+        (:func:`~motionhyst.analysis.steady.periodic_steady_state`); one whose fixed point
+        does not converge because the loop hunts says so, with its limit cycle's period.
 
     Warns
     -----
