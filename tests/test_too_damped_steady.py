@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import re
 import tomllib
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +58,25 @@ def _last_period_e1(run, f: float = 5.0) -> float:
     return float(2 * abs(np.mean(e * np.exp(-2j * np.pi * f * t))))
 
 
+@contextmanager
+def _at_most_passes(link, passes: int, why: str):
+    """The link's periodic response counted while the block runs: more than `passes` calls
+    fail the test with `why` (a pass of the fixed point calls it once)."""
+    harmonics = link.periodic_harmonics
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        assert len(calls) <= passes, why
+        return harmonics(*args, **kwargs)
+
+    link.periodic_harmonics = counted
+    try:
+        yield
+    finally:
+        link.periodic_harmonics = harmonics
+
+
 @pytest.mark.parametrize(("sigma1", "sigma2"), [(0.0, 2000.0), (2000.0, 0.0), (0.0, 1e4),
                                                 (0.0, 1e5)])
 def test_the_steady_state_of_a_damped_link_agrees_with_a_run_in_time(sigma1, sigma2):
@@ -85,18 +105,9 @@ def test_a_damper_that_holds_the_stage_is_solved_not_iterated():
     from motionhyst import SineReference, periodic_steady_state, simulate
 
     link = _lugre(0.0, 1e6)
-    calls = []
-    harmonics = link.periodic_harmonics
-
-    def counted(*args, **kwargs):
-        calls.append(1)
-        assert len(calls) <= 10, "the iteration did not end"
-        return harmonics(*args, **kwargs)
-
-    link.periodic_harmonics = counted
-    ss = periodic_steady_state(_paper_loop(link), 0.01, 5.0)
+    with _at_most_passes(link, 10, "the iteration did not end"):
+        ss = periodic_steady_state(_paper_loop(link), 0.01, 5.0)
     assert np.all(np.isfinite(ss.e)) and np.max(np.abs(ss.e[2:])) < 1e-8
-    link.periodic_harmonics = harmonics
     e1 = _last_period_e1(simulate(_paper_loop(link), SineReference(0.01, 5.0), 2.4, dt=2e-6))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-6), (abs(ss.e[1]), e1)
 
@@ -113,19 +124,10 @@ def test_the_sampled_steady_state_of_a_damped_link_agrees_with_a_run_in_time(sig
     from motionhyst.time.sampled import simulate_sampled
 
     link = _lugre(0.0, sigma2)
-    calls = []
-    harmonics = link.periodic_harmonics
-
-    def counted(*args, **kwargs):
-        calls.append(1)
-        assert len(calls) <= 10, "the iteration went on"
-        return harmonics(*args, **kwargs)
-
-    link.periodic_harmonics = counted
     loop = _paper_loop(link, sampled=True)
-    ss = periodic_steady_state(loop, 0.01, 5.0)
+    with _at_most_passes(link, 10, "the iteration went on"):
+        ss = periodic_steady_state(loop, 0.01, 5.0)
     assert np.max(np.abs(ss.e[100:])) < 1e-8 * abs(ss.e[1]), np.max(np.abs(ss.e[100:]))
-    link.periodic_harmonics = harmonics
     e1 = _last_period_e1(simulate_sampled(loop, SineReference(0.01, 5.0), duration,
                                           substeps=40, linear=False))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-6), (abs(ss.e[1]), e1)
@@ -144,16 +146,7 @@ def test_a_loop_too_damped_for_the_fixed_point_is_refused_within_a_few_passes(
     from motionhyst import periodic_steady_state
 
     link = _lugre(sigma1, 0.0)
-    calls = []
-    harmonics = link.periodic_harmonics
-
-    def counted(*args, **kwargs):
-        calls.append(1)
-        assert len(calls) <= 10, "the iteration went on"
-        return harmonics(*args, **kwargs)
-
-    link.periodic_harmonics = counted
-    with pytest.raises(RuntimeError, match=(
+    with _at_most_passes(link, 10, "the iteration went on"), pytest.raises(RuntimeError, match=(
             r"steady state at 5 Hz: the fixed point diverges: a change of the error grows "
             rf"[\d.]+ times a pass at harmonic {harmonic} \({harmonic * 5} Hz\) after \d+ "
             rf"passes: the link's bristle damping sigma1 = {re.escape(f'{sigma1:.4g}')} N s/m "
