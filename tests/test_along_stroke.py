@@ -138,12 +138,17 @@ def test_cli_scan_at_a_stroke_position(tmp_path, capsys):
     assert "along" in capsys.readouterr().err
 
 
-def test_sampled_loop_refuses_a_link_along_the_stroke():
+def test_sampled_loop_in_pieces_with_unit_scales_is_the_base_link_run():
+    # the sampled run of a link along the stroke is run in its pieces (the parameters set
+    # between them): with unit scales, the run of the base link in one, sample for sample
+    # (tests/test_along_stroke_routes.py: a varying table against the continuous run)
     d = Scenario.from_file("examples/paper_10khz.toml").to_dict()
-    d["hysteresis"]["along"] = {"position": TABLE[0], **TABLE[1]}
-    loop = Scenario.from_dict(d, "s.toml").loop()
-    with pytest.raises(ValueError, match="continuous controller"):
-        simulate(loop, scan(0.01, **FAST), 0.05)
+    base = simulate(Scenario.from_dict(d, "s.toml").loop(), scan(0.05, **FAST), 0.2)
+    d["hysteresis"]["along"] = {"position": TABLE[0], "fc": [1.0, 1.0, 1.0]}
+    along = simulate(Scenario.from_dict(d, "s.toml").loop(), scan(0.05, **FAST), 0.2)
+    assert len(AlongStroke(Jenkins(K_LINK, FC_LINK), TABLE[0], {}).pieces(along.r)) > 50
+    for c in ("e", "u", "w", "y1"):
+        assert_array_equal(getattr(along, c), getattr(base, c))
 
 
 def test_chunks_of_a_run_along_the_stroke_are_the_run(stage, controller):

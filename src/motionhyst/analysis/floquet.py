@@ -46,6 +46,7 @@ from motionhyst.core.budget import check_memory, check_work
 from motionhyst.core.lti import TWO_PI
 from motionhyst.core.textfmt import g
 from motionhyst.hysteresis import Hysteresis
+from motionhyst.hysteresis.along_stroke import AlongStroke
 from motionhyst.hysteresis.stepping import STOP
 
 __all__ = ["MAX_TIME_SCALE_RATIO", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STATE_CUBED",
@@ -512,8 +513,9 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
     Raises
     ------
     ValueError
-        For a sampled controller, a measured plant, no link, a link of another kind, or
-        time scales the monodromy does not resolve (:func:`unresolved_time_scales`).
+        For a sampled controller, a measured plant, no link, a link of another kind (one
+        along the stroke), or time scales the monodromy does not resolve
+        (:func:`unresolved_time_scales`).
     motionhyst.core.budget.BudgetError
         Above the memory or work budget (:func:`check_floquet_budget`), before the work.
 
@@ -530,6 +532,9 @@ def steady_state_floquet(loop: Loop, ss: SteadyState, samples: int | None = None
         raise ValueError("the loop has no link")
     if loop.sampled is not None or not loop.is_lti:
         raise ValueError("Floquet multipliers need a continuous loop with a plant model")
+    if isinstance(link, AlongStroke):
+        raise ValueError("Floquet multipliers need the link's parameters fixed; a link along the "
+                         "stroke ([hysteresis] along) changes them with the position")
     why = unresolved_time_scales(loop)
     if why:
         raise ValueError(f"Floquet multipliers not computed: {why}")

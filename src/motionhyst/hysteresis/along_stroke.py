@@ -25,14 +25,27 @@ from itertools import pairwise
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
 
-__all__ = ["STEPS_PER_INTERVAL", "AlongStroke"]
+__all__ = ["MAX_PERIODS", "NO_DESCRIBING_FUNCTION", "PERIODIC_RTOL", "STALL_PERIODS",
+           "STEPS_PER_INTERVAL", "AlongStroke"]
 
 #: Parameter updates of a time run per interval of the table (the parameters are held over
 #: the samples within one such step of the position).
 STEPS_PER_INTERVAL = 64
+#: A periodic force (:meth:`AlongStroke.periodic_harmonics`) repeats the previous period's to
+#: this fraction of its largest value ...
+PERIODIC_RTOL = 1e-14
+#: ... within this many periods of the displacement, run from rest ...
+MAX_PERIODS = 200
+#: ... and refused once its change has not shrunk for this many periods.
+STALL_PERIODS = 10
+#: The refusal of a computation that needs the link's describing function (or its HOSIDF).
+NO_DESCRIBING_FUNCTION = ("a link along the stroke ([hysteresis] along) has no describing "
+                          "function: run it in time (simulate, scan), or compute its exact "
+                          "steady state in a study (outputs e1, harmonics, error_rms)")
 
 
 class AlongStroke(Hysteresis):
@@ -143,9 +156,28 @@ class AlongStroke(Hysteresis):
         ----------
         A, omega : array_like
             Amplitude and frequency (unused).
+
+        Raises
+        ------
+        ValueError
+            Always (:data:`NO_DESCRIBING_FUNCTION`).
         """
-        raise ValueError("a link that varies along the stroke has no describing function: "
-                         "run it in time (simulate, scan)")
+        raise ValueError(NO_DESCRIBING_FUNCTION)
+
+    def hosidf(self, A, n_max, omega=None):
+        """Not defined, as :meth:`describing_function` (its first harmonic).
+
+        Parameters
+        ----------
+        A, n_max, omega
+            As :meth:`Hysteresis.hosidf` (unused).
+
+        Raises
+        ------
+        ValueError
+            Always (:data:`NO_DESCRIBING_FUNCTION`).
+        """
+        raise ValueError(NO_DESCRIBING_FUNCTION)
 
     def time_stepping(self) -> Stepping:
         """The elements at the start of the table's first position (the runs update them)."""
@@ -179,7 +211,8 @@ class AlongStroke(Hysteresis):
         edges = [0, *breaks.tolist(), x.size]
         return list(pairwise(edges))
 
-    def response(self, x: ArrayLike, w0: float = 0.0) -> NDArray[np.float64]:
+    def response(self, x: ArrayLike, w0: float = 0.0, t: ArrayLike | None = None
+                 ) -> NDArray[np.float64]:
         """Force for the displacement samples `x` from rest, the parameters updated between
         :meth:`pieces` at each one's mean position.
 
@@ -189,21 +222,117 @@ class AlongStroke(Hysteresis):
             Displacement samples [m] (positions on the table).
         w0 : float
             Must be 0: the link starts at rest.
+        t : array_like, optional
+            Sample times [s], uniformly spaced, same length as `x`: required for a
+            rate-dependent base (LuGre), whose force depends on the velocity.
         """
         if w0 != 0.0:
             raise ValueError("a link along the stroke starts at rest (w0 = 0)")
         x = np.ascontiguousarray(x, dtype=float)
-        st = self.at(float(x[0]) if x.size else 0.0).time_stepping()
+        run = self._runner(float(x[0]) if x.size else 0.0, self._step(x, t))
+        return run(x, 0)
+
+    def periodic_harmonics(self, X: NDArray[np.complex128], n_harmonics: int,
+                           omega: float | None = None) -> NDArray[np.complex128]:
+        """Harmonics of the periodic force for a periodic displacement, the table followed.
+
+        The period is sampled as :meth:`Hysteresis.periodic_harmonics` samples it and
+        run from rest, period after period, the parameters updated between
+        :meth:`pieces` as in a time run, until a period's force repeats the previous
+        one to :data:`PERIODIC_RTOL` of its largest value.
+
+        Parameters
+        ----------
+        X : ndarray of complex
+            Harmonics ``X_0 .. X_M`` of the displacement (positions on the table) over one
+            period (``rfft / N`` scaling).
+        n_harmonics : int
+            Highest output harmonic ``H``.
+        omega : float, optional
+            Angular frequency [rad/s]; required for a rate-dependent base (LuGre).
+
+        Returns
+        -------
+        ndarray of complex, shape (H + 1,)
+
+        Raises
+        ------
+        RuntimeError
+            If the force does not repeat within :data:`MAX_PERIODS` periods, or its change
+            has not shrunk for :data:`STALL_PERIODS` periods.
+
+        Examples
+        --------
+        With unit scales, the base link's own (exact) harmonics:
+
+        >>> from motionhyst import Jenkins
+        >>> base = Jenkins(20.0, 0.05)
+        >>> link = AlongStroke(base, [-0.01, 0.01], {"fc": [1.0, 1.0]})
+        >>> X = np.array([0.0, 0.01 / 2j])
+        >>> bool(np.allclose(link.periodic_harmonics(X, 5), base.periodic_harmonics(X, 5),
+        ...                  rtol=0, atol=1e-6 * 0.05))
+        True
+        """
+        from motionhyst.hysteresis.periodic import sample_period
+
+        H = int(n_harmonics)
+        N = max(8 * H, 8 * (len(X) - 1), 8192)
+        x = np.ascontiguousarray(sample_period(X, N))
+        h = 0.0
+        if not self.rate_independent:
+            h = 2.0 * np.pi / (check_omega(omega, self.base.name) * N)
+        run = self._runner(float(x[0]), h)
+        w = run(x, 0)
+        smallest, since = np.inf, 0
+        for p in range(1, MAX_PERIODS):
+            prev, w = w, run(x, p * N)
+            change = float(np.max(np.abs(w - prev)))
+            if change <= PERIODIC_RTOL * max(float(np.max(np.abs(w))), 1e-300):
+                return (np.fft.rfft(w) / N)[: H + 1]
+            smallest, since = (change, 0) if change < smallest else (smallest, since + 1)
+            if since >= STALL_PERIODS:
+                break
+        raise RuntimeError(f"the {self.base.name} link along the stroke ([hysteresis] along) "
+                           f"has no periodic force: its change from period to period "
+                           f"({change:.2g} N) does not shrink (a spring that never slips, "
+                           "scaled along the stroke, drifts); run it in time (simulate)")
+
+    def _step(self, x: NDArray[np.float64], t: ArrayLike | None) -> float:
+        """The uniform step of the sample times `t` (0 for a rate-independent base, whose
+        force does not depend on it)."""
+        if self.rate_independent:
+            return 0.0
+        if t is None:
+            raise ValueError(f"the {self.base.name} model is rate-dependent: response() of its "
+                             "link along the stroke needs the sample times t [s]")
+        ts = np.asarray(t, dtype=float)
+        if ts.shape != x.shape or not np.all(np.isfinite(ts)):
+            raise ValueError("x and t must be finite and of the same length")
+        if ts.size < 2:
+            return 0.0
+        h = (ts[-1] - ts[0]) / (ts.size - 1)
+        if not h > 0 or np.max(np.abs(np.diff(ts) - h)) > 1e-9 * h:
+            raise ValueError("the sample times t of a link along the stroke must be "
+                             "uniformly spaced and increasing")
+        return float(h)
+
+    def _runner(self, x0: float, h: float):
+        """``run(x, i0)``: the force of the samples `x` (indices from `i0`, step `h`), the
+        elements' state carried from call to call, starting at rest at `x0`."""
+        st = self.at(x0).time_stepping()
         s = np.ascontiguousarray(st.state0, dtype=float).copy()
         s_prev, scalars = s.copy(), np.zeros(2)
-        out = np.empty(x.size)
-        for i0, i1 in self.pieces(x):
-            piece = x[i0:i1]
-            params = np.ascontiguousarray(self.stepping_params(float(np.mean(piece))))
-            out[i0:i1] = open_loop_chunk(st.codes, params, s, s_prev, scalars,
-                                                 np.ascontiguousarray(piece), 0.0, i0, GL_T,
-                                                 GL_W)
-        return out
+
+        def run(x: NDArray[np.float64], i0: int) -> NDArray[np.float64]:
+            out = np.empty(x.size)
+            for a, b in self.pieces(x):
+                piece = x[a:b]
+                params = np.ascontiguousarray(self.stepping_params(float(np.mean(piece))))
+                out[a:b] = open_loop_chunk(st.codes, params, s, s_prev, scalars,
+                                           np.ascontiguousarray(piece), h, i0 + a, GL_T, GL_W)
+            return out
+
+        return run
 
     def to_dict(self) -> dict:
         """The base model's parameters and the table (key ``along``)."""

@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.hysteresis.along_stroke import AlongStroke
 from motionhyst.hysteresis.stepping import GL_T, GL_W, N_PARAMS, Stepping
 from motionhyst.time.kernel import CLOSED as CLOSED
 from motionhyst.time.kernel import (
@@ -590,12 +591,25 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
         if z0.shape != (ns,) or not np.all(np.isfinite(z0)):
             raise ValueError(f"x0 must be {ns} finite values (q, q'), got {np.shape(x0)}")
         state.z[:] = z0
-    ctrl = (Ac, Bc, Cc, Dc, rr, fff, float(u_max), R, r1, 0, n_delay)
     # a constant force on the plant (its force offset), beside the held controller force
     a = np.full(n_k * R + 1, float(getattr(mech, "force_offset", 0.0)))
-    Y, _, W, U, worst, done = run_steps(
-        steps, Cout, np.zeros(3), 1, stepping, a, state, vel_row=2, convention=OPEN,
-        ftol=1e-13 * stepping.scale, record_every=R, record_initial=True, controller=ctrl)
+    # a link along the stroke: its parameters at the setpoint's mean over each of its pieces
+    # of the samples, held over their controller periods (the continuous run's rule)
+    pieces = link.pieces(rr) if isinstance(link, AlongStroke) else [(0, n_k)]
+    parts, worst, done = [], 0, 0
+    for k0, k1 in pieces:
+        if isinstance(link, AlongStroke):
+            stepping.params[:] = link.stepping_params(float(np.mean(rr[k0:k1])))
+        ctrl = (Ac, Bc, Cc, Dc, rr[k0:k1], fff[k0:k1], float(u_max), R, r1, 0, n_delay)
+        Yp, _, Wp, Up, worst_p, done_p = run_steps(
+            steps, Cout, np.zeros(3), 1, stepping, a[k0 * R:k1 * R + 1], state, vel_row=2,
+            convention=OPEN, ftol=1e-13 * stepping.scale, record_every=R,
+            record_initial=k0 == 0, controller=ctrl)
+        parts.append((Yp, Wp, Up))
+        worst, done = max(worst, worst_p), done + done_p
+        if worst > MAX_FIXED_POINT_ITERATIONS:
+            break
+    Y, W, U = (np.concatenate([p[i] for p in parts]) for i in range(3))
     if worst > MAX_FIXED_POINT_ITERATIONS:
         raise StepNotConverged(f"the link's implicit step at t = {done / R * T:.6g} s did "
                                f"not converge in {MAX_FIXED_POINT_ITERATIONS} iterations: the "

@@ -189,7 +189,6 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
         if dt is not None and abs(dt - loop.sampled.period) > 1e-9 * loop.sampled.period:
             raise ValueError(f"a sampled loop runs at its controller's period "
                              f"{loop.sampled.period:g} s, not dt = {dt:g} s")
-        _refuse_along_stroke(loop, "with a sampled controller")
         return simulate_sampled(loop, reference, duration, force=force)
     _check_feedforward(loop)
     engine = _Engine(loop, reference, dt, force)
@@ -216,13 +215,6 @@ def _check_proper(loop: Loop) -> None:
                          "derivative_filter_hz, or sample_rate_hz to run it sampled")
 
 
-def _refuse_along_stroke(loop: Loop, how: str) -> None:
-    if isinstance(loop.hysteresis, AlongStroke) or isinstance(loop.hysteresis_feedforward,
-                                                              AlongStroke):
-        raise ValueError(f"a link that varies along the stroke is run with a continuous "
-                         f"controller, not {how}")
-
-
 def _along_stroke(engine: _Engine, t: NDArray[np.float64], h_foh: float) -> Simulation:
     """The run in the link's pieces (:meth:`AlongStroke.pieces` of the setpoint), the link at
     the setpoint's mean position over each (the stage's within the error); a feedforward
@@ -233,7 +225,7 @@ def _along_stroke(engine: _Engine, t: NDArray[np.float64], h_foh: float) -> Simu
     if uf.shape != t.shape:
         raise ValueError("the feedforward force must give one finite value per time")
     if isinstance(engine.hff, AlongStroke):  # phi_hat(r) of the whole run, as a force
-        uf = uf + engine.hff.response(r)
+        uf = uf + engine.hff.response(r, t=t)  # t: a rate-dependent model's velocity
         engine.hff = None
 
     def force(tt):
