@@ -632,3 +632,22 @@ def fast_pole(sc, pole: float) -> str:
     return (f"beyond a motion stage's {g(PLAUSIBLE_POLE_HZ)} Hz: "
             + (named[0] if named else f"are {sc.source}'s [stage] and [controller] values in "
                f"SI units?"))
+
+
+def refuse_along_stroke_for(sc, command: str) -> None:
+    """Refuse, before the loop is built, a command that compares with the describing function
+    (``steady``, ``analyze``, ``stability``, ``reproduce``) for a scenario whose link or
+    feedforward model varies along the stroke (``along``): it has none
+    (:data:`~motionhyst.hysteresis.along_stroke.NO_DESCRIBING_FUNCTION`).
+
+    Parameters
+    ----------
+    sc : Scenario
+        The command's scenario.
+    command : str
+        The command, named in the message.
+    """
+    if sc.along_stroke:
+        from motionhyst.hysteresis.along_stroke import NO_DESCRIBING_FUNCTION
+
+        raise UsageError(f"{command}: {sc.source}: {NO_DESCRIBING_FUNCTION}")

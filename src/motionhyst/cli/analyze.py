@@ -8,6 +8,7 @@ from motionhyst.cli._common import (
     distinct,
     positive,
     print_json,
+    refuse_along_stroke_for,
     release_held,
     scenario_frequencies,
     warn_plant_fit,
@@ -23,6 +24,7 @@ def run(args: argparse.Namespace) -> int:
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
     sc = load_scenario(args.scenario, check=False)  # the loop is built once the input is checked
+    refuse_along_stroke_for(sc, args.command)
     freqs = scenario_frequencies(sc, args.frequency, args.command)
     loop = sc.loop()  # its own refusals (a plant's file, stability) before the analysis loads
     amplitude = args.amplitude or sc.amplitude

@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from motionhyst.cli._common import add_force_option, release_held, warn_plant_fit
+from motionhyst.cli._common import (
+    add_force_option,
+    refuse_along_stroke_for,
+    release_held,
+    warn_plant_fit,
+)
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
 __all__ = []
@@ -20,6 +25,7 @@ def run(args: argparse.Namespace) -> int:
     # the loop is built (and checked) inside reproduce, while the first figures are drawn; the
     # warnings held until then are shown once it is (checked), as the long work starts
     sc = load_scenario(args.scenario, check=False)
+    refuse_along_stroke_for(sc, "reproduce")
     # no formula sizes the report's figures: its CPU time is bounded as a search's is, and a
     # report stopped writes none of its files
     with cpu_time_limit(max_seconds(), "reproduce", "raise --max-seconds (Table I's report "

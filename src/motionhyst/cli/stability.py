@@ -11,6 +11,7 @@ from motionhyst.cli._common import (
     UsageError,
     output_file,
     print_json,
+    refuse_along_stroke_for,
     refuse_unused,
     release_held,
     warn_plant_fit,
@@ -35,6 +36,7 @@ def run(args: argparse.Namespace) -> int:
         if figure.path.suffix.lower() not in FIGURE_SUFFIXES:
             raise UsageError("stability --figure: give a .png, .pdf or .svg file")
     sc = load_scenario(args.scenario)
+    refuse_along_stroke_for(sc, "stability")
     try:
         loop = sc.loop()  # an open-loop scenario is refused before the analysis loads
     except ValueError as exc:

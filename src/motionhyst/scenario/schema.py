@@ -170,6 +170,14 @@ class Scenario:
         or a two-mass stage with an ``output``): force in, position out, no controller."""
         return self.model.open_loop
 
+    @property
+    def along_stroke(self) -> bool:
+        """True where the link or the feedforward's link model varies along the stroke
+        (``along``: :class:`~motionhyst.hysteresis.along_stroke.AlongStroke`)."""
+        ff = self.model.feedforward
+        return any(getattr(section, "along", None) is not None
+                   for section in (self.model.hysteresis, getattr(ff, "hysteresis", None)))
+
     def _closed(self, what: str) -> None:
         if self.model.plant_only and not self.model.open_loop:
             raise ScenarioError(f"{self.source}: describes only a plant (no [hysteresis], "

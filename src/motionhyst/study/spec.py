@@ -458,6 +458,7 @@ class StudyDefinition:
         """Validate the scenario with the first value of each axis and sample; a key the
         scenario does not accept raises :class:`StudyError` naming it, an implausible value
         of its stage is a warning (:func:`~motionhyst.scenario.schema.warn_implausible`)."""
+        from motionhyst.hysteresis.along_stroke import NO_DESCRIBING_FUNCTION
         from motionhyst.scenario import Scenario, ScenarioError
         from motionhyst.scenario.schema import warn_implausible
 
@@ -487,6 +488,8 @@ class StudyDefinition:
             raise StudyError(str(exc)) from None
         if sc.is_open_loop:
             raise StudyError("the scenario is an open-loop system; a study needs a closed loop")
+        if "E" in self.outputs and sc.along_stroke:  # refused before the points run
+            raise StudyError(f"'outputs': E: {NO_DESCRIBING_FUNCTION}")
         sc.source = self.scenario_source  # its stage's implausible values named once
         warn_implausible(sc)
 

@@ -1,0 +1,197 @@
+"""Every route of a link along the stroke (hysteresis/along_stroke.py) for every link model:
+the exact periodic steady state (continuous and sampled loop) against runs in time, the
+sampled loop's run following the table against the continuous run, and the routes that need
+the describing function refused in one line naming ``[hysteresis] along``."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+from conftest import FC_LINK, K_LINK
+
+from motionhyst import Loop, periodic_steady_state, simulate
+from motionhyst.analysis.comparison import compare_with_describing_function
+from motionhyst.analysis.floquet import steady_state_floquet
+from motionhyst.analysis.quasilinear import loop_mismatch
+from motionhyst.cli import main as cli_main
+from motionhyst.core.textfiles import toml_table
+from motionhyst.hysteresis import BoucWen, Coulomb, Dahl, Jenkins, LuGre, MaxwellIwan, MaxwellSlip
+from motionhyst.hysteresis.along_stroke import AlongStroke
+from motionhyst.scan.profiles import scan
+from motionhyst.scenario import Scenario, default_scenario
+from motionhyst.time.references import SineReference
+
+A, F = 0.01, 5.0  # the stage spans the whole table below
+POSITION = [-A, A]
+#: each model with the scales that change its force over the table (4x from end to end)
+LINKS = {
+    "jenkins": (Jenkins(K_LINK, FC_LINK), {"fc": [0.5, 2.0]}),
+    "maxwell-slip": (MaxwellSlip([10.0, 10.0], [0.02, 0.03]), {"fc": [0.5, 2.0]}),
+    "dahl": (Dahl(K_LINK, FC_LINK), {"fc": [0.5, 2.0]}),
+    "bouc-wen": (BoucWen(k=K_LINK, fc=FC_LINK), {"fc": [0.5, 2.0]}),
+    "lugre": (LuGre(sigma0=1e3, sigma1=100.0, sigma2=0.0, fc=FC_LINK, fs=0.06, vs=0.01),
+              {"fc": [0.5, 2.0], "fs": [0.5, 2.0]}),
+    "coulomb": (Coulomb(FC_LINK), {"fc": [0.5, 2.0]}),
+    "maxwell-iwan": (MaxwellIwan(k0=5.0, ki=30.0, d_min=1e-4, d_max=4e-3, kv=[8.0],
+                                 cv=[0.4], n_stops=16), {"ki": [0.25, 4.0]}),
+}
+
+
+def _along(name: str) -> AlongStroke:
+    base, scales = LINKS[name]
+    return AlongStroke(base, POSITION, scales)
+
+
+def _harmonics_in_time(loop: Loop, periods: int = 6, n: int = 8000) -> np.ndarray:
+    """The error's harmonics (complex amplitudes of sin(n theta), as SteadyState.e) over the
+    last of `periods` periods of a run from rest with `n` steps a period."""
+    sim = simulate(loop, SineReference(A, F), periods / F, dt=1.0 / (F * n))
+    e = sim.e[-n - 1:-1]
+    return 2j * np.fft.rfft(e)[:8] / n
+
+
+@pytest.mark.parametrize("name", list(LINKS))
+def test_steady_state_along_the_stroke_is_the_run_in_time(stage, controller, name):
+    # the link's part of the error, e - e_linear, at harmonics 1 and 3: the steady state
+    # (the table followed at the stage's position) against the last of 6 periods of a run
+    # from rest (the table followed at the setpoint, within the tracking error); main gave
+    # LuGre's the linear loop's (the link's part 0, where the run has 3.9e-8 m)
+    loop = Loop(stage, controller, _along(name))
+    ss = periodic_steady_state(loop, A, F)
+    run = _harmonics_in_time(loop)
+    link_part = ss.e[1] - ss.e_linear[1]
+    assert abs(link_part) > 1e-9
+    assert abs(ss.e[1] - run[1]) < 2e-3 * abs(link_part)
+    assert abs(ss.e[3] - run[3]) < 2e-3 * abs(link_part)
+    # the table matters: the base link alone is 10 % or more off
+    base = periodic_steady_state(Loop(stage, controller, LINKS[name][0]), A, F)
+    assert abs(base.e[1] - run[1]) > 0.1 * abs(link_part)
+
+
+def test_rate_dependent_link_along_the_stroke_as_feedforward(stage, controller):
+    # a LuGre model along the stroke as the feedforward, unit scales: the run and the steady
+    # state are those of the LuGre model itself (main ran it without time: no force)
+    lugre = LINKS["lugre"][0]
+    unit = AlongStroke(lugre, POSITION, {"fc": [1.0, 1.0]})
+    link = Jenkins(K_LINK, FC_LINK)
+    ref = SineReference(A, F)
+    runs = [simulate(Loop(stage, controller, link, hysteresis_feedforward=h), ref, 2 / F)
+            for h in (lugre, unit)]
+    assert np.max(np.abs(runs[1].e - runs[0].e)) < 1e-3 * np.max(np.abs(runs[0].e))
+    states = [periodic_steady_state(Loop(stage, controller, link, hysteresis_feedforward=h),
+                                    A, F) for h in (lugre, unit)]
+    assert abs(states[1].e[1] - states[0].e[1]) < 1e-6 * abs(states[0].e[1])
+    with pytest.raises(ValueError, match="sample times"):
+        unit.response(np.linspace(0.0, 0.01, 11))
+
+
+def _sampled_scenario(rate_hz: float | None, name: str = "jenkins",
+                      table: dict | None = None) -> Scenario:
+    d = default_scenario().to_dict()
+    base, scales = LINKS[name]
+    d["hysteresis"] = {**base.to_dict(), "along": table or {"position": POSITION, **scales}}
+    if rate_hz is not None:
+        d["controller"]["sample_rate_hz"] = rate_hz
+        d["feedforward"] = {"type": "rigid-body"}
+    return Scenario.from_dict(d, "s.toml")
+
+
+def test_sampled_run_follows_the_table_as_the_continuous_run():
+    # a scan over a table whose fc falls and rises +-25 %: at 50 kHz the sampled loop's link
+    # error (e - e_linear) is the continuous loop's to 0.5 % of its peak; the table's first
+    # position held (what main ran, silently) is 40 % off
+    table = {"position": [0.0, 0.05, 0.1], "fc": [1.2, 0.7, 1.1], "k": [1.0, 0.8, 1.3]}
+    p = scan(0.1, speed=0.5, a_max=20.0, j_max=2000.0, s_max=4e5, start=0.01)
+    cont = simulate(_sampled_scenario(None, table=table).loop(), p, p.end)
+    sampled = simulate(_sampled_scenario(50e3, table=table).loop(), p, p.end)
+    ref = np.interp(sampled.t, cont.t, cont.e - cont.e_linear)
+    peak = np.max(np.abs(ref))
+    assert np.max(np.abs(sampled.e - sampled.e_linear - ref)) < 5e-3 * peak
+    d = _sampled_scenario(50e3, table=table).to_dict()
+    d["hysteresis"].pop("along")
+    d["hysteresis"]["fc"] = 1.2 * FC_LINK
+    first = simulate(Scenario.from_dict(d, "b.toml").loop(), p, p.end)
+    assert np.max(np.abs(first.e - first.e_linear - ref)) > 0.3 * peak
+
+
+@pytest.mark.parametrize("name", ["jenkins", "lugre"])
+def test_sampled_steady_state_along_the_stroke_is_the_sampled_run(name):
+    # the hybrid loop's steady state against the last of 6 periods of its run in time, at
+    # the controller's samples (10 kHz: 2000 a period)
+    loop = _sampled_scenario(10e3, name).loop()
+    ss = periodic_steady_state(loop, A, F)
+    sim = simulate(loop, SineReference(A, F), 6 / F)
+    n = 2000
+    run = 2j * np.fft.rfft(sim.e[-n - 1:-1])[:4] / n
+    link_part = ss.e[1] - ss.e_linear[1]
+    assert abs(link_part) > 1e-9
+    assert abs(ss.e[1] - run[1]) < 2e-3 * abs(link_part)
+
+
+def _write(tmp_path, sc: Scenario):
+    path = tmp_path / "along.toml"
+    path.write_text("".join(toml_table(k, v) for k, v in sc.to_dict().items()))
+    return path
+
+
+@pytest.mark.parametrize("name", list(LINKS))
+@pytest.mark.parametrize("command", ["steady", "analyze", "stability", "reproduce"])
+def test_describing_function_commands_refuse_in_one_line(tmp_path, capsys, name, command):
+    path = _write(tmp_path, _sampled_scenario(None, name))
+    before = sorted(p.name for p in tmp_path.iterdir())
+    args = [command, str(path)] + (["--out", str(tmp_path / "out")] if command == "reproduce"
+                                   else [])
+    assert cli_main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert "[hysteresis] along" in err and "simulate" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written
+
+
+def test_api_routes_of_the_describing_function_refuse(stage, controller):
+    link = _along("lugre")
+    loop = Loop(stage, controller, link)
+    for route in (lambda: link.describing_function(A, 1.0), lambda: link.hosidf(A, 3, 1.0),
+                  lambda: loop_mismatch(loop, [F], A),
+                  lambda: compare_with_describing_function(loop, A, [F])):
+        with pytest.raises(ValueError, match=r"\[hysteresis\] along"):
+            route()
+    ss = periodic_steady_state(Loop(stage, controller, _along("jenkins")), A, F)
+    with pytest.raises(ValueError, match="along the stroke"):
+        steady_state_floquet(Loop(stage, controller, _along("jenkins")), ss)
+
+
+def test_study_of_a_link_along_the_stroke(tmp_path, capsys):
+    # its exact steady state is the study's e1 and error_rms; E (the describing function's)
+    # is refused before any point runs, nothing written
+    sc = _sampled_scenario(None, "lugre")
+    path = _write(tmp_path, sc)
+    study = tmp_path / "study.toml"
+    study.write_text(f'scenario = "{path.name}"\noutputs = ["e1", "error_rms"]\n'
+                     f"[axes]\namplitude = [{A}]\nfrequency_hz = [{F}]\n")
+    table = tmp_path / "t.csv"
+    assert cli_main(["study", str(study), "--out", str(tmp_path / "s.zarr"), "--workers", "0",
+                     "--table", str(table)]) == 0
+    row = next(csv.DictReader(table.open()))
+    ss = periodic_steady_state(sc.loop(), A, F)
+    assert float(row["error_rms"]) == pytest.approx(ss.error_rms, rel=1e-9)
+    capsys.readouterr()
+    study.write_text(study.read_text().replace('"error_rms"', '"E"'))
+    assert cli_main(["study", str(study), "--out", str(tmp_path / "e.zarr"), "--workers",
+                     "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "[hysteresis] along" in err
+    assert not (tmp_path / "e.zarr").exists()
+
+
+def test_a_spring_that_never_slips_scaled_along_the_stroke_has_no_steady_state(stage,
+                                                                             controller):
+    # k0 of a Maxwell-Iwan link (a spring in parallel) held piece by piece: its force moves
+    # by 2e-4 of itself every period (in simulate as well), the change does not shrink
+    base, _ = LINKS["maxwell-iwan"]
+    link = AlongStroke(base, POSITION, {"k0": [0.5, 2.0]})
+    with pytest.raises(RuntimeError, match=r"no periodic force.*\[hysteresis\] along|"
+                                           r"\[hysteresis\] along.*no periodic force"):
+        periodic_steady_state(Loop(stage, controller, link), A, F)
