@@ -195,3 +195,23 @@ def test_a_spring_that_never_slips_scaled_along_the_stroke_has_no_steady_state(s
     with pytest.raises(RuntimeError, match=r"no periodic force.*\[hysteresis\] along|"
                                            r"\[hysteresis\] along.*no periodic force"):
         periodic_steady_state(Loop(stage, controller, link), A, F)
+
+
+def test_sampled_loop_runs_a_rate_dependent_feedforward_over_its_samples():
+    # the controller's LuGre model (plain, or along the stroke with unit scales) integrated
+    # over the setpoint's sample times (their integrations converge as the samples resolve
+    # the bristles' deflection): the two runs agree and differ from the run without
+    # it (main refused the plain model, "response() needs the sample times", and ran the one
+    # along the stroke without time: no force)
+    lugre = LINKS["lugre"][0].to_dict()
+    runs = []
+    for ff in (None, lugre, {**lugre, "along": {"position": POSITION, "fc": [1.0, 1.0]}}):
+        d = _sampled_scenario(50e3).to_dict()  # 6 um a sample, the bristles' 50 um resolved
+        if ff is not None:
+            d["feedforward"]["hysteresis"] = ff
+        runs.append(simulate(Scenario.from_dict(d, "s.toml").loop(), SineReference(A, F),
+                             1 / F))
+    none, plain, along = (r.e for r in runs)
+    # 0.6 % at 50 kHz, 4.6 % at 10 kHz: the two integrations' difference, shrinking with the
+    # sample; a feedforward without force would be 100 % off
+    assert np.max(np.abs(along - plain)) < 1e-2 * np.max(np.abs(plain - none))

@@ -79,8 +79,9 @@ def feedforward_samples(loop: Loop, reference, t: ArrayLike) -> np.ndarray:
     elif ff is not None:
         v = _velocity(reference, ahead) if (ff.viscous or ff.coulomb) else np.zeros(t.shape)
         out += ff.force(v, acc)
-    if hff is not None:
-        out += hff.response(np.asarray(r, dtype=float))
+    if hff is not None:  # a rate-dependent model (LuGre) integrated over the samples' times
+        r = np.asarray(r, dtype=float)
+        out += hff.response(r) if hff.rate_independent else hff.response(r, t=ahead)
     return out
 
 
