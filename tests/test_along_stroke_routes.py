@@ -215,3 +215,41 @@ def test_sampled_loop_runs_a_rate_dependent_feedforward_over_its_samples():
     # 0.6 % at 50 kHz, 4.6 % at 10 kHz: the two integrations' difference, shrinking with the
     # sample; a feedforward without force would be 100 % off
     assert np.max(np.abs(along - plain)) < 1e-2 * np.max(np.abs(plain - none))
+
+
+OPEN_LOOP = {"mass-spring-damper": {"type": "mass-spring-damper", "m": 1.0, "c": 20.0,
+                                    "k": 1000.0},
+             "quasi-static": {"type": "quasi-static"}}
+
+
+@pytest.mark.parametrize("stage_kind", list(OPEN_LOOP))
+def test_open_loop_systems_refuse_a_link_along_the_stroke(tmp_path, capsys, stage_kind):
+    # predict ran the table's first position (a quasi-static Jenkins link over fc 0.5x..2x
+    # on [-10, 10] mm: a peak force 0.25 N where the table gives 1 N at 10 mm), exit 0
+    link = {"model": "jenkins", "k": 200.0, "fc": 0.5,
+            "along": {"position": POSITION, "fc": [0.5, 2.0]}}
+    path = tmp_path / "open.toml"
+    path.write_text(toml_table("stage", OPEN_LOOP[stage_kind]) + toml_table("hysteresis", link))
+    t = np.arange(2001) * 1e-3
+    column, values = (("displacement", A * np.sin(2 * np.pi * t)) if stage_kind == "quasi-static"
+                      else ("force", 12.0 * np.sin(2 * np.pi * t)))
+    record = tmp_path / "in.csv"
+    record.write_text(f"time,{column}\n"
+                      + "".join(f"{a!r},{b!r}\n" for a, b in zip(t, values, strict=True)))
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert cli_main(["predict", str(path), str(record), "--out", str(tmp_path / "o.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "[hysteresis] along" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_open_loop_api_refuses_a_link_along_the_stroke():
+    from motionhyst.plants.quasi_static import QuasiStatic
+    from motionhyst.time.openloop import OpenLoop
+    from motionhyst.time.quasi_static import force_from_displacement
+
+    link = _along("jenkins")
+    with pytest.raises(ValueError, match=r"\[hysteresis\] along"):
+        OpenLoop(QuasiStatic(), link)
+    with pytest.raises(ValueError, match=r"\[hysteresis\] along"):
+        force_from_displacement(QuasiStatic(), link, np.arange(11) * 1e-3, np.linspace(0.0, A, 11))

@@ -29,8 +29,8 @@ from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
 
-__all__ = ["MAX_PERIODS", "NO_DESCRIBING_FUNCTION", "PERIODIC_RTOL", "STALL_PERIODS",
-           "STEPS_PER_INTERVAL", "AlongStroke"]
+__all__ = ["FIXED_IN_OPEN_LOOP", "MAX_PERIODS", "NO_DESCRIBING_FUNCTION", "PERIODIC_RTOL",
+           "STALL_PERIODS", "STEPS_PER_INTERVAL", "AlongStroke"]
 
 #: Parameter updates of a time run per interval of the table (the parameters are held over
 #: the samples within one such step of the position).
@@ -42,6 +42,10 @@ PERIODIC_RTOL = 1e-14
 MAX_PERIODS = 200
 #: ... and refused once its change has not shrunk for this many periods.
 STALL_PERIODS = 10
+#: The refusal of an open-loop system's link along the stroke (its runs hold the parameters).
+FIXED_IN_OPEN_LOOP = ("an open-loop system (predict, identify) runs its link with fixed "
+                      "parameters: a link along the stroke ([hysteresis] along) is run in a "
+                      "closed loop (simulate, scan)")
 #: The refusal of a computation that needs the link's describing function (or its HOSIDF).
 NO_DESCRIBING_FUNCTION = ("a link along the stroke ([hysteresis] along) has no describing "
                           "function: run it in time (simulate, scan), or compute its exact "

@@ -140,6 +140,10 @@ class Scenario:
         except ValidationError as err:
             raise ScenarioError(format_error(source, err)) from None
         sc = cls(model, source, base_dir)
+        if model.open_loop and sc.along_stroke:
+            from motionhyst.hysteresis.along_stroke import FIXED_IN_OPEN_LOOP
+
+            raise ScenarioError(f"{source}: {FIXED_IN_OPEN_LOOP}")
         if check and not (model.open_loop or model.plant_only):
             sc.loop()  # builds and checks stability
         return sc

@@ -68,6 +68,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.budget import check_memory
 from motionhyst.hysteresis import BoucWen, Hysteresis
+from motionhyst.hysteresis.along_stroke import FIXED_IN_OPEN_LOOP, AlongStroke
 from motionhyst.hysteresis.stepping import (
     DIFFERENTIATED,
     N_PARAMS,
@@ -209,6 +210,8 @@ class OpenLoop:
     """
 
     def __init__(self, plant: Plant, hysteresis: Hysteresis | None = None) -> None:
+        if isinstance(hysteresis, AlongStroke):
+            raise ValueError(FIXED_IN_OPEN_LOOP)
         self.plant = plant
         self.hysteresis = hysteresis
 

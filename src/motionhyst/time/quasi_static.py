@@ -53,6 +53,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.compiled import njit
+from motionhyst.hysteresis.along_stroke import FIXED_IN_OPEN_LOOP, AlongStroke
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.hysteresis.stepping import (
     COULOMB,
@@ -248,6 +249,8 @@ def _parts(plant, link: Hysteresis | None) -> tuple[Stepping, float, float, floa
     if plant.has_inertia:
         raise ValueError(f"a {plant.name} has inertia: its response needs its masses "
                          f"(motionhyst.time.openloop.OpenLoop), not the quasi-static balance")
+    if isinstance(link, AlongStroke):
+        raise ValueError(FIXED_IN_OPEN_LOOP)
     st = Stepping.empty() if link is None else link.time_stepping()
     return st, float(plant.k), float(plant.c), float(plant.force_offset)
 
