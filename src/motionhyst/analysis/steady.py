@@ -281,7 +281,10 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
     Parameters
     ----------
     loop : Loop
-        The loop (with or without hysteresis and hysteresis feedforward).
+        The loop (with or without hysteresis and hysteresis feedforward).  A link along
+        the stroke (:class:`~motionhyst.hysteresis.along_stroke.AlongStroke`) is followed
+        at the stage's position, the sine about the table's position 0 (its feedforward
+        model at the setpoint's).
     amplitude : float
         Reference amplitude ``A`` [m], > 0.
     frequency_hz : float
