@@ -48,8 +48,9 @@ FIXED_IN_OPEN_LOOP = ("an open-loop system (predict, identify) runs its link wit
                       "closed loop (simulate, scan)")
 #: The refusal of a computation that needs the link's describing function (or its HOSIDF).
 NO_DESCRIBING_FUNCTION = ("a link along the stroke ([hysteresis] along) has no describing "
-                          "function: run it in time (simulate, scan), or compute its exact "
-                          "steady state in a study (outputs e1, harmonics, error_rms)")
+                          "function: run it in time (simulate --time-series, scan), or compute "
+                          "its exact steady state in a study (outputs e1, harmonics, "
+                          "error_rms)")
 
 
 class AlongStroke(Hysteresis):
