@@ -10,10 +10,12 @@ address space it hardly uses).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import resource
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 REFUSAL_LIMIT = 1 << 30
@@ -68,6 +70,18 @@ def popen(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,
     return subprocess.Popen([sys.executable, "-c", MAIN, *argv], cwd=cwd,
                             env=environment() if env is None else env,
                             preexec_fn=_limiter(limit, file_limit), **kwargs)
+
+
+@contextlib.contextmanager
+def ended(proc: subprocess.Popen) -> Iterator[subprocess.Popen]:
+    """`proc` inside the block, killed (and waited for) if it still runs when the block ends:
+    a test that fails leaves no command running."""
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
 
 
 def run(argv: list[str], cwd: Path, limit: int = REFUSAL_LIMIT,

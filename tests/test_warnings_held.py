@@ -173,17 +173,13 @@ def test_a_run_interrupted_after_its_checks_shows_its_warnings_then_interrupted(
     (branch sig16 held it to the end and dropped it on the interruption: review A16 H2)."""
     populate(tmp_path, {"ms.csv": _ms_reference, "o.csv": "old\n"})
     before = snapshot(tmp_path)
-    proc = limited_process.popen(["simulate", "--reference-csv", "ms.csv", "--time-series",
-                                  "o.csv", "--force"], tmp_path)
-    try:
+    with limited_process.ended(limited_process.popen(
+            ["simulate", "--reference-csv", "ms.csv", "--time-series", "o.csv", "--force"],
+            tmp_path)) as proc:
         first = _first_line(proc, timeout=600)
         assert proc.poll() is None, (proc.returncode, first)
         proc.send_signal(getattr(signal, name))
         _, rest = proc.communicate(timeout=300)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
     # numba's first-use notice goes straight to stderr, held or not: not a warning
     lines = [line for line in (first + rest).decode().splitlines()
              if not line.startswith("motionhyst: compiling")]

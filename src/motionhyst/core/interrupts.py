@@ -10,7 +10,10 @@ compiled wrapper unpickles an array's type as it boxes the results of a kernel r
 several arrays) must not raise there: numba would hand back a tuple with an item missing,
 and the caller crash with a segmentation fault.  The handler notes it instead
 (:func:`defer`) and the main thread's next kernel call raises it once numba has returned
-(:func:`raise_deferred`, from :class:`motionhyst.core.compiled.Kernel`).
+(:func:`raise_deferred`, from :class:`motionhyst.core.compiled.Kernel`).  Every handler of
+the package that raises does so through :func:`raise_or_defer`: the command's own and an
+output file's while it is written (a handler that raised there unconditionally ended a
+long run in a segmentation fault instead of exit 130).
 
 Examples
 --------
@@ -28,9 +31,16 @@ False
 
 from __future__ import annotations
 
+import os
+import signal
 import threading
 
-__all__ = ["DEFERRED", "defer", "in_numba", "interrupted", "raise_deferred"]
+__all__ = ["DEFERRED", "RESEND_SECONDS", "defer", "in_numba", "interrupted", "raise_deferred",
+           "raise_or_defer"]
+
+RESEND_SECONDS = 0.05
+"""A signal deferred is sent again after this time [s] if no kernel's call has raised it
+meanwhile (numba compiling, not boxing a kernel's results: no call returns soon)."""
 
 DEFERRED: list[str] = []
 """Names of the signals noted while numba's own code ran, not yet raised."""
@@ -115,3 +125,48 @@ def raise_deferred() -> None:
         name = DEFERRED[0]
         DEFERRED.clear()
         raise KeyboardInterrupt(name)
+
+
+def raise_or_defer(signum: int, frame) -> None:
+    """What a SIGINT or SIGTERM handler of the package does: raise ``KeyboardInterrupt``
+    (named by the signal), or, where the signal found numba's own Python code running
+    (:func:`in_numba`), note it (:func:`defer`) and send it again a moment later
+    (:data:`RESEND_SECONDS`) unless a kernel's call has raised it meanwhile.
+
+    Parameters
+    ----------
+    signum : int
+        The signal.
+    frame : frame or None
+        Where it found the interpreter (the handler's argument).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Outside numba's code.
+
+    Examples
+    --------
+    >>> import signal, sys
+    >>> try:
+    ...     raise_or_defer(signal.SIGTERM, sys._getframe())
+    ... except KeyboardInterrupt as exc:
+    ...     print(exc)
+    SIGTERM
+    """
+    name = signal.Signals(signum).name
+    if in_numba(frame):
+        defer(name)
+        again = threading.Timer(RESEND_SECONDS, _resend, (os.getpid(), signum))
+        again.daemon = True
+        again.start()
+        return
+    DEFERRED.clear()
+    raise KeyboardInterrupt(name)
+
+
+def _resend(pid: int, signum: int) -> None:
+    """Send `signum` to this process again if it is still deferred (and this is the process
+    that deferred it)."""
+    if DEFERRED and os.getpid() == pid:
+        os.kill(pid, signum)

@@ -61,6 +61,7 @@ from typing import IO
 import numpy as np
 from numpy.typing import ArrayLike
 
+from motionhyst.core.interrupts import raise_or_defer
 from motionhyst.core.textfiles import CSV_FORMAT, csv_header, csv_rows
 from motionhyst.io.leftovers import clean_stale as clean_stale
 from motionhyst.io.leftovers import scratch_folder as scratch_folder
@@ -375,7 +376,7 @@ def _signals_raise() -> Iterator[list[int]]:
             os.kill(os.getpid(), signum)
             return
         received.append(signum)
-        raise KeyboardInterrupt(signal.Signals(signum).name)
+        raise_or_defer(signum, frame)  # not inside numba's boxing of a kernel's results
 
     saved = {}
     for sig in (signal.SIGINT, signal.SIGTERM):
