@@ -1,7 +1,9 @@
-"""A signal ends a long run as a signal (issue 26: Ctrl-C or SIGTERM at any moment exits 130,
-the old files intact): one that finds numba boxing a kernel's results while an output file
-is written is raised once the kernel has returned (main: the file writer's handler raised it
-there, and numba's broken tuple ended the run in a segmentation fault, exit -11).
+"""A signal ends a long run at once (issue 26: Ctrl-C or SIGTERM at any moment exits 130, the
+old files intact): the compiled step loop runs in calls of bounded work, between which the
+signal is taken, with the numbers of one call; and a signal that finds numba boxing a
+kernel's results while an output file is written is raised once the kernel has returned
+(main: the file writer's handler raised it there, and numba's broken tuple ended the run in a
+segmentation fault, exit -11).
 """
 
 from __future__ import annotations
@@ -11,10 +13,98 @@ import time
 from pathlib import Path
 
 import limited_process
+import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
+from motionhyst.time import engine
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _sampled_run():
+    """The paper's loop at 10 kHz (its force 1.5 samples late: periods of two step kinds)."""
+    from motionhyst.scenario import load_scenario
+    from motionhyst.time.references import SineReference
+    from motionhyst.time.sampled import simulate_sampled
+
+    loop = load_scenario(EXAMPLES / "paper_10khz.toml").loop()
+    sim = simulate_sampled(loop, SineReference(0.01, 5.0), 0.05, linear=False)
+    return sim.e, sim.u, sim.w, sim.y1
+
+
+def _closed_loop_run():
+    """Table I's continuous loop (the closed-loop convention, exogenous outputs)."""
+    from motionhyst.scenario import default_scenario_path, load_scenario
+    from motionhyst.time.references import SineReference
+    from motionhyst.time.simulation import simulate
+
+    loop = load_scenario(default_scenario_path()).loop()
+    sim = simulate(loop, SineReference(0.01, 5.0), 0.1)
+    return sim.e, sim.w, sim.u
+
+
+def _sensitivities_run():
+    """A Jenkins link on a mass-spring-damper with the sensitivities identify's search uses."""
+    from motionhyst.hysteresis import Jenkins
+    from motionhyst.hysteresis.stepping import N_PARAMS
+    from motionhyst.time.openloop import MassSpringDamper, simulate_elements
+
+    t = np.arange(1500) / 750.0
+    u = 40 * np.sin(2 * np.pi * 8 * t)
+    dparams = np.zeros((1, N_PARAMS, 2))
+    dparams[0, 0, 0] = dparams[0, 1, 1] = 1.0
+    return simulate_elements(MassSpringDamper(2.0, 10.0, 5e4).mechanics(),
+                             Jenkins(k=2e4, fc=10.0).time_stepping(), u, 750.0, 40,
+                             periodic=False, dparams=dparams)
+
+
+def _calls(monkeypatch) -> list[int]:
+    """The steps of each call of the compiled step loop from now on."""
+    calls: list[int] = []
+    kernel = engine.step_loop
+
+    def counted(*args):
+        calls.append(args[11].shape[0] - 1)  # the force nodes `a`: steps + 1
+        return kernel(*args)
+
+    monkeypatch.setattr(engine, "step_loop", counted)
+    return calls
+
+
+@pytest.mark.parametrize("run", [_sampled_run, _closed_loop_run, _sensitivities_run],
+                         ids=["sampled", "closed-loop", "sensitivities"])
+def test_a_run_in_calls_of_bounded_work_gives_the_numbers_of_one_call(monkeypatch, run):
+    """Cut at every record and controller period it can be (main: the whole run in one call,
+    20 s and more for a link of 100 elements, deaf to signals), the run gives one call's
+    numbers bit for bit."""
+    calls = _calls(monkeypatch)
+    monkeypatch.setattr(engine, "CALL_SECONDS", 1e9)
+    whole = run()
+    assert calls and max(calls) > 1000  # the case has long calls to cut
+    one_call = len(calls)
+    monkeypatch.setattr(engine, "CALL_SECONDS", 1e-12)  # a call per record or period
+    cut = run()
+    assert len(calls) - one_call > 20 * one_call
+    for a, b in zip(whole, cut, strict=True):
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("elements", [0, 1, 100, 10_000])
+@pytest.mark.parametrize("sensitivities", [0, 5])
+@pytest.mark.parametrize("align", [1, 3, 40])
+def test_a_call_runs_the_most_whole_periods_within_its_nominal_work(elements, sensitivities,
+                                                                   align):
+    """A call's steps are whole records and controller periods (`align`), as many as keep
+    its nominal work within CALL_SECONDS (one period where a period is more)."""
+    from motionhyst.time.steps import SECONDS_PER_ELEMENT_STEP, SECONDS_PER_STEP
+
+    steps = engine.call_steps(elements, sensitivities, align)
+    per_step = (SECONDS_PER_STEP + elements * SECONDS_PER_ELEMENT_STEP) * (1 + sensitivities)
+    assert steps % align == 0 and steps >= align
+    assert steps == align or steps * per_step <= engine.CALL_SECONDS
+    assert (steps + align) * per_step > engine.CALL_SECONDS
+    assert engine.CALL_SECONDS <= 0.1  # within the 2 s a signal may take on a loaded machine
 
 
 def _many_elements(path: Path) -> None:

@@ -65,12 +65,15 @@ from motionhyst.time.kernel import (
 from motionhyst.time.steps import (
     SAMPLED_MIN_SUBSTEPS,
     SAMPLED_STEPS_PER_MODE_PERIOD,
+    SECONDS_PER_ELEMENT_STEP,
+    SECONDS_PER_STEP,
     check_link_damping,
     run_delay,
     sampled_substeps,
 )
 
 __all__ = [
+    "CALL_SECONDS",
     "DiscreteController",
     "FohStep",
     "LoopState",
@@ -266,6 +269,40 @@ _EMPTY_CONTROLLER = (np.zeros((0, 0)), np.zeros((0, 2)), np.zeros(0), np.zeros(2
                      np.zeros(0), math.inf, 0, 0, 0, 0)
 
 
+CALL_SECONDS = 0.1
+"""Nominal work [s] of one call of the compiled step loop (:data:`SECONDS_PER_STEP` and
+:data:`SECONDS_PER_ELEMENT_STEP` a step, times one plus the sensitivities): a longer run is
+run in calls of about this much, its state carried from one to the next.  A signal
+(Ctrl-C, SIGTERM) is taken between two calls, never inside one: a run of a link of 100
+elements held one for 20 s and more."""
+
+
+def call_steps(n_elements: int, n_sensitivities: int, align: int) -> int:
+    """Steps of one call of the compiled step loop (:data:`CALL_SECONDS`): a multiple of
+    `align` (the steps between records and of a controller period), at least one.
+
+    Parameters
+    ----------
+    n_elements : int
+        The link's elements.
+    n_sensitivities : int
+        The sensitivities computed.
+    align : int
+        What the steps are a multiple of.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> call_steps(1, 0, 1), call_steps(100, 0, 1), call_steps(100, 0, 8)
+    (62500, 8695, 8688)
+    """
+    per_step = (SECONDS_PER_STEP + n_elements * SECONDS_PER_ELEMENT_STEP) * (1 + n_sensitivities)
+    return max(1, int(CALL_SECONDS / per_step) // align) * align
+
+
 def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
               stepping: Stepping, a: NDArray[np.float64], state: LoopState, *,
               vel_row: int = -1,
@@ -360,20 +397,46 @@ def run_steps(steps: list[FohStep], C: ArrayLike, D: ArrayLike, link_row: int,
         state.out_prev = np.zeros(C.shape[0])
     ctrl = _EMPTY_CONTROLLER if controller is None else controller
     Ac, Bc, Cc, Dc, ref, ff, u_max, period, r1, meas_row, n_delay = ctrl
-    Y, SY, W, U, worst, done = step_loop(
-        A, B0, B1, C, G, hs, dA, dB0, dB1, int(link_row), int(vel_row),
-        np.ascontiguousarray(a, dtype=float),
-        np.zeros(0) if dexo is None else np.ascontiguousarray(dexo, dtype=float),
-        np.zeros((0, C.shape[0])) if exo is None else np.ascontiguousarray(exo, dtype=float),
-        int(record_every), bool(record_initial),
-        np.ascontiguousarray(stepping.codes, dtype=np.int64),
-        np.ascontiguousarray(stepping.params, dtype=float), dp, GL_T, GL_W, float(ftol),
-        MAX_FIXED_POINT_ITERATIONS, int(convention), int(state.i0), int(i_first),
-        bool(state.fresh), Ac, Bc, Cc, Dc, ref, ff, float(u_max), int(period), int(r1),
-        int(meas_row), int(n_delay), state.z, state.s, state.s_prev, state.sx, state.ss,
-        state.ss_prev, state.dvec, state.out_prev, state.scal, state.xc, state.uq)
-    state.fresh = False
-    state.i0 += int(done)
+    a = np.ascontiguousarray(a, dtype=float)
+    dexo = np.zeros(0) if dexo is None else np.ascontiguousarray(dexo, dtype=float)
+    exo = (np.zeros((0, C.shape[0])) if exo is None
+           else np.ascontiguousarray(exo, dtype=float))
+    codes = np.ascontiguousarray(stepping.codes, dtype=np.int64)
+    params = np.ascontiguousarray(stepping.params, dtype=float)
+    n, P = a.shape[0] - 1, state.sx.shape[1]
+    period = int(period)
+    # the run in calls of bounded work, each a whole number of records and of controller
+    # periods (the kernel counts both from its first step); outputs as one call gives them
+    chunk = call_steps(m, P, math.lcm(int(record_every), max(period, 1)))
+    if n > chunk:
+        n_rec = n // int(record_every) + (1 if record_initial else 0)
+        Y, SY = np.zeros((n_rec, C.shape[0])), np.zeros((n_rec, C.shape[0], P))
+        W, U = np.zeros(n_rec), np.zeros(-(-n // period) if period > 0 else 0)
+    worst = done = rec = 0
+    for start in range(0, max(n, 1), chunk):
+        steps_here = max(min(chunk, n - start), 0)
+        k0 = start // period if period > 0 else 0
+        Yc, SYc, Wc, Uc, worst_c, done_c = step_loop(
+            A, B0, B1, C, G, hs, dA, dB0, dB1, int(link_row), int(vel_row),
+            a[start:start + steps_here + 1], dexo[start:start + steps_here] if dexo.size else dexo,
+            exo[start:start + steps_here] if exo.shape[0] else exo, int(record_every),
+            bool(record_initial and start == 0), codes, params, dp, GL_T, GL_W, float(ftol),
+            MAX_FIXED_POINT_ITERATIONS, int(convention), int(state.i0), int(i_first),
+            bool(state.fresh), Ac, Bc, Cc, Dc, ref[k0:] if period > 0 else ref,
+            ff[k0:] if period > 0 else ff, float(u_max), period, int(r1), int(meas_row),
+            int(n_delay), state.z, state.s, state.s_prev, state.sx, state.ss, state.ss_prev,
+            state.dvec, state.out_prev, state.scal, state.xc, state.uq)
+        state.fresh = False
+        state.i0 += int(done_c)
+        if n <= chunk:  # one call: its outputs as they are
+            return Yc, SYc, Wc, Uc, int(worst_c), int(done_c)
+        Y[rec:rec + Yc.shape[0]], SY[rec:rec + Yc.shape[0]] = Yc, SYc
+        W[rec:rec + Yc.shape[0]] = Wc
+        U[k0:k0 + Uc.shape[0]] = Uc
+        rec += Yc.shape[0]
+        worst, done = max(worst, int(worst_c)), done + int(done_c)
+        if done_c < steps_here:  # a step did not converge: the run stops there
+            break
     return Y, SY, W, U, int(worst), int(done)
 
 
