@@ -236,6 +236,26 @@ def test_a_failed_model_is_a_row_and_the_others_go_on(tmp_path, capsys, monkeypa
     assert f"(the rule stated in advance): coulomb, {worst:.3g} mm" in out
 
 
+def test_the_best_of_models_that_all_failed_is_a_failed_fit_naming_each():
+    """EMPSBenchmark.best() when every model failed (review B17 L2): main raised min()'s
+    'ValueError: min() arg is an empty sequence'; now the FitFailed (a RuntimeError, the
+    command line's one line) naming each model and its reason.  With one model scored it is
+    that one."""
+    from motionhyst.identify.emps import EMPSBenchmark, EMPSModel
+    from motionhyst.identify.io_checks import FitFailed
+
+    failed = [EMPSModel.failed("dahl", {}, {}, "the fit failed: its prediction is not finite"),
+              EMPSModel.failed("coulomb", {}, {}, "no fit")]
+    with pytest.raises(FitFailed) as caught:
+        EMPSBenchmark(failed, None, None, False, {}).best()
+    assert str(caught.value) == ("no model to choose: every model's fit failed (dahl: the fit "
+                                 "failed: its prediction is not finite; coulomb: no fit)")
+    with pytest.raises(FitFailed, match=r"\(no model fitted\)$"):
+        EMPSBenchmark([], None, None, False, {}).best()
+    scored = EMPSModel("jenkins", {}, {}, {}, {"rmse_mm": 2.5}, 0.0)
+    assert EMPSBenchmark([*failed, scored], None, None, False, {}).best() is scored
+
+
 def test_benchmark_emps_every_split(tmp_path, capsys, monkeypatch):
     """--periods all: both halves, then all periods but the last and all but the first, each
     validated on what it left out; the rule takes the worst of the four."""

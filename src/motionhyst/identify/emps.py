@@ -389,9 +389,14 @@ class EMPSBenchmark:
         return {"models": [m.to_dict() for m in self.models]}
 
     def best(self) -> EMPSModel:
-        """The model with the smallest validation RMSE (of those that did not fail)."""
-        return min((m for m in self.models if m.error is None),
-                   key=lambda m: m.validation["rmse_mm"])
+        """The model with the smallest validation RMSE (of those that did not fail); when
+        every model failed, :class:`~motionhyst.identify.io_checks.FitFailed` (a
+        ``RuntimeError``) naming each and why: there is no best of none."""
+        fitted = [m for m in self.models if m.error is None]
+        if not fitted:
+            why = "; ".join(f"{m.name}: {m.error}" for m in self.models) or "no model fitted"
+            raise FitFailed(f"no model to choose: every model's fit failed ({why})")
+        return min(fitted, key=lambda m: m.validation["rmse_mm"])
 
     @property
     def failed(self) -> list[EMPSModel]:
