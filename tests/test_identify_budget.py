@@ -404,7 +404,6 @@ def test_a_two_mass_bouc_wen_search_is_sized_by_its_measured_estimate(tmp_path):
     135 at 1e5) it runs within 40 MB of address space above the warmed process (its run of
     the fitted model at the end, sized before the search at the search's steps, takes 37
     MB)."""
-    sys.path.insert(0, str(Path(__file__).parent))
     from test_identify_two_mass import FS as FS_TWO_MASS
     from test_identify_two_mass import _record
 
@@ -445,7 +444,6 @@ def test_a_two_mass_bouc_wen_fits_last_run_is_held_wherever_its_search_is(tmp_pa
     and refused before the search at 31M; sized at what RK4 takes (21 bytes a step, 17.5-18.7
     traced: 15.9 MB) it is held wherever the search is (24 MB and more), so the search's
     refusal is the one line under 20M, before any work, nothing saved."""
-    sys.path.insert(0, str(Path(__file__).parent))
     from test_identify_two_mass import _record
 
     from motionhyst.hysteresis import BoucWen
@@ -473,7 +471,6 @@ def test_a_fits_last_run_above_the_search_is_refused_before_the_search(monkeypat
     400 steps: 16.8 MB against 14.6; at 200 steps 8.4 against 8.2; at 37, 1.6 against 3.0):
     under a budget of 15 MB the search would fit, its last run would not, and the refusal
     is that run's, one line, before any evaluation."""
-    sys.path.insert(0, str(Path(__file__).parent))
     from test_identify_two_mass import _record
 
     from motionhyst.core.budget import BudgetError, set_max_memory

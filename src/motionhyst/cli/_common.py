@@ -351,16 +351,15 @@ class HeldWarnings:
 
     Examples
     --------
-    >>> import sys
-    >>> sys.stderr = sys.stdout                            # to show the lines here
-    >>> held = HeldWarnings()
-    >>> held.hold()
-    >>> held.say("motionhyst: warning: steady: a line")    # held: nothing shown yet
-    >>> held.release()                                     # the checks passed
+    >>> import contextlib, sys
+    >>> with contextlib.redirect_stderr(sys.stdout):       # to show the lines here
+    ...     held = HeldWarnings()
+    ...     held.hold()
+    ...     held.say("motionhyst: warning: steady: a line")    # held: nothing shown yet
+    ...     held.release()                                     # the checks passed
+    ...     held.say("motionhyst: warning: steady: another")   # shown as it comes
     motionhyst: warning: steady: a line
-    >>> held.say("motionhyst: warning: steady: another")   # shown as it comes
     motionhyst: warning: steady: another
-    >>> sys.stderr = sys.__stderr__
     """
 
     def __init__(self) -> None:
@@ -428,11 +427,10 @@ def say_later(line: str) -> None:
 
     Examples
     --------
-    >>> import sys
-    >>> sys.stderr = sys.stdout                            # to show the line here
-    >>> say_later("motionhyst: warning: analyze: a line")
+    >>> import contextlib, sys
+    >>> with contextlib.redirect_stderr(sys.stdout):       # to show the line here
+    ...     say_later("motionhyst: warning: analyze: a line")
     motionhyst: warning: analyze: a line
-    >>> sys.stderr = sys.__stderr__
     """
     if _RUNNING:
         _RUNNING[-1].say(line)
@@ -479,21 +477,21 @@ def warnings_on_stderr(command: str, held: HeldWarnings | None = None) -> Iterat
 
     Examples
     --------
-    >>> import sys
+    >>> import contextlib, sys
     >>> from motionhyst.core.warnings import warn
-    >>> sys.stderr = sys.stdout                            # to show the line here
-    >>> with warnings_on_stderr("analyze"):
+    >>> here = contextlib.redirect_stderr(sys.stdout)      # to show the lines here
+    >>> with here, warnings_on_stderr("analyze"):
     ...     warn("0.05 Hz below f* = 0.15 Hz (eq. 13)")
     motionhyst: warning: analyze: 0.05 Hz below f* = 0.15 Hz (eq. 13)
     >>> held = HeldWarnings()
-    >>> try:
-    ...     with warnings_on_stderr("analyze", held):
-    ...         held.hold()                                # the command checks its input
-    ...         warn("0.05 Hz below f* = 0.15 Hz (eq. 13)")
-    ...         raise ValueError("refused")                # a refusal before the work
-    ... except ValueError:
-    ...     held.drop()                                    # its one line is all it says
-    >>> sys.stderr = sys.__stderr__
+    >>> with contextlib.redirect_stderr(sys.stdout):
+    ...     try:
+    ...         with warnings_on_stderr("analyze", held):
+    ...             held.hold()                            # the command checks its input
+    ...             warn("0.05 Hz below f* = 0.15 Hz (eq. 13)")
+    ...             raise ValueError("refused")            # a refusal before the work
+    ...     except ValueError:
+    ...         held.drop()                                # its one line is all it says
     """
     from motionhyst.core.warnings import MotionhystWarning
 
