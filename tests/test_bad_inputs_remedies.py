@@ -283,3 +283,37 @@ def test_the_budget_options_before_the_command_set_the_budget(capsys):
     assert "above the work budget of 0.02 s (--max-seconds)" in capsys.readouterr().err
     assert main(["--max-memory", "1K", *argv]) == 2
     assert "above the memory budget of 1.02 kB (--max-memory)" in capsys.readouterr().err
+
+
+UNDETERMINED = {"m": 2.18, "c": 21.0, "link.sigma0": 1e5, "link.sigma1": 300.0,
+                "link.fc": 0.98, "link.fs": 1.2, "link.vs": 0.01, "link.sigma2": 5.0}
+"""A LuGre link's fit (a mass-damper's and the link's parameters) whose records determine the
+mass alone."""
+
+
+@pytest.mark.parametrize(("link", "remedy"), [
+    ("lugre", "--model jenkins or coulomb"), ("dahl", "--model jenkins or coulomb"),
+    ("bouc-wen", "--model jenkins or coulomb"), ("jenkins", "--model coulomb"),
+    ("maxwell-slip", "fewer --elements"), ("coulomb", None)])
+def test_an_undetermined_fit_s_remedy_names_what_simplifies_its_link(link, remedy):
+    """A LuGre fit the records do not determine: main's remedy was 'a simpler link (fewer
+    --elements)', an option of Maxwell-slip links only (refused with any other
+    --model); now each link is told what simplifies it, and a Coulomb link, the simplest,
+    only the record.  (The command, measured: identify short.csv --record input-output
+    --model lugre on test_records_of_other_kinds' 64 samples of a mass-spring-damper, exit 2
+    after 33 s: 'the records determine 2 of the model's 8 parameters ... give a longer or
+    richer record, or a simpler link (--model jenkins or coulomb)'.)"""
+    from motionhyst.identify.io_checks import FitFailed
+    from motionhyst.identify.io_uncertainty import judge_determined
+
+    std = dict.fromkeys(UNDETERMINED)
+    std["m"] = 0.01
+    with pytest.raises(FitFailed) as caught:
+        judge_determined(UNDETERMINED, std, link=link)
+    message = str(caught.value)
+    assert message.startswith("the fit failed: the records determine 1 of the model's 8 ")
+    assert ("--elements" in message) == (link == "maxwell-slip")
+    if remedy is None:
+        assert message.endswith("cannot predict; give a longer or richer record")
+    else:
+        assert message.endswith(f"give a longer or richer record, or a simpler link ({remedy})")

@@ -460,7 +460,7 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         failed = None
         try:  # parameters the records do not determine: a warning, or (most) a failed fit
             determined = judge_determined(fit.estimates, fit.judged_std or fit.std, invariant,
-                                          zero, _one_way_names(fit))
+                                          zero, _one_way_names(fit), link.name)
         except FitFailed as exc:
             failed = exc
         kept = (_determined_elements(fit, n_elements, invariant, zero)
@@ -584,7 +584,8 @@ def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
         raise failed
     try:
         determined = judge_determined(rigid.estimates, rigid.judged_std or rigid.std, (),
-                                      zero_allowed(stage, Coulomb), _one_way_names(rigid))
+                                      zero_allowed(stage, Coulomb), _one_way_names(rigid),
+                                      Coulomb.name)
     except FitFailed:
         raise failed from None
     names = undetermined(fit.estimates, fit.judged_std or fit.std, invariant, zero)

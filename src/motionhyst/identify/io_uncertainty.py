@@ -42,7 +42,7 @@ from motionhyst.identify.residual_noise import (
 
 __all__ = ["AT_ZERO", "BOUC_WEN_SCALE", "UNDETERMINED_FACTOR", "UNDETERMINED_SHARE",
            "WINDOW_INFLATION", "CorrelatedErrors", "WindowNoise", "correlated_errors",
-           "judge_determined", "parallel_note", "undetermined", "widened_note",
+           "judge_determined", "parallel_note", "simpler_link", "undetermined", "widened_note",
            "window_inflation", "zero_allowed"]
 
 SINGULAR_RTOL = 1e-8
@@ -653,9 +653,42 @@ def undetermined(estimates: dict[str, float], std: dict[str, float | None],
     return out
 
 
+def simpler_link(link: str | None) -> str:
+    """The remedy of a fit whose records determine too little, as far as the link goes: the
+    options that make the `link` (its model's name, ``--model``) simpler, and only those
+    that apply to it (a Maxwell-slip link's elements; a link of fewer parameters for the
+    others; none for a Coulomb link, the simplest).
+
+    Parameters
+    ----------
+    link : str or None
+        The link's model name (``"lugre"``, ``"maxwell-slip"``, ...); None: any link.
+
+    Returns
+    -------
+    str
+        ``", or a simpler link (...)"``, or ``""``.
+
+    Examples
+    --------
+    >>> simpler_link("maxwell-slip"), simpler_link("jenkins"), simpler_link("coulomb")
+    (', or a simpler link (fewer --elements)', ', or a simpler link (--model coulomb)', '')
+    >>> simpler_link("lugre")
+    ', or a simpler link (--model jenkins or coulomb)'
+    """
+    if link == "coulomb":
+        return ""
+    if link == "maxwell-slip":
+        return ", or a simpler link (fewer --elements)"
+    if link == "jenkins":
+        return ", or a simpler link (--model coulomb)"
+    return ", or a simpler link (--model jenkins or coulomb)"
+
+
 def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
                      invariant: tuple[str, ...] = (), zero: set[str] | frozenset = frozenset(),
-                     explained: set[str] | frozenset = frozenset()) -> list[str]:
+                     explained: set[str] | frozenset = frozenset(),
+                     link: str | None = None) -> list[str]:
     """What the records do not determine, judged: the warnings to give, or a failed fit.
 
     Parameters
@@ -674,6 +707,9 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
         Parameters another warning names already (a slip force the fit's link holds one
         way only, :func:`~motionhyst.identify.io_one_way.one_way_slip`): counted, not named
         again.
+    link : str, optional
+        The link's model name: the failed fit's remedy names only what simplifies it
+        (:func:`simpler_link`).
 
     Returns
     -------
@@ -718,8 +754,8 @@ def judge_determined(estimates: dict[str, float], std: dict[str, float | None],
         raise FitFailed(f"the fit failed: the records determine {len(physical) - len(names)} "
                         f"of the model's {len(physical)} parameters (not {shown}): its values "
                         f"would be the search's, and the model, one of many that fit these "
-                        f"records as well, cannot predict; give a longer or richer record, or "
-                        f"a simpler link (fewer --elements)")
+                        f"records as well, cannot predict; give a longer or richer record"
+                        f"{simpler_link(link)}")
     names = [n for n in names if n not in explained]
     if not names:
         return []
