@@ -745,3 +745,36 @@ def test_a_damping_at_its_bound_says_so(exact):
     free = fit_frf(LINES, *measure(exact, seed=0)).to_dict()["modes"][0]
     assert free["damping_at_bound"] is False
     assert free["damping_std"] == pytest.approx(6e-5, rel=0.2)
+
+
+LIGHT = ("measured plant: mode 1 at 694.3 Hz: lighter than the lines resolve (its peak falls "
+         "between them): the damping ratio 1e-05 is the fit's lower bound, not an estimate; "
+         "lines closer to it resolve it")
+
+
+@pytest.mark.parametrize(("b", "seed"), [(0.1, 1), (0.1, 2), (1.0, 1), (1.0, 2)])
+def test_a_mode_lighter_than_the_lines_resolve_is_said_so(b, seed):
+    """Table I's stage with b = 0.1 or 1 N s/m (damping 2.9e-6 and 2.9e-5, below and near the
+    fit's bound 1e-5), fitted at that bound in these draws, its r1 the stage's m2 / (M m1):
+    a passive stage's mode whose width the lines do not resolve (review B17 M3).  main warned
+    'not a mode of a passive stage (positive collocated residue, resonant)'; now it is said
+    to be lighter than the lines resolve, its damping the bound, not an estimate."""
+    stage = ModalPlant.from_two_mass(TwoMassStage(5.0, 17.5, b, 7.4e7))
+    fit = fit_frf(LINES, *measure(stage, seed=seed))
+    assert len(fit.plant.modes) == 1
+    mode = fit.plant.modes[0]
+    assert mode.damping == pytest.approx(1e-5)
+    assert mode.r1 == pytest.approx(17.5 / (22.5 * 5.0), rel=1e-3)
+    assert fit.warnings == [LIGHT]
+
+
+def test_a_mode_of_negative_residue_is_still_no_passive_stage_s():
+    """A second mode with r1 < 0 (a collocated response no passive stage has) keeps its
+    warning; the stage's mode beside it, resolved (damping 0.3 %), has none."""
+    stage = ModalPlant(22.5, (Mode(694.26, 0.003, 17.5 / (22.5 * 5.0), 1 / 22.5),
+                              Mode(1500.0, 0.02, -0.05, 0.01)))
+    fit = fit_frf(LINES, *measure(stage, seed=0))
+    assert [round(m.frequency_hz) for m in fit.plant.modes] == [694, 1500]
+    assert fit.warnings == ["measured plant: mode 2 at 1500 Hz (r1 = -0.04999 1/kg < 0): not a "
+                            "mode of a passive stage (positive collocated residue, resonant); "
+                            "the fit uses it for something the model lacks"]

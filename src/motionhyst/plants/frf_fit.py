@@ -812,7 +812,9 @@ def _diagnose(fit: FrfFit) -> list[str]:
     - ``Pf2(0)`` not determined: its standard deviation above
       :data:`PF2_RELATIVE_STD` of it (the modes lie beyond the measured lines);
     - modes a passive stage does not have: a negative collocated residue
-      ``r1`` (by more than 3 standard deviations) or a damping ratio at its bound;
+      ``r1`` (by more than 3 standard deviations) or a damping ratio at its bound, but for
+      a mode with a positive ``r1`` at the lower bound: a stage's mode lighter than the
+      lines resolve, its damping not an estimate;
     - a rigid-body mass outside :data:`PLAUSIBLE_MASS_KG` (a unit slip: kHz for Hz);
     - errors far above the noise: in a decade band, the RMS of the complex
       relative error more than :data:`RESIDUAL_NOISE_RATIO` times its
@@ -840,15 +842,22 @@ def _diagnose(fit: FrfFit) -> list[str]:
         out.append(f"measured plant: Pf2(0) = {_pm(p.pf2_static, fit.pf2_static_std)} m/N is not "
                    f"determined to {PF2_RELATIVE_STD:.0%} by the data, nor is |E| at low "
                    f"frequencies (eq. 20 divides by it); measure up to and beyond the first mode")
-    odd = []
+    odd, light = [], []
     for i, (m, s) in enumerate(zip(p.modes, fit.mode_std, strict=True), start=1):
         why = []
         if m.r1 < -3 * s["r1"]:
             why.append(f"r1 = {_num(m.r1)} 1/kg < 0")
-        if damping_at_bound(m.damping):
+        if (m.damping <= DAMPING_BOUNDS[0] * 1.001 and m.r1 > 0 and not why
+                and m not in low):  # a stage's mode, its width unresolved
+            light.append(f"mode {i} at {_num(m.frequency_hz)} Hz")
+        elif damping_at_bound(m.damping):
             why.append(f"damping at its bound {_num(m.damping)}")
         if why and m not in low:  # those are in the warning above
             odd.append(f"mode {i} at {_num(m.frequency_hz)} Hz ({', '.join(why)})")
+    if light:
+        out.append(f"measured plant: {'; '.join(light)}: lighter than the lines resolve (its "
+                   f"peak falls between them): the damping ratio {_num(DAMPING_BOUNDS[0])} is "
+                   f"the fit's lower bound, not an estimate; lines closer to it resolve it")
     if odd:
         out.append(f"measured plant: {'; '.join(odd)}: not a mode of a passive stage (positive "
                    f"collocated residue, resonant); the fit uses it for something the model "
