@@ -208,3 +208,37 @@ def test_the_budget_beyond_the_machine_is_warned_of_before_a_kill(tmp_path):
         r"[kMGT]B of memory this machine has: a computation that large would be killed by the "
         r"system, not refused", lines[0]), lines
     assert list(tmp_path.iterdir()) == []
+
+
+def _mm_hysteresis_record(path: Path) -> None:
+    """A force-displacement record in mm (a 178 'm' stroke: warned of) of a Jenkins element
+    (k 1 N/'m', fc 50 N): a link the fit finds."""
+    t = np.arange(4000) / 1000.0
+    x = 200.0 * np.sin(2 * np.pi * t) + 50.0 * np.sin(6 * np.pi * t)
+    w, force = np.zeros_like(x), 0.0
+    for i in range(1, x.size):
+        force = min(max(force + (x[i] - x[i - 1]), -50.0), 50.0)
+        w[i] = force
+    w += 0.01 * np.random.default_rng(0).standard_normal(t.size)
+    np.savetxt(path, np.column_stack([t, x, w]), delimiter=",",
+               header="time,displacement,force", comments="", fmt="%.9g")
+
+
+def test_the_warnings_held_come_before_a_first_compilation_s_notice(tmp_path):
+    """identify on a cold cache (review B17 L1): the record's unit warning, held while its
+    checks run, came after the compilation the checks start (main: the notice, then seconds
+    to minutes of compiling, then the warning); now the warning, then the notice.  Run as the
+    console script runs, the notice not left out, with a cache folder of its own."""
+    import sys
+
+    populate(tmp_path, {"r.csv": _mm_hysteresis_record})
+    proc = subprocess.run([sys.executable, "-m", "motionhyst.cli", "identify", "r.csv"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=900,
+                          env=limited_process.environment(NUMBA_CACHE_DIR=str(tmp_path / "c")))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("Maxwell-slip hysteresis identified from r.csv")
+    assert proc.stderr.splitlines() == [
+        "motionhyst: warning: identify: r.csv: displacement reaches 178 m, beyond the 100 m of "
+        "a motion stage's stroke: if the positions are not in metres, scale them (--scale "
+        "displacement=0.001 for mm, 1e-6 for um)",
+        "motionhyst: compiling numerical kernels on first use (cached for later runs) ..."]

@@ -493,10 +493,15 @@ def warnings_on_stderr(command: str, held: HeldWarnings | None = None) -> Iterat
     ...     except ValueError:
     ...         held.drop()                                # its one line is all it says
     """
+    from motionhyst.core.compiled import before_notice
     from motionhyst.core.warnings import MotionhystWarning
 
     held = HeldWarnings() if held is None else held
     _RUNNING.append(held)
+    # a first compilation's notice (seconds to minutes of work among the checks) comes
+    # after the warnings held so far, in this process (a forked worker holds none)
+    pid = os.getpid()
+    hook = before_notice(lambda: held.release() if os.getpid() == pid else None)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("always", MotionhystWarning)
@@ -516,6 +521,7 @@ def warnings_on_stderr(command: str, held: HeldWarnings | None = None) -> Iterat
             yield
     finally:
         _RUNNING.remove(held)
+        before_notice(hook)
     held.release()
 
 

@@ -19,7 +19,9 @@ Jenkins element) does not import numba.  At the first call, once per process:
   :data:`KEEP_RECENT` most recently used, are removed (:func:`prune_caches`),
   so that they do not pile up, one per edit or upgrade;
 * the first compilation announces itself with one line on stderr (it takes
-  seconds; later runs load the cache).
+  seconds; later runs load the cache); what a command held back to that moment (its
+  warnings, while it checks its input) is shown just before (:func:`before_notice`), not
+  after the compilation.
 
 Kernels calling other kernels work as in numba: a kernel passes for its numba
 dispatcher inside compiled code.  A kernel declared with a signature
@@ -47,7 +49,8 @@ from typing import Any
 from motionhyst.core.interrupts import DEFERRED, raise_deferred
 
 _LOCK = threading.RLock()
-_STATE: dict[str, Any] = {"cache": None, "announced": False, "numba": None}
+_STATE: dict[str, Any] = {"cache": None, "announced": False, "numba": None,
+                          "before_notice": None}
 _PACKAGE = __name__.partition(".")[0]
 
 
@@ -288,6 +291,9 @@ def _announce(dispatcher) -> None:
     if not module.startswith(_PACKAGE + "."):
         return
     _STATE["announced"] = True
+    hook = _STATE.get("before_notice")
+    if hook is not None:
+        hook()
     where = ("cached for later runs" if _STATE["cache"]
              else "no writable cache folder: compiled for this run only")
     print(f"motionhyst: compiling numerical kernels on first use ({where}) ...",
@@ -461,6 +467,36 @@ def njit(func: Callable | str | None = None, **options
     return Kernel(func, options)
 
 
+def before_notice(hook: Callable[[], None] | None) -> Callable[[], None] | None:
+    """Call `hook` just before the notice of the first compilation is printed (None: call
+    nothing); the hook it replaces is returned.
+
+    A command holds its warnings while it checks its input; a compilation on a cold cache
+    among its checks takes seconds to minutes, which the user spends reading its notice:
+    the warnings held so far are shown before it, not after.  A notice left out
+    (:func:`quiet_compilation`) calls nothing.
+
+    Parameters
+    ----------
+    hook : callable or None
+        Called without arguments.
+
+    Returns
+    -------
+    callable or None
+        The hook set before.
+
+    Examples
+    --------
+    >>> previous = before_notice(lambda: print("held lines"))
+    >>> before_notice(previous) is not None
+    True
+    """
+    replaced = _STATE.get("before_notice")
+    _STATE["before_notice"] = hook
+    return replaced
+
+
 def quiet_compilation(quiet: bool = True) -> None:
     """Leave out (or restore) the one-line notice of the first compilation.
 
@@ -491,5 +527,5 @@ def compiled_in_memory() -> bool | None:
     return None if c is None else not c
 
 
-__all__ = ["BUSY_SECONDS", "KEEP_RECENT", "PRUNE_SECONDS", "Kernel", "compiled_in_memory",
-           "njit", "prune_caches", "quiet_compilation"]
+__all__ = ["BUSY_SECONDS", "KEEP_RECENT", "PRUNE_SECONDS", "Kernel", "before_notice",
+           "compiled_in_memory", "njit", "prune_caches", "quiet_compilation"]
