@@ -152,3 +152,35 @@ def test_a_signal_during_a_sampled_time_series_is_exit_130_the_old_file_intact(t
     assert err.decode() == "motionhyst: interrupted\n" and out == b""
     assert snapshot(tmp_path) == before
 
+
+
+@pytest.mark.parametrize("link", ["maxwell-slip", "lugre"])
+def test_a_link_s_force_record_in_calls_of_bounded_work_is_one_call_s(monkeypatch, link):
+    """The link's force from a displacement record (predict's quasi-static runs, a loop's
+    hysteresis feedforward) in calls of open_loop_chunk of at most CALL_ELEMENT_STEPS element
+    steps (main: one call for the whole record, 17 s for 2e6 samples through 50 elements):
+    the numbers of one call bit for bit, rate-dependent elements' first step included."""
+    from motionhyst.hysteresis import LuGre, MaxwellSlip, stepping
+    from motionhyst.plants import QuasiStatic
+    from motionhyst.time import quasi_static
+
+    model = (MaxwellSlip(k=[100.0] * 5, fc=[0.1, 0.2, 0.3, 0.4, 0.5]) if link == "maxwell-slip"
+             else LuGre(sigma0=1e5, sigma1=300.0, sigma2=5.0, fc=1.0, fs=1.5, vs=0.01))
+    t = np.arange(20_000) * 1e-4
+    x = 0.01 * np.sin(2 * np.pi * 5 * t) + 0.002 * np.sin(2 * np.pi * 37 * t)
+    calls: list[int] = []
+    kernel = quasi_static.open_loop_calls.__globals__["open_loop_chunk"]
+
+    def counted(*args):
+        calls.append(args[5].size)
+        return kernel(*args)
+
+    monkeypatch.setattr(stepping, "open_loop_chunk", counted)
+    monkeypatch.setattr(stepping, "CALL_ELEMENT_STEPS", 10**12)
+    whole = quasi_static.force_from_displacement(QuasiStatic(k=1e3), model, t, x)
+    assert calls == [t.size]
+    monkeypatch.setattr(stepping, "CALL_ELEMENT_STEPS", 1_000)
+    cut = quasi_static.force_from_displacement(QuasiStatic(k=1e3), model, t, x)
+    m = len(model.time_stepping().codes)
+    assert len(calls) > 10 and max(calls[1:]) == max(1, 1_000 // m)
+    assert np.array_equal(whole, cut)

@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis.base import Hysteresis
-from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
+from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_calls
 
 __all__ = ["FIXED_IN_OPEN_LOOP", "MAX_PERIODS", "NO_DESCRIBING_FUNCTION", "PERIODIC_RTOL",
            "STALL_PERIODS", "STEPS_PER_INTERVAL", "AlongStroke"]
@@ -333,8 +333,8 @@ class AlongStroke(Hysteresis):
             for a, b in self.pieces(x):
                 piece = x[a:b]
                 params = np.ascontiguousarray(self.stepping_params(float(np.mean(piece))))
-                out[a:b] = open_loop_chunk(st.codes, params, s, s_prev, scalars,
-                                           np.ascontiguousarray(piece), h, i0 + a, GL_T, GL_W)
+                out[a:b] = open_loop_calls(st.codes, params, s, s_prev, scalars, piece, h,
+                                           i0 + a, GL_T, GL_W)
             return out
 
         return run

@@ -33,9 +33,10 @@ from motionhyst.core.compiled import njit
 from motionhyst.hysteresis._lugre_kernels import lugre_relax
 from motionhyst.hysteresis._ode_kernels import GL_T, GL_W, bouc_wen_step, dahl_advance
 
-__all__ = ["BOUC_WEN", "COULOMB", "DAHL", "DIFFERENTIATED", "GL_T", "GL_W", "LUGRE", "MAXWELL",
-           "N_PARAMS", "N_PARTIALS", "STOP", "VISCOUS", "Stepping", "advance", "advance_partials",
-           "backward_weights", "coulomb_implicit", "open_loop", "open_loop_chunk"]
+__all__ = ["BOUC_WEN", "CALL_ELEMENT_STEPS", "COULOMB", "DAHL", "DIFFERENTIATED", "GL_T", "GL_W",
+           "LUGRE", "MAXWELL", "N_PARAMS", "N_PARTIALS", "STOP", "VISCOUS", "Stepping", "advance",
+           "advance_partials", "backward_weights", "coulomb_implicit", "open_loop",
+           "open_loop_calls", "open_loop_chunk"]
 
 STOP, DAHL, BOUC_WEN, LUGRE, MAXWELL, COULOMB, VISCOUS = 0, 1, 2, 3, 4, 5, 6
 N_PARAMS = 6
@@ -559,6 +560,49 @@ def open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt,
     return w
 
 
+CALL_ELEMENT_STEPS = 300_000
+"""Samples times elements of one call of :func:`open_loop_chunk` from :func:`open_loop_calls`
+(0.03-0.2 s, by the elements' kinds and the machine's load): a signal (Ctrl-C, SIGTERM) is
+taken between two calls, never inside one (a record of 2e6 samples through 50 elements held
+one call for 17 s)."""
+
+
+def open_loop_calls(codes, params, s, s_prev, scalars, x, h, i0, glt, glw):
+    """:func:`open_loop_chunk` in calls of at most :data:`CALL_ELEMENT_STEPS` element steps,
+    the state carried from one to the next: the same numbers as one call.
+
+    Parameters
+    ----------
+    codes, params, s, s_prev, scalars, x, h, i0, glt, glw
+        As :func:`open_loop_chunk` (`s`, `s_prev`, `scalars` updated in place).
+
+    Returns
+    -------
+    ndarray
+        The link force at the samples `x` [N].
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import Jenkins
+    >>> st = Jenkins(k=1e4, fc=5.0).time_stepping()
+    >>> x = 0.002 * np.sin(np.linspace(0.0, 20.0, 3001))
+    >>> s = np.array(st.state0, dtype=float)
+    >>> w = open_loop_calls(st.codes, st.params, s, s.copy(), np.zeros(2), x, 1e-3, 0, GL_T,
+    ...                     GL_W)
+    >>> bool(np.array_equal(w, open_loop(st.codes, st.params, st.state0, x, 1e-3, GL_T, GL_W)))
+    True
+    """
+    x = np.ascontiguousarray(x, dtype=float)
+    step = max(1, CALL_ELEMENT_STEPS // max(int(codes.shape[0]), 1))
+    if x.size <= step:
+        return open_loop_chunk(codes, params, s, s_prev, scalars, x, h, i0, glt, glw)
+    out = np.empty(x.size)
+    for a in range(0, x.size, step):
+        out[a:a + step] = open_loop_chunk(codes, params, s, s_prev, scalars, x[a:a + step], h,
+                                          i0 + a, glt, glw)
+    return out
+
+
 def open_loop(codes, params, s0, x, h, glt, glw):
     """Force of the elements for the displacement samples `x` (step `h`), from rest at ``x[0]``.
 
@@ -589,6 +633,5 @@ def open_loop(codes, params, s0, x, h, glt, glw):
     True
     """
     s = np.array(s0, dtype=float)
-    return open_loop_chunk(codes, params, s, s.copy(), np.zeros(2),
-                           np.ascontiguousarray(x, dtype=float), h, 0, glt, glw)
+    return open_loop_calls(codes, params, s, s.copy(), np.zeros(2), x, h, 0, glt, glw)
 

@@ -61,7 +61,7 @@ from motionhyst.hysteresis.stepping import (
     GL_W,
     Stepping,
     advance,
-    open_loop_chunk,
+    open_loop_calls,
 )
 from motionhyst.time.periodic_runs import periodic_output
 from motionhyst.time.resample import check_record, sampling_rate
@@ -393,7 +393,7 @@ def force_from_displacement(plant, link: Hysteresis | None, t: ArrayLike,
 
     def run() -> NDArray[np.float64]:
         x_prev, dx_prev = scalars[0], scalars[1]
-        w = open_loop_chunk(st.codes, st.params, s, s_prev, scalars, xs, h, done[0], GL_T,
+        w = open_loop_calls(st.codes, st.params, s, s_prev, scalars, xs, h, done[0], GL_T,
                             GL_W)
         dx = np.diff(xs, prepend=x_prev)
         dx_before = np.concatenate([[dx_prev], dx[:-1]])

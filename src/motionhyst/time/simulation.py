@@ -35,7 +35,7 @@ from motionhyst.core.lti import (
 )
 from motionhyst.hysteresis import Hysteresis
 from motionhyst.hysteresis.along_stroke import AlongStroke
-from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_chunk
+from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_calls
 from motionhyst.time.engine import FohStep, LoopState, run_steps
 from motionhyst.time.kernel import CLOSED, MAX_FIXED_POINT_ITERATIONS, StepNotConverged
 from motionhyst.time.sampled import simulate_sampled
@@ -397,8 +397,8 @@ class _Engine:
         elif hff.rate_independent:
             uh = self._rate_independent_feedforward(r)
         else:  # as the link in the loop: force with the velocity at the sample
-            uh = open_loop_chunk(self.hff_codes, self.hff_params, self.hff_s,
-                                  self.hff_s_prev, self.hff_scalars, r, step, i0, GL_T, GL_W)
+            uh = open_loop_calls(self.hff_codes, self.hff_params, self.hff_s,
+                                 self.hff_s_prev, self.hff_scalars, r, step, i0, GL_T, GL_W)
         if self.force is not None:
             uf = np.asarray(self.force(t), dtype=float)
             if uf.shape != t.shape or not np.all(np.isfinite(uf)):
