@@ -45,7 +45,13 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis._fixed_point import Passes, chord, not_converged, viscous_damping
+from motionhyst.analysis._fixed_point import (
+    Mixing,
+    Passes,
+    chord,
+    not_converged,
+    viscous_damping,
+)
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
@@ -388,6 +394,7 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
         # a damping at every amplitude is solved with the linear loop, the rest iterated
         linear = chord(G_1, frequency_hz, viscous_damping(hyst))
         passes = Passes(frequency_hz, hyst, solved=linear is not None)
+        mixing = Mixing()
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(X, H, omega)
             if linear is None:
@@ -399,12 +406,13 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
             change = float(np.max(np.abs(W_new - W)))
             residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
             passes.step(T.w_e * (W_new - W), e_lin + T.w_e * (W_new - U_h))
-            W, X = W_new, X_new
+            W, X, X_in = W_new, X_new, X
             # error of a contraction with observed rate rho is about residual * rho / (1 - rho)
             rho = residual / previous if it > 2 and previous > 0 else 1.0
             previous = residual
             if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
                 break
+            X = mixing.next(X_in, X_new)
         else:
             raise not_converged(frequency_hz, max_iter, residual)
         passes.judge(e_lin + T.w_e * (W - U_h))
@@ -751,6 +759,8 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
     if hyst is not None:
         previous = np.inf
         passes = Passes(frequency_hz, hyst, solved=bool(np.any(L != 0)))
+        mixing = Mixing()
+        W_in = W
         for it in range(1, max_iter + 1):
             W_new = hyst.periodic_harmonics(Y1[H:], H, omega)
             if np.any(L != 0):
@@ -765,6 +775,10 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
             previous = residual
             if it > 1 and (change == 0.0 or (rho < 0.5 and residual * rho / (1 - rho) <= tol)):
                 break
+            W_next = mixing.next(W_in, W)
+            if W_next is not W:  # a mixed pass: the link moves as the mixture's force says
+                Y1 = respond(W_next)[0]
+            W_in = W_next
         else:
             raise not_converged(frequency_hz, max_iter, residual)
         passes.judge(E[H:])
