@@ -90,16 +90,18 @@ def viscous_damping(link) -> float:
     return 0.0
 
 
-def _damping_words(link, solved: bool) -> str:
-    """The link's damping keys and values that the iteration feeds back, for a refusal (empty
-    for a link without any; its :func:`viscous_damping` left out where it is `solved` with
-    the loop)."""
+def _damping_words(link, solved: bool, omega: float = np.inf) -> str:
+    """The link's damping keys and values that the iteration feeds back at the angular
+    frequency `omega` [rad/s], for a refusal (empty for a link without any; its
+    :func:`viscous_damping` left out where it is `solved` with the loop; LuGre's bristle
+    damping only where ``omega sigma1`` exceeds the bristles' stiffness ``sigma0``: below, the
+    stiffness is what the loop amplifies)."""
     name = type(link).__name__
     words = []
     if name == "LuGre":
         if link.sigma2 and not solved:
             words.append(f"viscous friction sigma2 = {link.sigma2:.4g} N s/m")
-        if link.sigma1:
+        if link.sigma1 and omega * link.sigma1 >= link.sigma0:
             words.append(f"bristle damping sigma1 = {link.sigma1:.4g} N s/m (while it sticks)")
     elif name == "Coulomb" and (link.c_pos or link.c_neg) and not solved:
         words.append(f"viscous friction c_pos = {link.c_pos:.4g}, c_neg = {link.c_neg:.4g} "
@@ -177,7 +179,7 @@ class Passes:
         (:class:`NoFixedPoint`: a caller can tell whether the loop hunts, which mixed passes
         of such a loop show as a change that grows or stalls too)."""
         n = int(np.nanargmax(np.abs(dE))) if np.any(np.isfinite(dE)) else 0
-        words = _damping_words(self.link, self.solved)
+        words = _damping_words(self.link, self.solved, TWO_PI * n * self.frequency_hz)
         which = "damping" if words else "stiffness"
         raise NoFixedPoint(
             f"steady state at {self.frequency_hz:g} Hz: the fixed point {what} at harmonic "
