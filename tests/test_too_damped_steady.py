@@ -312,18 +312,22 @@ def test_a_refusal_names_the_bristle_damping_only_where_it_outweighs_their_stiff
     """At harmonic ``n`` LuGre's bristles feed back ``sigma0 + j n w sigma1``: the refusal
     names sigma1 where ``n w sigma1 >= sigma0`` (Table I's link, sigma1 = 1e5, at 675 Hz:
     4.2e8 against 20), else the link's stiffness (examples/hunting.toml's link, sigma0 = 1e5,
-    sigma1 = 316, at 0.1 Hz: 199 against 1e5; its mixed passes, fs = fc, grow there)."""
-    from motionhyst.analysis._fixed_point import Passes
+    sigma1 = 316, at 0.1 Hz: 199 against 1e5; its mixed passes, fs = fc, grow there).  The
+    latter is a NoFixedPoint, which the commands check for a loop that hunts; the former is
+    not (no hunting check's cost before a refusal the damping explains)."""
+    from motionhyst.analysis._fixed_point import NoFixedPoint, Passes
 
     dE = np.zeros(200, dtype=complex)
     dE[135] = 1e-6
     with pytest.raises(RuntimeError, match=r"at harmonic 135 \(675 Hz\) after 7 passes: the "
-                                           r"link's bristle damping sigma1 = 1e\+05 N s/m"):
+                                           r"link's bristle damping sigma1 = 1e\+05 N s/m") as err:
         Passes(5.0, _lugre(1e5, 0.0)).refuse("diverges", dE, 7)
+    assert not isinstance(err.value, NoFixedPoint)
     stiff = LuGre(sigma0=1e5, sigma1=316.22776601683796, sigma2=0.4, fc=1.0, fs=1.0, vs=0.001)
     dE = np.zeros(40, dtype=complex)
     dE[1] = 1e-3
     with pytest.raises(RuntimeError, match=r"at harmonic 1 \(0.1 Hz\) after 16 passes: the "
                                            r"link's stiffness, fed back .* lower the link's "
-                                           r"stiffness$"):
+                                           r"stiffness$") as err:
         Passes(0.1, stiff, solved=True).refuse("diverges", dE, 16)
+    assert isinstance(err.value, NoFixedPoint) and err.value.frequency_hz == 0.1

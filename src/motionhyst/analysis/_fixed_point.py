@@ -133,7 +133,7 @@ class Passes:
 
     def step(self, dE: NDArray[np.complex128], E: NDArray[np.complex128]) -> None:
         """Record a pass's change `dE` of the error's harmonics ``0 .. H`` (`E` after it);
-        raise :class:`NoFixedPoint` once it has grown :data:`GROWING_PASSES` passes in a row
+        raise RuntimeError (:meth:`refuse`) once it has grown :data:`GROWING_PASSES` passes in a row
         above :data:`FULL_RESIDUAL` of the error's RMS, or :data:`GROWING_PASSES_LARGE` passes
         above :data:`LARGE_CHANGE` of it, or stalled :data:`STALLED_PASSES` passes above
         :data:`LARGE_CHANGE` of it."""
@@ -175,18 +175,21 @@ class Passes:
                         len(self.sizes) if passes is None else passes)
 
     def refuse(self, what: str, dE: NDArray[np.complex128], passes: int) -> None:
-        """Raise the refusal: `what` the iteration did, at the harmonic where `dE` is largest
-        (:class:`NoFixedPoint`: a caller can tell whether the loop hunts, which mixed passes
-        of such a loop show as a change that grows or stalls too)."""
+        """Raise the refusal: `what` the iteration did, at the harmonic where `dE` is largest;
+        where no damping of the link explains it there, a :class:`NoFixedPoint`, whose caller
+        can tell whether the loop hunts (mixed passes of such a loop grow or stall too)."""
         n = int(np.nanargmax(np.abs(dE))) if np.any(np.isfinite(dE)) else 0
         words = _damping_words(self.link, self.solved, TWO_PI * n * self.frequency_hz)
         which = "damping" if words else "stiffness"
-        raise NoFixedPoint(
+        message = (
             f"steady state at {self.frequency_hz:g} Hz: the fixed point {what} at harmonic "
             f"{n} ({n * self.frequency_hz:.4g} Hz) after {passes} passes: the link's "
             f"{words or 'stiffness'}, fed back through the loop, amplifies each pass there; "
             f"no answer is given: run the loop in time (motionhyst simulate --time-series) or "
-            f"lower the link's {which}", self.frequency_hz)
+            f"lower the link's {which}")
+        if words:
+            raise RuntimeError(message)
+        raise NoFixedPoint(message, self.frequency_hz)
 
 
 def _rms(E: NDArray[np.complex128]) -> float:
