@@ -13,9 +13,10 @@ few iterations, and ``e`` (about 1e-8 m against positions of 1e-2 m) is never
 formed by subtracting positions.  A link's force linear in its velocity at every
 amplitude (LuGre's ``sigma2``) is solved with the loop, ``y1 = (y1_lin + T_{w->y1} (w(y1) -
 L y1)) / (1 - T_{w->y1} L)`` with ``L = j n w c`` (a sampled loop: per alias class), where
-the iteration would multiply a change by ``|T_{w->y1} L|`` each pass; every pass is judged
-at every harmonic (:mod:`motionhyst.analysis._fixed_point`): no answer where it did not
-converge.
+the iteration would multiply a change by ``|T_{w->y1} L|`` each pass; passes that contract
+slowly or grow at a few harmonics (LuGre's ``sigma1``, which acts while the link sticks) are
+mixed with the ones before (Anderson acceleration), and every pass is judged at every
+harmonic (:mod:`motionhyst.analysis._fixed_point`): no answer where it did not converge.
 
 Complex amplitudes are reported relative to ``sin(n omega t)``:
 a signal is ``c_0 + sum_n |c_n| sin(n omega t + angle c_n)``.
