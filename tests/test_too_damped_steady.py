@@ -303,9 +303,10 @@ def test_a_loop_that_hunts_is_said_to_hunt(tmp_path):
     assert len(errors) == 1 and "Traceback" not in out["err"], out["err"]
     assert errors[0] == (
         "motionhyst: error: steady state at 0.1 Hz: the loop hunts: it has a stable "
-        "self-excited limit cycle of period 24.44 s (its exact orbit; motionhyst stability "
-        "shows it), so no periodic steady state of the reference's 10 s period; run it in "
-        "time (motionhyst simulate --time-series)"), errors
+        "self-excited limit cycle of period 24.44 s (a run from rest settles on it; motionhyst "
+        "stability shows its exact orbit), so no periodic steady state of the reference's 10 s "
+        "period; run it in time (motionhyst simulate --time-series, with [controller] "
+        "derivative_filter_hz: a pure derivative has no run)"), errors
 
 
 def test_a_refusal_names_the_bristle_damping_only_where_it_outweighs_their_stiffness():

@@ -63,11 +63,14 @@ SLOW = 0.5
 class NoFixedPoint(RuntimeError):
     """The fixed point did not converge in its passes at `frequency_hz` [Hz] (a link too
     stiff for the loop, or a loop with no steady state of the reference's period: one that
-    hunts); a caller that can tell which says so."""
+    hunts); a caller that can tell which says so.  `change` is the last pass's relative
+    change of the link force's first harmonic: a loop that hunts leaves it large (0.86 for
+    examples/hunting.toml at 0.1 Hz), above :data:`LARGE_CHANGE`."""
 
-    def __init__(self, message: str, frequency_hz: float) -> None:
+    def __init__(self, message: str, frequency_hz: float, change: float = np.inf) -> None:
         super().__init__(message)
         self.frequency_hz = float(frequency_hz)
+        self.change = float(change)
 
 
 def not_converged(frequency_hz: float, max_iter: int, residual: float) -> NoFixedPoint:
@@ -75,7 +78,7 @@ def not_converged(frequency_hz: float, max_iter: int, residual: float) -> NoFixe
     return NoFixedPoint(
         f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
         f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop",
-        frequency_hz)
+        frequency_hz, residual)
 
 
 def viscous_damping(link) -> float:

@@ -22,16 +22,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis._fixed_point import NoFixedPoint
 from motionhyst.analysis.floquet import (
     FloquetResult,
     check_floquet_budget,
     steady_state_floquet,
     unresolved_time_scales,
 )
+from motionhyst.analysis.hunting import steady_state_unless_hunting
 from motionhyst.analysis.plausibility import check_frequency_range, check_plausible
 from motionhyst.analysis.quasilinear import error_harmonics_df, loop_mismatch
-from motionhyst.analysis.steady import SteadyState, steady_state_sweep
+from motionhyst.analysis.steady import SteadyState
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.budget import BudgetError
 from motionhyst.core.textfmt import g, table
@@ -157,40 +157,10 @@ class DescribingFunctionComparison:
 
 
 def _steady_states(loop: Loop, amplitude: float, f: NDArray[np.float64]) -> list[SteadyState]:
-    """:func:`~motionhyst.analysis.steady.steady_state_sweep`; a fixed point that does not
-    converge because the loop hunts is refused saying so (:func:`_hunting`)."""
-    try:
-        return steady_state_sweep(loop, amplitude, f)
-    except NoFixedPoint as exc:
-        raise _hunting(loop, exc) from None
-
-
-def _hunting(loop: Loop, exc: NoFixedPoint) -> RuntimeError:
-    """The refusal of a steady state whose fixed point did not converge (`exc`): where the
-    loop has a stable limit cycle (:func:`~motionhyst.analysis.stability.stability` with its
-    setpoint held, the exact orbit where the loop allows, else the describing function's
-    prediction) it hunts, and has no steady state of the reference's period; else `exc`."""
-    from motionhyst.analysis.stability import stability
-
-    link = loop.hysteresis
-    if link is None or not loop.is_lti:
-        return exc
-    try:
-        res = stability(loop, exact=loop.sampled is None and link.n_states > 0, search=False)
-    except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError):
-        return exc
-    exact = [c.period_s for c in res.exact if c.stable]
-    predicted = [1.0 / p.frequency_hz for p in res.predicted if p.stable]
-    if not (exact or predicted):
-        return exc
-    period, how = ((exact[0], "its exact orbit") if exact
-                   else (predicted[0], "predicted by the describing function"))
-    f = exc.frequency_hz
-    return RuntimeError(
-        f"steady state at {f:g} Hz: the loop hunts: it has a stable self-excited limit cycle "
-        f"of period {period:.4g} s ({how}; motionhyst stability shows it), so no periodic "
-        f"steady state of the reference's {1 / f:.4g} s period; run it in time "
-        f"(motionhyst simulate --time-series)")
+    """The steady state at each frequency; a fixed point that does not converge because the
+    loop hunts is refused saying so
+    (:func:`~motionhyst.analysis.hunting.steady_state_unless_hunting`)."""
+    return [steady_state_unless_hunting(loop, amplitude, float(fi)) for fi in f]
 
 
 def compare_with_describing_function(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,

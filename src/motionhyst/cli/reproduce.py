@@ -23,7 +23,8 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.scenario import load_scenario
 
     # the loop is built (and checked) inside reproduce, while the first figures are drawn; the
-    # warnings held until then are shown once it is (checked), as the long work starts
+    # warnings held until then are shown once its steady states have answered (checked): a
+    # loop that hunts is refused in one line
     sc = load_scenario(args.scenario, check=False)
     refuse_along_stroke_for(sc, "reproduce")
     # no formula sizes the report's figures: its CPU time is bounded as a search's is, and a

@@ -49,10 +49,13 @@ def run(args: argparse.Namespace, notice: str = "") -> int:
         say_later(notice)
     check_frequency_range(loop, freqs)  # what the analysis refuses as it starts: before
     check_steady_frequencies(loop, freqs)  # the warnings held are shown
-    release_held()  # the work starts: the warnings so far are shown
+    # the steady states refuse a loop that hunts (or a link too stiff for it) once computed:
+    # the warnings stay held until they are, so that a refusal is its one line (they say
+    # what an answer means, which a refusal has not); an interruption shows them
     result = compare_with_describing_function(loop, amplitude, freqs,  # warns as it starts
                                               floquet=floquet)
     warn_plant_fit(sc)
+    release_held()  # the answer: the warnings so far are shown before it
     if args.json:
         print_json(result.to_dict())
         return 0

@@ -255,10 +255,12 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
     inputs : iterable of paths
         Files the command read (the scenario): never replaced.
     checked : callable, optional
-        Called once the loop is built and checked and its frequencies are known good
+        Called once the loop is built and checked, its frequencies are known good
         (:func:`~motionhyst.analysis.plausibility.check_frequency_range`,
-        :func:`~motionhyst.analysis.steady.check_steady_frequencies`), as the long work
-        starts (the command shows the warnings it held until then).
+        :func:`~motionhyst.analysis.steady.check_steady_frequencies`) and its steady states
+        have answered (a loop that hunts has none: refused in one line,
+        :func:`~motionhyst.analysis.hunting.steady_state_unless_hunting`); the command shows
+        the warnings it held until then.
 
     Returns
     -------
@@ -295,16 +297,15 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             # (python-control) and builds the loop; the later workers inherit both from this
             # process (python-control imports matplotlib)
             figures.submit(_link_figures(el, A, freqs))
+            from motionhyst.analysis.hunting import steady_state_unless_hunting
             from motionhyst.analysis.plausibility import check_frequency_range
             from motionhyst.analysis.quasilinear import analyze, error_harmonics_df, loop_mismatch
-            from motionhyst.analysis.steady import check_steady_frequencies, periodic_steady_state
+            from motionhyst.analysis.steady import check_steady_frequencies
 
             loop = sc.loop()
             check_frequency_range(loop, freqs)  # what the analyses refuse as they start
             if loop.plant.is_lti:  # raw measured lines have no steady state: none computed
                 check_steady_frequencies(loop, freqs)
-            if checked is not None:
-                checked()
             analysis = analyze(loop, A, freqs)
             steps.update()
             figures.submit({"fig9": lambda: _plots().fig9_quasilinear_plant(
@@ -319,7 +320,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             if raw_data:  # the steady state needs the plant at every harmonic: no exact results
                 states, E_df, H_df, exact = [], [], [], []
             else:
-                states = [periodic_steady_state(loop, A, f) for f in freqs]
+                states = [steady_state_unless_hunting(loop, A, f) for f in freqs]
                 E_df = loop_mismatch(loop, freqs, A)
                 H_df = [error_harmonics_df(loop, A, f, n_max=7) for f in freqs]
                 figures.submit({"fig11": lambda: _plots().fig11_errors(states, E_df, H_df)})
@@ -330,7 +331,11 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
                     rate = loop.sampled.sample_rate_hz
                     f_exact = rate / np.maximum(3, np.round(rate / f_exact))
                 f_exact = np.unique(np.concatenate([f_exact, freqs]))
-                exact = [periodic_steady_state(loop, A, f) for f in f_exact]
+                exact = [steady_state_unless_hunting(loop, A, f) for f in f_exact]
+            # the steady states have answered (a loop that hunts is refused in one line, the
+            # warnings held): the warnings are shown as the figures and the report follow
+            if checked is not None:
+                checked()
             digital = None
             if not raw_data and loop.sampled is None and loop.hysteresis is not None:
                 from motionhyst.analysis.digital import compare_digital

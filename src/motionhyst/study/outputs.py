@@ -58,11 +58,13 @@ class Point:
 
     @property
     def steady(self) -> SteadyState:
-        """The exact periodic steady state (eq. 18's exact counterpart), computed once."""
+        """The exact periodic steady state (eq. 18's exact counterpart), computed once; a loop
+        that hunts is refused saying so."""
         if self._steady is None:
-            from motionhyst.analysis.steady import periodic_steady_state
+            from motionhyst.analysis.hunting import steady_state_unless_hunting
 
-            self._steady = periodic_steady_state(self.loop, self.amplitude, self.frequency_hz)
+            self._steady = steady_state_unless_hunting(self.loop, self.amplitude,
+                                                       self.frequency_hz)
         return self._steady
 
 
