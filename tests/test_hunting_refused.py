@@ -156,3 +156,19 @@ def test_a_loop_close_to_hunting_keeps_its_steady_state():
     assert abs(E[3]) == pytest.approx(abs(ss.e[3]), rel=3e-3)
     d = ss.time_series(t.size)["e"] - e
     assert np.max(np.abs(d - d.mean())) < 1e-4 * np.max(np.abs(e))
+
+
+def test_the_run_in_time_the_refusal_advises_is_refused_in_one_line(tmp_path):
+    """The remedy's ``simulate --time-series``: the PID's pure derivative has no run in time.
+    Main printed the f* warning and the warning that 1 s holds no period of 0.1 Hz, then the
+    refusal (3 lines), once the run had started; now the refusal alone, before it."""
+    populate(tmp_path, {"hunting.toml": HUNTING})
+    before = snapshot(tmp_path)
+    out = probe(["simulate", "hunting.toml", "--time-series", "h.csv", "--duration", "1"],
+                tmp_path)
+    assert out["rc"] == 2, out
+    assert out["err"].splitlines() == [
+        "motionhyst: error: the controller is not proper (more zeros than poles: a PID's kd "
+        "without derivative_filter_hz): a time simulation needs [controller] "
+        "derivative_filter_hz, or sample_rate_hz to run it sampled"], out["err"]
+    assert snapshot(tmp_path) == before

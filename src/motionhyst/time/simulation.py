@@ -52,7 +52,7 @@ from motionhyst.time.steps import (
 )
 
 __all__ = ["RUN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "Simulation",
-           "check_run_work", "simulate", "simulate_chunks"]
+           "check_proper", "check_run_work", "simulate", "simulate_chunks"]
 
 
 
@@ -205,9 +205,31 @@ def simulate(loop: Loop, reference, duration: float, dt: float | None = None,
     return engine.run(t, 0, h_foh)
 
 
-def _check_proper(loop: Loop) -> None:
+def check_proper(loop: Loop) -> None:
     """Refuse a continuous controller with more zeros than poles (a PID's pure derivative):
-    its force has no realisation to run in time."""
+    its force has no realisation to run in time.
+
+    Parameters
+    ----------
+    loop : Loop
+        A loop with a continuous controller.
+
+    Raises
+    ------
+    ValueError
+        For a controller with more zeros than poles, naming the keys that give it a run.
+
+    Examples
+    --------
+    >>> import control
+    >>> from motionhyst import Loop
+    >>> from motionhyst.plants import MassDamper
+    >>> pid = control.tf([6.0, 3.0, 4.0], [1.0, 0.0])        # kd s + kp + ki / s
+    >>> check_proper(Loop(MassDamper(m=1.0, c=0.0), pid, feedforward=None))
+    Traceback (most recent call last):
+    ...
+    ValueError: the controller is not proper (more zeros than poles: a PID's kd without ...
+    """
     num, den = tf_poly(loop.controller, "controller")
     if len(np.trim_zeros(num, "f")) > len(np.trim_zeros(den, "f")):
         raise ValueError("the controller is not proper (more zeros than poles: a PID's kd "
@@ -342,7 +364,7 @@ class _Engine:
     def __init__(self, loop: Loop, reference, dt: float | None, force):
         if loop.feedforward != "rigid-body" and loop.feedforward is not None:
             raise ValueError("unknown feedforward")
-        _check_proper(loop)
+        check_proper(loop)
         self.loop = loop
         self.reference = reference
         self.force = force
