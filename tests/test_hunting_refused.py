@@ -172,3 +172,22 @@ def test_the_run_in_time_the_refusal_advises_is_refused_in_one_line(tmp_path):
         "without derivative_filter_hz): a time simulation needs [controller] "
         "derivative_filter_hz, or sample_rate_hz to run it sampled"], out["err"]
     assert snapshot(tmp_path) == before
+
+
+def test_without_a_cycle_or_a_run_the_fixed_points_refusal_stands(monkeypatch):
+    """Table I's Jenkins link has no smooth state equation: the describing function decides
+    (it predicts no cycle); a run that fails numerically finds none: the refusal is the fixed
+    point's own in both cases."""
+    from motionhyst.analysis import hunting
+    from motionhyst.analysis._fixed_point import not_converged
+
+    exc = not_converged(5.0, 50, 0.5)
+    paper = load_scenario(EXAMPLES / "paper.toml").loop()
+    assert hunting.hunting_refusal(paper, exc, 0.01) is exc
+
+    def fails(loop, offset):
+        raise RuntimeError("the run failed")
+
+    monkeypatch.setattr(hunting, "hunting_period", fails)
+    loop = load_scenario(EXAMPLES / "hunting.toml").loop()
+    assert hunting.hunting_refusal(loop, exc, 0.01) is exc

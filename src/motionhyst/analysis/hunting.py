@@ -246,11 +246,13 @@ def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeE
     link = loop.hysteresis
     if link is None or not loop.is_lti or not exc.change >= LARGE_CHANGE:
         return exc  # a fixed point that came near an answer: no cycle of its own took over
+    how = "a run from rest settles on it"
     try:
         period = hunting_period(loop, amplitude)
-        how = "a run from rest settles on it"
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+    except ValueError:  # no run of this loop: the describing function's prediction
         period, how = _predicted_period(loop), "predicted by the describing function"
+    except (RuntimeError, ArithmeticError, np.linalg.LinAlgError):
+        period = None  # a run that failed finds no cycle: the fixed point's own refusal
     if period is None:
         return exc
     f = exc.frequency_hz
