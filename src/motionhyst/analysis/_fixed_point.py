@@ -64,8 +64,9 @@ class NoFixedPoint(RuntimeError):
     """The fixed point did not converge in its passes at `frequency_hz` [Hz] (a link too
     stiff for the loop, or a loop with no steady state of the reference's period: one that
     hunts); a caller that can tell which says so.  `change` is the last pass's relative
-    change of the link force's first harmonic: a loop that hunts leaves it large (0.86 for
-    examples/hunting.toml at 0.1 Hz), above :data:`LARGE_CHANGE`."""
+    change of the link force's first harmonic after all passes (:func:`not_converged`; a loop
+    that hunts leaves it large, above :data:`LARGE_CHANGE`), unknown (inf) for passes refused
+    as they grow or stall (:meth:`Passes.refuse`)."""
 
     def __init__(self, message: str, frequency_hz: float, change: float = np.inf) -> None:
         super().__init__(message)

@@ -216,7 +216,7 @@ def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeE
     (:func:`hunting_period` from rest at `amplitude`; the describing function's prediction
     for a loop that cannot be run so) it says so, with the cycle's period; else `exc`, the
     link too stiff for the loop.  A fixed point that came within that of an answer is no
-    loop's own cycle (the hunting loop at 5 Hz: 0.007, its 10 mm reference keeps it sliding).
+    loop's own cycle.
 
     Parameters
     ----------
