@@ -253,3 +253,21 @@ def test_open_loop_api_refuses_a_link_along_the_stroke():
         OpenLoop(QuasiStatic(), link)
     with pytest.raises(ValueError, match=r"\[hysteresis\] along"):
         force_from_displacement(QuasiStatic(), link, np.arange(11) * 1e-3, np.linspace(0.0, A, 11))
+
+
+@pytest.mark.parametrize("amplitude", [1e-4, 1e-5])
+@pytest.mark.parametrize("name", ["dahl", "bouc-wen"])
+def test_a_small_stroke_s_periodic_force_is_the_base_link_s(name, amplitude):
+    """At 0.1 mm and 10 um about 2 mm on the table (unit scales) the periodic force is the
+    base link's own harmonics: a Dahl or Bouc-Wen link forgets its start from rest slowly
+    there (its change shrinks by a steady ratio a period, extrapolated to its limit) and
+    the change stops at the run's rounding (settled, not a drift)."""
+    from motionhyst.hysteresis.bouc_wen import BoucWen
+    from motionhyst.hysteresis.dahl import Dahl
+
+    base = Dahl(20.0, 0.05) if name == "dahl" else BoucWen(20.0, 0.05)
+    link = AlongStroke(base, [-0.01, 0.01], {"fc": [1.0, 1.0]})
+    X = np.zeros(6, dtype=complex)
+    X[0], X[1] = 0.002, amplitude / 2j
+    W, ref = link.periodic_harmonics(X, 5), base.periodic_harmonics(X, 5)
+    assert np.max(np.abs(W - ref)) <= 1e-9 * np.max(np.abs(ref))

@@ -29,19 +29,25 @@ from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_calls
 
-__all__ = ["FIXED_IN_OPEN_LOOP", "MAX_PERIODS", "NO_DESCRIBING_FUNCTION", "PERIODIC_RTOL",
-           "STALL_PERIODS", "STEPS_PER_INTERVAL", "AlongStroke"]
+__all__ = ["EXTRAPOLATED_RTOL", "FIXED_IN_OPEN_LOOP", "MAX_PERIODS", "NO_DESCRIBING_FUNCTION",
+           "PERIODIC_RTOL", "STALL_PERIODS", "STEPS_PER_INTERVAL", "AlongStroke"]
 
 #: Parameter updates of a time run per interval of the table (the parameters are held over
 #: the samples within one such step of the position).
 STEPS_PER_INTERVAL = 64
 #: A periodic force (:meth:`AlongStroke.periodic_harmonics`) repeats the previous period's to
-#: this fraction of its largest value ...
-PERIODIC_RTOL = 1e-14
+#: this fraction of its largest value (a period's run rounds its force to about 1e-14 of it) ...
+PERIODIC_RTOL = 1e-12
 #: ... within this many periods of the displacement, run from rest ...
-MAX_PERIODS = 200
+MAX_PERIODS = 2000
 #: ... and refused once its change has not shrunk for this many periods.
 STALL_PERIODS = 10
+#: A change that shrinks by a steady ratio ``q`` a period (a Dahl link at a small stroke
+#: forgets its start slowly) is extrapolated to its limit, ``w + (w - w_prev) q / (1 - q)``, once
+#: that step, ``|w - w_prev| q / (1 - q)``, is at most this fraction of the force (its error a
+#: tenth of it at most: the ratios agree to a tenth of ``1 - q``); a change that stops
+#: shrinking below it is the run's rounding, settled.
+EXTRAPOLATED_RTOL = 1e-6
 #: The refusal of an open-loop system's link along the stroke (its runs hold the parameters).
 FIXED_IN_OPEN_LOOP = ("an open-loop system (predict, identify) runs its link with fixed "
                       "parameters: a link along the stroke ([hysteresis] along) is run in a "
@@ -263,8 +269,9 @@ class AlongStroke(Hysteresis):
         Raises
         ------
         RuntimeError
-            If the force does not repeat within :data:`MAX_PERIODS` periods, or its change
-            has not shrunk for :data:`STALL_PERIODS` periods.
+            If the force does not repeat within :data:`MAX_PERIODS` periods (nor extrapolates
+            to its limit, :data:`EXTRAPOLATED_RTOL`), or its change has not shrunk for
+            :data:`STALL_PERIODS` periods.
 
         Examples
         --------
@@ -288,19 +295,31 @@ class AlongStroke(Hysteresis):
             h = 2.0 * np.pi / (check_omega(omega, self.base.name) * N)
         run = self._runner(float(x[0]), h)
         w = run(x, 0)
-        smallest, since = np.inf, 0
+        smallest, since, changes = np.inf, 0, []
         for p in range(1, MAX_PERIODS):
             prev, w = w, run(x, p * N)
             change = float(np.max(np.abs(w - prev)))
-            if change <= PERIODIC_RTOL * max(float(np.max(np.abs(w))), 1e-300):
+            scale = max(float(np.max(np.abs(w))), 1e-300)
+            if change <= PERIODIC_RTOL * scale:
                 return (np.fft.rfft(w) / N)[: H + 1]
+            changes.append(change)
             smallest, since = (change, 0) if change < smallest else (smallest, since + 1)
             if since >= STALL_PERIODS:
-                break
-        raise RuntimeError(f"the {self.base.name} link along the stroke ([hysteresis] along) "
-                           f"has no periodic force: its change from period to period "
-                           f"({change:.2g} N) does not shrink (a spring that never slips, "
-                           "scaled along the stroke, drifts); run it in time (simulate)")
+                if smallest <= EXTRAPOLATED_RTOL * scale:  # at the run's rounding, settled
+                    return (np.fft.rfft(w) / N)[: H + 1]
+                raise RuntimeError(
+                    f"the {self.base.name} link along the stroke ([hysteresis] along) has no "
+                    f"periodic force: its change from period to period ({change:.2g} N) does "
+                    "not shrink (a spring that never slips, scaled along the stroke, drifts); "
+                    "run it in time (simulate --time-series)")
+            if len(changes) > 2 * STALL_PERIODS:
+                rest = _geometric_rest(changes[-STALL_PERIODS - 1:])
+                if change * rest <= EXTRAPOLATED_RTOL * scale:
+                    return (np.fft.rfft(w + (w - prev) * rest) / N)[: H + 1]
+        raise RuntimeError(
+            f"the {self.base.name} link along the stroke ([hysteresis] along) settles too "
+            f"slowly: after {MAX_PERIODS} periods its force still changes by {change:.2g} N "
+            "a period; run it in time (simulate --time-series)")
 
     def _step(self, x: NDArray[np.float64], t: ArrayLike | None) -> float:
         """The uniform step of the sample times `t` (0 for a rate-independent base, whose
@@ -344,6 +363,20 @@ class AlongStroke(Hysteresis):
         return {**self.base.to_dict(), "along": {"position": self.position.tolist(),
                                                  **{k: v.tolist() for k, v in
                                                     self.scales.items()}}}
+
+
+def _geometric_rest(changes: list[float]) -> float:
+    """``q / (1 - q)`` of changes that shrink by a steady ratio ``q`` a period (the sum of all
+    later changes over the last), or infinity when they do not (a ratio of 1 or more, or
+    ratios that vary by more than a tenth of ``1 - q``)."""
+    c = np.asarray(changes, dtype=float)
+    ratios = c[1:] / c[:-1]
+    if not np.all((ratios > 0.0) & (ratios < 1.0)):
+        return np.inf
+    q = float(np.exp(np.mean(np.log(ratios))))
+    if np.ptp(ratios) > 0.1 * (1.0 - q):
+        return np.inf
+    return q / (1.0 - q)
 
 
 @lru_cache(maxsize=4096)
