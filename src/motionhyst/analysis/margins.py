@@ -27,8 +27,8 @@ For LTI systems ``L`` is scanned on a dense logarithmic grid, made denser
 around every lightly damped pole and zero of ``C`` and ``P2`` (a resonance
 narrower than the grid's spacing, such as the stage's 694 Hz mode with a
 damping ratio of 0.0027, would otherwise fall between two points), and each
-crossing and each local minimum of ``|1 + L|`` is refined by root finding, so
-a margin is found wherever the grid brackets it.  For measured data only the
+crossing and the lowest local minima of ``|1 + L|`` are refined by root finding,
+so a margin is found wherever the grid brackets it.  For measured data only the
 measured lines are evaluated: crossings are interpolated linearly in
 ``log f`` between the two lines that bracket them and the modulus margin is
 the smallest ``|1 + L|`` on the lines (an upper bound of the true one).
@@ -54,6 +54,8 @@ BANDWIDTH_DEFINITION = ("crossover frequency: the lowest frequency where |L| = |
                         "through 1 (0 dB)")
 #: Grid density of the scan of an LTI loop [points per decade].
 POINTS_PER_DECADE = 400
+#: The local minima of ``|1 + L|`` on the grid refined for the modulus margin, lowest first.
+REFINED_DIPS = 8
 #: Poles and zeros of damping ratio below this get points of their own.
 LIGHTLY_DAMPED = 0.1
 #: Those points lie either side of ``f_n`` at detunings from 0.01 to ``RESONANCE_SPAN`` damping
@@ -350,13 +352,14 @@ def loop_margins(controller, plant, zoh: ZohEquivalent | None = None) -> LoopMar
     falling = [x for i, x in zip(idx, fc, strict=True) if lm[i] > 0]
     bw = min(falling) if falling else math.nan
 
-    # modulus margin: min |1 + L|, each local minimum on the grid refined
+    # modulus margin: min |1 + L|, the lowest local minima on the grid refined (far above
+    # the loop's dips, where L is small, |1 + L| has minima of rounding by the hundred)
     d = np.abs(1.0 + L)
     i = int(np.argmin(d))
     mm, f_mm = float(d[i]), float(f[i])
     if not data:
         dips = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:])) + 1
-        for j in dips:
+        for j in dips[np.argsort(d[dips])][:REFINED_DIPS]:
             res = minimize_scalar(lambda x: abs(1.0 + loop_at(x)), bounds=(f[j - 1], f[j + 1]),
                                   method="bounded", options={"xatol": 1e-10 * f[j]})
             if res.fun < mm:
