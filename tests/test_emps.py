@@ -559,8 +559,9 @@ def test_every_default_model_finds_the_axis_on_the_raw_record():
     identifies it when it has the test record: a default model's mass within 3 % of the
     benchmark's 95.1 kg and its force offset, as the reference model's OF, within 0.6 N of
     -3.16 N, or a warning that says which misses and by how much.  Measured: Coulomb with
-    viscous friction by direction 93.47 kg, Jenkins 93.91 kg, in the band; the Coulomb link
-    with the offset drifting 92.05 kg, 3.2 % low (the drift in time takes part of the
+    viscous friction by direction 93.47 kg (92.98 kg on a machine with numpy 2.4.6 and scipy
+    1.17.1: its search ends elsewhere on a flat valley), Jenkins 93.91 kg, in the band; the
+    Coulomb link with the offset drifting 92.05 kg, 3.2 % low (the drift in time takes part of the
     inertia: 93.3 kg costs it 0.49 against 0.43 mm), said; every OF -3.15 to -3.21 N."""
     from motionhyst.identify.emps import MODELS
 
@@ -574,7 +575,7 @@ def test_every_default_model_finds_the_axis_on_the_raw_record():
         assert model.parameters["offset"] == pytest.approx(-3.16, abs=0.6), model.name
         assert not any("as OF" in w for w in model.warnings), model.name
     by_name = {m.name: m for m in res.models}
-    assert by_name["coulomb-asymmetric"].parameters["m"] == pytest.approx(93.5, abs=0.5)
+    assert by_name["coulomb-asymmetric"].parameters["m"] == pytest.approx(93.5, abs=0.6)
     assert by_name["jenkins-asymmetric"].parameters["m"] == pytest.approx(93.9, abs=0.5)
     drifting = by_name["coulomb-asymmetric-drift"]
     assert drifting.parameters["m"] == pytest.approx(92.05, abs=0.15)

@@ -130,7 +130,8 @@ def test_identify_on_its_cap_says_whether_it_had_settled(tmp_path, capsys, monke
     from motionhyst.identify.io_records import IORecord
 
     def no_step_tolerance(fun, x0, **kwargs):
-        return solve_within(fun, x0, **{**kwargs, "xtol": None, "gtol": None})
+        return solve_within(fun, x0, **{**kwargs, "xtol": None, "gtol": None,
+                                        "ftol": 1.01 * np.finfo(float).eps})
 
     monkeypatch.setattr(io_elements, "solve_within", no_step_tolerance)
     monkeypatch.setattr(input_output, "ELEMENT_NFEV", 5)
