@@ -108,10 +108,10 @@ def test_a_friction_link_the_records_do_not_determine_is_its_rigid_limit(monkeyp
 
     judged = input_output.judge_determined
 
-    def lugre_undetermined(estimates, std, invariant, zero, explained=frozenset()):
+    def lugre_undetermined(estimates, std, invariant, zero, explained=frozenset(), link=None):
         if "link.stribeck" in estimates:
             raise FitFailed("the fit failed: the records determine 2 of the model's 7 parameters")
-        return judged(estimates, std, invariant, zero, explained)
+        return judged(estimates, std, invariant, zero, explained, link)
 
     monkeypatch.setattr(input_output, "judge_determined", lugre_undetermined)
     rec = _axis_record(Coulomb(fc=TRUE["link.fc"]), n=1500)
@@ -136,10 +136,10 @@ def test_the_rigid_limit_keeps_the_viscous_friction_by_direction_warning(monkeyp
 
     judged = input_output.judge_determined
 
-    def jenkins_undetermined(estimates, std, invariant, zero, explained=frozenset()):
+    def jenkins_undetermined(estimates, std, invariant, zero, explained=frozenset(), link=None):
         if "link.k" in estimates:
             raise FitFailed("the fit failed: the records determine 1 of the model's 2 parameters")
-        return judged(estimates, std, invariant, zero, explained)
+        return judged(estimates, std, invariant, zero, explained, link)
 
     monkeypatch.setattr(input_output, "judge_determined", jenkins_undetermined)
     t = np.arange(2000) / FS
