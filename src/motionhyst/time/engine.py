@@ -659,7 +659,10 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
     # a link along the stroke: its parameters at the setpoint's mean over each of its pieces
     # of the samples, held over their controller periods (the continuous run's rule)
     pieces = link.pieces(rr) if isinstance(link, AlongStroke) else [(0, n_k)]
-    parts, worst, done = [], 0, 0
+    # each piece's records copied into the run's as it ends: the run held once (its
+    # SAMPLED_SAMPLE_BYTES), not again in its pieces
+    out: list[NDArray[np.float64]] = []
+    rows, worst, done = [0, 0, 0], 0, 0
     for k0, k1 in pieces:
         if isinstance(link, AlongStroke):
             stepping.params[:] = link.stepping_params(float(np.mean(rr[k0:k1])))
@@ -668,11 +671,18 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
             steps, Cout, np.zeros(3), 1, stepping, a[k0 * R:k1 * R + 1], state, vel_row=2,
             convention=OPEN, ftol=1e-13 * stepping.scale, record_every=R,
             record_initial=k0 == 0, controller=ctrl)
-        parts.append((Yp, Wp, Up))
+        for i, p in enumerate((Yp, Wp, Up)):
+            if len(pieces) == 1:
+                out.append(p)
+                continue
+            if len(out) < 3:
+                out.append(np.empty((n_k + 1, *p.shape[1:])))
+            out[i][rows[i]:rows[i] + len(p)] = p
+            rows[i] += len(p)
         worst, done = max(worst, worst_p), done + done_p
         if worst > MAX_FIXED_POINT_ITERATIONS:
             break
-    Y, W, U = (np.concatenate([p[i] for p in parts]) for i in range(3))
+    Y, W, U = out
     if worst > MAX_FIXED_POINT_ITERATIONS:
         raise StepNotConverged(f"the link's implicit step at t = {done / R * T:.6g} s did "
                                f"not converge in {MAX_FIXED_POINT_ITERATIONS} iterations: the "
