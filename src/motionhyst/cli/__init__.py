@@ -47,7 +47,8 @@ COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identif
             "study", "benchmark", "reproduce")
 """The commands, in the order ``motionhyst --help`` lists them (module names)."""
 
-_STOPPED = {"identify": "; its search, which no formula sizes, is stopped after S s of CPU time",
+_STOPPED = {"df": "; the computation is stopped after S s of CPU time",
+            "identify": "; its search, which no formula sizes, is stopped after S s of CPU time",
             "reproduce": "; the report is stopped after S s of CPU time"}
 # what --max-seconds also stops once it runs, by command (core.budget.cpu_time_limit's callers)
 

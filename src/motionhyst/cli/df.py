@@ -14,7 +14,6 @@ from motionhyst.cli._common import (
     harmonic_count,
     nonnegative,
     positive,
-    print_json,
 )
 
 # the command is the interface (see motionhyst.cli.main); nothing here is a library API
@@ -82,19 +81,48 @@ def _df_frequencies(args: argparse.Namespace, el) -> list[float | None]:
     return list(args.frequency)
 
 
+TEXT_VALUE_BYTES = 600
+"""Memory of one value of ``df``'s answer printed as text [B]: the point's objects and its
+line (measured 550: Jenkins, 1000 amplitudes x 1001 values, 695 MB at the peak beside the
+process's 150 MB; LuGre, 1000 points x 501 values, 275 MB beside it)."""
+
+JSON_VALUE_BYTES = 2000
+"""The same printed as JSON (measured 1800: 400 amplitudes x 401 values, 285 MB)."""
+
+REMEDY = "give fewer --amplitude or --frequency values, or fewer --harmonics"
+
+
+def _check_size(args: argparse.Namespace, n_points: int) -> None:
+    """Refuse an answer whose values would not fit the memory budget, before computing it."""
+    from motionhyst.core.budget import check_memory
+
+    values = n_points * (1 + (args.harmonics or 0))
+    check_memory(values * (JSON_VALUE_BYTES if args.json else TEXT_VALUE_BYTES),
+                 f"the describing function at {n_points} points of {values // n_points} "
+                 f"values each", REMEDY)
+
+
 def run(args: argparse.Namespace) -> int:
-    """Describing function (and higher harmonics) of a hysteresis element."""
+    """Describing function (and higher harmonics) of a hysteresis element.
+
+    Sized before it starts (:data:`TEXT_VALUE_BYTES` or :data:`JSON_VALUE_BYTES` a value,
+    against ``--max-memory``) and stopped after ``--max-seconds`` of CPU time: an
+    element's periodic response costs from microseconds (Jenkins) to milliseconds (LuGre,
+    integrated) a point, which no formula tells in advance.
+    """
     from motionhyst.analysis.describing import describing_function
+    from motionhyst.core.budget import cpu_time_limit, max_seconds
+    from motionhyst.core.jsonio import dumps
 
     args.frequency = distinct(args.frequency, "--frequency", "df")
     el = _element_from_args(args)
     freqs = _df_frequencies(args, el)
-    result = describing_function(el, args.amplitude, None if freqs == [None] else freqs,
-                                 harmonics=args.harmonics or 0)
-    if args.json:
-        print_json(result.to_dict())
-    else:
-        print(result)
+    _check_size(args, len(args.amplitude) * len(freqs))
+    with cpu_time_limit(max_seconds(), "df", REMEDY + ", or a larger --max-seconds"):
+        result = describing_function(el, args.amplitude, None if freqs == [None] else freqs,
+                                     harmonics=args.harmonics or 0)
+        text = dumps(result.to_dict()) if args.json else str(result)
+    print(text)
     return 0
 
 
