@@ -83,9 +83,10 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst predict: --substeps must be from 1 to 10000, got "
                          f"{args.substeps}")
     from motionhyst.io.outputs import OutputFile
+    from motionhyst.scenario.files import read_files
 
     target = OutputFile(args.out, force=args.force,
-                        inputs=[args.scenario, args.data, args.init_from],
+                        inputs=[*read_files(args.scenario), args.data, args.init_from],
                         option="--out")  # refused before any work
     if args.init_window is not None and args.init_from is None:
         raise UsageError("motionhyst predict: --init-window applies with --init-from only")

@@ -159,10 +159,11 @@ def _check_rate_resolves(args: argparse.Namespace, length: float, speed: float, 
 def _output(args):
     """The ``--time-series`` target, checked before any computation (None without it)."""
     from motionhyst.io.outputs import OutputFile
+    from motionhyst.scenario.files import read_files
 
     if not args.time_series:
         return None
-    return OutputFile(args.time_series, force=args.force, inputs=[args.scenario],
+    return OutputFile(args.time_series, force=args.force, inputs=read_files(args.scenario),
                       option="--time-series")
 
 

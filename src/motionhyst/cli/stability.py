@@ -26,13 +26,14 @@ FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
 def run(args: argparse.Namespace) -> int:
     """Limit cycles of the scenario's loop with its link."""
     from motionhyst.scenario import load_scenario
+    from motionhyst.scenario.files import read_files
 
     figure = None
     if args.figure is None:
         refuse_unused(args, ("--force",), "without --figure (the only file stability writes)")
     else:
         figure = output_file(args.figure, args, "--figure",
-                             [] if args.scenario is None else [args.scenario])
+                             read_files(args.scenario))
         if figure.path.suffix.lower() not in FIGURE_SUFFIXES:
             raise UsageError("stability --figure: give a .png, .pdf or .svg file")
     sc = load_scenario(args.scenario)

@@ -143,12 +143,15 @@ def _check_files(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run a study (or resume it), or summarize a store."""
     _check_options(args)
+    from motionhyst.scenario.files import read_files
+
+    inputs = [*read_files(args.study), args.from_identification]
     args.table_file = (None if args.table is None
-                       else output_file(args.table, args, "--table", [args.study]))
+                       else output_file(args.table, args, "--table", inputs))
     args.netcdf_file = (None if args.netcdf is None
-                        else output_file(args.netcdf, args, "--netcdf", [args.study]))
+                        else output_file(args.netcdf, args, "--netcdf", inputs))
     args.figure_file = (None if args.figure is None
-                        else output_file(args.figure, args, "--figure", [args.study]))
+                        else output_file(args.figure, args, "--figure", inputs))
     if args.figure_file is not None and args.figure_file.path.suffix.lower() not in (
             ".png", ".pdf", ".svg"):
         raise UsageError("study --figure: give a .png, .pdf or .svg file")
