@@ -2,14 +2,19 @@
 
 ``examples/hunting.toml`` (Olsson and Astrom 2001: a 1 kg mass on LuGre friction with a
 Stribeck dip under a PID) has a stable self-excited cycle of 24.437 s (tests/test_stability.py
-checks its exact orbit against a stiff-ODE run).  Driven at 0.1 Hz it has no steady state of
-the reference's period: the fixed point makes no progress.  Main said so after the fixed point's
-50 passes and the whole stability analysis (9.3 s of CPU at a load of 10), on a second line
-below a warning about f*; ``study`` and ``reproduce`` said "the dynamic link is too stiff".
-Now the mixed passes stall after 11, a run in time of the loop with its setpoint held finds
-the cycle (0.17 s), and every command says it in one line.
+checks its exact orbit against a stiff-ODE run).  Driven at 10 mm and 0.002 Hz its integrator
+winds up past the friction's breakaway (ki A / w = 4 N/(m s) 10 mm / (2 pi 0.002 Hz) = 3.2 N
+against fs = 1.5 N) and it hunts, stick-slip of the cycle's period inside the reference's 500 s: no
+steady state of the reference's period (a run in time from rest: e1 over its first four
+periods 7.4e-4, 8.0e-4, 1.3e-3, 1.8e-3 m), and the fixed point makes no progress.  Main said
+so (at the example's 0.1 Hz, where the driven loop sticks and has a steady state) after the
+fixed point's 50 passes and the whole stability analysis (9.3 s of CPU at a load of 10), on a
+second line below a warning about f*; ``study`` and ``reproduce`` said "the dynamic link is
+too stiff".  Now the passes stall, a run in time of the loop with its setpoint held finds the
+cycle (0.17 s), and every command says it in one line.
 A loop close to hunting (fs = fc: no Stribeck dip), or the hunting loop driven where it slides
-throughout, keeps its steady state, which agrees with an independent run in time.
+throughout or sticks throughout, keeps its steady state, which agrees with an independent run
+in time.
 """
 
 from __future__ import annotations
@@ -70,8 +75,8 @@ def test_steady_refuses_in_one_line_without_the_warning_it_makes_moot(tmp_path):
     as the work started) and the refusal below it; the warnings now wait for the answer."""
     populate(tmp_path, {"hunting.toml": HUNTING})
     before = snapshot(tmp_path)
-    line = _one_refusal(probe(["steady", "hunting.toml", "--frequency", "0.1"], tmp_path))
-    assert line.startswith("motionhyst: error: steady state at 0.1 Hz: the loop hunts: it has a "
+    line = _one_refusal(probe(["steady", "hunting.toml", "--frequency", "0.002"], tmp_path))
+    assert line.startswith("motionhyst: error: steady state at 0.002 Hz: the loop hunts: it has a "
                            "stable self-excited limit cycle of period 24.44 s"), line
     # the remedy names what a run in time of this loop needs: its PID has a pure derivative
     assert "derivative_filter_hz" in line
@@ -91,7 +96,7 @@ def test_steady_still_warns_when_it_answers(tmp_path):
 
 def test_study_points_say_the_loop_hunts(tmp_path):
     study = ('scenario = "hunting.toml"\noutputs = ["e1"]\n\n[axes]\namplitude = [0.01]\n'
-             'frequency_hz = [0.1, 0.2]\n')
+             'frequency_hz = [0.002, 0.003]\n')
     populate(tmp_path, {"hunting.toml": HUNTING, "s.toml": study})
     line = _one_refusal(probe(["study", "s.toml", "--out", "s.zarr", "--workers", "0"],
                               tmp_path))
@@ -101,8 +106,9 @@ def test_study_points_say_the_loop_hunts(tmp_path):
 def test_reproduce_refuses_in_one_line_before_writing(tmp_path):
     """With rigid-body feedforward (eq. 18's mismatch needs it): main printed three warnings
     (f*, numpy's divide by zero twice) and 'the dynamic link is too stiff'."""
-    scenario = HUNTING.replace('[feedforward]\ntype = "none"', '[feedforward]\ntype = "rigid-body"')
-    assert scenario != HUNTING
+    scenario = HUNTING.replace('[feedforward]\ntype = "none"', '[feedforward]\ntype = "rigid-body"'
+                               ).replace("frequencies = [0.1]", "frequencies = [0.002]")
+    assert scenario.count("0.002") == 1 and "rigid-body" in scenario
     populate(tmp_path, {"h.toml": scenario})
     before = snapshot(tmp_path)
     _one_refusal(probe(["reproduce", "h.toml", "--out", "rep", "--quiet"], tmp_path))
@@ -126,9 +132,11 @@ def test_a_fixed_point_that_came_near_an_answer_is_not_called_hunting(monkeypatc
     assert hunting.hunting_refusal(loop, near, 0.01) is near
 
 
-def _independent_run(fs: float, f: float, amplitude: float, t_end: float):
+def _independent_run(fs: float, f: float, amplitude: float, t_end: float,
+                     integral: float = 0.0):
     """The hunting loop with friction `fs` driven by ``r = amplitude sin(2 pi f t)`` from
-    rest, written out (states y, v, the integral of the error, z; no feedforward)."""
+    rest (the PID's integral of the error starting at `integral`), written out (states y, v,
+    the integral of the error, z; no feedforward)."""
     from scipy.integrate import solve_ivp
 
     m, kp, ki, kd = 1.0, 3.0, 4.0, 6.0
@@ -143,7 +151,7 @@ def _independent_run(fs: float, f: float, amplitude: float, t_end: float):
         u = kp * (r - y) + ki * x[2] + kd * (rd - v)
         return [v, (u - (s0 * z + s1 * zdot + s2 * v)) / m, r - y, zdot]
 
-    return solve_ivp(rhs, (0.0, t_end), [0.0, 0.0, 0.0, 0.0], method="LSODA", rtol=1e-9,
+    return solve_ivp(rhs, (0.0, t_end), [0.0, 0.0, integral, 0.0], method="LSODA", rtol=1e-9,
                      atol=[1e-12, 1e-12, 1e-12, 1e-16], dense_output=True)
 
 
@@ -164,6 +172,34 @@ def test_a_loop_close_to_hunting_keeps_its_steady_state():
     assert abs(E[3]) == pytest.approx(abs(ss.e[3]), rel=3e-3)
     d = ss.time_series(t.size)["e"] - e
     assert np.max(np.abs(d - d.mean())) < 1e-4 * np.max(np.abs(e))
+
+
+@pytest.mark.parametrize(("fs", "e1"), [(1.5, 9.999703392e-3), (1.0, 9.999704790e-3)])
+def test_the_driven_loop_that_sticks_has_its_steady_state(fs, e1):
+    """At 10 mm and 0.1 Hz the PID's force stays below the friction's (kp A, ki A / w and
+    kd A w: 0.03, 0.064 and 0.038 N against fc = 1 N): the stage sticks, its bristles
+    (1e5 N/m, 3e4 times the loop's stiffness) deflecting by 1e-6 m.  The fixed point's plain
+    and mixed passes grow by the bristles' stiffness each pass (main refused it: 'the loop
+    hunts', or with fs = fc 'the link's stiffness'); with the stuck link's spring and damper
+    solved with the loop it converges in 4 passes.  An independent run in time whose
+    integral of the error starts at its periodic mean (-A / w: 2 pi f A sin integrates to
+    A (1 - cos)) is periodic from its first period and agrees to 1e-8 (measured 5e-11 and
+    7e-11); from rest it keeps the integral's mean A / w, which the bristles' stiffness
+    against ki bleeds off in sigma0 / ki = 2.5e4 s (agreement 2e-6 after 3 periods)."""
+    from motionhyst import periodic_steady_state
+
+    f, amplitude = 0.1, 0.01
+    ss = periodic_steady_state(_hunting(**{"hysteresis.fs": fs}).loop(), amplitude, f)
+    assert ss.iterations <= 6
+    run = _independent_run(fs, f, amplitude, 30.0, integral=-amplitude / (2 * math.pi * f))
+    t = 20.0 + np.arange(4000) / (4000 * f)        # the third period
+    e = amplitude * np.sin(2 * math.pi * f * t) - run.sol(t)[0]
+    E = 2 * np.fft.rfft(e) / t.size
+    assert abs(E[1]) == pytest.approx(abs(ss.e[1]), rel=1e-8)
+    assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-8)
+    run = _independent_run(fs, f, amplitude, 30.0)
+    e = amplitude * np.sin(2 * math.pi * f * t) - run.sol(t)[0]
+    assert abs(2 * np.fft.rfft(e)[1] / t.size) == pytest.approx(abs(ss.e[1]), rel=1e-5)
 
 
 def test_the_run_in_time_the_refusal_advises_is_refused_in_one_line(tmp_path):

@@ -17,7 +17,20 @@ cannot be solved with the loop that way; where it makes the plain pass ``x <- g(
 contract slowly or grow at a few harmonics (the stage's resonance), the passes are mixed
 (:class:`Mixing`, Anderson acceleration): each takes the combination of the last passes'
 ``g(x)`` whose residual ``g(x) - x`` is least, which converges where those few harmonics of
-the plain pass grow, and the iteration stops at the same fixed point.
+the plain pass grow, and the iteration stops at the same fixed point.  Mixed passes that still
+make progress after the pass limit go on, up to :data:`EXTRA_PASSES` times it
+(:class:`Progress`); an iteration left unfinished is refused as slow, not as a stiff link.
+
+A link that sticks (LuGre's bristles, ``sigma0`` far above the loop's stiffness: a PID on a
+1 kg stage against 1e5 N/m) returns a change of its force multiplied by its stiffness times
+``|T_{w->y1}|``, thousands of times a pass.  Where the passes above are refused, the link's
+stiffness and damping while it sticks (:func:`sticking`) are solved with the loop as the
+damping at every amplitude is (:func:`chord`, ``L = k + j n w c``), starting from the loop
+with the link stuck; only the link's departure from that spring is iterated, which vanishes
+while it sticks and is bounded by ``k`` while it slips (a sampled loop: only where the refusal
+is not the link's damping's, which no Floquet multipliers check there).  A loop that converges
+without it keeps its passes and its numbers; where it does not converge either, the first
+refusal stands.
 """
 
 from __future__ import annotations
@@ -58,9 +71,21 @@ MEMORY = 10
 #: fraction of the pass before's (a fixed point that contracts fast is computed as it always
 #: was, to the bit); the first pass that does not starts the mixing.
 SLOW = 0.5
+#: Passes beyond the limit, as a multiple of it, that an iteration still making progress
+#: (:class:`Progress`) may run before it is refused as slow: Table I's LuGre with sigma1 =
+#: 1e4 at 1 mm, 5 Hz ended its 50 mixed passes at a relative change of 6.3e-7.
+EXTRA_PASSES = 3
+#: The passes over which :class:`Progress` compares the smallest residual with that of as
+#: many passes before.
+PROGRESS_WINDOW = 10
 
 
-class NoFixedPoint(RuntimeError):
+class FixedPointError(RuntimeError):
+    """The fixed point of the steady state refused: it diverged, stalled or did not finish in
+    its passes (:class:`Passes`, :func:`not_converged`)."""
+
+
+class NoFixedPoint(FixedPointError):
     """The fixed point did not converge in its passes at `frequency_hz` [Hz] (a link too
     stiff for the loop, or a loop with no steady state of the reference's period: one that
     hunts); a caller that can tell which says so.  `change` is the last pass's relative
@@ -75,11 +100,79 @@ class NoFixedPoint(RuntimeError):
 
 
 def not_converged(frequency_hz: float, max_iter: int, residual: float) -> NoFixedPoint:
-    """The refusal of a fixed point that did not converge in `max_iter` passes."""
+    """The refusal of a fixed point that did not converge in `max_iter` passes: one that
+    still changes its answer by a tenth (:data:`LARGE_CHANGE`) made no progress (a link too
+    stiff for the loop, or a loop that hunts); one below that is slow.
+
+    Examples
+    --------
+    >>> from motionhyst.analysis._fixed_point import not_converged
+    >>> print(not_converged(5.0, 200, 6.3e-7))
+    steady state at 5 Hz did not converge in 200 iterations (relative change 6.3e-07): its \
+passes are too slow for this loop; no answer is given: run the loop in time (motionhyst \
+simulate --time-series)
+    """
+    why = ("the dynamic link is too stiff for this loop" if not residual < LARGE_CHANGE else
+           "its passes are too slow for this loop; no answer is given: run the loop in time "
+           "(motionhyst simulate --time-series)")
     return NoFixedPoint(
         f"steady state at {frequency_hz:g} Hz did not converge in {max_iter} iterations "
-        f"(relative change {residual:.2g}); the dynamic link is too stiff for this loop",
-        frequency_hz, residual)
+        f"(relative change {residual:.2g}): {why}", frequency_hz, residual)
+
+
+class Progress:
+    """The pass limit of a fixed point: `max_iter` passes, and up to :data:`EXTRA_PASSES`
+    times as many more while the smallest relative change of the last :data:`PROGRESS_WINDOW`
+    passes is below half that of the window before (mixed passes do not shrink pass by
+    pass).
+
+    Examples
+    --------
+    >>> from motionhyst.analysis._fixed_point import Progress
+    >>> shrinking, stalled = Progress(20), Progress(20)
+    >>> all(shrinking.more(it, 0.9 ** it) for it in range(1, 20))
+    True
+    >>> shrinking.more(20, 0.9 ** 20)            # still shrinking after 20 passes: on
+    True
+    >>> [stalled.more(it, 1e-6) for it in range(1, 21)][-1]   # no progress: refused
+    False
+    """
+
+    def __init__(self, max_iter: int) -> None:
+        self.max_iter = int(max_iter)
+        self.residuals: list[float] = []
+
+    def more(self, it: int, residual: float) -> bool:
+        """Whether a pass may follow pass `it`, whose relative change was `residual`."""
+        self.residuals.append(float(residual))
+        if it < self.max_iter:
+            return True
+        if it >= (1 + EXTRA_PASSES) * self.max_iter or len(self.residuals) < 2 * PROGRESS_WINDOW:
+            return False
+        last = min(self.residuals[-PROGRESS_WINDOW:])
+        before = min(self.residuals[-2 * PROGRESS_WINDOW:-PROGRESS_WINDOW])
+        return last < 0.5 * before
+
+
+def sticking(link) -> tuple[float, float]:
+    """The link's stiffness [N/m] and damping [N s/m] while it sticks: its
+    :meth:`~motionhyst.hysteresis.base.Hysteresis.initial_stiffness` (0 where it is not finite
+    and positive) and its :func:`viscous_damping`, with LuGre's bristle damping ``sigma1``
+    (its force ``sigma0 z + sigma1 dz/dt + sigma2 v``, Canudas de Wit et al. 1995, is that
+    of a spring and dampers for ``z = y1`` while it sticks).
+
+    Examples
+    --------
+    >>> from motionhyst.analysis._fixed_point import sticking
+    >>> from motionhyst.hysteresis import LuGre
+    >>> sticking(LuGre(sigma0=1e5, sigma1=316.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3))
+    (100000.0, 316.4)
+    """
+    k = float(link.initial_stiffness) if link is not None else 0.0
+    c = viscous_damping(link)
+    if type(link).__name__ == "LuGre":
+        c += float(link.sigma1)
+    return (k if np.isfinite(k) and k > 0 else 0.0), c
 
 
 def viscous_damping(link) -> float:
@@ -192,7 +285,7 @@ class Passes:
             f"no answer is given: run the loop in time (motionhyst simulate --time-series) or "
             f"lower the link's {which}")
         if words:
-            raise RuntimeError(message)
+            raise FixedPointError(message)
         raise NoFixedPoint(message, self.frequency_hz)
 
 
@@ -202,13 +295,13 @@ def _rms(E: NDArray[np.complex128]) -> float:
     return float(np.sqrt(abs(E[0]) ** 2 + 2.0 * np.sum(np.abs(E[1:]) ** 2)))
 
 
-def chord(G_1: NDArray[np.complex128], frequency_hz: float, c: float):
-    """The linear damping's force per harmonic ``L = j n w c`` and the loop's
-    ``1 / (1 - T_{w->y1} L)`` with it, or None for ``c = 0`` (or a loop that this damping
-    makes singular at a harmonic)."""
-    if not c > 0:
+def chord(G_1: NDArray[np.complex128], frequency_hz: float, c: float, k: float = 0.0):
+    """The linear spring's and damping's force per harmonic ``L = k + j n w c`` and the
+    loop's ``1 / (1 - T_{w->y1} L)`` with it, or None for ``c = k = 0`` (or a loop that they
+    make singular at a harmonic)."""
+    if not (c > 0 or k > 0):
         return None
-    L = 1j * TWO_PI * float(frequency_hz) * np.arange(G_1.size) * c
+    L = k + 1j * TWO_PI * float(frequency_hz) * np.arange(G_1.size) * c
     den = 1.0 - G_1 * L
     if not np.all(np.abs(den) > 1e-6):
         return None
@@ -265,3 +358,67 @@ class Mixing:
                                 np.concatenate([F[:, -1].real, F[:, -1].imag]), rcond=None)[0]
         mixed = gx - dG @ gamma
         return mixed if np.all(np.isfinite(mixed)) else gx
+
+
+class ContinuousPasses:
+    """The passes of the continuous loop's fixed point ``y1 = y1_lin + T_{w->y1} (w(y1) -
+    U_h)`` (:mod:`motionhyst.analysis.steady`) for one link, frequency and reference.
+
+    Parameters
+    ----------
+    hyst : Hysteresis
+        The link.
+    frequency_hz : float
+        The reference's frequency [Hz].
+    H : int
+        The highest harmonic kept.
+    y1_lin, e_lin, U_h : ndarray of complex
+        Harmonics ``0 .. H`` (``rfft / N`` scaling) of the linear loop's ``y1`` and ``e`` and
+        of the feedforward's force on the link's side.
+    T : tuple
+        The loop's transfers at the harmonics (``w_y1``, ``w_e``).
+    tol, max_iter : float, int
+        The stopping rule's tolerance and the pass limit (:class:`Progress`).
+    """
+
+    def __init__(self, hyst, frequency_hz: float, H: int, y1_lin, e_lin, U_h, T, tol: float,
+                 max_iter: int) -> None:
+        self.hyst, self.frequency_hz, self.H = hyst, float(frequency_hz), H
+        self.y1_lin, self.e_lin, self.U_h, self.T = y1_lin, e_lin, U_h, T
+        self.tol, self.max_iter = float(tol), int(max_iter)
+
+    def passes(self, linear, X: NDArray[np.complex128], W: NDArray[np.complex128]
+               ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], int, float]:
+        """The link's force ``W`` and displacement ``X`` at the fixed point, the passes and
+        the last relative change, from `X` (`W` the force the first pass is compared with);
+        `linear` the link's part solved with the loop (:func:`chord`) or None.  Raises
+        :class:`FixedPointError` where it does not converge."""
+        hyst, T, G_1, y1_lin, U_h = self.hyst, self.T, self.T.w_y1, self.y1_lin, self.U_h
+        omega = TWO_PI * self.frequency_hz
+        previous, residual, it = np.inf, np.inf, 0
+        passes = Passes(self.frequency_hz, hyst, solved=linear is not None)
+        mixing, limit = Mixing(), Progress(self.max_iter)
+        while True:
+            it += 1
+            W_new = hyst.periodic_harmonics(X, self.H, omega)
+            if linear is None:
+                X_new = y1_lin + G_1 * (W_new - U_h)
+            else:  # W_new + L (X_new - X): the force with its linear part at X_new
+                L, inverse = linear
+                X_new = (y1_lin + G_1 * (W_new - L * X - U_h)) * inverse
+                W_new = W_new + L * (X_new - X)
+            change = float(np.max(np.abs(W_new - W)))
+            residual = float(abs(W_new[1] - W[1]) / max(abs(W_new[1]), 1e-300))
+            passes.step(T.w_e * (W_new - W), self.e_lin + T.w_e * (W_new - U_h))
+            W, X, X_in = W_new, X_new, X
+            # error of a contraction with observed rate rho is about residual * rho / (1 - rho)
+            rho = residual / previous if it > 2 and previous > 0 else 1.0
+            previous = residual
+            if it > 1 and (change == 0.0
+                           or (rho < 0.5 and residual * rho / (1 - rho) <= self.tol)):
+                break
+            if not limit.more(it, residual):
+                raise not_converged(self.frequency_hz, it, residual)
+            X = mixing.next(X_in, X_new)
+        passes.judge(self.e_lin + T.w_e * (W - U_h))
+        return W, X, it, residual
