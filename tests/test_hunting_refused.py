@@ -184,8 +184,9 @@ def test_the_driven_loop_that_sticks_has_its_steady_state(fs, e1):
     solved with the loop it converges in 4 passes.  An independent run in time whose
     integral of the error starts at its periodic mean (-A / w: 2 pi f A sin integrates to
     A (1 - cos)) is periodic from its first period and agrees to 1e-8 (measured 5e-11 and
-    7e-11); from rest it keeps the integral's mean A / w, which the bristles' stiffness
-    against ki bleeds off in sigma0 / ki = 2.5e4 s (agreement 2e-6 after 3 periods)."""
+    7e-11); from rest it keeps the integral's mean A / w, which a slow mode of the
+    integrator against the bristles bleeds off (Floquet multipliers 0.9998 a 10 s period: a
+    time constant of 5e4 s; agreement 2e-6 after 3 periods)."""
     from motionhyst import periodic_steady_state
 
     f, amplitude = 0.1, 0.01

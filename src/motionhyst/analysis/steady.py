@@ -408,7 +408,8 @@ def periodic_steady_state(loop: Loop, amplitude: float, frequency_hz: float,
         except FixedPointError as refusal:
             # a link that sticks: its spring and damping solved with the loop too, from the
             # loop with the link stuck; where that does not converge either, the first refusal
-            stuck = chord(G_1, frequency_hz, *sticking(hyst)[::-1])
+            k, c = sticking(hyst)
+            stuck = chord(G_1, frequency_hz, c, k) if c > viscous_damping(hyst) or k else None
             if stuck is None:
                 raise
             X = (y1_lin - G_1 * U_h) * stuck[1]
@@ -805,7 +806,7 @@ def _sampled_steady_state(loop: Loop, amplitude: float, frequency_hz: float, N: 
             # LuGre sigma1 = 1e6 converged so to e1 = 0.01034 m where a run in time settles
             # on 0.01300 m
             k, c = sticking(hyst)
-            L = linear(c, k)
+            L = linear(c, k) if c > viscous_damping(hyst) or k else None
             if L is None:
                 raise
             W = damped(np.zeros(H + 1, dtype=complex), np.zeros(n.size), L)
