@@ -15,34 +15,17 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-import numpy as np
 import pytest
+from paper_loops import last_period_e1, paper_loop
 
 from motionhyst.hysteresis import LuGre
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-SAMPLED = (EXAMPLES / "paper_10khz.toml").read_text()
 
 
 def _lugre(sigma1: float) -> LuGre:
     """Table I's link as LuGre (sigma0 = 20 N/m, fc = 0.05 N) with bristle damping `sigma1`."""
     return LuGre(sigma0=20.0, sigma1=sigma1, sigma2=0.0, fc=0.05, fs=0.07, vs=0.1)
-
-
-def _paper_loop(link, sampled: bool = False):
-    from motionhyst import Loop
-    from motionhyst.scenario import Scenario, default_scenario
-
-    sc = (Scenario.from_dict(tomllib.loads(SAMPLED), "s") if sampled else default_scenario())
-    return Loop(sc.plant(), sc.controller(), link)
-
-
-def _last_period_e1(run, f: float = 5.0) -> float:
-    """``|e_1|`` of the last period of a run in time."""
-    t, e = np.asarray(run.t), np.asarray(run.e)
-    last = (t >= t[-1] - 1 / f - 1e-9) & (t < t[-1] - 1e-9)
-    t, e = t[last], e[last]
-    return float(2 * abs(np.mean(e * np.exp(-2j * np.pi * f * t))))
 
 
 @pytest.mark.parametrize(("sigma1", "amplitude", "frequency", "duration", "e1"), [
@@ -59,11 +42,11 @@ def test_a_link_that_sticks_is_solved_with_the_loop(sigma1, amplitude, frequency
     and 5.8e-8 after 2 s)."""
     from motionhyst import SineReference, periodic_steady_state, simulate
 
-    ss = periodic_steady_state(_paper_loop(_lugre(sigma1)), amplitude, frequency)
+    ss = periodic_steady_state(paper_loop(_lugre(sigma1)), amplitude, frequency)
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-9)
-    run = simulate(_paper_loop(_lugre(sigma1)), SineReference(amplitude, frequency), duration,
+    run = simulate(paper_loop(_lugre(sigma1)), SineReference(amplitude, frequency), duration,
                    dt=1e-6)
-    assert abs(ss.e[1]) == pytest.approx(_last_period_e1(run, frequency), rel=1e-6)
+    assert abs(ss.e[1]) == pytest.approx(last_period_e1(run, frequency), rel=1e-6)
 
 
 def test_the_sampled_loop_whose_link_sticks_is_solved_with_the_loop():
@@ -88,7 +71,7 @@ def test_the_sampled_loop_whose_link_sticks_is_solved_with_the_loop():
     ss = periodic_steady_state(loop, amplitude, f)
     assert abs(ss.e[1]) == pytest.approx(9.999164734e-3, rel=1e-9)
     run = simulate_sampled(loop, SineReference(amplitude, f), 4.0, substeps=40, linear=False)
-    assert abs(ss.e[1]) == pytest.approx(_last_period_e1(run, f), rel=5e-6)
+    assert abs(ss.e[1]) == pytest.approx(last_period_e1(run, f), rel=5e-6)
 
 
 def test_mixed_passes_that_still_make_progress_run_on():
@@ -100,10 +83,10 @@ def test_mixed_passes_that_still_make_progress_run_on():
     from motionhyst import SineReference, periodic_steady_state, simulate
 
     amplitude, f = 10 ** -2.5, 20.0
-    ss = periodic_steady_state(_paper_loop(_lugre(1e4)), amplitude, f, n_harmonics=300)
+    ss = periodic_steady_state(paper_loop(_lugre(1e4)), amplitude, f, n_harmonics=300)
     assert 50 < ss.iterations <= 200
-    run = simulate(_paper_loop(_lugre(1e4)), SineReference(amplitude, f), 0.5, dt=1e-6)
-    assert abs(ss.e[1]) == pytest.approx(_last_period_e1(run, f), rel=1e-7)
+    run = simulate(paper_loop(_lugre(1e4)), SineReference(amplitude, f), 0.5, dt=1e-6)
+    assert abs(ss.e[1]) == pytest.approx(last_period_e1(run, f), rel=1e-7)
 
 
 def test_an_iteration_left_unfinished_is_called_slow():

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_probe import probe
+from paper_loops import last_period_e1, paper_loop
 
 from motionhyst.hysteresis import LuGre
 
@@ -43,22 +44,6 @@ def _sampled_with(damping: float, key: str) -> str:
     assert JENKINS in SAMPLED
     return SAMPLED.replace(JENKINS, f'model = "lugre"\nsigma0 = 20.0\n{key} = {damping!r}\n'
                                     f'fc = 0.05\nfs = 0.07\nvs = 0.1')
-
-
-def _paper_loop(link, sampled: bool = False):
-    from motionhyst import Loop
-    from motionhyst.scenario import Scenario, default_scenario
-
-    sc = (Scenario.from_dict(tomllib.loads(SAMPLED), "s") if sampled else default_scenario())
-    return Loop(sc.plant(), sc.controller(), link)
-
-
-def _last_period_e1(run, f: float = 5.0) -> float:
-    """``|e_1|`` of the last period of a run in time."""
-    t, e = np.asarray(run.t), np.asarray(run.e)
-    last = (t >= t[-1] - 1 / f - 1e-9) & (t < t[-1] - 1e-9)
-    t, e = t[last], e[last]
-    return float(2 * abs(np.mean(e * np.exp(-2j * np.pi * f * t))))
 
 
 @contextmanager
@@ -90,10 +75,10 @@ def test_the_steady_state_of_a_damped_link_agrees_with_a_run_in_time(sigma1, sig
     above the 100th is larger than the fundamental's 1e-5 (1e-11 of it or less)."""
     from motionhyst import SineReference, periodic_steady_state, simulate
 
-    loop = _paper_loop(_lugre(sigma1, sigma2))
+    loop = paper_loop(_lugre(sigma1, sigma2))
     ss = periodic_steady_state(loop, 0.01, 5.0)
-    e1 = _last_period_e1(simulate(loop, SineReference(0.01, 5.0), 1.0,
-                                  dt=2e-6 if sigma2 > 5e4 else None))
+    e1 = last_period_e1(simulate(loop, SineReference(0.01, 5.0), 1.0,
+                                 dt=2e-6 if sigma2 > 5e4 else None))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-4), (abs(ss.e[1]), e1)
     if sigma1 == 0:
         assert np.max(np.abs(ss.e[100:])) < 1e-5 * abs(ss.e[1]), np.max(np.abs(ss.e[100:]))
@@ -109,9 +94,9 @@ def test_a_damper_that_holds_the_stage_is_solved_not_iterated():
 
     link = _lugre(0.0, 1e6)
     with _at_most_passes(link, 10, "the iteration did not end"):
-        ss = periodic_steady_state(_paper_loop(link), 0.01, 5.0)
+        ss = periodic_steady_state(paper_loop(link), 0.01, 5.0)
     assert np.all(np.isfinite(ss.e)) and np.max(np.abs(ss.e[2:])) < 1e-8
-    e1 = _last_period_e1(simulate(_paper_loop(link), SineReference(0.01, 5.0), 2.4, dt=2e-6))
+    e1 = last_period_e1(simulate(paper_loop(link), SineReference(0.01, 5.0), 2.4, dt=2e-6))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-6), (abs(ss.e[1]), e1)
 
 
@@ -127,12 +112,12 @@ def test_the_sampled_steady_state_of_a_damped_link_agrees_with_a_run_in_time(sig
     from motionhyst.time.sampled import simulate_sampled
 
     link = _lugre(0.0, sigma2)
-    loop = _paper_loop(link, sampled=True)
+    loop = paper_loop(link, sampled=True)
     with _at_most_passes(link, 10, "the iteration went on"):
         ss = periodic_steady_state(loop, 0.01, 5.0)
     assert np.max(np.abs(ss.e[100:])) < 1e-8 * abs(ss.e[1]), np.max(np.abs(ss.e[100:]))
-    e1 = _last_period_e1(simulate_sampled(loop, SineReference(0.01, 5.0), duration,
-                                          substeps=40, linear=False))
+    e1 = last_period_e1(simulate_sampled(loop, SineReference(0.01, 5.0), duration,
+                                         substeps=40, linear=False))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-6), (abs(ss.e[1]), e1)
 
 
@@ -161,7 +146,7 @@ def test_a_loop_too_damped_for_the_fixed_point_is_refused_within_a_few_passes(
             r"\(while it sticks\), fed back through the loop, amplifies each pass there; no "
             r"answer is given: run the loop in time \(motionhyst simulate --time-series\) or "
             r"lower the link's damping$")):
-        periodic_steady_state(_paper_loop(link, sampled), 0.01, 5.0)
+        periodic_steady_state(paper_loop(link, sampled), 0.01, 5.0)
 
 
 @pytest.mark.parametrize(("sigma1", "amplitude", "sampled", "e1_in_time"), [
@@ -177,7 +162,7 @@ def test_a_change_that_grows_for_a_few_passes_then_settles_is_an_answer(
     the judgement of every pass refused them (review A17 H1)."""
     from motionhyst import periodic_steady_state
 
-    ss = periodic_steady_state(_paper_loop(_lugre(sigma1, 0.0), sampled), amplitude, 5.0)
+    ss = periodic_steady_state(paper_loop(_lugre(sigma1, 0.0), sampled), amplitude, 5.0)
     assert abs(ss.e[1]) == pytest.approx(e1_in_time, rel=1e-6)
 
 
@@ -188,7 +173,7 @@ def test_a_refusal_names_the_damping_it_iterates_not_the_one_it_solves():
     from motionhyst import periodic_steady_state
 
     with pytest.raises(RuntimeError, match=r"bristle damping sigma1 = 1e\+05 N s/m") as err:
-        periodic_steady_state(_paper_loop(_lugre(1e5, 1e3)), 0.01, 5.0)
+        periodic_steady_state(paper_loop(_lugre(1e5, 1e3)), 0.01, 5.0)
     assert "sigma2" not in str(err.value)
 
 
@@ -207,8 +192,8 @@ def test_a_damping_while_it_sticks_that_the_plain_passes_cannot_settle_is_mixed_
 
     link = _lugre(sigma1, 0.0)
     with _at_most_passes(link, 50, "the iteration went on"):
-        ss = periodic_steady_state(_paper_loop(link), 0.01, 5.0, n_harmonics=harmonics)
-    e1 = _last_period_e1(simulate(_paper_loop(link), SineReference(0.01, 5.0), 1.0, dt=1e-6))
+        ss = periodic_steady_state(paper_loop(link), 0.01, 5.0, n_harmonics=harmonics)
+    e1 = last_period_e1(simulate(paper_loop(link), SineReference(0.01, 5.0), 1.0, dt=1e-6))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=rel), (abs(ss.e[1]), e1)
 
 
@@ -230,11 +215,11 @@ def test_the_sampled_loop_that_settles_slowly_is_mixed_to_the_answer(scenario, a
         link = loop.hysteresis
     else:
         link = _lugre(2000.0, 0.0)
-        loop = _paper_loop(link, sampled=True)
+        loop = paper_loop(link, sampled=True)
     with _at_most_passes(link, 20, "the iteration went on"):
         ss = periodic_steady_state(loop, amplitude, 5.0)
-    e1 = _last_period_e1(simulate_sampled(loop, SineReference(amplitude, 5.0), 3.0,
-                                          substeps=40, linear=False))
+    e1 = last_period_e1(simulate_sampled(loop, SineReference(amplitude, 5.0), 3.0,
+                                         substeps=40, linear=False))
     assert abs(ss.e[1]) == pytest.approx(e1, rel=1e-6), (abs(ss.e[1]), e1)
 
 
