@@ -3,21 +3,27 @@
 A loop with integral action around friction with a Stribeck dip (Olsson and Astrom 2001,
 ``examples/hunting.toml``) sticks, winds its integrator up until the friction breaks away,
 slips past the setpoint and sticks again: a stable self-excited cycle of its own period.
-Driven by a reference, it has no periodic steady state of the reference's period, and the
-fixed point of :func:`~motionhyst.analysis.steady.periodic_steady_state` does not converge
-(:class:`~motionhyst.analysis._fixed_point.NoFixedPoint`), as it does not for a link too
-stiff for the loop.  :func:`steady_state_unless_hunting` tells the two apart.
+Driven by a reference slow enough for the integrator to wind up, it keeps slipping at that
+rhythm: it has no periodic steady state of the reference's period, and the fixed point of
+:func:`~motionhyst.analysis.steady.periodic_steady_state` does not converge
+(:class:`~motionhyst.analysis._fixed_point.NoFixedPoint`), as it may not for a link too
+stiff for the loop.  Driven faster or with a smaller amplitude, the same loop may stick and
+follow the reference (at 0.1 Hz, 10 mm its PID's force stays below the friction's): whether
+it hunts is a question about the driven loop.  :func:`steady_state_unless_hunting` asks it.
 
-The loop with its setpoint held at 0 (the state equation seen by the link,
-:class:`~motionhyst.analysis.floquet.LoopStateEquation`, as for
+First the loop's own cycle: the loop with its setpoint held at 0 (the state equation seen by
+the link, :class:`~motionhyst.analysis.floquet.LoopStateEquation`, as for
 :func:`~motionhyst.analysis.stability.stability`) is released at rest, its link's
 displacement the reference's amplitude away from the setpoint, and run in time by a stiff
 solver (LSODA) until its upward crossings of ``y1 = 0`` repeat: a run that settles on a
-cycle has found a stable one, and its period (:func:`hunting_period`).  For a loop that
-cannot be run so (a sampled loop, a link without a smooth state equation) the describing
-function's prediction decides, as ``motionhyst stability`` would.  A run costs a fraction
-of a second where the whole analysis (loci, the cut at the integrator, the exact orbit)
-costs seconds; ``motionhyst stability`` refines the cycle to its exact orbit.
+cycle has found a stable one, and its period (:func:`hunting_period`).  A loop without one
+does not hunt.  Then the driven loop, run in time from rest (:func:`driven_run`): it hunts
+where its error keeps crossing zero at the cycle's rhythm and its periods do not repeat; it
+follows the reference where they do.  For a loop that cannot be run so (a sampled loop, a
+link without a smooth state equation) the describing function's prediction is said, as a
+possibility.  The runs cost a fraction of a second where the whole analysis (loci, the cut
+at the integrator, the exact orbit) costs seconds; ``motionhyst stability`` refines the
+cycle to its exact orbit.
 
 Examples
 --------
@@ -37,6 +43,9 @@ friction with a Stribeck dip.
 from __future__ import annotations
 
 import math
+import time
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -47,7 +56,8 @@ from motionhyst.analysis.steady import SteadyState, periodic_steady_state
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.lti import TWO_PI, tf_poly
 
-__all__ = ["hunting_period", "hunting_refusal", "steady_state_unless_hunting"]
+__all__ = ["DrivenRun", "driven_run", "hunting_period", "hunting_refusal",
+           "steady_state_unless_hunting"]
 
 #: Relative tolerance of the run (the period it gives is good to about this, far finer
 #: than the message's four digits: 24.43681 s for the exact orbit's 24.43679 s).
@@ -65,14 +75,29 @@ PIECE_SLOW_PERIODS = 10.0
 #: The run has come to rest when every state of the loop is below this fraction of its
 #: start's.
 AT_REST = 1e-8
-#: Evaluations of the loop's state equation the run may take at most (about 12 us each):
-#: a stiff loop with fast dynamics stops there, its cycle not found, in well under a second
-#: (the hunting loop settles in 13 300).
-MAX_EVALUATIONS = 50_000
+#: Processor time [s] a run may take at most: a stiff loop with fast dynamics stops there, its
+#: cycle not found (the fixed point's refusal stands).  The run is bounded by the simulated
+#: time above; this guards the refusal's time only (the hunting loop's run takes 0.17 s,
+#: with ki = 16, whose cycle of 6.657 s needs 60 600 evaluations, 0.8 s).
+RUN_SECONDS = 1.5
 
 
 class _Exhausted(Exception):
-    """The run took :data:`MAX_EVALUATIONS` evaluations."""
+    """The run took :data:`RUN_SECONDS` of processor time."""
+
+
+def _timed(rhs: Callable[[float, NDArray], NDArray]) -> Callable[[float, NDArray], NDArray]:
+    """`rhs` that raises :class:`_Exhausted` once the run has taken :data:`RUN_SECONDS` of
+    processor time (looked at every 256 evaluations)."""
+    calls, end = [0], time.process_time() + RUN_SECONDS
+
+    def timed(t: float, X: NDArray) -> NDArray:
+        calls[0] += 1
+        if calls[0] % 256 == 0 and time.process_time() > end:
+            raise _Exhausted
+        return rhs(t, X)
+
+    return timed
 
 
 def _start(sys: LoopStateEquation, offset: float) -> tuple[NDArray, NDArray]:
@@ -106,7 +131,7 @@ def hunting_period(loop: Loop, offset: float) -> float | None:
     at 0, released at rest with its link's displacement `offset` [m] away (module
     docstring); None where the run comes to rest or does not settle (in
     :data:`RUN_SLOW_PERIODS` periods of the slowest closed-loop pole, or
-    :data:`MAX_EVALUATIONS` evaluations of the state equation).
+    :data:`RUN_SECONDS` of processor time).
 
     Parameters
     ----------
@@ -155,13 +180,7 @@ def hunting_period(loop: Loop, offset: float) -> float | None:
     piece = PIECE_SLOW_PERIODS * t_slow
     atol = RUN_RTOL * 1e-2 * np.maximum(scale, 1e-300)
     start = float(np.max(np.abs(X[:sys.n]) / scale[:sys.n]))
-    evaluations = [0]
-
-    def rhs(t: float, X: NDArray) -> NDArray:
-        evaluations[0] += 1
-        if evaluations[0] > MAX_EVALUATIONS:
-            raise _Exhausted
-        return sys.rhs(t, X)
+    rhs = _timed(sys.rhs)
 
     te: list[float] = []
     ye: list[NDArray] = []
@@ -185,6 +204,215 @@ def hunting_period(loop: Loop, offset: float) -> float | None:
         if np.max(np.abs(X[:sys.n]) / scale[:sys.n]) < AT_REST * start:
             return None
     return None
+
+
+class DrivenRun(NamedTuple):
+    """What a run in time of the driven loop from rest shows (:func:`driven_run`).
+
+    Parameters
+    ----------
+    verdict : {"follows", "hunts", "unsettled"}
+        It follows the reference's period (its link's displacement over the last period
+        within :data:`FOLLOWS` of the amplitude of the one before); it hunts (it does not
+        follow, and its error crosses zero upward at the loop's own cycle's rhythm,
+        :data:`RHYTHM_CROSSINGS` intervals in a row within :data:`RHYTHM` of that cycle's
+        period); or neither, within the run's length.
+    seconds : float
+        The run's length [s].
+    change : float
+        The largest change of the link's displacement from the last whole period to the one
+        before [m] (nan before two periods).
+    e1 : float
+        The amplitude of the error's first harmonic over the last whole period [m] (nan
+        before one).
+    rhythm : float
+        The mean interval of the error's last upward crossings [s] (nan without them).
+    """
+
+    verdict: str
+    seconds: float
+    change: float
+    e1: float
+    rhythm: float
+
+
+#: The driven run follows the reference's period when its link's displacement over a period
+#: differs from the period before's by at most this fraction of the reference's amplitude
+#: (the hunting loop at 0.1 Hz, 10 mm, stuck: 1.1e-5, its presliding creep) ...
+FOLLOWS = 1e-3
+#: ... judged once it has run at least this many of the reference's periods and of the
+#: loop's own cycle's (a hunting loop sticks for up to a cycle before its first slip).
+MIN_PERIODS = 3
+MIN_CYCLES = 2.0
+#: It hunts when its error's last upward crossings come this many intervals in a row within
+#: this fraction of the loop's own cycle's period (the hunting loop driven at 0.005 Hz,
+#: 10 mm: 24.35 to 24.52 s for its cycle's 24.44 s; at 0.01 Hz, 30 mm: 23.8 to 25.8 s).
+RHYTHM_CROSSINGS = 4
+RHYTHM = 0.1
+#: The run's length at most: this many of the loop's own cycles, and at least
+#: :data:`MIN_PERIODS` reference periods where that is longer, but never more than
+#: :data:`MAX_CYCLES` cycles (a reference far slower than the cycle is judged by its rhythm).
+RUN_CYCLES = 8.0
+MAX_CYCLES = 24.0
+#: Samples of a period at which the run's periods are compared.
+PHASES = 256
+
+
+def _series_derivatives(num: NDArray, den: NDArray, count: int) -> NDArray:
+    """``y(0+), y'(0+), ...`` (`count` of them) of the inverse Laplace transform of the
+    strictly proper ``num(s) / den(s)``: the coefficients of its expansion in ``1 / s``."""
+    num = np.trim_zeros(np.asarray(num, dtype=float), "f")
+    den = np.trim_zeros(np.asarray(den, dtype=float), "f")
+    lag = len(den) - len(num)                         # the relative degree, >= 1
+    q = np.zeros(max(count - lag + 1, 0))
+    padded = np.concatenate([num, np.zeros(q.size)])
+    for k in range(q.size):
+        acc = padded[k] - sum(den[i] * q[k - i] for i in range(1, min(k, len(den) - 1) + 1))
+        q[k] = acc / den[0]
+    out = np.zeros(count)
+    for j in range(count):
+        if 0 <= j + 1 - lag < q.size:
+            out[j] = q[j + 1 - lag]
+    return out
+
+
+def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) -> DrivenRun:
+    """Run the loop driven by ``r = amplitude sin(2 pi frequency_hz t)`` in time from rest and
+    say whether it follows the reference's period or hunts at the rhythm of its own cycle
+    of period `cycle` [s] (:func:`hunting_period`): :class:`DrivenRun`.
+
+    The loop's response to the reference alone, ``y1 = p(t)`` in its steady state, is known
+    in closed form (``T_{r->y1}(j w)``); the run integrates the rest, the link's force through
+    ``T_{w->y1}`` (:class:`~motionhyst.analysis.floquet.LoopStateEquation`) and the linear
+    loop's transient, started where ``y1`` and its derivatives are those of the loop started
+    at rest (their values at ``0+`` from ``T_{r->y1}(s) R(s)``), the link unloaded.  It runs
+    in pieces, at most :data:`RUN_CYCLES` cycles (:data:`MIN_PERIODS` reference periods where
+    longer, at most :data:`MAX_CYCLES` cycles) and :data:`RUN_SECONDS` of processor time,
+    and stops once it follows or hunts.
+
+    Parameters
+    ----------
+    loop : Loop
+        A continuous LTI loop with a link that has a smooth state equation, no hysteresis or
+        Coulomb feedforward (their force is no linear transfer of the reference).
+    amplitude : float
+        Reference amplitude [m], > 0.
+    frequency_hz : float
+        Reference frequency [Hz], > 0.
+    cycle : float
+        The period of the loop's own cycle [s], > 0.
+
+    Returns
+    -------
+    DrivenRun
+
+    Raises
+    ------
+    ValueError
+        For a loop that cannot be run so, or a non-positive argument.
+
+    Examples
+    --------
+    The hunting loop (``examples/hunting.toml``) at 10 mm: at 0.1 Hz its PID's force stays
+    below the friction and the stage sticks; at 0.005 Hz the integrator winds up, the stage
+    slips, sticks and slips again at its own cycle's rhythm.
+
+    >>> import control
+    >>> from motionhyst import Loop, LuGre
+    >>> from motionhyst.plants import MassDamper
+    >>> link = LuGre(sigma0=1e5, sigma1=1e5 ** 0.5, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
+    >>> loop = Loop(MassDamper(m=1.0, c=0.0), control.tf([6.0, 3.0, 4.0], [1.0, 0.0]), link,
+    ...             feedforward=None)
+    >>> run = driven_run(loop, 0.01, 0.1, 24.437)
+    >>> print(run.verdict, f"{run.e1 * 1e3:.4f} mm")
+    follows 9.9997 mm
+    >>> run = driven_run(loop, 0.01, 0.005, 24.437)
+    >>> print(run.verdict, f"{run.rhythm:.3g} s")
+    hunts 24.5 s
+    """
+    from scipy.integrate import solve_ivp
+
+    link = loop.hysteresis
+    if (link is None or link.n_states == 0 or loop.sampled is not None or not loop.is_lti
+            or loop.hysteresis_feedforward is not None
+            or (loop.ff is not None and loop.ff.coulomb)):
+        raise ValueError("a run of the driven loop needs a continuous LTI loop, a link with a "
+                         "smooth state equation and no hysteresis or Coulomb feedforward")
+    for name, value in (("amplitude", amplitude), ("frequency", frequency_hz),
+                        ("cycle", cycle)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be finite and > 0, got {value!r}")
+    A, f = float(amplitude), float(frequency_hz)
+    sys = LoopStateEquation(loop)
+    omega, period = TWO_PI * f, 1.0 / f
+    num, den = tf_poly(loop.transfer_tf("r->y1"), "r->y1")
+    T = complex(np.polyval(num, 1j * omega) / np.polyval(den, 1j * omega))  # T_{r->y1}(j w)
+    rest = _series_derivatives(A * omega * np.asarray(num, dtype=float),
+                               np.polymul(den, [1.0, 0.0, omega ** 2]), sys.n)
+    steady = A * (T * (1j * omega) ** np.arange(sys.n)).imag      # p(0), p'(0), ...
+    obs = np.array([sys.C @ np.linalg.matrix_power(sys.A, k) for k in range(sys.n)])
+    X = np.zeros(sys.N)
+    X[:sys.n] = np.linalg.solve(obs, rest - steady)
+    _, scale = _start(sys, A)
+    atol = RUN_RTOL * 1e-2 * np.maximum(scale, 1e-300)
+    TA, TV = A * T, A * T * 1j * omega
+
+    def field(t: float, X: NDArray) -> NDArray:
+        x, z = X[:sys.n], X[sys.n:]
+        v = float((TV * np.exp(1j * omega * t)).imag + sys.CA @ x)
+        zdot, w, *_ = link.state_equation(z, v)
+        return np.concatenate([sys.A @ x - sys.B * w, zdot])
+
+    def jac(t: float, X: NDArray) -> NDArray:
+        v = float((TV * np.exp(1j * omega * t)).imag + sys.CA @ X[:sys.n])
+        return sys.linearised(X[sys.n:], v)
+
+    def error(t: NDArray, x: NDArray) -> NDArray:
+        return A * np.sin(omega * t) - (TA * np.exp(1j * omega * t)).imag - sys.C @ x
+
+    rhs = _timed(field)
+    length = min(max(RUN_CYCLES * cycle, MIN_PERIODS * period), MAX_CYCLES * cycle)
+    split = max(1, math.ceil(period / cycle))       # pieces a period: judged after each
+    phases = np.array_split(np.arange(PHASES) / PHASES * period, split)
+    ups: list[float] = []
+    periods: list[NDArray] = []         # the error at the phases, period by period
+    pieces: list[NDArray] = []
+    change = e1 = rhythm = math.nan
+    k = 0
+    while k * period / split < length * (1.0 - 1e-12):
+        t0, t1 = k * period / split, (k + 1) * period / split
+        try:
+            sol = solve_ivp(rhs, (t0, t1), X, method="LSODA", jac=jac, rtol=RUN_RTOL,
+                            atol=atol, dense_output=True)
+        except _Exhausted:
+            break
+        if not sol.success:
+            break
+        X = sol.y[:, -1]
+        e = error(sol.t, sol.y[:sys.n])
+        for i in np.nonzero((e[:-1] < 0.0) & (e[1:] >= 0.0))[0]:
+            ups.append(float(sol.t[i] - e[i] * (sol.t[i + 1] - sol.t[i]) / (e[i + 1] - e[i])))
+        at = (k // split) * period + phases[k % split]
+        pieces.append(error(at, sol.sol(at)[:sys.n]))
+        k += 1
+        if k % split == 0:
+            periods.append(np.concatenate(pieces))
+            pieces = []
+            e1 = float(2.0 * abs(np.fft.rfft(periods[-1])[1]) / PHASES)
+            if len(periods) >= 2:
+                change = float(np.max(np.abs(periods[-1] - periods[-2])))
+        gaps = np.diff([u for u in ups if u > cycle][-RHYTHM_CROSSINGS - 1:])
+        if gaps.size:
+            rhythm = float(np.mean(gaps))
+        if (len(periods) >= MIN_PERIODS and t1 >= MIN_CYCLES * cycle
+                and change <= FOLLOWS * A):
+            return DrivenRun("follows", t1, change, e1, rhythm)
+        own = (gaps.size == RHYTHM_CROSSINGS
+               and bool(np.all(np.abs(gaps / cycle - 1.0) <= RHYTHM)))
+        whole = period / rhythm if own else 0.0    # a rhythm the reference's period locks
+        if own and (change > FOLLOWS * A or abs(whole - round(whole)) > RHYTHM):
+            return DrivenRun("hunts", t1, change, e1, rhythm)
+    return DrivenRun("unsettled", k * period / split, change, e1, rhythm)
 
 
 def _predicted_period(loop: Loop) -> float | None:
@@ -211,12 +439,16 @@ def _runs_in_time(loop: Loop) -> bool:
 
 def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeError:
     """The refusal of a steady state whose fixed point did not converge (`exc`, at the
-    reference's `amplitude` [m]): where it made no progress (its last change above
-    :data:`~motionhyst.analysis._fixed_point.LARGE_CHANGE` of the answer) and the loop hunts
-    (:func:`hunting_period` from rest at `amplitude`; the describing function's prediction
-    for a loop that cannot be run so) it says so, with the cycle's period; else `exc`, the
-    link too stiff for the loop.  A fixed point that came within that of an answer is no
-    loop's own cycle.
+    reference's `amplitude` [m]), true of the driven loop.
+
+    Where the fixed point made progress (its last change below
+    :data:`~motionhyst.analysis._fixed_point.LARGE_CHANGE` of the answer), or the loop has no
+    cycle of its own (:func:`hunting_period`, its setpoint held), `exc` stands.  Else the loop
+    driven by the reference is run in time from rest (:func:`driven_run`): where it hunts,
+    the refusal says so, with its own cycle's period; where it follows the reference's
+    period, `exc` with what the run shows (the loop does not hunt); where it does neither in
+    its run, or cannot be run so, `exc` with the cycle the loop has with its setpoint held
+    (the describing function's prediction for a loop without a run): it may hunt.
 
     Parameters
     ----------
@@ -240,36 +472,61 @@ def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeE
     >>> link = LuGre(sigma0=1e5, sigma1=1e5 ** 0.5, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
     >>> loop = Loop(MassDamper(m=1.0, c=0.0), control.tf([6.0, 3.0, 4.0], [1.0, 0.0]), link,
     ...             feedforward=None)                    # examples/hunting.toml's loop
+    >>> print(hunting_refusal(loop, not_converged(0.005, 50, 0.86), 0.01))
+    steady state at 0.005 Hz: the loop hunts: ... of period 24.44 s ...
     >>> print(hunting_refusal(loop, not_converged(0.1, 50, 0.86), 0.01))
-    steady state at 0.1 Hz: the loop hunts: ... of period 24.44 s (a run from rest ...
+    steady state at 0.1 Hz did not converge ...; a run in time from rest follows the ...
     """
     link = loop.hysteresis
     if link is None or not loop.is_lti or not exc.change >= LARGE_CHANGE:
         return exc  # a fixed point that came near an answer: no cycle of its own took over
-    how = "a run from rest settles on it"
-    try:
-        period = hunting_period(loop, amplitude)
-    except ValueError:  # no run of this loop: the describing function's prediction
-        period, how = _predicted_period(loop), "predicted by the describing function"
-    except (RuntimeError, ArithmeticError, np.linalg.LinAlgError):
-        period = None  # a run that failed finds no cycle: the fixed point's own refusal
-    if period is None:
-        return exc
     f = exc.frequency_hz
-    run = ("run it in time (motionhyst simulate --time-series)" if _runs_in_time(loop) else
-           "run it in time (motionhyst simulate --time-series, with [controller] "
-           "derivative_filter_hz: a pure derivative has no run)")
-    return RuntimeError(
-        f"steady state at {f:g} Hz: the loop hunts: it has a stable self-excited limit cycle "
-        f"of period {period:.4g} s ({how}; motionhyst stability shows its exact orbit), so "
-        f"no periodic steady state of the reference's {1 / f:.4g} s period; {run}")
+    remedy = ("run it in time (motionhyst simulate --time-series)" if _runs_in_time(loop) else
+              "run it in time (motionhyst simulate --time-series, with [controller] "
+              "derivative_filter_hz: a pure derivative has no run)")
+    try:
+        cycle = hunting_period(loop, amplitude)
+    except ValueError:  # no run of this loop: the describing function's prediction
+        predicted = _predicted_period(loop)
+        if predicted is None:
+            return exc
+        return NoFixedPoint(
+            f"{exc}; the describing function predicts a stable self-excited limit cycle of "
+            f"period {predicted:.4g} s with the setpoint held (motionhyst stability): the "
+            f"loop may hunt; {remedy}", f, exc.change)
+    except (RuntimeError, ArithmeticError, np.linalg.LinAlgError):
+        return exc  # a run that failed finds no cycle: the fixed point's own refusal
+    if cycle is None:
+        return exc
+    held = (f"with its setpoint held the loop has a stable self-excited limit cycle of period "
+            f"{cycle:.4g} s (motionhyst stability shows its exact orbit)")
+    try:
+        run = driven_run(loop, amplitude, f, cycle)
+    except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError):
+        return NoFixedPoint(f"{exc}; {held}: driven, it may hunt; {remedy}", f, exc.change)
+    if run.verdict == "hunts":
+        return RuntimeError(
+            f"steady state at {f:g} Hz: the loop hunts: driven from rest, a run in time slips "
+            f"at its own rhythm (its error crosses zero upward every {run.rhythm:.3g} s) and "
+            f"does not settle on the reference's {1 / f:.4g} s period; {held}, so no periodic "
+            f"steady state of the reference's period; {remedy}")
+    if run.verdict == "follows":
+        return NoFixedPoint(
+            f"{exc}; a run in time from rest follows the reference's {1 / f:.4g} s period "
+            f"(after {run.seconds * f:.3g} periods its error changes by {run.change:.2g} m a "
+            f"period, its first harmonic {run.e1:.6g} m): the loop does not hunt", f,
+            exc.change)
+    return NoFixedPoint(
+        f"{exc}; a run in time from rest has not settled on the reference's {1 / f:.4g} s "
+        f"period in {run.seconds:.4g} s and {held}: it may hunt; {remedy}", f, exc.change)
 
 
 def steady_state_unless_hunting(loop: Loop, amplitude: float, frequency_hz: float
                                 ) -> SteadyState:
     """:func:`~motionhyst.analysis.steady.periodic_steady_state`; a fixed point that does not
-    converge because the loop hunts is refused saying so, with the cycle's period
-    (:func:`hunting_refusal`).
+    converge because the driven loop hunts (a run in time from rest) is refused saying so,
+    with the cycle's period, and one whose driven loop follows the reference says what the
+    run shows (:func:`hunting_refusal`).
 
     Parameters
     ----------

@@ -1,0 +1,173 @@
+"""Whether a loop hunts is asked of the loop driven by its reference (issue 26).
+
+``examples/hunting.toml`` (a 1 kg mass on LuGre friction with a Stribeck dip under a PID) has
+a stable self-excited cycle of 24.437 s with its setpoint held.  Driven at 0.1 Hz, 10 mm its
+PID's force stays below the friction: the stage sticks and follows the reference (a run from
+rest: e1 = 9.99972e-3 m over its 5th period, changing 1.4e-7 m a period), yet main refused it
+saying "the loop hunts".  Driven at 0.005 Hz, 10 mm the integrator winds up over the
+reference's half period, the stage breaks away, slips and sticks again every 24.3 to 24.5 s:
+it hunts.  The driven loop is now run in time from rest (:func:`driven_run`) and only a run
+that keeps slipping at the cycle's rhythm, its periods not repeating, is called hunting; each
+verdict is checked against an independent run of the loop written out.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from cli_probe import probe
+from file_trees import populate, snapshot
+from test_hunting_refused import HUNTING, _hunting, _independent_run
+
+from motionhyst.analysis._fixed_point import not_converged
+from motionhyst.analysis.hunting import (
+    _series_derivatives,
+    driven_run,
+    hunting_period,
+    hunting_refusal,
+)
+
+#: The exact orbit's period with its setpoint held (tests/test_stability.py).
+PERIOD = 24.436786
+
+
+def _upward_crossings(run, f: float, amplitude: float, t0: float, t1: float) -> np.ndarray:
+    """Times [s] of the upward zero crossings of the independent run's error in [t0, t1]
+    (on a 1 ms grid)."""
+    t = np.arange(t0, t1, 1e-3)
+    e = amplitude * np.sin(2 * math.pi * f * t) - run.sol(t)[0]
+    return t[1:][(e[:-1] < 0.0) & (e[1:] >= 0.0)]
+
+
+def test_a_driven_loop_that_sticks_is_not_called_hunting():
+    """At 0.1 Hz, 10 mm the fixed point made no progress (main: a relative change of 0.86
+    after its passes) and main said the loop hunts with its 24.44 s cycle.  An independent run
+    from rest sticks: its error's first harmonic over the 5th period is 9.999724e-3 m, its
+    displacement changes by 1.4e-7 m from the 4th period to the 5th (presliding creep); the
+    driven run says it follows the reference after those 5 periods, with that first harmonic
+    (1.5e-6 apart: the run's tolerance 1e-6); its change from period to period, 1.4e-7 m, is
+    at its accuracy, far below its threshold of 1e-3 of the amplitude."""
+    loop = _hunting().loop()
+    run = _independent_run(1.5, 0.1, 0.01, 50.0)
+    t = 40.0 + np.arange(4000) / 400.0
+    e = 0.01 * np.sin(2 * math.pi * 0.1 * t) - run.sol(t)[0]
+    e1 = abs(2 * np.fft.rfft(e)[1] / t.size)
+    change = np.max(np.abs(run.sol(t)[0] - run.sol(t - 10.0)[0]))
+    assert change < 1e-6
+    driven = driven_run(loop, 0.01, 0.1, PERIOD)
+    assert driven.verdict == "follows" and driven.seconds == pytest.approx(50.0)
+    assert driven.e1 == pytest.approx(e1, rel=1e-5)
+    assert driven.change < 1e-4 * 0.01          # 1.4e-7 m: the run's accuracy, not the creep
+    exc = not_converged(0.1, 50, 0.86)
+    message = str(hunting_refusal(loop, exc, 0.01))
+    assert "hunts" not in message and message.startswith(str(exc)), message
+    assert ("a run in time from rest follows the reference's 10 s period" in message
+            and "its first harmonic 0.0099997" in message and "the loop does not hunt" in message)
+
+
+def test_a_driven_loop_that_hunts_is_refused_with_its_cycle():
+    """At 0.005 Hz, 10 mm an independent run from rest slips every 24.3 to 24.53 s from its
+    67th second on (its own cycle's 24.44 s) and its two periods differ by 0.134 m: the
+    driven run says it hunts, at that rhythm, and the refusal names the cycle."""
+    run = _independent_run(1.5, 0.005, 0.01, 400.0)
+    gaps = np.diff(_upward_crossings(run, 0.005, 0.01, 50.0, 400.0))
+    assert gaps.size >= 12 and np.all(np.abs(gaps / PERIOD - 1.0) < 0.01), gaps
+    t = np.arange(0.0, 200.0, 0.01)
+    assert np.max(np.abs(run.sol(t + 200.0)[0] - run.sol(t)[0])) > 0.1
+    loop = _hunting().loop()
+    driven = driven_run(loop, 0.01, 0.005, PERIOD)
+    assert driven.verdict == "hunts"
+    assert driven.rhythm == pytest.approx(PERIOD, rel=0.01)
+    message = str(hunting_refusal(loop, not_converged(0.005, 50, 0.86), 0.01))
+    assert message.startswith("steady state at 0.005 Hz: the loop hunts: driven from rest"), message
+    assert "period 24.44 s" in message and "every 24.5 s" in message
+    assert "does not settle on the reference's 200 s period" in message
+
+
+def test_a_faster_cycle_is_found_and_its_driven_loop_hunts():
+    """ki = 16: the cycle of 6.657 s with the setpoint held, which main's cap of 50 000
+    evaluations missed (its run needs 60 600), so main named the link's stiffness.  Driven at
+    0.01 Hz, 10 mm an independent run slips every 8.0, 7.3, 7.0, ... s, settling on 6.657 s;
+    the driven run says it hunts from its first four intervals (within 10 % of the cycle)."""
+    loop = _hunting(**{"controller.ki": 16.0}).loop()
+    cycle = hunting_period(loop, 0.01)
+    assert cycle == pytest.approx(6.657, rel=1e-3)
+    run = _independent_run(1.5, 0.01, 0.01, 200.0, ki=16.0)
+    gaps = np.diff(_upward_crossings(run, 0.01, 0.01, 100.0, 200.0))
+    assert np.all(np.abs(gaps / cycle - 1.0) < 2e-3), gaps
+    driven = driven_run(loop, 0.01, 0.01, cycle)
+    assert driven.verdict == "hunts" and abs(driven.rhythm / cycle - 1.0) < 0.1
+    message = str(hunting_refusal(loop, not_converged(0.01, 50, 0.86), 0.01))
+    assert "the loop hunts" in message and "period 6.657 s" in message, message
+    assert "too stiff" not in message
+
+
+def test_without_a_cycle_of_its_own_the_loop_is_not_run_driven(monkeypatch):
+    """fs = fc: no cycle with the setpoint held (each slip ends nearer the setpoint), so no
+    driven run is made and the fixed point's refusal stands."""
+    from motionhyst.analysis import hunting
+
+    def run(*args):
+        raise AssertionError("a driven run for a loop without a cycle of its own")
+
+    monkeypatch.setattr(hunting, "driven_run", run)
+    exc = not_converged(0.1, 50, 0.86)
+    assert hunting.hunting_refusal(_hunting(**{"hysteresis.fs": 1.0}).loop(), exc, 0.01) is exc
+
+
+def test_a_run_that_neither_follows_nor_hunts_says_the_loop_may_hunt(monkeypatch):
+    """A driven run that ends undecided (its processor time spent) claims nothing: the fixed
+    point's refusal, the held loop's cycle and 'it may hunt'."""
+    from motionhyst.analysis import hunting
+
+    monkeypatch.setattr(hunting, "RUN_SECONDS", 0.0)
+    loop = _hunting().loop()
+    exc = not_converged(0.005, 50, 0.86)
+    monkeypatch.setattr(hunting, "hunting_period", lambda loop, offset: PERIOD)
+    message = str(hunting.hunting_refusal(loop, exc, 0.01))
+    assert message.startswith(str(exc)) and "the loop hunts" not in message, message
+    assert "has not settled on the reference's 200 s period" in message
+    assert "period 24.44 s" in message and "it may hunt" in message
+
+
+def test_steady_never_says_a_sticking_driven_loop_hunts(tmp_path):
+    """The command at 0.1 Hz: one line, exit 2, no claim of hunting (an answer, exit 0, once
+    the fixed point converges for a link that sticks); nothing written."""
+    populate(tmp_path, {"hunting.toml": HUNTING})
+    before = snapshot(tmp_path)
+    out = probe(["steady", "hunting.toml", "--frequency", "0.1", "--no-floquet"], tmp_path)
+    assert "hunts" not in out["err"] and "Traceback" not in out["err"], out
+    if out["rc"] != 0:
+        assert out["rc"] == 2 and len(out["err"].splitlines()) == 1, out
+        assert "the loop does not hunt" in out["err"], out
+    assert snapshot(tmp_path) == before
+
+
+def test_the_start_from_rest_is_the_laplace_transforms_initial_values():
+    """``y(0+), y'(0+), ...`` of ``num / den``: 1 / (s + 1) is exp(-t) (1, -1, 1); 2 / (s^2 +
+    3 s + 2) is 2 exp(-t) - 2 exp(-2 t) (0, 2, -6, 14); (s + 3) / (s + 1)^2 is (1 + 2 t)
+    exp(-t) (1, 1, -3)."""
+    assert _series_derivatives(np.array([1.0]), np.array([1.0, 1.0]), 3) == pytest.approx(
+        [1.0, -1.0, 1.0])
+    assert _series_derivatives(np.array([2.0]), np.array([1.0, 3.0, 2.0]), 4) == pytest.approx(
+        [0.0, 2.0, -6.0, 14.0])
+    assert _series_derivatives(np.array([1.0, 3.0]), np.array([1.0, 2.0, 1.0]),
+                               3) == pytest.approx([1.0, 1.0, -3.0])
+
+
+def test_a_loop_the_driven_run_cannot_take_is_refused_before_it_runs():
+    """Hysteresis or Coulomb feedforward (no linear transfer of the reference), a sampled loop,
+    a link without a smooth state equation: a ValueError, before any run."""
+    from test_hunting_refused import EXAMPLES
+
+    from motionhyst.scenario import load_scenario
+
+    with pytest.raises(ValueError, match="smooth state equation"):
+        driven_run(load_scenario(EXAMPLES / "paper.toml").loop(), 0.01, 5.0, 1.0)
+    coulomb = _hunting(**{"feedforward.type": "rigid-body", "feedforward.coulomb": 1.0}).loop()
+    with pytest.raises(ValueError, match="no hysteresis or Coulomb feedforward"):
+        driven_run(coulomb, 0.01, 0.1, PERIOD)
+    with pytest.raises(ValueError, match="cycle must be finite"):
+        driven_run(_hunting().loop(), 0.01, 0.1, 0.0)
