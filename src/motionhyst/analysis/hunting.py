@@ -75,10 +75,12 @@ PIECE_SLOW_PERIODS = 10.0
 #: The run has come to rest when every state of the loop is below this fraction of its
 #: start's.
 AT_REST = 1e-8
-#: Processor time [s] a run may take at most: a stiff loop with fast dynamics stops there, its
-#: cycle not found (the fixed point's refusal stands).  The run is bounded by the simulated
-#: time above; this guards the refusal's time only (the hunting loop's run takes 0.17 s,
-#: with ki = 16, whose cycle of 6.657 s needs 60 600 evaluations, 0.8 s).
+#: Processor time [s] of its thread a run may take at most (a study's threads do not share
+#: it): a stiff loop with fast dynamics stops there, its cycle not found (the fixed point's
+#: refusal stands, no claim of hunting).  Each run is bounded by the simulated time it covers
+#: (here :data:`RUN_SLOW_PERIODS`; :func:`driven_run`'s cycles and periods); this guards the
+#: refusal's time only: the hunting loop's run takes 0.17 s, with ki = 16 (its cycle of
+#: 6.657 s needs 60 600 evaluations, which main's cap of 50 000 missed) 0.8 s.
 RUN_SECONDS = 1.5
 
 
@@ -88,12 +90,12 @@ class _Exhausted(Exception):
 
 def _timed(rhs: Callable[[float, NDArray], NDArray]) -> Callable[[float, NDArray], NDArray]:
     """`rhs` that raises :class:`_Exhausted` once the run has taken :data:`RUN_SECONDS` of
-    processor time (looked at every 256 evaluations)."""
-    calls, end = [0], time.process_time() + RUN_SECONDS
+    its thread's processor time (looked at every 256 evaluations)."""
+    calls, end = [0], time.thread_time() + RUN_SECONDS
 
     def timed(t: float, X: NDArray) -> NDArray:
         calls[0] += 1
-        if calls[0] % 256 == 0 and time.process_time() > end:
+        if calls[0] % 256 == 0 and time.thread_time() > end:
             raise _Exhausted
         return rhs(t, X)
 
