@@ -171,3 +171,14 @@ def test_a_loop_the_driven_run_cannot_take_is_refused_before_it_runs():
         driven_run(coulomb, 0.01, 0.1, PERIOD)
     with pytest.raises(ValueError, match="cycle must be finite"):
         driven_run(_hunting().loop(), 0.01, 0.1, 0.0)
+
+
+def test_a_loop_with_coulomb_feedforward_may_hunt_but_is_not_said_to():
+    """Coulomb feedforward (``fc sign(r')``: no linear transfer of the reference) has no
+    driven run: the refusal is the fixed point's, with the held loop's cycle (24.44 s, the
+    feedforward does not act with the setpoint held) and 'it may hunt'."""
+    loop = _hunting(**{"feedforward.type": "rigid-body", "feedforward.coulomb": 1.0}).loop()
+    exc = not_converged(0.005, 50, 0.86)
+    message = str(hunting_refusal(loop, exc, 0.01))
+    assert message.startswith(str(exc)) and "the loop hunts" not in message, message
+    assert "period 24.44 s" in message and "driven, it may hunt" in message
