@@ -214,16 +214,16 @@ class DrivenRun(NamedTuple):
     Parameters
     ----------
     verdict : {"follows", "hunts", "unsettled"}
-        It follows the reference's period (its link's displacement over the last period
-        within :data:`FOLLOWS` of the amplitude of the one before); it hunts (it does not
+        It follows the reference's period (its error over the last period within
+        :data:`FOLLOWS` of the reference's amplitude of the one before's); it hunts (it does not
         follow, and its error crosses zero upward at the loop's own cycle's rhythm,
         :data:`RHYTHM_CROSSINGS` intervals in a row within :data:`RHYTHM` of that cycle's
         period); or neither, within the run's length.
     seconds : float
         The run's length [s].
     change : float
-        The largest change of the link's displacement from the last whole period to the one
-        before [m] (nan before two periods).
+        The largest change of the error from the last whole period to the one before [m]
+        (nan before two periods).
     e1 : float
         The amplitude of the error's first harmonic over the last whole period [m] (nan
         before one).
@@ -238,9 +238,10 @@ class DrivenRun(NamedTuple):
     rhythm: float
 
 
-#: The driven run follows the reference's period when its link's displacement over a period
-#: differs from the period before's by at most this fraction of the reference's amplitude
-#: (the hunting loop at 0.1 Hz, 10 mm, stuck: 1.1e-5, its presliding creep) ...
+#: The driven run follows the reference's period when its error over a period differs from
+#: the period before's by at most this fraction of the reference's amplitude (the hunting
+#: loop at 0.1 Hz, 10 mm, stuck: 1.4e-5 after 5 periods, its creep and the run's accuracy;
+#: driven at 0.005 Hz, where it hunts, its two periods differ by 13 times it) ...
 FOLLOWS = 1e-3
 #: ... judged once it has run at least this many of the reference's periods and of the
 #: loop's own cycle's (a hunting loop sticks for up to a cycle before its first slip).
@@ -248,7 +249,7 @@ MIN_PERIODS = 3
 MIN_CYCLES = 2.0
 #: It hunts when its error's last upward crossings come this many intervals in a row within
 #: this fraction of the loop's own cycle's period (the hunting loop driven at 0.005 Hz,
-#: 10 mm: 24.35 to 24.52 s for its cycle's 24.44 s; at 0.01 Hz, 30 mm: 23.8 to 25.8 s).
+#: 10 mm: 24.31 to 24.53 s for its cycle's 24.44 s; at 0.01 Hz, 30 mm: 23.8 to 25.8 s).
 RHYTHM_CROSSINGS = 4
 RHYTHM = 0.1
 #: The run's length at most: this many of the loop's own cycles, and at least
