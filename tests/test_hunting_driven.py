@@ -210,3 +210,16 @@ def _table_i() -> dict:
     from test_hunting_refused import EXAMPLES
 
     return tomllib.loads((EXAMPLES / "paper.toml").read_text())
+
+
+def test_a_reference_far_slower_than_the_cycle_is_judged_by_the_rhythm():
+    """0.001 Hz, 10 mm: 40.9 cycles a period, which the run (24 cycles at most) does not
+    complete; an independent run slips every 24.4 s (within 1 %) from its 100th second.  A
+    rhythm that close to a whole fraction of the period (40.92) cannot be told from one the
+    period locks: the run says it hunts."""
+    run = _independent_run(1.5, 0.001, 0.01, 300.0)
+    gaps = np.diff(_upward_crossings(run, 0.001, 0.01, 100.0, 300.0))
+    assert gaps.size >= 6 and np.all(np.abs(gaps / PERIOD - 1.0) < 0.01), gaps
+    driven = driven_run(_hunting().loop(), 0.01, 0.001, PERIOD)
+    assert driven.verdict == "hunts" and driven.rhythm == pytest.approx(PERIOD, rel=0.01)
+    assert driven.seconds < 1000.0      # before a period: the rhythm decides

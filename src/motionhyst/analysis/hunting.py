@@ -422,8 +422,11 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
             return DrivenRun("follows", t1, change, e1, rhythm)
         own = (gaps.size == RHYTHM_CROSSINGS
                and bool(np.all(np.abs(gaps / cycle - 1.0) <= RHYTHM)))
-        whole = period / rhythm if own else 0.0    # a rhythm the reference's period locks
-        if own and (change > FOLLOWS * A or abs(whole - round(whole)) > RHYTHM):
+        # a rhythm the reference's period may lock: a whole fraction of it, told from the next
+        # only below 1 / RHYTHM cycles a period (the hunting loop at 0.001 Hz: 40.92 a period)
+        whole = period / rhythm if own else 0.0
+        locked = whole < 1.0 / RHYTHM and abs(whole - round(whole)) <= RHYTHM
+        if own and (change > FOLLOWS * A or not locked):
             return DrivenRun("hunts", t1, change, e1, rhythm)
     return DrivenRun("unsettled", k * period / split, change, e1, rhythm)
 
