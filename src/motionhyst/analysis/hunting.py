@@ -530,7 +530,9 @@ def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeE
         return NoFixedPoint(
             f"{exc}; a run in time from rest follows the reference's {1 / f:.4g} s period "
             f"(after {run.seconds * f:.3g} periods its error changes by {run.change:.2g} m a "
-            f"period, its first harmonic {run.e1:.6g} m): the loop does not hunt", f,
+            f"period, its first harmonic {run.e1:.6g} m): the loop does not hunt"
+            + ("" if _runs_in_time(loop) else "; motionhyst simulate --time-series needs "
+               "[controller] derivative_filter_hz (a pure derivative has no run)"), f,
             exc.change)
     return NoFixedPoint(
         f"{exc}; a run in time from rest has not settled on the reference's {1 / f:.4g} s "
