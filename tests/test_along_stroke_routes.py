@@ -6,6 +6,7 @@ the describing function refused in one line naming ``[hysteresis] along``."""
 from __future__ import annotations
 
 import csv
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -271,3 +272,45 @@ def test_a_small_stroke_s_periodic_force_is_the_base_link_s(name, amplitude):
     X[0], X[1] = 0.002, amplitude / 2j
     W, ref = link.periodic_harmonics(X, 5), base.periodic_harmonics(X, 5)
     assert np.max(np.abs(W - ref)) <= 1e-9 * np.max(np.abs(ref))
+
+
+def _feedforward_along(tmp_path) -> Path:
+    """Table I with its link plain and the feedforward's model of it along the stroke."""
+    d = default_scenario().to_dict()
+    base, scales = LINKS["jenkins"]
+    d["feedforward"]["hysteresis"] = {**base.to_dict(),
+                                      "along": {"position": POSITION, **scales}}
+    return _write(tmp_path, Scenario.from_dict(d, "s.toml"))
+
+
+@pytest.mark.parametrize("command", ["steady", "analyze", "stability", "reproduce", "study",
+                                     "simulate"])
+def test_refusals_name_the_feedforward_s_key(tmp_path, capsys, command):
+    # a feedforward model along the stroke (the link itself plain) was refused naming
+    # "[hysteresis] along", a key the scenario does not have
+    path = _feedforward_along(tmp_path)
+    args = {"reproduce": ["--out", str(tmp_path / "out")],
+            "simulate": ["--time-series", str(tmp_path / "run.csv"), "--duration", "0.01",
+                         "--frequency", "5"]
+            }.get(command, [])
+    if command == "study":
+        study = tmp_path / "study.toml"
+        study.write_text(f'scenario = "{path.name}"\noutputs = ["E"]\n'
+                         f"[axes]\namplitude = [{A}]\nfrequency_hz = [{F}]\n")
+        path, args = study, ["--out", str(tmp_path / "s.zarr"), "--workers", "0"]
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert cli_main([command, str(path), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert "[feedforward.hysteresis] along" in err and "[hysteresis] along" not in err, err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_a_feedforward_model_along_the_stroke_names_its_key_in_the_api(stage, controller):
+    sc = Scenario.from_dict({**default_scenario().to_dict(), "feedforward": {
+        "type": "rigid-body", "hysteresis": {**LINKS["jenkins"][0].to_dict(), "along": {
+            "position": POSITION, "fc": [0.5, 2.0]}}}}, "s.toml")
+    assert sc.along_keys == ["[feedforward.hysteresis] along"]
+    assert sc.loop().hysteresis_feedforward.key == "[feedforward.hysteresis] along"
+    assert sc.loop().hysteresis_feedforward.shifted(0.001).key == sc.along_keys[0]
+    assert _sampled_scenario(None).along_keys == ["[hysteresis] along"]

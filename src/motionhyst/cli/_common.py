@@ -654,4 +654,5 @@ def refuse_along_stroke_for(sc, command: str) -> None:
     if sc.along_stroke:
         from motionhyst.hysteresis.along_stroke import NO_DESCRIBING_FUNCTION
 
-        raise UsageError(f"{command}: {sc.source}: {NO_DESCRIBING_FUNCTION}")
+        raise UsageError(f"{command}: {sc.source}: "
+                         f"{NO_DESCRIBING_FUNCTION.format(key=', '.join(sc.along_keys))}")

@@ -328,9 +328,10 @@ def _time_series(args: argparse.Namespace, sc) -> int:
         options["settle_band"] = args.settle_band
     loop = sc.loop()
     if loop.sampled is None:  # a pure derivative has no run: refused before the warnings show
-        from motionhyst.time.simulation import check_proper
+        from motionhyst.time.simulation import check_long_run, check_proper
 
         check_proper(loop)
+        check_long_run(loop)
     release_held()  # the run starts: the warnings so far are shown
     with out.open(newline="") as fh, in_the_commands_terms(sc, remedy):
         s = run_time_series(loop, ref, duration, fh, **options)

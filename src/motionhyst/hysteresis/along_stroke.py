@@ -29,7 +29,8 @@ from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis.base import Hysteresis
 from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_calls
 
-__all__ = ["EXTRAPOLATED_RTOL", "FIXED_IN_OPEN_LOOP", "MAX_PERIODS", "NO_DESCRIBING_FUNCTION",
+__all__ = ["EXTRAPOLATED_RTOL", "FEEDFORWARD_KEY", "FIXED_IN_OPEN_LOOP", "LINK_KEY", "MAX_PERIODS",
+           "NO_DESCRIBING_FUNCTION",
            "PERIODIC_RTOL", "STALL_PERIODS", "STEPS_PER_INTERVAL", "AlongStroke"]
 
 #: Parameter updates of a time run per interval of the table (the parameters are held over
@@ -52,11 +53,16 @@ EXTRAPOLATED_RTOL = 1e-6
 FIXED_IN_OPEN_LOOP = ("an open-loop system (predict, identify) runs its link with fixed "
                       "parameters: a link along the stroke ([hysteresis] along) is run in a "
                       "closed loop (simulate, scan)")
-#: The refusal of a computation that needs the link's describing function (or its HOSIDF).
-NO_DESCRIBING_FUNCTION = ("a link along the stroke ([hysteresis] along) has no describing "
+#: The refusal of a computation that needs the link's describing function (or its HOSIDF),
+#: its ``{key}`` the scenario's key of the table.
+NO_DESCRIBING_FUNCTION = ("a link along the stroke ({key}) has no describing "
                           "function: run it in time (simulate --time-series, scan), or compute "
                           "its exact steady state in a study (outputs e1, harmonics, "
                           "error_rms)")
+#: The scenario's key of a link along the stroke (``key`` of :class:`AlongStroke`) ...
+LINK_KEY = "[hysteresis] along"
+#: ... and of the feedforward's model of it.
+FEEDFORWARD_KEY = "[feedforward.hysteresis] along"
 
 
 class AlongStroke(Hysteresis):
@@ -71,6 +77,9 @@ class AlongStroke(Hysteresis):
     scales : dict
         For each parameter of `base` that varies, its scale at each position
         (positive; a parameter not named keeps scale 1).
+    key : str
+        The scenario's key that gives the table, named in refusals (:data:`LINK_KEY`, or
+        :data:`FEEDFORWARD_KEY` for the feedforward's model).
 
     Examples
     --------
@@ -87,10 +96,12 @@ class AlongStroke(Hysteresis):
 
     name = "along-stroke"
 
-    def __init__(self, base: Hysteresis, position: ArrayLike, scales: dict) -> None:
+    def __init__(self, base: Hysteresis, position: ArrayLike, scales: dict,
+                 key: str = LINK_KEY) -> None:
         if isinstance(base, AlongStroke):
             raise ValueError("the base of a link along the stroke is a link model")
         self.base = base
+        self.key = key
         self.position = np.asarray(position, dtype=float)
         x = self.position
         if x.ndim != 1 or x.size < 2 or not np.all(np.isfinite(x)) or np.any(np.diff(x) <= 0):
@@ -143,7 +154,7 @@ class AlongStroke(Hysteresis):
         base : Hysteresis
             The new base (same model).
         """
-        return AlongStroke(base, self.position, self.scales)
+        return AlongStroke(base, self.position, self.scales, self.key)
 
     def shifted(self, x0: float) -> AlongStroke:
         """The link seen from a stroke position `x0`: position 0 here is `x0` on the table.
@@ -153,7 +164,7 @@ class AlongStroke(Hysteresis):
         x0 : float
             Where on the stroke the motion starts [m].
         """
-        return AlongStroke(self.base, self.position - float(x0), self.scales)
+        return AlongStroke(self.base, self.position - float(x0), self.scales, self.key)
 
     @property
     def initial_stiffness(self) -> float:
@@ -173,7 +184,7 @@ class AlongStroke(Hysteresis):
         ValueError
             Always (:data:`NO_DESCRIBING_FUNCTION`).
         """
-        raise ValueError(NO_DESCRIBING_FUNCTION)
+        raise ValueError(NO_DESCRIBING_FUNCTION.format(key=self.key))
 
     def hosidf(self, A, n_max, omega=None):
         """Not defined, as :meth:`describing_function` (its first harmonic).
@@ -188,7 +199,7 @@ class AlongStroke(Hysteresis):
         ValueError
             Always (:data:`NO_DESCRIBING_FUNCTION`).
         """
-        raise ValueError(NO_DESCRIBING_FUNCTION)
+        raise ValueError(NO_DESCRIBING_FUNCTION.format(key=self.key))
 
     def time_stepping(self) -> Stepping:
         """The elements at the start of the table's first position (the runs update them)."""
@@ -308,7 +319,7 @@ class AlongStroke(Hysteresis):
                 if smallest <= EXTRAPOLATED_RTOL * scale:  # at the run's rounding, settled
                     return (np.fft.rfft(w) / N)[: H + 1]
                 raise RuntimeError(
-                    f"the {self.base.name} link along the stroke ([hysteresis] along) has no "
+                    f"the {self.base.name} link along the stroke ({self.key}) has no "
                     f"periodic force: its change from period to period ({change:.2g} N) does "
                     "not shrink (a spring that never slips, scaled along the stroke, drifts); "
                     "run it in time (simulate --time-series)")
@@ -317,7 +328,7 @@ class AlongStroke(Hysteresis):
                 if change * rest <= EXTRAPOLATED_RTOL * scale:
                     return (np.fft.rfft(w + (w - prev) * rest) / N)[: H + 1]
         raise RuntimeError(
-            f"the {self.base.name} link along the stroke ([hysteresis] along) settles too "
+            f"the {self.base.name} link along the stroke ({self.key}) settles too "
             f"slowly: after {MAX_PERIODS} periods its force still changes by {change:.2g} N "
             "a period; run it in time (simulate --time-series)")
 

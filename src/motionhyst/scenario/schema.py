@@ -178,9 +178,19 @@ class Scenario:
     def along_stroke(self) -> bool:
         """True where the link or the feedforward's link model varies along the stroke
         (``along``: :class:`~motionhyst.hysteresis.along_stroke.AlongStroke`)."""
+        return bool(self.along_keys)
+
+    @property
+    def along_keys(self) -> list[str]:
+        """The keys that vary a link along the stroke, as the scenario writes them
+        (``[hysteresis] along``, ``[feedforward.hysteresis] along``): named in refusals."""
+        from motionhyst.hysteresis.along_stroke import FEEDFORWARD_KEY, LINK_KEY
+
         ff = self.model.feedforward
-        return any(getattr(section, "along", None) is not None
-                   for section in (self.model.hysteresis, getattr(ff, "hysteresis", None)))
+        sections = ((self.model.hysteresis, LINK_KEY),
+                    (getattr(ff, "hysteresis", None), FEEDFORWARD_KEY))
+        return [key for section, key in sections
+                if getattr(section, "along", None) is not None]
 
     def _closed(self, what: str) -> None:
         if self.model.plant_only and not self.model.open_loop:
@@ -485,7 +495,12 @@ class Scenario:
                 link = self.hysteresis()
                 self._checked_denominator(coefficients, link)
                 parts = (self.plant(), self.controller(), link)
-            hff = None if hff is None else build_hysteresis(hff)
+            if hff is not None:
+                hff = build_hysteresis(hff)
+                if hff.name == "along-stroke":  # its refusals name the key that gives it
+                    from motionhyst.hysteresis.along_stroke import FEEDFORWARD_KEY, AlongStroke
+
+                    hff = AlongStroke(hff.base, hff.position, hff.scales, FEEDFORWARD_KEY)
             from motionhyst.controllers.loop import Loop  # once the parts' files are read
 
             try:

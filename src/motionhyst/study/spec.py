@@ -489,7 +489,8 @@ class StudyDefinition:
         if sc.is_open_loop:
             raise StudyError("the scenario is an open-loop system; a study needs a closed loop")
         if "E" in self.outputs and sc.along_stroke:  # refused before the points run
-            raise StudyError(f"'outputs': E: {NO_DESCRIBING_FUNCTION}")
+            raise StudyError("'outputs': E: "
+                             f"{NO_DESCRIBING_FUNCTION.format(key=', '.join(sc.along_keys))}")
         sc.source = self.scenario_source  # its stage's implausible values named once
         warn_implausible(sc)
 

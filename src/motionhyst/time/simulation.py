@@ -52,7 +52,7 @@ from motionhyst.time.steps import (
 )
 
 __all__ = ["RUN_REMEDY", "SECONDS_PER_ELEMENT_STEP", "SECONDS_PER_STEP", "Simulation",
-           "check_proper", "check_run_work", "simulate", "simulate_chunks"]
+           "check_long_run", "check_proper", "check_run_work", "simulate", "simulate_chunks"]
 
 
 
@@ -273,6 +273,30 @@ def _in_pieces(engine: _Engine, t: NDArray[np.float64], i0: int, h_foh: float,
                          for c in ("t", "r", "e", "y1", "y2", "u", "w", "e_linear")})
 
 
+def check_long_run(loop: Loop) -> None:
+    """Refuse, before a run starts, what a continuous loop's run in pieces
+    (:func:`simulate_chunks`) does not take: a feedforward other than ``M r''``
+    (:func:`_check_feedforward`) and a feedforward model along the stroke, whose force
+    :func:`simulate` takes from the whole run's setpoint.  A ``ValueError`` names the
+    scenario's key of what is not taken, and what runs it.
+
+    Parameters
+    ----------
+    loop : Loop
+        The loop to run, its controller continuous.
+
+    Examples
+    --------
+    >>> from motionhyst.scenario import default_scenario
+    >>> check_long_run(default_scenario().loop())          # Table I: taken
+    """
+    _check_feedforward(loop)
+    if isinstance(loop.hysteresis_feedforward, AlongStroke):
+        raise ValueError(f"a continuous loop's long run in time takes no feedforward model "
+                         f"along the stroke ({loop.hysteresis_feedforward.key}): it is run "
+                         f"by scan (motionhyst scan)")
+
+
 def _check_feedforward(loop: Loop) -> None:
     """The continuous run takes the rigid-body feedforward ``M r''`` alone; say so otherwise."""
     ff = loop.ff
@@ -325,10 +349,7 @@ def simulate_chunks(loop: Loop, reference, duration: float, dt: float | None = N
         for i0 in range(0, whole.t.size, int(chunk)):
             yield Simulation(**{c: getattr(whole, c)[i0:i0 + int(chunk)] for c in cols})
         return
-    _check_feedforward(loop)
-    if isinstance(loop.hysteresis_feedforward, AlongStroke):
-        raise ValueError("a hysteresis feedforward model along the stroke is run by scan, not "
-                         "in chunks")
+    check_long_run(loop)
     engine = _Engine(loop, reference, dt, force)
     n = int(np.ceil(duration / engine.step)) + 1
     check_run_work(loop, n)
