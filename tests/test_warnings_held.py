@@ -242,3 +242,41 @@ def test_the_warnings_held_come_before_a_first_compilation_s_notice(tmp_path):
         "a motion stage's stroke: if the positions are not in metres, scale them (--scale "
         "displacement=0.001 for mm, 1e-6 for um)",
         "motionhyst: compiling numerical kernels on first use (cached for later runs) ..."]
+
+
+OLD_SPELLING = " (`motionhyst simulate` without --time-series is now `motionhyst steady`)"
+NOTICE = ("motionhyst simulate: without --time-series this computes the periodic steady state; "
+          "the command for that is now `motionhyst steady`")
+
+
+@pytest.mark.parametrize(("files", "argv", "error"), [
+    # refused once the loop is built, after the stage's mass was warned of
+    ({"s.toml": _light_10khz()}, ["simulate", "s.toml", "--frequency", "7"], SEVEN_HZ),
+    # refused as the scenario is read
+    ({}, ["simulate", "none.toml"], "motionhyst: error: none.toml: cannot read"),
+    # refused as the options are read
+    ({"s.toml": _light_10khz()}, ["simulate", "s.toml", "--duration", "1"],
+     "motionhyst: error: simulate: --duration has no effect without --time-series")])
+def test_an_old_spelling_s_refusal_is_one_line_that_names_the_new_one(
+        tmp_path, capsys, monkeypatch, files, argv, error):
+    """Review B18 M2: the old spelling's notice was held with the warnings and dropped by a
+    refusal (the user of the old spelling never told the new one); the notice before the
+    refusal would be two lines.  Now the refusal's one line ends with the new spelling."""
+    populate(tmp_path, files)
+    before = snapshot(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1, err
+    assert err.startswith(error) and err.endswith(OLD_SPELLING + "\n"), err
+    assert snapshot(tmp_path) == before
+
+
+def test_an_old_spelling_s_answer_comes_with_its_notice(tmp_path, capsys, monkeypatch):
+    """An answer shows the notice first (a refusal of the new spelling has no postscript)."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", str(EXAMPLES / "paper.toml"), "--frequency", "5"]) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith("Exact periodic steady state") and err.splitlines()[0] == NOTICE
+    assert main(["steady", "none.toml"]) == 2
+    assert capsys.readouterr().err.endswith("cannot read (No such file or directory)\n")

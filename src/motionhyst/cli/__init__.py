@@ -372,21 +372,23 @@ def _failed(exc: Exception, held: HeldWarnings) -> int:
         held.drop()
     else:
         held.release()
+    # an old spelling's new one ends the refusal's line (cli._common.old_spelling)
+    tail = f" ({held.postscript})" if held.postscript else ""
     try:
         raise exc
     except UsageError as exc:  # "motionhyst identify: ..." -> "motionhyst: error: identify: ..."
         # "motionhyst identify: ..." of a command's parser, "motionhyst: ..." of the top one
         text = str(exc).removeprefix("motionhyst ").removeprefix("motionhyst: ")
-        _say(f"motionhyst: error: {one_line(text)}")
+        _say(f"motionhyst: error: {one_line(text)}{tail}")
     except OSError as exc:  # "No space left on device: out.csv", not "[Errno 28] ... 'out.csv'"
         text = (f"{exc.filename}: {exc.strerror}" if exc.strerror and exc.filename is not None
                 else exc.strerror or str(exc))
-        _say(f"motionhyst: error: {one_line(text)}")
+        _say(f"motionhyst: error: {one_line(text)}{tail}")
     except (ValueError, RuntimeError) as exc:
-        _say(f"motionhyst: error: {one_line(str(exc))}")
+        _say(f"motionhyst: error: {one_line(str(exc))}{tail}")
     except MemoryError:  # an estimate missed: still one line, and the remedy
         _say("motionhyst: error: out of memory; give a smaller problem (or a larger "
-             "--max-memory, if the machine has it)")
+             f"--max-memory, if the machine has it){tail}")
     except Exception as exc:  # a defect of the tool, not the input: one line, exit 1
         if os.environ.get(TRACEBACK_VARIABLE):
             raise

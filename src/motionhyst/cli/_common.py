@@ -14,9 +14,26 @@ from collections.abc import Callable, Iterator, Sequence
 
 from motionhyst.core.textfmt import g, table
 
-__all__ = ["EXIT_USAGE", "HeldWarnings", "Parser", "UsageError", "add_record_options", "finite",
-           "g", "harmonic_count", "memory_size", "nonnegative", "one_line", "positive",
-           "print_json", "release_held", "say_later", "table", "whole_number"]
+__all__ = [
+    "EXIT_USAGE",
+    "HeldWarnings",
+    "Parser",
+    "UsageError",
+    "add_record_options",
+    "finite",
+    "g",
+    "harmonic_count",
+    "memory_size",
+    "nonnegative",
+    "old_spelling",
+    "one_line",
+    "positive",
+    "print_json",
+    "release_held",
+    "say_later",
+    "table",
+    "whole_number",
+]
 
 EXIT_USAGE = 2
 """Exit code of every user error."""
@@ -366,6 +383,8 @@ class HeldWarnings:
         self.lines: list[str] = []
         self.holding = False
         self.pid = os.getpid()
+        #: What ends a refusal's one line (an old spelling's new one: :func:`old_spelling`)
+        self.postscript = ""
 
     def hold(self) -> None:
         """Hold the lines from now on, until :meth:`release` or :meth:`drop`."""
@@ -436,6 +455,31 @@ def say_later(line: str) -> None:
         _RUNNING[-1].say(line)
     else:
         _write_lines([line])
+
+
+def old_spelling(notice: str, postscript: str) -> None:
+    """The running command was given in an old spelling: `notice` (the whole line) is shown
+    with its warnings (:func:`say_later`), and a refusal, which drops them to be one line,
+    ends that line with ``(postscript)``: the user learns the new spelling either way.
+
+    Parameters
+    ----------
+    notice : str
+        The line ``motionhyst COMMAND: ... is now ...``.
+    postscript : str
+        Its short form, ending a refusal's line.
+
+    Examples
+    --------
+    >>> import contextlib, sys
+    >>> with contextlib.redirect_stderr(sys.stdout):       # outside a command: at once
+    ...     old_spelling("motionhyst old: the command is now `motionhyst new`",
+    ...                  "`motionhyst old` is now `motionhyst new`")
+    motionhyst old: the command is now `motionhyst new`
+    """
+    say_later(notice)
+    if _RUNNING:
+        _RUNNING[-1].postscript = postscript
 
 
 def release_held() -> None:

@@ -16,6 +16,7 @@ from motionhyst.cli._common import (
     distinct,
     fast_pole,
     in_the_commands_terms,
+    old_spelling,
     output_file,
     positive,
     print_json,
@@ -53,13 +54,15 @@ def run(args: argparse.Namespace) -> int:
     from motionhyst.cli import steady
     from motionhyst.scenario import load_scenario
 
+    if not args.time_series:  # its notice shown with its warnings, or ending its refusal
+        old_spelling("motionhyst simulate: without --time-series this computes the periodic "
+                     "steady state; the command for that is now `motionhyst steady`",
+                     "`motionhyst simulate` without --time-series is now `motionhyst steady`")
     args.frequency = distinct(args.frequency, "--frequency", "simulate")
     if not args.time_series:
         refuse_unused(args, TIME_SERIES_ONLY, "without --time-series (it shapes the transient "
                       "run written to CSV)")
-        return steady.run(args, notice="motionhyst simulate: without --time-series this "
-                          "computes the periodic steady state; the command for that is now "
-                          "`motionhyst steady`")
+        return steady.run(args)
     # the loop is built (python-control) once the run's options and files are checked
     return _time_series(args, load_scenario(args.scenario, check=False))
 

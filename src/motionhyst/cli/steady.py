@@ -12,7 +12,6 @@ from motionhyst.cli._common import (
     print_json,
     refuse_along_stroke_for,
     release_held,
-    say_later,
     scenario_frequencies,
     warn_plant_fit,
 )
@@ -21,10 +20,8 @@ from motionhyst.cli._common import (
 __all__ = []
 
 
-def run(args: argparse.Namespace, notice: str = "") -> int:
-    """Exact periodic steady state of the nonlinear loop, next to the describing function;
-    `notice` (an old spelling's) goes to stderr with the warnings, once the input is checked,
-    before the work: a refusal stays one line."""
+def run(args: argparse.Namespace) -> int:
+    """Exact periodic steady state of the nonlinear loop, next to the describing function."""
     from motionhyst.scenario import load_scenario
 
     args.frequency = distinct(args.frequency, "--frequency", args.command)
@@ -45,8 +42,6 @@ def run(args: argparse.Namespace, notice: str = "") -> int:
         option = "--no-floquet" if args.command == "steady" else "motionhyst steady --no-floquet"
         check_floquet_budget(loop, freqs, remedy=f"give fewer frequencies ({given}) or leave "
                                                  f"the multipliers out ({option})")
-    if notice:
-        say_later(notice)
     check_frequency_range(loop, freqs)  # what the analysis refuses as it starts: before
     check_steady_frequencies(loop, freqs)  # the warnings held are shown
     # the steady states refuse a loop that hunts (or a link too stiff for it) once computed:
