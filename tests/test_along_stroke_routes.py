@@ -187,15 +187,45 @@ def test_study_of_a_link_along_the_stroke(tmp_path, capsys):
     assert not (tmp_path / "e.zarr").exists()
 
 
-def test_a_spring_that_never_slips_scaled_along_the_stroke_has_no_steady_state(stage,
-                                                                             controller):
-    # k0 of a Maxwell-Iwan link (a spring in parallel) held piece by piece: its force moves
-    # by 2e-4 of itself every period (in simulate as well), the change does not shrink
+def test_a_spring_that_never_slips_scaled_along_the_stroke_is_refused(stage, controller):
+    # k0 of a Maxwell-Iwan link (a spring in parallel) held piece by piece: its force moved
+    # by 3e-4 of its peak every period in simulate and scan (the step across a cell edge
+    # taken with the new cell's k0 one way, the old one's the other), and the steady state
+    # refused it after 2000 periods; now the table is refused as it is read, everywhere
     base, _ = LINKS["maxwell-iwan"]
-    link = AlongStroke(base, POSITION, {"k0": [0.5, 2.0]})
-    with pytest.raises(RuntimeError, match=r"no periodic force.*\[hysteresis\] along|"
-                                           r"\[hysteresis\] along.*no periodic force"):
-        periodic_steady_state(Loop(stage, controller, link), A, F)
+    with pytest.raises(ValueError, match="k0 of the maxwell-iwan model is a spring that "
+                                         "never slips"):
+        AlongStroke(base, POSITION, {"k0": [0.5, 2.0]})
+    unit = AlongStroke(base, POSITION, {"k0": [1.0, 1.0], "ki": [0.5, 2.0]})  # k0 constant
+    assert unit.at(A).k0 == base.k0
+    ss = periodic_steady_state(Loop(stage, controller, unit), A, F)
+    assert np.isfinite(ss.e[1])
+
+
+@pytest.mark.parametrize("section", ["hysteresis", "feedforward"])
+@pytest.mark.parametrize("command", [
+    ["steady"], ["simulate", "--time-series", "run.csv", "--frequency", "5"],
+    ["scan", "--length", "0.002", "--speed", "0.01", "--a-max", "1", "--j-max", "100",
+     "--s-max", "1e4"]])
+def test_a_spring_that_never_slips_along_the_stroke_is_one_line(tmp_path, capsys,
+                                                                monkeypatch, section, command):
+    d = default_scenario().to_dict()
+    base, _ = LINKS["maxwell-iwan"]
+    table = {**base.to_dict(), "along": {"position": POSITION, "k0": [0.5, 2.0]}}
+    path = tmp_path / "s.toml"
+    body = "".join(toml_table(k, v) for k, v in d.items() if k not in ("hysteresis",
+                                                                        "feedforward"))
+    body += toml_table("hysteresis", table if section == "hysteresis" else d["hysteresis"])
+    body += toml_table("feedforward", {"type": "rigid-body", **(
+        {"hysteresis": table} if section == "feedforward" else {})})
+    path.write_text(body)
+    monkeypatch.chdir(tmp_path)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert cli_main([command[0], str(path), *command[1:]]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert f"[{section}]" in err and "k0 of the maxwell-iwan model" in err, err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_sampled_loop_runs_a_rate_dependent_feedforward_over_its_samples():
@@ -302,7 +332,7 @@ def test_refusals_name_the_feedforward_s_key(tmp_path, capsys, command):
     assert cli_main([command, str(path), *args]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err, err
-    assert "[feedforward.hysteresis] along" in err and "[hysteresis] along" not in err, err
+    assert "[feedforward] hysteresis.along" in err and "[hysteresis] along" not in err, err
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
@@ -310,7 +340,7 @@ def test_a_feedforward_model_along_the_stroke_names_its_key_in_the_api(stage, co
     sc = Scenario.from_dict({**default_scenario().to_dict(), "feedforward": {
         "type": "rigid-body", "hysteresis": {**LINKS["jenkins"][0].to_dict(), "along": {
             "position": POSITION, "fc": [0.5, 2.0]}}}}, "s.toml")
-    assert sc.along_keys == ["[feedforward.hysteresis] along"]
-    assert sc.loop().hysteresis_feedforward.key == "[feedforward.hysteresis] along"
+    assert sc.along_keys == ["[feedforward] hysteresis.along"]
+    assert sc.loop().hysteresis_feedforward.key == "[feedforward] hysteresis.along"
     assert sc.loop().hysteresis_feedforward.shifted(0.001).key == sc.along_keys[0]
     assert _sampled_scenario(None).along_keys == ["[hysteresis] along"]

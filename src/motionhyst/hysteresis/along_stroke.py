@@ -62,7 +62,7 @@ NO_DESCRIBING_FUNCTION = ("a link along the stroke ({key}) has no describing "
 #: The scenario's key of a link along the stroke (``key`` of :class:`AlongStroke`) ...
 LINK_KEY = "[hysteresis] along"
 #: ... and of the feedforward's model of it.
-FEEDFORWARD_KEY = "[feedforward.hysteresis] along"
+FEEDFORWARD_KEY = "[feedforward] hysteresis.along"
 
 
 class AlongStroke(Hysteresis):
@@ -117,6 +117,12 @@ class AlongStroke(Hysteresis):
             if v.shape != x.shape or not np.all(np.isfinite(v)) or np.any(v <= 0):
                 raise ValueError(f"the scales of {name} must be {x.size} positive values, one "
                                  "per position")
+            if name in base.never_slips and np.ptp(v) > 0:
+                raise ValueError(
+                    f"{name} of the {base.name} model is a spring that never slips: scaled "
+                    f"along the stroke its force would depend on the path, not the "
+                    f"position (a run drifts every period, a steady state has none); keep "
+                    f"{name} constant along the stroke and scale the parts that slip")
             self.scales[name] = v
         self.rate_independent = base.rate_independent
         self.parameters = base.parameters

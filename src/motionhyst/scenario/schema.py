@@ -183,7 +183,7 @@ class Scenario:
     @property
     def along_keys(self) -> list[str]:
         """The keys that vary a link along the stroke, as the scenario writes them
-        (``[hysteresis] along``, ``[feedforward.hysteresis] along``): named in refusals."""
+        (``[hysteresis] along``, ``[feedforward] hysteresis.along``): named in refusals."""
         from motionhyst.hysteresis.along_stroke import FEEDFORWARD_KEY, LINK_KEY
 
         ff = self.model.feedforward
