@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from motionhyst.analysis.equations import over_error_without_link
 from motionhyst.analysis.floquet import (
     FloquetResult,
     check_floquet_budget,
@@ -37,7 +38,8 @@ from motionhyst.core.budget import BudgetError
 from motionhyst.core.textfmt import g, table
 from motionhyst.core.warnings import warn
 
-__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
+__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function",
+           "exact_mismatch"]
 
 
 @dataclass
@@ -74,8 +76,12 @@ class ComparisonPoint:
         """JSON-ready dictionary: one point of the ``steady --json`` schema (with
         ``floquet_max`` and ``stable`` when the multipliers were computed; null where
         they cannot be)."""
-        out = self.state.to_dict(mismatch_df=self.mismatch_df,
-                                 error_harmonics_df=self.error_harmonics_df)
+        with np.errstate(divide="ignore", invalid="ignore"):  # nan below where e_hat = 0
+            out = self.state.to_dict(mismatch_df=self.mismatch_df,
+                                     error_harmonics_df=self.error_harmonics_df)
+        E = exact_mismatch(self.state)
+        out["mismatch_simulated_abs"] = abs(E)
+        out["mismatch_simulated_phase_deg"] = float(np.degrees(np.angle(E)))
         if self.floquet is not False:
             f = self.floquet
             out.update({"floquet_max": None, "stable": None} if f is None else f.to_dict())
@@ -125,7 +131,16 @@ class DescribingFunctionComparison:
         return table(["f [Hz]", "|e1| [m]", "angle e1 [deg]", "|e3| [m]", "|e3| HOSIDF",
                       "|e5| [m]", "|e5| HOSIDF",
                       "|e1 lin| [m]", "|E sim|", "angle E sim", "|E df| (18)", "angle E df",
-                      "peak e [m]", "rms e-e_lin [m]"], rows) + self._floquet_lines()
+                      "peak e [m]", "rms e-e_lin [m]"], rows) + self._undefined_line() + \
+            self._floquet_lines()
+
+    def _undefined_line(self) -> str:
+        """Why E is nan where the loop without the link has no error (e1 linear = 0)."""
+        if all(p.state.e_linear[1] != 0 for p in self.points):
+            return ""
+        return ("\n  E (sim and eq. 18) is not defined where |e1 lin| = 0: the plant has no "
+                "flexible part (Pf2 = Pr - P2 = 0), so its rigid-body feedforward leaves no "
+                "error without the link; e1 is the link's error")
 
     def _floquet_lines(self) -> str:
         lines = []
@@ -154,6 +169,25 @@ class DescribingFunctionComparison:
         return fig11_errors([p.state for p in self.points],
                             [p.mismatch_df for p in self.points],
                             [p.error_harmonics_df for p in self.points], ax=ax)
+
+
+def exact_mismatch(state: SteadyState) -> complex:
+    """The exact mismatch ``E_sim = e1 / e1_linear`` of a steady state (compare eq. 18),
+    nan where the loop without the link has no error (a rigid plant under its rigid-body
+    feedforward: :func:`~motionhyst.analysis.equations.over_error_without_link`).
+
+    Parameters
+    ----------
+    state : SteadyState
+        The exact periodic steady state.
+
+    Examples
+    --------
+    >>> from motionhyst import default_scenario, periodic_steady_state
+    >>> round(abs(exact_mismatch(periodic_steady_state(default_scenario().loop(), 0.01, 5.0))), 2)
+    6.04
+    """
+    return complex(over_error_without_link(state.e[1], state.e_linear[1]))
 
 
 def _steady_states(loop: Loop, amplitude: float, f: NDArray[np.float64]) -> list[SteadyState]:

@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.lti import TWO_PI
 
-__all__ = ["f_star", "mismatch", "mismatch_asymptote", "mismatch_crossover", "quasi_linear_plant",
-           "sensitivity_s1"]
+__all__ = ["f_star", "mismatch", "mismatch_asymptote", "mismatch_crossover",
+           "over_error_without_link", "quasi_linear_plant", "sensitivity_s1"]
 
 
 def quasi_linear_plant(P1: ArrayLike, P2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
@@ -96,7 +96,33 @@ def mismatch(C: ArrayLike, P1: ArrayLike, P2: ArrayLike, Pr: ArrayLike, Pf2: Arr
     """
     C, P1, P2, Pr, Pf2, D = (np.asarray(x) for x in (C, P1, P2, Pr, Pf2, D))
     S1 = sensitivity_s1(P1, D)
-    return (C * P2 + 1.0) * (Pf2 + P2 * D * P1 * S1) / (Pf2 * (C * P2 * S1 + 1.0))
+    return over_error_without_link((C * P2 + 1.0) * (Pf2 + P2 * D * P1 * S1),
+                                   Pf2 * (C * P2 * S1 + 1.0))
+
+
+def over_error_without_link(e: ArrayLike, e_hat: ArrayLike) -> NDArray[np.complex128]:
+    """``e / e_hat``, the quotient of a mismatch (eqs. 18, 20), nan where ``e_hat = 0``.
+
+    With a rigid plant (``Pf2 = Pr - P2 = 0``: a mass-damper with ``c = 0``) the
+    rigid-body feedforward ``M r''`` leaves no error without the link, so the mismatch
+    compares the link's error with nothing: it is not defined (nan, never ``inf`` and
+    numpy's division warning).
+
+    Parameters
+    ----------
+    e : array_like
+        The error with the link (or a quantity proportional to it).
+    e_hat : array_like
+        The error without it, in the same proportion.
+
+    Examples
+    --------
+    >>> over_error_without_link([2.0, 1.0], [4.0, 0.0]).tolist()
+    [(0.5+0j), (nan+nanj)]
+    """
+    e, e_hat = np.asarray(e, dtype=complex), np.asarray(e_hat, dtype=complex)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(e_hat == 0, complex(np.nan, np.nan), e / np.where(e_hat == 0, 1, e_hat))
 
 
 def mismatch_asymptote(Pr: ArrayLike, Pf2: ArrayLike, D: ArrayLike) -> NDArray[np.complex128]:
@@ -124,7 +150,7 @@ def mismatch_asymptote(Pr: ArrayLike, Pf2: ArrayLike, D: ArrayLike) -> NDArray[n
     >>> np.abs(mismatch_asymptote(Pr, Pf2, D)).round(2).tolist()
     [5.36]
     """
-    return np.asarray(Pr) ** 2 * np.asarray(D) / np.asarray(Pf2)
+    return over_error_without_link(np.asarray(Pr) ** 2 * np.asarray(D), Pf2)
 
 
 def f_star(k: float, M: float) -> float:

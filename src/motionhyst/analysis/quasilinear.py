@@ -32,7 +32,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from motionhyst.analysis.equations import f_star, mismatch, mismatch_asymptote, mismatch_crossover
+from motionhyst.analysis.equations import (
+    f_star,
+    mismatch,
+    mismatch_asymptote,
+    mismatch_crossover,
+    over_error_without_link,
+)
 from motionhyst.analysis.equations import quasi_linear_plant as quasi_linear_plant
 from motionhyst.analysis.equations import sensitivity_s1 as sensitivity_s1
 from motionhyst.analysis.margins import LoopMargins, loop_margins
@@ -125,10 +131,12 @@ class QuasiLinearAnalysis:
         Gain, phase and modulus margins of the linear loop ``C P2``
         (:func:`motionhyst.analysis.margins.loop_margins`).
     unresolved : list of str
-        For raw measured data (``use = "data"``), the quantities the data
-        cannot give and why (they are nan): frequencies that are not measured
-        lines, lines where ``Pf2 = Pr - P2`` is below the data's resolution,
-        eq. (21).  Empty for a model.
+        The quantities that are nan and why.  For raw measured data (``use = "data"``):
+        frequencies that are not measured lines, lines where ``Pf2 = Pr - P2`` is below
+        the data's resolution, eq. (21).  For a model: eq. (21) without a flexible mode,
+        and ``E`` of a rigid plant (:data:`NO_ERROR_WITHOUT_LINK`).
+    measured : bool
+        The plant is raw measured data.
     sampling : str or None
         For a sampled controller: its rate, delay and feedforward advance, and
         what the analysis approximates above the Nyquist frequency.
@@ -162,6 +170,7 @@ class QuasiLinearAnalysis:
     margins: LoopMargins | None = None
     unresolved: list[str] = field(default_factory=list)
     sampling: str | None = None
+    measured: bool = False
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``analyze --json`` schema)."""
@@ -220,7 +229,8 @@ class QuasiLinearAnalysis:
                             "A_y1 [m]"], rows))
         if self.unresolved:
             lines += ["", "Not resolved from the raw measured data (nan above; fit the data "
-                      'with [plant] use = "fit" to get them):']
+                      'with [plant] use = "fit" to get them):' if self.measured else
+                      "Not resolved (nan above):"]
             lines += [f"  - {u}" for u in self.unresolved]
         return "\n".join(lines)
 
@@ -344,10 +354,10 @@ def residual_mismatch(loop: Loop, omega: ArrayLike, D: ArrayLike, D_ff: ArrayLik
     D, D_ff = np.asarray(D), np.asarray(D_ff)
     if loop.sampled is None:
         y1 = (t_ry1 - t_wy1 * D_ff) / (1.0 - t_wy1 * D)
-        return 1.0 + t_we * (D * y1 - D_ff) / t_re
+        return 1.0 + over_error_without_link(t_we * (D * y1 - D_ff), t_re)
     t_fe, t_fy1 = loop.transfer("f->e", w), loop.transfer("f->y1", w)
     y1 = (t_ry1 + t_fy1 * D_ff) / (1.0 - t_wy1 * D)
-    return 1.0 + (t_we * D * y1 + t_fe * D_ff) / t_re
+    return 1.0 + over_error_without_link(t_we * D * y1 + t_fe * D_ff, t_re)
 
 
 def error_harmonics_df(loop: Loop, amplitude: float, frequency_hz: float, n_max: int = 5,
@@ -576,6 +586,8 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
             warn(f"|C P2| does not fall through 1 in the range searched: the loop has no "
                  f"bandwidth; are the moving mass M = {g(loop.M)} kg and the controller's gain "
                  f"what was meant?")
+        if not np.all(np.isfinite(E)):  # e_hat = 0: nan, not inf (eqs. 18, 20)
+            unresolved.append(NO_ERROR_WITHOUT_LINK.format(plant=loop.plant.name))
         if q is None:  # eq. (21) does not apply: say so rather than print nan
             unresolved.append(f"eq. (21): needs a flexible mode with a static compliance "
                               f"Pf2(0) > 0 (the two-mass stage's m1 m2 / (k M^2)); the "
@@ -588,7 +600,7 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
         f_star_hz=f_star(k_link, loop.M), bandwidth_hz=bandwidth_hz, margins=margins,
         mismatch_crossover_hz=crossover, mismatch_crossover_exact_hz=crossover_exact,
         points=points, amplitude_mode=amplitude_mode, df_frequency_hz=f_df,
-        unresolved=unresolved, sampling=sampling)
+        unresolved=unresolved, sampling=sampling, measured=not loop.plant.is_lti)
 
 
 def _sampling_note(loop: Loop, f: NDArray[np.float64]) -> str:
@@ -611,6 +623,11 @@ def _sampling_note(loop: Loop, f: NDArray[np.float64]) -> str:
             f"images at f + k {c.sample_rate_hz:g} Hz reach the plant without it){above}")
 
 
+#: Why ``E`` and ``E~`` (eqs. 18, 20) are nan for a rigid plant (its name for ``{plant}``).
+NO_ERROR_WITHOUT_LINK = ("E and E~ (eqs. 18, 20): not defined: the {plant} plant has no "
+                         "flexible part (Pf2 = Pr - P2 = 0), so its rigid-body feedforward "
+                         "leaves no error without the link (e_hat = 0) to compare the link's "
+                         "error with; the steady state's e1 is that error")
 #: ``Pf2 = Pr - P2`` counts as resolved by data where ``|Pf2| / |P2|`` exceeds this many times
 #: the data's relative scatter (three standard deviations).
 RESOLUTION_FACTOR = 3.0

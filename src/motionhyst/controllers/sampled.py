@@ -394,10 +394,13 @@ class SampledController:
             Angular frequencies [rad/s].
         """
         zinv = np.exp(-1j * np.asarray(omega, dtype=float) * self.period)
-        Y = polyval_zinv(self.y_num, zinv) / polyval_zinv(self.y_den, zinv)
-        if self.one_dof:
-            return Y, Y
-        return polyval_zinv(self.r_num, zinv) / polyval_zinv(self.r_den, zinv), Y
+        # at a pole (an integrator's z = 1) infinite, nan where a zero meets it: the periodic
+        # steady state sets that point (z_0 of a free plant) from the static balance
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Y = polyval_zinv(self.y_num, zinv) / polyval_zinv(self.y_den, zinv)
+            if self.one_dof:
+                return Y, Y
+            return polyval_zinv(self.r_num, zinv) / polyval_zinv(self.r_den, zinv), Y
 
     def feedback_response(self, omega: ArrayLike) -> NDArray[np.complex128]:
         """The feedback path ``Y(e^{j w T})`` (the controller of the stability margins).

@@ -165,9 +165,12 @@ def _report_text(sc: Scenario, link: Hysteresis, analysis: QuasiLinearAnalysis,
                   "\\|e1\\| [m] | \\|e3\\| [m] | peak e [m] |", "|---|---|---|---|---|---|---|---|"]
     for st, E in zip(states, E_df, strict=True):
         e3 = float(abs(st.e[3])) if st.n_harmonics >= 3 else None
+        from motionhyst.analysis.comparison import exact_mismatch
+
+        E_sim = exact_mismatch(st)  # nan where the loop without the link has no error
         lines.append(f"| {_fmt(st.frequency_hz)} | {_fmt(abs(E))} | "
-                     f"{np.degrees(np.angle(E)):.2f} | {_fmt(abs(st.mismatch))} | "
-                     f"{np.degrees(np.angle(st.mismatch)):.2f} | {_fmt(float(abs(st.e[1])))} | "
+                     f"{np.degrees(np.angle(E)):.2f} | {_fmt(abs(E_sim))} | "
+                     f"{np.degrees(np.angle(E_sim)):.2f} | {_fmt(float(abs(st.e[1])))} | "
                      f"{_fmt(e3)} | {_fmt(st.error_peak)} |")
     if digital is not None:
         lines += ["", "## The loop as a real-time computer runs it", "",
@@ -297,6 +300,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             # (python-control) and builds the loop; the later workers inherit both from this
             # process (python-control imports matplotlib)
             figures.submit(_link_figures(el, A, freqs))
+            from motionhyst.analysis.comparison import ComparisonPoint
             from motionhyst.analysis.hunting import steady_state_unless_hunting
             from motionhyst.analysis.plausibility import check_frequency_range
             from motionhyst.analysis.quasilinear import analyze, error_harmonics_df, loop_mismatch
@@ -346,7 +350,7 @@ def reproduce(sc: Scenario, out_dir: str | Path, quiet: bool = False,
             summary = {
                 "scenario": sc.to_dict(),
                 "analyze": analysis.to_dict(),
-                "simulate": {"points": [s.to_dict(mismatch_df=complex(e), error_harmonics_df=h)
+                "simulate": {"points": [ComparisonPoint(s, complex(e), h).to_dict()
                                         for s, e, h in zip(states, E_df, H_df, strict=True)]},
             }
             if fit is not None:
