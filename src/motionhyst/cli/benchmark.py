@@ -138,6 +138,32 @@ def _emps_record(path: Path, name: str):
     return IORecord(data[:, 0], data[:, 1], data[:, 2], name)
 
 
+EMPS_SECONDS_PER_SAMPLE = 1e-3
+"""The least CPU time of one model's fit and scores per sample of the record it is identified
+from [s] (measured: 18-54 s for the Coulomb and Jenkins links on 12480 samples of DATA_EMPS):
+``benchmark emps`` estimates its run from it and refuses one above ``--max-seconds`` before
+it starts."""
+EMPS_REMEDY = ("give fewer --models, one split (--periods 1-2), or a larger --max-seconds (the "
+               "default models take about 5 min of CPU time)")
+"""What a user can change when ``benchmark emps`` is above its work budget."""
+
+
+def _emps_seconds(estimation, test, periods, models) -> float:
+    """The least CPU time the fits of ``benchmark emps`` take [s]: each model once a split
+    (both halves of DATA_EMPS by default, four splits with ``--periods all``, the whole
+    record with the test record), :data:`EMPS_SECONDS_PER_SAMPLE` a sample identified from."""
+    from motionhyst.identify.emps import MODELS, PERIOD
+
+    n = estimation.t.size
+    if test is not None or periods is None:  # the whole record, or each half once
+        samples = n
+    elif periods == "all":  # the halves, then all periods but the last and all but the first
+        samples = n + 2 * max(n - PERIOD, 0)
+    else:
+        samples = min((periods[1] - periods[0] + 1) * PERIOD, n)
+    return len(MODELS if models is None else models) * samples * EMPS_SECONDS_PER_SAMPLE
+
+
 def run_emps(args: argparse.Namespace) -> int:
     """Identify the EMPS axis on DATA_EMPS.mat and score each model; print the table or JSON."""
     from motionhyst.identify.emps_files import ESTIMATION_FILE, TEST_FILE
@@ -173,19 +199,23 @@ def run_emps(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst benchmark emps: --periods splits DATA_EMPS when there is "
                          f"no test record; {test_path} is there")
     # the optimisers imported once the folder, its records and the options are known good
+    from motionhyst.core.budget import check_work, cpu_time_limit, max_seconds
     from motionhyst.identify.emps import CHOSEN, choose, cross_validate, run_emps
 
     def say(msg: str) -> None:
         if not args.json:
             print(f"  {msg}", file=sys.stderr, flush=True)
 
+    check_work(_emps_seconds(estimation, test, args.periods, models), "benchmark emps",
+               EMPS_REMEDY)
     release_held()  # the fits start: the warnings so far are shown
-    if test is None and args.periods in (None, "all"):  # one split alone says little
-        results = cross_validate(estimation, models=models, progress=say,
-                                 splits="halves" if args.periods is None else "all")
-    else:
-        results = [run_emps(estimation, test, models=models, periods=args.periods or (1, 2),
-                            progress=say)]
+    with cpu_time_limit(max_seconds(), "benchmark emps", EMPS_REMEDY):
+        if test is None and args.periods in (None, "all"):  # one split alone says little
+            results = cross_validate(estimation, models=models, progress=say,
+                                     splits="halves" if args.periods is None else "all")
+        else:
+            results = [run_emps(estimation, test, models=models,
+                                periods=args.periods or (1, 2), progress=say)]
     chosen = None
     if len(results) > 1:
         picked = choose(results)  # None: every model failed on some split
