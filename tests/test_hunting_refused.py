@@ -132,10 +132,11 @@ def test_a_fixed_point_that_came_near_an_answer_is_not_called_hunting(monkeypatc
     assert hunting.hunting_refusal(loop, near, 0.01) is near
 
 
-def _independent_run(fs: float, f: float, amplitude: float, t_end: float, ki: float = 4.0):
+def _independent_run(fs: float, f: float, amplitude: float, t_end: float, ki: float = 4.0,
+                     integral: float = 0.0):
     """The hunting loop with friction `fs` (and integral gain `ki`) driven by ``r = amplitude
-    sin(2 pi f t)`` from rest, written out (states y, v, the integral of the error, z; no
-    feedforward)."""
+    sin(2 pi f t)`` from rest (the PID's integral of the error starting at `integral`), written
+    out (states y, v, the integral of the error, z; no feedforward)."""
     from scipy.integrate import solve_ivp
 
     m, kp, kd = 1.0, 3.0, 6.0
