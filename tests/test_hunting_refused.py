@@ -2,8 +2,10 @@
 
 ``examples/hunting.toml`` (Olsson and Astrom 2001: a 1 kg mass on LuGre friction with a
 Stribeck dip under a PID) has a stable self-excited cycle of 24.437 s (tests/test_stability.py
-checks its exact orbit against a stiff-ODE run).  Driven at 0.005 Hz, 10 mm (its integrator
-winds up over the reference's half period of 100 s) it slips at that cycle's rhythm and has
+checks its exact orbit against a stiff-ODE run).  Driven at 0.002 Hz, 10 mm (its integrator
+winds up over the reference's half period of 250 s to ki A / w = 3.2 N, past the 1.5 N of
+breakaway: no stuck state holds it; at 0.005 Hz, 1.27 N, a stuck steady state exists beside
+the hunting a run from rest finds) it slips at that cycle's rhythm and has
 no steady state of the reference's period: the fixed point makes no progress.  Main said so
 after the fixed point's 50 passes and the whole stability analysis (9.3 s of CPU at a load
 of 10), on a second line below a warning about f*; ``study`` and ``reproduce`` said "the
@@ -72,11 +74,11 @@ def test_the_run_from_rest_finds_the_cycle_and_its_period():
 def test_steady_refuses_in_one_line_without_the_warning_it_makes_moot(tmp_path):
     """Main printed the warning 'below f* = 50.3 Hz' (held while the input was checked, shown
     as the work started) and the refusal below it; the warnings now wait for the answer.
-    Driven at 0.005 Hz, 10 mm, the loop hunts (tests/test_hunting_driven.py runs it)."""
+    Driven at 0.002 Hz, 10 mm, the loop hunts."""
     populate(tmp_path, {"hunting.toml": HUNTING})
     before = snapshot(tmp_path)
-    line = _one_refusal(probe(["steady", "hunting.toml", "--frequency", "0.005"], tmp_path))
-    assert line.startswith("motionhyst: error: steady state at 0.005 Hz: the loop hunts: driven "
+    line = _one_refusal(probe(["steady", "hunting.toml", "--frequency", "0.002"], tmp_path))
+    assert line.startswith("motionhyst: error: steady state at 0.002 Hz: the loop hunts: driven "
                            "from rest, a run in time slips at its own rhythm"), line
     # the remedy names what a run in time of this loop needs: its PID has a pure derivative
     assert "derivative_filter_hz" in line
@@ -96,7 +98,7 @@ def test_steady_still_warns_when_it_answers(tmp_path):
 
 def test_study_points_say_the_loop_hunts(tmp_path):
     study = ('scenario = "hunting.toml"\noutputs = ["e1"]\n\n[axes]\namplitude = [0.01]\n'
-             'frequency_hz = [0.005, 0.002]\n')
+             'frequency_hz = [0.002, 0.003]\n')
     populate(tmp_path, {"hunting.toml": HUNTING, "s.toml": study})
     line = _one_refusal(probe(["study", "s.toml", "--out", "s.zarr", "--workers", "0"],
                               tmp_path))
@@ -107,8 +109,8 @@ def test_reproduce_refuses_in_one_line_before_writing(tmp_path):
     """With rigid-body feedforward (eq. 18's mismatch needs it): main printed three warnings
     (f*, numpy's divide by zero twice) and 'the dynamic link is too stiff'."""
     scenario = HUNTING.replace('[feedforward]\ntype = "none"', '[feedforward]\ntype = "rigid-body"'
-                               ).replace("frequencies = [0.1]", "frequencies = [0.005]")
-    assert scenario.count("0.005") == 1 and "rigid-body" in scenario
+                               ).replace("frequencies = [0.1]", "frequencies = [0.002]")
+    assert scenario.count("0.002") == 1 and "rigid-body" in scenario
     populate(tmp_path, {"h.toml": scenario})
     before = snapshot(tmp_path)
     _one_refusal(probe(["reproduce", "h.toml", "--out", "rep", "--quiet"], tmp_path))

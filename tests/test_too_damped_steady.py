@@ -280,26 +280,27 @@ def test_a_change_left_at_a_harmonic_is_judged_after_the_passes():
 
 
 def test_a_loop_that_hunts_is_said_to_hunt(tmp_path):
-    """``simulate examples/hunting.toml --frequency 0.005`` (the old spelling of ``steady``):
+    """``simulate examples/hunting.toml --frequency 0.002`` (the old spelling of ``steady``):
     the PID loop with a Stribeck dip has a self-excited cycle of 24.44 s (tests/test_stability.py
-    checks it against a stiff ODE solver); driven at 0.005 Hz, 10 mm it keeps slipping at that
-    rhythm (tests/test_hunting_driven.py), so its fixed point cannot settle.  Main said 'the
-    dynamic link is too stiff for this loop'; now one line says that it hunts, the cycle's
-    period and what to run instead.  (At the example's 0.1 Hz the driven loop sticks and
-    follows the reference: it is not said to hunt.)"""
-    out = probe(["simulate", str(EXAMPLES / "hunting.toml"), "--frequency", "0.005"], tmp_path)
+    checks it against a stiff ODE solver); driven at 0.002 Hz, 10 mm its integrator winds up
+    past the breakaway (ki A / w = 3.2 N against fs = 1.5 N) and it keeps slipping at that
+    rhythm, so its fixed point cannot settle.  Main said 'the dynamic link is too stiff for
+    this loop'; now one line says that it hunts, the cycle's period and what to run instead,
+    and names the new spelling.  (At the example's 0.1 Hz the driven loop sticks and has its
+    steady state: tests/test_hunting_refused.py.)"""
+    out = probe(["simulate", str(EXAMPLES / "hunting.toml"), "--frequency", "0.002"], tmp_path)
     assert out["rc"] == 2, out
     errors = [ln for ln in out["err"].splitlines() if ln.startswith("motionhyst: error")]
     assert len(errors) == 1 and "Traceback" not in out["err"], out["err"]
     assert errors[0].startswith(
-        "motionhyst: error: steady state at 0.005 Hz: the loop hunts: driven from rest, a run "
-        "in time slips at its own rhythm (its error crosses zero upward every 24.5 s, 8.18 "
-        "times the reference's 200 s period); with its setpoint held the loop has a "
+        "motionhyst: error: steady state at 0.002 Hz: the loop hunts: driven from rest, a run "
+        "in time slips at its own rhythm (its error crosses zero upward every 24.4 s, 20.5 "
+        "times the reference's 500 s period); with its setpoint held the loop has a "
         "stable self-excited limit cycle of period 24.44 s"), errors
     assert errors[0].endswith(
         "so no periodic steady state of the reference's period; run it in time (motionhyst "
         "simulate --time-series, with [controller] derivative_filter_hz: a pure derivative has "
-        "no run)"), errors
+        "no run) (`motionhyst simulate` without --time-series is now `motionhyst steady`)"), errors
 
 
 def test_a_refusal_names_the_bristle_damping_only_where_it_outweighs_their_stiffness():
