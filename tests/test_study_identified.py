@@ -477,3 +477,34 @@ def test_an_identification_whose_names_the_scenario_lacks_is_refused_before_its_
     study["samples"]["seed"] = -1
     with pytest.raises(StudyError, match=r"\[samples\] 'seed': give a whole number >= 0"):
         Study.from_dict(study, base_dir=tmp_path)
+
+
+def test_a_covariance_no_lognormal_has_is_refused_not_drawn_forever():
+    """k 2000 +- 1e6 and fc 2 +- 10 with correlation -0.23 (an identification with standard
+    errors far wider than its values, review B19 F15): ``log1p(C_kf / (m_k m_f))`` of a
+    covariance below ``-m_k m_f`` is NaN, every draw was NaN and redrawn, and ``study
+    --from-identification`` ran until killed (11 min); now one line saying why."""
+    c = -2.33e6
+    d = JointNormal(("hysteresis.k", "hysteresis.fc"), (2000.0, 2.0), ((1e12, c), (c, 100.0)),
+                    "id.toml")
+    assert d.log_space
+    with pytest.raises(ValueError, match=r"^id\.toml: the covariance of hysteresis\.k and "
+                                         r"hysteresis\.fc \(-2\.33e\+06\) is at or below minus "
+                                         r"the product of their means \(2000 x 2\)"):
+        d.draw(np.random.default_rng(0), 10)
+
+
+def test_draws_outside_the_admitted_values_are_redrawn_a_bounded_number_of_times(monkeypatch):
+    """A Bouc-Wen exponent nu = 1.05 +- 0.1 (normal draws: 0.095 relative) puts 31 % of its
+    draws below its least value 1: redrawn until every draw is admitted, and refused once the
+    rounds run out."""
+    from motionhyst.study import identified
+
+    d = JointNormal(("hysteresis.nu",), (1.05,), ((0.01,),))
+    assert not d.log_space
+    x = d.draw(np.random.default_rng(1), 20000)
+    assert np.all(x >= 1.0)
+    monkeypatch.setattr(identified, "MAX_REDRAWS", 0)
+    with pytest.raises(ValueError, match=r"^\d+ of 20000 draws still have a parameter outside "
+                                         r"its admitted values after 0 redraws"):
+        d.draw(np.random.default_rng(1), 20000)

@@ -209,10 +209,19 @@ class JointNormal:
         log = self.log_space
         mu, s = m.copy(), c.copy()
         if log:
-            s[np.ix_(p, p)] = np.log1p(c[np.ix_(p, p)] / np.outer(m[p], m[p]))
+            with np.errstate(invalid="ignore"):  # below -1: refused below
+                s[np.ix_(p, p)] = np.log1p(c[np.ix_(p, p)] / np.outer(m[p], m[p]))
             s[np.ix_(p, ~p)] = c[np.ix_(p, ~p)] / m[p][:, None]
             s[np.ix_(~p, p)] = s[np.ix_(p, ~p)].T
             mu[p] = np.log(m[p]) - np.diag(s)[p] / 2
+        where = f"{self.source}: " if self.source != "<dict>" else ""
+        if not np.all(np.isfinite(s)):  # log1p of C_ij / (m_i m_j) <= -1
+            i, j = np.argwhere(~np.isfinite(s))[0]
+            raise ValueError(f"{where}the covariance of {self.keys[i]} and {self.keys[j]} "
+                             f"({c[i, j]:.3g}) is at or below minus the product of their means "
+                             f"({m[i]:g} x {m[j]:g}): no lognormal draws have these means and "
+                             f"covariance (standard errors {self.std[i]:.3g} and "
+                             f"{self.std[j]:.3g}, too wide for the values to draw from)")
         factor = _factor(s)
 
         def sample(rows: int) -> NDArray[np.float64]:
@@ -229,7 +238,14 @@ class JointNormal:
 
         x = sample(n)
         bad = np.nonzero(outside(x))[0]
+        rounds = 0
         while bad.size:
+            rounds += 1
+            if rounds > MAX_REDRAWS:
+                raise ValueError(f"{where}{bad.size} of {n} draws still have a parameter "
+                                 f"outside its admitted values after {MAX_REDRAWS} redraws: "
+                                 f"the standard errors are too wide for the values to draw "
+                                 f"from")
             x[bad] = sample(bad.size)
             bad = bad[outside(x[bad])]
         return x
@@ -261,6 +277,12 @@ def _admitted(key: str, value: float) -> bool:
     if not math.isfinite(value):
         return False
     return least is None or (value >= least if least else value > least)
+
+
+MAX_REDRAWS = 1000
+"""Rounds of redrawing the draws with a parameter at or below its least value (each round
+keeps the admitted ones): a distribution that puts almost all its mass there is refused, not
+drawn from forever."""
 
 
 def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
