@@ -67,13 +67,19 @@ def test_a_plant_file_named_as_a_figure_is_not_replaced_by_it(tmp_path, monkeypa
 
 
 def test_the_files_a_toml_reads(tmp_path):
-    """A study's scenario and its plant, resolved against each TOML's folder; a TOML that
-    does not parse lists itself alone (its errors are the reader's)."""
+    """A study's scenario and its plant, resolved against each TOML's folder (the plant
+    against the study's too, as the study reads it), a study's [samples]
+    from_identification; a TOML that does not parse lists itself alone (its errors are the
+    reader's)."""
     (tmp_path / "sub").mkdir()
     (tmp_path / "sub" / "s.toml").write_text('[plant]\nfile = "../frf.csv"\n')
     (tmp_path / "study.toml").write_text('scenario = "sub/s.toml"\n')
     (tmp_path / "bad.toml").write_text("scenario = \n")
     assert read_files(tmp_path / "study.toml") == [
-        tmp_path / "study.toml", tmp_path / "sub" / "s.toml", tmp_path / "sub" / ".." / "frf.csv"]
+        tmp_path / "study.toml", tmp_path / "sub" / "s.toml", tmp_path / "sub" / ".." / "frf.csv",
+        tmp_path / ".." / "frf.csv"]  # the study reads it against its own folder
+    (tmp_path / "mc.toml").write_text('scenario = "sub/s.toml"\n[samples]\n'
+                                      'from_identification = "idn.toml"\n')
+    assert tmp_path / "idn.toml" in read_files(tmp_path / "mc.toml")
     assert read_files(tmp_path / "bad.toml") == [tmp_path / "bad.toml"]
     assert read_files(None) == []

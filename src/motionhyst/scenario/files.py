@@ -1,7 +1,8 @@
 """The files a scenario or a study TOML reads: what no command may write over.
 
 A scenario reads its own TOML and, for a measured plant, the FRF file ``[plant] file``; a
-study reads its TOML, the scenario its ``scenario`` key names and that scenario's files.
+study reads its TOML, the scenario its ``scenario`` key names and that scenario's files, and
+the identification its ``[samples] from_identification`` names.
 Each writer lists these among its inputs (:func:`motionhyst.io.outputs.check_not_input`)
 before it computes anything, so that ``--force`` replaces only the command's own output:
 ``scan --time-series frf.csv --force`` once replaced the measured FRF the scenario named.
@@ -47,8 +48,9 @@ def _named(value, folder: Path) -> Path | None:
 
 
 def read_files(path: str | os.PathLike | None) -> list[Path]:
-    """The files a scenario or study TOML at `path` reads: itself, a study's scenario, a
-    scenario's measured plant (``[plant] file``), each resolved against its TOML's folder.
+    """The files a scenario or study TOML at `path` reads: itself, a study's scenario and
+    ``[samples] from_identification``, a scenario's measured plant (``[plant] file``), each
+    resolved against its TOML's folder (a study's scenario's plant against the study's too).
 
     Parameters
     ----------
@@ -59,20 +61,33 @@ def read_files(path: str | os.PathLike | None) -> list[Path]:
     -------
     list of Path
         `path` first, then the files it names (whether or not they exist).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "s.toml").write_text('[plant]\nfile = "frf.csv"\n')
+    >>> [p.name for p in read_files(folder / "s.toml")]
+    ['s.toml', 'frf.csv']
     """
     if path is None:
         return []
     first = Path(path)
-    files, todo = [first], [first]
+    files, todo = [first], [(first, first.parent)]
     while todo:
-        toml = todo.pop()
+        toml, study_folder = todo.pop()
         data = _table(toml)
-        plant = data.get("plant")
-        named = [_named(data.get("scenario"), toml.parent),
-                 _named(plant.get("file"), toml.parent) if isinstance(plant, dict) else None]
+        plant, samples = data.get("plant"), data.get("samples")
+        file = plant.get("file") if isinstance(plant, dict) else None
+        scenario = _named(data.get("scenario"), toml.parent)
+        # a study reads its scenario's plant file against the study's folder (its
+        # base_dir); by itself the scenario reads it against its own: both are inputs
+        named = [scenario, _named(file, toml.parent), _named(file, study_folder),
+                 _named(samples.get("from_identification"), toml.parent)
+                 if isinstance(samples, dict) else None]
         for f in named:
             if f is not None and f not in files:
                 files.append(f)
-                if f.suffix.lower() == ".toml":
-                    todo.append(f)
+                if f == scenario:
+                    todo.append((f, study_folder))
     return files
