@@ -83,7 +83,7 @@ def test_a_driven_loop_that_hunts_is_refused_with_its_cycle():
     message = str(hunting_refusal(loop, not_converged(0.005, 50, 0.86), 0.01))
     assert message.startswith("steady state at 0.005 Hz: the loop hunts: driven from rest"), message
     assert "period 24.44 s" in message and "every 24.5 s" in message
-    assert "8.18 times the reference's 200 s period" in message
+    assert "8.18 times in the reference's 200 s period" in message
 
 
 def test_a_faster_cycle_is_found_and_its_driven_loop_hunts():

@@ -530,7 +530,7 @@ def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeE
         return NoFixedPoint(f"{exc}; {held}: driven, it may hunt; {remedy}", f, exc.change)
     if run.verdict == "hunts":
         seen = (f"its periods differ by {run.change:.2g} m" if np.isfinite(run.change) else
-                f"{1 / (f * run.rhythm):.3g} times the reference's {1 / f:.4g} s period")
+                f"{1 / (f * run.rhythm):.3g} times in the reference's {1 / f:.4g} s period")
         return RuntimeError(
             f"steady state at {f:g} Hz: the loop hunts: driven from rest, a run in time slips "
             f"at its own rhythm (its error crosses zero upward every {run.rhythm:.3g} s, "
