@@ -66,7 +66,7 @@ def read_files(path: str | os.PathLike | None) -> list[Path]:
     --------
     >>> import tempfile
     >>> folder = Path(tempfile.mkdtemp())
-    >>> _ = (folder / "s.toml").write_text('[plant]\nfile = "frf.csv"\n')
+    >>> _ = (folder / "s.toml").write_text('[plant]\\nfile = "frf.csv"\\n')
     >>> [p.name for p in read_files(folder / "s.toml")]
     ['s.toml', 'frf.csv']
     """
