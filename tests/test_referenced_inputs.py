@@ -8,6 +8,8 @@ FRF or its identification (exit 0, the user's file lost; review B19 F11, F12).""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 from motionhyst.cli import main
@@ -69,8 +71,8 @@ def test_a_plant_file_named_as_a_figure_is_not_replaced_by_it(tmp_path, monkeypa
 def test_the_files_a_toml_reads(tmp_path):
     """A study's scenario and its plant, resolved against each TOML's folder (the plant
     against the study's too, as the study reads it), a study's [samples]
-    from_identification; a TOML that does not parse lists itself alone (its errors are the
-    reader's)."""
+    from_identification; a TOML that does not parse, or is a pipe, lists itself alone (its
+    errors are the reader's)."""
     (tmp_path / "sub").mkdir()
     (tmp_path / "sub" / "s.toml").write_text('[plant]\nfile = "../frf.csv"\n')
     (tmp_path / "study.toml").write_text('scenario = "sub/s.toml"\n')
@@ -82,4 +84,7 @@ def test_the_files_a_toml_reads(tmp_path):
                                       'from_identification = "idn.toml"\n')
     assert tmp_path / "idn.toml" in read_files(tmp_path / "mc.toml")
     assert read_files(tmp_path / "bad.toml") == [tmp_path / "bad.toml"]
+    os.mkfifo(tmp_path / "pipe.toml")  # not opened: it would wait for a writer
+    (tmp_path / "p.toml").write_text('scenario = "pipe.toml"\n')
+    assert read_files(tmp_path / "p.toml") == [tmp_path / "p.toml", tmp_path / "pipe.toml"]
     assert read_files(None) == []

@@ -24,18 +24,19 @@ Examples
 from __future__ import annotations
 
 import os
-import tomllib
 from pathlib import Path
+
+from motionhyst.io.inputs import read_toml
 
 __all__ = ["read_files"]
 
 
 def _table(path: Path) -> dict:
-    """The TOML at `path` as a table, or an empty one where it cannot be read or parsed."""
+    """The TOML at `path` as a table, or an empty one where it cannot be read or parsed (a
+    pipe, a device or a folder is not opened: :func:`~motionhyst.io.inputs.read_toml`)."""
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, ValueError):
+        return read_toml(path)
+    except (OSError, ValueError):  # InputFileError, BudgetError: the reader's to report
         return {}
 
 
