@@ -151,7 +151,8 @@ def test_a_refusal_names_the_cause_and_a_remedy_the_command_has(tmp_path, files,
 def test_simulate_s_old_spelling_names_steady_s_option(tmp_path):
     """``simulate`` without ``--time-series`` is the old spelling of ``steady``: a refusal of
     its Floquet multipliers names ``steady --no-floquet`` (``simulate`` has no such option),
-    in one line: the notice that the spelling is old comes only once the input is checked."""
+    in one line, which ends with the spelling's new name (the notice stands alone only before
+    an answer)."""
     populate(tmp_path, {"s.toml": _paper("frequencies = [5.0, 10.0, 15.0]", "frequencies = ["
                                          + ", ".join(f"{1 + i * 1e-3:.3f}"
                                                      for i in range(100_000)) + "]")})
@@ -160,7 +161,9 @@ def test_simulate_s_old_spelling_names_steady_s_option(tmp_path):
     lines = err.strip().splitlines()
     assert code == 2 and out == "" and len(lines) == 1, err
     assert lines[0].endswith("give fewer frequencies (s.toml's [reference] frequencies) or "
-                             "leave the multipliers out (motionhyst steady --no-floquet)"), err
+                             "leave the multipliers out (motionhyst steady --no-floquet) "
+                             "(`motionhyst simulate` without --time-series is now `motionhyst "
+                             "steady`)"), err
     assert snapshot(tmp_path) == before
 
 
