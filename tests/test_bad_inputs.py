@@ -169,6 +169,11 @@ CASES = [
      ["--frequency 5 is given twice"]),
     ("frequency-repeated-simulate", {}, ["simulate", "--frequency", "5", "10", "5"],
      ["--frequency 5 is given twice"]),
+    # an option given twice: argparse kept the last (5 Hz silently dropped), now refused
+    ("frequency-option-twice", {}, ["steady", "--frequency", "5", "--frequency", "10"],
+     ["--frequency is given twice; give it once, all its values after it"]),
+    ("amplitude-option-twice", {}, ["analyze", "--amplitude", "1e-3", "--amplitude", "1e-2"],
+     ["--amplitude is given twice; give it once"]),
     ("df-no-amplitude", {}, ["df", "--k", "20", "--fc", "0.05"], ["--amplitude"]),
     ("df-harmonics-zero", {}, ["df", "--k", "20", "--fc", "0.05", "--amplitude", "1e-3",
                                "--harmonics", "0"], ["--harmonics"]),

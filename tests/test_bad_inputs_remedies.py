@@ -274,16 +274,18 @@ def test_the_top_parser_s_refusal_has_one_prefix(capsys):
 
 def test_the_budget_options_before_the_command_set_the_budget(capsys):
     """``motionhyst --max-seconds S COMMAND`` (as the budget's documentation spelt it) was
-    "invalid choice: '0.01'"; it sets the budget as the command's own option does, which
-    wins where both are given."""
+    "invalid choice: '0.01'"; it sets the budget as the command's own option does.  Given
+    both before the command and after it, one value was dropped without a word: refused."""
     from motionhyst.cli import main
 
     argv = ["steady", "--frequency", "5", "10"]
     assert main(["--max-seconds", "0.01", *argv]) == 2
     err = capsys.readouterr().err
     assert "above the work budget of 0.01 s (--max-seconds)" in err, err
-    assert main(["--max-seconds", "1e-9", *argv, "--max-seconds", "0.02"]) == 2
-    assert "above the work budget of 0.02 s (--max-seconds)" in capsys.readouterr().err
+    for option, value in (("--max-seconds", "0.02"), ("--max-memory", "2G")):
+        assert main([option, value, *argv, option, value]) == 2
+        assert capsys.readouterr().err == (f"motionhyst: error: steady: {option} is given twice "
+                                           f"(before the command and after it); give it once\n")
     assert main(["--max-memory", "1K", *argv]) == 2
     assert "above the memory budget of 1.02 kB (--max-memory)" in capsys.readouterr().err
 

@@ -546,13 +546,14 @@ def test_a_study_above_the_work_budget_is_refused_before_anything_is_written(tmp
         est = json.loads(capsys.readouterr().out)
         assert est["within_budget"] is fits and est["budget_seconds"] == float(budget)
     assert est["memory_bytes"] > 50e6                        # the libraries and kernels held
-    args = ["study", str(study_file), "--out", str(out), "--workers", "2"]
+    store = ["study", str(study_file), "--out", str(out)]
+    args = [*store, "--workers", "2"]
     assert main([*args, "--max-seconds", "1e-6"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "a study of 32 points (" in err[0] and "on 2 workers" in err[0]
     assert "above the work budget" in err[0] and "--max-seconds" in err[0]
     assert not out.exists()
-    assert main([*args, "--workers", "0", "--json"]) == 0
+    assert main([*store, "--workers", "0", "--json"]) == 0
     capsys.readouterr()
     assert main([*args, "--max-seconds", "1e-6"]) == 0       # nothing missing: nothing to refuse
     before = sorted(p.relative_to(out) for p in out.rglob("*"))

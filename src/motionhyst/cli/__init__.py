@@ -138,6 +138,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
+        _budget_given_once(args)
         if closed:
             if not any(getattr(args, name, None) for name in FILE_OUTPUTS):
                 state = "closed" if sys.stdout is None else "not open for writing"
@@ -339,6 +340,17 @@ def _say(line: str) -> None:
     to say what happened."""
     with contextlib.suppress(OSError, ValueError):
         print(line, file=sys.stderr)
+
+
+def _budget_given_once(args: argparse.Namespace) -> None:
+    """Refuse ``--max-memory`` or ``--max-seconds`` given both before the command and after it
+    (``motionhyst --max-memory 1G steady paper.toml --max-memory 2G``): the two parsers each
+    see it once, and one of the values would be dropped without a word."""
+    for option in ("--max-memory", "--max-seconds"):
+        dest = option[2:].replace("-", "_")
+        if getattr(args, "before_" + dest) is not None and getattr(args, dest) is not None:
+            raise UsageError(f"motionhyst {args.command}: {option} is given twice (before the "
+                             f"command and after it); give it once")
 
 
 def _warn_budget_beyond_machine(args: argparse.Namespace) -> None:

@@ -52,11 +52,28 @@ class UsageError(Exception):
     """
 
 
+class _StoreOnce(argparse._StoreAction):
+    """An option's value, refused when the option is given again: argparse keeps the last
+    (``--frequency 5 --frequency 10`` ran 10 Hz alone, the 5 Hz silently dropped)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = getattr(parser, "given", None)
+        if given is not None and option_string is not None:
+            if self.dest in given:
+                many = (f", all its values after it ({option_string} A B ...)"
+                        if self.nargs in ("+", "*") else "")
+                parser.error(f"{option_string} is given twice; give it once{many}")
+            given.add(self.dest)
+        super().__call__(parser, namespace, values, option_string)
+
+
 class Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line (no usage block); an empty value is an error.
+    """ArgumentParser whose errors are one line (no usage block); an empty value is an error,
+    and so is an option given twice.
 
     An empty argument (``--time-series ""``, an unset shell variable) would
-    otherwise count as an option not given: silently ignored.
+    otherwise count as an option not given, and an option given twice its last value:
+    silently ignored.
 
     Examples
     --------
@@ -66,10 +83,17 @@ class Parser(argparse.ArgumentParser):
     2
     """
 
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
+        self.given: set[str] | None = None
+
     def error(self, message: str):
         raise UsageError(f"{self.prog}: {message}")
 
     def parse_known_args(self, args=None, namespace=None):
+        self.given = set()
         namespace, extras = super().parse_known_args(args, namespace)
         for action in self._actions:
             value = getattr(namespace, action.dest, None)
