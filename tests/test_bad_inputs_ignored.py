@@ -79,6 +79,24 @@ CASES = [
     ("max-seconds-before-and-after", {}, ["--max-seconds", "1e-9", "steady", "s.toml",
                                           "--max-seconds", "100"],
      ["steady: --max-seconds is given twice (before the command and after it)"]),
+    # ------------------------------------ predict: a map's entry for what the run predicts
+    # the displacement of a force record is the output, not read: the entry was dropped
+    ("predict-columns-displacement-unread", {}, ["predict", "axis.toml", "force.csv", "--out",
+                                                 "p.csv", "--columns", "displacement=foo"],
+     ["predict: --columns names 'displacement', which is not read here: the run predicts the "
+      "displacement from the force of force.csv, which holds no column 'foo' (a measured one "
+      "is read with --init-from REC)"]),
+    ("predict-scale-displacement-unread", {}, ["predict", "axis.toml", "force.csv", "--out",
+                                               "p.csv", "--scale", "displacement=1e-3"],
+     ["predict: --scale names 'displacement', which is not read here", "holds no "
+      "displacement"]),
+    ("predict-columns-force-unread", {}, ["predict", "qs.toml", "position.csv", "--out",
+                                          "f.csv", "--columns", "force=foo"],
+     ["predict: --columns names 'force', which is not read here: the run predicts the force "
+      "from the displacement of position.csv, which holds no column 'foo'"]),
+    ("predict-scale-force-unread", {}, ["predict", "qs.toml", "position.csv", "--out", "f.csv",
+                                        "--scale", "force=1e-3"],
+     ["predict: --scale names 'force', which is not read here"]),
 ]
 
 
@@ -92,4 +110,22 @@ def test_refused_in_one_line_touching_nothing(tmp_path, files, argv, words):
     assert line.startswith("motionhyst: error: ") and not missing, (missing, line)
     # nothing changed, nothing added (beside the folder either)
     assert (snapshot(root), list(tmp_path.iterdir())) == (before, [root])
+
+
+def test_the_map_given_identify_still_reads_the_record_that_holds_the_position(tmp_path):
+    """A force record that holds the measured position too (the record identify was given),
+    read with identify's map: the entry for the position describes the file, and is kept
+    (only time and force are read); the run predicts as without it."""
+    rec = _series("time,force,pos", _force, _position)
+    populate(tmp_path, {"axis.toml": MASS_DAMPER, "rec.csv": rec,
+                        "force.csv": _series("time,force", _force)})
+    outputs = []
+    for name, maps in (("a.csv", ["--columns", "displacement=pos", "--scale",
+                                  "displacement=1"]), ("b.csv", [])):
+        record = "rec.csv" if maps else "force.csv"
+        code, _, err = limited_process.run(["predict", "axis.toml", record, "--out", name,
+                                            *maps], tmp_path)
+        assert code == 0 and err == "", err
+        outputs.append((tmp_path / name).read_text())
+    assert outputs[0] == outputs[1]
 

@@ -106,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
         return _predict_force(args, sc, system, target)
     # the maps may also name the position (the --init-from record's, or INPUT's measured one,
     # as the map given to identify): only time and force are read from INPUT
+    if args.init_from is None:
+        _check_named_unread(args, "displacement", "force")
     _check_unread(args, system)
     data = read_record(args.data, ("time", "force"),
                        columns=_without(args.columns, "displacement"),
@@ -210,6 +212,27 @@ def _check_unread(args: argparse.Namespace, system) -> None:
 
     check_unread([args.data], ("time", "force"), least,
                  columns=_without(args.columns, "displacement"))
+
+
+def _check_named_unread(args: argparse.Namespace, quantity: str, read: str) -> None:
+    """Refuse a ``--columns`` or ``--scale`` entry for the `quantity` the run predicts (and so
+    does not read) where INPUT holds no such column: the entry would be dropped without a
+    word (``--scale displacement=1e-3`` on a force record does not scale the output).  Where
+    INPUT holds it (the measured record itself, read with the map given to identify) the
+    entry describes the file and is kept, as the other quantities of that map are."""
+    from motionhyst.io.records import record_columns
+
+    columns, scale = args.columns or {}, args.scale or {}
+    if quantity not in columns and quantity not in scale:
+        return
+    if quantity in record_columns(args.data, columns):
+        return
+    option, held = (("--columns", f"column {columns[quantity]!r}") if quantity in columns
+                    else ("--scale", quantity))
+    also = " (a measured one is read with --init-from REC)" if quantity == "displacement" else ""
+    raise UsageError(f"motionhyst predict: {option} names {quantity!r}, which is not read "
+                     f"here: the run predicts the {quantity} from the {read} of {args.data}, "
+                     f"which holds no {held}{also}")
 
 
 def _without(mapping, quantity: str):
@@ -446,6 +469,7 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     from motionhyst.time.resample import check_whole_periods
 
     # the maps may name the force too (as the map a user gave identify)
+    _check_named_unread(args, "force", "displacement")
     check_unread([args.data], ("time", "displacement"), _check_force_memory,
                  columns=_without(args.columns, "force"))  # a long record: unread
     data = read_record(args.data, ("time", "displacement"),
