@@ -10,6 +10,8 @@ was there before byte-identical afterwards, with no file added.
 from __future__ import annotations
 
 import math
+import resource
+from pathlib import Path
 
 import limited_process
 import pytest
@@ -18,6 +20,7 @@ from file_trees import populate, snapshot
 from motionhyst.scenario import default_scenario_path
 
 PAPER = default_scenario_path().read_text()
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 MASS_DAMPER = ('[stage]\ntype = "mass-damper"\nm = 10.0\nc = 20.0\n\n'
                '[hysteresis]\nmodel = "jenkins"\nk = 2000.0\nfc = 2.0\n')
@@ -32,6 +35,24 @@ def _series(header: str, *columns) -> str:
         t = i / 1000.0
         rows.append(",".join([repr(t), *(repr(f(t)) for f in columns)]) + "\n")
     return header + "\n" + "".join(rows)
+
+
+def _measured(path: Path) -> None:
+    """Table I's stage (eqs. 1-2) as a measured response, 61 lines from 1 Hz to 3 kHz of
+    ``P1`` and ``P2`` (plant.csv), and the scenario `path` with ``[plant] file`` in place of
+    its [stage]."""
+    m1, m2, b, k = 5.0, 17.5, 90.0, 7.4e7
+    rows = []
+    for i in range(61):
+        s = 2j * math.pi * 3000.0 ** (i / 60)
+        den = s * s * (m1 * m2 * s * s + (m1 + m2) * (b * s + k))
+        p1, p2 = (m2 * s * s + b * s + k) / den, (b * s + k) / den
+        rows.append(f"{abs(s) / (2 * math.pi)!r},{p1.real!r},{p1.imag!r},{p2.real!r},"
+                    f"{p2.imag!r}\n")
+    path.with_name("plant.csv").write_text("frequency_hz,p1_re,p1_im,p2_re,p2_im\n"
+                                           + "".join(rows))
+    path.write_text(PAPER[:PAPER.index("[stage]")] + '[plant]\nfile = "plant.csv"\n\n'
+                    + PAPER[PAPER.index("[hysteresis]"):])
 
 
 def _force(t: float) -> float:
@@ -97,6 +118,41 @@ CASES = [
     ("predict-scale-force-unread", {}, ["predict", "qs.toml", "position.csv", "--out", "f.csv",
                                         "--scale", "force=1e-3"],
      ["predict: --scale names 'force', which is not read here"]),
+    # ----------------------------------------------------- refusals said once and plainly
+    # the scenario's name was said twice, and "is a quasi-static (an open-loop ...)"
+    ("stability-open-loop-named-once", {}, ["stability", "axis.toml"],
+     ["stability: axis.toml: [stage] is a mass-damper stage (an open-loop system"]),
+    ("stability-quasi-static-stage", {}, ["stability", "qs.toml"],
+     ["stability: qs.toml: [stage] is a quasi-static stage (an open-loop system"]),
+    # predict of a measured plant said "[stage] is not ..." of a scenario without [stage]
+    ("predict-measured-plant", {"m.toml": _measured}, ["predict", "m.toml", "force.csv",
+                                                       "--out", "p.csv"],
+     ["m.toml: has a measured [plant], not a [stage]; an open-loop system needs a [stage] "
+      "of type"]),
+    # a robustness filter's corner beyond every frequency of the trial filters nothing
+    ("scan-ilc-cutoff-above-nyquist", {}, [*SCAN, "--compensation", "ilc", "--ilc-cutoff",
+                                           "1e9"],
+     ["scan: --ilc-cutoff 1e+09 Hz is above", "Hz, the Nyquist frequency of the run's "
+      "samples (a step of", "give a corner below it (default 300 Hz)"]),
+    ("scan-ilc-cutoff-above-a-sampled-loop-s-nyquist",
+     {"z.toml": (EXAMPLES / "paper_10khz.toml").read_text()},
+     [*SCAN, "z.toml", "--compensation", "ilc", "--ilc-cutoff", "5001"],
+     ["scan: --ilc-cutoff 5001 Hz is above 5000 Hz, the Nyquist frequency of the run's "
+      "samples (a step of 0.0001 s)"]),
+    ("scan-ilc-cutoff-above-a-measured-loop-s-nyquist", {"m.toml": _measured},
+     [*SCAN, "m.toml", "--compensation", "ilc", "--ilc-cutoff", "1e9"],
+     ["scan: --ilc-cutoff 1e+09 Hz is above"]),
+    # a model TOML under another name (identify --save x.csv wrote TOML into x.csv)
+    ("identify-save-csv", {"rec.csv": _series("time,displacement,force", _position,
+                                              lambda t: 2.0 * _position(t) / 1e-3)},
+     ["identify", "rec.csv", "--save", "x.csv"],
+     ["identify: --save x.csv: the identified model is written as a scenario TOML (read by "
+      "predict, steady and study --from-identification); give a name ending in .toml"]),
+    ("identify-input-output-save-txt", {"rec.csv": _series("time,force,displacement", _force,
+                                                           _position)},
+     ["identify", "rec.csv", "--record", "input-output", "--plant", "mass-damper", "--model",
+      "jenkins", "--save", "model.txt"],
+     ["identify: --save model.txt: the identified model is written as a scenario TOML"]),
 ]
 
 
@@ -129,3 +185,16 @@ def test_the_map_given_identify_still_reads_the_record_that_holds_the_position(t
         outputs.append((tmp_path / name).read_text())
     assert outputs[0] == outputs[1]
 
+
+def test_a_budget_beyond_the_machine_is_not_said_before_a_refusal(tmp_path):
+    """A --max-memory larger than the machine is warned of when the work starts; a refusal
+    before the work (here too many time steps) was that warning and the refusal, two lines:
+    it is the refusal's line alone.  Without an address-space limit: under one within the
+    machine's memory nothing is warned of in any case."""
+    populate(tmp_path, BASE)
+    before = snapshot(tmp_path)
+    line = limited_process.refusal(["simulate", "s.toml", "--frequency", "5", "--time-series",
+                                    "big.csv", "--duration", "1e5", "--max-memory", "1e308"],
+                                   tmp_path, limit=resource.RLIM_INFINITY)
+    assert line.startswith("motionhyst: error: ") and "too many time steps" in line, line
+    assert snapshot(tmp_path) == before

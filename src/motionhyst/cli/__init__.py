@@ -153,8 +153,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                         else args.max_seconds)
         max_memory(), max_seconds()  # MOTIONHYST_MAX_* set to no size: refused by every command
         with warnings_on_stderr(args.command, held):
-            _warn_budget_beyond_machine(args)  # at once: it is about the process being killed
-            held.hold()  # the others until the command's checks before its work pass
+            held.hold()  # until the command's checks before its work pass: a refusal is one line
+            _warn_budget_beyond_machine(args)  # shown when the work (what may be killed) starts
             code = args.func(args)
         if interrupts.received:  # a library swallowed it (an optional import that failed)
             raise KeyboardInterrupt

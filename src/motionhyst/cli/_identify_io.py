@@ -105,6 +105,22 @@ def add_input_output_arguments(q: argparse.ArgumentParser) -> None:
     q.add_argument("--force", action="store_true", help="replace the --save file if it exists")
 
 
+def save_target(args: argparse.Namespace, inputs):
+    """The ``--save`` file, checked before the work as every output is (never one of the
+    `inputs`), and refused unless its name ends in ``.toml``: the identified model is a
+    scenario TOML, which predict, steady and study read by that name."""
+    from pathlib import Path
+
+    from motionhyst.io.outputs import OutputFile
+
+    target = OutputFile(args.save, force=args.force, inputs=inputs, option="--save")
+    if Path(args.save).suffix.lower() != ".toml":
+        raise UsageError(f"motionhyst identify: --save {args.save}: the identified model is "
+                         f"written as a scenario TOML (read by predict, steady and study "
+                         f"--from-identification); give a name ending in .toml")
+    return target
+
+
 def check_not_input_output(args: argparse.Namespace, closed_loop: bool = False) -> None:
     """One-line error for input-output options given with another record kind (`closed_loop`:
     a closed-loop record, which takes ``--offset`` too; ``--model`` and ``--max-evaluations``
@@ -148,9 +164,7 @@ def run_input_output(args: argparse.Namespace) -> int:
         raise UsageError("motionhyst identify: --nu applies to --model bouc-wen only")
     target = None
     if args.save is not None:  # refused before the work, not after
-        from motionhyst.io.outputs import OutputFile
-
-        target = OutputFile(args.save, force=args.force, inputs=args.data, option="--save")
+        target = save_target(args, args.data)
         _check_savable_plant(plant)
     nu = None if args.nu == "free" else (1.0 if args.nu is None else args.nu)
     # on a mass-damper the Bouc-Wen link is a friction link, fitted as the element links

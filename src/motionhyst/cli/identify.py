@@ -22,6 +22,7 @@ from motionhyst.cli._identify_io import (
     add_input_output_arguments,
     check_not_input_output,
     run_input_output,
+    save_target,
     search_budget,
 )
 
@@ -174,9 +175,7 @@ def run(args: argparse.Namespace) -> int:
         if kind != "force-displacement":
             raise UsageError(f"motionhyst identify: --save applies to input-output and "
                              f"force-displacement records; {path} is a closed-loop record")
-        from motionhyst.io.outputs import OutputFile
-
-        target = OutputFile(args.save, force=args.force, inputs=[path], option="--save")
+        target = save_target(args, [path])
     if kind != "force-displacement" and args.scenario is None:
         raise UsageError(f"motionhyst identify: {path} is a closed-loop record: give the "
                          f"loop's plant with --scenario FILE (a [stage], or a measured "
@@ -433,9 +432,7 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
         raise UsageError("motionhyst identify: --elements applies to --model maxwell-slip only")
     target = None
     if args.save is not None:  # refused before the work, not after
-        from motionhyst.io.outputs import OutputFile
-
-        target = OutputFile(args.save, force=args.force, inputs=paths, option="--save")
+        target = save_target(args, paths)
     from motionhyst.hysteresis import model_class
     from motionhyst.identify.fd_memory import check_link_force_memory
     from motionhyst.identify.records import load_force_displacement_csv

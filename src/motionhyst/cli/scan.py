@@ -245,13 +245,29 @@ def _profiles(args: argparse.Namespace):
     return profile, other, [w for w in stretched if w]
 
 
-def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None:
+def _check_ilc_cutoff(cutoff: float | None, step: float) -> None:
+    """Refuse an ``--ilc-cutoff`` (`cutoff`, None where not given) above the Nyquist frequency
+    of the run's samples (a time step of `step`): the robustness filter ``Q`` would be above
+    one half at every frequency a trial has, its corner beyond them all, and no longer bound
+    the improper ``1 / PS`` it is there for (:mod:`motionhyst.scan.ilc`)."""
+    nyquist = 0.5 / step
+    if cutoff is not None and cutoff > nyquist:
+        raise UsageError(f"{PROG}: --ilc-cutoff {cutoff:g} Hz is above {g(nyquist)} Hz, the "
+                         f"Nyquist frequency of the run's samples (a step of {g(step)} s): the "
+                         f"robustness filter Q would pass every frequency of a trial (its "
+                         f"corner beyond them all); give a corner below it (default "
+                         f"{ILC_DEFAULTS['ilc_cutoff']:g} Hz)")
+
+
+def _check_steps(args: argparse.Namespace, sc, profile, other, out=None,
+                 cutoff: float | None = None) -> None:
     """Refuse a scan of far too many time steps, or of too much work (a link of many
     elements), before its loop is built: the step is the loop's own where its coefficients
     give its poles (:func:`pole_step`; an unstable loop is refused there), else at most the
     sampled controller's period or the setpoint's (:func:`longest_step`).  An exposure window
-    that holds one of those steps, and a ``--time-series`` (`out`) that does not fit where it
-    is written, are refused too."""
+    that holds one of those steps, a ``--time-series`` (`out`) that does not fit where it
+    is written, and an ``--ilc-cutoff`` (`cutoff`) above the run's Nyquist frequency, are
+    refused too."""
     from motionhyst.scan.profiles import check_window_samples
     from motionhyst.time.steps import (
         check_scan_steps,
@@ -291,6 +307,8 @@ def _check_steps(args: argparse.Namespace, sc, profile, other, out=None) -> None
                     check_window_samples(args.window, step, "give a longer --window")
                 except ValueError as exc:
                     raise UsageError(f"{PROG}: --window: {exc}") from None
+                if p is profile:
+                    _check_ilc_cutoff(cutoff, step)
             with in_the_commands_terms(sc, REMEDY):
                 check_steps_work(n, (sc.hysteresis(),), REMEDY)
 
@@ -348,13 +366,14 @@ def run(args: argparse.Namespace) -> int:
     # every check the loop is not needed for comes before it is built (python-control,
     # scipy): a refusal does not wait for them
     sc = load_scenario(args.scenario, check=False)
+    cutoff = args.ilc_cutoff  # as given (None: the default), against the run's samples
     _check_options(args)
     _check_rate(args, sc)
     out = _output(args)
     _check_model_terms(args, sc)
     _check_at(args, sc)
     profile, other, stretched = _profiles(args)
-    _check_steps(args, sc, profile, other, out)
+    _check_steps(args, sc, profile, other, out, cutoff)
     from motionhyst.core.warnings import warn
 
     for text in stretched:  # once nothing is refused: a refusal is one line
@@ -365,6 +384,10 @@ def run(args: argparse.Namespace) -> int:
     if other is not None and args.other_length is not None:
         check_stroke(args.other_length, "--other-length")
     loop = sc.loop()
+    if cutoff is not None and sc.fastest_pole() is None and loop.sampled is None:
+        from motionhyst.time.simulation import default_step  # the step known from the loop
+
+        _check_ilc_cutoff(cutoff, default_step(loop, profile.max_frequency_hz))
     from motionhyst.scan.ilc import ILCFilters
     from motionhyst.scan.scanning import run_scan
     from motionhyst.scan.terms import scan_terms

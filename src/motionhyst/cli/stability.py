@@ -41,14 +41,14 @@ def run(args: argparse.Namespace) -> int:
     try:
         loop = sc.loop()  # an open-loop scenario is refused before the analysis loads
     except ValueError as exc:
-        raise UsageError(f"stability: {sc.source}: {exc}") from None
+        raise _refusal(sc, exc) from None
     from motionhyst.analysis.stability import stability
 
     release_held()  # the search for cycles starts: the warnings so far are shown
     try:
         result = stability(loop, exact=not args.no_exact)
     except ValueError as exc:
-        raise UsageError(f"stability: {sc.source}: {exc}") from None
+        raise _refusal(sc, exc) from None
     warn_plant_fit(sc)
     if figure is not None:
         import io
@@ -62,6 +62,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"Stability of {sc.source}, the setpoint held at 0")
     print(result)
     return 0
+
+
+def _refusal(sc, exc: ValueError) -> UsageError:
+    """The one line of a refusal of the scenario `sc`, named once: the scenario's own errors
+    begin with its name already."""
+    text = str(exc)
+    where = "" if text.startswith(f"{sc.source}:") else f"{sc.source}: "
+    return UsageError(f"stability: {where}{text}")
 
 
 def add_parser(sub) -> None:

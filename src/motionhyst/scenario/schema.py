@@ -229,10 +229,11 @@ class Scenario:
     def open_loop(self) -> OpenLoop:
         """The open-loop system of the stage and its link (force in, a position out)."""
         if not self.model.open_loop:
-            raise ScenarioError(f"{self.source}: [stage] is not a {open_loop_kinds()} nor a "
-                                f"two-mass stage with an output; an open-loop system needs "
-                                f"[stage] type = one of those, or output = \"y2\" "
-                                f"or \"y1\" in a two-mass [stage] (and no [controller])")
+            what = ("has a measured [plant], not a [stage]" if self.model.stage is None else
+                    f"[stage] is not a {open_loop_kinds()} nor a two-mass stage with an output")
+            raise ScenarioError(f"{self.source}: {what}; an open-loop system needs a [stage] of "
+                                f"type {open_loop_kinds()}, or a two-mass [stage] with output = "
+                                f"\"y2\" or \"y1\" (and no [controller])")
         from motionhyst.time.openloop import OpenLoop
 
         return OpenLoop(self.plant(), self.hysteresis())

@@ -159,7 +159,7 @@ def open_loop_what(stage) -> str:
     """What an open-loop ``[stage]`` is, for messages."""
     if getattr(stage, "output", None) is not None:
         return f'a {stage.type} stage with output = "{stage.output}"'
-    return f"a {stage.type}"
+    return f"a {stage.type} stage"
 
 
 class PlantSection(_Section):
