@@ -266,8 +266,9 @@ def run_input_output(args: argparse.Namespace) -> int:
                "fewer_elements": args.elements is None, "rigid_limit": True})
     from motionhyst.identify.io_checks import FitFailed
 
-    try:
-        with search_budget(), warnings.catch_warnings():
+    try:  # the fit's warnings wait for its judgement: a refusal is one line
+        with search_budget(), warnings.catch_warnings(record=True) as held:
+            warnings.simplefilter("always")
             if unit_slip:  # the fit's own line on the mass's size says it again
                 warnings.filterwarnings("ignore", message=r".* kg, outside the usual .* of "
                                         r"motion stages: if the records' units are not SI")
@@ -278,6 +279,8 @@ def run_input_output(args: argparse.Namespace) -> int:
         if any(str(path) in str(exc) for path in args.data):
             raise
         raise FitFailed(f"{', '.join(map(str, args.data))}: {exc}") from None
+    for h in held:
+        warnings.warn_explicit(h.message, h.category, h.filename, h.lineno)
     result = {**fit.to_dict(), "records": fit.records}
     reference = reference_forms(fit, records) if plant == "mass-damper" else []
     if reference:

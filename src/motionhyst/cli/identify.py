@@ -533,18 +533,20 @@ def _refuse_a_mass(records: list[tuple], refuse: bool = False) -> str | None:
 def _check_determined(path: Path, ident, x, w) -> None:
     """No answer from a record without hysteresis: when a spring explains the force as well
     as the elements within the noise (:func:`~motionhyst.identify.io_checks.hysteresis_gain`),
-    or when no element of the fit slips in the
-    record (each one's slip displacement fc/k reaches half the record's displacement range,
-    its fc not determined), the force follows the displacement as a spring's, or is noise,
-    and a slip force would be a guess.  (An element that never slips beside others that do
-    is the model's parallel spring: kept, its fc "not determined" in the table.)"""
+    or when no element of the fit slips in the record (each one's slip displacement fc/k
+    reaches :data:`SLIP_SHARE` of half the record's displacement range: its fc is not
+    determined, any larger one fits as well, whatever its standard error says), the force
+    follows the displacement as a spring's, or is noise, and a slip force would be a guess.
+    (An element that never slips beside others that do is the model's parallel spring: kept,
+    its fc "not determined" in the table.)"""
     import numpy as np
 
     from motionhyst.identify.io_checks import NO_HYSTERESIS_GAIN, hysteresis_gain
 
     half = 0.5 * float(x.max() - x.min())
-    never = [e for e in ident.elements
-             if not math.isfinite(e["fc_std"]) and e["fc"] / e["k"] >= half]
+    never = [e for e in ident.elements if e["fc"] / e["k"] >= SLIP_SHARE * half]
+    for e in never:  # pinned at the record's end by the fit, not found in it
+        e["fc_std"] = math.inf
     # a spring (and offset) by least squares: what the elements explain beyond it, in noise
     # variances (the smallest slip displacement can fall short of the half-range by noise)
     A = np.column_stack([x, np.ones_like(x)])
@@ -561,11 +563,13 @@ def _check_determined(path: Path, ident, x, w) -> None:
             f"amplitude, may)")
     if never and len(never) == len(ident.elements):
         e = min(never, key=lambda e: e["fc"] / e["k"])
+        spring = float(np.linalg.lstsq(A, w, rcond=None)[0][0])
         raise ValueError(
             f"{path}: no hysteresis in the record: no element slips in it (the smallest slip "
-            f"displacement fitted, fc/k = {g(e['fc'] / e['k'])} m, reaches the record's "
-            f"half-range {g(half)} m; R^2 = {ident.r2:.3g}): the force follows the "
-            f"displacement as a spring's, or is noise, and a slip force would be a guess; "
+            f"displacement fitted, fc/k = {g(e['fc'] / e['k'])} m, reaches "
+            f"{100 * SLIP_SHARE:g} % of the record's half-range {g(half)} m, where any larger "
+            f"fc fits as well; R^2 = {ident.r2:.3g}): the force follows the displacement as a "
+            f"spring's (k = {g(spring)} N/m), or is noise, and a slip force would be a guess; "
             f"nothing identified (a record whose displacement makes the link slip, a larger "
             f"amplitude, may)")
 
