@@ -6,6 +6,10 @@
   slip force with a standard error of 0.008 %.  The same link driven further (2 mm) slips,
   and its slip force is found.  An axis whose Jenkins link never slips (input-output
   records): refused, the link's spring named, nothing saved (it saved fc = 5.6e12 N).
+* The same record given twice in two files (a CSV and a MATLAB file of it, the CSV written
+  again with 6 significant digits, a part of it cut out): fitted as two records, standard
+  errors sqrt(2) too small, exit 0; now refused as a record given twice is by name or byte
+  for byte, before any fit.
 """
 
 from __future__ import annotations
@@ -14,9 +18,11 @@ import json
 
 import numpy as np
 import pytest
+import scipy.io
 
 from motionhyst.cli import main
 from motionhyst.hysteresis import Jenkins
+from motionhyst.identify.record_overlap import repeated_record
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import OpenLoop
 
@@ -105,3 +111,49 @@ def test_a_stuck_link_of_an_axis_is_refused_and_its_spring_named(capsys, tmp_pat
     spring = float(err.split("it acts as a spring of ")[1].split(" N/m")[0])
     assert spring == pytest.approx(LINK_K, rel=1e-3)
     assert not saved.exists()
+
+
+def copies(tmp_path):
+    """A record's CSV and three copies that are not byte for byte: a MATLAB file, the CSV
+    with 6 significant digits, its second half with the time from 0."""
+    t, u, y = axis_record()
+    csv = write_csv(tmp_path / "rec.csv", (t, u, y))
+    mat = tmp_path / "rec.mat"
+    scipy.io.savemat(mat, {"time": t, "force": u, "displacement": y})
+    short = write_csv(tmp_path / "rec6.csv", (t, u, y), fmt="%.6g")
+    half = write_csv(tmp_path / "half.csv", (t[1000:] - t[1000], u[1000:], y[1000:]))
+    return csv, [mat, short, half]
+
+
+@pytest.mark.parametrize("which", [0, 1, 2])
+def test_a_record_given_twice_in_two_formats_is_refused(capsys, tmp_path, which):
+    """Base: exit 0, "identified from 2 input-output record(s)", every standard error
+    divided by sqrt 2 (m 7.4e-06 against 1.1e-05 from one record)."""
+    csv, others = copies(tmp_path)
+    saved = tmp_path / "m.toml"
+    rc, out, err = run(capsys, "identify", str(csv), str(others[which]), "--record",
+                       "input-output", "--plant", "mass-damper", "--model", "jenkins",
+                       "--save", str(saved))
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert f"{csv} and {others[which]} hold the same record as read" in err
+    assert "a record given twice counts its samples twice" in err and not saved.exists()
+
+
+def test_force_displacement_records_given_twice_are_refused(capsys, tmp_path):
+    record = stand_record(tmp_path / "stand.csv", 2e-3)
+    t, x, f = np.loadtxt(record, delimiter=",", skiprows=1).T
+    mat = tmp_path / "stand.mat"
+    scipy.io.savemat(mat, {"time": t, "displacement": x, "force": f})
+    rc, out, err = run(capsys, "identify", str(record), str(mat), "--model", "jenkins")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert f"{record} and {mat} hold the same record as read (4000 samples alike)" in err
+
+
+def test_records_of_one_stage_with_their_own_noise_are_two_records():
+    """Two runs of the same input on the same axis differ by their noise (0.1 um, against a
+    tolerance of 1e-5 of 0.7 mm): not one record twice; a part of either is."""
+    (t, u, y0), (_, _, y1) = axis_record(0), axis_record(1)
+    step = float(t[1] - t[0])
+    assert repeated_record([(step, (u, y0)), (step, (u, y1))]) is None
+    assert repeated_record([(step, (u, y0)), (step, (u, y1)),
+                            (step, (u[:300], y1[:300]))]) == (1, 2, 300)

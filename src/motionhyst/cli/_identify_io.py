@@ -226,6 +226,8 @@ def run_input_output(args: argparse.Namespace) -> int:
     records = [load_io_csv(path, columns=args.columns, scale=args.scale) for path in args.data]
     floor([rec.u.size for rec in records])
     check_records(records, args.periodic)  # identify_io checks them again: nothing is skipped
+    refuse_repeated([(path, rec.t, (rec.u, rec.y)) for path, rec in zip(args.data, records,
+                                                                        strict=True)])
     from motionhyst.identify.io_response import check_response
 
     check_response(records)  # a position that does not depend on the force: no fit explains it
@@ -342,6 +344,23 @@ def run_input_output(args: argparse.Namespace) -> int:
 #: constant force offset (by direction, or an offset drifting in time)
 BEYOND_REFERENCE = ("c_skew", "link.c_pos", "link.c_neg", "link.fc_pos", "link.fc_neg",
                     "input_drift")
+
+
+def refuse_repeated(records: list[tuple]) -> None:
+    """Refuse records ``(path, t, columns)`` of which two hold the same samples as read
+    (:func:`~motionhyst.identify.record_overlap.repeated_record`: a CSV and a MATLAB file
+    of it, the CSV written again with another float format, a part of it cut out), with
+    the line of a record given twice by name or byte for byte."""
+    from motionhyst.identify.record_overlap import repeated_record
+
+    same = repeated_record([(float(t[-1] - t[0]) / max(t.size - 1, 1), columns)
+                            for _, t, columns in records])
+    if same is not None:
+        i, j, n = same
+        raise UsageError(f"motionhyst identify: {records[i][0]} and {records[j][0]} hold the "
+                         f"same record as read ({n} samples alike): a record given twice "
+                         f"counts its samples twice (standard errors too small); give each "
+                         f"record once")
 
 
 def reference_forms(fit, records) -> list[dict]:

@@ -21,6 +21,7 @@ from motionhyst.cli._common import (
 from motionhyst.cli._identify_io import (
     add_input_output_arguments,
     check_not_input_output,
+    refuse_repeated,
     run_input_output,
     save_target,
     search_budget,
@@ -449,6 +450,7 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     for path in paths:
         t, x, w = load_force_displacement_csv(path, columns=args.columns, scale=args.scale)
         records.append((path, t, x, w))
+    refuse_repeated([(path, t, (x, w)) for path, t, x, w in records])
     _check_forces_follow(records)  # light: before the fit's sizes load its libraries
     check([t.size for _, t, _, _ in records])  # before the mass check and the starts
     mass = _refuse_a_mass(records)

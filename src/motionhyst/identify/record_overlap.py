@@ -1,0 +1,118 @@
+"""Records that hold the same samples: one record given twice, in two files.
+
+A fit of several records counts each sample once; a record given twice (a CSV and a MATLAB
+file of it, the CSV saved again with another float format, or a part of it cut out) counts
+its samples twice, and the standard errors come out ``sqrt(2)`` too small.  Files compared
+byte for byte miss every such copy: the records are compared as read, by their values
+(:func:`shared_samples`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["MIN_SHARED", "SAME_VALUE_RTOL", "repeated_record", "shared_samples"]
+
+#: Two values are the same sample's when they differ by less than this share of the larger
+#: magnitude of their column (a record written again with 6 significant digits: 5e-6)
+SAME_VALUE_RTOL = 1e-5
+
+#: The fewest samples two records share for one to be a part of the other (and not two
+#: records that meet by chance at a sample)
+MIN_SHARED = 10
+
+
+def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.float64]],
+                   step_a: float, step_b: float) -> int:
+    """How many samples record `b` shares with record `a`, where `b` starts inside `a`
+    (equal, a part of it, or overlapping its end): 0 if none.
+
+    Samples are shared when every column (`a` and `b`: the same columns, one array each,
+    of the records' own lengths) agrees within :data:`SAME_VALUE_RTOL` of the column's
+    largest magnitude, from `b`'s first sample to the end of either record, and the records
+    have one time step (the time stamps themselves may be shifted: a part cut out of a
+    record and its time set from 0).  A shared run must move (every column's range over it
+    above the tolerance's hundredfold, not two records that both rest) and hold at least
+    :data:`MIN_SHARED` samples.
+
+    Parameters
+    ----------
+    a, b : sequence of ndarray
+        The records' columns (force, displacement, ...), each of its record's length.
+    step_a, step_b : float
+        Their time steps [s].
+
+    Returns
+    -------
+    int
+        The number of samples shared (0: none).
+
+    Examples
+    --------
+    A part of a record, written with 6 significant digits, is found in it:
+
+    >>> import numpy as np
+    >>> t = np.arange(1000) / 1000.0
+    >>> x, f = np.sin(2 * np.pi * t), 3.0 + np.cos(5 * t)
+    >>> part = [np.array([float(f"{v:.6g}") for v in c[200:700]]) for c in (x, f)]
+    >>> shared_samples([x, f], part, 1e-3, 1e-3)
+    500
+    >>> shared_samples([x, f], [x[200:700] + 1e-3, f[200:700]], 1e-3, 1e-3)   # another record
+    0
+    """
+    if not a or len(a) != len(b) or not (abs(step_a - step_b) <= 1e-6 * abs(step_a)):
+        return 0
+    n_a, n_b = a[0].size, b[0].size
+    if min(n_a, n_b) < MIN_SHARED:
+        return 0
+    tol = [SAME_VALUE_RTOL * max(float(np.max(np.abs(ca))), float(np.max(np.abs(cb))))
+           for ca, cb in zip(a, b, strict=True)]
+    starts = np.ones(n_a, dtype=bool)
+    for ca, cb, e in zip(a, b, tol, strict=True):
+        starts &= np.abs(ca - cb[0]) <= e
+    for i in np.flatnonzero(starts)[:100]:  # a resting start matches many: the first hundred
+        n = min(n_a - int(i), n_b)
+        if n < MIN_SHARED:
+            break
+        if all(np.all(np.abs(ca[i:i + n] - cb[:n]) <= e) and np.ptp(cb[:n]) > 100 * e
+               for ca, cb, e in zip(a, b, tol, strict=True)):
+            return n
+    return 0
+
+
+def repeated_record(records: Sequence[tuple[float, Sequence[NDArray[np.float64]]]]
+                    ) -> tuple[int, int, int] | None:
+    """The first two of `records` that hold the same samples, as read
+    (:func:`shared_samples` either way round), or None.
+
+    Parameters
+    ----------
+    records : sequence of (float, sequence of ndarray)
+        Each record's time step [s] and columns (the same columns for all).
+
+    Returns
+    -------
+    tuple of int or None
+        ``(i, j, n)``: records `i` < `j` share `n` samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(500) / 100.0
+    >>> one = [np.sin(t), np.cos(3 * t)]
+    >>> other = [np.sin(t + 1.0), np.cos(3 * t + 1.0)]
+    >>> repeated_record([(0.01, one), (0.01, other), (0.01, [c[100:] for c in one])])
+    (0, 2, 400)
+    >>> repeated_record([(0.01, one), (0.01, other)]) is None
+    True
+    """
+    for j in range(len(records)):
+        for i in range(j):
+            (da, a), (db, b) = records[i], records[j]
+            n = shared_samples(a, b, da, db) or shared_samples(b, a, db, da)
+            if n:
+                return i, j, n
+    return None
