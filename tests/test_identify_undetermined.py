@@ -10,6 +10,8 @@
   again with 6 significant digits, a part of it cut out): fitted as two records, standard
   errors sqrt(2) too small, exit 0; now refused as a record given twice is by name or byte
   for byte, before any fit.
+* A single mass's record fitted as a two-mass stage (--plant two-mass): refused before the
+  search (it ran to the work budget, an hour by default).
 """
 
 from __future__ import annotations
@@ -157,3 +159,32 @@ def test_records_of_one_stage_with_their_own_noise_are_two_records():
     assert repeated_record([(step, (u, y0)), (step, (u, y1))]) is None
     assert repeated_record([(step, (u, y0)), (step, (u, y1)),
                             (step, (u[:300], y1[:300]))]) == (1, 2, 300)
+
+
+def multisine_axis(path):
+    """The axis driven by 0.5 N at each of 1, 2, 3, 4 and 5 Hz (4 s at 500 Hz)."""
+    t = np.arange(2000) / 500.0
+    u = sum(0.5 * np.sin(2 * np.pi * f * t + f) for f in (1.0, 2.0, 3.0, 4.0, 5.0))
+    y = OpenLoop(MassDamper(10.0, 20.0), Jenkins(k=LINK_K, fc=LINK_FC)).simulate(
+        t, u).displacement
+    return write_csv(path, (t, u, y + 1e-7 * np.random.default_rng(3).standard_normal(t.size)))
+
+
+def test_a_single_mass_is_not_searched_as_two_masses(capsys, tmp_path):
+    """Base: --plant two-mass on a 10 kg axis's record searched until the work budget (an
+    hour of CPU by default; --max-seconds 20: 'did not finish within the work budget').
+    Driven by two sines, the record's response has 2 lines, 4 numbers for a two-mass
+    stage's 6; driven by five, the two-mass stage that fits them best has a second mass of
+    1e-7 kg beside 8 kg: either way one line before the search, naming the single-mass
+    plants."""
+    two = write_csv(tmp_path / "axis.csv", axis_record())
+    five = multisine_axis(tmp_path / "five.csv")
+    for record, words in ((two, "the records do not show two masses: they excite 2 line(s) "
+                                "of their frequency response (1, 3.75 Hz)"),
+                          (five, "the records show one mass, not two: the two-mass stage "
+                                 "that fits their frequency response best has masses of")):
+        rc, out, err = run(capsys, "identify", str(record), "--record", "input-output",
+                           "--plant", "two-mass", "--model", "jenkins", "--max-seconds", "20")
+        assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+        assert f"{record}: {words}" in err, err
+        assert "--plant mass-spring-damper or mass-damper" in err

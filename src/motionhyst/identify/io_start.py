@@ -25,6 +25,14 @@ __all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "e
            "reference_mass"]
 
 BLA_STARTS = 6  # two-mass: grid points refined
+#: A two-mass stage whose lighter mass is below this share of the other is one mass (the
+#: records' best fit ends there when they do not determine a second one:
+#: :func:`best_linear_approximation_two_mass`)
+MASS_RATIO = 0.01
+#: The fewest lines of the records' frequency response a two-mass stage is fitted to: its
+#: linear model (``m1, m2, b, k`` and the link's ``kl, cl``) has 6 parameters, and 4 complex
+#: lines give 8 numbers, more than it takes to pass through them
+TWO_MASS_LINES = 4
 
 
 def best_linear_approximation(records: list[IORecord]) -> MassSpringDamper:
@@ -335,9 +343,12 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     ------
     ValueError
         One line when the best fit's internal mode (``sqrt(k (m1 + m2) / (m1 m2))``) is
-        above the records' Nyquist frequency: their masses move as one, the records are
-        a single mass's (a two-mass fit would spend its search on parameters the records
-        do not determine).
+        above the records' Nyquist frequency, or one of its masses below
+        :data:`MASS_RATIO` of the other: their masses move as one, the records are a single
+        mass's (a two-mass fit would spend its search on parameters the records do not
+        determine: a 10 kg axis's record, its best fit 0.0098 and 9.8 kg, ran to the work
+        budget); or when the records excite fewer than :data:`TWO_MASS_LINES` lines, too
+        few to determine a two-mass stage at all.
 
     Examples
     --------
@@ -357,6 +368,15 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     f, G = _spectral_response(records)
     keep = f < 0.5 * records[0].fs * (1 - 1e-9)  # the Nyquist line is ambiguous
     f, G = f[keep], G[keep]
+    names = records[0].name if len(records) == 1 else f"{records[0].name} and the others"
+    if f.size < TWO_MASS_LINES:  # fewer numbers than the linear model's parameters
+        raise ValueError(f"{names}: the records do not show two masses: they excite "
+                         f"{f.size} line(s) of their frequency response "
+                         f"({', '.join(f'{v:.3g}' for v in f)} Hz), {2 * f.size} numbers for "
+                         f"the 6 parameters of a two-mass stage on the link's linear spring "
+                         f"and damper: a second mass is not determined; identify a single "
+                         f"mass (--plant mass-spring-damper or mass-damper), or give a record "
+                         f"that excites more frequencies (a multisine, a sweep)")
     if not periodic:
         G = _arx_response(records, f)
     s = 2j * np.pi * f
@@ -400,11 +420,17 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     f_internal = math.sqrt(k * (m1 + m2) / (m1 * m2)) / (2 * math.pi)
     nyquist = 0.5 * records[0].fs
     if not f_internal < nyquist:  # the masses move as one within the records' band
-        names = records[0].name if len(records) == 1 else f"{records[0].name} and the others"
         raise ValueError(f"{names}: the records show one mass, not two: the two-mass stage "
                          f"that fits their frequency response best has its internal mode at "
                          f"{f_internal:.3g} Hz, above their Nyquist frequency {nyquist:.3g} Hz; "
                          f"identify a single mass (--plant mass-spring-damper or mass-damper)")
+    if min(m1, m2) < MASS_RATIO * max(m1, m2):  # one mass and a vanishing one
+        raise ValueError(f"{names}: the records show one mass, not two: the two-mass stage "
+                         f"that fits their frequency response best has masses of {m1:.3g} and "
+                         f"{m2:.3g} kg, one below {MASS_RATIO:g} of the other: a second mass "
+                         f"is not determined; identify a single mass (--plant "
+                         f"mass-spring-damper or mass-damper), or give a record that excites "
+                         f"the internal mode")
     return TwoMass(m1, m2, b, k, output), float(kl), float(cl)
 
 
