@@ -202,10 +202,13 @@ def run(args: argparse.Namespace) -> int:
 
         x, noise = estimate_displacement(t, x)  # the link's input, as predict estimates it
         extra["displacement_noise"] = noise.to_dict()
-        from motionhyst.identify.records import check_force_follows
+        from motionhyst.identify.records import ForceFalls, check_force_follows
 
         try:  # a force that is noise, or of a sensor reversed: before the mass check and fit
             check_force_follows(x, w, t)
+        except ForceFalls as exc:
+            _refuse_a_driven_mass(measured)  # a force that drives a mass: said so
+            raise ValueError(f"{path}: {exc}") from None
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
     else:
@@ -501,11 +504,14 @@ def _check_forces_follow(records: list[tuple]) -> None:
     refusal for every ``--model`` as for the elements' fit (a Dahl link's fit refused white
     noise only after its start)."""
     from motionhyst.identify.displacement_noise import estimate_displacement
-    from motionhyst.identify.records import check_force_follows
+    from motionhyst.identify.records import ForceFalls, check_force_follows
 
     for path, t, x, w in records:
         try:
             check_force_follows(estimate_displacement(t, x)[0], w, t)
+        except ForceFalls as exc:
+            _refuse_a_driven_mass([(path, t, x, w)])  # a force that drives a mass: said so
+            raise ValueError(f"{path}: {exc}") from None
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
 
@@ -530,6 +536,34 @@ def _refuse_a_mass(records: list[tuple], refuse: bool = False) -> str | None:
             return None
         uniform.append(IORecord(t, w, x, str(path)))
     return check_no_inertia(uniform, refuse)
+
+
+def _refuse_a_driven_mass(records: list[tuple]) -> None:
+    """Refuse force-displacement records ``(path, t, x, w)`` whose force falls as the
+    displacement rises because it drives a mass
+    (:func:`~motionhyst.identify.fd_inertia.driven_mass`): a stage's input-output record,
+    which has the same header, read by default as force-displacement; its refusal named a
+    sensor's sign ("--scale force=-1"), and following it led to two more refusals, none
+    naming --record input-output.  Records whose stamps are not uniform are not judged."""
+    from motionhyst.identify.fd_inertia import driven_mass
+    from motionhyst.identify.io_records import IORecord
+    from motionhyst.time.resample import check_record
+
+    for _, t, _, w in records:
+        try:
+            check_record(t, w)
+        except ValueError:
+            return
+    found = driven_mass([IORecord(t, w, x, str(path)) for path, t, x, w in records])
+    if found is not None:
+        m, _, share = found
+        raise ValueError(f"{records[0][0]}: no hysteresis found: the force falls as the "
+                         f"displacement rises as a force that drives a mass does (the "
+                         f"record's inverse dynamics: a mass of about {m:.2g} kg, its force "
+                         f"m x'' {100 * share:.2g} % of the force's RMS): a stage's "
+                         f"input-output record (force in, position out)? identify its mass "
+                         f"and link with --record input-output (--plant mass-damper or "
+                         f"mass-spring-damper); nothing identified")
 
 
 def _check_determined(path: Path, ident, x, w) -> None:

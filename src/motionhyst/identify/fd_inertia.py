@@ -43,8 +43,8 @@ from motionhyst.hysteresis import Jenkins
 from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, robust_least_squares
 from motionhyst.identify.io_records import IORecord
 
-__all__ = ["MASS_EXPLAINED", "MASS_SIGMAS", "REFUSE_SHARE", "WARN_SHARE", "LinkInertia",
-           "check_no_inertia", "link_inertia"]
+__all__ = ["DRIVEN_SHARE", "MASS_EXPLAINED", "MASS_SIGMAS", "REFUSE_SHARE", "WARN_SHARE",
+           "LinkInertia", "check_no_inertia", "driven_mass", "link_inertia"]
 
 #: Slip displacements of the regression's stop operators per decade
 STOPS_PER_DECADE = 6
@@ -274,3 +274,64 @@ def check_no_inertia(records: list[IORecord], refuse: bool = False) -> str | Non
                          f"nothing identified")
     return (f"{names}: the force accelerates {what}: the link identified absorbs it (a mass "
             f"and its link are --record input-output --plant mass-damper)")
+
+
+#: A force that falls as the position rises drives a mass (:func:`driven_mass`) where the
+#: inverse-dynamics mass's force ``m y''`` is at least this share of the force's RMS
+DRIVEN_SHARE = 0.1
+
+
+def driven_mass(records: list[IORecord]) -> tuple[float, float, float] | None:
+    """The mass of records whose force (``u``) falls as the position (``y``) rises because it
+    drives that mass (a stage's input-output record above its resonance: the position lags
+    the force by nearly 180 degrees), not because a sensor's sign is reversed; or None.
+
+    The records' inverse dynamics (``u = m y'' + c y' + f sign(y') + u0 + k y``, the rates by
+    Savitzky-Golay filters of about 10 ms:
+    :func:`~motionhyst.identify.io_start.equation_rows`, as input-output identification
+    checks a stage's inertia) show such a mass positive by :data:`MASS_SIGMAS` Newey-West
+    standard errors, its force ``m y''`` at least :data:`DRIVEN_SHARE` of the force's RMS,
+    and a spring ``k`` that is not negative by as many (a sensor's sign reversed makes the
+    spring negative, not the mass positive).
+
+    Parameters
+    ----------
+    records : list of IORecord
+        The records (force as ``u``, position as ``y``), uniformly sampled.
+
+    Returns
+    -------
+    tuple of float or None
+        ``(m, std, share)``: the mass [kg], its standard error and its force's share.
+
+    Examples
+    --------
+    A 2 kg mass on a spring of 500 N/m (its resonance at 2.5 Hz) driven at 3 and 17 Hz, and
+    a spring's record with its force's sign reversed:
+
+    >>> t = np.arange(2000) / 1000.0
+    >>> y = 1e-3 * np.sin(2 * np.pi * 3 * t) + 4e-4 * np.sin(2 * np.pi * 17 * t)
+    >>> a = np.gradient(np.gradient(y, t), t)
+    >>> m, std, share = driven_mass([IORecord(t, 2.0 * a + 500.0 * y, y, "stage.csv")])
+    >>> round(m, 1), share > 0.5
+    (2.0, True)
+    >>> driven_mass([IORecord(t, -500.0 * y, y, "reversed.csv")]) is None
+    True
+    """
+    from motionhyst.identify.io_start import equation_rows
+
+    rows, rhs = equation_rows(records, floating=True, light=True)
+    rows = [np.column_stack([r, rec.y - np.mean(rec.y)]) for r, rec in zip(rows, records,
+                                                                           strict=True)]
+    fs = (records[0].t.size - 1) / float(records[0].t[-1] - records[0].t[0])
+    with few_blas_threads(sum(r.shape[0] for r in rows), rows[0].shape[1]):
+        coef, cov = robust_least_squares(rows, rhs, max(7, 2 * round(0.005 * fs) + 1))
+    m, k = float(coef[0]), float(coef[-1])
+    m_std, k_std = (math.sqrt(max(float(cov[i, i]), 0.0)) for i in (0, -1))
+    u = np.concatenate([b - np.mean(b) for b in rhs])
+    a = np.concatenate([r[:, 0] for r in rows])
+    u_rms = math.sqrt(float(np.mean(u ** 2)))
+    share = m * math.sqrt(float(np.mean(a ** 2))) / u_rms if u_rms > 0 else 0.0
+    if m > MASS_SIGMAS * m_std and share >= DRIVEN_SHARE and k > -MASS_SIGMAS * k_std:
+        return m, m_std, share
+    return None

@@ -399,6 +399,17 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
         y_all = np.concatenate([rec.y - np.mean(rec.y) for rec in records])
         if K < 0 and np.dot(u_all, y_all) < -SIGN_CORRELATION * np.linalg.norm(
                 u_all) * np.linalg.norm(y_all):
+            from motionhyst.identify.fd_inertia import driven_mass
+
+            found = driven_mass(records)  # above a mass's resonance its position falls too
+            if found is not None:
+                raise ValueError(f"the position falls as the force rises (a stiffness of "
+                                 f"{K:.3g} N/m) as a mass's does when the force drives it: "
+                                 f"the records' inverse dynamics give a mass of about "
+                                 f"{found[0]:.2g} kg (its force m y'' "
+                                 f"{100 * found[2]:.2g} % of the force's RMS), which a "
+                                 f"quasi-static plant does not have; identify a stage with a "
+                                 f"mass (--plant mass-damper or mass-spring-damper)")
             raise ValueError(f"the position falls as the force rises (a stiffness of {K:.3g} "
                              f"N/m): is one sensor's sign reversed? (--scale "
                              f"displacement=-1)")

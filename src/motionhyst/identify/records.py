@@ -13,7 +13,7 @@ from motionhyst.io.csvdata import Source, describe
 from motionhyst.io.records import read_record
 
 __all__ = ["DECIMATED_RATE", "ELASTIC_CURVE_RATIO", "FOLLOW_GAIN", "SCALE_RATIO",
-           "check_controller_period", "check_force_follows", "check_force_scale",
+           "ForceFalls", "check_controller_period", "check_force_follows", "check_force_scale",
            "check_loops_open", "count_reversals", "fit_every", "load_closed_loop_csv",
            "load_force_displacement_csv", "prefilter_cutoff"]
 
@@ -159,6 +159,25 @@ least :data:`~motionhyst.identify.io_checks.NO_HYSTERESIS_GAIN` beyond a spring,
 through those three."""
 
 
+class ForceFalls(ValueError):
+    """A force-displacement record whose force falls as its displacement rises
+    (:func:`check_force_follows`): a sensor's sign reversed, or a force that drives a mass
+    (a stage's input-output record: above its resonance the position lags the force by
+    nearly 180 degrees), which the caller tells by the record's inertia.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(1000) / 1000.0
+    >>> x = 1e-3 * np.sin(2 * np.pi * 3.0 * t)
+    >>> try:
+    ...     check_force_follows(x, -2000.0 * x, t)
+    ... except ForceFalls as exc:
+    ...     print(str(exc)[:62])
+    no hysteresis found: the force falls as the displacement rises
+    """
+
+
 def check_force_follows(x: ArrayLike, w: ArrayLike, t: ArrayLike) -> None:
     """Refuse, before any fit, a force-displacement record whose force does not follow its
     displacement: it falls as the displacement rises (their correlation below -0.5: a
@@ -177,7 +196,8 @@ def check_force_follows(x: ArrayLike, w: ArrayLike, t: ArrayLike) -> None:
     Raises
     ------
     ValueError
-        One line: what the force does, and what would help.
+        One line: what the force does, and what would help (:class:`ForceFalls` where it
+        falls as the displacement rises).
 
     Examples
     --------
@@ -197,7 +217,7 @@ def check_force_follows(x: ArrayLike, w: ArrayLike, t: ArrayLike) -> None:
     if x.size < 8 or not (xx > 0 and ww > 0):
         return
     if float(x0 @ w0) < -0.5 * math.sqrt(xx * ww):
-        raise ValueError("no hysteresis found: the force falls as the displacement rises (is "
+        raise ForceFalls("no hysteresis found: the force falls as the displacement rises (is "
                          "one sensor's sign reversed? --scale force=-1)")
     v = np.gradient(x, t)
     basis = np.column_stack([np.ones_like(x), x0, v, np.sign(v)])
