@@ -583,6 +583,13 @@ def _check_determined(path: Path, ident, x, w) -> None:
     never = [e for e in ident.elements if e["fc"] / e["k"] >= SLIP_SHARE * half]
     for e in never:  # pinned at the record's end by the fit, not found in it
         e["fc_std"] = math.inf
+    if never and ident.covariance is not None and ident.n_elements > 1:  # nor saved as one
+        from motionhyst.identify.io_uncertainty import covariance_table
+
+        names = ident.covariance["parameters"]
+        std = {n: None if n in {f"fc[{ident.elements.index(e)}]" for e in never} else 1.0
+               for n in names}
+        ident.covariance = covariance_table(names, np.array(ident.covariance["matrix"]), std)
     # a spring (and offset) by least squares: what the elements explain beyond it, in noise
     # variances (the smallest slip displacement can fall short of the half-range by noise)
     A = np.column_stack([x, np.ones_like(x)])
