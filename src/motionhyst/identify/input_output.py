@@ -477,8 +477,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         break
     fit.n_evaluations = budget.used  # refits with fewer elements included
     if not fit.extra.get("rigid_limit"):
-        _refuse_a_stuck_link(fit, records, undetermined(
-            fit.estimates, fit.judged_std or fit.std, invariant, zero))
+        _refuse_a_stuck_link(fit, records, set(undetermined(
+            fit.estimates, fit.judged_std or fit.std, invariant, zero)) - _one_way_names(fit))
     if (stage.has_inertia and not asymmetric and _is_axis(stage)
             and (not periodic or isinstance(fit.hysteresis, Coulomb))):
         note = viscous_direction_note(records)  # a symmetric fit's mass is biased: its rigid
@@ -602,22 +602,24 @@ def _undetermined_link(fit: IOIdentification, failed: FitFailed, stage: Plant,
 
 
 def _refuse_a_stuck_link(fit: IOIdentification, records: list[IORecord],
-                         names: list[str]) -> None:
-    """Refuse a fit whose records do not determine any of its link's slip forces (`names`,
-    the parameters they do not determine): the link never slips in them, its force is a
-    spring's (``link.k``, the stop operators' stiffness, eq. 3), and a slip force the model
-    would hold is the search's, anything above the spring's force at the records' strokes
-    (a Jenkins link stuck throughout ended at fc = 5.6e12 N).  A model saved with it would
-    predict a link that never slips, whatever the force: refused, the spring named."""
+                         names: set[str]) -> None:
+    """Refuse a fit whose records determine none of its link's slip forces (`names`, the
+    parameters they do not determine, less those a one-way slip's warning names as one
+    force): a link with a spring (``link.k``, the stop operators' stiffness, eq. 3) then
+    never slips in them, its force is that spring's, and a slip force the model would hold
+    is the search's, anything above the spring's force at the records' strokes (a Jenkins
+    link stuck throughout ended at fc = 5.6e12 N).  A model saved with it would predict a
+    link that never slips, whatever the force: refused, the spring named.  (A link without a
+    spring, Coulomb's, is judged by :func:`judge_determined` alone.)"""
     slips = [n for n in fit.estimates if n == "link.fc" or n.startswith("link.fc[")]
-    if not slips or not set(slips) <= set(names):
-        return
     springs = [n for n in fit.estimates if n == "link.k" or n.startswith("link.k[")]
+    if not slips or not springs or not set(slips) <= names:
+        return
     k = sum(fit.estimates[n] for n in springs)
     half = max(0.5 * float(np.ptp(rec.y)) for rec in records)
     spring = (f"it acts as a spring of {k:.4g} N/m (link.k; any slip force above its "
               f"{k * half:.3g} N at the records' half-stroke {half:.3g} m fits as well)"
-              if springs and all(n not in names for n in springs) and k > 0
+              if all(n not in names for n in springs) and k > 0
               else "its force is not a slip's")
     raise FitFailed(f"the fit failed: the link never slips in these records (not determined: "
                     f"{', '.join(slips)}, the search ended at {fit.estimates[slips[0]]:.3g} N): "
