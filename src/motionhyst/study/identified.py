@@ -138,11 +138,10 @@ class JointNormal:
                              f"to draw must be {what}")
         if not (np.all(np.isfinite(c)) and np.allclose(c, c.T, rtol=1e-9, atol=0.0)):
             raise ValueError(f"{where}the covariance must be finite and symmetric")
-        s = np.sqrt(np.clip(np.diag(c), 0.0, None))
-        w = np.linalg.eigvalsh(c / np.outer(np.where(s > 0, s, 1), np.where(s > 0, s, 1)))
-        if np.any(np.diag(c) < 0) or w[0] < -_CORRELATION_ROUNDING * d:
+        least = _least_eigenvalue(c)
+        if np.any(np.diag(c) < 0) or least < -_CORRELATION_ROUNDING * d:
             raise ValueError(f"{where}the covariance is not positive semi-definite (its "
-                             f"correlation matrix has the eigenvalue {w[0]:.3g})")
+                             f"correlation matrix has the eigenvalue {least:.3g})")
 
     @property
     def std(self) -> NDArray[np.float64]:
@@ -283,6 +282,14 @@ MAX_REDRAWS = 1000
 """Rounds of redrawing the draws with a parameter at or below its least value (each round
 keeps the admitted ones): a distribution that puts almost all its mass there is refused, not
 drawn from forever."""
+
+
+def _least_eigenvalue(c: NDArray[np.float64]) -> float:
+    """The least eigenvalue of the correlation matrix of the covariance `c` (a standard
+    deviation of 0 counted as 1): negative for a matrix that is no covariance."""
+    s = np.sqrt(np.clip(np.diag(c), 0.0, None))
+    s = np.where(s > 0, s, 1.0)
+    return float(np.linalg.eigvalsh(c / np.outer(s, s))[0])
 
 
 def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -442,12 +449,32 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
     at = [names.index(n) for n in drawn]
     if cov.shape != (len(names), len(names)):
         raise ValueError(f"{where}: the covariance is not a {len(names)} x {len(names)} matrix")
+    _check_whole(np.asarray(sec.correlation, dtype=float) if hint == "--save" else cov, names,
+                 where, hint)
     sub = cov[np.ix_(at, at)]
     try:
         return JointNormal(tuple(keys[n] for n in drawn), tuple(float(mean[n]) for n in drawn),
                            tuple(map(tuple, sub.tolist())), str(path))
     except ValueError as exc:  # named as the other errors of the file
         raise ValueError(f"from_identification {exc}") from None
+
+
+def _check_whole(cov: NDArray[np.float64], names: list, where: str, hint: str) -> None:
+    """Refuse an identification whose whole covariance (of every parameter it names, drawn
+    or not) is no covariance: not finite, not symmetric, or with a correlation matrix that
+    has a negative eigenvalue (beyond the rounding of a saved matrix), which no estimates
+    have; the block drawn may look fine while the whole is impossible."""
+    n = len(names)
+    if not (np.all(np.isfinite(cov)) and np.allclose(cov, cov.T, rtol=1e-9, atol=0.0)):
+        raise ValueError(f"{where}: the covariance of its {n} parameters is not finite and "
+                         f"symmetric")
+    least = _least_eigenvalue(cov) if n else 0.0
+    if np.any(np.diag(cov) < 0) or least < -_CORRELATION_ROUNDING * n:
+        named = f" ({', '.join(map(str, names))})" if n <= 8 else ""
+        raise ValueError(f"{where}: the correlation matrix of its {n} parameters{named} is "
+                         f"not positive semi-definite (it has the eigenvalue {least:.3g}): no "
+                         f"estimates have it; write the identification again (`motionhyst "
+                         f"identify ... {hint}`)")
 
 
 def _one_element(elements: list, where: str) -> dict:

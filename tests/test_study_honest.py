@@ -1,0 +1,111 @@
+"""A study that answers only what its inputs determine (issue 26, review B19 F2, F7, F9, F14):
+an identification that is no covariance, or of another stage, is refused in one line; a
+distribution that puts its mass where the scenario refuses is refused before any point runs;
+``--force`` replaces only the store's own entries.
+
+The command-line cases run in a child process under an address-space limit
+(:mod:`limited_process`) in a folder of the user's files, and assert exit code 2, one line on
+stderr (no traceback), nothing on stdout, and every file there before byte-identical after.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import limited_process
+import numpy as np
+import pytest
+from file_trees import populate, snapshot
+
+from motionhyst.study.identified import joint_from_identification
+
+STAGE = '[stage]\ntype = "mass-damper"\nm = 10.0\nc = 20.0\n'
+LINK = '[hysteresis]\nmodel = "jenkins"\nk = 2000.0\nfc = 2.0\n'
+LOOP = (STAGE + "\n" + LINK + '\n[controller]\ntype = "pid"\nkp = 2e5\nki = 2e6\nkd = 2000.0\n'
+        'derivative_filter_hz = 500.0\n\n[reference]\namplitude = 1e-3\nfrequencies = [5.0]\n')
+"""A 10 kg mass-damper with Table I's link scaled to it, in a PID loop: the identified system."""
+
+PARAMETERS = ["stage.m", "stage.c", "hysteresis.k", "hysteresis.fc"]
+ESTIMATES = [10.000019830835344, 19.999853571462516, 1999.7570141694232, 2.000046906500395]
+STD = [1.053330127908144e-05, 9.263367796655379e-05, 0.14162079797906132, 2.3699220872117845e-05]
+CORRELATION = [[1.0, -0.310198981648, -0.816862210666, 0.487396001347],
+               [-0.310198981648, 1.0, 0.051352043296, -0.938686314713],
+               [-0.816862210666, 0.051352043296, 1.0, -0.23309814522],
+               [0.487396001347, -0.938686314713, -0.23309814522, 1.0]]
+"""What ``identify --record input-output --plant mass-damper --model jenkins --save`` wrote for
+4000 samples of the 10 kg mass-damper with its link (review B19's id.toml)."""
+
+
+def identification(estimates=ESTIMATES, correlation=CORRELATION, stage: str = STAGE) -> str:
+    """A model file as ``identify --save`` writes it: the stage, the link, [identification]."""
+    return (stage + "\n" + LINK + "\n[identification]\nrecord = \"input-output\"\n"
+            f"parameters = {json.dumps(PARAMETERS)}\nestimates = {json.dumps(estimates)}\n"
+            f"std = {json.dumps(STD)}\ncorrelation = {json.dumps(correlation)}\n")
+
+
+def _not_psd() -> list[list[float]]:
+    """The correlation with corr(stage.m, hysteresis.fc) = 0.99: eigenvalue -0.29."""
+    r = [list(row) for row in CORRELATION]
+    r[0][3] = r[3][0] = 0.99
+    return r
+
+
+def study_text(scenario: str, n: int = 4, extra: str = "") -> str:
+    return (f'scenario = "{scenario}"\noutputs = ["e1"]\n[axes]\nfrequency_hz = [5.0]\n'
+            f"[samples]\nn = {n}\nseed = 0\n{extra}")
+
+
+def refused(tmp_path: Path, files: dict, argv: list[str]) -> str:
+    """Run `argv` in `tmp_path` holding `files`: exit 2, one line on stderr (returned), nothing
+    on stdout, every file byte-identical and none added."""
+    populate(tmp_path, files)
+    before = snapshot(tmp_path)
+    code, out, err = limited_process.run(argv, tmp_path, limited_process.REFUSAL_LIMIT)
+    assert code == 2, err
+    assert out == ""
+    assert len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err
+    assert snapshot(tmp_path) == before
+    return err.strip()
+
+
+# ----------------------------------------------------------- F14: a correlation that is none
+def test_a_correlation_matrix_with_a_negative_eigenvalue_is_refused_whole(tmp_path):
+    """corr(stage.m, hysteresis.fc) = 0.99 in the identification of the 10 kg stage: the 4 x 4
+    matrix has the eigenvalue -0.290 (no estimates have it); only its (k, fc) block was drawn,
+    which is a correlation, and the study ran (exit 0).  Now the whole matrix is checked."""
+    bad = _not_psd()
+    assert np.linalg.eigvalsh(np.array(bad))[0] == pytest.approx(-0.2904, abs=1e-4)
+    path = tmp_path / "bad.toml"
+    path.write_text(identification(correlation=bad))
+    with pytest.raises(ValueError, match=r"bad\.toml: the correlation matrix of its 4 "
+                                         r"parameters \(stage\.m, stage\.c, hysteresis\.k, "
+                                         r"hysteresis\.fc\) is not positive semi-definite \(it "
+                                         r"has the eigenvalue -0\.29\)"):
+        joint_from_identification(path)
+    # the same of `identify --json`: its covariance matrix
+    fit = {"plant": {"type": "mass-damper", "m": 10.0, "c": 20.0},
+           "hysteresis": {"model": "jenkins", "k": 2000.0, "fc": 2.0},
+           "estimates": {"m": ESTIMATES[0], "c": ESTIMATES[1], "link.k": ESTIMATES[2],
+                         "link.fc": ESTIMATES[3]},
+           "covariance": {"parameters": ["m", "c", "link.k", "link.fc"],
+                          "matrix": (np.array(bad) * np.outer(STD, STD)).tolist()}}
+    (tmp_path / "bad.json").write_text(json.dumps(fit))
+    with pytest.raises(ValueError, match=r"not positive semi-definite \(it has the eigenvalue "
+                                         r"-0\.29\).*identify \.\.\. --json"):
+        joint_from_identification(tmp_path / "bad.json")
+    # a saved matrix's rounding (1e-12) is no refusal: the identification as written is drawn
+    (tmp_path / "good.toml").write_text(identification())
+    assert joint_from_identification(tmp_path / "good.toml").keys == tuple(PARAMETERS[2:])
+
+
+def test_study_refuses_an_impossible_correlation_in_one_line(tmp_path):
+    err = refused(tmp_path, {"loop.toml": LOOP, "st.toml": study_text("loop.toml"),
+                             "bad.toml": identification(correlation=_not_psd())},
+                  ["study", "st.toml", "--out", "st.zarr", "--workers", "0",
+                   "--from-identification", "bad.toml"])
+    assert err.endswith("bad.toml: the correlation matrix of its 4 parameters (stage.m, "
+                        "stage.c, hysteresis.k, hysteresis.fc) is not positive semi-definite "
+                        "(it has the eigenvalue -0.29): no estimates have it; write the "
+                        "identification again (`motionhyst identify ... --save`)"), err
