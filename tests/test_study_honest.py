@@ -11,6 +11,7 @@ stderr (no traceback), nothing on stdout, and every file there before byte-ident
 from __future__ import annotations
 
 import json
+import tomllib
 from pathlib import Path
 
 import limited_process
@@ -18,6 +19,7 @@ import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
+from motionhyst.study import Study, StudyError
 from motionhyst.study.identified import joint_from_identification
 
 STAGE = '[stage]\ntype = "mass-damper"\nm = 10.0\nc = 20.0\n'
@@ -109,3 +111,54 @@ def test_study_refuses_an_impossible_correlation_in_one_line(tmp_path):
                         "stage.c, hysteresis.k, hysteresis.fc) is not positive semi-definite "
                         "(it has the eigenvalue -0.29): no estimates have it; write the "
                         "identification again (`motionhyst identify ... --save`)"), err
+
+
+# ------------------------------------------- F2: a user's file in the store folder is kept
+PAPER_STUDY = ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\namplitude = [0.01]\n'
+               'frequency_hz = [{}]\n')
+
+
+@pytest.mark.parametrize("where", ["notes.txt", "e1/notes.txt"])
+def test_force_onto_a_store_holding_a_users_file_is_refused(tmp_path, where):
+    """``study --force`` onto another study's store replaced the whole folder: a file the user
+    had put in it (notes.txt) was deleted with it (exit 0).  Now refused in one line naming
+    it, before any point is computed; the store and the file stay as they were."""
+    from motionhyst.scenario import default_scenario_path
+    from motionhyst.study.store import StudyStore
+
+    (tmp_path / "paper.toml").write_text(default_scenario_path().read_text())
+    (tmp_path / "old.toml").write_text(PAPER_STUDY.format("5.0"))
+    StudyStore.create(tmp_path / "st.zarr", Study.from_file(tmp_path / "old.toml"))
+    err = refused(tmp_path, {"new.toml": PAPER_STUDY.format("6.0"),
+                             f"st.zarr/{where}": "my notes\n"},
+                  ["study", "new.toml", "--out", "st.zarr", "--workers", "0", "--force"])
+    assert err.endswith(f"--out st.zarr: holds {where}, not the study's; --force replaces the "
+                        f"store with all in its folder: move them out of it, or give another "
+                        f"--out"), err
+
+
+def test_a_store_is_deleted_only_when_all_in_its_folder_is_its_own(tmp_path):
+    from motionhyst.scenario import default_scenario_path
+    from motionhyst.study.store import StudyStore, foreign_entries, remove_store
+
+    study = Study.from_dict(tomllib.loads(PAPER_STUDY.format("5.0")),
+                            scenario=tomllib.loads(default_scenario_path().read_text()))
+    StudyStore.create(tmp_path / "s.zarr", study)
+    assert foreign_entries(tmp_path / "s.zarr") == []
+    (tmp_path / "s.zarr" / "mine").mkdir()
+    (tmp_path / "s.zarr" / "status" / "x.txt").write_text("x")
+    assert foreign_entries(tmp_path / "s.zarr") == ["mine", "status/x.txt"]
+    with pytest.raises(StudyError, match=r"s\.zarr: holds mine and 1 more, not the store's; "
+                                         r"refusing to delete it"):
+        remove_store(tmp_path / "s.zarr")
+    assert (tmp_path / "s.zarr" / "status" / "x.txt").read_text() == "x"
+
+
+def test_the_rate_of_a_slow_study_keeps_its_digits():
+    """'2 points: 2 computed in 8.7 s (0 points/s)': the rate rounded to 0."""
+    from motionhyst.study.runner import RunReport
+
+    assert "(0.23 points/s)" in str(RunReport(points=2, computed=2, failed=0, seconds=8.7))
+    assert "(7.14 points/s)" in str(RunReport(points=50, computed=50, failed=0, seconds=7.0))
+    assert "(2400 points/s)" in str(RunReport(points=2400, computed=2400, failed=0,
+                                              seconds=1.0))

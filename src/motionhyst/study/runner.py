@@ -37,7 +37,14 @@ from motionhyst.study.engine import (
 )
 from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import StudyDefinition, StudyError
-from motionhyst.study.store import FAILED, StudyStore, is_study_store, remove_store
+from motionhyst.study.store import (
+    FAILED,
+    StudyStore,
+    foreign_entries,
+    is_study_store,
+    listed,
+    remove_store,
+)
 
 __all__ = ["LOCK_NAME", "Estimate", "RunReport", "check_budget", "estimate_study",
            "machine_load", "run_lock", "run_study"]
@@ -71,6 +78,8 @@ class RunReport:
     >>> r = RunReport(points=400, computed=100, failed=2, seconds=4.0, cpu_seconds=7.6)
     >>> print(r)
     400 points: 100 computed in 4.0 s (25 points/s), 2 failed
+    >>> print(RunReport(points=2, computed=2, failed=0, seconds=8.7))
+    2 points: 2 computed in 8.7 s (0.23 points/s), 0 failed
     >>> sorted(r.to_dict())                                # the ``study --json`` schema
     ['computed', 'cpu_seconds', 'failed', 'points', 'seconds']
     """
@@ -88,8 +97,9 @@ class RunReport:
 
     def __str__(self) -> str:
         rate = self.computed / self.seconds if self.seconds > 0 else float("nan")
+        shown = f"{rate:.0f}" if rate >= 100 else f"{rate:.3g}"  # 0.23, not 0
         return (f"{self.points} points: {self.computed} computed in {self.seconds:.1f} s "
-                f"({rate:.0f} points/s), {self.failed} failed")
+                f"({shown} points/s), {self.failed} failed")
 
 
 @dataclass
@@ -290,12 +300,16 @@ def _resumed_store(study: StudyDefinition, path: Path, force: bool) -> StudyStor
                 store.status()  # every chunk readable, every value a status
                 return store
         except StudyError as exc:  # damaged: replaced as another study's store is
-            if force:
-                return None
-            raise StudyError(f"--out {exc}; give --force to replace it") from None
+            if not force:
+                raise StudyError(f"--out {exc}; give --force to replace it") from None
         if not force:
             raise StudyError(f"--out {path}: holds another study (other scenario, axes, "
                              f"samples or outputs); give --force to replace it")
+        foreign = foreign_entries(path)
+        if foreign:  # a user's file in the folder is never deleted with the store
+            raise StudyError(f"--out {path}: holds {listed(foreign)}, not the study's; "
+                             f"--force replaces the store with all in its folder: move them "
+                             f"out of it, or give another --out")
     elif not path.parent.is_dir():
         raise StudyError(f"--out {path}: folder {path.parent} does not exist")
     return None

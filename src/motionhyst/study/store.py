@@ -24,7 +24,8 @@ from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import REFERENCE_AXES, StudyDefinition, StudyError
 
 __all__ = ["FAILED", "FLUSH_SECONDS", "MISSING", "OK", "REASONS", "ChunkWriter", "StudyStore",
-           "field_names", "is_study_store", "open_results", "remove_store"]
+           "field_names", "foreign_entries", "is_study_store", "listed", "open_results",
+           "remove_store"]
 
 MISSING, OK, FAILED = 0, 1, 2
 """Values of the ``status`` array."""
@@ -504,6 +505,47 @@ def is_study_store(path: str | Path) -> bool:
         return False                                                # thousands of levels deep
 
 
+def foreign_entries(path: str | Path) -> list[str]:
+    """The entries of the store folder `path` that are not the store's: anything beside its
+    ``zarr.json`` and its arrays' folders (each a ``zarr.json`` and its chunks ``c``), such
+    as a user's notes put there.  A store replaced with ``--force`` would take them with it.
+
+    Parameters
+    ----------
+    path : str or Path
+        A study's store folder.
+
+    Returns
+    -------
+    list of str
+        Their names relative to `path`, sorted (empty for a store as a study wrote it).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "zarr.json").write_text("{}")
+    >>> (folder / "e1" / "c").mkdir(parents=True)
+    >>> _ = (folder / "e1" / "zarr.json").write_text("{}")
+    >>> _ = (folder / "notes.txt").write_text("my notes")
+    >>> foreign_entries(folder)
+    ['notes.txt']
+    """
+    path = Path(path)
+    out = []
+    for entry in sorted(path.iterdir()):
+        if entry.name == "zarr.json" and entry.is_file() and not entry.is_symlink():
+            continue
+        if not (entry.is_dir() and not entry.is_symlink() and (entry / "zarr.json").is_file()):
+            out.append(entry.name)
+            continue
+        out.extend(f"{entry.name}/{inner.name}" for inner in sorted(entry.iterdir())
+                   if not (inner.name in ("zarr.json", "c") and not inner.is_symlink()
+                           and (inner.is_file() if inner.name == "zarr.json"
+                                else inner.is_dir())))
+    return out
+
+
 def remove_store(path: str | Path) -> None:
     """Delete a study's store (refuses anything else).
 
@@ -523,7 +565,27 @@ def remove_store(path: str | Path) -> None:
     """
     if not is_study_store(path):
         raise StudyError(f"{path}: not a store of motionhyst study; refusing to delete it")
+    foreign = foreign_entries(path)
+    if foreign:
+        raise StudyError(f"{path}: holds {listed(foreign)}, not the store's; refusing to "
+                         f"delete it")
     shutil.rmtree(path)
+
+
+def listed(names: list[str]) -> str:
+    """The first of `names` and how many more (for a message of one line).
+
+    Parameters
+    ----------
+    names : list of str
+        At least one name.
+
+    Examples
+    --------
+    >>> listed(["notes.txt"]), listed(["a.txt", "e1/b.txt", "c.txt"])
+    ('notes.txt', 'a.txt and 2 more')
+    """
+    return names[0] + (f" and {len(names) - 1} more" if len(names) > 1 else "")
 
 
 def field_names(ds) -> list[str]:
