@@ -162,3 +162,106 @@ def test_the_rate_of_a_slow_study_keeps_its_digits():
     assert "(7.14 points/s)" in str(RunReport(points=50, computed=50, failed=0, seconds=7.0))
     assert "(2400 points/s)" in str(RunReport(points=2400, computed=2400, failed=0,
                                               seconds=1.0))
+
+
+# ------------------------------- F7: a distribution the scenario refuses; bands of survivors
+NORMAL_FC = ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\nfrequency_hz = [5.0]\n'
+             '[samples]\nn = 4\nseed = 0\n"hysteresis.fc" = {{ {} = [{}, {}] }}\n')
+
+
+def _paper_folder(tmp_path: Path) -> dict:
+    from motionhyst.scenario import default_scenario_path
+
+    return {"paper.toml": default_scenario_path().read_text()}
+
+
+@pytest.mark.parametrize(("kind", "a", "b", "share"), [
+    ("normal", 0.05, 0.1, "30.9 %"),     # P(fc <= 0) = Phi(-0.5) = 0.3085
+    ("uniform", -0.01, 0.09, "10 %"),    # 0.01 of 0.1 below 0
+    ("normal", 0.05, 0.02, None),        # Phi(-2.5) = 0.62 %: within the 1 % admitted
+])
+def test_a_distribution_whose_mass_the_scenario_refuses_is_refused_up_front(
+        tmp_path, kind, a, b, share):
+    """fc normal [0.05, 0.1] on the paper's loop: 28 % of 50 draws failed (fc <= 0) and the
+    summary's band was over the 36 left, exit 0.  The share refused is found from the
+    distribution's quantiles and the scenario alone, before any point runs."""
+    text = NORMAL_FC.format(kind, a, b)
+    if share is None:
+        study = Study.from_dict(tomllib.loads(text), base_dir=_write_paper(tmp_path))
+        assert study.samples["hysteresis.fc"] == (kind, a, b)
+        return
+    err = refused(tmp_path, {**_paper_folder(tmp_path), "st.toml": text},
+                  ["study", "st.toml", "--out", "st.zarr", "--workers", "0"])
+    assert (f"st.toml: [samples] 'hysteresis.fc': {kind} [{a:g}, {b:g}] puts {share} of its "
+            f"draws where the scenario refuses them (paper.toml: [hysteresis] fc: Input should "
+            f"be greater than 0 (got -") in err, err
+    assert err.endswith("more than the 1 % a study admits (its bands would be of the draws "
+                        "left); give a lognormal distribution (positive by construction) or one "
+                        "within the admitted values"), err
+
+
+def _write_paper(folder: Path) -> Path:
+    populate(folder, _paper_folder(folder))
+    return folder
+
+
+def test_a_band_over_fewer_samples_than_drawn_says_of_how_many(tmp_path):
+    """Two of five samples failed: the band is the percentiles of the other three's worst
+    cases (numpy's, independently), and the summary says 'of 3/5 samples'."""
+    from motionhyst.study import open_results
+    from motionhyst.study.store import FAILED, OK, StudyStore
+    from motionhyst.study.summary import summarize
+
+    text = NORMAL_FC.format("lognormal", 0.05, 0.1).replace("n = 4", "n = 5").replace(
+        "[5.0]", "[5.0, 10.0]")
+    study = Study.from_dict(tomllib.loads(text), base_dir=_write_paper(tmp_path))
+    store = StudyStore.create(tmp_path / "s.zarr", study)
+    e1 = np.array([1.0, 4.0, 2.0, 3.0, 5.0, 7.0]) * 1e-8  # samples 0, 2, 4 at 5 and 10 Hz
+    status = np.array([OK, FAILED, OK, FAILED, OK] * 2, np.int8)
+    indices = np.arange(10)  # frequency_hz, amplitude, sample (C order)
+    values = np.full(10, np.nan)
+    values[[0, 2, 4, 5, 7, 9]] = e1
+    store.write(indices, status, {"e1": values},
+                np.where(status == FAILED, 1, 0).astype(np.int8))
+    s = summarize(open_results(tmp_path / "s.zarr"))
+    worst = np.maximum(e1[:3], e1[3:])  # each computed sample's worst over the frequencies
+    np.testing.assert_allclose(list(s.band["e1"].values()), np.percentile(worst, [5, 50, 95]),
+                               rtol=1e-12)
+    assert s.band_samples["e1"] == {"band": 3, "widest": 3, "of": 5}
+    text = str(s)
+    assert "Monte Carlo, each sample's worst case, of 3/5 samples: 5 % " in text, text
+    assert ", of 3/5 samples: 5 % " in text.split("widest band at")[1], text
+    # all samples computed: no count
+    store.write([1, 3, 6, 8], np.full(4, OK, np.int8), {"e1": np.full(4, 1e-8)})
+    assert "samples:" not in str(summarize(open_results(tmp_path / "s.zarr")))
+
+
+def test_a_point_refused_by_the_scenario_is_named_by_its_file(tmp_path):
+    """The failure line said '<dict>: [hysteresis] fc: ...' (an internal name): now the
+    scenario's file."""
+    from motionhyst.study.engine import Evaluator
+    from motionhyst.study.store import FAILED
+
+    study = Study.from_dict(tomllib.loads(NORMAL_FC.format("lognormal", 0.05, 0.1)),
+                            base_dir=_write_paper(tmp_path))
+    study.scenario_source = "paper.toml"
+    study.sample_values[0, 0] = -0.01  # a draw the scenario refuses
+    batch = Evaluator(study).batch([0])
+    assert batch.status.tolist() == [FAILED]
+    (message,) = batch.failures.values()
+    assert message == ("point 0 (frequency_hz = 5, amplitude = 0.01, hysteresis.fc = -0.01): "
+                       "paper.toml: [hysteresis] fc: Input should be greater than 0 (got -0.01)")
+
+
+@pytest.mark.parametrize(("names", "words"), [
+    ("self.toml", "'scenario': self.toml is this study file; give the scenario it studies"),
+    ("other.toml", "'scenario': other.toml is a study file (it names a scenario and "
+                   "outputs); give the scenario it studies"),
+])
+def test_a_study_file_given_as_the_scenario_is_named_so(tmp_path, names, words):
+    """A study naming itself as its scenario said '[scenario]: unknown section'."""
+    err = refused(tmp_path, {"self.toml": f'scenario = "{names}"\noutputs = ["e1"]\n[axes]\n'
+                                          'frequency_hz = [5.0]\n',
+                             "other.toml": 'scenario = "paper.toml"\noutputs = ["e1"]\n'},
+                  ["study", "self.toml", "--out", "st.zarr", "--workers", "0"])
+    assert err.endswith(f"study: self.toml: {words} (the file of [stage], [controller], ...)"), err

@@ -152,8 +152,10 @@ class Evaluator:
             try:
                 with warnings.catch_warnings():  # a measured plant's fit: not once a point
                     warnings.simplefilter("ignore", MotionhystWarning)
+                    source = self.study.scenario_source
                     sc = Scenario.from_dict(self.study.scenario_at(values),
-                                            base_dir=self.study.base_dir)
+                                            source="the scenario" if source == "<dict>"
+                                            else source, base_dir=self.study.base_dir)
                     self._loop = sc.loop()
                 self._unset = tuple(t for t in ("jerk", "snap")
                                     if getattr(sc.model.feedforward, t, 0.0) is None)

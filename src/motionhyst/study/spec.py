@@ -16,6 +16,10 @@ samples of scenario keys from stated distributions, seeded::
     seed = 0
     "hysteresis.k" = { lognormal = [20.0, 0.1] }
 
+A distribution that puts more than :data:`MAX_REFUSED_MASS` of its mass where the scenario
+refuses the value (a normal one of a positive parameter reaching below 0) is refused: the
+bands of the draws left would be of a distribution the file does not state.
+
 The points are the cross product of the axes and the samples (a dimension ``sample``); an axis
 ``amplitude`` or ``frequency_hz`` not given is the scenario's ``[reference]`` one (a study whose
 only output is ``scan``, with axes or samples of its own, has neither: a scan does not follow
@@ -32,6 +36,7 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from statistics import NormalDist
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,8 +50,8 @@ from motionhyst.study.identified import (
 from motionhyst.study.outputs import OUTPUTS
 from motionhyst.study.scans import COMPENSATIONS, SCAN_AXES, check_scan_value, scan_settings
 
-__all__ = ["DISTRIBUTIONS", "REFERENCE_AXES", "StudyDefinition", "StudyError",
-           "is_scenario_key", "set_key"]
+__all__ = ["DISTRIBUTIONS", "MAX_REFUSED_MASS", "REFERENCE_AXES", "StudyDefinition",
+           "StudyError", "is_scenario_key", "set_key"]
 
 REFERENCE_AXES = ("amplitude", "frequency_hz")
 """Axes over the reference ``r = amplitude sin(2 pi frequency_hz t)`` (not scenario keys)."""
@@ -59,6 +64,12 @@ DISTRIBUTIONS = {
 """Distributions of Monte-Carlo samples and the meaning of their two parameters."""
 
 MAX_POINTS = 100_000_000
+
+MAX_REFUSED_MASS = 0.01
+"""Largest fraction of a ``[samples]`` distribution's mass that may lie where the scenario
+refuses the value (a normal distribution of a positive parameter reaching below 0): above it
+the study is refused before any point runs, as its bands would be of the draws the scenario
+admits alone, a truncated distribution the file does not state."""
 
 
 class StudyError(ValueError):
@@ -214,6 +225,15 @@ def _axis_values(key: str, spec, where: str) -> NDArray:
     return values
 
 
+def _quantile(kind: str, a: float, b: float, p: float) -> float:
+    """The value below which a `kind` distribution of parameters `a`, `b`
+    (:data:`DISTRIBUTIONS`) puts the fraction `p` of its mass."""
+    if kind == "uniform":
+        return a + p * (b - a)
+    z = NormalDist().inv_cdf(p)
+    return a + b * z if kind == "normal" else a * math.exp(b * z)
+
+
 def _distribution(key: str, spec) -> tuple[str, float, float]:
     if not isinstance(spec, dict) or len(spec) != 1 or next(iter(spec)) not in DISTRIBUTIONS:
         names = ", ".join(f"{{ {k} = {v} }}" for k, v in DISTRIBUTIONS.items())
@@ -354,10 +374,17 @@ class StudyDefinition:
             spath = Path(name)
             if not spath.is_absolute():
                 spath = (base_dir or Path.cwd()) / spath
+            if source != "<dict>" and spath.resolve() == Path(source).resolve():
+                raise StudyError(f"'scenario': {name} is this study file; give the scenario "
+                                 f"it studies (the file of [stage], [controller], ...)")
             try:
                 scenario = read_toml(spath)
             except InputFileError as exc:
                 raise StudyError(f"'scenario': {spath}: {exc}") from None
+            if "scenario" in scenario and "outputs" in scenario:
+                raise StudyError(f"'scenario': {name} is a study file (it names a scenario "
+                                 f"and outputs); give the scenario it studies (the file of "
+                                 f"[stage], [controller], ...)")
             scenario_source = name
         outputs = data.get("outputs")
         if (not isinstance(outputs, list) or not outputs
@@ -456,8 +483,10 @@ class StudyDefinition:
 
     def check(self) -> None:
         """Validate the scenario with the first value of each axis and sample; a key the
-        scenario does not accept raises :class:`StudyError` naming it, an implausible value
-        of its stage is a warning (:func:`~motionhyst.scenario.schema.warn_implausible`)."""
+        scenario does not accept raises :class:`StudyError` naming it, as does a ``[samples]``
+        distribution with more than :data:`MAX_REFUSED_MASS` of its mass where the scenario
+        refuses the value; an implausible value of its stage is a warning
+        (:func:`~motionhyst.scenario.schema.warn_implausible`)."""
         from motionhyst.hysteresis.along_stroke import NO_DESCRIBING_FUNCTION
         from motionhyst.scenario import Scenario, ScenarioError
         from motionhyst.scenario.schema import warn_implausible
@@ -486,6 +515,9 @@ class StudyDefinition:
                                     base_dir=self.base_dir, check=False)
         except ScenarioError as exc:
             raise StudyError(str(exc)) from None
+        for key in self.samples:  # the first point admitted: a refusal is the key's value
+            if is_scenario_key(key):
+                self._check_mass(key, first)
         if sc.is_open_loop:
             raise StudyError("the scenario is an open-loop system; a study needs a closed loop")
         if "E" in self.outputs and sc.along_stroke:  # refused before the points run
@@ -493,6 +525,48 @@ class StudyDefinition:
                              f"{NO_DESCRIBING_FUNCTION.format(key=', '.join(sc.along_keys))}")
         sc.source = self.scenario_source  # its stage's implausible values named once
         warn_implausible(sc)
+
+    def _refusal(self, key: str, value: float, first: dict) -> str | None:
+        """Why the scenario refuses `key` = `value` at the first point's other values (None:
+        admitted)."""
+        from motionhyst.scenario import Scenario, ScenarioError
+
+        data = self.scenario_at({**first, key: value})
+        name = self.scenario_source if self.scenario_source != "<dict>" else "the scenario"
+        try:
+            Scenario.from_dict(data, source=name, base_dir=self.base_dir, check=False)
+        except ScenarioError as exc:
+            return str(exc)
+        return None
+
+    def _check_mass(self, key: str, first: dict) -> None:
+        """Refuse a ``[samples]`` distribution of `key` that puts more than
+        :data:`MAX_REFUSED_MASS` of its mass where the scenario refuses the value: the
+        scenario is asked at the distribution's quantiles of that fraction, from each end;
+        the fraction refused is found by bisection (the admitted values an interval)."""
+        kind, a, b = self.samples[key]
+        for low in (True, False):
+            p = MAX_REFUSED_MASS if low else 1.0 - MAX_REFUSED_MASS
+            why = self._refusal(key, _quantile(kind, a, b, p), first)
+            if why is None:
+                continue
+            inner = 0.5
+            if self._refusal(key, _quantile(kind, a, b, inner), first) is not None:
+                share = "more than half"
+            else:  # refused at p, admitted at the median: the edge between
+                for _ in range(20):
+                    mid = (p + inner) / 2
+                    if self._refusal(key, _quantile(kind, a, b, mid), first) is None:
+                        inner = mid
+                    else:
+                        p = mid
+                share = f"{100 * (inner if low else 1.0 - inner):.3g} %"
+            remedy = ("a lognormal distribution (positive by construction) or one within the "
+                      "admitted values" if low else "a distribution within the admitted values")
+            raise StudyError(f"[samples] {key!r}: {kind} [{a:g}, {b:g}] puts {share} of its "
+                             f"draws where the scenario refuses them ({why}), more than the "
+                             f"{100 * MAX_REFUSED_MASS:g} % a study admits (its bands would "
+                             f"be of the draws left); give {remedy}")
 
     # ---------------------------------------------------------------- points
     def _draw(self) -> NDArray[np.float64]:

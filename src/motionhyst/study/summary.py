@@ -50,6 +50,10 @@ class StudySummary:
         Field to ``{"at": {axis: value}, "5": .., "50": .., "95": ..}``: the percentiles over
         the samples at the point of the axes where they spread most, relative to the median
         (where the machines of a fleet differ most).
+    band_samples : dict
+        Field to ``{"band": .., "widest": .., "of": ..}``: how many samples :attr:`band` and
+        :attr:`widest` are over, of all samples (fewer where points failed: the bands are
+        then of the samples left, which the text says: "of 36/50 samples").
     failures : dict
         Reason (:data:`~motionhyst.study.store.REASONS`) to ``{"points": .., "example": ..}``:
         how many points failed for it and the message of the first.
@@ -85,13 +89,21 @@ class StudySummary:
     failures: dict = field(default_factory=dict)
     dominates: dict = field(default_factory=dict)
     never: dict = field(default_factory=dict)
+    band_samples: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (the ``study --summary --json`` schema)."""
         return {"points": self.points, "computed": self.computed, "failed": self.failed,
                 "worst": self.worst, "per_axis": self.per_axis, "band": self.band,
                 "widest": self.widest, "failures": self.failures, "dominates": self.dominates,
-                "never": self.never}
+                "never": self.never, "band_samples": self.band_samples}
+
+    def _of(self, name: str, which: str) -> str:
+        """``, of 36/50 samples`` where a band is over fewer than all samples."""
+        n = self.band_samples.get(name, {})
+        if n.get(which, n.get("of")) == n.get("of"):
+            return ""
+        return f", of {n[which]}/{n['of']} samples"
 
     def __str__(self) -> str:
         lines = [f"{self.points} points: {self.computed} computed, {self.failed} failed, "
@@ -119,13 +131,13 @@ class StudySummary:
             lines.append(table(["axis", "worst at", "worst", "best of the worst"], rows))
             if name in self.band:
                 b = self.band[name]
-                lines.append("  Monte Carlo, each sample's worst case: " + ", ".join(
-                    f"{k} % {g(v)}" for k, v in b.items()))
+                lines.append(f"  Monte Carlo, each sample's worst case{self._of(name, 'band')}"
+                             ": " + ", ".join(f"{k} % {g(v)}" for k, v in b.items()))
             if name in self.widest:
                 w = dict(self.widest[name])
                 at = ", ".join(f"{k} = {_text(v)}" for k, v in w.pop("at").items())
-                lines.append(f"  Monte Carlo, widest band at {at}: " + ", ".join(
-                    f"{k} % {g(v)}" for k, v in w.items()))
+                lines.append(f"  Monte Carlo, widest band at {at}{self._of(name, 'widest')}: "
+                             + ", ".join(f"{k} % {g(v)}" for k, v in w.items()))
             if name in self.dominates:
                 lines.append("  " + _dominance_text(name, self.dominates[name]))
         return "\n".join(lines)
@@ -372,6 +384,7 @@ def summarize(ds) -> StudySummary:
             if per_sample.size:
                 out.band[name] = {f"{p:g}": float(np.percentile(per_sample, p)) for p in BAND}
             k = dims.index("sample")
+            out.band_samples[name] = {"band": int(per_sample.size), "of": int(mag.shape[k])}
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
                 q = np.nanpercentile(mag, BAND, axis=k)
@@ -382,4 +395,6 @@ def summarize(ds) -> StudySummary:
                 out.widest[name] = {
                     "at": {d: _coordinate(ds[d].values[i]) for d, i in zip(grid, j, strict=True)},
                     **{f"{p:g}": float(q[(n, *j)]) for n, p in enumerate(BAND)}}
+                out.band_samples[name]["widest"] = int(np.count_nonzero(
+                    np.isfinite(np.moveaxis(mag, k, -1)[j])))
     return out
