@@ -265,3 +265,66 @@ def test_a_study_file_given_as_the_scenario_is_named_so(tmp_path, names, words):
                              "other.toml": 'scenario = "paper.toml"\noutputs = ["e1"]\n'},
                   ["study", "self.toml", "--out", "st.zarr", "--workers", "0"])
     assert err.endswith(f"study: self.toml: {words} (the file of [stage], [controller], ...)"), err
+
+
+# ------------------------- F9: an identification's stage is the scenario's, or it is refused
+TWO_MASS_STUDY = ('scenario = "paper.toml"\noutputs = ["e1"]\n[axes]\nfrequency_hz = [5.0]\n'
+                  '[samples]\nn = 4\nseed = 0\n')
+
+
+def test_a_link_identified_on_another_stage_is_refused(tmp_path):
+    """The mass-damper identification (stage.m 10 kg, stage.c 20 N s/m, correlated with the
+    link's k by -0.82) on the paper's two-mass stage: the stage's estimates were dropped
+    without a word and the link put on the 22.5 kg stage, exit 0."""
+    err = refused(tmp_path, {**_paper_folder(tmp_path), "st.toml": TWO_MASS_STUDY,
+                             "id.toml": identification()},
+                  ["study", "st.toml", "--out", "st.zarr", "--workers", "0",
+                   "--from-identification", "id.toml"])
+    assert "id.toml: its link was identified on a stage (stage.m = 10, stage.c = 19.9999, " \
+           "estimated jointly with it) and the scenario's [stage] (m1, m2, b, k) does not " \
+           "have m, c; give a scenario of the identified stage, or " \
+           "from_identification_tables = [\"hysteresis\"] in [samples] to put the link alone " \
+           "on the scenario's stage" in err, err
+
+
+@pytest.mark.parametrize(("changed", "words"), [
+    ("m = 10.5", "the scenario's [stage] m = 10.5 is not the identified stage.m = 10 +- "
+                 "1.05e-05 (off by 4.75e+04 standard errors, more than 3)"),
+    ("c = 20.01", "the scenario's [stage] c = 20.01 is not the identified stage.c = 19.9999 "
+                  "+- 9.26e-05 (off by 110 standard errors, more than 3)"),
+])
+def test_a_stage_whose_values_differ_from_the_identified_is_refused(tmp_path, changed, words):
+    loop = LOOP.replace(changed.split(" = ")[0] + " = " + ("10.0" if changed[0] == "m"
+                                                           else "20.0"), changed)
+    assert loop != LOOP
+    err = refused(tmp_path, {"loop.toml": loop, "st.toml": study_text("loop.toml"),
+                             "id.toml": identification()},
+                  ["study", "st.toml", "--out", "st.zarr", "--workers", "0",
+                   "--from-identification", "id.toml"])
+    assert words in err, err
+
+
+def test_the_identified_stage_is_drawn_with_its_link_when_it_is_the_scenarios(tmp_path):
+    """The scenario's [stage] is the identified one (10 kg, 20 N s/m, within 3 standard
+    errors of the estimates 10.00002 and 19.99985): its estimates are drawn jointly with the
+    link's, with the identification's covariance (k-m correlation -0.82)."""
+    populate(tmp_path, {"loop.toml": LOOP, "id.toml": identification()})
+    n = 4000
+    study = Study.from_dict({**tomllib.loads(study_text("loop.toml", n)),
+                             "samples": {"n": n, "seed": 0, "from_identification": "id.toml"}},
+                            base_dir=tmp_path)
+    assert study.sampled_keys == tuple(PARAMETERS)
+    x = study.sample_values
+    cov = np.array(CORRELATION) * np.outer(STD, STD)
+    se = np.sqrt(np.diag(cov) / n)
+    assert np.all(np.abs(x.mean(axis=0) - ESTIMATES) <= 4 * se)
+    r = np.corrcoef(x.T)
+    rho = np.array(CORRELATION)
+    assert np.all(np.abs(r - rho) <= 4 * (1 - rho ** 2) / np.sqrt(n) + 1e-12), r  # its SE
+    assert r[0, 2] < -0.78
+    # the link alone on the scenario's stage, as the study file says
+    alone = Study.from_dict({**tomllib.loads(study_text("loop.toml", 10)),
+                             "samples": {"n": 10, "seed": 0, "from_identification": "id.toml",
+                                         "from_identification_tables": ["hysteresis"]}},
+                            base_dir=tmp_path)
+    assert alone.sampled_keys == ("hysteresis.k", "hysteresis.fc")

@@ -371,8 +371,10 @@ def test_a_bouc_wen_link_is_drawn_from_its_identified_products(bouc_wen):
         assert d.keys == BOUC_WEN_KEYS and not d.log_space
         np.testing.assert_allclose(d.covariance, c, rtol=1e-9, atol=1e-9 * np.abs(c).max())
 
-    # the identified system in a loop: the study's scenario
-    st = _loop_study(tmp_path, N_DRAWS)
+    # the identified system in a loop: the study's scenario (the link alone drawn, as asked;
+    # by default its stage's estimates are drawn with it: tests/test_study_honest.py)
+    link_only = {"from_identification_tables": ["hysteresis"]}
+    st = _loop_study(tmp_path, N_DRAWS, **link_only)
     assert st.sampled_keys == BOUC_WEN_KEYS
     _within_sampling_error(st.sample_values, mean, c)
     for i in (0, 7, 99):
@@ -385,7 +387,7 @@ def test_a_bouc_wen_link_is_drawn_from_its_identified_products(bouc_wen):
                                                              rel=1e-14)
         assert link["alpha"] == drawn["hysteresis.alpha"]
     # two machines of the fleet computed: their loops are built from the drawn links
-    small = _loop_study(tmp_path, 2)
+    small = _loop_study(tmp_path, 2, **link_only)
     report = run_study(small, tmp_path / "bw.zarr", workers=0)
     assert (report.computed, report.failed) == (2, 0)
     ds = open_results(tmp_path / "bw.zarr")

@@ -21,10 +21,11 @@ the records determine: :func:`~motionhyst.study.spec.set_key` sets ``beta``, ``g
 
 A study's ``[samples] from_identification = "model.toml"`` (or ``motionhyst study
 --from-identification model.toml``) draws the link's parameters (the keys
-``hysteresis.*``) jointly from that distribution, seeded (:class:`JointNormal`): the marginal
-of the link's parameters, the stage of the study's own scenario being its own; with
-``from_identification_tables = ["hysteresis", "stage"]`` (a study whose scenario is the
-identified system) the stage's estimates (``stage.m``, ...) are drawn jointly with them.  A
+``hysteresis.*``) jointly from that distribution, seeded (:class:`JointNormal`), and the
+stage's estimates (``stage.m``, ... of an input-output identification) with them when the
+scenario's ``[stage]`` is the identified one (:data:`motionhyst.study.spec.STAGE_MATCH`; a
+scenario of another stage is refused); ``from_identification_tables = ["hysteresis"]`` draws
+the marginal of the link's parameters alone, on the scenario's own stage.  A
 parameter
 must stay positive (:func:`least_value`): when every drawn positive parameter's relative
 standard error is at most :data:`LOG_SPACE_CV`, the draws are those of the normal distribution

@@ -50,7 +50,7 @@ from motionhyst.study.identified import (
 from motionhyst.study.outputs import OUTPUTS
 from motionhyst.study.scans import COMPENSATIONS, SCAN_AXES, check_scan_value, scan_settings
 
-__all__ = ["DISTRIBUTIONS", "MAX_REFUSED_MASS", "REFERENCE_AXES", "StudyDefinition",
+__all__ = ["DISTRIBUTIONS", "MAX_REFUSED_MASS", "REFERENCE_AXES", "STAGE_MATCH", "StudyDefinition",
            "StudyError", "is_scenario_key", "set_key"]
 
 REFERENCE_AXES = ("amplitude", "frequency_hz")
@@ -431,6 +431,7 @@ class StudyDefinition:
                 raise StudyError("'samples': give a table [samples]")
             n, seed = s.pop("n", None), s.pop("seed", None)
             identified = s.pop("from_identification", None)
+            chosen = "from_identification_tables" in s  # else the stage's as it matches
             tables = s.pop("from_identification_tables", ["hysteresis"])
             if not (isinstance(tables, list) and tables
                     and set(tables) <= {"hysteresis", "stage"}):
@@ -451,9 +452,15 @@ class StudyDefinition:
                 try:
                     def before_matrix(keys, values, n=n, seed=seed):
                         _check_count(n, seed)  # an identification's matrix is read after these
+                        if not chosen:
+                            _check_stage_keys(scenario, keys, values, str(ipath))
                         _check_drawn(scenario, keys, values, axes, base_dir)
 
-                    joint = joint_from_identification(ipath, tuple(tables), check=before_matrix)
+                    joint = joint_from_identification(
+                        ipath, tuple(tables) if chosen else ("hysteresis", "stage"),
+                        check=before_matrix)
+                    if joint is not None and not chosen:
+                        _check_stage_values(scenario, joint, str(ipath))
                     drawn = {} if joint is not None else distributions_from_identification(ipath)
                 except StudyError:
                     raise
@@ -730,6 +737,61 @@ def _check_drawn(scenario: dict, keys: list[str], values: list[float], axes: dic
             except ScenarioError as err:
                 if str(err).endswith("unknown key") or "Extra inputs" in str(err):
                     raise ValueError(f"{key!r}: not a key of the scenario ({err})") from None
+
+
+STAGE_MATCH = 3.0
+"""How many of its standard errors the scenario's ``[stage]`` value of an identified stage
+parameter may differ from the estimate for the identification's draws to be of that stage
+(then drawn jointly with the link's, as they were estimated)."""
+
+_BY_THE_LINK_ALONE = ('or from_identification_tables = ["hysteresis"] in [samples] to put the '
+                      "link alone on the scenario's stage")
+
+
+def _check_stage_keys(scenario: dict, keys: list[str], values: list[float], source: str
+                      ) -> None:
+    """Refuse an identification that holds stage parameters (``stage.m``, ... of an
+    input-output identification: estimated jointly with the link's) the scenario's
+    ``[stage]`` does not have: its link's draws are of another stage."""
+    stage = scenario.get("stage") if isinstance(scenario.get("stage"), dict) else None
+    held = [(k, v) for k, v in zip(keys, values, strict=True) if k.startswith("stage.")]
+    lacking = [(k, v) for k, v in held if stage is None or k[6:] not in stage]
+    if not lacking:
+        return
+    if stage is None:
+        what = "the scenario has no [stage] (a measured [plant])"
+    else:
+        names = [k for k, v in stage.items() if k != "type" and not isinstance(v, dict)]
+        kind = f"{stage['type']}: " if isinstance(stage.get("type"), str) else ""
+        what = (f"the scenario's [stage] ({kind}{', '.join(names)}) does not have "
+                f"{', '.join(k[6:] for k, _ in lacking)}")
+    raise ValueError(f"from_identification {source}: its link was identified on a stage "
+                     f"({', '.join(f'{k} = {v:.6g}' for k, v in held)}, estimated jointly "
+                     f"with it) and {what}; give a scenario of the identified stage, "
+                     f"{_BY_THE_LINK_ALONE}")
+
+
+def _check_stage_values(scenario: dict, joint: JointNormal, source: str) -> None:
+    """Refuse an identification whose stage estimates differ from the scenario's ``[stage]``
+    values by more than :data:`STAGE_MATCH` standard errors (else they are drawn jointly with
+    the link's, about the estimates)."""
+    stage = scenario.get("stage") if isinstance(scenario.get("stage"), dict) else {}
+    std = joint.std
+    for i, key in enumerate(joint.keys):
+        if not key.startswith("stage."):
+            continue
+        value, estimate = stage.get(key[6:]), joint.mean[i]
+        number = isinstance(value, int | float) and not isinstance(value, bool)
+        off = abs(value - estimate) if number else math.inf
+        if off <= STAGE_MATCH * std[i] + 1e-12 * abs(estimate):
+            continue
+        by = f"{off / std[i]:.3g} standard errors" if std[i] > 0 else "more than its rounding"
+        raise ValueError(f"from_identification {source}: the scenario's [stage] {key[6:]} = "
+                         f"{value!r} is not the identified {key} = {estimate:.6g} +- "
+                         f"{std[i]:.3g} (off by {by}, more than {STAGE_MATCH:g}): its link "
+                         f"was identified on that stage, jointly; give the identified values "
+                         f"in the scenario's [stage] (they are then drawn with the link's), "
+                         f"{_BY_THE_LINK_ALONE}")
 
 
 def _check_count(n, seed) -> None:
