@@ -328,3 +328,19 @@ def test_the_identified_stage_is_drawn_with_its_link_when_it_is_the_scenarios(tm
                                          "from_identification_tables": ["hysteresis"]}},
                             base_dir=tmp_path)
     assert alone.sampled_keys == ("hysteresis.k", "hysteresis.fc")
+
+
+def test_a_stage_estimate_without_a_standard_error_is_not_drawn(tmp_path):
+    """An `identify --json` whose stage estimate has no standard error (not in its covariance,
+    as `--save` leaves it out of [identification]) keeps the scenario's value: the stage is
+    now read by default, and such an estimate must not refuse the study."""
+    cov = (np.array(CORRELATION) * np.outer(STD, STD)).tolist()
+    fit = {"plant": {"type": "mass-damper", "m": 10.0, "c": 20.0, "force_offset": 1e-6},
+           "hysteresis": {"model": "jenkins", "k": 2000.0, "fc": 2.0},
+           "estimates": {"m": ESTIMATES[0], "c": ESTIMATES[1], "link.k": ESTIMATES[2],
+                         "link.fc": ESTIMATES[3], "force_offset": 1e-6},
+           "covariance": {"parameters": ["m", "c", "link.k", "link.fc"], "matrix": cov}}
+    (tmp_path / "fit.json").write_text(json.dumps(fit))
+    d = joint_from_identification(tmp_path / "fit.json", ("hysteresis", "stage"))
+    assert d.keys == tuple(PARAMETERS)
+    np.testing.assert_allclose(d.covariance, cov, rtol=1e-12)

@@ -428,7 +428,10 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
             plant = data.get("plant")
             if "stage" in tables and isinstance(plant, dict):  # its estimates, the stage's keys
                 keys.update({n: f"stage.{n}" for n in plant if n != "type" and n in mean})
-        keys = {n: k for n, k in keys.items() if k.partition(".")[0] in tables}
+        # a stage's estimate without a standard error has no distribution (as the TOML of
+        # `identify --save` leaves it out of [identification]): the scenario's value stays
+        keys = {n: k for n, k in keys.items() if k.partition(".")[0] in tables
+                and (n in names or not k.startswith("stage."))}
         missing = [n for n in keys if n not in names]
         hint = "--json"
     if missing:
