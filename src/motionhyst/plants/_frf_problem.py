@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.budget import check_memory
-from motionhyst.core.lti import TWO_PI
+from motionhyst.plants.modal import TWO_PI
 
 __all__ = ["DAMPING_BOUNDS", "FREQ_BOUNDS", "FrfProblem", "candidates"]
 

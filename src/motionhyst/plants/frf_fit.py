@@ -77,10 +77,9 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
 from motionhyst.core.blas import few_blas_threads
-from motionhyst.core.lti import TWO_PI
 from motionhyst.plants._frf_problem import DAMPING_BOUNDS, FREQ_BOUNDS, FrfProblem, candidates
 from motionhyst.plants.measured import MeasuredPlant
-from motionhyst.plants.modal import ModalPlant, Mode
+from motionhyst.plants.modal import TWO_PI, ModalPlant, Mode
 from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
 
 __all__ = ["FrfFit", "ModalPlant", "Mode", "damping_at_bound", "determined_modes",

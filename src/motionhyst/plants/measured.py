@@ -15,11 +15,10 @@ from motionhyst.plants.registry import register
 if TYPE_CHECKING:  # the readers (pandas, scipy.io) are imported when a file is read
     from motionhyst.io.csvdata import Source
 
-__all__ = ["FRD_LINE_BYTES", "MeasuredPlant", "load_frd_plant"]
+__all__ = ["FRD_LINE_BYTES", "FrdData", "MeasuredPlant", "frd_plant",
+           "load_frd_plant", "read_frd"]
 
 TWO_PI = 2.0 * np.pi
-
-__all__ = ["FRD_LINE_BYTES", "MeasuredPlant", "load_frd_plant"]
 
 
 @register
@@ -130,6 +129,116 @@ def _first_out_of_order(f: NDArray[np.float64]) -> str:
             f"by frequency")
 
 
+@dataclass(frozen=True)
+class FrdData:
+    """A measured response as read, before python-control holds it (:func:`read_frd`).
+
+    Attributes
+    ----------
+    frequency_hz : ndarray
+        Frequencies [Hz], positive and increasing.
+    P1, P2 : ndarray of complex
+        Collocated and non-collocated responses [m/N].
+    M : float
+        Rigid-body mass [kg]: given, or estimated from the lowest decade.
+    source : str
+        The file, as messages name it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.array([1.0, 2.0])
+    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2) + 0j
+    >>> FrdData(f, p, p, 22.5, "sampled").M
+    22.5
+    """
+
+    frequency_hz: NDArray[np.float64]
+    P1: NDArray[np.complex128]
+    P2: NDArray[np.complex128]
+    M: float
+    source: str
+
+
+def read_frd(path: Source, mass: float | None = None) -> FrdData:
+    """Read and check a measured response as :func:`load_frd_plant` does, without building
+    the plant (python-control is not loaded): what a fit of it needs.
+
+    Parameters
+    ----------
+    path : str, Path or DataFrame
+        As for :func:`load_frd_plant`.
+    mass : float, optional
+        As for :func:`load_frd_plant`.
+
+    Returns
+    -------
+    FrdData
+
+    Raises
+    ------
+    ValueError
+        One line naming the file.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pandas as pd
+    >>> f = np.array([1.0, 2.0, 4.0])
+    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2)
+    >>> data = read_frd(pd.DataFrame({"frequency_hz": f, "p1_re": p, "p1_im": 0 * f,
+    ...                               "p2_re": p, "p2_im": 0 * f}))
+    >>> round(data.M, 6), data.P1.dtype
+    (22.5, dtype('complex128'))
+    """
+    from motionhyst.io.csvdata import describe
+    from motionhyst.io.records import check_unread, read_record, record_columns
+
+    where = describe(path)
+    names = record_columns(path)
+    header = set(names)
+    expected = (f"{', '.join(_FRD_COLUMNS['reim'])} or {', '.join(_FRD_COLUMNS['absphase'])}"
+                f" next to frequency_hz (found {','.join(names) or 'none'})")
+    if "frequency_hz" not in header:
+        raise ValueError(f"{where}: missing column 'frequency_hz'; need columns {expected}")
+    kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
+    if kind is None:
+        raise ValueError(f"{where}: need columns {expected}")
+    check_unread([path], ("frequency_hz", *_FRD_COLUMNS[kind]), _check_lines)  # a long file
+    data = read_record(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
+    _check_lines([len(data)])
+    if not np.all(np.isfinite(data)):
+        raise ValueError(f"{where}: non-finite value in data")
+    f = data[:, 0].copy()
+    if np.any(f <= 0) or np.any(np.diff(f) <= 0):
+        raise ValueError(f"{where}: frequency_hz must be positive and increasing: "
+                         f"{_first_out_of_order(f)}")
+    if len(f) < 2:
+        raise ValueError(f"{where}: need at least two frequencies")
+    if kind == "reim":  # filled in place: no temporary of the whole response
+        p1, p2 = np.empty(len(f), complex), np.empty(len(f), complex)
+        p1.real, p1.imag, p2.real, p2.imag = data[:, 1], data[:, 2], data[:, 3], data[:, 4]
+    else:
+        for col, name in ((1, "p1_abs"), (3, "p2_abs")):
+            bad = np.flatnonzero(data[:, col] <= 0)
+            if bad.size:
+                raise ValueError(f"{where}: {name} must be > 0 (a magnitude; a sign belongs in "
+                                 f"the phase), got {data[bad[0], col]:g} at "
+                                 f"{f[bad[0]]:g} Hz")
+        p1 = data[:, 1] * np.exp(1j * np.deg2rad(data[:, 2]))
+        p2 = data[:, 3] * np.exp(1j * np.deg2rad(data[:, 4]))
+    del data
+    if mass is None:
+        low = f <= f[0] * 10
+        mass = float(np.median(-1.0 / ((TWO_PI * f[low]) ** 2 * p2[low].real)))
+        if not np.isfinite(mass) or mass <= 0:
+            raise ValueError(f"{where}: cannot estimate the rigid-body mass: -1/(omega^2 Re P2) "
+                             f"over the lowest decade is {mass:.3g} kg, not a mass (phases in "
+                             f"radians, or a sign?); check the data or give [plant] mass")
+    mass = check_positive("mass", mass)
+    return FrdData(f, p1, p2, mass, where)
+
+
 def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     """Read a measured plant from CSV or MATLAB ``.mat`` (or a DataFrame with the same columns).
 
@@ -171,58 +280,37 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
     >>> plant.frequency_range_hz
     (1.0, 2000.0...)
     """
-    from motionhyst.io.csvdata import describe
-    from motionhyst.io.records import check_unread, read_record, record_columns
+    return frd_plant(read_frd(path, mass))
 
-    where = describe(path)
-    names = record_columns(path)
-    header = set(names)
-    expected = (f"{', '.join(_FRD_COLUMNS['reim'])} or {', '.join(_FRD_COLUMNS['absphase'])}"
-                f" next to frequency_hz (found {','.join(names) or 'none'})")
-    if "frequency_hz" not in header:
-        raise ValueError(f"{where}: missing column 'frequency_hz'; need columns {expected}")
-    kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
-    if kind is None:
-        raise ValueError(f"{where}: need columns {expected}")
-    check_unread([path], ("frequency_hz", *_FRD_COLUMNS[kind]), _check_lines)  # a long file
-    data = read_record(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
-    _check_lines([len(data)])
-    if not np.all(np.isfinite(data)):
-        raise ValueError(f"{where}: non-finite value in data")
-    f = data[:, 0].copy()
-    if np.any(f <= 0) or np.any(np.diff(f) <= 0):
-        raise ValueError(f"{where}: frequency_hz must be positive and increasing: "
-                         f"{_first_out_of_order(f)}")
-    if len(f) < 2:
-        raise ValueError(f"{where}: need at least two frequencies")
-    if kind == "reim":  # filled in place: no temporary of the whole response
-        p1, p2 = np.empty(len(f), complex), np.empty(len(f), complex)
-        p1.real, p1.imag, p2.real, p2.imag = data[:, 1], data[:, 2], data[:, 3], data[:, 4]
-    else:
-        for col, name in ((1, "p1_abs"), (3, "p2_abs")):
-            bad = np.flatnonzero(data[:, col] <= 0)
-            if bad.size:
-                raise ValueError(f"{where}: {name} must be > 0 (a magnitude; a sign belongs in "
-                                 f"the phase), got {data[bad[0], col]:g} at "
-                                 f"{f[bad[0]]:g} Hz")
-        p1 = data[:, 1] * np.exp(1j * np.deg2rad(data[:, 2]))
-        p2 = data[:, 3] * np.exp(1j * np.deg2rad(data[:, 4]))
-    omega = TWO_PI * f
-    if mass is None:
-        low = f <= f[0] * 10
-        mass = float(np.median(-1.0 / (omega[low] ** 2 * p2[low].real)))
-        if not np.isfinite(mass) or mass <= 0:
-            raise ValueError(f"{where}: cannot estimate the rigid-body mass: -1/(omega^2 Re P2) "
-                             f"over the lowest decade is {mass:.3g} kg, not a mass (phases in "
-                             f"radians, or a sign?); check the data or give [plant] mass")
-    mass = check_positive("mass", mass)
+
+def frd_plant(data: FrdData) -> MeasuredPlant:
+    """The :class:`MeasuredPlant` of a response read by :func:`read_frd` (python-control's
+    frequency-response data, with their splines).
+
+    Parameters
+    ----------
+    data : FrdData
+        The response read.
+
+    Returns
+    -------
+    MeasuredPlant
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.geomspace(1.0, 100.0, 5)
+    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2) + 0j
+    >>> frd_plant(FrdData(f, p, p, 22.5, "sampled")).frequency_range_hz
+    (1.0, 100.0...)
+    """
     import control  # once the data are read and checked: a refusal does not wait for it
 
-    del data
-    P1 = control.frd(p1, omega, smooth=len(f) > 3)
-    del p1  # the response keeps its own copy
-    P2 = control.frd(p2, omega, smooth=len(f) > 3)
-    return MeasuredPlant(P1=P1, P2=P2, M=mass, source=where)
+    omega = TWO_PI * data.frequency_hz
+    smooth = len(omega) > 3
+    P1 = control.frd(data.P1, omega, smooth=smooth)
+    P2 = control.frd(data.P2, omega, smooth=smooth)
+    return MeasuredPlant(P1=P1, P2=P2, M=data.M, source=data.source)
 
 
 FRD_LINE_BYTES = 400

@@ -131,8 +131,7 @@ class ModalPlant(FixedPlant):
                     and np.isfinite(m.r2)):
                 raise ValueError(f"invalid mode {m}")
         self.source = source
-        n1, n2, den, nf1, nf2, q = _modal_polys(self.M, self.modes)
-        self._tf = {"P1": (n1, den), "P2": (n2, den), "Pf1": (nf1, q), "Pf2": (nf2, q)}
+        self._tf: dict | None = None  # the polynomials, made when a transfer is asked for
 
     @classmethod
     def from_two_mass(cls, stage) -> ModalPlant:
@@ -159,6 +158,9 @@ class ModalPlant(FixedPlant):
     def _get(self, name: str) -> Any:
         import control
 
+        if self._tf is None:
+            n1, n2, den, nf1, nf2, q = _modal_polys(self.M, self.modes)
+            self._tf = {"P1": (n1, den), "P2": (n2, den), "Pf1": (nf1, q), "Pf2": (nf2, q)}
         num, den = self._tf[name]
         return control.tf(num, den)
 

@@ -249,35 +249,36 @@ class Scenario:
         if m.stage is not None:
             self._plant = m.stage.build(closed_loop=True)
             return self._plant
-        from motionhyst.plants.measured import load_frd_plant
+        from motionhyst.plants.measured import frd_plant, read_frd
 
         f = Path(m.plant.file)
         if not f.is_absolute():
             f = self.base_dir / f
         try:
-            data = load_frd_plant(f, m.plant.mass)
+            data = read_frd(f, m.plant.mass)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
-        # imported once the data are read (a bad file is refused before it loads), and for
+        # imported once the data are read (a bad file is refused before they load), and for
         # a measured plant only: a [stage] needs neither the fit nor python-control
         from motionhyst.plants.frf_fit import (
             ABOVE_NOISE,
             NEEDLE_SEEN_RATIO,
             NONE_DETERMINED,
             SEEN_RATIO,
-            fit_measured_plant,
+            fit_frf,
         )
+        fit_data = (data.frequency_hz, data.P1, data.P2)
         if m.plant.use == "data":
             # the data's resolution: their scatter around the rigid body + modes fit
             try:
-                scatter = fit_measured_plant(data, mass=m.plant.mass).rms_relative_error
+                scatter = fit_frf(*fit_data, mass=m.plant.mass).rms_relative_error
             except ValueError:
                 scatter = None
-            self._plant = dataclasses.replace(data, resolution=scatter)
+            self._plant = dataclasses.replace(frd_plant(data), resolution=scatter)
             return self._plant
         try:  # the BIC's modes, less those the lines do not determine (fit_frf drops them)
-            self._fit = fit_measured_plant(data, modes=m.plant.modes, mass=m.plant.mass,
-                                           delay=m.plant.delay)
+            self._fit = fit_frf(*fit_data, modes=m.plant.modes, mass=m.plant.mass,
+                                source=data.source, delay=m.plant.delay)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {f}: cannot fit a rigid body "
                                 f"plus modes: {exc}") from None
