@@ -244,7 +244,7 @@ CASES = [
      ["analyze", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: 2 measured lines cannot "
                                 "determine a mode", "Pf2 = 0"], []),
     ("frf-modes-0", {"p.toml": _with_plant("modes = 0"), "plant.csv": _frd(LOG)},
-     ["steady", "p.toml"], 2, ["^p.toml: [plant] file: plant.csv: modes = 0", "Pf2 = 0"], []),
+     ["steady", "p.toml"], 2, ["^p.toml: [plant]: modes = 0", "Pf2 = 0"], []),
     ("frf-negative-magnitude", {"p.toml": _with_plant(), "plant.csv": _negative_magnitude()},
      ["analyze", "p.toml"], 2, ["p1_abs must be > 0", "phase", "at 1 Hz"], []),
     ("frf-in-khz", {"p.toml": _with_plant(), "plant.csv": _frd(LOG, scale_f=1e-3)},

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import limited_process
 import numpy as np
-from file_trees import populate
+import pytest
+from file_trees import populate, snapshot
 
 from motionhyst import TwoMassStage
 from motionhyst.plants.frf_fit import ModalPlant
@@ -57,24 +59,68 @@ def _csv(f=LINES, p1=None, p2=None, reim: bool = False, both_scale: float | None
 
 
 def _scenario(extra: str = "") -> str:
-    """Table I's scenario with ``[plant] file = "frf.csv"`` (and `extra`) for its [stage]."""
-    return (PAPER[:PAPER.index("[stage]")] + f'[plant]\nfile = "frf.csv"\n{extra}\n'
-            + PAPER[PAPER.index("[hysteresis]"):])
+    """Table I's scenario with ``[plant] file = "frf.csv"`` (and `extra`) for its [stage];
+    `extra` from ``[controller]`` on goes into that section."""
+    plant, _, controller = extra.partition("[controller]\n")
+    text = PAPER.replace("[controller]          # eq. (23)\n", f"[controller]\n{controller}")
+    return (text[:text.index("[stage]")] + f'[plant]\nfile = "frf.csv"\n{plant}\n'
+            + text[text.index("[hysteresis]"):])
 
 
 P1, P2 = _measured()
 CASES = [
     # (id, scenario's extra, frf.csv, words of the one line, decided before the fit)
+    ("modes-0", "modes = 0", _csv(), ["^s.toml: [plant]: modes = 0 leaves a rigid body alone",
+                                      "modes >= 1"], True),
+    ("two-lines", "", _csv(LINES[[20, 40]], P1[[20, 40]], P2[[20, 40]]),
+     ["^s.toml: [plant] file: frf.csv: 2 measured lines cannot determine a mode"], True),
+    ("discretisation-above-nyquist", '[controller]\nsample_rate_hz = 1e4\ndiscretization = '
+     '"tustin-prewarp"\nprewarp_hz = 6000.0\n', _csv(),
+     ["^s.toml: [controller]: prewarp_hz = 6000 Hz must lie below the Nyquist frequency"], True),
 ]
+
+
+@pytest.mark.parametrize(("extra", "frf", "words", "before_fit"), [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_a_response_that_cannot_give_the_plant_is_refused_in_one_line(tmp_path, extra, frf,
+                                                                      words, before_fit):
+    populate(tmp_path, {"s.toml": _scenario(extra), "frf.csv": frf})
+    before = snapshot(tmp_path)
+    line = limited_process.refusal(["analyze", "s.toml", "--frequency", "1", "5", "10"],
+                                   tmp_path)
+    for word in words:
+        if word.startswith("^"):
+            assert line.startswith(f"motionhyst: error: {word[1:]}"), (word, line)
+        else:
+            assert word in line, (word, line)
+    assert "[controller]" in extra or "[controller]:" not in line, line  # the data's, not it
+    assert snapshot(tmp_path) == before
+
+
+def _analyze_imports(folder: Path) -> tuple[str, str]:
+    """``motionhyst analyze s.toml`` in a child process: its exit code and which of
+    python-control and scipy.optimize it imported ("2 ['control']"), and its stderr."""
+    code = ("import sys\nfrom motionhyst.cli import main\n"
+            "code = main(['analyze', 's.toml', '--frequency', '1'])\n"
+            "print(code, sorted({'control', 'scipy.optimize'} & set(sys.modules)))\n")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=folder, capture_output=True,
+                          text=True, timeout=120, env=limited_process.environment())
+    return proc.stdout.splitlines()[-1], proc.stderr
+
+
+@pytest.mark.parametrize("case", [c for c in CASES if c[4]], ids=lambda c: c[0])
+def test_what_the_lines_decide_is_refused_before_python_control_loads(tmp_path, case):
+    """Checks first, the fit and python-control after: a refusal the lines decide does not
+    wait for them."""
+    populate(tmp_path, {"s.toml": _scenario(case[1]), "frf.csv": case[2]})
+    loaded, err = _analyze_imports(tmp_path)
+    assert loaded == "2 []", err
+
+
 def test_a_fit_refusal_comes_before_python_control_loads(tmp_path):
     """Three lines below the mode determine none (the fit's refusal): python-control, which a
     loop needs, is not imported for it."""
-    f = LINES[:3]
-    populate(tmp_path, {"s.toml": _scenario(), "frf.csv": _csv(f, P1[:3], P2[:3])})
-    code = ("import sys\nfrom motionhyst.cli import main\n"
-            "code = main(['analyze', 's.toml', '--frequency', '1'])\n"
-            "print(code, 'control' in sys.modules)\n")
-    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=120, env=limited_process.environment())
-    assert proc.stdout.splitlines()[-1] == "2 False", proc.stdout + proc.stderr
-    assert "determine none of the 1 mode(s)" in proc.stderr
+    populate(tmp_path, {"s.toml": _scenario(), "frf.csv": _csv(LINES[:3], P1[:3], P2[:3])})
+    loaded, err = _analyze_imports(tmp_path)
+    assert loaded == "2 ['scipy.optimize']", err
+    assert "determine none of the 1 mode(s)" in err

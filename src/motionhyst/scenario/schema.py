@@ -64,6 +64,7 @@ if TYPE_CHECKING:  # imported where used: validating a file needs neither python
     from motionhyst.controllers.pid import Pid
     from motionhyst.controllers.sampled import SampledController
     from motionhyst.plants.frf_fit import FrfFit
+    from motionhyst.plants.measured import FrdData
     from motionhyst.plants.registry import Plant
     from motionhyst.scenario.sections import FeedforwardSection
     from motionhyst.time.openloop import OpenLoop
@@ -258,8 +259,10 @@ class Scenario:
             data = read_frd(f, m.plant.mass)
         except ValueError as exc:
             raise ScenarioError(f"{self.source}: [plant] file: {exc}") from None
-        # imported once the data are read (a bad file is refused before they load), and for
-        # a measured plant only: a [stage] needs neither the fit nor python-control
+        self._check_frd(data, f)
+        # imported once the data are read and checked (a bad file is refused before they
+        # load), and for a measured plant only: a [stage] needs neither the fit nor
+        # python-control
         from motionhyst.plants.frf_fit import (
             ABOVE_NOISE,
             NEEDLE_SEEN_RATIO,
@@ -285,10 +288,7 @@ class Scenario:
         none = [w for w in self._fit.warnings if w.startswith(NONE_DETERMINED)]
         if not self._fit.plant.modes or none:  # Pf2 = 0: eqs. (18)-(21) divide by it
             n, chosen = len(self._fit.frequency_hz), self._fit.bic_modes
-            why = ("modes = 0 leaves" if m.plant.modes == 0 else
-                   f"{n} measured lines cannot determine a mode (4 parameters more), which "
-                   f"leaves" if 4 * n < 2 * (4 + (m.plant.mass is None)) else
-                   f"{n} measured lines ({self._fit.frequency_hz.min():.4g}-"
+            why = (f"{n} measured lines ({self._fit.frequency_hz.min():.4g}-"
                    f"{self._fit.frequency_hz.max():.4g} Hz) determine none of the {chosen} "
                    f"mode(s) the BIC chose (each with its residue r1 within its standard "
                    f"deviation of zero, or changing the response at no line by more than "
@@ -308,6 +308,15 @@ class Scenario:
         if m.plant_only:  # no loop to check: its doubts are said now
             self._warn_fit()
         return self._plant
+
+    def _check_frd(self, data: FrdData, path: Path) -> None:
+        """What a measured plant's lines decide before its fit: too few lines for a mode."""
+        sec, n = self.model.plant, data.frequency_hz.size
+        if sec.use == "fit" and sec.modes is None and 4 * n < 2 * (4 + (sec.mass is None)):
+            raise ScenarioError(f"{self.source}: [plant] file: {path}: {n} measured lines "
+                                f"cannot determine a mode (4 parameters more), which leaves "
+                                f"a rigid body alone, with Pf2 = 0 and no link between P1 and "
+                                f"P2 to analyse; give data up to above the first resonance")
 
     def _warn_fit(self) -> None:
         """The measured plant's fit warnings (:attr:`FrfFit.warnings`) as
@@ -337,10 +346,7 @@ class Scenario:
         """The feedback controller: continuous, or sampled with ``sample_rate_hz``."""
         self._closed("a controller")
         c = self.model.controller
-        try:
-            sampled = self._sampled_controller()
-        except ValueError as exc:  # a discretisation the controller does not allow
-            raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
+        sampled = self._discretised()
         if sampled is not None and c.type in ("tf-z", "two-dof-z", "pid"):
             return sampled
         import control
@@ -362,6 +368,14 @@ class Scenario:
         c = self.model.controller
         return Pid(c.kp, c.ki, c.kd, c.derivative_filter_hz,
                    tuple(Notch(n.frequency_hz, n.zeta_zero, n.zeta_pole) for n in c.notches))
+
+    def _discretised(self) -> SampledController | None:
+        """:meth:`_sampled_controller`, a ``sample_rate_hz`` the controller does not allow
+        refused (without python-control)."""
+        try:
+            return self._sampled_controller()
+        except ValueError as exc:
+            raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
 
     def _sampled_controller(self) -> SampledController | None:
         """The controller with ``sample_rate_hz`` (a continuous one discretised), None for a
@@ -492,6 +506,8 @@ class Scenario:
             # each part's own errors name their section: only the loop's are [controller]'s
             coefficients = self._coefficients()
             if coefficients is None:
+                if self.model.plant is not None:  # a discretisation refused before a fit
+                    self._discretised()
                 parts = (self.plant(), self.controller(), self.hysteresis())
             else:  # stable, from the coefficients: checked before python-control loads
                 link = self.hysteresis()

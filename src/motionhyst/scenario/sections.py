@@ -185,6 +185,10 @@ class PlantSection(_Section):
         for key in ("modes", "delay"):
             if self.use == "data" and getattr(self, key) is not None:
                 raise ValueError(f'{key} applies to use = "fit" only')
+        if self.modes == 0:  # decided here, not after a fit
+            raise ValueError("modes = 0 leaves a rigid body alone, with Pf2 = 0 and no link "
+                             "between P1 and P2 to analyse; give modes >= 1, or omit it (the "
+                             "BIC chooses them)")
         return self
 
 
