@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from file_trees import populate, snapshot
 
-from motionhyst import TwoMassStage
+from motionhyst import TwoMassStage, load_scenario
 from motionhyst.plants.frf_fit import ModalPlant
 from motionhyst.scenario import default_scenario_path
 
@@ -77,6 +77,9 @@ CASES = [
     ("discretisation-above-nyquist", '[controller]\nsample_rate_hz = 1e4\ndiscretization = '
      '"tustin-prewarp"\nprewarp_hz = 6000.0\n', _csv(),
      ["^s.toml: [controller]: prewarp_hz = 6000 Hz must lie below the Nyquist frequency"], True),
+    ("delay-in-seconds-for-microseconds", "delay = 1.0", _csv(),
+     ["^s.toml: [plant] delay: 1 s turns the phase of the lowest lines (1-", "is it in seconds?"],
+     True),
 ]
 
 
@@ -124,3 +127,17 @@ def test_a_fit_refusal_comes_before_python_control_loads(tmp_path):
     loaded, err = _analyze_imports(tmp_path)
     assert loaded == "2 ['scipy.optimize']", err
     assert "determine none of the 1 mode(s)" in err
+
+
+def _fit(tmp_path: Path, extra: str, frf: str):
+    populate(tmp_path, {"s.toml": _scenario(extra), "frf.csv": frf})
+    return load_scenario(tmp_path / "s.toml").plant_fit()
+
+
+def test_a_delay_that_is_the_data_s_is_divided_out(tmp_path):
+    """50 us given for a chain that delays by 50 us: the check passes and the fit finds
+    Table I's stage (M = 22.5 kg, eq. 2: the mode at 694.26 Hz)."""
+    fit = _fit(tmp_path, "delay = 50e-6", _csv(p1=_measured(50e-6)[0], p2=_measured(50e-6)[1]))
+    assert fit.delay_s == 50e-6 and fit.delay_given
+    assert fit.plant.M == pytest.approx(22.5, rel=0.01)
+    assert fit.plant.modes[0].frequency_hz == pytest.approx(694.26, rel=0.005)

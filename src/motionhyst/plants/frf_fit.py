@@ -78,6 +78,7 @@ from scipy.optimize import least_squares
 
 from motionhyst.core.blas import few_blas_threads
 from motionhyst.plants._frf_problem import DAMPING_BOUNDS, FREQ_BOUNDS, FrfProblem, candidates
+from motionhyst.plants.frf_checks import check_response
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.modal import TWO_PI, ModalPlant, Mode
 from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
@@ -493,7 +494,8 @@ def fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int | 
     ------
     ValueError
         Too few lines for the number of parameters, non-finite or zero data,
-        a negative delay, or data that are not a rigid body at low frequency.
+        a negative delay; data refused before the fit (:func:`~motionhyst.plants.frf_checks.
+        check_response`: not a rigid body at low frequency, a delay, units or phase sense).
 
     Examples
     --------
@@ -572,13 +574,14 @@ def _fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int |
         if not (np.isfinite(delay) and delay >= 0):
             raise ValueError(f"delay must be finite and >= 0, got {delay!r}")
         delay = float(delay)
-        if delay > 0:  # divided out: the fit is that of the mechanics
-            rot = np.exp(1j * TWO_PI * f * delay)
-            p1, p2 = p1 * rot, p2 * rot
     n_measured = f.size
     if f.size > MAX_FIT_LINES:  # a dense response: the fit's size bounded, not the data's
         keep = thin_lines(f, p1, p2)
         f, p1, p2 = f[keep], p1[keep], p2[keep]
+    check_response(f, p1, p2, mass, delay)
+    if delay:  # divided out: the fit is that of the mechanics
+        rot = np.exp(1j * TWO_PI * f * delay)
+        p1, p2 = p1 * rot, p2 * rot
     n_res = 4 * f.size
     n_fixed = 0 if mass is not None else 1
     if modes is not None:
@@ -592,12 +595,10 @@ def _fit_frf(frequency_hz: ArrayLike, P1: ArrayLike, P2: ArrayLike, modes: int |
     prob = FrfProblem(f, p1, p2, mass)
     if mass is None:
         # start: the rigid body of the lowest decade, -1 / (omega^2 Re P), both transfers
+        # (positive: check_response)
         low = f <= f[0] * 10.0
         w2 = (TWO_PI * f[low]) ** 2
         a0 = float(np.median(np.concatenate([-w2 * p1[low].real, -w2 * p2[low].real])))
-        if not a0 > 0:
-            raise ValueError("the data do not look like a rigid body 1/(M s^2) at the lowest "
-                             "measured frequencies (Re P > 0); give the mass or check the data")
         x = np.array([np.log(1.0 / a0)])
     else:
         x = np.zeros(0)

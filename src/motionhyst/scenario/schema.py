@@ -310,13 +310,22 @@ class Scenario:
         return self._plant
 
     def _check_frd(self, data: FrdData, path: Path) -> None:
-        """What a measured plant's lines decide before its fit: too few lines for a mode."""
+        """What a measured plant's lines decide before its fit (:mod:`~motionhyst.plants.
+        frf_checks`): too few lines for a mode, a delay."""
+        from motionhyst.plants.frf_checks import FrfInputError, check_response
+
         sec, n = self.model.plant, data.frequency_hz.size
         if sec.use == "fit" and sec.modes is None and 4 * n < 2 * (4 + (sec.mass is None)):
             raise ScenarioError(f"{self.source}: [plant] file: {path}: {n} measured lines "
                                 f"cannot determine a mode (4 parameters more), which leaves "
                                 f"a rigid body alone, with Pf2 = 0 and no link between P1 and "
                                 f"P2 to analyse; give data up to above the first resonance")
+        try:
+            check_response(data.frequency_hz, data.P1, data.P2, sec.mass,
+                           sec.delay if sec.use == "fit" else None)
+        except FrfInputError as exc:
+            where = "[plant] delay" if exc.key == "delay" else f"[plant] file: {path}"
+            raise ScenarioError(f"{self.source}: {where}: {exc}") from None
 
     def _warn_fit(self) -> None:
         """The measured plant's fit warnings (:attr:`FrfFit.warnings`) as
