@@ -22,7 +22,7 @@ import pytest
 from file_trees import populate, snapshot
 
 from motionhyst import TwoMassStage, load_scenario
-from motionhyst.plants.frf_fit import ModalPlant
+from motionhyst.plants.frf_fit import ModalPlant, fit_frf
 from motionhyst.scenario import default_scenario_path
 
 PAPER = default_scenario_path().read_text()
@@ -80,6 +80,9 @@ CASES = [
     ("delay-in-seconds-for-microseconds", "delay = 1.0", _csv(),
      ["^s.toml: [plant] delay: 1 s turns the phase of the lowest lines (1-", "is it in seconds?"],
      True),
+    ("both-column-sets-disagree", "", _csv(both_scale=10.0),
+     ["^s.toml: [plant] file: frf.csv: has both p1_re, p1_im and p1_abs, p1_phase_deg, and "
+      "they disagree", "at 1 Hz (line 1)"], True),
 ]
 
 
@@ -132,6 +135,15 @@ def test_a_fit_refusal_comes_before_python_control_loads(tmp_path):
 def _fit(tmp_path: Path, extra: str, frf: str):
     populate(tmp_path, {"s.toml": _scenario(extra), "frf.csv": frf})
     return load_scenario(tmp_path / "s.toml").plant_fit()
+
+
+def test_both_column_sets_that_agree_are_read_as_one(tmp_path):
+    """The same response written twice (re, im and abs, phase, 11 digits): the fit is that of
+    either set alone, to the digits written."""
+    both = _fit(tmp_path / "both", "", _csv(both_scale=1.0))
+    alone = fit_frf(LINES, P1, P2)
+    assert both.plant.M == pytest.approx(alone.plant.M, rel=1e-8)
+    assert both.plant.modes[0].frequency_hz == pytest.approx(694.26, abs=0.5)  # eq. (2)
 
 
 def test_a_delay_that_is_the_data_s_is_divided_out(tmp_path):

@@ -15,7 +15,7 @@ from motionhyst.plants.registry import register
 if TYPE_CHECKING:  # the readers (pandas, scipy.io) are imported when a file is read
     from motionhyst.io.csvdata import Source
 
-__all__ = ["FRD_LINE_BYTES", "FrdData", "MeasuredPlant", "frd_plant",
+__all__ = ["BOTH_SETS_RTOL", "FRD_LINE_BYTES", "FrdData", "MeasuredPlant", "frd_plant",
            "load_frd_plant", "read_frd"]
 
 TWO_PI = 2.0 * np.pi
@@ -129,6 +129,11 @@ def _first_out_of_order(f: NDArray[np.float64]) -> str:
             f"by frequency")
 
 
+#: Largest relative difference of the two column sets of one file, line by line, for them
+#: to be one measurement written twice (their rounding: 7 digits, 1e-4 deg, is far below).
+BOTH_SETS_RTOL = 1e-3
+
+
 @dataclass(frozen=True)
 class FrdData:
     """A measured response as read, before python-control holds it (:func:`read_frd`).
@@ -160,9 +165,35 @@ class FrdData:
     source: str
 
 
+def _both_sets(where: str, f, data: NDArray[np.float64]) -> None:
+    """Refuse a file whose re, im and abs, phase columns (both given) disagree."""
+    p1 = data[:, 1] + 1j * data[:, 2]
+    p2 = data[:, 3] + 1j * data[:, 4]
+    for name, p, col in (("P1", p1, 5), ("P2", p2, 7)):
+        q = data[:, col] * np.exp(1j * np.deg2rad(data[:, col + 1]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = np.abs(p - q) / np.maximum(np.abs(p), np.abs(q))
+        rel[~np.isfinite(rel)] = np.inf
+        i = int(np.argmax(rel))
+        if rel[i] > BOTH_SETS_RTOL:
+            n = name.lower()
+            raise ValueError(
+                f"{where}: has both {n}_re, {n}_im and {n}_abs, {n}_phase_deg, and they "
+                f"disagree: {name} = {_num(p[i])} against {_num(q[i])} at {f[i]:g} Hz "
+                f"(line {i + 1}); keep one set (the other may be in other units or a "
+                f"conjugate)")
+
+
+def _num(p: complex) -> str:
+    return f"{abs(p):.4g} m/N at {np.degrees(np.angle(p)):.4g} deg"
+
+
 def read_frd(path: Source, mass: float | None = None) -> FrdData:
     """Read and check a measured response as :func:`load_frd_plant` does, without building
     the plant (python-control is not loaded): what a fit of it needs.
+
+    A file with both column sets (``p1_re, ...`` and ``p1_abs, ...``) is read when they
+    agree to :data:`BOTH_SETS_RTOL` at every line, else refused.
 
     Parameters
     ----------
@@ -201,11 +232,12 @@ def read_frd(path: Source, mass: float | None = None) -> FrdData:
                 f" next to frequency_hz (found {','.join(names) or 'none'})")
     if "frequency_hz" not in header:
         raise ValueError(f"{where}: missing column 'frequency_hz'; need columns {expected}")
-    kind = next((k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header), None)
-    if kind is None:
+    kinds = [k for k, cols in _FRD_COLUMNS.items() if set(cols) <= header]
+    if not kinds:
         raise ValueError(f"{where}: need columns {expected}")
-    check_unread([path], ("frequency_hz", *_FRD_COLUMNS[kind]), _check_lines)  # a long file
-    data = read_record(path, ("frequency_hz", *_FRD_COLUMNS[kind]))
+    cols = ("frequency_hz", *(c for k in kinds for c in _FRD_COLUMNS[k]))
+    check_unread([path], cols, _check_lines)  # a long file
+    data = read_record(path, cols)
     _check_lines([len(data)])
     if not np.all(np.isfinite(data)):
         raise ValueError(f"{where}: non-finite value in data")
@@ -215,7 +247,9 @@ def read_frd(path: Source, mass: float | None = None) -> FrdData:
                          f"{_first_out_of_order(f)}")
     if len(f) < 2:
         raise ValueError(f"{where}: need at least two frequencies")
-    if kind == "reim":  # filled in place: no temporary of the whole response
+    if len(kinds) == 2:
+        _both_sets(where, f, data)
+    if kinds[0] == "reim":  # filled in place: no temporary of the whole response
         p1, p2 = np.empty(len(f), complex), np.empty(len(f), complex)
         p1.real, p1.imag, p2.real, p2.imag = data[:, 1], data[:, 2], data[:, 3], data[:, 4]
     else:
@@ -244,7 +278,8 @@ def load_frd_plant(path: Source, mass: float | None = None) -> MeasuredPlant:
 
     The file has a column (a MATLAB file: a vector variable) ``frequency_hz``, plus either
     ``p1_re, p1_im, p2_re, p2_im`` or ``p1_abs, p1_phase_deg, p2_abs,
-    p2_phase_deg`` (magnitudes in m/N, phases in degrees).
+    p2_phase_deg`` (magnitudes in m/N, phases in degrees); both sets only where they agree
+    (:func:`read_frd`).
 
     Parameters
     ----------
