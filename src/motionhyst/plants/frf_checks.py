@@ -7,9 +7,13 @@ each refusing with one line that names the cause:
   (``Re P < 0``), a stage's flexible part being small below its first mode;
 - a given delay ``tau`` that, divided out, turns lowest lines that are a rigid body
   into lines that are not (:func:`check_delay`);
+- phases of the opposite sign convention, ``P(-j w)`` for ``P(j w)``: a collocated
+  ``P1`` is passive, ``Im P1(j w) <= 0`` once a delay ``tau >= 0`` is divided out,
+  and its conjugate is not (:func:`check_phase_sense`).
 
 They cost milliseconds where the fit costs a second or more, and python-control is
-not loaded for them.
+not loaded for them.  A dense response is judged, and fitted, on the lines
+:func:`thin_lines` keeps.
 """
 
 from __future__ import annotations
@@ -19,11 +23,74 @@ from numpy.typing import NDArray
 
 from motionhyst.plants.modal import TWO_PI
 
-__all__ = ["FrfInputError", "check_delay", "check_response", "rigid_body_share"]
+__all__ = ["MAX_FIT_LINES", "FrfInputError", "check_delay", "check_phase_sense",
+           "check_response", "rigid_body_share", "thin_lines"]
 
 #: A line is a rigid body's when its phase is within 60 deg of -180 deg: the median of
 #: ``-Re P / |P|`` (the cosine of that angle) over the lowest decade at least this.
 RIGID_SHARE_MIN = 0.5
+#: The phase sense is judged when the conjugate's passivity violation (RMS of the positive
+#: part of ``Im P1 / |P1|``, the best delay divided out) is this many times the data's,
+#: over at least :data:`_PHASE_MIN_LINES` lines.
+PHASE_SENSE_RATIO = 4.0
+_PHASE_MIN_LINES = 10
+#: ... and the conjugate is passive within the data's noise: its violation at most the RMS of
+#: ``Im P1 / |P1|`` over the lowest decade (a rigid body's is 0), or this where that is less.
+_PHASE_FLOOR = 1e-3
+#: Delays tried: steps of this phase at the highest line, up to three turns.
+_DELAY_STEP_RAD = 0.01
+_DELAY_TURNS = 3.0
+
+
+#: Most measured lines a fit uses: a denser response is thinned (:func:`thin_lines`).
+MAX_FIT_LINES = 1000
+
+
+def thin_lines(f: NDArray[np.float64], p1: NDArray[np.complex128], p2: NDArray[np.complex128],
+               n_max: int = MAX_FIT_LINES) -> NDArray[np.intp]:
+    """Indices of at most about `n_max` lines of a dense response: log-spaced, peaks kept.
+
+    A measured response of more lines than a fit needs (a swept sine logged at
+    every sample, 1e6 lines) is thinned to lines evenly spaced in log frequency,
+    plus the three lines around each of the largest peaks of ``|P| w^2`` (the
+    response relative to a rigid body), where a lightly damped mode is narrow.
+
+    Parameters
+    ----------
+    f : ndarray
+        Frequencies [Hz], increasing.
+    p1, p2 : ndarray of complex
+        Responses at `f`.
+    n_max : int
+        Lines to keep, about (at least 20).
+
+    Returns
+    -------
+    ndarray of int
+        Increasing indices into `f`; all of them when ``f.size <= n_max``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.linspace(1.0, 1000.0, 100_000)
+    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2) * (1 + 0.5 * (np.abs(f - 700.0) < 0.02))
+    >>> keep = thin_lines(f, p, p, 200)
+    >>> len(keep) <= 200, bool(np.any(np.abs(f[keep] - 700.0) < 0.02))
+    (True, True)
+    """
+    n_max = max(int(n_max), 20)
+    if f.size <= n_max:
+        return np.arange(f.size)
+    n_peaks = 8
+    grid = np.geomspace(f[0], f[-1], n_max - 2 * 3 * n_peaks)
+    keep = [np.clip(np.searchsorted(f, grid), 0, f.size - 1), [0, f.size - 1]]
+    w2 = f**2
+    for p in (p1, p2):
+        a = np.abs(p) * w2
+        peaks = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
+        top = peaks[np.argsort(a[peaks])[-n_peaks:]]
+        keep.append(np.clip(np.concatenate([top - 1, top, top + 1]), 0, f.size - 1))
+    return np.unique(np.concatenate(keep))
 
 
 class FrfInputError(ValueError):
@@ -133,11 +200,95 @@ microseconds to milliseconds: is it in seconds? (omit it: the fit estimates the 
         f"to milliseconds: is it in seconds? (omit it: the fit estimates the delay)", "delay")
 
 
+def _violation(f: NDArray[np.float64], p1: NDArray[np.complex128],
+               taus: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Sum over the lines of the positive part of ``Im(P1 e^{s tau}) / |P1|``, squared, for
+    each delay of `taus` (in blocks: bounded memory)."""
+    out = np.empty(taus.size)
+    unit = p1 / np.abs(p1)
+    for i in range(0, taus.size, 64):
+        t = taus[i:i + 64, None]
+        im = (unit[None, :] * np.exp(1j * TWO_PI * f[None, :] * t)).imag
+        out[i:i + 64] = np.sum(np.clip(im, 0.0, None) ** 2, axis=1)
+    return out
+
+
+def _passivity_violation(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> float:
+    """RMS over the lines of the positive part of ``Im(P1 e^{s tau}) / |P1|`` at the delay
+    ``tau >= 0`` that makes it least: 0 for a passive collocated response seen through a
+    delay, the noise's share for a measured one."""
+    step = _DELAY_STEP_RAD / (TWO_PI * f[-1])
+    taus = np.arange(0.0, _DELAY_TURNS * TWO_PI / (TWO_PI * f[-1]), step)
+    v = _violation(f, p1, taus)
+    i = int(np.argmin(v))
+    fine = np.linspace(max(taus[i] - step, 0.0), taus[i] + step, 41)
+    return float(np.sqrt(min(v[i], float(np.min(_violation(f, p1, fine)))) / f.size))
+
+
+def check_phase_sense(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> None:
+    """Refuse a collocated ``P1`` whose phases have the opposite sign convention.
+
+    The collocated compliance of a passive stage lags: ``Im P1(j w) <= 0`` at every
+    frequency (the force does work on the stage), seen through a measurement delay
+    ``e^{-s tau}``, ``tau >= 0``, that the phase lags by more.  An analyser set to the
+    other convention exports ``P(-j w) = conj P(j w)``: around a mode the phase then
+    leads.  Refused when the conjugate of the data is passive within the data's noise and
+    with :data:`PHASE_SENSE_RATIO` times less violation than the data (each with the delay
+    that suits it best): one mode of negative residue is not a conjugate, nor is data
+    that show no mode (only the rigid body), which cannot tell, and pass.  Judged only on
+    lowest lines that are a rigid body (a sign flip is refused as such, not as this).
+
+    Parameters
+    ----------
+    f : ndarray
+        Frequencies [Hz], increasing.
+    p1 : ndarray of complex
+        Measured collocated response [m/N].
+
+    Raises
+    ------
+    FrfInputError
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from motionhyst.plants import ModalPlant, TwoMassStage
+    >>> f = np.geomspace(1.0, 3000.0, 60)
+    >>> p1, _ = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    ...                                  ).response(2 * np.pi * f)
+    >>> check_phase_sense(f, p1)
+    >>> check_phase_sense(f, np.conj(p1))
+    Traceback (most recent call last):
+    ...
+    motionhyst.plants.frf_checks.FrfInputError: the phases have the opposite sign \
+convention: P1 leads around its modes (its phase above 0 at lines 342.1-674.3 Hz), where a \
+collocated response of a passive stage lags (Im P1 <= 0); the file holds P(-jw) = conj \
+P(jw): negate p1_phase_deg and p2_phase_deg (or p1_im and p2_im)
+    """
+    if f.size < _PHASE_MIN_LINES or rigid_body_share(f, p1, p1) < RIGID_SHARE_MIN:
+        return
+    if f.size > MAX_FIT_LINES:  # a dense response: judged on lines thinned as for the fit
+        keep = thin_lines(f, p1, p1)
+        f, p1 = f[keep], p1[keep]
+    data, conj = _passivity_violation(f, p1), _passivity_violation(f, np.conj(p1))
+    low = p1[f <= f[0] * 10.0]
+    noise = max(float(np.sqrt(np.mean((low.imag / np.abs(low)) ** 2))), _PHASE_FLOOR)
+    if not (data > PHASE_SENSE_RATIO * conj and conj <= noise):
+        return
+    lead = f[(p1.imag > 0) & (p1.real > 0)]
+    where = (f" (its phase above 0 at lines {lead[0]:.4g}-{lead[-1]:.4g} Hz)" if lead.size
+             else "")
+    raise FrfInputError(
+        f"the phases have the opposite sign convention: P1 leads around its modes{where}, "
+        f"where a collocated response of a passive stage lags (Im P1 <= 0); the file holds "
+        f"P(-jw) = conj P(jw): negate p1_phase_deg and p2_phase_deg (or p1_im and p2_im)")
+
+
 def check_response(f: NDArray[np.float64], p1: NDArray[np.complex128],
                    p2: NDArray[np.complex128], mass: float | None = None,
                    delay: float | None = None) -> None:
-    """Every check of this module, cheapest and most specific first: a given delay, then
-    the rigid body at the lowest decade (when the mass is fitted).
+    """Every check of this module, cheapest and most specific first: a given delay, the
+    rigid body at the lowest decade (when the mass is fitted), the phase sense.
 
     Parameters
     ----------
@@ -177,3 +328,4 @@ def check_response(f: NDArray[np.float64], p1: NDArray[np.complex128],
             raise FrfInputError("the data do not look like a rigid body 1/(M s^2) at the "
                                 "lowest measured frequencies (Re P > 0); give the mass or "
                                 "check the data")
+    check_phase_sense(f, p1)

@@ -78,7 +78,7 @@ from scipy.optimize import least_squares
 
 from motionhyst.core.blas import few_blas_threads
 from motionhyst.plants._frf_problem import DAMPING_BOUNDS, FREQ_BOUNDS, FrfProblem, candidates
-from motionhyst.plants.frf_checks import check_response
+from motionhyst.plants.frf_checks import MAX_FIT_LINES, check_response, thin_lines
 from motionhyst.plants.measured import MeasuredPlant
 from motionhyst.plants.modal import TWO_PI, ModalPlant, Mode
 from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
@@ -88,57 +88,6 @@ __all__ = ["FrfFit", "ModalPlant", "Mode", "damping_at_bound", "determined_modes
 
 #: Largest number of modes the automatic choice tries.
 MAX_MODES = 6
-#: Most measured lines a fit uses: a denser response is thinned (:func:`thin_lines`).
-MAX_FIT_LINES = 1000
-
-
-def thin_lines(f: NDArray[np.float64], p1: NDArray[np.complex128], p2: NDArray[np.complex128],
-               n_max: int = MAX_FIT_LINES) -> NDArray[np.intp]:
-    """Indices of at most about `n_max` lines of a dense response: log-spaced, peaks kept.
-
-    A measured response of more lines than a fit needs (a swept sine logged at
-    every sample, 1e6 lines) is thinned to lines evenly spaced in log frequency,
-    plus the three lines around each of the largest peaks of ``|P| w^2`` (the
-    response relative to a rigid body), where a lightly damped mode is narrow.
-
-    Parameters
-    ----------
-    f : ndarray
-        Frequencies [Hz], increasing.
-    p1, p2 : ndarray of complex
-        Responses at `f`.
-    n_max : int
-        Lines to keep, about (at least 20).
-
-    Returns
-    -------
-    ndarray of int
-        Increasing indices into `f`; all of them when ``f.size <= n_max``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> f = np.linspace(1.0, 1000.0, 100_000)
-    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2) * (1 + 0.5 * (np.abs(f - 700.0) < 0.02))
-    >>> keep = thin_lines(f, p, p, 200)
-    >>> len(keep) <= 200, bool(np.any(np.abs(f[keep] - 700.0) < 0.02))
-    (True, True)
-    """
-    n_max = max(int(n_max), 20)
-    if f.size <= n_max:
-        return np.arange(f.size)
-    n_peaks = 8
-    grid = np.geomspace(f[0], f[-1], n_max - 2 * 3 * n_peaks)
-    keep = [np.clip(np.searchsorted(f, grid), 0, f.size - 1), [0, f.size - 1]]
-    w2 = f**2
-    for p in (p1, p2):
-        a = np.abs(p) * w2
-        peaks = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
-        top = peaks[np.argsort(a[peaks])[-n_peaks:]]
-        keep.append(np.clip(np.concatenate([top - 1, top, top + 1]), 0, f.size - 1))
-    return np.unique(np.concatenate(keep))
-
-
 def _start(prob: FrfProblem, x_prev, n_prev, tau: float | None = None):
     """Add one mode to the solution `x_prev` with `n_prev` modes by the separable scan.
 

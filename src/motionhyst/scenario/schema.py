@@ -311,7 +311,7 @@ class Scenario:
 
     def _check_frd(self, data: FrdData, path: Path) -> None:
         """What a measured plant's lines decide before its fit (:mod:`~motionhyst.plants.
-        frf_checks`): too few lines for a mode, a delay."""
+        frf_checks`): too few lines for a mode, a delay, phase sense."""
         from motionhyst.plants.frf_checks import FrfInputError, check_response
 
         sec, n = self.model.plant, data.frequency_hz.size
