@@ -80,6 +80,9 @@ CASES = [
     ("delay-in-seconds-for-microseconds", "delay = 1.0", _csv(),
      ["^s.toml: [plant] delay: 1 s turns the phase of the lowest lines (1-", "is it in seconds?"],
      True),
+    ("p2-in-um-per-newton", "", _csv(p1=P1, p2=P2 * 1e6),
+     ["^s.toml: [plant] file: frf.csv: P1 and P2 differ by a factor 1e+06 at the lowest lines",
+      "M = 22.5 kg from P1, 2.25e-05 kg from P2", "other units"], True),
     ("both-column-sets-disagree", "", _csv(both_scale=10.0),
      ["^s.toml: [plant] file: frf.csv: has both p1_re, p1_im and p1_abs, p1_phase_deg, and "
       "they disagree", "at 1 Hz (line 1)"], True),
@@ -89,6 +92,13 @@ CASES = [
     ("conjugated-phases-of-a-delayed-response", "",
      _csv(p1=np.conj(_measured(50e-6)[0]), p2=np.conj(_measured(50e-6)[1])),
      ["the phases have the opposite sign convention"], True),
+    ("response-in-mm-per-newton", "", _csv(p1=P1 * 1e3, p2=P2 * 1e3),
+     ["^s.toml: [plant] file: the loop with the plant fitted to frf.csv (M = 0.0225 kg, modes "
+      "at 694", "the fitted plant is what the [controller] does not stabilise",
+      "with a response in mm/N read as m/N (M = 22.5 kg): check the units"], False),
+    ("frequencies-in-rad-per-s", "", _csv(f=LINES * 2 * np.pi),
+     ["^s.toml: [plant] file: the loop with the plant fitted to frf.csv (M = 0.57 kg",
+      "frequencies in rad/s read as Hz (M = 22.5 kg)"], False),
 ]
 
 

@@ -7,6 +7,8 @@ each refusing with one line that names the cause:
   (``Re P < 0``), a stage's flexible part being small below its first mode;
 - a given delay ``tau`` that, divided out, turns lowest lines that are a rigid body
   into lines that are not (:func:`check_delay`);
+- ``P1`` and ``P2`` that differ by orders of magnitude at the lowest lines: one
+  transfer in other units (:func:`check_transfers_agree`);
 - phases of the opposite sign convention, ``P(-j w)`` for ``P(j w)``: a collocated
   ``P1`` is passive, ``Im P1(j w) <= 0`` once a delay ``tau >= 0`` is divided out,
   and its conjugate is not (:func:`check_phase_sense`).
@@ -24,8 +26,13 @@ from numpy.typing import NDArray
 from motionhyst.plants.modal import TWO_PI
 
 __all__ = ["MAX_FIT_LINES", "FrfInputError", "check_delay", "check_phase_sense",
-           "check_response", "rigid_body_share", "thin_lines"]
+           "check_response", "check_transfers_agree", "rigid_body_share", "thin_lines"]
 
+#: ``P1`` and ``P2`` at the lowest lines differing by more than this factor are not one
+#: stage's: a unit slip on one of them (mm/N or um/N for m/N: 1e3, 1e6).
+TRANSFER_RATIO_MAX = 100.0
+#: Lowest lines counted as "the lowest": up to this factor above the lowest frequency.
+_LOWEST_SPAN = 2.0
 #: A line is a rigid body's when its phase is within 60 deg of -180 deg: the median of
 #: ``-Re P / |P|`` (the cosine of that angle) over the lowest decade at least this.
 RIGID_SHARE_MIN = 0.5
@@ -200,6 +207,53 @@ microseconds to milliseconds: is it in seconds? (omit it: the fit estimates the 
         f"to milliseconds: is it in seconds? (omit it: the fit estimates the delay)", "delay")
 
 
+def check_transfers_agree(f: NDArray[np.float64], p1: NDArray[np.complex128],
+                          p2: NDArray[np.complex128]) -> None:
+    """Refuse ``P1`` and ``P2`` that differ by more than :data:`TRANSFER_RATIO_MAX` at the
+    lowest lines (up to twice the lowest frequency).
+
+    Below a stage's first mode both are its rigid body ``1/(M s^2)`` (eq. 1): they agree
+    to the flexible parts, a few percent.  A factor of 1e3 or 1e6 is one transfer written
+    in mm/N or um/N.
+
+    Parameters
+    ----------
+    f : ndarray
+        Frequencies [Hz], increasing.
+    p1, p2 : ndarray of complex
+        Measured responses at `f` [m/N].
+
+    Raises
+    ------
+    FrfInputError
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.geomspace(1.0, 100.0, 30)
+    >>> p = -1.0 / (22.5 * (2 * np.pi * f) ** 2)
+    >>> check_transfers_agree(f, p, 1e6 * p)
+    Traceback (most recent call last):
+    ...
+    motionhyst.plants.frf_checks.FrfInputError: P1 and P2 differ by a factor 1e+06 at the \
+lowest lines (1-1.887 Hz), where both are the rigid body 1/(M s^2) (M = 22.5 kg from P1, \
+2.25e-05 kg from P2): one transfer is in other units (mm/N or um/N for m/N?); check \
+p1_abs and p2_abs (or their re, im)
+    """
+    low = np.flatnonzero(f <= f[0] * _LOWEST_SPAN)
+    low = np.arange(min(max(low.size, 3), f.size))
+    ratio = float(np.median(np.abs(p1[low]) / np.abs(p2[low])))
+    if 1.0 / TRANSFER_RATIO_MAX <= ratio <= TRANSFER_RATIO_MAX:
+        return
+    w2 = (TWO_PI * f[low]) ** 2
+    m1, m2 = (float(np.median(1.0 / (w2 * np.abs(p[low])))) for p in (p1, p2))
+    raise FrfInputError(
+        f"P1 and P2 differ by a factor {max(ratio, 1 / ratio):.2g} at the lowest lines "
+        f"({f[low[0]]:.4g}-{f[low[-1]]:.4g} Hz), where both are the rigid body 1/(M s^2) "
+        f"(M = {m1:.3g} kg from P1, {m2:.3g} kg from P2): one transfer is in other units "
+        f"(mm/N or um/N for m/N?); check p1_abs and p2_abs (or their re, im)")
+
+
 def _violation(f: NDArray[np.float64], p1: NDArray[np.complex128],
                taus: NDArray[np.float64]) -> NDArray[np.float64]:
     """Sum over the lines of the positive part of ``Im(P1 e^{s tau}) / |P1|``, squared, for
@@ -288,7 +342,8 @@ def check_response(f: NDArray[np.float64], p1: NDArray[np.complex128],
                    p2: NDArray[np.complex128], mass: float | None = None,
                    delay: float | None = None) -> None:
     """Every check of this module, cheapest and most specific first: a given delay, the
-    rigid body at the lowest decade (when the mass is fitted), the phase sense.
+    transfers' agreement, the rigid body at the lowest decade (when the mass is fitted),
+    the phase sense.
 
     Parameters
     ----------
@@ -321,6 +376,7 @@ def check_response(f: NDArray[np.float64], p1: NDArray[np.complex128],
         check_delay(f, p1, p2, delay)
         rot = np.exp(1j * TWO_PI * f * delay)
         p1, p2 = p1 * rot, p2 * rot
+    check_transfers_agree(f, p1, p2)
     if mass is None:
         low = f <= f[0] * 10.0
         w2 = (TWO_PI * f[low]) ** 2
@@ -329,3 +385,49 @@ def check_response(f: NDArray[np.float64], p1: NDArray[np.complex128],
                                 "lowest measured frequencies (Re P > 0); give the mass or "
                                 "check the data")
     check_phase_sense(f, p1)
+
+
+#: Unit slips of a measured response, and what each makes of a fitted plant: the factor
+#: the response is ``c`` times the true one, the frequencies ``a`` times the true ones.
+UNIT_SLIPS = (
+    (1e3, 1.0, "a response in mm/N read as m/N"),
+    (1e6, 1.0, "a response in um/N read as m/N"),
+    (1e-3, 1.0, "a response 1e3 times too small"),
+    (1.0, TWO_PI, "frequencies in rad/s read as Hz"),
+    (1.0, 1.0 / TWO_PI, "frequencies 2 pi times too low"),
+    (1.0, 1e-3, "frequencies in kHz read as Hz"),
+    (1.0, 1e3, "frequencies in mHz read as Hz"),
+)
+
+
+def unit_slip_plants(plant):
+    """The fitted plant each slip of :data:`UNIT_SLIPS` would make the true one: with the
+    response ``c`` times and the frequencies ``a`` times the true ones, the true plant is
+    ``P(s) = P_fit(a s) / c``, ``M a^2 c``, modes at ``w / a`` with residues
+    ``r / (a^2 c)``.
+
+    Parameters
+    ----------
+    plant : ModalPlant
+        A plant fitted to the data (:func:`motionhyst.plants.frf_fit.fit_frf`).
+
+    Returns
+    -------
+    list of (str, ModalPlant)
+        The slip, and the plant the data would give without it.
+
+    Examples
+    --------
+    >>> from motionhyst.plants import ModalPlant, Mode
+    >>> fitted = ModalPlant(22.5e-3, [Mode(694.3, 0.00265, 155.6, 44.4)])   # mm/N data
+    >>> slip, true = unit_slip_plants(fitted)[0]
+    >>> slip, round(true.M, 6), round(true.modes[0].r1, 4)
+    ('a response in mm/N read as m/N', 22.5, 0.1556)
+    """
+    from motionhyst.plants.modal import ModalPlant, Mode
+
+    return [(what, ModalPlant(plant.M * a * a * c,
+                              [Mode(m.frequency_hz / a, m.damping, m.r1 / (a * a * c),
+                                    m.r2 / (a * a * c)) for m in plant.modes],
+                              source=plant.source))
+            for c, a, what in UNIT_SLIPS]

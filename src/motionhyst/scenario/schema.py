@@ -311,7 +311,7 @@ class Scenario:
 
     def _check_frd(self, data: FrdData, path: Path) -> None:
         """What a measured plant's lines decide before its fit (:mod:`~motionhyst.plants.
-        frf_checks`): too few lines for a mode, a delay, phase sense."""
+        frf_checks`): too few lines for a mode, a delay, units, phase sense."""
         from motionhyst.plants.frf_checks import FrfInputError, check_response
 
         sec, n = self.model.plant, data.frequency_hz.size
@@ -537,18 +537,48 @@ class Scenario:
             try:
                 loop.check_stable()
             except ValueError as exc:
-                if self._fit is not None and self._fit.warnings:  # the fit, not the controller
-                    raise ScenarioError(
-                        f"{self.source}: [plant] file: the loop with the plant fitted to "
-                        f"{self.model.plant.file} is unstable"
-                        f"{str(exc).replace('the controller does not stabilise the loop', '')}"
-                        f", and the fit is in doubt: "
-                        f"{self._fit.warnings[0].removeprefix('measured plant: ')}") from None
+                if self._fit is not None:  # the fitted plant, not the controller alone
+                    raise self._unstable_fit(exc, parts[1:], ff, hff) from None
                 raise ScenarioError(f"{self.source}: [controller]: {exc}") from None
             self._loop = loop
             self._warn_fit()
         self._warn_masses()
         return self._loop
+
+    def _unstable_fit(self, exc: ValueError, rest: tuple, ff, hff) -> ScenarioError:
+        """The refusal of a loop unstable with a fitted plant: the plant is named (its mass
+        and modes), with the fit's first doubt, or else the unit slip of the data that would
+        make the loop stable with a plausible mass (:func:`~motionhyst.plants.frf_checks.
+        unit_slip_plants`, :data:`~motionhyst.plants.registry.PLAUSIBLE_MASS_KG`), or
+        else the units and the controller to check."""
+        from motionhyst.controllers.loop import Loop
+        from motionhyst.plants.frf_checks import unit_slip_plants
+        from motionhyst.plants.registry import PLAUSIBLE_MASS_KG
+
+        fit, file = self._fit, self.model.plant.file
+        p = fit.plant
+        modes = ", ".join(f"{m.frequency_hz:.4g}" for m in p.modes)
+        pole = str(exc).replace("the controller does not stabilise the loop", "").strip()
+        head = (f"{self.source}: [plant] file: the loop with the plant fitted to {file} (M = "
+                f"{p.M:.3g} kg, modes at {modes} Hz) is unstable {pole}")
+        if fit.warnings:
+            return ScenarioError(f"{head}, and the fit is in doubt: "
+                                 f"{fit.warnings[0].removeprefix('measured plant: ')}")
+        slips = []
+        for what, plant in unit_slip_plants(p):
+            if not PLAUSIBLE_MASS_KG[0] <= plant.M <= PLAUSIBLE_MASS_KG[1]:
+                continue
+            try:
+                Loop(plant, *rest, feedforward=ff, hysteresis_feedforward=hff).check_stable()
+            except ValueError:
+                continue
+            slips.append(f"{what} (M = {plant.M:.3g} kg)")
+        why = (f"it stabilises the plant of these data with {' or '.join(slips)}: check the "
+               f"units of {file}" if slips else
+               f"check the units of {file} (a response in mm/N makes M 1e3 times too small, "
+               f"frequencies in rad/s 4 pi^2 times) and the [controller]")
+        return ScenarioError(f"{head}: the fitted plant is what the [controller] does not "
+                             f"stabilise; {why}")
 
     def _warn_masses(self) -> None:
         """:func:`warn_implausible` once, for a user's file, once its loop is built: a
