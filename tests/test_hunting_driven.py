@@ -88,7 +88,7 @@ def test_a_driven_loop_that_hunts_is_refused_with_its_cycle():
 
 def test_a_faster_cycle_is_found_and_its_driven_loop_hunts():
     """ki = 16: the cycle of 6.657 s with the setpoint held, which main's cap of 50 000
-    evaluations missed (its run needs 60 600), so main named the link's stiffness.  Driven at
+    evaluations missed (its run needed 60 600), so main named the link's stiffness.  Driven at
     0.01 Hz, 10 mm an independent run slips every 8.0, 7.3, 7.0, ... s, settling on 6.657 s;
     the driven run says it hunts from its first four intervals (within 10 % of the cycle)."""
     loop = _hunting(**{"controller.ki": 16.0}).loop()
@@ -117,12 +117,37 @@ def test_without_a_cycle_of_its_own_the_loop_is_not_run_driven(monkeypatch):
     assert hunting.hunting_refusal(_hunting(**{"hysteresis.fs": 1.0}).loop(), exc, 0.01) is exc
 
 
+def test_the_cycle_found_does_not_depend_on_the_machines_speed(monkeypatch):
+    """ki = 16 (its held run needs 47 600 evaluations, 60 600 with main's rounding): main
+    stopped the run at 1.5 s of processor time (0.8 s here), so on a machine, or under a
+    tracer such as coverage, five times slower it found no cycle and named the link's
+    stiffness.  The runs are bounded by
+    a count of evaluations now: with a clock five times faster the same cycle, and with a
+    count below what the run needs, none, on any machine."""
+    import time
+
+    from motionhyst.analysis import hunting
+
+    class Slower:
+        """The time module of a machine five times slower."""
+
+        @staticmethod
+        def thread_time() -> float:
+            return 5.0 * time.thread_time()
+
+    loop = _hunting(**{"controller.ki": 16.0}).loop()
+    monkeypatch.setattr(hunting, "time", Slower)
+    assert hunting_period(loop, 0.01) == pytest.approx(6.657, rel=1e-3)
+    monkeypatch.setattr(hunting, "RUN_EVALUATIONS", 40_000)
+    assert hunting_period(loop, 0.01) is None
+
+
 def test_a_run_that_neither_follows_nor_hunts_says_the_loop_may_hunt(monkeypatch):
-    """A driven run that ends undecided (its processor time spent) claims nothing: the fixed
+    """A driven run that ends undecided (its evaluations spent) claims nothing: the fixed
     point's refusal, the held loop's cycle and 'it may hunt'."""
     from motionhyst.analysis import hunting
 
-    monkeypatch.setattr(hunting, "RUN_SECONDS", 0.0)
+    monkeypatch.setattr(hunting, "RUN_EVALUATIONS", 1000)
     loop = _hunting().loop()
     exc = not_converged(0.005, 50, 0.86)
     monkeypatch.setattr(hunting, "hunting_period", lambda loop, offset: PERIOD)

@@ -75,31 +75,40 @@ PIECE_SLOW_PERIODS = 10.0
 #: The run has come to rest when every state of the loop is below this fraction of its
 #: start's.
 AT_REST = 1e-8
-#: Processor time [s] of its thread a run may take at most (a study's threads do not share
-#: it): a stiff loop with fast dynamics stops there, its cycle not found (the fixed point's
-#: refusal stands, no claim of hunting).  Each run is bounded by the simulated time it covers
-#: (here :data:`RUN_SLOW_PERIODS`; :func:`driven_run`'s cycles and periods); this guards the
-#: refusal's time only: the hunting loop's run takes 0.17 s, with ki = 16 (its cycle of
-#: 6.657 s needs 60 600 evaluations, which main's cap of 50 000 missed) 0.8 s.
-RUN_SECONDS = 1.5
+#: Evaluations of its right-hand side a run may take at most: each run is bounded by the
+#: simulated time it covers (here :data:`RUN_SLOW_PERIODS`; :func:`driven_run`'s cycles and
+#: periods), and by this where a stiff loop with fast dynamics would need more (its cycle not
+#: found: the fixed point's refusal stands, no claim of hunting).  A count, so that what is
+#: found does not depend on the machine's speed.  The largest run the tests make, the held
+#: loop with ki = 16 (its cycle of 6.657 s), needs 47 600 (0.43 s of processor time here);
+#: the same run with the right-hand side rounded otherwise needed 60 600 and 73 200 (a
+#: stiff run's steps follow its rounding), the others 2 700 to 17 100: twice the largest.
+#: A run that spends it all takes 1.3 to 1.7 s here (Table I with a LuGre link: 11 us an
+#: evaluation, LSODA's own work included).
+RUN_EVALUATIONS = 150_000
+#: Processor time [s] of its thread past which a run stops all the same (a study's threads do
+#: not share it): a safety net 18 times what :data:`RUN_EVALUATIONS` takes here, never
+#: reached but by a machine or a tracer (coverage) that many times slower.
+GUARD_SECONDS = 30.0
 
 
 class _Exhausted(Exception):
-    """The run took :data:`RUN_SECONDS` of processor time."""
+    """The run took :data:`RUN_EVALUATIONS` evaluations (or :data:`GUARD_SECONDS`)."""
 
 
-def _timed(rhs: Callable[[float, NDArray], NDArray]) -> Callable[[float, NDArray], NDArray]:
-    """`rhs` that raises :class:`_Exhausted` once the run has taken :data:`RUN_SECONDS` of
-    its thread's processor time (looked at every 256 evaluations)."""
-    calls, end = [0], time.thread_time() + RUN_SECONDS
+def _budgeted(rhs: Callable[[float, NDArray], NDArray]) -> Callable[[float, NDArray], NDArray]:
+    """`rhs` that raises :class:`_Exhausted` at its evaluation past :data:`RUN_EVALUATIONS`,
+    or once the run has taken :data:`GUARD_SECONDS` of its thread's processor time (looked
+    at every 4096 evaluations)."""
+    calls, limit, end = [0], RUN_EVALUATIONS, time.thread_time() + GUARD_SECONDS
 
-    def timed(t: float, X: NDArray) -> NDArray:
+    def budgeted(t: float, X: NDArray) -> NDArray:
         calls[0] += 1
-        if calls[0] % 256 == 0 and time.thread_time() > end:
+        if calls[0] > limit or (calls[0] % 4096 == 0 and time.thread_time() > end):
             raise _Exhausted
         return rhs(t, X)
 
-    return timed
+    return budgeted
 
 
 def _start(sys: LoopStateEquation, offset: float) -> tuple[NDArray, NDArray]:
@@ -112,6 +121,24 @@ def _start(sys: LoopStateEquation, offset: float) -> tuple[NDArray, NDArray]:
     scale[:sys.n] = np.abs(X0[:sys.n]) + 1e-3 * np.max(np.abs(X0[:sys.n]))
     scale[sys.n:] = offset * 1e-3
     return X0, scale
+
+
+def _held_field(sys: LoopStateEquation) -> Callable[[float, NDArray], NDArray]:
+    """``X'`` of the loop with its setpoint held (:meth:`LoopStateEquation.rhs`), the link's
+    ``z'`` and ``w`` from its :meth:`~motionhyst.hysteresis.base.Hysteresis.rates`: a held
+    run evaluates it tens of thousands of times (LuGre's scalar rates take 1.2 us, the
+    arrays of its state equation 11 us)."""
+    A, B, CA, n, rates = sys.A, sys.B, sys.CA, sys.n, sys.link.rates
+
+    def field(t: float, X: NDArray) -> NDArray:
+        x = X[:n]
+        zdot, w = rates(X[n:], float(CA @ x))
+        out = np.empty(X.size)
+        out[:n] = A @ x - B * w
+        out[n:] = zdot
+        return out
+
+    return field
 
 
 def _settled(te: list[float], ye: list[NDArray]) -> float | None:
@@ -133,7 +160,7 @@ def hunting_period(loop: Loop, offset: float) -> float | None:
     at 0, released at rest with its link's displacement `offset` [m] away (module
     docstring); None where the run comes to rest or does not settle (in
     :data:`RUN_SLOW_PERIODS` periods of the slowest closed-loop pole, or
-    :data:`RUN_SECONDS` of processor time).
+    :data:`RUN_EVALUATIONS` evaluations of its right-hand side).
 
     Parameters
     ----------
@@ -182,7 +209,7 @@ def hunting_period(loop: Loop, offset: float) -> float | None:
     piece = PIECE_SLOW_PERIODS * t_slow
     atol = RUN_RTOL * 1e-2 * np.maximum(scale, 1e-300)
     start = float(np.max(np.abs(X[:sys.n]) / scale[:sys.n]))
-    rhs = _timed(sys.rhs)
+    rhs = _budgeted(_held_field(sys))
 
     te: list[float] = []
     ye: list[NDArray] = []
@@ -301,8 +328,8 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
     states (an output matrix matching ``T_{w->e}``'s Markov parameters): on Table I with a
     LuGre link its first harmonic agrees with the exact steady state's to 6e-7.  It runs
     in pieces, at most :data:`RUN_CYCLES` cycles (:data:`MIN_PERIODS` reference periods where
-    longer, at most :data:`MAX_CYCLES` cycles) and :data:`RUN_SECONDS` of processor time,
-    and stops once it follows or hunts.
+    longer, at most :data:`MAX_CYCLES` cycles) and :data:`RUN_EVALUATIONS` evaluations of its
+    right-hand side, and stops once it follows or hunts.
 
     Parameters
     ----------
@@ -391,7 +418,7 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
     def error(t: NDArray, x: NDArray) -> NDArray:
         return (TE * np.exp(1j * omega * t)).imag + C_e @ x
 
-    rhs = _timed(field)
+    rhs = _budgeted(field)
     length = min(max(RUN_CYCLES * cycle, MIN_PERIODS * period), MAX_CYCLES * cycle)
     split = max(1, math.ceil(period / cycle))       # pieces a period: judged after each
     phases = np.array_split(np.arange(PHASES) / PHASES * period, split)

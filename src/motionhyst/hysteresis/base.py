@@ -184,6 +184,35 @@ class Hysteresis(ABC):
         """
         raise ValueError(f"the {self.name} model has no smooth state equation")
 
+    def rates(self, z: ArrayLike, v: float) -> tuple[ArrayLike, float]:
+        """``z'`` and ``w`` of :meth:`state_equation` without its derivatives: what a run in
+        time evaluates at every step (a model may give them cheaper).
+
+        Parameters
+        ----------
+        z, v
+            As :meth:`state_equation`.
+
+        Returns
+        -------
+        zdot, w
+            ``z'`` and the force [N].
+
+        Raises
+        ------
+        ValueError
+            For a model without a smooth state equation.
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import Dahl
+        >>> zdot, w = Dahl(k=20.0, fc=0.05).rates([0.0], 0.01)     # at rest, moving forward
+        >>> float(zdot[0]), w
+        (0.2, 0.0)
+        """
+        zdot, w, *_ = self.state_equation(z, v)
+        return zdot, w
+
     def time_stepping(self) -> Stepping:
         """The elements as the compiled time step advances them (:mod:`.stepping`).
 
