@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from motionhyst import Loop, analyze, periodic_steady_state
-from motionhyst.analysis.comparison import compare_with_describing_function, exact_mismatch
+from motionhyst.analysis.comparison import compare_with_describing_function
 from motionhyst.analysis.quasilinear import NO_ERROR_WITHOUT_LINK, loop_mismatch
 from motionhyst.cli import main
 from motionhyst.scenario import Scenario
@@ -60,11 +60,17 @@ def test_the_mismatch_of_a_rigid_plant_is_nan_without_numpy_warnings():
         res = analyze(loop, 0.01, [1.0, 5.0])
         E = loop_mismatch(loop, [1.0, 5.0], 0.01)
         ss = periodic_steady_state(loop, 0.01, 5.0)
-        E_sim = exact_mismatch(ss)
+        E_sim = ss.mismatch
+        text, d = str(ss), ss.to_dict()
     assert np.all(np.isnan(E)) and all(np.isnan(p.value) and np.isnan(p.asymptote)
                                        for p in res.points)
     assert NO_ERROR_WITHOUT_LINK.format(plant="mass-damper") in res.unresolved
     assert ss.e_linear[1] == 0 and abs(ss.e[1]) > 0 and np.isnan(E_sim)
+    # the steady state's own text and dictionary: not defined, never inf (main printed
+    # "|E| = inf, angle 45.00 deg" with numpy's warning, review C19 M2)
+    assert "|E| = |e1 / e1_linear|: not defined, the loop without the link has no error" in text
+    assert "inf" not in text.split()
+    assert np.isnan(d["mismatch_simulated_abs"]) and np.isnan(d["mismatch_simulated_phase_deg"])
     # a little viscous damping gives the linear loop an error again: E is a number
     damped = analyze(_loop(1.0), 0.01, [1.0, 5.0])
     assert all(np.isfinite(p.value) for p in damped.points)
@@ -74,7 +80,8 @@ def test_the_mismatch_of_a_rigid_plant_is_nan_without_numpy_warnings():
 def test_the_exact_mismatch_is_e1_over_the_linear_e1_elsewhere():
     loop = _loop(1.0)
     ss = periodic_steady_state(loop, 0.01, 5.0)
-    assert exact_mismatch(ss) == pytest.approx(ss.e[1] / ss.e_linear[1], rel=1e-15)
+    assert ss.mismatch == pytest.approx(ss.e[1] / ss.e_linear[1], rel=1e-15)
+    assert "|E| = |e1 / e1_linear| = " in str(ss)
 
 
 @pytest.mark.parametrize("command", ["analyze", "steady"])

@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from motionhyst.analysis.equations import over_error_without_link
 from motionhyst.analysis.floquet import (
     FloquetResult,
     check_floquet_budget,
@@ -38,8 +37,7 @@ from motionhyst.core.budget import BudgetError
 from motionhyst.core.textfmt import g, table
 from motionhyst.core.warnings import warn
 
-__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function",
-           "exact_mismatch"]
+__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
 
 
 @dataclass
@@ -76,12 +74,8 @@ class ComparisonPoint:
         """JSON-ready dictionary: one point of the ``steady --json`` schema (with
         ``floquet_max`` and ``stable`` when the multipliers were computed; null where
         they cannot be)."""
-        with np.errstate(divide="ignore", invalid="ignore"):  # nan below where e_hat = 0
-            out = self.state.to_dict(mismatch_df=self.mismatch_df,
-                                     error_harmonics_df=self.error_harmonics_df)
-        E = exact_mismatch(self.state)
-        out["mismatch_simulated_abs"] = abs(E)
-        out["mismatch_simulated_phase_deg"] = float(np.degrees(np.angle(E)))
+        out = self.state.to_dict(mismatch_df=self.mismatch_df,
+                                 error_harmonics_df=self.error_harmonics_df)
         if self.floquet is not False:
             f = self.floquet
             out.update({"floquet_max": None, "stable": None} if f is None else f.to_dict())
@@ -169,25 +163,6 @@ class DescribingFunctionComparison:
         return fig11_errors([p.state for p in self.points],
                             [p.mismatch_df for p in self.points],
                             [p.error_harmonics_df for p in self.points], ax=ax)
-
-
-def exact_mismatch(state: SteadyState) -> complex:
-    """The exact mismatch ``E_sim = e1 / e1_linear`` of a steady state (compare eq. 18),
-    nan where the loop without the link has no error (a rigid plant under its rigid-body
-    feedforward: :func:`~motionhyst.analysis.equations.over_error_without_link`).
-
-    Parameters
-    ----------
-    state : SteadyState
-        The exact periodic steady state.
-
-    Examples
-    --------
-    >>> from motionhyst import default_scenario, periodic_steady_state
-    >>> round(abs(exact_mismatch(periodic_steady_state(default_scenario().loop(), 0.01, 5.0))), 2)
-    6.04
-    """
-    return complex(over_error_without_link(state.e[1], state.e_linear[1]))
 
 
 def _steady_states(loop: Loop, amplitude: float, f: NDArray[np.float64]) -> list[SteadyState]:

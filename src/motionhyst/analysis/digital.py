@@ -28,7 +28,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from motionhyst.analysis.comparison import exact_mismatch
 from motionhyst.analysis.margins import LoopMargins, loop_margins
 from motionhyst.analysis.quasilinear import loop_mismatch
 from motionhyst.analysis.steady import periodic_steady_state
@@ -253,7 +252,7 @@ def compare_digital(loop: Loop, amplitude: float, frequencies_hz, sample_rate_hz
                 nan = float("nan")
                 points.append(DigitalPoint(fi, complex(Ei), complex(nan, nan), nan, nan))
                 continue
-            points.append(DigitalPoint(fi, complex(Ei), exact_mismatch(ss), ss.error_linear_rms,
+            points.append(DigitalPoint(fi, complex(Ei), ss.mismatch, ss.error_linear_rms,
                                        ss.error_hysteresis_rms))
         zoh = None if lp.sampled is None else lp.sampled_parts.zoh
         variants.append(DigitalVariant(name, loop_margins(lp.controller, lp.P2, zoh), points))

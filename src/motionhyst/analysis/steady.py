@@ -61,6 +61,7 @@ from motionhyst.analysis._fixed_point import (
     sticking,
     viscous_damping,
 )
+from motionhyst.analysis.equations import over_error_without_link
 from motionhyst.controllers.loop import Loop
 from motionhyst.core.compiled import njit
 from motionhyst.core.lti import TWO_PI
@@ -166,8 +167,18 @@ class SteadyState:
 
     @property
     def mismatch(self) -> complex:
-        """Exact mismatch ``E_sim = e_1 / e_1,linear`` (compare eq. 18)."""
-        return complex(self.e[1] / self.e_linear[1])
+        """Exact mismatch ``E_sim = e_1 / e_1,linear`` (compare eqs. 18, 20); nan (no
+        warning) where the loop without the link has no error, ``e_1,linear = 0`` (a rigid
+        plant under its rigid-body feedforward:
+        :func:`~motionhyst.analysis.equations.over_error_without_link`).
+
+        Examples
+        --------
+        >>> from motionhyst import default_scenario
+        >>> round(abs(periodic_steady_state(default_scenario().loop(), 0.01, 5.0).mismatch), 2)
+        6.04
+        """
+        return complex(over_error_without_link(self.e[1], self.e_linear[1]))
 
     @property
     def error_rms(self) -> float:
@@ -219,7 +230,8 @@ class SteadyState:
             f"Periodic steady state, r = {g(self.amplitude)} m sin(2 pi {g(self.frequency_hz)} t)"
             f": {self.n_harmonics} harmonics, {self.iterations} iterations{sampled}",
             f"  |E| = |e1 / e1_linear| = {g(abs(self.mismatch))}, "
-            f"angle {np.degrees(np.angle(self.mismatch)):.2f} deg",
+            f"angle {np.degrees(np.angle(self.mismatch)):.2f} deg" if self.e_linear[1] != 0 else
+            "  |E| = |e1 / e1_linear|: not defined, the loop without the link has no error",
             f"  error RMS {g(self.error_rms)} m (without hysteresis {g(self.error_linear_rms)} m)",
             table(["n", "|e_n| [m]", "angle e_n [deg]", "|w_n| [N]"], rows)])
 

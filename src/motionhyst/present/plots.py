@@ -15,7 +15,6 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
-from motionhyst.analysis.comparison import exact_mismatch
 from motionhyst.analysis.figures import fig11_errors
 from motionhyst.core.plotting import (
     LINEAR_COLOR,
@@ -553,7 +552,7 @@ def fig10_mismatch(loop: Loop, analysis: QuasiLinearAnalysis,
               label="|E~| = |Pr^2 D / Pf2|, eq. (20): low-frequency asymptote")
     if exact:
         fe = np.array([s.frequency_hz for s in exact])
-        Ee = np.array([abs(exact_mismatch(s)) for s in exact])  # nan where e_hat1 = 0
+        Ee = np.array([abs(s.mismatch) for s in exact])  # nan where e_hat1 = 0
         ax.loglog(fe, Ee, "o", mfc="none", color="tab:blue",
                   label="|e1 / e_hat1| of the exact periodic steady state (nonlinear loop)")
         fig.motionhyst_data.update(f_exact=fe, E_exact=Ee)
