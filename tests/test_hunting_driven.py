@@ -13,11 +13,11 @@ verdict is checked against an independent run of the loop written out.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
-from cli_probe import probe
 from file_trees import populate, snapshot
 from test_hunting_refused import HUNTING, _hunting, _independent_run
 
@@ -28,6 +28,7 @@ from motionhyst.analysis.hunting import (
     hunting_period,
     hunting_refusal,
 )
+from motionhyst.cli import main
 
 #: The exact orbit's period with its setpoint held (tests/test_stability.py).
 PERIOD = 24.436786
@@ -157,16 +158,21 @@ def test_a_run_that_neither_follows_nor_hunts_says_the_loop_may_hunt(monkeypatch
     assert "period 24.44 s" in message and "it may hunt" in message
 
 
-def test_steady_never_says_a_sticking_driven_loop_hunts(tmp_path):
-    """The command at 0.1 Hz: one line, exit 2, no claim of hunting (an answer, exit 0, once
-    the fixed point converges for a link that sticks); nothing written."""
+def test_steady_never_says_a_sticking_driven_loop_hunts(tmp_path, capsys, monkeypatch):
+    """The command at 0.1 Hz, where main said the loop hunts: the stuck link's steady state,
+    exit 0, its first harmonic that of tests/test_hunting_refused.py (an independent run in
+    time agrees to 1e-8), stderr the f* warning alone; nothing written."""
     populate(tmp_path, {"hunting.toml": HUNTING})
     before = snapshot(tmp_path)
-    out = probe(["steady", "hunting.toml", "--frequency", "0.1", "--no-floquet"], tmp_path)
-    assert "hunts" not in out["err"] and "Traceback" not in out["err"], out
-    if out["rc"] != 0:
-        assert out["rc"] == 2 and len(out["err"].splitlines()) == 1, out
-        assert "the loop does not hunt" in out["err"], out
+    monkeypatch.chdir(tmp_path)
+    assert main(["steady", "hunting.toml", "--frequency", "0.1", "--no-floquet", "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert err.splitlines() == [
+        "motionhyst: warning: steady: 0.1 Hz below f* = 50.3 Hz (eq. 13): the link shapes the "
+        "plant there, the asymptote of eq. (20) and the crossover of eq. (21) do not apply"], err
+    (point,) = json.loads(out)["points"]
+    assert point["error_harmonics"][0]["n"] == 1
+    assert point["error_harmonics"][0]["abs"] == pytest.approx(9.999703392e-3, rel=1e-8)
     assert snapshot(tmp_path) == before
 
 
