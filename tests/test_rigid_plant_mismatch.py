@@ -105,3 +105,25 @@ def test_the_comparison_s_table_names_the_undefined_mismatch():
     assert "not defined where |e1 lin| = 0" in str(cmp)
     assert "not defined" not in str(compare_with_describing_function(_loop(1.0), 0.01, [5.0],
                                                                      floquet=False))
+
+
+def test_a_nan_of_another_cause_is_not_blamed_on_a_rigid_plant(monkeypatch):
+    """``analyze`` named 'the plant has no flexible part' for any non-finite E (review C19
+    L4): a nan at one frequency of a plant with one (c = 1: Pf2 != 0) is not said to be it."""
+    from motionhyst.analysis import quasilinear
+
+    def one_nan(real):
+        def at_the_two_points(*args):
+            out = np.array(real(*args), dtype=complex)
+            if out.size == 2:  # not the crossover's search
+                out[-1] = complex(np.nan, np.nan)
+            return out
+        return at_the_two_points
+
+    for name in ("mismatch", "residual_mismatch"):
+        monkeypatch.setattr(quasilinear, name, one_nan(getattr(quasilinear, name)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = analyze(_loop(1.0), 0.01, [1.0, 5.0])
+    assert np.isfinite(res.points[0].value) and np.isnan(res.points[1].value)
+    assert not any("no flexible part" in u for u in res.unresolved), res.unresolved

@@ -586,7 +586,7 @@ def analyze(loop: Loop, amplitude: float, frequencies_hz: ArrayLike,
             warn(f"|C P2| does not fall through 1 in the range searched: the loop has no "
                  f"bandwidth; are the moving mass M = {g(loop.M)} kg and the controller's gain "
                  f"what was meant?")
-        if not np.all(np.isfinite(E)):  # e_hat = 0: nan, not inf (eqs. 18, 20)
+        if np.any(np.asarray(Pf2) == 0):  # e_hat = 0: E is nan, not inf (eqs. 18, 20)
             unresolved.append(NO_ERROR_WITHOUT_LINK.format(plant=loop.plant.name))
         if q is None:  # eq. (21) does not apply: say so rather than print nan
             unresolved.append(f"eq. (21): needs a flexible mode with a static compliance "
