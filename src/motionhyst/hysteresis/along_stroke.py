@@ -119,10 +119,11 @@ class AlongStroke(Hysteresis):
                                  "per position")
             if name in base.never_slips and np.ptp(v) > 0:
                 raise ValueError(
-                    f"{name} of the {base.name} model is a spring that never slips: scaled "
-                    f"along the stroke its force would depend on the path, not the "
-                    f"position (a run drifts every period, a steady state has none); keep "
-                    f"{name} constant along the stroke and scale the parts that slip")
+                    f"{name} of the {base.name} model is a spring that never slips: the "
+                    f"runs hold it piece by piece along the stroke (dw = k dx, k of the "
+                    f"piece), so its force drifts as the stage passes the pieces' edges (a "
+                    f"run drifts every period, a steady state has none); keep {name} "
+                    f"constant along the stroke and scale the parts that slip")
             self.scales[name] = v
         self.rate_independent = base.rate_independent
         self.parameters = base.parameters
@@ -327,7 +328,8 @@ class AlongStroke(Hysteresis):
                 raise RuntimeError(
                     f"the {self.base.name} link along the stroke ({self.key}) has no "
                     f"periodic force: its change from period to period ({change:.2g} N) does "
-                    "not shrink (a spring that never slips, scaled along the stroke, drifts); "
+                    "not shrink (a spring that does not slip, held piece by piece along the "
+                    "stroke, drifts); "
                     "run it in time (simulate --time-series)")
             if len(changes) > 2 * STALL_PERIODS:
                 rest = _geometric_rest(changes[-STALL_PERIODS - 1:])
