@@ -157,9 +157,10 @@ class Progress:
 def sticking(link) -> tuple[float, float]:
     """The link's stiffness [N/m] and damping [N s/m] while it sticks: its
     :meth:`~motionhyst.hysteresis.base.Hysteresis.initial_stiffness` (0 where it is not finite
-    and positive) and its :func:`viscous_damping`, with LuGre's bristle damping ``sigma1``
-    (its force ``sigma0 z + sigma1 dz/dt + sigma2 v``, Canudas de Wit et al. 1995, is that
-    of a spring and dampers for ``z = y1`` while it sticks).
+    and positive) and its :func:`viscous_damping`, with its
+    :attr:`~motionhyst.hysteresis.base.Hysteresis.bristle_damping` (LuGre's ``sigma1``: its
+    force ``sigma0 z + sigma1 dz/dt + sigma2 v``, Canudas de Wit et al. 1995, is that of a
+    spring and dampers for ``z = y1`` while it sticks).
 
     Examples
     --------
@@ -169,9 +170,7 @@ def sticking(link) -> tuple[float, float]:
     (100000.0, 316.4)
     """
     k = float(link.initial_stiffness) if link is not None else 0.0
-    c = viscous_damping(link)
-    if type(link).__name__ == "LuGre":
-        c += float(link.sigma1)
+    c = viscous_damping(link) + (link.bristle_damping if link is not None else 0.0)
     return (k if np.isfinite(k) and k > 0 else 0.0), c
 
 

@@ -165,6 +165,19 @@ class Hysteresis(ABC):
     #: Number of states of :meth:`state_equation` (0: the model has no smooth state equation).
     n_states: ClassVar[int] = 0
 
+    @property
+    def bristle_damping(self) -> float:
+        """The damping [N s/m] of the model's force while it sticks beyond its damping at every
+        amplitude: LuGre's ``sigma1``; 0 for a model without one.
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import Jenkins
+        >>> Jenkins(k=20.0, fc=0.05).bristle_damping
+        0.0
+        """
+        return 0.0
+
     def state_equation(self, z: ArrayLike, v: float):
         """The model as a smooth state equation ``z' = f(z, v)``, ``w = h(z, v)`` with its
         derivatives (see :meth:`motionhyst.hysteresis.LuGre.state_equation`).

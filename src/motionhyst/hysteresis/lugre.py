@@ -506,6 +506,19 @@ class LuGre(Hysteresis):
                 np.array([self.sigma0 + self.sigma1 * dzdot_dz]),
                 float(self.sigma1 * dzdot_dv + self.sigma2))
 
+    @property
+    def bristle_damping(self) -> float:
+        """``sigma1`` [N s/m]: while the element sticks (``z = y1``) its force is that of the
+        bristles' spring ``sigma0`` and this damper beside ``sigma2``
+        (:func:`~motionhyst.analysis._fixed_point.sticking`).
+
+        Examples
+        --------
+        >>> LuGre(sigma0=1e5, sigma1=316.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3).bristle_damping
+        316.0
+        """
+        return float(self.sigma1)
+
     def rates(self, z: ArrayLike, v: float) -> tuple[float, float]:
         """``z'`` and ``w`` of :meth:`state_equation` without its derivatives, in scalar
         arithmetic: a run in time evaluates them at every step
