@@ -295,10 +295,12 @@ def test_a_loop_that_hunts_is_said_to_hunt(tmp_path):
     assert errors[0].startswith(
         "motionhyst: error: steady state at 0.002 Hz: the loop hunts: driven from rest, a run "
         "in time slips at its own rhythm (its error crosses zero upward every 24.4 s, 20.5 "
-        "times in the reference's 500 s period); with its setpoint held the loop has a "
+        "times in the reference's 500 s period; the run covered 0.38 of it: whether its slips "
+        "repeat each period was not checked); with its setpoint held the loop has a "
         "stable self-excited limit cycle of period 24.44 s"), errors
     assert errors[0].endswith(
-        "so no periodic steady state of the reference's period; run it in time (motionhyst "
+        "and the fixed point found no periodic steady state of the reference's period; run it "
+        "in time (motionhyst "
         "simulate --time-series, with [controller] derivative_filter_hz: a pure derivative has "
         "no run) (`motionhyst simulate` without --time-series is now `motionhyst steady`)"), errors
 

@@ -556,13 +556,18 @@ def hunting_refusal(loop: Loop, exc: NoFixedPoint, amplitude: float) -> RuntimeE
     except (ValueError, RuntimeError, ArithmeticError, np.linalg.LinAlgError):
         return NoFixedPoint(f"{exc}; {held}: driven, it may hunt; {remedy}", f, exc.change)
     if run.verdict == "hunts":
-        seen = (f"its periods differ by {run.change:.2g} m" if np.isfinite(run.change) else
-                f"{1 / (f * run.rhythm):.3g} times in the reference's {1 / f:.4g} s period")
+        # two whole periods compared, or the rhythm alone within the first: then whether the
+        # slips repeat each period (a train the period entrains) was not seen
+        seen = (f"its periods differ by {run.change:.2g} m); {held}, so no periodic steady "
+                f"state of the reference's period" if np.isfinite(run.change) else
+                f"{1 / (f * run.rhythm):.3g} times in the reference's {1 / f:.4g} s period; "
+                f"the run covered {run.seconds * f:.2g} of it: whether its slips repeat each "
+                f"period was not checked); {held}, and the fixed point found no periodic "
+                f"steady state of the reference's period")
         return RuntimeError(
             f"steady state at {f:g} Hz: the loop hunts: driven from rest, a run in time slips "
             f"at its own rhythm (its error crosses zero upward every {run.rhythm:.3g} s, "
-            f"{seen}); {held}, so no periodic steady state of the reference's period; "
-            f"{remedy}")
+            f"{seen}; {remedy}")
     if run.verdict == "follows":
         return NoFixedPoint(
             f"{exc}; a run in time from rest follows the reference's {1 / f:.4g} s period "
