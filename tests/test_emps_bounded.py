@@ -55,16 +55,24 @@ def test_a_run_estimated_above_max_seconds_is_refused_before_it_starts(data, cap
     assert "1 of 1 fits failed" in capsys.readouterr().err
 
 
-def test_a_run_over_max_seconds_is_stopped(data, capsys, monkeypatch):
+@pytest.mark.parametrize("json", [True, False])
+def test_a_run_over_max_seconds_is_stopped(data, capsys, monkeypatch, json):
     """The estimate set aside (a machine slower than the nominal cost), the fits themselves
-    are stopped at --max-seconds of CPU time: one line, exit 2, no table."""
+    are stopped at --max-seconds of CPU time: one line, exit 2, no table.  Without --json on a
+    terminal the progress is one status line, cleared before the refusal (review C19 M4: each
+    fit's progress was a line of its own, printed before the refusal's)."""
+    import sys
+
     import motionhyst.cli.benchmark as command
 
     monkeypatch.setattr(command, "EMPS_SECONDS_PER_SAMPLE", 0.0)
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
     assert main(["benchmark", "emps", "--data", str(data), "--max-seconds", "0.5",
-                 "--models", "jenkins", "--json"]) == 2
+                 "--models", "jenkins", *(["--json"] if json else [])]) == 2
     out, err = capsys.readouterr()
     assert out == ""
     assert err.count("\n") == 1
-    assert err.startswith("motionhyst: error: benchmark emps did not finish within the work "
-                          "budget of 0.5 s of CPU time (--max-seconds); give fewer --models")
+    shown = err.rsplit("\r", 1)[-1]  # what the terminal shows: the status line was cleared
+    assert shown.startswith("motionhyst: error: benchmark emps did not finish within the work "
+                            "budget of 0.5 s of CPU time (--max-seconds); give fewer --models")
+    assert ("benchmark emps, jenkins: identifying" in err) != json  # the status line ran

@@ -200,16 +200,26 @@ def run_emps(args: argparse.Namespace) -> int:
                          f"no test record; {test_path} is there")
     # the optimisers imported once the folder, its records and the options are known good
     from motionhyst.core.budget import check_work, cpu_time_limit, max_seconds
-    from motionhyst.identify.emps import CHOSEN, choose, cross_validate, run_emps
-
-    def say(msg: str) -> None:
-        if not args.json:
-            print(f"  {msg}", file=sys.stderr, flush=True)
+    from motionhyst.identify.emps import CHOSEN, MODELS, choose, cross_validate, run_emps
 
     check_work(_emps_seconds(estimation, test, args.periods, models), "benchmark emps",
                EMPS_REMEDY)
+    from tqdm import tqdm
+
     release_held()  # the fits start: the warnings so far are shown
-    with cpu_time_limit(max_seconds(), "benchmark emps", EMPS_REMEDY):
+    # the progress on a terminal only, one status line cleared as the run ends: a run stopped
+    # by its budget is the one line of its refusal (the table has each fit's row and time)
+    splits = 1 if test is not None or args.periods not in (None, "all") else (
+        2 if args.periods is None else 4)
+    fits = splits * len(MODELS if models is None else models)
+    with (tqdm(total=2 * fits, desc="benchmark emps", bar_format="{desc}{postfix} [{elapsed}]",
+               disable=args.json or not sys.stderr.isatty(), file=sys.stderr,
+               leave=False) as bar,
+          cpu_time_limit(max_seconds(), "benchmark emps", EMPS_REMEDY)):
+        def say(msg: str) -> None:  # each fit's start and end
+            bar.update()
+            bar.set_postfix_str(msg)
+
         if test is None and args.periods in (None, "all"):  # one split alone says little
             results = cross_validate(estimation, models=models, progress=say,
                                      splits="halves" if args.periods is None else "all")
