@@ -14,11 +14,16 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MIN_SHARED", "SAME_VALUE_RTOL", "repeated_record", "shared_samples"]
+__all__ = ["MIN_SHARED", "SAME_VALUE_FLOOR", "SAME_VALUE_RTOL", "repeated_record", "shared_samples"]
 
-#: Two values are the same sample's when they differ by less than this share of the larger
-#: magnitude of their column (a record written again with 6 significant digits: 5e-6)
+#: Two values are the same sample's when they differ by less than this share of their own
+#: magnitude (a record written again with 6 significant digits: 5e-6); a share of the column's
+#: largest magnitude would take two runs whose noise is below it for one record
 SAME_VALUE_RTOL = 1e-5
+
+#: The least difference that always counts as the same value, as a share of the column's
+#: largest magnitude (values at or near zero, written as 0)
+SAME_VALUE_FLOOR = 1e-12
 
 #: The fewest samples two records share for one to be a part of the other (and not two
 #: records that meet by chance at a sample)
@@ -31,12 +36,12 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
     (equal, a part of it, or overlapping its end): 0 if none.
 
     Samples are shared when every column (`a` and `b`: the same columns, one array each,
-    of the records' own lengths) agrees within :data:`SAME_VALUE_RTOL` of the column's
-    largest magnitude, from `b`'s first sample to the end of either record, and the records
-    have one time step (the time stamps themselves may be shifted: a part cut out of a
-    record and its time set from 0).  A shared run must move (every column's range over it
-    above the tolerance's hundredfold, not two records that both rest) and hold at least
-    :data:`MIN_SHARED` samples.
+    of the records' own lengths) agrees within :data:`SAME_VALUE_RTOL` of each value's own
+    magnitude (how a value written with fewer significant digits errs), from `b`'s first
+    sample to the end of either record, and the records have one time step (the time stamps
+    themselves may be shifted: a part cut out of a record and its time set from 0).  A shared
+    run must move (every column's range over it above 1e-3 of its largest magnitude, not two
+    records that both rest) and hold at least :data:`MIN_SHARED` samples.
 
     Parameters
     ----------
@@ -62,23 +67,34 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
     500
     >>> shared_samples([x, f], [x[200:700] + 1e-3, f[200:700]], 1e-3, 1e-3)   # another record
     0
+
+    Two runs whose noise differs, however little, are two records:
+
+    >>> noisy = x[200:700] + 1e-8 * np.random.default_rng(0).standard_normal(500)
+    >>> shared_samples([x, f], [noisy, f[200:700]], 1e-3, 1e-3)
+    0
     """
     if not a or len(a) != len(b) or not (abs(step_a - step_b) <= 1e-6 * abs(step_a)):
         return 0
     n_a, n_b = a[0].size, b[0].size
     if min(n_a, n_b) < MIN_SHARED:
         return 0
-    tol = [SAME_VALUE_RTOL * max(float(np.max(np.abs(ca))), float(np.max(np.abs(cb))))
-           for ca, cb in zip(a, b, strict=True)]
+    scale = [max(float(np.max(np.abs(ca))), float(np.max(np.abs(cb))))
+             for ca, cb in zip(a, b, strict=True)]
+
+    def same(ca: NDArray[np.float64], cb: NDArray[np.float64], top: float) -> NDArray[np.bool_]:
+        return np.abs(ca - cb) <= (SAME_VALUE_RTOL * np.maximum(np.abs(ca), np.abs(cb))
+                                   + SAME_VALUE_FLOOR * top)
+
     starts = np.ones(n_a, dtype=bool)
-    for ca, cb, e in zip(a, b, tol, strict=True):
-        starts &= np.abs(ca - cb[0]) <= e
+    for ca, cb, top in zip(a, b, scale, strict=True):
+        starts &= same(ca, cb[0], top)
     for i in np.flatnonzero(starts)[:100]:  # a resting start matches many: the first hundred
         n = min(n_a - int(i), n_b)
         if n < MIN_SHARED:
             break
-        if all(np.all(np.abs(ca[i:i + n] - cb[:n]) <= e) and np.ptp(cb[:n]) > 100 * e
-               for ca, cb, e in zip(a, b, tol, strict=True)):
+        if all(np.all(same(ca[i:i + n], cb[:n], top)) and np.ptp(cb[:n]) > 1e-3 * top
+               for ca, cb, top in zip(a, b, scale, strict=True)):
             return n
     return 0
 
