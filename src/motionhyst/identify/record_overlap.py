@@ -14,20 +14,50 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MIN_SHARED", "SAME_VALUE_FLOOR", "SAME_VALUE_RTOL", "repeated_record", "shared_samples"]
+__all__ = ["MIN_SHARED", "SAME_VALUE_RTOL", "decimal_step", "repeated_record", "shared_samples"]
 
 #: Two values are the same sample's when they differ by less than this share of their own
-#: magnitude (a record written again with 6 significant digits: 5e-6); a share of the column's
-#: largest magnitude would take two runs whose noise is below it for one record
+#: magnitude (a record written again with 6 significant digits: 5e-6), or by less than half
+#: the decimal step of a column written with fixed decimals (:func:`decimal_step`); a share of
+#: the column's largest magnitude would take two runs whose noise lies below it for one record
 SAME_VALUE_RTOL = 1e-5
-
-#: The least difference that always counts as the same value, as a share of the column's
-#: largest magnitude (values at or near zero, written as 0)
-SAME_VALUE_FLOOR = 1e-12
 
 #: The fewest samples two records share for one to be a part of the other (and not two
 #: records that meet by chance at a sample)
 MIN_SHARED = 10
+
+
+def decimal_step(column: NDArray[np.float64]) -> float:
+    """The decimal step of a column written with fixed decimals: the largest ``10**-d``
+    (``d`` 0 to 15) on whose grid every value lies, or 0 if none does.
+
+    A column saved as ``%.6f`` lies on the grid of 1e-6; one saved with all its digits, or
+    with significant digits (``%.6g``), lies on none.
+
+    Parameters
+    ----------
+    column : ndarray
+        The values as read.
+
+    Returns
+    -------
+    float
+        The step, or 0.0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.sin(np.arange(100) / 10.0)
+    >>> decimal_step(np.array([float(f"{v:.6f}") for v in x]))
+    1e-06
+    >>> decimal_step(x)
+    0.0
+    """
+    ulps = 4.0 * np.spacing(np.abs(column))
+    for d in range(16):
+        if np.all(np.abs(np.round(column, d) - column) <= ulps):
+            return 10.0 ** -d
+    return 0.0
 
 
 def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.float64]],
@@ -37,7 +67,9 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
 
     Samples are shared when every column (`a` and `b`: the same columns, one array each,
     of the records' own lengths) agrees within :data:`SAME_VALUE_RTOL` of each value's own
-    magnitude (how a value written with fewer significant digits errs), from `b`'s first
+    magnitude (how a value written with fewer significant digits errs) or within half the
+    decimal step of a column written with fixed decimals (:func:`decimal_step`; half of each
+    step added where the two columns have different ones), from `b`'s first
     sample to the end of either record, and the records have one time step (the time stamps
     themselves may be shifted: a part cut out of a record and its time set from 0).  A shared
     run must move (every column's range over it above 1e-3 of its largest magnitude, not two
@@ -68,10 +100,17 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
     >>> shared_samples([x, f], [x[200:700] + 1e-3, f[200:700]], 1e-3, 1e-3)   # another record
     0
 
+    So is the record written with 8 fixed decimals:
+
+    >>> fixed = [np.array([float(f"{v:.8f}") for v in c]) for c in (x, f)]
+    >>> shared_samples([x, f], fixed, 1e-3, 1e-3)
+    1000
+
     Two runs whose noise differs, however little, are two records:
 
-    >>> noisy = x[200:700] + 1e-8 * np.random.default_rng(0).standard_normal(500)
-    >>> shared_samples([x, f], [noisy, f[200:700]], 1e-3, 1e-3)
+    >>> rng = np.random.default_rng(0)
+    >>> noisy = [x + 1e-8 * rng.standard_normal(1000), f + 1e-8 * rng.standard_normal(1000)]
+    >>> shared_samples([x, f], noisy, 1e-3, 1e-3)
     0
     """
     if not a or len(a) != len(b) or not (abs(step_a - step_b) <= 1e-6 * abs(step_a)):
@@ -81,20 +120,25 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
         return 0
     scale = [max(float(np.max(np.abs(ca))), float(np.max(np.abs(cb))))
              for ca, cb in zip(a, b, strict=True)]
+    steps = [(decimal_step(ca), decimal_step(cb)) for ca, cb in zip(a, b, strict=True)]
+    # half the coarser step; both halves where the steps differ (two roundings of one value)
+    rounding = [0.5 * max(qa, qb) + (0.5 * min(qa, qb) if qa != qb else 0.0)
+                for qa, qb in steps]
 
-    def same(ca: NDArray[np.float64], cb: NDArray[np.float64], top: float) -> NDArray[np.bool_]:
-        return np.abs(ca - cb) <= (SAME_VALUE_RTOL * np.maximum(np.abs(ca), np.abs(cb))
-                                   + SAME_VALUE_FLOOR * top)
+    def same(ca: NDArray[np.float64], cb: NDArray[np.float64], half: float
+             ) -> NDArray[np.bool_]:
+        big = np.maximum(np.abs(ca), np.abs(cb))
+        return np.abs(ca - cb) <= SAME_VALUE_RTOL * big + half + 4.0 * np.spacing(big)
 
     starts = np.ones(n_a, dtype=bool)
-    for ca, cb, top in zip(a, b, scale, strict=True):
-        starts &= same(ca, cb[0], top)
+    for ca, cb, half in zip(a, b, rounding, strict=True):
+        starts &= same(ca, cb[0], half)
     for i in np.flatnonzero(starts)[:100]:  # a resting start matches many: the first hundred
         n = min(n_a - int(i), n_b)
         if n < MIN_SHARED:
             break
-        if all(np.all(same(ca[i:i + n], cb[:n], top)) and np.ptp(cb[:n]) > 1e-3 * top
-               for ca, cb, top in zip(a, b, scale, strict=True)):
+        if all(np.all(same(ca[i:i + n], cb[:n], half)) and np.ptp(cb[:n]) > 1e-3 * top
+               for ca, cb, half, top in zip(a, b, rounding, scale, strict=True)):
             return n
     return 0
 
