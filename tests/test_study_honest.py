@@ -288,9 +288,9 @@ def test_a_link_identified_on_another_stage_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize(("changed", "words"), [
-    ("m = 10.5", "the scenario's [stage] m = 10.5 is not the identified stage.m = 10 +- "
+    ("m = 10.5", "the scenario's [stage] m = 10.5 is not the identified stage.m = 10.00002 +- "
                  "1.05e-05 (off by 4.75e+04 standard errors, more than 3)"),
-    ("c = 20.01", "the scenario's [stage] c = 20.01 is not the identified stage.c = 19.9999 "
+    ("c = 20.01", "the scenario's [stage] c = 20.01 is not the identified stage.c = 19.999854 "
                   "+- 9.26e-05 (off by 110 standard errors, more than 3)"),
 ])
 def test_a_stage_whose_values_differ_from_the_identified_is_refused(tmp_path, changed, words):
@@ -302,6 +302,26 @@ def test_a_stage_whose_values_differ_from_the_identified_is_refused(tmp_path, ch
                   ["study", "st.toml", "--out", "st.zarr", "--workers", "0",
                    "--from-identification", "id.toml"])
     assert words in err, err
+
+
+def test_the_stage_value_a_refusal_prints_is_accepted(tmp_path):
+    """An estimate of 10.00004 +- 1.05e-5 kg (3.8 standard errors from 10): the refusal of
+    m = 10 prints it with the digits its standard error needs (6 digits said "10"), and the
+    scenario given that printed value is accepted (review C20 M1)."""
+    estimates = [10.00004, *ESTIMATES[1:]]
+    loop = LOOP.replace("m = 10.0", "m = 10")
+    assert loop != LOOP
+    err = refused(tmp_path, {"loop.toml": loop, "st.toml": study_text("loop.toml"),
+                             "id.toml": identification(estimates)},
+                  ["study", "st.toml", "--out", "st.zarr", "--workers", "0",
+                   "--from-identification", "id.toml"])
+    printed = err.split("the identified stage.m = ")[1].split(" +- ")[0]
+    assert printed == "10.00004", err
+    populate(tmp_path, {"loop.toml": LOOP.replace("m = 10.0", f"m = {printed}")})
+    study = Study.from_dict({**tomllib.loads(study_text("loop.toml")),
+                             "samples": {"n": 4, "seed": 0, "from_identification": "id.toml"}},
+                            base_dir=tmp_path)
+    assert study.sampled_keys == tuple(PARAMETERS)
 
 
 def test_the_identified_stage_is_drawn_with_its_link_when_it_is_the_scenarios(tmp_path):

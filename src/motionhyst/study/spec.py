@@ -787,11 +787,20 @@ def _check_stage_values(scenario: dict, joint: JointNormal, source: str) -> None
             continue
         by = f"{off / std[i]:.3g} standard errors" if std[i] > 0 else "more than its rounding"
         raise ValueError(f"from_identification {source}: the scenario's [stage] {key[6:]} = "
-                         f"{value!r} is not the identified {key} = {estimate:.6g} +- "
+                         f"{value!r} is not the identified {key} = "
+                         f"{estimate:.{_digits(estimate, std[i])}g} +- "
                          f"{std[i]:.3g} (off by {by}, more than {STAGE_MATCH:g}): its link "
                          f"was identified on that stage, jointly; give the identified values "
                          f"in the scenario's [stage] (they are then drawn with the link's), "
                          f"{_BY_THE_LINK_ALONE}")
+
+
+def _digits(estimate: float, std: float) -> int:
+    """Significant digits that print `estimate` within a twentieth of its standard error
+    `std` (at least 6): the value a refusal asks for, copied as printed, is then accepted."""
+    if not (std > 0 and estimate != 0 and math.isfinite(estimate)):
+        return 17
+    return min(17, max(6, math.ceil(math.log10(abs(estimate) / std)) + 2))
 
 
 def _check_count(n, seed) -> None:
