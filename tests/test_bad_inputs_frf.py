@@ -92,6 +92,9 @@ CASES = [
     ("conjugated-phases-of-a-delayed-response", "",
      _csv(p1=np.conj(_measured(50e-6)[0]), p2=np.conj(_measured(50e-6)[1])),
      ["the phases have the opposite sign convention"], True),
+    ("p1-and-p2-swapped", "", _csv(p1=P2, p2=P1),
+     ["^s.toml: [plant] file: frf.csv: P1 and P2 look swapped", "put the collocated response "
+      "in p1_* and the non-collocated one in p2_*"], True),
     ("response-in-mm-per-newton", "", _csv(p1=P1 * 1e3, p2=P2 * 1e3),
      ["^s.toml: [plant] file: the loop with the plant fitted to frf.csv (M = 0.0225 kg, modes "
       "at 694", "the fitted plant is what the [controller] does not stabilise",

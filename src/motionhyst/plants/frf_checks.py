@@ -279,8 +279,10 @@ def _passivity_violation(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> 
     return float(np.sqrt(min(v[i], float(np.min(_violation(f, p1, fine)))) / f.size))
 
 
-def check_phase_sense(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> None:
-    """Refuse a collocated ``P1`` whose phases have the opposite sign convention.
+def check_phase_sense(f: NDArray[np.float64], p1: NDArray[np.complex128],
+                      p2: NDArray[np.complex128] | None = None) -> None:
+    """Refuse a collocated ``P1`` whose phases have the opposite sign convention, or that
+    is the non-collocated response (``P1`` and ``P2`` swapped).
 
     The collocated compliance of a passive stage lags: ``Im P1(j w) <= 0`` at every
     frequency (the force does work on the stage), seen through a measurement delay
@@ -291,6 +293,11 @@ def check_phase_sense(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> Non
     that suits it best): one mode of negative residue is not a conjugate, nor is data
     that show no mode (only the rigid body), which cannot tell, and pass.  Judged only on
     lowest lines that are a rigid body (a sign flip is refused as such, not as this).
+    The non-collocated response lags past -180 deg above its mode, so its conjugate looks
+    passive too: where the given ``P2`` is larger than ``P1`` over the top fifth of the
+    lines (above its modes the collocated response is the larger: its numerator keeps the
+    mass term), the columns are said to be swapped instead (negating the phases would fit
+    the swapped data).
 
     Parameters
     ----------
@@ -298,6 +305,8 @@ def check_phase_sense(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> Non
         Frequencies [Hz], increasing.
     p1 : ndarray of complex
         Measured collocated response [m/N].
+    p2 : ndarray of complex, optional
+        Measured non-collocated response [m/N]: told apart from a swapped ``P1``.
 
     Raises
     ------
@@ -318,12 +327,32 @@ def check_phase_sense(f: NDArray[np.float64], p1: NDArray[np.complex128]) -> Non
 convention: P1 leads around its modes (its phase above 0 at lines 342.1-674.3 Hz), where a \
 collocated response of a passive stage lags (Im P1 <= 0); the file holds P(-jw) = conj \
 P(jw): negate p1_phase_deg and p2_phase_deg (or p1_im and p2_im)
+
+    The two responses swapped:
+
+    >>> p1, p2 = ModalPlant.from_two_mass(TwoMassStage(m1=5.0, m2=17.5, b=90.0, k=7.4e7)
+    ...                                   ).response(2 * np.pi * f)
+    >>> check_phase_sense(f, p2, p1)
+    Traceback (most recent call last):
+    ...
+    motionhyst.plants.frf_checks.FrfInputError: P1 and P2 look swapped: P1 leads around \
+its modes (its phase above 0 at lines ...) and falls below P2 above them, where the \
+collocated response of a stage is the larger: put the collocated response in p1_* and the \
+non-collocated one in p2_*
+
+    Both conjugated are still a convention:
+
+    >>> check_phase_sense(f, np.conj(p1), np.conj(p2))
+    Traceback (most recent call last):
+    ...
+    motionhyst.plants.frf_checks.FrfInputError: the phases have the opposite sign ...
     """
     if f.size < _PHASE_MIN_LINES or rigid_body_share(f, p1, p1) < RIGID_SHARE_MIN:
         return
     if f.size > MAX_FIT_LINES:  # a dense response: judged on lines thinned as for the fit
         keep = thin_lines(f, p1, p1)
         f, p1 = f[keep], p1[keep]
+        p2 = None if p2 is None else p2[keep]
     data, conj = _passivity_violation(f, p1), _passivity_violation(f, np.conj(p1))
     low = p1[f <= f[0] * 10.0]
     noise = max(float(np.sqrt(np.mean((low.imag / np.abs(low)) ** 2))), _PHASE_FLOOR)
@@ -332,6 +361,12 @@ P(jw): negate p1_phase_deg and p2_phase_deg (or p1_im and p2_im)
     lead = f[(p1.imag > 0) & (p1.real > 0)]
     where = (f" (its phase above 0 at lines {lead[0]:.4g}-{lead[-1]:.4g} Hz)" if lead.size
              else "")
+    top = f >= f[int(0.8 * (f.size - 1))]
+    if p2 is not None and float(np.median(np.abs(p2[top]) / np.abs(p1[top]))) > 1.0:
+        raise FrfInputError(
+            f"P1 and P2 look swapped: P1 leads around its modes{where} and falls below P2 "
+            f"above them, where the collocated response of a stage is the larger: put the "
+            f"collocated response in p1_* and the non-collocated one in p2_*")
     raise FrfInputError(
         f"the phases have the opposite sign convention: P1 leads around its modes{where}, "
         f"where a collocated response of a passive stage lags (Im P1 <= 0); the file holds "
@@ -384,7 +419,7 @@ def check_response(f: NDArray[np.float64], p1: NDArray[np.complex128],
             raise FrfInputError("the data do not look like a rigid body 1/(M s^2) at the "
                                 "lowest measured frequencies (Re P > 0); give the mass or "
                                 "check the data")
-    check_phase_sense(f, p1)
+    check_phase_sense(f, p1, p2)
 
 
 #: Unit slips of a measured response, and what each makes of a fitted plant: the factor
