@@ -200,6 +200,20 @@ def test_a_distribution_whose_mass_the_scenario_refuses_is_refused_up_front(
                         "within the admitted values"), err
 
 
+def test_the_shares_refused_at_both_ends_are_added(tmp_path):
+    """Dahl's alpha lies in (0, 100]: uniform [-0.9, 100.9] puts 0.88 % of its draws below
+    and 0.88 % above, 1.77 % in all, more than the 1 % admitted (each end alone is not)."""
+    paper = _paper_folder(tmp_path)["paper.toml"]
+    dahl = paper.replace('model = "jenkins"', 'model = "dahl"\nalpha = 50.0')
+    assert dahl != paper
+    text = ('scenario = "dahl.toml"\noutputs = ["e1"]\n[axes]\nfrequency_hz = [5.0]\n'
+            '[samples]\nn = 4\nseed = 0\n"hysteresis.alpha" = { uniform = [-0.9, 100.9] }\n')
+    err = refused(tmp_path, {"dahl.toml": dahl, "st.toml": text},
+                  ["study", "st.toml", "--out", "st.zarr", "--workers", "0"])
+    assert "[samples] 'hysteresis.alpha': uniform [-0.9, 100.9] puts 1.77 % of its draws " \
+           "where the scenario refuses them" in err, err
+
+
 def _write_paper(folder: Path) -> Path:
     populate(folder, _paper_folder(folder))
     return folder

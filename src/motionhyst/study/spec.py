@@ -548,32 +548,41 @@ class StudyDefinition:
 
     def _check_mass(self, key: str, first: dict) -> None:
         """Refuse a ``[samples]`` distribution of `key` that puts more than
-        :data:`MAX_REFUSED_MASS` of its mass where the scenario refuses the value: the
-        scenario is asked at the distribution's quantiles of that fraction, from each end;
-        the fraction refused is found by bisection (the admitted values an interval)."""
+        :data:`MAX_REFUSED_MASS` of its mass where the scenario refuses the value, the two
+        ends together: from each end the scenario is asked at the distribution's quantile
+        1e-9 and, where it refuses there, the edge of the admitted values is found by
+        bisection of the quantile (the admitted values an interval)."""
         kind, a, b = self.samples[key]
+        shares, reasons = [], []
         for low in (True, False):
-            p = MAX_REFUSED_MASS if low else 1.0 - MAX_REFUSED_MASS
-            why = self._refusal(key, _quantile(kind, a, b, p), first)
+            edge = 1e-9
+            why = self._refusal(key, _quantile(kind, a, b, edge if low else 1.0 - edge), first)
             if why is None:
                 continue
             inner = 0.5
             if self._refusal(key, _quantile(kind, a, b, inner), first) is not None:
-                share = "more than half"
-            else:  # refused at p, admitted at the median: the edge between
-                for _ in range(20):
-                    mid = (p + inner) / 2
-                    if self._refusal(key, _quantile(kind, a, b, mid), first) is None:
+                shares.append(1.0)
+            else:  # refused near the end, admitted at the median: the edge between
+                for _ in range(30):
+                    mid = (edge + inner) / 2
+                    if self._refusal(key, _quantile(kind, a, b, mid if low else 1.0 - mid),
+                                     first) is None:
                         inner = mid
                     else:
-                        p = mid
-                share = f"{100 * (inner if low else 1.0 - inner):.3g} %"
-            remedy = ("a lognormal distribution (positive by construction) or one within the "
-                      "admitted values" if low else "a distribution within the admitted values")
-            raise StudyError(f"[samples] {key!r}: {kind} [{a:g}, {b:g}] puts {share} of its "
-                             f"draws where the scenario refuses them ({why}), more than the "
-                             f"{100 * MAX_REFUSED_MASS:g} % a study admits (its bands would "
-                             f"be of the draws left); give {remedy}")
+                        edge = mid
+                shares.append(inner)
+            reasons.append((shares[-1], low, why))
+        total = sum(shares)
+        if total <= MAX_REFUSED_MASS:
+            return
+        _, low, why = max(reasons)
+        share = "more than half" if total >= 0.5 else f"{100 * total:.3g} %"
+        remedy = ("a lognormal distribution (positive by construction) or one within the "
+                  "admitted values" if low else "a distribution within the admitted values")
+        raise StudyError(f"[samples] {key!r}: {kind} [{a:g}, {b:g}] puts {share} of its "
+                         f"draws where the scenario refuses them ({why}), more than the "
+                         f"{100 * MAX_REFUSED_MASS:g} % a study admits (its bands would "
+                         f"be of the draws left); give {remedy}")
 
     # ---------------------------------------------------------------- points
     def _draw(self) -> NDArray[np.float64]:
