@@ -350,8 +350,10 @@ def test_df_text_lists_parameters_and_initial_stiffness():
     (("--kv", "8", "--amplitude", "1e-3", "--frequency", "1"), ("kv and cv", "(1 != 0)")),
 ])
 def test_df_errors_are_one_line_exit_2(args, fragments):
-    rc, out, err = run_cli("df", "--model", "maxwell-iwan", "--k0", "5", "--ki", "30",
-                           "--d-min", "1e-4", "--d-max", "4e-3", *args)
+    base = {"--k0": "5", "--ki": "30", "--d-min": "1e-4", "--d-max": "4e-3"}
+    given = dict(zip(args[::2], args[1::2], strict=True))  # a case's value replaces the base's
+    rc, out, err = run_cli("df", "--model", "maxwell-iwan",
+                           *(x for kv in {**base, **given}.items() for x in kv))
     assert rc == 2 and out == ""
     assert err.count("\n") == 1 and "Traceback" not in err
     assert all(f in err for f in fragments)
