@@ -260,13 +260,13 @@ def run(args: argparse.Namespace) -> int:
 
             warn(mass)
         what = "force-displacement record"
-        from motionhyst.identify.io_checks import SYSTEMATIC_SHARE
+        from motionhyst.identify.io_checks import PREDICT_SHARE
 
         try:  # the fit's warnings on its values wait for its judgement: a refusal is one line
             with search_budget(), warnings.catch_warnings(record=True) as held:
                 warnings.simplefilter("always")
                 ident = identify_maxwell_slip(x, w, t=t, **options, target_share=(
-                    SYSTEMATIC_SHARE if args.elements is None else None))
+                    PREDICT_SHARE if args.elements is None else None))
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         _check_determined(path, ident, x, w)
@@ -652,19 +652,19 @@ def _refuse_beyond_bound(path: Path, x, w) -> None:
     """Refuse, before the fit, a force-displacement record that no number of Maxwell-slip
     elements describes: when even the best of them leave more systematic error
     (:func:`~motionhyst.identify.fd_bound.systematic_share_bound`, a lower bound) than a fit may
-    (:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`), the fit would end in
+    (:data:`~motionhyst.identify.io_checks.PREDICT_SHARE`), the fit would end in
     :func:`_judge_elements`'s refusal after its work.  The checks that name another cause
     (no hysteresis, a sensor's sign reversed) stay the fit's: the bound leaves them alone."""
     from motionhyst.identify.fd_bound import systematic_share_bound
     from motionhyst.identify.fd_memory import bound_columns
-    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed
+    from motionhyst.identify.io_checks import PREDICT_SHARE, FitFailed
 
     bound = systematic_share_bound(x, w, max_columns=bound_columns(x.size))
-    if bound > SYSTEMATIC_SHARE:
+    if bound > PREDICT_SHARE:
         raise FitFailed(f"{path}: no Maxwell-slip elements describe this record: any number "
                         f"of them leave a systematic error of at least {100 * bound:.2g} % of "
-                        f"the force's RMS (above {100 * SYSTEMATIC_SHARE:g} %, beyond the "
-                        f"noise) and would not predict another record of this link; a link "
+                        f"the force's RMS (above {100 * PREDICT_SHARE:g} %, beyond the "
+                        f"noise) and would predict another record of this link below 95 %; a link "
                         f"with a spring and damper in parallel may (--model dahl, bouc-wen or "
                         f"lugre); nothing identified")
 
@@ -672,32 +672,31 @@ def _refuse_beyond_bound(path: Path, x, w) -> None:
 def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
     """The systematic share of a force-displacement fit's error
     (:func:`~motionhyst.identify.io_checks.systematic_share`); above
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` a failed fit where `refuse`
-    (the order chosen by the criterion, or a model to save): elements that do not describe
-    the record do not predict another one of the same link; above
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_WARN_SHARE` a warning
+    :data:`~motionhyst.identify.io_checks.PREDICT_SHARE` a failed fit where `refuse` (the
+    order chosen by the criterion, or a model to save): elements that do not describe the
+    record predict another one of the same link below 95 %; a number of elements the user
+    fixed, shown and not saved, is a warning there
     (:func:`~motionhyst.identify.io_quasi_static_checks.systematic_warning`)."""
-    from motionhyst.identify.io_checks import SYSTEMATIC_SHARE, FitFailed, systematic_share
+    from motionhyst.identify.io_checks import PREDICT_SHARE, FitFailed, systematic_share
 
     share = systematic_share(w - ident.predict(x, ident.initial_forces), w)
-    if share <= SYSTEMATIC_SHARE:  # a fit, which may still predict another record worse
-        from motionhyst.core.warnings import warn
-        from motionhyst.identify.io_quasi_static_checks import systematic_warning
-
-        line = systematic_warning(share, "force", f"more --elements than "
-                                  f"{ident.n_elements}, or a link with a spring and damper in "
-                                  f"parallel (--model dahl, bouc-wen or lugre), may describe "
-                                  f"it better")
-        if line is not None:
-            warn(f"{path}: {line}")
-    elif refuse:
+    if share > PREDICT_SHARE and refuse:
         raise FitFailed(f"{path}: the fit failed: {ident.n_elements} Maxwell-slip element(s) "
                         f"leave a systematic error of {100 * share:.2g} % of the force's RMS "
-                        f"(above {100 * SYSTEMATIC_SHARE:g} %, beyond the noise): they do not "
-                        f"describe this link and would not predict another record of it"
-                        f"{'' if ident.order_stop is None else f' ({ident.order_stop})'}; a "
-                        f"link with a spring and damper in parallel may (--model dahl, "
-                        f"bouc-wen or lugre); nothing saved")
+                        f"(above {100 * PREDICT_SHARE:g} %, beyond the noise): they do not "
+                        f"describe this link and would predict another record of it below "
+                        f"95 %{'' if ident.order_stop is None else f' ({ident.order_stop})'}; "
+                        f"more --elements than {ident.n_elements} or a link with a spring and "
+                        f"damper in parallel may (--model dahl, bouc-wen or lugre); nothing "
+                        f"saved")
+    from motionhyst.core.warnings import warn
+    from motionhyst.identify.io_quasi_static_checks import systematic_warning
+
+    line = systematic_warning(share, "force", f"more --elements than {ident.n_elements}, or a "
+                              f"link with a spring and damper in parallel (--model dahl, "
+                              f"bouc-wen or lugre), may describe it better")
+    if line is not None:
+        warn(f"{path}: {line}")
     return share
 
 

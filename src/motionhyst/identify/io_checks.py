@@ -39,7 +39,7 @@ from motionhyst.identify.residual_noise import (
 __all__ = ["DIRECTION_MOVING", "DIRECTION_NODES", "DIRECTION_SAMPLES", "DIRECTION_SHARE",
            "DIRECTION_SIGNIFICANCE", "DIRECTION_TOP",
            "MASS_FACTOR", "MASS_SHARE", "MASS_SIGMAS", "MAX_PREDICT_SUBSTEPS",
-           "NO_HYSTERESIS_GAIN", "SPRING_SHARE", "SYSTEMATIC_SHARE", "SYSTEMATIC_WARN_SHARE",
+           "NO_HYSTERESIS_GAIN", "PREDICT_SHARE", "SPRING_SHARE", "SYSTEMATIC_SHARE",
            "FitFailed", "StiffFit", "budget_note", "check_inertia", "default_plant", "flat_profile",
            "hysteresis_gain", "judge_fit", "linear_mass_std", "noise_cost",
            "plausibility_warnings", "robust_least_squares", "systematic_share",
@@ -57,19 +57,19 @@ MASS_SHARE = 0.05
 MASS_SIGMAS = 3.0
 #: Inertia below this share of the force (``m a_rms / u_rms``) is not visible in the records
 INERTIA_SHARE = 1e-3
-#: A fit whose systematic error exceeds this share of the signal's RMS does not describe its
-#: record: on another record of the same machine it explains a few times less (measured on
-#: generated dampers and piezos: 2.8 to 15 % gave held-out fits of 47 to 90 %), while the right
-#: model with a sensor's quantisation, resonance above the band, gain nonlinearity of 0.5 % and
-#: a little creep leaves 0.3 to 0.9 %
+#: A record whose best description by a model class leaves a systematic error above this
+#: share of the signal's RMS is not of that class (the record checks that tell a spring's, a
+#: damper's or a mass's record from a link's use it)
 SYSTEMATIC_SHARE = 0.02
-#: ... and one above this share is a warning, on a link's force or a stage's position: on
-#: another record of the machine its error may be a few times larger (measured on generated
-#: dampers and piezos: a Dahl link on a damper's forces, 1.5 to 1.9 % on sines, predicted
+#: A fit whose systematic error exceeds this share of its signal's RMS (a link's force or a
+#: stage's position) is no model: it is refused and nothing is saved, because on another
+#: record of the same machine its error is a few times larger (measured on generated dampers
+#: and piezos: a Dahl link on a damper's forces, 1.5 to 1.9 % on sines, predicted
 #: earthquake-like histories at 92.3 to 94.8 %; a Bouc-Wen link on a piezo's positions, 1.8 %,
-#: other records at 93 to 98 %; the right models left 0 to 0.8 % and predicted them at 98.5
-#: to 99.9 %)
-SYSTEMATIC_WARN_SHARE = 0.0125
+#: other records at 93 to 98 %; 2.8 to 15 % gave 47 to 90 %), while the right model with a
+#: sensor's quantisation, resonance above the band, gain nonlinearity of 0.5 % and a little
+#: creep leaves 0.3 to 0.9 % and predicts them at 98.5 to 99.9 %
+PREDICT_SHARE = 0.0125
 
 
 class FitFailed(RuntimeError):

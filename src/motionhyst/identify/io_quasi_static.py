@@ -64,7 +64,6 @@ from motionhyst.identify.io_quasi_static_checks import (
     judge_hysteresis,
     judge_systematic,
     linear_rms,
-    systematic_warning,
 )
 from motionhyst.identify.io_records import IORecord
 from motionhyst.identify.io_results import IOIdentification, per_record_errors
@@ -488,7 +487,7 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
     plant, fitted = prob.model(v)
     stopped = budget is not None and sol.status == 0  # on its budget, before it converged
     try:
-        res, fit_rms, share = _judge(prob, v, records, force_error, K, C, b, periodic, out)
+        res, fit_rms, _ = _judge(prob, v, records, force_error, K, C, b, periodic, out)
     except FitFailed as exc:
         if not stopped:
             raise
@@ -539,10 +538,6 @@ def identify_quasi_static_io(records: list[IORecord], link: type, *, periodic: b
                 for n, x, x0, lg, f in zip(prob.names, v, v_start, prob.log, prob.free,
                                            strict=True)
                 if lg and f and x > 0 and x0 > 0 and max(x / x0, x0 / x) > RUNAWAY_FACTOR]
-    systematic = systematic_warning(share, what, "another --model may describe them better "
-                                    "(the loops' shape, a rate or speed dependence)")
-    if systematic is not None:
-        warnings.append(systematic)
     stribeck = _stribeck_warning(prob, sol, force_error, v_scale,
                                  None if budget is None else (budget - prob.n_eval) // per_step)
     if stribeck is not None:

@@ -5,9 +5,9 @@ linear spring and damper's simulation error (:func:`linear_rms`), a force fit th
 finite and better than the force's spread and the linear model (:func:`judge_force_fit`),
 a link that explains more than the linear model within the noise
 (:func:`judge_hysteresis`), and a systematic error within
-:data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` (:func:`judge_systematic`), one
-above :data:`~motionhyst.identify.io_checks.SYSTEMATIC_WARN_SHARE` a warning
-(:func:`systematic_warning`, on the force-displacement Maxwell-slip route too).
+:data:`~motionhyst.identify.io_checks.PREDICT_SHARE` (:func:`judge_systematic`); the
+warning for Maxwell-slip elements of a number the user fixed, shown and not saved, that
+leave more (:func:`systematic_warning`).
 """
 
 from __future__ import annotations
@@ -19,8 +19,7 @@ from numpy.typing import NDArray
 
 from motionhyst.identify.io_checks import (
     NO_HYSTERESIS_GAIN,
-    SYSTEMATIC_SHARE,
-    SYSTEMATIC_WARN_SHARE,
+    PREDICT_SHARE,
     FitFailed,
     hysteresis_gain,
     systematic_share,
@@ -54,7 +53,7 @@ def judge_force_fit(fit_rms: float, res: NDArray[np.float64], records: list[IORe
     """Raise :class:`FitFailed` unless the forces predicted from the displacement are a
     result: finite, better than the force's own spread and than the linear model's
     ``K y + C y' + b``, and describing the records to within
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of the force's RMS beyond
+    :data:`~motionhyst.identify.io_checks.PREDICT_SHARE` of the force's RMS beyond
     the noise (:func:`~motionhyst.identify.io_checks.systematic_share`, returned)."""
     if not all(np.all(np.isfinite(f)) for f in forces) or not math.isfinite(fit_rms):
         raise FitFailed("the fit failed: the identified link's force is not finite")
@@ -95,29 +94,29 @@ def judge_systematic(res: NDArray[np.float64], measured: list[NDArray[np.float64
                       what: str) -> float:
     """The largest systematic share of the residuals `res` (the records one after the
     other) over the records; raise :class:`FitFailed` if it is above
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE` of a record's `measured`
+    :data:`~motionhyst.identify.io_checks.PREDICT_SHARE` of a record's `measured`
     signal (:func:`~motionhyst.identify.io_checks.systematic_share`): a model that does
     not describe its records (a piezo's creep, a rate dependence the link lacks) does not
-    predict another one."""
+    predict another one (a fit below 95 %)."""
     parts = np.split(res, np.cumsum([m.size for m in measured])[:-1])
     share = max(systematic_share(r, m) for r, m in zip(parts, measured, strict=True))
-    if share > SYSTEMATIC_SHARE:
+    if share > PREDICT_SHARE:
         raise FitFailed(f"the fit failed: the model leaves a systematic error of "
                         f"{100 * share:.2g} % of the {what}'s RMS (above "
-                        f"{100 * SYSTEMATIC_SHARE:g} %, beyond the noise): it does not describe "
+                        f"{100 * PREDICT_SHARE:g} %, beyond the noise): it does not describe "
                         f"these records (a creep, a rate dependence or a link another --model "
-                        f"describes) and would not predict another one")
+                        f"describes) and would predict another one below 95 %; nothing saved")
     return share
 
 
 def systematic_warning(share: float, what: str, remedy: str) -> str | None:
-    """The warning for a fit that leaves a systematic `share` of the `what`'s RMS beyond the
-    noise above :data:`~motionhyst.identify.io_checks.SYSTEMATIC_WARN_SHARE` (and within
-    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`, or it is no fit): on another
-    record of the machine its error may be a few times larger; `remedy` says what may describe
-    the records better.  None below."""
-    if not share > SYSTEMATIC_WARN_SHARE:
+    """The warning for a fit shown but not saved (Maxwell-slip elements of a number the user
+    fixed) that leaves a systematic `share` of the `what`'s RMS beyond the noise above
+    :data:`~motionhyst.identify.io_checks.PREDICT_SHARE`: on another record of the machine
+    its error may be a few times larger; `remedy` says what may describe the records better.
+    None below."""
+    if not share > PREDICT_SHARE:
         return None
     return (f"the model leaves a systematic error of {100 * share:.2g} % of the {what}'s RMS "
-            f"beyond the noise (above {100 * SYSTEMATIC_WARN_SHARE:g} %): on another record "
+            f"beyond the noise (above {100 * PREDICT_SHARE:g} %): on another record "
             f"of this machine its error may be a few times larger (a fit below 95 %); {remedy}")
