@@ -675,9 +675,15 @@ def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
     :data:`~motionhyst.identify.io_checks.PREDICT_SHARE` a failed fit where `refuse` (the
     order chosen by the criterion, or a model to save): elements that do not describe the
     record predict another one of the same link below 95 %; a number of elements the user
-    fixed, shown and not saved, is a warning there
+    fixed, shown and not saved, is a warning there up to
+    :data:`~motionhyst.identify.io_checks.SYSTEMATIC_SHARE`
     (:func:`~motionhyst.identify.io_quasi_static_checks.systematic_warning`)."""
-    from motionhyst.identify.io_checks import PREDICT_SHARE, FitFailed, systematic_share
+    from motionhyst.identify.io_checks import (
+        PREDICT_SHARE,
+        SYSTEMATIC_SHARE,
+        FitFailed,
+        systematic_share,
+    )
 
     share = systematic_share(w - ident.predict(x, ident.initial_forces), w)
     if share > PREDICT_SHARE and refuse:
@@ -689,14 +695,15 @@ def _judge_elements(path: Path, ident, x, w, refuse: bool) -> float:
                         f"more --elements than {ident.n_elements} or a link with a spring and "
                         f"damper in parallel may (--model dahl, bouc-wen or lugre); nothing "
                         f"saved")
-    from motionhyst.core.warnings import warn
-    from motionhyst.identify.io_quasi_static_checks import systematic_warning
+    if share <= SYSTEMATIC_SHARE:  # above, the record's own checks name the cause (a mass)
+        from motionhyst.core.warnings import warn
+        from motionhyst.identify.io_quasi_static_checks import systematic_warning
 
-    line = systematic_warning(share, "force", f"more --elements than {ident.n_elements}, or a "
-                              f"link with a spring and damper in parallel (--model dahl, "
-                              f"bouc-wen or lugre), may describe it better")
-    if line is not None:
-        warn(f"{path}: {line}")
+        line = systematic_warning(share, "force", f"more --elements than {ident.n_elements}, "
+                                  f"or a link with a spring and damper in parallel (--model "
+                                  f"dahl, bouc-wen or lugre), may describe it better")
+        if line is not None:
+            warn(f"{path}: {line}")
     return share
 
 
