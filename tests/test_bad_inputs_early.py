@@ -60,7 +60,7 @@ IDENTIFY = ["identify", "jd.csv"]
 # (id, extra files, argv, words of the one line on stderr)
 CASES = [
     ("jenkins-with-a-damper", {}, IDENTIFY,
-     ["jd.csv: " + NOT_MAXWELL_SLIP, "(above 2 %, beyond the noise)",
+     ["jd.csv: " + NOT_MAXWELL_SLIP, "(above 1.25 %, beyond the noise)",
       "--model dahl, bouc-wen or lugre", "nothing identified"]),
     ("jenkins-with-a-damper-saved", {}, [*IDENTIFY, "--save", "link.toml"],
      ["jd.csv: " + NOT_MAXWELL_SLIP]),

@@ -117,7 +117,7 @@ def test_the_bound_holds_fewer_stop_operators_within_a_small_budget(monkeypatch)
     full = systematic_share_bound(x, w)
     few = systematic_share_bound(x, w, max_columns=fd_memory.MIN_BOUND_COLUMNS)
     assert full == pytest.approx(0.0936, abs=5e-4)
-    assert 0.07 < few <= full  # lower, and still a refusal (above 2 %)
+    assert 0.07 < few <= full  # lower, and still a refusal (above 1.25 %)
 
 
 def test_the_elements_fit_runs_within_its_estimate_and_is_refused_just_below(tmp_path):
