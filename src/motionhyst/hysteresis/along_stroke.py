@@ -9,12 +9,34 @@ its ends)::
     p(x) = p_base s_p(x)
 
 The elements keep their state (for a stop operator, its force) when the
-parameters change: a Jenkins element follows ``dw = k(x) dx`` while ``|w| <
-fc(x)`` and slips at ``w = +-fc(x)``.  The time runs update the parameters
-between pieces of the run over which the position stays within one
-:data:`STEPS_PER_INTERVAL`-th of the table's spacing, at the piece's mean
-position (the setpoint's in a closed loop: the stage's within the tracking
-error).
+parameters change: a Jenkins element follows the paper's eq. (3) with ``k_J(x)``,
+``dw = k(x) dx`` while ``|w| < fc(x)``, and slips at ``w = +-fc(x)``.  The time runs
+update the parameters between pieces of the run over which the position stays within
+one :data:`STEPS_PER_INTERVAL`-th of the table's spacing, at the piece's mean position
+(the setpoint's in a closed loop: the stage's within the tracking error).
+
+A stop operator whose stiffness varies is a conservative spring while it sticks: its
+force is ``w = w_s + K(x) - K(x_s)`` since it stuck at ``x_s`` with ``w_s``, where
+``K(x) = integral of k(x) dx`` (:meth:`AlongStroke.stiffness_integral`; exact for the
+table's piecewise-linear ``k``, held beyond its ends), whatever path ``x`` took.  A
+stiffness held piece by piece (``dw = k dx`` with the piece's ``k``) instead gains or
+loses a little at each pass over a piece's edge, and a stop that never slips kept it:
+its force drifted period after period.  So:
+
+- the open-loop runs (:meth:`AlongStroke.response`, :meth:`AlongStroke.periodic_harmonics`,
+  hence the exact steady state) advance such a stop on ``K(x) / k(x_0)`` with its
+  stiffness at the table's first position: exact, sticking and slipping alike;
+- the closed loops' runs (continuous and sampled), whose compiled step cannot transform
+  the stage's position, set each such stop's force at a piece's end to
+  ``w_s + K(x_e) - K(x_s)`` where it stuck through the piece
+  (:meth:`AlongStroke.conserve`): exact at the pieces' ends where it sticks, so a stop
+  that never slips returns to its force at the same position; within a piece, and over
+  a piece where it slipped, the piece's held ``k`` (an error of the order of ``k'
+  dx^2`` over the piece's ``dx``, not carried on: a slip sets the force).
+
+The other kinds keep the piece's parameters: Dahl, Bouc-Wen and Maxwell branches
+forget their start (a run settles on one periodic force), LuGre's state is the
+bristles' deflection, not a force.
 """
 
 from __future__ import annotations
@@ -27,11 +49,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from motionhyst.core.validation import check_omega
 from motionhyst.hysteresis.base import Hysteresis
-from motionhyst.hysteresis.stepping import GL_T, GL_W, Stepping, open_loop_calls
+from motionhyst.hysteresis.stepping import GL_T, GL_W, STOP, Stepping, open_loop_calls
 
 __all__ = ["EXTRAPOLATED_RTOL", "FEEDFORWARD_KEY", "FIXED_IN_OPEN_LOOP", "LINK_KEY", "MAX_PERIODS",
            "NO_DESCRIBING_FUNCTION",
-           "PERIODIC_RTOL", "STALL_PERIODS", "STEPS_PER_INTERVAL", "AlongStroke"]
+           "PERIODIC_RTOL", "STALL_PERIODS", "STEPS_PER_INTERVAL", "STUCK_RTOL", "AlongStroke"]
 
 #: Parameter updates of a time run per interval of the table (the parameters are held over
 #: the samples within one such step of the position).
@@ -49,6 +71,11 @@ STALL_PERIODS = 10
 #: tenth of it at most: the ratios agree to a tenth of ``1 - q``); a change that stops
 #: shrinking below it is the run's rounding, settled.
 EXTRAPOLATED_RTOL = 1e-6
+#: A stop operator stuck through a piece of a closed loop's run (:meth:`AlongStroke.conserve`):
+#: its force at the piece's end is its start plus the piece's ``k`` times the displacement to
+#: this fraction of the larger (the compiled step's rounding over a piece is ~1e-15 of it; a
+#: slip smaller than this is taken as none, its error as small).
+STUCK_RTOL = 1e-9
 #: The refusal of an open-loop system's link along the stroke (its runs hold the parameters).
 FIXED_IN_OPEN_LOOP = ("an open-loop system (predict, identify) runs its link with fixed "
                       "parameters: a link along the stroke ([hysteresis] along) is run in a "
@@ -117,17 +144,19 @@ class AlongStroke(Hysteresis):
             if v.shape != x.shape or not np.all(np.isfinite(v)) or np.any(v <= 0):
                 raise ValueError(f"the scales of {name} must be {x.size} positive values, one "
                                  "per position")
-            if name in base.never_slips and np.ptp(v) > 0:
-                raise ValueError(
-                    f"{name} of the {base.name} model is a spring that never slips: the "
-                    f"runs hold it piece by piece along the stroke (dw = k dx, k of the "
-                    f"piece), so its force drifts as the stage passes the pieces' edges (a "
-                    f"run drifts every period, a steady state has none); keep {name} "
-                    f"constant along the stroke and scale the parts that slip")
             self.scales[name] = v
         self.rate_independent = base.rate_independent
         self.parameters = base.parameters
         base.time_stepping()  # a model without a time-domain update is refused here
+        codes = self.time_stepping().codes
+        # the stop operators whose stiffness varies: k at the table's positions, and its
+        # integral from the first one (trapezoids: exact for the linear interpolation)
+        k = np.array([self.stepping_params(xi)[:, 0] for xi in x])
+        self._stops = np.flatnonzero((codes == STOP) & (np.ptp(k, axis=0) > 0))
+        self._k = k[:, self._stops]
+        self._K = np.vstack([np.zeros((1, self._stops.size)),
+                             np.cumsum(0.5 * (self._k[1:] + self._k[:-1]) * np.diff(x)[:, None],
+                                       axis=0)])
 
     def __repr__(self) -> str:
         return (f"AlongStroke({self.base!r}, position={self.position.tolist()}, "
@@ -221,6 +250,104 @@ class AlongStroke(Hysteresis):
             Position [m].
         """
         return self.at(x).time_stepping().params
+
+    @property
+    def varying_stops(self) -> NDArray[np.int64]:
+        """The rows of the elements (:meth:`time_stepping`) that are stop operators whose
+        stiffness varies along the table (advanced by :meth:`stiffness_integral`)."""
+        return self._stops
+
+    def stiffness_integral(self, x: ArrayLike) -> NDArray[np.float64]:
+        """``K(x) = integral of k(u) du`` from the table's first position to `x`, for each
+        of the :attr:`varying_stops`: the force a stop operator stuck at ``x_s`` gains moving
+        to `x` is ``K(x) - K(x_s)`` (the paper's eq. (3), ``dw = k_J(x) dx``, integrated).
+
+        Exact for the table's ``k``, linear between its positions and held beyond its ends.
+
+        Parameters
+        ----------
+        x : array_like
+            Positions [m].
+
+        Returns
+        -------
+        ndarray, shape ``x.shape + (len(varying_stops),)``
+            [N].
+
+        Examples
+        --------
+        A Jenkins element whose stiffness doubles from 10 to 20 N/m over 0.1 m:
+
+        >>> from motionhyst import Jenkins
+        >>> link = AlongStroke(Jenkins(10.0, 5.0), [0.0, 0.1], {"k": [1.0, 2.0]})
+        >>> K = link.stiffness_integral([0.0, 0.1, 0.2])[:, 0]
+        >>> [round(float(v), 12) for v in K]           # 1.5 N over the table, then 20 N/m
+        [0.0, 1.5, 3.5]
+        """
+        return self._integral(np.asarray(x, dtype=float), slice(None))
+
+    def _integral(self, x: NDArray[np.float64], columns) -> NDArray[np.float64]:
+        """:meth:`stiffness_integral` of the :attr:`varying_stops` `columns` selects."""
+        xp, k, K = self.position, self._k[:, columns], self._K[:, columns]
+        i = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, xp.size - 2)
+        u = (np.clip(x, xp[0], xp[-1]) - xp[i])[..., None]
+        slope = (k[i + 1] - k[i]) / (xp[i + 1] - xp[i])[..., None]
+        out = K[i] + u * (k[i] + 0.5 * slope * u)
+        out += k[0] * np.minimum(x - xp[0], 0.0)[..., None]
+        out += k[-1] * np.maximum(x - xp[-1], 0.0)[..., None]
+        return out
+
+    def conserve(self, s: NDArray[np.float64], s_start: NDArray[np.float64], y_start: float,
+                 y_end: float, params: NDArray[np.float64]) -> float:
+        """Set, in place, the force `s` at a piece's end of each of the :attr:`varying_stops`
+        that stuck through the piece to ``w_s + K(y_end) - K(y_start)``
+        (:meth:`stiffness_integral`), the piece having advanced it with its held ``k``.
+
+        A stop stuck through the piece where its force at the end is ``w_s + k (y_end -
+        y_start)`` to :data:`STUCK_RTOL` (a slip would have taken some of that off); the
+        conserved force is held within its slip force.
+
+        Parameters
+        ----------
+        s : ndarray
+            The elements' states at the piece's end (updated).
+        s_start : ndarray
+            Their states at its start.
+        y_start, y_end : float
+            The link's displacement at the piece's start and end (positions on the table) [m].
+        params : ndarray
+            The elements' parameter rows the piece was run with.
+
+        Returns
+        -------
+        float
+            The change of the link's force [N].
+
+        Examples
+        --------
+        A stop stuck at 0 N moved from 0 to 0.1 m with the piece's k = 15 N/m:
+
+        >>> from motionhyst import Jenkins
+        >>> link = AlongStroke(Jenkins(10.0, 5.0), [0.0, 0.1], {"k": [1.0, 2.0]})
+        >>> s = np.array([1.5 + 0.02])                 # as a piece with k = 15.2 N/m left it
+        >>> link.conserve(s, np.zeros(1), 0.0, 0.1, np.array([[15.2, 5.0, 0, 0, 0, 0]]))
+        -0.02...
+        >>> round(float(s[0]), 12)
+        1.5
+        """
+        rows = self._stops
+        if rows.size == 0 or y_end == y_start:
+            return 0.0
+        k, fc = params[rows, 0], params[rows, 1]
+        w0, w1 = s_start[rows], s[rows]
+        held = w0 + k * (y_end - y_start)
+        stuck = np.abs(w1 - held) <= STUCK_RTOL * np.maximum(np.abs(held), np.abs(w1))
+        if not np.any(stuck):
+            return 0.0
+        K = self.stiffness_integral(np.array([y_start, y_end]))
+        w = np.where(stuck, np.clip(w0 + (K[1] - K[0]), -fc, fc), w1)
+        s[rows] = w
+        return float(np.sum(w - w1))
 
     def pieces(self, x: ArrayLike) -> list[tuple[int, int]]:
         """Index ranges ``[i0, i1)`` of `x` within one :data:`STEPS_PER_INTERVAL`-th of the
@@ -328,8 +455,7 @@ class AlongStroke(Hysteresis):
                 raise RuntimeError(
                     f"the {self.base.name} link along the stroke ({self.key}) has no "
                     f"periodic force: its change from period to period ({change:.2g} N) does "
-                    "not shrink (a spring that does not slip, held piece by piece along the "
-                    "stroke, drifts); "
+                    "not shrink (its elements neither settle nor forget their start); "
                     "run it in time (simulate --time-series)")
             if len(changes) > 2 * STALL_PERIODS:
                 rest = _geometric_rest(changes[-STALL_PERIODS - 1:])
@@ -359,20 +485,48 @@ class AlongStroke(Hysteresis):
                              "uniformly spaced and increasing")
         return float(h)
 
+    def _groups(self) -> list[tuple[NDArray[np.int64], int]]:
+        """The elements' rows run together by :meth:`_runner`: ``(rows, j)`` with ``j`` the
+        column of :meth:`stiffness_integral` they run on (-1: on the position itself); the
+        :attr:`varying_stops` grouped by the shape of their stiffness along the table."""
+        n = self.time_stepping().codes.size
+        rest = np.setdiff1d(np.arange(n), self._stops)
+        groups = [(rest, -1)] if rest.size else []
+        shape = self._k / self._k[0]
+        left = list(range(self._stops.size))
+        while left:
+            j = left[0]
+            same = [c for c in left if np.allclose(shape[:, c], shape[:, j], rtol=1e-12, atol=0)]
+            groups.append((self._stops[same], j))
+            left = [c for c in left if c not in same]
+        return groups
+
     def _runner(self, x0: float, h: float):
         """``run(x, i0)``: the force of the samples `x` (indices from `i0`, step `h`), the
-        elements' state carried from call to call, starting at rest at `x0`."""
+        elements' state carried from call to call, starting at rest at `x0`.
+
+        The :attr:`varying_stops` run on ``K(x) / k(x_0)`` (:meth:`stiffness_integral`,
+        ``x_0`` the table's first position) with their stiffness at ``x_0``: their force
+        gains ``K(x_e) - K(x_s)`` while they stick (exact), the others' run on ``x``."""
         st = self.at(x0).time_stepping()
-        s = np.ascontiguousarray(st.state0, dtype=float).copy()
-        s_prev, scalars = s.copy(), np.zeros(2)
+        state = []
+        for rows, j in self._groups():
+            s = np.ascontiguousarray(st.state0[rows], dtype=float).copy()
+            state.append((rows, j, np.ascontiguousarray(st.codes[rows]), s, s.copy(),
+                          np.zeros(2)))
 
         def run(x: NDArray[np.float64], i0: int) -> NDArray[np.float64]:
-            out = np.empty(x.size)
+            out = np.zeros(x.size)
             for a, b in self.pieces(x):
-                piece = x[a:b]
-                params = np.ascontiguousarray(self.stepping_params(float(np.mean(piece))))
-                out[a:b] = open_loop_calls(st.codes, params, s, s_prev, scalars, piece, h,
-                                           i0 + a, GL_T, GL_W)
+                params = self.stepping_params(float(np.mean(x[a:b])))
+                for rows, j, codes, s, s_prev, scalars in state:
+                    p = np.ascontiguousarray(params[rows])
+                    piece = x[a:b]
+                    if j >= 0:  # the position stretched by the stiffness' scale
+                        p[:, 0] = self._k[0, np.searchsorted(self._stops, rows)]
+                        piece = self._integral(piece, slice(j, j + 1))[:, 0] / self._k[0, j]
+                    out[a:b] += open_loop_calls(codes, p, s, s_prev, scalars, piece, h, i0 + a,
+                                                GL_T, GL_W)
             return out
 
         return run

@@ -49,10 +49,6 @@ class Hysteresis(ABC):
     defines_zeta : bool
         True if the model defines the paper's ``zeta = fc / (k A)`` (eq. 4)
         through :meth:`zeta`.
-    never_slips : tuple of str
-        The parameters of a spring that never slips (its force updated by ``k dx``): a
-        link along the stroke keeps them constant
-        (:class:`~motionhyst.hysteresis.along_stroke.AlongStroke`).
 
     Examples
     --------
@@ -74,7 +70,6 @@ class Hysteresis(ABC):
     rate_independent: ClassVar[bool] = True
     parameters: ClassVar[tuple[Parameter, ...]] = ()
     defines_zeta: ClassVar[bool] = False
-    never_slips: ClassVar[tuple[str, ...]] = ()
 
     @property
     @abstractmethod

@@ -241,7 +241,6 @@ class MaxwellIwan(Hysteresis):
     """
 
     name = "maxwell-iwan"
-    never_slips = ("k0",)
     rate_independent = False
     parameters = (
         Parameter("k0", "N/m", "stiffness k0 of the parallel spring", kind="nonnegative",

@@ -663,14 +663,24 @@ def run_sampled(plant, link, controller, r: ArrayLike, *, ff: ArrayLike | None =
     # SAMPLED_SAMPLE_BYTES), not again in its pieces
     out: list[NDArray[np.float64]] = []
     rows, worst, done = [0, 0, 0], 0, 0
+    y_end = None  # the link's displacement at the last piece's end
     for k0, k1 in pieces:
         if isinstance(link, AlongStroke):
             stepping.params[:] = link.stepping_params(float(np.mean(rr[k0:k1])))
+            s_start = state.s.copy()
         ctrl = (Ac, Bc, Cc, Dc, rr[k0:k1], fff[k0:k1], float(u_max), R, r1, 0, n_delay)
         Yp, _, Wp, Up, worst_p, done_p = run_steps(
             steps, Cout, np.zeros(3), 1, stepping, a[k0 * R:k1 * R + 1], state, vel_row=2,
             convention=OPEN, ftol=1e-13 * stepping.scale, record_every=R,
             record_initial=k0 == 0, controller=ctrl)
+        if isinstance(link, AlongStroke) and len(Yp):
+            # its stop operators' stiffness conserved where they stuck through the piece
+            y_start = Yp[0, 1] if y_end is None else y_end
+            y_end = float(Yp[-1, 1])
+            dw = link.conserve(state.s, s_start, y_start, y_end, stepping.params)
+            if dw:
+                state.scal[0] += dw  # the force at the node the next step starts from
+                Wp[-1] += dw
         for i, p in enumerate((Yp, Wp, Up)):
             if len(pieces) == 1:
                 out.append(p)

@@ -260,15 +260,26 @@ def _along_stroke(engine: _Engine, t: NDArray[np.float64], h_foh: float) -> Simu
 def _in_pieces(engine: _Engine, t: NDArray[np.float64], i0: int, h_foh: float,
                r: NDArray[np.float64] | None = None) -> Simulation:
     """``engine.run`` of the samples `t` (indices from `i0`), a link along the stroke updated
-    between its pieces of the setpoint `r` (``reference(t)`` if not given)."""
+    between its pieces of the setpoint `r` (``reference(t)`` if not given), its stop
+    operators' stiffness conserved at each piece's end (:meth:`AlongStroke.conserve`: the
+    state carried and the piece's last record)."""
     link = engine.loop.hysteresis
     if not isinstance(link, AlongStroke):
         return engine.run(t, i0, h_foh)
     r = np.asarray(engine.reference(t)[0], dtype=float) if r is None else r
     parts = []
+    state = engine.state
     for a, b in link.pieces(r):
         engine.stepping.params[:] = link.stepping_params(float(np.mean(r[a:b])))
-        parts.append(engine.run(t[a:b], i0 + a, h_foh))
+        s_start = state.s.copy()
+        part = engine.run(t[a:b], i0 + a, h_foh)
+        y_start = part.y1[0] if engine.y1_end is None else engine.y1_end
+        engine.y1_end = float(part.y1[-1])
+        dw = link.conserve(state.s, s_start, y_start, engine.y1_end, engine.stepping.params)
+        if dw:
+            state.scal[0] += dw  # the force at the node the next step starts from
+            part.w[-1] += dw
+        parts.append(part)
     return Simulation(**{c: np.concatenate([getattr(p, c) for p in parts])
                          for c in ("t", "r", "e", "y1", "y2", "u", "w", "e_linear")})
 
@@ -414,6 +425,7 @@ class _Engine:
                                  self.f_scale)
         self.state = LoopState.at_rest(Ad.shape[0], self.stepping)
         self.r_prev = None
+        self.y1_end = None  # the link's position at the last sample run
         self.uh_prev = 0.0
         self.hff_history = np.empty(0)
         if self.hff is not None and not self.hff.rate_independent:
