@@ -108,3 +108,22 @@ def test_an_iteration_left_unfinished_is_called_slow():
     stalled = Progress(50)
     assert all(stalled.more(it, 1e-6) for it in range(1, 50))
     assert not stalled.more(50, 1e-6)
+
+
+def test_a_link_along_the_stroke_sticks_as_its_base_model():
+    # the stiffness and damping while it sticks, and the viscous part, read from the model's
+    # attributes: a LuGre along the stroke with unit scales is the plain LuGre (main gave
+    # it no sigma1 in the chord and no sigma2 in the linear part: it named classes); a table
+    # that scales sigma1 and sigma2 gives the largest along it
+    from motionhyst.analysis._fixed_point import sticking, viscous_damping
+    from motionhyst.hysteresis import Coulomb
+    from motionhyst.hysteresis.along_stroke import AlongStroke
+
+    link = LuGre(sigma0=1e5, sigma1=316.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
+    unit = AlongStroke(link, [0.0, 0.1], {"fc": [1.0, 1.0]})
+    assert sticking(unit) == sticking(link) == (1e5, pytest.approx(316.4))
+    assert viscous_damping(unit) == viscous_damping(link) == pytest.approx(0.4)
+    scaled = AlongStroke(link, [0.0, 0.1], {"sigma1": [1.0, 2.0], "sigma2": [0.5, 1.5]})
+    assert sticking(scaled)[1] == pytest.approx(2 * 316.0 + 1.5 * 0.4)
+    coulomb = Coulomb(fc_pos=1.0, fc_neg=2.0, c_pos=3.0, c_neg=5.0)
+    assert viscous_damping(coulomb) == 4.0

@@ -175,15 +175,11 @@ def sticking(link) -> tuple[float, float]:
 
 
 def viscous_damping(link) -> float:
-    """The part of a link's force linear in its velocity at every amplitude [N s/m]: LuGre's
-    ``sigma2``, the mean of an asymmetric Coulomb link's ``c_pos`` and ``c_neg``; 0 else."""
-    if link is None:
-        return 0.0
-    if type(link).__name__ == "LuGre":
-        return float(link.sigma2)
-    if type(link).__name__ == "Coulomb":
-        return 0.5 * float(link.c_pos + link.c_neg)
-    return 0.0
+    """The part of a link's force linear in its velocity at every amplitude [N s/m]: its
+    :attr:`~motionhyst.hysteresis.base.Hysteresis.viscous_damping` (LuGre's ``sigma2``, the
+    mean of an asymmetric Coulomb link's ``c_pos`` and ``c_neg``; along the stroke, the
+    largest along the table); 0 without a link."""
+    return 0.0 if link is None else float(link.viscous_damping)
 
 
 def _damping_words(link, solved: bool, omega: float = np.inf) -> str:

@@ -205,7 +205,39 @@ class AlongStroke(Hysteresis):
     @property
     def initial_stiffness(self) -> float:
         """The largest initial stiffness along the table [N/m]."""
-        return max(self.at(x).initial_stiffness for x in self.position)
+        return self._largest("initial_stiffness")
+
+    @property
+    def bristle_damping(self) -> float:
+        """The largest :attr:`~motionhyst.hysteresis.base.Hysteresis.bristle_damping` along
+        the table [N s/m] (the base model's, LuGre's ``sigma1``, scaled).
+
+        Examples
+        --------
+        >>> from motionhyst import LuGre
+        >>> lugre = LuGre(sigma0=1e5, sigma1=316.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
+        >>> AlongStroke(lugre, [0.0, 0.1], {"fc": [1.0, 2.0]}).bristle_damping
+        316.0
+        """
+        return self._largest("bristle_damping")
+
+    @property
+    def viscous_damping(self) -> float:
+        """The largest :attr:`~motionhyst.hysteresis.base.Hysteresis.viscous_damping` along
+        the table [N s/m] (the base model's, scaled).
+
+        Examples
+        --------
+        >>> from motionhyst import LuGre
+        >>> lugre = LuGre(sigma0=1e5, sigma1=316.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3)
+        >>> AlongStroke(lugre, [0.0, 0.1], {"sigma2": [1.0, 0.5]}).viscous_damping
+        0.4
+        """
+        return self._largest("viscous_damping")
+
+    def _largest(self, attribute: str) -> float:
+        """The largest value of the base model's `attribute` at the table's positions."""
+        return max(float(getattr(self.at(x), attribute)) for x in self.position)
 
     def describing_function(self, A, omega=None):
         """Not defined: the link's parameters change with the position.

@@ -173,6 +173,20 @@ class Hysteresis(ABC):
         """
         return 0.0
 
+    @property
+    def viscous_damping(self) -> float:
+        """The part of the model's force linear in its velocity at every amplitude [N s/m]:
+        LuGre's ``sigma2``, the mean of an asymmetric Coulomb link's ``c_pos`` and ``c_neg``;
+        0 for a model without one.
+
+        Examples
+        --------
+        >>> from motionhyst.hysteresis import Jenkins
+        >>> Jenkins(k=20.0, fc=0.05).viscous_damping
+        0.0
+        """
+        return 0.0
+
     def state_equation(self, z: ArrayLike, v: float):
         """The model as a smooth state equation ``z' = f(z, v)``, ``w = h(z, v)`` with its
         derivatives (see :meth:`motionhyst.hysteresis.LuGre.state_equation`).

@@ -118,6 +118,18 @@ class Coulomb(Hysteresis):
         return cls(fc_pos=fc_pos, fc_neg=fc_neg, c_pos=c_pos, c_neg=c_neg)
 
     @property
+    def viscous_damping(self) -> float:
+        """The mean of ``c_pos`` and ``c_neg`` [N s/m]: the part of the viscous force by
+        direction that is linear in the velocity.
+
+        Examples
+        --------
+        >>> Coulomb(fc_pos=20.1, fc_neg=20.6, c_pos=166.7, c_neg=240.4).viscous_damping
+        203.55
+        """
+        return 0.5 * float(self.c_pos + self.c_neg)
+
+    @property
     def symmetric(self) -> bool:
         """True for equal slip forces and no viscous terms (``fc`` alone)."""
         return self.fc_pos == self.fc_neg and self.c_pos == 0.0 and self.c_neg == 0.0

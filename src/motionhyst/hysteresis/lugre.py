@@ -519,6 +519,17 @@ class LuGre(Hysteresis):
         """
         return float(self.sigma1)
 
+    @property
+    def viscous_damping(self) -> float:
+        """``sigma2`` [N s/m]: the viscous part of the force, ``sigma2 v``, at every amplitude.
+
+        Examples
+        --------
+        >>> LuGre(sigma0=1e5, sigma1=316.0, sigma2=0.4, fc=1.0, fs=1.5, vs=1e-3).viscous_damping
+        0.4
+        """
+        return float(self.sigma2)
+
     def rates(self, z: ArrayLike, v: float) -> tuple[float, float]:
         """``z'`` and ``w`` of :meth:`state_equation` without its derivatives, in scalar
         arithmetic: a run in time evaluates them at every step
