@@ -219,8 +219,12 @@ def test_the_driven_run_agrees_with_the_exact_steady_state_of_table_i():
     """Table I (a leadlag-lowpass controller, rigid-body feedforward, the stage's two bodies:
     the error is not ``r - y1``) with a LuGre link whose fixed point converges: the driven run
     from rest follows the reference after 3 periods, and its error's first harmonic agrees
-    with the exact steady state's, an independent computation, to 6e-7 at 5 Hz and 2.2e-6 at
-    20 Hz (measured; ``r - y1`` would be 11 % and 23 % off)."""
+    with the exact steady state's, an independent computation (``r - y1`` would be 11 % and
+    23 % off).  Run at 1/100 of RUN_RTOL it agrees to 2e-7 at 5 Hz and 3.4e-7 at 20 Hz
+    (measured), asserted to 1e-5.  At RUN_RTOL itself (the hunting refusal's run) its error
+    is the integration's: 6e-7 and 2.2e-6 here, but 4e-5 to 6.5e-5 at 20 Hz where the
+    right-hand side's arithmetic rounds otherwise, and 6e-6 at 1e-7: asserted to 1e-4."""
+    from motionhyst.analysis.hunting import RUN_RTOL
     from motionhyst.analysis.steady import periodic_steady_state
     from motionhyst.scenario import Scenario
 
@@ -229,9 +233,12 @@ def test_the_driven_run_agrees_with_the_exact_steady_state_of_table_i():
     loop = Scenario.from_dict({**_table_i(), "hysteresis": model}, "p.toml").loop()
     for f in (5.0, 20.0):
         exact = abs(periodic_steady_state(loop, 0.01, f).e[1])
+        fine = driven_run(loop, 0.01, f, 0.7 / f, rtol=RUN_RTOL / 100)
+        assert fine.verdict == "follows"
+        assert fine.e1 == pytest.approx(exact, rel=1e-5)
         driven = driven_run(loop, 0.01, f, 0.7 / f)
         assert driven.verdict == "follows"
-        assert driven.e1 == pytest.approx(exact, rel=1e-5)
+        assert driven.e1 == pytest.approx(exact, rel=1e-4)
 
 
 def _table_i() -> dict:

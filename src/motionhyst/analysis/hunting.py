@@ -314,7 +314,8 @@ def _series_derivatives(num: NDArray, den: NDArray, count: int) -> NDArray:
     return out
 
 
-def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) -> DrivenRun:
+def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float, *,
+               rtol: float = RUN_RTOL) -> DrivenRun:
     """Run the loop driven by ``r = amplitude sin(2 pi frequency_hz t)`` in time from rest and
     say whether it follows the reference's period or hunts at the rhythm of its own cycle
     of period `cycle` [s] (:func:`hunting_period`): :class:`DrivenRun`.
@@ -342,6 +343,8 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
         Reference frequency [Hz], > 0.
     cycle : float
         The period of the loop's own cycle [s], > 0.
+    rtol : float
+        The run's relative tolerance (:data:`RUN_RTOL`; a tighter one for a reference).
 
     Returns
     -------
@@ -380,7 +383,7 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
         raise ValueError("a run of the driven loop needs a continuous LTI loop, a link with a "
                          "smooth state equation and no hysteresis or Coulomb feedforward")
     for name, value in (("amplitude", amplitude), ("frequency", frequency_hz),
-                        ("cycle", cycle)):
+                        ("cycle", cycle), ("rtol", rtol)):
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be finite and > 0, got {value!r}")
     A, f = float(amplitude), float(frequency_hz)
@@ -395,7 +398,7 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
     X = np.zeros(sys.N)
     X[:sys.n] = np.linalg.solve(obs, rest - steady)
     _, scale = _start(sys, A)
-    atol = RUN_RTOL * 1e-2 * np.maximum(scale, 1e-300)
+    atol = rtol * 1e-2 * np.maximum(scale, 1e-300)
     TV = A * T * 1j * omega
     # the error: its linear response to the reference, and C_e x with C_e matching the Markov
     # parameters of T_{w->e} (the input of the realisation is -w): C_e A^k B = -h_k
@@ -430,7 +433,7 @@ def driven_run(loop: Loop, amplitude: float, frequency_hz: float, cycle: float) 
     while k * period / split < length * (1.0 - 1e-12):
         t0, t1 = k * period / split, (k + 1) * period / split
         try:
-            sol = solve_ivp(rhs, (t0, t1), X, method="LSODA", jac=jac, rtol=RUN_RTOL,
+            sol = solve_ivp(rhs, (t0, t1), X, method="LSODA", jac=jac, rtol=rtol,
                             atol=atol, dense_output=True)
         except _Exhausted:
             break
