@@ -53,19 +53,26 @@ def _harmonics_in_time(loop: Loop, periods: int = 6, n: int = 8000) -> np.ndarra
     return 2j * np.fft.rfft(e)[:8] / n
 
 
-@pytest.mark.parametrize("name", list(LINKS))
-def test_steady_state_along_the_stroke_is_the_run_in_time(stage, controller, name):
-    # the link's part of the error, e - e_linear, at harmonics 1 and 3: the steady state
-    # (the table followed at the stage's position) against the last of 6 periods of a run
-    # from rest (the table followed at the setpoint, within the tracking error); main gave
-    # LuGre's the linear loop's (the link's part 0, where the run has 3.9e-8 m)
-    loop = Loop(stage, controller, _along(name))
+def steady_is_run(loop: Loop) -> tuple[np.ndarray, complex]:
+    """Assert that the loop's exact steady state at ``A sin(2 pi F t)`` is the last of 6
+    periods of its run from rest: the link's part of the error, ``e - e_linear``, at
+    harmonics 1 and 3 to 2e-3 of it; the run's harmonics and that part returned."""
     ss = periodic_steady_state(loop, A, F)
     run = _harmonics_in_time(loop)
     link_part = ss.e[1] - ss.e_linear[1]
     assert abs(link_part) > 1e-9
     assert abs(ss.e[1] - run[1]) < 2e-3 * abs(link_part)
     assert abs(ss.e[3] - run[3]) < 2e-3 * abs(link_part)
+    return run, link_part
+
+
+@pytest.mark.parametrize("name", list(LINKS))
+def test_steady_state_along_the_stroke_is_the_run_in_time(stage, controller, name):
+    # the link's part of the error, e - e_linear, at harmonics 1 and 3: the steady state
+    # (the table followed at the stage's position) against the last of 6 periods of a run
+    # from rest (the table followed at the setpoint, within the tracking error); main gave
+    # LuGre's the linear loop's (the link's part 0, where the run has 3.9e-8 m)
+    run, link_part = steady_is_run(Loop(stage, controller, _along(name)))
     # the table matters: the base link alone is 10 % or more off
     base = periodic_steady_state(Loop(stage, controller, LINKS[name][0]), A, F)
     assert abs(base.e[1] - run[1]) > 0.1 * abs(link_part)
@@ -196,12 +203,7 @@ def test_a_spring_that_never_slips_scaled_along_the_stroke_is_run():
     loop = _sampled_scenario(None, "maxwell-iwan",
                              table={"position": POSITION, "k0": [0.5, 2.0]}).loop()
     assert loop.hysteresis.at(A).k0 == pytest.approx(2.0 * LINKS["maxwell-iwan"][0].k0)
-    ss = periodic_steady_state(loop, A, F)
-    run = _harmonics_in_time(loop)
-    link_part = ss.e[1] - ss.e_linear[1]
-    assert abs(link_part) > 1e-9
-    assert abs(ss.e[1] - run[1]) < 2e-3 * abs(link_part)
-    assert abs(ss.e[3] - run[3]) < 2e-3 * abs(link_part)
+    steady_is_run(loop)
 
 
 def test_sampled_loop_runs_a_rate_dependent_feedforward_over_its_samples():
