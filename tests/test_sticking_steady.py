@@ -127,3 +127,11 @@ def test_a_link_along_the_stroke_sticks_as_its_base_model():
     assert sticking(scaled)[1] == pytest.approx(2 * 316.0 + 1.5 * 0.4)
     coulomb = Coulomb(fc_pos=1.0, fc_neg=2.0, c_pos=3.0, c_neg=5.0)
     assert viscous_damping(coulomb) == 4.0
+    # and a refusal names the same dampings (main: none for the link along the stroke)
+    from motionhyst.analysis._fixed_point import _damping_words
+
+    words = ("viscous friction sigma2 = 0.4 N s/m and bristle damping sigma1 = 316 N s/m "
+             "(while it sticks)")
+    assert _damping_words(unit, False, 1e9) == _damping_words(link, False, 1e9) == words
+    assert _damping_words(unit, True, 1.0) == ""          # solved; below sigma0 / sigma1
+    assert _damping_words(coulomb, False) == "viscous friction c_pos = 3, c_neg = 5 N s/m"

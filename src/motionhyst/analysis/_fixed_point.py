@@ -187,17 +187,19 @@ def _damping_words(link, solved: bool, omega: float = np.inf) -> str:
     frequency `omega` [rad/s], for a refusal (empty for a link without any; its
     :func:`viscous_damping` left out where it is `solved` with the loop; LuGre's bristle
     damping only where ``omega sigma1`` exceeds the bristles' stiffness ``sigma0``: below, the
-    stiffness is what the loop amplifies)."""
-    name = type(link).__name__
+    stiffness is what the loop amplifies).  Read from the model's attributes (a link along
+    the stroke's largest along its table), its keys from its base model's."""
+    model = getattr(link, "base", link)
     words = []
-    if name == "LuGre":
-        if link.sigma2 and not solved:
-            words.append(f"viscous friction sigma2 = {link.sigma2:.4g} N s/m")
-        if link.sigma1 and omega * link.sigma1 >= link.sigma0:
-            words.append(f"bristle damping sigma1 = {link.sigma1:.4g} N s/m (while it sticks)")
-    elif name == "Coulomb" and (link.c_pos or link.c_neg) and not solved:
-        words.append(f"viscous friction c_pos = {link.c_pos:.4g}, c_neg = {link.c_neg:.4g} "
-                     f"N s/m")
+    if hasattr(model, "c_pos"):
+        if (model.c_pos or model.c_neg) and not solved:
+            words.append(f"viscous friction c_pos = {model.c_pos:.4g}, c_neg = "
+                         f"{model.c_neg:.4g} N s/m")
+    elif link.viscous_damping and not solved:
+        words.append(f"viscous friction sigma2 = {link.viscous_damping:.4g} N s/m")
+    sigma1 = link.bristle_damping
+    if sigma1 and omega * sigma1 >= link.initial_stiffness:
+        words.append(f"bristle damping sigma1 = {sigma1:.4g} N s/m (while it sticks)")
     return " and ".join(words)
 
 
