@@ -402,7 +402,8 @@ class AlongStroke(Hysteresis):
     def response(self, x: ArrayLike, w0: float = 0.0, t: ArrayLike | None = None
                  ) -> NDArray[np.float64]:
         """Force for the displacement samples `x` from rest, the parameters updated between
-        :meth:`pieces` at each one's mean position.
+        :meth:`pieces` at each one's mean position, the :attr:`varying_stops` advanced on
+        :meth:`stiffness_integral` (exact: the module docstring).
 
         Parameters
         ----------
@@ -426,8 +427,10 @@ class AlongStroke(Hysteresis):
 
         The period is sampled as :meth:`Hysteresis.periodic_harmonics` samples it and
         run from rest, period after period, the parameters updated between
-        :meth:`pieces` as in a time run, until a period's force repeats the previous
-        one to :data:`PERIODIC_RTOL` of its largest value.
+        :meth:`pieces` as in a time run (the :attr:`varying_stops` on
+        :meth:`stiffness_integral`: a stop that never slips repeats its force exactly), until
+        a period's force repeats the previous one to :data:`PERIODIC_RTOL` of its largest
+        value.
 
         Parameters
         ----------
