@@ -124,11 +124,13 @@ def test_sampled_run_follows_the_table_as_the_continuous_run():
     assert np.max(np.abs(first.e - first.e_linear - ref)) > 0.3 * peak
 
 
-@pytest.mark.parametrize("name", ["jenkins", "lugre"])
-def test_sampled_steady_state_along_the_stroke_is_the_sampled_run(name):
+@pytest.mark.parametrize("name, table", [("jenkins", None), ("lugre", None),
+                                         ("jenkins", {"position": POSITION, "k": [0.5, 2.0]})])
+def test_sampled_steady_state_along_the_stroke_is_the_sampled_run(name, table):
     # the hybrid loop's steady state against the last of 6 periods of its run in time, at
-    # the controller's samples (10 kHz: 2000 a period)
-    loop = _sampled_scenario(10e3, name).loop()
+    # the controller's samples (10 kHz: 2000 a period); a stiffness along the stroke too
+    # (the steady state's stops on the integral of k, the run's set at its pieces' ends)
+    loop = _sampled_scenario(10e3, name, table).loop()
     ss = periodic_steady_state(loop, A, F)
     sim = simulate(loop, SineReference(A, F), 6 / F)
     n = 2000
