@@ -258,18 +258,22 @@ def run_input_output(args: argparse.Namespace) -> int:
         if note is not None:
             warn(note)
     from motionhyst.identify.input_output import identify_io
+    from motionhyst.identify.io_budget import EvaluationBudget
 
-    extras = ({"offset": args.offset or "auto", "max_evaluations": args.max_evaluations}
+    # the warnings above are shown once the search's plan passes its evaluation budget: a
+    # refusal of the plan (a --max-evaluations below its least) is one line
+    budget = EvaluationBudget(args.max_evaluations, planned=release_held)
+    extras = ({"offset": args.offset or "auto", "max_evaluations": budget}
               if bouc_wen_own else
               {"offset": args.offset or "auto", "from_rest": args.from_rest,
-               "max_evaluations": args.max_evaluations, "init_window": args.init_window,
+               "max_evaluations": budget, "init_window": args.init_window,
                "asymmetric": True if args.asymmetric else (False if args.symmetric else None),
                "drift": args.drift,
                "fewer_elements": args.elements is None, "rigid_limit": True})
     from motionhyst.identify.io_checks import FitFailed
 
     try:  # the fit's warnings wait for its judgement: a refusal is one line
-        with search_budget(), warnings.catch_warnings(record=True) as held:
+        with search_budget(release=False), warnings.catch_warnings(record=True) as held:
             warnings.simplefilter("always")
             if unit_slip:  # the fit's own line on the mass's size says it again
                 warnings.filterwarnings("ignore", message=r".* kg, outside the usual .* of "
@@ -460,13 +464,15 @@ SEARCH_REMEDY = "give a shorter record or fewer --max-evaluations, or a larger -
 """What a user can change when identify's search runs out of its work budget."""
 
 
-def search_budget():
+def search_budget(release: bool = True):
     """The work budget of identify's search, a context around the fit alone: no formula sizes
     a search that stops when it converges, so it is stopped after ``--max-seconds`` of CPU
     time (:func:`motionhyst.core.budget.cpu_time_limit`), exit 2, nothing saved.  The search
     is the command's work: the warnings held while its input was checked are shown as it
-    starts."""
+    starts (here, or with `release` False where its plan passes: an input-output search's
+    evaluation budget, :class:`~motionhyst.identify.io_budget.EvaluationBudget`)."""
     from motionhyst.core.budget import cpu_time_limit, max_seconds
 
-    release_held()
+    if release:
+        release_held()
     return cpu_time_limit(max_seconds(), "identify", SEARCH_REMEDY)

@@ -215,7 +215,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
                 tol: float = 1e-12, max_nfev: int = 60, n_elements: int = 4,
                 start_nfev: int | None = None, plant: Plant | type | str = MassSpringDamper,
                 output: str | None = None, offset: str = "auto", from_rest: bool = False,
-                max_evaluations: int | None = None, init_window: int | None = None,
+                max_evaluations: int | EvaluationBudget | None = None,
+                init_window: int | None = None,
                 asymmetric: bool | None = None, drift: bool = False,
                 fewer_elements: bool = False, rigid_limit: bool = False,
                 rigid: IOIdentification | None = None, checked: bool = False
@@ -318,11 +319,12 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
     from_rest : bool
         The records start at rest; otherwise each record's initial velocity (and
         position, on a spring) is estimated (the element links).
-    max_evaluations : int, optional
+    max_evaluations : int or EvaluationBudget, optional
         The search's whole budget of model evaluations: every start, profile point,
         Coulomb fit a friction link starts from, refinement and the standard errors'
         evaluations, and a refit with fewer elements, together
-        (:class:`~motionhyst.identify.io_budget.EvaluationBudget`).
+        (:class:`~motionhyst.identify.io_budget.EvaluationBudget`; one given is charged,
+        and told when the search starts).
     init_window : int, optional
         The element links: each record's initial state (and a floating stage's
         position offset) is not estimated but set, at every step of the search,
@@ -435,7 +437,8 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         if not checked:
             check_inertia(records)
             check_one_stage(records, shape.floating, single_mass=shape.n == 1)
-    fewer, budget = None, EvaluationBudget(max_evaluations)  # the whole search's, refits too
+    fewer, budget = None, (max_evaluations if isinstance(max_evaluations, EvaluationBudget)
+                           else EvaluationBudget(max_evaluations))  # the whole search's, refits
     why: dict[int, str] = {}  # why a Maxwell-slip fit of so many elements was given up
     while True:
         try:
@@ -522,6 +525,7 @@ def _route(records: list[IORecord], link: type[Hysteresis], stage: Plant, *, per
         if init_window is not None:
             raise ValueError("a stage without inertia has no state for an initialisation "
                              "window to set")
+        max_evaluations.charge(0)  # no plan of starts: the search starts here
         fit = identify_quasi_static_io(records, link, periodic=periodic,
                                        n_elements=n_elements, offset=offset,
                                        max_evaluations=max_evaluations.left, tol=tol,

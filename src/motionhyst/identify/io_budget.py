@@ -46,6 +46,11 @@ class EvaluationBudget:
     ----------
     limit : int, optional
         The most evaluations in all; None: no limit (only counted).
+    planned : callable, optional
+        Called once, with no arguments, when the search's plan has passed
+        (:meth:`plan_starts`) or its first evaluation is charged: the search starts (the
+        ``identify`` command then shows the warnings it held while it checked the records,
+        so a refusal of the plan is one line).
 
     Examples
     --------
@@ -60,15 +65,30 @@ class EvaluationBudget:
     share spent
     >>> budget.used, budget.left
     (7, 3)
+    >>> said = EvaluationBudget(20, planned=lambda: print("the search starts"))
+    >>> try:                           # refused before it starts: nothing said
+    ...     said.plan_starts(4, 10)
+    ... except ValueError:
+    ...     print("refused")
+    refused
+    >>> said.charge()
+    the search starts
     """
 
-    def __init__(self, limit: int | None = None) -> None:
+    def __init__(self, limit: int | None = None,
+                 planned: Callable[[], object] | None = None) -> None:
         if limit is not None and not (isinstance(limit, int | np.integer) and limit >= 1):
             raise ValueError(f"a budget of model evaluations is a whole number >= 1, got "
                              f"{limit!r}")
         self.limit = None if limit is None else int(limit)
         self.used = 0
         self._stop = self.limit
+        self._planned = planned
+
+    def _start(self) -> None:
+        planned, self._planned = self._planned, None
+        if planned is not None:
+            planned()
 
     @property
     def left(self) -> int | None:
@@ -97,6 +117,7 @@ class EvaluationBudget:
         """
         if self._stop is not None and self.used + n > self._stop:
             raise BudgetSpent(f"{n} more model evaluations past the budget")
+        self._start()
         self.used += n
 
     def plan_starts(self, n_fits: int, per_step: int, seeded: bool = False, runs: int = 0
@@ -160,6 +181,7 @@ class EvaluationBudget:
                              f"{' (one for the Coulomb fit it also starts from)' if seeded else ''}"
                              f", {per_step} for each of two steps of its refinement and 2 to "
                              f"choose its start")
+        self._start()
         return final, self._shares(n_fits, None if left is None else
                                    runs + (left - final - runs) // (3 if seeded else 2))
 
