@@ -25,10 +25,6 @@ __all__ = ["best_linear_approximation", "best_linear_approximation_two_mass", "e
            "reference_mass"]
 
 BLA_STARTS = 6  # two-mass: grid points refined
-#: A two-mass stage whose lighter mass is below this share of the other is one mass (the
-#: records' best fit ends there when they do not determine a second one:
-#: :func:`best_linear_approximation_two_mass`)
-MASS_RATIO = 0.01
 #: The fewest lines of the records' frequency response a two-mass stage is fitted to: its
 #: linear model (``m1, m2, b, k`` and the link's ``kl, cl``) has 6 parameters, and 4 complex
 #: lines give 8 numbers, more than it takes to pass through them
@@ -342,13 +338,17 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
     Raises
     ------
     ValueError
-        One line when the best fit's internal mode (``sqrt(k (m1 + m2) / (m1 m2))``) is
-        above the records' Nyquist frequency, or one of its masses below
-        :data:`MASS_RATIO` of the other: their masses move as one, the records are a single
-        mass's (a two-mass fit would spend its search on parameters the records do not
-        determine: a 10 kg axis's record, its best fit 0.0098 and 9.8 kg, ran to the work
-        budget); or when the records excite fewer than :data:`TWO_MASS_LINES` lines, too
-        few to determine a two-mass stage at all.
+        One line when the records do not determine a second mass: the best fit's internal
+        mode (``sqrt(k (m1 + m2) / (m1 m2))``) above the records' Nyquist frequency, or
+        outside the band of the lines they excite (its resonance is not in them), or the
+        lighter mass's standard error (from the fit's Jacobian and residual) as large as
+        its value.  Their masses then move as one, the records are a single mass's (a
+        two-mass fit would spend its search on parameters the records do not determine: a
+        10 kg axis's record, its best fit 0.0098 and 9.8 kg with its mode at 314 Hz beside
+        lines of 1-4.25 Hz, ran to the work budget), however light or heavy a second mass
+        is (a 0.5 kg carriage on a 60 kg stage whose mode the records excite is
+        determined).  Also when the records excite fewer than :data:`TWO_MASS_LINES`
+        lines, too few to determine a two-mass stage at all.
 
     Examples
     --------
@@ -424,13 +424,21 @@ def best_linear_approximation_two_mass(records: list[IORecord], output: str = "y
                          f"that fits their frequency response best has its internal mode at "
                          f"{f_internal:.3g} Hz, above their Nyquist frequency {nyquist:.3g} Hz; "
                          f"identify a single mass (--plant mass-spring-damper or mass-damper)")
-    if min(m1, m2) < MASS_RATIO * max(m1, m2):  # one mass and a vanishing one
+    # the lighter mass's relative standard error: of its log, from the fit's Jacobian
+    dof = max(sol.fun.size - sol.x.size, 1)
+    cov = 2.0 * sol.cost / dof * np.linalg.pinv(sol.jac.T @ sol.jac)
+    light = 0 if m1 <= m2 else 1
+    std = math.sqrt(max(float(cov[light, light]), 0.0))
+    why = (f"has its internal mode at {f_internal:.3g} Hz, outside the band of the lines they "
+           f"excite ({f[0]:.3g}-{f[-1]:.3g} Hz)" if not f[0] <= f_internal <= f[-1] else
+           f"has its lighter mass's standard error {std:.2g} times its value"
+           if not std < 1.0 else None)
+    if why is not None:  # the masses' split is not in the records
         raise ValueError(f"{names}: the records show one mass, not two: the two-mass stage "
-                         f"that fits their frequency response best has masses of {m1:.3g} and "
-                         f"{m2:.3g} kg, one below {MASS_RATIO:g} of the other: a second mass "
-                         f"is not determined; identify a single mass (--plant "
-                         f"mass-spring-damper or mass-damper), or give a record that excites "
-                         f"the internal mode")
+                         f"that fits their frequency response best (masses of {m1:.3g} and "
+                         f"{m2:.3g} kg) {why}: a second mass is not determined; identify a "
+                         f"single mass (--plant mass-spring-damper or mass-damper), or give a "
+                         f"record that excites the internal mode")
     return TwoMass(m1, m2, b, k, output), float(kl), float(cl)
 
 
