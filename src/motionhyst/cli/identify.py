@@ -456,6 +456,15 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     refuse_repeated([(path, t, (x, w)) for path, t, x, w in records])
     _check_forces_follow(records)  # light: before the fit's sizes load its libraries
     check([t.size for _, t, _, _ in records])  # before the mass check and the starts
+    from motionhyst.identify.determinacy import check_samples_per_parameter
+    from motionhyst.identify.fd_memory import link_force_parameters
+
+    names = ", ".join(str(p) for p in paths)
+    try:  # a record too short for the model: no search
+        check_samples_per_parameter([t.size for _, t, _, _ in records], link_force_parameters(
+            model_class(args.model), args.elements or 3, nu), f"the {args.model} link's fit")
+    except ValueError as exc:
+        raise ValueError(f"{names}: {exc}") from None
     mass = _refuse_a_mass(records)
     if mass is not None:
         from motionhyst.core.warnings import warn
@@ -464,7 +473,6 @@ def _run_link_force(args: argparse.Namespace, paths: list[Path]) -> int:
     from motionhyst.identify.io_link_force import identify_link_force
     from motionhyst.identify.io_records import IORecord
 
-    names = ", ".join(str(p) for p in paths)
     try:
         with search_budget():
             fit = identify_link_force([IORecord(t, w, x, str(p)) for p, t, x, w in records],

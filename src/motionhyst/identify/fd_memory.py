@@ -31,7 +31,7 @@ from motionhyst.core.budget import check_memory, format_size
 __all__ = ["BOUND_COPIES", "CLOSED_LOOP_BYTES", "CLOSED_LOOP_ROW_BYTES", "FIT_ROW_BYTES",
            "LOOP_BYTES", "MIN_BOUND_COLUMNS", "RECORD_BYTES", "bound_columns",
            "check_closed_loop_memory", "check_elements_fit_memory", "check_link_force_memory",
-           "elements_fit_memory", "link_force_memory"]
+           "elements_fit_memory", "link_force_memory", "link_force_parameters"]
 
 FIT_ROW_BYTES = 3500
 """Bytes of the Maxwell-slip fit per row of its residual (its 40 stop operators and their
@@ -216,6 +216,44 @@ def link_force_memory(sizes: list[int], parameters: int) -> dict[str, float]:
     return {"starts": starts, "search": search, "total": max(starts, search)}
 
 
+def link_force_parameters(link: type, n_elements: int = 3, nu: float | None = None,
+                          n_records: int = 1, output_offsets: bool = False) -> int:
+    """The parameters a link's fit by the force's error estimates: the spring and damper in
+    parallel, the link's, the force's offset (and each record's position offset).
+
+    Parameters
+    ----------
+    link : type
+        The link's model class.
+    n_elements : int
+        Elements of a list model (Maxwell-slip).
+    nu : float, optional
+        A Bouc-Wen link's exponent, fixed; None: estimated (a variable more).
+    n_records : int
+        The records.
+    output_offsets : bool
+        Each record's position offset is estimated too.
+
+    Returns
+    -------
+    int
+        The parameters.
+
+    Examples
+    --------
+    >>> from motionhyst.hysteresis import Dahl, LuGre
+    >>> link_force_parameters(Dahl), link_force_parameters(LuGre)
+    (6, 8)
+    """
+    from motionhyst.hysteresis import BoucWen
+    from motionhyst.identify.io_bouc_wen_shape import BoucWenShape
+    from motionhyst.identify.io_layout import LinkLayout
+
+    layout = (BoucWenShape.of_exponent(nu) if link is BoucWen
+              else LinkLayout.of(link, n_elements))  # the search's, with k, c and offsets
+    return 2 + len(layout.names) + 1 + (n_records if output_offsets else 0)
+
+
 def check_link_force_memory(sizes: list[int], link: type, n_elements: int = 3,
                             nu: float | None = None, what: str = "force-displacement",
                             output_offsets: bool = False) -> None:
@@ -257,13 +295,7 @@ take 33.9 MB, the elements' fit it starts from 156 MB: a larger --max-memory if 
 has it, or shorter records
     >>> set_max_memory(None)
     """
-    from motionhyst.hysteresis import BoucWen
-    from motionhyst.identify.io_bouc_wen_shape import BoucWenShape
-    from motionhyst.identify.io_layout import LinkLayout
-
-    layout = (BoucWenShape.of_exponent(nu) if link is BoucWen
-              else LinkLayout.of(link, n_elements))  # the search's, with k, c and offsets
-    parameters = 2 + len(layout.names) + 1 + (len(sizes) if output_offsets else 0)
+    parameters = link_force_parameters(link, n_elements, nu, len(sizes), output_offsets)
     need = link_force_memory(sizes, parameters)
     n = sum(int(s) for s in sizes)
     article = "an" if what[:1] in "aeiou" else "a"

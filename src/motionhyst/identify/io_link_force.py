@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from motionhyst.core.warnings import warn
 from motionhyst.hysteresis import BoucWen
+from motionhyst.identify.determinacy import judge_link_force
 from motionhyst.identify.displacement_noise import estimate_displacement
 from motionhyst.identify.io_checks import budget_note
 from motionhyst.identify.io_quasi_static import identify_quasi_static_io
@@ -67,7 +68,9 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     Raises
     ------
     FitFailed
-        A fit that is no result, or of whose parameters the records determine at most half
+        A fit that is no result, or with a positive parameter not two standard errors from 0
+        (:func:`~motionhyst.identify.determinacy.judge_link_force`), or of whose parameters
+        the records determine at most half
         (:func:`~motionhyst.identify.io_uncertainty.judge_determined`; fewer not determined
         are one of the result's ``warnings``, and so are the values that only its standard
         errors widened for the residuals' correlation leave undetermined or not
@@ -101,9 +104,13 @@ def identify_link_force(records: list[IORecord], link: type, *, n_elements: int 
     if fit.extra.get("budget_reached"):  # a good fit all the same: said, not refused
         fit.warnings.append(budget_note(fit.n_evaluations))
     invariant, zero = BOUC_WEN_SCALE if link is BoucWen else (), zero_allowed(fit.plant, link)
+    said = list(fit.warnings)  # the search's own (a Stribeck curve the records do not hold)
     # parameters the records do not determine: a warning, or (most of them) a failed fit
     fit.warnings.extend(judge_determined(fit.estimates, fit.judged_std or fit.std, invariant,
                                          zero))
+    # a positive one not two standard errors from 0: a failed fit
+    judge_link_force(fit.estimates, fit.judged_std or fit.std, invariant, zero, link.name,
+                     said)
     widened = widened_note(fit.estimates, fit.std, fit.judged_std, invariant, zero) \
         if fit.judged_std and fit.extra.get("std_lower_bound") else None
     if widened is not None:  # determined on white residuals, not beyond the model's error
