@@ -141,6 +141,7 @@ from motionhyst.identify.io_uncertainty import (
 )
 from motionhyst.identify.io_uncertainty import FD_SINGULAR_RTOL as FD_SINGULAR_RTOL
 from motionhyst.identify.io_uncertainty import SINGULAR_RTOL as SINGULAR_RTOL
+from motionhyst.identify.link_slips import check_link_slips
 from motionhyst.plants import MassSpringDamper, Plant, plant_class
 from motionhyst.time.openloop import is_periodic_record
 from motionhyst.time.resample import check_whole_periods
@@ -437,6 +438,10 @@ def identify_io(records: list[IORecord], model: type[Hysteresis] | Hysteresis | 
         if not checked:
             check_inertia(records)
             check_one_stage(records, shape.floating, single_mass=shape.n == 1)
+        names = {p.name for p in _link_class(model).parameters}
+        if (shape.n == 1 and not periodic and {"k", "fc"} <= names
+                and (shape.floating or link is not BoucWen)):
+            check_link_slips(records, link.name, stage_k=not shape.floating)
     fewer, budget = None, (max_evaluations if isinstance(max_evaluations, EvaluationBudget)
                            else EvaluationBudget(max_evaluations))  # the whole search's, refits
     why: dict[int, str] = {}  # why a Maxwell-slip fit of so many elements was given up
