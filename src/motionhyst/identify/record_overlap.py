@@ -14,13 +14,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MIN_SHARED", "SAME_VALUE_RTOL", "decimal_step", "repeated_record", "shared_samples"]
-
-#: Two values are the same sample's when they differ by less than this share of their own
-#: magnitude (a record written again with 6 significant digits: 5e-6), or by less than half
-#: the decimal step of a column written with fixed decimals (:func:`decimal_step`); a share of
-#: the column's largest magnitude would take two runs whose noise lies below it for one record
-SAME_VALUE_RTOL = 1e-5
+__all__ = ["MIN_SHARED", "decimal_step", "repeated_record", "shared_samples",
+           "significant_digits"]
 
 #: The fewest samples two records share for one to be a part of the other (and not two
 #: records that meet by chance at a sample)
@@ -60,16 +55,64 @@ def decimal_step(column: NDArray[np.float64]) -> float:
     return 0.0
 
 
+def significant_digits(column: NDArray[np.float64]) -> int:
+    """The significant digits a column was written with: the fewest ``s`` (1 to 17) such that
+    every value lies on the grid of its own ``s``-th significant digit.
+
+    A column saved as ``%.6g`` has 6; one saved with all its digits (``repr``, a MATLAB
+    file's doubles) 15 to 17, whatever noise its values carry.
+
+    Parameters
+    ----------
+    column : ndarray
+        The values as read.
+
+    Returns
+    -------
+    int
+        The digits (17 for a column of zeros alone, whose grid is any).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = 5e-3 + 1e-3 * np.sin(np.arange(100) / 10.0)
+    >>> significant_digits(np.array([float(f"{v:.6g}") for v in x])), significant_digits(x) >= 15
+    (6, True)
+    """
+    v = np.asarray(column, dtype=float)
+    v = v[np.isfinite(v) & (v != 0.0)]
+    if v.size == 0:
+        return 17
+    exponent = np.floor(np.log10(np.abs(v)))
+    ulps = 4.0 * np.spacing(np.abs(v))
+    for s in range(1, 17):
+        quantum = 10.0 ** (exponent - s + 1)
+        if np.all(np.abs(np.round(v / quantum) * quantum - v) <= ulps):
+            return s
+    return 17
+
+
+def _half_quantum(values: NDArray[np.float64], digits: int) -> NDArray[np.float64]:
+    """Half the step of the `digits`-th significant digit at each value (0 at 0)."""
+    big = np.abs(values)
+    exponent = np.floor(np.log10(np.where(big > 0.0, big, 1.0)))
+    return np.where(big > 0.0, 0.5 * 10.0 ** (exponent - digits + 1), 0.0)
+
+
 def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.float64]],
                    step_a: float, step_b: float) -> int:
     """How many samples record `b` shares with record `a`, where `b` starts inside `a`
     (equal, a part of it, or overlapping its end): 0 if none.
 
     Samples are shared when every column (`a` and `b`: the same columns, one array each,
-    of the records' own lengths) agrees within :data:`SAME_VALUE_RTOL` of each value's own
-    magnitude (how a value written with fewer significant digits errs) or within half the
-    decimal step of a column written with fixed decimals (:func:`decimal_step`; half of each
-    step added where the two columns have different ones), from `b`'s first
+    of the records' own lengths) agrees within what writing it again can change: half the
+    step of the last significant digit of the column written with fewer
+    (:func:`significant_digits`: a copy saved with 6 significant digits errs by 5e-6 of each
+    value at most), or half the decimal step of a column written with fixed decimals
+    (:func:`decimal_step`; half of each step added where the two columns have different
+    ones), and by nothing more (a few units in the last place): two runs saved with all
+    their digits are two records however little their noise, and so are two saved with the
+    same digits whose noise moves a digit.  From `b`'s first
     sample to the end of either record, and the records have one time step (the time stamps
     themselves may be shifted: a part cut out of a record and its time set from 0).  A shared
     run must move (every column's range over it above 1e-3 of its largest magnitude, not two
@@ -106,14 +149,17 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
     >>> shared_samples([x, f], fixed, 1e-3, 1e-3)
     1000
 
-    Two runs whose noise differs are two records where the noise exceeds 1e-5 of the values
-    somewhere (near the zero crossings of a column that crosses zero; noise below that share
-    of every value cannot be told from a copy written with 6 significant digits):
+    Two runs whose noise differs are two records, however small the noise against the
+    values (here 1e-9 of a position 2 from its zero, a force that repeats), when they are
+    saved with all their digits; a copy of either, saved with 6 significant digits, is one:
 
     >>> rng = np.random.default_rng(0)
-    >>> noisy = [x + 1e-6 * rng.standard_normal(1000), f + 1e-6 * rng.standard_normal(1000)]
-    >>> shared_samples([x, f], noisy, 1e-3, 1e-3)
+    >>> run = [x + 2.0 + 1e-9 * rng.standard_normal(1000), f]
+    >>> other = [x + 2.0 + 1e-9 * rng.standard_normal(1000), f]
+    >>> shared_samples(run, other, 1e-3, 1e-3)
     0
+    >>> shared_samples(run, [np.array([float(f"{v:.6g}") for v in c]) for c in run], 1e-3, 1e-3)
+    1000
     """
     if not a or len(a) != len(b) or not (abs(step_a - step_b) <= 1e-6 * abs(step_a)):
         return 0
@@ -126,21 +172,26 @@ def shared_samples(a: Sequence[NDArray[np.float64]], b: Sequence[NDArray[np.floa
     # half the coarser step; both halves where the steps differ (two roundings of one value)
     rounding = [0.5 * max(qa, qb) + (0.5 * min(qa, qb) if qa != qb else 0.0)
                 for qa, qb in steps]
+    digits = [(significant_digits(ca), significant_digits(cb))
+              for ca, cb in zip(a, b, strict=True)]
 
-    def same(ca: NDArray[np.float64], cb: NDArray[np.float64], half: float
-             ) -> NDArray[np.bool_]:
+    def same(ca: NDArray[np.float64], cb: NDArray[np.float64], half: float,
+             sig: tuple[int, int]) -> NDArray[np.bool_]:
         big = np.maximum(np.abs(ca), np.abs(cb))
-        return np.abs(ca - cb) <= SAME_VALUE_RTOL * big + half + 4.0 * np.spacing(big)
+        fewer, more = min(sig), max(sig)
+        written = _half_quantum(big, fewer) + (_half_quantum(big, more) if more < 15 and
+                                               more != fewer else 0.0)
+        return np.abs(ca - cb) <= np.maximum(written, half) + 4.0 * np.spacing(big)
 
     starts = np.ones(n_a, dtype=bool)
-    for ca, cb, half in zip(a, b, rounding, strict=True):
-        starts &= same(ca, cb[0], half)
+    for ca, cb, half, sig in zip(a, b, rounding, digits, strict=True):
+        starts &= same(ca, cb[0], half, sig)
     for i in np.flatnonzero(starts)[:100]:  # a resting start matches many: the first hundred
         n = min(n_a - int(i), n_b)
         if n < MIN_SHARED:
             break
-        if all(np.all(same(ca[i:i + n], cb[:n], half)) and np.ptp(cb[:n]) > 1e-3 * top
-               for ca, cb, half, top in zip(a, b, rounding, scale, strict=True)):
+        if all(np.all(same(ca[i:i + n], cb[:n], half, sig)) and np.ptp(cb[:n]) > 1e-3 * top
+               for ca, cb, half, sig, top in zip(a, b, rounding, digits, scale, strict=True)):
             return n
     return 0
 
