@@ -154,6 +154,79 @@ def test_a_store_is_deleted_only_when_all_in_its_folder_is_its_own(tmp_path):
     assert (tmp_path / "s.zarr" / "status" / "x.txt").read_text() == "x"
 
 
+DS_STORE = b"\x00\x00\x00\x01Bud1" + bytes(24)
+"""The first bytes of a .DS_Store as macOS's Finder writes it (a 'Bud1' buddy allocator)."""
+
+
+def _os_metadata(folder: Path) -> None:
+    """What macOS and Windows write into a store folder shown in a file manager."""
+    (folder / ".DS_Store").write_bytes(DS_STORE)
+    (folder / "e1" / ".DS_Store").write_bytes(DS_STORE)
+    (folder / "e1" / "._zarr.json").write_bytes(b"\x00\x05\x16\x07\x00\x02\x00\x00")
+    (folder / "Thumbs.db").write_bytes(b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + bytes(504))
+    (folder / "desktop.ini").write_bytes(b"\xff\xfe" + "\r\n[.ShellClassInfo]\r\n"
+                                         .encode("utf-16-le"))
+
+
+def test_an_operating_systems_files_in_a_store_are_not_the_users(tmp_path):
+    """Review C20 L6: a .DS_Store (Finder), ._* (AppleDouble), Thumbs.db or desktop.ini
+    (Explorer) in the store's folders made ``--force`` refuse the store as holding the user's
+    files.  They are the system's by their name and first bytes: they go with the store.  A
+    file of such a name holding anything else, a link or a folder of that name, stays the
+    user's."""
+    from motionhyst.scenario import default_scenario_path
+    from motionhyst.study.store import StudyStore, foreign_entries, remove_store
+
+    study = Study.from_dict(tomllib.loads(PAPER_STUDY.format("5.0")),
+                            scenario=tomllib.loads(default_scenario_path().read_text()))
+    store = tmp_path / "s.zarr"
+    StudyStore.create(store, study)
+    _os_metadata(store)
+    assert foreign_entries(store) == []
+    (store / "status" / "._c").write_text("my notes")  # a user's, not AppleDouble
+    (store / "desktop.ini").unlink()
+    (store / "Desktop.ini").write_text("my notes")
+    (store / "Thumbs.db").unlink()
+    (store / "thumbs.db").mkdir()
+    (tmp_path / "target").write_bytes(DS_STORE)
+    (store / "e1" / ".DS_Store").unlink()
+    (store / "e1" / ".DS_Store").symlink_to(tmp_path / "target")
+    mine = ["Desktop.ini", "e1/.DS_Store", "status/._c", "thumbs.db"]
+    assert foreign_entries(store) == mine
+    for name in mine:
+        p = store / name
+        p.rmdir() if p.is_dir() and not p.is_symlink() else p.unlink()
+    remove_store(store)
+    assert not store.exists()
+    assert (tmp_path / "target").read_bytes() == DS_STORE
+
+
+def test_force_replaces_a_store_a_file_manager_has_shown(tmp_path):
+    """The command of review C20 L6: ``study --force`` onto another study's store that Finder
+    and Explorer have shown is exit 0, the new study in the store; the same study again reads
+    the store without zarr's warning on the .DS_Store beside its arrays."""
+    from motionhyst.scenario import default_scenario_path
+    from motionhyst.study.store import StudyStore
+
+    populate(tmp_path, {"paper.toml": default_scenario_path().read_text(),
+                        "old.toml": PAPER_STUDY.format("5.0"),
+                        "new.toml": PAPER_STUDY.format("6.0")})
+    StudyStore.create(tmp_path / "st.zarr", Study.from_file(tmp_path / "old.toml"))
+    _os_metadata(tmp_path / "st.zarr")
+    argv = ["study", "new.toml", "--out", "st.zarr", "--workers", "0"]
+    code, out, err = limited_process.run([*argv, "--force"], tmp_path,
+                                         limited_process.RUN_LIMIT)
+    assert code == 0, err
+    assert "1 points: 1 computed" in out
+    assert StudyStore.open(tmp_path / "st.zarr").matches(Study.from_file(tmp_path / "new.toml"))
+    assert not (tmp_path / "st.zarr" / "Thumbs.db").exists()
+    (tmp_path / "st.zarr" / ".DS_Store").write_bytes(DS_STORE)
+    code, out, err = limited_process.run(argv, tmp_path, limited_process.RUN_LIMIT)
+    assert code == 0, err
+    assert "1 points: 0 computed" in out
+    assert "warning" not in err.lower() and "zarr" not in err.lower(), err
+
+
 def test_the_rate_of_a_slow_study_keeps_its_digits():
     """'2 points: 2 computed in 8.7 s (0 points/s)': the rate rounded to 0."""
     from motionhyst.study.runner import RunReport

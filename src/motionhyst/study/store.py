@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import shutil
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +26,8 @@ from motionhyst.study.outputs import fields_of
 from motionhyst.study.spec import REFERENCE_AXES, StudyDefinition, StudyError
 
 __all__ = ["FAILED", "FLUSH_SECONDS", "MISSING", "OK", "REASONS", "ChunkWriter", "StudyStore",
-           "field_names", "foreign_entries", "is_study_store", "listed", "open_results",
-           "remove_store"]
+           "field_names", "foreign_entries", "is_os_metadata", "is_study_store", "listed",
+           "open_results", "remove_store"]
 
 MISSING, OK, FAILED = 0, 1, 2
 """Values of the ``status`` array."""
@@ -38,6 +40,24 @@ REASONS = {
     4: "a numerical error (overflow, a singular matrix)",
 }
 """Values of the ``reason`` array: why a point failed (0 for a point that did not fail)."""
+
+OS_METADATA = {
+    ".ds_store": b"\x00\x00\x00\x01Bud1",                    # macOS Finder: a folder's view
+    "thumbs.db": b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1",      # Windows Explorer: thumbnails
+    "ehthumbs.db": b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1",    # (an OLE compound file each)
+    "desktop.ini": b"[",                                       # Windows: a folder's settings
+}
+"""The files an operating system's file manager writes into a folder it shows, by lower-case
+name, each with the first bytes it writes (``desktop.ini``: its first section, after blank
+lines and a byte-order mark).  Files named ``._<name>`` are macOS's AppleDouble files
+(:data:`APPLE_DOUBLE` first)."""
+
+_NOT_ZARR = re.compile(r"Object at (.+) is not recognized as a component of a Zarr hierarchy\.")
+"""zarr's warning on an entry of a group that is neither an array nor a group."""
+
+APPLE_DOUBLE = b"\x00\x05\x16\x07"
+"""The first bytes of an AppleDouble file (macOS's resource fork of ``<name>`` as ``._<name>``
+on a volume that has none)."""
 
 FLUSH_SECONDS = 2.0
 """Least time between two writes of the chunks a run holds open [s] (the first batch is
@@ -505,10 +525,55 @@ def is_study_store(path: str | Path) -> bool:
         return False                                                # thousands of levels deep
 
 
+def is_os_metadata(entry: Path) -> bool:
+    """Whether `entry` is a file an operating system wrote into a folder it showed: a regular
+    file (not a link) named as one of :data:`OS_METADATA` or ``._<name>`` whose first bytes are
+    those the system writes.  A user's file of that name holding anything else is not one.
+
+    Parameters
+    ----------
+    entry : Path
+        A folder's entry.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / ".DS_Store").write_bytes(OS_METADATA[".ds_store"] + bytes(8))
+    >>> _ = (folder / "Thumbs.db").write_text("my notes")
+    >>> is_os_metadata(folder / ".DS_Store"), is_os_metadata(folder / "Thumbs.db")
+    (True, False)
+    """
+    name = entry.name.lower()
+    if name.startswith("._"):
+        magic = APPLE_DOUBLE
+    elif name in OS_METADATA:
+        magic = OS_METADATA[name]
+    else:
+        return False
+    if entry.is_symlink() or not entry.is_file():  # never open a FIFO, a device or a link
+        return False
+    try:
+        with entry.open("rb") as f:
+            head = f.read(512)
+    except OSError:
+        return False
+    if name == "desktop.ini":  # text, often UTF-16 with a byte-order mark, blank lines first
+        for bom, codec in ((b"\xff\xfe", "utf-16-le"), (b"\xef\xbb\xbf", "utf-8")):
+            if head.startswith(bom):
+                head = head[len(bom):].decode(codec, errors="replace").encode()
+                break
+        head = head.lstrip(b"\r\n\t \x00")
+    return head.startswith(magic)
+
+
 def foreign_entries(path: str | Path) -> list[str]:
     """The entries of the store folder `path` that are not the store's: anything beside its
     ``zarr.json`` and its arrays' folders (each a ``zarr.json`` and its chunks ``c``), such
     as a user's notes put there.  A store replaced with ``--force`` would take them with it.
+    The files a file manager writes into a folder it shows (:func:`is_os_metadata`: macOS's
+    ``.DS_Store`` and ``._*``, Windows's ``Thumbs.db`` and ``desktop.ini``) are not the user's:
+    they go with the store.
 
     Parameters
     ----------
@@ -534,15 +599,16 @@ def foreign_entries(path: str | Path) -> list[str]:
     path = Path(path)
     out = []
     for entry in sorted(path.iterdir()):
-        if entry.name == "zarr.json" and entry.is_file() and not entry.is_symlink():
+        if ((entry.name == "zarr.json" and entry.is_file() and not entry.is_symlink())
+                or is_os_metadata(entry)):
             continue
         if not (entry.is_dir() and not entry.is_symlink() and (entry / "zarr.json").is_file()):
             out.append(entry.name)
             continue
         out.extend(f"{entry.name}/{inner.name}" for inner in sorted(entry.iterdir())
-                   if not (inner.name in ("zarr.json", "c") and not inner.is_symlink()
+                   if not ((inner.name in ("zarr.json", "c") and not inner.is_symlink()
                            and (inner.is_file() if inner.name == "zarr.json"
-                                else inner.is_dir())))
+                                else inner.is_dir())) or is_os_metadata(inner)))
     return out
 
 
@@ -635,10 +701,16 @@ def open_results(path: str | Path):
     import xarray as xr  # loaded once the store is one (pandas with it)
 
     try:
-        ds = xr.open_zarr(str(path), consolidated=False, mask_and_scale=False).load()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ds = xr.open_zarr(str(path), consolidated=False, mask_and_scale=False).load()
     except (RuntimeError, ValueError) as exc:
         if not _in_codec(exc):
             raise
         raise StudyError(f"{_damaged(path, f'its values cannot be read: {exc}')}; remove it (a "
                          f"study run again computes every point)") from None
+    for w in caught:  # zarr's word on a file manager's .DS_Store beside the arrays is dropped
+        name = _NOT_ZARR.fullmatch(str(w.message))
+        if not (name and is_os_metadata(Path(path) / name[1])):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return ds
