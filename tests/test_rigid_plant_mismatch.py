@@ -127,3 +127,29 @@ def test_a_nan_of_another_cause_is_not_blamed_on_a_rigid_plant(monkeypatch):
         res = analyze(_loop(1.0), 0.01, [1.0, 5.0])
     assert np.isfinite(res.points[0].value) and np.isnan(res.points[1].value)
     assert not any("no flexible part" in u for u in res.unresolved), res.unresolved
+
+
+def test_the_removed_exact_mismatch_is_a_deprecated_alias_of_the_property():
+    """Review C20 L2: ``comparison.exact_mismatch`` (public in 0.1) was removed without an
+    alias.  It is back, warning that ``SteadyState.mismatch`` replaces it, and gives that value;
+    both are the exact e1 over the linear loop's error ``A (1 - P2 Cff) / (1 + C P2)`` at the
+    frequency, evaluated here from the controller, plant and feedforward alone (python-control),
+    not from the steady state's harmonics."""
+    import control
+
+    from motionhyst import default_scenario
+    from motionhyst.analysis.comparison import exact_mismatch
+
+    loop, A, f = default_scenario().loop(), 0.01, 5.0
+    ss = periodic_steady_state(loop, A, f)
+    with pytest.warns(DeprecationWarning, match=r"exact_mismatch\(state\) is deprecated: use "
+                                                 r"state\.mismatch \(SteadyState\.mismatch\)"):
+        E = exact_mismatch(ss)
+    assert E == ss.mismatch
+    w = 2.0 * np.pi * f
+    C, P2 = (complex(control.evalfr(sys, 1j * w)) for sys in (loop.controller, loop.P2))
+    e1_linear = A * (1.0 - P2 * loop.ff.linear_response(np.array([w]))[0]) / (1.0 + C * P2)
+    assert E == pytest.approx(ss.e[1] / e1_linear, rel=1e-9)
+    assert abs(E) == pytest.approx(6.04, abs=0.005)
+    with pytest.warns(DeprecationWarning):
+        assert np.isnan(exact_mismatch(periodic_steady_state(_loop(0.0), 0.01, 5.0)))

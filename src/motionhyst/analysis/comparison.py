@@ -17,6 +17,7 @@ Examples
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,7 +38,8 @@ from motionhyst.core.budget import BudgetError
 from motionhyst.core.textfmt import g, table
 from motionhyst.core.warnings import warn
 
-__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function"]
+__all__ = ["ComparisonPoint", "DescribingFunctionComparison", "compare_with_describing_function",
+           "exact_mismatch"]
 
 
 @dataclass
@@ -163,6 +165,35 @@ class DescribingFunctionComparison:
         return fig11_errors([p.state for p in self.points],
                             [p.mismatch_df for p in self.points],
                             [p.error_harmonics_df for p in self.points], ax=ax)
+
+
+def exact_mismatch(state: SteadyState) -> complex:
+    """The exact mismatch ``E_sim = e1 / e1_linear`` of a steady state (compare eq. 18).
+
+    .. deprecated:: 0.1.0
+        Use :attr:`SteadyState.mismatch <motionhyst.analysis.steady.SteadyState.mismatch>`,
+        which this returns (nan where the loop without the link has no error); this name
+        warns with a :class:`DeprecationWarning` and will be removed in the next release.
+
+    Parameters
+    ----------
+    state : SteadyState
+        The exact periodic steady state.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from motionhyst import default_scenario, periodic_steady_state
+    >>> state = periodic_steady_state(default_scenario().loop(), 0.01, 5.0)
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", DeprecationWarning)
+    ...     round(abs(exact_mismatch(state)), 2), round(abs(state.mismatch), 2)
+    (6.04, 6.04)
+    """
+    warnings.warn("motionhyst.analysis.comparison.exact_mismatch(state) is deprecated: use "
+                  "state.mismatch (SteadyState.mismatch); exact_mismatch will be removed in "
+                  "the next release", DeprecationWarning, stacklevel=2)
+    return state.mismatch
 
 
 def _steady_states(loop: Loop, amplitude: float, f: NDArray[np.float64]) -> list[SteadyState]:
