@@ -81,7 +81,8 @@ def test_a_correlation_matrix_with_a_negative_eigenvalue_is_refused_whole(tmp_pa
     assert np.linalg.eigvalsh(np.array(bad))[0] == pytest.approx(-0.2904, abs=1e-4)
     path = tmp_path / "bad.toml"
     path.write_text(identification(correlation=bad))
-    with pytest.raises(ValueError, match=r"bad\.toml: the correlation matrix of its 4 "
+    with pytest.raises(ValueError, match=r"bad\.toml: \[identification\]: correlation: the "
+                                         r"correlation matrix of its 4 "
                                          r"parameters \(stage\.m, stage\.c, hysteresis\.k, "
                                          r"hysteresis\.fc\) is not positive semi-definite \(it "
                                          r"has the eigenvalue -0\.29\)"):
@@ -107,10 +108,42 @@ def test_study_refuses_an_impossible_correlation_in_one_line(tmp_path):
                              "bad.toml": identification(correlation=_not_psd())},
                   ["study", "st.toml", "--out", "st.zarr", "--workers", "0",
                    "--from-identification", "bad.toml"])
-    assert err.endswith("bad.toml: the correlation matrix of its 4 parameters (stage.m, "
-                        "stage.c, hysteresis.k, hysteresis.fc) is not positive semi-definite "
-                        "(it has the eigenvalue -0.29): no estimates have it; write the "
-                        "identification again (`motionhyst identify ... --save`)"), err
+    assert err.endswith(NOT_PSD.format("bad.toml")), err
+
+
+NOT_PSD = ("{}: [identification]: correlation: the correlation matrix of its 4 parameters "
+           "(stage.m, stage.c, hysteresis.k, hysteresis.fc) is not positive semi-definite (it "
+           "has the eigenvalue -0.29): no estimates have it; write the identification again "
+           "(`motionhyst identify ... --save`)")
+
+
+@pytest.mark.parametrize("argv", [
+    ["predict", "bad.toml", "force.csv", "--out", "p.csv"],
+    ["steady", "loop.toml", "--frequency", "5", "--no-floquet"],
+    ["analyze", "loop.toml"],
+    ["stability", "loop.toml"],
+    ["simulate", "loop.toml", "--frequency", "5", "--time-series", "ts.csv"],
+    ["scan", "loop.toml", "--length", "0.005", "--speed", "0.05", "--a-max", "2", "--j-max",
+     "50", "--s-max", "1000"],
+    ["reproduce", "loop.toml", "--out", "figures"],
+    ["study", "st.toml", "--out", "st.zarr", "--workers", "0"],
+], ids=lambda argv: argv[0])
+def test_every_command_refuses_an_impossible_correlation_where_it_reads_it(tmp_path, argv):
+    """The correlation of [identification] was checked only by a study drawing from it:
+    ``predict`` of that model file and every command of a scenario holding it ran (exit 0)
+    with an identification no estimates have.  Now refused where the file is read, in one
+    line naming the key, before any work."""
+    loop = LOOP + "\n" + identification(correlation=_not_psd()).partition(LINK)[2]
+    t = np.arange(2000) * 1e-3
+    force = "time,force\n" + "".join(f"{a:.3f},{b:.6g}\n"
+                                      for a, b in zip(t, 50.0 * np.sin(4 * np.pi * t),
+                                                      strict=True))
+    err = refused(tmp_path, {"bad.toml": identification(correlation=_not_psd()),
+                             "loop.toml": loop, "force.csv": force,
+                             "st.toml": study_text("loop.toml", n=1).split("[samples]")[0]},
+                  argv)
+    named = "st.toml: the scenario" if argv[0] == "study" else argv[1]
+    assert err.endswith(NOT_PSD.format(named)), err
 
 
 # ------------------------------------------- F2: a user's file in the store folder is kept

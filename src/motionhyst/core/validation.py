@@ -16,8 +16,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["MAGNITUDES", "check_amplitudes", "check_finite", "check_magnitude", "check_magnitudes",
-           "check_omega", "check_positive"]
+__all__ = ["CORRELATION_ROUNDING", "MAGNITUDES", "check_amplitudes", "check_correlation",
+           "check_finite", "check_magnitude", "check_magnitudes", "check_omega", "check_positive",
+           "least_correlation_eigenvalue"]
 
 MAGNITUDES = (1e-30, 1e30)
 """The magnitudes of user-given numbers (in SI units) that motionhyst computes with: beyond
@@ -194,3 +195,68 @@ def check_omega(omega, model: str) -> float:
     if not np.isfinite(om) or om < 0:
         raise ValueError(f"omega must be finite and >= 0, got {omega!r}")
     return om
+
+
+CORRELATION_ROUNDING = 1e-9
+"""How far below 0, per parameter, the least eigenvalue of a saved correlation matrix may lie
+(``identify --save`` rounds it to 1e-12): below, no estimates have that matrix."""
+
+
+def least_correlation_eigenvalue(c: ArrayLike) -> float:
+    """The least eigenvalue of the correlation matrix of the covariance `c` (a standard
+    deviation of 0 counted as 1): negative for a matrix that is no covariance.
+
+    Parameters
+    ----------
+    c : array_like
+        A symmetric n x n matrix (a covariance or a correlation matrix), n >= 1.
+
+    Examples
+    --------
+    >>> round(least_correlation_eigenvalue([[4.0, 1.0], [1.0, 1.0]]), 3)
+    0.5
+    """
+    c = np.asarray(c, dtype=float)
+    s = np.sqrt(np.clip(np.diag(c), 0.0, None))
+    s = np.where(s > 0, s, 1.0)
+    return float(np.linalg.eigvalsh(c / np.outer(s, s))[0])
+
+
+def check_correlation(c: ArrayLike, names: list[str], hint: str) -> None:
+    """Refuse the covariance or correlation matrix `c` of an identification's parameters
+    `names` when a variance is negative or its correlation matrix has an eigenvalue below
+    ``-CORRELATION_ROUNDING * n``: no estimates have it.  The check of the whole matrix, of
+    every parameter, drawn or not (a block may look fine while the whole is impossible).
+
+    Parameters
+    ----------
+    c : array_like
+        Symmetric and finite, n x n.
+    names : list of str
+        The n parameters (named in the message when they are at most 8).
+    hint : str
+        The option of ``motionhyst identify`` that writes the file (``--save``, ``--json``).
+
+    Raises
+    ------
+    ValueError
+        One line: the matrix, its least eigenvalue, and the remedy.
+
+    Examples
+    --------
+    >>> check_correlation([[1.0, 0.5], [0.5, 1.0]], ["k", "fc"], "--save")
+    >>> try:
+    ...     check_correlation([[1.0, 1.5], [1.5, 1.0]], ["k", "fc"], "--save")
+    ... except ValueError as exc:
+    ...     print(str(exc).split(" (it has")[0])
+    the correlation matrix of its 2 parameters (k, fc) is not positive semi-definite
+    """
+    c = np.asarray(c, dtype=float)
+    n = len(names)
+    least = least_correlation_eigenvalue(c) if n else 0.0
+    if np.any(np.diag(c) < 0) or least < -CORRELATION_ROUNDING * n:
+        named = f" ({', '.join(map(str, names))})" if n <= 8 else ""
+        raise ValueError(f"the correlation matrix of its {n} parameters{named} is not positive "
+                         f"semi-definite (it has the eigenvalue {least:.3g}): no estimates have "
+                         f"it; write the identification again (`motionhyst identify ... "
+                         f"{hint}`)")

@@ -25,6 +25,7 @@ from pydantic import (
     model_validator,
 )
 
+from motionhyst.core.validation import check_correlation
 from motionhyst.hysteresis import MODELS, Hysteresis, model_class
 from motionhyst.hysteresis.registry import Form
 from motionhyst.plants.registry import PLANTS, plant_class, stage_types
@@ -558,6 +559,10 @@ class IdentificationSection(_Section):
             if r[i][i] != 1.0 or any(abs(r[i][j] - r[j][i]) > 1e-9 for j in range(i)):
                 raise ValueError("correlation: a correlation matrix has 1 on its diagonal and "
                                  "is symmetric")
+        try:  # every command that reads the file refuses it, not only a study drawing from it
+            check_correlation(r, self.parameters, "--save")
+        except ValueError as exc:
+            raise ValueError(f"correlation: {exc}") from None
         return self
 
 

@@ -50,6 +50,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from motionhyst.core.budget import format_size
+from motionhyst.core.validation import (
+    CORRELATION_ROUNDING,
+    check_correlation,
+    least_correlation_eigenvalue,
+)
 from motionhyst.identify.io_uncertainty import BOUC_WEN_IDENTIFIED
 from motionhyst.io.inputs import TOML_EXPANSION, InputFileError, read_text, read_toml
 
@@ -66,7 +71,6 @@ a few kB (its largest, 20 Maxwell-slip elements with the stage, under 100 kB: th
 of some 50 parameters); a larger file is refused before it is parsed (parsing TOML takes about
 0.1 s of CPU per MB)."""
 
-_CORRELATION_ROUNDING = 1e-9  # a saved correlation matrix is rounded to 1e-12
 
 
 def least_value(key: str) -> float | None:
@@ -139,8 +143,8 @@ class JointNormal:
                              f"to draw must be {what}")
         if not (np.all(np.isfinite(c)) and np.allclose(c, c.T, rtol=1e-9, atol=0.0)):
             raise ValueError(f"{where}the covariance must be finite and symmetric")
-        least = _least_eigenvalue(c)
-        if np.any(np.diag(c) < 0) or least < -_CORRELATION_ROUNDING * d:
+        least = least_correlation_eigenvalue(c)
+        if np.any(np.diag(c) < 0) or least < -CORRELATION_ROUNDING * d:
             raise ValueError(f"{where}the covariance is not positive semi-definite (its "
                              f"correlation matrix has the eigenvalue {least:.3g})")
 
@@ -283,14 +287,6 @@ MAX_REDRAWS = 1000
 """Rounds of redrawing the draws with a parameter at or below its least value (each round
 keeps the admitted ones): a distribution that puts almost all its mass there is refused, not
 drawn from forever."""
-
-
-def _least_eigenvalue(c: NDArray[np.float64]) -> float:
-    """The least eigenvalue of the correlation matrix of the covariance `c` (a standard
-    deviation of 0 counted as 1): negative for a matrix that is no covariance."""
-    s = np.sqrt(np.clip(np.diag(c), 0.0, None))
-    s = np.where(s > 0, s, 1.0)
-    return float(np.linalg.eigvalsh(c / np.outer(s, s))[0])
 
 
 def _factor(c: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -453,8 +449,8 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
     at = [names.index(n) for n in drawn]
     if cov.shape != (len(names), len(names)):
         raise ValueError(f"{where}: the covariance is not a {len(names)} x {len(names)} matrix")
-    _check_whole(np.asarray(sec.correlation, dtype=float) if hint == "--save" else cov, names,
-                 where, hint)
+    if hint == "--json":  # [identification] of a TOML is checked where it is read
+        _check_whole(cov, names, where)
     sub = cov[np.ix_(at, at)]
     try:
         return JointNormal(tuple(keys[n] for n in drawn), tuple(float(mean[n]) for n in drawn),
@@ -463,22 +459,17 @@ def joint_from_identification(path: str | Path, tables: tuple[str, ...] = ("hyst
         raise ValueError(f"from_identification {exc}") from None
 
 
-def _check_whole(cov: NDArray[np.float64], names: list, where: str, hint: str) -> None:
-    """Refuse an identification whose whole covariance (of every parameter it names, drawn
-    or not) is no covariance: not finite, not symmetric, or with a correlation matrix that
-    has a negative eigenvalue (beyond the rounding of a saved matrix), which no estimates
-    have; the block drawn may look fine while the whole is impossible."""
-    n = len(names)
+def _check_whole(cov: NDArray[np.float64], names: list, where: str) -> None:
+    """Refuse an ``identify --json`` whose whole covariance (of every parameter it names,
+    drawn or not) is no covariance: not finite, not symmetric, or not positive semi-definite
+    (:func:`~motionhyst.core.validation.check_correlation`)."""
     if not (np.all(np.isfinite(cov)) and np.allclose(cov, cov.T, rtol=1e-9, atol=0.0)):
-        raise ValueError(f"{where}: the covariance of its {n} parameters is not finite and "
-                         f"symmetric")
-    least = _least_eigenvalue(cov) if n else 0.0
-    if np.any(np.diag(cov) < 0) or least < -_CORRELATION_ROUNDING * n:
-        named = f" ({', '.join(map(str, names))})" if n <= 8 else ""
-        raise ValueError(f"{where}: the correlation matrix of its {n} parameters{named} is "
-                         f"not positive semi-definite (it has the eigenvalue {least:.3g}): no "
-                         f"estimates have it; write the identification again (`motionhyst "
-                         f"identify ... {hint}`)")
+        raise ValueError(f"{where}: the covariance of its {len(names)} parameters is not finite "
+                         f"and symmetric")
+    try:
+        check_correlation(cov, names, "--json")
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
 
 
 def _one_element(elements: list, where: str) -> dict:
