@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from motionhyst.cli._common import UsageError, g, print_json, release_held, table, whole_number
@@ -90,6 +92,31 @@ def _data(args: argparse.Namespace) -> Path:
     return data
 
 
+BOUC_WEN_REMEDY = "give a larger --max-seconds"
+"""What a user can change when ``benchmark bouc-wen`` runs over its work budget (its training
+data, models and test sets are the benchmark's)."""
+
+
+@contextmanager
+def _progress(name: str, steps: int, quiet: bool, remedy: str) -> Iterator[Callable[[str], None]]:
+    """``say(msg)`` for each of the `steps` of ``benchmark name``, in a block stopped at
+    ``--max-seconds`` of CPU time.  The progress is shown on a terminal only, as one status
+    line cleared as the block ends (`quiet`: never): a run stopped by its budget is the one
+    line of its refusal, and the table has each step's figures and time."""
+    from tqdm import tqdm
+
+    from motionhyst.core.budget import cpu_time_limit, max_seconds
+
+    with (tqdm(total=steps, desc=f"benchmark {name}", bar_format="{desc}{postfix} [{elapsed}]",
+               disable=quiet or not sys.stderr.isatty(), file=sys.stderr, leave=False) as bar,
+          cpu_time_limit(max_seconds(), f"benchmark {name}", remedy)):
+        def say(msg: str) -> None:
+            bar.update()
+            bar.set_postfix_str(msg)
+
+        yield say
+
+
 def run_bouc_wen(args: argparse.Namespace) -> int:
     """Make training data, identify, score on the official test sets, print the table."""
     from motionhyst.identify.benchmark import run_benchmark
@@ -98,12 +125,10 @@ def run_bouc_wen(args: argparse.Namespace) -> int:
         args.seed = 0
     data = _data(args)
 
-    def say(msg: str) -> None:
-        if not args.json:
-            print(f"  {msg}", file=sys.stderr, flush=True)
-
     release_held()  # the work starts: the warnings so far are shown
-    res = run_benchmark(data, seed=args.seed, progress=say)
+    # the training data, then each model identified and scored: 1 + 2 x 2 steps
+    with _progress("bouc-wen", 5, args.json, BOUC_WEN_REMEDY) as say:
+        res = run_benchmark(data, seed=args.seed, progress=say)
     res["data"] = str(data)
     if args.json:
         print_json(res)
@@ -199,27 +224,16 @@ def run_emps(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst benchmark emps: --periods splits DATA_EMPS when there is "
                          f"no test record; {test_path} is there")
     # the optimisers imported once the folder, its records and the options are known good
-    from motionhyst.core.budget import check_work, cpu_time_limit, max_seconds
+    from motionhyst.core.budget import check_work
     from motionhyst.identify.emps import CHOSEN, MODELS, choose, cross_validate, run_emps
 
     check_work(_emps_seconds(estimation, test, args.periods, models), "benchmark emps",
                EMPS_REMEDY)
-    from tqdm import tqdm
-
     release_held()  # the fits start: the warnings so far are shown
-    # the progress on a terminal only, one status line cleared as the run ends: a run stopped
-    # by its budget is the one line of its refusal (the table has each fit's row and time)
     splits = 1 if test is not None or args.periods not in (None, "all") else (
         2 if args.periods is None else 4)
     fits = splits * len(MODELS if models is None else models)
-    with (tqdm(total=2 * fits, desc="benchmark emps", bar_format="{desc}{postfix} [{elapsed}]",
-               disable=args.json or not sys.stderr.isatty(), file=sys.stderr,
-               leave=False) as bar,
-          cpu_time_limit(max_seconds(), "benchmark emps", EMPS_REMEDY)):
-        def say(msg: str) -> None:  # each fit's start and end
-            bar.update()
-            bar.set_postfix_str(msg)
-
+    with _progress("emps", 2 * fits, args.json, EMPS_REMEDY) as say:  # each fit's start, end
         if test is None and args.periods in (None, "all"):  # one split alone says little
             results = cross_validate(estimation, models=models, progress=say,
                                      splits="halves" if args.periods is None else "all")
