@@ -276,6 +276,82 @@ def test_a_file_or_a_size_is_refused_before_any_heavy_library(tmp_path, argv, er
     assert out["heavy"] == [], f"motionhyst {' '.join(argv)} imported {out['heavy']}"
 
 
+# python-control's plots and scipy.signal's statistics and image filters: what its import
+# would load for a computation that never uses them (motionhyst.core.deferred)
+CONTROL_EXTRAS = ("matplotlib", "mpl_toolkits", "scipy.stats", "scipy.ndimage")
+
+
+@pytest.mark.parametrize("argv", [
+    ["analyze", "--frequency", "5"],
+    ["steady", "--frequency", "5", "--no-floquet"],
+    ["stability"],
+])
+def test_a_command_that_builds_its_loop_imports_python_control_without_its_plots(argv):
+    out = probe(argv)
+    assert out["rc"] == 0, out["err"]
+    assert "control" in out["packages"]
+    loaded = [m for m in out["heavy"] if m.startswith(CONTROL_EXTRAS)]
+    assert loaded == [], f"motionhyst {' '.join(argv)} imported {loaded[:5]}"
+
+
+_DEFERRED_USED = """
+import json, sys
+import numpy as np
+if sys.argv[1] == "deferred":
+    from motionhyst.core.deferred import defer_control_extras
+    defer_control_extras()
+import control
+extras = sorted({m.split(".")[0] + "." + m.split(".")[1] if m.startswith("scipy.") else
+                 m.split(".")[0] for m in sys.modules if m.startswith(CONTROL_EXTRAS)})
+import matplotlib
+matplotlib.use("Agg")
+from scipy.signal import find_peaks_cwt, medfilt, savgol_filter
+x = np.sin(np.linspace(0.0, 20.0, 200)) + 0.1 * np.cos(np.linspace(0.0, 170.0, 200))
+sys_ = control.tf([1.0], [1.0, 0.4, 1.0])
+cplt = control.pole_zero_plot(sys_, grid=True)   # control.grid, axisartist
+nichols = control.nichols_plot(sys_)             # matplotlib.transforms
+bode = control.bode_plot(sys_)                   # pyplot
+print(json.dumps({
+    "extras": extras,
+    "peaks": find_peaks_cwt(x, [5]).tolist(),                   # scipy.stats
+    "savgol": savgol_filter(x, 7, 2, mode="nearest").tolist(),  # scipy.ndimage
+    "median": medfilt(x, 5).tolist(),
+    "lines": [len(a.get_lines()) for a in bode.axes.ravel()],
+    "nichols": [len(a.get_lines()) for a in nichols.axes.ravel()],
+    "grid": type(cplt.axes.ravel()[0]).__name__,
+}))
+""".replace("CONTROL_EXTRAS", repr(CONTROL_EXTRAS))
+
+
+def test_python_control_s_deferred_plots_and_statistics_work_when_used(tmp_path):
+    """The stand-ins import the real modules at their first use: python-control's plots
+    (pyplot, a pole-zero map's grid, a Nichols chart's transforms) and scipy.signal's peak
+    search, filters and median give what the plain import gives."""
+    plain, deferred = (_run(_DEFERRED_USED, how, cwd=tmp_path) for how in ("plain", "deferred"))
+    assert plain.returncode == 0 and deferred.returncode == 0, plain.stderr + deferred.stderr
+    plain, deferred = json.loads(plain.stdout), json.loads(deferred.stdout)
+    assert plain.pop("extras") == ["matplotlib", "mpl_toolkits", "scipy.ndimage", "scipy.stats"]
+    assert deferred.pop("extras") == []
+    assert deferred == plain
+
+
+def test_a_name_a_stand_in_does_not_forward_imports_the_real_module():
+    """Another version of python-control or scipy that imports more than the names forwarded
+    gets the real module (a slower import, never a wrong one)."""
+    code = ("import json, sys\n"
+            "from motionhyst.core.deferred import Deferred\n"
+            "sys.modules['fractions'] = stand_in = Deferred('fractions', ('gcd_unused',))\n"
+            "forward = stand_in.gcd_unused\n"
+            "before = 'fractions' in sys.modules and sys.modules['fractions'] is stand_in\n"
+            "Fraction = stand_in.Fraction\n"
+            "import fractions\n"
+            "print(json.dumps([before, fractions is not stand_in, Fraction is fractions.Fraction,"
+            " str(Fraction(1, 3) + Fraction(1, 6))]))\n")
+    proc = _run(code)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == [True, True, True, "1/2"]
+
+
 def test_import_motionhyst_is_light_and_exports_every_name():
     code = """
 import json, sys

@@ -41,6 +41,7 @@ from motionhyst.core.budget import (
     set_max_memory,
     set_max_seconds,
 )
+from motionhyst.core.deferred import defer_control_extras
 from motionhyst.core.interrupts import DEFERRED, defer, in_numba, interrupted
 
 COMMANDS = ("df", "analyze", "steady", "stability", "simulate", "scan", "identify", "predict",
@@ -132,6 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # is (files and temporary folders are closed by the command itself); only unreachable
         # cycles are left to the operating system
         atexit.register(gc.freeze)
+    defer_control_extras()  # a loop's refusal does not wait for python-control's plots to load
     interrupts = _Interrupts()
     held = HeldWarnings()
     closed = not _writable(sys.stdout)  # ``>&-`` (None) or opened for reading (``1</dev/null``)
