@@ -705,3 +705,33 @@ def test_bad_plant_mass(tmp_path, mass):
     path = tmp_path / "s.toml"
     path.write_text(dump_toml(d))
     assert_one_line(load_error(path), path, "[plant]", "mass")
+
+
+@pytest.mark.parametrize("values", [
+    [20.0] * 1000 + [1e-300] + [1e40],      # the first outside is named
+    [3] * 10 + [10**31] + [1.0],            # integers
+    [1.0, True, 1e-300],                     # a boolean: not a number of the scale
+    [1.0, 1e-300, 10**400],                  # an integer beyond a float, after one outside
+    [0.0, -1e30, float("inf"), float("nan"), -1e-30] * 3,  # 0, the bounds, non-finite: allowed
+])
+def test_a_list_s_magnitudes_are_checked_as_each_number_is(values):
+    """A scenario's list (up to 100 000 values) is checked at once, with the answer of checking
+    each number in turn (:func:`~motionhyst.core.validation.check_magnitude`)."""
+    from motionhyst.core.validation import check_magnitude, check_magnitudes
+
+    def each():
+        for i, v in enumerate(values):
+            if isinstance(v, int | float) and not isinstance(v, bool):
+                check_magnitude(f"[hysteresis] k[{i}]", v)
+
+    expected = got = None
+    try:
+        each()
+    except (ValueError, OverflowError) as exc:
+        expected = (type(exc), str(exc))
+    try:
+        check_magnitudes({"hysteresis": {"k": values}})
+    except (ValueError, OverflowError) as exc:
+        got = (type(exc), str(exc))
+    assert got == expected
+    assert expected is not None or values[0] == 0.0

@@ -81,10 +81,29 @@ def check_magnitudes(data, where: str = "") -> None:
             else:
                 check_magnitudes(value, f"{where} {key}".strip())
     elif isinstance(data, list):
+        if _numbers_checked(data, where):
+            return
         for i, value in enumerate(data):
             check_magnitudes(value, f"{where}[{i}]")
     elif isinstance(data, int | float) and not isinstance(data, bool):
         check_magnitude(where, data)
+
+
+def _numbers_checked(values: list, where: str) -> bool:
+    """Whether the list `values` holds only numbers (int, float), checked at once as
+    :func:`check_magnitude` checks each (the first outside raised, named ``where[i]``): a
+    scenario's list of 100 000 values in milliseconds, not a second."""
+    if not {type(v) for v in values} <= {float, int}:
+        return False
+    try:
+        a = np.abs(np.asarray(values, dtype=float))
+    except OverflowError:  # an integer beyond a float: said where each is checked in turn
+        return False
+    outside = (a != 0.0) & np.isfinite(a) & ((a < MAGNITUDES[0]) | (a > MAGNITUDES[1]))
+    if outside.any():
+        i = int(np.argmax(outside))
+        check_magnitude(f"{where}[{i}]", values[i])
+    return True
 
 
 def check_finite(name: str, value: float) -> float:
