@@ -51,17 +51,17 @@ from motionhyst.identify.io_start import (
     inverse_dynamics,
     reference_mass,
 )
+from motionhyst.identify.io_stiffness import profile_stiffness, stiffness_grid
 from motionhyst.identify.io_uncertainty import (
     FD_SINGULAR_RTOL,
     SINGULAR_RTOL,
-    WINDOW_INFLATION,
     WindowNoise,
     correlated_errors,
     covariance_table,
     parallel_note,
     undetermined_notes,
     weak_notes,
-    window_inflation,
+    window_price,
 )
 from motionhyst.identify.residual_noise import white_noise_variance
 from motionhyst.identify.rigid_limit import as_rigid_limit, rigid_seed
@@ -562,7 +562,10 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     first sample, its velocity at the first samples' slope); the refinement on all
     records runs from the best start and from it with each record's initial state as
     its first :data:`~motionhyst.identify.io_predict.INIT_WINDOW` samples set it there
-    (:func:`~motionhyst.identify.io_refine.refine`), and the better end is kept.
+    (:func:`~motionhyst.identify.io_refine.refine`), and the better end is kept.  A Jenkins
+    link (or a Maxwell-slip link of one element) on a mass-damper is then profiled over its
+    stiffness (:func:`~motionhyst.identify.io_stiffness.profile_stiffness`): a held stiffness
+    that fits the records better than that end is refined from, and the better end kept.
 
     `link` is the link model's class, `plant` a plant instance of the stage's class and
     measured output (its values are not used): a floating stage of two masses is the
@@ -739,6 +742,14 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     # window's state fitted better at the start and ended at fc 18.5 N for a true 20 N)
     sol, q_start, most = refine(prob, q0, tol, max_nfev, reserve, bool(extras.initial) and own,
                                 rigid_link, segments, other)
+    # a Jenkins link, or a Maxwell-slip link of one element (a Jenkins link): its stiffness
+    k_name = ("link.k" if layout.cls is Jenkins else "link.k[0]"
+              if layout.cls is MaxwellSlip and n == 1 else None)
+    if axis and k_name is not None:  # the stiffness's other wells, as the records' cost says
+        v_end = prob.values(prob.whole(sol.x))
+        sol = profile_stiffness(prob, sol, n_plant + layout.names.index(k_name), stiffness_grid(
+            records, v_end[0], float(np.sum(v_end[n_plant:n_base][force]))), tol, max_nfev,
+            reserve)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
     rss = float(res @ res)
@@ -787,9 +798,6 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     for name in one_way.names if one_way is not None else ():  # one force: the sum's known
         std[name] = None
         not_ident[name] = one_way.note
-    # a Jenkins link, or a Maxwell-slip link of one element (a Jenkins link): its stiffness
-    k_name = ("link.k" if layout.cls is Jenkins else "link.k[0]"
-              if layout.cls is MaxwellSlip and n == 1 else None)
     limit = (as_rigid_limit(coulomb, {"m": estimates["m"], "link.k": estimates[k_name]},
                             {"link.k": std[k_name]}, records[0].fs, math.sqrt(rss / res.size),
                             layout.cls.name)
@@ -834,7 +842,7 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
     if one_way is not None:
         notes.append(one_way.line)
     if noise is not None:
-        notes.extend(_window_price(J, rss, res.size, rtol, noise, names[:n_base], init_window))
+        notes.extend(window_price(J, rss, res.size, rtol, noise, names[:n_base], init_window))
     calm = settled(sol, prob.values, std_v)  # on its cap, still to 1 % of the reported std
     return IOIdentification(
         plant=fitted, hysteresis=link, warnings=notes,
@@ -855,24 +863,6 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
                **({"one_way": one_way.to_dict()} if one_way is not None else {})},
         judged_std={nm: None if s is None else float(w)
                     for (nm, s), w in zip(std.items(), white, strict=True)})
-
-
-def _window_price(J, rss, n_rows, rtol, noise: WindowNoise, names: list[str], window: int
-                  ) -> list[str]:
-    """One line when the noise of the initialisation window's samples makes the standard
-    error of one of the stage's or link's parameters (`names`, the first columns of `J`)
-    more than :data:`~motionhyst.identify.io_uncertainty.WINDOW_INFLATION` times that with
-    the records' states estimated from all their samples; else none."""
-    ratio = window_inflation(J, rss, n_rows, rtol, noise)[:len(names)]
-    ratio = np.where(np.isfinite(ratio), ratio, 0.0)
-    worst = int(np.argmax(ratio)) if ratio.size else 0
-    if not ratio.size or ratio[worst] <= WINDOW_INFLATION:
-        return []
-    return [f"the initialisation window's {window} samples set each record's initial state "
-            f"with their noise (its velocity to +- {noise.velocity_std():.2g} m/s): the "
-            f"standard errors are up to {ratio[worst]:.3g} times ({names[worst]}) those with "
-            f"the state estimated from all the samples (identify without --init-window); a "
-            f"longer window narrows them"]
 
 
 def _linear_rms(records, structure, r, periodic, output_offset) -> float | None:

@@ -467,6 +467,25 @@ def window_inflation(J: NDArray[np.float64], rss: float, n_rows: int, rtol: floa
         return with_window / estimated[:J.shape[1]]
 
 
+def window_price(J, rss: float, n_rows: int, rtol: float, noise: WindowNoise,
+                 names: list[str], window: int) -> list[str]:
+    """One line when the noise of the initialisation window's samples makes the standard
+    error of one of the stage's or link's parameters (`names`, the first columns of `J`)
+    more than :data:`WINDOW_INFLATION` times that with the records' states estimated from
+    all their samples (:func:`window_inflation`); else none.  `window` is the window's
+    samples."""
+    ratio = window_inflation(J, rss, n_rows, rtol, noise)[:len(names)]
+    ratio = np.where(np.isfinite(ratio), ratio, 0.0)
+    worst = int(np.argmax(ratio)) if ratio.size else 0
+    if not ratio.size or ratio[worst] <= WINDOW_INFLATION:
+        return []
+    return [f"the initialisation window's {window} samples set each record's initial state "
+            f"with their noise (its velocity to +- {noise.velocity_std():.2g} m/s): the "
+            f"standard errors are up to {ratio[worst]:.3g} times ({names[worst]}) those with "
+            f"the state estimated from all the samples (identify without --init-window); a "
+            f"longer window narrows them"]
+
+
 def covariance_table(names: list[str], cov: NDArray[np.float64],
                      std: dict[str, float | None]) -> dict:
     """``{"parameters": [...], "matrix": [[...]]}``: the covariance of the parameters whose
