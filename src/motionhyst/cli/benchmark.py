@@ -168,8 +168,7 @@ EMPS_SECONDS_PER_SAMPLE = 1e-3
 from [s] (measured: 18-54 s for the Coulomb and Jenkins links on 12480 samples of DATA_EMPS):
 ``benchmark emps`` estimates its run from it and refuses one above ``--max-seconds`` before
 it starts."""
-EMPS_REMEDY = ("give fewer --models, one split (--periods 1-2), or a larger --max-seconds (the "
-               "default models take about 5 min of CPU time)")
+EMPS_REMEDY = "give fewer --models, one split (--periods 1-2), or a larger --max-seconds"
 """What a user can change when ``benchmark emps`` is above its work budget."""
 
 
