@@ -556,10 +556,10 @@ def test_jenkins_with_a_drifting_offset_keeps_the_stiffness_the_record_shows():
 def test_emps_periods_3_4_jenkins_leaves_its_local_minimum():
     """The Jenkins link with viscous friction by direction and the offset drifting, identified
     on EMPS periods 3-4 as the command does: its search ended at k 2.3e6 N/m fitting the
-    periods to 0.2339 mm (the base, 3bf7065), a local minimum: held at 1.32e7 N/m (the grid)
-    and the rest refined, it fits them better; the search now ends there, k 1.32e7 N/m, 0.2333
-    mm, and predicts the held-out periods 1-2 to 4.23 mm (base: 5.72; issue 21's target for
-    this model, at most 5.5 mm)."""
+    periods to 0.2339 mm (the base, 3bf7065), a local minimum: held at 1.08e7 N/m (the grid
+    about that end) and the rest refined, it fits them better; the search now ends there, k
+    1.0e7 N/m, 0.2297 mm, and predicts the held-out periods 1-2 to 4.39 mm (base: 5.72; issue
+    21's target for this model, at most 5.5 mm)."""
     res = run_emps(_data_emps(), models=("jenkins-asymmetric-drift",), periods=(3, 4))
     (model,) = res.models
     assert model.limit is None

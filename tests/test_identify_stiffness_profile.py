@@ -13,7 +13,7 @@ from motionhyst.identify import io_elements
 from motionhyst.identify.emps import score
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_friction import PRESLIDING_BOUND, STUCK_MODE_SAMPLES
-from motionhyst.identify.io_stiffness import PER_DECADE, stiffness_grid
+from motionhyst.identify.io_stiffness import PER_DECADE, SPAN, stiffness_grid
 from motionhyst.plants.mass_damper import MassDamper
 from motionhyst.time.openloop import OpenLoop
 
@@ -32,17 +32,23 @@ def jenkins_axis(k: float, noise: float = 1e-9) -> IORecord:
     return IORecord(t, u, y + noise * np.random.default_rng(7).standard_normal(t.size), "axis")
 
 
-def test_the_grid_spans_the_stiffnesses_the_records_resolve():
-    """From a slip displacement fc / k of PRESLIDING_BOUND of the stroke to a stuck mode
-    sqrt(k / m) / 2 pi at fs / STUCK_MODE_SAMPLES, PER_DECADE values a decade."""
+@pytest.mark.parametrize("k_end", [3e6, 1e8, 5e4])
+def test_the_grid_lies_about_the_end_within_what_the_records_resolve(k_end):
+    """PER_DECADE values a decade about the refinement's end (not the end itself), at most
+    SPAN decades each side, none softer than a slip displacement fc / k of PRESLIDING_BOUND
+    of the stroke or stiffer than a stuck mode sqrt(k / m) / 2 pi at fs / STUCK_MODE_SAMPLES
+    (an end near a bound: the values on that side cut off)."""
     rec = jenkins_axis(1e7)
-    grid = stiffness_grid([rec], 95.0, 20.0)
-    stroke = float(np.ptp(rec.y))
-    assert 20.0 / grid[0] == pytest.approx(PRESLIDING_BOUND * stroke, rel=1e-12)
-    assert math.sqrt(grid[-1] / 95.0) / (2 * math.pi) == pytest.approx(
-        1000.0 / STUCK_MODE_SAMPLES, rel=1e-12)
-    steps = np.diff(np.log10(grid))
-    assert np.allclose(steps, steps[0]) and steps[0] <= 1.0 / PER_DECADE
+    grid = stiffness_grid([rec], 95.0, 20.0, k_end)
+    lo = 20.0 / (PRESLIDING_BOUND * float(np.ptp(rec.y)))
+    hi = 95.0 * (2 * math.pi * 1000.0 / STUCK_MODE_SAMPLES) ** 2
+    assert grid.size and lo <= grid.min() and grid.max() <= hi
+    decades = np.log10(grid / k_end) * PER_DECADE  # whole numbers of steps from the end
+    assert np.allclose(decades, np.round(decades)) and np.all(np.round(decades) != 0)
+    assert np.abs(np.log10(grid / k_end)).max() <= SPAN + 1e-12
+    full = [k for k in k_end * 10.0 ** (np.arange(-9, 10) / PER_DECADE)
+            if lo <= k <= hi and k != k_end and abs(math.log10(k / k_end)) <= SPAN + 1e-12]
+    assert grid == pytest.approx(full, rel=1e-12)  # every such value, none left out
 
 
 @pytest.mark.parametrize("k", [3e6, 3e7])

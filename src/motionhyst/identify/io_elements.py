@@ -747,8 +747,9 @@ def identify_elements_io(records, link, periodic, substeps, tol, max_nfev, n, t_
               if layout.cls is MaxwellSlip and n == 1 else None)
     if axis and k_name is not None:  # the stiffness's other wells, as the records' cost says
         v_end = prob.values(prob.whole(sol.x))
-        sol = profile_stiffness(prob, sol, n_plant + layout.names.index(k_name), stiffness_grid(
-            records, v_end[0], float(np.sum(v_end[n_plant:n_base][force]))), tol, max_nfev,
+        at = n_plant + layout.names.index(k_name)
+        sol = profile_stiffness(prob, sol, at, stiffness_grid(
+            records, v_end[0], float(np.sum(v_end[n_plant:n_base][force])), v_end[at]),
             reserve)
     v = prob.values(sol.x)
     res = prob.residuals(sol.x) * y_scale
