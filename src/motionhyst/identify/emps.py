@@ -83,7 +83,8 @@ within 3 % of the benchmark's 95.1 kg; the drifting offset takes part of the ine
 3.2 % low, which its warnings say
 (:func:`~motionhyst.identify.emps_reference.reference_notes`).  Other models are given by name
 (:func:`run_emps`'s `models`, ``benchmark emps --models``): ``jenkins-asymmetric-drift`` (a
-stiffness the halves resolve, 2.3e6-2.9e6 N/m; 1.29 and 5.72 mm on the two splits), those
+stiffness the halves resolve, 3.1e6 and 1.0e7 N/m; 1.17 and 4.39 mm on the two splits, its
+worse below ``coulomb-asymmetric-drift``'s, at about 2 min of CPU a fit), those
 with one viscous coefficient (``"coulomb-symmetric"``, ``"jenkins-symmetric"``,
 ``"jenkins-symmetric-drift"``: 90.6-91.5 kg, the difference between the directions taken into
 the mass), and those named by their link alone (``"jenkins"``), fitted as ``identify`` fits
