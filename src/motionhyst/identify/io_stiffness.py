@@ -114,8 +114,8 @@ def profile_stiffness(prob, sol: OptimizeResult, index: int, grid: NDArray[np.fl
     at each value of `grid` in turn, the others refined from `sol` with it (at most
     :data:`HELD_STEPS` steps each, ended at :data:`HELD_TOL`); from the held fit of least
     cost, if it costs less than `sol`, everything is refined (as the held fits: on a cost that
-    is not smooth in the stiffness the search's own tolerance spends its `max_nfev` steps for
-    a fraction of a percent), and that end is returned where it costs less than `sol`.
+    is not smooth in the stiffness the search's own tolerance runs to its step limit for a
+    fraction of a percent), and that end is returned where it costs less than `sol`.
 
     With a budget (``prob.budget``), `reserve` evaluations are kept for what follows; the
     held fits share half of the rest, each an equal part, and are not run where that part is
