@@ -78,9 +78,9 @@ direction (``-asymmetric``, ``identify --asymmetric``: the structure of the benc
 asymmetric model, eq. 12 of its description; ``jenkins-asymmetric`` is the Jenkins link on a
 mass-damper, fitted and scored with the 20-sample initialisation window), the Coulomb link also
 with the force offset drifting in time from the record's start (``-drift``, ``identify
---drift``).  On the whole of ``DATA_EMPS`` the first and the third find 93.47 and 93.91 kg,
-within 3 % of the benchmark's 95.1 kg; the drifting offset takes part of the inertia, 92.05 kg,
-3.2 % low, which its warnings say
+--drift``).  On the whole of ``DATA_EMPS`` the first and the third find 93.47 and 92.34 kg
+(the Jenkins stiffness profiled: 1.4e6 N/m), within 3 % of the benchmark's 95.1 kg; the
+drifting offset takes part of the inertia, 92.05 kg, 3.2 % low, which its warnings say
 (:func:`~motionhyst.identify.emps_reference.reference_notes`).  Other models are given by name
 (:func:`run_emps`'s `models`, ``benchmark emps --models``): ``jenkins-asymmetric-drift`` (a
 stiffness the halves resolve, 3.1e6 and 1.0e7 N/m; 1.17 and 4.39 mm on the two splits, its
