@@ -10,6 +10,7 @@ import argparse
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 
 from motionhyst.cli._common import UsageError, g, print_json, release_held, table, whole_number
@@ -44,6 +45,11 @@ def add_parser(sub) -> None:
                         "or -symmetric for one coefficient (neither: by direction where the "
                         "record shows it, as identify fits it) and -drift for a force offset "
                         "drifting in time)")
+    q.add_argument("--workers", type=whole_number(1, 4096, "--workers"),
+                   help="emps: processes fitting at once, each a chain of models (a Jenkins "
+                        "link after the Coulomb link it starts from) on a split (default: "
+                        "every core this process may use; 1: this process). The figures are "
+                        "the same with any number; --max-seconds holds each chain to it")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=run)
 
@@ -73,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the benchmark named and print its table (or JSON)."""
     if args.name == "emps":
         return run_emps(args)
-    for option in ("periods", "models"):
+    for option in ("periods", "models", "workers"):
         if getattr(args, option) is not None:
             raise UsageError(f"motionhyst benchmark: --{option} applies to emps only")
     return run_bouc_wen(args)
@@ -223,8 +229,9 @@ def run_emps(args: argparse.Namespace) -> int:
         raise UsageError(f"motionhyst benchmark emps: --periods splits DATA_EMPS when there is "
                          f"no test record; {test_path} is there")
     # the optimisers imported once the folder, its records and the options are known good
-    from motionhyst.core.budget import check_work
+    from motionhyst.core.budget import check_work, cpu_time_limit, max_seconds
     from motionhyst.identify.emps import CHOSEN, MODELS, choose, cross_validate, run_emps
+    from motionhyst.identify.emps_workers import usable_cores
 
     check_work(_emps_seconds(estimation, test, args.periods, models), "benchmark emps",
                EMPS_REMEDY)
@@ -232,13 +239,17 @@ def run_emps(args: argparse.Namespace) -> int:
     splits = 1 if test is not None or args.periods not in (None, "all") else (
         2 if args.periods is None else 4)
     fits = splits * len(MODELS if models is None else models)
+    # the workers' CPU time is theirs: each chain of fits is held to the budget in its own
+    workers = {"workers": args.workers or usable_cores(), "guard": partial(
+        cpu_time_limit, max_seconds(), "benchmark emps", EMPS_REMEDY)}
     with _progress("emps", 2 * fits, args.json, EMPS_REMEDY) as say:  # each fit's start, end
         if test is None and args.periods in (None, "all"):  # one split alone says little
             results = cross_validate(estimation, models=models, progress=say,
-                                     splits="halves" if args.periods is None else "all")
+                                     splits="halves" if args.periods is None else "all",
+                                     **workers)
         else:
             results = [run_emps(estimation, test, models=models,
-                                periods=args.periods or (1, 2), progress=say)]
+                                periods=args.periods or (1, 2), progress=say, **workers)]
     chosen = None
     if len(results) > 1:
         picked = choose(results)  # None: every model failed on some split

@@ -35,13 +35,14 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from motionhyst.core.warnings import MotionhystWarning
 from motionhyst.identify._emps_cells import failed_table, friction, marked, offset, own, viscous
-from motionhyst.identify.emps_files import COLUMNS, DRIVE_GAIN, ESTIMATION_FILE, TEST_FILE
+from motionhyst.identify.emps_files import COLUMNS, DRIVE_GAIN, ESTIMATION_FILE, PERIOD, TEST_FILE
 from motionhyst.identify.emps_models import (
     OPTIONS,
     RIGID_LIMIT,
@@ -60,9 +61,11 @@ from motionhyst.identify.emps_reference import (
     reference_notes,
     reference_system,
 )
+from motionhyst.identify.emps_scores import own_offset_score, period_drift, score
+from motionhyst.identify.emps_workers import map_in_workers
 from motionhyst.identify.input_output import IORecord, identify_io
 from motionhyst.identify.io_checks import MAX_PREDICT_SUBSTEPS, FitFailed
-from motionhyst.identify.io_predict import INIT_WINDOW, predict_from_window
+from motionhyst.identify.io_predict import INIT_WINDOW
 from motionhyst.identify.io_start import inverse_dynamics
 
 __all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
@@ -70,8 +73,6 @@ __all__ = ["CHOSEN", "COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE",
            "EMPSBenchmark", "EMPSModel", "choose", "cross_validate", "own_offset_score",
            "period_drift", "run_emps", "score", "split_by_periods"]
 
-PERIOD = 6240
-"""Samples per period of the estimation record's reference ``qg``."""
 MODELS = ("coulomb-asymmetric", "coulomb-asymmetric-drift", "jenkins-asymmetric")
 """Link models identified by default: friction of a positioning axis with viscous friction by
 direction (``-asymmetric``, ``identify --asymmetric``: the structure of the benchmark's
@@ -517,153 +518,12 @@ class EMPSBenchmark:
         return fig
 
 
-def own_offset_score(system, record: IORecord, span: float = 2.0) -> dict:
-    """The model's score on a record with the force offset that suits the record best.
-
-    The force offset ``OF`` alone is re-estimated on `record` (the plant
-    receives ``F - OF``), everything else kept: the error left is the model's
-    own, the rest of its score was the difference between the offset of the
-    records it was identified from and this one's.  A diagnosis, not a score:
-    the benchmark's models may not look at the record they are scored on.
-
-    Parameters
-    ----------
-    system : OpenLoop
-        The model (a plant with ``force_offset = -OF``).
-    record : IORecord
-        The record scored.
-    span : float
-        The offset is searched within this many newtons of the model's [N].
-
-    Returns
-    -------
-    dict
-        ``{"offset": OF [N], "rmse_mm": ..}``.
-
-    Examples
-    --------
-    The reference model on its own record made with an offset 0.2 N larger:
-
-    >>> import numpy as np
-    >>> t = np.arange(3000) / 1000.0
-    >>> u = 120.0 * np.sin(2 * np.pi * t) + 40.0 * np.sin(5 * np.pi * t)
-    >>> shifted = reference_system(dict(REFERENCE_MODEL, offset=-2.9648))
-    >>> y = shifted.simulate(t, u).displacement
-    >>> own = own_offset_score(reference_system(), IORecord(t, u, y, "shifted"))
-    >>> round(own["offset"], 3), own["rmse_mm"] < 0.01
-    (-2.965, True)
-    """
-    from scipy.optimize import minimize_scalar
-
-    plant = system.plant
-    of = -plant.force_offset
-
-    def rmse(offset: float) -> float:
-        plant.force_offset = -offset
-        try:
-            return float(score(system, record)[0]["rmse_mm"])
-        finally:
-            plant.force_offset = -of
-
-    sol = minimize_scalar(rmse, bounds=(of - span, of + span), method="bounded",
-                          options={"xatol": 1e-3})
-    return {"offset": float(sol.x), "rmse_mm": float(sol.fun)}
-
-
-def period_drift(record: IORecord, period: int = PERIOD) -> list[dict]:
-    """The inverse-dynamics (IDIM-LS) estimate of each period of a record, to see it drift.
-
-    Each period (the last one if it holds at least half of one) is fitted
-    alone by :func:`~motionhyst.identify.io_start.inverse_dynamics`, with one
-    viscous friction and with one per direction.  On ``DATA_EMPS`` the force
-    offset moves from -3.00 to -3.34 N over the four periods of the same motion;
-    with viscous friction by direction the offset stays between -0.32 and -0.24 N and the
-    forward viscous friction falls from 171 to 165 N s/m instead (the axis
-    warming up, or a drift of the drive): a model identified on some periods
-    misses the others by that much, whatever its friction law.
-
-    Parameters
-    ----------
-    record : IORecord
-        The record.
-    period : int
-        Samples per period.
-
-    Returns
-    -------
-    list of dict
-        ``{"period", "m", "offset", "c_pos", "c_neg", "offset_asymmetric"}`` per
-        period (1-based), in [kg], [N], [N s/m].
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> t = np.arange(4000) / 1000.0
-    >>> y = 0.05 * np.sin(2 * np.pi * t)
-    >>> v = np.gradient(y, t, edge_order=2)
-    >>> u = 95 * np.gradient(v, t, edge_order=2) + 200 * v + 20 * np.sign(v) - 3 - 0.2 * t
-    >>> [round(d["offset"], 2) for d in period_drift(IORecord(t, u, y), 1000)]
-    [-3.1, -3.3, -3.5, -3.7]
-    """
-    out = []
-    for i in range(-(-record.t.size // period)):
-        s = slice(i * period, min((i + 1) * period, record.t.size))
-        if s.stop - s.start < period // 2:
-            break
-        piece = [IORecord(record.t[s], record.u[s], record.y[s], record.name)]
-        sym = inverse_dynamics(piece, floating=True)
-        asym = inverse_dynamics(piece, floating=True, asymmetric=True)
-        out.append({"period": i + 1, "m": sym["m"], "offset": sym["u0"],
-                    "c_pos": asym["c_pos"], "c_neg": asym["c_neg"],
-                    "offset_asymmetric": asym["u0"]})
-    return out
-
-
-def score(system, record: IORecord) -> tuple[dict, np.ndarray]:
-    """The benchmark's metric of a model on a record, and the simulated position.
-
-    The position is simulated from the force alone, the initial state set from
-    the first :data:`INIT_WINDOW` samples
-    (:func:`~motionhyst.identify.io_predict.predict_from_window`); the RMS error
-    in mm and the fit in % count the samples from :data:`INIT_WINDOW` on.
-
-    Parameters
-    ----------
-    system : OpenLoop
-        The model (its plant's ``force_offset`` applied).
-    record : IORecord
-        Time [s], force [N] and measured position [m].
-
-    Returns
-    -------
-    dict
-        ``{"record": record.name, "rmse_mm": .., "fit_percent": ..}``.
-    ndarray
-        The simulated position [m].
-
-    Examples
-    --------
-    The reference model scored on a record it made itself, shifted by 1 mm (the
-    state set from the window takes the shift up):
-
-    >>> import numpy as np
-    >>> ref = reference_system()
-    >>> t = np.arange(3000) / 1000.0
-    >>> u = 120.0 * np.sin(2 * np.pi * t)
-    >>> y = ref.simulate(t, u).displacement
-    >>> metric, _ = score(ref, IORecord(t, u, y + 1e-3, "shifted"))
-    >>> metric["rmse_mm"] < 0.01, round(metric["fit_percent"], 1)
-    (True, 100.0)
-    """
-    pred = predict_from_window(system, record.t, record.u, record.y, window=INIT_WINDOW)
-    return ({"record": record.name, "rmse_mm": 1e3 * pred.rmse,
-             "fit_percent": pred.fit_percent}, pred.displacement)
-
-
 def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
                    period: int | None = None,
                    progress: Callable[[str], None] | None = None,
-                   splits: str = "halves") -> list[EMPSBenchmark]:
+                   splits: str = "halves", workers: int = 1,
+                   guard: Callable[[], AbstractContextManager] | None = None
+                   ) -> list[EMPSBenchmark]:
     """The benchmark without its test record: identified on each half of the estimation
     record's periods and scored on the other half, both ways (with ``splits="all"`` also
     on all periods but the last and all but the first, each scored on the one left).
@@ -677,8 +537,8 @@ def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
     ----------
     estimation : IORecord
         The estimation record (at least two periods).
-    models, period, progress
-        As for :func:`run_emps`.
+    models, period, progress, workers, guard
+        As for :func:`run_emps` (the fits of every split share the workers).
     splits : {"halves", "all"}
         ``"halves"``: periods 1-2 then 3-4 (of four); ``"all"``: then also 1-3 and
         2-4, each validated on the period it leaves out (a record of three or more
@@ -728,13 +588,19 @@ def cross_validate(estimation: IORecord, *, models: Sequence[str] | None = None,
             raise ValueError(f"{estimation.name}: {count} periods of {period} samples; "
                              f"every split needs three or more")
         ways += [w for w in ((1, count - 1), (2, count)) if w not in ways]
-    return [run_emps(estimation, models=models, periods=periods, period=period,
-                     progress=progress) for periods in ways]
+    models = MODELS if models is None else tuple(models)
+    for name in models:
+        check_model(name)
+    pairs = [split_by_periods(estimation, way, period, name=estimation.name) for way in ways]
+    fitted = _fit_splits(pairs, models, workers, guard, progress)
+    return [_benchmark(estimation, None, est, val, out, period)
+            for (est, val), out in zip(pairs, fitted, strict=True)]
 
 
 def run_emps(estimation: IORecord, test: IORecord | None = None, *,
              models: Sequence[str] | None = None, periods: tuple[int, int] = (1, 2),
-             period: int | None = None, progress: Callable[[str], None] | None = None
+             period: int | None = None, progress: Callable[[str], None] | None = None,
+             workers: int = 1, guard: Callable[[], AbstractContextManager] | None = None
              ) -> EMPSBenchmark:
     """Identify the axis with each link model and score it by the benchmark's metric.
 
@@ -754,7 +620,15 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     period : int, optional
         Samples per period of the estimation record (default :data:`PERIOD`).
     progress : callable, optional
-        Called with a line of text as each model starts and ends.
+        Called with a line of text as each model starts and ends (with workers: as each
+        chain of models is handed to one, and as each model ends).
+    workers : int
+        The most processes fitting at once (:func:`~motionhyst.identify.emps_workers.
+        map_in_workers`): the models come in chains, a Jenkins link after the Coulomb link
+        with its options (its start), each chain in one process; the same figures as one.
+    guard : callable, optional
+        With workers: returns the context each chain runs in, in its worker (the caller's
+        CPU-time limit counts its own process's time, not the workers').
 
     Returns
     -------
@@ -781,7 +655,6 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
     >>> round(p["m"], 1), round(p["c"], 1), round(p["fc"], 2), round(p["offset"], 3)
     (95.1, 203.5, 20.39, -3.165)
     """
-    say = progress or (lambda _msg: None)
     models = MODELS if models is None else tuple(models)
     period = PERIOD if period is None else int(period)
     if test is None:
@@ -790,21 +663,14 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         est, val = estimation, test
     for name in models:
         check_model(name)
-    out: list[EMPSModel] = []
-    rigid: dict[frozenset, object] = {}  # the Coulomb fits by options: the others' start
-    for name in models:
-        say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
-        t0 = time.perf_counter()
-        try:
-            model = _model(name, est, val, out, rigid)
-        except ValueError as exc:  # this model's row says why; the others' minutes are kept
-            why = " ".join(str(exc).removeprefix(f"{name}: ").split())
-            model = EMPSModel.failed(name, {"record": est.name}, {"record": val.name}, why)
-        model.seconds = time.perf_counter() - t0
-        out.append(model)
-        say(f"{name}: failed ({model.seconds:.0f} s): {model.error}" if model.error else
-            f"{name}: {model.validation['rmse_mm']:.3g} mm on {val.name} "
-            f"({model.seconds:.0f} s)")
+    out = _fit_splits([(est, val)], models, workers, guard, progress)[0]
+    return _benchmark(estimation, test, est, val, out, period)
+
+
+def _benchmark(estimation: IORecord, test: IORecord | None, est: IORecord, val: IORecord,
+               out: list[EMPSModel], period: int) -> EMPSBenchmark:
+    """The models `out` fitted on `est`, with the reference models scored on `est` and `val`
+    and, without `test`, the periods' drift of `estimation`."""
     ref = {"estimation": score(reference_system(), est)[0],
            "validation": score(reference_system(), val)[0],
            "asymmetric": {"parameters": dict(REFERENCE_ASYMMETRIC),
@@ -819,6 +685,68 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
                     "validation": score(own, val)[0]}
     drift = [] if test is not None else period_drift(estimation, period)
     return EMPSBenchmark(out, est, val, test is not None, ref, drift)
+
+
+def _fit_splits(splits: list[tuple[IORecord, IORecord]], models: tuple[str, ...], workers: int,
+                guard: Callable[[], AbstractContextManager] | None,
+                progress: Callable[[str], None] | None) -> list[list[EMPSModel]]:
+    """The `models` fitted on each split's estimation record and scored on its validation
+    record, in the order of `models`: in this process one after another, or by chains in
+    `workers` processes (the chains with a link other than Coulomb, the longest, first)."""
+    say = progress or (lambda _msg: None)
+    if workers <= 1:
+        return [_fit_chain(est, val, models, say) for est, val in splits]
+    chains: dict[frozenset, list[str]] = {}  # a link starts from the Coulomb fit of its options
+    for name in models:
+        chains.setdefault(frozenset(model_options(name)[1]), []).append(name)
+    order = sorted(((k, tuple(chain)) for k in range(len(splits)) for chain in chains.values()),
+                   key=lambda kc: all(model_options(n)[0] == "coulomb" for n in kc[1]))
+    tasks = [(*splits[k], chain) for k, chain in order]
+
+    def started(i: int) -> None:
+        est, _, names = tasks[i]
+        say(f"{', '.join(names)}: identifying on {est.name} ({est.t.size} samples) ...")
+
+    def finished(i: int, fitted: list[EMPSModel]) -> None:
+        for model in fitted:
+            say(_ended(model, tasks[i][1]))
+
+    ends = map_in_workers(_chain_task, tasks, workers, guard, started, finished)
+    by_fit = {(k, model.name): model
+              for (k, _), fitted in zip(order, ends, strict=True) for model in fitted}
+    return [[by_fit[k, name] for name in models] for k in range(len(splits))]
+
+
+def _chain_task(task: tuple[IORecord, IORecord, tuple[str, ...]]) -> list[EMPSModel]:
+    """:func:`_fit_chain` of a worker's task ``(est, val, names)``."""
+    return _fit_chain(*task)
+
+
+def _fit_chain(est: IORecord, val: IORecord, names: Sequence[str],
+               say: Callable[[str], None] = lambda _msg: None) -> list[EMPSModel]:
+    """The models `names` identified on `est` and scored on `val`, one after another (a
+    failed fit a row saying why); `say` told as each starts and ends."""
+    out: list[EMPSModel] = []
+    rigid: dict[frozenset, object] = {}  # the Coulomb fits by options: the others' start
+    for name in names:
+        say(f"{name}: identifying on {est.name} ({est.t.size} samples) ...")
+        t0 = time.perf_counter()
+        try:
+            model = _model(name, est, val, out, rigid)
+        except ValueError as exc:  # this model's row says why; the others' minutes are kept
+            why = " ".join(str(exc).removeprefix(f"{name}: ").split())
+            model = EMPSModel.failed(name, {"record": est.name}, {"record": val.name}, why)
+        model.seconds = time.perf_counter() - t0
+        out.append(model)
+        say(_ended(model, val))
+    return out
+
+
+def _ended(model: EMPSModel, val: IORecord) -> str:
+    """The progress line of a model fitted and scored on `val`."""
+    return (f"{model.name}: failed ({model.seconds:.0f} s): {model.error}" if model.error else
+            f"{model.name}: {model.validation['rmse_mm']:.3g} mm on {val.name} "
+            f"({model.seconds:.0f} s)")
 
 
 def _model(name: str, est: IORecord, val: IORecord, done: list[EMPSModel], rigid: dict

@@ -1,4 +1,4 @@
-"""The EMPS benchmark's files: their names, their variables and the drive's gain.
+"""The EMPS benchmark's files: their names, their variables, the drive's gain and the period.
 
 A. Janot, M. Gautier and M. Brunot, "Data Set and Reference Models of EMPS",
 Workshop on Nonlinear System Identification Benchmarks, Eindhoven, 2019
@@ -15,7 +15,7 @@ Examples
 
 from __future__ import annotations
 
-__all__ = ["COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "TEST_FILE"]
+__all__ = ["COLUMNS", "DRIVE_GAIN", "ESTIMATION_FILE", "PERIOD", "TEST_FILE"]
 
 ESTIMATION_FILE = "DATA_EMPS.mat"
 """The benchmark's estimation record."""
@@ -25,3 +25,5 @@ COLUMNS = {"time": "t", "force": "vir", "displacement": "qm"}
 """The records' variables: time [s], controller output [V], measured position [m]."""
 DRIVE_GAIN = 35.15065
 """The drive's gain ``gtau`` [N/V]: the force on the load is ``gtau * vir``."""
+PERIOD = 6240
+"""Samples per period of the estimation record's reference ``qg``."""
