@@ -623,9 +623,10 @@ def run_emps(estimation: IORecord, test: IORecord | None = None, *,
         Called with a line of text as each model starts and ends (with workers: as each
         chain of models is handed to one, and as each model ends).
     workers : int
-        The most processes fitting at once (:func:`~motionhyst.identify.emps_workers.
-        map_in_workers`): the models come in chains, a Jenkins link after the Coulomb link
-        with its options (its start), each chain in one process; the same figures as one.
+        The most processes fitting at once
+        (:func:`~motionhyst.identify.emps_workers.map_in_workers`): the models come in
+        chains, a Jenkins link after the Coulomb link with its options (its start), each
+        chain in one process; the same figures as in one.
     guard : callable, optional
         With workers: returns the context each chain runs in, in its worker (the caller's
         CPU-time limit counts its own process's time, not the workers').
