@@ -400,6 +400,31 @@ print(json.dumps({"w": w.tolist(), "in_memory": compiled_in_memory()}))
 """
 
 
+def _run_on_a_terminal(code: str, env: dict, cwd: Path) -> subprocess.CompletedProcess:
+    """:func:`_run` with stderr a terminal (a pseudo-terminal read here), where the first
+    compilation is announced."""
+    import pty
+
+    parent, child = pty.openpty()
+    with subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                          stderr=child, env=env, cwd=cwd, text=True) as proc:
+        os.close(child)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(parent, 4096)
+            except OSError:  # the terminal's other end closed: the process ended
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        os.close(parent)
+        out = proc.stdout.read()
+        rc = proc.wait(timeout=600)
+    err = b"".join(chunks).decode().replace("\r\n", "\n")
+    return subprocess.CompletedProcess(proc.args, rc, out, err)
+
+
 def _env(root: Path, cache_home: Path) -> dict:
     env = {k: v for k, v in os.environ.items()
            if k not in ("HOME", "XDG_CACHE_HOME", "NUMBA_CACHE_DIR", "PYTHONPATH")}
@@ -414,13 +439,15 @@ def test_read_only_install_without_cache_folder_compiles_in_memory(tmp_path):
     blocked.write_text("")  # neither the user cache nor HOME can hold a folder
     env = _env(root, blocked)
     env["HOME"] = str(blocked)
-    proc = _run(_KERNEL, env=env, cwd=tmp_path)
+    proc = _run_on_a_terminal(_KERNEL, env=env, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     assert out == {"w": [0.0, 0.05, -0.05, 0.05], "in_memory": True}
     assert proc.stderr.count("motionhyst: compiling") == 1
     assert "this run only" in proc.stderr
     assert "Traceback" not in proc.stderr
+    piped = _run(_KERNEL, env=env, cwd=tmp_path)  # stderr not a terminal: nothing announced
+    assert piped.returncode == 0 and json.loads(piped.stdout) == out and piped.stderr == ""
 
 
 def test_read_only_install_caches_in_the_user_folder(tmp_path):
@@ -428,13 +455,13 @@ def test_read_only_install_caches_in_the_user_folder(tmp_path):
     cache = tmp_path / "cache"
     env = _env(root, cache)
     env.pop("HOME", None)
-    first = _run(_KERNEL, env=env, cwd=tmp_path)
+    first = _run_on_a_terminal(_KERNEL, env=env, cwd=tmp_path)
     assert first.returncode == 0, first.stderr
     assert json.loads(first.stdout) == {"w": [0.0, 0.05, -0.05, 0.05], "in_memory": False}
     assert first.stderr.count("motionhyst: compiling") == 1
     assert "cached for later runs" in first.stderr
     assert list(cache.rglob("*.nbi")), "no numba index in the user cache folder"
-    second = _run(_KERNEL, env=env, cwd=tmp_path)
+    second = _run_on_a_terminal(_KERNEL, env=env, cwd=tmp_path)
     assert second.returncode == 0, second.stderr
     assert second.stdout == first.stdout
     assert "compiling" not in second.stderr  # loaded from the cache, nothing announced

@@ -6,6 +6,7 @@ budget beyond the machine is warned of at once, before a run the system may kill
 
 from __future__ import annotations
 
+import io
 import os
 import re
 import resource
@@ -13,6 +14,7 @@ import select
 import signal
 import subprocess
 import time
+import types
 from pathlib import Path
 
 import limited_process
@@ -224,10 +226,16 @@ def _mm_hysteresis_record(path: Path) -> None:
                header="time,displacement,force", comments="", fmt="%.9g")
 
 
-def test_the_warnings_held_come_before_a_first_compilation_s_notice(tmp_path):
-    """identify on a cold cache (review B17 L1): the record's unit warning, held while its
-    checks run, came after the compilation the checks start (main: the notice, then seconds
-    to minutes of compiling, then the warning); now the warning, then the notice.  Run as the
+MM_STROKE = ("motionhyst: warning: identify: r.csv: displacement reaches 178 m, beyond the 100 m "
+             "of a motion stage's stroke: if the positions are not in metres, scale them (--scale "
+             "displacement=0.001 for mm, 1e-6 for um)")
+"""The warning :func:`_mm_hysteresis_record` gets from identify."""
+
+
+def test_a_first_compilation_says_nothing_where_stderr_is_not_a_terminal(tmp_path):
+    """identify on a cold cache (a fresh install), stderr a pipe as a script has it (review
+    B21 F5: the notice of the first compilation made a refusal after it two lines): the
+    command says only what it says on a warm cache, the record's unit warning.  Run as the
     console script runs, the notice not left out, with a cache folder of its own."""
     import sys
 
@@ -237,11 +245,49 @@ def test_the_warnings_held_come_before_a_first_compilation_s_notice(tmp_path):
                           env=limited_process.environment(NUMBA_CACHE_DIR=str(tmp_path / "c")))
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("Maxwell-slip hysteresis identified from r.csv")
-    assert proc.stderr.splitlines() == [
-        "motionhyst: warning: identify: r.csv: displacement reaches 178 m, beyond the 100 m of "
-        "a motion stage's stroke: if the positions are not in metres, scale them (--scale "
-        "displacement=0.001 for mm, 1e-6 for um)",
-        "motionhyst: compiling numerical kernels on first use (cached for later runs) ..."]
+    assert list((tmp_path / "c").rglob("*.nbi")), "no kernel was compiled into the cache"
+    assert proc.stderr.splitlines() == [MM_STROKE]
+
+
+class _Terminal(io.StringIO):
+    """A stream that says it is a terminal."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+@pytest.mark.parametrize("terminal", [True, False])
+def test_the_warnings_held_come_before_a_first_compilation_s_notice_on_a_terminal(
+        monkeypatch, terminal):
+    """Review B17 L1: on a terminal the warnings held while a command checks its input come
+    before the notice of a first compilation (seconds to minutes), not after it.  Review B21
+    F5: elsewhere there is no notice, and the warnings stay held (a refusal then drops them
+    and is its one line)."""
+    import contextlib
+
+    from motionhyst.cli._common import HeldWarnings, warnings_on_stderr
+    from motionhyst.core import compiled
+    from motionhyst.core.warnings import warn
+
+    def kernel():
+        """A function of the package, as the compile event names its dispatcher's."""
+
+    kernel.__module__ = "motionhyst.hysteresis.jenkins"
+    monkeypatch.setitem(compiled._STATE, "announced", False)
+    monkeypatch.setitem(compiled._STATE, "cache", True)
+    err = _Terminal() if terminal else io.StringIO()
+    held = HeldWarnings()
+    with contextlib.redirect_stderr(err):
+        with pytest.raises(ValueError), warnings_on_stderr("identify", held):
+            held.hold()
+            warn("r.csv: displacement reaches 178 m")
+            compiled._announce(types.SimpleNamespace(py_func=kernel))
+            raise ValueError("a refusal after the compilation")
+        held.drop()
+    notice = "motionhyst: compiling numerical kernels on first use (cached for later runs) ..."
+    assert err.getvalue().splitlines() == (
+        ["motionhyst: warning: identify: r.csv: displacement reaches 178 m", notice]
+        if terminal else [])
 
 
 OLD_SPELLING = " (`motionhyst simulate` without --time-series is now `motionhyst steady`)"

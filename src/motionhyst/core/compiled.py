@@ -18,10 +18,12 @@ Jenkins element) does not import numba.  At the first call, once per process:
   :data:`PRUNE_SECONDS`, or for :data:`BUSY_SECONDS` past the
   :data:`KEEP_RECENT` most recently used, are removed (:func:`prune_caches`),
   so that they do not pile up, one per edit or upgrade;
-* the first compilation announces itself with one line on stderr (it takes
-  seconds; later runs load the cache); what a command held back to that moment (its
-  warnings, while it checks its input) is shown just before (:func:`before_notice`), not
-  after the compilation.
+* the first compilation announces itself with one line on stderr when stderr is a
+  terminal (it takes seconds; later runs load the cache); what a command held back to
+  that moment (its warnings, while it checks its input) is shown just before
+  (:func:`before_notice`), not after the compilation.  Where stderr is not a terminal (a
+  script, a pipe, a file) nothing is announced and the warnings stay held as usual, so
+  that a refusal after a first compilation is still its one line.
 
 Kernels calling other kernels work as in numba: a kernel passes for its numba
 dispatcher inside compiled code.  A kernel declared with a signature
@@ -283,14 +285,26 @@ def _can_cache(py_func: Callable = _probe) -> bool:
     return True
 
 
+def _on_terminal(stream) -> bool:
+    """True if `stream` is a terminal (a stream without ``isatty``, or a closed one, is not)."""
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
 def _announce(dispatcher) -> None:
-    """One line on stderr before the first compilation of a motionhyst kernel."""
+    """One line on stderr before the first compilation of a motionhyst kernel, when stderr
+    is a terminal: a script's or a pipe's stderr gets only what the command says (a refusal
+    stays its one line); the warnings held so far stay held as usual there."""
     if _STATE["announced"]:
         return
     module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
     if not module.startswith(_PACKAGE + "."):
         return
     _STATE["announced"] = True
+    if not _on_terminal(sys.stderr):
+        return
     hook = _STATE.get("before_notice")
     if hook is not None:
         hook()
@@ -474,7 +488,7 @@ def before_notice(hook: Callable[[], None] | None) -> Callable[[], None] | None:
     A command holds its warnings while it checks its input; a compilation on a cold cache
     among its checks takes seconds to minutes, which the user spends reading its notice:
     the warnings held so far are shown before it, not after.  A notice left out
-    (:func:`quiet_compilation`) calls nothing.
+    (:func:`quiet_compilation`, or stderr not a terminal) calls nothing.
 
     Parameters
     ----------
