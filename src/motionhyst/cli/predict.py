@@ -486,8 +486,10 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     try:
         # the link's input without the sensor's white noise, as identify estimates it
         x, noise = estimate_displacement(t, x, periodic=args.periodic)
+        # the link relaxed where the record starts, as identify fits a force-displacement
+        # record (a sensor's zero or a record cut from a run does not load it)
         w = force_from_displacement(system.plant, system.hysteresis, t, x,
-                                    periodic=args.periodic)
+                                    periodic=args.periodic, x_before=float(x[0]))
     except (ValueError, ArithmeticError) as exc:  # a record or model the run refuses
         raise ValueError(f"{args.data}: {exc or type(exc).__name__}") from None
     target.write_csv({"time": t, "force": w}, fmt="%.17g")
@@ -498,7 +500,8 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     if args.json:
         print_json(summary)
         return 0
-    what = "periodic steady state" if args.periodic else "the link relaxed at 0 before it"
+    what = ("periodic steady state" if args.periodic
+            else "the link relaxed at its first displacement")
     print(f"Predicted the force of {sc.source} for the {t.size} displacement samples of "
           f"{args.data} ({what}) -> {args.out}")
     print(f"  force RMS {summary['force_rms']:.4g} N, peak {summary['force_peak']:.4g} N")

@@ -15,7 +15,9 @@ displacement linear in time over the step ``h``), ``v_n`` the velocity by the
 second-order backward difference (stable for a damper of any time constant
 ``c / k``, shorter than a step or not; the rates inside LuGre's force are
 taken alike).  Before the first sample the link is relaxed at ``x = 0``
-(the first velocity ``x_0 / h``).
+(the first velocity ``x_0 / h``), or, for the force, where the caller says
+(``x_before``: ``motionhyst predict`` takes it relaxed at the record's first
+displacement, as a force-displacement fit does).
 
 * Force from displacement (:func:`force_from_displacement`) evaluates the
   right-hand side: one pass of the link's update.
@@ -344,13 +346,13 @@ def displacement_from_force(plant, link: Hysteresis | None, t: ArrayLike, force:
 
 
 def force_from_displacement(plant, link: Hysteresis | None, t: ArrayLike,
-                            displacement: ArrayLike, *, periodic: bool = False
-                            ) -> NDArray[np.float64]:
+                            displacement: ArrayLike, *, periodic: bool = False,
+                            x_before: float = 0.0) -> NDArray[np.float64]:
     """The force that holds a quasi-static plant at a displacement record.
 
     ``u_n = w_n + k x_n + c v_n - f0`` (``v_n`` the second-order backward
-    difference) with ``x_{-1} = 0`` and the link relaxed there (the inverse of
-    :func:`displacement_from_force`).
+    difference) with ``x_{-1} = x_before`` and the link relaxed there, at rest
+    (with ``x_before = 0``, the inverse of :func:`displacement_from_force`).
 
     Parameters
     ----------
@@ -365,6 +367,12 @@ def force_from_displacement(plant, link: Hysteresis | None, t: ArrayLike,
     periodic : bool
         True: `displacement` holds whole periods; the force of the periodic
         steady state (the first period's run forgotten).
+    x_before : float
+        Displacement before the first sample [m], where the link is relaxed and at
+        rest: 0 for a link relaxed at ``x = 0``; the first sample's displacement for
+        a record cut from a run (or read by a sensor with a zero offset) whose link
+        is taken relaxed where the record starts, as a force-displacement fit takes
+        it (``motionhyst predict``).
 
     Returns
     -------
@@ -381,6 +389,10 @@ def force_from_displacement(plant, link: Hysteresis | None, t: ArrayLike,
     ...                             [0.0, 5e-4, 2e-3, 1e-3])
     >>> [round(float(v), 9) for v in u]                 # k x + the link (slips at 10 N)
     [0.0, 5.5, 12.0, 1.0]
+    >>> u = force_from_displacement(QuasiStatic(k=1e3), Jenkins(k=1e4, fc=10.0), t,
+    ...                             [1e-3, 1.5e-3, 3e-3, 2e-3], x_before=1e-3)
+    >>> [round(float(v), 9) for v in u]                 # the link relaxed at 1 mm
+    [1.0, 6.5, 13.0, 2.0]
     """
     tt, x = check_record(t, displacement, what="displacement")
     h = 1.0 / sampling_rate(tt)
@@ -388,7 +400,7 @@ def force_from_displacement(plant, link: Hysteresis | None, t: ArrayLike,
     xs = np.ascontiguousarray(x, dtype=float)
     s = np.array(st.state0, dtype=float)
     s_prev = s.copy()
-    scalars = np.zeros(2)  # (x_prev, dx_prev): relaxed at 0 before the first sample
+    scalars = np.array([float(x_before), 0.0])  # (x_prev, dx_prev): relaxed, at rest
     done = [1]  # samples run, counting the relaxed one before the first
 
     def run() -> NDArray[np.float64]:
