@@ -179,3 +179,20 @@ def test_a_force_displacement_model_predicts_its_own_record_at_the_fit_identify_
     assert fit_rms <= rms <= 1.02 * fit_rms, (rms, fit_rms)
     assert "(the link relaxed at its first displacement)" in out
 
+
+def test_init_from_does_not_switch_a_force_displacement_model_to_the_displacement(
+        capsys, tmp_path, damper):
+    """Review B21 F2: with --init-from the same model and record gave the displacement
+    (header time,displacement, exit 0) where without it they give the force.  The quantity
+    is the model's: --init-from (which sets the state of a displacement predicted from a
+    force) is refused for it, one line, nothing written (--predict displacement asks for
+    the displacement)."""
+    model, _, quake = damper
+    out_csv = tmp_path / "p.csv"
+    rc, out, err = run(capsys, "predict", str(model), str(quake), "--out", str(out_csv),
+                       "--init-from", str(quake))
+    assert rc == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"motionhyst: error: predict: --init-from sets the state "
+                          f"of a displacement predicted from a force; {model} predicts the "
+                          f"force of {quake}'s displacement"), err
+    assert not out_csv.exists()

@@ -427,6 +427,16 @@ def _input_quantity(args: argparse.Namespace, sc, system) -> str:
         if "force" not in names and "displacement" in names:
             raise UsageError(f"motionhyst predict: --init-from applies to a force record (the "
                              f"displacement predicted); {args.data} holds a displacement")
+        ident = sc.model.identification
+        if ("displacement" in names and args.predict is None and ident is not None
+                and ident.record == "force-displacement"):
+            # the quantity predicted is the model's, never switched by an option
+            raise UsageError(f"motionhyst predict: --init-from sets the state of a "
+                             f"displacement predicted from a force; {sc.source} predicts the "
+                             f"force of {args.data}'s displacement (its [identification] "
+                             f"record is force-displacement), from its link relaxed at the "
+                             f"first displacement: leave out --init-from, or give --predict "
+                             f"displacement to predict the displacement from the force")
         return "force"
     if args.predict is not None:
         return "force" if args.predict == "displacement" else "displacement"
