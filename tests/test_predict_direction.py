@@ -196,3 +196,34 @@ def test_init_from_does_not_switch_a_force_displacement_model_to_the_displacemen
                           f"of a displacement predicted from a force; {model} predicts the "
                           f"force of {quake}'s displacement"), err
     assert not out_csv.exists()
+
+
+def test_a_record_cut_from_a_run_has_no_damper_spike_at_its_first_sample(capsys, tmp_path):
+    """Review B21 F9: the middle of a damper's record (it starts 2 cm from 0) was predicted
+    from the link relaxed at x = 0, a jump of the whole offset in one sample: a damper's
+    force c x0 / h at sample 0 several times the record's peak (review: 3238 N for a 600 N
+    damper).  Now the link starts relaxed at the first displacement: the prediction's peak
+    is the record's, within the share the unknown start state of its link can add."""
+    from records_of_other_kinds import earthquake_like
+
+    from motionhyst.time.quasi_static import force_from_displacement
+
+    plant, link = QuasiStatic(k=5.0e4, c=2.0e3), Jenkins(k=1.5e6, fc=3.0e3)
+    t = np.arange(8000) / 200.0
+    x = earthquake_like(t, np.random.default_rng(4), 0.02)
+    x += 0.02 - x[4000]  # the cut starts 2 cm away from the run's start
+    force = force_from_displacement(plant, link, t, x)
+    cut = tmp_path / "cut.csv"
+    np.savetxt(cut, np.column_stack([t[4000:], x[4000:]]), delimiter=",",
+               header="time,displacement", comments="")
+    model = tmp_path / "damper.toml"
+    model.write_text('[stage]\ntype = "quasi-static"\nk = 5e4\nc = 2e3\n[hysteresis]\n'
+                     'model = "jenkins"\nk = 1.5e6\nfc = 3e3\n')
+    out_csv = tmp_path / "f.csv"
+    rc, out, err = run(capsys, "predict", str(model), str(cut), "--out", str(out_csv))
+    assert rc == 0 and "(the link relaxed at its first displacement)" in out, err
+    predicted = np.loadtxt(out_csv, delimiter=",", skiprows=1)[:, 1]
+    true_peak = float(np.max(np.abs(force[4000:])))
+    # the link's unknown start adds at most its slip force 2 fc to any sample
+    assert float(np.max(np.abs(predicted))) <= true_peak + 2 * link.fc
+    assert float(np.max(np.abs(predicted - force[4000:]))) <= 2 * link.fc
