@@ -142,7 +142,11 @@ CASES = [
     ("init-from-a-folder", {"d/x.csv": "1"}, [*PREDICT, "--init-from", "d"], ["it is a folder"]),
     ("init-from-window-past-the-record", {},
      [*PREDICT, "--init-from", "axis.csv", "--init-window", "100000"],
-     ["no more than the initialisation window of 100000"]),
+     ["fewer than twice the initialisation window of 100000"]),
+    # review B21 F16: a window leaving one sample scored it at "fit -inf %", exit 0
+    ("init-from-window-leaving-one-sample", {},
+     [*PREDICT, "--init-from", "axis.csv", "--init-window", "599"],
+     ["the record has 600 samples, fewer than twice the initialisation window of 599"]),
     # ------------------------------------------------------------------- periodic records
     ("periodic-three-samples", {"r.csv": "time,force,displacement\n0,1,0\n0.001,2,0.1\n"
                                          "0.002,1,0\n"},

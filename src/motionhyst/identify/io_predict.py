@@ -337,9 +337,10 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     y = np.asarray(displacement, dtype=float)
     if y.shape != tt.shape or not np.all(np.isfinite(y)):
         raise ValueError("the measured position must be finite and as long as the force")
-    if tt.size <= window:
-        raise ValueError(f"the record has {tt.size} samples, no more than the initialisation "
-                         f"window of {window}")
+    if tt.size < 2 * window:  # a score of one sample (no spread) was "fit -inf %"
+        raise ValueError(f"the record has {tt.size} samples, fewer than twice the "
+                         f"initialisation window of {window} (the error is scored on at least "
+                         f"as many samples after it as set the state)")
     if system.hysteresis is not None and not hasattr(system.hysteresis, "time_stepping"):
         raise ValueError("this link cannot be simulated")
     fs = sampling_rate(tt)
