@@ -128,6 +128,7 @@ def run(args: argparse.Namespace) -> int:
                              f"of {args.data} (the same time column)")
         _check_same_run(args, u, rec.u)
     u_model, noise = u, None
+    zero = 0.0 if rec is not None else _position_offset(sc, system)
     release_held()  # the run starts: the warnings so far are shown
     try:
         if not system.plant.has_inertia:  # the link's input without the load cell's white
@@ -143,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
             out_t, out_y = pred.t, pred.displacement
         else:
             out = system.simulate(t, u_model, periodic=args.periodic, substeps=args.substeps)
-            out_t, out_y = out.t, out.displacement
+            out_t, out_y = out.t, out.displacement + zero
     except StepNotConverged as exc:  # the library's remedy names its argument
         raise ValueError(f"{args.data}: {exc.what}; give more --substeps") from None
     except (ValueError, ArithmeticError) as exc:  # a model the simulation refuses
@@ -156,6 +157,8 @@ def run(args: argparse.Namespace) -> int:
                "displacement_peak": float(np.max(np.abs(out_y)))}
     if pred is not None:
         summary.update(pred.to_dict())
+    else:
+        summary["position_offset"] = zero
     if noise is not None:
         summary["force_noise"] = noise.to_dict()
     if args.json:
@@ -167,6 +170,8 @@ def run(args: argparse.Namespace) -> int:
               f"samples of {args.data} -> {args.out}")
         print(f"  displacement RMS {summary['displacement_rms']:.4g} m, peak "
               f"{summary['displacement_peak']:.4g} m")
+        if zero:
+            print(f"  {_offset_text(zero)}")
         if pred is not None:
             print(f"  initial position {pred.initial_state['position']:.6g} m, velocity "
                   f"{pred.initial_state['velocity']:.6g} m/s; RMS error from sample {window + 1} "
@@ -176,6 +181,22 @@ def run(args: argparse.Namespace) -> int:
         if noise is not None and noise.sigma > 0:
             print(f"  force: {noise.reason}")
     return 0
+
+
+def _position_offset(sc, system) -> float:
+    """The zero of the position sensor a model without inertia was identified with (its
+    ``[identification] position_offset``, written by ``identify --save``) [m]; 0 for a model
+    with inertia or one that does not give it."""
+    ident = sc.model.identification
+    if system.plant.has_inertia or ident is None or ident.position_offset is None:
+        return 0.0
+    return float(ident.position_offset)
+
+
+def _offset_text(zero: float) -> str:
+    """What the output says of the position offset it applied."""
+    return (f"position offset {zero:.6g} m (the sensor's zero the model was identified with, "
+            f"its [identification] position_offset)")
 
 
 def _check_unread(args: argparse.Namespace, system) -> None:
@@ -486,6 +507,8 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
                        columns=_without(args.columns, "force"),
                        scale=_without(args.scale, "force"))
     t, x = data[:, 0], data[:, 1]
+    zero = _position_offset(sc, system)
+    x = x - zero  # the link's displacement: the record's less its sensor's zero
     _check_force_memory([t.size])
     target.check_csv_size(t.size, 2, "%.17g", remedy=SHORTER)
     if args.periodic:
@@ -506,7 +529,7 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "predicted": "force", "force_rms": float(np.sqrt(np.mean(w ** 2))),
                "force_peak": float(np.max(np.abs(w))),
-               "displacement_noise": noise.to_dict()}
+               "displacement_noise": noise.to_dict(), "position_offset": zero}
     if args.json:
         print_json(summary)
         return 0
@@ -515,6 +538,8 @@ def _predict_force(args: argparse.Namespace, sc, system, target) -> int:
     print(f"Predicted the force of {sc.source} for the {t.size} displacement samples of "
           f"{args.data} ({what}) -> {args.out}")
     print(f"  force RMS {summary['force_rms']:.4g} N, peak {summary['force_peak']:.4g} N")
+    if zero:
+        print(f"  {_offset_text(zero)}")
     if noise.sigma > 0:
         print(f"  displacement: {noise.reason}")
     return 0

@@ -218,7 +218,13 @@ class IOIdentification:
         for name, values in self.extra.get("initial_state", {}).items():
             lines.append(f"# initial state {name} of each record: "
                          f"{', '.join(f'{v:.6g}' for v in values)}")
-        if (offsets or self.extra.get("initial_state")) and self.output != "force":
+        # a model without inertia rests where its sensor reads this zero: predict applies it
+        zero = (float(np.mean(offsets)) if any(offsets) and self.output != "force"
+                and not self.plant.has_inertia else None)
+        if zero is not None:
+            lines.append("# (motionhyst predict applies [identification] position_offset, their "
+                         "mean; --init-from REC sets it from a record's first samples)")
+        elif (offsets or self.extra.get("initial_state")) and self.output != "force":
             lines.append("# (motionhyst predict --init-from REC sets both from a record's first "
                          "samples)")
         stage, link = self.plant.to_dict(), self.hysteresis.to_dict()
@@ -234,7 +240,8 @@ class IOIdentification:
                    if isinstance(v, list) for i in range(len(v))}}
         ident = identification_toml(self.extra.get("covariance", {}), self.estimates, keys,
                                     "force-displacement" if self.output == "force"
-                                    else "input-output", lower_bound=self.extra.get("std_note"))
+                                    else "input-output", lower_bound=self.extra.get("std_note"),
+                                    position_offset=zero)
         return text + ("\n" + ident if ident else "")
 
 

@@ -499,7 +499,8 @@ def covariance_table(names: list[str], cov: NDArray[np.float64],
 
 
 def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str, str],
-                        record: str | None = None, lower_bound: str | None = None) -> str:
+                        record: str | None = None, lower_bound: str | None = None,
+                        position_offset: float | None = None) -> str:
     """The ``[identification]`` table of a saved identification (TOML): the kind of `record`
     it was identified from (what ``predict`` predicts), the parameters of the covariance
     `table` (:func:`covariance_table`) that `keys` maps to scenario keys, under those keys,
@@ -511,11 +512,14 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
     outside the magnitudes a scenario accepts); correlations are rounded to 1e-12.  With
     `lower_bound` (why they are lower bounds:
     :func:`~motionhyst.identify.residual_noise.lower_bound_note`) a comment says it, and that
-    a study drawn from them understates the spread.
+    a study drawn from them understates the spread.  A `position_offset` [m] (the position
+    sensor's zero that ``predict`` applies) is written after the kind.
     """
     names = [n for n in table.get("parameters", []) if n in keys]
+    head = ("" if record is None else f"record = {json.dumps(record)}\n") + (
+        "" if position_offset is None else f"position_offset = {float(position_offset)!r}\n")
     if not names:  # the record's kind alone: what predict predicts
-        return "" if record is None else f"[identification]\nrecord = {json.dumps(record)}\n"
+        return f"[identification]\n{head}" if head else ""
     where = [table["parameters"].index(n) for n in names]
     cov = np.array(table["matrix"], dtype=float)[np.ix_(where, where)]
     std = np.sqrt(np.diag(cov))
@@ -529,9 +533,8 @@ def identification_toml(table: dict, estimates: dict[str, float], keys: dict[str
     bound = "".join(f"# {line}\n" for line in said) if lower_bound else ""
     return ("# the estimates' standard errors and correlations (from the fit's Jacobian) for a "
             "Monte-Carlo\n# study: motionhyst study STUDY.toml --from-identification "
-            f"THIS_FILE\n{bound}[identification]\n"
-            + ("" if record is None else f"record = {json.dumps(record)}\n")
-            + f"parameters = [{', '.join(json.dumps(keys[n]) for n in names)}]\n"
+            f"THIS_FILE\n{bound}[identification]\n{head}"
+            f"parameters = [{', '.join(json.dumps(keys[n]) for n in names)}]\n"
             f"estimates = [{', '.join(repr(float(estimates[n])) for n in names)}]\n"
             f"std = [{', '.join(repr(float(v)) for v in std)}]\n"
             f"correlation = [\n{rows}]\n")

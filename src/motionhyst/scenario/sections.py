@@ -535,9 +535,15 @@ class IdentificationSection(_Section):
     ``record`` is the kind of record the model was identified from: ``motionhyst predict``
     predicts what that record measured (a force-displacement record's force from a
     displacement, an input-output record's position from a force); a model none of whose
-    standard errors the records determine holds ``record`` alone (no parameters)."""
+    standard errors the records determine holds ``record`` alone (no parameters).
+    ``position_offset`` [m] is the zero of the position sensor of the record(s) a model
+    without inertia was identified from (an input-output record's estimated output offset, the
+    mean of several records'): ``motionhyst predict`` adds it to a position it predicts and
+    subtracts it from a displacement record it predicts the force of (a held-out part of the
+    same run has the same sensor); ``predict --init-from`` sets it from the record instead."""
 
     record: Literal["force-displacement", "input-output"] | None = None
+    position_offset: Annotated[float, Field(allow_inf_nan=False)] | None = None
     parameters: list[str] = []
     estimates: list[Annotated[float, Field(allow_inf_nan=False)]] = []
     std: list[NonNegativeFloat] = []
