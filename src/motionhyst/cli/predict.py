@@ -149,7 +149,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"{args.data}: {exc.what}; give more --substeps") from None
     except (ValueError, ArithmeticError) as exc:  # a model the simulation refuses
         raise ValueError(f"{args.data}: {exc or type(exc).__name__}") from None
-    _warn_loaded_start(args, system, u)  # a prediction made: a refusal stays one line
+    if pred is None or "link_state" not in pred.initial_state:  # else set from the window
+        _warn_loaded_start(args, system, u)  # a prediction made: a refusal stays one line
     target.write_csv({"time": out_t, "displacement": out_y}, fmt="%.17g")
     summary = {"out": str(args.out), "samples": int(t.size), "periodic": bool(args.periodic),
                "predicted": "displacement",
@@ -176,6 +177,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"  initial position {pred.initial_state['position']:.6g} m, velocity "
                   f"{pred.initial_state['velocity']:.6g} m/s; RMS error from sample {window + 1} "
                   f"on {pred.rmse:.4g} m (fit {pred.fit_percent:.2f} %)")
+            if "link_state" in pred.initial_state:
+                print(f"  the link's state at the first sample set from the window too "
+                      f"({', '.join(f'{v:.6g}' for v in pred.initial_state['link_state'])})")
             if pred.floor_text():
                 print(f"  ({pred.floor_text()})")
         if noise is not None and noise.sigma > 0:
@@ -371,8 +375,10 @@ def _warn_loaded_start(args: argparse.Namespace, system, u) -> None:
         where = (f", {abs(start - rest):.4g} N ({share}) from where the model rests ({rest:.4g} "
                  f"N, its force offset)" if offset else f" ({share} from where the model rests, "
                  f"0 N)")
+        why = (" (--init-from sets the state of a link of one element; how the force splits "
+               "among several needs the record's history)" if args.init_from else "")
         warn(f"{args.data} starts under load, at {start:.4g} N{where}: a model without inertia "
-             f"starts its link relaxed, not where on its loops the part of a longer run "
+             f"starts its link relaxed{why}, not where on its loops the part of a longer run "
              f"begins, and may miss by the loops' width; predict the record from its start (or "
              f"a record that starts at rest)")
 

@@ -32,8 +32,8 @@ from motionhyst.time.openloop import (
 from motionhyst.time.resample import fine_blocks, held_nodes
 
 __all__ = ["INIT_WINDOW", "WINDOW_NODE_BYTES", "WINDOW_RUN_SAMPLE_BYTES", "WINDOW_SAMPLE_BYTES",
-           "WindowPrediction", "predict_from_window", "run_from_state", "state_from_window",
-           "window_memory", "window_noise_floor"]
+           "WindowPrediction", "link_state_from_window", "predict_from_window", "run_from_state",
+           "state_from_window", "window_memory", "window_noise_floor"]
 
 #: The benchmark's initialisation window [samples]
 INIT_WINDOW = 20
@@ -294,8 +294,11 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     """Simulate a record from its force, the initial state set from its first samples.
 
     A plant without inertia (:class:`~motionhyst.plants.quasi_static.QuasiStatic`)
-    has no state but its link's, relaxed at the start: the window sets only the
-    position's offset (reported as the initial position, velocity 0).
+    has no state but its link's: the window sets the position's offset (reported as
+    the initial position, velocity 0) and, for a link of one element (Bouc-Wen, Dahl,
+    LuGre, Jenkins), the element's state and the displacement before the first sample
+    (:func:`link_state_from_window`); the elements of a Maxwell-slip link start
+    relaxed (how the force splits among them needs the record's history).
 
     Parameters
     ----------
@@ -344,10 +347,8 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     if system.hysteresis is not None and not hasattr(system.hysteresis, "time_stepping"):
         raise ValueError("this link cannot be simulated")
     fs = sampling_rate(tt)
-    if not system.plant.has_inertia:  # no state but the link's: only the position's offset
-        x = system.simulate(tt, u).displacement
-        position = float(np.mean(y[:window] - x[:window]))
-        return _scored(tt, x + position, y, window, position, 0.0)
+    if not system.plant.has_inertia:  # no state but the link's, and the position's offset
+        return _quasi_static_from_window(system, tt, u, y, window)
     r = substeps or system.default_substeps(fs)
     u = u + float(getattr(system.plant, "force_drift", 0.0)) * tt  # a drifting force offset
     mech = system.plant.mechanics()
@@ -362,6 +363,100 @@ def predict_from_window(system: OpenLoop, t, force, displacement,
     pred.noise = math.sqrt(white_noise_variance([yhat - y]))
     pred.noise_floor = window_noise_floor(mech, st, k_link, u, fs, r, position, velocity, yhat,
                                           window, pred.noise)
+    return pred
+
+
+def link_state_from_window(system: OpenLoop, t, u, y, window: int = INIT_WINDOW
+                           ) -> tuple[float, float, NDArray[np.float64] | None]:
+    """The position offset, the displacement before the first sample and the link's state
+    there that best explain the first `window` positions of a model without inertia.
+
+    Without inertia the window's forces and positions fix the link's force at each of its
+    samples (``w = u + f0 - k x - c x'``); a link of one element (its state one number) is
+    set by least squares of the run over the window, with the position offset and the
+    displacement before the first sample (the first velocity).  A link of several
+    elements (Maxwell-slip) keeps them relaxed at the offset: how the force splits among
+    them needs the record's history, not its window.
+
+    Parameters
+    ----------
+    system : OpenLoop
+        A quasi-static plant and its link.
+    t, u, y : ndarray
+        The record's time [s], force [N] and measured position [m].
+    window : int
+        Samples that set the state, at least 2.
+
+    Returns
+    -------
+    position : float
+        The position offset [m] (the sensor's reading where the model is at 0).
+    x_before : float
+        The model's displacement before the first sample [m].
+    states : ndarray or None
+        The link's element states there (None: relaxed, several elements or none).
+
+    Examples
+    --------
+    A Dahl damper cut from a longer run, loaded at its first sample:
+
+    >>> from motionhyst.hysteresis import Dahl
+    >>> from motionhyst.plants import QuasiStatic
+    >>> from motionhyst.time.quasi_static import displacement_from_force
+    >>> system = OpenLoop(QuasiStatic(k=1e4, c=50.0), Dahl(k=3e5, fc=300.0))
+    >>> t = np.arange(400) / 1000.0
+    >>> u = 400.0 + 300.0 * np.sin(2 * np.pi * 3 * t)
+    >>> x = displacement_from_force(system.plant, system.hysteresis, t, u,
+    ...                             initial=(0.03, [0.6]))
+    >>> p, xb, s = link_state_from_window(system, t, u, x + 1e-3)
+    >>> round(p * 1e3, 6), round(xb * 1e3, 4), round(float(s[0]), 6)
+    (1.0, 30.0, 0.6)
+    """
+    from motionhyst.time.quasi_static import displacement_from_force
+
+    x = displacement_from_force(system.plant, system.hysteresis, t, u)
+    position = float(np.mean(y[:window] - x[:window]))
+    st = None if system.hysteresis is None else system.hysteresis.time_stepping()
+    if st is None or st.codes.size != 1:
+        return position, 0.0, None
+    yw, tw, uw = y[:window], t[:window], u[:window]
+    scale = max(float(np.ptp(yw)), 1e-12 * max(1.0, abs(float(yw[0]))), 1e-15)
+
+    def res(p):
+        with np.errstate(all="ignore"):
+            try:
+                xw = displacement_from_force(system.plant, system.hysteresis, tw, uw,
+                                             initial=(p[1], p[2:]))
+            except ValueError:  # a state whose force the link does not hold
+                return np.full(window, 1e6)
+            r = (xw + p[0] - yw) / scale
+        return np.where(np.isfinite(r), r, 1e6)
+
+    start = [position, float(yw[0]) - position - float(yw[1] - yw[0]),
+             *np.asarray(st.state0, dtype=float)]
+    sol = least_squares(res, start, x_scale="jac")
+    if not sol.cost < 0.5 * float(res(start) @ res(start)):  # no better than relaxed
+        return position, 0.0, None
+    return float(sol.x[0]), float(sol.x[1]), np.asarray(sol.x[2:], dtype=float)
+
+
+def _quasi_static_from_window(system: OpenLoop, tt, u, y, window: int) -> WindowPrediction:
+    """:func:`predict_from_window` for a model without inertia (its link's state set from
+    the window: :func:`link_state_from_window`)."""
+    from motionhyst.time.quasi_static import displacement_from_force
+
+    u = u + float(getattr(system.plant, "force_drift", 0.0)) * tt  # as OpenLoop.simulate
+    position, x_before, states = link_state_from_window(system, tt, u, y, window)
+    start = float(np.median(u[:10])) + float(system.plant.force_offset)
+    if abs(start) <= 0.05 * float(np.ptp(u)):  # starts where the model rests: relaxed
+        x = displacement_from_force(system.plant, system.hysteresis, tt, u)
+        position = float(np.mean(y[:window] - x[:window]))
+        return _scored(tt, x + position, y, window, position, 0.0)
+    initial = None if states is None else (x_before, states)
+    x = displacement_from_force(system.plant, system.hysteresis, tt, u, initial=initial)
+    pred = _scored(tt, x + position, y, window, position, 0.0)
+    if states is not None:
+        pred.initial_state["link_state"] = [float(v) for v in states]
     return pred
 
 

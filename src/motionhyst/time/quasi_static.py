@@ -265,7 +265,9 @@ def _link_stiffness(link: Hysteresis | None) -> float:
 
 
 def displacement_from_force(plant, link: Hysteresis | None, t: ArrayLike, force: ArrayLike, *,
-                            periodic: bool = False) -> NDArray[np.float64]:
+                            periodic: bool = False,
+                            initial: tuple[float, ArrayLike] | None = None
+                            ) -> NDArray[np.float64]:
     """The displacement where a quasi-static plant's link balances a force record.
 
     Parameters
@@ -283,6 +285,10 @@ def displacement_from_force(plant, link: Hysteresis | None, t: ArrayLike, force:
         False: from the link relaxed at ``x = 0`` before the first sample.
         True: `force` holds whole periods; the periodic steady state (periods
         repeated until the displacement repeats).
+    initial : (float, array_like), optional
+        Not periodic: the displacement before the first sample [m] and the link's element
+        states there (``Stepping.state0``'s layout; default ``(0, state0)``, relaxed at 0): a
+        record cut from a longer run.
 
     Returns
     -------
@@ -318,8 +324,9 @@ def displacement_from_force(plant, link: Hysteresis | None, t: ArrayLike, force:
     st, k, c, f0 = _parts(plant, link)
     slope = k + c / h + _link_stiffness(link)
     uf = np.ascontiguousarray(u + f0, dtype=float)
-    state = [np.array(st.state0, dtype=float), np.array(st.state0, dtype=float),
-             np.array([0.0, 0.0, 1.0])]
+    x_before, s0 = (0.0, st.state0) if initial is None else initial
+    s0 = np.array(s0, dtype=float).reshape(np.shape(st.state0))
+    state = [s0, s0.copy(), np.array([float(x_before), 0.0, 1.0])]
 
     def run() -> NDArray[np.float64]:
         x = quasi_static_run(st.codes, st.params, state[0], state[1], state[2], uf, k, c, h,
