@@ -4,6 +4,8 @@ split in one process, and every figure is the one the fits give in one process, 
 digit."""
 
 import math
+import multiprocessing
+import time
 
 import numpy as np
 import pytest
@@ -67,3 +69,24 @@ def test_a_task_that_raises_ends_the_map_with_its_exception():
     with pytest.raises(ValueError, match="math domain error"):
         map_in_workers(math.sqrt, [4.0, -1.0, 9.0], workers=2)
     assert map_in_workers(math.sqrt, [4.0, 9.0, 16.0], workers=2) == [2.0, 3.0, 4.0]
+
+
+def _sleep_or_raise(task):
+    """A task that sleeps `task` seconds, or raises for ``"raise"``."""
+    if task == "raise":
+        raise ValueError("the task failed")
+    time.sleep(task)
+    return task
+
+
+def test_a_task_that_raises_stops_the_workers_still_running():
+    """The map ends with the first error at once: the worker still sleeping through its
+    10-minute task is stopped, not waited for (before, leaving the pool waited for every
+    running chain: Ctrl-C or SIGTERM on ``benchmark emps`` took minutes to exit)."""
+    before = set(multiprocessing.active_children())
+    with pytest.raises(ValueError, match="the task failed"):
+        map_in_workers(_sleep_or_raise, [600.0, "raise"], workers=2)
+    workers = set(multiprocessing.active_children()) - before
+    for worker in workers:
+        worker.join(30.0)
+    assert not any(worker.is_alive() for worker in workers)

@@ -48,7 +48,8 @@ def map_in_workers(work: Callable[[Any], Any], tasks: Sequence[Any], workers: in
     The workers are forked from this process (they see its modules as they are, its
     settings included); where the system cannot fork, or with one worker or one task, the
     tasks run here one after another.  The first task that raises ends the map with its
-    exception once the tasks already running have ended (those not started are not).
+    exception, and so does an interrupt (Ctrl-C, SIGTERM) here: the tasks not started are
+    not, and the workers still running one are stopped at once.
 
     Parameters
     ----------
@@ -85,8 +86,10 @@ def map_in_workers(work: Callable[[Any], Any], tasks: Sequence[Any], workers: in
                 finished(i, out[-1])
         return out
     results: list[Any] = [None] * len(tasks)
-    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)),
-                             mp_context=multiprocessing.get_context("fork")) as pool:
+    before = set(multiprocessing.active_children())
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)),
+                               mp_context=multiprocessing.get_context("fork"))
+    try:
         index = {}
         for i, task in enumerate(tasks):
             index[pool.submit(_guarded, work, task, guard)] = i
@@ -97,12 +100,16 @@ def map_in_workers(work: Callable[[Any], Any], tasks: Sequence[Any], workers: in
             done, pending = wait(pending, return_when=FIRST_EXCEPTION)
             for future in sorted(done, key=index.__getitem__):
                 if future.exception() is not None:
-                    for other in pending:
-                        other.cancel()
                     raise future.exception()
                 results[index[future]] = future.result()
                 if finished is not None:
                     finished(index[future], results[index[future]])
+    except BaseException:  # a task's error, Ctrl-C or SIGTERM: the workers end now
+        pool.shutdown(wait=False, cancel_futures=True)
+        for worker in set(multiprocessing.active_children()) - before:
+            worker.terminate()
+        raise
+    pool.shutdown()
     return results
 
 
