@@ -9,7 +9,7 @@ slip force run away to 5.6e12 N, refused by
 asks the records first: a linear mass-spring-damper is fitted to them by simulation error
 (each record's force offset, initial position and velocity and position offset projected
 out, :func:`linear_stage_error`); when it leaves no more than :data:`NOISE_SHARE` times the
-records' white noise (:func:`~motionhyst.identify.residual_noise.white_noise_variance`), no
+white noise of its residual (:func:`~motionhyst.identify.residual_noise.white_noise_variance`), no
 slip is in them and the fit is refused in one line, before the search.  A record with a
 slip at the noise's level or below is left to the search and its judgement afterwards.
 """
@@ -48,6 +48,21 @@ def _responses(m: float, c: float, k: float, rec: IORecord) -> NDArray[np.float6
                             np.ones(n)])
 
 
+def _stage_residuals(m: float, c: float, k: float, records: list[IORecord]
+                     ) -> list[NDArray[np.float64]] | None:
+    """Each record's position less the linear stage's simulation (its force offset, initial
+    state and position offset projected out); None if the stage does not run."""
+    out = []
+    for rec in records:
+        cols = _responses(m, c, k, rec)
+        if not np.all(np.isfinite(cols)):
+            return None
+        rest = rec.y - cols[:, 0]
+        x = np.linalg.lstsq(cols[:, 1:], rest, rcond=None)[0]
+        out.append(rest - cols[:, 1:] @ x)
+    return out
+
+
 def linear_stage_error(records: list[IORecord], start: tuple[float, float, float]
                        ) -> tuple[tuple[float, float, float], float]:
     """The mass-spring-damper ``1 / (m s^2 + c s + k)`` that fits the records best by
@@ -83,16 +98,10 @@ def linear_stage_error(records: list[IORecord], start: tuple[float, float, float
     scale = float(np.sqrt(np.mean(np.concatenate([rec.y for rec in records]) ** 2))) or 1.0
 
     def residual(logp: NDArray[np.float64]) -> NDArray[np.float64]:
-        m, c, k = np.exp(logp)
-        out = []
-        for rec in records:
-            cols = _responses(m, c, k, rec)
-            if not np.all(np.isfinite(cols)):  # a stage that does not run: no fit there
-                return np.full(sum(r.y.size for r in records), 1e6)
-            rest = rec.y - cols[:, 0]
-            x = np.linalg.lstsq(cols[:, 1:], rest, rcond=None)[0]
-            out.append((rest - cols[:, 1:] @ x) / scale)
-        r = np.concatenate(out)
+        parts = _stage_residuals(*np.exp(logp), records)
+        if parts is None:  # a stage that does not run: no fit there
+            return np.full(sum(r.y.size for r in records), 1e6)
+        r = np.concatenate(parts) / scale
         return np.where(np.isfinite(r), r, 1e6)
 
     x0 = np.log(np.maximum(np.asarray(start, dtype=float), 1e-12))
@@ -143,11 +152,15 @@ def check_link_slips(records: list[IORecord], link: str, stage_k: bool) -> None:
     from motionhyst.identify.io_checks import FitFailed
     from motionhyst.identify.io_start import inverse_dynamics
 
-    noise = math.sqrt(white_noise_variance([rec.y for rec in records]))
     idim = inverse_dynamics(records, floating=False)
     start = (idim["m"] if idim["m"] > 0 else 1.0, idim["c"] if idim["c"] > 0 else 1.0,
              idim["k"] if idim.get("k", 0.0) > 0 else 1.0)
     (m, c, k), rms = linear_stage_error(records, start)
+    # the noise of the fit's residual, not of the position: a record's own fast motion (a
+    # resonance in band, a force of broad band) is no noise, and would hide a small slip
+    parts = _stage_residuals(m, c, k, records)
+    noise = math.sqrt(white_noise_variance(parts if parts is not None
+                                           else [rec.y for rec in records]))
     if not rms <= NOISE_SHARE * noise:
         return
     half = max(0.5 * float(np.ptp(rec.y)) for rec in records)
