@@ -346,31 +346,21 @@ def _centred(u, ok, line: bool):
     return x - (float(k @ x) / kk) * k if kk > 0 else x
 
 
-LOADED_START = 0.05
-"""A model without inertia whose force record starts farther than this share of the force's
-range from the model's rest (``-f0``, its force offset) starts under a load whose link state
-is not known: the later half of a piezo's record, predicted from its link relaxed at its
-first sample, scored 0.5 % (from the whole record's history: 98.9 %)."""
-
-LOADED_START_SAMPLES = 10
-"""The first samples of a force record whose median is where it starts
-(:data:`LOADED_START`): one sample's noise or spike does not decide."""
-
-
 def _warn_loaded_start(args: argparse.Namespace, system, u) -> None:
     """Warn when a model without inertia is run from a force record that starts under load
-    (:data:`LOADED_START`, from the median of its first :data:`LOADED_START_SAMPLES`): its
-    link starts relaxed there, where the force balances the model's offset alone, which a
-    record cut from a longer run does not."""
+    (:func:`~motionhyst.identify.io_predict.start_load`): its link starts relaxed there,
+    where the force balances the model's offset alone, which a record cut from a longer run
+    does not."""
     from motionhyst.core.warnings import warn
+    from motionhyst.identify.io_predict import start_load
 
     if system.plant.has_inertia or system.hysteresis is None or args.periodic:
         return  # a periodic steady state has no start
-    start = float(np.median(u[:LOADED_START_SAMPLES]))
     offset = float(getattr(system.plant, "force_offset", 0.0))
     rest = -offset if offset else 0.0  # u + f0 = w(y) + k y + c y': at rest u = -f0
-    span = float(np.ptp(u))
-    if span > 0 and abs(start - rest) > LOADED_START * span:
+    away = start_load(u, offset)
+    if away is not None:
+        start, span = rest + away, float(np.ptp(u))
         share = f"{100 * abs(start - rest) / span:.0f} % of its force's range"
         where = (f", {abs(start - rest):.4g} N ({share}) from where the model rests ({rest:.4g} "
                  f"N, its force offset)" if offset else f" ({share} from where the model rests, "
