@@ -253,6 +253,8 @@ class _Interrupts:
         # swallowed there with a traceback on stderr and the work goes on: noted, not shown,
         # and the signal sent again a moment later, when the callback has returned
         if os.getpid() != self.pid or not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            if os.getpid() == self.pid and self.received:  # after a signal: what it left
+                return  # half-built (_finalisers_silent)
             self.hook(unraisable)
             return
         name = str(unraisable.exc_value.args[0]) if unraisable.exc_value.args else ""
@@ -291,6 +293,14 @@ class _Interrupts:
                 signal.signal(sig, signal.SIG_IGN if ignore else previous)
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self.hook
+        if ignore and self.received:  # an interrupted command's last moments: a finaliser of
+            sys.unraisablehook = _finalisers_silent  # what the signal left half-built raises
+
+
+def _finalisers_silent(unraisable) -> None:
+    """An interrupted command exits 130 with one line: the errors Python cannot raise as
+    it ends (a finaliser of an object the signal left half-built, llvmlite's compiler's
+    when it came while a kernel compiled) are not shown."""
 
 
 class _NamedOutput:
